@@ -1,0 +1,20 @@
+#pragma once
+// Exceptions for what a user can cause. Internal invariants use assert instead.
+#include <stdexcept>
+#include <string>
+
+namespace geode {
+
+// Bad input: a malformed file, an out-of-range index, an unknown option value. The message
+// names the file (or argument), the line or element, and the reason.
+struct InvalidInput : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Input that is well-formed but topologically unusable: a non-conforming interface, an
+// arrangement that is not in general position, a cell that is not a ball.
+struct TopologyError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+}  // namespace geode
