@@ -1,0 +1,158 @@
+#include "support/fixtures.hpp"
+
+#include <algorithm>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <vector>
+
+#include "primal/errors.hpp"
+#include "primal/topology.hpp"
+
+namespace geode::test {
+namespace {
+
+[[noreturn]] void fail(const std::string& file, int line, const std::string& why) {
+  throw InvalidInput(file + ":" + std::to_string(line) + ": " + why);
+}
+
+// Splits one CSV line on commas; each field must parse completely as a number.
+std::vector<double> parse_row(const std::string& text, const std::string& file, int line,
+                              std::size_t fields) {
+  std::vector<double> out;
+  std::stringstream ss(text);
+  std::string field;
+  while (std::getline(ss, field, ',')) {
+    std::size_t used = 0;
+    double value = 0.0;
+    try {
+      value = std::stod(field, &used);
+    } catch (const std::exception&) {
+      fail(file, line, "field '" + field + "' is not a number");
+    }
+    while (used < field.size() && (field[used] == ' ' || field[used] == '\r')) ++used;
+    if (used != field.size()) fail(file, line, "field '" + field + "' is not a number");
+    out.push_back(value);
+  }
+  if (out.size() != fields) {
+    fail(file, line, "expected " + std::to_string(fields) + " fields, got " +
+                         std::to_string(out.size()));
+  }
+  return out;
+}
+
+std::vector<std::vector<double>> read_rows(const std::string& file, std::size_t fields) {
+  std::ifstream in(file);
+  if (!in) throw InvalidInput(file + ": cannot open");
+  std::string text;
+  std::vector<std::vector<double>> rows;
+  int line = 0;
+  while (std::getline(in, text)) {
+    ++line;
+    if (line == 1) continue;  // header
+    if (text.find_first_not_of(" \r\t") == std::string::npos) continue;
+    rows.push_back(parse_row(text, file, line, fields));
+    // Rows are numbered 1..N in order; the number is the first field.
+    if (rows.back()[0] != static_cast<double>(rows.size())) {
+      fail(file, line, "row number " + std::to_string(rows.back()[0]) + ", expected " +
+                           std::to_string(rows.size()));
+    }
+  }
+  return rows;
+}
+
+}  // namespace
+
+primal::HexMesh read_hex_csv(const std::string& nodes_csv, const std::string& hexes_csv) {
+  primal::HexMesh mesh;
+  for (const auto& r : read_rows(nodes_csv, 4)) mesh.points.emplace_back(r[1], r[2], r[3]);
+  const auto rows = read_rows(hexes_csv, 9);
+  for (std::size_t h = 0; h < rows.size(); ++h) {
+    std::array<primal::Index, 8> hex{};
+    for (int c = 0; c < 8; ++c) {
+      const double n = rows[h][c + 1];
+      if (n != static_cast<double>(static_cast<long>(n)) || n < 1 ||
+          n > static_cast<double>(mesh.points.size())) {
+        fail(hexes_csv, static_cast<int>(h) + 2,
+             "hex " + std::to_string(h + 1) + " corner n" + std::to_string(c + 1) +
+                 " is not a node number in 1.." + std::to_string(mesh.points.size()));
+      }
+      hex[c] = static_cast<primal::Index>(n) - 1;  // paper order is VTK order; see header
+    }
+    mesh.hexes.push_back(hex);
+  }
+  return mesh;
+}
+
+primal::HexMesh appendix_a_geode() {
+  const std::string dir = std::string(GEODE_SOURCE_DIR) + "/notebooks-data/appendix-a/";
+  return read_hex_csv(dir + "nodes.csv", dir + "hexes.csv");
+}
+
+primal::HexMesh structured_hex_grid(int nx, int ny, int nz) {
+  primal::HexMesh mesh;
+  auto id = [&](int i, int j, int k) {
+    return static_cast<primal::Index>(i + (nx + 1) * (j + (ny + 1) * k));
+  };
+  for (int k = 0; k <= nz; ++k)
+    for (int j = 0; j <= ny; ++j)
+      for (int i = 0; i <= nx; ++i) mesh.points.emplace_back(i, j, k);
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        std::array<primal::Index, 8> hex{};
+        // Corner c sits at the offsets of its unit-cube coordinates (topology table).
+        for (int c = 0; c < 8; ++c) {
+          const auto& rc = primal::topology::kHexCornerCoords[c];
+          hex[c] = id(i + rc[0], j + rc[1], k + rc[2]);
+        }
+        mesh.hexes.push_back(hex);
+      }
+  return mesh;
+}
+
+primal::QuadMesh structured_quad_grid(int nx, int ny) {
+  primal::QuadMesh mesh;
+  auto id = [&](int i, int j) { return static_cast<primal::Index>(i + (nx + 1) * j); };
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i) mesh.points.emplace_back(i, j, 0.0);
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i)
+      mesh.quads.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
+  return mesh;
+}
+
+primal::QuadMesh boundary_quads(const primal::HexMesh& mesh,
+                                const std::function<bool(const primal::Point&)>& keep) {
+  // A face is on the boundary when exactly one hex uses it; key faces by sorted corners.
+  std::map<std::array<primal::Index, 4>, int> uses;
+  std::vector<std::array<primal::Index, 4>> faces;
+  for (const auto& hex : mesh.hexes)
+    for (const auto& fc : primal::topology::kHexFaceCorners) {
+      std::array<primal::Index, 4> f{hex[fc[0]], hex[fc[1]], hex[fc[2]], hex[fc[3]]};
+      faces.push_back(f);
+      std::sort(f.begin(), f.end());
+      ++uses[f];
+    }
+  primal::QuadMesh out;
+  std::vector<primal::Index> renumber(mesh.points.size(), primal::kInvalidIndex);
+  for (const auto& f : faces) {
+    auto key = f;
+    std::sort(key.begin(), key.end());
+    if (uses[key] != 1) continue;
+    if (!std::all_of(f.begin(), f.end(), [&](primal::Index n) { return keep(mesh.points[n]); }))
+      continue;
+    std::array<primal::Index, 4> q{};
+    for (int c = 0; c < 4; ++c) {
+      if (renumber[f[c]] == primal::kInvalidIndex) {
+        renumber[f[c]] = static_cast<primal::Index>(out.points.size());
+        out.points.push_back(mesh.points[f[c]]);
+      }
+      q[c] = renumber[f[c]];
+    }
+    out.quads.push_back(q);
+  }
+  return out;
+}
+
+}  // namespace geode::test
