@@ -1,0 +1,144 @@
+#include "primal/boundary.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <string>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "primal/errors.hpp"
+#include "primal/topology.hpp"
+
+namespace geode::primal {
+
+namespace topo = topology;
+
+EdgeKey edge_key(Index a, Index b) { return a < b ? EdgeKey{a, b} : EdgeKey{b, a}; }
+
+FaceKey face_key(std::span<const Index> nodes) {
+  assert(nodes.size() == 3 || nodes.size() == 4);
+  FaceKey k{kInvalidIndex, kInvalidIndex, kInvalidIndex, kInvalidIndex};
+  std::copy(nodes.begin(), nodes.end(), k.begin());
+  // Insertion sort: std::sort on a 3-4 element prefix trips GCC 12's -Warray-bounds.
+  for (std::size_t i = 1; i < nodes.size(); ++i) {
+    for (std::size_t j = i; j > 0 && k[j - 1] > k[j]; --j) std::swap(k[j - 1], k[j]);
+  }
+  return k;
+}
+
+namespace {
+
+void check_indices(const HexMesh& mesh) {
+  const auto n = static_cast<Index>(mesh.points.size());
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
+    for (Index v : mesh.hexes[h]) {
+      if (v < 0 || v >= n) {
+        throw InvalidInput("hex " + std::to_string(h) + ": node " + std::to_string(v) +
+                           " out of range [0, " + std::to_string(n) + ")");
+      }
+    }
+  }
+}
+
+std::array<Index, 4> hex_face_nodes(const std::array<Index, 8>& hex, int f) {
+  std::array<Index, 4> q{};
+  for (int i = 0; i < 4; ++i) q[i] = hex[topo::kHexFaceCorners[f][i]];
+  return q;
+}
+
+}  // namespace
+
+std::vector<UniqueFace> unique_faces(const HexMesh& mesh) {
+  check_indices(mesh);
+  std::vector<UniqueFace> faces;
+  std::unordered_map<FaceKey, std::size_t, IndexArrayHash> index;
+  index.reserve(mesh.hexes.size() * 4);
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
+    for (int f = 0; f < topo::kHexFaces; ++f) {
+      const auto nodes = hex_face_nodes(mesh.hexes[h], f);
+      const FaceKey key = face_key(nodes);
+      auto [it, inserted] = index.try_emplace(key, faces.size());
+      if (inserted) faces.push_back(UniqueFace{key, nodes, {}});
+      faces[it->second].uses.push_back(HexFaceUse{static_cast<Index>(h), f});
+    }
+  }
+  return faces;
+}
+
+std::vector<EdgeKey> unique_edges(const HexMesh& mesh) {
+  check_indices(mesh);
+  std::vector<EdgeKey> edges;
+  std::unordered_set<EdgeKey, IndexArrayHash> seen;
+  seen.reserve(mesh.hexes.size() * 4);
+  for (const auto& hex : mesh.hexes) {
+    for (const auto& e : topo::kHexEdgeCorners) {
+      const EdgeKey key = edge_key(hex[e[0]], hex[e[1]]);
+      if (seen.insert(key).second) edges.push_back(key);
+    }
+  }
+  return edges;
+}
+
+std::vector<BoundaryQuad> boundary_quads(const HexMesh& mesh) {
+  std::vector<BoundaryQuad> out;
+  for (const auto& f : unique_faces(mesh)) {
+    if (f.uses.size() == 1) out.push_back(BoundaryQuad{f.uses[0].hex, f.uses[0].local_face, f.nodes});
+  }
+  return out;
+}
+
+BoundarySurface extract_boundary(const HexMesh& mesh) {
+  BoundarySurface b;
+  const auto quads = boundary_quads(mesh);
+
+  // Combinatorial Euler characteristic, independent of what OpenMesh accepts.
+  std::unordered_map<Index, SurfaceMesh::VertexHandle> vertex_of;
+  std::unordered_map<EdgeKey, int, IndexArrayHash> edge_uses;
+  for (const auto& q : quads) {
+    for (int i = 0; i < 4; ++i) {
+      vertex_of.try_emplace(q.nodes[i]);
+      ++edge_uses[edge_key(q.nodes[i], q.nodes[(i + 1) % 4])];
+    }
+  }
+  b.euler = static_cast<int>(vertex_of.size()) - static_cast<int>(edge_uses.size()) +
+            static_cast<int>(quads.size());
+
+  // Vertices in order of first appearance so that the surface is deterministic.
+  for (const auto& q : quads) {
+    for (Index v : q.nodes) {
+      auto& vh = vertex_of[v];
+      if (!vh.is_valid()) {
+        const Point& p = mesh.points[static_cast<std::size_t>(v)];
+        vh = b.surface.add_vertex(SurfaceMesh::Point(static_cast<float>(p.x()),
+                                                     static_cast<float>(p.y()),
+                                                     static_cast<float>(p.z())));
+        b.vertex_node.push_back(v);
+      }
+    }
+  }
+  // OpenMesh reports refused faces on its error stream; they are reported in `rejected`.
+  const bool was_enabled = omerr().is_enabled();
+  omerr().disable();
+  for (const auto& q : quads) {
+    std::vector<SurfaceMesh::VertexHandle> vhs;
+    for (Index v : q.nodes) vhs.push_back(vertex_of[v]);
+    const auto fh = b.surface.add_face(vhs);
+    if (fh.is_valid()) {
+      assert(static_cast<std::size_t>(fh.idx()) == b.faces.size());
+      b.faces.push_back(q);
+    } else {
+      b.rejected.push_back(q);
+    }
+  }
+  if (was_enabled) omerr().enable();
+
+  b.closed = std::all_of(edge_uses.begin(), edge_uses.end(),
+                         [](const auto& kv) { return kv.second == 2; });
+  b.manifold = b.rejected.empty();
+  for (auto vh : b.surface.vertices()) {
+    if (!b.surface.is_manifold(vh)) b.manifold = false;
+  }
+  return b;
+}
+
+}  // namespace geode::primal

@@ -1,0 +1,80 @@
+#pragma once
+// Shared entities of a hex mesh (edges and faces identified by their sorted node numbers) and
+// its boundary: the faces used by exactly one hex, as a list and as an OpenMesh quad surface.
+#include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
+
+#include <array>
+#include <cstddef>
+#include <functional>
+#include <span>
+#include <vector>
+
+#include "primal/mesh.hpp"
+
+namespace geode::primal {
+
+// An edge or face is identified by its node numbers sorted ascending, so that every element
+// using it produces the same key. A triangle's FaceKey pads slot 3 with kInvalidIndex.
+using EdgeKey = std::array<Index, 2>;
+using FaceKey = std::array<Index, 4>;
+
+EdgeKey edge_key(Index a, Index b);
+FaceKey face_key(std::span<const Index> nodes);  // 3 or 4 nodes
+
+// Hash for EdgeKey / FaceKey (and any std::array<Index, N>) in unordered containers.
+struct IndexArrayHash {
+  template <std::size_t N>
+  std::size_t operator()(const std::array<Index, N>& a) const noexcept {
+    std::size_t h = 0x9e3779b97f4a7c15ull;
+    for (Index i : a) h = (h ^ static_cast<std::size_t>(static_cast<std::uint32_t>(i))) * 0x100000001b3ull;
+    return h;
+  }
+};
+
+// One use of a face: hex `hex`, local face `local_face` (topology::kHexFaceCorners).
+struct HexFaceUse {
+  Index hex = kInvalidIndex;
+  int local_face = -1;
+};
+
+// A face of the mesh with every hex using it (1 on the boundary, 2 inside, more if invalid).
+struct UniqueFace {
+  FaceKey key{};
+  std::array<Index, 4> nodes{};  // ordered outward of uses[0]
+  std::vector<HexFaceUse> uses;
+};
+
+// Every face once, in order of first appearance (hex by hex, local faces in table order).
+// Throws InvalidInput if a hex references a node out of range.
+std::vector<UniqueFace> unique_faces(const HexMesh& mesh);
+
+// Every edge once, in order of first appearance (hex by hex, topology::kHexEdgeCorners order).
+std::vector<EdgeKey> unique_edges(const HexMesh& mesh);
+
+// A face used by exactly one hex; `nodes` ordered counter-clockwise seen from outside the mesh.
+struct BoundaryQuad {
+  Index hex = kInvalidIndex;
+  int local_face = -1;
+  std::array<Index, 4> nodes{};
+};
+
+std::vector<BoundaryQuad> boundary_quads(const HexMesh& mesh);
+
+// The boundary as an OpenMesh surface (float points, the library's default traits; exact
+// coordinates are mesh.points[vertex_node[v]]).
+using SurfaceMesh = OpenMesh::PolyMesh_ArrayKernelT<>;
+
+struct BoundarySurface {
+  SurfaceMesh surface;
+  std::vector<Index> vertex_node;     // surface vertex index -> hex mesh node
+  std::vector<BoundaryQuad> faces;    // surface face index -> boundary quad
+  std::vector<BoundaryQuad> rejected;  // quads OpenMesh refused (complex edge or vertex)
+  bool closed = false;    // every boundary edge is shared by two boundary quads
+  bool manifold = false;  // no quad rejected and every surface vertex is manifold
+  // V - E + F of the boundary quads, counted combinatorially (also when quads were rejected).
+  int euler = 0;
+};
+
+BoundarySurface extract_boundary(const HexMesh& mesh);
+
+}  // namespace geode::primal
