@@ -1,0 +1,392 @@
+#include "primal/quality.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "primal/errors.hpp"
+#include "primal/topology.hpp"
+
+namespace geode::primal {
+
+namespace {
+
+namespace topo = topology;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Sign (+1 / -1) of corner c along local axis i: the trilinear map's derivative at the centre
+// weights each corner by the product of these signs (1/4 of it in the unit cube).
+constexpr double corner_sign(int c, int i) { return topo::kHexCornerCoords[c][i] ? 1.0 : -1.0; }
+
+double det3(const Point& a, const Point& b, const Point& c) { return a.dot(b.cross(c)); }
+
+// Cross derivatives X12, X13, X23 of [Verdict] (taper).
+std::array<Point, 3> hex_cross_axes(const HexCorners& p) {
+  std::array<Point, 3> x{Point::Zero(), Point::Zero(), Point::Zero()};
+  for (int c = 0; c < 8; ++c) {
+    x[0] += corner_sign(c, 0) * corner_sign(c, 1) * p[c];
+    x[1] += corner_sign(c, 0) * corner_sign(c, 2) * p[c];
+    x[2] += corner_sign(c, 1) * corner_sign(c, 2) * p[c];
+  }
+  return x;
+}
+
+std::array<double, 12> edge_lengths(const HexCorners& p) {
+  std::array<double, 12> l{};
+  for (int e = 0; e < 12; ++e) {
+    l[e] = (p[topo::kHexEdgeCorners[e][1]] - p[topo::kHexEdgeCorners[e][0]]).norm();
+  }
+  return l;
+}
+
+// The 4 body diagonals join corner c to the corner with every local coordinate flipped.
+std::array<double, 4> diagonal_lengths(const HexCorners& p) {
+  // Corners 0..3 (bottom) and their opposites: 0-6, 1-7, 2-4, 3-5.
+  constexpr std::array<std::array<int, 2>, 4> kDiagonals{{{0, 6}, {1, 7}, {2, 4}, {3, 5}}};
+  std::array<double, 4> d{};
+  for (int i = 0; i < 4; ++i) d[i] = (p[kDiagonals[i][1]] - p[kDiagonals[i][0]]).norm();
+  return d;
+}
+
+double ratio(double num, double den) { return den > 0.0 ? num / den : kDegenerateMetric; }
+
+// Derivatives of the trilinear shape function of corner c on [0,1]^3 at (r, s, t).
+Point shape_gradient(int c, const Point& rst) {
+  Point f, df;
+  for (int i = 0; i < 3; ++i) {
+    const bool one = topo::kHexCornerCoords[c][i] != 0;
+    f[i] = one ? rst[i] : 1.0 - rst[i];
+    df[i] = one ? 1.0 : -1.0;
+  }
+  return {df[0] * f[1] * f[2], f[0] * df[1] * f[2], f[0] * f[1] * df[2]};
+}
+
+// Exact volume of the trilinear hex and its gradient with respect to the corners. det J is of
+// degree 2 in each local coordinate, so the 2x2x2 Gauss rule integrates it exactly.
+double trilinear_volume(const HexCorners& p, std::array<Point, 8>* gradient) {
+  const double g = 0.5 / std::sqrt(3.0);
+  const std::array<double, 2> pts{0.5 - g, 0.5 + g};
+  double volume = 0.0;
+  if (gradient) gradient->fill(Point::Zero());
+  for (double r : pts) {
+    for (double s : pts) {
+      for (double t : pts) {
+        const Point rst(r, s, t);
+        std::array<Point, 8> dn;
+        Eigen::Matrix3d jac = Eigen::Matrix3d::Zero();
+        for (int c = 0; c < 8; ++c) {
+          dn[c] = shape_gradient(c, rst);
+          jac += p[c] * dn[c].transpose();
+        }
+        const Point a = jac.col(0), b = jac.col(1), cc = jac.col(2);
+        volume += det3(a, b, cc) / 8.0;
+        if (gradient) {
+          // d det / d x_c = (b x c) dN/dr + (c x a) dN/ds + (a x b) dN/dt
+          const Point bc = b.cross(cc), ca = cc.cross(a), ab = a.cross(b);
+          for (int c = 0; c < 8; ++c) {
+            (*gradient)[c] += (bc * dn[c][0] + ca * dn[c][1] + ab * dn[c][2]) / 8.0;
+          }
+        }
+      }
+    }
+  }
+  return volume;
+}
+
+Point centre_normal(const QuadCorners& p) {
+  // Verdict's quad centre normal: X1 x X2 with X1 = (p1 + p2) - (p0 + p3), X2 = (p2 + p3) -
+  // (p0 + p1); it equals (p2 - p0) x (p3 - p1) / ... up to a factor 2.
+  const Point n = (p[2] - p[0]).cross(p[3] - p[1]);
+  const double len = n.norm();
+  return len > 0.0 ? Point(n / len) : Point::Zero();
+}
+
+std::array<double, 4> quad_signed_corner_areas(const QuadCorners& p, const Point& unit_normal,
+                                               std::array<double, 4>* scaled) {
+  std::array<double, 4> area{};
+  for (int c = 0; c < 4; ++c) {
+    const Point a = p[(c + 1) % 4] - p[c];
+    const Point b = p[(c + 3) % 4] - p[c];
+    area[c] = a.cross(b).dot(unit_normal);
+    if (scaled) {
+      const double l = a.norm() * b.norm();
+      (*scaled)[c] = l > 0.0 ? area[c] / l : 0.0;
+    }
+  }
+  return area;
+}
+
+}  // namespace
+
+std::array<Point, 3> hex_corner_frame(const HexCorners& p, int c) {
+  const auto& n = topo::kHexCornerNeighbors[c];
+  return {p[n[0]] - p[c], p[n[1]] - p[c], p[n[2]] - p[c]};
+}
+
+std::array<Point, 3> hex_principal_axes(const HexCorners& p) {
+  std::array<Point, 3> x{Point::Zero(), Point::Zero(), Point::Zero()};
+  for (int c = 0; c < 8; ++c) {
+    for (int i = 0; i < 3; ++i) x[i] += corner_sign(c, i) * p[c];
+  }
+  return x;
+}
+
+double scaled_determinant(const Point& a, const Point& b, const Point& c) {
+  const double l = a.norm() * b.norm() * c.norm();
+  return l > 0.0 ? det3(a, b, c) / l : 0.0;
+}
+
+std::array<double, 9> hex_scaled_jacobians(const HexCorners& p) {
+  std::array<double, 9> q{};
+  for (int c = 0; c < 8; ++c) {
+    const auto f = hex_corner_frame(p, c);
+    q[c] = scaled_determinant(f[0], f[1], f[2]);
+  }
+  const auto x = hex_principal_axes(p);
+  q[8] = scaled_determinant(x[0], x[1], x[2]);
+  return q;
+}
+
+std::array<double, 9> hex_jacobians(const HexCorners& p) {
+  std::array<double, 9> j{};
+  for (int c = 0; c < 8; ++c) {
+    const auto f = hex_corner_frame(p, c);
+    j[c] = det3(f[0], f[1], f[2]);
+  }
+  const auto x = hex_principal_axes(p);
+  j[8] = det3(x[0], x[1], x[2]) / 64.0;
+  return j;
+}
+
+// [Verdict] hex edge ratio: Hmax / Hmin, the longest over the shortest of the 12 edges.
+double hex_edge_ratio(const HexCorners& p) {
+  const auto l = edge_lengths(p);
+  const auto [lo, hi] = std::minmax_element(l.begin(), l.end());
+  return ratio(*hi, *lo);
+}
+
+// [Verdict] hex maximum edge ratio: max over i < j of max(|Xi|, |Xj|) / min(|Xi|, |Xj|).
+double hex_max_edge_ratio(const HexCorners& p) {
+  const auto x = hex_principal_axes(p);
+  double worst = 1.0;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = i + 1; j < 3; ++j) {
+      const double a = x[i].norm(), b = x[j].norm();
+      worst = std::max(worst, ratio(std::max(a, b), std::min(a, b)));
+    }
+  }
+  return worst;
+}
+
+double hex_aspect_ratio(const HexCorners& p) { return hex_max_edge_ratio(p); }
+
+// [Verdict] hex skew: max |cos| of the angles between the unit principal axes.
+double hex_skew(const HexCorners& p) {
+  auto x = hex_principal_axes(p);
+  for (auto& v : x) {
+    const double n = v.norm();
+    if (n <= 0.0) return kDegenerateMetric;
+    v /= n;
+  }
+  return std::max({std::abs(x[0].dot(x[1])), std::abs(x[0].dot(x[2])), std::abs(x[1].dot(x[2]))});
+}
+
+// [Verdict] hex taper: max over pairs (i, j) of |Xij| / min(|Xi|, |Xj|).
+double hex_taper(const HexCorners& p) {
+  const auto x = hex_principal_axes(p);
+  const auto xx = hex_cross_axes(p);
+  const double l0 = x[0].norm(), l1 = x[1].norm(), l2 = x[2].norm();
+  return std::max({ratio(xx[0].norm(), std::min(l0, l1)), ratio(xx[1].norm(), std::min(l0, l2)),
+                   ratio(xx[2].norm(), std::min(l1, l2))});
+}
+
+// [Verdict] hex volume. Verdict (2007) reports the centre Jacobian det(X1, X2, X3) / 64, newer
+// Verdict the 24-tet split through face and cell centres; we take the exact volume of the
+// trilinear map, which equals the 24-tet value (checked in tests) and the centre value for
+// parallelepipeds.
+double hex_volume(const HexCorners& p) { return trilinear_volume(p, nullptr); }
+
+// [Verdict] hex stretch: sqrt(3) * shortest edge / longest body diagonal.
+double hex_stretch(const HexCorners& p) {
+  const auto l = edge_lengths(p);
+  const auto d = diagonal_lengths(p);
+  return std::sqrt(3.0) * ratio(*std::min_element(l.begin(), l.end()),
+                                *std::max_element(d.begin(), d.end()));
+}
+
+// [Verdict] hex diagonal (ratio): shortest over longest body diagonal.
+double hex_diagonal(const HexCorners& p) {
+  const auto d = diagonal_lengths(p);
+  return ratio(*std::min_element(d.begin(), d.end()), *std::max_element(d.begin(), d.end()));
+}
+
+// [Verdict] hex dimension: Pronto3D's characteristic length for the stable time step (Taylor &
+// Flanagan, SAND87-1912), sqrt(V^2 / (2 sum_c |dV/dx_c|^2)) with the exact trilinear volume.
+// sqrt(3)/3 for the unit cube.
+double hex_dimension(const HexCorners& p) {
+  std::array<Point, 8> grad;
+  const double v = trilinear_volume(p, &grad);
+  double g2 = 0.0;
+  for (const auto& g : grad) g2 += g.squaredNorm();
+  return g2 > 0.0 ? std::sqrt(0.5 * v * v / g2) : 0.0;
+}
+
+// [Verdict] hex jacobian: min over the 8 corner determinants and the centre det(X)/64.
+double hex_jacobian(const HexCorners& p) {
+  const auto j = hex_jacobians(p);
+  return *std::min_element(j.begin(), j.end());
+}
+
+// [Verdict] hex scaled jacobian: min over the 8 corners and the centre (principal axes) of
+// det / product of the three column lengths. Verdict returns 1e30 when a column vanishes; we
+// return 0 for such a corner (a collapsed edge is a degenerate corner, not a perfect one).
+double hex_scaled_jacobian(const HexCorners& p) {
+  const auto q = hex_scaled_jacobians(p);
+  return *std::min_element(q.begin(), q.end());
+}
+
+// [Verdict] hex condition (maximum Frobenius aspect; Knupp, IJNME 48:1165, 2000): max over
+// corners of |A|_F |A^-1|_F / 3, 1 for a cube; 1e30 where a corner determinant is <= 0.
+double hex_condition(const HexCorners& p) {
+  double worst = 1.0;
+  for (int c = 0; c < 8; ++c) {
+    const auto f = hex_corner_frame(p, c);
+    const double det = det3(f[0], f[1], f[2]);
+    if (det <= 0.0) return kDegenerateMetric;
+    // |A^-1|_F = |adj A|_F / det, and the rows of adj A are the pairwise cross products.
+    const double a2 = f[0].squaredNorm() + f[1].squaredNorm() + f[2].squaredNorm();
+    const double adj2 = f[0].cross(f[1]).squaredNorm() + f[1].cross(f[2]).squaredNorm() +
+                        f[2].cross(f[0]).squaredNorm();
+    worst = std::max(worst, std::sqrt(a2 * adj2) / det / 3.0);
+  }
+  return worst;
+}
+
+// [Verdict] hex shape (Knupp): min over corners of 3 det(A)^(2/3) / |A|_F^2; 0 where a corner
+// determinant is <= 0.
+double hex_shape(const HexCorners& p) {
+  double best = 1.0;
+  for (int c = 0; c < 8; ++c) {
+    const auto f = hex_corner_frame(p, c);
+    const double det = det3(f[0], f[1], f[2]);
+    if (det <= 0.0) return 0.0;
+    const double a2 = f[0].squaredNorm() + f[1].squaredNorm() + f[2].squaredNorm();
+    best = std::min(best, 3.0 * std::cbrt(det * det) / a2);
+  }
+  return best;
+}
+
+// [Verdict] quad jacobian: minimum signed corner area (a x b) . n.
+double quad_jacobian(const QuadCorners& p) { return quad_jacobian(p, centre_normal(p)); }
+
+double quad_jacobian(const QuadCorners& p, const Point& normal) {
+  const double n = normal.norm();
+  const Point u = n > 0.0 ? Point(normal / n) : Point::Zero();
+  const auto a = quad_signed_corner_areas(p, u, nullptr);
+  return *std::min_element(a.begin(), a.end());
+}
+
+// [Verdict] quad scaled jacobian: min over corners of the signed area / (|a| |b|).
+double quad_scaled_jacobian(const QuadCorners& p) {
+  return quad_scaled_jacobian(p, centre_normal(p));
+}
+
+double quad_scaled_jacobian(const QuadCorners& p, const Point& normal) {
+  const double n = normal.norm();
+  const Point u = n > 0.0 ? Point(normal / n) : Point::Zero();
+  std::array<double, 4> q{};
+  quad_signed_corner_areas(p, u, &q);
+  return *std::min_element(q.begin(), q.end());
+}
+
+std::span<const HexMetricInfo> hex_metrics() {
+  // Acceptable ranges from the [Verdict] hexahedron tables.
+  static const std::array<HexMetricInfo, 12> kTable{{
+      {HexMetric::kEdgeRatio, "Edge Ratio", "edge_ratio", &hex_edge_ratio, 1.0, 1.3,
+       "Lmax / Lmin over the 12 edges [Verdict hex edge ratio]"},
+      {HexMetric::kAspectRatio, "Aspect Ratio", "aspect_ratio", &hex_aspect_ratio, 1.0, 1.3,
+       "max |Xi|/|Xj| of principal axes [Verdict hex max edge ratio = CUBIT aspect ratio]"},
+      {HexMetric::kSkew, "Skew", "skew", &hex_skew, 0.0, 0.5,
+       "max |cos| between unit principal axes [Verdict hex skew]"},
+      {HexMetric::kTaper, "Taper", "taper", &hex_taper, 0.0, 0.5,
+       "max |Xij| / min(|Xi|,|Xj|) [Verdict hex taper]"},
+      {HexMetric::kVolume, "Element Volume", "volume", &hex_volume, 0.0, kInf,
+       "exact trilinear volume [Verdict hex volume]"},
+      {HexMetric::kStretch, "Stretch", "stretch", &hex_stretch, 0.25, 1.0,
+       "sqrt(3) Lmin / Dmax [Verdict hex stretch]"},
+      {HexMetric::kDiagonal, "Diagonal Ratio", "diagonal", &hex_diagonal, 0.65, 1.0,
+       "Dmin / Dmax of body diagonals [Verdict hex diagonal]"},
+      {HexMetric::kDimension, "Dimension", "dimension", &hex_dimension, -kInf, kInf,
+       "V / sqrt(2 |grad V|^2), Pronto3D length [Verdict hex dimension]"},
+      {HexMetric::kJacobian, "Jacobian", "jacobian", &hex_jacobian, 0.0, kInf,
+       "min corner det, centre det/64 [Verdict hex jacobian]"},
+      {HexMetric::kScaledJacobian, "Scaled Jacobian", "scaled_jacobian", &hex_scaled_jacobian,
+       0.5, 1.0, "min over 8 corners and centre of det/(|a||b||c|) [Verdict hex scaled jacobian]"},
+      {HexMetric::kCondition, "Condition No.", "condition", &hex_condition, 1.0, 8.0,
+       "max corner |A|_F |A^-1|_F / 3 [Verdict hex condition; Knupp 2000]"},
+      {HexMetric::kShape, "Shape", "shape", &hex_shape, 0.3, 1.0,
+       "min corner 3 det^(2/3) / |A|_F^2 [Verdict hex shape; Knupp]"},
+  }};
+  return kTable;
+}
+
+const HexMetricInfo& hex_metric_info(HexMetric metric) {
+  for (const auto& m : hex_metrics()) {
+    if (m.metric == metric) return m;
+  }
+  throw InvalidInput("hex_metric_info: unknown metric id " +
+                     std::to_string(static_cast<int>(metric)));
+}
+
+const HexMetricInfo& hex_metric_info(std::string_view key_or_name) {
+  for (const auto& m : hex_metrics()) {
+    if (m.key == key_or_name || m.name == key_or_name) return m;
+  }
+  std::string known;
+  for (const auto& m : hex_metrics()) known += (known.empty() ? "" : ", ") + std::string(m.key);
+  throw InvalidInput("unknown hex quality metric '" + std::string(key_or_name) +
+                     "' (known: " + known + ")");
+}
+
+HexCorners hex_corners(const HexMesh& mesh, Index h) {
+  if (h < 0 || static_cast<std::size_t>(h) >= mesh.hexes.size()) {
+    throw InvalidInput("hex_corners: hex " + std::to_string(h) + " out of range (mesh has " +
+                       std::to_string(mesh.hexes.size()) + " hexes)");
+  }
+  HexCorners p;
+  for (int c = 0; c < 8; ++c) {
+    const Index n = mesh.hexes[h][c];
+    if (n < 0 || static_cast<std::size_t>(n) >= mesh.points.size()) {
+      throw InvalidInput("hex_corners: hex " + std::to_string(h) + " corner " +
+                         std::to_string(c) + " names node " + std::to_string(n) +
+                         ", out of range (mesh has " + std::to_string(mesh.points.size()) +
+                         " nodes)");
+    }
+    p[c] = mesh.points[n];
+  }
+  return p;
+}
+
+QuadCorners quad_corners(const QuadMesh& mesh, Index q) {
+  if (q < 0 || static_cast<std::size_t>(q) >= mesh.quads.size()) {
+    throw InvalidInput("quad_corners: quad " + std::to_string(q) + " out of range (mesh has " +
+                       std::to_string(mesh.quads.size()) + " quads)");
+  }
+  QuadCorners p;
+  for (int c = 0; c < 4; ++c) {
+    const Index n = mesh.quads[q][c];
+    if (n < 0 || static_cast<std::size_t>(n) >= mesh.points.size()) {
+      throw InvalidInput("quad_corners: quad " + std::to_string(q) + " corner " +
+                         std::to_string(c) + " names node " + std::to_string(n) +
+                         ", out of range (mesh has " + std::to_string(mesh.points.size()) +
+                         " nodes)");
+    }
+    p[c] = mesh.points[n];
+  }
+  return p;
+}
+
+}  // namespace geode::primal
