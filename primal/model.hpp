@@ -1,0 +1,84 @@
+#pragma once
+// A mixed hex + tet model as read from an input file (Exodus II, Gmsh): one point array shared
+// by both parts, element blocks, named node sets and side sets. This is the input of the
+// whole-model geode pipeline (interface detection, buffer layer, dicing, templates).
+//
+// Conventions:
+// - Element connectivity is in VTK/Exodus order (primal/topology.hpp); readers convert.
+// - Element order after reading is block by block (ascending block id), hexes and tets in
+//   their own arrays; writers emit blocks in ascending id, so a model whose elements are
+//   already grouped by block round-trips exactly.
+// - A side is (element, local face) with the face numbered as in topology.hpp
+//   (kHexFaceCorners / kTetFaceCorners), which is the Exodus side number minus one.
+#include <compare>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "primal/mesh.hpp"
+
+namespace geode::primal {
+
+enum class ElementKind : std::uint8_t { Hex, Tet };
+
+struct ElementRef {
+  ElementKind kind = ElementKind::Hex;
+  Index index = kInvalidIndex;  // into Model::hexes or Model::tets
+  auto operator<=>(const ElementRef&) const = default;
+};
+
+struct Side {
+  ElementRef element;
+  int face = 0;  // 0-based local face (topology.hpp order == Exodus side - 1)
+  auto operator<=>(const Side&) const = default;
+};
+
+struct NodeSet {
+  int id = 0;  // > 0
+  std::string name;
+  std::vector<Index> nodes;
+};
+
+struct SideSet {
+  int id = 0;  // > 0
+  std::string name;
+  std::vector<Side> sides;
+};
+
+struct Model {
+  std::vector<Point> points;
+  std::vector<std::array<Index, 8>> hexes;  // VTK/Exodus HEX8 order
+  std::vector<std::array<Index, 4>> tets;   // VTK/Exodus TETRA4 order
+  // Element block id (> 0) per element. Empty means "all in one block": 1 for hexes, 2 for tets.
+  std::vector<int> hex_block;
+  std::vector<int> tet_block;
+  std::map<int, std::string> block_names;  // optional
+  std::vector<NodeSet> node_sets;
+  std::vector<SideSet> side_sets;
+};
+
+// Block id of an element, applying the empty-vector defaults above.
+int block_of(const Model& model, ElementRef element);
+
+// Throws InvalidInput naming `source` and the offending element / set entry when a node index
+// is out of range, a block vector has the wrong size, an id is not positive, or a side's face
+// number is out of range. Readers call it before returning; writers before writing.
+void validate(const Model& model, std::string_view source);
+
+// The two parts over the model's whole point array (unused points included), so that node
+// numbers agree between the parts and the model.
+HexMesh hex_part(const Model& model);
+TetMesh tet_part(const Model& model);
+
+// Signed volume of tet (a, b, c, d): positive when a-b-c is counter-clockwise seen from d.
+double tet_volume(const Point& a, const Point& b, const Point& c, const Point& d);
+
+// Merges points closer than `tolerance` (keeps the lowest index, renumbers everything, drops
+// the merged points). Returns how many points were removed. Spatial hashing, O(n).
+Index merge_coincident_nodes(Model& model, double tolerance);
+
+}  // namespace geode::primal
