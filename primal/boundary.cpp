@@ -82,7 +82,8 @@ std::vector<EdgeKey> unique_edges(const HexMesh& mesh) {
 std::vector<BoundaryQuad> boundary_quads(const HexMesh& mesh) {
   std::vector<BoundaryQuad> out;
   for (const auto& f : unique_faces(mesh)) {
-    if (f.uses.size() == 1) out.push_back(BoundaryQuad{f.uses[0].hex, f.uses[0].local_face, f.nodes});
+    if (f.uses.size() == 1)
+      out.push_back(BoundaryQuad{f.uses[0].hex, f.uses[0].local_face, f.nodes});
   }
   return out;
 }
@@ -109,9 +110,8 @@ BoundarySurface extract_boundary(const HexMesh& mesh) {
       auto& vh = vertex_of[v];
       if (!vh.is_valid()) {
         const Point& p = mesh.points[static_cast<std::size_t>(v)];
-        vh = b.surface.add_vertex(SurfaceMesh::Point(static_cast<float>(p.x()),
-                                                     static_cast<float>(p.y()),
-                                                     static_cast<float>(p.z())));
+        vh = b.surface.add_vertex(SurfaceMesh::Point(
+            static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())));
         b.vertex_node.push_back(v);
       }
     }

@@ -2,7 +2,6 @@
 // Shared entities of a hex mesh (edges and faces identified by their sorted node numbers) and
 // its boundary: the faces used by exactly one hex, as a list and as an OpenMesh quad surface.
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
-
 #include <array>
 #include <cstddef>
 #include <functional>
@@ -26,7 +25,8 @@ struct IndexArrayHash {
   template <std::size_t N>
   std::size_t operator()(const std::array<Index, N>& a) const noexcept {
     std::size_t h = 0x9e3779b97f4a7c15ull;
-    for (Index i : a) h = (h ^ static_cast<std::size_t>(static_cast<std::uint32_t>(i))) * 0x100000001b3ull;
+    for (Index i : a)
+      h = (h ^ static_cast<std::size_t>(static_cast<std::uint32_t>(i))) * 0x100000001b3ull;
     return h;
   }
 };
@@ -66,11 +66,11 @@ using SurfaceMesh = OpenMesh::PolyMesh_ArrayKernelT<>;
 
 struct BoundarySurface {
   SurfaceMesh surface;
-  std::vector<Index> vertex_node;     // surface vertex index -> hex mesh node
-  std::vector<BoundaryQuad> faces;    // surface face index -> boundary quad
+  std::vector<Index> vertex_node;      // surface vertex index -> hex mesh node
+  std::vector<BoundaryQuad> faces;     // surface face index -> boundary quad
   std::vector<BoundaryQuad> rejected;  // quads OpenMesh refused (complex edge or vertex)
-  bool closed = false;    // every boundary edge is shared by two boundary quads
-  bool manifold = false;  // no quad rejected and every surface vertex is manifold
+  bool closed = false;                 // every boundary edge is shared by two boundary quads
+  bool manifold = false;               // no quad rejected and every surface vertex is manifold
   // V - E + F of the boundary quads, counted combinatorially (also when quads were rejected).
   int euler = 0;
 };

@@ -1,0 +1,77 @@
+#pragma once
+// Validity of a hex mesh (and of a planar quad mesh): is it a conforming, manifold,
+// positively oriented complex? The checks return a report instead of throwing so that a
+// researcher can see everything that is wrong at once; report.ok() is the yes/no answer.
+#include <string>
+#include <vector>
+
+#include "primal/boundary.hpp"
+#include "primal/mesh.hpp"
+
+namespace geode::primal {
+
+// Elements with an out-of-range node or a repeated node are listed and left out of the
+// topological checks (Euler characteristic, faces, edges, vertices, boundary), which run on
+// the remaining "proper" elements.
+struct HexValidityReport {
+  Index num_nodes = 0;
+  Index num_hexes = 0;
+  std::vector<Index> out_of_range_hexes;   // a node number outside [0, num_nodes)
+  std::vector<Index> non_finite_nodes;     // NaN or infinite coordinate
+  std::vector<Index> repeated_node_hexes;  // a node appearing twice in one hex
+  Index unused_nodes = 0;                  // nodes used by no proper hex
+
+  std::vector<FaceKey> overshared_faces;   // used by more than two hexes
+  std::vector<FaceKey> misoriented_faces;  // two hexes see it in the same cyclic order
+  // An edge whose hexes are not connected through faces around it (or that has a face used
+  // by more than two hexes); a vertex whose link is not a sphere (interior) or a disk
+  // (boundary), i.e. not face-connected or of the wrong Euler characteristic.
+  std::vector<EdgeKey> nonmanifold_edges;
+  std::vector<Index> nonmanifold_vertices;
+
+  // The complex of proper hexes: V - E + F - C (1 for a ball, 0 for a solid torus).
+  Index num_vertices = 0, num_edges = 0, num_faces = 0, num_cells = 0;
+  int euler = 0;
+
+  BoundarySurface boundary;  // closed, manifold, euler (2 for a sphere) inside
+
+  // Hexes with a corner Jacobian det(e_r, e_s, e_t) <= 0 (topology::kHexCornerNeighbors).
+  std::vector<Index> inverted_hexes;
+
+  bool ok() const;
+  std::string summary() const;  // one line per finding, listing the first few offenders
+};
+
+HexValidityReport check_validity(const HexMesh& mesh);
+
+// A quad mesh lying in the plane through its first node with normal `normal`.
+struct QuadValidityReport {
+  Index num_nodes = 0;
+  Index num_quads = 0;
+  std::vector<Index> out_of_range_quads;
+  std::vector<Index> non_finite_nodes;
+  std::vector<Index> repeated_node_quads;
+  Index unused_nodes = 0;
+  bool planar = true;  // every node within 1e-9 x (bounding box diagonal) of the plane
+
+  std::vector<EdgeKey> overshared_edges;    // used by more than two quads
+  std::vector<EdgeKey> misoriented_edges;   // two quads run along it in the same direction
+  std::vector<Index> nonmanifold_vertices;  // quads around it not connected through edges
+
+  Index num_vertices = 0, num_edges = 0, num_faces = 0;
+  int euler = 0;  // V - E + F: 1 for a disk, 0 for an annulus
+
+  // Boundary edges chained into closed loops, each a node cycle with the mesh on its left
+  // (seen from `normal`): the outer loop runs counter-clockwise, holes clockwise.
+  std::vector<std::vector<Index>> boundary_loops;
+
+  // Quads with a corner whose signed area (a x b) . normal is <= 0.
+  std::vector<Index> inverted_quads;
+
+  bool ok() const;
+  std::string summary() const;
+};
+
+QuadValidityReport check_validity(const QuadMesh& mesh, const Point& normal = Point::UnitZ());
+
+}  // namespace geode::primal
