@@ -1,0 +1,566 @@
+#include "stc/arrangement.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+
+#include "primal/errors.hpp"
+
+namespace geode::stc {
+namespace {
+
+struct UnionFind {
+  std::vector<int> parent;
+  explicit UnionFind(int n) : parent(static_cast<std::size_t>(n)) {
+    std::iota(parent.begin(), parent.end(), 0);
+  }
+  int find(int a) {
+    while (parent[static_cast<std::size_t>(a)] != a) {
+      parent[static_cast<std::size_t>(a)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(a)])];
+      a = parent[static_cast<std::size_t>(a)];
+    }
+    return a;
+  }
+  void unite(int a, int b) { parent[static_cast<std::size_t>(find(a))] = find(b); }
+};
+
+std::string fmt_point(const Point& x, int dim) {
+  std::ostringstream s;
+  s.precision(6);
+  s << "(" << x[0] << ", " << x[1];
+  if (dim == 3) s << ", " << x[2];
+  s << ")";
+  return s.str();
+}
+
+// An event on a traced curve: the curve crosses sheet `sheet` at vertex position x, between
+// polyline points i and i+1 at fraction t.
+struct Event {
+  double param;  // i + t
+  int sheet;
+  Point x;
+  int vertex = -1;
+};
+
+class Engine {
+ public:
+  Engine(const std::vector<Sheet>& sheets, const Domain& domain, const ArrangementOptions& opt)
+      : sheets_(sheets), domain_(domain), options_(opt), dim_(domain.dim) {
+    if (dim_ != 2 && dim_ != 3) throw InvalidInput("arrangement: dimension must be 2 or 3");
+    if (static_cast<int>(sheets.size()) < dim_)
+      throw InvalidInput("arrangement: needs at least as many sheets as dimensions");
+    for (int i = 0; i < dim_; ++i)
+      if (!(domain.hi[i] > domain.lo[i])) throw InvalidInput("arrangement: empty domain");
+    diag_ = (domain.hi - domain.lo).head(dim_).norm();
+    h_ = options_.step * diag_;
+    grad_h_ = 1e-6 * diag_;
+    tol_ = options_.tolerance * diag_;
+  }
+
+  Arrangement run();
+
+ private:
+  double value(int s, const Point& x) const { return sheets_[static_cast<std::size_t>(s)].field(x); }
+  Point grad(int s, const Point& x) const {
+    return gradient(sheets_[static_cast<std::size_t>(s)].field, x, grad_h_, dim_);
+  }
+  std::string name(int s) const { return "'" + sheets_[static_cast<std::size_t>(s)].name + "'"; }
+  std::string names(const std::vector<int>& S) const {
+    std::string r;
+    for (std::size_t i = 0; i < S.size(); ++i) r += (i ? ", " : "") + name(S[i]);
+    return r;
+  }
+
+  bool inside(const Point& x, double eps = 0.0) const {
+    for (int i = 0; i < dim_; ++i)
+      if (x[i] < domain_.lo[i] - eps || x[i] > domain_.hi[i] + eps) return false;
+    return true;
+  }
+
+  // Newton projection onto {f_s = 0, s in S}, with the coordinates in `fixed` (bit mask of
+  // axes) held. Returns false when it does not converge.
+  bool project(const std::vector<int>& S, Point& x, unsigned fixed = 0) const {
+    const int k = static_cast<int>(S.size());
+    Eigen::MatrixXd J(k, dim_);
+    Eigen::VectorXd F(k);
+    for (int it = 0; it < 40; ++it) {
+      double err = 0.0;
+      for (int r = 0; r < k; ++r) {
+        const Point g = grad(S[static_cast<std::size_t>(r)], x);
+        F[r] = value(S[static_cast<std::size_t>(r)], x);
+        for (int c = 0; c < dim_; ++c) J(r, c) = (fixed >> c) & 1u ? 0.0 : g[c];
+        const double gn = J.row(r).norm();
+        if (gn < 1e-14) return false;
+        err = std::max(err, std::abs(F[r]) / gn);
+      }
+      if (err < tol_) return true;
+      const Eigen::MatrixXd JJt = J * J.transpose();
+      Eigen::LDLT<Eigen::MatrixXd> ldlt(JJt);
+      if (ldlt.info() != Eigen::Success || std::abs(JJt.determinant()) < 1e-30) return false;
+      const Eigen::VectorXd dx = J.transpose() * ldlt.solve(F);
+      if (!dx.allFinite() || dx.norm() > 0.25 * diag_) return false;
+      for (int c = 0; c < dim_; ++c) x[c] -= dx[c];
+    }
+    return false;
+  }
+
+  Point tangent(const std::vector<int>& S, const Point& x) const {
+    if (dim_ == 2) {
+      const Point g = grad(S[0], x);
+      return Point(-g[1], g[0], 0.0);
+    }
+    return grad(S[0], x).cross(grad(S[1], x));
+  }
+
+  std::vector<Point> seeds(const std::vector<int>& S) const;
+  std::vector<Point> walk(const std::vector<int>& S, const Point& x0, Point t, bool& closed,
+                          int& end_face) const;
+  Curve trace(const std::vector<int>& S, const Point& x0) const;
+  std::vector<Event> events(const Curve& c) const;
+  int register_vertex(std::vector<int> sheets, const Point& x);
+  void check_vertex(const Vertex& v) const;
+
+  const std::vector<Sheet>& sheets_;
+  Domain domain_;
+  ArrangementOptions options_;
+  int dim_;
+  double diag_, h_, grad_h_, tol_;
+  std::vector<Vertex> vertices_;
+};
+
+std::vector<Point> Engine::seeds(const std::vector<int>& S) const {
+  // Sampling grid over the domain; a cell where every field of S changes sign holds a piece of
+  // their meeting curve (or comes close to one): project its centre onto the curve.
+  std::array<int, 3> n{1, 1, 1};
+  double longest = 0.0;
+  for (int i = 0; i < dim_; ++i) longest = std::max(longest, domain_.hi[i] - domain_.lo[i]);
+  for (int i = 0; i < dim_; ++i)
+    n[static_cast<std::size_t>(i)] = std::max(
+        2, static_cast<int>(std::lround(options_.seed_resolution * (domain_.hi[i] - domain_.lo[i]) / longest)));
+  auto node = [&](int i, int j, int k) {
+    Point p = domain_.lo;
+    const std::array<int, 3> ijk{i, j, k};
+    for (int a = 0; a < dim_; ++a)
+      p[a] = domain_.lo[a] + (domain_.hi[a] - domain_.lo[a]) * ijk[static_cast<std::size_t>(a)] / n[static_cast<std::size_t>(a)];
+    if (dim_ == 2) p[2] = 0.0;
+    return p;
+  };
+  const int nk = dim_ == 3 ? n[2] : 0;
+  const std::size_t nn = static_cast<std::size_t>((n[0] + 1) * (n[1] + 1) * (nk + 1));
+  std::vector<std::vector<double>> val(S.size(), std::vector<double>(nn));
+  auto id = [&](int i, int j, int k) { return static_cast<std::size_t>((k * (n[1] + 1) + j) * (n[0] + 1) + i); };
+  for (int k = 0; k <= nk; ++k)
+    for (int j = 0; j <= n[1]; ++j)
+      for (int i = 0; i <= n[0]; ++i)
+        for (std::size_t s = 0; s < S.size(); ++s) val[s][id(i, j, k)] = value(S[s], node(i, j, k));
+  std::vector<Point> out;
+  const int kcells = dim_ == 3 ? n[2] : 1;
+  for (int k = 0; k < kcells; ++k)
+    for (int j = 0; j < n[1]; ++j)
+      for (int i = 0; i < n[0]; ++i) {
+        bool all = true;
+        for (std::size_t s = 0; s < S.size() && all; ++s) {
+          double lo = 1e300, hi = -1e300;
+          for (int c = 0; c < (dim_ == 3 ? 8 : 4); ++c) {
+            const double v = val[s][id(i + (c & 1), j + ((c >> 1) & 1), dim_ == 3 ? k + ((c >> 2) & 1) : 0)];
+            lo = std::min(lo, v);
+            hi = std::max(hi, v);
+          }
+          all = lo <= 0.0 && hi >= 0.0;
+        }
+        if (!all) continue;
+        Point c = 0.5 * (node(i, j, dim_ == 3 ? k : 0) + node(i + 1, j + 1, dim_ == 3 ? k + 1 : 0));
+        if (project(S, c) && inside(c)) out.push_back(c);
+      }
+  return out;
+}
+
+std::vector<Point> Engine::walk(const std::vector<int>& S, const Point& x0, Point t, bool& closed,
+                                int& end_face) const {
+  std::vector<Point> pts;
+  Point x = x0;
+  t.normalize();
+  double travelled = 0.0;
+  closed = false;
+  end_face = -1;
+  while (true) {
+    double hh = h_;
+    Point xp;
+    Point tn;
+    while (true) {
+      xp = x + hh * t;
+      bool ok = project(S, xp) && (xp - x).norm() < 2.0 * hh;
+      if (ok) {
+        tn = tangent(S, xp);
+        if (tn.norm() < 1e-12) ok = false;
+        else {
+          tn.normalize();
+          if (tn.dot(t) < 0) tn = -tn;
+          ok = tn.dot(t) > 0.9;
+        }
+      }
+      if (ok) break;
+      hh *= 0.5;
+      if (hh < 1e-5 * h_)
+        throw TopologyError("arrangement: tracing the curve where sheets " + names(S) +
+                            " meet stalls near " + fmt_point(x, dim_) +
+                            ": the sheets are tangent there (not in general position)");
+    }
+    if (!inside(xp)) {
+      // Leave through the face crossed first; solve the curve and that face exactly.
+      int axis = -1;
+      bool high = false;
+      double best = 2.0;
+      for (int a = 0; a < dim_; ++a) {
+        for (int side = 0; side < 2; ++side) {
+          const double b = side ? domain_.hi[a] : domain_.lo[a];
+          const bool out = side ? xp[a] > b : xp[a] < b;
+          if (!out) continue;
+          const double f = (b - x[a]) / (xp[a] - x[a]);
+          if (f < best) best = f, axis = a, high = side == 1;
+        }
+      }
+      assert(axis >= 0);
+      Point y = x + best * (xp - x);
+      y[axis] = high ? domain_.hi[axis] : domain_.lo[axis];
+      if (!project(S, y, 1u << axis) || !inside(y, 1e-9 * diag_))
+        throw TopologyError("arrangement: the curve where sheets " + names(S) + " meet leaves the domain near " +
+                            fmt_point(xp, dim_) + " where it cannot be followed (it grazes the boundary)");
+      for (int a = 0; a < dim_; ++a) {
+        if (a == axis) continue;
+        if (std::min(std::abs(y[a] - domain_.lo[a]), std::abs(y[a] - domain_.hi[a])) < 1e-6 * diag_)
+          throw TopologyError("arrangement: the curve where sheets " + names(S) + " meet leaves the domain through " +
+                              std::string(dim_ == 3 ? "an edge" : "a corner") + " of the box at " +
+                              fmt_point(y, dim_) + " (not in general position)");
+      }
+      end_face = box_face(axis, high);
+      pts.push_back(y);
+      return pts;
+    }
+    // Closing a loop: the step passes next to the start.
+    if (travelled > 4.0 * h_) {
+      const Point d = xp - x;
+      const double s = std::clamp((x0 - x).dot(d) / d.squaredNorm(), 0.0, 1.0);
+      if ((x + s * d - x0).norm() < 0.5 * h_) {
+        closed = true;
+        return pts;
+      }
+    }
+    travelled += (xp - x).norm();
+    if (travelled > 200.0 * diag_)
+      throw TopologyError("arrangement: the curve where sheets " + names(S) + " meet does not close or end (near " +
+                          fmt_point(xp, dim_) + ")");
+    pts.push_back(xp);
+    x = xp;
+    t = tn;
+  }
+}
+
+Curve Engine::trace(const std::vector<int>& S, const Point& x0) const {
+  Curve c;
+  c.sheets = S;
+  const Point t0 = tangent(S, x0).normalized();
+  bool closed = false;
+  int face_f = -1, face_b = -1;
+  std::vector<Point> fwd = walk(S, x0, t0, closed, face_f);
+  if (closed) {
+    c.closed = true;
+    c.polyline.push_back(x0);
+    c.polyline.insert(c.polyline.end(), fwd.begin(), fwd.end());
+    return c;
+  }
+  std::vector<Point> bwd = walk(S, x0, -t0, closed, face_b);
+  c.polyline.assign(bwd.rbegin(), bwd.rend());
+  c.polyline.push_back(x0);
+  c.polyline.insert(c.polyline.end(), fwd.begin(), fwd.end());
+  c.end_faces = {face_b, face_f};
+  return c;
+}
+
+std::vector<Event> Engine::events(const Curve& c) const {
+  std::vector<Event> out;
+  const auto& P = c.polyline;
+  const std::size_t n = P.size();
+  const std::size_t segs = c.closed ? n : n - 1;
+  for (int s = 0; s < static_cast<int>(sheets_.size()); ++s) {
+    if (std::find(c.sheets.begin(), c.sheets.end(), s) != c.sheets.end()) continue;
+    std::vector<int> T = c.sheets;
+    T.push_back(s);
+    std::vector<double> v(n);
+    for (std::size_t i = 0; i < n; ++i) v[i] = value(s, P[i]);
+    for (std::size_t i = 0; i < segs; ++i) {
+      const std::size_t j = (i + 1) % n;
+      // Sub-sample a segment where the sheet comes close without a sign change: it may cross
+      // twice within one step.
+      std::vector<std::pair<double, Point>> sub{{0.0, P[i]}, {1.0, P[j]}};
+      const double gl = grad(s, P[i]).norm() * (P[j] - P[i]).norm();
+      if ((v[i] < 0) == (v[j] < 0) && std::min(std::abs(v[i]), std::abs(v[j])) < 2.0 * gl) {
+        sub.clear();
+        for (int q = 0; q <= 16; ++q) {
+          Point y = P[i] + (q / 16.0) * (P[j] - P[i]);
+          if (q != 0 && q != 16) project(c.sheets, y);
+          sub.emplace_back(q / 16.0, y);
+        }
+      }
+      for (std::size_t q = 0; q + 1 < sub.size(); ++q) {
+        const double a = value(s, sub[q].second), b = value(s, sub[q + 1].second);
+        if ((a < 0) == (b < 0)) continue;
+        const double f = a / (a - b);
+        Point x = sub[q].second + f * (sub[q + 1].second - sub[q].second);
+        if (!project(T, x))
+          throw TopologyError("arrangement: sheets " + names(T) + " cross near " + fmt_point(x, dim_) +
+                              " but their meeting point cannot be solved (tangency?)");
+        out.push_back({static_cast<double>(i) + sub[q].first + f * (sub[q + 1].first - sub[q].first), s, x});
+      }
+    }
+  }
+  std::sort(out.begin(), out.end(), [](const Event& a, const Event& b) { return a.param < b.param; });
+  return out;
+}
+
+int Engine::register_vertex(std::vector<int> S, const Point& x) {
+  std::sort(S.begin(), S.end());
+  for (std::size_t i = 0; i < vertices_.size(); ++i) {
+    if (vertices_[i].sheets == S && (vertices_[i].x - x).norm() < 1e-7 * diag_) {
+      ++vertices_[i].found;
+      return static_cast<int>(i);
+    }
+  }
+  Vertex v;
+  v.sheets = S;
+  v.x = x;
+  v.found = 1;
+  Eigen::MatrixXd J(dim_, dim_);
+  for (int r = 0; r < dim_; ++r) J.row(r) = grad(S[static_cast<std::size_t>(r)], x).head(dim_).transpose();
+  v.orientation = J.determinant() > 0 ? 1 : -1;
+  check_vertex(v);
+  vertices_.push_back(v);
+  return static_cast<int>(vertices_.size() - 1);
+}
+
+void Engine::check_vertex(const Vertex& v) const {
+  Eigen::MatrixXd J(dim_, dim_);
+  double prod = 1.0;
+  for (int r = 0; r < dim_; ++r) {
+    J.row(r) = grad(v.sheets[static_cast<std::size_t>(r)], v.x).head(dim_).transpose();
+    prod *= J.row(r).norm();
+  }
+  if (std::abs(J.determinant()) < 1e-6 * prod)
+    throw TopologyError("arrangement: sheets " + names(v.sheets) + " meet tangentially at " + fmt_point(v.x, dim_) +
+                        " (not in general position)");
+  for (int e = 0; e < static_cast<int>(sheets_.size()); ++e) {
+    if (std::find(v.sheets.begin(), v.sheets.end(), e) != v.sheets.end()) continue;
+    const double g = grad(e, v.x).norm();
+    if (std::abs(value(e, v.x)) < 1e-7 * diag_ * std::max(g, 1e-300))
+      throw TopologyError("arrangement: " + std::to_string(dim_ + 1) + " sheets " + names(v.sheets) + " and " +
+                          name(e) + " pass through one point " + fmt_point(v.x, dim_) + " (not in general position)");
+  }
+  for (int a = 0; a < dim_; ++a)
+    if (std::min(std::abs(v.x[a] - domain_.lo[a]), std::abs(v.x[a] - domain_.hi[a])) < 1e-6 * diag_)
+      throw TopologyError("arrangement: sheets " + names(v.sheets) + " meet on the domain boundary at " +
+                          fmt_point(v.x, dim_) + " (not in general position)");
+}
+
+Arrangement Engine::run() {
+  Arrangement A;
+  A.domain = domain_;
+  A.sheet_count = static_cast<int>(sheets_.size());
+  for (const auto& s : sheets_) A.sheet_names.push_back(s.name);
+
+  // 1. Curves: every (d-1)-subset of sheets, every component.
+  std::vector<std::vector<int>> subsets;
+  const int m = A.sheet_count;
+  if (dim_ == 2)
+    for (int a = 0; a < m; ++a) subsets.push_back({a});
+  else
+    for (int a = 0; a < m; ++a)
+      for (int b = a + 1; b < m; ++b) subsets.push_back({a, b});
+  for (const auto& S : subsets) {
+    std::vector<Curve> found;
+    for (const Point& s : seeds(S)) {
+      bool covered = false;
+      for (const Curve& c : found) {
+        for (const Point& p : c.polyline)
+          if ((p - s).norm() < 2.0 * h_) {
+            covered = true;
+            break;
+          }
+        if (covered) break;
+      }
+      if (!covered) found.push_back(trace(S, s));
+    }
+    for (auto& c : found) A.curves.push_back(std::move(c));
+  }
+
+  // 2. Events along each curve, vertices, and 1-cells.
+  struct RawEdge {
+    std::vector<int> sheets;
+    int va, vb;          // vertex or -1
+    int sa, sb;          // the vertex's extra sheet (toward the edge)
+    int fa, fb;          // face when no vertex
+    Point xa, xb;
+    std::vector<int> side;
+  };
+  std::vector<RawEdge> raw;
+  for (const Curve& c : A.curves) {
+    std::vector<Event> ev = events(c);
+    if (ev.empty()) {
+      std::string where = c.closed ? "a closed loop" : "a curve from boundary face " + std::to_string(c.end_faces[0]) +
+                                                           " to face " + std::to_string(c.end_faces[1]);
+      throw TopologyError("arrangement: sheets " + names(c.sheets) + " meet in " + where + " through " +
+                          fmt_point(c.polyline.front(), dim_) +
+                          " that no other sheet crosses: a 1-cell with no vertex has no dual element");
+    }
+    for (Event& e : ev) {
+      std::vector<int> T = c.sheets;
+      T.push_back(e.sheet);
+      e.vertex = register_vertex(T, e.x);
+    }
+    const auto& P = c.polyline;
+    const double n = static_cast<double>(P.size());
+    auto point_at = [&](double param) {
+      double p = c.closed ? std::fmod(param, n) : param;
+      const auto i = static_cast<std::size_t>(std::clamp(std::floor(p), 0.0, n - 1));
+      const std::size_t j = c.closed ? (i + 1) % P.size() : std::min(i + 1, P.size() - 1);
+      Point y = P[i] + (p - static_cast<double>(i)) * (P[j] - P[i]);
+      project(c.sheets, y);
+      return y;
+    };
+    auto make = [&](int va, int sa, int fa, const Point& xa, double pa, int vb, int sb, int fb, const Point& xb,
+                    double pb) {
+      RawEdge r{c.sheets, va, vb, sa, sb, fa, fb, xa, xb, {}};
+      const Point mid = point_at(0.5 * (pa + pb));
+      for (int s = 0; s < m; ++s) r.side.push_back(value(s, mid) < 0 ? -1 : 1);
+      raw.push_back(std::move(r));
+    };
+    if (c.closed) {
+      for (std::size_t i = 0; i < ev.size(); ++i) {
+        const Event& a = ev[i];
+        const Event& b = ev[(i + 1) % ev.size()];
+        const double pb = i + 1 < ev.size() ? b.param : b.param + n;
+        make(a.vertex, a.sheet, -1, a.x, a.param, b.vertex, b.sheet, -1, b.x, pb);
+      }
+    } else {
+      make(-1, -1, c.end_faces[0], P.front(), 0.0, ev.front().vertex, ev.front().sheet, -1, ev.front().x,
+           ev.front().param);
+      for (std::size_t i = 0; i + 1 < ev.size(); ++i)
+        make(ev[i].vertex, ev[i].sheet, -1, ev[i].x, ev[i].param, ev[i + 1].vertex, ev[i + 1].sheet, -1,
+             ev[i + 1].x, ev[i + 1].param);
+      make(ev.back().vertex, ev.back().sheet, -1, ev.back().x, ev.back().param, -1, -1, c.end_faces[1], P.back(),
+           n - 1.0);
+    }
+  }
+  for (const Vertex& v : vertices_)
+    if (v.found != dim_)
+      throw TopologyError("arrangement: the vertex of sheets " + names(v.sheets) + " at " + fmt_point(v.x, dim_) +
+                          " was found on " + std::to_string(v.found) + " of its " + std::to_string(dim_) +
+                          " curves: part of a curve was missed (raise the seed resolution) or the sheets are not "
+                          "in general position");
+
+  // 3. Deterministic vertex order: by sheets, then by position.
+  std::vector<int> order(vertices_.size());
+  std::iota(order.begin(), order.end(), 0);
+  auto key = [&](const Vertex& v) {
+    std::vector<long long> k(v.sheets.begin(), v.sheets.end());
+    for (int a = 0; a < dim_; ++a) k.push_back(std::llround(v.x[a] / diag_ * 1e6));
+    return k;
+  };
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    return key(vertices_[static_cast<std::size_t>(a)]) < key(vertices_[static_cast<std::size_t>(b)]);
+  });
+  std::vector<int> rank(vertices_.size());
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    rank[static_cast<std::size_t>(order[i])] = static_cast<int>(i);
+    A.vertices.push_back(vertices_[static_cast<std::size_t>(order[i])]);
+  }
+
+  // 4. Regions: union the octants around each 1-cell at its two ends.
+  const int octants = 1 << dim_;
+  const int nv = static_cast<int>(A.vertices.size());
+  UnionFind uf(nv * octants);
+  std::vector<unsigned> faces(static_cast<std::size_t>(nv * octants), 0u);
+  auto octant_bits = [&](int v, const std::vector<int>& S, int sigma, int extra, const std::vector<int>& side) {
+    const Vertex& V = A.vertices[static_cast<std::size_t>(v)];
+    int bits = 0;
+    for (int i = 0; i < dim_; ++i) {
+      const int s = V.sheets[static_cast<std::size_t>(i)];
+      bool pos;
+      if (s == extra)
+        pos = side[static_cast<std::size_t>(s)] > 0;
+      else {
+        const auto it = std::find(S.begin(), S.end(), s);
+        assert(it != S.end());
+        pos = (sigma >> (it - S.begin())) & 1;
+      }
+      if (pos) bits |= 1 << i;
+    }
+    return v * octants + bits;
+  };
+  for (RawEdge& r : raw) {
+    Edge1 e;
+    e.sheets = r.sheets;
+    e.side = r.side;
+    if (r.va >= 0) r.va = rank[static_cast<std::size_t>(r.va)];
+    if (r.vb >= 0) r.vb = rank[static_cast<std::size_t>(r.vb)];
+    e.a = {r.va, r.fa, r.xa};
+    e.b = {r.vb, r.fb, r.xb};
+    for (int sigma = 0; sigma < (1 << (dim_ - 1)); ++sigma) {
+      const int ka = r.va >= 0 ? octant_bits(r.va, r.sheets, sigma, r.sa, r.side) : -1;
+      const int kb = r.vb >= 0 ? octant_bits(r.vb, r.sheets, sigma, r.sb, r.side) : -1;
+      if (ka >= 0 && kb >= 0) uf.unite(ka, kb);
+      if (ka >= 0 && kb < 0) faces[static_cast<std::size_t>(ka)] |= 1u << r.fb;
+      if (kb >= 0 && ka < 0) faces[static_cast<std::size_t>(kb)] |= 1u << r.fa;
+    }
+    A.edges.push_back(std::move(e));
+  }
+  std::vector<int> label(static_cast<std::size_t>(nv * octants), -1);
+  A.region.assign(static_cast<std::size_t>(nv), {-1, -1, -1, -1, -1, -1, -1, -1});
+  for (int v = 0; v < nv; ++v) {
+    const Vertex& V = A.vertices[static_cast<std::size_t>(v)];
+    Eigen::MatrixXd J(dim_, dim_);
+    for (int r = 0; r < dim_; ++r) J.row(r) = grad(V.sheets[static_cast<std::size_t>(r)], V.x).head(dim_).transpose();
+    const Eigen::MatrixXd Jinv = J.inverse();
+    for (int b = 0; b < octants; ++b) {
+      const int root = uf.find(v * octants + b);
+      int& l = label[static_cast<std::size_t>(root)];
+      const bool fresh = l < 0;
+      if (fresh) {
+        l = A.region_count++;
+        A.region_faces.push_back(0u);
+        A.region_signs.emplace_back();
+      }
+      A.region[static_cast<std::size_t>(v)][static_cast<std::size_t>(b)] = l;
+      A.region_faces[static_cast<std::size_t>(l)] |= faces[static_cast<std::size_t>(v * octants + b)];
+      // Sign vector of the region, sampled just inside this octant.
+      Eigen::VectorXd sigma(dim_);
+      for (int i = 0; i < dim_; ++i) sigma[i] = (b >> i) & 1 ? 1.0 : -1.0;
+      Eigen::VectorXd d = Jinv * sigma;
+      Point x = V.x;
+      for (int i = 0; i < dim_; ++i) x[i] += 1e-5 * diag_ * d[i] / d.norm();
+      std::vector<int> sg;
+      for (int s = 0; s < m; ++s) sg.push_back(value(s, x) < 0 ? -1 : 1);
+      auto& rs = A.region_signs[static_cast<std::size_t>(l)];
+      if (fresh)
+        rs = sg;
+      else if (rs != sg)
+        throw TopologyError("arrangement: one region joins octants of different sign vectors (near " +
+                            fmt_point(V.x, dim_) + " where sheets " + names(V.sheets) +
+                            " meet): the curves were traced inconsistently");
+    }
+  }
+  for (unsigned i = 0; i < faces.size(); ++i)
+    A.region_faces[static_cast<std::size_t>(label[static_cast<std::size_t>(uf.find(static_cast<int>(i)))])] |= faces[i];
+  return A;
+}
+
+}  // namespace
+
+Arrangement compute_arrangement(const std::vector<Sheet>& sheets, const Domain& domain,
+                                const ArrangementOptions& options) {
+  return Engine(sheets, domain, options).run();
+}
+
+}  // namespace geode::stc

@@ -1,0 +1,96 @@
+#pragma once
+// The arrangement of sheets inside a box (3D) or rectangle (2D), computed to the precision
+// of Newton's method on the sheets' fields.
+//
+// Route: for every set of d-1 sheets (pairs in 3D, single curves in 2D) the engine traces
+// the curve where they meet (predictor-corrector, seeded from a coarse sampling grid and
+// from nowhere else), finds on it, in order, the vertices where one more sheet crosses
+// (Newton on the d x d system), and where it leaves the domain. Consecutive events along a
+// curve bound a 1-cell; the 2^(d-1) regions around a 1-cell are the same at both of its
+// ends. Joining those region labels across all 1-cells gives the d-cells (a union-find over
+// the octants of the vertices): in a hex mesh every node is a corner of some hex and the
+// hexes around a node are face-connected, so face adjacency alone identifies every cell.
+//
+// General position is checked, not assumed: four sheets through one point, a tangency, a
+// vertex on the domain boundary, a curve leaving through a box edge, a curve with no vertex,
+// a vertex missed by one of its curves are thrown as TopologyError naming the sheets and
+// the point. Cells that are not balls are caught when dualizing (stc/dualize.hpp).
+#include <array>
+#include <string>
+#include <vector>
+
+#include "primal/mesh.hpp"
+#include "stc/sheet.hpp"
+
+namespace geode::stc {
+
+// Axis-aligned box; dim 2 uses x and y only (z of lo and hi ignored).
+struct Domain {
+  Point lo = Point::Zero();
+  Point hi = Point::Ones();
+  int dim = 3;
+};
+
+// Domain boundary pieces: face 2*axis + (0 for the low side, 1 for the high side).
+inline int box_face(int axis, bool high) { return 2 * axis + (high ? 1 : 0); }
+
+struct ArrangementOptions {
+  // Seeding grid: cells along the longest domain axis. Results are identical for every value
+  // in the supported range (see tests/stc/arrangement_test.cpp).
+  int seed_resolution = 24;
+  // Tracing step as a fraction of the domain diagonal.
+  double step = 0.004;
+  // Newton tolerance on field values, relative to the field gradient (a length).
+  double tolerance = 1e-11;
+};
+
+// A 0-cell: d sheets meet transversally at x.
+struct Vertex {
+  std::vector<int> sheets;  // sorted ascending, d entries
+  Point x;
+  int orientation = 1;  // sign of det of the sheets' gradients, in sheet order
+  int found = 0;        // how many of its d curves reported it (must be d)
+};
+
+// Where a 1-cell ends: at a vertex, or on the domain boundary (a face).
+struct CurveEnd {
+  int vertex = -1;  // vertex index or -1
+  int face = -1;    // box face when vertex < 0
+  Point x;
+};
+
+// A 1-cell: piece of the curve where d-1 sheets meet, between two consecutive events.
+struct Edge1 {
+  std::vector<int> sheets;  // d-1 sheets, sorted
+  CurveEnd a, b;
+  std::vector<int> side;    // sign (+1/-1) of every sheet at the 1-cell's midpoint
+};
+
+// One traced component of the meeting curve of d-1 sheets.
+struct Curve {
+  std::vector<int> sheets;
+  std::vector<Point> polyline;
+  bool closed = false;
+  std::array<int, 2> end_faces{-1, -1};  // box faces at the two ends when open
+};
+
+struct Arrangement {
+  Domain domain;
+  int sheet_count = 0;
+  std::vector<std::string> sheet_names;
+  std::vector<Vertex> vertices;  // in a deterministic order (sheets, then position)
+  std::vector<Edge1> edges;
+  std::vector<Curve> curves;
+  // Region (d-cell) of each vertex octant: region[v][bits], bit i set when the i-th sheet
+  // of the vertex is positive there. Regions are numbered 0..region_count-1.
+  std::vector<std::array<int, 8>> region;
+  int region_count = 0;
+  // Per region: the box faces it touches (bit mask), a sign vector over all sheets.
+  std::vector<unsigned> region_faces;
+  std::vector<std::vector<int>> region_signs;
+};
+
+Arrangement compute_arrangement(const std::vector<Sheet>& sheets, const Domain& domain,
+                                const ArrangementOptions& options = {});
+
+}  // namespace geode::stc

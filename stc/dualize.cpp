@@ -1,0 +1,165 @@
+#include "stc/dualize.hpp"
+
+#include <algorithm>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "primal/errors.hpp"
+#include "primal/topology.hpp"
+
+namespace geode::stc {
+namespace {
+
+std::string sheet_list(const Arrangement& A, const std::vector<int>& S) {
+  std::string r;
+  for (std::size_t i = 0; i < S.size(); ++i)
+    r += (i ? ", '" : "'") + A.sheet_names[static_cast<std::size_t>(S[i])] + "'";
+  return r;
+}
+
+std::string where(const primal::Point& x, int dim) {
+  std::ostringstream s;
+  s.precision(5);
+  s << "(" << x[0] << ", " << x[1];
+  if (dim == 3) s << ", " << x[2];
+  s << ")";
+  return s.str();
+}
+
+// Euler characteristic of the link of every node. In a hex mesh the link of node v has a
+// vertex per edge at v, an edge per face at v and a triangle per hex at v; in a quad mesh a
+// vertex per edge at v and an edge per quad at v. A ball's interior node has a sphere (2) or
+// circle (0) as link; a boundary node a disk (1) or a path (1).
+std::vector<int> link_euler(const DualMesh& D, std::size_t nodes) {
+  std::vector<std::set<std::pair<int, int>>> edges(nodes);
+  std::vector<std::set<std::vector<int>>> faces(nodes);
+  std::vector<int> cells(nodes, 0);
+  auto key = [](int a, int b) { return std::make_pair(std::min(a, b), std::max(a, b)); };
+  if (D.dim == 3) {
+    for (const auto& h : D.hex.hexes) {
+      for (const auto& e : primal::topology::kHexEdgeCorners) {
+        edges[static_cast<std::size_t>(h[static_cast<std::size_t>(e[0])])].insert(key(h[static_cast<std::size_t>(e[0])], h[static_cast<std::size_t>(e[1])]));
+        edges[static_cast<std::size_t>(h[static_cast<std::size_t>(e[1])])].insert(key(h[static_cast<std::size_t>(e[0])], h[static_cast<std::size_t>(e[1])]));
+      }
+      for (const auto& f : primal::topology::kHexFaceCorners) {
+        std::vector<int> q;
+        for (int c : f) q.push_back(h[static_cast<std::size_t>(c)]);
+        std::sort(q.begin(), q.end());
+        for (int c : f) faces[static_cast<std::size_t>(h[static_cast<std::size_t>(c)])].insert(q);
+      }
+      for (int c : h) ++cells[static_cast<std::size_t>(c)];
+    }
+    std::vector<int> chi(nodes);
+    for (std::size_t v = 0; v < nodes; ++v)
+      chi[v] = static_cast<int>(edges[v].size()) - static_cast<int>(faces[v].size()) + cells[v];
+    return chi;
+  }
+  for (const auto& q : D.quad.quads) {
+    for (const auto& e : primal::topology::kQuadEdgeCorners) {
+      const int a = q[static_cast<std::size_t>(e[0])], b = q[static_cast<std::size_t>(e[1])];
+      edges[static_cast<std::size_t>(a)].insert(key(a, b));
+      edges[static_cast<std::size_t>(b)].insert(key(a, b));
+    }
+    for (int c : q) ++cells[static_cast<std::size_t>(c)];
+  }
+  std::vector<int> chi(nodes);
+  for (std::size_t v = 0; v < nodes; ++v) chi[v] = static_cast<int>(edges[v].size()) - cells[v];
+  return chi;
+}
+
+}  // namespace
+
+DualMesh dualize(const Arrangement& A) {
+  const int dim = A.domain.dim;
+  DualMesh D;
+  D.dim = dim;
+  const int corners = 1 << dim;
+  // Number the nodes in the order they first appear as element corners.
+  std::vector<int> node_of_region(static_cast<std::size_t>(A.region_count), -1);
+  std::vector<int> region_of_node;
+  auto node = [&](int region) {
+    int& n = node_of_region[static_cast<std::size_t>(region)];
+    if (n < 0) {
+      n = static_cast<int>(region_of_node.size());
+      region_of_node.push_back(region);
+    }
+    return n;
+  };
+  for (std::size_t v = 0; v < A.vertices.size(); ++v) {
+    const Vertex& V = A.vertices[v];
+    std::array<primal::Index, 8> cell{};
+    for (int c = 0; c < corners; ++c) {
+      // Corner c of the reference element sits on the positive side of sheet i when its
+      // local coordinate i is 1; a negative orientation mirrors the first axis.
+      const auto& rc = primal::topology::kHexCornerCoords[static_cast<std::size_t>(c)];
+      int bits = 0;
+      for (int i = 0; i < dim; ++i) {
+        bool pos = rc[static_cast<std::size_t>(i)] == 1;
+        if (i == 0 && V.orientation < 0) pos = !pos;
+        if (pos) bits |= 1 << i;
+      }
+      cell[static_cast<std::size_t>(c)] = node(A.region[v][static_cast<std::size_t>(bits)]);
+    }
+    std::set<primal::Index> distinct(cell.begin(), cell.begin() + corners);
+    if (static_cast<int>(distinct.size()) != corners)
+      throw TopologyError("dualize: around the vertex of sheets " + sheet_list(A, V.sheets) + " at " +
+                          where(V.x, dim) + " two octants are one region: its element would repeat a node");
+    if (dim == 3)
+      D.hex.hexes.push_back(cell);
+    else
+      D.quad.quads.push_back({cell[0], cell[1], cell[2], cell[3]});
+    D.element_sheets.push_back(V.sheets);
+    D.element_centres.push_back(V.x);
+  }
+  const std::size_t nodes = region_of_node.size();
+  if (static_cast<int>(nodes) != A.region_count)
+    throw TopologyError("dualize: " + std::to_string(A.region_count - static_cast<int>(nodes)) +
+                        " region(s) touch no vertex: a cell with no element around it");
+
+  // Node positions: the mean of the vertices around the region, put onto the box features it
+  // touches. A first guess only: node placement and smoothing come later.
+  std::vector<primal::Point> sum(nodes, primal::Point::Zero());
+  std::vector<int> count(nodes, 0);
+  auto accumulate = [&](const auto& elements) {
+    for (std::size_t e = 0; e < elements.size(); ++e)
+      for (auto n : elements[e]) {
+        sum[static_cast<std::size_t>(n)] += D.element_centres[e];
+        ++count[static_cast<std::size_t>(n)];
+      }
+  };
+  if (dim == 3) accumulate(D.hex.hexes); else accumulate(D.quad.quads);
+  std::vector<primal::Point> pts(nodes);
+  for (std::size_t n = 0; n < nodes; ++n) {
+    const int r = region_of_node[n];
+    primal::Point p = sum[n] / count[n];
+    const unsigned f = A.region_faces[static_cast<std::size_t>(r)];
+    for (int axis = 0; axis < dim; ++axis) {
+      if ((f >> (2 * axis)) & 1u) p[axis] = A.domain.lo[axis];
+      if ((f >> (2 * axis + 1)) & 1u) p[axis] = A.domain.hi[axis];
+    }
+    pts[n] = p;
+    D.node_faces.push_back(f);
+    D.node_signs.push_back(A.region_signs[static_cast<std::size_t>(r)]);
+  }
+  if (dim == 3) D.hex.points = pts; else D.quad.points = pts;
+
+  // Every region must be a ball (a half-ball at the boundary).
+  const std::vector<int> chi = link_euler(D, nodes);
+  for (std::size_t n = 0; n < nodes; ++n) {
+    const bool boundary = D.node_faces[n] != 0;
+    const int expect = boundary ? 1 : (dim == 3 ? 2 : 0);
+    if (chi[n] != expect) {
+      std::string s;
+      for (std::size_t i = 0; i < D.node_signs[n].size(); ++i)
+        s += std::string(i ? ", " : "") + A.sheet_names[i] + (D.node_signs[n][i] > 0 ? "+" : "-");
+      throw TopologyError("dualize: the region on sides {" + s + "} near " + where(pts[n], dim) + " is not a " +
+                          (boundary ? "half-ball meeting the boundary in one disk" : "ball") +
+                          " (its node's link has Euler characteristic " + std::to_string(chi[n]) + ", expected " +
+                          std::to_string(expect) + ")");
+    }
+  }
+  return D;
+}
+
+}  // namespace geode::stc
