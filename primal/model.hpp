@@ -5,9 +5,9 @@
 //
 // Conventions:
 // - Element connectivity is in VTK/Exodus order (primal/topology.hpp); readers convert.
-// - Element order after reading is block by block (ascending block id), hexes and tets in
-//   their own arrays; writers emit blocks in ascending id, so a model whose elements are
-//   already grouped by block round-trips exactly.
+// - Element order after reading is block by block (Gmsh: ascending block id; Exodus: file
+//   order), hexes and tets in their own arrays; writers emit blocks in ascending id, so a
+//   model whose elements are already grouped by ascending block round-trips exactly.
 // - A side is (element, local face) with the face numbered as in topology.hpp
 //   (kHexFaceCorners / kTetFaceCorners), which is the Exodus side number minus one.
 #include <compare>

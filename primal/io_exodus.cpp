@@ -1,0 +1,320 @@
+#include "primal/io_exodus.hpp"
+
+#include <exodusII.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "primal/errors.hpp"
+#include "primal/topology.hpp"
+
+namespace geode::primal {
+
+namespace {
+
+// Longer names than Exodus's default 32 characters.
+constexpr int kNameLength = 80;
+
+// Owns an open Exodus file id.
+class ExodusFile {
+ public:
+  explicit ExodusFile(int id) : id_(id) {}
+  ~ExodusFile() {
+    if (id_ >= 0) ex_close(id_);
+  }
+  ExodusFile(const ExodusFile&) = delete;
+  ExodusFile& operator=(const ExodusFile&) = delete;
+  int id() const { return id_; }
+  int close() {
+    const int status = ex_close(id_);
+    id_ = -1;
+    return status;
+  }
+
+ private:
+  int id_;
+};
+
+void check(int status, const std::string& where, const std::string& what) {
+  if (status < 0) throw InvalidInput(where + ": " + what + " failed (Exodus status " + std::to_string(status) + ")");
+}
+
+// Names as Exodus wants them: an array of char* to buffers of kNameLength + 1.
+struct NameBuffers {
+  std::vector<std::vector<char>> storage;
+  std::vector<char*> pointers;
+  explicit NameBuffers(std::size_t n) : storage(n, std::vector<char>(kNameLength + 1, '\0')) {
+    for (auto& s : storage) pointers.push_back(s.data());
+  }
+  void set(std::size_t i, const std::string& name) {
+    std::copy_n(name.begin(), std::min<std::size_t>(name.size(), kNameLength), storage[i].begin());
+  }
+  std::string get(std::size_t i) const { return std::string(storage[i].data()); }
+};
+
+std::string upper(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return s;
+}
+
+}  // namespace
+
+Model read_exodus(const std::filesystem::path& path) {
+  const std::string source = path.string();
+  {
+    std::ifstream probe(path, std::ios::binary);
+    if (!probe || !std::filesystem::is_regular_file(path))
+      throw InvalidInput(source + ": cannot open file (missing or unreadable)");
+  }
+  ex_opts(0);  // we report errors ourselves, through exceptions
+  int cpu_word_size = 8, io_word_size = 0;
+  float version = 0.0f;
+  ExodusFile file(ex_open(source.c_str(), EX_READ, &cpu_word_size, &io_word_size, &version));
+  if (file.id() < 0) throw InvalidInput(source + ": not a readable Exodus II file (truncated or corrupt?)");
+  const int exo = file.id();
+  const int64_t used_name_length = ex_inquire_int(exo, EX_INQ_DB_MAX_USED_NAME_LENGTH);
+  ex_set_max_name_length(exo, static_cast<int>(std::clamp<int64_t>(used_name_length, 32, kNameLength)));
+
+  char title[MAX_LINE_LENGTH + 1] = {};
+  int num_dim = 0, num_nodes = 0, num_elem = 0, num_blocks = 0, num_node_sets = 0, num_side_sets = 0;
+  check(ex_get_init(exo, title, &num_dim, &num_nodes, &num_elem, &num_blocks, &num_node_sets, &num_side_sets),
+        source, "reading the header");
+  if (num_dim < 2 || num_dim > 3)
+    throw InvalidInput(source + ": " + std::to_string(num_dim) + "-dimensional model; expected 3 (or 2)");
+
+  Model model;
+  {
+    std::vector<double> x(static_cast<std::size_t>(num_nodes)), y(x.size()), z(x.size(), 0.0);
+    if (num_nodes > 0)
+      check(ex_get_coord(exo, x.data(), y.data(), num_dim == 3 ? z.data() : nullptr), source,
+            "reading coordinates");
+    for (std::size_t i = 0; i < x.size(); ++i) model.points.emplace_back(x[i], y[i], z[i]);
+  }
+
+  // Element blocks in file order; global element number (1-based) -> element.
+  std::vector<ElementRef> global;
+  if (num_blocks > 0) {
+    std::vector<int> ids(static_cast<std::size_t>(num_blocks));
+    check(ex_get_ids(exo, EX_ELEM_BLOCK, ids.data()), source, "reading element block ids");
+    NameBuffers names(ids.size());
+    if (ex_get_names(exo, EX_ELEM_BLOCK, names.pointers.data()) >= 0)
+      for (std::size_t b = 0; b < ids.size(); ++b)
+        if (!names.get(b).empty()) model.block_names[ids[b]] = names.get(b);
+    for (int id : ids) {
+      const std::string where = source + ": element block " + std::to_string(id);
+      char type_buffer[MAX_STR_LENGTH + 1] = {};
+      int count = 0, per_elem = 0, edges = 0, faces = 0, attributes = 0;
+      check(ex_get_block(exo, EX_ELEM_BLOCK, id, type_buffer, &count, &per_elem, &edges, &faces, &attributes),
+            where, "reading the block header");
+      const std::string type = upper(type_buffer);
+      const bool hex = per_elem == 8 && (type == "HEX8" || type == "HEX" || type == "HEXAHEDRON");
+      const bool tet = per_elem == 4 && (type == "TETRA4" || type == "TETRA" || type == "TET4" || type == "TET");
+      if (!hex && !tet)
+        throw InvalidInput(where + ": element " + std::to_string(global.size() + 1) + ": element type '" +
+                           std::string(type_buffer) + "' with " + std::to_string(per_elem) +
+                           " nodes is not supported; only HEX8 and TETRA4 are");
+      if (id <= 0) throw InvalidInput(where + ": block id is not positive");
+      std::vector<int> conn(static_cast<std::size_t>(count) * static_cast<std::size_t>(per_elem));
+      if (count > 0) check(ex_get_conn(exo, EX_ELEM_BLOCK, id, conn.data(), nullptr, nullptr), where, "reading connectivity");
+      for (int e = 0; e < count; ++e) {
+        const std::size_t base = static_cast<std::size_t>(e) * static_cast<std::size_t>(per_elem);
+        auto node = [&](int corner) {
+          const int n = conn[base + static_cast<std::size_t>(corner)];
+          if (n < 1 || n > num_nodes)
+            throw InvalidInput(where + ": element " + std::to_string(global.size() + 1) + ": corner " +
+                               std::to_string(corner + 1) + " refers to node " + std::to_string(n) +
+                               ", out of range [1, " + std::to_string(num_nodes) + "]");
+          return static_cast<Index>(n - 1);
+        };
+        if (hex) {
+          std::array<Index, 8> h{};
+          for (std::size_t c = 0; c < 8; ++c) h[c] = node(kExodusHexToVtk[c]);
+          global.push_back({ElementKind::Hex, static_cast<Index>(model.hexes.size())});
+          model.hexes.push_back(h);
+          model.hex_block.push_back(id);
+        } else {
+          std::array<Index, 4> t{};
+          for (std::size_t c = 0; c < 4; ++c) t[c] = node(kExodusTetToVtk[c]);
+          global.push_back({ElementKind::Tet, static_cast<Index>(model.tets.size())});
+          model.tets.push_back(t);
+          model.tet_block.push_back(id);
+        }
+      }
+    }
+  }
+
+  if (num_node_sets > 0) {
+    std::vector<int> ids(static_cast<std::size_t>(num_node_sets));
+    check(ex_get_ids(exo, EX_NODE_SET, ids.data()), source, "reading node set ids");
+    NameBuffers names(ids.size());
+    const bool named = ex_get_names(exo, EX_NODE_SET, names.pointers.data()) >= 0;
+    for (std::size_t s = 0; s < ids.size(); ++s) {
+      NodeSet set{ids[s], named ? names.get(s) : std::string(), {}};
+      const std::string where = source + ": node set " + std::to_string(set.id);
+      int count = 0, factors = 0;
+      check(ex_get_set_param(exo, EX_NODE_SET, set.id, &count, &factors), where, "reading the set header");
+      std::vector<int> nodes(static_cast<std::size_t>(count));
+      if (count > 0) check(ex_get_set(exo, EX_NODE_SET, set.id, nodes.data(), nullptr), where, "reading entries");
+      for (std::size_t i = 0; i < nodes.size(); ++i) {
+        if (nodes[i] < 1 || nodes[i] > num_nodes)
+          throw InvalidInput(where + ": entry " + std::to_string(i + 1) + " refers to node " +
+                             std::to_string(nodes[i]) + ", out of range");
+        set.nodes.push_back(static_cast<Index>(nodes[i] - 1));
+      }
+      model.node_sets.push_back(std::move(set));
+    }
+  }
+
+  if (num_side_sets > 0) {
+    std::vector<int> ids(static_cast<std::size_t>(num_side_sets));
+    check(ex_get_ids(exo, EX_SIDE_SET, ids.data()), source, "reading side set ids");
+    NameBuffers names(ids.size());
+    const bool named = ex_get_names(exo, EX_SIDE_SET, names.pointers.data()) >= 0;
+    for (std::size_t s = 0; s < ids.size(); ++s) {
+      SideSet set{ids[s], named ? names.get(s) : std::string(), {}};
+      const std::string where = source + ": side set " + std::to_string(set.id);
+      int count = 0, factors = 0;
+      check(ex_get_set_param(exo, EX_SIDE_SET, set.id, &count, &factors), where, "reading the set header");
+      std::vector<int> elems(static_cast<std::size_t>(count)), sides(elems.size());
+      if (count > 0) check(ex_get_set(exo, EX_SIDE_SET, set.id, elems.data(), sides.data()), where, "reading entries");
+      for (std::size_t i = 0; i < elems.size(); ++i) {
+        const std::string entry = where + ": entry " + std::to_string(i + 1);
+        if (elems[i] < 1 || static_cast<std::size_t>(elems[i]) > global.size())
+          throw InvalidInput(entry + " refers to element " + std::to_string(elems[i]) + ", out of range");
+        const ElementRef element = global[static_cast<std::size_t>(elems[i] - 1)];
+        const int faces = element.kind == ElementKind::Hex ? topology::kHexFaces : 4;
+        if (sides[i] < 1 || sides[i] > faces)
+          throw InvalidInput(entry + ": element " + std::to_string(elems[i]) + ": side " +
+                             std::to_string(sides[i]) + " out of range [1, " + std::to_string(faces) + "]");
+        set.sides.push_back({element, sides[i] - 1});
+      }
+      model.side_sets.push_back(std::move(set));
+    }
+  }
+  validate(model, source);
+  return model;
+}
+
+void write_exodus(const Model& model, const std::filesystem::path& path) {
+  const std::string target = path.string();
+  validate(model, target);
+
+  // Blocks in ascending id, each of one element type; global numbering follows.
+  std::map<int, std::pair<std::vector<Index>, std::vector<Index>>> blocks;  // id -> (hexes, tets)
+  for (std::size_t h = 0; h < model.hexes.size(); ++h)
+    blocks[block_of(model, {ElementKind::Hex, static_cast<Index>(h)})].first.push_back(static_cast<Index>(h));
+  for (std::size_t t = 0; t < model.tets.size(); ++t)
+    blocks[block_of(model, {ElementKind::Tet, static_cast<Index>(t)})].second.push_back(static_cast<Index>(t));
+  std::vector<int> hex_global(model.hexes.size()), tet_global(model.tets.size());
+  int next = 1;
+  for (const auto& [id, members] : blocks) {
+    if (!members.first.empty() && !members.second.empty())
+      throw InvalidInput(target + ": block " + std::to_string(id) +
+                         " holds both hexes and tets; an Exodus block holds one element type");
+    for (Index h : members.first) hex_global[static_cast<std::size_t>(h)] = next++;
+    for (Index t : members.second) tet_global[static_cast<std::size_t>(t)] = next++;
+  }
+
+  const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : ".";
+  const std::filesystem::path temp =
+      dir / ("." + path.filename().string() + ".geode-tmp-" + std::to_string(::getpid()));
+  try {
+    ex_opts(0);
+    int cpu_word_size = 8, io_word_size = 8;
+    ExodusFile file(ex_create(temp.string().c_str(), EX_CLOBBER, &cpu_word_size, &io_word_size));
+    if (file.id() < 0) throw InvalidInput(target + ": cannot create temporary file " + temp.string());
+    const int exo = file.id();
+    check(ex_set_max_name_length(exo, kNameLength), target, "setting the name length");
+    check(ex_put_init(exo, "geode", 3, static_cast<int64_t>(model.points.size()),
+                      static_cast<int64_t>(model.hexes.size() + model.tets.size()),
+                      static_cast<int64_t>(blocks.size()), static_cast<int64_t>(model.node_sets.size()),
+                      static_cast<int64_t>(model.side_sets.size())),
+          target, "writing the header");
+    if (!model.points.empty()) {
+      std::vector<double> x, y, z;
+      for (const Point& p : model.points) {
+        x.push_back(p.x());
+        y.push_back(p.y());
+        z.push_back(p.z());
+      }
+      check(ex_put_coord(exo, x.data(), y.data(), z.data()), target, "writing coordinates");
+    }
+    NameBuffers block_names(blocks.size());
+    std::size_t b = 0;
+    for (const auto& [id, members] : blocks) {
+      const bool hex = !members.first.empty();
+      const auto& list = hex ? members.first : members.second;
+      const int per_elem = hex ? 8 : 4;
+      check(ex_put_block(exo, EX_ELEM_BLOCK, id, hex ? "HEX8" : "TETRA4", static_cast<int64_t>(list.size()),
+                         per_elem, 0, 0, 0),
+            target, "writing block " + std::to_string(id));
+      std::vector<int> conn(list.size() * static_cast<std::size_t>(per_elem));
+      for (std::size_t i = 0; i < list.size(); ++i) {
+        const auto e = static_cast<std::size_t>(list[i]);
+        const std::size_t base = i * static_cast<std::size_t>(per_elem);
+        // exodus_corner[k*ToVtk[c]] = vtk_corner[c]
+        for (std::size_t c = 0; c < static_cast<std::size_t>(per_elem); ++c) {
+          if (hex)
+            conn[base + static_cast<std::size_t>(kExodusHexToVtk[c])] = model.hexes[e][c] + 1;
+          else
+            conn[base + static_cast<std::size_t>(kExodusTetToVtk[c])] = model.tets[e][c] + 1;
+        }
+      }
+      if (!conn.empty())
+        check(ex_put_conn(exo, EX_ELEM_BLOCK, id, conn.data(), nullptr, nullptr), target,
+              "writing block " + std::to_string(id) + " connectivity");
+      if (auto it = model.block_names.find(id); it != model.block_names.end()) block_names.set(b, it->second);
+      ++b;
+    }
+    if (!blocks.empty()) check(ex_put_names(exo, EX_ELEM_BLOCK, block_names.pointers.data()), target, "writing block names");
+
+    NameBuffers node_set_names(model.node_sets.size());
+    for (std::size_t s = 0; s < model.node_sets.size(); ++s) {
+      const NodeSet& set = model.node_sets[s];
+      check(ex_put_set_param(exo, EX_NODE_SET, set.id, static_cast<int64_t>(set.nodes.size()), 0), target,
+            "writing node set " + std::to_string(set.id));
+      std::vector<int> nodes;
+      for (Index v : set.nodes) nodes.push_back(v + 1);
+      if (!nodes.empty())
+        check(ex_put_set(exo, EX_NODE_SET, set.id, nodes.data(), nullptr), target,
+              "writing node set " + std::to_string(set.id));
+      node_set_names.set(s, set.name);
+    }
+    if (!model.node_sets.empty())
+      check(ex_put_names(exo, EX_NODE_SET, node_set_names.pointers.data()), target, "writing node set names");
+
+    NameBuffers side_set_names(model.side_sets.size());
+    for (std::size_t s = 0; s < model.side_sets.size(); ++s) {
+      const SideSet& set = model.side_sets[s];
+      check(ex_put_set_param(exo, EX_SIDE_SET, set.id, static_cast<int64_t>(set.sides.size()), 0), target,
+            "writing side set " + std::to_string(set.id));
+      std::vector<int> elems, sides;
+      for (const Side& side : set.sides) {
+        const auto e = static_cast<std::size_t>(side.element.index);
+        elems.push_back(side.element.kind == ElementKind::Hex ? hex_global[e] : tet_global[e]);
+        sides.push_back(side.face + 1);
+      }
+      if (!elems.empty())
+        check(ex_put_set(exo, EX_SIDE_SET, set.id, elems.data(), sides.data()), target,
+              "writing side set " + std::to_string(set.id));
+      side_set_names.set(s, set.name);
+    }
+    if (!model.side_sets.empty())
+      check(ex_put_names(exo, EX_SIDE_SET, side_set_names.pointers.data()), target, "writing side set names");
+    check(file.close(), target, "closing the temporary file");
+    std::error_code ec;
+    std::filesystem::rename(temp, path, ec);
+    if (ec) throw InvalidInput(target + ": cannot rename temporary file: " + ec.message());
+  } catch (...) {
+    std::error_code ignored;
+    std::filesystem::remove(temp, ignored);
+    throw;
+  }
+}
+
+}  // namespace geode::primal

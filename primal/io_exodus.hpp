@@ -1,0 +1,32 @@
+#pragma once
+// Exodus II input and output of a mixed hex + tet model (libexodusII): coordinates, element
+// blocks 'HEX8' / 'TETRA4', named node sets and side sets, block names.
+//
+// Node order: Exodus HEX8 and TETRA4 number their corners as VTK does (Exodus II manual,
+// "Element Types"; primal/topology.hpp), so kExodusHexToVtk / kExodusTetToVtk are the identity;
+// they are kept as data so that the conversion is visible. Side numbers are 1-based in the
+// file and 0-based (topology.hpp face order, which is Exodus's side order) in the Model.
+// Elements are numbered globally in block order in the file; the reader keeps the blocks in
+// file order, the writer writes them in ascending id (hexes and tets of one id cannot share an
+// Exodus block: writing such a model throws InvalidInput).
+#include <array>
+#include <filesystem>
+
+#include "primal/model.hpp"
+
+namespace geode::primal {
+
+// vtk_corner[i] = exodus_corner[kExodus*ToVtk[i]].
+inline constexpr std::array<int, 8> kExodusHexToVtk{0, 1, 2, 3, 4, 5, 6, 7};
+inline constexpr std::array<int, 4> kExodusTetToVtk{0, 1, 2, 3};
+
+// Throws InvalidInput naming the file, the block / element / set entry and the reason: missing
+// or unreadable file, not an Exodus file (e.g. truncated), an element type other than HEX8 /
+// TETRA4 (HEX / HEXAHEDRON / TETRA / TET4 with 8 / 4 nodes are accepted as aliases), a node or
+// element number out of range, a side number out of range.
+Model read_exodus(const std::filesystem::path& path);
+
+// Writes atomically (a temporary file in the same directory, then rename).
+void write_exodus(const Model& model, const std::filesystem::path& path);
+
+}  // namespace geode::primal
