@@ -16,7 +16,8 @@ Point flat(const Point& p) { return Point(p[0], 0.0, p[2]); }
 
 }  // namespace
 
-std::vector<Tunnel> complete_tunnels(const InterfacePatch& patch, const std::vector<double>& heights) {
+std::vector<Tunnel> complete_tunnels(const InterfacePatch& patch,
+                                     const std::function<double(const Point& along)>& height) {
   std::vector<Tunnel> out;
   if (patch.cells.size() != 1) throw InvalidInput("complete_tunnels: a template is built over one interface cell");
   const auto& cell = patch.cells.front();
@@ -26,7 +27,7 @@ std::vector<Tunnel> complete_tunnels(const InterfacePatch& patch, const std::vec
     // The dual of a segment is its midpoint; dicing doubles it at the quarter points.
     const Point mid = 0.5 * (P(0) + P(1));
     const double a = 0.25 * (P(1) - P(0)).norm();
-    const double h = heights.at(0);
+    const double h = height(Point::Zero());
     Tunnel t;
     t.sheet = {"tunnel", [mid, a, h](const Point& x) {
                  const double d = std::abs(x[0] - mid[0]) / a, y = x[1] / h;
@@ -43,7 +44,7 @@ std::vector<Tunnel> complete_tunnels(const InterfacePatch& patch, const std::vec
     const Point m1 = 0.5 * (P((i + 2) % 4) + P((i + 3) % 4));
     const Point dir = (m1 - m0).normalized();
     const double a = 0.25 * (P(i + 1) - P(i)).norm();
-    const double h = heights.at(static_cast<std::size_t>(i));
+    const double h = height(dir);
     Tunnel t;
     t.along = dir;
     t.sheet = {"tunnel " + std::to_string(i), [m0, dir, a, h](const Point& x) {

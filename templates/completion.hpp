@@ -6,6 +6,7 @@
 // side (v = 0) to the tet side (v = 1), w = z across (u, w in [-1, 1]). 2D uses u and v only.
 // The arrangement's topology does not change under the affine map to the real box, so the
 // template is derived once per choice and then mapped.
+#include <functional>
 #include <vector>
 
 #include "primal/mesh.hpp"
@@ -27,12 +28,14 @@ struct InterfacePatch {
 // doubled by dicing into two parallel copies; complete each pair into a tunnel over them:
 // f = (d / a)^2 + (v / height)^2 - 1, with d the distance from the pre-diced chord within the
 // interface plane and a the distance from it to the diced copies (a quarter of the edge it
-// crosses). Negative inside the tunnel. heights[i] is the roof of the tunnel of chord i.
+// crosses). Negative inside the tunnel. height(along) gives the roof of the tunnel whose
+// chord runs in direction `along` (2D: along is zero).
 struct Tunnel {
   stc::Sheet sheet;
   Point along;  // direction of the chord (3D); zero in 2D
 };
-std::vector<Tunnel> complete_tunnels(const InterfacePatch& quads, const std::vector<double>& heights);
+std::vector<Tunnel> complete_tunnels(const InterfacePatch& quads,
+                                     const std::function<double(const Point& along)>& height);
 
 // Tet side: the dual of the diced triangles is a circle around every original vertex,
 // crossing the halves of its edges away from it. Complete each circle into a dome over the

@@ -2,6 +2,9 @@
 // Geode transition templates derived from completed dual sheet arrangements (the paper's
 // Section 2). Nothing here is typed in: each template is the dual of its arrangement.
 #include <Eigen/Core>
+#include <string>
+#include <vector>
+
 #include "primal/mesh.hpp"
 
 namespace geode::templates {
@@ -15,12 +18,73 @@ enum class Diagonal { Main, Anti };
 // feet are the two dual chords of the diced bottom quad parallel to x) or along z.
 enum class Higher { X, Z };
 
+// How the tet-side quad is split: two triangles by a diagonal (the geode), or four around a
+// centre vertex (the paper's Section 5 variant).
+enum class TopSplit { TwoTriangles, FourTriangles };
+
+// How the two completed arrangements are pushed together, in reference units of the buffer
+// cell (height 1, half-width 1): the tunnels' roof heights, how deep the domes reach below
+// the tet side, and where each dome's circle crosses the diced tet interface (0: just
+// outside the diced nodes it must enclose, 1: just inside the nearest it must leave out).
+struct PushParameters {
+  double high_roof = 0.85;
+  double low_roof = 0.6;
+  double dome_depth = 0.9;
+  double dome_radius = 0.6;
+};
+
 // The buffer cell: an axis-aligned box centred at the origin, y up; the tet side (diced
-// triangles) on top (y = +box.y/2), the hex side (diced quad) at the bottom.
+// triangles) on top (y = +box.y/2), the hex side (diced quad) at the bottom. 2D templates use
+// box.x and box.y.
 struct GeodeOptions {
   Eigen::Vector3d box{24.0, 14.0, 24.0};
   Diagonal diagonal = Diagonal::Main;
   Higher higher = Higher::X;
+  TopSplit split = TopSplit::TwoTriangles;
+  PushParameters push;
 };
+
+// The paper's two conditions on the pushed-together arrangement (Section 2.2), evaluated on
+// the computed arrangement.
+struct InterleaveChecks {
+  // (1) every point where three dome sheets meet lies inside both tunnels.
+  bool triple_domes_in_pocket = false;
+  int triple_dome_points = 0;
+  // (2) every dome-dome curve but the one(s) starting and ending on the tet face leaves the
+  // cell through a side inside a tunnel entrance.
+  bool dome_curves_exit_in_tunnels = false;
+  int dome_curves = 0;
+  int dome_curves_on_tet_face = 0;
+  std::vector<std::string> failures;
+  bool ok() const { return triple_domes_in_pocket && dome_curves_exit_in_tunnels; }
+};
+
+struct SheetInfo {
+  std::string name;
+  std::string kind;  // "tunnel" or "dome"
+};
+
+struct Template {
+  int dim = 3;
+  primal::HexMesh hex;    // dim 3: corner order as primal/topology.hpp, nodes in the box
+  primal::QuadMesh quad;  // dim 2: in the (x, y) plane
+  std::vector<SheetInfo> sheets;
+  std::vector<std::vector<int>> element_sheets;  // sheets meeting in each element
+  std::vector<unsigned> node_faces;  // box faces under each node: bit 2*axis + (high side)
+  InterleaveChecks checks;
+};
+
+// Derive a template: complete the diced interfaces' duals into tunnels and domes, push them
+// together, compute the arrangement and dualize it. Top and bottom nodes are placed exactly
+// where dicing puts them; a node is matched to its diced position by the sides of every
+// sheet it lies on, so a boundary that differs from the prescribed diced interface is an
+// error, not a silent mismatch. Other nodes get the dual's first guess (see smoothing).
+// Throws TopologyError with the diagnosis when the arrangement does not dualize to a valid
+// mesh, and InvalidInput for a degenerate box.
+Template build_geode3d(const GeodeOptions& options);
+Template build_geode2d(const GeodeOptions& options);
+
+// Parse "24x14x24" (or "24x14" for 2D); InvalidInput naming the text otherwise.
+Eigen::Vector3d parse_box(const std::string& text);
 
 }  // namespace geode::templates

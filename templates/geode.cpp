@@ -1,0 +1,290 @@
+#include "templates/geode.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <regex>
+#include <set>
+
+#include "primal/errors.hpp"
+#include "primal/topology.hpp"
+#include "stc/arrangement.hpp"
+#include "stc/dualize.hpp"
+#include "templates/completion.hpp"
+
+namespace geode::templates {
+namespace {
+
+using primal::Index;
+
+// Reference buffer cell: u, w in [-1, 1] across, v in [0, 1] from the hex side up.
+stc::Domain reference_domain(int dim) {
+  if (dim == 2) return {Point(-1, 0, 0), Point(1, 1, 0), 2};
+  return {Point(-1, 0, -1), Point(1, 1, 1), 3};
+}
+
+Point to_box(const Point& r, const Eigen::Vector3d& box, int dim) {
+  return Point(0.5 * box.x() * r[0], box.y() * (r[1] - 0.5), dim == 3 ? 0.5 * box.z() * r[2] : 0.0);
+}
+
+std::string corner_name(const Point& p) {
+  return std::string("(") + (p[0] < 0 ? "-x" : "+x") + "," + (p[2] < 0 ? "-z" : "+z") + ")";
+}
+
+// Diced nodes of an interface patch: vertices, edge midpoints, cell centroids (3D), with the
+// diced cells as node lists. This is the prescribed boundary the template must reproduce.
+struct Diced {
+  std::vector<Point> nodes;
+  std::vector<std::vector<int>> cells;
+};
+
+Diced dice_patch(const InterfacePatch& p) {
+  Diced d;
+  d.nodes = p.points;
+  std::map<std::pair<int, int>, int> mid;
+  auto midpoint = [&](int a, int b) {
+    const auto key = std::make_pair(std::min(a, b), std::max(a, b));
+    auto it = mid.find(key);
+    if (it != mid.end()) return it->second;
+    d.nodes.push_back(0.5 * (p.points[static_cast<std::size_t>(a)] + p.points[static_cast<std::size_t>(b)]));
+    return mid[key] = static_cast<int>(d.nodes.size() - 1);
+  };
+  for (const auto& c : p.cells) {
+    const int n = static_cast<int>(c.size());
+    if (p.dim == 2) {
+      const int m = midpoint(c[0], c[1]);
+      d.cells.push_back({c[0], m});
+      d.cells.push_back({m, c[1]});
+      continue;
+    }
+    Point g = Point::Zero();
+    for (int i : c) g += p.points[static_cast<std::size_t>(i)];
+    d.nodes.push_back(g / n);
+    const int centre = static_cast<int>(d.nodes.size() - 1);
+    for (int i = 0; i < n; ++i)
+      d.cells.push_back({c[static_cast<std::size_t>(i)], midpoint(c[static_cast<std::size_t>(i)], c[static_cast<std::size_t>((i + 1) % n)]),
+                         centre, midpoint(c[static_cast<std::size_t>((i + n - 1) % n)], c[static_cast<std::size_t>(i)])});
+  }
+  return d;
+}
+
+// Box faces a reference point lies on.
+unsigned faces_of(const Point& r, const stc::Domain& D) {
+  unsigned f = 0;
+  for (int a = 0; a < D.dim; ++a) {
+    if (std::abs(r[a] - D.lo[a]) < 1e-12) f |= 1u << stc::box_face(a, false);
+    if (std::abs(r[a] - D.hi[a]) < 1e-12) f |= 1u << stc::box_face(a, true);
+  }
+  return f;
+}
+
+// Put the template's nodes on one interface face where dicing puts them. A dual node on that
+// face matches the diced node whose neighbourhood inside the cell has the same sides of every
+// sheet and which lies on the same box faces. Then every diced cell must be a boundary
+// element face of the template: the boundary is the prescribed one.
+void place_interface(const stc::DualMesh& D, const std::vector<stc::Sheet>& sheets, const Diced& diced,
+                     int face, const stc::Domain& dom, std::vector<Point>& pts, const char* side_name) {
+  const std::size_t nodes = D.node_faces.size();
+  std::vector<int> node_of(diced.nodes.size(), -1);
+  const Point centre = 0.5 * (dom.lo + dom.hi);
+  for (std::size_t i = 0; i < diced.nodes.size(); ++i) {
+    const Point q = diced.nodes[i];
+    // Sample just inside the cell, towards its centre, to read the sides of the sheets.
+    const Point s = q + 1e-7 * (centre - q);
+    std::vector<int> sg;
+    for (const auto& sh : sheets) sg.push_back(sh.field(s) < 0 ? -1 : 1);
+    const unsigned f = faces_of(q, dom);
+    for (std::size_t n = 0; n < nodes; ++n) {
+      if (D.node_faces[n] != f || D.node_signs[n] != sg) continue;
+      if (node_of[i] >= 0)
+        throw TopologyError(std::string("geode: two template nodes match the diced ") + side_name + " node " +
+                            std::to_string(i) + ": the boundary is not the prescribed one");
+      node_of[i] = static_cast<int>(n);
+    }
+    if (node_of[i] < 0)
+      throw TopologyError(std::string("geode: no template node matches the diced ") + side_name + " node " +
+                          std::to_string(i) + ": the boundary is not the prescribed one");
+  }
+  // Every dual node on that face must be matched, and every diced cell must be a face of it.
+  std::set<int> matched(node_of.begin(), node_of.end());
+  for (std::size_t n = 0; n < nodes; ++n)
+    if (((D.node_faces[n] >> face) & 1u) && !matched.count(static_cast<int>(n)))
+      throw TopologyError(std::string("geode: the template has a node on the ") + side_name +
+                          " face that the diced interface does not have");
+  std::set<std::vector<int>> faces;
+  auto add_faces = [&](const auto& elements, const auto& table) {
+    for (const auto& e : elements)
+      for (const auto& fc : table) {
+        std::vector<int> k;
+        for (int c : fc) k.push_back(e[static_cast<std::size_t>(c)]);
+        std::sort(k.begin(), k.end());
+        faces.insert(k);
+      }
+  };
+  if (D.dim == 3)
+    add_faces(D.hex.hexes, primal::topology::kHexFaceCorners);
+  else
+    add_faces(D.quad.quads, primal::topology::kQuadEdgeCorners);
+  for (const auto& c : diced.cells) {
+    std::vector<int> k;
+    for (int i : c) k.push_back(node_of[static_cast<std::size_t>(i)]);
+    std::sort(k.begin(), k.end());
+    if (!faces.count(k))
+      throw TopologyError(std::string("geode: a diced ") + side_name +
+                          " cell is not a face of the template: the boundary is not the prescribed one");
+  }
+  for (std::size_t i = 0; i < diced.nodes.size(); ++i) pts[static_cast<std::size_t>(node_of[i])] = diced.nodes[i];
+}
+
+InterleaveChecks check_interleave(const stc::Arrangement& A, const std::vector<SheetInfo>& info,
+                                  const std::vector<stc::Sheet>& sheets) {
+  InterleaveChecks c;
+  std::vector<int> tunnels, domes;
+  for (int s = 0; s < static_cast<int>(info.size()); ++s)
+    (info[static_cast<std::size_t>(s)].kind == "tunnel" ? tunnels : domes).push_back(s);
+  auto in_all_tunnels = [&](const Point& x) {
+    for (int t : tunnels)
+      if (sheets[static_cast<std::size_t>(t)].field(x) >= 0) return false;
+    return true;
+  };
+  auto in_some_tunnel = [&](const Point& x) {
+    for (int t : tunnels)
+      if (sheets[static_cast<std::size_t>(t)].field(x) < 0) return true;
+    return false;
+  };
+  auto is_dome = [&](int s) { return info[static_cast<std::size_t>(s)].kind == "dome"; };
+  c.triple_domes_in_pocket = true;
+  for (const auto& v : A.vertices) {
+    if (!std::all_of(v.sheets.begin(), v.sheets.end(), is_dome)) continue;
+    ++c.triple_dome_points;
+    if (!in_all_tunnels(v.x)) {
+      c.triple_domes_in_pocket = false;
+      c.failures.push_back("condition 1: the point where three domes meet is not inside both tunnels");
+    }
+  }
+  const int top = stc::box_face(1, true);
+  c.dome_curves_exit_in_tunnels = true;
+  for (const auto& cv : A.curves) {
+    if (A.domain.dim != 3 || cv.sheets.size() != 2 || !is_dome(cv.sheets[0]) || !is_dome(cv.sheets[1])) continue;
+    ++c.dome_curves;
+    if (cv.closed) {
+      c.dome_curves_exit_in_tunnels = false;
+      c.failures.push_back("condition 2: a dome-dome curve is closed inside the cell");
+      continue;
+    }
+    if (cv.end_faces[0] == top && cv.end_faces[1] == top) {
+      ++c.dome_curves_on_tet_face;
+      continue;
+    }
+    for (int e = 0; e < 2; ++e) {
+      const int f = cv.end_faces[static_cast<std::size_t>(e)];
+      if (f == top) continue;
+      const Point x = e == 0 ? cv.polyline.front() : cv.polyline.back();
+      if (f == stc::box_face(1, false) || !in_some_tunnel(x)) {
+        c.dome_curves_exit_in_tunnels = false;
+        c.failures.push_back("condition 2: the curve of " + info[static_cast<std::size_t>(cv.sheets[0])].name + " and " +
+                             info[static_cast<std::size_t>(cv.sheets[1])].name +
+                             " leaves the cell outside every tunnel entrance");
+      }
+    }
+  }
+  return c;
+}
+
+Template build(const GeodeOptions& o, int dim) {
+  for (int a = 0; a < dim; ++a)
+    if (!(o.box[a] > 0) || !std::isfinite(o.box[a]))
+      throw InvalidInput("geode: box dimensions must be positive and finite");
+  const PushParameters& p = o.push;
+  if (!(0 < p.low_roof && p.low_roof < p.high_roof && p.high_roof < 1))
+    throw InvalidInput("geode: tunnel roofs must satisfy 0 < low < high < 1 (tunnels must not reach the tet side)");
+  if (!(0 < p.dome_depth && p.dome_depth < 1))
+    throw InvalidInput("geode: dome depth must be in (0, 1) (domes must not reach the hex side)");
+  if (!(0 < p.dome_radius && p.dome_radius < 1)) throw InvalidInput("geode: dome radius blend must be in (0, 1)");
+
+  // The interface cells before dicing, in reference coordinates.
+  InterfacePatch bottom, top;
+  bottom.dim = top.dim = dim;
+  if (dim == 2) {
+    bottom.points = {Point(-1, 0, 0), Point(1, 0, 0)};
+    bottom.cells = {{0, 1}};
+    top.points = {Point(-1, 1, 0), Point(1, 1, 0)};
+    top.cells = {{0, 1}};
+  } else {
+    bottom.points = {Point(-1, 0, -1), Point(1, 0, -1), Point(1, 0, 1), Point(-1, 0, 1)};
+    bottom.cells = {{0, 1, 2, 3}};
+    // Top corners, counter-clockwise seen from above (y up): (-x,+z) (+x,+z) (+x,-z) (-x,-z).
+    top.points = {Point(-1, 1, 1), Point(1, 1, 1), Point(1, 1, -1), Point(-1, 1, -1)};
+    if (o.split == TopSplit::FourTriangles) {
+      top.points.push_back(Point(0, 1, 0));
+      top.cells = {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}};
+    } else if (o.diagonal == Diagonal::Main) {
+      top.cells = {{0, 1, 2}, {0, 2, 3}};
+    } else {
+      top.cells = {{0, 1, 3}, {1, 2, 3}};
+    }
+  }
+
+  // Complete both duals and push them together.
+  const auto tunnels = complete_tunnels(bottom, [&](const Point& along) {
+    if (dim == 2) return p.high_roof;
+    const bool along_x = std::abs(along.x()) > std::abs(along.z());
+    return along_x == (o.higher == Higher::X) ? p.high_roof : p.low_roof;
+  });
+  const auto domes = complete_domes(top, 1.0, p.dome_depth, p.dome_radius);
+  std::vector<stc::Sheet> sheets;
+  Template T;
+  T.dim = dim;
+  for (const auto& t : tunnels) {
+    stc::Sheet s = t.sheet;
+    if (dim == 3) s.name = std::abs(t.along.x()) > std::abs(t.along.z()) ? "tunnel x" : "tunnel z";
+    sheets.push_back(s);
+  }
+  for (const auto& d : domes) {
+    stc::Sheet s = d.sheet;
+    const Point& v = top.points[static_cast<std::size_t>(d.vertex)];
+    s.name = dim == 2 ? std::string("dome ") + (v.x() < 0 ? "-x" : "+x")
+                      : (std::abs(v.x()) < 1e-12 ? std::string("dome centre") : "dome " + corner_name(v));
+    sheets.push_back(s);
+  }
+  for (const auto& s : sheets) T.sheets.push_back({s.name, s.kind});
+
+  const stc::Domain dom = reference_domain(dim);
+  const stc::Arrangement A = stc::compute_arrangement(sheets, dom);
+  T.checks = check_interleave(A, T.sheets, sheets);
+  const stc::DualMesh D = stc::dualize(A);
+
+  std::vector<Point> pts = dim == 3 ? D.hex.points : D.quad.points;
+  place_interface(D, sheets, dice_patch(bottom), stc::box_face(1, false), dom, pts, "hex-side");
+  place_interface(D, sheets, dice_patch(top), stc::box_face(1, true), dom, pts, "tet-side");
+  for (auto& q : pts) q = to_box(q, o.box, dim);
+  if (dim == 3) {
+    T.hex.hexes = D.hex.hexes;
+    T.hex.points = pts;
+  } else {
+    T.quad.quads = D.quad.quads;
+    T.quad.points = pts;
+  }
+  T.element_sheets = D.element_sheets;
+  T.node_faces = D.node_faces;
+  return T;
+}
+
+}  // namespace
+
+Template build_geode3d(const GeodeOptions& options) { return build(options, 3); }
+Template build_geode2d(const GeodeOptions& options) { return build(options, 2); }
+
+Eigen::Vector3d parse_box(const std::string& text) {
+  static const std::regex re(R"(^\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*[xX]\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)(?:\s*[xX]\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?))?\s*$)");
+  std::smatch m;
+  if (!std::regex_match(text, m, re))
+    throw InvalidInput("--box '" + text + "': expected WIDTHxHEIGHTxDEPTH such as 24x14x24 (or 24x14 in 2D)");
+  Eigen::Vector3d b(std::stod(m[1]), std::stod(m[2]), m[3].matched ? std::stod(m[3]) : 0.0);
+  for (int a = 0; a < (m[3].matched ? 3 : 2); ++a)
+    if (!(b[a] > 0)) throw InvalidInput("--box '" + text + "': every dimension must be positive");
+  if (!m[3].matched) b.z() = b.x();
+  return b;
+}
+
+}  // namespace geode::templates

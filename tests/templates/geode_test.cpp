@@ -1,0 +1,129 @@
+// The geode templates come out of their sheet arrangements: compare them with the paper's
+// Appendix A by graph isomorphism, check validity, the prescribed boundary and the paper's
+// two interleaving conditions.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <set>
+
+#include "primal/errors.hpp"
+#include "support/fixtures.hpp"
+#include "support/isomorphism.hpp"
+#include "templates/geode.hpp"
+
+using namespace geode;
+using templates::GeodeOptions;
+
+namespace {
+
+// Labels: which box faces (top, bottom, sides) a node lies on, so that the isomorphism must
+// map the tet side to the tet side and the hex side to the hex side.
+int side_label(const primal::Point& p, const Eigen::Vector3d& box) {
+  const double eps = 1e-6 * box.norm();
+  int l = 0;
+  if (std::abs(p.y() - 0.5 * box.y()) < eps) l |= 1;
+  if (std::abs(p.y() + 0.5 * box.y()) < eps) l |= 2;
+  if (std::abs(std::abs(p.x()) - 0.5 * box.x()) < eps || std::abs(std::abs(p.z()) - 0.5 * box.z()) < eps) l |= 4;
+  return l;
+}
+
+test::NodeLabels labels(const primal::HexMesh& a, const primal::HexMesh& b, const Eigen::Vector3d& box) {
+  test::NodeLabels L;
+  for (const auto& p : a.points) L.first.push_back(side_label(p, box));
+  for (const auto& p : b.points) L.second.push_back(side_label(p, box));
+  return L;
+}
+
+primal::QuadMesh side_face(const primal::HexMesh& m, int axis, double value) {
+  return test::boundary_quads(m, [=](const primal::Point& p) { return std::abs(p[axis] - value) < 1e-9; });
+}
+
+}  // namespace
+
+TEST_CASE("geode3d: the derived template is isomorphic to the paper's Appendix A") {
+  const GeodeOptions o;
+  const auto T = templates::build_geode3d(o);
+  CHECK(T.hex.hexes.size() == 26);
+  CHECK(T.hex.points.size() == 48);
+  const primal::HexMesh ref = test::appendix_a_geode();
+  const auto m = test::find_isomorphism(T.hex, ref, labels(T.hex, ref, o.box));
+  REQUIRE(m.has_value());
+  CHECK(test::is_isomorphism(T.hex, ref, *m, labels(T.hex, ref, o.box)));
+  CHECK(T.checks.ok());
+  CHECK(T.checks.triple_dome_points == 2);
+  CHECK(T.checks.dome_curves_on_tet_face == 1);
+  // Six sheets: two tunnels and four domes.
+  int tunnels = 0, domes = 0;
+  for (const auto& s : T.sheets) (s.kind == "tunnel" ? tunnels : domes) += 1;
+  CHECK(tunnels == 2);
+  CHECK(domes == 4);
+}
+
+TEST_CASE("geode3d: tet-side and hex-side nodes sit exactly where dicing puts them") {
+  const GeodeOptions o;
+  const auto T = templates::build_geode3d(o);
+  std::set<std::pair<long, long>> top, bottom;
+  for (const auto& p : T.hex.points) {
+    auto key = std::make_pair(std::lround(p.x() * 1000), std::lround(p.z() * 1000));
+    if (std::abs(p.y() - 7) < 1e-9) top.insert(key);
+    if (std::abs(p.y() + 7) < 1e-9) bottom.insert(key);
+  }
+  // Diced quad: 3 x 3 grid at -12, 0, 12.
+  std::set<std::pair<long, long>> expect_bottom;
+  for (int i : {-12, 0, 12})
+    for (int j : {-12, 0, 12}) expect_bottom.insert({i * 1000, j * 1000});
+  CHECK(bottom == expect_bottom);
+  // Diced triangles (main diagonal (-12,12)-(12,-12)): corners, edge midpoints, the diagonal's
+  // midpoint and the two centroids (+-4, +-4).
+  std::set<std::pair<long, long>> expect_top = expect_bottom;
+  expect_top.insert({4000, 4000});
+  expect_top.insert({-4000, -4000});
+  CHECK(top == expect_top);
+}
+
+TEST_CASE("geode3d: other boxes, diagonals and tunnel orders give the same template") {
+  const primal::HexMesh ref = test::appendix_a_geode();
+  struct Case { Eigen::Vector3d box; templates::Diagonal d; templates::Higher h; };
+  for (const Case& c : {Case{{24, 14, 24}, templates::Diagonal::Anti, templates::Higher::X},
+                        Case{{24, 14, 24}, templates::Diagonal::Main, templates::Higher::Z},
+                        Case{{10, 30, 16}, templates::Diagonal::Main, templates::Higher::X}}) {
+    GeodeOptions o;
+    o.box = c.box;
+    o.diagonal = c.d;
+    o.higher = c.h;
+    const auto T = templates::build_geode3d(o);
+    CAPTURE(c.box.transpose());
+    CHECK(test::find_isomorphism(T.hex, ref).has_value());
+  }
+}
+
+TEST_CASE("geode2d: the 2D geode has five quads and is each side face of the 3D geode") {
+  GeodeOptions o;
+  const auto T2 = templates::build_geode2d(o);
+  CHECK(T2.quad.quads.size() == 5);
+  CHECK(T2.quad.points.size() == 9);
+  const auto T3 = templates::build_geode3d(o);
+  for (int axis : {0, 2})
+    for (double s : {-12.0, 12.0}) {
+      const primal::QuadMesh side = side_face(T3.hex, axis, s);
+      CAPTURE(axis);
+      CAPTURE(s);
+      CHECK(side.quads.size() == 5);
+      CHECK(test::find_isomorphism(side, T2.quad).has_value());
+    }
+}
+
+TEST_CASE("geode: pushing the arrangements too little is diagnosed, not meshed") {
+  GeodeOptions o;
+  o.push.dome_depth = 0.3;  // domes stay above the tunnels: dome-tunnel curves with no vertex
+  CHECK_THROWS_AS(templates::build_geode3d(o), TopologyError);
+}
+
+TEST_CASE("geode: bad options are rejected") {
+  GeodeOptions o;
+  o.push.high_roof = 1.2;
+  CHECK_THROWS_AS(templates::build_geode3d(o), InvalidInput);
+  CHECK_THROWS_AS(templates::parse_box("24x14x"), InvalidInput);
+  CHECK_THROWS_AS(templates::parse_box("24x-1x3"), InvalidInput);
+  CHECK(templates::parse_box("24x14x24") == Eigen::Vector3d(24, 14, 24));
+}
