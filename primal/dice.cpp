@@ -1,0 +1,240 @@
+#include "primal/dice.hpp"
+
+#include <bit>
+#include <string>
+#include <unordered_map>
+
+#include "primal/errors.hpp"
+#include "primal/topology.hpp"
+
+namespace geode::primal {
+
+namespace topo = topology;
+
+namespace {
+
+// A child corner is the centroid of a subset of its parent's corners (a bit mask over the
+// parent's local corners): one corner, an edge, a face or the whole element.
+using Support = unsigned;
+
+template <std::size_t NChildren, std::size_t NCorners>
+using ChildTable = std::array<std::array<Support, NCorners>, NChildren>;
+
+// Hex (dim 3) or quad (dim 2) at parent corner c: child corner k sits at c + k on the doubled
+// grid {0,1,2}^dim; its support is the parent corners that agree with it on every axis where
+// it is not at 1 (the middle). Corner coordinates come from topology::kHexCornerCoords, whose
+// first four entries are the quad's counter-clockwise corners.
+template <int Dim>
+ChildTable<(1u << Dim), (1u << Dim)> tensor_children() {
+  constexpr int n = 1 << Dim;
+  ChildTable<n, n> t{};
+  for (int c = 0; c < n; ++c) {
+    for (int k = 0; k < n; ++k) {
+      Support s = 0;
+      for (int q = 0; q < n; ++q) {
+        bool agrees = true;
+        for (int d = 0; d < Dim; ++d) {
+          const int p = topo::kHexCornerCoords[c][d] + topo::kHexCornerCoords[k][d];
+          if (p != 1 && topo::kHexCornerCoords[q][d] != p / 2) agrees = false;
+        }
+        if (agrees) s |= 1u << q;
+      }
+      t[c][k] = s;
+    }
+  }
+  return t;
+}
+
+// Simplex (Dim + 1 corners) -> Dim-cube children. Child at corner i uses the other corners
+// (a, b[, c]) in an order making (i, a, b[, c]) an even permutation of (0, 1, ...), so that
+// the child's axes a - i, b - i[, c - i] have the parent's orientation. Child corner k with
+// cube coordinates (r, s[, t]) is the centroid of {i} + {a if r} + {b if s} + {c if t}.
+template <int Dim>
+ChildTable<Dim + 1, (1u << Dim)> simplex_children() {
+  constexpr int n = Dim + 1;
+  ChildTable<n, (1u << Dim)> t{};
+  for (int i = 0; i < n; ++i) {
+    std::array<int, n> order{};
+    order[0] = i;
+    for (int j = 0, m = 1; j < n; ++j) {
+      if (j != i) order[m++] = j;
+    }
+    int inversions = 0;
+    for (int x = 0; x < n; ++x) {
+      for (int y = x + 1; y < n; ++y) inversions += order[x] > order[y];
+    }
+    if (inversions % 2) std::swap(order[n - 2], order[n - 1]);
+    for (int k = 0; k < (1 << Dim); ++k) {
+      Support s = 1u << i;
+      for (int d = 0; d < Dim; ++d) {
+        if (topo::kHexCornerCoords[k][d]) s |= 1u << order[d + 1];
+      }
+      t[i][k] = s;
+    }
+  }
+  return t;
+}
+
+template <typename ChildArray>
+struct Diced {
+  std::vector<Point> points;
+  std::vector<ChildArray> elements;
+  std::vector<NodeOrigin> origin;
+  std::vector<Index> parent;
+};
+
+// The dicing engine shared by the four element types. `dim` tells whether a support that is
+// neither a corner, an edge nor the whole element is a face (3D).
+template <std::size_t NP, std::size_t NChildren, std::size_t NC>
+Diced<std::array<Index, NC>> dice_elements(const std::vector<Point>& points,
+                                           const std::vector<std::array<Index, NP>>& elements,
+                                           const ChildTable<NChildren, NC>& table,
+                                           const char* what) {
+  const auto nv = static_cast<Index>(points.size());
+  for (std::size_t e = 0; e < elements.size(); ++e) {
+    for (std::size_t c = 0; c < NP; ++c) {
+      const Index v = elements[e][c];
+      if (v < 0 || v >= nv) {
+        throw InvalidInput(std::string("dice: ") + what + " " + std::to_string(e) + " corner " +
+                           std::to_string(c) + ": node " + std::to_string(v) +
+                           " out of range [0, " + std::to_string(nv) + ")");
+      }
+    }
+  }
+  constexpr Support kAll = (1u << NP) - 1;
+
+  // Pass 1: number edges and faces in order of first appearance.
+  std::unordered_map<FaceKey, Index, IndexArrayHash> edge_id, face_id;
+  std::vector<FaceKey> edge_keys, face_keys;
+  auto key_of = [&](const std::array<Index, NP>& elem, Support s) {
+    std::array<Index, 4> nodes{};
+    std::size_t n = 0;
+    for (std::size_t q = 0; q < NP; ++q) {
+      if (s & (1u << q)) nodes[n++] = elem[q];
+    }
+    FaceKey k = n == 2 ? FaceKey{std::min(nodes[0], nodes[1]), std::max(nodes[0], nodes[1]),
+                                 kInvalidIndex, kInvalidIndex}
+                       : face_key(std::span<const Index>(nodes.data(), n));
+    return k;
+  };
+  for (const auto& elem : elements) {
+    for (const auto& child : table) {
+      for (Support s : child) {
+        const int count = std::popcount(s);
+        if (count == 1 || s == kAll) continue;
+        const FaceKey k = key_of(elem, s);
+        auto& ids = count == 2 ? edge_id : face_id;
+        auto& keys = count == 2 ? edge_keys : face_keys;
+        if (ids.try_emplace(k, static_cast<Index>(keys.size())).second) keys.push_back(k);
+      }
+    }
+  }
+  const auto ne = static_cast<Index>(edge_keys.size());
+  const auto nf = static_cast<Index>(face_keys.size());
+
+  Diced<std::array<Index, NC>> out;
+  out.points = points;
+  out.origin.resize(points.size());
+  for (Index v = 0; v < nv; ++v) out.origin[v].nodes[0] = v;
+  auto centroid = [&](const FaceKey& k) {
+    Point p = Point::Zero();
+    int n = 0;
+    for (Index v : k) {
+      if (v == kInvalidIndex) break;
+      p += points[v];
+      ++n;
+    }
+    return Point(p / n);
+  };
+  for (const auto& k : edge_keys) {
+    out.points.push_back(centroid(k));
+    out.origin.push_back(NodeOrigin{NodeOriginKind::kEdge, k, kInvalidIndex});
+  }
+  for (const auto& k : face_keys) {
+    out.points.push_back(centroid(k));
+    out.origin.push_back(NodeOrigin{NodeOriginKind::kFace, k, kInvalidIndex});
+  }
+  for (std::size_t e = 0; e < elements.size(); ++e) {
+    Point p = Point::Zero();
+    for (Index v : elements[e]) p += points[v];
+    out.points.push_back(p / static_cast<double>(NP));
+    NodeOrigin o;
+    o.kind = NodeOriginKind::kCell;
+    o.element = static_cast<Index>(e);
+    out.origin.push_back(o);
+  }
+
+  // Pass 2: children.
+  for (std::size_t e = 0; e < elements.size(); ++e) {
+    const auto& elem = elements[e];
+    for (const auto& child : table) {
+      std::array<Index, NC> c{};
+      for (std::size_t k = 0; k < NC; ++k) {
+        const Support s = child[k];
+        const int count = std::popcount(s);
+        if (count == 1) {
+          c[k] = elem[static_cast<std::size_t>(std::countr_zero(s))];
+        } else if (s == kAll) {
+          c[k] = nv + ne + nf + static_cast<Index>(e);
+        } else if (count == 2) {
+          c[k] = nv + edge_id.at(key_of(elem, s));
+        } else {
+          c[k] = nv + ne + face_id.at(key_of(elem, s));
+        }
+      }
+      out.elements.push_back(c);
+      out.parent.push_back(static_cast<Index>(e));
+    }
+  }
+  return out;
+}
+
+template <typename Result, typename Diced>
+Result finish(Diced&& d, const std::vector<int>& block) {
+  Result r;
+  r.origin = std::move(d.origin);
+  r.parent = std::move(d.parent);
+  r.mesh.points = std::move(d.points);
+  if constexpr (std::is_same_v<Result, DicedHexMesh>) {
+    r.mesh.hexes = std::move(d.elements);
+    if (!block.empty()) {
+      for (Index p : r.parent) r.mesh.block.push_back(block.at(static_cast<std::size_t>(p)));
+    }
+  } else {
+    r.mesh.quads = std::move(d.elements);
+  }
+  return r;
+}
+
+void check_block(std::size_t block, std::size_t elements, const char* what) {
+  if (block != 0 && block != elements) {
+    throw InvalidInput(std::string("dice: ") + what + " mesh has " + std::to_string(elements) +
+                       " elements but " + std::to_string(block) + " block tags");
+  }
+}
+
+}  // namespace
+
+DicedHexMesh dice(const HexMesh& mesh) {
+  check_block(mesh.block.size(), mesh.hexes.size(), "hex");
+  static const auto table = tensor_children<3>();
+  return finish<DicedHexMesh>(dice_elements(mesh.points, mesh.hexes, table, "hex"), mesh.block);
+}
+
+DicedHexMesh dice(const TetMesh& mesh) {
+  check_block(mesh.block.size(), mesh.tets.size(), "tet");
+  static const auto table = simplex_children<3>();
+  return finish<DicedHexMesh>(dice_elements(mesh.points, mesh.tets, table, "tet"), mesh.block);
+}
+
+DicedQuadMesh dice(const QuadMesh& mesh) {
+  static const auto table = tensor_children<2>();
+  return finish<DicedQuadMesh>(dice_elements(mesh.points, mesh.quads, table, "quad"), {});
+}
+
+DicedQuadMesh dice(const TriMesh& mesh) {
+  static const auto table = simplex_children<2>();
+  return finish<DicedQuadMesh>(dice_elements(mesh.points, mesh.tris, table, "triangle"), {});
+}
+
+}  // namespace geode::primal

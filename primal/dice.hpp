@@ -1,0 +1,48 @@
+#pragma once
+// Dicing: split every element at its edge midpoints, face centres and centre. Quads -> 4
+// quads, triangles -> 3 quads, hexes -> 8 hexes, tets -> 4 hexes. Each edge and each face gets
+// one new node shared by all elements around it, so a conforming mesh dices into a conforming
+// mesh. Children keep the corner order of primal/topology.hpp and the orientation of their
+// parent: a positively oriented (VTK order) input gives positively oriented output.
+//
+// Node numbering of the result: the input points keep their numbers 0..V-1 (even unused
+// ones), then one node per edge, per face (3D only), per element, each group in order of first
+// appearance, so V' = V + E + F + C (hexes, tets) or V + E + F (quads, triangles).
+#include <cstdint>
+#include <vector>
+
+#include "primal/boundary.hpp"
+#include "primal/mesh.hpp"
+
+namespace geode::primal {
+
+enum class NodeOriginKind : std::uint8_t { kNode, kEdge, kFace, kCell };
+
+// What a node of a diced mesh came from.
+struct NodeOrigin {
+  NodeOriginKind kind = NodeOriginKind::kNode;
+  // kNode: {node}; kEdge: its 2 nodes; kFace: its 3 or 4 nodes; sorted ascending and padded
+  // with kInvalidIndex (a FaceKey). kCell: all kInvalidIndex.
+  FaceKey nodes{kInvalidIndex, kInvalidIndex, kInvalidIndex, kInvalidIndex};
+  Index element = kInvalidIndex;  // kCell: the input element it is the centre of
+};
+
+struct DicedHexMesh {
+  HexMesh mesh;                    // block copied from the parent element when given
+  std::vector<NodeOrigin> origin;  // per node of mesh
+  std::vector<Index> parent;       // per hex of mesh: the input element
+};
+
+struct DicedQuadMesh {
+  QuadMesh mesh;
+  std::vector<NodeOrigin> origin;
+  std::vector<Index> parent;
+};
+
+// Throw geode::InvalidInput naming the element if a node number is out of range.
+DicedHexMesh dice(const HexMesh& mesh);    // 8 hexes per hex, child c at parent corner c
+DicedHexMesh dice(const TetMesh& mesh);    // 4 hexes per tet, child c at parent corner c
+DicedQuadMesh dice(const QuadMesh& mesh);  // 4 per quad; like hexes
+DicedQuadMesh dice(const TriMesh& mesh);   // 3 per triangle; like tets
+
+}  // namespace geode::primal
