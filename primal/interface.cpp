@@ -1,0 +1,208 @@
+#include "primal/interface.hpp"
+
+#include <algorithm>
+#include <string>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "primal/boundary.hpp"
+#include "primal/errors.hpp"
+#include "primal/topology.hpp"
+
+namespace geode::primal {
+
+namespace {
+
+struct TetFaceUse {
+  Index tet = kInvalidIndex;
+  int face = -1;
+  std::array<Index, 3> nodes{};  // outward of the tet
+};
+
+std::string nodes_text(std::span<const Index> nodes) {
+  std::string s;
+  for (Index v : nodes) s += (s.empty() ? "" : " ") + std::to_string(v);
+  return s;
+}
+
+std::string quad_name(Index hex, int face, const std::array<Index, 4>& corners) {
+  return "hex " + std::to_string(hex) + " face " + std::to_string(face) + " (nodes " +
+         nodes_text(corners) + ")";
+}
+
+// Whether p lies on triangle (a, b, c), edges and corners included, within tol * longest edge.
+bool on_triangle(const Point& p, const Point& a, const Point& b, const Point& c, double tol) {
+  const Point n = (b - a).cross(c - a);
+  const double n2 = n.squaredNorm();
+  const double h = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+  if (n2 <= 0.0 || h <= 0.0) return false;
+  if (std::abs((p - a).dot(n)) / std::sqrt(n2) > tol * h) return false;
+  const double la = (b - p).cross(c - p).dot(n) / n2;
+  const double lb = (c - p).cross(a - p).dot(n) / n2;
+  const double lc = (a - p).cross(b - p).dot(n) / n2;
+  return la >= -tol && lb >= -tol && lc >= -tol;
+}
+
+}  // namespace
+
+std::array<std::array<Index, 3>, 2> interface_triangles(const InterfaceQuad& q) {
+  const auto& c = q.corners;
+  if (q.diagonal == 0) return {{{c[0], c[1], c[2]}, {c[0], c[2], c[3]}}};
+  return {{{c[0], c[1], c[3]}, {c[1], c[2], c[3]}}};
+}
+
+Interface find_interface(const Model& model, double tol) {
+  validate(model, "find_interface");
+  const auto& P = model.points;
+  auto pt = [&](Index v) -> const Point& { return P[static_cast<std::size_t>(v)]; };
+
+  // Boundary triangles of the tet part.
+  std::unordered_map<FaceKey, std::vector<TetFaceUse>, IndexArrayHash> tet_faces;
+  for (std::size_t t = 0; t < model.tets.size(); ++t)
+    for (int f = 0; f < 4; ++f) {
+      TetFaceUse use{static_cast<Index>(t), f, {}};
+      for (std::size_t i = 0; i < 3; ++i)
+        use.nodes[i] = model.tets[t][static_cast<std::size_t>(
+            topology::kTetFaceCorners[static_cast<std::size_t>(f)][i])];
+      auto& uses = tet_faces[face_key(use.nodes)];
+      uses.push_back(use);
+      if (uses.size() > 2)
+        throw TopologyError("find_interface: triangle (nodes " + nodes_text(use.nodes) +
+                            ") is a face of more than two tets (" + std::to_string(uses[0].tet) +
+                            ", " + std::to_string(uses[1].tet) + ", " + std::to_string(t) + ")");
+    }
+  std::unordered_set<FaceKey, IndexArrayHash> matched_tris;
+
+  const HexMesh hexes = hex_part(model);
+  const auto quads = boundary_quads(hexes);
+  Interface out;
+  std::vector<const BoundaryQuad*> unmatched_quads;
+  for (const BoundaryQuad& bq : quads) {
+    const auto& c = bq.nodes;
+    const std::array<std::array<std::array<Index, 3>, 2>, 2> splits{
+        {{{{c[0], c[1], c[2]}, {c[0], c[2], c[3]}}}, {{{c[0], c[1], c[3]}, {c[1], c[2], c[3]}}}}};
+    std::array<std::array<const TetFaceUse*, 2>, 2> found{};
+    int count = 0;
+    for (int d = 0; d < 2; ++d)
+      for (int i = 0; i < 2; ++i) {
+        auto it = tet_faces.find(
+            face_key(splits[static_cast<std::size_t>(d)][static_cast<std::size_t>(i)]));
+        if (it != tet_faces.end() && it->second.size() == 1) {
+          found[static_cast<std::size_t>(d)][static_cast<std::size_t>(i)] = &it->second[0];
+          ++count;
+        }
+      }
+    if (count == 0) {
+      unmatched_quads.push_back(&bq);
+      continue;
+    }
+    const std::string name = quad_name(bq.hex, bq.local_face, c);
+    const bool d0 = found[0][0] && found[0][1], d1 = found[1][0] && found[1][1];
+    if (count != 2 || !(d0 || d1)) {
+      std::string detail;
+      for (int d = 0; d < 2; ++d)
+        for (int i = 0; i < 2; ++i)
+          if (const TetFaceUse* u = found[static_cast<std::size_t>(d)][static_cast<std::size_t>(i)])
+            detail += (detail.empty() ? "" : ", ") + std::string("tet ") + std::to_string(u->tet) +
+                      " face " + std::to_string(u->face) + " (nodes " + nodes_text(u->nodes) + ")";
+      throw TopologyError("find_interface: " + name + " is matched by " +
+                          (count == 1
+                               ? std::string("only one triangle of the tet part")
+                               : std::to_string(count) + " triangles not forming one split") +
+                          ": " + detail);
+    }
+    InterfaceQuad q;
+    q.hex = bq.hex;
+    q.face = bq.local_face;
+    q.corners = c;
+    q.diagonal = d0 ? 0 : 1;
+    // The quad's normal points into the tet side; each tet's apex must lie there.
+    const Point normal = (pt(c[2]) - pt(c[0])).cross(pt(c[3]) - pt(c[1]));
+    const Point centre = (pt(c[0]) + pt(c[1]) + pt(c[2]) + pt(c[3])) / 4.0;
+    for (std::size_t i = 0; i < 2; ++i) {
+      const TetFaceUse& u = *found[static_cast<std::size_t>(q.diagonal)][i];
+      q.tets[i] = u.tet;
+      q.tet_faces[i] = u.face;
+      matched_tris.insert(face_key(u.nodes));
+      const auto& tet = model.tets[static_cast<std::size_t>(u.tet)];
+      Index apex = kInvalidIndex;
+      for (Index v : tet)
+        if (std::find(u.nodes.begin(), u.nodes.end(), v) == u.nodes.end()) apex = v;
+      if ((pt(apex) - centre).dot(normal) <= 0.0)
+        throw TopologyError("find_interface: tet " + std::to_string(u.tet) + " on " + name +
+                            " lies on the hex side of it (the parts overlap or are inverted)");
+    }
+    out.quads.push_back(q);
+  }
+
+  // Node-wise conformity: a node of one side must not lie on a face of the other side that
+  // does not have it as a corner. Candidates are unmatched boundary faces sharing a node.
+  std::unordered_map<Index, std::vector<const BoundaryQuad*>> quads_at;
+  for (const BoundaryQuad* bq : unmatched_quads)
+    for (Index v : bq->nodes) quads_at[v].push_back(bq);
+  // In tet order, so that the first offence reported does not depend on hashing.
+  for (std::size_t t = 0; t < model.tets.size(); ++t)
+    for (int f = 0; f < 4; ++f) {
+      std::array<Index, 3> nodes{};
+      for (std::size_t i = 0; i < 3; ++i)
+        nodes[i] = model.tets[t][static_cast<std::size_t>(
+            topology::kTetFaceCorners[static_cast<std::size_t>(f)][i])];
+      const FaceKey key = face_key(nodes);
+      const auto& uses = tet_faces.at(key);
+      if (uses.size() != 1 || matched_tris.count(key)) continue;
+      const TetFaceUse& tri = uses[0];
+      std::unordered_set<const BoundaryQuad*> seen;
+      for (Index v : tri.nodes) {
+        auto it = quads_at.find(v);
+        if (it == quads_at.end()) continue;
+        for (const BoundaryQuad* bq : it->second) {
+          if (!seen.insert(bq).second) continue;
+          const auto& c = bq->nodes;
+          auto has = [](auto& arr, Index x) {
+            return std::find(arr.begin(), arr.end(), x) != arr.end();
+          };
+          for (Index p : tri.nodes) {
+            if (has(c, p)) continue;
+            if (on_triangle(pt(p), pt(c[0]), pt(c[1]), pt(c[2]), tol) ||
+                on_triangle(pt(p), pt(c[0]), pt(c[2]), pt(c[3]), tol) ||
+                on_triangle(pt(p), pt(c[0]), pt(c[1]), pt(c[3]), tol) ||
+                on_triangle(pt(p), pt(c[1]), pt(c[2]), pt(c[3]), tol))
+              throw TopologyError(
+                  "find_interface: node " + std::to_string(p) + " of the tet part (tet " +
+                  std::to_string(tri.tet) + ") lies on " + quad_name(bq->hex, bq->local_face, c) +
+                  " but is not one of its corners: the parts do not conform node-wise");
+          }
+          for (Index p : c) {
+            if (has(tri.nodes, p)) continue;
+            if (on_triangle(pt(p), pt(tri.nodes[0]), pt(tri.nodes[1]), pt(tri.nodes[2]), tol))
+              throw TopologyError(
+                  "find_interface: node " + std::to_string(p) + " of the hex part (hex " +
+                  std::to_string(bq->hex) + ") lies on tet " + std::to_string(tri.tet) + " face " +
+                  std::to_string(tri.face) + " (nodes " + nodes_text(tri.nodes) +
+                  ") but is not one of its corners: the parts do not conform node-wise");
+          }
+        }
+      }
+    }
+
+  for (const InterfaceQuad& q : out.quads)
+    out.nodes.insert(out.nodes.end(), q.corners.begin(), q.corners.end());
+  std::sort(out.nodes.begin(), out.nodes.end());
+  out.nodes.erase(std::unique(out.nodes.begin(), out.nodes.end()), out.nodes.end());
+
+  // Nodes shared by both parts must be interface nodes.
+  std::vector<char> in_hex(P.size(), 0), in_tet(P.size(), 0);
+  for (const auto& h : model.hexes)
+    for (Index v : h) in_hex[static_cast<std::size_t>(v)] = 1;
+  for (const auto& t : model.tets)
+    for (Index v : t) in_tet[static_cast<std::size_t>(v)] = 1;
+  for (std::size_t v = 0; v < P.size(); ++v)
+    if (in_hex[v] && in_tet[v] &&
+        !std::binary_search(out.nodes.begin(), out.nodes.end(), static_cast<Index>(v)))
+      throw TopologyError("find_interface: node " + std::to_string(v) +
+                          " is used by both the hex and the tet part but lies on no interface quad "
+                          "(the parts touch along an edge or at a point only)");
+  return out;
+}
+
+}  // namespace geode::primal

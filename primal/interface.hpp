@@ -1,0 +1,48 @@
+#pragma once
+// The interface between the hex part and the tet part of a Model: the boundary quads of the
+// hex part whose two triangles (split along one diagonal) are boundary faces of the tet part.
+// Both parts must share the interface nodes (conform node-wise); merge coincident nodes first
+// (merge_coincident_nodes) if the input keeps the parts apart.
+#include <array>
+#include <vector>
+
+#include "primal/model.hpp"
+
+namespace geode::primal {
+
+struct InterfaceQuad {
+  Index hex = kInvalidIndex;   // the hex owning the quad
+  int face = -1;               // its local face (topology::kHexFaceCorners)
+  // The face's corners in kHexFaceCorners order: counter-clockwise seen from outside the hex,
+  // i.e. from the tet side.
+  std::array<Index, 4> corners{};
+  // Which diagonal the tets split the quad along: 0 joins corners[0]-corners[2], 1 joins
+  // corners[1]-corners[3]. Triangle i is then (c0 c1 c2), (c0 c2 c3) for diagonal 0 and
+  // (c0 c1 c3), (c1 c2 c3) for diagonal 1.
+  int diagonal = 0;
+  std::array<Index, 2> tets{kInvalidIndex, kInvalidIndex};  // tet owning triangle i
+  std::array<int, 2> tet_faces{-1, -1};                     // its local face (kTetFaceCorners)
+};
+
+struct Interface {
+  std::vector<InterfaceQuad> quads;  // in order of the hex part's boundary quads
+  std::vector<Index> nodes;          // every interface node, ascending
+};
+
+// The two triangles of an interface quad, as node triples in the quad's orientation.
+std::array<std::array<Index, 3>, 2> interface_triangles(const InterfaceQuad& quad);
+
+// Finds the interface. Throws TopologyError naming the hex face (hex, local face, nodes) or
+// node when the parts do not conform:
+// - a boundary quad of the hex part matched by only one triangle of the tet part (or by
+//   triangles of both diagonals);
+// - a node of one side lying on a boundary face of the other side without being one of its
+//   corners (hanging node, different refinement, unmerged duplicate node);
+// - a node used by both parts that is on no interface quad (the parts touch along an edge
+//   or at a point only);
+// - a tet on the hex side of the interface quad it touches (the parts overlap);
+// - a face shared by more than two tets.
+// `tolerance` is relative to the local edge length (used by the hanging-node test).
+Interface find_interface(const Model& model, double tolerance = 1e-6);
+
+}  // namespace geode::primal

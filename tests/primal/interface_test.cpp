@@ -1,0 +1,144 @@
+// Interface detection between the hex and tet parts of a model. Known answers are counted by
+// hand on small grids built by grid_model (Kuhn tets: every cell face is split along the
+// diagonal from its lowest to its highest corner).
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <set>
+#include <string>
+
+#include "primal/demo_models.hpp"
+#include "primal/errors.hpp"
+#include "primal/interface.hpp"
+#include "primal/topology.hpp"
+
+using namespace geode;
+using namespace geode::primal;
+
+namespace {
+
+// Appends b's points and elements to a (no sets), shifting b by `offset`.
+void append(Model& a, const Model& b, const Point& offset) {
+  const auto base = static_cast<Index>(a.points.size());
+  for (const Point& p : b.points) a.points.push_back(p + offset);
+  for (auto h : b.hexes) {
+    for (Index& v : h) v += base;
+    a.hexes.push_back(h);
+    a.hex_block.push_back(1);
+  }
+  for (auto t : b.tets) {
+    for (Index& v : t) v += base;
+    a.tets.push_back(t);
+    a.tet_block.push_back(2);
+  }
+}
+
+// Every interface quad's triangles are the named faces of the named tets, its hex face is the
+// named face of the named hex, and its diagonal is the lowest-to-highest corner pair (the Kuhn
+// split), which is corners 0-2 or 1-3 by position.
+void check_consistent(const Model& m, const Interface& itf) {
+  for (const InterfaceQuad& q : itf.quads) {
+    for (std::size_t i = 0; i < 4; ++i)
+      CHECK(q.corners[i] == m.hexes[static_cast<std::size_t>(q.hex)][static_cast<std::size_t>(
+                                topology::kHexFaceCorners[static_cast<std::size_t>(q.face)][i])]);
+    const auto tris = interface_triangles(q);
+    for (std::size_t i = 0; i < 2; ++i) {
+      std::set<Index> face;
+      for (int c : topology::kTetFaceCorners[static_cast<std::size_t>(q.tet_faces[i])])
+        face.insert(m.tets[static_cast<std::size_t>(q.tets[i])][static_cast<std::size_t>(c)]);
+      CHECK(face == std::set<Index>(tris[i].begin(), tris[i].end()));
+    }
+    // Kuhn diagonal: from the corner with the smallest coordinate sum to the largest.
+    auto sum = [&](Index v) { return m.points[static_cast<std::size_t>(v)].sum(); };
+    const auto lo = std::min_element(q.corners.begin(), q.corners.end(), [&](Index a, Index b) { return sum(a) < sum(b); });
+    const auto lo_pos = lo - q.corners.begin();
+    CHECK(q.diagonal == lo_pos % 2);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("find_interface: known counts on small grids") {
+  struct Row {
+    const char* name;
+    std::array<int, 3> cells;
+    std::function<bool(int, int, int)> is_tet;
+    std::size_t quads, nodes;
+  };
+  const Row rows[] = {
+      // One hex with a cube of 6 tets on its top face: 1 quad, its 4 corners.
+      {"one hex, tets on top", {1, 1, 2}, [](int, int, int k) { return k == 1; }, 1, 4},
+      // Half/half block 2x2x2: the x = 1 plane, 2x2 quads, 3x3 nodes.
+      {"half block", {2, 2, 2}, [](int i, int, int) { return i == 1; }, 4, 9},
+      // L-shaped hex part around one tet cell in a 2x2x1 block: two perpendicular quads
+      // sharing the concave edge: 6 nodes.
+      {"L-shaped", {2, 2, 1}, [](int i, int j, int) { return i == 1 && j == 1; }, 2, 6},
+      // Tet cell wrapped around a hex corner: 3 tet cells of a 2x2x1 block -> the hex cell's
+      // two inner faces, convex seen from the tets: 2 quads, 6 nodes.
+      {"convex edge", {2, 2, 1}, [](int i, int j, int) { return i == 1 || j == 1; }, 2, 6},
+      // A tet nugget in the middle of a 3x3x3 block: the 6 faces of the cavity, 8 corners.
+      {"enclosed nugget", {3, 3, 3}, [](int i, int j, int k) { return i == 1 && j == 1 && k == 1; }, 6, 8},
+  };
+  for (const Row& row : rows) {
+    CAPTURE(row.name);
+    const Model m = grid_model(row.cells, 1.0, row.is_tet);
+    const Interface itf = find_interface(m);
+    CHECK(itf.quads.size() == row.quads);
+    CHECK(itf.nodes.size() == row.nodes);
+    check_consistent(m, itf);
+  }
+}
+
+TEST_CASE("find_interface: one hex under tets, the face and diagonal by hand") {
+  const Model m = grid_model({1, 1, 2}, 1.0, [](int, int, int k) { return k == 1; });
+  const Interface itf = find_interface(m);
+  REQUIRE(itf.quads.size() == 1);
+  const InterfaceQuad& q = itf.quads[0];
+  CHECK(q.hex == 0);
+  CHECK(q.face == 5);  // top face (t-max), corners 4 5 6 7 = nodes 4 5 7 6 of the grid
+  CHECK(q.corners == std::array<Index, 4>{4, 5, 7, 6});
+  // Kuhn split of the tet cell joins (0,0,1) = node 4 and (1,1,1) = node 7: corners 0 and 2.
+  CHECK(q.diagonal == 0);
+  CHECK(itf.nodes == std::vector<Index>{4, 5, 6, 7});
+}
+
+TEST_CASE("find_interface: rejects non-conforming interfaces, naming the face or node") {
+  SUBCASE("a quad matched by one triangle only") {
+    Model m = grid_model({1, 1, 2}, 1.0, [](int, int, int k) { return k == 1; });
+    const Interface itf = find_interface(m);
+    const Index gone = itf.quads[0].tets[1];
+    m.tets.erase(m.tets.begin() + gone);
+    m.tet_block.erase(m.tet_block.begin() + gone);
+    CHECK_THROWS_WITH_AS(find_interface(m), doctest::Contains("hex 0 face 5 (nodes 4 5 7 6) is matched by only one triangle"),
+                         TopologyError);
+  }
+  SUBCASE("a hanging tet node in the middle of a hex face") {
+    Model m = grid_model({1, 1, 1}, 1.0, [](int, int, int) { return false; });
+    m.points.emplace_back(0.5, 0.5, 1.0);  // node 8: centre of the top face
+    m.points.emplace_back(0.5, 0.5, 2.0);  // node 9: apex
+    const std::array<Index, 4> top{4, 5, 7, 6};  // counter-clockwise seen from above
+    for (std::size_t i = 0; i < 4; ++i) {
+      m.tets.push_back({top[i], top[(i + 1) % 4], 8, 9});
+      m.tet_block.push_back(2);
+    }
+    for (const auto& t : m.tets)
+      REQUIRE(tet_volume(m.points[static_cast<std::size_t>(t[0])], m.points[static_cast<std::size_t>(t[1])],
+                         m.points[static_cast<std::size_t>(t[2])], m.points[static_cast<std::size_t>(t[3])]) > 0);
+    CHECK_THROWS_WITH_AS(find_interface(m),
+                         doctest::Contains("node 8 of the tet part (tet 0) lies on hex 0 face 5"),
+                         TopologyError);
+  }
+  SUBCASE("a finer hex side under one coarse tet cell") {
+    Model m = grid_model({2, 2, 1}, 0.5, [](int, int, int) { return false; });
+    append(m, grid_model({1, 1, 1}, 1.0, [](int, int, int) { return true; }), Point(0, 0, 0.5));
+    CHECK(merge_coincident_nodes(m, 1e-9) == 4);
+    // Hex-side node (0.5, 0, 0.5) = grid node 1 lies on the edge of a coarse triangle.
+    CHECK_THROWS_WITH_AS(find_interface(m), doctest::Contains("of the hex part"), TopologyError);
+  }
+  SUBCASE("parts touching along an edge only") {
+    Model m = grid_model({1, 1, 1}, 1.0, [](int, int, int) { return false; });
+    append(m, grid_model({1, 1, 1}, 1.0, [](int, int, int) { return true; }), Point(1, 1, 0));
+    CHECK(merge_coincident_nodes(m, 1e-9) == 2);
+    CHECK_THROWS_WITH_AS(find_interface(m), doctest::Contains("lies on no interface quad"), TopologyError);
+  }
+}
