@@ -1,0 +1,324 @@
+#include "stc/mesh_dual.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <numeric>
+#include <string>
+#include <unordered_map>
+
+#include "primal/errors.hpp"
+#include "primal/topology.hpp"
+
+namespace geode::stc {
+namespace {
+
+using primal::Index;
+namespace topo = primal::topology;
+
+// Reference-cell tables per dimension, read from primal/topology.hpp.
+template <int Dim>
+struct Ref;
+
+template <>
+struct Ref<3> {
+  static constexpr int kCorners = 8;
+  static constexpr int kFacets = 6;
+  static constexpr int kFacetSize = 4;
+  static constexpr const char* kCellName = "hex";
+  static constexpr const auto& edges = topo::kHexEdgeCorners;
+  static constexpr const auto& facets = topo::kHexFaceCorners;
+  static constexpr int edge_class(int e) { return e / 4; }  // topology.hpp: class e / 4
+};
+
+template <>
+struct Ref<2> {
+  static constexpr int kCorners = 4;
+  static constexpr int kFacets = 4;
+  static constexpr int kFacetSize = 2;
+  static constexpr const char* kCellName = "quad";
+  static constexpr const auto& edges = topo::kQuadEdgeCorners;
+  static constexpr const auto& facets = topo::kQuadEdgeCorners;
+  static constexpr int edge_class(int e) { return e % 2; }  // opposite edges i, i+2
+};
+
+struct UnionFind {
+  std::vector<Index> parent;
+  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  Index find(Index x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  }
+  void unite(Index a, Index b) { parent[find(a)] = find(b); }
+};
+
+std::uint64_t pair_key(Index a, Index b) {
+  if (a > b) std::swap(a, b);
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) |
+         static_cast<std::uint32_t>(b);
+}
+
+// Local hex edge joining two corners, from the edge table; -1 when they are not joined.
+int local_hex_edge(int a, int b) {
+  for (int e = 0; e < topo::kHexEdges; ++e) {
+    const auto& ec = topo::kHexEdgeCorners[e];
+    if ((ec[0] == a && ec[1] == b) || (ec[0] == b && ec[1] == a)) return e;
+  }
+  return -1;
+}
+
+// 3D traces: every boundary quad links, for each of its two pairs of opposite edges, the two
+// edges of that pair (they belong to one sheet: a face's opposite edges are parallel in its
+// hex). On a closed 2-manifold boundary each boundary edge has exactly two links, so the links
+// of one sheet form disjoint loops: walk them.
+void build_traces(const std::vector<std::array<Index, 8>>&, MeshDual<3>& dual) {
+  struct Link {
+    Index a, b;
+    CellFacet facet;
+  };
+  std::vector<Link> links;
+  for (const CellFacet& f : dual.boundary) {
+    const auto& fc = topo::kHexFaceCorners[f.local];
+    std::array<Index, 4> side{};  // global edges of the face's sides (c0c1, c1c2, c2c3, c3c0)
+    for (int k = 0; k < 4; ++k) {
+      const int e = local_hex_edge(fc[k], fc[(k + 1) % 4]);
+      assert(e >= 0);
+      side[k] = dual.cell_edges[f.cell][e];
+    }
+    links.push_back({side[0], side[2], f});
+    links.push_back({side[1], side[3], f});
+  }
+  std::vector<std::vector<Index>> at(dual.edges.size());  // links at each edge
+  for (std::size_t l = 0; l < links.size(); ++l) {
+    at[links[l].a].push_back(static_cast<Index>(l));
+    at[links[l].b].push_back(static_cast<Index>(l));
+  }
+  for (std::size_t e = 0; e < at.size(); ++e) {
+    if (!at[e].empty() && at[e].size() != 2) {
+      throw TopologyError("edge " + std::to_string(dual.edges[e][0]) + "-" +
+                          std::to_string(dual.edges[e][1]) + " lies on " +
+                          std::to_string(at[e].size()) +
+                          " boundary quads, not 2: the boundary is not a closed 2-manifold");
+    }
+  }
+  std::vector<char> used(links.size(), 0);
+  for (MeshSheet& sheet : dual.sheets) {
+    for (Index start : sheet.edges) {
+      if (at[start].empty() || used[at[start][0]]) continue;
+      TraceCurve curve;
+      curve.closed = true;
+      Index cur = start;
+      for (;;) {
+        Index next_link = -1;
+        for (Index l : at[cur])
+          if (!used[l]) next_link = l;
+        if (next_link < 0) break;  // back at the start: both links of `start` are used
+        used[next_link] = 1;
+        const Link& lk = links[next_link];
+        curve.edges.push_back(cur);
+        curve.facets.push_back(lk.facet);
+        cur = lk.a == cur ? lk.b : lk.a;
+      }
+      assert(cur == start);
+      sheet.trace.push_back(std::move(curve));
+    }
+  }
+}
+
+void build_traces(const std::vector<std::array<Index, 4>>&, MeshDual<2>& dual) {
+  // A chord ends where it crosses a boundary edge; the boundary facet is that edge.
+  for (const CellFacet& f : dual.boundary) {
+    const Index e = dual.cell_edges[f.cell][f.local];
+    dual.sheets[dual.edge_sheet[e]].trace.push_back(TraceCurve{{e}, {f}, false});
+  }
+}
+
+template <int Dim>
+MeshDual<Dim> build(std::size_t n_nodes, const std::vector<std::array<Index, Ref<Dim>::kCorners>>& cells) {
+  using R = Ref<Dim>;
+  MeshDual<Dim> dual;
+  const Index n_cells = static_cast<Index>(cells.size());
+
+  // Validate and number the edges.
+  std::unordered_map<std::uint64_t, Index> edge_id;
+  dual.cell_edges.resize(n_cells);
+  for (Index c = 0; c < n_cells; ++c) {
+    const auto& cell = cells[c];
+    const std::string name = std::string(R::kCellName) + " " + std::to_string(c);
+    for (int k = 0; k < R::kCorners; ++k) {
+      if (cell[k] < 0 || static_cast<std::size_t>(cell[k]) >= n_nodes)
+        throw InvalidInput(name + ": corner " + std::to_string(k) + " = " +
+                           std::to_string(cell[k]) + " is not a node (mesh has " +
+                           std::to_string(n_nodes) + ")");
+      for (int j = 0; j < k; ++j)
+        if (cell[j] == cell[k])
+          throw InvalidInput(name + ": node " + std::to_string(cell[k]) + " is corner " +
+                             std::to_string(j) + " and " + std::to_string(k));
+    }
+    for (int e = 0; e < MeshDual<Dim>::kCellEdges; ++e) {
+      const Index a = cell[R::edges[e][0]], b = cell[R::edges[e][1]];
+      auto [it, fresh] = edge_id.emplace(pair_key(a, b), static_cast<Index>(dual.edges.size()));
+      if (fresh) dual.edges.push_back({std::min(a, b), std::max(a, b)});
+      dual.cell_edges[c][e] = it->second;
+    }
+  }
+
+  // Sheets: within a cell the edges of one class are equivalent.
+  UnionFind uf(dual.edges.size());
+  for (const auto& ce : dual.cell_edges)
+    for (int e = 0; e < MeshDual<Dim>::kCellEdges; ++e)
+      for (int f = e + 1; f < MeshDual<Dim>::kCellEdges; ++f)
+        if (R::edge_class(e) == R::edge_class(f)) uf.unite(ce[e], ce[f]);
+  std::vector<Index> sheet_of_root(dual.edges.size(), -1);
+  dual.cell_sheets.resize(n_cells);
+  for (Index c = 0; c < n_cells; ++c) {
+    for (int e = 0; e < MeshDual<Dim>::kCellEdges; ++e) {
+      Index& s = sheet_of_root[uf.find(dual.cell_edges[c][e])];
+      if (s < 0) {
+        s = static_cast<Index>(dual.sheets.size());
+        dual.sheets.emplace_back();
+      }
+      dual.cell_sheets[c][R::edge_class(e)] = s;
+    }
+  }
+  dual.edge_sheet.resize(dual.edges.size());
+  for (std::size_t e = 0; e < dual.edges.size(); ++e) {
+    dual.edge_sheet[e] = sheet_of_root[uf.find(static_cast<Index>(e))];
+    dual.sheets[dual.edge_sheet[e]].edges.push_back(static_cast<Index>(e));
+  }
+  for (Index c = 0; c < n_cells; ++c) {
+    auto tuple = dual.cell_sheets[c];
+    for (Index s : tuple) dual.sheets[s].cells.push_back(c);
+    std::sort(tuple.begin(), tuple.end());
+    for (int k = 1; k < Dim; ++k)
+      if (tuple[k] == tuple[k - 1]) dual.sheets[tuple[k]].self_intersecting = true;
+    ++dual.intersections[tuple];
+  }
+
+  // Boundary facets: used by one cell only.
+  std::unordered_map<std::uint64_t, std::vector<CellFacet>> by_key;  // keyed by 2 min nodes
+  for (Index c = 0; c < n_cells; ++c)
+    for (int f = 0; f < R::kFacets; ++f) {
+      std::array<Index, R::kFacetSize> key{};
+      for (int k = 0; k < R::kFacetSize; ++k) key[k] = cells[c][R::facets[f][k]];
+      std::sort(key.begin(), key.end());
+      by_key[pair_key(key[0], key[1])].push_back({c, f});
+    }
+  for (Index c = 0; c < n_cells; ++c)
+    for (int f = 0; f < R::kFacets; ++f) {
+      std::array<Index, R::kFacetSize> key{};
+      for (int k = 0; k < R::kFacetSize; ++k) key[k] = cells[c][R::facets[f][k]];
+      std::sort(key.begin(), key.end());
+      std::vector<Index> users;
+      for (const CellFacet& g : by_key[pair_key(key[0], key[1])]) {
+        std::array<Index, R::kFacetSize> other{};
+        for (int k = 0; k < R::kFacetSize; ++k) other[k] = cells[g.cell][R::facets[g.local][k]];
+        std::sort(other.begin(), other.end());
+        if (other == key) users.push_back(g.cell);
+      }
+      if (users.size() > 2)
+        throw TopologyError(std::string(R::kCellName) + " " + std::to_string(c) + ": facet " +
+                            std::to_string(f) + " is shared by " + std::to_string(users.size()) +
+                            " cells");
+      if (users.size() == 1) dual.boundary.push_back({c, f});
+    }
+
+  build_traces(cells, dual);
+  return dual;
+}
+
+template <int Dim>
+std::vector<std::vector<TraceCurve>> split(const MeshDual<Dim>& dual, Index sheet,
+                                           const FacetClassifier& classify, int regions) {
+  if (sheet < 0 || static_cast<std::size_t>(sheet) >= dual.sheets.size())
+    throw InvalidInput("trace_by_region: no sheet " + std::to_string(sheet));
+  std::vector<std::vector<TraceCurve>> out(regions);
+  for (const TraceCurve& curve : dual.sheets[sheet].trace) {
+    const std::size_t n = curve.facets.size();
+    std::vector<int> region(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      region[i] = classify(curve.facets[i]);
+      if (region[i] < 0 || region[i] >= regions)
+        throw InvalidInput("trace_by_region: sheet " + std::to_string(sheet) + ", " +
+                           (Dim == 3 ? "hex " : "quad ") + std::to_string(curve.facets[i].cell) +
+                           " facet " + std::to_string(curve.facets[i].local) + " is in region " +
+                           std::to_string(region[i]) + ", outside [0, " +
+                           std::to_string(regions) + ")");
+    }
+    if (n == 0) continue;
+    if (std::all_of(region.begin(), region.end(), [&](int r) { return r == region[0]; })) {
+      out[region[0]].push_back(curve);
+      continue;
+    }
+    // Start a closed curve at a change of region so that no run wraps around.
+    std::size_t first = 0;
+    if (curve.closed)
+      while (region[first] == region[(first + n - 1) % n]) ++first;
+    const std::size_t ne = curve.edges.size();
+    for (std::size_t done = 0; done < n;) {
+      const std::size_t i = (first + done) % n;
+      TraceCurve piece;
+      piece.edges.push_back(curve.edges[i]);
+      std::size_t k = done;
+      while (k < n && region[(first + k) % n] == region[i]) {
+        const std::size_t j = (first + k) % n;
+        piece.facets.push_back(curve.facets[j]);
+        piece.edges.push_back(curve.edges[(j + 1) % ne]);
+        ++k;
+      }
+      out[region[i]].push_back(std::move(piece));
+      done = k;
+    }
+  }
+  return out;
+}
+
+template <typename Cell>
+FacetClassifier box_classifier(const std::vector<primal::Point>& points,
+                               const std::vector<Cell>& cells, const auto& facet_table, int axes,
+                               const primal::Point& lo, const primal::Point& hi, double tol) {
+  return [&points, &cells, &facet_table, axes, lo, hi, tol](const CellFacet& f) {
+    for (int axis = 0; axis < axes; ++axis)
+      for (int high = 0; high < 2; ++high) {
+        const double plane = high ? hi[axis] : lo[axis];
+        const bool on = std::all_of(
+            facet_table[f.local].begin(), facet_table[f.local].end(), [&](int corner) {
+              return std::abs(points[cells[f.cell][corner]][axis] - plane) <= tol;
+            });
+        if (on) return 2 * axis + high;
+      }
+    return -1;
+  };
+}
+
+}  // namespace
+
+HexDual mesh_dual(const primal::HexMesh& mesh) { return build<3>(mesh.points.size(), mesh.hexes); }
+
+QuadDual mesh_dual(const primal::QuadMesh& mesh) {
+  return build<2>(mesh.points.size(), mesh.quads);
+}
+
+std::vector<std::vector<TraceCurve>> trace_by_region(const HexDual& dual, Index sheet,
+                                                     const FacetClassifier& classify,
+                                                     int regions) {
+  return split(dual, sheet, classify, regions);
+}
+
+std::vector<std::vector<TraceCurve>> trace_by_region(const QuadDual& dual, Index sheet,
+                                                     const FacetClassifier& classify,
+                                                     int regions) {
+  return split(dual, sheet, classify, regions);
+}
+
+FacetClassifier box_face_classifier(const primal::HexMesh& mesh, const primal::Point& lo,
+                                    const primal::Point& hi, double tol) {
+  return box_classifier(mesh.points, mesh.hexes, topo::kHexFaceCorners, 3, lo, hi, tol);
+}
+
+FacetClassifier box_face_classifier(const primal::QuadMesh& mesh, const primal::Point& lo,
+                                    const primal::Point& hi, double tol) {
+  return box_classifier(mesh.points, mesh.quads, topo::kQuadEdgeCorners, 2, lo, hi, tol);
+}
+
+}  // namespace geode::stc
