@@ -1,0 +1,264 @@
+#include "primal/buffer_layer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "primal/boundary.hpp"
+#include "primal/errors.hpp"
+#include "primal/quality.hpp"
+#include "primal/topology.hpp"
+
+namespace geode::primal {
+
+namespace {
+
+double min_dot(const Point& d, const std::vector<Point>& normals) {
+  double m = std::numeric_limits<double>::infinity();
+  for (const Point& n : normals) m = std::min(m, d.dot(n));
+  return m;
+}
+
+// The unit direction d maximizing min_i d . n_i over unit normals n_i, projected by `project`
+// (the outer-boundary constraint). The unconstrained optimum is the centre of the smallest
+// spherical cap holding the normals, fixed by at most three of them, so the candidates are the
+// normals, the midpoints of pairs and the equidistant directions of triples.
+template <class Project>
+std::pair<Point, double> best_direction(const std::vector<Point>& n, Project project) {
+  std::vector<Point> candidates;
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    candidates.push_back(n[i]);
+    for (std::size_t j = i + 1; j < n.size(); ++j) {
+      candidates.push_back(n[i] + n[j]);
+      for (std::size_t k = j + 1; k < n.size(); ++k) {
+        const Point d = (n[i] - n[j]).cross(n[i] - n[k]);
+        candidates.push_back(d);
+        candidates.push_back(-d);
+      }
+    }
+  }
+  Point sum = Point::Zero();
+  for (const Point& x : n) sum += x;
+  candidates.push_back(sum);
+  Point best = Point::Zero();
+  double best_m = -std::numeric_limits<double>::infinity();
+  for (Point d : candidates) {
+    d = project(d);
+    const double len = d.norm();
+    if (len < 1e-12) continue;
+    d /= len;
+    const double m = min_dot(d, n);
+    if (m > best_m) {
+      best_m = m;
+      best = d;
+    }
+  }
+  return {best, best_m};
+}
+
+}  // namespace
+
+BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
+                                const BufferLayerOptions& opt) {
+  validate(input, "insert_buffer_layer");
+  const std::size_t n_points = input.points.size();
+  const auto& P = input.points;
+  auto pt = [&](Index v) -> const Point& { return P[static_cast<std::size_t>(v)]; };
+
+  BufferLayer out;
+  out.model = input;
+  out.top_node.assign(n_points, kInvalidIndex);
+  std::vector<Index> interface_nodes = itf.nodes;
+  for (std::size_t k = 0; k < interface_nodes.size(); ++k)
+    out.top_node[static_cast<std::size_t>(interface_nodes[k])] = static_cast<Index>(n_points + k);
+  auto slot = [&](Index v) {
+    return static_cast<std::size_t>(out.top_node[static_cast<std::size_t>(v)]) - n_points;
+  };
+  const std::size_t n_moved = interface_nodes.size();
+
+  // Per moved node: unit corner normals of its interface quads, the shortest edge at it.
+  std::vector<std::vector<Point>> corner_normals(n_moved);
+  std::vector<double> shortest(n_moved, std::numeric_limits<double>::infinity());
+  for (const InterfaceQuad& q : itf.quads)
+    for (std::size_t i = 0; i < 4; ++i) {
+      const Index v = q.corners[i];
+      const Point er = pt(q.corners[(i + 1) % 4]) - pt(v);
+      const Point es = pt(q.corners[(i + 3) % 4]) - pt(v);
+      const Point n = er.cross(es);
+      if (n.norm() <= 0.0)
+        throw TopologyError("insert_buffer_layer: interface quad of hex " + std::to_string(q.hex) +
+                            " face " + std::to_string(q.face) + " is degenerate at node " +
+                            std::to_string(v));
+      corner_normals[slot(v)].push_back(n.normalized());
+      shortest[slot(v)] = std::min({shortest[slot(v)], er.norm(), es.norm()});
+    }
+  // Tets touching the interface, tet edges at moved nodes, and the tet part's outer boundary
+  // (faces used once that are not interface triangles).
+  std::unordered_set<FaceKey, IndexArrayHash> interface_tris;
+  for (const InterfaceQuad& q : itf.quads)
+    for (const auto& tri : interface_triangles(q)) interface_tris.insert(face_key(tri));
+  std::unordered_map<FaceKey, int, IndexArrayHash> tet_face_uses;
+  for (const auto& t : input.tets)
+    for (const auto& fc : topology::kTetFaceCorners)
+      ++tet_face_uses[face_key(std::array<Index, 3>{t[static_cast<std::size_t>(fc[0])], t[static_cast<std::size_t>(fc[1])],
+                                                    t[static_cast<std::size_t>(fc[2])]})];
+  std::vector<std::vector<Point>> outer_normals(n_moved);  // area-weighted
+  std::vector<Index> touched_tets;
+  for (std::size_t t = 0; t < input.tets.size(); ++t) {
+    const auto& tet = input.tets[t];
+    bool touches = false;
+    for (Index v : tet) touches |= out.top_node[static_cast<std::size_t>(v)] != kInvalidIndex;
+    if (!touches) continue;
+    touched_tets.push_back(static_cast<Index>(t));
+    for (const auto& e : topology::kTetEdgeCorners) {
+      const Index a = tet[static_cast<std::size_t>(e[0])], b = tet[static_cast<std::size_t>(e[1])];
+      const double len = (pt(a) - pt(b)).norm();
+      for (Index v : {a, b})
+        if (out.top_node[static_cast<std::size_t>(v)] != kInvalidIndex) shortest[slot(v)] = std::min(shortest[slot(v)], len);
+    }
+    for (const auto& fc : topology::kTetFaceCorners) {
+      const std::array<Index, 3> tri{tet[static_cast<std::size_t>(fc[0])], tet[static_cast<std::size_t>(fc[1])],
+                                     tet[static_cast<std::size_t>(fc[2])]};
+      const FaceKey key = face_key(tri);
+      if (tet_face_uses[key] != 1 || interface_tris.count(key)) continue;
+      const Point area = (pt(tri[1]) - pt(tri[0])).cross(pt(tri[2]) - pt(tri[0]));  // outward
+      for (Index v : tri)
+        if (out.top_node[static_cast<std::size_t>(v)] != kInvalidIndex) outer_normals[slot(v)].push_back(area);
+    }
+  }
+
+  // Step direction per moved node.
+  const double feature_cos = std::cos(opt.feature_angle * M_PI / 180.0);
+  std::vector<Point> direction(n_moved);
+  for (std::size_t k = 0; k < n_moved; ++k) {
+    const Index v = interface_nodes[k];
+    // Cluster the outer normals into features.
+    std::vector<Point> features;  // summed area vectors
+    for (const Point& a : outer_normals[k]) {
+      bool merged = false;
+      for (Point& f : features)
+        if (f.normalized().dot(a.normalized()) >= feature_cos) {
+          f += a;
+          merged = true;
+          break;
+        }
+      if (!merged) features.push_back(a);
+    }
+    for (Point& f : features) f.normalize();
+    if (features.size() >= 3)
+      throw TopologyError("insert_buffer_layer: node " + std::to_string(v) +
+                          " is a corner of the tet part's outer boundary (" +
+                          std::to_string(features.size()) +
+                          " feature faces meet there): its tet-side copy cannot move off the interface");
+    auto project = [&](Point d) -> Point {
+      if (features.size() == 1) return d - d.dot(features[0]) * features[0];
+      if (features.size() == 2) {
+        const Point axis = features[0].cross(features[1]).normalized();
+        return d.dot(axis) * axis;
+      }
+      return d;
+    };
+    auto [d, m] = best_direction(corner_normals[k], project);
+    if (!(m >= opt.min_visibility))
+      throw TopologyError("insert_buffer_layer: node " + std::to_string(v) +
+                          ": no direction into the tet side lies above all " +
+                          std::to_string(corner_normals[k].size()) +
+                          " interface faces at it (best min cos " + std::to_string(m) +
+                          "), so no valid buffer layer can be placed there (the paper's Figure 9 right)");
+    direction[k] = d;
+  }
+
+  // Move, check, halve the steps of nodes of failing elements, repeat.
+  std::vector<double> scale(n_moved, 1.0);
+  auto tet_vol = [](const std::vector<Point>& pts, const std::array<Index, 4>& t) {
+    return tet_volume(pts[static_cast<std::size_t>(t[0])], pts[static_cast<std::size_t>(t[1])],
+                      pts[static_cast<std::size_t>(t[2])], pts[static_cast<std::size_t>(t[3])]);
+  };
+  for (const InterfaceQuad& q : itf.quads) {
+    BufferHex b;
+    for (std::size_t i = 0; i < 4; ++i) {
+      b.corners[i] = q.corners[i];
+      b.corners[i + 4] = out.top_node[static_cast<std::size_t>(q.corners[i])];
+    }
+    b.diagonal = q.diagonal == 0 ? std::array<int, 2>{4, 6} : std::array<int, 2>{5, 7};
+    b.quad = static_cast<Index>(out.hexes.size());
+    out.hexes.push_back(b);
+  }
+  for (auto& t : out.model.tets)
+    for (Index& v : t)
+      if (out.top_node[static_cast<std::size_t>(v)] != kInvalidIndex) v = out.top_node[static_cast<std::size_t>(v)];
+
+  for (int round = 0;; ++round) {
+    out.model.points.resize(n_points);
+    for (std::size_t k = 0; k < n_moved; ++k) {
+      const std::size_t v = static_cast<std::size_t>(interface_nodes[k]);
+      out.model.points.push_back(P[v] + scale[k] * opt.thickness * shortest[k] * direction[k]);
+    }
+    std::vector<char> failing(n_moved, 0);
+    std::string first_failure;
+    out.report.min_tet_volume_ratio = 1.0;
+    out.report.min_scaled_jacobian = 1.0;
+    for (Index t : touched_tets) {
+      const double before = tet_vol(P, input.tets[static_cast<std::size_t>(t)]);
+      const auto& moved = out.model.tets[static_cast<std::size_t>(t)];
+      const double ratio = tet_vol(out.model.points, moved) / before;
+      out.report.min_tet_volume_ratio = std::min(out.report.min_tet_volume_ratio, ratio);
+      if (ratio < opt.min_volume_ratio) {
+        for (Index v : moved)
+          if (static_cast<std::size_t>(v) >= n_points) {
+            failing[static_cast<std::size_t>(v) - n_points] = 1;
+            if (first_failure.empty())
+              first_failure = "node " + std::to_string(interface_nodes[static_cast<std::size_t>(v) - n_points]) +
+                              ": tet " + std::to_string(t) + " keeps only " + std::to_string(ratio) +
+                              " of its volume";
+          }
+      }
+    }
+    for (const BufferHex& b : out.hexes) {
+      HexCorners c;
+      for (std::size_t i = 0; i < 8; ++i) c[i] = out.model.points[static_cast<std::size_t>(b.corners[i])];
+      const double sj = hex_scaled_jacobian(c);
+      out.report.min_scaled_jacobian = std::min(out.report.min_scaled_jacobian, sj);
+      if (sj < opt.min_scaled_jacobian)
+        for (std::size_t i = 4; i < 8; ++i) {
+          failing[static_cast<std::size_t>(b.corners[i]) - n_points] = 1;
+          if (first_failure.empty())
+            first_failure = "node " + std::to_string(b.corners[i - 4]) + ": the buffer hex on hex " +
+                            std::to_string(itf.quads[static_cast<std::size_t>(b.quad)].hex) + " face " +
+                            std::to_string(itf.quads[static_cast<std::size_t>(b.quad)].face) +
+                            " has scaled Jacobian " + std::to_string(sj);
+        }
+    }
+    out.report.halvings = round;
+    if (first_failure.empty()) break;
+    if (round >= opt.max_halvings)
+      throw TopologyError("insert_buffer_layer: no valid buffer layer after " + std::to_string(round) +
+                          " halvings of the step: " + first_failure);
+    for (std::size_t k = 0; k < n_moved; ++k)
+      if (failing[k]) scale[k] *= 0.5;
+  }
+  out.report.min_step = std::numeric_limits<double>::infinity();
+  out.report.max_step = 0.0;
+  for (std::size_t k = 0; k < n_moved; ++k) {
+    const double step = scale[k] * opt.thickness * shortest[k];
+    out.report.min_step = std::min(out.report.min_step, step);
+    out.report.max_step = std::max(out.report.max_step, step);
+  }
+  if (n_moved == 0) out.report.min_step = 0.0;
+  return out;
+}
+
+HexMesh buffer_hex_mesh(const BufferLayer& layer) {
+  HexMesh mesh;
+  mesh.points = layer.model.points;
+  for (const BufferHex& b : layer.hexes) {
+    mesh.hexes.push_back(b.corners);
+    mesh.block.push_back(3);
+  }
+  return mesh;
+}
+
+}  // namespace geode::primal

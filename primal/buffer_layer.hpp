@@ -1,0 +1,77 @@
+#pragma once
+// The buffer layer of the geode algorithm (the paper's Section 1): one layer of hexes between
+// the hex part and the tet part, made by shrinking the tet part away from the interface. Each
+// interface node is duplicated; the duplicate belongs to the tet side and moves into it, so
+// each interface quad becomes a buffer hex whose bottom face is the hex part's quad and whose
+// top face is the two (moved) tet triangles.
+//
+// Buffer hex corner convention (VTK/Exodus order, primal/topology.hpp):
+//   corners 0-3: the interface quad (InterfaceQuad::corners), the hex-part side, counter-
+//                clockwise seen from the tet side, so the buffer hex is positively oriented;
+//   corners 4-7: their tet-side duplicates, corner 4+i above corner i;
+//   the top face (local face 5, t = 1) is on the tet side, split into two triangles along
+//   `diagonal` = {4, 6} or {5, 7} (the corners the split joins); the bottom face (local face 4,
+//   t = 0) is on the hex side. For the geode template of templates/geode.hpp (y up, top at
+//   y = +h/2) one right-handed map is r = z, s = x, t = y, under which Diagonal::Main (which
+//   joins (-x,+z) and (+x,-z)) is {5, 7} and Diagonal::Anti is {4, 6}.
+#include <array>
+#include <vector>
+
+#include "primal/interface.hpp"
+#include "primal/model.hpp"
+
+namespace geode::primal {
+
+struct BufferLayerOptions {
+  // Step of each duplicated node, as a fraction of the shortest tet or interface-quad edge at it.
+  double thickness = 0.25;
+  // Every moved tet keeps at least this fraction of its volume.
+  double min_volume_ratio = 0.05;
+  // Every buffer hex has a Verdict scaled Jacobian (min over 8 corners and centre) above this.
+  double min_scaled_jacobian = 1e-3;
+  // The step direction d at a node must satisfy d . n >= min_visibility for the unit corner
+  // normal n of every interface quad at the node; otherwise no valid buffer hex fits there.
+  double min_visibility = 0.05;
+  // Nodes of failing elements have their step halved at most this often.
+  int max_halvings = 8;
+  // Angle (degrees) above which two outer-boundary faces of the tet part at a node form a
+  // feature: a moved node slides in the boundary's tangent plane, along a feature edge, or
+  // (at a feature corner) cannot move.
+  double feature_angle = 30.0;
+};
+
+struct BufferHex {
+  std::array<Index, 8> corners{};  // see the convention above
+  std::array<int, 2> diagonal{};   // {4, 6} or {5, 7}
+  Index quad = kInvalidIndex;      // index into Interface::quads
+};
+
+struct BufferLayerReport {
+  double min_tet_volume_ratio = 1.0;    // over the tets that moved
+  double min_scaled_jacobian = 1.0;     // over the buffer hexes
+  double min_step = 0.0, max_step = 0.0;  // distances the duplicated nodes moved
+  int halvings = 0;                     // rounds of step halving needed
+};
+
+struct BufferLayer {
+  // The input model with the tet part shrunk: one duplicate per interface node appended to
+  // the points (model.points[top_node[v]]), every tet renumbered to the duplicates. Hexes,
+  // blocks, node sets (which keep the hex-side nodes) and side sets are unchanged; the buffer
+  // hexes are not in it.
+  Model model;
+  std::vector<Index> top_node;  // per input node: its tet-side duplicate or kInvalidIndex
+  std::vector<BufferHex> hexes;  // one per interface quad, in Interface::quads order
+  BufferLayerReport report;
+};
+
+// Throws TopologyError naming the node (and the element) where no valid layer can be placed:
+// no direction sees all interface faces at a node (the paper's Figure 9 right), a node at a
+// corner of the tet part's outer boundary, or an element still inverted / collapsed after
+// max_halvings halvings.
+BufferLayer insert_buffer_layer(const Model& model, const Interface& interface,
+                                const BufferLayerOptions& options = {});
+
+// The buffer hexes as a hex mesh over layer.model.points (block = 3).
+HexMesh buffer_hex_mesh(const BufferLayer& layer);
+
+}  // namespace geode::primal

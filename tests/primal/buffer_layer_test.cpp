@@ -1,0 +1,164 @@
+// Buffer layer: corner conventions, positive elements, and no gap or overlap: the volumes of
+// hex part + buffer hexes + shrunk tets add up to the volume of the original block. Each
+// element's volume is its boundary flux with every face triangulated the same way from both
+// sides (buffer tops along their diagonal, other quads from their smallest node), so shared
+// faces cancel and the sum is the flux through the outer boundary, which the layer must not move.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <set>
+#include <string>
+
+#include "primal/buffer_layer.hpp"
+#include "primal/demo_models.hpp"
+#include "primal/errors.hpp"
+#include "primal/quality.hpp"
+#include "primal/topology.hpp"
+
+using namespace geode;
+using namespace geode::primal;
+
+namespace {
+
+double tri_flux(const std::vector<Point>& p, Index a, Index b, Index c) {
+  return p[static_cast<std::size_t>(a)].dot(p[static_cast<std::size_t>(b)].cross(p[static_cast<std::size_t>(c)])) / 6.0;
+}
+
+// Quad (outward, counter-clockwise) split along corners (k, k+2).
+double quad_flux(const std::vector<Point>& p, std::array<Index, 4> q, int k) {
+  auto at = [&](int i) { return q[static_cast<std::size_t>((i + k) % 4)]; };
+  return tri_flux(p, at(0), at(1), at(2)) + tri_flux(p, at(0), at(2), at(3));
+}
+
+int canonical_split(const std::array<Index, 4>& q) {
+  return static_cast<int>(std::min_element(q.begin(), q.end()) - q.begin()) % 2;
+}
+
+double hex_flux_volume(const std::vector<Point>& p, const std::array<Index, 8>& h, int top_split = -1) {
+  double v = 0;
+  for (int f = 0; f < 6; ++f) {
+    std::array<Index, 4> q{};
+    for (std::size_t i = 0; i < 4; ++i)
+      q[i] = h[static_cast<std::size_t>(topology::kHexFaceCorners[static_cast<std::size_t>(f)][i])];
+    // Face 5 is 4 5 6 7: split 0 joins 4-6, split 1 joins 5-7.
+    v += quad_flux(p, q, f == 5 && top_split >= 0 ? top_split : canonical_split(q));
+  }
+  return v;
+}
+
+struct Case {
+  const char* name;
+  std::array<int, 3> cells;
+  std::function<bool(int, int, int)> is_tet;
+  std::size_t quads;
+};
+
+void check_layer(const Case& c) {
+  CAPTURE(c.name);
+  const Model m = grid_model(c.cells, 1.0, c.is_tet);
+  const Interface itf = find_interface(m);
+  REQUIRE(itf.quads.size() == c.quads);
+  const BufferLayer layer = insert_buffer_layer(m, itf);
+  const auto& p = layer.model.points;
+  REQUIRE(p.size() == m.points.size() + itf.nodes.size());
+  REQUIRE(layer.hexes.size() == itf.quads.size());
+  CHECK(layer.model.hexes == m.hexes);
+
+  double total = 0;
+  for (const auto& h : m.hexes) total += hex_flux_volume(p, h);
+  for (std::size_t b = 0; b < layer.hexes.size(); ++b) {
+    const BufferHex& bh = layer.hexes[b];
+    const InterfaceQuad& q = itf.quads[static_cast<std::size_t>(bh.quad)];
+    CHECK(bh.quad == static_cast<Index>(b));
+    for (std::size_t i = 0; i < 4; ++i) {
+      CHECK(bh.corners[i] == q.corners[i]);                                          // hex side
+      CHECK(bh.corners[i + 4] == layer.top_node[static_cast<std::size_t>(q.corners[i])]);  // tet side
+    }
+    CHECK(bh.diagonal == (q.diagonal == 0 ? std::array<int, 2>{4, 6} : std::array<int, 2>{5, 7}));
+    // The top triangles along the diagonal are faces of the two (renumbered) tets.
+    const auto& k = bh.corners;
+    const std::array<std::array<Index, 3>, 2> top =
+        q.diagonal == 0 ? std::array<std::array<Index, 3>, 2>{{{k[4], k[5], k[6]}, {k[4], k[6], k[7]}}}
+                        : std::array<std::array<Index, 3>, 2>{{{k[4], k[5], k[7]}, {k[5], k[6], k[7]}}};
+    for (std::size_t i = 0; i < 2; ++i) {
+      const auto& t = layer.model.tets[static_cast<std::size_t>(q.tets[i])];
+      std::set<Index> face;
+      for (int cc : topology::kTetFaceCorners[static_cast<std::size_t>(q.tet_faces[i])])
+        face.insert(t[static_cast<std::size_t>(cc)]);
+      CHECK(face == std::set<Index>(top[i].begin(), top[i].end()));
+    }
+    HexCorners corners;
+    for (std::size_t i = 0; i < 8; ++i) corners[i] = p[static_cast<std::size_t>(k[i])];
+    CHECK(hex_scaled_jacobian(corners) > 0.0);
+    const double v = hex_flux_volume(p, k, q.diagonal);
+    CHECK(v > 0.0);
+    total += v;
+  }
+  for (const auto& t : layer.model.tets) {
+    const double v = tet_volume(p[static_cast<std::size_t>(t[0])], p[static_cast<std::size_t>(t[1])],
+                                p[static_cast<std::size_t>(t[2])], p[static_cast<std::size_t>(t[3])]);
+    CHECK(v > 0.0);
+    total += v;
+  }
+  CHECK(total == doctest::Approx(c.cells[0] * c.cells[1] * c.cells[2]).epsilon(1e-12));
+  CHECK(layer.report.min_scaled_jacobian > 0.0);
+  CHECK(layer.report.min_tet_volume_ratio > 0.0);
+}
+
+}  // namespace
+
+TEST_CASE("insert_buffer_layer: valid, gap-free layers on convex and concave interfaces") {
+  const Case cases[] = {
+      {"one hex, tets on one face", {1, 1, 2}, [](int, int, int k) { return k == 1; }, 1},
+      {"half block (interface meets the outer boundary)", {2, 2, 2}, [](int i, int, int) { return i == 1; }, 4},
+      {"L-shaped interface (concave edge)", {2, 2, 1}, [](int i, int j, int) { return i == 1 && j == 1; }, 2},
+      {"tets around a hex edge (convex edge)", {2, 2, 1}, [](int i, int j, int) { return i == 1 || j == 1; }, 2},
+      {"tets around a hex corner (convex corner)", {2, 2, 2},
+       [](int i, int j, int k) { return i == 1 || j == 1 || k == 1; }, 3},
+      {"hex block around an L-shaped tet region", {4, 4, 3},
+       [](int i, int j, int k) { return k == 1 && ((i == 1 && (j == 1 || j == 2)) || (i == 2 && j == 1)); }, 14},
+      {"enclosed tet nugget (hex block with a tet cavity)", {3, 3, 3},
+       [](int i, int j, int k) { return i == 1 && j == 1 && k == 1; }, 6},
+  };
+  for (const Case& c : cases) check_layer(c);
+}
+
+TEST_CASE("insert_buffer_layer: one hex under tets, positions by hand") {
+  const Model m = grid_model({1, 1, 2}, 1.0, [](int, int, int k) { return k == 1; });
+  const BufferLayer layer = insert_buffer_layer(m, find_interface(m));
+  // Each top corner sits on an outer crease of the tet part (two outer faces), so it slides
+  // along the crease, +z, by thickness 0.25 x shortest edge 1.
+  for (const BufferHex& b : layer.hexes)
+    for (std::size_t i = 0; i < 4; ++i) {
+      const Point d = layer.model.points[static_cast<std::size_t>(b.corners[i + 4])] -
+                      layer.model.points[static_cast<std::size_t>(b.corners[i])];
+      CHECK((d - Point(0, 0, 0.25)).norm() < 1e-14);
+    }
+  CHECK(layer.report.min_step == doctest::Approx(0.25));
+  CHECK(layer.report.max_step == doctest::Approx(0.25));
+  CHECK(layer.report.min_scaled_jacobian == doctest::Approx(1.0));
+  CHECK(layer.report.halvings == 0);
+  CHECK(buffer_hex_mesh(layer).hexes.size() == 1);
+}
+
+TEST_CASE("insert_buffer_layer: the nugget's corners move along the cavity diagonal") {
+  const Model m = grid_model({3, 3, 3}, 1.0, [](int i, int j, int k) { return i == 1 && j == 1 && k == 1; });
+  const BufferLayer layer = insert_buffer_layer(m, find_interface(m));
+  // Corner (1,1,1) of the cavity: three faces with normals +x, +y, +z; the best direction is
+  // the diagonal; the shortest edge there is 1.
+  const Index v = 1 + 4 * (1 + 4 * 1);
+  const Point moved = layer.model.points[static_cast<std::size_t>(layer.top_node[static_cast<std::size_t>(v)])];
+  CHECK((moved - (Point(1, 1, 1) + 0.25 * Point(1, 1, 1).normalized())).norm() < 1e-12);
+}
+
+TEST_CASE("insert_buffer_layer: no layer where no direction sees all interface faces") {
+  // Simplified Figure 9 right: two tet cells of a 2x2x2 block meeting the centre node
+  // (1,1,1) = node 13 from opposite octants, (1,0,0) and (0,1,1). The interface faces at node
+  // 13 face +x, -y, -z (first cell) and -x, +y, +z (second): no direction is above all six.
+  const Model m = grid_model({2, 2, 2}, 1.0, [](int i, int j, int k) {
+    return (i == 1 && j == 0 && k == 0) || (i == 0 && j == 1 && k == 1);
+  });
+  const Interface itf = find_interface(m);
+  CHECK(itf.quads.size() == 6);
+  CHECK_THROWS_WITH_AS(insert_buffer_layer(m, itf), doctest::Contains("node 13: no direction"), TopologyError);
+}
