@@ -17,4 +17,22 @@ namespace geode::primal {
 Model grid_model(std::array<int, 3> cells, double h,
                  const std::function<bool(int, int, int)>& is_tet);
 
+// Demo (a), meshed with the Gmsh API (OpenCASCADE boxes, transfinite meshing): the block
+// [0,2] x [0,1] x [0,1]; x < 1 a structured n x n x n hex mesh (block 1 "hex"), x > 1 a
+// transfinite tet mesh (block 2 "tet", Gmsh splits each structured cell into 6 tets) whose
+// x = 1 face triangulates the same n x n grid, so the parts conform node-wise with every
+// interface quad split into two triangles. The two boxes are meshed as separate volumes and
+// their coincident interface nodes merged afterwards (Gmsh cannot put quads on one side and
+// triangles on the other of one shared surface). Elements Gmsh returns inverted are re-oriented.
+Model demo_half_block(int n = 4);
+
+// Demo (b), in the spirit of the paper's Figure 8 (Fulcher's nugget). Simplified: the nugget is
+// a plain cube [-1,1]^3 (no imprinted circles), tet-meshed by Gmsh's unstructured 3D
+// Delaunay mesher inside a structured triangulated surface (n x n cells per face, each split
+// in two); it is surrounded by the 26 sweepable boxes of a 3 x 3 x 3 split of [-2,2]^3
+// (structured hexes, n/2 cells across each outer layer; block 1 "hex blocks"), instead of real
+// sweepable parts. Nugget tets are block 2 "tet nugget". Side set 1 "outside" holds the outer
+// boundary quads. n must be even and >= 2.
+Model demo_nugget(int n = 4);
+
 }  // namespace geode::primal

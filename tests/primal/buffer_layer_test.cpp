@@ -162,3 +162,38 @@ TEST_CASE("insert_buffer_layer: no layer where no direction sees all interface f
   CHECK(itf.quads.size() == 6);
   CHECK_THROWS_WITH_AS(insert_buffer_layer(m, itf), doctest::Contains("node 13: no direction"), TopologyError);
 }
+
+TEST_CASE("Gmsh demo models: conforming interface and a valid buffer layer") {
+  SUBCASE("half block, structured hexes | transfinite tets") {
+    const int n = 3;
+    const Model m = demo_half_block(n);
+    CHECK(m.hexes.size() == static_cast<std::size_t>(n * n * n));
+    CHECK(m.tets.size() == static_cast<std::size_t>(6 * n * n * n));
+    CHECK(m.points.size() == static_cast<std::size_t>((2 * n + 1) * (n + 1) * (n + 1)));  // interface merged
+    const Interface itf = find_interface(m);
+    CHECK(itf.quads.size() == static_cast<std::size_t>(n * n));
+    CHECK(itf.nodes.size() == static_cast<std::size_t>((n + 1) * (n + 1)));
+    for (const InterfaceQuad& q : itf.quads)
+      for (Index v : q.corners) CHECK(m.points[static_cast<std::size_t>(v)].x() == doctest::Approx(1.0));
+    const BufferLayer layer = insert_buffer_layer(m, itf);
+    CHECK(layer.report.min_scaled_jacobian > 0.5);  // a flat interface: near-box buffer hexes
+    for (const auto& t : layer.model.tets)
+      CHECK(tet_volume(layer.model.points[static_cast<std::size_t>(t[0])], layer.model.points[static_cast<std::size_t>(t[1])],
+                       layer.model.points[static_cast<std::size_t>(t[2])], layer.model.points[static_cast<std::size_t>(t[3])]) > 0);
+  }
+  SUBCASE("tet nugget inside sweepable hex blocks (Figure 8, simplified)") {
+    const int n = 4;
+    const Model m = demo_nugget(n);
+    // 26 blocks on a 4 x 4 x 4 structured grid of cells of size 0.5 minus the nugget's 4^3.
+    CHECK(m.hexes.size() == static_cast<std::size_t>(8 * 8 * 8 - 4 * 4 * 4));
+    CHECK(m.side_sets.at(0).sides.size() == static_cast<std::size_t>(6 * 8 * 8));
+    const Interface itf = find_interface(m);
+    CHECK(itf.quads.size() == static_cast<std::size_t>(6 * n * n));
+    CHECK(itf.nodes.size() == static_cast<std::size_t>(6 * n * n + 2));  // closed surface: V = F + 2
+    const BufferLayer layer = insert_buffer_layer(m, itf);
+    CHECK(layer.report.min_scaled_jacobian > 0.0);
+    CHECK(layer.report.min_tet_volume_ratio > 0.0);
+    MESSAGE("nugget demo: ", m.tets.size(), " tets, buffer min scaled Jacobian ", layer.report.min_scaled_jacobian,
+            ", min tet volume ratio ", layer.report.min_tet_volume_ratio, ", halvings ", layer.report.halvings);
+  }
+}
