@@ -40,8 +40,8 @@ struct DicedQuadMesh {
 };
 
 // Throw geode::InvalidInput naming the element if a node number is out of range.
-DicedHexMesh dice(const HexMesh& mesh);    // 8 hexes per hex, child c at parent corner c
-DicedHexMesh dice(const TetMesh& mesh);    // 4 hexes per tet, child c at parent corner c
+DicedHexMesh dice(const HexMesh& mesh);    // 8 per hex; child c has parent corner c as corner c
+DicedHexMesh dice(const TetMesh& mesh);    // 4 per tet; child c has parent corner c as corner 0
 DicedQuadMesh dice(const QuadMesh& mesh);  // 4 per quad; like hexes
 DicedQuadMesh dice(const TriMesh& mesh);   // 3 per triangle; like tets
 

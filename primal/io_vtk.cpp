@@ -1,0 +1,1034 @@
+#include "primal/io_vtk.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <sstream>
+
+#include "primal/atomic_file.hpp"
+#include "primal/errors.hpp"
+#include "primal/quality.hpp"
+
+namespace geode::primal {
+
+const std::vector<double>* VtkCellData::find_double(const std::string& name) const {
+  for (const auto& [n, v] : doubles) {
+    if (n == name) return &v;
+  }
+  return nullptr;
+}
+
+const std::vector<int>* VtkCellData::find_int(const std::string& name) const {
+  for (const auto& [n, v] : ints) {
+    if (n == name) return &v;
+  }
+  return nullptr;
+}
+
+double tet_scaled_jacobian(const Point& p0, const Point& p1, const Point& p2, const Point& p3) {
+  const double det = (p1 - p0).dot((p2 - p0).cross(p3 - p0));  // 6V, the same at every corner
+  const std::array<Point, 4> p{p0, p1, p2, p3};
+  double max_product = 0.0;
+  for (int c = 0; c < 4; ++c) {
+    double product = 1.0;
+    for (int o = 0; o < 4; ++o) {
+      if (o != c) product *= (p[o] - p[c]).norm();
+    }
+    max_product = std::max(max_product, product);
+  }
+  if (max_product <= 0.0) return 0.0;
+  return det * std::sqrt(2.0) / max_product;
+}
+
+namespace {
+
+// ---- Common: a mesh as cells + arrays ------------------------------------------------------
+
+const char* cell_type_name(int type) {
+  switch (type) {
+    case kVtkTriangle:
+      return "triangle";
+    case kVtkQuad:
+      return "quad";
+    case kVtkTetra:
+      return "tetra";
+    case kVtkHexahedron:
+      return "hexahedron";
+    default:
+      return nullptr;
+  }
+}
+
+int cell_type_size(int type) {
+  switch (type) {
+    case kVtkTriangle:
+      return 3;
+    case kVtkQuad:
+      return 4;
+    case kVtkTetra:
+      return 4;
+    case kVtkHexahedron:
+      return 8;
+    default:
+      return 0;
+  }
+}
+
+// What the writers emit, built once per call from the mesh.
+struct Grid {
+  const std::vector<Point>* points = nullptr;
+  int cell_type = 0;
+  int corners = 0;
+  std::vector<Index> connectivity;  // corners per cell, flattened
+  VtkCellData data;
+};
+
+template <std::size_t N>
+Grid make_grid(const std::filesystem::path& path, const std::vector<Point>& points,
+               const std::vector<std::array<Index, N>>& cells, int type,
+               const std::vector<int>& block, std::vector<double> scaled_jacobian,
+               const VtkCellData& extra) {
+  const std::string file = path.string();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!points[i].allFinite()) {
+      throw InvalidInput(file + ": point " + std::to_string(i) + " has a non-finite coordinate");
+    }
+  }
+  Grid g;
+  g.points = &points;
+  g.cell_type = type;
+  g.corners = static_cast<int>(N);
+  for (std::size_t c = 0; c < cells.size(); ++c) {
+    for (Index v : cells[c]) {
+      if (v < 0 || static_cast<std::size_t>(v) >= points.size()) {
+        throw InvalidInput(file + ": element " + std::to_string(c) + ": node " + std::to_string(v) +
+                           " out of range [0, " + std::to_string(points.size()) + ")");
+      }
+      g.connectivity.push_back(v);
+    }
+  }
+  g.data.doubles.emplace_back("scaled_jacobian", std::move(scaled_jacobian));
+  if (!block.empty()) g.data.ints.emplace_back("block", block);
+  for (const auto& a : extra.doubles) g.data.doubles.push_back(a);
+  for (const auto& a : extra.ints) g.data.ints.push_back(a);
+
+  std::vector<std::string> names;
+  auto check = [&](const std::string& name, std::size_t size) {
+    if (name.empty() || std::any_of(name.begin(), name.end(), [](unsigned char ch) {
+          return std::isspace(ch) || !std::isprint(ch);
+        })) {
+      throw InvalidInput(file + ": cell array name '" + name +
+                         "' must be non-empty printable text without spaces");
+    }
+    if (std::find(names.begin(), names.end(), name) != names.end()) {
+      throw InvalidInput(file + ": cell array '" + name + "' given twice");
+    }
+    names.push_back(name);
+    if (size != cells.size()) {
+      throw InvalidInput(file + ": cell array '" + name + "' has " + std::to_string(size) +
+                         " values for " + std::to_string(cells.size()) + " cells");
+    }
+  };
+  for (const auto& [name, v] : g.data.doubles) check(name, v.size());
+  for (const auto& [name, v] : g.data.ints) check(name, v.size());
+  return g;
+}
+
+Grid grid_of(const std::filesystem::path& path, const HexMesh& m, const VtkCellData& extra) {
+  std::vector<double> sj;
+  for (std::size_t h = 0; h < m.hexes.size(); ++h) {
+    bool in_range = std::all_of(m.hexes[h].begin(), m.hexes[h].end(), [&](Index v) {
+      return v >= 0 && static_cast<std::size_t>(v) < m.points.size();
+    });
+    sj.push_back(in_range ? hex_scaled_jacobian(hex_corners(m, static_cast<Index>(h))) : 0.0);
+  }
+  return make_grid(path, m.points, m.hexes, kVtkHexahedron, m.block, std::move(sj), extra);
+}
+
+Grid grid_of(const std::filesystem::path& path, const TetMesh& m, const VtkCellData& extra) {
+  std::vector<double> sj;
+  for (const auto& t : m.tets) {
+    bool in_range = std::all_of(t.begin(), t.end(), [&](Index v) {
+      return v >= 0 && static_cast<std::size_t>(v) < m.points.size();
+    });
+    sj.push_back(in_range ? tet_scaled_jacobian(m.points[t[0]], m.points[t[1]], m.points[t[2]],
+                                                m.points[t[3]])
+                          : 0.0);
+  }
+  return make_grid(path, m.points, m.tets, kVtkTetra, m.block, std::move(sj), extra);
+}
+
+Grid grid_of(const std::filesystem::path& path, const QuadMesh& m, const VtkCellData& extra) {
+  std::vector<double> sj;
+  for (std::size_t q = 0; q < m.quads.size(); ++q) {
+    bool in_range = std::all_of(m.quads[q].begin(), m.quads[q].end(), [&](Index v) {
+      return v >= 0 && static_cast<std::size_t>(v) < m.points.size();
+    });
+    sj.push_back(in_range ? quad_scaled_jacobian(quad_corners(m, static_cast<Index>(q))) : 0.0);
+  }
+  return make_grid(path, m.points, m.quads, kVtkQuad, {}, std::move(sj), extra);
+}
+
+// Shortest text that reads back to the same double.
+std::string format_double(double x) {
+  char buf[64];
+  const auto res = std::to_chars(buf, buf + sizeof buf, x);
+  return std::string(buf, res.ptr);
+}
+
+std::string xml_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&apos;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+// Values in rows of `per_line`.
+template <typename T, typename F>
+void write_values(std::ostream& os, const std::vector<T>& v, std::size_t per_line,
+                  const char* indent, F&& fmt) {
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    os << (i % per_line == 0 ? indent : " ") << fmt(v[i]);
+    if (i % per_line == per_line - 1 || i + 1 == v.size()) os << '\n';
+  }
+}
+
+void write_vtu_grid(std::ostream& os, const Grid& g) {
+  const auto& pts = *g.points;
+  const std::size_t ncells = g.connectivity.size() / static_cast<std::size_t>(g.corners);
+  const char* ind = "          ";
+  os << "<?xml version=\"1.0\"?>\n"
+     << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+     << "  <UnstructuredGrid>\n"
+     << "    <Piece NumberOfPoints=\"" << pts.size() << "\" NumberOfCells=\"" << ncells << "\">\n"
+     << "      <Points>\n"
+     << "        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+  for (const auto& p : pts) {
+    os << ind << format_double(p.x()) << ' ' << format_double(p.y()) << ' ' << format_double(p.z())
+       << '\n';
+  }
+  os << "        </DataArray>\n"
+     << "      </Points>\n"
+     << "      <Cells>\n"
+     << "        <DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">\n";
+  write_values(os, g.connectivity, static_cast<std::size_t>(g.corners), ind,
+               [](Index v) { return v; });
+  os << "        </DataArray>\n"
+     << "        <DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">\n";
+  std::vector<long> offsets(ncells);
+  for (std::size_t c = 0; c < ncells; ++c)
+    offsets[c] = static_cast<long>((c + 1) * static_cast<std::size_t>(g.corners));
+  write_values(os, offsets, 10, ind, [](long v) { return v; });
+  os << "        </DataArray>\n"
+     << "        <DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
+  write_values(os, std::vector<int>(ncells, g.cell_type), 20, ind, [](int v) { return v; });
+  os << "        </DataArray>\n"
+     << "      </Cells>\n"
+     << "      <CellData Scalars=\"scaled_jacobian\">\n";
+  for (const auto& [name, v] : g.data.doubles) {
+    os << "        <DataArray type=\"Float64\" Name=\"" << xml_escape(name)
+       << "\" format=\"ascii\">\n";
+    write_values(os, v, 6, ind, format_double);
+    os << "        </DataArray>\n";
+  }
+  for (const auto& [name, v] : g.data.ints) {
+    os << "        <DataArray type=\"Int32\" Name=\"" << xml_escape(name)
+       << "\" format=\"ascii\">\n";
+    write_values(os, v, 10, ind, [](int x) { return x; });
+    os << "        </DataArray>\n";
+  }
+  os << "      </CellData>\n"
+     << "    </Piece>\n"
+     << "  </UnstructuredGrid>\n"
+     << "</VTKFile>\n";
+}
+
+void write_vtk_grid(std::ostream& os, const Grid& g) {
+  const auto& pts = *g.points;
+  const std::size_t ncells = g.connectivity.size() / static_cast<std::size_t>(g.corners);
+  os << "# vtk DataFile Version 4.2\n"
+     << "geode mesh\n"
+     << "ASCII\n"
+     << "DATASET UNSTRUCTURED_GRID\n"
+     << "POINTS " << pts.size() << " double\n";
+  for (const auto& p : pts) {
+    os << format_double(p.x()) << ' ' << format_double(p.y()) << ' ' << format_double(p.z())
+       << '\n';
+  }
+  os << "CELLS " << ncells << ' ' << ncells * static_cast<std::size_t>(g.corners + 1) << '\n';
+  for (std::size_t c = 0; c < ncells; ++c) {
+    os << g.corners;
+    for (int k = 0; k < g.corners; ++k)
+      os << ' '
+         << g.connectivity[c * static_cast<std::size_t>(g.corners) + static_cast<std::size_t>(k)];
+    os << '\n';
+  }
+  os << "CELL_TYPES " << ncells << '\n';
+  for (std::size_t c = 0; c < ncells; ++c) os << g.cell_type << '\n';
+  os << "CELL_DATA " << ncells << '\n';
+  for (const auto& [name, v] : g.data.doubles) {
+    os << "SCALARS " << name << " double 1\nLOOKUP_TABLE default\n";
+    write_values(os, v, 6, "", format_double);
+  }
+  for (const auto& [name, v] : g.data.ints) {
+    os << "SCALARS " << name << " int 1\nLOOKUP_TABLE default\n";
+    write_values(os, v, 10, "", [](int x) { return x; });
+  }
+}
+
+// ---- Reading: shared checks -----------------------------------------------------------------
+
+[[noreturn]] void fail(const std::string& file, int line, const std::string& what) {
+  throw InvalidInput(file + ":" + std::to_string(line) + ": " + what);
+}
+
+std::string read_all(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InvalidInput(path.string() + ": cannot open for reading");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Checks cell types, node counts and node ranges; `line_of_cell` gives the line to report.
+template <typename LineOf>
+void check_cells(const VtkGrid& g, LineOf&& line_of_cell) {
+  for (std::size_t c = 0; c < g.cells.size(); ++c) {
+    const int type = g.cell_types[c];
+    const char* name = cell_type_name(type);
+    if (!name) {
+      fail(g.source, line_of_cell(c, true),
+           "cell " + std::to_string(c) + ": unknown or unsupported cell type " +
+               std::to_string(type) + " (supported: 5 triangle, 9 quad, 10 tetra, 12 hexahedron)");
+    }
+    if (static_cast<int>(g.cells[c].size()) != cell_type_size(type)) {
+      fail(g.source, line_of_cell(c, false),
+           "cell " + std::to_string(c) + ": type " + std::to_string(type) + " (" + name +
+               ") needs " + std::to_string(cell_type_size(type)) + " nodes, has " +
+               std::to_string(g.cells[c].size()));
+    }
+    for (Index v : g.cells[c]) {
+      if (v < 0 || static_cast<std::size_t>(v) >= g.points.size()) {
+        fail(g.source, line_of_cell(c, false),
+             "cell " + std::to_string(c) + ": node " + std::to_string(v) + " out of range [0, " +
+                 std::to_string(g.points.size()) + ")");
+      }
+    }
+  }
+}
+
+// Numbers of a text block with the line each starts on.
+struct Numbers {
+  std::vector<std::string_view> tokens;
+  std::vector<int> lines;
+};
+
+Numbers split_numbers(std::string_view text, int first_line) {
+  Numbers n;
+  int line = first_line;
+  std::size_t i = 0;
+  while (i < text.size()) {
+    if (text[i] == '\n') ++line;
+    if (std::isspace(static_cast<unsigned char>(text[i]))) {
+      ++i;
+      continue;
+    }
+    const std::size_t start = i;
+    while (i < text.size() && !std::isspace(static_cast<unsigned char>(text[i]))) ++i;
+    n.tokens.push_back(text.substr(start, i - start));
+    n.lines.push_back(line);
+  }
+  return n;
+}
+
+double parse_double(const std::string& file, int line, std::string_view tok) {
+  double x = 0.0;
+  const char* b = tok.data();
+  const char* e = tok.data() + tok.size();
+  if (!tok.empty() && *b == '+') ++b;
+  const auto res = std::from_chars(b, e, x);
+  if (res.ec != std::errc() || res.ptr != e)
+    fail(file, line, "'" + std::string(tok) + "' is not a number");
+  return x;
+}
+
+long long parse_int(const std::string& file, int line, std::string_view tok) {
+  long long x = 0;
+  const auto res = std::from_chars(tok.data(), tok.data() + tok.size(), x);
+  if (res.ec != std::errc() || res.ptr != tok.data() + tok.size()) {
+    fail(file, line, "'" + std::string(tok) + "' is not an integer");
+  }
+  return x;
+}
+
+Point point_from(const std::string& file, int line, std::size_t index, double x, double y,
+                 double z) {
+  const Point p(x, y, z);
+  if (!p.allFinite()) {
+    fail(file, line, "point " + std::to_string(index) + ": non-finite coordinate (NaN or inf)");
+  }
+  return p;
+}
+
+// ---- XML (.vtu) -------------------------------------------------------------------------------
+
+struct XmlElement {
+  std::string name;
+  std::map<std::string, std::string> attrs;
+  std::string text;
+  int line = 0;       // of the start tag
+  int text_line = 0;  // where the text content starts
+  std::vector<XmlElement> children;
+
+  const XmlElement* child(const std::string& n) const {
+    for (const auto& c : children) {
+      if (c.name == n) return &c;
+    }
+    return nullptr;
+  }
+  std::string attr(const std::string& n) const {
+    const auto it = attrs.find(n);
+    return it == attrs.end() ? std::string() : it->second;
+  }
+};
+
+// A small XML reader for what VTK writes: tags, attributes, text, comments, declarations.
+class XmlParser {
+ public:
+  XmlParser(std::string text, std::string file) : s_(std::move(text)), file_(std::move(file)) {}
+
+  XmlElement parse() {
+    skip_misc();
+    if (pos_ >= s_.size() || s_[pos_] != '<')
+      fail(file_, line_, "not an XML file (no root element)");
+    XmlElement root = element();
+    return root;
+  }
+
+ private:
+  std::string s_, file_;
+  std::size_t pos_ = 0;
+  int line_ = 1;
+
+  void advance(std::size_t n) {
+    for (std::size_t k = 0; k < n && pos_ < s_.size(); ++k) line_ += s_[pos_++] == '\n';
+  }
+  bool starts(std::string_view p) const { return s_.compare(pos_, p.size(), p) == 0; }
+  [[noreturn]] void eof(const std::string& inside, int opened) {
+    fail(file_, line_,
+         "unexpected end of file inside " + inside + " opened at line " + std::to_string(opened) +
+             " (truncated file?)");
+  }
+  void skip_space() {
+    while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_]))) advance(1);
+  }
+  void skip_until(std::string_view end, const std::string& what) {
+    const int opened = line_;
+    const auto e = s_.find(end, pos_);
+    if (e == std::string::npos) eof(what, opened);
+    advance(e + end.size() - pos_);
+  }
+  void skip_misc() {
+    while (true) {
+      skip_space();
+      if (starts("<?"))
+        skip_until("?>", "an XML declaration");
+      else if (starts("<!--"))
+        skip_until("-->", "a comment");
+      else if (starts("<!"))
+        skip_until(">", "a DOCTYPE");
+      else
+        return;
+    }
+  }
+  std::string name() {
+    const std::size_t start = pos_;
+    while (pos_ < s_.size() &&
+           (std::isalnum(static_cast<unsigned char>(s_[pos_])) || s_[pos_] == '_' ||
+            s_[pos_] == ':' || s_[pos_] == '-' || s_[pos_] == '.')) {
+      advance(1);
+    }
+    return s_.substr(start, pos_ - start);
+  }
+  static std::string unescape(const std::string& v) {
+    std::string out;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      if (v[i] == '&') {
+        static const std::pair<const char*, char> ents[] = {
+            {"&amp;", '&'}, {"&lt;", '<'}, {"&gt;", '>'}, {"&quot;", '"'}, {"&apos;", '\''}};
+        bool done = false;
+        for (const auto& [ent, ch] : ents) {
+          if (v.compare(i, std::char_traits<char>::length(ent), ent) == 0) {
+            out += ch;
+            i += std::char_traits<char>::length(ent) - 1;
+            done = true;
+            break;
+          }
+        }
+        if (!done) out += '&';
+      } else {
+        out += v[i];
+      }
+    }
+    return out;
+  }
+
+  XmlElement element() {
+    XmlElement el;
+    el.line = line_;
+    advance(1);  // '<'
+    el.name = name();
+    if (el.name.empty()) fail(file_, line_, "malformed tag");
+    const std::string tag = "<" + el.name + ">";
+    // Attributes.
+    while (true) {
+      skip_space();
+      if (pos_ >= s_.size()) eof("the tag " + tag, el.line);
+      if (starts("/>")) {
+        advance(2);
+        return el;
+      }
+      if (s_[pos_] == '>') {
+        advance(1);
+        break;
+      }
+      const std::string key = name();
+      skip_space();
+      if (key.empty() || pos_ >= s_.size() || s_[pos_] != '=') {
+        if (pos_ >= s_.size()) eof("the tag " + tag, el.line);
+        fail(file_, line_, "malformed attribute in " + tag);
+      }
+      advance(1);
+      skip_space();
+      if (pos_ >= s_.size()) eof("the tag " + tag, el.line);
+      const char q = s_[pos_];
+      if (q != '"' && q != '\'')
+        fail(file_, line_, "attribute " + key + " in " + tag + " is not quoted");
+      advance(1);
+      const auto e = s_.find(q, pos_);
+      if (e == std::string::npos) eof("the tag " + tag, el.line);
+      el.attrs[key] = unescape(s_.substr(pos_, e - pos_));
+      advance(e + 1 - pos_);
+    }
+    // Content.
+    el.text_line = line_;
+    while (true) {
+      const std::size_t lt = s_.find('<', pos_);
+      if (lt == std::string::npos) {
+        advance(s_.size() - pos_);
+        eof(tag, el.line);
+      }
+      el.text += s_.substr(pos_, lt - pos_);
+      advance(lt - pos_);
+      if (starts("</")) {
+        advance(2);
+        const std::string end = name();
+        skip_space();
+        if (pos_ >= s_.size()) eof(tag, el.line);
+        if (end != el.name || s_[pos_] != '>') {
+          fail(file_, line_,
+               "closing tag </" + end + "> does not match " + tag + " opened at line " +
+                   std::to_string(el.line));
+        }
+        advance(1);
+        return el;
+      }
+      if (starts("<!--")) {
+        skip_until("-->", "a comment");
+        continue;
+      }
+      el.children.push_back(element());
+    }
+  }
+};
+
+// A DataArray's values as tokens, checked for encoding and count.
+Numbers data_array_values(const std::string& file, const XmlElement& a, std::size_t expected,
+                          const std::string& what) {
+  const std::string format = a.attr("format");
+  if (format != "ascii") {
+    fail(file, a.line,
+         what + ": format=\"" + format + "\" is not supported (only ascii DataArrays are read)");
+  }
+  Numbers n = split_numbers(a.text, a.text_line);
+  if (n.tokens.size() != expected) {
+    fail(file, a.line,
+         what + ": " + std::to_string(n.tokens.size()) + " values, expected " +
+             std::to_string(expected) + (n.tokens.size() < expected ? " (truncated?)" : ""));
+  }
+  return n;
+}
+
+const XmlElement& required(const std::string& file, const XmlElement& parent,
+                           const std::string& name) {
+  const XmlElement* c = parent.child(name);
+  if (!c) fail(file, parent.line, "<" + parent.name + "> has no <" + name + ">");
+  return *c;
+}
+
+std::size_t count_attr(const std::string& file, const XmlElement& el, const std::string& key) {
+  const std::string v = el.attr(key);
+  const long long n =
+      parse_int(file, el.line, v.empty() ? std::string_view("missing") : std::string_view(v));
+  if (n < 0) fail(file, el.line, key + " is negative");
+  return static_cast<std::size_t>(n);
+}
+
+bool is_float_type(const std::string& t) { return t == "Float32" || t == "Float64"; }
+bool is_int_type(const std::string& t) {
+  return t == "Int8" || t == "UInt8" || t == "Int16" || t == "UInt16" || t == "Int32" ||
+         t == "UInt32" || t == "Int64" || t == "UInt64";
+}
+
+}  // namespace
+
+// ---- Writers ----------------------------------------------------------------------------------
+
+#define GEODE_VTK_WRITER(fn, writer, Mesh)                                                 \
+  void fn(const std::filesystem::path& path, const Mesh& mesh, const VtkCellData& extra) { \
+    const Grid g = grid_of(path, mesh, extra);                                             \
+    write_file_atomically(path, [&](std::ostream& os) { writer(os, g); });                 \
+  }
+GEODE_VTK_WRITER(write_vtu, write_vtu_grid, HexMesh)
+GEODE_VTK_WRITER(write_vtu, write_vtu_grid, TetMesh)
+GEODE_VTK_WRITER(write_vtu, write_vtu_grid, QuadMesh)
+GEODE_VTK_WRITER(write_vtk, write_vtk_grid, HexMesh)
+GEODE_VTK_WRITER(write_vtk, write_vtk_grid, TetMesh)
+GEODE_VTK_WRITER(write_vtk, write_vtk_grid, QuadMesh)
+#undef GEODE_VTK_WRITER
+
+// ---- .vtu reader ------------------------------------------------------------------------------
+
+VtkGrid read_vtu(const std::filesystem::path& path) {
+  VtkGrid g;
+  g.source = path.string();
+  const std::string& file = g.source;
+  const XmlElement root = XmlParser(read_all(path), file).parse();
+  if (root.name != "VTKFile" || root.attr("type") != "UnstructuredGrid") {
+    fail(file, root.line,
+         "not a VTK UnstructuredGrid file (root <" + root.name + "> type \"" + root.attr("type") +
+             "\")");
+  }
+  const XmlElement& ug = required(file, root, "UnstructuredGrid");
+  const XmlElement& piece = required(file, ug, "Piece");
+  if (std::count_if(ug.children.begin(), ug.children.end(),
+                    [](const XmlElement& e) { return e.name == "Piece"; }) != 1) {
+    fail(file, piece.line, "only single-Piece files are supported");
+  }
+  const std::size_t np = count_attr(file, piece, "NumberOfPoints");
+  const std::size_t nc = count_attr(file, piece, "NumberOfCells");
+
+  // Points.
+  const XmlElement& pts = required(file, piece, "Points");
+  const XmlElement& pa = required(file, pts, "DataArray");
+  if (pa.attr("NumberOfComponents") != "3")
+    fail(file, pa.line, "Points: NumberOfComponents must be 3");
+  {
+    const Numbers n = data_array_values(file, pa, 3 * np, "Points");
+    for (std::size_t i = 0; i < np; ++i) {
+      double x[3];
+      for (int k = 0; k < 3; ++k)
+        x[k] = parse_double(file, n.lines[3 * i + k], n.tokens[3 * i + k]);
+      g.points.push_back(point_from(file, n.lines[3 * i], i, x[0], x[1], x[2]));
+    }
+  }
+
+  // Cells.
+  const XmlElement& cells = required(file, piece, "Cells");
+  const XmlElement *conn = nullptr, *offs = nullptr, *types = nullptr;
+  for (const auto& a : cells.children) {
+    const std::string nm = a.attr("Name");
+    if (nm == "connectivity") conn = &a;
+    if (nm == "offsets") offs = &a;
+    if (nm == "types") types = &a;
+  }
+  if (!conn || !offs || !types) {
+    fail(file, cells.line, "<Cells> needs DataArrays connectivity, offsets and types");
+  }
+  const Numbers on = data_array_values(file, *offs, nc, "offsets");
+  const Numbers tn = data_array_values(file, *types, nc, "types");
+  std::vector<std::size_t> offsets;
+  for (std::size_t c = 0; c < nc; ++c) {
+    const long long o = parse_int(file, on.lines[c], on.tokens[c]);
+    if (o < 0 || (c > 0 && static_cast<std::size_t>(o) < offsets.back())) {
+      fail(file, on.lines[c],
+           "offsets: cell " + std::to_string(c) + ": offset " + std::to_string(o) +
+               " is negative or decreasing");
+    }
+    offsets.push_back(static_cast<std::size_t>(o));
+  }
+  const Numbers cn = data_array_values(file, *conn, nc ? offsets.back() : 0, "connectivity");
+  std::vector<int> cell_line(nc, conn->line), type_line(nc, types->line);
+  for (std::size_t c = 0; c < nc; ++c) {
+    g.cell_types.push_back(static_cast<int>(parse_int(file, tn.lines[c], tn.tokens[c])));
+    type_line[c] = tn.lines[c];
+    std::vector<Index> cell;
+    const std::size_t begin = c ? offsets[c - 1] : 0;
+    for (std::size_t i = begin; i < offsets[c]; ++i) {
+      cell.push_back(static_cast<Index>(parse_int(file, cn.lines[i], cn.tokens[i])));
+    }
+    if (begin < offsets[c]) cell_line[c] = cn.lines[begin];
+    g.cells.push_back(std::move(cell));
+  }
+  check_cells(g, [&](std::size_t c, bool type) { return type ? type_line[c] : cell_line[c]; });
+
+  // Cell data.
+  if (const XmlElement* cd = piece.child("CellData")) {
+    for (const auto& a : cd->children) {
+      if (a.name != "DataArray") continue;
+      const std::string nm = a.attr("Name"), type = a.attr("type");
+      if (nm.empty()) fail(file, a.line, "CellData: DataArray without a Name");
+      const std::string comps = a.attr("NumberOfComponents");
+      if (!comps.empty() && comps != "1") {
+        fail(file, a.line, "CellData '" + nm + "': only 1-component arrays are read");
+      }
+      const Numbers n = data_array_values(file, a, nc, "CellData '" + nm + "'");
+      if (is_float_type(type)) {
+        std::vector<double> v;
+        for (std::size_t i = 0; i < nc; ++i)
+          v.push_back(parse_double(file, n.lines[i], n.tokens[i]));
+        g.cell_data.doubles.emplace_back(nm, std::move(v));
+      } else if (is_int_type(type)) {
+        std::vector<int> v;
+        for (std::size_t i = 0; i < nc; ++i)
+          v.push_back(static_cast<int>(parse_int(file, n.lines[i], n.tokens[i])));
+        g.cell_data.ints.emplace_back(nm, std::move(v));
+      } else {
+        fail(file, a.line, "CellData '" + nm + "': unsupported type \"" + type + "\"");
+      }
+    }
+  }
+  return g;
+}
+
+// ---- Legacy .vtk reader -----------------------------------------------------------------------
+
+namespace {
+
+// Token stream over the body of a legacy file (after the 3 header lines).
+class Tokens {
+ public:
+  Tokens(const Numbers& n, std::string file) : n_(n), file_(std::move(file)) {}
+  bool done() const { return i_ >= n_.tokens.size(); }
+  int line() const { return done() ? (n_.lines.empty() ? 1 : n_.lines.back()) : n_.lines[i_]; }
+  std::string_view next(const std::string& what) {
+    if (done()) {
+      fail(file_, line(), "unexpected end of file while reading " + what + " (truncated file?)");
+    }
+    return n_.tokens[i_++];
+  }
+  std::string_view peek() const { return done() ? std::string_view() : n_.tokens[i_]; }
+  int line_before() const { return i_ ? n_.lines[i_ - 1] : 1; }
+  long long integer(const std::string& what) {
+    const auto t = next(what);
+    return parse_int(file_, line_before(), t);
+  }
+  double real(const std::string& what) {
+    const auto t = next(what);
+    return parse_double(file_, line_before(), t);
+  }
+  std::size_t count(const std::string& what) {
+    const long long n = integer(what);
+    if (n < 0) fail(file_, line_before(), what + " is negative");
+    return static_cast<std::size_t>(n);
+  }
+  void expect(std::string_view word, const std::string& what) {
+    const auto t = next(what);
+    if (t != word) {
+      fail(file_, line_before(),
+           "expected " + std::string(word) + ", found '" + std::string(t) + "'");
+    }
+  }
+
+ private:
+  const Numbers& n_;
+  std::string file_;
+  std::size_t i_ = 0;
+};
+
+std::string upper(std::string_view s) {
+  std::string u(s);
+  for (auto& c : u) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return u;
+}
+
+}  // namespace
+
+VtkGrid read_vtk(const std::filesystem::path& path) {
+  VtkGrid g;
+  g.source = path.string();
+  const std::string& file = g.source;
+  const std::string text = read_all(path);
+  // Header: 3 lines.
+  std::size_t pos = 0;
+  std::array<std::string, 3> header;
+  for (int l = 0; l < 3; ++l) {
+    const auto e = text.find('\n', pos);
+    if (e == std::string::npos)
+      fail(file, l + 1, "unexpected end of file in the header (truncated file?)");
+    header[l] = text.substr(pos, e - pos);
+    if (!header[l].empty() && header[l].back() == '\r') header[l].pop_back();
+    pos = e + 1;
+  }
+  if (header[0].rfind("# vtk DataFile Version", 0) != 0) {
+    fail(file, 1, "not a legacy VTK file (expected '# vtk DataFile Version')");
+  }
+  if (upper(header[2]).rfind("ASCII", 0) != 0) {
+    fail(file, 3, "'" + header[2] + "' is not supported (only ASCII legacy files are read)");
+  }
+  const Numbers body = split_numbers(std::string_view(text).substr(pos), 4);
+  Tokens t(body, file);
+  t.expect("DATASET", "the DATASET line");
+  if (const auto type = t.next("the dataset type"); upper(type) != "UNSTRUCTURED_GRID") {
+    fail(file, t.line_before(),
+         "dataset " + std::string(type) + " is not supported (UNSTRUCTURED_GRID only)");
+  }
+  std::vector<int> cell_line, type_line;
+  std::size_t nc = 0;
+  bool have_points = false, have_cells = false, have_types = false;
+  while (!t.done()) {
+    const std::string key = upper(t.next("a section keyword"));
+    const int key_line = t.line_before();
+    if (key == "POINTS") {
+      const std::size_t np = t.count("the number of points");
+      t.next("the point type");
+      for (std::size_t i = 0; i < np; ++i) {
+        const std::string what = "point " + std::to_string(i);
+        const double x = t.real(what);
+        const int line = t.line_before();
+        const double y = t.real(what), z = t.real(what);
+        g.points.push_back(point_from(file, line, i, x, y, z));
+      }
+      have_points = true;
+    } else if (key == "CELLS") {
+      nc = t.count("the number of cells");
+      const std::size_t size = t.count("the CELLS size");
+      if (upper(t.peek()) ==
+          "OFFSETS") {  // 5.1 layout: OFFSETS type (n+1 values) CONNECTIVITY type
+        t.next("OFFSETS");
+        t.next("the offsets type");
+        if (nc == 0) fail(file, key_line, "CELLS: 5.1 layout needs at least one offset");
+        std::vector<std::size_t> offsets;
+        for (std::size_t i = 0; i < nc; ++i)
+          offsets.push_back(t.count("offset " + std::to_string(i)));
+        t.expect("CONNECTIVITY", "the CONNECTIVITY keyword");
+        t.next("the connectivity type");
+        nc -= 1;  // the 5.1 header counts offsets
+        for (std::size_t c = 0; c < nc; ++c) {
+          if (offsets[c + 1] < offsets[c] || offsets[c + 1] > size) {
+            fail(file, key_line, "OFFSETS: cell " + std::to_string(c) + " has bad offsets");
+          }
+          std::vector<Index> cell;
+          cell_line.push_back(t.line());
+          for (std::size_t i = offsets[c]; i < offsets[c + 1]; ++i) {
+            cell.push_back(static_cast<Index>(t.integer("cell " + std::to_string(c))));
+          }
+          g.cells.push_back(std::move(cell));
+        }
+      } else {
+        std::size_t read = 0;
+        for (std::size_t c = 0; c < nc; ++c) {
+          const std::string what = "cell " + std::to_string(c);
+          const std::size_t n = t.count(what);
+          cell_line.push_back(t.line_before());
+          std::vector<Index> cell;
+          for (std::size_t i = 0; i < n; ++i) cell.push_back(static_cast<Index>(t.integer(what)));
+          read += n + 1;
+          g.cells.push_back(std::move(cell));
+        }
+        if (read != size) {
+          fail(file, key_line,
+               "CELLS: size " + std::to_string(size) + " but the cells hold " +
+                   std::to_string(read) + " values");
+        }
+      }
+      have_cells = true;
+    } else if (key == "CELL_TYPES") {
+      const std::size_t n = t.count("the number of cell types");
+      if (!have_cells || n != nc) {
+        fail(file, key_line,
+             "CELL_TYPES " + std::to_string(n) + " does not follow CELLS " + std::to_string(nc));
+      }
+      for (std::size_t c = 0; c < n; ++c) {
+        g.cell_types.push_back(
+            static_cast<int>(t.integer("the type of cell " + std::to_string(c))));
+        type_line.push_back(t.line_before());
+      }
+      have_types = true;
+    } else if (key == "CELL_DATA" || key == "POINT_DATA") {
+      const bool cell = key == "CELL_DATA";
+      const std::size_t n = t.count("the " + key + " count");
+      if (cell && (!have_types || n != nc)) {
+        fail(file, key_line,
+             "CELL_DATA " + std::to_string(n) + " does not match " + std::to_string(nc) + " cells");
+      }
+      // Attribute sections until the next dataset-level keyword.
+      while (!t.done()) {
+        const std::string kind = upper(t.peek());
+        if (kind == "CELL_DATA" || kind == "POINT_DATA") break;
+        t.next("an attribute");
+        const int attr_line = t.line_before();
+        std::vector<std::pair<std::string, std::string>> arrays;  // name, type
+        std::vector<std::size_t> comps;
+        if (kind == "SCALARS") {
+          const std::string name(t.next("the SCALARS name"));
+          const std::string type(t.next("the SCALARS type"));
+          std::size_t nco = 1;
+          if (upper(t.peek()) != "LOOKUP_TABLE") nco = t.count("the SCALARS component count");
+          t.expect("LOOKUP_TABLE", "LOOKUP_TABLE");
+          t.next("the lookup table name");
+          arrays.emplace_back(name, type);
+          comps.push_back(nco);
+        } else if (kind == "FIELD") {
+          t.next("the FIELD name");
+          const std::size_t k = t.count("the FIELD array count");
+          for (std::size_t a = 0; a < k; ++a) {
+            const std::string name(t.next("a FIELD array name"));
+            const std::size_t nco = t.count("the component count of " + name);
+            const std::size_t tuples = t.count("the tuple count of " + name);
+            const std::string type(t.next("the type of " + name));
+            if (tuples != n)
+              fail(file, t.line_before(),
+                   "FIELD array " + name + ": " + std::to_string(tuples) + " tuples, expected " +
+                       std::to_string(n));
+            // FIELD arrays are read one by one (values follow each header).
+            const bool is_real = upper(type) == "FLOAT" || upper(type) == "DOUBLE";
+            std::vector<double> dv;
+            std::vector<int> iv;
+            for (std::size_t i = 0; i < n * nco; ++i) {
+              if (is_real)
+                dv.push_back(t.real("array " + name));
+              else
+                iv.push_back(static_cast<int>(t.integer("array " + name)));
+            }
+            if (cell && nco == 1) {
+              if (is_real)
+                g.cell_data.doubles.emplace_back(name, std::move(dv));
+              else
+                g.cell_data.ints.emplace_back(name, std::move(iv));
+            }
+          }
+          continue;
+        } else if (kind == "VECTORS" || kind == "NORMALS") {
+          arrays.emplace_back(std::string(t.next("the array name")),
+                              std::string(t.next("the array type")));
+          comps.push_back(3);
+        } else {
+          fail(file, attr_line, "unsupported attribute section '" + kind + "'");
+        }
+        for (std::size_t a = 0; a < arrays.size(); ++a) {
+          const auto& [name, type] = arrays[a];
+          const bool is_real = upper(type) == "FLOAT" || upper(type) == "DOUBLE";
+          std::vector<double> dv;
+          std::vector<int> iv;
+          for (std::size_t i = 0; i < n * comps[a]; ++i) {
+            if (is_real)
+              dv.push_back(t.real("array " + name));
+            else
+              iv.push_back(static_cast<int>(t.integer("array " + name)));
+          }
+          if (cell && comps[a] == 1) {
+            if (is_real)
+              g.cell_data.doubles.emplace_back(name, std::move(dv));
+            else
+              g.cell_data.ints.emplace_back(name, std::move(iv));
+          }
+        }
+      }
+    } else if (key == "METADATA") {
+      // VTK 8+ metadata block: skip to the blank-line-terminated end is not token-visible;
+      // our writer never emits it.
+      fail(file, key_line, "METADATA sections are not supported");
+    } else {
+      fail(file, key_line, "unknown or unsupported section '" + key + "'");
+    }
+  }
+  if (!have_points) fail(file, t.line(), "no POINTS section (truncated file?)");
+  if (!have_cells) fail(file, t.line(), "no CELLS section (truncated file?)");
+  if (!have_types) fail(file, t.line(), "no CELL_TYPES section (truncated file?)");
+  check_cells(g, [&](std::size_t c, bool type) { return type ? type_line[c] : cell_line[c]; });
+  return g;
+}
+
+VtkGrid read_vtk_file(const std::filesystem::path& path) {
+  const std::string ext = path.extension().string();
+  if (ext == ".vtu") return read_vtu(path);
+  if (ext == ".vtk") return read_vtk(path);
+  throw InvalidInput(path.string() + ": unknown extension '" + ext + "' (expected .vtu or .vtk)");
+}
+
+// ---- Typed meshes -----------------------------------------------------------------------------
+
+namespace {
+
+template <std::size_t N>
+std::vector<std::array<Index, N>> typed_cells(const VtkGrid& g, int type) {
+  std::vector<std::array<Index, N>> out;
+  for (std::size_t c = 0; c < g.cells.size(); ++c) {
+    if (g.cell_types[c] != type || g.cells[c].size() != N) {
+      const char* have = cell_type_name(g.cell_types[c]);
+      throw InvalidInput(g.source + ": cell " + std::to_string(c) + " is VTK type " +
+                         std::to_string(g.cell_types[c]) + " (" + (have ? have : "unknown") +
+                         "), expected " + std::to_string(type) + " (" + cell_type_name(type) + ")");
+    }
+    std::array<Index, N> a{};
+    std::copy(g.cells[c].begin(), g.cells[c].end(), a.begin());
+    out.push_back(a);
+  }
+  return out;
+}
+
+std::vector<int> block_of(const VtkGrid& g) {
+  const auto* b = g.cell_data.find_int("block");
+  return b ? *b : std::vector<int>{};
+}
+
+}  // namespace
+
+HexMesh to_hex_mesh(const VtkGrid& g) {
+  HexMesh m;
+  m.points = g.points;
+  m.hexes = typed_cells<8>(g, kVtkHexahedron);
+  m.block = block_of(g);
+  return m;
+}
+
+TetMesh to_tet_mesh(const VtkGrid& g) {
+  TetMesh m;
+  m.points = g.points;
+  m.tets = typed_cells<4>(g, kVtkTetra);
+  m.block = block_of(g);
+  return m;
+}
+
+QuadMesh to_quad_mesh(const VtkGrid& g) {
+  QuadMesh m;
+  m.points = g.points;
+  m.quads = typed_cells<4>(g, kVtkQuad);
+  return m;
+}
+
+}  // namespace geode::primal

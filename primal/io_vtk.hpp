@@ -1,0 +1,81 @@
+#pragma once
+// VTK output for viewers (ParaView, VisIt) and reading it back: XML unstructured grid (.vtu,
+// ASCII DataArrays) and legacy (.vtk, "# vtk DataFile Version 4.2": the classic CELLS n size
+// layout every legacy reader since VTK 4 opens, without the 5.1 OFFSETS/CONNECTIVITY form).
+// Hexes, tets and quads (quads as VTK_QUAD in 3D space). Writes are atomic
+// (primal/atomic_file.hpp): a failure leaves no half-written file.
+//
+// Every written grid carries the cell arrays "scaled_jacobian" ([Verdict] hex, tet or quad
+// scaled Jacobian) and "block" (mesh.block, when not empty), then the caller's arrays.
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "primal/mesh.hpp"
+
+namespace geode::primal {
+
+// VTK cell type numbers (vtkCellType.h).
+inline constexpr int kVtkTriangle = 5;
+inline constexpr int kVtkQuad = 9;
+inline constexpr int kVtkTetra = 10;
+inline constexpr int kVtkHexahedron = 12;
+
+// Named per-cell arrays, written in this order. Names: non-empty, no white space (the legacy
+// format separates tokens by white space).
+struct VtkCellData {
+  std::vector<std::pair<std::string, std::vector<double>>> doubles;
+  std::vector<std::pair<std::string, std::vector<int>>> ints;
+
+  const std::vector<double>* find_double(const std::string& name) const;
+  const std::vector<int>* find_int(const std::string& name) const;
+};
+
+// Throw geode::InvalidInput (naming the file and the array, node or element) for an array of
+// the wrong length, a bad or repeated name, a node number out of range, a non-finite point,
+// or a file that cannot be written.
+void write_vtu(const std::filesystem::path& path, const HexMesh& mesh,
+               const VtkCellData& extra = {});
+void write_vtu(const std::filesystem::path& path, const TetMesh& mesh,
+               const VtkCellData& extra = {});
+void write_vtu(const std::filesystem::path& path, const QuadMesh& mesh,
+               const VtkCellData& extra = {});
+void write_vtk(const std::filesystem::path& path, const HexMesh& mesh,
+               const VtkCellData& extra = {});
+void write_vtk(const std::filesystem::path& path, const TetMesh& mesh,
+               const VtkCellData& extra = {});
+void write_vtk(const std::filesystem::path& path, const QuadMesh& mesh,
+               const VtkCellData& extra = {});
+
+// An unstructured grid as read: points, cells (VTK corner order) and cell arrays.
+struct VtkGrid {
+  std::string source;  // the file, for messages
+  std::vector<Point> points;
+  std::vector<int> cell_types;
+  std::vector<std::vector<Index>> cells;
+  VtkCellData cell_data;  // Float32/Float64 arrays as doubles, integer arrays as ints
+};
+
+// Readers of ASCII files: .vtu with format="ascii" DataArrays (one Piece), legacy .vtk in
+// ASCII with the classic CELLS layout or the 5.1 OFFSETS/CONNECTIVITY layout. Cells must be
+// triangles, quads, tets or hexes. Point data is skipped. Throw geode::InvalidInput naming the
+// file, the line (and point or cell) and the reason: truncated file, unknown cell type, wrong
+// node count for a cell type, node number out of range, NaN or infinite coordinate, too few or
+// too many values, unsupported encoding.
+VtkGrid read_vtu(const std::filesystem::path& path);
+VtkGrid read_vtk(const std::filesystem::path& path);
+// By extension: .vtu or .vtk.
+VtkGrid read_vtk_file(const std::filesystem::path& path);
+
+// The grid as a typed mesh; throw geode::InvalidInput naming the file and the first cell of
+// another type. An int cell array "block" becomes mesh.block.
+HexMesh to_hex_mesh(const VtkGrid& grid);
+TetMesh to_tet_mesh(const VtkGrid& grid);
+QuadMesh to_quad_mesh(const VtkGrid& grid);
+
+// [Verdict] tet scaled Jacobian: 6V sqrt(2) / max over corners of the product of the three
+// edge lengths there (1 for the regular tet, <= 0 when inverted or flat).
+double tet_scaled_jacobian(const Point& p0, const Point& p1, const Point& p2, const Point& p3);
+
+}  // namespace geode::primal
