@@ -134,7 +134,8 @@ void build_traces(const std::vector<std::array<Index, 4>>&, MeshDual<2>& dual) {
 }
 
 template <int Dim>
-MeshDual<Dim> build(std::size_t n_nodes, const std::vector<std::array<Index, Ref<Dim>::kCorners>>& cells) {
+MeshDual<Dim> build(std::size_t n_nodes,
+                    const std::vector<std::array<Index, Ref<Dim>::kCorners>>& cells) {
   using R = Ref<Dim>;
   MeshDual<Dim> dual;
   const Index n_cells = static_cast<Index>(cells.size());

@@ -6,9 +6,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <set>
 #include <string>
+
+#include <unistd.h>
 
 #include "primal/errors.hpp"
 #include "primal/topology.hpp"
@@ -474,4 +478,28 @@ TEST_CASE("bad input is reported with the element") {
                   geode::InvalidInput);
   CHECK_THROWS_AS(stc::trace_by_region(d, 5, [](const stc::CellFacet&) { return 0; }, 6),
                   geode::InvalidInput);
+}
+
+TEST_CASE("the fixture reader names the file and the line of a bad row") {
+  namespace fs = std::filesystem;
+  const fs::path dir =
+      fs::temp_directory_path() / ("geode_fixture_test_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  auto write = [&](const char* name, const std::string& text) {
+    std::ofstream(dir / name) << text;
+    return (dir / name).string();
+  };
+  const std::string nodes = write("nodes.csv", "node,x,y,z\n1,0,0,0\n2,1,0,0\n");
+  const std::string good = write("good.csv", "hex,n1,n2,n3,n4,n5,n6,n7,n8\n");
+  CHECK(gt::read_hex_csv(nodes, good).points.size() == 2);
+  const std::string range = write("range.csv", "hex,n1,n2,n3,n4,n5,n6,n7,n8\n1,1,2,3,4,5,6,7,8\n");
+  CHECK_THROWS_WITH_AS(gt::read_hex_csv(nodes, range), doctest::Contains("range.csv:2"),
+                       geode::InvalidInput);
+  const std::string text = write("text.csv", "node,x,y,z\n1,0,zero,0\n");
+  CHECK_THROWS_WITH_AS(gt::read_hex_csv(text, good), doctest::Contains("text.csv:2"),
+                       geode::InvalidInput);
+  const std::string gap = write("gap.csv", "node,x,y,z\n1,0,0,0\n3,0,0,0\n");
+  CHECK_THROWS_WITH_AS(gt::read_hex_csv(gap, good), doctest::Contains("gap.csv:3"),
+                       geode::InvalidInput);
+  fs::remove_all(dir);
 }
