@@ -184,6 +184,7 @@ std::vector<Point> Engine::walk(const std::vector<int>& S, const Point& x0, Poin
   Point x = x0;
   t.normalize();
   double travelled = 0.0;
+  long steps = 0;
   closed = false;
   end_face = -1;
   while (true) {
@@ -250,7 +251,9 @@ std::vector<Point> Engine::walk(const std::vector<int>& S, const Point& x0, Poin
       }
     }
     travelled += (xp - x).norm();
-    if (travelled > 200.0 * diag_)
+    // A curve longer than many domain diagonals, or one that needs far more steps than its
+    // length asks for, is hopping between branches near a tangency: report, do not spin.
+    if (travelled > 20.0 * diag_ || ++steps > 40 * static_cast<long>(20.0 * diag_ / h_))
       throw TopologyError("arrangement: the curve where sheets " + names(S) + " meet does not close or end (near " +
                           fmt_point(xp, dim_) + ")");
     pts.push_back(xp);
