@@ -267,6 +267,7 @@ Template build(const GeodeOptions& o, int dim) {
   }
   T.element_sheets = D.element_sheets;
   T.node_faces = D.node_faces;
+  T.node_signs = D.node_signs;
   return T;
 }
 
@@ -274,6 +275,30 @@ Template build(const GeodeOptions& o, int dim) {
 
 Template build_geode3d(const GeodeOptions& options) { return build(options, 3); }
 Template build_geode2d(const GeodeOptions& options) { return build(options, 2); }
+
+primal::SmoothResult smooth_template(Template& t, bool slide_faces) {
+  if (t.dim == 3) {
+    Point lo = Point::Constant(1e300), up = Point::Constant(-1e300);
+    for (const auto& p : t.hex.points) lo = lo.cwiseMin(p), up = up.cwiseMax(p);
+    // Box faces in smooth.hpp order: -x, +x, -y, +y, -z, +z (as stc::box_face).
+    std::array<bool, 6> fixed{};
+    if (!slide_faces) fixed[2] = fixed[3] = true;
+    const auto constraints = primal::box_constraints(t.hex.points, lo, up, fixed);
+    return primal::smooth_hex_mesh(t.hex, constraints);
+  }
+  Point lo = Point::Constant(1e300), up = Point::Constant(-1e300);
+  for (const auto& p : t.quad.points) lo = lo.cwiseMin(p), up = up.cwiseMax(p);
+  std::vector<primal::NodeConstraint> c;
+  for (const auto& p : t.quad.points) {
+    const bool on_x = std::abs(p.x() - lo.x()) < 1e-9 || std::abs(p.x() - up.x()) < 1e-9;
+    const bool on_y = std::abs(p.y() - lo.y()) < 1e-9 || std::abs(p.y() - up.y()) < 1e-9;
+    if ((on_x && on_y) || (on_y && !slide_faces)) c.push_back(primal::NodeConstraint::fixed());
+    else if (on_x) c.push_back(primal::NodeConstraint::line(p, Point::UnitY()));
+    else if (on_y) c.push_back(primal::NodeConstraint::line(p, Point::UnitX()));
+    else c.push_back(primal::NodeConstraint::plane(p, Point::UnitZ()));
+  }
+  return primal::smooth_quad_mesh(t.quad, Point::UnitZ(), c);
+}
 
 Eigen::Vector3d parse_box(const std::string& text) {
   static const std::regex re(R"(^\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*[xX]\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)(?:\s*[xX]\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?))?\s*$)");

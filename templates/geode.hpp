@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "primal/mesh.hpp"
+#include "primal/smooth.hpp"
 
 namespace geode::templates {
 
@@ -71,6 +72,9 @@ struct Template {
   std::vector<SheetInfo> sheets;
   std::vector<std::vector<int>> element_sheets;  // sheets meeting in each element
   std::vector<unsigned> node_faces;  // box faces under each node: bit 2*axis + (high side)
+  // Per node: the side (+1/-1) of every sheet its region lies on. With node_faces this names a
+  // node independently of numbering, e.g. to identify side-face nodes of neighbouring templates.
+  std::vector<std::vector<int>> node_signs;
   InterleaveChecks checks;
 };
 
@@ -83,6 +87,12 @@ struct Template {
 // mesh, and InvalidInput for a degenerate box.
 Template build_geode3d(const GeodeOptions& options);
 Template build_geode2d(const GeodeOptions& options);
+
+// Place the template's free nodes by optimization (primal/smooth.hpp): untangle, then maximise
+// the minimum scaled Jacobian. Tet- and hex-side nodes stay at their diced positions unless
+// slide_faces, in which case they slide within their face (box edges along the edge, corners
+// fixed); side-face nodes always slide within their face.
+primal::SmoothResult smooth_template(Template& t, bool slide_faces);
 
 // Parse "24x14x24" (or "24x14" for 2D); InvalidInput naming the text otherwise.
 Eigen::Vector3d parse_box(const std::string& text);

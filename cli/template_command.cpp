@@ -1,0 +1,253 @@
+// geode template NAME: derive a transition template from its sheet arrangement and print or
+// write it.
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "cli/commands.hpp"
+#include "primal/atomic_file.hpp"
+#include "primal/errors.hpp"
+#include "primal/io_vtk.hpp"
+#include "primal/quality.hpp"
+#include "primal/quality_report.hpp"
+#include "templates/geode.hpp"
+
+namespace geode::cli {
+namespace {
+
+struct TemplateArgs {
+  std::string name;
+  std::string box = "24x14x24";
+  std::string diagonal = "main";
+  std::string higher = "x";
+  std::string format = "appendix";
+  std::string output;
+  bool slide = false;
+  bool no_smooth = false;
+  bool quality = false;
+  templates::PushParameters push;
+};
+
+// The paper's Table 2 layout: three column groups of "Node x y z", 1-based.
+std::string appendix_nodes(const std::vector<primal::Point>& pts, int dim) {
+  std::ostringstream s;
+  const std::size_t n = pts.size(), rows = (n + 2) / 3;
+  s << "Table 2: Node positions (" << n << " nodes)\n";
+  for (int g = 0; g < 3; ++g) s << (g ? "\t" : "") << (dim == 3 ? "Node\tx\ty\tz" : "Node\tx\ty");
+  s << "\n" << std::fixed << std::setprecision(1);
+  for (std::size_t r = 0; r < rows; ++r) {
+    for (std::size_t g = 0; g < 3; ++g) {
+      const std::size_t i = g * rows + r;
+      if (i >= n) break;
+      s << (g ? "\t" : "") << i + 1 << "\t" << pts[i].x() << "\t" << pts[i].y();
+      if (dim == 3) s << "\t" << pts[i].z();
+    }
+    s << "\n";
+  }
+  return s.str();
+}
+
+// The paper's Table 3 layout: two column groups of "Hex n1 .. n8", 1-based.
+template <class Cells>
+std::string appendix_cells(const Cells& cells, const char* what) {
+  std::ostringstream s;
+  const std::size_t n = cells.size(), rows = (n + 1) / 2, k = cells.empty() ? 0 : cells[0].size();
+  s << "Table 3: Connectivity (" << n << " " << what << ")\n";
+  for (int g = 0; g < 2; ++g) {
+    s << (g ? "\t" : "") << (k == 8 ? "Hex" : "Quad");
+    for (std::size_t c = 0; c < k; ++c) s << "\tn" << c + 1;
+  }
+  s << "\n";
+  for (std::size_t r = 0; r < rows; ++r) {
+    for (std::size_t g = 0; g < 2; ++g) {
+      const std::size_t i = g * rows + r;
+      if (i >= n) break;
+      s << (g ? "\t" : "") << i + 1;
+      for (auto v : cells[i]) s << "\t" << v + 1;
+    }
+    s << "\n";
+  }
+  return s.str();
+}
+
+template <class Cells>
+std::string csv_tables(const std::vector<primal::Point>& pts, const Cells& cells, int dim) {
+  std::ostringstream s;
+  s << std::setprecision(17) << (dim == 3 ? "node,x,y,z\n" : "node,x,y\n");
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    s << i + 1 << "," << pts[i].x() << "," << pts[i].y();
+    if (dim == 3) s << "," << pts[i].z();
+    s << "\n";
+  }
+  s << "\n" << (dim == 3 ? "hex" : "quad");
+  for (std::size_t c = 0; c < (dim == 3 ? 8u : 4u); ++c) s << ",n" << c + 1;
+  s << "\n";
+  for (std::size_t i = 0; i < cells.size(); ++i) {
+    s << i + 1;
+    for (auto v : cells[i]) s << "," << v + 1;
+    s << "\n";
+  }
+  return s.str();
+}
+
+nlohmann::json to_json(const templates::Template& T, const std::string& name) {
+  nlohmann::json j;
+  j["template"] = name;
+  j["index_base"] = 1;
+  const auto& pts = T.dim == 3 ? T.hex.points : T.quad.points;
+  for (const auto& p : pts) j["nodes"].push_back(T.dim == 3 ? nlohmann::json{p.x(), p.y(), p.z()} : nlohmann::json{p.x(), p.y()});
+  auto cells = nlohmann::json::array();
+  if (T.dim == 3)
+    for (const auto& h : T.hex.hexes) {
+      nlohmann::json c;
+      for (auto v : h) c.push_back(v + 1);
+      cells.push_back(c);
+    }
+  else
+    for (const auto& q : T.quad.quads) {
+      nlohmann::json c;
+      for (auto v : q) c.push_back(v + 1);
+      cells.push_back(c);
+    }
+  j[T.dim == 3 ? "hexes" : "quads"] = cells;
+  for (const auto& s : T.sheets) j["sheets"].push_back({{"name", s.name}, {"kind", s.kind}});
+  std::map<std::vector<int>, int> table;
+  for (std::size_t e = 0; e < T.element_sheets.size(); ++e) {
+    j["element_sheets"].push_back(T.element_sheets[e]);
+    ++table[T.element_sheets[e]];
+  }
+  for (const auto& [sheets, count] : table) {
+    nlohmann::json names;
+    for (int s : sheets) names.push_back(T.sheets[static_cast<std::size_t>(s)].name);
+    j["intersections"].push_back({{"sheets", names}, {"elements", count}});
+  }
+  j["checks"] = {{"triple_domes_in_pocket", T.checks.triple_domes_in_pocket},
+                 {"dome_curves_exit_in_tunnels", T.checks.dome_curves_exit_in_tunnels},
+                 {"failures", T.checks.failures}};
+  return j;
+}
+
+void run_template(const TemplateArgs& a) {
+  templates::GeodeOptions o;
+  o.box = templates::parse_box(a.box);
+  o.diagonal = a.diagonal == "anti" ? templates::Diagonal::Anti : templates::Diagonal::Main;
+  o.higher = a.higher == "z" ? templates::Higher::Z : templates::Higher::X;
+  o.push = a.push;
+  templates::Template T;
+  if (a.name == "geode2d") {
+    T = templates::build_geode2d(o);
+  } else {
+    if (a.name == "geode4tri") o.split = templates::TopSplit::FourTriangles;
+    T = templates::build_geode3d(o);
+  }
+  if (!T.checks.ok() && a.name != "geode2d") {
+    std::string why;
+    for (const auto& f : T.checks.failures) why += (why.empty() ? "" : "; ") + f;
+    std::cerr << "geode: warning: the interleave fails the paper's conditions: " << why << "\n";
+  }
+  std::string smooth_note;
+  if (!a.no_smooth) {
+    const auto r = templates::smooth_template(T, a.slide);
+    std::ostringstream s;
+    s << "smoothing (" << (a.slide ? "tet/hex-side nodes slide" : "tet/hex-side nodes fixed") << "): min scaled Jacobian "
+      << r.initial_min_scaled_jacobian << " -> " << r.final_min_scaled_jacobian << " in " << r.iterations
+      << " iterations, " << r.seconds << " s";
+    smooth_note = s.str();
+    if (!r.untangled) std::cerr << "geode: warning: smoothing could not untangle every element\n";
+  }
+  const int dim = T.dim;
+  const auto& pts = dim == 3 ? T.hex.points : T.quad.points;
+  std::string text;
+  if (a.format == "appendix") {
+    text = "# geode template " + a.name + ", box " + a.box + (smooth_note.empty() ? "" : "; " + smooth_note) + "\n";
+    text += appendix_nodes(pts, dim) + "\n";
+    text += dim == 3 ? appendix_cells(T.hex.hexes, "hexes") : appendix_cells(T.quad.quads, "quads");
+  } else if (a.format == "csv") {
+    text = dim == 3 ? csv_tables(pts, T.hex.hexes, 3) : csv_tables(pts, T.quad.quads, 2);
+  } else if (a.format == "json") {
+    text = to_json(T, a.name).dump(1) + "\n";
+  }
+  if (a.quality && dim == 3) text += "\nQuality report (Verdict definitions)\n" + primal::format_quality_table(primal::hex_quality_report(T.hex));
+  if (a.quality && dim == 2) {
+    double lo = 1e300, hi = -1e300;
+    for (std::size_t q = 0; q < T.quad.quads.size(); ++q) {
+      const double v = primal::quad_scaled_jacobian(primal::quad_corners(T.quad, static_cast<primal::Index>(q)), primal::Point::UnitZ());
+      lo = std::min(lo, v), hi = std::max(hi, v);
+    }
+    std::ostringstream s;
+    s << "\nQuad scaled Jacobian: min " << lo << ", max " << hi << "\n";
+    text += s.str();
+  }
+  if (a.format == "vtu") {
+    if (a.output.empty()) throw InvalidInput("--format vtu needs -o FILE.vtu");
+    std::vector<double> sj;
+    if (dim == 3) {
+      for (std::size_t h = 0; h < T.hex.hexes.size(); ++h)
+        sj.push_back(primal::hex_scaled_jacobian(primal::hex_corners(T.hex, static_cast<primal::Index>(h))));
+      primal::VtkCellData cd;
+      cd.doubles.push_back({"scaled_jacobian", sj});
+      primal::write_vtu(a.output, T.hex, cd);
+    } else {
+      for (std::size_t q = 0; q < T.quad.quads.size(); ++q)
+        sj.push_back(primal::quad_scaled_jacobian(primal::quad_corners(T.quad, static_cast<primal::Index>(q)), primal::Point::UnitZ()));
+      primal::VtkCellData cd;
+      cd.doubles.push_back({"scaled_jacobian", sj});
+      primal::write_vtu(a.output, T.quad, cd);
+    }
+    if (!text.empty()) std::cout << text;
+    return;
+  }
+  if (a.output.empty())
+    std::cout << text;
+  else
+    primal::write_file_atomically(a.output, [&](std::ostream& os) { os << text; });
+}
+
+}  // namespace
+
+void add_template_command(CLI::App& app) {
+  auto args = std::make_shared<TemplateArgs>();
+  CLI::App* t = app.add_subcommand(
+      "template",
+      "Derive a transition template from its completed, pushed-together sheet arrangement (no\n"
+      "connectivity is typed in) and print or write it. Tet- and hex-side nodes sit where dicing\n"
+      "puts them; the rest are placed by optimization unless --no-smooth.");
+  t->add_option("NAME", args->name,
+                "geode3d: the 26-hex geode (tet side split by a diagonal into 2 triangles);\n"
+                "geode2d: the 5-quad 2D geode; geode4tri: the tet side split into 4 triangles")
+      ->required()
+      ->check(CLI::IsMember({"geode3d", "geode2d", "geode4tri"}));
+  t->add_option("--box", args->box, "buffer cell WIDTHxHEIGHTxDEPTH (x, y up, z), centred at the origin; tet side on top")
+      ->capture_default_str();
+  t->add_option("--diagonal", args->diagonal,
+                "main: the top diagonal joins (-x,+z) and (+x,-z) as in the paper's Appendix A; anti: the other one")
+      ->check(CLI::IsMember({"main", "anti"}))
+      ->capture_default_str();
+  t->add_option("--higher", args->higher, "which tunnel's roof is higher where they cross: the one along x or along z")
+      ->check(CLI::IsMember({"x", "z"}))
+      ->capture_default_str();
+  t->add_option("--format", args->format,
+                "appendix: the paper's Tables 2 and 3 (1-based); csv: node and element tables; json: with\n"
+                "sheets, their intersections and the interleave checks; vtu: VTK XML for ParaView (needs -o)")
+      ->check(CLI::IsMember({"appendix", "csv", "json", "vtu"}))
+      ->capture_default_str();
+  t->add_option("-o,--output", args->output, "write to FILE (atomically) instead of standard output");
+  t->add_flag("--slide", args->slide, "let tet- and hex-side nodes slide within their faces while smoothing");
+  t->add_flag("--no-smooth", args->no_smooth, "keep the dual's first-guess positions");
+  t->add_flag("--quality", args->quality, "append the quality report (the paper's Table 1 metrics)");
+  t->add_option("--high-roof", args->push.high_roof, "push: higher tunnel roof, fraction of the height")->capture_default_str();
+  t->add_option("--low-roof", args->push.low_roof, "push: lower tunnel roof, fraction of the height")->capture_default_str();
+  t->add_option("--dome-depth", args->push.dome_depth, "push: how far below the tet side the domes reach, fraction of the height")
+      ->capture_default_str();
+  t->add_option("--dome-radius", args->push.dome_radius,
+                "push: where each dome's circle crosses the diced tet side, 0..1 between the nodes it\n"
+                "must enclose and the nearest it must leave out")
+      ->capture_default_str();
+  t->callback([args] { run_template(*args); });
+}
+
+}  // namespace geode::cli
