@@ -7,6 +7,7 @@
 #include <set>
 
 #include "primal/errors.hpp"
+#include "primal/validity.hpp"
 #include "support/fixtures.hpp"
 #include "support/isomorphism.hpp"
 #include "templates/geode.hpp"
@@ -126,4 +127,72 @@ TEST_CASE("geode: bad options are rejected") {
   CHECK_THROWS_AS(templates::parse_box("24x14x"), InvalidInput);
   CHECK_THROWS_AS(templates::parse_box("24x-1x3"), InvalidInput);
   CHECK(templates::parse_box("24x14x24") == Eigen::Vector3d(24, 14, 24));
+}
+
+namespace {
+
+// Combinatorial validity (orientation aside): a complex whose faces are shared by at most two
+// hexes, consistently oriented, manifold, a ball (Euler characteristic 1) with a closed
+// manifold sphere boundary (Euler characteristic 2).
+void check_combinatorial_ball(const primal::HexValidityReport& r) {
+  CHECK(r.out_of_range_hexes.empty());
+  CHECK(r.repeated_node_hexes.empty());
+  CHECK(r.overshared_faces.empty());
+  CHECK(r.misoriented_faces.empty());
+  CHECK(r.nonmanifold_edges.empty());
+  CHECK(r.nonmanifold_vertices.empty());
+  CHECK(r.unused_nodes == 0);
+  CHECK(r.euler == 1);
+  CHECK(r.boundary.closed);
+  CHECK(r.boundary.manifold);
+  CHECK(r.boundary.euler == 2);
+}
+
+}  // namespace
+
+TEST_CASE("geode3d: the smoothed template is a valid mesh of the box") {
+  for (bool slide : {false, true}) {
+    CAPTURE(slide);
+    auto T = templates::build_geode3d(GeodeOptions{});
+    const auto before = primal::check_validity(T.hex);
+    check_combinatorial_ball(before);
+    const auto r = templates::smooth_template(T, slide);
+    CHECK(r.untangled);
+    const auto after = primal::check_validity(T.hex);
+    check_combinatorial_ball(after);
+    CHECK(after.inverted_hexes.empty());
+    CHECK(after.ok());
+    // Issue target: the paper reached 0.26; ours must reach 0.40 in both modes.
+    CHECK(r.final_min_scaled_jacobian >= 0.40);
+  }
+}
+
+TEST_CASE("geode2d: the smoothed 2D geode is a valid quad mesh of the rectangle") {
+  auto T = templates::build_geode2d(GeodeOptions{});
+  const auto r = templates::smooth_template(T, false);
+  CHECK(r.untangled);
+  const auto v = primal::check_validity(T.quad);
+  CHECK(v.ok());
+  CHECK(v.euler == 1);
+  CHECK(v.boundary_loops.size() == 1);
+  CHECK(v.boundary_loops.front().size() == 6);  // 2 diced edges top and bottom, 1 per side
+}
+
+// The paper's open question (Section 5): split the tet-side quad into four triangles. What we
+// found (see README): the arrangement (2 tunnels, 5 domes) dualizes to a combinatorially valid
+// 36-hex mesh with the prescribed boundary and 2D-geode sides, but it fails the paper's first
+// condition: the four points where three domes meet lie outside the tunnels' pocket, and the
+// smoother does not untangle it.
+TEST_CASE("geode4tri: what the four-triangle variant yields") {
+  GeodeOptions o;
+  o.split = templates::TopSplit::FourTriangles;
+  auto T = templates::build_geode3d(o);
+  CHECK(T.hex.hexes.size() == 36);
+  CHECK(T.sheets.size() == 7);
+  check_combinatorial_ball(primal::check_validity(T.hex));
+  CHECK(T.checks.triple_dome_points == 4);
+  CHECK_FALSE(T.checks.triple_domes_in_pocket);
+  const auto T2 = templates::build_geode2d(GeodeOptions{});
+  for (int axis : {0, 2})
+    for (double s : {-12.0, 12.0}) CHECK(test::find_isomorphism(side_face(T.hex, axis, s), T2.quad).has_value());
 }
