@@ -959,8 +959,8 @@ VtkGrid read_vtk(const std::filesystem::path& path) {
         }
       }
     } else if (key == "METADATA") {
-      // VTK 8+ metadata block: skip to the blank-line-terminated end is not token-visible;
-      // our writer never emits it.
+      // VTK 8+ writes METADATA blocks ending at a blank line, which this token reader cannot
+      // see; our writers never emit them.
       fail(file, key_line, "METADATA sections are not supported");
     } else {
       fail(file, key_line, "unknown or unsupported section '" + key + "'");
