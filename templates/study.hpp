@@ -1,0 +1,123 @@
+#pragma once
+// Parameter studies of the geode templates (the paper's Sections 2.2 and 3.2):
+//  - interleave study: sweep how far the two completed arrangements are pushed together and
+//    classify what each push dualizes to (a template class, or the reason it does not);
+//  - shape study: the smoothed template's minimum scaled Jacobian against the buffer cell's
+//    height, and in sheared and tapered buffer cells.
+// Results are computed, never typed in; the only paper numbers here are Table 1's, printed
+// next to ours for comparison (paper_table1()).
+#include <array>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "primal/quality_report.hpp"
+#include "templates/geode.hpp"
+
+namespace geode::templates {
+
+// ---- Interleave study ----------------------------------------------------------------------
+
+// A canonical invariant of a template (equal for isomorphic templates; different values prove
+// the templates differ): "<hexes>h|<kind triples>|<hash>", where kind triples is the sorted
+// multiset of per-element sheet-kind triples (e.g. "dome+dome+tunnel:8") and hash is a
+// 64-bit colour-refinement (1-dimensional Weisfeiler-Leman) hash of the node-hex incidence
+// graph, hexes initially coloured by their kind triple and nodes by which box faces (tet
+// side, hex side, sides) they lie on.
+std::string template_class_key(const Template& t);
+
+// An error message with its numbers (coordinates, node numbers) replaced by '#', so that runs
+// failing for the same reason share one diagnosis; sheet names are kept.
+std::string strip_numbers(const std::string& message);
+
+struct PushGrid {
+  std::vector<double> high_roof, low_roof, dome_depth, dome_radius;
+};
+
+struct InterleaveRun {
+  PushParameters push;
+  bool valid = false;        // the arrangement dualized to a template
+  int hexes = 0;
+  std::string class_label;   // "V1", "V2", ... for template classes, "E1", ... for diagnoses
+  bool conditions_ok = false;  // the paper's two interleave conditions (valid runs only)
+  std::string conditions;      // the failed conditions, stripped of numbers (valid runs)
+  std::string diagnosis;       // the TopologyError, stripped (error runs)
+  double seconds = 0.0;
+};
+
+struct InterleaveClass {
+  std::string label;
+  bool valid = false;
+  std::string key;  // template_class_key, or the stripped diagnosis
+  int hexes = 0;
+  int count = 0;
+  int conditions_ok = 0;  // runs of the class meeting the paper's conditions
+  PushParameters example;  // the first run of the class in sweep order
+};
+
+struct InterleaveStudy {
+  std::string template_name;
+  std::vector<InterleaveRun> runs;       // sweep order: high, low, depth, radius
+  std::vector<InterleaveClass> classes;  // valid classes, then errors; each by count, then key
+};
+
+// Builds the template for every grid point with 0 < low < high < 1 (others are skipped:
+// build_geode3d rejects them as invalid input). split picks geode3d or geode4tri; the rest of
+// `base` (box, diagonal, higher) is kept.
+InterleaveStudy interleave_study(const GeodeOptions& base, const PushGrid& grid,
+                                 const std::string& template_name);
+
+// CSV: high_roof,low_roof,dome_depth,dome_radius,outcome,hexes,class,conditions_ok,diagnosis
+void write_interleave_csv(std::ostream& out, const InterleaveStudy& study);
+// CSV: class,outcome,count,hexes,conditions_ok,example high/low/depth/radius,key
+void write_interleave_summary(std::ostream& out, const InterleaveStudy& study);
+
+// ---- Shape study ---------------------------------------------------------------------------
+
+// A buffer cell given by its 8 corners, corner[bx + 2 by + 4 bz] with bx, by, bz in {0, 1}
+// (by = 1 is the tet side). Each face must be planar (shears and tapers are).
+using CellCorners = std::array<primal::Point, 8>;
+CellCorners box_cell(const Eigen::Vector3d& box);
+// Top face shifted by height * tan(angle) along +x (a parallelepiped).
+CellCorners sheared_cell(const Eigen::Vector3d& box, double angle_degrees);
+// Top face scaled about the axis by `ratio` in x and z (a frustum; ratio 1 is the box).
+CellCorners tapered_cell(const Eigen::Vector3d& box, double ratio);
+
+// Maps the template's positions (built in the box of `box_of_t`, centred) trilinearly into
+// the cell, then smooths: tet- and hex-side nodes fixed (slide = false) or sliding in their
+// planes (slide = true); side-face nodes slide in their face planes, nodes on two faces along
+// the common edge, cell corners fixed.
+primal::SmoothResult smooth_in_cell(Template& t, const Eigen::Vector3d& box_of_t,
+                                    const CellCorners& cell, bool slide);
+
+struct ShapeRow {
+  std::string cell;   // "box", "shear", "taper"
+  double parameter = 0.0;  // height, shear angle (degrees) or taper ratio
+  std::string mode;   // "fixed" or "slide"
+  double initial_min_sj = 0.0, final_min_sj = 0.0, final_max_sj = 0.0;
+  bool untangled = false;
+  int iterations = 0;
+  double seconds = 0.0;
+};
+
+// Geode in a 24 x h x 24 box for each height, both modes.
+std::vector<ShapeRow> height_study(const std::vector<double>& heights, double base = 24.0);
+// Geode in sheared (angles, degrees) and tapered (top/bottom ratios) 24 x 14 x 24 cells.
+std::vector<ShapeRow> distorted_study(const std::vector<double>& shear_degrees,
+                                      const std::vector<double>& taper_ratios);
+// CSV: cell,parameter,mode,initial_min_sj,final_min_sj,final_max_sj,untangled,iterations,seconds
+void write_shape_csv(std::ostream& out, const std::vector<ShapeRow>& rows);
+
+// The paper's Table 1 (CUBIT report, 24 x 14 x 24 geode), for comparison only.
+struct PaperRow {
+  primal::HexMetric metric;
+  double average, std_dev, minimum, maximum;
+};
+const std::vector<PaperRow>& paper_table1();
+
+// Smoothed 24 x 14 x 24 geode in both modes: the Table 1 report next to the paper's values
+// (CSV: metric,mode,average,std_dev,min,max,paper_average,paper_std_dev,paper_min,paper_max)
+// and per-hex scaled Jacobians (CSV: mode,hex,scaled_jacobian).
+void write_geode_quality(std::ostream& report_csv, std::ostream* per_hex_csv);
+
+}  // namespace geode::templates
