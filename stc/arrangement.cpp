@@ -84,8 +84,11 @@ class Engine {
   // axes) held. Returns false when it does not converge.
   bool project(const std::vector<int>& S, Point& x, unsigned fixed = 0) const {
     const int k = static_cast<int>(S.size());
-    Eigen::MatrixXd J(k, dim_);
-    Eigen::VectorXd F(k);
+    // At most 3 x 3: fixed capacity keeps the hot path off the heap.
+    using Mat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3>;
+    using Vec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1>;
+    Mat J(k, dim_);
+    Vec F(k);
     for (int it = 0; it < 40; ++it) {
       double err = 0.0;
       for (int r = 0; r < k; ++r) {
@@ -97,10 +100,10 @@ class Engine {
         err = std::max(err, std::abs(F[r]) / gn);
       }
       if (err < tol_) return true;
-      const Eigen::MatrixXd JJt = J * J.transpose();
-      Eigen::LDLT<Eigen::MatrixXd> ldlt(JJt);
-      if (ldlt.info() != Eigen::Success || std::abs(JJt.determinant()) < 1e-30) return false;
-      const Eigen::VectorXd dx = J.transpose() * ldlt.solve(F);
+      const Mat JJt = J * J.transpose();
+      const double det = JJt.determinant();
+      if (!(std::abs(det) > 1e-30)) return false;
+      const Vec dx = J.transpose() * JJt.inverse() * F;
       if (!dx.allFinite() || dx.norm() > 0.25 * diag_) return false;
       for (int c = 0; c < dim_; ++c) x[c] -= dx[c];
     }
@@ -123,6 +126,15 @@ class Engine {
   int register_vertex(std::vector<int> sheets, const Point& x);
   void check_vertex(const Vertex& v) const;
 
+  // Sampling grid for seeds, evaluated once for every sheet.
+  void sample_grid();
+  Point grid_node(int i, int j, int k) const;
+  std::size_t grid_id(int i, int j, int k) const {
+    return static_cast<std::size_t>((k * (n_[1] + 1) + j) * (n_[0] + 1) + i);
+  }
+  std::array<int, 3> n_{1, 1, 1};
+  std::vector<std::vector<double>> grid_;
+
   const std::vector<Sheet>& sheets_;
   Domain domain_;
   ArrangementOptions options_;
@@ -131,48 +143,54 @@ class Engine {
   std::vector<Vertex> vertices_;
 };
 
-std::vector<Point> Engine::seeds(const std::vector<int>& S) const {
-  // Sampling grid over the domain; a cell where every field of S changes sign holds a piece of
-  // their meeting curve (or comes close to one): project its centre onto the curve.
-  std::array<int, 3> n{1, 1, 1};
+Point Engine::grid_node(int i, int j, int k) const {
+  Point p = domain_.lo;
+  const std::array<int, 3> ijk{i, j, k};
+  for (int a = 0; a < dim_; ++a)
+    p[a] = domain_.lo[a] + (domain_.hi[a] - domain_.lo[a]) * ijk[static_cast<std::size_t>(a)] / n_[static_cast<std::size_t>(a)];
+  if (dim_ == 2) p[2] = 0.0;
+  return p;
+}
+
+void Engine::sample_grid() {
   double longest = 0.0;
   for (int i = 0; i < dim_; ++i) longest = std::max(longest, domain_.hi[i] - domain_.lo[i]);
+  n_ = {1, 1, 0};
   for (int i = 0; i < dim_; ++i)
-    n[static_cast<std::size_t>(i)] = std::max(
+    n_[static_cast<std::size_t>(i)] = std::max(
         2, static_cast<int>(std::lround(options_.seed_resolution * (domain_.hi[i] - domain_.lo[i]) / longest)));
-  auto node = [&](int i, int j, int k) {
-    Point p = domain_.lo;
-    const std::array<int, 3> ijk{i, j, k};
-    for (int a = 0; a < dim_; ++a)
-      p[a] = domain_.lo[a] + (domain_.hi[a] - domain_.lo[a]) * ijk[static_cast<std::size_t>(a)] / n[static_cast<std::size_t>(a)];
-    if (dim_ == 2) p[2] = 0.0;
-    return p;
-  };
-  const int nk = dim_ == 3 ? n[2] : 0;
-  const std::size_t nn = static_cast<std::size_t>((n[0] + 1) * (n[1] + 1) * (nk + 1));
-  std::vector<std::vector<double>> val(S.size(), std::vector<double>(nn));
-  auto id = [&](int i, int j, int k) { return static_cast<std::size_t>((k * (n[1] + 1) + j) * (n[0] + 1) + i); };
-  for (int k = 0; k <= nk; ++k)
-    for (int j = 0; j <= n[1]; ++j)
-      for (int i = 0; i <= n[0]; ++i)
-        for (std::size_t s = 0; s < S.size(); ++s) val[s][id(i, j, k)] = value(S[s], node(i, j, k));
+  const std::size_t nn = static_cast<std::size_t>((n_[0] + 1) * (n_[1] + 1) * (n_[2] + 1));
+  grid_.assign(sheets_.size(), std::vector<double>(nn));
+  for (int k = 0; k <= n_[2]; ++k)
+    for (int j = 0; j <= n_[1]; ++j)
+      for (int i = 0; i <= n_[0]; ++i) {
+        const Point p = grid_node(i, j, k);
+        for (std::size_t s = 0; s < sheets_.size(); ++s) grid_[s][grid_id(i, j, k)] = value(static_cast<int>(s), p);
+      }
+}
+
+std::vector<Point> Engine::seeds(const std::vector<int>& S) const {
+  // A grid cell where every field of S changes sign holds a piece of their meeting curve (or
+  // comes close to one): project its centre onto the curve.
   std::vector<Point> out;
-  const int kcells = dim_ == 3 ? n[2] : 1;
+  const int kcells = dim_ == 3 ? n_[2] : 1;
+  const int corners = dim_ == 3 ? 8 : 4;
   for (int k = 0; k < kcells; ++k)
-    for (int j = 0; j < n[1]; ++j)
-      for (int i = 0; i < n[0]; ++i) {
+    for (int j = 0; j < n_[1]; ++j)
+      for (int i = 0; i < n_[0]; ++i) {
         bool all = true;
         for (std::size_t s = 0; s < S.size() && all; ++s) {
+          const auto& val = grid_[static_cast<std::size_t>(S[s])];
           double lo = 1e300, hi = -1e300;
-          for (int c = 0; c < (dim_ == 3 ? 8 : 4); ++c) {
-            const double v = val[s][id(i + (c & 1), j + ((c >> 1) & 1), dim_ == 3 ? k + ((c >> 2) & 1) : 0)];
+          for (int c = 0; c < corners; ++c) {
+            const double v = val[grid_id(i + (c & 1), j + ((c >> 1) & 1), dim_ == 3 ? k + ((c >> 2) & 1) : 0)];
             lo = std::min(lo, v);
             hi = std::max(hi, v);
           }
           all = lo <= 0.0 && hi >= 0.0;
         }
         if (!all) continue;
-        Point c = 0.5 * (node(i, j, dim_ == 3 ? k : 0) + node(i + 1, j + 1, dim_ == 3 ? k + 1 : 0));
+        Point c = 0.5 * (grid_node(i, j, dim_ == 3 ? k : 0) + grid_node(i + 1, j + 1, dim_ == 3 ? k + 1 : 0));
         if (project(S, c) && inside(c)) out.push_back(c);
       }
   return out;
@@ -373,6 +391,7 @@ Arrangement Engine::run() {
   A.sheet_count = static_cast<int>(sheets_.size());
   for (const auto& s : sheets_) A.sheet_names.push_back(s.name);
 
+  sample_grid();
   // 1. Curves: every (d-1)-subset of sheets, every component.
   std::vector<std::vector<int>> subsets;
   const int m = A.sheet_count;
