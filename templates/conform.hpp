@@ -1,0 +1,80 @@
+#pragma once
+// The geode algorithm on a whole model (the paper's Sections 1 and 4): find the hex/tet
+// interface, shrink the tet part off it (buffer layer), dice the hex part (8 per hex) and the
+// tet part (4 hexes per tet), fill every buffer hex with the 26-hex geode template mapped by
+// the trilinear map of its 8 corners, merge, smooth locally and verify. The result is all-hex.
+//
+// Merging. Tet- and hex-side template nodes are identified with diced nodes by their origin
+// (corner, edge midpoint, quad centre, triangle centroid: the keys of primal/dice's node-origin
+// map), never by position, and take the diced position. Side-face nodes of two buffer hexes
+// sharing a side face are matched topologically (the side face's quad mesh, propagated from the
+// shared top/bottom nodes across quad edges; the template's x- and z-faces have the same quad
+// mesh but different positions, so positions cannot be used) and their positions averaged.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "primal/buffer_layer.hpp"
+#include "primal/model.hpp"
+#include "primal/quality_report.hpp"
+#include "primal/smooth.hpp"
+#include "primal/validity.hpp"
+
+namespace geode::templates {
+
+enum class ConformSmooth { kNone, kLocal, kGlobal };
+
+struct ConformOptions {
+  primal::BufferLayerOptions buffer;
+  double interface_tolerance = 1e-6;  // find_interface: relative to the local edge length
+  // Box of the reference template (x, y, z as in templates/geode.hpp: y is the buffer hex's
+  // thickness direction). It is smoothed once per diagonal with top and bottom fixed; only its
+  // proportions matter. Thin, as the buffer layer is (paper, 3.2: short templates are best).
+  Eigen::Vector3d template_box{2.0, 1.0, 2.0};
+  // kLocal: nodes of the geode hexes and of the hexes around them (one ring) move, the rest is
+  // fixed. kGlobal: every node moves. Model boundary nodes are fixed in both.
+  ConformSmooth smooth = ConformSmooth::kLocal;
+  primal::SmoothOptions smooth_options;
+  // Called with one line per stage (for the command line's progress output); may be empty.
+  std::function<void(const std::string&)> progress;
+};
+
+// Output element blocks, by origin.
+inline constexpr int kDicedHexBlock = 1;
+inline constexpr int kGeodeBlock = 2;
+inline constexpr int kDicedTetBlock = 3;
+
+struct BlockQuality {
+  int block = 0;
+  std::string name;
+  primal::QualityReport report;
+};
+
+struct ConformResult {
+  // All-hex model: hexes grouped by block (diced hexes, geode hexes, diced tets, ascending id),
+  // block names "diced hex", "geode", "diced tet". Node sets: every input node of the set plus
+  // the diced edge / face nodes whose origin nodes are all in the set. Side sets: every input
+  // side becomes the diced children's faces lying on it (4 per hex face, 3 per tet face).
+  primal::Model model;
+  primal::Index input_hexes = 0, input_tets = 0, interface_quads = 0;
+  primal::Index diced_hexes = 0, geode_hexes = 0, diced_tet_hexes = 0;
+  primal::BufferLayerReport buffer;
+  double template_min_scaled_jacobian = 0.0;  // the two reference templates, after smoothing
+  double min_scaled_jacobian_before_smoothing = 0.0;
+  primal::SmoothResult smoothing;  // zero-initialised when ConformSmooth::kNone
+  primal::HexValidityReport validity;
+  std::vector<BlockQuality> quality;  // one per non-empty block
+  std::vector<std::string> warnings;  // e.g. "3 hexes with scaled Jacobian <= 0: 12 40 ..."
+  double seconds = 0.0;
+};
+
+// Throws TopologyError from find_interface / insert_buffer_layer (named by them), when a side
+// face is shared by more than two buffer hexes, or when the side faces of two buffer hexes do
+// not match; InvalidInput when the model has no hexes, no tets or no interface. A result whose
+// validity is not ok() is still returned (with warnings) so that it can be inspected.
+ConformResult conform(const primal::Model& input, const ConformOptions& options = {});
+
+// The output model's hexes as a HexMesh (block per hex).
+primal::HexMesh hex_mesh(const primal::Model& model);
+
+}  // namespace geode::templates
