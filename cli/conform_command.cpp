@@ -1,6 +1,172 @@
+// geode conform INPUT: the geode algorithm on a whole hex + tet model; geode demo: the same on
+// a demo model built with Gmsh (primal/demo_models).
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
 #include "cli/commands.hpp"
+#include "primal/atomic_file.hpp"
+#include "primal/demo_models.hpp"
+#include "primal/errors.hpp"
+#include "primal/io_exodus.hpp"
+#include "primal/io_gmsh.hpp"
+#include "primal/io_vtk.hpp"
+#include "primal/quality.hpp"
+#include "primal/quality_report.hpp"
+#include "templates/conform.hpp"
 
 namespace geode::cli {
-// Whole-model commands (conform, demo) are registered here.
-void add_conform_commands(CLI::App&) {}
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string extension(const fs::path& p) {
+  std::string e = p.extension().string();
+  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
+  return e;
+}
+
+primal::Model read_model(const fs::path& path) {
+  const std::string e = extension(path);
+  if (!fs::exists(path)) throw InvalidInput(path.string() + ": no such file");
+  if (e == ".msh") return primal::read_gmsh(path);
+  if (e == ".exo" || e == ".e") return primal::read_exodus(path);
+  throw InvalidInput(path.string() + ": unknown input format '" + e +
+                     "' (expected .msh, .exo or .e)");
+}
+
+void check_output_extension(const fs::path& path) {
+  const std::string e = extension(path);
+  if (e != ".exo" && e != ".e" && e != ".msh" && e != ".vtu")
+    throw InvalidInput(path.string() + ": unknown output format '" + e +
+                       "' (expected .exo, .e, .msh or .vtu)");
+}
+
+void write_model(const primal::Model& model, const fs::path& path) {
+  const std::string e = extension(path);
+  if (e == ".exo" || e == ".e") return primal::write_exodus(model, path);
+  if (e == ".msh") return primal::write_gmsh(model, path);
+  if (e == ".vtu") return primal::write_vtu(path, templates::hex_mesh(model));
+  check_output_extension(path);
+}
+
+templates::ConformSmooth parse_smooth(const std::string& s) {
+  if (s == "local") return templates::ConformSmooth::kLocal;
+  if (s == "global") return templates::ConformSmooth::kGlobal;
+  if (s == "none") return templates::ConformSmooth::kNone;
+  throw InvalidInput("--smooth: unknown value '" + s + "' (expected local, global or none)");
+}
+
+struct ConformArgs {
+  std::string input;
+  std::string output;
+  std::string report;
+  std::string smooth = "local";
+  std::string model = "half";
+  int n = 4;
+  bool quiet = false;
+};
+
+nlohmann::json result_json(const templates::ConformResult& r) {
+  nlohmann::json j;
+  j["input"] = {{"hexes", r.input_hexes}, {"tets", r.input_tets},
+                {"interface_quads", r.interface_quads}};
+  j["output"] = {{"hexes", r.model.hexes.size()},    {"nodes", r.model.points.size()},
+                 {"diced_hexes", r.diced_hexes},     {"geode_hexes", r.geode_hexes},
+                 {"diced_tet_hexes", r.diced_tet_hexes}};
+  j["valid"] = r.validity.ok();
+  j["template_min_scaled_jacobian"] = r.template_min_scaled_jacobian;
+  j["min_scaled_jacobian_before_smoothing"] = r.min_scaled_jacobian_before_smoothing;
+  j["min_scaled_jacobian_after_smoothing"] = r.smoothing.final_min_scaled_jacobian;
+  j["buffer_layer_min_scaled_jacobian"] = r.buffer.min_scaled_jacobian;
+  j["seconds"] = r.seconds;
+  j["warnings"] = r.warnings;
+  j["blocks"] = nlohmann::json::array();
+  for (const auto& b : r.quality)
+    j["blocks"].push_back({{"id", b.block}, {"name", b.name},
+                           {"quality", primal::quality_report_json(b.report)}});
+  return j;
+}
+
+double min_sj(const primal::QualityReport& q) {
+  for (const auto& m : q.metrics)
+    if (m.metric == primal::HexMetric::kScaledJacobian) return m.minimum;
+  return 0.0;
+}
+
+void print_summary(const templates::ConformResult& r, std::ostream& os, bool tables) {
+  os << "input: " << r.input_hexes << " hexes, " << r.input_tets << " tets, "
+     << r.interface_quads << " interface quads\n";
+  os << "output: " << r.model.hexes.size() << " hexes (" << r.diced_hexes << " diced hex, "
+     << r.geode_hexes << " geode, " << r.diced_tet_hexes << " diced tet), "
+     << r.model.points.size() << " nodes, " << (r.validity.ok() ? "valid" : "INVALID") << ", "
+     << r.seconds << " s\n";
+  for (const auto& b : r.quality) {
+    os << "block " << b.block << " \"" << b.name << "\": " << b.report.num_hexes
+       << " hexes, min scaled Jacobian " << min_sj(b.report) << "\n";
+    if (tables) os << primal::format_quality_table(b.report) << "\n";
+  }
+  for (const auto& w : r.warnings) os << "warning: " << w << "\n";
+}
+
+void run(const primal::Model& model, const ConformArgs& a, bool tables) {
+  templates::ConformOptions opts;
+  opts.smooth = parse_smooth(a.smooth);
+  if (!a.quiet && isatty(STDERR_FILENO))
+    opts.progress = [](const std::string& line) { std::cerr << "geode: " << line << "\n"; };
+  const templates::ConformResult r = templates::conform(model, opts);
+  if (!a.output.empty()) write_model(r.model, a.output);
+  if (!a.report.empty()) {
+    const std::string text = result_json(r).dump(2) + "\n";
+    primal::write_file_atomically(a.report, [&](std::ostream& os) { os << text; });
+  }
+  if (!a.quiet) print_summary(r, std::cout, tables);
+  if (!a.output.empty() && !a.quiet) std::cout << "wrote " << a.output << "\n";
+}
+
+}  // namespace
+
+void add_conform_commands(CLI::App& app) {
+  auto args = std::make_shared<ConformArgs>();
+  CLI::App* c = app.add_subcommand(
+      "conform",
+      "Conform the hex part of a model to its tet part with geode templates: buffer layer, "
+      "dicing (8 per hex, 4 per tet), 26 geode hexes per interface quad.");
+  c->add_option("INPUT", args->input, "input model (.msh, .exo, .e)")->required();
+  c->add_option("-o,--output", args->output, "output model (.exo, .e, .msh, .vtu)");
+  c->add_option("--report", args->report, "write a JSON report (counts, quality per block)");
+  c->add_option("--smooth", args->smooth, "local (default), global or none");
+  c->add_flag("--quiet", args->quiet, "no progress and no summary");
+  c->callback([args] {
+    if (!args->output.empty()) check_output_extension(args->output);
+    parse_smooth(args->smooth);
+    run(read_model(args->input), *args, false);
+  });
+
+  auto dargs = std::make_shared<ConformArgs>();
+  CLI::App* d = app.add_subcommand(
+      "demo", "Build a demo model (half hex / half tet block, or a tet nugget in hex blocks) and "
+              "conform it, printing the quality report per block.");
+  d->add_option("-o,--output", dargs->output, "output model (.exo, .e, .msh, .vtu)");
+  d->add_option("--model", dargs->model, "half (default) or nugget");
+  d->add_option("-n", dargs->n, "cells across (demo_half_block / demo_nugget; default 4)");
+  d->add_option("--report", dargs->report, "write a JSON report");
+  d->add_option("--smooth", dargs->smooth, "local (default), global or none");
+  d->add_flag("--quiet", dargs->quiet, "no progress and no summary");
+  d->callback([dargs] {
+    if (!dargs->output.empty()) check_output_extension(dargs->output);
+    parse_smooth(dargs->smooth);
+    primal::Model model;
+    if (dargs->model == "half") model = primal::demo_half_block(dargs->n);
+    else if (dargs->model == "nugget") model = primal::demo_nugget(dargs->n);
+    else throw InvalidInput("--model: unknown demo '" + dargs->model + "' (expected half or nugget)");
+    run(model, *dargs, true);
+  });
+}
+
 }  // namespace geode::cli
