@@ -73,6 +73,16 @@ RefTemplate make_reference(const Eigen::Vector3d& box, std::array<int, 2> diagon
   ref.min_scaled_jacobian = smooth_template(ref.tpl, false).final_min_scaled_jacobian;
   const auto& pts = ref.tpl.hex.points;
   const std::size_t n = pts.size();
+  // A smoothed template with two nodes at one place would glue the model together there.
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = i + 1; j < n; ++j)
+      if ((pts[i] - pts[j]).norm() < 1e-6 * box.norm()) {
+        std::ostringstream m;
+        m << "the smoothed geode template in a " << box.x() << " x " << box.y() << " x "
+          << box.z() << " box has nodes " << i << " and " << j << " at one place ("
+          << pts[i].transpose() << "); choose other template proportions";
+        throw TopologyError(m.str());
+      }
   ref.rst.resize(n);
   ref.key_corners.resize(n);
   constexpr double kTol = 1e-6;

@@ -29,8 +29,10 @@ struct ConformOptions {
   double interface_tolerance = 1e-6;  // find_interface: relative to the local edge length
   // Box of the reference template (x, y, z as in templates/geode.hpp: y is the buffer hex's
   // thickness direction). It is smoothed once per diagonal with top and bottom fixed; only its
-  // proportions matter. Thin, as the buffer layer is (paper, 3.2: short templates are best).
-  Eigen::Vector3d template_box{2.0, 1.0, 2.0};
+  // proportions matter. The paper's 24 x 14 x 24: with flatter boxes (2 x 1 x 2, 2 x 0.8 x 2)
+  // smooth_template slides a side-face node of the Anti-diagonal template onto the hex-side
+  // edge midpoint (two nodes at one place), which conform() rejects.
+  Eigen::Vector3d template_box{24.0, 14.0, 24.0};
   // kLocal: nodes of the geode hexes and of the hexes around them (one ring) move, the rest is
   // fixed. kGlobal: every node moves. Model boundary nodes are fixed in both.
   ConformSmooth smooth = ConformSmooth::kLocal;

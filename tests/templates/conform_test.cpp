@@ -1,0 +1,140 @@
+// The geode algorithm on whole models: the result is a conforming all-hex mesh (every interior
+// face shared by two hexes, closed boundary, no two nodes at one place, every hex positive)
+// with the hand-checked counts 8 per input hex, 26 per interface quad, 4 per tet.
+#include <doctest/doctest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <set>
+
+#include "primal/boundary.hpp"
+#include "primal/demo_models.hpp"
+#include "primal/errors.hpp"
+#include "primal/io_exodus.hpp"
+#include "primal/quality.hpp"
+#include "primal/topology.hpp"
+#include "templates/conform.hpp"
+
+using namespace geode;
+using primal::Index;
+
+namespace {
+
+struct Expected {
+  Index hexes, tets, quads;  // input hexes, tets, interface quads
+};
+
+// Everything a conforming all-hex result must satisfy, plus its counts.
+void check_result(const templates::ConformResult& r, const Expected& e) {
+  CHECK(r.input_hexes == e.hexes);
+  CHECK(r.input_tets == e.tets);
+  CHECK(r.interface_quads == e.quads);
+  CHECK(r.diced_hexes == 8 * e.hexes);
+  CHECK(r.geode_hexes == 26 * e.quads);
+  CHECK(r.diced_tet_hexes == 4 * e.tets);
+  REQUIRE(r.model.hexes.size() == static_cast<std::size_t>(8 * e.hexes + 26 * e.quads + 4 * e.tets));
+  CHECK(r.model.tets.empty());
+  const primal::HexMesh mesh = templates::hex_mesh(r.model);
+  const primal::HexValidityReport v = primal::check_validity(mesh);
+  INFO(v.summary());
+  CHECK(v.ok());
+  CHECK(v.overshared_faces.empty());
+  CHECK(v.boundary.closed);
+  CHECK(v.boundary.manifold);
+  CHECK(v.euler == 1);            // the grid models and demos are balls
+  CHECK(v.boundary.euler == 2);   // whose boundary is a sphere
+  CHECK(v.inverted_hexes.empty());
+  CHECK(v.unused_nodes == 0);
+  for (const auto& h : mesh.hexes) {
+    primal::HexCorners c;
+    for (int k = 0; k < 8; ++k) c[k] = mesh.points[h[k]];
+    CHECK(primal::hex_scaled_jacobian(c) > 0.0);
+  }
+  // Nothing left unmerged: no two nodes at one place (an unmerged template side or top node
+  // would be one, and its faces would show up as boundary faces inside the model).
+  primal::Model copy = r.model;
+  CHECK(primal::merge_coincident_nodes(copy, 1e-9) == 0);
+  // Blocks by origin, ascending.
+  for (std::size_t h = 0; h < r.model.hexes.size(); ++h) {
+    const int expected = h < static_cast<std::size_t>(8 * e.hexes) ? templates::kDicedHexBlock
+                         : h < static_cast<std::size_t>(8 * e.hexes + 26 * e.quads)
+                             ? templates::kGeodeBlock
+                             : templates::kDicedTetBlock;
+    if (r.model.hex_block[h] != expected) {
+      FAIL("hex " << h << " in block " << r.model.hex_block[h]);
+      break;
+    }
+  }
+  CHECK(r.quality.size() == 3);
+  CHECK(r.warnings.empty());
+}
+
+}  // namespace
+
+TEST_CASE("one hex with six tets on one face: 8 + 26 + 24 hexes, valid") {
+  // Cells (0,0,0) hex, (1,0,0) six Kuhn tets; the shared face x = 1 is one interface quad.
+  const primal::Model m = primal::grid_model({2, 1, 1}, 1.0, [](int i, int, int) { return i == 1; });
+  const auto r = templates::conform(m);
+  check_result(r, {1, 6, 1});
+  CHECK(r.model.hexes.size() == 58);
+}
+
+TEST_CASE("L-shaped interfaces: buffer hexes meeting at a concave edge merge their sides") {
+  SUBCASE("2 x 2 cells, one tet cell: 2 interface quads at right angles") {
+    const auto m = primal::grid_model({2, 2, 1}, 1.0, [](int i, int j, int) { return i == 1 && j == 1; });
+    // 3 hexes, 6 tets; quads: hex (0,1) x+ face and hex (1,0) y+ face.
+    check_result(templates::conform(m), {3, 6, 2});
+  }
+  SUBCASE("3 x 3 x 2 cells, tets where i, j >= 1: 8 quads, coplanar and L neighbours") {
+    const auto m = primal::grid_model({3, 3, 2}, 1.0, [](int i, int j, int) { return i >= 1 && j >= 1; });
+    // Hexes: 5 cells per layer x 2 = 10; tets: 4 cells x 2 x 6 = 48; quads: per layer 2 on
+    // x = 1 (j = 1, 2) and 2 on y = 1 (i = 1, 2), x 2 layers = 8.
+    check_result(templates::conform(m), {10, 48, 8});
+  }
+}
+
+TEST_CASE("half-block demo, n = 2") {
+  // n^3 = 8 hexes, 6 n^3 = 48 tets, n^2 = 4 interface quads.
+  const auto r = templates::conform(primal::demo_half_block(2));
+  check_result(r, {8, 48, 4});
+}
+
+TEST_CASE("nugget demo, n = 2: side set 'outside' carried to the diced hexes") {
+  const primal::Model m = primal::demo_nugget(2);
+  const auto r = templates::conform(m);
+  // Interface: the nugget cube's 6 faces, n x n = 4 quads each.
+  check_result(r, {static_cast<Index>(m.hexes.size()), static_cast<Index>(m.tets.size()), 24});
+  REQUIRE(m.side_sets.size() == 1);
+  REQUIRE(r.model.side_sets.size() == 1);
+  // Each outer quad is diced into 4 quads, each a boundary face of the output.
+  CHECK(r.model.side_sets[0].sides.size() == 4 * m.side_sets[0].sides.size());
+  const primal::HexMesh mesh = templates::hex_mesh(r.model);
+  std::set<primal::FaceKey> boundary;
+  for (const auto& q : primal::boundary_quads(mesh)) boundary.insert(primal::face_key(q.nodes));
+  for (const auto& s : r.model.side_sets[0].sides) {
+    std::array<Index, 4> f{};
+    for (int k = 0; k < 4; ++k)
+      f[k] = mesh.hexes[s.element.index][primal::topology::kHexFaceCorners[s.face][k]];
+    CHECK(boundary.count(primal::face_key(f)) == 1);
+  }
+}
+
+TEST_CASE("the result round-trips through Exodus") {
+  const auto r = templates::conform(primal::demo_half_block(2));
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("geode-conform-" + std::to_string(::getpid()) + ".exo");
+  primal::write_exodus(r.model, path);
+  const primal::Model back = primal::read_exodus(path);
+  std::filesystem::remove(path);
+  CHECK(back.points == r.model.points);
+  CHECK(back.hexes == r.model.hexes);
+  CHECK(back.hex_block == r.model.hex_block);
+  CHECK(back.tets.empty());
+}
+
+TEST_CASE("conform rejects models without both parts") {
+  const auto hexes = primal::grid_model({2, 1, 1}, 1.0, [](int, int, int) { return false; });
+  CHECK_THROWS_AS(templates::conform(hexes), InvalidInput);
+  const auto tets = primal::grid_model({2, 1, 1}, 1.0, [](int, int, int) { return true; });
+  CHECK_THROWS_AS(templates::conform(tets), InvalidInput);
+}
