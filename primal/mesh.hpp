@@ -2,6 +2,7 @@
 // Compact volume and surface meshes: index arrays plus Eigen coordinates. 2D meshes (quads,
 // triangles) carry 3D points so that a planar template and a face of a 3D one share a type.
 #include <Eigen/Core>
+#include <Eigen/Geometry>  // cross products on Point
 #include <array>
 #include <cstdint>
 #include <vector>

@@ -250,7 +250,7 @@ Template build(const GeodeOptions& o, int dim) {
   for (const auto& s : sheets) T.sheets.push_back({s.name, s.kind});
 
   const stc::Domain dom = reference_domain(dim);
-  const stc::Arrangement A = stc::compute_arrangement(sheets, dom);
+  const stc::Arrangement A = stc::compute_arrangement(sheets, dom, o.arrangement);
   T.checks = check_interleave(A, T.sheets, sheets);
   const stc::DualMesh D = stc::dualize(A);
 

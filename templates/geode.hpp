@@ -7,6 +7,7 @@
 
 #include "primal/mesh.hpp"
 #include "primal/smooth.hpp"
+#include "stc/arrangement.hpp"
 
 namespace geode::templates {
 
@@ -43,6 +44,7 @@ struct GeodeOptions {
   Higher higher = Higher::X;
   TopSplit split = TopSplit::TwoTriangles;
   PushParameters push;
+  stc::ArrangementOptions arrangement;  // sampling and tracing; the result does not depend on it
 };
 
 // The paper's two conditions on the pushed-together arrangement (Section 2.2), evaluated on

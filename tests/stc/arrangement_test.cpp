@@ -1,0 +1,126 @@
+// The arrangement engine: planes dualize to structured grids, the result does not depend on
+// the sampling resolution or step, and configurations out of general position are
+// diagnosed, never meshed.
+#include <doctest/doctest.h>
+
+#include <string>
+
+#include "primal/errors.hpp"
+#include "stc/arrangement.hpp"
+#include "stc/dualize.hpp"
+#include "stc/mesh_dual.hpp"
+#include "support/fixtures.hpp"
+#include "support/isomorphism.hpp"
+#include "templates/geode.hpp"
+
+using namespace geode;
+using stc::Point;
+
+namespace {
+
+stc::Sheet plane(int axis, double c, const std::string& name) {
+  return {name, [axis, c](const Point& x) { return x[axis] - c; }, "plane"};
+}
+
+// Planes x = 0.2, 0.5, 0.7 (tilted a little so nothing is axis-aligned by accident),
+// y = 0.3, 0.6, z = 0.4, 0.8 in the unit box.
+std::vector<stc::Sheet> plane_family() {
+  std::vector<stc::Sheet> s;
+  for (double c : {0.2, 0.5, 0.7}) s.push_back({"x", [c](const Point& x) { return x[0] - c + 0.05 * x[1]; }, "plane"});
+  for (double c : {0.3, 0.6}) s.push_back({"y", [c](const Point& x) { return x[1] - c - 0.04 * x[2]; }, "plane"});
+  for (double c : {0.4, 0.8}) s.push_back({"z", [c](const Point& x) { return x[2] - c + 0.03 * x[0]; }, "plane"});
+  return s;
+}
+
+std::string diagnosis(const std::vector<stc::Sheet>& s, const stc::Domain& d) {
+  try {
+    stc::dualize(stc::compute_arrangement(s, d));
+  } catch (const TopologyError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST_CASE("arrangement: planes dualize to the structured grid, and back") {
+  const stc::Domain box{Point(0, 0, 0), Point(1, 1, 1), 3};
+  const auto D = stc::dualize(stc::compute_arrangement(plane_family(), box));
+  CHECK(D.hex.hexes.size() == 12);
+  CHECK(D.hex.points.size() == 36);
+  const auto grid = test::structured_hex_grid(3, 2, 2);
+  CHECK(test::find_isomorphism(D.hex, grid).has_value());
+  // Round trip: the dual of the result has the 3 + 2 + 2 sheets we started from.
+  CHECK(stc::mesh_dual(D.hex).sheets.size() == 7);
+  // Every hex positively oriented by construction: its centre Jacobian is positive at the
+  // first-guess positions of a planar arrangement.
+  for (const auto& h : D.hex.hexes) {
+    const Point a = D.hex.points[h[1]] - D.hex.points[h[0]], b = D.hex.points[h[3]] - D.hex.points[h[0]],
+                c = D.hex.points[h[4]] - D.hex.points[h[0]];
+    CHECK(a.cross(b).dot(c) > 0);
+  }
+}
+
+TEST_CASE("arrangement: lines in a rectangle dualize to the quad grid") {
+  const stc::Domain rect{Point(0, 0, 0), Point(2, 1, 0), 2};
+  std::vector<stc::Sheet> s;
+  for (double c : {0.3, 0.9, 1.5, 1.8}) s.push_back(plane(0, c, "x"));
+  for (double c : {0.25, 0.5, 0.75}) s.push_back({"y", [c](const Point& x) { return x[1] - c - 0.05 * x[0]; }, "line"});
+  const auto D = stc::dualize(stc::compute_arrangement(s, rect));
+  CHECK(D.quad.quads.size() == 12);
+  CHECK(test::find_isomorphism(D.quad, test::structured_quad_grid(4, 3)).has_value());
+}
+
+TEST_CASE("arrangement: the geode's mesh does not depend on sampling resolution or step") {
+  // Reference: default options, through the template builder's own sheets.
+  const auto ref = templates::build_geode3d({});
+  struct Case { int resolution; double step; };
+  for (const Case c : {Case{12, 0.004}, Case{16, 0.004}, Case{32, 0.004}, Case{48, 0.004}, Case{24, 0.002},
+                       Case{24, 0.008}}) {
+    CAPTURE(c.resolution);
+    CAPTURE(c.step);
+    templates::GeodeOptions o;
+    o.arrangement.seed_resolution = c.resolution;
+    o.arrangement.step = c.step;
+    const auto T = templates::build_geode3d(o);
+    CHECK(T.hex.hexes == ref.hex.hexes);  // same numbering, not just isomorphic
+    REQUIRE(T.hex.points.size() == ref.hex.points.size());
+    for (std::size_t i = 0; i < T.hex.points.size(); ++i) CHECK((T.hex.points[i] - ref.hex.points[i]).norm() < 1e-6);
+  }
+}
+
+TEST_CASE("arrangement: configurations out of general position are diagnosed") {
+  const stc::Domain box{Point(0, 0, 0), Point(1, 1, 1), 3};
+  SUBCASE("four sheets through one point") {
+    auto s = plane_family();
+    // A fourth plane through the vertex where x = 0.5, y = 0.6 and z = 0.4 meet: a combination
+    // of their fields vanishes there.
+    s.push_back({"slanted", [f0 = s[1].field, f1 = s[4].field, f2 = s[5].field](const Point& x) {
+                   return f0(x) + 0.5 * f1(x) + 0.7 * f2(x);
+                 }, "plane"});
+    CHECK(diagnosis(s, box).find("pass through one point") != std::string::npos);
+  }
+  SUBCASE("three sheets meeting tangentially") {
+    // f's gradient at (0.5, 0.4, 0.5) is (1, 0, 1): in the span of the two planes' normals.
+    std::vector<stc::Sheet> s{plane(0, 0.5, "x"), plane(2, 0.5, "z"), plane(1, 0.8, "y"),
+                              {"cubic", [](const Point& x) {
+                                 const double t = x[1] - 0.4;
+                                 return (x[0] - 0.5) + (x[2] - 0.5) + t * t * t;
+                               }, "cubic"}};
+    CHECK(diagnosis(s, box).find("tangen") != std::string::npos);
+  }
+  SUBCASE("a vertex on the boundary") {
+    std::vector<stc::Sheet> s{plane(0, 0.5, "x"), plane(1, 0.5, "y"),
+                              {"z", [](const Point& x) { return x[2] - 0.5 * (x[0] + x[1]) + 0.5; }, "plane"}};
+    // z = 0.5 (x + y) - 0.5 meets x = y = 0.5 at z = 0: on the bottom face.
+    CHECK(diagnosis(s, box).find("boundary") != std::string::npos);
+  }
+  SUBCASE("a curve with no vertex") {
+    std::vector<stc::Sheet> s{plane(0, 0.5, "x"), plane(1, 0.5, "y"), plane(0, 0.7, "x2")};
+    CHECK(diagnosis(s, box).find("no vertex") != std::string::npos);
+  }
+  SUBCASE("bad domain") {
+    CHECK_THROWS_AS(stc::compute_arrangement(plane_family(), stc::Domain{Point(0, 0, 0), Point(1, 0, 1), 3}),
+                    InvalidInput);
+  }
+}
