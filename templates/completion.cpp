@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <set>
 #include <string>
 
+#include "primal/dice.hpp"
 #include "primal/errors.hpp"
 
 namespace geode::templates {
@@ -58,37 +58,69 @@ std::vector<Tunnel> complete_tunnels(const InterfacePatch& patch,
   return out;
 }
 
-std::vector<Dome> complete_domes(const InterfacePatch& patch, double v_top, double k, double blend) {
-  // Diced nodes: the vertices, the edge midpoints, the cell centroids.
-  std::set<std::pair<int, int>> edges;
-  for (const auto& c : patch.cells)
-    for (std::size_t i = 0; i < c.size(); ++i) {
-      const int a = c[i], b = c[(i + 1) % c.size()];
-      if (patch.dim == 2 && i == 1) break;  // a segment has one edge
-      edges.insert({std::min(a, b), std::max(a, b)});
+DicedPatch dice_patch(const InterfacePatch& p) {
+  DicedPatch d;
+  if (p.dim == 2) {
+    d.nodes = p.points;
+    for (std::size_t i = 0; i < p.points.size(); ++i) d.owners.push_back({static_cast<int>(i)});
+    for (const auto& c : p.cells) {
+      if (c.size() != 2) throw InvalidInput("dice_patch: a 2D interface cell is a segment");
+      d.nodes.push_back(0.5 * (p.points[static_cast<std::size_t>(c[0])] + p.points[static_cast<std::size_t>(c[1])]));
+      d.owners.push_back({c[0], c[1]});
+      const int m = static_cast<int>(d.nodes.size() - 1);
+      d.cells.push_back({c[0], m});
+      d.cells.push_back({m, c[1]});
     }
+    return d;
+  }
+  auto fill = [&](const auto& diced, const auto& cells) {
+    d.nodes = diced.mesh.points;
+    for (const auto& q : diced.mesh.quads) d.cells.push_back({q[0], q[1], q[2], q[3]});
+    for (const auto& o : diced.origin) {
+      std::vector<int> own;
+      if (o.kind == primal::NodeOriginKind::kCell)
+        for (auto v : cells[static_cast<std::size_t>(o.element)]) own.push_back(v);
+      else
+        for (auto v : o.nodes)
+          if (v != primal::kInvalidIndex) own.push_back(v);
+      d.owners.push_back(own);
+    }
+  };
+  const bool quads = std::all_of(p.cells.begin(), p.cells.end(), [](const auto& c) { return c.size() == 4; });
+  const bool tris = std::all_of(p.cells.begin(), p.cells.end(), [](const auto& c) { return c.size() == 3; });
+  if (quads) {
+    primal::QuadMesh m{p.points, {}};
+    for (const auto& c : p.cells) m.quads.push_back({c[0], c[1], c[2], c[3]});
+    fill(primal::dice(m), m.quads);
+  } else if (tris) {
+    primal::TriMesh m{p.points, {}};
+    for (const auto& c : p.cells) m.tris.push_back({c[0], c[1], c[2]});
+    fill(primal::dice(m), m.tris);
+  } else {
+    throw InvalidInput("dice_patch: a 3D interface patch is all quads or all triangles");
+  }
+  return d;
+}
+
+std::vector<Dome> complete_domes(const InterfacePatch& patch, double v_top, double k, double blend) {
+  const DicedPatch diced = dice_patch(patch);
   std::vector<Dome> out;
   for (int v = 0; v < static_cast<int>(patch.points.size()); ++v) {
     bool used = false;
     for (const auto& c : patch.cells) used |= std::find(c.begin(), c.end(), v) != c.end();
     if (!used) continue;
     const Point V = flat(patch.points[static_cast<std::size_t>(v)]);
+    // The circle around v encloses the diced nodes that belong to v (v itself, the midpoints of
+    // its edges, the centres of its cells) and leaves out all others.
     double inside = 0.0, outside = std::numeric_limits<double>::max();
-    auto classify = [&](const Point& p, bool in) {
-      const double d = (flat(p) - V).norm();
-      if (in) inside = std::max(inside, d); else outside = std::min(outside, d);
-    };
-    for (int u = 0; u < static_cast<int>(patch.points.size()); ++u)
-      if (u != v) classify(patch.points[static_cast<std::size_t>(u)], false);
-    for (const auto& e : edges)
-      classify(0.5 * (patch.points[static_cast<std::size_t>(e.first)] + patch.points[static_cast<std::size_t>(e.second)]),
-               e.first == v || e.second == v);
-    if (patch.dim == 3)
-      for (const auto& c : patch.cells) {
-        Point g = Point::Zero();
-        for (int i : c) g += patch.points[static_cast<std::size_t>(i)];
-        classify(g / static_cast<double>(c.size()), std::find(c.begin(), c.end(), v) != c.end());
-      }
+    for (std::size_t n = 0; n < diced.nodes.size(); ++n) {
+      const double d = (flat(diced.nodes[n]) - V).norm();
+      const auto& own = diced.owners[n];
+      if (std::find(own.begin(), own.end(), v) != own.end())
+        inside = std::max(inside, d);
+      else
+        outside = std::min(outside, d);
+    }
     if (!(inside < outside))
       throw TopologyError("complete_domes: no circle around interface vertex " + std::to_string(v) +
                           " separates its diced nodes from the others");

@@ -24,6 +24,16 @@ struct InterfacePatch {
   std::vector<std::vector<int>> cells;  // quads or triangles (3D); segments (2D)
 };
 
+// The patch after dicing (primal/dice.hpp in 3D; a segment splits at its midpoint in 2D):
+// the diced nodes, the diced cells (quads; segments in 2D), and for every diced node the
+// patch vertices it belongs to (itself, the two ends of its edge, or the corners of its cell).
+struct DicedPatch {
+  std::vector<Point> nodes;
+  std::vector<std::vector<int>> cells;
+  std::vector<std::vector<int>> owners;
+};
+DicedPatch dice_patch(const InterfacePatch& patch);
+
 // Hex side: each dual chord of the pre-diced quad (2D: the dual point of the segment) is
 // doubled by dicing into two parallel copies; complete each pair into a tunnel over them:
 // f = (d / a)^2 + (v / height)^2 - 1, with d the distance from the pre-diced chord within the

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <regex>
 #include <set>
 
@@ -31,43 +30,6 @@ std::string corner_name(const Point& p) {
   return std::string("(") + (p[0] < 0 ? "-x" : "+x") + "," + (p[2] < 0 ? "-z" : "+z") + ")";
 }
 
-// Diced nodes of an interface patch: vertices, edge midpoints, cell centroids (3D), with the
-// diced cells as node lists. This is the prescribed boundary the template must reproduce.
-struct Diced {
-  std::vector<Point> nodes;
-  std::vector<std::vector<int>> cells;
-};
-
-Diced dice_patch(const InterfacePatch& p) {
-  Diced d;
-  d.nodes = p.points;
-  std::map<std::pair<int, int>, int> mid;
-  auto midpoint = [&](int a, int b) {
-    const auto key = std::make_pair(std::min(a, b), std::max(a, b));
-    auto it = mid.find(key);
-    if (it != mid.end()) return it->second;
-    d.nodes.push_back(0.5 * (p.points[static_cast<std::size_t>(a)] + p.points[static_cast<std::size_t>(b)]));
-    return mid[key] = static_cast<int>(d.nodes.size() - 1);
-  };
-  for (const auto& c : p.cells) {
-    const int n = static_cast<int>(c.size());
-    if (p.dim == 2) {
-      const int m = midpoint(c[0], c[1]);
-      d.cells.push_back({c[0], m});
-      d.cells.push_back({m, c[1]});
-      continue;
-    }
-    Point g = Point::Zero();
-    for (int i : c) g += p.points[static_cast<std::size_t>(i)];
-    d.nodes.push_back(g / n);
-    const int centre = static_cast<int>(d.nodes.size() - 1);
-    for (int i = 0; i < n; ++i)
-      d.cells.push_back({c[static_cast<std::size_t>(i)], midpoint(c[static_cast<std::size_t>(i)], c[static_cast<std::size_t>((i + 1) % n)]),
-                         centre, midpoint(c[static_cast<std::size_t>((i + n - 1) % n)], c[static_cast<std::size_t>(i)])});
-  }
-  return d;
-}
-
 // Box faces a reference point lies on.
 unsigned faces_of(const Point& r, const stc::Domain& D) {
   unsigned f = 0;
@@ -82,7 +44,7 @@ unsigned faces_of(const Point& r, const stc::Domain& D) {
 // face matches the diced node whose neighbourhood inside the cell has the same sides of every
 // sheet and which lies on the same box faces. Then every diced cell must be a boundary
 // element face of the template: the boundary is the prescribed one.
-void place_interface(const stc::DualMesh& D, const std::vector<stc::Sheet>& sheets, const Diced& diced,
+void place_interface(const stc::DualMesh& D, const std::vector<stc::Sheet>& sheets, const DicedPatch& diced,
                      int face, const stc::Domain& dom, std::vector<Point>& pts, const char* side_name) {
   const std::size_t nodes = D.node_faces.size();
   std::vector<int> node_of(diced.nodes.size(), -1);
