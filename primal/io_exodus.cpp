@@ -1,5 +1,7 @@
 #include "primal/io_exodus.hpp"
 
+#include "primal/atomic_file.hpp"
+
 #include <exodusII.h>
 #include <unistd.h>
 
@@ -220,10 +222,7 @@ void write_exodus(const Model& model, const std::filesystem::path& path) {
     for (Index t : members.second) tet_global[static_cast<std::size_t>(t)] = next++;
   }
 
-  const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : ".";
-  const std::filesystem::path temp =
-      dir / ("." + path.filename().string() + ".geode-tmp-" + std::to_string(::getpid()));
-  try {
+  write_path_atomically(path, "", [&](const std::filesystem::path& temp) {
     ex_opts(0);
     int cpu_word_size = 8, io_word_size = 8;
     ExodusFile file(ex_create(temp.string().c_str(), EX_CLOBBER, &cpu_word_size, &io_word_size));
@@ -307,14 +306,7 @@ void write_exodus(const Model& model, const std::filesystem::path& path) {
     if (!model.side_sets.empty())
       check(ex_put_names(exo, EX_SIDE_SET, side_set_names.pointers.data()), target, "writing side set names");
     check(file.close(), target, "closing the temporary file");
-    std::error_code ec;
-    std::filesystem::rename(temp, path, ec);
-    if (ec) throw InvalidInput(target + ": cannot rename temporary file: " + ec.message());
-  } catch (...) {
-    std::error_code ignored;
-    std::filesystem::remove(temp, ignored);
-    throw;
-  }
+  });
 }
 
 }  // namespace geode::primal

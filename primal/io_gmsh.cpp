@@ -1,5 +1,7 @@
 #include "primal/io_gmsh.hpp"
 
+#include "primal/atomic_file.hpp"
+
 #include <gmsh.h>
 #include <unistd.h>
 
@@ -244,13 +246,9 @@ Model read_gmsh(const std::filesystem::path& path) {
 void write_gmsh(const Model& model, const std::filesystem::path& path, GmshFormat format) {
   const std::string target = path.string();
   validate(model, target);
-  const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : ".";
-  // Gmsh picks the format from the extension, so the temporary file keeps ".msh".
-  const std::filesystem::path temp =
-      dir / ("." + path.filename().string() + ".geode-tmp-" + std::to_string(::getpid()) + ".msh");
-
   GmshSession session;
-  try {
+  // Gmsh picks the format from the extension, so the temporary file keeps ".msh".
+  write_path_atomically(path, ".msh", [&](const std::filesystem::path& temp) {
     gmsh_call(target, [&] {
       gmsh::model::add("geode");
       std::vector<int> blocks;
@@ -363,16 +361,7 @@ void write_gmsh(const Model& model, const std::filesystem::path& path, GmshForma
       gmsh::option::setNumber("Mesh.SaveAll", 1);
       gmsh::write(temp.string());
     });
-    if (!std::filesystem::exists(temp))
-      throw InvalidInput(target + ": Gmsh could not write the temporary file " + temp.string());
-    std::error_code ec;
-    std::filesystem::rename(temp, path, ec);
-    if (ec) throw InvalidInput(target + ": cannot rename temporary file: " + ec.message());
-  } catch (...) {
-    std::error_code ignored;
-    std::filesystem::remove(temp, ignored);
-    throw;
-  }
+  });
 }
 
 }  // namespace geode::primal
