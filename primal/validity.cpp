@@ -1,5 +1,7 @@
 #include "primal/validity.hpp"
 
+#include "primal/disjoint_sets.hpp"
+
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -65,21 +67,6 @@ const HexIncidence& hex_incidence() {
 }
 
 // Union-find over a small set of element uses.
-struct DisjointSets {
-  std::vector<int> parent;
-  explicit DisjointSets(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
-  int find(int x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  }
-  void unite(int a, int b) { parent[find(a)] = find(b); }
-  std::size_t count() {
-    std::size_t n = 0;
-    for (std::size_t i = 0; i < parent.size(); ++i)
-      n += find(static_cast<int>(i)) == static_cast<int>(i);
-    return n;
-  }
-};
 
 template <std::size_t N>
 bool has_repeated(const std::array<Index, N>& a) {

@@ -7,25 +7,12 @@
 #include <numeric>
 #include <sstream>
 
+#include "primal/disjoint_sets.hpp"
 #include "primal/errors.hpp"
 
 namespace geode::stc {
 namespace {
 
-struct UnionFind {
-  std::vector<int> parent;
-  explicit UnionFind(int n) : parent(static_cast<std::size_t>(n)) {
-    std::iota(parent.begin(), parent.end(), 0);
-  }
-  int find(int a) {
-    while (parent[static_cast<std::size_t>(a)] != a) {
-      parent[static_cast<std::size_t>(a)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(a)])];
-      a = parent[static_cast<std::size_t>(a)];
-    }
-    return a;
-  }
-  void unite(int a, int b) { parent[static_cast<std::size_t>(find(a))] = find(b); }
-};
 
 std::string fmt_point(const Point& x, int dim) {
   std::ostringstream s;
@@ -502,7 +489,7 @@ Arrangement Engine::run() {
   // 4. Regions: union the octants around each 1-cell at its two ends.
   const int octants = 1 << dim_;
   const int nv = static_cast<int>(A.vertices.size());
-  UnionFind uf(nv * octants);
+  primal::DisjointSets uf(static_cast<std::size_t>(nv * octants));
   std::vector<unsigned> faces(static_cast<std::size_t>(nv * octants), 0u);
   auto octant_bits = [&](int v, const std::vector<int>& S, int sigma, int extra, const std::vector<int>& side) {
     const Vertex& V = A.vertices[static_cast<std::size_t>(v)];

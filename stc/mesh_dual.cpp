@@ -1,5 +1,7 @@
 #include "stc/mesh_dual.hpp"
 
+#include "primal/disjoint_sets.hpp"
+
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -42,15 +44,6 @@ struct Ref<2> {
   static constexpr int edge_class(int e) { return e % 2; }  // opposite edges i, i+2
 };
 
-struct UnionFind {
-  std::vector<Index> parent;
-  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
-  Index find(Index x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  }
-  void unite(Index a, Index b) { parent[find(a)] = find(b); }
-};
 
 std::uint64_t pair_key(Index a, Index b) {
   if (a > b) std::swap(a, b);
@@ -165,7 +158,7 @@ MeshDual<Dim> build(std::size_t n_nodes,
   }
 
   // Sheets: within a cell the edges of one class are equivalent.
-  UnionFind uf(dual.edges.size());
+  primal::DisjointSets uf(dual.edges.size());
   for (const auto& ce : dual.cell_edges)
     for (int e = 0; e < MeshDual<Dim>::kCellEdges; ++e)
       for (int f = e + 1; f < MeshDual<Dim>::kCellEdges; ++f)

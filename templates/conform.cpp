@@ -1,5 +1,7 @@
 #include "templates/conform.hpp"
 
+#include "primal/disjoint_sets.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -156,21 +158,6 @@ Point trilinear(const std::array<Point, 8>& P, const Point& q) {
   return x;
 }
 
-struct UnionFind {
-  std::vector<Index> parent;
-  Index add() {
-    parent.push_back(static_cast<Index>(parent.size()));
-    return parent.back();
-  }
-  Index find(Index a) {
-    while (parent[a] != a) a = parent[a] = parent[parent[a]];
-    return a;
-  }
-  void unite(Index a, Index b) {
-    a = find(a), b = find(b);
-    if (a != b) parent[std::max(a, b)] = std::min(a, b);
-  }
-};
 
 // Matches the nodes of side face ka of template A with those of side face kb of template B
 // (the same face of the model), starting from the nodes both share on the tet and hex sides
@@ -373,7 +360,7 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
   t0 = Clock::now();
   const std::size_t nb = layer.hexes.size();
   std::vector<std::vector<Index>> inst_global(nb), inst_side(nb);
-  UnionFind uf;
+  primal::DisjointSets uf;
   std::vector<Point> side_pos;
   for (std::size_t b = 0; b < nb; ++b) {
     const primal::BufferHex& bh = layer.hexes[b];
@@ -445,7 +432,7 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
   }
   // One node per union-find class at the mean of its members.
   {
-    const Index ns = static_cast<Index>(uf.parent.size());
+    const Index ns = static_cast<Index>(uf.size());
     std::vector<Point> sum(ns, Point::Zero());
     std::vector<int> cnt(ns, 0);
     for (Index s = 0; s < ns; ++s) sum[uf.find(s)] += side_pos[s], ++cnt[uf.find(s)];
