@@ -17,7 +17,6 @@
 
 #include "stc/arrangement.hpp"
 #include "stc/dualize.hpp"
-#include "templates/completion.hpp"
 #include "templates/geode.hpp"
 
 namespace gt = geode::templates;
@@ -51,24 +50,6 @@ void report(const char* what, const Timing& t, double target, int repeats) {
               1e3 * t.min, 1e3 * t.median, repeats, 1e3 * target, t.median < target ? "ok  " : "SLOW", peak_kib());
 }
 
-// The geode's six sheets exactly as build_geode3d makes them (default push, diagonal Main,
-// tunnel x higher): the same completion calls on the same reference interface.
-std::vector<geode::stc::Sheet> geode_sheets() {
-  const gt::PushParameters p;
-  gt::InterfacePatch bottom, top;
-  bottom.points = {Point(-1, 0, -1), Point(1, 0, -1), Point(1, 0, 1), Point(-1, 0, 1)};
-  bottom.cells = {{0, 1, 2, 3}};
-  top.points = {Point(-1, 1, 1), Point(1, 1, 1), Point(1, 1, -1), Point(-1, 1, -1)};
-  top.cells = {{0, 1, 2}, {0, 2, 3}};
-  std::vector<geode::stc::Sheet> sheets;
-  for (const auto& t : gt::complete_tunnels(bottom, [&](const Point& along) {
-         return std::abs(along.x()) > std::abs(along.z()) ? p.high_roof : p.low_roof;
-       }))
-    sheets.push_back(t.sheet);
-  for (const auto& d : gt::complete_domes(top, 1.0, p.dome_depth, p.dome_radius)) sheets.push_back(d.sheet);
-  return sheets;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -76,8 +57,10 @@ int main(int argc, char** argv) {
   const int smooth_repeats = std::max(3, repeats / 4);
   std::printf("peak RSS at start: %ld KiB\n", peak_kib());
 
-  const auto sheets = geode_sheets();
-  const geode::stc::Domain dom{Point(-1, 0, -1), Point(1, 1, 1), 3};
+  // The geode's six sheets exactly as build_geode3d makes them (default options).
+  const gt::GeodeArrangement G = gt::geode_arrangement(gt::GeodeOptions{}, 3);
+  const auto& sheets = G.sheets;
+  const geode::stc::Domain& dom = G.domain;
   std::size_t hexes = 0, vertices = 0;
   const Timing arr = time_it(repeats, [&] { vertices = geode::stc::compute_arrangement(sheets, dom).vertices.size(); });
   report("(a1) compute_arrangement (6 sheets)", arr, 0.050, repeats);

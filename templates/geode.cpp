@@ -153,7 +153,10 @@ InterleaveChecks check_interleave(const stc::Arrangement& A, const std::vector<S
   return c;
 }
 
-Template build(const GeodeOptions& o, int dim) {
+}  // namespace
+
+GeodeArrangement geode_arrangement(const GeodeOptions& o, int dim) {
+  if (dim != 2 && dim != 3) throw InvalidInput("geode: dimension must be 2 or 3");
   for (int a = 0; a < dim; ++a)
     if (!(o.box[a] > 0) || !std::isfinite(o.box[a]))
       throw InvalidInput("geode: box dimensions must be positive and finite");
@@ -165,7 +168,10 @@ Template build(const GeodeOptions& o, int dim) {
   if (!(0 < p.dome_radius && p.dome_radius < 1)) throw InvalidInput("geode: dome radius blend must be in (0, 1)");
 
   // The interface cells before dicing, in reference coordinates.
-  InterfacePatch bottom, top;
+  GeodeArrangement G;
+  G.domain = reference_domain(dim);
+  InterfacePatch& bottom = G.hex_side;
+  InterfacePatch& top = G.tet_side;
   bottom.dim = top.dim = dim;
   if (dim == 2) {
     bottom.points = {Point(-1, 0, 0), Point(1, 0, 0)};
@@ -194,9 +200,7 @@ Template build(const GeodeOptions& o, int dim) {
     return along_x == (o.higher == Higher::X) ? p.high_roof : p.low_roof;
   });
   const auto domes = complete_domes(top, 1.0, p.dome_depth, p.dome_radius);
-  std::vector<stc::Sheet> sheets;
-  Template T;
-  T.dim = dim;
+  std::vector<stc::Sheet>& sheets = G.sheets;
   for (const auto& t : tunnels) {
     stc::Sheet s = t.sheet;
     if (dim == 3) s.name = std::abs(t.along.x()) > std::abs(t.along.z()) ? "tunnel x" : "tunnel z";
@@ -209,16 +213,25 @@ Template build(const GeodeOptions& o, int dim) {
                       : (std::abs(v.x()) < 1e-12 ? std::string("dome centre") : "dome " + corner_name(v));
     sheets.push_back(s);
   }
-  for (const auto& s : sheets) T.sheets.push_back({s.name, s.kind});
+  return G;
+}
 
-  const stc::Domain dom = reference_domain(dim);
+namespace {
+
+Template build(const GeodeOptions& o, int dim) {
+  const GeodeArrangement G = geode_arrangement(o, dim);
+  const auto& sheets = G.sheets;
+  const stc::Domain& dom = G.domain;
+  Template T;
+  T.dim = dim;
+  for (const auto& s : sheets) T.sheets.push_back({s.name, s.kind});
   const stc::Arrangement A = stc::compute_arrangement(sheets, dom, o.arrangement);
   T.checks = check_interleave(A, T.sheets, sheets);
   const stc::DualMesh D = stc::dualize(A);
 
   std::vector<Point> pts = dim == 3 ? D.hex.points : D.quad.points;
-  place_interface(D, sheets, dice_patch(bottom), stc::box_face(1, false), dom, pts, "hex-side");
-  place_interface(D, sheets, dice_patch(top), stc::box_face(1, true), dom, pts, "tet-side");
+  place_interface(D, sheets, dice_patch(G.hex_side), stc::box_face(1, false), dom, pts, "hex-side");
+  place_interface(D, sheets, dice_patch(G.tet_side), stc::box_face(1, true), dom, pts, "tet-side");
   for (auto& q : pts) q = to_box(q, o.box, dim);
   if (dim == 3) {
     T.hex.hexes = D.hex.hexes;

@@ -8,6 +8,7 @@
 #include "primal/mesh.hpp"
 #include "primal/smooth.hpp"
 #include "stc/arrangement.hpp"
+#include "templates/completion.hpp"
 
 namespace geode::templates {
 
@@ -79,6 +80,16 @@ struct Template {
   std::vector<std::vector<int>> node_signs;
   InterleaveChecks checks;
 };
+
+// The completed, pushed-together arrangement before it is computed: the sheets (tunnels
+// first, then domes) in the reference cell (u, w in [-1, 1], v in [0, 1] up), and the two
+// interface patches they were completed from. dim is 2 or 3.
+struct GeodeArrangement {
+  std::vector<stc::Sheet> sheets;
+  stc::Domain domain;
+  InterfacePatch hex_side, tet_side;
+};
+GeodeArrangement geode_arrangement(const GeodeOptions& options, int dim);
 
 // Derive a template: complete the diced interfaces' duals into tunnels and domes, push them
 // together, compute the arrangement and dualize it. Top and bottom nodes are placed exactly
