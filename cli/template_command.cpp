@@ -183,21 +183,12 @@ void run_template(const TemplateArgs& a) {
     text += s.str();
   }
   if (a.format == "vtu") {
+    // The writer adds the scaled Jacobian (and block) cell arrays itself.
     if (a.output.empty()) throw InvalidInput("--format vtu needs -o FILE.vtu");
-    std::vector<double> sj;
-    if (dim == 3) {
-      for (std::size_t h = 0; h < T.hex.hexes.size(); ++h)
-        sj.push_back(primal::hex_scaled_jacobian(primal::hex_corners(T.hex, static_cast<primal::Index>(h))));
-      primal::VtkCellData cd;
-      cd.doubles.push_back({"scaled_jacobian", sj});
-      primal::write_vtu(a.output, T.hex, cd);
-    } else {
-      for (std::size_t q = 0; q < T.quad.quads.size(); ++q)
-        sj.push_back(primal::quad_scaled_jacobian(primal::quad_corners(T.quad, static_cast<primal::Index>(q)), primal::Point::UnitZ()));
-      primal::VtkCellData cd;
-      cd.doubles.push_back({"scaled_jacobian", sj});
-      primal::write_vtu(a.output, T.quad, cd);
-    }
+    if (dim == 3)
+      primal::write_vtu(a.output, T.hex);
+    else
+      primal::write_vtu(a.output, T.quad);
     if (!text.empty()) std::cout << text;
     return;
   }
