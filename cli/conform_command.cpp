@@ -51,7 +51,7 @@ void write_model(const primal::Model& model, const fs::path& path) {
   const std::string e = extension(path);
   if (e == ".exo" || e == ".e") return primal::write_exodus(model, path);
   if (e == ".msh") return primal::write_gmsh(model, path);
-  if (e == ".vtu") return primal::write_vtu(path, templates::hex_mesh(model));
+  if (e == ".vtu") return primal::write_vtu(path, primal::hex_part(model));
   check_output_extension(path);
 }
 

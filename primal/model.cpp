@@ -95,7 +95,9 @@ HexMesh hex_part(const Model& model) {
   HexMesh mesh;
   mesh.points = model.points;
   mesh.hexes = model.hexes;
-  mesh.block = model.hex_block;
+  mesh.block.resize(model.hexes.size());
+  for (std::size_t h = 0; h < model.hexes.size(); ++h)
+    mesh.block[h] = block_of(model, {ElementKind::Hex, static_cast<Index>(h)});
   return mesh;
 }
 
@@ -103,7 +105,9 @@ TetMesh tet_part(const Model& model) {
   TetMesh mesh;
   mesh.points = model.points;
   mesh.tets = model.tets;
-  mesh.block = model.tet_block;
+  mesh.block.resize(model.tets.size());
+  for (std::size_t t = 0; t < model.tets.size(); ++t)
+    mesh.block[t] = block_of(model, {ElementKind::Tet, static_cast<Index>(t)});
   return mesh;
 }
 

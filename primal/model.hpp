@@ -70,7 +70,7 @@ int block_of(const Model& model, ElementRef element);
 void validate(const Model& model, std::string_view source);
 
 // The two parts over the model's whole point array (unused points included), so that node
-// numbers agree between the parts and the model.
+// numbers agree between the parts and the model. Every element carries its block (block_of).
 HexMesh hex_part(const Model& model);
 TetMesh tet_part(const Model& model);
 

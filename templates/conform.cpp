@@ -260,15 +260,6 @@ double min_scaled_jacobian(const primal::HexMesh& mesh, std::vector<Index>* bad 
 
 }  // namespace
 
-primal::HexMesh hex_mesh(const primal::Model& model) {
-  primal::HexMesh mesh;
-  mesh.points = model.points;
-  mesh.hexes = model.hexes;
-  mesh.block.resize(model.hexes.size());
-  for (std::size_t h = 0; h < model.hexes.size(); ++h)
-    mesh.block[h] = primal::block_of(model, {primal::ElementKind::Hex, static_cast<Index>(h)});
-  return mesh;
-}
 
 ConformResult conform(const primal::Model& input, const ConformOptions& options) {
   const auto t_start = Clock::now();

@@ -76,7 +76,4 @@ struct ConformResult {
 // validity is not ok() is still returned (with warnings) so that it can be inspected.
 ConformResult conform(const primal::Model& input, const ConformOptions& options = {});
 
-// The output model's hexes as a HexMesh (block per hex).
-primal::HexMesh hex_mesh(const primal::Model& model);
-
 }  // namespace geode::templates

@@ -34,7 +34,7 @@ void check_result(const templates::ConformResult& r, const Expected& e) {
   CHECK(r.diced_tet_hexes == 4 * e.tets);
   REQUIRE(r.model.hexes.size() == static_cast<std::size_t>(8 * e.hexes + 26 * e.quads + 4 * e.tets));
   CHECK(r.model.tets.empty());
-  const primal::HexMesh mesh = templates::hex_mesh(r.model);
+  const primal::HexMesh mesh = primal::hex_part(r.model);
   const primal::HexValidityReport v = primal::check_validity(mesh);
   INFO(v.summary());
   CHECK(v.ok());
@@ -115,7 +115,7 @@ TEST_CASE("nugget demo, n = 2: side set 'outside' carried to the diced hexes") {
   REQUIRE(r.model.side_sets.size() == 1);
   // Each outer quad is diced into 4 quads, each a boundary face of the output.
   CHECK(r.model.side_sets[0].sides.size() == 4 * m.side_sets[0].sides.size());
-  const primal::HexMesh mesh = templates::hex_mesh(r.model);
+  const primal::HexMesh mesh = primal::hex_part(r.model);
   std::set<primal::FaceKey> boundary;
   for (const auto& q : primal::boundary_quads(mesh)) boundary.insert(primal::face_key(q.nodes));
   for (const auto& s : r.model.side_sets[0].sides) {
