@@ -328,13 +328,15 @@ ShapeRow shape_row(const std::string& cell, double parameter, bool slide, const 
 
 std::vector<ShapeRow> height_study(const std::vector<double>& heights, double base) {
   std::vector<ShapeRow> rows;
-  for (double h : heights)
+  for (double h : heights) {
+    GeodeOptions o;
+    o.box = Eigen::Vector3d(base, h, base);
+    const Template ref = build_geode3d(o);
     for (bool slide : {false, true}) {
-      GeodeOptions o;
-      o.box = Eigen::Vector3d(base, h, base);
-      Template t = build_geode3d(o);
+      Template t = ref;
       rows.push_back(shape_row("box", h, slide, smooth_template(t, slide)));
     }
+  }
   return rows;
 }
 
@@ -381,8 +383,9 @@ void write_geode_quality(std::ostream& report_csv, std::ostream* per_hex_csv) {
   if (per_hex_csv) *per_hex_csv << "mode,hex,scaled_jacobian\n";
   std::vector<primal::HexMetric> metrics;
   for (const auto& p : paper_table1()) metrics.push_back(p.metric);
+  const Template ref = build_geode3d(GeodeOptions{});
   for (bool slide : {false, true}) {
-    Template t = build_geode3d(GeodeOptions{});
+    Template t = ref;
     smooth_template(t, slide);
     const auto report = primal::hex_quality_report(t.hex, {}, metrics);
     const char* mode = slide ? "slide" : "fixed";

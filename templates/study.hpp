@@ -116,7 +116,7 @@ struct PaperRow {
 const std::vector<PaperRow>& paper_table1();
 
 // Smoothed 24 x 14 x 24 geode in both modes: the Table 1 report next to the paper's values
-// (CSV: metric,mode,average,std_dev,min,max,paper_average,paper_std_dev,paper_min,paper_max)
+// (CSV: metric,key,mode,average,std_dev,min,max,paper_average,paper_std_dev,paper_min,paper_max)
 // and per-hex scaled Jacobians (CSV: mode,hex,scaled_jacobian).
 void write_geode_quality(std::ostream& report_csv, std::ostream* per_hex_csv);
 
