@@ -304,8 +304,8 @@ std::vector<Event> Engine::events(const Curve& c) const {
       // Sub-sample a segment where the sheet comes close without a sign change: it may cross
       // twice within one step.
       std::vector<std::pair<double, Point>> sub{{0.0, P[i]}, {1.0, P[j]}};
-      const double gl = grad(s, P[i]).norm() * (P[j] - P[i]).norm();
-      if ((v[i] < 0) == (v[j] < 0) && std::min(std::abs(v[i]), std::abs(v[j])) < 2.0 * gl) {
+      if ((v[i] < 0) == (v[j] < 0) &&
+          std::min(std::abs(v[i]), std::abs(v[j])) < 2.0 * grad(s, P[i]).norm() * (P[j] - P[i]).norm()) {
         sub.clear();
         for (int q = 0; q <= 16; ++q) {
           Point y = P[i] + (q / 16.0) * (P[j] - P[i]);
@@ -560,8 +560,6 @@ Arrangement Engine::run() {
                             " meet): the curves were traced inconsistently");
     }
   }
-  for (unsigned i = 0; i < faces.size(); ++i)
-    A.region_faces[static_cast<std::size_t>(label[static_cast<std::size_t>(uf.find(static_cast<int>(i)))])] |= faces[i];
   return A;
 }
 

@@ -129,7 +129,7 @@ TEST_CASE("smoothing the Appendix A geode: untangles and reaches min scaled Jaco
     HexMesh mesh = appendix_a();
     const auto constraints = gp::box_constraints(mesh.points, kLo, kHi, mode.fixed_faces);
     const auto r = gp::smooth_hex_mesh(mesh, constraints);
-    MESSAGE(mode.name << ": min SJ " << r.initial_min_scaled_jacobian << " -> "
+    MESSAGE(mode_name << ": min SJ " << r.initial_min_scaled_jacobian << " -> "
                       << r.final_min_scaled_jacobian << " (max " << r.final_max_scaled_jacobian
                       << "), iterations " << r.untangle_iterations << " + " << r.shape_iterations
                       << ", " << r.seconds << " s");
@@ -180,7 +180,7 @@ TEST_CASE("smoothing keeps constrained nodes on their box faces and edges, fixed
       }
       moved += (p - q).norm() > 1e-3;
     }
-    MESSAGE(mode.name << ": fixed " << fixed << ", on planes " << planes << ", on lines " << lines
+    MESSAGE(mode_name << ": fixed " << fixed << ", on planes " << planes << ", on lines " << lines
                       << ", moved " << moved);
     CHECK(moved > 10);
     // Box corners are always fixed (8). With top and bottom fixed, so is every node there:

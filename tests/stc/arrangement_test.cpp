@@ -113,7 +113,7 @@ TEST_CASE("arrangement: configurations out of general position are diagnosed") {
     std::vector<stc::Sheet> s{plane(0, 0.5, "x"), plane(1, 0.5, "y"),
                               {"z", [](const Point& x) { return x[2] - 0.5 * (x[0] + x[1]) + 0.5; }, "plane"}};
     // z = 0.5 (x + y) - 0.5 meets x = y = 0.5 at z = 0: on the bottom face.
-    CHECK(diagnosis(s, box).find("boundary") != std::string::npos);
+    CHECK(diagnosis(s, box).find("meet on the domain boundary") != std::string::npos);
   }
   SUBCASE("a curve with no vertex") {
     std::vector<stc::Sheet> s{plane(0, 0.5, "x"), plane(1, 0.5, "y"), plane(0, 0.7, "x2")};
