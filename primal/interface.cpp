@@ -45,10 +45,18 @@ bool on_triangle(const Point& p, const Point& a, const Point& b, const Point& c,
 
 }  // namespace
 
-std::array<std::array<Index, 3>, 2> interface_triangles(const InterfaceQuad& q) {
-  const auto& c = q.corners;
-  if (q.diagonal == 0) return {{{c[0], c[1], c[2]}, {c[0], c[2], c[3]}}};
+namespace {
+
+// The two triangles a quad splits into along diagonal 0 (corners 0-2) or 1 (corners 1-3).
+std::array<std::array<Index, 3>, 2> split(const std::array<Index, 4>& c, int diagonal) {
+  if (diagonal == 0) return {{{c[0], c[1], c[2]}, {c[0], c[2], c[3]}}};
   return {{{c[0], c[1], c[3]}, {c[1], c[2], c[3]}}};
+}
+
+}  // namespace
+
+std::array<std::array<Index, 3>, 2> interface_triangles(const InterfaceQuad& q) {
+  return split(q.corners, q.diagonal);
 }
 
 Interface find_interface(const Model& model, double tol) {
@@ -79,8 +87,7 @@ Interface find_interface(const Model& model, double tol) {
   std::vector<const BoundaryQuad*> unmatched_quads;
   for (const BoundaryQuad& bq : quads) {
     const auto& c = bq.nodes;
-    const std::array<std::array<std::array<Index, 3>, 2>, 2> splits{
-        {{{{c[0], c[1], c[2]}, {c[0], c[2], c[3]}}}, {{{c[0], c[1], c[3]}, {c[1], c[2], c[3]}}}}};
+    const std::array<std::array<std::array<Index, 3>, 2>, 2> splits{split(c, 0), split(c, 1)};
     std::array<std::array<const TetFaceUse*, 2>, 2> found{};
     int count = 0;
     for (int d = 0; d < 2; ++d)

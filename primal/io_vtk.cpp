@@ -29,21 +29,6 @@ const std::vector<int>* VtkCellData::find_int(const std::string& name) const {
   return nullptr;
 }
 
-double tet_scaled_jacobian(const Point& p0, const Point& p1, const Point& p2, const Point& p3) {
-  const double det = (p1 - p0).dot((p2 - p0).cross(p3 - p0));  // 6V, the same at every corner
-  const std::array<Point, 4> p{p0, p1, p2, p3};
-  double max_product = 0.0;
-  for (int c = 0; c < 4; ++c) {
-    double product = 1.0;
-    for (int o = 0; o < 4; ++o) {
-      if (o != c) product *= (p[o] - p[c]).norm();
-    }
-    max_product = std::max(max_product, product);
-  }
-  if (max_product <= 0.0) return 0.0;
-  return det * std::sqrt(2.0) / max_product;
-}
-
 namespace {
 
 // ---- Common: a mesh as cells + arrays ------------------------------------------------------

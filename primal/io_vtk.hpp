@@ -74,8 +74,5 @@ HexMesh to_hex_mesh(const VtkGrid& grid);
 TetMesh to_tet_mesh(const VtkGrid& grid);
 QuadMesh to_quad_mesh(const VtkGrid& grid);
 
-// [Verdict] tet scaled Jacobian: 6V sqrt(2) / max over corners of the product of the three
-// edge lengths there (1 for the regular tet, <= 0 when inverted or flat).
-double tet_scaled_jacobian(const Point& p0, const Point& p1, const Point& p2, const Point& p3);
 
 }  // namespace geode::primal

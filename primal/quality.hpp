@@ -68,6 +68,10 @@ double quad_jacobian(const QuadCorners& p, const Point& normal);
 double quad_scaled_jacobian(const QuadCorners& p);                  // min area / (|a||b|)
 double quad_scaled_jacobian(const QuadCorners& p, const Point& normal);
 
+// [Verdict] tet scaled Jacobian: 6V sqrt(2) / max over corners of the product of the three
+// edge lengths there (1 for the regular tet, <= 0 when inverted or flat).
+double tet_scaled_jacobian(const Point& p0, const Point& p1, const Point& p2, const Point& p3);
+
 // ---- Registry --------------------------------------------------------------------------------
 
 enum class HexMetric {
