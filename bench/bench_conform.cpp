@@ -10,6 +10,7 @@
 
 #include "primal/demo_models.hpp"
 #include "primal/quality.hpp"
+#include "primal/errors.hpp"
 #include "templates/conform.hpp"
 
 int main(int argc, char** argv) {
@@ -23,9 +24,12 @@ int main(int argc, char** argv) {
   const primal::Model m =
       primal::grid_model({n, n, n}, 1.0, [n](int i, int, int) { return i >= n / 2; });
   templates::ConformOptions o;
-  o.smooth = mode == "none"     ? templates::ConformSmooth::kNone
-             : mode == "global" ? templates::ConformSmooth::kGlobal
-                                : templates::ConformSmooth::kLocal;
+  try {
+    o.smooth = templates::parse_conform_smooth(mode);
+  } catch (const InvalidInput& e) {
+    std::fprintf(stderr, "bench_conform: %s\n", e.what());
+    return 2;
+  }
   o.progress = [](const std::string& s) { std::fprintf(stderr, "  %s\n", s.c_str()); };
   const auto t0 = std::chrono::steady_clock::now();
   const templates::ConformResult r = templates::conform(m, o);

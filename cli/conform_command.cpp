@@ -55,13 +55,6 @@ void write_model(const primal::Model& model, const fs::path& path) {
   check_output_extension(path);
 }
 
-templates::ConformSmooth parse_smooth(const std::string& s) {
-  if (s == "local") return templates::ConformSmooth::kLocal;
-  if (s == "global") return templates::ConformSmooth::kGlobal;
-  if (s == "none") return templates::ConformSmooth::kNone;
-  throw InvalidInput("--smooth: unknown value '" + s + "' (expected local, global or none)");
-}
-
 struct ConformArgs {
   std::string input;
   std::string output;
@@ -116,7 +109,7 @@ void print_summary(const templates::ConformResult& r, std::ostream& os, bool tab
 
 void run(const primal::Model& model, const ConformArgs& a, bool tables) {
   templates::ConformOptions opts;
-  opts.smooth = parse_smooth(a.smooth);
+  opts.smooth = templates::parse_conform_smooth(a.smooth);
   if (!a.quiet && isatty(STDERR_FILENO))
     opts.progress = [](const std::string& line) { std::cerr << "geode: " << line << "\n"; };
   const templates::ConformResult r = templates::conform(model, opts);
@@ -131,6 +124,17 @@ void run(const primal::Model& model, const ConformArgs& a, bool tables) {
 
 }  // namespace
 
+// Options conform and demo share: where to write, the report, smoothing, quiet.
+void add_run_options(CLI::App* c, ConformArgs& a) {
+  c->add_option("-o,--output", a.output, "output model (.exo, .e, .msh, .vtu)");
+  c->add_option("--report", a.report, "write a JSON report (counts, quality per block)");
+  c->add_option("--smooth", a.smooth,
+                "local: the buffer layer and one ring around it (default); global: every node; none")
+      ->check(CLI::IsMember({"local", "global", "none"}))
+      ->capture_default_str();
+  c->add_flag("--quiet", a.quiet, "no progress and no summary");
+}
+
 void add_conform_commands(CLI::App& app) {
   auto args = std::make_shared<ConformArgs>();
   CLI::App* c = app.add_subcommand(
@@ -138,13 +142,10 @@ void add_conform_commands(CLI::App& app) {
       "Conform the hex part of a model to its tet part with geode templates: buffer layer, "
       "dicing (8 per hex, 4 per tet), 26 geode hexes per interface quad.");
   c->add_option("INPUT", args->input, "input model (.msh, .exo, .e)")->required();
-  c->add_option("-o,--output", args->output, "output model (.exo, .e, .msh, .vtu)");
-  c->add_option("--report", args->report, "write a JSON report (counts, quality per block)");
-  c->add_option("--smooth", args->smooth, "local (default), global or none");
-  c->add_flag("--quiet", args->quiet, "no progress and no summary");
+  add_run_options(c, *args);
   c->callback([args] {
+    // Check the output name before the long run, not after it.
     if (!args->output.empty()) check_output_extension(args->output);
-    parse_smooth(args->smooth);
     run(read_model(args->input), *args, false);
   });
 
@@ -152,19 +153,13 @@ void add_conform_commands(CLI::App& app) {
   CLI::App* d = app.add_subcommand(
       "demo", "Build a demo model (half hex / half tet block, or a tet nugget in hex blocks) and "
               "conform it, printing the quality report per block.");
-  d->add_option("-o,--output", dargs->output, "output model (.exo, .e, .msh, .vtu)");
-  d->add_option("--model", dargs->model, "half (default) or nugget");
-  d->add_option("-n", dargs->n, "cells across (demo_half_block / demo_nugget; default 4)");
-  d->add_option("--report", dargs->report, "write a JSON report");
-  d->add_option("--smooth", dargs->smooth, "local (default), global or none");
-  d->add_flag("--quiet", dargs->quiet, "no progress and no summary");
+  d->add_option("--model", dargs->model, "half (default) or nugget")->check(CLI::IsMember({"half", "nugget"}));
+  d->add_option("-n", dargs->n, "cells across (demo_half_block / demo_nugget; default 4)")->check(CLI::PositiveNumber);
+  add_run_options(d, *dargs);
   d->callback([dargs] {
     if (!dargs->output.empty()) check_output_extension(dargs->output);
-    parse_smooth(dargs->smooth);
-    primal::Model model;
-    if (dargs->model == "half") model = primal::demo_half_block(dargs->n);
-    else if (dargs->model == "nugget") model = primal::demo_nugget(dargs->n);
-    else throw InvalidInput("--model: unknown demo '" + dargs->model + "' (expected half or nugget)");
+    const primal::Model model =
+        dargs->model == "half" ? primal::demo_half_block(dargs->n) : primal::demo_nugget(dargs->n);
     run(model, *dargs, true);
   });
 }

@@ -261,6 +261,13 @@ double min_scaled_jacobian(const primal::HexMesh& mesh, std::vector<Index>* bad 
 }  // namespace
 
 
+ConformSmooth parse_conform_smooth(const std::string& word) {
+  if (word == "local") return ConformSmooth::kLocal;
+  if (word == "global") return ConformSmooth::kGlobal;
+  if (word == "none") return ConformSmooth::kNone;
+  throw InvalidInput("smoothing mode '" + word + "': expected local, global or none");
+}
+
 ConformResult conform(const primal::Model& input, const ConformOptions& options) {
   const auto t_start = Clock::now();
   auto say = [&](const std::string& line) {

@@ -24,6 +24,9 @@ namespace geode::templates {
 
 enum class ConformSmooth { kNone, kLocal, kGlobal };
 
+// "local", "global" or "none"; InvalidInput naming the word otherwise.
+ConformSmooth parse_conform_smooth(const std::string& word);
+
 struct ConformOptions {
   primal::BufferLayerOptions buffer;
   double interface_tolerance = 1e-6;  // find_interface: relative to the local edge length
