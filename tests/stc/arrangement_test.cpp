@@ -124,3 +124,23 @@ TEST_CASE("arrangement: configurations out of general position are diagnosed") {
                     InvalidInput);
   }
 }
+
+TEST_CASE("arrangement: sheets composed with the field algebra") {
+  // x = 0.2 and x = 0.7 as one sheet (the union of the half-spaces x < 0.2 and x > 0.7), x = 0.5
+  // as an offset plane with its sides flipped; y and z planes as before: still the 3 x 2 x 2 grid.
+  const stc::Domain box{Point(0, 0, 0), Point(1, 1, 1), 3};
+  auto s = plane_family();
+  const stc::Field left = [](const Point& x) { return x[0] - 0.2; };
+  const stc::Field right = [](const Point& x) { return 0.7 - x[0]; };
+  std::vector<stc::Sheet> sheets{
+      {"x outer pair", stc::field_union(left, right), "union"},
+      {"x middle", stc::field_scaled(stc::field_offset([](const Point& x) { return x[0]; }, 0.5), -1.0), "offset"}};
+  sheets.insert(sheets.end(), s.begin() + 3, s.end());  // the y and z planes
+  const auto D = stc::dualize(stc::compute_arrangement(sheets, box));
+  CHECK(D.hex.hexes.size() == 12);
+  CHECK(test::find_isomorphism(D.hex, test::structured_hex_grid(3, 2, 2)).has_value());
+  // The intersection of the two half-spaces is the slab between the planes: the same zero set.
+  sheets[0].field = stc::field_intersection([](const Point& x) { return 0.2 - x[0]; },
+                                            [](const Point& x) { return x[0] - 0.7; });
+  CHECK(stc::dualize(stc::compute_arrangement(sheets, box)).hex.hexes.size() == 12);
+}
