@@ -1,53 +1,22 @@
 // Time and iterations of the smoother on the paper's Appendix A geode (24 x 14 x 24 box) in
 // both boundary modes, with the resulting min/max scaled Jacobian and the Table-1-style report.
-// Usage: bench_smooth [repeats]   (reads notebooks-data/appendix-a from the source tree)
+// Usage: bench_smooth [repeats]   (reads notebooks-data/appendix-a through tests/support)
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
-#include <sstream>
 #include <string>
 
 #include "primal/errors.hpp"
 #include "primal/quality.hpp"
 #include "primal/quality_report.hpp"
 #include "primal/smooth.hpp"
+#include "support/fixtures.hpp"
 
 namespace gp = geode::primal;
 
-#ifndef GEODE_SOURCE_DIR
-#define GEODE_SOURCE_DIR "."
-#endif
-
-static gp::HexMesh read_appendix_a(const std::string& dir) {
-  gp::HexMesh m;
-  std::string line;
-  std::ifstream nodes(dir + "/nodes.csv"), hexes(dir + "/hexes.csv");
-  if (!nodes || !hexes) throw geode::InvalidInput(dir + ": cannot open nodes.csv / hexes.csv");
-  std::getline(nodes, line);
-  while (std::getline(nodes, line)) {
-    std::replace(line.begin(), line.end(), ',', ' ');
-    std::istringstream in(line);
-    double id, x, y, z;
-    if (in >> id >> x >> y >> z) m.points.emplace_back(x, y, z);
-  }
-  std::getline(hexes, line);
-  while (std::getline(hexes, line)) {
-    std::replace(line.begin(), line.end(), ',', ' ');
-    std::istringstream in(line);
-    int id;
-    std::array<gp::Index, 8> h;
-    in >> id;
-    for (auto& n : h) in >> n, --n;  // 1-based; paper order is VTK order
-    if (in) m.hexes.push_back(h);
-  }
-  return m;
-}
-
 int main(int argc, char** argv) {
   const int repeats = argc > 1 ? std::max(1, std::atoi(argv[1])) : 5;
-  const std::string dir = std::string(GEODE_SOURCE_DIR) + "/notebooks-data/appendix-a";
-  const gp::HexMesh paper = read_appendix_a(dir);
+  const gp::HexMesh paper = geode::test::appendix_a_geode();
   const gp::Point lo(-12, -7, -12), hi(12, 7, 12);
   struct Mode {
     const char* name;
