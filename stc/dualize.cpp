@@ -144,7 +144,10 @@ DualMesh dualize(const Arrangement& A) {
   }
   if (dim == 3) D.hex.points = pts; else D.quad.points = pts;
 
-  // Every region must be a ball (a half-ball at the boundary).
+  // Every region must be a ball, or a half-ball where it touches the domain boundary. Unlike
+  // primal::check_validity, which judges a node against the mesh's own boundary, this holds
+  // the link to what the region touches geometrically, so a region inside the box whose node
+  // lands on the mesh boundary is caught too.
   const std::vector<int> chi = link_euler(D, nodes);
   for (std::size_t n = 0; n < nodes; ++n) {
     const bool boundary = D.node_faces[n] != 0;
