@@ -68,23 +68,26 @@ class Engine {
   }
 
   // Newton projection onto {f_s = 0, s in S}, with the coordinates in `fixed` (bit mask of
-  // axes) held. Returns false when it does not converge.
+  // axes) held. Returns false when it does not converge. A step that does not reduce the
+  // residual is halved (up to 12 times): on smooth fields near their zero set the full step
+  // always does, so this only acts where fields are piecewise smooth (stc/mesh_fields.hpp),
+  // where plain Newton can cycle between the pieces of a kinked sheet.
   bool project(const std::vector<int>& S, Point& x, unsigned fixed = 0) const {
     const int k = static_cast<int>(S.size());
     // At most 3 x 3: fixed capacity keeps the hot path off the heap.
     using Mat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3>;
     using Vec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1>;
     Mat J(k, dim_);
-    Vec F(k);
+    Vec F(k), gnorm(k);
+    for (int r = 0; r < k; ++r) F[r] = value(S[static_cast<std::size_t>(r)], x);
     for (int it = 0; it < 40; ++it) {
       double err = 0.0;
       for (int r = 0; r < k; ++r) {
         const Point g = grad(S[static_cast<std::size_t>(r)], x);
-        F[r] = value(S[static_cast<std::size_t>(r)], x);
         for (int c = 0; c < dim_; ++c) J(r, c) = (fixed >> c) & 1u ? 0.0 : g[c];
-        const double gn = J.row(r).norm();
-        if (gn < 1e-14) return false;
-        err = std::max(err, std::abs(F[r]) / gn);
+        gnorm[r] = J.row(r).norm();
+        if (gnorm[r] < 1e-14) return false;
+        err = std::max(err, std::abs(F[r]) / gnorm[r]);
       }
       if (err < tol_) return true;
       const Mat JJt = J * J.transpose();
@@ -92,7 +95,22 @@ class Engine {
       if (!(std::abs(det) > 1e-30)) return false;
       const Vec dx = J.transpose() * JJt.inverse() * F;
       if (!dx.allFinite() || dx.norm() > 0.25 * diag_) return false;
-      for (int c = 0; c < dim_; ++c) x[c] -= dx[c];
+      double step = 1.0;
+      for (int halving = 0;; ++halving) {
+        Point y = x;
+        for (int c = 0; c < dim_; ++c) y[c] -= step * dx[c];
+        double trial = 0.0;
+        for (int r = 0; r < k; ++r) {
+          F[r] = value(S[static_cast<std::size_t>(r)], y);
+          trial = std::max(trial, std::abs(F[r]) / gnorm[r]);
+        }
+        if (trial < err || trial < tol_) {
+          x = y;
+          break;
+        }
+        if (halving == 12) return false;
+        step *= 0.5;
+      }
     }
     return false;
   }
@@ -188,6 +206,10 @@ std::vector<Point> Engine::walk(const std::vector<int>& S, const Point& x0, Poin
   std::vector<Point> pts;
   Point x = x0;
   t.normalize();
+  // The curve's tangent (gradient cross product, or the rotated gradient in 2D) keeps its
+  // orientation along the curve between tangencies: walk with it, not by comparing with the
+  // last step, so that a kink of more than 90 degrees (piecewise-smooth fields) is followed.
+  const double sigma = tangent(S, x0).dot(t) < 0 ? -1.0 : 1.0;
   double travelled = 0.0;
   long steps = 0;
   closed = false;
@@ -197,16 +219,28 @@ std::vector<Point> Engine::walk(const std::vector<int>& S, const Point& x0, Poin
     Point xp;
     Point tn;
     while (true) {
-      xp = x + hh * t;
-      bool ok = project(S, xp) && (xp - x).norm() < 2.0 * hh;
-      if (ok) {
-        tn = tangent(S, xp);
-        if (tn.norm() < 1e-12) ok = false;
-        else {
-          tn.normalize();
-          if (tn.dot(t) < 0) tn = -tn;
-          ok = tn.dot(t) > 0.9;
-        }
+      // A step: predict along t (or, at a kink, along the curve's direction just beyond x),
+      // correct onto the curve, and accept when it moved forward by about the step length and
+      // the new tangent agrees with the direction taken.
+      auto attempt = [&](const Point& dir, bool at_kink) {
+        xp = x + hh * dir;
+        if (!project(S, xp) || (xp - x).norm() >= 2.0 * hh || (xp - x).dot(dir) < 0.25 * hh) return false;
+        tn = sigma * tangent(S, xp);
+        if (tn.norm() < 1e-12) return false;
+        const double transversal = !at_kink || dim_ == 2
+                                       ? 1.0
+                                       : tn.norm() / (grad(S[0], xp).norm() * grad(S[1], xp).norm());
+        tn.normalize();
+        return tn.dot(dir) > 0.9 && transversal > 0.05;
+      };
+      bool ok = attempt(t, false);
+      // A smooth curve turns little over a step. One that still cannot be followed over a tiny
+      // step, while its sheets stay transversal, has a kink (piecewise-smooth fields such as
+      // stc/mesh_fields.hpp's, whose gradients jump across cell faces): continue along the
+      // tangent found just past x. Tangent sheets (parallel gradients) still stall below.
+      if (!ok && hh < 1e-3 * h_) {
+        Point beyond = sigma * tangent(S, x + hh * t);
+        if (beyond.norm() > 1e-12) ok = attempt(beyond.normalized(), true);
       }
       if (ok) break;
       hh *= 0.5;
