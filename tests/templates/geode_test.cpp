@@ -181,8 +181,8 @@ TEST_CASE("geode2d: the smoothed 2D geode is a valid quad mesh of the rectangle"
 // The paper's open question (Section 5): split the tet-side quad into four triangles. What we
 // found (see README): the arrangement (2 tunnels, 5 domes) dualizes to a combinatorially valid
 // 36-hex mesh with the prescribed boundary and 2D-geode sides, but it fails the paper's first
-// condition: the four points where three domes meet lie outside the tunnels' pocket, and the
-// smoother does not untangle it.
+// condition: the four points where three domes meet lie outside the tunnels' pocket (why:
+// tests/templates/four_triangle_test.cpp), and the smoother does not untangle it.
 TEST_CASE("geode4tri: what the four-triangle variant yields") {
   GeodeOptions o;
   o.split = templates::TopSplit::FourTriangles;
