@@ -3,6 +3,8 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <deque>
 #include <limits>
 #include <memory>
@@ -95,7 +97,8 @@ class CellLocator {
 
   // Local coordinates of x in `cell` by Newton's method, kept within a margin of the cell so
   // that a point far outside a distorted cell cannot send the iteration astray.
-  Vec invert(Index cell, const Vec& x) const {
+  // With `probe`, gives up early once x is clearly outside (the caller only asks "is x here?").
+  Vec invert(Index cell, const Vec& x, bool probe) const {
     Vec u = Vec::Constant(0.5);
     for (int it = 0; it < 30; ++it) {
       Mat J;
@@ -104,6 +107,7 @@ class CellLocator {
       if (!du.allFinite()) break;
       u = (u - du).cwiseMax(-1.0).cwiseMin(2.0);
       if (du.norm() < 1e-13) break;
+      if (probe && it >= 2 && outside(u) > 0.25) break;
     }
     return u;
   }
@@ -112,13 +116,21 @@ class CellLocator {
 
   Hit locate(const Point& p) const {
     const Vec x = p.template head<Dim>();
-    // Every sheet is evaluated at the same points (values, then 2d finite-difference probes).
-    for (const auto& [cx, hit] : cache_)
-      if (cx == x) return hit;
+    // Every sheet is evaluated at the same points (values, finite-difference probes, every
+    // point of a traced curve once per other sheet): a direct-mapped cache keyed by the exact
+    // coordinates.
+    std::size_t key = 0;
+    for (int a = 0; a < Dim; ++a) {
+      std::uint64_t bits;
+      std::memcpy(&bits, &x[a], sizeof bits);
+      key = (key ^ static_cast<std::size_t>(bits)) * 0x9E3779B97F4A7C15ull;
+    }
+    auto& slot = cache_[(key >> 40) % cache_.size()];
+    if (slot.first == x) return slot.second;
     Hit best;
     double best_out = 1e300;
-    auto consider = [&](Index c) {
-      const Vec u = invert(c, x);
+    auto consider = [&](Index c, bool probe) {
+      const Vec u = invert(c, x, probe);
       // Newton may stall (clamped) at a wrong u inside the cell: a cell counts only where its
       // map reaches x.
       const double miss = (map(c, u) - x).norm() / scale_;
@@ -131,10 +143,10 @@ class CellLocator {
       return (x.array() >= box_lo_[i].array()).all() && (x.array() <= box_hi_[i].array()).all();
     };
     // Points come in runs along a curve: the last cell first, then the bucket's cells.
-    bool found = last_ != primal::kInvalidIndex && in_box(last_) && consider(last_);
+    bool found = last_ != primal::kInvalidIndex && in_box(last_) && consider(last_, true);
     for (Index c : buckets_[bucket_id(bucket_coords(x))]) {
       if (found) break;
-      if (in_box(c)) found = consider(c);
+      if (in_box(c)) found = consider(c, true);
     }
     if (!found) {
       // Off the mesh (a probe or a Newton iterate outside the box): the nearest cells' maps,
@@ -146,11 +158,10 @@ class CellLocator {
         nearest = std::min(nearest, gap[c]);
       }
       for (std::size_t c = 0; c < cells_.size(); ++c)
-        if (gap[c] <= nearest + 1e-6 * scale_) consider(static_cast<Index>(c));
+        if (gap[c] <= nearest + 1e-6 * scale_) consider(static_cast<Index>(c), false);
     }
     last_ = best.cell;
-    cache_[next_] = {x, best};
-    next_ = (next_ + 1) % cache_.size();
+    slot = {x, best};
     return best;
   }
 
@@ -187,8 +198,7 @@ class CellLocator {
   std::vector<std::vector<Index>> buckets_;
   std::vector<Vec> box_lo_, box_hi_;  // per cell, padded
   mutable Index last_ = primal::kInvalidIndex;
-  mutable std::array<std::pair<Vec, Hit>, 16> cache_{};
-  mutable std::size_t next_ = 0;
+  mutable std::vector<std::pair<Vec, Hit>> cache_ = std::vector<std::pair<Vec, Hit>>(4096);
 };
 
 // What the fields of one mesh share: a copy of the mesh, its locator and the nodal values.

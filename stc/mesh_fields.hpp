@@ -20,7 +20,8 @@
 // The cell holding a point is found by a bucket grid and Newton's method on the inverse
 // multilinear map; a point outside every cell (a finite-difference probe just off the
 // boundary) uses the nearest cell's map extended. Evaluating a field is not thread-safe (the
-// fields of one mesh share a cache of recent points); the arrangement engine is single-threaded.
+// fields of one mesh share a cache of located points); the arrangement engine is
+// single-threaded.
 #include <vector>
 
 #include "primal/mesh.hpp"

@@ -6,7 +6,10 @@
 #include <cmath>
 #include <string>
 
+#include "primal/demo_models.hpp"
+#include "primal/dice.hpp"
 #include "primal/errors.hpp"
+#include "primal/model.hpp"
 #include "primal/quality.hpp"
 #include "primal/smooth.hpp"
 #include "primal/validity.hpp"
@@ -157,6 +160,24 @@ TEST_CASE("round trip: each side of the geode (the 2D geode) comes back") {
   const auto m = gt::find_isomorphism(D.quad, side);
   REQUIRE(m.has_value());
   CHECK(gt::is_isomorphism(D.quad, side, *m));
+}
+
+TEST_CASE("round trip: diced tet meshes (closed and hemispherical dome sheets) come back") {
+  // Kuhn-split cubes diced into 4 hexes per tet: every interior vertex of the tet mesh is
+  // surrounded by a closed sheet, every boundary vertex by a hemisphere ending on the box.
+  for (int n : {1, 2}) {
+    CAPTURE(n);
+    const primal::TetMesh tets =
+        primal::tet_part(primal::grid_model({n, n, n}, 1.0, [](int, int, int) { return true; }));
+    const HexMesh g = primal::dice(tets).mesh;
+    const auto dual = stc::mesh_dual(g);
+    CHECK(dual.sheets.size() == static_cast<std::size_t>((n + 1) * (n + 1) * (n + 1)));  // one per tet vertex
+    const auto D = round_trip(g);
+    CHECK(D.hex.hexes.size() == g.hexes.size());
+    const auto m = gt::find_isomorphism(D.hex, g);
+    REQUIRE(m.has_value());
+    CHECK(gt::is_isomorphism(D.hex, g, *m));
+  }
 }
 
 TEST_CASE("round trip: meshes the fields cannot represent are refused with the reason") {
