@@ -8,9 +8,9 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
-#include <sys/wait.h>
 
 #include "primal/io_vtk.hpp"
+#include "support/cli_run.hpp"
 #include "support/fixtures.hpp"
 #include "support/isomorphism.hpp"
 
@@ -18,28 +18,9 @@ using namespace geode;
 
 namespace {
 
-struct Run {
-  int code = -1;
-  std::string out;
-};
-
-// Runs the geode command with `args`, capturing standard output (standard error is dropped).
-Run geode_cli(const std::string& args) {
-  Run r;
-  const std::string cmd = std::string(GEODE_CLI_PATH) + " " + args + " 2>/dev/null";
-  FILE* p = ::popen(cmd.c_str(), "r");
-  REQUIRE(p != nullptr);
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  const int status = ::pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
-
-std::filesystem::path temp_path(const std::string& name) {
-  return std::filesystem::temp_directory_path() / ("geode-cli-test-" + std::to_string(::getpid()) + "-" + name);
-}
+using Run = test::CliRun;
+using test::geode_cli;
+using test::temp_path;
 
 primal::HexMesh hex_from_tables(const std::vector<primal::Point>& pts, const std::vector<std::array<int, 8>>& hexes) {
   primal::HexMesh m;

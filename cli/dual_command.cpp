@@ -1,0 +1,220 @@
+// geode dual MESH: a hex (or quad) mesh seen as its sheet arrangement (the STC from the primal
+// side: stc/mesh_dual), and with --rebuild the same sheets handed to the arrangement engine and
+// dualized back (stc/mesh_fields, compute_arrangement, dualize).
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "cli/commands.hpp"
+#include "primal/atomic_file.hpp"
+#include "primal/errors.hpp"
+#include "primal/io_exodus.hpp"
+#include "primal/io_gmsh.hpp"
+#include "primal/io_vtk.hpp"
+#include "primal/model.hpp"
+#include "stc/arrangement.hpp"
+#include "stc/dualize.hpp"
+#include "stc/mesh_dual.hpp"
+#include "stc/mesh_fields.hpp"
+
+namespace geode::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using primal::Index;
+
+std::string lower_extension(const fs::path& p) {
+  std::string e = p.extension().string();
+  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
+  return e;
+}
+
+struct DualArgs {
+  std::string input;
+  std::string format = "text";
+  std::string output;
+  std::string rebuild;
+};
+
+// A mesh as read: hexes, or quads (a planar quad mesh in z = 0, from .vtu / .vtk only).
+struct InputMesh {
+  int dim = 3;
+  primal::HexMesh hex;
+  primal::QuadMesh quad;
+};
+
+InputMesh read_input(const fs::path& path) {
+  if (!fs::exists(path)) throw InvalidInput(path.string() + ": no such file");
+  const std::string e = lower_extension(path);
+  InputMesh m;
+  if (e == ".vtu" || e == ".vtk") {
+    const primal::VtkGrid g = primal::read_vtk_file(path);
+    const bool quads = !g.cell_types.empty() && std::all_of(g.cell_types.begin(), g.cell_types.end(),
+                                                             [](int t) { return t == primal::kVtkQuad; });
+    if (quads) {
+      m.dim = 2;
+      m.quad = primal::to_quad_mesh(g);
+      for (std::size_t n = 0; n < m.quad.points.size(); ++n)
+        if (m.quad.points[n].z() != 0.0)
+          throw InvalidInput(path.string() + ": node " + std::to_string(n) +
+                             " has z != 0: a quad mesh must lie in the plane z = 0");
+    } else {
+      m.hex = primal::to_hex_mesh(g);  // names the first cell that is not a hex
+    }
+    return m;
+  }
+  primal::Model model;
+  if (e == ".msh")
+    model = primal::read_gmsh(path);
+  else if (e == ".exo" || e == ".e")
+    model = primal::read_exodus(path);
+  else
+    throw InvalidInput(path.string() + ": unknown input format '" + e + "' (expected .vtu, .vtk, .msh, .exo or .e)");
+  if (!model.tets.empty())
+    throw InvalidInput(path.string() + ": holds " + std::to_string(model.tets.size()) +
+                       " tets; the dual is read off all-hex meshes (use `geode conform` first)");
+  m.hex = primal::hex_part(model);
+  return m;
+}
+
+template <class Dual>
+nlohmann::json dual_json(const Dual& dual, Index nodes, Index cells) {
+  nlohmann::json j;
+  j["nodes"] = nodes;
+  j["cells"] = cells;
+  j["sheets"] = nlohmann::json::array();
+  for (std::size_t s = 0; s < dual.sheets.size(); ++s) {
+    const auto& sh = dual.sheets[s];
+    int closed = 0;
+    for (const auto& t : sh.trace) closed += t.closed;
+    j["sheets"].push_back({{"sheet", s},
+                           {"edges", sh.edges.size()},
+                           {"crossings", sh.cells.size()},
+                           {"self_intersecting", sh.self_intersecting},
+                           {"trace_pieces", sh.trace.size()},
+                           {"closed_trace_pieces", closed}});
+  }
+  j["intersections"] = nlohmann::json::array();
+  for (const auto& [tuple, count] : dual.intersections)
+    j["intersections"].push_back({{"sheets", std::vector<Index>(tuple.begin(), tuple.end())}, {"cells", count}});
+  return j;
+}
+
+std::string dual_text(const nlohmann::json& j, int dim) {
+  std::ostringstream s;
+  const char* cell = dim == 3 ? "hexes" : "quads";
+  const char* sheet = dim == 3 ? "sheets" : "chords";
+  s << j["nodes"].get<Index>() << " nodes, " << j["cells"].get<Index>() << " " << cell << ", "
+    << j["sheets"].size() << " " << sheet << "\n\n";
+  s << (dim == 3 ? "sheet" : "chord") << "\tedges\tcrossings\tself-intersecting\tboundary trace pieces (closed)\n";
+  for (const auto& sh : j["sheets"])
+    s << sh["sheet"].get<Index>() << "\t" << sh["edges"].get<std::size_t>() << "\t" << sh["crossings"].get<std::size_t>()
+      << "\t" << (sh["self_intersecting"].get<bool>() ? "yes" : "no") << "\t"
+      << sh["trace_pieces"].get<std::size_t>() << " (" << sh["closed_trace_pieces"].get<int>() << ")\n";
+  s << "\n" << (dim == 3 ? "triple" : "crossing") << "\t" << cell << " where they meet\n";
+  for (const auto& t : j["intersections"]) {
+    std::string tuple;
+    for (Index x : t["sheets"]) tuple += (tuple.empty() ? "" : " ") + std::to_string(x);
+    s << tuple << "\t" << t["cells"].get<Index>() << "\n";
+  }
+  return s.str();
+}
+
+// The sorted multiset of cells per sheet tuple: equal for isomorphic meshes (whatever the
+// sheet numbering), a cheap cross-check of a rebuild.
+template <class Dual>
+std::vector<Index> tuple_counts(const Dual& d) {
+  std::vector<Index> c;
+  for (const auto& [t, n] : d.intersections) c.push_back(n);
+  std::sort(c.begin(), c.end());
+  return c;
+}
+
+void run_dual(const DualArgs& a) {
+  const fs::path in(a.input);
+  const InputMesh m = read_input(in);
+  nlohmann::json j;
+  std::vector<Index> counts;
+  if (m.dim == 3) {
+    const auto dual = stc::mesh_dual(m.hex);
+    j = dual_json(dual, static_cast<Index>(m.hex.points.size()), static_cast<Index>(m.hex.hexes.size()));
+    counts = tuple_counts(dual);
+  } else {
+    const auto dual = stc::mesh_dual(m.quad);
+    j = dual_json(dual, static_cast<Index>(m.quad.points.size()), static_cast<Index>(m.quad.quads.size()));
+    counts = tuple_counts(dual);
+  }
+  j["input"] = a.input;
+  j["dimension"] = m.dim;
+
+  if (!a.rebuild.empty()) {
+    const fs::path out(a.rebuild);
+    const std::string e = lower_extension(out);
+    if (e != ".vtu" && e != ".vtk")
+      throw InvalidInput(out.string() + ": unknown output format '" + e + "' (expected .vtu or .vtk)");
+    // Name the input in what the engine reports (it only knows hexes and sheets by number).
+    stc::DualMesh D;
+    try {
+      const stc::MeshArrangementInput fields = m.dim == 3 ? stc::sheet_fields(m.hex) : stc::sheet_fields(m.quad);
+      D = stc::dualize(stc::compute_arrangement(fields.sheets, fields.domain));
+    } catch (const InvalidInput& x) {
+      throw InvalidInput(a.input + ": cannot rebuild: " + x.what());
+    } catch (const TopologyError& x) {
+      throw TopologyError(a.input + ": cannot rebuild: " + x.what());
+    }
+    nlohmann::json r;
+    r["file"] = a.rebuild;
+    r["nodes"] = m.dim == 3 ? D.hex.points.size() : D.quad.points.size();
+    r["cells"] = m.dim == 3 ? D.hex.hexes.size() : D.quad.quads.size();
+    const std::vector<Index> rebuilt = m.dim == 3 ? tuple_counts(stc::mesh_dual(D.hex)) : tuple_counts(stc::mesh_dual(D.quad));
+    r["same_counts"] = rebuilt == counts && r["nodes"] == j["nodes"] && r["cells"] == j["cells"];
+    // Writers are atomic (primal/io_vtk.hpp): nothing half-written on failure.
+    if (m.dim == 3)
+      e == ".vtu" ? primal::write_vtu(out, D.hex) : primal::write_vtk(out, D.hex);
+    else
+      e == ".vtu" ? primal::write_vtu(out, D.quad) : primal::write_vtk(out, D.quad);
+    j["rebuild"] = r;
+  }
+
+  std::string text;
+  if (a.format == "json") {
+    text = j.dump(2) + "\n";
+  } else {
+    text = dual_text(j, m.dim);
+    if (j.contains("rebuild")) {
+      const auto& r = j["rebuild"];
+      text += "\nrebuilt through the arrangement engine: " + std::to_string(r["nodes"].get<std::size_t>()) + " nodes, " +
+              std::to_string(r["cells"].get<std::size_t>()) + (m.dim == 3 ? " hexes" : " quads") + " -> " + a.rebuild +
+              "\n  same node, cell and intersection counts as the input: " + (r["same_counts"].get<bool>() ? "yes" : "NO") +
+              "\n";
+    }
+  }
+  if (a.output.empty())
+    std::cout << text;
+  else
+    primal::write_file_atomically(a.output, [&](std::ostream& o) { o << text; });
+}
+
+}  // namespace
+
+void add_dual_command(CLI::App& app) {
+  auto a = std::make_shared<DualArgs>();
+  CLI::App* d = app.add_subcommand(
+      "dual",
+      "A mesh's dual: its sheets (chords in 2D), each sheet's crossings and boundary trace, and how many\n"
+      "hexes each triple of sheets meets in. --rebuild realizes those sheets as fields, computes their\n"
+      "arrangement and dualizes it back (stc/mesh_fields.hpp): for a mesh that fills a box with positively\n"
+      "oriented cells and sheets that do not cross themselves, the result is the same mesh up to numbering.");
+  d->add_option("mesh", a->input, "All-hex mesh (.vtu, .vtk, .msh, .exo, .e) or planar quad mesh in z = 0 (.vtu, .vtk)")
+      ->required();
+  d->add_option("--format", a->format, "text (tables) or json")->check(CLI::IsMember({"text", "json"}));
+  d->add_option("-o,--output", a->output, "Write the report here instead of standard output");
+  d->add_option("--rebuild", a->rebuild, "Rebuild the mesh from its sheets through the arrangement engine; write it here (.vtu, .vtk)");
+  d->callback([a] { run_dual(*a); });
+}
+
+}  // namespace geode::cli

@@ -1,0 +1,40 @@
+#pragma once
+// Running the built `geode` command from a test (GEODE_CLI_PATH, set by CMake for the test
+// programs) and naming scratch files. Header-only: the path is known where the tests are
+// compiled, not in the fixtures library.
+#include <doctest/doctest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+namespace geode::test {
+
+struct CliRun {
+  int code = -1;
+  std::string out;
+};
+
+// Runs `geode <args>` through the shell, capturing standard output, and standard error with it
+// when `with_stderr` (dropped otherwise).
+inline CliRun geode_cli(const std::string& args, bool with_stderr = false) {
+  CliRun r;
+  const std::string cmd = std::string(GEODE_CLI_PATH) + " " + args + (with_stderr ? " 2>&1" : " 2>/dev/null");
+  FILE* p = ::popen(cmd.c_str(), "r");
+  REQUIRE(p != nullptr);
+  char buf[4096];
+  std::size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
+  const int status = ::pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+// A file name in the temporary directory, unique to this process.
+inline std::filesystem::path temp_path(const std::string& name) {
+  return std::filesystem::temp_directory_path() / ("geode-cli-test-" + std::to_string(::getpid()) + "-" + name);
+}
+
+}  // namespace geode::test
