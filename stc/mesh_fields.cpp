@@ -212,9 +212,10 @@ struct MeshFieldData {
 
 const char* cell_word(int dim) { return dim == 3 ? "hex" : "quad"; }
 
-template <int Dim, class Dual>
+// make_classifier(lo, hi, tol): stc::box_face_classifier for the mesh at hand.
+template <int Dim, class Dual, class MakeClassifier>
 MeshArrangementInput build(const std::vector<Point>& points, const std::vector<CellArray<Dim>>& cells,
-                           const Dual& dual) {
+                           const Dual& dual, MakeClassifier make_classifier) {
   constexpr int kCorners = 1 << Dim;
   if (cells.empty()) throw InvalidInput(std::string("sheet_fields: the mesh has no ") + cell_word(Dim) + "es");
   auto data = std::make_shared<MeshFieldData<Dim>>();
@@ -315,22 +316,9 @@ MeshArrangementInput build(const std::vector<Point>& points, const std::vector<C
       hi = hi.cwiseMax(points[static_cast<std::size_t>(n)]);
     }
   if (Dim == 2) lo[2] = hi[2] = 0.0;
-  const double tol = 1e-9 * (hi - lo).norm();
+  const FacetClassifier classify = make_classifier(lo, hi, 1e-9 * (hi - lo).norm());
   for (const CellFacet& f : dual.boundary) {
-    const auto& cell = cells[static_cast<std::size_t>(f.cell)];
-    bool on = false;
-    for (int a = 0; a < Dim && !on; ++a)
-      for (double plane : {lo[a], hi[a]}) {
-        bool all = true;
-        if constexpr (Dim == 3) {
-          for (int k : topo::kHexFaceCorners[static_cast<std::size_t>(f.local)])
-            all = all && std::abs(points[static_cast<std::size_t>(cell[static_cast<std::size_t>(k)])][a] - plane) <= tol;
-        } else {
-          for (int k : topo::kQuadEdgeCorners[static_cast<std::size_t>(f.local)])
-            all = all && std::abs(points[static_cast<std::size_t>(cell[static_cast<std::size_t>(k)])][a] - plane) <= tol;
-        }
-        on = on || all;
-      }
+    const bool on = classify(f) >= 0;
     if (!on)
       throw InvalidInput(std::string("sheet_fields: boundary ") + (Dim == 3 ? "face " : "edge ") +
                          std::to_string(f.local) + " of " + cell_word(Dim) + " " + std::to_string(f.cell) +
@@ -345,11 +333,15 @@ MeshArrangementInput build(const std::vector<Point>& points, const std::vector<C
 }  // namespace
 
 MeshArrangementInput sheet_fields(const primal::HexMesh& mesh) {
-  return build<3>(mesh.points, mesh.hexes, mesh_dual(mesh));
+  return build<3>(mesh.points, mesh.hexes, mesh_dual(mesh), [&](const Point& lo, const Point& hi, double tol) {
+    return box_face_classifier(mesh, lo, hi, tol);
+  });
 }
 
 MeshArrangementInput sheet_fields(const primal::QuadMesh& mesh) {
-  return build<2>(mesh.points, mesh.quads, mesh_dual(mesh));
+  return build<2>(mesh.points, mesh.quads, mesh_dual(mesh), [&](const Point& lo, const Point& hi, double tol) {
+    return box_face_classifier(mesh, lo, hi, tol);
+  });
 }
 
 }  // namespace geode::stc
