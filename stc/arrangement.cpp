@@ -9,18 +9,87 @@
 
 #include "primal/disjoint_sets.hpp"
 #include "primal/errors.hpp"
+#include "primal/topology.hpp"
 
 namespace geode::stc {
 namespace {
 
-
-std::string fmt_point(const Point& x, int dim) {
+std::string format_point(const Point& x, int dim) {
   std::ostringstream s;
   s.precision(6);
   s << "(" << x[0] << ", " << x[1];
   if (dim == 3) s << ", " << x[2];
   s << ")";
   return s.str();
+}
+
+// Length of the first dim components (no dynamic-size head(): GCC 12 misreads it as out of
+// bounds under -Warray-bounds).
+double norm_d(const Point& v, int dim) { return dim == 3 ? v.norm() : std::hypot(v[0], v[1]); }
+
+// Trilinear (bilinear for dim 2) map of the unit cube onto the hexahedron (quadrilateral)
+// with VTK corners P: corner c's shape function is the product over the axes of r or 1 - r.
+Point multilinear(const std::array<Point, 8>& P, const Point& r, int dim) {
+  Point x = Point::Zero();
+  for (int c = 0; c < (1 << dim); ++c) {
+    const auto& rc = primal::topology::kHexCornerCoords[static_cast<std::size_t>(c)];
+    double w = 1.0;
+    for (int a = 0; a < dim; ++a) w *= rc[static_cast<std::size_t>(a)] ? r[a] : 1.0 - r[a];
+    x += w * P[static_cast<std::size_t>(c)];
+  }
+  if (dim == 2) x[2] = 0.0;
+  return x;
+}
+
+// Determinant of the map's Jacobian at local coordinates r (columns d/dr, d/ds, d/dt).
+double multilinear_jacobian(const std::array<Point, 8>& P, const Point& r, int dim) {
+  Eigen::Matrix3d J = Eigen::Matrix3d::Zero();
+  for (int c = 0; c < (1 << dim); ++c) {
+    const auto& rc = primal::topology::kHexCornerCoords[static_cast<std::size_t>(c)];
+    for (int d = 0; d < dim; ++d) {
+      double w = rc[static_cast<std::size_t>(d)] ? 1.0 : -1.0;
+      for (int a = 0; a < dim; ++a)
+        if (a != d) w *= rc[static_cast<std::size_t>(a)] ? r[a] : 1.0 - r[a];
+      J.col(d) += w * P[static_cast<std::size_t>(c)];
+    }
+  }
+  return dim == 3 ? J.determinant() : J(0, 0) * J(1, 1) - J(0, 1) * J(1, 0);
+}
+
+Domain make_cell_domain(const std::array<Point, 8>& P, int dim) {
+  const char* what = dim == 3 ? "hexahedron" : "quadrilateral";
+  const int n = 1 << dim;
+  Point lo = Point::Constant(1e300), hi = Point::Constant(-1e300);
+  for (int c = 0; c < n; ++c) {
+    if (!P[static_cast<std::size_t>(c)].allFinite())
+      throw InvalidInput(std::string("domain: ") + what + " corner " + std::to_string(c) + " is not finite");
+    lo = lo.cwiseMin(P[static_cast<std::size_t>(c)]);
+    hi = hi.cwiseMax(P[static_cast<std::size_t>(c)]);
+  }
+  const double size = norm_d(hi - lo, dim);
+  if (!(size > 0)) throw InvalidInput(std::string("domain: degenerate ") + what + " (all corners coincide)");
+  // Positive at every corner and at the centre: the test the mesh-quality literature uses
+  // for a valid trilinear element (Knupp's corner Jacobians plus the centre). Relative to the
+  // cell's size so that a flattened cell is refused too.
+  const double floor = 1e-12 * std::pow(size, dim);
+  for (int c = 0; c <= n; ++c) {
+    Point r = Point::Constant(0.5);
+    if (c < n)
+      for (int a = 0; a < 3; ++a) r[a] = primal::topology::kHexCornerCoords[static_cast<std::size_t>(c)][static_cast<std::size_t>(a)];
+    const double j = multilinear_jacobian(P, r, dim);
+    if (!(j > floor))
+      throw InvalidInput(std::string("domain: the ") + what + "'s Jacobian is not positive at " +
+                         (c < n ? "corner " + std::to_string(c) + " " + format_point(P[static_cast<std::size_t>(c)], dim)
+                                : std::string("its centre")) +
+                         " (det " + std::to_string(j) + "): corners must be in VTK order" +
+                         (dim == 3 ? " (bottom 0-1-2-3 counter-clockwise seen from above, 4-7 above them)"
+                                   : " (counter-clockwise)") +
+                         " and the cell not inverted or flat");
+  }
+  Domain d(lo, hi, dim);
+  if (dim == 2) d.lo[2] = d.hi[2] = 0.0;
+  d.corners = P;
+  return d;
 }
 
 // An event on a traced curve: the curve crosses sheet `sheet` at vertex position x, between
@@ -35,13 +104,15 @@ struct Event {
 class Engine {
  public:
   Engine(const std::vector<Sheet>& sheets, const Domain& domain, const ArrangementOptions& opt)
-      : sheets_(sheets), domain_(domain), options_(opt), dim_(domain.dim) {
-    if (dim_ != 2 && dim_ != 3) throw InvalidInput("arrangement: dimension must be 2 or 3");
+      : user_(domain),
+        domain_(reference_box(domain)),
+        mapped_(compose(sheets)),
+        sheets_(domain.corners ? mapped_ : sheets),
+        options_(opt),
+        dim_(domain.dim) {
     if (static_cast<int>(sheets.size()) < dim_)
       throw InvalidInput("arrangement: needs at least as many sheets as dimensions");
-    for (int i = 0; i < dim_; ++i)
-      if (!(domain.hi[i] > domain.lo[i])) throw InvalidInput("arrangement: empty domain");
-    diag_ = (domain.hi - domain.lo).head(dim_).norm();
+    diag_ = (domain_.hi - domain_.lo).head(dim_).norm();
     h_ = options_.step * diag_;
     grad_h_ = 1e-6 * diag_;
     tol_ = options_.tolerance * diag_;
@@ -50,6 +121,58 @@ class Engine {
   Arrangement run();
 
  private:
+  // The box the engine computes in. For a hexahedron: corner 0's position, and per axis the
+  // mean length of the cell's edges along it, so that the seeding grid, the step and the
+  // tolerances (all relative to this box) keep their meaning; for a hexahedron equal to a
+  // box it is that box.
+  static Domain reference_box(const Domain& d) {
+    if (d.dim != 2 && d.dim != 3) throw InvalidInput("arrangement: dimension must be 2 or 3");
+    if (!d.corners) {
+      for (int i = 0; i < d.dim; ++i)
+        if (!(d.hi[i] > d.lo[i])) throw InvalidInput("arrangement: empty domain");
+      return Domain(d.lo, d.hi, d.dim);
+    }
+    make_cell_domain(*d.corners, d.dim);  // throws on bad corners (they may be filled in by hand)
+    const auto& P = *d.corners;
+    Point len = Point::Zero();
+    for (const auto& e : primal::topology::kHexEdgeCorners) {
+      const Point v = P[static_cast<std::size_t>(e[1])] - P[static_cast<std::size_t>(e[0])];
+      const auto& a = primal::topology::kHexCornerCoords[static_cast<std::size_t>(e[0])];
+      const auto& b = primal::topology::kHexCornerCoords[static_cast<std::size_t>(e[1])];
+      int axis = 0;
+      while (a[static_cast<std::size_t>(axis)] == b[static_cast<std::size_t>(axis)]) ++axis;
+      if (d.dim == 2 && (axis == 2 || a[2] || b[2])) continue;  // the quad's 4 edges only
+      len[axis] += norm_d(v, d.dim) / (d.dim == 3 ? 4.0 : 2.0);
+    }
+    Point lo = P[0];
+    if (d.dim == 2) lo[2] = 0.0, len[2] = 0.0;
+    return Domain(lo, lo + len, d.dim);
+  }
+  // Every field composed with the map from the reference box to the hexahedron.
+  std::vector<Sheet> compose(const std::vector<Sheet>& sheets) const {
+    if (!user_.corners) return {};
+    std::vector<Sheet> out;
+    for (const Sheet& s : sheets) {
+      Sheet m{s.name, {}, s.kind};
+      m.field = [f = &s.field, P = *user_.corners, lo = domain_.lo, hi = domain_.hi, dim = user_.dim](const Point& u) {
+        Point r = Point::Zero();
+        for (int a = 0; a < dim; ++a) r[a] = (u[a] - lo[a]) / (hi[a] - lo[a]);
+        return (*f)(multilinear(P, r, dim));
+      };
+      out.push_back(std::move(m));
+    }
+    return out;
+  }
+  // Reference-box position -> local coordinates in [0, 1]^d -> physical position.
+  Point local(const Point& u) const {
+    Point r = Point::Zero();
+    for (int a = 0; a < dim_; ++a) r[a] = (u[a] - domain_.lo[a]) / (domain_.hi[a] - domain_.lo[a]);
+    return r;
+  }
+  Point physical(const Point& u) const { return user_.corners ? domain_point(user_, local(u)) : u; }
+  // Positions in messages are physical.
+  std::string fmt_point(const Point& u, int dim) const { return format_point(physical(u), dim); }
+
   double value(int s, const Point& x) const { return sheets_[static_cast<std::size_t>(s)].field(x); }
   Point grad(int s, const Point& x) const {
     return gradient(sheets_[static_cast<std::size_t>(s)].field, x, grad_h_, dim_);
@@ -122,8 +245,10 @@ class Engine {
   std::array<int, 3> n_{1, 1, 1};
   std::vector<std::vector<double>> grid_;
 
+  Domain user_;    // as given
+  Domain domain_;  // the reference box (user_ itself for a box)
+  std::vector<Sheet> mapped_;  // the fields composed with the map, for a hexahedron
   const std::vector<Sheet>& sheets_;
-  Domain domain_;
   ArrangementOptions options_;
   int dim_;
   double diag_, h_, grad_h_, tol_;
@@ -374,7 +499,7 @@ void Engine::check_vertex(const Vertex& v) const {
 
 Arrangement Engine::run() {
   Arrangement A;
-  A.domain = domain_;
+  A.domain = user_;
   A.sheet_count = static_cast<int>(sheets_.size());
   for (const auto& s : sheets_) A.sheet_names.push_back(s.name);
 
@@ -560,10 +685,40 @@ Arrangement Engine::run() {
                             " meet): the curves were traced inconsistently");
     }
   }
+  // Report physical positions (the identity for a box). A vertex's orientation was taken
+  // from the composed fields' gradients: it is the physical one where the map's Jacobian is
+  // positive, which the corner and centre test does not promise everywhere.
+  for (Vertex& v : A.vertices) {
+    v.local = local(v.x);
+    if (user_.corners && !(multilinear_jacobian(*user_.corners, v.local, dim_) > 0))
+      throw InvalidInput("arrangement: the domain cell folds over (Jacobian not positive) where sheets " +
+                         names(v.sheets) + " meet at " + fmt_point(v.x, dim_));
+    v.x = physical(v.x);
+  }
+  if (user_.corners) {
+    for (Edge1& e : A.edges) e.a.x = physical(e.a.x), e.b.x = physical(e.b.x);
+    for (Curve& c : A.curves)
+      for (Point& p : c.polyline) p = physical(p);
+  }
   return A;
 }
 
 }  // namespace
+
+Domain Domain::hexahedron(const std::array<Point, 8>& corners) { return make_cell_domain(corners, 3); }
+
+Domain Domain::quadrilateral(const std::array<Point, 4>& corners) {
+  std::array<Point, 8> P;
+  for (std::size_t c = 0; c < 8; ++c) P[c] = corners[c % 4];  // 4-7 unused in 2D
+  return make_cell_domain(P, 2);
+}
+
+Point domain_point(const Domain& domain, const Point& r) {
+  if (domain.corners) return multilinear(*domain.corners, r, domain.dim);
+  Point x = Point::Zero();
+  for (int a = 0; a < domain.dim; ++a) x[a] = domain.lo[a] + (domain.hi[a] - domain.lo[a]) * r[a];
+  return x;
+}
 
 Arrangement compute_arrangement(const std::vector<Sheet>& sheets, const Domain& domain,
                                 const ArrangementOptions& options) {
