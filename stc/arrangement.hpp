@@ -15,6 +15,26 @@
 // vertex on the domain boundary, a curve leaving through a box edge, a curve with no vertex,
 // a vertex missed by one of its curves are thrown as TopologyError naming the sheets and
 // the point. Cells that are not balls are caught when dualizing (stc/dualize.hpp).
+//
+// Tangencies away from vertices leave nothing behind to trace, so they are searched for:
+//  - two sheets that touch (3D: surfaces meeting at an isolated point; 2D: curves touching):
+//    from every seeding-grid cell where both zero sets come within about a cell and their
+//    gradients, estimated from the grid, are within 45 degrees of parallel, and which is more
+//    than two cells from the curves traced for that pair (2D: from its vertices),
+//    Levenberg-Marquardt looks for a common zero; one with gradients parallel to within
+//    sin 1e-3 is a touching, one with crossing gradients must lie on a traced curve (be a
+//    vertex), else a piece of the arrangement smaller than the grid was missed;
+//  - a curve that touches a third sheet (2D: a curve touching another): along the traced
+//    curve, where that sheet's field comes close without changing sign;
+//  - a sheet that touches a domain face: from grid nodes on the face where the field is a
+//    discrete extremum of one sign within a grid step of zero.
+// Resolution limits, honestly: a common zero counts as one when both fields are below 1e-9
+// of the domain diagonal times their gradients, so sheets closer than about 2e-9 diagonals
+// are reported as touching; sheets crossing at an angle below about 0.06 degrees are
+// reported as tangent. A touching is found only if the grid sees both zero sets near it:
+// features much smaller than a seeding cell (a sphere of radius below a cell touching a
+// plane) can pass unseen, as can a touching within two cells of a traced curve of the same
+// two sheets. Raising seed_resolution tightens all of these.
 #include <array>
 #include <optional>
 #include <string>
