@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numeric>
 #include <sstream>
+#include <unordered_map>
 
 #include "primal/disjoint_sets.hpp"
 #include "primal/errors.hpp"
@@ -239,7 +240,7 @@ class Engine {
   std::vector<Event> events(const Curve& c) const;
   void check_touching(const std::vector<Curve>& curves) const;
   int register_vertex(std::vector<int> sheets, const Point& x);
-  void check_vertex(const Vertex& v) const;
+  void check_vertex(const Vertex& v, const Eigen::MatrixXd& J) const;
 
   // An equation for the touching search: sheet `sheet`'s field, or (sheet < 0) the domain
   // face x[axis] = at.
@@ -287,6 +288,10 @@ class Engine {
   int dim_;
   double diag_, h_, grad_h_, tol_;
   std::vector<Vertex> vertices_;
+  std::vector<Eigen::MatrixXd> jacobians_;  // per vertex: its sheets' gradients as rows
+  // Vertices by their sheets (key: the sorted sheet indices in base sheet_count), for
+  // register_vertex's search; each list in registration order.
+  std::unordered_map<long long, std::vector<int>> vertices_by_sheets_;
 };
 
 Point Engine::grid_node(int i, int j, int k) const {
@@ -718,10 +723,15 @@ void Engine::check_touching(const std::vector<Curve>& curves) const {
 
 int Engine::register_vertex(std::vector<int> S, const Point& x) {
   std::sort(S.begin(), S.end());
-  for (std::size_t i = 0; i < vertices_.size(); ++i) {
-    if (vertices_[i].sheets == S && (vertices_[i].x - x).norm() < 1e-7 * diag_) {
-      ++vertices_[i].found;
-      return static_cast<int>(i);
+  long long key = 0;
+  for (int s : S) key = key * static_cast<long long>(sheets_.size()) + s;
+  std::vector<int>& same = vertices_by_sheets_[key];
+  // The first match in registration order, as a scan over all vertices would find.
+  for (int i : same) {
+    Vertex& v = vertices_[static_cast<std::size_t>(i)];
+    if ((v.x - x).norm() < 1e-7 * diag_) {
+      ++v.found;
+      return i;
     }
   }
   Vertex v;
@@ -731,18 +741,16 @@ int Engine::register_vertex(std::vector<int> S, const Point& x) {
   Eigen::MatrixXd J(dim_, dim_);
   for (int r = 0; r < dim_; ++r) J.row(r) = grad(S[static_cast<std::size_t>(r)], x).head(dim_).transpose();
   v.orientation = J.determinant() > 0 ? 1 : -1;
-  check_vertex(v);
+  check_vertex(v, J);
   vertices_.push_back(v);
+  jacobians_.push_back(std::move(J));
+  same.push_back(static_cast<int>(vertices_.size() - 1));
   return static_cast<int>(vertices_.size() - 1);
 }
 
-void Engine::check_vertex(const Vertex& v) const {
-  Eigen::MatrixXd J(dim_, dim_);
+void Engine::check_vertex(const Vertex& v, const Eigen::MatrixXd& J) const {
   double prod = 1.0;
-  for (int r = 0; r < dim_; ++r) {
-    J.row(r) = grad(v.sheets[static_cast<std::size_t>(r)], v.x).head(dim_).transpose();
-    prod *= J.row(r).norm();
-  }
+  for (int r = 0; r < dim_; ++r) prod *= J.row(r).norm();
   if (std::abs(J.determinant()) < 1e-6 * prod)
     throw TopologyError("arrangement: sheets " + names(v.sheets) + " meet tangentially at " + fmt_point(v.x, dim_) +
                         " (not in general position)");
@@ -917,9 +925,7 @@ Arrangement Engine::run() {
   A.region.assign(static_cast<std::size_t>(nv), {-1, -1, -1, -1, -1, -1, -1, -1});
   for (int v = 0; v < nv; ++v) {
     const Vertex& V = A.vertices[static_cast<std::size_t>(v)];
-    Eigen::MatrixXd J(dim_, dim_);
-    for (int r = 0; r < dim_; ++r) J.row(r) = grad(V.sheets[static_cast<std::size_t>(r)], V.x).head(dim_).transpose();
-    const Eigen::MatrixXd Jinv = J.inverse();
+    const Eigen::MatrixXd Jinv = jacobians_[static_cast<std::size_t>(order[static_cast<std::size_t>(v)])].inverse();
     for (int b = 0; b < octants; ++b) {
       const int root = uf.find(v * octants + b);
       int& l = label[static_cast<std::size_t>(root)];
