@@ -72,7 +72,14 @@ struct Case {
   std::vector<stc::Sheet> sheets;
   const char* expect;  // in the diagnosis; "" for a valid mesh
   std::size_t elements = 0;  // of the valid mesh
+  bool in_cell = false;       // in kCell instead of the unit box
 };
+
+// A skewed, tapered hexahedron around the unit box whose top face is the box's (z = 1): the
+// engine works on the composed fields, where a touching must still be found.
+const stc::Domain kCell = stc::Domain::hexahedron({Point(-0.2, -0.1, 0), Point(1.1, -0.2, 0), Point(1.2, 1.1, 0),
+                                                   Point(-0.1, 1.0, 0), Point(0, 0, 1), Point(1, 0, 1), Point(1, 1, 1),
+                                                   Point(0, 1, 1)});
 
 std::vector<stc::Sheet> with(std::vector<stc::Sheet> a, const std::vector<stc::Sheet>& b) {
   a.insert(a.end(), b.begin(), b.end());
@@ -121,13 +128,21 @@ TEST_CASE("tangency: sheets that touch away from any vertex are diagnosed, near 
        with(curve_cross(c), {plane(Point(0.49 + kRho, 0, 0), Point(1, 0, 0), "p")}), "", 12},
       {"sphere touching a box face", 3, ball_in_cross(Point(0.5, 0.5, 0.7), 0.3, 3), "touch"},
       {"sphere 1e-2 short of a box face", 3, ball_in_cross(Point(0.5, 0.5, 0.69), 0.3, 3), "", 7},
+      {"in a hexahedron: sphere touching plane", 3,
+       with(ball_in_cross(c, 0.3, 3), {plane(Point(0.8, 0, 0), Point(1, 0, 0), "p")}), "touch", 0, true},
+      {"in a hexahedron: sphere 1e-2 short of plane", 3,
+       with(ball_in_cross(c, 0.3, 3), {plane(Point(0.81, 0, 0), Point(1, 0, 0), "p")}), "", 8, true},
+      {"in a hexahedron: sphere touching its top face", 3, ball_in_cross(Point(0.5, 0.5, 0.7), 0.3, 3),
+       "touches the domain boundary (face 5)", 0, true},
+      {"in a hexahedron: sphere 1e-2 short of its top face", 3, ball_in_cross(Point(0.5, 0.5, 0.69), 0.3, 3), "", 7,
+       true},
       {"circle touching a square side", 2, ball_in_cross(Point(0.5, 0.7, 0), 0.3, 2), "touch"},
       {"circle 1e-2 short of a square side", 2, ball_in_cross(Point(0.5, 0.69, 0), 0.3, 2), "", 5},
   };
   for (const Case& k : cases) {
     CAPTURE(k.name);
     std::size_t elements = 0;
-    const std::string msg = diagnosis(k.sheets, k.dim == 3 ? kBox : kSquare, elements);
+    const std::string msg = diagnosis(k.sheets, k.in_cell ? kCell : k.dim == 3 ? kBox : kSquare, elements);
     CAPTURE(msg);
     if (*k.expect) {
       CHECK(msg.find(k.expect) != std::string::npos);
