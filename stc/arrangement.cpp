@@ -711,7 +711,8 @@ void Engine::check_touching(const std::vector<Curve>& curves) const {
               }
               if (!extremum || std::abs(v) > spread) continue;
               Point x = grid_node(p[0], p[1], p[2]);
-              if (!common_zero({s}, face, x) || !inside(x)) continue;
+              // On the face only to the solver's tolerance: allow for that, not more.
+              if (!common_zero({s}, face, x) || !inside(x, 1e-6 * diag_)) continue;
               if (sine(grad(s, x), Point::Unit(axis)) < kParallel)
                 throw TopologyError("arrangement: sheet " + name(s) + " touches the domain boundary (face " +
                                     std::to_string(box_face(axis, high == 1)) + ") at " + fmt_point(x, dim_) +
