@@ -6,21 +6,91 @@
 #include <cmath>
 #include <numeric>
 #include <sstream>
+#include <unordered_map>
 
 #include "primal/disjoint_sets.hpp"
 #include "primal/errors.hpp"
+#include "primal/topology.hpp"
 
 namespace geode::stc {
 namespace {
 
-
-std::string fmt_point(const Point& x, int dim) {
+std::string format_point(const Point& x, int dim) {
   std::ostringstream s;
   s.precision(6);
   s << "(" << x[0] << ", " << x[1];
   if (dim == 3) s << ", " << x[2];
   s << ")";
   return s.str();
+}
+
+// Length of the first dim components (no dynamic-size head(): GCC 12 misreads it as out of
+// bounds under -Warray-bounds).
+double norm_d(const Point& v, int dim) { return dim == 3 ? v.norm() : std::hypot(v[0], v[1]); }
+
+// Trilinear (bilinear for dim 2) map of the unit cube onto the hexahedron (quadrilateral)
+// with VTK corners P: corner c's shape function is the product over the axes of r or 1 - r.
+Point multilinear(const std::array<Point, 8>& P, const Point& r, int dim) {
+  Point x = Point::Zero();
+  for (int c = 0; c < (1 << dim); ++c) {
+    const auto& rc = primal::topology::kHexCornerCoords[static_cast<std::size_t>(c)];
+    double w = 1.0;
+    for (int a = 0; a < dim; ++a) w *= rc[static_cast<std::size_t>(a)] ? r[a] : 1.0 - r[a];
+    x += w * P[static_cast<std::size_t>(c)];
+  }
+  if (dim == 2) x[2] = 0.0;
+  return x;
+}
+
+// Determinant of the map's Jacobian at local coordinates r (columns d/dr, d/ds, d/dt).
+double multilinear_jacobian(const std::array<Point, 8>& P, const Point& r, int dim) {
+  Eigen::Matrix3d J = Eigen::Matrix3d::Zero();
+  for (int c = 0; c < (1 << dim); ++c) {
+    const auto& rc = primal::topology::kHexCornerCoords[static_cast<std::size_t>(c)];
+    for (int d = 0; d < dim; ++d) {
+      double w = rc[static_cast<std::size_t>(d)] ? 1.0 : -1.0;
+      for (int a = 0; a < dim; ++a)
+        if (a != d) w *= rc[static_cast<std::size_t>(a)] ? r[a] : 1.0 - r[a];
+      J.col(d) += w * P[static_cast<std::size_t>(c)];
+    }
+  }
+  return dim == 3 ? J.determinant() : J(0, 0) * J(1, 1) - J(0, 1) * J(1, 0);
+}
+
+Domain make_cell_domain(const std::array<Point, 8>& P, int dim) {
+  const char* what = dim == 3 ? "hexahedron" : "quadrilateral";
+  const int n = 1 << dim;
+  Point lo = Point::Constant(1e300), hi = Point::Constant(-1e300);
+  for (int c = 0; c < n; ++c) {
+    if (!P[static_cast<std::size_t>(c)].allFinite())
+      throw InvalidInput(std::string("domain: ") + what + " corner " + std::to_string(c) + " is not finite");
+    lo = lo.cwiseMin(P[static_cast<std::size_t>(c)]);
+    hi = hi.cwiseMax(P[static_cast<std::size_t>(c)]);
+  }
+  const double size = norm_d(hi - lo, dim);
+  if (!(size > 0)) throw InvalidInput(std::string("domain: degenerate ") + what + " (all corners coincide)");
+  // Positive at every corner and at the centre: the test the mesh-quality literature uses
+  // for a valid trilinear element (Knupp's corner Jacobians plus the centre). Relative to the
+  // cell's size so that a flattened cell is refused too.
+  const double floor = 1e-12 * std::pow(size, dim);
+  for (int c = 0; c <= n; ++c) {
+    Point r = Point::Constant(0.5);
+    if (c < n)
+      for (int a = 0; a < 3; ++a) r[a] = primal::topology::kHexCornerCoords[static_cast<std::size_t>(c)][static_cast<std::size_t>(a)];
+    const double j = multilinear_jacobian(P, r, dim);
+    if (!(j > floor))
+      throw InvalidInput(std::string("domain: the ") + what + "'s Jacobian is not positive at " +
+                         (c < n ? "corner " + std::to_string(c) + " " + format_point(P[static_cast<std::size_t>(c)], dim)
+                                : std::string("its centre")) +
+                         " (det " + std::to_string(j) + "): corners must be in VTK order" +
+                         (dim == 3 ? " (bottom 0-1-2-3 counter-clockwise seen from above, 4-7 above them)"
+                                   : " (counter-clockwise)") +
+                         " and the cell not inverted or flat");
+  }
+  Domain d(lo, hi, dim);
+  if (dim == 2) d.lo[2] = d.hi[2] = 0.0;
+  d.corners = P;
+  return d;
 }
 
 // An event on a traced curve: the curve crosses sheet `sheet` at vertex position x, between
@@ -32,16 +102,22 @@ struct Event {
   int vertex = -1;
 };
 
+// Gradients whose angle has a sine below this are parallel: the sheets are tangent (about
+// 0.06 degrees; a touching point found to the engine's tolerance is far below it).
+constexpr double kParallel = 1e-3;
+
 class Engine {
  public:
   Engine(const std::vector<Sheet>& sheets, const Domain& domain, const ArrangementOptions& opt)
-      : sheets_(sheets), domain_(domain), options_(opt), dim_(domain.dim) {
-    if (dim_ != 2 && dim_ != 3) throw InvalidInput("arrangement: dimension must be 2 or 3");
+      : user_(domain),
+        domain_(reference_box(domain)),
+        mapped_(compose(sheets)),
+        sheets_(domain.corners ? mapped_ : sheets),
+        options_(opt),
+        dim_(domain.dim) {
     if (static_cast<int>(sheets.size()) < dim_)
       throw InvalidInput("arrangement: needs at least as many sheets as dimensions");
-    for (int i = 0; i < dim_; ++i)
-      if (!(domain.hi[i] > domain.lo[i])) throw InvalidInput("arrangement: empty domain");
-    diag_ = (domain.hi - domain.lo).head(dim_).norm();
+    diag_ = (domain_.hi - domain_.lo).head(dim_).norm();
     h_ = options_.step * diag_;
     grad_h_ = 1e-6 * diag_;
     tol_ = options_.tolerance * diag_;
@@ -50,6 +126,58 @@ class Engine {
   Arrangement run();
 
  private:
+  // The box the engine computes in. For a hexahedron: corner 0's position, and per axis the
+  // mean length of the cell's edges along it, so that the seeding grid, the step and the
+  // tolerances (all relative to this box) keep their meaning; for a hexahedron equal to a
+  // box it is that box.
+  static Domain reference_box(const Domain& d) {
+    if (d.dim != 2 && d.dim != 3) throw InvalidInput("arrangement: dimension must be 2 or 3");
+    if (!d.corners) {
+      for (int i = 0; i < d.dim; ++i)
+        if (!(d.hi[i] > d.lo[i])) throw InvalidInput("arrangement: empty domain");
+      return Domain(d.lo, d.hi, d.dim);
+    }
+    make_cell_domain(*d.corners, d.dim);  // throws on bad corners (they may be filled in by hand)
+    const auto& P = *d.corners;
+    Point len = Point::Zero();
+    for (const auto& e : primal::topology::kHexEdgeCorners) {
+      const Point v = P[static_cast<std::size_t>(e[1])] - P[static_cast<std::size_t>(e[0])];
+      const auto& a = primal::topology::kHexCornerCoords[static_cast<std::size_t>(e[0])];
+      const auto& b = primal::topology::kHexCornerCoords[static_cast<std::size_t>(e[1])];
+      int axis = 0;
+      while (a[static_cast<std::size_t>(axis)] == b[static_cast<std::size_t>(axis)]) ++axis;
+      if (d.dim == 2 && (axis == 2 || a[2] || b[2])) continue;  // the quad's 4 edges only
+      len[axis] += norm_d(v, d.dim) / (d.dim == 3 ? 4.0 : 2.0);
+    }
+    Point lo = P[0];
+    if (d.dim == 2) lo[2] = 0.0, len[2] = 0.0;
+    return Domain(lo, lo + len, d.dim);
+  }
+  // Every field composed with the map from the reference box to the hexahedron.
+  std::vector<Sheet> compose(const std::vector<Sheet>& sheets) const {
+    if (!user_.corners) return {};
+    std::vector<Sheet> out;
+    for (const Sheet& s : sheets) {
+      Sheet m{s.name, {}, s.kind};
+      m.field = [f = &s.field, P = *user_.corners, lo = domain_.lo, hi = domain_.hi, dim = user_.dim](const Point& u) {
+        Point r = Point::Zero();
+        for (int a = 0; a < dim; ++a) r[a] = (u[a] - lo[a]) / (hi[a] - lo[a]);
+        return (*f)(multilinear(P, r, dim));
+      };
+      out.push_back(std::move(m));
+    }
+    return out;
+  }
+  // Reference-box position -> local coordinates in [0, 1]^d -> physical position.
+  Point local(const Point& u) const {
+    Point r = Point::Zero();
+    for (int a = 0; a < dim_; ++a) r[a] = (u[a] - domain_.lo[a]) / (domain_.hi[a] - domain_.lo[a]);
+    return r;
+  }
+  Point physical(const Point& u) const { return user_.corners ? domain_point(user_, local(u)) : u; }
+  // Positions in messages are physical.
+  std::string fmt_point(const Point& u, int dim) const { return format_point(physical(u), dim); }
+
   double value(int s, const Point& x) const { return sheets_[static_cast<std::size_t>(s)].field(x); }
   Point grad(int s, const Point& x) const {
     return gradient(sheets_[static_cast<std::size_t>(s)].field, x, grad_h_, dim_);
@@ -128,11 +256,41 @@ class Engine {
                           int& end_face) const;
   Curve trace(const std::vector<int>& S, const Point& x0) const;
   std::vector<Event> events(const Curve& c) const;
+  void check_touching(const std::vector<Curve>& curves) const;
   int register_vertex(std::vector<int> sheets, const Point& x);
-  void check_vertex(const Vertex& v) const;
+  void check_vertex(const Vertex& v, const Eigen::MatrixXd& J) const;
+
+  // An equation for the touching search: sheet `sheet`'s field, or (sheet < 0) the domain
+  // face x[axis] = at.
+  struct Equation {
+    int sheet = -1;
+    int axis = 0;
+    double at = 0.0;
+  };
+  double eval(const Equation& e, const Point& x) const { return e.sheet >= 0 ? value(e.sheet, x) : x[e.axis] - e.at; }
+  Point eval_grad(const Equation& e, const Point& x) const {
+    return e.sheet >= 0 ? grad(e.sheet, x) : Point::Unit(e.axis);
+  }
+  bool common_zero(const Equation& a, const Equation& b, Point& x) const;
+  // Sine of the angle between two gradients (0: parallel or antiparallel).
+  double sine(const Point& a, const Point& b) const {
+    const double s = dim_ == 3 ? a.cross(b).norm() : std::abs(a[0] * b[1] - a[1] * b[0]);
+    return s / (a.norm() * b.norm());
+  }
 
   // Sampling grid for seeds, evaluated once for every sheet.
   void sample_grid();
+  int cell_count() const { return n_[0] * n_[1] * (dim_ == 3 ? n_[2] : 1); }
+  std::array<int, 3> cell_of(const Point& x) const {
+    std::array<int, 3> c{0, 0, 0};
+    for (int a = 0; a < dim_; ++a) {
+      const auto A = static_cast<std::size_t>(a);
+      const double t = (x[a] - domain_.lo[a]) / (domain_.hi[a] - domain_.lo[a]) * n_[A];
+      c[A] = std::clamp(static_cast<int>(std::floor(t)), 0, n_[A] - 1);
+    }
+    return c;
+  }
+  int cell_id(int i, int j, int k) const { return (k * n_[1] + j) * n_[0] + i; }
   Point grid_node(int i, int j, int k) const;
   std::size_t grid_id(int i, int j, int k) const {
     return static_cast<std::size_t>((k * (n_[1] + 1) + j) * (n_[0] + 1) + i);
@@ -140,12 +298,18 @@ class Engine {
   std::array<int, 3> n_{1, 1, 1};
   std::vector<std::vector<double>> grid_;
 
+  Domain user_;    // as given
+  Domain domain_;  // the reference box (user_ itself for a box)
+  std::vector<Sheet> mapped_;  // the fields composed with the map, for a hexahedron
   const std::vector<Sheet>& sheets_;
-  Domain domain_;
   ArrangementOptions options_;
   int dim_;
   double diag_, h_, grad_h_, tol_;
   std::vector<Vertex> vertices_;
+  std::vector<Eigen::MatrixXd> jacobians_;  // per vertex: its sheets' gradients as rows
+  // Vertices by their sheets (key: the sorted sheet indices in base sheet_count), for
+  // register_vertex's search; each list in registration order.
+  std::unordered_map<long long, std::vector<int>> vertices_by_sheets_;
 };
 
 Point Engine::grid_node(int i, int j, int k) const {
@@ -304,6 +468,11 @@ std::vector<Point> Engine::walk(const std::vector<int>& S, const Point& x0, Poin
 Curve Engine::trace(const std::vector<int>& S, const Point& x0) const {
   Curve c;
   c.sheets = S;
+  // Two surfaces that only touch have an isolated common point where the projection of a
+  // seed may land: no curve to trace, and their gradients are parallel there.
+  if (dim_ == 3 && sine(grad(S[0], x0), grad(S[1], x0)) < kParallel)
+    throw TopologyError("arrangement: sheets " + names(S) + " touch at " + fmt_point(x0, dim_) +
+                        " without crossing (tangent there; not in general position)");
   const Point t0 = tangent(S, x0).normalized();
   bool closed = false;
   int face_f = -1, face_b = -1;
@@ -333,6 +502,10 @@ std::vector<Event> Engine::events(const Curve& c) const {
     T.push_back(s);
     std::vector<double> v(n);
     for (std::size_t i = 0; i < n; ++i) v[i] = value(s, P[i]);
+    // Where the sheet comes close without a sign change, the point of the curve nearest to
+    // it: if the d sheets have a common point there that is not a crossing found below, the
+    // curve touches the sheet (a tangency away from any vertex of theirs).
+    std::vector<Point> touch;
     for (std::size_t i = 0; i < segs; ++i) {
       const std::size_t j = (i + 1) % n;
       // Sub-sample a segment where the sheet comes close without a sign change: it may cross
@@ -347,8 +520,25 @@ std::vector<Event> Engine::events(const Curve& c) const {
           sub.emplace_back(q / 16.0, y);
         }
       }
+      std::vector<double> sv(sub.size());
+      for (std::size_t q = 0; q < sub.size(); ++q) sv[q] = value(s, sub[q].second);
+      if (sub.size() > 2) {
+        // A touching point lies within half a sub-step of a sub-sample, where the field is
+        // then far below its gradient times a sub-step; a near miss farther away is not tried.
+        std::size_t best = 0;
+        bool change = false;
+        for (std::size_t q = 0; q < sub.size(); ++q) {
+          if (std::abs(sv[q]) < std::abs(sv[best])) best = q;
+          change = change || (sv[q] < 0) != (sv[0] < 0);
+        }
+        Point y = sub[best].second;
+        const double substep = (P[j] - P[i]).norm() / 16.0;
+        if (!change && std::abs(sv[best]) < grad(s, y).norm() * substep && project(T, y) &&
+            (y - sub[best].second).norm() < 16.0 * substep)
+          touch.push_back(y);
+      }
       for (std::size_t q = 0; q + 1 < sub.size(); ++q) {
-        const double a = value(s, sub[q].second), b = value(s, sub[q + 1].second);
+        const double a = sv[q], b = sv[q + 1];
         if ((a < 0) == (b < 0)) continue;
         const double f = a / (a - b);
         Point x = sub[q].second + f * (sub[q + 1].second - sub[q].second);
@@ -358,17 +548,225 @@ std::vector<Event> Engine::events(const Curve& c) const {
         out.push_back({static_cast<double>(i) + sub[q].first + f * (sub[q + 1].first - sub[q].first), s, x});
       }
     }
+    for (const Point& y : touch) {
+      bool crossing = false;
+      for (const Event& e : out) crossing = crossing || (e.sheet == s && (e.x - y).norm() < 1e-6 * diag_);
+      if (!crossing)
+        throw TopologyError("arrangement: the curve where sheets " + names(c.sheets) + " meet touches sheet " +
+                            name(s) + " at " + fmt_point(y, dim_) +
+                            " without crossing it (tangent there; not in general position)");
+    }
   }
   std::sort(out.begin(), out.end(), [](const Event& a, const Event& b) { return a.param < b.param; });
   return out;
 }
 
+// Levenberg-Marquardt on the two equations, each scaled by its gradient so that residuals are
+// distances: from x, look for a point where both vanish. Returns true with x there, false at
+// a local minimum of the residual that is not a common zero (a near miss) or when the search
+// leaves the domain. Near a touching point the system is singular and convergence only
+// linear, but the residual falls as the square of the distance: a few dozen steps suffice.
+bool Engine::common_zero(const Equation& a, const Equation& b, Point& x) const {
+  const double zero = 1e-9 * diag_;
+  double mu = 1e-3;
+  for (int it = 0; it < 60; ++it) {
+    const Point ga = eval_grad(a, x), gb = eval_grad(b, x);
+    const double na = ga.norm(), nb = gb.norm();
+    if (!(na > 1e-300 && nb > 1e-300)) return false;
+    const Eigen::Vector2d r(eval(a, x) / na, eval(b, x) / nb);
+    if (r.cwiseAbs().maxCoeff() < zero) return true;
+    Eigen::Matrix<double, 2, 3> J;
+    J.row(0) = (ga / na).transpose();
+    J.row(1) = (gb / nb).transpose();
+    if (dim_ == 2) J.col(2).setZero();
+    const Eigen::Matrix2d JJt = J * J.transpose();
+    bool accepted = false;
+    while (!accepted && mu < 1e8) {
+      const Eigen::Vector2d w = (JJt + mu * Eigen::Matrix2d::Identity()).ldlt().solve(r);
+      const Point y = x - J.transpose() * w;
+      const Eigen::Vector2d ry(eval(a, y) / na, eval(b, y) / nb);
+      if (ry.allFinite() && ry.squaredNorm() < r.squaredNorm()) {
+        x = y;
+        mu = std::max(mu / 3.0, 1e-12);
+        accepted = true;
+      } else {
+        mu *= 4.0;
+      }
+    }
+    if (!accepted || !inside(x, 0.1 * diag_)) return false;
+  }
+  return false;
+}
+
+// Sheets that touch without crossing leave no curve (3D) or no vertex (2D) behind, and a sheet
+// that touches the domain boundary no trace on it: nothing else notices them. Look where the
+// seeding grid says two zero sets come within about a cell of each other with nearly parallel
+// gradients, away from the curves already traced for that pair (vertices in 2D), and solve
+// for a common zero there. See the resolution limits in arrangement.hpp.
+void Engine::check_touching(const std::vector<Curve>& curves) const {
+  const int kcells = dim_ == 3 ? n_[2] : 1;
+  const int corners = dim_ == 3 ? 8 : 4;
+  const int ncell = cell_count();
+  const int m = static_cast<int>(sheets_.size());
+  std::array<double, 3> step{};
+  for (int a = 0; a < dim_; ++a)
+    step[static_cast<std::size_t>(a)] = (domain_.hi[a] - domain_.lo[a]) / n_[static_cast<std::size_t>(a)];
+  auto corner_id = [&](int i, int j, int k, int c) {
+    return grid_id(i + (c & 1), j + ((c >> 1) & 1), dim_ == 3 ? k + ((c >> 2) & 1) : 0);
+  };
+  // Per sheet and cell: is the zero set within about one cell (the smallest corner value no
+  // larger than the spread over the corners, which for a linear field is the gradient times
+  // the cell's extent along it).
+  std::vector<std::vector<char>> near(static_cast<std::size_t>(m), std::vector<char>(static_cast<std::size_t>(ncell), 0));
+  for (int s = 0; s < m; ++s) {
+    const auto& val = grid_[static_cast<std::size_t>(s)];
+    for (int k = 0; k < kcells; ++k)
+      for (int j = 0; j < n_[1]; ++j)
+        for (int i = 0; i < n_[0]; ++i) {
+          double lo = 1e300, hi = -1e300, least = 1e300;
+          for (int c = 0; c < corners; ++c) {
+            const double v = val[corner_id(i, j, k, c)];
+            lo = std::min(lo, v), hi = std::max(hi, v), least = std::min(least, std::abs(v));
+          }
+          near[static_cast<std::size_t>(s)][static_cast<std::size_t>(cell_id(i, j, k))] = least <= hi - lo;
+        }
+  }
+  // The field's gradient in a cell, estimated from its corners.
+  auto slope = [&](int s, int id) {
+    const int i = id % n_[0], j = (id / n_[0]) % n_[1], k = id / (n_[0] * n_[1]);
+    const auto& val = grid_[static_cast<std::size_t>(s)];
+    Point g = Point::Zero();
+    for (int c = 0; c < corners; ++c) {
+      const double v = val[corner_id(i, j, k, c)];
+      for (int a = 0; a < dim_; ++a)
+        g[a] += ((c >> a) & 1 ? v : -v) / (step[static_cast<std::size_t>(a)] * (corners / 2));
+    }
+    return g;
+  };
+  auto centre = [&](int id) {
+    const int i = id % n_[0], j = (id / n_[0]) % n_[1], k = id / (n_[0] * n_[1]);
+    return Point(0.5 * (grid_node(i, j, k) + grid_node(i + 1, j + 1, dim_ == 3 ? k + 1 : 0)));
+  };
+  // Cells within `r` cells of x; consecutive calls from the same cell are skipped (a polyline
+  // has many points per cell).
+  std::array<int, 3> last{-1, -1, -1};
+  auto mark = [&](std::vector<char>& covered, const Point& x, int r) {
+    const auto c = cell_of(x);
+    if (c == last) return;
+    last = c;
+    for (int k = std::max(0, c[2] - r); k <= std::min(kcells - 1, c[2] + r); ++k)
+      for (int j = std::max(0, c[1] - r); j <= std::min(n_[1] - 1, c[1] + r); ++j)
+        for (int i = std::max(0, c[0] - r); i <= std::min(n_[0] - 1, c[0] + r); ++i)
+          covered[static_cast<std::size_t>(cell_id(i, j, k))] = 1;
+  };
+
+  // Pairs of sheets. A common zero with parallel gradients is a touching point; one with
+  // crossing gradients must lie on a traced curve (3D) or be a vertex (2D), else a piece of
+  // the arrangement smaller than the seeding grid was missed.
+  std::vector<char> covered(static_cast<std::size_t>(ncell));
+  for (int a = 0; a < m; ++a)
+    for (int b = a + 1; b < m; ++b) {
+      const std::vector<int> S{a, b};
+      std::fill(covered.begin(), covered.end(), 0);
+      last = {-1, -1, -1};
+      std::vector<const Curve*> mine;
+      std::vector<Point> crossings;
+      if (dim_ == 3) {
+        for (const Curve& c : curves)
+          if (c.sheets == S) {
+            mine.push_back(&c);
+            for (const Point& p : c.polyline) mark(covered, p, 2);
+          }
+      } else {
+        for (const Vertex& v : vertices_)
+          if (v.sheets == S) {
+            crossings.push_back(v.x);
+            mark(covered, v.x, 2);
+          }
+      }
+      for (int id = 0; id < ncell; ++id) {
+        const auto I = static_cast<std::size_t>(id);
+        if (covered[I] || !near[static_cast<std::size_t>(a)][I] || !near[static_cast<std::size_t>(b)][I]) continue;
+        // Zero sets crossing at more than 45 degrees here: a crossing, not a touching.
+        const Point ga = slope(a, id), gb = slope(b, id);
+        if (ga.norm() > 0 && gb.norm() > 0 && sine(ga, gb) > 0.7) continue;
+        covered[I] = 1;
+        Point x = centre(id);
+        const bool zero = common_zero({a}, {b}, x);
+        last = {-1, -1, -1};
+        if (inside(x)) mark(covered, x, 1);  // later starts nearby would end there too
+        if (!zero || !inside(x)) continue;
+        if (sine(grad(a, x), grad(b, x)) < kParallel)
+          throw TopologyError("arrangement: sheets " + names(S) + " touch at " + fmt_point(x, dim_) +
+                              " without crossing (tangent there; not in general position)");
+        double best = 1e300;
+        for (const Curve* c : mine)
+          for (const Point& p : c->polyline) best = std::min(best, (p - x).norm());
+        for (const Point& p : crossings) best = std::min(best, (p - x).norm());
+        if (best > (dim_ == 3 ? 2.0 * h_ : 1e-6 * diag_))
+          throw TopologyError("arrangement: sheets " + names(S) + " meet at " + fmt_point(x, dim_) + " but no " +
+                              (dim_ == 3 ? "curve traced for them passes there" : "vertex was found there") +
+                              ": a piece smaller than the seeding grid was missed (raise the seed resolution)");
+      }
+    }
+
+  // A sheet and a domain face: a common zero where the sheet's gradient is normal to the face
+  // is a touching point. There the field restricted to the face has an extremum near zero:
+  // start from every face node of the grid whose value is the smallest in size among its
+  // neighbours on the face, all of the same sign, and within a grid step of zero by their
+  // differences. A trace crossing the face has a sign change next to it and starts nothing.
+  for (int axis = 0; axis < dim_; ++axis)
+    for (int high = 0; high < 2; ++high) {
+      const Equation face{-1, axis, high ? domain_.hi[axis] : domain_.lo[axis]};
+      std::array<int, 3> top{n_[0], n_[1], dim_ == 3 ? n_[2] : 0};
+      const auto A = static_cast<std::size_t>(axis);
+      for (int s = 0; s < m; ++s) {
+        const auto& val = grid_[static_cast<std::size_t>(s)];
+        std::array<int, 3> p{0, 0, 0}, from{0, 0, 0}, to = top;
+        from[A] = to[A] = high ? top[A] : 0;
+        for (p[2] = from[2]; p[2] <= to[2]; ++p[2])
+          for (p[1] = from[1]; p[1] <= to[1]; ++p[1])
+            for (p[0] = from[0]; p[0] <= to[0]; ++p[0]) {
+              const double v = val[grid_id(p[0], p[1], p[2])];
+              bool extremum = true;
+              double spread = 0.0;
+              int sign = v < 0 ? -1 : v > 0 ? 1 : 0;  // of the node, or of its first nonzero neighbour
+              for (int d = 0; d < 27 && extremum; ++d) {
+                std::array<int, 3> q{p[0] + d % 3 - 1, p[1] + (d / 3) % 3 - 1, p[2] + d / 9 - 1};
+                if (q[A] != p[A] || q == p) continue;
+                bool in = true;
+                for (std::size_t a = 0; a < 3; ++a) in = in && q[a] >= 0 && q[a] <= top[a];
+                if (!in) continue;
+                const double w = val[grid_id(q[0], q[1], q[2])];
+                const int sw = w < 0 ? -1 : w > 0 ? 1 : 0;
+                if (sign == 0) sign = sw;
+                extremum = (sw == 0 || sw == sign) && std::abs(v) <= std::abs(w);
+                spread = std::max(spread, std::abs(w - v));
+              }
+              if (!extremum || std::abs(v) > spread) continue;
+              Point x = grid_node(p[0], p[1], p[2]);
+              // On the face only to the solver's tolerance: allow for that, not more.
+              if (!common_zero({s}, face, x) || !inside(x, 1e-6 * diag_)) continue;
+              if (sine(grad(s, x), Point::Unit(axis)) < kParallel)
+                throw TopologyError("arrangement: sheet " + name(s) + " touches the domain boundary (face " +
+                                    std::to_string(box_face(axis, high == 1)) + ") at " + fmt_point(x, dim_) +
+                                    " without crossing it (tangent to it; not in general position)");
+            }
+      }
+    }
+}
+
 int Engine::register_vertex(std::vector<int> S, const Point& x) {
   std::sort(S.begin(), S.end());
-  for (std::size_t i = 0; i < vertices_.size(); ++i) {
-    if (vertices_[i].sheets == S && (vertices_[i].x - x).norm() < 1e-7 * diag_) {
-      ++vertices_[i].found;
-      return static_cast<int>(i);
+  long long key = 0;
+  for (int s : S) key = key * static_cast<long long>(sheets_.size()) + s;
+  std::vector<int>& same = vertices_by_sheets_[key];
+  // The first match in registration order, as a scan over all vertices would find.
+  for (int i : same) {
+    Vertex& v = vertices_[static_cast<std::size_t>(i)];
+    if ((v.x - x).norm() < 1e-7 * diag_) {
+      ++v.found;
+      return i;
     }
   }
   Vertex v;
@@ -378,18 +776,16 @@ int Engine::register_vertex(std::vector<int> S, const Point& x) {
   Eigen::MatrixXd J(dim_, dim_);
   for (int r = 0; r < dim_; ++r) J.row(r) = grad(S[static_cast<std::size_t>(r)], x).head(dim_).transpose();
   v.orientation = J.determinant() > 0 ? 1 : -1;
-  check_vertex(v);
+  check_vertex(v, J);
   vertices_.push_back(v);
+  jacobians_.push_back(std::move(J));
+  same.push_back(static_cast<int>(vertices_.size() - 1));
   return static_cast<int>(vertices_.size() - 1);
 }
 
-void Engine::check_vertex(const Vertex& v) const {
-  Eigen::MatrixXd J(dim_, dim_);
+void Engine::check_vertex(const Vertex& v, const Eigen::MatrixXd& J) const {
   double prod = 1.0;
-  for (int r = 0; r < dim_; ++r) {
-    J.row(r) = grad(v.sheets[static_cast<std::size_t>(r)], v.x).head(dim_).transpose();
-    prod *= J.row(r).norm();
-  }
+  for (int r = 0; r < dim_; ++r) prod *= J.row(r).norm();
   if (std::abs(J.determinant()) < 1e-6 * prod)
     throw TopologyError("arrangement: sheets " + names(v.sheets) + " meet tangentially at " + fmt_point(v.x, dim_) +
                         " (not in general position)");
@@ -408,7 +804,7 @@ void Engine::check_vertex(const Vertex& v) const {
 
 Arrangement Engine::run() {
   Arrangement A;
-  A.domain = domain_;
+  A.domain = user_;
   A.sheet_count = static_cast<int>(sheets_.size());
   for (const auto& s : sheets_) A.sheet_names.push_back(s.name);
 
@@ -496,6 +892,7 @@ Arrangement Engine::run() {
            n - 1.0);
     }
   }
+  check_touching(A.curves);
   for (const Vertex& v : vertices_)
     if (v.found != dim_)
       throw TopologyError("arrangement: the vertex of sheets " + names(v.sheets) + " at " + fmt_point(v.x, dim_) +
@@ -563,9 +960,7 @@ Arrangement Engine::run() {
   A.region.assign(static_cast<std::size_t>(nv), {-1, -1, -1, -1, -1, -1, -1, -1});
   for (int v = 0; v < nv; ++v) {
     const Vertex& V = A.vertices[static_cast<std::size_t>(v)];
-    Eigen::MatrixXd J(dim_, dim_);
-    for (int r = 0; r < dim_; ++r) J.row(r) = grad(V.sheets[static_cast<std::size_t>(r)], V.x).head(dim_).transpose();
-    const Eigen::MatrixXd Jinv = J.inverse();
+    const Eigen::MatrixXd Jinv = jacobians_[static_cast<std::size_t>(order[static_cast<std::size_t>(v)])].inverse();
     for (int b = 0; b < octants; ++b) {
       const int root = uf.find(v * octants + b);
       int& l = label[static_cast<std::size_t>(root)];
@@ -594,10 +989,40 @@ Arrangement Engine::run() {
                             " meet): the curves were traced inconsistently");
     }
   }
+  // Report physical positions (the identity for a box). A vertex's orientation was taken
+  // from the composed fields' gradients: it is the physical one where the map's Jacobian is
+  // positive, which the corner and centre test does not promise everywhere.
+  for (Vertex& v : A.vertices) {
+    v.local = local(v.x);
+    if (user_.corners && !(multilinear_jacobian(*user_.corners, v.local, dim_) > 0))
+      throw InvalidInput("arrangement: the domain cell folds over (Jacobian not positive) where sheets " +
+                         names(v.sheets) + " meet at " + fmt_point(v.x, dim_));
+    v.x = physical(v.x);
+  }
+  if (user_.corners) {
+    for (Edge1& e : A.edges) e.a.x = physical(e.a.x), e.b.x = physical(e.b.x);
+    for (Curve& c : A.curves)
+      for (Point& p : c.polyline) p = physical(p);
+  }
   return A;
 }
 
 }  // namespace
+
+Domain Domain::hexahedron(const std::array<Point, 8>& corners) { return make_cell_domain(corners, 3); }
+
+Domain Domain::quadrilateral(const std::array<Point, 4>& corners) {
+  std::array<Point, 8> P;
+  for (std::size_t c = 0; c < 8; ++c) P[c] = corners[c % 4];  // 4-7 unused in 2D
+  return make_cell_domain(P, 2);
+}
+
+Point domain_point(const Domain& domain, const Point& r) {
+  if (domain.corners) return multilinear(*domain.corners, r, domain.dim);
+  Point x = Point::Zero();
+  for (int a = 0; a < domain.dim; ++a) x[a] = domain.lo[a] + (domain.hi[a] - domain.lo[a]) * r[a];
+  return x;
+}
 
 Arrangement compute_arrangement(const std::vector<Sheet>& sheets, const Domain& domain,
                                 const ArrangementOptions& options) {

@@ -1,6 +1,6 @@
 #pragma once
-// The arrangement of sheets inside a box (3D) or rectangle (2D), computed to the precision
-// of Newton's method on the sheets' fields.
+// The arrangement of sheets inside a box or hexahedron (3D), rectangle or quadrilateral (2D),
+// computed to the precision of Newton's method on the sheets' fields.
 //
 // Route: for every set of d-1 sheets (pairs in 3D, single curves in 2D) the engine traces
 // the curve where they meet (predictor-corrector, seeded from a coarse sampling grid and
@@ -15,7 +15,28 @@
 // vertex on the domain boundary, a curve leaving through a box edge, a curve with no vertex,
 // a vertex missed by one of its curves are thrown as TopologyError naming the sheets and
 // the point. Cells that are not balls are caught when dualizing (stc/dualize.hpp).
+//
+// Tangencies away from vertices leave nothing behind to trace, so they are searched for:
+//  - two sheets that touch (3D: surfaces meeting at an isolated point; 2D: curves touching):
+//    from every seeding-grid cell where both zero sets come within about a cell and their
+//    gradients, estimated from the grid, are within 45 degrees of parallel, and which is more
+//    than two cells from the curves traced for that pair (2D: from its vertices),
+//    Levenberg-Marquardt looks for a common zero; one with gradients parallel to within
+//    sin 1e-3 is a touching, one with crossing gradients must lie on a traced curve (be a
+//    vertex), else a piece of the arrangement smaller than the grid was missed;
+//  - a curve that touches a third sheet (2D: a curve touching another): along the traced
+//    curve, where that sheet's field comes close without changing sign;
+//  - a sheet that touches a domain face: from grid nodes on the face where the field is a
+//    discrete extremum of one sign within a grid step of zero.
+// Resolution limits, honestly: a common zero counts as one when both fields are below 1e-9
+// of the domain diagonal times their gradients, so sheets closer than about 2e-9 diagonals
+// are reported as touching; sheets crossing at an angle below about 0.06 degrees are
+// reported as tangent. A touching is found only if the grid sees both zero sets near it:
+// features much smaller than a seeding cell (a sphere of radius below a cell touching a
+// plane) can pass unseen, as can a touching within two cells of a traced curve of the same
+// two sheets. Raising seed_resolution tightens all of these.
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,14 +45,39 @@
 
 namespace geode::stc {
 
-// Axis-aligned box; dim 2 uses x and y only (z of lo and hi ignored).
+// The domain: an axis-aligned box (dim 2 uses x and y only, z of lo and hi ignored), or a
+// hexahedron given by its 8 corners in VTK order (primal/topology.hpp), or in 2D a
+// quadrilateral given by 4 corners counter-clockwise.
+//
+// A hexahedron is the trilinear (a quadrilateral the bilinear) image of the unit cube: local
+// coordinates (r, s, t) in [0, 1]^d, corner c at kHexCornerCoords[c]. The engine computes in
+// a box of the same proportions, on every sheet's field composed with that map, so planar
+// box faces and straight box edges are exactly the hexahedron's (possibly curved) faces and
+// edges; every position it reports is mapped back to physical space.
 struct Domain {
-  Point lo = Point::Zero();
+  Point lo = Point::Zero();  // the box; for a hexahedron, its bounding box (informative)
   Point hi = Point::Ones();
   int dim = 3;
+  std::optional<std::array<Point, 8>> corners;  // set for a hexahedron / quadrilateral
+
+  Domain() = default;
+  Domain(const Point& box_lo, const Point& box_hi, int d = 3) : lo(box_lo), hi(box_hi), dim(d) {}
+  // Throw InvalidInput naming the corner when the map's Jacobian is not positive at a corner
+  // or at the centre (corners out of VTK order, or an inverted / degenerate hexahedron).
+  static Domain hexahedron(const std::array<Point, 8>& corners);
+  static Domain quadrilateral(const std::array<Point, 4>& corners);
 };
 
-// Domain boundary pieces: face 2*axis + (0 for the low side, 1 for the high side).
+// Physical position of the local coordinates (r, s, t) in [0, 1]^d of the domain (for a box,
+// lo + (hi - lo) * r componentwise).
+Point domain_point(const Domain& domain, const Point& local);
+
+// Domain boundary pieces: face 2*axis + (0 for the low side, 1 for the high side), axis in
+// local coordinates. For a hexahedron, with VTK corners (primal/topology.hpp):
+//   face 0: r = 0, corners 0 3 7 4   face 1: r = 1, corners 1 2 6 5
+//   face 2: s = 0, corners 0 1 5 4   face 3: s = 1, corners 3 2 6 7
+//   face 4: t = 0, corners 0 1 2 3   face 5: t = 1, corners 4 5 6 7
+// and for a quadrilateral: face 0 = edge 3-0, 1 = edge 1-2, 2 = edge 0-1, 3 = edge 2-3.
 inline int box_face(int axis, bool high) { return 2 * axis + (high ? 1 : 0); }
 
 struct ArrangementOptions {
@@ -48,6 +94,7 @@ struct ArrangementOptions {
 struct Vertex {
   std::vector<int> sheets;  // sorted ascending, d entries
   Point x;
+  Point local;  // x in the domain's local coordinates (domain_point(domain, local) == x)
   int orientation = 1;  // sign of det of the sheets' gradients, in sheet order
   int found = 0;        // how many of its d curves reported it (must be d)
 };

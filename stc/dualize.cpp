@@ -164,14 +164,18 @@ DualMesh dualize(const Arrangement& A) {
     throw TopologyError("dualize: " + std::to_string(A.region_count - static_cast<int>(nodes)) +
                         " region(s) touch no vertex: a cell with no element around it");
 
-  // Node positions: the mean of the vertices around the region, put onto the box features it
-  // touches. A first guess only: node placement and smoothing come later.
+  // Node positions: the mean of the vertices around the region, put onto the domain faces
+  // it touches. In a hexahedral domain taken in local coordinates, where faces are planes,
+  // and mapped, so the node stays inside; in a box (an affine image of its local
+  // coordinates, so the same point) in physical ones, as results before hexahedral domains
+  // were, bit for bit. A first guess only: node placement and smoothing come later.
+  const bool cell = A.domain.corners.has_value();
   std::vector<primal::Point> sum(nodes, primal::Point::Zero());
   std::vector<int> count(nodes, 0);
   auto accumulate = [&](const auto& elements) {
     for (std::size_t e = 0; e < elements.size(); ++e)
       for (auto n : elements[e]) {
-        sum[static_cast<std::size_t>(n)] += D.element_centres[e];
+        sum[static_cast<std::size_t>(n)] += cell ? A.vertices[e].local : A.vertices[e].x;
         ++count[static_cast<std::size_t>(n)];
       }
   };
@@ -182,10 +186,10 @@ DualMesh dualize(const Arrangement& A) {
     primal::Point p = sum[n] / count[n];
     const unsigned f = A.region_faces[static_cast<std::size_t>(r)];
     for (int axis = 0; axis < dim; ++axis) {
-      if ((f >> (2 * axis)) & 1u) p[axis] = A.domain.lo[axis];
-      if ((f >> (2 * axis + 1)) & 1u) p[axis] = A.domain.hi[axis];
+      if ((f >> (2 * axis)) & 1u) p[axis] = cell ? 0.0 : A.domain.lo[axis];
+      if ((f >> (2 * axis + 1)) & 1u) p[axis] = cell ? 1.0 : A.domain.hi[axis];
     }
-    pts[n] = p;
+    pts[n] = cell ? domain_point(A.domain, p) : p;
     D.node_faces.push_back(f);
     D.node_signs.push_back(A.region_signs[static_cast<std::size_t>(r)]);
   }

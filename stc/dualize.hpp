@@ -15,7 +15,8 @@ struct DualMesh {
   int dim = 3;
   primal::HexMesh hex;    // dim 3
   primal::QuadMesh quad;  // dim 2
-  // Per node: the box faces its region touches (bit 2*axis + high); 0 for interior nodes.
+  // Per node: the domain faces its region touches (bit stc::box_face(axis, high), axis in
+  // the domain's local coordinates); 0 for interior nodes.
   std::vector<unsigned> node_faces;
   // Per node: the region's sign over every sheet (+1/-1).
   std::vector<std::vector<int>> node_signs;
