@@ -193,6 +193,11 @@ TEST_CASE("round trip: meshes the fields cannot represent are refused with the r
     CHECK_THROWS_WITH_AS(stc::sheet_fields(g), doctest::Contains("is inverted or flat at its corner"),
                          InvalidInput);
   }
+  SUBCASE("a chord that does not separate (an annulus: a 3 x 3 grid without its centre)") {
+    QuadMesh ring = gt::structured_quad_grid(3, 3);
+    ring.quads.erase(ring.quads.begin() + 4);  // quad (1, 1)
+    CHECK_THROWS_WITH_AS(stc::sheet_fields(ring), doctest::Contains("does not separate the mesh"), TopologyError);
+  }
   SUBCASE("a self-intersecting chord") {
     // The band of tests/stc/mesh_dual_test.cpp: chord 0 crosses itself in quad 0. Topology is
     // checked before geometry, so the (unplaceable) band is refused for its chord.
