@@ -550,7 +550,11 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
   by_key = primal::KeyMap<4>();
   for (auto* v : {&gh, &gt, &renum}) *v = {};
   points = {}, origin_key = {}, inst_global = {}, inst_side = {};
-  res.min_scaled_jacobian_before_smoothing = min_scaled_jacobian(mesh);
+  // Without smoothing the positions do not change: the inverted hexes found here are the
+  // verification's too.
+  std::vector<Index> bad;
+  res.min_scaled_jacobian_before_smoothing =
+      min_scaled_jacobian(mesh, options.smooth == ConformSmooth::kNone ? &bad : nullptr);
 
   // 6. Smoothing, model boundary nodes fixed. Local: one small problem per buffer hex (its 26
   // geode hexes' nodes move, with every hex touching them; the rest is fixed), swept in order,
@@ -648,8 +652,7 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
   t0 = Clock::now();
   res.validity = primal::check_validity(mesh);
   if (!res.validity.ok()) res.warnings.push_back("invalid mesh: " + res.validity.summary());
-  std::vector<Index> bad;
-  min_scaled_jacobian(mesh, &bad);
+  if (options.smooth != ConformSmooth::kNone) min_scaled_jacobian(mesh, &bad);
   if (!bad.empty()) {
     std::ostringstream m;
     m << bad.size() << " hexes with scaled Jacobian <= 0:";
