@@ -306,7 +306,26 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
   std::vector<FaceKey> origin_key(V);  // per global node; {-1..} for cell / template nodes
   for (Index v = 0; v < V; ++v) origin_key[v] = {v, kInvalidIndex, kInvalidIndex, kInvalidIndex};
   const FaceKey kNoKey{kInvalidIndex, kInvalidIndex, kInvalidIndex, kInvalidIndex};
-  primal::KeyMap<4> by_key(dh.mesh.points.size() + dt.mesh.points.size() - 2 * lm.points.size());
+  // A diced node can be met twice (by the other part's dicing, or as a template's tet/hex-side
+  // node) only if every origin node of it is a buffer hex corner or used by both parts; dice()
+  // numbers each origin once per part, so only those go through the map (a few per interface
+  // quad instead of every diced edge and face).
+  std::vector<char> shared(static_cast<std::size_t>(V), 0);
+  {
+    std::vector<char> in_hex(static_cast<std::size_t>(V), 0);
+    for (const auto& h : lm.hexes)
+      for (Index v : h) in_hex[v] = 1;
+    for (const auto& t : lm.tets)
+      for (Index v : t) shared[v] |= in_hex[v];
+    for (const auto& b : layer.hexes)
+      for (Index v : b.corners) shared[v] = 1;
+  }
+  auto may_meet = [&](const FaceKey& key) {
+    for (Index v : key)
+      if (v != kInvalidIndex && !shared[v]) return false;
+    return true;
+  };
+  primal::KeyMap<4> by_key(16 * layer.hexes.size());
   auto add_node = [&](const Point& p, const FaceKey& key) {
     points.push_back(p);
     origin_key.push_back(key);
@@ -325,6 +344,10 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
         continue;
       }
       const FaceKey key = normalized(o.nodes);
+      if (!may_meet(key)) {
+        g[i] = add_node(d.mesh.points[i], key);
+        continue;
+      }
       auto [id, inserted] = by_key.try_emplace(key, kInvalidIndex);
       if (inserted) *id = add_node(d.mesh.points[i], key);
       g[i] = *id;
@@ -332,6 +355,11 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
     return g;
   };
   std::vector<Index> gh = global_of(dh), gt = global_of(dt);
+  // Positions now live in `points`; origins are needed again only for side sets.
+  for (primal::DicedHexMesh* d : {&dh, &dt}) {
+    d->mesh.points = {};
+    if (lm.side_sets.empty()) d->origin = {};
+  }
   res.diced_hexes = static_cast<Index>(dh.mesh.hexes.size());
   res.diced_tet_hexes = static_cast<Index>(dt.mesh.hexes.size());
   say("dicing: " + std::to_string(res.diced_hexes) + " hexes from hexes, " +
@@ -394,6 +422,7 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
       }
     }
   }
+  by_key = primal::KeyMap<4>();  // every template node is placed
   // Side faces shared by two buffer hexes.
   std::unordered_map<FaceKey, std::vector<std::pair<int, int>>, primal::IndexArrayHash> side_uses;
   for (std::size_t b = 0; b < nb; ++b)
@@ -547,7 +576,6 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
     }
   }
   dh = {}, dt = {};
-  by_key = primal::KeyMap<4>();
   for (auto* v : {&gh, &gt, &renum}) *v = {};
   points = {}, origin_key = {}, inst_global = {}, inst_side = {};
   // Without smoothing the positions do not change: the inverted hexes found here are the
