@@ -632,7 +632,10 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
       }
       for (Index v : movable) cons[local[v]] = primal::NodeConstraint::free();
       if (!sub.hexes.empty()) {
-        const primal::SmoothResult r = primal::smooth_hex_mesh(sub, cons, options.smooth_options);
+        const primal::SmoothResult r = primal::smooth_hex_mesh(
+            sub, cons,
+            options.smooth == ConformSmooth::kLocal ? options.local_smooth_options
+                                                    : options.smooth_options);
         // Keep the patch only if it did not lower its minimum (the optimiser returns its best
         // iterate, but an untangling failure could still leave it worse).
         if (r.final_min_scaled_jacobian >= r.initial_min_scaled_jacobian)
