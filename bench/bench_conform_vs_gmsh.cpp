@@ -18,7 +18,8 @@
 //
 // Usage: bench_conform_vs_gmsh [n] [repeats] [geode-executable]
 //   n default 40, repeats default 1, geode default: `geode` next to this program; gmsh is
-//   /usr/bin/gmsh unless GMSH is set in the environment. Exit 0 when every child succeeded.
+//   /usr/bin/gmsh unless GMSH is set in the environment; GEODE_BENCH_KEEP set keeps the
+//   temporary directory (inputs, outputs, logs). Exit 0 when every child succeeded.
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -205,7 +206,11 @@ int main(int argc, char** argv) {
   std::printf("geode conform / gmsh subdivide+save: time %.2fx, memory %.2fx; output %s\n",
               conform.seconds / sub_save.seconds, conform.peak_mib / sub_save.peak_mib,
               geode_valid ? "valid" : "INVALID");
-  std::error_code ec;
-  fs::remove_all(dir, ec);
+  if (std::getenv("GEODE_BENCH_KEEP")) {
+    std::printf("kept %s\n", dir.c_str());
+  } else {
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+  }
   return geode_valid ? 0 : 1;
 }
