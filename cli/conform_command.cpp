@@ -107,12 +107,23 @@ void print_summary(const templates::ConformResult& r, std::ostream& os, bool tab
   for (const auto& w : r.warnings) os << "warning: " << w << "\n";
 }
 
-void run(const primal::Model& model, const ConformArgs& a, bool tables) {
+// `source` names the input file in the model's own errors (no tet part, no interface, a face
+// that does not conform: they name elements and nodes, not the file); empty for demos.
+void run(const primal::Model& model, const ConformArgs& a, bool tables,
+         const std::string& source = {}) {
   templates::ConformOptions opts;
   opts.smooth = templates::parse_conform_smooth(a.smooth);
   if (!a.quiet && isatty(STDERR_FILENO))
     opts.progress = [](const std::string& line) { std::cerr << "geode: " << line << "\n"; };
-  const templates::ConformResult r = templates::conform(model, opts);
+  const std::string prefix = source.empty() ? "" : source + ": ";
+  templates::ConformResult r;
+  try {
+    r = templates::conform(model, opts);
+  } catch (const InvalidInput& e) {
+    throw InvalidInput(prefix + e.what());
+  } catch (const TopologyError& e) {
+    throw TopologyError(prefix + e.what());
+  }
   if (!a.output.empty()) write_model(r.model, a.output);
   if (!a.report.empty()) {
     const std::string text = result_json(r).dump(2) + "\n";
@@ -146,7 +157,7 @@ void add_conform_commands(CLI::App& app) {
   c->callback([args] {
     // Check the output name before the long run, not after it.
     if (!args->output.empty()) check_output_extension(args->output);
-    run(read_model(args->input), *args, false);
+    run(read_model(args->input), *args, false, args->input);
   });
 
   auto dargs = std::make_shared<ConformArgs>();

@@ -89,8 +89,11 @@ std::vector<BoundaryQuad> boundary_quads(const HexMesh& mesh) {
 }
 
 BoundarySurface extract_boundary(const HexMesh& mesh) {
+  return extract_boundary(mesh.points, boundary_quads(mesh));
+}
+
+BoundarySurface extract_boundary(const std::vector<Point>& points, std::vector<BoundaryQuad> quads) {
   BoundarySurface b;
-  const auto quads = boundary_quads(mesh);
 
   // Combinatorial Euler characteristic, independent of what OpenMesh accepts.
   std::unordered_map<Index, SurfaceMesh::VertexHandle> vertex_of;
@@ -109,7 +112,7 @@ BoundarySurface extract_boundary(const HexMesh& mesh) {
     for (Index v : q.nodes) {
       auto& vh = vertex_of[v];
       if (!vh.is_valid()) {
-        const Point& p = mesh.points[static_cast<std::size_t>(v)];
+        const Point& p = points[static_cast<std::size_t>(v)];
         vh = b.surface.add_vertex(SurfaceMesh::Point(
             static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())));
         b.vertex_node.push_back(v);

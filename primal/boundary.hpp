@@ -76,5 +76,7 @@ struct BoundarySurface {
 };
 
 BoundarySurface extract_boundary(const HexMesh& mesh);
+// The same from boundary quads already found (in the order given, nodes outward), over `points`.
+BoundarySurface extract_boundary(const std::vector<Point>& points, std::vector<BoundaryQuad> quads);
 
 }  // namespace geode::primal

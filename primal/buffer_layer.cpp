@@ -9,6 +9,7 @@
 
 #include "primal/boundary.hpp"
 #include "primal/errors.hpp"
+#include "primal/key_map.hpp"
 #include "primal/quality.hpp"
 #include "primal/topology.hpp"
 
@@ -97,14 +98,21 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
     }
   // Tets touching the interface, tet edges at moved nodes, and the tet part's outer boundary
   // (faces used once that are not interface triangles).
-  std::unordered_set<FaceKey, IndexArrayHash> interface_tris;
-  for (const InterfaceQuad& q : itf.quads)
-    for (const auto& tri : interface_triangles(q)) interface_tris.insert(face_key(tri));
-  std::unordered_map<FaceKey, int, IndexArrayHash> tet_face_uses;
+  // Per tet-part triangle the number of tets using it, interface triangles marked by -1.
+  KeyMap<4> tet_face_uses(2 * input.tets.size());
   for (const auto& t : input.tets)
     for (const auto& fc : topology::kTetFaceCorners)
-      ++tet_face_uses[face_key(std::array<Index, 3>{t[static_cast<std::size_t>(fc[0])], t[static_cast<std::size_t>(fc[1])],
-                                                    t[static_cast<std::size_t>(fc[2])]})];
+      ++*tet_face_uses
+             .try_emplace(face_key(std::array<Index, 3>{t[static_cast<std::size_t>(fc[0])],
+                                                       t[static_cast<std::size_t>(fc[1])],
+                                                       t[static_cast<std::size_t>(fc[2])]}),
+                          0)
+             .first;
+  std::vector<FaceKey> interface_tris;
+  for (const InterfaceQuad& q : itf.quads)
+    for (const auto& tri : interface_triangles(q)) interface_tris.push_back(face_key(tri));
+  for (const FaceKey& key : interface_tris)
+    if (Index* uses = tet_face_uses.find(key)) *uses = -1;
   std::vector<std::vector<Point>> outer_normals(n_moved);  // area-weighted
   std::vector<Index> touched_tets;
   for (std::size_t t = 0; t < input.tets.size(); ++t) {
@@ -123,7 +131,8 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
       const std::array<Index, 3> tri{tet[static_cast<std::size_t>(fc[0])], tet[static_cast<std::size_t>(fc[1])],
                                      tet[static_cast<std::size_t>(fc[2])]};
       const FaceKey key = face_key(tri);
-      if (tet_face_uses[key] != 1 || interface_tris.count(key)) continue;
+      const Index* uses = tet_face_uses.find(key);
+      if (!uses || *uses != 1) continue;  // inner or interface triangle
       const Point area = (pt(tri[1]) - pt(tri[0])).cross(pt(tri[2]) - pt(tri[0]));  // outward
       for (Index v : tri)
         if (out.top_node[static_cast<std::size_t>(v)] != kInvalidIndex) outer_normals[slot(v)].push_back(area);

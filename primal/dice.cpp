@@ -2,7 +2,9 @@
 
 #include <bit>
 #include <string>
-#include <unordered_map>
+#include <algorithm>
+
+#include "primal/key_map.hpp"
 
 #include "primal/errors.hpp"
 #include "primal/topology.hpp"
@@ -103,9 +105,25 @@ Diced<std::array<Index, NC>> dice_elements(const std::vector<Point>& points,
   }
   constexpr Support kAll = (1u << NP) - 1;
 
-  // Pass 1: number edges and faces in order of first appearance.
-  std::unordered_map<FaceKey, Index, IndexArrayHash> edge_id, face_id;
+  // The distinct edge and face supports of one element, in order of first appearance over the
+  // table (children in order, corners in order), and each child corner's slot among them.
+  std::vector<Support> supports;
+  std::array<std::array<int, NC>, NChildren> slot_of{};
+  for (std::size_t ch = 0; ch < NChildren; ++ch)
+    for (std::size_t k = 0; k < NC; ++k) {
+      const Support s = table[ch][k];
+      slot_of[ch][k] = -1;
+      if (std::popcount(s) == 1 || s == kAll) continue;
+      auto it = std::find(supports.begin(), supports.end(), s);
+      slot_of[ch][k] = static_cast<int>(it - supports.begin());
+      if (it == supports.end()) supports.push_back(s);
+    }
+  const std::size_t ns = supports.size();
+
+  // Pass 1: number edges and faces in order of first appearance; remember each element's.
+  KeyMap<4> edge_id(elements.size() * 2), face_id(elements.size() * 2);
   std::vector<FaceKey> edge_keys, face_keys;
+  std::vector<Index> element_ids(elements.size() * ns);  // per element and slot: edge or face id
   auto key_of = [&](const std::array<Index, NP>& elem, Support s) {
     std::array<Index, 4> nodes{};
     std::size_t n = 0;
@@ -117,22 +135,27 @@ Diced<std::array<Index, NC>> dice_elements(const std::vector<Point>& points,
                        : face_key(std::span<const Index>(nodes.data(), n));
     return k;
   };
-  for (const auto& elem : elements) {
-    for (const auto& child : table) {
-      for (Support s : child) {
-        const int count = std::popcount(s);
-        if (count == 1 || s == kAll) continue;
-        const FaceKey k = key_of(elem, s);
-        auto& ids = count == 2 ? edge_id : face_id;
-        auto& keys = count == 2 ? edge_keys : face_keys;
-        if (ids.try_emplace(k, static_cast<Index>(keys.size())).second) keys.push_back(k);
-      }
+  for (std::size_t e = 0; e < elements.size(); ++e) {
+    for (std::size_t i = 0; i < ns; ++i) {
+      const Support s = supports[i];
+      const FaceKey k = key_of(elements[e], s);
+      const bool edge = std::popcount(s) == 2;
+      auto& ids = edge ? edge_id : face_id;
+      auto& keys = edge ? edge_keys : face_keys;
+      const auto [id, inserted] = ids.try_emplace(k, static_cast<Index>(keys.size()));
+      if (inserted) keys.push_back(k);
+      element_ids[e * ns + i] = *id;
     }
   }
   const auto ne = static_cast<Index>(edge_keys.size());
   const auto nf = static_cast<Index>(face_keys.size());
 
   Diced<std::array<Index, NC>> out;
+  const std::size_t total = points.size() + edge_keys.size() + face_keys.size() + elements.size();
+  out.points.reserve(total);
+  out.origin.reserve(total);
+  out.elements.reserve(elements.size() * NChildren);
+  out.parent.reserve(elements.size() * NChildren);
   out.points = points;
   out.origin.resize(points.size());
   for (Index v = 0; v < nv; ++v) out.origin[v].nodes[0] = v;
@@ -167,19 +190,18 @@ Diced<std::array<Index, NC>> dice_elements(const std::vector<Point>& points,
   // Pass 2: children.
   for (std::size_t e = 0; e < elements.size(); ++e) {
     const auto& elem = elements[e];
-    for (const auto& child : table) {
+    for (std::size_t ch = 0; ch < NChildren; ++ch) {
       std::array<Index, NC> c{};
       for (std::size_t k = 0; k < NC; ++k) {
-        const Support s = child[k];
+        const Support s = table[ch][k];
         const int count = std::popcount(s);
         if (count == 1) {
           c[k] = elem[static_cast<std::size_t>(std::countr_zero(s))];
         } else if (s == kAll) {
           c[k] = nv + ne + nf + static_cast<Index>(e);
-        } else if (count == 2) {
-          c[k] = nv + edge_id.at(key_of(elem, s));
         } else {
-          c[k] = nv + ne + face_id.at(key_of(elem, s));
+          const Index id = element_ids[e * ns + static_cast<std::size_t>(slot_of[ch][k])];
+          c[k] = count == 2 ? nv + id : nv + ne + id;
         }
       }
       out.elements.push_back(c);

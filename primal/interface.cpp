@@ -7,6 +7,7 @@
 
 #include "primal/boundary.hpp"
 #include "primal/errors.hpp"
+#include "primal/key_map.hpp"
 #include "primal/topology.hpp"
 
 namespace geode::primal {
@@ -17,6 +18,12 @@ struct TetFaceUse {
   Index tet = kInvalidIndex;
   int face = -1;
   std::array<Index, 3> nodes{};  // outward of the tet
+};
+
+struct TriangleUses {
+  std::array<TetFaceUse, 2> use;
+  int count = 0;
+  bool matched = false;  // one of the two triangles of an interface quad
 };
 
 std::string nodes_text(std::span<const Index> nodes) {
@@ -64,22 +71,32 @@ Interface find_interface(const Model& model, double tol) {
   const auto& P = model.points;
   auto pt = [&](Index v) -> const Point& { return P[static_cast<std::size_t>(v)]; };
 
-  // Boundary triangles of the tet part.
-  std::unordered_map<FaceKey, std::vector<TetFaceUse>, IndexArrayHash> tet_faces;
+  // Triangles of the tet part with the tets using them (boundary triangles: one use).
+  KeyMap<4> tri_index(2 * model.tets.size());
+  std::vector<TriangleUses> tris;
+  tris.reserve(2 * model.tets.size() + 2);
   for (std::size_t t = 0; t < model.tets.size(); ++t)
     for (int f = 0; f < 4; ++f) {
       TetFaceUse use{static_cast<Index>(t), f, {}};
       for (std::size_t i = 0; i < 3; ++i)
         use.nodes[i] = model.tets[t][static_cast<std::size_t>(
             topology::kTetFaceCorners[static_cast<std::size_t>(f)][i])];
-      auto& uses = tet_faces[face_key(use.nodes)];
-      uses.push_back(use);
-      if (uses.size() > 2)
+      const auto [id, inserted] =
+          tri_index.try_emplace(face_key(use.nodes), static_cast<Index>(tris.size()));
+      if (inserted) tris.emplace_back();
+      TriangleUses& uses = tris[static_cast<std::size_t>(*id)];
+      if (uses.count == 2)
         throw TopologyError("find_interface: triangle (nodes " + nodes_text(use.nodes) +
-                            ") is a face of more than two tets (" + std::to_string(uses[0].tet) +
-                            ", " + std::to_string(uses[1].tet) + ", " + std::to_string(t) + ")");
+                            ") is a face of more than two tets (" + std::to_string(uses.use[0].tet) +
+                            ", " + std::to_string(uses.use[1].tet) + ", " + std::to_string(t) + ")");
+      uses.use[static_cast<std::size_t>(uses.count++)] = use;
     }
-  std::unordered_set<FaceKey, IndexArrayHash> matched_tris;
+  // The boundary triangle with this key, or nullptr.
+  auto boundary_triangle = [&](const FaceKey& key) -> const TetFaceUse* {
+    const Index* id = tri_index.find(key);
+    if (!id || tris[static_cast<std::size_t>(*id)].count != 1) return nullptr;
+    return &tris[static_cast<std::size_t>(*id)].use[0];
+  };
 
   const HexMesh hexes = hex_part(model);
   const auto quads = boundary_quads(hexes);
@@ -92,10 +109,9 @@ Interface find_interface(const Model& model, double tol) {
     int count = 0;
     for (int d = 0; d < 2; ++d)
       for (int i = 0; i < 2; ++i) {
-        auto it = tet_faces.find(
-            face_key(splits[static_cast<std::size_t>(d)][static_cast<std::size_t>(i)]));
-        if (it != tet_faces.end() && it->second.size() == 1) {
-          found[static_cast<std::size_t>(d)][static_cast<std::size_t>(i)] = &it->second[0];
+        if (const TetFaceUse* u = boundary_triangle(
+                face_key(splits[static_cast<std::size_t>(d)][static_cast<std::size_t>(i)]))) {
+          found[static_cast<std::size_t>(d)][static_cast<std::size_t>(i)] = u;
           ++count;
         }
       }
@@ -130,7 +146,7 @@ Interface find_interface(const Model& model, double tol) {
       const TetFaceUse& u = *found[static_cast<std::size_t>(q.diagonal)][i];
       q.tets[i] = u.tet;
       q.tet_faces[i] = u.face;
-      matched_tris.insert(face_key(u.nodes));
+      tris[static_cast<std::size_t>(*tri_index.find(face_key(u.nodes)))].matched = true;
       const auto& tet = model.tets[static_cast<std::size_t>(u.tet)];
       Index apex = kInvalidIndex;
       for (Index v : tet)
@@ -154,10 +170,9 @@ Interface find_interface(const Model& model, double tol) {
       for (std::size_t i = 0; i < 3; ++i)
         nodes[i] = model.tets[t][static_cast<std::size_t>(
             topology::kTetFaceCorners[static_cast<std::size_t>(f)][i])];
-      const FaceKey key = face_key(nodes);
-      const auto& uses = tet_faces.at(key);
-      if (uses.size() != 1 || matched_tris.count(key)) continue;
-      const TetFaceUse& tri = uses[0];
+      const TriangleUses& uses = tris[static_cast<std::size_t>(*tri_index.find(face_key(nodes)))];
+      if (uses.count != 1 || uses.matched) continue;
+      const TetFaceUse& tri = uses.use[0];
       std::unordered_set<const BoundaryQuad*> seen;
       for (Index v : tri.nodes) {
         auto it = quads_at.find(v);

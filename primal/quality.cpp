@@ -64,32 +64,49 @@ Point shape_gradient(int c, const Point& rst) {
   return {df[0] * f[1] * f[2], f[0] * df[1] * f[2], f[0] * f[1] * df[2]};
 }
 
+// Shape-function gradients at the 2x2x2 Gauss points: [point][corner], point index 4 r + 2 s
+// + t over {0.5 - g, 0.5 + g}. Tabulated once: every volume evaluation would recompute them.
+struct GaussGradients {
+  std::array<std::array<Point, 8>, 8> dn;
+};
+
+const GaussGradients& gauss_gradients() {
+  static const GaussGradients table = [] {
+    const double g = 0.5 / std::sqrt(3.0);
+    const std::array<double, 2> pts{0.5 - g, 0.5 + g};
+    GaussGradients t;
+    int k = 0;
+    for (double r : pts)
+      for (double s : pts)
+        for (double u : pts) {
+          for (int c = 0; c < 8; ++c) t.dn[k][c] = shape_gradient(c, Point(r, s, u));
+          ++k;
+        }
+    return t;
+  }();
+  return table;
+}
+
 // Exact volume of the trilinear hex and its gradient with respect to the corners. det J is of
 // degree 2 in each local coordinate, so the 2x2x2 Gauss rule integrates it exactly.
 double trilinear_volume(const HexCorners& p, std::array<Point, 8>* gradient) {
-  const double g = 0.5 / std::sqrt(3.0);
-  const std::array<double, 2> pts{0.5 - g, 0.5 + g};
+  const GaussGradients& gg = gauss_gradients();
   double volume = 0.0;
   if (gradient) gradient->fill(Point::Zero());
-  for (double r : pts) {
-    for (double s : pts) {
-      for (double t : pts) {
-        const Point rst(r, s, t);
-        std::array<Point, 8> dn;
-        Eigen::Matrix3d jac = Eigen::Matrix3d::Zero();
-        for (int c = 0; c < 8; ++c) {
-          dn[c] = shape_gradient(c, rst);
-          jac += p[c] * dn[c].transpose();
-        }
-        const Point a = jac.col(0), b = jac.col(1), cc = jac.col(2);
-        volume += det3(a, b, cc) / 8.0;
-        if (gradient) {
-          // d det / d x_c = (b x c) dN/dr + (c x a) dN/ds + (a x b) dN/dt
-          const Point bc = b.cross(cc), ca = cc.cross(a), ab = a.cross(b);
-          for (int c = 0; c < 8; ++c) {
-            (*gradient)[c] += (bc * dn[c][0] + ca * dn[c][1] + ab * dn[c][2]) / 8.0;
-          }
-        }
+  for (const auto& dn : gg.dn) {
+    // Columns of the Jacobian: sum over corners of x_c dN_c/dr (/ds, /dt).
+    Point a = Point::Zero(), b = Point::Zero(), cc = Point::Zero();
+    for (int c = 0; c < 8; ++c) {
+      a += p[c] * dn[c][0];
+      b += p[c] * dn[c][1];
+      cc += p[c] * dn[c][2];
+    }
+    volume += det3(a, b, cc) / 8.0;
+    if (gradient) {
+      // d det / d x_c = (b x c) dN/dr + (c x a) dN/ds + (a x b) dN/dt
+      const Point bc = b.cross(cc), ca = cc.cross(a), ab = a.cross(b);
+      for (int c = 0; c < 8; ++c) {
+        (*gradient)[c] += (bc * dn[c][0] + ca * dn[c][1] + ab * dn[c][2]) / 8.0;
       }
     }
   }

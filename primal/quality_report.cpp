@@ -39,18 +39,23 @@ QualityReport hex_quality_report(const HexMesh& mesh, std::span<const Index> hex
     chosen.assign(metrics.begin(), metrics.end());
   }
 
-  std::vector<HexCorners> corners;
-  corners.reserve(hexes.size());
-  for (Index h : hexes) corners.push_back(hex_corners(mesh, h));
+  // Check every hex number once; metrics then gather their corners straight from the mesh
+  // (a copy of all corners would cost 192 bytes per hex).
+  for (Index h : hexes) hex_corners(mesh, h);
 
   QualityReport report;
   report.num_hexes = static_cast<Index>(hexes.size());
   report.std_dev_kind = kind;
   const double n = static_cast<double>(hexes.size());
+  std::vector<double> q(hexes.size());
   for (HexMetric id : chosen) {
     const HexMetricInfo& info = hex_metric_info(id);
-    std::vector<double> q(hexes.size());
-    for (std::size_t i = 0; i < hexes.size(); ++i) q[i] = info.evaluate(corners[i]);
+    for (std::size_t i = 0; i < hexes.size(); ++i) {
+      HexCorners c;
+      const auto& hex = mesh.hexes[static_cast<std::size_t>(hexes[i])];
+      for (int k = 0; k < 8; ++k) c[k] = mesh.points[static_cast<std::size_t>(hex[k])];
+      q[i] = info.evaluate(c);
+    }
     MetricSummary s;
     s.metric = id;
     const auto lo = std::min_element(q.begin(), q.end());

@@ -305,6 +305,9 @@ class Problem {
       const double w = w_[k] / sum;
       if (w < 1e-14) continue;  // far above the minimum: contributes nothing measurable
       const Local& l = locals_[k];
+      // A frame of fixed nodes only (the outer ring of a local patch) has no derivatives; its
+      // value counted in the soft minimum above.
+      if (l.idx.empty()) continue;
       const Vec gk = l.map.transpose() * dq_[k];
       for (std::size_t i = 0; i < l.idx.size(); ++i) (*grad)[l.idx[i]] -= w * gk[i];
       if (!hess) continue;

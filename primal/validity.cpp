@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cstdint>
+#include <tuple>
 #include <cmath>
 #include <numeric>
 #include <sstream>
@@ -161,15 +163,18 @@ std::string HexValidityReport::summary() const {
 }
 
 HexValidityReport check_validity(const HexMesh& mesh) {
+  // Everything is read off the node -> hex incidence (CSR) instead of hashing every face and
+  // edge of the mesh: all hexes using a face (an edge) contain its smallest node, so the uses of
+  // a face or edge are found among the few hexes around one node. A face or edge is numbered by
+  // its first use (hex, local face / edge), which is the order of first appearance.
   HexValidityReport r;
   r.num_nodes = static_cast<Index>(mesh.points.size());
   r.num_hexes = static_cast<Index>(mesh.hexes.size());
   r.non_finite_nodes = non_finite(mesh.points);
 
-  // The proper hexes, on which the topology is analysed.
-  HexMesh proper;
-  proper.points = mesh.points;
+  // The proper hexes, on which the topology is analysed; use p refers to mesh.hexes[original[p]].
   std::vector<Index> original;  // proper hex -> input hex
+  original.reserve(mesh.hexes.size());
   for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
     const auto& hex = mesh.hexes[h];
     if (!in_range(hex, mesh.points.size())) {
@@ -177,7 +182,6 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     } else if (has_repeated(hex)) {
       r.repeated_node_hexes.push_back(static_cast<Index>(h));
     } else {
-      proper.hexes.push_back(hex);
       original.push_back(static_cast<Index>(h));
     }
   }
@@ -193,109 +197,197 @@ HexValidityReport check_validity(const HexMesh& mesh) {
   }
 
   const auto& inc = hex_incidence();
-  const std::size_t nh = proper.hexes.size();
-
-  // Global face and edge numbers per hex.
-  const auto faces = unique_faces(proper);
-  std::vector<std::array<Index, 6>> hex_faces(nh);
-  for (std::size_t f = 0; f < faces.size(); ++f) {
-    for (const auto& u : faces[f].uses) hex_faces[u.hex][u.local_face] = static_cast<Index>(f);
-    if (faces[f].uses.size() > 2) r.overshared_faces.push_back(faces[f].key);
-    if (faces[f].uses.size() == 2) {
-      const auto& u1 = faces[f].uses[1];
-      std::array<Index, 4> other{};
-      for (int i = 0; i < 4; ++i) {
-        other[i] = proper.hexes[u1.hex][topo::kHexFaceCorners[u1.local_face][i]];
-      }
-      if (!opposite_cycles(faces[f].nodes, other)) {
-        r.misoriented_faces.push_back(faces[f].key);
-      }
-    }
-  }
-  std::unordered_map<EdgeKey, Index, IndexArrayHash> edge_id;
-  std::vector<EdgeKey> edges;
-  std::vector<std::array<Index, 12>> hex_edges(nh);
-  for (std::size_t h = 0; h < nh; ++h) {
+  const std::size_t nh = original.size();
+  const std::size_t nv = mesh.points.size();
+  auto hex = [&](Index p) -> const std::array<Index, 8>& {
+    return mesh.hexes[static_cast<std::size_t>(original[static_cast<std::size_t>(p)])];
+  };
+  auto corner_of = [&](Index p, Index v) {
+    const auto& h = hex(p);
+    return static_cast<int>(std::find(h.begin(), h.end(), v) - h.begin());
+  };
+  // Local edge joining two corners (-1 if they are not joined by an edge).
+  static const auto kEdgeOf = [] {
+    std::array<std::array<int, 8>, 8> t{};
+    for (auto& row : t) row.fill(-1);
     for (int e = 0; e < topo::kHexEdges; ++e) {
-      const auto& c = topo::kHexEdgeCorners[e];
-      const EdgeKey k = edge_key(proper.hexes[h][c[0]], proper.hexes[h][c[1]]);
-      auto [it, inserted] = edge_id.try_emplace(k, static_cast<Index>(edges.size()));
-      if (inserted) edges.push_back(k);
-      hex_edges[h][e] = it->second;
+      t[topo::kHexEdgeCorners[e][0]][topo::kHexEdgeCorners[e][1]] = e;
+      t[topo::kHexEdgeCorners[e][1]][topo::kHexEdgeCorners[e][0]] = e;
     }
-  }
+    return t;
+  }();
 
-  // Edges: the hexes around an edge must form one chain or ring through shared faces.
+  // Node -> proper hexes, ascending.
+  std::vector<Index> start(nv + 1, 0), around;
+  for (std::size_t p = 0; p < nh; ++p)
+    for (Index v : hex(static_cast<Index>(p))) ++start[static_cast<std::size_t>(v) + 1];
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  around.resize(static_cast<std::size_t>(start.back()));
   {
-    std::vector<std::vector<std::pair<Index, int>>> edge_uses(edges.size());  // (hex, local edge)
-    for (std::size_t h = 0; h < nh; ++h) {
-      for (int e = 0; e < topo::kHexEdges; ++e)
-        edge_uses[hex_edges[h][e]].emplace_back(static_cast<Index>(h), e);
-    }
-    for (std::size_t e = 0; e < edges.size(); ++e) {
-      const auto& uses = edge_uses[e];
-      DisjointSets sets(uses.size());
-      std::unordered_map<Index, int> first_use_of_face;
-      bool overshared = false;
-      for (std::size_t i = 0; i < uses.size(); ++i) {
-        for (int lf : inc.edge_faces[uses[i].second]) {
-          const Index f = hex_faces[uses[i].first][lf];
-          overshared |= faces[f].uses.size() > 2;
-          auto [it, inserted] = first_use_of_face.try_emplace(f, static_cast<int>(i));
-          if (!inserted) sets.unite(it->second, static_cast<int>(i));
+    std::vector<Index> fill(start.begin(), start.end() - 1);
+    for (std::size_t p = 0; p < nh; ++p)
+      for (Index v : hex(static_cast<Index>(p)))
+        around[static_cast<std::size_t>(fill[static_cast<std::size_t>(v)]++)] = static_cast<Index>(p);
+  }
+  auto face_nodes = [&](Index p, int lf) {
+    std::array<Index, 4> q{};
+    for (int i = 0; i < 4; ++i) q[i] = hex(p)[topo::kHexFaceCorners[lf][i]];
+    return q;
+  };
+
+  // Faces. face_lead[6 p + f]: the first use of that face; face_info[first use]: the number of
+  // uses (1, 2, 3 = more) in bits 0-1, bit 2 set when two uses see it in the same cyclic order.
+  std::vector<Index> face_lead(6 * nh, kInvalidIndex);
+  std::vector<std::uint8_t> face_info(6 * nh, 0);
+  {
+    std::vector<std::pair<FaceKey, Index>> local;  // faces whose smallest node is v, with use
+    for (std::size_t v = 0; v < nv; ++v) {
+      local.clear();
+      for (Index k = start[v]; k < start[v + 1]; ++k) {
+        const Index p = around[static_cast<std::size_t>(k)];
+        const int c = corner_of(p, static_cast<Index>(v));
+        for (int lf : inc.corner_faces[c]) {
+          const auto q = face_nodes(p, lf);
+          if (*std::min_element(q.begin(), q.end()) != static_cast<Index>(v)) continue;
+          local.emplace_back(face_key(q), 6 * p + lf);
         }
       }
-      if (overshared || sets.count() != 1) r.nonmanifold_edges.push_back(edges[e]);
+      std::sort(local.begin(), local.end());
+      for (std::size_t i = 0; i < local.size();) {
+        std::size_t j = i + 1;
+        while (j < local.size() && local[j].first == local[i].first) ++j;
+        const Index lead = local[i].second;
+        for (std::size_t k = i; k < j; ++k) face_lead[static_cast<std::size_t>(local[k].second)] = lead;
+        std::uint8_t info = static_cast<std::uint8_t>(std::min<std::size_t>(j - i, 3));
+        if (j - i == 2) {
+          const Index u1 = local[i + 1].second;
+          if (!opposite_cycles(face_nodes(lead / 6, lead % 6), face_nodes(u1 / 6, u1 % 6)))
+            info |= 4;
+        }
+        face_info[static_cast<std::size_t>(lead)] = info;
+        i = j;
+      }
     }
   }
-
-  // Vertices: the link (triangles = hexes, edges = faces, vertices = edges at the vertex) must
-  // be connected with Euler characteristic 2 (sphere, interior) or 1 (disk, boundary).
-  std::vector<std::vector<std::pair<Index, int>>> vertex_uses(mesh.points.size());  // (hex, corner)
-  for (std::size_t h = 0; h < nh; ++h) {
-    for (int c = 0; c < topo::kHexCorners; ++c)
-      vertex_uses[proper.hexes[h][c]].emplace_back(static_cast<Index>(h), c);
+  std::vector<BoundaryQuad> boundary;
+  for (std::size_t u = 0; u < 6 * nh; ++u) {
+    if (face_lead[u] != static_cast<Index>(u)) continue;
+    ++r.num_faces;
+    const Index p = static_cast<Index>(u / 6);
+    const int lf = static_cast<int>(u % 6);
+    const auto uses = face_info[u] & 3;
+    if (uses == 3) r.overshared_faces.push_back(face_key(face_nodes(p, lf)));
+    if (face_info[u] & 4) r.misoriented_faces.push_back(face_key(face_nodes(p, lf)));
+    if (uses == 1) boundary.push_back(BoundaryQuad{original[static_cast<std::size_t>(p)], lf, face_nodes(p, lf)});
   }
-  for (std::size_t v = 0; v < vertex_uses.size(); ++v) {
-    const auto& uses = vertex_uses[v];
-    if (uses.empty()) {
+  auto face_uses = [&](Index p, int lf) {
+    return face_info[static_cast<std::size_t>(face_lead[static_cast<std::size_t>(6 * p + lf)])] & 3;
+  };
+
+  // Vertices and the edges starting at them (other end larger). An edge's hexes must form one
+  // chain or ring through shared faces. A vertex's link (triangles = hexes, edges = faces,
+  // vertices = edges at the vertex) must be connected with Euler characteristic 2 (sphere,
+  // interior) or 1 (disk, boundary).
+  std::vector<std::pair<Index, EdgeKey>> bad_edges;  // (first use 12 p + e, edge)
+  std::vector<Index> parent;                          // union-find over the local uses
+  auto find = [&](Index x) {
+    while (parent[static_cast<std::size_t>(x)] != x)
+      x = parent[static_cast<std::size_t>(x)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
+    return x;
+  };
+  auto unite = [&](Index a, Index b) {
+    a = find(a), b = find(b);
+    if (a < b) parent[static_cast<std::size_t>(b)] = a;
+    if (b < a) parent[static_cast<std::size_t>(a)] = b;
+  };
+  auto components = [&](std::size_t n) {
+    std::size_t c = 0;
+    for (std::size_t i = 0; i < n; ++i) c += find(static_cast<Index>(i)) == static_cast<Index>(i);
+    return c;
+  };
+  struct EdgeUse {
+    Index other;  // the edge's other end
+    Index use;    // 12 p + local edge
+  };
+  std::vector<EdgeUse> edge_uses;
+  std::vector<std::pair<Index, int>> first_use_of_face;  // (face lead, local use)
+  std::vector<Index> others;
+  for (std::size_t v = 0; v < nv; ++v) {
+    const Index n = start[v + 1] - start[v];
+    if (n == 0) {
       ++r.unused_nodes;
       continue;
     }
     ++r.num_vertices;
-    DisjointSets sets(uses.size());
-    std::unordered_map<Index, int> first_use_of_face;
-    std::unordered_set<Index> link_vertices;
-    bool boundary = false, overshared = false;
-    for (std::size_t i = 0; i < uses.size(); ++i) {
-      const auto [h, c] = uses[i];
+    parent.resize(static_cast<std::size_t>(n));
+    std::iota(parent.begin(), parent.end(), Index{0});
+    first_use_of_face.clear();
+    others.clear();
+    edge_uses.clear();
+    bool on_boundary = false, overshared = false;
+    for (Index i = 0; i < n; ++i) {
+      const Index p = around[static_cast<std::size_t>(start[v] + i)];
+      const int c = corner_of(p, static_cast<Index>(v));
       for (int lf : inc.corner_faces[c]) {
-        const Index f = hex_faces[h][lf];
-        boundary |= faces[f].uses.size() == 1;
-        overshared |= faces[f].uses.size() > 2;
-        auto [it, inserted] = first_use_of_face.try_emplace(f, static_cast<int>(i));
-        if (!inserted) sets.unite(it->second, static_cast<int>(i));
+        const auto uses = face_uses(p, lf);
+        on_boundary |= uses == 1;
+        overshared |= uses == 3;
+        const Index f = face_lead[static_cast<std::size_t>(6 * p + lf)];
+        auto it = std::find_if(first_use_of_face.begin(), first_use_of_face.end(),
+                               [f](const auto& x) { return x.first == f; });
+        if (it == first_use_of_face.end()) first_use_of_face.emplace_back(f, i);
+        else unite(it->second, i);
       }
-      for (int le : inc.corner_edges[c]) link_vertices.insert(hex_edges[h][le]);
+      for (int nc : topo::kHexCornerNeighbors[c]) {
+        const Index b = hex(p)[nc];
+        others.push_back(b);
+        if (b > static_cast<Index>(v)) edge_uses.push_back({b, 12 * p + kEdgeOf[c][nc]});
+      }
     }
-    const auto link_euler = static_cast<long>(link_vertices.size()) -
-                            static_cast<long>(first_use_of_face.size()) +
-                            static_cast<long>(uses.size());
-    if (overshared || sets.count() != 1 || link_euler != (boundary ? 1 : 2)) {
+    std::sort(others.begin(), others.end());
+    const auto link_vertices = std::unique(others.begin(), others.end()) - others.begin();
+    const auto link_euler = static_cast<long>(link_vertices) -
+                            static_cast<long>(first_use_of_face.size()) + static_cast<long>(n);
+    if (overshared || components(static_cast<std::size_t>(n)) != 1 ||
+        link_euler != (on_boundary ? 1 : 2)) {
       r.nonmanifold_vertices.push_back(static_cast<Index>(v));
     }
-  }
 
-  r.num_edges = static_cast<Index>(edges.size());
-  r.num_faces = static_cast<Index>(faces.size());
+    std::sort(edge_uses.begin(), edge_uses.end(),
+              [](const EdgeUse& a, const EdgeUse& b) { return std::tie(a.other, a.use) < std::tie(b.other, b.use); });
+    for (std::size_t i = 0; i < edge_uses.size();) {
+      std::size_t j = i + 1;
+      while (j < edge_uses.size() && edge_uses[j].other == edge_uses[i].other) ++j;
+      ++r.num_edges;
+      const std::size_t m = j - i;
+      parent.resize(m);
+      std::iota(parent.begin(), parent.end(), Index{0});
+      first_use_of_face.clear();
+      bool edge_overshared = false;
+      for (std::size_t k = 0; k < m; ++k) {
+        const Index p = edge_uses[i + k].use / 12;
+        const int le = edge_uses[i + k].use % 12;
+        for (int lf : inc.edge_faces[le]) {
+          edge_overshared |= face_uses(p, lf) == 3;
+          const Index f = face_lead[static_cast<std::size_t>(6 * p + lf)];
+          auto it = std::find_if(first_use_of_face.begin(), first_use_of_face.end(),
+                                 [f](const auto& x) { return x.first == f; });
+          if (it == first_use_of_face.end()) first_use_of_face.emplace_back(f, static_cast<int>(k));
+          else unite(it->second, static_cast<Index>(k));
+        }
+      }
+      if (edge_overshared || components(m) != 1)
+        bad_edges.emplace_back(edge_uses[i].use, edge_key(static_cast<Index>(v), edge_uses[i].other));
+      i = j;
+    }
+  }
+  std::sort(bad_edges.begin(), bad_edges.end());
+  for (const auto& [use, e] : bad_edges) r.nonmanifold_edges.push_back(e);
+
   r.num_cells = static_cast<Index>(nh);
   r.euler = r.num_vertices - r.num_edges + r.num_faces - r.num_cells;
 
-  r.boundary = extract_boundary(proper);
-  // Report boundary quads against the input hex numbers.
-  for (auto* list : {&r.boundary.faces, &r.boundary.rejected}) {
-    for (auto& q : *list) q.hex = original[q.hex];
-  }
+  r.boundary = extract_boundary(mesh.points, std::move(boundary));
   return r;
 }
 

@@ -15,6 +15,7 @@
 #include "primal/dice.hpp"
 #include "primal/errors.hpp"
 #include "primal/interface.hpp"
+#include "primal/key_map.hpp"
 #include "primal/quality.hpp"
 #include "primal/topology.hpp"
 #include "templates/geode.hpp"
@@ -299,13 +300,32 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
   t0 = Clock::now();
   const primal::Model& lm = layer.model;
   const Index V = static_cast<Index>(lm.points.size());
-  const primal::DicedHexMesh dh = primal::dice(primal::hex_part(lm));
-  const primal::DicedHexMesh dt = primal::dice(primal::tet_part(lm));
+  primal::DicedHexMesh dh = primal::dice(primal::hex_part(lm));
+  primal::DicedHexMesh dt = primal::dice(primal::tet_part(lm));
   std::vector<Point> points(lm.points.begin(), lm.points.end());
   std::vector<FaceKey> origin_key(V);  // per global node; {-1..} for cell / template nodes
   for (Index v = 0; v < V; ++v) origin_key[v] = {v, kInvalidIndex, kInvalidIndex, kInvalidIndex};
   const FaceKey kNoKey{kInvalidIndex, kInvalidIndex, kInvalidIndex, kInvalidIndex};
-  std::unordered_map<FaceKey, Index, primal::IndexArrayHash> by_key;
+  // A diced node can be met twice (by the other part's dicing, or as a template's tet/hex-side
+  // node) only if every origin node of it is a buffer hex corner or used by both parts; dice()
+  // numbers each origin once per part, so only those go through the map (a few per interface
+  // quad instead of every diced edge and face).
+  std::vector<char> shared(static_cast<std::size_t>(V), 0);
+  {
+    std::vector<char> in_hex(static_cast<std::size_t>(V), 0);
+    for (const auto& h : lm.hexes)
+      for (Index v : h) in_hex[v] = 1;
+    for (const auto& t : lm.tets)
+      for (Index v : t) shared[v] |= in_hex[v];
+    for (const auto& b : layer.hexes)
+      for (Index v : b.corners) shared[v] = 1;
+  }
+  auto may_meet = [&](const FaceKey& key) {
+    for (Index v : key)
+      if (v != kInvalidIndex && !shared[v]) return false;
+    return true;
+  };
+  primal::KeyMap<4> by_key(16 * layer.hexes.size());
   auto add_node = [&](const Point& p, const FaceKey& key) {
     points.push_back(p);
     origin_key.push_back(key);
@@ -324,13 +344,22 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
         continue;
       }
       const FaceKey key = normalized(o.nodes);
-      auto [it, inserted] = by_key.try_emplace(key, kInvalidIndex);
-      if (inserted) it->second = add_node(d.mesh.points[i], key);
-      g[i] = it->second;
+      if (!may_meet(key)) {
+        g[i] = add_node(d.mesh.points[i], key);
+        continue;
+      }
+      auto [id, inserted] = by_key.try_emplace(key, kInvalidIndex);
+      if (inserted) *id = add_node(d.mesh.points[i], key);
+      g[i] = *id;
     }
     return g;
   };
-  const std::vector<Index> gh = global_of(dh), gt = global_of(dt);
+  std::vector<Index> gh = global_of(dh), gt = global_of(dt);
+  // Positions now live in `points`; origins are needed again only for side sets.
+  for (primal::DicedHexMesh* d : {&dh, &dt}) {
+    d->mesh.points = {};
+    if (lm.side_sets.empty()) d->origin = {};
+  }
   res.diced_hexes = static_cast<Index>(dh.mesh.hexes.size());
   res.diced_tet_hexes = static_cast<Index>(dt.mesh.hexes.size());
   say("dicing: " + std::to_string(res.diced_hexes) + " hexes from hexes, " +
@@ -378,8 +407,8 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
         Index g = kInvalidIndex;
         if (key[1] == kInvalidIndex) {
           g = key[0];
-        } else if (auto it = by_key.find(key); it != by_key.end()) {
-          g = it->second;
+        } else if (const Index* id = by_key.find(key)) {
+          g = *id;
         }
         if (g == kInvalidIndex)
           throw TopologyError("buffer hex " + std::to_string(b) +
@@ -393,6 +422,7 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
       }
     }
   }
+  by_key = primal::KeyMap<4>();  // every template node is placed
   // Side faces shared by two buffer hexes.
   std::unordered_map<FaceKey, std::vector<std::pair<int, int>>, primal::IndexArrayHash> side_uses;
   for (std::size_t b = 0; b < nb; ++b)
@@ -450,6 +480,7 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
   std::vector<std::array<Index, 8>> hexes;
   std::vector<int> block;
   hexes.reserve(dh.mesh.hexes.size() + 26 * nb + dt.mesh.hexes.size());
+  block.reserve(hexes.capacity());
   for (const auto& h : dh.mesh.hexes) {
     std::array<Index, 8> o{};
     for (int c = 0; c < 8; ++c) o[c] = gh[h[c]];
@@ -470,6 +501,7 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
   }
   std::vector<Index> renum(points.size(), kInvalidIndex);
   primal::HexMesh mesh;
+  mesh.points.reserve(points.size());
   for (auto& h : hexes)
     for (Index& v : h) {
       if (renum[v] == kInvalidIndex) {
@@ -480,7 +512,77 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
     }
   mesh.hexes = std::move(hexes);
   mesh.block = std::move(block);
-  res.min_scaled_jacobian_before_smoothing = min_scaled_jacobian(mesh);
+
+  // Node sets and side sets carried over (they depend only on the numbering, not on node
+  // positions); after them the dicing and merging data are released before smoothing and
+  // verification, which need room of their own.
+  std::vector<primal::NodeSet> node_sets;
+  std::vector<primal::SideSet> side_sets;
+  for (const primal::NodeSet& ns : lm.node_sets) {
+    std::vector<char> in(V, 0);
+    for (Index v : ns.nodes) in[v] = 1;
+    primal::NodeSet o{ns.id, ns.name, {}};
+    for (std::size_t g = 0; g < origin_key.size(); ++g) {
+      if (renum[g] == kInvalidIndex || origin_key[g][0] == kInvalidIndex) continue;
+      bool all = true;
+      for (Index v : origin_key[g])
+        if (v != kInvalidIndex) all = all && in[v];
+      if (all) o.nodes.push_back(renum[g]);
+    }
+    std::sort(o.nodes.begin(), o.nodes.end());
+    node_sets.push_back(std::move(o));
+  }
+  if (!lm.side_sets.empty()) {
+    // Children of each input element, with their output hex number.
+    std::vector<std::vector<Index>> hex_children(lm.hexes.size()), tet_children(lm.tets.size());
+    for (std::size_t c = 0; c < dh.parent.size(); ++c)
+      hex_children[dh.parent[c]].push_back(static_cast<Index>(c));
+    for (std::size_t c = 0; c < dt.parent.size(); ++c)
+      tet_children[dt.parent[c]].push_back(static_cast<Index>(c));
+    const Index tet_offset = res.diced_hexes + res.geode_hexes;
+    for (const primal::SideSet& ss : lm.side_sets) {
+      primal::SideSet o{ss.id, ss.name, {}};
+      for (const primal::Side& side : ss.sides) {
+        const bool is_hex = side.element.kind == primal::ElementKind::Hex;
+        std::vector<Index> face;
+        if (is_hex) {
+          for (int c : topo::kHexFaceCorners[side.face])
+            face.push_back(lm.hexes[side.element.index][c]);
+        } else {
+          for (int c : topo::kTetFaceCorners[side.face])
+            face.push_back(lm.tets[side.element.index][c]);
+        }
+        const primal::DicedHexMesh& d = is_hex ? dh : dt;
+        const auto& children = is_hex ? hex_children[side.element.index]
+                                      : tet_children[side.element.index];
+        auto on_face = [&](Index node) {
+          const primal::NodeOrigin& og = d.origin[node];
+          if (node < V) return std::find(face.begin(), face.end(), node) != face.end();
+          if (og.kind == primal::NodeOriginKind::kCell) return false;
+          for (Index v : og.nodes)
+            if (v != kInvalidIndex && std::find(face.begin(), face.end(), v) == face.end())
+              return false;
+          return true;
+        };
+        for (Index c : children)
+          for (int f = 0; f < 6; ++f) {
+            bool all = true;
+            for (int k : topo::kHexFaceCorners[f]) all = all && on_face(d.mesh.hexes[c][k]);
+            if (all)
+              o.sides.push_back({{primal::ElementKind::Hex, is_hex ? c : tet_offset + c}, f});
+          }
+      }
+      side_sets.push_back(std::move(o));
+    }
+  }
+  dh = {}, dt = {};
+  for (auto* v : {&gh, &gt, &renum}) *v = {};
+  points = {}, origin_key = {}, inst_global = {}, inst_side = {};
+  // Without smoothing the positions do not change: the inverted hexes found here are the
+  // verification's too.
+  std::vector<Index> bad;
+  res.min_scaled_jacobian_before_smoothing =
+      min_scaled_jacobian(mesh, options.smooth == ConformSmooth::kNone ? &bad : nullptr);
 
   // 6. Smoothing, model boundary nodes fixed. Local: one small problem per buffer hex (its 26
   // geode hexes' nodes move, with every hex touching them; the rest is fixed), swept in order,
@@ -530,7 +632,10 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
       }
       for (Index v : movable) cons[local[v]] = primal::NodeConstraint::free();
       if (!sub.hexes.empty()) {
-        const primal::SmoothResult r = primal::smooth_hex_mesh(sub, cons, options.smooth_options);
+        const primal::SmoothResult r = primal::smooth_hex_mesh(
+            sub, cons,
+            options.smooth == ConformSmooth::kLocal ? options.local_smooth_options
+                                                    : options.smooth_options);
         // Keep the patch only if it did not lower its minimum (the optimiser returns its best
         // iterate, but an untangling failure could still leave it worse).
         if (r.final_min_scaled_jacobian >= r.initial_min_scaled_jacobian)
@@ -578,8 +683,7 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
   t0 = Clock::now();
   res.validity = primal::check_validity(mesh);
   if (!res.validity.ok()) res.warnings.push_back("invalid mesh: " + res.validity.summary());
-  std::vector<Index> bad;
-  min_scaled_jacobian(mesh, &bad);
+  if (options.smooth != ConformSmooth::kNone) min_scaled_jacobian(mesh, &bad);
   if (!bad.empty()) {
     std::ostringstream m;
     m << bad.size() << " hexes with scaled Jacobian <= 0:";
@@ -599,69 +703,14 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
   say("verification: " + std::string(res.validity.ok() ? "valid" : "INVALID") + " (" +
       std::to_string(since(t0)) + " s)");
 
-  // 8. The output model, with node sets and side sets carried over.
+  // 8. The output model.
   primal::Model& out = res.model;
   for (const auto& [id, name] : blocks) out.block_names[id] = name;
-  out.hex_block = mesh.block;
-  out.hexes = mesh.hexes;
-  out.points = mesh.points;
-  for (const primal::NodeSet& ns : lm.node_sets) {
-    std::vector<char> in(V, 0);
-    for (Index v : ns.nodes) in[v] = 1;
-    primal::NodeSet o{ns.id, ns.name, {}};
-    for (std::size_t g = 0; g < origin_key.size(); ++g) {
-      if (renum[g] == kInvalidIndex || origin_key[g][0] == kInvalidIndex) continue;
-      bool all = true;
-      for (Index v : origin_key[g])
-        if (v != kInvalidIndex) all = all && in[v];
-      if (all) o.nodes.push_back(renum[g]);
-    }
-    std::sort(o.nodes.begin(), o.nodes.end());
-    out.node_sets.push_back(std::move(o));
-  }
-  if (!lm.side_sets.empty()) {
-    // Children of each input element, with their output hex number.
-    std::vector<std::vector<Index>> hex_children(lm.hexes.size()), tet_children(lm.tets.size());
-    for (std::size_t c = 0; c < dh.parent.size(); ++c)
-      hex_children[dh.parent[c]].push_back(static_cast<Index>(c));
-    for (std::size_t c = 0; c < dt.parent.size(); ++c)
-      tet_children[dt.parent[c]].push_back(static_cast<Index>(c));
-    const Index tet_offset = res.diced_hexes + res.geode_hexes;
-    for (const primal::SideSet& ss : lm.side_sets) {
-      primal::SideSet o{ss.id, ss.name, {}};
-      for (const primal::Side& side : ss.sides) {
-        const bool is_hex = side.element.kind == primal::ElementKind::Hex;
-        std::vector<Index> face;
-        if (is_hex) {
-          for (int c : topo::kHexFaceCorners[side.face])
-            face.push_back(lm.hexes[side.element.index][c]);
-        } else {
-          for (int c : topo::kTetFaceCorners[side.face])
-            face.push_back(lm.tets[side.element.index][c]);
-        }
-        const primal::DicedHexMesh& d = is_hex ? dh : dt;
-        const auto& children = is_hex ? hex_children[side.element.index]
-                                      : tet_children[side.element.index];
-        auto on_face = [&](Index node) {
-          const primal::NodeOrigin& og = d.origin[node];
-          if (node < V) return std::find(face.begin(), face.end(), node) != face.end();
-          if (og.kind == primal::NodeOriginKind::kCell) return false;
-          for (Index v : og.nodes)
-            if (v != kInvalidIndex && std::find(face.begin(), face.end(), v) == face.end())
-              return false;
-          return true;
-        };
-        for (Index c : children)
-          for (int f = 0; f < 6; ++f) {
-            bool all = true;
-            for (int k : topo::kHexFaceCorners[f]) all = all && on_face(d.mesh.hexes[c][k]);
-            if (all)
-              o.sides.push_back({{primal::ElementKind::Hex, is_hex ? c : tet_offset + c}, f});
-          }
-      }
-      out.side_sets.push_back(std::move(o));
-    }
-  }
+  out.hex_block = std::move(mesh.block);
+  out.hexes = std::move(mesh.hexes);
+  out.points = std::move(mesh.points);
+  out.node_sets = std::move(node_sets);
+  out.side_sets = std::move(side_sets);
   res.seconds = since(t_start);
   return res;
 }

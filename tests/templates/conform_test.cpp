@@ -105,9 +105,9 @@ TEST_CASE("nugget demo, n = 2: side set 'outside' carried to the diced hexes") {
   // smoothing (fewer sharpness stages and iterations) untangles them and keeps the test fast
   // under the sanitizers.
   templates::ConformOptions options;
-  options.smooth_options.sharpness = {10, 40};
-  options.smooth_options.max_iterations = 200;
-  options.smooth_options.max_stage_iterations = 50;
+  options.local_smooth_options.sharpness = {10, 40};
+  options.local_smooth_options.max_iterations = 200;
+  options.local_smooth_options.max_stage_iterations = 50;
   const auto r = templates::conform(m, options);
   // Interface: the nugget cube's 6 faces, n x n = 4 quads each.
   check_result(r, {static_cast<Index>(m.hexes.size()), static_cast<Index>(m.tets.size()), 24});

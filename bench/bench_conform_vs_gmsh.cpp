@@ -1,0 +1,216 @@
+// Whole-process time and peak memory of `geode conform --smooth none` next to gmsh's all-hex
+// subdivision of the same tet part (the issue's Speed and memory case).
+//
+// The model is primal::grid_model: n x n x n unit cells, those with i >= n/2 split into 6 Kuhn
+// tets (n = 40: 32,000 hexes + 192,000 tets). It is written to a temporary directory twice, as
+// binary .msh v4.1: the whole model (geode's input) and its tet part alone, compacted (gmsh's
+// input). Then, each as a child process timed from fork to wait4 (wall time; peak RSS from the
+// child's rusage):
+//   gmsh subdivide        gmsh -nt 1 sub.geo -   with  Merge; Mesh.SubdivisionAlgorithm = 2;
+//                         RefineMesh;   (read + subdivide, nothing written)
+//   gmsh subdivide+save   the same, then Mesh.Binary = 1; Save "gmsh.msh";
+//   geode conform         geode conform model.msh -o geode.exo --report r.json --smooth none
+//                         --quiet   (read, interface, buffer layer, dice, templates, verify,
+//                         quality report, write Exodus)
+// Every child runs `repeats` times; the fastest run is shown (the machine is shared). Output hex
+// counts are read back (gmsh's file through read_gmsh, geode's from its report), so a child that
+// did nothing cannot look fast.
+//
+// Usage: bench_conform_vs_gmsh [n] [repeats] [geode-executable]
+//   n default 40, repeats default 1, geode default: `geode` next to this program; gmsh is
+//   /usr/bin/gmsh unless GMSH is set in the environment; GEODE_BENCH_KEEP set keeps the
+//   temporary directory (inputs, outputs, logs). Exit 0 when every child succeeded.
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "primal/demo_models.hpp"
+#include "primal/errors.hpp"
+#include "primal/io_gmsh.hpp"
+
+namespace fs = std::filesystem;
+namespace gp = geode::primal;
+
+namespace {
+
+struct Run {
+  double seconds = 0.0;
+  double peak_mib = 0.0;
+  int status = 0;  // wait status; 0 when the child exited 0
+};
+
+// fork + execv `argv`, stdout and stderr to `log`; wall time from fork to wait4.
+Run run_child(const std::vector<std::string>& argv, const fs::path& log) {
+  std::vector<char*> args;
+  for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
+  std::fflush(nullptr);
+  const auto t0 = std::chrono::steady_clock::now();
+  const pid_t pid = fork();
+  if (pid < 0) {
+    std::perror("bench_conform_vs_gmsh: fork");
+    std::exit(2);
+  }
+  if (pid == 0) {
+    if (!std::freopen(log.c_str(), "w", stdout) || !std::freopen(log.c_str(), "a", stderr))
+      _exit(126);
+    execv(args[0], args.data());
+    std::perror("execv");
+    _exit(127);
+  }
+  int status = 0;
+  rusage ru{};
+  if (wait4(pid, &status, 0, &ru) != pid) {
+    std::perror("bench_conform_vs_gmsh: wait4");
+    std::exit(2);
+  }
+  Run r;
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.peak_mib = ru.ru_maxrss / 1024.0;  // ru_maxrss is in KiB on Linux
+  r.status = status;
+  return r;
+}
+
+Run best_of(int repeats, const std::vector<std::string>& argv, const fs::path& log,
+            const char* what) {
+  Run best;
+  for (int i = 0; i < repeats; ++i) {
+    const Run r = run_child(argv, log);
+    if (r.status != 0) {
+      std::fprintf(stderr, "bench_conform_vs_gmsh: %s failed (wait status %d), see %s\n", what,
+                   r.status, log.c_str());
+      std::exit(1);
+    }
+    if (i == 0 || r.seconds < best.seconds) best = r;
+  }
+  return best;
+}
+
+void write_text(const fs::path& path, const std::string& text) {
+  std::ofstream os(path);
+  os << text;
+  if (!os) {
+    std::fprintf(stderr, "bench_conform_vs_gmsh: cannot write %s\n", path.c_str());
+    std::exit(2);
+  }
+}
+
+// The tet part alone with only the nodes it uses, in one block.
+gp::Model tet_model(const gp::Model& m) {
+  gp::Model t;
+  std::vector<gp::Index> renum(m.points.size(), gp::kInvalidIndex);
+  for (const auto& tet : m.tets) {
+    std::array<gp::Index, 4> o{};
+    for (int c = 0; c < 4; ++c) {
+      gp::Index& r = renum[static_cast<std::size_t>(tet[static_cast<std::size_t>(c)])];
+      if (r == gp::kInvalidIndex) {
+        r = static_cast<gp::Index>(t.points.size());
+        t.points.push_back(m.points[static_cast<std::size_t>(tet[static_cast<std::size_t>(c)])]);
+      }
+      o[static_cast<std::size_t>(c)] = r;
+    }
+    t.tets.push_back(o);
+  }
+  t.tet_block.assign(t.tets.size(), 1);
+  return t;
+}
+
+void print_row(const char* what, const Run& r, std::size_t hexes, const Run& reference) {
+  std::printf("%-22s %8.2f s %9.1f MiB %10zu hexes %7.0f B/hex   time %.2fx  memory %.2fx\n",
+              what, r.seconds, r.peak_mib, hexes, r.peak_mib * 1048576.0 / hexes,
+              r.seconds / reference.seconds, r.peak_mib / reference.peak_mib);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int n = argc > 1 ? std::atoi(argv[1]) : 40;
+  const int repeats = argc > 2 ? std::atoi(argv[2]) : 1;
+  const fs::path self = fs::canonical("/proc/self/exe");
+  const std::string geode = argc > 3 ? argv[3] : (self.parent_path() / "geode").string();
+  const char* gmsh_env = std::getenv("GMSH");
+  const std::string gmsh = gmsh_env ? gmsh_env : "/usr/bin/gmsh";
+  if (n < 2 || repeats < 1) {
+    std::fprintf(stderr, "usage: bench_conform_vs_gmsh [n >= 2] [repeats >= 1] [geode]\n");
+    return 2;
+  }
+  for (const auto& exe : {geode, gmsh})
+    if (access(exe.c_str(), X_OK) != 0) {
+      std::fprintf(stderr, "bench_conform_vs_gmsh: %s is not an executable\n", exe.c_str());
+      return 2;
+    }
+
+  std::string dir_template = (fs::temp_directory_path() / "geode-bench-XXXXXX").string();
+  if (!mkdtemp(dir_template.data())) {
+    std::perror("bench_conform_vs_gmsh: mkdtemp");
+    return 2;
+  }
+  const fs::path dir = dir_template;
+
+  const gp::Model model =
+      gp::grid_model({n, n, n}, 1.0, [n](int i, int, int) { return i >= n / 2; });
+  gp::write_gmsh(model, dir / "model.msh", gp::GmshFormat::Binary);
+  gp::write_gmsh(tet_model(model), dir / "tets.msh", gp::GmshFormat::Binary);
+  std::printf("n %d: %zu hexes + %zu tets (%zu nodes); inputs in %s\n", n, model.hexes.size(),
+              model.tets.size(), model.points.size(), dir.c_str());
+
+  const std::string refine = "Merge \"" + (dir / "tets.msh").string() +
+                             "\";\nMesh.SubdivisionAlgorithm = 2;\nRefineMesh;\n";
+  write_text(dir / "sub.geo", refine);
+  write_text(dir / "sub_save.geo",
+             refine + "Mesh.Binary = 1;\nSave \"" + (dir / "gmsh.msh").string() + "\";\n");
+
+  const Run sub = best_of(repeats, {gmsh, "-nt", "1", (dir / "sub.geo").string(), "-"},
+                          dir / "gmsh.log", "gmsh subdivide");
+  const Run sub_save = best_of(repeats, {gmsh, "-nt", "1", (dir / "sub_save.geo").string(), "-"},
+                               dir / "gmsh_save.log", "gmsh subdivide+save");
+  const Run conform =
+      best_of(repeats,
+              {geode, "conform", (dir / "model.msh").string(), "-o", (dir / "geode.exo").string(),
+               "--report", (dir / "report.json").string(), "--smooth", "none", "--quiet"},
+              dir / "geode.log", "geode conform");
+
+  std::size_t gmsh_hexes = 0, geode_hexes = 0;
+  bool geode_valid = false;
+  try {
+    const gp::Model g = gp::read_gmsh(dir / "gmsh.msh");
+    gmsh_hexes = g.hexes.size();
+    if (!g.tets.empty()) std::printf("warning: gmsh's output still has %zu tets\n", g.tets.size());
+    std::ifstream is(dir / "report.json");
+    const nlohmann::json j = nlohmann::json::parse(is);
+    geode_hexes = j.at("output").at("hexes").get<std::size_t>();
+    geode_valid = j.at("valid").get<bool>();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_conform_vs_gmsh: reading the outputs back: %s\n", e.what());
+    return 1;
+  }
+  if (gmsh_hexes == 0 || geode_hexes == 0) {
+    std::fprintf(stderr, "bench_conform_vs_gmsh: an output has no hexes\n");
+    return 1;
+  }
+
+  std::printf("best of %d; ratios against gmsh subdivide (read + RefineMesh, no output)\n",
+              repeats);
+  print_row("gmsh subdivide", sub, gmsh_hexes, sub);
+  print_row("gmsh subdivide+save", sub_save, gmsh_hexes, sub);
+  print_row("geode conform", conform, geode_hexes, sub);
+  std::printf("geode conform / gmsh subdivide+save: time %.2fx, memory %.2fx; output %s\n",
+              conform.seconds / sub_save.seconds, conform.peak_mib / sub_save.peak_mib,
+              geode_valid ? "valid" : "INVALID");
+  if (std::getenv("GEODE_BENCH_KEEP")) {
+    std::printf("kept %s\n", dir.c_str());
+  } else {
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+  }
+  return geode_valid ? 0 : 1;
+}

@@ -1,0 +1,154 @@
+// The `geode conform` command end to end: a small hex + tet model written as .msh and as .exo
+// is conformed into an Exodus file that is read back (all hex, valid, counts as in the JSON
+// report); bad input exits non-zero, names the file and writes nothing.
+#include <doctest/doctest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "primal/demo_models.hpp"
+#include "primal/io_exodus.hpp"
+#include "primal/io_gmsh.hpp"
+#include "primal/validity.hpp"
+#include "templates/conform.hpp"
+
+using namespace geode;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Run {
+  int code = -1;
+  std::string out;  // standard output and standard error
+};
+
+Run geode_cli(const std::string& args) {
+  Run r;
+  const std::string cmd = std::string(GEODE_CLI_PATH) + " " + args + " 2>&1";
+  FILE* p = ::popen(cmd.c_str(), "r");
+  REQUIRE(p != nullptr);
+  char buf[4096];
+  std::size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
+  const int status = ::pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+// A fresh directory removed at the end of the test.
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    std::string t = (fs::temp_directory_path() / "geode-conform-cli-XXXXXX").string();
+    REQUIRE(::mkdtemp(t.data()) != nullptr);
+    path = t;
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+};
+
+// 4 x 2 x 2 unit cells; cells with i >= 2 split into 6 tets. Hand count: 8 hexes, 8 * 6 = 48
+// tets, the interface x = 2 is 2 x 2 = 4 quads.
+primal::Model small_model() {
+  return primal::grid_model({4, 2, 2}, 1.0, [](int i, int, int) { return i >= 2; });
+}
+
+}  // namespace
+
+TEST_CASE("geode conform: .msh and .exo input -> valid all-hex Exodus matching the report") {
+  TempDir dir;
+  const primal::Model model = small_model();
+  REQUIRE(model.hexes.size() == 8);
+  REQUIRE(model.tets.size() == 48);
+  primal::write_gmsh(model, dir.path / "in.msh");
+  primal::write_exodus(model, dir.path / "in.exo");
+
+  for (const char* input : {"in.msh", "in.exo"}) {
+    CAPTURE(input);
+    const fs::path out = dir.path / (std::string(input) + ".out.exo");
+    const fs::path report = dir.path / (std::string(input) + ".json");
+    const Run r = geode_cli("conform " + (dir.path / input).string() + " -o " + out.string() +
+                            " --report " + report.string() + " --quiet");
+    INFO(r.out);
+    REQUIRE(r.code == 0);
+    CHECK(r.out.empty());  // --quiet
+
+    const primal::Model result = primal::read_exodus(out);
+    CHECK(result.tets.empty());
+    const primal::HexValidityReport v = primal::check_validity(primal::hex_part(result));
+    INFO(v.summary());
+    CHECK(v.ok());
+    CHECK(v.boundary.euler == 2);  // the box stays a ball
+
+    std::ifstream is(report);
+    const nlohmann::json j = nlohmann::json::parse(is);  // throws (fails the test) if malformed
+    CHECK(j.at("input").at("hexes") == 8);
+    CHECK(j.at("input").at("tets") == 48);
+    CHECK(j.at("input").at("interface_quads") == 4);
+    // 8 hexes * 8 + 4 buffer hexes * 26 + 48 tets * 4.
+    const auto& o = j.at("output");
+    CHECK(o.at("diced_hexes") == 64);
+    CHECK(o.at("geode_hexes") == 104);
+    CHECK(o.at("diced_tet_hexes") == 192);
+    CHECK(o.at("hexes") == 360);
+    CHECK(o.at("hexes").get<std::size_t>() == result.hexes.size());
+    CHECK(o.at("nodes").get<std::size_t>() == result.points.size());
+    CHECK(j.at("valid") == true);
+    // One Exodus block per origin, with the report's counts.
+    auto in_block = [&](int b) { return std::count(result.hex_block.begin(), result.hex_block.end(), b); };
+    CHECK(in_block(templates::kDicedHexBlock) == 64);
+    CHECK(in_block(templates::kGeodeBlock) == 104);
+    CHECK(in_block(templates::kDicedTetBlock) == 192);
+    std::size_t block_hexes = 0;
+    for (const auto& b : j.at("blocks")) block_hexes += b.at("quality").at("num_hexes").get<std::size_t>();
+    CHECK(block_hexes == 360);
+  }
+}
+
+TEST_CASE("geode conform: bad input exits non-zero, names the file and writes nothing") {
+  TempDir dir;
+  const fs::path out = dir.path / "out.exo";
+  const fs::path report = dir.path / "r.json";
+  auto check_refused = [&](const fs::path& input, const std::string& why) {
+    CAPTURE(input);
+    const Run r = geode_cli("conform " + input.string() + " -o " + out.string() + " --report " +
+                            report.string() + " --quiet");
+    INFO(r.out);
+    CHECK(r.code != 0);
+    CHECK(r.out.find(input.string()) != std::string::npos);
+    CHECK(r.out.find(why) != std::string::npos);
+    CHECK_FALSE(fs::exists(out));
+    CHECK_FALSE(fs::exists(report));
+  };
+
+  SUBCASE("a file that does not exist") { check_refused(dir.path / "missing.msh", "no such file"); }
+  SUBCASE("a hex-only model") {
+    const primal::Model hexes = primal::grid_model({2, 2, 2}, 1.0, [](int, int, int) { return false; });
+    primal::write_gmsh(hexes, dir.path / "hexes.msh");
+    check_refused(dir.path / "hexes.msh", "0 tets");
+  }
+  SUBCASE("a hex part and a tet part that do not touch") {
+    // Two hex cells, a gap cell and two tet cells: no interface quad.
+    const primal::Model apart = [] {
+      primal::Model m = primal::grid_model({5, 1, 1}, 1.0, [](int i, int, int) { return i >= 3; });
+      m.hexes.erase(m.hexes.begin() + 2);
+      m.hex_block.erase(m.hex_block.begin() + 2);
+      return m;
+    }();
+    primal::write_exodus(apart, dir.path / "apart.exo");
+    check_refused(dir.path / "apart.exo", "no interface quad");
+  }
+  // Nothing half-written left behind either.
+  for (const auto& e : fs::directory_iterator(dir.path)) {
+    const std::string name = e.path().filename().string();
+    CHECK((name == "hexes.msh" || name == "apart.exo"));
+  }
+}
