@@ -2,8 +2,6 @@
 // is conformed into an Exodus file that is read back (all hex, valid, counts as in the JSON
 // report); bad input exits non-zero, names the file and writes nothing.
 #include <doctest/doctest.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -16,6 +14,7 @@
 #include "primal/io_exodus.hpp"
 #include "primal/io_gmsh.hpp"
 #include "primal/validity.hpp"
+#include "support/cli_run.hpp"
 #include "templates/conform.hpp"
 
 using namespace geode;
@@ -23,37 +22,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Run {
-  int code = -1;
-  std::string out;  // standard output and standard error
-};
+using test::TempDir;
+using Run = test::CliRun;
 
-Run geode_cli(const std::string& args) {
-  Run r;
-  const std::string cmd = std::string(GEODE_CLI_PATH) + " " + args + " 2>&1";
-  FILE* p = ::popen(cmd.c_str(), "r");
-  REQUIRE(p != nullptr);
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  const int status = ::pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
-
-// A fresh directory removed at the end of the test.
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    std::string t = (fs::temp_directory_path() / "geode-conform-cli-XXXXXX").string();
-    REQUIRE(::mkdtemp(t.data()) != nullptr);
-    path = t;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-};
+// Standard output and standard error together: the messages are checked.
+Run geode_cli(const std::string& args) { return test::geode_cli(args, true); }
 
 // 4 x 2 x 2 unit cells; cells with i >= 2 split into 6 tets. Hand count: 8 hexes, 8 * 6 = 48
 // tets, the interface x = 2 is 2 x 2 = 4 quads.
