@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cctype>
 #include <filesystem>
 #include <iostream>
@@ -113,8 +114,19 @@ void run(const primal::Model& model, const ConformArgs& a, bool tables,
          const std::string& source = {}) {
   templates::ConformOptions opts;
   opts.smooth = templates::parse_conform_smooth(a.smooth);
-  if (!a.quiet && isatty(STDERR_FILENO))
+  if (!a.quiet && isatty(STDERR_FILENO)) {
     opts.progress = [](const std::string& line) { std::cerr << "geode: " << line << "\n"; };
+    // Local smoothing is the long step: a bar redrawn in place, at most ten times a second.
+    auto last = std::make_shared<std::chrono::steady_clock::time_point>();
+    opts.smoothing_progress = [last](std::size_t done, std::size_t total) {
+      const auto now = std::chrono::steady_clock::now();
+      if (done < total && now - *last < std::chrono::milliseconds(100)) return;
+      *last = now;
+      const std::size_t width = 30, filled = total ? width * done / total : width;
+      std::cerr << "\rgeode: smoothing [" << std::string(filled, '#') << std::string(width - filled, '.') << "] "
+                << done << " / " << total << " buffer hexes" << (done == total ? "\n" : "") << std::flush;
+    };
+  }
   const std::string prefix = source.empty() ? "" : source + ": ";
   templates::ConformResult r;
   try {

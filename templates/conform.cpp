@@ -664,7 +664,9 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
         std::sort(movable.begin(), movable.end());
         movable.erase(std::unique(movable.begin(), movable.end()), movable.end());
         smooth_patch(movable);
-        if ((b + 1) % 100 == 0)
+        if (options.smoothing_progress)
+          options.smoothing_progress(b + 1, nb);
+        else if ((b + 1) % 100 == 0)
           say("smoothing: " + std::to_string(b + 1) + " / " + std::to_string(nb) +
               " buffer hexes (" + std::to_string(since(t0)) + " s)");
       }

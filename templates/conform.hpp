@@ -52,6 +52,9 @@ struct ConformOptions {
   }();
   // Called with one line per stage (for the command line's progress output); may be empty.
   std::function<void(const std::string&)> progress;
+  // Called after each buffer hex of local smoothing with (done, total), for a progress bar;
+  // when empty, `progress` gets a line every 100 buffer hexes instead.
+  std::function<void(std::size_t done, std::size_t total)> smoothing_progress;
 };
 
 // Output element blocks, by origin.
