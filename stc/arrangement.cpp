@@ -10,6 +10,7 @@
 
 #include "primal/disjoint_sets.hpp"
 #include "primal/errors.hpp"
+#include "primal/multilinear.hpp"
 #include "primal/topology.hpp"
 
 namespace geode::stc {
@@ -29,31 +30,16 @@ std::string format_point(const Point& x, int dim) {
 double norm_d(const Point& v, int dim) { return dim == 3 ? v.norm() : std::hypot(v[0], v[1]); }
 
 // Trilinear (bilinear for dim 2) map of the unit cube onto the hexahedron (quadrilateral)
-// with VTK corners P: corner c's shape function is the product over the axes of r or 1 - r.
+// with VTK corners P (primal/multilinear.hpp), kept in the plane z = 0 in 2D.
 Point multilinear(const std::array<Point, 8>& P, const Point& r, int dim) {
-  Point x = Point::Zero();
-  for (int c = 0; c < (1 << dim); ++c) {
-    const auto& rc = primal::topology::kHexCornerCoords[static_cast<std::size_t>(c)];
-    double w = 1.0;
-    for (int a = 0; a < dim; ++a) w *= rc[static_cast<std::size_t>(a)] ? r[a] : 1.0 - r[a];
-    x += w * P[static_cast<std::size_t>(c)];
-  }
+  Point x = primal::multilinear_point(P, r, dim);
   if (dim == 2) x[2] = 0.0;
   return x;
 }
 
-// Determinant of the map's Jacobian at local coordinates r (columns d/dr, d/ds, d/dt).
+// Determinant of the map's Jacobian at local coordinates r.
 double multilinear_jacobian(const std::array<Point, 8>& P, const Point& r, int dim) {
-  Eigen::Matrix3d J = Eigen::Matrix3d::Zero();
-  for (int c = 0; c < (1 << dim); ++c) {
-    const auto& rc = primal::topology::kHexCornerCoords[static_cast<std::size_t>(c)];
-    for (int d = 0; d < dim; ++d) {
-      double w = rc[static_cast<std::size_t>(d)] ? 1.0 : -1.0;
-      for (int a = 0; a < dim; ++a)
-        if (a != d) w *= rc[static_cast<std::size_t>(a)] ? r[a] : 1.0 - r[a];
-      J.col(d) += w * P[static_cast<std::size_t>(c)];
-    }
-  }
+  const Eigen::Matrix3d J = primal::multilinear_jacobian(P, r, dim);
   return dim == 3 ? J.determinant() : J(0, 0) * J(1, 1) - J(0, 1) * J(1, 0);
 }
 

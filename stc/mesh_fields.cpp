@@ -12,6 +12,7 @@
 
 #include "primal/disjoint_sets.hpp"
 #include "primal/errors.hpp"
+#include "primal/multilinear.hpp"
 #include "primal/topology.hpp"
 
 namespace geode::stc {
@@ -23,8 +24,7 @@ using primal::Index;
 template <int Dim>
 using CellArray = std::array<Index, std::size_t{1} << Dim>;
 
-// Multilinear cell maps on the unit cube / square (corner c at kHexCornerCoords[c]; the quad's
-// corners are the hex's first four) and the cell holding a point.
+// The cell holding a point, and its local coordinates under the cell's multilinear map.
 template <int Dim>
 class CellLocator {
  public:
@@ -69,30 +69,20 @@ class CellLocator {
     }
   }
 
-  static double shape(int c, const Vec& u) {
-    double w = 1.0;
-    for (int a = 0; a < Dim; ++a) w *= topo::kHexCornerCoords[static_cast<std::size_t>(c)][static_cast<std::size_t>(a)] ? u[a] : 1.0 - u[a];
-    return w;
+  static Point local(const Vec& u) {
+    Point r = Point::Zero();
+    r.template head<Dim>() = u;
+    return r;
   }
+  static double shape(int c, const Vec& u) { return primal::multilinear_shape(c, local(u), Dim); }
 
+  // The cell's map (primal/multilinear.hpp) at u, and its Jacobian.
   Vec map(Index cell, const Vec& u, Mat* jacobian = nullptr) const {
-    Vec x = Vec::Zero();
-    if (jacobian) jacobian->setZero();
-    for (int c = 0; c < kCorners; ++c) {
-      const Vec p = points_[static_cast<std::size_t>(cells_[static_cast<std::size_t>(cell)][static_cast<std::size_t>(c)])].template head<Dim>();
-      x += shape(c, u) * p;
-      if (!jacobian) continue;
-      for (int a = 0; a < Dim; ++a) {
-        // d(shape)/du_a: the factor along a differentiated.
-        double w = 1.0;
-        for (int b = 0; b < Dim; ++b) {
-          const bool one = topo::kHexCornerCoords[static_cast<std::size_t>(c)][static_cast<std::size_t>(b)] != 0;
-          w *= b == a ? (one ? 1.0 : -1.0) : (one ? u[b] : 1.0 - u[b]);
-        }
-        jacobian->col(a) += w * p;
-      }
-    }
-    return x;
+    std::array<Point, kCorners> P;
+    for (int c = 0; c < kCorners; ++c)
+      P[static_cast<std::size_t>(c)] = points_[static_cast<std::size_t>(cells_[static_cast<std::size_t>(cell)][static_cast<std::size_t>(c)])];
+    if (jacobian) *jacobian = primal::multilinear_jacobian(P, local(u), Dim).template topLeftCorner<Dim, Dim>();
+    return primal::multilinear_point(P, local(u), Dim).template head<Dim>();
   }
 
   // Local coordinates of x in `cell` by Newton's method, kept within a margin of the cell so

@@ -16,6 +16,7 @@
 #include "primal/errors.hpp"
 #include "primal/interface.hpp"
 #include "primal/key_map.hpp"
+#include "primal/multilinear.hpp"
 #include "primal/quality.hpp"
 #include "primal/topology.hpp"
 #include "templates/geode.hpp"
@@ -148,16 +149,6 @@ RefTemplate make_reference(const Eigen::Vector3d& box, std::array<int, 2> diagon
   return ref;
 }
 
-Point trilinear(const std::array<Point, 8>& P, const Point& q) {
-  Point x = Point::Zero();
-  for (int c = 0; c < 8; ++c) {
-    const auto& cc = topo::kHexCornerCoords[c];
-    const double w = (cc[0] ? q.x() : 1 - q.x()) * (cc[1] ? q.y() : 1 - q.y()) *
-                     (cc[2] ? q.z() : 1 - q.z());
-    x += w * P[c];
-  }
-  return x;
-}
 
 
 // Matches the nodes of side face ka of template A with those of side face kb of template B
@@ -398,7 +389,7 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
     inst_global[b].assign(n, kInvalidIndex);
     inst_side[b].assign(n, kInvalidIndex);
     for (std::size_t i = 0; i < n; ++i) {
-      const Point x = trilinear(P, ref.rst[i]);
+      const Point x = primal::multilinear_point(P, ref.rst[i], 3);
       if (!ref.key_corners[i].empty()) {
         FaceKey key = kNoKey;
         for (std::size_t k = 0; k < ref.key_corners[i].size(); ++k)

@@ -13,7 +13,9 @@
 #include <sstream>
 
 #include "primal/errors.hpp"
+#include "primal/multilinear.hpp"
 #include "primal/quality.hpp"
+#include "primal/topology.hpp"
 
 namespace geode::templates {
 namespace {
@@ -276,17 +278,17 @@ primal::SmoothResult smooth_in_cell(Template& t, const Eigen::Vector3d& box_of_t
       origin[static_cast<std::size_t>(2 * axis + high)] = centre;
       normal[static_cast<std::size_t>(2 * axis + high)] = n.normalized();
     }
-  // Trilinear map of the reference position (s, v, w) in [0, 1]^3.
-  for (auto& p : t.hex.points) {
-    const double a[3] = {p.x() / box_of_t.x() + 0.5, p.y() / box_of_t.y() + 0.5, p.z() / box_of_t.z() + 0.5};
-    Point x = Point::Zero();
-    for (int i = 0; i < 8; ++i) {
-      double w = 1.0;
-      for (int k = 0; k < 3; ++k) w *= (i >> k) & 1 ? a[k] : 1.0 - a[k];
-      x += w * cell[static_cast<std::size_t>(i)];
-    }
-    p = x;
+  // Trilinear map (primal/multilinear.hpp) of the reference position in [0, 1]^3; the cell's
+  // corners are numbered bitwise here (bx + 2 by + 4 bz), VTK corner c is the one at
+  // kHexCornerCoords[c].
+  std::array<Point, 8> vtk;
+  for (int c = 0; c < 8; ++c) {
+    const auto& rc = primal::topology::kHexCornerCoords[static_cast<std::size_t>(c)];
+    vtk[static_cast<std::size_t>(c)] = cell[static_cast<std::size_t>(rc[0] + 2 * rc[1] + 4 * rc[2])];
   }
+  for (auto& p : t.hex.points)
+    p = primal::multilinear_point(
+        vtk, Point(p.x() / box_of_t.x() + 0.5, p.y() / box_of_t.y() + 0.5, p.z() / box_of_t.z() + 0.5), 3);
   std::vector<primal::NodeConstraint> c;
   for (std::size_t n = 0; n < t.hex.points.size(); ++n) {
     std::vector<int> faces;
