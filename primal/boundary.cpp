@@ -7,6 +7,7 @@
 #include <unordered_set>
 
 #include "primal/errors.hpp"
+#include "primal/key_map.hpp"
 #include "primal/topology.hpp"
 
 namespace geode::primal {
@@ -80,11 +81,25 @@ std::vector<EdgeKey> unique_edges(const HexMesh& mesh) {
 }
 
 std::vector<BoundaryQuad> boundary_quads(const HexMesh& mesh) {
+  check_indices(mesh);
+  // Face key -> its first use (6 hex + local face), or kShared once a second hex uses it: one
+  // flat map instead of unique_faces' per-face use lists (conform calls this on meshes of
+  // millions of hexes). Same result and order: boundary faces by first appearance.
+  constexpr Index kShared = -2;
+  KeyMap<4> first_use(mesh.hexes.size() * 3);
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
+    for (int f = 0; f < topo::kHexFaces; ++f) {
+      const auto [slot, inserted] =
+          first_use.try_emplace(face_key(hex_face_nodes(mesh.hexes[h], f)), static_cast<Index>(6 * h + f));
+      if (!inserted) *slot = kShared;
+    }
   std::vector<BoundaryQuad> out;
-  for (const auto& f : unique_faces(mesh)) {
-    if (f.uses.size() == 1)
-      out.push_back(BoundaryQuad{f.uses[0].hex, f.uses[0].local_face, f.nodes});
-  }
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
+    for (int f = 0; f < topo::kHexFaces; ++f) {
+      const auto nodes = hex_face_nodes(mesh.hexes[h], f);
+      if (*first_use.find(face_key(nodes)) == static_cast<Index>(6 * h + f))
+        out.push_back(BoundaryQuad{static_cast<Index>(h), f, nodes});
+    }
   return out;
 }
 
