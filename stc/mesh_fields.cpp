@@ -106,6 +106,8 @@ class CellLocator {
 
   Hit locate(const Point& p) const {
     const Vec x = p.template head<Dim>();
+    // A diverged iterate: no cell, and the field's value is NaN (the engine rejects it).
+    if (!x.allFinite()) return {0, Vec::Constant(std::numeric_limits<double>::quiet_NaN())};
     // Every sheet is evaluated at the same points (values, finite-difference probes, every
     // point of a traced curve once per other sheet): a direct-mapped cache keyed by the exact
     // coordinates.
@@ -160,7 +162,8 @@ class CellLocator {
     std::array<int, Dim> b{};
     for (int a = 0; a < Dim; ++a) {
       const double t = (x[a] - lo_[a]) / std::max(hi_[a] - lo_[a], 1e-300);
-      b[a] = std::clamp(static_cast<int>(std::floor(t * n_[a])), 0, n_[a] - 1);
+      // Clamped as a double: a point far off the mesh must not overflow the int cast.
+      b[a] = static_cast<int>(std::clamp(std::floor(t * n_[a]), 0.0, n_[a] - 1.0));
     }
     return b;
   }
