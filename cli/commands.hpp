@@ -1,6 +1,10 @@
 #pragma once
 // Sub-commands of the `geode` command line; each file registers its own.
 #include <CLI/CLI.hpp>
+#include <filesystem>
+#include <string>
+
+#include "primal/model.hpp"
 
 namespace geode::cli {
 
@@ -8,5 +12,11 @@ void add_template_command(CLI::App& app);   // cli/template_command.cpp
 void add_study_commands(CLI::App& app);     // cli/study_command.cpp
 void add_conform_commands(CLI::App& app);   // cli/conform_command.cpp: conform, demo
 void add_dual_command(CLI::App& app);       // cli/dual_command.cpp
+
+// Shared by the commands (cli/files.cpp): the extension in lower case (".msh"), and a model
+// read by extension (.msh, .exo, .e); InvalidInput naming the file when it is missing or of
+// another format.
+std::string file_extension(const std::filesystem::path& p);
+primal::Model read_model(const std::filesystem::path& path);
 
 }  // namespace geode::cli

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cctype>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -26,30 +25,15 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string extension(const fs::path& p) {
-  std::string e = p.extension().string();
-  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
-  return e;
-}
-
-primal::Model read_model(const fs::path& path) {
-  const std::string e = extension(path);
-  if (!fs::exists(path)) throw InvalidInput(path.string() + ": no such file");
-  if (e == ".msh") return primal::read_gmsh(path);
-  if (e == ".exo" || e == ".e") return primal::read_exodus(path);
-  throw InvalidInput(path.string() + ": unknown input format '" + e +
-                     "' (expected .msh, .exo or .e)");
-}
-
 void check_output_extension(const fs::path& path) {
-  const std::string e = extension(path);
+  const std::string e = file_extension(path);
   if (e != ".exo" && e != ".e" && e != ".msh" && e != ".vtu")
     throw InvalidInput(path.string() + ": unknown output format '" + e +
                        "' (expected .exo, .e, .msh or .vtu)");
 }
 
 void write_model(const primal::Model& model, const fs::path& path) {
-  const std::string e = extension(path);
+  const std::string e = file_extension(path);
   if (e == ".exo" || e == ".e") return primal::write_exodus(model, path);
   if (e == ".msh") return primal::write_gmsh(model, path);
   if (e == ".vtu") return primal::write_vtu(path, primal::hex_part(model));

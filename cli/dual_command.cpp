@@ -2,7 +2,6 @@
 // side: stc/mesh_dual), and with --rebuild the same sheets handed to the arrangement engine and
 // dualized back (stc/mesh_fields, compute_arrangement, dualize).
 #include <algorithm>
-#include <cctype>
 #include <filesystem>
 #include <iostream>
 #include <map>
@@ -12,8 +11,6 @@
 #include "cli/commands.hpp"
 #include "primal/atomic_file.hpp"
 #include "primal/errors.hpp"
-#include "primal/io_exodus.hpp"
-#include "primal/io_gmsh.hpp"
 #include "primal/io_vtk.hpp"
 #include "primal/model.hpp"
 #include "stc/arrangement.hpp"
@@ -26,12 +23,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using primal::Index;
-
-std::string lower_extension(const fs::path& p) {
-  std::string e = p.extension().string();
-  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
-  return e;
-}
 
 struct DualArgs {
   std::string input;
@@ -49,7 +40,7 @@ struct InputMesh {
 
 InputMesh read_input(const fs::path& path) {
   if (!fs::exists(path)) throw InvalidInput(path.string() + ": no such file");
-  const std::string e = lower_extension(path);
+  const std::string e = file_extension(path);
   InputMesh m;
   if (e == ".vtu" || e == ".vtk") {
     const primal::VtkGrid g = primal::read_vtk_file(path);
@@ -67,13 +58,9 @@ InputMesh read_input(const fs::path& path) {
     }
     return m;
   }
-  primal::Model model;
-  if (e == ".msh")
-    model = primal::read_gmsh(path);
-  else if (e == ".exo" || e == ".e")
-    model = primal::read_exodus(path);
-  else
+  if (e != ".msh" && e != ".exo" && e != ".e")
     throw InvalidInput(path.string() + ": unknown input format '" + e + "' (expected .vtu, .vtk, .msh, .exo or .e)");
+  const primal::Model model = read_model(path);
   if (!model.tets.empty())
     throw InvalidInput(path.string() + ": holds " + std::to_string(model.tets.size()) +
                        " tets; the dual is read off all-hex meshes (use `geode conform` first)");
@@ -153,7 +140,7 @@ void run_dual(const DualArgs& a) {
 
   if (!a.rebuild.empty()) {
     const fs::path out(a.rebuild);
-    const std::string e = lower_extension(out);
+    const std::string e = file_extension(out);
     if (e != ".vtu" && e != ".vtk")
       throw InvalidInput(out.string() + ": unknown output format '" + e + "' (expected .vtu or .vtk)");
     // Name the input in what the engine reports (it only knows hexes and sheets by number).

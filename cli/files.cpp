@@ -1,0 +1,28 @@
+// File-name helpers shared by the commands (cli/commands.hpp).
+#include <algorithm>
+#include <cctype>
+
+#include "cli/commands.hpp"
+#include "primal/errors.hpp"
+#include "primal/io_exodus.hpp"
+#include "primal/io_gmsh.hpp"
+
+namespace geode::cli {
+
+namespace fs = std::filesystem;
+
+std::string file_extension(const fs::path& p) {
+  std::string e = p.extension().string();
+  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
+  return e;
+}
+
+primal::Model read_model(const fs::path& path) {
+  const std::string e = file_extension(path);
+  if (!fs::exists(path)) throw InvalidInput(path.string() + ": no such file");
+  if (e == ".msh") return primal::read_gmsh(path);
+  if (e == ".exo" || e == ".e") return primal::read_exodus(path);
+  throw InvalidInput(path.string() + ": unknown input format '" + e + "' (expected .msh, .exo or .e)");
+}
+
+}  // namespace geode::cli
