@@ -62,4 +62,32 @@ inline constexpr std::array<std::array<int, 2>, 6> kTetEdgeCorners{{
 // Triangle: corners counter-clockwise.
 inline constexpr std::array<std::array<int, 2>, 3> kTriEdgeCorners{{{0, 1}, {1, 2}, {2, 0}}};
 
+// The cells of a d-dimensional mesh as one trait, for code written once for hex (3) and quad
+// (2) meshes: corners, facets (what two neighbouring cells share: hex faces, quad edges),
+// edges and their parallel class.
+template <int Dim>
+struct CellTopology;
+
+template <>
+struct CellTopology<3> {
+  static constexpr int kCorners = kHexCorners;
+  static constexpr int kFacets = kHexFaces;
+  static constexpr int kFacetSize = 4;
+  static constexpr const char* kCellName = "hex";
+  static constexpr const auto& edges = kHexEdgeCorners;
+  static constexpr const auto& facets = kHexFaceCorners;
+  static constexpr int edge_class(int e) { return e / 4; }
+};
+
+template <>
+struct CellTopology<2> {
+  static constexpr int kCorners = 4;
+  static constexpr int kFacets = 4;
+  static constexpr int kFacetSize = 2;
+  static constexpr const char* kCellName = "quad";
+  static constexpr const auto& edges = kQuadEdgeCorners;
+  static constexpr const auto& facets = kQuadEdgeCorners;
+  static constexpr int edge_class(int e) { return e % 2; }  // opposite edges i, i + 2
+};
+
 }  // namespace geode::primal::topology

@@ -18,32 +18,9 @@ namespace {
 using primal::Index;
 namespace topo = primal::topology;
 
-// Reference-cell tables per dimension, read from primal/topology.hpp.
+// Reference-cell tables per dimension (primal/topology.hpp).
 template <int Dim>
-struct Ref;
-
-template <>
-struct Ref<3> {
-  static constexpr int kCorners = 8;
-  static constexpr int kFacets = 6;
-  static constexpr int kFacetSize = 4;
-  static constexpr const char* kCellName = "hex";
-  static constexpr const auto& edges = topo::kHexEdgeCorners;
-  static constexpr const auto& facets = topo::kHexFaceCorners;
-  static constexpr int edge_class(int e) { return e / 4; }  // topology.hpp: class e / 4
-};
-
-template <>
-struct Ref<2> {
-  static constexpr int kCorners = 4;
-  static constexpr int kFacets = 4;
-  static constexpr int kFacetSize = 2;
-  static constexpr const char* kCellName = "quad";
-  static constexpr const auto& edges = topo::kQuadEdgeCorners;
-  static constexpr const auto& facets = topo::kQuadEdgeCorners;
-  static constexpr int edge_class(int e) { return e % 2; }  // opposite edges i, i+2
-};
-
+using Ref = topo::CellTopology<Dim>;
 
 std::uint64_t pair_key(Index a, Index b) {
   if (a > b) std::swap(a, b);

@@ -40,20 +40,12 @@ template <int N>
 struct Kind;
 
 template <>
-struct Kind<8> {
-  static constexpr int kFacets = 6;
-  static constexpr int kFacetSize = 4;
-  static constexpr const auto& facets = topo::kHexFaceCorners;
-  static constexpr const auto& edges = topo::kHexEdgeCorners;
+struct Kind<8> : topo::CellTopology<3> {
   static const std::vector<std::array<int, 8>>& symmetries() { return hex_symmetries(); }
 };
 
 template <>
-struct Kind<4> {
-  static constexpr int kFacets = 4;
-  static constexpr int kFacetSize = 2;
-  static constexpr const auto& facets = topo::kQuadEdgeCorners;
-  static constexpr const auto& edges = topo::kQuadEdgeCorners;
+struct Kind<4> : topo::CellTopology<2> {
   static const std::vector<std::array<int, 4>>& symmetries() { return quad_symmetries(); }
 };
 
