@@ -1,7 +1,6 @@
 #include "stc/dualize.hpp"
 
 #include <algorithm>
-#include <map>
 #include <set>
 #include <sstream>
 
@@ -67,52 +66,6 @@ std::vector<int> link_euler(const DualMesh& D, std::size_t nodes) {
   std::vector<int> chi(nodes);
   for (std::size_t v = 0; v < nodes; ++v) chi[v] = static_cast<int>(edges[v].size()) - cells[v];
   return chi;
-}
-
-// Number of groups of elements around every node that are connected through facets (faces in
-// 3D, edges in 2D) containing the node: 1 when its link is connected. The Euler characteristic
-// alone cannot tell a sphere from two disks (two hexes sharing only a corner).
-std::vector<int> link_components(const DualMesh& D, std::size_t nodes) {
-  std::vector<std::vector<int>> around(nodes);
-  std::map<std::vector<int>, std::vector<int>> facet_elements;
-  auto visit = [&](const auto& elements, const auto& facets) {
-    for (std::size_t e = 0; e < elements.size(); ++e) {
-      for (int c : elements[e]) around[static_cast<std::size_t>(c)].push_back(static_cast<int>(e));
-      for (const auto& f : facets) {
-        std::vector<int> key;
-        for (int c : f) key.push_back(elements[e][static_cast<std::size_t>(c)]);
-        std::sort(key.begin(), key.end());
-        facet_elements[key].push_back(static_cast<int>(e));
-      }
-    }
-  };
-  if (D.dim == 3)
-    visit(D.hex.hexes, primal::topology::kHexFaceCorners);
-  else
-    visit(D.quad.quads, primal::topology::kQuadEdgeCorners);
-  // Per node, a union-find over the positions of its elements in around[node].
-  std::vector<std::vector<int>> parent(nodes);
-  for (std::size_t v = 0; v < nodes; ++v) {
-    parent[v].resize(around[v].size());
-    for (std::size_t i = 0; i < parent[v].size(); ++i) parent[v][i] = static_cast<int>(i);
-  }
-  auto find = [&](std::vector<int>& p, int i) {
-    while (p[static_cast<std::size_t>(i)] != i) i = p[static_cast<std::size_t>(i)] = p[static_cast<std::size_t>(p[static_cast<std::size_t>(i)])];
-    return i;
-  };
-  for (const auto& [key, elements] : facet_elements)
-    for (std::size_t k = 1; k < elements.size(); ++k)
-      for (int v : key) {
-        auto& a = around[static_cast<std::size_t>(v)];
-        auto& p = parent[static_cast<std::size_t>(v)];
-        const int i = static_cast<int>(std::find(a.begin(), a.end(), elements[0]) - a.begin());
-        const int j = static_cast<int>(std::find(a.begin(), a.end(), elements[k]) - a.begin());
-        p[static_cast<std::size_t>(find(p, i))] = find(p, j);
-      }
-  std::vector<int> groups(nodes, 0);
-  for (std::size_t v = 0; v < nodes; ++v)
-    for (std::size_t i = 0; i < parent[v].size(); ++i) groups[v] += find(parent[v], static_cast<int>(i)) == static_cast<int>(i);
-  return groups;
 }
 
 }  // namespace
@@ -200,18 +153,17 @@ DualMesh dualize(const Arrangement& A) {
   // the link to what the region touches geometrically, so a region inside the box whose node
   // lands on the mesh boundary is caught too.
   const std::vector<int> chi = link_euler(D, nodes);
-  const std::vector<int> groups = link_components(D, nodes);
   for (std::size_t n = 0; n < nodes; ++n) {
     const bool boundary = D.node_faces[n] != 0;
     const int expect = boundary ? 1 : (dim == 3 ? 2 : 0);
-    if (chi[n] != expect || groups[n] != 1) {
+    if (chi[n] != expect) {
       std::string s;
       for (std::size_t i = 0; i < D.node_signs[n].size(); ++i)
         s += std::string(i ? ", " : "") + A.sheet_names[i] + (D.node_signs[n][i] > 0 ? "+" : "-");
       throw TopologyError("dualize: the region on sides {" + s + "} near " + where(pts[n], dim) + " is not a " +
                           (boundary ? "half-ball meeting the boundary in one disk" : "ball") +
                           " (its node's link has Euler characteristic " + std::to_string(chi[n]) + ", expected " +
-                          std::to_string(expect) + ", in " + std::to_string(groups[n]) + " piece(s), expected 1)");
+                          std::to_string(expect) + ")");
     }
   }
 
@@ -219,7 +171,9 @@ DualMesh dualize(const Arrangement& A) {
   // domain boundary. Regions are joined only along 1-cells, so a piece of sheet with a hole
   // (an annulus no curve crosses) splits its region into parts that each look like a ball, and
   // a region meeting the boundary where no curve ends is not known to touch it; both leave
-  // this global trace.
+  // this global trace. check_validity also requires every node's elements to be connected
+  // through faces (edges in 2D): a link Euler characteristic of 2 cannot tell a sphere from
+  // two disks.
   std::vector<char> on_boundary(nodes, 0);
   bool ball = true;
   std::string found;
