@@ -218,6 +218,13 @@ MeshArrangementInput build(const std::vector<Point>& points, const std::vector<C
   const CellLocator<Dim>& loc = *data->locator;
 
   const std::size_t nn = points.size();
+  // Node adjacency with each edge's sheet, built once: per sheet, the walks skip its own edges.
+  std::vector<std::vector<std::pair<Index, Index>>> adjacent(nn);
+  for (std::size_t e = 0; e < dual.edges.size(); ++e) {
+    const auto& E = dual.edges[e];
+    adjacent[static_cast<std::size_t>(E[0])].emplace_back(E[1], dual.edge_sheet[e]);
+    adjacent[static_cast<std::size_t>(E[1])].emplace_back(E[0], dual.edge_sheet[e]);
+  }
   MeshArrangementInput out;
   for (std::size_t s = 0; s < dual.sheets.size(); ++s) {
     const MeshSheet& sheet = dual.sheets[s];
@@ -228,14 +235,8 @@ MeshArrangementInput build(const std::vector<Point>& points, const std::vector<C
                           " or another): it has no two sides to give a field");
     // Sides: the nodes joined by edges of other sheets.
     primal::DisjointSets sides(nn);
-    std::vector<char> touches(nn, 0);
-    for (std::size_t e = 0; e < dual.edges.size(); ++e) {
-      const auto& E = dual.edges[e];
-      if (dual.edge_sheet[e] == static_cast<Index>(s))
-        touches[static_cast<std::size_t>(E[0])] = touches[static_cast<std::size_t>(E[1])] = 1;
-      else
-        sides.unite(E[0], E[1]);
-    }
+    for (std::size_t e = 0; e < dual.edges.size(); ++e)
+      if (dual.edge_sheet[e] != static_cast<Index>(s)) sides.unite(dual.edges[e][0], dual.edges[e][1]);
     for (Index e : sheet.edges) {
       const auto& E = dual.edges[static_cast<std::size_t>(e)];
       if (sides.find(E[0]) == sides.find(E[1]))
@@ -247,20 +248,14 @@ MeshArrangementInput build(const std::vector<Point>& points, const std::vector<C
     // Layers: breadth-first over edges of other sheets from the nodes ending an S edge.
     std::vector<int> layer(nn, -1);
     std::deque<Index> queue;
-    for (std::size_t n = 0; n < nn; ++n)
-      if (touches[n]) layer[n] = 1, queue.push_back(static_cast<Index>(n));
-    std::vector<std::vector<Index>> adjacent(nn);
-    for (std::size_t e = 0; e < dual.edges.size(); ++e)
-      if (dual.edge_sheet[e] != static_cast<Index>(s)) {
-        const auto& E = dual.edges[e];
-        adjacent[static_cast<std::size_t>(E[0])].push_back(E[1]);
-        adjacent[static_cast<std::size_t>(E[1])].push_back(E[0]);
-      }
+    for (Index e : sheet.edges)
+      for (Index n : dual.edges[static_cast<std::size_t>(e)])
+        if (layer[static_cast<std::size_t>(n)] < 0) layer[static_cast<std::size_t>(n)] = 1, queue.push_back(n);
     while (!queue.empty()) {
       const Index n = queue.front();
       queue.pop_front();
-      for (Index m : adjacent[static_cast<std::size_t>(n)])
-        if (layer[static_cast<std::size_t>(m)] < 0) {
+      for (const auto& [m, sheet_of_edge] : adjacent[static_cast<std::size_t>(n)])
+        if (sheet_of_edge != static_cast<Index>(s) && layer[static_cast<std::size_t>(m)] < 0) {
           layer[static_cast<std::size_t>(m)] = layer[static_cast<std::size_t>(n)] + 1;
           queue.push_back(m);
         }
