@@ -241,9 +241,7 @@ std::vector<Index> boundary_nodes(const primal::HexMesh& mesh) {
 double min_scaled_jacobian(const primal::HexMesh& mesh, std::vector<Index>* bad = nullptr) {
   double mn = 1.0;
   for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
-    primal::HexCorners c;
-    for (int k = 0; k < 8; ++k) c[k] = mesh.points[mesh.hexes[h][k]];
-    const double sj = primal::hex_scaled_jacobian(c);
+    const double sj = primal::hex_scaled_jacobian(primal::hex_corners(mesh, static_cast<Index>(h)));
     mn = std::min(mn, sj);
     if (bad && sj <= 0) bad->push_back(static_cast<Index>(h));
   }
@@ -662,7 +660,7 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
               " buffer hexes (" + std::to_string(since(t0)) + " s)");
       }
     }
-    res.smoothing.final_min_scaled_jacobian = min_scaled_jacobian(mesh);
+    res.smoothing.final_min_scaled_jacobian = min_scaled_jacobian(mesh, &bad);  // also for step 7
     res.smoothing.untangled = res.smoothing.final_min_scaled_jacobian > 0;
     res.smoothing.seconds = since(t0);
     say("smoothing (" + std::string(options.smooth == ConformSmooth::kLocal ? "local" : "global") +
@@ -676,7 +674,6 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
   t0 = Clock::now();
   res.validity = primal::check_validity(mesh);
   if (!res.validity.ok()) res.warnings.push_back("invalid mesh: " + res.validity.summary());
-  if (options.smooth != ConformSmooth::kNone) min_scaled_jacobian(mesh, &bad);
   if (!bad.empty()) {
     std::ostringstream m;
     m << bad.size() << " hexes with scaled Jacobian <= 0:";
