@@ -118,7 +118,14 @@ double tet_volume(const Point& a, const Point& b, const Point& c, const Point& d
 Index merge_coincident_nodes(Model& model, double tolerance) {
   const std::size_t n = model.points.size();
   if (n == 0) return 0;
-  const double cell = std::max(tolerance, 1e-300) * 2.0;
+  if (!(tolerance >= 0.0) || !std::isfinite(tolerance))
+    throw InvalidInput("merge_coincident_nodes: tolerance " + std::to_string(tolerance) + " is not a finite value >= 0");
+  // Cells no smaller than 1e-12 of the largest coordinate keep every cell index below 1e12 in
+  // size (the float -> integer cast must not overflow), whatever the tolerance.
+  double largest = 0.0;
+  for (const Point& p : model.points) largest = std::max(largest, p.cwiseAbs().maxCoeff());
+  if (!std::isfinite(largest)) throw InvalidInput("merge_coincident_nodes: a node has a non-finite coordinate");
+  const double cell = std::max({2.0 * tolerance, 1e-12 * largest, 1e-300});
   // Hash each point into a grid of cells of size 2*tol; a partner lies in one of the 27
   // neighbouring cells.
   struct Key {
@@ -127,7 +134,10 @@ Index merge_coincident_nodes(Model& model, double tolerance) {
   };
   struct KeyHash {
     std::size_t operator()(const Key& k) const {
-      return static_cast<std::size_t>(k.x * 73856093LL ^ k.y * 19349663LL ^ k.z * 83492791LL);
+      // Unsigned arithmetic: wraps instead of overflowing.
+      return static_cast<std::size_t>(static_cast<unsigned long long>(k.x) * 73856093ull ^
+                                      static_cast<unsigned long long>(k.y) * 19349663ull ^
+                                      static_cast<unsigned long long>(k.z) * 83492791ull);
     }
   };
   auto key_of = [&](const Point& p) {

@@ -3,6 +3,7 @@
 // diagonal from its lowest to its highest corner).
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <algorithm>
 #include <set>
 #include <string>
@@ -141,4 +142,13 @@ TEST_CASE("find_interface: rejects non-conforming interfaces, naming the face or
     CHECK(merge_coincident_nodes(m, 1e-9) == 2);
     CHECK_THROWS_WITH_AS(find_interface(m), doctest::Contains("lies on no interface quad"), TopologyError);
   }
+}
+
+TEST_CASE("merge_coincident_nodes: a zero tolerance merges exact copies only; bad ones are refused") {
+  Model m = grid_model({1, 1, 1}, 1.0, [](int, int, int) { return false; });
+  append(m, grid_model({1, 1, 1}, 1.0, [](int, int, int) { return false; }), Point(1, 0, 0));
+  m.points.push_back(Point(1e6, 1e6, 1e-300));  // far away and tiny: no overflow in the grid
+  CHECK(merge_coincident_nodes(m, 0.0) == 4);   // the shared face's four nodes
+  CHECK_THROWS_WITH_AS(merge_coincident_nodes(m, -1.0), doctest::Contains("tolerance"), InvalidInput);
+  CHECK_THROWS_AS(merge_coincident_nodes(m, std::nan("")), InvalidInput);
 }
