@@ -6,8 +6,6 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -15,6 +13,7 @@
 #include "primal/quality.hpp"
 #include "primal/smooth.hpp"
 #include "primal/topology.hpp"
+#include "support/fixtures.hpp"
 
 namespace {
 
@@ -24,47 +23,14 @@ using gp::Index;
 using gp::NodeConstraint;
 using gp::Point;
 
-// ---- Appendix A reader (test-only; the tables never enter the library) ----------------------
-
-std::vector<std::vector<double>> read_csv_rows(const std::string& path, std::size_t columns) {
-  std::ifstream in(path);
-  if (!in) throw geode::InvalidInput(path + ": cannot open");
-  std::vector<std::vector<double>> rows;
-  std::string line;
-  std::getline(in, line);  // header
-  for (int number = 2; std::getline(in, line); ++number) {
-    if (line.empty()) continue;
-    std::vector<double> row;
-    std::stringstream ss(line);
-    for (std::string cell; std::getline(ss, cell, ',');) row.push_back(std::stod(cell));
-    if (row.size() != columns) {
-      throw geode::InvalidInput(path + ":" + std::to_string(number) + ": expected " +
-                                std::to_string(columns) + " values");
-    }
-    rows.push_back(row);
-  }
-  return rows;
-}
-
-// The paper lists a hex as n1..n4, a face, then n5..n8 the opposite face with n5 above n1.
-// Whether that is VTK order depends on the turning sense of n1..n4: VTK wants it
-// counter-clockwise seen from n5..n8. The test "Appendix A corner order" below measures it;
-// `reverse` swaps n2 <-> n4 and n6 <-> n8 (a mirror of the corner numbering) if needed.
-HexMesh appendix_a(bool reverse) {
-  const std::string dir = std::string(GEODE_SOURCE_DIR) + "/notebooks-data/appendix-a/";
-  HexMesh mesh;
-  for (const auto& r : read_csv_rows(dir + "nodes.csv", 4)) mesh.points.emplace_back(r[1], r[2], r[3]);
-  for (const auto& r : read_csv_rows(dir + "hexes.csv", 9)) {
-    std::array<Index, 8> h;
-    for (int c = 0; c < 8; ++c) h[c] = static_cast<Index>(r[1 + c]) - 1;
-    if (reverse) std::swap(h[1], h[3]), std::swap(h[5], h[7]);
-    mesh.hexes.push_back(h);
-  }
+// The paper's Appendix A (tests/support/fixtures.hpp); `reverse` mirrors the corner numbering
+// (swaps n2 <-> n4 and n6 <-> n8), for the test that measures which reading is VTK order.
+HexMesh appendix_a(bool reverse = false) {
+  HexMesh mesh = geode::test::appendix_a_geode();
+  if (reverse)
+    for (auto& h : mesh.hexes) std::swap(h[1], h[3]), std::swap(h[5], h[7]);
   return mesh;
 }
-
-// Measured below: the paper's order is already VTK order.
-[[maybe_unused]] HexMesh appendix_a() { return appendix_a(false); }
 
 int hexes_with_negative_corner(const HexMesh& m) {
   int count = 0;
@@ -202,21 +168,6 @@ TEST_CASE("smoothing is deterministic") {
 
 namespace {
 
-// (n+1)^2 nodes, n x n unit squares in the plane z = 0, counter-clockwise seen from +z.
-gp::QuadMesh quad_grid(int n) {
-  gp::QuadMesh m;
-  for (int j = 0; j <= n; ++j) {
-    for (int i = 0; i <= n; ++i) m.points.emplace_back(i, j, 0);
-  }
-  for (int j = 0; j < n; ++j) {
-    for (int i = 0; i < n; ++i) {
-      const Index v = i + (n + 1) * j;
-      m.quads.push_back({v, v + 1, v + n + 2, v + n + 1});
-    }
-  }
-  return m;
-}
-
 double min_quad_sj(const gp::QuadMesh& m) {
   double q = 1.0;
   for (Index i = 0; i < static_cast<Index>(m.quads.size()); ++i) {
@@ -231,7 +182,7 @@ TEST_CASE("planar quad smoothing untangles a folded grid back to squares") {
   // 3 x 3 grid with the boundary fixed; interior node (1,1) dragged past (2,2) folds the
   // quads around it. The best placement of the 4 interior nodes is the unit grid (all scaled
   // Jacobians 1), which the smoother must find; nodes stay in z = 0 exactly.
-  gp::QuadMesh m = quad_grid(3);
+  gp::QuadMesh m = geode::test::structured_quad_grid(3, 3);
   m.points[5] = Point(2.4, 2.3, 0);
   std::vector<NodeConstraint> c(m.points.size(), NodeConstraint::fixed());
   for (Index v : {5, 6, 9, 10}) c[v] = NodeConstraint::free();
@@ -273,6 +224,6 @@ TEST_CASE("smoothing rejects malformed constraints") {
   std::vector<NodeConstraint> bad(m.points.size());
   bad[4] = NodeConstraint::plane(Point(0, 0, 0), Point(0, 0, 0));
   CHECK_THROWS_WITH(gp::smooth_hex_mesh(m, bad), doctest::Contains("node 4"));
-  gp::QuadMesh q = quad_grid(1);
+  gp::QuadMesh q = geode::test::structured_quad_grid(1, 1);
   CHECK_THROWS_AS(gp::smooth_quad_mesh(q, Point(0, 0, 0)), geode::InvalidInput);
 }
