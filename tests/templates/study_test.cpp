@@ -94,6 +94,13 @@ TEST_CASE("smooth_in_cell: a sheared cell keeps tet/hex-side nodes on their plan
     const auto r = templates::smooth_in_cell(T, o.box, cell, slide);
     CHECK(r.untangled);
     CHECK(r.final_min_scaled_jacobian > 0.0);
+    // The checks below only look at nodes on faces: make sure there are such nodes (9 on the
+    // diced hex side, 11 on the diced tet side, and some on the x- and z-faces).
+    int on_y = 0, on_x = 0, on_z = 0;
+    for (unsigned f : T.node_faces) on_y += (f & (3u << 2)) != 0, on_x += (f & 3u) != 0, on_z += (f & (3u << 4)) != 0;
+    CHECK(on_y == 20);
+    CHECK(on_x > 0);
+    CHECK(on_z > 0);
     for (std::size_t i = 0; i < T.hex.points.size(); ++i) {
       const auto& p = T.hex.points[i];
       const auto& q = before[i];
