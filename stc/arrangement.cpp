@@ -14,7 +14,6 @@
 #include "primal/topology.hpp"
 
 namespace geode::stc {
-namespace {
 
 std::string format_point(const Point& x, int dim) {
   std::ostringstream s;
@@ -24,6 +23,8 @@ std::string format_point(const Point& x, int dim) {
   s << ")";
   return s.str();
 }
+
+namespace {
 
 // Length of the first dim components (no dynamic-size head(): GCC 12 misreads it as out of
 // bounds under -Warray-bounds).

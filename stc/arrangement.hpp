@@ -137,6 +137,9 @@ struct Arrangement {
   std::vector<std::vector<int>> region_signs;
 };
 
+// "(x, y, z)" ("(x, y)" in 2D) to 6 significant digits, for diagnoses.
+std::string format_point(const Point& x, int dim);
+
 Arrangement compute_arrangement(const std::vector<Sheet>& sheets, const Domain& domain,
                                 const ArrangementOptions& options = {});
 

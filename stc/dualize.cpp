@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <set>
-#include <sstream>
 
 #include "primal/errors.hpp"
 #include "primal/topology.hpp"
@@ -16,15 +15,6 @@ std::string sheet_list(const Arrangement& A, const std::vector<int>& S) {
   for (std::size_t i = 0; i < S.size(); ++i)
     r += (i ? ", '" : "'") + A.sheet_names[static_cast<std::size_t>(S[i])] + "'";
   return r;
-}
-
-std::string where(const primal::Point& x, int dim) {
-  std::ostringstream s;
-  s.precision(5);
-  s << "(" << x[0] << ", " << x[1];
-  if (dim == 3) s << ", " << x[2];
-  s << ")";
-  return s.str();
 }
 
 // Euler characteristic of the link of every node. In a hex mesh the link of node v has a
@@ -104,7 +94,7 @@ DualMesh dualize(const Arrangement& A) {
     std::set<primal::Index> distinct(cell.begin(), cell.begin() + corners);
     if (static_cast<int>(distinct.size()) != corners)
       throw TopologyError("dualize: around the vertex of sheets " + sheet_list(A, V.sheets) + " at " +
-                          where(V.x, dim) + " two octants are one region: its element would repeat a node");
+                          format_point(V.x, dim) + " two octants are one region: its element would repeat a node");
     if (dim == 3)
       D.hex.hexes.push_back(cell);
     else
@@ -160,7 +150,7 @@ DualMesh dualize(const Arrangement& A) {
       std::string s;
       for (std::size_t i = 0; i < D.node_signs[n].size(); ++i)
         s += std::string(i ? ", " : "") + A.sheet_names[i] + (D.node_signs[n][i] > 0 ? "+" : "-");
-      throw TopologyError("dualize: the region on sides {" + s + "} near " + where(pts[n], dim) + " is not a " +
+      throw TopologyError("dualize: the region on sides {" + s + "} near " + format_point(pts[n], dim) + " is not a " +
                           (boundary ? "half-ball meeting the boundary in one disk" : "ball") +
                           " (its node's link has Euler characteristic " + std::to_string(chi[n]) + ", expected " +
                           std::to_string(expect) + ")");
@@ -196,7 +186,7 @@ DualMesh dualize(const Arrangement& A) {
                         "): a piece of sheet with a hole, or a region split where no curve runs");
   for (std::size_t n = 0; n < nodes; ++n)
     if ((D.node_faces[n] != 0) != (on_boundary[n] != 0))
-      throw TopologyError("dualize: the node of the region near " + where(pts[n], dim) + " is " +
+      throw TopologyError("dualize: the node of the region near " + format_point(pts[n], dim) + " is " +
                           (on_boundary[n] ? "" : "not ") + "on the dual's boundary but its region " +
                           (D.node_faces[n] ? "touches" : "does not touch") +
                           " the domain boundary as the traced curves show it");
