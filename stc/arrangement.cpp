@@ -187,7 +187,10 @@ class Engine {
   // residual is halved (up to 12 times): on smooth fields near their zero set the full step
   // always does, so this only acts where fields are piecewise smooth (stc/mesh_fields.hpp),
   // where plain Newton can cycle between the pieces of a kinked sheet.
-  bool project(const std::vector<int>& S, Point& x, unsigned fixed = 0) const {
+  // On success `grads` (when given) receives the sheets' gradients at the returned x, which
+  // the convergence test has just computed: callers need them for the curve's tangent.
+  bool project(const std::vector<int>& S, Point& x, unsigned fixed = 0,
+               std::array<Point, 3>* grads = nullptr) const {
     const int k = static_cast<int>(S.size());
     // At most 3 x 3: fixed capacity keeps the hot path off the heap.
     using Mat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3>;
@@ -199,6 +202,7 @@ class Engine {
       double err = 0.0;
       for (int r = 0; r < k; ++r) {
         const Point g = grad(S[static_cast<std::size_t>(r)], x);
+        if (grads) (*grads)[static_cast<std::size_t>(r)] = g;
         for (int c = 0; c < dim_; ++c) J(r, c) = (fixed >> c) & 1u ? 0.0 : g[c];
         gnorm[r] = J.row(r).norm();
         if (gnorm[r] < 1e-14) return false;
@@ -230,12 +234,15 @@ class Engine {
     return false;
   }
 
+  // The curve's tangent from the gradients of its d-1 sheets: the rotated gradient in 2D,
+  // their cross product in 3D.
+  Point tangent_of(const std::array<Point, 3>& g) const {
+    return dim_ == 2 ? Point(-g[0][1], g[0][0], 0.0) : g[0].cross(g[1]);
+  }
   Point tangent(const std::vector<int>& S, const Point& x) const {
-    if (dim_ == 2) {
-      const Point g = grad(S[0], x);
-      return Point(-g[1], g[0], 0.0);
-    }
-    return grad(S[0], x).cross(grad(S[1], x));
+    std::array<Point, 3> g;
+    for (std::size_t r = 0; r < S.size(); ++r) g[r] = grad(S[r], x);
+    return tangent_of(g);
   }
 
   std::vector<Point> seeds(const std::vector<int>& S) const;
@@ -375,12 +382,11 @@ std::vector<Point> Engine::walk(const std::vector<int>& S, const Point& x0, Poin
       // the new tangent agrees with the direction taken.
       auto attempt = [&](const Point& dir, bool at_kink) {
         xp = x + hh * dir;
-        if (!project(S, xp) || (xp - x).norm() >= 2.0 * hh || (xp - x).dot(dir) < 0.25 * hh) return false;
-        tn = sigma * tangent(S, xp);
+        std::array<Point, 3> g;
+        if (!project(S, xp, 0, &g) || (xp - x).norm() >= 2.0 * hh || (xp - x).dot(dir) < 0.25 * hh) return false;
+        tn = sigma * tangent_of(g);
         if (tn.norm() < 1e-12) return false;
-        const double transversal = !at_kink || dim_ == 2
-                                       ? 1.0
-                                       : tn.norm() / (grad(S[0], xp).norm() * grad(S[1], xp).norm());
+        const double transversal = !at_kink || dim_ == 2 ? 1.0 : tn.norm() / (g[0].norm() * g[1].norm());
         tn.normalize();
         return tn.dot(dir) > 0.9 && transversal > 0.05;
       };
@@ -457,10 +463,12 @@ Curve Engine::trace(const std::vector<int>& S, const Point& x0) const {
   c.sheets = S;
   // Two surfaces that only touch have an isolated common point where the projection of a
   // seed may land: no curve to trace, and their gradients are parallel there.
-  if (dim_ == 3 && sine(grad(S[0], x0), grad(S[1], x0)) < kParallel)
+  std::array<Point, 3> g;
+  for (std::size_t r = 0; r < S.size(); ++r) g[r] = grad(S[r], x0);
+  if (dim_ == 3 && sine(g[0], g[1]) < kParallel)
     throw TopologyError("arrangement: sheets " + names(S) + " touch at " + fmt_point(x0, dim_) +
                         " without crossing (tangent there; not in general position)");
-  const Point t0 = tangent(S, x0).normalized();
+  const Point t0 = tangent_of(g).normalized();
   bool closed = false;
   int face_f = -1, face_b = -1;
   std::vector<Point> fwd = walk(S, x0, t0, closed, face_f);
