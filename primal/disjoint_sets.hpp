@@ -14,6 +14,12 @@ class DisjointSets {
   DisjointSets() = default;
   explicit DisjointSets(std::size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), Index{0}); }
 
+  // Back to n singletons, reusing the storage (for many small problems in a row).
+  void reset(std::size_t n) {
+    parent_.resize(n);
+    std::iota(parent_.begin(), parent_.end(), Index{0});
+  }
+
   // Adds a singleton set and returns its element.
   Index add() {
     parent_.push_back(static_cast<Index>(parent_.size()));

@@ -68,8 +68,6 @@ const HexIncidence& hex_incidence() {
   return inc;
 }
 
-// Union-find over a small set of element uses.
-
 template <std::size_t N>
 bool has_repeated(const std::array<Index, N>& a) {
   for (std::size_t i = 0; i < N; ++i) {
@@ -289,22 +287,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
   // vertices = edges at the vertex) must be connected with Euler characteristic 2 (sphere,
   // interior) or 1 (disk, boundary).
   std::vector<std::pair<Index, EdgeKey>> bad_edges;  // (first use 12 p + e, edge)
-  std::vector<Index> parent;                          // union-find over the local uses
-  auto find = [&](Index x) {
-    while (parent[static_cast<std::size_t>(x)] != x)
-      x = parent[static_cast<std::size_t>(x)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
-    return x;
-  };
-  auto unite = [&](Index a, Index b) {
-    a = find(a), b = find(b);
-    if (a < b) parent[static_cast<std::size_t>(b)] = a;
-    if (b < a) parent[static_cast<std::size_t>(a)] = b;
-  };
-  auto components = [&](std::size_t n) {
-    std::size_t c = 0;
-    for (std::size_t i = 0; i < n; ++i) c += find(static_cast<Index>(i)) == static_cast<Index>(i);
-    return c;
-  };
+  DisjointSets uses_joined;                           // over the local uses
   struct EdgeUse {
     Index other;  // the edge's other end
     Index use;    // 12 p + local edge
@@ -319,8 +302,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
       continue;
     }
     ++r.num_vertices;
-    parent.resize(static_cast<std::size_t>(n));
-    std::iota(parent.begin(), parent.end(), Index{0});
+    uses_joined.reset(static_cast<std::size_t>(n));
     first_use_of_face.clear();
     others.clear();
     edge_uses.clear();
@@ -336,7 +318,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
         auto it = std::find_if(first_use_of_face.begin(), first_use_of_face.end(),
                                [f](const auto& x) { return x.first == f; });
         if (it == first_use_of_face.end()) first_use_of_face.emplace_back(f, i);
-        else unite(it->second, i);
+        else uses_joined.unite(it->second, i);
       }
       for (int nc : topo::kHexCornerNeighbors[c]) {
         const Index b = hex(p)[nc];
@@ -348,7 +330,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     const auto link_vertices = std::unique(others.begin(), others.end()) - others.begin();
     const auto link_euler = static_cast<long>(link_vertices) -
                             static_cast<long>(first_use_of_face.size()) + static_cast<long>(n);
-    if (overshared || components(static_cast<std::size_t>(n)) != 1 ||
+    if (overshared || uses_joined.count() != 1 ||
         link_euler != (on_boundary ? 1 : 2)) {
       r.nonmanifold_vertices.push_back(static_cast<Index>(v));
     }
@@ -360,8 +342,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
       while (j < edge_uses.size() && edge_uses[j].other == edge_uses[i].other) ++j;
       ++r.num_edges;
       const std::size_t m = j - i;
-      parent.resize(m);
-      std::iota(parent.begin(), parent.end(), Index{0});
+      uses_joined.reset(m);
       first_use_of_face.clear();
       bool edge_overshared = false;
       for (std::size_t k = 0; k < m; ++k) {
@@ -373,10 +354,10 @@ HexValidityReport check_validity(const HexMesh& mesh) {
           auto it = std::find_if(first_use_of_face.begin(), first_use_of_face.end(),
                                  [f](const auto& x) { return x.first == f; });
           if (it == first_use_of_face.end()) first_use_of_face.emplace_back(f, static_cast<int>(k));
-          else unite(it->second, static_cast<Index>(k));
+          else uses_joined.unite(it->second, static_cast<Index>(k));
         }
       }
-      if (edge_overshared || components(m) != 1)
+      if (edge_overshared || uses_joined.count() != 1)
         bad_edges.emplace_back(edge_uses[i].use, edge_key(static_cast<Index>(v), edge_uses[i].other));
       i = j;
     }
