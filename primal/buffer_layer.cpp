@@ -4,8 +4,6 @@
 #include <cmath>
 #include <limits>
 #include <string>
-#include <unordered_map>
-#include <unordered_set>
 
 #include "primal/boundary.hpp"
 #include "primal/errors.hpp"
@@ -72,7 +70,7 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
   BufferLayer out;
   out.model = input;
   out.top_node.assign(n_points, kInvalidIndex);
-  std::vector<Index> interface_nodes = itf.nodes;
+  const std::vector<Index>& interface_nodes = itf.nodes;
   for (std::size_t k = 0; k < interface_nodes.size(); ++k)
     out.top_node[static_cast<std::size_t>(interface_nodes[k])] = static_cast<Index>(n_points + k);
   auto slot = [&](Index v) {
