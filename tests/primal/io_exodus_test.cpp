@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "support/temp_dir.hpp"
 #include "primal/demo_models.hpp"
 #include "primal/errors.hpp"
 #include "primal/io_exodus.hpp"
@@ -20,10 +21,10 @@ using namespace geode::primal;
 
 namespace {
 
-fs::path scratch_dir() {
-  fs::path dir = fs::temp_directory_path() / ("geode-io-exodus-" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  return dir;
+// One directory for the whole test program, removed at exit.
+const fs::path& scratch_dir() {
+  static const geode::test::TempDir dir;
+  return dir.path;
 }
 
 // 2 x 2 x 1 cells of size 0.5: x < 0.5 hexes (block 1 "steel"), x >= 0.5 Kuhn tets (block 2),

@@ -8,6 +8,7 @@
 #include <string>
 #include <unistd.h>
 
+#include "support/temp_dir.hpp"
 #include "primal/demo_models.hpp"
 #include "primal/errors.hpp"
 #include "primal/io_gmsh.hpp"
@@ -19,10 +20,10 @@ using namespace geode::primal;
 
 namespace {
 
-fs::path scratch_dir() {
-  fs::path dir = fs::temp_directory_path() / ("geode-io-gmsh-" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  return dir;
+// One directory for the whole test program, removed at exit.
+const fs::path& scratch_dir() {
+  static const geode::test::TempDir dir;
+  return dir.path;
 }
 
 void write_text(const fs::path& path, const std::string& text) {

@@ -1,15 +1,15 @@
 #pragma once
 // Running the built `geode` command from a test (GEODE_CLI_PATH, set by CMake for the test
-// programs) and naming scratch files. Header-only: the path is known where the tests are
+// programs); scratch files come from support/temp_dir.hpp. Header-only: the path is known where the tests are
 // compiled, not in the fixtures library.
 #include <doctest/doctest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdio>
-#include <cstdlib>
-#include <filesystem>
 #include <string>
+
+#include "support/temp_dir.hpp"
 
 namespace geode::test {
 
@@ -32,26 +32,5 @@ inline CliRun geode_cli(const std::string& args, bool with_stderr = false) {
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
 }
-
-// A file name in the temporary directory, unique to this process.
-inline std::filesystem::path temp_path(const std::string& name) {
-  return std::filesystem::temp_directory_path() / ("geode-cli-test-" + std::to_string(::getpid()) + "-" + name);
-}
-
-// A fresh directory, removed with everything in it at the end of the test.
-struct TempDir {
-  std::filesystem::path path;
-  TempDir() {
-    std::string t = (std::filesystem::temp_directory_path() / "geode-cli-test-XXXXXX").string();
-    REQUIRE(::mkdtemp(t.data()) != nullptr);
-    path = t;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-};
 
 }  // namespace geode::test
