@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <fstream>
-#include <map>
 #include <sstream>
 #include <vector>
 
+#include "primal/boundary.hpp"
 #include "primal/errors.hpp"
 #include "primal/topology.hpp"
 
@@ -124,24 +124,12 @@ primal::QuadMesh structured_quad_grid(int nx, int ny) {
 
 primal::QuadMesh boundary_quads(const primal::HexMesh& mesh,
                                 const std::function<bool(const primal::Point&)>& keep) {
-  // A face is on the boundary when exactly one hex uses it; key faces by sorted corners.
-  std::map<std::array<primal::Index, 4>, int> uses;
-  std::vector<std::array<primal::Index, 4>> faces;
-  for (const auto& hex : mesh.hexes)
-    for (const auto& fc : primal::topology::kHexFaceCorners) {
-      std::array<primal::Index, 4> f{hex[fc[0]], hex[fc[1]], hex[fc[2]], hex[fc[3]]};
-      faces.push_back(f);
-      std::sort(f.begin(), f.end());
-      ++uses[f];
-    }
+  // primal::boundary_quads gives them in first-appearance order, outward: keep, renumber.
   primal::QuadMesh out;
   std::vector<primal::Index> renumber(mesh.points.size(), primal::kInvalidIndex);
-  for (const auto& f : faces) {
-    auto key = f;
-    std::sort(key.begin(), key.end());
-    if (uses[key] != 1) continue;
-    if (!std::all_of(f.begin(), f.end(), [&](primal::Index n) { return keep(mesh.points[n]); }))
-      continue;
+  for (const primal::BoundaryQuad& b : primal::boundary_quads(mesh)) {
+    const auto& f = b.nodes;
+    if (!std::all_of(f.begin(), f.end(), [&](primal::Index n) { return keep(mesh.points[n]); })) continue;
     std::array<primal::Index, 4> q{};
     for (int c = 0; c < 4; ++c) {
       if (renumber[f[c]] == primal::kInvalidIndex) {
