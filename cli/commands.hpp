@@ -2,6 +2,8 @@
 // Sub-commands of the `geode` command line; each file registers its own.
 #include <CLI/CLI.hpp>
 #include <filesystem>
+#include <functional>
+#include <ostream>
 #include <string>
 
 #include "primal/model.hpp"
@@ -18,5 +20,7 @@ void add_dual_command(CLI::App& app);       // cli/dual_command.cpp
 // another format.
 std::string file_extension(const std::filesystem::path& p);
 primal::Model read_model(const std::filesystem::path& path);
+// Standard output when `path` is empty or "-", else the file, written atomically.
+void write_or_print(const std::string& path, const std::function<void(std::ostream&)>& write);
 
 }  // namespace geode::cli

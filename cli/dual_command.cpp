@@ -9,7 +9,6 @@
 #include <sstream>
 
 #include "cli/commands.hpp"
-#include "primal/atomic_file.hpp"
 #include "primal/errors.hpp"
 #include "primal/io_vtk.hpp"
 #include "primal/model.hpp"
@@ -180,10 +179,7 @@ void run_dual(const DualArgs& a) {
               "\n";
     }
   }
-  if (a.output.empty())
-    std::cout << text;
-  else
-    primal::write_file_atomically(a.output, [&](std::ostream& o) { o << text; });
+  write_or_print(a.output, [&](std::ostream& os) { os << text; });
 }
 
 }  // namespace

@@ -1,8 +1,10 @@
 // File-name helpers shared by the commands (cli/commands.hpp).
 #include <algorithm>
 #include <cctype>
+#include <iostream>
 
 #include "cli/commands.hpp"
+#include "primal/atomic_file.hpp"
 #include "primal/errors.hpp"
 #include "primal/io_exodus.hpp"
 #include "primal/io_gmsh.hpp"
@@ -23,6 +25,14 @@ primal::Model read_model(const fs::path& path) {
   if (e == ".msh") return primal::read_gmsh(path);
   if (e == ".exo" || e == ".e") return primal::read_exodus(path);
   throw InvalidInput(path.string() + ": unknown input format '" + e + "' (expected .msh, .exo or .e)");
+}
+
+void write_or_print(const std::string& path, const std::function<void(std::ostream&)>& write) {
+  if (path.empty() || path == "-") {
+    write(std::cout);
+    return;
+  }
+  primal::write_file_atomically(path, write);
 }
 
 }  // namespace geode::cli

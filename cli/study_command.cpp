@@ -5,7 +5,6 @@
 #include <sstream>
 
 #include "cli/commands.hpp"
-#include "primal/atomic_file.hpp"
 #include "primal/errors.hpp"
 #include "templates/study.hpp"
 
@@ -27,14 +26,6 @@ templates::PushGrid default_grid(const std::string& name) {
           {0.2, 0.35, 0.5, 0.6, 0.7, 0.8},
           {0.3, 0.5, 0.7, 0.9, 0.97},
           {0.2, 0.4, 0.6, 0.8}};
-}
-
-void write_or_print(const std::string& path, const std::function<void(std::ostream&)>& write) {
-  if (path.empty() || path == "-") {
-    write(std::cout);
-    return;
-  }
-  primal::write_file_atomically(path, write);
 }
 
 void run_interleave(const InterleaveArgs& a) {

@@ -9,7 +9,6 @@
 #include <sstream>
 
 #include "cli/commands.hpp"
-#include "primal/atomic_file.hpp"
 #include "primal/errors.hpp"
 #include "primal/io_vtk.hpp"
 #include "primal/quality.hpp"
@@ -192,10 +191,7 @@ void run_template(const TemplateArgs& a) {
     if (!text.empty()) std::cout << text;
     return;
   }
-  if (a.output.empty())
-    std::cout << text;
-  else
-    primal::write_file_atomically(a.output, [&](std::ostream& os) { os << text; });
+  write_or_print(a.output, [&](std::ostream& os) { os << text; });
 }
 
 }  // namespace
