@@ -8,10 +8,10 @@
 #include <cstdlib>
 #include <string>
 
-#include "primal/demo_models.hpp"
+#include "primal/grid_model.hpp"
 #include "primal/quality.hpp"
 #include "primal/errors.hpp"
-#include "templates/conform.hpp"
+#include "conform/conform.hpp"
 
 int main(int argc, char** argv) {
   using namespace geode;
@@ -23,16 +23,16 @@ int main(int argc, char** argv) {
   }
   const primal::Model m =
       primal::grid_model({n, n, n}, 1.0, [n](int i, int, int) { return i >= n / 2; });
-  templates::ConformOptions o;
+  conform::ConformOptions o;
   try {
-    o.smooth = templates::parse_conform_smooth(mode);
+    o.smooth = conform::parse_conform_smooth(mode);
   } catch (const InvalidInput& e) {
     std::fprintf(stderr, "bench_conform: %s\n", e.what());
     return 2;
   }
   o.progress = [](const std::string& s) { std::fprintf(stderr, "  %s\n", s.c_str()); };
   const auto t0 = std::chrono::steady_clock::now();
-  const templates::ConformResult r = templates::conform(m, o);
+  const conform::ConformResult r = conform::conform(m, o);
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   rusage ru{};
   getrusage(RUSAGE_SELF, &ru);

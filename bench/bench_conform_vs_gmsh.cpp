@@ -33,7 +33,7 @@
 #include <string>
 #include <vector>
 
-#include "primal/demo_models.hpp"
+#include "primal/grid_model.hpp"
 #include "primal/errors.hpp"
 #include "primal/io_gmsh.hpp"
 

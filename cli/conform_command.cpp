@@ -11,14 +11,14 @@
 
 #include "cli/commands.hpp"
 #include "primal/atomic_file.hpp"
-#include "primal/demo_models.hpp"
+#include "conform/demo_models.hpp"
 #include "primal/errors.hpp"
 #include "primal/io_exodus.hpp"
 #include "primal/io_gmsh.hpp"
 #include "primal/io_vtk.hpp"
 #include "primal/quality.hpp"
 #include "primal/quality_report.hpp"
-#include "templates/conform.hpp"
+#include "conform/conform.hpp"
 
 namespace geode::cli {
 namespace {
@@ -50,7 +50,7 @@ struct ConformArgs {
   bool quiet = false;
 };
 
-nlohmann::json result_json(const templates::ConformResult& r) {
+nlohmann::json result_json(const conform::ConformResult& r) {
   nlohmann::json j;
   j["input"] = {{"hexes", r.input_hexes}, {"tets", r.input_tets},
                 {"interface_quads", r.interface_quads}};
@@ -77,7 +77,7 @@ double min_sj(const primal::QualityReport& q) {
   return 0.0;
 }
 
-void print_summary(const templates::ConformResult& r, std::ostream& os, bool tables) {
+void print_summary(const conform::ConformResult& r, std::ostream& os, bool tables) {
   os << "input: " << r.input_hexes << " hexes, " << r.input_tets << " tets, "
      << r.interface_quads << " interface quads\n";
   os << "output: " << r.model.hexes.size() << " hexes (" << r.diced_hexes << " diced hex, "
@@ -96,8 +96,8 @@ void print_summary(const templates::ConformResult& r, std::ostream& os, bool tab
 // that does not conform: they name elements and nodes, not the file); empty for demos.
 void run(const primal::Model& model, const ConformArgs& a, bool tables,
          const std::string& source = {}) {
-  templates::ConformOptions opts;
-  opts.smooth = templates::parse_conform_smooth(a.smooth);
+  conform::ConformOptions opts;
+  opts.smooth = conform::parse_conform_smooth(a.smooth);
   if (!a.quiet && isatty(STDERR_FILENO)) {
     opts.progress = [](const std::string& line) { std::cerr << "geode: " << line << "\n"; };
     // Local smoothing is the long step: a bar redrawn in place, at most ten times a second.
@@ -112,9 +112,9 @@ void run(const primal::Model& model, const ConformArgs& a, bool tables,
     };
   }
   const std::string prefix = source.empty() ? "" : source + ": ";
-  templates::ConformResult r;
+  conform::ConformResult r;
   try {
-    r = templates::conform(model, opts);
+    r = conform::conform(model, opts);
   } catch (const InvalidInput& e) {
     throw InvalidInput(prefix + e.what());
   } catch (const TopologyError& e) {
@@ -166,7 +166,7 @@ void add_conform_commands(CLI::App& app) {
   d->callback([dargs] {
     if (!dargs->output.empty()) check_output_extension(dargs->output);
     const primal::Model model =
-        dargs->model == "half" ? primal::demo_half_block(dargs->n) : primal::demo_nugget(dargs->n);
+        dargs->model == "half" ? conform::demo_half_block(dargs->n) : conform::demo_nugget(dargs->n);
     run(model, *dargs, true);
   });
 }

@@ -53,7 +53,7 @@ class GmshSession {
 
 // Converts Gmsh's current model (inside a GmshSession) to a Model, as read_gmsh does after
 // opening; `source` names it in error messages. Lets builders that mesh with the Gmsh API
-// (primal/demo_models.hpp) share the reader's conversion.
+// (conform/demo_models.hpp) share the reader's conversion.
 Model model_from_gmsh(std::string_view source);
 
 }  // namespace geode::primal

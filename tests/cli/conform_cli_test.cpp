@@ -10,12 +10,12 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "primal/demo_models.hpp"
+#include "primal/grid_model.hpp"
 #include "primal/io_exodus.hpp"
 #include "primal/io_gmsh.hpp"
 #include "primal/validity.hpp"
 #include "support/cli_run.hpp"
-#include "templates/conform.hpp"
+#include "conform/conform.hpp"
 
 using namespace geode;
 namespace fs = std::filesystem;
@@ -77,9 +77,9 @@ TEST_CASE("geode conform: .msh and .exo input -> valid all-hex Exodus matching t
     CHECK(j.at("valid") == true);
     // One Exodus block per origin, with the report's counts.
     auto in_block = [&](int b) { return std::count(result.hex_block.begin(), result.hex_block.end(), b); };
-    CHECK(in_block(templates::kDicedHexBlock) == 64);
-    CHECK(in_block(templates::kGeodeBlock) == 104);
-    CHECK(in_block(templates::kDicedTetBlock) == 192);
+    CHECK(in_block(conform::kDicedHexBlock) == 64);
+    CHECK(in_block(conform::kGeodeBlock) == 104);
+    CHECK(in_block(conform::kDicedTetBlock) == 192);
     std::size_t block_hexes = 0;
     for (const auto& b : j.at("blocks")) block_hexes += b.at("quality").at("num_hexes").get<std::size_t>();
     CHECK(block_hexes == 360);

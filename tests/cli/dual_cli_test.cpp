@@ -9,7 +9,7 @@
 
 #include "primal/io_gmsh.hpp"
 #include "primal/io_vtk.hpp"
-#include "primal/demo_models.hpp"
+#include "primal/grid_model.hpp"
 #include "support/cli_run.hpp"
 #include "support/fixtures.hpp"
 #include "support/isomorphism.hpp"

@@ -8,7 +8,7 @@
 #include <set>
 #include <string>
 
-#include "primal/demo_models.hpp"
+#include "primal/grid_model.hpp"
 #include "primal/errors.hpp"
 #include "primal/interface.hpp"
 #include "primal/topology.hpp"

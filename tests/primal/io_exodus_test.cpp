@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "support/temp_dir.hpp"
-#include "primal/demo_models.hpp"
+#include "primal/grid_model.hpp"
 #include "primal/errors.hpp"
 #include "primal/io_exodus.hpp"
 

@@ -9,7 +9,7 @@
 #include <unistd.h>
 
 #include "support/temp_dir.hpp"
-#include "primal/demo_models.hpp"
+#include "primal/grid_model.hpp"
 #include "primal/errors.hpp"
 #include "primal/io_gmsh.hpp"
 #include "primal/topology.hpp"

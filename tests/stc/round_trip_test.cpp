@@ -6,7 +6,7 @@
 #include <cmath>
 #include <string>
 
-#include "primal/demo_models.hpp"
+#include "primal/grid_model.hpp"
 #include "primal/dice.hpp"
 #include "primal/errors.hpp"
 #include "primal/model.hpp"

@@ -20,7 +20,13 @@
 #include "primal/interface.hpp"
 #include "primal/model.hpp"
 
-namespace geode::primal {
+namespace geode::conform {
+
+using primal::HexMesh;
+using primal::Index;
+using primal::Interface;
+using primal::kInvalidIndex;
+using primal::Model;
 
 struct BufferLayerOptions {
   // Step of each duplicated node, as a fraction of the shortest tet or interface-quad edge at it.
@@ -74,4 +80,4 @@ BufferLayer insert_buffer_layer(const Model& model, const Interface& interface,
 // The buffer hexes as a hex mesh over layer.model.points (block = 3).
 HexMesh buffer_hex_mesh(const BufferLayer& layer);
 
-}  // namespace geode::primal
+}  // namespace geode::conform

@@ -1,4 +1,4 @@
-#include "templates/conform.hpp"
+#include "conform/conform.hpp"
 
 #include "primal/disjoint_sets.hpp"
 
@@ -21,7 +21,7 @@
 #include "primal/topology.hpp"
 #include "templates/geode.hpp"
 
-namespace geode::templates {
+namespace geode::conform {
 namespace {
 
 using primal::FaceKey;
@@ -29,6 +29,11 @@ using primal::Index;
 using primal::kInvalidIndex;
 using primal::Point;
 namespace topo = primal::topology;
+using templates::build_geode3d;
+using templates::Diagonal;
+using templates::GeodeOptions;
+using templates::smooth_template;
+using templates::Template;
 
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) {
@@ -280,7 +285,7 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
   say("interface: " + std::to_string(iface.quads.size()) + " quads (" +
       std::to_string(since(t0)) + " s)");
   t0 = Clock::now();
-  const primal::BufferLayer layer = primal::insert_buffer_layer(input, iface, options.buffer);
+  const BufferLayer layer = insert_buffer_layer(input, iface, options.buffer);
   res.buffer = layer.report;
   say("buffer layer: " + std::to_string(layer.hexes.size()) + " hexes, min scaled Jacobian " +
       std::to_string(layer.report.min_scaled_jacobian) + " (" + std::to_string(since(t0)) + " s)");
@@ -357,7 +362,7 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
   // 3. Reference templates, one per diagonal, built and smoothed once.
   t0 = Clock::now();
   std::array<std::optional<RefTemplate>, 2> refs;  // [0]: {4,6}, [1]: {5,7}
-  auto ref_index = [](const primal::BufferHex& b) { return b.diagonal[0] == 5 ? 1 : 0; };
+  auto ref_index = [](const BufferHex& b) { return b.diagonal[0] == 5 ? 1 : 0; };
   res.template_min_scaled_jacobian = 1.0;
   for (const auto& b : layer.hexes) {
     const int r = ref_index(b);
@@ -379,7 +384,7 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
   primal::DisjointSets uf;
   std::vector<Point> side_pos;
   for (std::size_t b = 0; b < nb; ++b) {
-    const primal::BufferHex& bh = layer.hexes[b];
+    const BufferHex& bh = layer.hexes[b];
     const RefTemplate& ref = *refs[ref_index(bh)];
     std::array<Point, 8> P;
     for (int c = 0; c < 8; ++c) P[c] = lm.points[bh.corners[c]];
@@ -705,4 +710,4 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
   return res;
 }
 
-}  // namespace geode::templates
+}  // namespace geode::conform

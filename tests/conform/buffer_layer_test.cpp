@@ -9,14 +9,16 @@
 #include <set>
 #include <string>
 
-#include "primal/buffer_layer.hpp"
-#include "primal/demo_models.hpp"
+#include "conform/buffer_layer.hpp"
+#include "conform/demo_models.hpp"
+#include "primal/grid_model.hpp"
 #include "primal/errors.hpp"
 #include "primal/quality.hpp"
 #include "primal/topology.hpp"
 
 using namespace geode;
 using namespace geode::primal;
+using namespace geode::conform;
 
 namespace {
 

@@ -14,13 +14,13 @@
 #include <string>
 #include <vector>
 
-#include "primal/buffer_layer.hpp"
+#include "conform/buffer_layer.hpp"
 #include "primal/model.hpp"
 #include "primal/quality_report.hpp"
 #include "primal/smooth.hpp"
 #include "primal/validity.hpp"
 
-namespace geode::templates {
+namespace geode::conform {
 
 enum class ConformSmooth { kNone, kLocal, kGlobal };
 
@@ -28,7 +28,7 @@ enum class ConformSmooth { kNone, kLocal, kGlobal };
 ConformSmooth parse_conform_smooth(const std::string& word);
 
 struct ConformOptions {
-  primal::BufferLayerOptions buffer;
+  BufferLayerOptions buffer;
   double interface_tolerance = 1e-6;  // find_interface: relative to the local edge length
   // Box of the reference template (x, y, z as in templates/geode.hpp: y is the buffer hex's
   // thickness direction). It is smoothed once per diagonal with top and bottom fixed; only its
@@ -76,7 +76,7 @@ struct ConformResult {
   primal::Model model;
   primal::Index input_hexes = 0, input_tets = 0, interface_quads = 0;
   primal::Index diced_hexes = 0, geode_hexes = 0, diced_tet_hexes = 0;
-  primal::BufferLayerReport buffer;
+  BufferLayerReport buffer;
   double template_min_scaled_jacobian = 0.0;  // the two reference templates, after smoothing
   double min_scaled_jacobian_before_smoothing = 0.0;
   primal::SmoothResult smoothing;  // zero-initialised when ConformSmooth::kNone
@@ -92,4 +92,4 @@ struct ConformResult {
 // validity is not ok() is still returned (with warnings) so that it can be inspected.
 ConformResult conform(const primal::Model& input, const ConformOptions& options = {});
 
-}  // namespace geode::templates
+}  // namespace geode::conform

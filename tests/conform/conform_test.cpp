@@ -8,12 +8,13 @@
 #include <set>
 
 #include "primal/boundary.hpp"
-#include "primal/demo_models.hpp"
+#include "conform/demo_models.hpp"
+#include "primal/grid_model.hpp"
 #include "primal/errors.hpp"
 #include "primal/io_exodus.hpp"
 #include "primal/quality.hpp"
 #include "primal/topology.hpp"
-#include "templates/conform.hpp"
+#include "conform/conform.hpp"
 
 using namespace geode;
 using primal::Index;
@@ -25,7 +26,7 @@ struct Expected {
 };
 
 // Everything a conforming all-hex result must satisfy, plus its counts.
-void check_result(const templates::ConformResult& r, const Expected& e) {
+void check_result(const conform::ConformResult& r, const Expected& e) {
   CHECK(r.input_hexes == e.hexes);
   CHECK(r.input_tets == e.tets);
   CHECK(r.interface_quads == e.quads);
@@ -56,10 +57,10 @@ void check_result(const templates::ConformResult& r, const Expected& e) {
   CHECK(primal::merge_coincident_nodes(copy, 1e-9) == 0);
   // Blocks by origin, ascending.
   for (std::size_t h = 0; h < r.model.hexes.size(); ++h) {
-    const int expected = h < static_cast<std::size_t>(8 * e.hexes) ? templates::kDicedHexBlock
+    const int expected = h < static_cast<std::size_t>(8 * e.hexes) ? conform::kDicedHexBlock
                          : h < static_cast<std::size_t>(8 * e.hexes + 26 * e.quads)
-                             ? templates::kGeodeBlock
-                             : templates::kDicedTetBlock;
+                             ? conform::kGeodeBlock
+                             : conform::kDicedTetBlock;
     if (r.model.hex_block[h] != expected) {
       FAIL("hex " << h << " in block " << r.model.hex_block[h]);
       break;
@@ -74,7 +75,7 @@ void check_result(const templates::ConformResult& r, const Expected& e) {
 TEST_CASE("one hex with six tets on one face: 8 + 26 + 24 hexes, valid") {
   // Cells (0,0,0) hex, (1,0,0) six Kuhn tets; the shared face x = 1 is one interface quad.
   const primal::Model m = primal::grid_model({2, 1, 1}, 1.0, [](int i, int, int) { return i == 1; });
-  const auto r = templates::conform(m);
+  const auto r = conform::conform(m);
   check_result(r, {1, 6, 1});
   CHECK(r.model.hexes.size() == 58);
 }
@@ -83,32 +84,32 @@ TEST_CASE("L-shaped interfaces: buffer hexes meeting at a concave edge merge the
   SUBCASE("2 x 2 cells, one tet cell: 2 interface quads at right angles") {
     const auto m = primal::grid_model({2, 2, 1}, 1.0, [](int i, int j, int) { return i == 1 && j == 1; });
     // 3 hexes, 6 tets; quads: hex (0,1) x+ face and hex (1,0) y+ face.
-    check_result(templates::conform(m), {3, 6, 2});
+    check_result(conform::conform(m), {3, 6, 2});
   }
   SUBCASE("3 x 3 x 2 cells, tets where i, j >= 1: 8 quads, coplanar and L neighbours") {
     const auto m = primal::grid_model({3, 3, 2}, 1.0, [](int i, int j, int) { return i >= 1 && j >= 1; });
     // Hexes: 5 cells per layer x 2 = 10; tets: 4 cells x 2 x 6 = 48; quads: per layer 2 on
     // x = 1 (j = 1, 2) and 2 on y = 1 (i = 1, 2), x 2 layers = 8.
-    check_result(templates::conform(m), {10, 48, 8});
+    check_result(conform::conform(m), {10, 48, 8});
   }
 }
 
 TEST_CASE("half-block demo, n = 2") {
   // n^3 = 8 hexes, 6 n^3 = 48 tets, n^2 = 4 interface quads.
-  const auto r = templates::conform(primal::demo_half_block(2));
+  const auto r = conform::conform(conform::demo_half_block(2));
   check_result(r, {8, 48, 4});
 }
 
 TEST_CASE("nugget demo, n = 2: side set 'outside' carried to the diced hexes") {
-  const primal::Model m = primal::demo_nugget(2);
+  const primal::Model m = conform::demo_nugget(2);
   // Unsmoothed, the buffer hexes at the cube's corners give inverted geode hexes; a short
   // smoothing (fewer sharpness stages and iterations) untangles them and keeps the test fast
   // under the sanitizers.
-  templates::ConformOptions options;
+  conform::ConformOptions options;
   options.local_smooth_options.sharpness = {10, 40};
   options.local_smooth_options.max_iterations = 200;
   options.local_smooth_options.max_stage_iterations = 50;
-  const auto r = templates::conform(m, options);
+  const auto r = conform::conform(m, options);
   // Interface: the nugget cube's 6 faces, n x n = 4 quads each.
   check_result(r, {static_cast<Index>(m.hexes.size()), static_cast<Index>(m.tets.size()), 24});
   REQUIRE(m.side_sets.size() == 1);
@@ -127,7 +128,7 @@ TEST_CASE("nugget demo, n = 2: side set 'outside' carried to the diced hexes") {
 }
 
 TEST_CASE("the result round-trips through Exodus") {
-  const auto r = templates::conform(primal::demo_half_block(2));
+  const auto r = conform::conform(conform::demo_half_block(2));
   const auto path = std::filesystem::temp_directory_path() /
                     ("geode-conform-" + std::to_string(::getpid()) + ".exo");
   primal::write_exodus(r.model, path);
@@ -141,7 +142,7 @@ TEST_CASE("the result round-trips through Exodus") {
 
 TEST_CASE("conform rejects models without both parts") {
   const auto hexes = primal::grid_model({2, 1, 1}, 1.0, [](int, int, int) { return false; });
-  CHECK_THROWS_AS(templates::conform(hexes), InvalidInput);
+  CHECK_THROWS_AS(conform::conform(hexes), InvalidInput);
   const auto tets = primal::grid_model({2, 1, 1}, 1.0, [](int, int, int) { return true; });
-  CHECK_THROWS_AS(templates::conform(tets), InvalidInput);
+  CHECK_THROWS_AS(conform::conform(tets), InvalidInput);
 }

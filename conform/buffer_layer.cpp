@@ -1,4 +1,4 @@
-#include "primal/buffer_layer.hpp"
+#include "conform/buffer_layer.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -11,7 +11,9 @@
 #include "primal/quality.hpp"
 #include "primal/topology.hpp"
 
-namespace geode::primal {
+namespace geode::conform {
+
+using namespace primal;
 
 namespace {
 
@@ -268,4 +270,4 @@ HexMesh buffer_hex_mesh(const BufferLayer& layer) {
   return mesh;
 }
 
-}  // namespace geode::primal
+}  // namespace geode::conform

@@ -1,21 +1,14 @@
 #pragma once
-// Mixed hex + tet models to exercise the whole-model geode pipeline: small synthetic grids for
-// tests, and demo models meshed with the Gmsh API (no input file).
+// Mixed hex + tet models to exercise the whole-model geode pipeline:
+// demo models meshed with the Gmsh API (no input file).
 #include <array>
 #include <functional>
 
 #include "primal/model.hpp"
 
-namespace geode::primal {
+namespace geode::conform {
 
-// A grid of cells * h on [0, cells.x*h] x ...; node (i,j,k) is number
-// i + (nx+1) * (j + (ny+1) * k). Cell (i,j,k) is a hex (block 1) unless is_tet(i,j,k), then it
-// is split into 6 positive tets (block 2) around its diagonal from its lowest to its highest
-// corner (Kuhn / Freudenthal). Every cell face is then split along the diagonal joining its
-// lowest and highest corners, so the tets conform to each other and to the hex faces they touch
-// (each such quad is two tet triangles). No node sets or side sets.
-Model grid_model(std::array<int, 3> cells, double h,
-                 const std::function<bool(int, int, int)>& is_tet);
+using primal::Model;
 
 // Demo (a), meshed with the Gmsh API (OpenCASCADE boxes, transfinite meshing): the block
 // [0,2] x [0,1] x [0,1]; x < 1 a structured n x n x n hex mesh (block 1 "hex"), x > 1 a
@@ -35,4 +28,4 @@ Model demo_half_block(int n = 4);
 // boundary quads. n must be even and >= 2.
 Model demo_nugget(int n = 4);
 
-}  // namespace geode::primal
+}  // namespace geode::conform
