@@ -14,12 +14,23 @@ void add_template_command(CLI::App& app);   // cli/template_command.cpp
 void add_study_commands(CLI::App& app);     // cli/study_command.cpp
 void add_conform_commands(CLI::App& app);   // cli/conform_command.cpp: conform, demo
 void add_dual_command(CLI::App& app);       // cli/dual_command.cpp
+void add_check_command(CLI::App& app);      // cli/check_command.cpp
 
 // Shared by the commands (cli/files.cpp): the extension in lower case (".msh"), and a model
 // read by extension (.msh, .exo, .e); InvalidInput naming the file when it is missing or of
 // another format.
 std::string file_extension(const std::filesystem::path& p);
 primal::Model read_model(const std::filesystem::path& path);
+// An all-hex mesh, or a planar quad mesh in z = 0 (.vtu / .vtk only), read by extension (.vtu,
+// .vtk, .msh, .exo, .e); InvalidInput naming the file otherwise (tets included). index_base is
+// how the file numbers its nodes and elements: 0 for VTK, 1 for Gmsh and Exodus.
+struct MeshFile {
+  int dim = 3;
+  primal::HexMesh hex;
+  primal::QuadMesh quad;
+  primal::Index index_base = 0;
+};
+MeshFile read_mesh_file(const std::filesystem::path& path);
 // Standard output when `path` is empty or "-", else the file, written atomically.
 void write_or_print(const std::string& path, const std::function<void(std::ostream&)>& write);
 

@@ -124,6 +124,7 @@ nlohmann::json to_json(const templates::Template& T, const std::string& name) {
     for (int s : sheets) names.push_back(T.sheets[static_cast<std::size_t>(s)].name);
     j["intersections"].push_back({{"sheets", names}, {"elements", count}});
   }
+  j["obstructions"] = primal::obstructions_json(templates::template_obstructions(T), 1);
   j["checks"] = {{"triple_domes_in_pocket", T.checks.triple_domes_in_pocket},
                  {"dome_curves_exit_in_tunnels", T.checks.dome_curves_exit_in_tunnels},
                  {"failures", T.checks.failures}};
@@ -156,7 +157,14 @@ void run_template(const TemplateArgs& a) {
       << r.initial_min_scaled_jacobian << " -> " << r.final_min_scaled_jacobian << " in " << r.iterations
       << " iterations, " << r.seconds << " s";
     smooth_note = s.str();
-    if (!r.untangled) std::cerr << "geode: warning: smoothing could not untangle every element\n";
+    if (!r.untangled) {
+      // Say whether the mesh itself forbids positive Jacobians, rather than blame the smoother.
+      const auto obstructions = templates::template_obstructions(T);
+      std::cerr << "geode: warning: smoothing could not untangle every element; "
+                << (obstructions.empty() ? "no combinatorial obstruction found (primal/realizability.hpp)\n"
+                                         : "the mesh cannot be untangled: " +
+                                               primal::format_obstructions(obstructions, T.dim, 1));
+    }
   }
   const int dim = T.dim;
   const auto& pts = dim == 3 ? T.hex.points : T.quad.points;

@@ -5,7 +5,9 @@
 #include <deque>
 #include <functional>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <set>
+#include <sstream>
 #include <string>
 #include <unordered_map>
 
@@ -546,6 +548,42 @@ std::vector<Obstruction> find_obstructions(const HexMesh& mesh, const Realizabil
 
 std::vector<Obstruction> find_obstructions(const QuadMesh& mesh, const RealizabilityOptions& options) {
   return QuadFinder(mesh, options).run();
+}
+
+std::string format_obstructions(const std::vector<Obstruction>& obstructions, int dim, Index base, std::size_t limit) {
+  std::ostringstream os;
+  if (obstructions.empty()) return "no obstructions found\n";
+  std::map<ObstructionKind, int> count;
+  for (const auto& o : obstructions) ++count[o.kind];
+  os << obstructions.size() << (obstructions.size() == 1 ? " obstruction" : " obstructions") << " (";
+  bool first = true;
+  for (const auto& [kind, n] : count) os << (first ? "" : ", ") << n << " " << to_string(kind), first = false;
+  os << ")\n";
+  auto list = [&](const std::vector<Index>& ids) {
+    for (std::size_t i = 0; i < ids.size(); ++i) os << (i ? " " : "") << ids[i] + base;
+  };
+  for (std::size_t i = 0; i < std::min(limit, obstructions.size()); ++i) {
+    const auto& o = obstructions[i];
+    os << "  " << to_string(o.kind) << ": " << (dim == 2 ? "quads " : "hexes ");
+    list(o.hexes);
+    os << "; nodes ";
+    list(o.nodes);
+    os << "\n";
+  }
+  if (obstructions.size() > limit) os << "  ... and " << obstructions.size() - limit << " more\n";
+  return os.str();
+}
+
+nlohmann::json obstructions_json(const std::vector<Obstruction>& obstructions, Index base) {
+  auto j = nlohmann::json::array();
+  auto shifted = [base](const std::vector<Index>& ids) {
+    std::vector<Index> out;
+    for (Index i : ids) out.push_back(i + base);
+    return out;
+  };
+  for (const auto& o : obstructions)
+    j.push_back({{"kind", std::string(to_string(o.kind))}, {"hexes", shifted(o.hexes)}, {"nodes", shifted(o.nodes)}});
+  return j;
 }
 
 }  // namespace geode::primal

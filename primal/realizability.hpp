@@ -35,6 +35,8 @@
 // of its quads. For a template, pass `node_faces` instead: the faces of its box each node lies
 // on, as bits (templates::Template::node_faces), so the answer does not depend on where the
 // nodes currently are.
+#include <nlohmann/json_fwd.hpp>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -74,5 +76,13 @@ std::vector<Obstruction> find_obstructions(const HexMesh& mesh, const Realizabil
 // quad with two edges on one straight side), flat corner. The 3D pinched corner and two-quad
 // node have no separate 2D form: they are the doublet and the two-edges quad.
 std::vector<Obstruction> find_obstructions(const QuadMesh& mesh, const RealizabilityOptions& options = {});
+
+// One line per obstruction, "  doublet: hexes 3 7; nodes 5 9" (quads for dim 2), numbers plus
+// `base` (1 for files that number from 1), at most `limit` lines and then how many more; a
+// first line counts them by kind ("no obstructions found" when there are none).
+std::string format_obstructions(const std::vector<Obstruction>& obstructions, int dim, Index base = 0,
+                                std::size_t limit = 50);
+// [{"kind": "doublet", "hexes": [...], "nodes": [...]}, ...], numbers plus `base`.
+nlohmann::json obstructions_json(const std::vector<Obstruction>& obstructions, Index base = 0);
 
 }  // namespace geode::primal

@@ -275,6 +275,12 @@ primal::SmoothResult smooth_template(Template& t, bool slide_faces) {
   return primal::smooth_quad_mesh(t.quad, Point::UnitZ(), c);
 }
 
+std::vector<primal::Obstruction> template_obstructions(const Template& t) {
+  primal::RealizabilityOptions o;
+  o.node_faces = t.node_faces;
+  return t.dim == 3 ? primal::find_obstructions(t.hex, o) : primal::find_obstructions(t.quad, o);
+}
+
 Eigen::Vector3d parse_box(const std::string& text) {
   static const std::regex re(R"(^\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*[xX]\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)(?:\s*[xX]\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?))?\s*$)");
   std::smatch m;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "primal/mesh.hpp"
+#include "primal/realizability.hpp"
 #include "primal/smooth.hpp"
 #include "stc/arrangement.hpp"
 #include "templates/completion.hpp"
@@ -106,6 +107,10 @@ Template build_geode2d(const GeodeOptions& options);
 // slide_faces, in which case they slide within their face (box edges along the edge, corners
 // fixed); side-face nodes always slide within their face.
 primal::SmoothResult smooth_template(Template& t, bool slide_faces);
+
+// The combinatorial obstructions to untangling the template (primal/realizability.hpp), its
+// planar faces being the faces of its box (node_faces), wherever its nodes currently are.
+std::vector<primal::Obstruction> template_obstructions(const Template& t);
 
 // Parse "24x14x24" (or "24x14" for 2D); InvalidInput naming the text otherwise.
 Eigen::Vector3d parse_box(const std::string& text);

@@ -1,0 +1,138 @@
+// geode check MESH: is a hex (or planar quad) mesh a valid complex, how good are its elements,
+// and which combinatorial obstructions keep any placement of its nodes from positive
+// Jacobians (primal/validity.hpp, primal/quality_report.hpp, primal/realizability.hpp).
+#include <algorithm>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "cli/commands.hpp"
+#include "primal/errors.hpp"
+#include "primal/quality.hpp"
+#include "primal/quality_report.hpp"
+#include "primal/realizability.hpp"
+#include "primal/validity.hpp"
+
+namespace geode::cli {
+namespace {
+
+using primal::Index;
+
+struct CheckArgs {
+  std::string input;
+  std::string format = "text";
+  std::string output;
+  double planar_angle = primal::RealizabilityOptions{}.planar_angle_degrees;
+};
+
+struct Checked {
+  bool valid = false;
+  std::string validity;  // the report's summary
+  bool analysable = false;  // every element's nodes in range and distinct: quality and obstructions computed
+  nlohmann::json quality;
+  std::string quality_text;
+  std::vector<primal::Obstruction> obstructions;
+};
+
+Checked check_hexes(const primal::HexMesh& mesh, const primal::RealizabilityOptions& options) {
+  Checked c;
+  const auto v = primal::check_validity(mesh);
+  c.valid = v.ok();
+  c.validity = v.summary();
+  c.analysable = v.out_of_range_hexes.empty() && v.repeated_node_hexes.empty() && !mesh.hexes.empty();
+  if (!c.analysable) return c;
+  const auto q = primal::hex_quality_report(mesh);
+  c.quality = primal::quality_report_json(q);
+  c.quality_text = primal::format_quality_table(q);
+  c.obstructions = primal::find_obstructions(mesh, options);
+  return c;
+}
+
+Checked check_quads(const primal::QuadMesh& mesh, const primal::RealizabilityOptions& options) {
+  Checked c;
+  const auto v = primal::check_validity(mesh);
+  c.valid = v.ok();
+  c.validity = v.summary();
+  c.analysable = v.out_of_range_quads.empty() && v.repeated_node_quads.empty() && !mesh.quads.empty();
+  if (!c.analysable) return c;
+  double lo = 1e300, hi = -1e300;
+  Index at = 0;
+  for (std::size_t q = 0; q < mesh.quads.size(); ++q) {
+    const double s = primal::quad_scaled_jacobian(primal::quad_corners(mesh, static_cast<Index>(q)), primal::Point::UnitZ());
+    if (s < lo) lo = s, at = static_cast<Index>(q);
+    hi = std::max(hi, s);
+  }
+  c.quality = {{"num_quads", mesh.quads.size()}, {"scaled_jacobian", {{"min", lo}, {"max", hi}, {"min_quad", at}}}};
+  std::ostringstream s;
+  s << "Quad scaled Jacobian: min " << lo << " (quad " << at << "), max " << hi << "\n";
+  c.quality_text = s.str();
+  c.obstructions = primal::find_obstructions(mesh, options);
+  return c;
+}
+
+void run_check(const CheckArgs& a) {
+  const MeshFile m = read_mesh_file(a.input);
+  primal::RealizabilityOptions options;
+  options.planar_angle_degrees = a.planar_angle;
+  Checked c = m.dim == 3 ? check_hexes(m.hex, options) : check_quads(m.quad, options);
+  const Index base = m.index_base;
+  if (c.quality.contains("num_quads")) c.quality["scaled_jacobian"]["min_quad"] = c.quality["scaled_jacobian"]["min_quad"].get<Index>() + base;
+  if (c.quality.contains("metrics"))
+    for (auto& metric : c.quality["metrics"])
+      for (const char* k : {"min_hex", "max_hex"}) metric[k] = metric[k].get<Index>() + base;
+  std::string text;
+  if (a.format == "json") {
+    nlohmann::json j;
+    j["file"] = a.input;
+    j["dimension"] = m.dim;
+    j["index_base"] = base;
+    j["valid"] = c.valid;
+    j["validity"] = c.validity;
+    j["quality"] = c.analysable ? c.quality : nlohmann::json();
+    j["obstructions"] = c.analysable ? primal::obstructions_json(c.obstructions, base) : nlohmann::json();
+    text = j.dump(1) + "\n";
+  } else {
+    std::ostringstream s;
+    s << a.input << " (" << (m.dim == 3 ? "elements" : "quads") << " and nodes numbered from " << base << ")\n"
+      << c.validity;
+    if (c.analysable) {
+      s << "\n" << c.quality_text << "\nrealizability: "
+        << primal::format_obstructions(c.obstructions, m.dim, base, static_cast<std::size_t>(-1));
+    } else {
+      s << "\nquality and realizability not checked: some elements have out-of-range or repeated nodes\n";
+    }
+    text = s.str();
+  }
+  write_or_print(a.output, [&](std::ostream& os) { os << text; });
+}
+
+}  // namespace
+
+void add_check_command(CLI::App& app) {
+  auto a = std::make_shared<CheckArgs>();
+  CLI::App* c = app.add_subcommand(
+      "check",
+      "Check a hex (or planar quad) mesh: its validity as a complex (faces shared by two hexes, manifold\n"
+      "edges and vertices, closed boundary, Euler characteristic, positive corner Jacobians), its quality\n"
+      "(the paper's Table 1 metrics), and the combinatorial obstructions to any positive-Jacobian\n"
+      "embedding with its planar boundary faces kept planar: doublets, pinched corners, a hex with two\n"
+      "faces on one planar boundary face, flat corners, two-quad boundary nodes (primal/realizability.hpp\n"
+      "says why each blocks). Exit 0 whenever the file could be checked.");
+  c->add_option("mesh", a->input, "All-hex mesh (.vtu, .vtk, .msh, .exo, .e) or planar quad mesh in z = 0 (.vtu, .vtk)")
+      ->required();
+  c->add_option("--format", a->format,
+                "text, or json: {\"valid\", \"validity\", \"quality\", \"obstructions\": [{\"kind\", \"hexes\", \"nodes\"}]}\n"
+                "with ids as the file numbers them (\"index_base\")")
+      ->check(CLI::IsMember({"text", "json"}))
+      ->capture_default_str();
+  c->add_option("-o,--output", a->output, "Write the report here instead of standard output");
+  c->add_option("--planar-angle", a->planar_angle,
+                "boundary quads whose normals differ by less than this many degrees (and that lie in one plane)\n"
+                "form one planar boundary face")
+      ->check(CLI::Range(0.0, 90.0))
+      ->capture_default_str();
+  c->callback([a] { run_check(*a); });
+}
+
+}  // namespace geode::cli
