@@ -1,0 +1,175 @@
+// The `geode check` command end to end: the geode has no obstruction, the plain four-triangle
+// dual has pinched corners and its 24-hex class doublets (each confirmed here by counting faces
+// in the file read back, not by the library), ids are the file's own, refusals exit 2.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+
+#include "primal/boundary.hpp"
+#include "primal/io_gmsh.hpp"
+#include "primal/io_vtk.hpp"
+#include "primal/grid_model.hpp"
+#include "primal/topology.hpp"
+#include "support/cli_run.hpp"
+#include "support/fixtures.hpp"
+
+using namespace geode;
+using primal::Index;
+using test::geode_cli;
+
+namespace {
+
+// The faces of hex h as sorted node keys.
+std::set<primal::FaceKey> faces_of(const primal::HexMesh& m, Index h) {
+  std::set<primal::FaceKey> out;
+  for (const auto& f : primal::topology::kHexFaceCorners) {
+    std::array<Index, 4> q{};
+    for (int i = 0; i < 4; ++i) q[i] = m.hexes[h][f[i]];
+    out.insert(primal::face_key(q));
+  }
+  return out;
+}
+
+// Distinct faces of the mesh with a corner at v whose two neighbours in the face are a and b.
+std::size_t faces_at_corner(const primal::HexMesh& m, Index v, Index a, Index b) {
+  std::set<primal::FaceKey> found;
+  for (std::size_t h = 0; h < m.hexes.size(); ++h)
+    for (const auto& f : primal::topology::kHexFaceCorners)
+      for (int i = 0; i < 4; ++i) {
+        if (m.hexes[h][f[i]] != v) continue;
+        const Index p = m.hexes[h][f[(i + 3) % 4]], n = m.hexes[h][f[(i + 1) % 4]];
+        if ((p == a && n == b) || (p == b && n == a)) {
+          std::array<Index, 4> q{};
+          for (int k = 0; k < 4; ++k) q[k] = m.hexes[h][f[k]];
+          found.insert(primal::face_key(q));
+        }
+      }
+  return found.size();
+}
+
+nlohmann::json check_json(const std::filesystem::path& file) {
+  const auto r = geode_cli("check " + file.string() + " --format json");
+  REQUIRE(r.code == 0);
+  return nlohmann::json::parse(r.out);
+}
+
+std::size_t count_kind(const nlohmann::json& j, const std::string& kind) {
+  return static_cast<std::size_t>(std::count_if(j["obstructions"].begin(), j["obstructions"].end(),
+                                                [&](const nlohmann::json& o) { return o["kind"] == kind; }));
+}
+
+}  // namespace
+
+TEST_CASE("geode check: the geode has no obstruction, the four-triangle duals do") {
+  test::TempDir dir;
+  const auto geode = dir.path / "geode.vtu", plain = dir.path / "plain4.vtu", c24 = dir.path / "class24.vtu";
+  REQUIRE(geode_cli("template geode3d --format vtu -o " + geode.string()).code == 0);
+  REQUIRE(geode_cli("template geode4tri --no-smooth --format vtu -o " + plain.string()).code == 0);
+  REQUIRE(geode_cli("template geode4tri --no-smooth --high-roof 0.5 --low-roof 0.45 --dome-depth 0.9 "
+                    "--dome-radius 0.4 --format vtu -o " + c24.string())
+              .code == 0);
+
+  const auto g = check_json(geode);
+  CHECK(g["valid"] == true);
+  CHECK(g["index_base"] == 0);
+  CHECK(g["obstructions"].empty());
+  CHECK(g["quality"]["num_hexes"] == 26);
+
+  SUBCASE("plain four-triangle dual: pinched corners") {
+    const auto j = check_json(plain);
+    const primal::HexMesh m = primal::to_hex_mesh(primal::read_vtu(plain));
+    CHECK(m.hexes.size() == 36);
+    REQUIRE(count_kind(j, "pinched-corner") >= 1);
+    for (const auto& o : j["obstructions"]) {
+      if (o["kind"] != "pinched-corner") continue;
+      const auto n = o["nodes"].get<std::vector<Index>>();
+      REQUIRE(n.size() == 3);
+      CHECK(faces_at_corner(m, n[0], n[1], n[2]) >= 2);
+    }
+  }
+
+  SUBCASE("its 24-hex class: doublets") {
+    const auto j = check_json(c24);
+    const primal::HexMesh m = primal::to_hex_mesh(primal::read_vtu(c24));
+    CHECK(m.hexes.size() == 24);
+    REQUIRE(count_kind(j, "doublet") >= 1);
+    for (const auto& o : j["obstructions"]) {
+      if (o["kind"] != "doublet") continue;
+      const auto h = o["hexes"].get<std::vector<Index>>();
+      REQUIRE(h.size() == 2);
+      std::vector<primal::FaceKey> shared;
+      const auto a = faces_of(m, h[0]), b = faces_of(m, h[1]);
+      std::set_intersection(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(shared));
+      CHECK(shared.size() >= 2);
+    }
+  }
+
+  SUBCASE("template --format json and the warning name the same obstructions") {
+    const auto t = geode_cli("template geode4tri --no-smooth --format json");
+    REQUIRE(t.code == 0);
+    const auto tj = nlohmann::json::parse(t.out);
+    const auto cj = check_json(plain);
+    REQUIRE(tj["obstructions"].size() == cj["obstructions"].size());
+    for (std::size_t i = 0; i < cj["obstructions"].size(); ++i) {
+      CHECK(tj["obstructions"][i]["kind"] == cj["obstructions"][i]["kind"]);
+      // The template numbers from 1, the .vtu file from 0.
+      for (std::size_t k = 0; k < cj["obstructions"][i]["nodes"].size(); ++k)
+        CHECK(tj["obstructions"][i]["nodes"][k].get<int>() == cj["obstructions"][i]["nodes"][k].get<int>() + 1);
+    }
+    const auto smoothed = geode_cli("template geode4tri --format csv", true);
+    CHECK(smoothed.out.find("smoothing could not untangle every element; the mesh cannot be untangled") !=
+          std::string::npos);
+    CHECK(smoothed.out.find("pinched-corner: hexes") != std::string::npos);
+  }
+}
+
+TEST_CASE("geode check: text report, quad meshes, the file's own numbering") {
+  test::TempDir dir;
+  SUBCASE("a clean quad grid, in text") {
+    const auto in = dir.path / "quads.vtk";
+    primal::write_vtk(in, test::structured_quad_grid(3, 2));
+    const auto r = geode_cli("check " + in.string());
+    REQUIRE(r.code == 0);
+    CHECK(r.out.find("quad mesh") != std::string::npos);
+    CHECK(r.out.find("realizability: no obstructions found") != std::string::npos);
+  }
+  SUBCASE("a quad doublet") {
+    primal::QuadMesh q = test::structured_quad_grid(3, 3);
+    const Index e = static_cast<Index>(q.points.size());
+    q.points.emplace_back(1.6, 1.4, 0.0);
+    const auto c = q.quads[4];
+    q.quads[4] = {c[0], c[1], c[2], e};
+    q.quads.push_back({c[0], e, c[2], c[3]});
+    const auto in = dir.path / "doublet.vtu";
+    primal::write_vtu(in, q);
+    const auto j = check_json(in);
+    CHECK(j["dimension"] == 2);
+    REQUIRE(j["obstructions"].size() == 1);
+    CHECK(j["obstructions"][0]["kind"] == "doublet");
+    CHECK(j["obstructions"][0]["hexes"] == nlohmann::json{4, 9});
+  }
+  SUBCASE("Gmsh numbers from 1") {
+    // Two unit hexes side by side.
+    primal::Model model = primal::grid_model({2, 1, 1}, 1.0, [](int, int, int) { return false; });
+    const auto in = dir.path / "two.msh";
+    primal::write_gmsh(model, in);
+    const auto j = check_json(in);
+    CHECK(j["index_base"] == 1);
+    CHECK(j["valid"] == true);
+    CHECK(j["obstructions"].empty());
+    CHECK(j["quality"]["metrics"][0]["min_hex"].get<int>() >= 1);
+  }
+  SUBCASE("refusals") {
+    CHECK(geode_cli("check " + (dir.path / "missing.vtu").string()).code == 2);
+    const auto in = dir.path / "mixed.msh";
+    primal::write_gmsh(primal::grid_model({2, 1, 1}, 1.0, [](int i, int, int) { return i == 1; }), in);
+    const auto r = geode_cli("check " + in.string(), true);
+    CHECK(r.code == 2);
+    CHECK(r.out.find(in.string() + ": holds") != std::string::npos);
+    CHECK(geode_cli("check " + in.string() + " --format yaml").code != 0);
+  }
+}
