@@ -477,6 +477,8 @@ json read_spec_json(const std::filesystem::path& path) {
     return j;
   } catch (const json::parse_error& e) {
     throw InvalidInput(name + ": not valid JSON: " + e.what());
+  } catch (const json::out_of_range& e) {  // a number too large for a double
+    throw InvalidInput(name + ": not valid JSON: " + e.what());
   }
 }
 
