@@ -8,6 +8,10 @@
 
 #include "primal/model.hpp"
 
+namespace geode::templates {
+struct Template;
+}
+
 namespace geode::cli {
 
 void add_template_command(CLI::App& app);   // cli/template_command.cpp
@@ -15,6 +19,7 @@ void add_study_commands(CLI::App& app);     // cli/study_command.cpp
 void add_conform_commands(CLI::App& app);   // cli/conform_command.cpp: conform, demo
 void add_dual_command(CLI::App& app);       // cli/dual_command.cpp
 void add_check_command(CLI::App& app);      // cli/check_command.cpp
+void add_arrange_command(CLI::App& app);    // cli/arrange_command.cpp
 
 // Shared by the commands (cli/files.cpp): the extension in lower case (".msh"), and a model
 // read by extension (.msh, .exo, .e); InvalidInput naming the file when it is missing or of
@@ -33,5 +38,19 @@ struct MeshFile {
 MeshFile read_mesh_file(const std::filesystem::path& path);
 // Standard output when `path` is empty or "-", else the file, written atomically.
 void write_or_print(const std::string& path, const std::function<void(std::ostream&)>& write);
+
+// A derived template's output, shared by `template` and `arrange` (cli/template_command.cpp):
+// warns when the paper's interleave conditions fail, smooths, then writes `format`
+// (appendix, csv, json, vtu) to `output` or standard output.
+struct TemplateOutput {
+  std::string name;   // the template's name in the JSON ("template") and the appendix title
+  std::string title;  // what follows the name in the appendix title, e.g. "box 24x14x24"
+  std::string format = "appendix";
+  std::string output;
+  bool smooth = true;
+  bool slide = false;
+  bool quality = false;
+};
+void write_template(templates::Template& t, const TemplateOutput& out);
 
 }  // namespace geode::cli

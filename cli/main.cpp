@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   geode::cli::add_conform_commands(app);
   geode::cli::add_dual_command(app);
   geode::cli::add_check_command(app);
+  geode::cli::add_arrange_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

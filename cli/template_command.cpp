@@ -14,6 +14,7 @@
 #include "primal/quality.hpp"
 #include "primal/quality_report.hpp"
 #include "templates/geode.hpp"
+#include "templates/spec.hpp"
 
 namespace geode::cli {
 namespace {
@@ -137,20 +138,27 @@ void run_template(const TemplateArgs& a) {
   o.diagonal = a.diagonal == "anti" ? templates::Diagonal::Anti : templates::Diagonal::Main;
   o.higher = a.higher == "z" ? templates::Higher::Z : templates::Higher::X;
   o.push = a.push;
-  templates::Template T;
-  if (a.name == "geode2d") {
-    T = templates::build_geode2d(o);
-  } else {
-    if (a.name == "geode4tri") o.split = templates::TopSplit::FourTriangles;
-    T = templates::build_geode3d(o);
+  if (a.name == "geode4tri") o.split = templates::TopSplit::FourTriangles;
+  const int dim = a.name == "geode2d" ? 2 : 3;
+  if (a.format == "spec") {
+    const std::string text = templates::format_spec(templates::spec_json(templates::geode_spec(o, dim)));
+    write_or_print(a.output, [&](std::ostream& os) { os << text; });
+    return;
   }
-  if (!T.checks.ok() && a.name != "geode2d") {
+  templates::Template T = dim == 2 ? templates::build_geode2d(o) : templates::build_geode3d(o);
+  write_template(T, {a.name, "box " + a.box, a.format, a.output, !a.no_smooth, a.slide, a.quality});
+}
+
+}  // namespace
+
+void write_template(templates::Template& T, const TemplateOutput& a) {
+  if (!T.checks.ok()) {
     std::string why;
     for (const auto& f : T.checks.failures) why += (why.empty() ? "" : "; ") + f;
     std::cerr << "geode: warning: the interleave fails the paper's conditions: " << why << "\n";
   }
   std::string smooth_note;
-  if (!a.no_smooth) {
+  if (a.smooth) {
     const auto r = templates::smooth_template(T, a.slide);
     std::ostringstream s;
     s << "smoothing (" << (a.slide ? "tet/hex-side nodes slide" : "tet/hex-side nodes fixed") << "): min scaled Jacobian "
@@ -170,7 +178,7 @@ void run_template(const TemplateArgs& a) {
   const auto& pts = dim == 3 ? T.hex.points : T.quad.points;
   std::string text;
   if (a.format == "appendix") {
-    text = "# geode template " + a.name + ", box " + a.box + (smooth_note.empty() ? "" : "; " + smooth_note) + "\n";
+    text = "# geode template " + a.name + ", " + a.title + (smooth_note.empty() ? "" : "; " + smooth_note) + "\n";
     text += appendix_nodes(pts, dim) + "\n";
     text += dim == 3 ? appendix_cells(T.hex.hexes, "hexes") : appendix_cells(T.quad.quads, "quads");
   } else if (a.format == "csv") {
@@ -202,8 +210,6 @@ void run_template(const TemplateArgs& a) {
   write_or_print(a.output, [&](std::ostream& os) { os << text; });
 }
 
-}  // namespace
-
 void add_template_command(CLI::App& app) {
   auto args = std::make_shared<TemplateArgs>();
   CLI::App* t = app.add_subcommand(
@@ -227,8 +233,9 @@ void add_template_command(CLI::App& app) {
       ->capture_default_str();
   t->add_option("--format", args->format,
                 "appendix: the paper's Tables 2 and 3 (1-based); csv: node and element tables; json: with\n"
-                "sheets, their intersections and the interleave checks; vtu: VTK XML for ParaView (needs -o)")
-      ->check(CLI::IsMember({"appendix", "csv", "json", "vtu"}))
+                "sheets, their intersections and the interleave checks; vtu: VTK XML for ParaView (needs -o);\n"
+                "spec: the template as an arrangement spec for `geode arrange` (nothing is derived)")
+      ->check(CLI::IsMember({"appendix", "csv", "json", "vtu", "spec"}))
       ->capture_default_str();
   t->add_option("-o,--output", args->output, "write to FILE (atomically) instead of standard output");
   t->add_flag("--slide", args->slide, "let tet- and hex-side nodes slide within their faces while smoothing");

@@ -4,12 +4,14 @@
 #include <cmath>
 #include <regex>
 #include <set>
+#include <tuple>
 
 #include "primal/errors.hpp"
 #include "primal/topology.hpp"
 #include "stc/arrangement.hpp"
 #include "stc/dualize.hpp"
 #include "templates/completion.hpp"
+#include "templates/spec.hpp"
 
 namespace geode::templates {
 namespace {
@@ -33,9 +35,10 @@ std::string corner_name(const Point& p) {
 // Box faces a reference point lies on.
 unsigned faces_of(const Point& r, const stc::Domain& D) {
   unsigned f = 0;
+  const double eps = 1e-12 * (D.hi - D.lo).norm();
   for (int a = 0; a < D.dim; ++a) {
-    if (std::abs(r[a] - D.lo[a]) < 1e-12) f |= 1u << stc::box_face(a, false);
-    if (std::abs(r[a] - D.hi[a]) < 1e-12) f |= 1u << stc::box_face(a, true);
+    if (std::abs(r[a] - D.lo[a]) < eps) f |= 1u << stc::box_face(a, false);
+    if (std::abs(r[a] - D.hi[a]) < eps) f |= 1u << stc::box_face(a, true);
   }
   return f;
 }
@@ -153,25 +156,15 @@ InterleaveChecks check_interleave(const stc::Arrangement& A, const std::vector<S
   return c;
 }
 
-}  // namespace
-
-GeodeArrangement geode_arrangement(const GeodeOptions& o, int dim) {
+// The interface cells before dicing, in reference coordinates; throws InvalidInput for a
+// degenerate box or push.
+std::pair<InterfacePatch, InterfacePatch> reference_patches(const GeodeOptions& o, int dim) {
   if (dim != 2 && dim != 3) throw InvalidInput("geode: dimension must be 2 or 3");
   for (int a = 0; a < dim; ++a)
     if (!(o.box[a] > 0) || !std::isfinite(o.box[a]))
       throw InvalidInput("geode: box dimensions must be positive and finite");
-  const PushParameters& p = o.push;
-  if (!(0 < p.low_roof && p.low_roof < p.high_roof && p.high_roof < 1))
-    throw InvalidInput("geode: tunnel roofs must satisfy 0 < low < high < 1 (tunnels must not reach the tet side)");
-  if (!(0 < p.dome_depth && p.dome_depth < 1))
-    throw InvalidInput("geode: dome depth must be in (0, 1) (domes must not reach the hex side)");
-  if (!(0 < p.dome_radius && p.dome_radius < 1)) throw InvalidInput("geode: dome radius blend must be in (0, 1)");
-
-  // The interface cells before dicing, in reference coordinates.
-  GeodeArrangement G;
-  G.domain = reference_domain(dim);
-  InterfacePatch& bottom = G.hex_side;
-  InterfacePatch& top = G.tet_side;
+  if (const std::string why = push_error(o.push); !why.empty()) throw InvalidInput("geode: " + why);
+  InterfacePatch bottom, top;
   bottom.dim = top.dim = dim;
   if (dim == 2) {
     bottom.points = {Point(-1, 0, 0), Point(1, 0, 0)};
@@ -192,15 +185,28 @@ GeodeArrangement geode_arrangement(const GeodeOptions& o, int dim) {
       top.cells = {{0, 1, 3}, {1, 2, 3}};
     }
   }
+  return {bottom, top};
+}
 
-  // Complete both duals and push them together.
+}  // namespace
+
+std::string push_error(const PushParameters& p) {
+  if (!(0 < p.low_roof && p.low_roof < p.high_roof && p.high_roof < 1))
+    return "tunnel roofs must satisfy 0 < low < high < 1 (tunnels must not reach the tet side)";
+  if (!(0 < p.dome_depth && p.dome_depth < 1)) return "dome depth must be in (0, 1) (domes must not reach the hex side)";
+  if (!(0 < p.dome_radius && p.dome_radius < 1)) return "dome radius blend must be in (0, 1)";
+  return "";
+}
+
+std::vector<stc::Sheet> complete_interface(const InterfacePatch& bottom, const InterfacePatch& top,
+                                           const PushParameters& p, Higher higher, int dim) {
   const auto tunnels = complete_tunnels(bottom, [&](const Point& along) {
     if (dim == 2) return p.high_roof;
     const bool along_x = std::abs(along.x()) > std::abs(along.z());
-    return along_x == (o.higher == Higher::X) ? p.high_roof : p.low_roof;
+    return along_x == (higher == Higher::X) ? p.high_roof : p.low_roof;
   });
   const auto domes = complete_domes(top, 1.0, p.dome_depth, p.dome_radius);
-  std::vector<stc::Sheet>& sheets = G.sheets;
+  std::vector<stc::Sheet> sheets;
   for (const auto& t : tunnels) {
     stc::Sheet s = t.sheet;
     if (dim == 3) s.name = std::abs(t.along.x()) > std::abs(t.along.z()) ? "tunnel x" : "tunnel z";
@@ -213,27 +219,45 @@ GeodeArrangement geode_arrangement(const GeodeOptions& o, int dim) {
                       : (std::abs(v.x()) < 1e-12 ? std::string("dome centre") : "dome " + corner_name(v));
     sheets.push_back(s);
   }
+  return sheets;
+}
+
+GeodeArrangement geode_arrangement(const GeodeOptions& o, int dim) {
+  GeodeArrangement G;
+  std::tie(G.hex_side, G.tet_side) = reference_patches(o, dim);
+  G.domain = reference_domain(dim);
+  G.sheets = complete_interface(G.hex_side, G.tet_side, o.push, o.higher, dim);
   return G;
 }
 
-namespace {
+ArrangementSpec geode_spec(const GeodeOptions& o, int dim) {
+  auto [bottom, top] = reference_patches(o, dim);
+  for (auto& q : bottom.points) q = to_box(q, o.box, dim);
+  for (auto& q : top.points) q = to_box(q, o.box, dim);
+  ArrangementSpec spec;
+  spec.dim = dim;
+  const stc::Domain ref = reference_domain(dim);
+  spec.domain = stc::Domain(to_box(ref.lo, o.box, dim), to_box(ref.hi, o.box, dim), dim);
+  spec.completion = CompletionSpec{bottom, top, o.higher, o.push};
+  return spec;
+}
 
-Template build(const GeodeOptions& o, int dim) {
-  const GeodeArrangement G = geode_arrangement(o, dim);
-  const auto& sheets = G.sheets;
-  const stc::Domain& dom = G.domain;
+Template build_template(const ArrangementSpec& spec, const stc::ArrangementOptions& options) {
+  const std::vector<stc::Sheet> sheets = spec_sheets(spec);
+  const stc::Domain& dom = spec.domain;
   Template T;
-  T.dim = dim;
+  T.dim = spec.dim;
   for (const auto& s : sheets) T.sheets.push_back({s.name, s.kind});
-  const stc::Arrangement A = stc::compute_arrangement(sheets, dom, o.arrangement);
+  const stc::Arrangement A = stc::compute_arrangement(sheets, dom, options);
   T.checks = check_interleave(A, T.sheets, sheets);
   const stc::DualMesh D = stc::dualize(A);
 
-  std::vector<Point> pts = dim == 3 ? D.hex.points : D.quad.points;
-  place_interface(D, sheets, dice_patch(G.hex_side), stc::box_face(1, false), dom, pts, "hex-side");
-  place_interface(D, sheets, dice_patch(G.tet_side), stc::box_face(1, true), dom, pts, "tet-side");
-  for (auto& q : pts) q = to_box(q, o.box, dim);
-  if (dim == 3) {
+  std::vector<Point> pts = spec.dim == 3 ? D.hex.points : D.quad.points;
+  if (spec.completion) {
+    place_interface(D, sheets, dice_patch(spec.completion->hex_side), stc::box_face(1, false), dom, pts, "hex-side");
+    place_interface(D, sheets, dice_patch(spec.completion->tet_side), stc::box_face(1, true), dom, pts, "tet-side");
+  }
+  if (spec.dim == 3) {
     T.hex.hexes = D.hex.hexes;
     T.hex.points = pts;
   } else {
@@ -246,10 +270,8 @@ Template build(const GeodeOptions& o, int dim) {
   return T;
 }
 
-}  // namespace
-
-Template build_geode3d(const GeodeOptions& options) { return build(options, 3); }
-Template build_geode2d(const GeodeOptions& options) { return build(options, 2); }
+Template build_geode3d(const GeodeOptions& options) { return build_template(geode_spec(options, 3), options.arrangement); }
+Template build_geode2d(const GeodeOptions& options) { return build_template(geode_spec(options, 2), options.arrangement); }
 
 primal::SmoothResult smooth_template(Template& t, bool slide_faces) {
   if (t.dim == 3) {

@@ -92,13 +92,31 @@ struct GeodeArrangement {
 };
 GeodeArrangement geode_arrangement(const GeodeOptions& options, int dim);
 
-// Derive a template: complete the diced interfaces' duals into tunnels and domes, push them
-// together, compute the arrangement and dualize it. Top and bottom nodes are placed exactly
-// where dicing puts them; a node is matched to its diced position by the sides of every
-// sheet it lies on, so a boundary that differs from the prescribed diced interface is an
-// error, not a silent mismatch. Other nodes get the dual's first guess (see smoothing).
-// Throws TopologyError with the diagnosis when the arrangement does not dualize to a valid
-// mesh, and InvalidInput for a degenerate box.
+// Why a push cannot be used ("" when it can): roofs 0 < low < high < 1, depth and radius
+// blend in (0, 1).
+std::string push_error(const PushParameters& push);
+
+// Complete the hex side's chords into tunnels and the tet side's vertices into domes and push
+// them together, in the reference cell: the tunnels first ("tunnel x", "tunnel z"; 2D
+// "tunnel"), then the domes ("dome (-x,+z)", "dome centre"; 2D "dome -x"). The tunnel whose
+// chord runs along `higher` gets the high roof.
+std::vector<stc::Sheet> complete_interface(const InterfacePatch& hex_side, const InterfacePatch& tet_side,
+                                           const PushParameters& push, Higher higher, int dim);
+
+// The template as an arrangement spec (templates/spec.hpp): the buffer cell's box, its two
+// interface patches before dicing, the push. build_geode3d and build_geode2d derive from it.
+struct ArrangementSpec;
+ArrangementSpec geode_spec(const GeodeOptions& options, int dim);
+
+// Derive a template from a spec: compute the arrangement of its sheets and dualize it. With a
+// completion block, tet- and hex-side nodes are placed exactly where dicing puts them; a node
+// is matched to its diced position by the sides of every sheet it lies on, so a boundary that
+// differs from the prescribed diced interface is an error, not a silent mismatch. Other nodes
+// get the dual's first guess (see smoothing). Throws TopologyError with the diagnosis when the
+// arrangement does not dualize to a valid mesh.
+Template build_template(const ArrangementSpec& spec, const stc::ArrangementOptions& options = {});
+
+// build_template(geode_spec(options, 3 or 2)); InvalidInput for a degenerate box or push.
 Template build_geode3d(const GeodeOptions& options);
 Template build_geode2d(const GeodeOptions& options);
 

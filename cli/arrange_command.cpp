@@ -1,0 +1,60 @@
+// geode arrange SPEC.json: an arrangement given as a file (templates/spec.hpp) -> arrangement
+// -> diagnoses -> dual mesh -> optional smoothing -> the template command's outputs.
+#include <filesystem>
+#include <memory>
+
+#include "cli/commands.hpp"
+#include "primal/errors.hpp"
+#include "templates/geode.hpp"
+#include "templates/spec.hpp"
+
+namespace geode::cli {
+namespace {
+
+struct ArrangeArgs {
+  std::string spec;
+  std::string output;
+  std::string format = "appendix";
+  bool smooth = false;
+  bool slide = false;
+  bool quality = false;
+};
+
+void run_arrange(const ArrangeArgs& a) {
+  const templates::ArrangementSpec spec = templates::read_spec(a.spec);
+  // The smoother's constraints keep nodes on axis-aligned box faces.
+  if (a.smooth && spec.domain.corners)
+    throw InvalidInput(a.spec + ": --smooth needs a box domain (this spec's domain is a " +
+                       (spec.dim == 3 ? "hexahedron)" : "quadrilateral)"));
+  templates::Template t = templates::build_template(spec);
+  const std::string name = std::filesystem::path(a.spec).stem().string();
+  write_template(t, {name, "spec " + std::filesystem::path(a.spec).filename().string(), a.format, a.output, a.smooth,
+                     a.slide, a.quality});
+}
+
+}  // namespace
+
+void add_arrange_command(CLI::App& app) {
+  auto args = std::make_shared<ArrangeArgs>();
+  CLI::App* c = app.add_subcommand(
+      "arrange",
+      "Compute the arrangement of the sheets a JSON spec gives (domain, sheets, optional completion\n"
+      "block and push; format in README.md, 'Arrangements as files'), diagnose it, dualize it and\n"
+      "print or write the mesh. Exit 2 for a bad spec (naming the JSON path), 3 when the\n"
+      "arrangement does not dualize (naming the sheets and the place).");
+  c->add_option("SPEC", args->spec, "the spec, a JSON file")->required();
+  c->add_option("--format", args->format,
+                "appendix: node and element tables (1-based); csv; json: with sheets, their\n"
+                "intersections and the interleave checks; vtu: VTK XML for ParaView (needs -o)")
+      ->check(CLI::IsMember({"appendix", "csv", "json", "vtu"}))
+      ->capture_default_str();
+  c->add_option("-o,--output", args->output, "write to FILE (atomically) instead of standard output");
+  c->add_flag("--smooth", args->smooth,
+              "place the nodes by optimization (untangle, then maximise the minimum scaled Jacobian);\n"
+              "without it, nodes sit at the dual's first guess (diced positions on a completion's faces)");
+  c->add_flag("--slide", args->slide, "with --smooth: tet- and hex-side nodes slide within their faces");
+  c->add_flag("--quality", args->quality, "append the quality report (the paper's Table 1 metrics)");
+  c->callback([args] { run_arrange(*args); });
+}
+
+}  // namespace geode::cli

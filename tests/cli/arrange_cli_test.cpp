@@ -1,0 +1,145 @@
+// The `geode arrange` command end to end: the shipped specs (notebooks-data/specs/) are what
+// `geode template NAME --format spec` writes and arrange to the built-in templates; known
+// answers; bad specs exit 2 naming the JSON path, arrangements that do not dualize exit 3.
+#include <doctest/doctest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "support/cli_run.hpp"
+#include "support/isomorphism.hpp"
+
+using namespace geode;
+using test::geode_cli;
+using test::temp_path;
+
+namespace {
+
+std::string read_text(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void write_text(const std::filesystem::path& p, const std::string& text) { std::ofstream(p) << text; }
+
+// The mesh of a `--format json` output (1-based cells), as a hex or quad mesh.
+struct JsonMesh {
+  int dim = 3;
+  primal::HexMesh hex;
+  primal::QuadMesh quad;
+};
+JsonMesh mesh_of(const nlohmann::json& j) {
+  JsonMesh m;
+  m.dim = j.contains("hexes") ? 3 : 2;
+  std::vector<primal::Point> pts;
+  for (const auto& p : j["nodes"]) pts.emplace_back(p[0].get<double>(), p[1].get<double>(), m.dim == 3 ? p[2].get<double>() : 0.0);
+  if (m.dim == 3) {
+    m.hex.points = pts;
+    for (const auto& h : j["hexes"]) {
+      std::array<primal::Index, 8> c{};
+      for (std::size_t i = 0; i < 8; ++i) c[i] = h[i].get<primal::Index>() - 1;
+      m.hex.hexes.push_back(c);
+    }
+  } else {
+    m.quad.points = pts;
+    for (const auto& q : j["quads"]) {
+      std::array<primal::Index, 4> c{};
+      for (std::size_t i = 0; i < 4; ++i) c[i] = q[i].get<primal::Index>() - 1;
+      m.quad.quads.push_back(c);
+    }
+  }
+  return m;
+}
+
+const std::string kPlanes =
+    R"("sheets": [{"name": "x", "plane": {"point": [0.5, 0.5, 0.5], "normal": [1, 0, 0]}},
+                  {"name": "y", "plane": {"point": [0.5, 0.5, 0.5], "normal": [0, 1, 0]}},
+                  {"name": "z", "plane": {"point": [0.5, 0.5, 0.5], "normal": [0, 0, 1]}})";
+
+std::string three_planes_and(const std::string& extra) {
+  return R"({"dim": 3, "domain": {"box": [[0, 0, 0], [1, 1, 1]]}, )" + kPlanes + extra + "]}";
+}
+
+}  // namespace
+
+TEST_CASE("geode arrange: the shipped specs are the built-in templates") {
+  for (const std::string name : {"geode3d", "geode2d", "geode4tri"}) {
+    CAPTURE(name);
+    const std::filesystem::path shipped = std::filesystem::path(GEODE_SOURCE_DIR) / "notebooks-data/specs" / (name + ".json");
+    const auto spec = geode_cli("template " + name + " --format spec");
+    REQUIRE(spec.code == 0);
+    CHECK(spec.out == read_text(shipped));  // regenerate with the command when this fails
+
+    const auto built = geode_cli("template " + name + " --no-smooth --format json");
+    const auto arranged = geode_cli("arrange " + shipped.string() + " --format json");
+    REQUIRE(built.code == 0);
+    REQUIRE(arranged.code == 0);
+    const auto a = nlohmann::json::parse(built.out), b = nlohmann::json::parse(arranged.out);
+    CHECK(a["sheets"] == b["sheets"]);
+    CHECK(a["intersections"] == b["intersections"]);
+    const JsonMesh ma = mesh_of(a), mb = mesh_of(b);
+    const auto& pa = ma.dim == 3 ? ma.hex.points : ma.quad.points;
+    const auto& pb = mb.dim == 3 ? mb.hex.points : mb.quad.points;
+    REQUIRE(pa.size() == pb.size());
+    CHECK(ma.hex.hexes.size() == mb.hex.hexes.size());
+    CHECK(ma.quad.quads.size() == mb.quad.quads.size());
+    CHECK((ma.dim == 3 ? test::find_isomorphism(ma.hex, mb.hex).has_value()
+                       : test::find_isomorphism(ma.quad, mb.quad).has_value()));
+    for (std::size_t i = 0; i < pa.size(); ++i) CHECK((pa[i] - pb[i]).norm() < 1e-9);
+  }
+}
+
+TEST_CASE("geode arrange: the issue's form, three planes and a sphere, is the pillowed hex") {
+  const auto spec = temp_path("pillow.json");
+  write_text(spec, three_planes_and(R"(, {"name": "s", "sphere": {"center": [0.5, 0.5, 0.5], "radius": 0.3}})"));
+  const auto out = temp_path("pillow-out.json");
+  const auto r = geode_cli("arrange " + spec.string() + " --smooth --format json -o " + out.string());
+  REQUIRE(r.code == 0);
+  const auto j = nlohmann::json::parse(read_text(out));
+  CHECK(j["hexes"].size() == 7);
+  CHECK(j["nodes"].size() == 16);
+  CHECK(j["sheets"].size() == 4);
+  CHECK(j["sheets"][3]["kind"] == "sphere");
+  CHECK(j["template"] == spec.stem().string());
+  std::filesystem::remove(spec);
+  std::filesystem::remove(out);
+}
+
+TEST_CASE("geode arrange: bad specs exit 2 naming the JSON path, non-dualizing ones exit 3") {
+  const auto spec = temp_path("bad.json");
+  const auto out = temp_path("bad-out.json");
+  struct Case {
+    std::string what;
+    std::string text;
+    int code;
+    const char* message;
+  };
+  const std::vector<Case> cases = {
+      {"zero normal", three_planes_and(R"(, {"name": "w", "plane": {"point": [0, 0, 0], "normal": [0, 0, 0]}})"), 2,
+       ": sheets[3].plane.normal: must not be zero"},
+      {"too large for a double", three_planes_and(R"(, {"name": "s", "sphere": {"center": [0.5, 0.5, 0.5], "radius": 1e999}})"), 2,
+       ": not valid JSON: [json.exception.out_of_range.406] number overflow"},
+      {"NaN is not JSON", three_planes_and(R"(, {"name": "s", "sphere": {"center": [0.5, 0.5, 0.5], "radius": NaN}})"), 2,
+       ": not valid JSON"},
+      {"wrong dim", R"({"dim": 4, "domain": {"box": [[0, 0], [1, 1]]}, "sheets": []})", 2, ": dim: must be 2 or 3"},
+      {"sphere through the box faces' crossing",
+       three_planes_and(R"(, {"name": "s", "sphere": {"center": [0.5, 0.5, 0.5], "radius": 0.5}})"), 3,
+       "arrangement: sheets 'x', 'y', 's' meet on the domain boundary"},
+  };
+  for (const auto& c : cases) {
+    CAPTURE(c.what);
+    write_text(spec, c.text);
+    const auto r = geode_cli("arrange " + spec.string() + " --format json -o " + out.string(), true);
+    CHECK(r.code == c.code);
+    CHECK(r.out.find(c.message) != std::string::npos);
+    CHECK(std::count(r.out.begin(), r.out.end(), '\n') == 1);
+    CHECK_FALSE(std::filesystem::exists(out));
+  }
+  CHECK(geode_cli("arrange " + temp_path("missing.json").string()).code == 2);
+  std::filesystem::remove(spec);
+}
