@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numeric>
 
 #include "primal/errors.hpp"
@@ -44,6 +45,36 @@ TEST_CASE("interleave study: the default push is the 26-hex geode, and other out
   CHECK(total == static_cast<int>(study.runs.size()));
   for (const auto& r : study.runs)
     if (!r.valid) CHECK(r.diagnosis.find_first_of("0123456789.") == r.diagnosis.find("1-cell"));
+  // The geode's class is a usable template; no class with an obstruction is ever untangled.
+  CHECK(cls->obstructions.empty());
+  CHECK(cls->usable);
+  CHECK(cls->min_sj_fixed > 0.3);
+  CHECK(cls->min_sj_slide > 0.3);
+  for (const auto& c : study.classes) {
+    if (!c.valid || c.obstructions.empty()) continue;
+    CHECK_FALSE(c.usable);
+    CHECK(c.min_sj_fixed <= 0.0);
+    CHECK(c.min_sj_slide <= 0.0);
+  }
+}
+
+TEST_CASE("template_obstructions: none on the geode, pinched corners and doublets on four-triangle duals") {
+  auto kinds = [](const std::vector<primal::Obstruction>& o) {
+    std::map<primal::ObstructionKind, int> n;
+    for (const auto& x : o) ++n[x.kind];
+    return n;
+  };
+  CHECK(templates::template_obstructions(templates::build_geode3d(GeodeOptions{})).empty());
+  CHECK(templates::template_obstructions(templates::build_geode2d(GeodeOptions{})).empty());
+  GeodeOptions four;
+  four.split = templates::TopSplit::FourTriangles;
+  const auto plain = kinds(templates::template_obstructions(templates::build_geode3d(four)));
+  CHECK(plain.count(primal::ObstructionKind::kPinchedCorner));
+  four.push = {0.5, 0.45, 0.9, 0.4};
+  const auto t24 = templates::build_geode3d(four);
+  CHECK(t24.hex.hexes.size() == 24);
+  const auto c24 = kinds(templates::template_obstructions(t24));
+  CHECK(c24.count(primal::ObstructionKind::kDoublet));
 }
 
 TEST_CASE("interleave study: grid points with low >= high are skipped") {
