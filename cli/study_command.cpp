@@ -51,7 +51,11 @@ void run_interleave(const InterleaveArgs& a) {
   for (const auto& c : study.classes) {
     log << "  " << c.label << "  " << std::setw(4) << c.count << " runs  ";
     if (c.valid)
-      log << c.hexes << " hexes, conditions ok in " << c.conditions_ok << "/" << c.count;
+      log << c.hexes << " hexes, conditions ok in " << c.conditions_ok << "/" << c.count << ", "
+          << (c.obstructions.empty() ? std::string("no obstruction")
+                                     : std::to_string(c.obstructions.size()) + " obstructions")
+          << ", smoothed min SJ " << c.min_sj_fixed << " fixed / " << c.min_sj_slide << " sliding"
+          << (c.usable ? ": usable" : ": not usable");
     else
       log << "error";
     log << "  e.g. push " << c.example.high_roof << " " << c.example.low_roof << " " << c.example.dome_depth << " "

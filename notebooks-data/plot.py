@@ -120,8 +120,10 @@ def interleave(name):
             x = float(r["dome_depth"]) + 0.012 * (k - (len(radii) - 1) / 2)  # radius as a small x offset
             y = float(r["low_roof"])
             valid = r["outcome"] == "valid"
-            marker = ("o" if r["conditions_ok"] == "1" else "^") if valid else "x"
-            ax.scatter([x], [y], color=colour[r["class"]], marker=marker, s=28)
+            usable = valid and summary[r["class"]]["usable"] == "1"
+            marker = ("*" if usable else "o" if r["conditions_ok"] == "1" else "^") if valid else "x"
+            ax.scatter([x], [y], color=colour[r["class"]], marker=marker, s=90 if usable else 28,
+                       edgecolors="black" if usable else None, linewidths=0.6)
             p = tuple(float(r[c]) for c in ("high_roof", "low_roof", "dome_depth", "dome_radius"))
             if name == "geode3d" and p == default:
                 ax.scatter([x], [y], facecolors="none", edgecolors="red", s=140, lw=1.5)
@@ -133,16 +135,21 @@ def interleave(name):
     for c in labels:
         s = summary[c]
         if s["outcome"] == "valid":
-            text = f"{c}: {s['hexes']} hexes, {s['count']} runs, conditions ok {s['conditions_ok']}"
+            text = f"{c}: {s['hexes']} hexes, {s['count']} runs, conditions ok {s['conditions_ok']}, "
+            if s["usable"] == "1":
+                text += f"USABLE, min SJ {float(s['min_sj_fixed']):.2f} fixed / {float(s['min_sj_slide']):.2f} sliding"
+            else:
+                text += "not usable: " + (s["obstructions"].replace(";", ", ") or "smoothing fails")
         else:
             key = s["key"]
             text = f"{c}: {s['count']} runs, " + (key[:60] + "..." if len(key) > 60 else key)
-        handles.append(plt.Line2D([], [], color=colour[c], marker="o" if c.startswith("V") else "x", ls="", label=text))
+        mark = ("*" if s["usable"] == "1" else "o") if c.startswith("V") else "x"
+        handles.append(plt.Line2D([], [], color=colour[c], marker=mark, ls="", label=text))
     if name == "geode3d":
         handles.append(plt.Line2D([], [], color="red", marker="o", mfc="none", ls="", label="paper's push (0.85, 0.6, 0.9, 0.6)"))
     fig.legend(handles=handles, loc="lower center", ncol=2, fontsize=6.5, frameon=False)
-    fig.suptitle(f"{name}: outcome class of each push (o: valid, paper's conditions hold; ^: valid, they fail; "
-                 f"x: TopologyError)\nwithin a panel, the 4 dome-radius values are small x offsets, left to right "
+    fig.suptitle(f"{name}: outcome class of each push (*: usable template: no obstruction, untangled; "
+                 f"o: valid complex, paper's conditions hold; ^: valid, they fail; x: TopologyError)\nwithin a panel, the 4 dome-radius values are small x offsets, left to right "
                  f"{', '.join(f'{r:g}' for r in radii)}  (geode study interleave --template {name})", fontsize=9)
     fig.subplots_adjust(left=0.7 / (3.1 * len(highs)), right=0.99, wspace=0.08, top=1 - 0.75 / height_in,
                         bottom=(legend_in + 0.55) / height_in)

@@ -110,6 +110,37 @@ Index patch_from_bits(const std::vector<unsigned>& bits, const std::array<Index,
   return kNoPatch;
 }
 
+// Quads (hex faces, or a quad mesh's quads) sharing a corner: the same node v with the same two
+// neighbours a, b in the quad. One group per such (v, min(a, b), max(a, b)) used by two or more
+// quads, in order of first appearance, quads ascending. quad(i) is null for quads to skip.
+struct SharedCorner {
+  std::array<Index, 3> corner;
+  std::vector<Index> quads;
+};
+
+std::vector<SharedCorner> shared_corners(std::size_t n, const std::function<const std::array<Index, 4>*(std::size_t)>& quad) {
+  std::map<std::array<Index, 3>, std::vector<Index>> by_corner;
+  std::vector<std::array<Index, 3>> order;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto* q = quad(i);
+    if (!q) continue;
+    for (std::size_t c = 0; c < 4; ++c) {
+      const Index v = (*q)[c], a = (*q)[(c + 3) % 4], b = (*q)[(c + 1) % 4];
+      const std::array<Index, 3> key{v, std::min(a, b), std::max(a, b)};
+      auto& list = by_corner[key];
+      if (list.empty()) order.push_back(key);
+      list.push_back(static_cast<Index>(i));
+    }
+  }
+  std::vector<SharedCorner> out;
+  for (const auto& key : order) {
+    auto list = by_corner.at(key);
+    sort_unique(list);
+    if (list.size() >= 2) out.push_back({key, list});
+  }
+  return out;
+}
+
 // ---- Hex meshes ----------------------------------------------------------------------------
 
 class HexFinder {
@@ -250,28 +281,14 @@ class HexFinder {
 
   // Distinct faces sharing both edges va, vb at a node v.
   void find_pinched_corners() {
-    std::map<std::array<Index, 3>, std::vector<Index>> by_corner;  // (v, min(a, b), max(a, b)) -> faces
-    std::vector<std::array<Index, 3>> order;
-    for (std::size_t f = 0; f < faces_.size(); ++f) {
-      const auto& q = faces_[f].nodes;
-      for (int i = 0; i < 4; ++i) {
-        const Index v = q[static_cast<std::size_t>(i)], a = q[static_cast<std::size_t>((i + 3) % 4)],
-                    b = q[static_cast<std::size_t>((i + 1) % 4)];
-        const std::array<Index, 3> key{v, std::min(a, b), std::max(a, b)};
-        auto& list = by_corner[key];
-        if (list.empty()) order.push_back(key);
-        list.push_back(static_cast<Index>(f));
-      }
-    }
-    for (const auto& key : order) {
-      const auto& list = by_corner.at(key);
-      if (list.size() < 2) continue;
+    for (const auto& [corner, faces] :
+         shared_corners(faces_.size(), [&](std::size_t f) { return &faces_[f].nodes; })) {
       std::vector<Index> hexes;
-      for (Index f : list)
+      for (Index f : faces)
         for (const auto& [h, lf] : faces_[static_cast<std::size_t>(f)].uses) hexes.push_back(h);
       sort_unique(hexes);
-      if (explained_by_doublet(key[0], hexes)) continue;
-      pinched_.push_back(Obstruction{ObstructionKind::kPinchedCorner, hexes, {key[0], key[1], key[2]}});
+      if (explained_by_doublet(corner[0], hexes)) continue;
+      pinched_.push_back(Obstruction{ObstructionKind::kPinchedCorner, hexes, {corner[0], corner[1], corner[2]}});
     }
   }
 
@@ -471,26 +488,11 @@ class QuadFinder {
 
   // Quads sharing both edges va, vb at a node v.
   void find_doublets() {
-    std::map<std::array<Index, 3>, std::vector<Index>> by_corner;
-    std::vector<std::array<Index, 3>> order;
-    for (std::size_t q = 0; q < mesh_.quads.size(); ++q) {
-      const auto& quad = mesh_.quads[q];
-      if (has_repeated(quad)) continue;
-      for (int c = 0; c < 4; ++c) {
-        const Index v = quad[static_cast<std::size_t>(c)], a = quad[static_cast<std::size_t>((c + 3) % 4)],
-                    b = quad[static_cast<std::size_t>((c + 1) % 4)];
-        const std::array<Index, 3> k{v, std::min(a, b), std::max(a, b)};
-        auto& list = by_corner[k];
-        if (list.empty()) order.push_back(k);
-        list.push_back(static_cast<Index>(q));
-      }
-    }
-    for (const auto& k : order) {
-      auto quads = by_corner.at(k);
-      if (quads.size() < 2) continue;
-      sort_unique(quads);
-      doublets_.push_back(Obstruction{ObstructionKind::kDoublet, quads, {k[0], k[1], k[2]}});
-    }
+    const auto groups = shared_corners(mesh_.quads.size(), [&](std::size_t q) {
+      return has_repeated(mesh_.quads[q]) ? nullptr : &mesh_.quads[q];
+    });
+    for (const auto& [corner, quads] : groups)
+      doublets_.push_back(Obstruction{ObstructionKind::kDoublet, quads, {corner[0], corner[1], corner[2]}});
   }
 
   void find_two_edges_and_flat_corners() {

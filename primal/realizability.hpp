@@ -1,18 +1,24 @@
 #pragma once
 // Combinatorial obstructions to a positive-Jacobian embedding of a hex (or quad) mesh with its
-// planar boundary faces kept planar: configurations that no placement of the nodes can give
-// positive corner Jacobians, whatever the smoother does. A valid complex (primal/validity.hpp)
-// can still carry them; each is reported with the hexes (quads) and nodes involved.
+// planar boundary faces kept planar: configurations that no placement of the nodes turns into
+// an embedded mesh with positive corner Jacobians, whatever the smoother does. A valid complex
+// (primal/validity.hpp) can still carry them; each is reported with the hexes (quads) and
+// nodes involved.
 //
 // Why each one blocks (corner Jacobian = det of the three edge vectors at a hex corner,
 // topology::kHexCornerNeighbors; positive at every corner means every dihedral angle of a hex
 // at an edge end, and every face angle at a corner, lies strictly between 0 and pi):
 //  - doublet: two hexes sharing two faces, i.e. an interior edge in only two hexes. The
-//    dihedral angles around an interior edge sum to 2 pi, so it needs at least three hexes.
+//    dihedral angles around an interior edge sum to a multiple of 2 pi, each less than pi, so
+//    it needs at least three hexes.
 //    (2D: a node inside the mesh in only two quads, which then share both its edges.)
 //  - pinched corner: two distinct faces sharing both edges va, vb at a node v. Both faces are
-//    tangent at v to the plane of va and vb, so the hex corners at v between them span no
-//    solid angle (a two-sided polygon in the link of v).
+//    tangent at v to the plane of va and vb (a two-sided polygon in the link of v), so the
+//    hex corners on each side of the pair cover every direction around v a whole number of
+//    times, at least once: at least twice together, and the hexes around v overlap. Corner
+//    Jacobians can all be positive then (the hexes wrap twice around v), so this one blocks
+//    an embedding, not positive Jacobians; when both faces are on the boundary, the boundary
+//    closes on itself at v instead.
 //  - two faces on one boundary face: a hex with two of its faces on the same planar boundary
 //    face. Where the two faces meet (or along a face, if they are opposite) the hex's edges
 //    all lie in that plane: a zero corner Jacobian.

@@ -71,6 +71,26 @@ std::string csv_quote(const std::string& s) {
   return r + "\"";
 }
 
+// Obstructions and smoothed quality of a valid class's example template.
+void measure_class(InterleaveClass& c, const Template& example) {
+  c.obstructions = template_obstructions(example);
+  Template fixed = example, slide = example;
+  const auto f = smooth_template(fixed, false);
+  const auto s = smooth_template(slide, true);
+  c.min_sj_fixed = f.final_min_scaled_jacobian;
+  c.min_sj_slide = s.final_min_scaled_jacobian;
+  c.usable = c.obstructions.empty() && f.untangled && c.min_sj_fixed > 0.0;
+}
+
+// "doublet:10;pinched-corner:1", kinds in enum order.
+std::string obstruction_counts(const std::vector<primal::Obstruction>& obstructions) {
+  std::map<primal::ObstructionKind, int> count;
+  for (const auto& o : obstructions) ++count[o.kind];
+  std::string r;
+  for (const auto& [kind, n] : count) r += (r.empty() ? "" : ";") + std::string(primal::to_string(kind)) + ":" + std::to_string(n);
+  return r;
+}
+
 }  // namespace
 
 std::string template_class_key(const Template& t) {
@@ -153,6 +173,7 @@ InterleaveStudy interleave_study(const GeodeOptions& base, const PushGrid& grid,
     int count = 0;
     int ok = 0;
     PushParameters example;
+    Template example_template;  // valid classes
   };
   std::map<std::pair<bool, std::string>, Outcome> outcomes;
   std::vector<std::string> keys;  // per run
@@ -167,8 +188,9 @@ InterleaveStudy interleave_study(const GeodeOptions& base, const PushGrid& grid,
           run.push = o.push;
           const auto t0 = std::chrono::steady_clock::now();
           std::string key;
+          Template t;
           try {
-            const Template t = build_geode3d(o);
+            t = build_geode3d(o);
             run.valid = true;
             run.hexes = static_cast<int>(t.hex.hexes.size());
             run.conditions_ok = t.checks.ok();
@@ -182,7 +204,7 @@ InterleaveStudy interleave_study(const GeodeOptions& base, const PushGrid& grid,
           }
           run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
           auto& oc = outcomes[{run.valid, key}];
-          if (oc.count == 0) oc = {run.valid, key, run.hexes, 0, 0, run.push};
+          if (oc.count == 0) oc = {run.valid, key, run.hexes, 0, 0, run.push, std::move(t)};
           ++oc.count;
           oc.ok += run.conditions_ok ? 1 : 0;
           keys.push_back(key);
@@ -207,6 +229,7 @@ InterleaveStudy interleave_study(const GeodeOptions& base, const PushGrid& grid,
     c.count = oc->count;
     c.conditions_ok = oc->ok;
     c.example = oc->example;
+    if (c.valid) measure_class(c, oc->example_template);
     label[{c.valid, c.key}] = c.label;
     study.classes.push_back(c);
   }
@@ -227,11 +250,18 @@ void write_interleave_csv(std::ostream& out, const InterleaveStudy& study) {
 
 void write_interleave_summary(std::ostream& out, const InterleaveStudy& study) {
   out << "class,outcome,count,hexes,conditions_ok,example_high_roof,example_low_roof,example_dome_depth,"
-         "example_dome_radius,key\n";
-  for (const auto& c : study.classes)
+         "example_dome_radius,key,obstructions,min_sj_fixed,min_sj_slide,usable\n";
+  for (const auto& c : study.classes) {
     out << c.label << "," << (c.valid ? "valid" : "error") << "," << c.count << "," << c.hexes << ","
         << c.conditions_ok << "," << fmt(c.example.high_roof) << "," << fmt(c.example.low_roof) << ","
-        << fmt(c.example.dome_depth) << "," << fmt(c.example.dome_radius) << "," << csv_quote(c.key) << "\n";
+        << fmt(c.example.dome_depth) << "," << fmt(c.example.dome_radius) << "," << csv_quote(c.key) << ",";
+    if (c.valid)
+      out << obstruction_counts(c.obstructions) << "," << fmt(c.min_sj_fixed) << "," << fmt(c.min_sj_slide) << ","
+          << (c.usable ? 1 : 0);
+    else
+      out << ",,,";
+    out << "\n";
+  }
 }
 
 // ---- Shape study ---------------------------------------------------------------------------

@@ -53,6 +53,13 @@ struct InterleaveClass {
   int count = 0;
   int conditions_ok = 0;  // runs of the class meeting the paper's conditions
   PushParameters example;  // the first run of the class in sweep order
+  // Valid classes, measured on the example's template: the obstructions to untangling it
+  // (template_obstructions), and its smoothed minimum scaled Jacobian with tet- and hex-side
+  // nodes fixed at the diced positions and sliding in their faces (smooth_template). A class is
+  // usable as a template when it has no obstruction and the fixed-side minimum is positive.
+  std::vector<primal::Obstruction> obstructions;
+  double min_sj_fixed = 0.0, min_sj_slide = 0.0;
+  bool usable = false;
 };
 
 struct InterleaveStudy {
@@ -62,14 +69,15 @@ struct InterleaveStudy {
 };
 
 // Builds the template for every grid point with 0 < low < high < 1 (others are skipped:
-// build_geode3d rejects them as invalid input). split picks geode3d or geode4tri; the rest of
+// build_geode3d rejects them as invalid input), then measures each valid class. split picks geode3d or geode4tri; the rest of
 // `base` (box, diagonal, higher) is kept.
 InterleaveStudy interleave_study(const GeodeOptions& base, const PushGrid& grid,
                                  const std::string& template_name);
 
 // CSV: high_roof,low_roof,dome_depth,dome_radius,outcome,hexes,class,conditions_ok,diagnosis
 void write_interleave_csv(std::ostream& out, const InterleaveStudy& study);
-// CSV: class,outcome,count,hexes,conditions_ok,example high/low/depth/radius,key
+// CSV: class,outcome,count,hexes,conditions_ok,example high/low/depth/radius,key,obstructions
+// (count per kind, "doublet:10;pinched-corner:1"),min_sj_fixed,min_sj_slide,usable
 void write_interleave_summary(std::ostream& out, const InterleaveStudy& study);
 
 // ---- Shape study ---------------------------------------------------------------------------

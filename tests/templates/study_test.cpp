@@ -5,10 +5,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numeric>
 
 #include "primal/errors.hpp"
 #include "primal/quality.hpp"
+#include "primal/topology.hpp"
 #include "templates/study.hpp"
 
 using namespace geode;
@@ -44,6 +46,85 @@ TEST_CASE("interleave study: the default push is the 26-hex geode, and other out
   CHECK(total == static_cast<int>(study.runs.size()));
   for (const auto& r : study.runs)
     if (!r.valid) CHECK(r.diagnosis.find_first_of("0123456789.") == r.diagnosis.find("1-cell"));
+  // The geode's class is a usable template; no class with an obstruction is ever untangled.
+  CHECK(cls->obstructions.empty());
+  CHECK(cls->usable);
+  CHECK(cls->min_sj_fixed > 0.3);
+  CHECK(cls->min_sj_slide > 0.3);
+  // Every obstruction but the pinched corner forbids positive Jacobians outright.
+  for (const auto& c : study.classes) {
+    if (!c.valid || c.obstructions.empty()) continue;
+    CHECK_FALSE(c.usable);
+    const bool absolute = std::any_of(c.obstructions.begin(), c.obstructions.end(), [](const primal::Obstruction& o) {
+      return o.kind != primal::ObstructionKind::kPinchedCorner;
+    });
+    if (!absolute) continue;
+    CHECK(c.min_sj_fixed <= 0.0);
+    CHECK(c.min_sj_slide <= 0.0);
+  }
+}
+
+namespace {
+
+// Sum over the hexes at node v of their corner's solid angle (Van Oosterom and Strackee's
+// formula for the spherical triangle of the three edge directions), in units of 4 pi: 1 for an
+// embedded interior node, k when the hexes wrap k times around it.
+double coverage(const primal::HexMesh& m, primal::Index v) {
+  double sum = 0.0;
+  for (const auto& hex : m.hexes)
+    for (int c = 0; c < 8; ++c) {
+      if (hex[c] != v) continue;
+      std::array<primal::Point, 3> e;
+      for (int k = 0; k < 3; ++k)
+        e[k] = (m.points[hex[primal::topology::kHexCornerNeighbors[c][k]]] - m.points[v]).normalized();
+      sum += 2.0 * std::atan2(e[0].dot(e[1].cross(e[2])), 1.0 + e[0].dot(e[1]) + e[1].dot(e[2]) + e[2].dot(e[0]));
+    }
+  return sum / (4.0 * M_PI);
+}
+
+}  // namespace
+
+TEST_CASE("a pinched corner the smoother 'untangles' is a double cover") {
+  // A 30-hex class meeting the paper's conditions with one pinched corner at an interior node:
+  // with the tet and hex sides sliding, the smoother reaches positive Jacobians, but the hexes
+  // around that node wrap twice around it.
+  GeodeOptions o;
+  o.push = {0.55, 0.5, 0.97, 0.8};
+  templates::Template t = templates::build_geode3d(o);
+  REQUIRE(t.hex.hexes.size() == 30);
+  CHECK(t.checks.ok());
+  const auto obstructions = templates::template_obstructions(t);
+  REQUIRE(obstructions.size() == 1);
+  REQUIRE(obstructions[0].kind == primal::ObstructionKind::kPinchedCorner);
+  const primal::Index v = obstructions[0].nodes[0];
+  CHECK(t.node_faces[v] == 0u);  // interior
+  // Whether the smoother reaches positive Jacobians here is its business; when it does, the
+  // overlap must show.
+  const auto r = templates::smooth_template(t, true);
+  if (r.final_min_scaled_jacobian > 0.0) CHECK(coverage(t.hex, v) == doctest::Approx(2.0).epsilon(1e-6));
+  // Every other interior node is covered once.
+  for (std::size_t n = 0; n < t.hex.points.size(); ++n)
+    if (t.node_faces[n] == 0u && static_cast<primal::Index>(n) != v && r.final_min_scaled_jacobian > 0.0)
+      CHECK(coverage(t.hex, static_cast<primal::Index>(n)) == doctest::Approx(1.0).epsilon(1e-6));
+}
+
+TEST_CASE("template_obstructions: none on the geode, pinched corners and doublets on four-triangle duals") {
+  auto kinds = [](const std::vector<primal::Obstruction>& o) {
+    std::map<primal::ObstructionKind, int> n;
+    for (const auto& x : o) ++n[x.kind];
+    return n;
+  };
+  CHECK(templates::template_obstructions(templates::build_geode3d(GeodeOptions{})).empty());
+  CHECK(templates::template_obstructions(templates::build_geode2d(GeodeOptions{})).empty());
+  GeodeOptions four;
+  four.split = templates::TopSplit::FourTriangles;
+  const auto plain = kinds(templates::template_obstructions(templates::build_geode3d(four)));
+  CHECK(plain.count(primal::ObstructionKind::kPinchedCorner));
+  four.push = {0.5, 0.45, 0.9, 0.4};
+  const auto t24 = templates::build_geode3d(four);
+  CHECK(t24.hex.hexes.size() == 24);
+  const auto c24 = kinds(templates::template_obstructions(t24));
+  CHECK(c24.count(primal::ObstructionKind::kDoublet));
 }
 
 TEST_CASE("interleave study: grid points with low >= high are skipped") {
