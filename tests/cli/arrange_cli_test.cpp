@@ -143,3 +143,37 @@ TEST_CASE("geode arrange: bad specs exit 2 naming the JSON path, non-dualizing o
   CHECK(geode_cli("arrange " + temp_path("missing.json").string()).code == 2);
   std::filesystem::remove(spec);
 }
+
+TEST_CASE("geode study interleave --spec: a spec swept by path classifies as the built-in study does") {
+  const std::string shipped = (std::filesystem::path(GEODE_SOURCE_DIR) / "notebooks-data/specs/geode3d.json").string();
+  const auto swept = geode_cli("study interleave --spec " + shipped +
+                               " --sweep push.high_roof=0.75,0.85 --sweep push.low_roof=0.6:0.8:2");
+  const auto builtin = geode_cli("study interleave --high 0.75 0.85 --low 0.6 0.8 --depth 0.9 --radius 0.6");
+  REQUIRE(swept.code == 0);
+  REQUIRE(builtin.code == 0);
+  // The same rows (0.75 / 0.8 is skipped by both: low above high), plus the swept columns.
+  std::istringstream a(swept.out), b(builtin.out);
+  std::string la, lb;
+  int rows = 0;
+  while (std::getline(b, lb)) {
+    REQUIRE(std::getline(a, la));
+    if (rows++ == 0) {
+      CHECK(la == lb + R"(,"push.high_roof","push.low_roof")");
+      continue;
+    }
+    CHECK(la.rfind(lb + ",", 0) == 0);
+  }
+  CHECK(rows == 4);
+
+  // A sheet's radius swept in a plain spec: the pillow, then a sphere through the box's faces.
+  const auto spec = temp_path("sweep.json");
+  write_text(spec, R"({"dim": 3, "domain": {"box": [[0, 0, 0], [1, 1, 1]]},
+                       "sweep": {"sheets[3].sphere.radius": [0.3, 0.5]}, )" +
+                       kPlanes + R"(, {"name": "s", "sphere": {"center": [0.5, 0.5, 0.5], "radius": 0.3}}]})");
+  const auto r = geode_cli("study interleave --spec " + spec.string());
+  REQUIRE(r.code == 0);
+  CHECK(r.out.find("valid,7,V1,1,\"\",0.3\n") != std::string::npos);
+  CHECK(r.out.find("error,0,E1,,") != std::string::npos);
+  CHECK(geode_cli("study interleave --spec " + spec.string() + " --sweep sheets[3].sphere.radios=1:2:2").code == 2);
+  std::filesystem::remove(spec);
+}
