@@ -94,20 +94,28 @@ TEST_CASE("geode arrange: the shipped specs are the built-in templates") {
   }
 }
 
-TEST_CASE("geode arrange: the issue's form, three planes and a sphere, is the pillowed hex") {
-  const auto spec = temp_path("pillow.json");
-  write_text(spec, three_planes_and(R"(, {"name": "s", "sphere": {"center": [0.5, 0.5, 0.5], "radius": 0.3}})"));
+TEST_CASE("geode arrange: the README's examples, the pillowed hex and the pillowed quad") {
+  const auto specs = std::filesystem::path(GEODE_SOURCE_DIR) / "notebooks-data/specs";
   const auto out = temp_path("pillow-out.json");
-  const auto r = geode_cli("arrange " + spec.string() + " --smooth --format json -o " + out.string());
+  const auto r = geode_cli("arrange " + (specs / "pillow.json").string() + " --smooth --format json -o " + out.string());
   REQUIRE(r.code == 0);
   const auto j = nlohmann::json::parse(read_text(out));
-  CHECK(j["hexes"].size() == 7);
+  CHECK(j["hexes"].size() == 7);  // three planes and a sphere around their crossing
   CHECK(j["nodes"].size() == 16);
   CHECK(j["sheets"].size() == 4);
   CHECK(j["sheets"][3]["kind"] == "sphere");
-  CHECK(j["template"] == spec.stem().string());
-  std::filesystem::remove(spec);
+  CHECK(j["template"] == "pillow");
   std::filesystem::remove(out);
+
+  const auto q = geode_cli("arrange " + (specs / "pillow2d.json").string() + " --format json");
+  REQUIRE(q.code == 0);
+  CHECK(nlohmann::json::parse(q.out)["quads"].size() == 5);  // two lines and a circle
+  // Its sweep block grows the circle through the rectangle's long sides: 5 quads, a tangency, 3.
+  const auto s = geode_cli("study interleave --spec " + (specs / "pillow2d.json").string());
+  REQUIRE(s.code == 0);
+  CHECK(s.out.find("valid,5,V1,1,\"\",0.4\n") != std::string::npos);
+  CHECK(s.out.find("error,0,E1,,\"arrangement: sheets 'a', 'c' meet on the domain boundary") != std::string::npos);
+  CHECK(s.out.find("valid,3,V2,1,\"\",0.6\n") != std::string::npos);
 }
 
 TEST_CASE("geode arrange: bad specs exit 2 naming the JSON path, non-dualizing ones exit 3") {
