@@ -1,4 +1,6 @@
 // geode study interleave | shape: parameter studies of the geode templates (templates/study.hpp).
+#include <algorithm>
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -6,6 +8,7 @@
 
 #include "cli/commands.hpp"
 #include "primal/errors.hpp"
+#include "templates/spec.hpp"
 #include "templates/study.hpp"
 
 namespace geode::cli {
@@ -16,6 +19,8 @@ struct InterleaveArgs {
   std::string output;
   std::string summary;
   std::vector<double> high, low, depth, radius;
+  std::string spec;
+  std::vector<std::string> sweep;
 };
 
 // Default grids: 5-6 values per parameter inside the valid ranges, including the paper's
@@ -28,26 +33,53 @@ templates::PushGrid default_grid(const std::string& name) {
           {0.2, 0.4, 0.6, 0.8}};
 }
 
+// The spec's sweep block, then --sweep options (replacing an axis of the same path).
+templates::InterleaveStudy spec_study(const InterleaveArgs& a) {
+  const nlohmann::json spec = templates::read_spec_json(a.spec);
+  const std::string source = std::filesystem::path(a.spec).filename().string();
+  templates::parse_spec(spec, source);  // the unswept spec must be valid too
+  std::vector<templates::SweepAxis> axes = templates::spec_sweep(spec, source);
+  for (const auto& text : a.sweep) {
+    templates::SweepAxis axis = templates::parse_sweep_option(text);
+    nlohmann::json probe = spec;
+    templates::set_spec_number(probe, axis.path, axis.values.front(), source);
+    auto same = std::find_if(axes.begin(), axes.end(), [&](const auto& x) { return x.path == axis.path; });
+    if (same != axes.end()) *same = axis; else axes.push_back(axis);
+  }
+  if (axes.empty()) throw InvalidInput(source + ": nothing to sweep (give --sweep PATH=FROM:TO:COUNT or a sweep block)");
+  auto study = templates::interleave_study(spec, source, axes, std::filesystem::path(a.spec).stem().string());
+  if (study.runs.empty()) throw InvalidInput(source + ": every sweep point is invalid input (e.g. low roof above high)");
+  return study;
+}
+
 void run_interleave(const InterleaveArgs& a) {
-  if (a.name != "geode3d" && a.name != "geode4tri")
-    throw InvalidInput("study interleave: unknown template '" + a.name + "' (geode3d or geode4tri)");
-  templates::PushGrid grid = default_grid(a.name);
-  if (!a.high.empty()) grid.high_roof = a.high;
-  if (!a.low.empty()) grid.low_roof = a.low;
-  if (!a.depth.empty()) grid.dome_depth = a.depth;
-  if (!a.radius.empty()) grid.dome_radius = a.radius;
-  templates::GeodeOptions o;
-  if (a.name == "geode4tri") o.split = templates::TopSplit::FourTriangles;
-  const auto study = templates::interleave_study(o, grid, a.name);
-  if (study.runs.empty()) throw InvalidInput("study interleave: no grid point has 0 < low < high < 1");
+  templates::InterleaveStudy study;
+  if (!a.spec.empty()) {
+    study = spec_study(a);
+  } else {
+    if (!a.sweep.empty()) throw InvalidInput("study interleave: --sweep needs --spec");
+    if (a.name != "geode3d" && a.name != "geode4tri")
+      throw InvalidInput("study interleave: unknown template '" + a.name + "' (geode3d or geode4tri)");
+    templates::PushGrid grid = default_grid(a.name);
+    if (!a.high.empty()) grid.high_roof = a.high;
+    if (!a.low.empty()) grid.low_roof = a.low;
+    if (!a.depth.empty()) grid.dome_depth = a.depth;
+    if (!a.radius.empty()) grid.dome_radius = a.radius;
+    templates::GeodeOptions o;
+    if (a.name == "geode4tri") o.split = templates::TopSplit::FourTriangles;
+    study = templates::interleave_study(o, grid, a.name);
+    if (study.runs.empty()) throw InvalidInput("study interleave: no grid point has 0 < low < high < 1");
+  }
   write_or_print(a.output, [&](std::ostream& s) { templates::write_interleave_csv(s, study); });
   if (!a.summary.empty())
     write_or_print(a.summary, [&](std::ostream& s) { templates::write_interleave_summary(s, study); });
   double total = 0;
   for (const auto& r : study.runs) total += r.seconds;
   std::ostream& log = a.output.empty() ? std::cerr : std::cout;
-  log << a.name << ": " << study.runs.size() << " runs, " << std::setprecision(3) << total << " s, "
-      << study.classes.size() << " outcome classes\n";
+  log << study.template_name << ": " << study.runs.size() << " runs, " << std::setprecision(3) << total << " s, "
+      << study.classes.size() << " outcome classes";
+  if (study.skipped) log << ", " << study.skipped << " sweep points skipped as invalid input";
+  log << "\n";
   for (const auto& c : study.classes) {
     log << "  " << c.label << "  " << std::setw(4) << c.count << " runs  ";
     if (c.valid)
@@ -111,6 +143,13 @@ void add_study_commands(CLI::App& app) {
   inter->add_option("--low", ia->low, "low roof values");
   inter->add_option("--depth", ia->depth, "dome depth values");
   inter->add_option("--radius", ia->radius, "dome radius blend values");
+  inter->add_option("--spec", ia->spec,
+                    "sweep an arrangement spec (geode arrange's format) instead of a built-in template;\n"
+                    "its \"sweep\" block and --sweep say what to sweep")
+      ->excludes("--template")->excludes("--high")->excludes("--low")->excludes("--depth")->excludes("--radius");
+  inter->add_option("--sweep", ia->sweep,
+                    "with --spec: PATH=FROM:TO:COUNT or PATH=V1,V2,... for a number in the spec, e.g.\n"
+                    "push.high_roof=0.55:0.95:5 or sheets[3].sphere.radius=0.2,0.3 (repeat for a grid)");
   inter->callback([ia] { run_interleave(*ia); });
 
   auto sa = std::make_shared<ShapeArgs>();

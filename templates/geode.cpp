@@ -32,7 +32,7 @@ std::string corner_name(const Point& p) {
   return std::string("(") + (p[0] < 0 ? "-x" : "+x") + "," + (p[2] < 0 ? "-z" : "+z") + ")";
 }
 
-// Box faces a reference point lies on.
+// Box faces a point lies on.
 unsigned faces_of(const Point& r, const stc::Domain& D) {
   unsigned f = 0;
   const double eps = 1e-12 * (D.hi - D.lo).norm();
@@ -216,7 +216,11 @@ std::vector<stc::Sheet> complete_interface(const InterfacePatch& bottom, const I
     stc::Sheet s = d.sheet;
     const Point& v = top.points[static_cast<std::size_t>(d.vertex)];
     s.name = dim == 2 ? std::string("dome ") + (v.x() < 0 ? "-x" : "+x")
-                      : (std::abs(v.x()) < 1e-12 ? std::string("dome centre") : "dome " + corner_name(v));
+                      : (std::abs(v.x()) < 1e-12 && std::abs(v.z()) < 1e-12 ? std::string("dome centre")
+                                                                             : "dome " + corner_name(v));
+    // A spec's tet side may have several vertices in one quadrant: names must stay unique.
+    for (const auto& other : sheets)
+      if (other.name == s.name) s.name += " " + std::to_string(d.vertex);
     sheets.push_back(s);
   }
   return sheets;

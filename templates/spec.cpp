@@ -180,11 +180,14 @@ std::array<Point, 3> Reader::frame(const json& j, const std::string& path) const
 }
 
 stc::Field Reader::shape(const json& j, const std::string& path) const {
+  if (!j.is_object()) fail(path, "must be an object holding one shape");
   std::string kind;
   for (const auto& [key, value] : j.items())
     if (shape_dims().count(key)) {
       if (!kind.empty()) fail(path, "has two shapes, '" + kind + "' and '" + key + "'");
       kind = key;
+    } else if (key != "name" && key != "kind") {  // a sheet's own keys; parse_spec checks those
+      fail(join(path, key), "unknown key");
     }
   if (kind.empty()) {
     std::string known;

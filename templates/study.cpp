@@ -164,8 +164,62 @@ std::string strip_numbers(const std::string& message) {
 
 InterleaveStudy interleave_study(const GeodeOptions& base, const PushGrid& grid,
                                  const std::string& template_name) {
+  std::vector<InterleaveCase> cases;
+  for (double high : grid.high_roof)
+    for (double low : grid.low_roof) {
+      if (!(0 < low && low < high && high < 1)) continue;
+      for (double depth : grid.dome_depth)
+        for (double radius : grid.dome_radius) {
+          GeodeOptions o = base;
+          o.push = {high, low, depth, radius};
+          cases.push_back({o.push, {}, [o] { return build_geode3d(o); }});
+        }
+    }
+  return interleave_study(cases, template_name);
+}
+
+InterleaveStudy interleave_study(const nlohmann::json& spec, const std::string& source,
+                                 const std::vector<SweepAxis>& axes, const std::string& template_name) {
+  std::vector<InterleaveCase> cases;
+  std::vector<std::string> names;
+  for (const auto& a : axes) names.push_back(a.path);
+  int skipped = 0;
+  std::vector<std::size_t> at(axes.size(), 0);
+  for (bool more = true; more;) {
+    nlohmann::json j = spec;
+    InterleaveCase c;
+    for (std::size_t i = 0; i < axes.size(); ++i) {
+      c.parameters.push_back(axes[i].values[at[i]]);
+      set_spec_number(j, axes[i].path, c.parameters.back(), source);
+    }
+    try {
+      const ArrangementSpec s = parse_spec(j, source);
+      if (s.completion) c.push = s.completion->push;
+      c.build = [s] { return build_template(s); };
+      cases.push_back(c);
+    } catch (const InvalidInput&) {
+      ++skipped;
+    }
+    // Odometer over the axes, the last fastest.
+    more = false;
+    for (std::size_t i = axes.size(); i-- > 0;) {
+      if (++at[i] < axes[i].values.size()) {
+        more = true;
+        break;
+      }
+      at[i] = 0;
+    }
+  }
+  InterleaveStudy study = interleave_study(cases, template_name, names);
+  study.skipped = skipped;
+  return study;
+}
+
+InterleaveStudy interleave_study(const std::vector<InterleaveCase>& cases, const std::string& template_name,
+                                 const std::vector<std::string>& parameter_names) {
   InterleaveStudy study;
   study.template_name = template_name;
+  study.parameter_names = parameter_names;
   struct Outcome {
     bool valid;
     std::string key;
@@ -177,40 +231,34 @@ InterleaveStudy interleave_study(const GeodeOptions& base, const PushGrid& grid,
   };
   std::map<std::pair<bool, std::string>, Outcome> outcomes;
   std::vector<std::string> keys;  // per run
-  for (double high : grid.high_roof)
-    for (double low : grid.low_roof) {
-      if (!(0 < low && low < high && high < 1)) continue;
-      for (double depth : grid.dome_depth)
-        for (double radius : grid.dome_radius) {
-          GeodeOptions o = base;
-          o.push = {high, low, depth, radius};
-          InterleaveRun run;
-          run.push = o.push;
-          const auto t0 = std::chrono::steady_clock::now();
-          std::string key;
-          Template t;
-          try {
-            t = build_geode3d(o);
-            run.valid = true;
-            run.hexes = static_cast<int>(t.hex.hexes.size());
-            run.conditions_ok = t.checks.ok();
-            std::set<std::string> failed;
-            for (const auto& f : t.checks.failures) failed.insert(strip_numbers(f));
-            for (const auto& f : failed) run.conditions += (run.conditions.empty() ? "" : "; ") + f;
-            key = template_class_key(t);
-          } catch (const TopologyError& e) {
-            run.diagnosis = strip_numbers(e.what());
-            key = run.diagnosis;
-          }
-          run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-          auto& oc = outcomes[{run.valid, key}];
-          if (oc.count == 0) oc = {run.valid, key, run.hexes, 0, 0, run.push, std::move(t)};
-          ++oc.count;
-          oc.ok += run.conditions_ok ? 1 : 0;
-          keys.push_back(key);
-          study.runs.push_back(run);
-        }
+  for (const auto& cs : cases) {
+    InterleaveRun run;
+    run.push = cs.push;
+    run.parameters = cs.parameters;
+    const auto t0 = std::chrono::steady_clock::now();
+    std::string key;
+    Template t;
+    try {
+      t = cs.build();
+      run.valid = true;
+      run.hexes = static_cast<int>(t.dim == 3 ? t.hex.hexes.size() : t.quad.quads.size());
+      run.conditions_ok = t.checks.ok();
+      std::set<std::string> failed;
+      for (const auto& f : t.checks.failures) failed.insert(strip_numbers(f));
+      for (const auto& f : failed) run.conditions += (run.conditions.empty() ? "" : "; ") + f;
+      key = template_class_key(t);
+    } catch (const TopologyError& e) {
+      run.diagnosis = strip_numbers(e.what());
+      key = run.diagnosis;
     }
+    run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    auto& oc = outcomes[{run.valid, key}];
+    if (oc.count == 0) oc = {run.valid, key, run.hexes, 0, 0, run.push, std::move(t)};
+    ++oc.count;
+    oc.ok += run.conditions_ok ? 1 : 0;
+    keys.push_back(key);
+    study.runs.push_back(run);
+  }
   std::vector<const Outcome*> order;
   for (const auto& [k, oc] : outcomes) order.push_back(&oc);
   std::stable_sort(order.begin(), order.end(), [](const Outcome* a, const Outcome* b) {
@@ -239,12 +287,16 @@ InterleaveStudy interleave_study(const GeodeOptions& base, const PushGrid& grid,
 }
 
 void write_interleave_csv(std::ostream& out, const InterleaveStudy& study) {
-  out << "high_roof,low_roof,dome_depth,dome_radius,outcome,hexes,class,conditions_ok,diagnosis\n";
+  out << "high_roof,low_roof,dome_depth,dome_radius,outcome,hexes,class,conditions_ok,diagnosis";
+  for (const auto& p : study.parameter_names) out << "," << csv_quote(p);
+  out << "\n";
   for (const auto& r : study.runs) {
     out << fmt(r.push.high_roof) << "," << fmt(r.push.low_roof) << "," << fmt(r.push.dome_depth) << ","
         << fmt(r.push.dome_radius) << "," << (r.valid ? "valid" : "error") << "," << r.hexes << "," << r.class_label
         << "," << (r.valid ? (r.conditions_ok ? "1" : "0") : "") << ","
-        << csv_quote(r.valid ? r.conditions : r.diagnosis) << "\n";
+        << csv_quote(r.valid ? r.conditions : r.diagnosis);
+    for (double p : r.parameters) out << "," << fmt(p);
+    out << "\n";
   }
 }
 

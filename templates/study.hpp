@@ -7,12 +7,15 @@
 // Results are computed, never typed in; the only paper numbers here are Table 1's, printed
 // next to ours for comparison (paper_table1()).
 #include <array>
+#include <functional>
+#include <nlohmann/json.hpp>
 #include <ostream>
 #include <string>
 #include <vector>
 
 #include "primal/quality_report.hpp"
 #include "templates/geode.hpp"
+#include "templates/spec.hpp"
 
 namespace geode::templates {
 
@@ -36,6 +39,7 @@ struct PushGrid {
 
 struct InterleaveRun {
   PushParameters push;
+  std::vector<double> parameters;  // the swept values, one per InterleaveStudy::parameter_names
   bool valid = false;        // the arrangement dualized to a template
   int hexes = 0;
   std::string class_label;   // "V1", "V2", ... for template classes, "E1", ... for diagnoses
@@ -64,6 +68,8 @@ struct InterleaveClass {
 
 struct InterleaveStudy {
   std::string template_name;
+  std::vector<std::string> parameter_names;  // swept spec paths (spec studies; else empty)
+  int skipped = 0;                           // sweep points whose spec is invalid input
   std::vector<InterleaveRun> runs;       // sweep order: high, low, depth, radius
   std::vector<InterleaveClass> classes;  // valid classes, then errors; each by count, then key
 };
@@ -74,7 +80,23 @@ struct InterleaveStudy {
 InterleaveStudy interleave_study(const GeodeOptions& base, const PushGrid& grid,
                                  const std::string& template_name);
 
-// CSV: high_roof,low_roof,dome_depth,dome_radius,outcome,hexes,class,conditions_ok,diagnosis
+// One point of a sweep: the push and swept values the CSV records, and how to build it.
+struct InterleaveCase {
+  PushParameters push;
+  std::vector<double> parameters;
+  std::function<Template()> build;
+};
+InterleaveStudy interleave_study(const std::vector<InterleaveCase>& cases, const std::string& template_name,
+                                 const std::vector<std::string>& parameter_names = {});
+
+// A spec (templates/spec.hpp) swept over every combination of the axes' values (the first
+// axis slowest); points whose spec is invalid input (e.g. low roof above high) are skipped
+// and counted. `source` names the spec in messages.
+InterleaveStudy interleave_study(const nlohmann::json& spec, const std::string& source,
+                                 const std::vector<SweepAxis>& axes, const std::string& template_name);
+
+// CSV: high_roof,low_roof,dome_depth,dome_radius,outcome,hexes,class,conditions_ok,diagnosis,
+// then one column per swept spec path (spec studies)
 void write_interleave_csv(std::ostream& out, const InterleaveStudy& study);
 // CSV: class,outcome,count,hexes,conditions_ok,example high/low/depth/radius,key,obstructions
 // (count per kind, "doublet:10;pinched-corner:1"),min_sj_fixed,min_sj_slide,usable

@@ -94,20 +94,28 @@ TEST_CASE("geode arrange: the shipped specs are the built-in templates") {
   }
 }
 
-TEST_CASE("geode arrange: the issue's form, three planes and a sphere, is the pillowed hex") {
-  const auto spec = temp_path("pillow.json");
-  write_text(spec, three_planes_and(R"(, {"name": "s", "sphere": {"center": [0.5, 0.5, 0.5], "radius": 0.3}})"));
+TEST_CASE("geode arrange: the README's examples, the pillowed hex and the pillowed quad") {
+  const auto specs = std::filesystem::path(GEODE_SOURCE_DIR) / "notebooks-data/specs";
   const auto out = temp_path("pillow-out.json");
-  const auto r = geode_cli("arrange " + spec.string() + " --smooth --format json -o " + out.string());
+  const auto r = geode_cli("arrange " + (specs / "pillow.json").string() + " --smooth --format json -o " + out.string());
   REQUIRE(r.code == 0);
   const auto j = nlohmann::json::parse(read_text(out));
-  CHECK(j["hexes"].size() == 7);
+  CHECK(j["hexes"].size() == 7);  // three planes and a sphere around their crossing
   CHECK(j["nodes"].size() == 16);
   CHECK(j["sheets"].size() == 4);
   CHECK(j["sheets"][3]["kind"] == "sphere");
-  CHECK(j["template"] == spec.stem().string());
-  std::filesystem::remove(spec);
+  CHECK(j["template"] == "pillow");
   std::filesystem::remove(out);
+
+  const auto q = geode_cli("arrange " + (specs / "pillow2d.json").string() + " --format json");
+  REQUIRE(q.code == 0);
+  CHECK(nlohmann::json::parse(q.out)["quads"].size() == 5);  // two lines and a circle
+  // Its sweep block grows the circle through the rectangle's long sides: 5 quads, a tangency, 3.
+  const auto s = geode_cli("study interleave --spec " + (specs / "pillow2d.json").string());
+  REQUIRE(s.code == 0);
+  CHECK(s.out.find("valid,5,V1,1,\"\",0.4\n") != std::string::npos);
+  CHECK(s.out.find("error,0,E1,,\"arrangement: sheets 'a', 'c' meet on the domain boundary") != std::string::npos);
+  CHECK(s.out.find("valid,3,V2,1,\"\",0.6\n") != std::string::npos);
 }
 
 TEST_CASE("geode arrange: bad specs exit 2 naming the JSON path, non-dualizing ones exit 3") {
@@ -141,5 +149,39 @@ TEST_CASE("geode arrange: bad specs exit 2 naming the JSON path, non-dualizing o
     CHECK_FALSE(std::filesystem::exists(out));
   }
   CHECK(geode_cli("arrange " + temp_path("missing.json").string()).code == 2);
+  std::filesystem::remove(spec);
+}
+
+TEST_CASE("geode study interleave --spec: a spec swept by path classifies as the built-in study does") {
+  const std::string shipped = (std::filesystem::path(GEODE_SOURCE_DIR) / "notebooks-data/specs/geode3d.json").string();
+  const auto swept = geode_cli("study interleave --spec " + shipped +
+                               " --sweep push.high_roof=0.75,0.85 --sweep push.low_roof=0.6:0.8:2");
+  const auto builtin = geode_cli("study interleave --high 0.75 0.85 --low 0.6 0.8 --depth 0.9 --radius 0.6");
+  REQUIRE(swept.code == 0);
+  REQUIRE(builtin.code == 0);
+  // The same rows (0.75 / 0.8 is skipped by both: low above high), plus the swept columns.
+  std::istringstream a(swept.out), b(builtin.out);
+  std::string la, lb;
+  int rows = 0;
+  while (std::getline(b, lb)) {
+    REQUIRE(std::getline(a, la));
+    if (rows++ == 0) {
+      CHECK(la == lb + R"(,"push.high_roof","push.low_roof")");
+      continue;
+    }
+    CHECK(la.rfind(lb + ",", 0) == 0);
+  }
+  CHECK(rows == 4);
+
+  // A sheet's radius swept in a plain spec: the pillow, then a sphere through the box's faces.
+  const auto spec = temp_path("sweep.json");
+  write_text(spec, R"({"dim": 3, "domain": {"box": [[0, 0, 0], [1, 1, 1]]},
+                       "sweep": {"sheets[3].sphere.radius": [0.3, 0.5]}, )" +
+                       kPlanes + R"(, {"name": "s", "sphere": {"center": [0.5, 0.5, 0.5], "radius": 0.3}}]})");
+  const auto r = geode_cli("study interleave --spec " + spec.string());
+  REQUIRE(r.code == 0);
+  CHECK(r.out.find("valid,7,V1,1,\"\",0.3\n") != std::string::npos);
+  CHECK(r.out.find("error,0,E1,,") != std::string::npos);
+  CHECK(geode_cli("study interleave --spec " + spec.string() + " --sweep sheets[3].sphere.radios=1:2:2").code == 2);
   std::filesystem::remove(spec);
 }

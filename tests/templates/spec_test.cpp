@@ -203,6 +203,9 @@ TEST_CASE("spec: bad specs name the file, the JSON path and the sheet") {
   negative["sheets"][3]["sphere"]["radius"] = -1;
   two_d_shape["sheets"][0] = {{"name", "c"}, {"circle", {{"center", {0, 0}}, {"radius", 1}}}};
   typo["domian"] = typo["domain"];
+  json nested = three_planes();
+  nested["sheets"][0] = json::parse(R"({"name": "u", "union": [{"sphere": {"center": [0, 0, 0], "radius": 1}, "centre": 1},
+                                                             {"plane": {"point": [0, 0, 0], "normal": [1, 0, 0]}}]})");
   no_dim.erase("dim");
   duplicate["sheets"][1]["name"] = "x";
   const std::vector<Case> cases = {
@@ -215,6 +218,7 @@ TEST_CASE("spec: bad specs name the file, the JSON path and the sheet") {
       {"2D shape in 3D", two_d_shape, "spec.json: sheets[0].circle: is a 2D shape; the spec's dim is 3"},
       {"unknown top-level key", typo, "spec.json: domian: unknown key"},
       {"no dim", no_dim, "spec.json: dim: missing"},
+      {"unknown key in a nested shape", nested, "spec.json: sheets[0].union[0].centre: unknown key"},
       {"duplicate name", duplicate, "spec.json: sheets[1] (x): a second sheet of this name"},
   };
   for (const auto& c : cases) {
