@@ -16,8 +16,8 @@ void add_conform_commands(CLI::App& app);   // cli/conform_command.cpp: conform,
 void add_dual_command(CLI::App& app);       // cli/dual_command.cpp
 
 // Shared by the commands (cli/files.cpp): the extension in lower case (".msh"), and a model
-// read by extension (.msh, .exo, .e); InvalidInput naming the file when it is missing or of
-// another format.
+// read by extension and checked content (primal/read_model.hpp: .msh, .exo, .e, .vtu, .vtk);
+// InvalidInput naming the file when it is missing or of another format.
 std::string file_extension(const std::filesystem::path& p);
 primal::Model read_model(const std::filesystem::path& path);
 // Standard output when `path` is empty or "-", else the file, written atomically.

@@ -11,6 +11,7 @@
 
 #include "primal/atomic_file.hpp"
 #include "primal/errors.hpp"
+#include "primal/file_format.hpp"
 #include "primal/quality.hpp"
 
 namespace geode::primal {
@@ -288,14 +289,6 @@ void write_vtk_grid(std::ostream& os, const Grid& g) {
 
 [[noreturn]] void fail(const std::string& file, int line, const std::string& what) {
   throw InvalidInput(file + ":" + std::to_string(line) + ": " + what);
-}
-
-std::string read_all(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InvalidInput(path.string() + ": cannot open for reading");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 // Checks cell types, node counts and node ranges; `line_of_cell` gives the line to report.
@@ -608,10 +601,15 @@ GEODE_VTK_WRITER(write_vtk, write_vtk_grid, QuadMesh)
 // ---- .vtu reader ------------------------------------------------------------------------------
 
 VtkGrid read_vtu(const std::filesystem::path& path) {
+  check_mesh_format(path, MeshFileFormat::kVtu);
+  return parse_vtu(read_file_bytes(path), path.string());
+}
+
+VtkGrid parse_vtu(std::string_view content, const std::string& source) {
   VtkGrid g;
-  g.source = path.string();
+  g.source = source;
   const std::string& file = g.source;
-  const XmlElement root = XmlParser(read_all(path), file).parse();
+  const XmlElement root = XmlParser(std::string(content), file).parse();
   if (root.name != "VTKFile" || root.attr("type") != "UnstructuredGrid") {
     fail(file, root.line,
          "not a VTK UnstructuredGrid file (root <" + root.name + "> type \"" + root.attr("type") +
@@ -763,10 +761,15 @@ std::string upper(std::string_view s) {
 }  // namespace
 
 VtkGrid read_vtk(const std::filesystem::path& path) {
+  check_mesh_format(path, MeshFileFormat::kVtk);
+  return parse_vtk(read_file_bytes(path), path.string());
+}
+
+VtkGrid parse_vtk(std::string_view content, const std::string& source) {
   VtkGrid g;
-  g.source = path.string();
+  g.source = source;
   const std::string& file = g.source;
-  const std::string text = read_all(path);
+  const std::string_view text = content;
   // Header: 3 lines.
   std::size_t pos = 0;
   std::array<std::string, 3> header;
@@ -774,7 +777,7 @@ VtkGrid read_vtk(const std::filesystem::path& path) {
     const auto e = text.find('\n', pos);
     if (e == std::string::npos)
       fail(file, l + 1, "unexpected end of file in the header (truncated file?)");
-    header[l] = text.substr(pos, e - pos);
+    header[l] = std::string(text.substr(pos, e - pos));
     if (!header[l].empty() && header[l].back() == '\r') header[l].pop_back();
     pos = e + 1;
   }
