@@ -93,7 +93,7 @@ void check_mesh_format(const std::filesystem::path& path, MeshFileFormat expecte
   const std::string head = read_file_head(path);
   const MeshFileFormat found = sniff_mesh_format(head);
   if (found == expected) return;
-  std::string what = path.string() + ": not a " + mesh_format_name(expected) + " file";
+  std::string what = path.string() + ": not in " + mesh_format_name(expected) + " format";
   if (head.empty())
     what += " (the file is empty)";
   else if (found != MeshFileFormat::kUnknown)

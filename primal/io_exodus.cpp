@@ -217,7 +217,7 @@ Model read_exodus(const std::filesystem::path& path, const ReadOptions& options)
     }
   }
   validate(model, source);
-  if (options.check_geometry) check_geometry(model, source);
+  options.check_geometry ? check_geometry(model, source) : check_points(model, source);
   return model;
 }
 

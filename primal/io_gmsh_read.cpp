@@ -6,6 +6,7 @@
 // is allocated, so that a corrupt count cannot exhaust memory.
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <cstring>
 #include <map>
 #include <set>
@@ -67,7 +68,7 @@ class MshReader {
 
   Model read() {
     if (sniff_mesh_format(s_) != MeshFileFormat::kGmsh)
-      fail_at(0, "not a Gmsh .msh file (it does not start with $MeshFormat; Gmsh scripts are not read)");
+      fail_at(0, "not in Gmsh .msh format (it does not start with $MeshFormat; Gmsh scripts are not read)");
     bool have_nodes = false, have_elements = false;
     while (true) {
       skip_space();
@@ -158,6 +159,12 @@ class MshReader {
     if (t.front() == '+') t.remove_prefix(1);
     double x = 0.0;
     const auto res = std::from_chars(t.data(), t.data() + t.size(), x);
+    // Beyond the range of a double: infinite, refused with the node's tag by check_points.
+    if (res.ec == std::errc::result_out_of_range && res.ptr == t.data() + t.size() && !t.empty() &&
+        t.find_first_of("eE") != std::string_view::npos && t.find("e-") == std::string_view::npos &&
+        t.find("E-") == std::string_view::npos)
+      return t.front() == '-' ? -HUGE_VAL : HUGE_VAL;
+    if (res.ec == std::errc::result_out_of_range && res.ptr == t.data() + t.size()) return 0.0;  // underflow
     if (res.ec != std::errc() || res.ptr != t.data() + t.size())
       fail_at(pos_ - t.size(), std::string(what) + ": '" + std::string(t) + "' is not a number");
     return x;
@@ -568,7 +575,7 @@ class MshReader {
 
 Model parse_gmsh(std::string_view content, const std::string& source, const ReadOptions& options) {
   Model model = MshReader(content, source).read();
-  if (options.check_geometry) check_geometry(model, source);
+  options.check_geometry ? check_geometry(model, source) : check_points(model, source);
   return model;
 }
 

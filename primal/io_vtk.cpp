@@ -4,10 +4,15 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstring>
+#include <limits>
+#include <memory>
 #include <fstream>
 #include <map>
 #include <optional>
 #include <sstream>
+
+#include <zlib.h>
 
 #include "primal/atomic_file.hpp"
 #include "primal/errors.hpp"
@@ -322,6 +327,7 @@ void check_cells(const VtkGrid& g, LineOf&& line_of_cell) {
 struct Numbers {
   std::vector<std::string_view> tokens;
   std::vector<int> lines;
+  std::shared_ptr<const std::string> storage;  // the tokens' text when decoded from binary
 };
 
 Numbers split_numbers(std::string_view text, int first_line) {
@@ -543,13 +549,185 @@ class XmlParser {
   }
 };
 
+// How a .vtu stores binary DataArrays: the VTKFile's header_type and compressor, and the
+// <AppendedData> bytes (after its '_'), cut out before the XML is parsed.
+struct VtuEncoding {
+  std::size_t header_bytes = 4;  // UInt32 (default) or UInt64
+  bool zlib = false;
+  std::string_view appended;
+  bool appended_base64 = false;
+};
+
+int base64_value(char c) {
+  if (c >= 'A' && c <= 'Z') return c - 'A';
+  if (c >= 'a' && c <= 'z') return c - 'a' + 26;
+  if (c >= '0' && c <= '9') return c - '0' + 52;
+  if (c == '+') return 62;
+  if (c == '/') return 63;
+  return -1;
+}
+
+// Decodes base64 one 4-character quantum at a time, so that parts encoded apart (VTK encodes a
+// header and its data separately, each padded) decode as their concatenation.
+std::string decode_base64(std::string_view text, const std::string& file, int line) {
+  std::string out;
+  out.reserve(text.size() / 4 * 3);
+  int quantum[4];
+  int n = 0, pad = 0;
+  for (char c : text) {
+    if (std::isspace(static_cast<unsigned char>(c))) continue;
+    if (c == '=') {
+      if (n < 2) fail(file, line, "base64: misplaced padding");
+      ++pad;
+      quantum[n++] = 0;
+    } else {
+      const int v = base64_value(c);
+      if (v < 0) fail(file, line, std::string("base64: invalid character '") + c + "'");
+      if (pad) fail(file, line, "base64: data after padding inside a quantum");
+      quantum[n++] = v;
+    }
+    if (n == 4) {
+      const unsigned bits = static_cast<unsigned>(quantum[0] << 18 | quantum[1] << 12 | quantum[2] << 6 | quantum[3]);
+      out += static_cast<char>(bits >> 16);
+      if (pad < 2) out += static_cast<char>(bits >> 8 & 0xff);
+      if (pad < 1) out += static_cast<char>(bits & 0xff);
+      n = pad = 0;
+    }
+  }
+  if (n != 0) fail(file, line, "base64: the text ends inside a quantum (truncated?)");
+  return out;
+}
+
+std::size_t type_size(const std::string& t) {
+  if (t == "Int8" || t == "UInt8") return 1;
+  if (t == "Int16" || t == "UInt16") return 2;
+  if (t == "Int32" || t == "UInt32" || t == "Float32") return 4;
+  if (t == "Int64" || t == "UInt64" || t == "Float64") return 8;
+  return 0;
+}
+
+// The array's raw bytes from a (header, data) stream: uncompressed, the header is the byte
+// count; zlib-compressed, it is [blocks, block size, last block size, compressed sizes...]
+// (VTK's vtkZLibDataCompressor layout). `want` bytes are expected; anything else is refused
+// before it is allocated.
+std::string array_bytes(std::string_view stream, const VtuEncoding& enc, std::size_t want,
+                        const std::string& file, int line, const std::string& what) {
+  std::size_t at = 0;
+  auto header = [&]() -> std::uint64_t {
+    if (stream.size() - at < enc.header_bytes) fail(file, line, what + ": binary header cut short (truncated?)");
+    std::uint64_t v = 0;
+    if (enc.header_bytes == 4) {
+      std::uint32_t x;
+      std::memcpy(&x, stream.data() + at, 4);
+      v = x;
+    } else {
+      std::memcpy(&v, stream.data() + at, 8);
+    }
+    at += enc.header_bytes;
+    return v;
+  };
+  if (!enc.zlib) {
+    const std::uint64_t n = header();
+    if (n != want) fail(file, line, what + ": binary data of " + std::to_string(n) + " bytes, expected " + std::to_string(want));
+    if (stream.size() - at < n) fail(file, line, what + ": binary data cut short (truncated?)");
+    return std::string(stream.substr(at, n));
+  }
+  const std::uint64_t blocks = header(), block_size = header(), last_size = header();
+  if (blocks > stream.size() / enc.header_bytes) fail(file, line, what + ": compressed header announces " + std::to_string(blocks) + " blocks");
+  const std::uint64_t last = last_size == 0 ? block_size : last_size;
+  // block_size is the nominal size of every block but the last (meshio writes 32768 for one
+  // short block); the sizes must add up to what the array holds.
+  if (blocks > 0 && (last > block_size || last > want || (blocks > 1 && block_size > want / (blocks - 1)) ||
+                     (blocks - 1) * block_size + last != want))
+    fail(file, line, what + ": compressed blocks do not add up to the " + std::to_string(want) + " bytes expected");
+  if (blocks == 0 && want != 0) fail(file, line, what + ": no compressed blocks for " + std::to_string(want) + " bytes");
+  std::vector<std::uint64_t> sizes;
+  for (std::uint64_t b = 0; b < blocks; ++b) sizes.push_back(header());
+  std::string out;
+  out.reserve(want);
+  for (std::uint64_t b = 0; b < blocks; ++b) {
+    if (stream.size() - at < sizes[b]) fail(file, line, what + ": compressed block " + std::to_string(b + 1) + " cut short (truncated?)");
+    const std::uint64_t size = b + 1 == blocks ? last : block_size;
+    std::string block(size, '\0');
+    uLongf got = static_cast<uLongf>(size);
+    const int status = uncompress(reinterpret_cast<Bytef*>(block.data()), &got,
+                                  reinterpret_cast<const Bytef*>(stream.data() + at), static_cast<uLong>(sizes[b]));
+    if (status != Z_OK || got != size)
+      fail(file, line, what + ": compressed block " + std::to_string(b + 1) + " does not inflate to " + std::to_string(size) + " bytes (zlib status " + std::to_string(status) + ")");
+    out += block;
+    at += sizes[b];
+  }
+  return out;
+}
+
+template <class T>
+void append_values(std::string& text, const std::string& bytes) {
+  for (std::size_t i = 0; i + sizeof(T) <= bytes.size(); i += sizeof(T)) {
+    T x;
+    std::memcpy(&x, bytes.data() + i, sizeof(T));
+    char buf[64];
+    const auto res = std::to_chars(buf, buf + sizeof buf, x);
+    text.append(buf, res.ptr);
+    text += ' ';
+  }
+}
+
+// A binary DataArray's values as text tokens, so that ASCII and binary arrays share one path.
+Numbers binary_values(const std::string& file, const XmlElement& a, std::size_t expected, const std::string& what,
+                      const VtuEncoding& enc) {
+  const std::string type = a.attr("type"), format = a.attr("format");
+  const std::size_t size = type_size(type);
+  if (size == 0) fail(file, a.line, what + ": unsupported type \"" + type + "\"");
+  if (expected > (std::numeric_limits<std::size_t>::max() / 16) / size) fail(file, a.line, what + ": too many values");
+  const std::size_t want = expected * size;
+  std::string bytes;
+  if (format == "binary") {
+    bytes = array_bytes(decode_base64(a.text, file, a.text_line), enc, want, file, a.line, what);
+  } else {
+    const std::string offset_text = a.attr("offset");
+    std::size_t offset = 0;
+    const auto res = std::from_chars(offset_text.data(), offset_text.data() + offset_text.size(), offset);
+    if (offset_text.empty() || res.ec != std::errc() || res.ptr != offset_text.data() + offset_text.size())
+      fail(file, a.line, what + ": appended DataArray without a valid offset");
+    if (offset > enc.appended.size()) fail(file, a.line, what + ": offset " + offset_text + " lies beyond the appended data (truncated?)");
+    const std::string_view rest = enc.appended.substr(offset);
+    if (enc.appended_base64) {
+      // Decoded to the end: the array's header and data, encoded apart or together, come
+      // first; the arrays after it follow and are ignored.
+      std::string_view piece = rest.substr(0, rest.find_first_not_of(
+          "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/="));
+      piece = piece.substr(0, piece.size() - piece.size() % 4);
+      const std::string decoded = decode_base64(piece, file, a.line);
+      bytes = array_bytes(decoded, enc, want, file, a.line, what);
+    } else {
+      bytes = array_bytes(rest, enc, want, file, a.line, what);
+    }
+  }
+  auto text = std::make_shared<std::string>();
+  if (type == "Int8") append_values<std::int8_t>(*text, bytes);
+  if (type == "UInt8") append_values<std::uint8_t>(*text, bytes);
+  if (type == "Int16") append_values<std::int16_t>(*text, bytes);
+  if (type == "UInt16") append_values<std::uint16_t>(*text, bytes);
+  if (type == "Int32") append_values<std::int32_t>(*text, bytes);
+  if (type == "UInt32") append_values<std::uint32_t>(*text, bytes);
+  if (type == "Int64") append_values<std::int64_t>(*text, bytes);
+  if (type == "UInt64") append_values<std::uint64_t>(*text, bytes);
+  if (type == "Float32") append_values<float>(*text, bytes);
+  if (type == "Float64") append_values<double>(*text, bytes);
+  Numbers n = split_numbers(*text, a.line);
+  n.storage = std::move(text);
+  std::fill(n.lines.begin(), n.lines.end(), a.line);
+  return n;
+}
+
 // A DataArray's values as tokens, checked for encoding and count.
 Numbers data_array_values(const std::string& file, const XmlElement& a, std::size_t expected,
-                          const std::string& what) {
+                          const std::string& what, const VtuEncoding& enc) {
   const std::string format = a.attr("format");
+  if (format == "binary" || format == "appended") return binary_values(file, a, expected, what, enc);
   if (format != "ascii") {
     fail(file, a.line,
-         what + ": format=\"" + format + "\" is not supported (only ascii DataArrays are read)");
+         what + ": format=\"" + format + "\" is not supported (ascii, binary and appended are read)");
   }
   Numbers n = split_numbers(a.text, a.text_line);
   if (n.tokens.size() != expected) {
@@ -609,7 +787,38 @@ VtkGrid parse_vtu(std::string_view content, const std::string& source) {
   VtkGrid g;
   g.source = source;
   const std::string& file = g.source;
-  const XmlElement root = XmlParser(std::string(content), file).parse();
+  // Appended data is raw bytes that may hold '<': cut out before the XML is parsed.
+  std::string xml(content);
+  VtuEncoding enc;
+  std::string appended_bytes;
+  if (const auto tag = xml.find("<AppendedData"); tag != std::string::npos) {
+    const auto close = xml.find('>', tag);
+    const auto underscore = close == std::string::npos ? close : xml.find('_', close);
+    const auto end = xml.rfind("</AppendedData>");
+    if (underscore == std::string::npos || end == std::string::npos || end < underscore)
+      fail(file, static_cast<int>(std::count(xml.begin(), xml.begin() + static_cast<std::ptrdiff_t>(tag), '\n')) + 1,
+           "<AppendedData> without its '_' marker or its end tag (truncated file?)");
+    appended_bytes = xml.substr(underscore + 1, end - underscore - 1);
+    // Keep the line count of what follows for messages.
+    const auto lines = std::count(appended_bytes.begin(), appended_bytes.end(), '\n');
+    xml.replace(underscore, end - underscore, std::string(static_cast<std::size_t>(lines), '\n'));
+    enc.appended = appended_bytes;
+  }
+  const XmlElement root = XmlParser(std::move(xml), file).parse();
+  if (const std::string h = root.attr("header_type"); !h.empty() && h != "UInt32" && h != "UInt64")
+    fail(file, root.line, "header_type \"" + h + "\" is not supported (UInt32 and UInt64 are)");
+  enc.header_bytes = root.attr("header_type") == "UInt64" ? 8 : 4;
+  if (const std::string c = root.attr("compressor"); !c.empty()) {
+    if (c != "vtkZLibDataCompressor") fail(file, root.line, "compressor \"" + c + "\" is not supported (vtkZLibDataCompressor is)");
+    enc.zlib = true;
+  }
+  if (const std::string order = root.attr("byte_order"); !order.empty() && order != "LittleEndian")
+    fail(file, root.line, "byte_order \"" + order + "\" is not supported (LittleEndian is)");
+  if (const XmlElement* ad = root.child("AppendedData")) {
+    const std::string e = ad->attr("encoding");
+    if (e != "raw" && e != "base64") fail(file, ad->line, "AppendedData encoding \"" + e + "\" is not supported (raw and base64 are)");
+    enc.appended_base64 = e == "base64";
+  }
   if (root.name != "VTKFile" || root.attr("type") != "UnstructuredGrid") {
     fail(file, root.line,
          "not a VTK UnstructuredGrid file (root <" + root.name + "> type \"" + root.attr("type") +
@@ -630,7 +839,7 @@ VtkGrid parse_vtu(std::string_view content, const std::string& source) {
   if (pa.attr("NumberOfComponents") != "3")
     fail(file, pa.line, "Points: NumberOfComponents must be 3");
   {
-    const Numbers n = data_array_values(file, pa, 3 * np, "Points");
+    const Numbers n = data_array_values(file, pa, 3 * np, "Points", enc);
     for (std::size_t i = 0; i < np; ++i) {
       double x[3];
       for (int k = 0; k < 3; ++k)
@@ -651,8 +860,8 @@ VtkGrid parse_vtu(std::string_view content, const std::string& source) {
   if (!conn || !offs || !types) {
     fail(file, cells.line, "<Cells> needs DataArrays connectivity, offsets and types");
   }
-  const Numbers on = data_array_values(file, *offs, nc, "offsets");
-  const Numbers tn = data_array_values(file, *types, nc, "types");
+  const Numbers on = data_array_values(file, *offs, nc, "offsets", enc);
+  const Numbers tn = data_array_values(file, *types, nc, "types", enc);
   std::vector<std::size_t> offsets;
   for (std::size_t c = 0; c < nc; ++c) {
     const long long o = parse_int(file, on.lines[c], on.tokens[c]);
@@ -663,7 +872,7 @@ VtkGrid parse_vtu(std::string_view content, const std::string& source) {
     }
     offsets.push_back(static_cast<std::size_t>(o));
   }
-  const Numbers cn = data_array_values(file, *conn, nc ? offsets.back() : 0, "connectivity");
+  const Numbers cn = data_array_values(file, *conn, nc ? offsets.back() : 0, "connectivity", enc);
   std::vector<int> cell_line(nc, conn->line), type_line(nc, types->line);
   for (std::size_t c = 0; c < nc; ++c) {
     g.cell_types.push_back(static_cast<int>(parse_int(file, tn.lines[c], tn.tokens[c])));
@@ -688,7 +897,7 @@ VtkGrid parse_vtu(std::string_view content, const std::string& source) {
       if (!comps.empty() && comps != "1") {
         fail(file, a.line, "CellData '" + nm + "': only 1-component arrays are read");
       }
-      const Numbers n = data_array_values(file, a, nc, "CellData '" + nm + "'");
+      const Numbers n = data_array_values(file, a, nc, "CellData '" + nm + "'", enc);
       if (is_float_type(type)) {
         std::vector<double> v;
         for (std::size_t i = 0; i < nc; ++i)
@@ -724,6 +933,11 @@ class Tokens {
     return n_.tokens[i_++];
   }
   std::string_view peek() const { return done() ? std::string_view() : n_.tokens[i_]; }
+  // Skips tokens up to the next blank line (a gap of two or more lines between tokens).
+  void skip_to_blank_line() {
+    int last = line_before();
+    while (!done() && n_.lines[i_] <= last + 1) last = n_.lines[i_++];
+  }
   int line_before() const { return i_ ? n_.lines[i_ - 1] : 1; }
   long long integer(const std::string& what) {
     const auto t = next(what);
@@ -878,6 +1092,10 @@ VtkGrid parse_vtk(std::string_view content, const std::string& source) {
         const std::string kind = upper(t.peek());
         if (kind == "CELL_DATA" || kind == "POINT_DATA") break;
         t.next("an attribute");
+        if (kind == "METADATA") {
+          t.skip_to_blank_line();
+          continue;
+        }
         const int attr_line = t.line_before();
         std::vector<std::pair<std::string, std::string>> arrays;  // name, type
         std::vector<std::size_t> comps;
@@ -947,9 +1165,8 @@ VtkGrid parse_vtk(std::string_view content, const std::string& source) {
         }
       }
     } else if (key == "METADATA") {
-      // VTK 8+ writes METADATA blocks ending at a blank line, which this token reader cannot
-      // see; our writers never emit them.
-      fail(file, key_line, "METADATA sections are not supported");
+      // VTK 8+ writes METADATA blocks (array information) that end at a blank line.
+      t.skip_to_blank_line();
     } else {
       fail(file, key_line, "unknown or unsupported section '" + key + "'");
     }

@@ -167,12 +167,16 @@ void validate(const Model& model, std::string_view source) {
   }
 }
 
-void check_geometry(const Model& model, std::string_view source) {
-  const std::string where(source);
+void check_points(const Model& model, std::string_view source) {
   for (std::size_t n = 0; n < model.points.size(); ++n)
     if (!model.points[n].allFinite())
-      throw InvalidInput(where + ": " + describe_node(model, static_cast<Index>(n)) +
+      throw InvalidInput(std::string(source) + ": " + describe_node(model, static_cast<Index>(n)) +
                          " has a non-finite coordinate");
+}
+
+void check_geometry(const Model& model, std::string_view source) {
+  const std::string where(source);
+  check_points(model, source);
   auto pt = [&](Index v) -> const Point& { return model.points[static_cast<std::size_t>(v)]; };
   for (std::size_t t = 0; t < model.tets.size(); ++t) {
     const auto& c = model.tets[t];

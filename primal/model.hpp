@@ -69,7 +69,8 @@ struct Model {
 
 // What readers check beyond the file's structure.
 struct ReadOptions {
-  // check_geometry below: off only for tools that read connectivity alone (a mesh's dual).
+  // check_geometry below (else check_points only): off for tools that read connectivity
+  // alone (a mesh's dual).
   bool check_geometry = true;
 };
 
@@ -93,8 +94,10 @@ int block_of(const Model& model, ElementRef element);
 // side's face number is out of range. Readers call it before returning; writers before writing.
 void validate(const Model& model, std::string_view source);
 
-// What readers refuse beyond structure (validate): a node with a NaN or infinite coordinate
-// (every node, used or not), a tet of signed volume <= 0 and a hex with a corner Jacobian <= 0
+// A node with a NaN or infinite coordinate (every node, used or not): InvalidInput naming
+// `source` and the node by its file id, with its coordinates. Readers always check it.
+void check_points(const Model& model, std::string_view source);
+// What readers refuse beyond structure (validate): check_points, then a tet of signed volume <= 0 and a hex with a corner Jacobian <= 0
 // (topology.hpp's corner frames: inverted, flat or folded). Throws InvalidInput naming `source`
 // and the node or element by its file id, with coordinates.
 void check_geometry(const Model& model, std::string_view source);

@@ -45,7 +45,7 @@ Model model_from_vtk(const VtkGrid& grid, const ReadOptions& options) {
     }
   }
   validate(model, grid.source);
-  if (options.check_geometry) check_geometry(model, grid.source);
+  options.check_geometry ? check_geometry(model, grid.source) : check_points(model, grid.source);
   return model;
 }
 
