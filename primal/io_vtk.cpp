@@ -641,6 +641,9 @@ std::string array_bytes(std::string_view stream, const VtuEncoding& enc, std::si
                      (blocks - 1) * block_size + last != want))
     fail(file, line, what + ": compressed blocks do not add up to the " + std::to_string(want) + " bytes expected");
   if (blocks == 0 && want != 0) fail(file, line, what + ": no compressed blocks for " + std::to_string(want) + " bytes");
+  // zlib inflates at most about 1032:1: a header that promises more is corrupt, and is refused
+  // before anything of that size is allocated.
+  if (want / 1032 > stream.size()) fail(file, line, what + ": " + std::to_string(want) + " bytes cannot come from " + std::to_string(stream.size()) + " compressed bytes");
   std::vector<std::uint64_t> sizes;
   for (std::uint64_t b = 0; b < blocks; ++b) sizes.push_back(header());
   std::string out;
@@ -923,27 +926,82 @@ namespace {
 // Token stream over the body of a legacy file (after the 3 header lines).
 class Tokens {
  public:
-  Tokens(const Numbers& n, std::string file) : n_(n), file_(std::move(file)) {}
-  bool done() const { return i_ >= n_.tokens.size(); }
-  int line() const { return done() ? (n_.lines.empty() ? 1 : n_.lines.back()) : n_.lines[i_]; }
+  Tokens(std::string_view text, int first_line, std::string file) : s_(text), line_(first_line), file_(std::move(file)) {}
+  bool done() {
+    skip_space();
+    return pos_ >= s_.size();
+  }
+  int line() {
+    skip_space();
+    return line_;
+  }
   std::string_view next(const std::string& what) {
-    if (done()) {
-      fail(file_, line(), "unexpected end of file while reading " + what + " (truncated file?)");
-    }
-    return n_.tokens[i_++];
+    if (done()) fail(file_, line_, "unexpected end of file while reading " + what + " (truncated file?)");
+    const std::size_t start = pos_;
+    while (pos_ < s_.size() && !std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
+    token_line_ = line_;
+    return s_.substr(start, pos_ - start);
   }
-  std::string_view peek() const { return done() ? std::string_view() : n_.tokens[i_]; }
-  // Skips tokens up to the next blank line (a gap of two or more lines between tokens).
+  std::string_view peek() const {
+    std::size_t start = pos_;
+    while (start < s_.size() && std::isspace(static_cast<unsigned char>(s_[start]))) ++start;
+    std::size_t end = start;
+    while (end < s_.size() && !std::isspace(static_cast<unsigned char>(s_[end]))) ++end;
+    return s_.substr(start, end - start);
+  }
+  // Skips up to the next blank line (VTK's METADATA blocks end there).
   void skip_to_blank_line() {
-    int last = line_before();
-    while (!done() && n_.lines[i_] <= last + 1) last = n_.lines[i_++];
+    while (pos_ < s_.size()) {
+      const std::size_t eol = s_.find('\n', pos_);
+      if (eol == std::string_view::npos) {
+        pos_ = s_.size();
+        return;
+      }
+      pos_ = eol + 1;
+      ++line_;
+      std::size_t p = pos_;
+      while (p < s_.size() && s_[p] != '\n' && std::isspace(static_cast<unsigned char>(s_[p]))) ++p;
+      if (p >= s_.size() || s_[p] == '\n') return;
+    }
   }
-  int line_before() const { return i_ ? n_.lines[i_ - 1] : 1; }
+  int line_before() const { return token_line_; }
+  // Binary legacy files (big-endian, VTK's file format manual): the values of one array follow
+  // the line that announces it. begin_array(type) switches integer() and real() to those bytes
+  // until end_array(); in ASCII files both do nothing.
+  void set_binary(bool binary) { binary_ = binary; }
+  void begin_array(std::string_view type, const std::string& what) {
+    if (!binary_) return;
+    const std::string t = lower(type);
+    if (t == "float") size_ = 4, real_ = true;
+    else if (t == "double") size_ = 8, real_ = true;
+    else if (t == "char" || t == "unsigned_char" || t == "bit") size_ = 1, real_ = false;
+    else if (t == "short" || t == "unsigned_short") size_ = 2, real_ = false;
+    else if (t == "int" || t == "unsigned_int" || t == "vtktypeint32") size_ = 4, real_ = false;
+    else if (t == "long" || t == "unsigned_long" || t == "vtktypeint64" || t == "vtktypeuint64" || t == "vtkidtype") size_ = 8, real_ = false;
+    else fail(file_, line_, what + ": binary type '" + std::string(type) + "' is not supported");
+    unsigned_ = t.rfind("unsigned", 0) == 0 || t == "vtktypeuint64";
+    const std::size_t eol = s_.find('\n', pos_);
+    if (eol == std::string_view::npos) fail(file_, line_, what + ": no binary data (truncated file?)");
+    pos_ = eol + 1;
+    ++line_;
+    in_array_ = true;
+  }
+  void end_array() {
+    if (!in_array_) return;
+    in_array_ = false;
+    // The bytes may hold '\n': count none of them as lines.
+  }
   long long integer(const std::string& what) {
+    if (in_array_) {
+      const double v = raw(what);
+      if (real_) fail(file_, line_, what + ": floating-point data where integers are expected");
+      return static_cast<long long>(v);
+    }
     const auto t = next(what);
     return parse_int(file_, line_before(), t);
   }
   double real(const std::string& what) {
+    if (in_array_) return raw(what);
     const auto t = next(what);
     return parse_double(file_, line_before(), t);
   }
@@ -961,9 +1019,43 @@ class Tokens {
   }
 
  private:
-  const Numbers& n_;
+  std::string_view s_;
+  std::size_t pos_ = 0;
+  int line_ = 1, token_line_ = 1;
   std::string file_;
-  std::size_t i_ = 0;
+  bool binary_ = false, in_array_ = false, real_ = false, unsigned_ = false;
+  std::size_t size_ = 4;
+
+  static std::string lower(std::string_view s) {
+    std::string l(s);
+    for (auto& c : l) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return l;
+  }
+  void skip_space() {
+    if (in_array_) return;
+    while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_]))) line_ += s_[pos_++] == '\n';
+  }
+  // One big-endian value of the current array type.
+  double raw(const std::string& what) {
+    if (s_.size() - pos_ < size_) fail(file_, line_, what + ": binary data cut short (truncated file?)");
+    std::uint64_t bits = 0;
+    for (std::size_t k = 0; k < size_; ++k) bits = bits << 8 | static_cast<unsigned char>(s_[pos_ + k]);
+    pos_ += size_;
+    if (real_) {
+      if (size_ == 4) {
+        const auto b32 = static_cast<std::uint32_t>(bits);
+        float f;
+        std::memcpy(&f, &b32, 4);
+        return f;
+      }
+      double d;
+      std::memcpy(&d, &bits, 8);
+      return d;
+    }
+    if (unsigned_ || size_ == 8) return static_cast<double>(static_cast<std::int64_t>(bits));
+    const std::uint64_t sign = std::uint64_t{1} << (8 * size_ - 1);
+    return static_cast<double>(static_cast<std::int64_t>((bits ^ sign)) - static_cast<std::int64_t>(sign));
+  }
 };
 
 std::string upper(std::string_view s) {
@@ -998,11 +1090,11 @@ VtkGrid parse_vtk(std::string_view content, const std::string& source) {
   if (header[0].rfind("# vtk DataFile Version", 0) != 0) {
     fail(file, 1, "not a legacy VTK file (expected '# vtk DataFile Version')");
   }
-  if (upper(header[2]).rfind("ASCII", 0) != 0) {
-    fail(file, 3, "'" + header[2] + "' is not supported (only ASCII legacy files are read)");
-  }
-  const Numbers body = split_numbers(std::string_view(text).substr(pos), 4);
-  Tokens t(body, file);
+  const bool binary = upper(header[2]).rfind("BINARY", 0) == 0;
+  if (!binary && upper(header[2]).rfind("ASCII", 0) != 0)
+    fail(file, 3, "'" + header[2] + "' is neither ASCII nor BINARY");
+  Tokens t(text.substr(pos), 4, file);
+  t.set_binary(binary);
   t.expect("DATASET", "the DATASET line");
   if (const auto type = t.next("the dataset type"); upper(type) != "UNSTRUCTURED_GRID") {
     fail(file, t.line_before(),
@@ -1016,7 +1108,7 @@ VtkGrid parse_vtk(std::string_view content, const std::string& source) {
     const int key_line = t.line_before();
     if (key == "POINTS") {
       const std::size_t np = t.count("the number of points");
-      t.next("the point type");
+      t.begin_array(t.next("the point type"), "POINTS");
       for (std::size_t i = 0; i < np; ++i) {
         const std::string what = "point " + std::to_string(i);
         const double x = t.real(what);
@@ -1024,6 +1116,7 @@ VtkGrid parse_vtk(std::string_view content, const std::string& source) {
         const double y = t.real(what), z = t.real(what);
         g.points.push_back(point_from(file, line, i, x, y, z));
       }
+      t.end_array();
       have_points = true;
     } else if (key == "CELLS") {
       nc = t.count("the number of cells");
@@ -1031,13 +1124,14 @@ VtkGrid parse_vtk(std::string_view content, const std::string& source) {
       if (upper(t.peek()) ==
           "OFFSETS") {  // 5.1 layout: OFFSETS type (n+1 values) CONNECTIVITY type
         t.next("OFFSETS");
-        t.next("the offsets type");
+        t.begin_array(t.next("the offsets type"), "OFFSETS");
         if (nc == 0) fail(file, key_line, "CELLS: 5.1 layout needs at least one offset");
         std::vector<std::size_t> offsets;
         for (std::size_t i = 0; i < nc; ++i)
           offsets.push_back(t.count("offset " + std::to_string(i)));
+        t.end_array();
         t.expect("CONNECTIVITY", "the CONNECTIVITY keyword");
-        t.next("the connectivity type");
+        t.begin_array(t.next("the connectivity type"), "CONNECTIVITY");
         nc -= 1;  // the 5.1 header counts offsets
         for (std::size_t c = 0; c < nc; ++c) {
           if (offsets[c + 1] < offsets[c] || offsets[c + 1] > size) {
@@ -1050,8 +1144,10 @@ VtkGrid parse_vtk(std::string_view content, const std::string& source) {
           }
           g.cells.push_back(std::move(cell));
         }
+        t.end_array();
       } else {
         std::size_t read = 0;
+        t.begin_array("int", "CELLS");
         for (std::size_t c = 0; c < nc; ++c) {
           const std::string what = "cell " + std::to_string(c);
           const std::size_t n = t.count(what);
@@ -1061,6 +1157,7 @@ VtkGrid parse_vtk(std::string_view content, const std::string& source) {
           read += n + 1;
           g.cells.push_back(std::move(cell));
         }
+        t.end_array();
         if (read != size) {
           fail(file, key_line,
                "CELLS: size " + std::to_string(size) + " but the cells hold " +
@@ -1074,11 +1171,13 @@ VtkGrid parse_vtk(std::string_view content, const std::string& source) {
         fail(file, key_line,
              "CELL_TYPES " + std::to_string(n) + " does not follow CELLS " + std::to_string(nc));
       }
+      t.begin_array("int", "CELL_TYPES");
       for (std::size_t c = 0; c < n; ++c) {
         g.cell_types.push_back(
             static_cast<int>(t.integer("the type of cell " + std::to_string(c))));
         type_line.push_back(t.line_before());
       }
+      t.end_array();
       have_types = true;
     } else if (key == "CELL_DATA" || key == "POINT_DATA") {
       const bool cell = key == "CELL_DATA";
@@ -1124,12 +1223,14 @@ VtkGrid parse_vtk(std::string_view content, const std::string& source) {
             const bool is_real = upper(type) == "FLOAT" || upper(type) == "DOUBLE";
             std::vector<double> dv;
             std::vector<int> iv;
+            t.begin_array(type, "FIELD array " + name);
             for (std::size_t i = 0; i < n * nco; ++i) {
               if (is_real)
                 dv.push_back(t.real("array " + name));
               else
                 iv.push_back(static_cast<int>(t.integer("array " + name)));
             }
+            t.end_array();
             if (cell && nco == 1) {
               if (is_real)
                 g.cell_data.doubles.emplace_back(name, std::move(dv));
@@ -1150,12 +1251,14 @@ VtkGrid parse_vtk(std::string_view content, const std::string& source) {
           const bool is_real = upper(type) == "FLOAT" || upper(type) == "DOUBLE";
           std::vector<double> dv;
           std::vector<int> iv;
+          t.begin_array(type, "array " + name);
           for (std::size_t i = 0; i < n * comps[a]; ++i) {
             if (is_real)
               dv.push_back(t.real("array " + name));
             else
               iv.push_back(static_cast<int>(t.integer("array " + name)));
           }
+          t.end_array();
           if (cell && comps[a] == 1) {
             if (is_real)
               g.cell_data.doubles.emplace_back(name, std::move(dv));

@@ -58,7 +58,7 @@ TEST_CASE("VTK's own writer: every .vtu encoding and legacy .vtk read back the s
   run_script("vtk", source, dir.path);
   for (const std::string name : {"ascii.vtu", "binary.vtu", "binary-zlib.vtu", "appended-raw.vtu", "appended-base64.vtu",
                            "appended-raw-zlib.vtu", "binary-zlib-uint64.vtu", "appended-base64-zlib-uint64.vtu",
-                           "legacy-ascii.vtk"}) {
+                           "legacy-ascii.vtk", "legacy-binary.vtk"}) {
     CAPTURE(name);
     const VtkGrid g = read_vtk_file(dir.path / name);
     const HexMesh back = to_hex_mesh(g);
