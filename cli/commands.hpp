@@ -22,8 +22,8 @@ void add_check_command(CLI::App& app);      // cli/check_command.cpp
 void add_arrange_command(CLI::App& app);    // cli/arrange_command.cpp
 
 // Shared by the commands (cli/files.cpp): the extension in lower case (".msh"), and a model
-// read by extension (.msh, .exo, .e); InvalidInput naming the file when it is missing or of
-// another format.
+// read by extension and checked content (primal/read_model.hpp: .msh, .exo, .e, .vtu, .vtk);
+// InvalidInput naming the file when it is missing or of another format.
 std::string file_extension(const std::filesystem::path& p);
 primal::Model read_model(const std::filesystem::path& path);
 // An all-hex mesh, or a planar quad mesh in z = 0 (.vtu / .vtk only), read by extension (.vtu,

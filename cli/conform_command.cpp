@@ -148,7 +148,7 @@ void add_conform_commands(CLI::App& app) {
       "conform",
       "Conform the hex part of a model to its tet part with geode templates: buffer layer, "
       "dicing (8 per hex, 4 per tet), 26 geode hexes per interface quad.");
-  c->add_option("INPUT", args->input, "input model (.msh, .exo, .e)")->required();
+  c->add_option("INPUT", args->input, "input model (.msh, .exo, .e, .vtu, .vtk)")->required();
   add_run_options(c, *args);
   c->callback([args] {
     // Check the output name before the long run, not after it.

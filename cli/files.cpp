@@ -9,6 +9,7 @@
 #include "primal/io_exodus.hpp"
 #include "primal/io_gmsh.hpp"
 #include "primal/io_vtk.hpp"
+#include "primal/read_model.hpp"
 
 namespace geode::cli {
 
@@ -20,13 +21,7 @@ std::string file_extension(const fs::path& p) {
   return e;
 }
 
-primal::Model read_model(const fs::path& path) {
-  const std::string e = file_extension(path);
-  if (!fs::exists(path)) throw InvalidInput(path.string() + ": no such file");
-  if (e == ".msh") return primal::read_gmsh(path);
-  if (e == ".exo" || e == ".e") return primal::read_exodus(path);
-  throw InvalidInput(path.string() + ": unknown input format '" + e + "' (expected .msh, .exo or .e)");
-}
+primal::Model read_model(const fs::path& path) { return primal::read_model(path); }
 
 MeshFile read_mesh_file(const fs::path& path) {
   if (!fs::exists(path)) throw InvalidInput(path.string() + ": no such file");

@@ -26,15 +26,13 @@ struct TriangleUses {
   bool matched = false;  // one of the two triangles of an interface quad
 };
 
-std::string nodes_text(std::span<const Index> nodes) {
-  std::string s;
-  for (Index v : nodes) s += (s.empty() ? "" : " ") + std::to_string(v);
-  return s;
+// Messages speak in the file's ids (model.hpp: describe_element, node_list).
+std::string quad_name(const Model& model, Index hex, const std::array<Index, 4>& corners) {
+  return describe_element(model, {ElementKind::Hex, hex}) + " face (nodes " + node_list(model, corners) + ")";
 }
 
-std::string quad_name(Index hex, int face, const std::array<Index, 4>& corners) {
-  return "hex " + std::to_string(hex) + " face " + std::to_string(face) + " (nodes " +
-         nodes_text(corners) + ")";
+std::string tet_face_name(const Model& model, const TetFaceUse& use) {
+  return describe_element(model, {ElementKind::Tet, use.tet}) + " face (nodes " + node_list(model, use.nodes) + ")";
 }
 
 // Whether p lies on triangle (a, b, c), edges and corners included, within tol * longest edge.
@@ -86,9 +84,11 @@ Interface find_interface(const Model& model, double tol) {
       if (inserted) tris.emplace_back();
       TriangleUses& uses = tris[static_cast<std::size_t>(*id)];
       if (uses.count == 2)
-        throw TopologyError("find_interface: triangle (nodes " + nodes_text(use.nodes) +
-                            ") is a face of more than two tets (" + std::to_string(uses.use[0].tet) +
-                            ", " + std::to_string(uses.use[1].tet) + ", " + std::to_string(t) + ")");
+        throw TopologyError("find_interface: triangle (nodes " + node_list(model, use.nodes) +
+                            ") is a face of more than two tets (" +
+                            describe_element(model, {ElementKind::Tet, uses.use[0].tet}) + ", " +
+                            describe_element(model, {ElementKind::Tet, uses.use[1].tet}) + ", " +
+                            describe_element(model, {ElementKind::Tet, static_cast<Index>(t)}) + ")");
       uses.use[static_cast<std::size_t>(uses.count++)] = use;
     }
   // The boundary triangle with this key, or nullptr.
@@ -119,15 +119,14 @@ Interface find_interface(const Model& model, double tol) {
       unmatched_quads.push_back(&bq);
       continue;
     }
-    const std::string name = quad_name(bq.hex, bq.local_face, c);
+    const std::string name = quad_name(model, bq.hex, c);
     const bool d0 = found[0][0] && found[0][1], d1 = found[1][0] && found[1][1];
     if (count != 2 || !(d0 || d1)) {
       std::string detail;
       for (int d = 0; d < 2; ++d)
         for (int i = 0; i < 2; ++i)
           if (const TetFaceUse* u = found[static_cast<std::size_t>(d)][static_cast<std::size_t>(i)])
-            detail += (detail.empty() ? "" : ", ") + std::string("tet ") + std::to_string(u->tet) +
-                      " face " + std::to_string(u->face) + " (nodes " + nodes_text(u->nodes) + ")";
+            detail += (detail.empty() ? "" : ", ") + tet_face_name(model, *u);
       throw TopologyError("find_interface: " + name + " is matched by " +
                           (count == 1
                                ? std::string("only one triangle of the tet part")
@@ -152,7 +151,7 @@ Interface find_interface(const Model& model, double tol) {
       for (Index v : tet)
         if (std::find(u.nodes.begin(), u.nodes.end(), v) == u.nodes.end()) apex = v;
       if ((pt(apex) - centre).dot(normal) <= 0.0)
-        throw TopologyError("find_interface: tet " + std::to_string(u.tet) + " on " + name +
+        throw TopologyError("find_interface: " + describe_element(model, {ElementKind::Tet, u.tet}) + " on " + name +
                             " lies on the hex side of it (the parts overlap or are inverted)");
     }
     out.quads.push_back(q);
@@ -190,18 +189,17 @@ Interface find_interface(const Model& model, double tol) {
                 on_triangle(pt(p), pt(c[0]), pt(c[1]), pt(c[3]), tol) ||
                 on_triangle(pt(p), pt(c[1]), pt(c[2]), pt(c[3]), tol))
               throw TopologyError(
-                  "find_interface: node " + std::to_string(p) + " of the tet part (tet " +
-                  std::to_string(tri.tet) + ") lies on " + quad_name(bq->hex, bq->local_face, c) +
+                  "find_interface: " + describe_node(model, p) + " of the tet part (" +
+                  describe_element(model, {ElementKind::Tet, tri.tet}) + ") lies on " + quad_name(model, bq->hex, c) +
                   " but is not one of its corners: the parts do not conform node-wise");
           }
           for (Index p : c) {
             if (has(tri.nodes, p)) continue;
             if (on_triangle(pt(p), pt(tri.nodes[0]), pt(tri.nodes[1]), pt(tri.nodes[2]), tol))
               throw TopologyError(
-                  "find_interface: node " + std::to_string(p) + " of the hex part (hex " +
-                  std::to_string(bq->hex) + ") lies on tet " + std::to_string(tri.tet) + " face " +
-                  std::to_string(tri.face) + " (nodes " + nodes_text(tri.nodes) +
-                  ") but is not one of its corners: the parts do not conform node-wise");
+                  "find_interface: " + describe_node(model, p) + " of the hex part (" +
+                  describe_element(model, {ElementKind::Hex, bq->hex}) + ") lies on " + tet_face_name(model, tri) +
+                  " but is not one of its corners: the parts do not conform node-wise");
           }
         }
       }
@@ -221,7 +219,7 @@ Interface find_interface(const Model& model, double tol) {
   for (std::size_t v = 0; v < P.size(); ++v)
     if (in_hex[v] && in_tet[v] &&
         !std::binary_search(out.nodes.begin(), out.nodes.end(), static_cast<Index>(v)))
-      throw TopologyError("find_interface: node " + std::to_string(v) +
+      throw TopologyError("find_interface: " + describe_node(model, static_cast<Index>(v)) +
                           " is used by both the hex and the tet part but lies on no interface quad "
                           "(the parts touch along an edge or at a point only)");
   return out;

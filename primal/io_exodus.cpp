@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "primal/errors.hpp"
+#include "primal/file_format.hpp"
 #include "primal/topology.hpp"
 
 namespace geode::primal {
@@ -66,13 +67,9 @@ std::string upper(std::string s) {
 
 }  // namespace
 
-Model read_exodus(const std::filesystem::path& path) {
+Model read_exodus(const std::filesystem::path& path, const ReadOptions& options) {
   const std::string source = path.string();
-  {
-    std::ifstream probe(path, std::ios::binary);
-    if (!probe || !std::filesystem::is_regular_file(path))
-      throw InvalidInput(source + ": cannot open file (missing or unreadable)");
-  }
+  check_mesh_format(path, MeshFileFormat::kExodus);
   ex_opts(0);  // we report errors ourselves, through exceptions
   int cpu_word_size = 8, io_word_size = 0;
   float version = 0.0f;
@@ -97,6 +94,22 @@ Model read_exodus(const std::filesystem::path& path) {
             "reading coordinates");
     for (std::size_t i = 0; i < x.size(); ++i) model.points.emplace_back(x[i], y[i], z[i]);
   }
+  // Node and element number maps (Cubit's ids): the file ids in messages. Without maps in the
+  // file, libexodusII gives 1..n.
+  std::vector<int64_t> element_map;
+  if (num_nodes > 0) {
+    std::vector<int> ids(static_cast<std::size_t>(num_nodes));
+    check(ex_get_id_map(exo, EX_NODE_MAP, ids.data()), source, "reading the node number map");
+    model.node_ids.assign(ids.begin(), ids.end());
+  }
+  if (num_elem > 0) {
+    std::vector<int> ids(static_cast<std::size_t>(num_elem));
+    check(ex_get_id_map(exo, EX_ELEM_MAP, ids.data()), source, "reading the element number map");
+    element_map.assign(ids.begin(), ids.end());
+  }
+  auto element_file_id = [&](std::size_t global_index) {
+    return global_index < element_map.size() ? element_map[global_index] : static_cast<int64_t>(global_index) + 1;
+  };
 
   // Element blocks in file order; global element number (1-based) -> element.
   std::vector<ElementRef> global;
@@ -104,10 +117,14 @@ Model read_exodus(const std::filesystem::path& path) {
     std::vector<int> ids(static_cast<std::size_t>(num_blocks));
     check(ex_get_ids(exo, EX_ELEM_BLOCK, ids.data()), source, "reading element block ids");
     NameBuffers names(ids.size());
-    if (ex_get_names(exo, EX_ELEM_BLOCK, names.pointers.data()) >= 0)
-      for (std::size_t b = 0; b < ids.size(); ++b)
-        if (!names.get(b).empty()) model.block_names[ids[b]] = names.get(b);
-    for (int id : ids) {
+    const bool named = ex_get_names(exo, EX_ELEM_BLOCK, names.pointers.data()) >= 0;
+    // meshio numbers blocks from 0: a file with any id <= 0 gets its blocks numbered by
+    // position (1, 2, ...), which keeps every id positive and distinct.
+    const bool renumber = std::any_of(ids.begin(), ids.end(), [](int id) { return id <= 0; });
+    for (std::size_t b = 0; b < ids.size(); ++b) {
+      const int id = ids[b];
+      const int block_id = renumber ? static_cast<int>(b) + 1 : id;
+      if (named && !names.get(b).empty()) model.block_names[block_id] = names.get(b);
       const std::string where = source + ": element block " + std::to_string(id);
       char type_buffer[MAX_STR_LENGTH + 1] = {};
       int count = 0, per_elem = 0, edges = 0, faces = 0, attributes = 0;
@@ -120,7 +137,6 @@ Model read_exodus(const std::filesystem::path& path) {
         throw InvalidInput(where + ": element " + std::to_string(global.size() + 1) + ": element type '" +
                            std::string(type_buffer) + "' with " + std::to_string(per_elem) +
                            " nodes is not supported; only HEX8 and TETRA4 are");
-      if (id <= 0) throw InvalidInput(where + ": block id is not positive");
       std::vector<int> conn(static_cast<std::size_t>(count) * static_cast<std::size_t>(per_elem));
       if (count > 0) check(ex_get_conn(exo, EX_ELEM_BLOCK, id, conn.data(), nullptr, nullptr), where, "reading connectivity");
       for (int e = 0; e < count; ++e) {
@@ -136,15 +152,17 @@ Model read_exodus(const std::filesystem::path& path) {
         if (hex) {
           std::array<Index, 8> h{};
           for (std::size_t c = 0; c < 8; ++c) h[c] = node(kExodusHexToVtk[c]);
+          model.hex_ids.push_back(element_file_id(global.size()));
           global.push_back({ElementKind::Hex, static_cast<Index>(model.hexes.size())});
           model.hexes.push_back(h);
-          model.hex_block.push_back(id);
+          model.hex_block.push_back(block_id);
         } else {
           std::array<Index, 4> t{};
           for (std::size_t c = 0; c < 4; ++c) t[c] = node(kExodusTetToVtk[c]);
+          model.tet_ids.push_back(element_file_id(global.size()));
           global.push_back({ElementKind::Tet, static_cast<Index>(model.tets.size())});
           model.tets.push_back(t);
-          model.tet_block.push_back(id);
+          model.tet_block.push_back(block_id);
         }
       }
     }
@@ -199,6 +217,7 @@ Model read_exodus(const std::filesystem::path& path) {
     }
   }
   validate(model, source);
+  options.check_geometry ? check_geometry(model, source) : check_points(model, source);
   return model;
 }
 

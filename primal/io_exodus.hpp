@@ -20,11 +20,15 @@ namespace geode::primal {
 inline constexpr std::array<int, 8> kExodusHexToVtk{0, 1, 2, 3, 4, 5, 6, 7};
 inline constexpr std::array<int, 4> kExodusTetToVtk{0, 1, 2, 3};
 
-// Throws InvalidInput naming the file, the block / element / set entry and the reason: missing
-// or unreadable file, not an Exodus file (e.g. truncated), an element type other than HEX8 /
-// TETRA4 (HEX / HEXAHEDRON / TETRA / TET4 with 8 / 4 nodes are accepted as aliases), a node or
-// element number out of range, a side number out of range.
-Model read_exodus(const std::filesystem::path& path);
+// The file is checked for the netCDF / HDF5 signature (file_format.hpp) before libexodusII
+// opens it. Node and element number maps, when present (Cubit writes them), are the model's
+// file ids; otherwise 1-based numbers. Block ids are the file's; a file with a block id <= 0
+// (meshio numbers blocks from 0) gets its blocks numbered 1, 2, ... in file order. Throws InvalidInput naming the file, the block / element
+// / set entry and the reason: missing or unreadable file, not an Exodus file (e.g. truncated),
+// an element type other than HEX8 / TETRA4 (HEX / HEXAHEDRON / TETRA / TET4 with 8 / 4 nodes
+// are accepted as aliases), a node or element number out of range, a side number out of
+// range; then check_geometry (model.hpp) unless options say otherwise.
+Model read_exodus(const std::filesystem::path& path, const ReadOptions& options = {});
 
 // Writes atomically (a temporary file in the same directory, then rename).
 void write_exodus(const Model& model, const std::filesystem::path& path);

@@ -13,6 +13,7 @@
 
 #include "primal/boundary.hpp"
 #include "primal/errors.hpp"
+#include "primal/file_format.hpp"
 #include "primal/topology.hpp"
 
 namespace geode::primal {
@@ -229,18 +230,9 @@ Model model_from_gmsh(std::string_view source_view) {
   return model;
 }
 
-Model read_gmsh(const std::filesystem::path& path) {
-  const std::string source = path.string();
-  {
-    std::ifstream probe(path, std::ios::binary);
-    if (!probe || !std::filesystem::is_regular_file(path))
-      throw InvalidInput(source + ": cannot open file (missing or unreadable)");
-  }
-  GmshSession session;
-  gmsh_call(source, [&] { gmsh::open(source); });
-  Model model;
-  gmsh_call(source, [&] { model = model_from_gmsh(source); });
-  return model;
+Model read_gmsh(const std::filesystem::path& path, const ReadOptions& options) {
+  check_mesh_format(path, MeshFileFormat::kGmsh);
+  return parse_gmsh(read_file_bytes(path), path.string(), options);
 }
 
 void write_gmsh(const Model& model, const std::filesystem::path& path, GmshFormat format) {

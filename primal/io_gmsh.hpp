@@ -1,6 +1,8 @@
 #pragma once
-// Gmsh .msh (v4.1, ASCII or binary) input and output of a mixed hex + tet model through the
-// Gmsh C++ API.
+// Gmsh .msh input and output of a mixed hex + tet model. Reading is our own (io_gmsh_read.cpp:
+// versions 2.2 and 4.1, ASCII and binary), so that a user's file never reaches libgmsh, which
+// would run any text that is not a mesh as a Gmsh script; writing (v4.1) and the demo models
+// use the Gmsh C++ API.
 //
 // Mapping between a Model and Gmsh's entities:
 // - element blocks  <-> volume entities; the block id is the entity's first physical group
@@ -30,11 +32,16 @@ inline constexpr std::array<int, 4> kGmshTetToVtk{0, 1, 2, 3};
 
 enum class GmshFormat { Ascii, Binary };
 
-// Reads a .msh file (any version Gmsh reads; 4.1 is what we write). Throws InvalidInput naming
-// the file, the element or entry and the reason: missing or unreadable file, a file Gmsh
-// cannot parse (e.g. truncated), a volume element that is not a linear hex or tet, a node tag
-// out of range, a side-set face that is no face of a hex or tet.
-Model read_gmsh(const std::filesystem::path& path);
+// Reads a .msh file, version 2.2 or 4.1, ASCII or binary. Node and element tags become the
+// model's file ids. Throws InvalidInput naming the file, the line (byte in binary files) or
+// the element / node tag and the reason: missing or unreadable file, a file that does not
+// start with $MeshFormat (a script, another format), another version, a truncated section or
+// one without its $End line, a volume element that is not a linear hex or tet, an element
+// referring to a node not in $Nodes, a node given twice at two places, a side-set face that is
+// no face of a hex or tet; then check_geometry (model.hpp) unless options say otherwise.
+Model read_gmsh(const std::filesystem::path& path, const ReadOptions& options = {});
+// The same on a file's content; `source` names it in messages.
+Model parse_gmsh(std::string_view content, const std::string& source, const ReadOptions& options = {});
 
 // Writes .msh v4.1 atomically (a temporary file in the same directory, then rename). Block ids
 // must be positive; a block may hold both hexes and tets.

@@ -9,6 +9,7 @@
 // scaled Jacobian) and "block" (mesh.block, when not empty), then the caller's arrays.
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -63,8 +64,12 @@ struct VtkGrid {
 // file, the line (and point or cell) and the reason: truncated file, unknown cell type, wrong
 // node count for a cell type, node number out of range, NaN or infinite coordinate, too few or
 // too many values, unsupported encoding.
+// The file's content is checked (file_format.hpp) before it is parsed.
 VtkGrid read_vtu(const std::filesystem::path& path);
 VtkGrid read_vtk(const std::filesystem::path& path);
+// The same on a file's content; `source` names it in messages.
+VtkGrid parse_vtu(std::string_view content, const std::string& source);
+VtkGrid parse_vtk(std::string_view content, const std::string& source);
 // By extension: .vtu or .vtk.
 VtkGrid read_vtk_file(const std::filesystem::path& path);
 

@@ -1,12 +1,14 @@
 #include "primal/model.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <string>
 #include <unordered_map>
 #include <unordered_set>
 
 #include "primal/errors.hpp"
+#include "primal/quality.hpp"
 #include "primal/topology.hpp"
 
 namespace geode::primal {
@@ -17,42 +19,115 @@ int block_of(const Model& model, ElementRef element) {
   return model.tet_block.empty() ? 2 : model.tet_block[static_cast<std::size_t>(element.index)];
 }
 
+std::int64_t node_id(const Model& model, Index node) {
+  const auto n = static_cast<std::size_t>(node);
+  return n < model.node_ids.size() ? model.node_ids[n] : std::int64_t{node} + 1;
+}
+
+std::int64_t element_id(const Model& model, ElementRef element) {
+  const auto& ids = element.kind == ElementKind::Hex ? model.hex_ids : model.tet_ids;
+  const auto e = static_cast<std::size_t>(element.index);
+  return e < ids.size() ? ids[e] : std::int64_t{element.index} + 1;
+}
+
+std::string number_text(double x) {
+  char buf[32];
+  const auto res = std::to_chars(buf, buf + sizeof buf, x);
+  return std::string(buf, res.ptr);
+}
+
+std::string point_text(const Point& p) {
+  return "(" + number_text(p.x()) + ", " + number_text(p.y()) + ", " + number_text(p.z()) + ")";
+}
+
+std::string describe_node(const Model& model, Index node) {
+  std::string s = "node " + std::to_string(node_id(model, node));
+  if (node >= 0 && static_cast<std::size_t>(node) < model.points.size())
+    s += " " + point_text(model.points[static_cast<std::size_t>(node)]);
+  return s;
+}
+
+std::string node_list(const Model& model, std::span<const Index> nodes) {
+  std::string s;
+  for (Index v : nodes) s += (s.empty() ? "" : " ") + std::to_string(node_id(model, v));
+  return s;
+}
+
+namespace {
+
+const char* kind_name(ElementKind kind) { return kind == ElementKind::Hex ? "hex" : "tet"; }
+
+// The element's corners, or an empty span when it does not exist.
+std::span<const Index> corners_of(const Model& model, ElementRef e) {
+  const auto i = static_cast<std::size_t>(e.index);
+  if (e.kind == ElementKind::Hex)
+    return e.index >= 0 && i < model.hexes.size() ? std::span<const Index>(model.hexes[i]) : std::span<const Index>();
+  return e.index >= 0 && i < model.tets.size() ? std::span<const Index>(model.tets[i]) : std::span<const Index>();
+}
+
+}  // namespace
+
+std::string describe_element(const Model& model, ElementRef element) {
+  std::string s = std::string(kind_name(element.kind)) + " " + std::to_string(element_id(model, element));
+  const auto corners = corners_of(model, element);
+  if (corners.empty()) return s;
+  Point centre = Point::Zero();
+  for (Index v : corners) {
+    if (v < 0 || static_cast<std::size_t>(v) >= model.points.size()) return s;
+    centre += model.points[static_cast<std::size_t>(v)];
+  }
+  return s + " (centre " + point_text(centre / static_cast<double>(corners.size())) + ")";
+}
+
 namespace {
 
 template <std::size_t N>
-void check_elements(const std::vector<std::array<Index, N>>& elements, Index num_points,
-                    std::string_view source, const char* what) {
+void check_elements(const Model& model, const std::vector<std::array<Index, N>>& elements,
+                    ElementKind kind, std::string_view source) {
+  const auto num_points = static_cast<Index>(model.points.size());
   for (std::size_t e = 0; e < elements.size(); ++e)
     for (std::size_t c = 0; c < N; ++c) {
       const Index n = elements[e][c];
       if (n < 0 || n >= num_points)
-        throw InvalidInput(std::string(source) + ": " + what + " " + std::to_string(e) +
-                           ": corner " + std::to_string(c) + " refers to node " +
-                           std::to_string(n) + ", out of range [0, " +
-                           std::to_string(num_points) + ")");
+        throw InvalidInput(std::string(source) + ": " + kind_name(kind) + " " +
+                           std::to_string(element_id(model, {kind, static_cast<Index>(e)})) +
+                           ": corner " + std::to_string(c + 1) + " refers to node index " +
+                           std::to_string(n) + ", out of range [0, " + std::to_string(num_points) + ")");
     }
 }
 
-void check_blocks(const std::vector<int>& blocks, std::size_t count, std::string_view source,
-                  const char* what) {
+void check_blocks(const Model& model, const std::vector<int>& blocks, ElementKind kind,
+                  std::string_view source) {
+  const std::size_t count = kind == ElementKind::Hex ? model.hexes.size() : model.tets.size();
   if (!blocks.empty() && blocks.size() != count)
-    throw InvalidInput(std::string(source) + ": " + what + " block ids: " +
+    throw InvalidInput(std::string(source) + ": " + kind_name(kind) + " block ids: " +
                        std::to_string(blocks.size()) + " ids for " + std::to_string(count) +
                        " elements");
   for (std::size_t e = 0; e < blocks.size(); ++e)
     if (blocks[e] <= 0)
-      throw InvalidInput(std::string(source) + ": " + what + " " + std::to_string(e) +
+      throw InvalidInput(std::string(source) + ": " + kind_name(kind) + " " +
+                         std::to_string(element_id(model, {kind, static_cast<Index>(e)})) +
                          ": block id " + std::to_string(blocks[e]) + " is not positive");
+}
+
+void check_ids(const std::vector<std::int64_t>& ids, std::size_t count, std::string_view source,
+               const char* what) {
+  if (!ids.empty() && ids.size() != count)
+    throw InvalidInput(std::string(source) + ": " + what + " file ids: " + std::to_string(ids.size()) +
+                       " ids for " + std::to_string(count) + " entries");
 }
 
 }  // namespace
 
 void validate(const Model& model, std::string_view source) {
   const auto num_points = static_cast<Index>(model.points.size());
-  check_elements(model.hexes, num_points, source, "hex");
-  check_elements(model.tets, num_points, source, "tet");
-  check_blocks(model.hex_block, model.hexes.size(), source, "hex");
-  check_blocks(model.tet_block, model.tets.size(), source, "tet");
+  check_ids(model.node_ids, model.points.size(), source, "node");
+  check_ids(model.hex_ids, model.hexes.size(), source, "hex");
+  check_ids(model.tet_ids, model.tets.size(), source, "tet");
+  check_elements(model, model.hexes, ElementKind::Hex, source);
+  check_elements(model, model.tets, ElementKind::Tet, source);
+  check_blocks(model, model.hex_block, ElementKind::Hex, source);
+  check_blocks(model, model.tet_block, ElementKind::Tet, source);
   std::unordered_set<int> node_set_ids, side_set_ids;
   for (const NodeSet& set : model.node_sets)
     if (!node_set_ids.insert(set.id).second)
@@ -68,7 +143,7 @@ void validate(const Model& model, std::string_view source) {
     if (set.id <= 0) throw InvalidInput(where + ": id is not positive");
     for (std::size_t i = 0; i < set.nodes.size(); ++i)
       if (set.nodes[i] < 0 || set.nodes[i] >= num_points)
-        throw InvalidInput(where + ": entry " + std::to_string(i) + " refers to node " +
+        throw InvalidInput(where + ": entry " + std::to_string(i + 1) + " refers to node index " +
                            std::to_string(set.nodes[i]) + ", out of range");
   }
   for (const SideSet& set : model.side_sets) {
@@ -81,13 +156,50 @@ void validate(const Model& model, std::string_view source) {
       const std::size_t count = hex ? model.hexes.size() : model.tets.size();
       const int faces = hex ? topology::kHexFaces : 4;
       if (s.element.index < 0 || static_cast<std::size_t>(s.element.index) >= count)
-        throw InvalidInput(where + ": entry " + std::to_string(i) + " refers to " +
-                           (hex ? "hex " : "tet ") + std::to_string(s.element.index) +
+        throw InvalidInput(where + ": entry " + std::to_string(i + 1) + " refers to " +
+                           (hex ? "hex index " : "tet index ") + std::to_string(s.element.index) +
                            ", out of range");
       if (s.face < 0 || s.face >= faces)
-        throw InvalidInput(where + ": entry " + std::to_string(i) + ": face " +
-                           std::to_string(s.face) + " out of range");
+        throw InvalidInput(where + ": entry " + std::to_string(i + 1) + ": " +
+                           describe_element(model, s.element) + ": face " +
+                           std::to_string(s.face + 1) + " out of range [1, " + std::to_string(faces) + "]");
     }
+  }
+}
+
+void check_points(const Model& model, std::string_view source) {
+  for (std::size_t n = 0; n < model.points.size(); ++n)
+    if (!model.points[n].allFinite())
+      throw InvalidInput(std::string(source) + ": " + describe_node(model, static_cast<Index>(n)) +
+                         " has a non-finite coordinate");
+}
+
+void check_geometry(const Model& model, std::string_view source) {
+  const std::string where(source);
+  check_points(model, source);
+  auto pt = [&](Index v) -> const Point& { return model.points[static_cast<std::size_t>(v)]; };
+  for (std::size_t t = 0; t < model.tets.size(); ++t) {
+    const auto& c = model.tets[t];
+    const double volume = tet_volume(pt(c[0]), pt(c[1]), pt(c[2]), pt(c[3]));
+    if (!(volume > 0.0)) {
+      const ElementRef e{ElementKind::Tet, static_cast<Index>(t)};
+      throw InvalidInput(where + ": " + describe_element(model, e) + " is " +
+                         (volume < 0.0 ? "inverted" : "flat") + " (signed volume " +
+                         number_text(volume) + "; nodes " + node_list(model, c) + ")");
+    }
+  }
+  for (std::size_t h = 0; h < model.hexes.size(); ++h) {
+    HexCorners corners;
+    for (std::size_t c = 0; c < 8; ++c) corners[c] = pt(model.hexes[h][c]);
+    const auto jacobians = hex_jacobians(corners);
+    for (std::size_t c = 0; c < 8; ++c)
+      if (!(jacobians[c] > 0.0)) {
+        const ElementRef e{ElementKind::Hex, static_cast<Index>(h)};
+        throw InvalidInput(where + ": " + describe_element(model, e) + " is " +
+                           (jacobians[c] < 0.0 ? "inverted" : "flat") + " at its corner " +
+                           describe_node(model, model.hexes[h][c]) + " (corner Jacobian " +
+                           number_text(jacobians[c]) + "; nodes " + node_list(model, model.hexes[h]) + ")");
+      }
   }
 }
 
@@ -191,6 +303,12 @@ Index merge_coincident_nodes(Model& model, double tolerance) {
     for (Index v : set.nodes)
       if (seen.insert(v).second) unique.push_back(v);
     set.nodes = std::move(unique);
+  }
+  if (!model.node_ids.empty()) {
+    std::vector<std::int64_t> ids;
+    for (std::size_t i = 0; i < n; ++i)
+      if (representative[i] == static_cast<Index>(i)) ids.push_back(model.node_ids[i]);
+    model.node_ids = std::move(ids);
   }
   const auto removed = static_cast<Index>(n - points.size());
   model.points = std::move(points);

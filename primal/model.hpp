@@ -13,6 +13,7 @@
 #include <compare>
 #include <cstdint>
 #include <map>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -59,15 +60,47 @@ struct Model {
   std::map<int, std::string> block_names;  // optional
   std::vector<NodeSet> node_sets;
   std::vector<SideSet> side_sets;
+  // The file's own ids, for messages (Gmsh node and element tags, Exodus 1-based numbers, VTK
+  // 0-based ids as ParaView shows them). Empty means index + 1, the ids a writer gives.
+  std::vector<std::int64_t> node_ids;
+  std::vector<std::int64_t> hex_ids;
+  std::vector<std::int64_t> tet_ids;
 };
+
+// What readers check beyond the file's structure.
+struct ReadOptions {
+  // check_geometry below (else check_points only): off for tools that read connectivity
+  // alone (a mesh's dual).
+  bool check_geometry = true;
+};
+
+// The file id of a node or element (see Model::node_ids).
+std::int64_t node_id(const Model& model, Index node);
+std::int64_t element_id(const Model& model, ElementRef element);
+// For messages, in file ids with coordinates: "node 14 (0.5, 1, 0)", "hex 97 (centre (0.5,
+// 0.5, 0.5))", and a list of nodes "4 5 9 8".
+std::string describe_node(const Model& model, Index node);
+std::string describe_element(const Model& model, ElementRef element);
+std::string node_list(const Model& model, std::span<const Index> nodes);
+// Shortest text that reads back to the same double; a point as "(x, y, z)".
+std::string number_text(double x);
+std::string point_text(const Point& p);
 
 // Block id of an element, applying the empty-vector defaults above.
 int block_of(const Model& model, ElementRef element);
 
 // Throws InvalidInput naming `source` and the offending element / set entry when a node index
-// is out of range, a block vector has the wrong size, an id is not positive, or a side's face
-// number is out of range. Readers call it before returning; writers before writing.
+// is out of range, a block or file-id vector has the wrong size, an id is not positive, or a
+// side's face number is out of range. Readers call it before returning; writers before writing.
 void validate(const Model& model, std::string_view source);
+
+// A node with a NaN or infinite coordinate (every node, used or not): InvalidInput naming
+// `source` and the node by its file id, with its coordinates. Readers always check it.
+void check_points(const Model& model, std::string_view source);
+// What readers refuse beyond structure (validate): check_points, then a tet of signed volume <= 0 and a hex with a corner Jacobian <= 0
+// (topology.hpp's corner frames: inverted, flat or folded). Throws InvalidInput naming `source`
+// and the node or element by its file id, with coordinates.
+void check_geometry(const Model& model, std::string_view source);
 
 // The two parts over the model's whole point array (unused points included), so that node
 // numbers agree between the parts and the model. Every element carries its block (block_of).

@@ -110,7 +110,7 @@ TEST_CASE("find_interface: rejects non-conforming interfaces, naming the face or
     const Index gone = itf.quads[0].tets[1];
     m.tets.erase(m.tets.begin() + gone);
     m.tet_block.erase(m.tet_block.begin() + gone);
-    CHECK_THROWS_WITH_AS(find_interface(m), doctest::Contains("hex 0 face 5 (nodes 4 5 7 6) is matched by only one triangle"),
+    CHECK_THROWS_WITH_AS(find_interface(m), doctest::Contains("hex 1 (centre (0.5, 0.5, 0.5)) face (nodes 5 6 8 7) is matched by only one triangle"),
                          TopologyError);
   }
   SUBCASE("a hanging tet node in the middle of a hex face") {
@@ -126,7 +126,7 @@ TEST_CASE("find_interface: rejects non-conforming interfaces, naming the face or
       REQUIRE(tet_volume(m.points[static_cast<std::size_t>(t[0])], m.points[static_cast<std::size_t>(t[1])],
                          m.points[static_cast<std::size_t>(t[2])], m.points[static_cast<std::size_t>(t[3])]) > 0);
     CHECK_THROWS_WITH_AS(find_interface(m),
-                         doctest::Contains("node 8 of the tet part (tet 0) lies on hex 0 face 5"),
+                         doctest::Contains("node 9 (0.5, 0.5, 1) of the tet part (tet 1 (centre (0.5, 0.25, 1.25))) lies on hex 1"),
                          TopologyError);
   }
   SUBCASE("a finer hex side under one coarse tet cell") {

@@ -191,7 +191,7 @@ TEST_CASE("write_gmsh is atomic and validates indices") {
   Model bad = sample_model();
   bad.hexes[1][6] = 999;  // out of range
   CHECK_THROWS_WITH_AS(write_gmsh(bad, file),
-                       doctest::Contains("hex 1: corner 6 refers to node 999"), InvalidInput);
+                       doctest::Contains("hex 2: corner 7 refers to node index 999"), InvalidInput);
   std::ifstream in(file);
   std::stringstream text;
   text << in.rdbuf();

@@ -1,0 +1,582 @@
+// Our own reader of Gmsh .msh 2.2 and 4.1 (ASCII and binary): user files never reach libgmsh,
+// whose open() runs any text that is not a mesh as a Gmsh script. Format reference: Gmsh
+// reference manual, "MSH file format" (version 4.1) and "Legacy formats" (version 2.2).
+// Sections read: $MeshFormat, $PhysicalNames, $Entities, $Nodes, $Elements; any other section
+// is skipped up to its $End line. Counts are checked against the bytes left before anything
+// is allocated, so that a corrupt count cannot exhaust memory.
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <set>
+#include <string>
+#include <unordered_map>
+
+#include "primal/boundary.hpp"
+#include "primal/errors.hpp"
+#include "primal/file_format.hpp"
+#include "primal/io_gmsh.hpp"
+#include "primal/topology.hpp"
+
+namespace geode::primal {
+
+namespace {
+
+constexpr int kTri3 = 2, kQuad4 = 3, kTet4 = 4, kHex8 = 5;
+
+struct GmshType {
+  int type;
+  int dim;
+  int nodes;
+  const char* name;
+};
+
+// Element types as the reference manual numbers them ("MSH file format", elm-type), with
+// their dimension and node count: enough to step over any element a mesh may hold.
+constexpr GmshType kGmshTypes[] = {
+    {1, 1, 2, "2-node line"},          {2, 2, 3, "3-node triangle"},      {3, 2, 4, "4-node quadrangle"},
+    {4, 3, 4, "4-node tetrahedron"},   {5, 3, 8, "8-node hexahedron"},    {6, 3, 6, "6-node prism"},
+    {7, 3, 5, "5-node pyramid"},       {8, 1, 3, "3-node line"},          {9, 2, 6, "6-node triangle"},
+    {10, 2, 9, "9-node quadrangle"},   {11, 3, 10, "10-node tetrahedron"}, {12, 3, 27, "27-node hexahedron"},
+    {13, 3, 18, "18-node prism"},      {14, 3, 14, "14-node pyramid"},    {15, 0, 1, "1-node point"},
+    {16, 2, 8, "8-node quadrangle"},   {17, 3, 20, "20-node hexahedron"}, {18, 3, 15, "15-node prism"},
+    {19, 3, 13, "13-node pyramid"},    {20, 2, 9, "9-node triangle"},     {21, 2, 10, "10-node triangle"},
+    {22, 2, 12, "12-node triangle"},   {23, 2, 15, "15-node triangle"},   {24, 2, 15, "15-node triangle"},
+    {25, 2, 21, "21-node triangle"},   {26, 1, 4, "4-node line"},         {27, 1, 5, "5-node line"},
+    {28, 1, 6, "6-node line"},         {29, 3, 20, "20-node tetrahedron"}, {30, 3, 35, "35-node tetrahedron"},
+    {31, 3, 56, "56-node tetrahedron"}, {92, 3, 64, "64-node hexahedron"}, {93, 3, 125, "125-node hexahedron"},
+};
+
+const GmshType* gmsh_type(long long type) {
+  for (const GmshType& t : kGmshTypes)
+    if (t.type == type) return &t;
+  return nullptr;
+}
+
+struct RawElement {
+  std::int64_t tag = 0;
+  int type = 0;
+  int entity = 0;
+  int physical = 0;  // version 2.2: the element's own physical tag (0: none)
+  std::size_t first = 0;  // into MshReader::element_nodes_
+};
+
+class MshReader {
+ public:
+  MshReader(std::string_view data, std::string source) : s_(data), source_(std::move(source)) {}
+
+  Model read() {
+    if (sniff_mesh_format(s_) != MeshFileFormat::kGmsh)
+      fail_at(0, "not in Gmsh .msh format (it does not start with $MeshFormat; Gmsh scripts are not read)");
+    bool have_nodes = false, have_elements = false;
+    while (true) {
+      skip_space();
+      if (pos_ >= s_.size()) break;
+      const std::size_t start = pos_;
+      const std::string name = section_name();
+      if (name == "MeshFormat") {
+        mesh_format();
+      } else if (name == "PhysicalNames") {
+        physical_names();
+      } else if (name == "Entities") {
+        if (version_ == 2) fail_at(start, "$Entities in a version 2 file");
+        entities();
+      } else if (name == "Nodes") {
+        if (have_nodes) fail_at(start, "a second $Nodes section");
+        version_ == 4 ? nodes41() : nodes22();
+        have_nodes = true;
+      } else if (name == "Elements") {
+        if (have_elements) fail_at(start, "a second $Elements section");
+        version_ == 4 ? elements41() : elements22();
+        have_elements = true;
+      } else {
+        skip_section(name, start);
+        continue;
+      }
+      end_section(name, start);
+    }
+    if (!have_nodes) fail_at(pos_, "no $Nodes section (truncated file?)");
+    if (!have_elements) fail_at(pos_, "no $Elements section (truncated file?)");
+    return build();
+  }
+
+ private:
+  std::string_view s_;
+  std::string source_;
+  std::size_t pos_ = 0;
+  int version_ = 0;  // 2 (2.x) or 4 (4.1); 0 before $MeshFormat
+  bool binary_ = false;
+  std::map<std::pair<int, int>, std::string> physical_names_;       // (dim, tag) -> name
+  std::map<std::pair<int, int>, std::vector<int>> entity_physicals_;  // (dim, entity) -> tags
+  std::vector<std::int64_t> node_tags_;
+  std::vector<Point> node_points_;
+  std::vector<RawElement> elements_;
+  std::vector<std::int64_t> element_nodes_;
+
+  // ---- Messages --------------------------------------------------------------------------
+
+  [[noreturn]] void fail_at(std::size_t at, const std::string& what) const {
+    std::string where = source_ + ": ";
+    if (!binary_ || version_ == 0) {
+      const auto line = std::count(s_.begin(), s_.begin() + static_cast<std::ptrdiff_t>(std::min(at, s_.size())), '\n') + 1;
+      where += "line " + std::to_string(line) + ": ";
+    } else {
+      where += "byte " + std::to_string(at) + ": ";
+    }
+    throw InvalidInput(where + what);
+  }
+  [[noreturn]] void fail(const std::string& what) const { fail_at(pos_, what); }
+
+  // ---- Lexing ----------------------------------------------------------------------------
+
+  void skip_space() {
+    while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
+  }
+  std::string_view token(const char* what) {
+    skip_space();
+    const std::size_t start = pos_;
+    while (pos_ < s_.size() && !std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
+    if (start == pos_) fail(std::string("unexpected end of file reading ") + what + " (truncated file?)");
+    const std::string_view t = s_.substr(start, pos_ - start);
+    if (t.front() == '$') {
+      pos_ = start;
+      fail(std::string("expected ") + what + ", found " + std::string(t) + " (truncated section?)");
+    }
+    return t;
+  }
+  template <class T>
+  T ascii_integer(const char* what) {
+    const std::string_view t = token(what);
+    T x{};
+    const auto res = std::from_chars(t.data(), t.data() + t.size(), x);
+    if (res.ec != std::errc() || res.ptr != t.data() + t.size())
+      fail_at(pos_ - t.size(), std::string(what) + ": '" + std::string(t) + "' is not an integer in range");
+    return x;
+  }
+  double ascii_real(const char* what) {
+    std::string_view t = token(what);
+    if (t.front() == '+') t.remove_prefix(1);
+    double x = 0.0;
+    const auto res = std::from_chars(t.data(), t.data() + t.size(), x);
+    // Beyond the range of a double: infinite, refused with the node's tag by check_points.
+    if (res.ec == std::errc::result_out_of_range && res.ptr == t.data() + t.size() && !t.empty() &&
+        t.find_first_of("eE") != std::string_view::npos && t.find("e-") == std::string_view::npos &&
+        t.find("E-") == std::string_view::npos)
+      return t.front() == '-' ? -HUGE_VAL : HUGE_VAL;
+    if (res.ec == std::errc::result_out_of_range && res.ptr == t.data() + t.size()) return 0.0;  // underflow
+    if (res.ec != std::errc() || res.ptr != t.data() + t.size())
+      fail_at(pos_ - t.size(), std::string(what) + ": '" + std::string(t) + "' is not a number");
+    return x;
+  }
+  template <class T>
+  T raw(const char* what) {
+    if (s_.size() - pos_ < sizeof(T)) fail(std::string("unexpected end of file reading ") + what + " (truncated file?)");
+    T x;
+    std::memcpy(&x, s_.data() + pos_, sizeof(T));
+    pos_ += sizeof(T);
+    return x;
+  }
+  // Fields: 4-byte int, size_t (8 bytes in 4.1 binary; int in 2.2 binary), double.
+  long long int_field(const char* what) { return binary_ ? raw<std::int32_t>(what) : ascii_integer<long long>(what); }
+  long long size_field(const char* what) {
+    if (!binary_) return ascii_integer<long long>(what);
+    if (version_ == 2) return raw<std::int32_t>(what);
+    const std::uint64_t v = raw<std::uint64_t>(what);
+    if (v > static_cast<std::uint64_t>(INT64_MAX)) fail_at(pos_ - 8, std::string(what) + ": " + std::to_string(v) + " is out of range");
+    return static_cast<long long>(v);
+  }
+  double real_field(const char* what) { return binary_ ? raw<double>(what) : ascii_real(what); }
+  // A count read from the file, refused when the bytes left cannot hold `count` items of at
+  // least `min_bytes` each.
+  std::size_t count_field(const char* what, std::size_t min_bytes) {
+    const std::size_t at = pos_;
+    const long long n = size_field(what);
+    if (n < 0) fail_at(at, std::string(what) + " " + std::to_string(n) + " is negative");
+    if (static_cast<unsigned long long>(n) > (s_.size() - pos_) / std::max<std::size_t>(min_bytes, 1))
+      fail_at(at, std::string(what) + " " + std::to_string(n) + " is more than the rest of the file can hold (truncated file?)");
+    return static_cast<std::size_t>(n);
+  }
+  // Per-item minimum sizes for count_field: ASCII items are at least "d " per number.
+  std::size_t item_bytes(std::size_t ascii_numbers, std::size_t binary_bytes) const {
+    return binary_ ? binary_bytes : 2 * ascii_numbers;
+  }
+  std::size_t size_bytes() const { return version_ == 2 ? 4 : 8; }
+
+  // ---- Sections --------------------------------------------------------------------------
+
+  std::string section_name() {
+    if (s_[pos_] != '$') fail("expected a section ($Name), found '" + std::string(s_.substr(pos_, 20)) + "'");
+    const std::size_t start = ++pos_;
+    while (pos_ < s_.size() && !std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
+    const std::string name(s_.substr(start, pos_ - start));
+    // The rest of the line: binary data starts right after it.
+    while (pos_ < s_.size() && s_[pos_] != '\n' && std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
+    if (pos_ < s_.size() && s_[pos_] == '\n') ++pos_;
+    return name;
+  }
+  void end_section(const std::string& name, std::size_t start) {
+    skip_space();
+    const std::string end = "$End" + name;
+    if (s_.substr(pos_, end.size()) != end || (pos_ + end.size() < s_.size() && !std::isspace(static_cast<unsigned char>(s_[pos_ + end.size()])))) {
+      if (pos_ >= s_.size()) fail_at(start, "$" + name + " has no " + end + " (truncated file?)");
+      fail("$" + name + " ends without " + end + " (found '" + std::string(s_.substr(pos_, std::min<std::size_t>(20, s_.find('\n', pos_) - pos_))) + "')");
+    }
+    pos_ += end.size();
+  }
+  void skip_section(const std::string& name, std::size_t start) {
+    const std::string end = "$End" + name;
+    const std::size_t e = s_.find(end, pos_);
+    if (e == std::string_view::npos) fail_at(start, "$" + name + " has no " + end + " (truncated file?)");
+    pos_ = e + end.size();
+  }
+
+  void mesh_format() {
+    const std::size_t at = pos_;
+    const std::string_view v = token("the version");
+    int file_type = static_cast<int>(ascii_integer<long long>("the file type"));
+    const long long data_size = ascii_integer<long long>("the data size");
+    if (v == "4.1")
+      version_ = 4;
+    else if (v == "2" || v == "2.0" || v == "2.1" || v == "2.2")
+      version_ = 2;
+    else
+      fail_at(at, "MSH version " + std::string(v) + " is not read (versions 2.2 and 4.1 are)");
+    if (file_type != 0 && file_type != 1) fail_at(at, "file type " + std::to_string(file_type) + " is neither 0 (ASCII) nor 1 (binary)");
+    if (data_size != 8) fail_at(at, "data size " + std::to_string(data_size) + " is not read (8 is)");
+    binary_ = file_type == 1;
+    if (binary_) {
+      if (pos_ < s_.size() && s_[pos_] == '\r') ++pos_;
+      if (pos_ >= s_.size() || s_[pos_] != '\n') fail("binary $MeshFormat: no line end after the header");
+      ++pos_;
+      const std::int32_t one = raw<std::int32_t>("the endianness check");
+      if (one != 1) fail_at(pos_ - 4, "binary file of another byte order (the check integer reads " + std::to_string(one) + ")");
+    }
+  }
+
+  void physical_names() {
+    const bool was_binary = binary_;
+    binary_ = false;  // always text
+    const std::size_t n = count_field("the number of physical names", 6);
+    for (std::size_t i = 0; i < n; ++i) {
+      const int dim = static_cast<int>(ascii_integer<int>("a physical dimension"));
+      const int tag = ascii_integer<int>("a physical tag");
+      skip_space();
+      if (pos_ >= s_.size() || s_[pos_] != '"') fail("physical name " + std::to_string(tag) + ": expected a quoted name");
+      const std::size_t close = s_.find('"', pos_ + 1);
+      const std::size_t eol = s_.find('\n', pos_);
+      if (close == std::string_view::npos || close > eol) fail("physical name " + std::to_string(tag) + ": no closing quote on its line");
+      physical_names_[{dim, tag}] = std::string(s_.substr(pos_ + 1, close - pos_ - 1));
+      pos_ = close + 1;
+    }
+    binary_ = was_binary;
+  }
+
+  void entities() {
+    std::array<std::size_t, 4> counts{};
+    for (std::size_t d = 0; d < 4; ++d) counts[d] = count_field("an entity count", item_bytes(5, 36));
+    for (int dim = 0; dim < 4; ++dim)
+      for (std::size_t i = 0; i < counts[static_cast<std::size_t>(dim)]; ++i) {
+        const int tag = static_cast<int>(int_field("an entity tag"));
+        for (int k = 0; k < (dim == 0 ? 3 : 6); ++k) real_field("an entity bounding box");
+        const std::size_t np = count_field("a physical tag count", item_bytes(1, 4));
+        std::vector<int> physicals;
+        for (std::size_t p = 0; p < np; ++p) physicals.push_back(static_cast<int>(int_field("a physical tag")));
+        entity_physicals_[{dim, tag}] = std::move(physicals);
+        if (dim > 0) {
+          const std::size_t nb = count_field("a bounding entity count", item_bytes(1, 4));
+          for (std::size_t b = 0; b < nb; ++b) int_field("a bounding entity tag");
+        }
+      }
+  }
+
+  void add_node(std::int64_t tag, const Point& p) {
+    node_tags_.push_back(tag);
+    node_points_.push_back(p);
+  }
+
+  void nodes41() {
+    const std::size_t blocks = count_field("the number of node blocks", item_bytes(4, 20));
+    const std::size_t total = count_field("the number of nodes", item_bytes(4, 32));
+    size_field("the smallest node tag");
+    size_field("the largest node tag");
+    node_tags_.reserve(total);
+    node_points_.reserve(total);
+    for (std::size_t b = 0; b < blocks; ++b) {
+      const long long dim = int_field("a node block's entity dimension");
+      int_field("a node block's entity tag");
+      const long long parametric = int_field("a node block's parametric flag");
+      if (dim < 0 || dim > 3) fail("node block " + std::to_string(b + 1) + ": entity dimension " + std::to_string(dim));
+      if (parametric != 0 && parametric != 1) fail("node block " + std::to_string(b + 1) + ": parametric flag " + std::to_string(parametric));
+      const std::size_t extra = parametric ? static_cast<std::size_t>(dim) : 0;
+      const std::size_t n = count_field("a node block's node count", item_bytes(4 + extra, 32 + 8 * extra));
+      std::vector<std::int64_t> tags(n);
+      for (std::size_t i = 0; i < n; ++i) tags[i] = size_field("a node tag");
+      for (std::size_t i = 0; i < n; ++i) {
+        Point p;
+        for (int k = 0; k < 3; ++k) p[k] = real_field("a node coordinate");
+        for (std::size_t k = 0; k < extra; ++k) real_field("a parametric coordinate");
+        add_node(tags[i], p);
+      }
+    }
+    if (node_tags_.size() != total)
+      fail("$Nodes announces " + std::to_string(total) + " nodes, its blocks hold " + std::to_string(node_tags_.size()));
+  }
+
+  // A count written as text even in binary files (version 2.2), then its line end.
+  std::size_t text_count(const char* what, std::size_t ascii_min_bytes, std::size_t binary_min_bytes) {
+    const bool was_binary = binary_;
+    binary_ = false;
+    const std::size_t n = count_field(what, was_binary ? binary_min_bytes : ascii_min_bytes);
+    binary_ = was_binary;
+    if (binary_) {
+      while (pos_ < s_.size() && s_[pos_] != '\n' && std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
+      if (pos_ >= s_.size() || s_[pos_] != '\n') fail(std::string("no line end after ") + what);
+      ++pos_;
+    }
+    return n;
+  }
+
+  void nodes22() {
+    const std::size_t n = text_count("the number of nodes", 8, 28);
+    node_tags_.reserve(n);
+    node_points_.reserve(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::int64_t tag = binary_ ? raw<std::int32_t>("a node tag") : ascii_integer<long long>("a node tag");
+      Point p;
+      for (int k = 0; k < 3; ++k) p[k] = real_field("a node coordinate");
+      add_node(tag, p);
+    }
+  }
+
+  const GmshType& known_type(long long type, std::size_t at) const {
+    const GmshType* t = gmsh_type(type);
+    if (!t) fail_at(at, "element type " + std::to_string(type) + " is not a Gmsh element type this reader knows");
+    return *t;
+  }
+
+  void elements41() {
+    const std::size_t blocks = count_field("the number of element blocks", item_bytes(4, 20));
+    const std::size_t total = count_field("the number of elements", item_bytes(2, 16));
+    size_field("the smallest element tag");
+    size_field("the largest element tag");
+    elements_.reserve(total);
+    for (std::size_t b = 0; b < blocks; ++b) {
+      int_field("an element block's entity dimension");
+      const int entity = static_cast<int>(int_field("an element block's entity tag"));
+      const std::size_t at = pos_;
+      const GmshType& type = known_type(int_field("an element block's element type"), at);
+      const auto nn = static_cast<std::size_t>(type.nodes);
+      const std::size_t n = count_field("an element block's element count", item_bytes(1 + nn, 8 * (1 + nn)));
+      for (std::size_t e = 0; e < n; ++e) {
+        RawElement el{size_field("an element tag"), type.type, entity, 0, element_nodes_.size()};
+        for (std::size_t k = 0; k < nn; ++k) element_nodes_.push_back(size_field("an element's node tag"));
+        elements_.push_back(el);
+      }
+    }
+    if (elements_.size() != total)
+      fail("$Elements announces " + std::to_string(total) + " elements, its blocks hold " + std::to_string(elements_.size()));
+  }
+
+  void elements22() {
+    const std::size_t total = text_count("the number of elements", 8, 8);
+    elements_.reserve(total);
+    auto element = [&](std::int64_t tag, const GmshType& type, const std::vector<long long>& tags) {
+      RawElement el{tag, type.type, tags.size() > 1 ? static_cast<int>(tags[1]) : 0,
+                    tags.empty() ? 0 : static_cast<int>(tags[0]), element_nodes_.size()};
+      for (int k = 0; k < type.nodes; ++k) element_nodes_.push_back(int_field("an element's node tag"));
+      elements_.push_back(el);
+    };
+    std::vector<long long> tags;
+    if (!binary_) {
+      for (std::size_t e = 0; e < total; ++e) {
+        const std::int64_t tag = ascii_integer<long long>("an element tag");
+        const std::size_t at = pos_;
+        const GmshType& type = known_type(ascii_integer<long long>("an element type"), at);
+        const std::size_t nt = count_field("an element's tag count", 2);
+        tags.clear();
+        for (std::size_t k = 0; k < nt; ++k) tags.push_back(ascii_integer<long long>("an element tag"));
+        element(tag, type, tags);
+      }
+      return;
+    }
+    while (elements_.size() < total) {
+      const std::size_t at = pos_;
+      const GmshType& type = known_type(raw<std::int32_t>("an element type"), at);
+      const std::size_t nt_at = pos_ + 4;
+      const std::size_t follow = count_field("an element header's element count", 4);
+      const std::int32_t nt = raw<std::int32_t>("an element header's tag count");
+      if (nt < 0 || nt > 64) fail_at(nt_at, "element header: tag count " + std::to_string(nt));
+      if (follow > total - elements_.size()) fail_at(at, "element header: more elements than $Elements announces");
+      if (follow * (1 + static_cast<std::size_t>(nt) + static_cast<std::size_t>(type.nodes)) > (s_.size() - pos_) / 4)
+        fail_at(at, "element header: " + std::to_string(follow) + " elements are more than the rest of the file can hold (truncated file?)");
+      for (std::size_t e = 0; e < follow; ++e) {
+        const std::int64_t tag = raw<std::int32_t>("an element tag");
+        tags.clear();
+        for (std::int32_t k = 0; k < nt; ++k) tags.push_back(raw<std::int32_t>("an element tag"));
+        element(tag, type, tags);
+      }
+      if (follow == 0) fail_at(at, "element header announces no elements");
+    }
+  }
+
+  // ---- The model ---------------------------------------------------------------------------
+
+  // Physical groups of an element: its entity's (4.1) or its own tag (2.2).
+  std::vector<int> physicals_of(const RawElement& e, int dim) const {
+    if (version_ == 2) return e.physical != 0 ? std::vector<int>{e.physical} : std::vector<int>{};
+    const auto it = entity_physicals_.find({dim, e.entity});
+    return it == entity_physicals_.end() ? std::vector<int>{} : it->second;
+  }
+
+  Model build() {
+    Model model;
+    // Nodes by ascending tag; a tag listed twice must name one point.
+    std::vector<std::size_t> order(node_tags_.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return node_tags_[a] < node_tags_[b]; });
+    std::unordered_map<std::int64_t, Index> index_of;
+    index_of.reserve(order.size());
+    for (std::size_t i : order) {
+      const std::int64_t tag = node_tags_[i];
+      if (auto it = index_of.find(tag); it != index_of.end()) {
+        const Point& first = model.points[static_cast<std::size_t>(it->second)];
+        if (first != node_points_[i] && !(first.hasNaN() && node_points_[i].hasNaN()))
+          throw InvalidInput(source_ + ": node " + std::to_string(tag) + " is given twice, at " +
+                             point_text(first) + " and " + point_text(node_points_[i]));
+        continue;
+      }
+      if (tag <= 0) throw InvalidInput(source_ + ": node tag " + std::to_string(tag) + " is not positive");
+      if (model.points.size() >= static_cast<std::size_t>(INT32_MAX))
+        throw InvalidInput(source_ + ": more nodes than this reader can number");
+      index_of.emplace(tag, static_cast<Index>(model.points.size()));
+      model.points.push_back(node_points_[i]);
+      model.node_ids.push_back(tag);
+    }
+    auto node = [&](const RawElement& e, std::size_t k) {
+      const std::int64_t tag = element_nodes_[e.first + k];
+      const auto it = index_of.find(tag);
+      if (it == index_of.end())
+        throw InvalidInput(source_ + ": element " + std::to_string(e.tag) + ": corner " + std::to_string(k + 1) +
+                           " refers to node " + std::to_string(tag) + ", which is not in $Nodes");
+      return it->second;
+    };
+
+    // Volume elements, block by block (ascending block id, file order within a block).
+    struct Volume {
+      int block;
+      std::size_t element;
+    };
+    std::vector<Volume> volumes;
+    for (std::size_t i = 0; i < elements_.size(); ++i) {
+      const RawElement& e = elements_[i];
+      const GmshType& type = *gmsh_type(e.type);
+      if (type.dim != 3) continue;
+      if (e.type != kHex8 && e.type != kTet4)
+        throw InvalidInput(source_ + ": element " + std::to_string(e.tag) + ": " + type.name + " (Gmsh type " +
+                           std::to_string(e.type) + ") is not supported; only 4-node tetrahedra and 8-node hexahedra are");
+      const std::vector<int> physicals = physicals_of(e, 3);
+      int block = physicals.empty() ? e.entity : *std::min_element(physicals.begin(), physicals.end());
+      // meshio writes 0 for a missing physical and entity tag: the model's default block.
+      if (block == 0) block = e.type == kHex8 ? 1 : 2;
+      if (block < 0)
+        throw InvalidInput(source_ + ": element " + std::to_string(e.tag) + ": block (physical or entity tag) " +
+                           std::to_string(block) + " is not positive");
+      volumes.push_back({block, i});
+    }
+    std::stable_sort(volumes.begin(), volumes.end(), [](const Volume& a, const Volume& b) { return a.block < b.block; });
+    for (const Volume& v : volumes) {
+      const RawElement& e = elements_[v.element];
+      if (auto it = physical_names_.find({3, v.block}); it != physical_names_.end() && !it->second.empty())
+        model.block_names[v.block] = it->second;
+      if (e.type == kHex8) {
+        std::array<Index, 8> hex{};
+        for (std::size_t c = 0; c < 8; ++c) hex[c] = node(e, static_cast<std::size_t>(kGmshHexToVtk[c]));
+        model.hexes.push_back(hex);
+        model.hex_block.push_back(v.block);
+        model.hex_ids.push_back(e.tag);
+      } else {
+        std::array<Index, 4> tet{};
+        for (std::size_t c = 0; c < 4; ++c) tet[c] = node(e, static_cast<std::size_t>(kGmshTetToVtk[c]));
+        model.tets.push_back(tet);
+        model.tet_block.push_back(v.block);
+        model.tet_ids.push_back(e.tag);
+      }
+    }
+
+    // Lower-dimensional physical groups: side sets (dim 2), node sets (dim 0 and 1), in
+    // ascending (dim, tag) as Gmsh lists them.
+    std::map<std::pair<int, int>, std::vector<std::size_t>> groups;
+    for (const auto& [key, physicals] : entity_physicals_)
+      if (key.first < 3)
+        for (int p : physicals) groups[{key.first, p}];
+    for (std::size_t i = 0; i < elements_.size(); ++i) {
+      const int dim = gmsh_type(elements_[i].type)->dim;
+      if (dim < 3)
+        for (int p : physicals_of(elements_[i], dim)) groups[{dim, p}].push_back(i);
+    }
+    std::unordered_map<FaceKey, Side, IndexArrayHash> face_owner;
+    if (std::any_of(groups.begin(), groups.end(), [](const auto& g) { return g.first.first == 2; })) {
+      for (std::size_t h = 0; h < model.hexes.size(); ++h)
+        for (int f = 0; f < topology::kHexFaces; ++f) {
+          std::array<Index, 4> q{};
+          for (std::size_t i = 0; i < 4; ++i)
+            q[i] = model.hexes[h][static_cast<std::size_t>(topology::kHexFaceCorners[static_cast<std::size_t>(f)][i])];
+          face_owner.emplace(face_key(q), Side{{ElementKind::Hex, static_cast<Index>(h)}, f});
+        }
+      for (std::size_t t = 0; t < model.tets.size(); ++t)
+        for (int f = 0; f < 4; ++f) {
+          std::array<Index, 3> tri{};
+          for (std::size_t i = 0; i < 3; ++i)
+            tri[i] = model.tets[t][static_cast<std::size_t>(topology::kTetFaceCorners[static_cast<std::size_t>(f)][i])];
+          face_owner.emplace(face_key(tri), Side{{ElementKind::Tet, static_cast<Index>(t)}, f});
+        }
+    }
+    for (const auto& [key, members] : groups) {
+      const auto [dim, tag] = key;
+      std::string name;
+      if (auto it = physical_names_.find(key); it != physical_names_.end()) name = it->second;
+      if (dim == 2) {
+        SideSet set{tag, name, {}};
+        const std::string where = source_ + ": side set " + std::to_string(tag) + " '" + name + "'";
+        for (std::size_t i : members) {
+          const RawElement& e = elements_[i];
+          if (e.type != kTri3 && e.type != kQuad4)
+            throw InvalidInput(where + ": element " + std::to_string(e.tag) + ": " + gmsh_type(e.type)->name +
+                               " (Gmsh type " + std::to_string(e.type) +
+                               ") is not supported; only 3-node triangles and 4-node quads are");
+          std::vector<Index> face;
+          for (std::size_t k = 0; k < (e.type == kTri3 ? 3u : 4u); ++k) face.push_back(node(e, k));
+          const auto it = face_owner.find(face_key(face));
+          if (it == face_owner.end())
+            throw InvalidInput(where + ": element " + std::to_string(e.tag) + " is not a face of any hex or tet");
+          set.sides.push_back(it->second);
+        }
+        std::sort(set.sides.begin(), set.sides.end());
+        set.sides.erase(std::unique(set.sides.begin(), set.sides.end()), set.sides.end());
+        model.side_sets.push_back(std::move(set));
+      } else {
+        NodeSet set{tag, name, {}};
+        for (std::size_t i : members) {
+          const RawElement& e = elements_[i];
+          for (int k = 0; k < gmsh_type(e.type)->nodes; ++k) set.nodes.push_back(node(e, static_cast<std::size_t>(k)));
+        }
+        std::sort(set.nodes.begin(), set.nodes.end());
+        set.nodes.erase(std::unique(set.nodes.begin(), set.nodes.end()), set.nodes.end());
+        model.node_sets.push_back(std::move(set));
+      }
+    }
+    validate(model, source_);
+    return model;
+  }
+};
+
+}  // namespace
+
+Model parse_gmsh(std::string_view content, const std::string& source, const ReadOptions& options) {
+  Model model = MshReader(content, source).read();
+  options.check_geometry ? check_geometry(model, source) : check_points(model, source);
+  return model;
+}
+
+}  // namespace geode::primal

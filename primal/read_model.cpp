@@ -1,0 +1,75 @@
+#include "primal/read_model.hpp"
+
+#include <string>
+
+#include "primal/errors.hpp"
+#include "primal/file_format.hpp"
+#include "primal/io_exodus.hpp"
+#include "primal/io_gmsh.hpp"
+
+namespace geode::primal {
+
+Model model_from_vtk(const VtkGrid& grid, const ReadOptions& options) {
+  Model model;
+  model.points = grid.points;
+  for (std::size_t n = 0; n < grid.points.size(); ++n) model.node_ids.push_back(static_cast<std::int64_t>(n));
+  const std::vector<int>* blocks = nullptr;
+  std::string block_array;
+  for (const char* name : {"block", "gmsh:physical", "CellEntityIds"})
+    if ((blocks = grid.cell_data.find_int(name))) {
+      block_array = name;
+      break;
+    }
+  for (std::size_t c = 0; c < grid.cells.size(); ++c) {
+    const int type = grid.cell_types[c];
+    if (type == kVtkTriangle || type == kVtkQuad) continue;
+    if (type != kVtkHexahedron && type != kVtkTetra)
+      throw InvalidInput(grid.source + ": cell " + std::to_string(c) + ": VTK cell type " + std::to_string(type) +
+                         " is not supported; only hexahedra (12) and tetrahedra (10) are");
+    const int block = blocks ? (*blocks)[c] : (type == kVtkHexahedron ? 1 : 2);
+    if (block <= 0)
+      throw InvalidInput(grid.source + ": cell " + std::to_string(c) + ": block id " + std::to_string(block) +
+                         " (cell array '" + block_array + "') is not positive");
+    if (type == kVtkHexahedron) {
+      std::array<Index, 8> h{};
+      std::copy(grid.cells[c].begin(), grid.cells[c].end(), h.begin());
+      model.hexes.push_back(h);
+      model.hex_block.push_back(block);
+      model.hex_ids.push_back(static_cast<std::int64_t>(c));
+    } else {
+      std::array<Index, 4> t{};
+      std::copy(grid.cells[c].begin(), grid.cells[c].end(), t.begin());
+      model.tets.push_back(t);
+      model.tet_block.push_back(block);
+      model.tet_ids.push_back(static_cast<std::int64_t>(c));
+    }
+  }
+  validate(model, grid.source);
+  options.check_geometry ? check_geometry(model, grid.source) : check_points(model, grid.source);
+  return model;
+}
+
+Model read_model(const std::filesystem::path& path, const ReadOptions& options) {
+  const MeshFileFormat format = mesh_format_from_extension(path);
+  if (format == MeshFileFormat::kUnknown) {
+    (void)read_file_head(path);  // a missing file is named as such first
+    throw InvalidInput(path.string() + ": unknown input format '" + path.extension().string() +
+                       "' (expected .msh, .exo, .e, .vtu or .vtk)");
+  }
+  check_mesh_format(path, format);
+  switch (format) {
+    case MeshFileFormat::kGmsh:
+      return read_gmsh(path, options);
+    case MeshFileFormat::kExodus:
+      return read_exodus(path, options);
+    case MeshFileFormat::kVtu:
+      return model_from_vtk(read_vtu(path), options);
+    case MeshFileFormat::kVtk:
+      return model_from_vtk(read_vtk(path), options);
+    case MeshFileFormat::kUnknown:
+      break;
+  }
+  throw InvalidInput(path.string() + ": unknown input format");
+}
+
+}  // namespace geode::primal

@@ -1,0 +1,18 @@
+// libFuzzer target: the legacy .vtk reader and its conversion to a model, on arbitrary bytes.
+// InvalidInput is the expected answer to bad bytes.
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+
+#include "primal/errors.hpp"
+#include "primal/io_vtk.hpp"
+#include "primal/read_model.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  try {
+    const auto grid = geode::primal::parse_vtk(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz.vtk");
+    (void)geode::primal::model_from_vtk(grid);
+  } catch (const geode::InvalidInput&) {
+  }
+  return 0;
+}

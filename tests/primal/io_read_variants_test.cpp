@@ -1,0 +1,137 @@
+// Readers against files other programs write: VTK's own writer (every .vtu encoding: ascii,
+// binary base64, appended raw and base64, zlib-compressed, UInt64 headers; legacy .vtk),
+// meshio (.exo, .msh 2.2 ASCII and binary, .vtu, .vtk) and Gmsh's own writer (.msh 2.2 and 4.1,
+// ASCII and binary). Each must read back the mesh that was written, point for point.
+#include <doctest/doctest.h>
+
+#include <gmsh.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include "primal/errors.hpp"
+#include "primal/grid_model.hpp"
+#include "primal/io_gmsh.hpp"
+#include "primal/io_vtk.hpp"
+#include "primal/read_model.hpp"
+#include "support/fixtures.hpp"
+#include "support/temp_dir.hpp"
+
+namespace fs = std::filesystem;
+using namespace geode;
+using namespace geode::primal;
+
+namespace {
+
+// A 3 x 2 x 2 hex grid with moved interior nodes (coordinates that are not round numbers) and
+// two blocks.
+HexMesh sample_hexes() {
+  HexMesh m = test::structured_hex_grid(3, 2, 2);
+  for (std::size_t n = 0; n < m.points.size(); ++n) m.points[n] += 0.01 * Point(std::sin(1.0 * n), std::cos(2.0 * n), 0.3);
+  m.block.assign(m.hexes.size(), 1);
+  for (std::size_t h = 0; h < m.hexes.size() / 2; ++h) m.block[h] = 7;
+  return m;
+}
+
+void run_script(const std::string& kind, const fs::path& source, const fs::path& dir) {
+  const std::string script = std::string(GEODE_SOURCE_DIR) + "/tests/primal/write_variants.py";
+  const std::string cmd = "/usr/bin/python3 '" + script + "' " + kind + " '" + source.string() + "' '" + dir.string() + "'";
+  const int status = std::system(cmd.c_str());
+  // The Python packages are required (scripts/common.sh): a missing one fails the test.
+  REQUIRE_MESSAGE(status == 0, cmd);
+}
+
+void check_points(const std::vector<Point>& a, const std::vector<Point>& b, double tol) {
+  REQUIRE(a.size() == b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) CHECK((a[i] - b[i]).norm() <= tol);
+}
+
+}  // namespace
+
+TEST_CASE("VTK's own writer: every .vtu encoding and legacy .vtk read back the same mesh") {
+  test::TempDir dir;
+  const HexMesh m = sample_hexes();
+  const fs::path source = dir.path / "source.vtu";
+  write_vtu(source, m);
+  run_script("vtk", source, dir.path);
+  for (const std::string name : {"ascii.vtu", "binary.vtu", "binary-zlib.vtu", "appended-raw.vtu", "appended-base64.vtu",
+                           "appended-raw-zlib.vtu", "binary-zlib-uint64.vtu", "appended-base64-zlib-uint64.vtu",
+                           "legacy-ascii.vtk", "legacy-binary.vtk"}) {
+    CAPTURE(name);
+    const VtkGrid g = read_vtk_file(dir.path / name);
+    const HexMesh back = to_hex_mesh(g);
+    // Float64 throughout: exact, but for VTK's legacy text writer, which prints fewer digits.
+    check_points(back.points, m.points, name.ends_with(".vtk") ? 1e-10 : 0.0);
+    CHECK(back.hexes == m.hexes);
+    CHECK(back.block == m.block);
+    REQUIRE(g.cell_data.find_double("scaled_jacobian") != nullptr);
+    // The same file as a model: blocks from the "block" array, VTK's 0-based ids.
+    const Model model = read_model(dir.path / name);
+    CHECK(model.hexes == m.hexes);
+    CHECK(model.hex_block == m.block);
+    CHECK(describe_node(model, 0).rfind("node 0 (", 0) == 0);
+  }
+}
+
+TEST_CASE("meshio's files: .exo, .msh 2.2 ASCII and binary, .vtu, .vtk read as models") {
+  test::TempDir dir;
+  const HexMesh m = sample_hexes();
+  const fs::path source = dir.path / "source.vtu";
+  write_vtu(source, m);
+  run_script("meshio", source, dir.path);
+  for (const std::string name : {"meshio.exo", "meshio-22-ascii.msh", "meshio-22-binary.msh", "meshio.vtu",
+                           "meshio-ascii.vtu", "meshio.vtk"}) {
+    CAPTURE(name);
+    const Model model = read_model(dir.path / name);
+    // meshio's text formats print fewer digits than a double holds.
+    check_points(model.points, m.points, 1e-10);
+    CHECK(model.hexes == m.hexes);
+    CHECK(model.tets.empty());
+  }
+}
+
+TEST_CASE("Gmsh's own writer: .msh 2.2 and 4.1, ASCII and binary, read back the same model") {
+  test::TempDir dir;
+  Model m = grid_model({2, 2, 1}, 0.5, [](int i, int, int) { return i >= 1; });
+  m.points[4] += Point(0.01, -0.02, 0.03);
+  m.block_names[1] = "steel";
+  m.side_sets.push_back({21, "outside", {{{ElementKind::Hex, 0}, 4}, {{ElementKind::Tet, 0}, 3}}});
+  const fs::path ours = dir.path / "ours.msh";
+  write_gmsh(m, ours);
+  for (const double version : {2.2, 4.1})
+    for (const int binary : {0, 1}) {
+      CAPTURE(version);
+      CAPTURE(binary);
+      const fs::path file = dir.path / ("gmsh-" + std::to_string(version) + "-" + std::to_string(binary) + ".msh");
+      {
+        GmshSession session;
+        gmsh::open(ours.string());  // our own file, written above: never a user's
+        gmsh::option::setNumber("Mesh.MshFileVersion", version);
+        gmsh::option::setNumber("Mesh.Binary", binary);
+        // Version 2.2 with SaveAll writes every element with physical tag 0; without it, every
+        // element of a physical group (all of ours are) with the group's tag.
+        gmsh::option::setNumber("Mesh.SaveAll", version > 4 ? 1 : 0);
+        gmsh::write(file.string());
+      }
+      const Model back = read_gmsh(file);
+      check_points(back.points, m.points, 0.0);
+      CHECK(back.hexes == m.hexes);
+      CHECK(back.tets == m.tets);
+      CHECK(back.hex_block == std::vector<int>(m.hexes.size(), 1));
+      CHECK(back.block_names == m.block_names);
+      REQUIRE(back.side_sets.size() == 1);
+      CHECK(back.side_sets[0].id == 21);
+      CHECK(back.side_sets[0].sides == m.side_sets[0].sides);
+      // Tags are the file ids: our writer numbers from 1 and Gmsh keeps that in 4.1 (in 2.2 it
+      // renumbers elements its own way).
+      CHECK(back.node_ids.front() == 1);
+      if (version > 4) CHECK(back.hex_ids.front() == 1);
+      std::vector<std::int64_t> ids = back.hex_ids;
+      ids.insert(ids.end(), back.tet_ids.begin(), back.tet_ids.end());
+      std::sort(ids.begin(), ids.end());
+      CHECK(std::adjacent_find(ids.begin(), ids.end()) == ids.end());
+      CHECK(ids.front() >= 1);
+    }
+}
