@@ -98,6 +98,27 @@ primal::SmoothResult smooth_node_patches(primal::HexMesh& mesh,
   return total;
 }
 
+// The map of the reference cell into a buffer hex: bilinear on the bottom (the hex side's
+// quad), piecewise linear over the two triangles of the top (so the tet side's diced nodes,
+// edge midpoints and triangle centroids, are images of the template's), linear in t between
+// them. The trilinear map would instead follow a twisted top's bilinear surface, whose
+// diagonal midpoint passes the template nodes under it; this one keeps every template hex
+// positive wherever the buffer hex is valid.
+Point buffer_map(const std::array<Point, 8>& P, const std::array<int, 2>& diagonal, const Point& rst) {
+  const double r = rst.x(), s = rst.y(), t = rst.z();
+  const Point bottom = primal::multilinear_point(P, Point(r, s, 0.0), 2);
+  // Top corners 4..7 at (r, s) = (0,0), (1,0), (1,1), (0,1).
+  Point top;
+  if (diagonal[0] == 4) {  // split 4-6: the line r = s
+    top = r >= s ? P[4] + r * (P[5] - P[4]) + s * (P[6] - P[5])
+                 : P[4] + s * (P[7] - P[4]) + r * (P[6] - P[7]);
+  } else {  // split 5-7: the line r + s = 1
+    top = r + s <= 1 ? P[4] + r * (P[5] - P[4]) + s * (P[7] - P[4])
+                     : P[6] + (1 - r) * (P[7] - P[6]) + (1 - s) * (P[5] - P[6]);
+  }
+  return (1 - t) * bottom + t * top;
+}
+
 // conform()'s stages, in the order run() calls them; each reads what the previous ones left.
 class Conformer {
  public:
@@ -216,7 +237,7 @@ void Conformer::place_templates() {
     inst_global_[b].assign(n, kInvalidIndex);
     inst_side_[b].assign(n, kInvalidIndex);
     for (std::size_t i = 0; i < n; ++i) {
-      const Point x = primal::multilinear_point(P, rt.rst[i], 3);
+      const Point x = buffer_map(P, bh.diagonal, rt.rst[i]);
       if (!rt.key_corners[i].empty()) {
         FaceKey key = kNoOrigin;
         for (std::size_t k = 0; k < rt.key_corners[i].size(); ++k)
