@@ -45,6 +45,7 @@ struct ConformArgs {
   std::string output;
   std::string report;
   std::string smooth = "local";
+  std::string quality = "sj";
   std::string model = "half";
   std::string save_input;
   int n = 4;
@@ -99,6 +100,7 @@ void run(const primal::Model& model, const ConformArgs& a, bool tables,
          const std::string& source = {}) {
   conform::ConformOptions opts;
   opts.smooth = conform::parse_conform_smooth(a.smooth);
+  opts.quality = conform::parse_conform_quality(a.quality);
   if (!a.quiet && isatty(STDERR_FILENO)) {
     opts.progress = [](const std::string& line) { std::cerr << "geode: " << line << "\n"; };
     // Local smoothing is the long step: a bar redrawn in place, at most ten times a second.
@@ -139,6 +141,11 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
   c->add_option("--smooth", a.smooth,
                 "local: the buffer layer and one ring around it (default); global: every node; none")
       ->check(CLI::IsMember({"local", "global", "none"}))
+      ->capture_default_str();
+  c->add_option("--quality", a.quality,
+                "sj: validity and the scaled Jacobian per block (default, cheap); full: every "
+                "metric of the paper's Table 1 per block")
+      ->check(CLI::IsMember({"sj", "full"}))
       ->capture_default_str();
   c->add_flag("--quiet", a.quiet, "no progress and no summary");
 }
