@@ -27,6 +27,13 @@ enum class ConformSmooth { kNone, kLocal, kGlobal };
 // "local", "global" or "none"; InvalidInput naming the word otherwise.
 ConformSmooth parse_conform_smooth(const std::string& word);
 
+// What the verification reports per block besides validity: the scaled Jacobian alone
+// (cheap), or every metric of the paper's Table 1 (primal/quality_report.hpp).
+enum class ConformQuality { kScaledJacobian, kFull };
+
+// "sj" or "full"; InvalidInput naming the word otherwise.
+ConformQuality parse_conform_quality(const std::string& word);
+
 struct ConformOptions {
   BufferLayerOptions buffer;
   double interface_tolerance = 1e-6;  // find_interface: relative to the local edge length
@@ -39,6 +46,7 @@ struct ConformOptions {
   // kLocal: nodes of the geode hexes and of the hexes around them (one ring) move, the rest is
   // fixed. kGlobal: every node moves. Model boundary nodes are fixed in both.
   ConformSmooth smooth = ConformSmooth::kLocal;
+  ConformQuality quality = ConformQuality::kScaledJacobian;
   primal::SmoothOptions smooth_options;  // kGlobal
   // kLocal patches start from the smoothed reference template mapped into the buffer hex, so
   // the blunt soft-minimum stages (sharpness 10-40) only spread changes that the sharp ones
@@ -81,7 +89,7 @@ struct ConformResult {
   double min_scaled_jacobian_before_smoothing = 0.0;
   primal::SmoothResult smoothing;  // zero-initialised when ConformSmooth::kNone
   primal::HexValidityReport validity;
-  std::vector<BlockQuality> quality;  // one per non-empty block
+  std::vector<BlockQuality> quality;  // one per non-empty block (ConformOptions::quality)
   std::vector<std::string> warnings;  // e.g. "3 hexes with scaled Jacobian <= 0: 12 40 ..."
   double seconds = 0.0;
 };
