@@ -220,19 +220,26 @@ namespace {
 
 Template build(const GeodeOptions& o, int dim) {
   const GeodeArrangement G = geode_arrangement(o, dim);
-  const auto& sheets = G.sheets;
-  const stc::Domain& dom = G.domain;
+  const stc::Arrangement A = stc::compute_arrangement(G.sheets, G.domain, o.arrangement);
+  const stc::DualMesh D = stc::dualize(A);
+  Template T = template_from_dual(D, G.sheets, G.domain, {dice_patch(G.hex_side), "hex-side"},
+                                  {dice_patch(G.tet_side), "tet-side"}, o.box);
+  T.checks = check_interleave(A, T.sheets, G.sheets);
+  return T;
+}
+
+}  // namespace
+
+Template template_from_dual(const stc::DualMesh& D, const std::vector<stc::Sheet>& sheets, const stc::Domain& dom,
+                            const PrescribedFace& bottom, const PrescribedFace& top, const Eigen::Vector3d& box) {
+  const int dim = D.dim;
   Template T;
   T.dim = dim;
   for (const auto& s : sheets) T.sheets.push_back({s.name, s.kind});
-  const stc::Arrangement A = stc::compute_arrangement(sheets, dom, o.arrangement);
-  T.checks = check_interleave(A, T.sheets, sheets);
-  const stc::DualMesh D = stc::dualize(A);
-
   std::vector<Point> pts = dim == 3 ? D.hex.points : D.quad.points;
-  place_interface(D, sheets, dice_patch(G.hex_side), stc::box_face(1, false), dom, pts, "hex-side");
-  place_interface(D, sheets, dice_patch(G.tet_side), stc::box_face(1, true), dom, pts, "tet-side");
-  for (auto& q : pts) q = to_box(q, o.box, dim);
+  place_interface(D, sheets, bottom.cells, stc::box_face(1, false), dom, pts, bottom.name);
+  place_interface(D, sheets, top.cells, stc::box_face(1, true), dom, pts, top.name);
+  for (auto& q : pts) q = to_box(q, box, dim);
   if (dim == 3) {
     T.hex.hexes = D.hex.hexes;
     T.hex.points = pts;
@@ -245,8 +252,6 @@ Template build(const GeodeOptions& o, int dim) {
   T.node_signs = D.node_signs;
   return T;
 }
-
-}  // namespace
 
 Template build_geode3d(const GeodeOptions& options) { return build(options, 3); }
 Template build_geode2d(const GeodeOptions& options) { return build(options, 2); }
