@@ -14,6 +14,7 @@
 #include "primal/quality.hpp"
 #include "primal/quality_report.hpp"
 #include "templates/geode.hpp"
+#include "templates/refine.hpp"
 
 namespace geode::cli {
 namespace {
@@ -29,6 +30,8 @@ struct TemplateArgs {
   bool no_smooth = false;
   bool quality = false;
   templates::PushParameters push;
+  templates::RefineOptions refine;
+  bool refine_roofs = false;  // --high-roof / --low-roof given: they apply to refine3 too
 };
 
 // The paper's Table 2 layout: three column groups of "Node x y z", 1-based.
@@ -124,6 +127,7 @@ nlohmann::json to_json(const templates::Template& T, const std::string& name) {
     for (int s : sheets) names.push_back(T.sheets[static_cast<std::size_t>(s)].name);
     j["intersections"].push_back({{"sheets", names}, {"elements", count}});
   }
+  if (name.rfind("refine", 0) == 0) return j;  // the paper's conditions are about domes
   j["checks"] = {{"triple_domes_in_pocket", T.checks.triple_domes_in_pocket},
                  {"dome_curves_exit_in_tunnels", T.checks.dome_curves_exit_in_tunnels},
                  {"failures", T.checks.failures}};
@@ -137,22 +141,30 @@ void run_template(const TemplateArgs& a) {
   o.higher = a.higher == "z" ? templates::Higher::Z : templates::Higher::X;
   o.push = a.push;
   templates::Template T;
-  if (a.name == "geode2d") {
+  const bool refine = a.name == "refine3" || a.name == "refine3-2d";
+  templates::RefineOptions ro = a.refine;
+  ro.box = o.box;
+  if (a.refine_roofs) ro.high_roof = a.push.high_roof, ro.low_roof = a.push.low_roof;
+  if (refine) {
+    T = a.name == "refine3" ? templates::build_refine3(ro) : templates::build_refine3_2d(ro);
+  } else if (a.name == "geode2d") {
     T = templates::build_geode2d(o);
   } else {
     if (a.name == "geode4tri") o.split = templates::TopSplit::FourTriangles;
     T = templates::build_geode3d(o);
   }
-  if (!T.checks.ok() && a.name != "geode2d") {
+  if (!refine && !T.checks.ok() && a.name != "geode2d") {
     std::string why;
     for (const auto& f : T.checks.failures) why += (why.empty() ? "" : "; ") + f;
     std::cerr << "geode: warning: the interleave fails the paper's conditions: " << why << "\n";
   }
   std::string smooth_note;
   if (!a.no_smooth) {
-    const auto r = templates::smooth_template(T, a.slide);
+    const auto r = refine ? templates::smooth_refine3(T, ro, !a.slide) : templates::smooth_template(T, a.slide);
     std::ostringstream s;
-    s << "smoothing (" << (a.slide ? "tet/hex-side nodes slide" : "tet/hex-side nodes fixed") << "): min scaled Jacobian "
+    s << "smoothing (" << (refine ? (a.slide ? "side nodes slide" : "side faces fixed at the 2D template")
+                                  : (a.slide ? "tet/hex-side nodes slide" : "tet/hex-side nodes fixed"))
+      << "): min scaled Jacobian "
       << r.initial_min_scaled_jacobian << " -> " << r.final_min_scaled_jacobian << " in " << r.iterations
       << " iterations, " << r.seconds << " s";
     smooth_note = s.str();
@@ -205,9 +217,11 @@ void add_template_command(CLI::App& app) {
       "puts them; the rest are placed by optimization unless --no-smooth.");
   t->add_option("NAME", args->name,
                 "geode3d: the 26-hex geode (tet side split by a diagonal into 2 triangles);\n"
-                "geode2d: the 5-quad 2D geode; geode4tri: the tet side split into 4 triangles")
+                "geode2d: the 5-quad 2D geode; geode4tri: the tet side split into 4 triangles;\n"
+                "refine3: one coarse quad on top over 3 x 3 fine quads below (13 hexes); refine3-2d: one\n"
+                "coarse edge over three fine ones (4 quads)")
       ->required()
-      ->check(CLI::IsMember({"geode3d", "geode2d", "geode4tri"}));
+      ->check(CLI::IsMember({"geode3d", "geode2d", "geode4tri", "refine3", "refine3-2d"}));
   t->add_option("--box", args->box, "buffer cell WIDTHxHEIGHTxDEPTH (x, y up, z), centred at the origin; tet side on top")
       ->capture_default_str();
   t->add_option("--diagonal", args->diagonal,
@@ -223,18 +237,30 @@ void add_template_command(CLI::App& app) {
       ->check(CLI::IsMember({"appendix", "csv", "json", "vtu"}))
       ->capture_default_str();
   t->add_option("-o,--output", args->output, "write to FILE (atomically) instead of standard output");
-  t->add_flag("--slide", args->slide, "let tet- and hex-side nodes slide within their faces while smoothing");
+  t->add_flag("--slide", args->slide,
+              "let tet- and hex-side nodes slide within their faces while smoothing; refine3: let the side\n"
+              "faces' nodes slide instead of fixing them at the smoothed 2D template (neighbours then need\n"
+              "not match)");
   t->add_flag("--no-smooth", args->no_smooth, "keep the dual's first-guess positions");
   t->add_flag("--quality", args->quality, "append the quality report (the paper's Table 1 metrics)");
-  t->add_option("--high-roof", args->push.high_roof, "push: higher tunnel roof, fraction of the height")->capture_default_str();
-  t->add_option("--low-roof", args->push.low_roof, "push: lower tunnel roof, fraction of the height")->capture_default_str();
+  t->add_option("--high-roof", args->push.high_roof,
+                "push: higher tunnel roof, fraction of the height (refine3: the tunnel along x; default 0.75 there)")
+      ->capture_default_str();
+  t->add_option("--low-roof", args->push.low_roof,
+                "push: lower tunnel roof, fraction of the height (refine3: the tunnel along z; default 0.6 there)")
+      ->capture_default_str();
+  t->add_option("--layer", args->refine.layer, "refine3: height of the horizontal layer sheet, below both roofs")
+      ->capture_default_str();
   t->add_option("--dome-depth", args->push.dome_depth, "push: how far below the tet side the domes reach, fraction of the height")
       ->capture_default_str();
   t->add_option("--dome-radius", args->push.dome_radius,
                 "push: where each dome's circle crosses the diced tet side, 0..1 between the nodes it\n"
                 "must enclose and the nearest it must leave out")
       ->capture_default_str();
-  t->callback([args] { run_template(*args); });
+  t->callback([args, t] {
+    args->refine_roofs = t->count("--high-roof") + t->count("--low-roof") > 0;
+    run_template(*args);
+  });
 }
 
 }  // namespace geode::cli

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "primal/io_vtk.hpp"
+#include "primal/validity.hpp"
 #include "support/cli_run.hpp"
 #include "support/fixtures.hpp"
 #include "support/isomorphism.hpp"
@@ -95,4 +96,22 @@ TEST_CASE("geode template: bad input exits non-zero with nothing written") {
   CHECK(geode_cli("template geode3d --dome-depth 0.3 -o " + out.string()).code == 3);  // diagnosis
   CHECK(geode_cli("template geode3d --format vtu").code == 2);                         // needs -o
   CHECK_FALSE(std::filesystem::exists(out));
+}
+
+TEST_CASE("geode template refine3: the 13-hex refinement template, valid and untangled") {
+  const Run r = geode_cli("template refine3 --format json");
+  REQUIRE(r.code == 0);
+  const auto j = nlohmann::json::parse(r.out);
+  std::vector<primal::Point> pts;
+  for (const auto& p : j["nodes"]) pts.emplace_back(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
+  std::vector<std::array<int, 8>> hexes;
+  for (const auto& h : j["hexes"]) hexes.push_back(h.get<std::array<int, 8>>());
+  CHECK(hexes.size() == 13);
+  CHECK(j["sheets"].size() == 5);
+  CHECK_FALSE(j.contains("checks"));
+  CHECK(primal::check_validity(hex_from_tables(pts, hexes)).ok());
+  const Run q = geode_cli("template refine3-2d --quality");
+  REQUIRE(q.code == 0);
+  CHECK(q.out.find("Table 3: Connectivity (4 quads)") != std::string::npos);
+  CHECK(geode_cli("template refine3 --layer 0.9").code == 2);  // above both roofs
 }
