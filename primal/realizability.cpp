@@ -1,0 +1,551 @@
+#include "primal/realizability.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <functional>
+#include <map>
+#include <set>
+#include <string>
+#include <unordered_map>
+
+#include "primal/boundary.hpp"
+#include "primal/errors.hpp"
+#include "primal/topology.hpp"
+
+namespace geode::primal {
+
+namespace topo = topology;
+
+std::string_view to_string(ObstructionKind kind) {
+  switch (kind) {
+    case ObstructionKind::kDoublet: return "doublet";
+    case ObstructionKind::kPinchedCorner: return "pinched-corner";
+    case ObstructionKind::kTwoFacesOnBoundaryFace: return "two-faces-on-boundary-face";
+    case ObstructionKind::kFlatCorner: return "flat-corner";
+    case ObstructionKind::kTwoQuadBoundaryNode: return "two-quad-boundary-node";
+  }
+  return "unknown";
+}
+
+namespace {
+
+constexpr Index kNoPatch = -1;
+
+template <std::size_t N>
+bool has_repeated(const std::array<Index, N>& a) {
+  for (std::size_t i = 0; i < N; ++i)
+    for (std::size_t j = i + 1; j < N; ++j)
+      if (a[i] == a[j]) return true;
+  return false;
+}
+
+template <std::size_t N>
+void check_range(const std::array<Index, N>& cell, std::size_t nodes, const char* what, std::size_t id) {
+  for (Index v : cell)
+    if (v < 0 || static_cast<std::size_t>(v) >= nodes)
+      throw InvalidInput(std::string(what) + " " + std::to_string(id) + ": node " + std::to_string(v) +
+                         " out of range [0, " + std::to_string(nodes) + ")");
+}
+
+void sort_unique(std::vector<Index>& v) {
+  std::sort(v.begin(), v.end());
+  v.erase(std::unique(v.begin(), v.end()), v.end());
+}
+
+double bbox_diagonal(const std::vector<Point>& points) {
+  if (points.empty()) return 0.0;
+  Point lo = points.front(), hi = points.front();
+  for (const auto& p : points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  return (hi - lo).norm();
+}
+
+// Region growing: element i joins the patch of seed s (reached through `neighbours`) when
+// fits(s, i); elements that cannot seed (flat(i) false) stay on no patch. Patches are numbered
+// by their seed's order, so the result does not depend on hashing.
+std::vector<Index> grow_patches(std::size_t n, const std::function<std::vector<Index>(Index)>& neighbours,
+                                const std::function<bool(Index)>& flat, const std::function<bool(Index, Index)>& fits) {
+  std::vector<Index> patch(n, kNoPatch);
+  Index next = 0;
+  for (std::size_t s = 0; s < n; ++s) {
+    const auto seed = static_cast<Index>(s);
+    if (patch[s] != kNoPatch || !flat(seed)) continue;
+    patch[s] = next;
+    std::deque<Index> queue{seed};
+    while (!queue.empty()) {
+      const Index e = queue.front();
+      queue.pop_front();
+      for (Index o : neighbours(e)) {
+        auto& p = patch[static_cast<std::size_t>(o)];
+        if (p != kNoPatch || !flat(o) || !fits(seed, o)) continue;
+        p = next;
+        queue.push_back(o);
+      }
+    }
+    ++next;
+  }
+  return patch;
+}
+
+bool contains(const std::vector<Index>& sorted, Index x) { return std::binary_search(sorted.begin(), sorted.end(), x); }
+
+// Nodes' planar faces from the template's bits: face f for bit f.
+std::vector<std::vector<Index>> node_patches_from_bits(const std::vector<unsigned>& bits) {
+  std::vector<std::vector<Index>> out(bits.size());
+  for (std::size_t v = 0; v < bits.size(); ++v)
+    for (unsigned f = 0; f < 32; ++f)
+      if ((bits[v] >> f) & 1u) out[v].push_back(static_cast<Index>(f));
+  return out;
+}
+
+// The planar face all of `nodes` lie on by their bits (the lowest if several), or kNoPatch.
+template <std::size_t N>
+Index patch_from_bits(const std::vector<unsigned>& bits, const std::array<Index, N>& nodes) {
+  unsigned common = ~0u;
+  for (Index v : nodes) common &= bits[static_cast<std::size_t>(v)];
+  for (unsigned f = 0; f < 32; ++f)
+    if ((common >> f) & 1u) return static_cast<Index>(f);
+  return kNoPatch;
+}
+
+// ---- Hex meshes ----------------------------------------------------------------------------
+
+class HexFinder {
+ public:
+  HexFinder(const HexMesh& mesh, const RealizabilityOptions& options) : mesh_(mesh), options_(options) {}
+
+  std::vector<Obstruction> run() {
+    collect_faces();
+    find_patches();
+    find_doublets();
+    find_pinched_corners();
+    find_two_faces();
+    find_flat_corners();
+    find_two_quad_nodes();
+    std::vector<Obstruction> out;
+    for (auto* list : {&doublets_, &pinched_, &two_faces_, &flat_, &two_quad_}) out.insert(out.end(), list->begin(), list->end());
+    return out;
+  }
+
+ private:
+  struct Face {
+    std::array<Index, 4> nodes{};  // as the first hex using it sees it
+    std::vector<std::pair<Index, int>> uses;  // (hex, local face)
+  };
+
+  void collect_faces() {
+    const std::size_t nv = mesh_.points.size();
+    if (!options_.node_faces.empty() && options_.node_faces.size() != nv)
+      throw InvalidInput("realizability: node_faces has " + std::to_string(options_.node_faces.size()) +
+                         " entries for " + std::to_string(nv) + " nodes");
+    std::unordered_map<FaceKey, Index, IndexArrayHash> face_id;
+    for (std::size_t h = 0; h < mesh_.hexes.size(); ++h) {
+      const auto& hex = mesh_.hexes[h];
+      check_range(hex, nv, "hex", h);
+      if (has_repeated(hex)) continue;
+      for (int f = 0; f < topo::kHexFaces; ++f) {
+        std::array<Index, 4> q{};
+        for (int i = 0; i < 4; ++i) q[static_cast<std::size_t>(i)] = hex[static_cast<std::size_t>(topo::kHexFaceCorners[static_cast<std::size_t>(f)][static_cast<std::size_t>(i)])];
+        const auto [it, inserted] = face_id.try_emplace(face_key(q), static_cast<Index>(faces_.size()));
+        if (inserted) faces_.push_back(Face{q, {}});
+        faces_[static_cast<std::size_t>(it->second)].uses.emplace_back(static_cast<Index>(h), f);
+      }
+    }
+    for (std::size_t f = 0; f < faces_.size(); ++f)
+      if (faces_[f].uses.size() == 1) boundary_.push_back(static_cast<Index>(f));
+  }
+
+  // Patch of each boundary quad (index into boundary_) and the patches at each node.
+  void find_patches() {
+    const std::size_t nb = boundary_.size();
+    node_patches_.assign(mesh_.points.size(), {});
+    boundary_quads_at_.assign(mesh_.points.size(), {});
+    for (std::size_t b = 0; b < nb; ++b)
+      for (Index v : face(b).nodes) boundary_quads_at_[static_cast<std::size_t>(v)].push_back(static_cast<Index>(b));
+    if (!options_.node_faces.empty()) {
+      quad_patch_.resize(nb);
+      for (std::size_t b = 0; b < nb; ++b) quad_patch_[b] = patch_from_bits(options_.node_faces, face(b).nodes);
+      node_patches_ = node_patches_from_bits(options_.node_faces);
+      return;
+    }
+    const double tol = options_.planar_distance * bbox_diagonal(mesh_.points);
+    const double cos_tol = std::cos(options_.planar_angle_degrees * M_PI / 180.0);
+    std::vector<Point> normal(nb), centre(nb);
+    std::vector<char> flat(nb, 0);
+    auto pt = [&](Index v) -> const Point& { return mesh_.points[static_cast<std::size_t>(v)]; };
+    auto off_plane = [&](std::size_t plane, std::size_t quad) {
+      double d = 0.0;
+      for (Index v : face(quad).nodes) d = std::max(d, std::abs(normal[plane].dot(pt(v) - centre[plane])));
+      return d;
+    };
+    for (std::size_t b = 0; b < nb; ++b) {
+      const auto& q = face(b).nodes;
+      const Point n = (pt(q[2]) - pt(q[0])).cross(pt(q[3]) - pt(q[1]));
+      centre[b] = 0.25 * (pt(q[0]) + pt(q[1]) + pt(q[2]) + pt(q[3]));
+      if (!(n.norm() > 0.0)) continue;
+      normal[b] = n.normalized();
+      flat[b] = off_plane(b, b) <= tol;
+    }
+    // Boundary quads sharing an edge.
+    std::unordered_map<EdgeKey, std::vector<Index>, IndexArrayHash> by_edge;
+    for (std::size_t b = 0; b < nb; ++b) {
+      const auto& q = face(b).nodes;
+      for (int i = 0; i < 4; ++i) by_edge[edge_key(q[static_cast<std::size_t>(i)], q[static_cast<std::size_t>((i + 1) % 4)])].push_back(static_cast<Index>(b));
+    }
+    quad_patch_ = grow_patches(
+        nb,
+        [&](Index b) {
+          std::vector<Index> out;
+          const auto& q = face(static_cast<std::size_t>(b)).nodes;
+          for (int i = 0; i < 4; ++i)
+            for (Index o : by_edge.at(edge_key(q[static_cast<std::size_t>(i)], q[static_cast<std::size_t>((i + 1) % 4)])))
+              if (o != b) out.push_back(o);
+          return out;
+        },
+        [&](Index b) { return flat[static_cast<std::size_t>(b)] != 0; },
+        [&](Index s, Index b) {
+          const auto su = static_cast<std::size_t>(s), bu = static_cast<std::size_t>(b);
+          return normal[su].dot(normal[bu]) >= cos_tol && off_plane(su, bu) <= tol;
+        });
+    for (std::size_t b = 0; b < nb; ++b)
+      if (quad_patch_[b] != kNoPatch)
+        for (Index v : face(b).nodes) node_patches_[static_cast<std::size_t>(v)].push_back(quad_patch_[b]);
+    for (auto& p : node_patches_) sort_unique(p);
+  }
+
+  // Interior edges in fewer than three hexes, merged by their pair of hexes.
+  void find_doublets() {
+    std::unordered_map<EdgeKey, std::vector<Index>, IndexArrayHash> edge_hexes;
+    std::vector<EdgeKey> order;
+    for (std::size_t h = 0; h < mesh_.hexes.size(); ++h) {
+      const auto& hex = mesh_.hexes[h];
+      if (has_repeated(hex)) continue;
+      for (const auto& e : topo::kHexEdgeCorners) {
+        const EdgeKey k = edge_key(hex[static_cast<std::size_t>(e[0])], hex[static_cast<std::size_t>(e[1])]);
+        auto [it, inserted] = edge_hexes.try_emplace(k);
+        if (inserted) order.push_back(k);
+        it->second.push_back(static_cast<Index>(h));
+      }
+    }
+    std::unordered_map<EdgeKey, bool, IndexArrayHash> on_boundary;
+    for (Index f : boundary_) {
+      const auto& q = faces_[static_cast<std::size_t>(f)].nodes;
+      for (int i = 0; i < 4; ++i) on_boundary[edge_key(q[static_cast<std::size_t>(i)], q[static_cast<std::size_t>((i + 1) % 4)])] = true;
+    }
+    std::map<std::vector<Index>, std::size_t> by_hexes;
+    for (const auto& k : order) {
+      auto hexes = edge_hexes.at(k);
+      sort_unique(hexes);
+      if (hexes.size() >= 3 || on_boundary.count(k)) continue;
+      auto [it, inserted] = by_hexes.try_emplace(hexes, doublets_.size());
+      if (inserted) doublets_.push_back(Obstruction{ObstructionKind::kDoublet, hexes, {}});
+      auto& nodes = doublets_[it->second].nodes;
+      nodes.insert(nodes.end(), k.begin(), k.end());
+      sort_unique(nodes);
+      for (Index v : k) doublet_ends_.emplace(v, it->second);
+    }
+  }
+
+  // Distinct faces sharing both edges va, vb at a node v.
+  void find_pinched_corners() {
+    std::map<std::array<Index, 3>, std::vector<Index>> by_corner;  // (v, min(a, b), max(a, b)) -> faces
+    std::vector<std::array<Index, 3>> order;
+    for (std::size_t f = 0; f < faces_.size(); ++f) {
+      const auto& q = faces_[f].nodes;
+      for (int i = 0; i < 4; ++i) {
+        const Index v = q[static_cast<std::size_t>(i)], a = q[static_cast<std::size_t>((i + 3) % 4)],
+                    b = q[static_cast<std::size_t>((i + 1) % 4)];
+        const std::array<Index, 3> key{v, std::min(a, b), std::max(a, b)};
+        auto& list = by_corner[key];
+        if (list.empty()) order.push_back(key);
+        list.push_back(static_cast<Index>(f));
+      }
+    }
+    for (const auto& key : order) {
+      const auto& list = by_corner.at(key);
+      if (list.size() < 2) continue;
+      std::vector<Index> hexes;
+      for (Index f : list)
+        for (const auto& [h, lf] : faces_[static_cast<std::size_t>(f)].uses) hexes.push_back(h);
+      sort_unique(hexes);
+      if (explained_by_doublet(key[0], hexes)) continue;
+      pinched_.push_back(Obstruction{ObstructionKind::kPinchedCorner, hexes, {key[0], key[1], key[2]}});
+    }
+  }
+
+  // A doublet's two hexes, at an end of its edge, have their third faces there pinched.
+  bool explained_by_doublet(Index v, const std::vector<Index>& hexes) const {
+    const auto [lo, hi] = doublet_ends_.equal_range(v);
+    for (auto it = lo; it != hi; ++it) {
+      const auto& pair = doublets_[it->second].hexes;
+      if (std::all_of(pair.begin(), pair.end(), [&](Index h) { return contains(hexes, h); })) return true;
+    }
+    return false;
+  }
+
+  // Hexes with two boundary faces on one planar face.
+  void find_two_faces() {
+    std::map<Index, std::vector<std::pair<int, Index>>> per_hex;  // hex -> (local face, patch)
+    for (std::size_t b = 0; b < boundary_.size(); ++b) {
+      if (quad_patch_[b] == kNoPatch) continue;
+      const auto& use = face(b).uses.front();
+      per_hex[use.first].emplace_back(use.second, quad_patch_[b]);
+    }
+    for (const auto& [h, list] : per_hex) {
+      std::map<Index, std::vector<int>> by_patch;
+      for (const auto& [lf, p] : list) by_patch[p].push_back(lf);
+      for (const auto& [p, local] : by_patch) {
+        if (local.size() < 2) continue;
+        Obstruction o{ObstructionKind::kTwoFacesOnBoundaryFace, {h}, {}};
+        for (int lf : local)
+          for (int c : topo::kHexFaceCorners[static_cast<std::size_t>(lf)]) o.nodes.push_back(hex(h)[static_cast<std::size_t>(c)]);
+        sort_unique(o.nodes);
+        two_faces_.push_back(o);
+        // Corners on two of these faces: already explained, not repeated as flat corners.
+        for (int c = 0; c < topo::kHexCorners; ++c) {
+          int on = 0;
+          for (int lf : local) {
+            const auto& fc = topo::kHexFaceCorners[static_cast<std::size_t>(lf)];
+            on += std::find(fc.begin(), fc.end(), c) != fc.end();
+          }
+          if (on >= 2) explained_corners_.insert({h, c});
+        }
+      }
+    }
+  }
+
+  // Hex corners whose node and three neighbours share a planar face.
+  void find_flat_corners() {
+    for (std::size_t h = 0; h < mesh_.hexes.size(); ++h) {
+      const auto& hx = mesh_.hexes[h];
+      if (has_repeated(hx)) continue;
+      for (int c = 0; c < topo::kHexCorners; ++c) {
+        if (explained_corners_.count({static_cast<Index>(h), c})) continue;
+        const Index v = hx[static_cast<std::size_t>(c)];
+        const auto& nb = topo::kHexCornerNeighbors[static_cast<std::size_t>(c)];
+        const bool flat = std::any_of(patches(v).begin(), patches(v).end(), [&](Index p) {
+          return std::all_of(nb.begin(), nb.end(), [&](int n) { return contains(patches(hx[static_cast<std::size_t>(n)]), p); });
+        });
+        if (!flat) continue;
+        flat_.push_back(Obstruction{ObstructionKind::kFlatCorner,
+                                    {static_cast<Index>(h)},
+                                    {v, hx[static_cast<std::size_t>(nb[0])], hx[static_cast<std::size_t>(nb[1])], hx[static_cast<std::size_t>(nb[2])]}});
+      }
+    }
+  }
+
+  // Nodes inside one planar face (every boundary quad at them on it) with fewer than three.
+  void find_two_quad_nodes() {
+    for (std::size_t v = 0; v < mesh_.points.size(); ++v) {
+      const auto& quads = boundary_quads_at_[v];
+      if (quads.empty() || node_patches_[v].size() != 1) continue;
+      const Index p = node_patches_[v].front();
+      if (!std::all_of(quads.begin(), quads.end(), [&](Index b) { return quad_patch_[static_cast<std::size_t>(b)] == p; }))
+        continue;
+      if (quads.size() >= 3) continue;
+      Obstruction o{ObstructionKind::kTwoQuadBoundaryNode, {}, {static_cast<Index>(v)}};
+      for (Index b : quads) o.hexes.push_back(face(static_cast<std::size_t>(b)).uses.front().first);
+      sort_unique(o.hexes);
+      two_quad_.push_back(o);
+    }
+  }
+
+  const Face& face(std::size_t boundary_index) const { return faces_[static_cast<std::size_t>(boundary_[boundary_index])]; }
+  const std::array<Index, 8>& hex(Index h) const { return mesh_.hexes[static_cast<std::size_t>(h)]; }
+  const std::vector<Index>& patches(Index v) const { return node_patches_[static_cast<std::size_t>(v)]; }
+
+  const HexMesh& mesh_;
+  const RealizabilityOptions& options_;
+  std::vector<Face> faces_;
+  std::vector<Index> boundary_;                       // faces used by one hex
+  std::vector<Index> quad_patch_;                     // per boundary_ entry
+  std::vector<std::vector<Index>> node_patches_;      // sorted
+  std::vector<std::vector<Index>> boundary_quads_at_;  // per node, boundary_ entries
+  std::multimap<Index, std::size_t> doublet_ends_;    // node -> doublet
+  std::set<std::pair<Index, int>> explained_corners_;  // (hex, corner) in a two-faces finding
+  std::vector<Obstruction> doublets_, pinched_, two_faces_, flat_, two_quad_;
+};
+
+// ---- Quad meshes ---------------------------------------------------------------------------
+
+class QuadFinder {
+ public:
+  QuadFinder(const QuadMesh& mesh, const RealizabilityOptions& options) : mesh_(mesh), options_(options) {}
+
+  std::vector<Obstruction> run() {
+    collect_edges();
+    find_sides();
+    find_doublets();
+    find_two_edges_and_flat_corners();
+    std::vector<Obstruction> out = doublets_;
+    out.insert(out.end(), two_edges_.begin(), two_edges_.end());
+    out.insert(out.end(), flat_.begin(), flat_.end());
+    return out;
+  }
+
+ private:
+  void collect_edges() {
+    const std::size_t nv = mesh_.points.size();
+    if (!options_.node_faces.empty() && options_.node_faces.size() != nv)
+      throw InvalidInput("realizability: node_faces has " + std::to_string(options_.node_faces.size()) +
+                         " entries for " + std::to_string(nv) + " nodes");
+    std::unordered_map<EdgeKey, std::vector<std::pair<Index, int>>, IndexArrayHash> uses;
+    std::vector<EdgeKey> order;
+    for (std::size_t q = 0; q < mesh_.quads.size(); ++q) {
+      check_range(mesh_.quads[q], nv, "quad", q);
+      if (has_repeated(mesh_.quads[q])) continue;
+      for (int e = 0; e < 4; ++e) {
+        const auto k = key(static_cast<Index>(q), e);
+        auto [it, inserted] = uses.try_emplace(k);
+        if (inserted) order.push_back(k);
+        it->second.emplace_back(static_cast<Index>(q), e);
+      }
+    }
+    for (const auto& k : order)
+      if (uses.at(k).size() == 1) boundary_.push_back(uses.at(k).front());
+  }
+
+  EdgeKey key(Index q, int e) const {
+    const auto& quad = mesh_.quads[static_cast<std::size_t>(q)];
+    return edge_key(quad[static_cast<std::size_t>(e)], quad[static_cast<std::size_t>((e + 1) % 4)]);
+  }
+
+  void find_sides() {
+    const std::size_t nb = boundary_.size();
+    node_sides_.assign(mesh_.points.size(), {});
+    if (!options_.node_faces.empty()) {
+      side_.resize(nb);
+      for (std::size_t b = 0; b < nb; ++b) {
+        const auto [q, e] = boundary_[b];
+        side_[b] = patch_from_bits(options_.node_faces, key(q, e));
+      }
+      node_sides_ = node_patches_from_bits(options_.node_faces);
+      return;
+    }
+    const double tol = options_.planar_distance * bbox_diagonal(mesh_.points);
+    const double cos_tol = std::cos(options_.planar_angle_degrees * M_PI / 180.0);
+    auto ends = [&](std::size_t b) { return key(boundary_[b].first, boundary_[b].second); };
+    auto pt = [&](Index v) -> const Point& { return mesh_.points[static_cast<std::size_t>(v)]; };
+    std::vector<Point> dir(nb);
+    std::vector<char> flat(nb, 0);
+    for (std::size_t b = 0; b < nb; ++b) {
+      const auto k = ends(b);
+      const Point d = pt(k[1]) - pt(k[0]);
+      if (!(d.norm() > 0.0)) continue;
+      dir[b] = d.normalized();
+      flat[b] = 1;
+    }
+    auto off_line = [&](std::size_t line, std::size_t edge) {
+      const Point& o = pt(ends(line)[0]);
+      double d = 0.0;
+      for (Index v : ends(edge)) {
+        const Point r = pt(v) - o;
+        d = std::max(d, (r - r.dot(dir[line]) * dir[line]).norm());
+      }
+      return d;
+    };
+    std::unordered_map<Index, std::vector<Index>> at_node;
+    for (std::size_t b = 0; b < nb; ++b)
+      for (Index v : ends(b)) at_node[v].push_back(static_cast<Index>(b));
+    side_ = grow_patches(
+        nb,
+        [&](Index b) {
+          std::vector<Index> out;
+          for (Index v : ends(static_cast<std::size_t>(b)))
+            for (Index o : at_node.at(v))
+              if (o != b) out.push_back(o);
+          return out;
+        },
+        [&](Index b) { return flat[static_cast<std::size_t>(b)] != 0; },
+        [&](Index s, Index b) {
+          const auto su = static_cast<std::size_t>(s), bu = static_cast<std::size_t>(b);
+          return std::abs(dir[su].dot(dir[bu])) >= cos_tol && off_line(su, bu) <= tol;
+        });
+    for (std::size_t b = 0; b < nb; ++b)
+      if (side_[b] != kNoPatch)
+        for (Index v : ends(b)) node_sides_[static_cast<std::size_t>(v)].push_back(side_[b]);
+    for (auto& s : node_sides_) sort_unique(s);
+  }
+
+  // Quads sharing both edges va, vb at a node v.
+  void find_doublets() {
+    std::map<std::array<Index, 3>, std::vector<Index>> by_corner;
+    std::vector<std::array<Index, 3>> order;
+    for (std::size_t q = 0; q < mesh_.quads.size(); ++q) {
+      const auto& quad = mesh_.quads[q];
+      if (has_repeated(quad)) continue;
+      for (int c = 0; c < 4; ++c) {
+        const Index v = quad[static_cast<std::size_t>(c)], a = quad[static_cast<std::size_t>((c + 3) % 4)],
+                    b = quad[static_cast<std::size_t>((c + 1) % 4)];
+        const std::array<Index, 3> k{v, std::min(a, b), std::max(a, b)};
+        auto& list = by_corner[k];
+        if (list.empty()) order.push_back(k);
+        list.push_back(static_cast<Index>(q));
+      }
+    }
+    for (const auto& k : order) {
+      auto quads = by_corner.at(k);
+      if (quads.size() < 2) continue;
+      sort_unique(quads);
+      doublets_.push_back(Obstruction{ObstructionKind::kDoublet, quads, {k[0], k[1], k[2]}});
+    }
+  }
+
+  void find_two_edges_and_flat_corners() {
+    std::map<Index, std::vector<std::pair<int, Index>>> per_quad;  // quad -> (local edge, side)
+    for (std::size_t b = 0; b < boundary_.size(); ++b)
+      if (side_[b] != kNoPatch) per_quad[boundary_[b].first].emplace_back(boundary_[b].second, side_[b]);
+    std::set<std::pair<Index, int>> explained;  // (quad, corner) between two edges on one side
+    for (const auto& [q, list] : per_quad) {
+      std::map<Index, std::vector<int>> by_side;
+      for (const auto& [e, s] : list) by_side[s].push_back(e);
+      for (const auto& [s, local] : by_side) {
+        if (local.size() < 2) continue;
+        Obstruction o{ObstructionKind::kTwoFacesOnBoundaryFace, {q}, {}};
+        std::map<int, int> corner_uses;
+        for (int e : local)
+          for (int c : {e, (e + 1) % 4}) {
+            o.nodes.push_back(mesh_.quads[static_cast<std::size_t>(q)][static_cast<std::size_t>(c)]);
+            ++corner_uses[c];
+          }
+        sort_unique(o.nodes);
+        two_edges_.push_back(o);
+        for (const auto& [c, n] : corner_uses)
+          if (n >= 2) explained.insert({q, c});
+      }
+    }
+    for (std::size_t q = 0; q < mesh_.quads.size(); ++q) {
+      const auto& quad = mesh_.quads[q];
+      if (has_repeated(quad)) continue;
+      for (int c = 0; c < 4; ++c) {
+        if (explained.count({static_cast<Index>(q), c})) continue;
+        const Index v = quad[static_cast<std::size_t>(c)], a = quad[static_cast<std::size_t>((c + 1) % 4)],
+                    b = quad[static_cast<std::size_t>((c + 3) % 4)];
+        const auto& sv = node_sides_[static_cast<std::size_t>(v)];
+        const bool flat = std::any_of(sv.begin(), sv.end(), [&](Index s) {
+          return contains(node_sides_[static_cast<std::size_t>(a)], s) && contains(node_sides_[static_cast<std::size_t>(b)], s);
+        });
+        if (flat) flat_.push_back(Obstruction{ObstructionKind::kFlatCorner, {static_cast<Index>(q)}, {v, a, b}});
+      }
+    }
+  }
+
+  const QuadMesh& mesh_;
+  const RealizabilityOptions& options_;
+  std::vector<std::pair<Index, int>> boundary_;  // boundary edges as (quad, local edge)
+  std::vector<Index> side_;                        // per boundary edge
+  std::vector<std::vector<Index>> node_sides_;     // sorted
+  std::vector<Obstruction> doublets_, two_edges_, flat_;
+};
+
+}  // namespace
+
+std::vector<Obstruction> find_obstructions(const HexMesh& mesh, const RealizabilityOptions& options) {
+  return HexFinder(mesh, options).run();
+}
+
+std::vector<Obstruction> find_obstructions(const QuadMesh& mesh, const RealizabilityOptions& options) {
+  return QuadFinder(mesh, options).run();
+}
+
+}  // namespace geode::primal
