@@ -13,6 +13,7 @@
 #include "primal/io_vtk.hpp"
 #include "primal/quality.hpp"
 #include "primal/quality_report.hpp"
+#include "templates/fixup.hpp"
 #include "templates/geode.hpp"
 #include "templates/refine.hpp"
 
@@ -28,6 +29,7 @@ struct TemplateArgs {
   std::string output;
   bool slide = false;
   bool no_smooth = false;
+  bool no_fixup = false;
   bool quality = false;
   templates::PushParameters push;
   templates::RefineOptions refine;
@@ -159,6 +161,15 @@ void run_template(const TemplateArgs& a) {
     std::cerr << "geode: warning: the interleave fails the paper's conditions: " << why << "\n";
   }
   std::string smooth_note;
+  if (a.name == "geode4tri" && !a.no_fixup) {
+    const auto f = templates::fix_up(T);
+    std::ostringstream s;
+    s << "fix-up: " << f.obstructions_before << " -> " << f.obstructions_after << " obstructions, " << T.hex.hexes.size()
+      << " hexes";
+    for (const auto& step : f.steps) s << "; " << step;
+    smooth_note = s.str();
+    if (f.obstructions_after > 0) std::cerr << "geode: warning: fix-up left " << f.obstructions_after << " obstructions\n";
+  }
   if (!a.no_smooth) {
     const auto r = refine ? templates::smooth_refine3(T, ro, !a.slide) : templates::smooth_template(T, a.slide);
     std::ostringstream s;
@@ -167,7 +178,7 @@ void run_template(const TemplateArgs& a) {
       << "): min scaled Jacobian "
       << r.initial_min_scaled_jacobian << " -> " << r.final_min_scaled_jacobian << " in " << r.iterations
       << " iterations, " << r.seconds << " s";
-    smooth_note = s.str();
+    smooth_note += (smooth_note.empty() ? "" : "; ") + s.str();
     if (!r.untangled) std::cerr << "geode: warning: smoothing could not untangle every element\n";
   }
   const int dim = T.dim;
@@ -242,6 +253,9 @@ void add_template_command(CLI::App& app) {
               "faces' nodes slide instead of fixing them at the smoothed 2D template (neighbours then need\n"
               "not match)");
   t->add_flag("--no-smooth", args->no_smooth, "keep the dual's first-guess positions");
+  t->add_flag("--no-fixup", args->no_fixup,
+              "geode4tri: the plain dual of the arrangement, without pillowing away the obstructions to a\n"
+              "positive-Jacobian placement (its pinched corners cannot be untangled)");
   t->add_flag("--quality", args->quality, "append the quality report (the paper's Table 1 metrics)");
   t->add_option("--high-roof", args->push.high_roof,
                 "push: higher tunnel roof, fraction of the height (refine3: the tunnel along x; default 0.75 there)")

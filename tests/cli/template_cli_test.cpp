@@ -115,3 +115,23 @@ TEST_CASE("geode template refine3: the 13-hex refinement template, valid and unt
   CHECK(q.out.find("Table 3: Connectivity (4 quads)") != std::string::npos);
   CHECK(geode_cli("template refine3 --layer 0.9").code == 2);  // above both roofs
 }
+
+TEST_CASE("geode template geode4tri: fixed up by default, the plain dual with --no-fixup") {
+  const Run fixed = geode_cli("template geode4tri --format json");
+  REQUIRE(fixed.code == 0);
+  const auto j = nlohmann::json::parse(fixed.out);
+  std::vector<primal::Point> pts;
+  for (const auto& p : j["nodes"]) pts.emplace_back(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
+  std::vector<std::array<int, 8>> hexes;
+  for (const auto& h : j["hexes"]) hexes.push_back(h.get<std::array<int, 8>>());
+  CHECK(hexes.size() == 56);
+  CHECK(primal::check_validity(hex_from_tables(pts, hexes)).ok());
+  const Run fixed_text = geode_cli("template geode4tri", true);
+  REQUIRE(fixed_text.code == 0);
+  CHECK(fixed_text.out.find("fix-up: 2 -> 0 obstructions") != std::string::npos);
+  CHECK(fixed_text.out.find("could not untangle") == std::string::npos);
+  const Run plain = geode_cli("template geode4tri --no-fixup", true);
+  REQUIRE(plain.code == 0);
+  CHECK(plain.out.find("Table 3: Connectivity (36 hexes)") != std::string::npos);
+  CHECK(plain.out.find("could not untangle") != std::string::npos);
+}
