@@ -103,22 +103,26 @@ FixupResult fix_up(Template& t, const FixupOptions& options) {
   auto current = obstructions(t.hex, t.node_faces);
   out.obstructions_before = static_cast<int>(current.size());
   for (int step = 0; step < options.max_steps && !current.empty(); ++step) {
-    const primal::Obstruction& o = current.front();
+    // The first obstruction (in find_obstructions' order) that some shrink set reduces.
     std::size_t best = current.size();
     std::vector<Index> best_set;
-    for (const auto& set : candidate_sets(o.hexes, options.max_subset_hexes)) {
-      const auto r = primal::pillow(t.hex, set, options.pillow);
-      if (!combinatorially_valid(primal::check_validity(r.mesh))) continue;  // the set's surface is not manifold
-      std::vector<unsigned> faces = t.node_faces;
-      faces.resize(r.mesh.points.size(), 0u);
-      const std::size_t left = obstructions(r.mesh, faces).size();
-      if (left < best) best = left, best_set = set;
+    const primal::Obstruction* fixed = nullptr;
+    for (const auto& o : current) {
+      for (const auto& set : candidate_sets(o.hexes, options.max_subset_hexes)) {
+        const auto r = primal::pillow(t.hex, set, options.pillow);
+        if (!combinatorially_valid(primal::check_validity(r.mesh))) continue;  // the set's surface is not manifold
+        std::vector<unsigned> faces = t.node_faces;
+        faces.resize(r.mesh.points.size(), 0u);
+        const std::size_t left = obstructions(r.mesh, faces).size();
+        if (left < best) best = left, best_set = set, fixed = &o;
+      }
+      if (fixed) break;
     }
-    if (best_set.empty()) break;
+    if (!fixed) break;
     std::ostringstream s;
     s << "pillow hexes";
     for (Index h : best_set) s << " " << h;
-    s << " (" << primal::to_string(o.kind) << "): " << current.size() << " -> " << best << " obstructions";
+    s << " (" << primal::to_string(fixed->kind) << "): " << current.size() << " -> " << best << " obstructions";
     out.steps.push_back(s.str());
     apply(t, best_set, primal::pillow(t.hex, best_set, options.pillow));
     current = obstructions(t.hex, t.node_faces);

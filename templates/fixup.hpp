@@ -26,11 +26,13 @@ struct FixupResult {
   std::vector<std::string> steps;  // one line per pillowing: which hexes, what it removed
 };
 
-// Repeatedly: for the first obstruction found, try subsets of its hexes as shrink sets
+// Repeatedly: for each obstruction in turn, try subsets of its hexes as shrink sets
 // (FixupOptions), skip those whose pillowing is not a valid complex (a set whose surface is
-// not manifold), and keep the one leaving the fewest obstructions, smallest set first, if that
-// is fewer than before; else stop. The template's mesh, node faces and node signs (a new sheet per
-// pillowing, negative inside), sheets and element sheets are updated; new nodes are interior.
+// not manifold), and apply the one leaving the fewest obstructions, smallest set first, if
+// that is fewer than before; stop when no obstruction can be reduced. An obstruction of the
+// boundary itself (a two-quad boundary node) cannot be: the boundary is kept. The template's
+// mesh, node faces and node signs (a new sheet per pillowing, negative inside), sheets and
+// element sheets are updated; new nodes are interior.
 FixupResult fix_up(Template& t, const FixupOptions& options = {});
 
 }  // namespace geode::templates
