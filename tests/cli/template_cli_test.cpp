@@ -34,6 +34,15 @@ primal::HexMesh hex_from_tables(const std::vector<primal::Point>& pts, const std
   return m;
 }
 
+// The hex mesh of `geode template --format json` output.
+primal::HexMesh hex_from_json(const nlohmann::json& j) {
+  std::vector<primal::Point> pts;
+  for (const auto& p : j["nodes"]) pts.emplace_back(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
+  std::vector<std::array<int, 8>> hexes;
+  for (const auto& h : j["hexes"]) hexes.push_back(h.get<std::array<int, 8>>());
+  return hex_from_tables(pts, hexes);
+}
+
 }  // namespace
 
 TEST_CASE("geode template: json output is the Appendix A template with its sheets") {
@@ -102,14 +111,11 @@ TEST_CASE("geode template refine3: the 13-hex refinement template, valid and unt
   const Run r = geode_cli("template refine3 --format json");
   REQUIRE(r.code == 0);
   const auto j = nlohmann::json::parse(r.out);
-  std::vector<primal::Point> pts;
-  for (const auto& p : j["nodes"]) pts.emplace_back(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
-  std::vector<std::array<int, 8>> hexes;
-  for (const auto& h : j["hexes"]) hexes.push_back(h.get<std::array<int, 8>>());
-  CHECK(hexes.size() == 13);
+  const primal::HexMesh m = hex_from_json(j);
+  CHECK(m.hexes.size() == 13);
   CHECK(j["sheets"].size() == 5);
   CHECK_FALSE(j.contains("checks"));
-  CHECK(primal::check_validity(hex_from_tables(pts, hexes)).ok());
+  CHECK(primal::check_validity(m).ok());
   const Run q = geode_cli("template refine3-2d --quality");
   REQUIRE(q.code == 0);
   CHECK(q.out.find("Table 3: Connectivity (4 quads)") != std::string::npos);
@@ -120,12 +126,9 @@ TEST_CASE("geode template geode4tri: fixed up by default, the plain dual with --
   const Run fixed = geode_cli("template geode4tri --format json");
   REQUIRE(fixed.code == 0);
   const auto j = nlohmann::json::parse(fixed.out);
-  std::vector<primal::Point> pts;
-  for (const auto& p : j["nodes"]) pts.emplace_back(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
-  std::vector<std::array<int, 8>> hexes;
-  for (const auto& h : j["hexes"]) hexes.push_back(h.get<std::array<int, 8>>());
-  CHECK(hexes.size() == 56);
-  CHECK(primal::check_validity(hex_from_tables(pts, hexes)).ok());
+  const primal::HexMesh m = hex_from_json(j);
+  CHECK(m.hexes.size() == 56);
+  CHECK(primal::check_validity(m).ok());
   const Run fixed_text = geode_cli("template geode4tri", true);
   REQUIRE(fixed_text.code == 0);
   CHECK(fixed_text.out.find("fix-up: 2 -> 0 obstructions") != std::string::npos);

@@ -12,6 +12,7 @@
 #include "primal/errors.hpp"
 #include "primal/quality.hpp"
 #include "primal/validity.hpp"
+#include "support/ball_checks.hpp"
 #include "support/fixtures.hpp"
 #include "support/isomorphism.hpp"
 #include "templates/refine.hpp"
@@ -34,18 +35,6 @@ std::set<std::pair<long, long>> face_positions(const primal::QuadMesh& f, int ac
   std::set<std::pair<long, long>> s;
   for (const auto& p : f.points) s.insert({std::lround(p[across] * 1e7), std::lround(p.y() * 1e7)});
   return s;
-}
-
-void check_ball(const primal::HexValidityReport& r) {
-  CHECK(r.overshared_faces.empty());
-  CHECK(r.misoriented_faces.empty());
-  CHECK(r.nonmanifold_edges.empty());
-  CHECK(r.nonmanifold_vertices.empty());
-  CHECK(r.unused_nodes == 0);
-  CHECK(r.euler == 1);
-  CHECK(r.boundary.closed);
-  CHECK(r.boundary.manifold);
-  CHECK(r.boundary.euler == 2);
 }
 
 // Every node of `face` is one of the k x k grid's nodes over [-hx, hx] x [-hz, hz] and every
@@ -101,7 +90,7 @@ TEST_CASE("refine3: the dual of two tunnels, two middle planes and a layer is a 
   // layer meet once.
   CHECK(T.hex.hexes.size() == 13);
   CHECK(T.sheets.size() == 5);
-  check_ball(primal::check_validity(T.hex));
+  test::check_combinatorial_ball(primal::check_validity(T.hex));
   // Coarse side: one undiced quad on the box's top corners; fine side: the 3 x 3 grid.
   const auto top = face_of(T.hex, 1, 7.0), bottom = face_of(T.hex, 1, -7.0);
   CHECK(top.quads.size() == 1);
@@ -138,7 +127,7 @@ TEST_CASE("refine3: smoothed, untangled, and neighbouring cells match on their s
     const auto r = templates::smooth_refine3(T, o);
     CHECK(r.untangled);
     const auto v = primal::check_validity(T.hex);
-    check_ball(v);
+    test::check_combinatorial_ball(v);
     CHECK(v.ok());
     MESSAGE("refine3 " << box.transpose() << ": min scaled Jacobian " << r.final_min_scaled_jacobian);
     CHECK(r.final_min_scaled_jacobian >= target);
