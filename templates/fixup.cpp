@@ -19,16 +19,17 @@ std::vector<primal::Obstruction> obstructions(const primal::HexMesh& mesh, const
   return primal::find_obstructions(mesh, o);
 }
 
-// The sheet of hex h that separates its local face f from the opposite face: the one of its
-// sheets on which the two faces' nodes have different signs.
+// The sheet of hex h that separates its local face f from the opposite face: of the hex's
+// three sheets, the other two cut the face, this one leaves all its corners on one side.
 int sheet_across(const Template& t, Index h, int f) {
   const auto& hex = t.hex.hexes[static_cast<std::size_t>(h)];
-  const auto node = [&](int face, int i) {
-    return static_cast<std::size_t>(hex[static_cast<std::size_t>(primal::topology::kHexFaceCorners[static_cast<std::size_t>(face)][static_cast<std::size_t>(i)])]);
-  };
-  const int g = primal::topology::kHexOppositeFace[static_cast<std::size_t>(f)];
-  for (int s : t.element_sheets[static_cast<std::size_t>(h)])
-    if (t.node_signs[node(f, 0)][static_cast<std::size_t>(s)] != t.node_signs[node(g, 0)][static_cast<std::size_t>(s)]) return s;
+  const auto& face = primal::topology::kHexFaceCorners[static_cast<std::size_t>(f)];
+  for (int s : t.element_sheets[static_cast<std::size_t>(h)]) {
+    const auto sign = [&](int i) {
+      return t.node_signs[static_cast<std::size_t>(hex[static_cast<std::size_t>(face[static_cast<std::size_t>(i)])])][static_cast<std::size_t>(s)];
+    };
+    if (sign(0) == sign(1) && sign(1) == sign(2) && sign(2) == sign(3)) return s;
+  }
   return -1;
 }
 

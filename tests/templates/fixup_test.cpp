@@ -62,6 +62,18 @@ TEST_CASE("fix_up: the four-triangle dual's pinched corners are pillowed away, t
   CHECK(T.node_faces.size() == T.hex.points.size());
   CHECK(T.node_signs.size() == T.hex.points.size());
   CHECK(T.element_sheets.size() == T.hex.hexes.size());
+  CHECK(T.sheets.size() == plain.sheets.size() + r.steps.size());  // a sheet per pillowing
+  for (const auto& s : T.element_sheets) CHECK(s.size() == 3);      // every hex is a sheet triple
+  // Each node's signs: its side of every sheet, the new ones included.
+  for (const auto& sg : T.node_signs) CHECK(sg.size() == T.sheets.size());
+  // and every sheet of a hex passes through it: its corners lie on both sides.
+  for (std::size_t h = 0; h < T.hex.hexes.size(); ++h)
+    for (int sheet : T.element_sheets[h]) {
+      int plus = 0, minus = 0;
+      for (auto n : T.hex.hexes[h]) (T.node_signs[static_cast<std::size_t>(n)][static_cast<std::size_t>(sheet)] > 0 ? plus : minus)++;
+      CAPTURE(h);
+      CHECK((plus == 4 && minus == 4));
+    }
   CHECK(boundary_geometry(T.hex) == boundary_geometry(plain.hex));
   const auto v = primal::check_validity(T.hex);
   CHECK(v.euler == 1);
