@@ -50,6 +50,10 @@ struct TemplateOutput {
   bool smooth = true;
   bool slide = false;
   bool quality = false;
+  bool check_conditions = true;  // the paper's interleave conditions (geode templates only)
+  std::string note;              // e.g. what a fix-up did; printed with the smoothing note
+  // Replaces templates::smooth_template (e.g. the refinement template's own smoothing).
+  std::function<primal::SmoothResult(templates::Template&)> smoother;
 };
 void write_template(templates::Template& t, const TemplateOutput& out);
 

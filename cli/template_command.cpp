@@ -13,7 +13,9 @@
 #include "primal/io_vtk.hpp"
 #include "primal/quality.hpp"
 #include "primal/quality_report.hpp"
+#include "templates/fixup.hpp"
 #include "templates/geode.hpp"
+#include "templates/refine.hpp"
 #include "templates/spec.hpp"
 
 namespace geode::cli {
@@ -28,8 +30,11 @@ struct TemplateArgs {
   std::string output;
   bool slide = false;
   bool no_smooth = false;
+  bool no_fixup = false;
   bool quality = false;
   templates::PushParameters push;
+  templates::RefineOptions refine;
+  bool refine_roofs = false;  // --high-roof / --low-roof given: they apply to refine3 too
 };
 
 // The paper's Table 2 layout: three column groups of "Node x y z", 1-based.
@@ -126,6 +131,7 @@ nlohmann::json to_json(const templates::Template& T, const std::string& name) {
     j["intersections"].push_back({{"sheets", names}, {"elements", count}});
   }
   j["obstructions"] = primal::obstructions_json(templates::template_obstructions(T), 1);
+  if (name.rfind("refine", 0) == 0) return j;  // the paper's conditions are about domes
   j["checks"] = {{"triple_domes_in_pocket", T.checks.triple_domes_in_pocket},
                  {"dome_curves_exit_in_tunnels", T.checks.dome_curves_exit_in_tunnels},
                  {"failures", T.checks.failures}};
@@ -138,33 +144,58 @@ void run_template(const TemplateArgs& a) {
   o.diagonal = a.diagonal == "anti" ? templates::Diagonal::Anti : templates::Diagonal::Main;
   o.higher = a.higher == "z" ? templates::Higher::Z : templates::Higher::X;
   o.push = a.push;
+  const bool refine = a.name == "refine3" || a.name == "refine3-2d";
+  const int dim = a.name == "geode2d" || a.name == "refine3-2d" ? 2 : 3;
   if (a.name == "geode4tri") o.split = templates::TopSplit::FourTriangles;
-  const int dim = a.name == "geode2d" ? 2 : 3;
   if (a.format == "spec") {
+    if (refine) throw InvalidInput("--format spec: " + a.name + " has no spec yet (geode3d, geode2d, geode4tri have)");
     const std::string text = templates::format_spec(templates::spec_json(templates::geode_spec(o, dim)));
     write_or_print(a.output, [&](std::ostream& os) { os << text; });
     return;
   }
-  templates::Template T = dim == 2 ? templates::build_geode2d(o) : templates::build_geode3d(o);
-  write_template(T, {a.name, "box " + a.box, a.format, a.output, !a.no_smooth, a.slide, a.quality});
+  TemplateOutput out{a.name, "box " + a.box, a.format, a.output, !a.no_smooth, a.slide, a.quality};
+  templates::Template T;
+  if (refine) {
+    templates::RefineOptions ro = a.refine;
+    ro.box = o.box;
+    if (a.refine_roofs) ro.high_roof = a.push.high_roof, ro.low_roof = a.push.low_roof;
+    T = a.name == "refine3" ? templates::build_refine3(ro) : templates::build_refine3_2d(ro);
+    out.check_conditions = false;
+    out.smoother = [ro, fixed = !a.slide](templates::Template& t) { return templates::smooth_refine3(t, ro, fixed); };
+  } else {
+    T = dim == 2 ? templates::build_geode2d(o) : templates::build_geode3d(o);
+    out.check_conditions = dim == 3;
+  }
+  if (a.name == "geode4tri" && !a.no_fixup) {
+    const auto f = templates::fix_up(T);
+    std::ostringstream s;
+    s << "fix-up: " << f.obstructions_before << " -> " << f.obstructions_after << " obstructions, " << T.hex.hexes.size()
+      << " hexes";
+    for (const auto& step : f.steps) s << "; " << step;
+    out.note = s.str();
+    if (f.obstructions_after > 0) std::cerr << "geode: warning: fix-up left " << f.obstructions_after << " obstructions\n";
+  }
+  write_template(T, out);
 }
 
 }  // namespace
 
 void write_template(templates::Template& T, const TemplateOutput& a) {
-  if (!T.checks.ok()) {
+  if (a.check_conditions && !T.checks.ok()) {
     std::string why;
     for (const auto& f : T.checks.failures) why += (why.empty() ? "" : "; ") + f;
     std::cerr << "geode: warning: the interleave fails the paper's conditions: " << why << "\n";
   }
-  std::string smooth_note;
+  std::string smooth_note = a.note;
   if (a.smooth) {
-    const auto r = templates::smooth_template(T, a.slide);
+    const auto r = a.smoother ? a.smoother(T) : templates::smooth_template(T, a.slide);
     std::ostringstream s;
-    s << "smoothing (" << (a.slide ? "tet/hex-side nodes slide" : "tet/hex-side nodes fixed") << "): min scaled Jacobian "
+    s << "smoothing (" << (a.smoother ? (a.slide ? "side nodes slide" : "side faces fixed at the 2D template")
+                                      : (a.slide ? "tet/hex-side nodes slide" : "tet/hex-side nodes fixed"))
+      << "): min scaled Jacobian "
       << r.initial_min_scaled_jacobian << " -> " << r.final_min_scaled_jacobian << " in " << r.iterations
       << " iterations, " << r.seconds << " s";
-    smooth_note = s.str();
+    smooth_note += (smooth_note.empty() ? "" : "; ") + s.str();
     if (!r.untangled) {
       // Say whether the mesh itself forbids positive Jacobians, rather than blame the smoother.
       const auto obstructions = templates::template_obstructions(T);
@@ -219,9 +250,11 @@ void add_template_command(CLI::App& app) {
       "puts them; the rest are placed by optimization unless --no-smooth.");
   t->add_option("NAME", args->name,
                 "geode3d: the 26-hex geode (tet side split by a diagonal into 2 triangles);\n"
-                "geode2d: the 5-quad 2D geode; geode4tri: the tet side split into 4 triangles")
+                "geode2d: the 5-quad 2D geode; geode4tri: the tet side split into 4 triangles;\n"
+                "refine3: one coarse quad on top over 3 x 3 fine quads below (13 hexes); refine3-2d: one\n"
+                "coarse edge over three fine ones (4 quads)")
       ->required()
-      ->check(CLI::IsMember({"geode3d", "geode2d", "geode4tri"}));
+      ->check(CLI::IsMember({"geode3d", "geode2d", "geode4tri", "refine3", "refine3-2d"}));
   t->add_option("--box", args->box, "buffer cell WIDTHxHEIGHTxDEPTH (x, y up, z), centred at the origin; tet side on top")
       ->capture_default_str();
   t->add_option("--diagonal", args->diagonal,
@@ -238,18 +271,33 @@ void add_template_command(CLI::App& app) {
       ->check(CLI::IsMember({"appendix", "csv", "json", "vtu", "spec"}))
       ->capture_default_str();
   t->add_option("-o,--output", args->output, "write to FILE (atomically) instead of standard output");
-  t->add_flag("--slide", args->slide, "let tet- and hex-side nodes slide within their faces while smoothing");
+  t->add_flag("--slide", args->slide,
+              "let tet- and hex-side nodes slide within their faces while smoothing; refine3: let the side\n"
+              "faces' nodes slide instead of fixing them at the smoothed 2D template (neighbours then need\n"
+              "not match)");
   t->add_flag("--no-smooth", args->no_smooth, "keep the dual's first-guess positions");
+  t->add_flag("--no-fixup", args->no_fixup,
+              "geode4tri: the plain dual of the arrangement, without pillowing away the obstructions to a\n"
+              "positive-Jacobian placement (its pinched corners cannot be untangled)");
   t->add_flag("--quality", args->quality, "append the quality report (the paper's Table 1 metrics)");
-  t->add_option("--high-roof", args->push.high_roof, "push: higher tunnel roof, fraction of the height")->capture_default_str();
-  t->add_option("--low-roof", args->push.low_roof, "push: lower tunnel roof, fraction of the height")->capture_default_str();
+  t->add_option("--high-roof", args->push.high_roof,
+                "push: higher tunnel roof, fraction of the height (refine3: the tunnel along x; default 0.75 there)")
+      ->capture_default_str();
+  t->add_option("--low-roof", args->push.low_roof,
+                "push: lower tunnel roof, fraction of the height (refine3: the tunnel along z; default 0.6 there)")
+      ->capture_default_str();
+  t->add_option("--layer", args->refine.layer, "refine3: height of the horizontal layer sheet, below both roofs")
+      ->capture_default_str();
   t->add_option("--dome-depth", args->push.dome_depth, "push: how far below the tet side the domes reach, fraction of the height")
       ->capture_default_str();
   t->add_option("--dome-radius", args->push.dome_radius,
                 "push: where each dome's circle crosses the diced tet side, 0..1 between the nodes it\n"
                 "must enclose and the nearest it must leave out")
       ->capture_default_str();
-  t->callback([args] { run_template(*args); });
+  t->callback([args, t] {
+    args->refine_roofs = t->count("--high-roof") + t->count("--low-roof") > 0;
+    run_template(*args);
+  });
 }
 
 }  // namespace geode::cli

@@ -246,31 +246,54 @@ ArrangementSpec geode_spec(const GeodeOptions& o, int dim) {
   return spec;
 }
 
-Template build_template(const ArrangementSpec& spec, const stc::ArrangementOptions& options) {
-  const std::vector<stc::Sheet> sheets = spec_sheets(spec);
-  const stc::Domain& dom = spec.domain;
-  Template T;
-  T.dim = spec.dim;
-  for (const auto& s : sheets) T.sheets.push_back({s.name, s.kind});
-  const stc::Arrangement A = stc::compute_arrangement(sheets, dom, options);
-  T.checks = check_interleave(A, T.sheets, sheets);
-  const stc::DualMesh D = stc::dualize(A);
+namespace {
 
-  std::vector<Point> pts = spec.dim == 3 ? D.hex.points : D.quad.points;
-  if (spec.completion) {
-    place_interface(D, sheets, dice_patch(spec.completion->hex_side), stc::box_face(1, false), dom, pts, "hex-side");
-    place_interface(D, sheets, dice_patch(spec.completion->tet_side), stc::box_face(1, true), dom, pts, "tet-side");
-  }
-  if (spec.dim == 3) {
+// The dual as a Template: nodes on the bottom (hex- or fine-side) and top faces placed at their
+// prescribed cells' nodes when those are given.
+Template dual_template(const stc::DualMesh& D, const std::vector<stc::Sheet>& sheets, const stc::Domain& dom,
+                       const PrescribedFace* bottom, const PrescribedFace* top) {
+  const int dim = D.dim;
+  Template T;
+  T.dim = dim;
+  for (const auto& s : sheets) T.sheets.push_back({s.name, s.kind});
+  std::vector<Point> pts = dim == 3 ? D.hex.points : D.quad.points;
+  if (bottom) place_interface(D, sheets, bottom->cells, stc::box_face(1, false), dom, pts, bottom->name);
+  if (top) place_interface(D, sheets, top->cells, stc::box_face(1, true), dom, pts, top->name);
+  if (dim == 3) {
     T.hex.hexes = D.hex.hexes;
-    T.hex.points = pts;
+    T.hex.points = std::move(pts);
   } else {
     T.quad.quads = D.quad.quads;
-    T.quad.points = pts;
+    T.quad.points = std::move(pts);
   }
   T.element_sheets = D.element_sheets;
   T.node_faces = D.node_faces;
   T.node_signs = D.node_signs;
+  return T;
+}
+
+}  // namespace
+
+Template template_from_dual(const stc::DualMesh& D, const std::vector<stc::Sheet>& sheets, const stc::Domain& dom,
+                            const PrescribedFace& bottom, const PrescribedFace& top, const Eigen::Vector3d& box) {
+  Template T = dual_template(D, sheets, dom, &bottom, &top);
+  for (auto& q : T.dim == 3 ? T.hex.points : T.quad.points) q = to_box(q, box, T.dim);
+  return T;
+}
+
+Template build_template(const ArrangementSpec& spec, const stc::ArrangementOptions& options) {
+  const std::vector<stc::Sheet> sheets = spec_sheets(spec);
+  const stc::Arrangement A = stc::compute_arrangement(sheets, spec.domain, options);
+  const stc::DualMesh D = stc::dualize(A);
+  Template T;
+  if (spec.completion) {
+    const PrescribedFace bottom{dice_patch(spec.completion->hex_side), "hex-side"};
+    const PrescribedFace top{dice_patch(spec.completion->tet_side), "tet-side"};
+    T = dual_template(D, sheets, spec.domain, &bottom, &top);
+  } else {
+    T = dual_template(D, sheets, spec.domain, nullptr, nullptr);
+  }
+  T.checks = check_interleave(A, T.sheets, sheets);
   return T;
 }
 

@@ -9,6 +9,7 @@
 #include "primal/realizability.hpp"
 #include "primal/smooth.hpp"
 #include "stc/arrangement.hpp"
+#include "stc/dualize.hpp"
 #include "templates/completion.hpp"
 
 namespace geode::templates {
@@ -118,6 +119,18 @@ Template build_template(const ArrangementSpec& spec, const stc::ArrangementOptio
 
 // build_template(geode_spec(options, 3 or 2)); InvalidInput for a degenerate box or push.
 Template build_geode3d(const GeodeOptions& options);
+
+// The dual of a reference-cell arrangement (u, w in [-1, 1], v in [0, 1]) as a Template in the
+// box: the nodes on the bottom (v = 0) and top (v = 1) faces are matched to the prescribed
+// cells' nodes by the sides of every sheet and placed there (TopologyError naming `name` when
+// the dual's boundary differs from the prescribed cells), then everything is mapped to the box.
+struct PrescribedFace {
+  DicedPatch cells;  // nodes (reference coordinates) and cells; owners are not read
+  const char* name;  // for diagnoses, e.g. "hex-side"
+};
+Template template_from_dual(const stc::DualMesh& dual, const std::vector<stc::Sheet>& sheets,
+                            const stc::Domain& domain, const PrescribedFace& bottom, const PrescribedFace& top,
+                            const Eigen::Vector3d& box);
 Template build_geode2d(const GeodeOptions& options);
 
 // Place the template's free nodes by optimization (primal/smooth.hpp): untangle, then maximise

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "primal/io_vtk.hpp"
+#include "primal/validity.hpp"
 #include "support/cli_run.hpp"
 #include "support/fixtures.hpp"
 #include "support/isomorphism.hpp"
@@ -31,6 +32,15 @@ primal::HexMesh hex_from_tables(const std::vector<primal::Point>& pts, const std
     m.hexes.push_back(c);
   }
   return m;
+}
+
+// The hex mesh of `geode template --format json` output.
+primal::HexMesh hex_from_json(const nlohmann::json& j) {
+  std::vector<primal::Point> pts;
+  for (const auto& p : j["nodes"]) pts.emplace_back(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
+  std::vector<std::array<int, 8>> hexes;
+  for (const auto& h : j["hexes"]) hexes.push_back(h.get<std::array<int, 8>>());
+  return hex_from_tables(pts, hexes);
 }
 
 }  // namespace
@@ -95,4 +105,36 @@ TEST_CASE("geode template: bad input exits non-zero with nothing written") {
   CHECK(geode_cli("template geode3d --dome-depth 0.3 -o " + out.string()).code == 3);  // diagnosis
   CHECK(geode_cli("template geode3d --format vtu").code == 2);                         // needs -o
   CHECK_FALSE(std::filesystem::exists(out));
+}
+
+TEST_CASE("geode template refine3: the 13-hex refinement template, valid and untangled") {
+  const Run r = geode_cli("template refine3 --format json");
+  REQUIRE(r.code == 0);
+  const auto j = nlohmann::json::parse(r.out);
+  const primal::HexMesh m = hex_from_json(j);
+  CHECK(m.hexes.size() == 13);
+  CHECK(j["sheets"].size() == 5);
+  CHECK_FALSE(j.contains("checks"));
+  CHECK(primal::check_validity(m).ok());
+  const Run q = geode_cli("template refine3-2d --quality");
+  REQUIRE(q.code == 0);
+  CHECK(q.out.find("Table 3: Connectivity (4 quads)") != std::string::npos);
+  CHECK(geode_cli("template refine3 --layer 0.9").code == 2);  // above both roofs
+}
+
+TEST_CASE("geode template geode4tri: fixed up by default, the plain dual with --no-fixup") {
+  const Run fixed = geode_cli("template geode4tri --format json");
+  REQUIRE(fixed.code == 0);
+  const auto j = nlohmann::json::parse(fixed.out);
+  const primal::HexMesh m = hex_from_json(j);
+  CHECK(m.hexes.size() == 56);
+  CHECK(primal::check_validity(m).ok());
+  const Run fixed_text = geode_cli("template geode4tri", true);
+  REQUIRE(fixed_text.code == 0);
+  CHECK(fixed_text.out.find("fix-up: 2 -> 0 obstructions") != std::string::npos);
+  CHECK(fixed_text.out.find("could not untangle") == std::string::npos);
+  const Run plain = geode_cli("template geode4tri --no-fixup", true);
+  REQUIRE(plain.code == 0);
+  CHECK(plain.out.find("Table 3: Connectivity (36 hexes)") != std::string::npos);
+  CHECK(plain.out.find("could not untangle") != std::string::npos);
 }

@@ -8,6 +8,7 @@
 
 #include "primal/errors.hpp"
 #include "primal/validity.hpp"
+#include "support/ball_checks.hpp"
 #include "support/fixtures.hpp"
 #include "support/isomorphism.hpp"
 #include "templates/geode.hpp"
@@ -129,26 +130,7 @@ TEST_CASE("geode: bad options are rejected") {
   CHECK(templates::parse_box("24x14x24") == Eigen::Vector3d(24, 14, 24));
 }
 
-namespace {
-
-// Combinatorial validity (orientation aside): a complex whose faces are shared by at most two
-// hexes, consistently oriented, manifold, a ball (Euler characteristic 1) with a closed
-// manifold sphere boundary (Euler characteristic 2).
-void check_combinatorial_ball(const primal::HexValidityReport& r) {
-  CHECK(r.out_of_range_hexes.empty());
-  CHECK(r.repeated_node_hexes.empty());
-  CHECK(r.overshared_faces.empty());
-  CHECK(r.misoriented_faces.empty());
-  CHECK(r.nonmanifold_edges.empty());
-  CHECK(r.nonmanifold_vertices.empty());
-  CHECK(r.unused_nodes == 0);
-  CHECK(r.euler == 1);
-  CHECK(r.boundary.closed);
-  CHECK(r.boundary.manifold);
-  CHECK(r.boundary.euler == 2);
-}
-
-}  // namespace
+using test::check_combinatorial_ball;
 
 TEST_CASE("geode3d: the smoothed template is a valid mesh of the box") {
   for (bool slide : {false, true}) {
