@@ -30,43 +30,6 @@ struct DualArgs {
   std::string rebuild;
 };
 
-// A mesh as read: hexes, or quads (a planar quad mesh in z = 0, from .vtu / .vtk only).
-struct InputMesh {
-  int dim = 3;
-  primal::HexMesh hex;
-  primal::QuadMesh quad;
-};
-
-InputMesh read_input(const fs::path& path) {
-  if (!fs::exists(path)) throw InvalidInput(path.string() + ": no such file");
-  const std::string e = file_extension(path);
-  InputMesh m;
-  if (e == ".vtu" || e == ".vtk") {
-    const primal::VtkGrid g = primal::read_vtk_file(path);
-    const bool quads = !g.cell_types.empty() && std::all_of(g.cell_types.begin(), g.cell_types.end(),
-                                                             [](int t) { return t == primal::kVtkQuad; });
-    if (quads) {
-      m.dim = 2;
-      m.quad = primal::to_quad_mesh(g);
-      for (std::size_t n = 0; n < m.quad.points.size(); ++n)
-        if (m.quad.points[n].z() != 0.0)
-          throw InvalidInput(path.string() + ": node " + std::to_string(n) +
-                             " has z != 0: a quad mesh must lie in the plane z = 0");
-    } else {
-      m.hex = primal::to_hex_mesh(g);  // names the first cell that is not a hex
-    }
-    return m;
-  }
-  if (e != ".msh" && e != ".exo" && e != ".e")
-    throw InvalidInput(path.string() + ": unknown input format '" + e + "' (expected .vtu, .vtk, .msh, .exo or .e)");
-  const primal::Model model = read_model(path);
-  if (!model.tets.empty())
-    throw InvalidInput(path.string() + ": holds " + std::to_string(model.tets.size()) +
-                       " tets; the dual is read off all-hex meshes (use `geode conform` first)");
-  m.hex = primal::hex_part(model);
-  return m;
-}
-
 template <class Dual>
 nlohmann::json dual_json(const Dual& dual, Index nodes, Index cells) {
   nlohmann::json j;
@@ -122,7 +85,7 @@ std::vector<Index> tuple_counts(const Dual& d) {
 
 void run_dual(const DualArgs& a) {
   const fs::path in(a.input);
-  const InputMesh m = read_input(in);
+  const InputMesh m = read_hex_or_quad_mesh(in);
   nlohmann::json j;
   std::vector<Index> counts;
   if (m.dim == 3) {

@@ -8,6 +8,7 @@
 #include "primal/errors.hpp"
 #include "primal/io_exodus.hpp"
 #include "primal/io_gmsh.hpp"
+#include "primal/io_vtk.hpp"
 
 namespace geode::cli {
 
@@ -25,6 +26,36 @@ primal::Model read_model(const fs::path& path) {
   if (e == ".msh") return primal::read_gmsh(path);
   if (e == ".exo" || e == ".e") return primal::read_exodus(path);
   throw InvalidInput(path.string() + ": unknown input format '" + e + "' (expected .msh, .exo or .e)");
+}
+
+InputMesh read_hex_or_quad_mesh(const fs::path& path) {
+  if (!fs::exists(path)) throw InvalidInput(path.string() + ": no such file");
+  const std::string e = file_extension(path);
+  InputMesh m;
+  if (e == ".vtu" || e == ".vtk") {
+    const primal::VtkGrid g = primal::read_vtk_file(path);
+    const bool quads = !g.cell_types.empty() && std::all_of(g.cell_types.begin(), g.cell_types.end(),
+                                                             [](int t) { return t == primal::kVtkQuad; });
+    if (quads) {
+      m.dim = 2;
+      m.quad = primal::to_quad_mesh(g);
+      for (std::size_t n = 0; n < m.quad.points.size(); ++n)
+        if (m.quad.points[n].z() != 0.0)
+          throw InvalidInput(path.string() + ": node " + std::to_string(n) +
+                             " has z != 0: a quad mesh must lie in the plane z = 0");
+    } else {
+      m.hex = primal::to_hex_mesh(g);  // names the first cell that is not a hex
+    }
+    return m;
+  }
+  if (e != ".msh" && e != ".exo" && e != ".e")
+    throw InvalidInput(path.string() + ": unknown input format '" + e + "' (expected .vtu, .vtk, .msh, .exo or .e)");
+  const primal::Model model = read_model(path);
+  if (!model.tets.empty())
+    throw InvalidInput(path.string() + ": holds " + std::to_string(model.tets.size()) +
+                       " tets; an all-hex mesh is expected (use `geode conform` first)");
+  m.hex = primal::hex_part(model);
+  return m;
 }
 
 void write_or_print(const std::string& path, const std::function<void(std::ostream&)>& write) {

@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   geode::cli::add_study_commands(app);
   geode::cli::add_conform_commands(app);
   geode::cli::add_dual_command(app);
+  geode::cli::add_view_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

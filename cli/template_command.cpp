@@ -9,7 +9,9 @@
 #include <sstream>
 
 #include "cli/commands.hpp"
+#include "primal/boundary.hpp"
 #include "primal/errors.hpp"
+#include "primal/io_html.hpp"
 #include "primal/io_vtk.hpp"
 #include "primal/quality.hpp"
 #include "primal/quality_report.hpp"
@@ -130,6 +132,36 @@ nlohmann::json to_json(const templates::Template& T, const std::string& name) {
   return j;
 }
 
+// The template with its arrangement's sheets contoured from their fields in the reference cell
+// and mapped to the box as the nodes are (Figure 7 of the paper), each sheet's layer of hexes,
+// and the tet and hex sides as face groups (Figure 1, left).
+void write_template_html(const TemplateArgs& a, const templates::GeodeOptions& o, const templates::Template& T,
+                         const std::string& smooth_note) {
+  const templates::GeodeArrangement G = templates::geode_arrangement(o, T.dim);
+  primal::ViewScene scene;
+  scene.title = "geode template " + a.name;
+  scene.caption = "geode template " + a.name + " --box " + a.box + " --diagonal " + a.diagonal + " --higher " + a.higher +
+                  ": " + std::to_string(T.dim == 3 ? T.hex.hexes.size() : T.quad.quads.size()) +
+                  (T.dim == 3 ? " hexes" : " quads") + (smooth_note.empty() ? ", not smoothed" : ", " + smooth_note) +
+                  ". Sheets: the arrangement's fields contoured in the cell (marching tetrahedra), mapped to the box "
+                  "like the nodes; the smoothed hexes need not follow them. Layers: the hexes dual to each sheet.";
+  scene.sheets = arrangement_view_sheets(G.sheets, G.domain, T.element_sheets,
+                                         [&](const primal::Point& r) { return templates::box_point(r, o.box, T.dim); });
+  if (T.dim == 2) {
+    primal::write_html(a.output, T.quad, scene);
+    return;
+  }
+  primal::ViewFaceGroup tet{"tet side", {}}, hex{"hex side", {}};
+  for (const auto& q : primal::boundary_quads(T.hex)) {
+    unsigned common = ~0u;
+    for (auto n : q.nodes) common &= T.node_faces[static_cast<std::size_t>(n)];
+    if (common & (1u << stc::box_face(1, true))) tet.quads.push_back(q.nodes);
+    if (common & (1u << stc::box_face(1, false))) hex.quads.push_back(q.nodes);
+  }
+  scene.groups = {tet, hex};
+  primal::write_html(a.output, T.hex, scene);
+}
+
 void run_template(const TemplateArgs& a) {
   templates::GeodeOptions o;
   o.box = templates::parse_box(a.box);
@@ -181,6 +213,12 @@ void run_template(const TemplateArgs& a) {
     s << "\nQuad scaled Jacobian: min " << lo << ", max " << hi << "\n";
     text += s.str();
   }
+  if (a.format == "html") {
+    if (a.output.empty()) throw InvalidInput("--format html needs -o FILE.html");
+    write_template_html(a, o, T, smooth_note);
+    if (!text.empty()) std::cout << text;
+    return;
+  }
   if (a.format == "vtu") {
     // The writer adds the scaled Jacobian (and block) cell arrays itself.
     if (a.output.empty()) throw InvalidInput("--format vtu needs -o FILE.vtu");
@@ -219,8 +257,9 @@ void add_template_command(CLI::App& app) {
       ->capture_default_str();
   t->add_option("--format", args->format,
                 "appendix: the paper's Tables 2 and 3 (1-based); csv: node and element tables; json: with\n"
-                "sheets, their intersections and the interleave checks; vtu: VTK XML for ParaView (needs -o)")
-      ->check(CLI::IsMember({"appendix", "csv", "json", "vtu"}))
+                "sheets, their intersections and the interleave checks; vtu: VTK XML for ParaView (needs -o);\n"
+                "html: a self-contained viewer of the hexes, the arrangement's sheets and their layers (needs -o)")
+      ->check(CLI::IsMember({"appendix", "csv", "json", "vtu", "html"}))
       ->capture_default_str();
   t->add_option("-o,--output", args->output, "write to FILE (atomically) instead of standard output");
   t->add_flag("--slide", args->slide, "let tet- and hex-side nodes slide within their faces while smoothing");

@@ -22,10 +22,6 @@ stc::Domain reference_domain(int dim) {
   return {Point(-1, 0, -1), Point(1, 1, 1), 3};
 }
 
-Point to_box(const Point& r, const Eigen::Vector3d& box, int dim) {
-  return Point(0.5 * box.x() * r[0], box.y() * (r[1] - 0.5), dim == 3 ? 0.5 * box.z() * r[2] : 0.0);
-}
-
 std::string corner_name(const Point& p) {
   return std::string("(") + (p[0] < 0 ? "-x" : "+x") + "," + (p[2] < 0 ? "-z" : "+z") + ")";
 }
@@ -232,7 +228,7 @@ Template build(const GeodeOptions& o, int dim) {
   std::vector<Point> pts = dim == 3 ? D.hex.points : D.quad.points;
   place_interface(D, sheets, dice_patch(G.hex_side), stc::box_face(1, false), dom, pts, "hex-side");
   place_interface(D, sheets, dice_patch(G.tet_side), stc::box_face(1, true), dom, pts, "tet-side");
-  for (auto& q : pts) q = to_box(q, o.box, dim);
+  for (auto& q : pts) q = box_point(q, o.box, dim);
   if (dim == 3) {
     T.hex.hexes = D.hex.hexes;
     T.hex.points = pts;
@@ -273,6 +269,10 @@ primal::SmoothResult smooth_template(Template& t, bool slide_faces) {
     else c.push_back(primal::NodeConstraint::plane(p, Point::UnitZ()));
   }
   return primal::smooth_quad_mesh(t.quad, Point::UnitZ(), c);
+}
+
+Point box_point(const Point& r, const Eigen::Vector3d& box, int dim) {
+  return Point(0.5 * box.x() * r[0], box.y() * (r[1] - 0.5), dim == 3 ? 0.5 * box.z() * r[2] : 0.0);
 }
 
 Eigen::Vector3d parse_box(const std::string& text) {

@@ -91,6 +91,10 @@ struct GeodeArrangement {
 };
 GeodeArrangement geode_arrangement(const GeodeOptions& options, int dim);
 
+// Where a reference point (u, v, w) of the buffer cell lies in the box centred at the origin
+// (the map that places a derived template's nodes).
+Point box_point(const Point& reference, const Eigen::Vector3d& box, int dim);
+
 // Derive a template: complete the diced interfaces' duals into tunnels and domes, push them
 // together, compute the arrangement and dualize it. Top and bottom nodes are placed exactly
 // where dicing puts them; a node is matched to its diced position by the sides of every
