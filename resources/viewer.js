@@ -8,6 +8,7 @@
 //   layer=s                 the hex layer dual to sheet s     layermode=highlight|alone
 //   colour=quality|layer|block|plain   shrink=0.1..1   explode=0..2   peel=N (hide N outer layers)
 //   hexes=0   edges=0   groups=all|g1,g2   view=AZ,EL (degrees)   zoom=Z   ui=0   legend=0
+//   probe=X,Y   hover at that pixel once loaded; the tip's text goes into #status (for tests)
 (function () {
   'use strict';
   const D = JSON.parse(document.getElementById('geode-data').textContent);
@@ -352,5 +353,10 @@
   if (!window.geodeErrors.length) {
     status.textContent = `viewer-ok ${cellsName}=${ncell} sheets=${D.sheets.length} shown=${sheetShown.filter((x) => x).length}` +
       ` layer=${S.layer >= 0 ? slug(D.sheets[S.layer].name) : 'none'} peel=${S.peel} depth=${maxDepth}`;
+    if (hash.probe) {
+      const [x, y] = hash.probe.split(',').map(Number), r = renderer.domElement.getBoundingClientRect();
+      hover({ clientX: r.left + x, clientY: r.top + y });
+      status.textContent += ' probe: ' + tip.textContent.replace(/\n/g, ' | ');
+    }
   }
 })();

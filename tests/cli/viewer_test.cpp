@@ -119,9 +119,17 @@ TEST_CASE("viewer: the geode's HTML opens offline, draws, and hiding a sheet cha
   CHECK(text.find("default-src 'none'") != std::string::npos);  // and the page's policy forbids loads
 
   const std::string file = "file://" + html.string();
-  // The hexes drawn, a layer picked and the outer hexes peeled off through the URL hash.
-  const std::string status = page_status(dir, file + "#layer=dome-mx-pz&peel=1");
-  CHECK_MESSAGE(status == "viewer-ok hexes=26 sheets=6 shown=6 layer=dome-mx-pz peel=1 depth=1", status);
+  // Loaded with the sheets hidden and a layer picked, then hovered at the centre: the tip names a
+  // hex and its nodes exactly as the CSV output numbers them (1-based).
+  const std::string status = page_status(dir, file + "#sheets=none&layer=tunnel-x&probe=240,180");
+  CHECK_MESSAGE(status.rfind("viewer-ok hexes=26 sheets=6 shown=0 layer=tunnel-x peel=0 depth=1 probe: hex ", 0) == 0, status);
+  std::smatch tip;
+  REQUIRE_MESSAGE(std::regex_search(status, tip, std::regex("probe: hex ([0-9]+) .*nodes ([0-9 ]+) \\| node ([0-9]+) ")), status);
+  const auto csv = geode_cli("template geode3d --format csv");
+  REQUIRE(csv.code == 0);
+  const std::string row = "\n" + tip[1].str() + "," + std::regex_replace(tip[2].str(), std::regex(" "), ",") + "\n";
+  CHECK_MESSAGE(csv.out.find(row) != std::string::npos, "hex row " << row << " not in the CSV output");
+  CHECK((" " + tip[2].str() + " ").find(" " + tip[3].str() + " ") != std::string::npos);
 
   const test::Image all = screenshot(dir, file + "#hexes=0&ui=0", "all.png");
   CHECK(all.width == 480);
