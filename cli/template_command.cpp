@@ -140,8 +140,11 @@ void write_template_html(const TemplateArgs& a, const templates::GeodeOptions& o
   const templates::GeodeArrangement G = templates::geode_arrangement(o, T.dim);
   primal::ViewScene scene;
   scene.title = "geode template " + a.name;
+  std::ostringstream push;
+  push << " --high-roof " << o.push.high_roof << " --low-roof " << o.push.low_roof << " --dome-depth " << o.push.dome_depth
+       << " --dome-radius " << o.push.dome_radius;
   scene.caption = "geode template " + a.name + " --box " + a.box + " --diagonal " + a.diagonal + " --higher " + a.higher +
-                  ": " + std::to_string(T.dim == 3 ? T.hex.hexes.size() : T.quad.quads.size()) +
+                  push.str() + (a.slide ? " --slide" : "") + ": " + std::to_string(T.dim == 3 ? T.hex.hexes.size() : T.quad.quads.size()) +
                   (T.dim == 3 ? " hexes" : " quads") + (smooth_note.empty() ? ", not smoothed" : ", " + smooth_note) +
                   ". Sheets: the arrangement's fields contoured in the cell (marching tetrahedra), mapped to the box "
                   "like the nodes; the smoothed hexes need not follow them. Layers: the hexes dual to each sheet.";
