@@ -28,8 +28,11 @@ void run_arrange(const ArrangeArgs& a) {
                        (spec.dim == 3 ? "hexahedron)" : "quadrilateral)"));
   templates::Template t = templates::build_template(spec);
   const std::string name = std::filesystem::path(a.spec).stem().string();
-  write_template(t, {name, "spec " + std::filesystem::path(a.spec).filename().string(), a.format, a.output, a.smooth,
-                     a.slide, a.quality});
+  TemplateOutput out{name, "spec " + std::filesystem::path(a.spec).filename().string(), a.format, a.output, a.smooth,
+                     a.slide, a.quality};
+  if (a.format == "html") out.sheets = templates::spec_sheets(spec), out.domain = spec.domain;
+  out.caption = "geode arrange " + a.spec + (a.smooth ? " --smooth" : "") + (a.slide ? " --slide" : "");
+  write_template(t, out);
 }
 
 }  // namespace
@@ -45,8 +48,9 @@ void add_arrange_command(CLI::App& app) {
   c->add_option("SPEC", args->spec, "the spec, a JSON file")->required();
   c->add_option("--format", args->format,
                 "appendix: node and element tables (1-based); csv; json: with sheets, their\n"
-                "intersections and the interleave checks; vtu: VTK XML for ParaView (needs -o)")
-      ->check(CLI::IsMember({"appendix", "csv", "json", "vtu"}))
+                "intersections and the interleave checks; vtu: VTK XML for ParaView (needs -o); html: a\n"
+                "self-contained viewer of the mesh, the sheets and their layers (needs -o)")
+      ->check(CLI::IsMember({"appendix", "csv", "json", "vtu", "html"}))
       ->capture_default_str();
   c->add_option("-o,--output", args->output, "write to FILE (atomically) instead of standard output");
   c->add_flag("--smooth", args->smooth,

@@ -5,8 +5,13 @@
 #include <functional>
 #include <ostream>
 #include <string>
+#include <vector>
 
+#include "primal/io_html.hpp"
 #include "primal/model.hpp"
+#include "primal/smooth.hpp"
+#include "stc/arrangement.hpp"
+#include "stc/sheet.hpp"
 
 namespace geode::templates {
 struct Template;
@@ -20,6 +25,7 @@ void add_conform_commands(CLI::App& app);   // cli/conform_command.cpp: conform,
 void add_dual_command(CLI::App& app);       // cli/dual_command.cpp
 void add_check_command(CLI::App& app);      // cli/check_command.cpp
 void add_arrange_command(CLI::App& app);    // cli/arrange_command.cpp
+void add_view_command(CLI::App& app);       // cli/view_command.cpp
 
 // Shared by the commands (cli/files.cpp): the extension in lower case (".msh"), and a model
 // read by extension and checked content (primal/read_model.hpp: .msh, .exo, .e, .vtu, .vtk);
@@ -36,6 +42,14 @@ struct MeshFile {
   primal::Index index_base = 0;
 };
 MeshFile read_mesh_file(const std::filesystem::path& path);
+
+// The sheets of a computed arrangement for the HTML viewer (cli/view_command.cpp): each sheet
+// contoured from its field inside the domain (stc/sheet_surfaces.hpp), its points mapped by
+// `to_physical` (identity when empty), and its layer read off the dual's element_sheets.
+std::vector<primal::ViewSheet> arrangement_view_sheets(const std::vector<stc::Sheet>& sheets, const stc::Domain& domain,
+                                                       const std::vector<std::vector<int>>& element_sheets,
+                                                       const std::function<primal::Point(const primal::Point&)>& to_physical);
+
 // Standard output when `path` is empty or "-", else the file, written atomically.
 void write_or_print(const std::string& path, const std::function<void(std::ostream&)>& write);
 
@@ -54,6 +68,12 @@ struct TemplateOutput {
   std::string note;              // e.g. what a fix-up did; printed with the smoothing note
   // Replaces templates::smooth_template (e.g. the refinement template's own smoothing).
   std::function<primal::SmoothResult(templates::Template&)> smoother;
+  // --format html: the arrangement's sheets and domain (contoured for the viewer), the map from
+  // the domain to the template's coordinates (identity when empty), and the command that made it.
+  std::vector<stc::Sheet> sheets;
+  stc::Domain domain;
+  std::function<primal::Point(const primal::Point&)> to_physical;
+  std::string caption;
 };
 void write_template(templates::Template& t, const TemplateOutput& out);
 

@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   geode::cli::add_dual_command(app);
   geode::cli::add_check_command(app);
   geode::cli::add_arrange_command(app);
+  geode::cli::add_view_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -9,7 +9,9 @@
 #include <sstream>
 
 #include "cli/commands.hpp"
+#include "primal/boundary.hpp"
 #include "primal/errors.hpp"
+#include "primal/io_html.hpp"
 #include "primal/io_vtk.hpp"
 #include "primal/quality.hpp"
 #include "primal/quality_report.hpp"
@@ -138,6 +140,33 @@ nlohmann::json to_json(const templates::Template& T, const std::string& name) {
   return j;
 }
 
+// The template with its arrangement's sheets contoured from their fields in the domain and
+// mapped as the nodes are (Figure 7 of the paper), each sheet's layer of hexes, and the tet and
+// hex sides as face groups (Figure 1, left).
+void write_template_html(const TemplateOutput& a, const templates::Template& T, const std::string& smooth_note) {
+  primal::ViewScene scene;
+  scene.title = "geode template " + a.name;
+  scene.caption = (a.caption.empty() ? a.name + ", " + a.title : a.caption) + ": " +
+                  std::to_string(T.dim == 3 ? T.hex.hexes.size() : T.quad.quads.size()) +
+                  (T.dim == 3 ? " hexes" : " quads") + (smooth_note.empty() ? ", not smoothed" : ", " + smooth_note) +
+                  ". Sheets: the arrangement's fields contoured in the cell (marching tetrahedra), mapped "
+                  "like the nodes; the smoothed hexes need not follow them. Layers: the hexes dual to each sheet.";
+  scene.sheets = arrangement_view_sheets(a.sheets, a.domain, T.element_sheets, a.to_physical);
+  if (T.dim == 2) {
+    primal::write_html(a.output, T.quad, scene);
+    return;
+  }
+  primal::ViewFaceGroup tet{"tet side", {}}, hex{"hex side", {}};
+  for (const auto& q : primal::boundary_quads(T.hex)) {
+    unsigned common = ~0u;
+    for (auto n : q.nodes) common &= T.node_faces[static_cast<std::size_t>(n)];
+    if (common & (1u << stc::box_face(1, true))) tet.quads.push_back(q.nodes);
+    if (common & (1u << stc::box_face(1, false))) hex.quads.push_back(q.nodes);
+  }
+  scene.groups = {tet, hex};
+  primal::write_html(a.output, T.hex, scene);
+}
+
 void run_template(const TemplateArgs& a) {
   templates::GeodeOptions o;
   o.box = templates::parse_box(a.box);
@@ -162,10 +191,28 @@ void run_template(const TemplateArgs& a) {
     T = a.name == "refine3" ? templates::build_refine3(ro) : templates::build_refine3_2d(ro);
     out.check_conditions = false;
     out.smoother = [ro, fixed = !a.slide](templates::Template& t) { return templates::smooth_refine3(t, ro, fixed); };
+    if (a.format == "html") {
+      const templates::RefineArrangement R = templates::refine3_arrangement(ro, dim);
+      out.sheets = R.sheets, out.domain = R.domain;
+    }
   } else {
     T = dim == 2 ? templates::build_geode2d(o) : templates::build_geode3d(o);
     out.check_conditions = dim == 3;
+    if (a.format == "html") {
+      const templates::GeodeArrangement G = templates::geode_arrangement(o, dim);
+      out.sheets = G.sheets, out.domain = G.domain;
+    }
   }
+  // The arrangements above are built in the reference cell; the nodes are mapped to the box.
+  out.to_physical = [box = o.box, dim](const primal::Point& r) { return templates::box_point(r, box, dim); };
+  std::ostringstream cmd;
+  cmd << "geode template " << a.name << " --box " << a.box;
+  if (!refine)
+    cmd << " --diagonal " << a.diagonal << " --higher " << a.higher << " --high-roof " << o.push.high_roof
+        << " --low-roof " << o.push.low_roof << " --dome-depth " << o.push.dome_depth << " --dome-radius "
+        << o.push.dome_radius;
+  if (a.slide) cmd << " --slide";
+  out.caption = cmd.str();
   if (a.name == "geode4tri" && !a.no_fixup) {
     const auto f = templates::fix_up(T);
     std::ostringstream s;
@@ -228,6 +275,12 @@ void write_template(templates::Template& T, const TemplateOutput& a) {
     s << "\nQuad scaled Jacobian: min " << lo << ", max " << hi << "\n";
     text += s.str();
   }
+  if (a.format == "html") {
+    if (a.output.empty()) throw InvalidInput("--format html needs -o FILE.html");
+    write_template_html(a, T, smooth_note);
+    if (!text.empty()) std::cout << text;
+    return;
+  }
   if (a.format == "vtu") {
     // The writer adds the scaled Jacobian (and block) cell arrays itself.
     if (a.output.empty()) throw InvalidInput("--format vtu needs -o FILE.vtu");
@@ -267,8 +320,9 @@ void add_template_command(CLI::App& app) {
   t->add_option("--format", args->format,
                 "appendix: the paper's Tables 2 and 3 (1-based); csv: node and element tables; json: with\n"
                 "sheets, their intersections and the interleave checks; vtu: VTK XML for ParaView (needs -o);\n"
-                "spec: the template as an arrangement spec for `geode arrange` (nothing is derived)")
-      ->check(CLI::IsMember({"appendix", "csv", "json", "vtu", "spec"}))
+                "spec: the template as an arrangement spec for `geode arrange` (nothing is derived);\n"
+                "html: a self-contained viewer of the hexes, the arrangement's sheets and their layers (needs -o)")
+      ->check(CLI::IsMember({"appendix", "csv", "json", "vtu", "spec", "html"}))
       ->capture_default_str();
   t->add_option("-o,--output", args->output, "write to FILE (atomically) instead of standard output");
   t->add_flag("--slide", args->slide,

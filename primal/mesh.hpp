@@ -36,4 +36,10 @@ struct TriMesh {
   std::vector<std::array<Index, 3>> tris;
 };
 
+// Line segments in space, e.g. a chord of a quad mesh drawn as a curve.
+struct SegmentMesh {
+  std::vector<Point> points;
+  std::vector<std::array<Index, 2>> segments;
+};
+
 }  // namespace geode::primal

@@ -24,10 +24,6 @@ stc::Domain reference_domain(int dim) {
   return {Point(-1, 0, -1), Point(1, 1, 1), 3};
 }
 
-Point to_box(const Point& r, const Eigen::Vector3d& box, int dim) {
-  return Point(0.5 * box.x() * r[0], box.y() * (r[1] - 0.5), dim == 3 ? 0.5 * box.z() * r[2] : 0.0);
-}
-
 std::string corner_name(const Point& p) {
   return std::string("(") + (p[0] < 0 ? "-x" : "+x") + "," + (p[2] < 0 ? "-z" : "+z") + ")";
 }
@@ -236,12 +232,12 @@ GeodeArrangement geode_arrangement(const GeodeOptions& o, int dim) {
 
 ArrangementSpec geode_spec(const GeodeOptions& o, int dim) {
   auto [bottom, top] = reference_patches(o, dim);
-  for (auto& q : bottom.points) q = to_box(q, o.box, dim);
-  for (auto& q : top.points) q = to_box(q, o.box, dim);
+  for (auto& q : bottom.points) q = box_point(q, o.box, dim);
+  for (auto& q : top.points) q = box_point(q, o.box, dim);
   ArrangementSpec spec;
   spec.dim = dim;
   const stc::Domain ref = reference_domain(dim);
-  spec.domain = stc::Domain(to_box(ref.lo, o.box, dim), to_box(ref.hi, o.box, dim), dim);
+  spec.domain = stc::Domain(box_point(ref.lo, o.box, dim), box_point(ref.hi, o.box, dim), dim);
   spec.completion = CompletionSpec{bottom, top, o.higher, o.push};
   return spec;
 }
@@ -277,7 +273,7 @@ Template dual_template(const stc::DualMesh& D, const std::vector<stc::Sheet>& sh
 Template template_from_dual(const stc::DualMesh& D, const std::vector<stc::Sheet>& sheets, const stc::Domain& dom,
                             const PrescribedFace& bottom, const PrescribedFace& top, const Eigen::Vector3d& box) {
   Template T = dual_template(D, sheets, dom, &bottom, &top);
-  for (auto& q : T.dim == 3 ? T.hex.points : T.quad.points) q = to_box(q, box, T.dim);
+  for (auto& q : T.dim == 3 ? T.hex.points : T.quad.points) q = box_point(q, box, T.dim);
   return T;
 }
 
@@ -328,6 +324,10 @@ std::vector<primal::Obstruction> template_obstructions(const Template& t) {
   primal::RealizabilityOptions o;
   o.node_faces = t.node_faces;
   return t.dim == 3 ? primal::find_obstructions(t.hex, o) : primal::find_obstructions(t.quad, o);
+}
+
+Point box_point(const Point& r, const Eigen::Vector3d& box, int dim) {
+  return Point(0.5 * box.x() * r[0], box.y() * (r[1] - 0.5), dim == 3 ? 0.5 * box.z() * r[2] : 0.0);
 }
 
 Eigen::Vector3d parse_box(const std::string& text) {

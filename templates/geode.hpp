@@ -93,6 +93,10 @@ struct GeodeArrangement {
 };
 GeodeArrangement geode_arrangement(const GeodeOptions& options, int dim);
 
+// Where a reference point (u, v, w) of the buffer cell lies in the box centred at the origin
+// (the map that places a derived template's nodes).
+Point box_point(const Point& reference, const Eigen::Vector3d& box, int dim);
+
 // Why a push cannot be used ("" when it can): roofs 0 < low < high < 1, depth and radius
 // blend in (0, 1).
 std::string push_error(const PushParameters& push);
