@@ -28,8 +28,9 @@ void run_arrange(const ArrangeArgs& a) {
                        (spec.dim == 3 ? "hexahedron)" : "quadrilateral)"));
   templates::Template t = templates::build_template(spec);
   const std::string name = std::filesystem::path(a.spec).stem().string();
-  TemplateOutput out{name, "spec " + std::filesystem::path(a.spec).filename().string(), a.format, a.output, a.smooth,
-                     a.slide, a.quality};
+  TemplateOutput out;
+  out.name = name, out.title = "spec " + std::filesystem::path(a.spec).filename().string();
+  out.format = a.format, out.output = a.output, out.smooth = a.smooth, out.slide = a.slide, out.quality = a.quality;
   if (a.format == "html") out.sheets = templates::spec_sheets(spec), out.domain = spec.domain;
   out.caption = "geode arrange " + a.spec + (a.smooth ? " --smooth" : "") + (a.slide ? " --slide" : "");
   write_template(t, out);

@@ -182,7 +182,9 @@ void run_template(const TemplateArgs& a) {
     write_or_print(a.output, [&](std::ostream& os) { os << text; });
     return;
   }
-  TemplateOutput out{a.name, "box " + a.box, a.format, a.output, !a.no_smooth, a.slide, a.quality};
+  TemplateOutput out;
+  out.name = a.name, out.title = "box " + a.box, out.format = a.format, out.output = a.output;
+  out.smooth = !a.no_smooth, out.slide = a.slide, out.quality = a.quality;
   templates::Template T;
   if (refine) {
     templates::RefineOptions ro = a.refine;

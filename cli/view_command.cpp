@@ -70,7 +70,7 @@ void run_view(const ViewArgs& a) {
   const std::filesystem::path out(a.output);
   if (file_extension(out) != ".html")
     throw InvalidInput(a.output + ": unknown output format '" + file_extension(out) + "' (expected .html)");
-  const InputMesh m = read_hex_or_quad_mesh(a.input);
+  const MeshFile m = read_mesh_file(a.input);
   primal::ViewScene scene;
   scene.title = a.title.empty() ? std::filesystem::path(a.input).filename().string() : a.title;
   const char* cells = m.dim == 3 ? "hexes" : "quads";
