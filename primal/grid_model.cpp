@@ -7,7 +7,8 @@ namespace geode::primal {
 
 Model grid_model(std::array<int, 3> cells, double h,
                  const std::function<bool(int, int, int)>& is_tet) {
-  const auto [nx, ny, nz] = cells;
+  // Plain variables, not a structured binding: clang 14 (the fuzz build) cannot capture those.
+  const int nx = cells[0], ny = cells[1], nz = cells[2];
   Model model;
   auto id = [&](int i, int j, int k) { return static_cast<Index>(i + (nx + 1) * (j + (ny + 1) * k)); };
   for (int k = 0; k <= nz; ++k)

@@ -32,8 +32,9 @@ struct Interface {
 // The two triangles of an interface quad, as node triples in the quad's orientation.
 std::array<std::array<Index, 3>, 2> interface_triangles(const InterfaceQuad& quad);
 
-// Finds the interface. Throws TopologyError naming the hex face (hex, local face, nodes) or
-// node when the parts do not conform:
+// Finds the interface. Throws TopologyError naming the hex face (hex and nodes) or node, in the
+// model's file ids with coordinates (model.hpp: describe_element, describe_node), when the parts
+// do not conform:
 // - a boundary quad of the hex part matched by only one triangle of the tet part (or by
 //   triangles of both diagonals);
 // - a node of one side lying on a boundary face of the other side without being one of its

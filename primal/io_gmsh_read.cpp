@@ -295,11 +295,18 @@ class MshReader {
     node_points_.push_back(p);
   }
 
+  // The header of $Nodes and $Elements in 4.1: block count, item count, smallest and largest
+  // tag (the tags are checked one by one instead).
+  std::pair<std::size_t, std::size_t> blocks_header(const char* items, std::size_t ascii_min, std::size_t binary_min) {
+    const std::size_t blocks = count_field((std::string("the number of ") + items + " blocks").c_str(), item_bytes(4, 20));
+    const std::size_t total = count_field((std::string("the number of ") + items + "s").c_str(), item_bytes(ascii_min, binary_min));
+    size_field("the smallest tag");
+    size_field("the largest tag");
+    return {blocks, total};
+  }
+
   void nodes41() {
-    const std::size_t blocks = count_field("the number of node blocks", item_bytes(4, 20));
-    const std::size_t total = count_field("the number of nodes", item_bytes(4, 32));
-    size_field("the smallest node tag");
-    size_field("the largest node tag");
+    const auto [blocks, total] = blocks_header("node", 4, 32);
     node_tags_.reserve(total);
     node_points_.reserve(total);
     for (std::size_t b = 0; b < blocks; ++b) {
@@ -356,10 +363,7 @@ class MshReader {
   }
 
   void elements41() {
-    const std::size_t blocks = count_field("the number of element blocks", item_bytes(4, 20));
-    const std::size_t total = count_field("the number of elements", item_bytes(2, 16));
-    size_field("the smallest element tag");
-    size_field("the largest element tag");
+    const auto [blocks, total] = blocks_header("element", 2, 16);
     elements_.reserve(total);
     for (std::size_t b = 0; b < blocks; ++b) {
       int_field("an element block's entity dimension");

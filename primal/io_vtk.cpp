@@ -368,6 +368,13 @@ long long parse_int(const std::string& file, int line, std::string_view tok) {
   return x;
 }
 
+int parse_int32(const std::string& file, int line, std::string_view tok) {
+  const long long v = parse_int(file, line, tok);
+  if (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max())
+    fail(file, line, "'" + std::string(tok) + "' is out of range");
+  return static_cast<int>(v);
+}
+
 Point point_from(const std::string& file, int line, std::size_t index, double x, double y,
                  double z) {
   const Point p(x, y, z);
@@ -878,12 +885,12 @@ VtkGrid parse_vtu(std::string_view content, const std::string& source) {
   const Numbers cn = data_array_values(file, *conn, nc ? offsets.back() : 0, "connectivity", enc);
   std::vector<int> cell_line(nc, conn->line), type_line(nc, types->line);
   for (std::size_t c = 0; c < nc; ++c) {
-    g.cell_types.push_back(static_cast<int>(parse_int(file, tn.lines[c], tn.tokens[c])));
+    g.cell_types.push_back(parse_int32(file, tn.lines[c], tn.tokens[c]));
     type_line[c] = tn.lines[c];
     std::vector<Index> cell;
     const std::size_t begin = c ? offsets[c - 1] : 0;
     for (std::size_t i = begin; i < offsets[c]; ++i) {
-      cell.push_back(static_cast<Index>(parse_int(file, cn.lines[i], cn.tokens[i])));
+      cell.push_back(parse_int32(file, cn.lines[i], cn.tokens[i]));
     }
     if (begin < offsets[c]) cell_line[c] = cn.lines[begin];
     g.cells.push_back(std::move(cell));
@@ -909,7 +916,7 @@ VtkGrid parse_vtu(std::string_view content, const std::string& source) {
       } else if (is_int_type(type)) {
         std::vector<int> v;
         for (std::size_t i = 0; i < nc; ++i)
-          v.push_back(static_cast<int>(parse_int(file, n.lines[i], n.tokens[i])));
+          v.push_back(parse_int32(file, n.lines[i], n.tokens[i]));
         g.cell_data.ints.emplace_back(nm, std::move(v));
       } else {
         fail(file, a.line, "CellData '" + nm + "': unsupported type \"" + type + "\"");
@@ -993,9 +1000,15 @@ class Tokens {
   }
   long long integer(const std::string& what) {
     if (in_array_) {
-      const double v = raw(what);
       if (real_) fail(file_, line_, what + ": floating-point data where integers are expected");
-      return static_cast<long long>(v);
+      const std::uint64_t bits = raw_bits(what);
+      if (unsigned_ || size_ == 8) {
+        if (unsigned_ && bits > static_cast<std::uint64_t>(std::numeric_limits<long long>::max()))
+          fail(file_, line_, what + ": " + std::to_string(bits) + " is out of range");
+        return static_cast<long long>(bits);
+      }
+      const std::uint64_t sign = std::uint64_t{1} << (8 * size_ - 1);
+      return static_cast<long long>(bits ^ sign) - static_cast<long long>(sign);
     }
     const auto t = next(what);
     return parse_int(file_, line_before(), t);
@@ -1004,6 +1017,13 @@ class Tokens {
     if (in_array_) return raw(what);
     const auto t = next(what);
     return parse_double(file_, line_before(), t);
+  }
+  // An integer that must fit an int (node numbers, cell types, int arrays).
+  int int32(const std::string& what) {
+    const long long v = integer(what);
+    if (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max())
+      fail(file_, line_before(), what + ": " + std::to_string(v) + " is out of range");
+    return static_cast<int>(v);
   }
   std::size_t count(const std::string& what) {
     const long long n = integer(what);
@@ -1035,12 +1055,17 @@ class Tokens {
     if (in_array_) return;
     while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_]))) line_ += s_[pos_++] == '\n';
   }
-  // One big-endian value of the current array type.
-  double raw(const std::string& what) {
+  // One big-endian value of the current array type, as its bits.
+  std::uint64_t raw_bits(const std::string& what) {
     if (s_.size() - pos_ < size_) fail(file_, line_, what + ": binary data cut short (truncated file?)");
     std::uint64_t bits = 0;
     for (std::size_t k = 0; k < size_; ++k) bits = bits << 8 | static_cast<unsigned char>(s_[pos_ + k]);
     pos_ += size_;
+    return bits;
+  }
+  // The same as a double (integer arrays read as reals: converted exactly up to 2^53).
+  double raw(const std::string& what) {
+    const std::uint64_t bits = raw_bits(what);
     if (real_) {
       if (size_ == 4) {
         const auto b32 = static_cast<std::uint32_t>(bits);
@@ -1052,9 +1077,10 @@ class Tokens {
       std::memcpy(&d, &bits, 8);
       return d;
     }
-    if (unsigned_ || size_ == 8) return static_cast<double>(static_cast<std::int64_t>(bits));
+    if (unsigned_) return static_cast<double>(bits);
+    if (size_ == 8) return static_cast<double>(static_cast<std::int64_t>(bits));
     const std::uint64_t sign = std::uint64_t{1} << (8 * size_ - 1);
-    return static_cast<double>(static_cast<std::int64_t>((bits ^ sign)) - static_cast<std::int64_t>(sign));
+    return static_cast<double>(static_cast<std::int64_t>(bits ^ sign) - static_cast<std::int64_t>(sign));
   }
 };
 
@@ -1140,7 +1166,7 @@ VtkGrid parse_vtk(std::string_view content, const std::string& source) {
           std::vector<Index> cell;
           cell_line.push_back(t.line());
           for (std::size_t i = offsets[c]; i < offsets[c + 1]; ++i) {
-            cell.push_back(static_cast<Index>(t.integer("cell " + std::to_string(c))));
+            cell.push_back((t.int32("cell " + std::to_string(c))));
           }
           g.cells.push_back(std::move(cell));
         }
@@ -1153,7 +1179,7 @@ VtkGrid parse_vtk(std::string_view content, const std::string& source) {
           const std::size_t n = t.count(what);
           cell_line.push_back(t.line_before());
           std::vector<Index> cell;
-          for (std::size_t i = 0; i < n; ++i) cell.push_back(static_cast<Index>(t.integer(what)));
+          for (std::size_t i = 0; i < n; ++i) cell.push_back((t.int32(what)));
           read += n + 1;
           g.cells.push_back(std::move(cell));
         }
@@ -1174,7 +1200,7 @@ VtkGrid parse_vtk(std::string_view content, const std::string& source) {
       t.begin_array("int", "CELL_TYPES");
       for (std::size_t c = 0; c < n; ++c) {
         g.cell_types.push_back(
-            static_cast<int>(t.integer("the type of cell " + std::to_string(c))));
+            (t.int32("the type of cell " + std::to_string(c))));
         type_line.push_back(t.line_before());
       }
       t.end_array();
@@ -1228,7 +1254,7 @@ VtkGrid parse_vtk(std::string_view content, const std::string& source) {
               if (is_real)
                 dv.push_back(t.real("array " + name));
               else
-                iv.push_back(static_cast<int>(t.integer("array " + name)));
+                iv.push_back((t.int32("array " + name)));
             }
             t.end_array();
             if (cell && nco == 1) {
@@ -1256,7 +1282,7 @@ VtkGrid parse_vtk(std::string_view content, const std::string& source) {
             if (is_real)
               dv.push_back(t.real("array " + name));
             else
-              iv.push_back(static_cast<int>(t.integer("array " + name)));
+              iv.push_back((t.int32("array " + name)));
           }
           t.end_array();
           if (cell && comps[a] == 1) {

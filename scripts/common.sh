@@ -24,6 +24,29 @@ geode_install() {
   fi
 }
 
+# geode_fuzz: the libFuzzer targets of the file readers (tests/fuzz), built with clang in
+# build-fuzz, each run for GEODE_FUZZ_SECONDS (30) from its seed corpus; a crash fails, its input
+# kept as build-fuzz/crash-<reader>-*.
+geode_fuzz() {
+  local seconds=${GEODE_FUZZ_SECONDS:-30} dir="$GEODE_ROOT/build-fuzz"
+  CC=clang CXX=clang++ cmake -S "$GEODE_ROOT" -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGEODE_FUZZ=ON \
+    -DGEODE_BENCH=OFF >/dev/null
+  cmake --build "$dir" -j "$JOBS" --target fuzz_msh fuzz_vtu fuzz_vtk
+  for reader in msh vtu vtk; do
+    local work
+    work=$(mktemp -d)
+    echo "== fuzz $reader ($seconds s)"
+    if ! "$dir/fuzz_$reader" -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=10 \
+        -artifact_prefix="$dir/crash-$reader-" "$work" "$GEODE_ROOT/tests/fuzz/corpus/$reader" \
+        >"$dir/fuzz_$reader.log" 2>&1; then
+      tail -40 "$dir/fuzz_$reader.log" >&2
+      rm -rf "$work"
+      exit 1
+    fi
+    rm -rf "$work"
+  done
+}
+
 # geode_build DIR [cmake args...]
 geode_build() {
   local dir=$1; shift

@@ -43,6 +43,14 @@ void run_script(const std::string& kind, const fs::path& source, const fs::path&
   REQUIRE_MESSAGE(status == 0, cmd);
 }
 
+// sample_hexes() written by us as ASCII .vtu, then by write_variants.py `kind` into `dir`.
+HexMesh write_variants(const std::string& kind, const fs::path& dir) {
+  const HexMesh m = sample_hexes();
+  write_vtu(dir / "source.vtu", m);
+  run_script(kind, dir / "source.vtu", dir);
+  return m;
+}
+
 void check_points(const std::vector<Point>& a, const std::vector<Point>& b, double tol) {
   REQUIRE(a.size() == b.size());
   for (std::size_t i = 0; i < a.size(); ++i) CHECK((a[i] - b[i]).norm() <= tol);
@@ -52,10 +60,7 @@ void check_points(const std::vector<Point>& a, const std::vector<Point>& b, doub
 
 TEST_CASE("VTK's own writer: every .vtu encoding and legacy .vtk read back the same mesh") {
   test::TempDir dir;
-  const HexMesh m = sample_hexes();
-  const fs::path source = dir.path / "source.vtu";
-  write_vtu(source, m);
-  run_script("vtk", source, dir.path);
+  const HexMesh m = write_variants("vtk", dir.path);
   for (const std::string name : {"ascii.vtu", "binary.vtu", "binary-zlib.vtu", "appended-raw.vtu", "appended-base64.vtu",
                            "appended-raw-zlib.vtu", "binary-zlib-uint64.vtu", "appended-base64-zlib-uint64.vtu",
                            "legacy-ascii.vtk", "legacy-binary.vtk"}) {
@@ -77,10 +82,7 @@ TEST_CASE("VTK's own writer: every .vtu encoding and legacy .vtk read back the s
 
 TEST_CASE("meshio's files: .exo, .msh 2.2 ASCII and binary, .vtu, .vtk read as models") {
   test::TempDir dir;
-  const HexMesh m = sample_hexes();
-  const fs::path source = dir.path / "source.vtu";
-  write_vtu(source, m);
-  run_script("meshio", source, dir.path);
+  const HexMesh m = write_variants("meshio", dir.path);
   for (const std::string name : {"meshio.exo", "meshio-22-ascii.msh", "meshio-22-binary.msh", "meshio.vtu",
                            "meshio-ascii.vtu", "meshio.vtk"}) {
     CAPTURE(name);
