@@ -245,14 +245,16 @@ void write_template(templates::Template& T, const TemplateOutput& a) {
       << r.initial_min_scaled_jacobian << " -> " << r.final_min_scaled_jacobian << " in " << r.iterations
       << " iterations, " << r.seconds << " s";
     smooth_note += (smooth_note.empty() ? "" : "; ") + s.str();
-    if (!r.untangled) {
-      // Say whether the mesh itself forbids positive Jacobians, rather than blame the smoother.
-      const auto obstructions = templates::template_obstructions(T);
+    // Say whether the mesh itself forbids an untangled embedding, rather than blame the smoother
+    // (or trust positive Jacobians around a pinched corner, where the cells overlap).
+    const auto obstructions = templates::template_obstructions(T);
+    if (!r.untangled)
       std::cerr << "geode: warning: smoothing could not untangle every element; "
                 << (obstructions.empty() ? "no combinatorial obstruction found (primal/realizability.hpp)\n"
-                                         : "the mesh cannot be untangled: " +
-                                               primal::format_obstructions(obstructions, T.dim, 1));
-    }
+                                         : "no placement can: " + primal::format_obstructions(obstructions, T.dim, 1));
+    else if (!obstructions.empty())
+      std::cerr << "geode: warning: every corner Jacobian is positive, but the cells overlap: "
+                << primal::format_obstructions(obstructions, T.dim, 1);
   }
   const int dim = T.dim;
   const auto& pts = dim == 3 ? T.hex.points : T.quad.points;

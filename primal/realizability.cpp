@@ -91,6 +91,12 @@ std::vector<Index> grow_patches(std::size_t n, const std::function<std::vector<I
 
 bool contains(const std::vector<Index>& sorted, Index x) { return std::binary_search(sorted.begin(), sorted.end(), x); }
 
+void check_node_faces(const RealizabilityOptions& options, std::size_t nodes) {
+  if (!options.node_faces.empty() && options.node_faces.size() != nodes)
+    throw InvalidInput("realizability: node_faces has " + std::to_string(options.node_faces.size()) +
+                       " entries for " + std::to_string(nodes) + " nodes");
+}
+
 // Nodes' planar faces from the template's bits: face f for bit f.
 std::vector<std::vector<Index>> node_patches_from_bits(const std::vector<unsigned>& bits) {
   std::vector<std::vector<Index>> out(bits.size());
@@ -168,9 +174,7 @@ class HexFinder {
 
   void collect_faces() {
     const std::size_t nv = mesh_.points.size();
-    if (!options_.node_faces.empty() && options_.node_faces.size() != nv)
-      throw InvalidInput("realizability: node_faces has " + std::to_string(options_.node_faces.size()) +
-                         " entries for " + std::to_string(nv) + " nodes");
+    check_node_faces(options_, nv);
     std::unordered_map<FaceKey, Index, IndexArrayHash> face_id;
     for (std::size_t h = 0; h < mesh_.hexes.size(); ++h) {
       const auto& hex = mesh_.hexes[h];
@@ -405,9 +409,7 @@ class QuadFinder {
  private:
   void collect_edges() {
     const std::size_t nv = mesh_.points.size();
-    if (!options_.node_faces.empty() && options_.node_faces.size() != nv)
-      throw InvalidInput("realizability: node_faces has " + std::to_string(options_.node_faces.size()) +
-                         " entries for " + std::to_string(nv) + " nodes");
+    check_node_faces(options_, nv);
     std::unordered_map<EdgeKey, std::vector<std::pair<Index, int>>, IndexArrayHash> uses;
     std::vector<EdgeKey> order;
     for (std::size_t q = 0; q < mesh_.quads.size(); ++q) {
