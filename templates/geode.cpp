@@ -200,9 +200,9 @@ GeodeArrangement geode_arrangement(const GeodeOptions& o, int dim) {
     return along_x == (o.higher == Higher::X) ? p.high_roof : p.low_roof;
   });
   auto domes = complete_domes(top, 1.0, p.dome_depth, p.dome_radius);
+  if (!(p.centre_depth >= 0 && p.centre_depth < 1 && p.centre_radius >= 0 && p.centre_radius < 1))
+    throw InvalidInput("geode: centre dome depth and radius blend must be in [0, 1) (0: as the corner domes)");
   if (o.split == TopSplit::FourTriangles && (p.centre_depth > 0 || p.centre_radius > 0)) {
-    if (!(p.centre_depth >= 0 && p.centre_depth < 1 && p.centre_radius >= 0 && p.centre_radius < 1))
-      throw InvalidInput("geode: centre dome depth and radius blend must be in [0, 1) (0: as the corner domes)");
     const auto centre = complete_domes(top, 1.0, p.centre_depth > 0 ? p.centre_depth : p.dome_depth,
                                        p.centre_radius > 0 ? p.centre_radius : p.dome_radius);
     for (auto& d : domes)
