@@ -344,6 +344,12 @@ void add_template_command(CLI::App& app) {
   t->add_option("--low-roof", args->push.low_roof,
                 "push: lower tunnel roof, fraction of the height (refine3: the tunnel along z; default 0.6 there)")
       ->capture_default_str();
+  t->add_option("--centre-depth", args->push.centre_depth,
+                "push, geode4tri: depth of the centre vertex's dome (0: --dome-depth)")
+      ->capture_default_str();
+  t->add_option("--centre-radius", args->push.centre_radius,
+                "push, geode4tri: radius blend of the centre vertex's dome (0: --dome-radius)")
+      ->capture_default_str();
   t->add_option("--layer", args->refine.layer, "refine3: height of the horizontal layer sheet, below both roofs")
       ->capture_default_str();
   t->add_option("--dome-depth", args->push.dome_depth, "push: how far below the tet side the domes reach, fraction of the height")

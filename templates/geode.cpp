@@ -191,6 +191,8 @@ std::string push_error(const PushParameters& p) {
     return "tunnel roofs must satisfy 0 < low < high < 1 (tunnels must not reach the tet side)";
   if (!(0 < p.dome_depth && p.dome_depth < 1)) return "dome depth must be in (0, 1) (domes must not reach the hex side)";
   if (!(0 < p.dome_radius && p.dome_radius < 1)) return "dome radius blend must be in (0, 1)";
+  if (!(p.centre_depth >= 0 && p.centre_depth < 1 && p.centre_radius >= 0 && p.centre_radius < 1))
+    return "centre dome depth and radius blend must be in [0, 1) (0: as the corner domes)";
   return "";
 }
 
@@ -201,7 +203,14 @@ std::vector<stc::Sheet> complete_interface(const InterfacePatch& bottom, const I
     const bool along_x = std::abs(along.x()) > std::abs(along.z());
     return along_x == (higher == Higher::X) ? p.high_roof : p.low_roof;
   });
-  const auto domes = complete_domes(top, 1.0, p.dome_depth, p.dome_radius);
+  auto domes = complete_domes(top, 1.0, p.dome_depth, p.dome_radius);
+  if (p.centre_depth > 0 || p.centre_radius > 0) {
+    // Only the four-triangle split has a centre vertex: the last patch point, vertex 4.
+    const auto centre = complete_domes(top, 1.0, p.centre_depth > 0 ? p.centre_depth : p.dome_depth,
+                                       p.centre_radius > 0 ? p.centre_radius : p.dome_radius);
+    for (auto& d : domes)
+      if (d.vertex == 4) d = centre.back();
+  }
   std::vector<stc::Sheet> sheets;
   for (const auto& t : tunnels) {
     stc::Sheet s = t.sheet;

@@ -36,6 +36,10 @@ struct PushParameters {
   double low_roof = 0.6;
   double dome_depth = 0.9;
   double dome_radius = 0.6;
+  // Four-triangle split only: the centre vertex's dome gets its own depth and radius blend
+  // (0: the same as the corner domes'), a wider family than one depth for all.
+  double centre_depth = 0.0;
+  double centre_radius = 0.0;
 };
 
 // The buffer cell: an axis-aligned box centred at the origin, y up; the tet side (diced

@@ -146,7 +146,7 @@ InterfacePatch Reader::patch(const json& j, const std::string& path, const stc::
 }
 
 PushParameters Reader::push(const json& j) const {
-  object(j, "push", {"high_roof", "low_roof", "dome_depth", "dome_radius"});
+  object(j, "push", {"high_roof", "low_roof", "dome_depth", "dome_radius", "centre_depth", "centre_radius"});
   PushParameters p;
   const auto get = [&](const char* key, double& x) {
     if (j.contains(key)) x = number(j[key], join("push", key));
@@ -155,6 +155,8 @@ PushParameters Reader::push(const json& j) const {
   get("low_roof", p.low_roof);
   get("dome_depth", p.dome_depth);
   get("dome_radius", p.dome_radius);
+  get("centre_depth", p.centre_depth);
+  get("centre_radius", p.centre_radius);
   if (const std::string why = push_error(p); !why.empty()) fail("push", why);
   return p;
 }
@@ -339,7 +341,7 @@ json patch_json(const InterfacePatch& p) {
 // Keys in the order a reader expects them (the rest after, alphabetically).
 int key_rank(const std::string& key) {
   static const std::vector<std::string> order = {"dim", "domain", "completion", "hex_side", "tet_side", "higher",
-                                                 "push", "high_roof", "low_roof", "dome_depth", "dome_radius",
+                                                 "push", "high_roof", "low_roof", "dome_depth", "dome_radius", "centre_depth", "centre_radius",
                                                  "sheets", "name", "kind", "sweep"};
   const auto it = std::find(order.begin(), order.end(), key);
   return it == order.end() ? static_cast<int>(order.size()) : static_cast<int>(it - order.begin());
@@ -507,6 +509,9 @@ json spec_json(const ArrangementSpec& s) {
                  {"low_roof", c.push.low_roof},
                  {"dome_depth", c.push.dome_depth},
                  {"dome_radius", c.push.dome_radius}};
+    // The centre dome's own depth and radius: written only when set (0 means as the corners').
+    if (c.push.centre_depth > 0) j["push"]["centre_depth"] = c.push.centre_depth;
+    if (c.push.centre_radius > 0) j["push"]["centre_radius"] = c.push.centre_radius;
   }
   if (!s.sheets.empty()) {
     j["sheets"] = json::array();

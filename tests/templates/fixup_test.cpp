@@ -121,3 +121,20 @@ TEST_CASE("fix_up: the geode has nothing to fix") {
   CHECK(r.steps.empty());
   CHECK(T.hex.hexes == hexes);
 }
+
+TEST_CASE("fix_up: a centre dome of its own depth and radius needs one pillowing and smooths to >= 0.3") {
+  auto o = four_triangles();
+  o.push.dome_depth = 0.95;
+  o.push.dome_radius = 0.8;
+  o.push.centre_depth = 0.45;
+  o.push.centre_radius = 0.15;
+  auto T = templates::build_geode3d(o);
+  const auto r = templates::fix_up(T);
+  CHECK(r.obstructions_before == 1);
+  CHECK(r.obstructions_after == 0);
+  const auto s = templates::smooth_template(T, false);
+  CHECK(s.untangled);
+  MESSAGE("geode4tri, own centre dome: " << T.hex.hexes.size() << " hexes, min scaled Jacobian " << s.final_min_scaled_jacobian);
+  CHECK(s.final_min_scaled_jacobian >= 0.3);
+  CHECK(primal::check_validity(T.hex).ok());
+}
