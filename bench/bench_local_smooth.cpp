@@ -1,7 +1,8 @@
 // The worst-first local smoother (primal/local_smooth.hpp) on conform's output before smoothing:
 // CPU milliseconds per buffer hex, patches, min scaled Jacobian per block before and after, with
 // 1 thread and with TBB's default; then the same machinery over every hex (global).
-// Usage: bench_local_smooth [half-block n] [nugget n]   (defaults 8 and 4)
+// Usage: bench_local_smooth [half-block n] [nugget n] [target] [max_visits] [max_iterations]
+//        (defaults 8, 4 and LocalSmoothOptions' own)
 #include <ctime>
 #include <algorithm>
 #include <cstdio>
@@ -35,7 +36,7 @@ void print_blocks(const char* label, const std::map<int, double>& b) {
   std::printf("\n");
 }
 
-void run(const char* name, const primal::Model& input) {
+void run(const char* name, const primal::Model& input, const primal::LocalSmoothOptions& base) {
   conform::ConformOptions o;
   o.smooth = conform::ConformSmooth::kNone;
   const conform::ConformResult r = conform::conform(input, o);
@@ -61,7 +62,7 @@ void run(const char* name, const primal::Model& input) {
                {"global, default threads", true, 0}};
   for (const Mode& m : modes) {
     primal::HexMesh work = mesh;
-    primal::LocalSmoothOptions lo;
+    primal::LocalSmoothOptions lo = base;
     lo.threads = m.threads;
     const std::clock_t c0 = std::clock();
     const auto res = primal::smooth_hexes_local(work, cons, &surface,
@@ -80,7 +81,12 @@ void run(const char* name, const primal::Model& input) {
 int main(int argc, char** argv) {
   const int half = argc > 1 ? std::atoi(argv[1]) : 8;
   const int nugget = argc > 2 ? std::atoi(argv[2]) : 4;
-  run(("half block " + std::to_string(half)).c_str(), conform::demo_half_block(half));
-  run(("nugget " + std::to_string(nugget)).c_str(), conform::demo_nugget(nugget));
+  primal::LocalSmoothOptions o;
+  if (argc > 3) o.target = std::atof(argv[3]);
+  if (argc > 4) o.max_visits = std::atoi(argv[4]);
+  if (argc > 5) o.max_iterations = std::atoi(argv[5]);
+  std::printf("target %.2f, max_visits %d, max_iterations %d\n", o.target, o.max_visits, o.max_iterations);
+  run(("half block " + std::to_string(half)).c_str(), conform::demo_half_block(half), o);
+  run(("nugget " + std::to_string(nugget)).c_str(), conform::demo_nugget(nugget), o);
   return 0;
 }

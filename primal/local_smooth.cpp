@@ -161,7 +161,7 @@ struct Context {
   const SurfaceProjector* projector;
   const LocalSmoothOptions& options;
   std::vector<Index> node_start, node_hexes;  // node -> hexes (CSR)
-  std::vector<double> floor;                  // per hex
+  std::vector<double> start;                  // per hex, its scaled Jacobian when the call began
 };
 
 bool is_fixed(const Context& ctx, Index v) {
@@ -232,7 +232,7 @@ struct PatchOutcome {
 // One patch: the free nodes of a seed hex move; every frame with a moving node is counted.
 class Patch {
  public:
-  Patch(const Context& ctx, Index seed, std::span<const Index> affected)
+  Patch(const Context& ctx, Index seed, std::span<const Index> affected, const std::vector<double>& sj)
       : ctx_(ctx), hex_(affected.begin(), affected.end()) {
     for (Index v : ctx.mesh.hexes[seed])
       if (!is_fixed(ctx, v) && std::find(node_.begin(), node_.end(), v) == node_.end())
@@ -261,6 +261,18 @@ class Patch {
       sum += (ctx.mesh.points[ctx.mesh.hexes[seed][e[0]]] - ctx.mesh.points[ctx.mesh.hexes[seed][e[1]]]).norm();
     length_ = std::max(sum / 12.0, 1e-300);
     unit_ = length_ * length_ * length_;
+    // Floors (see the header): the patch's worst never drops; hexes within `margin` of it keep
+    // their start; better ones may lose `loss` from their start, never past worst + margin.
+    double worst = std::numeric_limits<double>::max();
+    for (Index h : hex_) worst = std::min(worst, sj[h]);
+    const double keep = std::max(worst, 0.0) + ctx.options.margin;
+    for (Index h : hex_) {
+      const double s = ctx.start[h];
+      const double f = s <= 0.0 ? -std::numeric_limits<double>::infinity()
+                       : s < keep ? s
+                                  : std::max(keep, s - ctx.options.loss);
+      floor_.push_back(sj[h] <= 0.0 ? f : std::min(sj[h], std::max(f, worst)));
+    }
   }
 
   PatchOutcome run(std::vector<double>& sj) {
@@ -344,12 +356,15 @@ class Patch {
     const auto& shapes = frame_shapes();
     for (std::size_t k = 0; k < n; ++k) {
       const double w = std::exp(-t * (q_[k] - qmin)) / sum;
-      if (w < 1e-12) continue;  // far above the minimum: nothing measurable
+      if (w < 1e-10) continue;  // far above the minimum: nothing measurable
+      // Second derivatives only where the weight is large enough to shape the step (the soft
+      // minimum's curvature is dominated by its few lowest frames); the gradient stays exact.
+      const bool second = w >= 1e-4;
       const FrameRef& r = frames_[k];
       const FrameShape& s = shapes[r.frame];
       FrameVector g;
       FrameMatrix h;
-      measure(columns(p, r), r, untangle, &g, &h);
+      measure(columns(p, r), r, untangle, &g, second ? &h : nullptr);
       int count = 0;
       std::array<int, 8> node{};
       std::array<int, 8> slot{};
@@ -364,6 +379,11 @@ class Patch {
         ++count;
       }
       for (int a = 0; a < count; ++a) {
+        if (!second) {
+          for (int b = 0; b < count; ++b)
+            hess->block<3, 3>(3 * node[a], 3 * node[b]) += t * w * gn[a] * gn[b].transpose();
+          continue;
+        }
         // Rows of the node-a mix of H: sum_i coef[i][a] H(3i.., :).
         Eigen::Matrix<double, 3, 9> row = Eigen::Matrix<double, 3, 9>::Zero();
         for (int i = 0; i < 3; ++i) row += s.coef[i][slot[a]] * h.block<3, 9>(3 * i, 0);
@@ -380,7 +400,7 @@ class Patch {
 
   bool feasible(const std::vector<Point>& p) const {
     for (std::size_t h = 0; h < hex_.size(); ++h)
-      if (hex_sj(p, h) < ctx_.floor[hex_[h]]) return false;
+      if (hex_sj(p, h) < floor_[h]) return false;
     return true;
   }
 
@@ -429,7 +449,7 @@ class Patch {
     if (longest > 0.25 * length_) d *= 0.25 * length_ / longest;
     const double slope = g.dot(d);
     trial_ = pos_;
-    for (double step = 1.0; step > 1e-4; step *= 0.5) {
+    for (double step = 1.0; step > 0.01; step *= 0.5) {
       for (int i = 0; i < moving_; ++i)
         trial_[i] = constrain(ctx_, node_[i], pos_[i] + step * (basis[i] * d.segment(offset[i], basis[i].cols())));
       const double f = -soft_min(trial_, untangle, t, nullptr, nullptr);
@@ -449,7 +469,7 @@ class Patch {
   std::vector<std::array<int, 8>> local_;  // per affected hex, its corners' local numbers
   std::vector<Point> pos_, trial_;
   std::vector<FrameRef> frames_;
-  std::vector<double> q_;
+  std::vector<double> q_, floor_;
   int moving_ = 0;
   double length_ = 1.0, unit_ = 1.0, lambda_ = 0.0, last_gain_ = 0.0;
 };
@@ -503,11 +523,7 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
   LocalSmoothResult res;
   std::vector<double> sj(nh);
   for (std::size_t h = 0; h < nh; ++h) sj[h] = hex_scaled_jacobian(hex_corners(mesh, static_cast<Index>(h)));
-  ctx.floor.resize(nh);
-  for (std::size_t h = 0; h < nh; ++h)
-    ctx.floor[h] = sj[h] <= 0.0             ? -std::numeric_limits<double>::infinity()
-                   : sj[h] < options.target ? sj[h]
-                                            : std::max(options.target, sj[h] - options.loss);
+  ctx.start = sj;
   auto summarise = [&](double& min_sj, Index& inverted) {
     min_sj = nh ? *std::min_element(sj.begin(), sj.end()) : 0.0;
     inverted = static_cast<Index>(std::count_if(sj.begin(), sj.end(), [](double q) { return q <= 0.0; }));
@@ -555,7 +571,7 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chosen.size(), 1),
                         [&](const tbb::blocked_range<std::size_t>& r) {
                           for (std::size_t i = r.begin(); i != r.end(); ++i)
-                            outcome[i] = Patch(ctx, chosen[i], affected[i]).run(sj);
+                            outcome[i] = Patch(ctx, chosen[i], affected[i], sj).run(sj);
                         });
     });
     for (std::size_t i = 0; i < chosen.size(); ++i) {

@@ -7,11 +7,14 @@
 // Jacobian first untangles (soft minimum of the Jacobians / L^3), then improves shape.
 //
 // Guarantees.
-//  - No hex ends below its floor: min(start, max(target, start - loss)) with `start` its scaled
-//    Jacobian when the call began; every trial step that would break a floor is cut back. So a
-//    valid hex below the target never gets worse and a good one loses at most `loss`, never past
-//    the target. An inverted hex has no floor: untangling may have to move it through worse
-//    shapes; the soft minimum of the Jacobians it maximises keeps the worst from dropping.
+//  - Floors. Let `start` be a hex's scaled Jacobian when the call began and `worst` the lowest
+//    of a patch's hexes when the patch begins. No hex of a patch ends below `worst`; a hex that
+//    started within `margin` of it ends no lower than its start; a better one loses at most
+//    `loss` from its start and never falls below worst + margin. Every trial step that would
+//    break a floor is cut back, so the patch's worst hex never gets worse, hexes near the worst
+//    never lose, and good hexes pay a bounded price. An inverted hex has no floor: untangling
+//    may move it through worse shapes; the soft minimum of the Jacobians it maximises keeps
+//    the worst Jacobian from dropping.
 //  - Termination: each patch's soft minimum rises monotonically (Armijo) and stops when it rises
 //    by less than `min_gain`, after max_iterations, or when no step is accepted; each hex seeds
 //    at most max_visits patches, and only when a neighbouring patch moved one of its nodes since
@@ -33,10 +36,11 @@
 namespace geode::primal {
 
 struct LocalSmoothOptions {
-  double target = 0.5;        // hexes with a scaled Jacobian below it seed patches
-  double loss = 0.05;         // how far a hex at or above the target may fall (not past it)
-  int max_visits = 3;         // patches seeded by one hex
-  int max_iterations = 10;    // Newton iterations per patch
+  double target = 0.35;       // hexes with a scaled Jacobian below it seed patches
+  double margin = 0.1;        // hexes this close to a patch's worst never lose (see Floors)
+  double loss = 0.1;          // how far a better hex may fall from its start
+  int max_visits = 2;         // patches seeded by one hex
+  int max_iterations = 5;     // Newton iterations per patch (per phase)
   double sharpness = 60.0;    // soft minimum of scaled Jacobians
   double untangle_sharpness = 20.0;  // soft minimum of Jacobians / L^3
   double min_gain = 1e-4;     // soft-minimum rise counted as progress

@@ -148,18 +148,21 @@ TEST_CASE("a tangled grid is untangled, boundary nodes on their planes") {
   CHECK(moved_on_boundary > 0);
 }
 
-TEST_CASE("no hex ends below its floor; the worst rises") {
+TEST_CASE("hexes near the worst never lose; others lose at most `loss`") {
   gp::LocalSmoothOptions o;
   o.target = 0.9;
-  o.loss = 0.05;
   HexMesh mesh = jittered_grid(5, 0.3, 11);
   const auto start = scaled_jacobians(mesh);
+  const double worst = *std::min_element(start.begin(), start.end());
+  REQUIRE(worst > 0.0);
   const auto res = gp::smooth_hexes_local(mesh, gp::boundary_slide_constraints(mesh), nullptr, {}, o);
   const auto end = scaled_jacobians(mesh);
   int improved = 0;
   for (std::size_t h = 0; h < start.size(); ++h) {
-    const double floor = start[h] <= 0 ? -1.0 : start[h] < o.target ? start[h] : std::max(o.target, start[h] - o.loss);
-    CHECK(end[h] >= floor);
+    CAPTURE(h);
+    CHECK(end[h] >= worst);  // floors never go below a patch's worst, itself >= the mesh's
+    if (start[h] < worst + o.margin) CHECK(end[h] >= start[h]);
+    CHECK(end[h] >= start[h] - o.loss);
     improved += end[h] > start[h] + 1e-3;
   }
   CHECK(res.final_min_scaled_jacobian > res.initial_min_scaled_jacobian + 0.05);
