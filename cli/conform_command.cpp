@@ -46,6 +46,7 @@ struct ConformArgs {
   std::string report;
   std::string smooth = "local";
   std::string model = "half";
+  std::string save_input;
   int n = 4;
   bool quiet = false;
 };
@@ -158,15 +159,34 @@ void add_conform_commands(CLI::App& app) {
 
   auto dargs = std::make_shared<ConformArgs>();
   CLI::App* d = app.add_subcommand(
-      "demo", "Build a demo model (half hex / half tet block, or a tet nugget in hex blocks) and "
-              "conform it, printing the quality report per block.");
-  d->add_option("--model", dargs->model, "half (default) or nugget")->check(CLI::IsMember({"half", "nugget"}));
-  d->add_option("-n", dargs->n, "cells across (demo_half_block / demo_nugget; default 4)")->check(CLI::PositiveNumber);
+      "demo", "Build a demo model with the Gmsh API (--model) and conform it, printing the quality "
+              "report per block; --save-input writes the model itself.");
+  d->add_option("--model", dargs->model,
+                 "half: structured hexes beside Kuhn-split transfinite tets (default); delaunay, "
+                 "delaunay-random: beside a Delaunay tet box, interface diagonals alternating or "
+                 "random; cylinder: a swept hex cylinder with unstructured quad caps in a tet box; "
+                 "lshape: a hex block in the notch of an L-shaped tet part (concave interface); "
+                 "nugget: a Delaunay tet cube in 26 structured blocks")
+      ->check(CLI::IsMember(conform::demo_model_names()))
+      ->capture_default_str();
+  d->add_option("-n,--size", dargs->n, "cells per unit length (default 4; nugget rounds up to even)")
+      ->check(CLI::PositiveNumber);
+  d->add_option("--save-input", dargs->save_input,
+                "write the demo's input model (.msh, .exo, .e) to try `geode conform` on it; "
+                "without -o or --report nothing is conformed");
   add_run_options(d, *dargs);
   d->callback([dargs] {
     if (!dargs->output.empty()) check_output_extension(dargs->output);
-    const primal::Model model =
-        dargs->model == "half" ? conform::demo_half_block(dargs->n) : conform::demo_nugget(dargs->n);
+    const primal::Model model = conform::demo_model(dargs->model, dargs->n);
+    if (!dargs->save_input.empty()) {
+      const std::string e = file_extension(dargs->save_input);
+      if (e == ".vtu") throw InvalidInput(dargs->save_input + ": --save-input needs .msh, .exo or .e (a .vtu holds no tets)");
+      write_model(model, dargs->save_input);
+      if (!dargs->quiet)
+        std::cout << "wrote " << dargs->save_input << " (" << model.hexes.size() << " hexes, "
+                  << model.tets.size() << " tets)\n";
+      if (dargs->output.empty() && dargs->report.empty()) return;
+    }
     run(model, *dargs, true);
   });
 }

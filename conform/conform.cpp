@@ -1,25 +1,20 @@
 #include "conform/conform.hpp"
 
-#include "primal/disjoint_sets.hpp"
-
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <numeric>
-#include <optional>
-#include <set>
 #include <sstream>
 #include <unordered_map>
 
+#include "conform/reference_template.hpp"
 #include "primal/boundary.hpp"
-#include "primal/dice.hpp"
+#include "primal/dice_model.hpp"
+#include "primal/disjoint_sets.hpp"
 #include "primal/errors.hpp"
 #include "primal/interface.hpp"
-#include "primal/key_map.hpp"
 #include "primal/multilinear.hpp"
 #include "primal/quality.hpp"
 #include "primal/topology.hpp"
-#include "templates/geode.hpp"
 
 namespace geode::conform {
 namespace {
@@ -27,402 +22,255 @@ namespace {
 using primal::FaceKey;
 using primal::Index;
 using primal::kInvalidIndex;
+using primal::kNoOrigin;
 using primal::Point;
 namespace topo = primal::topology;
-using templates::build_geode3d;
-using templates::Diagonal;
-using templates::GeodeOptions;
-using templates::smooth_template;
-using templates::Template;
 
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-// The origin key of a diced node: its origin nodes sorted ascending, padded with
-// kInvalidIndex (1 node: an input node, 2: an edge midpoint, 3 / 4: a face centre).
-FaceKey normalized(FaceKey k) {
-  std::sort(k.begin(), k.end(), [](Index a, Index b) {
-    if (a == kInvalidIndex || b == kInvalidIndex) return b == kInvalidIndex && a != kInvalidIndex;
-    return a < b;
-  });
-  return k;
+constexpr std::array<std::pair<int, const char*>, 3> kBlocks{
+    {{kDicedHexBlock, "diced hex"}, {kGeodeBlock, "geode"}, {kDicedTetBlock, "diced tet"}}};
+
+// Moves the nodes of each patch (global nodes, none on the model boundary) together with every
+// hex around them, the rest fixed, one patch after the other; a patch is kept only if it did
+// not lower its own minimum. `after_patch` is called with the number of patches done.
+primal::SmoothResult smooth_node_patches(primal::HexMesh& mesh,
+                                         const std::vector<std::vector<Index>>& patches,
+                                         const primal::SmoothOptions& options,
+                                         const std::function<void(std::size_t)>& after_patch,
+                                         Index& smoothed_hexes) {
+  primal::SmoothResult total;
+  const std::size_t np = mesh.points.size();
+  // Node -> hexes (CSR).
+  std::vector<Index> start(np + 1, 0), node_hexes;
+  for (const auto& h : mesh.hexes)
+    for (Index v : h) ++start[v + 1];
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  node_hexes.resize(start.back());
+  {
+    std::vector<Index> fill(start.begin(), start.end() - 1);
+    for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
+      for (Index v : mesh.hexes[h]) node_hexes[fill[v]++] = static_cast<Index>(h);
+  }
+  std::vector<Index> local(np, kInvalidIndex);
+  std::vector<char> in_sub(mesh.hexes.size(), 0);
+  for (std::size_t p = 0; p < patches.size(); ++p) {
+    const std::vector<Index>& movable = patches[p];
+    primal::HexMesh sub;
+    std::vector<Index> global, sub_hexes;
+    std::vector<primal::NodeConstraint> cons;
+    for (Index v : movable)
+      for (Index k = start[v]; k < start[v + 1]; ++k)
+        if (!in_sub[node_hexes[k]]) in_sub[node_hexes[k]] = 1, sub_hexes.push_back(node_hexes[k]);
+    for (Index h : sub_hexes) {
+      std::array<Index, 8> o{};
+      for (int c = 0; c < 8; ++c) {
+        const Index v = mesh.hexes[h][c];
+        if (local[v] == kInvalidIndex) {
+          local[v] = static_cast<Index>(sub.points.size());
+          sub.points.push_back(mesh.points[v]);
+          global.push_back(v);
+          cons.push_back(primal::NodeConstraint::fixed());
+        }
+        o[c] = local[v];
+      }
+      sub.hexes.push_back(o);
+    }
+    for (Index v : movable) cons[local[v]] = primal::NodeConstraint::free();
+    if (!sub.hexes.empty()) {
+      const primal::SmoothResult r = primal::smooth_hex_mesh(sub, cons, options);
+      // The optimiser returns its best iterate, but an untangling failure could still leave it
+      // worse than it started.
+      if (r.final_min_scaled_jacobian >= r.initial_min_scaled_jacobian)
+        for (std::size_t i = 0; i < global.size(); ++i) mesh.points[global[i]] = sub.points[i];
+      total.iterations += r.iterations;
+      total.untangle_iterations += r.untangle_iterations;
+      total.shape_iterations += r.shape_iterations;
+    }
+    smoothed_hexes += static_cast<Index>(sub.hexes.size());
+    for (Index v : global) local[v] = kInvalidIndex;
+    for (Index h : sub_hexes) in_sub[h] = 0;
+    if (after_patch) after_patch(p + 1);
+  }
+  return total;
 }
 
-// Buffer hex side faces 0..3 (topology order: s-min, r-max, s-max, r-min) as template box-face
-// bits (templates/geode.hpp: bit 2*axis + high) under r = z, s = x, t = y
-// (primal/buffer_layer.hpp).
-constexpr std::array<int, 4> kSideBit{0, 5, 1, 4};
-constexpr int kBottomBit = 2, kTopBit = 3;
-
-int corner_at(int r, int s, int t) {
-  for (int c = 0; c < 8; ++c)
-    if (topo::kHexCornerCoords[c] == std::array<int, 3>{r, s, t}) return c;
-  return -1;
+// The map of the reference cell into a buffer hex: bilinear on the bottom (the hex side's
+// quad), piecewise linear over the two triangles of the top (so the tet side's diced nodes,
+// edge midpoints and triangle centroids, are images of the template's), linear in t between
+// them. The trilinear map would instead follow a twisted top's bilinear surface, whose
+// diagonal midpoint passes the template nodes under it; this one keeps every template hex
+// positive wherever the buffer hex is valid.
+Point buffer_map(const std::array<Point, 8>& P, const std::array<int, 2>& diagonal, const Point& rst) {
+  const double r = rst.x(), s = rst.y(), t = rst.z();
+  const Point bottom = primal::multilinear_point(P, Point(r, s, 0.0), 2);
+  // Top corners 4..7 at (r, s) = (0,0), (1,0), (1,1), (0,1).
+  Point top;
+  if (diagonal[0] == 4) {  // split 4-6: the line r = s
+    top = r >= s ? P[4] + r * (P[5] - P[4]) + s * (P[6] - P[5])
+                 : P[4] + s * (P[7] - P[4]) + r * (P[6] - P[7]);
+  } else {  // split 5-7: the line r + s = 1
+    top = r + s <= 1 ? P[4] + r * (P[5] - P[4]) + s * (P[7] - P[4])
+                     : P[6] + (1 - r) * (P[7] - P[6]) + (1 - s) * (P[5] - P[6]);
+  }
+  return (1 - t) * bottom + t * top;
 }
 
-// A template prepared for one diagonal: reference coordinates (r, s, t) in [0,1]^3 of every
-// node, and for tet/hex-side nodes the buffer hex corners whose diced node it is.
-struct RefTemplate {
-  Template tpl;
-  double min_scaled_jacobian = 0.0;
-  std::vector<Point> rst;
-  std::vector<std::vector<int>> key_corners;  // empty: not a tet/hex-side node
-  std::array<std::vector<int>, 4> side_nodes;
-  std::array<std::vector<std::array<int, 4>>, 4> side_quads;
+// conform()'s stages, in the order run() calls them; each reads what the previous ones left.
+class Conformer {
+ public:
+  Conformer(const primal::Model& input, const ConformOptions& options)
+      : input_(input), options_(options) {}
+
+  ConformResult run() {
+    const auto t_start = Clock::now();
+    find_interface();
+    insert_buffer();
+    dice_and_merge();
+    place_templates();
+    match_sides();
+    assemble();
+    smooth();
+    verify();
+    output();
+    res_.seconds = since(t_start);
+    return std::move(res_);
+  }
+
+ private:
+  void say(const std::string& line) const {
+    if (options_.progress) options_.progress(line);
+  }
+  std::string took() const { return " (" + std::to_string(since(t0_)) + " s)"; }
+  const RefTemplate& ref(std::size_t b) const {
+    return layer_.hexes[b].diagonal[0] == 5 ? *refs_[1] : *refs_[0];
+  }
+
+  void find_interface();
+  void insert_buffer();
+  void dice_and_merge();
+  void place_templates();
+  void match_sides();
+  void assemble();
+  void smooth();
+  void verify();
+  void output();
+
+  const primal::Model& input_;
+  const ConformOptions& options_;
+  ConformResult res_;
+  Clock::time_point t0_;
+  primal::Interface interface_;
+  BufferLayer layer_;
+  primal::DicedModel diced_;
+  std::array<const RefTemplate*, 2> refs_{};  // diagonal {4, 6}, {5, 7}
+  // Per buffer hex and template node: its global node, or (side-face nodes, until
+  // match_sides) a disjoint-sets item at side_pos_.
+  std::vector<std::vector<Index>> inst_global_, inst_side_;
+  primal::DisjointSets side_sets_uf_;
+  std::vector<Point> side_pos_;
+  primal::HexMesh mesh_;
+  std::vector<primal::NodeSet> node_sets_;
+  std::vector<primal::SideSet> side_sets_;
+  std::vector<Index> inverted_;  // hexes with scaled Jacobian <= 0 after smoothing
 };
 
-RefTemplate make_reference(const Eigen::Vector3d& box, std::array<int, 2> diagonal) {
-  RefTemplate ref;
-  GeodeOptions o;
-  o.box = box;
-  o.diagonal = diagonal == std::array<int, 2>{5, 7} ? Diagonal::Main : Diagonal::Anti;
-  ref.tpl = build_geode3d(o);
-  ref.min_scaled_jacobian = smooth_template(ref.tpl, false).final_min_scaled_jacobian;
-  const auto& pts = ref.tpl.hex.points;
-  const std::size_t n = pts.size();
-  // A smoothed template with two nodes at one place would glue the model together there.
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t j = i + 1; j < n; ++j)
-      if ((pts[i] - pts[j]).norm() < 1e-6 * box.norm()) {
-        std::ostringstream m;
-        m << "the smoothed geode template in a " << box.x() << " x " << box.y() << " x "
-          << box.z() << " box has nodes " << i << " and " << j << " at one place ("
-          << pts[i].transpose() << "); choose other template proportions";
-        throw TopologyError(m.str());
-      }
-  ref.rst.resize(n);
-  ref.key_corners.resize(n);
-  constexpr double kTol = 1e-6;
-  auto third = [&](double v) -> int {  // 0, 1, 2 for 0, 1/2, 1; -1 otherwise
-    for (int k = 0; k < 3; ++k)
-      if (std::abs(v - 0.5 * k) < kTol) return k;
-    return -1;
-  };
-  for (std::size_t i = 0; i < n; ++i) {
-    const Point& p = pts[i];
-    const Point q{p.z() / box.z() + 0.5, p.x() / box.x() + 0.5, p.y() / box.y() + 0.5};
-    ref.rst[i] = q;
-    const unsigned f = ref.tpl.node_faces[i];
-    for (int k = 0; k < 4; ++k)
-      if (f & (1u << kSideBit[k])) ref.side_nodes[k].push_back(static_cast<int>(i));
-    const bool bottom = f & (1u << kBottomBit), top = f & (1u << kTopBit);
-    if (!bottom && !top) continue;
-    const int t = top ? 1 : 0;
-    const int a = third(q.x()), b = third(q.y());
-    std::vector<int>& key = ref.key_corners[i];
-    if (a >= 0 && b >= 0 && a != 1 && b != 1) {
-      key = {corner_at(a / 2, b / 2, t)};
-    } else if (a == 1 && b >= 0 && b != 1) {
-      key = {corner_at(0, b / 2, t), corner_at(1, b / 2, t)};
-    } else if (b == 1 && a >= 0 && a != 1) {
-      key = {corner_at(a / 2, 0, t), corner_at(a / 2, 1, t)};
-    } else if (a == 1 && b == 1) {
-      if (bottom) key = {0, 1, 2, 3};
-      else key = {diagonal[0], diagonal[1]};
-    } else if (top) {
-      // A triangle centroid: the triangle of the split top face containing the point.
-      const bool d46 = diagonal == std::array<int, 2>{4, 6};
-      if (d46) key = q.x() > q.y() ? std::vector<int>{4, 5, 6} : std::vector<int>{4, 6, 7};
-      else key = q.x() + q.y() < 1 ? std::vector<int>{4, 5, 7} : std::vector<int>{5, 6, 7};
-      double cr = 0, cs = 0;
-      for (int c : key) cr += topo::kHexCornerCoords[c][0], cs += topo::kHexCornerCoords[c][1];
-      if (std::abs(cr / 3 - q.x()) > kTol || std::abs(cs / 3 - q.y()) > kTol) key.clear();
-    }
-    if (key.empty() || std::find(key.begin(), key.end(), -1) != key.end()) {
-      std::ostringstream m;
-      m << "geode template node " << i << " at (" << p.transpose()
-        << ") lies on the " << (top ? "tet" : "hex")
-        << " side but at no diced position (corner, edge midpoint, face centre)";
-      throw TopologyError(m.str());
-    }
-  }
-  for (int k = 0; k < 4; ++k) {
-    const unsigned bit = 1u << kSideBit[k];
-    for (const auto& h : ref.tpl.hex.hexes)
-      for (const auto& fc : topo::kHexFaceCorners) {
-        std::array<int, 4> q{};
-        bool on = true;
-        for (int j = 0; j < 4; ++j) {
-          q[j] = h[fc[j]];
-          on = on && (ref.tpl.node_faces[q[j]] & bit);
-        }
-        if (on) ref.side_quads[k].push_back(q);
-      }
-  }
-  return ref;
-}
-
-
-
-// Matches the nodes of side face ka of template A with those of side face kb of template B
-// (the same face of the model), starting from the nodes both share on the tet and hex sides
-// (global ids ga / gb >= 0) and propagating across the quads of the face: a quad of A with an
-// edge whose two ends are matched corresponds to the one unmatched quad of B having the
-// images as an edge and agreeing with every match made so far. Returns A node -> B node;
-// throws TopologyError when the face meshes do not correspond.
-std::unordered_map<int, int> match_side(const RefTemplate& A, int ka,
-                                        const std::vector<Index>& ga, const RefTemplate& B,
-                                        int kb, const std::vector<Index>& gb,
-                                        const std::string& where) {
-  const auto& na = A.side_nodes[ka];
-  const auto& nb = B.side_nodes[kb];
-  const auto& qa = A.side_quads[ka];
-  const auto& qb = B.side_quads[kb];
-  auto fail = [&](const std::string& why) {
-    throw TopologyError("side faces of " + where + " do not correspond: " + why);
-  };
-  if (na.size() != nb.size() || qa.size() != qb.size()) fail("different node or quad counts");
-  std::unordered_map<int, int> m, inv;
-  std::unordered_map<Index, int> b_of_global;
-  for (int b : nb)
-    if (gb[b] >= 0) b_of_global[gb[b]] = b;
-  for (int a : na)
-    if (ga[a] >= 0) {
-      auto it = b_of_global.find(ga[a]);
-      if (it == b_of_global.end()) fail("a tet/hex-side node of one is not on the other");
-      m[a] = it->second, inv[it->second] = a;
-    }
-  std::vector<bool> done_a(qa.size(), false), done_b(qb.size(), false);
-  bool progress = true;
-  while (progress) {
-    progress = false;
-    for (std::size_t i = 0; i < qa.size(); ++i) {
-      if (done_a[i]) continue;
-      const auto& q = qa[i];
-      int found = -1, found_dir = 0, found_s = 0, found_e = 0, candidates = 0;
-      for (int e = 0; e < 4 && candidates == 0; ++e) {
-        auto x0 = m.find(q[e]), x1 = m.find(q[(e + 1) % 4]);
-        if (x0 == m.end() || x1 == m.end()) continue;
-        for (std::size_t j = 0; j < qb.size(); ++j) {
-          if (done_b[j]) continue;
-          const auto& p = qb[j];
-          for (int s = 0; s < 4; ++s) {
-            if (p[s] != x0->second) continue;
-            for (int dir : {1, 3}) {
-              if (p[(s + dir) % 4] != x1->second) continue;
-              // q[e + k] -> p[s + k * dir]; check every known match agrees.
-              bool ok = true;
-              for (int k = 0; k < 4 && ok; ++k) {
-                const int a = q[(e + k) % 4], b = p[(s + k * dir) % 4];
-                auto ia = m.find(a);
-                auto ib = inv.find(b);
-                if (ia != m.end() && ia->second != b) ok = false;
-                if (ib != inv.end() && ib->second != a) ok = false;
-              }
-              if (ok) {
-                ++candidates;
-                found = static_cast<int>(j), found_dir = dir, found_s = s, found_e = e;
-              }
-            }
-          }
-        }
-      }
-      if (candidates != 1) continue;  // none yet or ambiguous: wait for more matches
-      const auto& p = qb[found];
-      for (int k = 0; k < 4; ++k) {
-        const int a = q[(found_e + k) % 4], b = p[(found_s + k * found_dir) % 4];
-        m[a] = b, inv[b] = a;
-      }
-      done_a[i] = done_b[found] = true;
-      progress = true;
-    }
-  }
-  if (m.size() != na.size() || inv.size() != nb.size()) fail("propagation left nodes unmatched");
-  return m;
-}
-
-std::vector<Index> boundary_nodes(const primal::HexMesh& mesh) {
-  std::vector<char> on(mesh.points.size(), 0);
-  for (const auto& q : primal::boundary_quads(mesh))
-    for (Index v : q.nodes) on[v] = 1;
-  std::vector<Index> out;
-  for (std::size_t i = 0; i < on.size(); ++i)
-    if (on[i]) out.push_back(static_cast<Index>(i));
-  return out;
-}
-
-double min_scaled_jacobian(const primal::HexMesh& mesh, std::vector<Index>* bad = nullptr) {
-  double mn = 1.0;
-  for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
-    const double sj = primal::hex_scaled_jacobian(primal::hex_corners(mesh, static_cast<Index>(h)));
-    mn = std::min(mn, sj);
-    if (bad && sj <= 0) bad->push_back(static_cast<Index>(h));
-  }
-  return mn;
-}
-
-}  // namespace
-
-
-ConformSmooth parse_conform_smooth(const std::string& word) {
-  if (word == "local") return ConformSmooth::kLocal;
-  if (word == "global") return ConformSmooth::kGlobal;
-  if (word == "none") return ConformSmooth::kNone;
-  throw InvalidInput("smoothing mode '" + word + "': expected local, global or none");
-}
-
-ConformResult conform(const primal::Model& input, const ConformOptions& options) {
-  const auto t_start = Clock::now();
-  auto say = [&](const std::string& line) {
-    if (options.progress) options.progress(line);
-  };
-  ConformResult res;
-  res.input_hexes = static_cast<Index>(input.hexes.size());
-  res.input_tets = static_cast<Index>(input.tets.size());
-  if (input.hexes.empty() || input.tets.empty())
+void Conformer::find_interface() {
+  res_.input_hexes = static_cast<Index>(input_.hexes.size());
+  res_.input_tets = static_cast<Index>(input_.tets.size());
+  if (input_.hexes.empty() || input_.tets.empty())
     throw InvalidInput("conform: the model needs a hex part and a tet part (it has " +
-                       std::to_string(input.hexes.size()) + " hexes, " +
-                       std::to_string(input.tets.size()) + " tets)");
-
-  // 1. Interface and buffer layer.
-  auto t0 = Clock::now();
-  const primal::Interface iface = primal::find_interface(input, options.interface_tolerance);
-  if (iface.quads.empty())
+                       std::to_string(input_.hexes.size()) + " hexes, " +
+                       std::to_string(input_.tets.size()) + " tets)");
+  t0_ = Clock::now();
+  interface_ = primal::find_interface(input_, options_.interface_tolerance);
+  if (interface_.quads.empty())
     throw InvalidInput("conform: the hex part and the tet part share no interface quad");
-  res.interface_quads = static_cast<Index>(iface.quads.size());
-  say("interface: " + std::to_string(iface.quads.size()) + " quads (" +
-      std::to_string(since(t0)) + " s)");
-  t0 = Clock::now();
-  const BufferLayer layer = insert_buffer_layer(input, iface, options.buffer);
-  res.buffer = layer.report;
-  say("buffer layer: " + std::to_string(layer.hexes.size()) + " hexes, min scaled Jacobian " +
-      std::to_string(layer.report.min_scaled_jacobian) + " (" + std::to_string(since(t0)) + " s)");
+  res_.interface_quads = static_cast<Index>(interface_.quads.size());
+  say("interface: " + std::to_string(interface_.quads.size()) + " quads" + took());
+}
 
-  // 2. Dice both parts over the layer model's point array and merge their nodes by origin.
-  t0 = Clock::now();
-  const primal::Model& lm = layer.model;
-  const Index V = static_cast<Index>(lm.points.size());
-  primal::DicedHexMesh dh = primal::dice(primal::hex_part(lm));
-  primal::DicedHexMesh dt = primal::dice(primal::tet_part(lm));
-  std::vector<Point> points(lm.points.begin(), lm.points.end());
-  std::vector<FaceKey> origin_key(V);  // per global node; {-1..} for cell / template nodes
-  for (Index v = 0; v < V; ++v) origin_key[v] = {v, kInvalidIndex, kInvalidIndex, kInvalidIndex};
-  const FaceKey kNoKey{kInvalidIndex, kInvalidIndex, kInvalidIndex, kInvalidIndex};
-  // A diced node can be met twice (by the other part's dicing, or as a template's tet/hex-side
-  // node) only if every origin node of it is a buffer hex corner or used by both parts; dice()
-  // numbers each origin once per part, so only those go through the map (a few per interface
-  // quad instead of every diced edge and face).
-  std::vector<char> shared(static_cast<std::size_t>(V), 0);
-  {
-    std::vector<char> in_hex(static_cast<std::size_t>(V), 0);
-    for (const auto& h : lm.hexes)
-      for (Index v : h) in_hex[v] = 1;
-    for (const auto& t : lm.tets)
-      for (Index v : t) shared[v] |= in_hex[v];
-    for (const auto& b : layer.hexes)
-      for (Index v : b.corners) shared[v] = 1;
-  }
-  auto may_meet = [&](const FaceKey& key) {
-    for (Index v : key)
-      if (v != kInvalidIndex && !shared[v]) return false;
-    return true;
-  };
-  primal::KeyMap<4> by_key(16 * layer.hexes.size());
-  auto add_node = [&](const Point& p, const FaceKey& key) {
-    points.push_back(p);
-    origin_key.push_back(key);
-    return static_cast<Index>(points.size() - 1);
-  };
-  auto global_of = [&](const primal::DicedHexMesh& d) {
-    std::vector<Index> g(d.mesh.points.size());
-    for (std::size_t i = 0; i < g.size(); ++i) {
-      if (static_cast<Index>(i) < V) {
-        g[i] = static_cast<Index>(i);
-        continue;
-      }
-      const primal::NodeOrigin& o = d.origin[i];
-      if (o.kind == primal::NodeOriginKind::kCell) {
-        g[i] = add_node(d.mesh.points[i], kNoKey);
-        continue;
-      }
-      const FaceKey key = normalized(o.nodes);
-      if (!may_meet(key)) {
-        g[i] = add_node(d.mesh.points[i], key);
-        continue;
-      }
-      auto [id, inserted] = by_key.try_emplace(key, kInvalidIndex);
-      if (inserted) *id = add_node(d.mesh.points[i], key);
-      g[i] = *id;
-    }
-    return g;
-  };
-  std::vector<Index> gh = global_of(dh), gt = global_of(dt);
-  // Positions now live in `points`; origins are needed again only for side sets.
-  for (primal::DicedHexMesh* d : {&dh, &dt}) {
-    d->mesh.points = {};
-    if (lm.side_sets.empty()) d->origin = {};
-  }
-  res.diced_hexes = static_cast<Index>(dh.mesh.hexes.size());
-  res.diced_tet_hexes = static_cast<Index>(dt.mesh.hexes.size());
-  say("dicing: " + std::to_string(res.diced_hexes) + " hexes from hexes, " +
-      std::to_string(res.diced_tet_hexes) + " from tets (" + std::to_string(since(t0)) + " s)");
+void Conformer::insert_buffer() {
+  t0_ = Clock::now();
+  layer_ = insert_buffer_layer(input_, interface_, options_.buffer);
+  interface_ = {};
+  res_.buffer = layer_.report;
+  say("buffer layer: " + std::to_string(layer_.hexes.size()) + " hexes, min scaled Jacobian " +
+      std::to_string(layer_.report.min_scaled_jacobian) + took());
+}
 
-  // 3. Reference templates, one per diagonal, built and smoothed once.
-  t0 = Clock::now();
-  std::array<std::optional<RefTemplate>, 2> refs;  // [0]: {4,6}, [1]: {5,7}
-  auto ref_index = [](const BufferHex& b) { return b.diagonal[0] == 5 ? 1 : 0; };
-  res.template_min_scaled_jacobian = 1.0;
-  for (const auto& b : layer.hexes) {
-    const int r = ref_index(b);
-    if (!refs[r]) {
-      refs[r] = make_reference(options.template_box, b.diagonal);
-      res.template_min_scaled_jacobian =
-          std::min(res.template_min_scaled_jacobian, refs[r]->min_scaled_jacobian);
-    }
-  }
-  say("templates: built and smoothed, min scaled Jacobian " +
-      std::to_string(res.template_min_scaled_jacobian) + " (" + std::to_string(since(t0)) +
-      " s)");
+// Both parts diced over the layer model's point array, nodes merged by origin; the buffer
+// hex corners are shareable so that template nodes find their diced nodes by origin.
+void Conformer::dice_and_merge() {
+  t0_ = Clock::now();
+  std::vector<char> shareable(layer_.model.points.size(), 0);
+  for (const auto& b : layer_.hexes)
+    for (Index v : b.corners) shareable[v] = 1;
+  diced_ = primal::dice_model(layer_.model, shareable);
+  res_.diced_hexes = static_cast<Index>(diced_.hex_children.size());
+  res_.diced_tet_hexes = static_cast<Index>(diced_.tet_children.size());
+  say("dicing: " + std::to_string(res_.diced_hexes) + " hexes from hexes, " +
+      std::to_string(res_.diced_tet_hexes) + " from tets" + took());
+}
 
-  // 4. Map a template into every buffer hex. Tet/hex-side nodes become their diced node;
-  // interior nodes new nodes; side-face nodes union-find items merged across shared faces.
-  t0 = Clock::now();
-  const std::size_t nb = layer.hexes.size();
-  std::vector<std::vector<Index>> inst_global(nb), inst_side(nb);
-  primal::DisjointSets uf;
-  std::vector<Point> side_pos;
+// A template in every buffer hex: tet/hex-side nodes become their diced node, interior nodes
+// new nodes, side-face nodes disjoint-sets items merged across shared faces by match_sides.
+void Conformer::place_templates() {
+  t0_ = Clock::now();
+  refs_[0] = &reference_template(options_.template_box, {4, 6});
+  refs_[1] = &reference_template(options_.template_box, {5, 7});
+  res_.template_min_scaled_jacobian =
+      std::min(refs_[0]->min_scaled_jacobian, refs_[1]->min_scaled_jacobian);
+  const primal::Model& lm = layer_.model;
+  const std::size_t nb = layer_.hexes.size();
+  inst_global_.assign(nb, {});
+  inst_side_.assign(nb, {});
   for (std::size_t b = 0; b < nb; ++b) {
-    const BufferHex& bh = layer.hexes[b];
-    const RefTemplate& ref = *refs[ref_index(bh)];
+    const BufferHex& bh = layer_.hexes[b];
+    const RefTemplate& rt = ref(b);
     std::array<Point, 8> P;
     for (int c = 0; c < 8; ++c) P[c] = lm.points[bh.corners[c]];
-    const std::size_t n = ref.rst.size();
-    inst_global[b].assign(n, kInvalidIndex);
-    inst_side[b].assign(n, kInvalidIndex);
+    const std::size_t n = rt.rst.size();
+    inst_global_[b].assign(n, kInvalidIndex);
+    inst_side_[b].assign(n, kInvalidIndex);
     for (std::size_t i = 0; i < n; ++i) {
-      const Point x = primal::multilinear_point(P, ref.rst[i], 3);
-      if (!ref.key_corners[i].empty()) {
-        FaceKey key = kNoKey;
-        for (std::size_t k = 0; k < ref.key_corners[i].size(); ++k)
-          key[k] = bh.corners[ref.key_corners[i][k]];
-        key = normalized(key);
-        Index g = kInvalidIndex;
-        if (key[1] == kInvalidIndex) {
-          g = key[0];
-        } else if (const Index* id = by_key.find(key)) {
-          g = *id;
-        }
+      const Point x = buffer_map(P, bh.diagonal, rt.rst[i]);
+      if (!rt.key_corners[i].empty()) {
+        FaceKey key = kNoOrigin;
+        for (std::size_t k = 0; k < rt.key_corners[i].size(); ++k)
+          key[k] = bh.corners[rt.key_corners[i][k]];
+        const Index g = diced_.find(key);
         if (g == kInvalidIndex)
           throw TopologyError("buffer hex " + std::to_string(b) +
                               ": a template node has no diced node to merge with");
-        inst_global[b][i] = g;
-      } else if (ref.tpl.node_faces[i] != 0) {
-        inst_side[b][i] = uf.add();
-        side_pos.push_back(x);
+        inst_global_[b][i] = g;
+      } else if (rt.tpl.node_faces[i] != 0) {
+        inst_side_[b][i] = side_sets_uf_.add();
+        side_pos_.push_back(x);
       } else {
-        inst_global[b][i] = add_node(x, kNoKey);
+        inst_global_[b][i] = diced_.add_node(x);
       }
     }
   }
-  by_key = primal::KeyMap<4>();  // every template node is placed
-  // Side faces shared by two buffer hexes.
+  diced_.shared = primal::KeyMap<4>();  // every template node is placed
+  res_.geode_hexes = static_cast<Index>(26 * nb);
+  say("geode templates: " + std::to_string(nb) + " buffer hexes, reference min scaled Jacobian " +
+      std::to_string(res_.template_min_scaled_jacobian) + took());
+}
+
+// Side faces shared by two buffer hexes: their template nodes matched topologically, one node
+// per class at the mean of its members.
+void Conformer::match_sides() {
+  t0_ = Clock::now();
+  const std::size_t nb = layer_.hexes.size();
   std::unordered_map<FaceKey, std::vector<std::pair<int, int>>, primal::IndexArrayHash> side_uses;
   for (std::size_t b = 0; b < nb; ++b)
     for (int k = 0; k < 4; ++k) {
       std::array<Index, 4> f{};
-      for (int j = 0; j < 4; ++j) f[j] = layer.hexes[b].corners[topo::kHexFaceCorners[k][j]];
+      for (int j = 0; j < 4; ++j) f[j] = layer_.hexes[b].corners[topo::kHexFaceCorners[k][j]];
       side_uses[primal::face_key(f)].push_back({static_cast<int>(b), k});
     }
   Index shared_faces = 0;
@@ -439,275 +287,165 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
     ++shared_faces;
     const auto [ba, ka] = uses[0];
     const auto [bb, kb] = uses[1];
-    const RefTemplate& A = *refs[ref_index(layer.hexes[ba])];
-    const RefTemplate& B = *refs[ref_index(layer.hexes[bb])];
-    const auto m = match_side(A, ka, inst_global[ba], B, kb, inst_global[bb],
-                              "buffer hexes " + std::to_string(ba) + " and " +
-                                  std::to_string(bb));
+    const auto m = match_side(ref(ba), ka, inst_global_[ba], ref(bb), kb, inst_global_[bb],
+                              "buffer hexes " + std::to_string(ba) + " and " + std::to_string(bb));
     for (const auto& [a, b] : m) {
-      const Index sa = inst_side[ba][a], sb = inst_side[bb][b];
+      const Index sa = inst_side_[ba][a], sb = inst_side_[bb][b];
       if ((sa == kInvalidIndex) != (sb == kInvalidIndex))
         throw TopologyError("buffer hexes " + std::to_string(ba) + " and " + std::to_string(bb) +
                             ": a side node matches a tet/hex-side node");
-      if (sa != kInvalidIndex) uf.unite(sa, sb);
+      if (sa != kInvalidIndex) side_sets_uf_.unite(sa, sb);
     }
   }
-  // One node per union-find class at the mean of its members.
-  {
-    const Index ns = static_cast<Index>(uf.size());
-    std::vector<Point> sum(ns, Point::Zero());
-    std::vector<int> cnt(ns, 0);
-    for (Index s = 0; s < ns; ++s) sum[uf.find(s)] += side_pos[s], ++cnt[uf.find(s)];
-    std::vector<Index> gid(ns, kInvalidIndex);
-    for (Index s = 0; s < ns; ++s)
-      if (uf.find(s) == s) gid[s] = add_node(sum[s] / cnt[s], kNoKey);
-    for (std::size_t b = 0; b < nb; ++b)
-      for (std::size_t i = 0; i < inst_side[b].size(); ++i)
-        if (inst_side[b][i] != kInvalidIndex) inst_global[b][i] = gid[uf.find(inst_side[b][i])];
-  }
-  res.geode_hexes = static_cast<Index>(26 * nb);
-  say("geode templates: " + std::to_string(nb) + " buffer hexes, " +
-      std::to_string(shared_faces) + " shared side faces merged (" + std::to_string(since(t0)) +
-      " s)");
+  auto& uf = side_sets_uf_;
+  const Index ns = static_cast<Index>(uf.size());
+  std::vector<Point> sum(ns, Point::Zero());
+  std::vector<int> cnt(ns, 0);
+  for (Index s = 0; s < ns; ++s) sum[uf.find(s)] += side_pos_[s], ++cnt[uf.find(s)];
+  std::vector<Index> gid(ns, kInvalidIndex);
+  for (Index s = 0; s < ns; ++s)
+    if (uf.find(s) == s) gid[s] = diced_.add_node(sum[s] / cnt[s]);
+  for (std::size_t b = 0; b < nb; ++b)
+    for (std::size_t i = 0; i < inst_side_[b].size(); ++i)
+      if (inst_side_[b][i] != kInvalidIndex) inst_global_[b][i] = gid[uf.find(inst_side_[b][i])];
+  uf = {}, side_pos_ = {}, inst_side_ = {};
+  say("side faces: " + std::to_string(shared_faces) + " shared by two buffer hexes, merged" +
+      took());
+}
 
-  // 5. Assemble the hexes, blocks in ascending id, and drop unused nodes.
+// The hexes by block in ascending id, unused nodes dropped, node and side sets carried over
+// (they depend only on the numbering); the dicing data are released before smoothing and
+// verification, which need room of their own.
+void Conformer::assemble() {
+  const std::size_t nb = layer_.hexes.size();
   std::vector<std::array<Index, 8>> hexes;
   std::vector<int> block;
-  hexes.reserve(dh.mesh.hexes.size() + 26 * nb + dt.mesh.hexes.size());
+  hexes.reserve(diced_.hex_children.size() + 26 * nb + diced_.tet_children.size());
   block.reserve(hexes.capacity());
-  for (const auto& h : dh.mesh.hexes) {
-    std::array<Index, 8> o{};
-    for (int c = 0; c < 8; ++c) o[c] = gh[h[c]];
-    hexes.push_back(o), block.push_back(kDicedHexBlock);
-  }
-  for (std::size_t b = 0; b < nb; ++b) {
-    const RefTemplate& ref = *refs[ref_index(layer.hexes[b])];
-    for (const auto& h : ref.tpl.hex.hexes) {
+  for (const auto& h : diced_.hex_children) hexes.push_back(h), block.push_back(kDicedHexBlock);
+  for (std::size_t b = 0; b < nb; ++b)
+    for (const auto& h : ref(b).tpl.hex.hexes) {
       std::array<Index, 8> o{};
-      for (int c = 0; c < 8; ++c) o[c] = inst_global[b][h[c]];
+      for (int c = 0; c < 8; ++c) o[c] = inst_global_[b][h[c]];
       hexes.push_back(o), block.push_back(kGeodeBlock);
     }
-  }
-  for (const auto& h : dt.mesh.hexes) {
-    std::array<Index, 8> o{};
-    for (int c = 0; c < 8; ++c) o[c] = gt[h[c]];
-    hexes.push_back(o), block.push_back(kDicedTetBlock);
-  }
-  std::vector<Index> renum(points.size(), kInvalidIndex);
-  primal::HexMesh mesh;
-  mesh.points.reserve(points.size());
+  for (const auto& h : diced_.tet_children) hexes.push_back(h), block.push_back(kDicedTetBlock);
+  inst_global_ = {};
+  std::vector<Index> renum(diced_.points.size(), kInvalidIndex);
+  mesh_.points.reserve(diced_.points.size());
   for (auto& h : hexes)
     for (Index& v : h) {
       if (renum[v] == kInvalidIndex) {
-        renum[v] = static_cast<Index>(mesh.points.size());
-        mesh.points.push_back(points[v]);
+        renum[v] = static_cast<Index>(mesh_.points.size());
+        mesh_.points.push_back(diced_.points[v]);
       }
       v = renum[v];
     }
-  mesh.hexes = std::move(hexes);
-  mesh.block = std::move(block);
-
-  // Node sets and side sets carried over (they depend only on the numbering, not on node
-  // positions); after them the dicing and merging data are released before smoothing and
-  // verification, which need room of their own.
-  std::vector<primal::NodeSet> node_sets;
-  std::vector<primal::SideSet> side_sets;
-  for (const primal::NodeSet& ns : lm.node_sets) {
-    std::vector<char> in(V, 0);
-    for (Index v : ns.nodes) in[v] = 1;
-    primal::NodeSet o{ns.id, ns.name, {}};
-    for (std::size_t g = 0; g < origin_key.size(); ++g) {
-      if (renum[g] == kInvalidIndex || origin_key[g][0] == kInvalidIndex) continue;
-      bool all = true;
-      for (Index v : origin_key[g])
-        if (v != kInvalidIndex) all = all && in[v];
-      if (all) o.nodes.push_back(renum[g]);
-    }
-    std::sort(o.nodes.begin(), o.nodes.end());
-    node_sets.push_back(std::move(o));
-  }
-  if (!lm.side_sets.empty()) {
-    // Children of each input element, with their output hex number.
-    std::vector<std::vector<Index>> hex_children(lm.hexes.size()), tet_children(lm.tets.size());
-    for (std::size_t c = 0; c < dh.parent.size(); ++c)
-      hex_children[dh.parent[c]].push_back(static_cast<Index>(c));
-    for (std::size_t c = 0; c < dt.parent.size(); ++c)
-      tet_children[dt.parent[c]].push_back(static_cast<Index>(c));
-    const Index tet_offset = res.diced_hexes + res.geode_hexes;
-    for (const primal::SideSet& ss : lm.side_sets) {
-      primal::SideSet o{ss.id, ss.name, {}};
-      for (const primal::Side& side : ss.sides) {
-        const bool is_hex = side.element.kind == primal::ElementKind::Hex;
-        std::vector<Index> face;
-        if (is_hex) {
-          for (int c : topo::kHexFaceCorners[side.face])
-            face.push_back(lm.hexes[side.element.index][c]);
-        } else {
-          for (int c : topo::kTetFaceCorners[side.face])
-            face.push_back(lm.tets[side.element.index][c]);
-        }
-        const primal::DicedHexMesh& d = is_hex ? dh : dt;
-        const auto& children = is_hex ? hex_children[side.element.index]
-                                      : tet_children[side.element.index];
-        auto on_face = [&](Index node) {
-          const primal::NodeOrigin& og = d.origin[node];
-          if (node < V) return std::find(face.begin(), face.end(), node) != face.end();
-          if (og.kind == primal::NodeOriginKind::kCell) return false;
-          for (Index v : og.nodes)
-            if (v != kInvalidIndex && std::find(face.begin(), face.end(), v) == face.end())
-              return false;
-          return true;
-        };
-        for (Index c : children)
-          for (int f = 0; f < 6; ++f) {
-            bool all = true;
-            for (int k : topo::kHexFaceCorners[f]) all = all && on_face(d.mesh.hexes[c][k]);
-            if (all)
-              o.sides.push_back({{primal::ElementKind::Hex, is_hex ? c : tet_offset + c}, f});
-          }
-      }
-      side_sets.push_back(std::move(o));
-    }
-  }
-  dh = {}, dt = {};
-  for (auto* v : {&gh, &gt, &renum}) *v = {};
-  points = {}, origin_key = {}, inst_global = {}, inst_side = {};
+  mesh_.hexes = std::move(hexes);
+  mesh_.block = std::move(block);
+  node_sets_ = primal::diced_node_sets(layer_.model, diced_, renum);
+  side_sets_ = primal::diced_side_sets(layer_.model, diced_, 0, res_.diced_hexes + res_.geode_hexes);
+  diced_ = primal::DicedModel();
   // Without smoothing the positions do not change: the inverted hexes found here are the
   // verification's too.
-  std::vector<Index> bad;
-  res.min_scaled_jacobian_before_smoothing =
-      min_scaled_jacobian(mesh, options.smooth == ConformSmooth::kNone ? &bad : nullptr);
+  res_.min_scaled_jacobian_before_smoothing = primal::min_scaled_jacobian(
+      mesh_, options_.smooth == ConformSmooth::kNone ? &inverted_ : nullptr);
+}
 
-  // 6. Smoothing, model boundary nodes fixed. Local: one small problem per buffer hex (its 26
-  // geode hexes' nodes move, with every hex touching them; the rest is fixed), swept in order,
-  // so the cost grows linearly with the interface (the optimiser is built for template-sized
-  // meshes). Global: one problem over the whole mesh (slow beyond a few thousand hexes).
-  if (options.smooth != ConformSmooth::kNone) {
-    t0 = Clock::now();
-    const std::size_t np = mesh.points.size();
-    std::vector<char> on_boundary(np, 0);
-    for (Index v : boundary_nodes(mesh)) on_boundary[v] = 1;
-    // Node -> hexes (CSR).
-    std::vector<Index> start(np + 1, 0), node_hexes;
-    for (const auto& h : mesh.hexes)
-      for (Index v : h) ++start[v + 1];
-    std::partial_sum(start.begin(), start.end(), start.begin());
-    node_hexes.resize(start.back());
-    {
-      std::vector<Index> fill(start.begin(), start.end() - 1);
-      for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
-        for (Index v : mesh.hexes[h]) node_hexes[fill[v]++] = static_cast<Index>(h);
-    }
-    res.smoothing.initial_min_scaled_jacobian = res.min_scaled_jacobian_before_smoothing;
-    std::vector<Index> local(np, kInvalidIndex);
-    std::vector<char> in_sub(mesh.hexes.size(), 0);
-    Index smoothed_hexes = 0;
-    // Moves `movable` (global nodes, not on the boundary) with all hexes around them.
-    auto smooth_patch = [&](const std::vector<Index>& movable) {
-      primal::HexMesh sub;
-      std::vector<Index> global, sub_hexes;
-      std::vector<primal::NodeConstraint> cons;
-      for (Index v : movable)
-        for (Index k = start[v]; k < start[v + 1]; ++k)
-          if (!in_sub[node_hexes[k]]) in_sub[node_hexes[k]] = 1, sub_hexes.push_back(node_hexes[k]);
-      for (Index h : sub_hexes) {
-        std::array<Index, 8> o{};
-        for (int c = 0; c < 8; ++c) {
-          const Index v = mesh.hexes[h][c];
-          if (local[v] == kInvalidIndex) {
-            local[v] = static_cast<Index>(sub.points.size());
-            sub.points.push_back(mesh.points[v]);
-            global.push_back(v);
-            cons.push_back(primal::NodeConstraint::fixed());
-          }
-          o[c] = local[v];
-        }
-        sub.hexes.push_back(o);
-      }
-      for (Index v : movable) cons[local[v]] = primal::NodeConstraint::free();
-      if (!sub.hexes.empty()) {
-        const primal::SmoothResult r = primal::smooth_hex_mesh(
-            sub, cons,
-            options.smooth == ConformSmooth::kLocal ? options.local_smooth_options
-                                                    : options.smooth_options);
-        // Keep the patch only if it did not lower its minimum (the optimiser returns its best
-        // iterate, but an untangling failure could still leave it worse).
-        if (r.final_min_scaled_jacobian >= r.initial_min_scaled_jacobian)
-          for (std::size_t i = 0; i < global.size(); ++i) mesh.points[global[i]] = sub.points[i];
-        res.smoothing.iterations += r.iterations;
-        res.smoothing.untangle_iterations += r.untangle_iterations;
-        res.smoothing.shape_iterations += r.shape_iterations;
-      }
-      smoothed_hexes += static_cast<Index>(sub.hexes.size());
-      for (Index v : global) local[v] = kInvalidIndex;
-      for (Index h : sub_hexes) in_sub[h] = 0;
-    };
-    if (options.smooth == ConformSmooth::kGlobal) {
+// Model boundary nodes fixed. Local: one patch per buffer hex (its 26 geode hexes' nodes move,
+// with every hex touching them), so the cost grows linearly with the interface. Global: one
+// patch of every node.
+void Conformer::smooth() {
+  if (options_.smooth == ConformSmooth::kNone) return;
+  t0_ = Clock::now();
+  const std::size_t np = mesh_.points.size();
+  std::vector<char> on_boundary(np, 0);
+  for (Index v : primal::boundary_nodes(mesh_)) on_boundary[v] = 1;
+  std::vector<std::vector<Index>> patches;
+  const bool local = options_.smooth == ConformSmooth::kLocal;
+  if (!local) {
+    patches.emplace_back();
+    for (std::size_t v = 0; v < np; ++v)
+      if (!on_boundary[v]) patches.back().push_back(static_cast<Index>(v));
+  } else {
+    const std::size_t nb = layer_.hexes.size();
+    for (std::size_t b = 0; b < nb; ++b) {
       std::vector<Index> movable;
-      for (std::size_t v = 0; v < np; ++v)
-        if (!on_boundary[v]) movable.push_back(static_cast<Index>(v));
-      smooth_patch(movable);
-    } else {
-      const Index first_geode = res.diced_hexes;
-      for (std::size_t b = 0; b < nb; ++b) {
-        std::vector<Index> movable;
-        for (Index h = first_geode + static_cast<Index>(26 * b);
-             h < first_geode + static_cast<Index>(26 * (b + 1)); ++h)
-          for (Index v : mesh.hexes[h])
-            if (!on_boundary[v]) movable.push_back(v);
-        std::sort(movable.begin(), movable.end());
-        movable.erase(std::unique(movable.begin(), movable.end()), movable.end());
-        smooth_patch(movable);
-        if (options.smoothing_progress)
-          options.smoothing_progress(b + 1, nb);
-        else if ((b + 1) % 100 == 0)
-          say("smoothing: " + std::to_string(b + 1) + " / " + std::to_string(nb) +
-              " buffer hexes (" + std::to_string(since(t0)) + " s)");
-      }
+      for (Index h = res_.diced_hexes + static_cast<Index>(26 * b);
+           h < res_.diced_hexes + static_cast<Index>(26 * (b + 1)); ++h)
+        for (Index v : mesh_.hexes[h])
+          if (!on_boundary[v]) movable.push_back(v);
+      std::sort(movable.begin(), movable.end());
+      movable.erase(std::unique(movable.begin(), movable.end()), movable.end());
+      patches.push_back(std::move(movable));
     }
-    res.smoothing.final_min_scaled_jacobian = min_scaled_jacobian(mesh, &bad);  // also for step 7
-    res.smoothing.untangled = res.smoothing.final_min_scaled_jacobian > 0;
-    res.smoothing.seconds = since(t0);
-    say("smoothing (" + std::string(options.smooth == ConformSmooth::kLocal ? "local" : "global") +
-        "): " + std::to_string(smoothed_hexes) + " hex-patches, min scaled Jacobian " +
-        std::to_string(res.smoothing.initial_min_scaled_jacobian) + " -> " +
-        std::to_string(res.smoothing.final_min_scaled_jacobian) + " (" +
-        std::to_string(since(t0)) + " s)");
   }
+  const std::size_t total = patches.size();
+  auto after_patch = [&](std::size_t done) {
+    if (!local) return;
+    if (options_.smoothing_progress)
+      options_.smoothing_progress(done, total);
+    else if (done % 100 == 0)
+      say("smoothing: " + std::to_string(done) + " / " + std::to_string(total) +
+          " buffer hexes" + took());
+  };
+  Index smoothed_hexes = 0;
+  res_.smoothing = smooth_node_patches(
+      mesh_, patches, local ? options_.local_smooth_options : options_.smooth_options,
+      after_patch, smoothed_hexes);
+  res_.smoothing.initial_min_scaled_jacobian = res_.min_scaled_jacobian_before_smoothing;
+  res_.smoothing.final_min_scaled_jacobian = primal::min_scaled_jacobian(mesh_, &inverted_);
+  res_.smoothing.untangled = res_.smoothing.final_min_scaled_jacobian > 0;
+  res_.smoothing.seconds = since(t0_);
+  say("smoothing (" + std::string(local ? "local" : "global") + "): " +
+      std::to_string(smoothed_hexes) + " hex-patches, min scaled Jacobian " +
+      std::to_string(res_.smoothing.initial_min_scaled_jacobian) + " -> " +
+      std::to_string(res_.smoothing.final_min_scaled_jacobian) + took());
+}
 
-  // 7. Verify and report.
-  t0 = Clock::now();
-  res.validity = primal::check_validity(mesh);
-  if (!res.validity.ok()) res.warnings.push_back("invalid mesh: " + res.validity.summary());
-  if (!bad.empty()) {
+void Conformer::verify() {
+  t0_ = Clock::now();
+  res_.validity = primal::check_validity(mesh_);
+  if (!res_.validity.ok()) res_.warnings.push_back("invalid mesh: " + res_.validity.summary());
+  if (!inverted_.empty()) {
     std::ostringstream m;
-    m << bad.size() << " hexes with scaled Jacobian <= 0:";
-    for (std::size_t i = 0; i < std::min<std::size_t>(bad.size(), 20); ++i) m << " " << bad[i];
-    if (bad.size() > 20) m << " ...";
-    res.warnings.push_back(m.str());
+    m << inverted_.size() << " hexes with scaled Jacobian <= 0:";
+    for (std::size_t i = 0; i < std::min<std::size_t>(inverted_.size(), 20); ++i)
+      m << " " << inverted_[i];
+    if (inverted_.size() > 20) m << " ...";
+    res_.warnings.push_back(m.str());
   }
-  const std::array<std::pair<int, const char*>, 3> blocks{
-      {{kDicedHexBlock, "diced hex"}, {kGeodeBlock, "geode"}, {kDicedTetBlock, "diced tet"}}};
-  for (const auto& [id, name] : blocks) {
+  for (const auto& [id, name] : kBlocks) {
     std::vector<Index> sel;
-    for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
-      if (mesh.block[h] == id) sel.push_back(static_cast<Index>(h));
+    for (std::size_t h = 0; h < mesh_.hexes.size(); ++h)
+      if (mesh_.block[h] == id) sel.push_back(static_cast<Index>(h));
     if (sel.empty()) continue;
-    res.quality.push_back({id, name, primal::hex_quality_report(mesh, sel)});
+    res_.quality.push_back({id, name, primal::hex_quality_report(mesh_, sel)});
   }
-  say("verification: " + std::string(res.validity.ok() ? "valid" : "INVALID") + " (" +
-      std::to_string(since(t0)) + " s)");
+  say("verification: " + std::string(res_.validity.ok() ? "valid" : "INVALID") + took());
+}
 
-  // 8. The output model.
-  primal::Model& out = res.model;
-  for (const auto& [id, name] : blocks) out.block_names[id] = name;
-  out.hex_block = std::move(mesh.block);
-  out.hexes = std::move(mesh.hexes);
-  out.points = std::move(mesh.points);
-  out.node_sets = std::move(node_sets);
-  out.side_sets = std::move(side_sets);
-  res.seconds = since(t_start);
-  return res;
+void Conformer::output() {
+  primal::Model& out = res_.model;
+  for (const auto& [id, name] : kBlocks) out.block_names[id] = name;
+  out.hex_block = std::move(mesh_.block);
+  out.hexes = std::move(mesh_.hexes);
+  out.points = std::move(mesh_.points);
+  out.node_sets = std::move(node_sets_);
+  out.side_sets = std::move(side_sets_);
+}
+
+}  // namespace
+
+ConformSmooth parse_conform_smooth(const std::string& word) {
+  if (word == "local") return ConformSmooth::kLocal;
+  if (word == "global") return ConformSmooth::kGlobal;
+  if (word == "none") return ConformSmooth::kNone;
+  throw InvalidInput("smoothing mode '" + word + "': expected local, global or none");
+}
+
+ConformResult conform(const primal::Model& input, const ConformOptions& options) {
+  return Conformer(input, options).run();
 }
 
 }  // namespace geode::conform

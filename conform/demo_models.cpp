@@ -6,6 +6,10 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <functional>
+#include <map>
+#include <memory>
+#include <random>
 #include <utility>
 
 #include "primal/boundary.hpp"
@@ -70,6 +74,232 @@ Model with_gmsh(const std::string& name, F&& build) {
     merge_coincident_nodes(m, 1e-9);
     orient_positively(m);
     return m;
+  } catch (const std::string& s) {
+    throw std::runtime_error(name + ": Gmsh failed: " + s);
+  }
+}
+
+
+// A closed triangulated surface being assembled for tet_fill: points merged by position.
+struct Shell {
+  std::vector<Point> points;
+  std::vector<std::array<Index, 3>> tris;
+  std::map<std::array<long long, 3>, Index> by_position;
+
+  Index node(const Point& p) {
+    // Positions from different Gmsh models agree to rounding error; 1e-8 cells merge them.
+    const std::array<long long, 3> key{std::llround(p.x() * 1e8), std::llround(p.y() * 1e8),
+                                       std::llround(p.z() * 1e8)};
+    auto [it, inserted] = by_position.try_emplace(key, static_cast<Index>(points.size()));
+    if (inserted) points.push_back(p);
+    return it->second;
+  }
+};
+
+// Triangles of the surfaces of Gmsh's current model (meshed) for which keep(tag) holds.
+template <class Keep>
+void append_gmsh_triangles(Shell& shell, Keep keep) {
+  std::vector<std::size_t> tags;
+  std::vector<double> coords, parametric;
+  gmsh::model::mesh::getNodes(tags, coords, parametric, -1, -1, true, false);
+  std::map<std::size_t, Point> node;
+  for (std::size_t i = 0; i < tags.size(); ++i)
+    node[tags[i]] = Point(coords[3 * i], coords[3 * i + 1], coords[3 * i + 2]);
+  gmsh::vectorpair surfaces;
+  gmsh::model::getEntities(surfaces, 2);
+  for (const auto& [dim, tag] : surfaces) {
+    if (!keep(tag)) continue;
+    std::vector<std::size_t> elements, nodes;
+    gmsh::model::mesh::getElementsByType(2, elements, nodes, tag);
+    for (std::size_t e = 0; e + 2 < nodes.size(); e += 3)
+      shell.tris.push_back({shell.node(node.at(nodes[e])), shell.node(node.at(nodes[e + 1])),
+                            shell.node(node.at(nodes[e + 2]))});
+  }
+}
+
+// The boundary quads of the hex part for which on_interface(centre) holds, each split into two
+// triangles: along corners 0-2 when split(quad number, centre) is false, 1-3 otherwise (the
+// other diagonal where that one would fold the quad).
+template <class OnInterface, class Split>
+void append_interface_triangles(Shell& shell, const Model& hexes, OnInterface on_interface,
+                                Split split) {
+  int count = 0;
+  for (const BoundaryQuad& q : boundary_quads(hex_part(hexes))) {
+    Point c = Point::Zero();
+    for (Index v : q.nodes) c += hexes.points[static_cast<std::size_t>(v)] / 4.0;
+    if (!on_interface(c)) continue;
+    std::array<Index, 4> n{};
+    std::array<Point, 4> p;
+    for (int k = 0; k < 4; ++k) {
+      p[k] = hexes.points[static_cast<std::size_t>(q.nodes[k])];
+      n[k] = shell.node(p[k]);
+    }
+    // A split folding a non-convex quad (a triangle facing away from the quad) is not taken.
+    const Point normal = (p[2] - p[0]).cross(p[3] - p[1]);
+    auto folds = [&](int a, int b, int d) { return (p[b] - p[a]).cross(p[d] - p[a]).dot(normal) <= 0; };
+    const bool folds02 = folds(0, 1, 2) || folds(0, 2, 3), folds13 = folds(0, 1, 3) || folds(1, 2, 3);
+    bool along13 = split(count++, c);
+    if (along13 ? folds13 : folds02) along13 = !along13;
+    if (along13) {
+      shell.tris.push_back({n[0], n[1], n[3]});
+      shell.tris.push_back({n[1], n[2], n[3]});
+    } else {
+      shell.tris.push_back({n[0], n[1], n[2]});
+      shell.tris.push_back({n[0], n[2], n[3]});
+    }
+  }
+}
+
+// Gmsh's Delaunay tets inside the closed surface `shell` (whose nodes it keeps), as a new
+// Gmsh model; `holes` are closed surfaces inside it bounding regions left empty (further
+// surface loops of the volume).
+Model tet_fill(const Shell& shell, const std::vector<Shell>& holes, int block,
+               const std::string& block_name) {
+  gmsh::model::add("tet_fill");
+  std::size_t next_node = 1;
+  auto add_surface = [&](const Shell& s) {
+    const int tag = gmsh::model::addDiscreteEntity(2);
+    std::vector<std::size_t> node_tags;
+    std::vector<double> coords;
+    for (const Point& p : s.points) {
+      node_tags.push_back(next_node++);
+      coords.insert(coords.end(), {p.x(), p.y(), p.z()});
+    }
+    std::vector<std::size_t> tri_nodes;
+    for (const auto& t : s.tris)
+      for (Index v : t) tri_nodes.push_back(node_tags[static_cast<std::size_t>(v)]);
+    gmsh::model::mesh::addNodes(2, tag, node_tags, coords);
+    gmsh::model::mesh::addElementsByType(tag, 2, {}, tri_nodes);
+    return tag;
+  };
+  std::vector<int> loops{gmsh::model::geo::addSurfaceLoop({add_surface(shell)})};
+  for (const Shell& h : holes) loops.push_back(gmsh::model::geo::addSurfaceLoop({add_surface(h)}));
+  const int volume = gmsh::model::geo::addVolume(loops);
+  gmsh::model::geo::synchronize();
+  gmsh::model::addPhysicalGroup(3, {volume}, block);
+  gmsh::model::setPhysicalName(3, block, block_name);
+  gmsh::model::mesh::generate(3);
+  Model m = model_from_gmsh("tet_fill");
+  gmsh::model::remove();
+  return m;
+}
+
+// hexes + tets as one model, coincident nodes merged, every element positively oriented.
+Model join(Model hexes, const Model& tets) {
+  const Index offset = static_cast<Index>(hexes.points.size());
+  hexes.points.insert(hexes.points.end(), tets.points.begin(), tets.points.end());
+  for (auto t : tets.tets) {
+    for (Index& v : t) v += offset;
+    hexes.tets.push_back(t);
+  }
+  if (!tets.tet_block.empty()) hexes.tet_block = tets.tet_block;
+  for (const auto& [id, name] : tets.block_names) hexes.block_names[id] = name;
+  if (hexes.hex_block.empty()) hexes.hex_block.assign(hexes.hexes.size(), 1);
+  merge_coincident_nodes(hexes, 1e-9);
+  orient_positively(hexes);
+  // Drop points no element uses (Gmsh's geometry points).
+  std::vector<Index> renum(hexes.points.size(), kInvalidIndex);
+  std::vector<Point> points;
+  auto use = [&](Index& v) {
+    if (renum[static_cast<std::size_t>(v)] == kInvalidIndex) {
+      renum[static_cast<std::size_t>(v)] = static_cast<Index>(points.size());
+      points.push_back(hexes.points[static_cast<std::size_t>(v)]);
+    }
+    v = renum[static_cast<std::size_t>(v)];
+  };
+  for (auto& h : hexes.hexes)
+    for (Index& v : h) use(v);
+  for (auto& t : hexes.tets)
+    for (Index& v : t) use(v);
+  for (auto& ns : hexes.node_sets)
+    for (Index& v : ns.nodes) use(v);
+  hexes.points = std::move(points);
+  return hexes;
+}
+
+// The hex part meshed by `build` in a new Gmsh model (volumes meshed separately, coincident
+// nodes merged), positively oriented.
+template <class F>
+Model hex_part_from_gmsh(const std::string& name, F&& build) {
+  gmsh::model::add(name);
+  build();
+  gmsh::model::mesh::generate(3);
+  Model m = model_from_gmsh(name);
+  m.tets.clear(), m.tet_block.clear();
+  merge_coincident_nodes(m, 1e-9);
+  orient_positively(m);
+  gmsh::model::remove();
+  return m;
+}
+
+// The boundary of an OCC solid made by `build` (returns its volume tag), meshed in 2D with
+// cells of size h, the curves for which `fixed_curve(bounding box)` holds transfinite with cells
+// of size h, as a Shell of the surfaces for which keep(bounding box) holds.
+using Box = std::array<double, 6>;
+Box bounding_box(int dim, int tag) {
+  Box b;
+  gmsh::model::getBoundingBox(dim, tag, b[0], b[1], b[2], b[3], b[4], b[5]);
+  return b;
+}
+
+template <class Build, class FixedCurve, class Keep>
+void append_solid_boundary(Shell& shell, double h, Build build, FixedCurve fixed_curve, Keep keep) {
+  gmsh::model::add("outer");
+  build();
+  gmsh::model::occ::synchronize();
+  gmsh::option::setNumber("Mesh.MeshSizeMax", h);
+  gmsh::option::setNumber("Mesh.MeshSizeMin", 0.5 * h);
+  gmsh::vectorpair curves;
+  gmsh::model::getEntities(curves, 1);
+  for (const auto& [dim, tag] : curves) {
+    const Box b = bounding_box(dim, tag);
+    if (!fixed_curve(b)) continue;
+    const double length = std::max({b[3] - b[0], b[4] - b[1], b[5] - b[2]});
+    gmsh::model::mesh::setTransfiniteCurve(tag, std::max(1, static_cast<int>(std::lround(length / h))) + 1);
+  }
+  gmsh::model::mesh::generate(2);
+  append_gmsh_triangles(shell, [&](int tag) { return keep(bounding_box(2, tag)); });
+  gmsh::model::remove();
+  gmsh::option::setNumber("Mesh.MeshSizeMax", 1e22);
+  gmsh::option::setNumber("Mesh.MeshSizeMin", 0);
+}
+
+// Split chooser: alternate by the quad centre's grid cell parity, or random (fixed seed).
+std::function<bool(int, const Point&)> diagonal_chooser(DemoDiagonals d, double h) {
+  if (d == DemoDiagonals::kAlternate)
+    return [h](int, const Point& c) {
+      const long long s = std::llround(std::floor(c.x() / h)) + std::llround(std::floor(c.y() / h)) +
+                          std::llround(std::floor(c.z() / h));
+      return (s & 1) != 0;
+    };
+  auto rng = std::make_shared<std::mt19937>(12345u);
+  return [rng](int, const Point&) { return ((*rng)() & 1u) != 0; };
+}
+
+// Gmsh's OCC bounding boxes are enlarged by a tolerance; entity tests on them allow for it.
+constexpr double kEps = 1e-4;
+
+void transfinite_box(int volume, double h) {
+  gmsh::vectorpair surfaces, curves;
+  for (int s : boundary_surfaces(volume)) surfaces.push_back({2, s});
+  gmsh::model::getBoundary(surfaces, curves, false, false, false);
+  for (const auto& [dim, tag] : curves) {
+    const Box b = bounding_box(1, tag);
+    const double length = std::max({b[3] - b[0], b[4] - b[1], b[5] - b[2]});
+    gmsh::model::mesh::setTransfiniteCurve(std::abs(tag), std::max(1, static_cast<int>(std::lround(length / h))) + 1);
+  }
+  for (int s : boundary_surfaces(volume)) {
+    gmsh::model::mesh::setTransfiniteSurface(s);
+    gmsh::model::mesh::setRecombine(2, s);
+  }
+  gmsh::model::mesh::setTransfiniteVolume(volume);
+  gmsh::model::mesh::setRecombine(3, volume);
+}
+
+Model run_gmsh(const std::string& name, const std::function<Model()>& build) {
+  GmshSession session;
+  try {
+    return build();
   } catch (const std::string& s) {
     throw std::runtime_error(name + ": Gmsh failed: " + s);
   }
@@ -144,6 +374,104 @@ Model demo_nugget(int n) {
   }
   m.side_sets.push_back(std::move(outside));
   return m;
+}
+
+}  // namespace geode::conform
+
+namespace geode::conform {
+
+Model demo_delaunay_block(int n, DemoDiagonals diagonals) {
+  if (n < 1) throw InvalidInput("demo_delaunay_block: n = " + std::to_string(n) + " must be >= 1");
+  const double h = 1.0 / n;
+  return run_gmsh("demo_delaunay_block", [&] {
+    Model hexes = hex_part_from_gmsh("hexes", [h] {
+      const int box = gmsh::model::occ::addBox(0, 0, 0, 1, 1, 1);
+      gmsh::model::occ::synchronize();
+      transfinite_box(box, h);
+      gmsh::model::addPhysicalGroup(3, {box}, 1);
+      gmsh::model::setPhysicalName(3, 1, "hex");
+    });
+    Shell shell;
+    append_solid_boundary(
+        shell, h, [] { gmsh::model::occ::addBox(1, 0, 0, 1, 1, 1); },
+        [](const Box& b) { return b[3] < 1 + kEps; }, [](const Box& b) { return b[3] > 1 + kEps; });
+    append_interface_triangles(shell, hexes, [](const Point& c) { return c.x() > 1 - kEps; },
+                               diagonal_chooser(diagonals, h));
+    return join(std::move(hexes), tet_fill(shell, {}, 2, "tet"));
+  });
+}
+
+Model demo_cylinder(int n) {
+  if (n < 2) throw InvalidInput("demo_cylinder: n = " + std::to_string(n) + " must be >= 2");
+  const double h = 1.0 / n;
+  return run_gmsh("demo_cylinder", [&] {
+    Model hexes = hex_part_from_gmsh("cylinder", [n, h] {
+      const int disk = gmsh::model::occ::addDisk(0, 0, -0.5, 0.5, 0.5);
+      gmsh::vectorpair out;
+      gmsh::model::occ::extrude({{2, disk}}, 0, 0, 1, out, {n}, {}, true);
+      gmsh::model::occ::synchronize();
+      gmsh::option::setNumber("Mesh.MeshSizeMax", h);
+      gmsh::model::mesh::setRecombine(2, disk);
+      for (const auto& [dim, tag] : out)
+        if (dim == 3) {
+          gmsh::model::addPhysicalGroup(3, {tag}, 1);
+          gmsh::model::setPhysicalName(3, 1, "hex cylinder");
+        }
+    });
+    gmsh::option::setNumber("Mesh.MeshSizeMax", 1e22);
+    Shell outer, inner;
+    append_solid_boundary(
+        outer, 2 * h, [] { gmsh::model::occ::addBox(-1, -1, -1, 2, 2, 2); },
+        [](const Box&) { return false; }, [](const Box&) { return true; });
+    append_interface_triangles(inner, hexes, [](const Point&) { return true; },
+                               diagonal_chooser(DemoDiagonals::kRandom, h));
+    return join(std::move(hexes), tet_fill(outer, {inner}, 2, "tet box"));
+  });
+}
+
+Model demo_l_shape(int n) {
+  if (n < 1) throw InvalidInput("demo_l_shape: n = " + std::to_string(n) + " must be >= 1");
+  const double h = 1.0 / n;
+  auto in_notch = [](const Box& b) { return b[0] > 1 - kEps && b[1] > 1 - kEps; };
+  return run_gmsh("demo_l_shape", [&] {
+    Model hexes = hex_part_from_gmsh("notch", [h] {
+      const int box = gmsh::model::occ::addBox(1, 1, 0, 1, 1, 1);
+      gmsh::model::occ::synchronize();
+      transfinite_box(box, h);
+      gmsh::model::addPhysicalGroup(3, {box}, 1);
+      gmsh::model::setPhysicalName(3, 1, "hex notch");
+    });
+    Shell shell;
+    append_solid_boundary(
+        shell, h,
+        [] {
+          gmsh::vectorpair out;
+          std::vector<gmsh::vectorpair> map;
+          gmsh::model::occ::cut({{3, gmsh::model::occ::addBox(0, 0, 0, 2, 2, 1)}},
+                                {{3, gmsh::model::occ::addBox(1, 1, 0, 1, 1, 1)}}, out, map);
+        },
+        in_notch, [&](const Box& b) { return !in_notch(b); });
+    append_interface_triangles(
+        shell, hexes, [](const Point& c) { return c.x() < 1 + kEps || c.y() < 1 + kEps; },
+        diagonal_chooser(DemoDiagonals::kRandom, h));
+    return join(std::move(hexes), tet_fill(shell, {}, 2, "tet L"));
+  });
+}
+
+const std::vector<std::string>& demo_model_names() {
+  static const std::vector<std::string> names{"half", "delaunay", "delaunay-random", "cylinder",
+                                              "lshape", "nugget"};
+  return names;
+}
+
+Model demo_model(const std::string& name, int n) {
+  if (name == "half") return demo_half_block(n);
+  if (name == "delaunay") return demo_delaunay_block(n, DemoDiagonals::kAlternate);
+  if (name == "delaunay-random") return demo_delaunay_block(n, DemoDiagonals::kRandom);
+  if (name == "cylinder") return demo_cylinder(n);
+  if (name == "lshape") return demo_l_shape(n);
+  if (name == "nugget") return demo_nugget(n % 2 ? n + 1 : n);
+  throw InvalidInput("demo model '" + name + "': expected one of half, delaunay, delaunay-random, cylinder, lshape, nugget");
 }
 
 }  // namespace geode::conform

@@ -3,6 +3,8 @@
 // demo models meshed with the Gmsh API (no input file).
 #include <array>
 #include <functional>
+#include <string>
+#include <vector>
 
 #include "primal/model.hpp"
 
@@ -27,5 +29,30 @@ Model demo_half_block(int n = 4);
 // sweepable parts. Nugget tets are block 2 "tet nugget". Side set 1 "outside" holds the outer
 // boundary quads. n must be even and >= 2.
 Model demo_nugget(int n = 4);
+
+// The realistic models below mesh a hex part with the Gmsh API, triangulate the tet region's
+// boundary (Gmsh's 2D mesher on the outer surfaces, the hex part's interface quads split into
+// two triangles each) and fill it with Gmsh's 3D Delaunay tets; nothing is transfinite on the
+// tet side. n sets the cell size (1/n per unit length); small n gives seconds-sized models.
+enum class DemoDiagonals { kAlternate, kRandom };
+
+// (a) Structured hexes [0,1]^3 (n^3, block 1 "hex") beside a Delaunay tet box [1,2] x [0,1]^2
+// (block 2 "tet"); interface quads split alternately (checkerboard) or at random.
+Model demo_delaunay_block(int n = 4, DemoDiagonals diagonals = DemoDiagonals::kAlternate);
+
+// (b) A curved interface: a hex cylinder (radius 0.5, height 1: a disk of unstructured
+// recombined quads swept in n layers; block 1) inside a tet-meshed box [-1,1]^3 (block 2).
+Model demo_cylinder(int n = 4);
+
+// (c) A concave interface: a structured hex block [1,2]^2 x [0,1] in the notch of an L-shaped
+// Delaunay tet part [0,2]^2 x [0,1] minus the notch, so the tet part wraps the interface edge.
+Model demo_l_shape(int n = 4);
+
+// The names `geode demo --model` takes: half, delaunay, delaunay-random, cylinder, lshape,
+// nugget (d: a convex Delaunay tet nugget in structured blocks).
+const std::vector<std::string>& demo_model_names();
+// The model of that name with size parameter n (made even where the model needs it); throws
+// InvalidInput naming an unknown name.
+Model demo_model(const std::string& name, int n);
 
 }  // namespace geode::conform

@@ -80,6 +80,16 @@ std::vector<EdgeKey> unique_edges(const HexMesh& mesh) {
   return edges;
 }
 
+std::vector<Index> boundary_nodes(const HexMesh& mesh) {
+  std::vector<char> on(mesh.points.size(), 0);
+  for (const auto& q : boundary_quads(mesh))
+    for (Index v : q.nodes) on[static_cast<std::size_t>(v)] = 1;
+  std::vector<Index> out;
+  for (std::size_t i = 0; i < on.size(); ++i)
+    if (on[i]) out.push_back(static_cast<Index>(i));
+  return out;
+}
+
 std::vector<BoundaryQuad> boundary_quads(const HexMesh& mesh) {
   check_indices(mesh);
   // Face key -> its first use (6 hex + local face), or kShared once a second hex uses it: one

@@ -60,6 +60,9 @@ struct BoundaryQuad {
 
 std::vector<BoundaryQuad> boundary_quads(const HexMesh& mesh);
 
+// The nodes of the boundary quads, ascending.
+std::vector<Index> boundary_nodes(const HexMesh& mesh);
+
 // The boundary as an OpenMesh surface (float points, the library's default traits; exact
 // coordinates are mesh.points[vertex_node[v]]).
 using SurfaceMesh = OpenMesh::PolyMesh_ArrayKernelT<>;

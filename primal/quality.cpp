@@ -387,6 +387,16 @@ HexCorners hex_corners(const HexMesh& mesh, Index h) {
   return p;
 }
 
+double min_scaled_jacobian(const HexMesh& mesh, std::vector<Index>* inverted) {
+  double mn = 1.0;
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
+    const double sj = hex_scaled_jacobian(hex_corners(mesh, static_cast<Index>(h)));
+    mn = std::min(mn, sj);
+    if (inverted && sj <= 0) inverted->push_back(static_cast<Index>(h));
+  }
+  return mn;
+}
+
 QuadCorners quad_corners(const QuadMesh& mesh, Index q) {
   if (q < 0 || static_cast<std::size_t>(q) >= mesh.quads.size()) {
     throw InvalidInput("quad_corners: quad " + std::to_string(q) + " out of range (mesh has " +

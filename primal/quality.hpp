@@ -15,6 +15,7 @@
 #include <array>
 #include <span>
 #include <string_view>
+#include <vector>
 
 #include "primal/mesh.hpp"
 
@@ -107,6 +108,10 @@ const HexMetricInfo& hex_metric_info(std::string_view key_or_name);
 
 // Corner positions of hex h of a mesh (throws geode::InvalidInput on a bad index).
 HexCorners hex_corners(const HexMesh& mesh, Index h);
+
+// The minimum hex_scaled_jacobian over the mesh (1 for an empty mesh); the hexes at or below 0
+// are appended to `inverted` when given.
+double min_scaled_jacobian(const HexMesh& mesh, std::vector<Index>* inverted = nullptr);
 QuadCorners quad_corners(const QuadMesh& mesh, Index q);
 
 }  // namespace geode::primal

@@ -1,0 +1,46 @@
+#pragma once
+// The geode template prepared for the buffer hexes of conform(): built from the dual sheet
+// arrangement (templates/geode.hpp) and smoothed once per process and diagonal, with every
+// node's reference coordinates (r, s, t) in the buffer hex and, for tet- and hex-side nodes,
+// the buffer hex corners whose diced node it is (corner, edge midpoint, face centre,
+// triangle centroid).
+#include <Eigen/Core>
+#include <array>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "primal/mesh.hpp"
+#include "templates/geode.hpp"
+
+namespace geode::conform {
+
+struct RefTemplate {
+  templates::Template tpl;
+  double min_scaled_jacobian = 0.0;
+  std::vector<primal::Point> rst;             // reference coordinates in [0, 1]^3
+  std::vector<std::vector<int>> key_corners;  // empty: not a tet/hex-side node
+  // Per buffer hex side face 0..3 (topology order): its template nodes and quads.
+  std::array<std::vector<int>, 4> side_nodes;
+  std::array<std::vector<std::array<int, 4>>, 4> side_quads;
+};
+
+// The template for a buffer hex whose top is split along `diagonal` ({4, 6} or {5, 7},
+// conform/buffer_layer.hpp), built and smoothed in a box of proportions `box` on the first
+// call and kept for the process (thread-safe). Throws TopologyError when the smoothed template
+// has two nodes at one place or a tet/hex-side node at no diced position.
+const RefTemplate& reference_template(const Eigen::Vector3d& box, std::array<int, 2> diagonal);
+
+// Matches the nodes of side face ka of template A with those of side face kb of template B
+// (the same face of the model), starting from the nodes both share on the tet and hex sides
+// (global ids ga / gb >= 0) and propagating across the quads of the face: a quad of A with an
+// edge whose two ends are matched corresponds to the one unmatched quad of B having the
+// images as an edge and agreeing with every match made so far. Returns A node -> B node;
+// throws TopologyError naming `where` when the face meshes do not correspond.
+std::unordered_map<int, int> match_side(const RefTemplate& A, int ka,
+                                        const std::vector<primal::Index>& ga,
+                                        const RefTemplate& B, int kb,
+                                        const std::vector<primal::Index>& gb,
+                                        const std::string& where);
+
+}  // namespace geode::conform

@@ -1,0 +1,59 @@
+#pragma once
+// Dicing a whole mixed model (primal/model.hpp) over one node array: the hex part 8 per hex,
+// the tet part 4 per tet (primal/dice.hpp), every diced node keeping its origin (the sorted
+// input nodes it was made from), and the model's node and side sets carried onto the result.
+//
+// A diced edge or face node is made once per part by dice(); the two parts meet it twice only
+// where every origin node is used by both parts (the hex/tet interface) or was marked
+// `shareable` by the caller. Only those nodes go through a hash map (DicedModel::find), so
+// merging costs a few probes per interface face instead of one per diced edge and face.
+#include <span>
+#include <vector>
+
+#include "primal/boundary.hpp"
+#include "primal/key_map.hpp"
+#include "primal/model.hpp"
+
+namespace geode::primal {
+
+// The origin key of a node without origin (cell centres, nodes added by the caller).
+inline constexpr FaceKey kNoOrigin{kInvalidIndex, kInvalidIndex, kInvalidIndex, kInvalidIndex};
+
+// `key` sorted ascending with its kInvalidIndex padding last.
+FaceKey normalized_origin(FaceKey key);
+
+struct DicedModel {
+  // The model's points first (same numbers, unused ones included), then new nodes.
+  std::vector<Point> points;
+  // Per node: its origin nodes, normalized (an input node v: {v, -1, -1, -1}; an edge
+  // midpoint: its 2 nodes; a face centre: 3 or 4), kNoOrigin for cell centres and added nodes.
+  std::vector<FaceKey> origin;
+  // Children in global node numbers, each part in its parent's order (dice.hpp's corner order).
+  std::vector<std::array<Index, 8>> hex_children, tet_children;
+  std::vector<Index> hex_parent, tet_parent;  // per child: index into Model::hexes / tets
+
+  Index add_node(const Point& p, const FaceKey& origin_key = kNoOrigin);
+  // The node made from the (unsorted) origin nodes `key`: an input node itself, else an edge or
+  // face node whose origin nodes are all shareable; kInvalidIndex when there is none.
+  Index find(const FaceKey& key) const;
+
+  KeyMap<4> shared;  // normalized origin -> node, for nodes whose origin nodes are all shareable
+};
+
+// `shareable` (per model point, may be empty) marks nodes besides the interface whose diced
+// edge and face nodes the caller will look up with find(). Throws InvalidInput from dice().
+DicedModel dice_model(const Model& model, std::span<const char> shareable = {});
+
+// The model's node sets on the diced nodes: every input node of a set plus every diced node
+// whose origin nodes are all in it. `renumber` maps a diced node to its output number
+// (kInvalidIndex: dropped).
+std::vector<NodeSet> diced_node_sets(const Model& model, const DicedModel& diced,
+                                     std::span<const Index> renumber);
+
+// The model's side sets on the diced hexes: each input side becomes the faces of its parent's
+// children lying on it (4 per hex face, 3 per tet face). Output hex numbers are
+// hex_offset + child for hex children and tet_offset + child for tet children.
+std::vector<SideSet> diced_side_sets(const Model& model, const DicedModel& diced,
+                                     Index hex_offset, Index tet_offset);
+
+}  // namespace geode::primal
