@@ -1,8 +1,11 @@
-// The worst-first local smoother (primal/local_smooth.hpp) on conform's output before smoothing:
-// CPU milliseconds per buffer hex, patches, min scaled Jacobian per block before and after, with
-// 1 thread and with TBB's default; then the same machinery over every hex (global).
-// Usage: bench_local_smooth [half-block n] [nugget n] [target] [max_visits] [max_iterations]
-//        (defaults 8, 4 and LocalSmoothOptions' own)
+// The worst-first local smoother (primal/local_smooth.hpp) on conform's output before smoothing,
+// for every demo model (conform/demo_models.hpp): CPU milliseconds per buffer hex, patches, min
+// scaled Jacobian per block before and after, with 1 thread and with TBB's default; then the
+// same machinery over every hex (global, conform's global options); then the whole conform
+// with default options, timed.
+// Usage: bench_local_smooth [n] [target] [max_visits] [max_iterations] [model...]
+//        (defaults 4, LocalSmoothOptions' own, every demo model)
+#include <chrono>
 #include <ctime>
 #include <algorithm>
 #include <cstdio>
@@ -36,7 +39,7 @@ void print_blocks(const char* label, const std::map<int, double>& b) {
   std::printf("\n");
 }
 
-void run(const char* name, const primal::Model& input, const primal::LocalSmoothOptions& base) {
+void run(const std::string& name, const primal::Model& input, const primal::LocalSmoothOptions& base) {
   conform::ConformOptions o;
   o.smooth = conform::ConformSmooth::kNone;
   const conform::ConformResult r = conform::conform(input, o);
@@ -51,7 +54,7 @@ void run(const char* name, const primal::Model& input, const primal::LocalSmooth
   const auto seeds = primal::hexes_around(mesh, geode);
   const auto cons = primal::boundary_slide_constraints(mesh);
   const primal::TriMesh surface = primal::boundary_triangulation(mesh);
-  std::printf("%s: %zu tets, %zu input hexes -> %zu hexes, %.0f buffer hexes, %zu seeds\n", name,
+  std::printf("%s: %zu tets, %zu input hexes -> %zu hexes, %.0f buffer hexes, %zu seeds\n", name.c_str(),
               input.tets.size(), input.hexes.size(), mesh.hexes.size(), buffer, seeds.size());
   print_blocks("before", block_minima(mesh));
   struct Mode {
@@ -63,6 +66,7 @@ void run(const char* name, const primal::Model& input, const primal::LocalSmooth
   for (const Mode& m : modes) {
     primal::HexMesh work = mesh;
     primal::LocalSmoothOptions lo = base;
+    if (m.global) lo.target = conform::ConformOptions{}.global_smooth_options.target;
     lo.threads = m.threads;
     const std::clock_t c0 = std::clock();
     const auto res = primal::smooth_hexes_local(work, cons, &surface,
@@ -79,14 +83,27 @@ void run(const char* name, const primal::Model& input, const primal::LocalSmooth
 }  // namespace
 
 int main(int argc, char** argv) {
-  const int half = argc > 1 ? std::atoi(argv[1]) : 8;
-  const int nugget = argc > 2 ? std::atoi(argv[2]) : 4;
+  const int n = argc > 1 ? std::atoi(argv[1]) : 4;
   primal::LocalSmoothOptions o;
-  if (argc > 3) o.target = std::atof(argv[3]);
-  if (argc > 4) o.max_visits = std::atoi(argv[4]);
-  if (argc > 5) o.max_iterations = std::atoi(argv[5]);
-  std::printf("target %.2f, max_visits %d, max_iterations %d\n", o.target, o.max_visits, o.max_iterations);
-  run(("half block " + std::to_string(half)).c_str(), conform::demo_half_block(half), o);
-  run(("nugget " + std::to_string(nugget)).c_str(), conform::demo_nugget(nugget), o);
+  if (argc > 2) o.target = std::atof(argv[2]);
+  if (argc > 3) o.max_visits = std::atoi(argv[3]);
+  if (argc > 4) o.max_iterations = std::atoi(argv[4]);
+  std::vector<std::string> models(argv + std::min(argc, 5), argv + argc);
+  if (models.empty()) models = conform::demo_model_names();
+  std::printf("n %d, target %.2f, max_visits %d, max_iterations %d\n", n, o.target, o.max_visits,
+              o.max_iterations);
+  for (const std::string& name : models) {
+    const primal::Model input = conform::demo_model(name, n);
+    run(name + " " + std::to_string(n), input, o);
+    conform::ConformOptions co;
+    co.local_smooth_options = o;
+    const std::clock_t c0 = std::clock();
+    const auto t0 = std::chrono::steady_clock::now();
+    const conform::ConformResult r = conform::conform(input, co);
+    std::printf("  whole conform (local): %.3f s CPU, %.3f s wall, valid %s, min SJ %.4f\n",
+                static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC,
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+                r.validity.ok() ? "yes" : "NO", r.smoothing.final_min_scaled_jacobian);
+  }
   return 0;
 }

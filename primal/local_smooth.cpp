@@ -544,6 +544,7 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
     std::vector<Index> cand;
     for (Index h : pool)
       if (sj[h] < options.target && visits[h] < options.max_visits && dirty[h]) cand.push_back(h);
+    if (options.progress) options.progress(pool.size() - cand.size(), pool.size());
     if (cand.empty()) break;
     std::sort(cand.begin(), cand.end(), [&](Index a, Index b) { return sj[a] < sj[b] || (sj[a] == sj[b] && a < b); });
     // Worst first, each patch sharing no hex with one kept before it in this round.

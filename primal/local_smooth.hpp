@@ -27,6 +27,7 @@
 //    kSurface nodes move in their tangent plane and are projected back onto the nearest triangle
 //    of the given surface triangulation after every step.
 #include <cstddef>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -45,6 +46,8 @@ struct LocalSmoothOptions {
   double untangle_sharpness = 20.0;  // soft minimum of Jacobians / L^3
   double min_gain = 1e-4;     // soft-minimum rise counted as progress
   int threads = 0;            // 0: TBB's default; 1: serial
+  // Called before each round and at the end with (seed hexes not waiting for a patch, seeds).
+  std::function<void(std::size_t settled, std::size_t seeds)> progress;
 };
 
 struct LocalSmoothResult {
