@@ -139,7 +139,9 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
   c->add_option("-o,--output", a.output, "output model (.exo, .e, .msh, .vtu)");
   c->add_option("--report", a.report, "write a JSON report (counts, quality per block)");
   c->add_option("--smooth", a.smooth,
-                "local: the buffer layer and one ring around it (default); global: every node; none")
+                "worst-first smoothing, model boundary nodes sliding on the boundary; local: hexes below "
+                "0.35 among the geode hexes and those touching them (default); global: every hex "
+                "below 0.5; none")
       ->check(CLI::IsMember({"local", "global", "none"}))
       ->capture_default_str();
   c->add_option("--quality", a.quality,

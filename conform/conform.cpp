@@ -35,70 +35,6 @@ double since(Clock::time_point t0) {
 constexpr std::array<std::pair<int, const char*>, 3> kBlocks{
     {{kDicedHexBlock, "diced hex"}, {kGeodeBlock, "geode"}, {kDicedTetBlock, "diced tet"}}};
 
-// Moves the nodes of each patch (global nodes, none on the model boundary) together with every
-// hex around them, the rest fixed, one patch after the other; a patch is kept only if it did
-// not lower its own minimum. `after_patch` is called with the number of patches done.
-primal::SmoothResult smooth_node_patches(primal::HexMesh& mesh,
-                                         const std::vector<std::vector<Index>>& patches,
-                                         const primal::SmoothOptions& options,
-                                         const std::function<void(std::size_t)>& after_patch,
-                                         Index& smoothed_hexes) {
-  primal::SmoothResult total;
-  const std::size_t np = mesh.points.size();
-  // Node -> hexes (CSR).
-  std::vector<Index> start(np + 1, 0), node_hexes;
-  for (const auto& h : mesh.hexes)
-    for (Index v : h) ++start[v + 1];
-  std::partial_sum(start.begin(), start.end(), start.begin());
-  node_hexes.resize(start.back());
-  {
-    std::vector<Index> fill(start.begin(), start.end() - 1);
-    for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
-      for (Index v : mesh.hexes[h]) node_hexes[fill[v]++] = static_cast<Index>(h);
-  }
-  std::vector<Index> local(np, kInvalidIndex);
-  std::vector<char> in_sub(mesh.hexes.size(), 0);
-  for (std::size_t p = 0; p < patches.size(); ++p) {
-    const std::vector<Index>& movable = patches[p];
-    primal::HexMesh sub;
-    std::vector<Index> global, sub_hexes;
-    std::vector<primal::NodeConstraint> cons;
-    for (Index v : movable)
-      for (Index k = start[v]; k < start[v + 1]; ++k)
-        if (!in_sub[node_hexes[k]]) in_sub[node_hexes[k]] = 1, sub_hexes.push_back(node_hexes[k]);
-    for (Index h : sub_hexes) {
-      std::array<Index, 8> o{};
-      for (int c = 0; c < 8; ++c) {
-        const Index v = mesh.hexes[h][c];
-        if (local[v] == kInvalidIndex) {
-          local[v] = static_cast<Index>(sub.points.size());
-          sub.points.push_back(mesh.points[v]);
-          global.push_back(v);
-          cons.push_back(primal::NodeConstraint::fixed());
-        }
-        o[c] = local[v];
-      }
-      sub.hexes.push_back(o);
-    }
-    for (Index v : movable) cons[local[v]] = primal::NodeConstraint::free();
-    if (!sub.hexes.empty()) {
-      const primal::SmoothResult r = primal::smooth_hex_mesh(sub, cons, options);
-      // The optimiser returns its best iterate, but an untangling failure could still leave it
-      // worse than it started.
-      if (r.final_min_scaled_jacobian >= r.initial_min_scaled_jacobian)
-        for (std::size_t i = 0; i < global.size(); ++i) mesh.points[global[i]] = sub.points[i];
-      total.iterations += r.iterations;
-      total.untangle_iterations += r.untangle_iterations;
-      total.shape_iterations += r.shape_iterations;
-    }
-    smoothed_hexes += static_cast<Index>(sub.hexes.size());
-    for (Index v : global) local[v] = kInvalidIndex;
-    for (Index h : sub_hexes) in_sub[h] = 0;
-    if (after_patch) after_patch(p + 1);
-  }
-  return total;
-}
-
 // The map of the reference cell into a buffer hex: bilinear on the bottom (the hex side's
 // quad), piecewise linear over the two triangles of the top (so the tet side's diced nodes,
 // edge midpoints and triangle centroids, are images of the template's), linear in t between
@@ -353,53 +289,38 @@ void Conformer::assemble() {
       mesh_, options_.smooth == ConformSmooth::kNone ? &inverted_ : nullptr);
 }
 
-// Model boundary nodes fixed. Local: one patch per buffer hex (its 26 geode hexes' nodes move,
-// with every hex touching them), so the cost grows linearly with the interface. Global: one
-// patch of every node.
+// The worst-first smoother (primal/local_smooth.hpp); model boundary nodes slide on the diced
+// boundary. Local: patches seeded by the geode hexes and the hexes touching them, so the cost
+// follows the interface; global: by every hex.
 void Conformer::smooth() {
   if (options_.smooth == ConformSmooth::kNone) return;
   t0_ = Clock::now();
-  const std::size_t np = mesh_.points.size();
-  std::vector<char> on_boundary(np, 0);
-  for (Index v : primal::boundary_nodes(mesh_)) on_boundary[v] = 1;
-  std::vector<std::vector<Index>> patches;
   const bool local = options_.smooth == ConformSmooth::kLocal;
-  if (!local) {
-    patches.emplace_back();
-    for (std::size_t v = 0; v < np; ++v)
-      if (!on_boundary[v]) patches.back().push_back(static_cast<Index>(v));
-  } else {
-    const std::size_t nb = layer_.hexes.size();
-    for (std::size_t b = 0; b < nb; ++b) {
-      std::vector<Index> movable;
-      for (Index h = res_.diced_hexes + static_cast<Index>(26 * b);
-           h < res_.diced_hexes + static_cast<Index>(26 * (b + 1)); ++h)
-        for (Index v : mesh_.hexes[h])
-          if (!on_boundary[v]) movable.push_back(v);
-      std::sort(movable.begin(), movable.end());
-      movable.erase(std::unique(movable.begin(), movable.end()), movable.end());
-      patches.push_back(std::move(movable));
-    }
+  std::vector<Index> seeds;
+  if (local) {
+    std::vector<Index> geode(static_cast<std::size_t>(res_.geode_hexes));
+    std::iota(geode.begin(), geode.end(), res_.diced_hexes);
+    seeds = primal::hexes_around(mesh_, geode);
   }
-  const std::size_t total = patches.size();
-  auto after_patch = [&](std::size_t done) {
-    if (!local) return;
-    if (options_.smoothing_progress)
-      options_.smoothing_progress(done, total);
-    else if (done % 100 == 0)
-      say("smoothing: " + std::to_string(done) + " / " + std::to_string(total) +
-          " buffer hexes" + took());
+  const auto constraints = primal::boundary_slide_constraints(mesh_);
+  const primal::TriMesh surface = primal::boundary_triangulation(mesh_);
+  primal::LocalSmoothOptions o = local ? options_.local_smooth_options : options_.global_smooth_options;
+  auto last = Clock::now();
+  o.progress = [&](std::size_t settled, std::size_t total) {
+    if (options_.smoothing_progress) {
+      options_.smoothing_progress(settled, total);
+    } else if (since(last) > 5.0) {
+      last = Clock::now();
+      say("smoothing: " + std::to_string(settled) + " / " + std::to_string(total) +
+          " seed hexes settled" + took());
+    }
   };
-  Index smoothed_hexes = 0;
-  res_.smoothing = smooth_node_patches(
-      mesh_, patches, local ? options_.local_smooth_options : options_.smooth_options,
-      after_patch, smoothed_hexes);
+  res_.smoothing = primal::smooth_hexes_local(mesh_, constraints, &surface, seeds, o);
   res_.smoothing.initial_min_scaled_jacobian = res_.min_scaled_jacobian_before_smoothing;
   res_.smoothing.final_min_scaled_jacobian = primal::min_scaled_jacobian(mesh_, &inverted_);
-  res_.smoothing.untangled = res_.smoothing.final_min_scaled_jacobian > 0;
-  res_.smoothing.seconds = since(t0_);
+  const Index patches = res_.smoothing.patches;
   say("smoothing (" + std::string(local ? "local" : "global") + "): " +
-      std::to_string(smoothed_hexes) + " hex-patches, min scaled Jacobian " +
+      std::to_string(patches) + " patches, min scaled Jacobian " +
       std::to_string(res_.smoothing.initial_min_scaled_jacobian) + " -> " +
       std::to_string(res_.smoothing.final_min_scaled_jacobian) + took());
 }

@@ -17,7 +17,7 @@
 #include "conform/buffer_layer.hpp"
 #include "primal/model.hpp"
 #include "primal/quality_report.hpp"
-#include "primal/smooth.hpp"
+#include "primal/local_smooth.hpp"
 #include "primal/validity.hpp"
 
 namespace geode::conform {
@@ -43,25 +43,22 @@ struct ConformOptions {
   // smooth_template slides a side-face node of the Anti-diagonal template onto the hex-side
   // edge midpoint (two nodes at one place), which conform() rejects.
   Eigen::Vector3d template_box{24.0, 14.0, 24.0};
-  // kLocal: nodes of the geode hexes and of the hexes around them (one ring) move, the rest is
-  // fixed. kGlobal: every node moves. Model boundary nodes are fixed in both.
+  // The worst-first smoother (primal/local_smooth.hpp), model boundary nodes sliding in their
+  // plane, along their feature edge or on the diced boundary triangulation. kLocal: patches
+  // seeded by the geode hexes and every hex touching them; kGlobal: by every hex, with a
+  // higher target so that the diced parts are improved too.
   ConformSmooth smooth = ConformSmooth::kLocal;
   ConformQuality quality = ConformQuality::kScaledJacobian;
-  primal::SmoothOptions smooth_options;  // kGlobal
-  // kLocal patches start from the smoothed reference template mapped into the buffer hex, so
-  // the blunt soft-minimum stages (sharpness 10-40) only spread changes that the sharp ones
-  // then work against. Starting at 80: the same minimum scaled Jacobian, every block's minimum
-  // as high or higher, on the half-block demo (0.189489, 4x faster) and the bench_conform
-  // n = 8 grid (0.190207, 2x faster).
-  primal::SmoothOptions local_smooth_options = [] {
-    primal::SmoothOptions o;
-    o.sharpness = {80, 160, 320, 640, 1280, 2560};
+  primal::LocalSmoothOptions local_smooth_options;
+  primal::LocalSmoothOptions global_smooth_options = [] {
+    primal::LocalSmoothOptions o;
+    o.target = 0.5;
     return o;
   }();
   // Called with one line per stage (for the command line's progress output); may be empty.
   std::function<void(const std::string&)> progress;
-  // Called after each buffer hex of local smoothing with (done, total), for a progress bar;
-  // when empty, `progress` gets a line every 100 buffer hexes instead.
+  // Called after each round of smoothing with (seed hexes settled, seed hexes), for a progress
+  // bar; when empty, `progress` gets a line every few seconds instead.
   std::function<void(std::size_t done, std::size_t total)> smoothing_progress;
 };
 
@@ -87,7 +84,7 @@ struct ConformResult {
   BufferLayerReport buffer;
   double template_min_scaled_jacobian = 0.0;  // the two reference templates, after smoothing
   double min_scaled_jacobian_before_smoothing = 0.0;
-  primal::SmoothResult smoothing;  // zero-initialised when ConformSmooth::kNone
+  primal::LocalSmoothResult smoothing;  // zero-initialised when ConformSmooth::kNone
   primal::HexValidityReport validity;
   std::vector<BlockQuality> quality;  // one per non-empty block (ConformOptions::quality)
   std::vector<std::string> warnings;  // e.g. "3 hexes with scaled Jacobian <= 0: 12 40 ..."

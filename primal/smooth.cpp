@@ -141,7 +141,8 @@ std::vector<NodeSpace> node_spaces(const std::vector<Point>& points,
           dirs = {Point::UnitX(), Point::UnitY(), Point::UnitZ()};
         }
         break;
-      case NodeConstraint::Kind::kPlane: {
+      case NodeConstraint::Kind::kPlane:
+      case NodeConstraint::Kind::kSurface: {
         const Point n = c.direction.normalized();
         s.base -= (s.base - c.origin).dot(n) * n;
         if (plane_normal && n.cross(*plane_normal).norm() > 1e-12) {

@@ -31,7 +31,9 @@
 namespace geode::primal {
 
 struct NodeConstraint {
-  enum class Kind { kFree, kFixed, kPlane, kLine };
+  // kSurface: on a surface triangulation given to the smoother (primal/local_smooth.hpp), with
+  // direction its normal at origin; smoothers without a surface keep it in that tangent plane.
+  enum class Kind { kFree, kFixed, kPlane, kLine, kSurface };
   Kind kind = Kind::kFree;
   Point origin = Point::Zero();     // a point of the plane or line
   Point direction = Point::Zero();  // plane normal or line direction (any length > 0)
@@ -43,6 +45,9 @@ struct NodeConstraint {
   }
   static NodeConstraint line(const Point& origin, const Point& direction) {
     return {Kind::kLine, origin, direction};
+  }
+  static NodeConstraint surface(const Point& origin, const Point& normal) {
+    return {Kind::kSurface, origin, normal};
   }
 };
 

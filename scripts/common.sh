@@ -4,7 +4,8 @@ set -euo pipefail
 GEODE_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 GEODE_PACKAGES=(cmake g++ make libopenmesh-dev libeigen3-dev doctest-dev libcli11-dev
   nlohmann-json3-dev libexodusii-dev libgmsh-dev gmsh python3-vtk9 python3-matplotlib
-  zlib1g-dev python3-meshio python3-netcdf4 clang libclang-rt-14-dev libjs-three chromium)
+  zlib1g-dev python3-meshio python3-netcdf4 clang libclang-rt-14-dev libjs-three chromium
+  libtbb-dev)
 JOBS=${JOBS:-$(nproc)}
 
 geode_install() {

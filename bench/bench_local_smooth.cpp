@@ -1,0 +1,109 @@
+// The worst-first local smoother (primal/local_smooth.hpp) on conform's output before smoothing,
+// for every demo model (conform/demo_models.hpp): CPU milliseconds per buffer hex, patches, min
+// scaled Jacobian per block before and after, with 1 thread and with TBB's default; then the
+// same machinery over every hex (global, conform's global options); then the whole conform
+// with default options, timed.
+// Usage: bench_local_smooth [n] [target] [max_visits] [max_iterations] [model...]
+//        (defaults 4, LocalSmoothOptions' own, every demo model)
+#include <chrono>
+#include <ctime>
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "conform/conform.hpp"
+#include "conform/demo_models.hpp"
+#include "primal/local_smooth.hpp"
+#include "primal/quality.hpp"
+
+namespace {
+
+using namespace geode;
+
+std::map<int, double> block_minima(const primal::HexMesh& m) {
+  std::map<int, double> out;
+  for (primal::Index h = 0; h < static_cast<primal::Index>(m.hexes.size()); ++h) {
+    const double q = primal::hex_scaled_jacobian(primal::hex_corners(m, h));
+    auto [it, fresh] = out.emplace(m.block[h], q);
+    if (!fresh) it->second = std::min(it->second, q);
+  }
+  return out;
+}
+
+void print_blocks(const char* label, const std::map<int, double>& b) {
+  std::printf("    %-7s min SJ", label);
+  for (const auto& [id, q] : b) std::printf("  block %d: %.4f", id, q);
+  std::printf("\n");
+}
+
+void run(const std::string& name, const primal::Model& input, const primal::LocalSmoothOptions& base) {
+  conform::ConformOptions o;
+  o.smooth = conform::ConformSmooth::kNone;
+  const conform::ConformResult r = conform::conform(input, o);
+  primal::HexMesh mesh;
+  mesh.points = r.model.points;
+  mesh.hexes = r.model.hexes;
+  mesh.block = r.model.hex_block;
+  const double buffer = static_cast<double>(r.geode_hexes) / 26.0;
+  std::vector<primal::Index> geode;
+  for (primal::Index h = 0; h < static_cast<primal::Index>(mesh.hexes.size()); ++h)
+    if (mesh.block[h] == conform::kGeodeBlock) geode.push_back(h);
+  const auto seeds = primal::hexes_around(mesh, geode);
+  const auto cons = primal::boundary_slide_constraints(mesh);
+  const primal::TriMesh surface = primal::boundary_triangulation(mesh);
+  std::printf("%s: %zu tets, %zu input hexes -> %zu hexes, %.0f buffer hexes, %zu seeds\n", name.c_str(),
+              input.tets.size(), input.hexes.size(), mesh.hexes.size(), buffer, seeds.size());
+  print_blocks("before", block_minima(mesh));
+  struct Mode {
+    const char* label;
+    bool global;
+    int threads;
+  } modes[] = {{"local, 1 thread", false, 1}, {"local, default threads", false, 0},
+               {"global, default threads", true, 0}};
+  for (const Mode& m : modes) {
+    primal::HexMesh work = mesh;
+    primal::LocalSmoothOptions lo = base;
+    if (m.global) lo.target = conform::ConformOptions{}.global_smooth_options.target;
+    lo.threads = m.threads;
+    const std::clock_t c0 = std::clock();
+    const auto res = primal::smooth_hexes_local(work, cons, &surface,
+                                                m.global ? std::span<const primal::Index>{} : seeds, lo);
+    const double cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
+    std::printf("  %-24s %.3f ms CPU per buffer hex (%.3f s CPU, %.3f s wall), %d patches, %d rounds,"
+                " %ld iterations, inverted %d -> %d\n",
+                m.label, 1e3 * cpu / buffer, cpu, res.seconds, res.patches, res.rounds, res.iterations,
+                res.initial_inverted, res.final_inverted);
+    print_blocks("after", block_minima(work));
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int n = argc > 1 ? std::atoi(argv[1]) : 4;
+  primal::LocalSmoothOptions o;
+  if (argc > 2) o.target = std::atof(argv[2]);
+  if (argc > 3) o.max_visits = std::atoi(argv[3]);
+  if (argc > 4) o.max_iterations = std::atoi(argv[4]);
+  std::vector<std::string> models(argv + std::min(argc, 5), argv + argc);
+  if (models.empty()) models = conform::demo_model_names();
+  std::printf("n %d, target %.2f, max_visits %d, max_iterations %d\n", n, o.target, o.max_visits,
+              o.max_iterations);
+  for (const std::string& name : models) {
+    const primal::Model input = conform::demo_model(name, n);
+    run(name + " " + std::to_string(n), input, o);
+    conform::ConformOptions co;
+    co.local_smooth_options = o;
+    const std::clock_t c0 = std::clock();
+    const auto t0 = std::chrono::steady_clock::now();
+    const conform::ConformResult r = conform::conform(input, co);
+    std::printf("  whole conform (local): %.3f s CPU, %.3f s wall, valid %s, min SJ %.4f\n",
+                static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC,
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+                r.validity.ok() ? "yes" : "NO", r.smoothing.final_min_scaled_jacobian);
+  }
+  return 0;
+}

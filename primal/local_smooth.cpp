@@ -1,0 +1,653 @@
+#include "primal/local_smooth.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <string>
+#include <unordered_map>
+
+#include "primal/boundary.hpp"
+#include "primal/errors.hpp"
+#include "primal/frame_derivatives.hpp"
+#include "primal/quality.hpp"
+#include "primal/topology.hpp"
+
+namespace geode::primal {
+
+namespace {
+
+namespace topo = topology;
+
+// A patch moves the free nodes of one hex: at most 8 nodes, 24 unknowns.
+constexpr int kMaxDof = 24;
+using PatchVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxDof, 1>;
+using PatchMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxDof, kMaxDof>;
+using Basis = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, 3>;
+
+// Frame f of a hex (0..7 corner f, 8 the centre) as columns v_i = sum_k coef[i][k] p[corner[k]]
+// (primal/quality.hpp: corner edges in kHexCornerNeighbors order; principal axes X1, X2, X3).
+struct FrameShape {
+  int nodes = 0;
+  std::array<int, 8> corner{};
+  std::array<std::array<double, 8>, 3> coef{};
+  double det_scale = 1.0;  // Jacobian = det * det_scale
+};
+
+const std::array<FrameShape, 9>& frame_shapes() {
+  static const std::array<FrameShape, 9> shapes = [] {
+    std::array<FrameShape, 9> s{};
+    for (int c = 0; c < 8; ++c) {
+      FrameShape& f = s[c];
+      f.nodes = 4;
+      f.corner = {c, topo::kHexCornerNeighbors[c][0], topo::kHexCornerNeighbors[c][1],
+                  topo::kHexCornerNeighbors[c][2], 0, 0, 0, 0};
+      for (int i = 0; i < 3; ++i) f.coef[i][0] = -1.0, f.coef[i][i + 1] = 1.0;
+    }
+    FrameShape& centre = s[8];
+    centre.nodes = 8;
+    centre.det_scale = 1.0 / 64.0;
+    for (int c = 0; c < 8; ++c) {
+      centre.corner[c] = c;
+      for (int i = 0; i < 3; ++i) centre.coef[i][c] = topo::kHexCornerCoords[c][i] ? 1.0 : -1.0;
+    }
+    return s;
+  }();
+  return shapes;
+}
+
+// Closest point of triangle abc to p (C. Ericson, Real-Time Collision Detection, 5.1.5).
+Point closest_on_triangle(const Point& p, const Point& a, const Point& b, const Point& c) {
+  const Point ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Point bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + d1 / (d1 - d3) * ab;
+  const Point cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + d2 / (d2 - d6) * ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b);
+  const double denom = 1.0 / (va + vb + vc);
+  return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
+// Nearest-triangle queries on a uniform grid of triangle bounding boxes.
+class SurfaceProjector {
+ public:
+  explicit SurfaceProjector(const TriMesh& s) : s_(s) {
+    if (s.tris.empty()) return;
+    lo_ = Point::Constant(std::numeric_limits<double>::max());
+    double edges = 0.0;
+    for (const auto& t : s.tris) {
+      for (int k = 0; k < 3; ++k) {
+        lo_ = lo_.cwiseMin(s.points[t[k]]);
+        edges += (s.points[t[k]] - s.points[t[(k + 1) % 3]]).norm();
+      }
+    }
+    cell_ = std::max(2.0 * edges / (3.0 * static_cast<double>(s.tris.size())), 1e-12);
+    for (std::size_t i = 0; i < s.tris.size(); ++i) {
+      Point a = s.points[s.tris[i][0]], b = a;
+      for (int k = 1; k < 3; ++k) a = a.cwiseMin(s.points[s.tris[i][k]]), b = b.cwiseMax(s.points[s.tris[i][k]]);
+      const auto ca = cell_of(a), cb = cell_of(b);
+      for (Index x = ca[0]; x <= cb[0]; ++x)
+        for (Index y = ca[1]; y <= cb[1]; ++y)
+          for (Index z = ca[2]; z <= cb[2]; ++z) grid_[{x, y, z}].push_back(static_cast<Index>(i));
+    }
+  }
+
+  // Nearest point of the surface to p and the unit normal of its triangle.
+  Point project(const Point& p, Point* normal) const {
+    const auto c = cell_of(p);
+    double best = std::numeric_limits<double>::max();
+    Point out = p;
+    Index best_tri = kInvalidIndex;
+    for (Index r = 1; r < 1 << 20; r *= 2) {
+      for (Index x = c[0] - r; x <= c[0] + r; ++x)
+        for (Index y = c[1] - r; y <= c[1] + r; ++y)
+          for (Index z = c[2] - r; z <= c[2] + r; ++z) {
+            const auto it = grid_.find({x, y, z});
+            if (it == grid_.end()) continue;
+            for (Index t : it->second) {
+              const auto& tri = s_.tris[t];
+              const Point q = closest_on_triangle(p, s_.points[tri[0]], s_.points[tri[1]],
+                                                  s_.points[tri[2]]);
+              const double d = (q - p).squaredNorm();
+              if (d < best || (d == best && t < best_tri)) best = d, out = q, best_tri = t;
+            }
+          }
+      // Every triangle within r cells of p has been seen.
+      if (best_tri != kInvalidIndex && std::sqrt(best) <= r * cell_) break;
+      if (r > (1 << 16)) break;
+    }
+    if (normal && best_tri != kInvalidIndex) {
+      const auto& tri = s_.tris[best_tri];
+      *normal = (s_.points[tri[1]] - s_.points[tri[0]])
+                    .cross(s_.points[tri[2]] - s_.points[tri[0]])
+                    .normalized();
+    }
+    return out;
+  }
+
+ private:
+  std::array<Index, 3> cell_of(const Point& p) const {
+    std::array<Index, 3> c{};
+    for (int k = 0; k < 3; ++k) c[k] = static_cast<Index>(std::floor((p[k] - lo_[k]) / cell_));
+    return c;
+  }
+
+  const TriMesh& s_;
+  Point lo_ = Point::Zero();
+  double cell_ = 1.0;
+  std::unordered_map<std::array<Index, 3>, std::vector<Index>, IndexArrayHash> grid_;
+};
+
+// Shared, read-only data of one smoothing call.
+struct Context {
+  HexMesh& mesh;
+  std::span<const NodeConstraint> constraints;
+  const SurfaceProjector* projector;
+  const LocalSmoothOptions& options;
+  std::vector<Index> node_start, node_hexes;  // node -> hexes (CSR)
+  std::vector<double> start;                  // per hex, its scaled Jacobian when the call began
+};
+
+bool is_fixed(const Context& ctx, Index v) {
+  return !ctx.constraints.empty() && ctx.constraints[v].kind == NodeConstraint::Kind::kFixed;
+}
+
+// The tangent basis a node moves in at p (3 x dof, orthonormal).
+Basis motion_basis(const Context& ctx, Index v, const Point& p) {
+  const NodeConstraint c = ctx.constraints.empty() ? NodeConstraint::free() : ctx.constraints[v];
+  Basis b;
+  auto plane = [&](const Point& n) {
+    int k = 0;  // the axis least aligned with n, so axis-aligned planes get axis tangents
+    for (int i = 1; i < 3; ++i)
+      if (std::abs(n[i]) < std::abs(n[k])) k = i;
+    const Point t1 = n.cross(Point::Unit(k)).normalized();
+    b.resize(3, 2);
+    b.col(0) = t1, b.col(1) = n.cross(t1);
+  };
+  switch (c.kind) {
+    case NodeConstraint::Kind::kFree:
+      b = Eigen::Matrix3d::Identity();
+      break;
+    case NodeConstraint::Kind::kFixed:
+      b.resize(3, 0);
+      break;
+    case NodeConstraint::Kind::kPlane:
+      plane(c.direction.normalized());
+      break;
+    case NodeConstraint::Kind::kSurface: {
+      Point n;
+      ctx.projector->project(p, &n);
+      plane(n);
+      break;
+    }
+    case NodeConstraint::Kind::kLine:
+      b.resize(3, 1);
+      b.col(0) = c.direction.normalized();
+      break;
+  }
+  return b;
+}
+
+// Where a constrained node lands: exactly on its plane, line or surface.
+Point constrain(const Context& ctx, Index v, const Point& p) {
+  if (ctx.constraints.empty()) return p;
+  const NodeConstraint& c = ctx.constraints[v];
+  switch (c.kind) {
+    case NodeConstraint::Kind::kPlane: {
+      const Point n = c.direction.normalized();
+      return p - (p - c.origin).dot(n) * n;
+    }
+    case NodeConstraint::Kind::kLine: {
+      const Point d = c.direction.normalized();
+      return c.origin + (p - c.origin).dot(d) * d;
+    }
+    case NodeConstraint::Kind::kSurface:
+      return ctx.projector->project(p, nullptr);
+    default:
+      return p;
+  }
+}
+
+struct PatchOutcome {
+  bool moved = false;
+  int iterations = 0;
+};
+
+// One patch: the free nodes of a seed hex move; every frame with a moving node is counted.
+class Patch {
+ public:
+  Patch(const Context& ctx, Index seed, std::span<const Index> affected, const std::vector<double>& sj)
+      : ctx_(ctx), hex_(affected.begin(), affected.end()) {
+    for (Index v : ctx.mesh.hexes[seed])
+      if (!is_fixed(ctx, v) && std::find(node_.begin(), node_.end(), v) == node_.end())
+        node_.push_back(v);
+    moving_ = static_cast<int>(node_.size());
+    local_.resize(hex_.size());
+    for (std::size_t h = 0; h < hex_.size(); ++h)
+      for (int c = 0; c < 8; ++c) {
+        const Index v = ctx.mesh.hexes[hex_[h]][c];
+        auto it = std::find(node_.begin(), node_.end(), v);
+        if (it == node_.end()) node_.push_back(v), it = node_.end() - 1;
+        local_[h][c] = static_cast<int>(it - node_.begin());
+      }
+    pos_.resize(node_.size());
+    for (std::size_t i = 0; i < node_.size(); ++i) pos_[i] = ctx.mesh.points[node_[i]];
+    const auto& shapes = frame_shapes();
+    for (std::size_t h = 0; h < hex_.size(); ++h)
+      for (int f = 0; f < 9; ++f) {
+        bool has = false;
+        for (int k = 0; k < shapes[f].nodes; ++k) has = has || local_[h][shapes[f].corner[k]] < moving_;
+        if (has) frames_.push_back({static_cast<int>(h), f});
+      }
+    // Length unit: the mean edge of the seed hex.
+    double sum = 0.0;
+    for (const auto& e : topo::kHexEdgeCorners)
+      sum += (ctx.mesh.points[ctx.mesh.hexes[seed][e[0]]] - ctx.mesh.points[ctx.mesh.hexes[seed][e[1]]]).norm();
+    length_ = std::max(sum / 12.0, 1e-300);
+    unit_ = length_ * length_ * length_;
+    // Floors (see the header): the patch's worst never drops; hexes within `margin` of it keep
+    // their start; better ones may lose `loss` from their start, never past worst + margin.
+    double worst = std::numeric_limits<double>::max();
+    for (Index h : hex_) worst = std::min(worst, sj[h]);
+    const double keep = std::max(worst, 0.0) + ctx.options.margin;
+    for (Index h : hex_) {
+      const double s = ctx.start[h];
+      const double f = s <= 0.0 ? -std::numeric_limits<double>::infinity()
+                       : s < keep ? s
+                                  : std::max(keep, s - ctx.options.loss);
+      floor_.push_back(sj[h] <= 0.0 ? f : std::min(sj[h], std::max(f, worst)));
+    }
+  }
+
+  PatchOutcome run(std::vector<double>& sj) {
+    PatchOutcome out;
+    if (moving_ == 0) return out;
+    const LocalSmoothOptions& o = ctx_.options;
+    for (int phase = 0; phase < 2; ++phase) {
+      const bool untangle = phase == 0;
+      if (untangle && min_frame(true) > 0.0) continue;
+      const double t = untangle ? o.untangle_sharpness : o.sharpness;
+      for (int it = 0; it < o.max_iterations; ++it) {
+        const bool ok = newton_step(untangle, t);
+        ++out.iterations;
+        if (!ok) break;
+        out.moved = true;
+        if (untangle && min_frame(true) > 0.0) break;
+        if (last_gain_ < o.min_gain) break;
+      }
+    }
+    if (out.moved) {
+      // Patches of one round write disjoint nodes and hexes (see the round selection).
+      for (int i = 0; i < moving_; ++i) ctx_.mesh.points[node_[i]] = pos_[i];
+      for (std::size_t h = 0; h < hex_.size(); ++h) sj[hex_[h]] = hex_sj(pos_, h);
+    }
+    return out;
+  }
+
+ private:
+  struct FrameRef {
+    int hex;    // index into hex_
+    int frame;  // 0..8
+  };
+
+  FrameVector columns(const std::vector<Point>& p, const FrameRef& r) const {
+    const FrameShape& s = frame_shapes()[r.frame];
+    FrameVector v = FrameVector::Zero();
+    for (int k = 0; k < s.nodes; ++k) {
+      const Point& x = p[local_[r.hex][s.corner[k]]];
+      for (int i = 0; i < 3; ++i) v.segment<3>(3 * i) += s.coef[i][k] * x;
+    }
+    return v;
+  }
+
+  double measure(const FrameVector& v, const FrameRef& r, bool untangle, FrameVector* g,
+                 FrameMatrix* h) const {
+    if (!untangle) return scaled_determinant_derivatives(v, g, h);
+    const double scale = frame_shapes()[r.frame].det_scale / unit_;
+    const double d = determinant_derivatives(v, g, h);
+    if (g) *g *= scale;
+    if (h) *h *= scale;
+    return d * scale;
+  }
+
+  double min_frame(bool untangle) const {
+    double m = std::numeric_limits<double>::max();
+    for (const FrameRef& r : frames_) m = std::min(m, measure(columns(pos_, r), r, untangle, nullptr, nullptr));
+    return m;
+  }
+
+  double hex_sj(const std::vector<Point>& p, std::size_t h) const {
+    HexCorners c;
+    for (int k = 0; k < 8; ++k) c[k] = p[local_[h][k]];
+    return hex_scaled_jacobian(c);
+  }
+
+  // Soft minimum -1/t log sum exp(-t q_k) over the frames at positions p; with grad and hess,
+  // the derivatives of its negative with respect to the moving nodes' xyz coordinates.
+  double soft_min(const std::vector<Point>& p, bool untangle, double t, PatchVector* grad,
+                  PatchMatrix* hess) {
+    const std::size_t n = frames_.size();
+    q_.resize(n);
+    for (std::size_t k = 0; k < n; ++k) q_[k] = measure(columns(p, frames_[k]), frames_[k], untangle, nullptr, nullptr);
+    const double qmin = *std::min_element(q_.begin(), q_.end());
+    double sum = 0.0;
+    for (std::size_t k = 0; k < n; ++k) sum += std::exp(-t * (q_[k] - qmin));
+    const double value = qmin - std::log(sum) / t;
+    if (!grad) return value;
+    const int m3 = 3 * moving_;
+    grad->setZero(m3);
+    hess->setZero(m3, m3);
+    const auto& shapes = frame_shapes();
+    for (std::size_t k = 0; k < n; ++k) {
+      const double w = std::exp(-t * (q_[k] - qmin)) / sum;
+      if (w < 1e-10) continue;  // far above the minimum: nothing measurable
+      // Second derivatives only where the weight is large enough to shape the step (the soft
+      // minimum's curvature is dominated by its few lowest frames); the gradient stays exact.
+      const bool second = w >= 1e-4;
+      const FrameRef& r = frames_[k];
+      const FrameShape& s = shapes[r.frame];
+      FrameVector g;
+      FrameMatrix h;
+      measure(columns(p, r), r, untangle, &g, second ? &h : nullptr);
+      int count = 0;
+      std::array<int, 8> node{};
+      std::array<int, 8> slot{};
+      std::array<Point, 8> gn;
+      for (int a = 0; a < s.nodes; ++a) {
+        const int ln = local_[r.hex][s.corner[a]];
+        if (ln >= moving_) continue;
+        node[count] = ln, slot[count] = a;
+        gn[count] = s.coef[0][a] * g.segment<3>(0) + s.coef[1][a] * g.segment<3>(3) +
+                    s.coef[2][a] * g.segment<3>(6);
+        grad->segment<3>(3 * ln) -= w * gn[count];
+        ++count;
+      }
+      for (int a = 0; a < count; ++a) {
+        if (!second) {
+          for (int b = 0; b < count; ++b)
+            hess->block<3, 3>(3 * node[a], 3 * node[b]) += t * w * gn[a] * gn[b].transpose();
+          continue;
+        }
+        // Rows of the node-a mix of H: sum_i coef[i][a] H(3i.., :).
+        Eigen::Matrix<double, 3, 9> row = Eigen::Matrix<double, 3, 9>::Zero();
+        for (int i = 0; i < 3; ++i) row += s.coef[i][slot[a]] * h.block<3, 9>(3 * i, 0);
+        for (int b = 0; b < count; ++b) {
+          Eigen::Matrix3d blk = Eigen::Matrix3d::Zero();
+          for (int j = 0; j < 3; ++j) blk += s.coef[j][slot[b]] * row.block<3, 3>(0, 3 * j);
+          hess->block<3, 3>(3 * node[a], 3 * node[b]) += -w * blk + t * w * gn[a] * gn[b].transpose();
+        }
+      }
+    }
+    *hess -= t * (*grad) * grad->transpose();  // the mean gradient is -grad
+    return value;
+  }
+
+  bool feasible(const std::vector<Point>& p) const {
+    for (std::size_t h = 0; h < hex_.size(); ++h)
+      if (hex_sj(p, h) < floor_[h]) return false;
+    return true;
+  }
+
+  // One damped Newton step on -soft_min in the moving nodes' free coordinates; false when no
+  // step raised the soft minimum within the floors.
+  bool newton_step(bool untangle, double t) {
+    PatchVector gx;
+    PatchMatrix hx;
+    const double f0 = -soft_min(pos_, untangle, t, &gx, &hx);
+    std::array<Basis, 8> basis;
+    std::array<int, 8> offset{};
+    int dof = 0;
+    for (int i = 0; i < moving_; ++i) {
+      basis[i] = motion_basis(ctx_, node_[i], pos_[i]);
+      offset[i] = dof;
+      dof += static_cast<int>(basis[i].cols());
+    }
+    if (dof == 0) return false;
+    PatchVector g(dof);
+    PatchMatrix h(dof, dof);
+    for (int i = 0; i < moving_; ++i) {
+      const auto di = basis[i].cols();
+      g.segment(offset[i], di) = basis[i].transpose() * gx.segment<3>(3 * i);
+      for (int j = 0; j < moving_; ++j)
+        h.block(offset[i], offset[j], di, basis[j].cols()) =
+            basis[i].transpose() * hx.block<3, 3>(3 * i, 3 * j) * basis[j];
+    }
+    const double scale = std::max(h.diagonal().cwiseAbs().maxCoeff(), 1e-300);
+    PatchVector d;
+    for (int attempt = 0; attempt < 40; ++attempt) {
+      PatchMatrix a = h;
+      a.diagonal().array() += lambda_;
+      Eigen::LLT<PatchMatrix> llt(a);
+      if (llt.info() == Eigen::Success) {
+        d = -llt.solve(g);
+        if (d.allFinite() && g.dot(d) < 0.0) break;
+      }
+      d.resize(0);
+      lambda_ = std::max(4.0 * lambda_, 1e-8 * scale);
+    }
+    if (d.size() == 0) return false;
+    // Trust bound: no node moves more than a quarter of the seed's mean edge per step.
+    double longest = 0.0;
+    for (int i = 0; i < moving_; ++i)
+      longest = std::max(longest, (basis[i] * d.segment(offset[i], basis[i].cols())).norm());
+    if (longest > 0.25 * length_) d *= 0.25 * length_ / longest;
+    const double slope = g.dot(d);
+    trial_ = pos_;
+    for (double step = 1.0; step > 0.01; step *= 0.5) {
+      for (int i = 0; i < moving_; ++i)
+        trial_[i] = constrain(ctx_, node_[i], pos_[i] + step * (basis[i] * d.segment(offset[i], basis[i].cols())));
+      const double f = -soft_min(trial_, untangle, t, nullptr, nullptr);
+      if (std::isfinite(f) && f <= f0 + 1e-4 * step * slope && f < f0 && feasible(trial_)) {
+        last_gain_ = f0 - f;
+        lambda_ = step == 1.0 ? lambda_ / 4.0 : std::max(4.0 * lambda_, 1e-8 * scale);
+        pos_.swap(trial_);
+        return true;
+      }
+    }
+    return false;
+  }
+
+  const Context& ctx_;
+  std::vector<Index> hex_;                // affected hexes
+  std::vector<Index> node_;               // local -> global; the first moving_ move
+  std::vector<std::array<int, 8>> local_;  // per affected hex, its corners' local numbers
+  std::vector<Point> pos_, trial_;
+  std::vector<FrameRef> frames_;
+  std::vector<double> q_, floor_;
+  int moving_ = 0;
+  double length_ = 1.0, unit_ = 1.0, lambda_ = 0.0, last_gain_ = 0.0;
+};
+
+}  // namespace
+
+LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstraint> constraints,
+                                     const TriMesh* surface, std::span<const Index> seeds,
+                                     const LocalSmoothOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::size_t np = mesh.points.size(), nh = mesh.hexes.size();
+  if (!constraints.empty() && constraints.size() != np)
+    throw InvalidInput("smooth_hexes_local: " + std::to_string(constraints.size()) +
+                       " constraints for " + std::to_string(np) + " nodes");
+  for (std::size_t h = 0; h < nh; ++h)
+    for (Index v : mesh.hexes[h])
+      if (v < 0 || static_cast<std::size_t>(v) >= np)
+        throw InvalidInput("smooth_hexes_local: hex " + std::to_string(h) + " names node " +
+                           std::to_string(v) + ", out of range");
+  for (Index s : seeds)
+    if (s < 0 || static_cast<std::size_t>(s) >= nh)
+      throw InvalidInput("smooth_hexes_local: seed hex " + std::to_string(s) + " out of range");
+  std::unique_ptr<SurfaceProjector> projector;
+  for (std::size_t v = 0; v < constraints.size(); ++v) {
+    const NodeConstraint& c = constraints[v];
+    if (c.kind == NodeConstraint::Kind::kSurface && !surface)
+      throw InvalidInput("smooth_hexes_local: node " + std::to_string(v) +
+                         " slides on a surface but none is given");
+    if ((c.kind == NodeConstraint::Kind::kPlane || c.kind == NodeConstraint::Kind::kLine) &&
+        !(c.direction.norm() > 0.0 && c.direction.allFinite()))
+      throw InvalidInput("smooth_hexes_local: node " + std::to_string(v) +
+                         " has a zero or non-finite constraint direction");
+  }
+  if (surface) projector = std::make_unique<SurfaceProjector>(*surface);
+
+  Context ctx{mesh, constraints, projector.get(), options, {}, {}, {}};
+  ctx.node_start.assign(np + 1, 0);
+  for (const auto& h : mesh.hexes)
+    for (Index v : h) ++ctx.node_start[v + 1];
+  for (std::size_t v = 0; v < np; ++v) ctx.node_start[v + 1] += ctx.node_start[v];
+  ctx.node_hexes.resize(ctx.node_start.back());
+  {
+    std::vector<Index> fill(ctx.node_start.begin(), ctx.node_start.end() - 1);
+    for (std::size_t h = 0; h < nh; ++h)
+      for (Index v : mesh.hexes[h]) ctx.node_hexes[fill[v]++] = static_cast<Index>(h);
+  }
+  // Constrained nodes start exactly on their plane, line or surface.
+  for (std::size_t v = 0; v < constraints.size(); ++v)
+    mesh.points[v] = constrain(ctx, static_cast<Index>(v), mesh.points[v]);
+
+  LocalSmoothResult res;
+  std::vector<double> sj(nh);
+  for (std::size_t h = 0; h < nh; ++h) sj[h] = hex_scaled_jacobian(hex_corners(mesh, static_cast<Index>(h)));
+  ctx.start = sj;
+  auto summarise = [&](double& min_sj, Index& inverted) {
+    min_sj = nh ? *std::min_element(sj.begin(), sj.end()) : 0.0;
+    inverted = static_cast<Index>(std::count_if(sj.begin(), sj.end(), [](double q) { return q <= 0.0; }));
+  };
+  summarise(res.initial_min_scaled_jacobian, res.initial_inverted);
+
+  std::vector<Index> pool(seeds.begin(), seeds.end());
+  if (seeds.empty())
+    for (std::size_t h = 0; h < nh; ++h) pool.push_back(static_cast<Index>(h));
+  std::sort(pool.begin(), pool.end());
+  pool.erase(std::unique(pool.begin(), pool.end()), pool.end());
+  std::vector<int> visits(nh, 0);
+  std::vector<char> dirty(nh, 1);
+  std::vector<Index> claimed(nh, -1);
+  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+
+  for (Index round = 0;; ++round) {
+    std::vector<Index> cand;
+    for (Index h : pool)
+      if (sj[h] < options.target && visits[h] < options.max_visits && dirty[h]) cand.push_back(h);
+    if (options.progress) options.progress(pool.size() - cand.size(), pool.size());
+    if (cand.empty()) break;
+    std::sort(cand.begin(), cand.end(), [&](Index a, Index b) { return sj[a] < sj[b] || (sj[a] == sj[b] && a < b); });
+    // Worst first, each patch sharing no hex with one kept before it in this round.
+    std::vector<Index> chosen;
+    std::vector<std::vector<Index>> affected;
+    std::vector<Index> around;
+    for (Index h : cand) {
+      around.clear();
+      for (Index v : mesh.hexes[h])
+        if (!is_fixed(ctx, v))
+          for (Index k = ctx.node_start[v]; k < ctx.node_start[v + 1]; ++k) around.push_back(ctx.node_hexes[k]);
+      std::sort(around.begin(), around.end());
+      around.erase(std::unique(around.begin(), around.end()), around.end());
+      if (around.empty()) {  // every node fixed: nothing to do, ever
+        visits[h] = options.max_visits;
+        continue;
+      }
+      if (std::any_of(around.begin(), around.end(), [&](Index a) { return claimed[a] == round; })) continue;
+      for (Index a : around) claimed[a] = round;
+      chosen.push_back(h);
+      affected.push_back(around);
+    }
+    std::vector<PatchOutcome> outcome(chosen.size());
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chosen.size(), 1),
+                        [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t i = r.begin(); i != r.end(); ++i)
+                            outcome[i] = Patch(ctx, chosen[i], affected[i], sj).run(sj);
+                        });
+    });
+    for (std::size_t i = 0; i < chosen.size(); ++i) {
+      ++visits[chosen[i]];
+      dirty[chosen[i]] = 0;
+      res.iterations += outcome[i].iterations;
+      if (outcome[i].moved)
+        for (Index a : affected[i])
+          if (a != chosen[i]) dirty[a] = 1;
+    }
+    res.patches += static_cast<Index>(chosen.size());
+    res.rounds = round + 1;
+  }
+  summarise(res.final_min_scaled_jacobian, res.final_inverted);
+  res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return res;
+}
+
+std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh, double feature_angle) {
+  std::vector<NodeConstraint> out(mesh.points.size());
+  std::vector<std::vector<Point>> normals(mesh.points.size());
+  for (const BoundaryQuad& q : boundary_quads(mesh)) {
+    const auto& p = mesh.points;
+    const Point n = (p[q.nodes[2]] - p[q.nodes[0]]).cross(p[q.nodes[3]] - p[q.nodes[1]]);
+    if (!(n.norm() > 0.0)) continue;
+    for (Index v : q.nodes) normals[v].push_back(n.normalized());
+  }
+  const double cos_feature = std::cos(feature_angle * M_PI / 180.0);
+  constexpr double kParallel = 1e-9;
+  for (std::size_t v = 0; v < normals.size(); ++v) {
+    if (normals[v].empty()) continue;
+    // Group the normals: each joins the first group whose first normal is within the angle.
+    std::vector<std::vector<Point>> groups;
+    for (const Point& n : normals[v]) {
+      auto g = std::find_if(groups.begin(), groups.end(), [&](const auto& gr) { return gr[0].dot(n) >= cos_feature; });
+      if (g == groups.end()) groups.push_back({n});
+      else g->push_back(n);
+    }
+    auto planar = [&](const std::vector<Point>& gr) {
+      return std::all_of(gr.begin(), gr.end(), [&](const Point& n) { return n.cross(gr[0]).norm() <= kParallel; });
+    };
+    const Point& p = mesh.points[v];
+    if (groups.size() == 1) {
+      Point mean = Point::Zero();
+      for (const Point& n : groups[0]) mean += n;
+      out[v] = planar(groups[0]) ? NodeConstraint::plane(p, groups[0][0])
+                                 : NodeConstraint::surface(p, mean.normalized());
+    } else if (groups.size() == 2 && planar(groups[0]) && planar(groups[1])) {
+      out[v] = NodeConstraint::line(p, groups[0][0].cross(groups[1][0]).normalized());
+    } else {
+      out[v] = NodeConstraint::fixed();
+    }
+  }
+  return out;
+}
+
+TriMesh boundary_triangulation(const HexMesh& mesh) {
+  TriMesh t;
+  t.points = mesh.points;
+  for (const BoundaryQuad& q : boundary_quads(mesh)) {
+    t.tris.push_back({q.nodes[0], q.nodes[1], q.nodes[2]});
+    t.tris.push_back({q.nodes[0], q.nodes[2], q.nodes[3]});
+  }
+  return t;
+}
+
+std::vector<Index> hexes_around(const HexMesh& mesh, std::span<const Index> hexes) {
+  std::vector<char> node(mesh.points.size(), 0);
+  for (Index h : hexes)
+    for (Index v : mesh.hexes[h]) node[v] = 1;
+  std::vector<Index> out;
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
+    if (std::any_of(mesh.hexes[h].begin(), mesh.hexes[h].end(), [&](Index v) { return node[v]; }))
+      out.push_back(static_cast<Index>(h));
+  return out;
+}
+
+}  // namespace geode::primal

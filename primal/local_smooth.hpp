@@ -1,0 +1,88 @@
+#pragma once
+// Worst-first local smoothing of large hex meshes: the hexes below a quality target are taken
+// worst first; each one's free nodes (a patch of at most 8 nodes) move together to raise the
+// soft minimum of the corner measures of every frame they touch (8 corners and the centre of
+// each hex around them, [Verdict] scaled Jacobian), by a damped Newton method with analytic
+// gradients and Hessians (primal/frame_derivatives.hpp). A patch with a non-positive corner
+// Jacobian first untangles (soft minimum of the Jacobians / L^3), then improves shape.
+//
+// Guarantees.
+//  - Floors. Let `start` be a hex's scaled Jacobian when the call began and `worst` the lowest
+//    of a patch's hexes when the patch begins. No hex of a patch ends below `worst`; a hex that
+//    started within `margin` of it ends no lower than its start; a better one loses at most
+//    `loss` from its start and never falls below worst + margin. Every trial step that would
+//    break a floor is cut back, so the patch's worst hex never gets worse, hexes near the worst
+//    never lose, and good hexes pay a bounded price. An inverted hex has no floor: untangling
+//    may move it through worse shapes; the soft minimum of the Jacobians it maximises keeps
+//    the worst Jacobian from dropping.
+//  - Termination: each patch's soft minimum rises monotonically (Armijo) and stops when it rises
+//    by less than `min_gain`, after max_iterations, or when no step is accepted; each hex seeds
+//    at most max_visits patches, and only when a neighbouring patch moved one of its nodes since
+//    its last one. Only frames with a moving node are counted, so a patch cannot stall on a
+//    frame it cannot change.
+//  - Determinism: patches run in rounds; a round takes the candidates worst first (ties by hex
+//    number) and keeps those that share no hex with one already kept (so no two touch a common
+//    frame), then runs them in parallel (TBB). The result does not depend on the thread count.
+//  - Constraints (primal/smooth.hpp's NodeConstraint): plane and line nodes stay on them exactly;
+//    kSurface nodes move in their tangent plane and are projected back onto the nearest triangle
+//    of the given surface triangulation after every step.
+#include <cstddef>
+#include <functional>
+#include <span>
+#include <vector>
+
+#include "primal/mesh.hpp"
+#include "primal/smooth.hpp"
+
+namespace geode::primal {
+
+struct LocalSmoothOptions {
+  double target = 0.35;       // hexes with a scaled Jacobian below it seed patches
+  double margin = 0.1;        // hexes this close to a patch's worst never lose (see Floors)
+  double loss = 0.1;          // how far a better hex may fall from its start
+  int max_visits = 2;         // patches seeded by one hex
+  int max_iterations = 5;     // Newton iterations per patch (per phase)
+  double sharpness = 60.0;    // soft minimum of scaled Jacobians
+  double untangle_sharpness = 20.0;  // soft minimum of Jacobians / L^3
+  double min_gain = 1e-4;     // soft-minimum rise counted as progress
+  int threads = 0;            // 0: TBB's default; 1: serial
+  // Called before each round and at the end with (seed hexes not waiting for a patch, seeds).
+  std::function<void(std::size_t settled, std::size_t seeds)> progress;
+};
+
+struct LocalSmoothResult {
+  double initial_min_scaled_jacobian = 0.0;  // over the whole mesh
+  double final_min_scaled_jacobian = 0.0;
+  Index initial_inverted = 0, final_inverted = 0;  // hexes with scaled Jacobian <= 0
+  Index patches = 0, rounds = 0;
+  long iterations = 0;  // Newton iterations over all patches
+  double seconds = 0.0;  // wall clock
+};
+
+// Smooths `mesh` in place. `constraints`: one per node (empty: all free); `surface`: the
+// triangulation kSurface nodes stay on (required when a constraint is kSurface); `seeds`: the
+// hexes that may seed patches (empty: every hex; patches still move every free node of the
+// seed, and their neighbours only within their floors). Throws InvalidInput on a size
+// mismatch, a bad node number or a kSurface constraint without a surface.
+LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstraint> constraints,
+                                     const TriMesh* surface = nullptr,
+                                     std::span<const Index> seeds = {},
+                                     const LocalSmoothOptions& options = {});
+
+// Constraints that keep the mesh's boundary where it is while letting it slide: a boundary
+// node whose boundary quads all lie in one plane slides in it; where their normals fall in two
+// groups more than `feature_angle` (degrees) apart and each group is planar, the node slides
+// along the feature edge (the planes' intersection line); where the boundary is curved
+// (normals within the angle but not parallel), the node is kSurface; otherwise (corners,
+// curved feature edges) fixed. Interior nodes are free.
+std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh,
+                                                       double feature_angle = 30.0);
+
+// The mesh's boundary quads, each split into two triangles (along the 0-2 diagonal): the
+// surface kSurface nodes slide on when no input triangulation is at hand.
+TriMesh boundary_triangulation(const HexMesh& mesh);
+
+// Every hex sharing a node with one of `hexes` (those included), ascending.
+std::vector<Index> hexes_around(const HexMesh& mesh, std::span<const Index> hexes);
+
+}  // namespace geode::primal

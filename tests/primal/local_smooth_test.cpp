@@ -1,0 +1,228 @@
+// The worst-first local smoother (primal/local_smooth.hpp): analytic derivatives against finite
+// differences, untangling, the per-hex floors, boundary nodes kept on their plane / edge /
+// triangulation, and the same result for any thread count.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "primal/errors.hpp"
+#include "primal/frame_derivatives.hpp"
+#include "primal/local_smooth.hpp"
+#include "primal/quality.hpp"
+
+namespace {
+
+namespace gp = geode::primal;
+using gp::HexMesh;
+using gp::Index;
+using gp::NodeConstraint;
+using gp::Point;
+
+// Deterministic pseudo-random numbers in [-1, 1] (no std distribution: portable sequences).
+struct Lcg {
+  std::uint64_t s;
+  double next() {
+    s = s * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<double>(s >> 11) / static_cast<double>(1ull << 52) - 1.0;
+  }
+};
+
+// n x n x n unit cells over [0, n]^3, nodes mapped by `map`.
+template <class Map>
+HexMesh grid(int n, Map map) {
+  HexMesh m;
+  auto id = [n](int i, int j, int k) { return static_cast<Index>(i + (n + 1) * (j + (n + 1) * k)); };
+  for (int k = 0; k <= n; ++k)
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i) m.points.push_back(map(Point(i, j, k)));
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        m.hexes.push_back({id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k),
+                           id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1),
+                           id(i, j + 1, k + 1)});
+  return m;
+}
+
+std::vector<double> scaled_jacobians(const HexMesh& m) {
+  std::vector<double> q;
+  for (Index h = 0; h < static_cast<Index>(m.hexes.size()); ++h)
+    q.push_back(gp::hex_scaled_jacobian(gp::hex_corners(m, h)));
+  return q;
+}
+
+// Interior nodes jittered by up to `amount` per coordinate.
+HexMesh jittered_grid(int n, double amount, std::uint64_t seed) {
+  Lcg r{seed};
+  return grid(n, [&](const Point& p) {
+    Point q = p;
+    for (int a = 0; a < 3; ++a)
+      if (p[a] > 0 && p[a] < n) q[a] += amount * r.next();
+    return q;
+  });
+}
+
+double distance_to(const gp::TriMesh& s, const Point& p) {
+  double best = 1e300;
+  for (const auto& t : s.tris) {
+    // Sample-free: distance to the plane when the projection falls inside, else to the edges.
+    const Point a = s.points[t[0]], b = s.points[t[1]], c = s.points[t[2]];
+    const Point n = (b - a).cross(c - a).normalized();
+    const Point q = p - (p - a).dot(n) * n;
+    const double u = (b - a).cross(q - a).dot(n), v = (c - b).cross(q - b).dot(n),
+                 w = (a - c).cross(q - c).dot(n);
+    if (u >= -1e-12 && v >= -1e-12 && w >= -1e-12) best = std::min(best, (p - q).norm());
+    for (const auto& [x, y] : {std::pair{a, b}, std::pair{b, c}, std::pair{c, a}}) {
+      const double s01 = std::clamp((p - x).dot(y - x) / (y - x).squaredNorm(), 0.0, 1.0);
+      best = std::min(best, (p - (x + s01 * (y - x))).norm());
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+TEST_CASE("frame derivatives match central differences") {
+  Lcg r{7};
+  for (int trial = 0; trial < 20; ++trial) {
+    gp::FrameVector v;
+    for (int i = 0; i < 9; ++i) v[i] = r.next() + (i % 4 == 0 ? 1.5 : 0.0);  // near the identity
+    for (bool scaled : {false, true}) {
+      CAPTURE(trial);
+      CAPTURE(scaled);
+      auto f = [&](const gp::FrameVector& x, gp::FrameVector* g, gp::FrameMatrix* h) {
+        return scaled ? gp::scaled_determinant_derivatives(x, g, h)
+                      : gp::determinant_derivatives(x, g, h);
+      };
+      gp::FrameVector g;
+      gp::FrameMatrix h;
+      const double value = f(v, &g, &h);
+      CHECK(value == doctest::Approx(f(v, nullptr, nullptr)));
+      const double eps = 1e-6;
+      for (int i = 0; i < 9; ++i) {
+        gp::FrameVector vp = v, vm = v, gp_, gm;
+        vp[i] += eps, vm[i] -= eps;
+        CHECK(g[i] == doctest::Approx((f(vp, nullptr, nullptr) - f(vm, nullptr, nullptr)) / (2 * eps)).epsilon(1e-6));
+        f(vp, &gp_, nullptr), f(vm, &gm, nullptr);
+        const gp::FrameVector col = (gp_ - gm) / (2 * eps);
+        for (int j = 0; j < 9; ++j) CHECK(h(j, i) == doctest::Approx(col[j]).epsilon(1e-5).scale(1.0));
+      }
+      CHECK((h - h.transpose()).norm() < 1e-12);
+    }
+  }
+}
+
+TEST_CASE("a tangled grid is untangled, boundary nodes on their planes") {
+  // Interior nodes pushed across their neighbours: several hexes inverted.
+  HexMesh mesh = grid(4, [](const Point& p) { return p; });
+  Lcg r{3};
+  for (Point& p : mesh.points)
+    if (p.minCoeff() > 0 && p.maxCoeff() < 4)
+      for (int a = 0; a < 3; ++a) p[a] += 0.9 * r.next();
+  const HexMesh before = mesh;
+  const auto initial = scaled_jacobians(mesh);
+  const int inverted = static_cast<int>(std::count_if(initial.begin(), initial.end(), [](double q) { return q <= 0; }));
+  REQUIRE(inverted > 0);
+  const auto cons = gp::boundary_slide_constraints(mesh);
+  const auto res = gp::smooth_hexes_local(mesh, cons);
+  CHECK(res.initial_inverted == inverted);
+  CHECK(res.final_inverted == 0);
+  const auto after = scaled_jacobians(mesh);
+  CHECK(*std::min_element(after.begin(), after.end()) > 0.2);
+  CHECK(res.final_min_scaled_jacobian == *std::min_element(after.begin(), after.end()));
+  MESSAGE("untangled " << inverted << " hexes: min SJ " << res.initial_min_scaled_jacobian << " -> "
+                       << res.final_min_scaled_jacobian << " in " << res.patches << " patches, "
+                       << res.rounds << " rounds, " << res.iterations << " iterations");
+  // Face nodes slide in their face planes, edge nodes along their edges, corners stay.
+  int moved_on_boundary = 0;
+  for (std::size_t v = 0; v < mesh.points.size(); ++v) {
+    const Point& p = mesh.points[v];
+    const Point& q = before.points[v];
+    for (int a = 0; a < 3; ++a)
+      if (q[a] == 0 || q[a] == 4) CHECK(std::abs(p[a] - q[a]) < 1e-12);
+    if (cons[v].kind != NodeConstraint::Kind::kFree && (p - q).norm() > 1e-3) ++moved_on_boundary;
+  }
+  CHECK(moved_on_boundary > 0);
+}
+
+TEST_CASE("hexes near the worst never lose; others lose at most `loss`") {
+  gp::LocalSmoothOptions o;
+  o.target = 0.9;
+  HexMesh mesh = jittered_grid(5, 0.3, 11);
+  const auto start = scaled_jacobians(mesh);
+  const double worst = *std::min_element(start.begin(), start.end());
+  REQUIRE(worst > 0.0);
+  const auto res = gp::smooth_hexes_local(mesh, gp::boundary_slide_constraints(mesh), nullptr, {}, o);
+  const auto end = scaled_jacobians(mesh);
+  int improved = 0;
+  for (std::size_t h = 0; h < start.size(); ++h) {
+    CAPTURE(h);
+    CHECK(end[h] >= worst);  // floors never go below a patch's worst, itself >= the mesh's
+    if (start[h] < worst + o.margin) CHECK(end[h] >= start[h]);
+    CHECK(end[h] >= start[h] - o.loss);
+    improved += end[h] > start[h] + 1e-3;
+  }
+  CHECK(res.final_min_scaled_jacobian > res.initial_min_scaled_jacobian + 0.05);
+  CHECK(improved > 10);
+}
+
+TEST_CASE("seeds limit the smoothing to their neighbourhood") {
+  HexMesh mesh = jittered_grid(5, 0.3, 5);
+  const HexMesh before = mesh;
+  const std::vector<Index> seeds{62};  // the centre hex of 125
+  gp::smooth_hexes_local(mesh, gp::boundary_slide_constraints(mesh), nullptr, seeds);
+  std::vector<char> near(mesh.points.size(), 0);
+  for (Index h : gp::hexes_around(mesh, seeds))
+    for (Index v : mesh.hexes[h]) near[v] = 1;
+  int moved = 0;
+  for (std::size_t v = 0; v < mesh.points.size(); ++v) {
+    if (!near[v]) CHECK(mesh.points[v] == before.points[v]);
+    moved += mesh.points[v] != before.points[v];
+  }
+  CHECK(moved > 0);
+}
+
+TEST_CASE("curved boundary nodes stay on the boundary triangulation") {
+  // A grid whose top bulges (z = 3 + 0.4 sin): top nodes are kSurface, and the sides planes.
+  HexMesh mesh = grid(3, [](const Point& p) {
+    return Point(p.x(), p.y(), p.z() * (1.0 + 0.13 * std::sin(p.x()) * std::sin(p.y())));
+  });
+  Lcg r{9};
+  for (Point& p : mesh.points)  // skew the interior so that the top nodes want to move
+    if (p.minCoeff() > 0 && p.x() < 3 && p.y() < 3) p.x() += 0.35 * r.next(), p.y() += 0.35 * r.next();
+  const auto cons = gp::boundary_slide_constraints(mesh);
+  const gp::TriMesh surface = gp::boundary_triangulation(mesh);
+  const HexMesh before = mesh;
+  gp::LocalSmoothOptions o;
+  o.target = 0.95;
+  const auto res = gp::smooth_hexes_local(mesh, cons, &surface, {}, o);
+  CHECK(res.final_min_scaled_jacobian >= res.initial_min_scaled_jacobian);
+  int surface_nodes = 0, moved = 0;
+  for (std::size_t v = 0; v < mesh.points.size(); ++v) {
+    if (cons[v].kind != NodeConstraint::Kind::kSurface) continue;
+    ++surface_nodes;
+    CHECK(distance_to(surface, mesh.points[v]) < 1e-9);
+    moved += (mesh.points[v] - before.points[v]).norm() > 1e-3;
+  }
+  CHECK(surface_nodes > 0);
+  CHECK(moved > 0);
+  gp::HexMesh unconstrained = before;
+  CHECK_THROWS_AS(gp::smooth_hexes_local(unconstrained, cons), geode::InvalidInput);
+}
+
+TEST_CASE("one thread and two threads give the same mesh") {
+  HexMesh a = jittered_grid(6, 0.35, 21);
+  HexMesh b = a;
+  gp::LocalSmoothOptions o;
+  o.threads = 1;
+  const auto ra = gp::smooth_hexes_local(a, gp::boundary_slide_constraints(a), nullptr, {}, o);
+  o.threads = 2;
+  const auto rb = gp::smooth_hexes_local(b, gp::boundary_slide_constraints(b), nullptr, {}, o);
+  CHECK(ra.patches == rb.patches);
+  CHECK(ra.iterations == rb.iterations);
+  CHECK(a.points == b.points);  // bit for bit
+  CHECK(ra.final_min_scaled_jacobian > ra.initial_min_scaled_jacobian);
+}
