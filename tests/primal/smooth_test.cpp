@@ -41,14 +41,6 @@ int hexes_with_negative_corner(const HexMesh& m) {
   return count;
 }
 
-double min_scaled_jacobian(const HexMesh& m) {
-  double q = 1.0;
-  for (Index h = 0; h < static_cast<Index>(m.hexes.size()); ++h) {
-    q = std::min(q, gp::hex_scaled_jacobian(gp::hex_corners(m, h)));
-  }
-  return q;
-}
-
 const Point kLo(-12, -7, -12), kHi(12, 7, 12);
 // y is up: faces y- (index 2) and y+ (index 3) are the bottom and top.
 constexpr std::array<bool, 6> kSlideAll = {false, false, false, false, false, false};
