@@ -1,23 +1,26 @@
-// Whole-process time and peak memory of `geode conform --smooth none` next to gmsh's all-hex
-// subdivision of the same tet part (the Speed and memory case).
+// Whole-process time and peak memory of `geode conform` with its default options next to
+// gmsh's all-hex subdivision of the same tet part (the Speed and memory case).
 //
-// The model is primal::grid_model: n x n x n unit cells, those with i >= n/2 split into 6 Kuhn
-// tets (n = 40: 32,000 hexes + 192,000 tets). It is written to a temporary directory twice, as
+// The model is conform::demo_delaunay_block(n): structured hexes [0,1]^3 (n^3) beside a Gmsh
+// Delaunay tet box [1,2] x [0,1]^2 with alternating interface diagonals (n = 26: about 200k
+// tets). It is written to a temporary directory twice, as
 // binary .msh v4.1: the whole model (geode's input) and its tet part alone, compacted (gmsh's
 // input). Then, each as a child process timed from fork to wait4 (wall time; peak RSS from the
 // child's rusage):
 //   gmsh subdivide        gmsh -nt 1 sub.geo -   with  Merge; Mesh.SubdivisionAlgorithm = 2;
 //                         RefineMesh;   (read + subdivide, nothing written)
 //   gmsh subdivide+save   the same, then Mesh.Binary = 1; Save "gmsh.msh";
-//   geode conform         geode conform model.msh -o geode.exo --report r.json --smooth none
-//                         --quiet   (read, interface, buffer layer, dice, templates, verify,
-//                         quality report, write Exodus)
+//   geode conform         geode conform model.msh -o geode.exo --report r.json --quiet
+//                         (defaults: read, interface, buffer layer, dice, templates, local
+//                         smoothing, verify, scaled Jacobian per block, write Exodus)
+//   geode --smooth none   the same without smoothing; the difference over the buffer hexes
+//                         is printed as the local smoothing's milliseconds per buffer hex
 // Every child runs `repeats` times; the fastest run is shown (the machine is shared). Output hex
 // counts are read back (gmsh's file through read_gmsh, geode's from its report), so a child that
 // did nothing cannot look fast.
 //
 // Usage: bench_conform_vs_gmsh [n] [repeats] [geode-executable]
-//   n default 40, repeats default 1, geode default: `geode` next to this program; gmsh is
+//   n default 26, repeats default 1, geode default: `geode` next to this program; gmsh is
 //   /usr/bin/gmsh unless GMSH is set in the environment; GEODE_BENCH_KEEP set keeps the
 //   temporary directory (inputs, outputs, logs). Exit 0 when every child succeeded.
 #include <sys/resource.h>
@@ -33,7 +36,7 @@
 #include <string>
 #include <vector>
 
-#include "primal/grid_model.hpp"
+#include "conform/demo_models.hpp"
 #include "primal/errors.hpp"
 #include "primal/io_gmsh.hpp"
 
@@ -133,7 +136,7 @@ void print_row(const char* what, const Run& r, std::size_t hexes, const Run& ref
 }  // namespace
 
 int main(int argc, char** argv) {
-  const int n = argc > 1 ? std::atoi(argv[1]) : 40;
+  const int n = argc > 1 ? std::atoi(argv[1]) : 26;
   const int repeats = argc > 2 ? std::atoi(argv[2]) : 1;
   const fs::path self = fs::canonical("/proc/self/exe");
   const std::string geode = argc > 3 ? argv[3] : (self.parent_path() / "geode").string();
@@ -156,8 +159,7 @@ int main(int argc, char** argv) {
   }
   const fs::path dir = dir_template;
 
-  const gp::Model model =
-      gp::grid_model({n, n, n}, 1.0, [n](int i, int, int) { return i >= n / 2; });
+  const gp::Model model = geode::conform::demo_delaunay_block(n);
   gp::write_gmsh(model, dir / "model.msh", gp::GmshFormat::Binary);
   gp::write_gmsh(tet_model(model), dir / "tets.msh", gp::GmshFormat::Binary);
   std::printf("n %d: %zu hexes + %zu tets (%zu nodes); inputs in %s\n", n, model.hexes.size(),
@@ -176,11 +178,18 @@ int main(int argc, char** argv) {
   const Run conform =
       best_of(repeats,
               {geode, "conform", (dir / "model.msh").string(), "-o", (dir / "geode.exo").string(),
-               "--report", (dir / "report.json").string(), "--smooth", "none", "--quiet"},
+               "--report", (dir / "report.json").string(), "--quiet"},
               dir / "geode.log", "geode conform");
+  const Run conform_none =
+      best_of(repeats,
+              {geode, "conform", (dir / "model.msh").string(), "-o", (dir / "geode_none.exo").string(),
+               "--report", (dir / "report_none.json").string(), "--smooth", "none", "--quiet"},
+              dir / "geode_none.log", "geode conform --smooth none");
 
   std::size_t gmsh_hexes = 0, geode_hexes = 0;
   bool geode_valid = false;
+  std::size_t buffer_hexes = 0;
+  std::vector<std::string> block_min;
   try {
     const gp::Model g = gp::read_gmsh(dir / "gmsh.msh");
     gmsh_hexes = g.hexes.size();
@@ -189,6 +198,11 @@ int main(int argc, char** argv) {
     const nlohmann::json j = nlohmann::json::parse(is);
     geode_hexes = j.at("output").at("hexes").get<std::size_t>();
     geode_valid = j.at("valid").get<bool>();
+    buffer_hexes = j.at("input").at("interface_quads").get<std::size_t>();
+    for (const auto& b : j.at("blocks"))
+      for (const auto& m : b.at("quality").at("metrics"))
+        if (m.at("key") == "scaled_jacobian")
+          block_min.push_back(b.at("name").get<std::string>() + " " + std::to_string(m.at("min").get<double>()));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_conform_vs_gmsh: reading the outputs back: %s\n", e.what());
     return 1;
@@ -203,6 +217,13 @@ int main(int argc, char** argv) {
   print_row("gmsh subdivide", sub, gmsh_hexes, sub);
   print_row("gmsh subdivide+save", sub_save, gmsh_hexes, sub);
   print_row("geode conform", conform, geode_hexes, sub);
+  print_row("geode --smooth none", conform_none, geode_hexes, sub);
+  std::printf("local smoothing: %.1f ms per buffer hex (%zu buffer hexes)\n",
+              1e3 * (conform.seconds - conform_none.seconds) / static_cast<double>(buffer_hexes),
+              buffer_hexes);
+  std::printf("min scaled Jacobian per block:");
+  for (const auto& b : block_min) std::printf("  %s", b.c_str());
+  std::printf("\n");
   std::printf("geode conform / gmsh subdivide+save: time %.2fx, memory %.2fx; output %s\n",
               conform.seconds / sub_save.seconds, conform.peak_mib / sub_save.peak_mib,
               geode_valid ? "valid" : "INVALID");

@@ -296,6 +296,17 @@ void transfinite_box(int volume, double h) {
   gmsh::model::mesh::setRecombine(3, volume);
 }
 
+// The unit cube at `corner` as structured hexes of size h (block 1 named `name`).
+Model structured_unit_cube(const Point& corner, double h, const std::string& name) {
+  return hex_part_from_gmsh(name, [&] {
+    const int box = gmsh::model::occ::addBox(corner.x(), corner.y(), corner.z(), 1, 1, 1);
+    gmsh::model::occ::synchronize();
+    transfinite_box(box, h);
+    gmsh::model::addPhysicalGroup(3, {box}, 1);
+    gmsh::model::setPhysicalName(3, 1, name);
+  });
+}
+
 Model run_gmsh(const std::string& name, const std::function<Model()>& build) {
   GmshSession session;
   try {
@@ -384,13 +395,7 @@ Model demo_delaunay_block(int n, DemoDiagonals diagonals) {
   if (n < 1) throw InvalidInput("demo_delaunay_block: n = " + std::to_string(n) + " must be >= 1");
   const double h = 1.0 / n;
   return run_gmsh("demo_delaunay_block", [&] {
-    Model hexes = hex_part_from_gmsh("hexes", [h] {
-      const int box = gmsh::model::occ::addBox(0, 0, 0, 1, 1, 1);
-      gmsh::model::occ::synchronize();
-      transfinite_box(box, h);
-      gmsh::model::addPhysicalGroup(3, {box}, 1);
-      gmsh::model::setPhysicalName(3, 1, "hex");
-    });
+    Model hexes = structured_unit_cube(Point(0, 0, 0), h, "hex");
     Shell shell;
     append_solid_boundary(
         shell, h, [] { gmsh::model::occ::addBox(1, 0, 0, 1, 1, 1); },
@@ -434,13 +439,7 @@ Model demo_l_shape(int n) {
   const double h = 1.0 / n;
   auto in_notch = [](const Box& b) { return b[0] > 1 - kEps && b[1] > 1 - kEps; };
   return run_gmsh("demo_l_shape", [&] {
-    Model hexes = hex_part_from_gmsh("notch", [h] {
-      const int box = gmsh::model::occ::addBox(1, 1, 0, 1, 1, 1);
-      gmsh::model::occ::synchronize();
-      transfinite_box(box, h);
-      gmsh::model::addPhysicalGroup(3, {box}, 1);
-      gmsh::model::setPhysicalName(3, 1, "hex notch");
-    });
+    Model hexes = structured_unit_cube(Point(1, 1, 0), h, "hex notch");
     Shell shell;
     append_solid_boundary(
         shell, h,
