@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "cli/commands.hpp"
+#include "cli/conventions.hpp"
 #include "primal/errors.hpp"
 #include "templates/study.hpp"
 
@@ -31,6 +32,10 @@ templates::PushGrid default_grid(const std::string& name) {
 void run_interleave(const InterleaveArgs& a) {
   if (a.name != "geode3d" && a.name != "geode4tri")
     throw InvalidInput("study interleave: unknown template '" + a.name + "' (geode3d or geode4tri)");
+  for (const std::string* path : {&a.output, &a.summary}) {
+    output_format(*path, "", {"csv"}, "csv");
+    check_output_path(*path);
+  }
   templates::PushGrid grid = default_grid(a.name);
   if (!a.high.empty()) grid.high_roof = a.high;
   if (!a.low.empty()) grid.low_roof = a.low;
@@ -65,6 +70,10 @@ struct ShapeArgs {
 };
 
 void run_shape(const ShapeArgs& a) {
+  for (const std::string* path : {&a.height_csv, &a.distorted_csv, &a.quality_csv, &a.sj_csv}) {
+    output_format(*path, "", {"csv"}, "csv");
+    check_output_path(*path);
+  }
   const bool any = !a.height_csv.empty() || !a.distorted_csv.empty() || !a.quality_csv.empty() || !a.sj_csv.empty();
   if (!a.height_csv.empty() || !any) {
     std::vector<double> h = a.heights;
@@ -100,13 +109,14 @@ void add_study_commands(CLI::App& app) {
       "Sweep the push parameters (high roof, low roof, dome depth, dome radius) and classify what each push "
       "dualizes to: a template class (hex count, sheet-kind triples, colour-refinement hash) with the paper's "
       "two conditions, or the TopologyError's diagnosis with numbers stripped");
-  inter->add_option("--template", ia->name, "geode3d (default) or geode4tri");
+  inter->add_option("--template", ia->name, "geode3d (default) or geode4tri")
+      ->check(CLI::IsMember({"geode3d", "geode4tri"}));
   inter->add_option("-o,--output", ia->output, "per-run CSV (default: stdout)");
   inter->add_option("--summary", ia->summary, "per-class summary CSV");
-  inter->add_option("--high", ia->high, "high roof values (default grid if omitted)");
-  inter->add_option("--low", ia->low, "low roof values");
-  inter->add_option("--depth", ia->depth, "dome depth values");
-  inter->add_option("--radius", ia->radius, "dome radius blend values");
+  inter->add_option("--high", ia->high, "high roof values (default grid if omitted)")->check(number_check(0, 1));
+  inter->add_option("--low", ia->low, "low roof values")->check(number_check(0, 1));
+  inter->add_option("--depth", ia->depth, "dome depth values")->check(number_check(0, 1));
+  inter->add_option("--radius", ia->radius, "dome radius blend values")->check(number_check(0, 1));
   inter->callback([ia] { run_interleave(*ia); });
 
   auto sa = std::make_shared<ShapeArgs>();
@@ -119,9 +129,9 @@ void add_study_commands(CLI::App& app) {
   shape->add_option("--distorted-csv", sa->distorted_csv, "sheared/tapered cell study CSV");
   shape->add_option("--quality-csv", sa->quality_csv, "Table 1 report of the smoothed geode with the paper's values");
   shape->add_option("--sj-csv", sa->sj_csv, "per-hex scaled Jacobians of the smoothed geode (both modes)");
-  shape->add_option("--heights", sa->heights, "box heights (default 6, 8, ..., 30)");
-  shape->add_option("--shears", sa->shears, "shear angles in degrees (default 0 10 20 30 40)");
-  shape->add_option("--tapers", sa->tapers, "top/bottom taper ratios (default 0.4 0.6 0.8 1 1.25 1.5)");
+  shape->add_option("--heights", sa->heights, "box heights (default 6, 8, ..., 30), in [0.1, 2400]")->check(number_check(0.1, 2400));
+  shape->add_option("--shears", sa->shears, "shear angles in degrees (default 0 10 20 30 40), in [0, 80]")->check(number_check(0, 80));
+  shape->add_option("--tapers", sa->tapers, "top/bottom taper ratios (default 0.4 0.6 0.8 1 1.25 1.5), in [0.01, 100]")->check(number_check(0.01, 100));
   shape->callback([sa] { run_shape(*sa); });
 }
 

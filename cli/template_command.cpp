@@ -9,8 +9,10 @@
 #include <sstream>
 
 #include "cli/commands.hpp"
+#include "cli/conventions.hpp"
 #include "primal/errors.hpp"
 #include "primal/io_vtk.hpp"
+#include "primal/model.hpp"
 #include "primal/quality.hpp"
 #include "primal/quality_report.hpp"
 #include "templates/geode.hpp"
@@ -20,10 +22,11 @@ namespace {
 
 struct TemplateArgs {
   std::string name;
-  std::string box = "24x14x24";
+  std::string box;  // empty: 24x14x24 (24x14 in 2D)
   std::string diagonal = "main";
   std::string higher = "x";
-  std::string format = "appendix";
+  std::string format;  // empty: by the extension of -o, else appendix
+  std::string vtu_encoding = "binary";
   std::string output;
   bool slide = false;
   bool no_smooth = false;
@@ -130,9 +133,19 @@ nlohmann::json to_json(const templates::Template& T, const std::string& name) {
   return j;
 }
 
+const std::vector<std::string> kTemplateFormats{"appendix", "csv", "json", "vtu", "vtk", "msh", "msh22", "exo"};
+
 void run_template(const TemplateArgs& a) {
+  // Refuse a bad output before the derivation, not after it.
+  check_output_path(a.output);
+  const std::string format = output_format(a.output, a.format, kTemplateFormats, "appendix");
+  const int dim = a.name == "geode2d" ? 2 : 3;
+  if (dim == 2 && is_mesh_format(format) && format != "vtu" && format != "vtk")
+    throw InvalidInput(a.output + ": geode2d is a quad mesh; write it as .vtu or .vtk");
+  const std::string box_text = a.box.empty() ? (dim == 3 ? "24x14x24" : "24x14") : a.box;
+  const auto box = parse_box("--box", box_text, dim);
   templates::GeodeOptions o;
-  o.box = templates::parse_box(a.box);
+  o.box = Eigen::Vector3d(box[0], box[1], box[2]);
   o.diagonal = a.diagonal == "anti" ? templates::Diagonal::Anti : templates::Diagonal::Main;
   o.higher = a.higher == "z" ? templates::Higher::Z : templates::Higher::X;
   o.push = a.push;
@@ -158,16 +171,15 @@ void run_template(const TemplateArgs& a) {
     smooth_note = s.str();
     if (!r.untangled) std::cerr << "geode: warning: smoothing could not untangle every element\n";
   }
-  const int dim = T.dim;
   const auto& pts = dim == 3 ? T.hex.points : T.quad.points;
   std::string text;
-  if (a.format == "appendix") {
-    text = "# geode template " + a.name + ", box " + a.box + (smooth_note.empty() ? "" : "; " + smooth_note) + "\n";
+  if (format == "appendix") {
+    text = "# geode template " + a.name + ", box " + box_text + (smooth_note.empty() ? "" : "; " + smooth_note) + "\n";
     text += appendix_nodes(pts, dim) + "\n";
     text += dim == 3 ? appendix_cells(T.hex.hexes, "hexes") : appendix_cells(T.quad.quads, "quads");
-  } else if (a.format == "csv") {
+  } else if (format == "csv") {
     text = dim == 3 ? csv_tables(pts, T.hex.hexes, 3) : csv_tables(pts, T.quad.quads, 2);
-  } else if (a.format == "json") {
+  } else if (format == "json") {
     text = to_json(T, a.name).dump(1) + "\n";
   }
   if (a.quality && dim == 3) text += "\nQuality report (Verdict definitions)\n" + primal::format_quality_table(primal::hex_quality_report(T.hex));
@@ -181,13 +193,18 @@ void run_template(const TemplateArgs& a) {
     s << "\nQuad scaled Jacobian: min " << lo << ", max " << hi << "\n";
     text += s.str();
   }
-  if (a.format == "vtu") {
-    // The writer adds the scaled Jacobian (and block) cell arrays itself.
-    if (a.output.empty()) throw InvalidInput("--format vtu needs -o FILE.vtu");
-    if (dim == 3)
-      primal::write_vtu(a.output, T.hex);
-    else
-      primal::write_vtu(a.output, T.quad);
+  if (is_mesh_format(format)) {
+    // The mesh goes to the file (the writers add the scaled Jacobian cell array); the quality
+    // tables, if asked for, to standard output.
+    const auto vtu = a.vtu_encoding == "ascii" ? primal::VtuEncoding::kAscii : primal::VtuEncoding::kBinary;
+    if (dim == 2) {
+      format == "vtu" ? primal::write_vtu(a.output, T.quad, {}, vtu) : primal::write_vtk(a.output, T.quad);
+    } else {
+      primal::Model m;
+      m.points = T.hex.points;
+      m.hexes = T.hex.hexes;
+      write_mesh(m, a.output, format, vtu);
+    }
     if (!text.empty()) std::cout << text;
     return;
   }
@@ -208,8 +225,10 @@ void add_template_command(CLI::App& app) {
                 "geode2d: the 5-quad 2D geode; geode4tri: the tet side split into 4 triangles")
       ->required()
       ->check(CLI::IsMember({"geode3d", "geode2d", "geode4tri"}));
-  t->add_option("--box", args->box, "buffer cell WIDTHxHEIGHTxDEPTH (x, y up, z), centred at the origin; tet side on top")
-      ->capture_default_str();
+  t->add_option("--box", args->box,
+                "buffer cell WIDTHxHEIGHTxDEPTH (x, y up, z; WIDTHxHEIGHT for geode2d), centred at the\n"
+                "origin, tet side on top; each in [1e-6, 1e6], at most 1e4 between largest and smallest\n"
+                "(default 24x14x24)");
   t->add_option("--diagonal", args->diagonal,
                 "main: the top diagonal joins (-x,+z) and (+x,-z) as in the paper's Appendix A; anti: the other one")
       ->check(CLI::IsMember({"main", "anti"}))
@@ -218,21 +237,28 @@ void add_template_command(CLI::App& app) {
       ->check(CLI::IsMember({"x", "z"}))
       ->capture_default_str();
   t->add_option("--format", args->format,
-                "appendix: the paper's Tables 2 and 3 (1-based); csv: node and element tables; json: with\n"
-                "sheets, their intersections and the interleave checks; vtu: VTK XML for ParaView (needs -o)")
-      ->check(CLI::IsMember({"appendix", "csv", "json", "vtu"}))
+                "appendix (default): the paper's Tables 2 and 3 (1-based); csv: node and element tables;\n"
+                "json: with sheets, their intersections and the interleave checks; vtu, vtk, msh, msh22,\n"
+                "exo: the mesh (needs -o). Without it, the extension of -o decides (.txt .csv .json .vtu\n"
+                ".vtk .msh .exo .e); one that contradicts the extension is refused")
+      ->check(CLI::IsMember(kTemplateFormats));
+  t->add_option("--vtu-encoding", args->vtu_encoding, "binary (base64, default) or ascii DataArrays in .vtu")
+      ->check(CLI::IsMember({"binary", "ascii"}))
       ->capture_default_str();
-  t->add_option("-o,--output", args->output, "write to FILE (atomically) instead of standard output");
+  t->add_option("-o,--output", args->output,
+                "write to FILE (atomically) instead of standard output; its extension picks the format");
   t->add_flag("--slide", args->slide, "let tet- and hex-side nodes slide within their faces while smoothing");
   t->add_flag("--no-smooth", args->no_smooth, "keep the dual's first-guess positions");
   t->add_flag("--quality", args->quality, "append the quality report (the paper's Table 1 metrics)");
-  t->add_option("--high-roof", args->push.high_roof, "push: higher tunnel roof, fraction of the height")->capture_default_str();
-  t->add_option("--low-roof", args->push.low_roof, "push: lower tunnel roof, fraction of the height")->capture_default_str();
+  t->add_option("--high-roof", args->push.high_roof, "push: higher tunnel roof, fraction of the height")->check(number_check())->capture_default_str();
+  t->add_option("--low-roof", args->push.low_roof, "push: lower tunnel roof, fraction of the height")->check(number_check())->capture_default_str();
   t->add_option("--dome-depth", args->push.dome_depth, "push: how far below the tet side the domes reach, fraction of the height")
+      ->check(number_check())
       ->capture_default_str();
   t->add_option("--dome-radius", args->push.dome_radius,
                 "push: where each dome's circle crosses the diced tet side, 0..1 between the nodes it\n"
                 "must enclose and the nearest it must leave out")
+      ->check(number_check())
       ->capture_default_str();
   t->callback([args] { run_template(*args); });
 }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <numeric>
 #include <optional>
 #include <set>
@@ -253,6 +254,26 @@ double min_scaled_jacobian(const primal::HexMesh& mesh, std::vector<Index>* bad 
   return mn;
 }
 
+// The output's block ids and names: the input's, plus the geode block when it has a name.
+struct OutputBlocks {
+  int geode_id = 0;  // 0: geode hexes join the tet-side block they were carved from
+  std::map<int, std::string> names;
+};
+
+OutputBlocks output_blocks(const primal::Model& input, const std::string& geode_block) {
+  OutputBlocks o;
+  o.names = input.block_names;
+  if (geode_block.empty()) return o;
+  int top = 0;
+  for (std::size_t h = 0; h < input.hexes.size(); ++h)
+    top = std::max(top, primal::block_of(input, {primal::ElementKind::Hex, static_cast<Index>(h)}));
+  for (std::size_t t = 0; t < input.tets.size(); ++t)
+    top = std::max(top, primal::block_of(input, {primal::ElementKind::Tet, static_cast<Index>(t)}));
+  o.geode_id = top + 1;
+  o.names[o.geode_id] = geode_block;
+  return o;
+}
+
 }  // namespace
 
 
@@ -470,28 +491,34 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
       std::to_string(shared_faces) + " shared side faces merged (" + std::to_string(since(t0)) +
       " s)");
 
-  // 5. Assemble the hexes, blocks in ascending id, and drop unused nodes.
+  // 5. Assemble the hexes (diced hexes, geode hexes, diced tets) and drop unused nodes. Each
+  // output hex is in the input block of the element it comes from (dice() copies it); a geode
+  // hex in the block of the tet its buffer hex was carved from, or in a block of its own.
+  const OutputBlocks blocks = output_blocks(input, options.geode_block);
   std::vector<std::array<Index, 8>> hexes;
   std::vector<int> block;
   hexes.reserve(dh.mesh.hexes.size() + 26 * nb + dt.mesh.hexes.size());
   block.reserve(hexes.capacity());
-  for (const auto& h : dh.mesh.hexes) {
+  for (std::size_t k = 0; k < dh.mesh.hexes.size(); ++k) {
     std::array<Index, 8> o{};
-    for (int c = 0; c < 8; ++c) o[c] = gh[h[c]];
-    hexes.push_back(o), block.push_back(kDicedHexBlock);
+    for (int c = 0; c < 8; ++c) o[c] = gh[dh.mesh.hexes[k][c]];
+    hexes.push_back(o), block.push_back(dh.mesh.block[k]);
   }
   for (std::size_t b = 0; b < nb; ++b) {
     const RefTemplate& ref = *refs[ref_index(layer.hexes[b])];
+    const Index carved_from = iface.quads[layer.hexes[b].quad].tets[0];
+    const int id = blocks.geode_id ? blocks.geode_id
+                                   : primal::block_of(input, {primal::ElementKind::Tet, carved_from});
     for (const auto& h : ref.tpl.hex.hexes) {
       std::array<Index, 8> o{};
       for (int c = 0; c < 8; ++c) o[c] = inst_global[b][h[c]];
-      hexes.push_back(o), block.push_back(kGeodeBlock);
+      hexes.push_back(o), block.push_back(id);
     }
   }
-  for (const auto& h : dt.mesh.hexes) {
+  for (std::size_t k = 0; k < dt.mesh.hexes.size(); ++k) {
     std::array<Index, 8> o{};
-    for (int c = 0; c < 8; ++c) o[c] = gt[h[c]];
-    hexes.push_back(o), block.push_back(kDicedTetBlock);
+    for (int c = 0; c < 8; ++c) o[c] = gt[dt.mesh.hexes[k][c]];
+    hexes.push_back(o), block.push_back(dt.mesh.block[k]);
   }
   std::vector<Index> renum(points.size(), kInvalidIndex);
   primal::HexMesh mesh;
@@ -686,21 +713,22 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
     if (bad.size() > 20) m << " ...";
     res.warnings.push_back(m.str());
   }
-  const std::array<std::pair<int, const char*>, 3> blocks{
-      {{kDicedHexBlock, "diced hex"}, {kGeodeBlock, "geode"}, {kDicedTetBlock, "diced tet"}}};
-  for (const auto& [id, name] : blocks) {
-    std::vector<Index> sel;
-    for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
-      if (mesh.block[h] == id) sel.push_back(static_cast<Index>(h));
-    if (sel.empty()) continue;
-    res.quality.push_back({id, name, primal::hex_quality_report(mesh, sel)});
+  {
+    std::map<int, std::vector<Index>> members;  // output block -> its hexes, ascending id
+    for (std::size_t h = 0; h < mesh.hexes.size(); ++h) members[mesh.block[h]].push_back(static_cast<Index>(h));
+    for (const auto& [id, sel] : members) {
+      const auto name = blocks.names.find(id);
+      res.quality.push_back({id, name != blocks.names.end() ? name->second : "block " + std::to_string(id),
+                             primal::hex_quality_report(mesh, sel)});
+    }
   }
   say("verification: " + std::string(res.validity.ok() ? "valid" : "INVALID") + " (" +
       std::to_string(since(t0)) + " s)");
 
   // 8. The output model.
   primal::Model& out = res.model;
-  for (const auto& [id, name] : blocks) out.block_names[id] = name;
+  for (const BlockQuality& q : res.quality)
+    if (auto it = blocks.names.find(q.block); it != blocks.names.end()) out.block_names.insert(*it);
   out.hex_block = std::move(mesh.block);
   out.hexes = std::move(mesh.hexes);
   out.points = std::move(mesh.points);

@@ -29,6 +29,8 @@ inline constexpr std::array<int, 8> kGmshHexToVtk{0, 1, 2, 3, 4, 5, 6, 7};
 inline constexpr std::array<int, 4> kGmshTetToVtk{0, 1, 2, 3};
 
 enum class GmshFormat { Ascii, Binary };
+// MSH 4.1 (Gmsh 4's own) or 2.2 (what older solvers' readers and converters still expect).
+enum class GmshVersion { k41, k22 };
 
 // Reads a .msh file (any version Gmsh reads; 4.1 is what we write). Throws InvalidInput naming
 // the file, the element or entry and the reason: missing or unreadable file, a file Gmsh
@@ -36,10 +38,12 @@ enum class GmshFormat { Ascii, Binary };
 // out of range, a side-set face that is no face of a hex or tet.
 Model read_gmsh(const std::filesystem::path& path);
 
-// Writes .msh v4.1 atomically (a temporary file in the same directory, then rename). Block ids
-// must be positive; a block may hold both hexes and tets.
+// Writes .msh (v4.1 or 2.2) atomically (a temporary file in the same directory, then rename).
+// Block ids must be positive; a block may hold both hexes and tets. Blocks become physical
+// volumes, side sets physical surfaces (their faces as triangles / quads), node sets physical
+// points, each with its id and name.
 void write_gmsh(const Model& model, const std::filesystem::path& path,
-                GmshFormat format = GmshFormat::Ascii);
+                GmshFormat format = GmshFormat::Ascii, GmshVersion version = GmshVersion::k41);
 
 // RAII: initializes the Gmsh API (no config files, General.Terminal = 0) and finalizes it on
 // destruction. Gmsh's state is global: do not nest sessions or use them from several threads.
