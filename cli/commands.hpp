@@ -1,5 +1,8 @@
 #pragma once
-// Sub-commands of the `geode` command line; each file registers its own.
+// Sub-commands of the `geode` command line; each file registers its own. A new command follows
+// cli/conventions.hpp (exit codes, number_check / parse_box for numbers, output_format +
+// check_output_path before any work, OutputFiles for outputs written as one, write_mesh for
+// every mesh format) and reports long work through cli/progress.hpp.
 #include <CLI/CLI.hpp>
 #include <filesystem>
 #include <functional>
