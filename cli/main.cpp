@@ -43,13 +43,8 @@ int main(int argc, char** argv) {
   geode::cli::add_dual_command(app);
   try {
     app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForVersion& e) {
-    return app.exit(e);
   } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     const std::string cmd = command_path(app);
     std::cerr << cmd << ": usage error: " << one_line(e.what()) << " (see " << cmd << " --help)\n";
     return 2;

@@ -77,7 +77,7 @@ struct Grid {
   std::size_t cells() const { return types.size(); }
 };
 
-// Appends `cells` of VTK type `type`, checking node numbers (`first` numbers them in messages).
+// Appends `cells` of VTK type `type`, checking node numbers (named 1-based in messages).
 template <std::size_t N>
 void add_cells(Grid& g, const std::string& file, const std::vector<std::array<Index, N>>& cells,
                int type) {
@@ -158,34 +158,30 @@ double hex_sj(const std::array<Point, 8>& p) { return hex_scaled_jacobian(p); }
 double tet_sj(const std::array<Point, 4>& p) { return tet_scaled_jacobian(p[0], p[1], p[2], p[3]); }
 double quad_sj(const std::array<Point, 4>& p) { return quad_scaled_jacobian(p); }
 
-Grid grid_of(const std::filesystem::path& path, const HexMesh& m, const VtkCellData& extra) {
+// A mesh of one cell type.
+template <std::size_t N, class Metric>
+Grid single_type_grid(const std::filesystem::path& path, const std::vector<Point>& points,
+                      const std::vector<std::array<Index, N>>& cells, int type, Metric&& metric,
+                      const std::vector<int>& block, const VtkCellData& extra) {
   const std::string file = path.string();
-  Grid g = start_grid(file, m.points);
-  add_cells(g, file, m.hexes, kVtkHexahedron);
+  Grid g = start_grid(file, points);
+  add_cells(g, file, cells, type);
   std::vector<double> sj;
-  append_quality(sj, m.points, m.hexes, hex_sj);
-  finish_grid(g, file, std::move(sj), m.block, extra);
+  append_quality(sj, points, cells, metric);
+  finish_grid(g, file, std::move(sj), block, extra);
   return g;
+}
+
+Grid grid_of(const std::filesystem::path& path, const HexMesh& m, const VtkCellData& extra) {
+  return single_type_grid(path, m.points, m.hexes, kVtkHexahedron, hex_sj, m.block, extra);
 }
 
 Grid grid_of(const std::filesystem::path& path, const TetMesh& m, const VtkCellData& extra) {
-  const std::string file = path.string();
-  Grid g = start_grid(file, m.points);
-  add_cells(g, file, m.tets, kVtkTetra);
-  std::vector<double> sj;
-  append_quality(sj, m.points, m.tets, tet_sj);
-  finish_grid(g, file, std::move(sj), m.block, extra);
-  return g;
+  return single_type_grid(path, m.points, m.tets, kVtkTetra, tet_sj, m.block, extra);
 }
 
 Grid grid_of(const std::filesystem::path& path, const QuadMesh& m, const VtkCellData& extra) {
-  const std::string file = path.string();
-  Grid g = start_grid(file, m.points);
-  add_cells(g, file, m.quads, kVtkQuad);
-  std::vector<double> sj;
-  append_quality(sj, m.points, m.quads, quad_sj);
-  finish_grid(g, file, std::move(sj), {}, extra);
-  return g;
+  return single_type_grid(path, m.points, m.quads, kVtkQuad, quad_sj, {}, extra);
 }
 
 // A model: hexes then tets, each with its element block (block_of).

@@ -65,6 +65,20 @@ std::string slurp(const fs::path& p) {
 // 8 hexes * 8 diced; 4 buffer hexes * 26 geode + 48 tets * 4 diced.
 const std::map<int, std::size_t> kExpected{{7, 64}, {9, 104 + 192}};
 
+// Blocks, names and both sets as conform must carry them for steel_rubber().
+void check_carried(const primal::Model& o, const primal::Model& input) {
+  CHECK(block_counts(o.hex_block) == kExpected);
+  CHECK(o.block_names == input.block_names);
+  REQUIRE(o.node_sets.size() == 1);
+  CHECK(o.node_sets[0].id == 3);
+  CHECK(o.node_sets[0].name == "clamp");
+  CHECK(o.node_sets[0].nodes.size() == 25);  // the 5 x 5 diced nodes of the face x = 0
+  REQUIRE(o.side_sets.size() == 1);
+  CHECK(o.side_sets[0].id == 5);
+  CHECK(o.side_sets[0].name == "load");
+  CHECK(o.side_sets[0].sides.size() == 24);  // 3 quads per triangle
+}
+
 }  // namespace
 
 TEST_CASE("conform carries blocks and sets: steel and rubber keep their ids and names") {
@@ -82,17 +96,7 @@ TEST_CASE("conform carries blocks and sets: steel and rubber keep their ids and 
                                            true);
     INFO(r.out);
     REQUIRE(r.code == 0);
-    const primal::Model o = primal::read_exodus(out);
-    CHECK(block_counts(o.hex_block) == kExpected);
-    CHECK(o.block_names == model.block_names);
-    REQUIRE(o.node_sets.size() == 1);
-    CHECK(o.node_sets[0].id == 3);
-    CHECK(o.node_sets[0].name == "clamp");
-    CHECK(o.node_sets[0].nodes.size() == 25);  // the 5 x 5 diced nodes of the face x = 0
-    REQUIRE(o.side_sets.size() == 1);
-    CHECK(o.side_sets[0].id == 5);
-    CHECK(o.side_sets[0].name == "load");
-    CHECK(o.side_sets[0].sides.size() == 24);  // 3 quads per triangle
+    check_carried(primal::read_exodus(out), model);
     // The report speaks per output block.
     std::ifstream is(report);
     const nlohmann::json j = nlohmann::json::parse(is);
@@ -117,16 +121,7 @@ TEST_CASE("conform carries blocks and sets: steel and rubber keep their ids and 
   SUBCASE(".msh: physical volumes, a physical surface for the side set, physical points") {
     const fs::path out = dir.path / "out.msh";
     REQUIRE(test::geode_cli("conform " + in.string() + " -o " + out.string() + " --quiet").code == 0);
-    const primal::Model o = primal::read_gmsh(out);
-    CHECK(block_counts(o.hex_block) == kExpected);
-    CHECK(o.block_names == model.block_names);
-    REQUIRE(o.side_sets.size() == 1);
-    CHECK(o.side_sets[0].id == 5);
-    CHECK(o.side_sets[0].name == "load");
-    CHECK(o.side_sets[0].sides.size() == 24);
-    REQUIRE(o.node_sets.size() == 1);
-    CHECK(o.node_sets[0].name == "clamp");
-    CHECK(o.node_sets[0].nodes.size() == 25);
+    check_carried(primal::read_gmsh(out), model);
   }
   SUBCASE(".vtu: the block cell array and the names as field data") {
     const fs::path out = dir.path / "out.vtu";

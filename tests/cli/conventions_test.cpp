@@ -280,3 +280,28 @@ TEST_CASE("cli conventions: an invalid result exits 4, says so even with --quiet
   CHECK(fs::exists(out));
   CHECK(fs::exists(report));
 }
+
+TEST_CASE("cli conventions: dual --rebuild writes every mesh format, by the extension, with its report as one") {
+  TempDir dir;
+  const fs::path in = dir.path / "grid.exo";
+  primal::write_exodus(primal::grid_model({2, 2, 2}, 1.0, [](int, int, int) { return false; }), in);
+  for (const char* name : {"r.msh", "r.exo", "r.e", "r.vtk", "r.vtu"}) {
+    CAPTURE(name);
+    const fs::path out = dir.path / name, report = dir.path / (std::string(name) + ".json");
+    const test::CliRun r =
+        test::geode_cli("dual " + in.string() + " --rebuild " + out.string() + " -o " + report.string(), true);
+    INFO(r.out);
+    REQUIRE(r.code == 0);
+    CHECK(fs::exists(report));  // the report's format from its extension: JSON
+    std::ifstream is(report);
+    CHECK(is.peek() == '{');
+    const std::string e = out.extension().string();
+    if (e == ".msh") CHECK(primal::read_gmsh(out).hexes.size() == 8);
+    if (e == ".exo" || e == ".e") CHECK(primal::read_exodus(out).hexes.size() == 8);
+    if (e == ".vtk") CHECK(primal::to_hex_mesh(primal::read_vtk(out)).hexes.size() == 8);
+    if (e == ".vtu") {  // binary: its header and the decoded cell array
+      CHECK(slurp(out).find("NumberOfCells=\"8\"") != std::string::npos);
+      CHECK(binary_doubles(slurp(out), "Name=\"scaled_jacobian\"").size() == 8);
+    }
+  }
+}
