@@ -320,9 +320,10 @@ void write_vtu_grid(std::ostream& os, const Grid& g, VtuEncoding encoding) {
   os << "      </Points>\n"
      << "      <Cells>\n";
   auto integer = [](auto v) { return static_cast<long long>(v); };
-  write_data_array<std::int64_t>(os, encoding, "Int64", " Name=\"connectivity\"", g.connectivity, 8,
+  // Int32 like Index: node numbers fit, and half the bytes of Int64.
+  write_data_array<std::int32_t>(os, encoding, "Int32", " Name=\"connectivity\"", g.connectivity, 8,
                                  integer);
-  write_data_array<std::int64_t>(os, encoding, "Int64", " Name=\"offsets\"", g.offsets, 10, integer);
+  write_data_array<std::int32_t>(os, encoding, "Int32", " Name=\"offsets\"", g.offsets, 10, integer);
   write_data_array<std::uint8_t>(os, encoding, "UInt8", " Name=\"types\"", g.types, 20, integer);
   os << "      </Cells>\n"
      << "      <CellData Scalars=\"scaled_jacobian\">\n";
