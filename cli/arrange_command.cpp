@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "cli/commands.hpp"
+#include "cli/conventions.hpp"
 #include "primal/errors.hpp"
 #include "templates/geode.hpp"
 #include "templates/spec.hpp"
@@ -14,13 +15,16 @@ namespace {
 struct ArrangeArgs {
   std::string spec;
   std::string output;
-  std::string format = "appendix";
+  std::string format;  // empty: by the extension of -o, else appendix
   bool smooth = false;
   bool slide = false;
   bool quality = false;
 };
 
 void run_arrange(const ArrangeArgs& a) {
+  check_output_path(a.output);
+  const std::string format =
+      output_format(a.output, a.format, {"appendix", "csv", "json", "vtu", "vtk", "msh", "msh22", "exo", "html"}, "appendix");
   const templates::ArrangementSpec spec = templates::read_spec(a.spec);
   // The smoother's constraints keep nodes on axis-aligned box faces.
   if (a.smooth && spec.domain.corners)
@@ -30,8 +34,8 @@ void run_arrange(const ArrangeArgs& a) {
   const std::string name = std::filesystem::path(a.spec).stem().string();
   TemplateOutput out;
   out.name = name, out.title = "spec " + std::filesystem::path(a.spec).filename().string();
-  out.format = a.format, out.output = a.output, out.smooth = a.smooth, out.slide = a.slide, out.quality = a.quality;
-  if (a.format == "html") out.sheets = templates::spec_sheets(spec), out.domain = spec.domain;
+  out.format = format, out.output = a.output, out.smooth = a.smooth, out.slide = a.slide, out.quality = a.quality;
+  if (format == "html") out.sheets = templates::spec_sheets(spec), out.domain = spec.domain;
   out.caption = "geode arrange " + a.spec + (a.smooth ? " --smooth" : "") + (a.slide ? " --slide" : "");
   write_template(t, out);
 }
@@ -49,10 +53,9 @@ void add_arrange_command(CLI::App& app) {
   c->add_option("SPEC", args->spec, "the spec, a JSON file")->required();
   c->add_option("--format", args->format,
                 "appendix: node and element tables (1-based); csv; json: with sheets, their\n"
-                "intersections and the interleave checks; vtu: VTK XML for ParaView (needs -o); html: a\n"
+                "intersections and the interleave checks; vtu, vtk, msh, msh22, exo: the mesh (needs -o); html: a\n"
                 "self-contained viewer of the mesh, the sheets and their layers (needs -o)")
-      ->check(CLI::IsMember({"appendix", "csv", "json", "vtu", "html"}))
-      ->capture_default_str();
+      ->check(CLI::IsMember({"appendix", "csv", "json", "vtu", "vtk", "msh", "msh22", "exo", "html"}));
   c->add_option("-o,--output", args->output, "write to FILE (atomically) instead of standard output");
   c->add_flag("--smooth", args->smooth,
               "place the nodes by optimization (untangle, then maximise the minimum scaled Jacobian);\n"

@@ -1,5 +1,8 @@
 #pragma once
-// Sub-commands of the `geode` command line; each file registers its own.
+// Sub-commands of the `geode` command line; each file registers its own. A new command follows
+// cli/conventions.hpp (exit codes, number_check / parse_box for numbers, output_format +
+// check_output_path before any work, OutputFiles for outputs written as one, write_mesh for
+// every mesh format) and reports long work through cli/progress.hpp.
 #include <CLI/CLI.hpp>
 #include <filesystem>
 #include <functional>
@@ -59,8 +62,9 @@ void write_or_print(const std::string& path, const std::function<void(std::ostre
 struct TemplateOutput {
   std::string name;   // the template's name in the JSON ("template") and the appendix title
   std::string title;  // what follows the name in the appendix title, e.g. "box 24x14x24"
-  std::string format = "appendix";
+  std::string format = "appendix";  // resolved (cli/conventions.hpp: output_format)
   std::string output;
+  std::string vtu_encoding = "binary";
   bool smooth = true;
   bool slide = false;
   bool quality = false;

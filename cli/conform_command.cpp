@@ -1,55 +1,43 @@
 // geode conform INPUT: the geode algorithm on a whole hex + tet model; geode demo: the same on
-// a demo model built with Gmsh (primal/demo_models).
-#include <unistd.h>
-
+// a demo model built with Gmsh (conform/demo_models).
 #include <algorithm>
-#include <chrono>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "cli/commands.hpp"
-#include "primal/atomic_file.hpp"
+#include "cli/conventions.hpp"
+#include "cli/progress.hpp"
+#include "conform/conform.hpp"
 #include "conform/demo_models.hpp"
 #include "primal/errors.hpp"
-#include "primal/io_exodus.hpp"
-#include "primal/io_gmsh.hpp"
-#include "primal/io_vtk.hpp"
 #include "primal/quality.hpp"
 #include "primal/quality_report.hpp"
-#include "conform/conform.hpp"
 
 namespace geode::cli {
 namespace {
 
 namespace fs = std::filesystem;
 
-void check_output_extension(const fs::path& path) {
-  const std::string e = file_extension(path);
-  if (e != ".exo" && e != ".e" && e != ".msh" && e != ".vtu")
-    throw InvalidInput(path.string() + ": unknown output format '" + e +
-                       "' (expected .exo, .e, .msh or .vtu)");
-}
-
-void write_model(const primal::Model& model, const fs::path& path) {
-  const std::string e = file_extension(path);
-  if (e == ".exo" || e == ".e") return primal::write_exodus(model, path);
-  if (e == ".msh") return primal::write_gmsh(model, path);
-  if (e == ".vtu") return primal::write_vtu(path, primal::hex_part(model));
-  check_output_extension(path);
-}
+const std::vector<std::string> kMeshFormats{"exo", "msh", "msh22", "vtu", "vtk"};
 
 struct ConformArgs {
   std::string input;
   std::string output;
+  std::string format;
+  std::string vtu_encoding = "binary";
   std::string report;
   std::string smooth = "local";
   std::string quality = "sj";
+  std::string geode_block;
   std::string model = "half";
   std::string save_input;
+  double merge_tolerance = -1;  // < 0: no merging
   int n = 4;
   bool quiet = false;
+  bool write_invalid = false;
 };
 
 nlohmann::json result_json(const conform::ConformResult& r) {
@@ -79,12 +67,19 @@ double min_sj(const primal::QualityReport& q) {
   return 0.0;
 }
 
+// Valid: faces shared by two hexes, closed boundary, and no hex with scaled Jacobian <= 0.
+bool result_valid(const conform::ConformResult& r) {
+  if (!r.validity.ok()) return false;
+  return std::all_of(r.quality.begin(), r.quality.end(),
+                     [](const conform::BlockQuality& b) { return min_sj(b.report) > 0.0; });
+}
+
 void print_summary(const conform::ConformResult& r, std::ostream& os, bool tables) {
   os << "input: " << r.input_hexes << " hexes, " << r.input_tets << " tets, "
      << r.interface_quads << " interface quads\n";
   os << "output: " << r.model.hexes.size() << " hexes (" << r.diced_hexes << " diced hex, "
      << r.geode_hexes << " geode, " << r.diced_tet_hexes << " diced tet), "
-     << r.model.points.size() << " nodes, " << (r.validity.ok() ? "valid" : "INVALID") << ", "
+     << r.model.points.size() << " nodes, " << (result_valid(r) ? "valid" : "INVALID") << ", "
      << r.seconds << " s\n";
   for (const auto& b : r.quality) {
     os << "block " << b.block << " \"" << b.name << "\": " << b.report.num_hexes
@@ -94,50 +89,111 @@ void print_summary(const conform::ConformResult& r, std::ostream& os, bool table
   for (const auto& w : r.warnings) os << "warning: " << w << "\n";
 }
 
+// Nodes at one place as other nodes (within 1e-9 of the model's size): the parts were meshed
+// separately. A hint for a failed interface, empty when there are none.
+std::string duplicate_node_hint(const primal::Model& model) {
+  if (model.points.empty()) return {};
+  Eigen::AlignedBox3d box;
+  for (const auto& p : model.points) box.extend(p);
+  const double tolerance = 1e-9 * box.diagonal().norm();
+  primal::Model copy = model;
+  const primal::Index merged = primal::merge_coincident_nodes(copy, tolerance);
+  if (merged == 0) return {};
+  std::ostringstream s;
+  s << "; hint: " << merged << " nodes lie at the same place as others (parts meshed separately?): "
+    << "--merge-tolerance " << tolerance << " merges them";
+  return s.str();
+}
+
+// The output paths and format, checked before any work: names, directories, format agreement.
+std::string check_outputs(const ConformArgs& a) {
+  std::string format;
+  if (!a.output.empty()) {
+    if (a.output == "-") throw InvalidInput("-o -: a mesh is written to a file, not to standard output");
+    check_output_path(a.output);
+    format = output_format(a.output, a.format, kMeshFormats, "");
+  } else if (!a.format.empty()) {
+    throw InvalidInput("--format " + a.format + " needs -o FILE");
+  }
+  if (!a.report.empty()) {
+    if (file_extension(a.report) != ".json")
+      throw InvalidInput(a.report + ": the report is JSON; name it *.json");
+    check_output_path(a.report);
+    if (!a.output.empty() && fs::weakly_canonical(a.report) == fs::weakly_canonical(a.output))
+      throw InvalidInput(a.report + ": the report and the mesh are the same file");
+  }
+  return format;
+}
+
 // `source` names the input file in the model's own errors (no tet part, no interface, a face
 // that does not conform: they name elements and nodes, not the file); empty for demos.
-void run(const primal::Model& model, const ConformArgs& a, bool tables,
+void run(primal::Model model, const ConformArgs& a, const std::string& format, bool tables,
          const std::string& source = {}) {
+  const std::string prefix = source.empty() ? "" : source + ": ";
+  Progress progress = Progress::for_stderr(a.quiet);
+  if (a.merge_tolerance >= 0) {
+    const primal::Index merged = primal::merge_coincident_nodes(model, a.merge_tolerance);
+    progress.stage("merged " + std::to_string(merged) + " coincident nodes");
+  }
   conform::ConformOptions opts;
   opts.smooth = conform::parse_conform_smooth(a.smooth);
   opts.quality = conform::parse_conform_quality(a.quality);
-  if (!a.quiet && isatty(STDERR_FILENO)) {
-    opts.progress = [](const std::string& line) { std::cerr << "geode: " << line << "\n"; };
-    // Local smoothing is the long step: a bar redrawn in place, at most ten times a second.
-    auto last = std::make_shared<std::chrono::steady_clock::time_point>();
-    opts.smoothing_progress = [last](std::size_t done, std::size_t total) {
-      const auto now = std::chrono::steady_clock::now();
-      if (done < total && now - *last < std::chrono::milliseconds(100)) return;
-      *last = now;
-      const std::size_t width = 30, filled = total ? width * done / total : width;
-      std::cerr << "\rgeode: smoothing [" << std::string(filled, '#') << std::string(width - filled, '.') << "] "
-                << done << " / " << total << " buffer hexes" << (done == total ? "\n" : "") << std::flush;
-    };
-  }
-  const std::string prefix = source.empty() ? "" : source + ": ";
+  opts.geode_block = a.geode_block;
+  opts.progress = [&progress](const std::string& line) { progress.stage(line); };
+  opts.smoothing_progress = [&progress](std::size_t done, std::size_t total) {
+    progress.step("seed hexes settled", done, total);
+  };
   conform::ConformResult r;
   try {
     r = conform::conform(model, opts);
   } catch (const InvalidInput& e) {
-    throw InvalidInput(prefix + e.what());
+    throw InvalidInput(prefix + e.what() + duplicate_node_hint(model));
   } catch (const TopologyError& e) {
-    throw TopologyError(prefix + e.what());
+    throw TopologyError(prefix + e.what() + duplicate_node_hint(model));
   }
-  if (!a.output.empty()) write_model(r.model, a.output);
-  if (!a.report.empty()) {
-    const std::string text = result_json(r).dump(2) + "\n";
-    primal::write_file_atomically(a.report, [&](std::ostream& os) { os << text; });
+  const bool valid = result_valid(r);
+  if (valid || a.write_invalid) {
+    OutputFiles files;
+    if (!a.output.empty())
+      files.add(a.output, [&](const fs::path& temp) {
+        write_mesh(r.model, temp, format,
+                   a.vtu_encoding == "ascii" ? primal::VtuEncoding::kAscii : primal::VtuEncoding::kBinary);
+      });
+    if (!a.report.empty()) {
+      files.add(a.report, [text = result_json(r).dump(2) + "\n"](const fs::path& temp) {
+        write_or_print(temp.string(), [&](std::ostream& os) { os << text; });
+      });
+    }
+    files.commit();
   }
   if (!a.quiet) print_summary(r, std::cout, tables);
-  if (!a.output.empty() && !a.quiet) std::cout << "wrote " << a.output << "\n";
+  if (!a.quiet && (valid || a.write_invalid)) {
+    if (!a.output.empty()) std::cout << "wrote " << a.output << "\n";
+    if (!a.report.empty()) std::cout << "wrote " << a.report << "\n";
+  }
+  if (!valid) {
+    std::string why = r.warnings.empty() ? std::string("verification failed") : r.warnings.front();
+    for (std::size_t w = 1; w < r.warnings.size(); ++w) why += "; " + r.warnings[w];
+    throw InvalidResult(prefix + why +
+                        (a.write_invalid ? " (written anyway: --write-invalid)"
+                                         : " (nothing written; --write-invalid writes it anyway)"));
+  }
 }
-
-}  // namespace
 
 // Options conform and demo share: where to write, the report, smoothing, quiet.
 void add_run_options(CLI::App* c, ConformArgs& a) {
-  c->add_option("-o,--output", a.output, "output model (.exo, .e, .msh, .vtu)");
-  c->add_option("--report", a.report, "write a JSON report (counts, quality per block)");
+  c->add_option("-o,--output", a.output,
+                "output mesh; the format follows the extension: .exo/.e (Exodus II), .msh (Gmsh 4.1),\n"
+                ".vtu (VTK XML, binary), .vtk (VTK legacy); written only if the result is valid\n"
+                "(see --write-invalid), together with --report (both or neither)");
+  c->add_option("--format", a.format,
+                "mesh format, when it must be named: exo, msh, msh22 (Gmsh 2.2, .msh), vtu, vtk;\n"
+                "one that contradicts the extension of -o is refused")
+      ->check(CLI::IsMember(kMeshFormats));
+  c->add_option("--vtu-encoding", a.vtu_encoding, "binary (base64, default) or ascii DataArrays in .vtu")
+      ->check(CLI::IsMember({"binary", "ascii"}))
+      ->capture_default_str();
+  c->add_option("--report", a.report, "write a JSON report (counts, validity, quality per output block) to FILE.json");
   c->add_option("--smooth", a.smooth,
                 "worst-first smoothing, model boundary nodes sliding on the boundary; local: hexes below "
                 "0.35 among the geode hexes and those touching them (default); global: every hex "
@@ -149,54 +205,73 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
                 "metric of the paper's Table 1 per block")
       ->check(CLI::IsMember({"sj", "full"}))
       ->capture_default_str();
-  c->add_flag("--quiet", a.quiet, "no progress and no summary");
+  c->add_option("--geode-block", a.geode_block,
+                "put the geode hexes in a block of their own with this name (id one above every\n"
+                "input block); by default each goes to the tet-side block it was carved from");
+  c->add_option("--merge-tolerance", a.merge_tolerance,
+                "first merge nodes closer than this distance (model units), for parts meshed\n"
+                "separately whose interface nodes are duplicated")
+      ->check(number_check(0, 1e300));
+  c->add_flag("--write-invalid", a.write_invalid,
+              "write the mesh and report even when verification fails (the exit code is still 4)");
+  c->add_flag("--quiet", a.quiet, "no progress and no summary (errors and the invalid-result message still print)");
 }
+
+}  // namespace
 
 void add_conform_commands(CLI::App& app) {
   auto args = std::make_shared<ConformArgs>();
   CLI::App* c = app.add_subcommand(
       "conform",
-      "Conform the hex part of a model to its tet part with geode templates: buffer layer, "
-      "dicing (8 per hex, 4 per tet), 26 geode hexes per interface quad.");
+      "Conform the hex part of a model to its tet part with geode templates: buffer layer, dicing\n"
+      "(8 per hex, 4 per tet), 26 geode hexes per interface quad. Input element blocks, node sets\n"
+      "and side sets are carried to the output. Exit 4 when the result fails verification.");
   c->add_option("INPUT", args->input, "input model (.msh, .exo, .e, .vtu, .vtk)")->required();
   add_run_options(c, *args);
   c->callback([args] {
-    // Check the output name before the long run, not after it.
-    if (!args->output.empty()) check_output_extension(args->output);
-    run(read_model(args->input), *args, false, args->input);
+    const std::string format = check_outputs(*args);  // before the long run, not after it
+    run(read_model(args->input), *args, format, false, args->input);
   });
 
   auto dargs = std::make_shared<ConformArgs>();
   CLI::App* d = app.add_subcommand(
-      "demo", "Build a demo model with the Gmsh API (--model) and conform it, printing the quality "
+      "demo", "Build a demo model with the Gmsh API (--model) and conform it, printing the quality\n"
               "report per block; --save-input writes the model itself.");
   d->add_option("--model", dargs->model,
-                 "half: structured hexes beside Kuhn-split transfinite tets (default); delaunay, "
-                 "delaunay-random: beside a Delaunay tet box, interface diagonals alternating or "
-                 "random; cylinder: a swept hex cylinder with unstructured quad caps in a tet box; "
-                 "lshape: a hex block in the notch of an L-shaped tet part (concave interface); "
+                 "half: structured hexes beside Kuhn-split transfinite tets (default); delaunay,\n"
+                 "delaunay-random: beside a Delaunay tet box, interface diagonals alternating or\n"
+                 "random; cylinder: a swept hex cylinder with unstructured quad caps in a tet box;\n"
+                 "lshape: a hex block in the notch of an L-shaped tet part (concave interface);\n"
                  "nugget: a Delaunay tet cube in 26 structured blocks")
       ->check(CLI::IsMember(conform::demo_model_names()))
       ->capture_default_str();
-  d->add_option("-n,--size", dargs->n, "cells per unit length (default 4; nugget rounds up to even)")
-      ->check(CLI::PositiveNumber);
+  d->add_option("-n,--size", dargs->n, "cells per unit length (1 to 64; default 4; nugget rounds up to even)")
+      ->check(number_check(1, 64, true));
   d->add_option("--save-input", dargs->save_input,
-                "write the demo's input model (.msh, .exo, .e) to try `geode conform` on it; "
+                "write the demo's input model (.msh, .exo, .e, .vtu, .vtk) to try `geode conform` on it;\n"
                 "without -o or --report nothing is conformed");
   add_run_options(d, *dargs);
   d->callback([dargs] {
-    if (!dargs->output.empty()) check_output_extension(dargs->output);
-    const primal::Model model = conform::demo_model(dargs->model, dargs->n);
+    const std::string format = check_outputs(*dargs);
+    std::string save_format;
     if (!dargs->save_input.empty()) {
-      const std::string e = file_extension(dargs->save_input);
-      if (e == ".vtu") throw InvalidInput(dargs->save_input + ": --save-input needs .msh, .exo or .e (a .vtu holds no tets)");
-      write_model(model, dargs->save_input);
+      check_output_path(dargs->save_input);
+      save_format = output_format(dargs->save_input, "", kMeshFormats, "");
+    }
+    primal::Model model = conform::demo_model(dargs->model, dargs->n);
+    if (!dargs->save_input.empty()) {
+      OutputFiles files;
+      files.add(dargs->save_input, [&](const fs::path& temp) {
+        write_mesh(model, temp, save_format,
+                   dargs->vtu_encoding == "ascii" ? primal::VtuEncoding::kAscii : primal::VtuEncoding::kBinary);
+      });
+      files.commit();
       if (!dargs->quiet)
         std::cout << "wrote " << dargs->save_input << " (" << model.hexes.size() << " hexes, "
                   << model.tets.size() << " tets)\n";
       if (dargs->output.empty() && dargs->report.empty()) return;
     }
-    run(model, *dargs, true);
+    run(std::move(model), *dargs, format, true);
   });
 }
 

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "cli/commands.hpp"
+#include "cli/conventions.hpp"
 #include "primal/errors.hpp"
 #include "primal/io_vtk.hpp"
 #include "primal/model.hpp"
@@ -25,9 +26,10 @@ using primal::Index;
 
 struct DualArgs {
   std::string input;
-  std::string format = "text";
+  std::string format;  // empty: by the extension of -o, else text
   std::string output;
   std::string rebuild;
+  std::string vtu_encoding = "binary";
 };
 
 template <class Dual>
@@ -84,8 +86,18 @@ std::vector<Index> tuple_counts(const Dual& d) {
 }
 
 void run_dual(const DualArgs& a) {
+  // Outputs are checked before the input is read and the engine runs.
+  check_output_path(a.output);
+  const std::string format = output_format(a.output, a.format, {"text", "json"}, "text");
+  std::string rebuild_format;
+  if (!a.rebuild.empty()) {
+    check_output_path(a.rebuild);
+    rebuild_format = output_format(a.rebuild, "", {"vtu", "vtk", "msh", "exo"}, "");
+  }
   const fs::path in(a.input);
   const MeshFile m = read_mesh_file(in);
+  if (m.dim == 2 && !rebuild_format.empty() && rebuild_format != "vtu" && rebuild_format != "vtk")
+    throw InvalidInput(a.rebuild + ": " + a.input + " is a quad mesh; rebuild it as .vtu or .vtk");
   nlohmann::json j;
   std::vector<Index> counts;
   if (m.dim == 3) {
@@ -100,13 +112,9 @@ void run_dual(const DualArgs& a) {
   j["input"] = a.input;
   j["dimension"] = m.dim;
 
+  stc::DualMesh D;
   if (!a.rebuild.empty()) {
-    const fs::path out(a.rebuild);
-    const std::string e = file_extension(out);
-    if (e != ".vtu" && e != ".vtk")
-      throw InvalidInput(out.string() + ": unknown output format '" + e + "' (expected .vtu or .vtk)");
     // Name the input in what the engine reports (it only knows hexes and sheets by number).
-    stc::DualMesh D;
     try {
       const stc::MeshArrangementInput fields = m.dim == 3 ? stc::sheet_fields(m.hex) : stc::sheet_fields(m.quad);
       D = stc::dualize(stc::compute_arrangement(fields.sheets, fields.domain));
@@ -121,16 +129,11 @@ void run_dual(const DualArgs& a) {
     r["cells"] = m.dim == 3 ? D.hex.hexes.size() : D.quad.quads.size();
     const std::vector<Index> rebuilt = m.dim == 3 ? tuple_counts(stc::mesh_dual(D.hex)) : tuple_counts(stc::mesh_dual(D.quad));
     r["same_counts"] = rebuilt == counts && r["nodes"] == j["nodes"] && r["cells"] == j["cells"];
-    // Writers are atomic (primal/io_vtk.hpp): nothing half-written on failure.
-    if (m.dim == 3)
-      e == ".vtu" ? primal::write_vtu(out, D.hex) : primal::write_vtk(out, D.hex);
-    else
-      e == ".vtu" ? primal::write_vtu(out, D.quad) : primal::write_vtk(out, D.quad);
     j["rebuild"] = r;
   }
 
   std::string text;
-  if (a.format == "json") {
+  if (format == "json") {
     text = j.dump(2) + "\n";
   } else {
     text = dual_text(j, m.dim);
@@ -142,7 +145,24 @@ void run_dual(const DualArgs& a) {
               "\n";
     }
   }
-  write_or_print(a.output, [&](std::ostream& os) { os << text; });
+  // The rebuilt mesh and the report file are written as one (both or neither).
+  OutputFiles files;
+  if (!a.rebuild.empty())
+    files.add(a.rebuild, [&](const fs::path& temp) {
+      const auto vtu = a.vtu_encoding == "ascii" ? primal::VtuEncoding::kAscii : primal::VtuEncoding::kBinary;
+      if (m.dim == 2) {
+        rebuild_format == "vtu" ? primal::write_vtu(temp, D.quad, {}, vtu) : primal::write_vtk(temp, D.quad);
+      } else {
+        primal::Model model;
+        model.points = D.hex.points;
+        model.hexes = D.hex.hexes;
+        write_mesh(model, temp, rebuild_format, vtu);
+      }
+    });
+  const bool to_file = !a.output.empty() && a.output != "-";
+  if (to_file) files.add(a.output, [&](const fs::path& temp) { write_or_print(temp.string(), [&](std::ostream& os) { os << text; }); });
+  files.commit();
+  if (!to_file) std::cout << text;
 }
 
 }  // namespace
@@ -157,9 +177,17 @@ void add_dual_command(CLI::App& app) {
       "oriented cells and sheets that do not cross themselves, the result is the same mesh up to numbering.");
   d->add_option("mesh", a->input, "All-hex mesh (.vtu, .vtk, .msh, .exo, .e) or planar quad mesh in z = 0 (.vtu, .vtk)")
       ->required();
-  d->add_option("--format", a->format, "text (tables) or json")->check(CLI::IsMember({"text", "json"}));
+  d->add_option("--format", a->format,
+                "report format: text (tables; default) or json; without it the extension of -o decides\n"
+                "(.txt, .json); one that contradicts the extension is refused")
+      ->check(CLI::IsMember({"text", "json"}));
   d->add_option("-o,--output", a->output, "Write the report here instead of standard output");
-  d->add_option("--rebuild", a->rebuild, "Rebuild the mesh from its sheets through the arrangement engine; write it here (.vtu, .vtk)");
+  d->add_option("--rebuild", a->rebuild,
+                "Rebuild the mesh from its sheets through the arrangement engine; write it here, the\n"
+                "format by the extension: .vtu (binary), .vtk, .msh, .exo/.e (hexes; quads: .vtu, .vtk)");
+  d->add_option("--vtu-encoding", a->vtu_encoding, "binary (base64, default) or ascii DataArrays in .vtu")
+      ->check(CLI::IsMember({"binary", "ascii"}))
+      ->capture_default_str();
   d->callback([a] { run_dual(*a); });
 }
 

@@ -2,13 +2,41 @@
 #include <iostream>
 
 #include "cli/commands.hpp"
+#include "cli/conventions.hpp"
 #include "primal/errors.hpp"
+
+namespace {
+
+// One line: CLI11's messages may span several.
+std::string one_line(std::string s) {
+  for (char& c : s)
+    if (c == '\n' || c == '\r') c = ' ';
+  while (!s.empty() && s.back() == ' ') s.pop_back();
+  return s;
+}
+
+// "geode conform" for the deepest sub-command given, for the --help hint.
+std::string command_path(const CLI::App& app) {
+  std::string path = "geode";
+  const CLI::App* a = &app;
+  while (true) {
+    const auto subs = a->get_subcommands();
+    if (subs.empty()) break;
+    a = subs.front();
+    path += " " + a->get_name();
+  }
+  return path;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{
       "geode: all-hex transition templates derived from completed dual sheet arrangements, and the\n"
-      "geode algorithm that conforms a diced hex mesh to a diced tet mesh with them."};
+      "geode algorithm that conforms a diced hex mesh to a diced tet mesh with them.\n"
+      "Exit codes: 0 done, 2 usage or input error, 3 topology refusal, 4 invalid result."};
   app.require_subcommand(1);
+  app.set_version_flag("--version", geode::cli::version_text(), "print the version and exit");
   geode::cli::add_template_command(app);
   geode::cli::add_study_commands(app);
   geode::cli::add_conform_commands(app);
@@ -19,15 +47,21 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    const std::string cmd = command_path(app);
+    std::cerr << cmd << ": usage error: " << one_line(e.what()) << " (see " << cmd << " --help)\n";
+    return 2;
   } catch (const geode::InvalidInput& e) {
-    std::cerr << "geode: error: " << e.what() << "\n";
+    std::cerr << "geode: error: " << one_line(e.what()) << "\n";
     return 2;
   } catch (const geode::TopologyError& e) {
-    std::cerr << "geode: topology error: " << e.what() << "\n";
+    std::cerr << "geode: topology error: " << one_line(e.what()) << "\n";
     return 3;
+  } catch (const geode::cli::InvalidResult& e) {
+    std::cerr << "geode: invalid result: " << one_line(e.what()) << "\n";
+    return 4;
   } catch (const std::exception& e) {
-    std::cerr << "geode: error: " << e.what() << "\n";
+    std::cerr << "geode: error: " << one_line(e.what()) << "\n";
     return 1;
   }
   return 0;

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "cli/commands.hpp"
+#include "cli/conventions.hpp"
 #include "primal/errors.hpp"
 #include "templates/spec.hpp"
 #include "templates/study.hpp"
@@ -53,6 +54,10 @@ templates::InterleaveStudy spec_study(const InterleaveArgs& a) {
 }
 
 void run_interleave(const InterleaveArgs& a) {
+  for (const std::string* path : {&a.output, &a.summary}) {
+    output_format(*path, "", {"csv"}, "csv");
+    check_output_path(*path);
+  }
   templates::InterleaveStudy study;
   if (!a.spec.empty()) {
     study = spec_study(a);
@@ -101,6 +106,10 @@ struct ShapeArgs {
 };
 
 void run_shape(const ShapeArgs& a) {
+  for (const std::string* path : {&a.height_csv, &a.distorted_csv, &a.quality_csv, &a.sj_csv}) {
+    output_format(*path, "", {"csv"}, "csv");
+    check_output_path(*path);
+  }
   const bool any = !a.height_csv.empty() || !a.distorted_csv.empty() || !a.quality_csv.empty() || !a.sj_csv.empty();
   if (!a.height_csv.empty() || !any) {
     std::vector<double> h = a.heights;
@@ -136,13 +145,14 @@ void add_study_commands(CLI::App& app) {
       "Sweep the push parameters (high roof, low roof, dome depth, dome radius) and classify what each push "
       "dualizes to: a template class (hex count, sheet-kind triples, colour-refinement hash) with the paper's "
       "two conditions, or the TopologyError's diagnosis with numbers stripped");
-  inter->add_option("--template", ia->name, "geode3d (default) or geode4tri");
+  inter->add_option("--template", ia->name, "geode3d (default) or geode4tri")
+      ->check(CLI::IsMember({"geode3d", "geode4tri"}));
   inter->add_option("-o,--output", ia->output, "per-run CSV (default: stdout)");
   inter->add_option("--summary", ia->summary, "per-class summary CSV");
-  inter->add_option("--high", ia->high, "high roof values (default grid if omitted)");
-  inter->add_option("--low", ia->low, "low roof values");
-  inter->add_option("--depth", ia->depth, "dome depth values");
-  inter->add_option("--radius", ia->radius, "dome radius blend values");
+  inter->add_option("--high", ia->high, "high roof values (default grid if omitted)")->check(number_check(0, 1));
+  inter->add_option("--low", ia->low, "low roof values")->check(number_check(0, 1));
+  inter->add_option("--depth", ia->depth, "dome depth values")->check(number_check(0, 1));
+  inter->add_option("--radius", ia->radius, "dome radius blend values")->check(number_check(0, 1));
   inter->add_option("--spec", ia->spec,
                     "sweep an arrangement spec (geode arrange's format) instead of a built-in template;\n"
                     "its \"sweep\" block and --sweep say what to sweep")
@@ -162,9 +172,9 @@ void add_study_commands(CLI::App& app) {
   shape->add_option("--distorted-csv", sa->distorted_csv, "sheared/tapered cell study CSV");
   shape->add_option("--quality-csv", sa->quality_csv, "Table 1 report of the smoothed geode with the paper's values");
   shape->add_option("--sj-csv", sa->sj_csv, "per-hex scaled Jacobians of the smoothed geode (both modes)");
-  shape->add_option("--heights", sa->heights, "box heights (default 6, 8, ..., 30)");
-  shape->add_option("--shears", sa->shears, "shear angles in degrees (default 0 10 20 30 40)");
-  shape->add_option("--tapers", sa->tapers, "top/bottom taper ratios (default 0.4 0.6 0.8 1 1.25 1.5)");
+  shape->add_option("--heights", sa->heights, "box heights (default 6, 8, ..., 30), in [0.1, 2400]")->check(number_check(0.1, 2400));
+  shape->add_option("--shears", sa->shears, "shear angles in degrees (default 0 10 20 30 40), in [0, 80]")->check(number_check(0, 80));
+  shape->add_option("--tapers", sa->tapers, "top/bottom taper ratios (default 0.4 0.6 0.8 1 1.25 1.5), in [0.01, 100]")->check(number_check(0.01, 100));
   shape->callback([sa] { run_shape(*sa); });
 }
 

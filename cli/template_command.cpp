@@ -9,10 +9,12 @@
 #include <sstream>
 
 #include "cli/commands.hpp"
+#include "cli/conventions.hpp"
 #include "primal/boundary.hpp"
 #include "primal/errors.hpp"
 #include "primal/io_html.hpp"
 #include "primal/io_vtk.hpp"
+#include "primal/model.hpp"
 #include "primal/quality.hpp"
 #include "primal/quality_report.hpp"
 #include "templates/fixup.hpp"
@@ -25,10 +27,11 @@ namespace {
 
 struct TemplateArgs {
   std::string name;
-  std::string box = "24x14x24";
+  std::string box;  // empty: 24x14x24 (24x14 in 2D)
   std::string diagonal = "main";
   std::string higher = "x";
-  std::string format = "appendix";
+  std::string format;  // empty: by the extension of -o, else appendix
+  std::string vtu_encoding = "binary";
   std::string output;
   bool slide = false;
   bool no_smooth = false;
@@ -167,23 +170,33 @@ void write_template_html(const TemplateOutput& a, const templates::Template& T, 
   primal::write_html(a.output, T.hex, scene);
 }
 
+const std::vector<std::string> kTemplateFormats{"appendix", "csv", "json", "vtu", "vtk", "msh", "msh22", "exo", "spec", "html"};
+
 void run_template(const TemplateArgs& a) {
+  // Refuse a bad output before the derivation, not after it.
+  check_output_path(a.output);
+  const std::string format = output_format(a.output, a.format, kTemplateFormats, "appendix");
+  const int dim = a.name == "geode2d" || a.name == "refine3-2d" ? 2 : 3;
+  if (dim == 2 && is_mesh_format(format) && format != "vtu" && format != "vtk")
+    throw InvalidInput(a.output + ": " + a.name + " is a quad mesh; write it as .vtu or .vtk");
+  const std::string box_text = a.box.empty() ? (dim == 3 ? "24x14x24" : "24x14") : a.box;
+  const auto box = parse_box("--box", box_text, dim);
   templates::GeodeOptions o;
-  o.box = templates::parse_box(a.box);
+  o.box = Eigen::Vector3d(box[0], box[1], box[2]);
   o.diagonal = a.diagonal == "anti" ? templates::Diagonal::Anti : templates::Diagonal::Main;
   o.higher = a.higher == "z" ? templates::Higher::Z : templates::Higher::X;
   o.push = a.push;
   const bool refine = a.name == "refine3" || a.name == "refine3-2d";
-  const int dim = a.name == "geode2d" || a.name == "refine3-2d" ? 2 : 3;
   if (a.name == "geode4tri") o.split = templates::TopSplit::FourTriangles;
-  if (a.format == "spec") {
+  if (format == "spec") {
     if (refine) throw InvalidInput("--format spec: " + a.name + " has no spec yet (geode3d, geode2d, geode4tri have)");
     const std::string text = templates::format_spec(templates::spec_json(templates::geode_spec(o, dim)));
     write_or_print(a.output, [&](std::ostream& os) { os << text; });
     return;
   }
   TemplateOutput out;
-  out.name = a.name, out.title = "box " + a.box, out.format = a.format, out.output = a.output;
+  out.name = a.name, out.title = "box " + box_text, out.format = format, out.output = a.output;
+  out.vtu_encoding = a.vtu_encoding;
   out.smooth = !a.no_smooth, out.slide = a.slide, out.quality = a.quality;
   templates::Template T;
   if (refine) {
@@ -193,14 +206,14 @@ void run_template(const TemplateArgs& a) {
     T = a.name == "refine3" ? templates::build_refine3(ro) : templates::build_refine3_2d(ro);
     out.check_conditions = false;
     out.smoother = [ro, fixed = !a.slide](templates::Template& t) { return templates::smooth_refine3(t, ro, fixed); };
-    if (a.format == "html") {
+    if (format == "html") {
       const templates::RefineArrangement R = templates::refine3_arrangement(ro, dim);
       out.sheets = R.sheets, out.domain = R.domain;
     }
   } else {
     T = dim == 2 ? templates::build_geode2d(o) : templates::build_geode3d(o);
     out.check_conditions = dim == 3;
-    if (a.format == "html") {
+    if (format == "html") {
       const templates::GeodeArrangement G = templates::geode_arrangement(o, dim);
       out.sheets = G.sheets, out.domain = G.domain;
     }
@@ -208,7 +221,7 @@ void run_template(const TemplateArgs& a) {
   // The arrangements above are built in the reference cell; the nodes are mapped to the box.
   out.to_physical = [box = o.box, dim](const primal::Point& r) { return templates::box_point(r, box, dim); };
   std::ostringstream cmd;
-  cmd << "geode template " << a.name << " --box " << a.box;
+  cmd << "geode template " << a.name << " --box " << box_text;
   if (!refine)
     cmd << " --diagonal " << a.diagonal << " --higher " << a.higher << " --high-roof " << o.push.high_roof
         << " --low-roof " << o.push.low_roof << " --dome-depth " << o.push.dome_depth << " --dome-radius "
@@ -285,13 +298,21 @@ void write_template(templates::Template& T, const TemplateOutput& a) {
     if (!text.empty()) std::cout << text;
     return;
   }
-  if (a.format == "vtu") {
-    // The writer adds the scaled Jacobian (and block) cell arrays itself.
-    if (a.output.empty()) throw InvalidInput("--format vtu needs -o FILE.vtu");
-    if (dim == 3)
-      primal::write_vtu(a.output, T.hex);
-    else
-      primal::write_vtu(a.output, T.quad);
+  if (is_mesh_format(a.format)) {
+    // The mesh goes to the file (the writers add the scaled Jacobian cell array); the quality
+    // tables, if asked for, to standard output.
+    if (a.output.empty()) throw InvalidInput("--format " + a.format + " needs -o FILE");
+    const auto vtu = a.vtu_encoding == "ascii" ? primal::VtuEncoding::kAscii : primal::VtuEncoding::kBinary;
+    if (dim == 2) {
+      if (a.format != "vtu" && a.format != "vtk")
+        throw InvalidInput(a.output + ": a quad mesh is written as .vtu or .vtk");
+      a.format == "vtu" ? primal::write_vtu(a.output, T.quad, {}, vtu) : primal::write_vtk(a.output, T.quad);
+    } else {
+      primal::Model m;
+      m.points = T.hex.points;
+      m.hexes = T.hex.hexes;
+      write_mesh(m, a.output, a.format, vtu);
+    }
     if (!text.empty()) std::cout << text;
     return;
   }
@@ -312,8 +333,10 @@ void add_template_command(CLI::App& app) {
                 "coarse edge over three fine ones (4 quads)")
       ->required()
       ->check(CLI::IsMember({"geode3d", "geode2d", "geode4tri", "refine3", "refine3-2d"}));
-  t->add_option("--box", args->box, "buffer cell WIDTHxHEIGHTxDEPTH (x, y up, z), centred at the origin; tet side on top")
-      ->capture_default_str();
+  t->add_option("--box", args->box,
+                "buffer cell WIDTHxHEIGHTxDEPTH (x, y up, z; WIDTHxHEIGHT for the 2D templates), centred at\n"
+                "the origin, tet side on top; each in [1e-6, 1e6], at most 1e4 between largest and smallest\n"
+                "(default 24x14x24)");
   t->add_option("--diagonal", args->diagonal,
                 "main: the top diagonal joins (-x,+z) and (+x,-z) as in the paper's Appendix A; anti: the other one")
       ->check(CLI::IsMember({"main", "anti"}))
@@ -322,13 +345,18 @@ void add_template_command(CLI::App& app) {
       ->check(CLI::IsMember({"x", "z"}))
       ->capture_default_str();
   t->add_option("--format", args->format,
-                "appendix: the paper's Tables 2 and 3 (1-based); csv: node and element tables; json: with\n"
-                "sheets, their intersections and the interleave checks; vtu: VTK XML for ParaView (needs -o);\n"
-                "spec: the template as an arrangement spec for `geode arrange` (nothing is derived);\n"
-                "html: a self-contained viewer of the hexes, the arrangement's sheets and their layers (needs -o)")
-      ->check(CLI::IsMember({"appendix", "csv", "json", "vtu", "spec", "html"}))
+                "appendix (default): the paper's Tables 2 and 3 (1-based); csv: node and element tables;\n"
+                "json: with sheets, their intersections and the interleave checks; vtu, vtk, msh, msh22,\n"
+                "exo: the mesh (needs -o); spec: the template as an arrangement spec for `geode arrange`\n"
+                "(nothing is derived); html: a self-contained viewer of the hexes, the arrangement's sheets\n"
+                "and their layers (needs -o). Without it, the extension of -o decides (.txt .csv .json\n"
+                ".vtu .vtk .msh .exo .e .html); one that contradicts the extension is refused")
+      ->check(CLI::IsMember(kTemplateFormats));
+  t->add_option("--vtu-encoding", args->vtu_encoding, "binary (base64, default) or ascii DataArrays in .vtu")
+      ->check(CLI::IsMember({"binary", "ascii"}))
       ->capture_default_str();
-  t->add_option("-o,--output", args->output, "write to FILE (atomically) instead of standard output");
+  t->add_option("-o,--output", args->output,
+                "write to FILE (atomically) instead of standard output; its extension picks the format");
   t->add_flag("--slide", args->slide,
               "let tet- and hex-side nodes slide within their faces while smoothing; refine3: let the side\n"
               "faces' nodes slide instead of fixing them at the smoothed 2D template (neighbours then need\n"
@@ -340,23 +368,30 @@ void add_template_command(CLI::App& app) {
   t->add_flag("--quality", args->quality, "append the quality report (the paper's Table 1 metrics)");
   t->add_option("--high-roof", args->push.high_roof,
                 "push: higher tunnel roof, fraction of the height (refine3: the tunnel along x; default 0.75 there)")
+      ->check(number_check())
       ->capture_default_str();
   t->add_option("--low-roof", args->push.low_roof,
                 "push: lower tunnel roof, fraction of the height (refine3: the tunnel along z; default 0.6 there)")
+      ->check(number_check())
       ->capture_default_str();
   t->add_option("--centre-depth", args->push.centre_depth,
                 "push, geode4tri: depth of the centre vertex's dome (0: --dome-depth)")
+      ->check(number_check())
       ->capture_default_str();
   t->add_option("--centre-radius", args->push.centre_radius,
                 "push, geode4tri: radius blend of the centre vertex's dome (0: --dome-radius)")
+      ->check(number_check())
       ->capture_default_str();
   t->add_option("--layer", args->refine.layer, "refine3: height of the horizontal layer sheet, below both roofs")
+      ->check(number_check())
       ->capture_default_str();
   t->add_option("--dome-depth", args->push.dome_depth, "push: how far below the tet side the domes reach, fraction of the height")
+      ->check(number_check())
       ->capture_default_str();
   t->add_option("--dome-radius", args->push.dome_radius,
                 "push: where each dome's circle crosses the diced tet side, 0..1 between the nodes it\n"
                 "must enclose and the nearest it must leave out")
+      ->check(number_check())
       ->capture_default_str();
   t->callback([args, t] {
     args->refine_roofs = t->count("--high-roof") + t->count("--low-roof") > 0;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <map>
 #include <numeric>
 #include <sstream>
 #include <unordered_map>
@@ -32,8 +33,25 @@ double since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-constexpr std::array<std::pair<int, const char*>, 3> kBlocks{
-    {{kDicedHexBlock, "diced hex"}, {kGeodeBlock, "geode"}, {kDicedTetBlock, "diced tet"}}};
+// The output's block ids and names: the input's, plus the geode block when it has a name.
+struct OutputBlocks {
+  int geode_id = 0;  // 0: geode hexes join the tet-side block they were carved from
+  std::map<int, std::string> names;
+};
+
+OutputBlocks output_blocks(const primal::Model& input, const std::string& geode_block) {
+  OutputBlocks o;
+  o.names = input.block_names;
+  if (geode_block.empty()) return o;
+  int top = 0;
+  for (std::size_t h = 0; h < input.hexes.size(); ++h)
+    top = std::max(top, primal::block_of(input, {primal::ElementKind::Hex, static_cast<Index>(h)}));
+  for (std::size_t t = 0; t < input.tets.size(); ++t)
+    top = std::max(top, primal::block_of(input, {primal::ElementKind::Tet, static_cast<Index>(t)}));
+  o.geode_id = top + 1;
+  o.names[o.geode_id] = geode_block;
+  return o;
+}
 
 // The map of the reference cell into a buffer hex: bilinear on the bottom (the hex side's
 // quad), piecewise linear over the two triangles of the top (so the tet side's diced nodes,
@@ -113,6 +131,7 @@ class Conformer {
   std::vector<primal::NodeSet> node_sets_;
   std::vector<primal::SideSet> side_sets_;
   std::vector<Index> inverted_;  // hexes with scaled Jacobian <= 0 after smoothing
+  OutputBlocks blocks_;
 };
 
 void Conformer::find_interface() {
@@ -259,14 +278,25 @@ void Conformer::assemble() {
   std::vector<int> block;
   hexes.reserve(diced_.hex_children.size() + 26 * nb + diced_.tet_children.size());
   block.reserve(hexes.capacity());
-  for (const auto& h : diced_.hex_children) hexes.push_back(h), block.push_back(kDicedHexBlock);
-  for (std::size_t b = 0; b < nb; ++b)
+  // Each output hex is in the input block of the element it comes from; a geode hex in the
+  // block of the tet its buffer hex was carved from, or in a block of its own.
+  blocks_ = output_blocks(input_, options_.geode_block);
+  const primal::Model& lm = layer_.model;
+  for (std::size_t k = 0; k < diced_.hex_children.size(); ++k)
+    hexes.push_back(diced_.hex_children[k]),
+        block.push_back(primal::block_of(lm, {primal::ElementKind::Hex, diced_.hex_parent[k]}));
+  for (std::size_t b = 0; b < nb; ++b) {
+    const Index carved_from = interface_.quads[layer_.hexes[b].quad].tets[0];
+    const int id = blocks_.geode_id ? blocks_.geode_id : primal::block_of(lm, {primal::ElementKind::Tet, carved_from});
     for (const auto& h : ref(b).tpl.hex.hexes) {
       std::array<Index, 8> o{};
       for (int c = 0; c < 8; ++c) o[c] = inst_global_[b][h[c]];
-      hexes.push_back(o), block.push_back(kGeodeBlock);
+      hexes.push_back(o), block.push_back(id);
     }
-  for (const auto& h : diced_.tet_children) hexes.push_back(h), block.push_back(kDicedTetBlock);
+  }
+  for (std::size_t k = 0; k < diced_.tet_children.size(); ++k)
+    hexes.push_back(diced_.tet_children[k]),
+        block.push_back(primal::block_of(lm, {primal::ElementKind::Tet, diced_.tet_parent[k]}));
   inst_global_ = {};
   std::vector<Index> renum(diced_.points.size(), kInvalidIndex);
   mesh_.points.reserve(diced_.points.size());
@@ -337,24 +367,22 @@ void Conformer::verify() {
     if (inverted_.size() > 20) m << " ...";
     res_.warnings.push_back(m.str());
   }
-  for (const auto& [id, name] : kBlocks) {
-    std::vector<Index> sel;
-    for (std::size_t h = 0; h < mesh_.hexes.size(); ++h)
-      if (mesh_.block[h] == id) sel.push_back(static_cast<Index>(h));
-    if (sel.empty()) continue;
-    constexpr std::array<primal::HexMetric, 1> kCheap{primal::HexMetric::kScaledJacobian};
-    res_.quality.push_back(
-        {id, name,
-         options_.quality == ConformQuality::kFull
-             ? primal::hex_quality_report(mesh_, sel)
-             : primal::hex_quality_report(mesh_, sel, kCheap)});
+  std::map<int, std::vector<Index>> members;  // output block -> its hexes, ascending id
+  for (std::size_t h = 0; h < mesh_.hexes.size(); ++h) members[mesh_.block[h]].push_back(static_cast<Index>(h));
+  constexpr std::array<primal::HexMetric, 1> kCheap{primal::HexMetric::kScaledJacobian};
+  for (const auto& [id, sel] : members) {
+    const auto name = blocks_.names.find(id);
+    res_.quality.push_back({id, name != blocks_.names.end() ? name->second : "block " + std::to_string(id),
+                            options_.quality == ConformQuality::kFull ? primal::hex_quality_report(mesh_, sel)
+                                                                      : primal::hex_quality_report(mesh_, sel, kCheap)});
   }
   say("verification: " + std::string(res_.validity.ok() ? "valid" : "INVALID") + took());
 }
 
 void Conformer::output() {
   primal::Model& out = res_.model;
-  for (const auto& [id, name] : kBlocks) out.block_names[id] = name;
+  for (const BlockQuality& q : res_.quality)
+    if (auto it = blocks_.names.find(q.block); it != blocks_.names.end()) out.block_names.insert(*it);
   out.hex_block = std::move(mesh_.block);
   out.hexes = std::move(mesh_.hexes);
   out.points = std::move(mesh_.points);

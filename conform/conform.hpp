@@ -55,17 +55,15 @@ struct ConformOptions {
     o.target = 0.5;
     return o;
   }();
+  // Empty: geode hexes go to the tet-side block they were carved from (an analyst's material).
+  // A name: they get a block of their own with that name, id one above every input block id.
+  std::string geode_block;
   // Called with one line per stage (for the command line's progress output); may be empty.
   std::function<void(const std::string&)> progress;
   // Called after each round of smoothing with (seed hexes settled, seed hexes), for a progress
   // bar; when empty, `progress` gets a line every few seconds instead.
   std::function<void(std::size_t done, std::size_t total)> smoothing_progress;
 };
-
-// Output element blocks, by origin.
-inline constexpr int kDicedHexBlock = 1;
-inline constexpr int kGeodeBlock = 2;
-inline constexpr int kDicedTetBlock = 3;
 
 struct BlockQuality {
   int block = 0;
@@ -74,8 +72,10 @@ struct BlockQuality {
 };
 
 struct ConformResult {
-  // All-hex model: hexes grouped by block (diced hexes, geode hexes, diced tets, ascending id),
-  // block names "diced hex", "geode", "diced tet". Node sets: every input node of the set plus
+  // All-hex model: hexes by origin (diced_hexes diced hexes, geode_hexes geode hexes, 26 per
+  // interface quad in Interface order, diced_tet_hexes diced tets), each in an input block:
+  // a diced hex or tet in its parent's, a geode hex in that of the tet its buffer hex was
+  // carved from (or ConformOptions::geode_block); input block names kept. Node sets: every input node of the set plus
   // the diced edge / face nodes whose origin nodes are all in the set. Side sets: every input
   // side becomes the diced children's faces lying on it (4 per hex face, 3 per tet face).
   primal::Model model;
@@ -86,7 +86,7 @@ struct ConformResult {
   double min_scaled_jacobian_before_smoothing = 0.0;
   primal::LocalSmoothResult smoothing;  // zero-initialised when ConformSmooth::kNone
   primal::HexValidityReport validity;
-  std::vector<BlockQuality> quality;  // one per non-empty block (ConformOptions::quality)
+  std::vector<BlockQuality> quality;  // one per output block, ascending id ("block N" unnamed); ConformOptions::quality
   std::vector<std::string> warnings;  // e.g. "3 hexes with scaled Jacobian <= 0: 12 40 ..."
   double seconds = 0.0;
 };

@@ -262,6 +262,10 @@ void write_exodus(const Model& model, const std::filesystem::path& path) {
       }
       check(ex_put_coord(exo, x.data(), y.data(), z.data()), target, "writing coordinates");
     }
+    // Post-processors (ParaView, Cubit) label the axes by these names; empty ones show as blanks.
+    char cx[] = "x", cy[] = "y", cz[] = "z";
+    char* coordinate_names[] = {cx, cy, cz};
+    check(ex_put_coord_names(exo, coordinate_names), target, "writing coordinate names");
     NameBuffers block_names(blocks.size());
     std::size_t b = 0;
     for (const auto& [id, members] : blocks) {

@@ -235,7 +235,8 @@ Model read_gmsh(const std::filesystem::path& path, const ReadOptions& options) {
   return parse_gmsh(read_file_bytes(path), path.string(), options);
 }
 
-void write_gmsh(const Model& model, const std::filesystem::path& path, GmshFormat format) {
+void write_gmsh(const Model& model, const std::filesystem::path& path, GmshFormat format,
+                GmshVersion version) {
   const std::string target = path.string();
   validate(model, target);
   GmshSession session;
@@ -348,7 +349,7 @@ void write_gmsh(const Model& model, const std::filesystem::path& path, GmshForma
         gmsh::model::setPhysicalName(0, set.id, set.name);
       }
 
-      gmsh::option::setNumber("Mesh.MshFileVersion", 4.1);
+      gmsh::option::setNumber("Mesh.MshFileVersion", version == GmshVersion::k22 ? 2.2 : 4.1);
       gmsh::option::setNumber("Mesh.Binary", format == GmshFormat::Binary ? 1 : 0);
       gmsh::option::setNumber("Mesh.SaveAll", 1);
       gmsh::write(temp.string());

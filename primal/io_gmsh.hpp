@@ -31,6 +31,8 @@ inline constexpr std::array<int, 8> kGmshHexToVtk{0, 1, 2, 3, 4, 5, 6, 7};
 inline constexpr std::array<int, 4> kGmshTetToVtk{0, 1, 2, 3};
 
 enum class GmshFormat { Ascii, Binary };
+// MSH 4.1 (Gmsh 4's own) or 2.2 (what older solvers' readers and converters still expect).
+enum class GmshVersion { k41, k22 };
 
 // Reads a .msh file, version 2.2 or 4.1, ASCII or binary. Node and element tags become the
 // model's file ids. Throws InvalidInput naming the file, the line (byte in binary files) or
@@ -43,10 +45,12 @@ Model read_gmsh(const std::filesystem::path& path, const ReadOptions& options = 
 // The same on a file's content; `source` names it in messages.
 Model parse_gmsh(std::string_view content, const std::string& source, const ReadOptions& options = {});
 
-// Writes .msh v4.1 atomically (a temporary file in the same directory, then rename). Block ids
-// must be positive; a block may hold both hexes and tets.
+// Writes .msh (v4.1 or 2.2) atomically (a temporary file in the same directory, then rename).
+// Block ids must be positive; a block may hold both hexes and tets. Blocks become physical
+// volumes, side sets physical surfaces (their faces as triangles / quads), node sets physical
+// points, each with its id and name.
 void write_gmsh(const Model& model, const std::filesystem::path& path,
-                GmshFormat format = GmshFormat::Ascii);
+                GmshFormat format = GmshFormat::Ascii, GmshVersion version = GmshVersion::k41);
 
 // RAII: initializes the Gmsh API (no config files, General.Terminal = 0) and finalizes it on
 // destruction. Gmsh's state is global: do not nest sessions or use them from several threads.

@@ -2,6 +2,9 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <cstring>
 #include <charconv>
 #include <cmath>
 #include <cstring>
@@ -69,39 +72,50 @@ int cell_type_size(int type) {
   }
 }
 
-// What the writers emit, built once per call from the mesh.
+// What the writers emit, built once per call from the mesh: cells of one or more types.
 struct Grid {
   const std::vector<Point>* points = nullptr;
-  int cell_type = 0;
-  int corners = 0;
+  std::vector<std::uint8_t> types;  // per cell
+  std::vector<Index> offsets;       // per cell: one past its last corner in `connectivity`
   std::vector<Index> connectivity;  // corners per cell, flattened
   VtkCellData data;
+  std::map<int, std::string> block_names;  // written as field data (a Model's named blocks)
+  std::size_t cells() const { return types.size(); }
 };
 
+// Appends `cells` of VTK type `type`, checking node numbers (named 1-based in messages).
 template <std::size_t N>
-Grid make_grid(const std::filesystem::path& path, const std::vector<Point>& points,
-               const std::vector<std::array<Index, N>>& cells, int type,
-               const std::vector<int>& block, std::vector<double> scaled_jacobian,
-               const VtkCellData& extra) {
-  const std::string file = path.string();
+void add_cells(Grid& g, const std::string& file, const std::vector<std::array<Index, N>>& cells,
+               int type) {
+  const std::size_t np = g.points->size();
+  for (std::size_t c = 0; c < cells.size(); ++c) {
+    for (Index v : cells[c]) {
+      if (v < 0 || static_cast<std::size_t>(v) >= np) {
+        throw InvalidInput(file + ": " + cell_type_name(type) + " " + std::to_string(c + 1) +
+                           ": node " + std::to_string(v + 1) + " out of range [1, " +
+                           std::to_string(np) + "]");
+      }
+      g.connectivity.push_back(v);
+    }
+    g.types.push_back(static_cast<std::uint8_t>(type));
+    g.offsets.push_back(static_cast<Index>(g.connectivity.size()));
+  }
+}
+
+Grid start_grid(const std::string& file, const std::vector<Point>& points) {
   for (std::size_t i = 0; i < points.size(); ++i) {
     if (!points[i].allFinite()) {
-      throw InvalidInput(file + ": point " + std::to_string(i) + " has a non-finite coordinate");
+      throw InvalidInput(file + ": node " + std::to_string(i + 1) + " has a non-finite coordinate");
     }
   }
   Grid g;
   g.points = &points;
-  g.cell_type = type;
-  g.corners = static_cast<int>(N);
-  for (std::size_t c = 0; c < cells.size(); ++c) {
-    for (Index v : cells[c]) {
-      if (v < 0 || static_cast<std::size_t>(v) >= points.size()) {
-        throw InvalidInput(file + ": element " + std::to_string(c) + ": node " + std::to_string(v) +
-                           " out of range [0, " + std::to_string(points.size()) + ")");
-      }
-      g.connectivity.push_back(v);
-    }
-  }
+  return g;
+}
+
+// The standard arrays, then the caller's; names and lengths checked.
+void finish_grid(Grid& g, const std::string& file, std::vector<double> scaled_jacobian,
+                 const std::vector<int>& block, const VtkCellData& extra) {
   g.data.doubles.emplace_back("scaled_jacobian", std::move(scaled_jacobian));
   if (!block.empty()) g.data.ints.emplace_back("block", block);
   for (const auto& a : extra.doubles) g.data.doubles.push_back(a);
@@ -119,49 +133,81 @@ Grid make_grid(const std::filesystem::path& path, const std::vector<Point>& poin
       throw InvalidInput(file + ": cell array '" + name + "' given twice");
     }
     names.push_back(name);
-    if (size != cells.size()) {
+    if (size != g.cells()) {
       throw InvalidInput(file + ": cell array '" + name + "' has " + std::to_string(size) +
-                         " values for " + std::to_string(cells.size()) + " cells");
+                         " values for " + std::to_string(g.cells()) + " cells");
     }
   };
   for (const auto& [name, v] : g.data.doubles) check(name, v.size());
   for (const auto& [name, v] : g.data.ints) check(name, v.size());
+}
+
+// Verdict scaled Jacobian per cell, 0 for a cell with a node out of range (reported later).
+template <std::size_t N, class F>
+void append_quality(std::vector<double>& sj, const std::vector<Point>& pts,
+                    const std::vector<std::array<Index, N>>& cells, F&& metric) {
+  for (const auto& c : cells) {
+    const bool in_range = std::all_of(c.begin(), c.end(), [&](Index v) {
+      return v >= 0 && static_cast<std::size_t>(v) < pts.size();
+    });
+    if (!in_range) {
+      sj.push_back(0.0);
+      continue;
+    }
+    std::array<Point, N> p;
+    for (std::size_t k = 0; k < N; ++k) p[k] = pts[static_cast<std::size_t>(c[k])];
+    sj.push_back(metric(p));
+  }
+}
+
+double hex_sj(const std::array<Point, 8>& p) { return hex_scaled_jacobian(p); }
+double tet_sj(const std::array<Point, 4>& p) { return tet_scaled_jacobian(p[0], p[1], p[2], p[3]); }
+double quad_sj(const std::array<Point, 4>& p) { return quad_scaled_jacobian(p); }
+
+// A mesh of one cell type.
+template <std::size_t N, class Metric>
+Grid single_type_grid(const std::filesystem::path& path, const std::vector<Point>& points,
+                      const std::vector<std::array<Index, N>>& cells, int type, Metric&& metric,
+                      const std::vector<int>& block, const VtkCellData& extra) {
+  const std::string file = path.string();
+  Grid g = start_grid(file, points);
+  add_cells(g, file, cells, type);
+  std::vector<double> sj;
+  append_quality(sj, points, cells, metric);
+  finish_grid(g, file, std::move(sj), block, extra);
   return g;
 }
 
 Grid grid_of(const std::filesystem::path& path, const HexMesh& m, const VtkCellData& extra) {
-  std::vector<double> sj;
-  for (std::size_t h = 0; h < m.hexes.size(); ++h) {
-    bool in_range = std::all_of(m.hexes[h].begin(), m.hexes[h].end(), [&](Index v) {
-      return v >= 0 && static_cast<std::size_t>(v) < m.points.size();
-    });
-    sj.push_back(in_range ? hex_scaled_jacobian(hex_corners(m, static_cast<Index>(h))) : 0.0);
-  }
-  return make_grid(path, m.points, m.hexes, kVtkHexahedron, m.block, std::move(sj), extra);
+  return single_type_grid(path, m.points, m.hexes, kVtkHexahedron, hex_sj, m.block, extra);
 }
 
 Grid grid_of(const std::filesystem::path& path, const TetMesh& m, const VtkCellData& extra) {
-  std::vector<double> sj;
-  for (const auto& t : m.tets) {
-    bool in_range = std::all_of(t.begin(), t.end(), [&](Index v) {
-      return v >= 0 && static_cast<std::size_t>(v) < m.points.size();
-    });
-    sj.push_back(in_range ? tet_scaled_jacobian(m.points[t[0]], m.points[t[1]], m.points[t[2]],
-                                                m.points[t[3]])
-                          : 0.0);
-  }
-  return make_grid(path, m.points, m.tets, kVtkTetra, m.block, std::move(sj), extra);
+  return single_type_grid(path, m.points, m.tets, kVtkTetra, tet_sj, m.block, extra);
 }
 
 Grid grid_of(const std::filesystem::path& path, const QuadMesh& m, const VtkCellData& extra) {
+  return single_type_grid(path, m.points, m.quads, kVtkQuad, quad_sj, {}, extra);
+}
+
+// A model: hexes then tets, each with its element block (block_of).
+Grid grid_of(const std::filesystem::path& path, const Model& m, const VtkCellData& extra) {
+  const std::string file = path.string();
+  validate(m, file);
+  Grid g = start_grid(file, m.points);
+  add_cells(g, file, m.hexes, kVtkHexahedron);
+  add_cells(g, file, m.tets, kVtkTetra);
   std::vector<double> sj;
-  for (std::size_t q = 0; q < m.quads.size(); ++q) {
-    bool in_range = std::all_of(m.quads[q].begin(), m.quads[q].end(), [&](Index v) {
-      return v >= 0 && static_cast<std::size_t>(v) < m.points.size();
-    });
-    sj.push_back(in_range ? quad_scaled_jacobian(quad_corners(m, static_cast<Index>(q))) : 0.0);
-  }
-  return make_grid(path, m.points, m.quads, kVtkQuad, {}, std::move(sj), extra);
+  append_quality(sj, m.points, m.hexes, hex_sj);
+  append_quality(sj, m.points, m.tets, tet_sj);
+  std::vector<int> block;
+  for (std::size_t h = 0; h < m.hexes.size(); ++h)
+    block.push_back(block_of(m, {ElementKind::Hex, static_cast<Index>(h)}));
+  for (std::size_t t = 0; t < m.tets.size(); ++t)
+    block.push_back(block_of(m, {ElementKind::Tet, static_cast<Index>(t)}));
+  finish_grid(g, file, std::move(sj), block, extra);
+  g.block_names = m.block_names;
+  return g;
 }
 
 // Shortest text that reads back to the same double.
@@ -207,50 +253,92 @@ void write_values(std::ostream& os, const std::vector<T>& v, std::size_t per_lin
   }
 }
 
-void write_vtu_grid(std::ostream& os, const Grid& g) {
+// Base64 (RFC 4648) of a byte string, as VTK's XML "binary" format wants it.
+std::string base64(const std::string& bytes) {
+  static constexpr char kDigits[] =
+      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((bytes.size() + 2) / 3 * 4);
+  std::size_t i = 0;
+  for (; i + 2 < bytes.size(); i += 3) {
+    const auto b = (static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[i])) << 16) |
+                   (static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[i + 1])) << 8) |
+                   static_cast<unsigned char>(bytes[i + 2]);
+    out += kDigits[(b >> 18) & 63], out += kDigits[(b >> 12) & 63];
+    out += kDigits[(b >> 6) & 63], out += kDigits[b & 63];
+  }
+  if (i < bytes.size()) {
+    auto b = static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[i])) << 16;
+    if (i + 1 < bytes.size()) b |= static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[i + 1])) << 8;
+    out += kDigits[(b >> 18) & 63], out += kDigits[(b >> 12) & 63];
+    out += i + 1 < bytes.size() ? kDigits[(b >> 6) & 63] : '=';
+    out += '=';
+  }
+  return out;
+}
+
+// One DataArray: ASCII rows of `per_line`, or (binary) base64 of a UInt64 byte count followed
+// by the little-endian values, the layout VTK writes for uncompressed inline binary data.
+template <typename Out, typename T, typename F>
+void write_data_array(std::ostream& os, VtuEncoding encoding, const char* type,
+                      const std::string& attributes, const std::vector<T>& v,
+                      std::size_t per_line, F&& fmt) {
+  static_assert(std::endian::native == std::endian::little, "binary .vtu is written little-endian");
+  os << "        <DataArray type=\"" << type << "\"" << attributes << " format=\""
+     << (encoding == VtuEncoding::kAscii ? "ascii" : "binary") << "\">\n";
+  if (encoding == VtuEncoding::kAscii) {
+    write_values(os, v, per_line, "          ", fmt);
+  } else {
+    std::string bytes(sizeof(std::uint64_t) + v.size() * sizeof(Out), '\0');
+    const std::uint64_t n = v.size() * sizeof(Out);
+    std::memcpy(bytes.data(), &n, sizeof n);
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      const Out x = static_cast<Out>(v[i]);
+      std::memcpy(bytes.data() + sizeof n + i * sizeof(Out), &x, sizeof x);
+    }
+    os << "          " << base64(bytes) << "\n";
+  }
+  os << "        </DataArray>\n";
+}
+
+void write_vtu_grid(std::ostream& os, const Grid& g, VtuEncoding encoding) {
   const auto& pts = *g.points;
-  const std::size_t ncells = g.connectivity.size() / static_cast<std::size_t>(g.corners);
-  const char* ind = "          ";
   os << "<?xml version=\"1.0\"?>\n"
-     << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-     << "  <UnstructuredGrid>\n"
-     << "    <Piece NumberOfPoints=\"" << pts.size() << "\" NumberOfCells=\"" << ncells << "\">\n"
-     << "      <Points>\n"
-     << "        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-  for (const auto& p : pts) {
-    os << ind << format_double(p.x()) << ' ' << format_double(p.y()) << ' ' << format_double(p.z())
-       << '\n';
+     << "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\""
+     << (encoding == VtuEncoding::kAscii ? "" : " header_type=\"UInt64\"") << ">\n"
+     << "  <UnstructuredGrid>\n";
+  // Block names, which the cell array "block" cannot carry: one-value field arrays
+  // "block:NAME" holding the block id (ParaView lists them under Field Data).
+  if (!g.block_names.empty()) {
+    os << "    <FieldData>\n";
+    for (const auto& [id, name] : g.block_names)
+      os << "      <DataArray type=\"Int32\" Name=\"block:" << xml_escape(name)
+         << "\" NumberOfTuples=\"1\" format=\"ascii\">" << id << "</DataArray>\n";
+    os << "    </FieldData>\n";
   }
-  os << "        </DataArray>\n"
-     << "      </Points>\n"
-     << "      <Cells>\n"
-     << "        <DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">\n";
-  write_values(os, g.connectivity, static_cast<std::size_t>(g.corners), ind,
-               [](Index v) { return v; });
-  os << "        </DataArray>\n"
-     << "        <DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">\n";
-  std::vector<long> offsets(ncells);
-  for (std::size_t c = 0; c < ncells; ++c)
-    offsets[c] = static_cast<long>((c + 1) * static_cast<std::size_t>(g.corners));
-  write_values(os, offsets, 10, ind, [](long v) { return v; });
-  os << "        </DataArray>\n"
-     << "        <DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
-  write_values(os, std::vector<int>(ncells, g.cell_type), 20, ind, [](int v) { return v; });
-  os << "        </DataArray>\n"
-     << "      </Cells>\n"
+  os << "    <Piece NumberOfPoints=\"" << pts.size() << "\" NumberOfCells=\"" << g.cells() << "\">\n"
+     << "      <Points>\n";
+  std::vector<double> xyz;
+  xyz.reserve(3 * pts.size());
+  for (const auto& p : pts) xyz.insert(xyz.end(), {p.x(), p.y(), p.z()});
+  write_data_array<double>(os, encoding, "Float64", " NumberOfComponents=\"3\"", xyz, 3,
+                           format_double);
+  os << "      </Points>\n"
+     << "      <Cells>\n";
+  auto integer = [](auto v) { return static_cast<long long>(v); };
+  // Int32 like Index: node numbers fit, and half the bytes of Int64.
+  write_data_array<std::int32_t>(os, encoding, "Int32", " Name=\"connectivity\"", g.connectivity, 8,
+                                 integer);
+  write_data_array<std::int32_t>(os, encoding, "Int32", " Name=\"offsets\"", g.offsets, 10, integer);
+  write_data_array<std::uint8_t>(os, encoding, "UInt8", " Name=\"types\"", g.types, 20, integer);
+  os << "      </Cells>\n"
      << "      <CellData Scalars=\"scaled_jacobian\">\n";
-  for (const auto& [name, v] : g.data.doubles) {
-    os << "        <DataArray type=\"Float64\" Name=\"" << xml_escape(name)
-       << "\" format=\"ascii\">\n";
-    write_values(os, v, 6, ind, format_double);
-    os << "        </DataArray>\n";
-  }
-  for (const auto& [name, v] : g.data.ints) {
-    os << "        <DataArray type=\"Int32\" Name=\"" << xml_escape(name)
-       << "\" format=\"ascii\">\n";
-    write_values(os, v, 10, ind, [](int x) { return x; });
-    os << "        </DataArray>\n";
-  }
+  for (const auto& [name, v] : g.data.doubles)
+    write_data_array<double>(os, encoding, "Float64", " Name=\"" + xml_escape(name) + "\"", v, 6,
+                             format_double);
+  for (const auto& [name, v] : g.data.ints)
+    write_data_array<std::int32_t>(os, encoding, "Int32", " Name=\"" + xml_escape(name) + "\"", v, 10,
+                                   integer);
   os << "      </CellData>\n"
      << "    </Piece>\n"
      << "  </UnstructuredGrid>\n"
@@ -259,7 +347,7 @@ void write_vtu_grid(std::ostream& os, const Grid& g) {
 
 void write_vtk_grid(std::ostream& os, const Grid& g) {
   const auto& pts = *g.points;
-  const std::size_t ncells = g.connectivity.size() / static_cast<std::size_t>(g.corners);
+  const std::size_t ncells = g.cells();
   os << "# vtk DataFile Version 4.2\n"
      << "geode mesh\n"
      << "ASCII\n"
@@ -269,16 +357,16 @@ void write_vtk_grid(std::ostream& os, const Grid& g) {
     os << format_double(p.x()) << ' ' << format_double(p.y()) << ' ' << format_double(p.z())
        << '\n';
   }
-  os << "CELLS " << ncells << ' ' << ncells * static_cast<std::size_t>(g.corners + 1) << '\n';
+  os << "CELLS " << ncells << ' ' << ncells + g.connectivity.size() << '\n';
+  Index begin = 0;
   for (std::size_t c = 0; c < ncells; ++c) {
-    os << g.corners;
-    for (int k = 0; k < g.corners; ++k)
-      os << ' '
-         << g.connectivity[c * static_cast<std::size_t>(g.corners) + static_cast<std::size_t>(k)];
+    os << g.offsets[c] - begin;
+    for (Index k = begin; k < g.offsets[c]; ++k) os << ' ' << g.connectivity[static_cast<std::size_t>(k)];
     os << '\n';
+    begin = g.offsets[c];
   }
   os << "CELL_TYPES " << ncells << '\n';
-  for (std::size_t c = 0; c < ncells; ++c) os << g.cell_type << '\n';
+  for (std::size_t c = 0; c < ncells; ++c) os << static_cast<int>(g.types[c]) << '\n';
   os << "CELL_DATA " << ncells << '\n';
   for (const auto& [name, v] : g.data.doubles) {
     os << "SCALARS " << name << " double 1\nLOOKUP_TABLE default\n";
@@ -773,18 +861,21 @@ bool is_int_type(const std::string& t) {
 
 // ---- Writers ----------------------------------------------------------------------------------
 
-#define GEODE_VTK_WRITER(fn, writer, Mesh)                                                 \
-  void fn(const std::filesystem::path& path, const Mesh& mesh, const VtkCellData& extra) { \
-    const Grid g = grid_of(path, mesh, extra);                                             \
-    write_file_atomically(path, [&](std::ostream& os) { writer(os, g); });                 \
+#define GEODE_VTK_WRITERS(Mesh)                                                             \
+  void write_vtu(const std::filesystem::path& path, const Mesh& mesh, const VtkCellData& extra, \
+                 VtuEncoding encoding) {                                                       \
+    const Grid g = grid_of(path, mesh, extra);                                                 \
+    write_file_atomically(path, [&](std::ostream& os) { write_vtu_grid(os, g, encoding); });   \
+  }                                                                                            \
+  void write_vtk(const std::filesystem::path& path, const Mesh& mesh, const VtkCellData& extra) { \
+    const Grid g = grid_of(path, mesh, extra);                                                 \
+    write_file_atomically(path, [&](std::ostream& os) { write_vtk_grid(os, g); });             \
   }
-GEODE_VTK_WRITER(write_vtu, write_vtu_grid, HexMesh)
-GEODE_VTK_WRITER(write_vtu, write_vtu_grid, TetMesh)
-GEODE_VTK_WRITER(write_vtu, write_vtu_grid, QuadMesh)
-GEODE_VTK_WRITER(write_vtk, write_vtk_grid, HexMesh)
-GEODE_VTK_WRITER(write_vtk, write_vtk_grid, TetMesh)
-GEODE_VTK_WRITER(write_vtk, write_vtk_grid, QuadMesh)
-#undef GEODE_VTK_WRITER
+GEODE_VTK_WRITERS(HexMesh)
+GEODE_VTK_WRITERS(TetMesh)
+GEODE_VTK_WRITERS(QuadMesh)
+GEODE_VTK_WRITERS(Model)
+#undef GEODE_VTK_WRITERS
 
 // ---- .vtu reader ------------------------------------------------------------------------------
 

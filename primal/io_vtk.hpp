@@ -1,8 +1,8 @@
 #pragma once
 // VTK output for viewers (ParaView, VisIt) and reading it back: XML unstructured grid (.vtu,
-// ASCII DataArrays) and legacy (.vtk, "# vtk DataFile Version 4.2": the classic CELLS n size
+// ASCII or base64 binary DataArrays) and legacy (.vtk, "# vtk DataFile Version 4.2": the classic CELLS n size
 // layout every legacy reader since VTK 4 opens, without the 5.1 OFFSETS/CONNECTIVITY form).
-// Hexes, tets and quads (quads as VTK_QUAD in 3D space). Writes are atomic
+// Hexes, tets and quads (quads as VTK_QUAD in 3D space), or a whole Model (hexes and tets). Writes are atomic
 // (primal/atomic_file.hpp): a failure leaves no half-written file.
 //
 // Every written grid carries the cell arrays "scaled_jacobian" ([Verdict] hex, tet or quad
@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "primal/mesh.hpp"
+#include "primal/model.hpp"
 
 namespace geode::primal {
 
@@ -33,20 +34,30 @@ struct VtkCellData {
   const std::vector<int>* find_int(const std::string& name) const;
 };
 
-// Throw geode::InvalidInput (naming the file and the array, node or element) for an array of
-// the wrong length, a bad or repeated name, a node number out of range, a non-finite point,
-// or a file that cannot be written.
+// How a .vtu stores its DataArrays: ASCII text, or "binary" (base64 of a UInt64 byte count and
+// the little-endian values; header_type="UInt64"), which ParaView, VTK and meshio read: exact
+// doubles without printing and parsing them as text.
+enum class VtuEncoding { kAscii, kBinary };
+
+// Throw geode::InvalidInput (naming the file and the array, or the node or element by its
+// 1-based number) for an array of the wrong length, a bad or repeated name, a node number out of
+// range, a non-finite point, or a file that cannot be written. A Model is written with its hexes
+// then its tets, the cell array "block" holding each element's block (block_of).
 void write_vtu(const std::filesystem::path& path, const HexMesh& mesh,
-               const VtkCellData& extra = {});
+               const VtkCellData& extra = {}, VtuEncoding encoding = VtuEncoding::kAscii);
 void write_vtu(const std::filesystem::path& path, const TetMesh& mesh,
-               const VtkCellData& extra = {});
+               const VtkCellData& extra = {}, VtuEncoding encoding = VtuEncoding::kAscii);
 void write_vtu(const std::filesystem::path& path, const QuadMesh& mesh,
-               const VtkCellData& extra = {});
+               const VtkCellData& extra = {}, VtuEncoding encoding = VtuEncoding::kAscii);
+void write_vtu(const std::filesystem::path& path, const Model& model,
+               const VtkCellData& extra = {}, VtuEncoding encoding = VtuEncoding::kAscii);
 void write_vtk(const std::filesystem::path& path, const HexMesh& mesh,
                const VtkCellData& extra = {});
 void write_vtk(const std::filesystem::path& path, const TetMesh& mesh,
                const VtkCellData& extra = {});
 void write_vtk(const std::filesystem::path& path, const QuadMesh& mesh,
+               const VtkCellData& extra = {});
+void write_vtk(const std::filesystem::path& path, const Model& model,
                const VtkCellData& extra = {});
 
 // An unstructured grid as read: points, cells (VTK corner order) and cell arrays.

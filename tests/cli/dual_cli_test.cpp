@@ -38,7 +38,7 @@ TEST_CASE("geode dual: sheets and triples of a grid, and its rebuild") {
   const auto in = temp_path("grid.vtu"), out = temp_path("grid-rebuilt.vtu");
   const primal::HexMesh g = moved_grid();
   primal::write_vtu(in, g);
-  const auto r = geode_cli("dual " + in.string() + " --format json --rebuild " + out.string());
+  const auto r = geode_cli("dual " + in.string() + " --format json --vtu-encoding ascii --rebuild " + out.string());
   REQUIRE(r.code == 0);
   const auto j = nlohmann::json::parse(r.out);
   CHECK(j["cells"] == 12);

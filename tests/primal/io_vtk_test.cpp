@@ -327,11 +327,11 @@ TEST_CASE("io_vtk: writes are atomic and check their input") {
   SUBCASE("bad meshes are refused") {
     HexMesh nan = m;
     nan.points[2].x() = std::nan("");
-    CHECK_THROWS_WITH_AS(write_vtu(file, nan), doctest::Contains("point 2 has a non-finite"),
+    CHECK_THROWS_WITH_AS(write_vtu(file, nan), doctest::Contains("node 3 has a non-finite"),
                          geode::InvalidInput);
     HexMesh out = m;
     out.hexes[3][5] = 77;
-    CHECK_THROWS_WITH_AS(write_vtk(file, out), doctest::Contains("element 3: node 77 out of range"),
+    CHECK_THROWS_WITH_AS(write_vtk(file, out), doctest::Contains("hexahedron 4: node 78 out of range"),
                          geode::InvalidInput);
     CHECK(slurp(file) == before);
   }

@@ -1,0 +1,213 @@
+// Conventions shared by every command (cli/conventions.hpp).
+#include "cli/conventions.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <optional>
+#include <sstream>
+
+#include "cli/commands.hpp"
+#include "primal/errors.hpp"
+#include "primal/io_exodus.hpp"
+#include "primal/io_gmsh.hpp"
+
+#ifndef GEODE_VERSION
+#define GEODE_VERSION "unknown"
+#endif
+
+namespace geode::cli {
+
+namespace fs = std::filesystem;
+
+std::string version_text() { return std::string("geode ") + GEODE_VERSION; }
+
+namespace {
+
+// Shortest text of a limit for messages ("64", "1e+06").
+std::string short_number(double x) {
+  std::ostringstream s;
+  s << x;
+  return s.str();
+}
+
+// The whole text as a finite double, or nothing.
+std::optional<double> finite_number(const std::string& text) {
+  double x = 0;
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, x);
+  if (ec != std::errc() || ptr != end || !std::isfinite(x)) return std::nullopt;
+  return x;
+}
+
+struct FormatInfo {
+  const char* name;
+  std::vector<std::string> extensions;
+  bool mesh;
+};
+
+const std::vector<FormatInfo>& formats() {
+  static const std::vector<FormatInfo> table{
+      {"exo", {".exo", ".e"}, true},  {"msh", {".msh"}, true},    {"msh22", {".msh"}, true},
+      {"vtu", {".vtu"}, true},        {"vtk", {".vtk"}, true},    {"json", {".json"}, false},   {"spec", {".json"}, false},
+      {"csv", {".csv"}, false},       {"appendix", {".txt"}, false}, {"text", {".txt"}, false},
+      {"html", {".html", ".htm"}, false}};
+  return table;
+}
+
+const FormatInfo* find_format(const std::string& name) {
+  for (const auto& f : formats())
+    if (name == f.name) return &f;
+  return nullptr;
+}
+
+std::string join(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
+  return s;
+}
+
+}  // namespace
+
+CLI::Validator number_check(double lo, double hi, bool integer) {
+  return CLI::Validator(
+      [lo, hi, integer](std::string& text) -> std::string {
+        const auto x = finite_number(text);
+        if (!x) return "'" + text + "' is not a finite number";
+        if (integer && *x != std::floor(*x)) return "'" + text + "' is not a whole number";
+        if (*x < lo || *x > hi)
+          return text + " is out of range [" + short_number(lo) + ", " + short_number(hi) + "]";
+        return {};
+      },
+      integer ? "INT" : "NUMBER");
+}
+
+std::array<double, 3> parse_box(const std::string& option, const std::string& text, int dim) {
+  const std::string expected = dim == 3 ? "WIDTHxHEIGHTxDEPTH such as 24x14x24" : "WIDTHxHEIGHT such as 24x14";
+  std::vector<std::string> parts;
+  std::string part;
+  for (char c : text) {
+    if (c == 'x' || c == 'X') {
+      parts.push_back(part);
+      part.clear();
+    } else {
+      part += c;
+    }
+  }
+  parts.push_back(part);
+  if (static_cast<int>(parts.size()) != dim)
+    throw InvalidInput(option + " '" + text + "': " + std::to_string(parts.size()) + " number" +
+                       (parts.size() == 1 ? "" : "s") + " for a " + std::to_string(dim) +
+                       "D template; expected " + expected);
+  std::array<double, 3> box{};
+  for (int a = 0; a < dim; ++a) {
+    const auto x = finite_number(parts[static_cast<std::size_t>(a)]);
+    if (!x)
+      throw InvalidInput(option + " '" + text + "': '" + parts[static_cast<std::size_t>(a)] +
+                         "' is not a finite number; expected " + expected);
+    if (!(*x >= 1e-6 && *x <= 1e6))
+      throw InvalidInput(option + " '" + text + "': every dimension must lie in [1e-6, 1e6]");
+    box[static_cast<std::size_t>(a)] = *x;
+  }
+  if (dim == 2) box[2] = box[0];
+  const auto [lo, hi] = std::minmax_element(box.begin(), box.begin() + dim);
+  if (*hi > 1e4 * *lo)
+    throw InvalidInput(option + " '" + text + "': degenerate box (the largest dimension is more than 1e4 times the smallest)");
+  return box;
+}
+
+bool is_mesh_format(const std::string& format) {
+  const FormatInfo* f = find_format(format);
+  return f && f->mesh;
+}
+
+std::string output_format(const std::string& path, const std::string& format,
+                          const std::vector<std::string>& allowed, const std::string& fallback) {
+  if (!format.empty() && std::find(allowed.begin(), allowed.end(), format) == allowed.end())
+    throw InvalidInput("--format " + format + ": expected one of " + join(allowed));
+  if (path.empty() || path == "-") {
+    const std::string f = format.empty() ? fallback : format;
+    if (is_mesh_format(f)) throw InvalidInput("--format " + f + " needs -o FILE");
+    return f;
+  }
+  const std::string e = file_extension(path);
+  std::vector<std::string> by_extension, extensions;
+  for (const auto& name : allowed) {
+    const FormatInfo* f = find_format(name);
+    if (!f) continue;
+    for (const auto& x : f->extensions) {
+      if (std::find(extensions.begin(), extensions.end(), x) == extensions.end()) extensions.push_back(x);
+      if (x == e) by_extension.push_back(name);
+    }
+  }
+  if (by_extension.empty()) {
+    // A text format may go to a file of any other name (report.out); a mesh needs its extension.
+    bool known_elsewhere = false;
+    for (const auto& f : formats())
+      known_elsewhere |= std::find(f.extensions.begin(), f.extensions.end(), e) != f.extensions.end();
+    if (!format.empty() && !is_mesh_format(format) && !known_elsewhere) return format;
+    throw InvalidInput(path + ": unknown output format '" + e + "' (expected " + join(extensions) + ")");
+  }
+  if (format.empty()) return by_extension.front();  // .msh: msh (4.1) before msh22
+  if (std::find(by_extension.begin(), by_extension.end(), format) == by_extension.end())
+    throw InvalidInput(path + ": --format " + format + " contradicts the extension '" + e + "' (" +
+                       join(by_extension) + ")");
+  return format;
+}
+
+void check_output_path(const std::string& path) {
+  if (path.empty() || path == "-") return;
+  const fs::path p(path);
+  std::error_code ec;
+  if (fs::is_directory(p, ec)) throw InvalidInput(path + ": is a directory, not an output file");
+  const fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
+  if (!fs::is_directory(dir, ec)) throw InvalidInput(path + ": directory " + dir.string() + " does not exist");
+  if (::access(dir.c_str(), W_OK | X_OK) != 0)
+    throw InvalidInput(path + ": directory " + dir.string() + " is not writable");
+  if (fs::exists(p, ec) && ::access(p.c_str(), W_OK) != 0)
+    throw InvalidInput(path + ": exists and is not writable");
+}
+
+void write_mesh(const primal::Model& model, const fs::path& path, const std::string& format,
+                primal::VtuEncoding vtu) {
+  if (format == "exo") return primal::write_exodus(model, path);
+  if (format == "msh") return primal::write_gmsh(model, path);
+  if (format == "msh22") return primal::write_gmsh(model, path, primal::GmshFormat::Ascii, primal::GmshVersion::k22);
+  if (format == "vtu") return primal::write_vtu(path, model, {}, vtu);
+  if (format == "vtk") return primal::write_vtk(path, model);
+  throw InvalidInput(path.string() + ": '" + format + "' is not a mesh format");
+}
+
+void OutputFiles::add(const fs::path& target, Writer write) {
+  const fs::path dir = target.parent_path();
+  const std::string name = "." + target.stem().string() + ".geode-" + std::to_string(::getpid()) + "-" +
+                           std::to_string(entries_.size()) + target.extension().string();
+  entries_.push_back({target, dir / name, std::move(write)});
+}
+
+void OutputFiles::commit() {
+  for (const Entry& e : entries_) {
+    pending_.push_back(e.temp);
+    e.write(e.temp);
+  }
+  std::vector<fs::path> renamed;
+  for (const Entry& e : entries_) {
+    std::error_code ec;
+    fs::rename(e.temp, e.target, ec);
+    if (ec) {
+      for (const auto& r : renamed) fs::remove(r, ec);
+      throw InvalidInput(e.target.string() + ": cannot write (" + ec.message() + "); nothing written");
+    }
+    renamed.push_back(e.target);
+  }
+  pending_.clear();
+}
+
+OutputFiles::~OutputFiles() {
+  std::error_code ec;
+  for (const auto& p : pending_) fs::remove(p, ec);
+}
+
+}  // namespace geode::cli

@@ -1,0 +1,93 @@
+#pragma once
+// What every `geode` command shares, so that all of them speak one way (cli/commands.hpp):
+//
+// - Exit codes: 0 done, 2 usage or input error, 3 topology refusal, 4 invalid result (main.cpp
+//   maps InvalidInput, TopologyError and InvalidResult). Every error is one line on stderr.
+// - Numbers: number_check() for every numeric option (finite, in range, one-line message);
+//   parse_box() for WIDTHxHEIGHT[xDEPTH] with the dimension count the command needs.
+// - Outputs: output_format() picks the format from the extension (a --format that contradicts
+//   it is refused), check_output_path() refuses a missing or unwritable directory before any
+//   work, OutputFiles writes several outputs as one (all or none), write_mesh() writes a model
+//   in any mesh format of the matrix below.
+//
+// Output formats (name: extensions):
+//   exo: .exo .e   msh: .msh (v4.1)   msh22: .msh (v2.2)   vtu: .vtu (binary, or --vtu-encoding
+//   ascii)   vtk: .vtk (legacy ASCII); text formats a command may add: json .json, csv .csv,
+//   appendix .txt, text .txt.
+#include <CLI/CLI.hpp>
+#include <array>
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "primal/io_vtk.hpp"
+#include "primal/model.hpp"
+
+namespace geode::cli {
+
+// The result was computed but fails verification (e.g. inverted hexes): exit 4. The message
+// is printed even with --quiet.
+struct InvalidResult : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// "geode 0.1.0" (CMake's project version).
+std::string version_text();
+
+// ---- Numbers ----------------------------------------------------------------------------------
+
+// A CLI11 check: the text is a finite number in [lo, hi] (an integer when `integer`). The
+// message is one line ("-n: 0 is out of range [1, 64]"), unlike CLI11's ranges, which print
+// the limits of double.
+CLI::Validator number_check(double lo = std::numeric_limits<double>::lowest(),
+                            double hi = std::numeric_limits<double>::max(), bool integer = false);
+
+// "24x14x24" (dim 3) or "24x14" (dim 2): exactly `dim` finite numbers, each in [1e-6, 1e6] and
+// the largest at most 1e4 times the smallest (a flatter box is degenerate for the templates).
+// InvalidInput naming `option` otherwise. A 2D box gets depth = width.
+std::array<double, 3> parse_box(const std::string& option, const std::string& text, int dim);
+
+// ---- Outputs ----------------------------------------------------------------------------------
+
+// The format of output `path`: the format its extension names among `allowed` (a given
+// `format` must agree), or `format` when the path has no known extension and `format` is a text
+// format, or `fallback` for standard output (empty path or "-"). InvalidInput (exit 2) for a
+// contradiction, an extension no allowed format has, or a mesh format without a file.
+std::string output_format(const std::string& path, const std::string& format,
+                          const std::vector<std::string>& allowed, const std::string& fallback);
+
+// Whether a format name is one of the mesh formats (exo, msh, msh22, vtu, vtk).
+bool is_mesh_format(const std::string& format);
+
+// The output can be written: not a directory, its directory exists and is writable. Call it
+// before any long work; InvalidInput naming the path otherwise. Empty and "-" pass.
+void check_output_path(const std::string& path);
+
+// Writes a model in a mesh format; `vtu` is the encoding for .vtu.
+void write_mesh(const primal::Model& model, const std::filesystem::path& path,
+                const std::string& format, primal::VtuEncoding vtu = primal::VtuEncoding::kBinary);
+
+// Several outputs written as one: each goes to a temporary file next to its target (same
+// extension, so writers that go by it still work), and only when all are written are they
+// renamed over their targets. If any write fails, every temporary is removed and nothing is
+// written; if a rename fails, the outputs already renamed are removed (never half a result).
+class OutputFiles {
+ public:
+  using Writer = std::function<void(const std::filesystem::path& temp)>;
+  void add(const std::filesystem::path& target, Writer write);
+  void commit();
+  ~OutputFiles();
+
+ private:
+  struct Entry {
+    std::filesystem::path target, temp;
+    Writer write;
+  };
+  std::vector<Entry> entries_;
+  std::vector<std::filesystem::path> pending_;  // temporaries to remove on failure
+};
+
+}  // namespace geode::cli

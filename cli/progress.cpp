@@ -1,0 +1,53 @@
+// Progress on stderr (cli/progress.hpp).
+#include "cli/progress.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <iostream>
+
+namespace geode::cli {
+
+Progress::Progress(bool quiet, bool terminal) : quiet_(quiet), terminal_(terminal) {}
+
+Progress Progress::for_stderr(bool quiet) { return Progress(quiet, ::isatty(STDERR_FILENO) == 1); }
+
+void Progress::end_bar() {
+  if (bar_drawn_) std::cerr << "\n";
+  bar_drawn_ = false;
+}
+
+void Progress::stage(const std::string& line) {
+  if (quiet_) return;
+  end_bar();
+  std::cerr << "geode: " << line << std::endl;
+}
+
+void Progress::step(const std::string& what, std::size_t done, std::size_t total) {
+  if (quiet_) return;
+  const auto now = Clock::now();
+  if (what != what_ || done == 0) {
+    end_bar();
+    what_ = what;
+    started_ = now;
+    last_ = now;
+  }
+  const bool finished = done >= total;
+  if (now - started_ < kDelay) return;  // short steps stay silent
+  const auto count = std::to_string(done) + " / " + std::to_string(total) + " " + what;
+  const auto seconds = std::chrono::duration_cast<std::chrono::seconds>(now - started_).count();
+  if (terminal_) {
+    if (!finished && bar_drawn_ && now - last_ < kRedraw) return;
+    const std::size_t width = 30, filled = total ? width * std::min(done, total) / total : width;
+    std::cerr << "\rgeode: [" << std::string(filled, '#') << std::string(width - filled, '.') << "] " << count
+              << " (" << seconds << " s)" << std::flush;
+    bar_drawn_ = true;
+    if (finished) end_bar();
+  } else {
+    if (!finished && now - last_ < kLogEvery) return;
+    std::cerr << "geode: " << count << " (" << seconds << " s)" << std::endl;
+  }
+  last_ = now;
+}
+
+}  // namespace geode::cli

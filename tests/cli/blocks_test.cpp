@@ -1,0 +1,167 @@
+// Materials survive `geode conform`: a model whose hex part is the physical volume "steel"
+// (id 7) and whose tet part is "rubber" (id 9), with a node set and a side set, comes out with
+// the same block ids and names in .exo, .msh and .vtu: diced hexes in steel, geode hexes and
+// diced tets in rubber (or the geode hexes in a block of their own with --geode-block); the
+// sets carried with their ids and names; Exodus coordinate names x, y, z.
+#include <doctest/doctest.h>
+#include <exodusII.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "primal/grid_model.hpp"
+#include "primal/io_exodus.hpp"
+#include "primal/io_gmsh.hpp"
+#include "primal/io_vtk.hpp"
+#include "primal/topology.hpp"
+#include "support/cli_run.hpp"
+
+using namespace geode;
+namespace fs = std::filesystem;
+
+namespace {
+
+// 4 x 2 x 2 unit cells, i >= 2 split into tets: 8 steel hexes, 48 rubber tets, 4 interface
+// quads. Node set 3 "clamp": the nodes at x = 0; side set 5 "load": the tet faces at x = 4.
+primal::Model steel_rubber() {
+  primal::Model m = primal::grid_model({4, 2, 2}, 1.0, [](int i, int, int) { return i >= 2; });
+  m.hex_block.assign(m.hexes.size(), 7);
+  m.tet_block.assign(m.tets.size(), 9);
+  m.block_names = {{7, "steel"}, {9, "rubber"}};
+  primal::NodeSet clamp{3, "clamp", {}};
+  for (std::size_t v = 0; v < m.points.size(); ++v)
+    if (m.points[v].x() == 0.0) clamp.nodes.push_back(static_cast<primal::Index>(v));
+  m.node_sets = {clamp};
+  primal::SideSet load{5, "load", {}};
+  for (std::size_t t = 0; t < m.tets.size(); ++t)
+    for (int f = 0; f < 4; ++f) {
+      bool on = true;
+      for (int c : primal::topology::kTetFaceCorners[static_cast<std::size_t>(f)])
+        on = on && m.points[static_cast<std::size_t>(m.tets[t][static_cast<std::size_t>(c)])].x() == 4.0;
+      if (on) load.sides.push_back({{primal::ElementKind::Tet, static_cast<primal::Index>(t)}, f});
+    }
+  m.side_sets = {load};
+  return m;
+}
+
+std::map<int, std::size_t> block_counts(const std::vector<int>& block) {
+  std::map<int, std::size_t> n;
+  for (int b : block) ++n[b];
+  return n;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// 8 hexes * 8 diced; 4 buffer hexes * 26 geode + 48 tets * 4 diced.
+const std::map<int, std::size_t> kExpected{{7, 64}, {9, 104 + 192}};
+
+// Blocks, names and both sets as conform must carry them for steel_rubber().
+void check_carried(const primal::Model& o, const primal::Model& input) {
+  CHECK(block_counts(o.hex_block) == kExpected);
+  CHECK(o.block_names == input.block_names);
+  REQUIRE(o.node_sets.size() == 1);
+  CHECK(o.node_sets[0].id == 3);
+  CHECK(o.node_sets[0].name == "clamp");
+  CHECK(o.node_sets[0].nodes.size() == 25);  // the 5 x 5 diced nodes of the face x = 0
+  REQUIRE(o.side_sets.size() == 1);
+  CHECK(o.side_sets[0].id == 5);
+  CHECK(o.side_sets[0].name == "load");
+  CHECK(o.side_sets[0].sides.size() == 24);  // 3 quads per triangle
+}
+
+}  // namespace
+
+TEST_CASE("conform carries blocks and sets: steel and rubber keep their ids and names") {
+  test::TempDir dir;
+  const primal::Model model = steel_rubber();
+  REQUIRE(model.node_sets[0].nodes.size() == 9);
+  REQUIRE(model.side_sets[0].sides.size() == 8);
+  const fs::path in = dir.path / "in.msh";
+  primal::write_gmsh(model, in);
+
+  SUBCASE(".exo") {
+    const fs::path out = dir.path / "out.exo", report = dir.path / "r.json";
+    const test::CliRun r = test::geode_cli("conform " + in.string() + " -o " + out.string() + " --report " +
+                                               report.string() + " --quiet",
+                                           true);
+    INFO(r.out);
+    REQUIRE(r.code == 0);
+    check_carried(primal::read_exodus(out), model);
+    // The report speaks per output block.
+    std::ifstream is(report);
+    const nlohmann::json j = nlohmann::json::parse(is);
+    REQUIRE(j.at("blocks").size() == 2);
+    CHECK(j.at("blocks")[0].at("id") == 7);
+    CHECK(j.at("blocks")[0].at("name") == "steel");
+    CHECK(j.at("blocks")[1].at("name") == "rubber");
+    CHECK(j.at("blocks")[1].at("quality").at("num_hexes") == 296);
+    // Coordinate names.
+    int cpu = 8, io = 0;
+    float version = 0;
+    const int exo = ex_open(out.string().c_str(), EX_READ, &cpu, &io, &version);
+    REQUIRE(exo >= 0);
+    char x[MAX_STR_LENGTH + 1] = {}, y[MAX_STR_LENGTH + 1] = {}, z[MAX_STR_LENGTH + 1] = {};
+    char* names[] = {x, y, z};
+    CHECK(ex_get_coord_names(exo, names) >= 0);
+    ex_close(exo);
+    CHECK(std::string(x) == "x");
+    CHECK(std::string(y) == "y");
+    CHECK(std::string(z) == "z");
+  }
+  SUBCASE(".msh: physical volumes, a physical surface for the side set, physical points") {
+    const fs::path out = dir.path / "out.msh";
+    REQUIRE(test::geode_cli("conform " + in.string() + " -o " + out.string() + " --quiet").code == 0);
+    check_carried(primal::read_gmsh(out), model);
+  }
+  SUBCASE(".vtu: the block cell array and the names as field data") {
+    const fs::path out = dir.path / "out.vtu";
+    REQUIRE(test::geode_cli("conform " + in.string() + " --vtu-encoding ascii -o " + out.string() + " --quiet").code == 0);
+    const primal::VtkGrid g = primal::read_vtu(out);
+    REQUIRE(g.cell_data.find_int("block") != nullptr);
+    CHECK(block_counts(*g.cell_data.find_int("block")) == kExpected);
+    const std::string xml = slurp(out);
+    CHECK(xml.find("Name=\"block:steel\" NumberOfTuples=\"1\" format=\"ascii\">7<") != std::string::npos);
+    CHECK(xml.find("Name=\"block:rubber\" NumberOfTuples=\"1\" format=\"ascii\">9<") != std::string::npos);
+  }
+  SUBCASE("--geode-block: the geode hexes in a block of their own") {
+    const fs::path out = dir.path / "out.exo";
+    REQUIRE(test::geode_cli("conform " + in.string() + " --geode-block transition -o " + out.string() + " --quiet")
+                .code == 0);
+    const primal::Model o = primal::read_exodus(out);
+    CHECK(block_counts(o.hex_block) == std::map<int, std::size_t>{{7, 64}, {9, 192}, {10, 104}});
+    CHECK(o.block_names.at(10) == "transition");
+    CHECK(o.block_names.at(7) == "steel");
+  }
+}
+
+TEST_CASE("conform: parts meshed separately get a hint, and --merge-tolerance joins them") {
+  test::TempDir dir;
+  // The tet part on nodes of its own: every interface node duplicated at the same place.
+  primal::Model m = primal::grid_model({4, 2, 2}, 1.0, [](int i, int, int) { return i >= 2; });
+  const std::size_t n = m.points.size();
+  for (std::size_t v = 0; v < n; ++v) m.points.push_back(m.points[v]);
+  for (auto& t : m.tets)
+    for (auto& v : t) v += static_cast<primal::Index>(n);
+  const fs::path in = dir.path / "in.exo", out = dir.path / "out.exo";
+  primal::write_exodus(m, in);
+  const test::CliRun r = test::geode_cli("conform " + in.string() + " -o " + out.string() + " --quiet", true);
+  INFO(r.out);
+  CHECK((r.code == 2 || r.code == 3));
+  CHECK(r.out.find("nodes lie at the same place as others") != std::string::npos);
+  CHECK(r.out.find("--merge-tolerance") != std::string::npos);
+  CHECK(!fs::exists(out));
+  const test::CliRun merged = test::geode_cli("conform " + in.string() + " --merge-tolerance 1e-9 -o " + out.string() + " --quiet", true);
+  INFO(merged.out);
+  CHECK(merged.code == 0);
+  CHECK(primal::read_exodus(out).hexes.size() == 360);
+}

@@ -1,0 +1,307 @@
+// Conventions every `geode` command follows (cli/conventions.hpp): usage errors are one line
+// with exit 2 and write nothing, numbers are validated, --version, the output format follows
+// the extension (a contradicting --format is refused), outputs are checked before any work and
+// written both or neither, an invalid result exits 4 and writes nothing unless asked.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "primal/grid_model.hpp"
+#include "primal/io_exodus.hpp"
+#include "primal/io_gmsh.hpp"
+#include "primal/io_vtk.hpp"
+#include "support/cli_run.hpp"
+
+using namespace geode;
+namespace fs = std::filesystem;
+
+namespace {
+
+using test::TempDir;
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::size_t lines(const std::string& s) { return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n')); }
+
+// 4 x 2 x 2 unit cells, cells with i >= 2 split into 6 tets: 8 hexes, 48 tets, 4 interface quads.
+primal::Model small_model() {
+  return primal::grid_model({4, 2, 2}, 1.0, [](int i, int, int) { return i >= 2; });
+}
+
+}  // namespace
+
+TEST_CASE("cli conventions: usage errors and bad numbers are one line on stderr, exit 2, nothing written") {
+  TempDir dir;
+  const std::string d = dir.path.string() + "/";
+  const fs::path in = dir.path / "in.msh";
+  primal::write_gmsh(small_model(), in);
+  struct Case {
+    std::string args;
+    std::string words;  // expected in the message
+  };
+  const std::vector<Case> cases{
+      {"", "subcommand is required"},
+      {"template", "NAME is required"},
+      {"template geode3d --bogus", "--bogus"},
+      {"template geode5d", "geode5d"},
+      {"conform", "INPUT is required"},
+      {"dual", "required"},
+      {"study", "subcommand"},
+      {"demo -n 0", "-n: 0 is out of range [1, 64]"},
+      {"demo -n 2.5", "not a whole number"},
+      {"demo -n abc", "not a finite number"},
+      {"demo --model sphere", "sphere"},
+      {"template geode3d --box 1e400x1x1", "'1e400' is not a finite number"},
+      {"template geode3d --box 1e308x14x24", "[1e-6, 1e6]"},
+      {"template geode3d --box 24x14", "2 numbers for a 3D template"},
+      {"template geode2d --box 24x14x24", "3 numbers for a 2D template"},
+      {"template geode3d --box nanx14x24", "not a finite number"},
+      {"template geode3d --box 0x14x24", "[1e-6, 1e6]"},
+      {"template geode3d --box 24x0.001x24", "degenerate box"},
+      {"template geode3d --box 24x14x", "not a finite number"},
+      {"template geode3d --high-roof nan", "--high-roof: 'nan' is not a finite number"},
+      {"template geode3d --dome-radius 1e999", "not a finite number"},
+      {"study interleave --high 1e400", "not a finite number"},
+      {"study interleave --low 2", "out of range [0, 1]"},
+      {"study shape --heights -3", "out of range"},
+      {"conform " + in.string() + " --merge-tolerance -1", "out of range"},
+      {"conform " + in.string() + " --smooth fast", "fast"},
+      // Outputs: format by extension, contradictions, unknown extensions, missing directories.
+      {"template geode3d -o " + d + "t.vtu --format csv", "--format csv contradicts the extension '.vtu'"},
+      {"template geode3d --format vtu -o " + d + "t.vtk", "--format vtu contradicts the extension '.vtk'"},
+      {"template geode3d -o " + d + "t.xyz", "unknown output format '.xyz'"},
+      {"template geode3d --format vtu", "needs -o FILE"},
+      {"template geode2d -o " + d + "t.exo", "quad mesh"},
+      {"template geode3d -o " + d + "missing/t.vtu", "does not exist"},
+      {"conform " + in.string() + " -o " + d + "out.stl", "unknown output format '.stl'"},
+      {"conform " + in.string() + " -o " + d + "out.exo --format vtu", "contradicts"},
+      {"conform " + in.string() + " -o " + d + "out.exo --report " + d + "r.txt", "JSON"},
+      {"conform " + in.string() + " -o " + d + "out.exo --report " + d + "missing/r.json", "missing"},
+      {"conform " + in.string() + " -o " + d, "is a directory"},
+      {"dual " + in.string() + " --rebuild " + d + "r.stl", "unknown output format '.stl'"},
+      {"dual " + in.string() + " -o " + d + "r.json --format text", "contradicts"},
+      {"study shape -o " + d + "h.txt", "unknown output format '.txt'"},
+  };
+  for (const Case& c : cases) {
+    CAPTURE(c.args);
+    const test::CliRun r = test::geode_cli(c.args, true);  // stdout is empty: all of it is stderr
+    INFO(r.out);
+    CHECK(r.code == 2);
+    CHECK(lines(r.out) == 1);
+    CHECK(r.out.size() < 300);  // no 300-digit ranges
+    CHECK(r.out.find(c.words) != std::string::npos);
+    CHECK(dir.entries() == 1);  // only the input
+  }
+}
+
+TEST_CASE("cli conventions: --version and --help") {
+  const test::CliRun v = test::geode_cli("--version");
+  CHECK(v.code == 0);
+  CHECK(v.out.rfind("geode ", 0) == 0);
+  CHECK(lines(v.out) == 1);
+  for (const char* cmd : {"template", "conform", "demo", "dual", "study interleave", "study shape"}) {
+    CAPTURE(cmd);
+    const test::CliRun h = test::geode_cli(std::string(cmd) + " --help");
+    CHECK(h.code == 0);
+    CHECK(h.out.find("--help") != std::string::npos);
+  }
+  const test::CliRun h = test::geode_cli("conform --help");
+  for (const char* opt : {"--output", "--format", "--report", "--smooth", "--geode-block", "--merge-tolerance",
+                          "--write-invalid", "--quiet", "--vtu-encoding"})
+    CHECK(h.out.find(opt) != std::string::npos);
+}
+
+TEST_CASE("cli conventions: template -o picks the format from the extension") {
+  TempDir dir;
+  struct Case {
+    std::string name;
+    std::string starts_with;
+  };
+  const std::vector<Case> cases{{"t.vtu", "<?xml"},       {"t.vtk", "# vtk DataFile"},
+                                {"t.msh", "$MeshFormat"},  {"t.txt", "# geode template geode3d"},
+                                {"t.csv", "node,x,y,z"},   {"t.json", "{"},
+                                {"t.exo", "CDF"},          {"t.e", "CDF"}};
+  for (const Case& c : cases) {
+    CAPTURE(c.name);
+    const fs::path out = dir.path / c.name;
+    const test::CliRun r = test::geode_cli("template geode3d --no-smooth -o " + out.string(), true);
+    INFO(r.out);
+    REQUIRE(r.code == 0);
+    CHECK(slurp(out).rfind(c.starts_with, 0) == 0);
+  }
+  // The meshes read back with 26 hexes; .vtu is binary by default (no text tables in it).
+  CHECK(primal::read_gmsh(dir.path / "t.msh").hexes.size() == 26);
+  CHECK(primal::read_exodus(dir.path / "t.exo").hexes.size() == 26);
+  CHECK(primal::to_hex_mesh(primal::read_vtk(dir.path / "t.vtk")).hexes.size() == 26);
+  CHECK(slurp(dir.path / "t.vtu").find("format=\"binary\"") != std::string::npos);
+  CHECK(slurp(dir.path / "t.vtu").find("Table") == std::string::npos);
+  // .msh as Gmsh 2.2 when asked.
+  REQUIRE(test::geode_cli("template geode3d --no-smooth --format msh22 -o " + (dir.path / "t22.msh").string()).code == 0);
+  CHECK(slurp(dir.path / "t22.msh").rfind("$MeshFormat\n2.2", 0) == 0);
+  CHECK(primal::read_gmsh(dir.path / "t22.msh").hexes.size() == 26);
+}
+
+namespace {
+
+std::vector<std::uint8_t> base64_decode(const std::string& text) {
+  auto value = [](char c) -> int {
+    if (c >= 'A' && c <= 'Z') return c - 'A';
+    if (c >= 'a' && c <= 'z') return c - 'a' + 26;
+    if (c >= '0' && c <= '9') return c - '0' + 52;
+    if (c == '+') return 62;
+    if (c == '/') return 63;
+    return -1;
+  };
+  std::vector<std::uint8_t> out;
+  std::uint32_t acc = 0;
+  int bits = 0;
+  for (char c : text) {
+    const int v = value(c);
+    if (v < 0) continue;  // '=' padding, white space
+    acc = (acc << 6) | static_cast<std::uint32_t>(v);
+    bits += 6;
+    if (bits >= 8) {
+      bits -= 8;
+      out.push_back(static_cast<std::uint8_t>((acc >> bits) & 0xff));
+    }
+  }
+  return out;
+}
+
+// The payload of the first DataArray after `marker` in a binary .vtu, as doubles.
+std::vector<double> binary_doubles(const std::string& xml, const std::string& marker) {
+  const std::size_t tag = xml.find(marker);
+  REQUIRE(tag != std::string::npos);
+  const std::size_t start = xml.find('>', tag) + 1, end = xml.find("</DataArray>", start);
+  const std::vector<std::uint8_t> bytes = base64_decode(xml.substr(start, end - start));
+  REQUIRE(bytes.size() >= 8);
+  std::uint64_t n = 0;
+  std::memcpy(&n, bytes.data(), 8);
+  REQUIRE(n + 8 == bytes.size());
+  std::vector<double> v(n / 8);
+  std::memcpy(v.data(), bytes.data() + 8, n);
+  return v;
+}
+
+}  // namespace
+
+TEST_CASE("cli conventions: a binary .vtu holds the same points and cell data as the ASCII one") {
+  TempDir dir;
+  const fs::path bin = dir.path / "b.vtu", txt = dir.path / "a.vtu";
+  REQUIRE(test::geode_cli("template geode3d -o " + bin.string()).code == 0);
+  REQUIRE(test::geode_cli("template geode3d --vtu-encoding ascii -o " + txt.string()).code == 0);
+  const primal::VtkGrid a = primal::read_vtu(txt);
+  REQUIRE(a.points.size() == 48);
+  const std::string xml = slurp(bin);
+  const std::vector<double> xyz = binary_doubles(xml, "NumberOfComponents=\"3\"");
+  REQUIRE(xyz.size() == 3 * a.points.size());
+  for (std::size_t i = 0; i < a.points.size(); ++i)
+    for (int k = 0; k < 3; ++k) CHECK(xyz[3 * i + static_cast<std::size_t>(k)] == a.points[i][k]);
+  const std::vector<double> sj = binary_doubles(xml, "Name=\"scaled_jacobian\"");
+  REQUIRE(a.cell_data.find_double("scaled_jacobian") != nullptr);
+  CHECK(sj == *a.cell_data.find_double("scaled_jacobian"));
+}
+
+TEST_CASE("cli conventions: conform checks its outputs before work and writes mesh and report both or neither") {
+  TempDir dir;
+  const fs::path in = dir.path / "in.msh", out = dir.path / "out.exo", report = dir.path / "r.json";
+  primal::write_gmsh(small_model(), in);
+  SUBCASE("a report in a missing directory: no mesh, exit 2, named") {
+    const test::CliRun r = test::geode_cli("conform " + in.string() + " -o " + out.string() + " --report " +
+                                               (dir.path / "missing" / "r.json").string(),
+                                           true);
+    CHECK(r.code == 2);
+    CHECK(r.out.find("missing") != std::string::npos);
+    CHECK(r.out.find("interface") == std::string::npos);  // refused before the first stage
+    CHECK(!fs::exists(out));
+  }
+  SUBCASE("a directory in the report's place: refused before work, no mesh either") {
+    fs::create_directory(report);
+    fs::create_directory(report / "keep");  // a non-empty directory cannot be replaced
+    const test::CliRun r = test::geode_cli("conform " + in.string() + " -o " + out.string() + " --report " +
+                                               report.string() + " --quiet",
+                                           true);
+    CHECK(r.code == 2);
+    CHECK(!fs::exists(out));
+  }
+  SUBCASE("both written") {
+    const test::CliRun r = test::geode_cli(
+        "conform " + in.string() + " -o " + out.string() + " --report " + report.string() + " --quiet", true);
+    INFO(r.out);
+    CHECK(r.code == 0);
+    CHECK(r.out.empty());
+    CHECK(fs::exists(out));
+    CHECK(fs::exists(report));
+    CHECK(dir.entries() == 3);  // no temporaries left
+  }
+}
+
+TEST_CASE("cli conventions: an invalid result exits 4, says so even with --quiet, writes only with --write-invalid") {
+  TempDir dir;
+  // The small model plus one hex meeting the hex part along an edge only: its diced hexes make
+  // that edge non-manifold, so the output cannot be valid whatever the algorithm does.
+  primal::Model m = small_model();
+  auto node_at = [&](const primal::Point& p) {
+    for (std::size_t i = 0; i < m.points.size(); ++i)
+      if ((m.points[i] - p).norm() < 1e-12) return static_cast<primal::Index>(i);
+    m.points.push_back(p);
+    return static_cast<primal::Index>(m.points.size() - 1);
+  };
+  std::array<primal::Index, 8> h{};
+  const double x[8] = {-1, 0, 0, -1, -1, 0, 0, -1}, y[8] = {-1, -1, 0, 0, -1, -1, 0, 0}, z[8] = {0, 0, 0, 0, 1, 1, 1, 1};
+  for (int c = 0; c < 8; ++c) h[static_cast<std::size_t>(c)] = node_at({x[c], y[c], z[c]});
+  m.hexes.push_back(h);
+  if (!m.hex_block.empty()) m.hex_block.push_back(m.hex_block.front());
+  const fs::path in = dir.path / "in.exo", out = dir.path / "out.vtu", report = dir.path / "r.json";
+  primal::write_exodus(m, in);
+  const std::string args = "conform " + in.string() + " -o " + out.string() + " --report " + report.string() +
+                           " --smooth none --quiet";
+  const test::CliRun r = test::geode_cli(args, true);
+  INFO(r.out);
+  CHECK(r.code == 4);
+  CHECK(lines(r.out) == 1);
+  CHECK(r.out.find("invalid result") != std::string::npos);
+  CHECK(r.out.find("--write-invalid") != std::string::npos);
+  CHECK(dir.entries() == 1);
+  const test::CliRun w = test::geode_cli(args + " --write-invalid", true);
+  CHECK(w.code == 4);
+  CHECK(fs::exists(out));
+  CHECK(fs::exists(report));
+}
+
+TEST_CASE("cli conventions: dual --rebuild writes every mesh format, by the extension, with its report as one") {
+  TempDir dir;
+  const fs::path in = dir.path / "grid.exo";
+  primal::write_exodus(primal::grid_model({2, 2, 2}, 1.0, [](int, int, int) { return false; }), in);
+  for (const char* name : {"r.msh", "r.exo", "r.e", "r.vtk", "r.vtu"}) {
+    CAPTURE(name);
+    const fs::path out = dir.path / name, report = dir.path / (std::string(name) + ".json");
+    const test::CliRun r =
+        test::geode_cli("dual " + in.string() + " --rebuild " + out.string() + " -o " + report.string(), true);
+    INFO(r.out);
+    REQUIRE(r.code == 0);
+    CHECK(fs::exists(report));  // the report's format from its extension: JSON
+    std::ifstream is(report);
+    CHECK(is.peek() == '{');
+    const std::string e = out.extension().string();
+    if (e == ".msh") CHECK(primal::read_gmsh(out).hexes.size() == 8);
+    if (e == ".exo" || e == ".e") CHECK(primal::read_exodus(out).hexes.size() == 8);
+    if (e == ".vtk") CHECK(primal::to_hex_mesh(primal::read_vtk(out)).hexes.size() == 8);
+    if (e == ".vtu") {  // binary: its header and the decoded cell array
+      CHECK(slurp(out).find("NumberOfCells=\"8\"") != std::string::npos);
+      CHECK(binary_doubles(slurp(out), "Name=\"scaled_jacobian\"").size() == 8);
+    }
+  }
+}
