@@ -42,6 +42,7 @@ void print_blocks(const char* label, const std::map<int, double>& b) {
 void run(const std::string& name, const primal::Model& input, const primal::LocalSmoothOptions& base) {
   conform::ConformOptions o;
   o.smooth = conform::ConformSmooth::kNone;
+  o.geode_block = "geode";  // reported apart from the diced tets' block
   const conform::ConformResult r = conform::conform(input, o);
   primal::HexMesh mesh;
   mesh.points = r.model.points;
@@ -49,8 +50,8 @@ void run(const std::string& name, const primal::Model& input, const primal::Loca
   mesh.block = r.model.hex_block;
   const double buffer = static_cast<double>(r.geode_hexes) / 26.0;
   std::vector<primal::Index> geode;
-  for (primal::Index h = 0; h < static_cast<primal::Index>(mesh.hexes.size()); ++h)
-    if (mesh.block[h] == conform::kGeodeBlock) geode.push_back(h);
+  // conform's output order: diced hexes, geode hexes, diced tets.
+  for (primal::Index h = r.diced_hexes; h < r.diced_hexes + r.geode_hexes; ++h) geode.push_back(h);
   const auto seeds = primal::hexes_around(mesh, geode);
   const auto cons = primal::boundary_slide_constraints(mesh);
   const primal::TriMesh surface = primal::boundary_triangulation(mesh);

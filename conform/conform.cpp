@@ -132,6 +132,7 @@ class Conformer {
   std::vector<primal::SideSet> side_sets_;
   std::vector<Index> inverted_;  // hexes with scaled Jacobian <= 0 after smoothing
   OutputBlocks blocks_;
+  std::vector<Index> carved_from_;  // per buffer hex: the tet (input index) it was carved from
 };
 
 void Conformer::find_interface() {
@@ -152,6 +153,9 @@ void Conformer::find_interface() {
 void Conformer::insert_buffer() {
   t0_ = Clock::now();
   layer_ = insert_buffer_layer(input_, interface_, options_.buffer);
+  // The tet each buffer hex is carved from, whose block its geode hexes join by default.
+  carved_from_.reserve(layer_.hexes.size());
+  for (const BufferHex& b : layer_.hexes) carved_from_.push_back(interface_.quads[b.quad].tets[0]);
   interface_ = {};
   res_.buffer = layer_.report;
   say("buffer layer: " + std::to_string(layer_.hexes.size()) + " hexes, min scaled Jacobian " +
@@ -286,8 +290,7 @@ void Conformer::assemble() {
     hexes.push_back(diced_.hex_children[k]),
         block.push_back(primal::block_of(lm, {primal::ElementKind::Hex, diced_.hex_parent[k]}));
   for (std::size_t b = 0; b < nb; ++b) {
-    const Index carved_from = interface_.quads[layer_.hexes[b].quad].tets[0];
-    const int id = blocks_.geode_id ? blocks_.geode_id : primal::block_of(lm, {primal::ElementKind::Tet, carved_from});
+    const int id = blocks_.geode_id ? blocks_.geode_id : primal::block_of(lm, {primal::ElementKind::Tet, carved_from_[b]});
     for (const auto& h : ref(b).tpl.hex.hexes) {
       std::array<Index, 8> o{};
       for (int c = 0; c < 8; ++c) o[c] = inst_global_[b][h[c]];

@@ -646,7 +646,7 @@ class XmlParser {
 
 // How a .vtu stores binary DataArrays: the VTKFile's header_type and compressor, and the
 // <AppendedData> bytes (after its '_'), cut out before the XML is parsed.
-struct VtuEncoding {
+struct VtuStorage {
   std::size_t header_bytes = 4;  // UInt32 (default) or UInt64
   bool zlib = false;
   std::string_view appended;
@@ -705,7 +705,7 @@ std::size_t type_size(const std::string& t) {
 // count; zlib-compressed, it is [blocks, block size, last block size, compressed sizes...]
 // (VTK's vtkZLibDataCompressor layout). `want` bytes are expected; anything else is refused
 // before it is allocated.
-std::string array_bytes(std::string_view stream, const VtuEncoding& enc, std::size_t want,
+std::string array_bytes(std::string_view stream, const VtuStorage& enc, std::size_t want,
                         const std::string& file, int line, const std::string& what) {
   std::size_t at = 0;
   auto header = [&]() -> std::uint64_t {
@@ -772,7 +772,7 @@ void append_values(std::string& text, const std::string& bytes) {
 
 // A binary DataArray's values as text tokens, so that ASCII and binary arrays share one path.
 Numbers binary_values(const std::string& file, const XmlElement& a, std::size_t expected, const std::string& what,
-                      const VtuEncoding& enc) {
+                      const VtuStorage& enc) {
   const std::string type = a.attr("type"), format = a.attr("format");
   const std::size_t size = type_size(type);
   if (size == 0) fail(file, a.line, what + ": unsupported type \"" + type + "\"");
@@ -820,7 +820,7 @@ Numbers binary_values(const std::string& file, const XmlElement& a, std::size_t 
 
 // A DataArray's values as tokens, checked for encoding and count.
 Numbers data_array_values(const std::string& file, const XmlElement& a, std::size_t expected,
-                          const std::string& what, const VtuEncoding& enc) {
+                          const std::string& what, const VtuStorage& enc) {
   const std::string format = a.attr("format");
   if (format == "binary" || format == "appended") return binary_values(file, a, expected, what, enc);
   if (format != "ascii") {
@@ -890,7 +890,7 @@ VtkGrid parse_vtu(std::string_view content, const std::string& source) {
   const std::string& file = g.source;
   // Appended data is raw bytes that may hold '<': cut out before the XML is parsed.
   std::string xml(content);
-  VtuEncoding enc;
+  VtuStorage enc;
   std::string appended_bytes;
   if (const auto tag = xml.find("<AppendedData"); tag != std::string::npos) {
     const auto close = xml.find('>', tag);

@@ -59,7 +59,7 @@ TEST_CASE("cli conventions: usage errors and bad numbers are one line on stderr,
       {"conform", "INPUT is required"},
       {"dual", "required"},
       {"study", "subcommand"},
-      {"demo -n 0", "-n: 0 is out of range [1, 64]"},
+      {"demo -n 0", "--size: 0 is out of range [1, 64]"},
       {"demo -n 2.5", "not a whole number"},
       {"demo -n abc", "not a finite number"},
       {"demo --model sphere", "sphere"},
@@ -136,7 +136,7 @@ TEST_CASE("cli conventions: template -o picks the format from the extension") {
   for (const Case& c : cases) {
     CAPTURE(c.name);
     const fs::path out = dir.path / c.name;
-    const test::CliRun r = test::geode_cli("template geode3d --no-smooth -o " + out.string(), true);
+    const test::CliRun r = test::geode_cli("template geode3d -o " + out.string(), true);
     INFO(r.out);
     REQUIRE(r.code == 0);
     CHECK(slurp(out).rfind(c.starts_with, 0) == 0);
@@ -148,7 +148,7 @@ TEST_CASE("cli conventions: template -o picks the format from the extension") {
   CHECK(slurp(dir.path / "t.vtu").find("format=\"binary\"") != std::string::npos);
   CHECK(slurp(dir.path / "t.vtu").find("Table") == std::string::npos);
   // .msh as Gmsh 2.2 when asked.
-  REQUIRE(test::geode_cli("template geode3d --no-smooth --format msh22 -o " + (dir.path / "t22.msh").string()).code == 0);
+  REQUIRE(test::geode_cli("template geode3d --format msh22 -o " + (dir.path / "t22.msh").string()).code == 0);
   CHECK(slurp(dir.path / "t22.msh").rfind("$MeshFormat\n2.2", 0) == 0);
   CHECK(primal::read_gmsh(dir.path / "t22.msh").hexes.size() == 26);
 }
