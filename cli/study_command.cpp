@@ -8,6 +8,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/conventions.hpp"
+#include "cli/progress.hpp"
 #include "primal/errors.hpp"
 #include "templates/spec.hpp"
 #include "templates/study.hpp"
@@ -22,6 +23,7 @@ struct InterleaveArgs {
   std::vector<double> high, low, depth, radius;
   std::string spec;
   std::vector<std::string> sweep;
+  bool quiet = false;
 };
 
 // Default grids: 5-6 values per parameter inside the valid ranges, including the paper's
@@ -48,7 +50,11 @@ templates::InterleaveStudy spec_study(const InterleaveArgs& a) {
     if (same != axes.end()) *same = axis; else axes.push_back(axis);
   }
   if (axes.empty()) throw InvalidInput(source + ": nothing to sweep (give --sweep PATH=FROM:TO:COUNT or a sweep block)");
-  auto study = templates::interleave_study(spec, source, axes, std::filesystem::path(a.spec).stem().string());
+  Progress progress = Progress::for_stderr(a.quiet);
+  auto study = templates::interleave_study(spec, source, axes, std::filesystem::path(a.spec).stem().string(),
+                                           [&](const std::string& what, std::size_t done, std::size_t total) {
+                                             progress.step(what, done, total);
+                                           });
   if (study.runs.empty()) throw InvalidInput(source + ": every sweep point is invalid input (e.g. low roof above high)");
   return study;
 }
@@ -72,7 +78,10 @@ void run_interleave(const InterleaveArgs& a) {
     if (!a.radius.empty()) grid.dome_radius = a.radius;
     templates::GeodeOptions o;
     if (a.name == "geode4tri") o.split = templates::TopSplit::FourTriangles;
-    study = templates::interleave_study(o, grid, a.name);
+    Progress progress = Progress::for_stderr(a.quiet);
+    study = templates::interleave_study(o, grid, a.name, [&](const std::string& what, std::size_t done, std::size_t total) {
+      progress.step(what, done, total);
+    });
     if (study.runs.empty()) throw InvalidInput("study interleave: no grid point has 0 < low < high < 1");
   }
   write_or_print(a.output, [&](std::ostream& s) { templates::write_interleave_csv(s, study); });
@@ -160,6 +169,7 @@ void add_study_commands(CLI::App& app) {
   inter->add_option("--sweep", ia->sweep,
                     "with --spec: PATH=FROM:TO:COUNT or PATH=V1,V2,... for a number in the spec, e.g.\n"
                     "push.high_roof=0.55:0.95:5 or sheets[3].sphere.radius=0.2,0.3 (repeat for a grid)");
+  inter->add_flag("--quiet", ia->quiet, "no progress lines (a bar on a terminal, a line every few seconds in a log)");
   inter->callback([ia] { run_interleave(*ia); });
 
   auto sa = std::make_shared<ShapeArgs>();

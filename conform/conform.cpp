@@ -364,9 +364,10 @@ void Conformer::verify() {
   if (!res_.validity.ok()) res_.warnings.push_back("invalid mesh: " + res_.validity.summary());
   if (!inverted_.empty()) {
     std::ostringstream m;
-    m << inverted_.size() << " hexes with scaled Jacobian <= 0:";
+    // 1-based in the result model's element order (writers keep it when blocks ascend).
+    m << inverted_.size() << " hexes with scaled Jacobian <= 0 (1-based output elements):";
     for (std::size_t i = 0; i < std::min<std::size_t>(inverted_.size(), 20); ++i)
-      m << " " << inverted_[i];
+      m << " " << inverted_[i] + 1;
     if (inverted_.size() > 20) m << " ...";
     res_.warnings.push_back(m.str());
   }

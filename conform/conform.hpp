@@ -87,7 +87,7 @@ struct ConformResult {
   primal::LocalSmoothResult smoothing;  // zero-initialised when ConformSmooth::kNone
   primal::HexValidityReport validity;
   std::vector<BlockQuality> quality;  // one per output block, ascending id ("block N" unnamed); ConformOptions::quality
-  std::vector<std::string> warnings;  // e.g. "3 hexes with scaled Jacobian <= 0: 12 40 ..."
+  std::vector<std::string> warnings;  // e.g. "3 hexes with scaled Jacobian <= 0 (1-based output elements): 12 40 ..."
   double seconds = 0.0;
 };
 

@@ -5,8 +5,13 @@ GEODE_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 GEODE_PACKAGES=(cmake g++ make libopenmesh-dev libeigen3-dev doctest-dev libcli11-dev
   nlohmann-json3-dev libexodusii-dev libgmsh-dev gmsh python3-vtk9 python3-matplotlib
   zlib1g-dev python3-meshio python3-netcdf4 clang libclang-rt-14-dev libjs-three chromium
-  libtbb-dev)
+  libtbb-dev ccache)
 JOBS=${JOBS:-$(nproc)}
+# ccache keeps compiled objects between runs (and between clones: paths below the root are
+# hashed relative to it), so a second build costs little.
+export CCACHE_BASEDIR="$GEODE_ROOT"
+GEODE_LAUNCHER=()
+command -v ccache >/dev/null 2>&1 && GEODE_LAUNCHER=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 
 geode_install() {
   local missing=()
@@ -31,7 +36,7 @@ geode_install() {
 geode_fuzz() {
   local seconds=${GEODE_FUZZ_SECONDS:-30} dir="$GEODE_ROOT/build-fuzz"
   CC=clang CXX=clang++ cmake -S "$GEODE_ROOT" -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGEODE_FUZZ=ON \
-    -DGEODE_BENCH=OFF >/dev/null
+    -DGEODE_BENCH=OFF "${GEODE_LAUNCHER[@]}" >/dev/null
   cmake --build "$dir" -j "$JOBS" --target fuzz_msh fuzz_vtu fuzz_vtk
   for reader in msh vtu vtk; do
     local work
@@ -51,6 +56,6 @@ geode_fuzz() {
 # geode_build DIR [cmake args...]
 geode_build() {
   local dir=$1; shift
-  cmake -S "$GEODE_ROOT" -B "$GEODE_ROOT/$dir" "$@" >/dev/null
+  cmake -S "$GEODE_ROOT" -B "$GEODE_ROOT/$dir" "${GEODE_LAUNCHER[@]}" "$@" >/dev/null
   cmake --build "$GEODE_ROOT/$dir" -j "$JOBS"
 }

@@ -163,7 +163,7 @@ std::string strip_numbers(const std::string& message) {
 }
 
 InterleaveStudy interleave_study(const GeodeOptions& base, const PushGrid& grid,
-                                 const std::string& template_name) {
+                                 const std::string& template_name, const StudyProgress& progress) {
   std::vector<InterleaveCase> cases;
   for (double high : grid.high_roof)
     for (double low : grid.low_roof) {
@@ -175,11 +175,12 @@ InterleaveStudy interleave_study(const GeodeOptions& base, const PushGrid& grid,
           cases.push_back({o.push, {}, [o] { return build_geode3d(o); }});
         }
     }
-  return interleave_study(cases, template_name);
+  return interleave_study(cases, template_name, {}, progress);
 }
 
 InterleaveStudy interleave_study(const nlohmann::json& spec, const std::string& source,
-                                 const std::vector<SweepAxis>& axes, const std::string& template_name) {
+                                 const std::vector<SweepAxis>& axes, const std::string& template_name,
+                                 const StudyProgress& progress) {
   std::vector<InterleaveCase> cases;
   std::vector<std::string> names;
   for (const auto& a : axes) names.push_back(a.path);
@@ -210,13 +211,13 @@ InterleaveStudy interleave_study(const nlohmann::json& spec, const std::string& 
       at[i] = 0;
     }
   }
-  InterleaveStudy study = interleave_study(cases, template_name, names);
+  InterleaveStudy study = interleave_study(cases, template_name, names, progress);
   study.skipped = skipped;
   return study;
 }
 
 InterleaveStudy interleave_study(const std::vector<InterleaveCase>& cases, const std::string& template_name,
-                                 const std::vector<std::string>& parameter_names) {
+                                 const std::vector<std::string>& parameter_names, const StudyProgress& progress) {
   InterleaveStudy study;
   study.template_name = template_name;
   study.parameter_names = parameter_names;
@@ -258,6 +259,7 @@ InterleaveStudy interleave_study(const std::vector<InterleaveCase>& cases, const
     oc.ok += run.conditions_ok ? 1 : 0;
     keys.push_back(key);
     study.runs.push_back(run);
+    if (progress) progress("pushes", study.runs.size(), cases.size());
   }
   std::vector<const Outcome*> order;
   for (const auto& [k, oc] : outcomes) order.push_back(&oc);
@@ -278,6 +280,7 @@ InterleaveStudy interleave_study(const std::vector<InterleaveCase>& cases, const
     c.conditions_ok = oc->ok;
     c.example = oc->example;
     if (c.valid) measure_class(c, oc->example_template);
+    if (progress) progress("classes", study.classes.size() + 1, order.size());
     label[{c.valid, c.key}] = c.label;
     study.classes.push_back(c);
   }

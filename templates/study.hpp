@@ -74,11 +74,14 @@ struct InterleaveStudy {
   std::vector<InterleaveClass> classes;  // valid classes, then errors; each by count, then key
 };
 
+// Called with (what, done, total) as a sweep goes: "pushes" built, then "classes" measured.
+using StudyProgress = std::function<void(const std::string& what, std::size_t done, std::size_t total)>;
+
 // Builds the template for every grid point with 0 < low < high < 1 (others are skipped:
 // build_geode3d rejects them as invalid input), then measures each valid class. split picks geode3d or geode4tri; the rest of
 // `base` (box, diagonal, higher) is kept.
 InterleaveStudy interleave_study(const GeodeOptions& base, const PushGrid& grid,
-                                 const std::string& template_name);
+                                 const std::string& template_name, const StudyProgress& progress = {});
 
 // One point of a sweep: the push and swept values the CSV records, and how to build it.
 struct InterleaveCase {
@@ -87,13 +90,15 @@ struct InterleaveCase {
   std::function<Template()> build;
 };
 InterleaveStudy interleave_study(const std::vector<InterleaveCase>& cases, const std::string& template_name,
-                                 const std::vector<std::string>& parameter_names = {});
+                                 const std::vector<std::string>& parameter_names = {},
+                                 const StudyProgress& progress = {});
 
 // A spec (templates/spec.hpp) swept over every combination of the axes' values (the first
 // axis slowest); points whose spec is invalid input (e.g. low roof above high) are skipped
 // and counted. `source` names the spec in messages.
 InterleaveStudy interleave_study(const nlohmann::json& spec, const std::string& source,
-                                 const std::vector<SweepAxis>& axes, const std::string& template_name);
+                                 const std::vector<SweepAxis>& axes, const std::string& template_name,
+                                 const StudyProgress& progress = {});
 
 // CSV: high_roof,low_roof,dome_depth,dome_radius,outcome,hexes,class,conditions_ok,diagnosis,
 // then one column per swept spec path (spec studies)
