@@ -1,0 +1,38 @@
+#pragma once
+// VTK cell types as the .vtu / .vtk writers and readers (io_vtk.cpp, io_vtk_read.cpp) name
+// and size them. Internal to primal's VTK I/O.
+#include "primal/io_vtk.hpp"
+
+namespace geode::primal::vtk_cells {
+
+inline const char* cell_type_name(int type) {
+  switch (type) {
+    case kVtkTriangle:
+      return "triangle";
+    case kVtkQuad:
+      return "quad";
+    case kVtkTetra:
+      return "tetra";
+    case kVtkHexahedron:
+      return "hexahedron";
+    default:
+      return nullptr;
+  }
+}
+
+inline int cell_type_size(int type) {
+  switch (type) {
+    case kVtkTriangle:
+      return 3;
+    case kVtkQuad:
+      return 4;
+    case kVtkTetra:
+      return 4;
+    case kVtkHexahedron:
+      return 8;
+    default:
+      return 0;
+  }
+}
+
+}  // namespace geode::primal::vtk_cells

@@ -1,0 +1,1043 @@
+#include "primal/io_vtk.hpp"
+
+#include "primal/io_vtk_cells.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <cstring>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <sstream>
+
+#include <zlib.h>
+
+#include "primal/atomic_file.hpp"
+#include "primal/errors.hpp"
+#include "primal/file_format.hpp"
+#include "primal/quality.hpp"
+
+namespace geode::primal {
+
+using vtk_cells::cell_type_name;
+using vtk_cells::cell_type_size;
+
+namespace {
+
+// ---- Reading: shared checks -----------------------------------------------------------------
+
+[[noreturn]] void fail(const std::string& file, int line, const std::string& what) {
+  throw InvalidInput(file + ":" + std::to_string(line) + ": " + what);
+}
+
+// Checks cell types, node counts and node ranges; `line_of_cell` gives the line to report.
+template <typename LineOf>
+void check_cells(const VtkGrid& g, LineOf&& line_of_cell) {
+  for (std::size_t c = 0; c < g.cells.size(); ++c) {
+    const int type = g.cell_types[c];
+    const char* name = cell_type_name(type);
+    if (!name) {
+      fail(g.source, line_of_cell(c, true),
+           "cell " + std::to_string(c) + ": unknown or unsupported cell type " +
+               std::to_string(type) + " (supported: 5 triangle, 9 quad, 10 tetra, 12 hexahedron)");
+    }
+    if (static_cast<int>(g.cells[c].size()) != cell_type_size(type)) {
+      fail(g.source, line_of_cell(c, false),
+           "cell " + std::to_string(c) + ": type " + std::to_string(type) + " (" + name +
+               ") needs " + std::to_string(cell_type_size(type)) + " nodes, has " +
+               std::to_string(g.cells[c].size()));
+    }
+    for (Index v : g.cells[c]) {
+      if (v < 0 || static_cast<std::size_t>(v) >= g.points.size()) {
+        fail(g.source, line_of_cell(c, false),
+             "cell " + std::to_string(c) + ": node " + std::to_string(v) + " out of range [0, " +
+                 std::to_string(g.points.size()) + ")");
+      }
+    }
+  }
+}
+
+// Numbers of a text block with the line each starts on.
+struct Numbers {
+  std::vector<std::string_view> tokens;
+  std::vector<int> lines;
+  std::shared_ptr<const std::string> storage;  // the tokens' text when decoded from binary
+};
+
+Numbers split_numbers(std::string_view text, int first_line) {
+  Numbers n;
+  int line = first_line;
+  std::size_t i = 0;
+  while (i < text.size()) {
+    if (text[i] == '\n') ++line;
+    if (std::isspace(static_cast<unsigned char>(text[i]))) {
+      ++i;
+      continue;
+    }
+    const std::size_t start = i;
+    while (i < text.size() && !std::isspace(static_cast<unsigned char>(text[i]))) ++i;
+    n.tokens.push_back(text.substr(start, i - start));
+    n.lines.push_back(line);
+  }
+  return n;
+}
+
+double parse_double(const std::string& file, int line, std::string_view tok) {
+  double x = 0.0;
+  const char* b = tok.data();
+  const char* e = tok.data() + tok.size();
+  if (!tok.empty() && *b == '+') ++b;
+  const auto res = std::from_chars(b, e, x);
+  if (res.ec != std::errc() || res.ptr != e)
+    fail(file, line, "'" + std::string(tok) + "' is not a number");
+  return x;
+}
+
+long long parse_int(const std::string& file, int line, std::string_view tok) {
+  long long x = 0;
+  const auto res = std::from_chars(tok.data(), tok.data() + tok.size(), x);
+  if (res.ec != std::errc() || res.ptr != tok.data() + tok.size()) {
+    fail(file, line, "'" + std::string(tok) + "' is not an integer");
+  }
+  return x;
+}
+
+int parse_int32(const std::string& file, int line, std::string_view tok) {
+  const long long v = parse_int(file, line, tok);
+  if (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max())
+    fail(file, line, "'" + std::string(tok) + "' is out of range");
+  return static_cast<int>(v);
+}
+
+Point point_from(const std::string& file, int line, std::size_t index, double x, double y,
+                 double z) {
+  const Point p(x, y, z);
+  if (!p.allFinite()) {
+    fail(file, line, "point " + std::to_string(index) + ": non-finite coordinate (NaN or inf)");
+  }
+  return p;
+}
+
+// ---- XML (.vtu) -------------------------------------------------------------------------------
+
+struct XmlElement {
+  std::string name;
+  std::map<std::string, std::string> attrs;
+  std::string text;
+  int line = 0;       // of the start tag
+  int text_line = 0;  // where the text content starts
+  std::vector<XmlElement> children;
+
+  const XmlElement* child(const std::string& n) const {
+    for (const auto& c : children) {
+      if (c.name == n) return &c;
+    }
+    return nullptr;
+  }
+  std::string attr(const std::string& n) const {
+    const auto it = attrs.find(n);
+    return it == attrs.end() ? std::string() : it->second;
+  }
+};
+
+// A small XML reader for what VTK writes: tags, attributes, text, comments, declarations.
+class XmlParser {
+ public:
+  XmlParser(std::string text, std::string file) : s_(std::move(text)), file_(std::move(file)) {}
+
+  XmlElement parse() {
+    skip_misc();
+    if (pos_ >= s_.size() || s_[pos_] != '<')
+      fail(file_, line_, "not an XML file (no root element)");
+    XmlElement root = element();
+    return root;
+  }
+
+ private:
+  std::string s_, file_;
+  std::size_t pos_ = 0;
+  int line_ = 1;
+
+  void advance(std::size_t n) {
+    for (std::size_t k = 0; k < n && pos_ < s_.size(); ++k) line_ += s_[pos_++] == '\n';
+  }
+  bool starts(std::string_view p) const { return s_.compare(pos_, p.size(), p) == 0; }
+  [[noreturn]] void eof(const std::string& inside, int opened) {
+    fail(file_, line_,
+         "unexpected end of file inside " + inside + " opened at line " + std::to_string(opened) +
+             " (truncated file?)");
+  }
+  void skip_space() {
+    while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_]))) advance(1);
+  }
+  void skip_until(std::string_view end, const std::string& what) {
+    const int opened = line_;
+    const auto e = s_.find(end, pos_);
+    if (e == std::string::npos) eof(what, opened);
+    advance(e + end.size() - pos_);
+  }
+  void skip_misc() {
+    while (true) {
+      skip_space();
+      if (starts("<?"))
+        skip_until("?>", "an XML declaration");
+      else if (starts("<!--"))
+        skip_until("-->", "a comment");
+      else if (starts("<!"))
+        skip_until(">", "a DOCTYPE");
+      else
+        return;
+    }
+  }
+  std::string name() {
+    const std::size_t start = pos_;
+    while (pos_ < s_.size() &&
+           (std::isalnum(static_cast<unsigned char>(s_[pos_])) || s_[pos_] == '_' ||
+            s_[pos_] == ':' || s_[pos_] == '-' || s_[pos_] == '.')) {
+      advance(1);
+    }
+    return s_.substr(start, pos_ - start);
+  }
+  static std::string unescape(const std::string& v) {
+    std::string out;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      if (v[i] == '&') {
+        static const std::pair<const char*, char> ents[] = {
+            {"&amp;", '&'}, {"&lt;", '<'}, {"&gt;", '>'}, {"&quot;", '"'}, {"&apos;", '\''}};
+        bool done = false;
+        for (const auto& [ent, ch] : ents) {
+          if (v.compare(i, std::char_traits<char>::length(ent), ent) == 0) {
+            out += ch;
+            i += std::char_traits<char>::length(ent) - 1;
+            done = true;
+            break;
+          }
+        }
+        if (!done) out += '&';
+      } else {
+        out += v[i];
+      }
+    }
+    return out;
+  }
+
+  XmlElement element() {
+    XmlElement el;
+    el.line = line_;
+    advance(1);  // '<'
+    el.name = name();
+    if (el.name.empty()) fail(file_, line_, "malformed tag");
+    const std::string tag = "<" + el.name + ">";
+    // Attributes.
+    while (true) {
+      skip_space();
+      if (pos_ >= s_.size()) eof("the tag " + tag, el.line);
+      if (starts("/>")) {
+        advance(2);
+        return el;
+      }
+      if (s_[pos_] == '>') {
+        advance(1);
+        break;
+      }
+      const std::string key = name();
+      skip_space();
+      if (key.empty() || pos_ >= s_.size() || s_[pos_] != '=') {
+        if (pos_ >= s_.size()) eof("the tag " + tag, el.line);
+        fail(file_, line_, "malformed attribute in " + tag);
+      }
+      advance(1);
+      skip_space();
+      if (pos_ >= s_.size()) eof("the tag " + tag, el.line);
+      const char q = s_[pos_];
+      if (q != '"' && q != '\'')
+        fail(file_, line_, "attribute " + key + " in " + tag + " is not quoted");
+      advance(1);
+      const auto e = s_.find(q, pos_);
+      if (e == std::string::npos) eof("the tag " + tag, el.line);
+      el.attrs[key] = unescape(s_.substr(pos_, e - pos_));
+      advance(e + 1 - pos_);
+    }
+    // Content.
+    el.text_line = line_;
+    while (true) {
+      const std::size_t lt = s_.find('<', pos_);
+      if (lt == std::string::npos) {
+        advance(s_.size() - pos_);
+        eof(tag, el.line);
+      }
+      el.text += s_.substr(pos_, lt - pos_);
+      advance(lt - pos_);
+      if (starts("</")) {
+        advance(2);
+        const std::string end = name();
+        skip_space();
+        if (pos_ >= s_.size()) eof(tag, el.line);
+        if (end != el.name || s_[pos_] != '>') {
+          fail(file_, line_,
+               "closing tag </" + end + "> does not match " + tag + " opened at line " +
+                   std::to_string(el.line));
+        }
+        advance(1);
+        return el;
+      }
+      if (starts("<!--")) {
+        skip_until("-->", "a comment");
+        continue;
+      }
+      el.children.push_back(element());
+    }
+  }
+};
+
+// How a .vtu stores binary DataArrays: the VTKFile's header_type and compressor, and the
+// <AppendedData> bytes (after its '_'), cut out before the XML is parsed.
+struct VtuStorage {
+  std::size_t header_bytes = 4;  // UInt32 (default) or UInt64
+  bool zlib = false;
+  std::string_view appended;
+  bool appended_base64 = false;
+};
+
+int base64_value(char c) {
+  if (c >= 'A' && c <= 'Z') return c - 'A';
+  if (c >= 'a' && c <= 'z') return c - 'a' + 26;
+  if (c >= '0' && c <= '9') return c - '0' + 52;
+  if (c == '+') return 62;
+  if (c == '/') return 63;
+  return -1;
+}
+
+// Decodes base64 one 4-character quantum at a time, so that parts encoded apart (VTK encodes a
+// header and its data separately, each padded) decode as their concatenation.
+std::string decode_base64(std::string_view text, const std::string& file, int line) {
+  std::string out;
+  out.reserve(text.size() / 4 * 3);
+  int quantum[4];
+  int n = 0, pad = 0;
+  for (char c : text) {
+    if (std::isspace(static_cast<unsigned char>(c))) continue;
+    if (c == '=') {
+      if (n < 2) fail(file, line, "base64: misplaced padding");
+      ++pad;
+      quantum[n++] = 0;
+    } else {
+      const int v = base64_value(c);
+      if (v < 0) fail(file, line, std::string("base64: invalid character '") + c + "'");
+      if (pad) fail(file, line, "base64: data after padding inside a quantum");
+      quantum[n++] = v;
+    }
+    if (n == 4) {
+      const unsigned bits = static_cast<unsigned>(quantum[0] << 18 | quantum[1] << 12 | quantum[2] << 6 | quantum[3]);
+      out += static_cast<char>(bits >> 16);
+      if (pad < 2) out += static_cast<char>(bits >> 8 & 0xff);
+      if (pad < 1) out += static_cast<char>(bits & 0xff);
+      n = pad = 0;
+    }
+  }
+  if (n != 0) fail(file, line, "base64: the text ends inside a quantum (truncated?)");
+  return out;
+}
+
+std::size_t type_size(const std::string& t) {
+  if (t == "Int8" || t == "UInt8") return 1;
+  if (t == "Int16" || t == "UInt16") return 2;
+  if (t == "Int32" || t == "UInt32" || t == "Float32") return 4;
+  if (t == "Int64" || t == "UInt64" || t == "Float64") return 8;
+  return 0;
+}
+
+// The array's raw bytes from a (header, data) stream: uncompressed, the header is the byte
+// count; zlib-compressed, it is [blocks, block size, last block size, compressed sizes...]
+// (VTK's vtkZLibDataCompressor layout). `want` bytes are expected; anything else is refused
+// before it is allocated.
+std::string array_bytes(std::string_view stream, const VtuStorage& enc, std::size_t want,
+                        const std::string& file, int line, const std::string& what) {
+  std::size_t at = 0;
+  auto header = [&]() -> std::uint64_t {
+    if (stream.size() - at < enc.header_bytes) fail(file, line, what + ": binary header cut short (truncated?)");
+    std::uint64_t v = 0;
+    if (enc.header_bytes == 4) {
+      std::uint32_t x;
+      std::memcpy(&x, stream.data() + at, 4);
+      v = x;
+    } else {
+      std::memcpy(&v, stream.data() + at, 8);
+    }
+    at += enc.header_bytes;
+    return v;
+  };
+  if (!enc.zlib) {
+    const std::uint64_t n = header();
+    if (n != want) fail(file, line, what + ": binary data of " + std::to_string(n) + " bytes, expected " + std::to_string(want));
+    if (stream.size() - at < n) fail(file, line, what + ": binary data cut short (truncated?)");
+    return std::string(stream.substr(at, n));
+  }
+  const std::uint64_t blocks = header(), block_size = header(), last_size = header();
+  if (blocks > stream.size() / enc.header_bytes) fail(file, line, what + ": compressed header announces " + std::to_string(blocks) + " blocks");
+  const std::uint64_t last = last_size == 0 ? block_size : last_size;
+  // block_size is the nominal size of every block but the last (meshio writes 32768 for one
+  // short block); the sizes must add up to what the array holds.
+  if (blocks > 0 && (last > block_size || last > want || (blocks > 1 && block_size > want / (blocks - 1)) ||
+                     (blocks - 1) * block_size + last != want))
+    fail(file, line, what + ": compressed blocks do not add up to the " + std::to_string(want) + " bytes expected");
+  if (blocks == 0 && want != 0) fail(file, line, what + ": no compressed blocks for " + std::to_string(want) + " bytes");
+  // zlib inflates at most about 1032:1: a header that promises more is corrupt, and is refused
+  // before anything of that size is allocated.
+  if (want / 1032 > stream.size()) fail(file, line, what + ": " + std::to_string(want) + " bytes cannot come from " + std::to_string(stream.size()) + " compressed bytes");
+  std::vector<std::uint64_t> sizes;
+  for (std::uint64_t b = 0; b < blocks; ++b) sizes.push_back(header());
+  std::string out;
+  out.reserve(want);
+  for (std::uint64_t b = 0; b < blocks; ++b) {
+    if (stream.size() - at < sizes[b]) fail(file, line, what + ": compressed block " + std::to_string(b + 1) + " cut short (truncated?)");
+    const std::uint64_t size = b + 1 == blocks ? last : block_size;
+    std::string block(size, '\0');
+    uLongf got = static_cast<uLongf>(size);
+    const int status = uncompress(reinterpret_cast<Bytef*>(block.data()), &got,
+                                  reinterpret_cast<const Bytef*>(stream.data() + at), static_cast<uLong>(sizes[b]));
+    if (status != Z_OK || got != size)
+      fail(file, line, what + ": compressed block " + std::to_string(b + 1) + " does not inflate to " + std::to_string(size) + " bytes (zlib status " + std::to_string(status) + ")");
+    out += block;
+    at += sizes[b];
+  }
+  return out;
+}
+
+template <class T>
+void append_values(std::string& text, const std::string& bytes) {
+  for (std::size_t i = 0; i + sizeof(T) <= bytes.size(); i += sizeof(T)) {
+    T x;
+    std::memcpy(&x, bytes.data() + i, sizeof(T));
+    char buf[64];
+    const auto res = std::to_chars(buf, buf + sizeof buf, x);
+    text.append(buf, res.ptr);
+    text += ' ';
+  }
+}
+
+// A binary DataArray's values as text tokens, so that ASCII and binary arrays share one path.
+Numbers binary_values(const std::string& file, const XmlElement& a, std::size_t expected, const std::string& what,
+                      const VtuStorage& enc) {
+  const std::string type = a.attr("type"), format = a.attr("format");
+  const std::size_t size = type_size(type);
+  if (size == 0) fail(file, a.line, what + ": unsupported type \"" + type + "\"");
+  if (expected > (std::numeric_limits<std::size_t>::max() / 16) / size) fail(file, a.line, what + ": too many values");
+  const std::size_t want = expected * size;
+  std::string bytes;
+  if (format == "binary") {
+    bytes = array_bytes(decode_base64(a.text, file, a.text_line), enc, want, file, a.line, what);
+  } else {
+    const std::string offset_text = a.attr("offset");
+    std::size_t offset = 0;
+    const auto res = std::from_chars(offset_text.data(), offset_text.data() + offset_text.size(), offset);
+    if (offset_text.empty() || res.ec != std::errc() || res.ptr != offset_text.data() + offset_text.size())
+      fail(file, a.line, what + ": appended DataArray without a valid offset");
+    if (offset > enc.appended.size()) fail(file, a.line, what + ": offset " + offset_text + " lies beyond the appended data (truncated?)");
+    const std::string_view rest = enc.appended.substr(offset);
+    if (enc.appended_base64) {
+      // Decoded to the end: the array's header and data, encoded apart or together, come
+      // first; the arrays after it follow and are ignored.
+      std::string_view piece = rest.substr(0, rest.find_first_not_of(
+          "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/="));
+      piece = piece.substr(0, piece.size() - piece.size() % 4);
+      const std::string decoded = decode_base64(piece, file, a.line);
+      bytes = array_bytes(decoded, enc, want, file, a.line, what);
+    } else {
+      bytes = array_bytes(rest, enc, want, file, a.line, what);
+    }
+  }
+  auto text = std::make_shared<std::string>();
+  if (type == "Int8") append_values<std::int8_t>(*text, bytes);
+  if (type == "UInt8") append_values<std::uint8_t>(*text, bytes);
+  if (type == "Int16") append_values<std::int16_t>(*text, bytes);
+  if (type == "UInt16") append_values<std::uint16_t>(*text, bytes);
+  if (type == "Int32") append_values<std::int32_t>(*text, bytes);
+  if (type == "UInt32") append_values<std::uint32_t>(*text, bytes);
+  if (type == "Int64") append_values<std::int64_t>(*text, bytes);
+  if (type == "UInt64") append_values<std::uint64_t>(*text, bytes);
+  if (type == "Float32") append_values<float>(*text, bytes);
+  if (type == "Float64") append_values<double>(*text, bytes);
+  Numbers n = split_numbers(*text, a.line);
+  n.storage = std::move(text);
+  std::fill(n.lines.begin(), n.lines.end(), a.line);
+  return n;
+}
+
+// A DataArray's values as tokens, checked for encoding and count.
+Numbers data_array_values(const std::string& file, const XmlElement& a, std::size_t expected,
+                          const std::string& what, const VtuStorage& enc) {
+  const std::string format = a.attr("format");
+  if (format == "binary" || format == "appended") return binary_values(file, a, expected, what, enc);
+  if (format != "ascii") {
+    fail(file, a.line,
+         what + ": format=\"" + format + "\" is not supported (ascii, binary and appended are read)");
+  }
+  Numbers n = split_numbers(a.text, a.text_line);
+  if (n.tokens.size() != expected) {
+    fail(file, a.line,
+         what + ": " + std::to_string(n.tokens.size()) + " values, expected " +
+             std::to_string(expected) + (n.tokens.size() < expected ? " (truncated?)" : ""));
+  }
+  return n;
+}
+
+const XmlElement& required(const std::string& file, const XmlElement& parent,
+                           const std::string& name) {
+  const XmlElement* c = parent.child(name);
+  if (!c) fail(file, parent.line, "<" + parent.name + "> has no <" + name + ">");
+  return *c;
+}
+
+std::size_t count_attr(const std::string& file, const XmlElement& el, const std::string& key) {
+  const std::string v = el.attr(key);
+  const long long n =
+      parse_int(file, el.line, v.empty() ? std::string_view("missing") : std::string_view(v));
+  if (n < 0) fail(file, el.line, key + " is negative");
+  return static_cast<std::size_t>(n);
+}
+
+bool is_float_type(const std::string& t) { return t == "Float32" || t == "Float64"; }
+bool is_int_type(const std::string& t) {
+  return t == "Int8" || t == "UInt8" || t == "Int16" || t == "UInt16" || t == "Int32" ||
+         t == "UInt32" || t == "Int64" || t == "UInt64";
+}
+
+}  // namespace
+
+// ---- .vtu reader ------------------------------------------------------------------------------
+
+VtkGrid read_vtu(const std::filesystem::path& path) {
+  check_mesh_format(path, MeshFileFormat::kVtu);
+  return parse_vtu(read_file_bytes(path), path.string());
+}
+
+VtkGrid parse_vtu(std::string_view content, const std::string& source) {
+  VtkGrid g;
+  g.source = source;
+  const std::string& file = g.source;
+  // Appended data is raw bytes that may hold '<': cut out before the XML is parsed.
+  std::string xml(content);
+  VtuStorage enc;
+  std::string appended_bytes;
+  if (const auto tag = xml.find("<AppendedData"); tag != std::string::npos) {
+    const auto close = xml.find('>', tag);
+    const auto underscore = close == std::string::npos ? close : xml.find('_', close);
+    const auto end = xml.rfind("</AppendedData>");
+    if (underscore == std::string::npos || end == std::string::npos || end < underscore)
+      fail(file, static_cast<int>(std::count(xml.begin(), xml.begin() + static_cast<std::ptrdiff_t>(tag), '\n')) + 1,
+           "<AppendedData> without its '_' marker or its end tag (truncated file?)");
+    appended_bytes = xml.substr(underscore + 1, end - underscore - 1);
+    // Keep the line count of what follows for messages.
+    const auto lines = std::count(appended_bytes.begin(), appended_bytes.end(), '\n');
+    xml.replace(underscore, end - underscore, std::string(static_cast<std::size_t>(lines), '\n'));
+    enc.appended = appended_bytes;
+  }
+  const XmlElement root = XmlParser(std::move(xml), file).parse();
+  if (const std::string h = root.attr("header_type"); !h.empty() && h != "UInt32" && h != "UInt64")
+    fail(file, root.line, "header_type \"" + h + "\" is not supported (UInt32 and UInt64 are)");
+  enc.header_bytes = root.attr("header_type") == "UInt64" ? 8 : 4;
+  if (const std::string c = root.attr("compressor"); !c.empty()) {
+    if (c != "vtkZLibDataCompressor") fail(file, root.line, "compressor \"" + c + "\" is not supported (vtkZLibDataCompressor is)");
+    enc.zlib = true;
+  }
+  if (const std::string order = root.attr("byte_order"); !order.empty() && order != "LittleEndian")
+    fail(file, root.line, "byte_order \"" + order + "\" is not supported (LittleEndian is)");
+  if (const XmlElement* ad = root.child("AppendedData")) {
+    const std::string e = ad->attr("encoding");
+    if (e != "raw" && e != "base64") fail(file, ad->line, "AppendedData encoding \"" + e + "\" is not supported (raw and base64 are)");
+    enc.appended_base64 = e == "base64";
+  }
+  if (root.name != "VTKFile" || root.attr("type") != "UnstructuredGrid") {
+    fail(file, root.line,
+         "not a VTK UnstructuredGrid file (root <" + root.name + "> type \"" + root.attr("type") +
+             "\")");
+  }
+  const XmlElement& ug = required(file, root, "UnstructuredGrid");
+  const XmlElement& piece = required(file, ug, "Piece");
+  if (std::count_if(ug.children.begin(), ug.children.end(),
+                    [](const XmlElement& e) { return e.name == "Piece"; }) != 1) {
+    fail(file, piece.line, "only single-Piece files are supported");
+  }
+  const std::size_t np = count_attr(file, piece, "NumberOfPoints");
+  const std::size_t nc = count_attr(file, piece, "NumberOfCells");
+
+  // Points.
+  const XmlElement& pts = required(file, piece, "Points");
+  const XmlElement& pa = required(file, pts, "DataArray");
+  if (pa.attr("NumberOfComponents") != "3")
+    fail(file, pa.line, "Points: NumberOfComponents must be 3");
+  {
+    const Numbers n = data_array_values(file, pa, 3 * np, "Points", enc);
+    for (std::size_t i = 0; i < np; ++i) {
+      double x[3];
+      for (int k = 0; k < 3; ++k)
+        x[k] = parse_double(file, n.lines[3 * i + k], n.tokens[3 * i + k]);
+      g.points.push_back(point_from(file, n.lines[3 * i], i, x[0], x[1], x[2]));
+    }
+  }
+
+  // Cells.
+  const XmlElement& cells = required(file, piece, "Cells");
+  const XmlElement *conn = nullptr, *offs = nullptr, *types = nullptr;
+  for (const auto& a : cells.children) {
+    const std::string nm = a.attr("Name");
+    if (nm == "connectivity") conn = &a;
+    if (nm == "offsets") offs = &a;
+    if (nm == "types") types = &a;
+  }
+  if (!conn || !offs || !types) {
+    fail(file, cells.line, "<Cells> needs DataArrays connectivity, offsets and types");
+  }
+  const Numbers on = data_array_values(file, *offs, nc, "offsets", enc);
+  const Numbers tn = data_array_values(file, *types, nc, "types", enc);
+  std::vector<std::size_t> offsets;
+  for (std::size_t c = 0; c < nc; ++c) {
+    const long long o = parse_int(file, on.lines[c], on.tokens[c]);
+    if (o < 0 || (c > 0 && static_cast<std::size_t>(o) < offsets.back())) {
+      fail(file, on.lines[c],
+           "offsets: cell " + std::to_string(c) + ": offset " + std::to_string(o) +
+               " is negative or decreasing");
+    }
+    offsets.push_back(static_cast<std::size_t>(o));
+  }
+  const Numbers cn = data_array_values(file, *conn, nc ? offsets.back() : 0, "connectivity", enc);
+  std::vector<int> cell_line(nc, conn->line), type_line(nc, types->line);
+  for (std::size_t c = 0; c < nc; ++c) {
+    g.cell_types.push_back(parse_int32(file, tn.lines[c], tn.tokens[c]));
+    type_line[c] = tn.lines[c];
+    std::vector<Index> cell;
+    const std::size_t begin = c ? offsets[c - 1] : 0;
+    for (std::size_t i = begin; i < offsets[c]; ++i) {
+      cell.push_back(parse_int32(file, cn.lines[i], cn.tokens[i]));
+    }
+    if (begin < offsets[c]) cell_line[c] = cn.lines[begin];
+    g.cells.push_back(std::move(cell));
+  }
+  check_cells(g, [&](std::size_t c, bool type) { return type ? type_line[c] : cell_line[c]; });
+
+  // Cell data.
+  if (const XmlElement* cd = piece.child("CellData")) {
+    for (const auto& a : cd->children) {
+      if (a.name != "DataArray") continue;
+      const std::string nm = a.attr("Name"), type = a.attr("type");
+      if (nm.empty()) fail(file, a.line, "CellData: DataArray without a Name");
+      const std::string comps = a.attr("NumberOfComponents");
+      if (!comps.empty() && comps != "1") {
+        fail(file, a.line, "CellData '" + nm + "': only 1-component arrays are read");
+      }
+      const Numbers n = data_array_values(file, a, nc, "CellData '" + nm + "'", enc);
+      if (is_float_type(type)) {
+        std::vector<double> v;
+        for (std::size_t i = 0; i < nc; ++i)
+          v.push_back(parse_double(file, n.lines[i], n.tokens[i]));
+        g.cell_data.doubles.emplace_back(nm, std::move(v));
+      } else if (is_int_type(type)) {
+        std::vector<int> v;
+        for (std::size_t i = 0; i < nc; ++i)
+          v.push_back(parse_int32(file, n.lines[i], n.tokens[i]));
+        g.cell_data.ints.emplace_back(nm, std::move(v));
+      } else {
+        fail(file, a.line, "CellData '" + nm + "': unsupported type \"" + type + "\"");
+      }
+    }
+  }
+  return g;
+}
+
+// ---- Legacy .vtk reader -----------------------------------------------------------------------
+
+namespace {
+
+// Token stream over the body of a legacy file (after the 3 header lines).
+class Tokens {
+ public:
+  Tokens(std::string_view text, int first_line, std::string file) : s_(text), line_(first_line), file_(std::move(file)) {}
+  bool done() {
+    skip_space();
+    return pos_ >= s_.size();
+  }
+  int line() {
+    skip_space();
+    return line_;
+  }
+  std::string_view next(const std::string& what) {
+    if (done()) fail(file_, line_, "unexpected end of file while reading " + what + " (truncated file?)");
+    const std::size_t start = pos_;
+    while (pos_ < s_.size() && !std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
+    token_line_ = line_;
+    return s_.substr(start, pos_ - start);
+  }
+  std::string_view peek() const {
+    std::size_t start = pos_;
+    while (start < s_.size() && std::isspace(static_cast<unsigned char>(s_[start]))) ++start;
+    std::size_t end = start;
+    while (end < s_.size() && !std::isspace(static_cast<unsigned char>(s_[end]))) ++end;
+    return s_.substr(start, end - start);
+  }
+  // Skips up to the next blank line (VTK's METADATA blocks end there).
+  void skip_to_blank_line() {
+    while (pos_ < s_.size()) {
+      const std::size_t eol = s_.find('\n', pos_);
+      if (eol == std::string_view::npos) {
+        pos_ = s_.size();
+        return;
+      }
+      pos_ = eol + 1;
+      ++line_;
+      std::size_t p = pos_;
+      while (p < s_.size() && s_[p] != '\n' && std::isspace(static_cast<unsigned char>(s_[p]))) ++p;
+      if (p >= s_.size() || s_[p] == '\n') return;
+    }
+  }
+  int line_before() const { return token_line_; }
+  // Binary legacy files (big-endian, VTK's file format manual): the values of one array follow
+  // the line that announces it. begin_array(type) switches integer() and real() to those bytes
+  // until end_array(); in ASCII files both do nothing.
+  void set_binary(bool binary) { binary_ = binary; }
+  void begin_array(std::string_view type, const std::string& what) {
+    if (!binary_) return;
+    const std::string t = lower(type);
+    if (t == "float") size_ = 4, real_ = true;
+    else if (t == "double") size_ = 8, real_ = true;
+    else if (t == "char" || t == "unsigned_char" || t == "bit") size_ = 1, real_ = false;
+    else if (t == "short" || t == "unsigned_short") size_ = 2, real_ = false;
+    else if (t == "int" || t == "unsigned_int" || t == "vtktypeint32") size_ = 4, real_ = false;
+    else if (t == "long" || t == "unsigned_long" || t == "vtktypeint64" || t == "vtktypeuint64" || t == "vtkidtype") size_ = 8, real_ = false;
+    else fail(file_, line_, what + ": binary type '" + std::string(type) + "' is not supported");
+    unsigned_ = t.rfind("unsigned", 0) == 0 || t == "vtktypeuint64";
+    const std::size_t eol = s_.find('\n', pos_);
+    if (eol == std::string_view::npos) fail(file_, line_, what + ": no binary data (truncated file?)");
+    pos_ = eol + 1;
+    ++line_;
+    in_array_ = true;
+  }
+  void end_array() {
+    if (!in_array_) return;
+    in_array_ = false;
+    // The bytes may hold '\n': count none of them as lines.
+  }
+  long long integer(const std::string& what) {
+    if (in_array_) {
+      if (real_) fail(file_, line_, what + ": floating-point data where integers are expected");
+      const std::uint64_t bits = raw_bits(what);
+      if (unsigned_ || size_ == 8) {
+        if (unsigned_ && bits > static_cast<std::uint64_t>(std::numeric_limits<long long>::max()))
+          fail(file_, line_, what + ": " + std::to_string(bits) + " is out of range");
+        return static_cast<long long>(bits);
+      }
+      const std::uint64_t sign = std::uint64_t{1} << (8 * size_ - 1);
+      return static_cast<long long>(bits ^ sign) - static_cast<long long>(sign);
+    }
+    const auto t = next(what);
+    return parse_int(file_, line_before(), t);
+  }
+  double real(const std::string& what) {
+    if (in_array_) return raw(what);
+    const auto t = next(what);
+    return parse_double(file_, line_before(), t);
+  }
+  // An integer that must fit an int (node numbers, cell types, int arrays).
+  int int32(const std::string& what) {
+    const long long v = integer(what);
+    if (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max())
+      fail(file_, line_before(), what + ": " + std::to_string(v) + " is out of range");
+    return static_cast<int>(v);
+  }
+  std::size_t count(const std::string& what) {
+    const long long n = integer(what);
+    if (n < 0) fail(file_, line_before(), what + " is negative");
+    return static_cast<std::size_t>(n);
+  }
+  void expect(std::string_view word, const std::string& what) {
+    const auto t = next(what);
+    if (t != word) {
+      fail(file_, line_before(),
+           "expected " + std::string(word) + ", found '" + std::string(t) + "'");
+    }
+  }
+
+ private:
+  std::string_view s_;
+  std::size_t pos_ = 0;
+  int line_ = 1, token_line_ = 1;
+  std::string file_;
+  bool binary_ = false, in_array_ = false, real_ = false, unsigned_ = false;
+  std::size_t size_ = 4;
+
+  static std::string lower(std::string_view s) {
+    std::string l(s);
+    for (auto& c : l) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return l;
+  }
+  void skip_space() {
+    if (in_array_) return;
+    while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_]))) line_ += s_[pos_++] == '\n';
+  }
+  // One big-endian value of the current array type, as its bits.
+  std::uint64_t raw_bits(const std::string& what) {
+    if (s_.size() - pos_ < size_) fail(file_, line_, what + ": binary data cut short (truncated file?)");
+    std::uint64_t bits = 0;
+    for (std::size_t k = 0; k < size_; ++k) bits = bits << 8 | static_cast<unsigned char>(s_[pos_ + k]);
+    pos_ += size_;
+    return bits;
+  }
+  // The same as a double (integer arrays read as reals: converted exactly up to 2^53).
+  double raw(const std::string& what) {
+    const std::uint64_t bits = raw_bits(what);
+    if (real_) {
+      if (size_ == 4) {
+        const auto b32 = static_cast<std::uint32_t>(bits);
+        float f;
+        std::memcpy(&f, &b32, 4);
+        return f;
+      }
+      double d;
+      std::memcpy(&d, &bits, 8);
+      return d;
+    }
+    if (unsigned_) return static_cast<double>(bits);
+    if (size_ == 8) return static_cast<double>(static_cast<std::int64_t>(bits));
+    const std::uint64_t sign = std::uint64_t{1} << (8 * size_ - 1);
+    return static_cast<double>(static_cast<std::int64_t>(bits ^ sign) - static_cast<std::int64_t>(sign));
+  }
+};
+
+std::string upper(std::string_view s) {
+  std::string u(s);
+  for (auto& c : u) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return u;
+}
+
+}  // namespace
+
+VtkGrid read_vtk(const std::filesystem::path& path) {
+  check_mesh_format(path, MeshFileFormat::kVtk);
+  return parse_vtk(read_file_bytes(path), path.string());
+}
+
+VtkGrid parse_vtk(std::string_view content, const std::string& source) {
+  VtkGrid g;
+  g.source = source;
+  const std::string& file = g.source;
+  const std::string_view text = content;
+  // Header: 3 lines.
+  std::size_t pos = 0;
+  std::array<std::string, 3> header;
+  for (int l = 0; l < 3; ++l) {
+    const auto e = text.find('\n', pos);
+    if (e == std::string::npos)
+      fail(file, l + 1, "unexpected end of file in the header (truncated file?)");
+    header[l] = std::string(text.substr(pos, e - pos));
+    if (!header[l].empty() && header[l].back() == '\r') header[l].pop_back();
+    pos = e + 1;
+  }
+  if (header[0].rfind("# vtk DataFile Version", 0) != 0) {
+    fail(file, 1, "not a legacy VTK file (expected '# vtk DataFile Version')");
+  }
+  const bool binary = upper(header[2]).rfind("BINARY", 0) == 0;
+  if (!binary && upper(header[2]).rfind("ASCII", 0) != 0)
+    fail(file, 3, "'" + header[2] + "' is neither ASCII nor BINARY");
+  Tokens t(text.substr(pos), 4, file);
+  t.set_binary(binary);
+  t.expect("DATASET", "the DATASET line");
+  if (const auto type = t.next("the dataset type"); upper(type) != "UNSTRUCTURED_GRID") {
+    fail(file, t.line_before(),
+         "dataset " + std::string(type) + " is not supported (UNSTRUCTURED_GRID only)");
+  }
+  std::vector<int> cell_line, type_line;
+  std::size_t nc = 0;
+  bool have_points = false, have_cells = false, have_types = false;
+  while (!t.done()) {
+    const std::string key = upper(t.next("a section keyword"));
+    const int key_line = t.line_before();
+    if (key == "POINTS") {
+      const std::size_t np = t.count("the number of points");
+      t.begin_array(t.next("the point type"), "POINTS");
+      for (std::size_t i = 0; i < np; ++i) {
+        const std::string what = "point " + std::to_string(i);
+        const double x = t.real(what);
+        const int line = t.line_before();
+        const double y = t.real(what), z = t.real(what);
+        g.points.push_back(point_from(file, line, i, x, y, z));
+      }
+      t.end_array();
+      have_points = true;
+    } else if (key == "CELLS") {
+      nc = t.count("the number of cells");
+      const std::size_t size = t.count("the CELLS size");
+      if (upper(t.peek()) ==
+          "OFFSETS") {  // 5.1 layout: OFFSETS type (n+1 values) CONNECTIVITY type
+        t.next("OFFSETS");
+        t.begin_array(t.next("the offsets type"), "OFFSETS");
+        if (nc == 0) fail(file, key_line, "CELLS: 5.1 layout needs at least one offset");
+        std::vector<std::size_t> offsets;
+        for (std::size_t i = 0; i < nc; ++i)
+          offsets.push_back(t.count("offset " + std::to_string(i)));
+        t.end_array();
+        t.expect("CONNECTIVITY", "the CONNECTIVITY keyword");
+        t.begin_array(t.next("the connectivity type"), "CONNECTIVITY");
+        nc -= 1;  // the 5.1 header counts offsets
+        for (std::size_t c = 0; c < nc; ++c) {
+          if (offsets[c + 1] < offsets[c] || offsets[c + 1] > size) {
+            fail(file, key_line, "OFFSETS: cell " + std::to_string(c) + " has bad offsets");
+          }
+          std::vector<Index> cell;
+          cell_line.push_back(t.line());
+          for (std::size_t i = offsets[c]; i < offsets[c + 1]; ++i) {
+            cell.push_back((t.int32("cell " + std::to_string(c))));
+          }
+          g.cells.push_back(std::move(cell));
+        }
+        t.end_array();
+      } else {
+        std::size_t read = 0;
+        t.begin_array("int", "CELLS");
+        for (std::size_t c = 0; c < nc; ++c) {
+          const std::string what = "cell " + std::to_string(c);
+          const std::size_t n = t.count(what);
+          cell_line.push_back(t.line_before());
+          std::vector<Index> cell;
+          for (std::size_t i = 0; i < n; ++i) cell.push_back((t.int32(what)));
+          read += n + 1;
+          g.cells.push_back(std::move(cell));
+        }
+        t.end_array();
+        if (read != size) {
+          fail(file, key_line,
+               "CELLS: size " + std::to_string(size) + " but the cells hold " +
+                   std::to_string(read) + " values");
+        }
+      }
+      have_cells = true;
+    } else if (key == "CELL_TYPES") {
+      const std::size_t n = t.count("the number of cell types");
+      if (!have_cells || n != nc) {
+        fail(file, key_line,
+             "CELL_TYPES " + std::to_string(n) + " does not follow CELLS " + std::to_string(nc));
+      }
+      t.begin_array("int", "CELL_TYPES");
+      for (std::size_t c = 0; c < n; ++c) {
+        g.cell_types.push_back(
+            (t.int32("the type of cell " + std::to_string(c))));
+        type_line.push_back(t.line_before());
+      }
+      t.end_array();
+      have_types = true;
+    } else if (key == "CELL_DATA" || key == "POINT_DATA") {
+      const bool cell = key == "CELL_DATA";
+      const std::size_t n = t.count("the " + key + " count");
+      if (cell && (!have_types || n != nc)) {
+        fail(file, key_line,
+             "CELL_DATA " + std::to_string(n) + " does not match " + std::to_string(nc) + " cells");
+      }
+      // Attribute sections until the next dataset-level keyword.
+      while (!t.done()) {
+        const std::string kind = upper(t.peek());
+        if (kind == "CELL_DATA" || kind == "POINT_DATA") break;
+        t.next("an attribute");
+        if (kind == "METADATA") {
+          t.skip_to_blank_line();
+          continue;
+        }
+        const int attr_line = t.line_before();
+        std::vector<std::pair<std::string, std::string>> arrays;  // name, type
+        std::vector<std::size_t> comps;
+        if (kind == "SCALARS") {
+          const std::string name(t.next("the SCALARS name"));
+          const std::string type(t.next("the SCALARS type"));
+          std::size_t nco = 1;
+          if (upper(t.peek()) != "LOOKUP_TABLE") nco = t.count("the SCALARS component count");
+          t.expect("LOOKUP_TABLE", "LOOKUP_TABLE");
+          t.next("the lookup table name");
+          arrays.emplace_back(name, type);
+          comps.push_back(nco);
+        } else if (kind == "FIELD") {
+          t.next("the FIELD name");
+          const std::size_t k = t.count("the FIELD array count");
+          for (std::size_t a = 0; a < k; ++a) {
+            const std::string name(t.next("a FIELD array name"));
+            const std::size_t nco = t.count("the component count of " + name);
+            const std::size_t tuples = t.count("the tuple count of " + name);
+            const std::string type(t.next("the type of " + name));
+            if (tuples != n)
+              fail(file, t.line_before(),
+                   "FIELD array " + name + ": " + std::to_string(tuples) + " tuples, expected " +
+                       std::to_string(n));
+            // FIELD arrays are read one by one (values follow each header).
+            const bool is_real = upper(type) == "FLOAT" || upper(type) == "DOUBLE";
+            std::vector<double> dv;
+            std::vector<int> iv;
+            t.begin_array(type, "FIELD array " + name);
+            for (std::size_t i = 0; i < n * nco; ++i) {
+              if (is_real)
+                dv.push_back(t.real("array " + name));
+              else
+                iv.push_back((t.int32("array " + name)));
+            }
+            t.end_array();
+            if (cell && nco == 1) {
+              if (is_real)
+                g.cell_data.doubles.emplace_back(name, std::move(dv));
+              else
+                g.cell_data.ints.emplace_back(name, std::move(iv));
+            }
+          }
+          continue;
+        } else if (kind == "VECTORS" || kind == "NORMALS") {
+          arrays.emplace_back(std::string(t.next("the array name")),
+                              std::string(t.next("the array type")));
+          comps.push_back(3);
+        } else {
+          fail(file, attr_line, "unsupported attribute section '" + kind + "'");
+        }
+        for (std::size_t a = 0; a < arrays.size(); ++a) {
+          const auto& [name, type] = arrays[a];
+          const bool is_real = upper(type) == "FLOAT" || upper(type) == "DOUBLE";
+          std::vector<double> dv;
+          std::vector<int> iv;
+          t.begin_array(type, "array " + name);
+          for (std::size_t i = 0; i < n * comps[a]; ++i) {
+            if (is_real)
+              dv.push_back(t.real("array " + name));
+            else
+              iv.push_back((t.int32("array " + name)));
+          }
+          t.end_array();
+          if (cell && comps[a] == 1) {
+            if (is_real)
+              g.cell_data.doubles.emplace_back(name, std::move(dv));
+            else
+              g.cell_data.ints.emplace_back(name, std::move(iv));
+          }
+        }
+      }
+    } else if (key == "METADATA") {
+      // VTK 8+ writes METADATA blocks (array information) that end at a blank line.
+      t.skip_to_blank_line();
+    } else {
+      fail(file, key_line, "unknown or unsupported section '" + key + "'");
+    }
+  }
+  if (!have_points) fail(file, t.line(), "no POINTS section (truncated file?)");
+  if (!have_cells) fail(file, t.line(), "no CELLS section (truncated file?)");
+  if (!have_types) fail(file, t.line(), "no CELL_TYPES section (truncated file?)");
+  check_cells(g, [&](std::size_t c, bool type) { return type ? type_line[c] : cell_line[c]; });
+  return g;
+}
+
+VtkGrid read_vtk_file(const std::filesystem::path& path) {
+  const std::string ext = path.extension().string();
+  if (ext == ".vtu") return read_vtu(path);
+  if (ext == ".vtk") return read_vtk(path);
+  throw InvalidInput(path.string() + ": unknown extension '" + ext + "' (expected .vtu or .vtk)");
+}
+
+}  // namespace geode::primal
