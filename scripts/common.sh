@@ -8,8 +8,8 @@ GEODE_PACKAGES=(cmake g++ make libopenmesh-dev libeigen3-dev doctest-dev libcli1
   libtbb-dev ccache)
 JOBS=${JOBS:-$(nproc)}
 # ccache keeps compiled objects between runs (and between clones: paths below the root are
-# hashed relative to it), so a second build costs little.
-export CCACHE_BASEDIR="$GEODE_ROOT"
+# hashed relative to it, the build directory not at all), so a second build costs little.
+export CCACHE_BASEDIR="$GEODE_ROOT" CCACHE_NOHASHDIR=1
 GEODE_LAUNCHER=()
 command -v ccache >/dev/null 2>&1 && GEODE_LAUNCHER=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 
