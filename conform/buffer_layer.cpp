@@ -90,9 +90,9 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
       const Point es = pt(q.corners[(i + 3) % 4]) - pt(v);
       const Point n = er.cross(es);
       if (n.norm() <= 0.0)
-        throw TopologyError("insert_buffer_layer: interface quad of hex " + std::to_string(q.hex) +
-                            " face " + std::to_string(q.face) + " is degenerate at node " +
-                            std::to_string(v));
+        throw TopologyError("insert_buffer_layer: interface face " + std::to_string(q.face + 1) + " of " +
+                            describe_element(input, {ElementKind::Hex, q.hex}) + " is degenerate at " +
+                            describe_node(input, v));
       corner_normals[slot(v)].push_back(n.normalized());
       shortest[slot(v)] = std::min({shortest[slot(v)], er.norm(), es.norm()});
     }
@@ -158,7 +158,7 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
     }
     for (Point& f : features) f.normalize();
     if (features.size() >= 3)
-      throw TopologyError("insert_buffer_layer: node " + std::to_string(v) +
+      throw TopologyError("insert_buffer_layer: " + describe_node(input, v) +
                           " is a corner of the tet part's outer boundary (" +
                           std::to_string(features.size()) +
                           " feature faces meet there): its tet-side copy cannot move off the interface");
@@ -172,7 +172,7 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
     };
     auto [d, m] = best_direction(corner_normals[k], project);
     if (!(m >= opt.min_visibility))
-      throw TopologyError("insert_buffer_layer: node " + std::to_string(v) +
+      throw TopologyError("insert_buffer_layer: " + describe_node(input, v) +
                           ": no direction into the tet side lies above all " +
                           std::to_string(corner_normals[k].size()) +
                           " interface faces at it (best min cos " + std::to_string(m) +
@@ -220,8 +220,9 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
           if (static_cast<std::size_t>(v) >= n_points) {
             failing[static_cast<std::size_t>(v) - n_points] = 1;
             if (first_failure.empty())
-              first_failure = "node " + std::to_string(interface_nodes[static_cast<std::size_t>(v) - n_points]) +
-                              ": tet " + std::to_string(t) + " keeps only " + std::to_string(ratio) +
+              first_failure = describe_node(input, interface_nodes[static_cast<std::size_t>(v) - n_points]) +
+                              ": " + describe_element(input, {ElementKind::Tet, static_cast<Index>(t)}) +
+                              " keeps only " + std::to_string(ratio) +
                               " of its volume";
           }
       }

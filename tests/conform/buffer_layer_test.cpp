@@ -162,7 +162,7 @@ TEST_CASE("insert_buffer_layer: no layer where no direction sees all interface f
   });
   const Interface itf = find_interface(m);
   CHECK(itf.quads.size() == 6);
-  CHECK_THROWS_WITH_AS(insert_buffer_layer(m, itf), doctest::Contains("node 13: no direction"), TopologyError);
+  CHECK_THROWS_WITH_AS(insert_buffer_layer(m, itf), doctest::Contains("node 14 (1, 1, 1): no direction"), TopologyError);
 }
 
 TEST_CASE("Gmsh demo models: conforming interface and a valid buffer layer") {
