@@ -40,6 +40,10 @@ namespace {
 // Checks cell types, node counts and node ranges; `line_of_cell` gives the line to report.
 template <typename LineOf>
 void check_cells(const VtkGrid& g, LineOf&& line_of_cell) {
+  if (g.cell_types.size() != g.cells.size())  // named at the first cell or type without a partner
+    fail(g.source,
+         g.cell_types.size() > g.cells.size() ? line_of_cell(g.cells.size(), true) : line_of_cell(g.cell_types.size(), false),
+         std::to_string(g.cells.size()) + " cells but " + std::to_string(g.cell_types.size()) + " cell types");
   for (std::size_t c = 0; c < g.cells.size(); ++c) {
     const int type = g.cell_types[c];
     const char* name = cell_type_name(type);
@@ -858,6 +862,9 @@ VtkGrid parse_vtk(std::string_view content, const std::string& source) {
   while (!t.done()) {
     const std::string key = upper(t.next("a section keyword"));
     const int key_line = t.line_before();
+    // Each section once: a repeated one would append to arrays already checked against others.
+    if ((key == "POINTS" && have_points) || (key == "CELLS" && have_cells) || (key == "CELL_TYPES" && have_types))
+      fail(file, key_line, key + " given twice");
     if (key == "POINTS") {
       const std::size_t np = t.count("the number of points");
       t.begin_array(t.next("the point type"), "POINTS");
