@@ -31,18 +31,20 @@ geode_install() {
 }
 
 # geode_fuzz: the libFuzzer targets of the file readers (tests/fuzz), built with clang in
-# build-fuzz, each run for GEODE_FUZZ_SECONDS (30) from its seed corpus; a crash fails, its input
-# kept as build-fuzz/crash-<reader>-*.
+# build-fuzz, each run for GEODE_FUZZ_RUNS inputs (100,000; about 10 to 35 s each here) from its
+# seed corpus with a fixed seed, so a run is repeatable for a given build (a longer search:
+# GEODE_FUZZ_RUNS=-1 GEODE_FUZZ_SECONDS=600). A crash fails, its input kept as
+# build-fuzz/crash-<reader>-*: fix it and add it to tests/fuzz/regressions.
 geode_fuzz() {
-  local seconds=${GEODE_FUZZ_SECONDS:-30} dir="$GEODE_ROOT/build-fuzz"
+  local runs=${GEODE_FUZZ_RUNS:-100000} seconds=${GEODE_FUZZ_SECONDS:-120} dir="$GEODE_ROOT/build-fuzz"
   CC=clang CXX=clang++ cmake -S "$GEODE_ROOT" -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGEODE_FUZZ=ON \
     -DGEODE_BENCH=OFF "${GEODE_LAUNCHER[@]}" >/dev/null
   cmake --build "$dir" -j "$JOBS" --target fuzz_msh fuzz_vtu fuzz_vtk
   for reader in msh vtu vtk; do
     local work
     work=$(mktemp -d)
-    echo "== fuzz $reader ($seconds s)"
-    if ! "$dir/fuzz_$reader" -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=10 \
+    echo "== fuzz $reader ($runs inputs, at most $seconds s)"
+    if ! "$dir/fuzz_$reader" -seed=1 -runs="$runs" -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=10 \
         -artifact_prefix="$dir/crash-$reader-" "$work" "$GEODE_ROOT/tests/fuzz/corpus/$reader" \
         >"$dir/fuzz_$reader.log" 2>&1; then
       tail -40 "$dir/fuzz_$reader.log" >&2
