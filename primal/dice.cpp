@@ -1,12 +1,12 @@
 #include "primal/dice.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <string>
-#include <algorithm>
-
-#include "primal/key_map.hpp"
 
 #include "primal/errors.hpp"
+#include "primal/key_map.hpp"
+#include "primal/quality.hpp"
 #include "primal/topology.hpp"
 
 namespace geode::primal {
@@ -257,6 +257,62 @@ DicedQuadMesh dice(const QuadMesh& mesh) {
 DicedQuadMesh dice(const TriMesh& mesh) {
   static const auto table = simplex_children<2>();
   return finish<DicedQuadMesh>(dice_elements(mesh.points, mesh.tris, table, "triangle"), {});
+}
+
+namespace {
+
+// Each child corner of a diced reference element as the element corners it averages, read
+// off dice() itself so that this follows the dicing's node placement and corner order.
+template <class Mesh, std::size_t N>
+std::vector<std::array<std::vector<int>, 8>> child_weights() {
+  Mesh ref;
+  std::array<Index, N> cell{};
+  for (std::size_t i = 0; i < N; ++i) ref.points.push_back(Point::Zero()), cell[i] = static_cast<Index>(i);
+  if constexpr (N == 4) ref.tets.push_back(cell);
+  else ref.hexes.push_back(cell);
+  const DicedHexMesh d = dice(ref);
+  std::vector<std::array<std::vector<int>, 8>> children;
+  for (const auto& h : d.mesh.hexes) {
+    std::array<std::vector<int>, 8> w;
+    for (int c = 0; c < 8; ++c) {
+      const NodeOrigin& o = d.origin[static_cast<std::size_t>(h[c])];
+      if (o.kind == NodeOriginKind::kCell) {
+        for (std::size_t i = 0; i < N; ++i) w[c].push_back(static_cast<int>(i));
+      } else {
+        for (Index v : o.nodes)
+          if (v != kInvalidIndex) w[c].push_back(static_cast<int>(v));
+      }
+    }
+    children.push_back(w);
+  }
+  return children;
+}
+
+template <class Mesh, std::size_t N>
+double diced_min(std::span<const Point> points, std::span<const std::array<Index, N>> cells) {
+  static const auto children = child_weights<Mesh, N>();
+  double lowest = 1.0;
+  for (const auto& cell : cells)
+    for (const auto& w : children) {
+      HexCorners p;
+      for (int c = 0; c < 8; ++c) {
+        Point s = Point::Zero();
+        for (int i : w[c]) s += points[static_cast<std::size_t>(cell[static_cast<std::size_t>(i)])];
+        p[c] = s / static_cast<double>(w[c].size());
+      }
+      lowest = std::min(lowest, hex_scaled_jacobian(p));
+    }
+  return lowest;
+}
+
+}  // namespace
+
+double diced_min_scaled_jacobian(std::span<const Point> points, std::span<const std::array<Index, 4>> tets) {
+  return diced_min<TetMesh, 4>(points, tets);
+}
+
+double diced_min_scaled_jacobian(std::span<const Point> points, std::span<const std::array<Index, 8>> hexes) {
+  return diced_min<HexMesh, 8>(points, hexes);
 }
 
 }  // namespace geode::primal

@@ -8,7 +8,9 @@
 // Node numbering of the result: the input points keep their numbers 0..V-1 (even unused
 // ones), then one node per edge, per face (3D only), per element, each group in order of first
 // appearance, so V' = V + E + F + C (hexes, tets) or V + E + F (quads, triangles).
+#include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "primal/boundary.hpp"
@@ -44,5 +46,11 @@ DicedHexMesh dice(const HexMesh& mesh);    // 8 per hex; child c has parent corn
 DicedHexMesh dice(const TetMesh& mesh);    // 4 per tet; child c has parent corner c as corner 0
 DicedQuadMesh dice(const QuadMesh& mesh);  // 4 per quad; like hexes
 DicedQuadMesh dice(const TriMesh& mesh);   // 3 per triangle; like tets
+
+// The lowest scaled Jacobian (primal/quality.hpp) of the hexes `dice` would make of these
+// elements, computed element by element without building the diced mesh: what an element
+// part gives when diced alone, the yardstick for a transition placed beside it. 1 when empty.
+double diced_min_scaled_jacobian(std::span<const Point> points, std::span<const std::array<Index, 4>> tets);
+double diced_min_scaled_jacobian(std::span<const Point> points, std::span<const std::array<Index, 8>> hexes);
 
 }  // namespace geode::primal

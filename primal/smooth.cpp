@@ -112,7 +112,7 @@ std::string node_name(std::size_t i) { return "node " + std::to_string(i); }
 
 std::vector<NodeSpace> node_spaces(const std::vector<Point>& points,
                                    std::span<const NodeConstraint> constraints,
-                                   const Point* plane_normal) {
+                                   const Point* plane_normal, std::span<const NodeLink> links) {
   if (!constraints.empty() && constraints.size() != points.size()) {
     throw InvalidInput("smooth: " + std::to_string(constraints.size()) + " constraints for " +
                        std::to_string(points.size()) + " nodes");
@@ -163,8 +163,32 @@ std::vector<NodeSpace> node_spaces(const std::vector<Point>& points,
     }
     s.basis.resize(3, static_cast<Eigen::Index>(dirs.size()));
     for (std::size_t k = 0; k < dirs.size(); ++k) s.basis.col(static_cast<Eigen::Index>(k)) = dirs[k];
-    s.offset = offset;
-    offset += static_cast<int>(dirs.size());
+  }
+  // Followers take their leader's coordinates through the link's map; the others get their own.
+  std::vector<char> follows(points.size(), 0);
+  for (const NodeLink& l : links) {
+    const auto n = static_cast<std::size_t>(l.node), lead = static_cast<std::size_t>(l.leader);
+    if (l.node < 0 || n >= points.size() || l.leader < 0 || lead >= points.size() || n == lead ||
+        !l.map.allFinite())
+      throw InvalidInput("smooth: a node link names node " + std::to_string(l.node) + " and leader " +
+                         std::to_string(l.leader) + " (" + std::to_string(points.size()) + " nodes)");
+    follows[n] = 1;
+  }
+  for (const NodeLink& l : links)
+    if (follows[static_cast<std::size_t>(l.leader)])
+      throw InvalidInput("smooth: " + node_name(static_cast<std::size_t>(l.leader)) +
+                         " leads a link but follows another");
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (follows[i]) continue;
+    spaces[i].offset = offset;
+    offset += static_cast<int>(spaces[i].basis.cols());
+  }
+  for (const NodeLink& l : links) {
+    NodeSpace& s = spaces[static_cast<std::size_t>(l.node)];
+    const NodeSpace& lead = spaces[static_cast<std::size_t>(l.leader)];
+    s.base = points[static_cast<std::size_t>(l.node)];
+    s.basis = l.map * lead.basis;
+    s.offset = lead.offset;
   }
   return spaces;
 }
@@ -226,7 +250,7 @@ class Problem {
   Problem(const std::vector<Frame>& frames, std::vector<NodeSpace> spaces, double unit,
           double guard)
       : spaces_(std::move(spaces)), unit_(unit), guard_(guard) {
-    for (const auto& s : spaces_) dof_ += static_cast<int>(s.basis.cols());
+    for (const auto& s : spaces_) dof_ = std::max(dof_, s.offset + static_cast<int>(s.basis.cols()));
     for (const Frame& f : frames) {
       if (f.guard != 0 && !(guard > 0.0)) continue;
       Local l;
@@ -619,7 +643,7 @@ SmoothResult smooth_hex_mesh(HexMesh& mesh, std::span<const NodeConstraint> cons
   for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
     for (Index n : mesh.hexes[h]) check_nodes(mesh.points.size(), n, "hex " + std::to_string(h));
   }
-  auto spaces = node_spaces(mesh.points, constraints, nullptr);
+  auto spaces = node_spaces(mesh.points, constraints, nullptr, options.links);
   return run(mesh.points, hex_frames(mesh), std::move(spaces), 3, options);
 }
 
@@ -633,7 +657,7 @@ SmoothResult smooth_quad_mesh(QuadMesh& mesh, const Point& normal,
     for (Index n : mesh.quads[q]) check_nodes(mesh.points.size(), n, "quad " + std::to_string(q));
   }
   const Point n = normal.normalized();
-  auto spaces = node_spaces(mesh.points, constraints, &n);
+  auto spaces = node_spaces(mesh.points, constraints, &n, options.links);
   return run(mesh.points, quad_frames(mesh, n), std::move(spaces), 2, options);
 }
 

@@ -22,6 +22,7 @@
 // decrease, or after max_stage_iterations; all stages together stop after max_iterations. The
 // returned positions are those of the iterate with the largest true minimum scaled Jacobian.
 // No randomness and no threads: the same input gives bit-identical output.
+#include <Eigen/Core>
 #include <array>
 #include <span>
 #include <vector>
@@ -60,6 +61,16 @@ std::vector<NodeConstraint> box_constraints(std::span<const Point> points, const
                                             std::array<bool, 6> fixed_faces = {},
                                             double tol = 1e-9);
 
+// A node that moves with another (its leader): p = p0 + map (q - q0), p0 and q0 their places
+// at the start, q the leader's place. Ties symmetric copies of one node, e.g. the side faces
+// of a template that neighbours share in any orientation. The node's own constraint is
+// ignored; the caller keeps `map` consistent with the leader's constraint (a leader mapped
+// onto itself must be constrained to the map's fixed directions). A leader is not a follower.
+struct NodeLink {
+  Index node = 0, leader = 0;
+  Eigen::Matrix3d map = Eigen::Matrix3d::Identity();
+};
+
 struct SmoothOptions {
   int max_iterations = 3000;           // L-BFGS iterations over all phases
   int max_untangle_iterations = 1000;
@@ -75,6 +86,7 @@ struct SmoothOptions {
   // |A|_F^2; quads 2 det / (|a|^2 + |b|^2)) divided by this factor; it binds only where a
   // corner's shape falls below factor x (the scaled Jacobian being achieved). 0 turns it off.
   double shape_guard = 0.5;
+  std::vector<NodeLink> links;  // hex and quad meshes alike
 };
 
 struct SmoothResult {

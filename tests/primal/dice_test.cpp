@@ -271,3 +271,20 @@ TEST_CASE("dice: bad input") {
   b.block = {1};
   CHECK_THROWS_AS(dice(b), geode::InvalidInput);
 }
+
+TEST_CASE("diced_min_scaled_jacobian: the minimum over dice()'s hexes, without dicing") {
+  for (double amount : {0.0, 0.08, 0.2}) {
+    CAPTURE(amount);
+    TetMesh t = kuhn_grid(3);
+    jitter(t.points, amount);
+    HexMesh h = structured_hex_grid(3, 2, 2);
+    jitter(h.points, amount);
+    const double tets = diced_min_scaled_jacobian(t.points, t.tets);
+    const double hexes = diced_min_scaled_jacobian(h.points, h.hexes);
+    CHECK(tets == doctest::Approx(min_scaled_jacobian(dice(t).mesh)).epsilon(1e-12));
+    CHECK(hexes == doctest::Approx(min_scaled_jacobian(dice(h).mesh)).epsilon(1e-12));
+    if (amount == 0.0) CHECK(hexes == doctest::Approx(1.0));
+    else CHECK(tets < diced_min_scaled_jacobian(kuhn_grid(3).points, kuhn_grid(3).tets));
+  }
+  CHECK(diced_min_scaled_jacobian(std::vector<Point>{}, std::vector<std::array<Index, 4>>{}) == 1.0);
+}

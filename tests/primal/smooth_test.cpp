@@ -222,3 +222,53 @@ TEST_CASE("smoothing rejects malformed constraints") {
   gp::QuadMesh q = geode::test::structured_quad_grid(1, 1);
   CHECK_THROWS_AS(gp::smooth_quad_mesh(q, Point(0, 0, 0)), geode::InvalidInput);
 }
+
+TEST_CASE("linked nodes move as their leader's mirror image: a symmetric mesh stays symmetric") {
+  // A 2 x 2 x 2 grid on [-1, 1]^3, perturbed symmetrically about x = 0.
+  HexMesh m;
+  auto id = [](int i, int j, int k) { return static_cast<Index>(i + 3 * j + 9 * k); };
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) m.points.emplace_back(i - 1.0, j - 1.0, k - 1.0);
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i)
+        m.hexes.push_back({id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k),
+                           id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1), id(i, j + 1, k + 1)});
+  m.points[id(1, 1, 1)] = Point(0.0, 0.5, 0.4);
+  m.points[id(0, 1, 1)] = Point(-1.0, 0.5, -0.5);
+  m.points[id(2, 1, 1)] = Point(1.0, 0.5, -0.5);
+  m.points[id(0, 1, 0)] = Point(-0.4, 0.6, -1.0);
+  m.points[id(2, 1, 0)] = Point(0.4, 0.6, -1.0);
+  const double before = gp::min_scaled_jacobian(m);
+  auto constraints = gp::box_constraints(m.points, Point::Constant(-1), Point::Constant(1));
+  gp::SmoothOptions o;
+  const Eigen::Matrix3d mirror = Eigen::Vector3d(-1, 1, 1).asDiagonal();
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 3; ++j) {
+      o.links.push_back({id(2, j, k), id(0, j, k), mirror});
+      // A leader that is its own mirror image moves in the plane x = 0 only.
+      auto& c = constraints[id(1, j, k)];
+      const Point p = m.points[id(1, j, k)];
+      if (c.kind == NodeConstraint::Kind::kFree) c = NodeConstraint::plane(p, Point::UnitX());
+      else if (c.kind == NodeConstraint::Kind::kPlane) c = NodeConstraint::line(p, c.direction.cross(Point::UnitX()));
+    }
+  const HexMesh start = m;
+  const auto r = gp::smooth_hex_mesh(m, constraints, o);
+  CHECK(r.final_min_scaled_jacobian > before + 0.1);
+  CHECK((m.points[id(1, 1, 1)] - start.points[id(1, 1, 1)]).norm() > 0.1);
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 3; ++j) {
+      CHECK((m.points[id(2, j, k)] - mirror * m.points[id(0, j, k)]).norm() < 1e-12);
+      CHECK(std::abs(m.points[id(1, j, k)].x()) < 1e-12);
+    }
+
+  // A leader that follows another, or a link out of range, is refused.
+  gp::SmoothOptions chained;
+  chained.links = {{id(2, 0, 0), id(0, 0, 0), mirror}, {id(0, 0, 0), id(1, 0, 0), mirror}};
+  HexMesh copy = start;
+  CHECK_THROWS_AS(gp::smooth_hex_mesh(copy, constraints, chained), geode::InvalidInput);
+  gp::SmoothOptions out_of_range;
+  out_of_range.links = {{id(2, 0, 0), 99, mirror}};
+  CHECK_THROWS_AS(gp::smooth_hex_mesh(copy, constraints, out_of_range), geode::InvalidInput);
+}
