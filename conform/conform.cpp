@@ -9,6 +9,7 @@
 
 #include "conform/reference_template.hpp"
 #include "primal/boundary.hpp"
+#include "primal/dice.hpp"
 #include "primal/dice_model.hpp"
 #include "primal/disjoint_sets.hpp"
 #include "primal/errors.hpp"
@@ -143,6 +144,8 @@ void Conformer::find_interface() {
                        std::to_string(input_.hexes.size()) + " hexes, " +
                        std::to_string(input_.tets.size()) + " tets)");
   t0_ = Clock::now();
+  res_.input_diced_hex_min_scaled_jacobian = primal::diced_min_scaled_jacobian(input_.points, input_.hexes);
+  res_.input_diced_tet_min_scaled_jacobian = primal::diced_min_scaled_jacobian(input_.points, input_.tets);
   interface_ = primal::find_interface(input_, options_.interface_tolerance);
   if (interface_.quads.empty())
     throw InvalidInput("conform: the hex part and the tet part share no interface quad");

@@ -8,8 +8,10 @@
 // (corner, edge midpoint, quad centre, triangle centroid: the keys of primal/dice's node-origin
 // map), never by position, and take the diced position. Side-face nodes of two buffer hexes
 // sharing a side face are matched topologically (the side face's quad mesh, propagated from the
-// shared top/bottom nodes across quad edges; the template's x- and z-faces have the same quad
-// mesh but different positions, so positions cannot be used) and their positions averaged.
+// shared top/bottom nodes across quad edges) and merged. The reference template's four side
+// faces carry one mirror-symmetric mesh (templates/side_faces.hpp) and a side face is mapped
+// bilinearly from its four corners by both buffer hexes, so both place a merged node at the
+// same point: no position is reconciled, and a placement valid in each buffer hex stays valid.
 #include <functional>
 #include <string>
 #include <vector>
@@ -38,11 +40,11 @@ struct ConformOptions {
   BufferLayerOptions buffer;
   double interface_tolerance = 1e-6;  // find_interface: relative to the local edge length
   // Box of the reference template (x, y, z as in templates/geode.hpp: y is the buffer hex's
-  // thickness direction). It is smoothed once per diagonal with top and bottom fixed; only its
-  // proportions matter. The paper's 24 x 14 x 24: with flatter boxes (2 x 1 x 2, 2 x 0.8 x 2)
-  // smooth_template slides a side-face node of the Anti-diagonal template onto the hex-side
-  // edge midpoint (two nodes at one place), which conform() rejects.
-  Eigen::Vector3d template_box{24.0, 14.0, 24.0};
+  // thickness direction). It is smoothed once per diagonal, top and bottom fixed and its four
+  // side faces one shared mesh (templates/side_faces.hpp); only its proportions matter. Near
+  // the buffer hexes' own (a quarter of the edge thick by default), a template mapped into
+  // them keeps most of its quality: the paper's 24 x 14 x 24 is taller than the buffer hexes.
+  Eigen::Vector3d template_box{24.0, 8.0, 24.0};
   // The worst-first smoother (primal/local_smooth.hpp), model boundary nodes sliding in their
   // plane, along their feature edge or on the diced boundary triangulation. kLocal: patches
   // seeded by the geode hexes and every hex touching them; kGlobal: by every hex, with a
@@ -83,6 +85,9 @@ struct ConformResult {
   primal::Index diced_hexes = 0, geode_hexes = 0, diced_tet_hexes = 0;
   BufferLayerReport buffer;
   double template_min_scaled_jacobian = 0.0;  // the two reference templates, after smoothing
+  // The yardstick for the transition: the input's hexes and tets each diced alone
+  // (primal::diced_min_scaled_jacobian), before the buffer layer moves anything.
+  double input_diced_hex_min_scaled_jacobian = 1.0, input_diced_tet_min_scaled_jacobian = 1.0;
   double min_scaled_jacobian_before_smoothing = 0.0;
   primal::LocalSmoothResult smoothing;  // zero-initialised when ConformSmooth::kNone
   primal::HexValidityReport validity;

@@ -9,7 +9,9 @@
 #include <tuple>
 
 #include "primal/errors.hpp"
+#include "primal/patch_match.hpp"
 #include "primal/topology.hpp"
+#include "templates/side_faces.hpp"
 
 namespace geode::conform {
 namespace {
@@ -20,7 +22,6 @@ namespace topo = primal::topology;
 using templates::build_geode3d;
 using templates::Diagonal;
 using templates::GeodeOptions;
-using templates::smooth_template;
 
 // Buffer hex side faces 0..3 (topology order: s-min, r-max, s-max, r-min) as template box-face
 // bits (templates/geode.hpp: bit 2*axis + high) under r = z, s = x, t = y
@@ -40,7 +41,7 @@ RefTemplate make_reference(const Eigen::Vector3d& box, std::array<int, 2> diagon
   o.box = box;
   o.diagonal = diagonal == std::array<int, 2>{5, 7} ? Diagonal::Main : Diagonal::Anti;
   ref.tpl = build_geode3d(o);
-  ref.min_scaled_jacobian = smooth_template(ref.tpl, false).final_min_scaled_jacobian;
+  ref.min_scaled_jacobian = templates::smooth_template_shared_sides(ref.tpl).final_min_scaled_jacobian;
   const auto& pts = ref.tpl.hex.points;
   const std::size_t n = pts.size();
   // A smoothed template with two nodes at one place would glue the model together there.
@@ -130,71 +131,23 @@ std::unordered_map<int, int> match_side(const RefTemplate& A, int ka,
                                         const std::vector<Index>& ga, const RefTemplate& B,
                                         int kb, const std::vector<Index>& gb,
                                         const std::string& where) {
-  const auto& na = A.side_nodes[ka];
-  const auto& nb = B.side_nodes[kb];
-  const auto& qa = A.side_quads[ka];
-  const auto& qb = B.side_quads[kb];
   auto fail = [&](const std::string& why) {
     throw TopologyError("side faces of " + where + " do not correspond: " + why);
   };
-  if (na.size() != nb.size() || qa.size() != qb.size()) fail("different node or quad counts");
-  std::unordered_map<int, int> m, inv;
+  // Seeds: the tet- and hex-side nodes the two templates share (the same global node).
   std::unordered_map<Index, int> b_of_global;
-  for (int b : nb)
+  for (int b : B.side_nodes[kb])
     if (gb[b] >= 0) b_of_global[gb[b]] = b;
-  for (int a : na)
+  std::vector<std::pair<int, int>> seeds;
+  for (int a : A.side_nodes[ka])
     if (ga[a] >= 0) {
-      auto it = b_of_global.find(ga[a]);
+      const auto it = b_of_global.find(ga[a]);
       if (it == b_of_global.end()) fail("a tet/hex-side node of one is not on the other");
-      m[a] = it->second, inv[it->second] = a;
+      seeds.emplace_back(a, it->second);
     }
-  std::vector<bool> done_a(qa.size(), false), done_b(qb.size(), false);
-  bool progress = true;
-  while (progress) {
-    progress = false;
-    for (std::size_t i = 0; i < qa.size(); ++i) {
-      if (done_a[i]) continue;
-      const auto& q = qa[i];
-      int found = -1, found_dir = 0, found_s = 0, found_e = 0, candidates = 0;
-      for (int e = 0; e < 4 && candidates == 0; ++e) {
-        auto x0 = m.find(q[e]), x1 = m.find(q[(e + 1) % 4]);
-        if (x0 == m.end() || x1 == m.end()) continue;
-        for (std::size_t j = 0; j < qb.size(); ++j) {
-          if (done_b[j]) continue;
-          const auto& p = qb[j];
-          for (int s = 0; s < 4; ++s) {
-            if (p[s] != x0->second) continue;
-            for (int dir : {1, 3}) {
-              if (p[(s + dir) % 4] != x1->second) continue;
-              // q[e + k] -> p[s + k * dir]; check every known match agrees.
-              bool ok = true;
-              for (int k = 0; k < 4 && ok; ++k) {
-                const int a = q[(e + k) % 4], b = p[(s + k * dir) % 4];
-                auto ia = m.find(a);
-                auto ib = inv.find(b);
-                if (ia != m.end() && ia->second != b) ok = false;
-                if (ib != inv.end() && ib->second != a) ok = false;
-              }
-              if (ok) {
-                ++candidates;
-                found = static_cast<int>(j), found_dir = dir, found_s = s, found_e = e;
-              }
-            }
-          }
-        }
-      }
-      if (candidates != 1) continue;  // none yet or ambiguous: wait for more matches
-      const auto& p = qb[found];
-      for (int k = 0; k < 4; ++k) {
-        const int a = q[(found_e + k) % 4], b = p[(found_s + k * found_dir) % 4];
-        m[a] = b, inv[b] = a;
-      }
-      done_a[i] = done_b[found] = true;
-      progress = true;
-    }
-  }
-  if (m.size() != na.size() || inv.size() != nb.size()) fail("propagation left nodes unmatched");
-  return m;
+  primal::PatchMatch m = primal::match_quad_patches(A.side_quads[ka], B.side_quads[kb], seeds);
+  if (!m.ok()) fail(m.error);
+  return std::move(m.map);
 }
 
 }  // namespace geode::conform
