@@ -15,6 +15,7 @@
 #include "primal/errors.hpp"
 #include "primal/quality.hpp"
 #include "primal/quality_report.hpp"
+#include "templates/geode.hpp"
 
 namespace geode::cli {
 namespace {
@@ -35,10 +36,14 @@ struct ConformArgs {
   std::string model = "half";
   std::string save_input;
   double merge_tolerance = -1;  // < 0: no merging
+  double buffer_thickness = conform::BufferLayerOptions{}.thickness;
+  std::string template_box;
   int n = 4;
   bool quiet = false;
   bool write_invalid = false;
 };
+
+double output_min_sj(const conform::ConformResult& r);
 
 nlohmann::json result_json(const conform::ConformResult& r) {
   nlohmann::json j;
@@ -52,6 +57,9 @@ nlohmann::json result_json(const conform::ConformResult& r) {
   j["min_scaled_jacobian_before_smoothing"] = r.min_scaled_jacobian_before_smoothing;
   j["min_scaled_jacobian_after_smoothing"] = r.smoothing.final_min_scaled_jacobian;
   j["buffer_layer_min_scaled_jacobian"] = r.buffer.min_scaled_jacobian;
+  j["input_diced_alone_min_scaled_jacobian"] = {{"hexes", r.input_diced_hex_min_scaled_jacobian},
+                                                {"tets", r.input_diced_tet_min_scaled_jacobian}};
+  j["output_min_scaled_jacobian"] = output_min_sj(r);
   j["seconds"] = r.seconds;
   j["warnings"] = r.warnings;
   j["blocks"] = nlohmann::json::array();
@@ -65,6 +73,12 @@ double min_sj(const primal::QualityReport& q) {
   for (const auto& m : q.metrics)
     if (m.metric == primal::HexMetric::kScaledJacobian) return m.minimum;
   return 0.0;
+}
+
+double output_min_sj(const conform::ConformResult& r) {
+  double m = 1.0;
+  for (const auto& b : r.quality) m = std::min(m, min_sj(b.report));
+  return m;
 }
 
 // Valid: faces shared by two hexes, closed boundary, and no hex with scaled Jacobian <= 0.
@@ -86,6 +100,12 @@ void print_summary(const conform::ConformResult& r, std::ostream& os, bool table
        << " hexes, min scaled Jacobian " << min_sj(b.report) << "\n";
     if (tables) os << primal::format_quality_table(b.report) << "\n";
   }
+  // The transition against the input's own elements diced alone (the yardstick).
+  const double yardstick = std::min(r.input_diced_hex_min_scaled_jacobian, r.input_diced_tet_min_scaled_jacobian);
+  os << "input diced alone: min scaled Jacobian " << r.input_diced_hex_min_scaled_jacobian << " (hexes), "
+     << r.input_diced_tet_min_scaled_jacobian << " (tets); output " << output_min_sj(r);
+  if (yardstick > 0) os << " = " << output_min_sj(r) / yardstick << " x the lower";
+  os << "\n";
   for (const auto& w : r.warnings) os << "warning: " << w << "\n";
 }
 
@@ -139,6 +159,8 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
   opts.smooth = conform::parse_conform_smooth(a.smooth);
   opts.quality = conform::parse_conform_quality(a.quality);
   opts.geode_block = a.geode_block;
+  opts.buffer.thickness = a.buffer_thickness;
+  if (!a.template_box.empty()) opts.template_box = templates::parse_box(a.template_box);
   opts.progress = [&progress](const std::string& line) { progress.stage(line); };
   opts.smoothing_progress = [&progress](std::size_t done, std::size_t total) {
     progress.step("seed hexes settled", done, total);
@@ -212,6 +234,14 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
                 "first merge nodes closer than this distance (model units), for parts meshed\n"
                 "separately whose interface nodes are duplicated")
       ->check(number_check(0, 1e300));
+  c->add_option("--buffer-thickness", a.buffer_thickness,
+                "how far the tet part shrinks off the interface, as a fraction of the shortest edge\n"
+                "at each interface node (the buffer layer's thickness)")
+      ->check(number_check(0.01, 0.45))
+      ->capture_default_str();
+  c->add_option("--template-box", a.template_box,
+                "proportions WxHxD of the box the reference geode template is smoothed in once per\n"
+                "run (H: the buffer hex's thickness direction; default 24x14x24, the paper's)");
   c->add_flag("--write-invalid", a.write_invalid,
               "write the mesh and report even when verification fails (the exit code is still 4)");
   c->add_flag("--quiet", a.quiet, "no progress and no summary (errors and the invalid-result message still print)");
