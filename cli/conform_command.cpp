@@ -37,6 +37,7 @@ struct ConformArgs {
   std::string save_input;
   double merge_tolerance = -1;  // < 0: no merging
   double buffer_thickness = conform::BufferLayerOptions{}.thickness;
+  double smooth_target = 0.0;
   std::string template_box;
   int n = 4;
   bool quiet = false;
@@ -160,6 +161,7 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
   opts.quality = conform::parse_conform_quality(a.quality);
   opts.geode_block = a.geode_block;
   opts.buffer.thickness = a.buffer_thickness;
+  opts.smooth_target = a.smooth_target;
   if (!a.template_box.empty()) opts.template_box = templates::parse_box(a.template_box);
   opts.progress = [&progress](const std::string& line) { progress.stage(line); };
   opts.smoothing_progress = [&progress](std::size_t done, std::size_t total) {
@@ -218,9 +220,15 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
   c->add_option("--report", a.report, "write a JSON report (counts, validity, quality per output block) to FILE.json");
   c->add_option("--smooth", a.smooth,
                 "worst-first smoothing, model boundary nodes sliding on the boundary; local: hexes below "
-                "0.35 among the geode hexes and those touching them (default); global: every hex "
-                "below 0.5; none")
+                "--smooth-target among the geode hexes and those touching them (default); global: every "
+                "hex below 0.5; none")
       ->check(CLI::IsMember({"local", "global", "none"}))
+      ->capture_default_str();
+  c->add_option("--smooth-target", a.smooth_target,
+                "local smoothing: 0 (default) works where the transition is worse than the input's own\n"
+                "hexes and tets diced alone, lifting those hexes toward 0.35; a value > 0 works on every\n"
+                "geode hex and neighbour below it (e.g. 0.35: more quality, more time)")
+      ->check(number_check(0, 1))
       ->capture_default_str();
   c->add_option("--quality", a.quality,
                 "sj: validity and the scaled Jacobian per block (default, cheap); full: every "

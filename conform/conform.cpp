@@ -325,21 +325,19 @@ void Conformer::assemble() {
       mesh_, options_.smooth == ConformSmooth::kNone ? &inverted_ : nullptr);
 }
 
+// Automatic target: hexes near the transition below the yardstick are the defects; patches
+// start on them and on the hexes within this many rings of them (a defect is lifted by moving
+// its neighbours too), not along the whole interface.
+constexpr int kDefectRings = 2;
+
 // The worst-first smoother (primal/local_smooth.hpp); model boundary nodes slide on the diced
-// boundary. Local: patches seeded by the geode hexes and the hexes touching them, so the cost
-// follows the interface; global: by every hex.
+// boundary. Local: patches seeded near the geode hexes, on the submesh around the seeds, so
+// the cost follows the interface (or, with the automatic target, its defects); global: every
+// hex.
 void Conformer::smooth() {
   if (options_.smooth == ConformSmooth::kNone) return;
   t0_ = Clock::now();
   const bool local = options_.smooth == ConformSmooth::kLocal;
-  std::vector<Index> seeds;
-  if (local) {
-    std::vector<Index> geode(static_cast<std::size_t>(res_.geode_hexes));
-    std::iota(geode.begin(), geode.end(), res_.diced_hexes);
-    seeds = primal::hexes_around(mesh_, geode);
-  }
-  const auto constraints = primal::boundary_slide_constraints(mesh_);
-  const primal::TriMesh surface = primal::boundary_triangulation(mesh_);
   primal::LocalSmoothOptions o = local ? options_.local_smooth_options : options_.global_smooth_options;
   auto last = Clock::now();
   o.progress = [&](std::size_t settled, std::size_t total) {
@@ -351,7 +349,26 @@ void Conformer::smooth() {
           " seed hexes settled" + took());
     }
   };
-  res_.smoothing = primal::smooth_hexes_local(mesh_, constraints, &surface, seeds, o);
+  if (local) {
+    std::vector<Index> geode(static_cast<std::size_t>(res_.geode_hexes));
+    std::iota(geode.begin(), geode.end(), res_.diced_hexes);
+    std::vector<Index> seeds = primal::hexes_around(mesh_, geode);
+    if (options_.smooth_target > 0.0) {
+      o.target = options_.smooth_target;
+    } else {
+      const double yardstick = std::min(res_.input_diced_hex_min_scaled_jacobian, res_.input_diced_tet_min_scaled_jacobian);
+      std::vector<Index> defects;
+      for (Index h : seeds)
+        if (primal::hex_scaled_jacobian(primal::hex_corners(mesh_, h)) < yardstick) defects.push_back(h);
+      for (int ring = 0; ring < kDefectRings && !defects.empty(); ++ring) defects = primal::hexes_around(mesh_, defects);
+      seeds = std::move(defects);
+    }
+    res_.smoothing = primal::smooth_hexes_around(mesh_, seeds, o);
+  } else {
+    const auto constraints = primal::boundary_slide_constraints(mesh_);
+    const primal::TriMesh surface = primal::boundary_triangulation(mesh_);
+    res_.smoothing = primal::smooth_hexes_local(mesh_, constraints, &surface, {}, o);
+  }
   res_.smoothing.initial_min_scaled_jacobian = res_.min_scaled_jacobian_before_smoothing;
   res_.smoothing.final_min_scaled_jacobian = primal::min_scaled_jacobian(mesh_, &inverted_);
   const Index patches = res_.smoothing.patches;

@@ -47,11 +47,25 @@ struct ConformOptions {
   Eigen::Vector3d template_box{24.0, 8.0, 24.0};
   // The worst-first smoother (primal/local_smooth.hpp), model boundary nodes sliding in their
   // plane, along their feature edge or on the diced boundary triangulation. kLocal: patches
-  // seeded by the geode hexes and every hex touching them; kGlobal: by every hex, with a
-  // higher target so that the diced parts are improved too.
+  // seeded near the geode hexes (see smooth_target), on the submesh around them; kGlobal: by
+  // every hex, with a higher target so that the diced parts are improved too.
   ConformSmooth smooth = ConformSmooth::kLocal;
+  // kLocal. 0 (automatic): the defects are the geode hexes and their neighbours below the
+  // yardstick (the input's own hexes and tets diced alone, ConformResult); patches start on
+  // them and two rings around, at hexes below local_smooth_options.target. The smoother then
+  // works only where the transition is worse than dicing the input makes anyway, and its cost
+  // follows the defects, not the interface. > 0: every geode hex and its neighbours below this
+  // scaled Jacobian seed patches.
+  double smooth_target = 0.0;
   ConformQuality quality = ConformQuality::kScaledJacobian;
-  primal::LocalSmoothOptions local_smooth_options;
+  // More visits per hex and a narrower margin than the primal defaults: with the automatic
+  // target the patches are few, and lifting a defect takes its neighbours several moves.
+  primal::LocalSmoothOptions local_smooth_options = [] {
+    primal::LocalSmoothOptions o;
+    o.max_visits = 4;
+    o.margin = 0.05;
+    return o;
+  }();
   primal::LocalSmoothOptions global_smooth_options = [] {
     primal::LocalSmoothOptions o;
     o.target = 0.5;

@@ -591,10 +591,72 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
   return res;
 }
 
+LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seeds,
+                                      const LocalSmoothOptions& options, double feature_angle) {
+  for (Index s : seeds)
+    if (s < 0 || static_cast<std::size_t>(s) >= mesh.hexes.size())
+      throw InvalidInput("smooth_hexes_around: seed hex " + std::to_string(s) + " out of range");
+  if (seeds.empty()) return {};
+  std::vector<Index> sorted(seeds.begin(), seeds.end());
+  std::sort(sorted.begin(), sorted.end());
+  const std::vector<Index> region = hexes_around(mesh, seeds);  // hexes a patch can change
+  const std::vector<Index> outer = hexes_around(mesh, region);  // every hex sharing a face with them
+  // The submesh of `outer`, nodes numbered in order of first use.
+  HexMesh sub;
+  std::vector<Index> local(mesh.points.size(), kInvalidIndex), global;
+  sub.hexes.reserve(outer.size());
+  for (Index h : outer) {
+    std::array<Index, 8> c{};
+    for (int k = 0; k < 8; ++k) {
+      Index& l = local[mesh.hexes[h][k]];
+      if (l == kInvalidIndex) l = static_cast<Index>(global.size()), global.push_back(mesh.hexes[h][k]);
+      c[k] = l;
+    }
+    sub.hexes.push_back(c);
+  }
+  sub.points.reserve(global.size());
+  for (Index g : global) sub.points.push_back(mesh.points[g]);
+  // A face of a region hex is on the model's boundary iff it is on the submesh's: a hex on its
+  // other side would share a node with the region, so it is in `outer`.
+  std::vector<char> in_region(outer.size(), 0);
+  {
+    std::size_t r = 0;
+    for (std::size_t i = 0; i < outer.size(); ++i) {
+      while (r < region.size() && region[r] < outer[i]) ++r;
+      in_region[i] = r < region.size() && region[r] == outer[i];
+    }
+  }
+  std::vector<BoundaryQuad> boundary;
+  for (const BoundaryQuad& q : boundary_quads(sub))
+    if (in_region[static_cast<std::size_t>(q.hex)]) boundary.push_back(q);
+  auto constraints = boundary_slide_constraints(sub, boundary, feature_angle);
+  // Only the seeds' nodes move; the rest of the submesh is there to be measured.
+  std::vector<char> moves(sub.points.size(), 0);
+  std::vector<Index> local_seeds;
+  local_seeds.reserve(seeds.size());
+  for (Index s : seeds) {
+    for (Index v : mesh.hexes[s]) moves[local[v]] = 1;
+  }
+  for (std::size_t i = 0; i < outer.size(); ++i)
+    if (std::binary_search(sorted.begin(), sorted.end(), outer[i])) local_seeds.push_back(static_cast<Index>(i));
+  for (std::size_t v = 0; v < constraints.size(); ++v)
+    if (!moves[v]) constraints[v] = NodeConstraint::fixed();
+  const TriMesh surface = boundary_triangulation(sub.points, boundary);
+  LocalSmoothResult res = smooth_hexes_local(sub, constraints, &surface, local_seeds, options);
+  for (std::size_t v = 0; v < global.size(); ++v)
+    if (moves[v]) mesh.points[global[v]] = sub.points[v];
+  return res;
+}
+
 std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh, double feature_angle) {
+  return boundary_slide_constraints(mesh, boundary_quads(mesh), feature_angle);
+}
+
+std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh, std::span<const BoundaryQuad> boundary,
+                                                       double feature_angle) {
   std::vector<NodeConstraint> out(mesh.points.size());
   std::vector<std::vector<Point>> normals(mesh.points.size());
-  for (const BoundaryQuad& q : boundary_quads(mesh)) {
+  for (const BoundaryQuad& q : boundary) {
     const auto& p = mesh.points;
     const Point n = (p[q.nodes[2]] - p[q.nodes[0]]).cross(p[q.nodes[3]] - p[q.nodes[1]]);
     if (!(n.norm() > 0.0)) continue;
@@ -630,9 +692,13 @@ std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh, doub
 }
 
 TriMesh boundary_triangulation(const HexMesh& mesh) {
+  return boundary_triangulation(mesh.points, boundary_quads(mesh));
+}
+
+TriMesh boundary_triangulation(const std::vector<Point>& points, std::span<const BoundaryQuad> boundary) {
   TriMesh t;
-  t.points = mesh.points;
-  for (const BoundaryQuad& q : boundary_quads(mesh)) {
+  t.points = points;
+  for (const BoundaryQuad& q : boundary) {
     t.tris.push_back({q.nodes[0], q.nodes[1], q.nodes[2]});
     t.tris.push_back({q.nodes[0], q.nodes[2], q.nodes[3]});
   }

@@ -31,6 +31,7 @@
 #include <span>
 #include <vector>
 
+#include "primal/boundary.hpp"
 #include "primal/mesh.hpp"
 #include "primal/smooth.hpp"
 
@@ -69,6 +70,17 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
                                      std::span<const Index> seeds = {},
                                      const LocalSmoothOptions& options = {});
 
+// smooth_hexes_local with the model's boundary sliding (boundary_slide_constraints and
+// boundary_triangulation, `feature_angle`), run on the submesh of the hexes around the seeds
+// only: a patch moves the nodes of its seed hex, so every hex whose quality can change shares a
+// node with a seed, and the boundary there is told from one more ring of hexes. The cost then
+// follows the seeds, not the mesh (the whole-mesh boundary of a million hexes costs seconds).
+// Same result as smooth_hexes_local over the whole mesh with those constraints. The result's
+// minima are over the hexes around the seeds.
+LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seeds,
+                                      const LocalSmoothOptions& options = {},
+                                      double feature_angle = 30.0);
+
 // Constraints that keep the mesh's boundary where it is while letting it slide: a boundary
 // node whose boundary quads all lie in one plane slides in it; where their normals fall in two
 // groups more than `feature_angle` (degrees) apart and each group is planar, the node slides
@@ -77,10 +89,16 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
 // curved feature edges) fixed. Interior nodes are free.
 std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh,
                                                        double feature_angle = 30.0);
+// The same from boundary quads found otherwise (e.g. of a submesh whose own boundary is
+// larger than the model's); nodes on none of them are free.
+std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh,
+                                                       std::span<const BoundaryQuad> boundary,
+                                                       double feature_angle = 30.0);
 
 // The mesh's boundary quads, each split into two triangles (along the 0-2 diagonal): the
 // surface kSurface nodes slide on when no input triangulation is at hand.
 TriMesh boundary_triangulation(const HexMesh& mesh);
+TriMesh boundary_triangulation(const std::vector<Point>& points, std::span<const BoundaryQuad> boundary);
 
 // Every hex sharing a node with one of `hexes` (those included), ascending.
 std::vector<Index> hexes_around(const HexMesh& mesh, std::span<const Index> hexes);
