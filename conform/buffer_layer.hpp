@@ -30,7 +30,7 @@ using primal::Model;
 
 struct BufferLayerOptions {
   // Step of each duplicated node, as a fraction of the shortest tet or interface-quad edge at it.
-  double thickness = 0.25;
+  double thickness = 0.3;
   // Every moved tet keeps at least this fraction of its volume.
   double min_volume_ratio = 0.05;
   // Every buffer hex has a Verdict scaled Jacobian (min over 8 corners and centre) above this.

@@ -127,7 +127,9 @@ TEST_CASE("insert_buffer_layer: valid, gap-free layers on convex and concave int
 
 TEST_CASE("insert_buffer_layer: one hex under tets, positions by hand") {
   const Model m = grid_model({1, 1, 2}, 1.0, [](int, int, int k) { return k == 1; });
-  const BufferLayer layer = insert_buffer_layer(m, find_interface(m));
+  BufferLayerOptions o;
+  o.thickness = 0.25;
+  const BufferLayer layer = insert_buffer_layer(m, find_interface(m), o);
   // Each top corner sits on an outer crease of the tet part (two outer faces), so it slides
   // along the crease, +z, by thickness 0.25 x shortest edge 1.
   for (const BufferHex& b : layer.hexes)
@@ -147,10 +149,11 @@ TEST_CASE("insert_buffer_layer: the nugget's corners move along the cavity diago
   const Model m = grid_model({3, 3, 3}, 1.0, [](int i, int j, int k) { return i == 1 && j == 1 && k == 1; });
   const BufferLayer layer = insert_buffer_layer(m, find_interface(m));
   // Corner (1,1,1) of the cavity: three faces with normals +x, +y, +z; the best direction is
-  // the diagonal; the shortest edge there is 1.
+  // the diagonal; the shortest edge there is 1, so the step is the thickness.
   const Index v = 1 + 4 * (1 + 4 * 1);
   const Point moved = layer.model.points[static_cast<std::size_t>(layer.top_node[static_cast<std::size_t>(v)])];
-  CHECK((moved - (Point(1, 1, 1) + 0.25 * Point(1, 1, 1).normalized())).norm() < 1e-12);
+  const double step = BufferLayerOptions{}.thickness;
+  CHECK((moved - (Point(1, 1, 1) + step * Point(1, 1, 1).normalized())).norm() < 1e-12);
 }
 
 TEST_CASE("insert_buffer_layer: no layer where no direction sees all interface faces") {
