@@ -119,10 +119,11 @@ void append_gmsh_triangles(Shell& shell, Keep keep) {
 
 // The boundary quads of the hex part for which on_interface(centre) holds, each split into two
 // triangles: along corners 0-2 when split(quad number, centre) is false, 1-3 otherwise (the
-// other diagonal where that one would fold the quad).
-template <class OnInterface, class Split>
+// other diagonal where that one would fold the quad); or, where four(centre) holds, into four
+// triangles around a new node at the mean of its corners.
+template <class OnInterface, class Split, class Four>
 void append_interface_triangles(Shell& shell, const Model& hexes, OnInterface on_interface,
-                                Split split) {
+                                Split split, Four four) {
   int count = 0;
   for (const BoundaryQuad& q : boundary_quads(hex_part(hexes))) {
     Point c = Point::Zero();
@@ -139,6 +140,11 @@ void append_interface_triangles(Shell& shell, const Model& hexes, OnInterface on
     auto folds = [&](int a, int b, int d) { return (p[b] - p[a]).cross(p[d] - p[a]).dot(normal) <= 0; };
     const bool folds02 = folds(0, 1, 2) || folds(0, 2, 3), folds13 = folds(0, 1, 3) || folds(1, 2, 3);
     bool along13 = split(count++, c);
+    if (four(c)) {
+      const Index m = shell.node(c);
+      for (int k = 0; k < 4; ++k) shell.tris.push_back({n[k], n[(k + 1) % 4], m});
+      continue;
+    }
     if (along13 ? folds13 : folds02) along13 = !along13;
     if (along13) {
       shell.tris.push_back({n[0], n[1], n[3]});
@@ -148,6 +154,11 @@ void append_interface_triangles(Shell& shell, const Model& hexes, OnInterface on
       shell.tris.push_back({n[0], n[2], n[3]});
     }
   }
+}
+
+template <class OnInterface, class Split>
+void append_interface_triangles(Shell& shell, const Model& hexes, OnInterface on_interface, Split split) {
+  append_interface_triangles(shell, hexes, on_interface, split, [](const Point&) { return false; });
 }
 
 // Gmsh's Delaunay tets inside the closed surface `shell` (whose nodes it keeps), as a new
@@ -406,6 +417,29 @@ Model demo_delaunay_block(int n, DemoDiagonals diagonals) {
   });
 }
 
+Model demo_four_triangles(int n) {
+  if (n < 1) throw InvalidInput("demo_four_triangles: n = " + std::to_string(n) + " must be >= 1");
+  const double h = 1.0 / n;
+  return run_gmsh("demo_four_triangles", [&] {
+    Model hexes = structured_unit_cube(Point(0, 0, 0), h, "hex");
+    Shell shell;
+    append_solid_boundary(
+        shell, h, [] { gmsh::model::occ::addBox(1, 0, 0, 1, 1, 1); },
+        [](const Box& b) { return b[3] < 1 + kEps; }, [](const Box& b) { return b[3] > 1 + kEps; });
+    // Half the quads (at random, fixed seed) in four triangles, the rest in two along random
+    // diagonals; the first quad is always split in four so that every n has one.
+    auto rng = std::make_shared<std::mt19937>(2024u);
+    auto first = std::make_shared<bool>(true);
+    append_interface_triangles(shell, hexes, [](const Point& c) { return c.x() > 1 - kEps; },
+                               diagonal_chooser(DemoDiagonals::kRandom, h), [rng, first](const Point&) {
+                                 const bool four = *first || ((*rng)() & 1u) != 0;
+                                 *first = false;
+                                 return four;
+                               });
+    return join(std::move(hexes), tet_fill(shell, {}, 2, "tet"));
+  });
+}
+
 Model demo_cylinder(int n) {
   if (n < 2) throw InvalidInput("demo_cylinder: n = " + std::to_string(n) + " must be >= 2");
   const double h = 1.0 / n;
@@ -459,7 +493,7 @@ Model demo_l_shape(int n) {
 
 const std::vector<std::string>& demo_model_names() {
   static const std::vector<std::string> names{"half", "delaunay", "delaunay-random", "cylinder",
-                                              "lshape", "nugget"};
+                                              "lshape", "nugget", "fourtri"};
   return names;
 }
 
@@ -470,7 +504,8 @@ Model demo_model(const std::string& name, int n) {
   if (name == "cylinder") return demo_cylinder(n);
   if (name == "lshape") return demo_l_shape(n);
   if (name == "nugget") return demo_nugget(n % 2 ? n + 1 : n);
-  throw InvalidInput("demo model '" + name + "': expected one of half, delaunay, delaunay-random, cylinder, lshape, nugget");
+  if (name == "fourtri") return demo_four_triangles(n);
+  throw InvalidInput("demo model '" + name + "': expected one of half, delaunay, delaunay-random, cylinder, lshape, nugget, fourtri");
 }
 
 }  // namespace geode::conform

@@ -40,6 +40,11 @@ enum class DemoDiagonals { kAlternate, kRandom };
 // (block 2 "tet"); interface quads split alternately (checkerboard) or at random.
 Model demo_delaunay_block(int n = 4, DemoDiagonals diagonals = DemoDiagonals::kAlternate);
 
+// (a') The same hex block and Delaunay tet box, but the interface quads split at random into
+// four triangles around a node at the quad's centre (half of them, the first always) or into
+// two along random diagonals: a mixed interface for the four-triangle template.
+Model demo_four_triangles(int n = 4);
+
 // (b) A curved interface: a hex cylinder (radius 0.5, height 1: a disk of unstructured
 // recombined quads swept in n layers; block 1) inside a tet-meshed box [-1,1]^3 (block 2).
 Model demo_cylinder(int n = 4);
@@ -49,7 +54,7 @@ Model demo_cylinder(int n = 4);
 Model demo_l_shape(int n = 4);
 
 // The names `geode demo --model` takes: half, delaunay, delaunay-random, cylinder, lshape,
-// nugget (d: a convex Delaunay tet nugget in structured blocks).
+// nugget (d: a convex Delaunay tet nugget in structured blocks), fourtri (a').
 const std::vector<std::string>& demo_model_names();
 // The model of that name with size parameter n (made even where the model needs it); throws
 // InvalidInput naming an unknown name.
