@@ -59,9 +59,25 @@ std::vector<int> four_triangle_key(double r, double s, double tol) {
   return {};
 }
 
-// A template node's reference coordinates in the buffer hex (r = z, s = x, t = y).
+// A template node's reference coordinates in the buffer hex (r = z, s = x, t = y), and back.
 Point reference_coordinates(const Point& p, const Eigen::Vector3d& box) {
   return {p.z() / box.z() + 0.5, p.x() / box.x() + 0.5, p.y() / box.y() + 0.5};
+}
+Point box_position(const Point& rst, const Eigen::Vector3d& box) {
+  return {(rst.y() - 0.5) * box.x(), (rst.z() - 0.5) * box.y(), (rst.x() - 0.5) * box.z()};
+}
+
+// A smoothed template with two nodes at one place would glue the model together there.
+void check_distinct(const std::vector<Point>& pts, const Eigen::Vector3d& box) {
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    for (std::size_t j = i + 1; j < pts.size(); ++j)
+      if ((pts[i] - pts[j]).norm() < 1e-6 * box.norm()) {
+        std::ostringstream m;
+        m << "the smoothed geode template in a " << box.x() << " x " << box.y() << " x "
+          << box.z() << " box has nodes " << i << " and " << j << " at one place ("
+          << pts[i].transpose() << "); choose other template proportions";
+        throw TopologyError(m.str());
+      }
 }
 
 RefTemplate make_reference(const Eigen::Vector3d& box, std::array<int, 2> diagonal,
@@ -80,16 +96,7 @@ RefTemplate make_reference(const Eigen::Vector3d& box, std::array<int, 2> diagon
   ref.min_scaled_jacobian = smooth_template(ref.tpl, false).final_min_scaled_jacobian;
   const auto& pts = ref.tpl.hex.points;
   const std::size_t n = pts.size();
-  // A smoothed template with two nodes at one place would glue the model together there.
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t j = i + 1; j < n; ++j)
-      if ((pts[i] - pts[j]).norm() < 1e-6 * box.norm()) {
-        std::ostringstream m;
-        m << "the smoothed geode template in a " << box.x() << " x " << box.y() << " x "
-          << box.z() << " box has nodes " << i << " and " << j << " at one place ("
-          << pts[i].transpose() << "); choose other template proportions";
-        throw TopologyError(m.str());
-      }
+  check_distinct(pts, box);
   ref.rst.resize(n);
   ref.key_corners.resize(n);
   constexpr double kTol = 1e-6;
@@ -154,7 +161,7 @@ RefTemplate make_reference(const Eigen::Vector3d& box, std::array<int, 2> diagon
   return ref;
 }
 
-// Gives `four`'s side faces the positions of `geode`'s (node by node as match_side pairs them,
+// Gives `four`'s side faces the reference positions of `geode`'s (node by node as match_side pairs them,
 // face k with face k, starting from the nodes both have on the tet and hex sides) and smooths
 // its other nodes with every box face fixed: a four-triangle template then meets a geode
 // across a side face as two geodes meet, instead of at positions of its own.
@@ -175,10 +182,11 @@ void impose_geode_sides(RefTemplate& four, const RefTemplate& geode, const Eigen
   auto& pts = four.tpl.hex.points;
   for (int k = 0; k < 4; ++k)
     for (const auto& [a, b] : match_side(four, k, g4, geode, k, gg, "the four-triangle template and the geode"))
-      if (four.key_corners[a].empty()) pts[a] = geode.tpl.hex.points[b];
+      if (four.key_corners[a].empty()) pts[a] = box_position(geode.rst[b], box);
   const Point lo = -0.5 * box, hi = 0.5 * box;
   const auto constraints = primal::box_constraints(pts, lo, hi, {true, true, true, true, true, true});
   four.min_scaled_jacobian = primal::smooth_hex_mesh(four.tpl.hex, constraints).final_min_scaled_jacobian;
+  check_distinct(pts, box);
   for (std::size_t i = 0; i < pts.size(); ++i) four.rst[i] = reference_coordinates(pts[i], box);
 }
 
@@ -198,8 +206,13 @@ const RefTemplate& reference_template(const Eigen::Vector3d& box, std::array<int
   }
   auto& geode = slot_of(4);
   if (!geode) geode = std::make_unique<RefTemplate>(make_reference(box, {4, 6}));
-  auto four = std::make_unique<RefTemplate>(make_reference(box, {4, 6}, templates::TopSplit::FourTriangles));
-  impose_geode_sides(*four, *geode, box);
+  // Smoothed in a box half as tall: buffer hexes are flatter than the reference box, and the
+  // four-triangle template stacks more layers (its pillows) in the thickness; shapes smoothed at
+  // the flatter proportion keep its mapped hexes positive where the taller box's do not. Only
+  // reference coordinates are kept, so the sides still match the geode's.
+  const Eigen::Vector3d four_box(box.x(), 0.5 * box.y(), box.z());
+  auto four = std::make_unique<RefTemplate>(make_reference(four_box, {4, 6}, templates::TopSplit::FourTriangles));
+  impose_geode_sides(*four, *geode, four_box);
   slot = std::move(four);
   return *slot;
 }

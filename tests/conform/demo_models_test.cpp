@@ -1,21 +1,26 @@
 // conform() on the realistic demo models (Gmsh Delaunay tets, alternating and random
 // interface diagonals, a concave L-shaped interface): the result is a valid all-hex mesh
 // (every interior face shared by two hexes, closed manifold boundary, Euler characteristic of
-// a ball) with every scaled Jacobian positive, without smoothing and with the defaults.
+// a ball) with every scaled Jacobian positive, without smoothing and with the defaults; and a
+// mixed interface of two- and four-triangle quads.
 #include <doctest/doctest.h>
 
 #include <string>
 
 #include "conform/conform.hpp"
 #include "conform/demo_models.hpp"
+#include "conform/reference_template.hpp"
+#include "primal/interface.hpp"
 #include "primal/quality.hpp"
 #include "primal/validity.hpp"
 
 using namespace geode;
+using primal::Index;
 
 namespace {
 
-void check_valid(const conform::ConformResult& r) {
+// geode_hexes: 26 per interface quad unless given.
+void check_valid(const conform::ConformResult& r, primal::Index geode_hexes = -1) {
   const primal::HexMesh mesh = primal::hex_part(r.model);
   const primal::HexValidityReport v = primal::check_validity(mesh);
   INFO(v.summary());
@@ -27,7 +32,8 @@ void check_valid(const conform::ConformResult& r) {
   CHECK(v.boundary.euler == 2);
   CHECK(primal::min_scaled_jacobian(mesh) > 0.0);
   CHECK(r.warnings.empty());
-  CHECK(r.geode_hexes == 26 * r.interface_quads);
+  CHECK(r.geode_hexes == (geode_hexes < 0 ? 26 * r.interface_quads : geode_hexes));
+  CHECK(r.model.hexes.size() == static_cast<std::size_t>(r.diced_hexes + r.geode_hexes + r.diced_tet_hexes));
 }
 
 }  // namespace
@@ -49,4 +55,29 @@ TEST_CASE("realistic model, default options: valid and untangled") {
   const auto r = conform::conform(conform::demo_model("delaunay-random", 2));
   CHECK(r.interface_quads == 4);
   check_valid(r);
+}
+
+// A mixed interface: Delaunay tets whose interface quads are split into two triangles (random
+// diagonals) or four around a centre node; the four-triangle ones get the fixed-up
+// four-triangle template, its side faces merged with the neighbouring geodes'.
+TEST_CASE("mixed two- and four-triangle interface: valid and untangled") {
+  const primal::Model m = conform::demo_model("fourtri", 3);
+  const primal::Interface itf = primal::find_interface(m);
+  REQUIRE(itf.quads.size() == 9);
+  Index four = 0;
+  for (const auto& q : itf.quads) four += q.centre != primal::kInvalidIndex;
+  // Both kinds, and some four-triangle quads side by side with two-triangle ones.
+  CHECK(four > 0);
+  CHECK(four < 9);
+  const conform::ConformOptions defaults;
+  const auto per_four = static_cast<Index>(
+      conform::reference_template_four_triangles(defaults.template_box).tpl.hex.hexes.size());
+  for (const auto smooth : {conform::ConformSmooth::kNone, conform::ConformSmooth::kLocal}) {
+    CAPTURE(static_cast<int>(smooth));
+    conform::ConformOptions o;
+    o.smooth = smooth;
+    const auto r = conform::conform(m, o);
+    CHECK(r.interface_quads == 9);
+    check_valid(r, 26 * (9 - four) + per_four * four);
+  }
 }
