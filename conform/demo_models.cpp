@@ -119,8 +119,8 @@ void append_gmsh_triangles(Shell& shell, Keep keep) {
 
 // The boundary quads of the hex part for which on_interface(centre) holds, each split into two
 // triangles: along corners 0-2 when split(quad number, centre) is false, 1-3 otherwise (the
-// other diagonal where that one would fold the quad); or, where four(centre) holds, into four
-// triangles around a new node at the mean of its corners.
+// other diagonal where that one would fold the quad); or, where four(centre) holds and they do
+// not fold, into four triangles around a new node at the mean of its corners.
 template <class OnInterface, class Split, class Four>
 void append_interface_triangles(Shell& shell, const Model& hexes, OnInterface on_interface,
                                 Split split, Four four) {
@@ -140,7 +140,9 @@ void append_interface_triangles(Shell& shell, const Model& hexes, OnInterface on
     auto folds = [&](int a, int b, int d) { return (p[b] - p[a]).cross(p[d] - p[a]).dot(normal) <= 0; };
     const bool folds02 = folds(0, 1, 2) || folds(0, 2, 3), folds13 = folds(0, 1, 3) || folds(1, 2, 3);
     bool along13 = split(count++, c);
-    if (four(c)) {
+    bool four_folds = false;  // a triangle around the centre facing away (non-convex quad)
+    for (int k = 0; k < 4; ++k) four_folds |= (p[(k + 1) % 4] - p[k]).cross(c - p[k]).dot(normal) <= 0;
+    if (four(c) && !four_folds) {
       const Index m = shell.node(c);
       for (int k = 0; k < 4; ++k) shell.tris.push_back({n[k], n[(k + 1) % 4], m});
       continue;
@@ -417,6 +419,22 @@ Model demo_delaunay_block(int n, DemoDiagonals diagonals) {
   });
 }
 
+namespace {
+
+// Half the quads (at random, fixed seed) in four triangles; the first always, so that every
+// model has one.
+std::function<bool(const Point&)> four_chooser() {
+  auto rng = std::make_shared<std::mt19937>(2024u);
+  auto first = std::make_shared<bool>(true);
+  return [rng, first](const Point&) {
+    const bool four = *first || ((*rng)() & 1u) != 0;
+    *first = false;
+    return four;
+  };
+}
+
+}  // namespace
+
 Model demo_four_triangles(int n) {
   if (n < 1) throw InvalidInput("demo_four_triangles: n = " + std::to_string(n) + " must be >= 1");
   const double h = 1.0 / n;
@@ -426,21 +444,13 @@ Model demo_four_triangles(int n) {
     append_solid_boundary(
         shell, h, [] { gmsh::model::occ::addBox(1, 0, 0, 1, 1, 1); },
         [](const Box& b) { return b[3] < 1 + kEps; }, [](const Box& b) { return b[3] > 1 + kEps; });
-    // Half the quads (at random, fixed seed) in four triangles, the rest in two along random
-    // diagonals; the first quad is always split in four so that every n has one.
-    auto rng = std::make_shared<std::mt19937>(2024u);
-    auto first = std::make_shared<bool>(true);
     append_interface_triangles(shell, hexes, [](const Point& c) { return c.x() > 1 - kEps; },
-                               diagonal_chooser(DemoDiagonals::kRandom, h), [rng, first](const Point&) {
-                                 const bool four = *first || ((*rng)() & 1u) != 0;
-                                 *first = false;
-                                 return four;
-                               });
+                               diagonal_chooser(DemoDiagonals::kRandom, h), four_chooser());
     return join(std::move(hexes), tet_fill(shell, {}, 2, "tet"));
   });
 }
 
-Model demo_cylinder(int n) {
+Model demo_cylinder(int n, bool four_triangles) {
   if (n < 2) throw InvalidInput("demo_cylinder: n = " + std::to_string(n) + " must be >= 2");
   const double h = 1.0 / n;
   return run_gmsh("demo_cylinder", [&] {
@@ -462,8 +472,9 @@ Model demo_cylinder(int n) {
     append_solid_boundary(
         outer, 2 * h, [] { gmsh::model::occ::addBox(-1, -1, -1, 2, 2, 2); },
         [](const Box&) { return false; }, [](const Box&) { return true; });
+    const auto four = four_triangles ? four_chooser() : [](const Point&) { return false; };
     append_interface_triangles(inner, hexes, [](const Point&) { return true; },
-                               diagonal_chooser(DemoDiagonals::kRandom, h));
+                               diagonal_chooser(DemoDiagonals::kRandom, h), four);
     return join(std::move(hexes), tet_fill(outer, {inner}, 2, "tet box"));
   });
 }
@@ -493,7 +504,7 @@ Model demo_l_shape(int n) {
 
 const std::vector<std::string>& demo_model_names() {
   static const std::vector<std::string> names{"half", "delaunay", "delaunay-random", "cylinder",
-                                              "lshape", "nugget", "fourtri"};
+                                              "lshape", "nugget", "fourtri", "fourtri-cylinder"};
   return names;
 }
 
@@ -505,7 +516,10 @@ Model demo_model(const std::string& name, int n) {
   if (name == "lshape") return demo_l_shape(n);
   if (name == "nugget") return demo_nugget(n % 2 ? n + 1 : n);
   if (name == "fourtri") return demo_four_triangles(n);
-  throw InvalidInput("demo model '" + name + "': expected one of half, delaunay, delaunay-random, cylinder, lshape, nugget, fourtri");
+  if (name == "fourtri-cylinder") return demo_cylinder(n, true);
+  throw InvalidInput("demo model '" + name +
+                     "': expected one of half, delaunay, delaunay-random, cylinder, lshape, nugget, fourtri, "
+                     "fourtri-cylinder");
 }
 
 }  // namespace geode::conform

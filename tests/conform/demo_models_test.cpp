@@ -81,3 +81,18 @@ TEST_CASE("mixed two- and four-triangle interface: valid and untangled") {
     check_valid(r, 26 * (9 - four) + per_four * four);
   }
 }
+
+// The same on a curved, unstructured interface (the hex cylinder's recombined caps and swept
+// sides in a Delaunay tet box), where, as for the two-triangle cylinder, smoothing is needed.
+TEST_CASE("mixed interface on a curved cylinder, default options: valid and untangled") {
+  const primal::Model m = conform::demo_model("fourtri-cylinder", 2);
+  const primal::Interface itf = primal::find_interface(m);
+  Index four = 0;
+  for (const auto& q : itf.quads) four += q.centre != primal::kInvalidIndex;
+  CHECK(four > 0);
+  CHECK(four < static_cast<Index>(itf.quads.size()));
+  const auto r = conform::conform(m);
+  const auto per_four = static_cast<Index>(
+      conform::reference_template_four_triangles(conform::ConformOptions{}.template_box).tpl.hex.hexes.size());
+  check_valid(r, 26 * (r.interface_quads - four) + per_four * four);
+}
