@@ -245,7 +245,8 @@ void add_conform_commands(CLI::App& app) {
                  "random; cylinder: a swept hex cylinder with unstructured quad caps in a tet box;\n"
                  "lshape: a hex block in the notch of an L-shaped tet part (concave interface);\n"
                  "nugget: a Delaunay tet cube in 26 structured blocks; fourtri: beside a Delaunay tet\n"
-                 "box whose interface quads are split into two or four triangles (at random)")
+                 "box whose interface quads are split into two or four triangles (at random);\n"
+                 "fourtri-cylinder: the cylinder with half its interface quads in four triangles")
       ->check(CLI::IsMember(conform::demo_model_names()))
       ->capture_default_str();
   d->add_option("-n,--size", dargs->n, "cells per unit length (1 to 64; default 4; nugget rounds up to even)")
