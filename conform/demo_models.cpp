@@ -158,11 +158,6 @@ void append_interface_triangles(Shell& shell, const Model& hexes, OnInterface on
   }
 }
 
-template <class OnInterface, class Split>
-void append_interface_triangles(Shell& shell, const Model& hexes, OnInterface on_interface, Split split) {
-  append_interface_triangles(shell, hexes, on_interface, split, [](const Point&) { return false; });
-}
-
 // Gmsh's Delaunay tets inside the closed surface `shell` (whose nodes it keeps), as a new
 // Gmsh model; `holes` are closed surfaces inside it bounding regions left empty (further
 // surface loops of the volume).
@@ -289,6 +284,19 @@ std::function<bool(int, const Point&)> diagonal_chooser(DemoDiagonals d, double 
   return [rng](int, const Point&) { return ((*rng)() & 1u) != 0; };
 }
 
+// Four-triangle chooser: when `on`, half the quads (at random, fixed seed) in four triangles,
+// the first always so that every model has one; none otherwise.
+std::function<bool(const Point&)> four_chooser(bool on) {
+  if (!on) return [](const Point&) { return false; };
+  auto rng = std::make_shared<std::mt19937>(2024u);
+  auto first = std::make_shared<bool>(true);
+  return [rng, first](const Point&) {
+    const bool four = *first || ((*rng)() & 1u) != 0;
+    *first = false;
+    return four;
+  };
+}
+
 // Gmsh's OCC bounding boxes are enlarged by a tolerance; entity tests on them allow for it.
 constexpr double kEps = 1e-4;
 
@@ -404,7 +412,7 @@ Model demo_nugget(int n) {
 
 namespace geode::conform {
 
-Model demo_delaunay_block(int n, DemoDiagonals diagonals) {
+Model demo_delaunay_block(int n, DemoDiagonals diagonals, bool four_triangles) {
   if (n < 1) throw InvalidInput("demo_delaunay_block: n = " + std::to_string(n) + " must be >= 1");
   const double h = 1.0 / n;
   return run_gmsh("demo_delaunay_block", [&] {
@@ -414,38 +422,7 @@ Model demo_delaunay_block(int n, DemoDiagonals diagonals) {
         shell, h, [] { gmsh::model::occ::addBox(1, 0, 0, 1, 1, 1); },
         [](const Box& b) { return b[3] < 1 + kEps; }, [](const Box& b) { return b[3] > 1 + kEps; });
     append_interface_triangles(shell, hexes, [](const Point& c) { return c.x() > 1 - kEps; },
-                               diagonal_chooser(diagonals, h));
-    return join(std::move(hexes), tet_fill(shell, {}, 2, "tet"));
-  });
-}
-
-namespace {
-
-// Half the quads (at random, fixed seed) in four triangles; the first always, so that every
-// model has one.
-std::function<bool(const Point&)> four_chooser() {
-  auto rng = std::make_shared<std::mt19937>(2024u);
-  auto first = std::make_shared<bool>(true);
-  return [rng, first](const Point&) {
-    const bool four = *first || ((*rng)() & 1u) != 0;
-    *first = false;
-    return four;
-  };
-}
-
-}  // namespace
-
-Model demo_four_triangles(int n) {
-  if (n < 1) throw InvalidInput("demo_four_triangles: n = " + std::to_string(n) + " must be >= 1");
-  const double h = 1.0 / n;
-  return run_gmsh("demo_four_triangles", [&] {
-    Model hexes = structured_unit_cube(Point(0, 0, 0), h, "hex");
-    Shell shell;
-    append_solid_boundary(
-        shell, h, [] { gmsh::model::occ::addBox(1, 0, 0, 1, 1, 1); },
-        [](const Box& b) { return b[3] < 1 + kEps; }, [](const Box& b) { return b[3] > 1 + kEps; });
-    append_interface_triangles(shell, hexes, [](const Point& c) { return c.x() > 1 - kEps; },
-                               diagonal_chooser(DemoDiagonals::kRandom, h), four_chooser());
+                               diagonal_chooser(diagonals, h), four_chooser(four_triangles));
     return join(std::move(hexes), tet_fill(shell, {}, 2, "tet"));
   });
 }
@@ -472,9 +449,8 @@ Model demo_cylinder(int n, bool four_triangles) {
     append_solid_boundary(
         outer, 2 * h, [] { gmsh::model::occ::addBox(-1, -1, -1, 2, 2, 2); },
         [](const Box&) { return false; }, [](const Box&) { return true; });
-    const auto four = four_triangles ? four_chooser() : [](const Point&) { return false; };
     append_interface_triangles(inner, hexes, [](const Point&) { return true; },
-                               diagonal_chooser(DemoDiagonals::kRandom, h), four);
+                               diagonal_chooser(DemoDiagonals::kRandom, h), four_chooser(four_triangles));
     return join(std::move(hexes), tet_fill(outer, {inner}, 2, "tet box"));
   });
 }
@@ -497,7 +473,7 @@ Model demo_l_shape(int n) {
         in_notch, [&](const Box& b) { return !in_notch(b); });
     append_interface_triangles(
         shell, hexes, [](const Point& c) { return c.x() < 1 + kEps || c.y() < 1 + kEps; },
-        diagonal_chooser(DemoDiagonals::kRandom, h));
+        diagonal_chooser(DemoDiagonals::kRandom, h), four_chooser(false));
     return join(std::move(hexes), tet_fill(shell, {}, 2, "tet L"));
   });
 }
@@ -515,7 +491,7 @@ Model demo_model(const std::string& name, int n) {
   if (name == "cylinder") return demo_cylinder(n);
   if (name == "lshape") return demo_l_shape(n);
   if (name == "nugget") return demo_nugget(n % 2 ? n + 1 : n);
-  if (name == "fourtri") return demo_four_triangles(n);
+  if (name == "fourtri") return demo_delaunay_block(n, DemoDiagonals::kRandom, true);
   if (name == "fourtri-cylinder") return demo_cylinder(n, true);
   throw InvalidInput("demo model '" + name +
                      "': expected one of half, delaunay, delaunay-random, cylinder, lshape, nugget, fourtri, "

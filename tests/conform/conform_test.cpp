@@ -15,6 +15,7 @@
 #include "primal/io_exodus.hpp"
 #include "primal/quality.hpp"
 #include "primal/topology.hpp"
+#include "support/fixtures.hpp"
 #include "conform/conform.hpp"
 #include "conform/reference_template.hpp"
 
@@ -87,14 +88,7 @@ TEST_CASE("one hex under a fan of four tets: the four-triangle template, valid")
   // node 8, off the face's middle, each under a tet with apex 9. The centre moves with the
   // buffer layer; the template's tet-side nodes (centre, centre-corner midpoints, triangle
   // centroids) must merge with the diced tets' or the boundary would not close.
-  primal::Model m = primal::grid_model({1, 1, 1}, 1.0, [](int, int, int) { return false; });
-  m.points.emplace_back(0.45, 0.55, 1.0);  // node 8
-  m.points.emplace_back(0.5, 0.5, 1.8);    // node 9
-  const std::array<Index, 4> top{4, 5, 7, 6};
-  for (std::size_t i = 0; i < 4; ++i) {
-    m.tets.push_back({top[i], top[(i + 1) % 4], 8, 9});
-    m.tet_block.push_back(2);
-  }
+  const primal::Model m = test::four_tet_fan({0.45, 0.55, 1.0}, {0.5, 0.5, 1.8});
   const conform::ConformOptions defaults;
   const auto per_four = static_cast<Index>(
       conform::reference_template_four_triangles(defaults.template_box).tpl.hex.hexes.size());

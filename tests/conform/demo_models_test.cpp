@@ -36,6 +36,21 @@ void check_valid(const conform::ConformResult& r, primal::Index geode_hexes = -1
   CHECK(r.model.hexes.size() == static_cast<std::size_t>(r.diced_hexes + r.geode_hexes + r.diced_tet_hexes));
 }
 
+// The model's interface quads split into four triangles, checked to be some but not all, and
+// the geode hexes conform() must make for it: 26 per two-triangle quad, the four-triangle
+// template's count per four-triangle one.
+std::pair<Index, Index> mixed_interface(const primal::Model& m) {
+  const primal::Interface itf = primal::find_interface(m);
+  const auto quads = static_cast<Index>(itf.quads.size());
+  Index four = 0;
+  for (const auto& q : itf.quads) four += q.centre != primal::kInvalidIndex;
+  CHECK(four > 0);
+  CHECK(four < quads);
+  const auto per_four = static_cast<Index>(
+      conform::reference_template_four_triangles(conform::ConformOptions{}.template_box).tpl.hex.hexes.size());
+  return {four, 26 * (quads - four) + per_four * four};
+}
+
 }  // namespace
 
 TEST_CASE("realistic models, no smoothing: valid and untangled by the placement alone") {
@@ -62,23 +77,14 @@ TEST_CASE("realistic model, default options: valid and untangled") {
 // four-triangle template, its side faces merged with the neighbouring geodes'.
 TEST_CASE("mixed two- and four-triangle interface: valid and untangled") {
   const primal::Model m = conform::demo_model("fourtri", 3);
-  const primal::Interface itf = primal::find_interface(m);
-  REQUIRE(itf.quads.size() == 9);
-  Index four = 0;
-  for (const auto& q : itf.quads) four += q.centre != primal::kInvalidIndex;
-  // Both kinds, and some four-triangle quads side by side with two-triangle ones.
-  CHECK(four > 0);
-  CHECK(four < 9);
-  const conform::ConformOptions defaults;
-  const auto per_four = static_cast<Index>(
-      conform::reference_template_four_triangles(defaults.template_box).tpl.hex.hexes.size());
+  const Index geode_hexes = mixed_interface(m).second;
   for (const auto smooth : {conform::ConformSmooth::kNone, conform::ConformSmooth::kLocal}) {
     CAPTURE(static_cast<int>(smooth));
     conform::ConformOptions o;
     o.smooth = smooth;
     const auto r = conform::conform(m, o);
     CHECK(r.interface_quads == 9);
-    check_valid(r, 26 * (9 - four) + per_four * four);
+    check_valid(r, geode_hexes);
   }
 }
 
@@ -86,13 +92,5 @@ TEST_CASE("mixed two- and four-triangle interface: valid and untangled") {
 // sides in a Delaunay tet box), where, as for the two-triangle cylinder, smoothing is needed.
 TEST_CASE("mixed interface on a curved cylinder, default options: valid and untangled") {
   const primal::Model m = conform::demo_model("fourtri-cylinder", 2);
-  const primal::Interface itf = primal::find_interface(m);
-  Index four = 0;
-  for (const auto& q : itf.quads) four += q.centre != primal::kInvalidIndex;
-  CHECK(four > 0);
-  CHECK(four < static_cast<Index>(itf.quads.size()));
-  const auto r = conform::conform(m);
-  const auto per_four = static_cast<Index>(
-      conform::reference_template_four_triangles(conform::ConformOptions{}.template_box).tpl.hex.hexes.size());
-  check_valid(r, 26 * (r.interface_quads - four) + per_four * four);
+  check_valid(conform::conform(m), mixed_interface(m).second);
 }

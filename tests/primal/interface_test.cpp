@@ -12,6 +12,7 @@
 #include "primal/errors.hpp"
 #include "primal/interface.hpp"
 #include "primal/topology.hpp"
+#include "support/fixtures.hpp"
 
 using namespace geode;
 using namespace geode::primal;
@@ -106,14 +107,8 @@ TEST_CASE("find_interface: one hex under tets, the face and diagonal by hand") {
 TEST_CASE("find_interface: a quad split into four triangles around a tet node") {
   // One hex; its top face 4 5 7 6 (counter-clockwise seen from above) in four triangles
   // around node 8, each under a tet with apex 9; the centre is off the quad's middle.
-  Model m = grid_model({1, 1, 1}, 1.0, [](int, int, int) { return false; });
-  m.points.emplace_back(0.4, 0.55, 1.0);  // node 8
-  m.points.emplace_back(0.5, 0.5, 2.0);   // node 9
+  Model m = test::four_tet_fan({0.4, 0.55, 1.0}, {0.5, 0.5, 2.0});
   const std::array<Index, 4> top{4, 5, 7, 6};
-  for (std::size_t i = 0; i < 4; ++i) {
-    m.tets.push_back({top[i], top[(i + 1) % 4], 8, 9});
-    m.tet_block.push_back(2);
-  }
   const Interface itf = find_interface(m);
   REQUIRE(itf.quads.size() == 1);
   const InterfaceQuad& q = itf.quads[0];
@@ -165,14 +160,7 @@ TEST_CASE("find_interface: rejects non-conforming interfaces, naming the face or
                          TopologyError);
   }
   SUBCASE("a four-triangle centre that is a hex node too") {
-    Model m = grid_model({1, 1, 1}, 1.0, [](int, int, int) { return false; });
-    m.points.emplace_back(0.5, 0.5, 1.0);  // node 8: centre of the top face
-    m.points.emplace_back(0.5, 0.5, 2.0);  // node 9: apex
-    const std::array<Index, 4> top{4, 5, 7, 6};
-    for (std::size_t i = 0; i < 4; ++i) {
-      m.tets.push_back({top[i], top[(i + 1) % 4], 8, 9});
-      m.tet_block.push_back(2);
-    }
+    Model m = test::four_tet_fan({0.5, 0.5, 1.0}, {0.5, 0.5, 2.0});
     // A hex below the first one using node 8 as a corner (nonsense geometry, topology only).
     const auto base = static_cast<Index>(m.points.size());
     for (int k = 0; k < 7; ++k) m.points.emplace_back(0.1 * k, -1.0, -1.0 - 0.1 * k);
