@@ -36,10 +36,9 @@ void check_valid(const conform::ConformResult& r, primal::Index geode_hexes = -1
   CHECK(r.model.hexes.size() == static_cast<std::size_t>(r.diced_hexes + r.geode_hexes + r.diced_tet_hexes));
 }
 
-// The model's interface quads split into four triangles, checked to be some but not all, and
-// the geode hexes conform() must make for it: 26 per two-triangle quad, the four-triangle
-// template's count per four-triangle one.
-std::pair<Index, Index> mixed_interface(const primal::Model& m) {
+// The geode hexes conform() must make for the model: 26 per two-triangle interface quad, the
+// four-triangle template's count per four-triangle one (checked to be some but not all quads).
+Index mixed_geode_hexes(const primal::Model& m) {
   const primal::Interface itf = primal::find_interface(m);
   const auto quads = static_cast<Index>(itf.quads.size());
   Index four = 0;
@@ -48,7 +47,7 @@ std::pair<Index, Index> mixed_interface(const primal::Model& m) {
   CHECK(four < quads);
   const auto per_four = static_cast<Index>(
       conform::reference_template_four_triangles(conform::ConformOptions{}.template_box).tpl.hex.hexes.size());
-  return {four, 26 * (quads - four) + per_four * four};
+  return 26 * (quads - four) + per_four * four;
 }
 
 }  // namespace
@@ -77,7 +76,7 @@ TEST_CASE("realistic model, default options: valid and untangled") {
 // four-triangle template, its side faces merged with the neighbouring geodes'.
 TEST_CASE("mixed two- and four-triangle interface: valid and untangled") {
   const primal::Model m = conform::demo_model("fourtri", 3);
-  const Index geode_hexes = mixed_interface(m).second;
+  const Index geode_hexes = mixed_geode_hexes(m);
   for (const auto smooth : {conform::ConformSmooth::kNone, conform::ConformSmooth::kLocal}) {
     CAPTURE(static_cast<int>(smooth));
     conform::ConformOptions o;
@@ -92,5 +91,5 @@ TEST_CASE("mixed two- and four-triangle interface: valid and untangled") {
 // sides in a Delaunay tet box), where, as for the two-triangle cylinder, smoothing is needed.
 TEST_CASE("mixed interface on a curved cylinder, default options: valid and untangled") {
   const primal::Model m = conform::demo_model("fourtri-cylinder", 2);
-  check_valid(conform::conform(m), mixed_interface(m).second);
+  check_valid(conform::conform(m), mixed_geode_hexes(m));
 }
