@@ -53,14 +53,8 @@ OutputBlocks output_blocks(const primal::Model& input, const std::string& geode_
   return o;
 }
 
-// The map of the reference cell into a buffer hex: bilinear on the bottom (the hex side's
-// quad), piecewise linear over the two triangles of the top (so the tet side's diced nodes,
-// edge midpoints and triangle centroids, are images of the template's), linear in t between
-// them. The trilinear map would instead follow a twisted top's bilinear surface, whose
-// diagonal midpoint passes the template nodes under it; this one keeps every template hex
-// positive wherever the buffer hex is valid.
-// A four-triangle top (a centre node, `centre`, at (r, s) = (1/2, 1/2)) is piecewise linear
-// over its four triangles the same way.
+// A four-triangle top (a centre node, `centre`, at (r, s) = (1/2, 1/2)) at (r, s): linear over
+// each of its four triangles, as buffer_map's two-triangle tops are.
 Point four_triangle_top(const std::array<Point, 8>& P, const Point& centre, double r, double s) {
   // Top corners 4..7 at (r, s) = (0,0), (1,0), (1,1), (0,1); triangle i is (4+i, 4+(i+1)%4, centre),
   // the one whose side of the square is nearest to (r, s).
@@ -76,6 +70,12 @@ Point four_triangle_top(const std::array<Point, 8>& P, const Point& centre, doub
   return (1 - lb - lc) * P[4 + i] + lb * P[4 + (i + 1) % 4] + lc * centre;
 }
 
+// The map of the reference cell into a buffer hex: bilinear on the bottom (the hex side's
+// quad), piecewise linear over the two triangles of the top (so the tet side's diced nodes,
+// edge midpoints and triangle centroids, are images of the template's), linear in t between
+// them. The trilinear map would instead follow a twisted top's bilinear surface, whose
+// diagonal midpoint passes the template nodes under it; this one keeps every template hex
+// positive wherever the buffer hex is valid. With `centre`, the top is four_triangle_top.
 Point buffer_map(const std::array<Point, 8>& P, const std::array<int, 2>& diagonal, const Point& rst,
                  const Point* centre = nullptr) {
   const double r = rst.x(), s = rst.y(), t = rst.z();
