@@ -262,8 +262,10 @@ void add_conform_commands(CLI::App& app) {
   CLI::App* c = app.add_subcommand(
       "conform",
       "Conform the hex part of a model to its tet part with geode templates: buffer layer, dicing\n"
-      "(8 per hex, 4 per tet), 26 geode hexes per interface quad. Input element blocks, node sets\n"
-      "and side sets are carried to the output. Exit 4 when the result fails verification.");
+      "(8 per hex, 4 per tet), 26 geode hexes per interface quad split into two triangles (the\n"
+      "fixed-up four-triangle template where the tet side splits a quad into four triangles around a\n"
+      "centre node). Input element blocks, node sets and side sets are carried to the output. Exit 4\n"
+      "when the result fails verification.");
   c->add_option("INPUT", args->input, "input model (.msh, .exo, .e, .vtu, .vtk)")->required();
   add_run_options(c, *args);
   c->callback([args] {
@@ -280,7 +282,9 @@ void add_conform_commands(CLI::App& app) {
                  "delaunay-random: beside a Delaunay tet box, interface diagonals alternating or\n"
                  "random; cylinder: a swept hex cylinder with unstructured quad caps in a tet box;\n"
                  "lshape: a hex block in the notch of an L-shaped tet part (concave interface);\n"
-                 "nugget: a Delaunay tet cube in 26 structured blocks")
+                 "nugget: a Delaunay tet cube in 26 structured blocks; fourtri: beside a Delaunay tet\n"
+                 "box whose interface quads are split into two or four triangles (at random);\n"
+                 "fourtri-cylinder: the cylinder with half its interface quads in four triangles")
       ->check(CLI::IsMember(conform::demo_model_names()))
       ->capture_default_str();
   d->add_option("-n,--size", dargs->n, "cells per unit length (1 to 64; default 4; nugget rounds up to even)")

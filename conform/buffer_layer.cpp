@@ -114,11 +114,16 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
   for (const FaceKey& key : interface_tris)
     if (Index* uses = tet_face_uses.find(key)) *uses = -1;
   std::vector<std::vector<Point>> outer_normals(n_moved);  // area-weighted
+  // Per input node: the interface quad it is the four-triangle centre of, or kInvalidIndex.
+  std::vector<Index> centre_of(n_points, kInvalidIndex);
+  for (std::size_t q = 0; q < itf.quads.size(); ++q)
+    if (itf.quads[q].centre != kInvalidIndex) centre_of[static_cast<std::size_t>(itf.quads[q].centre)] = static_cast<Index>(q);
   std::vector<Index> touched_tets;
   for (std::size_t t = 0; t < input.tets.size(); ++t) {
     const auto& tet = input.tets[t];
     bool touches = false;
-    for (Index v : tet) touches |= out.top_node[static_cast<std::size_t>(v)] != kInvalidIndex;
+    for (Index v : tet)
+      touches |= out.top_node[static_cast<std::size_t>(v)] != kInvalidIndex || centre_of[static_cast<std::size_t>(v)] != kInvalidIndex;
     if (!touches) continue;
     touched_tets.push_back(static_cast<Index>(t));
     for (const auto& e : topology::kTetEdgeCorners) {
@@ -193,6 +198,7 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
       b.corners[i + 4] = out.top_node[static_cast<std::size_t>(q.corners[i])];
     }
     b.diagonal = q.diagonal == 0 ? std::array<int, 2>{4, 6} : std::array<int, 2>{5, 7};
+    b.centre = q.centre;
     b.quad = static_cast<Index>(out.hexes.size());
     out.hexes.push_back(b);
   }
@@ -206,7 +212,23 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
       const std::size_t v = static_cast<std::size_t>(interface_nodes[k]);
       out.model.points.push_back(P[v] + scale[k] * opt.thickness * shortest[k] * direction[k]);
     }
+    // A four-triangle centre keeps its place relative to the quad's corners.
+    for (const BufferHex& b : out.hexes) {
+      if (b.centre == kInvalidIndex) continue;
+      Point step = Point::Zero();
+      for (std::size_t i = 0; i < 4; ++i)
+        step += (out.model.points[static_cast<std::size_t>(b.corners[i + 4])] - P[static_cast<std::size_t>(b.corners[i])]) / 4.0;
+      out.model.points[static_cast<std::size_t>(b.centre)] = P[static_cast<std::size_t>(b.centre)] + step;
+    }
     std::vector<char> failing(n_moved, 0);
+    // A failing centre's steps are its quad's corners'.
+    auto fail_node = [&](Index v) {
+      if (static_cast<std::size_t>(v) >= n_points) {
+        failing[static_cast<std::size_t>(v) - n_points] = 1;
+      } else if (const Index q = centre_of[static_cast<std::size_t>(v)]; q != kInvalidIndex) {
+        for (std::size_t i = 4; i < 8; ++i) failing[static_cast<std::size_t>(out.hexes[static_cast<std::size_t>(q)].corners[i]) - n_points] = 1;
+      }
+    };
     std::string first_failure;
     out.report.min_tet_volume_ratio = 1.0;
     out.report.min_scaled_jacobian = 1.0;
@@ -216,21 +238,31 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
       const double ratio = tet_vol(out.model.points, moved) / before;
       out.report.min_tet_volume_ratio = std::min(out.report.min_tet_volume_ratio, ratio);
       if (ratio < opt.min_volume_ratio) {
-        for (Index v : moved)
-          if (static_cast<std::size_t>(v) >= n_points) {
-            failing[static_cast<std::size_t>(v) - n_points] = 1;
-            if (first_failure.empty())
-              first_failure = describe_node(input, interface_nodes[static_cast<std::size_t>(v) - n_points]) +
-                              ": " + describe_element(input, {ElementKind::Tet, static_cast<Index>(t)}) +
-                              " keeps only " + std::to_string(ratio) +
-                              " of its volume";
-          }
+        for (Index v : moved) fail_node(v);
+        for (Index v : moved) {
+          if (!first_failure.empty()) break;
+          const bool duplicate = static_cast<std::size_t>(v) >= n_points;
+          if (duplicate || centre_of[static_cast<std::size_t>(v)] != kInvalidIndex)
+            first_failure = describe_node(input, duplicate ? interface_nodes[static_cast<std::size_t>(v) - n_points] : v) +
+                            ": " + describe_element(input, {ElementKind::Tet, static_cast<Index>(t)}) + " keeps only " +
+                            std::to_string(ratio) + " of its volume";
+        }
       }
     }
     for (const BufferHex& b : out.hexes) {
       HexCorners c;
       for (std::size_t i = 0; i < 8; ++i) c[i] = out.model.points[static_cast<std::size_t>(b.corners[i])];
-      const double sj = hex_scaled_jacobian(c);
+      double sj = hex_scaled_jacobian(c);
+      if (b.centre != kInvalidIndex) {
+        // A four-triangle top: each triangle must face away from the bottom face's centre,
+        // measured as a scaled Jacobian (the tet's volume over its edge lengths at the centre).
+        const Point& top = out.model.points[static_cast<std::size_t>(b.centre)];
+        const Point bottom = (c[0] + c[1] + c[2] + c[3]) / 4.0;
+        for (std::size_t i = 0; i < 4; ++i) {
+          const Point a = c[4 + i] - bottom, e = c[4 + (i + 1) % 4] - bottom, m = top - bottom;
+          sj = std::min(sj, a.cross(e).dot(m) / (a.norm() * e.norm() * m.norm()));
+        }
+      }
       out.report.min_scaled_jacobian = std::min(out.report.min_scaled_jacobian, sj);
       if (sj < opt.min_scaled_jacobian)
         for (std::size_t i = 4; i < 8; ++i) {

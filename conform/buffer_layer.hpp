@@ -10,7 +10,9 @@
 //                clockwise seen from the tet side, so the buffer hex is positively oriented;
 //   corners 4-7: their tet-side duplicates, corner 4+i above corner i;
 //   the top face (local face 5, t = 1) is on the tet side, split into two triangles along
-//   `diagonal` = {4, 6} or {5, 7} (the corners the split joins); the bottom face (local face 4,
+//   `diagonal` = {4, 6} or {5, 7} (the corners the split joins), or into four triangles
+//   around `centre` (a tet-part node used by no hex, so it is moved, not duplicated: by the
+//   mean step of the quad's corners); the bottom face (local face 4,
 //   t = 0) is on the hex side. For the geode template of templates/geode.hpp (y up, top at
 //   y = +h/2) one right-handed map is r = z, s = x, t = y, under which Diagonal::Main (which
 //   joins (-x,+z) and (+x,-z)) is {5, 7} and Diagonal::Anti is {4, 6}.
@@ -48,7 +50,8 @@ struct BufferLayerOptions {
 
 struct BufferHex {
   std::array<Index, 8> corners{};  // see the convention above
-  std::array<int, 2> diagonal{};   // {4, 6} or {5, 7}
+  std::array<int, 2> diagonal{};   // {4, 6} or {5, 7}; not used with a centre
+  Index centre = kInvalidIndex;    // four-triangle top: its centre node (model.points[centre])
   Index quad = kInvalidIndex;      // index into Interface::quads
 };
 
@@ -61,7 +64,8 @@ struct BufferLayerReport {
 
 struct BufferLayer {
   // The input model with the tet part shrunk: one duplicate per interface node appended to
-  // the points (model.points[top_node[v]]), every tet renumbered to the duplicates. Hexes,
+  // the points (model.points[top_node[v]]), every tet renumbered to the duplicates, centre
+  // nodes of four-triangle quads moved in place. Hexes,
   // blocks, node sets (which keep the hex-side nodes) and side sets are unchanged; the buffer
   // hexes are not in it.
   Model model;

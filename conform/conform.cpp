@@ -54,18 +54,38 @@ OutputBlocks output_blocks(const primal::Model& input, const std::string& geode_
   return o;
 }
 
+// A four-triangle top (a centre node, `centre`, at (r, s) = (1/2, 1/2)) at (r, s): linear over
+// each of its four triangles, as buffer_map's two-triangle tops are.
+Point four_triangle_top(const std::array<Point, 8>& P, const Point& centre, double r, double s) {
+  // Top corners 4..7 at (r, s) = (0,0), (1,0), (1,1), (0,1); triangle i is (4+i, 4+(i+1)%4, centre),
+  // the one whose side of the square is nearest to (r, s).
+  const std::array<double, 4> side_distance{s, 1 - r, 1 - s, r};
+  const int i = static_cast<int>(std::min_element(side_distance.begin(), side_distance.end()) - side_distance.begin());
+  constexpr std::array<std::array<double, 2>, 4> kAt{{{0, 0}, {1, 0}, {1, 1}, {0, 1}}};
+  const auto& a = kAt[i];
+  const auto& b = kAt[(i + 1) % 4];
+  // Barycentric coordinates of (r, s) in (a, b, (1/2, 1/2)).
+  const double ux = b[0] - a[0], uy = b[1] - a[1], vx = 0.5 - a[0], vy = 0.5 - a[1];
+  const double px = r - a[0], py = s - a[1], det = ux * vy - uy * vx;
+  const double lb = (px * vy - py * vx) / det, lc = (ux * py - uy * px) / det;
+  return (1 - lb - lc) * P[4 + i] + lb * P[4 + (i + 1) % 4] + lc * centre;
+}
+
 // The map of the reference cell into a buffer hex: bilinear on the bottom (the hex side's
 // quad), piecewise linear over the two triangles of the top (so the tet side's diced nodes,
 // edge midpoints and triangle centroids, are images of the template's), linear in t between
 // them. The trilinear map would instead follow a twisted top's bilinear surface, whose
 // diagonal midpoint passes the template nodes under it; this one keeps every template hex
-// positive wherever the buffer hex is valid.
-Point buffer_map(const std::array<Point, 8>& P, const std::array<int, 2>& diagonal, const Point& rst) {
+// positive wherever the buffer hex is valid. With `centre`, the top is four_triangle_top.
+Point buffer_map(const std::array<Point, 8>& P, const std::array<int, 2>& diagonal, const Point& rst,
+                 const Point* centre = nullptr) {
   const double r = rst.x(), s = rst.y(), t = rst.z();
   const Point bottom = primal::multilinear_point(P, Point(r, s, 0.0), 2);
   // Top corners 4..7 at (r, s) = (0,0), (1,0), (1,1), (0,1).
   Point top;
-  if (diagonal[0] == 4) {  // split 4-6: the line r = s
+  if (centre) {
+    top = four_triangle_top(P, *centre, r, s);
+  } else if (diagonal[0] == 4) {  // split 4-6: the line r = s
     top = r >= s ? P[4] + r * (P[5] - P[4]) + s * (P[6] - P[5])
                  : P[4] + s * (P[7] - P[4]) + r * (P[6] - P[7]);
   } else {  // split 5-7: the line r + s = 1
@@ -102,6 +122,7 @@ class Conformer {
   }
   std::string took() const { return " (" + std::to_string(since(t0_)) + " s)"; }
   const RefTemplate& ref(std::size_t b) const {
+    if (layer_.hexes[b].centre != kInvalidIndex) return *refs_[2];
     return layer_.hexes[b].diagonal[0] == 5 ? *refs_[1] : *refs_[0];
   }
 
@@ -122,7 +143,7 @@ class Conformer {
   primal::Interface interface_;
   BufferLayer layer_;
   primal::DicedModel diced_;
-  std::array<const RefTemplate*, 2> refs_{};  // diagonal {4, 6}, {5, 7}
+  std::array<const RefTemplate*, 3> refs_{};  // diagonal {4, 6}, {5, 7}, four triangles
   // Per buffer hex and template node: its global node, or (side-face nodes, until
   // match_sides) a disjoint-sets item at side_pos_.
   std::vector<std::vector<Index>> inst_global_, inst_side_;
@@ -170,8 +191,10 @@ void Conformer::insert_buffer() {
 void Conformer::dice_and_merge() {
   t0_ = Clock::now();
   std::vector<char> shareable(layer_.model.points.size(), 0);
-  for (const auto& b : layer_.hexes)
+  for (const auto& b : layer_.hexes) {
     for (Index v : b.corners) shareable[v] = 1;
+    if (b.centre != kInvalidIndex) shareable[b.centre] = 1;
+  }
   diced_ = primal::dice_model(layer_.model, shareable);
   res_.diced_hexes = static_cast<Index>(diced_.hex_children.size());
   res_.diced_tet_hexes = static_cast<Index>(diced_.tet_children.size());
@@ -189,6 +212,11 @@ void Conformer::place_templates() {
       std::min(refs_[0]->min_scaled_jacobian, refs_[1]->min_scaled_jacobian);
   const primal::Model& lm = layer_.model;
   const std::size_t nb = layer_.hexes.size();
+  // The four-triangle template only when some buffer hex needs it (its fix-up costs time).
+  if (std::any_of(layer_.hexes.begin(), layer_.hexes.end(), [](const BufferHex& b) { return b.centre != kInvalidIndex; })) {
+    refs_[2] = &reference_template_four_triangles(options_.template_box);
+    res_.template_min_scaled_jacobian = std::min(res_.template_min_scaled_jacobian, refs_[2]->min_scaled_jacobian);
+  }
   inst_global_.assign(nb, {});
   inst_side_.assign(nb, {});
   for (std::size_t b = 0; b < nb; ++b) {
@@ -196,15 +224,20 @@ void Conformer::place_templates() {
     const RefTemplate& rt = ref(b);
     std::array<Point, 8> P;
     for (int c = 0; c < 8; ++c) P[c] = lm.points[bh.corners[c]];
+    const bool four = bh.centre != kInvalidIndex;
+    const Point centre = four ? lm.points[bh.centre] : Point::Zero();
     const std::size_t n = rt.rst.size();
     inst_global_[b].assign(n, kInvalidIndex);
     inst_side_[b].assign(n, kInvalidIndex);
+    res_.geode_hexes += static_cast<Index>(rt.tpl.hex.hexes.size());
     for (std::size_t i = 0; i < n; ++i) {
-      const Point x = buffer_map(P, bh.diagonal, rt.rst[i]);
+      const Point x = buffer_map(P, bh.diagonal, rt.rst[i], four ? &centre : nullptr);
       if (!rt.key_corners[i].empty()) {
         FaceKey key = kNoOrigin;
-        for (std::size_t k = 0; k < rt.key_corners[i].size(); ++k)
-          key[k] = bh.corners[rt.key_corners[i][k]];
+        for (std::size_t k = 0; k < rt.key_corners[i].size(); ++k) {
+          const int c = rt.key_corners[i][k];
+          key[k] = c == kCentreCorner ? bh.centre : bh.corners[c];
+        }
         const Index g = diced_.find(key);
         if (g == kInvalidIndex)
           throw TopologyError("buffer hex " + std::to_string(b) +
@@ -219,7 +252,6 @@ void Conformer::place_templates() {
     }
   }
   diced_.shared = primal::KeyMap<4>();  // every template node is placed
-  res_.geode_hexes = static_cast<Index>(26 * nb);
   say("geode templates: " + std::to_string(nb) + " buffer hexes, reference min scaled Jacobian " +
       std::to_string(res_.template_min_scaled_jacobian) + took());
 }
@@ -283,7 +315,7 @@ void Conformer::assemble() {
   const std::size_t nb = layer_.hexes.size();
   std::vector<std::array<Index, 8>> hexes;
   std::vector<int> block;
-  hexes.reserve(diced_.hex_children.size() + 26 * nb + diced_.tet_children.size());
+  hexes.reserve(diced_.hex_children.size() + res_.geode_hexes + diced_.tet_children.size());
   block.reserve(hexes.capacity());
   // Each output hex is in the input block of the element it comes from; a geode hex in the
   // block of the tet its buffer hex was carved from, or in a block of its own.

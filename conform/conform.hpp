@@ -1,12 +1,13 @@
 #pragma once
 // The geode algorithm on a whole model (the paper's Sections 1 and 4): find the hex/tet
 // interface, shrink the tet part off it (buffer layer), dice the hex part (8 per hex) and the
-// tet part (4 hexes per tet), fill every buffer hex with the 26-hex geode template mapped by
-// the trilinear map of its 8 corners, merge, smooth locally and verify. The result is all-hex.
+// tet part (4 hexes per tet), fill every buffer hex with the 26-hex geode template (or, where
+// the interface quad is split into four triangles around a centre node, the fixed-up
+// four-triangle template) mapped into it, merge, smooth locally and verify. The result is all-hex.
 //
 // Merging. Tet- and hex-side template nodes are identified with diced nodes by their origin
-// (corner, edge midpoint, quad centre, triangle centroid: the keys of primal/dice's node-origin
-// map), never by position, and take the diced position. Side-face nodes of two buffer hexes
+// (corner, edge midpoint, quad centre, triangle centroid, a four-triangle top's centre node:
+// the keys of primal/dice's node-origin map), never by position, and take the diced position. Side-face nodes of two buffer hexes
 // sharing a side face are matched topologically (the side face's quad mesh, propagated from the
 // shared top/bottom nodes across quad edges) and merged. The reference template's four side
 // faces carry one mirror-symmetric mesh (templates/side_faces.hpp) and a side face is mapped
@@ -89,7 +90,8 @@ struct BlockQuality {
 
 struct ConformResult {
   // All-hex model: hexes by origin (diced_hexes diced hexes, geode_hexes geode hexes, 26 per
-  // interface quad in Interface order, diced_tet_hexes diced tets), each in an input block:
+  // two-triangle interface quad and the four-triangle template's count per four-triangle one,
+  // in Interface order, diced_tet_hexes diced tets), each in an input block:
   // a diced hex or tet in its parent's, a geode hex in that of the tet its buffer hex was
   // carved from (or ConformOptions::geode_block); input block names kept. Node sets: every input node of the set plus
   // the diced edge / face nodes whose origin nodes are all in the set. Side sets: every input
@@ -98,7 +100,7 @@ struct ConformResult {
   primal::Index input_hexes = 0, input_tets = 0, interface_quads = 0;
   primal::Index diced_hexes = 0, geode_hexes = 0, diced_tet_hexes = 0;
   BufferLayerReport buffer;
-  double template_min_scaled_jacobian = 0.0;  // the two reference templates, after smoothing
+  double template_min_scaled_jacobian = 0.0;  // the reference templates used, after smoothing
   // The yardstick for the transition: the input's hexes and tets each diced alone
   // (primal::diced_min_scaled_jacobian), before the buffer layer moves anything.
   double input_diced_hex_min_scaled_jacobian = 1.0, input_diced_tet_min_scaled_jacobian = 1.0;

@@ -119,10 +119,11 @@ void append_gmsh_triangles(Shell& shell, Keep keep) {
 
 // The boundary quads of the hex part for which on_interface(centre) holds, each split into two
 // triangles: along corners 0-2 when split(quad number, centre) is false, 1-3 otherwise (the
-// other diagonal where that one would fold the quad).
-template <class OnInterface, class Split>
+// other diagonal where that one would fold the quad); or, where four(centre) holds and they do
+// not fold, into four triangles around a new node at the mean of its corners.
+template <class OnInterface, class Split, class Four>
 void append_interface_triangles(Shell& shell, const Model& hexes, OnInterface on_interface,
-                                Split split) {
+                                Split split, Four four) {
   int count = 0;
   for (const BoundaryQuad& q : boundary_quads(hex_part(hexes))) {
     Point c = Point::Zero();
@@ -139,6 +140,13 @@ void append_interface_triangles(Shell& shell, const Model& hexes, OnInterface on
     auto folds = [&](int a, int b, int d) { return (p[b] - p[a]).cross(p[d] - p[a]).dot(normal) <= 0; };
     const bool folds02 = folds(0, 1, 2) || folds(0, 2, 3), folds13 = folds(0, 1, 3) || folds(1, 2, 3);
     bool along13 = split(count++, c);
+    bool four_folds = false;  // a triangle around the centre facing away (non-convex quad)
+    for (int k = 0; k < 4; ++k) four_folds |= (p[(k + 1) % 4] - p[k]).cross(c - p[k]).dot(normal) <= 0;
+    if (four(c) && !four_folds) {
+      const Index m = shell.node(c);
+      for (int k = 0; k < 4; ++k) shell.tris.push_back({n[k], n[(k + 1) % 4], m});
+      continue;
+    }
     if (along13 ? folds13 : folds02) along13 = !along13;
     if (along13) {
       shell.tris.push_back({n[0], n[1], n[3]});
@@ -276,6 +284,19 @@ std::function<bool(int, const Point&)> diagonal_chooser(DemoDiagonals d, double 
   return [rng](int, const Point&) { return ((*rng)() & 1u) != 0; };
 }
 
+// Four-triangle chooser: when `on`, half the quads (at random, fixed seed) in four triangles,
+// the first always so that every model has one; none otherwise.
+std::function<bool(const Point&)> four_chooser(bool on) {
+  if (!on) return [](const Point&) { return false; };
+  auto rng = std::make_shared<std::mt19937>(2024u);
+  auto first = std::make_shared<bool>(true);
+  return [rng, first](const Point&) {
+    const bool four = *first || ((*rng)() & 1u) != 0;
+    *first = false;
+    return four;
+  };
+}
+
 // Gmsh's OCC bounding boxes are enlarged by a tolerance; entity tests on them allow for it.
 constexpr double kEps = 1e-4;
 
@@ -391,7 +412,7 @@ Model demo_nugget(int n) {
 
 namespace geode::conform {
 
-Model demo_delaunay_block(int n, DemoDiagonals diagonals) {
+Model demo_delaunay_block(int n, DemoDiagonals diagonals, bool four_triangles) {
   if (n < 1) throw InvalidInput("demo_delaunay_block: n = " + std::to_string(n) + " must be >= 1");
   const double h = 1.0 / n;
   return run_gmsh("demo_delaunay_block", [&] {
@@ -401,12 +422,12 @@ Model demo_delaunay_block(int n, DemoDiagonals diagonals) {
         shell, h, [] { gmsh::model::occ::addBox(1, 0, 0, 1, 1, 1); },
         [](const Box& b) { return b[3] < 1 + kEps; }, [](const Box& b) { return b[3] > 1 + kEps; });
     append_interface_triangles(shell, hexes, [](const Point& c) { return c.x() > 1 - kEps; },
-                               diagonal_chooser(diagonals, h));
+                               diagonal_chooser(diagonals, h), four_chooser(four_triangles));
     return join(std::move(hexes), tet_fill(shell, {}, 2, "tet"));
   });
 }
 
-Model demo_cylinder(int n) {
+Model demo_cylinder(int n, bool four_triangles) {
   if (n < 2) throw InvalidInput("demo_cylinder: n = " + std::to_string(n) + " must be >= 2");
   const double h = 1.0 / n;
   return run_gmsh("demo_cylinder", [&] {
@@ -429,7 +450,7 @@ Model demo_cylinder(int n) {
         outer, 2 * h, [] { gmsh::model::occ::addBox(-1, -1, -1, 2, 2, 2); },
         [](const Box&) { return false; }, [](const Box&) { return true; });
     append_interface_triangles(inner, hexes, [](const Point&) { return true; },
-                               diagonal_chooser(DemoDiagonals::kRandom, h));
+                               diagonal_chooser(DemoDiagonals::kRandom, h), four_chooser(four_triangles));
     return join(std::move(hexes), tet_fill(outer, {inner}, 2, "tet box"));
   });
 }
@@ -452,14 +473,14 @@ Model demo_l_shape(int n) {
         in_notch, [&](const Box& b) { return !in_notch(b); });
     append_interface_triangles(
         shell, hexes, [](const Point& c) { return c.x() < 1 + kEps || c.y() < 1 + kEps; },
-        diagonal_chooser(DemoDiagonals::kRandom, h));
+        diagonal_chooser(DemoDiagonals::kRandom, h), four_chooser(false));
     return join(std::move(hexes), tet_fill(shell, {}, 2, "tet L"));
   });
 }
 
 const std::vector<std::string>& demo_model_names() {
   static const std::vector<std::string> names{"half", "delaunay", "delaunay-random", "cylinder",
-                                              "lshape", "nugget"};
+                                              "lshape", "nugget", "fourtri", "fourtri-cylinder"};
   return names;
 }
 
@@ -470,7 +491,11 @@ Model demo_model(const std::string& name, int n) {
   if (name == "cylinder") return demo_cylinder(n);
   if (name == "lshape") return demo_l_shape(n);
   if (name == "nugget") return demo_nugget(n % 2 ? n + 1 : n);
-  throw InvalidInput("demo model '" + name + "': expected one of half, delaunay, delaunay-random, cylinder, lshape, nugget");
+  if (name == "fourtri") return demo_delaunay_block(n, DemoDiagonals::kRandom, true);
+  if (name == "fourtri-cylinder") return demo_cylinder(n, true);
+  throw InvalidInput("demo model '" + name +
+                     "': expected one of half, delaunay, delaunay-random, cylinder, lshape, nugget, fourtri, "
+                     "fourtri-cylinder");
 }
 
 }  // namespace geode::conform

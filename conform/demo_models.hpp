@@ -37,19 +37,24 @@ Model demo_nugget(int n = 4);
 enum class DemoDiagonals { kAlternate, kRandom };
 
 // (a) Structured hexes [0,1]^3 (n^3, block 1 "hex") beside a Delaunay tet box [1,2] x [0,1]^2
-// (block 2 "tet"); interface quads split alternately (checkerboard) or at random.
-Model demo_delaunay_block(int n = 4, DemoDiagonals diagonals = DemoDiagonals::kAlternate);
+// (block 2 "tet"); interface quads split alternately (checkerboard) or at random. With
+// four_triangles, half of them (at random, the first always) are split into four triangles
+// around a node at the quad's centre instead: a mixed interface for the four-triangle template.
+Model demo_delaunay_block(int n = 4, DemoDiagonals diagonals = DemoDiagonals::kAlternate,
+                          bool four_triangles = false);
 
 // (b) A curved interface: a hex cylinder (radius 0.5, height 1: a disk of unstructured
 // recombined quads swept in n layers; block 1) inside a tet-meshed box [-1,1]^3 (block 2).
-Model demo_cylinder(int n = 4);
+// four_triangles: half the interface quads (as in (a)) in four triangles around their centre.
+Model demo_cylinder(int n = 4, bool four_triangles = false);
 
 // (c) A concave interface: a structured hex block [1,2]^2 x [0,1] in the notch of an L-shaped
 // Delaunay tet part [0,2]^2 x [0,1] minus the notch, so the tet part wraps the interface edge.
 Model demo_l_shape(int n = 4);
 
 // The names `geode demo --model` takes: half, delaunay, delaunay-random, cylinder, lshape,
-// nugget (d: a convex Delaunay tet nugget in structured blocks).
+// nugget (d: a convex Delaunay tet nugget in structured blocks), fourtri (a, random diagonals,
+// four-triangle quads), fourtri-cylinder (b with four-triangle quads).
 const std::vector<std::string>& demo_model_names();
 // The model of that name with size parameter n (made even where the model needs it); throws
 // InvalidInput naming an unknown name.

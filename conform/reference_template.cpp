@@ -10,7 +10,9 @@
 
 #include "primal/errors.hpp"
 #include "primal/patch_match.hpp"
+#include "primal/smooth.hpp"
 #include "primal/topology.hpp"
+#include "templates/fixup.hpp"
 #include "templates/side_faces.hpp"
 
 namespace geode::conform {
@@ -22,6 +24,7 @@ namespace topo = primal::topology;
 using templates::build_geode3d;
 using templates::Diagonal;
 using templates::GeodeOptions;
+using templates::smooth_template;
 
 // Buffer hex side faces 0..3 (topology order: s-min, r-max, s-max, r-min) as template box-face
 // bits (templates/geode.hpp: bit 2*axis + high) under r = z, s = x, t = y
@@ -35,18 +38,41 @@ int corner_at(int r, int s, int t) {
   return -1;
 }
 
-RefTemplate make_reference(const Eigen::Vector3d& box, std::array<int, 2> diagonal) {
-  RefTemplate ref;
-  GeodeOptions o;
-  o.box = box;
-  o.diagonal = diagonal == std::array<int, 2>{5, 7} ? Diagonal::Main : Diagonal::Anti;
-  ref.tpl = build_geode3d(o);
-  ref.min_scaled_jacobian = templates::smooth_template_shared_sides(ref.tpl).final_min_scaled_jacobian;
-  const auto& pts = ref.tpl.hex.points;
-  const std::size_t n = pts.size();
-  // A smoothed template with two nodes at one place would glue the model together there.
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t j = i + 1; j < n; ++j)
+// The diced node of a four-triangle top at (r, s) as buffer hex corners (kCentreCorner for the
+// centre): a corner, an edge midpoint, the centre, a centre-corner midpoint or the centroid of
+// a triangle (corner, next corner, centre); empty when (r, s) is none of them.
+std::vector<int> four_triangle_key(double r, double s, double tol) {
+  constexpr std::array<int, 4> kTop{4, 5, 6, 7};  // at (r, s) = (0,0), (1,0), (1,1), (0,1)
+  std::vector<std::vector<int>> keys{{kCentreCorner}};
+  for (int i = 0; i < 4; ++i) {
+    const int a = kTop[i], b = kTop[(i + 1) % 4];
+    keys.push_back({a}), keys.push_back({a, b}), keys.push_back({a, kCentreCorner});
+    keys.push_back({a, b, kCentreCorner});
+  }
+  for (const auto& key : keys) {
+    double cr = 0, cs = 0;
+    for (int c : key) {
+      cr += c == kCentreCorner ? 0.5 : topo::kHexCornerCoords[c][0];
+      cs += c == kCentreCorner ? 0.5 : topo::kHexCornerCoords[c][1];
+    }
+    const double n = static_cast<double>(key.size());
+    if (std::abs(cr / n - r) < tol && std::abs(cs / n - s) < tol) return key;
+  }
+  return {};
+}
+
+// A template node's reference coordinates in the buffer hex (r = z, s = x, t = y), and back.
+Point reference_coordinates(const Point& p, const Eigen::Vector3d& box) {
+  return {p.z() / box.z() + 0.5, p.x() / box.x() + 0.5, p.y() / box.y() + 0.5};
+}
+Point box_position(const Point& rst, const Eigen::Vector3d& box) {
+  return {(rst.y() - 0.5) * box.x(), (rst.z() - 0.5) * box.y(), (rst.x() - 0.5) * box.z()};
+}
+
+// A smoothed template with two nodes at one place would glue the model together there.
+void check_distinct(const std::vector<Point>& pts, const Eigen::Vector3d& box) {
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    for (std::size_t j = i + 1; j < pts.size(); ++j)
       if ((pts[i] - pts[j]).norm() < 1e-6 * box.norm()) {
         std::ostringstream m;
         m << "the smoothed geode template in a " << box.x() << " x " << box.y() << " x "
@@ -54,6 +80,28 @@ RefTemplate make_reference(const Eigen::Vector3d& box, std::array<int, 2> diagon
           << pts[i].transpose() << "); choose other template proportions";
         throw TopologyError(m.str());
       }
+}
+
+RefTemplate make_reference(const Eigen::Vector3d& box, std::array<int, 2> diagonal,
+                           templates::TopSplit split = templates::TopSplit::TwoTriangles) {
+  RefTemplate ref;
+  GeodeOptions o;
+  o.box = box;
+  o.diagonal = diagonal == std::array<int, 2>{5, 7} ? Diagonal::Main : Diagonal::Anti;
+  o.split = split;
+  const bool four = split == templates::TopSplit::FourTriangles;
+  ref.tpl = build_geode3d(o);
+  // The plain four-triangle dual has obstructions no placement can untangle (templates/fixup.hpp).
+  if (four && templates::fix_up(ref.tpl).obstructions_after > 0)
+    throw TopologyError("the four-triangle template in a " + std::to_string(box.x()) + " x " + std::to_string(box.y()) +
+                        " x " + std::to_string(box.z()) + " box keeps obstructions after fix-up");
+  // The geode's four side faces become one shared mesh (templates/side_faces.hpp); the
+  // four-triangle template takes the geode's afterwards (impose_geode_sides).
+  ref.min_scaled_jacobian = four ? smooth_template(ref.tpl, false).final_min_scaled_jacobian
+                                 : templates::smooth_template_shared_sides(ref.tpl).final_min_scaled_jacobian;
+  const auto& pts = ref.tpl.hex.points;
+  const std::size_t n = pts.size();
+  check_distinct(pts, box);
   ref.rst.resize(n);
   ref.key_corners.resize(n);
   constexpr double kTol = 1e-6;
@@ -64,7 +112,7 @@ RefTemplate make_reference(const Eigen::Vector3d& box, std::array<int, 2> diagon
   };
   for (std::size_t i = 0; i < n; ++i) {
     const Point& p = pts[i];
-    const Point q{p.z() / box.z() + 0.5, p.x() / box.x() + 0.5, p.y() / box.y() + 0.5};
+    const Point q = reference_coordinates(p, box);
     ref.rst[i] = q;
     const unsigned f = ref.tpl.node_faces[i];
     for (int k = 0; k < 4; ++k)
@@ -74,7 +122,9 @@ RefTemplate make_reference(const Eigen::Vector3d& box, std::array<int, 2> diagon
     const int t = top ? 1 : 0;
     const int a = third(q.x()), b = third(q.y());
     std::vector<int>& key = ref.key_corners[i];
-    if (a >= 0 && b >= 0 && a != 1 && b != 1) {
+    if (four && top) {
+      key = four_triangle_key(q.x(), q.y(), kTol);
+    } else if (a >= 0 && b >= 0 && a != 1 && b != 1) {
       key = {corner_at(a / 2, b / 2, t)};
     } else if (a == 1 && b >= 0 && b != 1) {
       key = {corner_at(0, b / 2, t), corner_at(1, b / 2, t)};
@@ -116,15 +166,64 @@ RefTemplate make_reference(const Eigen::Vector3d& box, std::array<int, 2> diagon
   return ref;
 }
 
+// Gives `four`'s side faces the reference positions of `geode`'s (node by node as match_side pairs them,
+// face k with face k, starting from the nodes both have on the tet and hex sides) and smooths
+// its other nodes with every box face fixed: a four-triangle template then meets a geode
+// across a side face as two geodes meet, instead of at positions of its own.
+void impose_geode_sides(RefTemplate& four, const RefTemplate& geode, const Eigen::Vector3d& box) {
+  // The tet/hex-side nodes of both as shared ids, by their (sorted) key corners.
+  std::map<std::vector<int>, Index> id_of;
+  auto ids = [&](const RefTemplate& t) {
+    std::vector<Index> g(t.key_corners.size(), -1);
+    for (std::size_t i = 0; i < g.size(); ++i) {
+      if (t.key_corners[i].empty()) continue;
+      std::vector<int> key = t.key_corners[i];
+      std::sort(key.begin(), key.end());
+      g[i] = id_of.try_emplace(key, static_cast<Index>(id_of.size())).first->second;
+    }
+    return g;
+  };
+  const std::vector<Index> g4 = ids(four), gg = ids(geode);
+  auto& pts = four.tpl.hex.points;
+  for (int k = 0; k < 4; ++k)
+    for (const auto& [a, b] : match_side(four, k, g4, geode, k, gg, "the four-triangle template and the geode"))
+      if (four.key_corners[a].empty()) pts[a] = box_position(geode.rst[b], box);
+  const Point lo = -0.5 * box, hi = 0.5 * box;
+  const auto constraints = primal::box_constraints(pts, lo, hi, {true, true, true, true, true, true});
+  four.min_scaled_jacobian = primal::smooth_hex_mesh(four.tpl.hex, constraints).final_min_scaled_jacobian;
+  check_distinct(pts, box);
+  for (std::size_t i = 0; i < pts.size(); ++i) four.rst[i] = reference_coordinates(pts[i], box);
+}
+
 }  // namespace
 
 const RefTemplate& reference_template(const Eigen::Vector3d& box, std::array<int, 2> diagonal) {
   static std::mutex mutex;
   static std::map<std::tuple<double, double, double, int>, std::unique_ptr<RefTemplate>> cache;
   const std::lock_guard<std::mutex> lock(mutex);
-  auto& slot = cache[{box.x(), box.y(), box.z(), diagonal[0]}];
-  if (!slot) slot = std::make_unique<RefTemplate>(make_reference(box, diagonal));
+  // Slot diagonal[0] (4 or 5), or kCentreCorner for the four-triangle template.
+  auto slot_of = [&](int d) -> std::unique_ptr<RefTemplate>& { return cache[{box.x(), box.y(), box.z(), d}]; };
+  auto& slot = slot_of(diagonal[0]);
+  if (slot) return *slot;
+  if (diagonal[0] != kCentreCorner) {
+    slot = std::make_unique<RefTemplate>(make_reference(box, diagonal));
+    return *slot;
+  }
+  auto& geode = slot_of(4);
+  if (!geode) geode = std::make_unique<RefTemplate>(make_reference(box, {4, 6}));
+  // Smoothed in a box half as tall: buffer hexes are flatter than the reference box, and the
+  // four-triangle template stacks more layers (its pillows) in the thickness; shapes smoothed at
+  // the flatter proportion keep its mapped hexes positive where the taller box's do not. Only
+  // reference coordinates are kept, so the sides still match the geode's.
+  const Eigen::Vector3d four_box(box.x(), 0.5 * box.y(), box.z());
+  auto four = std::make_unique<RefTemplate>(make_reference(four_box, {4, 6}, templates::TopSplit::FourTriangles));
+  impose_geode_sides(*four, *geode, four_box);
+  slot = std::move(four);
   return *slot;
+}
+
+const RefTemplate& reference_template_four_triangles(const Eigen::Vector3d& box) {
+  return reference_template(box, {kCentreCorner, kCentreCorner});
 }
 
 std::unordered_map<int, int> match_side(const RefTemplate& A, int ka,

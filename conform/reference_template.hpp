@@ -15,11 +15,14 @@
 
 namespace geode::conform {
 
+// A key_corners entry naming the centre node of a four-triangle top (not a buffer hex corner).
+inline constexpr int kCentreCorner = 8;
+
 struct RefTemplate {
   templates::Template tpl;
   double min_scaled_jacobian = 0.0;
   std::vector<primal::Point> rst;             // reference coordinates in [0, 1]^3
-  std::vector<std::vector<int>> key_corners;  // empty: not a tet/hex-side node
+  std::vector<std::vector<int>> key_corners;  // empty: not a tet/hex-side node; else corners 0..7 or kCentreCorner
   // Per buffer hex side face 0..3 (topology order): its template nodes and quads.
   std::array<std::vector<int>, 4> side_nodes;
   std::array<std::vector<std::array<int, 4>>, 4> side_quads;
@@ -30,6 +33,15 @@ struct RefTemplate {
 // call and kept for the process (thread-safe). Throws TopologyError when the smoothed template
 // has two nodes at one place or a tet/hex-side node at no diced position.
 const RefTemplate& reference_template(const Eigen::Vector3d& box, std::array<int, 2> diagonal);
+
+// The same for a buffer hex whose top is split into four triangles around a centre node: the
+// four-triangle variant's arrangement (templates/geode.hpp, TopSplit::FourTriangles), fixed up
+// by pillowing (templates/fixup.hpp) and smoothed. Its tet-side nodes are the corners, edge
+// midpoints, the centre, the midpoints of centre-corner edges and the four triangle
+// centroids; its side faces have the ordinary geode's quad mesh (match_side pairs them) and
+// are given the {4, 6} geode's reference positions, the rest smoothed with them fixed in a box
+// of half box.y (the buffer hexes are flat; see the .cpp).
+const RefTemplate& reference_template_four_triangles(const Eigen::Vector3d& box);
 
 // Matches the nodes of side face ka of template A with those of side face kb of template B
 // (the same face of the model), starting from the nodes both share on the tet and hex sides

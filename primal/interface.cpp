@@ -60,8 +60,14 @@ std::array<std::array<Index, 3>, 2> split(const std::array<Index, 4>& c, int dia
 
 }  // namespace
 
-std::array<std::array<Index, 3>, 2> interface_triangles(const InterfaceQuad& q) {
-  return split(q.corners, q.diagonal);
+std::vector<std::array<Index, 3>> interface_triangles(const InterfaceQuad& q) {
+  if (q.centre == kInvalidIndex) {
+    const auto two = split(q.corners, q.diagonal);
+    return {two.begin(), two.end()};
+  }
+  std::vector<std::array<Index, 3>> four;
+  for (std::size_t i = 0; i < 4; ++i) four.push_back({q.corners[i], q.corners[(i + 1) % 4], q.centre});
+  return four;
 }
 
 Interface find_interface(const Model& model, double tol) {
@@ -98,6 +104,34 @@ Interface find_interface(const Model& model, double tol) {
     return &tris[static_cast<std::size_t>(*id)].use[0];
   };
 
+  // Per boundary-triangle edge, the third nodes of the boundary triangles on it: the candidate
+  // centres of a four-triangle split.
+  std::unordered_map<EdgeKey, std::vector<Index>, IndexArrayHash> thirds;
+  for (const TriangleUses& uses : tris)
+    if (uses.count == 1)
+      for (std::size_t i = 0; i < 3; ++i)
+        thirds[edge_key(uses.use[0].nodes[i], uses.use[0].nodes[(i + 1) % 3])].push_back(
+            uses.use[0].nodes[(i + 2) % 3]);
+  std::vector<char> in_hex(P.size(), 0);
+  for (const auto& h : model.hexes)
+    for (Index v : h) in_hex[static_cast<std::size_t>(v)] = 1;
+  // The node x for which (c_i, c_i+1, x) are boundary triangles for all four sides of the quad;
+  // of several (a single tet layer's outer faces can fan around the quad too) the nearest to the
+  // quad's middle.
+  auto four_split_centre = [&](const std::array<Index, 4>& c) -> Index {
+    const auto it = thirds.find(edge_key(c[0], c[1]));
+    if (it == thirds.end()) return kInvalidIndex;
+    const Point middle = (pt(c[0]) + pt(c[1]) + pt(c[2]) + pt(c[3])) / 4.0;
+    Index best = kInvalidIndex;
+    for (Index x : it->second) {
+      bool all = true;
+      for (std::size_t i = 1; i < 4 && all; ++i)
+        all = boundary_triangle(face_key(std::array<Index, 3>{c[i], c[(i + 1) % 4], x})) != nullptr;
+      if (all && (best == kInvalidIndex || (pt(x) - middle).norm() < (pt(best) - middle).norm())) best = x;
+    }
+    return best;
+  };
+
   const HexMesh hexes = hex_part(model);
   const auto quads = boundary_quads(hexes);
   Interface out;
@@ -115,13 +149,17 @@ Interface find_interface(const Model& model, double tol) {
           ++count;
         }
       }
-    if (count == 0) {
+    const Index centre = count == 0 ? four_split_centre(c) : kInvalidIndex;
+    if (count == 0 && centre == kInvalidIndex) {
       unmatched_quads.push_back(&bq);
       continue;
     }
     const std::string name = quad_name(model, bq.hex, c);
+    if (centre != kInvalidIndex && in_hex[static_cast<std::size_t>(centre)])
+      throw TopologyError("find_interface: " + name + " is split into four triangles around " +
+                          describe_node(model, centre) + ", a node of the hex part too");
     const bool d0 = found[0][0] && found[0][1], d1 = found[1][0] && found[1][1];
-    if (count != 2 || !(d0 || d1)) {
+    if (centre == kInvalidIndex && (count != 2 || !(d0 || d1))) {
       std::string detail;
       for (int d = 0; d < 2; ++d)
         for (int i = 0; i < 2; ++i)
@@ -138,11 +176,14 @@ Interface find_interface(const Model& model, double tol) {
     q.face = bq.local_face;
     q.corners = c;
     q.diagonal = d0 ? 0 : 1;
+    q.centre = centre;
     // The quad's normal points into the tet side; each tet's apex must lie there.
     const Point normal = (pt(c[2]) - pt(c[0])).cross(pt(c[3]) - pt(c[1]));
-    const Point centre = (pt(c[0]) + pt(c[1]) + pt(c[2]) + pt(c[3])) / 4.0;
-    for (std::size_t i = 0; i < 2; ++i) {
-      const TetFaceUse& u = *found[static_cast<std::size_t>(q.diagonal)][i];
+    const Point middle = (pt(c[0]) + pt(c[1]) + pt(c[2]) + pt(c[3])) / 4.0;
+    const auto triangles = interface_triangles(q);
+    for (std::size_t i = 0; i < triangles.size(); ++i) {
+      const TetFaceUse& u = centre == kInvalidIndex ? *found[static_cast<std::size_t>(q.diagonal)][i]
+                                                    : *boundary_triangle(face_key(triangles[i]));
       q.tets[i] = u.tet;
       q.tet_faces[i] = u.face;
       tris[static_cast<std::size_t>(*tri_index.find(face_key(u.nodes)))].matched = true;
@@ -150,7 +191,7 @@ Interface find_interface(const Model& model, double tol) {
       Index apex = kInvalidIndex;
       for (Index v : tet)
         if (std::find(u.nodes.begin(), u.nodes.end(), v) == u.nodes.end()) apex = v;
-      if ((pt(apex) - centre).dot(normal) <= 0.0)
+      if ((pt(apex) - middle).dot(normal) <= 0.0)
         throw TopologyError("find_interface: " + describe_element(model, {ElementKind::Tet, u.tet}) + " on " + name +
                             " lies on the hex side of it (the parts overlap or are inverted)");
     }
@@ -211,9 +252,7 @@ Interface find_interface(const Model& model, double tol) {
   out.nodes.erase(std::unique(out.nodes.begin(), out.nodes.end()), out.nodes.end());
 
   // Nodes shared by both parts must be interface nodes.
-  std::vector<char> in_hex(P.size(), 0), in_tet(P.size(), 0);
-  for (const auto& h : model.hexes)
-    for (Index v : h) in_hex[static_cast<std::size_t>(v)] = 1;
+  std::vector<char> in_tet(P.size(), 0);
   for (const auto& t : model.tets)
     for (Index v : t) in_tet[static_cast<std::size_t>(v)] = 1;
   for (std::size_t v = 0; v < P.size(); ++v)

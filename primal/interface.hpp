@@ -1,6 +1,7 @@
 #pragma once
 // The interface between the hex part and the tet part of a Model: the boundary quads of the
-// hex part whose two triangles (split along one diagonal) are boundary faces of the tet part.
+// hex part whose two triangles (split along one diagonal), or four triangles (around a centre
+// node of the tet part, the paper's Section 5 variant), are boundary faces of the tet part.
 // Both parts must share the interface nodes (conform node-wise); merge coincident nodes first
 // (merge_coincident_nodes) if the input keeps the parts apart.
 #include <array>
@@ -20,8 +21,14 @@ struct InterfaceQuad {
   // corners[1]-corners[3]. Triangle i is then (c0 c1 c2), (c0 c2 c3) for diagonal 0 and
   // (c0 c1 c3), (c1 c2 c3) for diagonal 1.
   int diagonal = 0;
-  std::array<Index, 2> tets{kInvalidIndex, kInvalidIndex};  // tet owning triangle i
-  std::array<int, 2> tet_faces{-1, -1};                     // its local face (kTetFaceCorners)
+  // Four-triangle split: the tet-part node the four triangles share (kInvalidIndex for two
+  // triangles; `diagonal` is then not used). Triangle i is (c_i, c_i+1, centre).
+  Index centre = kInvalidIndex;
+  // Tet owning triangle i (the first 2, or all 4 with a centre) and its local face
+  // (kTetFaceCorners).
+  std::array<Index, 4> tets{kInvalidIndex, kInvalidIndex, kInvalidIndex, kInvalidIndex};
+  std::array<int, 4> tet_faces{-1, -1, -1, -1};
+  int triangle_count() const { return centre == kInvalidIndex ? 2 : 4; }
 };
 
 struct Interface {
@@ -29,14 +36,15 @@ struct Interface {
   std::vector<Index> nodes;          // every interface node, ascending
 };
 
-// The two triangles of an interface quad, as node triples in the quad's orientation.
-std::array<std::array<Index, 3>, 2> interface_triangles(const InterfaceQuad& quad);
+// The two or four triangles of an interface quad, as node triples in the quad's orientation.
+std::vector<std::array<Index, 3>> interface_triangles(const InterfaceQuad& quad);
 
 // Finds the interface. Throws TopologyError naming the hex face (hex and nodes) or node, in the
 // model's file ids with coordinates (model.hpp: describe_element, describe_node), when the parts
 // do not conform:
 // - a boundary quad of the hex part matched by only one triangle of the tet part (or by
 //   triangles of both diagonals);
+// - a four-triangle centre node that is a node of the hex part too;
 // - a node of one side lying on a boundary face of the other side without being one of its
 //   corners (hanging node, different refinement, unmerged duplicate node);
 // - a node used by both parts that is on no interface quad (the parts touch along an edge

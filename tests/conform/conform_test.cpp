@@ -1,6 +1,7 @@
 // The geode algorithm on whole models: the result is a conforming all-hex mesh (every interior
 // face shared by two hexes, closed boundary, no two nodes at one place, every hex positive)
-// with the hand-checked counts 8 per input hex, 26 per interface quad, 4 per tet.
+// with the hand-checked counts 8 per input hex, 26 per interface quad (the four-triangle
+// template's count per four-triangle quad), 4 per tet.
 #include <doctest/doctest.h>
 #include <unistd.h>
 
@@ -14,7 +15,9 @@
 #include "primal/io_exodus.hpp"
 #include "primal/quality.hpp"
 #include "primal/topology.hpp"
+#include "support/fixtures.hpp"
 #include "conform/conform.hpp"
+#include "conform/reference_template.hpp"
 
 using namespace geode;
 using primal::Index;
@@ -23,6 +26,7 @@ namespace {
 
 struct Expected {
   Index hexes, tets, quads;  // input hexes, tets, interface quads
+  Index geode = -1;          // geode hexes; -1: 26 per interface quad
 };
 
 // Everything a conforming all-hex result must satisfy, plus its counts.
@@ -30,10 +34,11 @@ void check_result(const conform::ConformResult& r, const Expected& e) {
   CHECK(r.input_hexes == e.hexes);
   CHECK(r.input_tets == e.tets);
   CHECK(r.interface_quads == e.quads);
+  const Index geode = e.geode < 0 ? 26 * e.quads : e.geode;
   CHECK(r.diced_hexes == 8 * e.hexes);
-  CHECK(r.geode_hexes == 26 * e.quads);
+  CHECK(r.geode_hexes == geode);
   CHECK(r.diced_tet_hexes == 4 * e.tets);
-  REQUIRE(r.model.hexes.size() == static_cast<std::size_t>(8 * e.hexes + 26 * e.quads + 4 * e.tets));
+  REQUIRE(r.model.hexes.size() == static_cast<std::size_t>(8 * e.hexes + geode + 4 * e.tets));
   CHECK(r.model.tets.empty());
   const primal::HexMesh mesh = primal::hex_part(r.model);
   const primal::HexValidityReport v = primal::check_validity(mesh);
@@ -76,6 +81,23 @@ TEST_CASE("one hex with six tets on one face: 8 + 26 + 24 hexes, valid") {
   const auto r = conform::conform(m);
   check_result(r, {1, 6, 1});
   CHECK(r.model.hexes.size() == 58);
+}
+
+TEST_CASE("one hex under a fan of four tets: the four-triangle template, valid") {
+  // The hex's top face (nodes 4 5 7 6, counter-clockwise from above) in four triangles around
+  // node 8, off the face's middle, each under a tet with apex 9. The centre moves with the
+  // buffer layer; the template's tet-side nodes (centre, centre-corner midpoints, triangle
+  // centroids) must merge with the diced tets' or the boundary would not close.
+  const primal::Model m = test::four_tet_fan({0.45, 0.55, 1.0}, {0.5, 0.5, 1.8});
+  const conform::ConformOptions defaults;
+  const auto per_four = static_cast<Index>(
+      conform::reference_template_four_triangles(defaults.template_box).tpl.hex.hexes.size());
+  for (const auto smooth : {conform::ConformSmooth::kNone, conform::ConformSmooth::kLocal}) {
+    CAPTURE(static_cast<int>(smooth));
+    conform::ConformOptions o;
+    o.smooth = smooth;
+    check_result(conform::conform(m, o), {1, 4, 1, per_four});
+  }
 }
 
 TEST_CASE("L-shaped interfaces: buffer hexes meeting at a concave edge merge their sides") {

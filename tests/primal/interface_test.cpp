@@ -12,6 +12,7 @@
 #include "primal/errors.hpp"
 #include "primal/interface.hpp"
 #include "primal/topology.hpp"
+#include "support/fixtures.hpp"
 
 using namespace geode;
 using namespace geode::primal;
@@ -103,6 +104,35 @@ TEST_CASE("find_interface: one hex under tets, the face and diagonal by hand") {
   CHECK(itf.nodes == std::vector<Index>{4, 5, 6, 7});
 }
 
+TEST_CASE("find_interface: a quad split into four triangles around a tet node") {
+  // One hex; its top face 4 5 7 6 (counter-clockwise seen from above) in four triangles
+  // around node 8, each under a tet with apex 9; the centre is off the quad's middle.
+  Model m = test::four_tet_fan({0.4, 0.55, 1.0}, {0.5, 0.5, 2.0});
+  const std::array<Index, 4> top{4, 5, 7, 6};
+  const Interface itf = find_interface(m);
+  REQUIRE(itf.quads.size() == 1);
+  const InterfaceQuad& q = itf.quads[0];
+  CHECK(q.centre == 8);
+  CHECK(q.triangle_count() == 4);
+  CHECK(q.corners == top);
+  // The centre is a tet node, not an interface node (it has no hex-side twin).
+  CHECK(itf.nodes == std::vector<Index>{4, 5, 6, 7});
+  const auto tris = interface_triangles(q);
+  REQUIRE(tris.size() == 4);
+  for (std::size_t i = 0; i < 4; ++i) {
+    CHECK(tris[i] == std::array<Index, 3>{top[i], top[(i + 1) % 4], 8});
+    std::set<Index> face;
+    for (int c : topology::kTetFaceCorners[static_cast<std::size_t>(q.tet_faces[i])])
+      face.insert(m.tets[static_cast<std::size_t>(q.tets[i])][static_cast<std::size_t>(c)]);
+    CHECK(face == std::set<Index>(tris[i].begin(), tris[i].end()));
+  }
+  SUBCASE("three of the four triangles: refused as a hanging node") {
+    m.tets.pop_back();
+    m.tet_block.pop_back();
+    CHECK_THROWS_WITH_AS(find_interface(m), doctest::Contains("lies on hex 1"), TopologyError);
+  }
+}
+
 TEST_CASE("find_interface: rejects non-conforming interfaces, naming the face or node") {
   SUBCASE("a quad matched by one triangle only") {
     Model m = grid_model({1, 1, 2}, 1.0, [](int, int, int k) { return k == 1; });
@@ -113,21 +143,30 @@ TEST_CASE("find_interface: rejects non-conforming interfaces, naming the face or
     CHECK_THROWS_WITH_AS(find_interface(m), doctest::Contains("hex 1 (centre (0.5, 0.5, 0.5)) face (nodes 5 6 8 7) is matched by only one triangle"),
                          TopologyError);
   }
-  SUBCASE("a hanging tet node in the middle of a hex face") {
+  SUBCASE("a hanging tet node in the middle of a hex face edge") {
     Model m = grid_model({1, 1, 1}, 1.0, [](int, int, int) { return false; });
-    m.points.emplace_back(0.5, 0.5, 1.0);  // node 8: centre of the top face
+    m.points.emplace_back(0.5, 0.0, 1.0);  // node 8: midpoint of top edge 4-5
     m.points.emplace_back(0.5, 0.5, 2.0);  // node 9: apex
-    const std::array<Index, 4> top{4, 5, 7, 6};  // counter-clockwise seen from above
-    for (std::size_t i = 0; i < 4; ++i) {
-      m.tets.push_back({top[i], top[(i + 1) % 4], 8, 9});
+    // The top face (4 5 7 6 counter-clockwise seen from above) in three triangles.
+    for (const std::array<Index, 3>& tri : {std::array<Index, 3>{4, 8, 6}, {8, 5, 7}, {8, 7, 6}}) {
+      m.tets.push_back({tri[0], tri[1], tri[2], 9});
       m.tet_block.push_back(2);
     }
     for (const auto& t : m.tets)
       REQUIRE(tet_volume(m.points[static_cast<std::size_t>(t[0])], m.points[static_cast<std::size_t>(t[1])],
                          m.points[static_cast<std::size_t>(t[2])], m.points[static_cast<std::size_t>(t[3])]) > 0);
     CHECK_THROWS_WITH_AS(find_interface(m),
-                         doctest::Contains("node 9 (0.5, 0.5, 1) of the tet part (tet 1 (centre (0.5, 0.25, 1.25))) lies on hex 1"),
+                         doctest::Contains("node 9 (0.5, 0, 1) of the tet part (tet 1 (centre (0.25, 0.375, 1.25))) lies on hex 1"),
                          TopologyError);
+  }
+  SUBCASE("a four-triangle centre that is a hex node too") {
+    Model m = test::four_tet_fan({0.5, 0.5, 1.0}, {0.5, 0.5, 2.0});
+    // A hex below the first one using node 8 as a corner (nonsense geometry, topology only).
+    const auto base = static_cast<Index>(m.points.size());
+    for (int k = 0; k < 7; ++k) m.points.emplace_back(0.1 * k, -1.0, -1.0 - 0.1 * k);
+    m.hexes.push_back({base, base + 1, base + 2, base + 3, base + 4, base + 5, base + 6, 8});
+    m.hex_block.push_back(1);
+    CHECK_THROWS_WITH_AS(find_interface(m), doctest::Contains("a node of the hex part too"), TopologyError);
   }
   SUBCASE("a finer hex side under one coarse tet cell") {
     Model m = grid_model({2, 2, 1}, 0.5, [](int, int, int) { return false; });

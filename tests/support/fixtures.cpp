@@ -7,6 +7,7 @@
 
 #include "primal/boundary.hpp"
 #include "primal/errors.hpp"
+#include "primal/grid_model.hpp"
 #include "primal/topology.hpp"
 
 namespace geode::test {
@@ -141,6 +142,18 @@ primal::QuadMesh boundary_quads(const primal::HexMesh& mesh,
     out.quads.push_back(q);
   }
   return out;
+}
+
+primal::Model four_tet_fan(const primal::Point& centre, const primal::Point& apex) {
+  primal::Model m = primal::grid_model({1, 1, 1}, 1.0, [](int, int, int) { return false; });
+  m.points.push_back(centre);  // node 8
+  m.points.push_back(apex);    // node 9
+  const std::array<primal::Index, 4> top{4, 5, 7, 6};
+  for (std::size_t i = 0; i < 4; ++i) {
+    m.tets.push_back({top[i], top[(i + 1) % 4], 8, 9});
+    m.tet_block.push_back(2);
+  }
+  return m;
 }
 
 }  // namespace geode::test

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "primal/mesh.hpp"
+#include "primal/model.hpp"
 
 namespace geode::test {
 
@@ -37,5 +38,10 @@ primal::QuadMesh structured_quad_grid(int nx, int ny);
 // quads counter-clockwise seen from outside the volume. E.g. one face of a box.
 primal::QuadMesh boundary_quads(const primal::HexMesh& mesh,
                                 const std::function<bool(const primal::Point&)>& keep);
+
+// One unit hex (primal::grid_model, block 1) whose top face, nodes 4 5 7 6 counter-clockwise
+// seen from above, is split into four triangles around node 8 at `centre`, each under a tet
+// (block 2) with apex node 9 at `apex`: the smallest four-triangle interface.
+primal::Model four_tet_fan(const primal::Point& centre, const primal::Point& apex);
 
 }  // namespace geode::test
