@@ -1,5 +1,8 @@
 #include "primal/quality.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
@@ -388,11 +391,15 @@ HexCorners hex_corners(const HexMesh& mesh, Index h) {
 }
 
 double min_scaled_jacobian(const HexMesh& mesh, std::vector<Index>* inverted) {
+  // Evaluated in parallel (TBB) into one slot per hex, then gathered in order.
+  std::vector<double> sj(mesh.hexes.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sj.size(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t h = r.begin(); h != r.end(); ++h) sj[h] = hex_scaled_jacobian(hex_corners(mesh, static_cast<Index>(h)));
+  });
   double mn = 1.0;
-  for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
-    const double sj = hex_scaled_jacobian(hex_corners(mesh, static_cast<Index>(h)));
-    mn = std::min(mn, sj);
-    if (inverted && sj <= 0) inverted->push_back(static_cast<Index>(h));
+  for (std::size_t h = 0; h < sj.size(); ++h) {
+    mn = std::min(mn, sj[h]);
+    if (inverted && sj[h] <= 0) inverted->push_back(static_cast<Index>(h));
   }
   return mn;
 }
