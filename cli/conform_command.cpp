@@ -126,8 +126,21 @@ std::string duplicate_node_hint(const primal::Model& model) {
   return s.str();
 }
 
+// --template-box, read as template --box reads its box (WxH means WxHxW); parse_box's
+// messages name --box.
+Eigen::Vector3d template_box(const std::string& text) {
+  try {
+    return templates::parse_box(text);
+  } catch (const InvalidInput& e) {
+    std::string why = e.what();
+    if (why.rfind("--box", 0) == 0) why.replace(0, 5, "--template-box");
+    throw InvalidInput(why);
+  }
+}
+
 // The output paths and format, checked before any work: names, directories, format agreement.
 std::string check_outputs(const ConformArgs& a) {
+  if (!a.template_box.empty()) template_box(a.template_box);  // a usage error, before the work
   std::string format;
   if (!a.output.empty()) {
     if (a.output == "-") throw InvalidInput("-o -: a mesh is written to a file, not to standard output");
@@ -162,7 +175,7 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
   opts.geode_block = a.geode_block;
   opts.buffer.thickness = a.buffer_thickness;
   opts.smooth_target = a.smooth_target;
-  if (!a.template_box.empty()) opts.template_box = templates::parse_box(a.template_box);
+  if (!a.template_box.empty()) opts.template_box = template_box(a.template_box);
   opts.progress = [&progress](const std::string& line) { progress.stage(line); };
   opts.smoothing_progress = [&progress](std::size_t done, std::size_t total) {
     progress.step("seed hexes settled", done, total);
@@ -219,9 +232,8 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
       ->capture_default_str();
   c->add_option("--report", a.report, "write a JSON report (counts, validity, quality per output block) to FILE.json");
   c->add_option("--smooth", a.smooth,
-                "worst-first smoothing, model boundary nodes sliding on the boundary; local: hexes below "
-                "--smooth-target among the geode hexes and those touching them (default); global: every "
-                "hex below 0.5; none")
+                "worst-first smoothing, model boundary nodes sliding on the boundary; local (default):\n"
+                "near the geode hexes (see --smooth-target); global: every hex below 0.5; none")
       ->check(CLI::IsMember({"local", "global", "none"}))
       ->capture_default_str();
   c->add_option("--smooth-target", a.smooth_target,
@@ -249,7 +261,7 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
       ->capture_default_str();
   c->add_option("--template-box", a.template_box,
                 "proportions WxHxD of the box the reference geode template is smoothed in once per\n"
-                "run (H: the buffer hex's thickness direction; default 24x14x24, the paper's)");
+                "run (H: the buffer hex's thickness direction; default 24x10x24, near the buffer hexes' own)");
   c->add_flag("--write-invalid", a.write_invalid,
               "write the mesh and report even when verification fails (the exit code is still 4)");
   c->add_flag("--quiet", a.quiet, "no progress and no summary (errors and the invalid-result message still print)");
