@@ -8,29 +8,9 @@
 
 #include "conform/conform.hpp"
 #include "conform/demo_models.hpp"
-#include "primal/quality.hpp"
-#include "primal/validity.hpp"
+#include "support/conform_checks.hpp"
 
 using namespace geode;
-
-namespace {
-
-void check_valid(const conform::ConformResult& r) {
-  const primal::HexMesh mesh = primal::hex_part(r.model);
-  const primal::HexValidityReport v = primal::check_validity(mesh);
-  INFO(v.summary());
-  CHECK(v.ok());
-  CHECK(v.overshared_faces.empty());
-  CHECK(v.boundary.closed);
-  CHECK(v.boundary.manifold);
-  CHECK(v.euler == 1);
-  CHECK(v.boundary.euler == 2);
-  CHECK(primal::min_scaled_jacobian(mesh) > 0.0);
-  CHECK(r.warnings.empty());
-  CHECK(r.geode_hexes == 26 * r.interface_quads);
-}
-
-}  // namespace
 
 TEST_CASE("realistic models, no smoothing: valid and untangled by the placement alone") {
   conform::ConformOptions o;
@@ -41,12 +21,12 @@ TEST_CASE("realistic models, no smoothing: valid and untangled by the placement 
     REQUIRE(!m.tets.empty());
     const auto r = conform::conform(m, o);
     CHECK(r.interface_quads == (name == "lshape" ? 18 : 9));
-    check_valid(r);
+    test::check_conform_result(r);
   }
 }
 
 TEST_CASE("realistic model, default options: valid and untangled") {
   const auto r = conform::conform(conform::demo_model("delaunay-random", 2));
   CHECK(r.interface_quads == 4);
-  check_valid(r);
+  test::check_conform_result(r);
 }
