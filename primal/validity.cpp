@@ -181,16 +181,49 @@ struct BoundaryWedge {
   Point other, inward;
 };
 
+// The covering degree at an interior node is also the number of corner cones containing any
+// direction that lies on no cone's face, which needs no square root or arctangent per corner.
+// A shared face's normal is computed as e_a x e_b by one corner and e_b x e_a by the other, which
+// are exact negatives in floating point, so the two corners never both claim the probe or both
+// miss it. The probe (coverage_probe) nearly on a face sends the node to the solid angles.
+constexpr double kProbeMargin = 1e-16;  // squared sine of the probe's angle to a face plane
+
 // The covering at node v of a manifold hex mesh: the corners' solid angles against 4 pi inside
 // and, on the boundary, against the solid angle inside the spherical polygon of the boundary
 // faces' sectors, 2 pi - sum(pi - interior angle), the interior angle at a boundary edge being
 // the dihedral angle between its two boundary faces measured through the inside. Nothing when
 // a corner is not positive (the cones are not oriented) or the boundary does not pair up.
 std::optional<NodeCoverage> hex_coverage(const std::vector<Point>& points, Index v,
-                                         const std::vector<CornerStar>& corners,
+                                         const std::vector<CornerStar>& corners, bool on_boundary,
                                          std::vector<BoundaryWedge>& wedges) {
   const Point& o = points[static_cast<std::size_t>(v)];
   NodeCoverage c{v, 0.0, 4.0 * kPi};
+  if (!on_boundary) {
+    int containing = 0;
+    bool clear = true;
+    for (const CornerStar& s : corners) {
+      std::array<Point, 3> e;
+      for (int k = 0; k < 3; ++k) e[k] = points[static_cast<std::size_t>(s.ends[k])] - o;
+      const Point n0 = e[1].cross(e[2]);
+      if (!(e[0].dot(n0) > 0.0)) return std::nullopt;
+      // In the cone when on the inner side of its three faces; certainly out once clearly
+      // outside one, whatever the others say.
+      bool out = false, near = false;
+      for (int k = 0; k < 3 && !out; ++k) {
+        const Point n = k == 0 ? n0 : e[(k + 1) % 3].cross(e[(k + 2) % 3]);
+        const double t = coverage_probe().dot(n);
+        if (t * t <= kProbeMargin * n.squaredNorm()) near = true;
+        else out = t < 0.0;
+      }
+      if (out) continue;
+      if (near) clear = false;
+      else ++containing;
+    }
+    if (clear) {
+      c.angle = 4.0 * kPi * containing;
+      return c;
+    }
+  }
   wedges.clear();
   for (const CornerStar& s : corners) {
     std::array<Point, 3> e;
@@ -257,6 +290,12 @@ std::optional<NodeCoverage> quad_coverage(Index v, const std::vector<QuadCornerA
 }
 
 }  // namespace
+
+// Arbitrary decimals, chosen to avoid grid axes and diagonals.
+const Point& coverage_probe() {
+  static const Point d = Point(0.3164, 0.5871, 0.7451).normalized();
+  return d;
+}
 
 // ---- Hex meshes ----------------------------------------------------------------------------
 
@@ -447,11 +486,10 @@ HexValidityReport check_validity(const HexMesh& mesh) {
       const int c = corner_of(p, static_cast<Index>(v));
       CornerStar& star = stars.emplace_back();
       for (int k = 0; k < 3; ++k) {
-        star.ends[k] = hex(p)[topo::kHexCornerNeighbors[c][k]];
-        star.boundary_without[k] = face_uses(p, inc.corner_face_without[c][k]) == 1;
-      }
-      for (int lf : inc.corner_faces[c]) {
+        const int lf = inc.corner_face_without[c][k];
         const auto uses = face_uses(p, lf);
+        star.ends[k] = hex(p)[topo::kHexCornerNeighbors[c][k]];
+        star.boundary_without[k] = uses == 1;
         on_boundary |= uses == 1;
         overshared |= uses == 3;
         const Index f = face_lead[static_cast<std::size_t>(6 * p + lf)];
@@ -473,7 +511,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     if (overshared || uses_joined.count() != 1 ||
         link_euler != (on_boundary ? 1 : 2)) {
       r.nonmanifold_vertices.push_back(static_cast<Index>(v));
-    } else if (const auto cover = hex_coverage(mesh.points, static_cast<Index>(v), stars, wedges);
+    } else if (const auto cover = hex_coverage(mesh.points, static_cast<Index>(v), stars, on_boundary, wedges);
                cover && overlaps(*cover)) {
       r.overlapping_nodes.push_back(*cover);
     }

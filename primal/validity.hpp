@@ -19,6 +19,11 @@ struct NodeCoverage {
   double expected = 0.0;  // 4 pi (2 pi in 2D) inside; on the boundary what the boundary leaves inside
 };
 
+// The direction along which check_validity counts the corner cones at an interior hex node (the
+// covering degree, without trigonometry); a node where it lies on a cone's face gets the sum of
+// solid angles instead. Public so that tests can put it on a face.
+const Point& coverage_probe();
+
 // Elements with an out-of-range node or a repeated node are listed and left out of the
 // topological checks (Euler characteristic, faces, edges, vertices, boundary), which run on
 // the remaining "proper" elements.

@@ -462,6 +462,27 @@ TEST_CASE("covering: hexes wrapping twice around nodes are found there, all corn
                          "not 4 pi, 34: 4 pi, not 2 pi)") != std::string::npos);
 }
 
+TEST_CASE("covering: the same where the counting probe runs along the wrapped edge") {
+  // Interior nodes are judged by counting the cones around the probe direction; turned so that
+  // the hub line runs along it, the probe is on faces of every hub corner and the solid angles
+  // decide, with the same answer.
+  const Eigen::Quaterniond turn = Eigen::Quaterniond::FromTwoVectors(Point::UnitZ(), coverage_probe());
+  for (int turns : {1, 2}) {
+    CAPTURE(turns);
+    HexMesh m = extrude(wrapped_star(turns), 2);
+    for (auto& p : m.points) p = turn * p;
+    const auto r = check_validity(m);
+    INFO(r.summary());
+    CHECK(r.ok() == (turns == 1));
+    const Index per_layer = static_cast<Index>(m.points.size() / 3);
+    CHECK(nodes_of(r.overlapping_nodes) == (turns == 1 ? std::vector<Index>{} : std::vector<Index>{0, per_layer, 2 * per_layer}));
+    if (turns == 2) {
+      REQUIRE(r.overlapping_nodes.size() == 3);
+      CHECK(r.overlapping_nodes[1].angle == doctest::Approx(8 * kPi));
+    }
+  }
+}
+
 TEST_CASE("covering: quad meshes, planar") {
   QuadMesh notched = wrapped_star(2);
   notched.quads.pop_back();
