@@ -126,6 +126,15 @@ void list(std::ostringstream& os, const char* what, const std::vector<T>& items,
 }
 
 std::string show_index(Index i) { return std::to_string(i); }
+template <std::size_t N>
+std::string show_key(const std::array<Index, N>& k) {
+  std::string s = "{";
+  for (std::size_t i = 0; i < N; ++i) {
+    if (k[i] == kInvalidIndex) break;
+    s += (i ? " " : "") + std::to_string(k[i]);
+  }
+  return s + "}";
+}
 std::string show_coverage(const NodeCoverage& c) {
   std::ostringstream os;
   os.precision(3);
@@ -249,15 +258,6 @@ std::optional<NodeCoverage> hex_coverage(const std::vector<Point>& points, Index
   }
   c.expected = 2.0 * kPi - exterior;
   return c;
-}
-template <std::size_t N>
-std::string show_key(const std::array<Index, N>& k) {
-  std::string s = "{";
-  for (std::size_t i = 0; i < N; ++i) {
-    if (k[i] == kInvalidIndex) break;
-    s += (i ? " " : "") + std::to_string(k[i]);
-  }
-  return s + "}";
 }
 
 // The 2D covering at node v (QuadValidityReport::overlapping_nodes): the corners' angles against
@@ -663,9 +663,9 @@ QuadValidityReport check_validity(const QuadMesh& mesh, const Point& normal_in) 
     std::unordered_map<Index, int> first_use_of_edge;
     bool overshared = false;
     corners.clear();
+    const Point& o = mesh.points[v];
     for (std::size_t i = 0; i < uses.size(); ++i) {
       const auto [q, c] = uses[i];
-      const Point& o = mesh.points[v];
       corners.push_back({mesh.points[proper[q][(c + 1) % 4]] - o, mesh.points[proper[q][(c + 3) % 4]] - o, false, false});
       // The two edges at corner c: edge c (leaving it) and edge c-1 (arriving).
       for (int le : {c, (c + 3) % 4}) {
@@ -679,9 +679,9 @@ QuadValidityReport check_validity(const QuadMesh& mesh, const Point& normal_in) 
     }
     if (overshared || sets.count() != 1) {
       r.nonmanifold_vertices.push_back(static_cast<Index>(v));
-    } else if (const auto cover = quad_coverage(static_cast<Index>(v), corners, normal);
-               r.planar && cover && overlaps(*cover)) {
-      r.overlapping_nodes.push_back(*cover);
+    } else if (r.planar) {
+      const auto cover = quad_coverage(static_cast<Index>(v), corners, normal);
+      if (cover && overlaps(*cover)) r.overlapping_nodes.push_back(*cover);
     }
   }
 
