@@ -190,12 +190,57 @@ struct BoundaryWedge {
   Point other, inward;
 };
 
-// The covering degree at an interior node is also the number of corner cones containing any
-// direction that lies on no cone's face, which needs no square root or arctangent per corner.
-// A shared face's normal is computed as e_a x e_b by one corner and e_b x e_a by the other, which
-// are exact negatives in floating point, so the two corners never both claim the probe or both
-// miss it. The probe (coverage_probe) nearly on a face sends the node to the solid angles.
-constexpr double kProbeMargin = 1e-16;  // squared sine of the probe's angle to a face plane
+// The covering degree at an interior node is also the number of corner cones containing a
+// direction d that lies on none of their faces (d is in the cone of e_0, e_1, e_2 when
+// det(d, e_j, e_k) > 0 for its three faces, given det(e_0, e_1, e_2) > 0), which costs no
+// square root or arctangent. A sign is trusted only when |det(d, e_j, e_k)| exceeds its rounding
+// error (a few ulps of |e_j| |e_k|) by far, so each count is exact; d nearly on a face or along
+// an edge leaves the node to the solid angles.
+constexpr double kProbeMargin = 1e-24;  // squared sine of the angle to a face counted as "on" it
+
+class ProbeCount {
+ public:
+  enum : std::uint8_t { kNotPositive = 1, kNearFace = 2 };
+
+  explicit ProbeCount(std::size_t nodes) : containing_(nodes, 0), flags_(nodes, 0) {}
+
+  // A proper hex with its corner positions and corner Jacobians (hex_jacobians).
+  void add(const std::array<Index, 8>& hex, const HexCorners& p, const std::array<double, 9>& jacobians) {
+    const Point& d = coverage_probe();
+    for (int c = 0; c < 8; ++c) {
+      const auto v = static_cast<std::size_t>(hex[c]);
+      if (!(jacobians[c] > 0.0)) {
+        flags_[v] |= kNotPositive;
+        continue;
+      }
+      std::array<Point, 3> e;
+      std::array<double, 3> length2;
+      for (int k = 0; k < 3; ++k) {
+        e[k] = p[topo::kHexCornerNeighbors[c][k]] - p[c];
+        length2[k] = e[k].squaredNorm();
+      }
+      // Inside when on the inner side of all three faces; certainly outside once clearly
+      // outside one of them, whatever the others say.
+      bool out = false, near = false;
+      for (int k = 0; k < 3 && !out; ++k) {
+        const int i = (k + 1) % 3, j = (k + 2) % 3;
+        const double t = d.dot(e[i].cross(e[j]));
+        if (t * t <= kProbeMargin * length2[i] * length2[j]) near = true;
+        else out = t < 0.0;
+      }
+      if (out) continue;
+      if (near) flags_[v] |= kNearFace;
+      else ++containing_[v];
+    }
+  }
+
+  std::uint8_t flags(std::size_t v) const { return flags_[v]; }
+  int containing(std::size_t v) const { return containing_[v]; }
+
+ private:
+  std::vector<int> containing_;
+  std::vector<std::uint8_t> flags_;
+};
 
 // The covering at node v of a manifold hex mesh: the corners' solid angles against 4 pi inside
 // and, on the boundary, against the solid angle inside the spherical polygon of the boundary
@@ -203,36 +248,10 @@ constexpr double kProbeMargin = 1e-16;  // squared sine of the probe's angle to 
 // the dihedral angle between its two boundary faces measured through the inside. Nothing when
 // a corner is not positive (the cones are not oriented) or the boundary does not pair up.
 std::optional<NodeCoverage> hex_coverage(const std::vector<Point>& points, Index v,
-                                         const std::vector<CornerStar>& corners, bool on_boundary,
+                                         const std::vector<CornerStar>& corners,
                                          std::vector<BoundaryWedge>& wedges) {
   const Point& o = points[static_cast<std::size_t>(v)];
   NodeCoverage c{v, 0.0, 4.0 * kPi};
-  if (!on_boundary) {
-    int containing = 0;
-    bool clear = true;
-    for (const CornerStar& s : corners) {
-      std::array<Point, 3> e;
-      for (int k = 0; k < 3; ++k) e[k] = points[static_cast<std::size_t>(s.ends[k])] - o;
-      const Point n0 = e[1].cross(e[2]);
-      if (!(e[0].dot(n0) > 0.0)) return std::nullopt;
-      // In the cone when on the inner side of its three faces; certainly out once clearly
-      // outside one, whatever the others say.
-      bool out = false, near = false;
-      for (int k = 0; k < 3 && !out; ++k) {
-        const Point n = k == 0 ? n0 : e[(k + 1) % 3].cross(e[(k + 2) % 3]);
-        const double t = coverage_probe().dot(n);
-        if (t * t <= kProbeMargin * n.squaredNorm()) near = true;
-        else out = t < 0.0;
-      }
-      if (out) continue;
-      if (near) clear = false;
-      else ++containing;
-    }
-    if (clear) {
-      c.angle = 4.0 * kPi * containing;
-      return c;
-    }
-  }
   wedges.clear();
   for (const CornerStar& s : corners) {
     std::array<Point, 3> e;
@@ -355,14 +374,18 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     }
   }
 
-  // Orientation (on in-range hexes with finite corners; a repeated node gives a zero Jacobian).
+  // Orientation (on in-range hexes with finite corners; a repeated node gives a zero Jacobian),
+  // and the interior covering counted along the probe on proper hexes.
+  ProbeCount probe(mesh.points.size());
   for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
     if (!in_range(mesh.hexes[h], mesh.points.size())) continue;
-    const auto j = hex_jacobians(hex_corners(mesh, static_cast<Index>(h)));
+    const HexCorners corners = hex_corners(mesh, static_cast<Index>(h));
+    const auto j = hex_jacobians(corners);
     // Corners 0..7 only: the centre value (index 8) is not a corner Jacobian.
     if (!std::all_of(j.begin(), j.begin() + 8, [](double d) { return d > 0.0; })) {
       r.inverted_hexes.push_back(static_cast<Index>(h));
     }
+    if (!has_repeated(mesh.hexes[h])) probe.add(mesh.hexes[h], corners, j);
   }
 
   const auto& inc = hex_incidence();
@@ -466,8 +489,29 @@ HexValidityReport check_validity(const HexMesh& mesh) {
   std::vector<EdgeUse> edge_uses;
   std::vector<std::pair<Index, int>> first_use_of_face;  // (face lead, local use)
   std::vector<Index> others;
+  // The covering at a manifold node: counted along the probe inside, else from solid angles;
+  // nothing where a corner is not positive (its hexes are listed as inverted).
   std::vector<CornerStar> stars;
   std::vector<BoundaryWedge> wedges;
+  auto covering = [&](Index v, bool on_boundary) -> std::optional<NodeCoverage> {
+    const auto flags = probe.flags(static_cast<std::size_t>(v));
+    if (flags & ProbeCount::kNotPositive) return std::nullopt;
+    if (!on_boundary && !(flags & ProbeCount::kNearFace)) {
+      const int k = probe.containing(static_cast<std::size_t>(v));
+      return NodeCoverage{v, 4.0 * kPi * k, 4.0 * kPi};
+    }
+    stars.clear();
+    for (Index i = start[static_cast<std::size_t>(v)]; i < start[static_cast<std::size_t>(v) + 1]; ++i) {
+      const Index p = around[static_cast<std::size_t>(i)];
+      const int c = corner_of(p, v);
+      CornerStar& star = stars.emplace_back();
+      for (int k = 0; k < 3; ++k) {
+        star.ends[k] = hex(p)[topo::kHexCornerNeighbors[c][k]];
+        star.boundary_without[k] = face_uses(p, inc.corner_face_without[c][k]) == 1;
+      }
+    }
+    return hex_coverage(mesh.points, v, stars, wedges);
+  };
   for (std::size_t v = 0; v < nv; ++v) {
     const Index n = start[v + 1] - start[v];
     if (n == 0) {
@@ -479,17 +523,12 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     first_use_of_face.clear();
     others.clear();
     edge_uses.clear();
-    stars.clear();
     bool on_boundary = false, overshared = false;
     for (Index i = 0; i < n; ++i) {
       const Index p = around[static_cast<std::size_t>(start[v] + i)];
       const int c = corner_of(p, static_cast<Index>(v));
-      CornerStar& star = stars.emplace_back();
-      for (int k = 0; k < 3; ++k) {
-        const int lf = inc.corner_face_without[c][k];
+      for (int lf : inc.corner_faces[c]) {
         const auto uses = face_uses(p, lf);
-        star.ends[k] = hex(p)[topo::kHexCornerNeighbors[c][k]];
-        star.boundary_without[k] = uses == 1;
         on_boundary |= uses == 1;
         overshared |= uses == 3;
         const Index f = face_lead[static_cast<std::size_t>(6 * p + lf)];
@@ -511,8 +550,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     if (overshared || uses_joined.count() != 1 ||
         link_euler != (on_boundary ? 1 : 2)) {
       r.nonmanifold_vertices.push_back(static_cast<Index>(v));
-    } else if (const auto cover = hex_coverage(mesh.points, static_cast<Index>(v), stars, on_boundary, wedges);
-               cover && overlaps(*cover)) {
+    } else if (const auto cover = covering(static_cast<Index>(v), on_boundary); cover && overlaps(*cover)) {
       r.overlapping_nodes.push_back(*cover);
     }
 
