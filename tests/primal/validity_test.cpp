@@ -1,6 +1,8 @@
 // Validity reports: a structured block and a solid torus are valid with the Euler
 // characteristics topology predicts; each kind of defect is built on purpose and must be found
-// exactly where it was put.
+// exactly where it was put. Covering: embedded meshes (flat, curved, concave and irregular
+// boundaries) cover every node once; fans wrapping two or three times around a node with every
+// corner positive are named at exactly the wrapped nodes, with their solid angles.
 #include <doctest/doctest.h>
 
 #include <Eigen/Geometry>
