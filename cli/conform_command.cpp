@@ -82,7 +82,8 @@ double output_min_sj(const conform::ConformResult& r) {
   return m;
 }
 
-// Valid: faces shared by two hexes, closed boundary, and no hex with scaled Jacobian <= 0.
+// Valid: faces shared by two hexes, closed boundary, every node covered once, and no hex with
+// scaled Jacobian <= 0.
 bool result_valid(const conform::ConformResult& r) {
   if (!r.validity.ok()) return false;
   return std::all_of(r.quality.begin(), r.quality.end(),

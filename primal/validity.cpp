@@ -7,7 +7,9 @@
 #include <cstdint>
 #include <tuple>
 #include <cmath>
+#include <numbers>
 #include <numeric>
+#include <optional>
 #include <sstream>
 #include <unordered_map>
 #include <unordered_set>
@@ -27,6 +29,9 @@ struct HexIncidence {
   std::array<std::array<int, 2>, 12> edge_faces{};   // the two local faces containing edge e
   std::array<std::array<int, 3>, 8> corner_faces{};  // the three local faces at corner c
   std::array<std::array<int, 3>, 8> corner_edges{};  // the three local edges at corner c
+  // The local face at corner c spanned by the two edges other than edge k of
+  // kHexCornerNeighbors[c], i.e. the corner's face without neighbour k.
+  std::array<std::array<int, 3>, 8> corner_face_without{};
 };
 
 bool face_has_edge(int f, int a, int b) {
@@ -62,6 +67,12 @@ const HexIncidence& hex_incidence() {
         }
       }
       assert(nf == 3 && ne == 3);
+      for (int k = 0; k < 3; ++k) {
+        for (int f : t.corner_faces[c]) {
+          const auto& q = topo::kHexFaceCorners[f];
+          if (std::find(q.begin(), q.end(), topo::kHexCornerNeighbors[c][k]) == q.end()) t.corner_face_without[c][k] = f;
+        }
+      }
     }
     return t;
   }();
@@ -124,16 +135,194 @@ std::string show_key(const std::array<Index, N>& k) {
   }
   return s + "}";
 }
+std::string show_coverage(const NodeCoverage& c) {
+  std::ostringstream os;
+  os.precision(3);
+  os << c.node << ": " << c.angle / std::numbers::pi << " pi, not " << c.expected / std::numbers::pi << " pi";
+  return os.str();
+}
+
+// ---- Local covering ------------------------------------------------------------------------
+// The corners around a node tile its neighbourhood once when the mesh is embedded there. The
+// corner's tangent cone is what the element covers next to the node (a multilinear element's
+// derivative at a corner maps the unit cube's corner onto the cone of its edges), and
+// neighbouring cones share their face sectors, so the cones' angles add up to the space
+// around the node times the number of times they wrap around it. That number is an integer,
+// so the sum differs from the expected value by a multiple of 2 pi (4 pi at interior 3D
+// nodes): half of that is the tolerance, far beyond rounding.
+
+constexpr double kPi = std::numbers::pi;
+
+bool overlaps(const NodeCoverage& c) { return std::abs(c.angle - c.expected) > kPi; }
+
+// Signed solid angle of the triangle a, b, c seen from the origin: A. Van Oosterom and
+// J. Strackee, "The Solid Angle of a Plane Triangle", IEEE Trans. Biomed. Eng. BME-30(2),
+// 125-126 (1983): tan(omega / 2) = det[a b c] / (|a||b||c| + (a.b)|c| + (a.c)|b| + (b.c)|a|),
+// the quadrant taken from atan2, so omega is in (0, 2 pi) when det > 0.
+double solid_angle(const Point& a, const Point& b, const Point& c) {
+  const double la = a.norm(), lb = b.norm(), lc = c.norm();
+  const double den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
+  return 2.0 * std::atan2(a.dot(b.cross(c)), den);
+}
+
+// The dihedral angle around `axis` from the half-plane through `from`, turning to the side of
+// `toward`, to the half-plane through `to`, in (0, 2 pi].
+double wedge_angle(const Point& axis, const Point& from, const Point& toward, const Point& to) {
+  const Point u = axis.normalized();
+  const Point a = from - from.dot(u) * u;
+  auto turn = [&](const Point& x) { return std::atan2(u.dot(a.cross(x)), a.dot(x)); };
+  double t = turn(to);
+  if (turn(toward) < 0.0) t = -t;
+  return t > 0.0 ? t : t + 2.0 * kPi;
+}
+
+// A hex corner at a node: the far ends of its edges (kHexCornerNeighbors order) and, for each
+// k, whether the corner's face without edge k is a boundary face.
+struct CornerStar {
+  std::array<Index, 3> ends{};
+  std::array<bool, 3> boundary_without{};
+};
+
+// A boundary face seen from one of its two edges at the node: the edge's far end, the face's
+// other edge there, and the third edge of the hex corner (pointing inside).
+struct BoundaryWedge {
+  Index end;
+  Point other, inward;
+};
+
+// The covering degree at an interior node is also the number of corner cones containing a
+// direction d that lies on none of their faces (d is in the cone of e_0, e_1, e_2 when
+// det(d, e_j, e_k) > 0 for its three faces, given det(e_0, e_1, e_2) > 0), which costs no
+// square root or arctangent. A sign is trusted only when |det(d, e_j, e_k)| exceeds its rounding
+// error (a few ulps of |e_j| |e_k|) by far, so each count is exact; d nearly on a face or along
+// an edge leaves the node to the solid angles.
+constexpr double kProbeMargin = 1e-24;  // squared sine of the angle to a face counted as "on" it
+
+class ProbeCount {
+ public:
+  enum : std::uint8_t { kNotPositive = 1, kNearFace = 2 };
+
+  explicit ProbeCount(std::size_t nodes) : containing_(nodes, 0), flags_(nodes, 0) {}
+
+  // A proper hex with its corner positions and corner Jacobians (hex_jacobians).
+  void add(const std::array<Index, 8>& hex, const HexCorners& p, const std::array<double, 9>& jacobians) {
+    const Point& d = coverage_probe();
+    for (int c = 0; c < 8; ++c) {
+      const auto v = static_cast<std::size_t>(hex[c]);
+      if (!(jacobians[c] > 0.0)) {
+        flags_[v] |= kNotPositive;
+        continue;
+      }
+      std::array<Point, 3> e;
+      std::array<double, 3> length2;
+      for (int k = 0; k < 3; ++k) {
+        e[k] = p[topo::kHexCornerNeighbors[c][k]] - p[c];
+        length2[k] = e[k].squaredNorm();
+      }
+      // Inside when on the inner side of all three faces; certainly outside once clearly
+      // outside one of them, whatever the others say.
+      bool out = false, near = false;
+      for (int k = 0; k < 3 && !out; ++k) {
+        const int i = (k + 1) % 3, j = (k + 2) % 3;
+        const double t = d.dot(e[i].cross(e[j]));
+        if (t * t <= kProbeMargin * length2[i] * length2[j]) near = true;
+        else out = t < 0.0;
+      }
+      if (out) continue;
+      if (near) flags_[v] |= kNearFace;
+      else ++containing_[v];
+    }
+  }
+
+  std::uint8_t flags(std::size_t v) const { return flags_[v]; }
+  int containing(std::size_t v) const { return containing_[v]; }
+
+ private:
+  std::vector<int> containing_;
+  std::vector<std::uint8_t> flags_;
+};
+
+// The covering at node v of a manifold hex mesh: the corners' solid angles against 4 pi inside
+// and, on the boundary, against the solid angle inside the spherical polygon of the boundary
+// faces' sectors, 2 pi - sum(pi - interior angle), the interior angle at a boundary edge being
+// the dihedral angle between its two boundary faces measured through the inside. Nothing when
+// a corner is not positive (the cones are not oriented) or the boundary does not pair up.
+std::optional<NodeCoverage> hex_coverage(const std::vector<Point>& points, Index v,
+                                         const std::vector<CornerStar>& corners,
+                                         std::vector<BoundaryWedge>& wedges) {
+  const Point& o = points[static_cast<std::size_t>(v)];
+  NodeCoverage c{v, 0.0, 4.0 * kPi};
+  wedges.clear();
+  for (const CornerStar& s : corners) {
+    std::array<Point, 3> e;
+    for (int k = 0; k < 3; ++k) e[k] = points[static_cast<std::size_t>(s.ends[k])] - o;
+    if (!(e[0].dot(e[1].cross(e[2])) > 0.0)) return std::nullopt;
+    c.angle += solid_angle(e[0], e[1], e[2]);
+    for (int k = 0; k < 3; ++k) {
+      if (!s.boundary_without[k]) continue;
+      const int i = (k + 1) % 3, j = (k + 2) % 3;
+      wedges.push_back({s.ends[i], e[j], e[k]});
+      wedges.push_back({s.ends[j], e[i], e[k]});
+    }
+  }
+  if (wedges.empty()) return c;
+  std::sort(wedges.begin(), wedges.end(), [](const BoundaryWedge& a, const BoundaryWedge& b) { return a.end < b.end; });
+  double exterior = 0.0;
+  for (std::size_t i = 0; i < wedges.size(); i += 2) {
+    if (i + 1 == wedges.size() || wedges[i + 1].end != wedges[i].end ||
+        (i + 2 < wedges.size() && wedges[i + 2].end == wedges[i].end))
+      return std::nullopt;
+    const Point axis = points[static_cast<std::size_t>(wedges[i].end)] - o;
+    exterior += kPi - wedge_angle(axis, wedges[i].other, wedges[i].inward, wedges[i + 1].other);
+  }
+  c.expected = 2.0 * kPi - exterior;
+  return c;
+}
+
+// The 2D covering at node v (QuadValidityReport::overlapping_nodes): the corners' angles against
+// 2 pi inside and against the angle from the leaving to the arriving boundary edge on the
+// boundary. `corners` holds (edge to the next corner, edge to the previous one, leaving edge on
+// the boundary, arriving edge on the boundary). Nothing when a corner is not positive or the
+// node does not have one boundary edge each way.
+struct QuadCornerAt {
+  Point next, prev;
+  bool leaving_boundary, arriving_boundary;
+};
+
+std::optional<NodeCoverage> quad_coverage(Index v, const std::vector<QuadCornerAt>& corners, const Point& normal) {
+  NodeCoverage c{v, 0.0, 2.0 * kPi};
+  const Point *out = nullptr, *in = nullptr;
+  int leaving = 0, arriving = 0;
+  for (const QuadCornerAt& q : corners) {
+    const double area = normal.dot(q.next.cross(q.prev));
+    if (!(area > 0.0)) return std::nullopt;
+    c.angle += std::atan2(area, q.next.dot(q.prev));
+    if (q.leaving_boundary) out = &q.next, ++leaving;
+    if (q.arriving_boundary) in = &q.prev, ++arriving;
+  }
+  if (leaving != arriving || leaving > 1) return std::nullopt;
+  if (out) {
+    const double t = std::atan2(normal.dot(out->cross(*in)), out->dot(*in));
+    c.expected = t > 0.0 ? t : t + 2.0 * kPi;
+  }
+  return c;
+}
 
 }  // namespace
+
+// Arbitrary decimals, chosen to avoid grid axes and diagonals.
+const Point& coverage_probe() {
+  static const Point d = Point(0.3164, 0.5871, 0.7451).normalized();
+  return d;
+}
 
 // ---- Hex meshes ----------------------------------------------------------------------------
 
 bool HexValidityReport::ok() const {
   return out_of_range_hexes.empty() && non_finite_nodes.empty() && repeated_node_hexes.empty() &&
          overshared_faces.empty() && misoriented_faces.empty() && nonmanifold_edges.empty() &&
-         nonmanifold_vertices.empty() && inverted_hexes.empty() && boundary.closed &&
-         boundary.manifold;
+         nonmanifold_vertices.empty() && inverted_hexes.empty() && overlapping_nodes.empty() &&
+         boundary.closed && boundary.manifold;
 }
 
 std::string HexValidityReport::summary() const {
@@ -157,6 +346,7 @@ std::string HexValidityReport::summary() const {
   list(os, "boundary quads OpenMesh rejected (hex)", boundary.rejected,
        [](const BoundaryQuad& q) { return std::to_string(q.hex); });
   list(os, "hexes with a non-positive corner Jacobian", inverted_hexes, show_index);
+  list(os, "nodes the hexes cover more than once (corner solid angles)", overlapping_nodes, show_coverage);
   return os.str();
 }
 
@@ -184,14 +374,18 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     }
   }
 
-  // Orientation (on in-range hexes with finite corners; a repeated node gives a zero Jacobian).
+  // Orientation (on in-range hexes with finite corners; a repeated node gives a zero Jacobian),
+  // and the interior covering counted along the probe on proper hexes.
+  ProbeCount probe(mesh.points.size());
   for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
     if (!in_range(mesh.hexes[h], mesh.points.size())) continue;
-    const auto j = hex_jacobians(hex_corners(mesh, static_cast<Index>(h)));
+    const HexCorners corners = hex_corners(mesh, static_cast<Index>(h));
+    const auto j = hex_jacobians(corners);
     // Corners 0..7 only: the centre value (index 8) is not a corner Jacobian.
     if (!std::all_of(j.begin(), j.begin() + 8, [](double d) { return d > 0.0; })) {
       r.inverted_hexes.push_back(static_cast<Index>(h));
     }
+    if (!has_repeated(mesh.hexes[h])) probe.add(mesh.hexes[h], corners, j);
   }
 
   const auto& inc = hex_incidence();
@@ -295,6 +489,29 @@ HexValidityReport check_validity(const HexMesh& mesh) {
   std::vector<EdgeUse> edge_uses;
   std::vector<std::pair<Index, int>> first_use_of_face;  // (face lead, local use)
   std::vector<Index> others;
+  // The covering at a manifold node: counted along the probe inside, else from solid angles;
+  // nothing where a corner is not positive (its hexes are listed as inverted).
+  std::vector<CornerStar> stars;
+  std::vector<BoundaryWedge> wedges;
+  auto covering = [&](Index v, bool on_boundary) -> std::optional<NodeCoverage> {
+    const auto flags = probe.flags(static_cast<std::size_t>(v));
+    if (flags & ProbeCount::kNotPositive) return std::nullopt;
+    if (!on_boundary && !(flags & ProbeCount::kNearFace)) {
+      const int k = probe.containing(static_cast<std::size_t>(v));
+      return NodeCoverage{v, 4.0 * kPi * k, 4.0 * kPi};
+    }
+    stars.clear();
+    for (Index i = start[static_cast<std::size_t>(v)]; i < start[static_cast<std::size_t>(v) + 1]; ++i) {
+      const Index p = around[static_cast<std::size_t>(i)];
+      const int c = corner_of(p, v);
+      CornerStar& star = stars.emplace_back();
+      for (int k = 0; k < 3; ++k) {
+        star.ends[k] = hex(p)[topo::kHexCornerNeighbors[c][k]];
+        star.boundary_without[k] = face_uses(p, inc.corner_face_without[c][k]) == 1;
+      }
+    }
+    return hex_coverage(mesh.points, v, stars, wedges);
+  };
   for (std::size_t v = 0; v < nv; ++v) {
     const Index n = start[v + 1] - start[v];
     if (n == 0) {
@@ -333,6 +550,8 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     if (overshared || uses_joined.count() != 1 ||
         link_euler != (on_boundary ? 1 : 2)) {
       r.nonmanifold_vertices.push_back(static_cast<Index>(v));
+    } else if (const auto cover = covering(static_cast<Index>(v), on_boundary); cover && overlaps(*cover)) {
+      r.overlapping_nodes.push_back(*cover);
     }
 
     std::sort(edge_uses.begin(), edge_uses.end(),
@@ -377,7 +596,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
 bool QuadValidityReport::ok() const {
   return out_of_range_quads.empty() && non_finite_nodes.empty() && repeated_node_quads.empty() &&
          planar && overshared_edges.empty() && misoriented_edges.empty() &&
-         nonmanifold_vertices.empty() && inverted_quads.empty();
+         nonmanifold_vertices.empty() && inverted_quads.empty() && overlapping_nodes.empty();
 }
 
 std::string QuadValidityReport::summary() const {
@@ -398,6 +617,7 @@ std::string QuadValidityReport::summary() const {
   list(os, "edges run in the same direction by both quads", misoriented_edges, show_key<2>);
   list(os, "non-manifold vertices", nonmanifold_vertices, show_index);
   list(os, "quads with a non-positive corner", inverted_quads, show_index);
+  list(os, "nodes the quads cover more than once (corner angles)", overlapping_nodes, show_coverage);
   return os.str();
 }
 
@@ -463,8 +683,10 @@ QuadValidityReport check_validity(const QuadMesh& mesh, const Point& normal_in) 
     if (uses.size() == 2 && tail(uses[0]) == tail(uses[1])) r.misoriented_edges.push_back(edges[e]);
   }
 
-  // Vertices: the quads around a vertex must be connected through the edges at it.
+  // Vertices: the quads around a vertex must be connected through the edges at it; a manifold
+  // one must be covered once.
   std::vector<std::vector<std::pair<Index, int>>> vertex_uses(mesh.points.size());
+  std::vector<QuadCornerAt> corners;
   for (std::size_t q = 0; q < proper.size(); ++q) {
     for (int c = 0; c < 4; ++c) vertex_uses[proper[q][c]].emplace_back(static_cast<Index>(q), c);
   }
@@ -478,18 +700,27 @@ QuadValidityReport check_validity(const QuadMesh& mesh, const Point& normal_in) 
     DisjointSets sets(uses.size());
     std::unordered_map<Index, int> first_use_of_edge;
     bool overshared = false;
+    corners.clear();
+    const Point& o = mesh.points[v];
     for (std::size_t i = 0; i < uses.size(); ++i) {
       const auto [q, c] = uses[i];
+      corners.push_back({mesh.points[proper[q][(c + 1) % 4]] - o, mesh.points[proper[q][(c + 3) % 4]] - o, false, false});
       // The two edges at corner c: edge c (leaving it) and edge c-1 (arriving).
       for (int le : {c, (c + 3) % 4}) {
         const auto& lc = topo::kQuadEdgeCorners[le];
         const Index e = edge_id.at(edge_key(proper[q][lc[0]], proper[q][lc[1]]));
         overshared |= edge_uses[e].size() > 2;
+        (le == c ? corners.back().leaving_boundary : corners.back().arriving_boundary) = edge_uses[e].size() == 1;
         auto [it, inserted] = first_use_of_edge.try_emplace(e, static_cast<int>(i));
         if (!inserted) sets.unite(it->second, static_cast<int>(i));
       }
     }
-    if (overshared || sets.count() != 1) r.nonmanifold_vertices.push_back(static_cast<Index>(v));
+    if (overshared || sets.count() != 1) {
+      r.nonmanifold_vertices.push_back(static_cast<Index>(v));
+    } else if (r.planar) {
+      const auto cover = quad_coverage(static_cast<Index>(v), corners, normal);
+      if (cover && overlaps(*cover)) r.overlapping_nodes.push_back(*cover);
+    }
   }
 
   r.num_edges = static_cast<Index>(edges.size());

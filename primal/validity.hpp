@@ -10,6 +10,20 @@
 
 namespace geode::primal {
 
+// A node where the elements around it overlap: the solid angles (angles in 2D) of their corners
+// add up to more than the space there, i.e. the elements cover the node's neighbourhood more
+// than once although every corner is positive.
+struct NodeCoverage {
+  Index node = kInvalidIndex;
+  double angle = 0.0;     // sum of the incident corners' solid angles (angles in 2D)
+  double expected = 0.0;  // 4 pi (2 pi in 2D) inside; on the boundary what the boundary leaves inside
+};
+
+// The direction along which check_validity counts the corner cones at an interior hex node (the
+// covering degree, without trigonometry); a node where it lies on a cone's face gets the sum of
+// solid angles instead. Public so that tests can put it on a face.
+const Point& coverage_probe();
+
 // Elements with an out-of-range node or a repeated node are listed and left out of the
 // topological checks (Euler characteristic, faces, edges, vertices, boundary), which run on
 // the remaining "proper" elements.
@@ -37,6 +51,15 @@ struct HexValidityReport {
 
   // Hexes with a corner Jacobian det(e_r, e_s, e_t) <= 0 (topology::kHexCornerNeighbors).
   std::vector<Index> inverted_hexes;
+
+  // Local covering: at a manifold node whose incident corners are all positive, the tangent cones
+  // of the corners (spanned by each corner's three edges) must tile the space around it once.
+  // Their solid angles sum to 4 pi k at an interior node whose hexes wrap k times around it; at
+  // a boundary node the sum must be the solid angle the boundary quads enclose on the inside
+  // (2 pi - the sum of the exterior angles of the boundary's spherical polygon around the node,
+  // Gauss-Bonnet). Positive Jacobians alone allow k = 2. Nodes with a non-positive corner are
+  // not judged here (their hexes are listed as inverted).
+  std::vector<NodeCoverage> overlapping_nodes;
 
   bool ok() const;
   std::string summary() const;  // one line per finding, listing the first few offenders
@@ -67,6 +90,11 @@ struct QuadValidityReport {
 
   // Quads with a corner whose signed area (a x b) . normal is <= 0.
   std::vector<Index> inverted_quads;
+
+  // The 2D local covering: at a manifold node whose incident corners are all positive, their
+  // angles sum to 2 pi inside and to the boundary's interior angle on the boundary; 4 pi etc.
+  // where the quads wrap around the node more than once.
+  std::vector<NodeCoverage> overlapping_nodes;
 
   bool ok() const;
   std::string summary() const;

@@ -18,6 +18,7 @@
 #include "support/fixtures.hpp"
 #include "conform/conform.hpp"
 #include "conform/reference_template.hpp"
+#include "support/conform_checks.hpp"
 
 using namespace geode;
 using primal::Index;
@@ -40,22 +41,7 @@ void check_result(const conform::ConformResult& r, const Expected& e) {
   CHECK(r.diced_tet_hexes == 4 * e.tets);
   REQUIRE(r.model.hexes.size() == static_cast<std::size_t>(8 * e.hexes + geode + 4 * e.tets));
   CHECK(r.model.tets.empty());
-  const primal::HexMesh mesh = primal::hex_part(r.model);
-  const primal::HexValidityReport v = primal::check_validity(mesh);
-  INFO(v.summary());
-  CHECK(v.ok());
-  CHECK(v.overshared_faces.empty());
-  CHECK(v.boundary.closed);
-  CHECK(v.boundary.manifold);
-  CHECK(v.euler == 1);            // the grid models and demos are balls
-  CHECK(v.boundary.euler == 2);   // whose boundary is a sphere
-  CHECK(v.inverted_hexes.empty());
-  CHECK(v.unused_nodes == 0);
-  for (const auto& h : mesh.hexes) {
-    primal::HexCorners c;
-    for (int k = 0; k < 8; ++k) c[k] = mesh.points[h[k]];
-    CHECK(primal::hex_scaled_jacobian(c) > 0.0);
-  }
+  test::check_conform_result(r, geode);
   // Nothing left unmerged: no two nodes at one place (an unmerged template side or top node
   // would be one, and its faces would show up as boundary faces inside the model).
   primal::Model copy = r.model;
@@ -70,7 +56,6 @@ void check_result(const conform::ConformResult& r, const Expected& e) {
     }
   }
   CHECK(r.quality.size() == 2);
-  CHECK(r.warnings.empty());
 }
 
 }  // namespace

@@ -11,30 +11,12 @@
 #include "conform/demo_models.hpp"
 #include "conform/reference_template.hpp"
 #include "primal/interface.hpp"
-#include "primal/quality.hpp"
-#include "primal/validity.hpp"
+#include "support/conform_checks.hpp"
 
 using namespace geode;
 using primal::Index;
 
 namespace {
-
-// geode_hexes: 26 per interface quad unless given.
-void check_valid(const conform::ConformResult& r, primal::Index geode_hexes = -1) {
-  const primal::HexMesh mesh = primal::hex_part(r.model);
-  const primal::HexValidityReport v = primal::check_validity(mesh);
-  INFO(v.summary());
-  CHECK(v.ok());
-  CHECK(v.overshared_faces.empty());
-  CHECK(v.boundary.closed);
-  CHECK(v.boundary.manifold);
-  CHECK(v.euler == 1);
-  CHECK(v.boundary.euler == 2);
-  CHECK(primal::min_scaled_jacobian(mesh) > 0.0);
-  CHECK(r.warnings.empty());
-  CHECK(r.geode_hexes == (geode_hexes < 0 ? 26 * r.interface_quads : geode_hexes));
-  CHECK(r.model.hexes.size() == static_cast<std::size_t>(r.diced_hexes + r.geode_hexes + r.diced_tet_hexes));
-}
 
 // The geode hexes conform() must make for the model: 26 per two-triangle interface quad, the
 // four-triangle template's count per four-triangle one (checked to be some but not all quads).
@@ -67,7 +49,7 @@ TEST_CASE("realistic models, no smoothing: valid and untangled by the placement 
     REQUIRE(!m.tets.empty());
     const auto r = conform::conform(m, o);
     CHECK(r.interface_quads == quads);
-    check_valid(r);
+    test::check_conform_result(r);
   }
 }
 
@@ -75,7 +57,7 @@ TEST_CASE("realistic models, default options: valid and untangled") {
   for (const char* name : {"delaunay-random", "cylinder"}) {
     CAPTURE(name);
     const auto r = conform::conform(conform::demo_model(name, 2));
-    check_valid(r);
+    test::check_conform_result(r);
     // The yardstick is measured on the input itself: Delaunay tets are far from the diced
     // Kuhn cube's 0.29, the swept hexes of the cylinder far from 1.
     CHECK(r.input_diced_tet_min_scaled_jacobian < 0.2);
@@ -95,7 +77,7 @@ TEST_CASE("mixed two- and four-triangle interface: valid and untangled") {
     o.smooth = smooth;
     const auto r = conform::conform(m, o);
     CHECK(r.interface_quads == 9);
-    check_valid(r, geode_hexes);
+    test::check_conform_result(r, geode_hexes);
   }
 }
 
@@ -111,5 +93,5 @@ constexpr bool kSanitized = false;
 TEST_CASE("mixed interface on a curved cylinder, default options: valid and untangled" *
           doctest::skip(kSanitized)) {
   const primal::Model m = conform::demo_model("fourtri-cylinder", 2);
-  check_valid(conform::conform(m), mixed_geode_hexes(m));
+  test::check_conform_result(conform::conform(m), mixed_geode_hexes(m));
 }

@@ -1,20 +1,31 @@
 // Validity reports: a structured block and a solid torus are valid with the Euler
 // characteristics topology predicts; each kind of defect is built on purpose and must be found
-// exactly where it was put.
+// exactly where it was put. Covering: embedded meshes (flat, curved, concave and irregular
+// boundaries) cover every node once; fans wrapping two or three times around a node with every
+// corner positive are named at exactly the wrapped nodes, with their solid angles.
 #include <doctest/doctest.h>
 
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
+#include <numbers>
+#include <random>
 #include <string>
 
 #include "primal/boundary.hpp"
+#include "primal/dice.hpp"
+#include "primal/grid_model.hpp"
+#include "primal/quality.hpp"
+#include "primal/smooth.hpp"
 #include "primal/topology.hpp"
 #include "primal/validity.hpp"
+#include "support/ball_checks.hpp"
 #include "support/fixtures.hpp"
 
 using namespace geode::primal;
+using geode::test::appendix_a_geode;
 using geode::test::structured_hex_grid;
 using geode::test::structured_quad_grid;
 
@@ -298,5 +309,216 @@ TEST_CASE("validity: each quad defect is found where it was put") {
     CHECK(check_validity(m, Point::UnitX()).ok());
     CHECK_FALSE(check_validity(m, -Point::UnitX()).ok());  // seen from -x: all clockwise
     CHECK_FALSE(check_validity(m).planar);
+  }
+}
+
+// ---- Local covering -------------------------------------------------------------------------
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// A fan of 4 * turns quads around node 0 (the hub), each a parallelogram hub, spoke i, outer
+// node, spoke i + 1, the spokes a quarter turn apart: turns = 1 is a valid disk, turns = 2
+// wraps twice around the hub with every corner positive, edges shared by two quads and the
+// hub's quads connected, i.e. nothing but the covering is wrong. Spoke radii grow by turn so
+// that no two nodes coincide. Nodes: hub, spokes 1 .. 4 turns, outer nodes after them.
+QuadMesh wrapped_star(int turns) {
+  QuadMesh m;
+  const int n = 4 * turns;
+  m.points.emplace_back(0.0, 0.0, 0.0);
+  for (int i = 0; i < n; ++i) {
+    const double r = 1.0 + 0.5 * (i / 4), a = kPi / 2 * i;
+    m.points.emplace_back(r * std::cos(a), r * std::sin(a), 0.0);
+  }
+  for (int i = 0; i < n; ++i) {
+    const Index s = 1 + i, t = 1 + (i + 1) % n;
+    m.points.push_back(m.points[s] + m.points[t]);
+    m.quads.push_back({0, s, static_cast<Index>(1 + n + i), t});
+  }
+  return m;
+}
+
+// `layers` layers of hexes over a planar quad mesh (counter-clockwise from +z), one unit
+// thick; node v of layer k is v + k * (number of quad nodes).
+HexMesh extrude(const QuadMesh& q, int layers) {
+  HexMesh m;
+  const auto n = static_cast<Index>(q.points.size());
+  for (int k = 0; k <= layers; ++k)
+    for (const Point& p : q.points) m.points.push_back(p + Point(0, 0, k));
+  for (int k = 0; k < layers; ++k)
+    for (const auto& f : q.quads)
+      m.hexes.push_back({f[0] + k * n, f[1] + k * n, f[2] + k * n, f[3] + k * n, f[0] + (k + 1) * n,
+                         f[1] + (k + 1) * n, f[2] + (k + 1) * n, f[3] + (k + 1) * n});
+  return m;
+}
+
+// Interior nodes of a structured grid moved by up to `amount` in each coordinate.
+HexMesh jittered_grid(int n, double amount) {
+  HexMesh m = structured_hex_grid(n, n, n);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> d(-amount, amount);
+  for (auto& p : m.points)
+    if (p.minCoeff() > 0.0 && p.maxCoeff() < n) p += Point(d(rng), d(rng), d(rng));
+  return m;
+}
+
+// A 4 x 4 x 2 grid bent into three quarters of a thick-walled tube (radii 1 to 2): curved
+// boundaries, convex outside and concave inside.
+HexMesh bent_grid() {
+  HexMesh m = structured_hex_grid(4, 4, 2);
+  for (auto& p : m.points) {
+    const double r = 1.0 + p.x() / 4, a = 1.5 * kPi * p.y() / 4;
+    p = Point(r * std::cos(a), r * std::sin(a), p.z() / 2);
+  }
+  return m;
+}
+
+// A Kuhn-split 2 x 2 x 2 grid of tets, diced into 4 hexes each.
+HexMesh kuhn_diced() {
+  const Model model = grid_model({2, 2, 2}, 1.0, [](int, int, int) { return true; });
+  return dice(tet_part(model)).mesh;
+}
+
+// The paper's Appendix A geode (tangled as printed) smoothed with its box faces sliding.
+HexMesh smoothed_geode() {
+  HexMesh m = appendix_a_geode();
+  smooth_hex_mesh(m, box_constraints(m.points, Point(-12, -7, -12), Point(12, 7, 12)));
+  return m;
+}
+
+std::vector<Index> nodes_of(const std::vector<NodeCoverage>& c) {
+  std::vector<Index> out;
+  for (const auto& x : c) out.push_back(x.node);
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("covering: embedded meshes cover every node once, on the boundary too") {
+  // Boundary nodes on flat faces, convex and concave edges and corners (the block without an
+  // octant has a node whose inside is 7/8 of space), curved walls, and the irregular corners
+  // of diced tets; an interior node with 5 or 7 hexes comes with dicing.
+  const std::vector<std::pair<const char*, std::function<HexMesh()>>> cases{
+      {"3 x 3 x 3 grid", [] { return structured_hex_grid(3, 3, 3); }},
+      {"ring of 8 hexes", [] { return keep_hexes(structured_hex_grid(3, 3, 1), {0, 1, 2, 3, 5, 6, 7, 8}); }},
+      {"2 x 2 x 2 block without an octant", [] { return keep_hexes(structured_hex_grid(2, 2, 2), {0, 1, 2, 3, 4, 5, 6}); }},
+      {"jittered 4 x 4 x 4 grid", [] { return jittered_grid(4, 0.3); }},
+      {"bent tube", bent_grid},
+      {"Kuhn-diced 2 x 2 x 2 tets", kuhn_diced},
+      {"Appendix A geode, smoothed", smoothed_geode},
+      {"fan of 4 hexes, 2 layers", [] { return extrude(wrapped_star(1), 2); }},
+  };
+  for (const auto& [name, make] : cases) {
+    CAPTURE(std::string(name));
+    const HexMesh m = make();
+    REQUIRE(min_scaled_jacobian(m) > 0.0);  // every node is judged
+    const auto r = check_validity(m);
+    INFO(r.summary());
+    CHECK(r.ok());
+    CHECK(r.overlapping_nodes.empty());
+  }
+}
+
+TEST_CASE("covering: hexes wrapping twice around nodes are found there, all corners positive") {
+  struct Case {
+    const char* name;
+    HexMesh mesh;
+    std::vector<Index> overlapping;
+    double angle_at_first;  // sum of the corner solid angles at the first overlapping node
+    double expected_at_first;
+  };
+  // The extruded twice-wrapped fan: its hub line (nodes 0, 17, 34 in layers 0, 1, 2) has 16
+  // quarter-space corners around the middle node (8 pi, not 4 pi) and 8 at the ends, which lie
+  // on the flat bottom and top (4 pi, not the half-space's 2 pi).
+  // Without one hex per layer (and its outer node: 16 nodes a layer) the hub line is on the
+  // boundary, in a 270 degree notch: 14 corners at the middle node (7 pi) where the notch
+  // leaves 3 pi.
+  QuadMesh notched = wrapped_star(2);
+  notched.quads.pop_back();
+  notched.points.pop_back();  // its outer node
+  const std::vector<Case> cases{
+      {"fan wrapping twice", extrude(wrapped_star(2), 2), {0, 17, 34}, 4 * kPi, 2 * kPi},
+      {"fan wrapping three times", extrude(wrapped_star(3), 1), {0, 25}, 6 * kPi, 2 * kPi},
+      {"notched fan wrapping twice", extrude(notched, 2), {0, 16, 32}, 3.5 * kPi, 1.5 * kPi},
+  };
+  for (const auto& c : cases) {
+    CAPTURE(std::string(c.name));
+    REQUIRE(min_scaled_jacobian(c.mesh) > 0.0);
+    const auto r = check_validity(c.mesh);
+    INFO(r.summary());
+    CHECK_FALSE(r.ok());
+    // Only the covering is wrong.
+    geode::test::check_combinatorial_ball(r);
+    CHECK(r.inverted_hexes.empty());
+    CHECK(nodes_of(r.overlapping_nodes) == c.overlapping);
+    REQUIRE(!r.overlapping_nodes.empty());
+    CHECK(r.overlapping_nodes[0].angle == doctest::Approx(c.angle_at_first));
+    CHECK(r.overlapping_nodes[0].expected == doctest::Approx(c.expected_at_first));
+  }
+  const auto r = check_validity(extrude(wrapped_star(2), 2));
+  REQUIRE(r.overlapping_nodes.size() == 3);
+  CHECK(r.overlapping_nodes[1].angle == doctest::Approx(8 * kPi));
+  CHECK(r.overlapping_nodes[1].expected == doctest::Approx(4 * kPi));
+  CHECK(r.summary().find("nodes the hexes cover more than once (corner solid angles): 3 (0: 4 pi, not 2 pi, 17: 8 pi, "
+                         "not 4 pi, 34: 4 pi, not 2 pi)") != std::string::npos);
+}
+
+TEST_CASE("covering: the same where the counting probe runs along the wrapped edge") {
+  // Interior nodes are judged by counting the cones around the probe direction; turned so that
+  // the hub line runs along it, the probe is on faces of every hub corner and the solid angles
+  // decide, with the same answer.
+  const Eigen::Quaterniond turn = Eigen::Quaterniond::FromTwoVectors(Point::UnitZ(), coverage_probe());
+  for (int turns : {1, 2}) {
+    CAPTURE(turns);
+    HexMesh m = extrude(wrapped_star(turns), 2);
+    for (auto& p : m.points) p = turn * p;
+    const auto r = check_validity(m);
+    INFO(r.summary());
+    CHECK(r.ok() == (turns == 1));
+    const Index per_layer = static_cast<Index>(m.points.size() / 3);
+    CHECK(nodes_of(r.overlapping_nodes) == (turns == 1 ? std::vector<Index>{} : std::vector<Index>{0, per_layer, 2 * per_layer}));
+    if (turns == 2) {
+      REQUIRE(r.overlapping_nodes.size() == 3);
+      CHECK(r.overlapping_nodes[1].angle == doctest::Approx(8 * kPi));
+    }
+  }
+}
+
+TEST_CASE("covering: quad meshes, planar") {
+  QuadMesh notched = wrapped_star(2);
+  notched.quads.pop_back();
+  notched.points.pop_back();  // its outer node
+  QuadMesh jittered = structured_quad_grid(4, 4);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> d(-0.3, 0.3);
+  for (auto& p : jittered.points)
+    if (p.x() > 0 && p.x() < 4 && p.y() > 0 && p.y() < 4) p += Point(d(rng), d(rng), 0.0);
+  struct Case {
+    const char* name;
+    QuadMesh mesh;
+    std::vector<Index> overlapping;
+    double angle, expected;  // at the first overlapping node
+  };
+  const std::vector<Case> cases{
+      {"3 x 3 grid", structured_quad_grid(3, 3), {}, 0, 0},
+      {"annulus", keep_quads(structured_quad_grid(3, 3), {0, 1, 2, 3, 5, 6, 7, 8}), {}, 0, 0},
+      {"L", keep_quads(structured_quad_grid(2, 2), {0, 1, 2}), {}, 0, 0},
+      {"jittered 4 x 4 grid", jittered, {}, 0, 0},
+      {"fan of 4", wrapped_star(1), {}, 0, 0},
+      {"fan wrapping twice", wrapped_star(2), {0}, 4 * kPi, 2 * kPi},
+      {"notched fan wrapping twice", notched, {0}, 3.5 * kPi, 1.5 * kPi},
+  };
+  for (const auto& c : cases) {
+    CAPTURE(std::string(c.name));
+    const auto r = check_validity(c.mesh);
+    INFO(r.summary());
+    CHECK(r.inverted_quads.empty());
+    CHECK(r.nonmanifold_vertices.empty());
+    CHECK(r.ok() == c.overlapping.empty());
+    CHECK(nodes_of(r.overlapping_nodes) == c.overlapping);
+    if (r.overlapping_nodes.empty()) continue;
+    CHECK(r.overlapping_nodes[0].angle == doctest::Approx(c.angle));
+    CHECK(r.overlapping_nodes[0].expected == doctest::Approx(c.expected));
   }
 }

@@ -11,6 +11,7 @@
 #include "primal/errors.hpp"
 #include "primal/quality.hpp"
 #include "primal/topology.hpp"
+#include "primal/validity.hpp"
 #include "templates/study.hpp"
 
 using namespace geode;
@@ -64,30 +65,10 @@ TEST_CASE("interleave study: the default push is the 26-hex geode, and other out
   }
 }
 
-namespace {
-
-// Sum over the hexes at node v of their corner's solid angle (Van Oosterom and Strackee's
-// formula for the spherical triangle of the three edge directions), in units of 4 pi: 1 for an
-// embedded interior node, k when the hexes wrap k times around it.
-double coverage(const primal::HexMesh& m, primal::Index v) {
-  double sum = 0.0;
-  for (const auto& hex : m.hexes)
-    for (int c = 0; c < 8; ++c) {
-      if (hex[c] != v) continue;
-      std::array<primal::Point, 3> e;
-      for (int k = 0; k < 3; ++k)
-        e[k] = (m.points[hex[primal::topology::kHexCornerNeighbors[c][k]]] - m.points[v]).normalized();
-      sum += 2.0 * std::atan2(e[0].dot(e[1].cross(e[2])), 1.0 + e[0].dot(e[1]) + e[1].dot(e[2]) + e[2].dot(e[0]));
-    }
-  return sum / (4.0 * M_PI);
-}
-
-}  // namespace
-
-TEST_CASE("a pinched corner the smoother 'untangles' is a double cover") {
+TEST_CASE("a pinched corner the smoother 'untangles' is a double cover, and check_validity says so") {
   // A 30-hex class meeting the paper's conditions with one pinched corner at an interior node:
   // with the tet and hex sides sliding, the smoother reaches positive Jacobians, but the hexes
-  // around that node wrap twice around it.
+  // around that node wrap twice around it (their corner solid angles sum to 8 pi).
   GeodeOptions o;
   o.push = {0.55, 0.5, 0.97, 0.8};
   templates::Template t = templates::build_geode3d(o);
@@ -98,14 +79,20 @@ TEST_CASE("a pinched corner the smoother 'untangles' is a double cover") {
   REQUIRE(obstructions[0].kind == primal::ObstructionKind::kPinchedCorner);
   const primal::Index v = obstructions[0].nodes[0];
   CHECK(t.node_faces[v] == 0u);  // interior
-  // Whether the smoother reaches positive Jacobians here is its business; when it does, the
-  // overlap must show.
   const auto r = templates::smooth_template(t, true);
-  if (r.final_min_scaled_jacobian > 0.0) CHECK(coverage(t.hex, v) == doctest::Approx(2.0).epsilon(1e-6));
-  // Every other interior node is covered once.
-  for (std::size_t n = 0; n < t.hex.points.size(); ++n)
-    if (t.node_faces[n] == 0u && static_cast<primal::Index>(n) != v && r.final_min_scaled_jacobian > 0.0)
-      CHECK(coverage(t.hex, static_cast<primal::Index>(n)) == doctest::Approx(1.0).epsilon(1e-6));
+  const auto report = primal::check_validity(t.hex);
+  INFO(report.summary());
+  // Never valid: inverted, or (what the smoother reaches today) positive but overlapping.
+  CHECK_FALSE(report.ok());
+  if (r.final_min_scaled_jacobian <= 0.0) return;  // whether it untangles is the smoother's business
+  CHECK(report.inverted_hexes.empty());
+  // That node and no other, interior or boundary.
+  REQUIRE(report.overlapping_nodes.size() == 1);
+  CHECK(report.overlapping_nodes[0].node == v);
+  CHECK(report.overlapping_nodes[0].angle == doctest::Approx(8 * M_PI));
+  CHECK(report.overlapping_nodes[0].expected == doctest::Approx(4 * M_PI));
+  CHECK(report.summary().find("cover more than once (corner solid angles): 1 (" + std::to_string(v) + ": 8 pi, not 4 pi)") !=
+        std::string::npos);
 }
 
 TEST_CASE("template_obstructions: none on the geode, pinched corners and doublets on four-triangle duals") {
