@@ -1,5 +1,8 @@
 #include "primal/validity.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "primal/disjoint_sets.hpp"
 
 #include <algorithm>
@@ -204,33 +207,47 @@ class ProbeCount {
 
   explicit ProbeCount(std::size_t nodes) : containing_(nodes, 0), flags_(nodes, 0) {}
 
-  // A proper hex with its corner positions and corner Jacobians (hex_jacobians).
-  void add(const std::array<Index, 8>& hex, const HexCorners& p, const std::array<double, 9>& jacobians) {
+  // What the probe finds at each corner of a proper hex, 2 bits per corner (kOut, kInside,
+  // kNear, kNotPositiveCorner), from its corner positions and Jacobians (hex_jacobians). Pure,
+  // so hexes can be classified in parallel and added in order.
+  enum : std::uint8_t { kOut = 0, kInside = 1, kNear = 2, kNotPositiveCorner = 3 };
+  static std::uint16_t classify(const HexCorners& p, const std::array<double, 9>& jacobians) {
     const Point& d = coverage_probe();
+    std::uint16_t code = 0;
+    for (int c = 0; c < 8; ++c) {
+      std::uint16_t k_code = kNotPositiveCorner;
+      if (jacobians[c] > 0.0) {
+        std::array<Point, 3> e;
+        std::array<double, 3> length2;
+        for (int k = 0; k < 3; ++k) {
+          e[k] = p[topo::kHexCornerNeighbors[c][k]] - p[c];
+          length2[k] = e[k].squaredNorm();
+        }
+        // Inside when on the inner side of all three faces; certainly outside once clearly
+        // outside one of them, whatever the others say.
+        bool out = false, near = false;
+        for (int k = 0; k < 3 && !out; ++k) {
+          const int i = (k + 1) % 3, j = (k + 2) % 3;
+          const double t = d.dot(e[i].cross(e[j]));
+          if (t * t <= kProbeMargin * length2[i] * length2[j]) near = true;
+          else out = t < 0.0;
+        }
+        k_code = out ? kOut : near ? kNear : kInside;
+      }
+      code = static_cast<std::uint16_t>(code | (k_code << (2 * c)));
+    }
+    return code;
+  }
+
+  void add(const std::array<Index, 8>& hex, std::uint16_t code) {
     for (int c = 0; c < 8; ++c) {
       const auto v = static_cast<std::size_t>(hex[c]);
-      if (!(jacobians[c] > 0.0)) {
-        flags_[v] |= kNotPositive;
-        continue;
+      switch ((code >> (2 * c)) & 3) {
+        case kNotPositiveCorner: flags_[v] |= kNotPositive; break;
+        case kNear: flags_[v] |= kNearFace; break;
+        case kInside: ++containing_[v]; break;
+        default: break;
       }
-      std::array<Point, 3> e;
-      std::array<double, 3> length2;
-      for (int k = 0; k < 3; ++k) {
-        e[k] = p[topo::kHexCornerNeighbors[c][k]] - p[c];
-        length2[k] = e[k].squaredNorm();
-      }
-      // Inside when on the inner side of all three faces; certainly outside once clearly
-      // outside one of them, whatever the others say.
-      bool out = false, near = false;
-      for (int k = 0; k < 3 && !out; ++k) {
-        const int i = (k + 1) % 3, j = (k + 2) % 3;
-        const double t = d.dot(e[i].cross(e[j]));
-        if (t * t <= kProbeMargin * length2[i] * length2[j]) near = true;
-        else out = t < 0.0;
-      }
-      if (out) continue;
-      if (near) flags_[v] |= kNearFace;
-      else ++containing_[v];
     }
   }
 
@@ -376,16 +393,29 @@ HexValidityReport check_validity(const HexMesh& mesh) {
 
   // Orientation (on in-range hexes with finite corners; a repeated node gives a zero Jacobian),
   // and the interior covering counted along the probe on proper hexes.
+  // The geometry per hex in parallel (TBB), one slot each: the probe's corner codes in bits
+  // 0-15, bit 16 when a corner Jacobian is not positive, bit 17 when the hex was measured;
+  // then gathered in hex order, so nothing depends on the thread count.
   ProbeCount probe(mesh.points.size());
-  for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
-    if (!in_range(mesh.hexes[h], mesh.points.size())) continue;
-    const HexCorners corners = hex_corners(mesh, static_cast<Index>(h));
-    const auto j = hex_jacobians(corners);
-    // Corners 0..7 only: the centre value (index 8) is not a corner Jacobian.
-    if (!std::all_of(j.begin(), j.begin() + 8, [](double d) { return d > 0.0; })) {
-      r.inverted_hexes.push_back(static_cast<Index>(h));
+  {
+    constexpr std::uint32_t kInverted = 1u << 16, kMeasured = 1u << 17;
+    std::vector<std::uint32_t> found(mesh.hexes.size(), 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.hexes.size(), 4096),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        for (std::size_t h = range.begin(); h != range.end(); ++h) {
+                          if (!in_range(mesh.hexes[h], mesh.points.size())) continue;
+                          const HexCorners corners = hex_corners(mesh, static_cast<Index>(h));
+                          const auto j = hex_jacobians(corners);
+                          // Corners 0..7 only: the centre value (index 8) is not a corner Jacobian.
+                          const bool positive = std::all_of(j.begin(), j.begin() + 8, [](double d) { return d > 0.0; });
+                          found[h] = kMeasured | (positive ? 0u : kInverted) | ProbeCount::classify(corners, j);
+                        }
+                      });
+    for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
+      if (!(found[h] & kMeasured)) continue;
+      if (found[h] & kInverted) r.inverted_hexes.push_back(static_cast<Index>(h));
+      if (!has_repeated(mesh.hexes[h])) probe.add(mesh.hexes[h], static_cast<std::uint16_t>(found[h] & 0xffffu));
     }
-    if (!has_repeated(mesh.hexes[h])) probe.add(mesh.hexes[h], corners, j);
   }
 
   const auto& inc = hex_incidence();
@@ -431,9 +461,11 @@ HexValidityReport check_validity(const HexMesh& mesh) {
   // uses (1, 2, 3 = more) in bits 0-1, bit 2 set when two uses see it in the same cyclic order.
   std::vector<Index> face_lead(6 * nh, kInvalidIndex);
   std::vector<std::uint8_t> face_info(6 * nh, 0);
-  {
+  // Each face is handled at its smallest node only, so nodes write disjoint slots and run in
+  // parallel (TBB) with the same result for any thread count.
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv, 4096), [&](const tbb::blocked_range<std::size_t>& range) {
     std::vector<std::pair<FaceKey, Index>> local;  // faces whose smallest node is v, with use
-    for (std::size_t v = 0; v < nv; ++v) {
+    for (std::size_t v = range.begin(); v != range.end(); ++v) {
       local.clear();
       for (Index k = start[v]; k < start[v + 1]; ++k) {
         const Index p = around[static_cast<std::size_t>(k)];
@@ -460,7 +492,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
         i = j;
       }
     }
-  }
+  });
   std::vector<BoundaryQuad> boundary;
   for (std::size_t u = 0; u < 6 * nh; ++u) {
     if (face_lead[u] != static_cast<Index>(u)) continue;
