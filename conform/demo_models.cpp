@@ -466,32 +466,32 @@ namespace {
 
 // An all-quad mesh of the square [-1,1]^2 (z = 0) with the circle of radius r about its centre
 // imprinted (the circle is a chain of quad edges), n uniform segments per side so that it meets
-// structured n x n faces. Blossom recombination leaves triangles or non-convex quads on some
-// inputs; the next 2D algorithm (Frontal-Delaunay, Delaunay, MeshAdapt) or a circle with two
-// more segments (the circle and the annulus both need an even number of boundary segments) is
-// tried until every cell is a convex quad.
+// structured n x n faces. Blossom recombination leaves triangles on some inputs; the next 2D
+// algorithm (Frontal-Delaunay, Delaunay, MeshAdapt) or a circle with two more segments (the
+// circle and the annulus both need an even number of boundary segments) is tried until the
+// quads alone tile the square.
 struct SquareQuads {
   std::vector<Point> points;
   std::vector<std::array<Index, 4>> quads;
 };
 
-bool all_convex(const SquareQuads& f) {
+// Every quad strictly convex and counter-clockwise, their areas summing to the square's: the
+// quads tile it without a fold, an overlap or a hole.
+bool tiles_square(const SquareQuads& f) {
+  double area = 0;
   for (const auto& q : f.quads) {
-    int positive = 0, negative = 0;
     for (std::size_t k = 0; k < 4; ++k) {
       const Point& a = f.points[static_cast<std::size_t>(q[(k + 3) % 4])];
       const Point& b = f.points[static_cast<std::size_t>(q[k])];
       const Point& c = f.points[static_cast<std::size_t>(q[(k + 1) % 4])];
-      const double cross = (c - b).cross(a - b).z();
-      if (cross > 0) ++positive;
-      else if (cross < 0) ++negative;
-      else return false;
+      if ((c - b).cross(a - b).z() <= 0) return false;
+      area += 0.5 * b.head<2>().homogeneous().cross(c.head<2>().homogeneous()).z();
     }
-    if (positive != 4 && negative != 4) return false;
   }
-  return true;
+  return !f.quads.empty() && std::abs(area - 4.0) < 1e-9;
 }
 
+// One attempt; no quads when the result does not tile the square.
 SquareQuads mesh_imprinted_square(int n, double r, int algorithm, int circle_segments) {
   gmsh::model::add("imprinted face");
   gmsh::vectorpair pieces;
@@ -515,20 +515,22 @@ SquareQuads mesh_imprinted_square(int n, double r, int algorithm, int circle_seg
   gmsh::option::setNumber("Mesh.Algorithm", 6);
 
   SquareQuads f;
-  std::vector<std::size_t> tags, elements, nodes, triangles;
+  std::vector<std::size_t> tags;
   std::vector<double> coords, parametric;
   gmsh::model::mesh::getNodes(tags, coords, parametric, -1, -1, true, false);
   std::map<std::size_t, Index> index;
-  for (std::size_t i = 0; i < tags.size(); ++i) {
-    index[tags[i]] = static_cast<Index>(f.points.size());
-    f.points.emplace_back(coords[3 * i], coords[3 * i + 1], 0.0);
-  }
-  gmsh::model::mesh::getElementsByType(3, elements, nodes);
-  for (std::size_t e = 0; e + 3 < nodes.size(); e += 4)
-    f.quads.push_back({index.at(nodes[e]), index.at(nodes[e + 1]), index.at(nodes[e + 2]), index.at(nodes[e + 3])});
-  gmsh::model::mesh::getElementsByType(2, elements, triangles);
+  for (std::size_t i = 0; i < tags.size(); ++i)
+    if (index.try_emplace(tags[i], static_cast<Index>(f.points.size())).second)
+      f.points.emplace_back(coords[3 * i], coords[3 * i + 1], 0.0);
+  // Fresh output vectors per call: Gmsh takes non-empty ones as preallocated.
+  std::vector<std::size_t> quads, quad_nodes, triangles, triangle_nodes;
+  gmsh::model::mesh::getElementsByType(3, quads, quad_nodes);
+  gmsh::model::mesh::getElementsByType(2, triangles, triangle_nodes);
   gmsh::model::remove();
-  if (!triangles.empty() || !all_convex(f)) f.quads.clear();
+  for (std::size_t e = 0; e + 3 < quad_nodes.size(); e += 4)
+    f.quads.push_back({index.at(quad_nodes[e]), index.at(quad_nodes[e + 1]), index.at(quad_nodes[e + 2]),
+                       index.at(quad_nodes[e + 3])});
+  if (!triangles.empty() || !tiles_square(f)) f.quads.clear();
   return f;
 }
 
@@ -540,8 +542,8 @@ SquareQuads imprinted_square(int n, double r) {
       SquareQuads f = mesh_imprinted_square(n, r, algorithm, segments + extra);
       if (!f.quads.empty()) return f;
     }
-  throw std::runtime_error("demo_fulcher: Gmsh's recombination left triangles or non-convex quads on the face with a circle of radius " +
-                           std::to_string(r) + " at n = " + std::to_string(n));
+  throw std::runtime_error("demo_fulcher: Gmsh's quads do not tile the face with a circle of radius " +
+                           std::to_string(r) + " at n = " + std::to_string(n) + " (triangles left or quads folded)");
 }
 
 // The face quads swept along `axis` from the nugget face (coordinate 1) to the box (2) in
