@@ -308,6 +308,24 @@ Model structured_unit_cube(const Point& corner, double h, const std::string& nam
   });
 }
 
+// The blocks (i, j, k) of the 3 x 3 x 3 split of [-2,2]^3 around the nugget [-1,1]^3 (block
+// (1, 1, 1)) for which keep(i, j, k) holds, as OCC boxes fragmented so that neighbours share faces.
+template <class Keep>
+gmsh::vectorpair split_box_blocks(Keep keep) {
+  const double edges[4] = {-2, -1, 1, 2};
+  gmsh::vectorpair blocks;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      for (int k = 0; k < 3; ++k)
+        if (keep(i, j, k))
+          blocks.push_back({3, gmsh::model::occ::addBox(edges[i], edges[j], edges[k], edges[i + 1] - edges[i],
+                                                        edges[j + 1] - edges[j], edges[k + 1] - edges[k])});
+  gmsh::vectorpair fragments;
+  std::vector<gmsh::vectorpair> map;
+  gmsh::model::occ::fragment(blocks, {}, fragments, map);
+  return fragments;
+}
+
 // Side set 1 "outside": the hex quads on the boundary of the box [-2,2]^3 around a nugget.
 void add_outside_side_set(Model& m) {
   SideSet outside{1, "outside", {}};
@@ -355,20 +373,8 @@ Model demo_half_block(int n) {
 Model demo_nugget(int n) {
   if (n < 2 || n % 2 != 0) throw InvalidInput("demo_nugget: n = " + std::to_string(n) + " must be even and >= 2");
   Model m = with_gmsh("demo_nugget", [n] {
-    const double edges[4] = {-2, -1, 1, 2};
-    gmsh::vectorpair blocks;
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j)
-        for (int k = 0; k < 3; ++k) {
-          if (i == 1 && j == 1 && k == 1) continue;
-          const int tag = gmsh::model::occ::addBox(edges[i], edges[j], edges[k], edges[i + 1] - edges[i],
-                                                   edges[j + 1] - edges[j], edges[k + 1] - edges[k]);
-          blocks.push_back({3, tag});
-        }
     // Shared faces between the hex blocks (not with the nugget: its faces carry triangles).
-    gmsh::vectorpair fragments;
-    std::vector<gmsh::vectorpair> map;
-    gmsh::model::occ::fragment(blocks, {}, fragments, map);
+    const gmsh::vectorpair fragments = split_box_blocks([](int i, int j, int k) { return i != 1 || j != 1 || k != 1; });
     const int nugget = gmsh::model::occ::addBox(-1, -1, -1, 2, 2, 2);
     gmsh::model::occ::synchronize();
     transfinite_curves(2.0 / n);
@@ -579,20 +585,9 @@ Model demo_fulcher(int n) {
   constexpr std::array<double, 3> radii{0.3, 0.5, 0.7};
   return run_gmsh("demo_fulcher", [&] {
     Model hexes = hex_part_from_gmsh("fulcher blocks", [n] {
-      const double edges[4] = {-2, -1, 1, 2};
-      gmsh::vectorpair blocks;
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-          for (int k = 0; k < 3; ++k) {
-            // The nugget and the three swept slabs (added below) are not structured blocks.
-            if ((i == 1) + (j == 1) + (k == 1) >= 2 && i + j + k >= 3) continue;
-            const int tag = gmsh::model::occ::addBox(edges[i], edges[j], edges[k], edges[i + 1] - edges[i],
-                                                     edges[j + 1] - edges[j], edges[k + 1] - edges[k]);
-            blocks.push_back({3, tag});
-          }
-      gmsh::vectorpair fragments;
-      std::vector<gmsh::vectorpair> map;
-      gmsh::model::occ::fragment(blocks, {}, fragments, map);
+      // The nugget and the three swept slabs (added below) are not structured blocks.
+      const gmsh::vectorpair fragments =
+          split_box_blocks([](int i, int j, int k) { return (i == 1) + (j == 1) + (k == 1) < 2 || i + j + k < 3; });
       gmsh::model::occ::synchronize();
       std::vector<int> volumes;
       for (const auto& [dim, tag] : fragments) {
