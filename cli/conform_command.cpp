@@ -295,12 +295,13 @@ void add_conform_commands(CLI::App& app) {
                  "delaunay-random: beside a Delaunay tet box, interface diagonals alternating or\n"
                  "random; cylinder: a swept hex cylinder with unstructured quad caps in a tet box;\n"
                  "lshape: a hex block in the notch of an L-shaped tet part (concave interface);\n"
-                 "nugget: a Delaunay tet cube in 26 structured blocks; fourtri: beside a Delaunay tet\n"
-                 "box whose interface quads are split into two or four triangles (at random);\n"
-                 "fourtri-cylinder: the cylinder with half its interface quads in four triangles")
+                 "nugget: a Delaunay tet cube in 26 structured blocks; fulcher: the same with circles\n"
+                 "imprinted on three nugget faces, those blocks swept from unstructured quads; fourtri:\n"
+                 "beside a Delaunay tet box whose interface quads are split into two or four triangles\n"
+                 "(at random); fourtri-cylinder: the cylinder with half its interface quads in four triangles")
       ->check(CLI::IsMember(conform::demo_model_names()))
       ->capture_default_str();
-  d->add_option("-n,--size", dargs->n, "cells per unit length (1 to 64; default 4; nugget rounds up to even)")
+  d->add_option("-n,--size", dargs->n, "cells per unit length (1 to 64; default 4; nugget, fulcher round up to even)")
       ->check(number_check(1, 64, true));
   d->add_option("--save-input", dargs->save_input,
                 "write the demo's input model (.msh, .exo, .e, .vtu, .vtk) to try `geode conform` on it;\n"

@@ -9,6 +9,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <numbers>
 #include <random>
 #include <utility>
 
@@ -328,6 +329,35 @@ Model structured_unit_cube(const Point& corner, double h, const std::string& nam
   });
 }
 
+// The blocks (i, j, k) of the 3 x 3 x 3 split of [-2,2]^3 around the nugget [-1,1]^3 (block
+// (1, 1, 1)) for which keep(i, j, k) holds, as OCC boxes fragmented so that neighbours share faces.
+template <class Keep>
+gmsh::vectorpair split_box_blocks(Keep keep) {
+  const double edges[4] = {-2, -1, 1, 2};
+  gmsh::vectorpair blocks;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      for (int k = 0; k < 3; ++k)
+        if (keep(i, j, k))
+          blocks.push_back({3, gmsh::model::occ::addBox(edges[i], edges[j], edges[k], edges[i + 1] - edges[i],
+                                                        edges[j + 1] - edges[j], edges[k + 1] - edges[k])});
+  gmsh::vectorpair fragments;
+  std::vector<gmsh::vectorpair> map;
+  gmsh::model::occ::fragment(blocks, {}, fragments, map);
+  return fragments;
+}
+
+// Side set 1 "outside": the hex quads on the boundary of the box [-2,2]^3 around a nugget.
+void add_outside_side_set(Model& m) {
+  SideSet outside{1, "outside", {}};
+  for (const BoundaryQuad& q : boundary_quads(hex_part(m))) {
+    Point c = Point::Zero();
+    for (Index v : q.nodes) c += m.points[static_cast<std::size_t>(v)] / 4.0;
+    if (c.cwiseAbs().maxCoeff() > 2.0 - 1e-9) outside.sides.push_back({{ElementKind::Hex, q.hex}, q.local_face});
+  }
+  m.side_sets.push_back(std::move(outside));
+}
+
 Model run_gmsh(const std::string& name, const std::function<Model()>& build) {
   GmshSession session;
   try {
@@ -364,20 +394,8 @@ Model demo_half_block(int n) {
 Model demo_nugget(int n) {
   if (n < 2 || n % 2 != 0) throw InvalidInput("demo_nugget: n = " + std::to_string(n) + " must be even and >= 2");
   Model m = with_gmsh("demo_nugget", [n] {
-    const double edges[4] = {-2, -1, 1, 2};
-    gmsh::vectorpair blocks;
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j)
-        for (int k = 0; k < 3; ++k) {
-          if (i == 1 && j == 1 && k == 1) continue;
-          const int tag = gmsh::model::occ::addBox(edges[i], edges[j], edges[k], edges[i + 1] - edges[i],
-                                                   edges[j + 1] - edges[j], edges[k + 1] - edges[k]);
-          blocks.push_back({3, tag});
-        }
     // Shared faces between the hex blocks (not with the nugget: its faces carry triangles).
-    gmsh::vectorpair fragments;
-    std::vector<gmsh::vectorpair> map;
-    gmsh::model::occ::fragment(blocks, {}, fragments, map);
+    const gmsh::vectorpair fragments = split_box_blocks([](int i, int j, int k) { return i != 1 || j != 1 || k != 1; });
     const int nugget = gmsh::model::occ::addBox(-1, -1, -1, 2, 2, 2);
     gmsh::model::occ::synchronize();
     transfinite_curves(2.0 / n);
@@ -397,14 +415,7 @@ Model demo_nugget(int n) {
     gmsh::model::addPhysicalGroup(3, {nugget}, 2);
     gmsh::model::setPhysicalName(3, 2, "tet nugget");
   });
-  // Side set: the outer boundary quads of the hex blocks.
-  SideSet outside{1, "outside", {}};
-  for (const BoundaryQuad& q : boundary_quads(hex_part(m))) {
-    Point c = Point::Zero();
-    for (Index v : q.nodes) c += m.points[static_cast<std::size_t>(v)] / 4.0;
-    if (c.cwiseAbs().maxCoeff() > 2.0 - 1e-9) outside.sides.push_back({{ElementKind::Hex, q.hex}, q.local_face});
-  }
-  m.side_sets.push_back(std::move(outside));
+  add_outside_side_set(m);
   return m;
 }
 
@@ -478,9 +489,152 @@ Model demo_l_shape(int n) {
   });
 }
 
+namespace {
+
+// An all-quad mesh of the square [-1,1]^2 (z = 0) with the circle of radius r about its centre
+// imprinted (the circle is a chain of quad edges), n uniform segments per side so that it meets
+// structured n x n faces. Blossom recombination leaves triangles on some inputs; the next 2D
+// algorithm (Frontal-Delaunay, Delaunay, MeshAdapt) or a circle with two more segments (the
+// circle and the annulus both need an even number of boundary segments) is tried until the
+// quads alone tile the square.
+struct SquareQuads {
+  std::vector<Point> points;
+  std::vector<std::array<Index, 4>> quads;
+};
+
+// Every quad strictly convex and counter-clockwise, their areas summing to the square's: the
+// quads tile it without a fold, an overlap or a hole.
+bool tiles_square(const SquareQuads& f) {
+  double area = 0;
+  for (const auto& q : f.quads) {
+    for (std::size_t k = 0; k < 4; ++k) {
+      const Point& a = f.points[static_cast<std::size_t>(q[(k + 3) % 4])];
+      const Point& b = f.points[static_cast<std::size_t>(q[k])];
+      const Point& c = f.points[static_cast<std::size_t>(q[(k + 1) % 4])];
+      if ((c - b).cross(a - b).z() <= 0) return false;
+      area += 0.5 * b.head<2>().homogeneous().cross(c.head<2>().homogeneous()).z();
+    }
+  }
+  return !f.quads.empty() && std::abs(area - 4.0) < 1e-9;
+}
+
+// One attempt; no quads when the result does not tile the square.
+SquareQuads mesh_imprinted_square(int n, double r, int algorithm, int circle_segments) {
+  gmsh::model::add("imprinted face");
+  gmsh::vectorpair pieces;
+  std::vector<gmsh::vectorpair> map;
+  gmsh::model::occ::fragment({{2, gmsh::model::occ::addRectangle(-1, -1, 0, 2, 2)}},
+                             {{2, gmsh::model::occ::addDisk(0, 0, 0, r, r)}}, pieces, map);
+  gmsh::model::occ::synchronize();
+  gmsh::vectorpair curves, surfaces;
+  gmsh::model::getEntities(curves, 1);
+  for (const auto& [dim, tag] : curves) {
+    const Box b = bounding_box(dim, tag);
+    const bool side = b[3] - b[0] < kEps || b[4] - b[1] < kEps;
+    gmsh::model::mesh::setTransfiniteCurve(tag, (side ? n : circle_segments) + 1);
+  }
+  gmsh::model::getEntities(surfaces, 2);
+  for (const auto& [dim, tag] : surfaces) gmsh::model::mesh::setRecombine(dim, tag);
+  gmsh::option::setNumber("Mesh.MeshSizeMax", 2.0 / n);
+  gmsh::option::setNumber("Mesh.Algorithm", algorithm);
+  gmsh::model::mesh::generate(2);
+  gmsh::option::setNumber("Mesh.MeshSizeMax", 1e22);
+  gmsh::option::setNumber("Mesh.Algorithm", 6);
+
+  SquareQuads f;
+  std::vector<std::size_t> tags;
+  std::vector<double> coords, parametric;
+  gmsh::model::mesh::getNodes(tags, coords, parametric, -1, -1, true, false);
+  std::map<std::size_t, Index> index;
+  for (std::size_t i = 0; i < tags.size(); ++i)
+    if (index.try_emplace(tags[i], static_cast<Index>(f.points.size())).second)
+      f.points.emplace_back(coords[3 * i], coords[3 * i + 1], 0.0);
+  // Fresh output vectors per call: Gmsh takes non-empty ones as preallocated.
+  std::vector<std::size_t> quads, quad_nodes, triangles, triangle_nodes;
+  gmsh::model::mesh::getElementsByType(3, quads, quad_nodes);
+  gmsh::model::mesh::getElementsByType(2, triangles, triangle_nodes);
+  gmsh::model::remove();
+  for (std::size_t e = 0; e + 3 < quad_nodes.size(); e += 4)
+    f.quads.push_back({index.at(quad_nodes[e]), index.at(quad_nodes[e + 1]), index.at(quad_nodes[e + 2]),
+                       index.at(quad_nodes[e + 3])});
+  if (!triangles.empty() || !tiles_square(f)) f.quads.clear();
+  return f;
+}
+
+SquareQuads imprinted_square(int n, double r) {
+  // About the cell size 2/n along the circle, even, at least 8.
+  const int segments = std::max(8, 2 * static_cast<int>(std::lround(std::numbers::pi * r * n / 2)));
+  for (int extra : {0, 2, 4})
+    for (int algorithm : {6, 5, 1}) {
+      SquareQuads f = mesh_imprinted_square(n, r, algorithm, segments + extra);
+      if (!f.quads.empty()) return f;
+    }
+  throw std::runtime_error("demo_fulcher: Gmsh's quads do not tile the face with a circle of radius " +
+                           std::to_string(r) + " at n = " + std::to_string(n) + " (triangles left or quads folded)");
+}
+
+// The face quads swept along `axis` from the nugget face (coordinate 1) to the box (2) in
+// `layers` equal layers, the face's (u, v) on the two other axes in cyclic order; block 1.
+void append_swept_slab(Model& m, const SquareQuads& face, int axis, int layers) {
+  const Index base = static_cast<Index>(m.points.size());
+  const Index count = static_cast<Index>(face.points.size());
+  for (int k = 0; k <= layers; ++k)
+    for (const Point& p : face.points) {
+      Point q;
+      q[axis] = 1.0 + static_cast<double>(k) / layers;
+      q[(axis + 1) % 3] = p.x();
+      q[(axis + 2) % 3] = p.y();
+      m.points.push_back(q);
+    }
+  for (int k = 0; k < layers; ++k)
+    for (const auto& quad : face.quads) {
+      std::array<Index, 8> h{};
+      for (std::size_t c = 0; c < 4; ++c) {
+        h[c] = base + k * count + quad[c];
+        h[c + 4] = base + (k + 1) * count + quad[c];
+      }
+      m.hexes.push_back(h);
+      m.hex_block.push_back(1);
+    }
+}
+
+}  // namespace
+
+Model demo_fulcher(int n) {
+  if (n < 2 || n % 2 != 0) throw InvalidInput("demo_fulcher: n = " + std::to_string(n) + " must be even and >= 2");
+  // Circle radii on the nugget faces x = 1, y = 1, z = 1.
+  constexpr std::array<double, 3> radii{0.3, 0.5, 0.7};
+  return run_gmsh("demo_fulcher", [&] {
+    Model hexes = hex_part_from_gmsh("fulcher blocks", [n] {
+      // The nugget and the three swept slabs (added below) are not structured blocks.
+      const gmsh::vectorpair fragments =
+          split_box_blocks([](int i, int j, int k) { return (i == 1) + (j == 1) + (k == 1) < 2 || i + j + k < 3; });
+      gmsh::model::occ::synchronize();
+      std::vector<int> volumes;
+      for (const auto& [dim, tag] : fragments) {
+        transfinite_box(tag, 2.0 / n);
+        volumes.push_back(tag);
+      }
+      gmsh::model::addPhysicalGroup(3, volumes, 1);
+      gmsh::model::setPhysicalName(3, 1, "hex blocks");
+    });
+    for (int axis = 0; axis < 3; ++axis)
+      append_swept_slab(hexes, imprinted_square(n, radii[static_cast<std::size_t>(axis)]), axis, n / 2);
+    merge_coincident_nodes(hexes, 1e-9);
+    orient_positively(hexes);
+    // The whole nugget boundary is interface: its triangles are the hex quads split in two.
+    Shell shell;
+    append_interface_triangles(shell, hexes, [](const Point& c) { return c.cwiseAbs().maxCoeff() < 1 + kEps; },
+                               diagonal_chooser(DemoDiagonals::kRandom, 2.0 / n), four_chooser(false));
+    Model m = join(std::move(hexes), tet_fill(shell, {}, 2, "tet nugget"));
+    add_outside_side_set(m);
+    return m;
+  });
+}
+
 const std::vector<std::string>& demo_model_names() {
   static const std::vector<std::string> names{"half", "delaunay", "delaunay-random", "cylinder",
-                                              "lshape", "nugget", "fourtri", "fourtri-cylinder"};
+                                              "lshape", "nugget", "fulcher", "fourtri", "fourtri-cylinder"};
   return names;
 }
 
@@ -491,11 +645,12 @@ Model demo_model(const std::string& name, int n) {
   if (name == "cylinder") return demo_cylinder(n);
   if (name == "lshape") return demo_l_shape(n);
   if (name == "nugget") return demo_nugget(n % 2 ? n + 1 : n);
+  if (name == "fulcher") return demo_fulcher(n % 2 ? n + 1 : n);
   if (name == "fourtri") return demo_delaunay_block(n, DemoDiagonals::kRandom, true);
   if (name == "fourtri-cylinder") return demo_cylinder(n, true);
   throw InvalidInput("demo model '" + name +
-                     "': expected one of half, delaunay, delaunay-random, cylinder, lshape, nugget, fourtri, "
-                     "fourtri-cylinder");
+                     "': expected one of half, delaunay, delaunay-random, cylinder, lshape, nugget, fulcher, "
+                     "fourtri, fourtri-cylinder");
 }
 
 }  // namespace geode::conform

@@ -52,9 +52,19 @@ Model demo_cylinder(int n = 4, bool four_triangles = false);
 // Delaunay tet part [0,2]^2 x [0,1] minus the notch, so the tet part wraps the interface edge.
 Model demo_l_shape(int n = 4);
 
+// (e) The paper's Section 4 example after Fulcher: the cube nugget [-1,1]^3 with circles of
+// radii 0.3, 0.5, 0.7 imprinted on its faces x = 1, y = 1, z = 1, filled with Gmsh Delaunay tets
+// (block 2 "tet nugget") inside the 26 blocks of a 3 x 3 x 3 split of [-2,2]^3 (block 1 "hex
+// blocks"): the three slabs on the imprinted faces are swept in n/2 layers from an unstructured
+// recombined quad mesh of the face (the circle a chain of quad edges), the other 23 blocks are
+// structured (n cells along a nugget edge, n/2 across a layer), so the interface quads are
+// unstructured on three faces. Interface diagonals random; side set 1 "outside" holds the outer
+// boundary quads. n must be even and >= 2.
+Model demo_fulcher(int n = 4);
+
 // The names `geode demo --model` takes: half, delaunay, delaunay-random, cylinder, lshape,
-// nugget (d: a convex Delaunay tet nugget in structured blocks), fourtri (a, random diagonals,
-// four-triangle quads), fourtri-cylinder (b with four-triangle quads).
+// nugget (d: a convex Delaunay tet nugget in structured blocks), fulcher (e), fourtri (a,
+// random diagonals, four-triangle quads), fourtri-cylinder (b with four-triangle quads).
 const std::vector<std::string>& demo_model_names();
 // The model of that name with size parameter n (made even where the model needs it); throws
 // InvalidInput naming an unknown name.
