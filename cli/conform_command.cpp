@@ -57,6 +57,7 @@ nlohmann::json result_json(const conform::ConformResult& r) {
   j["template_min_scaled_jacobian"] = r.template_min_scaled_jacobian;
   j["min_scaled_jacobian_before_smoothing"] = r.min_scaled_jacobian_before_smoothing;
   j["min_scaled_jacobian_after_smoothing"] = r.smoothing.final_min_scaled_jacobian;
+  j["hexes_inverted_by_placement"] = r.placement_inverted;
   j["buffer_layer_min_scaled_jacobian"] = r.buffer.min_scaled_jacobian;
   j["input_diced_alone_min_scaled_jacobian"] = {{"hexes", r.input_diced_hex_min_scaled_jacobian},
                                                 {"tets", r.input_diced_tet_min_scaled_jacobian}};
@@ -234,7 +235,8 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
   c->add_option("--report", a.report, "write a JSON report (counts, validity, quality per output block) to FILE.json");
   c->add_option("--smooth", a.smooth,
                 "worst-first smoothing, model boundary nodes sliding on the boundary; local (default):\n"
-                "near the geode hexes (see --smooth-target); global: every hex below 0.5; none")
+                "near the geode hexes (see --smooth-target); global: every hex below 0.5; none: only\n"
+                "hexes the placement inverted are untangled (the report counts them)")
       ->check(CLI::IsMember({"local", "global", "none"}))
       ->capture_default_str();
   c->add_option("--smooth-target", a.smooth_target,

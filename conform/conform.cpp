@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <sstream>
@@ -351,10 +352,8 @@ void Conformer::assemble() {
   node_sets_ = primal::diced_node_sets(layer_.model, diced_, renum);
   side_sets_ = primal::diced_side_sets(layer_.model, diced_, 0, res_.diced_hexes + res_.geode_hexes);
   diced_ = primal::DicedModel();
-  // Without smoothing the positions do not change: the inverted hexes found here are the
-  // verification's too.
-  res_.min_scaled_jacobian_before_smoothing = primal::min_scaled_jacobian(
-      mesh_, options_.smooth == ConformSmooth::kNone ? &inverted_ : nullptr);
+  res_.min_scaled_jacobian_before_smoothing = primal::min_scaled_jacobian(mesh_, &inverted_);
+  res_.placement_inverted = static_cast<Index>(inverted_.size());
 }
 
 // Automatic target: hexes near the transition below the yardstick are the defects; patches
@@ -367,8 +366,22 @@ constexpr int kDefectRings = 2;
 // the cost follows the interface (or, with the automatic target, its defects); global: every
 // hex.
 void Conformer::smooth() {
-  if (options_.smooth == ConformSmooth::kNone) return;
   t0_ = Clock::now();
+  if (options_.smooth == ConformSmooth::kNone) {
+    // No smoothing, but a hex the placement inverted (a buffer top folded at a convex edge or
+    // corner) is untangled, with the hexes within kDefectRings of it (a hex is untangled by
+    // moving its neighbours too), so that the result stays usable.
+    if (inverted_.empty()) return;
+    std::vector<Index> seeds = inverted_;
+    for (int ring = 0; ring < kDefectRings; ++ring) seeds = primal::hexes_around(mesh_, seeds);
+    res_.smoothing = primal::smooth_hexes_around(mesh_, seeds, options_.local_smooth_options);
+    res_.smoothing.initial_min_scaled_jacobian = res_.min_scaled_jacobian_before_smoothing;
+    inverted_.clear();
+    res_.smoothing.final_min_scaled_jacobian = primal::min_scaled_jacobian(mesh_, &inverted_);
+    say("untangling: " + std::to_string(res_.placement_inverted) + " hexes the placement inverted, " +
+        std::to_string(inverted_.size()) + " left" + took());
+    return;
+  }
   const bool local = options_.smooth == ConformSmooth::kLocal;
   primal::LocalSmoothOptions o = local ? options_.local_smooth_options : options_.global_smooth_options;
   auto last = Clock::now();
@@ -402,6 +415,7 @@ void Conformer::smooth() {
     res_.smoothing = primal::smooth_hexes_local(mesh_, constraints, &surface, {}, o);
   }
   res_.smoothing.initial_min_scaled_jacobian = res_.min_scaled_jacobian_before_smoothing;
+  inverted_.clear();
   res_.smoothing.final_min_scaled_jacobian = primal::min_scaled_jacobian(mesh_, &inverted_);
   const Index patches = res_.smoothing.patches;
   say("smoothing (" + std::string(local ? "local" : "global") + "): " +

@@ -49,7 +49,8 @@ struct ConformOptions {
   // The worst-first smoother (primal/local_smooth.hpp), model boundary nodes sliding in their
   // plane, along their feature edge or on the diced boundary triangulation. kLocal: patches
   // seeded near the geode hexes (see smooth_target), on the submesh around them; kGlobal: by
-  // every hex, with a higher target so that the diced parts are improved too.
+  // every hex, with a higher target so that the diced parts are improved too; kNone: nothing
+  // but untangling the hexes the placement inverted, if any (ConformResult::placement_inverted).
   ConformSmooth smooth = ConformSmooth::kLocal;
   // kLocal. 0 (automatic): the defects are the geode hexes and their neighbours below the
   // yardstick (the input's own hexes and tets diced alone, ConformResult); patches start on
@@ -105,7 +106,10 @@ struct ConformResult {
   // (primal::diced_min_scaled_jacobian), before the buffer layer moves anything.
   double input_diced_hex_min_scaled_jacobian = 1.0, input_diced_tet_min_scaled_jacobian = 1.0;
   double min_scaled_jacobian_before_smoothing = 0.0;
-  primal::LocalSmoothResult smoothing;  // zero-initialised when ConformSmooth::kNone
+  // Hexes the placement alone left with scaled Jacobian <= 0; ConformSmooth::kNone untangles
+  // them (patches seeded at them alone) and nothing else.
+  primal::Index placement_inverted = 0;
+  primal::LocalSmoothResult smoothing;  // kNone: the untangling only (zero when nothing was inverted)
   primal::HexValidityReport validity;
   std::vector<BlockQuality> quality;  // one per output block, ascending id ("block N" unnamed); ConformOptions::quality
   std::vector<std::string> warnings;  // e.g. "3 hexes with scaled Jacobian <= 0 (1-based output elements): 12 40 ..."

@@ -38,21 +38,27 @@ Index mixed_geode_hexes(const primal::Model& m) {
 
 }  // namespace
 
-TEST_CASE("realistic models, no smoothing: valid and untangled by the placement alone") {
+TEST_CASE("realistic models, --smooth none: valid; the placement alone inverts nothing but where counted") {
   conform::ConformOptions o;
   o.smooth = conform::ConformSmooth::kNone;
   // The curved cylinder and the convex nugget meet neighbouring buffer hexes at an angle: their
-  // shared side faces must take the same nodes from both templates.
+  // shared side faces must take the same nodes from both templates. On the Fulcher model the
+  // placement alone inverts geode hexes where buffer tops fold at the nugget's edges; kNone
+  // untangles them.
   const struct {
     const char* name;
     primal::Index quads;
-  } models[] = {{"delaunay", 9}, {"delaunay-random", 9}, {"lshape", 18}, {"nugget", 96}, {"cylinder", 146}};
-  for (const auto& [name, quads] : models) {
+    int n;
+    primal::Index inverted;  // by the placement alone, untangled by kNone
+  } models[] = {{"delaunay", 9, 3, 0}, {"delaunay-random", 9, 3, 0}, {"lshape", 18, 3, 0}, {"nugget", 96, 3, 0},
+                {"cylinder", 146, 3, 0}, {"fulcher", 143, 4, 6}};
+  for (const auto& [name, quads, n, inverted] : models) {
     CAPTURE(name);
-    const primal::Model m = conform::demo_model(name, 3);
+    const primal::Model m = conform::demo_model(name, n);
     REQUIRE(!m.tets.empty());
     const auto r = conform::conform(m, o);
     CHECK(r.interface_quads == quads);
+    CHECK(r.placement_inverted == inverted);
     test::check_conform_result(r);
   }
 }
