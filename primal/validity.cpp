@@ -512,43 +512,57 @@ HexValidityReport check_validity(const HexMesh& mesh) {
   // chain or ring through shared faces. A vertex's link (triangles = hexes, edges = faces,
   // vertices = edges at the vertex) must be connected with Euler characteristic 2 (sphere,
   // interior) or 1 (disk, boundary).
-  std::vector<std::pair<Index, EdgeKey>> bad_edges;  // (first use 12 p + e, edge)
-  DisjointSets uses_joined;                           // over the local uses
+  // Per node, independently: chunks of nodes run in parallel (TBB), each with its own scratch
+  // and findings, which are then joined in node order (the same result for any thread count).
   struct EdgeUse {
     Index other;  // the edge's other end
     Index use;    // 12 p + local edge
   };
-  std::vector<EdgeUse> edge_uses;
-  std::vector<std::pair<Index, int>> first_use_of_face;  // (face lead, local use)
-  std::vector<Index> others;
+  struct Scratch {
+    DisjointSets uses_joined;                           // over the local uses
+    std::vector<EdgeUse> edge_uses;
+    std::vector<std::pair<Index, int>> first_use_of_face;  // (face lead, local use)
+    std::vector<Index> others;
+    std::vector<CornerStar> stars;
+    std::vector<BoundaryWedge> wedges;
+  };
+  struct Found {
+    Index unused_nodes = 0, num_vertices = 0, num_edges = 0;
+    std::vector<Index> nonmanifold_vertices;
+    std::vector<NodeCoverage> overlapping_nodes;
+    std::vector<std::pair<Index, EdgeKey>> bad_edges;  // (first use 12 p + e, edge)
+  };
   // The covering at a manifold node: counted along the probe inside, else from solid angles;
   // nothing where a corner is not positive (its hexes are listed as inverted).
-  std::vector<CornerStar> stars;
-  std::vector<BoundaryWedge> wedges;
-  auto covering = [&](Index v, bool on_boundary) -> std::optional<NodeCoverage> {
+  auto covering = [&](Index v, bool on_boundary, Scratch& s) -> std::optional<NodeCoverage> {
     const auto flags = probe.flags(static_cast<std::size_t>(v));
     if (flags & ProbeCount::kNotPositive) return std::nullopt;
     if (!on_boundary && !(flags & ProbeCount::kNearFace)) {
       const int k = probe.containing(static_cast<std::size_t>(v));
       return NodeCoverage{v, 4.0 * kPi * k, 4.0 * kPi};
     }
-    stars.clear();
+    s.stars.clear();
     for (Index i = start[static_cast<std::size_t>(v)]; i < start[static_cast<std::size_t>(v) + 1]; ++i) {
       const Index p = around[static_cast<std::size_t>(i)];
       const int c = corner_of(p, v);
-      CornerStar& star = stars.emplace_back();
+      CornerStar& star = s.stars.emplace_back();
       for (int k = 0; k < 3; ++k) {
         star.ends[k] = hex(p)[topo::kHexCornerNeighbors[c][k]];
         star.boundary_without[k] = face_uses(p, inc.corner_face_without[c][k]) == 1;
       }
     }
-    return hex_coverage(mesh.points, v, stars, wedges);
+    return hex_coverage(mesh.points, v, s.stars, s.wedges);
   };
-  for (std::size_t v = 0; v < nv; ++v) {
+  auto visit = [&](std::size_t v, Scratch& s, Found& r) {
+    auto& uses_joined = s.uses_joined;
+    auto& edge_uses = s.edge_uses;
+    auto& first_use_of_face = s.first_use_of_face;
+    auto& others = s.others;
+    auto& bad_edges = r.bad_edges;
     const Index n = start[v + 1] - start[v];
     if (n == 0) {
       ++r.unused_nodes;
-      continue;
+      return;
     }
     ++r.num_vertices;
     uses_joined.reset(static_cast<std::size_t>(n));
@@ -582,7 +596,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     if (overshared || uses_joined.count() != 1 ||
         link_euler != (on_boundary ? 1 : 2)) {
       r.nonmanifold_vertices.push_back(static_cast<Index>(v));
-    } else if (const auto cover = covering(static_cast<Index>(v), on_boundary); cover && overlaps(*cover)) {
+    } else if (const auto cover = covering(static_cast<Index>(v), on_boundary, s); cover && overlaps(*cover)) {
       r.overlapping_nodes.push_back(*cover);
     }
 
@@ -612,6 +626,23 @@ HexValidityReport check_validity(const HexMesh& mesh) {
         bad_edges.emplace_back(edge_uses[i].use, edge_key(static_cast<Index>(v), edge_uses[i].other));
       i = j;
     }
+  };
+  constexpr std::size_t kChunk = 4096;
+  const std::size_t chunks = (nv + kChunk - 1) / kChunk;
+  std::vector<Found> found(chunks);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks), [&](const tbb::blocked_range<std::size_t>& range) {
+    Scratch scratch;
+    for (std::size_t c = range.begin(); c != range.end(); ++c)
+      for (std::size_t v = c * kChunk; v < std::min(nv, (c + 1) * kChunk); ++v) visit(v, scratch, found[c]);
+  });
+  std::vector<std::pair<Index, EdgeKey>> bad_edges;
+  for (Found& f : found) {
+    r.unused_nodes += f.unused_nodes;
+    r.num_vertices += f.num_vertices;
+    r.num_edges += f.num_edges;
+    r.nonmanifold_vertices.insert(r.nonmanifold_vertices.end(), f.nonmanifold_vertices.begin(), f.nonmanifold_vertices.end());
+    r.overlapping_nodes.insert(r.overlapping_nodes.end(), f.overlapping_nodes.begin(), f.overlapping_nodes.end());
+    bad_edges.insert(bad_edges.end(), f.bad_edges.begin(), f.bad_edges.end());
   }
   std::sort(bad_edges.begin(), bad_edges.end());
   for (const auto& [use, e] : bad_edges) r.nonmanifold_edges.push_back(e);
