@@ -211,11 +211,11 @@ const RefTemplate& reference_template(const Eigen::Vector3d& box, std::array<int
   }
   auto& geode = slot_of(4);
   if (!geode) geode = std::make_unique<RefTemplate>(make_reference(box, {4, 6}));
-  // Smoothed in a box half as tall: buffer hexes are flatter than the reference box, and the
-  // four-triangle template stacks more layers (its pillows) in the thickness; shapes smoothed at
-  // the flatter proportion keep its mapped hexes positive where the taller box's do not. Only
-  // reference coordinates are kept, so the sides still match the geode's.
-  const Eigen::Vector3d four_box(box.x(), 0.5 * box.y(), box.z());
+  // Smoothed in a flatter box than the geode's: the four-triangle template stacks more layers
+  // (its pillows) in the thickness; shapes smoothed at the flatter proportion keep its mapped
+  // hexes positive where the geode's box does not. Only reference coordinates are kept, so the
+  // sides still match the geode's.
+  const Eigen::Vector3d four_box(box.x(), 0.7 * box.y(), box.z());
   auto four = std::make_unique<RefTemplate>(make_reference(four_box, {4, 6}, templates::TopSplit::FourTriangles));
   impose_geode_sides(*four, *geode, four_box);
   slot = std::move(four);
