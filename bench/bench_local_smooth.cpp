@@ -48,7 +48,7 @@ void run(const std::string& name, const primal::Model& input, const primal::Loca
   mesh.points = r.model.points;
   mesh.hexes = r.model.hexes;
   mesh.block = r.model.hex_block;
-  const double buffer = static_cast<double>(r.geode_hexes) / 26.0;
+  const double buffer = static_cast<double>(r.interface_quads);
   std::vector<primal::Index> geode;
   // conform's output order: diced hexes, geode hexes, diced tets.
   for (primal::Index h = r.diced_hexes; h < r.diced_hexes + r.geode_hexes; ++h) geode.push_back(h);
@@ -106,7 +106,7 @@ int main(int argc, char** argv) {
     const auto t0 = std::chrono::steady_clock::now();
     const conform::ConformResult r = conform::conform(input, co);
     const double yardstick = std::min(r.input_diced_hex_min_scaled_jacobian, r.input_diced_tet_min_scaled_jacobian);
-    const double buffer = static_cast<double>(r.geode_hexes) / 26.0;
+    const double buffer = static_cast<double>(r.interface_quads);
     std::printf("  whole conform (defaults): %.3f s CPU, %.3f s wall, valid %s, min SJ %.4f = %.2f x the input diced alone;"
                 " its smoothing %.3f s wall = %.2f ms per buffer hex, %d patches\n",
                 static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC,
