@@ -188,9 +188,12 @@ void run_template(const TemplateArgs& a) {
   o.push = a.push;
   const bool refine = a.name == "refine3" || a.name == "refine3-2d";
   if (a.name == "geode4tri") o.split = templates::TopSplit::FourTriangles;
+  templates::RefineOptions ro = a.refine;
+  ro.box = o.box;
+  if (a.refine_roofs) ro.high_roof = a.push.high_roof, ro.low_roof = a.push.low_roof;
   if (format == "spec") {
-    if (refine) throw InvalidInput("--format spec: " + a.name + " has no spec yet (geode3d, geode2d, geode4tri have)");
-    const std::string text = templates::format_spec(templates::spec_json(templates::geode_spec(o, dim)));
+    const auto spec = refine ? templates::refine_spec(ro, dim) : templates::geode_spec(o, dim);
+    const std::string text = templates::format_spec(templates::spec_json(spec));
     write_or_print(a.output, [&](std::ostream& os) { os << text; });
     return;
   }
@@ -200,15 +203,13 @@ void run_template(const TemplateArgs& a) {
   out.smooth = !a.no_smooth, out.slide = a.slide, out.quality = a.quality;
   templates::Template T;
   if (refine) {
-    templates::RefineOptions ro = a.refine;
-    ro.box = o.box;
-    if (a.refine_roofs) ro.high_roof = a.push.high_roof, ro.low_roof = a.push.low_roof;
     T = a.name == "refine3" ? templates::build_refine3(ro) : templates::build_refine3_2d(ro);
     out.check_conditions = false;
     out.smoother = [ro, fixed = !a.slide](templates::Template& t) { return templates::smooth_refine3(t, ro, fixed); };
     if (format == "html") {
-      const templates::RefineArrangement R = templates::refine3_arrangement(ro, dim);
-      out.sheets = R.sheets, out.domain = R.domain;
+      // The refinement's spec is in the box already.
+      const templates::ArrangementSpec spec = templates::refine_spec(ro, dim);
+      out.sheets = templates::spec_sheets(spec), out.domain = spec.domain;
     }
   } else {
     T = dim == 2 ? templates::build_geode2d(o) : templates::build_geode3d(o);
@@ -217,9 +218,9 @@ void run_template(const TemplateArgs& a) {
       const templates::GeodeArrangement G = templates::geode_arrangement(o, dim);
       out.sheets = G.sheets, out.domain = G.domain;
     }
+    // The geode's arrangement is built in the reference cell; the nodes are mapped to the box.
+    out.to_physical = [box = o.box, dim](const primal::Point& r) { return templates::box_point(r, box, dim); };
   }
-  // The arrangements above are built in the reference cell; the nodes are mapped to the box.
-  out.to_physical = [box = o.box, dim](const primal::Point& r) { return templates::box_point(r, box, dim); };
   std::ostringstream cmd;
   cmd << "geode template " << a.name << " --box " << box_text;
   if (!refine)

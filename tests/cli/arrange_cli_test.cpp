@@ -68,7 +68,7 @@ std::string three_planes_and(const std::string& extra) {
 }  // namespace
 
 TEST_CASE("geode arrange: the shipped specs are the built-in templates") {
-  for (const std::string name : {"geode3d", "geode2d", "geode4tri"}) {
+  for (const std::string name : {"geode3d", "geode2d", "geode4tri", "refine3", "refine3-2d"}) {
     CAPTURE(name);
     const std::filesystem::path shipped = std::filesystem::path(GEODE_SOURCE_DIR) / "notebooks-data/specs" / (name + ".json");
     const auto spec = geode_cli("template " + name + " --format spec");
