@@ -227,6 +227,17 @@ void run_template(const TemplateArgs& a) {
     cmd << " --diagonal " << a.diagonal << " --higher " << a.higher << " --high-roof " << o.push.high_roof
         << " --low-roof " << o.push.low_roof << " --dome-depth " << o.push.dome_depth << " --dome-radius "
         << o.push.dome_radius;
+  // The wider dome family, where it differs from the defaults.
+  const templates::PushParameters plain;
+  if (!refine) {
+    if (o.push.centre_depth != plain.centre_depth) cmd << " --centre-depth " << o.push.centre_depth;
+    if (o.push.centre_radius != plain.centre_radius) cmd << " --centre-radius " << o.push.centre_radius;
+    if (o.push.dome_exponent != plain.dome_exponent) cmd << " --dome-exponent " << o.push.dome_exponent;
+    if (o.push.centre_exponent != plain.centre_exponent) cmd << " --centre-exponent " << o.push.centre_exponent;
+    if (o.push.dome_offset != plain.dome_offset) cmd << " --dome-offset " << o.push.dome_offset;
+    if (o.push.centre_offset != plain.centre_offset)
+      cmd << " --centre-offset " << o.push.centre_offset[0] << " " << o.push.centre_offset[1];
+  }
   if (a.slide) cmd << " --slide";
   out.caption = cmd.str();
   if (a.name == "geode4tri" && !a.no_fixup) {
@@ -383,6 +394,21 @@ void add_template_command(CLI::App& app) {
                 "push, geode4tri: radius blend of the centre vertex's dome (0: --dome-radius)")
       ->check(number_check())
       ->capture_default_str();
+  t->add_option("--dome-exponent", args->push.dome_exponent,
+                "push: superquadric exponent p of the domes (|x|^p + |y|^p + |z|^p level sets; 2: spheroids)")
+      ->check(number_check())
+      ->capture_default_str();
+  t->add_option("--centre-exponent", args->push.centre_exponent,
+                "push, geode4tri: exponent of the centre vertex's dome (0: --dome-exponent)")
+      ->check(number_check())
+      ->capture_default_str();
+  t->add_option("--dome-offset", args->push.dome_offset,
+                "push: move each corner dome's centre along the tet side toward its centre, fraction of the way")
+      ->check(number_check())
+      ->capture_default_str();
+  t->add_option("--centre-offset", args->push.centre_offset,
+                "push, geode4tri: move the centre vertex's dome by X Z, fractions of the half-width")
+      ->check(number_check());
   t->add_option("--layer", args->refine.layer, "refine3: height of the horizontal layer sheet, below both roofs")
       ->check(number_check())
       ->capture_default_str();
