@@ -145,7 +145,6 @@ std::vector<Dome> complete_domes(const InterfacePatch& patch, double v_top,
     Dome d;
     d.vertex = v;
     d.radius = R;
-    d.centre = V;
     if (round)
       d.sheet = {"dome " + std::to_string(v), [V, R, depth, v_top](const Point& x) {
                    const double r = (flat(x) - V).norm() / R, y = (v_top - x[1]) / depth;

@@ -59,7 +59,6 @@ struct Dome {
   stc::Sheet sheet;
   int vertex;     // interface vertex it goes around
   double radius;  // R
-  Point centre;   // where its axis meets the interface plane (the vertex unless offset)
 };
 std::vector<Dome> complete_domes(const InterfacePatch& triangles, double v_top, double depth,
                                 double blend = 0.5);

@@ -5,11 +5,11 @@
 // completed sheet arrangement. Nothing is typed in.
 //
 // Completion, in the box (fine side at the bottom): every dual chord of the fine side is
-// completed into a sheet. In each direction
-// the fine side has three parallel chords; the middle one is the coarse side's chord too and
-// goes straight up as a plane; the outer two are paired into a tunnel (an elliptic arch over
-// both). The side faces' chord (crossing the cell's vertical edges) is a horizontal layer
-// below both roofs. 3D: two tunnels, two middle planes, one layer; 2D: one of each.
+// completed into a sheet. In each direction the fine side has three parallel chords; the
+// middle one is the coarse side's chord too and goes straight up as a plane; the outer two are
+// paired into a tunnel (an elliptic arch over both). The side faces' chord (crossing the
+// cell's vertical edges) is a horizontal layer below both roofs. 3D: two tunnels, two middle
+// planes, one layer; 2D: one of each.
 #include <Eigen/Core>
 
 #include "stc/arrangement.hpp"

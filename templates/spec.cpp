@@ -174,9 +174,8 @@ PushParameters Reader::push(const json& j) const {
   }
   std::string key;
   if (const std::string why = push_error(p, &key); !why.empty()) {
-    // The roofs' order is a fault of the pair; name the one given, else the object.
-    const bool pair = key == "low_roof";
-    fail(pair ? "push" : join("push", key), why);
+    // The roofs' order is a fault of the pair, so it names the push object; others their key.
+    fail(key == "low_roof" ? "push" : join("push", key), why);
   }
   return p;
 }
