@@ -105,7 +105,10 @@ void run_interleave(const InterleaveArgs& a) {
     else
       log << "error";
     log << "  e.g. push " << c.example.high_roof << " " << c.example.low_roof << " " << c.example.dome_depth << " "
-        << c.example.dome_radius << "\n      " << c.key << "\n";
+        << c.example.dome_radius;
+    for (std::size_t i = 0; i < c.example_parameters.size(); ++i)
+      log << (i ? ", " : "; ") << study.parameter_names[i] << " " << c.example_parameters[i];
+    log << "\n      " << c.key << "\n";
   }
 }
 

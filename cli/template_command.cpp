@@ -188,9 +188,12 @@ void run_template(const TemplateArgs& a) {
   o.push = a.push;
   const bool refine = a.name == "refine3" || a.name == "refine3-2d";
   if (a.name == "geode4tri") o.split = templates::TopSplit::FourTriangles;
+  templates::RefineOptions ro = a.refine;
+  ro.box = o.box;
+  if (a.refine_roofs) ro.high_roof = a.push.high_roof, ro.low_roof = a.push.low_roof;
   if (format == "spec") {
-    if (refine) throw InvalidInput("--format spec: " + a.name + " has no spec yet (geode3d, geode2d, geode4tri have)");
-    const std::string text = templates::format_spec(templates::spec_json(templates::geode_spec(o, dim)));
+    const auto spec = refine ? templates::refine_spec(ro, dim) : templates::geode_spec(o, dim);
+    const std::string text = templates::format_spec(templates::spec_json(spec));
     write_or_print(a.output, [&](std::ostream& os) { os << text; });
     return;
   }
@@ -200,15 +203,13 @@ void run_template(const TemplateArgs& a) {
   out.smooth = !a.no_smooth, out.slide = a.slide, out.quality = a.quality;
   templates::Template T;
   if (refine) {
-    templates::RefineOptions ro = a.refine;
-    ro.box = o.box;
-    if (a.refine_roofs) ro.high_roof = a.push.high_roof, ro.low_roof = a.push.low_roof;
     T = a.name == "refine3" ? templates::build_refine3(ro) : templates::build_refine3_2d(ro);
     out.check_conditions = false;
     out.smoother = [ro, fixed = !a.slide](templates::Template& t) { return templates::smooth_refine3(t, ro, fixed); };
     if (format == "html") {
-      const templates::RefineArrangement R = templates::refine3_arrangement(ro, dim);
-      out.sheets = R.sheets, out.domain = R.domain;
+      // The refinement's spec is in the box already.
+      const templates::ArrangementSpec spec = templates::refine_spec(ro, dim);
+      out.sheets = templates::spec_sheets(spec), out.domain = spec.domain;
     }
   } else {
     T = dim == 2 ? templates::build_geode2d(o) : templates::build_geode3d(o);
@@ -217,15 +218,26 @@ void run_template(const TemplateArgs& a) {
       const templates::GeodeArrangement G = templates::geode_arrangement(o, dim);
       out.sheets = G.sheets, out.domain = G.domain;
     }
+    // The geode's arrangement is built in the reference cell; the nodes are mapped to the box.
+    out.to_physical = [box = o.box, dim](const primal::Point& r) { return templates::box_point(r, box, dim); };
   }
-  // The arrangements above are built in the reference cell; the nodes are mapped to the box.
-  out.to_physical = [box = o.box, dim](const primal::Point& r) { return templates::box_point(r, box, dim); };
   std::ostringstream cmd;
   cmd << "geode template " << a.name << " --box " << box_text;
   if (!refine)
     cmd << " --diagonal " << a.diagonal << " --higher " << a.higher << " --high-roof " << o.push.high_roof
         << " --low-roof " << o.push.low_roof << " --dome-depth " << o.push.dome_depth << " --dome-radius "
         << o.push.dome_radius;
+  // The wider dome family, where it differs from the defaults.
+  const templates::PushParameters plain;
+  if (!refine) {
+    if (o.push.centre_depth != plain.centre_depth) cmd << " --centre-depth " << o.push.centre_depth;
+    if (o.push.centre_radius != plain.centre_radius) cmd << " --centre-radius " << o.push.centre_radius;
+    if (o.push.dome_exponent != plain.dome_exponent) cmd << " --dome-exponent " << o.push.dome_exponent;
+    if (o.push.centre_exponent != plain.centre_exponent) cmd << " --centre-exponent " << o.push.centre_exponent;
+    if (o.push.dome_offset != plain.dome_offset) cmd << " --dome-offset " << o.push.dome_offset;
+    if (o.push.centre_offset != plain.centre_offset)
+      cmd << " --centre-offset " << o.push.centre_offset[0] << " " << o.push.centre_offset[1];
+  }
   if (a.slide) cmd << " --slide";
   out.caption = cmd.str();
   if (a.name == "geode4tri" && !a.no_fixup) {
@@ -382,6 +394,21 @@ void add_template_command(CLI::App& app) {
                 "push, geode4tri: radius blend of the centre vertex's dome (0: --dome-radius)")
       ->check(number_check())
       ->capture_default_str();
+  t->add_option("--dome-exponent", args->push.dome_exponent,
+                "push: superquadric exponent p of the domes (|x|^p + |y|^p + |z|^p level sets; 2: spheroids)")
+      ->check(number_check())
+      ->capture_default_str();
+  t->add_option("--centre-exponent", args->push.centre_exponent,
+                "push, geode4tri: exponent of the centre vertex's dome (0: --dome-exponent)")
+      ->check(number_check())
+      ->capture_default_str();
+  t->add_option("--dome-offset", args->push.dome_offset,
+                "push: move each corner dome's centre along the tet side toward its centre, fraction of the way")
+      ->check(number_check())
+      ->capture_default_str();
+  t->add_option("--centre-offset", args->push.centre_offset,
+                "push, geode4tri: move the centre vertex's dome by X Z, fractions of the half-width")
+      ->check(number_check());
   t->add_option("--layer", args->refine.layer, "refine3: height of the horizontal layer sheet, below both roofs")
       ->check(number_check())
       ->capture_default_str();

@@ -3,7 +3,7 @@
 
 Run: /usr/bin/python3 notebooks-data/plot.py   (needs Debian's python3-matplotlib)
 Writes next to this script: sj-histogram-geode3d.png, shape-height.png, shape-distorted.png,
-interleave-geode3d.png, interleave-geode4tri.png. Reads only CSVs written by `geode study`.
+interleave-geode3d.png, interleave-geode4tri.png, interleave-geode4tri-domes.png. Reads only CSVs written by `geode study`.
 """
 import csv
 import os
@@ -156,9 +156,52 @@ def interleave(name):
     save(fig, f"interleave-{name}.png")
 
 
+def domes():
+    """The four-triangle cell over the wider dome family (specs/geode4tri-domes.json's sweep)."""
+    name = "geode4tri-domes"
+    data = rows(f"interleave-{name}.csv")
+    summary = {r["class"]: r for r in rows(f"interleave-{name}-summary.csv")}
+    usable = [c for c, s in summary.items() if s["usable"] == "1"]
+    dome_p = sorted({float(r["push.dome_exponent"]) for r in data})
+    centre_p = sorted({float(r["push.centre_exponent"]) for r in data})
+    depths = sorted({float(r["push.centre_depth"]) for r in data})
+    fig, axes = plt.subplots(1, len(depths), figsize=(4.2 * len(depths) + 3.6, 4.4), squeeze=False)
+    axes = axes[0]
+    for ax, depth in zip(axes, depths):
+        grid = [[0] * len(dome_p) for _ in centre_p]
+        for i, cp in enumerate(centre_p):
+            for k, dp in enumerate(dome_p):
+                cell = [r for r in data if float(r["push.centre_depth"]) == depth
+                        and float(r["push.centre_exponent"]) == cp and float(r["push.dome_exponent"]) == dp]
+                good = sum(r["class"] in usable for r in cell)
+                valid = sum(r["outcome"] == "valid" for r in cell)
+                grid[i][k] = good / max(1, len(cell))
+                ax.text(k, i, f"{good}\n{valid}/{len(cell)}", ha="center", va="center", fontsize=8)
+        ax.imshow(grid, origin="lower", cmap="Greens", vmin=0, vmax=1, aspect="auto")
+        ax.set_xticks(range(len(dome_p)), [f"{p:g}" for p in dome_p])
+        ax.set_yticks(range(len(centre_p)), [f"{p:g}" for p in centre_p])
+        ax.set_xlabel("corner dome exponent p")
+        ax.set_title(f"centre dome depth {depth:g}", fontsize=9)
+    axes[0].set_ylabel("centre dome exponent")
+    lines = ["obstruction-free classes (all usable):"]
+    for c in usable:
+        s = summary[c]
+        lines.append(f"{c}: {s['hexes']} hexes, {s['count']} runs,\n    min SJ {float(s['min_sj_fixed']):.2f} fixed"
+                     f" / {float(s['min_sj_slide']):.2f} sliding")
+    valid = [s for s in summary.values() if s["outcome"] == "valid"]
+    lines.append(f"\n{len(valid)} valid classes, {len(summary) - len(valid)} diagnoses,\n{len(data)} pushes")
+    fig.text(1 - 3.5 / (4.2 * len(depths) + 3.6), 0.5, "\n".join(lines), fontsize=8, va="center")
+    fig.suptitle(f"{name}: pushes giving an obstruction-free (usable) template per cell: count, then valid/all "
+                 "(over dome offset,\ncentre offset, corner depth, radius blend; geode study interleave --spec "
+                 "specs/geode4tri-domes.json)", fontsize=9)
+    fig.subplots_adjust(left=0.07, right=1 - 3.7 / (4.2 * len(depths) + 3.6), wspace=0.25, top=0.84, bottom=0.12)
+    save(fig, f"interleave-{name}.png")
+
+
 if __name__ == "__main__":
     histogram()
     height()
     distorted()
     interleave("geode3d")
     interleave("geode4tri")
+    domes()

@@ -103,18 +103,33 @@ DicedPatch dice_patch(const InterfacePatch& p) {
 }
 
 std::vector<Dome> complete_domes(const InterfacePatch& patch, double v_top, double k, double blend) {
+  return complete_domes(patch, v_top, [k, blend](int) { return DomeShape{k, blend, 2.0, Point::Zero()}; });
+}
+
+std::vector<Dome> complete_domes(const InterfacePatch& patch, double v_top,
+                                 const std::function<DomeShape(int vertex)>& shape) {
   const DicedPatch diced = dice_patch(patch);
   std::vector<Dome> out;
   for (int v = 0; v < static_cast<int>(patch.points.size()); ++v) {
     bool used = false;
     for (const auto& c : patch.cells) used |= std::find(c.begin(), c.end(), v) != c.end();
     if (!used) continue;
-    const Point V = flat(patch.points[static_cast<std::size_t>(v)]);
-    // The circle around v encloses the diced nodes that belong to v (v itself, the midpoints of
+    const DomeShape s = shape(v);
+    const double p = s.exponent;
+    if (!(p >= 1) || !std::isfinite(p)) throw InvalidInput("complete_domes: the exponent must be >= 1 and finite");
+    const bool round = p == 2.0;
+    const Point V = flat(patch.points[static_cast<std::size_t>(v)]) + flat(s.offset);
+    // In-plane distance from the dome's centre: Euclidean for p = 2 (the spheroid's own
+    // formula), else the p-norm whose unit ball is the superquadric's trace.
+    const auto distance = [V, p, round](const Point& x) {
+      const Point d = flat(x) - V;
+      return round ? d.norm() : std::pow(std::pow(std::abs(d[0]), p) + std::pow(std::abs(d[2]), p), 1.0 / p);
+    };
+    // The trace around v encloses the diced nodes that belong to v (v itself, the midpoints of
     // its edges, the centres of its cells) and leaves out all others.
     double inside = 0.0, outside = std::numeric_limits<double>::max();
     for (std::size_t n = 0; n < diced.nodes.size(); ++n) {
-      const double d = (flat(diced.nodes[n]) - V).norm();
+      const double d = distance(diced.nodes[n]);
       const auto& own = diced.owners[n];
       if (std::find(own.begin(), own.end(), v) != own.end())
         inside = std::max(inside, d);
@@ -122,17 +137,25 @@ std::vector<Dome> complete_domes(const InterfacePatch& patch, double v_top, doub
         outside = std::min(outside, d);
     }
     if (!(inside < outside))
-      throw TopologyError("complete_domes: no circle around interface vertex " + std::to_string(v) +
+      throw TopologyError("complete_domes: no " + std::string(round ? "circle" : "superquadric trace") +
+                          " around interface vertex " + std::to_string(v) +
                           " separates its diced nodes from the others");
-    const double R = inside + blend * (outside - inside);
-    const double depth = k;
+    const double R = inside + s.blend * (outside - inside);
+    const double depth = s.depth;
     Dome d;
     d.vertex = v;
     d.radius = R;
-    d.sheet = {"dome " + std::to_string(v), [V, R, depth, v_top](const Point& x) {
-                 const double r = (flat(x) - V).norm() / R, y = (v_top - x[1]) / depth;
-                 return r * r + y * y - 1.0;
-               }, "dome"};
+    if (round)
+      d.sheet = {"dome " + std::to_string(v), [V, R, depth, v_top](const Point& x) {
+                   const double r = (flat(x) - V).norm() / R, y = (v_top - x[1]) / depth;
+                   return r * r + y * y - 1.0;
+                 }, "dome"};
+    else
+      d.sheet = {"dome " + std::to_string(v), [V, R, depth, v_top, p](const Point& x) {
+                   const Point q = flat(x) - V;
+                   return std::pow(std::abs(q[0]) / R, p) + std::pow(std::abs(q[2]) / R, p) +
+                          std::pow(std::abs(v_top - x[1]) / depth, p) - 1.0;
+                 }, "dome"};
     out.push_back(d);
   }
   return out;

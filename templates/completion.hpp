@@ -63,4 +63,19 @@ struct Dome {
 std::vector<Dome> complete_domes(const InterfacePatch& triangles, double v_top, double depth,
                                 double blend = 0.5);
 
+// A wider dome family: each vertex's dome gets its own depth and blend, a superquadric shape
+// f = |dx / R|^p + |dz / R|^p + |(v_top - v) / depth|^p - 1 (p = 2 is the spheroid above,
+// computed by the same formula bit for bit), and a centre moved off the vertex within the
+// interface plane by `offset`. R and the blend are then measured in the same p-norm from that
+// centre, so the dome's trace on the interface still separates the vertex's diced nodes from
+// the others (TopologyError when no such trace exists).
+struct DomeShape {
+  double depth = 0.9;
+  double blend = 0.5;
+  double exponent = 2.0;
+  Point offset = Point::Zero();  // in the interface plane (its v component is ignored)
+};
+std::vector<Dome> complete_domes(const InterfacePatch& triangles, double v_top,
+                                 const std::function<DomeShape(int vertex)>& shape);
+
 }  // namespace geode::templates

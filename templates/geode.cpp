@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <regex>
 #include <set>
 #include <tuple>
@@ -23,6 +24,9 @@ stc::Domain reference_domain(int dim) {
   if (dim == 2) return {Point(-1, 0, 0), Point(1, 1, 0), 2};
   return {Point(-1, 0, -1), Point(1, 1, 1), 3};
 }
+
+// The tet side's centre vertex (the four-triangle split's), in the reference cell.
+bool is_face_centre(const Point& p) { return std::abs(p.x()) < 1e-12 && std::abs(p.z()) < 1e-12; }
 
 std::string corner_name(const Point& p) {
   return std::string("(") + (p[0] < 0 ? "-x" : "+x") + "," + (p[2] < 0 ? "-z" : "+z") + ")";
@@ -186,13 +190,30 @@ std::pair<InterfacePatch, InterfacePatch> reference_patches(const GeodeOptions& 
 
 }  // namespace
 
-std::string push_error(const PushParameters& p) {
+std::string push_error(const PushParameters& p, std::string* key) {
+  const auto fault = [key](const char* name, const char* why) {
+    if (key) *key = name;
+    return std::string(why);
+  };
   if (!(0 < p.low_roof && p.low_roof < p.high_roof && p.high_roof < 1))
-    return "tunnel roofs must satisfy 0 < low < high < 1 (tunnels must not reach the tet side)";
-  if (!(0 < p.dome_depth && p.dome_depth < 1)) return "dome depth must be in (0, 1) (domes must not reach the hex side)";
-  if (!(0 < p.dome_radius && p.dome_radius < 1)) return "dome radius blend must be in (0, 1)";
+    return fault("low_roof", "tunnel roofs must satisfy 0 < low < high < 1 (tunnels must not reach the tet side)");
+  if (!(0 < p.dome_depth && p.dome_depth < 1))
+    return fault("dome_depth", "dome depth must be in (0, 1) (domes must not reach the hex side)");
+  if (!(0 < p.dome_radius && p.dome_radius < 1)) return fault("dome_radius", "dome radius blend must be in (0, 1)");
   if (!(p.centre_depth >= 0 && p.centre_depth < 1 && p.centre_radius >= 0 && p.centre_radius < 1))
-    return "centre dome depth and radius blend must be in [0, 1) (0: as the corner domes)";
+    return fault(p.centre_depth >= 0 && p.centre_depth < 1 ? "centre_radius" : "centre_depth",
+                 "centre dome depth and radius blend must be in [0, 1) (0: as the corner domes)");
+  // Beyond 20 the superquadric is a box to the arrangement's sampling, and below 1 not convex.
+  if (!(p.dome_exponent >= 1 && p.dome_exponent <= 20))
+    return fault("dome_exponent", "dome exponent must be in [1, 20] (2: spheroids)");
+  if (!(p.centre_exponent == 0 || (p.centre_exponent >= 1 && p.centre_exponent <= 20)))
+    return fault("centre_exponent", "centre dome exponent must be 0 (as the corner domes) or in [1, 20]");
+  if (!(p.dome_offset >= 0 && p.dome_offset < 1))
+    return fault("dome_offset", "dome offset must be in [0, 1) (a fraction of the way to the tet side's centre)");
+  for (int a = 0; a < 2; ++a)
+    if (!(std::abs(p.centre_offset[static_cast<std::size_t>(a)]) < 1))
+      return fault(a == 0 ? "centre_offset[0]" : "centre_offset[1]",
+                   "centre dome offsets must be in (-1, 1) (fractions of the half-width)");
   return "";
 }
 
@@ -203,14 +224,20 @@ std::vector<stc::Sheet> complete_interface(const InterfacePatch& bottom, const I
     const bool along_x = std::abs(along.x()) > std::abs(along.z());
     return along_x == (higher == Higher::X) ? p.high_roof : p.low_roof;
   });
-  auto domes = complete_domes(top, 1.0, p.dome_depth, p.dome_radius);
-  if (p.centre_depth > 0 || p.centre_radius > 0) {
-    // Only the four-triangle split has a centre vertex: the last patch point, vertex 4.
-    const auto centre = complete_domes(top, 1.0, p.centre_depth > 0 ? p.centre_depth : p.dome_depth,
-                                       p.centre_radius > 0 ? p.centre_radius : p.dome_radius);
-    for (auto& d : domes)
-      if (d.vertex == 4) d = centre.back();
-  }
+  const auto domes = complete_domes(top, 1.0, [&](int v) {
+    const Point& x = top.points[static_cast<std::size_t>(v)];
+    DomeShape s{p.dome_depth, p.dome_radius, p.dome_exponent, Point::Zero()};
+    if (is_face_centre(x)) {
+      if (p.centre_depth > 0) s.depth = p.centre_depth;
+      if (p.centre_radius > 0) s.blend = p.centre_radius;
+      if (p.centre_exponent > 0) s.exponent = p.centre_exponent;
+      s.offset = Point(p.centre_offset[0], 0, p.centre_offset[1]);
+    } else if (p.dome_offset > 0) {
+      // Toward the tet side's centre (u = w = 0 in the reference cell).
+      s.offset = -p.dome_offset * Point(x[0], 0, x[2]);
+    }
+    return s;
+  });
   std::vector<stc::Sheet> sheets;
   for (const auto& t : tunnels) {
     stc::Sheet s = t.sheet;
@@ -221,8 +248,7 @@ std::vector<stc::Sheet> complete_interface(const InterfacePatch& bottom, const I
     stc::Sheet s = d.sheet;
     const Point& v = top.points[static_cast<std::size_t>(d.vertex)];
     s.name = dim == 2 ? std::string("dome ") + (v.x() < 0 ? "-x" : "+x")
-                      : (std::abs(v.x()) < 1e-12 && std::abs(v.z()) < 1e-12 ? std::string("dome centre")
-                                                                             : "dome " + corner_name(v));
+                      : (is_face_centre(v) ? std::string("dome centre") : "dome " + corner_name(v));
     // A spec's tet side may have several vertices in one quadrant: names must stay unique.
     for (const auto& other : sheets)
       if (other.name == s.name) s.name += " " + std::to_string(d.vertex);
@@ -253,6 +279,12 @@ ArrangementSpec geode_spec(const GeodeOptions& o, int dim) {
 
 namespace {
 
+// A face whose cells the dual must have; name is for diagnoses, e.g. "hex-side".
+struct PrescribedFace {
+  DicedPatch cells;  // nodes and cells; owners are not read
+  const char* name;
+};
+
 // The dual as a Template: nodes on the bottom (hex- or fine-side) and top faces placed at their
 // prescribed cells' nodes when those are given.
 Template dual_template(const stc::DualMesh& D, const std::vector<stc::Sheet>& sheets, const stc::Domain& dom,
@@ -279,13 +311,6 @@ Template dual_template(const stc::DualMesh& D, const std::vector<stc::Sheet>& sh
 
 }  // namespace
 
-Template template_from_dual(const stc::DualMesh& D, const std::vector<stc::Sheet>& sheets, const stc::Domain& dom,
-                            const PrescribedFace& bottom, const PrescribedFace& top, const Eigen::Vector3d& box) {
-  Template T = dual_template(D, sheets, dom, &bottom, &top);
-  for (auto& q : T.dim == 3 ? T.hex.points : T.quad.points) q = box_point(q, box, T.dim);
-  return T;
-}
-
 Template build_template(const ArrangementSpec& spec, const stc::ArrangementOptions& options) {
   const std::vector<stc::Sheet> sheets = spec_sheets(spec);
   const stc::Arrangement A = stc::compute_arrangement(sheets, spec.domain, options);
@@ -296,7 +321,12 @@ Template build_template(const ArrangementSpec& spec, const stc::ArrangementOptio
     const PrescribedFace top{dice_patch(spec.completion->tet_side), "tet-side"};
     T = dual_template(D, sheets, spec.domain, &bottom, &top);
   } else {
-    T = dual_template(D, sheets, spec.domain, nullptr, nullptr);
+    // A "faces" block's cells are taken as they are, not diced.
+    const auto as_given = [](const std::optional<InterfacePatch>& p, const char* name) {
+      return p ? std::optional<PrescribedFace>(PrescribedFace{DicedPatch{p->points, p->cells, {}}, name}) : std::nullopt;
+    };
+    const auto bottom = as_given(spec.bottom_face, "faces.bottom"), top = as_given(spec.top_face, "faces.top");
+    T = dual_template(D, sheets, spec.domain, bottom ? &*bottom : nullptr, top ? &*top : nullptr);
   }
   T.checks = check_interleave(A, T.sheets, sheets);
   return T;

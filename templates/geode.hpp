@@ -2,6 +2,7 @@
 // Geode transition templates derived from completed dual sheet arrangements (the paper's
 // Section 2). Nothing here is typed in: each template is the dual of its arrangement.
 #include <Eigen/Core>
+#include <array>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,16 @@ struct PushParameters {
   // (0: the same as the corner domes'), a wider family than one depth for all.
   double centre_depth = 0.0;
   double centre_radius = 0.0;
+  // Superquadric domes (templates/completion.hpp DomeShape): the exponent p of the corner
+  // domes' |x|^p + |y|^p + |z|^p level sets (2: spheroids) and of the centre dome's (0: as the
+  // corners'). The centre dome is the one over a vertex at the tet side's centre.
+  double dome_exponent = 2.0;
+  double centre_exponent = 0.0;
+  // Domes off their vertices: every other dome's centre moves along the tet side toward the
+  // side's centre by this fraction of the way; the centre dome's by (x, z), fractions of the
+  // half-width.
+  double dome_offset = 0.0;
+  std::array<double, 2> centre_offset{0.0, 0.0};
 };
 
 // The buffer cell: an axis-aligned box centred at the origin, y up; the tet side (diced
@@ -102,8 +113,10 @@ GeodeArrangement geode_arrangement(const GeodeOptions& options, int dim);
 Point box_point(const Point& reference, const Eigen::Vector3d& box, int dim);
 
 // Why a push cannot be used ("" when it can): roofs 0 < low < high < 1, depth and radius
-// blend in (0, 1).
-std::string push_error(const PushParameters& push);
+// blend in (0, 1), exponents in [1, 20] (the centre's may be 0), dome offset in [0, 1), centre
+// offsets in (-1, 1). `key` (when given) receives the offending field's name, e.g.
+// "dome_exponent" or "centre_offset[1]" ("low_roof" for the roofs' order).
+std::string push_error(const PushParameters& push, std::string* key = nullptr);
 
 // Complete the hex side's chords into tunnels and the tet side's vertices into domes and push
 // them together, in the reference cell: the tunnels first ("tunnel x", "tunnel z"; 2D
@@ -121,24 +134,14 @@ ArrangementSpec geode_spec(const GeodeOptions& options, int dim);
 // completion block, tet- and hex-side nodes are placed exactly where dicing puts them; a node
 // is matched to its diced position by the sides of every sheet it lies on, so a boundary that
 // differs from the prescribed diced interface is an error, not a silent mismatch. Other nodes
-// get the dual's first guess (see smoothing). Throws TopologyError with the diagnosis when the
-// arrangement does not dualize to a valid mesh.
+// get the dual's first guess (see smoothing). A "faces" block's cells are matched the same way
+// and their nodes placed at the given points. Throws TopologyError with the diagnosis when the
+// arrangement does not dualize to a valid mesh or to the prescribed faces.
 Template build_template(const ArrangementSpec& spec, const stc::ArrangementOptions& options = {});
 
 // build_template(geode_spec(options, 3 or 2)); InvalidInput for a degenerate box or push.
 Template build_geode3d(const GeodeOptions& options);
 
-// The dual of a reference-cell arrangement (u, w in [-1, 1], v in [0, 1]) as a Template in the
-// box: the nodes on the bottom (v = 0) and top (v = 1) faces are matched to the prescribed
-// cells' nodes by the sides of every sheet and placed there (TopologyError naming `name` when
-// the dual's boundary differs from the prescribed cells), then everything is mapped to the box.
-struct PrescribedFace {
-  DicedPatch cells;  // nodes (reference coordinates) and cells; owners are not read
-  const char* name;  // for diagnoses, e.g. "hex-side"
-};
-Template template_from_dual(const stc::DualMesh& dual, const std::vector<stc::Sheet>& sheets,
-                            const stc::Domain& domain, const PrescribedFace& bottom, const PrescribedFace& top,
-                            const Eigen::Vector3d& box);
 Template build_geode2d(const GeodeOptions& options);
 
 // Place the template's free nodes by optimization (primal/smooth.hpp): untangle, then maximise

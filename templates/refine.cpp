@@ -7,25 +7,28 @@
 #include <string>
 
 #include "primal/errors.hpp"
-#include "stc/dualize.hpp"
+#include "templates/spec.hpp"
 
 namespace geode::templates {
 namespace {
 
+using nlohmann::json;
+
 constexpr int kRefinement = 3;
 
-// The refined (or coarse) face of the reference cell: a k x k grid of quads (k x 1 segments
-// in 2D) at height v.
-DicedPatch grid_face(int k, double v, int dim) {
-  DicedPatch d;
-  const auto at = [k](int i) { return -1.0 + 2.0 * i / k; };
+// The refined (or coarse) face of the box: a k x k grid of quads (k segments in 2D) at height
+// y, nodes in lexicographic order.
+InterfacePatch grid_face(int k, double y, const Eigen::Vector3d& box, int dim) {
+  InterfacePatch d;
+  d.dim = dim;
+  const auto at = [k](int i, double width) { return width * (2.0 * i - k) / (2.0 * k); };
   if (dim == 2) {
-    for (int i = 0; i <= k; ++i) d.nodes.push_back(Point(at(i), v, 0));
+    for (int i = 0; i <= k; ++i) d.points.push_back(Point(at(i, box.x()), y, 0));
     for (int i = 0; i < k; ++i) d.cells.push_back({i, i + 1});
     return d;
   }
   for (int j = 0; j <= k; ++j)
-    for (int i = 0; i <= k; ++i) d.nodes.push_back(Point(at(i), v, at(j)));
+    for (int i = 0; i <= k; ++i) d.points.push_back(Point(at(i, box.x()), y, at(j, box.z())));
   const auto n = [k](int i, int j) { return i + (k + 1) * j; };
   for (int j = 0; j < k; ++j)
     for (int i = 0; i < k; ++i) d.cells.push_back({n(i, j), n(i + 1, j), n(i + 1, j + 1), n(i, j + 1)});
@@ -34,37 +37,44 @@ DicedPatch grid_face(int k, double v, int dim) {
 
 // Where the dual chords of a face cross the axis `axis`: the midpoints between consecutive
 // node coordinates on that axis.
-std::vector<double> chord_offsets(const DicedPatch& face, int axis) {
+std::vector<double> chord_offsets(const InterfacePatch& face, int axis) {
   std::set<double> c;
-  for (const auto& p : face.nodes) c.insert(p[axis]);
+  for (const auto& p : face.points) c.insert(p[axis]);
   const std::vector<double> x(c.begin(), c.end());
   std::vector<double> mid;
   for (std::size_t i = 0; i + 1 < x.size(); ++i) mid.push_back(0.5 * (x[i] + x[i + 1]));
   return mid;
 }
 
-// The sheets completing the fine side's chords that cross axis `axis` (u = 0, w = 2): the
-// chord the coarse side shares becomes a plane; the two outer ones pair into a tunnel of
-// roof `roof` over them.
-void complete_chords(const DicedPatch& fine, const DicedPatch& coarse, int axis, double roof, const std::string& suffix,
-                     std::vector<stc::Sheet>& tunnels, std::vector<stc::Sheet>& planes) {
-  const std::vector<double> f = chord_offsets(fine, axis), c = chord_offsets(coarse, axis);
-  if (f.size() != static_cast<std::size_t>(kRefinement) || c.size() != 1 || std::abs(f[1] - c[0]) > 1e-12)
-    throw InvalidInput("refine3: the fine side must be the 3-refinement of the coarse side");
-  const double mid = c[0], centre = 0.5 * (f.front() + f.back()), a = 0.5 * (f.back() - f.front());
-  tunnels.push_back({"tunnel" + suffix, [axis, centre, a, roof](const Point& x) {
-                       const double d = (x[axis] - centre) / a, y = x[1] / roof;
-                       return d * d + y * y - 1.0;
-                     }, "tunnel"});
-  planes.push_back({"middle" + suffix, [axis, mid](const Point& x) { return x[axis] - mid; }, "plane"});
+json vec(const Point& p, int dim) { return dim == 3 ? json{p.x(), p.y(), p.z()} : json{p.x(), p.y()}; }
+
+SheetSpec sheet(const std::string& name, const std::string& kind, json shape) {
+  return {name, kind, json{{kind, std::move(shape)}}};
 }
 
-Template build(const RefineOptions& o, int dim) {
-  const RefineArrangement R = refine3_arrangement(o, dim);
-  const stc::Arrangement A = stc::compute_arrangement(R.sheets, R.domain, o.arrangement);
-  const stc::DualMesh D = stc::dualize(A);
-  return template_from_dual(D, R.sheets, R.domain, {R.fine, "fine-side"}, {R.coarse, "coarse-side"}, o.box);
+// The sheets completing the fine side's chords that cross axis `axis` (x = 0, z = 2): the
+// chord the coarse side shares becomes a plane; the two outer ones pair into a tunnel of roof
+// height `roof` over them (the spec's tunnel shape, footed on the fine face at y = foot).
+void complete_chords(const InterfacePatch& fine, const InterfacePatch& coarse, int axis, double roof, double foot,
+                     const std::string& suffix, int dim, std::vector<SheetSpec>& tunnels, std::vector<SheetSpec>& planes) {
+  const std::vector<double> f = chord_offsets(fine, axis), c = chord_offsets(coarse, axis);
+  const double width = f.empty() ? 0.0 : f.back() - f.front();
+  if (f.size() != static_cast<std::size_t>(kRefinement) || c.size() != 1 || std::abs(f[1] - c[0]) > 1e-12 * width)
+    throw InvalidInput("refine3: the fine side must be the 3-refinement of the coarse side");
+  Point centre = Point::Zero(), normal = Point::Zero();
+  centre[axis] = 0.5 * (f.front() + f.back());
+  centre.y() = foot;
+  normal[axis] = 1.0;
+  json tunnel = {{"point", vec(centre, dim)}, {"half_width", 0.5 * width}, {"height", roof}};
+  // A tunnel runs across the axis its chords cross: along z over x, along x over z.
+  if (dim == 3) tunnel["along"] = axis == 0 ? json{0.0, 0.0, 1.0} : json{1.0, 0.0, 0.0};
+  tunnels.push_back(sheet("tunnel" + suffix, "tunnel", tunnel));
+  Point mid = Point::Zero();
+  mid[axis] = c[0];
+  planes.push_back(sheet("middle" + suffix, "plane", {{"point", vec(mid, dim)}, {"normal", vec(normal, dim)}}));
 }
+
+Template build(const RefineOptions& o, int dim) { return build_template(refine_spec(o, dim), o.arrangement); }
 
 int sheet_index(const Template& t, const std::string& name) {
   for (std::size_t s = 0; s < t.sheets.size(); ++s)
@@ -74,7 +84,7 @@ int sheet_index(const Template& t, const std::string& name) {
 
 }  // namespace
 
-RefineArrangement refine3_arrangement(const RefineOptions& o, int dim) {
+ArrangementSpec refine_spec(const RefineOptions& o, int dim) {
   if (dim != 2 && dim != 3) throw InvalidInput("refine3: dimension must be 2 or 3");
   for (int a = 0; a < dim; ++a)
     if (!(o.box[a] > 0) || !std::isfinite(o.box[a])) throw InvalidInput("refine3: box dimensions must be positive and finite");
@@ -83,23 +93,26 @@ RefineArrangement refine3_arrangement(const RefineOptions& o, int dim) {
   if (!order)
     throw InvalidInput(dim == 2 ? "refine3: heights must satisfy 0 < layer < roof < 1"
                                 : "refine3: heights must satisfy 0 < layer < low roof < high roof < 1");
-  RefineArrangement R;
-  R.domain = dim == 2 ? stc::Domain(Point(-1, 0, 0), Point(1, 1, 0), 2) : stc::Domain(Point(-1, 0, -1), Point(1, 1, 1), 3);
-  R.fine = grid_face(kRefinement, 0.0, dim);
-  R.coarse = grid_face(1, 1.0, dim);
-  std::vector<stc::Sheet> tunnels, planes;
+  ArrangementSpec spec;
+  spec.dim = dim;
+  const Point half(0.5 * o.box.x(), 0.5 * o.box.y(), dim == 3 ? 0.5 * o.box.z() : 0.0);
+  spec.domain = stc::Domain(-half, half, dim);
+  const double bottom = -half.y(), height = o.box.y();
+  spec.bottom_face = grid_face(kRefinement, bottom, o.box, dim);
+  spec.top_face = grid_face(1, half.y(), o.box, dim);
+  std::vector<SheetSpec> tunnels, planes;
   if (dim == 2) {
-    complete_chords(R.fine, R.coarse, 0, o.high_roof, "", tunnels, planes);
+    complete_chords(*spec.bottom_face, *spec.top_face, 0, o.high_roof * height, bottom, "", dim, tunnels, planes);
   } else {
-    // Chords running along x cross the w axis (2), those along z the u axis (0).
-    complete_chords(R.fine, R.coarse, 2, o.high_roof, " x", tunnels, planes);
-    complete_chords(R.fine, R.coarse, 0, o.low_roof, " z", tunnels, planes);
+    // Chords running along x cross the z axis (2), those along z the x axis (0).
+    complete_chords(*spec.bottom_face, *spec.top_face, 2, o.high_roof * height, bottom, " x", dim, tunnels, planes);
+    complete_chords(*spec.bottom_face, *spec.top_face, 0, o.low_roof * height, bottom, " z", dim, tunnels, planes);
   }
-  R.sheets = tunnels;
-  R.sheets.insert(R.sheets.end(), planes.begin(), planes.end());
-  const double layer = o.layer;
-  R.sheets.push_back({"layer", [layer](const Point& x) { return x[1] - layer; }, "plane"});
-  return R;
+  spec.sheets = tunnels;
+  spec.sheets.insert(spec.sheets.end(), planes.begin(), planes.end());
+  spec.sheets.push_back(sheet("layer", "plane",
+                              {{"point", vec(Point(0, bottom + o.layer * height, 0), dim)}, {"normal", vec(Point::UnitY(), dim)}}));
+  return spec;
 }
 
 Template build_refine3(const RefineOptions& options) { return build(options, 3); }

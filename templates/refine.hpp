@@ -4,12 +4,12 @@
 // refinement below (2D: one coarse edge over three fine ones), derived as the dual of a
 // completed sheet arrangement. Nothing is typed in.
 //
-// Completion, in the reference cell of templates/completion.hpp (u, w in [-1, 1] across, v in
-// [0, 1] up): every dual chord of the fine side is completed into a sheet. In each direction
-// the fine side has three parallel chords; the middle one is the coarse side's chord too and
-// goes straight up as a plane; the outer two are paired into a tunnel (an elliptic arch over
-// both). The side faces' chord (crossing the cell's vertical edges) is a horizontal layer
-// below both roofs. 3D: two tunnels, two middle planes, one layer; 2D: one of each.
+// Completion, in the box (fine side at the bottom): every dual chord of the fine side is
+// completed into a sheet. In each direction the fine side has three parallel chords; the
+// middle one is the coarse side's chord too and goes straight up as a plane; the outer two are
+// paired into a tunnel (an elliptic arch over both). The side faces' chord (crossing the
+// cell's vertical edges) is a horizontal layer below both roofs. 3D: two tunnels, two middle
+// planes, one layer; 2D: one of each.
 #include <Eigen/Core>
 
 #include "stc/arrangement.hpp"
@@ -27,18 +27,17 @@ struct RefineOptions {
   stc::ArrangementOptions arrangement;
 };
 
-// The completed arrangement before it is computed: sheets (tunnels, middle planes, layer) in
-// the reference cell, and the two prescribed faces (fine below, coarse above).
-struct RefineArrangement {
-  std::vector<stc::Sheet> sheets;
-  stc::Domain domain;
-  DicedPatch fine, coarse;
-};
-RefineArrangement refine3_arrangement(const RefineOptions& options, int dim);
+// The template as an arrangement spec (templates/spec.hpp) in the box, centred at the origin:
+// the fine face (3 x 3 quads; 2D: 3 segments) prescribed on the bottom, the coarse one on top
+// (a "faces" block), and the sheets as shapes: tunnels ("tunnel x", "tunnel z"; 2D "tunnel"),
+// middle planes ("middle x", "middle z"; 2D "middle"), then "layer". InvalidInput for heights
+// out of order or a degenerate box.
+struct ArrangementSpec;
+ArrangementSpec refine_spec(const RefineOptions& options, int dim);
 
-// Compute and dualize the arrangement; the fine and coarse faces' nodes are placed where the
-// refinement puts them (TopologyError if the dual's boundary differs), the rest at the dual's
-// first guess. InvalidInput for heights out of order or a degenerate box.
+// build_template(refine_spec(options, 3 or 2)): the fine and coarse faces' nodes are placed
+// where the refinement puts them (TopologyError if the dual's boundary differs), the rest at
+// the dual's first guess.
 Template build_refine3(const RefineOptions& options);
 Template build_refine3_2d(const RefineOptions& options);
 

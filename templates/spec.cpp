@@ -75,7 +75,10 @@ class Reader {
   static std::string index(const std::string& path, int i) { return path + "[" + std::to_string(i) + "]"; }
 
   stc::Domain domain(const json& j) const;
-  InterfacePatch patch(const json& j, const std::string& path, const stc::Domain& box, bool top) const;
+  // prescribed: a "faces" block's face (quads or segments, any number), else a completion's
+  // side (the hex side one quad, the tet side triangles).
+  InterfacePatch patch(const json& j, const std::string& path, const stc::Domain& box, bool top,
+                       bool prescribed = false) const;
   PushParameters push(const json& j) const;
   stc::Field shape(const json& j, const std::string& path) const;
 
@@ -113,7 +116,8 @@ stc::Domain Reader::domain(const json& j) const {
   }
 }
 
-InterfacePatch Reader::patch(const json& j, const std::string& path, const stc::Domain& box, bool top) const {
+InterfacePatch Reader::patch(const json& j, const std::string& path, const stc::Domain& box, bool top,
+                             bool prescribed) const {
   object(j, path, {"points", "cells"});
   InterfacePatch p;
   p.dim = dim_;
@@ -127,11 +131,12 @@ InterfacePatch Reader::patch(const json& j, const std::string& path, const stc::
       if (x[a] < box.lo[a] - eps || x[a] > box.hi[a] + eps) fail(at, "must lie in the domain");
     p.points.push_back(x);
   });
-  const std::size_t k = dim_ == 2 ? 2 : (top ? 3 : 4);
+  const bool triangles = top && !prescribed;
+  const std::size_t k = dim_ == 2 ? 2 : (triangles ? 3 : 4);
   each(member(j, path, "cells"), join(path, "cells"), 1, [&](const json& c, const std::string& at) {
     if (!c.is_array() || c.size() != k)
       fail(at, "must be " + std::to_string(k) + " point indices (" +
-                   (dim_ == 2 ? "a segment" : top ? "a triangle" : "a quad") + ")");
+                   (dim_ == 2 ? "a segment" : triangles ? "a triangle" : "a quad") + ")");
     std::vector<int> cell;
     for (std::size_t i = 0; i < k; ++i) {
       if (!c[i].is_number_integer() || c[i].get<long long>() < 0 ||
@@ -141,12 +146,14 @@ InterfacePatch Reader::patch(const json& j, const std::string& path, const stc::
     }
     p.cells.push_back(cell);
   });
-  if (!top && p.cells.size() != 1) fail(join(path, "cells"), "the hex side is one cell (its tunnels are its chords)");
+  if (!top && !prescribed && p.cells.size() != 1)
+    fail(join(path, "cells"), "the hex side is one cell (its tunnels are its chords)");
   return p;
 }
 
 PushParameters Reader::push(const json& j) const {
-  object(j, "push", {"high_roof", "low_roof", "dome_depth", "dome_radius", "centre_depth", "centre_radius"});
+  object(j, "push", {"high_roof", "low_roof", "dome_depth", "dome_radius", "centre_depth", "centre_radius",
+                     "dome_exponent", "centre_exponent", "dome_offset", "centre_offset"});
   PushParameters p;
   const auto get = [&](const char* key, double& x) {
     if (j.contains(key)) x = number(j[key], join("push", key));
@@ -157,7 +164,19 @@ PushParameters Reader::push(const json& j) const {
   get("dome_radius", p.dome_radius);
   get("centre_depth", p.centre_depth);
   get("centre_radius", p.centre_radius);
-  if (const std::string why = push_error(p); !why.empty()) fail("push", why);
+  get("dome_exponent", p.dome_exponent);
+  get("centre_exponent", p.centre_exponent);
+  get("dome_offset", p.dome_offset);
+  if (j.contains("centre_offset")) {
+    const json& c = j["centre_offset"];
+    if (!c.is_array() || c.size() != 2) fail("push.centre_offset", "must be [x, z] (fractions of the half-width)");
+    for (std::size_t a = 0; a < 2; ++a) p.centre_offset[a] = number(c[a], index("push.centre_offset", static_cast<int>(a)));
+  }
+  std::string key;
+  if (const std::string why = push_error(p, &key); !why.empty()) {
+    // The roofs' order is a fault of the pair, so it names the push object; others their key.
+    fail(key == "low_roof" ? "push" : join("push", key), why);
+  }
   return p;
 }
 
@@ -341,7 +360,9 @@ json patch_json(const InterfacePatch& p) {
 // Keys in the order a reader expects them (the rest after, alphabetically).
 int key_rank(const std::string& key) {
   static const std::vector<std::string> order = {"dim", "domain", "completion", "hex_side", "tet_side", "higher",
+                                                 "faces", "bottom", "top",
                                                  "push", "high_roof", "low_roof", "dome_depth", "dome_radius", "centre_depth", "centre_radius",
+                                                 "dome_exponent", "centre_exponent", "dome_offset", "centre_offset",
                                                  "sheets", "name", "kind", "sweep"};
   const auto it = std::find(order.begin(), order.end(), key);
   return it == order.end() ? static_cast<int>(order.size()) : static_cast<int>(it - order.begin());
@@ -411,7 +432,7 @@ json::json_pointer pointer(const std::string& path, const std::string& source) {
 
 ArrangementSpec parse_spec(const json& j, const std::string& source) {
   Reader top(source, 3);
-  top.object(j, "", {"dim", "domain", "completion", "push", "sheets", "sweep", "comment"});
+  top.object(j, "", {"dim", "domain", "completion", "faces", "push", "sheets", "sweep", "comment"});
   ArrangementSpec spec;
   const json& d = top.member(j, "", "dim");
   if (!d.is_number_integer() || (d.get<long long>() != 2 && d.get<long long>() != 3)) top.fail("dim", "must be 2 or 3");
@@ -434,6 +455,15 @@ ArrangementSpec parse_spec(const json& j, const std::string& source) {
     spec.completion = cs;
   } else if (j.contains("push")) {
     r.fail("push", "is read by a completion block, and there is none");
+  }
+  if (j.contains("faces")) {
+    const json& f = j["faces"];
+    r.object(f, "faces", {"bottom", "top"});
+    if (spec.completion) r.fail("faces", "a completion block prescribes both faces already");
+    if (spec.domain.corners) r.fail("faces", "needs a box domain (the faces are its low-y and high-y faces)");
+    if (f.empty()) r.fail("faces", "give bottom, top or both");
+    if (f.contains("bottom")) spec.bottom_face = r.patch(f["bottom"], "faces.bottom", spec.domain, false, true);
+    if (f.contains("top")) spec.top_face = r.patch(f["top"], "faces.top", spec.domain, true, true);
   }
 
   std::set<std::string> names;
@@ -512,7 +542,14 @@ json spec_json(const ArrangementSpec& s) {
     // The centre dome's own depth and radius: written only when set (0 means as the corners').
     if (c.push.centre_depth > 0) j["push"]["centre_depth"] = c.push.centre_depth;
     if (c.push.centre_radius > 0) j["push"]["centre_radius"] = c.push.centre_radius;
+    // The wider dome family likewise, only off its defaults (spheroids on their vertices).
+    if (c.push.dome_exponent != 2.0) j["push"]["dome_exponent"] = c.push.dome_exponent;
+    if (c.push.centre_exponent > 0) j["push"]["centre_exponent"] = c.push.centre_exponent;
+    if (c.push.dome_offset > 0) j["push"]["dome_offset"] = c.push.dome_offset;
+    if (c.push.centre_offset[0] != 0 || c.push.centre_offset[1] != 0) j["push"]["centre_offset"] = c.push.centre_offset;
   }
+  if (s.bottom_face) j["faces"]["bottom"] = patch_json(*s.bottom_face);
+  if (s.top_face) j["faces"]["top"] = patch_json(*s.top_face);
   if (!s.sheets.empty()) {
     j["sheets"] = json::array();
     for (const auto& sh : s.sheets) {

@@ -9,6 +9,7 @@
 //               {"name": "s", "sphere": {"center": [..], "radius": r}}, ...],
 //    "completion": {"hex_side": {...}, "tet_side": {...}, "higher": "x"},   (optional)
 //    "push": {"high_roof": .., "low_roof": .., "dome_depth": .., "dome_radius": ..},
+//    "faces": {"bottom": {"points": [..], "cells": [..]}, "top": {...}},     (optional)
 //    "sweep": {"push.high_roof": [0.55, 0.75], ...}}                         (study input)
 //
 // Shapes (each field negative inside, the completion builders' algebraic forms): plane, line,
@@ -55,6 +56,11 @@ struct ArrangementSpec {
   int dim = 3;
   stc::Domain domain;
   std::optional<CompletionSpec> completion;
+  // Prescribed boundary faces without a completion (the "faces" block): cells on the box
+  // domain's low-y ("bottom") and high-y ("top") face, quads in 3D, segments in 2D, taken as
+  // they are (not diced). The dual must have exactly these cells there; their nodes are
+  // placed at the given points (as a completion's diced nodes are).
+  std::optional<InterfacePatch> bottom_face, top_face;
   std::vector<SheetSpec> sheets;  // after the completion's sheets
   nlohmann::json sweep;           // the "sweep" block as given (null when absent)
 };

@@ -228,6 +228,7 @@ InterleaveStudy interleave_study(const std::vector<InterleaveCase>& cases, const
     int count = 0;
     int ok = 0;
     PushParameters example;
+    std::vector<double> example_parameters;
     Template example_template;  // valid classes
   };
   std::map<std::pair<bool, std::string>, Outcome> outcomes;
@@ -254,7 +255,7 @@ InterleaveStudy interleave_study(const std::vector<InterleaveCase>& cases, const
     }
     run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     auto& oc = outcomes[{run.valid, key}];
-    if (oc.count == 0) oc = {run.valid, key, run.hexes, 0, 0, run.push, std::move(t)};
+    if (oc.count == 0) oc = {run.valid, key, run.hexes, 0, 0, run.push, run.parameters, std::move(t)};
     ++oc.count;
     oc.ok += run.conditions_ok ? 1 : 0;
     keys.push_back(key);
@@ -279,6 +280,7 @@ InterleaveStudy interleave_study(const std::vector<InterleaveCase>& cases, const
     c.count = oc->count;
     c.conditions_ok = oc->ok;
     c.example = oc->example;
+    c.example_parameters = oc->example_parameters;
     if (c.valid) measure_class(c, oc->example_template);
     if (progress) progress("classes", study.classes.size() + 1, order.size());
     label[{c.valid, c.key}] = c.label;
@@ -305,7 +307,9 @@ void write_interleave_csv(std::ostream& out, const InterleaveStudy& study) {
 
 void write_interleave_summary(std::ostream& out, const InterleaveStudy& study) {
   out << "class,outcome,count,hexes,conditions_ok,example_high_roof,example_low_roof,example_dome_depth,"
-         "example_dome_radius,key,obstructions,min_sj_fixed,min_sj_slide,usable\n";
+         "example_dome_radius,key,obstructions,min_sj_fixed,min_sj_slide,usable";
+  for (const auto& p : study.parameter_names) out << "," << csv_quote("example_" + p);
+  out << "\n";
   for (const auto& c : study.classes) {
     out << c.label << "," << (c.valid ? "valid" : "error") << "," << c.count << "," << c.hexes << ","
         << c.conditions_ok << "," << fmt(c.example.high_roof) << "," << fmt(c.example.low_roof) << ","
@@ -315,6 +319,7 @@ void write_interleave_summary(std::ostream& out, const InterleaveStudy& study) {
           << (c.usable ? 1 : 0);
     else
       out << ",,,";
+    for (double p : c.example_parameters) out << "," << fmt(p);
     out << "\n";
   }
 }

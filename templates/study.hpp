@@ -57,6 +57,7 @@ struct InterleaveClass {
   int count = 0;
   int conditions_ok = 0;  // runs of the class meeting the paper's conditions
   PushParameters example;  // the first run of the class in sweep order
+  std::vector<double> example_parameters;  // its swept values (spec studies)
   // Valid classes, measured on the example's template: the obstructions to untangling it
   // (template_obstructions), and its smoothed minimum scaled Jacobian with tet- and hex-side
   // nodes fixed at the diced positions and sliding in their faces (smooth_template). A class is
@@ -104,7 +105,8 @@ InterleaveStudy interleave_study(const nlohmann::json& spec, const std::string& 
 // then one column per swept spec path (spec studies)
 void write_interleave_csv(std::ostream& out, const InterleaveStudy& study);
 // CSV: class,outcome,count,hexes,conditions_ok,example high/low/depth/radius,key,obstructions
-// (count per kind, "doublet:10;pinched-corner:1"),min_sj_fixed,min_sj_slide,usable
+// (count per kind, "doublet:10;pinched-corner:1"),min_sj_fixed,min_sj_slide,usable, then the
+// example's value of each swept spec path ("example_" + path; spec studies)
 void write_interleave_summary(std::ostream& out, const InterleaveStudy& study);
 
 // ---- Shape study ---------------------------------------------------------------------------

@@ -68,7 +68,7 @@ std::string three_planes_and(const std::string& extra) {
 }  // namespace
 
 TEST_CASE("geode arrange: the shipped specs are the built-in templates") {
-  for (const std::string name : {"geode3d", "geode2d", "geode4tri"}) {
+  for (const std::string name : {"geode3d", "geode2d", "geode4tri", "refine3", "refine3-2d"}) {
     CAPTURE(name);
     const std::filesystem::path shipped = std::filesystem::path(GEODE_SOURCE_DIR) / "notebooks-data/specs" / (name + ".json");
     const auto spec = geode_cli("template " + name + " --format spec");
@@ -117,6 +117,13 @@ TEST_CASE("geode arrange: the README's examples, the pillowed hex and the pillow
   CHECK(s.out.find("valid,5,V1,1,\"\",0.4\n") != std::string::npos);
   CHECK(s.out.find("error,0,E1,,\"arrangement: sheets 'a', 'c' meet on the domain boundary") != std::string::npos);
   CHECK(s.out.find("valid,3,V2,1,\"\",0.6\n") != std::string::npos);
+  // The summary names each class's example by its swept values.
+  const auto summary = temp_path("pillow2d-summary.csv");
+  REQUIRE(geode_cli("study interleave --quiet --spec " + (specs / "pillow2d.json").string() + " --summary " + summary.string()).code == 0);
+  const std::string table = read_text(summary);
+  CHECK(table.find(",usable,\"example_sheets[2].circle.radius\"\n") != std::string::npos);
+  CHECK(table.find(",1,0.6\n") != std::string::npos);  // V2, usable, first seen at radius 0.6
+  std::filesystem::remove(summary);
 }
 
 TEST_CASE("geode arrange: bad specs exit 2 naming the JSON path, non-dualizing ones exit 3") {

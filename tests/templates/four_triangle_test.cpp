@@ -25,6 +25,7 @@
 #include "stc/arrangement.hpp"
 #include "templates/completion.hpp"
 #include "templates/geode.hpp"
+#include "templates/study.hpp"
 
 using namespace geode;
 using primal::Point;
@@ -128,4 +129,122 @@ TEST_CASE("geode4tri: the triple-dome points sit where the ratio says, outside t
       runs_with_points += points > 0;
     }
   CHECK(runs_with_points >= 6);  // 7 of the 8 pushes compute today
+}
+
+// ---- The wider dome family (PushParameters dome/centre exponent and offset) ----------------
+
+namespace {
+
+// The p-norm in the interface plane, as the superquadric dome's trace measures it.
+double planar_p(const Point& p, const Point& q, double e) {
+  return std::pow(std::pow(std::abs(p.x() - q.x()), e) + std::pow(std::abs(p.z() - q.z()), e), 1.0 / e);
+}
+
+// R of the dome around vertex v centred at c in the p-norm: the blend between the farthest
+// diced node it must enclose and the nearest it must leave out.
+double radius_p(const templates::InterfacePatch& patch, int v, const Point& c, double e, double blend) {
+  const auto diced = templates::dice_patch(patch);
+  double inside = 0.0, outside = 1e300;
+  for (std::size_t n = 0; n < diced.nodes.size(); ++n) {
+    const double d = planar_p(diced.nodes[n], c, e);
+    const auto& own = diced.owners[n];
+    if (std::find(own.begin(), own.end(), v) != own.end())
+      inside = std::max(inside, d);
+    else
+      outside = std::min(outside, d);
+  }
+  REQUIRE(inside < outside);
+  return inside + blend * (outside - inside);
+}
+
+}  // namespace
+
+TEST_CASE("geode4tri: spheroid domes on their vertices (p = 2, offset 0) are today's, bit for bit") {
+  GeodeOptions plain, given;
+  plain.split = given.split = templates::TopSplit::FourTriangles;
+  given.push.dome_exponent = given.push.centre_exponent = 2.0;
+  given.push.dome_offset = 0.0;
+  given.push.centre_offset = {0.0, 0.0};
+  // The domes' fields are the spheroid f = (|x - V| / R)^2 + ((1 - v) / depth)^2 - 1 written
+  // here, with R between the bounds read off the diced nodes: equal to the last bit.
+  const auto G = templates::geode_arrangement(given, 3);
+  REQUIRE(G.sheets.size() == 7);
+  for (int v = 0; v < 5; ++v) {
+    CAPTURE(v);
+    const Point V = G.tet_side.points[static_cast<std::size_t>(v)];
+    const auto diced = templates::dice_patch(G.tet_side);
+    double inside = 0.0, outside = 1e300;
+    for (std::size_t n = 0; n < diced.nodes.size(); ++n) {
+      const double dx = diced.nodes[n].x() - V.x(), dz = diced.nodes[n].z() - V.z();
+      const double d = std::sqrt(dx * dx + dz * dz);
+      const auto& own = diced.owners[n];
+      if (std::find(own.begin(), own.end(), v) != own.end())
+        inside = std::max(inside, d);
+      else
+        outside = std::min(outside, d);
+    }
+    const double R = inside + given.push.dome_radius * (outside - inside), depth = given.push.dome_depth;
+    const auto& field = G.sheets[static_cast<std::size_t>(2 + v)].field;
+    for (const Point& x : {Point(0.3, 0.7, -0.2), Point(-0.9, 0.95, 0.8), Point(0.01, 0.2, 0.6), Point(1, 1, -1)}) {
+      const double dx = x.x() - V.x(), dz = x.z() - V.z();
+      const double r = std::sqrt(dx * dx + dz * dz) / R, y = (1.0 - x.y()) / depth;
+      CHECK(field(x) == r * r + y * y - 1.0);
+    }
+  }
+  const auto a = templates::build_geode3d(plain), b = templates::build_geode3d(given);
+  CHECK(a.hex.hexes == b.hex.hexes);
+  CHECK(a.hex.points == b.hex.points);
+  CHECK(a.element_sheets == b.element_sheets);
+  // The class the interleave study recorded for the default push before the family was
+  // widened (notebooks-data/interleave-geode4tri-summary.csv, class V1).
+  CHECK(templates::template_class_key(b) ==
+        "36h|dome+dome+dome:4,dome+dome+tunnel:20,dome+tunnel+tunnel:12|78280234cfcacad4");
+}
+
+TEST_CASE("geode4tri: superquadric and off-vertex domes move the triple points where the p-norm says") {
+  // With one depth and one exponent p for all domes the depth term still cancels where three
+  // meet: |x - c_a|_p / R_a is equal for the three. On the perpendicular from the centre to the
+  // side w = 1 (corners (+-1, 1) moved by the offset f toward the centre), the point (0, t)
+  // solves |(1 - f, 1 - f - t)|_p / R_corner = t / R_centre.
+  struct Case {
+    double p, f, blend;
+  };
+  int computed = 0;
+  for (const Case c : {Case{3.0, 0.0, 0.6}, Case{2.0, 0.3, 0.6}, Case{1.5, 0.2, 0.5}, Case{4.0, 0.4, 0.3}}) {
+    CAPTURE(c.p);
+    CAPTURE(c.f);
+    GeodeOptions o;
+    o.split = templates::TopSplit::FourTriangles;
+    o.push.dome_exponent = c.p;
+    o.push.dome_offset = c.f;
+    o.push.dome_radius = c.blend;
+    const auto G = templates::geode_arrangement(o, 3);
+    const Point corner(-(1 - c.f), 1, 1 - c.f), centre(0, 1, 0);
+    const double r_corner = radius_p(G.tet_side, 0, corner, c.p, c.blend);
+    const double r_centre = radius_p(G.tet_side, 4, centre, c.p, c.blend);
+    double lo = 0.0, hi = 1.0;
+    const auto g = [&](double t) { return planar_p(Point(0, 1, t), corner, c.p) / r_corner - t / r_centre; };
+    REQUIRE(g(lo) > 0);
+    REQUIRE(g(hi) < 0);
+    for (int i = 0; i < 100; ++i) (g(0.5 * (lo + hi)) > 0 ? lo : hi) = 0.5 * (lo + hi);
+    const double predicted = 0.5 * (lo + hi);
+    MESSAGE("p " << c.p << ", offset " << c.f << ": triple points predicted at t = " << predicted);
+    stc::Arrangement A;
+    try {
+      A = stc::compute_arrangement(G.sheets, G.domain, o.arrangement);
+    } catch (const TopologyError&) {
+      continue;  // out of general position: nothing to compare
+    }
+    int points = 0;
+    for (const auto& v : A.vertices) {
+      if (!std::all_of(v.sheets.begin(), v.sheets.end(), [](int s) { return s >= 2; })) continue;
+      ++points;
+      const double t = std::max(std::abs(v.x.x()), std::abs(v.x.z()));
+      CHECK(std::min(std::abs(v.x.x()), std::abs(v.x.z())) < 1e-6);
+      CHECK(t == doctest::Approx(predicted).epsilon(1e-6));
+    }
+    CHECK(points == 4);  // one per triangle, by the four-fold symmetry
+    computed += points > 0;
+  }
+  CHECK(computed >= 3);
 }

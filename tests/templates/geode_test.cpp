@@ -178,3 +178,38 @@ TEST_CASE("geode4tri: what the four-triangle variant yields") {
   for (int axis : {0, 2})
     for (double s : {-12.0, 12.0}) CHECK(test::find_isomorphism(side_face(T.hex, axis, s), T2.quad).has_value());
 }
+
+TEST_CASE("geode4tri: superquadric domes over a shallow centre dome give an obstruction-free 44-hex template") {
+  // The same push with spheroid domes (p = 2) has a pinched corner and fails condition 1; with
+  // p = 3 for every dome the triple-dome points fall inside both tunnels and the dual has no
+  // obstruction, so the plain dual (no fix-up) smooths to positive Jacobians.
+  GeodeOptions o;
+  o.split = templates::TopSplit::FourTriangles;
+  o.push.centre_depth = 0.45;
+  o.push.dome_radius = 0.8;
+  o.push.centre_radius = 0.6;
+  const auto spheroids = templates::build_geode3d(o);
+  CHECK(spheroids.hex.hexes.size() == 40);
+  CHECK_FALSE(spheroids.checks.triple_domes_in_pocket);
+  CHECK(templates::template_obstructions(spheroids).size() == 1);
+
+  o.push.dome_exponent = 3;
+  auto T = templates::build_geode3d(o);
+  CHECK(T.hex.hexes.size() == 44);
+  check_combinatorial_ball(primal::check_validity(T.hex));
+  CHECK(T.checks.ok());
+  CHECK(T.checks.triple_dome_points == 4);
+  CHECK(templates::template_obstructions(T).empty());
+  // The prescribed boundary: 12 diced-triangle quads on the tet side, 4 on the hex side, and
+  // each side face the 2D geode, so it sits beside ordinary geodes.
+  CHECK(side_face(T.hex, 1, 7.0).quads.size() == 12);
+  CHECK(side_face(T.hex, 1, -7.0).quads.size() == 4);
+  const auto T2 = templates::build_geode2d(GeodeOptions{});
+  for (int axis : {0, 2})
+    for (double s : {-12.0, 12.0}) CHECK(test::find_isomorphism(side_face(T.hex, axis, s), T2.quad).has_value());
+  const auto r = templates::smooth_template(T, false);
+  CHECK(r.untangled);
+  CHECK(primal::check_validity(T.hex).ok());
+  MESSAGE("geode4tri, p = 3 domes: min scaled Jacobian " << r.final_min_scaled_jacobian << " (faces fixed)");
+  CHECK(r.final_min_scaled_jacobian >= 0.4);
+}

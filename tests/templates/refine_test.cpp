@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <set>
 
 #include "primal/errors.hpp"
@@ -16,6 +17,7 @@
 #include "support/fixtures.hpp"
 #include "support/isomorphism.hpp"
 #include "templates/refine.hpp"
+#include "templates/spec.hpp"
 
 using namespace geode;
 using primal::Point;
@@ -158,4 +160,32 @@ TEST_CASE("refine3: heights out of order are rejected") {
   o = RefineOptions{};
   o.box.y() = 0;
   CHECK_THROWS_AS(templates::build_refine3_2d(o), InvalidInput);
+}
+
+TEST_CASE("refine3: the templates are arrangement specs (faces block and shapes), read back exactly") {
+  for (int dim : {2, 3}) {
+    CAPTURE(dim);
+    RefineOptions o;
+    o.box = Eigen::Vector3d(20, 10, 30);
+    const auto spec = templates::refine_spec(o, dim);
+    // The prescribed faces: the 3-refinement below, the coarse cell above, as given (undiced).
+    REQUIRE(spec.bottom_face.has_value());
+    REQUIRE(spec.top_face.has_value());
+    CHECK(spec.bottom_face->cells.size() == (dim == 3 ? 9u : 3u));
+    CHECK(spec.top_face->cells.size() == 1);
+    CHECK_FALSE(spec.completion.has_value());
+    CHECK(spec.sheets.size() == (dim == 3 ? 5u : 3u));
+    const auto text = templates::format_spec(templates::spec_json(spec));
+    const auto read = templates::parse_spec(nlohmann::json::parse(text), "refine.json");
+    const auto a = dim == 3 ? templates::build_refine3(o) : templates::build_refine3_2d(o);
+    const auto b = templates::build_template(read);
+    CHECK(a.element_sheets == b.element_sheets);
+    if (dim == 3) {
+      CHECK(a.hex.hexes == b.hex.hexes);
+      CHECK(a.hex.points == b.hex.points);
+    } else {
+      CHECK(a.quad.quads == b.quad.quads);
+      CHECK(a.quad.points == b.quad.points);
+    }
+  }
 }

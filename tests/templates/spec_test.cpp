@@ -247,3 +247,84 @@ TEST_CASE("spec: sweeps set numbers by path") {
   j["sweep"]["sheets[9].plane.point[0]"] = {0.5};
   CHECK_THROWS_AS(templates::parse_spec(j, "s.json"), InvalidInput);
 }
+
+TEST_CASE("spec: the wider dome family's values are read, written back, and named by JSON path when bad") {
+  templates::GeodeOptions o;
+  o.split = templates::TopSplit::FourTriangles;
+  o.push.dome_exponent = 3;
+  o.push.centre_exponent = 1.5;
+  o.push.dome_offset = 0.25;
+  o.push.centre_offset = {0.1, -0.2};
+  const json written = templates::spec_json(templates::geode_spec(o, 3));
+  CHECK(written["push"]["dome_exponent"] == 3.0);
+  CHECK(written["push"]["centre_offset"] == json{0.1, -0.2});
+  const auto read = templates::parse_spec(json::parse(templates::format_spec(written)), "domes.json");
+  REQUIRE(read.completion.has_value());
+  CHECK(read.completion->push.centre_exponent == 1.5);
+  CHECK(read.completion->push.dome_offset == 0.25);
+  CHECK(read.completion->push.centre_offset[1] == -0.2);
+  // Defaults are not written: the built-in specs keep their text.
+  CHECK_FALSE(templates::spec_json(templates::geode_spec(templates::GeodeOptions{}, 3))["push"].contains("dome_exponent"));
+
+  struct Case {
+    const char* key;
+    json value;
+    const char* message;
+  };
+  const std::vector<Case> cases = {
+      {"dome_exponent", 0.5, "domes.json: push.dome_exponent: dome exponent must be in [1, 20] (2: spheroids)"},
+      {"dome_exponent", "2", "domes.json: push.dome_exponent: must be a number"},
+      {"centre_exponent", 30, "domes.json: push.centre_exponent: centre dome exponent must be 0 (as the corner domes) or in [1, 20]"},
+      {"dome_offset", -0.1, "domes.json: push.dome_offset: dome offset must be in [0, 1) (a fraction of the way to the tet side's centre)"},
+      {"centre_offset", json{0.0, 1.0}, "domes.json: push.centre_offset[1]: centre dome offsets must be in (-1, 1) (fractions of the half-width)"},
+      {"centre_offset", json{0.5}, "domes.json: push.centre_offset: must be [x, z] (fractions of the half-width)"},
+      {"centre_offset", json{0.5, "a"}, "domes.json: push.centre_offset[1]: must be a number"},
+  };
+  for (const auto& c : cases) {
+    CAPTURE(c.key);
+    json j = written;
+    j["push"][c.key] = c.value;
+    std::string message = "no error";
+    try {
+      templates::parse_spec(j, "domes.json");
+    } catch (const InvalidInput& e) {
+      message = e.what();
+    }
+    CHECK(message == c.message);
+  }
+}
+
+TEST_CASE("spec: a faces block prescribes boundary cells as given, and a different boundary is an error") {
+  // Three mid planes of the unit box: one hex whose bottom face is the box's bottom.
+  json j = three_planes();
+  j["faces"]["bottom"] = {{"points", {{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}}}, {"cells", {{0, 1, 2, 3}}}};
+  const auto spec = templates::parse_spec(j, "faces.json");
+  REQUIRE(spec.bottom_face.has_value());
+  CHECK_FALSE(spec.top_face.has_value());
+  CHECK(templates::spec_json(spec)["faces"] == j["faces"]);
+  const auto t = templates::build_template(spec);
+  REQUIRE(t.hex.hexes.size() == 1);
+  int on_bottom = 0;
+  for (const auto& p : t.hex.points) on_bottom += p.y() == 0.0;
+  CHECK(on_bottom == 4);
+
+  // Two quads where the dual has one: the boundary is not the prescribed one.
+  json two = three_planes();
+  two["faces"]["bottom"] = {{"points", {{0, 0, 0}, {0.5, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0.5, 0, 1}, {0, 0, 1}}},
+                            {"cells", {{0, 1, 4, 5}, {1, 2, 3, 4}}}};
+  CHECK_THROWS_AS(build(two), TopologyError);
+  try {
+    build(two);
+  } catch (const TopologyError& e) {
+    CHECK(std::string(e.what()).find("faces.bottom") != std::string::npos);
+  }
+
+  json triangle = three_planes(), off_face = three_planes(), with_completion = json::parse(templates::format_spec(
+                                                                   templates::spec_json(templates::geode_spec({}, 3))));
+  triangle["faces"]["top"] = {{"points", {{0, 1, 0}, {1, 1, 0}, {1, 1, 1}}}, {"cells", {{0, 1, 2}}}};
+  off_face["faces"]["bottom"] = {{"points", {{0, 0.5, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}}}, {"cells", {{0, 1, 2, 3}}}};
+  with_completion["faces"] = j["faces"];
+  CHECK(error_of(triangle) == "spec.json: faces.top.cells[0]: must be 4 point indices (a quad)");
+  CHECK(error_of(off_face) == "spec.json: faces.bottom.points[0]: must lie on the domain's low-y face (y = 0.000000)");
+  CHECK(error_of(with_completion) == "spec.json: faces: a completion block prescribes both faces already");
+}
