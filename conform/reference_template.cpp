@@ -90,8 +90,16 @@ RefTemplate make_reference(const Eigen::Vector3d& box, std::array<int, 2> diagon
   o.diagonal = diagonal == std::array<int, 2>{5, 7} ? Diagonal::Main : Diagonal::Anti;
   o.split = split;
   const bool four = split == templates::TopSplit::FourTriangles;
+  if (four) {
+    // The superquadric-dome class found free of obstructions (notebooks-data, interleave
+    // geode4tri-domes): 44 hexes, no fix-up needed.
+    o.push.dome_exponent = 3.0;
+    o.push.centre_depth = 0.45;
+    o.push.dome_radius = 0.8;
+    o.push.centre_radius = 0.6;
+  }
   ref.tpl = build_geode3d(o);
-  // The plain four-triangle dual has obstructions no placement can untangle (templates/fixup.hpp).
+  // Fix-up (templates/fixup.hpp) pillows away any obstruction to untangling; this class has none.
   if (four && templates::fix_up(ref.tpl).obstructions_after > 0)
     throw TopologyError("the four-triangle template in a " + std::to_string(box.x()) + " x " + std::to_string(box.y()) +
                         " x " + std::to_string(box.z()) + " box keeps obstructions after fix-up");
