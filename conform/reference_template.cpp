@@ -26,10 +26,10 @@ using templates::Diagonal;
 using templates::GeodeOptions;
 using templates::smooth_template;
 
-// Buffer hex side faces 0..3 (topology order: s-min, r-max, s-max, r-min) as template box-face
-// bits (templates/geode.hpp: bit 2*axis + high) under r = z, s = x, t = y
-// (primal/buffer_layer.hpp).
-constexpr std::array<int, 4> kSideBit{0, 5, 1, 4};
+// Buffer hex side faces 0..3 (topology order: s-min, r-max, s-max, r-min) as template side
+// faces (templates::side_faces order x-, x+, z-, z+) under r = z, s = x, t = y
+// (conform/buffer_layer.hpp); the top and bottom as box-face bits (bit 2*axis + high).
+constexpr std::array<int, 4> kSideFace{0, 3, 1, 2};
 constexpr int kBottomBit = 2, kTopBit = 3;
 
 int corner_at(int r, int s, int t) {
@@ -123,8 +123,6 @@ RefTemplate make_reference(const Eigen::Vector3d& box, std::array<int, 2> diagon
     const Point q = reference_coordinates(p, box);
     ref.rst[i] = q;
     const unsigned f = ref.tpl.node_faces[i];
-    for (int k = 0; k < 4; ++k)
-      if (f & (1u << kSideBit[k])) ref.side_nodes[k].push_back(static_cast<int>(i));
     const bool bottom = f & (1u << kBottomBit), top = f & (1u << kTopBit);
     if (!bottom && !top) continue;
     const int t = top ? 1 : 0;
@@ -158,18 +156,10 @@ RefTemplate make_reference(const Eigen::Vector3d& box, std::array<int, 2> diagon
       throw TopologyError(m.str());
     }
   }
+  const auto faces = templates::side_faces(ref.tpl);
   for (int k = 0; k < 4; ++k) {
-    const unsigned bit = 1u << kSideBit[k];
-    for (const auto& h : ref.tpl.hex.hexes)
-      for (const auto& fc : topo::kHexFaceCorners) {
-        std::array<int, 4> q{};
-        bool on = true;
-        for (int j = 0; j < 4; ++j) {
-          q[j] = h[fc[j]];
-          on = on && (ref.tpl.node_faces[q[j]] & bit);
-        }
-        if (on) ref.side_quads[k].push_back(q);
-      }
+    ref.side_nodes[k] = faces[kSideFace[k]].nodes;
+    ref.side_quads[k] = faces[kSideFace[k]].quads;
   }
   return ref;
 }
