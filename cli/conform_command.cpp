@@ -44,7 +44,17 @@ struct ConformArgs {
   bool write_invalid = false;
 };
 
-double output_min_sj(const conform::ConformResult& r);
+double min_sj(const primal::QualityReport& q) {
+  for (const auto& m : q.metrics)
+    if (m.metric == primal::HexMetric::kScaledJacobian) return m.minimum;
+  return 0.0;
+}
+
+double output_min_sj(const conform::ConformResult& r) {
+  double m = 1.0;
+  for (const auto& b : r.quality) m = std::min(m, min_sj(b.report));
+  return m;
+}
 
 nlohmann::json result_json(const conform::ConformResult& r) {
   nlohmann::json j;
@@ -69,18 +79,6 @@ nlohmann::json result_json(const conform::ConformResult& r) {
     j["blocks"].push_back({{"id", b.block}, {"name", b.name},
                            {"quality", primal::quality_report_json(b.report)}});
   return j;
-}
-
-double min_sj(const primal::QualityReport& q) {
-  for (const auto& m : q.metrics)
-    if (m.metric == primal::HexMetric::kScaledJacobian) return m.minimum;
-  return 0.0;
-}
-
-double output_min_sj(const conform::ConformResult& r) {
-  double m = 1.0;
-  for (const auto& b : r.quality) m = std::min(m, min_sj(b.report));
-  return m;
 }
 
 // Valid: faces shared by two hexes, closed boundary, every node covered once, and no hex with

@@ -134,6 +134,7 @@ class Conformer {
   void match_sides();
   void assemble();
   void smooth();
+  double measure();
   void verify();
   void output();
 
@@ -153,7 +154,10 @@ class Conformer {
   primal::HexMesh mesh_;
   std::vector<primal::NodeSet> node_sets_;
   std::vector<primal::SideSet> side_sets_;
-  std::vector<Index> inverted_;  // hexes with scaled Jacobian <= 0 after smoothing
+  // Every output hex's scaled Jacobian and the hexes at or below 0, as of the last measure():
+  // after placement, then after smoothing; verification reads them.
+  std::vector<double> sj_;
+  std::vector<Index> inverted_;
   OutputBlocks blocks_;
   std::vector<Index> carved_from_;  // per buffer hex: the tet (input index) it was carved from
 };
@@ -352,7 +356,7 @@ void Conformer::assemble() {
   node_sets_ = primal::diced_node_sets(layer_.model, diced_, renum);
   side_sets_ = primal::diced_side_sets(layer_.model, diced_, 0, res_.diced_hexes + res_.geode_hexes);
   diced_ = primal::DicedModel();
-  res_.min_scaled_jacobian_before_smoothing = primal::min_scaled_jacobian(mesh_, &inverted_);
+  res_.min_scaled_jacobian_before_smoothing = measure();
   res_.placement_inverted = static_cast<Index>(inverted_.size());
 }
 
@@ -376,8 +380,7 @@ void Conformer::smooth() {
     for (int ring = 0; ring < kDefectRings; ++ring) seeds = primal::hexes_around(mesh_, seeds);
     res_.smoothing = primal::smooth_hexes_around(mesh_, seeds, options_.local_smooth_options);
     res_.smoothing.initial_min_scaled_jacobian = res_.min_scaled_jacobian_before_smoothing;
-    inverted_.clear();
-    res_.smoothing.final_min_scaled_jacobian = primal::min_scaled_jacobian(mesh_, &inverted_);
+    res_.smoothing.final_min_scaled_jacobian = measure();
     say("untangling: " + std::to_string(res_.placement_inverted) + " hexes the placement inverted, " +
         std::to_string(inverted_.size()) + " left" + took());
     return;
@@ -404,7 +407,7 @@ void Conformer::smooth() {
       const double yardstick = std::min(res_.input_diced_hex_min_scaled_jacobian, res_.input_diced_tet_min_scaled_jacobian);
       std::vector<Index> defects;
       for (Index h : seeds)
-        if (primal::hex_scaled_jacobian(primal::hex_corners(mesh_, h)) < yardstick) defects.push_back(h);
+        if (sj_[static_cast<std::size_t>(h)] < yardstick) defects.push_back(h);
       for (int ring = 0; ring < kDefectRings && !defects.empty(); ++ring) defects = primal::hexes_around(mesh_, defects);
       seeds = std::move(defects);
     }
@@ -415,13 +418,23 @@ void Conformer::smooth() {
     res_.smoothing = primal::smooth_hexes_local(mesh_, constraints, &surface, {}, o);
   }
   res_.smoothing.initial_min_scaled_jacobian = res_.min_scaled_jacobian_before_smoothing;
-  inverted_.clear();
-  res_.smoothing.final_min_scaled_jacobian = primal::min_scaled_jacobian(mesh_, &inverted_);
+  res_.smoothing.final_min_scaled_jacobian = measure();
   const Index patches = res_.smoothing.patches;
   say("smoothing (" + std::string(local ? "local" : "global") + "): " +
       std::to_string(patches) + " patches, min scaled Jacobian " +
       std::to_string(res_.smoothing.initial_min_scaled_jacobian) + " -> " +
       std::to_string(res_.smoothing.final_min_scaled_jacobian) + took());
+}
+
+double Conformer::measure() {
+  sj_ = primal::scaled_jacobian_per_hex(mesh_);
+  inverted_.clear();
+  double lowest = 1.0;
+  for (std::size_t h = 0; h < sj_.size(); ++h) {
+    lowest = std::min(lowest, sj_[h]);
+    if (sj_[h] <= 0.0) inverted_.push_back(static_cast<Index>(h));
+  }
+  return lowest;
 }
 
 void Conformer::verify() {
@@ -439,13 +452,22 @@ void Conformer::verify() {
   }
   std::map<int, std::vector<Index>> members;  // output block -> its hexes, ascending id
   for (std::size_t h = 0; h < mesh_.hexes.size(); ++h) members[mesh_.block[h]].push_back(static_cast<Index>(h));
-  constexpr std::array<primal::HexMetric, 1> kCheap{primal::HexMetric::kScaledJacobian};
   for (const auto& [id, sel] : members) {
     const auto name = blocks_.names.find(id);
+    primal::QualityReport report;
+    if (options_.quality == ConformQuality::kFull) {
+      report = primal::hex_quality_report(mesh_, sel);
+    } else {  // the scaled Jacobians measured after smoothing
+      std::vector<double> values;
+      values.reserve(sel.size());
+      for (Index h : sel) values.push_back(sj_[static_cast<std::size_t>(h)]);
+      report.num_hexes = static_cast<Index>(sel.size());
+      report.metrics.push_back(primal::summarize_metric(primal::HexMetric::kScaledJacobian, values, sel));
+    }
     res_.quality.push_back({id, name != blocks_.names.end() ? name->second : "block " + std::to_string(id),
-                            options_.quality == ConformQuality::kFull ? primal::hex_quality_report(mesh_, sel)
-                                                                      : primal::hex_quality_report(mesh_, sel, kCheap)});
+                            std::move(report)});
   }
+  sj_ = {};
   say("verification: " + std::string(res_.validity.ok() ? "valid" : "INVALID") + took());
 }
 

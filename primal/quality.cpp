@@ -390,12 +390,17 @@ HexCorners hex_corners(const HexMesh& mesh, Index h) {
   return p;
 }
 
-double min_scaled_jacobian(const HexMesh& mesh, std::vector<Index>* inverted) {
-  // Evaluated in parallel (TBB) into one slot per hex, then gathered in order.
+std::vector<double> scaled_jacobian_per_hex(const HexMesh& mesh) {
+  // Each hex in its own slot (TBB): the values do not depend on the thread count.
   std::vector<double> sj(mesh.hexes.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sj.size(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t h = r.begin(); h != r.end(); ++h) sj[h] = hex_scaled_jacobian(hex_corners(mesh, static_cast<Index>(h)));
   });
+  return sj;
+}
+
+double min_scaled_jacobian(const HexMesh& mesh, std::vector<Index>* inverted) {
+  const std::vector<double> sj = scaled_jacobian_per_hex(mesh);
   double mn = 1.0;
   for (std::size_t h = 0; h < sj.size(); ++h) {
     mn = std::min(mn, sj[h]);

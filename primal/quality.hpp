@@ -112,6 +112,8 @@ HexCorners hex_corners(const HexMesh& mesh, Index h);
 // The minimum hex_scaled_jacobian over the mesh (1 for an empty mesh); the hexes at or below 0
 // are appended to `inverted` when given.
 double min_scaled_jacobian(const HexMesh& mesh, std::vector<Index>* inverted = nullptr);
+// hex_scaled_jacobian of every hex, in hex order (evaluated in parallel).
+std::vector<double> scaled_jacobian_per_hex(const HexMesh& mesh);
 QuadCorners quad_corners(const QuadMesh& mesh, Index q);
 
 }  // namespace geode::primal

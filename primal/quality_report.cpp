@@ -25,6 +25,28 @@ nlohmann::json bound(double v) { return std::isfinite(v) ? nlohmann::json(v) : n
 
 }  // namespace
 
+MetricSummary summarize_metric(HexMetric metric, std::span<const double> q, std::span<const Index> hexes,
+                               StdDevKind kind) {
+  if (q.empty() || q.size() != hexes.size())
+    throw InvalidInput("metric summary: " + std::to_string(q.size()) + " values for " + std::to_string(hexes.size()) +
+                       " hexes");
+  const double n = static_cast<double>(q.size());
+  MetricSummary s;
+  s.metric = metric;
+  const auto lo = std::min_element(q.begin(), q.end());
+  const auto hi = std::max_element(q.begin(), q.end());
+  s.minimum = *lo;
+  s.maximum = *hi;
+  s.min_hex = hexes[static_cast<std::size_t>(lo - q.begin())];
+  s.max_hex = hexes[static_cast<std::size_t>(hi - q.begin())];
+  s.average = std::accumulate(q.begin(), q.end(), 0.0) / n;
+  double ss = 0.0;  // two-pass: no cancellation for large, nearly equal values (volumes)
+  for (double v : q) ss += (v - s.average) * (v - s.average);
+  const double dof = kind == StdDevKind::kSample ? n - 1.0 : n;
+  s.std_dev = dof > 0.0 ? std::sqrt(ss / dof) : 0.0;
+  return s;
+}
+
 QualityReport hex_quality_report(const HexMesh& mesh, std::span<const Index> hexes,
                                  std::span<const HexMetric> metrics, StdDevKind kind) {
   std::vector<Index> all;
@@ -49,7 +71,6 @@ QualityReport hex_quality_report(const HexMesh& mesh, std::span<const Index> hex
   QualityReport report;
   report.num_hexes = static_cast<Index>(hexes.size());
   report.std_dev_kind = kind;
-  const double n = static_cast<double>(hexes.size());
   std::vector<double> q(hexes.size());
   for (HexMetric id : chosen) {
     const HexMetricInfo& info = hex_metric_info(id);
@@ -64,20 +85,7 @@ QualityReport hex_quality_report(const HexMesh& mesh, std::span<const Index> hex
                           q[i] = info.evaluate(c);
                         }
                       });
-    MetricSummary s;
-    s.metric = id;
-    const auto lo = std::min_element(q.begin(), q.end());
-    const auto hi = std::max_element(q.begin(), q.end());
-    s.minimum = *lo;
-    s.maximum = *hi;
-    s.min_hex = hexes[lo - q.begin()];
-    s.max_hex = hexes[hi - q.begin()];
-    s.average = std::accumulate(q.begin(), q.end(), 0.0) / n;
-    double ss = 0.0;  // two-pass: no cancellation for large, nearly equal values (volumes)
-    for (double v : q) ss += (v - s.average) * (v - s.average);
-    const double dof = kind == StdDevKind::kSample ? n - 1.0 : n;
-    s.std_dev = dof > 0.0 ? std::sqrt(ss / dof) : 0.0;
-    report.metrics.push_back(s);
+    report.metrics.push_back(summarize_metric(id, q, hexes, kind));
   }
   return report;
 }
