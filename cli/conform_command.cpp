@@ -15,7 +15,6 @@
 #include "primal/errors.hpp"
 #include "primal/quality.hpp"
 #include "primal/quality_report.hpp"
-#include "templates/geode.hpp"
 
 namespace geode::cli {
 namespace {
@@ -126,16 +125,10 @@ std::string duplicate_node_hint(const primal::Model& model) {
   return s.str();
 }
 
-// --template-box, read as template --box reads its box (WxH means WxHxW); parse_box's
-// messages name --box.
+// --template-box: three sizes, checked as template --box checks its box.
 Eigen::Vector3d template_box(const std::string& text) {
-  try {
-    return templates::parse_box(text);
-  } catch (const InvalidInput& e) {
-    std::string why = e.what();
-    if (why.rfind("--box", 0) == 0) why.replace(0, 5, "--template-box");
-    throw InvalidInput(why);
-  }
+  const auto b = parse_box("--template-box", text, 3);
+  return {b[0], b[1], b[2]};
 }
 
 // The output paths and format, checked before any work: names, directories, format agreement.

@@ -413,8 +413,9 @@ void Conformer::smooth() {
     }
     res_.smoothing = primal::smooth_hexes_around(mesh_, seeds, o);
   } else {
-    const auto constraints = primal::boundary_slide_constraints(mesh_);
-    const primal::TriMesh surface = primal::boundary_triangulation(mesh_);
+    const auto boundary = primal::boundary_quads(mesh_);  // once for both
+    const auto constraints = primal::boundary_slide_constraints(mesh_, boundary);
+    const primal::TriMesh surface = primal::boundary_triangulation(mesh_.points, boundary);
     res_.smoothing = primal::smooth_hexes_local(mesh_, constraints, &surface, {}, o);
   }
   res_.smoothing.initial_min_scaled_jacobian = res_.min_scaled_jacobian_before_smoothing;

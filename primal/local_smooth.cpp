@@ -521,8 +521,7 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
     mesh.points[v] = constrain(ctx, static_cast<Index>(v), mesh.points[v]);
 
   LocalSmoothResult res;
-  std::vector<double> sj(nh);
-  for (std::size_t h = 0; h < nh; ++h) sj[h] = hex_scaled_jacobian(hex_corners(mesh, static_cast<Index>(h)));
+  std::vector<double> sj = scaled_jacobian_per_hex(mesh);
   ctx.start = sj;
   auto summarise = [&](double& min_sj, Index& inverted) {
     min_sj = nh ? *std::min_element(sj.begin(), sj.end()) : 0.0;

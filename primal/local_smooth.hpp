@@ -73,8 +73,10 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
 // smooth_hexes_local with the model's boundary sliding (boundary_slide_constraints and
 // boundary_triangulation, `feature_angle`), run on the submesh of the hexes around the seeds
 // only: a patch moves the nodes of its seed hex, so every hex whose quality can change shares a
-// node with a seed, and the boundary there is told from one more ring of hexes. The cost then
-// follows the seeds, not the mesh (the whole-mesh boundary of a million hexes costs seconds).
+// node with a seed, and the boundary there is told from one more ring of hexes. Finding the
+// rings still scans the mesh once per ring, but the costly parts (boundary faces, constraints,
+// patches) follow the seeds, not the mesh (the whole-mesh boundary of a million hexes costs
+// seconds).
 // Same result as smooth_hexes_local over the whole mesh with those constraints. The result's
 // minima are over the hexes around the seeds.
 LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seeds,

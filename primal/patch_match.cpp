@@ -1,6 +1,7 @@
 #include "primal/patch_match.hpp"
 
 #include <unordered_set>
+#include <vector>
 
 namespace geode::primal {
 namespace {
