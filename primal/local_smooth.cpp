@@ -7,6 +7,7 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -162,7 +163,14 @@ struct Context {
   const LocalSmoothOptions& options;
   std::vector<Index> node_start, node_hexes;  // node -> hexes (CSR)
   std::vector<double> start;                  // per hex, its scaled Jacobian when the call began
+  std::vector<double> edge_floor;             // per hex, the shortest edge it may have
 };
+
+double shortest_edge(const HexCorners& c) {
+  double m = std::numeric_limits<double>::max();
+  for (const auto& e : topo::kHexEdgeCorners) m = std::min(m, (c[e[0]] - c[e[1]]).squaredNorm());
+  return std::sqrt(m);
+}
 
 bool is_fixed(const Context& ctx, Index v) {
   return !ctx.constraints.empty() && ctx.constraints[v].kind == NodeConstraint::Kind::kFixed;
@@ -272,6 +280,12 @@ class Patch {
                        : s < keep ? s
                                   : std::max(keep, s - ctx.options.loss);
       floor_.push_back(sj[h] <= 0.0 ? f : std::min(sj[h], std::max(f, worst)));
+    }
+    // A hex already below its edge floor (shortened while untangling) just gets no shorter.
+    for (std::size_t h = 0; h < hex_.size(); ++h) {
+      HexCorners c;
+      for (int k = 0; k < 8; ++k) c[k] = pos_[local_[h][k]];
+      edge_floor_.push_back(std::min(ctx.edge_floor[hex_[h]], shortest_edge(c)));
     }
   }
 
@@ -398,9 +412,15 @@ class Patch {
     return value;
   }
 
-  bool feasible(const std::vector<Point>& p) const {
-    for (std::size_t h = 0; h < hex_.size(); ++h)
-      if (hex_sj(p, h) < floor_[h]) return false;
+  // Untangling maximises Jacobians / L^3, which an edge collapse lowers: the edge floors bind
+  // the shape phase only, where an untangling step may need an edge shorter for a while.
+  bool feasible(const std::vector<Point>& p, bool untangle) const {
+    for (std::size_t h = 0; h < hex_.size(); ++h) {
+      HexCorners c;
+      for (int k = 0; k < 8; ++k) c[k] = p[local_[h][k]];
+      if (hex_scaled_jacobian(c) < floor_[h]) return false;
+      if (!untangle && shortest_edge(c) < edge_floor_[h]) return false;
+    }
     return true;
   }
 
@@ -453,7 +473,7 @@ class Patch {
       for (int i = 0; i < moving_; ++i)
         trial_[i] = constrain(ctx_, node_[i], pos_[i] + step * (basis[i] * d.segment(offset[i], basis[i].cols())));
       const double f = -soft_min(trial_, untangle, t, nullptr, nullptr);
-      if (std::isfinite(f) && f <= f0 + 1e-4 * step * slope && f < f0 && feasible(trial_)) {
+      if (std::isfinite(f) && f <= f0 + 1e-4 * step * slope && f < f0 && feasible(trial_, untangle)) {
         last_gain_ = f0 - f;
         lambda_ = step == 1.0 ? lambda_ / 4.0 : std::max(4.0 * lambda_, 1e-8 * scale);
         pos_.swap(trial_);
@@ -469,7 +489,7 @@ class Patch {
   std::vector<std::array<int, 8>> local_;  // per affected hex, its corners' local numbers
   std::vector<Point> pos_, trial_;
   std::vector<FrameRef> frames_;
-  std::vector<double> q_, floor_;
+  std::vector<double> q_, floor_, edge_floor_;
   int moving_ = 0;
   double length_ = 1.0, unit_ = 1.0, lambda_ = 0.0, last_gain_ = 0.0;
 };
@@ -480,6 +500,7 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
                                      const TriMesh* surface, std::span<const Index> seeds,
                                      const LocalSmoothOptions& options) {
   const auto start = std::chrono::steady_clock::now();
+  const std::clock_t cpu_start = std::clock();
   const std::size_t np = mesh.points.size(), nh = mesh.hexes.size();
   if (!constraints.empty() && constraints.size() != np)
     throw InvalidInput("smooth_hexes_local: " + std::to_string(constraints.size()) +
@@ -505,7 +526,7 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
   }
   if (surface) projector = std::make_unique<SurfaceProjector>(*surface);
 
-  Context ctx{mesh, constraints, projector.get(), options, {}, {}, {}};
+  Context ctx{mesh, constraints, projector.get(), options, {}, {}, {}, {}};
   ctx.node_start.assign(np + 1, 0);
   for (const auto& h : mesh.hexes)
     for (Index v : h) ++ctx.node_start[v + 1];
@@ -523,6 +544,9 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
   LocalSmoothResult res;
   std::vector<double> sj = scaled_jacobian_per_hex(mesh);
   ctx.start = sj;
+  ctx.edge_floor.resize(nh);
+  for (std::size_t h = 0; h < nh; ++h)
+    ctx.edge_floor[h] = options.min_edge_fraction * shortest_edge(hex_corners(mesh, static_cast<Index>(h)));
   auto summarise = [&](double& min_sj, Index& inverted) {
     min_sj = nh ? *std::min_element(sj.begin(), sj.end()) : 0.0;
     inverted = static_cast<Index>(std::count_if(sj.begin(), sj.end(), [](double q) { return q <= 0.0; }));
@@ -587,6 +611,7 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
   }
   summarise(res.final_min_scaled_jacobian, res.final_inverted);
   res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  res.cpu_seconds = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
   return res;
 }
 

@@ -14,7 +14,8 @@
 //    break a floor is cut back, so the patch's worst hex never gets worse, hexes near the worst
 //    never lose, and good hexes pay a bounded price. An inverted hex has no floor: untangling
 //    may move it through worse shapes; the soft minimum of the Jacobians it maximises keeps
-//    the worst Jacobian from dropping.
+//    the worst Jacobian from dropping. Improving shape, no edge shrinks below min_edge_fraction
+//    of its hex's shortest edge at the start (the scaled Jacobian cannot see an edge collapse).
 //  - Termination: each patch's soft minimum rises monotonically (Armijo) and stops when it rises
 //    by less than `min_gain`, after max_iterations, or when no step is accepted; each hex seeds
 //    at most max_visits patches, and only when a neighbouring patch moved one of its nodes since
@@ -41,6 +42,10 @@ struct LocalSmoothOptions {
   double target = 0.35;       // hexes with a scaled Jacobian below it seed patches
   double margin = 0.1;        // hexes this close to a patch's worst never lose (see Floors)
   double loss = 0.1;          // how far a better hex may fall from its start
+  // Improving shape, no hex's shortest edge drops below this fraction of its shortest edge when
+  // the call began: the scaled Jacobian normalises edge lengths, so it would let an edge shrink
+  // to nothing.
+  double min_edge_fraction = 0.5;
   int max_visits = 2;         // patches seeded by one hex
   int max_iterations = 5;     // Newton iterations per patch (per phase)
   double sharpness = 60.0;    // soft minimum of scaled Jacobians
@@ -58,6 +63,7 @@ struct LocalSmoothResult {
   Index patches = 0, rounds = 0;
   long iterations = 0;  // Newton iterations over all patches
   double seconds = 0.0;  // wall clock
+  double cpu_seconds = 0.0;  // the process's CPU time over all threads (std::clock)
 };
 
 // Smooths `mesh` in place. `constraints`: one per node (empty: all free); `surface`: the

@@ -12,6 +12,7 @@
 #include "primal/frame_derivatives.hpp"
 #include "primal/local_smooth.hpp"
 #include "primal/quality.hpp"
+#include "primal/topology.hpp"
 
 namespace {
 
@@ -167,6 +168,36 @@ TEST_CASE("hexes near the worst never lose; others lose at most `loss`") {
   }
   CHECK(res.final_min_scaled_jacobian > res.initial_min_scaled_jacobian + 0.05);
   CHECK(improved > 10);
+}
+
+// The scaled Jacobian normalises edge lengths, so only the edge floor keeps edges from
+// shrinking: without it (fraction 0) some edge ends below 0.9 of its hex's shortest one.
+TEST_CASE("no edge ends below min_edge_fraction of its hex's shortest edge at the start") {
+  const HexMesh start = jittered_grid(5, 0.3, 11);
+  auto shortest = [](const HexMesh& m, Index h) {
+    const auto c = gp::hex_corners(m, h);
+    double s = 1e300;
+    for (int a = 0; a < 8; ++a)
+      for (int b = a + 1; b < 8; ++b)
+        if (std::abs(gp::topology::kHexCornerCoords[a][0] - gp::topology::kHexCornerCoords[b][0]) +
+                std::abs(gp::topology::kHexCornerCoords[a][1] - gp::topology::kHexCornerCoords[b][1]) +
+                std::abs(gp::topology::kHexCornerCoords[a][2] - gp::topology::kHexCornerCoords[b][2]) == 1)
+          s = std::min(s, (c[a] - c[b]).norm());
+    return s;
+  };
+  auto below = [&](double fraction) {
+    gp::LocalSmoothOptions o;
+    o.target = 0.95;
+    o.max_visits = 4;
+    o.min_edge_fraction = fraction;
+    HexMesh mesh = start;
+    gp::smooth_hexes_local(mesh, gp::boundary_slide_constraints(mesh), nullptr, {}, o);
+    int n = 0;
+    for (Index h = 0; h < static_cast<Index>(mesh.hexes.size()); ++h) n += shortest(mesh, h) < 0.9 * shortest(start, h);
+    return n;
+  };
+  CHECK(below(0.9) == 0);
+  CHECK(below(0.0) > 0);
 }
 
 TEST_CASE("seeds limit the smoothing to their neighbourhood") {
