@@ -133,7 +133,10 @@ class Conformer {
   void place_templates();
   void match_sides();
   void assemble();
+  void untangle();
+  void add_smoothing(const primal::LocalSmoothResult& r);
   void smooth();
+  void smooth_defects(primal::LocalSmoothOptions o);
   double measure();
   void verify();
   void output();
@@ -360,10 +363,33 @@ void Conformer::assemble() {
   res_.placement_inverted = static_cast<Index>(inverted_.size());
 }
 
-// Automatic target: hexes near the transition below the yardstick are the defects; patches
-// start on them and on the hexes within this many rings of them (a defect is lifted by moving
-// its neighbours too), not along the whole interface.
+// A defect (a hex below the yardstick, or inverted) is lifted by moving its neighbours too: the
+// patches start on it and on the hexes within this many rings of it.
 constexpr int kDefectRings = 2;
+
+// A hex still inverted (the placement inverts one where a buffer top folds at a convex edge or
+// corner) is untangled with the hexes within kDefectRings of it (a hex is untangled by moving
+// its neighbours too), at local_smooth_options' own target, so that even --smooth none gives a
+// usable mesh. Reads inverted_ as the last measure() left it.
+void Conformer::untangle() {
+  if (inverted_.empty()) return;
+  const std::size_t before = inverted_.size();
+  std::vector<Index> seeds = inverted_;
+  for (int ring = 0; ring < kDefectRings; ++ring) seeds = primal::hexes_around(mesh_, seeds);
+  add_smoothing(primal::smooth_hexes_around(mesh_, seeds, options_.local_smooth_options));
+  res_.smoothing.final_min_scaled_jacobian = measure();
+  say("untangling: " + std::to_string(before) + " inverted hexes, " + std::to_string(inverted_.size()) +
+      " left" + took());
+}
+
+// Several smoothing passes report as one.
+void Conformer::add_smoothing(const primal::LocalSmoothResult& r) {
+  auto& s = res_.smoothing;
+  s.patches += r.patches, s.rounds += r.rounds, s.iterations += r.iterations;
+  s.seconds += r.seconds, s.cpu_seconds += r.cpu_seconds;
+  s.initial_inverted = res_.placement_inverted, s.final_inverted = r.final_inverted;
+  s.initial_min_scaled_jacobian = res_.min_scaled_jacobian_before_smoothing;
+}
 
 // The worst-first smoother (primal/local_smooth.hpp); model boundary nodes slide on the diced
 // boundary. Local: patches seeded near the geode hexes, on the submesh around the seeds, so
@@ -371,20 +397,8 @@ constexpr int kDefectRings = 2;
 // hex.
 void Conformer::smooth() {
   t0_ = Clock::now();
-  if (options_.smooth == ConformSmooth::kNone) {
-    // No smoothing, but a hex the placement inverted (a buffer top folded at a convex edge or
-    // corner) is untangled, with the hexes within kDefectRings of it (a hex is untangled by
-    // moving its neighbours too), so that the result stays usable.
-    if (inverted_.empty()) return;
-    std::vector<Index> seeds = inverted_;
-    for (int ring = 0; ring < kDefectRings; ++ring) seeds = primal::hexes_around(mesh_, seeds);
-    res_.smoothing = primal::smooth_hexes_around(mesh_, seeds, options_.local_smooth_options);
-    res_.smoothing.initial_min_scaled_jacobian = res_.min_scaled_jacobian_before_smoothing;
-    res_.smoothing.final_min_scaled_jacobian = measure();
-    say("untangling: " + std::to_string(res_.placement_inverted) + " hexes the placement inverted, " +
-        std::to_string(inverted_.size()) + " left" + took());
-    return;
-  }
+  if (options_.smooth == ConformSmooth::kNone) return untangle();
+  res_.smoothing.initial_min_scaled_jacobian = res_.min_scaled_jacobian_before_smoothing;
   const bool local = options_.smooth == ConformSmooth::kLocal;
   primal::LocalSmoothOptions o = local ? options_.local_smooth_options : options_.global_smooth_options;
   auto last = Clock::now();
@@ -397,34 +411,53 @@ void Conformer::smooth() {
           " seed hexes settled" + took());
     }
   };
-  if (local) {
+  if (local && options_.smooth_target > 0.0) {
     std::vector<Index> geode(static_cast<std::size_t>(res_.geode_hexes));
     std::iota(geode.begin(), geode.end(), res_.diced_hexes);
-    std::vector<Index> seeds = primal::hexes_around(mesh_, geode);
-    if (options_.smooth_target > 0.0) {
-      o.target = options_.smooth_target;
-    } else {
-      const double yardstick = std::min(res_.input_diced_hex_min_scaled_jacobian, res_.input_diced_tet_min_scaled_jacobian);
-      std::vector<Index> defects;
-      for (Index h : seeds)
-        if (sj_[static_cast<std::size_t>(h)] < yardstick) defects.push_back(h);
-      for (int ring = 0; ring < kDefectRings && !defects.empty(); ++ring) defects = primal::hexes_around(mesh_, defects);
-      seeds = std::move(defects);
-    }
-    res_.smoothing = primal::smooth_hexes_around(mesh_, seeds, o);
+    o.target = options_.smooth_target;
+    add_smoothing(primal::smooth_hexes_around(mesh_, primal::hexes_around(mesh_, geode), o));
+  } else if (local) {
+    smooth_defects(o);
   } else {
     const auto boundary = primal::boundary_quads(mesh_);  // once for both
     const auto constraints = primal::boundary_slide_constraints(mesh_, boundary);
     const primal::TriMesh surface = primal::boundary_triangulation(mesh_.points, boundary);
-    res_.smoothing = primal::smooth_hexes_local(mesh_, constraints, &surface, {}, o);
+    add_smoothing(primal::smooth_hexes_local(mesh_, constraints, &surface, {}, o));
   }
-  res_.smoothing.initial_min_scaled_jacobian = res_.min_scaled_jacobian_before_smoothing;
   res_.smoothing.final_min_scaled_jacobian = measure();
+  untangle();
   const Index patches = res_.smoothing.patches;
   say("smoothing (" + std::string(local ? "local" : "global") + "): " +
       std::to_string(patches) + " patches, min scaled Jacobian " +
       std::to_string(res_.smoothing.initial_min_scaled_jacobian) + " -> " +
       std::to_string(res_.smoothing.final_min_scaled_jacobian) + took());
+}
+
+// Automatic target. The defects are the hexes below the yardstick (the input's own hexes and
+// tets diced alone: every hex the transition did not touch is above it). Patches start on them
+// and kDefectRings around, at hexes below a target a little above the yardstick, so that the
+// smoother works only where the transition is worse than dicing makes anyway and its cost
+// follows the defects. A defect whose neighbours are above that target has no room to rise:
+// where defects remain, the pass is repeated around them with a slightly higher target (small
+// steps: a pass costs what lies below its target around the defects).
+constexpr double kDefectTarget = 1.2;       // x the yardstick, first pass
+constexpr double kDefectTargetStep = 0.02;  // added to it by each further pass
+constexpr int kDefectPasses = 8;
+
+void Conformer::smooth_defects(primal::LocalSmoothOptions o) {
+  const double yardstick = std::min(res_.input_diced_hex_min_scaled_jacobian, res_.input_diced_tet_min_scaled_jacobian);
+  for (int pass = 0; pass < kDefectPasses; ++pass) {
+    std::vector<Index> defects;
+    for (std::size_t h = 0; h < sj_.size(); ++h)
+      if (sj_[h] < yardstick) defects.push_back(static_cast<Index>(h));
+    if (defects.empty()) return;
+    for (int ring = 0; ring < kDefectRings; ++ring) defects = primal::hexes_around(mesh_, defects);
+    o.target = kDefectTarget * yardstick + pass * kDefectTargetStep;
+    add_smoothing(primal::smooth_hexes_around(mesh_, defects, o));
+    // A patch moves the nodes of its seed hex: only hexes around the seeds changed.
+    for (Index h : primal::hexes_around(mesh_, defects))
+      sj_[static_cast<std::size_t>(h)] = primal::hex_scaled_jacobian(primal::hex_corners(mesh_, h));
+  }
 }
 
 double Conformer::measure() {

@@ -52,16 +52,17 @@ struct ConformOptions {
   // every hex, with a higher target so that the diced parts are improved too; kNone: nothing
   // but untangling the hexes the placement inverted, if any (ConformResult::placement_inverted).
   ConformSmooth smooth = ConformSmooth::kLocal;
-  // kLocal. 0 (automatic): the defects are the geode hexes and their neighbours below the
-  // yardstick (the input's own hexes and tets diced alone, ConformResult); patches start on
-  // them and two rings around, at hexes below local_smooth_options.target. The smoother then
-  // works only where the transition is worse than dicing the input makes anyway, and its cost
-  // follows the defects, not the interface. > 0: every geode hex and its neighbours below this
-  // scaled Jacobian seed patches.
+  // kLocal. 0 (automatic): the defects are the hexes below the yardstick (the input's own hexes
+  // and tets diced alone, ConformResult); patches start on them and two rings around, at hexes
+  // below 1.2 x the yardstick, and up to seven times more around the defects left, each time
+  // 0.02 higher. The smoother works only where the transition is worse than dicing the input makes
+  // anyway, and its cost follows the defects, not the interface. > 0: every geode hex and its
+  // neighbours below this scaled Jacobian seed patches.
   double smooth_target = 0.0;
   ConformQuality quality = ConformQuality::kScaledJacobian;
-  // More visits per hex and a narrower margin than the primal defaults: with the automatic
-  // target the patches are few, and lifting a defect takes its neighbours several moves.
+  // kLocal, and the untangling of hexes still inverted (with any mode); the automatic target
+  // replaces its target. More visits per hex and a narrower margin than the primal defaults:
+  // lifting a defect takes its neighbours several moves.
   primal::LocalSmoothOptions local_smooth_options = [] {
     primal::LocalSmoothOptions o;
     o.max_visits = 4;
