@@ -359,10 +359,7 @@ class Patch {
     const std::size_t n = frames_.size();
     q_.resize(n);
     for (std::size_t k = 0; k < n; ++k) q_[k] = measure(columns(p, frames_[k]), frames_[k], untangle, nullptr, nullptr);
-    const double qmin = *std::min_element(q_.begin(), q_.end());
-    double sum = 0.0;
-    for (std::size_t k = 0; k < n; ++k) sum += std::exp(-t * (q_[k] - qmin));
-    const double value = qmin - std::log(sum) / t;
+    const auto [qmin, sum, value] = soft_of_q(t);
     if (!grad) return value;
     const int m3 = 3 * moving_;
     grad->setZero(m3);
@@ -414,14 +411,41 @@ class Patch {
 
   // Untangling maximises Jacobians / L^3, which an edge collapse lowers: the edge floors bind
   // the shape phase only, where an untangling step may need an edge shorter for a while.
-  bool feasible(const std::vector<Point>& p, bool untangle) const {
-    for (std::size_t h = 0; h < hex_.size(); ++h) {
+  // Most rejected trial steps break a floor, and mostly at the hex that broke one last time:
+  // it is checked first, so a rejection costs about one hex.
+  bool feasible(const std::vector<Point>& p, bool untangle) {
+    const std::size_t n = hex_.size();
+    trial_q_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t h = (i + last_broken_) % n;
       HexCorners c;
       for (int k = 0; k < 8; ++k) c[k] = p[local_[h][k]];
-      if (hex_scaled_jacobian(c) < floor_[h]) return false;
-      if (!untangle && shortest_edge(c) < edge_floor_[h]) return false;
+      trial_q_[h] = hex_scaled_jacobians(c);
+      const double q = *std::min_element(trial_q_[h].begin(), trial_q_[h].end());
+      if (q < floor_[h] || (!untangle && shortest_edge(c) < edge_floor_[h])) {
+        last_broken_ = h;
+        return false;
+      }
     }
     return true;
+  }
+
+  // The soft minimum at the positions feasible() accepted last, from the frame values it
+  // measured (the shape phase's frame measure is the scaled Jacobian itself).
+  double accepted_soft_min(double t) {
+    for (std::size_t k = 0; k < frames_.size(); ++k) q_[k] = trial_q_[frames_[k].hex][frames_[k].frame];
+    return soft_of_q(t).value;
+  }
+
+  // -1/t log sum exp(-t q_k) over q_, shifted by the minimum so that no exponential overflows.
+  struct Soft {
+    double qmin, sum, value;
+  };
+  Soft soft_of_q(double t) const {
+    const double qmin = *std::min_element(q_.begin(), q_.end());
+    double sum = 0.0;
+    for (double q : q_) sum += std::exp(-t * (q - qmin));
+    return {qmin, sum, qmin - std::log(sum) / t};
   }
 
   // One damped Newton step on -soft_min in the moving nodes' free coordinates; false when no
@@ -472,8 +496,9 @@ class Patch {
     for (double step = 1.0; step > 0.01; step *= 0.5) {
       for (int i = 0; i < moving_; ++i)
         trial_[i] = constrain(ctx_, node_[i], pos_[i] + step * (basis[i] * d.segment(offset[i], basis[i].cols())));
-      const double f = -soft_min(trial_, untangle, t, nullptr, nullptr);
-      if (std::isfinite(f) && f <= f0 + 1e-4 * step * slope && f < f0 && feasible(trial_, untangle)) {
+      if (!feasible(trial_, untangle)) continue;
+      const double f = untangle ? -soft_min(trial_, untangle, t, nullptr, nullptr) : -accepted_soft_min(t);
+      if (std::isfinite(f) && f <= f0 + 1e-4 * step * slope && f < f0) {
         last_gain_ = f0 - f;
         lambda_ = step == 1.0 ? lambda_ / 4.0 : std::max(4.0 * lambda_, 1e-8 * scale);
         pos_.swap(trial_);
@@ -490,6 +515,8 @@ class Patch {
   std::vector<Point> pos_, trial_;
   std::vector<FrameRef> frames_;
   std::vector<double> q_, floor_, edge_floor_;
+  std::size_t last_broken_ = 0;  // the hex whose floor a trial step broke last
+  std::vector<std::array<double, 9>> trial_q_;  // per hex, its frames' scaled Jacobians
   int moving_ = 0;
   double length_ = 1.0, unit_ = 1.0, lambda_ = 0.0, last_gain_ = 0.0;
 };
@@ -563,39 +590,50 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
   std::vector<Index> claimed(nh, -1);
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
 
+  // The hexes a patch seeded by pool[i] touches (sharing a free node with it), found once.
+  std::vector<std::vector<Index>> around(pool.size());
+  std::vector<char> found(pool.size(), 0);
   for (Index round = 0;; ++round) {
-    std::vector<Index> cand;
-    for (Index h : pool)
-      if (sj[h] < options.target && visits[h] < options.max_visits && dirty[h]) cand.push_back(h);
+    std::vector<std::size_t> cand;  // positions in pool
+    for (std::size_t i = 0; i < pool.size(); ++i) {
+      const Index h = pool[i];
+      if (sj[h] < options.target && visits[h] < options.max_visits && dirty[h]) cand.push_back(i);
+    }
     if (options.progress) options.progress(pool.size() - cand.size(), pool.size());
     if (cand.empty()) break;
-    std::sort(cand.begin(), cand.end(), [&](Index a, Index b) { return sj[a] < sj[b] || (sj[a] == sj[b] && a < b); });
+    std::sort(cand.begin(), cand.end(), [&](std::size_t i, std::size_t j) {
+      const Index a = pool[i], b = pool[j];
+      return sj[a] < sj[b] || (sj[a] == sj[b] && a < b);
+    });
     // Worst first, each patch sharing no hex with one kept before it in this round.
     std::vector<Index> chosen;
-    std::vector<std::vector<Index>> affected;
-    std::vector<Index> around;
-    for (Index h : cand) {
-      around.clear();
-      for (Index v : mesh.hexes[h])
-        if (!is_fixed(ctx, v))
-          for (Index k = ctx.node_start[v]; k < ctx.node_start[v + 1]; ++k) around.push_back(ctx.node_hexes[k]);
-      std::sort(around.begin(), around.end());
-      around.erase(std::unique(around.begin(), around.end()), around.end());
-      if (around.empty()) {  // every node fixed: nothing to do, ever
+    std::vector<const std::vector<Index>*> affected;
+    for (std::size_t i : cand) {
+      const Index h = pool[i];
+      std::vector<Index>& a = around[i];
+      if (!found[i]) {
+        found[i] = 1;
+        for (Index v : mesh.hexes[h])
+          if (!is_fixed(ctx, v))
+            for (Index k = ctx.node_start[v]; k < ctx.node_start[v + 1]; ++k) a.push_back(ctx.node_hexes[k]);
+        std::sort(a.begin(), a.end());
+        a.erase(std::unique(a.begin(), a.end()), a.end());
+      }
+      if (a.empty()) {  // every node fixed: nothing to do, ever
         visits[h] = options.max_visits;
         continue;
       }
-      if (std::any_of(around.begin(), around.end(), [&](Index a) { return claimed[a] == round; })) continue;
-      for (Index a : around) claimed[a] = round;
+      if (std::any_of(a.begin(), a.end(), [&](Index x) { return claimed[x] == round; })) continue;
+      for (Index x : a) claimed[x] = round;
       chosen.push_back(h);
-      affected.push_back(around);
+      affected.push_back(&a);
     }
     std::vector<PatchOutcome> outcome(chosen.size());
     arena.execute([&] {
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chosen.size(), 1),
                         [&](const tbb::blocked_range<std::size_t>& r) {
                           for (std::size_t i = r.begin(); i != r.end(); ++i)
-                            outcome[i] = Patch(ctx, chosen[i], affected[i], sj).run(sj);
+                            outcome[i] = Patch(ctx, chosen[i], *affected[i], sj).run(sj);
                         });
     });
     for (std::size_t i = 0; i < chosen.size(); ++i) {
@@ -603,7 +641,7 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
       dirty[chosen[i]] = 0;
       res.iterations += outcome[i].iterations;
       if (outcome[i].moved)
-        for (Index a : affected[i])
+        for (Index a : *affected[i])
           if (a != chosen[i]) dirty[a] = 1;
     }
     res.patches += static_cast<Index>(chosen.size());
