@@ -67,6 +67,9 @@ nlohmann::json result_json(const conform::ConformResult& r) {
   j["min_scaled_jacobian_before_smoothing"] = r.min_scaled_jacobian_before_smoothing;
   j["min_scaled_jacobian_after_smoothing"] = r.smoothing.final_min_scaled_jacobian;
   j["hexes_inverted_by_placement"] = r.placement_inverted;
+  j["smoothing"] = {{"patches", r.smoothing.patches},
+                    {"seconds", r.smoothing.seconds},
+                    {"cpu_seconds", r.smoothing.cpu_seconds}};
   j["buffer_layer_min_scaled_jacobian"] = r.buffer.min_scaled_jacobian;
   j["input_diced_alone_min_scaled_jacobian"] = {{"hexes", r.input_diced_hex_min_scaled_jacobian},
                                                 {"tets", r.input_diced_tet_min_scaled_jacobian}};

@@ -397,8 +397,9 @@ void Conformer::add_smoothing(const primal::LocalSmoothResult& r) {
 // hex.
 void Conformer::smooth() {
   t0_ = Clock::now();
-  if (options_.smooth == ConformSmooth::kNone) return untangle();
   res_.smoothing.initial_min_scaled_jacobian = res_.min_scaled_jacobian_before_smoothing;
+  res_.smoothing.final_min_scaled_jacobian = res_.min_scaled_jacobian_before_smoothing;
+  if (options_.smooth == ConformSmooth::kNone) return untangle();
   const bool local = options_.smooth == ConformSmooth::kLocal;
   primal::LocalSmoothOptions o = local ? options_.local_smooth_options : options_.global_smooth_options;
   auto last = Clock::now();
