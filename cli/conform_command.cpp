@@ -271,10 +271,11 @@ void add_conform_commands(CLI::App& app) {
   CLI::App* c = app.add_subcommand(
       "conform",
       "Conform the hex part of a model to its tet part with geode templates: buffer layer, dicing\n"
-      "(8 per hex, 4 per tet), 26 geode hexes per interface quad split into two triangles (the\n"
-      "fixed-up four-triangle template where the tet side splits a quad into four triangles around a\n"
-      "centre node). Input element blocks, node sets and side sets are carried to the output. Exit 4\n"
-      "when the result fails verification.");
+      "(8 per hex, 4 per tet), 26 geode hexes per interface quad split into two triangles (44 hexes of\n"
+      "the superquadric-dome four-triangle template where the tet side splits a quad into four triangles\n"
+      "around a centre node), smoothing where the result is below the input's own diced elements.\n"
+      "Input element blocks, node sets and side sets are carried to the output. Exit 4 when the result\n"
+      "fails verification.");
   c->add_option("INPUT", args->input, "input model (.msh, .exo, .e, .vtu, .vtk)")->required();
   add_run_options(c, *args);
   c->callback([args] {

@@ -85,8 +85,8 @@ TEST_CASE("realistic models, default options: valid, untangled, at least 0.9 x t
 }
 
 // A mixed interface: Delaunay tets whose interface quads are split into two triangles (random
-// diagonals) or four around a centre node; the four-triangle ones get the fixed-up
-// four-triangle template, its side faces merged with the neighbouring geodes'.
+// diagonals) or four around a centre node; the four-triangle ones get the four-triangle
+// template (conform/reference_template.hpp), its side faces merged with the neighbouring geodes'.
 TEST_CASE("mixed two- and four-triangle interface: valid and untangled") {
   const primal::Model m = conform::demo_model("fourtri", 3);
   const Index geode_hexes = mixed_geode_hexes(m);
