@@ -105,9 +105,10 @@ void print_summary(const conform::ConformResult& r, std::ostream& os, bool table
   }
   // The transition against the input's own elements diced alone (the yardstick).
   const double yardstick = std::min(r.input_diced_hex_min_scaled_jacobian, r.input_diced_tet_min_scaled_jacobian);
+  const double output = output_min_sj(r);
   os << "input diced alone: min scaled Jacobian " << r.input_diced_hex_min_scaled_jacobian << " (hexes), "
-     << r.input_diced_tet_min_scaled_jacobian << " (tets); output " << output_min_sj(r);
-  if (yardstick > 0) os << " = " << output_min_sj(r) / yardstick << " x the lower";
+     << r.input_diced_tet_min_scaled_jacobian << " (tets); output " << output;
+  if (yardstick > 0) os << " = " << output / yardstick << " x the lower";
   os << "\n";
   for (const auto& w : r.warnings) os << "warning: " << w << "\n";
 }
