@@ -5,6 +5,7 @@
 #include <limits>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <sstream>
 #include <unordered_map>
 
@@ -444,9 +445,11 @@ void Conformer::smooth() {
 constexpr double kDefectTarget = 1.2;       // x the yardstick, first pass
 constexpr double kDefectTargetStep = 0.02;  // added to it by each further pass
 constexpr int kDefectPasses = 8;
+constexpr double kFeatureAngle = 30.0;  // boundary nodes slide along edges sharper than this
 
 void Conformer::smooth_defects(primal::LocalSmoothOptions o) {
   const double yardstick = std::min(res_.input_diced_hex_min_scaled_jacobian, res_.input_diced_tet_min_scaled_jacobian);
+  std::optional<primal::SmoothStart> start;  // the floors hold over all passes
   for (int pass = 0; pass < kDefectPasses; ++pass) {
     std::vector<Index> defects;
     for (std::size_t h = 0; h < sj_.size(); ++h)
@@ -454,7 +457,8 @@ void Conformer::smooth_defects(primal::LocalSmoothOptions o) {
     if (defects.empty()) return;
     for (int ring = 0; ring < kDefectRings; ++ring) defects = primal::hexes_around(mesh_, defects);
     o.target = kDefectTarget * yardstick + pass * kDefectTargetStep;
-    add_smoothing(primal::smooth_hexes_around(mesh_, defects, o));
+    if (!start) start = primal::smooth_start(mesh_);
+    add_smoothing(primal::smooth_hexes_around(mesh_, defects, o, kFeatureAngle, &*start));
     // A patch moves the nodes of its seed hex: only hexes around the seeds changed.
     for (Index h : primal::hexes_around(mesh_, defects))
       sj_[static_cast<std::size_t>(h)] = primal::hex_scaled_jacobian(primal::hex_corners(mesh_, h));

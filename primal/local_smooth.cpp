@@ -523,10 +523,20 @@ class Patch {
 
 }  // namespace
 
+SmoothStart smooth_start(const HexMesh& mesh) {
+  SmoothStart s;
+  s.scaled_jacobian = scaled_jacobian_per_hex(mesh);
+  s.shortest_edge.resize(mesh.hexes.size());
+  tbb::parallel_for(std::size_t{0}, mesh.hexes.size(), [&](std::size_t h) {
+    s.shortest_edge[h] = shortest_edge(hex_corners(mesh, static_cast<Index>(h)));
+  });
+  return s;
+}
+
 LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstraint> constraints,
                                      const TriMesh* surface, std::span<const Index> seeds,
-                                     const LocalSmoothOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
+                                     const LocalSmoothOptions& options, const SmoothStart* start) {
+  const auto clock_start = std::chrono::steady_clock::now();
   const std::clock_t cpu_start = std::clock();
   const std::size_t np = mesh.points.size(), nh = mesh.hexes.size();
   if (!constraints.empty() && constraints.size() != np)
@@ -540,6 +550,8 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
   for (Index s : seeds)
     if (s < 0 || static_cast<std::size_t>(s) >= nh)
       throw InvalidInput("smooth_hexes_local: seed hex " + std::to_string(s) + " out of range");
+  if (start && (start->scaled_jacobian.size() != nh || start->shortest_edge.size() != nh))
+    throw InvalidInput("smooth_hexes_local: the start values are not one per hex");
   std::unique_ptr<SurfaceProjector> projector;
   for (std::size_t v = 0; v < constraints.size(); ++v) {
     const NodeConstraint& c = constraints[v];
@@ -569,11 +581,12 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
     mesh.points[v] = constrain(ctx, static_cast<Index>(v), mesh.points[v]);
 
   LocalSmoothResult res;
-  std::vector<double> sj = scaled_jacobian_per_hex(mesh);
-  ctx.start = sj;
+  const SmoothStart now = start ? SmoothStart{} : smooth_start(mesh);
+  const SmoothStart& from = start ? *start : now;
+  std::vector<double> sj = start ? scaled_jacobian_per_hex(mesh) : now.scaled_jacobian;
+  ctx.start = from.scaled_jacobian;
   ctx.edge_floor.resize(nh);
-  for (std::size_t h = 0; h < nh; ++h)
-    ctx.edge_floor[h] = options.min_edge_fraction * shortest_edge(hex_corners(mesh, static_cast<Index>(h)));
+  for (std::size_t h = 0; h < nh; ++h) ctx.edge_floor[h] = options.min_edge_fraction * from.shortest_edge[h];
   auto summarise = [&](double& min_sj, Index& inverted) {
     min_sj = nh ? *std::min_element(sj.begin(), sj.end()) : 0.0;
     inverted = static_cast<Index>(std::count_if(sj.begin(), sj.end(), [](double q) { return q <= 0.0; }));
@@ -648,16 +661,19 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
     res.rounds = round + 1;
   }
   summarise(res.final_min_scaled_jacobian, res.final_inverted);
-  res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
   res.cpu_seconds = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
   return res;
 }
 
 LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seeds,
-                                      const LocalSmoothOptions& options, double feature_angle) {
+                                      const LocalSmoothOptions& options, double feature_angle,
+                                      const SmoothStart* start) {
   for (Index s : seeds)
     if (s < 0 || static_cast<std::size_t>(s) >= mesh.hexes.size())
       throw InvalidInput("smooth_hexes_around: seed hex " + std::to_string(s) + " out of range");
+  if (start && (start->scaled_jacobian.size() != mesh.hexes.size() || start->shortest_edge.size() != mesh.hexes.size()))
+    throw InvalidInput("smooth_hexes_around: the start values are not one per hex");
   if (seeds.empty()) return {};
   std::vector<Index> sorted(seeds.begin(), seeds.end());
   std::sort(sorted.begin(), sorted.end());
@@ -704,7 +720,13 @@ LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seed
   for (std::size_t v = 0; v < constraints.size(); ++v)
     if (!moves[v]) constraints[v] = NodeConstraint::fixed();
   const TriMesh surface = boundary_triangulation(sub.points, boundary);
-  LocalSmoothResult res = smooth_hexes_local(sub, constraints, &surface, local_seeds, options);
+  SmoothStart sub_start;
+  if (start)
+    for (Index h : outer) {
+      sub_start.scaled_jacobian.push_back(start->scaled_jacobian[static_cast<std::size_t>(h)]);
+      sub_start.shortest_edge.push_back(start->shortest_edge[static_cast<std::size_t>(h)]);
+    }
+  LocalSmoothResult res = smooth_hexes_local(sub, constraints, &surface, local_seeds, options, start ? &sub_start : nullptr);
   for (std::size_t v = 0; v < global.size(); ++v)
     if (moves[v]) mesh.points[global[v]] = sub.points[v];
   return res;

@@ -66,15 +66,27 @@ struct LocalSmoothResult {
   double cpu_seconds = 0.0;  // the process's CPU time over all threads (std::clock)
 };
 
+// What the floors are measured from, per hex of the mesh: its scaled Jacobian and its shortest
+// edge. Each call measures them when it begins; a caller that smooths in several calls
+// (passes) passes the values from before the first, so that the bounds (`loss`,
+// `min_edge_fraction`) hold over all of them instead of compounding.
+struct SmoothStart {
+  std::vector<double> scaled_jacobian;
+  std::vector<double> shortest_edge;
+};
+SmoothStart smooth_start(const HexMesh& mesh);
+
 // Smooths `mesh` in place. `constraints`: one per node (empty: all free); `surface`: the
 // triangulation kSurface nodes stay on (required when a constraint is kSurface); `seeds`: the
 // hexes that may seed patches (empty: every hex; patches still move every free node of the
-// seed, and their neighbours only within their floors). Throws InvalidInput on a size
-// mismatch, a bad node number or a kSurface constraint without a surface.
+// seed, and their neighbours only within their floors); `start`: see SmoothStart (null: now).
+// Throws InvalidInput on a size mismatch, a bad node number or a kSurface constraint without
+// a surface.
 LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstraint> constraints,
                                      const TriMesh* surface = nullptr,
                                      std::span<const Index> seeds = {},
-                                     const LocalSmoothOptions& options = {});
+                                     const LocalSmoothOptions& options = {},
+                                     const SmoothStart* start = nullptr);
 
 // smooth_hexes_local with the model's boundary sliding (boundary_slide_constraints and
 // boundary_triangulation, `feature_angle`), run on the submesh of the hexes around the seeds
@@ -87,7 +99,8 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
 // minima are over the hexes around the seeds.
 LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seeds,
                                       const LocalSmoothOptions& options = {},
-                                      double feature_angle = 30.0);
+                                      double feature_angle = 30.0,
+                                      const SmoothStart* start = nullptr);
 
 // Constraints that keep the mesh's boundary where it is while letting it slide: a boundary
 // node whose boundary quads all lie in one plane slides in it; where their normals fall in two

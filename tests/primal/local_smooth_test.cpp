@@ -200,6 +200,38 @@ TEST_CASE("no edge ends below min_edge_fraction of its hex's shortest edge at th
   CHECK(below(0.0) > 0);
 }
 
+// Passes: floors measured from the values before the first call hold over all calls; measured
+// afresh by each call, the losses add up. A fixed interior node pushed toward a corner makes
+// the hexes around it poor, and they rise only at their neighbours' expense.
+TEST_CASE("smoothing in passes from one SmoothStart keeps every hex within `loss` of it") {
+  const int n = 4;
+  const HexMesh first = grid(n, [&](const Point& p) {
+    return p == Point(2, 2, 2) ? Point(2.6, 2.6, 2.6) : p;
+  });
+  const gp::SmoothStart start = gp::smooth_start(first);
+  auto lost = [&](bool shared) {
+    HexMesh mesh = first;
+    auto cons = gp::boundary_slide_constraints(mesh);
+    cons[static_cast<std::size_t>(2 + (n + 1) * (2 + (n + 1) * 2))] = NodeConstraint::fixed();
+    gp::LocalSmoothOptions o;
+    o.max_visits = 4;
+    for (double target : {0.9, 0.95, 0.99}) {
+      o.target = target;
+      gp::smooth_hexes_local(mesh, cons, nullptr, {}, o, shared ? &start : nullptr);
+    }
+    const auto end = scaled_jacobians(mesh);
+    int k = 0;
+    for (std::size_t h = 0; h < end.size(); ++h) k += end[h] < start.scaled_jacobian[h] - o.loss - 1e-12;
+    return k;
+  };
+  CHECK(lost(true) == 0);
+  CHECK(lost(false) > 0);
+  HexMesh mesh = first;
+  gp::SmoothStart wrong = start;
+  wrong.shortest_edge.pop_back();
+  CHECK_THROWS_AS(gp::smooth_hexes_local(mesh, {}, nullptr, {}, {}, &wrong), geode::InvalidInput);
+}
+
 TEST_CASE("seeds limit the smoothing to their neighbourhood") {
   HexMesh mesh = jittered_grid(5, 0.3, 5);
   const HexMesh before = mesh;
