@@ -162,7 +162,7 @@ struct Context {
   const SurfaceProjector* projector;
   const LocalSmoothOptions& options;
   std::vector<Index> node_start, node_hexes;  // node -> hexes (CSR)
-  std::vector<double> start;                  // per hex, its scaled Jacobian when the call began
+  std::vector<double> start;                  // per hex, its scaled Jacobian at the start (SmoothStart)
   std::vector<double> edge_floor;             // per hex, the shortest edge it may have
 };
 

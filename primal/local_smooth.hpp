@@ -7,12 +7,12 @@
 // Jacobian first untangles (soft minimum of the Jacobians / L^3), then improves shape.
 //
 // Guarantees.
-//  - Floors. Let `start` be a hex's scaled Jacobian when the call began and `worst` the lowest
-//    of a patch's hexes when the patch begins. No hex of a patch ends below `worst`; a hex that
-//    started within `margin` of it ends no lower than its start; a better one loses at most
-//    `loss` from its start and never falls below worst + margin. Every trial step that would
-//    break a floor is cut back, so the patch's worst hex never gets worse, hexes near the worst
-//    never lose, and good hexes pay a bounded price. An inverted hex has no floor: untangling
+//  - Floors. Let `start` be a hex's scaled Jacobian when the call began (or the SmoothStart
+//    given) and `worst` the lowest of a patch's hexes when the patch begins. No hex of a patch
+//    ends below `worst`; a hex that started within `margin` of it ends no lower than its start;
+//    a better one loses at most `loss` from its start and never falls below worst + margin.
+//    Every trial step that would break a floor is cut back, so the patch's worst hex never
+//    gets worse, hexes near the worst never lose, and good hexes pay a bounded price. An inverted hex has no floor: untangling
 //    may move it through worse shapes; the soft minimum of the Jacobians it maximises keeps
 //    the worst Jacobian from dropping. Improving shape, no edge shrinks below min_edge_fraction
 //    of its hex's shortest edge at the start (the scaled Jacobian cannot see an edge collapse).
