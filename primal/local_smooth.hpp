@@ -12,10 +12,11 @@
 //    ends below `worst`; a hex that started within `margin` of it ends no lower than its start;
 //    a better one loses at most `loss` from its start and never falls below worst + margin.
 //    Every trial step that would break a floor is cut back, so the patch's worst hex never
-//    gets worse, hexes near the worst never lose, and good hexes pay a bounded price. An inverted hex has no floor: untangling
-//    may move it through worse shapes; the soft minimum of the Jacobians it maximises keeps
-//    the worst Jacobian from dropping. Improving shape, no edge shrinks below min_edge_fraction
-//    of its hex's shortest edge at the start (the scaled Jacobian cannot see an edge collapse).
+//    gets worse, hexes near the worst never lose, and good hexes pay a bounded price. An
+//    inverted hex has no floor: untangling may move it through worse shapes; the soft minimum
+//    of the Jacobians it maximises keeps the worst Jacobian from dropping. Improving shape, no
+//    edge shrinks below min_edge_fraction of its hex's shortest edge at the start (the scaled
+//    Jacobian cannot see an edge collapse).
 //  - Termination: each patch's soft minimum rises monotonically (Armijo) and stops when it rises
 //    by less than `min_gain`, after max_iterations, or when no step is accepted; each hex seeds
 //    at most max_visits patches, and only when a neighbouring patch moved one of its nodes since
