@@ -182,7 +182,11 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
                           std::to_string(corner_normals[k].size()) +
                           " interface faces at it (best min cos " + std::to_string(m) +
                           "), so no valid buffer layer can be placed there (the paper's Figure 9 right)");
-    direction[k] = d;
+    // The mitred offset: a step of height / (d . n) along d puts the node at distance height
+    // from every interface face whose corner normal fixes the cap's rim, so at convex and
+    // concave edges and corners a buffer hex's top stays parallel to its bottom instead of
+    // tilting towards the edge (and folding along its diagonal where its neighbour's does not).
+    direction[k] = d / std::max(m, opt.min_mitre_cos);
   }
 
   // Move, check, halve the steps of nodes of failing elements, repeat.
@@ -285,7 +289,7 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
   out.report.min_step = std::numeric_limits<double>::infinity();
   out.report.max_step = 0.0;
   for (std::size_t k = 0; k < n_moved; ++k) {
-    const double step = scale[k] * opt.thickness * shortest[k];
+    const double step = scale[k] * opt.thickness * shortest[k] * direction[k].norm();
     out.report.min_step = std::min(out.report.min_step, step);
     out.report.max_step = std::max(out.report.max_step, step);
   }

@@ -31,8 +31,12 @@ using primal::kInvalidIndex;
 using primal::Model;
 
 struct BufferLayerOptions {
-  // Step of each duplicated node, as a fraction of the shortest tet or interface-quad edge at it.
+  // Height of the buffer layer at each interface node (its distance from the interface faces
+  // there), as a fraction of the shortest tet or interface-quad edge at the node.
   double thickness = 0.3;
+  // A node whose faces meet at an edge or corner moves height / cos along the direction d
+  // (cos = min over its corner normals n of d . n, the mitred offset), cos at least this.
+  double min_mitre_cos = 0.5;
   // Every moved tet keeps at least this fraction of its volume.
   double min_volume_ratio = 0.05;
   // Every buffer hex has a Verdict scaled Jacobian (min over 8 corners and centre) above this.
