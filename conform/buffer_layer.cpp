@@ -7,6 +7,7 @@
 
 #include "primal/boundary.hpp"
 #include "primal/errors.hpp"
+#include "primal/gradation.hpp"
 #include "primal/key_map.hpp"
 #include "primal/quality.hpp"
 #include "primal/topology.hpp"
@@ -189,8 +190,35 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
     direction[k] = d / std::max(m, opt.min_mitre_cos);
   }
 
+  // Height of the layer per node. thickness x the shortest edge at a node is safe for its
+  // tets but jumps where one short tet edge meets the interface: a buffer hex whose corners
+  // stand at unequal heights has a twisted top, folded along its diagonal, and the template's
+  // nodes under the fold invert. So a node is raised towards its neighbours' heights (the
+  // smallest field within raise_rate x edge length of them), but not above thickness x its
+  // interface quads' mean edge (the buffer hex's own proportions); then lowered so that no
+  // two neighbours differ by more than smooth_rate x their edge, here and after every halving.
+  GradedEdges quad_edges;
+  std::vector<double> mean_quad_edge(n_moved, 0.0);
+  for (const InterfaceQuad& q : itf.quads)
+    for (std::size_t i = 0; i < 4; ++i) {
+      const Index a = q.corners[i], b = q.corners[(i + 1) % 4];
+      const double len = (pt(a) - pt(b)).norm();
+      quad_edges.nodes.push_back({static_cast<Index>(slot(a)), static_cast<Index>(slot(b))});
+      quad_edges.length.push_back(len);
+      mean_quad_edge[slot(a)] += len, mean_quad_edge[slot(b)] += len;
+    }
+  std::vector<double> step(n_moved);  // the node's height; it moves step x direction
+  for (std::size_t k = 0; k < n_moved; ++k) step[k] = opt.thickness * shortest[k];
+  std::vector<double> raised = step;
+  grade_up(raised, quad_edges, opt.raise_rate);
+  std::vector<int> quads_at(n_moved, 0);  // two of a quad's edges per corner
+  for (const InterfaceQuad& q : itf.quads)
+    for (Index v : q.corners) ++quads_at[slot(v)];
+  for (std::size_t k = 0; k < n_moved; ++k)
+    step[k] = std::max(step[k], std::min(raised[k], opt.thickness * mean_quad_edge[k] / (2.0 * quads_at[k])));
+  grade_down(step, quad_edges, opt.smooth_rate);
+
   // Move, check, halve the steps of nodes of failing elements, repeat.
-  std::vector<double> scale(n_moved, 1.0);
   auto tet_vol = [](const std::vector<Point>& pts, const std::array<Index, 4>& t) {
     return tet_volume(pts[static_cast<std::size_t>(t[0])], pts[static_cast<std::size_t>(t[1])],
                       pts[static_cast<std::size_t>(t[2])], pts[static_cast<std::size_t>(t[3])]);
@@ -214,15 +242,15 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
     out.model.points.resize(n_points);
     for (std::size_t k = 0; k < n_moved; ++k) {
       const std::size_t v = static_cast<std::size_t>(interface_nodes[k]);
-      out.model.points.push_back(P[v] + scale[k] * opt.thickness * shortest[k] * direction[k]);
+      out.model.points.push_back(P[v] + step[k] * direction[k]);
     }
     // A four-triangle centre keeps its place relative to the quad's corners.
     for (const BufferHex& b : out.hexes) {
       if (b.centre == kInvalidIndex) continue;
-      Point step = Point::Zero();
+      Point shift = Point::Zero();
       for (std::size_t i = 0; i < 4; ++i)
-        step += (out.model.points[static_cast<std::size_t>(b.corners[i + 4])] - P[static_cast<std::size_t>(b.corners[i])]) / 4.0;
-      out.model.points[static_cast<std::size_t>(b.centre)] = P[static_cast<std::size_t>(b.centre)] + step;
+        shift += (out.model.points[static_cast<std::size_t>(b.corners[i + 4])] - P[static_cast<std::size_t>(b.corners[i])]) / 4.0;
+      out.model.points[static_cast<std::size_t>(b.centre)] = P[static_cast<std::size_t>(b.centre)] + shift;
     }
     std::vector<char> failing(n_moved, 0);
     // A failing centre's steps are its quad's corners'.
@@ -284,14 +312,15 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
       throw TopologyError("insert_buffer_layer: no valid buffer layer after " + std::to_string(round) +
                           " halvings of the step: " + first_failure);
     for (std::size_t k = 0; k < n_moved; ++k)
-      if (failing[k]) scale[k] *= 0.5;
+      if (failing[k]) step[k] *= 0.5;
+    grade_down(step, quad_edges, opt.smooth_rate);
   }
   out.report.min_step = std::numeric_limits<double>::infinity();
   out.report.max_step = 0.0;
   for (std::size_t k = 0; k < n_moved; ++k) {
-    const double step = scale[k] * opt.thickness * shortest[k] * direction[k].norm();
-    out.report.min_step = std::min(out.report.min_step, step);
-    out.report.max_step = std::max(out.report.max_step, step);
+    const double moved = step[k] * direction[k].norm();
+    out.report.min_step = std::min(out.report.min_step, moved);
+    out.report.max_step = std::max(out.report.max_step, moved);
   }
   if (n_moved == 0) out.report.min_step = 0.0;
   return out;
