@@ -197,6 +197,8 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
   // smallest field within raise_rate x edge length of them), but not above thickness x its
   // interface quads' mean edge (the buffer hex's own proportions); then lowered so that no
   // two neighbours differ by more than smooth_rate x their edge, here and after every halving.
+  // A raised node whose tets or buffer hexes fail drops back to its safe height (the graded
+  // thickness x shortest edge) before it is ever halved.
   GradedEdges quad_edges;
   std::vector<double> mean_quad_edge(n_moved, 0.0);
   for (const InterfaceQuad& q : itf.quads)
@@ -214,6 +216,8 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
   std::vector<int> quads_at(n_moved, 0);  // two of a quad's edges per corner
   for (const InterfaceQuad& q : itf.quads)
     for (Index v : q.corners) ++quads_at[slot(v)];
+  grade_down(step, quad_edges, opt.smooth_rate);
+  std::vector<double> safe = step;  // where a raised node falls back to
   for (std::size_t k = 0; k < n_moved; ++k)
     step[k] = std::max(step[k], std::min(raised[k], opt.thickness * mean_quad_edge[k] / (2.0 * quads_at[k])));
   grade_down(step, quad_edges, opt.smooth_rate);
@@ -238,7 +242,7 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
     for (Index& v : t)
       if (out.top_node[static_cast<std::size_t>(v)] != kInvalidIndex) v = out.top_node[static_cast<std::size_t>(v)];
 
-  for (int round = 0;; ++round) {
+  for (int halvings = 0;;) {
     out.model.points.resize(n_points);
     for (std::size_t k = 0; k < n_moved; ++k) {
       const std::size_t v = static_cast<std::size_t>(interface_nodes[k]);
@@ -306,13 +310,22 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
                             " has scaled Jacobian " + std::to_string(sj);
         }
     }
-    out.report.halvings = round;
+    out.report.halvings = halvings;
     if (first_failure.empty()) break;
-    if (round >= opt.max_halvings)
-      throw TopologyError("insert_buffer_layer: no valid buffer layer after " + std::to_string(round) +
+    if (halvings >= opt.max_halvings)
+      throw TopologyError("insert_buffer_layer: no valid buffer layer after " + std::to_string(halvings) +
                           " halvings of the step: " + first_failure);
+    bool halved = false;
     for (std::size_t k = 0; k < n_moved; ++k)
-      if (failing[k]) step[k] *= 0.5;
+      if (failing[k]) {  // a raised node falls back to its safe height first
+        if (step[k] > safe[k]) {
+          step[k] = safe[k];
+        } else {
+          step[k] *= 0.5, safe[k] = step[k];
+          halved = true;
+        }
+      }
+    halvings += halved;
     grade_down(step, quad_edges, opt.smooth_rate);
   }
   out.report.min_step = std::numeric_limits<double>::infinity();
