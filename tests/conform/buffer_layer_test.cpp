@@ -6,6 +6,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 #include <string>
 
@@ -187,6 +188,30 @@ TEST_CASE("insert_buffer_layer: buffer tops parallel to their bottoms at convex 
     }
     CHECK(layer.report.min_scaled_jacobian > 0.0);
   }
+}
+
+TEST_CASE("insert_buffer_layer: one short tet edge does not twist the buffer tops around it") {
+  // Tets above a 3 x 3 quad interface at z = 1; the tet node above interface node (1,1,1) is
+  // lowered to z = 1.5, so the shortest edge there is 0.5 and thickness x shortest edge 0.15,
+  // against 0.3 at every other node: the four buffer hexes at that node would have tops
+  // twisted by 0.15 over edges of length 1. Graded, the node is raised towards its neighbours
+  // and no two neighbours differ by more than smooth_rate x their edge; the tets stay positive.
+  Model m = grid_model({3, 3, 2}, 1.0, [](int, int, int k) { return k == 1; });
+  auto node = [](int i, int j, int k) { return static_cast<std::size_t>(i + 4 * (j + 4 * k)); };
+  m.points[node(1, 1, 2)].z() = 1.5;
+  const Interface itf = find_interface(m);
+  REQUIRE(itf.quads.size() == 9);
+  const BufferLayerOptions o;
+  const BufferLayer layer = insert_buffer_layer(m, itf, o);
+  auto height = [&](Index v) {
+    return layer.model.points[static_cast<std::size_t>(layer.top_node[static_cast<std::size_t>(v)])].z() - 1.0;
+  };
+  CHECK(height(static_cast<Index>(node(1, 1, 1))) > o.thickness * 0.5 + 0.05);
+  for (const InterfaceQuad& q : itf.quads)
+    for (std::size_t i = 0; i < 4; ++i)
+      CHECK(std::abs(height(q.corners[i]) - height(q.corners[(i + 1) % 4])) <= o.smooth_rate * 1.0 + 1e-12);
+  CHECK(layer.report.min_tet_volume_ratio > 0.2);
+  CHECK(layer.report.min_scaled_jacobian > 0.9);
 }
 
 TEST_CASE("insert_buffer_layer: no layer where no direction sees all interface faces") {
