@@ -193,12 +193,12 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
   // Height of the layer per node. thickness x the shortest edge at a node is safe for its
   // tets but jumps where one short tet edge meets the interface: a buffer hex whose corners
   // stand at unequal heights has a twisted top, folded along its diagonal, and the template's
-  // nodes under the fold invert. So a node is raised towards its neighbours' heights (the
-  // smallest field within raise_rate x edge length of them), but not above thickness x its
-  // interface quads' mean edge (the buffer hex's own proportions); then lowered so that no
-  // two neighbours differ by more than smooth_rate x their edge, here and after every halving.
-  // A raised node whose tets or buffer hexes fail drops back to its safe height (the graded
-  // thickness x shortest edge) before it is ever halved.
+  // nodes under the fold invert. So a node is raised towards its neighbours' heights (to at
+  // least a neighbour's height less raise_rate x their edge, primal::grade_up), but not above
+  // thickness x its interface quads' mean edge (the buffer hex's own proportions); then
+  // lowered so that no two neighbours differ by more than smooth_rate x their edge, here and
+  // after every halving. A raised node whose tets or buffer hexes fail drops back to its safe
+  // height (the graded thickness x shortest edge) before it is ever halved.
   GradedEdges quad_edges;
   std::vector<double> mean_quad_edge(n_moved, 0.0);
   for (const InterfaceQuad& q : itf.quads)
@@ -211,11 +211,11 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
     }
   std::vector<double> step(n_moved);  // the node's height; it moves step x direction
   for (std::size_t k = 0; k < n_moved; ++k) step[k] = opt.thickness * shortest[k];
-  std::vector<double> raised = step;
-  grade_up(raised, quad_edges, opt.raise_rate);
   std::vector<int> quads_at(n_moved, 0);  // two of a quad's edges per corner
   for (const InterfaceQuad& q : itf.quads)
     for (Index v : q.corners) ++quads_at[slot(v)];
+  std::vector<double> raised = step;
+  grade_up(raised, quad_edges, opt.raise_rate);
   grade_down(step, quad_edges, opt.smooth_rate);
   std::vector<double> safe = step;  // where a raised node falls back to
   for (std::size_t k = 0; k < n_moved; ++k)
