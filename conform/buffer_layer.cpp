@@ -7,6 +7,7 @@
 
 #include "primal/boundary.hpp"
 #include "primal/errors.hpp"
+#include "primal/gradation.hpp"
 #include "primal/key_map.hpp"
 #include "primal/quality.hpp"
 #include "primal/topology.hpp"
@@ -182,11 +183,46 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
                           std::to_string(corner_normals[k].size()) +
                           " interface faces at it (best min cos " + std::to_string(m) +
                           "), so no valid buffer layer can be placed there (the paper's Figure 9 right)");
-    direction[k] = d;
+    // The mitred offset: a step of height / (d . n) along d puts the node at distance height
+    // from every interface face whose corner normal fixes the cap's rim, so at convex and
+    // concave edges and corners a buffer hex's top stays parallel to its bottom instead of
+    // tilting towards the edge (and folding along its diagonal where its neighbour's does not).
+    direction[k] = d / std::max(m, opt.min_mitre_cos);
   }
 
+  // Height of the layer per node. thickness x the shortest edge at a node is safe for its
+  // tets but jumps where one short tet edge meets the interface: a buffer hex whose corners
+  // stand at unequal heights has a twisted top, folded along its diagonal, and the template's
+  // nodes under the fold invert. So a node is raised towards its neighbours' heights (to at
+  // least a neighbour's height less raise_rate x their edge, primal::grade_up), but not above
+  // thickness x its interface quads' mean edge (the buffer hex's own proportions); then
+  // lowered so that no two neighbours differ by more than smooth_rate x their edge, here and
+  // after every halving. A raised node whose tets or buffer hexes fail drops back to its safe
+  // height (the graded thickness x shortest edge) before it is ever halved.
+  GradedEdges quad_edges;
+  std::vector<double> mean_quad_edge(n_moved, 0.0);
+  for (const InterfaceQuad& q : itf.quads)
+    for (std::size_t i = 0; i < 4; ++i) {
+      const Index a = q.corners[i], b = q.corners[(i + 1) % 4];
+      const double len = (pt(a) - pt(b)).norm();
+      quad_edges.nodes.push_back({static_cast<Index>(slot(a)), static_cast<Index>(slot(b))});
+      quad_edges.length.push_back(len);
+      mean_quad_edge[slot(a)] += len, mean_quad_edge[slot(b)] += len;
+    }
+  std::vector<double> step(n_moved);  // the node's height; it moves step x direction
+  for (std::size_t k = 0; k < n_moved; ++k) step[k] = opt.thickness * shortest[k];
+  std::vector<int> quads_at(n_moved, 0);  // two of a quad's edges per corner
+  for (const InterfaceQuad& q : itf.quads)
+    for (Index v : q.corners) ++quads_at[slot(v)];
+  std::vector<double> raised = step;
+  grade_up(raised, quad_edges, opt.raise_rate);
+  grade_down(step, quad_edges, opt.smooth_rate);
+  std::vector<double> safe = step;  // where a raised node falls back to
+  for (std::size_t k = 0; k < n_moved; ++k)
+    step[k] = std::max(step[k], std::min(raised[k], opt.thickness * mean_quad_edge[k] / (2.0 * quads_at[k])));
+  grade_down(step, quad_edges, opt.smooth_rate);
+
   // Move, check, halve the steps of nodes of failing elements, repeat.
-  std::vector<double> scale(n_moved, 1.0);
   auto tet_vol = [](const std::vector<Point>& pts, const std::array<Index, 4>& t) {
     return tet_volume(pts[static_cast<std::size_t>(t[0])], pts[static_cast<std::size_t>(t[1])],
                       pts[static_cast<std::size_t>(t[2])], pts[static_cast<std::size_t>(t[3])]);
@@ -206,19 +242,19 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
     for (Index& v : t)
       if (out.top_node[static_cast<std::size_t>(v)] != kInvalidIndex) v = out.top_node[static_cast<std::size_t>(v)];
 
-  for (int round = 0;; ++round) {
+  for (int halvings = 0;;) {
     out.model.points.resize(n_points);
     for (std::size_t k = 0; k < n_moved; ++k) {
       const std::size_t v = static_cast<std::size_t>(interface_nodes[k]);
-      out.model.points.push_back(P[v] + scale[k] * opt.thickness * shortest[k] * direction[k]);
+      out.model.points.push_back(P[v] + step[k] * direction[k]);
     }
     // A four-triangle centre keeps its place relative to the quad's corners.
     for (const BufferHex& b : out.hexes) {
       if (b.centre == kInvalidIndex) continue;
-      Point step = Point::Zero();
+      Point shift = Point::Zero();
       for (std::size_t i = 0; i < 4; ++i)
-        step += (out.model.points[static_cast<std::size_t>(b.corners[i + 4])] - P[static_cast<std::size_t>(b.corners[i])]) / 4.0;
-      out.model.points[static_cast<std::size_t>(b.centre)] = P[static_cast<std::size_t>(b.centre)] + step;
+        shift += (out.model.points[static_cast<std::size_t>(b.corners[i + 4])] - P[static_cast<std::size_t>(b.corners[i])]) / 4.0;
+      out.model.points[static_cast<std::size_t>(b.centre)] = P[static_cast<std::size_t>(b.centre)] + shift;
     }
     std::vector<char> failing(n_moved, 0);
     // A failing centre's steps are its quad's corners'.
@@ -274,20 +310,30 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
                             " has scaled Jacobian " + std::to_string(sj);
         }
     }
-    out.report.halvings = round;
+    out.report.halvings = halvings;
     if (first_failure.empty()) break;
-    if (round >= opt.max_halvings)
-      throw TopologyError("insert_buffer_layer: no valid buffer layer after " + std::to_string(round) +
+    if (halvings >= opt.max_halvings)
+      throw TopologyError("insert_buffer_layer: no valid buffer layer after " + std::to_string(halvings) +
                           " halvings of the step: " + first_failure);
+    bool halved = false;
     for (std::size_t k = 0; k < n_moved; ++k)
-      if (failing[k]) scale[k] *= 0.5;
+      if (failing[k]) {  // a raised node falls back to its safe height first
+        if (step[k] > safe[k]) {
+          step[k] = safe[k];
+        } else {
+          step[k] *= 0.5, safe[k] = step[k];
+          halved = true;
+        }
+      }
+    halvings += halved;
+    grade_down(step, quad_edges, opt.smooth_rate);
   }
   out.report.min_step = std::numeric_limits<double>::infinity();
   out.report.max_step = 0.0;
   for (std::size_t k = 0; k < n_moved; ++k) {
-    const double step = scale[k] * opt.thickness * shortest[k];
-    out.report.min_step = std::min(out.report.min_step, step);
-    out.report.max_step = std::max(out.report.max_step, step);
+    const double moved = step[k] * direction[k].norm();
+    out.report.min_step = std::min(out.report.min_step, moved);
+    out.report.max_step = std::max(out.report.max_step, moved);
   }
   if (n_moved == 0) out.report.min_step = 0.0;
   return out;

@@ -31,8 +31,17 @@ using primal::kInvalidIndex;
 using primal::Model;
 
 struct BufferLayerOptions {
-  // Step of each duplicated node, as a fraction of the shortest tet or interface-quad edge at it.
+  // Height of the buffer layer at each interface node (its distance from the interface faces
+  // there), as a fraction of the shortest tet or interface-quad edge at the node.
   double thickness = 0.3;
+  // Heights vary smoothly along the interface (see insert_buffer_layer): a node is raised to
+  // within raise_rate x edge length of its neighbours' heights (not above thickness x its
+  // interface quads' mean edge), and neighbours differ by at most smooth_rate x their edge.
+  double raise_rate = 0.03;
+  double smooth_rate = 0.1;
+  // A node whose faces meet at an edge or corner moves height / cos along the direction d
+  // (cos = min over its corner normals n of d . n, the mitred offset), cos at least this.
+  double min_mitre_cos = 0.5;
   // Every moved tet keeps at least this fraction of its volume.
   double min_volume_ratio = 0.05;
   // Every buffer hex has a Verdict scaled Jacobian (min over 8 corners and centre) above this.

@@ -6,6 +6,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 #include <string>
 
@@ -149,11 +150,68 @@ TEST_CASE("insert_buffer_layer: the nugget's corners move along the cavity diago
   const Model m = grid_model({3, 3, 3}, 1.0, [](int i, int j, int k) { return i == 1 && j == 1 && k == 1; });
   const BufferLayer layer = insert_buffer_layer(m, find_interface(m));
   // Corner (1,1,1) of the cavity: three faces with normals +x, +y, +z; the best direction is
-  // the diagonal; the shortest edge there is 1, so the step is the thickness.
+  // the diagonal; the shortest edge there is 1, so the height is the thickness, and the mitred
+  // step puts the copy at that height above each of the three faces.
   const Index v = 1 + 4 * (1 + 4 * 1);
   const Point moved = layer.model.points[static_cast<std::size_t>(layer.top_node[static_cast<std::size_t>(v)])];
-  const double step = BufferLayerOptions{}.thickness;
-  CHECK((moved - (Point(1, 1, 1) + step * Point(1, 1, 1).normalized())).norm() < 1e-12);
+  const double height = BufferLayerOptions{}.thickness;
+  CHECK((moved - (Point(1, 1, 1) + height * Point(1, 1, 1))).norm() < 1e-12);
+}
+
+TEST_CASE("insert_buffer_layer: buffer tops parallel to their bottoms at convex and concave edges and corners") {
+  // Kuhn-split tets whose shortest edge is 1 at every interface node: the layer has one
+  // height, thickness x 1, and every buffer hex's top corners lie that far above the plane of
+  // its bottom quad, also where two or three interface faces meet (a step along the averaged
+  // normal alone would leave edge and corner copies at height / sqrt 2 or / sqrt 3, the tops
+  // tilted towards the edge and folded along their diagonals against the neighbours').
+  const Case cases[] = {
+      {"tet cavity (convex edges and corners seen from the tets)", {4, 4, 4},
+       [](int i, int j, int k) { return i >= 1 && i <= 2 && j >= 1 && j <= 2 && k >= 1 && k <= 2; }, 24},
+      {"hex block inside tets (concave edges and corners seen from the tets)", {4, 4, 4},
+       [](int i, int j, int k) { return !(i >= 1 && i <= 2 && j >= 1 && j <= 2 && k >= 1 && k <= 2); }, 24},
+      {"L-shaped tet region in a hex block (a concave edge)", {4, 4, 3},
+       [](int i, int j, int k) { return k == 1 && ((i == 1 && (j == 1 || j == 2)) || (i == 2 && j == 1)); }, 14},
+  };
+  const double height = BufferLayerOptions{}.thickness;
+  for (const Case& c : cases) {
+    CAPTURE(c.name);
+    const Model m = grid_model(c.cells, 1.0, c.is_tet);
+    const Interface itf = find_interface(m);
+    REQUIRE(itf.quads.size() == c.quads);
+    const BufferLayer layer = insert_buffer_layer(m, itf);
+    CHECK(layer.report.halvings == 0);
+    const auto& p = layer.model.points;
+    for (const BufferHex& b : layer.hexes) {
+      auto at = [&](int i) -> const Point& { return p[static_cast<std::size_t>(b.corners[static_cast<std::size_t>(i)])]; };
+      const Point n = (at(1) - at(0)).cross(at(3) - at(0)).normalized();  // into the tet side
+      for (int i = 4; i < 8; ++i) CHECK(n.dot(at(i) - at(0)) == doctest::Approx(height).epsilon(1e-12));
+    }
+    CHECK(layer.report.min_scaled_jacobian > 0.0);
+  }
+}
+
+TEST_CASE("insert_buffer_layer: one short tet edge does not twist the buffer tops around it") {
+  // Tets above a 3 x 3 quad interface at z = 1; the tet node above interface node (1,1,1) is
+  // lowered to z = 1.5, so the shortest edge there is 0.5 and thickness x shortest edge 0.15,
+  // against 0.3 at every other node: the four buffer hexes at that node would have tops
+  // twisted by 0.15 over edges of length 1. Graded, the node is raised towards its neighbours
+  // and no two neighbours differ by more than smooth_rate x their edge; the tets stay positive.
+  Model m = grid_model({3, 3, 2}, 1.0, [](int, int, int k) { return k == 1; });
+  auto node = [](int i, int j, int k) { return static_cast<std::size_t>(i + 4 * (j + 4 * k)); };
+  m.points[node(1, 1, 2)].z() = 1.5;
+  const Interface itf = find_interface(m);
+  REQUIRE(itf.quads.size() == 9);
+  const BufferLayerOptions o;
+  const BufferLayer layer = insert_buffer_layer(m, itf, o);
+  auto height = [&](Index v) {
+    return layer.model.points[static_cast<std::size_t>(layer.top_node[static_cast<std::size_t>(v)])].z() - 1.0;
+  };
+  CHECK(height(static_cast<Index>(node(1, 1, 1))) > o.thickness * 0.5 + 0.05);
+  for (const InterfaceQuad& q : itf.quads)
+    for (std::size_t i = 0; i < 4; ++i)
+      CHECK(std::abs(height(q.corners[i]) - height(q.corners[(i + 1) % 4])) <= o.smooth_rate * 1.0 + 1e-12);
+  CHECK(layer.report.min_tet_volume_ratio > 0.2);
+  CHECK(layer.report.min_scaled_jacobian > 0.9);
 }
 
 TEST_CASE("insert_buffer_layer: no layer where no direction sees all interface faces") {
