@@ -8,15 +8,14 @@
 #include <limits>
 #include <string>
 
+#include "primal/detail/smooth_frames.hpp"
 #include "primal/errors.hpp"
 #include "primal/quality.hpp"
-#include "primal/topology.hpp"
 
 namespace geode::primal {
 
 namespace {
 
-namespace topo = topology;
 using Vec = Eigen::VectorXd;
 
 // One column of a corner matrix: a linear combination of node positions plus a constant
@@ -46,24 +45,23 @@ Column difference(Index to, Index from) {
 }
 
 std::vector<Frame> hex_frames(const HexMesh& mesh) {
+  const auto& shapes = detail::hex_frame_shapes();
   std::vector<Frame> frames;
-  frames.reserve(mesh.hexes.size() * 9);
+  frames.reserve(mesh.hexes.size() * 17);
   for (const auto& h : mesh.hexes) {
-    for (int c = 0; c < 8; ++c) {
+    for (const detail::HexFrameShape& shape : shapes) {
       Frame f;
-      for (int i = 0; i < 3; ++i) f.col[i] = difference(h[topo::kHexCornerNeighbors[c][i]], h[c]);
+      f.det_scale = shape.det_scale;
+      for (int i = 0; i < 3; ++i) {
+        Column& c = f.col[i];
+        for (int k = 0; k < shape.nodes; ++k) {
+          if (shape.coef[i][k] == 0.0) continue;
+          c.node[c.terms] = h[shape.corner[k]], c.coef[c.terms] = shape.coef[i][k];
+          ++c.terms;
+        }
+      }
       frames.push_back(f);
     }
-    Frame centre;  // principal axes X1, X2, X3 (primal/quality.hpp)
-    centre.det_scale = 1.0 / 64.0;
-    for (int i = 0; i < 3; ++i) {
-      centre.col[i].terms = 8;
-      for (int c = 0; c < 8; ++c) {
-        centre.col[i].node[c] = h[c];
-        centre.col[i].coef[c] = topo::kHexCornerCoords[c][i] ? 1.0 : -1.0;
-      }
-    }
-    frames.push_back(centre);
     for (int c = 0; c < 8; ++c) {
       Frame g = frames[frames.size() - 9 + c];
       g.guard = 3;
@@ -88,17 +86,6 @@ std::vector<Frame> quad_frames(const QuadMesh& mesh, const Point& unit_normal) {
     }
   }
   return frames;
-}
-
-// Orthonormal tangent pair of a plane with unit normal n, built from the coordinate axis
-// least aligned with n, so that an axis-aligned normal gives exactly axis-aligned tangents.
-std::array<Point, 2> plane_tangents(const Point& n) {
-  int k = 0;
-  for (int i = 1; i < 3; ++i) {
-    if (std::abs(n[i]) < std::abs(n[k])) k = i;
-  }
-  const Point t1 = n.cross(Point::Unit(k)).normalized();
-  return {t1, n.cross(t1)};
 }
 
 // Each node moves as p = base + B u with B a 3 x dof orthonormal basis.
@@ -135,7 +122,7 @@ std::vector<NodeSpace> node_spaces(const std::vector<Point>& points,
         break;
       case NodeConstraint::Kind::kFree:
         if (plane_normal) {
-          const auto t = plane_tangents(*plane_normal);
+          const auto t = detail::plane_tangents(*plane_normal);
           dirs = {t[0], t[1]};
         } else {
           dirs = {Point::UnitX(), Point::UnitY(), Point::UnitZ()};
@@ -144,19 +131,19 @@ std::vector<NodeSpace> node_spaces(const std::vector<Point>& points,
       case NodeConstraint::Kind::kPlane:
       case NodeConstraint::Kind::kSurface: {
         const Point n = c.direction.normalized();
-        s.base -= (s.base - c.origin).dot(n) * n;
+        s.base = detail::project_to_plane(s.base, c.origin, n);
         if (plane_normal && n.cross(*plane_normal).norm() > 1e-12) {
           dirs = {n.cross(*plane_normal).normalized()};  // the line where the planes meet
         } else {
           // The mesh plane itself (same normal) or, for a hex mesh, the plane.
-          const auto t = plane_tangents(plane_normal ? *plane_normal : n);
+          const auto t = detail::plane_tangents(plane_normal ? *plane_normal : n);
           dirs = {t[0], t[1]};
         }
         break;
       }
       case NodeConstraint::Kind::kLine: {
         const Point d = c.direction.normalized();
-        s.base = c.origin + (s.base - c.origin).dot(d) * d;
+        s.base = detail::project_to_line(s.base, c.origin, d);
         if (!plane_normal || std::abs(d.dot(*plane_normal)) < 1e-12) dirs = {d};
         break;
       }
