@@ -10,6 +10,7 @@
 
 #include "primal/detail/smooth_frames.hpp"
 #include "primal/errors.hpp"
+#include "primal/frame_derivatives.hpp"
 #include "primal/quality.hpp"
 
 namespace geode::primal {
@@ -184,48 +185,18 @@ std::vector<NodeSpace> node_spaces(const std::vector<Point>& points,
 // scaled Jacobian (or, for a guard frame, its corner shape / guard factor).
 enum class Measure { kJacobian, kShape };
 
-// Value of a corner matrix [v0, v1, v2]; with d, also its derivative with respect to the 9
-// column entries.
-double column_value(const Eigen::Matrix<double, 9, 1>& v, Measure measure, int guard,
-                    double scale, Eigen::Matrix<double, 9, 1>* d) {
-  const Point a = v.segment<3>(0), b = v.segment<3>(3), c = v.segment<3>(6);
-  const Point bc = b.cross(c), ca = c.cross(a), ab = a.cross(b);
-  const double det = a.dot(bc);
-  if (measure == Measure::kJacobian) {
-    if (d) *d << bc * scale, ca * scale, ab * scale;
-    return det * scale;
-  }
-  if (guard != 0) {
-    // 3D: 3 sgn(det) |det|^(2/3) / S, S = |a|^2 + |b|^2 + |c|^2; 2D (c the unit normal):
-    // 2 det / S, S = |a|^2 + |b|^2. Both are then divided by the guard factor `scale`.
-    const bool three = guard == 3;
-    const double sum = a.squaredNorm() + b.squaredNorm() + (three ? c.squaredNorm() : 0.0);
-    if (!(sum > 0.0)) {
-      if (d) d->setZero();
-      return 0.0;
-    }
-    const double root = std::cbrt(std::abs(det));
-    const double num = three ? 3.0 * std::copysign(root * root, det) : 2.0 * det;
-    const double q = num / sum / scale;
-    if (d) {
-      // d num / d det: 2 |det|^(-1/3) in 3D (unbounded at det = 0, never reached after
-      // untangling), 2 in 2D.
-      const double dnum = three ? (root > 0.0 ? 2.0 / root : 0.0) : 2.0;
-      const double k = dnum / sum / scale;
-      *d << k * bc - 2.0 * q * a / sum, k * ca - 2.0 * q * b / sum,
-          three ? Point(k * ab - 2.0 * q * c / sum) : Point::Zero();
-    }
-    return q;
-  }
-  const double la = a.norm(), lb = b.norm(), lc = c.norm();
-  const double l = la * lb * lc;
-  if (!(l > 0.0)) {  // a degenerate column: value 0 (quality.hpp), no useful gradient
-    if (d) d->setZero();
-    return 0.0;
-  }
-  const double q = det / l;
-  if (d) *d << bc / l - q * a / (la * la), ca / l - q * b / (lb * lb), ab / l - q * c / (lc * lc);
-  return q;
+// Value of a corner matrix [v0, v1, v2]; with grad (hess), also its first (second) derivatives
+// with respect to the 9 column entries (primal/frame_derivatives.hpp). `scale` multiplies a
+// Jacobian and divides a guard frame's shape.
+double column_value(const FrameVector& v, Measure measure, int guard, double scale,
+                    FrameVector* grad, FrameMatrix* hess = nullptr) {
+  if (measure == Measure::kShape && guard == 0) return scaled_determinant_derivatives(v, grad, hess);
+  const double factor = measure == Measure::kJacobian ? scale : 1.0 / scale;
+  const double q = measure == Measure::kJacobian ? determinant_derivatives(v, grad, hess)
+                                                 : corner_shape_derivatives(v, guard, grad, hess);
+  if (grad) *grad *= factor;
+  if (hess) *hess *= factor;
+  return q * factor;
 }
 
 // The problem in reduced coordinates u (the free coordinates of every node, NodeSpace). Each
@@ -244,7 +215,7 @@ class Problem {
       l.det_scale = f.det_scale;
       l.guard = f.guard;
       l.v0.setZero();
-      std::vector<Eigen::Matrix<double, 9, 1>> cols;
+      std::vector<FrameVector> cols;
       for (int j = 0; j < 3; ++j) {
         const Column& c = f.col[j];
         l.v0.segment<3>(3 * j) += c.constant;
@@ -257,7 +228,7 @@ class Problem {
             const auto col = static_cast<std::size_t>(it - l.idx.begin());
             if (it == l.idx.end()) {
               l.idx.push_back(dof);
-              cols.push_back(Eigen::Matrix<double, 9, 1>::Zero());
+              cols.push_back(FrameVector::Zero());
             }
             cols[col].segment<3>(3 * j) += c.coef[t] * s.basis.col(k);
           }
@@ -292,8 +263,8 @@ class Problem {
   // Soft minimum of the frame values. With grad (and hess), the gradient (and Hessian) of its
   // negative, the function we minimise:
   //   grad f = -sum w_k g_k,  hess f = -sum w_k H_k + t (sum w_k g_k g_k^T - gbar gbar^T)
-  // with w the softmax weights, g_k, H_k the derivatives of q_k, gbar = sum w_k g_k. H_k comes
-  // from central differences of the analytic column gradient (9 x 9, then mapped by M).
+  // with w the softmax weights, g_k, H_k the derivatives of q_k, gbar = sum w_k g_k (H_k the
+  // analytic 9 x 9 Hessian of the frame's columns, then mapped by M).
   double soft_min(const Vec& x, Measure m, double t, Vec* grad,
                   Eigen::MatrixXd* hess = nullptr) {
     const std::size_t n = locals_.size();
@@ -323,8 +294,9 @@ class Problem {
       const Vec gk = l.map.transpose() * dq_[k];
       for (std::size_t i = 0; i < l.idx.size(); ++i) (*grad)[l.idx[i]] -= w * gk[i];
       if (!hess) continue;
-      const Eigen::Matrix<double, 9, 9> hv = column_hessian(
-          columns(k, x), m, m == Measure::kJacobian ? 0 : l.guard, scale_of(l, m));
+      FrameMatrix hv;
+      column_value(columns(k, x), m, m == Measure::kJacobian ? 0 : l.guard, scale_of(l, m), nullptr,
+                   &hv);
       const Eigen::MatrixXd hk = l.map.transpose() * hv * l.map;
       for (std::size_t i = 0; i < l.idx.size(); ++i) {
         for (std::size_t j = 0; j < l.idx.size(); ++j) {
@@ -338,7 +310,7 @@ class Problem {
 
  private:
   struct Local {
-    Eigen::Matrix<double, 9, 1> v0;
+    FrameVector v0;
     Eigen::Matrix<double, 9, Eigen::Dynamic> map;
     std::vector<int> idx;  // the reduced coordinates this frame depends on
     double det_scale = 1.0;
@@ -350,29 +322,13 @@ class Problem {
     return m == Measure::kJacobian ? l.det_scale / unit_ : guard_;
   }
 
-  Eigen::Matrix<double, 9, 1> columns(std::size_t k, const Vec& x) const {
+  FrameVector columns(std::size_t k, const Vec& x) const {
     const Local& l = locals_[k];
-    Eigen::Matrix<double, 9, 1> v = l.v0;
+    FrameVector v = l.v0;
     for (std::size_t i = 0; i < l.idx.size(); ++i) {
       v += l.map.col(static_cast<Eigen::Index>(i)) * x[l.idx[i]];
     }
     return v;
-  }
-
-  static Eigen::Matrix<double, 9, 9> column_hessian(const Eigen::Matrix<double, 9, 1>& v,
-                                                    Measure m, int guard, double scale) {
-    Eigen::Matrix<double, 9, 9> h;
-    Eigen::Matrix<double, 9, 1> dp, dm;
-    for (int i = 0; i < 9; ++i) {
-      const double step = 1e-6 * std::max(v.segment<3>(3 * (i / 3)).norm(), 1e-12);
-      Eigen::Matrix<double, 9, 1> vp = v, vm = v;
-      vp[i] += step;
-      vm[i] -= step;
-      column_value(vp, m, guard, scale, &dp);
-      column_value(vm, m, guard, scale, &dm);
-      h.col(i) = (dp - dm) / (2 * step);
-    }
-    return 0.5 * (h + h.transpose());
   }
 
   std::vector<NodeSpace> spaces_;
@@ -380,7 +336,7 @@ class Problem {
   std::vector<Local> locals_;
   int dof_ = 0;
   std::vector<double> q_, w_;
-  std::vector<Eigen::Matrix<double, 9, 1>> dq_;
+  std::vector<FrameVector> dq_;
 };
 
 // Minimises f with a damped Newton method: solve (H + lambda I) d = -g by Cholesky, raising
