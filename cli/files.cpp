@@ -6,6 +6,7 @@
 #include "cli/commands.hpp"
 #include "primal/atomic_file.hpp"
 #include "primal/errors.hpp"
+#include "primal/file_format.hpp"
 #include "primal/io_exodus.hpp"
 #include "primal/io_gmsh.hpp"
 #include "primal/io_vtk.hpp"
@@ -25,9 +26,12 @@ primal::Model read_model(const fs::path& path) { return primal::read_model(path)
 
 MeshFile read_mesh_file(const fs::path& path) {
   if (!fs::exists(path)) throw InvalidInput(path.string() + ": no such file");
-  const std::string e = file_extension(path);
+  const primal::MeshFileFormat format = primal::mesh_format_from_extension(path);
+  if (format == primal::MeshFileFormat::kUnknown)
+    throw InvalidInput(path.string() + ": unknown input format '" + file_extension(path) +
+                       "' (expected .vtu, .vtk, .msh, .exo or .e)");
   MeshFile m;
-  if (e == ".vtu" || e == ".vtk") {
+  if (format == primal::MeshFileFormat::kVtu || format == primal::MeshFileFormat::kVtk) {
     const primal::VtkGrid g = primal::read_vtk_file(path);
     const bool quads = !g.cell_types.empty() && std::all_of(g.cell_types.begin(), g.cell_types.end(),
                                                              [](int t) { return t == primal::kVtkQuad; });
@@ -43,8 +47,6 @@ MeshFile read_mesh_file(const fs::path& path) {
     }
     return m;
   }
-  if (e != ".msh" && e != ".exo" && e != ".e")
-    throw InvalidInput(path.string() + ": unknown input format '" + e + "' (expected .vtu, .vtk, .msh, .exo or .e)");
   const primal::Model model = read_model(path);
   if (!model.tets.empty())
     throw InvalidInput(path.string() + ": holds " + std::to_string(model.tets.size()) +

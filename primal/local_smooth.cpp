@@ -15,6 +15,7 @@
 #include <unordered_map>
 
 #include "primal/boundary.hpp"
+#include "primal/detail/smooth_frames.hpp"
 #include "primal/errors.hpp"
 #include "primal/frame_derivatives.hpp"
 #include "primal/quality.hpp"
@@ -32,36 +33,8 @@ using PatchVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxDof, 1>;
 using PatchMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxDof, kMaxDof>;
 using Basis = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, 3>;
 
-// Frame f of a hex (0..7 corner f, 8 the centre) as columns v_i = sum_k coef[i][k] p[corner[k]]
-// (primal/quality.hpp: corner edges in kHexCornerNeighbors order; principal axes X1, X2, X3).
-struct FrameShape {
-  int nodes = 0;
-  std::array<int, 8> corner{};
-  std::array<std::array<double, 8>, 3> coef{};
-  double det_scale = 1.0;  // Jacobian = det * det_scale
-};
-
-const std::array<FrameShape, 9>& frame_shapes() {
-  static const std::array<FrameShape, 9> shapes = [] {
-    std::array<FrameShape, 9> s{};
-    for (int c = 0; c < 8; ++c) {
-      FrameShape& f = s[c];
-      f.nodes = 4;
-      f.corner = {c, topo::kHexCornerNeighbors[c][0], topo::kHexCornerNeighbors[c][1],
-                  topo::kHexCornerNeighbors[c][2], 0, 0, 0, 0};
-      for (int i = 0; i < 3; ++i) f.coef[i][0] = -1.0, f.coef[i][i + 1] = 1.0;
-    }
-    FrameShape& centre = s[8];
-    centre.nodes = 8;
-    centre.det_scale = 1.0 / 64.0;
-    for (int c = 0; c < 8; ++c) {
-      centre.corner[c] = c;
-      for (int i = 0; i < 3; ++i) centre.coef[i][c] = topo::kHexCornerCoords[c][i] ? 1.0 : -1.0;
-    }
-    return s;
-  }();
-  return shapes;
-}
+using detail::hex_frame_shapes;
+using detail::HexFrameShape;
 
 // Closest point of triangle abc to p (C. Ericson, Real-Time Collision Detection, 5.1.5).
 Point closest_on_triangle(const Point& p, const Point& a, const Point& b, const Point& c) {
@@ -181,12 +154,9 @@ Basis motion_basis(const Context& ctx, Index v, const Point& p) {
   const NodeConstraint c = ctx.constraints.empty() ? NodeConstraint::free() : ctx.constraints[v];
   Basis b;
   auto plane = [&](const Point& n) {
-    int k = 0;  // the axis least aligned with n, so axis-aligned planes get axis tangents
-    for (int i = 1; i < 3; ++i)
-      if (std::abs(n[i]) < std::abs(n[k])) k = i;
-    const Point t1 = n.cross(Point::Unit(k)).normalized();
+    const auto t = detail::plane_tangents(n);
     b.resize(3, 2);
-    b.col(0) = t1, b.col(1) = n.cross(t1);
+    b.col(0) = t[0], b.col(1) = t[1];
   };
   switch (c.kind) {
     case NodeConstraint::Kind::kFree:
@@ -217,14 +187,10 @@ Point constrain(const Context& ctx, Index v, const Point& p) {
   if (ctx.constraints.empty()) return p;
   const NodeConstraint& c = ctx.constraints[v];
   switch (c.kind) {
-    case NodeConstraint::Kind::kPlane: {
-      const Point n = c.direction.normalized();
-      return p - (p - c.origin).dot(n) * n;
-    }
-    case NodeConstraint::Kind::kLine: {
-      const Point d = c.direction.normalized();
-      return c.origin + (p - c.origin).dot(d) * d;
-    }
+    case NodeConstraint::Kind::kPlane:
+      return detail::project_to_plane(p, c.origin, c.direction.normalized());
+    case NodeConstraint::Kind::kLine:
+      return detail::project_to_line(p, c.origin, c.direction.normalized());
     case NodeConstraint::Kind::kSurface:
       return ctx.projector->project(p, nullptr);
     default:
@@ -256,7 +222,7 @@ class Patch {
       }
     pos_.resize(node_.size());
     for (std::size_t i = 0; i < node_.size(); ++i) pos_[i] = ctx.mesh.points[node_[i]];
-    const auto& shapes = frame_shapes();
+    const auto& shapes = hex_frame_shapes();
     for (std::size_t h = 0; h < hex_.size(); ++h)
       for (int f = 0; f < 9; ++f) {
         bool has = false;
@@ -321,7 +287,7 @@ class Patch {
   };
 
   FrameVector columns(const std::vector<Point>& p, const FrameRef& r) const {
-    const FrameShape& s = frame_shapes()[r.frame];
+    const HexFrameShape& s = hex_frame_shapes()[r.frame];
     FrameVector v = FrameVector::Zero();
     for (int k = 0; k < s.nodes; ++k) {
       const Point& x = p[local_[r.hex][s.corner[k]]];
@@ -333,7 +299,7 @@ class Patch {
   double measure(const FrameVector& v, const FrameRef& r, bool untangle, FrameVector* g,
                  FrameMatrix* h) const {
     if (!untangle) return scaled_determinant_derivatives(v, g, h);
-    const double scale = frame_shapes()[r.frame].det_scale / unit_;
+    const double scale = hex_frame_shapes()[r.frame].det_scale / unit_;
     const double d = determinant_derivatives(v, g, h);
     if (g) *g *= scale;
     if (h) *h *= scale;
@@ -364,7 +330,7 @@ class Patch {
     const int m3 = 3 * moving_;
     grad->setZero(m3);
     hess->setZero(m3, m3);
-    const auto& shapes = frame_shapes();
+    const auto& shapes = hex_frame_shapes();
     for (std::size_t k = 0; k < n; ++k) {
       const double w = std::exp(-t * (q_[k] - qmin)) / sum;
       if (w < 1e-10) continue;  // far above the minimum: nothing measurable
@@ -372,7 +338,7 @@ class Patch {
       // minimum's curvature is dominated by its few lowest frames); the gradient stays exact.
       const bool second = w >= 1e-4;
       const FrameRef& r = frames_[k];
-      const FrameShape& s = shapes[r.frame];
+      const HexFrameShape& s = shapes[r.frame];
       FrameVector g;
       FrameMatrix h;
       measure(columns(p, r), r, untangle, &g, second ? &h : nullptr);

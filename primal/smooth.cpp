@@ -8,15 +8,15 @@
 #include <limits>
 #include <string>
 
+#include "primal/detail/smooth_frames.hpp"
 #include "primal/errors.hpp"
+#include "primal/frame_derivatives.hpp"
 #include "primal/quality.hpp"
-#include "primal/topology.hpp"
 
 namespace geode::primal {
 
 namespace {
 
-namespace topo = topology;
 using Vec = Eigen::VectorXd;
 
 // One column of a corner matrix: a linear combination of node positions plus a constant
@@ -46,24 +46,23 @@ Column difference(Index to, Index from) {
 }
 
 std::vector<Frame> hex_frames(const HexMesh& mesh) {
+  const auto& shapes = detail::hex_frame_shapes();
   std::vector<Frame> frames;
-  frames.reserve(mesh.hexes.size() * 9);
+  frames.reserve(mesh.hexes.size() * 17);
   for (const auto& h : mesh.hexes) {
-    for (int c = 0; c < 8; ++c) {
+    for (const detail::HexFrameShape& shape : shapes) {
       Frame f;
-      for (int i = 0; i < 3; ++i) f.col[i] = difference(h[topo::kHexCornerNeighbors[c][i]], h[c]);
+      f.det_scale = shape.det_scale;
+      for (int i = 0; i < 3; ++i) {
+        Column& c = f.col[i];
+        for (int k = 0; k < shape.nodes; ++k) {
+          if (shape.coef[i][k] == 0.0) continue;
+          c.node[c.terms] = h[shape.corner[k]], c.coef[c.terms] = shape.coef[i][k];
+          ++c.terms;
+        }
+      }
       frames.push_back(f);
     }
-    Frame centre;  // principal axes X1, X2, X3 (primal/quality.hpp)
-    centre.det_scale = 1.0 / 64.0;
-    for (int i = 0; i < 3; ++i) {
-      centre.col[i].terms = 8;
-      for (int c = 0; c < 8; ++c) {
-        centre.col[i].node[c] = h[c];
-        centre.col[i].coef[c] = topo::kHexCornerCoords[c][i] ? 1.0 : -1.0;
-      }
-    }
-    frames.push_back(centre);
     for (int c = 0; c < 8; ++c) {
       Frame g = frames[frames.size() - 9 + c];
       g.guard = 3;
@@ -88,17 +87,6 @@ std::vector<Frame> quad_frames(const QuadMesh& mesh, const Point& unit_normal) {
     }
   }
   return frames;
-}
-
-// Orthonormal tangent pair of a plane with unit normal n, built from the coordinate axis
-// least aligned with n, so that an axis-aligned normal gives exactly axis-aligned tangents.
-std::array<Point, 2> plane_tangents(const Point& n) {
-  int k = 0;
-  for (int i = 1; i < 3; ++i) {
-    if (std::abs(n[i]) < std::abs(n[k])) k = i;
-  }
-  const Point t1 = n.cross(Point::Unit(k)).normalized();
-  return {t1, n.cross(t1)};
 }
 
 // Each node moves as p = base + B u with B a 3 x dof orthonormal basis.
@@ -135,7 +123,7 @@ std::vector<NodeSpace> node_spaces(const std::vector<Point>& points,
         break;
       case NodeConstraint::Kind::kFree:
         if (plane_normal) {
-          const auto t = plane_tangents(*plane_normal);
+          const auto t = detail::plane_tangents(*plane_normal);
           dirs = {t[0], t[1]};
         } else {
           dirs = {Point::UnitX(), Point::UnitY(), Point::UnitZ()};
@@ -144,19 +132,19 @@ std::vector<NodeSpace> node_spaces(const std::vector<Point>& points,
       case NodeConstraint::Kind::kPlane:
       case NodeConstraint::Kind::kSurface: {
         const Point n = c.direction.normalized();
-        s.base -= (s.base - c.origin).dot(n) * n;
+        s.base = detail::project_to_plane(s.base, c.origin, n);
         if (plane_normal && n.cross(*plane_normal).norm() > 1e-12) {
           dirs = {n.cross(*plane_normal).normalized()};  // the line where the planes meet
         } else {
           // The mesh plane itself (same normal) or, for a hex mesh, the plane.
-          const auto t = plane_tangents(plane_normal ? *plane_normal : n);
+          const auto t = detail::plane_tangents(plane_normal ? *plane_normal : n);
           dirs = {t[0], t[1]};
         }
         break;
       }
       case NodeConstraint::Kind::kLine: {
         const Point d = c.direction.normalized();
-        s.base = c.origin + (s.base - c.origin).dot(d) * d;
+        s.base = detail::project_to_line(s.base, c.origin, d);
         if (!plane_normal || std::abs(d.dot(*plane_normal)) < 1e-12) dirs = {d};
         break;
       }
@@ -197,48 +185,18 @@ std::vector<NodeSpace> node_spaces(const std::vector<Point>& points,
 // scaled Jacobian (or, for a guard frame, its corner shape / guard factor).
 enum class Measure { kJacobian, kShape };
 
-// Value of a corner matrix [v0, v1, v2]; with d, also its derivative with respect to the 9
-// column entries.
-double column_value(const Eigen::Matrix<double, 9, 1>& v, Measure measure, int guard,
-                    double scale, Eigen::Matrix<double, 9, 1>* d) {
-  const Point a = v.segment<3>(0), b = v.segment<3>(3), c = v.segment<3>(6);
-  const Point bc = b.cross(c), ca = c.cross(a), ab = a.cross(b);
-  const double det = a.dot(bc);
-  if (measure == Measure::kJacobian) {
-    if (d) *d << bc * scale, ca * scale, ab * scale;
-    return det * scale;
-  }
-  if (guard != 0) {
-    // 3D: 3 sgn(det) |det|^(2/3) / S, S = |a|^2 + |b|^2 + |c|^2; 2D (c the unit normal):
-    // 2 det / S, S = |a|^2 + |b|^2. Both are then divided by the guard factor `scale`.
-    const bool three = guard == 3;
-    const double sum = a.squaredNorm() + b.squaredNorm() + (three ? c.squaredNorm() : 0.0);
-    if (!(sum > 0.0)) {
-      if (d) d->setZero();
-      return 0.0;
-    }
-    const double root = std::cbrt(std::abs(det));
-    const double num = three ? 3.0 * std::copysign(root * root, det) : 2.0 * det;
-    const double q = num / sum / scale;
-    if (d) {
-      // d num / d det: 2 |det|^(-1/3) in 3D (unbounded at det = 0, never reached after
-      // untangling), 2 in 2D.
-      const double dnum = three ? (root > 0.0 ? 2.0 / root : 0.0) : 2.0;
-      const double k = dnum / sum / scale;
-      *d << k * bc - 2.0 * q * a / sum, k * ca - 2.0 * q * b / sum,
-          three ? Point(k * ab - 2.0 * q * c / sum) : Point::Zero();
-    }
-    return q;
-  }
-  const double la = a.norm(), lb = b.norm(), lc = c.norm();
-  const double l = la * lb * lc;
-  if (!(l > 0.0)) {  // a degenerate column: value 0 (quality.hpp), no useful gradient
-    if (d) d->setZero();
-    return 0.0;
-  }
-  const double q = det / l;
-  if (d) *d << bc / l - q * a / (la * la), ca / l - q * b / (lb * lb), ab / l - q * c / (lc * lc);
-  return q;
+// Value of a corner matrix [v0, v1, v2]; with grad (hess), also its first (second) derivatives
+// with respect to the 9 column entries (primal/frame_derivatives.hpp). `scale` multiplies a
+// Jacobian and divides a guard frame's shape.
+double column_value(const FrameVector& v, Measure measure, int guard, double scale,
+                    FrameVector* grad, FrameMatrix* hess = nullptr) {
+  if (measure == Measure::kShape && guard == 0) return scaled_determinant_derivatives(v, grad, hess);
+  const double factor = measure == Measure::kJacobian ? scale : 1.0 / scale;
+  const double q = measure == Measure::kJacobian ? determinant_derivatives(v, grad, hess)
+                                                 : corner_shape_derivatives(v, guard, grad, hess);
+  if (grad) *grad *= factor;
+  if (hess) *hess *= factor;
+  return q * factor;
 }
 
 // The problem in reduced coordinates u (the free coordinates of every node, NodeSpace). Each
@@ -257,7 +215,7 @@ class Problem {
       l.det_scale = f.det_scale;
       l.guard = f.guard;
       l.v0.setZero();
-      std::vector<Eigen::Matrix<double, 9, 1>> cols;
+      std::vector<FrameVector> cols;
       for (int j = 0; j < 3; ++j) {
         const Column& c = f.col[j];
         l.v0.segment<3>(3 * j) += c.constant;
@@ -270,7 +228,7 @@ class Problem {
             const auto col = static_cast<std::size_t>(it - l.idx.begin());
             if (it == l.idx.end()) {
               l.idx.push_back(dof);
-              cols.push_back(Eigen::Matrix<double, 9, 1>::Zero());
+              cols.push_back(FrameVector::Zero());
             }
             cols[col].segment<3>(3 * j) += c.coef[t] * s.basis.col(k);
           }
@@ -305,8 +263,8 @@ class Problem {
   // Soft minimum of the frame values. With grad (and hess), the gradient (and Hessian) of its
   // negative, the function we minimise:
   //   grad f = -sum w_k g_k,  hess f = -sum w_k H_k + t (sum w_k g_k g_k^T - gbar gbar^T)
-  // with w the softmax weights, g_k, H_k the derivatives of q_k, gbar = sum w_k g_k. H_k comes
-  // from central differences of the analytic column gradient (9 x 9, then mapped by M).
+  // with w the softmax weights, g_k, H_k the derivatives of q_k, gbar = sum w_k g_k (H_k the
+  // analytic 9 x 9 Hessian of the frame's columns, then mapped by M).
   double soft_min(const Vec& x, Measure m, double t, Vec* grad,
                   Eigen::MatrixXd* hess = nullptr) {
     const std::size_t n = locals_.size();
@@ -336,8 +294,9 @@ class Problem {
       const Vec gk = l.map.transpose() * dq_[k];
       for (std::size_t i = 0; i < l.idx.size(); ++i) (*grad)[l.idx[i]] -= w * gk[i];
       if (!hess) continue;
-      const Eigen::Matrix<double, 9, 9> hv = column_hessian(
-          columns(k, x), m, m == Measure::kJacobian ? 0 : l.guard, scale_of(l, m));
+      FrameMatrix hv;
+      column_value(columns(k, x), m, m == Measure::kJacobian ? 0 : l.guard, scale_of(l, m), nullptr,
+                   &hv);
       const Eigen::MatrixXd hk = l.map.transpose() * hv * l.map;
       for (std::size_t i = 0; i < l.idx.size(); ++i) {
         for (std::size_t j = 0; j < l.idx.size(); ++j) {
@@ -351,7 +310,7 @@ class Problem {
 
  private:
   struct Local {
-    Eigen::Matrix<double, 9, 1> v0;
+    FrameVector v0;
     Eigen::Matrix<double, 9, Eigen::Dynamic> map;
     std::vector<int> idx;  // the reduced coordinates this frame depends on
     double det_scale = 1.0;
@@ -363,29 +322,13 @@ class Problem {
     return m == Measure::kJacobian ? l.det_scale / unit_ : guard_;
   }
 
-  Eigen::Matrix<double, 9, 1> columns(std::size_t k, const Vec& x) const {
+  FrameVector columns(std::size_t k, const Vec& x) const {
     const Local& l = locals_[k];
-    Eigen::Matrix<double, 9, 1> v = l.v0;
+    FrameVector v = l.v0;
     for (std::size_t i = 0; i < l.idx.size(); ++i) {
       v += l.map.col(static_cast<Eigen::Index>(i)) * x[l.idx[i]];
     }
     return v;
-  }
-
-  static Eigen::Matrix<double, 9, 9> column_hessian(const Eigen::Matrix<double, 9, 1>& v,
-                                                    Measure m, int guard, double scale) {
-    Eigen::Matrix<double, 9, 9> h;
-    Eigen::Matrix<double, 9, 1> dp, dm;
-    for (int i = 0; i < 9; ++i) {
-      const double step = 1e-6 * std::max(v.segment<3>(3 * (i / 3)).norm(), 1e-12);
-      Eigen::Matrix<double, 9, 1> vp = v, vm = v;
-      vp[i] += step;
-      vm[i] -= step;
-      column_value(vp, m, guard, scale, &dp);
-      column_value(vm, m, guard, scale, &dm);
-      h.col(i) = (dp - dm) / (2 * step);
-    }
-    return 0.5 * (h + h.transpose());
   }
 
   std::vector<NodeSpace> spaces_;
@@ -393,7 +336,7 @@ class Problem {
   std::vector<Local> locals_;
   int dof_ = 0;
   std::vector<double> q_, w_;
-  std::vector<Eigen::Matrix<double, 9, 1>> dq_;
+  std::vector<FrameVector> dq_;
 };
 
 // Minimises f with a damped Newton method: solve (H + lambda I) d = -g by Cholesky, raising

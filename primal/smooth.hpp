@@ -13,8 +13,8 @@
 // (continuation: a blunt t spreads the improvement over many elements, a sharp one then
 // pushes the worst). Untangling uses q = corner Jacobian / L^3 (L the mean edge length) and
 // L-BFGS; shape improvement uses q = scaled Jacobian (plus the shape guard, SmoothOptions) and a
-// damped Newton method (soft-min Hessian assembled from 9 x 9 per-corner Hessians, these by
-// central differences of the analytic gradient).
+// damped Newton method (soft-min Hessian assembled from the analytic 9 x 9 per-corner Hessians,
+// primal/frame_derivatives.hpp).
 //
 // Stopping rule. Untangling stops as soon as every corner and centre Jacobian is positive (or
 // after max_untangle_iterations). Each shape stage stops when its soft minimum has improved by

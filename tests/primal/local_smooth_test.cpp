@@ -91,12 +91,14 @@ TEST_CASE("frame derivatives match central differences") {
   for (int trial = 0; trial < 20; ++trial) {
     gp::FrameVector v;
     for (int i = 0; i < 9; ++i) v[i] = r.next() + (i % 4 == 0 ? 1.5 : 0.0);  // near the identity
-    for (bool scaled : {false, true}) {
+    // 0 determinant, 1 scaled determinant, 2 and 3 the quad and hex corner shapes.
+    for (int measure = 0; measure < 4; ++measure) {
       CAPTURE(trial);
-      CAPTURE(scaled);
+      CAPTURE(measure);
       auto f = [&](const gp::FrameVector& x, gp::FrameVector* g, gp::FrameMatrix* h) {
-        return scaled ? gp::scaled_determinant_derivatives(x, g, h)
-                      : gp::determinant_derivatives(x, g, h);
+        return measure == 0   ? gp::determinant_derivatives(x, g, h)
+               : measure == 1 ? gp::scaled_determinant_derivatives(x, g, h)
+                              : gp::corner_shape_derivatives(x, measure, g, h);
       };
       gp::FrameVector g;
       gp::FrameMatrix h;
