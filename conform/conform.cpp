@@ -6,6 +6,7 @@
 #include <map>
 #include <numeric>
 #include <optional>
+#include <span>
 #include <sstream>
 #include <unordered_map>
 
@@ -138,7 +139,9 @@ class Conformer {
   void add_smoothing(const primal::LocalSmoothResult& r);
   void smooth();
   void smooth_defects(primal::LocalSmoothOptions o);
-  double measure();
+  double measure();                               // every hex
+  double measure(std::span<const Index> hexes);   // these only, the others unchanged since
+  double scan();                                  // inverted_ and the minimum from sj_
   void verify();
   void output();
 
@@ -378,7 +381,7 @@ void Conformer::untangle() {
   std::vector<Index> seeds = inverted_;
   for (int ring = 0; ring < kDefectRings; ++ring) seeds = primal::hexes_around(mesh_, seeds);
   add_smoothing(primal::smooth_hexes_around(mesh_, seeds, options_.local_smooth_options));
-  res_.smoothing.final_min_scaled_jacobian = measure();
+  res_.smoothing.final_min_scaled_jacobian = measure(primal::hexes_around(mesh_, seeds));
   say("untangling: " + std::to_string(before) + " inverted hexes, " + std::to_string(inverted_.size()) +
       " left" + took());
 }
@@ -426,7 +429,8 @@ void Conformer::smooth() {
     const primal::TriMesh surface = primal::boundary_triangulation(mesh_.points, boundary);
     add_smoothing(primal::smooth_hexes_local(mesh_, constraints, &surface, {}, o));
   }
-  res_.smoothing.final_min_scaled_jacobian = measure();
+  // The automatic passes keep sj_ up to date as they go.
+  res_.smoothing.final_min_scaled_jacobian = local && options_.smooth_target <= 0.0 ? scan() : measure();
   untangle();
   const Index patches = res_.smoothing.patches;
   say("smoothing (" + std::string(local ? "local" : "global") + "): " +
@@ -457,16 +461,23 @@ void Conformer::smooth_defects(primal::LocalSmoothOptions o) {
     if (defects.empty()) return;
     for (int ring = 0; ring < kDefectRings; ++ring) defects = primal::hexes_around(mesh_, defects);
     o.target = kDefectTarget * yardstick + pass * kDefectTargetStep;
-    if (!start) start = primal::smooth_start(mesh_);
+    if (!start) start = primal::SmoothStart{sj_, primal::shortest_edge_per_hex(mesh_)};
     add_smoothing(primal::smooth_hexes_around(mesh_, defects, o, kFeatureAngle, &*start));
-    // A patch moves the nodes of its seed hex: only hexes around the seeds changed.
-    for (Index h : primal::hexes_around(mesh_, defects))
-      sj_[static_cast<std::size_t>(h)] = primal::hex_scaled_jacobian(primal::hex_corners(mesh_, h));
+    measure(primal::hexes_around(mesh_, defects));  // a patch moves the nodes of its seed hex only
   }
 }
 
 double Conformer::measure() {
   sj_ = primal::scaled_jacobian_per_hex(mesh_);
+  return scan();
+}
+
+double Conformer::measure(std::span<const Index> hexes) {
+  for (Index h : hexes) sj_[static_cast<std::size_t>(h)] = primal::hex_scaled_jacobian(primal::hex_corners(mesh_, h));
+  return scan();
+}
+
+double Conformer::scan() {
   inverted_.clear();
   double lowest = 1.0;
   for (std::size_t h = 0; h < sj_.size(); ++h) {

@@ -139,12 +139,6 @@ struct Context {
   std::vector<double> edge_floor;             // per hex, the shortest edge it may have
 };
 
-double shortest_edge(const HexCorners& c) {
-  double m = std::numeric_limits<double>::max();
-  for (const auto& e : topo::kHexEdgeCorners) m = std::min(m, (c[e[0]] - c[e[1]]).squaredNorm());
-  return std::sqrt(m);
-}
-
 bool is_fixed(const Context& ctx, Index v) {
   return !ctx.constraints.empty() && ctx.constraints[v].kind == NodeConstraint::Kind::kFixed;
 }
@@ -251,7 +245,7 @@ class Patch {
     for (std::size_t h = 0; h < hex_.size(); ++h) {
       HexCorners c;
       for (int k = 0; k < 8; ++k) c[k] = pos_[local_[h][k]];
-      edge_floor_.push_back(std::min(ctx.edge_floor[hex_[h]], shortest_edge(c)));
+      edge_floor_.push_back(std::min(ctx.edge_floor[hex_[h]], hex_shortest_edge(c)));
     }
   }
 
@@ -388,7 +382,7 @@ class Patch {
       for (int k = 0; k < 8; ++k) c[k] = p[local_[h][k]];
       trial_q_[h] = hex_scaled_jacobians(c);
       const double q = *std::min_element(trial_q_[h].begin(), trial_q_[h].end());
-      if (q < floor_[h] || (!untangle && shortest_edge(c) < edge_floor_[h])) {
+      if (q < floor_[h] || (!untangle && hex_shortest_edge(c) < edge_floor_[h])) {
         last_broken_ = h;
         return false;
       }
@@ -490,13 +484,7 @@ class Patch {
 }  // namespace
 
 SmoothStart smooth_start(const HexMesh& mesh) {
-  SmoothStart s;
-  s.scaled_jacobian = scaled_jacobian_per_hex(mesh);
-  s.shortest_edge.resize(mesh.hexes.size());
-  tbb::parallel_for(std::size_t{0}, mesh.hexes.size(), [&](std::size_t h) {
-    s.shortest_edge[h] = shortest_edge(hex_corners(mesh, static_cast<Index>(h)));
-  });
-  return s;
+  return {scaled_jacobian_per_hex(mesh), shortest_edge_per_hex(mesh)};
 }
 
 LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstraint> constraints,

@@ -399,6 +399,19 @@ std::vector<double> scaled_jacobian_per_hex(const HexMesh& mesh) {
   return sj;
 }
 
+double hex_shortest_edge(const HexCorners& p) {
+  const auto l = edge_lengths(p);
+  return *std::min_element(l.begin(), l.end());
+}
+
+std::vector<double> shortest_edge_per_hex(const HexMesh& mesh) {
+  std::vector<double> e(mesh.hexes.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, e.size(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t h = r.begin(); h != r.end(); ++h) e[h] = hex_shortest_edge(hex_corners(mesh, static_cast<Index>(h)));
+  });
+  return e;
+}
+
 double min_scaled_jacobian(const HexMesh& mesh, std::vector<Index>* inverted) {
   const std::vector<double> sj = scaled_jacobian_per_hex(mesh);
   double mn = 1.0;

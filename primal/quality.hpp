@@ -114,6 +114,9 @@ HexCorners hex_corners(const HexMesh& mesh, Index h);
 double min_scaled_jacobian(const HexMesh& mesh, std::vector<Index>* inverted = nullptr);
 // hex_scaled_jacobian of every hex, in hex order (evaluated in parallel).
 std::vector<double> scaled_jacobian_per_hex(const HexMesh& mesh);
+// The shortest of a hex's 12 edges; of every hex, in hex order (in parallel).
+double hex_shortest_edge(const HexCorners& p);
+std::vector<double> shortest_edge_per_hex(const HexMesh& mesh);
 QuadCorners quad_corners(const QuadMesh& mesh, Index q);
 
 }  // namespace geode::primal
