@@ -371,10 +371,10 @@ void Conformer::assemble() {
 // patches start on it and on the hexes within this many rings of it.
 constexpr int kDefectRings = 2;
 
-// A hex still inverted (the placement inverts one where a buffer top folds at a convex edge or
-// corner) is untangled with the hexes within kDefectRings of it (a hex is untangled by moving
-// its neighbours too), at local_smooth_options' own target, so that even --smooth none gives a
-// usable mesh. Reads inverted_ as the last measure() left it.
+// A hex still inverted (the placement can invert one in a poor buffer hex) is untangled with
+// the hexes within kDefectRings of it (a hex is untangled by moving its neighbours too), at
+// local_smooth_options' own target, so that even --smooth none gives a usable mesh. Reads
+// inverted_ as the last measure() or scan() left it.
 void Conformer::untangle() {
   if (inverted_.empty()) return;
   const std::size_t before = inverted_.size();
@@ -382,17 +382,17 @@ void Conformer::untangle() {
   for (int ring = 0; ring < kDefectRings; ++ring) seeds = primal::hexes_around(mesh_, seeds);
   add_smoothing(primal::smooth_hexes_around(mesh_, seeds, options_.local_smooth_options));
   res_.smoothing.final_min_scaled_jacobian = measure(primal::hexes_around(mesh_, seeds));
+  res_.smoothing.final_inverted = static_cast<Index>(inverted_.size());
   say("untangling: " + std::to_string(before) + " inverted hexes, " + std::to_string(inverted_.size()) +
       " left" + took());
 }
 
-// Several smoothing passes report as one.
+// Several smoothing calls report as one: their work adds up; the minima and inverted counts
+// are the whole mesh's (set in smooth() and untangle()).
 void Conformer::add_smoothing(const primal::LocalSmoothResult& r) {
   auto& s = res_.smoothing;
   s.patches += r.patches, s.rounds += r.rounds, s.iterations += r.iterations;
   s.seconds += r.seconds, s.cpu_seconds += r.cpu_seconds;
-  s.initial_inverted = res_.placement_inverted, s.final_inverted = r.final_inverted;
-  s.initial_min_scaled_jacobian = res_.min_scaled_jacobian_before_smoothing;
 }
 
 // The worst-first smoother (primal/local_smooth.hpp); model boundary nodes slide on the diced
@@ -403,6 +403,7 @@ void Conformer::smooth() {
   t0_ = Clock::now();
   res_.smoothing.initial_min_scaled_jacobian = res_.min_scaled_jacobian_before_smoothing;
   res_.smoothing.final_min_scaled_jacobian = res_.min_scaled_jacobian_before_smoothing;
+  res_.smoothing.initial_inverted = res_.smoothing.final_inverted = res_.placement_inverted;
   if (options_.smooth == ConformSmooth::kNone) return untangle();
   const bool local = options_.smooth == ConformSmooth::kLocal;
   primal::LocalSmoothOptions o = local ? options_.local_smooth_options : options_.global_smooth_options;
@@ -431,6 +432,7 @@ void Conformer::smooth() {
   }
   // The automatic passes keep sj_ up to date as they go.
   res_.smoothing.final_min_scaled_jacobian = local && options_.smooth_target <= 0.0 ? scan() : measure();
+  res_.smoothing.final_inverted = static_cast<Index>(inverted_.size());
   untangle();
   const Index patches = res_.smoothing.patches;
   say("smoothing (" + std::string(local ? "local" : "global") + "): " +
