@@ -1041,10 +1041,15 @@ VtkGrid parse_vtk(std::string_view content, const std::string& source) {
 }
 
 VtkGrid read_vtk_file(const std::filesystem::path& path) {
-  const std::string ext = path.extension().string();
-  if (ext == ".vtu") return read_vtu(path);
-  if (ext == ".vtk") return read_vtk(path);
-  throw InvalidInput(path.string() + ": unknown extension '" + ext + "' (expected .vtu or .vtk)");
+  switch (mesh_format_from_extension(path)) {  // the one place that decides (any case)
+    case MeshFileFormat::kVtu:
+      return read_vtu(path);
+    case MeshFileFormat::kVtk:
+      return read_vtk(path);
+    default:
+      throw InvalidInput(path.string() + ": unknown extension '" + path.extension().string() +
+                         "' (expected .vtu or .vtk)");
+  }
 }
 
 }  // namespace geode::primal

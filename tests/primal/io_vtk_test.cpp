@@ -161,6 +161,11 @@ TEST_CASE("io_vtk: a grid of another cell type is refused by the typed conversio
       doctest::Contains("h.vtk: cell 0 is VTK type 12 (hexahedron), expected 10 (tetra)"),
       geode::InvalidInput);
   CHECK_THROWS_AS(read_vtk_file(dir.path / "h.obj"), geode::InvalidInput);
+  // Extensions in any case, as everywhere else (primal/file_format.hpp).
+  write_vtu(dir.path / "H.VTU", test_hexes());
+  write_vtk(dir.path / "H.VTK", test_hexes());
+  CHECK(read_vtk_file(dir.path / "H.VTU").cell_types.size() == test_hexes().hexes.size());
+  CHECK(read_vtk_file(dir.path / "H.VTK").cell_types.size() == test_hexes().hexes.size());
 }
 
 namespace {
