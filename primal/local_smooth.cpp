@@ -233,6 +233,7 @@ class Patch {
     // their start; better ones may lose `loss` from their start, never past worst + margin.
     double worst = std::numeric_limits<double>::max();
     for (Index h : hex_) worst = std::min(worst, sj[h]);
+    tangled_ = worst <= 0.0;
     const double keep = std::max(worst, 0.0) + ctx.options.margin;
     for (Index h : hex_) {
       const double s = ctx.start[h];
@@ -255,7 +256,8 @@ class Patch {
     const LocalSmoothOptions& o = ctx_.options;
     for (int phase = 0; phase < 2; ++phase) {
       const bool untangle = phase == 0;
-      if (untangle && min_frame(true) > 0.0) continue;
+      // A positive scaled Jacobian means all nine frames are positive: no untangling then.
+      if (untangle && (!tangled_ || min_frame(true) > 0.0)) continue;
       const double t = untangle ? o.untangle_sharpness : o.sharpness;
       for (int it = 0; it < o.max_iterations; ++it) {
         const bool ok = newton_step(untangle, t);
@@ -430,7 +432,7 @@ class Patch {
       g.segment(offset[i], di) = basis[i].transpose() * gx.segment<3>(3 * i);
       for (int j = 0; j < moving_; ++j)
         h.block(offset[i], offset[j], di, basis[j].cols()) =
-            basis[i].transpose() * hx.block<3, 3>(3 * i, 3 * j) * basis[j];
+            (basis[i].transpose() * hx.block<3, 3>(3 * i, 3 * j)).lazyProduct(basis[j]);
     }
     const double scale = std::max(h.diagonal().cwiseAbs().maxCoeff(), 1e-300);
     PatchVector d;
@@ -478,6 +480,7 @@ class Patch {
   std::size_t last_broken_ = 0;  // the hex whose floor a trial step broke last
   std::vector<std::array<double, 9>> trial_q_;  // per hex, its frames' scaled Jacobians
   int moving_ = 0;
+  bool tangled_ = false;  // some patch hex has a scaled Jacobian <= 0
   double length_ = 1.0, unit_ = 1.0, lambda_ = 0.0, last_gain_ = 0.0;
 };
 
