@@ -378,48 +378,34 @@ void add_template_command(CLI::App& app) {
               "geode4tri: the plain dual of the arrangement, without pillowing away the obstructions to a\n"
               "positive-Jacobian placement (its pinched corners cannot be untangled)");
   t->add_flag("--quality", args->quality, "append the quality report (the paper's Table 1 metrics)");
-  t->add_option("--high-roof", args->push.high_roof,
-                "push: higher tunnel roof, fraction of the height (refine3: the tunnel along x; default 0.75 there)")
-      ->check(number_check())
-      ->capture_default_str();
-  t->add_option("--low-roof", args->push.low_roof,
-                "push: lower tunnel roof, fraction of the height (refine3: the tunnel along z; default 0.6 there)")
-      ->check(number_check())
-      ->capture_default_str();
-  t->add_option("--centre-depth", args->push.centre_depth,
-                "push, geode4tri: depth of the centre vertex's dome (0: --dome-depth)")
-      ->check(number_check())
-      ->capture_default_str();
-  t->add_option("--centre-radius", args->push.centre_radius,
-                "push, geode4tri: radius blend of the centre vertex's dome (0: --dome-radius)")
-      ->check(number_check())
-      ->capture_default_str();
-  t->add_option("--dome-exponent", args->push.dome_exponent,
-                "push: superquadric exponent p of the domes (|x|^p + |y|^p + |z|^p level sets; 2: spheroids)")
-      ->check(number_check())
-      ->capture_default_str();
-  t->add_option("--centre-exponent", args->push.centre_exponent,
-                "push, geode4tri: exponent of the centre vertex's dome (0: --dome-exponent)")
-      ->check(number_check())
-      ->capture_default_str();
-  t->add_option("--dome-offset", args->push.dome_offset,
-                "push: move each corner dome's centre along the tet side toward its centre, fraction of the way")
-      ->check(number_check())
-      ->capture_default_str();
+  // Every push parameter (and refine3's layer): a number with its default shown.
+  auto number_option = [t](const std::string& name, double& value, const std::string& help) {
+    t->add_option(name, value, help)->check(number_check())->capture_default_str();
+  };
+  number_option("--high-roof", args->push.high_roof,
+                "push: higher tunnel roof, fraction of the height (refine3: the tunnel along x; default 0.75 there)");
+  number_option("--low-roof", args->push.low_roof,
+                "push: lower tunnel roof, fraction of the height (refine3: the tunnel along z; default 0.6 there)");
+  number_option("--centre-depth", args->push.centre_depth,
+                "push, geode4tri: depth of the centre vertex's dome (0: --dome-depth)");
+  number_option("--centre-radius", args->push.centre_radius,
+                "push, geode4tri: radius blend of the centre vertex's dome (0: --dome-radius)");
+  number_option("--dome-exponent", args->push.dome_exponent,
+                "push: superquadric exponent p of the domes (|x|^p + |y|^p + |z|^p level sets; 2: spheroids)");
+  number_option("--centre-exponent", args->push.centre_exponent,
+                "push, geode4tri: exponent of the centre vertex's dome (0: --dome-exponent)");
+  number_option("--dome-offset", args->push.dome_offset,
+                "push: move each corner dome's centre along the tet side toward its centre, fraction of the way");
   t->add_option("--centre-offset", args->push.centre_offset,
                 "push, geode4tri: move the centre vertex's dome by X Z, fractions of the half-width")
       ->check(number_check());
-  t->add_option("--layer", args->refine.layer, "refine3: height of the horizontal layer sheet, below both roofs")
-      ->check(number_check())
-      ->capture_default_str();
-  t->add_option("--dome-depth", args->push.dome_depth, "push: how far below the tet side the domes reach, fraction of the height")
-      ->check(number_check())
-      ->capture_default_str();
-  t->add_option("--dome-radius", args->push.dome_radius,
+  number_option("--layer", args->refine.layer,
+                "refine3: height of the horizontal layer sheet, below both roofs");
+  number_option("--dome-depth", args->push.dome_depth,
+                "push: how far below the tet side the domes reach, fraction of the height");
+  number_option("--dome-radius", args->push.dome_radius,
                 "push: where each dome's circle crosses the diced tet side, 0..1 between the nodes it\n"
-                "must enclose and the nearest it must leave out")
-      ->check(number_check())
-      ->capture_default_str();
+                "must enclose and the nearest it must leave out");
   t->callback([args, t] {
     args->refine_roofs = t->count("--high-roof") + t->count("--low-roof") > 0;
     run_template(*args);
