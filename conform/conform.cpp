@@ -451,7 +451,6 @@ void Conformer::smooth() {
 constexpr double kDefectTarget = 1.2;       // x the yardstick, first pass
 constexpr double kDefectTargetStep = 0.02;  // added to it by each further pass
 constexpr int kDefectPasses = 8;
-constexpr double kFeatureAngle = 30.0;  // boundary nodes slide along edges sharper than this
 
 void Conformer::smooth_defects(primal::LocalSmoothOptions o) {
   const double yardstick = std::min(res_.input_diced_hex_min_scaled_jacobian, res_.input_diced_tet_min_scaled_jacobian);
@@ -464,7 +463,7 @@ void Conformer::smooth_defects(primal::LocalSmoothOptions o) {
     for (int ring = 0; ring < kDefectRings; ++ring) defects = primal::hexes_around(mesh_, defects);
     o.target = kDefectTarget * yardstick + pass * kDefectTargetStep;
     if (!start) start = primal::SmoothStart{sj_, primal::shortest_edge_per_hex(mesh_)};
-    add_smoothing(primal::smooth_hexes_around(mesh_, defects, o, kFeatureAngle, &*start));
+    add_smoothing(primal::smooth_hexes_around(mesh_, defects, o, primal::kFeatureAngle, &*start));
     measure(primal::hexes_around(mesh_, defects));  // a patch moves the nodes of its seed hex only
   }
 }

@@ -39,6 +39,10 @@
 
 namespace geode::primal {
 
+// Boundary normals more than this many degrees apart make a feature edge or corner (see
+// boundary_slide_constraints).
+inline constexpr double kFeatureAngle = 30.0;
+
 struct LocalSmoothOptions {
   double target = 0.35;       // hexes with a scaled Jacobian below it seed patches
   double margin = 0.1;        // hexes this close to a patch's worst never lose (see Floors)
@@ -100,7 +104,7 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
 // minima are over the hexes around the seeds.
 LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seeds,
                                       const LocalSmoothOptions& options = {},
-                                      double feature_angle = 30.0,
+                                      double feature_angle = kFeatureAngle,
                                       const SmoothStart* start = nullptr);
 
 // Constraints that keep the mesh's boundary where it is while letting it slide: a boundary
@@ -110,12 +114,12 @@ LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seed
 // (normals within the angle but not parallel), the node is kSurface; otherwise (corners,
 // curved feature edges) fixed. Interior nodes are free.
 std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh,
-                                                       double feature_angle = 30.0);
+                                                       double feature_angle = kFeatureAngle);
 // The same from boundary quads found otherwise (e.g. of a submesh whose own boundary is
 // larger than the model's); nodes on none of them are free.
 std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh,
                                                        std::span<const BoundaryQuad> boundary,
-                                                       double feature_angle = 30.0);
+                                                       double feature_angle = kFeatureAngle);
 
 // The mesh's boundary quads, each split into two triangles (along the 0-2 diagonal): the
 // surface kSurface nodes slide on when no input triangulation is at hand.
