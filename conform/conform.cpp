@@ -367,19 +367,18 @@ void Conformer::assemble() {
   res_.placement_inverted = static_cast<Index>(inverted_.size());
 }
 
-// A defect (a hex below the yardstick, or inverted) is lifted by moving its neighbours too: the
-// patches start on it and on the hexes within this many rings of it.
-constexpr int kDefectRings = 2;
+// A hex still inverted (the placement can invert one in a poor buffer hex) is untangled by
+// moving its neighbours too: patches start on it and on the hexes within this many rings of it.
+constexpr int kUntangleRings = 2;
 
-// A hex still inverted (the placement can invert one in a poor buffer hex) is untangled with
-// the hexes within kDefectRings of it (a hex is untangled by moving its neighbours too), at
+// A hex still inverted is untangled with the hexes within kUntangleRings of it, at
 // local_smooth_options' own target, so that even --smooth none gives a usable mesh. Reads
 // inverted_ as the last measure() or scan() left it.
 void Conformer::untangle() {
   if (inverted_.empty()) return;
   const std::size_t before = inverted_.size();
   std::vector<Index> seeds = inverted_;
-  for (int ring = 0; ring < kDefectRings; ++ring) seeds = primal::hexes_around(mesh_, seeds);
+  for (int ring = 0; ring < kUntangleRings; ++ring) seeds = primal::hexes_around(mesh_, seeds);
   add_smoothing(primal::smooth_hexes_around(mesh_, seeds, options_.local_smooth_options));
   res_.smoothing.final_min_scaled_jacobian = measure(primal::hexes_around(mesh_, seeds));
   res_.smoothing.final_inverted = static_cast<Index>(inverted_.size());
@@ -443,12 +442,15 @@ void Conformer::smooth() {
 
 // Automatic target. The defects are the hexes below the yardstick (the input's own hexes and
 // tets diced alone: every hex the transition did not touch is above it). Patches start on them
-// and kDefectRings around, at hexes below a target a little above the yardstick, so that the
-// smoother works only where the transition is worse than dicing makes anyway and its cost
-// follows the defects. A defect whose neighbours are above that target has no room to rise:
-// where defects remain, the pass is repeated around them with a slightly higher target (small
-// steps: a pass costs what lies below its target around the defects).
-constexpr double kDefectTarget = 1.2;       // x the yardstick, first pass
+// and on the hexes sharing a node with them (a defect is lifted by moving its neighbours too),
+// at hexes below a target a little above the yardstick, so that the smoother works only where
+// the transition is worse than dicing makes anyway and its cost follows the defects; a pass
+// ends as soon as no seed is below the yardstick (the target only gives room to get there). A
+// defect whose neighbours are above that target has no room to rise: where defects remain, the
+// pass is repeated around them with a slightly higher target (small steps: a pass costs what
+// lies below its target around the defects).
+constexpr int kDefectRings = 1;
+constexpr double kDefectTarget = 1.05;      // x the yardstick, first pass
 constexpr double kDefectTargetStep = 0.02;  // added to it by each further pass
 constexpr int kDefectPasses = 8;
 
@@ -462,6 +464,7 @@ void Conformer::smooth_defects(primal::LocalSmoothOptions o) {
     if (defects.empty()) return;
     for (int ring = 0; ring < kDefectRings; ++ring) defects = primal::hexes_around(mesh_, defects);
     o.target = kDefectTarget * yardstick + pass * kDefectTargetStep;
+    o.goal = yardstick;
     if (!start) start = primal::SmoothStart{sj_, primal::shortest_edge_per_hex(mesh_)};
     add_smoothing(primal::smooth_hexes_around(mesh_, defects, o, primal::kFeatureAngle, &*start));
     measure(primal::hexes_around(mesh_, defects));  // a patch moves the nodes of its seed hex only

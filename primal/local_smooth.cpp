@@ -571,6 +571,9 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
     }
     if (options.progress) options.progress(pool.size() - cand.size(), pool.size());
     if (cand.empty()) break;
+    // The caller's aim is met: the target above it only gave the hexes room to get there.
+    if (options.goal > 0.0 && std::all_of(pool.begin(), pool.end(), [&](Index h) { return sj[h] >= options.goal; }))
+      break;
     std::sort(cand.begin(), cand.end(), [&](std::size_t i, std::size_t j) {
       const Index a = pool[i], b = pool[j];
       return sj[a] < sj[b] || (sj[a] == sj[b] && a < b);

@@ -45,6 +45,10 @@ inline constexpr double kFeatureAngle = 30.0;
 
 struct LocalSmoothOptions {
   double target = 0.35;       // hexes with a scaled Jacobian below it seed patches
+  // > 0: the call ends as soon as every seed hex is at or above it, before the target is
+  // reached (a caller whose aim is below the target sets the target higher only to give the
+  // hexes room to rise).
+  double goal = 0.0;
   double margin = 0.1;        // hexes this close to a patch's worst never lose (see Floors)
   double loss = 0.1;          // how far a better hex may fall from its start
   // Improving shape, no hex's shortest edge drops below this fraction of its shortest edge when

@@ -172,6 +172,23 @@ TEST_CASE("hexes near the worst never lose; others lose at most `loss`") {
   CHECK(improved > 10);
 }
 
+// A goal below the target ends the call once every seed reaches it: fewer patches than the
+// target alone takes, and no seed below the goal.
+TEST_CASE("the call ends when every seed reaches the goal") {
+  gp::LocalSmoothOptions o;
+  o.target = 0.9;
+  const HexMesh start = jittered_grid(5, 0.3, 11);
+  HexMesh full = start;
+  const auto all = gp::smooth_hexes_local(full, gp::boundary_slide_constraints(full), nullptr, {}, o);
+  o.goal = 0.5 * (all.initial_min_scaled_jacobian + all.final_min_scaled_jacobian);
+  REQUIRE(o.goal > all.initial_min_scaled_jacobian + 0.02);
+  HexMesh part = start;
+  const auto res = gp::smooth_hexes_local(part, gp::boundary_slide_constraints(part), nullptr, {}, o);
+  CHECK(res.final_min_scaled_jacobian >= o.goal);
+  CHECK(res.patches < all.patches);
+  CHECK(res.final_min_scaled_jacobian < all.final_min_scaled_jacobian);
+}
+
 // The scaled Jacobian normalises edge lengths, so only the edge floor keeps edges from
 // shrinking: without it (fraction 0) some edge ends below 0.9 of its hex's shortest one.
 TEST_CASE("no edge ends below min_edge_fraction of its hex's shortest edge at the start") {
