@@ -93,14 +93,26 @@ int main(int argc, char** argv) {
   const bool defaults_only = argc > 1 && std::string(argv[1]) == "--defaults";
   if (defaults_only) --argc, ++argv;
   const int n = argc > 1 ? std::atoi(argv[1]) : 4;
+  std::vector<std::string> models(argv + std::min(argc, 5), argv + argc);
+  const auto names = conform::demo_model_names();
+  const bool known = std::all_of(models.begin(), models.end(), [&](const std::string& m) {
+    return std::find(names.begin(), names.end(), m) != names.end();
+  });
+  if (n < 1 || n > 64 || !known) {
+    std::fprintf(stderr, "usage: bench_local_smooth [--defaults] [n 1..64] [target] [max_visits] "
+                         "[max_iterations] [model...]\n");
+    return 2;
+  }
   primal::LocalSmoothOptions o;
   if (argc > 2) o.target = std::atof(argv[2]);
   if (argc > 3) o.max_visits = std::atoi(argv[3]);
   if (argc > 4) o.max_iterations = std::atoi(argv[4]);
-  std::vector<std::string> models(argv + std::min(argc, 5), argv + argc);
-  if (models.empty()) models = conform::demo_model_names();
-  std::printf("n %d, target %.2f, max_visits %d, max_iterations %d\n", n, o.target, o.max_visits,
-              o.max_iterations);
+  if (models.empty()) models = names;
+  if (defaults_only)
+    std::printf("n %d, conform's default options\n", n);
+  else
+    std::printf("n %d, target %.2f, max_visits %d, max_iterations %d\n", n, o.target, o.max_visits,
+                o.max_iterations);
   for (const std::string& name : models) {
     const primal::Model input = conform::demo_model(name, n);
     if (defaults_only)
