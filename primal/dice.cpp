@@ -4,6 +4,9 @@
 #include <bit>
 #include <string>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
 #include "primal/errors.hpp"
 #include "primal/key_map.hpp"
 #include "primal/quality.hpp"
@@ -288,21 +291,26 @@ std::vector<std::array<std::vector<int>, 8>> child_weights() {
   return children;
 }
 
+// Cells in parallel (TBB): a minimum does not depend on the order it is taken in.
 template <class Mesh, std::size_t N>
 double diced_min(std::span<const Point> points, std::span<const std::array<Index, N>> cells) {
   static const auto children = child_weights<Mesh, N>();
-  double lowest = 1.0;
-  for (const auto& cell : cells)
-    for (const auto& w : children) {
-      HexCorners p;
-      for (int c = 0; c < 8; ++c) {
-        Point s = Point::Zero();
-        for (int i : w[c]) s += points[static_cast<std::size_t>(cell[static_cast<std::size_t>(i)])];
-        p[c] = s / static_cast<double>(w[c].size());
-      }
-      lowest = std::min(lowest, hex_scaled_jacobian(p));
-    }
-  return lowest;
+  return tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, cells.size(), 4096), 1.0,
+      [&](const tbb::blocked_range<std::size_t>& range, double lowest) {
+        for (std::size_t k = range.begin(); k != range.end(); ++k)
+          for (const auto& w : children) {
+            HexCorners p;
+            for (int c = 0; c < 8; ++c) {
+              Point s = Point::Zero();
+              for (int i : w[c]) s += points[static_cast<std::size_t>(cells[k][static_cast<std::size_t>(i)])];
+              p[c] = s / static_cast<double>(w[c].size());
+            }
+            lowest = std::min(lowest, hex_scaled_jacobian(p));
+          }
+        return lowest;
+      },
+      [](double a, double b) { return std::min(a, b); });
 }
 
 }  // namespace

@@ -79,6 +79,7 @@ Interface find_interface(const Model& model, double tol) {
   KeyMap<4> tri_index(2 * model.tets.size());
   std::vector<TriangleUses> tris;
   tris.reserve(2 * model.tets.size() + 2);
+  std::vector<Index> tet_face_tri(4 * model.tets.size());  // tris index of face f of tet t at 4 t + f
   for (std::size_t t = 0; t < model.tets.size(); ++t)
     for (int f = 0; f < 4; ++f) {
       TetFaceUse use{static_cast<Index>(t), f, {}};
@@ -88,6 +89,7 @@ Interface find_interface(const Model& model, double tol) {
       const auto [id, inserted] =
           tri_index.try_emplace(face_key(use.nodes), static_cast<Index>(tris.size()));
       if (inserted) tris.emplace_back();
+      tet_face_tri[4 * t + static_cast<std::size_t>(f)] = *id;
       TriangleUses& uses = tris[static_cast<std::size_t>(*id)];
       if (uses.count == 2)
         throw TopologyError("find_interface: triangle (nodes " + node_list(model, use.nodes) +
@@ -205,12 +207,8 @@ Interface find_interface(const Model& model, double tol) {
     for (Index v : bq->nodes) quads_at[v].push_back(bq);
   // In tet order, so that the first offence reported does not depend on hashing.
   for (std::size_t t = 0; t < model.tets.size(); ++t)
-    for (int f = 0; f < 4; ++f) {
-      std::array<Index, 3> nodes{};
-      for (std::size_t i = 0; i < 3; ++i)
-        nodes[i] = model.tets[t][static_cast<std::size_t>(
-            topology::kTetFaceCorners[static_cast<std::size_t>(f)][i])];
-      const TriangleUses& uses = tris[static_cast<std::size_t>(*tri_index.find(face_key(nodes)))];
+    for (std::size_t f = 0; f < 4; ++f) {
+      const TriangleUses& uses = tris[static_cast<std::size_t>(tet_face_tri[4 * t + f])];
       if (uses.count != 1 || uses.matched) continue;
       const TetFaceUse& tri = uses.use[0];
       std::unordered_set<const BoundaryQuad*> seen;
