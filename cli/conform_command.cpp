@@ -67,6 +67,7 @@ nlohmann::json result_json(const conform::ConformResult& r) {
   j["min_scaled_jacobian_before_smoothing"] = r.min_scaled_jacobian_before_smoothing;
   j["min_scaled_jacobian_after_smoothing"] = r.smoothing.final_min_scaled_jacobian;
   j["hexes_inverted_by_placement"] = r.placement_inverted;
+  j["templates_settled"] = r.templates_settled;
   j["smoothing"] = {{"patches", r.smoothing.patches},
                     {"seconds", r.smoothing.seconds},
                     {"cpu_seconds", r.smoothing.cpu_seconds}};

@@ -20,6 +20,7 @@
 #include "primal/multilinear.hpp"
 #include "primal/quality.hpp"
 #include "primal/quality_report.hpp"
+#include "primal/smooth.hpp"
 #include "primal/topology.hpp"
 
 namespace geode::conform {
@@ -112,6 +113,7 @@ class Conformer {
     place_templates();
     match_sides();
     assemble();
+    settle_templates();
     smooth();
     verify();
     output();
@@ -135,6 +137,7 @@ class Conformer {
   void place_templates();
   void match_sides();
   void assemble();
+  void settle_templates();
   void untangle();
   void add_smoothing(const primal::LocalSmoothResult& r);
   void smooth();
@@ -167,6 +170,7 @@ class Conformer {
   std::vector<Index> inverted_;
   OutputBlocks blocks_;
   std::vector<Index> carved_from_;  // per buffer hex: the tet (input index) it was carved from
+  std::vector<Index> geode_first_;  // per buffer hex: its first output hex (then one past the last)
 };
 
 void Conformer::find_interface() {
@@ -336,7 +340,9 @@ void Conformer::assemble() {
   for (std::size_t k = 0; k < diced_.hex_children.size(); ++k)
     hexes.push_back(diced_.hex_children[k]),
         block.push_back(primal::block_of(lm, {primal::ElementKind::Hex, diced_.hex_parent[k]}));
+  geode_first_.reserve(nb + 1);
   for (std::size_t b = 0; b < nb; ++b) {
+    geode_first_.push_back(static_cast<Index>(hexes.size()));
     const int id = blocks_.geode_id ? blocks_.geode_id : primal::block_of(lm, {primal::ElementKind::Tet, carved_from_[b]});
     for (const auto& h : ref(b).tpl.hex.hexes) {
       std::array<Index, 8> o{};
@@ -344,6 +350,7 @@ void Conformer::assemble() {
       hexes.push_back(o), block.push_back(id);
     }
   }
+  geode_first_.push_back(static_cast<Index>(hexes.size()));
   for (std::size_t k = 0; k < diced_.tet_children.size(); ++k)
     hexes.push_back(diced_.tet_children[k]),
         block.push_back(primal::block_of(lm, {primal::ElementKind::Tet, diced_.tet_parent[k]}));
@@ -364,7 +371,55 @@ void Conformer::assemble() {
   side_sets_ = primal::diced_side_sets(layer_.model, diced_, 0, res_.diced_hexes + res_.geode_hexes);
   diced_ = primal::DicedModel();
   res_.min_scaled_jacobian_before_smoothing = measure();
+}
+
+// The map can invert a template hex where a buffer hex is far from the template's box (a
+// trapezoidal interface quad at a model corner squeezes one side of the template). Such a
+// template is put right inside its own buffer hex: its interior nodes (used by none of the
+// template's neighbours) are untangled and smoothed with every other node fixed (the template
+// smoother, primal/smooth.hpp), so the placement hands a valid mesh to smoothing wherever
+// that can be done inside the buffer hex, and the diced elements stay exactly as diced.
+// Untangling and shape together: a bound, as the buffer hex's fixed nodes soon cap the minimum.
+constexpr int kSettleIterations = 50;
+
+void Conformer::settle_templates() {
+  t0_ = Clock::now();
+  std::vector<std::size_t> buffer_hexes;  // those with an inverted geode hex, ascending
+  for (Index h : inverted_) {
+    if (h < geode_first_.front() || h >= geode_first_.back()) continue;
+    const auto b = static_cast<std::size_t>(std::upper_bound(geode_first_.begin(), geode_first_.end(), h) - geode_first_.begin() - 1);
+    if (buffer_hexes.empty() || buffer_hexes.back() != b) buffer_hexes.push_back(b);
+  }
+  for (std::size_t b : buffer_hexes) {
+    const RefTemplate& rt = ref(b);
+    const auto& local = rt.tpl.hex.hexes;
+    const Index first = geode_first_[b];
+    std::vector<Index> global(rt.rst.size(), kInvalidIndex);
+    for (std::size_t k = 0; k < local.size(); ++k)
+      for (int c = 0; c < 8; ++c) global[local[k][c]] = mesh_.hexes[first + k][c];
+    primal::HexMesh m;
+    m.hexes = local;
+    std::vector<primal::NodeConstraint> constraints;
+    for (std::size_t i = 0; i < global.size(); ++i) {
+      m.points.push_back(mesh_.points[global[i]]);
+      const bool interior = rt.key_corners[i].empty() && rt.tpl.node_faces[i] == 0;
+      constraints.push_back(interior ? primal::NodeConstraint::free() : primal::NodeConstraint::fixed());
+    }
+    primal::SmoothOptions so;
+    so.max_iterations = kSettleIterations;
+    const auto r = primal::smooth_hex_mesh(m, constraints, so);
+    if (r.final_min_scaled_jacobian <= r.initial_min_scaled_jacobian) continue;
+    for (std::size_t i = 0; i < global.size(); ++i) mesh_.points[global[i]] = m.points[i];
+    ++res_.templates_settled;
+    std::vector<Index> hexes(local.size());
+    std::iota(hexes.begin(), hexes.end(), first);
+    measure(hexes);
+  }
   res_.placement_inverted = static_cast<Index>(inverted_.size());
+  res_.min_scaled_jacobian_before_smoothing = scan();
+  if (!buffer_hexes.empty())
+    say("settling: " + std::to_string(buffer_hexes.size()) + " templates with an inverted hex, " +
+        std::to_string(res_.placement_inverted) + " hexes left inverted" + took());
 }
 
 // A hex still inverted (the placement can invert one in a poor buffer hex) is untangled by

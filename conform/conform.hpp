@@ -111,8 +111,11 @@ struct ConformResult {
   // (primal::diced_min_scaled_jacobian), before the buffer layer moves anything.
   double input_diced_hex_min_scaled_jacobian = 1.0, input_diced_tet_min_scaled_jacobian = 1.0;
   double min_scaled_jacobian_before_smoothing = 0.0;
-  // Hexes the placement alone left with scaled Jacobian <= 0; ConformSmooth::kNone untangles
-  // them (patches seeded at them alone) and nothing else.
+  // Buffer hexes whose template the map inverted, re-smoothed inside the buffer hex (interior
+  // template nodes only, every other node fixed) before any smoothing.
+  primal::Index templates_settled = 0;
+  // Hexes the placement (the map, then that settling) left with scaled Jacobian <= 0;
+  // ConformSmooth::kNone untangles them (patches seeded at them alone) and nothing else.
   primal::Index placement_inverted = 0;
   primal::LocalSmoothResult smoothing;  // kNone: the untangling only (zero when nothing was inverted)
   primal::HexValidityReport validity;

@@ -107,8 +107,6 @@ TEST_CASE("half-block demo, n = 2") {
 
 TEST_CASE("nugget demo, n = 2: side set 'outside' carried to the diced hexes") {
   const primal::Model m = conform::demo_nugget(2);
-  // Unsmoothed, the buffer hexes at the cube's corners give inverted geode hexes; the default
-  // local smoothing untangles them.
   const auto r = conform::conform(m);
   // Interface: the nugget cube's 6 faces, n x n = 4 quads each.
   check_result(r, {static_cast<Index>(m.hexes.size()), static_cast<Index>(m.tets.size()), 24});
