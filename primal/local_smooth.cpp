@@ -329,10 +329,13 @@ class Patch {
     const auto& shapes = hex_frame_shapes();
     for (std::size_t k = 0; k < n; ++k) {
       const double w = std::exp(-t * (q_[k] - qmin)) / sum;
-      if (w < 1e-10) continue;  // far above the minimum: nothing measurable
+      // Far above the minimum: a millionth of the gradient at most. The step is checked on the
+      // exact soft minimum (Armijo), so a direction this close to the gradient's costs nothing.
+      if (w < 1e-6) continue;
       // Second derivatives only where the weight is large enough to shape the step (the soft
-      // minimum's curvature is dominated by its few lowest frames); the gradient stays exact.
-      const bool second = w >= 1e-4;
+      // minimum's curvature is dominated by its few lowest frames); elsewhere the frame adds its
+      // Gauss-Newton part t w g g^T only.
+      const bool second = w >= 3e-3;
       const FrameRef& r = frames_[k];
       const HexFrameShape& s = shapes[r.frame];
       FrameVector g;
