@@ -2,8 +2,9 @@
 // The geode algorithm on a whole model (the paper's Sections 1 and 4): find the hex/tet
 // interface, shrink the tet part off it (buffer layer), dice the hex part (8 per hex) and the
 // tet part (4 hexes per tet), fill every buffer hex with the 26-hex geode template (or, where
-// the interface quad is split into four triangles around a centre node, the fixed-up
-// four-triangle template) mapped into it, merge, smooth locally and verify. The result is all-hex.
+// the interface quad is split into four triangles around a centre node, the 44-hex
+// four-triangle template) mapped into it (a template the map inverts is settled inside its
+// buffer hex), merge, smooth locally and verify. The result is all-hex.
 //
 // Merging. Tet- and hex-side template nodes are identified with diced nodes by their origin
 // (corner, edge midpoint, quad centre, triangle centroid, a four-triangle top's centre node:

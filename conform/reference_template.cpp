@@ -99,7 +99,8 @@ RefTemplate make_reference(const Eigen::Vector3d& box, std::array<int, 2> diagon
     o.push.centre_radius = 0.6;
   }
   ref.tpl = build_geode3d(o);
-  // Fix-up (templates/fixup.hpp) pillows away any obstruction to untangling; this class has none.
+  // Fix-up (templates/fixup.hpp) would pillow away an obstruction to untangling; this class has
+  // none, which the call checks.
   if (four && templates::fix_up(ref.tpl).obstructions_after > 0)
     throw TopologyError("the four-triangle template in a " + std::to_string(box.x()) + " x " + std::to_string(box.y()) +
                         " x " + std::to_string(box.z()) + " box keeps obstructions after fix-up");
@@ -209,8 +210,8 @@ const RefTemplate& reference_template(const Eigen::Vector3d& box, std::array<int
   }
   auto& geode = slot_of(4);
   if (!geode) geode = std::make_unique<RefTemplate>(make_reference(box, {4, 6}));
-  // Smoothed in a flatter box than the geode's: the four-triangle template stacks more layers
-  // (its pillows) in the thickness; shapes smoothed at the flatter proportion keep its mapped
+  // Smoothed in a flatter box than the geode's: the four-triangle template has more hexes
+  // across the thickness; shapes smoothed at the flatter proportion keep its mapped
   // hexes positive where the geode's box does not. Only reference coordinates are kept, so the
   // sides still match the geode's.
   const Eigen::Vector3d four_box(box.x(), 0.7 * box.y(), box.z());

@@ -35,12 +35,13 @@ struct RefTemplate {
 const RefTemplate& reference_template(const Eigen::Vector3d& box, std::array<int, 2> diagonal);
 
 // The same for a buffer hex whose top is split into four triangles around a centre node: the
-// four-triangle variant's arrangement (templates/geode.hpp, TopSplit::FourTriangles), fixed up
-// by pillowing (templates/fixup.hpp) and smoothed. Its tet-side nodes are the corners, edge
-// midpoints, the centre, the midpoints of centre-corner edges and the four triangle
-// centroids; its side faces have the ordinary geode's quad mesh (match_side pairs them) and
-// are given the {4, 6} geode's reference positions, the rest smoothed with them fixed in a box
-// of half box.y (the buffer hexes are flat; see the .cpp).
+// four-triangle variant's arrangement (templates/geode.hpp, TopSplit::FourTriangles) with
+// superquadric domes, a push class with no obstruction to untangling (templates/fixup.hpp
+// checks it), smoothed. Its tet-side nodes are the corners, edge midpoints, the centre, the
+// midpoints of centre-corner edges and the four triangle centroids; its side faces have the
+// ordinary geode's quad mesh (match_side pairs them) and are given the {4, 6} geode's
+// reference positions, the rest smoothed with them fixed in a box of 0.7 box.y (the buffer
+// hexes are flat; see the .cpp).
 const RefTemplate& reference_template_four_triangles(const Eigen::Vector3d& box);
 
 // Matches the nodes of side face ka of template A with those of side face kb of template B
