@@ -10,6 +10,9 @@
 #include <sstream>
 #include <unordered_map>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "conform/reference_template.hpp"
 #include "primal/boundary.hpp"
 #include "primal/dice.hpp"
@@ -138,6 +141,7 @@ class Conformer {
   void match_sides();
   void assemble();
   void settle_templates();
+  std::vector<std::pair<Index, Point>> settled(std::size_t b) const;
   void untangle();
   void add_smoothing(const primal::LocalSmoothResult& r);
   void smooth();
@@ -382,6 +386,33 @@ void Conformer::assemble() {
 // Untangling and shape together: a bound, as the buffer hex's fixed nodes soon cap the minimum.
 constexpr int kSettleIterations = 50;
 
+// One template settled: its interior nodes with their new positions, or nothing when the
+// smoother did not raise the template's minimum.
+std::vector<std::pair<Index, Point>> Conformer::settled(std::size_t b) const {
+  const RefTemplate& rt = ref(b);
+  const auto& local = rt.tpl.hex.hexes;
+  const Index first = geode_first_[b];
+  std::vector<Index> global(rt.rst.size(), kInvalidIndex);
+  for (std::size_t k = 0; k < local.size(); ++k)
+    for (int c = 0; c < 8; ++c) global[local[k][c]] = mesh_.hexes[first + k][c];
+  primal::HexMesh m;
+  m.hexes = local;
+  std::vector<primal::NodeConstraint> constraints;
+  for (std::size_t i = 0; i < global.size(); ++i) {
+    m.points.push_back(mesh_.points[global[i]]);
+    const bool interior = rt.key_corners[i].empty() && rt.tpl.node_faces[i] == 0;
+    constraints.push_back(interior ? primal::NodeConstraint::free() : primal::NodeConstraint::fixed());
+  }
+  primal::SmoothOptions so;
+  so.max_iterations = kSettleIterations;
+  const auto r = primal::smooth_hex_mesh(m, constraints, so);
+  std::vector<std::pair<Index, Point>> moved;
+  if (r.final_min_scaled_jacobian <= r.initial_min_scaled_jacobian) return moved;
+  for (std::size_t i = 0; i < global.size(); ++i)
+    if (constraints[i].kind == primal::NodeConstraint::Kind::kFree) moved.emplace_back(global[i], m.points[i]);
+  return moved;
+}
+
 void Conformer::settle_templates() {
   t0_ = Clock::now();
   std::vector<std::size_t> buffer_hexes;  // those with an inverted geode hex, ascending
@@ -390,36 +421,29 @@ void Conformer::settle_templates() {
     const auto b = static_cast<std::size_t>(std::upper_bound(geode_first_.begin(), geode_first_.end(), h) - geode_first_.begin() - 1);
     if (buffer_hexes.empty() || buffer_hexes.back() != b) buffer_hexes.push_back(b);
   }
-  for (std::size_t b : buffer_hexes) {
-    const RefTemplate& rt = ref(b);
-    const auto& local = rt.tpl.hex.hexes;
-    const Index first = geode_first_[b];
-    std::vector<Index> global(rt.rst.size(), kInvalidIndex);
-    for (std::size_t k = 0; k < local.size(); ++k)
-      for (int c = 0; c < 8; ++c) global[local[k][c]] = mesh_.hexes[first + k][c];
-    primal::HexMesh m;
-    m.hexes = local;
-    std::vector<primal::NodeConstraint> constraints;
-    for (std::size_t i = 0; i < global.size(); ++i) {
-      m.points.push_back(mesh_.points[global[i]]);
-      const bool interior = rt.key_corners[i].empty() && rt.tpl.node_faces[i] == 0;
-      constraints.push_back(interior ? primal::NodeConstraint::free() : primal::NodeConstraint::fixed());
-    }
-    primal::SmoothOptions so;
-    so.max_iterations = kSettleIterations;
-    const auto r = primal::smooth_hex_mesh(m, constraints, so);
-    if (r.final_min_scaled_jacobian <= r.initial_min_scaled_jacobian) continue;
-    for (std::size_t i = 0; i < global.size(); ++i) mesh_.points[global[i]] = m.points[i];
-    ++res_.templates_settled;
-    std::vector<Index> hexes(local.size());
-    std::iota(hexes.begin(), hexes.end(), first);
-    measure(hexes);
+  if (buffer_hexes.empty()) {
+    res_.placement_inverted = static_cast<Index>(inverted_.size());
+    return;
   }
-  res_.placement_inverted = static_cast<Index>(inverted_.size());
+  // Templates share no interior node: settled in parallel (TBB), written back in order.
+  std::vector<std::vector<std::pair<Index, Point>>> moved(buffer_hexes.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, buffer_hexes.size(), 1),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t j = range.begin(); j != range.end(); ++j) moved[j] = settled(buffer_hexes[j]);
+                    });
+  for (std::size_t j = 0; j < buffer_hexes.size(); ++j) {
+    if (moved[j].empty()) continue;
+    ++res_.templates_settled;
+    for (const auto& [v, x] : moved[j]) mesh_.points[v] = x;
+    const std::size_t b = buffer_hexes[j];
+    for (Index h = geode_first_[b]; h < geode_first_[b + 1]; ++h)
+      sj_[h] = primal::hex_scaled_jacobian(primal::hex_corners(mesh_, h));
+  }
   res_.min_scaled_jacobian_before_smoothing = scan();
-  if (!buffer_hexes.empty())
-    say("settling: " + std::to_string(buffer_hexes.size()) + " templates with an inverted hex, " +
-        std::to_string(res_.placement_inverted) + " hexes left inverted" + took());
+  res_.placement_inverted = static_cast<Index>(inverted_.size());
+  say("settling: " + std::to_string(buffer_hexes.size()) + " templates with an inverted hex, " +
+      std::to_string(res_.templates_settled) + " settled, " + std::to_string(res_.placement_inverted) +
+      " hexes left inverted" + took());
 }
 
 // A hex still inverted (the placement can invert one in a poor buffer hex) is untangled by
