@@ -377,13 +377,8 @@ void Conformer::assemble() {
   res_.min_scaled_jacobian_before_smoothing = measure();
 }
 
-// The map can invert a template hex where a buffer hex is far from the template's box (a
-// trapezoidal interface quad at a model corner squeezes one side of the template). Such a
-// template is put right inside its own buffer hex: its interior nodes (used by none of the
-// template's neighbours) are untangled and smoothed with every other node fixed (the template
-// smoother, primal/smooth.hpp), so the placement hands a valid mesh to smoothing wherever
-// that can be done inside the buffer hex, and the diced elements stay exactly as diced.
-// Untangling and shape together: a bound, as the buffer hex's fixed nodes soon cap the minimum.
+// Settling a template: untangling and shape together, at most this many iterations (a bound:
+// the buffer hex's fixed nodes soon cap the minimum).
 constexpr int kSettleIterations = 50;
 
 // One template settled: its interior nodes with their new positions, or nothing when the
@@ -413,6 +408,12 @@ std::vector<std::pair<Index, Point>> Conformer::settled(std::size_t b) const {
   return moved;
 }
 
+// The map can invert a template hex where a buffer hex is far from the template's box (a
+// trapezoidal interface quad at a model corner squeezes one side of the template). Such a
+// template is put right inside its own buffer hex: its interior nodes (used by none of the
+// template's neighbours) are untangled and smoothed with every other node fixed (the template
+// smoother, primal/smooth.hpp), so the placement hands a valid mesh to smoothing wherever
+// that can be done inside the buffer hex, and the diced elements stay exactly as diced.
 void Conformer::settle_templates() {
   t0_ = Clock::now();
   std::vector<std::size_t> buffer_hexes;  // those with an inverted geode hex, ascending
@@ -446,11 +447,12 @@ void Conformer::settle_templates() {
       " hexes left inverted" + took());
 }
 
-// A hex still inverted (the placement can invert one in a poor buffer hex) is untangled by
-// moving its neighbours too: patches start on it and on the hexes within this many rings of it.
+// A hex is untangled by moving its neighbours too: the patches start on it and on the hexes
+// within this many rings of it.
 constexpr int kUntangleRings = 2;
 
-// A hex still inverted is untangled with the hexes within kUntangleRings of it, at
+// A hex still inverted (one whose buffer hex leaves its template no valid placement, or one the
+// smoothing could not lift) is untangled with the hexes within kUntangleRings of it, at
 // local_smooth_options' own target, so that even --smooth none gives a usable mesh. Reads
 // inverted_ as the last measure() or scan() left it.
 void Conformer::untangle() {

@@ -56,9 +56,10 @@ struct ConformOptions {
   // kLocal. 0 (automatic): the defects are the hexes below the yardstick (the input's own hexes
   // and tets diced alone, ConformResult); patches start on them and the hexes sharing a node
   // with them, at hexes below 1.05 x the yardstick, until none is below the yardstick, and up
-  // to seven times more around the defects left, each time 0.02 higher. The smoother works only where the transition is worse than dicing the input makes
-  // anyway, and its cost follows the defects, not the interface. > 0: every geode hex and its
-  // neighbours below this scaled Jacobian seed patches.
+  // to seven times more around the defects left, each time 0.02 higher. The smoother works only
+  // where the transition is worse than dicing the input makes anyway, and its cost follows the
+  // defects, not the interface. > 0: every geode hex and its neighbours below this scaled
+  // Jacobian seed patches.
   double smooth_target = 0.0;
   ConformQuality quality = ConformQuality::kScaledJacobian;
   // kLocal, and the untangling of hexes still inverted (with any mode); the automatic target
