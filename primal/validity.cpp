@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include "primal/disjoint_sets.hpp"
+#include "primal/errors.hpp"
 
 #include <algorithm>
 #include <cassert>
@@ -424,10 +425,6 @@ HexValidityReport check_validity(const HexMesh& mesh) {
   auto hex = [&](Index p) -> const std::array<Index, 8>& {
     return mesh.hexes[static_cast<std::size_t>(original[static_cast<std::size_t>(p)])];
   };
-  auto corner_of = [&](Index p, Index v) {
-    const auto& h = hex(p);
-    return static_cast<int>(std::find(h.begin(), h.end(), v) - h.begin());
-  };
   // Local edge joining two corners (-1 if they are not joined by an edge).
   static const auto kEdgeOf = [] {
     std::array<std::array<int, 8>, 8> t{};
@@ -439,7 +436,10 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     return t;
   }();
 
-  // Node -> proper hexes, ascending.
+  // Node -> proper hexes, ascending, each with the node's corner in it: 8 p + corner (no search
+  // for the corner where a node's hexes are visited).
+  if (nh >= (std::size_t{1} << 28))
+    throw InvalidInput("check_validity: " + std::to_string(nh) + " hexes, 2^28 or more");
   std::vector<Index> start(nv + 1, 0), around;
   for (std::size_t p = 0; p < nh; ++p)
     for (Index v : hex(static_cast<Index>(p))) ++start[static_cast<std::size_t>(v) + 1];
@@ -448,8 +448,9 @@ HexValidityReport check_validity(const HexMesh& mesh) {
   {
     std::vector<Index> fill(start.begin(), start.end() - 1);
     for (std::size_t p = 0; p < nh; ++p)
-      for (Index v : hex(static_cast<Index>(p)))
-        around[static_cast<std::size_t>(fill[static_cast<std::size_t>(v)]++)] = static_cast<Index>(p);
+      for (int c = 0; c < 8; ++c)
+        around[static_cast<std::size_t>(fill[static_cast<std::size_t>(hex(static_cast<Index>(p))[c])]++)] =
+            static_cast<Index>(8 * p + static_cast<std::size_t>(c));
   }
   auto face_nodes = [&](Index p, int lf) {
     std::array<Index, 4> q{};
@@ -468,8 +469,8 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     for (std::size_t v = range.begin(); v != range.end(); ++v) {
       local.clear();
       for (Index k = start[v]; k < start[v + 1]; ++k) {
-        const Index p = around[static_cast<std::size_t>(k)];
-        const int c = corner_of(p, static_cast<Index>(v));
+        const Index p = around[static_cast<std::size_t>(k)] >> 3;
+        const int c = around[static_cast<std::size_t>(k)] & 7;
         for (int lf : inc.corner_faces[c]) {
           const auto q = face_nodes(p, lf);
           if (*std::min_element(q.begin(), q.end()) != static_cast<Index>(v)) continue;
@@ -543,8 +544,8 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     }
     s.stars.clear();
     for (Index i = start[static_cast<std::size_t>(v)]; i < start[static_cast<std::size_t>(v) + 1]; ++i) {
-      const Index p = around[static_cast<std::size_t>(i)];
-      const int c = corner_of(p, v);
+      const Index p = around[static_cast<std::size_t>(i)] >> 3;
+      const int c = around[static_cast<std::size_t>(i)] & 7;
       CornerStar& star = s.stars.emplace_back();
       for (int k = 0; k < 3; ++k) {
         star.ends[k] = hex(p)[topo::kHexCornerNeighbors[c][k]];
@@ -571,8 +572,8 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     edge_uses.clear();
     bool on_boundary = false, overshared = false;
     for (Index i = 0; i < n; ++i) {
-      const Index p = around[static_cast<std::size_t>(start[v] + i)];
-      const int c = corner_of(p, static_cast<Index>(v));
+      const Index p = around[static_cast<std::size_t>(start[v] + i)] >> 3;
+      const int c = around[static_cast<std::size_t>(start[v] + i)] & 7;
       for (int lf : inc.corner_faces[c]) {
         const auto uses = face_uses(p, lf);
         on_boundary |= uses == 1;

@@ -65,6 +65,7 @@ struct HexValidityReport {
   std::string summary() const;  // one line per finding, listing the first few offenders
 };
 
+// Throws InvalidInput for a mesh of 2^28 hexes or more (the incidence is kept in 32 bits).
 HexValidityReport check_validity(const HexMesh& mesh);
 
 // A quad mesh lying in the plane through its first node with normal `normal`.
