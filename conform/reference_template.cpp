@@ -197,28 +197,36 @@ void impose_geode_sides(RefTemplate& four, const RefTemplate& geode, const Eigen
 }  // namespace
 
 const RefTemplate& reference_template(const Eigen::Vector3d& box, std::array<int, 2> diagonal) {
+  // One slot per box and diagonal (kCentreCorner: the four-triangle template), built once;
+  // the lock only finds the slot, so that different templates are built at the same time
+  // (conform builds both diagonals in parallel). std::map nodes never move.
+  struct Slot {
+    std::once_flag once;
+    std::unique_ptr<RefTemplate> value;
+  };
   static std::mutex mutex;
-  static std::map<std::tuple<double, double, double, int>, std::unique_ptr<RefTemplate>> cache;
-  const std::lock_guard<std::mutex> lock(mutex);
-  // Slot diagonal[0] (4 or 5), or kCentreCorner for the four-triangle template.
-  auto slot_of = [&](int d) -> std::unique_ptr<RefTemplate>& { return cache[{box.x(), box.y(), box.z(), d}]; };
-  auto& slot = slot_of(diagonal[0]);
-  if (slot) return *slot;
-  if (diagonal[0] != kCentreCorner) {
-    slot = std::make_unique<RefTemplate>(make_reference(box, diagonal));
-    return *slot;
+  static std::map<std::tuple<double, double, double, int>, Slot> cache;
+  Slot* slot = nullptr;
+  {
+    const std::lock_guard<std::mutex> lock(mutex);
+    slot = &cache[{box.x(), box.y(), box.z(), diagonal[0]}];
   }
-  auto& geode = slot_of(4);
-  if (!geode) geode = std::make_unique<RefTemplate>(make_reference(box, {4, 6}));
-  // Smoothed in a flatter box than the geode's: the four-triangle template has more hexes
-  // across the thickness; shapes smoothed at the flatter proportion keep its mapped
-  // hexes positive where the geode's box does not. Only reference coordinates are kept, so the
-  // sides still match the geode's.
-  const Eigen::Vector3d four_box(box.x(), 0.7 * box.y(), box.z());
-  auto four = std::make_unique<RefTemplate>(make_reference(four_box, {4, 6}, templates::TopSplit::FourTriangles));
-  impose_geode_sides(*four, *geode, four_box);
-  slot = std::move(four);
-  return *slot;
+  std::call_once(slot->once, [&] {
+    if (diagonal[0] != kCentreCorner) {
+      slot->value = std::make_unique<RefTemplate>(make_reference(box, diagonal));
+      return;
+    }
+    const RefTemplate& geode = reference_template(box, {4, 6});
+    // Smoothed in a flatter box than the geode's: the four-triangle template has more hexes
+    // across the thickness; shapes smoothed at the flatter proportion keep its mapped
+    // hexes positive where the geode's box does not. Only reference coordinates are kept, so the
+    // sides still match the geode's.
+    const Eigen::Vector3d four_box(box.x(), 0.7 * box.y(), box.z());
+    auto four = std::make_unique<RefTemplate>(make_reference(four_box, {4, 6}, templates::TopSplit::FourTriangles));
+    impose_geode_sides(*four, geode, four_box);
+    slot->value = std::move(four);
+  });
+  return *slot->value;
 }
 
 const RefTemplate& reference_template_four_triangles(const Eigen::Vector3d& box) {

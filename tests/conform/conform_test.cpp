@@ -3,6 +3,8 @@
 // with the hand-checked counts 8 per input hex, 26 per interface quad (the four-triangle
 // template's count per four-triangle quad), 4 per tet.
 #include <doctest/doctest.h>
+
+#include <thread>
 #include <unistd.h>
 
 #include <filesystem>
@@ -97,6 +99,25 @@ TEST_CASE("L-shaped interfaces: buffer hexes meeting at a concave edge merge the
     // x = 1 (j = 1, 2) and 2 on y = 1 (i = 1, 2), x 2 layers = 8.
     check_result(conform::conform(m), {10, 48, 8});
   }
+}
+
+// conform builds the templates in parallel: each box and diagonal is built once, whichever
+// thread asks first, and every caller gets that one.
+TEST_CASE("reference templates: one per box and diagonal, from several threads at once") {
+  const Eigen::Vector3d box(24, 9, 24);  // a box no other test uses, so the slots start empty
+  std::array<const conform::RefTemplate*, 4> got{};
+  std::vector<std::thread> threads;
+  for (int i = 0; i < 4; ++i)
+    threads.emplace_back([&got, &box, i] {
+      got[static_cast<std::size_t>(i)] = &conform::reference_template(box, i % 2 ? std::array<int, 2>{5, 7} : std::array<int, 2>{4, 6});
+    });
+  for (auto& t : threads) t.join();
+  CHECK(got[0] == got[2]);
+  CHECK(got[1] == got[3]);
+  CHECK(got[0] != got[1]);
+  CHECK(got[0] == &conform::reference_template(box, {4, 6}));
+  CHECK(got[0]->min_scaled_jacobian > 0.0);
+  CHECK(got[1]->min_scaled_jacobian > 0.0);
 }
 
 TEST_CASE("half-block demo, n = 2") {
