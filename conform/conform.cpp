@@ -229,13 +229,13 @@ void Conformer::place_templates() {
   t0_ = Clock::now();
   // The four-triangle template only when some buffer hex needs it (it costs time); the
   // templates built in parallel (each once per process).
-  const bool four = std::any_of(layer_.hexes.begin(), layer_.hexes.end(), [](const BufferHex& b) { return b.centre != kInvalidIndex; });
+  const bool any_four = std::any_of(layer_.hexes.begin(), layer_.hexes.end(), [](const BufferHex& b) { return b.centre != kInvalidIndex; });
   tbb::parallel_invoke([&] { refs_[0] = &reference_template(options_.template_box, {4, 6}); },
                        [&] { refs_[1] = &reference_template(options_.template_box, {5, 7}); },
-                       [&] { if (four) refs_[2] = &reference_template_four_triangles(options_.template_box); });
+                       [&] { if (any_four) refs_[2] = &reference_template_four_triangles(options_.template_box); });
   res_.template_min_scaled_jacobian =
       std::min(refs_[0]->min_scaled_jacobian, refs_[1]->min_scaled_jacobian);
-  if (four) res_.template_min_scaled_jacobian = std::min(res_.template_min_scaled_jacobian, refs_[2]->min_scaled_jacobian);
+  if (any_four) res_.template_min_scaled_jacobian = std::min(res_.template_min_scaled_jacobian, refs_[2]->min_scaled_jacobian);
   const primal::Model& lm = layer_.model;
   const std::size_t nb = layer_.hexes.size();
   inst_global_.assign(nb, {});
