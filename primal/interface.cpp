@@ -188,7 +188,7 @@ Interface find_interface(const Model& model, double tol) {
                                                     : *boundary_triangle(face_key(triangles[i]));
       q.tets[i] = u.tet;
       q.tet_faces[i] = u.face;
-      tris[static_cast<std::size_t>(*tri_index.find(face_key(u.nodes)))].matched = true;
+      tris[static_cast<std::size_t>(tet_face_tri[4 * static_cast<std::size_t>(u.tet) + static_cast<std::size_t>(u.face)])].matched = true;
       const auto& tet = model.tets[static_cast<std::size_t>(u.tet)];
       Index apex = kInvalidIndex;
       for (Index v : tet)

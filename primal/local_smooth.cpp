@@ -243,11 +243,8 @@ class Patch {
       floor_.push_back(sj[h] <= 0.0 ? f : std::min(sj[h], std::max(f, worst)));
     }
     // A hex already below its edge floor (shortened while untangling) just gets no shorter.
-    for (std::size_t h = 0; h < hex_.size(); ++h) {
-      HexCorners c;
-      for (int k = 0; k < 8; ++k) c[k] = pos_[local_[h][k]];
-      edge_floor_.push_back(std::min(ctx.edge_floor[hex_[h]], hex_shortest_edge(c)));
-    }
+    for (std::size_t h = 0; h < hex_.size(); ++h)
+      edge_floor_.push_back(std::min(ctx.edge_floor[hex_[h]], hex_shortest_edge(corners(pos_, h))));
   }
 
   PatchOutcome run(std::vector<double>& sj) {
@@ -257,21 +254,23 @@ class Patch {
     for (int phase = 0; phase < 2; ++phase) {
       const bool untangle = phase == 0;
       // A positive scaled Jacobian means all nine frames are positive: no untangling then.
-      if (untangle && (!tangled_ || min_frame(true) > 0.0)) continue;
+      if (untangle && (!tangled_ || min_untangle_frame() > 0.0)) continue;
       const double t = untangle ? o.untangle_sharpness : o.sharpness;
+      q_at_pos_ = false;  // q_ holds the other phase's measure, if any
       for (int it = 0; it < o.max_iterations; ++it) {
         const bool ok = newton_step(untangle, t);
         ++out.iterations;
         if (!ok) break;
         out.moved = true;
-        if (untangle && min_frame(true) > 0.0) break;
+        // An accepted step leaves q_ at the new positions.
+        if (untangle && *std::min_element(q_.begin(), q_.end()) > 0.0) break;
         if (last_gain_ < o.min_gain) break;
       }
     }
     if (out.moved) {
       // Patches of one round write disjoint nodes and hexes (see the round selection).
       for (int i = 0; i < moving_; ++i) ctx_.mesh.points[node_[i]] = pos_[i];
-      for (std::size_t h = 0; h < hex_.size(); ++h) sj[hex_[h]] = hex_sj(pos_, h);
+      for (std::size_t h = 0; h < hex_.size(); ++h) sj[hex_[h]] = hex_scaled_jacobian(corners(pos_, h));
     }
     return out;
   }
@@ -302,25 +301,29 @@ class Patch {
     return d * scale;
   }
 
-  double min_frame(bool untangle) const {
+  double min_untangle_frame() const {
     double m = std::numeric_limits<double>::max();
-    for (const FrameRef& r : frames_) m = std::min(m, measure(columns(pos_, r), r, untangle, nullptr, nullptr));
+    for (const FrameRef& r : frames_) m = std::min(m, measure(columns(pos_, r), r, true, nullptr, nullptr));
     return m;
   }
 
-  double hex_sj(const std::vector<Point>& p, std::size_t h) const {
+  // Corners of affected hex h at positions p.
+  HexCorners corners(const std::vector<Point>& p, std::size_t h) const {
     HexCorners c;
     for (int k = 0; k < 8; ++k) c[k] = p[local_[h][k]];
-    return hex_scaled_jacobian(c);
+    return c;
   }
 
   // Soft minimum -1/t log sum exp(-t q_k) over the frames at positions p; with grad and hess,
   // the derivatives of its negative with respect to the moving nodes' xyz coordinates.
+  // `q_known`: q_ already holds the frame values at p.
   double soft_min(const std::vector<Point>& p, bool untangle, double t, PatchVector* grad,
-                  PatchMatrix* hess) {
+                  PatchMatrix* hess, bool q_known = false) {
     const std::size_t n = frames_.size();
-    q_.resize(n);
-    for (std::size_t k = 0; k < n; ++k) q_[k] = measure(columns(p, frames_[k]), frames_[k], untangle, nullptr, nullptr);
+    if (!q_known) {
+      q_.resize(n);
+      for (std::size_t k = 0; k < n; ++k) q_[k] = measure(columns(p, frames_[k]), frames_[k], untangle, nullptr, nullptr);
+    }
     const auto [qmin, sum, value] = soft_of_q(t);
     if (!grad) return value;
     const int m3 = 3 * moving_;
@@ -383,8 +386,7 @@ class Patch {
     trial_q_.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
       const std::size_t h = (i + last_broken_) % n;
-      HexCorners c;
-      for (int k = 0; k < 8; ++k) c[k] = p[local_[h][k]];
+      const HexCorners c = corners(p, h);
       trial_q_[h] = hex_scaled_jacobians(c);
       const double q = *std::min_element(trial_q_[h].begin(), trial_q_[h].end());
       if (q < floor_[h] || (!untangle && hex_shortest_edge(c) < edge_floor_[h])) {
@@ -418,7 +420,8 @@ class Patch {
   bool newton_step(bool untangle, double t) {
     PatchVector gx;
     PatchMatrix hx;
-    const double f0 = -soft_min(pos_, untangle, t, &gx, &hx);
+    const double f0 = -soft_min(pos_, untangle, t, &gx, &hx, q_at_pos_);
+    q_at_pos_ = false;  // trial steps overwrite q_
     std::array<Basis, 8> basis;
     std::array<int, 8> offset{};
     int dof = 0;
@@ -467,6 +470,7 @@ class Patch {
         last_gain_ = f0 - f;
         lambda_ = step == 1.0 ? lambda_ / 4.0 : std::max(4.0 * lambda_, 1e-8 * scale);
         pos_.swap(trial_);
+        q_at_pos_ = true;  // measured at this trial just above
         return true;
       }
     }
@@ -481,6 +485,7 @@ class Patch {
   std::vector<FrameRef> frames_;
   std::vector<double> q_, floor_, edge_floor_;
   std::size_t last_broken_ = 0;  // the hex whose floor a trial step broke last
+  bool q_at_pos_ = false;  // q_ holds this phase's frame values at pos_ (after an accepted step)
   std::vector<std::array<double, 9>> trial_q_;  // per hex, its frames' scaled Jacobians
   int moving_ = 0;
   bool tangled_ = false;  // some patch hex has a scaled Jacobian <= 0
@@ -565,7 +570,6 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
 
   // The hexes a patch seeded by pool[i] touches (sharing a free node with it), found once.
   std::vector<std::vector<Index>> around(pool.size());
-  std::vector<char> found(pool.size(), 0);
   for (Index round = 0;; ++round) {
     std::vector<std::size_t> cand;  // positions in pool
     for (std::size_t i = 0; i < pool.size(); ++i) {
@@ -587,8 +591,7 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
     for (std::size_t i : cand) {
       const Index h = pool[i];
       std::vector<Index>& a = around[i];
-      if (!found[i]) {
-        found[i] = 1;
+      if (a.empty()) {  // not found yet (a hex found with none is never a candidate again)
         for (Index v : mesh.hexes[h])
           if (!is_fixed(ctx, v))
             for (Index k = ctx.node_start[v]; k < ctx.node_start[v + 1]; ++k) a.push_back(ctx.node_hexes[k]);
@@ -692,6 +695,7 @@ LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seed
   LocalSmoothResult res = smooth_hexes_local(sub, constraints, &surface, local_seeds, options, start ? &sub_start : nullptr);
   for (std::size_t v = 0; v < global.size(); ++v)
     if (moves[v]) mesh.points[global[v]] = sub.points[v];
+  res.region = region;
   return res;
 }
 

@@ -16,7 +16,7 @@
 //    inverted hex has no floor: untangling may move it through worse shapes; the soft minimum
 //    of the Jacobians it maximises keeps the worst Jacobian from dropping. Improving shape, no
 //    edge shrinks below min_edge_fraction of its hex's shortest edge at the start (the scaled
-//    Jacobian cannot see an edge collapse).
+//    Jacobian cannot see an edge collapse); a hex untangling left shorter gets no shorter.
 //  - Termination: each patch's soft minimum rises monotonically (Armijo) and stops when it rises
 //    by less than `min_gain`, after max_iterations, or when no step is accepted; each hex seeds
 //    at most max_visits patches, and only when a neighbouring patch moved one of its nodes since
@@ -52,8 +52,8 @@ struct LocalSmoothOptions {
   double margin = 0.1;        // hexes this close to a patch's worst never lose (see Floors)
   double loss = 0.1;          // how far a better hex may fall from its start
   // Improving shape, no hex's shortest edge drops below this fraction of its shortest edge when
-  // the call began: the scaled Jacobian normalises edge lengths, so it would let an edge shrink
-  // to nothing.
+  // the call began (or below its current one, if untangling shortened it further): the scaled
+  // Jacobian normalises edge lengths, so it would let an edge shrink to nothing.
   double min_edge_fraction = 0.5;
   int max_visits = 2;         // patches seeded by one hex
   int max_iterations = 5;     // Newton iterations per patch (per phase)
@@ -73,6 +73,9 @@ struct LocalSmoothResult {
   long iterations = 0;  // Newton iterations over all patches
   double seconds = 0.0;  // wall clock
   double cpu_seconds = 0.0;  // the process's CPU time over all threads (std::clock)
+  // smooth_hexes_around: the hexes whose scaled Jacobian it can have changed (those sharing a
+  // node with a seed), ascending; empty from smooth_hexes_local.
+  std::vector<Index> region;
 };
 
 // What the floors are measured from, per hex of the mesh: its scaled Jacobian and its shortest
