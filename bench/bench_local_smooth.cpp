@@ -59,7 +59,7 @@ void run(const std::string& name, const primal::Model& input, const primal::Loca
   std::printf("%s: %zu tets, %zu input hexes -> %zu hexes, %.0f buffer hexes, %zu seeds\n", name.c_str(),
               input.tets.size(), input.hexes.size(), mesh.hexes.size(), buffer, seeds.size());
   print_blocks("before", block_minima(mesh));
-  const double yardstick = std::min(r.input_diced_hex_min_scaled_jacobian, r.input_diced_tet_min_scaled_jacobian);
+  const double yardstick = r.yardstick();
   std::printf("    --smooth none: valid %s, min SJ %.4f; input diced alone %.4f (hexes) %.4f (tets): %.2f x the lower\n",
               r.validity.ok() && primal::min_scaled_jacobian(mesh) > 0 ? "yes" : "NO", primal::min_scaled_jacobian(mesh),
               r.input_diced_hex_min_scaled_jacobian, r.input_diced_tet_min_scaled_jacobian,
@@ -75,10 +75,9 @@ void run(const std::string& name, const primal::Model& input, const primal::Loca
     primal::LocalSmoothOptions lo = base;
     if (m.global) lo.target = conform::ConformOptions{}.global_smooth_options.target;
     lo.threads = m.threads;
-    const std::clock_t c0 = std::clock();
     const auto res = primal::smooth_hexes_local(work, cons, &surface,
                                                 m.global ? std::span<const primal::Index>{} : seeds, lo);
-    const double cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
+    const double cpu = res.cpu_seconds;
     std::printf("  %-24s %.3f ms CPU per buffer hex (%.3f s CPU, %.3f s wall), %d patches, %d rounds,"
                 " %ld iterations, inverted %d -> %d\n",
                 m.label, 1e3 * cpu / buffer, cpu, res.seconds, res.patches, res.rounds, res.iterations,
@@ -123,7 +122,7 @@ int main(int argc, char** argv) {
     const std::clock_t c0 = std::clock();
     const auto t0 = std::chrono::steady_clock::now();
     const conform::ConformResult r = conform::conform(input, co);
-    const double yardstick = std::min(r.input_diced_hex_min_scaled_jacobian, r.input_diced_tet_min_scaled_jacobian);
+    const double yardstick = r.yardstick();
     const double buffer = static_cast<double>(r.interface_quads);
     std::printf("  whole conform (defaults): %.3f s CPU, %.3f s wall, valid %s, min SJ %.4f = %.2f x the input diced alone;"
                 " its smoothing %.3f s wall, %.3f s CPU = %.2f ms CPU per buffer hex, %d patches\n",

@@ -105,7 +105,7 @@ void print_summary(const conform::ConformResult& r, std::ostream& os, bool table
     if (tables) os << primal::format_quality_table(b.report) << "\n";
   }
   // The transition against the input's own elements diced alone (the yardstick).
-  const double yardstick = std::min(r.input_diced_hex_min_scaled_jacobian, r.input_diced_tet_min_scaled_jacobian);
+  const double yardstick = r.yardstick();
   const double output = output_min_sj(r);
   os << "input diced alone: min scaled Jacobian " << r.input_diced_hex_min_scaled_jacobian << " (hexes), "
      << r.input_diced_tet_min_scaled_jacobian << " (tets); output " << output;

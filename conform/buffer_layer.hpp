@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "primal/interface.hpp"
+#include "primal/local_smooth.hpp"
 #include "primal/model.hpp"
 
 namespace geode::conform {
@@ -32,7 +33,8 @@ using primal::Model;
 
 struct BufferLayerOptions {
   // Height of the buffer layer at each interface node (its distance from the interface faces
-  // there), as a fraction of the shortest tet or interface-quad edge at the node.
+  // there) before grading, as a fraction of the shortest tet or interface-quad edge at the
+  // node; grading (below) may raise it up to this fraction of the node's mean quad edge.
   double thickness = 0.3;
   // Heights vary smoothly along the interface (see insert_buffer_layer): a node is raised to
   // within raise_rate x edge length of its neighbours' heights (not above thickness x its
@@ -54,7 +56,7 @@ struct BufferLayerOptions {
   // Angle (degrees) above which two outer-boundary faces of the tet part at a node form a
   // feature: a moved node slides in the boundary's tangent plane, along a feature edge, or
   // (at a feature corner) cannot move.
-  double feature_angle = 30.0;
+  double feature_angle = primal::kFeatureAngle;
 };
 
 struct BufferHex {

@@ -147,9 +147,9 @@ class Conformer {
   void add_smoothing(const primal::LocalSmoothResult& r);
   void smooth();
   void smooth_defects(primal::LocalSmoothOptions o);
-  double measure();                               // every hex
-  double measure(std::span<const Index> hexes);   // these only, the others unchanged since
-  double scan();                                  // inverted_ and the minimum from sj_
+  double measure();                             // every hex, then scan()
+  void measure(std::span<const Index> hexes);   // these only, the others unchanged since
+  double scan();                                // inverted_ and the minimum from sj_
   void verify();
   void output();
 
@@ -169,8 +169,8 @@ class Conformer {
   primal::HexMesh mesh_;
   std::vector<primal::NodeSet> node_sets_;
   std::vector<primal::SideSet> side_sets_;
-  // Every output hex's scaled Jacobian and the hexes at or below 0, as of the last measure():
-  // after placement, then after smoothing; verification reads them.
+  // Every output hex's scaled Jacobian (kept current by assemble, settling and smoothing) and
+  // the hexes at or below 0 as of the last scan(); verification reads them.
   std::vector<double> sj_;
   std::vector<Index> inverted_;
   OutputBlocks blocks_;
@@ -264,11 +264,11 @@ void Conformer::place_templates() {
           throw TopologyError("buffer hex " + std::to_string(b) +
                               ": a template node has no diced node to merge with");
         inst_global_[b][i] = g;
-      } else if (rt.tpl.node_faces[i] != 0) {
+      } else if (rt.interior(i)) {
+        inst_global_[b][i] = diced_.add_node(x);
+      } else {
         inst_side_[b][i] = side_sets_uf_.add();
         side_pos_.push_back(x);
-      } else {
-        inst_global_[b][i] = diced_.add_node(x);
       }
     }
   }
@@ -396,8 +396,7 @@ std::vector<std::pair<Index, Point>> Conformer::settled(std::size_t b) const {
   std::vector<primal::NodeConstraint> constraints;
   for (std::size_t i = 0; i < global.size(); ++i) {
     m.points.push_back(mesh_.points[global[i]]);
-    const bool interior = rt.key_corners[i].empty() && rt.tpl.node_faces[i] == 0;
-    constraints.push_back(interior ? primal::NodeConstraint::free() : primal::NodeConstraint::fixed());
+    constraints.push_back(rt.interior(i) ? primal::NodeConstraint::free() : primal::NodeConstraint::fixed());
   }
   primal::SmoothOptions so;
   so.max_iterations = kSettleIterations;
@@ -438,8 +437,9 @@ void Conformer::settle_templates() {
     ++res_.templates_settled;
     for (const auto& [v, x] : moved[j]) mesh_.points[v] = x;
     const std::size_t b = buffer_hexes[j];
-    for (Index h = geode_first_[b]; h < geode_first_[b + 1]; ++h)
-      sj_[h] = primal::hex_scaled_jacobian(primal::hex_corners(mesh_, h));
+    std::vector<Index> hexes(static_cast<std::size_t>(geode_first_[b + 1] - geode_first_[b]));
+    std::iota(hexes.begin(), hexes.end(), geode_first_[b]);
+    measure(hexes);
   }
   res_.min_scaled_jacobian_before_smoothing = scan();
   res_.placement_inverted = static_cast<Index>(inverted_.size());
@@ -461,8 +461,10 @@ void Conformer::untangle() {
   const std::size_t before = inverted_.size();
   std::vector<Index> seeds = inverted_;
   for (int ring = 0; ring < kUntangleRings; ++ring) seeds = primal::hexes_around(mesh_, seeds);
-  add_smoothing(primal::smooth_hexes_around(mesh_, seeds, options_.local_smooth_options));
-  res_.smoothing.final_min_scaled_jacobian = measure(primal::hexes_around(mesh_, seeds));
+  const auto r = primal::smooth_hexes_around(mesh_, seeds, options_.local_smooth_options);
+  add_smoothing(r);
+  measure(r.region);
+  res_.smoothing.final_min_scaled_jacobian = scan();
   res_.smoothing.final_inverted = static_cast<Index>(inverted_.size());
   say("untangling: " + std::to_string(before) + " inverted hexes, " + std::to_string(inverted_.size()) +
       " left" + took());
@@ -502,7 +504,9 @@ void Conformer::smooth() {
     std::vector<Index> geode(static_cast<std::size_t>(res_.geode_hexes));
     std::iota(geode.begin(), geode.end(), res_.diced_hexes);
     o.target = options_.smooth_target;
-    add_smoothing(primal::smooth_hexes_around(mesh_, primal::hexes_around(mesh_, geode), o));
+    const auto r = primal::smooth_hexes_around(mesh_, primal::hexes_around(mesh_, geode), o);
+    add_smoothing(r);
+    measure(r.region);
   } else if (local) {
     smooth_defects(o);
   } else {
@@ -510,9 +514,9 @@ void Conformer::smooth() {
     const auto constraints = primal::boundary_slide_constraints(mesh_, boundary);
     const primal::TriMesh surface = primal::boundary_triangulation(mesh_.points, boundary);
     add_smoothing(primal::smooth_hexes_local(mesh_, constraints, &surface, {}, o));
+    sj_ = primal::scaled_jacobian_per_hex(mesh_);
   }
-  // The automatic passes keep sj_ up to date as they go.
-  res_.smoothing.final_min_scaled_jacobian = local && options_.smooth_target <= 0.0 ? scan() : measure();
+  res_.smoothing.final_min_scaled_jacobian = scan();
   res_.smoothing.final_inverted = static_cast<Index>(inverted_.size());
   untangle();
   const Index patches = res_.smoothing.patches;
@@ -536,20 +540,26 @@ constexpr double kDefectTarget = 1.05;      // x the yardstick, first pass
 constexpr double kDefectTargetStep = 0.02;  // added to it by each further pass
 constexpr int kDefectPasses = 8;
 
+// Keeps sj_ up to date. A pass changes only the hexes sharing a node with its seeds (its
+// region), and every defect was a seed, so the next pass's defects are in the region.
 void Conformer::smooth_defects(primal::LocalSmoothOptions o) {
-  const double yardstick = std::min(res_.input_diced_hex_min_scaled_jacobian, res_.input_diced_tet_min_scaled_jacobian);
+  const double yardstick = res_.yardstick();
+  std::vector<Index> defects;
+  for (std::size_t h = 0; h < sj_.size(); ++h)
+    if (sj_[h] < yardstick) defects.push_back(static_cast<Index>(h));
   std::optional<primal::SmoothStart> start;  // the floors hold over all passes
-  for (int pass = 0; pass < kDefectPasses; ++pass) {
-    std::vector<Index> defects;
-    for (std::size_t h = 0; h < sj_.size(); ++h)
-      if (sj_[h] < yardstick) defects.push_back(static_cast<Index>(h));
-    if (defects.empty()) return;
-    for (int ring = 0; ring < kDefectRings; ++ring) defects = primal::hexes_around(mesh_, defects);
+  for (int pass = 0; pass < kDefectPasses && !defects.empty(); ++pass) {
+    std::vector<Index> seeds = defects;
+    for (int ring = 0; ring < kDefectRings; ++ring) seeds = primal::hexes_around(mesh_, seeds);
     o.target = kDefectTarget * yardstick + pass * kDefectTargetStep;
     o.goal = yardstick;
     if (!start) start = primal::SmoothStart{sj_, primal::shortest_edge_per_hex(mesh_)};
-    add_smoothing(primal::smooth_hexes_around(mesh_, defects, o, primal::kFeatureAngle, &*start));
-    measure(primal::hexes_around(mesh_, defects));  // a patch moves the nodes of its seed hex only
+    const auto r = primal::smooth_hexes_around(mesh_, seeds, o, primal::kFeatureAngle, &*start);
+    add_smoothing(r);
+    measure(r.region);
+    defects.clear();
+    for (Index h : r.region)
+      if (sj_[static_cast<std::size_t>(h)] < yardstick) defects.push_back(h);
   }
 }
 
@@ -558,9 +568,8 @@ double Conformer::measure() {
   return scan();
 }
 
-double Conformer::measure(std::span<const Index> hexes) {
+void Conformer::measure(std::span<const Index> hexes) {
   for (Index h : hexes) sj_[static_cast<std::size_t>(h)] = primal::hex_scaled_jacobian(primal::hex_corners(mesh_, h));
-  return scan();
 }
 
 double Conformer::scan() {

@@ -14,6 +14,7 @@
 // faces carry one mirror-symmetric mesh (templates/side_faces.hpp) and a side face is mapped
 // bilinearly from its four corners by both buffer hexes, so both place a merged node at the
 // same point: no position is reconciled, and a placement valid in each buffer hex stays valid.
+#include <algorithm>
 #include <functional>
 #include <string>
 #include <vector>
@@ -112,14 +113,18 @@ struct ConformResult {
   // The yardstick for the transition: the input's hexes and tets each diced alone
   // (primal::diced_min_scaled_jacobian), before the buffer layer moves anything.
   double input_diced_hex_min_scaled_jacobian = 1.0, input_diced_tet_min_scaled_jacobian = 1.0;
+  double yardstick() const { return std::min(input_diced_hex_min_scaled_jacobian, input_diced_tet_min_scaled_jacobian); }
   double min_scaled_jacobian_before_smoothing = 0.0;
   // Buffer hexes whose template the map inverted, re-smoothed inside the buffer hex (interior
   // template nodes only, every other node fixed) before any smoothing.
   primal::Index templates_settled = 0;
-  // Hexes the placement (the map, then that settling) left with scaled Jacobian <= 0;
-  // ConformSmooth::kNone untangles them (patches seeded at them alone) and nothing else.
+  // Hexes the placement (the map, then that settling) left with scaled Jacobian <= 0; every mode
+  // untangles those still inverted (patches seeded within two rings of them); ConformSmooth::kNone
+  // does that and nothing else.
   primal::Index placement_inverted = 0;
-  primal::LocalSmoothResult smoothing;  // kNone: the untangling only (zero when nothing was inverted)
+  // The smoothing and untangling calls added up; the minima and inverted counts are the whole
+  // mesh's before and after (kNone: no patches when nothing was inverted).
+  primal::LocalSmoothResult smoothing;
   primal::HexValidityReport validity;
   std::vector<BlockQuality> quality;  // one per output block, ascending id ("block N" unnamed); ConformOptions::quality
   std::vector<std::string> warnings;  // e.g. "3 hexes with scaled Jacobian <= 0 (1-based output elements): 12 40 ..."

@@ -12,7 +12,6 @@
 #include "primal/patch_match.hpp"
 #include "primal/smooth.hpp"
 #include "primal/topology.hpp"
-#include "templates/fixup.hpp"
 #include "templates/side_faces.hpp"
 
 namespace geode::conform {
@@ -99,11 +98,11 @@ RefTemplate make_reference(const Eigen::Vector3d& box, std::array<int, 2> diagon
     o.push.centre_radius = 0.6;
   }
   ref.tpl = build_geode3d(o);
-  // Fix-up (templates/fixup.hpp) would pillow away an obstruction to untangling; this class has
-  // none, which the call checks.
-  if (four && templates::fix_up(ref.tpl).obstructions_after > 0)
+  // This class has no obstruction to untangling (primal/realizability.hpp), so it needs no
+  // fix-up; a box that gave it one would be refused here rather than pillowed silently.
+  if (four && !templates::template_obstructions(ref.tpl).empty())
     throw TopologyError("the four-triangle template in a " + std::to_string(box.x()) + " x " + std::to_string(box.y()) +
-                        " x " + std::to_string(box.z()) + " box keeps obstructions after fix-up");
+                        " x " + std::to_string(box.z()) + " box has obstructions to untangling");
   // The geode's four side faces become one shared mesh (templates/side_faces.hpp); the
   // four-triangle template takes the geode's afterwards (impose_geode_sides).
   ref.min_scaled_jacobian = four ? smooth_template(ref.tpl, false).final_min_scaled_jacobian

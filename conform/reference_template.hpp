@@ -23,6 +23,8 @@ struct RefTemplate {
   double min_scaled_jacobian = 0.0;
   std::vector<primal::Point> rst;             // reference coordinates in [0, 1]^3
   std::vector<std::vector<int>> key_corners;  // empty: not a tet/hex-side node; else corners 0..7 or kCentreCorner
+  // Node i is used by this template alone: not a tet/hex-side node, not on a side face.
+  bool interior(std::size_t i) const { return key_corners[i].empty() && tpl.node_faces[i] == 0; }
   // Per buffer hex side face 0..3 (topology order): its template nodes and quads.
   std::array<std::vector<int>, 4> side_nodes;
   std::array<std::vector<std::array<int, 4>>, 4> side_quads;
@@ -36,8 +38,8 @@ const RefTemplate& reference_template(const Eigen::Vector3d& box, std::array<int
 
 // The same for a buffer hex whose top is split into four triangles around a centre node: the
 // four-triangle variant's arrangement (templates/geode.hpp, TopSplit::FourTriangles) with
-// superquadric domes, a push class with no obstruction to untangling (templates/fixup.hpp
-// checks it), smoothed. Its tet-side nodes are the corners, edge midpoints, the centre, the
+// superquadric domes, a push class with no obstruction to untangling (checked: TopologyError
+// otherwise), smoothed. Its tet-side nodes are the corners, edge midpoints, the centre, the
 // midpoints of centre-corner edges and the four triangle centroids; its side faces have the
 // ordinary geode's quad mesh (match_side pairs them) and are given the {4, 6} geode's
 // reference positions, the rest smoothed with them fixed in a box of 0.7 box.y (the buffer

@@ -81,7 +81,7 @@ TEST_CASE("realistic models, default options: valid, untangled, at least 0.9 x t
     test::check_conform_result(r);
     // The transition is not the worst part: the output's minimum against the input's own
     // hexes and tets each diced alone (the coarse nugget's Delaunay tets dice to 0.29).
-    const double yardstick = std::min(r.input_diced_hex_min_scaled_jacobian, r.input_diced_tet_min_scaled_jacobian);
+    const double yardstick = r.yardstick();
     CHECK(r.smoothing.final_min_scaled_jacobian >= 0.9 * yardstick);
     // The yardstick is measured on the input itself: Delaunay tets are far from the diced
     // Kuhn cube's 0.29, the swept hexes of the cylinder and the imprinted faces far from 1.
