@@ -269,12 +269,13 @@ class Problem {
                   Eigen::MatrixXd* hess = nullptr) {
     const std::size_t n = locals_.size();
     q_.resize(n);
-    dq_.resize(n);
+    if (grad) dq_.resize(n);
     for (std::size_t k = 0; k < n; ++k) {
       const Local& l = locals_[k];
-      // Untangling looks at Jacobians only: a guard frame repeats its corner there.
+      // Untangling looks at Jacobians only: a guard frame repeats its corner there. Line-search
+      // evaluations (no grad) need the values only.
       q_[k] = column_value(columns(k, x), m, m == Measure::kJacobian ? 0 : l.guard, scale_of(l, m),
-                           &dq_[k]);
+                           grad ? &dq_[k] : nullptr);
     }
     const double qmin = *std::min_element(q_.begin(), q_.end());
     double sum = 0.0;
