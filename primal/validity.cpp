@@ -447,11 +447,17 @@ HexValidityReport check_validity(const HexMesh& mesh) {
   around.resize(static_cast<std::size_t>(start.back()));
   {
     std::vector<Index> fill(start.begin(), start.end() - 1);
-    for (std::size_t p = 0; p < nh; ++p)
+    for (std::size_t p = 0; p < nh; ++p) {
+      const auto& h = hex(static_cast<Index>(p));
       for (int c = 0; c < 8; ++c)
-        around[static_cast<std::size_t>(fill[static_cast<std::size_t>(hex(static_cast<Index>(p))[c])]++)] =
-            static_cast<Index>(8 * p + static_cast<std::size_t>(c));
+        around[static_cast<std::size_t>(fill[static_cast<std::size_t>(h[c])]++)] = static_cast<Index>(8 * p + static_cast<std::size_t>(c));
+    }
   }
+  // An incidence entry: the hex and the node's corner in it.
+  auto use_at = [&](Index k) {
+    const Index a = around[static_cast<std::size_t>(k)];
+    return std::pair<Index, int>{a >> 3, a & 7};
+  };
   auto face_nodes = [&](Index p, int lf) {
     std::array<Index, 4> q{};
     for (int i = 0; i < 4; ++i) q[i] = hex(p)[topo::kHexFaceCorners[lf][i]];
@@ -469,8 +475,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     for (std::size_t v = range.begin(); v != range.end(); ++v) {
       local.clear();
       for (Index k = start[v]; k < start[v + 1]; ++k) {
-        const Index p = around[static_cast<std::size_t>(k)] >> 3;
-        const int c = around[static_cast<std::size_t>(k)] & 7;
+        const auto [p, c] = use_at(k);
         for (int lf : inc.corner_faces[c]) {
           const auto q = face_nodes(p, lf);
           if (*std::min_element(q.begin(), q.end()) != static_cast<Index>(v)) continue;
@@ -544,8 +549,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     }
     s.stars.clear();
     for (Index i = start[static_cast<std::size_t>(v)]; i < start[static_cast<std::size_t>(v) + 1]; ++i) {
-      const Index p = around[static_cast<std::size_t>(i)] >> 3;
-      const int c = around[static_cast<std::size_t>(i)] & 7;
+      const auto [p, c] = use_at(i);
       CornerStar& star = s.stars.emplace_back();
       for (int k = 0; k < 3; ++k) {
         star.ends[k] = hex(p)[topo::kHexCornerNeighbors[c][k]];
@@ -572,8 +576,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     edge_uses.clear();
     bool on_boundary = false, overshared = false;
     for (Index i = 0; i < n; ++i) {
-      const Index p = around[static_cast<std::size_t>(start[v] + i)] >> 3;
-      const int c = around[static_cast<std::size_t>(start[v] + i)] & 7;
+      const auto [p, c] = use_at(start[v] + i);
       for (int lf : inc.corner_faces[c]) {
         const auto uses = face_uses(p, lf);
         on_boundary |= uses == 1;
