@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <mutex>
 #include <string>
 #include <unordered_map>
 #include <unordered_set>
@@ -28,6 +29,34 @@ FaceKey face_key(std::span<const Index> nodes) {
 }
 
 namespace {
+
+// OpenMesh reports refused faces on its process-wide error stream; extract_boundary reports them
+// in `rejected` instead. Boundaries are extracted from several threads at once (templates are
+// built in parallel), and OpenMesh's omerr() connects std::cerr on its first call without a lock,
+// so the first call and every enable/disable go through one mutex; the stream is disabled while
+// any extraction is adding faces and restored to its previous state when the last one ends.
+class OpenMeshErrorsSilenced {
+public:
+  OpenMeshErrorsSilenced() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (active_++ == 0) {
+      was_enabled_ = omerr().is_enabled();
+      omerr().disable();
+    }
+  }
+  ~OpenMeshErrorsSilenced() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (--active_ == 0 && was_enabled_) omerr().enable();
+  }
+  OpenMeshErrorsSilenced(const OpenMeshErrorsSilenced&) = delete;
+  OpenMeshErrorsSilenced& operator=(const OpenMeshErrorsSilenced&) = delete;
+
+private:
+  static inline std::mutex mutex_;
+  static inline int active_ = 0;
+  static inline bool was_enabled_ = true;
+};
+
 
 void check_indices(const HexMesh& mesh) {
   const auto n = static_cast<Index>(mesh.points.size());
@@ -144,9 +173,7 @@ BoundarySurface extract_boundary(const std::vector<Point>& points, std::vector<B
       }
     }
   }
-  // OpenMesh reports refused faces on its error stream; they are reported in `rejected`.
-  const bool was_enabled = omerr().is_enabled();
-  omerr().disable();
+  const OpenMeshErrorsSilenced silenced;
   for (const auto& q : quads) {
     std::vector<SurfaceMesh::VertexHandle> vhs;
     for (Index v : q.nodes) vhs.push_back(vertex_of[v]);
@@ -158,7 +185,6 @@ BoundarySurface extract_boundary(const std::vector<Point>& points, std::vector<B
       b.rejected.push_back(q);
     }
   }
-  if (was_enabled) omerr().enable();
 
   b.closed = std::all_of(edge_uses.begin(), edge_uses.end(),
                          [](const auto& kv) { return kv.second == 2; });
