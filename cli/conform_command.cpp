@@ -35,7 +35,8 @@ struct ConformArgs {
   std::string model = "half";
   std::string save_input;
   double merge_tolerance = -1;  // < 0: no merging
-  double buffer_thickness = conform::BufferLayerOptions{}.thickness;
+  double buffer_thickness = -1;  // < 0: the side's default
+  std::string buffer_side = "hex";
   double smooth_target = 0.0;
   std::string template_box;
   int n = 4;
@@ -171,7 +172,9 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
   opts.smooth = conform::parse_conform_smooth(a.smooth);
   opts.quality = conform::parse_conform_quality(a.quality);
   opts.geode_block = a.geode_block;
-  opts.buffer.thickness = a.buffer_thickness;
+  opts.buffer.side = a.buffer_side == "hex" ? conform::BufferSide::Hex : conform::BufferSide::Tet;
+  opts.buffer.thickness =
+      a.buffer_thickness > 0 ? a.buffer_thickness : conform::default_buffer_thickness(opts.buffer.side);
   opts.smooth_target = a.smooth_target;
   if (!a.template_box.empty()) opts.template_box = template_box(a.template_box);
   opts.progress = [&progress](const std::string& line) { progress.stage(line); };
@@ -254,14 +257,19 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
                 "first merge nodes closer than this distance (model units), for parts meshed\n"
                 "separately whose interface nodes are duplicated")
       ->check(number_check(0, 1e300));
-  c->add_option("--buffer-thickness", a.buffer_thickness,
-                "how far the tet part shrinks off the interface, as a fraction of the shortest edge\n"
-                "at each interface node (the buffer layer's thickness)")
-      ->check(number_check(0.01, 0.45))
+  c->add_option("--buffer-side", a.buffer_side,
+                "the part the buffer layer is carved from: hex (default; the tets stay as meshed, the\n"
+                "hexes at the interface are squashed) or tet (the hexes stay, the tets shrink off the interface)")
+      ->check(CLI::IsMember({"hex", "tet"}))
       ->capture_default_str();
+  c->add_option("--buffer-thickness", a.buffer_thickness,
+                "how far that part shrinks off the interface (the buffer layer's thickness), as a fraction\n"
+                "of the shortest edge at each interface node; default 0.5 with --buffer-side hex, 0.3 with tet")
+      ->check(number_check(0.01, 0.9));
   c->add_option("--template-box", a.template_box,
                 "proportions WxHxD of the box the reference geode template is smoothed in once per\n"
-                "run (H: the buffer hex's thickness direction; default 24x10x24, near the buffer hexes' own)");
+                "run (H: the buffer hex's thickness direction; default 24x12x24, near the buffer hexes' own;\n"
+                "24x10x24 suits --buffer-side tet)");
   c->add_flag("--write-invalid", a.write_invalid,
               "write the mesh and report even when verification fails (the exit code is still 4)");
   c->add_flag("--quiet", a.quiet, "no progress and no summary (errors and the invalid-result message still print)");

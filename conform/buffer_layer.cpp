@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <tuple>
 
 #include "primal/boundary.hpp"
 #include "primal/errors.hpp"
@@ -61,30 +62,55 @@ std::pair<Point, double> best_direction(const std::vector<Point>& n, Project pro
   return {best, best_m};
 }
 
-}  // namespace
+// insert_buffer_layer's stages over one state: which part moves (BufferSide), per moved node
+// (slot k of Interface::nodes) its geometry, direction and height, then the move-and-check
+// loop.
+class BufferBuilder {
+public:
+  BufferBuilder(const Model& input, const Interface& itf, const BufferLayerOptions& opt)
+      : input_(input), itf_(itf), opt_(opt), n_points_(input.points.size()), n_moved_(itf.nodes.size()),
+        hex_side_(opt.side == BufferSide::Hex) {}
+  BufferLayer run();
 
-BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
-                                const BufferLayerOptions& opt) {
-  validate(input, "insert_buffer_layer");
-  const std::size_t n_points = input.points.size();
-  const auto& P = input.points;
-  auto pt = [&](Index v) -> const Point& { return P[static_cast<std::size_t>(v)]; };
+private:
+  const Point& pt(Index v) const { return input_.points[static_cast<std::size_t>(v)]; }
+  std::size_t slot(Index v) const {
+    return static_cast<std::size_t>(out_.top_node[static_cast<std::size_t>(v)]) - n_points_;
+  }
+  bool moved(Index v) const { return out_.top_node[static_cast<std::size_t>(v)] != kInvalidIndex; }
+  void interface_geometry();
+  template <class Cells, class Edges, class Faces>
+  void moving_part(const Cells& cells, const Edges& edges, const Faces& faces,
+                   const std::vector<FaceKey>& interface_faces);
+  void directions();
+  void heights();
+  void make_hexes();
+  void place();
+  std::string check(std::vector<char>& failing);
+  void move_and_check();
 
-  BufferLayer out;
-  out.model = input;
-  out.top_node.assign(n_points, kInvalidIndex);
-  const std::vector<Index>& interface_nodes = itf.nodes;
-  for (std::size_t k = 0; k < interface_nodes.size(); ++k)
-    out.top_node[static_cast<std::size_t>(interface_nodes[k])] = static_cast<Index>(n_points + k);
-  auto slot = [&](Index v) {
-    return static_cast<std::size_t>(out.top_node[static_cast<std::size_t>(v)]) - n_points;
-  };
-  const std::size_t n_moved = interface_nodes.size();
+  const Model& input_;
+  const Interface& itf_;
+  const BufferLayerOptions& opt_;
+  const std::size_t n_points_, n_moved_;
+  const bool hex_side_;  // the hex part's copies move (into the hex part), the tet part stays
+  BufferLayer out_;
+  // Per moved node: unit corner normals of its interface quads pointing into the moving part,
+  // the shortest interface-quad or moving-part edge at it, area-weighted outward normals of
+  // the moving part's outer-boundary faces at it, its step direction and height.
+  std::vector<std::vector<Point>> corner_normals_, outer_normals_;
+  std::vector<double> shortest_, step_, safe_;
+  std::vector<Point> direction_;
+  GradedEdges quad_edges_;
+  std::vector<Index> centre_of_;  // per input node: the quad it is the four-triangle centre of
+  std::vector<Index> touched_;    // moving-part cells with a moved node (or a moved centre)
+};
 
-  // Per moved node: unit corner normals of its interface quads, the shortest edge at it.
-  std::vector<std::vector<Point>> corner_normals(n_moved);
-  std::vector<double> shortest(n_moved, std::numeric_limits<double>::infinity());
-  for (const InterfaceQuad& q : itf.quads)
+void BufferBuilder::interface_geometry() {
+  corner_normals_.assign(n_moved_, {});
+  shortest_.assign(n_moved_, std::numeric_limits<double>::infinity());
+  const double into = hex_side_ ? -1.0 : 1.0;  // corner normals point to the tet side
+  for (const InterfaceQuad& q : itf_.quads)
     for (std::size_t i = 0; i < 4; ++i) {
       const Index v = q.corners[i];
       const Point er = pt(q.corners[(i + 1) % 4]) - pt(v);
@@ -92,67 +118,69 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
       const Point n = er.cross(es);
       if (n.norm() <= 0.0)
         throw TopologyError("insert_buffer_layer: interface face " + std::to_string(q.face + 1) + " of " +
-                            describe_element(input, {ElementKind::Hex, q.hex}) + " is degenerate at " +
-                            describe_node(input, v));
-      corner_normals[slot(v)].push_back(n.normalized());
-      shortest[slot(v)] = std::min({shortest[slot(v)], er.norm(), es.norm()});
+                            describe_element(input_, {ElementKind::Hex, q.hex}) + " is degenerate at " +
+                            describe_node(input_, v));
+      corner_normals_[slot(v)].push_back(into * n.normalized());
+      shortest_[slot(v)] = std::min({shortest_[slot(v)], er.norm(), es.norm()});
     }
-  // Tets touching the interface, tet edges at moved nodes, and the tet part's outer boundary
-  // (faces used once that are not interface triangles).
-  // Per tet-part triangle the number of tets using it, interface triangles marked by -1.
-  KeyMap<4> tet_face_uses(2 * input.tets.size());
-  for (const auto& t : input.tets)
-    for (const auto& fc : topology::kTetFaceCorners)
-      ++*tet_face_uses
-             .try_emplace(face_key(std::array<Index, 3>{t[static_cast<std::size_t>(fc[0])],
-                                                       t[static_cast<std::size_t>(fc[1])],
-                                                       t[static_cast<std::size_t>(fc[2])]}),
-                          0)
-             .first;
-  std::vector<FaceKey> interface_tris;
-  for (const InterfaceQuad& q : itf.quads)
-    for (const auto& tri : interface_triangles(q)) interface_tris.push_back(face_key(tri));
-  for (const FaceKey& key : interface_tris)
-    if (Index* uses = tet_face_uses.find(key)) *uses = -1;
-  std::vector<std::vector<Point>> outer_normals(n_moved);  // area-weighted
-  // Per input node: the interface quad it is the four-triangle centre of, or kInvalidIndex.
-  std::vector<Index> centre_of(n_points, kInvalidIndex);
-  for (std::size_t q = 0; q < itf.quads.size(); ++q)
-    if (itf.quads[q].centre != kInvalidIndex) centre_of[static_cast<std::size_t>(itf.quads[q].centre)] = static_cast<Index>(q);
-  std::vector<Index> touched_tets;
-  for (std::size_t t = 0; t < input.tets.size(); ++t) {
-    const auto& tet = input.tets[t];
+  centre_of_.assign(n_points_, kInvalidIndex);
+  for (std::size_t q = 0; q < itf_.quads.size(); ++q)
+    if (itf_.quads[q].centre != kInvalidIndex)
+      centre_of_[static_cast<std::size_t>(itf_.quads[q].centre)] = static_cast<Index>(q);
+}
+
+// The moving part's cells at moved nodes (with a four-triangle centre on the tet side), their
+// edges at moved nodes, and the part's outer boundary (faces used once that are not interface
+// faces), whose normals constrain the direction of a moved node on it.
+template <class Cells, class Edges, class Faces>
+void BufferBuilder::moving_part(const Cells& cells, const Edges& edges, const Faces& faces,
+                                const std::vector<FaceKey>& interface_faces) {
+  constexpr std::size_t kFaceSize = std::tuple_size_v<typename Faces::value_type>;
+  auto face_nodes = [&](const auto& cell, const auto& fc) {
+    std::array<Index, kFaceSize> f{};
+    for (std::size_t i = 0; i < kFaceSize; ++i) f[i] = cell[static_cast<std::size_t>(fc[i])];
+    return f;
+  };
+  KeyMap<4> face_uses(cells.size() * faces.size() / 2);
+  for (const auto& cell : cells)
+    for (const auto& fc : faces) ++*face_uses.try_emplace(face_key(face_nodes(cell, fc)), 0).first;
+  for (const FaceKey& key : interface_faces)
+    if (Index* uses = face_uses.find(key)) *uses = -1;
+  outer_normals_.assign(n_moved_, {});
+  for (std::size_t c = 0; c < cells.size(); ++c) {
+    const auto& cell = cells[c];
     bool touches = false;
-    for (Index v : tet)
-      touches |= out.top_node[static_cast<std::size_t>(v)] != kInvalidIndex || centre_of[static_cast<std::size_t>(v)] != kInvalidIndex;
+    for (Index v : cell) touches |= moved(v) || (!hex_side_ && centre_of_[static_cast<std::size_t>(v)] != kInvalidIndex);
     if (!touches) continue;
-    touched_tets.push_back(static_cast<Index>(t));
-    for (const auto& e : topology::kTetEdgeCorners) {
-      const Index a = tet[static_cast<std::size_t>(e[0])], b = tet[static_cast<std::size_t>(e[1])];
+    touched_.push_back(static_cast<Index>(c));
+    for (const auto& e : edges) {
+      const Index a = cell[static_cast<std::size_t>(e[0])], b = cell[static_cast<std::size_t>(e[1])];
       const double len = (pt(a) - pt(b)).norm();
       for (Index v : {a, b})
-        if (out.top_node[static_cast<std::size_t>(v)] != kInvalidIndex) shortest[slot(v)] = std::min(shortest[slot(v)], len);
+        if (moved(v)) shortest_[slot(v)] = std::min(shortest_[slot(v)], len);
     }
-    for (const auto& fc : topology::kTetFaceCorners) {
-      const std::array<Index, 3> tri{tet[static_cast<std::size_t>(fc[0])], tet[static_cast<std::size_t>(fc[1])],
-                                     tet[static_cast<std::size_t>(fc[2])]};
-      const FaceKey key = face_key(tri);
-      const Index* uses = tet_face_uses.find(key);
-      if (!uses || *uses != 1) continue;  // inner or interface triangle
-      const Point area = (pt(tri[1]) - pt(tri[0])).cross(pt(tri[2]) - pt(tri[0]));  // outward
-      for (Index v : tri)
-        if (out.top_node[static_cast<std::size_t>(v)] != kInvalidIndex) outer_normals[slot(v)].push_back(area);
+    for (const auto& fc : faces) {
+      const auto f = face_nodes(cell, fc);
+      const Index* uses = face_uses.find(face_key(f));
+      if (!uses || *uses != 1) continue;  // inner or interface face
+      // Twice the outward area vector (triangle or quad: the cross product of the diagonals).
+      const Point area = kFaceSize == 3 ? Point((pt(f[1]) - pt(f[0])).cross(pt(f[2]) - pt(f[0])))
+                                        : Point((pt(f[2]) - pt(f[0])).cross(pt(f[kFaceSize - 1]) - pt(f[1])));
+      for (Index v : f)
+        if (moved(v)) outer_normals_[slot(v)].push_back(area);
     }
   }
+}
 
-  // Step direction per moved node.
-  const double feature_cos = std::cos(opt.feature_angle * M_PI / 180.0);
-  std::vector<Point> direction(n_moved);
-  for (std::size_t k = 0; k < n_moved; ++k) {
-    const Index v = interface_nodes[k];
+void BufferBuilder::directions() {
+  const char* part = hex_side_ ? "hex" : "tet";
+  const double feature_cos = std::cos(opt_.feature_angle * M_PI / 180.0);
+  direction_.assign(n_moved_, Point::Zero());
+  for (std::size_t k = 0; k < n_moved_; ++k) {
+    const Index v = itf_.nodes[k];
     // Cluster the outer normals into features.
     std::vector<Point> features;  // summed area vectors
-    for (const Point& a : outer_normals[k]) {
+    for (const Point& a : outer_normals_[k]) {
       bool merged = false;
       for (Point& f : features)
         if (f.normalized().dot(a.normalized()) >= feature_cos) {
@@ -164,10 +192,9 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
     }
     for (Point& f : features) f.normalize();
     if (features.size() >= 3)
-      throw TopologyError("insert_buffer_layer: " + describe_node(input, v) +
-                          " is a corner of the tet part's outer boundary (" +
-                          std::to_string(features.size()) +
-                          " feature faces meet there): its tet-side copy cannot move off the interface");
+      throw TopologyError("insert_buffer_layer: " + describe_node(input_, v) + " is a corner of the " + part +
+                          " part's outer boundary (" + std::to_string(features.size()) +
+                          " feature faces meet there): its " + part + "-side copy cannot move off the interface");
     auto project = [&](Point d) -> Point {
       if (features.size() == 1) return d - d.dot(features[0]) * features[0];
       if (features.size() == 2) {
@@ -176,167 +203,242 @@ BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
       }
       return d;
     };
-    auto [d, m] = best_direction(corner_normals[k], project);
-    if (!(m >= opt.min_visibility))
-      throw TopologyError("insert_buffer_layer: " + describe_node(input, v) +
-                          ": no direction into the tet side lies above all " +
-                          std::to_string(corner_normals[k].size()) +
+    auto [d, m] = best_direction(corner_normals_[k], project);
+    if (!(m >= opt_.min_visibility))
+      throw TopologyError("insert_buffer_layer: " + describe_node(input_, v) + ": no direction into the " + part +
+                          " side lies above all " + std::to_string(corner_normals_[k].size()) +
                           " interface faces at it (best min cos " + std::to_string(m) +
                           "), so no valid buffer layer can be placed there (the paper's Figure 9 right)");
     // The mitred offset: a step of height / (d . n) along d puts the node at distance height
     // from every interface face whose corner normal fixes the cap's rim, so at convex and
     // concave edges and corners a buffer hex's top stays parallel to its bottom instead of
     // tilting towards the edge (and folding along its diagonal where its neighbour's does not).
-    direction[k] = d / std::max(m, opt.min_mitre_cos);
+    direction_[k] = d / std::max(m, opt_.min_mitre_cos);
   }
+}
 
-  // Height of the layer per node. thickness x the shortest edge at a node is safe for its
-  // tets but jumps where one short tet edge meets the interface: a buffer hex whose corners
-  // stand at unequal heights has a twisted top, folded along its diagonal, and the template's
-  // nodes under the fold invert. So a node is raised towards its neighbours' heights (to at
-  // least a neighbour's height less raise_rate x their edge, primal::grade_up), but not above
-  // thickness x its interface quads' mean edge (the buffer hex's own proportions); then
-  // lowered so that no two neighbours differ by more than smooth_rate x their edge, here and
-  // after every halving. A raised node whose tets or buffer hexes fail drops back to its safe
-  // height (the graded thickness x shortest edge) before it is ever halved.
-  GradedEdges quad_edges;
-  std::vector<double> mean_quad_edge(n_moved, 0.0);
-  for (const InterfaceQuad& q : itf.quads)
+// Height of the layer per node. thickness x the shortest edge at a node is safe for its cells
+// but jumps where one short edge meets the interface: a buffer hex whose corners stand at
+// unequal heights has a twisted face, folded along its diagonal, and the template's nodes
+// under the fold invert. So a node is raised towards its neighbours' heights (to at least a
+// neighbour's height less raise_rate x their edge, primal::grade_up), but not above thickness
+// x its interface quads' mean edge (the buffer hex's own proportions); then lowered so that no
+// two neighbours differ by more than smooth_rate x their edge, here and after every halving. A
+// raised node whose cells or buffer hexes fail drops back to its safe height (the graded
+// thickness x shortest edge) before it is ever halved.
+void BufferBuilder::heights() {
+  std::vector<double> mean_quad_edge(n_moved_, 0.0);
+  for (const InterfaceQuad& q : itf_.quads)
     for (std::size_t i = 0; i < 4; ++i) {
       const Index a = q.corners[i], b = q.corners[(i + 1) % 4];
       const double len = (pt(a) - pt(b)).norm();
-      quad_edges.nodes.push_back({static_cast<Index>(slot(a)), static_cast<Index>(slot(b))});
-      quad_edges.length.push_back(len);
+      quad_edges_.nodes.push_back({static_cast<Index>(slot(a)), static_cast<Index>(slot(b))});
+      quad_edges_.length.push_back(len);
       mean_quad_edge[slot(a)] += len, mean_quad_edge[slot(b)] += len;
     }
-  std::vector<double> step(n_moved);  // the node's height; it moves step x direction
-  for (std::size_t k = 0; k < n_moved; ++k) step[k] = opt.thickness * shortest[k];
-  std::vector<int> quads_at(n_moved, 0);  // two of a quad's edges per corner
-  for (const InterfaceQuad& q : itf.quads)
+  step_.assign(n_moved_, 0.0);  // the node's height; it moves step x direction
+  for (std::size_t k = 0; k < n_moved_; ++k) step_[k] = opt_.thickness * shortest_[k];
+  std::vector<int> quads_at(n_moved_, 0);  // two of a quad's edges per corner
+  for (const InterfaceQuad& q : itf_.quads)
     for (Index v : q.corners) ++quads_at[slot(v)];
-  std::vector<double> raised = step;
-  grade_up(raised, quad_edges, opt.raise_rate);
-  grade_down(step, quad_edges, opt.smooth_rate);
-  std::vector<double> safe = step;  // where a raised node falls back to
-  for (std::size_t k = 0; k < n_moved; ++k)
-    step[k] = std::max(step[k], std::min(raised[k], opt.thickness * mean_quad_edge[k] / (2.0 * quads_at[k])));
-  grade_down(step, quad_edges, opt.smooth_rate);
+  std::vector<double> raised = step_;
+  grade_up(raised, quad_edges_, opt_.raise_rate);
+  grade_down(step_, quad_edges_, opt_.smooth_rate);
+  safe_ = step_;
+  for (std::size_t k = 0; k < n_moved_; ++k)
+    step_[k] = std::max(step_[k], std::min(raised[k], opt_.thickness * mean_quad_edge[k] / (2.0 * quads_at[k])));
+  grade_down(step_, quad_edges_, opt_.smooth_rate);
+}
 
-  // Move, check, halve the steps of nodes of failing elements, repeat.
-  auto tet_vol = [](const std::vector<Point>& pts, const std::array<Index, 4>& t) {
-    return tet_volume(pts[static_cast<std::size_t>(t[0])], pts[static_cast<std::size_t>(t[1])],
-                      pts[static_cast<std::size_t>(t[2])], pts[static_cast<std::size_t>(t[3])]);
-  };
-  for (const InterfaceQuad& q : itf.quads) {
+void BufferBuilder::make_hexes() {
+  for (const InterfaceQuad& q : itf_.quads) {
     BufferHex b;
     for (std::size_t i = 0; i < 4; ++i) {
       b.corners[i] = q.corners[i];
-      b.corners[i + 4] = out.top_node[static_cast<std::size_t>(q.corners[i])];
+      b.corners[i + 4] = out_.top_node[static_cast<std::size_t>(q.corners[i])];
     }
     b.diagonal = q.diagonal == 0 ? std::array<int, 2>{4, 6} : std::array<int, 2>{5, 7};
     b.centre = q.centre;
-    b.quad = static_cast<Index>(out.hexes.size());
-    out.hexes.push_back(b);
+    b.quad = static_cast<Index>(out_.hexes.size());
+    out_.hexes.push_back(b);
   }
-  for (auto& t : out.model.tets)
+  for (auto& t : out_.model.tets)
     for (Index& v : t)
-      if (out.top_node[static_cast<std::size_t>(v)] != kInvalidIndex) v = out.top_node[static_cast<std::size_t>(v)];
+      if (moved(v)) v = out_.top_node[static_cast<std::size_t>(v)];
+}
 
+// Points at the current steps: the moving copy of each interface node steps along its
+// direction, the other stays; a four-triangle centre (tet side) keeps its place relative to
+// its quad's corners.
+void BufferBuilder::place() {
+  auto& pts = out_.model.points;
+  pts.assign(input_.points.begin(), input_.points.end());
+  for (std::size_t k = 0; k < n_moved_; ++k) {
+    const std::size_t v = static_cast<std::size_t>(itf_.nodes[k]);
+    const Point p = input_.points[v] + step_[k] * direction_[k];
+    if (hex_side_) {
+      pts.push_back(input_.points[v]);
+      pts[v] = p;
+    } else {
+      pts.push_back(p);
+    }
+  }
+  if (hex_side_) return;
+  for (const BufferHex& b : out_.hexes) {
+    if (b.centre == kInvalidIndex) continue;
+    Point shift = Point::Zero();
+    for (std::size_t i = 0; i < 4; ++i)
+      shift += (pts[static_cast<std::size_t>(b.corners[i + 4])] - pt(b.corners[i])) / 4.0;
+    pts[static_cast<std::size_t>(b.centre)] = pt(b.centre) + shift;
+  }
+}
+
+// Marks the moved nodes of failing cells and buffer hexes; returns the first failure, named.
+std::string BufferBuilder::check(std::vector<char>& failing) {
+  const auto& pts = out_.model.points;
+  // A failing centre's steps are its quad's corners'.
+  auto fail_node = [&](Index v) {
+    if (static_cast<std::size_t>(v) >= n_points_) {
+      failing[static_cast<std::size_t>(v) - n_points_] = 1;
+    } else if (hex_side_ && moved(v)) {
+      failing[slot(v)] = 1;
+    } else if (const Index q = centre_of_[static_cast<std::size_t>(v)]; !hex_side_ && q != kInvalidIndex) {
+      for (std::size_t i = 4; i < 8; ++i)
+        failing[static_cast<std::size_t>(out_.hexes[static_cast<std::size_t>(q)].corners[i]) - n_points_] = 1;
+    }
+  };
+  std::string first_failure;
+  auto keeps_only = [&](ElementKind kind, Index c, double ratio, Index v) {
+    if (first_failure.empty())
+      first_failure = describe_node(input_, v) + ": " + describe_element(input_, {kind, c}) + " keeps only " +
+                      std::to_string(ratio) + " of its volume";
+  };
+  out_.report.min_volume_ratio = 1.0;
+  out_.report.min_scaled_jacobian = 1.0;
+  if (hex_side_) {
+    // A hex's volume near each corner is its corner Jacobian; the ratio is the least over the
+    // corners and the centre.
+    for (Index h : touched_) {
+      const auto& hex = input_.hexes[static_cast<std::size_t>(h)];
+      HexCorners before, after;
+      for (std::size_t i = 0; i < 8; ++i) {
+        before[i] = pt(hex[i]);
+        after[i] = pts[static_cast<std::size_t>(hex[i])];
+      }
+      const auto jb = hex_jacobians(before), ja = hex_jacobians(after);
+      double ratio = std::numeric_limits<double>::infinity();
+      for (std::size_t i = 0; i < 9; ++i)
+        if (jb[i] > 0.0) ratio = std::min(ratio, ja[i] / jb[i]);
+      out_.report.min_volume_ratio = std::min(out_.report.min_volume_ratio, ratio);
+      if (ratio < opt_.min_volume_ratio) {
+        for (Index v : hex) fail_node(v);
+        for (Index v : hex)
+          if (moved(v)) keeps_only(ElementKind::Hex, h, ratio, v);
+      }
+    }
+  } else {
+    for (Index t : touched_) {
+      const auto& tet = input_.tets[static_cast<std::size_t>(t)];
+      const auto& now = out_.model.tets[static_cast<std::size_t>(t)];
+      const double ratio = tet_volume(pts[static_cast<std::size_t>(now[0])], pts[static_cast<std::size_t>(now[1])],
+                                      pts[static_cast<std::size_t>(now[2])], pts[static_cast<std::size_t>(now[3])]) /
+                           tet_volume(pt(tet[0]), pt(tet[1]), pt(tet[2]), pt(tet[3]));
+      out_.report.min_volume_ratio = std::min(out_.report.min_volume_ratio, ratio);
+      if (ratio < opt_.min_volume_ratio) {
+        for (Index v : now) fail_node(v);
+        for (Index v : tet)
+          if (moved(v) || centre_of_[static_cast<std::size_t>(v)] != kInvalidIndex) keeps_only(ElementKind::Tet, t, ratio, v);
+      }
+    }
+  }
+  for (const BufferHex& b : out_.hexes) {
+    HexCorners c;
+    for (std::size_t i = 0; i < 8; ++i) c[i] = pts[static_cast<std::size_t>(b.corners[i])];
+    double sj = hex_scaled_jacobian(c);
+    if (b.centre != kInvalidIndex) {
+      // A four-triangle top: each triangle must face away from the bottom face's centre,
+      // measured as a scaled Jacobian (the tet's volume over its edge lengths at the centre).
+      const Point& top = pts[static_cast<std::size_t>(b.centre)];
+      const Point bottom = (c[0] + c[1] + c[2] + c[3]) / 4.0;
+      for (std::size_t i = 0; i < 4; ++i) {
+        const Point a = c[4 + i] - bottom, e = c[4 + (i + 1) % 4] - bottom, m = top - bottom;
+        sj = std::min(sj, a.cross(e).dot(m) / (a.norm() * e.norm() * m.norm()));
+      }
+    }
+    out_.report.min_scaled_jacobian = std::min(out_.report.min_scaled_jacobian, sj);
+    if (sj < opt_.min_scaled_jacobian)
+      for (std::size_t i = 4; i < 8; ++i) {
+        failing[static_cast<std::size_t>(b.corners[i]) - n_points_] = 1;
+        if (first_failure.empty())
+          first_failure = "node " + std::to_string(b.corners[i - 4]) + ": the buffer hex on hex " +
+                          std::to_string(itf_.quads[static_cast<std::size_t>(b.quad)].hex) + " face " +
+                          std::to_string(itf_.quads[static_cast<std::size_t>(b.quad)].face) +
+                          " has scaled Jacobian " + std::to_string(sj);
+      }
+  }
+  return first_failure;
+}
+
+// Move, check, halve the steps of nodes of failing elements, repeat.
+void BufferBuilder::move_and_check() {
   for (int halvings = 0;;) {
-    out.model.points.resize(n_points);
-    for (std::size_t k = 0; k < n_moved; ++k) {
-      const std::size_t v = static_cast<std::size_t>(interface_nodes[k]);
-      out.model.points.push_back(P[v] + step[k] * direction[k]);
-    }
-    // A four-triangle centre keeps its place relative to the quad's corners.
-    for (const BufferHex& b : out.hexes) {
-      if (b.centre == kInvalidIndex) continue;
-      Point shift = Point::Zero();
-      for (std::size_t i = 0; i < 4; ++i)
-        shift += (out.model.points[static_cast<std::size_t>(b.corners[i + 4])] - P[static_cast<std::size_t>(b.corners[i])]) / 4.0;
-      out.model.points[static_cast<std::size_t>(b.centre)] = P[static_cast<std::size_t>(b.centre)] + shift;
-    }
-    std::vector<char> failing(n_moved, 0);
-    // A failing centre's steps are its quad's corners'.
-    auto fail_node = [&](Index v) {
-      if (static_cast<std::size_t>(v) >= n_points) {
-        failing[static_cast<std::size_t>(v) - n_points] = 1;
-      } else if (const Index q = centre_of[static_cast<std::size_t>(v)]; q != kInvalidIndex) {
-        for (std::size_t i = 4; i < 8; ++i) failing[static_cast<std::size_t>(out.hexes[static_cast<std::size_t>(q)].corners[i]) - n_points] = 1;
-      }
-    };
-    std::string first_failure;
-    out.report.min_tet_volume_ratio = 1.0;
-    out.report.min_scaled_jacobian = 1.0;
-    for (Index t : touched_tets) {
-      const double before = tet_vol(P, input.tets[static_cast<std::size_t>(t)]);
-      const auto& moved = out.model.tets[static_cast<std::size_t>(t)];
-      const double ratio = tet_vol(out.model.points, moved) / before;
-      out.report.min_tet_volume_ratio = std::min(out.report.min_tet_volume_ratio, ratio);
-      if (ratio < opt.min_volume_ratio) {
-        for (Index v : moved) fail_node(v);
-        for (Index v : moved) {
-          if (!first_failure.empty()) break;
-          const bool duplicate = static_cast<std::size_t>(v) >= n_points;
-          if (duplicate || centre_of[static_cast<std::size_t>(v)] != kInvalidIndex)
-            first_failure = describe_node(input, duplicate ? interface_nodes[static_cast<std::size_t>(v) - n_points] : v) +
-                            ": " + describe_element(input, {ElementKind::Tet, static_cast<Index>(t)}) + " keeps only " +
-                            std::to_string(ratio) + " of its volume";
-        }
-      }
-    }
-    for (const BufferHex& b : out.hexes) {
-      HexCorners c;
-      for (std::size_t i = 0; i < 8; ++i) c[i] = out.model.points[static_cast<std::size_t>(b.corners[i])];
-      double sj = hex_scaled_jacobian(c);
-      if (b.centre != kInvalidIndex) {
-        // A four-triangle top: each triangle must face away from the bottom face's centre,
-        // measured as a scaled Jacobian (the tet's volume over its edge lengths at the centre).
-        const Point& top = out.model.points[static_cast<std::size_t>(b.centre)];
-        const Point bottom = (c[0] + c[1] + c[2] + c[3]) / 4.0;
-        for (std::size_t i = 0; i < 4; ++i) {
-          const Point a = c[4 + i] - bottom, e = c[4 + (i + 1) % 4] - bottom, m = top - bottom;
-          sj = std::min(sj, a.cross(e).dot(m) / (a.norm() * e.norm() * m.norm()));
-        }
-      }
-      out.report.min_scaled_jacobian = std::min(out.report.min_scaled_jacobian, sj);
-      if (sj < opt.min_scaled_jacobian)
-        for (std::size_t i = 4; i < 8; ++i) {
-          failing[static_cast<std::size_t>(b.corners[i]) - n_points] = 1;
-          if (first_failure.empty())
-            first_failure = "node " + std::to_string(b.corners[i - 4]) + ": the buffer hex on hex " +
-                            std::to_string(itf.quads[static_cast<std::size_t>(b.quad)].hex) + " face " +
-                            std::to_string(itf.quads[static_cast<std::size_t>(b.quad)].face) +
-                            " has scaled Jacobian " + std::to_string(sj);
-        }
-    }
-    out.report.halvings = halvings;
+    place();
+    std::vector<char> failing(n_moved_, 0);
+    const std::string first_failure = check(failing);
+    out_.report.halvings = halvings;
     if (first_failure.empty()) break;
-    if (halvings >= opt.max_halvings)
+    if (halvings >= opt_.max_halvings)
       throw TopologyError("insert_buffer_layer: no valid buffer layer after " + std::to_string(halvings) +
                           " halvings of the step: " + first_failure);
     bool halved = false;
-    for (std::size_t k = 0; k < n_moved; ++k)
+    for (std::size_t k = 0; k < n_moved_; ++k)
       if (failing[k]) {  // a raised node falls back to its safe height first
-        if (step[k] > safe[k]) {
-          step[k] = safe[k];
+        if (step_[k] > safe_[k]) {
+          step_[k] = safe_[k];
         } else {
-          step[k] *= 0.5, safe[k] = step[k];
+          step_[k] *= 0.5, safe_[k] = step_[k];
           halved = true;
         }
       }
     halvings += halved;
-    grade_down(step, quad_edges, opt.smooth_rate);
+    grade_down(step_, quad_edges_, opt_.smooth_rate);
   }
-  out.report.min_step = std::numeric_limits<double>::infinity();
-  out.report.max_step = 0.0;
-  for (std::size_t k = 0; k < n_moved; ++k) {
-    const double moved = step[k] * direction[k].norm();
-    out.report.min_step = std::min(out.report.min_step, moved);
-    out.report.max_step = std::max(out.report.max_step, moved);
+  out_.report.min_step = n_moved_ == 0 ? 0.0 : std::numeric_limits<double>::infinity();
+  out_.report.max_step = 0.0;
+  for (std::size_t k = 0; k < n_moved_; ++k) {
+    const double d = step_[k] * direction_[k].norm();
+    out_.report.min_step = std::min(out_.report.min_step, d);
+    out_.report.max_step = std::max(out_.report.max_step, d);
   }
-  if (n_moved == 0) out.report.min_step = 0.0;
-  return out;
+}
+
+BufferLayer BufferBuilder::run() {
+  out_.model = input_;
+  out_.top_node.assign(n_points_, kInvalidIndex);
+  for (std::size_t k = 0; k < n_moved_; ++k)
+    out_.top_node[static_cast<std::size_t>(itf_.nodes[k])] = static_cast<Index>(n_points_ + k);
+  interface_geometry();
+  std::vector<FaceKey> interface_faces;
+  if (hex_side_) {
+    for (const InterfaceQuad& q : itf_.quads) interface_faces.push_back(face_key(q.corners));
+    moving_part(input_.hexes, topology::kHexEdgeCorners, topology::kHexFaceCorners, interface_faces);
+  } else {
+    for (const InterfaceQuad& q : itf_.quads)
+      for (const auto& tri : interface_triangles(q)) interface_faces.push_back(face_key(tri));
+    moving_part(input_.tets, topology::kTetEdgeCorners, topology::kTetFaceCorners, interface_faces);
+  }
+  directions();
+  heights();
+  make_hexes();
+  move_and_check();
+  return std::move(out_);
+}
+
+}  // namespace
+
+BufferLayer insert_buffer_layer(const Model& input, const Interface& itf, const BufferLayerOptions& opt) {
+  validate(input, "insert_buffer_layer");
+  return BufferBuilder(input, itf, opt).run();
 }
 
 HexMesh buffer_hex_mesh(const BufferLayer& layer) {

@@ -1,9 +1,9 @@
 #pragma once
 // The buffer layer of the geode algorithm (the paper's Section 1): one layer of hexes between
-// the hex part and the tet part, made by shrinking the tet part away from the interface. Each
-// interface node is duplicated; the duplicate belongs to the tet side and moves into it, so
-// each interface quad becomes a buffer hex whose bottom face is the hex part's quad and whose
-// top face is the two (moved) tet triangles.
+// the hex part and the tet part. Each interface node is duplicated; one copy belongs to the hex
+// part, the other (the duplicate) to the tet part, and the copies of one side (BufferSide) move
+// into their part, so each interface quad becomes a buffer hex whose bottom face is the hex
+// part's quad and whose top face is the tet part's two (or four) triangles.
 //
 // Buffer hex corner convention (VTK/Exodus order, primal/topology.hpp):
 //   corners 0-3: the interface quad (InterfaceQuad::corners), the hex-part side, counter-
@@ -11,8 +11,8 @@
 //   corners 4-7: their tet-side duplicates, corner 4+i above corner i;
 //   the top face (local face 5, t = 1) is on the tet side, split into two triangles along
 //   `diagonal` = {4, 6} or {5, 7} (the corners the split joins), or into four triangles
-//   around `centre` (a tet-part node used by no hex, so it is moved, not duplicated: by the
-//   mean step of the quad's corners); the bottom face (local face 4,
+//   around `centre` (a tet-part node used by no hex, so it is not duplicated: carved from the
+//   tet side, it moves by the mean step of the quad's corners); the bottom face (local face 4,
 //   t = 0) is on the hex side. For the geode template of templates/geode.hpp (y up, top at
 //   y = +h/2) one right-handed map is r = z, s = x, t = y, under which Diagonal::Main (which
 //   joins (-x,+z) and (+x,-z)) is {5, 7} and Diagonal::Anti is {4, 6}.
@@ -31,11 +31,25 @@ using primal::Interface;
 using primal::kInvalidIndex;
 using primal::Model;
 
+// Which part the buffer layer is carved from: the copies of the interface nodes on that side
+// move into it, the other part keeps its elements exactly as they are. From the hex part
+// (default) the tets stay as meshed, so the transition is never below the input's own diced
+// tets there, and the buffer can be as thick as the template's best proportions: a box squashed
+// along its edge is still a box, while a tet loses height (and quality) as fast as the layer
+// gains it. The tet side suits hex parts that must not move.
+enum class BufferSide { Hex, Tet };
+
+// The default thickness per side: half the shortest edge from the hex part; 0.3 from the tet
+// part, whose first tets lose that fraction of their height.
+constexpr double default_buffer_thickness(BufferSide side) { return side == BufferSide::Hex ? 0.5 : 0.3; }
+
 struct BufferLayerOptions {
+  BufferSide side = BufferSide::Hex;
   // Height of the buffer layer at each interface node (its distance from the interface faces
-  // there) before grading, as a fraction of the shortest tet or interface-quad edge at the
-  // node; grading (below) may raise it up to this fraction of the node's mean quad edge.
-  double thickness = 0.3;
+  // there) before grading, as a fraction of the shortest edge of the moving part's elements or
+  // interface quads at the node; grading (below) may raise it up to this fraction of the
+  // node's mean quad edge.
+  double thickness = default_buffer_thickness(BufferSide::Hex);
   // Heights vary smoothly along the interface (see insert_buffer_layer): a node is raised to
   // within raise_rate x edge length of its neighbours' heights (not above thickness x its
   // interface quads' mean edge), and neighbours differ by at most smooth_rate x their edge.
@@ -44,7 +58,8 @@ struct BufferLayerOptions {
   // A node whose faces meet at an edge or corner moves height / cos along the direction d
   // (cos = min over its corner normals n of d . n, the mitred offset), cos at least this.
   double min_mitre_cos = 0.5;
-  // Every moved tet keeps at least this fraction of its volume.
+  // Every moved element keeps at least this fraction of its volume (a hex: at every corner,
+  // its corner Jacobian's fraction).
   double min_volume_ratio = 0.05;
   // Every buffer hex has a Verdict scaled Jacobian (min over 8 corners and centre) above this.
   double min_scaled_jacobian = 1e-3;
@@ -53,7 +68,7 @@ struct BufferLayerOptions {
   double min_visibility = 0.05;
   // Nodes of failing elements have their step halved at most this often.
   int max_halvings = 8;
-  // Angle (degrees) above which two outer-boundary faces of the tet part at a node form a
+  // Angle (degrees) above which two outer-boundary faces of the moving part at a node form a
   // feature: a moved node slides in the boundary's tangent plane, along a feature edge, or
   // (at a feature corner) cannot move.
   double feature_angle = primal::kFeatureAngle;
@@ -67,18 +82,19 @@ struct BufferHex {
 };
 
 struct BufferLayerReport {
-  double min_tet_volume_ratio = 1.0;    // over the tets that moved
+  double min_volume_ratio = 1.0;        // over the elements that moved
   double min_scaled_jacobian = 1.0;     // over the buffer hexes
   double min_step = 0.0, max_step = 0.0;  // distances the duplicated nodes moved
   int halvings = 0;                     // rounds of step halving needed
 };
 
 struct BufferLayer {
-  // The input model with the tet part shrunk: one duplicate per interface node appended to
-  // the points (model.points[top_node[v]]), every tet renumbered to the duplicates, centre
-  // nodes of four-triangle quads moved in place. Hexes,
-  // blocks, node sets (which keep the hex-side nodes) and side sets are unchanged; the buffer
-  // hexes are not in it.
+  // The input model with one part shrunk: one duplicate per interface node appended to the
+  // points (model.points[top_node[v]]), every tet renumbered to the duplicates. Carved from the
+  // hex part, the hex-side nodes (the input's ids) have moved and the duplicates stand where
+  // the interface was; from the tet part, the duplicates and the centre nodes of four-triangle
+  // quads have moved. Hexes, blocks, node sets (which keep the hex-side nodes) and side sets
+  // are unchanged; the buffer hexes are not in it.
   Model model;
   std::vector<Index> top_node;  // per input node: its tet-side duplicate or kInvalidIndex
   std::vector<BufferHex> hexes;  // one per interface quad, in Interface::quads order
@@ -87,7 +103,7 @@ struct BufferLayer {
 
 // Throws TopologyError naming the node (and the element) where no valid layer can be placed:
 // no direction sees all interface faces at a node (the paper's Figure 9 right), a node at a
-// corner of the tet part's outer boundary, or an element still inverted / collapsed after
+// corner of the moving part's outer boundary, or an element still inverted / collapsed after
 // max_halvings halvings.
 BufferLayer insert_buffer_layer(const Model& model, const Interface& interface,
                                 const BufferLayerOptions& options = {});

@@ -45,9 +45,10 @@ struct ConformOptions {
   // Box of the reference template (x, y, z as in templates/geode.hpp: y is the buffer hex's
   // thickness direction). It is smoothed once per diagonal, top and bottom fixed and its four
   // side faces one shared mesh (templates/side_faces.hpp); only its proportions matter. Near
-  // the buffer hexes' own (0.3 of the shortest edge thick by default), a template mapped into
-  // them keeps most of its quality: the paper's 24 x 14 x 24 is taller than the buffer hexes.
-  Eigen::Vector3d template_box{24.0, 10.0, 24.0};
+  // the buffer hexes' own (half the shortest edge thick by default), a template mapped into
+  // them keeps most of its quality (the paper's is 24 x 14 x 24; 24 x 10 x 24 suits the tet
+  // side's default thickness).
+  Eigen::Vector3d template_box{24.0, 12.0, 24.0};
   // The worst-first smoother (primal/local_smooth.hpp), model boundary nodes sliding in their
   // plane, along their feature edge or on the diced boundary triangulation. kLocal: patches
   // seeded near the geode hexes (see smooth_target), on the submesh around them; kGlobal: by

@@ -78,7 +78,8 @@ TEST_CASE("cli conventions: usage errors and bad numbers are one line on stderr,
       {"study shape --heights -3", "out of range"},
       {"conform " + in.string() + " --merge-tolerance -1", "out of range"},
       {"conform " + in.string() + " --smooth fast", "fast"},
-      {"conform " + in.string() + " --buffer-thickness 0.9", "out of range [0.01, 0.45]"},
+      {"conform " + in.string() + " --buffer-thickness 0.95", "out of range [0.01, 0.9]"},
+      {"conform " + in.string() + " --buffer-side both", "--buffer-side"},
       {"conform " + in.string() + " --smooth-target 2", "out of range [0, 1]"},
       {"conform " + in.string() + " --template-box 24x0x24 -o " + d + "out.exo", "--template-box '24x0x24'"},
       // Outputs: format by extension, contradictions, unknown extensions, missing directories.
@@ -123,7 +124,7 @@ TEST_CASE("cli conventions: --version and --help") {
   const test::CliRun h = test::geode_cli("conform --help");
   for (const char* opt : {"--output", "--format", "--report", "--smooth", "--geode-block", "--merge-tolerance",
                           "--write-invalid", "--quiet", "--vtu-encoding", "--smooth-target", "--buffer-thickness",
-                          "--template-box"})
+                          "--buffer-side", "--template-box"})
     CHECK(h.out.find(opt) != std::string::npos);
 }
 

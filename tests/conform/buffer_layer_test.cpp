@@ -1,5 +1,6 @@
-// Buffer layer: corner conventions, positive elements, and no gap or overlap: the volumes of
-// hex part + buffer hexes + shrunk tets add up to the volume of the original block. Each
+// Buffer layer, carved from either part: corner conventions, positive elements, the other part
+// untouched, and no gap or overlap: the volumes of hex part + buffer hexes + tets add up to the
+// volume of the original block. Each
 // element's volume is its boundary flux with every face triangulated the same way from both
 // sides (buffer tops along their diagonal, other quads from their smallest node), so shared
 // faces cancel and the sum is the flux through the outer boundary, which the layer must not move.
@@ -56,16 +57,35 @@ struct Case {
   std::size_t quads;
 };
 
-void check_layer(const Case& c) {
+constexpr std::array<BufferSide, 2> kSides{BufferSide::Hex, BufferSide::Tet};
+
+BufferLayerOptions on_side(BufferSide side) {
+  BufferLayerOptions o;
+  o.side = side;
+  o.thickness = default_buffer_thickness(side);
+  return o;
+}
+
+void check_layer(const Case& c, BufferSide side) {
   CAPTURE(c.name);
+  CAPTURE(static_cast<int>(side));
   const Model m = grid_model(c.cells, 1.0, c.is_tet);
   const Interface itf = find_interface(m);
   REQUIRE(itf.quads.size() == c.quads);
-  const BufferLayer layer = insert_buffer_layer(m, itf);
+  const BufferLayer layer = insert_buffer_layer(m, itf, on_side(side));
   const auto& p = layer.model.points;
   REQUIRE(p.size() == m.points.size() + itf.nodes.size());
   REQUIRE(layer.hexes.size() == itf.quads.size());
   CHECK(layer.model.hexes == m.hexes);
+  // The part the layer is not carved from keeps every corner where it was.
+  if (side == BufferSide::Hex) {
+    for (std::size_t t = 0; t < m.tets.size(); ++t)
+      for (std::size_t i = 0; i < 4; ++i)
+        CHECK(p[static_cast<std::size_t>(layer.model.tets[t][i])] == m.points[static_cast<std::size_t>(m.tets[t][i])]);
+  } else {
+    for (const auto& h : m.hexes)
+      for (Index v : h) CHECK(p[static_cast<std::size_t>(v)] == m.points[static_cast<std::size_t>(v)]);
+  }
 
   double total = 0;
   for (const auto& h : m.hexes) total += hex_flux_volume(p, h);
@@ -105,7 +125,7 @@ void check_layer(const Case& c) {
   }
   CHECK(total == doctest::Approx(c.cells[0] * c.cells[1] * c.cells[2]).epsilon(1e-12));
   CHECK(layer.report.min_scaled_jacobian > 0.0);
-  CHECK(layer.report.min_tet_volume_ratio > 0.0);
+  CHECK(layer.report.min_volume_ratio > 0.0);
 }
 
 }  // namespace
@@ -123,47 +143,69 @@ TEST_CASE("insert_buffer_layer: valid, gap-free layers on convex and concave int
       {"enclosed tet nugget (hex block with a tet cavity)", {3, 3, 3},
        [](int i, int j, int k) { return i == 1 && j == 1 && k == 1; }, 6},
   };
-  for (const Case& c : cases) check_layer(c);
+  for (const BufferSide side : kSides)
+    for (const Case& c : cases) check_layer(c, side);
 }
 
 TEST_CASE("insert_buffer_layer: one hex under tets, positions by hand") {
   const Model m = grid_model({1, 1, 2}, 1.0, [](int, int, int k) { return k == 1; });
-  BufferLayerOptions o;
-  o.thickness = 0.25;
-  const BufferLayer layer = insert_buffer_layer(m, find_interface(m), o);
-  // Each top corner sits on an outer crease of the tet part (two outer faces), so it slides
-  // along the crease, +z, by thickness 0.25 x shortest edge 1.
-  for (const BufferHex& b : layer.hexes)
-    for (std::size_t i = 0; i < 4; ++i) {
-      const Point d = layer.model.points[static_cast<std::size_t>(b.corners[i + 4])] -
-                      layer.model.points[static_cast<std::size_t>(b.corners[i])];
-      CHECK((d - Point(0, 0, 0.25)).norm() < 1e-14);
-    }
-  CHECK(layer.report.min_step == doctest::Approx(0.25));
-  CHECK(layer.report.max_step == doctest::Approx(0.25));
-  CHECK(layer.report.min_scaled_jacobian == doctest::Approx(1.0));
-  CHECK(layer.report.halvings == 0);
-  CHECK(buffer_hex_mesh(layer).hexes.size() == 1);
+  for (const BufferSide side : kSides) {
+    CAPTURE(static_cast<int>(side));
+    BufferLayerOptions o = on_side(side);
+    o.thickness = 0.25;
+    const BufferLayer layer = insert_buffer_layer(m, find_interface(m), o);
+    // Each interface node sits on an outer crease of either part (two outer faces), so its
+    // moving copy slides along the crease, by thickness 0.25 x shortest edge 1: the hex side's
+    // down (-z) from the interface at z = 1, the tet side's up.
+    for (const BufferHex& b : layer.hexes)
+      for (std::size_t i = 0; i < 4; ++i) {
+        const Point& bottom = layer.model.points[static_cast<std::size_t>(b.corners[i])];
+        const Point& top = layer.model.points[static_cast<std::size_t>(b.corners[i + 4])];
+        CHECK((top - bottom - Point(0, 0, 0.25)).norm() < 1e-14);
+        CHECK((side == BufferSide::Hex ? top : bottom).z() == 1.0);
+      }
+    CHECK(layer.report.min_step == doctest::Approx(0.25));
+    CHECK(layer.report.max_step == doctest::Approx(0.25));
+    CHECK(layer.report.min_scaled_jacobian == doctest::Approx(1.0));
+    CHECK(layer.report.halvings == 0);
+    CHECK(buffer_hex_mesh(layer).hexes.size() == 1);
+  }
 }
 
 TEST_CASE("insert_buffer_layer: the nugget's corners move along the cavity diagonal") {
   const Model m = grid_model({3, 3, 3}, 1.0, [](int i, int j, int k) { return i == 1 && j == 1 && k == 1; });
-  const BufferLayer layer = insert_buffer_layer(m, find_interface(m));
-  // Corner (1,1,1) of the cavity: three faces with normals +x, +y, +z; the best direction is
-  // the diagonal; the shortest edge there is 1, so the height is the thickness, and the mitred
-  // step puts the copy at that height above each of the three faces.
+  // Corner (1,1,1) of the cavity: three faces with normals +x, +y, +z towards the tets; the
+  // best direction is the diagonal, into the tets (tet side) or the hexes (hex side); the
+  // shortest edge there is 1, so the height is the thickness (0.3: at 0.5 the hex touching
+  // the cavity at that node alone would invert and the step be halved), and the mitred step
+  // puts the moving copy at that height from each of the three faces.
   const Index v = 1 + 4 * (1 + 4 * 1);
-  const Point moved = layer.model.points[static_cast<std::size_t>(layer.top_node[static_cast<std::size_t>(v)])];
-  const double height = BufferLayerOptions{}.thickness;
-  CHECK((moved - (Point(1, 1, 1) + height * Point(1, 1, 1))).norm() < 1e-12);
+  for (const BufferSide side : kSides) {
+    CAPTURE(static_cast<int>(side));
+    BufferLayerOptions o = on_side(side);
+    o.thickness = 0.3;
+    const BufferLayer layer = insert_buffer_layer(m, find_interface(m), o);
+    CHECK(layer.report.halvings == 0);
+    const auto& p = layer.model.points;
+    const Point& hex_copy = p[static_cast<std::size_t>(v)];
+    const Point& tet_copy = p[static_cast<std::size_t>(layer.top_node[static_cast<std::size_t>(v)])];
+    const double height = o.thickness;
+    const Point moved = side == BufferSide::Hex ? Point(Point(1, 1, 1) - height * Point(1, 1, 1))
+                                                : Point(Point(1, 1, 1) + height * Point(1, 1, 1));
+    CHECK(((side == BufferSide::Hex ? hex_copy : tet_copy) - moved).norm() < 1e-12);
+    CHECK((side == BufferSide::Hex ? tet_copy : hex_copy) == Point(1, 1, 1));
+  }
 }
 
 TEST_CASE("insert_buffer_layer: buffer tops parallel to their bottoms at convex and concave edges and corners") {
-  // Kuhn-split tets whose shortest edge is 1 at every interface node: the layer has one
-  // height, thickness x 1, and every buffer hex's top corners lie that far above the plane of
-  // its bottom quad, also where two or three interface faces meet (a step along the averaged
-  // normal alone would leave edge and corner copies at height / sqrt 2 or / sqrt 3, the tops
-  // tilted towards the edge and folded along their diagonals against the neighbours').
+  // Kuhn-split tets and unit hexes: the shortest edge is 1 at every interface node, so the
+  // layer has one height, thickness x 1, and every buffer hex's moving corners lie that far
+  // from the plane of its face on the part that stays (tet side: tops above the bottom quad;
+  // hex side: bottoms below the top quad), also where two or three interface faces meet (a
+  // step along the averaged normal alone would leave edge and corner copies at height / sqrt 2
+  // or / sqrt 3, the faces tilted towards the edge and folded along their diagonals against the
+  // neighbours'). Thickness 0.3 on both sides: at 0.5 the hexes at the cavity's corners, which
+  // touch it at one node, would invert and the layer be halved there.
   const Case cases[] = {
       {"tet cavity (convex edges and corners seen from the tets)", {4, 4, 4},
        [](int i, int j, int k) { return i >= 1 && i <= 2 && j >= 1 && j <= 2 && k >= 1 && k <= 2; }, 24},
@@ -172,22 +214,31 @@ TEST_CASE("insert_buffer_layer: buffer tops parallel to their bottoms at convex 
       {"L-shaped tet region in a hex block (a concave edge)", {4, 4, 3},
        [](int i, int j, int k) { return k == 1 && ((i == 1 && (j == 1 || j == 2)) || (i == 2 && j == 1)); }, 14},
   };
-  const double height = BufferLayerOptions{}.thickness;
-  for (const Case& c : cases) {
-    CAPTURE(c.name);
-    const Model m = grid_model(c.cells, 1.0, c.is_tet);
-    const Interface itf = find_interface(m);
-    REQUIRE(itf.quads.size() == c.quads);
-    const BufferLayer layer = insert_buffer_layer(m, itf);
-    CHECK(layer.report.halvings == 0);
-    const auto& p = layer.model.points;
-    for (const BufferHex& b : layer.hexes) {
-      auto at = [&](int i) -> const Point& { return p[static_cast<std::size_t>(b.corners[static_cast<std::size_t>(i)])]; };
-      const Point n = (at(1) - at(0)).cross(at(3) - at(0)).normalized();  // into the tet side
-      for (int i = 4; i < 8; ++i) CHECK(n.dot(at(i) - at(0)) == doctest::Approx(height).epsilon(1e-12));
+  const double height = 0.3;
+  for (const BufferSide side : kSides)
+    for (const Case& c : cases) {
+      CAPTURE(c.name);
+      CAPTURE(static_cast<int>(side));
+      const Model m = grid_model(c.cells, 1.0, c.is_tet);
+      const Interface itf = find_interface(m);
+      REQUIRE(itf.quads.size() == c.quads);
+      BufferLayerOptions o = on_side(side);
+      o.thickness = height;
+      const BufferLayer layer = insert_buffer_layer(m, itf, o);
+      CHECK(layer.report.halvings == 0);
+      const auto& p = layer.model.points;
+      for (const BufferHex& b : layer.hexes) {
+        auto at = [&](int i) -> const Point& { return p[static_cast<std::size_t>(b.corners[static_cast<std::size_t>(i)])]; };
+        if (side == BufferSide::Tet) {
+          const Point n = (at(1) - at(0)).cross(at(3) - at(0)).normalized();  // into the tet side
+          for (int i = 4; i < 8; ++i) CHECK(n.dot(at(i) - at(0)) == doctest::Approx(height).epsilon(1e-12));
+        } else {
+          const Point n = (at(5) - at(4)).cross(at(7) - at(4)).normalized();  // into the tet side
+          for (int i = 0; i < 4; ++i) CHECK(n.dot(at(4) - at(i)) == doctest::Approx(height).epsilon(1e-12));
+        }
+      }
+      CHECK(layer.report.min_scaled_jacobian > 0.0);
     }
-    CHECK(layer.report.min_scaled_jacobian > 0.0);
-  }
 }
 
 TEST_CASE("insert_buffer_layer: one short tet edge does not twist the buffer tops around it") {
@@ -201,7 +252,7 @@ TEST_CASE("insert_buffer_layer: one short tet edge does not twist the buffer top
   m.points[node(1, 1, 2)].z() = 1.5;
   const Interface itf = find_interface(m);
   REQUIRE(itf.quads.size() == 9);
-  const BufferLayerOptions o;
+  const BufferLayerOptions o = on_side(BufferSide::Tet);
   const BufferLayer layer = insert_buffer_layer(m, itf, o);
   auto height = [&](Index v) {
     return layer.model.points[static_cast<std::size_t>(layer.top_node[static_cast<std::size_t>(v)])].z() - 1.0;
@@ -210,7 +261,7 @@ TEST_CASE("insert_buffer_layer: one short tet edge does not twist the buffer top
   for (const InterfaceQuad& q : itf.quads)
     for (std::size_t i = 0; i < 4; ++i)
       CHECK(std::abs(height(q.corners[i]) - height(q.corners[(i + 1) % 4])) <= o.smooth_rate * 1.0 + 1e-12);
-  CHECK(layer.report.min_tet_volume_ratio > 0.2);
+  CHECK(layer.report.min_volume_ratio > 0.2);
   CHECK(layer.report.min_scaled_jacobian > 0.9);
 }
 
@@ -255,8 +306,8 @@ TEST_CASE("Gmsh demo models: conforming interface and a valid buffer layer") {
     CHECK(itf.nodes.size() == static_cast<std::size_t>(6 * n * n + 2));  // closed surface: V = F + 2
     const BufferLayer layer = insert_buffer_layer(m, itf);
     CHECK(layer.report.min_scaled_jacobian > 0.0);
-    CHECK(layer.report.min_tet_volume_ratio > 0.0);
+    CHECK(layer.report.min_volume_ratio > 0.0);
     MESSAGE("nugget demo: ", m.tets.size(), " tets, buffer min scaled Jacobian ", layer.report.min_scaled_jacobian,
-            ", min tet volume ratio ", layer.report.min_tet_volume_ratio, ", halvings ", layer.report.halvings);
+            ", min tet volume ratio ", layer.report.min_volume_ratio, ", halvings ", layer.report.halvings);
   }
 }

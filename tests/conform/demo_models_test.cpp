@@ -46,9 +46,9 @@ TEST_CASE("realistic models, --smooth none: valid; the placement inverts nothing
   // shared side faces must take the same nodes from both templates. On the Fulcher model, with
   // unstructured quads on three nugget faces, the buffer tops stay flat across the nugget's
   // edges and corners (the mitred offset of insert_buffer_layer) and untwisted (heights graded
-  // along the interface), so the map inverts nothing at n = 4; at n = 2 it inverts one geode
-  // hex, in the buffer hex on a trapezoidal quad (edges 0.28 to 1) at a nugget corner, and that
-  // template is settled inside its buffer hex.
+  // along the interface), so the map inverts nothing at n = 4; at n = 2 (quads of edges 0.28
+  // to 1) it inverts geode hexes in three buffer hexes, and those templates are settled inside
+  // their buffer hexes.
   const struct {
     const char* name;
     primal::Index quads;
@@ -56,7 +56,7 @@ TEST_CASE("realistic models, --smooth none: valid; the placement inverts nothing
     primal::Index settled;  // templates the map inverted, re-smoothed inside their buffer hex
   } models[] = {{"delaunay", 9, 3, 0}, {"delaunay-random", 9, 3, 0}, {"lshape", 18, 3, 0}, {"nugget", 96, 3, 0},
                 {"cylinder", 146, 3, 0}, {"fulcher", 143, 4, 0},
-                {"fulcher", 73, 2, 1}};
+                {"fulcher", 73, 2, 3}};
   for (const auto& [name, quads, n, settled] : models) {
     CAPTURE(name);
     const primal::Model m = conform::demo_model(name, n);
@@ -67,6 +67,44 @@ TEST_CASE("realistic models, --smooth none: valid; the placement inverts nothing
     CHECK(r.placement_inverted == 0);
     CHECK(r.smoothing.patches == 0);  // nothing left to untangle: the diced elements stay as diced
     test::check_conform_result(r);
+  }
+}
+
+TEST_CASE("buffer carved from the hex part: the tets stay as meshed, geode hexes >= 0.25 on planar interfaces") {
+  // Planar interfaces beside Gmsh Delaunay tets (alternating, random, two- and four-triangle
+  // splits) and beside Kuhn tets. Carved from the hex part, every tet keeps its nodes, so the
+  // diced tets are exactly the input's own (the output's minimum is the yardstick, nothing to
+  // smooth), and the buffer is half a hex edge thick, where the template keeps its quality;
+  // carved from the tet side (0.3 of the edge) the same geode hexes stay below 0.25.
+  const struct {
+    const char* name;
+    int n;
+  } models[] = {{"delaunay", 3}, {"delaunay-random", 5}, {"fourtri", 4}, {"half", 3}};
+  auto geode_min = [](const conform::ConformResult& r) {
+    for (const auto& b : r.quality)
+      if (b.name == "geode") return b.report.metrics.at(0).minimum;
+    return -1.0;
+  };
+  for (const auto& [name, n] : models) {
+    CAPTURE(name);
+    const primal::Model m = conform::demo_model(name, n);
+    conform::ConformOptions o;
+    o.smooth = conform::ConformSmooth::kNone;
+    o.geode_block = "geode";
+    const bool four = std::string(name) == "fourtri";
+    const auto r = conform::conform(m, o);
+    test::check_conform_result(r, four ? mixed_geode_hexes(m) : -1);
+    CHECK(r.templates_settled == 0);
+    CHECK(r.smoothing.patches == 0);
+    CHECK(r.smoothing.final_min_scaled_jacobian == doctest::Approx(r.yardstick()).epsilon(1e-12));
+    CHECK(geode_min(r) >= 0.25);
+    conform::ConformOptions t = o;
+    t.buffer.side = conform::BufferSide::Tet;
+    t.buffer.thickness = conform::default_buffer_thickness(conform::BufferSide::Tet);
+    t.template_box = {24.0, 10.0, 24.0};
+    const auto rt = conform::conform(m, t);
+    test::check_conform_result(rt, four ? mixed_geode_hexes(m) : -1);
+    CHECK(geode_min(rt) < 0.25);
   }
 }
 
