@@ -330,10 +330,17 @@ std::string BufferBuilder::check(std::vector<char>& failing) {
       for (std::size_t i = 0; i < 9; ++i)
         if (jb[i] > 0.0) ratio = std::min(ratio, ja[i] / jb[i]);
       out_.report.min_volume_ratio = std::min(out_.report.min_volume_ratio, ratio);
-      if (ratio < opt_.min_volume_ratio) {
+      const double sj_ratio = hex_scaled_jacobian(after) / std::max(hex_scaled_jacobian(before), 1e-12);
+      if (ratio < opt_.min_volume_ratio || sj_ratio < opt_.min_hex_quality_ratio) {
         for (Index v : hex) fail_node(v);
         for (Index v : hex)
-          if (moved(v)) keeps_only(ElementKind::Hex, h, ratio, v);
+          if (moved(v)) {
+            if (ratio < opt_.min_volume_ratio)
+              keeps_only(ElementKind::Hex, h, ratio, v);
+            else if (first_failure.empty())
+              first_failure = describe_node(input_, v) + ": " + describe_element(input_, {ElementKind::Hex, h}) +
+                              " keeps only " + std::to_string(sj_ratio) + " of its scaled Jacobian";
+          }
       }
     }
   } else {

@@ -61,6 +61,10 @@ struct BufferLayerOptions {
   // Every moved element keeps at least this fraction of its volume (a hex: at every corner,
   // its corner Jacobian's fraction).
   double min_volume_ratio = 0.05;
+  // Every moved hex keeps at least this fraction of its scaled Jacobian. A box touching the
+  // interface at one concave corner only, its corner pushed a quarter edge along the diagonal,
+  // keeps 0.44; squashed hexes of unstructured parts lose more unless held back here.
+  double min_hex_quality_ratio = 0.4;
   // Every buffer hex has a Verdict scaled Jacobian (min over 8 corners and centre) above this.
   double min_scaled_jacobian = 1e-3;
   // The step direction d at a node must satisfy d . n >= min_visibility for the unit corner

@@ -77,11 +77,20 @@ void check_layer(const Case& c, BufferSide side) {
   REQUIRE(p.size() == m.points.size() + itf.nodes.size());
   REQUIRE(layer.hexes.size() == itf.quads.size());
   CHECK(layer.model.hexes == m.hexes);
-  // The part the layer is not carved from keeps every corner where it was.
+  // The part the layer is not carved from keeps every corner where it was; squashed hexes
+  // keep their share of quality.
   if (side == BufferSide::Hex) {
     for (std::size_t t = 0; t < m.tets.size(); ++t)
       for (std::size_t i = 0; i < 4; ++i)
         CHECK(p[static_cast<std::size_t>(layer.model.tets[t][i])] == m.points[static_cast<std::size_t>(m.tets[t][i])]);
+    for (const auto& h : m.hexes) {
+      HexCorners before, after;
+      for (std::size_t i = 0; i < 8; ++i) {
+        before[i] = m.points[static_cast<std::size_t>(h[i])];
+        after[i] = p[static_cast<std::size_t>(h[i])];
+      }
+      CHECK(hex_scaled_jacobian(after) >= BufferLayerOptions{}.min_hex_quality_ratio * hex_scaled_jacobian(before));
+    }
   } else {
     for (const auto& h : m.hexes)
       for (Index v : h) CHECK(p[static_cast<std::size_t>(v)] == m.points[static_cast<std::size_t>(v)]);
@@ -176,14 +185,15 @@ TEST_CASE("insert_buffer_layer: the nugget's corners move along the cavity diago
   const Model m = grid_model({3, 3, 3}, 1.0, [](int i, int j, int k) { return i == 1 && j == 1 && k == 1; });
   // Corner (1,1,1) of the cavity: three faces with normals +x, +y, +z towards the tets; the
   // best direction is the diagonal, into the tets (tet side) or the hexes (hex side); the
-  // shortest edge there is 1, so the height is the thickness (0.3: at 0.5 the hex touching
-  // the cavity at that node alone would invert and the step be halved), and the mitred step
-  // puts the moving copy at that height from each of the three faces.
+  // shortest edge there is 1, so the height is the thickness (0.25: thicker, the hex touching
+  // the cavity at that node alone would keep less than min_hex_quality_ratio of its scaled
+  // Jacobian and the step be halved), and the mitred step puts the moving copy at that height
+  // from each of the three faces.
   const Index v = 1 + 4 * (1 + 4 * 1);
   for (const BufferSide side : kSides) {
     CAPTURE(static_cast<int>(side));
     BufferLayerOptions o = on_side(side);
-    o.thickness = 0.3;
+    o.thickness = 0.25;
     const BufferLayer layer = insert_buffer_layer(m, find_interface(m), o);
     CHECK(layer.report.halvings == 0);
     const auto& p = layer.model.points;
@@ -204,8 +214,9 @@ TEST_CASE("insert_buffer_layer: buffer tops parallel to their bottoms at convex 
   // hex side: bottoms below the top quad), also where two or three interface faces meet (a
   // step along the averaged normal alone would leave edge and corner copies at height / sqrt 2
   // or / sqrt 3, the faces tilted towards the edge and folded along their diagonals against the
-  // neighbours'). Thickness 0.3 on both sides: at 0.5 the hexes at the cavity's corners, which
-  // touch it at one node, would invert and the layer be halved there.
+  // neighbours'). Thickness 0.25 on both sides: the hexes touching the cavity at one corner
+  // node keep 0.44 of their scaled Jacobian; thicker, they would fall below
+  // min_hex_quality_ratio (0.4) and the layer be halved there.
   const Case cases[] = {
       {"tet cavity (convex edges and corners seen from the tets)", {4, 4, 4},
        [](int i, int j, int k) { return i >= 1 && i <= 2 && j >= 1 && j <= 2 && k >= 1 && k <= 2; }, 24},
@@ -214,7 +225,7 @@ TEST_CASE("insert_buffer_layer: buffer tops parallel to their bottoms at convex 
       {"L-shaped tet region in a hex block (a concave edge)", {4, 4, 3},
        [](int i, int j, int k) { return k == 1 && ((i == 1 && (j == 1 || j == 2)) || (i == 2 && j == 1)); }, 14},
   };
-  const double height = 0.3;
+  const double height = 0.25;
   for (const BufferSide side : kSides)
     for (const Case& c : cases) {
       CAPTURE(c.name);
