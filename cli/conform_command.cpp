@@ -252,7 +252,8 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
       ->capture_default_str();
   c->add_option("--geode-block", a.geode_block,
                 "put the geode hexes in a block of their own with this name (id one above every\n"
-                "input block); by default each goes to the tet-side block it was carved from");
+                "input block); by default each goes to the block of the element its buffer hex was carved\n"
+                "from (the hex under it; with --buffer-side tet, the tet above it)");
   c->add_option("--merge-tolerance", a.merge_tolerance,
                 "first merge nodes closer than this distance (model units), for parts meshed\n"
                 "separately whose interface nodes are duplicated")

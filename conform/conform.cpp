@@ -44,7 +44,7 @@ double since(Clock::time_point t0) {
 
 // The output's block ids and names: the input's, plus the geode block when it has a name.
 struct OutputBlocks {
-  int geode_id = 0;  // 0: geode hexes join the tet-side block they were carved from
+  int geode_id = 0;  // 0: geode hexes join the block of the element they were carved from
   std::map<int, std::string> names;
 };
 
@@ -174,7 +174,10 @@ class Conformer {
   std::vector<double> sj_;
   std::vector<Index> inverted_;
   OutputBlocks blocks_;
-  std::vector<Index> carved_from_;  // per buffer hex: the tet (input index) it was carved from
+  // Per buffer hex: the input element it was carved from (the hex under it or the tet above it,
+  // by BufferLayerOptions::side), whose block its geode hexes join by default: they fill space
+  // that part had.
+  std::vector<primal::ElementRef> carved_from_;
   std::vector<Index> geode_first_;  // per buffer hex: its first output hex (then one past the last)
 };
 
@@ -198,9 +201,12 @@ void Conformer::find_interface() {
 void Conformer::insert_buffer() {
   t0_ = Clock::now();
   layer_ = insert_buffer_layer(input_, interface_, options_.buffer);
-  // The tet each buffer hex is carved from, whose block its geode hexes join by default.
   carved_from_.reserve(layer_.hexes.size());
-  for (const BufferHex& b : layer_.hexes) carved_from_.push_back(interface_.quads[b.quad].tets[0]);
+  for (const BufferHex& b : layer_.hexes) {
+    const primal::InterfaceQuad& q = interface_.quads[b.quad];
+    carved_from_.push_back(options_.buffer.side == BufferSide::Hex ? primal::ElementRef{primal::ElementKind::Hex, q.hex}
+                                                                   : primal::ElementRef{primal::ElementKind::Tet, q.tets[0]});
+  }
   interface_ = {};
   res_.buffer = layer_.report;
   say("buffer layer: " + std::to_string(layer_.hexes.size()) + " hexes, min scaled Jacobian " +
@@ -339,7 +345,7 @@ void Conformer::assemble() {
   hexes.reserve(diced_.hex_children.size() + res_.geode_hexes + diced_.tet_children.size());
   block.reserve(hexes.capacity());
   // Each output hex is in the input block of the element it comes from; a geode hex in the
-  // block of the tet its buffer hex was carved from, or in a block of its own.
+  // block of the element its buffer hex was carved from, or in a block of its own.
   blocks_ = output_blocks(input_, options_.geode_block);
   const primal::Model& lm = layer_.model;
   for (std::size_t k = 0; k < diced_.hex_children.size(); ++k)
@@ -348,7 +354,7 @@ void Conformer::assemble() {
   geode_first_.reserve(nb + 1);
   for (std::size_t b = 0; b < nb; ++b) {
     geode_first_.push_back(static_cast<Index>(hexes.size()));
-    const int id = blocks_.geode_id ? blocks_.geode_id : primal::block_of(lm, {primal::ElementKind::Tet, carved_from_[b]});
+    const int id = blocks_.geode_id ? blocks_.geode_id : primal::block_of(lm, carved_from_[b]);
     for (const auto& h : ref(b).tpl.hex.hexes) {
       std::array<Index, 8> o{};
       for (int c = 0; c < 8; ++c) o[c] = inst_global_[b][h[c]];

@@ -1,6 +1,6 @@
 #pragma once
 // The geode algorithm on a whole model (the paper's Sections 1 and 4): find the hex/tet
-// interface, shrink the tet part off it (buffer layer), dice the hex part (8 per hex) and the
+// interface, shrink one part off it (buffer layer; the hex part by default), dice the hex part (8 per hex) and the
 // tet part (4 hexes per tet), fill every buffer hex with the 26-hex geode template (or, where
 // the interface quad is split into four triangles around a centre node, the 44-hex
 // four-triangle template) mapped into it (a template the map inverts is settled inside its
@@ -82,7 +82,8 @@ struct ConformOptions {
     o.target = 0.5;
     return o;
   }();
-  // Empty: geode hexes go to the tet-side block they were carved from (an analyst's material).
+  // Empty: geode hexes go to the block of the element their buffer hex was carved from (the
+  // hex under it, or the tet above it with BufferSide::Tet): the material of that space.
   // A name: they get a block of their own with that name, id one above every input block id.
   std::string geode_block;
   // Called with one line per stage (for the command line's progress output); may be empty.
@@ -102,8 +103,8 @@ struct ConformResult {
   // All-hex model: hexes by origin (diced_hexes diced hexes, geode_hexes geode hexes, 26 per
   // two-triangle interface quad and the four-triangle template's count per four-triangle one,
   // in Interface order, diced_tet_hexes diced tets), each in an input block:
-  // a diced hex or tet in its parent's, a geode hex in that of the tet its buffer hex was
-  // carved from (or ConformOptions::geode_block); input block names kept. Node sets: every input node of the set plus
+  // a diced hex or tet in its parent's, a geode hex in that of the hex (or, carved from the tet
+  // part, the tet) its buffer hex was carved from (or ConformOptions::geode_block); input block names kept. Node sets: every input node of the set plus
   // the diced edge / face nodes whose origin nodes are all in the set. Side sets: every input
   // side becomes the diced children's faces lying on it (4 per hex face, 3 per tet face).
   primal::Model model;

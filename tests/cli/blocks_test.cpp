@@ -1,7 +1,8 @@
 // Materials survive `geode conform`: a model whose hex part is the physical volume "steel"
 // (id 7) and whose tet part is "rubber" (id 9), with a node set and a side set, comes out with
-// the same block ids and names in .exo, .msh and .vtu: diced hexes in steel, geode hexes and
-// diced tets in rubber (or the geode hexes in a block of their own with --geode-block); the
+// the same block ids and names in .exo, .msh and .vtu: diced hexes and geode hexes in steel
+// (the buffer layer is carved from the hex part), diced tets in rubber (or the geode hexes in a
+// block of their own with --geode-block); the
 // sets carried with their ids and names; Exodus coordinate names x, y, z.
 #include <doctest/doctest.h>
 #include <exodusII.h>
@@ -62,8 +63,8 @@ std::string slurp(const fs::path& p) {
   return s.str();
 }
 
-// 8 hexes * 8 diced; 4 buffer hexes * 26 geode + 48 tets * 4 diced.
-const std::map<int, std::size_t> kExpected{{7, 64}, {9, 104 + 192}};
+// 8 hexes * 8 diced + 4 buffer hexes * 26 geode; 48 tets * 4 diced.
+const std::map<int, std::size_t> kExpected{{7, 64 + 104}, {9, 192}};
 
 // Blocks, names and both sets as conform must carry them for steel_rubber().
 void check_carried(const primal::Model& o, const primal::Model& input) {
@@ -104,7 +105,8 @@ TEST_CASE("conform carries blocks and sets: steel and rubber keep their ids and 
     CHECK(j.at("blocks")[0].at("id") == 7);
     CHECK(j.at("blocks")[0].at("name") == "steel");
     CHECK(j.at("blocks")[1].at("name") == "rubber");
-    CHECK(j.at("blocks")[1].at("quality").at("num_hexes") == 296);
+    CHECK(j.at("blocks")[0].at("quality").at("num_hexes") == 168);
+    CHECK(j.at("blocks")[1].at("quality").at("num_hexes") == 192);
     // Coordinate names.
     int cpu = 8, io = 0;
     float version = 0;
@@ -141,6 +143,12 @@ TEST_CASE("conform carries blocks and sets: steel and rubber keep their ids and 
     CHECK(block_counts(o.hex_block) == std::map<int, std::size_t>{{7, 64}, {9, 192}, {10, 104}});
     CHECK(o.block_names.at(10) == "transition");
     CHECK(o.block_names.at(7) == "steel");
+  }
+  SUBCASE("--buffer-side tet: the geode hexes fill the rubber's space and join it") {
+    const fs::path out = dir.path / "out.exo";
+    REQUIRE(test::geode_cli("conform " + in.string() + " --buffer-side tet -o " + out.string() + " --quiet").code == 0);
+    const primal::Model o = primal::read_exodus(out);
+    CHECK(block_counts(o.hex_block) == std::map<int, std::size_t>{{7, 64}, {9, 104 + 192}});
   }
 }
 
