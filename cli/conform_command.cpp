@@ -35,7 +35,7 @@ struct ConformArgs {
   std::string model = "half";
   std::string save_input;
   double merge_tolerance = -1;  // < 0: no merging
-  double buffer_thickness = -1;  // < 0: the side's default
+  double buffer_thickness = 0;  // 0: the side's default
   std::string buffer_side = "hex";
   double smooth_target = 0.0;
   std::string template_box;
@@ -140,6 +140,12 @@ Eigen::Vector3d template_box(const std::string& text) {
 // The output paths and format, checked before any work: names, directories, format agreement.
 std::string check_outputs(const ConformArgs& a) {
   if (!a.template_box.empty()) template_box(a.template_box);  // a usage error, before the work
+  if (a.buffer_side == "tet" && a.buffer_thickness > 0.45) {
+    std::ostringstream m;
+    m << "--buffer-thickness " << a.buffer_thickness
+      << " with --buffer-side tet: at most 0.45 (the tets at the interface would lose more of their height)";
+    throw InvalidInput(m.str());
+  }
   std::string format;
   if (!a.output.empty()) {
     if (a.output == "-") throw InvalidInput("-o -: a mesh is written to a file, not to standard output");
@@ -173,8 +179,7 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
   opts.quality = conform::parse_conform_quality(a.quality);
   opts.geode_block = a.geode_block;
   opts.buffer.side = a.buffer_side == "hex" ? conform::BufferSide::Hex : conform::BufferSide::Tet;
-  opts.buffer.thickness =
-      a.buffer_thickness > 0 ? a.buffer_thickness : conform::default_buffer_thickness(opts.buffer.side);
+  opts.buffer.thickness = std::max(a.buffer_thickness, 0.0);  // 0: the side's default
   opts.smooth_target = a.smooth_target;
   if (!a.template_box.empty()) opts.template_box = template_box(a.template_box);
   opts.progress = [&progress](const std::string& line) { progress.stage(line); };
@@ -265,7 +270,8 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
       ->capture_default_str();
   c->add_option("--buffer-thickness", a.buffer_thickness,
                 "how far that part shrinks off the interface (the buffer layer's thickness), as a fraction\n"
-                "of the shortest edge at each interface node; default 0.5 with --buffer-side hex, 0.3 with tet")
+                "of the shortest edge at each interface node; default 0.5 with --buffer-side hex (at most 0.9),\n"
+                "0.3 with tet (at most 0.45)")
       ->check(number_check(0.01, 0.9));
   c->add_option("--template-box", a.template_box,
                 "proportions WxHxD of the box the reference geode template is smoothed in once per\n"

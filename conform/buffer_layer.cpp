@@ -69,7 +69,8 @@ class BufferBuilder {
 public:
   BufferBuilder(const Model& input, const Interface& itf, const BufferLayerOptions& opt)
       : input_(input), itf_(itf), opt_(opt), n_points_(input.points.size()), n_moved_(itf.nodes.size()),
-        hex_side_(opt.side == BufferSide::Hex) {}
+        hex_side_(opt.side == BufferSide::Hex),
+        thickness_(opt.thickness > 0.0 ? opt.thickness : default_buffer_thickness(opt.side)) {}
   BufferLayer run();
 
 private:
@@ -94,6 +95,7 @@ private:
   const BufferLayerOptions& opt_;
   const std::size_t n_points_, n_moved_;
   const bool hex_side_;  // the hex part's copies move (into the hex part), the tet part stays
+  const double thickness_;
   BufferLayer out_;
   // Per moved node: unit corner normals of its interface quads pointing into the moving part,
   // the shortest interface-quad or moving-part edge at it, area-weighted outward normals of
@@ -109,7 +111,7 @@ private:
 void BufferBuilder::interface_geometry() {
   corner_normals_.assign(n_moved_, {});
   shortest_.assign(n_moved_, std::numeric_limits<double>::infinity());
-  const double into = hex_side_ ? -1.0 : 1.0;  // corner normals point to the tet side
+  const double into = hex_side_ ? -1.0 : 1.0;  // the quads' own corner normals face the tet side
   for (const InterfaceQuad& q : itf_.quads)
     for (std::size_t i = 0; i < 4; ++i) {
       const Index v = q.corners[i];
@@ -217,8 +219,9 @@ void BufferBuilder::directions() {
   }
 }
 
-// Height of the layer per node. thickness x the shortest edge at a node is safe for its cells
-// but jumps where one short edge meets the interface: a buffer hex whose corners stand at
+// Height of the layer per node. thickness x the shortest edge at a node keeps its cells in
+// proportion (where it does not, the checks of move_and_check halve it) but jumps where one
+// short edge meets the interface: a buffer hex whose corners stand at
 // unequal heights has a twisted face, folded along its diagonal, and the template's nodes
 // under the fold invert. So a node is raised towards its neighbours' heights (to at least a
 // neighbour's height less raise_rate x their edge, primal::grade_up), but not above thickness
@@ -237,7 +240,7 @@ void BufferBuilder::heights() {
       mean_quad_edge[slot(a)] += len, mean_quad_edge[slot(b)] += len;
     }
   step_.assign(n_moved_, 0.0);  // the node's height; it moves step x direction
-  for (std::size_t k = 0; k < n_moved_; ++k) step_[k] = opt_.thickness * shortest_[k];
+  for (std::size_t k = 0; k < n_moved_; ++k) step_[k] = thickness_ * shortest_[k];
   std::vector<int> quads_at(n_moved_, 0);  // two of a quad's edges per corner
   for (const InterfaceQuad& q : itf_.quads)
     for (Index v : q.corners) ++quads_at[slot(v)];
@@ -246,7 +249,7 @@ void BufferBuilder::heights() {
   grade_down(step_, quad_edges_, opt_.smooth_rate);
   safe_ = step_;
   for (std::size_t k = 0; k < n_moved_; ++k)
-    step_[k] = std::max(step_[k], std::min(raised[k], opt_.thickness * mean_quad_edge[k] / (2.0 * quads_at[k])));
+    step_[k] = std::max(step_[k], std::min(raised[k], thickness_ * mean_quad_edge[k] / (2.0 * quads_at[k])));
   grade_down(step_, quad_edges_, opt_.smooth_rate);
 }
 
@@ -330,7 +333,8 @@ std::string BufferBuilder::check(std::vector<char>& failing) {
       for (std::size_t i = 0; i < 9; ++i)
         if (jb[i] > 0.0) ratio = std::min(ratio, ja[i] / jb[i]);
       out_.report.min_volume_ratio = std::min(out_.report.min_volume_ratio, ratio);
-      const double sj_ratio = hex_scaled_jacobian(after) / std::max(hex_scaled_jacobian(before), 1e-12);
+      const double sj_before = hex_scaled_jacobian(before);
+      const double sj_ratio = sj_before > 0.0 ? hex_scaled_jacobian(after) / sj_before : 1.0;
       if (ratio < opt_.min_volume_ratio || sj_ratio < opt_.min_hex_quality_ratio) {
         for (Index v : hex) fail_node(v);
         for (Index v : hex)

@@ -33,10 +33,10 @@ using primal::Model;
 
 // Which part the buffer layer is carved from: the copies of the interface nodes on that side
 // move into it, the other part keeps its elements exactly as they are. From the hex part
-// (default) the tets stay as meshed, so the transition is never below the input's own diced
-// tets there, and the buffer can be as thick as the template's best proportions: a box squashed
-// along its edge is still a box, while a tet loses height (and quality) as fast as the layer
-// gains it. The tet side suits hex parts that must not move.
+// (default) the tets stay as meshed, so the diced tets are exactly the input's own, and the
+// buffer can be near the template's best proportions: a box squashed along its edge is still a
+// box, while a tet loses height (and quality) as fast as the layer gains it. The tet side suits
+// hex parts that must not move.
 enum class BufferSide { Hex, Tet };
 
 // The default thickness per side: half the shortest edge from the hex part; 0.3 from the tet
@@ -48,9 +48,9 @@ struct BufferLayerOptions {
   // Height of the buffer layer at each interface node (its distance from the interface faces
   // there) before grading, as a fraction of the shortest edge of the moving part's elements or
   // interface quads at the node; grading (below) may raise it up to this fraction of the
-  // node's mean quad edge.
-  double thickness = default_buffer_thickness(BufferSide::Hex);
-  // Heights vary smoothly along the interface (see insert_buffer_layer): a node is raised to
+  // node's mean quad edge. 0: default_buffer_thickness(side).
+  double thickness = 0.0;
+  // Heights vary smoothly along the interface (buffer_layer.cpp, heights()): a node is raised to
   // within raise_rate x edge length of its neighbours' heights (not above thickness x its
   // interface quads' mean edge), and neighbours differ by at most smooth_rate x their edge.
   double raise_rate = 0.03;
@@ -61,9 +61,10 @@ struct BufferLayerOptions {
   // Every moved element keeps at least this fraction of its volume (a hex: at every corner,
   // its corner Jacobian's fraction).
   double min_volume_ratio = 0.05;
-  // Every moved hex keeps at least this fraction of its scaled Jacobian. A box touching the
-  // interface at one concave corner only, its corner pushed a quarter edge along the diagonal,
-  // keeps 0.44; squashed hexes of unstructured parts lose more unless held back here.
+  // Every moved hex keeps at least this fraction of its scaled Jacobian (one that was not
+  // positive is not held to it). A cube touching the interface at one concave corner only, that
+  // corner pushed a quarter edge along each axis, keeps 0.44; squashed hexes of unstructured
+  // parts lose more unless held back here.
   double min_hex_quality_ratio = 0.4;
   // Every buffer hex has a Verdict scaled Jacobian (min over 8 corners and centre) above this.
   double min_scaled_jacobian = 1e-3;
@@ -88,7 +89,7 @@ struct BufferHex {
 struct BufferLayerReport {
   double min_volume_ratio = 1.0;        // over the elements that moved
   double min_scaled_jacobian = 1.0;     // over the buffer hexes
-  double min_step = 0.0, max_step = 0.0;  // distances the duplicated nodes moved
+  double min_step = 0.0, max_step = 0.0;  // distances the moving copies moved
   int halvings = 0;                     // rounds of step halving needed
 };
 

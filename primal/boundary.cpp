@@ -33,7 +33,8 @@ namespace {
 // OpenMesh reports refused faces on its process-wide error stream; extract_boundary reports them
 // in `rejected` instead. Boundaries are extracted from several threads at once (templates are
 // built in parallel), and OpenMesh's omerr() connects std::cerr on its first call without a lock,
-// so the first call and every enable/disable go through one mutex; the stream is disabled while
+// so the first call and every enable/disable go through one mutex (what OpenMesh then writes
+// to the disabled stream is buffered under OpenMesh's own lock); the stream is disabled while
 // any extraction is adding faces and restored to its previous state when the last one ends.
 class OpenMeshErrorsSilenced {
 public:

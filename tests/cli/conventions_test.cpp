@@ -80,6 +80,7 @@ TEST_CASE("cli conventions: usage errors and bad numbers are one line on stderr,
       {"conform " + in.string() + " --smooth fast", "fast"},
       {"conform " + in.string() + " --buffer-thickness 0.95", "out of range [0.01, 0.9]"},
       {"conform " + in.string() + " --buffer-side both", "--buffer-side"},
+      {"conform " + in.string() + " --buffer-side tet --buffer-thickness 0.6", "at most 0.45"},
       {"conform " + in.string() + " --smooth-target 2", "out of range [0, 1]"},
       {"conform " + in.string() + " --template-box 24x0x24 -o " + d + "out.exo", "--template-box '24x0x24'"},
       // Outputs: format by extension, contradictions, unknown extensions, missing directories.

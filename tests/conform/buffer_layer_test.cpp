@@ -61,8 +61,7 @@ constexpr std::array<BufferSide, 2> kSides{BufferSide::Hex, BufferSide::Tet};
 
 BufferLayerOptions on_side(BufferSide side) {
   BufferLayerOptions o;
-  o.side = side;
-  o.thickness = default_buffer_thickness(side);
+  o.side = side;  // thickness 0: default_buffer_thickness(side)
   return o;
 }
 
@@ -268,7 +267,7 @@ TEST_CASE("insert_buffer_layer: one short tet edge does not twist the buffer top
   auto height = [&](Index v) {
     return layer.model.points[static_cast<std::size_t>(layer.top_node[static_cast<std::size_t>(v)])].z() - 1.0;
   };
-  CHECK(height(static_cast<Index>(node(1, 1, 1))) > o.thickness * 0.5 + 0.05);
+  CHECK(height(static_cast<Index>(node(1, 1, 1))) > default_buffer_thickness(BufferSide::Tet) * 0.5 + 0.05);
   for (const InterfaceQuad& q : itf.quads)
     for (std::size_t i = 0; i < 4; ++i)
       CHECK(std::abs(height(q.corners[i]) - height(q.corners[(i + 1) % 4])) <= o.smooth_rate * 1.0 + 1e-12);
@@ -319,6 +318,6 @@ TEST_CASE("Gmsh demo models: conforming interface and a valid buffer layer") {
     CHECK(layer.report.min_scaled_jacobian > 0.0);
     CHECK(layer.report.min_volume_ratio > 0.0);
     MESSAGE("nugget demo: ", m.tets.size(), " tets, buffer min scaled Jacobian ", layer.report.min_scaled_jacobian,
-            ", min tet volume ratio ", layer.report.min_volume_ratio, ", halvings ", layer.report.halvings);
+            ", min volume ratio of the moved hexes ", layer.report.min_volume_ratio, ", halvings ", layer.report.halvings);
   }
 }
