@@ -73,6 +73,7 @@ nlohmann::json result_json(const conform::ConformResult& r) {
                     {"seconds", r.smoothing.seconds},
                     {"cpu_seconds", r.smoothing.cpu_seconds}};
   j["buffer_layer_min_scaled_jacobian"] = r.buffer.min_scaled_jacobian;
+  j["buffer_side"] = r.buffer_side == conform::BufferSide::Hex ? "hex" : "tet";
   j["input_diced_alone_min_scaled_jacobian"] = {{"hexes", r.input_diced_hex_min_scaled_jacobian},
                                                 {"tets", r.input_diced_tet_min_scaled_jacobian}};
   j["output_min_scaled_jacobian"] = output_min_sj(r);
@@ -112,7 +113,6 @@ void print_summary(const conform::ConformResult& r, std::ostream& os, bool table
      << r.input_diced_tet_min_scaled_jacobian << " (tets); output " << output;
   if (yardstick > 0) os << " = " << output / yardstick << " x the lower";
   os << "\n";
-  for (const auto& w : r.warnings) os << "warning: " << w << "\n";
 }
 
 // Nodes at one place as other nodes (within 1e-9 of the model's size): the parts were meshed
@@ -210,6 +210,9 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
     files.commit();
   }
   if (!a.quiet) print_summary(r, std::cout, tables);
+  // Warnings of a valid result go to stderr, --quiet or not (an invalid one's are in its error).
+  if (valid)
+    for (const auto& w : r.warnings) std::cerr << "geode: warning: " << w << "\n";
   if (!a.quiet && (valid || a.write_invalid)) {
     if (!a.output.empty()) std::cout << "wrote " << a.output << "\n";
     if (!a.report.empty()) std::cout << "wrote " << a.report << "\n";

@@ -200,11 +200,29 @@ void Conformer::find_interface() {
 
 void Conformer::insert_buffer() {
   t0_ = Clock::now();
-  layer_ = insert_buffer_layer(input_, interface_, options_.buffer);
+  res_.buffer_side = options_.buffer.side;
+  try {
+    layer_ = insert_buffer_layer(input_, interface_, options_.buffer);
+  } catch (const TopologyError& e) {
+    if (!options_.buffer_fallback) throw;
+    BufferLayerOptions other = options_.buffer;
+    other.side = options_.buffer.side == BufferSide::Hex ? BufferSide::Tet : BufferSide::Hex;
+    other.thickness = 0.0;  // that side's default
+    const char* first = options_.buffer.side == BufferSide::Hex ? "hex" : "tet";
+    const char* second = other.side == BufferSide::Hex ? "hex" : "tet";
+    try {
+      layer_ = insert_buffer_layer(input_, interface_, other);
+    } catch (const TopologyError& e2) {
+      throw TopologyError(std::string(e.what()) + "; from the " + second + " part: " + e2.what());
+    }
+    res_.buffer_side = other.side;
+    res_.warnings.push_back(std::string("buffer layer carved from the ") + second + " part, not the " + first +
+                            " part: " + e.what());
+  }
   carved_from_.reserve(layer_.hexes.size());
   for (const BufferHex& b : layer_.hexes) {
     const primal::InterfaceQuad& q = interface_.quads[b.quad];
-    carved_from_.push_back(options_.buffer.side == BufferSide::Hex ? primal::ElementRef{primal::ElementKind::Hex, q.hex}
+    carved_from_.push_back(res_.buffer_side == BufferSide::Hex ? primal::ElementRef{primal::ElementKind::Hex, q.hex}
                                                                    : primal::ElementRef{primal::ElementKind::Tet, q.tets[0]});
   }
   interface_ = {};

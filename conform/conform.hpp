@@ -41,6 +41,11 @@ ConformQuality parse_conform_quality(const std::string& word);
 
 struct ConformOptions {
   BufferLayerOptions buffer;
+  // When no buffer layer can be carved from buffer.side (a node where that part's copy cannot
+  // move off the interface, e.g. a hex-part corner under a tet part covering only part of a hex
+  // face), carve it from the other part (at that side's default thickness) and say so in
+  // ConformResult::warnings; false: refuse.
+  bool buffer_fallback = true;
   double interface_tolerance = 1e-6;  // find_interface: relative to the local edge length
   // Box of the reference template (x, y, z as in templates/geode.hpp: y is the buffer hex's
   // thickness direction). It is smoothed once per diagonal, top and bottom fixed and its four
@@ -111,6 +116,7 @@ struct ConformResult {
   primal::Index input_hexes = 0, input_tets = 0, interface_quads = 0;
   primal::Index diced_hexes = 0, geode_hexes = 0, diced_tet_hexes = 0;
   BufferLayerReport buffer;
+  BufferSide buffer_side = BufferSide::Hex;  // the part the buffer layer was carved from
   double template_min_scaled_jacobian = 0.0;  // the reference templates used, after smoothing
   // The yardstick for the transition: the input's hexes and tets each diced alone
   // (primal::diced_min_scaled_jacobian), before the buffer layer moves anything.

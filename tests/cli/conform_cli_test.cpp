@@ -125,3 +125,26 @@ TEST_CASE("geode conform: bad input exits non-zero, names the file and writes no
     CHECK((name == "hexes.msh" || name == "apart.exo"));
   }
 }
+
+TEST_CASE("geode conform: a warning reaches stderr with --quiet, and the report names the side") {
+  // A tet cell alone on a hex block's top: no layer can be carved from the hex part there (its
+  // nodes on the block's flat top cannot move below the interface), so conform carves it from
+  // the tet part and warns.
+  TempDir dir;
+  primal::Model m = primal::grid_model({2, 2, 2}, 1.0, [](int i, int j, int k) { return i == 0 && j == 0 && k == 1; });
+  std::erase_if(m.hexes, [&](const auto& h) { return m.points[static_cast<std::size_t>(h[0])].z() > 0.5; });
+  m.hex_block.assign(m.hexes.size(), 1);
+  primal::write_gmsh(m, dir.path / "in.msh");
+  const fs::path report = dir.path / "r.json";
+  const Run r = geode_cli("conform " + (dir.path / "in.msh").string() + " -o " + (dir.path / "out.exo").string() +
+                          " --report " + report.string() + " --quiet");
+  CHECK(r.code == 0);
+  // Nothing but the warning, on one line.
+  CHECK(r.out.rfind("geode: warning: buffer layer carved from the tet part, not the hex part", 0) == 0);
+  CHECK(std::count(r.out.begin(), r.out.end(), '\n') == 1);
+  std::ifstream is(report);
+  const nlohmann::json j = nlohmann::json::parse(is);
+  CHECK(j.at("buffer_side") == "tet");
+  CHECK(j.at("warnings").size() == 1);
+  CHECK(j.at("valid") == true);
+}

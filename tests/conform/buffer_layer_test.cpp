@@ -150,6 +150,10 @@ TEST_CASE("insert_buffer_layer: valid, gap-free layers on convex and concave int
        [](int i, int j, int k) { return k == 1 && ((i == 1 && (j == 1 || j == 2)) || (i == 2 && j == 1)); }, 14},
       {"enclosed tet nugget (hex block with a tet cavity)", {3, 3, 3},
        [](int i, int j, int k) { return i == 1 && j == 1 && k == 1; }, 6},
+      {"one layer of hexes between two tet layers", {2, 2, 3}, [](int, int, int k) { return k != 1; }, 8},
+      {"one layer of tets between two hex layers", {2, 2, 3}, [](int, int, int k) { return k == 1; }, 8},
+      {"enclosed hex nugget (a hex inside tets)", {3, 3, 3},
+       [](int i, int j, int k) { return !(i == 1 && j == 1 && k == 1); }, 6},
   };
   for (const BufferSide side : kSides)
     for (const Case& c : cases) check_layer(c, side);

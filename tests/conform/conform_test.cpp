@@ -49,10 +49,13 @@ void check_result(const conform::ConformResult& r, const Expected& e) {
   primal::Model copy = r.model;
   CHECK(primal::merge_coincident_nodes(copy, 1e-9) == 0);
   // Every model here has its hexes in block 1 and its tets in block 2: diced hexes stay in 1,
-  // geode hexes go to the block of the hexes their buffer layer was carved from (1), diced tets
+  // geode hexes go to the block of the part their buffer layer was carved from, diced tets
   // stay in 2.
+  const int geode_block = r.buffer_side == conform::BufferSide::Hex ? 1 : 2;
   for (std::size_t h = 0; h < r.model.hexes.size(); ++h) {
-    const int expected = h < static_cast<std::size_t>(8 * e.hexes + r.geode_hexes) ? 1 : 2;
+    const int expected = h < static_cast<std::size_t>(8 * e.hexes)                ? 1
+                         : h < static_cast<std::size_t>(8 * e.hexes + r.geode_hexes) ? geode_block
+                                                                                     : 2;
     if (r.model.hex_block[h] != expected) {
       FAIL("hex " << h << " in block " << r.model.hex_block[h]);
       break;
@@ -100,6 +103,30 @@ TEST_CASE("L-shaped interfaces: buffer hexes meeting at a concave edge merge the
     // x = 1 (j = 1, 2) and 2 on y = 1 (i = 1, 2), x 2 layers = 8.
     check_result(conform::conform(m), {10, 48, 8});
   }
+}
+
+TEST_CASE("a tet part over part of a hex face: carved from the tet part when the hex part cannot") {
+  // 2 x 2 x 2 cells, tets in cell (0, 0, 1) only: its bottom is the top of hex (0, 0, 0). The
+  // interface quad's corners and edges are on the hex part's flat top (or its crease with a
+  // side), where their hex-side copies could only slide in that plane, never below the
+  // interface; the tet part's copies move up the tet cell's edges.
+  primal::Model m = primal::grid_model({2, 2, 2}, 1.0, [](int i, int j, int k) { return i == 0 && j == 0 && k == 1; });
+  // Only the bottom layer of hexes: the tet cell stands alone on the hex block's top.
+  std::erase_if(m.hexes, [&](const auto& h) { return m.points[static_cast<std::size_t>(h[0])].z() > 0.5; });
+  m.hex_block.assign(m.hexes.size(), 1);
+  const primal::Interface itf = primal::find_interface(m);
+  REQUIRE(itf.quads.size() == 1);
+  CHECK_THROWS_WITH_AS(conform::insert_buffer_layer(m, itf), doctest::Contains("no direction into the hex side"),
+                       TopologyError);
+  auto r = conform::conform(m);
+  CHECK(r.buffer_side == conform::BufferSide::Tet);
+  REQUIRE(r.warnings.size() == 1);
+  CHECK(r.warnings[0].find("buffer layer carved from the tet part, not the hex part") != std::string::npos);
+  r.warnings.clear();  // the one expected; check_result wants none
+  check_result(r, {4, 6, 1});
+  conform::ConformOptions strict;
+  strict.buffer_fallback = false;
+  CHECK_THROWS_AS(conform::conform(m, strict), TopologyError);
 }
 
 // conform builds the templates in parallel: each box and diagonal is built once, whichever
