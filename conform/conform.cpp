@@ -223,7 +223,7 @@ void Conformer::insert_buffer() {
   for (const BufferHex& b : layer_.hexes) {
     const primal::InterfaceQuad& q = interface_.quads[b.quad];
     carved_from_.push_back(res_.buffer_side == BufferSide::Hex ? primal::ElementRef{primal::ElementKind::Hex, q.hex}
-                                                                   : primal::ElementRef{primal::ElementKind::Tet, q.tets[0]});
+                                                               : primal::ElementRef{primal::ElementKind::Tet, q.tets[0]});
   }
   interface_ = {};
   res_.buffer = layer_.report;

@@ -42,9 +42,9 @@ ConformQuality parse_conform_quality(const std::string& word);
 struct ConformOptions {
   BufferLayerOptions buffer;
   // When no buffer layer can be carved from buffer.side (a node where that part's copy cannot
-  // move off the interface, e.g. a hex-part corner under a tet part covering only part of a hex
-  // face), carve it from the other part (at that side's default thickness) and say so in
-  // ConformResult::warnings; false: refuse.
+  // move off the interface, e.g. on the hex part's flat boundary where a tet part covers only
+  // part of a hex face), carve it from the other part (at that side's default thickness) and say
+  // so in ConformResult::warnings; false: refuse.
   bool buffer_fallback = true;
   double interface_tolerance = 1e-6;  // find_interface: relative to the local edge length
   // Box of the reference template (x, y, z as in templates/geode.hpp: y is the buffer hex's
