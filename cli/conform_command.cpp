@@ -73,7 +73,7 @@ nlohmann::json result_json(const conform::ConformResult& r) {
                     {"seconds", r.smoothing.seconds},
                     {"cpu_seconds", r.smoothing.cpu_seconds}};
   j["buffer_layer_min_scaled_jacobian"] = r.buffer.min_scaled_jacobian;
-  j["buffer_side"] = r.buffer_side == conform::BufferSide::Hex ? "hex" : "tet";
+  j["buffer_side"] = conform::buffer_side_name(r.buffer_side);
   j["input_diced_alone_min_scaled_jacobian"] = {{"hexes", r.input_diced_hex_min_scaled_jacobian},
                                                 {"tets", r.input_diced_tet_min_scaled_jacobian}};
   j["output_min_scaled_jacobian"] = output_min_sj(r);
@@ -140,10 +140,10 @@ Eigen::Vector3d template_box(const std::string& text) {
 // The output paths and format, checked before any work: names, directories, format agreement.
 std::string check_outputs(const ConformArgs& a) {
   if (!a.template_box.empty()) template_box(a.template_box);  // a usage error, before the work
-  if (a.buffer_side == "tet" && a.buffer_thickness > 0.45) {
+  if (const double most = conform::max_buffer_thickness(conform::parse_buffer_side(a.buffer_side));
+      a.buffer_thickness > most) {
     std::ostringstream m;
-    m << "--buffer-thickness " << a.buffer_thickness
-      << " with --buffer-side tet: at most 0.45 (the tets at the interface would lose more of their height)";
+    m << "--buffer-thickness " << a.buffer_thickness << " with --buffer-side " << a.buffer_side << ": at most " << most;
     throw InvalidInput(m.str());
   }
   std::string format;
@@ -178,7 +178,7 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
   opts.smooth = conform::parse_conform_smooth(a.smooth);
   opts.quality = conform::parse_conform_quality(a.quality);
   opts.geode_block = a.geode_block;
-  opts.buffer.side = a.buffer_side == "hex" ? conform::BufferSide::Hex : conform::BufferSide::Tet;
+  opts.buffer.side = conform::parse_buffer_side(a.buffer_side);
   opts.buffer.thickness = std::max(a.buffer_thickness, 0.0);  // 0: the side's default
   opts.smooth_target = a.smooth_target;
   if (!a.template_box.empty()) opts.template_box = template_box(a.template_box);
@@ -275,7 +275,7 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
                 "how far that part shrinks off the interface (the buffer layer's thickness), as a fraction\n"
                 "of the shortest edge at each interface node; default 0.5 with --buffer-side hex (at most 0.9),\n"
                 "0.3 with tet (at most 0.45)")
-      ->check(number_check(0.01, 0.9));
+      ->check(number_check(0.01, conform::max_buffer_thickness(conform::BufferSide::kHex)));
   c->add_option("--template-box", a.template_box,
                 "proportions WxHxD of the box the reference geode template is smoothed in once per\n"
                 "run (H: the buffer hex's thickness direction; default 24x12x24, near the buffer hexes' own;\n"

@@ -69,7 +69,7 @@ class BufferBuilder {
 public:
   BufferBuilder(const Model& input, const Interface& itf, const BufferLayerOptions& opt)
       : input_(input), itf_(itf), opt_(opt), n_points_(input.points.size()), n_moved_(itf.nodes.size()),
-        hex_side_(opt.side == BufferSide::Hex),
+        hex_side_(opt.side == BufferSide::kHex),
         thickness_(opt.thickness > 0.0 ? opt.thickness : default_buffer_thickness(opt.side)) {}
   BufferLayer run();
 
@@ -175,7 +175,7 @@ void BufferBuilder::moving_part(const Cells& cells, const Edges& edges, const Fa
 }
 
 void BufferBuilder::directions() {
-  const char* part = hex_side_ ? "hex" : "tet";
+  const char* part = buffer_side_name(opt_.side);
   const double feature_cos = std::cos(opt_.feature_angle * M_PI / 180.0);
   direction_.assign(n_moved_, Point::Zero());
   for (std::size_t k = 0; k < n_moved_; ++k) {
@@ -231,6 +231,7 @@ void BufferBuilder::directions() {
 // thickness x shortest edge) before it is ever halved.
 void BufferBuilder::heights() {
   std::vector<double> mean_quad_edge(n_moved_, 0.0);
+  std::vector<int> quads_at(n_moved_, 0);  // two of a quad's edges per corner
   for (const InterfaceQuad& q : itf_.quads)
     for (std::size_t i = 0; i < 4; ++i) {
       const Index a = q.corners[i], b = q.corners[(i + 1) % 4];
@@ -238,12 +239,10 @@ void BufferBuilder::heights() {
       quad_edges_.nodes.push_back({static_cast<Index>(slot(a)), static_cast<Index>(slot(b))});
       quad_edges_.length.push_back(len);
       mean_quad_edge[slot(a)] += len, mean_quad_edge[slot(b)] += len;
+      ++quads_at[slot(a)];
     }
   step_.assign(n_moved_, 0.0);  // the node's height; it moves step x direction
   for (std::size_t k = 0; k < n_moved_; ++k) step_[k] = thickness_ * shortest_[k];
-  std::vector<int> quads_at(n_moved_, 0);  // two of a quad's edges per corner
-  for (const InterfaceQuad& q : itf_.quads)
-    for (Index v : q.corners) ++quads_at[slot(v)];
   std::vector<double> raised = step_;
   grade_up(raised, quad_edges_, opt_.raise_rate);
   grade_down(step_, quad_edges_, opt_.smooth_rate);
@@ -447,8 +446,20 @@ BufferLayer BufferBuilder::run() {
 
 }  // namespace
 
+const char* buffer_side_name(BufferSide side) { return side == BufferSide::kHex ? "hex" : "tet"; }
+
+BufferSide parse_buffer_side(const std::string& word) {
+  if (word == "hex") return BufferSide::kHex;
+  if (word == "tet") return BufferSide::kTet;
+  throw InvalidInput("buffer side '" + word + "': expected hex or tet");
+}
+
 BufferLayer insert_buffer_layer(const Model& input, const Interface& itf, const BufferLayerOptions& opt) {
   validate(input, "insert_buffer_layer");
+  if (!(opt.thickness >= 0.0 && opt.thickness <= max_buffer_thickness(opt.side)))
+    throw InvalidInput("insert_buffer_layer: thickness " + std::to_string(opt.thickness) + " from the " +
+                       buffer_side_name(opt.side) + " part (at most " +
+                       std::to_string(max_buffer_thickness(opt.side)) + ")");
   return BufferBuilder(input, itf, opt).run();
 }
 

@@ -17,6 +17,7 @@
 //   y = +h/2) one right-handed map is r = z, s = x, t = y, under which Diagonal::Main (which
 //   joins (-x,+z) and (+x,-z)) is {5, 7} and Diagonal::Anti is {4, 6}.
 #include <array>
+#include <string>
 #include <vector>
 
 #include "primal/interface.hpp"
@@ -37,18 +38,25 @@ using primal::Model;
 // buffer can be near the template's best proportions: a box squashed along its edge is still a
 // box, while a tet loses height (and quality) as fast as the layer gains it. The tet side suits
 // hex parts that must not move.
-enum class BufferSide { Hex, Tet };
+enum class BufferSide { kHex, kTet };
 
 // The default thickness per side: half the shortest edge from the hex part; 0.3 from the tet
 // part, whose first tets lose that fraction of their height.
-constexpr double default_buffer_thickness(BufferSide side) { return side == BufferSide::Hex ? 0.5 : 0.3; }
+constexpr double default_buffer_thickness(BufferSide side) { return side == BufferSide::kHex ? 0.5 : 0.3; }
+// The largest thickness per side: a hex squashed by more than 0.9 of its edge is nearly flat;
+// tets beside the interface would lose more than 0.45 of their height.
+constexpr double max_buffer_thickness(BufferSide side) { return side == BufferSide::kHex ? 0.9 : 0.45; }
+
+// "hex" or "tet"; parse_buffer_side throws InvalidInput naming any other word.
+const char* buffer_side_name(BufferSide side);
+BufferSide parse_buffer_side(const std::string& word);
 
 struct BufferLayerOptions {
-  BufferSide side = BufferSide::Hex;
+  BufferSide side = BufferSide::kHex;
   // Height of the buffer layer at each interface node (its distance from the interface faces
   // there) before grading, as a fraction of the shortest edge of the moving part's elements or
   // interface quads at the node; grading (below) may raise it up to this fraction of the
-  // node's mean quad edge. 0: default_buffer_thickness(side).
+  // node's mean quad edge. 0: default_buffer_thickness(side); at most max_buffer_thickness(side).
   double thickness = 0.0;
   // Heights vary smoothly along the interface (buffer_layer.cpp, heights()): a node is raised to
   // within raise_rate x edge length of its neighbours' heights (not above thickness x its
@@ -109,7 +117,7 @@ struct BufferLayer {
 // Throws TopologyError naming the node (and the element) where no valid layer can be placed:
 // no direction sees all interface faces at a node (the paper's Figure 9 right), a node at a
 // corner of the moving part's outer boundary, or an element still inverted / collapsed after
-// max_halvings halvings.
+// max_halvings halvings; InvalidInput for a thickness below 0 or above max_buffer_thickness.
 BufferLayer insert_buffer_layer(const Model& model, const Interface& interface,
                                 const BufferLayerOptions& options = {});
 

@@ -206,10 +206,10 @@ void Conformer::insert_buffer() {
   } catch (const TopologyError& e) {
     if (!options_.buffer_fallback) throw;
     BufferLayerOptions other = options_.buffer;
-    other.side = options_.buffer.side == BufferSide::Hex ? BufferSide::Tet : BufferSide::Hex;
+    other.side = options_.buffer.side == BufferSide::kHex ? BufferSide::kTet : BufferSide::kHex;
     other.thickness = 0.0;  // that side's default
-    const char* first = options_.buffer.side == BufferSide::Hex ? "hex" : "tet";
-    const char* second = other.side == BufferSide::Hex ? "hex" : "tet";
+    const char* first = buffer_side_name(options_.buffer.side);
+    const char* second = buffer_side_name(other.side);
     try {
       layer_ = insert_buffer_layer(input_, interface_, other);
     } catch (const TopologyError& e2) {
@@ -222,7 +222,7 @@ void Conformer::insert_buffer() {
   carved_from_.reserve(layer_.hexes.size());
   for (const BufferHex& b : layer_.hexes) {
     const primal::InterfaceQuad& q = interface_.quads[b.quad];
-    carved_from_.push_back(res_.buffer_side == BufferSide::Hex ? primal::ElementRef{primal::ElementKind::Hex, q.hex}
+    carved_from_.push_back(res_.buffer_side == BufferSide::kHex ? primal::ElementRef{primal::ElementKind::Hex, q.hex}
                                                                : primal::ElementRef{primal::ElementKind::Tet, q.tets[0]});
   }
   interface_ = {};

@@ -88,7 +88,7 @@ struct ConformOptions {
     return o;
   }();
   // Empty: geode hexes go to the block of the element their buffer hex was carved from (the
-  // hex under it, or the tet above it with BufferSide::Tet): the material of that space.
+  // hex under it, or the tet above it with BufferSide::kTet): the material of that space.
   // A name: they get a block of their own with that name, id one above every input block id.
   std::string geode_block;
   // Called with one line per stage (for the command line's progress output); may be empty.
@@ -116,7 +116,7 @@ struct ConformResult {
   primal::Index input_hexes = 0, input_tets = 0, interface_quads = 0;
   primal::Index diced_hexes = 0, geode_hexes = 0, diced_tet_hexes = 0;
   BufferLayerReport buffer;
-  BufferSide buffer_side = BufferSide::Hex;  // the part the buffer layer was carved from
+  BufferSide buffer_side = BufferSide::kHex;  // the part the buffer layer was carved from
   double template_min_scaled_jacobian = 0.0;  // the reference templates used, after smoothing
   // The yardstick for the transition: the input's hexes and tets each diced alone
   // (primal::diced_min_scaled_jacobian), before the buffer layer moves anything.

@@ -57,7 +57,7 @@ struct Case {
   std::size_t quads;
 };
 
-constexpr std::array<BufferSide, 2> kSides{BufferSide::Hex, BufferSide::Tet};
+constexpr std::array<BufferSide, 2> kSides{BufferSide::kHex, BufferSide::kTet};
 
 BufferLayerOptions on_side(BufferSide side) {
   BufferLayerOptions o;
@@ -78,7 +78,7 @@ void check_layer(const Case& c, BufferSide side) {
   CHECK(layer.model.hexes == m.hexes);
   // The part the layer is not carved from keeps every corner where it was; squashed hexes
   // keep their share of quality.
-  if (side == BufferSide::Hex) {
+  if (side == BufferSide::kHex) {
     for (std::size_t t = 0; t < m.tets.size(); ++t)
       for (std::size_t i = 0; i < 4; ++i)
         CHECK(p[static_cast<std::size_t>(layer.model.tets[t][i])] == m.points[static_cast<std::size_t>(m.tets[t][i])]);
@@ -174,7 +174,7 @@ TEST_CASE("insert_buffer_layer: one hex under tets, positions by hand") {
         const Point& bottom = layer.model.points[static_cast<std::size_t>(b.corners[i])];
         const Point& top = layer.model.points[static_cast<std::size_t>(b.corners[i + 4])];
         CHECK((top - bottom - Point(0, 0, 0.25)).norm() < 1e-14);
-        CHECK((side == BufferSide::Hex ? top : bottom).z() == 1.0);
+        CHECK((side == BufferSide::kHex ? top : bottom).z() == 1.0);
       }
     CHECK(layer.report.min_step == doctest::Approx(0.25));
     CHECK(layer.report.max_step == doctest::Approx(0.25));
@@ -203,10 +203,10 @@ TEST_CASE("insert_buffer_layer: the nugget's corners move along the cavity diago
     const Point& hex_copy = p[static_cast<std::size_t>(v)];
     const Point& tet_copy = p[static_cast<std::size_t>(layer.top_node[static_cast<std::size_t>(v)])];
     const double height = o.thickness;
-    const Point moved = side == BufferSide::Hex ? Point(Point(1, 1, 1) - height * Point(1, 1, 1))
+    const Point moved = side == BufferSide::kHex ? Point(Point(1, 1, 1) - height * Point(1, 1, 1))
                                                 : Point(Point(1, 1, 1) + height * Point(1, 1, 1));
-    CHECK(((side == BufferSide::Hex ? hex_copy : tet_copy) - moved).norm() < 1e-12);
-    CHECK((side == BufferSide::Hex ? tet_copy : hex_copy) == Point(1, 1, 1));
+    CHECK(((side == BufferSide::kHex ? hex_copy : tet_copy) - moved).norm() < 1e-12);
+    CHECK((side == BufferSide::kHex ? tet_copy : hex_copy) == Point(1, 1, 1));
   }
 }
 
@@ -243,7 +243,7 @@ TEST_CASE("insert_buffer_layer: buffer tops parallel to their bottoms at convex 
       const auto& p = layer.model.points;
       for (const BufferHex& b : layer.hexes) {
         auto at = [&](int i) -> const Point& { return p[static_cast<std::size_t>(b.corners[static_cast<std::size_t>(i)])]; };
-        if (side == BufferSide::Tet) {
+        if (side == BufferSide::kTet) {
           const Point n = (at(1) - at(0)).cross(at(3) - at(0)).normalized();  // into the tet side
           for (int i = 4; i < 8; ++i) CHECK(n.dot(at(i) - at(0)) == doctest::Approx(height).epsilon(1e-12));
         } else {
@@ -266,12 +266,12 @@ TEST_CASE("insert_buffer_layer: one short tet edge does not twist the buffer top
   m.points[node(1, 1, 2)].z() = 1.5;
   const Interface itf = find_interface(m);
   REQUIRE(itf.quads.size() == 9);
-  const BufferLayerOptions o = on_side(BufferSide::Tet);
+  const BufferLayerOptions o = on_side(BufferSide::kTet);
   const BufferLayer layer = insert_buffer_layer(m, itf, o);
   auto height = [&](Index v) {
     return layer.model.points[static_cast<std::size_t>(layer.top_node[static_cast<std::size_t>(v)])].z() - 1.0;
   };
-  CHECK(height(static_cast<Index>(node(1, 1, 1))) > default_buffer_thickness(BufferSide::Tet) * 0.5 + 0.05);
+  CHECK(height(static_cast<Index>(node(1, 1, 1))) > default_buffer_thickness(BufferSide::kTet) * 0.5 + 0.05);
   for (const InterfaceQuad& q : itf.quads)
     for (std::size_t i = 0; i < 4; ++i)
       CHECK(std::abs(height(q.corners[i]) - height(q.corners[(i + 1) % 4])) <= o.smooth_rate * 1.0 + 1e-12);
@@ -324,4 +324,21 @@ TEST_CASE("Gmsh demo models: conforming interface and a valid buffer layer") {
     MESSAGE("nugget demo: ", m.tets.size(), " tets, buffer min scaled Jacobian ", layer.report.min_scaled_jacobian,
             ", min volume ratio of the moved hexes ", layer.report.min_volume_ratio, ", halvings ", layer.report.halvings);
   }
+}
+
+TEST_CASE("insert_buffer_layer: a thickness beyond the side's bound is refused by name") {
+  const Model m = grid_model({1, 1, 2}, 1.0, [](int, int, int k) { return k == 1; });
+  const Interface itf = find_interface(m);
+  for (const BufferSide side : kSides) {
+    CAPTURE(static_cast<int>(side));
+    BufferLayerOptions o = on_side(side);
+    o.thickness = max_buffer_thickness(side);
+    CHECK_NOTHROW(insert_buffer_layer(m, itf, o));
+    o.thickness = max_buffer_thickness(side) + 0.01;
+    const std::string words = std::string("from the ") + buffer_side_name(side) + " part";
+    CHECK_THROWS_WITH_AS(insert_buffer_layer(m, itf, o), doctest::Contains(words.c_str()), InvalidInput);
+  }
+  CHECK(parse_buffer_side("hex") == BufferSide::kHex);
+  CHECK(parse_buffer_side("tet") == BufferSide::kTet);
+  CHECK_THROWS_AS(parse_buffer_side("both"), InvalidInput);
 }

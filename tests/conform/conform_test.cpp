@@ -51,7 +51,7 @@ void check_result(const conform::ConformResult& r, const Expected& e) {
   // Every model here has its hexes in block 1 and its tets in block 2: diced hexes stay in 1,
   // geode hexes go to the block of the part their buffer layer was carved from, diced tets
   // stay in 2.
-  const int geode_block = r.buffer_side == conform::BufferSide::Hex ? 1 : 2;
+  const int geode_block = r.buffer_side == conform::BufferSide::kHex ? 1 : 2;
   for (std::size_t h = 0; h < r.model.hexes.size(); ++h) {
     const int expected = h < static_cast<std::size_t>(8 * e.hexes)                ? 1
                          : h < static_cast<std::size_t>(8 * e.hexes + r.geode_hexes) ? geode_block
@@ -119,7 +119,7 @@ TEST_CASE("a tet part over part of a hex face: carved from the tet part when the
   CHECK_THROWS_WITH_AS(conform::insert_buffer_layer(m, itf), doctest::Contains("no direction into the hex side"),
                        TopologyError);
   auto r = conform::conform(m);
-  CHECK(r.buffer_side == conform::BufferSide::Tet);
+  CHECK(r.buffer_side == conform::BufferSide::kTet);
   REQUIRE(r.warnings.size() == 1);
   CHECK(r.warnings[0].find("buffer layer carved from the tet part, not the hex part") != std::string::npos);
   r.warnings.clear();  // the one expected; check_result wants none

@@ -99,7 +99,7 @@ TEST_CASE("buffer carved from the hex part: the tets stay as meshed, geode hexes
     CHECK(r.smoothing.final_min_scaled_jacobian == doctest::Approx(r.yardstick()).epsilon(1e-12));
     CHECK(geode_min(r) >= 0.25);
     conform::ConformOptions t = o;
-    t.buffer.side = conform::BufferSide::Tet;
+    t.buffer.side = conform::BufferSide::kTet;
     t.template_box = {24.0, 10.0, 24.0};
     const auto rt = conform::conform(m, t);
     test::check_conform_result(rt, four ? mixed_geode_hexes(m) : -1);
