@@ -248,7 +248,7 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
       ->capture_default_str();
   c->add_option("--smooth-target", a.smooth_target,
                 "local smoothing: 0 (default) works where the result is worse than the input's own hexes\n"
-                "and tets diced alone (the yardstick), on hexes below 1.05 x it around those until none is\n"
+                "and tets diced alone (the yardstick), on hexes below 1.1 x it around those until none is\n"
                 "below it, again where they remain (up to 8 passes); a value > 0 works on every geode hex\n"
                 "and neighbour below it (e.g. 0.35: more quality on good inputs, more time)")
       ->check(number_check(0, 1))

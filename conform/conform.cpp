@@ -558,11 +558,14 @@ void Conformer::smooth() {
 // ends as soon as no seed is below the yardstick (the target only gives room to get there). A
 // defect whose neighbours are above that target has no room to rise: where defects remain, the
 // pass is repeated around them with a slightly higher target (small steps: a pass costs what
-// lies below its target around the defects).
+// lies below its target around the defects). Within a pass each hex seeds one patch: a second
+// one, after a neighbour moved its nodes, mostly repeats work, while the next pass seeds afresh
+// where defects are left.
 constexpr int kDefectRings = 1;
-constexpr double kDefectTarget = 1.05;      // x the yardstick, first pass
+constexpr double kDefectTarget = 1.1;       // x the yardstick, first pass
 constexpr double kDefectTargetStep = 0.02;  // added to it by each further pass
 constexpr int kDefectPasses = 8;
+constexpr int kDefectVisits = 1;            // patches seeded by one hex in one pass
 
 // Keeps sj_ up to date. A pass changes only the hexes sharing a node with its seeds (its
 // region), and every defect was a seed, so the next pass's defects are in the region.
@@ -577,6 +580,7 @@ void Conformer::smooth_defects(primal::LocalSmoothOptions o) {
     for (int ring = 0; ring < kDefectRings; ++ring) seeds = primal::hexes_around(mesh_, seeds);
     o.target = kDefectTarget * yardstick + pass * kDefectTargetStep;
     o.goal = yardstick;
+    o.max_visits = kDefectVisits;
     if (!start) start = primal::SmoothStart{sj_, primal::shortest_edge_per_hex(mesh_)};
     const auto r = primal::smooth_hexes_around(mesh_, seeds, o, primal::kFeatureAngle, &*start);
     add_smoothing(r);

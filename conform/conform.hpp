@@ -62,19 +62,20 @@ struct ConformOptions {
   ConformSmooth smooth = ConformSmooth::kLocal;
   // kLocal. 0 (automatic): the defects are the hexes below the yardstick (the input's own hexes
   // and tets diced alone, ConformResult); patches start on them and the hexes sharing a node
-  // with them, at hexes below 1.05 x the yardstick, until none is below the yardstick, and up
-  // to seven times more around the defects left, each time 0.02 higher. The smoother works only
-  // where the transition is worse than dicing the input makes anyway, and its cost follows the
-  // defects, not the interface. > 0: every geode hex and its neighbours below this scaled
-  // Jacobian seed patches.
+  // with them (one patch each), at hexes below 1.1 x the yardstick, until none is below the
+  // yardstick, and up to seven times more around the defects left, each time 0.02 higher. The
+  // smoother works only where the transition is worse than dicing the input makes anyway, and
+  // its cost follows the defects, not the interface. > 0: every geode hex and its neighbours
+  // below this scaled Jacobian seed patches.
   double smooth_target = 0.0;
   ConformQuality quality = ConformQuality::kScaledJacobian;
   // kLocal, and the untangling of hexes still inverted (with any mode); the automatic target
-  // replaces its target and goal. More visits per hex, a narrower margin and a larger loss than
-  // the primal defaults: lifting a defect takes its neighbours several moves, hexes near the
-  // worst of a patch must give a little for it to rise (where every hex around a defect is
-  // within the margin of it, no patch can move), and the hexes around it may give up 0.2 (over
-  // all passes) so that it reaches the yardstick.
+  // replaces its target, goal and max_visits. A narrower margin and a larger loss than the
+  // primal defaults: hexes near the worst of a patch must give a little for it to rise (where
+  // every hex around a defect is within the margin of it, no patch can move), and the hexes
+  // around it may give up 0.2 (over all passes) so that it reaches the yardstick. More visits
+  // per hex for untangling and a fixed target: there a hex is lifted by its neighbours' moves
+  // within one call.
   primal::LocalSmoothOptions local_smooth_options = [] {
     primal::LocalSmoothOptions o;
     o.max_visits = 4;
