@@ -242,8 +242,9 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
   c->add_option("--report", a.report, "write a JSON report (counts, validity, quality per output block) to FILE.json");
   c->add_option("--smooth", a.smooth,
                 "worst-first smoothing, model boundary nodes sliding on the boundary; local (default):\n"
-                "near the geode hexes (see --smooth-target); global: every hex below 0.5; none: only\n"
-                "hexes the placement inverted are untangled (the report counts them)")
+                "near the geode hexes (see --smooth-target); global: every hex below 0.5, then local's\n"
+                "passes where a hex is still below the input diced alone; none: only hexes the placement\n"
+                "inverted are untangled (the report counts them)")
       ->check(CLI::IsMember({"local", "global", "none"}))
       ->capture_default_str();
   c->add_option("--smooth-target", a.smooth_target,
