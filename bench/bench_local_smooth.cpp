@@ -1,7 +1,8 @@
 // The worst-first local smoother (primal/local_smooth.hpp) on conform's output before smoothing,
 // for every demo model (conform/demo_models.hpp): CPU milliseconds per buffer hex, patches, min
 // scaled Jacobian per block before and after, with 1 thread and with TBB's default; then the
-// same machinery over every hex (global, conform's global options); then the whole conform
+// same machinery over every hex (conform's global options, without the defect passes that
+// follow it in conform's global mode); then the whole conform
 // with its default options (smoothing seeded at the defects, conform's local options), timed.
 // Usage: bench_local_smooth [--defaults] [n] [target] [max_visits] [max_iterations] [model...]
 //        (defaults 4, LocalSmoothOptions' own, every demo model); --defaults: only the whole

@@ -505,7 +505,7 @@ void Conformer::add_smoothing(const primal::LocalSmoothResult& r) {
 // The worst-first smoother (primal/local_smooth.hpp); model boundary nodes slide on the diced
 // boundary. Local: patches seeded near the geode hexes, on the submesh around the seeds, so
 // the cost follows the interface (or, with the automatic target, its defects); global: every
-// hex.
+// hex, then the automatic passes wherever a hex is still below the yardstick.
 void Conformer::smooth() {
   t0_ = Clock::now();
   res_.smoothing.initial_min_scaled_jacobian = res_.min_scaled_jacobian_before_smoothing;
@@ -540,7 +540,10 @@ void Conformer::smooth() {
     add_smoothing(primal::smooth_hexes_local(mesh_, constraints, &surface, {}, o));
     sj_ = primal::scaled_jacobian_per_hex(mesh_);
     // The global target lifts the whole mesh a little, not a defect to the yardstick: the
-    // local passes follow wherever a hex is still below it.
+    // local passes follow wherever a hex is still below it. Their floors are measured on the
+    // globally smoothed mesh: from before it, the edges the global pass shortened would leave
+    // the defects no room. So the bounds add up over the two: a hex may lose `loss` in each,
+    // an edge shrink to half of half its length.
     primal::LocalSmoothOptions d = options_.local_smooth_options;
     d.progress = o.progress;
     smooth_defects(d);

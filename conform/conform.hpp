@@ -70,13 +70,13 @@ struct ConformOptions {
   // below this scaled Jacobian seed patches.
   double smooth_target = 0.0;
   ConformQuality quality = ConformQuality::kScaledJacobian;
-  // kLocal, and the untangling of hexes still inverted (with any mode); the automatic target
-  // replaces its target, goal and max_visits. A narrower margin and a larger loss than the
-  // primal defaults: hexes near the worst of a patch must give a little for it to rise (where
-  // every hex around a defect is within the margin of it, no patch can move), and the hexes
-  // around it may give up 0.2 (over all passes) so that it reaches the yardstick. More visits
-  // per hex for untangling and a fixed target: there a hex is lifted by its neighbours' moves
-  // within one call.
+  // kLocal, kGlobal's automatic passes, and the untangling of hexes still inverted (with any
+  // mode); the automatic target replaces its target, goal and max_visits. A narrower margin and
+  // a larger loss than the primal defaults: hexes near the worst of a patch must give a little
+  // for it to rise (where every hex around a defect is within the margin of it, no patch can
+  // move), and the hexes around it may give up 0.2 (over all passes) so that it reaches the
+  // yardstick. More visits per hex (4) for untangling and an explicit smooth_target, each a
+  // single call: there a hex is lifted by its neighbours' moves within it.
   primal::LocalSmoothOptions local_smooth_options = [] {
     primal::LocalSmoothOptions o;
     o.max_visits = 4;
