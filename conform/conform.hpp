@@ -58,8 +58,8 @@ struct ConformOptions {
   // plane, along their feature edge or on the diced boundary triangulation. kLocal: patches
   // seeded near the geode hexes (see smooth_target), on the submesh around them; kGlobal: by
   // every hex, with a higher target so that the diced parts are improved too, then kLocal's
-  // automatic passes wherever a hex is still below the yardstick; kNone: nothing
-  // but untangling the hexes the placement inverted, if any (ConformResult::placement_inverted).
+  // automatic passes wherever a hex is still below the yardstick; kNone: nothing but
+  // untangling the hexes the placement inverted, if any (ConformResult::placement_inverted).
   ConformSmooth smooth = ConformSmooth::kLocal;
   // kLocal. 0 (automatic): the defects are the hexes below the yardstick (the input's own hexes
   // and tets diced alone, ConformResult); patches start on them and the hexes sharing a node
