@@ -82,7 +82,8 @@ private:
   void interface_geometry();
   template <class Cells, class Edges, class Faces>
   void moving_part(const Cells& cells, const Edges& edges, const Faces& faces,
-                   const std::vector<FaceKey>& interface_faces);
+                   const std::vector<std::pair<Index, int>>& interface_faces);
+  void measure_before();
   void directions();
   void heights();
   void make_hexes();
@@ -106,6 +107,10 @@ private:
   GradedEdges quad_edges_;
   std::vector<Index> centre_of_;  // per input node: the quad it is the four-triangle centre of
   std::vector<Index> touched_;    // moving-part cells with a moved node (or a moved centre)
+  // Per touched cell, as input: a hex's corner and centre Jacobians and its scaled Jacobian,
+  // a tet's volume (in before_).
+  std::vector<std::array<double, 9>> jacobians_before_;
+  std::vector<double> before_;
 };
 
 void BufferBuilder::interface_geometry() {
@@ -133,21 +138,31 @@ void BufferBuilder::interface_geometry() {
 
 // The moving part's cells at moved nodes (with a four-triangle centre on the tet side), their
 // edges at moved nodes, and the part's outer boundary (faces used once that are not interface
-// faces), whose normals constrain the direction of a moved node on it.
+// faces, given as (cell, local face)), whose normals constrain the direction of a moved node on
+// it.
 template <class Cells, class Edges, class Faces>
 void BufferBuilder::moving_part(const Cells& cells, const Edges& edges, const Faces& faces,
-                                const std::vector<FaceKey>& interface_faces) {
+                                const std::vector<std::pair<Index, int>>& interface_faces) {
   constexpr std::size_t kFaceSize = std::tuple_size_v<typename Faces::value_type>;
+  const std::size_t nf = faces.size();
   auto face_nodes = [&](const auto& cell, const auto& fc) {
     std::array<Index, kFaceSize> f{};
     for (std::size_t i = 0; i < kFaceSize; ++i) f[i] = cell[static_cast<std::size_t>(fc[i])];
     return f;
   };
-  KeyMap<4> face_uses(cells.size() * faces.size() / 2);
-  for (const auto& cell : cells)
-    for (const auto& fc : faces) ++*face_uses.try_emplace(face_key(face_nodes(cell, fc)), 0).first;
-  for (const FaceKey& key : interface_faces)
-    if (Index* uses = face_uses.find(key)) *uses = -1;
+  // Each cell face numbered once (its id), with its number of uses; interface faces get -1.
+  KeyMap<4> ids(cells.size() * nf / 2);
+  std::vector<Index> face_id(cells.size() * nf);
+  std::vector<Index> uses;
+  for (std::size_t c = 0; c < cells.size(); ++c)
+    for (std::size_t f = 0; f < nf; ++f) {
+      const auto [id, fresh] = ids.try_emplace(face_key(face_nodes(cells[c], faces[f])), static_cast<Index>(uses.size()));
+      if (fresh) uses.push_back(0);
+      face_id[c * nf + f] = *id;
+      ++uses[static_cast<std::size_t>(*id)];
+    }
+  for (const auto& [cell, f] : interface_faces)
+    uses[static_cast<std::size_t>(face_id[static_cast<std::size_t>(cell) * nf + static_cast<std::size_t>(f)])] = -1;
   outer_normals_.assign(n_moved_, {});
   for (std::size_t c = 0; c < cells.size(); ++c) {
     const auto& cell = cells[c];
@@ -161,15 +176,28 @@ void BufferBuilder::moving_part(const Cells& cells, const Edges& edges, const Fa
       for (Index v : {a, b})
         if (moved(v)) shortest_[slot(v)] = std::min(shortest_[slot(v)], len);
     }
-    for (const auto& fc : faces) {
-      const auto f = face_nodes(cell, fc);
-      const Index* uses = face_uses.find(face_key(f));
-      if (!uses || *uses != 1) continue;  // inner or interface face
+    for (std::size_t k = 0; k < nf; ++k) {
+      if (uses[static_cast<std::size_t>(face_id[c * nf + k])] != 1) continue;  // inner or interface face
+      const auto f = face_nodes(cell, faces[k]);
       // Twice the outward area vector (triangle or quad: the cross product of the diagonals).
       const Point area = kFaceSize == 3 ? Point((pt(f[1]) - pt(f[0])).cross(pt(f[2]) - pt(f[0])))
                                         : Point((pt(f[2]) - pt(f[0])).cross(pt(f[kFaceSize - 1]) - pt(f[1])));
       for (Index v : f)
         if (moved(v)) outer_normals_[slot(v)].push_back(area);
+    }
+  }
+}
+
+void BufferBuilder::measure_before() {
+  for (Index c : touched_) {
+    if (hex_side_) {
+      HexCorners corners;
+      for (std::size_t i = 0; i < 8; ++i) corners[i] = pt(input_.hexes[static_cast<std::size_t>(c)][i]);
+      jacobians_before_.push_back(hex_jacobians(corners));
+      before_.push_back(hex_scaled_jacobian(corners));
+    } else {
+      const auto& tet = input_.tets[static_cast<std::size_t>(c)];
+      before_.push_back(tet_volume(pt(tet[0]), pt(tet[1]), pt(tet[2]), pt(tet[3])));
     }
   }
 }
@@ -310,54 +338,50 @@ std::string BufferBuilder::check(std::vector<char>& failing) {
     }
   };
   std::string first_failure;
-  auto keeps_only = [&](ElementKind kind, Index c, double ratio, Index v) {
+  auto keeps_only = [&](ElementKind kind, Index c, double ratio, const char* what, Index v) {
     if (first_failure.empty())
       first_failure = describe_node(input_, v) + ": " + describe_element(input_, {kind, c}) + " keeps only " +
-                      std::to_string(ratio) + " of its volume";
+                      std::to_string(ratio) + " of its " + what;
   };
   out_.report.min_volume_ratio = 1.0;
   out_.report.min_scaled_jacobian = 1.0;
   if (hex_side_) {
     // A hex's volume near each corner is its corner Jacobian; the ratio is the least over the
     // corners and the centre.
-    for (Index h : touched_) {
+    for (std::size_t i = 0; i < touched_.size(); ++i) {
+      const Index h = touched_[i];
       const auto& hex = input_.hexes[static_cast<std::size_t>(h)];
-      HexCorners before, after;
-      for (std::size_t i = 0; i < 8; ++i) {
-        before[i] = pt(hex[i]);
-        after[i] = pts[static_cast<std::size_t>(hex[i])];
-      }
-      const auto jb = hex_jacobians(before), ja = hex_jacobians(after);
+      HexCorners after;
+      for (std::size_t k = 0; k < 8; ++k) after[k] = pts[static_cast<std::size_t>(hex[k])];
+      const auto& jb = jacobians_before_[i];
+      const auto ja = hex_jacobians(after);
       double ratio = std::numeric_limits<double>::infinity();
-      for (std::size_t i = 0; i < 9; ++i)
-        if (jb[i] > 0.0) ratio = std::min(ratio, ja[i] / jb[i]);
+      for (std::size_t k = 0; k < 9; ++k)
+        if (jb[k] > 0.0) ratio = std::min(ratio, ja[k] / jb[k]);
       out_.report.min_volume_ratio = std::min(out_.report.min_volume_ratio, ratio);
-      const double sj_before = hex_scaled_jacobian(before);
-      const double sj_ratio = sj_before > 0.0 ? hex_scaled_jacobian(after) / sj_before : 1.0;
+      const double sj_ratio = before_[i] > 0.0 ? hex_scaled_jacobian(after) / before_[i] : 1.0;
       if (ratio < opt_.min_volume_ratio || sj_ratio < opt_.min_hex_quality_ratio) {
         for (Index v : hex) fail_node(v);
+        const bool volume = ratio < opt_.min_volume_ratio;
         for (Index v : hex)
-          if (moved(v)) {
-            if (ratio < opt_.min_volume_ratio)
-              keeps_only(ElementKind::Hex, h, ratio, v);
-            else if (first_failure.empty())
-              first_failure = describe_node(input_, v) + ": " + describe_element(input_, {ElementKind::Hex, h}) +
-                              " keeps only " + std::to_string(sj_ratio) + " of its scaled Jacobian";
-          }
+          if (moved(v))
+            keeps_only(ElementKind::Hex, h, volume ? ratio : sj_ratio, volume ? "volume" : "scaled Jacobian", v);
       }
     }
   } else {
-    for (Index t : touched_) {
+    for (std::size_t i = 0; i < touched_.size(); ++i) {
+      const Index t = touched_[i];
       const auto& tet = input_.tets[static_cast<std::size_t>(t)];
       const auto& now = out_.model.tets[static_cast<std::size_t>(t)];
       const double ratio = tet_volume(pts[static_cast<std::size_t>(now[0])], pts[static_cast<std::size_t>(now[1])],
                                       pts[static_cast<std::size_t>(now[2])], pts[static_cast<std::size_t>(now[3])]) /
-                           tet_volume(pt(tet[0]), pt(tet[1]), pt(tet[2]), pt(tet[3]));
+                           before_[i];
       out_.report.min_volume_ratio = std::min(out_.report.min_volume_ratio, ratio);
       if (ratio < opt_.min_volume_ratio) {
         for (Index v : now) fail_node(v);
         for (Index v : tet)
-          if (moved(v) || centre_of_[static_cast<std::size_t>(v)] != kInvalidIndex) keeps_only(ElementKind::Tet, t, ratio, v);
+          if (moved(v) || centre_of_[static_cast<std::size_t>(v)] != kInvalidIndex)
+            keeps_only(ElementKind::Tet, t, ratio, "volume", v);
       }
     }
   }
@@ -372,18 +396,19 @@ std::string BufferBuilder::check(std::vector<char>& failing) {
       const Point bottom = (c[0] + c[1] + c[2] + c[3]) / 4.0;
       for (std::size_t i = 0; i < 4; ++i) {
         const Point a = c[4 + i] - bottom, e = c[4 + (i + 1) % 4] - bottom, m = top - bottom;
-        sj = std::min(sj, a.cross(e).dot(m) / (a.norm() * e.norm() * m.norm()));
+        sj = std::min(sj, scaled_determinant(a, e, m));
       }
     }
     out_.report.min_scaled_jacobian = std::min(out_.report.min_scaled_jacobian, sj);
     if (sj < opt_.min_scaled_jacobian)
       for (std::size_t i = 4; i < 8; ++i) {
         failing[static_cast<std::size_t>(b.corners[i]) - n_points_] = 1;
-        if (first_failure.empty())
-          first_failure = "node " + std::to_string(b.corners[i - 4]) + ": the buffer hex on hex " +
-                          std::to_string(itf_.quads[static_cast<std::size_t>(b.quad)].hex) + " face " +
-                          std::to_string(itf_.quads[static_cast<std::size_t>(b.quad)].face) +
+        if (first_failure.empty()) {
+          const InterfaceQuad& q = itf_.quads[static_cast<std::size_t>(b.quad)];
+          first_failure = describe_node(input_, b.corners[i - 4]) + ": the buffer hex on face " +
+                          std::to_string(q.face + 1) + " of " + describe_element(input_, {ElementKind::Hex, q.hex}) +
                           " has scaled Jacobian " + std::to_string(sj);
+        }
       }
   }
   return first_failure;
@@ -428,15 +453,17 @@ BufferLayer BufferBuilder::run() {
   for (std::size_t k = 0; k < n_moved_; ++k)
     out_.top_node[static_cast<std::size_t>(itf_.nodes[k])] = static_cast<Index>(n_points_ + k);
   interface_geometry();
-  std::vector<FaceKey> interface_faces;
-  if (hex_side_) {
-    for (const InterfaceQuad& q : itf_.quads) interface_faces.push_back(face_key(q.corners));
-    moving_part(input_.hexes, topology::kHexEdgeCorners, topology::kHexFaceCorners, interface_faces);
-  } else {
-    for (const InterfaceQuad& q : itf_.quads)
-      for (const auto& tri : interface_triangles(q)) interface_faces.push_back(face_key(tri));
-    moving_part(input_.tets, topology::kTetEdgeCorners, topology::kTetFaceCorners, interface_faces);
+  std::vector<std::pair<Index, int>> interface_faces;  // (cell, local face) of the moving part
+  for (const InterfaceQuad& q : itf_.quads) {
+    if (hex_side_) interface_faces.emplace_back(q.hex, q.face);
+    else
+      for (int i = 0; i < q.triangle_count(); ++i) interface_faces.emplace_back(q.tets[i], q.tet_faces[i]);
   }
+  if (hex_side_)
+    moving_part(input_.hexes, topology::kHexEdgeCorners, topology::kHexFaceCorners, interface_faces);
+  else
+    moving_part(input_.tets, topology::kTetEdgeCorners, topology::kTetFaceCorners, interface_faces);
+  measure_before();
   directions();
   heights();
   make_hexes();

@@ -66,8 +66,8 @@ struct BufferLayerOptions {
   // A node whose faces meet at an edge or corner moves height / cos along the direction d
   // (cos = min over its corner normals n of d . n, the mitred offset), cos at least this.
   double min_mitre_cos = 0.5;
-  // Every moved element keeps at least this fraction of its volume (a hex: at every corner,
-  // its corner Jacobian's fraction).
+  // Every moved element keeps at least this fraction of its volume (a hex: at every corner and
+  // at its centre, its Jacobian's fraction there).
   double min_volume_ratio = 0.05;
   // Every moved hex keeps at least this fraction of its scaled Jacobian (one that was not
   // positive is not held to it). A cube touching the interface at one concave corner only, that
