@@ -32,7 +32,7 @@ MeshFile read_mesh_file(const fs::path& path) {
                        "' (expected .vtu, .vtk, .msh, .exo or .e)");
   MeshFile m;
   if (format == primal::MeshFileFormat::kVtu || format == primal::MeshFileFormat::kVtk) {
-    const primal::VtkGrid g = format == primal::MeshFileFormat::kVtu ? primal::read_vtu(path) : primal::read_vtk(path);
+    const primal::VtkGrid g = primal::read_vtk_file(path);
     const bool quads = !g.cell_types.empty() && std::all_of(g.cell_types.begin(), g.cell_types.end(),
                                                              [](int t) { return t == primal::kVtkQuad; });
     if (quads) {

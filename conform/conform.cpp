@@ -5,7 +5,6 @@
 #include <limits>
 #include <map>
 #include <numeric>
-#include <optional>
 #include <span>
 #include <sstream>
 #include <unordered_map>
@@ -582,15 +581,15 @@ void Conformer::smooth_defects(primal::LocalSmoothOptions o) {
   std::vector<Index> defects;
   for (std::size_t h = 0; h < sj_.size(); ++h)
     if (sj_[h] < yardstick) defects.push_back(static_cast<Index>(h));
-  std::optional<primal::SmoothStart> start;  // the floors hold over all passes
+  if (defects.empty()) return;
+  const primal::SmoothStart start{sj_, primal::shortest_edge_per_hex(mesh_)};  // floors over all passes
+  o.goal = yardstick;
+  o.max_visits = kDefectVisits;
   for (int pass = 0; pass < kDefectPasses && !defects.empty(); ++pass) {
     std::vector<Index> seeds = defects;
     for (int ring = 0; ring < kDefectRings; ++ring) seeds = primal::hexes_around(mesh_, seeds);
     o.target = kDefectTarget * yardstick + pass * kDefectTargetStep;
-    o.goal = yardstick;
-    o.max_visits = kDefectVisits;
-    if (!start) start = primal::SmoothStart{sj_, primal::shortest_edge_per_hex(mesh_)};
-    const auto r = primal::smooth_hexes_around(mesh_, seeds, o, primal::kFeatureAngle, &*start);
+    const auto r = primal::smooth_hexes_around(mesh_, seeds, o, primal::kFeatureAngle, &start);
     add_smoothing(r);
     measure(r.region);
     defects.clear();

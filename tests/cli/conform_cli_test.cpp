@@ -15,6 +15,7 @@
 #include "primal/io_gmsh.hpp"
 #include "primal/validity.hpp"
 #include "support/cli_run.hpp"
+#include "support/fixtures.hpp"
 #include "conform/conform.hpp"
 
 using namespace geode;
@@ -131,10 +132,7 @@ TEST_CASE("geode conform: a warning reaches stderr with --quiet, and the report 
   // nodes on the block's flat top cannot move below the interface), so conform carves it from
   // the tet part and warns.
   TempDir dir;
-  primal::Model m = primal::grid_model({2, 2, 2}, 1.0, [](int i, int j, int k) { return i == 0 && j == 0 && k == 1; });
-  std::erase_if(m.hexes, [&](const auto& h) { return m.points[static_cast<std::size_t>(h[0])].z() > 0.5; });
-  m.hex_block.assign(m.hexes.size(), 1);
-  primal::write_gmsh(m, dir.path / "in.msh");
+  primal::write_gmsh(test::tet_cell_on_hex_top(), dir.path / "in.msh");
   const fs::path report = dir.path / "r.json";
   const Run r = geode_cli("conform " + (dir.path / "in.msh").string() + " -o " + (dir.path / "out.exo").string() +
                           " --report " + report.string() + " --quiet");

@@ -110,10 +110,7 @@ TEST_CASE("a tet part over part of a hex face: carved from the tet part when the
   // interface quad's corners and edges are on the hex part's flat top (or its crease with a
   // side), where their hex-side copies could only slide in that plane, never below the
   // interface; the tet part's copies move up the tet cell's edges.
-  primal::Model m = primal::grid_model({2, 2, 2}, 1.0, [](int i, int j, int k) { return i == 0 && j == 0 && k == 1; });
-  // Only the bottom layer of hexes: the tet cell stands alone on the hex block's top.
-  std::erase_if(m.hexes, [&](const auto& h) { return m.points[static_cast<std::size_t>(h[0])].z() > 0.5; });
-  m.hex_block.assign(m.hexes.size(), 1);
+  const primal::Model m = test::tet_cell_on_hex_top();
   const primal::Interface itf = primal::find_interface(m);
   REQUIRE(itf.quads.size() == 1);
   CHECK_THROWS_WITH_AS(conform::insert_buffer_layer(m, itf), doctest::Contains("no direction into the hex side"),

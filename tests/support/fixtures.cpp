@@ -156,4 +156,11 @@ primal::Model four_tet_fan(const primal::Point& centre, const primal::Point& ape
   return m;
 }
 
+primal::Model tet_cell_on_hex_top() {
+  primal::Model m = primal::grid_model({2, 2, 2}, 1.0, [](int i, int j, int k) { return i == 0 && j == 0 && k == 1; });
+  std::erase_if(m.hexes, [&](const auto& h) { return m.points[static_cast<std::size_t>(h[0])].z() > 0.5; });
+  m.hex_block.assign(m.hexes.size(), 1);
+  return m;
+}
+
 }  // namespace geode::test

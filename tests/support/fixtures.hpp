@@ -44,4 +44,9 @@ primal::QuadMesh boundary_quads(const primal::HexMesh& mesh,
 // (block 2) with apex node 9 at `apex`: the smallest four-triangle interface.
 primal::Model four_tet_fan(const primal::Point& centre, const primal::Point& apex);
 
+// A tet cell (primal::grid_model's six tets, block 2) standing alone on the top of a 2 x 2 x 1
+// hex block (block 1): the one interface quad lies on the hex block's flat top, so no buffer
+// layer can be carved from the hex part there.
+primal::Model tet_cell_on_hex_top();
+
 }  // namespace geode::test
