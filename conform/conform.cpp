@@ -215,8 +215,13 @@ void Conformer::insert_buffer() {
       throw TopologyError(std::string(e.what()) + "; from the " + second + " part: " + e2.what());
     }
     res_.buffer_side = other.side;
-    res_.warnings.push_back(std::string("buffer layer carved from the ") + second + " part, not the " + first +
-                            " part: " + e.what());
+    const std::string thickness =
+        options_.buffer.thickness > 0.0
+            ? " (its default thickness " + std::to_string(default_buffer_thickness(other.side)) + ", not the " +
+                  std::to_string(options_.buffer.thickness) + " given)"
+            : "";
+    res_.warnings.push_back(std::string("buffer layer carved from the ") + second + " part" + thickness +
+                            ", not the " + first + " part: " + e.what());
   }
   carved_from_.reserve(layer_.hexes.size());
   for (const BufferHex& b : layer_.hexes) {

@@ -124,6 +124,14 @@ TEST_CASE("a tet part over part of a hex face: carved from the tet part when the
   conform::ConformOptions strict;
   strict.buffer_fallback = false;
   CHECK_THROWS_AS(conform::conform(m, strict), TopologyError);
+  // A thickness given for the hex part does not carry over: the warning says so.
+  conform::ConformOptions thick;
+  thick.buffer.thickness = 0.6;
+  const auto rt = conform::conform(m, thick);
+  CHECK(rt.buffer_side == conform::BufferSide::kTet);
+  REQUIRE(rt.warnings.size() == 1);
+  CHECK(rt.warnings[0].find("carved from the tet part (its default thickness 0.3") != std::string::npos);
+  CHECK(rt.warnings[0].find("not the 0.6") != std::string::npos);
 }
 
 // conform builds the templates in parallel: each box and diagonal is built once, whichever
