@@ -1,7 +1,7 @@
 // Whole-process time and peak memory of `geode conform` with its default options next to
 // gmsh's all-hex subdivision of the same tet part (the Speed and memory case).
 //
-// The model is conform::demo_delaunay_block(n): structured hexes [0,1]^3 (n^3) beside a Gmsh
+// The model is demo::demo_delaunay_block(n): structured hexes [0,1]^3 (n^3) beside a Gmsh
 // Delaunay tet box [1,2] x [0,1]^2 with alternating interface diagonals (n = 26: about 200k
 // tets). It is written to a temporary directory twice, as
 // binary .msh v4.1: the whole model (geode's input) and its tet part alone, compacted (gmsh's
@@ -37,9 +37,9 @@
 #include <string>
 #include <vector>
 
-#include "conform/demo_models.hpp"
+#include "demo/demo_models.hpp"
 #include "primal/errors.hpp"
-#include "primal/io_gmsh.hpp"
+#include "io/gmsh.hpp"
 
 namespace fs = std::filesystem;
 namespace gp = geode::primal;
@@ -160,7 +160,7 @@ int main(int argc, char** argv) {
   }
   const fs::path dir = dir_template;
 
-  const gp::Model model = geode::conform::demo_delaunay_block(n);
+  const gp::Model model = geode::demo::demo_delaunay_block(n);
   gp::write_gmsh(model, dir / "model.msh", gp::GmshFormat::Binary);
   gp::write_gmsh(tet_model(model), dir / "tets.msh", gp::GmshFormat::Binary);
   std::printf("n %d: %zu hexes + %zu tets (%zu nodes); inputs in %s\n", n, model.hexes.size(),

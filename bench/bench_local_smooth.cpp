@@ -1,5 +1,5 @@
 // The worst-first local smoother (primal/local_smooth.hpp) on conform's output before smoothing,
-// for every demo model (conform/demo_models.hpp): CPU milliseconds per buffer hex, patches, min
+// for every demo model (demo/demo_models.hpp): CPU milliseconds per buffer hex, patches, min
 // scaled Jacobian per block before and after, with 1 thread and with TBB's default; then the
 // same machinery over every hex (conform's global options, without the defect passes that
 // follow it in conform's global mode); then the whole conform
@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "conform/conform.hpp"
-#include "conform/demo_models.hpp"
+#include "demo/demo_models.hpp"
 #include "primal/local_smooth.hpp"
 #include "primal/quality.hpp"
 
@@ -94,7 +94,7 @@ int main(int argc, char** argv) {
   if (defaults_only) --argc, ++argv;
   const int n = argc > 1 ? std::atoi(argv[1]) : 4;
   std::vector<std::string> models(argv + std::min(argc, 5), argv + argc);
-  const auto names = conform::demo_model_names();
+  const auto names = demo::demo_model_names();
   const bool known = std::all_of(models.begin(), models.end(), [&](const std::string& m) {
     return std::find(names.begin(), names.end(), m) != names.end();
   });
@@ -114,7 +114,7 @@ int main(int argc, char** argv) {
     std::printf("n %d, target %.2f, max_visits %d, max_iterations %d\n", n, o.target, o.max_visits,
                 o.max_iterations);
   for (const std::string& name : models) {
-    const primal::Model input = conform::demo_model(name, n);
+    const primal::Model input = demo::demo_model(name, n);
     if (defaults_only)
       std::printf("%s %d:\n", name.c_str(), n);
     else

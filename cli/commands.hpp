@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "primal/io_html.hpp"
+#include "viewer/html.hpp"
 #include "primal/model.hpp"
 #include "primal/smooth.hpp"
 #include "stc/arrangement.hpp"
@@ -31,7 +31,7 @@ void add_arrange_command(CLI::App& app);    // cli/arrange_command.cpp
 void add_view_command(CLI::App& app);       // cli/view_command.cpp
 
 // Shared by the commands (cli/files.cpp): the extension in lower case (".msh"), and a model
-// read by extension and checked content (primal/read_model.hpp: .msh, .exo, .e, .vtu, .vtk);
+// read by extension and checked content (io/read_model.hpp: .msh, .exo, .e, .vtu, .vtk);
 // InvalidInput naming the file when it is missing or of another format.
 std::string file_extension(const std::filesystem::path& p);
 primal::Model read_model(const std::filesystem::path& path);
@@ -49,7 +49,7 @@ MeshFile read_mesh_file(const std::filesystem::path& path);
 // The sheets of a computed arrangement for the HTML viewer (cli/view_command.cpp): each sheet
 // contoured from its field inside the domain (stc/sheet_surfaces.hpp), its points mapped by
 // `to_physical` (identity when empty), and its layer read off the dual's element_sheets.
-std::vector<primal::ViewSheet> arrangement_view_sheets(const std::vector<stc::Sheet>& sheets, const stc::Domain& domain,
+std::vector<viewer::ViewSheet> arrangement_view_sheets(const std::vector<stc::Sheet>& sheets, const stc::Domain& domain,
                                                        const std::vector<std::vector<int>>& element_sheets,
                                                        const std::function<primal::Point(const primal::Point&)>& to_physical);
 

@@ -11,7 +11,7 @@
 #include "cli/conventions.hpp"
 #include "cli/progress.hpp"
 #include "conform/conform.hpp"
-#include "conform/demo_models.hpp"
+#include "demo/demo_models.hpp"
 #include "primal/errors.hpp"
 #include "primal/quality.hpp"
 #include "primal/quality_report.hpp"
@@ -200,7 +200,7 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
     if (!a.output.empty())
       files.add(a.output, [&](const fs::path& temp) {
         write_mesh(r.model, temp, format,
-                   a.vtu_encoding == "ascii" ? primal::VtuEncoding::kAscii : primal::VtuEncoding::kBinary);
+                   a.vtu_encoding == "ascii" ? io::VtuEncoding::kAscii : io::VtuEncoding::kBinary);
       });
     if (!a.report.empty()) {
       files.add(a.report, [text = result_json(r).dump(2) + "\n"](const fs::path& temp) {
@@ -318,7 +318,7 @@ void add_conform_commands(CLI::App& app) {
                  "imprinted on three nugget faces, those blocks swept from unstructured quads; fourtri:\n"
                  "beside a Delaunay tet box whose interface quads are split into two or four triangles\n"
                  "(at random); fourtri-cylinder: the cylinder with half its interface quads in four triangles")
-      ->check(CLI::IsMember(conform::demo_model_names()))
+      ->check(CLI::IsMember(demo::demo_model_names()))
       ->capture_default_str();
   d->add_option("-n,--size", dargs->n, "cells per unit length (1 to 64; default 4; nugget, fulcher round up to even)")
       ->check(number_check(1, 64, true));
@@ -333,12 +333,12 @@ void add_conform_commands(CLI::App& app) {
       check_output_path(dargs->save_input);
       save_format = output_format(dargs->save_input, "", kMeshFormats, "");
     }
-    primal::Model model = conform::demo_model(dargs->model, dargs->n);
+    primal::Model model = demo::demo_model(dargs->model, dargs->n);
     if (!dargs->save_input.empty()) {
       OutputFiles files;
       files.add(dargs->save_input, [&](const fs::path& temp) {
         write_mesh(model, temp, save_format,
-                   dargs->vtu_encoding == "ascii" ? primal::VtuEncoding::kAscii : primal::VtuEncoding::kBinary);
+                   dargs->vtu_encoding == "ascii" ? io::VtuEncoding::kAscii : io::VtuEncoding::kBinary);
       });
       files.commit();
       if (!dargs->quiet)

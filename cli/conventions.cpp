@@ -11,8 +11,8 @@
 
 #include "cli/commands.hpp"
 #include "primal/errors.hpp"
-#include "primal/io_exodus.hpp"
-#include "primal/io_gmsh.hpp"
+#include "io/exodus.hpp"
+#include "io/gmsh.hpp"
 
 #ifndef GEODE_VERSION
 #define GEODE_VERSION "unknown"
@@ -171,12 +171,12 @@ void check_output_path(const std::string& path) {
 }
 
 void write_mesh(const primal::Model& model, const fs::path& path, const std::string& format,
-                primal::VtuEncoding vtu) {
-  if (format == "exo") return primal::write_exodus(model, path);
-  if (format == "msh") return primal::write_gmsh(model, path);
-  if (format == "msh22") return primal::write_gmsh(model, path, primal::GmshFormat::Ascii, primal::GmshVersion::k22);
-  if (format == "vtu") return primal::write_vtu(path, model, {}, vtu);
-  if (format == "vtk") return primal::write_vtk(path, model);
+                io::VtuEncoding vtu) {
+  if (format == "exo") return io::write_exodus(model, path);
+  if (format == "msh") return io::write_gmsh(model, path);
+  if (format == "msh22") return io::write_gmsh(model, path, io::GmshFormat::Ascii, io::GmshVersion::k22);
+  if (format == "vtu") return io::write_vtu(path, model, {}, vtu);
+  if (format == "vtk") return io::write_vtk(path, model);
   throw InvalidInput(path.string() + ": '" + format + "' is not a mesh format");
 }
 

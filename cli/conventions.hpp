@@ -23,7 +23,7 @@
 #include <string>
 #include <vector>
 
-#include "primal/io_vtk.hpp"
+#include "io/vtk.hpp"
 #include "primal/model.hpp"
 
 namespace geode::cli {
@@ -68,7 +68,7 @@ void check_output_path(const std::string& path);
 
 // Writes a model in a mesh format; `vtu` is the encoding for .vtu.
 void write_mesh(const primal::Model& model, const std::filesystem::path& path,
-                const std::string& format, primal::VtuEncoding vtu = primal::VtuEncoding::kBinary);
+                const std::string& format, io::VtuEncoding vtu = io::VtuEncoding::kBinary);
 
 // Several outputs written as one: each goes to a temporary file next to its target (same
 // extension, so writers that go by it still work), and only when all are written are they

@@ -11,7 +11,7 @@
 #include "cli/commands.hpp"
 #include "cli/conventions.hpp"
 #include "primal/errors.hpp"
-#include "primal/io_vtk.hpp"
+#include "io/vtk.hpp"
 #include "primal/model.hpp"
 #include "stc/arrangement.hpp"
 #include "stc/dualize.hpp"
@@ -149,9 +149,9 @@ void run_dual(const DualArgs& a) {
   OutputFiles files;
   if (!a.rebuild.empty())
     files.add(a.rebuild, [&](const fs::path& temp) {
-      const auto vtu = a.vtu_encoding == "ascii" ? primal::VtuEncoding::kAscii : primal::VtuEncoding::kBinary;
+      const auto vtu = a.vtu_encoding == "ascii" ? io::VtuEncoding::kAscii : io::VtuEncoding::kBinary;
       if (m.dim == 2) {
-        rebuild_format == "vtu" ? primal::write_vtu(temp, D.quad, {}, vtu) : primal::write_vtk(temp, D.quad);
+        rebuild_format == "vtu" ? io::write_vtu(temp, D.quad, {}, vtu) : io::write_vtk(temp, D.quad);
       } else {
         primal::Model model;
         model.points = D.hex.points;

@@ -4,13 +4,13 @@
 #include <iostream>
 
 #include "cli/commands.hpp"
-#include "primal/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 #include "primal/errors.hpp"
-#include "primal/file_format.hpp"
-#include "primal/io_exodus.hpp"
-#include "primal/io_gmsh.hpp"
-#include "primal/io_vtk.hpp"
-#include "primal/read_model.hpp"
+#include "io/file_format.hpp"
+#include "io/exodus.hpp"
+#include "io/gmsh.hpp"
+#include "io/vtk.hpp"
+#include "io/read_model.hpp"
 
 namespace geode::cli {
 
@@ -22,28 +22,28 @@ std::string file_extension(const fs::path& p) {
   return e;
 }
 
-primal::Model read_model(const fs::path& path) { return primal::read_model(path); }
+primal::Model read_model(const fs::path& path) { return io::read_model(path); }
 
 MeshFile read_mesh_file(const fs::path& path) {
   if (!fs::exists(path)) throw InvalidInput(path.string() + ": no such file");
-  const primal::MeshFileFormat format = primal::mesh_format_from_extension(path);
-  if (format == primal::MeshFileFormat::kUnknown)
+  const io::MeshFileFormat format = io::mesh_format_from_extension(path);
+  if (format == io::MeshFileFormat::kUnknown)
     throw InvalidInput(path.string() + ": unknown input format '" + file_extension(path) +
                        "' (expected .vtu, .vtk, .msh, .exo or .e)");
   MeshFile m;
-  if (format == primal::MeshFileFormat::kVtu || format == primal::MeshFileFormat::kVtk) {
-    const primal::VtkGrid g = primal::read_vtk_file(path);
+  if (format == io::MeshFileFormat::kVtu || format == io::MeshFileFormat::kVtk) {
+    const io::VtkGrid g = io::read_vtk_file(path);
     const bool quads = !g.cell_types.empty() && std::all_of(g.cell_types.begin(), g.cell_types.end(),
-                                                             [](int t) { return t == primal::kVtkQuad; });
+                                                             [](int t) { return t == io::kVtkQuad; });
     if (quads) {
       m.dim = 2;
-      m.quad = primal::to_quad_mesh(g);
+      m.quad = io::to_quad_mesh(g);
       for (std::size_t n = 0; n < m.quad.points.size(); ++n)
         if (m.quad.points[n].z() != 0.0)
           throw InvalidInput(path.string() + ": node " + std::to_string(n) +
                              " has z != 0: a quad mesh must lie in the plane z = 0");
     } else {
-      m.hex = primal::to_hex_mesh(g);  // names the first cell that is not a hex
+      m.hex = io::to_hex_mesh(g);  // names the first cell that is not a hex
     }
     return m;
   }
@@ -61,7 +61,7 @@ void write_or_print(const std::string& path, const std::function<void(std::ostre
     write(std::cout);
     return;
   }
-  primal::write_file_atomically(path, write);
+  io::write_file_atomically(path, write);
 }
 
 }  // namespace geode::cli

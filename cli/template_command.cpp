@@ -12,8 +12,8 @@
 #include "cli/conventions.hpp"
 #include "primal/boundary.hpp"
 #include "primal/errors.hpp"
-#include "primal/io_html.hpp"
-#include "primal/io_vtk.hpp"
+#include "viewer/html.hpp"
+#include "io/vtk.hpp"
 #include "primal/model.hpp"
 #include "primal/quality.hpp"
 #include "primal/quality_report.hpp"
@@ -147,7 +147,7 @@ nlohmann::json to_json(const templates::Template& T, const std::string& name) {
 // mapped as the nodes are (Figure 7 of the paper), each sheet's layer of hexes, and the tet and
 // hex sides as face groups (Figure 1, left).
 void write_template_html(const TemplateOutput& a, const templates::Template& T, const std::string& smooth_note) {
-  primal::ViewScene scene;
+  viewer::ViewScene scene;
   scene.title = "geode template " + a.name;
   scene.caption = (a.caption.empty() ? a.name + ", " + a.title : a.caption) + ": " +
                   std::to_string(T.dim == 3 ? T.hex.hexes.size() : T.quad.quads.size()) +
@@ -156,10 +156,10 @@ void write_template_html(const TemplateOutput& a, const templates::Template& T, 
                   "like the nodes; the smoothed hexes need not follow them. Layers: the hexes dual to each sheet.";
   scene.sheets = arrangement_view_sheets(a.sheets, a.domain, T.element_sheets, a.to_physical);
   if (T.dim == 2) {
-    primal::write_html(a.output, T.quad, scene);
+    viewer::write_html(a.output, T.quad, scene);
     return;
   }
-  primal::ViewFaceGroup tet{"tet side", {}}, hex{"hex side", {}};
+  viewer::ViewFaceGroup tet{"tet side", {}}, hex{"hex side", {}};
   for (const auto& q : primal::boundary_quads(T.hex)) {
     unsigned common = ~0u;
     for (auto n : q.nodes) common &= T.node_faces[static_cast<std::size_t>(n)];
@@ -167,7 +167,7 @@ void write_template_html(const TemplateOutput& a, const templates::Template& T, 
     if (common & (1u << stc::box_face(1, false))) hex.quads.push_back(q.nodes);
   }
   scene.groups = {tet, hex};
-  primal::write_html(a.output, T.hex, scene);
+  viewer::write_html(a.output, T.hex, scene);
 }
 
 const std::vector<std::string> kTemplateFormats{"appendix", "csv", "json", "vtu", "vtk", "msh", "msh22", "exo", "spec", "html"};
@@ -314,11 +314,11 @@ void write_template(templates::Template& T, const TemplateOutput& a) {
     // The mesh goes to the file (the writers add the scaled Jacobian cell array); the quality
     // tables, if asked for, to standard output.
     if (a.output.empty()) throw InvalidInput("--format " + a.format + " needs -o FILE");
-    const auto vtu = a.vtu_encoding == "ascii" ? primal::VtuEncoding::kAscii : primal::VtuEncoding::kBinary;
+    const auto vtu = a.vtu_encoding == "ascii" ? io::VtuEncoding::kAscii : io::VtuEncoding::kBinary;
     if (dim == 2) {
       if (a.format != "vtu" && a.format != "vtk")
         throw InvalidInput(a.output + ": a quad mesh is written as .vtu or .vtk");
-      a.format == "vtu" ? primal::write_vtu(a.output, T.quad, {}, vtu) : primal::write_vtk(a.output, T.quad);
+      a.format == "vtu" ? io::write_vtu(a.output, T.quad, {}, vtu) : io::write_vtk(a.output, T.quad);
     } else {
       primal::Model m;
       m.points = T.hex.points;

@@ -1,5 +1,5 @@
 // geode view MESH -o FILE.html: any hex (or planar quad) mesh as a self-contained HTML viewer
-// (primal/io_html.hpp) with its sheets: each sheet of the mesh's dual (stc/mesh_dual.hpp) shown
+// (viewer/html.hpp) with its sheets: each sheet of the mesh's dual (stc/mesh_dual.hpp) shown
 // as the dual surface through its layer of hexes (stc/sheet_surfaces.hpp). Also the helper the
 // template (and arrangement) commands use for sheets given as fields.
 #include <filesystem>
@@ -14,10 +14,10 @@
 
 namespace geode::cli {
 
-std::vector<primal::ViewSheet> arrangement_view_sheets(const std::vector<stc::Sheet>& sheets, const stc::Domain& domain,
+std::vector<viewer::ViewSheet> arrangement_view_sheets(const std::vector<stc::Sheet>& sheets, const stc::Domain& domain,
                                                        const std::vector<std::vector<int>>& element_sheets,
                                                        const std::function<primal::Point(const primal::Point&)>& to_physical) {
-  std::vector<primal::ViewSheet> out(sheets.size());
+  std::vector<viewer::ViewSheet> out(sheets.size());
   for (std::size_t s = 0; s < sheets.size(); ++s) out[s].name = sheets[s].name, out[s].kind = sheets[s].kind;
   if (domain.dim == 3) {
     auto surfaces = stc::contour_sheets(sheets, domain);
@@ -51,11 +51,11 @@ struct ViewArgs {
 
 // Sheets named as `geode dual` numbers them (0-based, first appearance), so the two agree.
 template <class Mesh, class Surfaces>
-std::vector<primal::ViewSheet> mesh_view_sheets(const Mesh& mesh, const Surfaces& make_surfaces) {
+std::vector<viewer::ViewSheet> mesh_view_sheets(const Mesh& mesh, const Surfaces& make_surfaces) {
   const auto dual = stc::mesh_dual(mesh);
   auto shapes = make_surfaces(mesh, dual);
   const auto layers = stc::sheet_layers(dual);
-  std::vector<primal::ViewSheet> out(dual.sheets.size());
+  std::vector<viewer::ViewSheet> out(dual.sheets.size());
   for (std::size_t s = 0; s < out.size(); ++s) {
     out[s].name = "sheet " + std::to_string(s);
     out[s].kind = "mesh";
@@ -71,7 +71,7 @@ void run_view(const ViewArgs& a) {
   if (file_extension(out) != ".html")
     throw InvalidInput(a.output + ": unknown output format '" + file_extension(out) + "' (expected .html)");
   const MeshFile m = read_mesh_file(a.input);
-  primal::ViewScene scene;
+  viewer::ViewScene scene;
   scene.title = a.title.empty() ? std::filesystem::path(a.input).filename().string() : a.title;
   const char* cells = m.dim == 3 ? "hexes" : "quads";
   const std::size_t n = m.dim == 3 ? m.hex.hexes.size() : m.quad.quads.size();
@@ -86,8 +86,8 @@ void run_view(const ViewArgs& a) {
   } catch (const TopologyError& e) {
     std::cerr << "geode: warning: " << a.input << ": no sheets shown: " << e.what() << "\n";
   }
-  if (m.dim == 3) primal::write_html(out, m.hex, scene);
-  else primal::write_html(out, m.quad, scene);
+  if (m.dim == 3) viewer::write_html(out, m.hex, scene);
+  else viewer::write_html(out, m.quad, scene);
 }
 
 }  // namespace
@@ -100,7 +100,7 @@ void add_view_command(CLI::App& app) {
       "when opened): the hexes with shrink, explode and peeling; every sheet of the mesh's dual as the\n"
       "surface through its layer of hexes, each with a toggle; each sheet's layer alone or highlighted;\n"
       "colour by scaled Jacobian; node and hex ids on hover (1-based, as the CSV and appendix outputs).\n"
-      "URL hash parameters (FILE.html#layer=sheet-0&peel=1) select a view; see resources/viewer.js.");
+      "URL hash parameters (FILE.html#layer=sheet-0&peel=1) select a view; see viewer/viewer.js.");
   v->add_option("mesh", a->input, "All-hex mesh (.vtu, .vtk, .msh, .exo, .e) or planar quad mesh in z = 0 (.vtu, .vtk)")
       ->required();
   v->add_option("-o,--output", a->output, "The HTML file to write (atomically)")->required();

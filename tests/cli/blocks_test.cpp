@@ -16,9 +16,9 @@
 #include <string>
 
 #include "primal/grid_model.hpp"
-#include "primal/io_exodus.hpp"
-#include "primal/io_gmsh.hpp"
-#include "primal/io_vtk.hpp"
+#include "io/exodus.hpp"
+#include "io/gmsh.hpp"
+#include "io/vtk.hpp"
 #include "primal/topology.hpp"
 #include "support/cli_run.hpp"
 
@@ -88,7 +88,7 @@ TEST_CASE("conform carries blocks and sets: steel and rubber keep their ids and 
   REQUIRE(model.node_sets[0].nodes.size() == 9);
   REQUIRE(model.side_sets[0].sides.size() == 8);
   const fs::path in = dir.path / "in.msh";
-  primal::write_gmsh(model, in);
+  io::write_gmsh(model, in);
 
   SUBCASE(".exo") {
     const fs::path out = dir.path / "out.exo", report = dir.path / "r.json";
@@ -97,7 +97,7 @@ TEST_CASE("conform carries blocks and sets: steel and rubber keep their ids and 
                                            true);
     INFO(r.out);
     REQUIRE(r.code == 0);
-    check_carried(primal::read_exodus(out), model);
+    check_carried(io::read_exodus(out), model);
     // The report speaks per output block.
     std::ifstream is(report);
     const nlohmann::json j = nlohmann::json::parse(is);
@@ -123,12 +123,12 @@ TEST_CASE("conform carries blocks and sets: steel and rubber keep their ids and 
   SUBCASE(".msh: physical volumes, a physical surface for the side set, physical points") {
     const fs::path out = dir.path / "out.msh";
     REQUIRE(test::geode_cli("conform " + in.string() + " -o " + out.string() + " --quiet").code == 0);
-    check_carried(primal::read_gmsh(out), model);
+    check_carried(io::read_gmsh(out), model);
   }
   SUBCASE(".vtu: the block cell array and the names as field data") {
     const fs::path out = dir.path / "out.vtu";
     REQUIRE(test::geode_cli("conform " + in.string() + " --vtu-encoding ascii -o " + out.string() + " --quiet").code == 0);
-    const primal::VtkGrid g = primal::read_vtu(out);
+    const io::VtkGrid g = io::read_vtu(out);
     REQUIRE(g.cell_data.find_int("block") != nullptr);
     CHECK(block_counts(*g.cell_data.find_int("block")) == kExpected);
     const std::string xml = slurp(out);
@@ -139,7 +139,7 @@ TEST_CASE("conform carries blocks and sets: steel and rubber keep their ids and 
     const fs::path out = dir.path / "out.exo";
     REQUIRE(test::geode_cli("conform " + in.string() + " --geode-block transition -o " + out.string() + " --quiet")
                 .code == 0);
-    const primal::Model o = primal::read_exodus(out);
+    const primal::Model o = io::read_exodus(out);
     CHECK(block_counts(o.hex_block) == std::map<int, std::size_t>{{7, 64}, {9, 192}, {10, 104}});
     CHECK(o.block_names.at(10) == "transition");
     CHECK(o.block_names.at(7) == "steel");
@@ -147,7 +147,7 @@ TEST_CASE("conform carries blocks and sets: steel and rubber keep their ids and 
   SUBCASE("--buffer-side tet: the geode hexes fill the rubber's space and join it") {
     const fs::path out = dir.path / "out.exo";
     REQUIRE(test::geode_cli("conform " + in.string() + " --buffer-side tet -o " + out.string() + " --quiet").code == 0);
-    const primal::Model o = primal::read_exodus(out);
+    const primal::Model o = io::read_exodus(out);
     CHECK(block_counts(o.hex_block) == std::map<int, std::size_t>{{7, 64}, {9, 104 + 192}});
   }
 }
@@ -161,7 +161,7 @@ TEST_CASE("conform: parts meshed separately get a hint, and --merge-tolerance jo
   for (auto& t : m.tets)
     for (auto& v : t) v += static_cast<primal::Index>(n);
   const fs::path in = dir.path / "in.exo", out = dir.path / "out.exo";
-  primal::write_exodus(m, in);
+  io::write_exodus(m, in);
   const test::CliRun r = test::geode_cli("conform " + in.string() + " -o " + out.string() + " --quiet", true);
   INFO(r.out);
   CHECK((r.code == 2 || r.code == 3));
@@ -171,5 +171,5 @@ TEST_CASE("conform: parts meshed separately get a hint, and --merge-tolerance jo
   const test::CliRun merged = test::geode_cli("conform " + in.string() + " --merge-tolerance 1e-9 -o " + out.string() + " --quiet", true);
   INFO(merged.out);
   CHECK(merged.code == 0);
-  CHECK(primal::read_exodus(out).hexes.size() == 360);
+  CHECK(io::read_exodus(out).hexes.size() == 360);
 }

@@ -10,8 +10,8 @@
 #include <string>
 
 #include "primal/boundary.hpp"
-#include "primal/io_gmsh.hpp"
-#include "primal/io_vtk.hpp"
+#include "io/gmsh.hpp"
+#include "io/vtk.hpp"
 #include "primal/grid_model.hpp"
 #include "primal/topology.hpp"
 #include "support/cli_run.hpp"
@@ -81,7 +81,7 @@ TEST_CASE("geode check: the geode has no obstruction, the four-triangle duals do
 
   SUBCASE("plain four-triangle dual: pinched corners") {
     const auto j = check_json(plain);
-    const primal::HexMesh m = primal::to_hex_mesh(primal::read_vtu(plain));
+    const primal::HexMesh m = io::to_hex_mesh(io::read_vtu(plain));
     CHECK(m.hexes.size() == 36);
     REQUIRE(count_kind(j, "pinched-corner") >= 1);
     for (const auto& o : j["obstructions"]) {
@@ -94,7 +94,7 @@ TEST_CASE("geode check: the geode has no obstruction, the four-triangle duals do
 
   SUBCASE("its 24-hex class: doublets") {
     const auto j = check_json(c24);
-    const primal::HexMesh m = primal::to_hex_mesh(primal::read_vtu(c24));
+    const primal::HexMesh m = io::to_hex_mesh(io::read_vtu(c24));
     CHECK(m.hexes.size() == 24);
     REQUIRE(count_kind(j, "doublet") >= 1);
     for (const auto& o : j["obstructions"]) {
@@ -132,7 +132,7 @@ TEST_CASE("geode check: text report, quad meshes, the file's own numbering") {
   test::TempDir dir;
   SUBCASE("a clean quad grid, in text") {
     const auto in = dir.path / "quads.vtk";
-    primal::write_vtk(in, test::structured_quad_grid(3, 2));
+    io::write_vtk(in, test::structured_quad_grid(3, 2));
     const auto r = geode_cli("check " + in.string());
     REQUIRE(r.code == 0);
     CHECK(r.out.find("quad mesh") != std::string::npos);
@@ -146,7 +146,7 @@ TEST_CASE("geode check: text report, quad meshes, the file's own numbering") {
     q.quads[4] = {c[0], c[1], c[2], e};
     q.quads.push_back({c[0], e, c[2], c[3]});
     const auto in = dir.path / "doublet.vtu";
-    primal::write_vtu(in, q);
+    io::write_vtu(in, q);
     const auto j = check_json(in);
     CHECK(j["dimension"] == 2);
     REQUIRE(j["obstructions"].size() == 1);
@@ -157,7 +157,7 @@ TEST_CASE("geode check: text report, quad meshes, the file's own numbering") {
     // Two unit hexes side by side.
     primal::Model model = primal::grid_model({2, 1, 1}, 1.0, [](int, int, int) { return false; });
     const auto in = dir.path / "two.msh";
-    primal::write_gmsh(model, in);
+    io::write_gmsh(model, in);
     const auto j = check_json(in);
     CHECK(j["index_base"] == 1);
     CHECK(j["valid"] == true);
@@ -167,7 +167,7 @@ TEST_CASE("geode check: text report, quad meshes, the file's own numbering") {
   SUBCASE("refusals") {
     CHECK(geode_cli("check " + (dir.path / "missing.vtu").string()).code == 2);
     const auto in = dir.path / "mixed.msh";
-    primal::write_gmsh(primal::grid_model({2, 1, 1}, 1.0, [](int i, int, int) { return i == 1; }), in);
+    io::write_gmsh(primal::grid_model({2, 1, 1}, 1.0, [](int i, int, int) { return i == 1; }), in);
     const auto r = geode_cli("check " + in.string(), true);
     CHECK(r.code == 2);
     CHECK(r.out.find(in.string() + ": holds") != std::string::npos);

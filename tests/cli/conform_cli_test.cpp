@@ -11,8 +11,8 @@
 #include <string>
 
 #include "primal/grid_model.hpp"
-#include "primal/io_exodus.hpp"
-#include "primal/io_gmsh.hpp"
+#include "io/exodus.hpp"
+#include "io/gmsh.hpp"
 #include "primal/validity.hpp"
 #include "support/cli_run.hpp"
 #include "support/fixtures.hpp"
@@ -42,8 +42,8 @@ TEST_CASE("geode conform: .msh and .exo input -> valid all-hex Exodus matching t
   const primal::Model model = small_model();
   REQUIRE(model.hexes.size() == 8);
   REQUIRE(model.tets.size() == 48);
-  primal::write_gmsh(model, dir.path / "in.msh");
-  primal::write_exodus(model, dir.path / "in.exo");
+  io::write_gmsh(model, dir.path / "in.msh");
+  io::write_exodus(model, dir.path / "in.exo");
 
   for (const char* input : {"in.msh", "in.exo"}) {
     CAPTURE(input);
@@ -55,7 +55,7 @@ TEST_CASE("geode conform: .msh and .exo input -> valid all-hex Exodus matching t
     REQUIRE(r.code == 0);
     CHECK(r.out.empty());  // --quiet
 
-    const primal::Model result = primal::read_exodus(out);
+    const primal::Model result = io::read_exodus(out);
     CHECK(result.tets.empty());
     const primal::HexValidityReport v = primal::check_validity(primal::hex_part(result));
     INFO(v.summary());
@@ -106,7 +106,7 @@ TEST_CASE("geode conform: bad input exits non-zero, names the file and writes no
   SUBCASE("a file that does not exist") { check_refused(dir.path / "missing.msh", "no such file"); }
   SUBCASE("a hex-only model") {
     const primal::Model hexes = primal::grid_model({2, 2, 2}, 1.0, [](int, int, int) { return false; });
-    primal::write_gmsh(hexes, dir.path / "hexes.msh");
+    io::write_gmsh(hexes, dir.path / "hexes.msh");
     check_refused(dir.path / "hexes.msh", "0 tets");
   }
   SUBCASE("a hex part and a tet part that do not touch") {
@@ -117,7 +117,7 @@ TEST_CASE("geode conform: bad input exits non-zero, names the file and writes no
       m.hex_block.erase(m.hex_block.begin() + 2);
       return m;
     }();
-    primal::write_exodus(apart, dir.path / "apart.exo");
+    io::write_exodus(apart, dir.path / "apart.exo");
     check_refused(dir.path / "apart.exo", "no interface quad");
   }
   // Nothing half-written left behind either.
@@ -132,7 +132,7 @@ TEST_CASE("geode conform: a warning reaches stderr with --quiet, and the report 
   // nodes on the block's flat top cannot move below the interface), so conform carves it from
   // the tet part and warns.
   TempDir dir;
-  primal::write_gmsh(test::tet_cell_on_hex_top(), dir.path / "in.msh");
+  io::write_gmsh(test::tet_cell_on_hex_top(), dir.path / "in.msh");
   const fs::path report = dir.path / "r.json";
   const Run r = geode_cli("conform " + (dir.path / "in.msh").string() + " -o " + (dir.path / "out.exo").string() +
                           " --report " + report.string() + " --quiet");

@@ -14,9 +14,9 @@
 #include <vector>
 
 #include "primal/grid_model.hpp"
-#include "primal/io_exodus.hpp"
-#include "primal/io_gmsh.hpp"
-#include "primal/io_vtk.hpp"
+#include "io/exodus.hpp"
+#include "io/gmsh.hpp"
+#include "io/vtk.hpp"
 #include "support/cli_run.hpp"
 
 using namespace geode;
@@ -46,7 +46,7 @@ TEST_CASE("cli conventions: usage errors and bad numbers are one line on stderr,
   TempDir dir;
   const std::string d = dir.path.string() + "/";
   const fs::path in = dir.path / "in.msh";
-  primal::write_gmsh(small_model(), in);
+  io::write_gmsh(small_model(), in);
   struct Case {
     std::string args;
     std::string words;  // expected in the message
@@ -148,15 +148,15 @@ TEST_CASE("cli conventions: template -o picks the format from the extension") {
     CHECK(slurp(out).rfind(c.starts_with, 0) == 0);
   }
   // The meshes read back with 26 hexes; .vtu is binary by default (no text tables in it).
-  CHECK(primal::read_gmsh(dir.path / "t.msh").hexes.size() == 26);
-  CHECK(primal::read_exodus(dir.path / "t.exo").hexes.size() == 26);
-  CHECK(primal::to_hex_mesh(primal::read_vtk(dir.path / "t.vtk")).hexes.size() == 26);
+  CHECK(io::read_gmsh(dir.path / "t.msh").hexes.size() == 26);
+  CHECK(io::read_exodus(dir.path / "t.exo").hexes.size() == 26);
+  CHECK(io::to_hex_mesh(io::read_vtk(dir.path / "t.vtk")).hexes.size() == 26);
   CHECK(slurp(dir.path / "t.vtu").find("format=\"binary\"") != std::string::npos);
   CHECK(slurp(dir.path / "t.vtu").find("Table") == std::string::npos);
   // .msh as Gmsh 2.2 when asked.
   REQUIRE(test::geode_cli("template geode3d --format msh22 -o " + (dir.path / "t22.msh").string()).code == 0);
   CHECK(slurp(dir.path / "t22.msh").rfind("$MeshFormat\n2.2", 0) == 0);
-  CHECK(primal::read_gmsh(dir.path / "t22.msh").hexes.size() == 26);
+  CHECK(io::read_gmsh(dir.path / "t22.msh").hexes.size() == 26);
 }
 
 namespace {
@@ -208,7 +208,7 @@ TEST_CASE("cli conventions: a binary .vtu holds the same points and cell data as
   const fs::path bin = dir.path / "b.vtu", txt = dir.path / "a.vtu";
   REQUIRE(test::geode_cli("template geode3d -o " + bin.string()).code == 0);
   REQUIRE(test::geode_cli("template geode3d --vtu-encoding ascii -o " + txt.string()).code == 0);
-  const primal::VtkGrid a = primal::read_vtu(txt);
+  const io::VtkGrid a = io::read_vtu(txt);
   REQUIRE(a.points.size() == 48);
   const std::string xml = slurp(bin);
   const std::vector<double> xyz = binary_doubles(xml, "NumberOfComponents=\"3\"");
@@ -223,7 +223,7 @@ TEST_CASE("cli conventions: a binary .vtu holds the same points and cell data as
 TEST_CASE("cli conventions: conform checks its outputs before work and writes mesh and report both or neither") {
   TempDir dir;
   const fs::path in = dir.path / "in.msh", out = dir.path / "out.exo", report = dir.path / "r.json";
-  primal::write_gmsh(small_model(), in);
+  io::write_gmsh(small_model(), in);
   SUBCASE("a report in a missing directory: no mesh, exit 2, named") {
     const test::CliRun r = test::geode_cli("conform " + in.string() + " -o " + out.string() + " --report " +
                                                (dir.path / "missing" / "r.json").string(),
@@ -271,7 +271,7 @@ TEST_CASE("cli conventions: an invalid result exits 4, says so even with --quiet
   m.hexes.push_back(h);
   if (!m.hex_block.empty()) m.hex_block.push_back(m.hex_block.front());
   const fs::path in = dir.path / "in.exo", out = dir.path / "out.vtu", report = dir.path / "r.json";
-  primal::write_exodus(m, in);
+  io::write_exodus(m, in);
   const std::string args = "conform " + in.string() + " -o " + out.string() + " --report " + report.string() +
                            " --smooth none --quiet";
   const test::CliRun r = test::geode_cli(args, true);
@@ -290,7 +290,7 @@ TEST_CASE("cli conventions: an invalid result exits 4, says so even with --quiet
 TEST_CASE("cli conventions: dual --rebuild writes every mesh format, by the extension, with its report as one") {
   TempDir dir;
   const fs::path in = dir.path / "grid.exo";
-  primal::write_exodus(primal::grid_model({2, 2, 2}, 1.0, [](int, int, int) { return false; }), in);
+  io::write_exodus(primal::grid_model({2, 2, 2}, 1.0, [](int, int, int) { return false; }), in);
   for (const char* name : {"r.msh", "r.exo", "r.e", "r.vtk", "r.vtu"}) {
     CAPTURE(name);
     const fs::path out = dir.path / name, report = dir.path / (std::string(name) + ".json");
@@ -302,9 +302,9 @@ TEST_CASE("cli conventions: dual --rebuild writes every mesh format, by the exte
     std::ifstream is(report);
     CHECK(is.peek() == '{');
     const std::string e = out.extension().string();
-    if (e == ".msh") CHECK(primal::read_gmsh(out).hexes.size() == 8);
-    if (e == ".exo" || e == ".e") CHECK(primal::read_exodus(out).hexes.size() == 8);
-    if (e == ".vtk") CHECK(primal::to_hex_mesh(primal::read_vtk(out)).hexes.size() == 8);
+    if (e == ".msh") CHECK(io::read_gmsh(out).hexes.size() == 8);
+    if (e == ".exo" || e == ".e") CHECK(io::read_exodus(out).hexes.size() == 8);
+    if (e == ".vtk") CHECK(io::to_hex_mesh(io::read_vtk(out)).hexes.size() == 8);
     if (e == ".vtu") {  // binary: its header and the decoded cell array
       CHECK(slurp(out).find("NumberOfCells=\"8\"") != std::string::npos);
       CHECK(binary_doubles(slurp(out), "Name=\"scaled_jacobian\"").size() == 8);

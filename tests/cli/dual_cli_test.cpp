@@ -7,8 +7,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "primal/io_gmsh.hpp"
-#include "primal/io_vtk.hpp"
+#include "io/gmsh.hpp"
+#include "io/vtk.hpp"
 #include "primal/grid_model.hpp"
 #include "support/cli_run.hpp"
 #include "support/fixtures.hpp"
@@ -37,7 +37,7 @@ primal::HexMesh moved_grid() {
 TEST_CASE("geode dual: sheets and triples of a grid, and its rebuild") {
   const auto in = temp_path("grid.vtu"), out = temp_path("grid-rebuilt.vtu");
   const primal::HexMesh g = moved_grid();
-  primal::write_vtu(in, g);
+  io::write_vtu(in, g);
   const auto r = geode_cli("dual " + in.string() + " --format json --vtu-encoding ascii --rebuild " + out.string());
   REQUIRE(r.code == 0);
   const auto j = nlohmann::json::parse(r.out);
@@ -46,7 +46,7 @@ TEST_CASE("geode dual: sheets and triples of a grid, and its rebuild") {
   CHECK(j["intersections"].size() == 3 * 2 * 2);  // every (x, y, z) triple, once each
   for (const auto& t : j["intersections"]) CHECK(t["cells"] == 1);
   CHECK(j["rebuild"]["same_counts"] == true);
-  const primal::HexMesh back = primal::to_hex_mesh(primal::read_vtu(out));
+  const primal::HexMesh back = io::to_hex_mesh(io::read_vtu(out));
   const auto m = test::find_isomorphism(back, g);
   CHECK(m.has_value());
   std::filesystem::remove(in);
@@ -55,7 +55,7 @@ TEST_CASE("geode dual: sheets and triples of a grid, and its rebuild") {
 
 TEST_CASE("geode dual: a quad mesh gives chords, in text") {
   const auto in = temp_path("quads.vtk");
-  primal::write_vtk(in, test::structured_quad_grid(4, 3));
+  io::write_vtk(in, test::structured_quad_grid(4, 3));
   const auto r = geode_cli("dual " + in.string());
   REQUIRE(r.code == 0);
   CHECK(r.out.find("20 nodes, 12 quads, 7 chords") != std::string::npos);
@@ -66,7 +66,7 @@ TEST_CASE("geode dual: refusals name the file and write nothing") {
   SUBCASE("no such file") { CHECK(geode_cli("dual " + temp_path("missing.vtu").string()).code == 2); }
   SUBCASE("a model with tets") {
     const auto in = temp_path("mixed.msh");
-    primal::write_gmsh(primal::grid_model({2, 1, 1}, 1.0, [](int i, int, int) { return i == 1; }), in);
+    io::write_gmsh(primal::grid_model({2, 1, 1}, 1.0, [](int i, int, int) { return i == 1; }), in);
     const auto r = geode_cli("dual " + in.string(), true);
     CHECK(r.code == 2);
     CHECK(r.out.find("tets") != std::string::npos);
@@ -74,7 +74,7 @@ TEST_CASE("geode dual: refusals name the file and write nothing") {
   }
   SUBCASE("a rebuild the fields cannot represent (the printed Appendix A positions fold 8 hexes)") {
     const auto in = temp_path("appendix.vtu"), out = temp_path("appendix-rebuilt.vtu");
-    primal::write_vtu(in, test::appendix_a_geode());
+    io::write_vtu(in, test::appendix_a_geode());
     const auto r = geode_cli("dual " + in.string() + " --rebuild " + out.string(), true);
     CHECK(r.code == 2);
     CHECK(r.out.find(in.string() + ": cannot rebuild: sheet_fields: hex") != std::string::npos);

@@ -9,7 +9,7 @@
 #include <sstream>
 #include <string>
 
-#include "primal/io_vtk.hpp"
+#include "io/vtk.hpp"
 #include "primal/validity.hpp"
 #include "support/cli_run.hpp"
 #include "support/fixtures.hpp"
@@ -87,13 +87,13 @@ TEST_CASE("geode template: appendix, csv and vtu outputs agree") {
 
   const auto vtu = temp_path("g.vtu");
   REQUIRE(geode_cli("template geode3d --format vtu --vtu-encoding ascii -o " + vtu.string()).code == 0);
-  const primal::HexMesh m = primal::to_hex_mesh(primal::read_vtu(vtu));
+  const primal::HexMesh m = io::to_hex_mesh(io::read_vtu(vtu));
   CHECK(test::find_isomorphism(m, test::appendix_a_geode()).has_value());
   std::filesystem::remove(vtu);
 
   const auto vtu2 = temp_path("g2.vtu");
   REQUIRE(geode_cli("template geode2d --format vtu --vtu-encoding ascii -o " + vtu2.string()).code == 0);
-  CHECK(primal::to_quad_mesh(primal::read_vtu(vtu2)).quads.size() == 5);
+  CHECK(io::to_quad_mesh(io::read_vtu(vtu2)).quads.size() == 5);
   std::filesystem::remove(vtu2);
 }
 

@@ -10,7 +10,7 @@
 #include <sstream>
 #include <string>
 
-#include "primal/io_vtk.hpp"
+#include "io/vtk.hpp"
 #include "support/cli_run.hpp"
 #include "support/fixtures.hpp"
 #include "support/png.hpp"
@@ -142,8 +142,8 @@ TEST_CASE("viewer: geode view shows any hex or quad mesh with its dual sheets") 
   REQUIRE_MESSAGE(have_chromium(), "chromium is not installed (scripts/common.sh installs it)");
   test::TempDir dir;
   const auto hex = dir.path / "grid.vtu", quad = dir.path / "grid2d.vtu";
-  primal::write_vtu(hex, test::structured_hex_grid(3, 2, 2));
-  primal::write_vtu(quad, test::structured_quad_grid(3, 2));
+  io::write_vtu(hex, test::structured_hex_grid(3, 2, 2));
+  io::write_vtu(quad, test::structured_quad_grid(3, 2));
   const auto h = dir.path / "grid.html", q = dir.path / "grid2d.html";
   REQUIRE(geode_cli("view " + hex.string() + " -o " + h.string()).code == 0);
   REQUIRE(geode_cli("view " + quad.string() + " -o " + q.string()).code == 0);

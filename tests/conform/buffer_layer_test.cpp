@@ -12,7 +12,7 @@
 #include <string>
 
 #include "conform/buffer_layer.hpp"
-#include "conform/demo_models.hpp"
+#include "demo/demo_models.hpp"
 #include "primal/grid_model.hpp"
 #include "primal/errors.hpp"
 #include "primal/quality.hpp"

@@ -11,10 +11,10 @@
 #include <set>
 
 #include "primal/boundary.hpp"
-#include "conform/demo_models.hpp"
+#include "demo/demo_models.hpp"
 #include "primal/grid_model.hpp"
 #include "primal/errors.hpp"
-#include "primal/io_exodus.hpp"
+#include "io/exodus.hpp"
 #include "primal/quality.hpp"
 #include "primal/topology.hpp"
 #include "support/fixtures.hpp"
@@ -155,12 +155,12 @@ TEST_CASE("reference templates: one per box and diagonal, from several threads a
 
 TEST_CASE("half-block demo, n = 2") {
   // n^3 = 8 hexes, 6 n^3 = 48 tets, n^2 = 4 interface quads.
-  const auto r = conform::conform(conform::demo_half_block(2));
+  const auto r = conform::conform(demo::demo_half_block(2));
   check_result(r, {8, 48, 4});
 }
 
 TEST_CASE("nugget demo, n = 2: side set 'outside' carried to the diced hexes") {
-  const primal::Model m = conform::demo_nugget(2);
+  const primal::Model m = demo::demo_nugget(2);
   const auto r = conform::conform(m);
   // Interface: the nugget cube's 6 faces, n x n = 4 quads each.
   check_result(r, {static_cast<Index>(m.hexes.size()), static_cast<Index>(m.tets.size()), 24});
@@ -180,11 +180,11 @@ TEST_CASE("nugget demo, n = 2: side set 'outside' carried to the diced hexes") {
 }
 
 TEST_CASE("the result round-trips through Exodus") {
-  const auto r = conform::conform(conform::demo_half_block(2));
+  const auto r = conform::conform(demo::demo_half_block(2));
   const auto path = std::filesystem::temp_directory_path() /
                     ("geode-conform-" + std::to_string(::getpid()) + ".exo");
-  primal::write_exodus(r.model, path);
-  const primal::Model back = primal::read_exodus(path);
+  io::write_exodus(r.model, path);
+  const primal::Model back = io::read_exodus(path);
   std::filesystem::remove(path);
   CHECK(back.points == r.model.points);
   CHECK(back.hexes == r.model.hexes);

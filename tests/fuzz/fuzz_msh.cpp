@@ -1,4 +1,4 @@
-// libFuzzer target: the .msh reader (primal/io_gmsh_read.cpp) on arbitrary bytes. InvalidInput
+// libFuzzer target: the .msh reader (io/gmsh_read.cpp) on arbitrary bytes. InvalidInput
 // is the expected answer to bad bytes; any other exception, a crash or a sanitizer report is a
 // finding. Built with -DGEODE_FUZZ=ON (clang), run by scripts/test.
 #include <cstddef>
@@ -6,11 +6,11 @@
 #include <string_view>
 
 #include "primal/errors.hpp"
-#include "primal/io_gmsh.hpp"
+#include "io/gmsh.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   try {
-    (void)geode::primal::parse_gmsh(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz.msh");
+    (void)geode::io::parse_gmsh(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz.msh");
   } catch (const geode::InvalidInput&) {
   }
   return 0;

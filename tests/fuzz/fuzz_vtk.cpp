@@ -5,13 +5,13 @@
 #include <string_view>
 
 #include "primal/errors.hpp"
-#include "primal/io_vtk.hpp"
-#include "primal/read_model.hpp"
+#include "io/vtk.hpp"
+#include "io/read_model.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   try {
-    const auto grid = geode::primal::parse_vtk(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz.vtk");
-    (void)geode::primal::model_from_vtk(grid);
+    const auto grid = geode::io::parse_vtk(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz.vtk");
+    (void)geode::io::model_from_vtk(grid);
   } catch (const geode::InvalidInput&) {
   }
   return 0;

@@ -1,16 +1,18 @@
-#include "primal/io_html.hpp"
+#include "viewer/html.hpp"
 
 #include <cmath>
 #include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
 
-#include "primal/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 #include "primal/errors.hpp"
 #include "primal/quality.hpp"
 #include "primal/topology.hpp"
 
-namespace geode::primal {
+namespace geode::viewer {
+
+using namespace primal;
 
 // Embedded at build time from resources/ and libjs-three (CMakeLists.txt).
 extern const char kViewerHtml[];
@@ -218,4 +220,4 @@ void write_html(const std::filesystem::path& path, const QuadMesh& mesh, const V
   write_file_atomically(path, [&](std::ostream& os) { os << text; });
 }
 
-}  // namespace geode::primal
+}  // namespace geode::viewer

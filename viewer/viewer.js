@@ -1,5 +1,5 @@
 // geode viewer: a hex (or quad) mesh with its sheets, from the JSON in #geode-data (written by
-// primal/io_html.cpp). Ids shown are 1-based, as in the appendix and CSV outputs.
+// viewer/html.cpp). Ids shown are 1-based, as in the appendix and CSV outputs.
 //
 // URL hash parameters (file.html#a=1&b=2) set the initial state, so that figures and tests need
 // no clicking. Sheets and face groups are named by slug (lower case, '-' -> 'm', '+' -> 'p',

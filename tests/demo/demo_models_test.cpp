@@ -13,7 +13,7 @@
 #include <string>
 
 #include "conform/conform.hpp"
-#include "conform/demo_models.hpp"
+#include "demo/demo_models.hpp"
 #include "conform/reference_template.hpp"
 #include "primal/interface.hpp"
 #include "primal/quality.hpp"
@@ -60,7 +60,7 @@ TEST_CASE("realistic models, --smooth none: valid; the placement inverts nothing
                 {"fulcher", 73, 2, 3}};
   for (const auto& [name, quads, n, settled] : models) {
     CAPTURE(name);
-    const primal::Model m = conform::demo_model(name, n);
+    const primal::Model m = demo::demo_model(name, n);
     REQUIRE(!m.tets.empty());
     const auto r = conform::conform(m, o);
     CHECK(r.interface_quads == quads);
@@ -88,7 +88,7 @@ TEST_CASE("buffer carved from the hex part: the tets stay as meshed, geode hexes
   };
   for (const auto& [name, n] : models) {
     CAPTURE(name);
-    const primal::Model m = conform::demo_model(name, n);
+    const primal::Model m = demo::demo_model(name, n);
     conform::ConformOptions o;
     o.smooth = conform::ConformSmooth::kNone;
     o.geode_block = "geode";
@@ -125,7 +125,7 @@ TEST_CASE("realistic models, default and global smoothing: valid, untangled, at 
     CAPTURE(global);
     conform::ConformOptions o;
     o.smooth = smooth;
-    const auto r = conform::conform(conform::demo_model(name, n), o);
+    const auto r = conform::conform(demo::demo_model(name, n), o);
     test::check_conform_result(r);
     // The transition is not the worst part: the output's minimum against the input's own
     // hexes and tets each diced alone (the coarse nugget's Delaunay tets dice to 0.29, above
@@ -145,7 +145,7 @@ TEST_CASE("realistic models, default and global smoothing: valid, untangled, at 
 // diagonals) or four around a centre node; the four-triangle ones get the four-triangle
 // template (conform/reference_template.hpp), its side faces merged with the neighbouring geodes'.
 TEST_CASE("mixed two- and four-triangle interface: valid and untangled") {
-  const primal::Model m = conform::demo_model("fourtri", 3);
+  const primal::Model m = demo::demo_model("fourtri", 3);
   const Index geode_hexes = mixed_geode_hexes(m);
   for (const auto smooth : {conform::ConformSmooth::kNone, conform::ConformSmooth::kLocal}) {
     CAPTURE(static_cast<int>(smooth));
@@ -168,13 +168,13 @@ constexpr bool kSanitized = false;
 #endif
 TEST_CASE("mixed interface on a curved cylinder, default options: valid and untangled" *
           doctest::skip(kSanitized)) {
-  const primal::Model m = conform::demo_model("fourtri-cylinder", 2);
+  const primal::Model m = demo::demo_model("fourtri-cylinder", 2);
   test::check_conform_result(conform::conform(m), mixed_geode_hexes(m));
 }
 
 TEST_CASE("fulcher demo: circles imprinted on three nugget faces, the parts conforming node-wise") {
   const int n = 4;
-  const primal::Model m = conform::demo_fulcher(n);
+  const primal::Model m = demo::demo_fulcher(n);
   // The parts fill the box: nugget [-1,1]^3 of tets, the 26 blocks around it of hexes.
   double tet_volume = 0, hex_volume = 0;
   for (const auto& t : m.tets) {

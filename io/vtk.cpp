@@ -1,6 +1,6 @@
-#include "primal/io_vtk.hpp"
+#include "io/vtk.hpp"
 
-#include "primal/io_vtk_cells.hpp"
+#include "io/vtk_cells.hpp"
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -18,12 +18,14 @@
 #include <sstream>
 
 
-#include "primal/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 #include "primal/errors.hpp"
-#include "primal/file_format.hpp"
+#include "io/file_format.hpp"
 #include "primal/quality.hpp"
 
-namespace geode::primal {
+namespace geode::io {
+
+using namespace primal;
 
 using vtk_cells::cell_type_name;
 using vtk_cells::cell_type_size;
@@ -421,4 +423,4 @@ QuadMesh to_quad_mesh(const VtkGrid& g) {
   return m;
 }
 
-}  // namespace geode::primal
+}  // namespace geode::io

@@ -13,11 +13,12 @@
 #include "support/temp_dir.hpp"
 #include "primal/grid_model.hpp"
 #include "primal/errors.hpp"
-#include "primal/io_exodus.hpp"
+#include "io/exodus.hpp"
 
 namespace fs = std::filesystem;
 using namespace geode;
 using namespace geode::primal;
+using namespace geode::io;
 
 namespace {
 

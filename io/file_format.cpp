@@ -1,4 +1,4 @@
-#include "primal/file_format.hpp"
+#include "io/file_format.hpp"
 
 #include <algorithm>
 #include <array>
@@ -7,7 +7,9 @@
 
 #include "primal/errors.hpp"
 
-namespace geode::primal {
+namespace geode::io {
+
+using namespace primal;
 
 namespace {
 
@@ -105,4 +107,4 @@ void check_mesh_format(const std::filesystem::path& path, MeshFileFormat expecte
   throw InvalidInput(what);
 }
 
-}  // namespace geode::primal
+}  // namespace geode::io

@@ -3,7 +3,7 @@
 // ASCII or base64 binary DataArrays) and legacy (.vtk, "# vtk DataFile Version 4.2": the classic CELLS n size
 // layout every legacy reader since VTK 4 opens, without the 5.1 OFFSETS/CONNECTIVITY form).
 // Hexes, tets and quads (quads as VTK_QUAD in 3D space), or a whole Model (hexes and tets). Writes are atomic
-// (primal/atomic_file.hpp): a failure leaves no half-written file.
+// (io/atomic_file.hpp): a failure leaves no half-written file.
 //
 // Every written grid carries the cell arrays "scaled_jacobian" ([Verdict] hex, tet or quad
 // scaled Jacobian) and "block" (mesh.block, when not empty), then the caller's arrays.
@@ -16,7 +16,7 @@
 #include "primal/mesh.hpp"
 #include "primal/model.hpp"
 
-namespace geode::primal {
+namespace geode::io {
 
 // VTK cell type numbers (vtkCellType.h).
 inline constexpr int kVtkTriangle = 5;
@@ -43,29 +43,29 @@ enum class VtuEncoding { kAscii, kBinary };
 // 1-based number) for an array of the wrong length, a bad or repeated name, a node number out of
 // range, a non-finite point, or a file that cannot be written. A Model is written with its hexes
 // then its tets, the cell array "block" holding each element's block (block_of).
-void write_vtu(const std::filesystem::path& path, const HexMesh& mesh,
+void write_vtu(const std::filesystem::path& path, const primal::HexMesh& mesh,
                const VtkCellData& extra = {}, VtuEncoding encoding = VtuEncoding::kAscii);
-void write_vtu(const std::filesystem::path& path, const TetMesh& mesh,
+void write_vtu(const std::filesystem::path& path, const primal::TetMesh& mesh,
                const VtkCellData& extra = {}, VtuEncoding encoding = VtuEncoding::kAscii);
-void write_vtu(const std::filesystem::path& path, const QuadMesh& mesh,
+void write_vtu(const std::filesystem::path& path, const primal::QuadMesh& mesh,
                const VtkCellData& extra = {}, VtuEncoding encoding = VtuEncoding::kAscii);
-void write_vtu(const std::filesystem::path& path, const Model& model,
+void write_vtu(const std::filesystem::path& path, const primal::Model& model,
                const VtkCellData& extra = {}, VtuEncoding encoding = VtuEncoding::kAscii);
-void write_vtk(const std::filesystem::path& path, const HexMesh& mesh,
+void write_vtk(const std::filesystem::path& path, const primal::HexMesh& mesh,
                const VtkCellData& extra = {});
-void write_vtk(const std::filesystem::path& path, const TetMesh& mesh,
+void write_vtk(const std::filesystem::path& path, const primal::TetMesh& mesh,
                const VtkCellData& extra = {});
-void write_vtk(const std::filesystem::path& path, const QuadMesh& mesh,
+void write_vtk(const std::filesystem::path& path, const primal::QuadMesh& mesh,
                const VtkCellData& extra = {});
-void write_vtk(const std::filesystem::path& path, const Model& model,
+void write_vtk(const std::filesystem::path& path, const primal::Model& model,
                const VtkCellData& extra = {});
 
 // An unstructured grid as read: points, cells (VTK corner order) and cell arrays.
 struct VtkGrid {
   std::string source;  // the file, for messages
-  std::vector<Point> points;
+  std::vector<primal::Point> points;
   std::vector<int> cell_types;
-  std::vector<std::vector<Index>> cells;
+  std::vector<std::vector<primal::Index>> cells;
   VtkCellData cell_data;  // Float32/Float64 arrays as doubles, integer arrays as ints
 };
 
@@ -86,9 +86,9 @@ VtkGrid read_vtk_file(const std::filesystem::path& path);
 
 // The grid as a typed mesh; throw geode::InvalidInput naming the file and the first cell of
 // another type. An int cell array "block" becomes mesh.block.
-HexMesh to_hex_mesh(const VtkGrid& grid);
-TetMesh to_tet_mesh(const VtkGrid& grid);
-QuadMesh to_quad_mesh(const VtkGrid& grid);
+primal::HexMesh to_hex_mesh(const VtkGrid& grid);
+primal::TetMesh to_tet_mesh(const VtkGrid& grid);
+primal::QuadMesh to_quad_mesh(const VtkGrid& grid);
 
 
-}  // namespace geode::primal
+}  // namespace geode::io

@@ -1,9 +1,9 @@
 #pragma once
-// VTK cell types as the .vtu / .vtk writers and readers (io_vtk.cpp, io_vtk_read.cpp) name
+// VTK cell types as the .vtu / .vtk writers and readers (vtk.cpp, vtk_read.cpp) name
 // and size them. Internal to primal's VTK I/O.
-#include "primal/io_vtk.hpp"
+#include "io/vtk.hpp"
 
-namespace geode::primal::vtk_cells {
+namespace geode::io::vtk_cells {
 
 inline const char* cell_type_name(int type) {
   switch (type) {
@@ -35,4 +35,4 @@ inline int cell_type_size(int type) {
   }
 }
 
-}  // namespace geode::primal::vtk_cells
+}  // namespace geode::io::vtk_cells

@@ -1,5 +1,5 @@
 #pragma once
-// Gmsh .msh input and output of a mixed hex + tet model. Reading is our own (io_gmsh_read.cpp:
+// Gmsh .msh input and output of a mixed hex + tet model. Reading is our own (gmsh_read.cpp:
 // versions 2.2 and 4.1, ASCII and binary), so that a user's file never reaches libgmsh, which
 // would run any text that is not a mesh as a Gmsh script; writing (v4.1) and the demo models
 // use the Gmsh C++ API.
@@ -24,7 +24,7 @@
 
 #include "primal/model.hpp"
 
-namespace geode::primal {
+namespace geode::io {
 
 // vtk_corner[i] = gmsh_corner[kGmsh*ToVtk[i]].
 inline constexpr std::array<int, 8> kGmshHexToVtk{0, 1, 2, 3, 4, 5, 6, 7};
@@ -41,15 +41,15 @@ enum class GmshVersion { k41, k22 };
 // one without its $End line, a volume element that is not a linear hex or tet, an element
 // referring to a node not in $Nodes, a node given twice at two places, a side-set face that is
 // no face of a hex or tet; then check_geometry (model.hpp) unless options say otherwise.
-Model read_gmsh(const std::filesystem::path& path, const ReadOptions& options = {});
+primal::Model read_gmsh(const std::filesystem::path& path, const primal::ReadOptions& options = {});
 // The same on a file's content; `source` names it in messages.
-Model parse_gmsh(std::string_view content, const std::string& source, const ReadOptions& options = {});
+primal::Model parse_gmsh(std::string_view content, const std::string& source, const primal::ReadOptions& options = {});
 
 // Writes .msh (v4.1 or 2.2) atomically (a temporary file in the same directory, then rename).
 // Block ids must be positive; a block may hold both hexes and tets. Blocks become physical
 // volumes, side sets physical surfaces (their faces as triangles / quads), node sets physical
 // points, each with its id and name.
-void write_gmsh(const Model& model, const std::filesystem::path& path,
+void write_gmsh(const primal::Model& model, const std::filesystem::path& path,
                 GmshFormat format = GmshFormat::Ascii, GmshVersion version = GmshVersion::k41);
 
 // RAII: initializes the Gmsh API (no config files, General.Terminal = 0) and finalizes it on
@@ -64,7 +64,7 @@ class GmshSession {
 
 // Converts Gmsh's current model (inside a GmshSession) to a Model, as read_gmsh does after
 // opening; `source` names it in error messages. Lets builders that mesh with the Gmsh API
-// (conform/demo_models.hpp) share the reader's conversion.
-Model model_from_gmsh(std::string_view source);
+// (demo/demo_models.hpp) share the reader's conversion.
+primal::Model model_from_gmsh(std::string_view source);
 
-}  // namespace geode::primal
+}  // namespace geode::io

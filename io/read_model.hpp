@@ -4,21 +4,21 @@
 // (file_format.hpp): .msh (Gmsh 2.2 / 4.1), .exo / .e (Exodus II), .vtu, .vtk.
 #include <filesystem>
 
-#include "primal/io_vtk.hpp"
+#include "io/vtk.hpp"
 #include "primal/model.hpp"
 
-namespace geode::primal {
+namespace geode::io {
 
 // Throws InvalidInput naming the file: missing, unknown extension, content of another format,
-// and whatever the format's reader refuses (io_gmsh.hpp, io_exodus.hpp, io_vtk.hpp), then
+// and whatever the format's reader refuses (gmsh.hpp, exodus.hpp, vtk.hpp), then
 // check_geometry unless options say otherwise.
-Model read_model(const std::filesystem::path& path, const ReadOptions& options = {});
+primal::Model read_model(const std::filesystem::path& path, const primal::ReadOptions& options = {});
 
 // A VTK grid as a model: hexes and tets (triangles and quads, boundary annotations, are left
 // out), VTK's 0-based point and cell ids (as ParaView shows them) as file ids, blocks from the
 // first integer cell array named "block" (our writers), "gmsh:physical" (meshio) or
 // "CellEntityIds"; without one, all hexes in block 1 and all tets in block 2. Other cell types
 // are refused naming the cell.
-Model model_from_vtk(const VtkGrid& grid, const ReadOptions& options = {});
+primal::Model model_from_vtk(const VtkGrid& grid, const primal::ReadOptions& options = {});
 
-}  // namespace geode::primal
+}  // namespace geode::io

@@ -15,11 +15,13 @@
 
 #include "primal/boundary.hpp"
 #include "primal/errors.hpp"
-#include "primal/file_format.hpp"
-#include "primal/io_gmsh.hpp"
+#include "io/file_format.hpp"
+#include "io/gmsh.hpp"
 #include "primal/topology.hpp"
 
-namespace geode::primal {
+namespace geode::io {
+
+using namespace primal;
 
 namespace {
 
@@ -583,4 +585,4 @@ Model parse_gmsh(std::string_view content, const std::string& source, const Read
   return model;
 }
 
-}  // namespace geode::primal
+}  // namespace geode::io

@@ -1,4 +1,4 @@
-#include "conform/demo_models.hpp"
+#include "demo/demo_models.hpp"
 
 #include <gmsh.h>
 
@@ -15,12 +15,13 @@
 
 #include "primal/boundary.hpp"
 #include "primal/errors.hpp"
-#include "primal/io_gmsh.hpp"
+#include "io/gmsh.hpp"
 #include "primal/quality.hpp"
 
-namespace geode::conform {
+namespace geode::demo {
 
 using namespace primal;
+using namespace io;
 
 // ---- Demo models meshed with the Gmsh API ----------------------------------------------------
 
@@ -419,9 +420,9 @@ Model demo_nugget(int n) {
   return m;
 }
 
-}  // namespace geode::conform
+}  // namespace geode::demo
 
-namespace geode::conform {
+namespace geode::demo {
 
 Model demo_delaunay_block(int n, DemoDiagonals diagonals, bool four_triangles) {
   if (n < 1) throw InvalidInput("demo_delaunay_block: n = " + std::to_string(n) + " must be >= 1");
@@ -653,4 +654,4 @@ Model demo_model(const std::string& name, int n) {
                      "fourtri, fourtri-cylinder");
 }
 
-}  // namespace geode::conform
+}  // namespace geode::demo

@@ -11,12 +11,13 @@
 #include "support/temp_dir.hpp"
 #include "primal/grid_model.hpp"
 #include "primal/errors.hpp"
-#include "primal/io_gmsh.hpp"
+#include "io/gmsh.hpp"
 #include "primal/topology.hpp"
 
 namespace fs = std::filesystem;
 using namespace geode;
 using namespace geode::primal;
+using namespace geode::io;
 
 namespace {
 

@@ -1,6 +1,6 @@
-#include "primal/io_gmsh.hpp"
+#include "io/gmsh.hpp"
 
-#include "primal/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 
 #include <gmsh.h>
 #include <unistd.h>
@@ -13,10 +13,12 @@
 
 #include "primal/boundary.hpp"
 #include "primal/errors.hpp"
-#include "primal/file_format.hpp"
+#include "io/file_format.hpp"
 #include "primal/topology.hpp"
 
-namespace geode::primal {
+namespace geode::io {
+
+using namespace primal;
 
 namespace {
 
@@ -357,4 +359,4 @@ void write_gmsh(const Model& model, const std::filesystem::path& path, GmshForma
   });
 }
 
-}  // namespace geode::primal
+}  // namespace geode::io

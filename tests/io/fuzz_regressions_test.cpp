@@ -7,14 +7,15 @@
 #include <string>
 
 #include "primal/errors.hpp"
-#include "primal/file_format.hpp"
-#include "primal/io_gmsh.hpp"
-#include "primal/io_vtk.hpp"
-#include "primal/read_model.hpp"
+#include "io/file_format.hpp"
+#include "io/gmsh.hpp"
+#include "io/vtk.hpp"
+#include "io/read_model.hpp"
 
 namespace fs = std::filesystem;
 using namespace geode;
 using namespace geode::primal;
+using namespace geode::io;
 
 TEST_CASE("fuzz regressions: every input the fuzzers found is read or refused with InvalidInput") {
   const fs::path dir = fs::path(GEODE_SOURCE_DIR) / "tests/fuzz/regressions";

@@ -14,7 +14,7 @@
 
 #include "primal/model.hpp"
 
-namespace geode::primal {
+namespace geode::io {
 
 // vtk_corner[i] = exodus_corner[kExodus*ToVtk[i]].
 inline constexpr std::array<int, 8> kExodusHexToVtk{0, 1, 2, 3, 4, 5, 6, 7};
@@ -28,9 +28,9 @@ inline constexpr std::array<int, 4> kExodusTetToVtk{0, 1, 2, 3};
 // an element type other than HEX8 / TETRA4 (HEX / HEXAHEDRON / TETRA / TET4 with 8 / 4 nodes
 // are accepted as aliases), a node or element number out of range, a side number out of
 // range; then check_geometry (model.hpp) unless options say otherwise.
-Model read_exodus(const std::filesystem::path& path, const ReadOptions& options = {});
+primal::Model read_exodus(const std::filesystem::path& path, const primal::ReadOptions& options = {});
 
 // Writes atomically (a temporary file in the same directory, then rename).
-void write_exodus(const Model& model, const std::filesystem::path& path);
+void write_exodus(const primal::Model& model, const std::filesystem::path& path);
 
-}  // namespace geode::primal
+}  // namespace geode::io

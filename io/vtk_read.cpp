@@ -1,6 +1,6 @@
-#include "primal/io_vtk.hpp"
+#include "io/vtk.hpp"
 
-#include "primal/io_vtk_cells.hpp"
+#include "io/vtk_cells.hpp"
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -19,12 +19,14 @@
 
 #include <zlib.h>
 
-#include "primal/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 #include "primal/errors.hpp"
-#include "primal/file_format.hpp"
+#include "io/file_format.hpp"
 #include "primal/quality.hpp"
 
-namespace geode::primal {
+namespace geode::io {
+
+using namespace primal;
 
 using vtk_cells::cell_type_name;
 using vtk_cells::cell_type_size;
@@ -1052,4 +1054,4 @@ VtkGrid read_vtk_file(const std::filesystem::path& path) {
   }
 }
 
-}  // namespace geode::primal
+}  // namespace geode::io

@@ -1,7 +1,7 @@
 // VTK I/O: exact round trips (.vtu and legacy .vtk) for hex, tet and quad meshes with cell
 // arrays; each kind of bad input rejected with the file, the line and the reason; atomic
 // writes; and, when python3-vtk9 is installed, VTK's own readers open what we write.
-#include "primal/io_vtk.hpp"
+#include "io/vtk.hpp"
 
 #include <doctest/doctest.h>
 #include <unistd.h>
@@ -14,7 +14,7 @@
 #include <memory>
 #include <sstream>
 
-#include "primal/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 #include "primal/dice.hpp"
 #include "primal/errors.hpp"
 #include "primal/quality.hpp"
@@ -22,6 +22,7 @@
 #include "support/temp_dir.hpp"
 
 using namespace geode::primal;
+using namespace geode::io;
 namespace fs = std::filesystem;
 
 namespace {
@@ -161,7 +162,7 @@ TEST_CASE("io_vtk: a grid of another cell type is refused by the typed conversio
       doctest::Contains("h.vtk: cell 0 is VTK type 12 (hexahedron), expected 10 (tetra)"),
       geode::InvalidInput);
   CHECK_THROWS_AS(read_vtk_file(dir.path / "h.obj"), geode::InvalidInput);
-  // Extensions in any case, as everywhere else (primal/file_format.hpp).
+  // Extensions in any case, as everywhere else (io/file_format.hpp).
   write_vtu(dir.path / "H.VTU", test_hexes());
   write_vtk(dir.path / "H.VTK", test_hexes());
   CHECK(read_vtk_file(dir.path / "H.VTU").cell_types.size() == test_hexes().hexes.size());
@@ -353,7 +354,7 @@ TEST_CASE("io_vtk: VTK's own readers (ParaView's) open what we write") {
   REQUIRE_MESSAGE(std::system("/usr/bin/python3 -c 'import vtk' >/dev/null 2>&1") == 0,
                   "/usr/bin/python3 cannot import vtk (apt-get install python3-vtk9)");
   TempDir dir;
-  const std::string script = std::string(GEODE_SOURCE_DIR) + "/tests/primal/vtk_reader_check.py";
+  const std::string script = std::string(GEODE_SOURCE_DIR) + "/tests/io/vtk_reader_check.py";
   auto check = [&](const fs::path& file, std::size_t cells) {
     const std::string cmd = "/usr/bin/python3 '" + script + "' '" + file.string() + "' " +
                             std::to_string(cells) + " --compare-scaled-jacobian";

@@ -7,7 +7,7 @@
 #include <string>
 #include <ostream>
 
-namespace geode::primal {
+namespace geode::io {
 
 // Calls `write` with a stream on a temporary file next to `path`, then renames it over `path`.
 // If `write` throws or the stream fails, the temporary file is removed, `path` is left as it
@@ -21,4 +21,4 @@ void write_file_atomically(const std::filesystem::path& path,
 void write_path_atomically(const std::filesystem::path& path, const std::string& suffix,
                            const std::function<void(const std::filesystem::path& temp)>& write);
 
-}  // namespace geode::primal
+}  // namespace geode::io

@@ -1,13 +1,15 @@
-#include "primal/read_model.hpp"
+#include "io/read_model.hpp"
 
 #include <string>
 
 #include "primal/errors.hpp"
-#include "primal/file_format.hpp"
-#include "primal/io_exodus.hpp"
-#include "primal/io_gmsh.hpp"
+#include "io/file_format.hpp"
+#include "io/exodus.hpp"
+#include "io/gmsh.hpp"
 
-namespace geode::primal {
+namespace geode::io {
+
+using namespace primal;
 
 Model model_from_vtk(const VtkGrid& grid, const ReadOptions& options) {
   Model model;
@@ -72,4 +74,4 @@ Model read_model(const std::filesystem::path& path, const ReadOptions& options) 
   throw InvalidInput(path.string() + ": unknown input format");
 }
 
-}  // namespace geode::primal
+}  // namespace geode::io

@@ -13,15 +13,16 @@
 
 #include "primal/errors.hpp"
 #include "primal/grid_model.hpp"
-#include "primal/io_gmsh.hpp"
-#include "primal/io_vtk.hpp"
-#include "primal/read_model.hpp"
+#include "io/gmsh.hpp"
+#include "io/vtk.hpp"
+#include "io/read_model.hpp"
 #include "support/fixtures.hpp"
 #include "support/temp_dir.hpp"
 
 namespace fs = std::filesystem;
 using namespace geode;
 using namespace geode::primal;
+using namespace geode::io;
 
 namespace {
 
@@ -36,7 +37,7 @@ HexMesh sample_hexes() {
 }
 
 void run_script(const std::string& kind, const fs::path& source, const fs::path& dir) {
-  const std::string script = std::string(GEODE_SOURCE_DIR) + "/tests/primal/write_variants.py";
+  const std::string script = std::string(GEODE_SOURCE_DIR) + "/tests/io/write_variants.py";
   const std::string cmd = "/usr/bin/python3 '" + script + "' " + kind + " '" + source.string() + "' '" + dir.string() + "'";
   const int status = std::system(cmd.c_str());
   // The Python packages are required (scripts/common.sh): a missing one fails the test.

@@ -8,7 +8,7 @@
 
 #include "primal/model.hpp"
 
-namespace geode::conform {
+namespace geode::demo {
 
 using primal::Model;
 
@@ -70,4 +70,4 @@ const std::vector<std::string>& demo_model_names();
 // InvalidInput naming an unknown name.
 Model demo_model(const std::string& name, int n);
 
-}  // namespace geode::conform
+}  // namespace geode::demo

@@ -1,4 +1,4 @@
-#include "primal/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -12,7 +12,9 @@
 
 #include "primal/errors.hpp"
 
-namespace geode::primal {
+namespace geode::io {
+
+using namespace primal;
 
 namespace {
 
@@ -91,4 +93,4 @@ void write_file_atomically(const std::filesystem::path& path,
   }, false);
 }
 
-}  // namespace geode::primal
+}  // namespace geode::io

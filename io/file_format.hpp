@@ -11,7 +11,7 @@
 #include <string>
 #include <string_view>
 
-namespace geode::primal {
+namespace geode::io {
 
 enum class MeshFileFormat { kUnknown, kGmsh, kExodus, kVtu, kVtk };
 
@@ -30,4 +30,4 @@ std::string read_file_bytes(const std::filesystem::path& path);
 // InvalidInput naming the file when its content is not `expected` (saying what it looks like).
 void check_mesh_format(const std::filesystem::path& path, MeshFileFormat expected);
 
-}  // namespace geode::primal
+}  // namespace geode::io

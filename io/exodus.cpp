@@ -1,6 +1,6 @@
-#include "primal/io_exodus.hpp"
+#include "io/exodus.hpp"
 
-#include "primal/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 
 #include <exodusII.h>
 #include <unistd.h>
@@ -13,10 +13,12 @@
 #include <vector>
 
 #include "primal/errors.hpp"
-#include "primal/file_format.hpp"
+#include "io/file_format.hpp"
 #include "primal/topology.hpp"
 
-namespace geode::primal {
+namespace geode::io {
+
+using namespace primal;
 
 namespace {
 
@@ -332,4 +334,4 @@ void write_exodus(const Model& model, const std::filesystem::path& path) {
   });
 }
 
-}  // namespace geode::primal
+}  // namespace geode::io
