@@ -37,6 +37,7 @@ struct ConformArgs {
   double merge_tolerance = -1;  // < 0: no merging
   double buffer_thickness = 0;  // 0: the side's default
   std::string buffer_side = "hex";
+  std::string pyramids = "split";
   double smooth_target = 0.0;
   std::string template_box;
   int n = 4;
@@ -58,11 +59,11 @@ double output_min_sj(const conform::ConformResult& r) {
 
 nlohmann::json result_json(const conform::ConformResult& r) {
   nlohmann::json j;
-  j["input"] = {{"hexes", r.input_hexes}, {"tets", r.input_tets},
-                {"interface_quads", r.interface_quads}};
+  j["input"] = {{"hexes", r.input_hexes}, {"tets", r.input_tets}, {"pyramids", r.input_pyramids},
+                {"wedges", r.input_wedges}, {"interface_quads", r.interface_quads}};
   j["output"] = {{"hexes", r.model.hexes.size()},    {"nodes", r.model.points.size()},
                  {"diced_hexes", r.diced_hexes},     {"geode_hexes", r.geode_hexes},
-                 {"diced_tet_hexes", r.diced_tet_hexes}};
+                 {"diced_tet_hexes", r.diced_tet_hexes}, {"diced_wedge_hexes", r.diced_wedge_hexes}};
   j["valid"] = r.validity.ok();
   j["template_min_scaled_jacobian"] = r.template_min_scaled_jacobian;
   j["min_scaled_jacobian_before_smoothing"] = r.min_scaled_jacobian_before_smoothing;
@@ -75,7 +76,8 @@ nlohmann::json result_json(const conform::ConformResult& r) {
   j["buffer_layer_min_scaled_jacobian"] = r.buffer.min_scaled_jacobian;
   j["buffer_side"] = conform::buffer_side_name(r.buffer_side);
   j["input_diced_alone_min_scaled_jacobian"] = {{"hexes", r.input_diced_hex_min_scaled_jacobian},
-                                                {"tets", r.input_diced_tet_min_scaled_jacobian}};
+                                                {"tets", r.input_diced_tet_min_scaled_jacobian},
+                                                {"wedges", r.input_diced_wedge_min_scaled_jacobian}};
   j["output_min_scaled_jacobian"] = output_min_sj(r);
   j["seconds"] = r.seconds;
   j["warnings"] = r.warnings;
@@ -95,10 +97,14 @@ bool result_valid(const conform::ConformResult& r) {
 }
 
 void print_summary(const conform::ConformResult& r, std::ostream& os, bool tables) {
-  os << "input: " << r.input_hexes << " hexes, " << r.input_tets << " tets, "
-     << r.interface_quads << " interface quads\n";
+  os << "input: " << r.input_hexes << " hexes, " << r.input_tets << " tets, ";
+  if (r.input_pyramids) os << r.input_pyramids << " pyramids (split), ";
+  if (r.input_wedges) os << r.input_wedges << " wedges, ";
+  os << r.interface_quads << " interface quads\n";
   os << "output: " << r.model.hexes.size() << " hexes (" << r.diced_hexes << " diced hex, "
-     << r.geode_hexes << " geode, " << r.diced_tet_hexes << " diced tet), "
+     << r.geode_hexes << " geode, " << r.diced_tet_hexes << " diced tet";
+  if (r.diced_wedge_hexes) os << ", " << r.diced_wedge_hexes << " diced wedge";
+  os << "), "
      << r.model.points.size() << " nodes, " << (result_valid(r) ? "valid" : "INVALID") << ", "
      << r.seconds << " s\n";
   for (const auto& b : r.quality) {
@@ -110,7 +116,9 @@ void print_summary(const conform::ConformResult& r, std::ostream& os, bool table
   const double yardstick = r.yardstick();
   const double output = output_min_sj(r);
   os << "input diced alone: min scaled Jacobian " << r.input_diced_hex_min_scaled_jacobian << " (hexes), "
-     << r.input_diced_tet_min_scaled_jacobian << " (tets); output " << output;
+     << r.input_diced_tet_min_scaled_jacobian << " (tets" << (r.input_pyramids ? ", pyramids as their two tets" : "") << ")";
+  if (r.input_wedges) os << ", " << r.input_diced_wedge_min_scaled_jacobian << " (wedges)";
+  os << "; output " << output;
   if (yardstick > 0) os << " = " << output / yardstick << " x the lower";
   os << "\n";
 }
@@ -176,6 +184,7 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
   }
   conform::ConformOptions opts;
   opts.smooth = conform::parse_conform_smooth(a.smooth);
+  opts.pyramids = conform::parse_conform_pyramids(a.pyramids);
   opts.quality = conform::parse_conform_quality(a.quality);
   opts.geode_block = a.geode_block;
   opts.buffer.side = conform::parse_buffer_side(a.buffer_side);
@@ -267,6 +276,10 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
                 "first merge nodes closer than this distance (model units), for parts meshed\n"
                 "separately whose interface nodes are duplicated")
       ->check(number_check(0, 1e300));
+  c->add_option("--pyramids", a.pyramids,
+                "what pyramids of a hybrid mesh become: split (default): two tets along the base diagonal\n"
+                "giving the better tets, the base quad then getting the geode transition")
+      ->capture_default_str();
   c->add_option("--buffer-side", a.buffer_side,
                 "the part the buffer layer is carved from: hex (default; the tets stay as meshed, the\n"
                 "hexes at the interface are squashed) or tet (the hexes stay, the tets shrink off the interface)")
@@ -317,7 +330,11 @@ void add_conform_commands(CLI::App& app) {
                  "nugget: a Delaunay tet cube in 26 structured blocks; fulcher: the same with circles\n"
                  "imprinted on three nugget faces, those blocks swept from unstructured quads; fourtri:\n"
                  "beside a Delaunay tet box whose interface quads are split into two or four triangles\n"
-                 "(at random); fourtri-cylinder: the cylinder with half its interface quads in four triangles")
+                 "(at random); fourtri-cylinder: the cylinder with half its interface quads in four triangles;\n"
+                 "hybrid meshes Gmsh makes in one generate(3), with its pyramids: hybrid (a transfinite hex\n"
+                 "box beside a Delaunay tet box), hybrid-cylinder (a swept hex cylinder in a Delaunay box),\n"
+                 "boundary-layer (wedge layers extruded on a tet box), hexdominant (hexes, tets, pyramids\n"
+                 "and wedges side by side)")
       ->check(CLI::IsMember(demo::demo_model_names()))
       ->capture_default_str();
   d->add_option("-n,--size", dargs->n, "cells per unit length (1 to 64; default 4; nugget, fulcher round up to even)")
@@ -343,7 +360,8 @@ void add_conform_commands(CLI::App& app) {
       files.commit();
       if (!dargs->quiet)
         std::cout << "wrote " << dargs->save_input << " (" << model.hexes.size() << " hexes, "
-                  << model.tets.size() << " tets)\n";
+                  << model.tets.size() << " tets, " << model.pyramids.size() << " pyramids, " << model.wedges.size()
+                  << " wedges)\n";
       if (dargs->output.empty() && dargs->report.empty()) return;
     }
     run(std::move(model), *dargs, format, true);

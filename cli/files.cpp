@@ -48,9 +48,10 @@ MeshFile read_mesh_file(const fs::path& path) {
     return m;
   }
   const primal::Model model = read_model(path);
-  if (!model.tets.empty())
-    throw InvalidInput(path.string() + ": holds " + std::to_string(model.tets.size()) +
-                       " tets; expected an all-hex mesh (use `geode conform` first)");
+  for (primal::ElementKind kind : {primal::ElementKind::Tet, primal::ElementKind::Pyramid, primal::ElementKind::Wedge})
+    if (const std::size_t n = primal::element_count(model, kind))
+      throw InvalidInput(path.string() + ": holds " + std::to_string(n) + " " + primal::element_kind_name(kind) +
+                         "s; expected an all-hex mesh (use `geode conform` first)");
   m.hex = primal::hex_part(model);
   m.index_base = 1;
   return m;

@@ -633,9 +633,145 @@ Model demo_fulcher(int n) {
   });
 }
 
+// ---- Hybrid models as a user meshes them: one geometry, one generate(3) --------------------
+// Hex volumes transfinite (or swept) and recombined, tet volumes Delaunay, wedges extruded in
+// layers, all meshed together, so Gmsh itself puts a pyramid on every quad a tet volume meets.
+
+namespace {
+
+// One Gmsh model meshed in one generate(3), each volume its own named block; elements Gmsh hands
+// back inverted re-oriented (orient_positively, with pyramids and wedges).
+template <class F>
+Model hybrid_gmsh(const std::string& name, F&& build) {
+  GmshSession session;
+  try {
+    gmsh::model::add(name);
+    build();
+    gmsh::model::mesh::generate(3);
+    Model m = model_from_gmsh(name);
+    auto pt = [&](Index v) -> const Point& { return m.points[static_cast<std::size_t>(v)]; };
+    orient_positively(m);
+    for (auto& p : m.pyramids)
+      if (tet_volume(pt(p[0]), pt(p[1]), pt(p[2]), pt(p[4])) < 0) std::swap(p[1], p[3]);
+    for (auto& w : m.wedges)
+      if (tet_volume(pt(w[0]), pt(w[1]), pt(w[2]), pt(w[3])) < 0) std::swap(w[1], w[2]), std::swap(w[4], w[5]);
+    return m;
+  } catch (const std::string& s) {
+    throw std::runtime_error(name + ": Gmsh failed: " + s);
+  }
+}
+
+void name_volume(int volume, int block, const std::string& name) {
+  gmsh::model::addPhysicalGroup(3, {volume}, block);
+  gmsh::model::setPhysicalName(3, block, name);
+}
+
+// OCC boxes fragmented so that neighbours share their faces; returns the volumes in input order.
+std::vector<int> shared_boxes(const std::vector<std::array<double, 6>>& boxes) {
+  gmsh::vectorpair in;
+  for (const auto& b : boxes) in.push_back({3, gmsh::model::occ::addBox(b[0], b[1], b[2], b[3], b[4], b[5])});
+  gmsh::vectorpair fragments;
+  std::vector<gmsh::vectorpair> map;
+  gmsh::model::occ::fragment(in, {}, fragments, map);
+  gmsh::model::occ::synchronize();
+  std::vector<int> volumes;
+  for (const auto& m : map) volumes.push_back(m.front().second);
+  return volumes;
+}
+
+}  // namespace
+
+Model demo_hybrid(int n) {
+  if (n < 1) throw InvalidInput("demo_hybrid: n = " + std::to_string(n) + " must be >= 1");
+  const double h = 1.0 / n;
+  return hybrid_gmsh("demo_hybrid", [&] {
+    const auto v = shared_boxes({{0, 0, 0, 1, 1, 1}, {1, 0, 0, 1, 1, 1}});
+    transfinite_box(v[0], h);
+    gmsh::option::setNumber("Mesh.MeshSizeMax", h);
+    name_volume(v[0], 1, "hex");
+    name_volume(v[1], 2, "tet");
+  });
+}
+
+Model demo_hybrid_cylinder(int n) {
+  if (n < 2) throw InvalidInput("demo_hybrid_cylinder: n = " + std::to_string(n) + " must be >= 2");
+  const double h = 1.0 / n;
+  return hybrid_gmsh("demo_hybrid_cylinder", [&] {
+    // A disk of recombined quads swept in n layers (the hex cylinder) inside a Delaunay box:
+    // the box is cut by the cylinder, sharing its surfaces.
+    const int disk = gmsh::model::occ::addDisk(0, 0, -0.5, 0.5, 0.5);
+    gmsh::vectorpair swept;
+    gmsh::model::occ::extrude({{2, disk}}, 0, 0, 1, swept, {n}, {}, true);
+    int cylinder = 0;
+    for (const auto& [dim, tag] : swept)
+      if (dim == 3) cylinder = tag;
+    const int box = gmsh::model::occ::addBox(-1, -1, -1, 2, 2, 2);
+    gmsh::vectorpair fragments;
+    std::vector<gmsh::vectorpair> map;
+    gmsh::model::occ::fragment({{3, box}}, {{3, cylinder}}, fragments, map);
+    gmsh::model::occ::synchronize();
+    int potting = 0;
+    for (const auto& [dim, tag] : map[0])
+      if (tag != cylinder) potting = tag;
+    gmsh::option::setNumber("Mesh.MeshSizeMax", h);
+    gmsh::option::setNumber("Mesh.RecombinationAlgorithm", 3);  // blossom full-quad: no triangle left
+    gmsh::model::mesh::setRecombine(2, disk);
+    name_volume(cylinder, 1, "hex cylinder");
+    name_volume(potting, 2, "tet box");
+  });
+}
+
+Model demo_boundary_layer(int n) {
+  if (n < 1) throw InvalidInput("demo_boundary_layer: n = " + std::to_string(n) + " must be >= 1");
+  const double h = 1.0 / n;
+  return hybrid_gmsh("demo_boundary_layer", [&] {
+    // A Delaunay tet box with a boundary layer of wedges extruded from its top in 3 layers
+    // (0.1 thick, graded), as an analyst grows one on a wall.
+    const int box = gmsh::model::occ::addBox(0, 0, 0, 1, 1, 1);
+    gmsh::model::occ::synchronize();
+    int top = 0;
+    for (int s : boundary_surfaces(box))
+      if (bounding_box(2, s)[2] > 1.0 - kEps) top = s;
+    gmsh::vectorpair layer;
+    gmsh::model::occ::extrude({{2, top}}, 0, 0, 0.1, layer, {1, 1, 1}, {0.2, 0.5, 1.0}, true);
+    gmsh::model::occ::synchronize();
+    gmsh::option::setNumber("Mesh.MeshSizeMax", h);
+    name_volume(box, 2, "tet");
+    for (const auto& [dim, tag] : layer)
+      if (dim == 3) name_volume(tag, 4, "boundary layer");
+  });
+}
+
+Model demo_hexdominant(int n) {
+  if (n < 1) throw InvalidInput("demo_hexdominant: n = " + std::to_string(n) + " must be >= 1");
+  const double h = 1.0 / n;
+  return hybrid_gmsh("demo_hexdominant", [&] {
+    // An L of a transfinite hex block [0,1]^3 and a Delaunay tet block [1,2] x [0,1]^2 (pyramids
+    // on their shared face), a layer of wedges extruded off the tet block's far face x = 2, and a
+    // second hex block [0,1] x [1,2] x [0,1] on the first one's back face: all four cell kinds
+    // side by side, hexes meeting wedges' neighbours, tets meeting pyramids and wedges.
+    const auto v = shared_boxes({{0, 0, 0, 1, 1, 1}, {1, 0, 0, 1, 1, 1}, {0, 1, 0, 1, 1, 1}});
+    transfinite_box(v[0], h);
+    transfinite_box(v[2], h);
+    int far = 0;
+    for (int s : boundary_surfaces(v[1]))
+      if (bounding_box(2, s)[0] > 2.0 - kEps) far = s;
+    gmsh::vectorpair layer;
+    gmsh::model::occ::extrude({{2, far}}, 0.15, 0, 0, layer, {2}, {}, true);
+    gmsh::model::occ::synchronize();
+    gmsh::option::setNumber("Mesh.MeshSizeMax", h);
+    name_volume(v[0], 1, "hex");
+    name_volume(v[2], 3, "hex back");
+    name_volume(v[1], 2, "tet");
+    for (const auto& [dim, tag] : layer)
+      if (dim == 3) name_volume(tag, 4, "wedge layer");
+  });
+}
+
 const std::vector<std::string>& demo_model_names() {
   static const std::vector<std::string> names{"half", "delaunay", "delaunay-random", "cylinder",
-                                              "lshape", "nugget", "fulcher", "fourtri", "fourtri-cylinder"};
+                                              "lshape", "nugget", "fulcher", "fourtri", "fourtri-cylinder",
+                                              "hybrid", "hybrid-cylinder", "boundary-layer", "hexdominant"};
   return names;
 }
 
@@ -649,9 +785,13 @@ Model demo_model(const std::string& name, int n) {
   if (name == "fulcher") return demo_fulcher(n % 2 ? n + 1 : n);
   if (name == "fourtri") return demo_delaunay_block(n, DemoDiagonals::kRandom, true);
   if (name == "fourtri-cylinder") return demo_cylinder(n, true);
+  if (name == "hybrid") return demo_hybrid(n);
+  if (name == "hybrid-cylinder") return demo_hybrid_cylinder(n);
+  if (name == "boundary-layer") return demo_boundary_layer(n);
+  if (name == "hexdominant") return demo_hexdominant(n);
   throw InvalidInput("demo model '" + name +
                      "': expected one of half, delaunay, delaunay-random, cylinder, lshape, nugget, fulcher, "
-                     "fourtri, fourtri-cylinder");
+                     "fourtri, fourtri-cylinder, hybrid, hybrid-cylinder, boundary-layer, hexdominant");
 }
 
 }  // namespace geode::demo

@@ -1,5 +1,5 @@
 #pragma once
-// Mixed hex + tet models to exercise the whole-model geode pipeline:
+// Mixed models (hexes, tets, pyramids, wedges) to exercise the whole-model geode pipeline:
 // demo models meshed with the Gmsh API (no input file).
 #include <array>
 #include <functional>
@@ -62,9 +62,30 @@ Model demo_l_shape(int n = 4);
 // boundary quads. n must be even and >= 2.
 Model demo_fulcher(int n = 4);
 
+// Hybrid models as an analyst makes them with Gmsh: one geometry, every volume meshed in one
+// generate(3) (hex volumes transfinite or swept and recombined, tet volumes Delaunay), so
+// Gmsh puts the pyramids on the quads tet volumes meet. Each volume is its own named block.
+// hybrid: a transfinite hex box [0,1]^3 (block 1 "hex") sharing its face x = 1 with a
+// Delaunay tet box [1,2] x [0,1]^2 (block 2 "tet", pyramids on the shared quads).
+Model demo_hybrid(int n = 4);
+// hybrid-cylinder: a disk of recombined quads swept in n layers (block 1 "hex cylinder",
+// radius 0.5, height 1) inside a Delaunay box [-1,1]^3 (block 2 "tet box"): a curved interface
+// of pyramids.
+Model demo_hybrid_cylinder(int n = 4);
+// boundary-layer: a Delaunay tet box [0,1]^3 (block 2 "tet") with 3 graded layers of wedges
+// extruded off its top, 0.1 thick (block 4 "boundary layer"): no quad meets a triangle.
+Model demo_boundary_layer(int n = 4);
+// hexdominant: all four kinds side by side: transfinite hex boxes [0,1]^3 (block 1 "hex") and
+// [0,1] x [1,2] x [0,1] (block 3 "hex back"), a Delaunay tet box [1,2] x [0,1]^2 (block 2
+// "tet", pyramids on the face it shares with the first hex box) and 2 layers of wedges extruded
+// 0.15 off its face x = 2 (block 4 "wedge layer"). (Debian's Gmsh 4.8 Mesh.Recombine3DAll
+// gave only tets or crashed, so the kinds come from transfinite, extruded and Delaunay volumes.)
+Model demo_hexdominant(int n = 4);
+
 // The names `geode demo --model` takes: half, delaunay, delaunay-random, cylinder, lshape,
 // nugget (d: a convex Delaunay tet nugget in structured blocks), fulcher (e), fourtri (a,
-// random diagonals, four-triangle quads), fourtri-cylinder (b with four-triangle quads).
+// random diagonals, four-triangle quads), fourtri-cylinder (b with four-triangle quads),
+// hybrid, hybrid-cylinder, boundary-layer, hexdominant.
 const std::vector<std::string>& demo_model_names();
 // The model of that name with size parameter n (made even where the model needs it); throws
 // InvalidInput naming an unknown name.

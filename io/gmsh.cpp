@@ -125,31 +125,21 @@ Model model_from_gmsh(std::string_view source_view) {
     for (std::size_t t = 0; t < types.size(); ++t) {
       const auto& tags = element_tags[t];
       const auto& nodes = element_nodes[t];
-      if (types[t] != kGmshHex8 && types[t] != kGmshTet4) {
+      const ElementKind* kind = gmsh_cell_kind(types[t]);
+      if (!kind) {
         if (!tags.empty())
-          throw InvalidInput(source + ": element " + std::to_string(tags.front()) + ": " +
-                             gmsh_type_name(types[t]) +
-                             " is not supported; only 4-node tetrahedra and 8-node "
-                             "hexahedra are");
+          throw InvalidInput(source + ": element " + std::to_string(tags.front()) + ": " + gmsh_type_name(types[t]) +
+                             " is not supported; only linear cells are (4-node tetrahedra, 8-node hexahedra, "
+                             "6-node prisms, 5-node pyramids)");
         continue;
       }
+      const GmshCell& cell = kGmshCells[static_cast<std::size_t>(*kind)];
+      const auto n = static_cast<std::size_t>(cell.corners);
       for (std::size_t e = 0; e < tags.size(); ++e) {
         const std::string what = "element " + std::to_string(tags[e]);
-        if (types[t] == kGmshHex8) {
-          std::array<Index, 8> hex{};
-          for (int c = 0; c < 8; ++c)
-            hex[static_cast<std::size_t>(c)] =
-                node(nodes[8 * e + static_cast<std::size_t>(kGmshHexToVtk[static_cast<std::size_t>(c)])], what);
-          model.hexes.push_back(hex);
-          model.hex_block.push_back(block);
-        } else {
-          std::array<Index, 4> tet{};
-          for (int c = 0; c < 4; ++c)
-            tet[static_cast<std::size_t>(c)] =
-                node(nodes[4 * e + static_cast<std::size_t>(kGmshTetToVtk[static_cast<std::size_t>(c)])], what);
-          model.tets.push_back(tet);
-          model.tet_block.push_back(block);
-        }
+        std::array<Index, 8> c{};
+        for (std::size_t k = 0; k < n; ++k) c[k] = node(nodes[n * e + static_cast<std::size_t>(cell.order[k])], what);
+        add_element(model, *kind, c, block, static_cast<std::int64_t>(tags[e]));
       }
     }
   }
@@ -157,27 +147,12 @@ Model model_from_gmsh(std::string_view source_view) {
   // Physical groups of lower dimension: side sets (dim 2) and node sets (dim 0, 1).
   gmsh::vectorpair groups;
   gmsh::model::getPhysicalGroups(groups);
-  std::unordered_map<FaceKey, Side, IndexArrayHash> face_owner;
+  FaceOwners face_owner;
   bool faces_built = false;
   auto build_faces = [&] {
     if (faces_built) return;
     faces_built = true;
-    for (std::size_t h = 0; h < model.hexes.size(); ++h)
-      for (int f = 0; f < topology::kHexFaces; ++f) {
-        std::array<Index, 4> q{};
-        for (int i = 0; i < 4; ++i)
-          q[static_cast<std::size_t>(i)] =
-              model.hexes[h][static_cast<std::size_t>(topology::kHexFaceCorners[static_cast<std::size_t>(f)][static_cast<std::size_t>(i)])];
-        face_owner.emplace(face_key(q), Side{{ElementKind::Hex, static_cast<Index>(h)}, f});
-      }
-    for (std::size_t t = 0; t < model.tets.size(); ++t)
-      for (int f = 0; f < 4; ++f) {
-        std::array<Index, 3> tri{};
-        for (int i = 0; i < 3; ++i)
-          tri[static_cast<std::size_t>(i)] =
-              model.tets[t][static_cast<std::size_t>(topology::kTetFaceCorners[static_cast<std::size_t>(f)][static_cast<std::size_t>(i)])];
-        face_owner.emplace(face_key(tri), Side{{ElementKind::Tet, static_cast<Index>(t)}, f});
-      }
+    face_owner = FaceOwners(model);
   };
   for (const auto& [dim, ptag] : groups) {
     if (dim == 3) continue;
@@ -207,10 +182,9 @@ Model model_from_gmsh(std::string_view source_view) {
             std::vector<Index> face;
             for (std::size_t i = 0; i < n; ++i)
               face.push_back(node(element_nodes[t][n * e + i], where + ": " + what));
-            auto it = face_owner.find(face_key(face));
-            if (it == face_owner.end())
-              throw InvalidInput(where + ": " + what + " is not a face of any hex or tet");
-            set.sides.push_back(it->second);
+            const Side* owner = face_owner.find(face);
+            if (!owner) throw InvalidInput(where + ": " + what + " is not a face of any volume element");
+            set.sides.push_back(*owner);
           }
         }
       }
@@ -247,10 +221,8 @@ void write_gmsh(const Model& model, const std::filesystem::path& path, GmshForma
     gmsh_call(target, [&] {
       gmsh::model::add("geode");
       std::vector<int> blocks;
-      for (std::size_t h = 0; h < model.hexes.size(); ++h)
-        blocks.push_back(block_of(model, {ElementKind::Hex, static_cast<Index>(h)}));
-      for (std::size_t t = 0; t < model.tets.size(); ++t)
-        blocks.push_back(block_of(model, {ElementKind::Tet, static_cast<Index>(t)}));
+      for (ElementKind kind : kElementKinds)
+        for (std::size_t e = 0; e < element_count(model, kind); ++e) blocks.push_back(block_of(model, {kind, static_cast<Index>(e)}));
       std::sort(blocks.begin(), blocks.end());
       blocks.erase(std::unique(blocks.begin(), blocks.end()), blocks.end());
       // Nodes live on the first volume entity; elements of other entities may use them.
@@ -268,35 +240,26 @@ void write_gmsh(const Model& model, const std::filesystem::path& path, GmshForma
 
       std::size_t next_element = 1;
       for (int b : blocks) {
-        std::vector<std::size_t> hex_tags, hex_nodes, tet_tags, tet_nodes;
-        for (std::size_t h = 0; h < model.hexes.size(); ++h) {
-          if (block_of(model, {ElementKind::Hex, static_cast<Index>(h)}) != b) continue;
-          hex_tags.push_back(next_element++);
-          // gmsh_corner[kGmshHexToVtk[i]] = vtk_corner[i]
-          std::array<std::size_t, 8> g{};
-          for (std::size_t c = 0; c < 8; ++c)
-            g[static_cast<std::size_t>(kGmshHexToVtk[c])] = static_cast<std::size_t>(model.hexes[h][c]) + 1;
-          hex_nodes.insert(hex_nodes.end(), g.begin(), g.end());
-        }
-        for (std::size_t t = 0; t < model.tets.size(); ++t) {
-          if (block_of(model, {ElementKind::Tet, static_cast<Index>(t)}) != b) continue;
-          tet_tags.push_back(next_element++);
-          std::array<std::size_t, 4> g{};
-          for (std::size_t c = 0; c < 4; ++c)
-            g[static_cast<std::size_t>(kGmshTetToVtk[c])] = static_cast<std::size_t>(model.tets[t][c]) + 1;
-          tet_nodes.insert(tet_nodes.end(), g.begin(), g.end());
-        }
         std::vector<int> types;
         std::vector<std::vector<std::size_t>> tags, nodes;
-        if (!hex_tags.empty()) {
-          types.push_back(kGmshHex8);
-          tags.push_back(hex_tags);
-          nodes.push_back(hex_nodes);
-        }
-        if (!tet_tags.empty()) {
-          types.push_back(kGmshTet4);
-          tags.push_back(tet_tags);
-          nodes.push_back(tet_nodes);
+        for (ElementKind kind : kElementKinds) {
+          const GmshCell& cell = kGmshCells[static_cast<std::size_t>(kind)];
+          std::vector<std::size_t> kind_tags, kind_nodes;
+          for (std::size_t e = 0; e < element_count(model, kind); ++e) {
+            const ElementRef ref{kind, static_cast<Index>(e)};
+            if (block_of(model, ref) != b) continue;
+            kind_tags.push_back(next_element++);
+            // gmsh_corner[order[i]] = model_corner[i]
+            const auto corners = element_corners(model, ref);
+            std::array<std::size_t, 8> g{};
+            for (std::size_t c = 0; c < static_cast<std::size_t>(cell.corners); ++c)
+              g[static_cast<std::size_t>(cell.order[c])] = static_cast<std::size_t>(corners[c]) + 1;
+            kind_nodes.insert(kind_nodes.end(), g.begin(), g.begin() + cell.corners);
+          }
+          if (kind_tags.empty()) continue;
+          types.push_back(cell.type);
+          tags.push_back(std::move(kind_tags));
+          nodes.push_back(std::move(kind_nodes));
         }
         gmsh::model::mesh::addElements(3, b, types, tags, nodes);
         gmsh::model::addPhysicalGroup(3, {b}, b);
@@ -309,17 +272,9 @@ void write_gmsh(const Model& model, const std::filesystem::path& path, GmshForma
         gmsh::model::addDiscreteEntity(2, ++surface);
         std::vector<std::size_t> tri_tags, tri_nodes, quad_tags, quad_nodes;
         for (const Side& s : set.sides) {
-          const auto e = static_cast<std::size_t>(s.element.index);
-          const auto f = static_cast<std::size_t>(s.face);
-          if (s.element.kind == ElementKind::Hex) {
-            quad_tags.push_back(next_element++);
-            for (int c : topology::kHexFaceCorners[f])
-              quad_nodes.push_back(static_cast<std::size_t>(model.hexes[e][static_cast<std::size_t>(c)]) + 1);
-          } else {
-            tri_tags.push_back(next_element++);
-            for (int c : topology::kTetFaceCorners[f])
-              tri_nodes.push_back(static_cast<std::size_t>(model.tets[e][static_cast<std::size_t>(c)]) + 1);
-          }
+          const std::vector<Index> face = element_face(model, s);
+          (face.size() == 4 ? quad_tags : tri_tags).push_back(next_element++);
+          for (Index v : face) (face.size() == 4 ? quad_nodes : tri_nodes).push_back(static_cast<std::size_t>(v) + 1);
         }
         std::vector<int> types;
         std::vector<std::vector<std::size_t>> tags, nodes;
