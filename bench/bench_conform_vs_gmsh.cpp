@@ -39,6 +39,7 @@
 
 #include "demo/demo_models.hpp"
 #include "primal/errors.hpp"
+#include "io/exodus.hpp"
 #include "io/gmsh.hpp"
 
 namespace fs = std::filesystem;
@@ -48,6 +49,7 @@ namespace {
 
 struct Run {
   double seconds = 0.0;
+  double cpu_seconds = 0.0;  // user + system, from the child's rusage
   double peak_mib = 0.0;
   int status = 0;  // wait status; 0 when the child exited 0
 };
@@ -79,6 +81,8 @@ Run run_child(const std::vector<std::string>& argv, const fs::path& log) {
   }
   Run r;
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.cpu_seconds = static_cast<double>(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
+                  1e-6 * static_cast<double>(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
   r.peak_mib = ru.ru_maxrss / 1024.0;  // ru_maxrss is in KiB on Linux
   r.status = status;
   return r;
@@ -128,10 +132,10 @@ gp::Model tet_model(const gp::Model& m) {
   return t;
 }
 
-void print_row(const char* what, const Run& r, std::size_t hexes, const Run& reference) {
-  std::printf("%-22s %8.2f s %9.1f MiB %10zu hexes %7.0f B/hex   time %.2fx  memory %.2fx\n",
-              what, r.seconds, r.peak_mib, hexes, r.peak_mib * 1048576.0 / hexes,
-              r.seconds / reference.seconds, r.peak_mib / reference.peak_mib);
+void print_row(const char* what, const Run& r, std::size_t hexes, const Run& reference, const Run& floor) {
+  std::printf("%-22s %7.2f s %7.2f s CPU %8.1f MiB %9zu hexes %5.0f B/hex   x gmsh %.2f  x floor %.2f (CPU %.2f)\n",
+              what, r.seconds, r.cpu_seconds, r.peak_mib, hexes, r.peak_mib * 1048576.0 / hexes,
+              r.seconds / reference.seconds, r.seconds / floor.seconds, r.cpu_seconds / floor.cpu_seconds);
 }
 
 }  // namespace
@@ -141,13 +145,14 @@ int main(int argc, char** argv) {
   const int repeats = argc > 2 ? std::atoi(argv[2]) : 1;
   const fs::path self = fs::canonical("/proc/self/exe");
   const std::string geode = argc > 3 ? argv[3] : (self.parent_path() / "geode").string();
+  const std::string floor_exe = (self.parent_path() / "bench_floor").string();
   const char* gmsh_env = std::getenv("GMSH");
   const std::string gmsh = gmsh_env ? gmsh_env : "/usr/bin/gmsh";
   if (n < 2 || repeats < 1) {
     std::fprintf(stderr, "usage: bench_conform_vs_gmsh [n >= 2] [repeats >= 1] [geode]\n");
     return 2;
   }
-  for (const auto& exe : {geode, gmsh})
+  for (const auto& exe : {geode, gmsh, floor_exe})
     if (access(exe.c_str(), X_OK) != 0) {
       std::fprintf(stderr, "bench_conform_vs_gmsh: %s is not an executable\n", exe.c_str());
       return 2;
@@ -187,12 +192,33 @@ int main(int argc, char** argv) {
                "--report", (dir / "report_none.json").string(), "--smooth", "none", "--quiet"},
               dir / "geode_none.log", "geode conform --smooth none");
 
-  std::size_t gmsh_hexes = 0, geode_hexes = 0;
+  const Run floor = best_of(repeats, {floor_exe, (dir / "model.msh").string(), (dir / "floor.exo").string()},
+                            dir / "floor.log", "floor");
+  // The same defaults on one thread (--threads 1): the 2-core speed-up, wall and CPU.
+  const Run conform_one =
+      best_of(repeats,
+              {geode, "conform", (dir / "model.msh").string(), "-o", (dir / "geode_one.exo").string(),
+               "--report", (dir / "report_one.json").string(), "--threads", "1", "--quiet"},
+              dir / "geode_one.log", "geode conform --threads 1");
+  // Every other output format against .exo (the same defaults).
+  std::vector<std::pair<std::string, Run>> formats;
+  for (const char* ext : {"msh", "vtu", "vtk"}) {
+    const std::string out = (dir / (std::string("geode.") + ext)).string();
+    formats.emplace_back(ext, best_of(repeats,
+                                      {geode, "conform", (dir / "model.msh").string(), "-o", out, "--report",
+                                       (dir / (std::string("report_") + ext + ".json")).string(), "--quiet"},
+                                      dir / (std::string("geode_") + ext + ".log"), ext));
+    std::error_code ec;
+    fs::remove(out, ec);
+  }
+
+  std::size_t gmsh_hexes = 0, geode_hexes = 0, floor_hexes = 0;
   bool geode_valid = false;
   std::size_t buffer_hexes = 0;
   double smoothing_cpu = 0.0;
   std::vector<std::string> block_min;
   try {
+    floor_hexes = geode::io::read_exodus(dir / "floor.exo").hexes.size();
     const gp::Model g = geode::io::read_gmsh(dir / "gmsh.msh");
     gmsh_hexes = g.hexes.size();
     if (!g.tets.empty()) std::printf("warning: gmsh's output still has %zu tets\n", g.tets.size());
@@ -210,17 +236,27 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "bench_conform_vs_gmsh: reading the outputs back: %s\n", e.what());
     return 1;
   }
-  if (gmsh_hexes == 0 || geode_hexes == 0) {
+  if (gmsh_hexes == 0 || geode_hexes == 0 || floor_hexes == 0) {
     std::fprintf(stderr, "bench_conform_vs_gmsh: an output has no hexes\n");
     return 1;
   }
 
-  std::printf("best of %d; ratios against gmsh subdivide (read + RefineMesh, no output)\n",
+  std::printf("best of %d; ratios against gmsh subdivide (read + RefineMesh, no output) and the floor\n",
               repeats);
-  print_row("gmsh subdivide", sub, gmsh_hexes, sub);
-  print_row("gmsh subdivide+save", sub_save, gmsh_hexes, sub);
-  print_row("geode conform", conform, geode_hexes, sub);
-  print_row("geode --smooth none", conform_none, geode_hexes, sub);
+  print_row("floor (read+dice+exo)", floor, floor_hexes, sub, floor);
+  print_row("gmsh subdivide", sub, gmsh_hexes, sub, floor);
+  print_row("gmsh subdivide+save", sub_save, gmsh_hexes, sub, floor);
+  print_row("geode conform", conform, geode_hexes, sub, floor);
+  print_row("geode --threads 1", conform_one, geode_hexes, sub, floor);
+  print_row("geode --smooth none", conform_none, geode_hexes, sub, floor);
+  for (const auto& [ext, r] : formats)
+    print_row(("geode -o ." + ext).c_str(), r, geode_hexes, sub, floor);
+  std::printf("geode conform / floor: time %.2fx, CPU %.2fx; --threads 1 / 2: wall %.2fx\n",
+              conform.seconds / floor.seconds, conform.cpu_seconds / floor.cpu_seconds,
+              conform_one.seconds / conform.seconds);
+  for (const auto& [ext, r] : formats)
+    std::printf("-o .%s / -o .exo: time %.2fx, CPU %.2fx\n", ext.c_str(), r.seconds / conform.seconds,
+                r.cpu_seconds / conform.cpu_seconds);
   std::printf("local smoothing: %.2f ms CPU per buffer hex (%zu buffer hexes); the two runs differ by %.2f s wall\n",
               1e3 * smoothing_cpu / static_cast<double>(buffer_hexes), buffer_hexes,
               conform.seconds - conform_none.seconds);

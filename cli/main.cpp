@@ -1,5 +1,8 @@
 // geode: all-hex meshing through the dual (the Spatial Twist Continuum).
 #include <iostream>
+#include <memory>
+
+#include <tbb/global_control.h>
 
 #include "cli/commands.hpp"
 #include "cli/conventions.hpp"
@@ -37,6 +40,18 @@ int main(int argc, char** argv) {
       "Exit codes: 0 done, 2 usage or input error, 3 topology refusal, 4 invalid result."};
   app.require_subcommand(1);
   app.set_version_flag("--version", geode::cli::version_text(), "print the version and exit");
+  // --threads before or after the command: subcommands pass options they do not know to here
+  // (fallthrough, inherited by the commands added below). Its callback runs before any command's.
+  std::unique_ptr<tbb::global_control> threads;
+  app.fallthrough();
+  app.add_option_function<int>(
+         "--threads",
+         [&threads](int n) {
+           threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                           static_cast<std::size_t>(n));
+         },
+         "worker threads (default: every core); every result is the same for any number")
+      ->check(CLI::Range(1, 4096));
   geode::cli::add_template_command(app);
   geode::cli::add_study_commands(app);
   geode::cli::add_conform_commands(app);

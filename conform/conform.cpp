@@ -403,21 +403,26 @@ void Conformer::match_sides() {
 }
 
 // The hexes by block in ascending id, unused nodes dropped, node and side sets carried over
-// (they depend only on the numbering); the dicing data are released before smoothing and
-// verification, which need room of their own.
+// (they depend only on the numbering). Memory: the output is built out of the dicing data,
+// not beside them: the diced hex children become the output's hex array, each dicing array is
+// released as soon as it is consumed, and the nodes are renumbered in place (no second copy
+// of the output mesh); the smoothing and verification that follow need room of their own.
 void Conformer::assemble() {
   const std::size_t nb = layer_.hexes.size();
-  std::vector<std::array<Index, 8>> hexes;
-  std::vector<int> block;
-  hexes.reserve(diced_.hex_children.size() + res_.geode_hexes + diced_.tet_children.size() + diced_.wedge_children.size());
-  block.reserve(hexes.capacity());
   // Each output hex is in the input block of the element it comes from; a geode hex in the
   // block of the element its buffer hex was carved from, or in a block of its own.
   blocks_ = output_blocks(input_, options_.geode_block);
   const primal::Model& lm = layer_.model;
-  for (std::size_t k = 0; k < diced_.hex_children.size(); ++k)
-    hexes.push_back(diced_.hex_children[k]),
-        block.push_back(primal::block_of(lm, {primal::ElementKind::Hex, diced_.hex_parent[k]}));
+  // Side sets read the children in diced numbers: taken before the children move.
+  side_sets_ = primal::diced_side_sets(lm, diced_, 0, res_.diced_hexes + res_.geode_hexes);
+  const std::size_t total = diced_.hex_children.size() + static_cast<std::size_t>(res_.geode_hexes) +
+                            diced_.tet_children.size() + diced_.wedge_children.size();
+  std::vector<std::array<Index, 8>> hexes = std::move(diced_.hex_children);
+  hexes.reserve(total);
+  std::vector<int> block;
+  block.reserve(total);
+  for (Index parent : diced_.hex_parent) block.push_back(primal::block_of(lm, {primal::ElementKind::Hex, parent}));
+  diced_.hex_parent = {};
   geode_first_.reserve(nb + 1);
   for (std::size_t b = 0; b < nb; ++b) {
     geode_first_.push_back(static_cast<Index>(hexes.size()));
@@ -429,27 +434,47 @@ void Conformer::assemble() {
     }
   }
   geode_first_.push_back(static_cast<Index>(hexes.size()));
-  for (std::size_t k = 0; k < diced_.tet_children.size(); ++k)
-    hexes.push_back(diced_.tet_children[k]),
-        block.push_back(primal::block_of(lm, {primal::ElementKind::Tet, diced_.tet_parent[k]}));
-  for (std::size_t k = 0; k < diced_.wedge_children.size(); ++k)
-    hexes.push_back(diced_.wedge_children[k]),
-        block.push_back(primal::block_of(lm, {primal::ElementKind::Wedge, diced_.wedge_parent[k]}));
   inst_global_ = {};
+  hexes.insert(hexes.end(), diced_.tet_children.begin(), diced_.tet_children.end());
+  diced_.tet_children = {};
+  for (Index parent : diced_.tet_parent) block.push_back(primal::block_of(lm, {primal::ElementKind::Tet, parent}));
+  diced_.tet_parent = {};
+  hexes.insert(hexes.end(), diced_.wedge_children.begin(), diced_.wedge_children.end());
+  diced_.wedge_children = {};
+  for (Index parent : diced_.wedge_parent) block.push_back(primal::block_of(lm, {primal::ElementKind::Wedge, parent}));
+  diced_.wedge_parent = {};
+  diced_.shared = primal::KeyMap<4>();
+  // Nodes numbered in order of first use by the hexes (unused ones dropped).
   std::vector<Index> renum(diced_.points.size(), kInvalidIndex);
-  mesh_.points.reserve(diced_.points.size());
+  Index used = 0;
   for (auto& h : hexes)
     for (Index& v : h) {
-      if (renum[v] == kInvalidIndex) {
-        renum[v] = static_cast<Index>(mesh_.points.size());
-        mesh_.points.push_back(diced_.points[v]);
-      }
-      v = renum[v];
+      Index& r = renum[static_cast<std::size_t>(v)];
+      if (r == kInvalidIndex) r = used++;
+      v = r;
     }
+  node_sets_ = primal::diced_node_sets(lm, diced_, renum);
+  diced_.origin = {};
+  // The points permuted in place: follow each cycle of the renumbering (dropped nodes go to
+  // the tail, then are cut off).
+  std::vector<Point>& points = diced_.points;
+  {
+    Index tail = used;
+    for (Index& r : renum)
+      if (r == kInvalidIndex) r = tail++;
+    for (std::size_t i = 0; i < renum.size(); ++i)
+      while (renum[i] != static_cast<Index>(i)) {
+        const auto j = static_cast<std::size_t>(renum[i]);
+        std::swap(points[i], points[j]);
+        std::swap(renum[i], renum[j]);
+      }
+  }
+  renum = {};
+  points.resize(static_cast<std::size_t>(used));
+  points.shrink_to_fit();
+  mesh_.points = std::move(points);
   mesh_.hexes = std::move(hexes);
   mesh_.block = std::move(block);
-  node_sets_ = primal::diced_node_sets(layer_.model, diced_, renum);
-  side_sets_ = primal::diced_side_sets(layer_.model, diced_, 0, res_.diced_hexes + res_.geode_hexes);
   diced_ = primal::DicedModel();
   res_.min_scaled_jacobian_before_smoothing = measure();
 }

@@ -3,14 +3,19 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <iomanip>
 #include <map>
+#include <mutex>
 #include <regex>
 #include <set>
 #include <sstream>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include "primal/errors.hpp"
 #include "primal/multilinear.hpp"
@@ -231,37 +236,61 @@ InterleaveStudy interleave_study(const std::vector<InterleaveCase>& cases, const
     std::vector<double> example_parameters;
     Template example_template;  // valid classes
   };
-  std::map<std::pair<bool, std::string>, Outcome> outcomes;
-  std::vector<std::string> keys;  // per run
-  for (const auto& cs : cases) {
+  // Every push is built on its own (TBB, one case per task: a push takes tens of milliseconds
+  // to seconds) into its own slot; the runs are then grouped into classes in case order, so the
+  // tables are the same for any thread count.
+  struct Built {
     InterleaveRun run;
-    run.push = cs.push;
-    run.parameters = cs.parameters;
-    const auto t0 = std::chrono::steady_clock::now();
     std::string key;
     Template t;
-    try {
-      t = cs.build();
-      run.valid = true;
-      run.hexes = static_cast<int>(t.dim == 3 ? t.hex.hexes.size() : t.quad.quads.size());
-      run.conditions_ok = t.checks.ok();
-      std::set<std::string> failed;
-      for (const auto& f : t.checks.failures) failed.insert(strip_numbers(f));
-      for (const auto& f : failed) run.conditions += (run.conditions.empty() ? "" : "; ") + f;
-      key = template_class_key(t);
-    } catch (const TopologyError& e) {
-      run.diagnosis = strip_numbers(e.what());
-      key = run.diagnosis;
+  };
+  std::vector<Built> built(cases.size());
+  std::atomic<std::size_t> done{0};
+  std::mutex progress_mutex;  // the callback is called from one thread at a time
+  auto report = [&](const char* what, std::size_t total) {
+    const std::size_t d = ++done;
+    if (!progress) return;
+    std::lock_guard lock(progress_mutex);
+    progress(what, d, total);
+  };
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cases.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+      const InterleaveCase& cs = cases[i];
+      InterleaveRun& run = built[i].run;
+      run.push = cs.push;
+      run.parameters = cs.parameters;
+      const auto t0 = std::chrono::steady_clock::now();
+      try {
+        Template& t = built[i].t;
+        t = cs.build();
+        run.valid = true;
+        run.hexes = static_cast<int>(t.dim == 3 ? t.hex.hexes.size() : t.quad.quads.size());
+        run.conditions_ok = t.checks.ok();
+        std::set<std::string> failed;
+        for (const auto& f : t.checks.failures) failed.insert(strip_numbers(f));
+        for (const auto& f : failed) run.conditions += (run.conditions.empty() ? "" : "; ") + f;
+        built[i].key = template_class_key(t);
+      } catch (const TopologyError& e) {
+        run.diagnosis = strip_numbers(e.what());
+        built[i].key = run.diagnosis;
+      }
+      run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      report("pushes", cases.size());
     }
-    run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    auto& oc = outcomes[{run.valid, key}];
-    if (oc.count == 0) oc = {run.valid, key, run.hexes, 0, 0, run.push, run.parameters, std::move(t)};
+  });
+  std::map<std::pair<bool, std::string>, Outcome> outcomes;
+  std::vector<std::string> keys;  // per run
+  for (Built& b : built) {
+    InterleaveRun& run = b.run;
+    auto& oc = outcomes[{run.valid, b.key}];
+    if (oc.count == 0) oc = {run.valid, b.key, run.hexes, 0, 0, run.push, run.parameters, std::move(b.t)};
     ++oc.count;
     oc.ok += run.conditions_ok ? 1 : 0;
-    keys.push_back(key);
-    study.runs.push_back(run);
-    if (progress) progress("pushes", study.runs.size(), cases.size());
+    keys.push_back(std::move(b.key));
+    study.runs.push_back(std::move(run));
+    b.t = Template();  // only the first of a class is kept
   }
+  built = {};
   std::vector<const Outcome*> order;
   for (const auto& [k, oc] : outcomes) order.push_back(&oc);
   std::stable_sort(order.begin(), order.end(), [](const Outcome* a, const Outcome* b) {
@@ -281,11 +310,17 @@ InterleaveStudy interleave_study(const std::vector<InterleaveCase>& cases, const
     c.conditions_ok = oc->ok;
     c.example = oc->example;
     c.example_parameters = oc->example_parameters;
-    if (c.valid) measure_class(c, oc->example_template);
-    if (progress) progress("classes", study.classes.size() + 1, order.size());
     label[{c.valid, c.key}] = c.label;
     study.classes.push_back(c);
   }
+  // Each valid class's example smoothed (twice) on its own, in parallel, into its own slot.
+  done = 0;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+      if (study.classes[i].valid) measure_class(study.classes[i], order[i]->example_template);
+      report("classes", order.size());
+    }
+  });
   for (std::size_t r = 0; r < study.runs.size(); ++r)
     study.runs[r].class_label = label.at({study.runs[r].valid, keys[r]});
   return study;

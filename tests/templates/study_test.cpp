@@ -7,6 +7,9 @@
 #include <cmath>
 #include <map>
 #include <numeric>
+#include <sstream>
+
+#include <tbb/global_control.h>
 
 #include "primal/errors.hpp"
 #include "primal/quality.hpp"
@@ -112,6 +115,27 @@ TEST_CASE("template_obstructions: none on the geode, pinched corners and doublet
   CHECK(t24.hex.hexes.size() == 24);
   const auto c24 = kinds(templates::template_obstructions(t24));
   CHECK(c24.count(primal::ObstructionKind::kDoublet));
+}
+
+TEST_CASE("interleave study: the same tables on one thread and on every core") {
+  // The pushes are built in parallel; the runs are grouped in case order, so the CSV tables
+  // must not depend on the thread count (nor on which push finishes first).
+  const templates::PushGrid grid{{0.85, 0.95}, {0.3, 0.6}, {0.5, 0.9}, {0.3, 0.6}};
+  auto tables = [&] {
+    const auto study = templates::interleave_study(GeodeOptions{}, grid, "geode3d");
+    std::ostringstream csv, summary;
+    templates::write_interleave_csv(csv, study);
+    templates::write_interleave_summary(summary, study);
+    return csv.str() + "\n" + summary.str();
+  };
+  std::string one;
+  {
+    tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
+    one = tables();
+  }
+  const std::string all = tables();
+  CHECK(one.find("V1") != std::string::npos);
+  CHECK(one == all);
 }
 
 TEST_CASE("interleave study: grid points with low >= high are skipped") {
