@@ -1,7 +1,5 @@
 #include "io/gmsh.hpp"
 
-#include "io/atomic_file.hpp"
-
 #include <gmsh.h>
 #include <unistd.h>
 
@@ -14,6 +12,7 @@
 #include "primal/boundary.hpp"
 #include "primal/errors.hpp"
 #include "io/file_format.hpp"
+#include "io/mapped_file.hpp"
 #include "primal/topology.hpp"
 
 namespace geode::io {
@@ -234,129 +233,7 @@ Model model_from_gmsh(std::string_view source_view) {
 
 Model read_gmsh(const std::filesystem::path& path, const ReadOptions& options) {
   check_mesh_format(path, MeshFileFormat::kGmsh);
-  return parse_gmsh(read_file_bytes(path), path.string(), options);
-}
-
-void write_gmsh(const Model& model, const std::filesystem::path& path, GmshFormat format,
-                GmshVersion version) {
-  const std::string target = path.string();
-  validate(model, target);
-  GmshSession session;
-  // Gmsh picks the format from the extension, so the temporary file keeps ".msh".
-  write_path_atomically(path, ".msh", [&](const std::filesystem::path& temp) {
-    gmsh_call(target, [&] {
-      gmsh::model::add("geode");
-      std::vector<int> blocks;
-      for (std::size_t h = 0; h < model.hexes.size(); ++h)
-        blocks.push_back(block_of(model, {ElementKind::Hex, static_cast<Index>(h)}));
-      for (std::size_t t = 0; t < model.tets.size(); ++t)
-        blocks.push_back(block_of(model, {ElementKind::Tet, static_cast<Index>(t)}));
-      std::sort(blocks.begin(), blocks.end());
-      blocks.erase(std::unique(blocks.begin(), blocks.end()), blocks.end());
-      // Nodes live on the first volume entity; elements of other entities may use them.
-      const int node_entity = blocks.empty() ? 1 : blocks.front();
-      if (blocks.empty()) gmsh::model::addDiscreteEntity(3, node_entity);
-      for (int b : blocks) gmsh::model::addDiscreteEntity(3, b);
-      std::vector<std::size_t> node_tags(model.points.size());
-      std::vector<double> coords;
-      coords.reserve(3 * model.points.size());
-      for (std::size_t i = 0; i < model.points.size(); ++i) {
-        node_tags[i] = i + 1;
-        coords.insert(coords.end(), {model.points[i].x(), model.points[i].y(), model.points[i].z()});
-      }
-      if (!node_tags.empty()) gmsh::model::mesh::addNodes(3, node_entity, node_tags, coords);
-
-      std::size_t next_element = 1;
-      for (int b : blocks) {
-        std::vector<std::size_t> hex_tags, hex_nodes, tet_tags, tet_nodes;
-        for (std::size_t h = 0; h < model.hexes.size(); ++h) {
-          if (block_of(model, {ElementKind::Hex, static_cast<Index>(h)}) != b) continue;
-          hex_tags.push_back(next_element++);
-          // gmsh_corner[kGmshHexToVtk[i]] = vtk_corner[i]
-          std::array<std::size_t, 8> g{};
-          for (std::size_t c = 0; c < 8; ++c)
-            g[static_cast<std::size_t>(kGmshHexToVtk[c])] = static_cast<std::size_t>(model.hexes[h][c]) + 1;
-          hex_nodes.insert(hex_nodes.end(), g.begin(), g.end());
-        }
-        for (std::size_t t = 0; t < model.tets.size(); ++t) {
-          if (block_of(model, {ElementKind::Tet, static_cast<Index>(t)}) != b) continue;
-          tet_tags.push_back(next_element++);
-          std::array<std::size_t, 4> g{};
-          for (std::size_t c = 0; c < 4; ++c)
-            g[static_cast<std::size_t>(kGmshTetToVtk[c])] = static_cast<std::size_t>(model.tets[t][c]) + 1;
-          tet_nodes.insert(tet_nodes.end(), g.begin(), g.end());
-        }
-        std::vector<int> types;
-        std::vector<std::vector<std::size_t>> tags, nodes;
-        if (!hex_tags.empty()) {
-          types.push_back(kGmshHex8);
-          tags.push_back(hex_tags);
-          nodes.push_back(hex_nodes);
-        }
-        if (!tet_tags.empty()) {
-          types.push_back(kGmshTet4);
-          tags.push_back(tet_tags);
-          nodes.push_back(tet_nodes);
-        }
-        gmsh::model::mesh::addElements(3, b, types, tags, nodes);
-        gmsh::model::addPhysicalGroup(3, {b}, b);
-        if (auto it = model.block_names.find(b); it != model.block_names.end())
-          gmsh::model::setPhysicalName(3, b, it->second);
-      }
-
-      int surface = 0;
-      for (const SideSet& set : model.side_sets) {
-        gmsh::model::addDiscreteEntity(2, ++surface);
-        std::vector<std::size_t> tri_tags, tri_nodes, quad_tags, quad_nodes;
-        for (const Side& s : set.sides) {
-          const auto e = static_cast<std::size_t>(s.element.index);
-          const auto f = static_cast<std::size_t>(s.face);
-          if (s.element.kind == ElementKind::Hex) {
-            quad_tags.push_back(next_element++);
-            for (int c : topology::kHexFaceCorners[f])
-              quad_nodes.push_back(static_cast<std::size_t>(model.hexes[e][static_cast<std::size_t>(c)]) + 1);
-          } else {
-            tri_tags.push_back(next_element++);
-            for (int c : topology::kTetFaceCorners[f])
-              tri_nodes.push_back(static_cast<std::size_t>(model.tets[e][static_cast<std::size_t>(c)]) + 1);
-          }
-        }
-        std::vector<int> types;
-        std::vector<std::vector<std::size_t>> tags, nodes;
-        if (!tri_tags.empty()) {
-          types.push_back(kGmshTri3);
-          tags.push_back(tri_tags);
-          nodes.push_back(tri_nodes);
-        }
-        if (!quad_tags.empty()) {
-          types.push_back(kGmshQuad4);
-          tags.push_back(quad_tags);
-          nodes.push_back(quad_nodes);
-        }
-        gmsh::model::mesh::addElements(2, surface, types, tags, nodes);
-        gmsh::model::addPhysicalGroup(2, {surface}, set.id);
-        gmsh::model::setPhysicalName(2, set.id, set.name);
-      }
-
-      int point_entity = 0;
-      for (const NodeSet& set : model.node_sets) {
-        gmsh::model::addDiscreteEntity(0, ++point_entity);
-        std::vector<std::size_t> tags, nodes;
-        for (Index v : set.nodes) {
-          tags.push_back(next_element++);
-          nodes.push_back(static_cast<std::size_t>(v) + 1);
-        }
-        gmsh::model::mesh::addElements(0, point_entity, {kGmshPoint}, {tags}, {nodes});
-        gmsh::model::addPhysicalGroup(0, {point_entity}, set.id);
-        gmsh::model::setPhysicalName(0, set.id, set.name);
-      }
-
-      gmsh::option::setNumber("Mesh.MshFileVersion", version == GmshVersion::k22 ? 2.2 : 4.1);
-      gmsh::option::setNumber("Mesh.Binary", format == GmshFormat::Binary ? 1 : 0);
-      gmsh::option::setNumber("Mesh.SaveAll", 1);
-      gmsh::write(temp.string());
-    });
-  });
+  return parse_gmsh(MappedFile(path).bytes(), path.string(), options);
 }
 
 }  // namespace geode::io
