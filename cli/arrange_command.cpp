@@ -47,7 +47,7 @@ void add_arrange_command(CLI::App& app) {
   CLI::App* c = app.add_subcommand(
       "arrange",
       "Compute the arrangement of the sheets a JSON spec gives (domain, sheets, optional completion\n"
-      "block and push; format in README.md, 'Arrangements as files'), diagnose it, dualize it and\n"
+      "block and push; format in docs/specs.md), diagnose it, dualize it and\n"
       "print or write the mesh. Exit 2 for a bad spec (naming the JSON path), 3 when the\n"
       "arrangement does not dualize (naming the sheets and the place).");
   c->add_option("SPEC", args->spec, "the spec, a JSON file")->required();
