@@ -4,9 +4,10 @@
 // - one volume entity per block (entity tag = block id) in the block's physical volume;
 //   all nodes are listed on the first volume entity (elements of every entity use them);
 // - one surface entity per side set holding its faces as triangles / quads, in the set's
-//   physical surface, then one point entity per node set holding one point element per node,
-//   in the set's physical point; their tags follow the largest block id, so that entity tags
-//   too are distinct across dimensions (GetFEM 5.4's importer keys entities by tag alone);
+//   physical surface, and one point entity per node set holding one point element per node,
+//   in the set's physical point;
+// - every entity's tag is its physical tag, so entity tags too are distinct across dimensions
+//   (GetFEM 5.4 takes a .msh 4.1 element's region from its entity's tag);
 // - $PhysicalNames for every named group, names made safe by io/names.hpp.
 // Physical tags are distinct across dimensions (GetFEM, among others, keeps one region per tag
 // and renumbers a tag used twice): blocks keep their ids; a side or node set whose id is
@@ -122,7 +123,6 @@ class MshLayout {
 
  private:
   std::vector<int> side_tags_, node_tags_;
-  int next_entity_ = 1;  // entity tags distinct across dimensions too (GetFEM's importer mixes them)
 
   Entity bounded(int dim, int tag, int physical, const std::vector<std::size_t>& nodes) const {
     Entity e{dim, tag, physical, Point::Zero(), Point::Zero()};
@@ -170,7 +170,6 @@ class MshLayout {
       entities_.push_back(bounded(3, 1, 0, all));
     }
     node_entity_ = entities_.front().tag;
-    next_entity_ = entities_.back().tag + 1;
   }
 
   void assign_set_tags() {
@@ -203,7 +202,7 @@ class MshLayout {
   void side_sets() {
     for (std::size_t s = 0; s < m_.side_sets.size(); ++s) {
       const SideSet& set = m_.side_sets[s];
-      const int entity = next_entity_++, physical = side_tags_[s];
+      const int physical = side_tags_[s], entity = physical;
       ElementBlock tri{2, entity, physical, kTri3, 3, {}, 0}, quad{2, entity, physical, kQuad4, 4, {}, 0};
       for (const Side& side : set.sides) {
         const auto e = static_cast<std::size_t>(side.element.index);
@@ -226,7 +225,7 @@ class MshLayout {
   void node_sets() {
     for (std::size_t s = 0; s < m_.node_sets.size(); ++s) {
       const NodeSet& set = m_.node_sets[s];
-      const int entity = next_entity_++, physical = node_tags_[s];
+      const int physical = node_tags_[s], entity = physical;
       ElementBlock points{0, entity, physical, kPoint, 1, {}, 0};
       for (Index v : set.nodes) points.node_tags.push_back(static_cast<std::size_t>(v) + 1);
       entities_.push_back(bounded(0, entity, physical, points.node_tags));
