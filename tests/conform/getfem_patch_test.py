@@ -7,7 +7,8 @@ For three demo models (geode demo --model NAME: a swept cylinder in a Delaunay t
 block in the notch of an L-shaped tet part, a tet cube in 26 structured blocks), the conformed
 all-hex mesh is written as .msh 4.1, .msh 2.2 and .vtu, and each file, read as written, must
 1. carry its element blocks as the solver's regions: GetFEM's Gmsh import gives one region per
-   physical volume, the .vtu (read with meshio) gives the cell array mat_id; the region ids are
+   physical volume (meshio reads the same from the .msh files), the .vtu (read with meshio)
+   gives the cell array mat_id; the region ids are
    the blocks of geode's report, with the same element counts in all three files, and every
    hex in exactly one region;
 2. pass the linear patch test: Laplace's equation with u = a + bx + cy + dz imposed on the
@@ -114,6 +115,12 @@ def run(geode, workdir, name, n):
         check(sorted(c) == blocks and all(v > 0 for v in c.values()), f"{name} {fmt}: GetFEM regions {sorted(c)} are the blocks {blocks}")
         check(sum(c.values()) == m.nbcvs(), f"{name} {fmt}: every hex of {m.nbcvs()} in one region ({c})")
         counts[fmt] = c
+        # meshio reads the same file to the same blocks and names.
+        mm = meshio.read(path)
+        physical = np.concatenate([d for cb, d in zip(mm.cells, mm.cell_data["gmsh:physical"]) if cb.type == "hexahedron"])
+        mc = {int(b): int(np.sum(physical == b)) for b in np.unique(physical)}
+        check(mc == c and all(v[1] == 3 for k, v in mm.field_data.items() if int(v[0]) in blocks),
+              f"{name} {fmt}: meshio reads the same blocks ({mc}) and their names ({sorted(mm.field_data)})")
         err = patch_error(m)
         check(err < 1e-10, f"{name} {fmt}: patch test, max relative error {err:.2e} over {m.nbpts()} nodes")
     mesh = meshio.read(os.path.join(workdir, files["vtu"]))
