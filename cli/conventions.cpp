@@ -190,7 +190,16 @@ void OutputFiles::add(const fs::path& target, Writer write) {
 void OutputFiles::commit() {
   for (const Entry& e : entries_) {
     pending_.push_back(e.temp);
-    e.write(e.temp);
+    try {
+      e.write(e.temp);
+    } catch (const InvalidInput& error) {
+      // Writers name the file they were given; the user gave the target, not our temporary.
+      std::string what = error.what();
+      const std::string temp = e.temp.string();
+      for (auto at = what.find(temp); at != std::string::npos; at = what.find(temp, at + e.target.string().size()))
+        what.replace(at, temp.size(), e.target.string());
+      throw InvalidInput(what);
+    }
   }
   std::vector<fs::path> renamed;
   for (const Entry& e : entries_) {

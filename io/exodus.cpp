@@ -3,7 +3,11 @@
 #include "io/atomic_file.hpp"
 
 #include <exodusII.h>
+#include <netcdf.h>
 #include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 
 #include <algorithm>
 #include <cctype>
@@ -14,6 +18,7 @@
 
 #include "primal/errors.hpp"
 #include "io/file_format.hpp"
+#include "io/names.hpp"
 #include "primal/topology.hpp"
 
 namespace geode::io {
@@ -45,8 +50,21 @@ class ExodusFile {
   int id_;
 };
 
+// The cause libexodusII recorded for its last error: a system error (ENOSPC on a full disk)
+// or a netCDF / Exodus one, in words.
+std::string exodus_cause() {
+  const char* msg = nullptr;
+  const char* func = nullptr;
+  int err = 0;
+  ex_get_err(&msg, &func, &err);
+  if (err > 0) return std::string(std::strerror(err)) + (err == ENOSPC || err == EDQUOT ? " (the disk is full)" : "");
+  if (err < 0) return nc_strerror(err);
+  return "Exodus error";
+}
+
+// `where` names the file the user gave (never the temporary one a write goes through).
 void check(int status, const std::string& where, const std::string& what) {
-  if (status < 0) throw InvalidInput(where + ": " + what + " failed (Exodus status " + std::to_string(status) + ")");
+  if (status < 0) throw InvalidInput(where + ": " + what + " failed: " + exodus_cause());
 }
 
 // Names as Exodus wants them: an array of char* to buffers of kNameLength + 1.
@@ -57,9 +75,35 @@ struct NameBuffers {
     for (auto& s : storage) pointers.push_back(s.data());
   }
   void set(std::size_t i, const std::string& name) {
-    std::copy_n(name.begin(), std::min<std::size_t>(name.size(), kNameLength), storage[i].begin());
+    const std::string safe = sanitize_name(name);
+    std::size_t n = std::min<std::size_t>(safe.size(), kNameLength);
+    while (n > 0 && n < safe.size() && (static_cast<unsigned char>(safe[n]) & 0xC0) == 0x80) --n;  // whole characters
+    std::copy_n(safe.begin(), n, storage[i].begin());
   }
   std::string get(std::size_t i) const { return std::string(storage[i].data()); }
+};
+
+// What an Exodus file can hold (see read_exodus).
+class ExodusBounds {
+ public:
+  ExodusBounds(const std::filesystem::path& path, std::string source) : source_(std::move(source)) {
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(path, ec);
+    const std::string head = read_file_head(path, 4);
+    const bool classic = head.rfind("CDF", 0) == 0;
+    size_ = ec ? 0 : size;
+    capacity_ = classic ? size_ : size_ * 1032 + 4096;
+  }
+  void check(std::int64_t count, std::size_t bytes_each, const char* what) const {
+    if (count < 0 || static_cast<std::uint64_t>(count) > capacity_ / bytes_each)
+      throw InvalidInput(source_ + ": the header announces " + std::to_string(count) + " " + what +
+                         ", more than a file of " + std::to_string(size_) +
+                         " bytes can hold (corrupt or truncated file?)");
+  }
+
+ private:
+  std::string source_;
+  std::uint64_t size_ = 0, capacity_ = 0;
 };
 
 std::string upper(std::string s) {
@@ -87,6 +131,15 @@ Model read_exodus(const std::filesystem::path& path, const ReadOptions& options)
         source, "reading the header");
   if (num_dim < 2 || num_dim > 3)
     throw InvalidInput(source + ": " + std::to_string(num_dim) + "-dimensional model; expected 3 (or 2)");
+  // Every count is bounded by what the file can hold before anything of its size is read or
+  // allocated: a classic netCDF file stores each value (4 bytes at least), a netCDF-4 (HDF5)
+  // one may compress them, by at most zlib's 1032:1.
+  const ExodusBounds bound(path, source);
+  bound.check(num_nodes, static_cast<std::size_t>(num_dim) * 4, "nodes");
+  bound.check(num_elem, 4, "elements");
+  bound.check(num_blocks, 4, "element blocks");
+  bound.check(num_node_sets, 4, "node sets");
+  bound.check(num_side_sets, 4, "side sets");
 
   Model model;
   {
@@ -132,6 +185,10 @@ Model read_exodus(const std::filesystem::path& path, const ReadOptions& options)
       int count = 0, per_elem = 0, edges = 0, faces = 0, attributes = 0;
       check(ex_get_block(exo, EX_ELEM_BLOCK, id, type_buffer, &count, &per_elem, &edges, &faces, &attributes),
             where, "reading the block header");
+      if (per_elem < 0 || per_elem > 64) throw InvalidInput(where + ": " + std::to_string(per_elem) + " nodes per element");
+      bound.check(count, 4 * static_cast<std::size_t>(std::max(per_elem, 1)), "elements in the block");
+      if (static_cast<std::int64_t>(global.size()) + count > num_elem)
+        throw InvalidInput(where + ": more elements in the blocks than the header's " + std::to_string(num_elem));
       const std::string type = upper(type_buffer);
       const ExodusCell* cell = nullptr;
       ElementKind kind = ElementKind::Hex;
@@ -171,13 +228,17 @@ Model read_exodus(const std::filesystem::path& path, const ReadOptions& options)
     check(ex_get_ids(exo, EX_NODE_SET, ids.data()), source, "reading node set ids");
     NameBuffers names(ids.size());
     const bool named = ex_get_names(exo, EX_NODE_SET, names.pointers.data()) >= 0;
+    // As for blocks: meshio numbers sets from 0, and a file with any id <= 0 gets its node
+    // sets numbered by position (1, 2, ...).
+    const bool renumber = std::any_of(ids.begin(), ids.end(), [](int id) { return id <= 0; });
     for (std::size_t s = 0; s < ids.size(); ++s) {
-      NodeSet set{ids[s], named ? names.get(s) : std::string(), {}};
-      const std::string where = source + ": node set " + std::to_string(set.id);
+      NodeSet set{renumber ? static_cast<int>(s) + 1 : ids[s], named ? names.get(s) : std::string(), {}};
+      const std::string where = source + ": node set " + std::to_string(ids[s]);
       int count = 0, factors = 0;
-      check(ex_get_set_param(exo, EX_NODE_SET, set.id, &count, &factors), where, "reading the set header");
+      check(ex_get_set_param(exo, EX_NODE_SET, ids[s], &count, &factors), where, "reading the set header");
+      bound.check(count, 4, "node set entries");
       std::vector<int> nodes(static_cast<std::size_t>(count));
-      if (count > 0) check(ex_get_set(exo, EX_NODE_SET, set.id, nodes.data(), nullptr), where, "reading entries");
+      if (count > 0) check(ex_get_set(exo, EX_NODE_SET, ids[s], nodes.data(), nullptr), where, "reading entries");
       for (std::size_t i = 0; i < nodes.size(); ++i) {
         if (nodes[i] < 1 || nodes[i] > num_nodes)
           throw InvalidInput(where + ": entry " + std::to_string(i + 1) + " refers to node " +
@@ -193,13 +254,15 @@ Model read_exodus(const std::filesystem::path& path, const ReadOptions& options)
     check(ex_get_ids(exo, EX_SIDE_SET, ids.data()), source, "reading side set ids");
     NameBuffers names(ids.size());
     const bool named = ex_get_names(exo, EX_SIDE_SET, names.pointers.data()) >= 0;
+    const bool renumber = std::any_of(ids.begin(), ids.end(), [](int id) { return id <= 0; });
     for (std::size_t s = 0; s < ids.size(); ++s) {
-      SideSet set{ids[s], named ? names.get(s) : std::string(), {}};
-      const std::string where = source + ": side set " + std::to_string(set.id);
+      SideSet set{renumber ? static_cast<int>(s) + 1 : ids[s], named ? names.get(s) : std::string(), {}};
+      const std::string where = source + ": side set " + std::to_string(ids[s]);
       int count = 0, factors = 0;
-      check(ex_get_set_param(exo, EX_SIDE_SET, set.id, &count, &factors), where, "reading the set header");
+      check(ex_get_set_param(exo, EX_SIDE_SET, ids[s], &count, &factors), where, "reading the set header");
+      bound.check(count, 8, "side set entries");
       std::vector<int> elems(static_cast<std::size_t>(count)), sides(elems.size());
-      if (count > 0) check(ex_get_set(exo, EX_SIDE_SET, set.id, elems.data(), sides.data()), where, "reading entries");
+      if (count > 0) check(ex_get_set(exo, EX_SIDE_SET, ids[s], elems.data(), sides.data()), where, "reading entries");
       for (std::size_t i = 0; i < elems.size(); ++i) {
         const std::string entry = where + ": entry " + std::to_string(i + 1);
         if (elems[i] < 1 || static_cast<std::size_t>(elems[i]) > global.size())
@@ -214,6 +277,7 @@ Model read_exodus(const std::filesystem::path& path, const ReadOptions& options)
       model.side_sets.push_back(std::move(set));
     }
   }
+  sanitize_names(model);
   validate(model, source);
   options.check_geometry ? check_geometry(model, source) : check_points(model, source);
   return model;
@@ -245,7 +309,7 @@ void write_exodus(const Model& model, const std::filesystem::path& path) {
     ex_opts(0);
     int cpu_word_size = 8, io_word_size = 8;
     ExodusFile file(ex_create(temp.string().c_str(), EX_CLOBBER, &cpu_word_size, &io_word_size));
-    if (file.id() < 0) throw InvalidInput(target + ": cannot create temporary file " + temp.string());
+    if (file.id() < 0) throw InvalidInput(target + ": cannot create the file: " + exodus_cause());
     const int exo = file.id();
     check(ex_set_max_name_length(exo, kNameLength), target, "setting the name length");
     check(ex_put_init(exo, "geode", 3, static_cast<int64_t>(model.points.size()),

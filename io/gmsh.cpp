@@ -1,7 +1,5 @@
 #include "io/gmsh.hpp"
 
-#include "io/atomic_file.hpp"
-
 #include <gmsh.h>
 #include <unistd.h>
 
@@ -14,6 +12,7 @@
 #include "primal/boundary.hpp"
 #include "primal/errors.hpp"
 #include "io/file_format.hpp"
+#include "io/mapped_file.hpp"
 #include "primal/topology.hpp"
 
 namespace geode::io {
@@ -208,110 +207,7 @@ Model model_from_gmsh(std::string_view source_view) {
 
 Model read_gmsh(const std::filesystem::path& path, const ReadOptions& options) {
   check_mesh_format(path, MeshFileFormat::kGmsh);
-  return parse_gmsh(read_file_bytes(path), path.string(), options);
-}
-
-void write_gmsh(const Model& model, const std::filesystem::path& path, GmshFormat format,
-                GmshVersion version) {
-  const std::string target = path.string();
-  validate(model, target);
-  GmshSession session;
-  // Gmsh picks the format from the extension, so the temporary file keeps ".msh".
-  write_path_atomically(path, ".msh", [&](const std::filesystem::path& temp) {
-    gmsh_call(target, [&] {
-      gmsh::model::add("geode");
-      std::vector<int> blocks;
-      for (ElementKind kind : kElementKinds)
-        for (std::size_t e = 0; e < element_count(model, kind); ++e) blocks.push_back(block_of(model, {kind, static_cast<Index>(e)}));
-      std::sort(blocks.begin(), blocks.end());
-      blocks.erase(std::unique(blocks.begin(), blocks.end()), blocks.end());
-      // Nodes live on the first volume entity; elements of other entities may use them.
-      const int node_entity = blocks.empty() ? 1 : blocks.front();
-      if (blocks.empty()) gmsh::model::addDiscreteEntity(3, node_entity);
-      for (int b : blocks) gmsh::model::addDiscreteEntity(3, b);
-      std::vector<std::size_t> node_tags(model.points.size());
-      std::vector<double> coords;
-      coords.reserve(3 * model.points.size());
-      for (std::size_t i = 0; i < model.points.size(); ++i) {
-        node_tags[i] = i + 1;
-        coords.insert(coords.end(), {model.points[i].x(), model.points[i].y(), model.points[i].z()});
-      }
-      if (!node_tags.empty()) gmsh::model::mesh::addNodes(3, node_entity, node_tags, coords);
-
-      std::size_t next_element = 1;
-      for (int b : blocks) {
-        std::vector<int> types;
-        std::vector<std::vector<std::size_t>> tags, nodes;
-        for (ElementKind kind : kElementKinds) {
-          const GmshCell& cell = kGmshCells[static_cast<std::size_t>(kind)];
-          std::vector<std::size_t> kind_tags, kind_nodes;
-          for (std::size_t e = 0; e < element_count(model, kind); ++e) {
-            const ElementRef ref{kind, static_cast<Index>(e)};
-            if (block_of(model, ref) != b) continue;
-            kind_tags.push_back(next_element++);
-            // gmsh_corner[order[i]] = model_corner[i]
-            const auto corners = element_corners(model, ref);
-            std::array<std::size_t, 8> g{};
-            for (std::size_t c = 0; c < static_cast<std::size_t>(cell.corners); ++c)
-              g[static_cast<std::size_t>(cell.order[c])] = static_cast<std::size_t>(corners[c]) + 1;
-            kind_nodes.insert(kind_nodes.end(), g.begin(), g.begin() + cell.corners);
-          }
-          if (kind_tags.empty()) continue;
-          types.push_back(cell.type);
-          tags.push_back(std::move(kind_tags));
-          nodes.push_back(std::move(kind_nodes));
-        }
-        gmsh::model::mesh::addElements(3, b, types, tags, nodes);
-        gmsh::model::addPhysicalGroup(3, {b}, b);
-        if (auto it = model.block_names.find(b); it != model.block_names.end())
-          gmsh::model::setPhysicalName(3, b, it->second);
-      }
-
-      int surface = 0;
-      for (const SideSet& set : model.side_sets) {
-        gmsh::model::addDiscreteEntity(2, ++surface);
-        std::vector<std::size_t> tri_tags, tri_nodes, quad_tags, quad_nodes;
-        for (const Side& s : set.sides) {
-          const std::vector<Index> face = element_face(model, s);
-          (face.size() == 4 ? quad_tags : tri_tags).push_back(next_element++);
-          for (Index v : face) (face.size() == 4 ? quad_nodes : tri_nodes).push_back(static_cast<std::size_t>(v) + 1);
-        }
-        std::vector<int> types;
-        std::vector<std::vector<std::size_t>> tags, nodes;
-        if (!tri_tags.empty()) {
-          types.push_back(kGmshTri3);
-          tags.push_back(tri_tags);
-          nodes.push_back(tri_nodes);
-        }
-        if (!quad_tags.empty()) {
-          types.push_back(kGmshQuad4);
-          tags.push_back(quad_tags);
-          nodes.push_back(quad_nodes);
-        }
-        gmsh::model::mesh::addElements(2, surface, types, tags, nodes);
-        gmsh::model::addPhysicalGroup(2, {surface}, set.id);
-        gmsh::model::setPhysicalName(2, set.id, set.name);
-      }
-
-      int point_entity = 0;
-      for (const NodeSet& set : model.node_sets) {
-        gmsh::model::addDiscreteEntity(0, ++point_entity);
-        std::vector<std::size_t> tags, nodes;
-        for (Index v : set.nodes) {
-          tags.push_back(next_element++);
-          nodes.push_back(static_cast<std::size_t>(v) + 1);
-        }
-        gmsh::model::mesh::addElements(0, point_entity, {kGmshPoint}, {tags}, {nodes});
-        gmsh::model::addPhysicalGroup(0, {point_entity}, set.id);
-        gmsh::model::setPhysicalName(0, set.id, set.name);
-      }
-
-      gmsh::option::setNumber("Mesh.MshFileVersion", version == GmshVersion::k22 ? 2.2 : 4.1);
-      gmsh::option::setNumber("Mesh.Binary", format == GmshFormat::Binary ? 1 : 0);
-      gmsh::option::setNumber("Mesh.SaveAll", 1);
-      gmsh::write(temp.string());
-    });
-  });
+  return parse_gmsh(MappedFile(path).bytes(), path.string(), options);
 }
 
 }  // namespace geode::io

@@ -1,16 +1,22 @@
 #pragma once
 // Gmsh .msh input and output of a mixed model (hexes, tets, pyramids, prisms). Reading is our own (gmsh_read.cpp:
 // versions 2.2 and 4.1, ASCII and binary), so that a user's file never reaches libgmsh, which
-// would run any text that is not a mesh as a Gmsh script; writing (v4.1) and the demo models
-// use the Gmsh C++ API.
+// would run any text that is not a mesh as a Gmsh script. Writing is our own too
+// (gmsh_write.cpp: 4.1 and 2.2, ASCII and binary, every write error reported); only the demo
+// models use the Gmsh C++ API (GmshSession, model_from_gmsh).
 //
 // Mapping between a Model and Gmsh's entities:
-// - element blocks  <-> volume entities; the block id is the entity's first physical group
-//   of dimension 3 (its name is the block name) or, without one, the entity tag;
+// - element blocks  <-> volume entities; the block id is the entity's physical group of
+//   dimension 3 (its name is the block name; in several: the one over the fewest entities, with
+//   a warning for a group left empty) or, without one, the entity tag; in a partitioned file,
+//   the partitioned entity's groups, else its parent's, else the parent's tag;
 // - side sets       <-> physical groups of dimension 2: each triangle / quad element is
 //   matched to the hex or tet face with the same nodes (hexes searched first, lowest index);
-// - node sets       <-> physical groups of dimension 0 or 1 (all nodes of their elements;
-//   the writer stores one point element per node in one point entity per set).
+// - node sets       <-> physical groups of dimension 0 or 1 (all nodes of their elements, and
+//   the elements as the set's pieces, model.hpp; the writer stores one point element per node
+//   in one point entity per set).
+// Written physical tags are distinct across dimensions (gmsh_write.cpp: a set whose id is a
+// block's, or another set's, is moved by a power of ten). Names go through io/names.hpp.
 // Entries of node sets come back sorted by node number, those of side sets sorted (hex sides
 // first, by element and face), since Gmsh groups elements by type. Nodes are numbered by ascending Gmsh
 // tag; the writer uses tag = index + 1, so models round-trip.

@@ -17,6 +17,8 @@
 #include "primal/errors.hpp"
 #include "io/file_format.hpp"
 #include "io/gmsh.hpp"
+#include "io/names.hpp"
+#include "io/read_warnings.hpp"
 #include "primal/topology.hpp"
 
 namespace geode::io {
@@ -84,6 +86,9 @@ class MshReader {
       } else if (name == "Entities") {
         if (version_ == 2) fail_at(start, "$Entities in a version 2 file");
         entities();
+      } else if (name == "PartitionedEntities") {
+        if (version_ == 2) fail_at(start, "$PartitionedEntities in a version 2 file");
+        partitioned_entities();
       } else if (name == "Nodes") {
         if (have_nodes) fail_at(start, "a second $Nodes section");
         version_ == 4 ? nodes41() : nodes22();
@@ -111,6 +116,15 @@ class MshReader {
   bool binary_ = false;
   std::map<std::pair<int, int>, std::string> physical_names_;       // (dim, tag) -> name
   std::map<std::pair<int, int>, std::vector<int>> entity_physicals_;  // (dim, entity) -> tags
+  // $PartitionedEntities (a partitioned 4.1 file): elements then name these entities, each
+  // with its parent entity of $Entities and physical tags of its own (Gmsh copies the
+  // parent's; when none are given the parent's hold).
+  struct Partitioned {
+    int parent_dim = 0, parent_tag = 0;
+    std::vector<int> physicals;
+  };
+  bool partitioned_ = false;
+  std::map<std::pair<int, int>, Partitioned> partitioned_entities_;
   std::vector<std::int64_t> node_tags_;
   std::vector<Point> node_points_;
   std::vector<RawElement> elements_;
@@ -292,6 +306,35 @@ class MshReader {
       }
   }
 
+  void partitioned_entities() {
+    partitioned_ = true;
+    size_field("the number of partitions");
+    const std::size_t ghosts = count_field("the number of ghost entities", item_bytes(2, 8));
+    for (std::size_t g = 0; g < ghosts; ++g) {
+      int_field("a ghost entity tag");
+      int_field("a ghost entity's partition");
+    }
+    std::array<std::size_t, 4> counts{};
+    for (std::size_t d = 0; d < 4; ++d) counts[d] = count_field("a partitioned entity count", item_bytes(8, 48));
+    for (int dim = 0; dim < 4; ++dim)
+      for (std::size_t i = 0; i < counts[static_cast<std::size_t>(dim)]; ++i) {
+        const int tag = static_cast<int>(int_field("a partitioned entity tag"));
+        Partitioned p;
+        p.parent_dim = static_cast<int>(int_field("a partitioned entity's parent dimension"));
+        p.parent_tag = static_cast<int>(int_field("a partitioned entity's parent tag"));
+        const std::size_t np = count_field("a partition count", item_bytes(1, 4));
+        for (std::size_t k = 0; k < np; ++k) int_field("a partition tag");
+        for (int k = 0; k < (dim == 0 ? 3 : 6); ++k) real_field("an entity bounding box");
+        const std::size_t nph = count_field("a physical tag count", item_bytes(1, 4));
+        for (std::size_t k = 0; k < nph; ++k) p.physicals.push_back(static_cast<int>(int_field("a physical tag")));
+        if (dim > 0) {
+          const std::size_t nb = count_field("a bounding entity count", item_bytes(1, 4));
+          for (std::size_t b = 0; b < nb; ++b) int_field("a bounding entity tag");
+        }
+        partitioned_entities_[{dim, tag}] = std::move(p);
+      }
+  }
+
   void add_node(std::int64_t tag, const Point& p) {
     node_tags_.push_back(tag);
     node_points_.push_back(p);
@@ -428,12 +471,45 @@ class MshReader {
 
   // ---- The model ---------------------------------------------------------------------------
 
-  // Physical groups of an element: its entity's (4.1) or its own tag (2.2).
+  // The entity of $Entities an element belongs to: its own, or in a partitioned file the
+  // parent of its partitioned entity.
+  int model_entity(const RawElement& e, int dim) const {
+    if (!partitioned_) return e.entity;
+    const auto it = partitioned_entities_.find({dim, e.entity});
+    return it == partitioned_entities_.end() || it->second.parent_dim != dim ? e.entity : it->second.parent_tag;
+  }
+  // Physical groups of an element: its entity's (4.1; a partitioned entity's own, else its
+  // parent's) or its own tag (2.2).
   std::vector<int> physicals_of(const RawElement& e, int dim) const {
     if (version_ == 2) return e.physical != 0 ? std::vector<int>{e.physical} : std::vector<int>{};
+    if (partitioned_) {
+      const auto it = partitioned_entities_.find({dim, e.entity});
+      if (it == partitioned_entities_.end()) return {};
+      if (!it->second.physicals.empty()) return it->second.physicals;
+      const auto parent = entity_physicals_.find({it->second.parent_dim, it->second.parent_tag});
+      return parent == entity_physicals_.end() ? std::vector<int>{} : parent->second;
+    }
     const auto it = entity_physicals_.find({dim, e.entity});
     return it == entity_physicals_.end() ? std::vector<int>{} : it->second;
   }
+
+  // An element's block among the physical volumes of its entity. A model has one block per
+  // element, while Gmsh lets an entity be in several physical groups (a material "tets" and
+  // an aggregate "steel" over several materials): the block is the group over the fewest
+  // entities of $Entities (the most specific; ties: the first listed), and a group left
+  // without elements that way is reported in a warning (build()).
+  int block_among(const std::vector<int>& physicals) {
+    if (physicals.size() == 1) return physicals.front();
+    if (group_sizes_.empty())
+      for (const auto& [key, tags] : entity_physicals_)
+        if (key.first == 3)
+          for (int p : tags) ++group_sizes_[p];
+    int best = physicals.front();
+    for (int p : physicals)
+      if (group_sizes_[p] < group_sizes_[best]) best = p;
+    return best;
+  }
+  std::map<int, std::size_t> group_sizes_;  // physical volume -> entities in it
 
   Model build() {
     Model model;
@@ -474,6 +550,7 @@ class MshReader {
       std::size_t element;
     };
     std::vector<Volume> volumes;
+    std::set<int> volume_groups;  // every physical volume holding elements
     for (std::size_t i = 0; i < elements_.size(); ++i) {
       const RawElement& e = elements_[i];
       const GmshType& type = *gmsh_type(e.type);
@@ -484,7 +561,8 @@ class MshReader {
                            std::to_string(e.type) + ") is not supported; only linear cells are (4-node tetrahedra, "
                            "8-node hexahedra, 6-node prisms, 5-node pyramids)");
       const std::vector<int> physicals = physicals_of(e, 3);
-      int block = physicals.empty() ? e.entity : *std::min_element(physicals.begin(), physicals.end());
+      int block = physicals.empty() ? model_entity(e, 3) : block_among(physicals);
+      for (int p : physicals) volume_groups.insert(p);
       // meshio writes 0 for a missing physical and entity tag: the model's default block.
       if (block == 0) block = default_block(*kind);
       if (block < 0)
@@ -493,6 +571,18 @@ class MshReader {
       volumes.push_back({block, i});
     }
     std::stable_sort(volumes.begin(), volumes.end(), [](const Volume& a, const Volume& b) { return a.block < b.block; });
+    {
+      std::set<int> blocks;
+      for (const Volume& v : volumes) blocks.insert(v.block);
+      for (int p : volume_groups)
+        if (!blocks.count(p)) {
+          const auto it = physical_names_.find({3, p});
+          read_warning(source_ + ": physical volume " + std::to_string(p) +
+                       (it == physical_names_.end() ? std::string() : " '" + sanitize_name(it->second) + "'") +
+                       " is not a block of its own: each of its entities is also in a physical volume over fewer "
+                       "entities, which is the block of its elements");
+        }
+    }
     for (const Volume& v : volumes) {
       const RawElement& e = elements_[v.element];
       if (auto it = physical_names_.find({3, v.block}); it != physical_names_.end() && !it->second.empty())
@@ -543,16 +633,22 @@ class MshReader {
         set.sides.erase(std::unique(set.sides.begin(), set.sides.end()), set.sides.end());
         model.side_sets.push_back(std::move(set));
       } else {
-        NodeSet set{tag, name, {}};
+        // The set's points and lines are kept as its pieces, so that dicing adds the nodes
+        // on these lines only (not on a face between two of them: primal/model.hpp).
+        NodeSet set{tag, name, {}, {}};
         for (std::size_t i : members) {
           const RawElement& e = elements_[i];
-          for (int k = 0; k < gmsh_type(e.type)->nodes; ++k) set.nodes.push_back(node(e, static_cast<std::size_t>(k)));
+          std::vector<Index> piece;
+          for (int k = 0; k < gmsh_type(e.type)->nodes; ++k) piece.push_back(node(e, static_cast<std::size_t>(k)));
+          set.nodes.insert(set.nodes.end(), piece.begin(), piece.end());
+          set.pieces.push_back(std::move(piece));
         }
         std::sort(set.nodes.begin(), set.nodes.end());
         set.nodes.erase(std::unique(set.nodes.begin(), set.nodes.end()), set.nodes.end());
         model.node_sets.push_back(std::move(set));
       }
     }
+    sanitize_names(model);
     validate(model, source_);
     return model;
   }

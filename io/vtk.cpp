@@ -1,5 +1,7 @@
 #include "io/vtk.hpp"
 
+#include "io/names.hpp"
+
 #include "io/vtk_cells.hpp"
 
 #include <Eigen/Geometry>
@@ -207,8 +209,12 @@ Grid grid_of(const std::filesystem::path& path, const Model& m, const VtkCellDat
   std::vector<int> block;
   for (ElementKind kind : kElementKinds)
     for (std::size_t e = 0; e < element_count(m, kind); ++e) block.push_back(block_of(m, {kind, static_cast<Index>(e)}));
-  finish_grid(g, file, std::move(sj), block, extra);
-  g.block_names = m.block_names;
+  // The block again as "mat_id", the cell array of material ids Python solvers read (SfePy's
+  // name; meshio hands it on), so that they find the materials without knowing ours.
+  VtkCellData data = extra;
+  data.ints.insert(data.ints.begin(), {"mat_id", block});
+  finish_grid(g, file, std::move(sj), block, data);
+  for (const auto& [id, name] : m.block_names) g.block_names[id] = sanitize_name(name);
   return g;
 }
 

@@ -22,6 +22,7 @@
 #include "io/atomic_file.hpp"
 #include "primal/errors.hpp"
 #include "io/file_format.hpp"
+#include "io/mapped_file.hpp"
 #include "primal/quality.hpp"
 
 namespace geode::io {
@@ -162,7 +163,7 @@ class XmlParser {
     skip_misc();
     if (pos_ >= s_.size() || s_[pos_] != '<')
       fail(file_, line_, "not an XML file (no root element)");
-    XmlElement root = element();
+    XmlElement root = element(0);
     return root;
   }
 
@@ -234,7 +235,12 @@ class XmlParser {
     return out;
   }
 
-  XmlElement element() {
+  // VTK files nest five deep; a deeper file is refused before recursion can exhaust the stack.
+  static constexpr int kMaxDepth = 64;
+
+  XmlElement element(int depth) {
+    if (depth >= kMaxDepth)
+      fail(file_, line_, "elements nested more than " + std::to_string(kMaxDepth) + " deep (not a VTK file)");
     XmlElement el;
     el.line = line_;
     advance(1);  // '<'
@@ -298,7 +304,7 @@ class XmlParser {
         skip_until("-->", "a comment");
         continue;
       }
-      el.children.push_back(element());
+      el.children.push_back(element(depth + 1));
     }
   }
 };
@@ -310,6 +316,10 @@ struct VtuStorage {
   bool zlib = false;
   std::string_view appended;
   bool appended_base64 = false;
+  // What zlib may still inflate over the whole file (array_bytes): real meshes compress a few
+  // times (points hardly, connectivity 5 to 10 x), while a bomb repeats one block or points
+  // several arrays at the same bytes; 64 MiB plus 64 bytes per byte of the file bounds both.
+  mutable std::uint64_t inflate_budget = 0;
 };
 
 int base64_value(char c) {
@@ -398,6 +408,10 @@ std::string array_bytes(std::string_view stream, const VtuStorage& enc, std::siz
   // zlib inflates at most about 1032:1: a header that promises more is corrupt, and is refused
   // before anything of that size is allocated.
   if (want / 1032 > stream.size()) fail(file, line, what + ": " + std::to_string(want) + " bytes cannot come from " + std::to_string(stream.size()) + " compressed bytes");
+  if (want > enc.inflate_budget)
+    fail(file, line, what + ": inflating to " + std::to_string(want) + " bytes would pass the file's bound of " +
+                         std::to_string(enc.inflate_budget) + " more bytes (64 MiB plus 64 times the file's size: a zlib bomb?)");
+  enc.inflate_budget -= want;
   std::vector<std::uint64_t> sizes;
   for (std::uint64_t b = 0; b < blocks; ++b) sizes.push_back(header());
   std::string out;
@@ -522,7 +536,7 @@ bool is_int_type(const std::string& t) {
 
 VtkGrid read_vtu(const std::filesystem::path& path) {
   check_mesh_format(path, MeshFileFormat::kVtu);
-  return parse_vtu(read_file_bytes(path), path.string());
+  return parse_vtu(MappedFile(path).bytes(), path.string());
 }
 
 VtkGrid parse_vtu(std::string_view content, const std::string& source) {
@@ -532,6 +546,7 @@ VtkGrid parse_vtu(std::string_view content, const std::string& source) {
   // Appended data is raw bytes that may hold '<': cut out before the XML is parsed.
   std::string xml(content);
   VtuStorage enc;
+  enc.inflate_budget = (std::uint64_t{64} << 20) + 64 * static_cast<std::uint64_t>(content.size());
   std::string appended_bytes;
   if (const auto tag = xml.find("<AppendedData"); tag != std::string::npos) {
     const auto close = xml.find('>', tag);
@@ -826,7 +841,7 @@ std::string upper(std::string_view s) {
 
 VtkGrid read_vtk(const std::filesystem::path& path) {
   check_mesh_format(path, MeshFileFormat::kVtk);
-  return parse_vtk(read_file_bytes(path), path.string());
+  return parse_vtk(MappedFile(path).bytes(), path.string());
 }
 
 VtkGrid parse_vtk(std::string_view content, const std::string& source) {

@@ -1,6 +1,7 @@
 #include "primal/dice_model.hpp"
 
 #include <algorithm>
+#include <set>
 
 #include "primal/dice.hpp"
 #include "primal/errors.hpp"
@@ -193,11 +194,24 @@ std::vector<NodeSet> diced_node_sets(const Model& model, const DicedModel& diced
     std::vector<char> in(model.points.size(), 0);
     for (Index v : ns.nodes) in[v] = 1;
     NodeSet o{ns.id, ns.name, {}};
+    // With pieces (model.hpp), a node made from nodes of one piece: its key's nodes, sorted.
+    std::set<FaceKey> within;
+    for (const auto& piece : ns.pieces) {
+      const std::size_t n = std::min<std::size_t>(piece.size(), 4);
+      for (std::size_t mask = 1; mask < (std::size_t{1} << n); ++mask) {
+        FaceKey sub{kInvalidIndex, kInvalidIndex, kInvalidIndex, kInvalidIndex};
+        std::size_t used = 0;
+        for (std::size_t k = 0; k < n; ++k)
+          if (mask >> k & 1) sub[used++] = piece[k];
+        within.insert(normalized_origin(sub));
+      }
+    }
     for (std::size_t g = 0; g < diced.origin.size() && g < renumber.size(); ++g) {
       if (renumber[g] == kInvalidIndex || diced.origin[g][0] == kInvalidIndex) continue;
       bool all = true;
       for (Index v : diced.origin[g])
         if (v != kInvalidIndex) all = all && in[v];
+      if (all && !ns.pieces.empty()) all = within.count(normalized_origin(diced.origin[g])) > 0;
       if (all) o.nodes.push_back(renumber[g]);
     }
     std::sort(o.nodes.begin(), o.nodes.end());

@@ -262,6 +262,10 @@ void validate(const Model& model, std::string_view source) {
       if (set.nodes[i] < 0 || set.nodes[i] >= num_points)
         throw InvalidInput(where + ": entry " + std::to_string(i + 1) + " refers to node index " +
                            std::to_string(set.nodes[i]) + ", out of range");
+    for (const auto& piece : set.pieces)
+      for (Index v : piece)
+        if (v < 0 || v >= num_points)
+          throw InvalidInput(where + ": a piece refers to node index " + std::to_string(v) + ", out of range");
   }
   for (const SideSet& set : model.side_sets) {
     const std::string where = std::string(source) + ": side set " + std::to_string(set.id) +
@@ -451,6 +455,8 @@ Index merge_coincident_nodes(Model& model, double tolerance) {
     for (Index& v : w) v = map(v);
   for (NodeSet& set : model.node_sets) {
     for (Index& v : set.nodes) v = map(v);
+    for (auto& piece : set.pieces)
+      for (Index& v : piece) v = map(v);
     std::unordered_set<Index> seen;
     std::vector<Index> unique;
     for (Index v : set.nodes)

@@ -5,7 +5,7 @@ GEODE_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 GEODE_PACKAGES=(cmake g++ make libopenmesh-dev libeigen3-dev doctest-dev libcli11-dev
   nlohmann-json3-dev libexodusii-dev libgmsh-dev gmsh python3-vtk9 python3-matplotlib
   zlib1g-dev python3-meshio python3-netcdf4 clang libclang-rt-14-dev libjs-three chromium
-  libtbb-dev ccache)
+  libtbb-dev ccache python3-getfem)
 JOBS=${JOBS:-$(nproc)}
 # ccache keeps compiled objects between runs (and between clones: paths below the root are
 # hashed relative to it, the build directory not at all), so a second build costs little.
@@ -39,8 +39,8 @@ geode_fuzz() {
   local runs=${GEODE_FUZZ_RUNS:-1000000} seconds=${GEODE_FUZZ_SECONDS:-120} dir="$GEODE_ROOT/build-fuzz"
   CC=clang CXX=clang++ cmake -S "$GEODE_ROOT" -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGEODE_FUZZ=ON \
     -DGEODE_BENCH=OFF "${GEODE_LAUNCHER[@]}" >/dev/null
-  cmake --build "$dir" -j "$JOBS" --target fuzz_msh fuzz_vtu fuzz_vtk
-  for reader in msh vtu vtk; do
+  cmake --build "$dir" -j "$JOBS" --target fuzz_msh fuzz_vtu fuzz_vtk fuzz_exo
+  for reader in msh vtu vtk exo; do
     local work
     work=$(mktemp -d)
     echo "== fuzz $reader ($runs inputs, at most $seconds s)"

@@ -95,6 +95,26 @@ TEST_CASE("meshio's files: .exo, .msh 2.2 ASCII and binary, .vtu, .vtk read as m
   }
 }
 
+TEST_CASE("meshio's .exo with node sets numbered from 0: the sets numbered by position") {
+  // The old reader refused the file ("node set 0 'ns_bottom': id is not positive") although it
+  // renumbers meshio's block ids from 0 the same way.
+  test::TempDir dir;
+  const HexMesh m = write_variants("meshio", dir.path);
+  const Model model = read_model(dir.path / "meshio-sets.exo");
+  REQUIRE(model.node_sets.size() == 2);
+  CHECK(model.node_sets[0].id == 1);
+  CHECK(model.node_sets[0].name == "ns_bottom");
+  CHECK(model.node_sets[1].id == 2);
+  CHECK(model.node_sets[1].name == "ns_top");
+  double low = m.points.front().z();
+  for (const Point& p : m.points) low = std::min(low, p.z());
+  std::size_t bottom = 0;
+  for (const Point& p : m.points) bottom += p.z() < low + 1e-9;
+  CHECK(bottom >= 4);
+  CHECK(model.node_sets[0].nodes.size() == bottom);
+  for (Index v : model.node_sets[0].nodes) CHECK(model.points[static_cast<std::size_t>(v)].z() < low + 1e-9);
+}
+
 TEST_CASE("Gmsh's own writer: .msh 2.2 and 4.1, ASCII and binary, read back the same model") {
   test::TempDir dir;
   Model m = grid_model({2, 2, 1}, 0.5, [](int i, int, int) { return i >= 1; });

@@ -5,8 +5,9 @@ usage: write_variants.py vtk SOURCE.vtu OUTDIR    VTK's own writer: .vtu ascii, 
                                                    binary + zlib, appended raw, appended base64,
                                                    appended raw + zlib, UInt64 headers; legacy
                                                    .vtk ascii and binary
-       write_variants.py meshio SOURCE.vtu OUTDIR  meshio: .exo, .msh 2.2 ascii and binary,
-                                                   .vtu (its default: binary + zlib), .vtk
+       write_variants.py meshio SOURCE.vtu OUTDIR  meshio: .exo (also with node sets), .msh 2.2
+                                                   ascii and binary, .vtu (its default: binary +
+                                                   zlib), .vtk
 
 SOURCE is an ASCII .vtu geode wrote; each output is named after its variant. Exit status 77 when
 the Python module is missing (the caller fails: the packages are required).
@@ -73,6 +74,12 @@ def meshio_variants(source, outdir):
     mesh.write(os.path.join(outdir, "meshio.vtu"))
     mesh.write(os.path.join(outdir, "meshio-ascii.vtu"), binary=False)
     mesh.write(os.path.join(outdir, "meshio.vtk"), binary=False)
+    # Node sets, which meshio numbers from 0 (ns_prop1 = 0, 1, ...).
+    import numpy as np
+    bottom = np.nonzero(mesh.points[:, 2] < mesh.points[:, 2].min() + 1e-9)[0]
+    top = np.nonzero(mesh.points[:, 2] > mesh.points[:, 2].max() - 1e-9)[0]
+    meshio.Mesh(mesh.points, mesh.cells, point_sets={"ns_bottom": bottom, "ns_top": top}).write(
+        os.path.join(outdir, "meshio-sets.exo"))
 
 
 if __name__ == "__main__":

@@ -1,0 +1,78 @@
+#include "io/file_sink.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <charconv>
+#include <cstring>
+
+#include "primal/errors.hpp"
+
+namespace geode::io {
+
+namespace {
+constexpr std::size_t kBufferBytes = std::size_t{1} << 20;
+}
+
+FileSink::FileSink(const std::filesystem::path& file, std::string target)
+    : target_(std::move(target)), buffer_(kBufferBytes) {
+  fd_ = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd_ < 0) fail("cannot open for writing", errno);
+}
+
+FileSink::~FileSink() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void FileSink::fail(const std::string& what, int err) const {
+  throw InvalidInput(target_ + ": " + what + ": " + std::strerror(err) +
+                     (err == ENOSPC || err == EDQUOT ? " (the disk is full)" : ""));
+}
+
+void FileSink::flush() {
+  std::size_t done = 0;
+  while (done < used_) {
+    const ssize_t n = ::write(fd_, buffer_.data() + done, used_ - done);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      fail("write failed", errno);
+    }
+    if (n == 0) fail("write failed", EIO);
+    done += static_cast<std::size_t>(n);
+  }
+  used_ = 0;
+}
+
+void FileSink::make_room(std::size_t n) {
+  flush();
+  if (n > buffer_.size()) buffer_.resize(n);
+}
+
+void FileSink::integer(std::int64_t x) {
+  if (buffer_.size() - used_ < 24) make_room(24);
+  const auto r = std::to_chars(buffer_.data() + used_, buffer_.data() + buffer_.size(), x);
+  used_ = static_cast<std::size_t>(r.ptr - buffer_.data());
+}
+
+void FileSink::real(double x) {
+  if (buffer_.size() - used_ < 32) make_room(32);
+  const auto r = std::to_chars(buffer_.data() + used_, buffer_.data() + buffer_.size(), x);
+  used_ = static_cast<std::size_t>(r.ptr - buffer_.data());
+}
+
+void FileSink::close() {
+  flush();
+  // Errors of delayed writes (NFS, some full file systems) show at fsync or close.
+  if (::fsync(fd_) != 0 && errno != EINVAL && errno != EROFS) {
+    const int err = errno;
+    ::close(fd_);
+    fd_ = -1;
+    fail("write failed", err);
+  }
+  const int status = ::close(fd_);
+  fd_ = -1;
+  if (status != 0) fail("write failed", errno);
+}
+
+}  // namespace geode::io

@@ -1,0 +1,444 @@
+// Our own writer of Gmsh .msh 4.1 and 2.2, ASCII and binary (Gmsh reference manual, "MSH file
+// format" and "Legacy formats"), so that no output depends on libgmsh and every write error
+// (a full disk) is reported (file_sink.hpp). The layout is Gmsh's own with Mesh.SaveAll:
+// - one volume entity per block (entity tag = block id) in the block's physical volume;
+//   all nodes are listed on the first volume entity (elements of every entity use them);
+// - one surface entity per side set holding its faces as triangles / quads, in the set's
+//   physical surface, and one point entity per node set holding one point element per node,
+//   in the set's physical point;
+// - every entity's tag is its physical tag, so entity tags too are distinct across dimensions
+//   (GetFEM 5.4 takes a .msh 4.1 element's region from its entity's tag);
+// - $PhysicalNames for every named group, names made safe by io/names.hpp.
+// Physical tags are distinct across dimensions (GetFEM, among others, keeps one region per tag
+// and renumbers a tag used twice): blocks keep their ids; a side or node set whose id is
+// already taken gets id + 10^k, 10^k the smallest power of ten above every id in the model
+// (side sets first, then node sets, each in model order).
+// Node tags are index + 1; element tags run from 1 over the blocks in ascending id (cell kinds
+// in the table's order within a block), then the side sets' faces, then the node sets' points.
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <map>
+#include <set>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "io/atomic_file.hpp"
+#include "io/file_sink.hpp"
+#include "io/gmsh.hpp"
+#include "io/names.hpp"
+#include "primal/errors.hpp"
+#include "primal/topology.hpp"
+
+namespace geode::io {
+
+using namespace primal;
+
+namespace {
+
+constexpr int kTri3 = 2, kQuad4 = 3, kPoint = 15;
+
+// The Model's volume cell kinds as Gmsh element types, in the order they are written within a
+// block: gmsh corner gmsh_from_vtk[i] of a cell is VTK corner i (gmsh.hpp's kGmsh*ToVtk).
+// A new cell kind of the Model is one row here and one case in cells_of below.
+struct VolumeKind {
+  ElementKind kind;
+  int gmsh_type;
+  std::size_t corners;
+  std::array<int, 8> gmsh_from_vtk;
+};
+constexpr VolumeKind kVolumeKinds[] = {
+    {ElementKind::Hex, 5, 8, kGmshHexToVtk},
+    {ElementKind::Tet, 4, 4, {kGmshTetToVtk[0], kGmshTetToVtk[1], kGmshTetToVtk[2], kGmshTetToVtk[3]}},
+    // pyramid (Gmsh 7, 5 corners) and wedge (Gmsh 6, 6 corners): rows to add with the Model's
+    // pyramid and wedge arrays (branch hybrid).
+};
+
+// The cells of one kind as (count, corners of cell i).
+struct CellArray {
+  std::size_t size = 0;
+  std::size_t stride = 0;
+  const Index* data = nullptr;
+  std::span<const Index> corners(std::size_t i) const { return {data + i * stride, stride}; }
+};
+CellArray cells_of(const Model& m, ElementKind kind) {
+  switch (kind) {
+    case ElementKind::Hex:
+      return {m.hexes.size(), 8, m.hexes.empty() ? nullptr : m.hexes.front().data()};
+    case ElementKind::Tet:
+      return {m.tets.size(), 4, m.tets.empty() ? nullptr : m.tets.front().data()};
+  }
+  return {};
+}
+
+// One entity block of $Elements: its entity and type, and each element's Gmsh node tags.
+struct ElementBlock {
+  int dim = 0;
+  int entity = 0;
+  int physical = 0;
+  int type = 0;
+  std::size_t nodes_per_element = 0;
+  std::vector<std::size_t> node_tags;  // nodes_per_element per element
+  std::size_t first_tag = 0;
+  std::size_t count() const { return nodes_per_element ? node_tags.size() / nodes_per_element : 0; }
+};
+
+struct Entity {
+  int dim = 0;
+  int tag = 0;
+  int physical = 0;
+  Point low = Point::Zero(), high = Point::Zero();
+};
+
+struct PhysicalName {
+  int dim = 0;
+  int tag = 0;
+  std::string name;
+};
+
+// The model laid out as Gmsh entities, element blocks and physical groups.
+class MshLayout {
+ public:
+  MshLayout(const Model& model, const std::string& target) : m_(model), target_(target) {
+    volumes();
+    assign_set_tags();
+    side_sets();
+    node_sets();
+    std::size_t next = 1;
+    for (ElementBlock& b : blocks_) {
+      b.first_tag = next;
+      next += b.count();
+    }
+    elements_ = next - 1;
+  }
+
+  const Model& m_;
+  const std::string& target_;
+  std::vector<Entity> entities_;  // in dimension order 0, 1, 2, 3 once sorted
+  std::vector<ElementBlock> blocks_;
+  std::vector<PhysicalName> names_;
+  std::size_t elements_ = 0;
+  int node_entity_ = 1;
+
+ private:
+  std::vector<int> side_tags_, node_tags_;
+
+  Entity bounded(int dim, int tag, int physical, const std::vector<std::size_t>& nodes) const {
+    Entity e{dim, tag, physical, Point::Zero(), Point::Zero()};
+    if (!nodes.empty()) {
+      e.low = e.high = m_.points[nodes.front() - 1];
+      for (std::size_t n : nodes) {
+        e.low = e.low.cwiseMin(m_.points[n - 1]);
+        e.high = e.high.cwiseMax(m_.points[n - 1]);
+      }
+    }
+    return e;
+  }
+
+  void volumes() {
+    std::map<int, std::vector<ElementBlock>> by_block;
+    for (const VolumeKind& k : kVolumeKinds) {
+      const CellArray cells = cells_of(m_, k.kind);
+      for (std::size_t i = 0; i < cells.size; ++i) {
+        const int block = block_of(m_, {k.kind, static_cast<Index>(i)});
+        auto& list = by_block[block];
+        if (list.empty() || list.back().type != k.gmsh_type)
+          list.push_back({3, block, block, k.gmsh_type, k.corners, {}, 0});
+        auto& tags = list.back().node_tags;
+        const std::size_t base = tags.size();
+        tags.resize(base + k.corners);
+        const auto c = cells.corners(i);
+        for (std::size_t v = 0; v < k.corners; ++v)
+          tags[base + static_cast<std::size_t>(k.gmsh_from_vtk[v])] = static_cast<std::size_t>(c[v]) + 1;
+      }
+    }
+    for (auto& [block, list] : by_block) {
+      std::vector<std::size_t> all;
+      for (ElementBlock& b : list) {
+        all.insert(all.end(), b.node_tags.begin(), b.node_tags.end());
+        blocks_.push_back(std::move(b));
+      }
+      entities_.push_back(bounded(3, block, block, all));
+      if (auto it = m_.block_names.find(block); it != m_.block_names.end() && !sanitize_name(it->second).empty())
+        names_.push_back({3, block, sanitize_name(it->second)});
+    }
+    if (by_block.empty()) {
+      // Nodes need an entity even without elements.
+      std::vector<std::size_t> all(m_.points.size());
+      for (std::size_t i = 0; i < all.size(); ++i) all[i] = i + 1;
+      entities_.push_back(bounded(3, 1, 0, all));
+    }
+    node_entity_ = entities_.front().tag;
+  }
+
+  void assign_set_tags() {
+    std::set<int> used;
+    long long largest = 0;
+    for (const auto& [block, list] : m_.block_names) largest = std::max<long long>(largest, block);
+    for (const Entity& e : entities_) {
+      if (e.physical) used.insert(e.physical);
+      largest = std::max<long long>(largest, e.physical);
+    }
+    for (const SideSet& s : m_.side_sets) largest = std::max<long long>(largest, s.id);
+    for (const NodeSet& s : m_.node_sets) largest = std::max<long long>(largest, s.id);
+    long long offset = 10;
+    while (offset <= largest) offset *= 10;
+    auto tag_for = [&](int id, const std::string& what) {
+      long long tag = id;
+      while (used.count(static_cast<int>(tag))) {
+        tag += offset;
+        if (tag > INT32_MAX)
+          throw InvalidInput(target_ + ": " + what + " " + std::to_string(id) +
+                             ": no distinct physical tag is left for it");
+      }
+      used.insert(static_cast<int>(tag));
+      return static_cast<int>(tag);
+    };
+    for (const SideSet& s : m_.side_sets) side_tags_.push_back(tag_for(s.id, "side set"));
+    for (const NodeSet& s : m_.node_sets) node_tags_.push_back(tag_for(s.id, "node set"));
+  }
+
+  void side_sets() {
+    for (std::size_t s = 0; s < m_.side_sets.size(); ++s) {
+      const SideSet& set = m_.side_sets[s];
+      const int physical = side_tags_[s], entity = physical;
+      ElementBlock tri{2, entity, physical, kTri3, 3, {}, 0}, quad{2, entity, physical, kQuad4, 4, {}, 0};
+      for (const Side& side : set.sides) {
+        const auto e = static_cast<std::size_t>(side.element.index);
+        const auto f = static_cast<std::size_t>(side.face);
+        if (side.element.kind == ElementKind::Hex) {
+          for (int c : topology::kHexFaceCorners[f]) quad.node_tags.push_back(static_cast<std::size_t>(m_.hexes[e][static_cast<std::size_t>(c)]) + 1);
+        } else {
+          for (int c : topology::kTetFaceCorners[f]) tri.node_tags.push_back(static_cast<std::size_t>(m_.tets[e][static_cast<std::size_t>(c)]) + 1);
+        }
+      }
+      std::vector<std::size_t> all = tri.node_tags;
+      all.insert(all.end(), quad.node_tags.begin(), quad.node_tags.end());
+      entities_.push_back(bounded(2, entity, physical, all));
+      if (!tri.node_tags.empty()) blocks_.push_back(std::move(tri));
+      if (!quad.node_tags.empty()) blocks_.push_back(std::move(quad));
+      if (const std::string name = sanitize_name(set.name); !name.empty()) names_.push_back({2, physical, name});
+    }
+  }
+
+  void node_sets() {
+    for (std::size_t s = 0; s < m_.node_sets.size(); ++s) {
+      const NodeSet& set = m_.node_sets[s];
+      const int physical = node_tags_[s], entity = physical;
+      ElementBlock points{0, entity, physical, kPoint, 1, {}, 0};
+      for (Index v : set.nodes) points.node_tags.push_back(static_cast<std::size_t>(v) + 1);
+      entities_.push_back(bounded(0, entity, physical, points.node_tags));
+      if (!points.node_tags.empty()) blocks_.push_back(std::move(points));
+      if (const std::string name = sanitize_name(set.name); !name.empty()) names_.push_back({0, physical, name});
+    }
+  }
+};
+
+class MshWriter {
+ public:
+  MshWriter(const MshLayout& layout, FileSink& out, bool binary, GmshVersion version)
+      : l_(layout), out_(out), binary_(binary), v41_(version == GmshVersion::k41) {}
+
+  void write() {
+    out_.text("$MeshFormat\n");
+    out_.text(v41_ ? "4.1 " : "2.2 ");
+    out_.text(binary_ ? "1 8\n" : "0 8\n");
+    if (binary_) {
+      out_.raw<std::int32_t>(1);
+      out_.ch('\n');
+    }
+    out_.text("$EndMeshFormat\n");
+    physical_names();
+    if (v41_) {
+      entities41();
+      nodes41();
+      elements41();
+    } else {
+      nodes22();
+      elements22();
+    }
+  }
+
+ private:
+  const MshLayout& l_;
+  FileSink& out_;
+  bool binary_;
+  bool v41_;
+
+  // ASCII fields separated by spaces, each line ended by the caller.
+  void num(std::int64_t x) { out_.integer(x); }
+  void sp() { out_.ch(' '); }
+  void nl() { out_.ch('\n'); }
+  // 4.1 binary: int is 4 bytes, size_t 8.
+  void int_field(int x, bool last = false) {
+    if (binary_) return out_.raw<std::int32_t>(x);
+    num(x);
+    last ? nl() : sp();
+  }
+  void size_field(std::size_t x, bool last = false) {
+    if (binary_) return out_.raw<std::uint64_t>(x);
+    num(static_cast<std::int64_t>(x));
+    last ? nl() : sp();
+  }
+  void real_field(double x, bool last = false) {
+    if (binary_) return out_.raw<double>(x);
+    out_.real(x);
+    last ? nl() : sp();
+  }
+
+  void physical_names() {
+    if (l_.names_.empty()) return;
+    out_.text("$PhysicalNames\n");
+    num(static_cast<std::int64_t>(l_.names_.size()));
+    nl();
+    for (const PhysicalName& p : l_.names_) {
+      num(p.dim);
+      sp();
+      num(p.tag);
+      out_.text(" \"");
+      out_.text(p.name);
+      out_.text("\"\n");
+    }
+    out_.text("$EndPhysicalNames\n");
+  }
+
+  void entities41() {
+    std::array<std::vector<const Entity*>, 4> by_dim;
+    for (const Entity& e : l_.entities_) by_dim[static_cast<std::size_t>(e.dim)].push_back(&e);
+    out_.text("$Entities\n");
+    for (std::size_t d = 0; d < 4; ++d) size_field(by_dim[d].size(), d == 3);
+    for (std::size_t d = 0; d < 4; ++d)
+      for (const Entity* e : by_dim[d]) {
+        int_field(e->tag);
+        for (int k = 0; k < 3; ++k) real_field(e->low[k]);
+        if (d > 0)
+          for (int k = 0; k < 3; ++k) real_field(e->high[k]);
+        size_field(e->physical ? 1 : 0, d == 0 && !e->physical);
+        if (e->physical) int_field(e->physical, d == 0);
+        if (d > 0) size_field(0, true);  // no bounding entities: a discrete model
+      }
+    if (binary_) nl();
+    out_.text("$EndEntities\n");
+  }
+
+  void nodes41() {
+    const auto& pts = l_.m_.points;
+    out_.text("$Nodes\n");
+    size_field(1);
+    size_field(pts.size());
+    size_field(pts.empty() ? 0 : 1);
+    size_field(pts.size(), true);
+    int_field(3);
+    int_field(l_.node_entity_);
+    int_field(0);
+    size_field(pts.size(), true);
+    for (std::size_t i = 0; i < pts.size(); ++i) size_field(i + 1, true);
+    for (const Point& p : pts) {
+      real_field(p.x());
+      real_field(p.y());
+      real_field(p.z(), true);
+    }
+    if (binary_) nl();
+    out_.text("$EndNodes\n");
+  }
+
+  void elements41() {
+    out_.text("$Elements\n");
+    size_field(l_.blocks_.size());
+    size_field(l_.elements_);
+    size_field(l_.elements_ ? 1 : 0);
+    size_field(l_.elements_, true);
+    for (const ElementBlock& b : l_.blocks_) {
+      int_field(b.dim);
+      int_field(b.entity);
+      int_field(b.type);
+      size_field(b.count(), true);
+      for (std::size_t e = 0; e < b.count(); ++e) {
+        size_field(b.first_tag + e);
+        for (std::size_t k = 0; k < b.nodes_per_element; ++k)
+          size_field(b.node_tags[e * b.nodes_per_element + k], k + 1 == b.nodes_per_element);
+      }
+    }
+    if (binary_) nl();
+    out_.text("$EndElements\n");
+  }
+
+  // 2.2: counts as text lines; binary records are 4-byte ints and 8-byte doubles.
+  void nodes22() {
+    const auto& pts = l_.m_.points;
+    out_.text("$Nodes\n");
+    num(static_cast<std::int64_t>(pts.size()));
+    nl();
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      if (binary_) {
+        out_.raw<std::int32_t>(static_cast<std::int32_t>(i + 1));
+        out_.raw<double>(pts[i].x());
+        out_.raw<double>(pts[i].y());
+        out_.raw<double>(pts[i].z());
+      } else {
+        num(static_cast<std::int64_t>(i + 1));
+        sp();
+        real_field(pts[i].x());
+        real_field(pts[i].y());
+        real_field(pts[i].z(), true);
+      }
+    }
+    if (binary_) nl();
+    out_.text("$EndNodes\n");
+  }
+
+  void elements22() {
+    out_.text("$Elements\n");
+    num(static_cast<std::int64_t>(l_.elements_));
+    nl();
+    for (const ElementBlock& b : l_.blocks_) {
+      if (binary_ && b.count() > 0) {
+        out_.raw<std::int32_t>(b.type);
+        out_.raw<std::int32_t>(static_cast<std::int32_t>(b.count()));
+        out_.raw<std::int32_t>(2);  // tags: physical, elementary entity
+      }
+      for (std::size_t e = 0; e < b.count(); ++e) {
+        const std::size_t* nodes = b.node_tags.data() + e * b.nodes_per_element;
+        if (binary_) {
+          out_.raw<std::int32_t>(static_cast<std::int32_t>(b.first_tag + e));
+          out_.raw<std::int32_t>(b.physical);
+          out_.raw<std::int32_t>(b.entity);
+          for (std::size_t k = 0; k < b.nodes_per_element; ++k) out_.raw<std::int32_t>(static_cast<std::int32_t>(nodes[k]));
+        } else {
+          num(static_cast<std::int64_t>(b.first_tag + e));
+          sp();
+          num(b.type);
+          out_.text(" 2 ");
+          num(b.physical);
+          sp();
+          num(b.entity);
+          for (std::size_t k = 0; k < b.nodes_per_element; ++k) {
+            sp();
+            num(static_cast<std::int64_t>(nodes[k]));
+          }
+          nl();
+        }
+      }
+    }
+    if (binary_) nl();
+    out_.text("$EndElements\n");
+  }
+};
+
+}  // namespace
+
+void write_gmsh(const Model& model, const std::filesystem::path& path, GmshFormat format, GmshVersion version) {
+  const std::string target = path.string();
+  validate(model, target);
+  const MshLayout layout(model, target);
+  if (version == GmshVersion::k22 && (model.points.size() >= INT32_MAX || layout.elements_ >= INT32_MAX))
+    throw InvalidInput(target + ": more nodes or elements than .msh 2.2's 32-bit tags can number; write .msh 4.1");
+  write_path_atomically(path, ".msh", [&](const std::filesystem::path& temp) {
+    FileSink out(temp, target);
+    MshWriter(layout, out, format == GmshFormat::Binary, version).write();
+    out.close();
+  });
+}
+
+}  // namespace geode::io

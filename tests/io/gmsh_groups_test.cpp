@@ -1,0 +1,148 @@
+// The .msh reader's physical groups as users' files hold them: partitioned files
+// ($PartitionedEntities, written by Gmsh at test time), an entity in several physical volumes,
+// and a node set given as lines that dicing must not grow onto a face.
+#include <doctest/doctest.h>
+
+#include <gmsh.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "io/gmsh.hpp"
+#include "io/read_warnings.hpp"
+#include "primal/dice_model.hpp"
+#include "primal/errors.hpp"
+#include "support/temp_dir.hpp"
+
+namespace fs = std::filesystem;
+using namespace geode;
+using namespace geode::primal;
+using namespace geode::io;
+
+namespace {
+
+void write_text(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+// Two boxes meshed by Gmsh: x in [0, 1] hexes (transfinite, recombined) in physical volume 1
+// "hex", x in [2, 3] tets in physical volume 2 "tet", partitioned into `parts` and written as
+// .msh 4.1 (ASCII or binary): elements then live on partitioned entities.
+void partitioned_file(const fs::path& file, bool binary, int parts) {
+  GmshSession session;
+  gmsh::model::add("parts");
+  // Apart, so that Gmsh puts no pyramids between the hexes' quads and the tets.
+  const int a = gmsh::model::occ::addBox(0, 0, 0, 1, 1, 1);
+  const int b = gmsh::model::occ::addBox(2, 0, 0, 1, 1, 1);
+  gmsh::model::occ::synchronize();
+  gmsh::vectorpair curves;
+  gmsh::model::getBoundary({{3, a}}, curves, false, false, true);
+  for (const auto& [dim, tag] : curves)
+    if (dim == 1) gmsh::model::mesh::setTransfiniteCurve(tag, 3);
+  gmsh::vectorpair surfaces;
+  gmsh::model::getBoundary({{3, a}}, surfaces, false, false, false);
+  for (const auto& [dim, tag] : surfaces) {
+    gmsh::model::mesh::setTransfiniteSurface(std::abs(tag));
+    gmsh::model::mesh::setRecombine(2, std::abs(tag));
+  }
+  gmsh::model::mesh::setTransfiniteVolume(a);
+  gmsh::option::setNumber("Mesh.MeshSizeMax", 0.5);
+  gmsh::model::addPhysicalGroup(3, {a}, 1);
+  gmsh::model::setPhysicalName(3, 1, "hex");
+  gmsh::model::addPhysicalGroup(3, {b}, 2);
+  gmsh::model::setPhysicalName(3, 2, "tet");
+  gmsh::model::mesh::generate(3);
+  gmsh::model::mesh::partition(parts);
+  gmsh::option::setNumber("Mesh.MshFileVersion", 4.1);
+  gmsh::option::setNumber("Mesh.Binary", binary ? 1 : 0);
+  gmsh::option::setNumber("Mesh.PartitionSplitMeshFiles", 0);
+  gmsh::write(file.string());
+}
+
+}  // namespace
+
+TEST_CASE("a partitioned .msh 4.1 (ASCII and binary) gives the blocks of its physical volumes") {
+  // The old reader skipped $PartitionedEntities: blocks came out as the partitioned entities'
+  // tags (3, 4, 5, 6), unnamed.
+  const test::TempDir dir;
+  for (bool binary : {false, true}) {
+    CAPTURE(binary);
+    const fs::path file = dir.path / (binary ? "parts-bin.msh" : "parts.msh");
+    partitioned_file(file, binary, 3);
+    const std::string head = [&] {
+      std::ifstream in(file, std::ios::binary);
+      return std::string(std::istreambuf_iterator<char>(in), {});
+    }();
+    REQUIRE(head.find("$PartitionedEntities") != std::string::npos);
+    const Model m = read_gmsh(file);
+    CHECK(!m.hexes.empty());
+    CHECK(!m.tets.empty());
+    CHECK(m.hex_block == std::vector<int>(m.hexes.size(), 1));
+    CHECK(m.tet_block == std::vector<int>(m.tets.size(), 2));
+    CHECK(m.block_names == std::map<int, std::string>{{1, "hex"}, {2, "tet"}});
+  }
+}
+
+TEST_CASE("an entity in several physical volumes: each element in the most specific, and a warning") {
+  // Tet entity 1 in physicals 2 "tets" and 1 "steel", hex entity 2 in 5 "hexes" and 1: the old
+  // reader took the smallest tag, so one block 1 held everything and "tets" and "hexes"
+  // vanished without a word.
+  const std::string text =
+      "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n"
+      "$PhysicalNames\n3\n3 1 \"steel\"\n3 2 \"tets\"\n3 5 \"hexes\"\n$EndPhysicalNames\n"
+      "$Entities\n0 0 0 2\n"
+      "1 1 0 0 2 1 1 2 2 1 0\n"
+      "2 0 0 0 1 1 1 2 5 1 0\n"
+      "$EndEntities\n"
+      "$Nodes\n1 9 1 9\n3 2 0 9\n1\n2\n3\n4\n5\n6\n7\n8\n9\n"
+      "0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n2 0 0\n$EndNodes\n"
+      "$Elements\n2 2 1 2\n"
+      "3 2 5 1\n1 1 2 3 4 5 6 7 8\n"
+      "3 1 4 1\n2 2 9 3 6\n"
+      "$EndElements\n";
+  const test::TempDir dir;
+  const fs::path file = dir.path / "multi.msh";
+  write_text(file, text);
+  ReadWarnings warnings;
+  const Model m = read_gmsh(file);
+  CHECK(m.hex_block == std::vector<int>{5});
+  CHECK(m.tet_block == std::vector<int>{2});
+  CHECK(m.block_names.at(5) == "hexes");
+  CHECK(m.block_names.at(2) == "tets");
+  REQUIRE(warnings.messages().size() == 1);
+  CHECK(warnings.messages()[0].find(file.string() + ": physical volume 1 'steel'") == 0);
+}
+
+TEST_CASE("a node set from a physical curve on two parallel edges stays on those edges when diced") {
+  // One unit hex; the physical curve 7 holds its bottom edges 1-2 and 4-3 (parallel). The set
+  // is those 4 nodes; diced, it gains the two edge midpoints, not the bottom face's centre
+  // between them (the old result: all 4 corners of that face in the set, so its centre too).
+  const std::string text =
+      "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
+      "$PhysicalNames\n1\n1 7 \"edges\"\n$EndPhysicalNames\n"
+      "$Nodes\n8\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n5 0 0 1\n6 1 0 1\n7 1 1 1\n8 0 1 1\n$EndNodes\n"
+      "$Elements\n3\n"
+      "1 1 2 7 1 1 2\n"
+      "2 1 2 7 1 4 3\n"
+      "3 5 2 1 1 1 2 3 4 5 6 7 8\n"
+      "$EndElements\n";
+  const test::TempDir dir;
+  const fs::path file = dir.path / "edges.msh";
+  write_text(file, text);
+  const Model m = read_gmsh(file);
+  REQUIRE(m.node_sets.size() == 1);
+  CHECK(m.node_sets[0].nodes == std::vector<Index>{0, 1, 2, 3});
+  const DicedModel diced = dice_model(m);
+  std::vector<Index> identity(diced.points.size());
+  for (std::size_t i = 0; i < identity.size(); ++i) identity[i] = static_cast<Index>(i);
+  const auto sets = diced_node_sets(m, diced, identity);
+  REQUIRE(sets.size() == 1);
+  REQUIRE(sets[0].nodes.size() == 6);
+  for (Index v : sets[0].nodes) {
+    const Point& p = diced.points[static_cast<std::size_t>(v)];
+    CHECK(p.z() == 0.0);
+    CHECK((p.y() == 0.0 || p.y() == 1.0));  // on edge 1-2 or 4-3, never the face centre (0.5, 0.5)
+  }
+}

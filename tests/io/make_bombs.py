@@ -1,0 +1,94 @@
+#!/usr/bin/python3
+"""Write the hostile input files of tests/io/bombs_test.sh into OUTDIR.
+
+usage: make_bombs.py OUTDIR
+
+- nested.vtu: 30,000 nested tags (200 KB), which once overflowed the XML parser's stack;
+- zlib.vtu: 1.2 MB of zlib blocks that inflate to 1.2 GB of points, every array pointing at
+  the same appended bytes (2.5 GB and more inflated in all);
+- nodes.exo: a 19 KB netCDF-4 Exodus file whose header claims 2e9 nodes (never written: HDF5
+  stores nothing for them), made from a meshio-written hex;
+- big.msh: a 6 GiB sparse .msh (no disk space used) with a bad token after its nodes, which a
+  reader that copies whole files into memory loads at once before finding it.
+Exit status 77 when a Python module is missing.
+"""
+import os
+import struct
+import sys
+import zlib
+
+
+def nested(outdir):
+    with open(os.path.join(outdir, "nested.vtu"), "w") as f:
+        f.write('<?xml version="1.0"?>\n<VTKFile type="UnstructuredGrid" version="1.0">\n')
+        f.write("<a>" * 30000)
+        f.write("</a>" * 30000)
+        f.write("\n</VTKFile>\n")
+
+
+def zlib_bomb(outdir):
+    block = 1 << 20
+    compressed = zlib.compress(bytes(block), 9)
+    blocks = 1200 * 1024 // len(compressed)  # about 1.2 MB of compressed data
+    points = blocks * block // 24
+    last = points * 24 - (blocks - 1) * block  # the blocks add up to the points array exactly
+    tail = zlib.compress(bytes(last), 9)
+    header = struct.pack("<" + "Q" * (3 + blocks), blocks, block, last, *([len(compressed)] * (blocks - 1)), len(tail))
+    data = header + compressed * (blocks - 1) + tail
+    arrays = ""
+    for name, kind, comps in (("Points", "Float64", 3),):
+        arrays += f'<Points><DataArray type="{kind}" NumberOfComponents="{comps}" format="appended" offset="0"/></Points>\n'
+    cells = "".join(
+        f'<DataArray type="{t}" Name="{n}" format="appended" offset="0"/>\n'
+        for n, t in (("connectivity", "Int64"), ("offsets", "Int64"), ("types", "UInt8")))
+    with open(os.path.join(outdir, "zlib.vtu"), "wb") as f:
+        f.write(('<?xml version="1.0"?>\n<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" '
+                 'header_type="UInt64" compressor="vtkZLibDataCompressor">\n<UnstructuredGrid>\n'
+                 f'<Piece NumberOfPoints="{points}" NumberOfCells="{points // 8}">\n'
+                 + arrays + "<Cells>\n" + cells + "</Cells>\n</Piece>\n</UnstructuredGrid>\n"
+                 '<AppendedData encoding="raw">\n_').encode())
+        f.write(data)
+        f.write(b"\n</AppendedData>\n</VTKFile>\n")
+
+
+def exodus_nodes(outdir):
+    try:
+        import meshio
+        import netCDF4
+        import numpy as np
+    except ImportError:
+        sys.exit(77)
+    small = os.path.join(outdir, "small.exo")
+    points = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]], float)
+    meshio.Mesh(points, [("hexahedron", np.arange(8).reshape(1, 8))]).write(small)
+    with netCDF4.Dataset(small) as src, netCDF4.Dataset(os.path.join(outdir, "nodes.exo"), "w", format="NETCDF4") as dst:
+        dst.setncatts({k: src.getncattr(k) for k in src.ncattrs()})
+        for name, dim in src.dimensions.items():
+            size = 2000000000 if name == "num_nodes" else (None if dim.isunlimited() else len(dim))
+            dst.createDimension(name, size)
+        for name, var in src.variables.items():
+            big = "num_nodes" in var.dimensions
+            out = dst.createVariable(name, var.datatype, var.dimensions,
+                                     chunksizes=[1024 if d == "num_nodes" else len(src.dimensions[d]) for d in var.dimensions] if big else None)
+            out.setncatts({k: var.getncattr(k) for k in var.ncattrs()})
+            if not big and var.size > 0:
+                out[:] = var[:]
+    os.remove(small)
+
+
+def big_msh(outdir):
+    # A valid start, then a bad token and 6 GiB of holes: a reader that maps the file touches
+    # one page; one that copies it first holds 6 GiB.
+    path = os.path.join(outdir, "big.msh")
+    with open(path, "wb") as f:
+        f.write(b"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 2 1 2\n3 1 0 2\n1\n2\n0 0 0\n1 0 0\n"
+                b"$EndNodes\n$Elements\nX\n")
+        f.truncate(6 << 30)
+
+
+if __name__ == "__main__":
+    outdir = sys.argv[1]
+    nested(outdir)
+    zlib_bomb(outdir)
+    exodus_nodes(outdir)
+    big_msh(outdir)
