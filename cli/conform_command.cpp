@@ -12,6 +12,7 @@
 #include "cli/progress.hpp"
 #include "conform/conform.hpp"
 #include "demo/demo_models.hpp"
+#include "conform/report.hpp"
 #include "primal/errors.hpp"
 #include "primal/quality.hpp"
 #include "primal/quality_report.hpp"
@@ -45,57 +46,6 @@ struct ConformArgs {
   bool write_invalid = false;
 };
 
-double min_sj(const primal::QualityReport& q) {
-  for (const auto& m : q.metrics)
-    if (m.metric == primal::HexMetric::kScaledJacobian) return m.minimum;
-  return 0.0;
-}
-
-double output_min_sj(const conform::ConformResult& r) {
-  double m = 1.0;
-  for (const auto& b : r.quality) m = std::min(m, min_sj(b.report));
-  return m;
-}
-
-nlohmann::json result_json(const conform::ConformResult& r) {
-  nlohmann::json j;
-  j["input"] = {{"hexes", r.input_hexes}, {"tets", r.input_tets}, {"pyramids", r.input_pyramids},
-                {"wedges", r.input_wedges}, {"interface_quads", r.interface_quads}};
-  j["output"] = {{"hexes", r.model.hexes.size()},    {"nodes", r.model.points.size()},
-                 {"diced_hexes", r.diced_hexes},     {"geode_hexes", r.geode_hexes},
-                 {"diced_tet_hexes", r.diced_tet_hexes}, {"diced_wedge_hexes", r.diced_wedge_hexes}};
-  j["valid"] = r.validity.ok();
-  j["template_min_scaled_jacobian"] = r.template_min_scaled_jacobian;
-  j["min_scaled_jacobian_before_smoothing"] = r.min_scaled_jacobian_before_smoothing;
-  j["min_scaled_jacobian_after_smoothing"] = r.smoothing.final_min_scaled_jacobian;
-  j["hexes_inverted_by_placement"] = r.placement_inverted;
-  j["templates_settled"] = r.templates_settled;
-  j["smoothing"] = {{"patches", r.smoothing.patches},
-                    {"seconds", r.smoothing.seconds},
-                    {"cpu_seconds", r.smoothing.cpu_seconds}};
-  j["buffer_layer_min_scaled_jacobian"] = r.buffer.min_scaled_jacobian;
-  j["buffer_side"] = conform::buffer_side_name(r.buffer_side);
-  j["input_diced_alone_min_scaled_jacobian"] = {{"hexes", r.input_diced_hex_min_scaled_jacobian},
-                                                {"tets", r.input_diced_tet_min_scaled_jacobian},
-                                                {"wedges", r.input_diced_wedge_min_scaled_jacobian}};
-  j["output_min_scaled_jacobian"] = output_min_sj(r);
-  j["seconds"] = r.seconds;
-  j["warnings"] = r.warnings;
-  j["blocks"] = nlohmann::json::array();
-  for (const auto& b : r.quality)
-    j["blocks"].push_back({{"id", b.block}, {"name", b.name},
-                           {"quality", primal::quality_report_json(b.report)}});
-  return j;
-}
-
-// Valid: faces shared by two hexes, closed boundary, every node covered once, and no hex with
-// scaled Jacobian <= 0.
-bool result_valid(const conform::ConformResult& r) {
-  if (!r.validity.ok()) return false;
-  return std::all_of(r.quality.begin(), r.quality.end(),
-                     [](const conform::BlockQuality& b) { return min_sj(b.report) > 0.0; });
-}
-
 void print_summary(const conform::ConformResult& r, std::ostream& os, bool tables) {
   os << "input: " << r.input_hexes << " hexes, " << r.input_tets << " tets, ";
   if (r.input_pyramids) os << r.input_pyramids << " pyramids (split), ";
@@ -105,38 +55,22 @@ void print_summary(const conform::ConformResult& r, std::ostream& os, bool table
      << r.geode_hexes << " geode, " << r.diced_tet_hexes << " diced tet";
   if (r.diced_wedge_hexes) os << ", " << r.diced_wedge_hexes << " diced wedge";
   os << "), "
-     << r.model.points.size() << " nodes, " << (result_valid(r) ? "valid" : "INVALID") << ", "
+     << r.model.points.size() << " nodes, " << (conform::result_valid(r) ? "valid" : "INVALID") << ", "
      << r.seconds << " s\n";
   for (const auto& b : r.quality) {
     os << "block " << b.block << " \"" << b.name << "\": " << b.report.num_hexes
-       << " hexes, min scaled Jacobian " << min_sj(b.report) << "\n";
+       << " hexes, min scaled Jacobian " << conform::block_min_scaled_jacobian(b.report) << "\n";
     if (tables) os << primal::format_quality_table(b.report) << "\n";
   }
   // The transition against the input's own elements diced alone (the yardstick).
   const double yardstick = r.yardstick();
-  const double output = output_min_sj(r);
+  const double output = conform::output_min_scaled_jacobian(r);
   os << "input diced alone: min scaled Jacobian " << r.input_diced_hex_min_scaled_jacobian << " (hexes), "
      << r.input_diced_tet_min_scaled_jacobian << " (tets" << (r.input_pyramids ? ", pyramids as their two tets" : "") << ")";
   if (r.input_wedges) os << ", " << r.input_diced_wedge_min_scaled_jacobian << " (wedges)";
   os << "; output " << output;
   if (yardstick > 0) os << " = " << output / yardstick << " x the lower";
   os << "\n";
-}
-
-// Nodes at one place as other nodes (within 1e-9 of the model's size): the parts were meshed
-// separately. A hint for a failed interface, empty when there are none.
-std::string duplicate_node_hint(const primal::Model& model) {
-  if (model.points.empty()) return {};
-  Eigen::AlignedBox3d box;
-  for (const auto& p : model.points) box.extend(p);
-  const double tolerance = 1e-9 * box.diagonal().norm();
-  primal::Model copy = model;
-  const primal::Index merged = primal::merge_coincident_nodes(copy, tolerance);
-  if (merged == 0) return {};
-  std::ostringstream s;
-  s << "; hint: " << merged << " nodes lie at the same place as others (parts meshed separately?): "
-    << "--merge-tolerance " << tolerance << " merges them";
-  return s.str();
 }
 
 // --template-box: three sizes, checked as template --box checks its box.
@@ -199,11 +133,11 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
   try {
     r = conform::conform(model, opts);
   } catch (const InvalidInput& e) {
-    throw InvalidInput(prefix + e.what() + duplicate_node_hint(model));
+    throw InvalidInput(prefix + e.what() + conform::duplicate_node_hint(model, "--merge-tolerance"));
   } catch (const TopologyError& e) {
-    throw TopologyError(prefix + e.what() + duplicate_node_hint(model));
+    throw TopologyError(prefix + e.what() + conform::duplicate_node_hint(model, "--merge-tolerance"));
   }
-  const bool valid = result_valid(r);
+  const bool valid = conform::result_valid(r);
   if (valid || a.write_invalid) {
     OutputFiles files;
     if (!a.output.empty())
@@ -212,7 +146,7 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
                    a.vtu_encoding == "ascii" ? io::VtuEncoding::kAscii : io::VtuEncoding::kBinary);
       });
     if (!a.report.empty()) {
-      files.add(a.report, [text = result_json(r).dump(2) + "\n"](const fs::path& temp) {
+      files.add(a.report, [text = conform::report_json(r).dump(2) + "\n"](const fs::path& temp) {
         write_or_print(temp.string(), [&](std::ostream& os) { os << text; });
       });
     }
@@ -227,9 +161,7 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
     if (!a.report.empty()) std::cout << "wrote " << a.report << "\n";
   }
   if (!valid) {
-    std::string why = r.warnings.empty() ? std::string("verification failed") : r.warnings.front();
-    for (std::size_t w = 1; w < r.warnings.size(); ++w) why += "; " + r.warnings[w];
-    throw InvalidResult(prefix + why +
+    throw InvalidResult(prefix + conform::invalid_reason(r) +
                         (a.write_invalid ? " (written anyway: --write-invalid)"
                                          : " (nothing written; --write-invalid writes it anyway)"));
   }

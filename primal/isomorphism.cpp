@@ -1,4 +1,4 @@
-#include "support/isomorphism.hpp"
+#include "primal/isomorphism.hpp"
 
 #include <algorithm>
 #include <map>
@@ -9,11 +9,10 @@
 #include "primal/errors.hpp"
 #include "primal/topology.hpp"
 
-namespace geode::test {
+namespace geode::primal {
 namespace {
 
-using primal::Index;
-namespace topo = primal::topology;
+namespace topo = topology;
 
 // All corner permutations p of a reference cell with N corners that send every edge to an
 // edge. Filtering N! permutations is cheap for N <= 8 and obviously complete.
@@ -406,24 +405,24 @@ bool is_rotation(const std::array<int, 8>& s) {
   return false;
 }
 
-std::optional<MeshMapping> find_isomorphism(const primal::HexMesh& a, const primal::HexMesh& b,
+std::optional<MeshMapping> find_isomorphism(const HexMesh& a, const HexMesh& b,
                                             const NodeLabels& labels) {
   return search<8>(a.points.size(), a.hexes, b.points.size(), b.hexes, labels);
 }
 
-std::optional<MeshMapping> find_isomorphism(const primal::QuadMesh& a, const primal::QuadMesh& b,
+std::optional<MeshMapping> find_isomorphism(const QuadMesh& a, const QuadMesh& b,
                                             const NodeLabels& labels) {
   return search<4>(a.points.size(), a.quads, b.points.size(), b.quads, labels);
 }
 
-bool is_isomorphism(const primal::HexMesh& a, const primal::HexMesh& b, const MeshMapping& m,
+bool is_isomorphism(const HexMesh& a, const HexMesh& b, const MeshMapping& m,
                     const NodeLabels& labels) {
   return check<8>(a.points.size(), a.hexes, b.points.size(), b.hexes, m, labels);
 }
 
-bool is_isomorphism(const primal::QuadMesh& a, const primal::QuadMesh& b, const MeshMapping& m,
+bool is_isomorphism(const QuadMesh& a, const QuadMesh& b, const MeshMapping& m,
                     const NodeLabels& labels) {
   return check<4>(a.points.size(), a.quads, b.points.size(), b.quads, m, labels);
 }
 
-}  // namespace geode::test
+}  // namespace geode::primal

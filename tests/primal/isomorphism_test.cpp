@@ -1,5 +1,5 @@
-// Tests of the test-support isomorphism checker (tests/support/isomorphism.hpp). It lives with
-// the stc tests because stc is where sheet arrangements get compared against references.
+// Tests of the mesh isomorphism checker (primal/isomorphism.hpp), which the tests of every layer
+// and the Python module use to compare meshes against references such as Appendix A.
 #include <doctest/doctest.h>
 
 #include <algorithm>

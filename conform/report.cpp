@@ -1,0 +1,78 @@
+// The verdict and report of a conform run (conform/report.hpp).
+#include "conform/report.hpp"
+
+#include <algorithm>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+namespace geode::conform {
+
+double block_min_scaled_jacobian(const primal::QualityReport& q) {
+  for (const auto& m : q.metrics)
+    if (m.metric == primal::HexMetric::kScaledJacobian) return m.minimum;
+  return 0.0;
+}
+
+double output_min_scaled_jacobian(const ConformResult& r) {
+  double m = 1.0;
+  for (const auto& b : r.quality) m = std::min(m, block_min_scaled_jacobian(b.report));
+  return m;
+}
+
+bool result_valid(const ConformResult& r) {
+  if (!r.validity.ok()) return false;
+  return std::all_of(r.quality.begin(), r.quality.end(),
+                     [](const BlockQuality& b) { return block_min_scaled_jacobian(b.report) > 0.0; });
+}
+
+std::string invalid_reason(const ConformResult& r) {
+  std::string why = r.warnings.empty() ? std::string("verification failed") : r.warnings.front();
+  for (std::size_t w = 1; w < r.warnings.size(); ++w) why += "; " + r.warnings[w];
+  return why;
+}
+
+std::string duplicate_node_hint(const primal::Model& model, const std::string& merge_option) {
+  if (model.points.empty()) return {};
+  Eigen::AlignedBox3d box;
+  for (const auto& p : model.points) box.extend(p);
+  const double tolerance = 1e-9 * box.diagonal().norm();
+  primal::Model copy = model;
+  const primal::Index merged = primal::merge_coincident_nodes(copy, tolerance);
+  if (merged == 0) return {};
+  std::ostringstream s;
+  s << "; hint: " << merged << " nodes lie at the same place as others (parts meshed separately?): "
+    << merge_option << (merge_option.ends_with('=') ? "" : " ") << tolerance << " merges them";
+  return s.str();
+}
+
+nlohmann::json report_json(const ConformResult& r) {
+  nlohmann::json j;
+  j["input"] = {{"hexes", r.input_hexes}, {"tets", r.input_tets}, {"pyramids", r.input_pyramids},
+                {"wedges", r.input_wedges}, {"interface_quads", r.interface_quads}};
+  j["output"] = {{"hexes", r.model.hexes.size()},    {"nodes", r.model.points.size()},
+                 {"diced_hexes", r.diced_hexes},     {"geode_hexes", r.geode_hexes},
+                 {"diced_tet_hexes", r.diced_tet_hexes}, {"diced_wedge_hexes", r.diced_wedge_hexes}};
+  j["valid"] = r.validity.ok();
+  j["template_min_scaled_jacobian"] = r.template_min_scaled_jacobian;
+  j["min_scaled_jacobian_before_smoothing"] = r.min_scaled_jacobian_before_smoothing;
+  j["min_scaled_jacobian_after_smoothing"] = r.smoothing.final_min_scaled_jacobian;
+  j["hexes_inverted_by_placement"] = r.placement_inverted;
+  j["templates_settled"] = r.templates_settled;
+  j["smoothing"] = {{"patches", r.smoothing.patches},
+                    {"seconds", r.smoothing.seconds},
+                    {"cpu_seconds", r.smoothing.cpu_seconds}};
+  j["buffer_layer_min_scaled_jacobian"] = r.buffer.min_scaled_jacobian;
+  j["buffer_side"] = buffer_side_name(r.buffer_side);
+  j["input_diced_alone_min_scaled_jacobian"] = {{"hexes", r.input_diced_hex_min_scaled_jacobian},
+                                                {"tets", r.input_diced_tet_min_scaled_jacobian},
+                                                {"wedges", r.input_diced_wedge_min_scaled_jacobian}};
+  j["output_min_scaled_jacobian"] = output_min_scaled_jacobian(r);
+  j["seconds"] = r.seconds;
+  j["warnings"] = r.warnings;
+  j["blocks"] = nlohmann::json::array();
+  for (const auto& b : r.quality)
+    j["blocks"].push_back({{"id", b.block}, {"name", b.name}, {"quality", primal::quality_report_json(b.report)}});
+  return j;
+}
+
+}  // namespace geode::conform

@@ -1,0 +1,258 @@
+"""geode: all-hex meshing through the dual sheet arrangement (the Spatial Twist Continuum).
+
+The library behind the `geode` command, for notebooks: templates derived from their sheet
+arrangements, arrangements given as specs, the dual of any hex mesh, validity and
+realizability checks, smoothing, the paper's Table 1 metrics, and whole hex + tet models
+conformed into one all-hex mesh. Arrays are numpy (points N x 3 float64, cells int32 in VTK
+order, every id 0-based); meshes in and out of conform are meshio.Mesh objects.
+
+    import geode
+    t = geode.template("geode3d")          # 26 hexes, isomorphic to the paper's Appendix A
+    t.points, t.hexes, t.sheets, t.conditions
+    geode.check(t.points, t.hexes)["valid"]
+    mesh, report = geode.conform(meshio.read("model.msh"))
+
+Failures raise geode.Error subclasses with the command's message and its exit code:
+InputError (2; also a ValueError), TopologyError (3), InvalidResultError (4).
+Long calls release the GIL, so other Python threads run meanwhile.
+"""
+import html as _html
+import os as _os
+import warnings as _warnings
+
+import numpy as _np
+
+from ._geode import (  # noqa: F401  (the public C++ entry points)
+    Error,
+    InputError,
+    InvalidResultError,
+    Template,
+    TopologyError,
+    __version__,
+    check,
+    demo_model_names,
+    dual,
+    isomorphism,
+    quality,
+    smooth,
+)
+from . import _geode
+
+__all__ = [
+    "Error", "InputError", "TopologyError", "InvalidResultError", "GeodeWarning", "Template",
+    "template", "template_names", "arrange", "dual", "check", "smooth", "quality", "isomorphism",
+    "conform", "demo_model", "demo_model_names", "study_interleave",
+]
+
+
+class GeodeWarning(UserWarning):
+    """What `geode` prints as a warning: failed interleave conditions, smoothing that could not untangle."""
+
+
+def _warn(result):
+    for w in result.warnings:
+        _warnings.warn(w, GeodeWarning, stacklevel=3)
+    return result
+
+
+def template_names():
+    """The built-in templates: {name: what it is}."""
+    return dict(_geode._template_names())
+
+
+def template(name, box=None, *, diagonal="main", higher="x", smooth=True, slide=False, fixup=True, **push):
+    """Derive a built-in template from its completed, pushed-together sheet arrangement.
+
+    name: geode3d, geode2d, geode4tri, refine3 or refine3-2d (template_names()). box: the buffer
+    cell (width, height, depth), tet side on top; default (24, 14, 24), (24, 14) in 2D.
+    diagonal: 'main' or 'anti'; higher: 'x' or 'z' (which tunnel's roof is higher). push: the
+    push parameters of `geode template` (high_roof, low_roof, dome_depth, dome_radius,
+    centre_depth, centre_radius, dome_exponent, centre_exponent, dome_offset, centre_offset=(x, z);
+    refine3: high_roof, low_roof, layer). smooth: place the free nodes by optimization (tet- and
+    hex-side nodes fixed, or sliding with slide=True); fixup: geode4tri's obstructions pillowed
+    away first. Returns a Template, as `geode template` derives it.
+    """
+    return _warn(_geode._template(name, box, diagonal, higher, smooth, slide, fixup, push))
+
+
+def arrange(spec, smooth=False, slide=False):
+    """Compute, diagnose and dualize the arrangement a spec gives (a dict, or a JSON file in the
+    format of `geode arrange`); smooth=True places the nodes by optimization (box domains)."""
+    if isinstance(spec, _os.PathLike):
+        spec = _os.fspath(spec)
+    return _warn(_geode.arrange(spec, smooth, slide))
+
+
+# ---- Template: meshio and the notebook viewer --------------------------------------------------
+
+def _template_to_meshio(self):
+    """The template as a meshio.Mesh (a copy), with each per-cell quality metric as cell data."""
+    import meshio
+
+    kind = "hexahedron" if self.dim == 3 else "quad"
+    cell_data = {key: [_np.array(values)] for key, values in self.quality.items()}
+    return meshio.Mesh(_np.array(self.points), [(kind, _np.array(self.cells))], cell_data=cell_data)
+
+
+def _viewer_iframe(page, height=480):
+    # The viewer is a whole page (its own scripts and styles): an iframe keeps it apart from the
+    # notebook's, and srcdoc keeps it self-contained (nothing fetched).
+    return ('<iframe style="width: 100%; height: {}px; border: 1px solid #ccc" srcdoc="{}"></iframe>'
+            .format(int(height), _html.escape(page, quote=True)))
+
+
+def _template_repr_html(self):
+    return _viewer_iframe(self.html())
+
+
+def _template_repr(self):
+    n = len(self.cells)
+    return "<geode.Template {}: {} {}, {} nodes, {} sheets>".format(
+        self.name, n, "hexes" if self.dim == 3 else "quads", len(self.points), len(self.sheets))
+
+
+Template.to_meshio = _template_to_meshio
+Template._repr_html_ = _template_repr_html
+Template.__repr__ = _template_repr
+
+
+# ---- Whole models ------------------------------------------------------------------------------
+
+_VOLUME = {"hexahedron": "hexes", "tetra": "tets"}
+_SURFACE = {"vertex", "line", "triangle", "quad"}  # boundary entities of a Gmsh file: not elements
+
+
+def _model_arrays(mesh=None, points=None, cells=None, cell_blocks=None, name="mesh"):
+    """A meshio.Mesh (or points + [(type, array)] cell blocks) as conform's arrays."""
+    if mesh is not None:
+        points = mesh.points
+        cells = [(c.type, c.data) for c in mesh.cells]
+        physical = mesh.cell_data.get("gmsh:physical")
+        names = {int(v[0]): k for k, v in (mesh.field_data or {}).items() if len(v) > 1 and int(v[1]) == 3}
+        point_sets = dict(mesh.point_sets or {})
+    else:
+        if points is None or cells is None:
+            raise InputError("conform: give a meshio.Mesh, or points and cells")
+        cells = list(cells.items()) if isinstance(cells, dict) else list(cells)
+        physical, names, point_sets = None, {}, {}
+    points = _np.asarray(points, dtype=float)
+    parts = {"hexes": [], "tets": []}
+    blocks = {"hexes": [], "tets": []}
+    volume_index = 0
+    for i, (kind, data) in enumerate(cells):
+        if kind in _SURFACE:
+            continue
+        if kind not in _VOLUME:
+            raise InputError("{}: cell block {} holds '{}' cells; geode.conform takes linear hexahedra and tetra"
+                             .format(name, i, kind))
+        data = _np.asarray(data)
+        if cell_blocks is not None:
+            ids = _np.full(len(data), int(cell_blocks[i]))
+        elif physical is not None and len(physical[i]) == len(data):
+            ids = _np.asarray(physical[i], dtype=int)
+        else:
+            ids = _np.full(len(data), volume_index + 1)
+        volume_index += 1
+        parts[_VOLUME[kind]].append(data)
+        blocks[_VOLUME[kind]].append(ids)
+    arrays = {}
+    for key, block_key, width in (("hexes", "hex_block", 8), ("tets", "tet_block", 4)):
+        arrays[key] = _np.concatenate(parts[key]) if parts[key] else _np.zeros((0, width), dtype=_np.int64)
+        arrays[block_key] = _np.concatenate(blocks[key]) if blocks[key] else _np.zeros(0, dtype=int)
+    node_sets = [{"id": k + 1, "name": n, "nodes": [int(x) for x in _np.asarray(v).ravel()]}
+                 for k, (n, v) in enumerate(point_sets.items())]
+    return points, arrays, names, node_sets
+
+
+def _model_to_meshio(model, cell_data_extra=None):
+    """Conform's (or a demo's) arrays as a meshio.Mesh: one cell block per element block, each
+    block a cell set named as the block, block ids as gmsh:physical, node sets as point sets."""
+    import meshio
+
+    cells, physical, cell_sets, field_data = [], [], {}, {}
+    names = model["block_names"]
+    groups = []
+    for kind, key, block_key in (("hexahedron", "hexes", "hex_block"), ("tetra", "tets", "tet_block")):
+        ids = _np.asarray(model[block_key])
+        for b in sorted(set(ids.tolist())):
+            groups.append((kind, b, _np.asarray(model[key])[ids == b]))
+    for i, (kind, b, data) in enumerate(groups):
+        cells.append((kind, data))
+        physical.append(_np.full(len(data), b, dtype=int))
+        set_name = names.get(b, "block {}".format(b))
+        cell_sets.setdefault(set_name, [_np.zeros(0, dtype=int) for _ in groups])
+        cell_sets[set_name][i] = _np.arange(len(data))
+        field_data[set_name] = _np.array([b, 3])
+    cell_data = {"gmsh:physical": physical, "gmsh:geometrical": [p.copy() for p in physical]}
+    point_sets = {s["name"] or "node set {}".format(s["id"]): _np.asarray(s["nodes"]) for s in model["node_sets"]}
+    return meshio.Mesh(model["points"], cells, cell_data=cell_data, cell_sets=cell_sets, field_data=field_data,
+                       point_sets=point_sets)
+
+
+def conform(mesh=None, *, points=None, cells=None, cell_blocks=None, name="mesh", smooth="local", quality="sj",
+            geode_block="", buffer_side="hex", buffer_thickness=0.0, smooth_target=0.0, template_box=None,
+            merge_tolerance=None, allow_invalid=False):
+    """Conform a hex + tet model into one valid all-hex mesh, as `geode conform` does.
+
+    mesh: a meshio.Mesh (hexahedron and tetra cells; Gmsh's surface and point entities are
+    skipped; blocks from gmsh:physical, else one per cell block; block names from field_data;
+    point sets become node sets), or points and cells ([(type, array)] or {type: array}) with
+    cell_blocks (one block id per cell block). The options are those of `geode conform`.
+    Returns (meshio.Mesh, report): the output with one cell block and one cell set per block,
+    block ids as gmsh:physical, node sets as point sets; the report as `--report` writes it,
+    with "side_sets" ([{id, name, sides: K x 2 (hex in the output's order, local face)}]).
+    A result that fails verification raises InvalidResultError, unless allow_invalid=True.
+    """
+    pts, arrays, names, node_sets = _model_arrays(mesh, points, cells, cell_blocks, name)
+    out = _geode._conform(pts, arrays["hexes"], arrays["hex_block"], arrays["tets"], arrays["tet_block"], names,
+                          node_sets, name, smooth, quality, geode_block, buffer_side, float(buffer_thickness),
+                          float(smooth_target), template_box, merge_tolerance)
+    if not out["valid"] and not allow_invalid:
+        raise InvalidResultError(out["invalid_reason"] + " (nothing returned; allow_invalid=True returns it anyway)")
+    model = out["model"]
+    report = out["report"]
+    # Side sets refer to hexes in conform's order; the meshio output groups them by block.
+    order = _np.argsort(_np.asarray(model["hex_block"]), kind="stable")
+    new_index = _np.empty_like(order)
+    new_index[order] = _np.arange(len(order))
+    report["side_sets"] = [{"id": s["id"], "name": s["name"],
+                            "sides": _np.column_stack([new_index[s["sides"][:, 0]], s["sides"][:, 1]])
+                            if len(s["sides"]) else s["sides"]} for s in model["side_sets"]]
+    report["merged_nodes"] = out["merged_nodes"]
+    return _model_to_meshio(model), report
+
+
+def demo_model(name="half", n=4):
+    """A demo hex + tet model meshed with the Gmsh API (demo_model_names(); `geode demo --model`),
+    as a meshio.Mesh."""
+    return _model_to_meshio(_geode._demo_model(name, int(n)))
+
+
+# ---- Studies -----------------------------------------------------------------------------------
+
+def study_interleave(spec, sweep=None, *, classes=False, progress=None, as_frame=None):
+    """Classify what every push of a sweep dualizes to, as `geode study interleave --spec` does.
+
+    spec: a spec dict, a JSON file, or a built-in geode template's name (geode3d, geode4tri).
+    sweep: {path: values}, each a list of numbers, {"from", "to", "count"} or "FROM:TO:COUNT"
+    (e.g. {"push.high_roof": [0.75, 0.85]}); it adds to, or replaces axes of, the spec's own sweep
+    block, the first axis slowest. Returns one record per push (high_roof, low_roof, dome_depth,
+    dome_radius, outcome, hexes, class, conditions_ok, diagnosis, seconds, then each swept path),
+    and with classes=True also one per class (the summary). Records are a pandas DataFrame when
+    pandas is importable (as_frame=None) or as_frame=True, else lists of dicts.
+    progress(what, done, total) is called as the sweep goes.
+    """
+    if isinstance(spec, _os.PathLike):
+        spec = _os.fspath(spec)
+    runs, summary = _geode._study_interleave(spec, sweep, progress)
+    if as_frame is None:
+        try:
+            import pandas  # noqa: F401
+            as_frame = True
+        except ImportError:
+            as_frame = False
+    if as_frame:
+        import pandas
+
+        runs, summary = pandas.DataFrame(runs), pandas.DataFrame(summary)
+    return (runs, summary) if classes else runs

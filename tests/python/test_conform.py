@@ -1,0 +1,104 @@
+"""geode.conform on meshio meshes and arrays, against `geode demo` / `geode conform`."""
+import json
+
+import meshio
+import numpy as np
+import pytest
+
+import geode
+from conftest import cli_error, one_line, run_cli
+
+
+@pytest.fixture(scope="module")
+def half():
+    return geode.demo_model("half", 2)
+
+
+def hexes_of(mesh):
+    return np.concatenate([c.data for c in mesh.cells if c.type == "hexahedron"])
+
+
+def test_demo_model(half):
+    kinds = {c.type for c in half.cells}
+    assert kinds == {"hexahedron", "tetra"}
+    assert set(half.cell_sets) == {"hex", "tet"}
+    assert "half" in geode.demo_model_names()
+
+
+def test_conform_matches_cli(half, tmp_path):
+    out, report = geode.conform(half)
+    run_cli("demo", "--model", "half", "-n", "2", "--report", tmp_path / "r.json", "--quiet")
+    cli = json.loads((tmp_path / "r.json").read_text())
+    assert report["valid"] and cli["valid"]
+    assert report["output"] == cli["output"] and report["input"] == cli["input"]
+    assert [b["name"] for b in report["blocks"]] == [b["name"] for b in cli["blocks"]]
+    for mine, theirs in zip(report["blocks"], cli["blocks"]):
+        assert mine["quality"]["metrics"][0]["min"] == pytest.approx(theirs["quality"]["metrics"][0]["min"], abs=1e-9)
+    hexes = hexes_of(out)
+    assert len(hexes) == report["output"]["hexes"] and {c.type for c in out.cells} == {"hexahedron"}
+    assert geode.check(out.points, hexes)["valid"]
+    # Blocks are cell sets, named as the input's, and gmsh:physical ids.
+    assert set(out.cell_sets) == {"hex", "tet"}
+    sizes = {name: sum(len(a) for a in arrays) for name, arrays in out.cell_sets.items()}
+    assert sizes == {b["name"]: b["quality"]["num_hexes"] for b in report["blocks"]}
+    assert [int(p[0]) for p in out.cell_data["gmsh:physical"]] == [b["id"] for b in report["blocks"]]
+
+
+def test_conform_a_file_meshio_read(tmp_path):
+    path = tmp_path / "in.msh"
+    run_cli("demo", "--model", "delaunay", "-n", "2", "--save-input", path, "--quiet")
+    run_cli("conform", path, "--report", tmp_path / "r.json", "--quiet", "--geode-block", "geode")
+    cli = json.loads((tmp_path / "r.json").read_text())
+    out, report = geode.conform(meshio.read(path), geode_block="geode")
+    assert report["output"] == cli["output"]
+    assert [b["name"] for b in report["blocks"]] == [b["name"] for b in cli["blocks"]]
+    assert "geode" in out.cell_sets
+
+
+def test_conform_arrays_and_sets(half):
+    hexes = np.concatenate([c.data for c in half.cells if c.type == "hexahedron"])
+    tets = np.concatenate([c.data for c in half.cells if c.type == "tetra"])
+    ends = np.flatnonzero(np.isclose(half.points[:, 0], 0))
+    out, report = geode.conform(points=half.points, cells=[("hexahedron", hexes), ("tetra", tets)], cell_blocks=[5, 7],
+                                quality="full")
+    assert [b["id"] for b in report["blocks"]] == [5, 7]
+    assert len(report["blocks"][0]["quality"]["metrics"]) == 12
+    # A node set on the face x = 0: the output's set is every output node there (the diced edge
+    # and face nodes of the face included; the output numbers nodes its own way).
+    with_set = meshio.Mesh(half.points, half.cells, cell_data=half.cell_data, field_data=half.field_data,
+                           point_sets={"x0": ends})
+    out, report = geode.conform(with_set)
+    assert set(out.point_sets) == {"x0"}
+    assert sorted(out.point_sets["x0"]) == np.flatnonzero(np.isclose(out.points[:, 0], 0)).tolist()
+    assert len(out.point_sets["x0"]) > len(ends)
+
+
+def test_conform_errors_match_cli(tmp_path):
+    t = geode.template("geode3d")
+    mesh = meshio.Mesh(t.points, [("hexahedron", t.hexes)])
+    with pytest.raises(geode.InputError) as e:
+        geode.conform(mesh, name="hexes.vtu")
+    assert e.value.exit_code == 2 and e.value.kind == "input" and isinstance(e.value, ValueError)
+    path = tmp_path / "hexes.vtu"
+    run_cli("template", "geode3d", "-o", path)
+    cli = run_cli("conform", path, "-o", tmp_path / "out.vtu", check=False)
+    assert cli.returncode == 2
+    assert one_line(str(e.value)) == cli_error(cli).replace(str(path), "hexes.vtu")
+
+
+def test_conform_refuses_bad_cells(half):
+    wedge = meshio.Mesh(half.points, [("wedge", np.array([[0, 1, 2, 3, 4, 5]]))])
+    with pytest.raises(geode.InputError, match="'wedge' cells"):
+        geode.conform(wedge)
+    tets = np.concatenate([c.data for c in half.cells if c.type == "tetra"]).copy()
+    tets[0] = tets[0][[1, 0, 2, 3]]  # inverted
+    hexes = hexes_of(half)
+    with pytest.raises(geode.InputError, match="tet 1 .*volume"):
+        geode.conform(points=half.points, cells=[("hexahedron", hexes), ("tetra", tets)])
+    with pytest.raises(geode.InputError, match="smooth"):
+        geode.conform(half, smooth="everywhere")
+
+
+def test_invalid_result_error_kind():
+    assert geode.InvalidResultError.exit_code == 4 and issubclass(geode.InvalidResultError, geode.Error)
+    assert geode.TopologyError.exit_code == 3 and geode.TopologyError.kind == "topology"

@@ -1,0 +1,42 @@
+"""Long calls release the GIL: another Python thread makes progress while they run."""
+import threading
+import time
+
+import geode
+
+
+def longest_stall(call):
+    """Runs call() in a thread while this one ticks; returns (its result, its seconds, the longest
+    gap between two ticks). A call holding the GIL stalls the ticking for as long as it runs."""
+    done = threading.Event()
+    result = {}
+
+    def work():
+        start = time.perf_counter()
+        result["value"] = call()
+        result["seconds"] = time.perf_counter() - start
+        done.set()
+
+    worker = threading.Thread(target=work)
+    last = time.perf_counter()
+    gap = 0.0
+    worker.start()
+    while not done.is_set():
+        time.sleep(0.001)
+        now = time.perf_counter()
+        gap, last = max(gap, now - last), now
+    worker.join()
+    return result["value"], result["seconds"], gap
+
+
+def test_template_releases_the_gil():
+    t, seconds, gap = longest_stall(lambda: geode.template("geode4tri"))
+    assert len(t.hexes) == 56
+    assert seconds > 0.2 and gap < 0.5 * seconds, (seconds, gap)
+
+
+def test_conform_releases_the_gil():
+    model = geode.demo_model("delaunay", 10)  # the reference templates are built once per process: a model
+    (mesh, report), seconds, gap = longest_stall(lambda: geode.conform(model))  # big enough to take time anyway
+    assert report["valid"]
+    assert seconds > 0.2 and gap < 0.5 * seconds, (seconds, gap)
