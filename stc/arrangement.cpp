@@ -1008,7 +1008,8 @@ Arrangement Engine::run() {
     }
   }
   // A pyramid's apex touches the domain only at face 5, where no curve ends: its region is
-  // the one with the apex's sign vector, which must be unique to be told apart.
+  // the one with the apex's sign vector, which must be unique to be told apart (among those
+  // that touch all four triangles, where several have it).
   if (user_.is_pyramid) {
     const Point apex = (*user_.corners)[4];
     std::vector<int> sg;
@@ -1016,10 +1017,24 @@ Arrangement Engine::run() {
     std::vector<int> hits;
     for (int r = 0; r < A.region_count; ++r)
       if (A.region_signs[static_cast<std::size_t>(r)] == sg) hits.push_back(r);
-    if (hits.size() != 1)
+    // Two regions may share a sign vector; the apex's touches all four triangles near it, a
+    // region far below rarely does.
+    if (hits.size() > 1) {
+      std::vector<int> around;
+      for (int r : hits)
+        if ((A.region_faces[static_cast<std::size_t>(r)] & 0xFu) == 0xFu) around.push_back(r);
+      if (around.size() == 1) hits = around;
+    }
+    if (hits.size() != 1) {
+      std::string masks;
+      for (int r : hits) masks += (masks.empty() ? "" : ", ") + std::to_string(A.region_faces[static_cast<std::size_t>(r)]);
       throw TopologyError("arrangement: " + std::to_string(hits.size()) +
                           " regions have the sign vector of the pyramid's apex " + format_point(apex, dim_) +
-                          (hits.empty() ? ": its region has no vertex around it" : ": its region cannot be told apart"));
+                          (hits.empty() ? ": its region has no vertex around it"
+                                        : ": the apex's region is split where no 1-cell joins its vertices (its hexes "
+                                          "would not meet face to face around its node), or another region has its "
+                                          "sides (boundary faces touched, as masks: " + masks + ")"));
+    }
     A.region_faces[static_cast<std::size_t>(hits[0])] |= 1u << box_face(2, true);
   }
   // Report physical positions (the identity for a box). A vertex's orientation was taken
