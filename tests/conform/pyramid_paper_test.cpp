@@ -11,6 +11,7 @@
 
 #include "conform/conform.hpp"
 #include "primal/quality.hpp"
+#include "primal/realizability.hpp"
 #include "primal/topology.hpp"
 #include "primal/validity.hpp"
 
@@ -52,4 +53,5 @@ TEST_CASE("pyramid as two tets over a hex, transition carved from the tets: 34 h
   const auto v = primal::check_validity(pyramid);
   CHECK(v.ok());
   CHECK(v.boundary.faces.size() == 4 + 4 * (5 + 3));  // not Schneiders' 16
+  CHECK(primal::find_obstructions(pyramid).empty());
 }

@@ -136,4 +136,13 @@ TEST_CASE("pyramid: Gmsh's all-hex subdivision of one pyramid, measured") {
   CHECK(dual.sheets.size() == 5);
   CHECK(std::count_if(dual.sheets.begin(), dual.sheets.end(), [](const auto& s) { return s.self_intersecting; }) == 2);
   CHECK(primal::find_obstructions(g).empty());
+  // Gmsh's own reference pyramid (base [-1, 1]^2, height 1): the 0.117.
+  const primal::HexMesh r = gmsh_pyramid_filling(
+      {Point(-1, -1, 0), Point(1, -1, 0), Point(1, 1, 0), Point(-1, 1, 0), Point(0, 0, 1)});
+  double rlo = 1.0;
+  for (Index h = 0; h < static_cast<Index>(r.hexes.size()); ++h)
+    rlo = std::min(rlo, primal::hex_scaled_jacobian(primal::hex_corners(r, h)));
+  MESSAGE("gmsh 88-hex pyramid, height 1: min scaled Jacobian " << rlo);
+  CHECK(rlo > 0.11);
+  CHECK(rlo < 0.125);
 }
