@@ -1,5 +1,6 @@
 // geode template NAME: derive a transition template from its sheet arrangement and print or
 // write it.
+#include <cmath>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -19,6 +20,7 @@
 #include "primal/quality_report.hpp"
 #include "templates/fixup.hpp"
 #include "templates/geode.hpp"
+#include "templates/pyramid.hpp"
 #include "templates/refine.hpp"
 #include "templates/spec.hpp"
 
@@ -176,6 +178,16 @@ void run_template(const TemplateArgs& a) {
   // Refuse a bad output before the derivation, not after it.
   check_output_path(a.output);
   const std::string format = output_format(a.output, a.format, kTemplateFormats, "appendix");
+  if (a.name == "pyramid") {
+    // Schneiders' surface on the equilateral pyramid (edges 2): the derivation stops at the
+    // certificate, computed from the surface, until the engine represents immersed sheets.
+    const double h = std::sqrt(2.0);
+    const auto c = templates::pyramid_certificate({primal::Point(-1, 0, -1), primal::Point(-1, 0, 1),
+                                                   primal::Point(1, 0, 1), primal::Point(1, 0, -1),
+                                                   primal::Point(0, h, 0)});
+    throw TopologyError("template pyramid: " + c.statement +
+                        " (self-intersecting sheets are not represented yet; templates/pyramid.hpp)");
+  }
   const int dim = a.name == "geode2d" || a.name == "refine3-2d" ? 2 : 3;
   if (dim == 2 && is_mesh_format(format) && format != "vtu" && format != "vtk")
     throw InvalidInput(a.output + ": " + a.name + " is a quad mesh; write it as .vtu or .vtk");
@@ -342,9 +354,10 @@ void add_template_command(CLI::App& app) {
                 "geode3d: the 26-hex geode (tet side split by a diagonal into 2 triangles);\n"
                 "geode2d: the 5-quad 2D geode; geode4tri: the tet side split into 4 triangles;\n"
                 "refine3: one coarse quad on top over 3 x 3 fine quads below (13 hexes); refine3-2d: one\n"
-                "coarse edge over three fine ones (4 quads)")
+                "coarse edge over three fine ones (4 quads); pyramid: Schneiders' 16-quad pyramid (exits 3\n"
+                "with the certificate that its dual needs a self-intersecting sheet, which the engine lacks)")
       ->required()
-      ->check(CLI::IsMember({"geode3d", "geode2d", "geode4tri", "refine3", "refine3-2d"}));
+      ->check(CLI::IsMember({"geode3d", "geode2d", "geode4tri", "refine3", "refine3-2d", "pyramid"}));
   t->add_option("--box", args->box,
                 "buffer cell WIDTHxHEIGHTxDEPTH (x, y up, z; WIDTHxHEIGHT for the 2D templates), centred at\n"
                 "the origin, tet side on top; each in [1e-6, 1e6], at most 1e4 between largest and smallest\n"

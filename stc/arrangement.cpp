@@ -44,8 +44,8 @@ double multilinear_jacobian(const std::array<Point, 8>& P, const Point& r, int d
   return dim == 3 ? J.determinant() : J(0, 0) * J(1, 1) - J(0, 1) * J(1, 0);
 }
 
-Domain make_cell_domain(const std::array<Point, 8>& P, int dim) {
-  const char* what = dim == 3 ? "hexahedron" : "quadrilateral";
+Domain make_cell_domain(const std::array<Point, 8>& P, int dim, bool pyramid = false) {
+  const char* what = pyramid ? "pyramid" : dim == 3 ? "hexahedron" : "quadrilateral";
   const int n = 1 << dim;
   Point lo = Point::Constant(1e300), hi = Point::Constant(-1e300);
   for (int c = 0; c < n; ++c) {
@@ -61,6 +61,7 @@ Domain make_cell_domain(const std::array<Point, 8>& P, int dim) {
   // cell's size so that a flattened cell is refused too.
   const double floor = 1e-12 * std::pow(size, dim);
   for (int c = 0; c <= n; ++c) {
+    if (pyramid && c >= 4 && c < n) continue;  // the apex: the map's Jacobian vanishes there
     Point r = Point::Constant(0.5);
     if (c < n)
       for (int a = 0; a < 3; ++a) r[a] = primal::topology::kHexCornerCoords[static_cast<std::size_t>(c)][static_cast<std::size_t>(a)];
@@ -70,13 +71,15 @@ Domain make_cell_domain(const std::array<Point, 8>& P, int dim) {
                          (c < n ? "corner " + std::to_string(c) + " " + format_point(P[static_cast<std::size_t>(c)], dim)
                                 : std::string("its centre")) +
                          " (det " + std::to_string(j) + "): corners must be in VTK order" +
-                         (dim == 3 ? " (bottom 0-1-2-3 counter-clockwise seen from above, 4-7 above them)"
-                                   : " (counter-clockwise)") +
+                         (pyramid    ? " (base 0-1-2-3 counter-clockwise seen from the apex 4)"
+                          : dim == 3 ? " (bottom 0-1-2-3 counter-clockwise seen from above, 4-7 above them)"
+                                     : " (counter-clockwise)") +
                          " and the cell not inverted or flat");
   }
   Domain d(lo, hi, dim);
   if (dim == 2) d.lo[2] = d.hi[2] = 0.0;
   d.corners = P;
+  d.is_pyramid = pyramid;
   return d;
 }
 
@@ -100,6 +103,7 @@ class Engine {
         domain_(reference_box(domain)),
         mapped_(compose(sheets)),
         sheets_(domain.corners ? mapped_ : sheets),
+        given_(sheets),
         options_(opt),
         dim_(domain.dim) {
     if (static_cast<int>(sheets.size()) < dim_)
@@ -113,6 +117,10 @@ class Engine {
   Arrangement run();
 
  private:
+  // A sheet through a pyramid's apex would end every curve of it in that one point (face 5
+  // of the reference box): refused, as a vertex on the boundary is.
+  void check_apex() const;
+
   // The box the engine computes in. For a hexahedron: corner 0's position, and per axis the
   // mean length of the cell's edges along it, so that the seeding grid, the step and the
   // tolerances (all relative to this box) keep their meaning; for a hexahedron equal to a
@@ -124,7 +132,7 @@ class Engine {
         if (!(d.hi[i] > d.lo[i])) throw InvalidInput("arrangement: empty domain");
       return Domain(d.lo, d.hi, d.dim);
     }
-    make_cell_domain(*d.corners, d.dim);  // throws on bad corners (they may be filled in by hand)
+    make_cell_domain(*d.corners, d.dim, d.is_pyramid);  // throws on bad corners (they may be filled in by hand)
     const auto& P = *d.corners;
     Point len = Point::Zero();
     for (const auto& e : primal::topology::kHexEdgeCorners) {
@@ -296,6 +304,7 @@ class Engine {
   Domain domain_;  // the reference box (user_ itself for a box)
   std::vector<Sheet> mapped_;  // the fields composed with the map, for a hexahedron
   const std::vector<Sheet>& sheets_;
+  const std::vector<Sheet>& given_;  // the fields in physical space
   ArrangementOptions options_;
   int dim_;
   double diag_, h_, grad_h_, tol_;
@@ -751,6 +760,19 @@ void Engine::check_touching(const std::vector<Curve>& curves) const {
     }
 }
 
+void Engine::check_apex() const {
+  if (!user_.is_pyramid) return;
+  const Point apex = (*user_.corners)[4];
+  for (int s = 0; s < static_cast<int>(sheets_.size()); ++s) {
+    // In physical space (the composed field's gradient vanishes at the apex).
+    const Field& f = given_[static_cast<std::size_t>(s)].field;
+    const double g = gradient(f, apex, grad_h_, dim_).norm();
+    if (std::abs(f(apex)) < 1e-6 * diag_ * std::max(g, 1e-300))
+      throw TopologyError("arrangement: sheet " + name(s) + " passes through the pyramid's apex " +
+                          format_point(apex, dim_) + " (its curves would end in one point; not in general position)");
+  }
+}
+
 int Engine::register_vertex(std::vector<int> S, const Point& x) {
   std::sort(S.begin(), S.end());
   long long key = 0;
@@ -803,6 +825,7 @@ Arrangement Engine::run() {
   A.sheet_count = static_cast<int>(sheets_.size());
   for (const auto& s : sheets_) A.sheet_names.push_back(s.name);
 
+  check_apex();
   sample_grid();
   // 1. Curves: every (d-1)-subset of sheets, every component.
   std::vector<std::vector<int>> subsets;
@@ -984,6 +1007,36 @@ Arrangement Engine::run() {
                             " meet): the curves were traced inconsistently");
     }
   }
+  // A pyramid's apex touches the domain only at face 5, where no curve ends: its region is
+  // the one with the apex's sign vector, which must be unique to be told apart (among those
+  // that touch all four triangles, where several have it).
+  if (user_.is_pyramid) {
+    const Point apex = (*user_.corners)[4];
+    std::vector<int> sg;
+    for (const Sheet& s : given_) sg.push_back(s.field(apex) < 0 ? -1 : 1);
+    std::vector<int> hits;
+    for (int r = 0; r < A.region_count; ++r)
+      if (A.region_signs[static_cast<std::size_t>(r)] == sg) hits.push_back(r);
+    // Two regions may share a sign vector; the apex's touches all four triangles near it, a
+    // region far below rarely does.
+    if (hits.size() > 1) {
+      std::vector<int> around;
+      for (int r : hits)
+        if ((A.region_faces[static_cast<std::size_t>(r)] & 0xFu) == 0xFu) around.push_back(r);
+      if (around.size() == 1) hits = around;
+    }
+    if (hits.size() != 1) {
+      std::string masks;
+      for (int r : hits) masks += (masks.empty() ? "" : ", ") + std::to_string(A.region_faces[static_cast<std::size_t>(r)]);
+      throw TopologyError("arrangement: " + std::to_string(hits.size()) +
+                          " regions have the sign vector of the pyramid's apex " + format_point(apex, dim_) +
+                          (hits.empty() ? ": its region has no vertex around it"
+                                        : ": the apex's region is split where no 1-cell joins its vertices (its hexes "
+                                          "would not meet face to face around its node), or another region has its "
+                                          "sides (boundary faces touched, as masks: " + masks + ")"));
+    }
+    A.region_faces[static_cast<std::size_t>(hits[0])] |= 1u << box_face(2, true);
+  }
   // Report physical positions (the identity for a box). A vertex's orientation was taken
   // from the composed fields' gradients: it is the physical one where the map's Jacobian is
   // positive, which the corner and centre test does not promise everywhere.
@@ -1005,6 +1058,12 @@ Arrangement Engine::run() {
 }  // namespace
 
 Domain Domain::hexahedron(const std::array<Point, 8>& corners) { return make_cell_domain(corners, 3); }
+
+Domain Domain::pyramid(const std::array<Point, 5>& corners) {
+  std::array<Point, 8> P;
+  for (std::size_t c = 0; c < 8; ++c) P[c] = corners[std::min<std::size_t>(c, 4)];
+  return make_cell_domain(P, 3, true);
+}
 
 Domain Domain::quadrilateral(const std::array<Point, 4>& corners) {
   std::array<Point, 8> P;

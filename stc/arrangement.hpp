@@ -46,7 +46,8 @@
 namespace geode::stc {
 
 // The domain: an axis-aligned box (dim 2 uses x and y only, z of lo and hi ignored), or a
-// hexahedron given by its 8 corners in VTK order (primal/topology.hpp), or in 2D a
+// hexahedron given by its 8 corners in VTK order (primal/topology.hpp), or a pyramid given by
+// its 5 (VTK order: base 0-1-2-3 counter-clockwise seen from the apex 4), or in 2D a
 // quadrilateral given by 4 corners counter-clockwise.
 //
 // A hexahedron is the trilinear (a quadrilateral the bilinear) image of the unit cube: local
@@ -54,11 +55,17 @@ namespace geode::stc {
 // a box of the same proportions, on every sheet's field composed with that map, so planar
 // box faces and straight box edges are exactly the hexahedron's (possibly curved) faces and
 // edges; every position it reports is mapped back to physical space.
+//
+// A pyramid is the hexahedron whose top corners 4-7 are all the apex: the map
+// (1 - t) B(r, s) + t apex, B the bilinear base. Its face t = 1 is the apex alone, so a sheet
+// through the apex (every curve there ending in one point) is refused; otherwise the apex lies
+// inside one region, the only one that touches face 5. The map's Jacobian vanishes only there.
 struct Domain {
   Point lo = Point::Zero();  // the box; for a hexahedron, its bounding box (informative)
   Point hi = Point::Ones();
   int dim = 3;
-  std::optional<std::array<Point, 8>> corners;  // set for a hexahedron / quadrilateral
+  std::optional<std::array<Point, 8>> corners;  // set for a hexahedron / quadrilateral / pyramid
+  bool is_pyramid = false;                      // corners 4-7 are one apex
 
   Domain() = default;
   Domain(const Point& box_lo, const Point& box_hi, int d = 3) : lo(box_lo), hi(box_hi), dim(d) {}
@@ -66,6 +73,9 @@ struct Domain {
   // or at the centre (corners out of VTK order, or an inverted / degenerate hexahedron).
   static Domain hexahedron(const std::array<Point, 8>& corners);
   static Domain quadrilateral(const std::array<Point, 4>& corners);
+  // Throws InvalidInput when the Jacobian is not positive at a base corner or at the centre
+  // (base not counter-clockwise seen from the apex, or the apex in the base's plane).
+  static Domain pyramid(const std::array<Point, 5>& corners);
 };
 
 // Physical position of the local coordinates (r, s, t) in [0, 1]^d of the domain (for a box,
@@ -77,6 +87,7 @@ Point domain_point(const Domain& domain, const Point& local);
 //   face 0: r = 0, corners 0 3 7 4   face 1: r = 1, corners 1 2 6 5
 //   face 2: s = 0, corners 0 1 5 4   face 3: s = 1, corners 3 2 6 7
 //   face 4: t = 0, corners 0 1 2 3   face 5: t = 1, corners 4 5 6 7
+// (a pyramid: faces 0-3 its triangles, 4 its base, 5 the apex)
 // and for a quadrilateral: face 0 = edge 3-0, 1 = edge 1-2, 2 = edge 0-1, 3 = edge 2-3.
 inline int box_face(int axis, bool high) { return 2 * axis + (high ? 1 : 0); }
 

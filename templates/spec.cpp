@@ -90,8 +90,8 @@ class Reader {
 };
 
 stc::Domain Reader::domain(const json& j) const {
-  object(j, "domain", {"box", "hexahedron", "quadrilateral"});
-  if (j.size() != 1) fail("domain", "give exactly one of box, hexahedron (3D), quadrilateral (2D)");
+  object(j, "domain", {"box", "hexahedron", "pyramid", "quadrilateral"});
+  if (j.size() != 1) fail("domain", "give exactly one of box, hexahedron, pyramid (3D), quadrilateral (2D)");
   if (j.contains("box")) {
     const json& b = j["box"];
     if (!b.is_array() || b.size() != 2) fail("domain.box", "must be [low corner, high corner]");
@@ -100,15 +100,17 @@ stc::Domain Reader::domain(const json& j) const {
       if (!(lo[a] < hi[a])) fail("domain.box", "the low corner must be below the high corner on every axis");
     return stc::Domain(lo, hi, dim_);
   }
-  const bool hex = j.contains("hexahedron");
-  const std::string key = hex ? "hexahedron" : "quadrilateral";
+  const bool pyramid = j.contains("pyramid");
+  const bool hex = j.contains("hexahedron") || pyramid;
+  const std::string key = pyramid ? "pyramid" : hex ? "hexahedron" : "quadrilateral";
   if (hex != (dim_ == 3)) fail("domain." + key, "is a " + std::string(hex ? "3D" : "2D") + " domain");
   const json& c = j[key];
-  const std::size_t n = hex ? 8 : 4;
+  const std::size_t n = pyramid ? 5 : hex ? 8 : 4;
   if (!c.is_array() || c.size() != n) fail("domain." + key, "must be " + std::to_string(n) + " corners");
   std::array<Point, 8> corners;
   for (std::size_t i = 0; i < n; ++i) corners[i] = point(c[i], index("domain." + key, static_cast<int>(i)));
   try {
+    if (pyramid) return stc::Domain::pyramid({corners[0], corners[1], corners[2], corners[3], corners[4]});
     return hex ? stc::Domain::hexahedron(corners)
                : stc::Domain::quadrilateral({corners[0], corners[1], corners[2], corners[3]});
   } catch (const InvalidInput& e) {
@@ -526,8 +528,9 @@ json spec_json(const ArrangementSpec& s) {
   j["dim"] = s.dim;
   if (s.domain.corners) {
     json c = json::array();
-    for (int i = 0; i < (s.dim == 3 ? 8 : 4); ++i) c.push_back(vector_json((*s.domain.corners)[static_cast<std::size_t>(i)], s.dim));
-    j["domain"][s.dim == 3 ? "hexahedron" : "quadrilateral"] = c;
+    for (int i = 0; i < (s.domain.is_pyramid ? 5 : s.dim == 3 ? 8 : 4); ++i)
+      c.push_back(vector_json((*s.domain.corners)[static_cast<std::size_t>(i)], s.dim));
+    j["domain"][s.domain.is_pyramid ? "pyramid" : s.dim == 3 ? "hexahedron" : "quadrilateral"] = c;
   } else {
     j["domain"]["box"] = {vector_json(s.domain.lo, s.dim), vector_json(s.domain.hi, s.dim)};
   }

@@ -4,7 +4,7 @@
 // ("Arrangements as files"); in short:
 //
 //   {"dim": 3,
-//    "domain": {"box": [[x0, y0, z0], [x1, y1, z1]]}            or {"hexahedron": [8 corners]}
+//    "domain": {"box": [[x0, y0, z0], [x1, y1, z1]]}  or {"hexahedron": [8 corners]} or {"pyramid": [5]}
 //    "sheets": [{"name": "x", "plane": {"point": [..], "normal": [..]}},
 //               {"name": "s", "sphere": {"center": [..], "radius": r}}, ...],
 //    "completion": {"hex_side": {...}, "tet_side": {...}, "higher": "x"},   (optional)

@@ -138,3 +138,13 @@ TEST_CASE("geode template geode4tri: fixed up by default, the plain dual with --
   CHECK(plain.out.find("Table 3: Connectivity (36 hexes)") != std::string::npos);
   CHECK(plain.out.find("could not untangle") != std::string::npos);
 }
+
+TEST_CASE("geode template pyramid: refused with the certificate, nothing written") {
+  const auto out = temp_path("pyramid.vtu");
+  const Run r = geode_cli("template pyramid -o " + out.string(), true);
+  CHECK(r.code == 3);
+  CHECK(r.out.find("2 chords") != std::string::npos);
+  CHECK(r.out.find("8 self-crossings") != std::string::npos);
+  CHECK(r.out.find("no arrangement of its sheets has this boundary") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(out));
+}
