@@ -55,8 +55,7 @@ void run(const std::string& name, const primal::Model& input, const primal::Loca
   // conform's output order: diced hexes, geode hexes, diced tets.
   for (primal::Index h = r.diced_hexes; h < r.diced_hexes + r.geode_hexes; ++h) geode.push_back(h);
   const auto seeds = primal::hexes_around(mesh, geode);
-  const auto cons = primal::boundary_slide_constraints(mesh);
-  const primal::TriMesh surface = primal::boundary_triangulation(mesh);
+  const auto cons = primal::boundary_slide_constraints(mesh);  // boundary and block interfaces kept
   std::printf("%s: %zu tets, %zu input hexes -> %zu hexes, %.0f buffer hexes, %zu seeds\n", name.c_str(),
               input.tets.size(), input.hexes.size(), mesh.hexes.size(), buffer, seeds.size());
   print_blocks("before", block_minima(mesh));
@@ -76,7 +75,7 @@ void run(const std::string& name, const primal::Model& input, const primal::Loca
     primal::LocalSmoothOptions lo = base;
     if (m.global) lo.target = conform::ConformOptions{}.global_smooth_options.target;
     lo.threads = m.threads;
-    const auto res = primal::smooth_hexes_local(work, cons, &surface,
+    const auto res = primal::smooth_hexes_local(work, cons, nullptr,
                                                 m.global ? std::span<const primal::Index>{} : seeds, lo);
     const double cpu = res.cpu_seconds;
     std::printf("  %-24s %.3f ms CPU per buffer hex (%.3f s CPU, %.3f s wall), %d patches, %d rounds,"

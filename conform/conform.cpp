@@ -579,8 +579,8 @@ void Conformer::add_smoothing(const primal::LocalSmoothResult& r) {
   s.seconds += r.seconds, s.cpu_seconds += r.cpu_seconds;
 }
 
-// The worst-first smoother (primal/local_smooth.hpp); model boundary nodes slide on the diced
-// boundary. Local: patches seeded near the geode hexes, on the submesh around the seeds, so
+// The worst-first smoother (primal/local_smooth.hpp); nodes on the model boundary and between
+// blocks slide only where that keeps every block's volume. Local: patches seeded near the geode hexes, on the submesh around the seeds, so
 // the cost follows the interface (or, with the automatic target, its defects); global: every
 // hex, then the automatic passes wherever a hex is still below the yardstick.
 void Conformer::smooth() {
@@ -611,10 +611,8 @@ void Conformer::smooth() {
   } else if (local) {
     smooth_defects(o);
   } else {
-    const auto boundary = primal::boundary_quads(mesh_);  // once for both
-    const auto constraints = primal::boundary_slide_constraints(mesh_, boundary);
-    const primal::TriMesh surface = primal::boundary_triangulation(mesh_.points, boundary);
-    add_smoothing(primal::smooth_hexes_local(mesh_, constraints, &surface, {}, o));
+    const auto constraints = primal::boundary_slide_constraints(mesh_);
+    add_smoothing(primal::smooth_hexes_local(mesh_, constraints, nullptr, {}, o));
     sj_ = primal::scaled_jacobian_per_hex(mesh_);
     // The global target lifts the whole mesh a little, not a defect to the yardstick: the
     // local passes follow wherever a hex is still below it. Their floors are measured on the
@@ -667,7 +665,7 @@ void Conformer::smooth_defects(primal::LocalSmoothOptions o) {
     std::vector<Index> seeds = defects;
     for (int ring = 0; ring < kDefectRings; ++ring) seeds = primal::hexes_around(mesh_, seeds);
     o.target = kDefectTarget * yardstick + pass * kDefectTargetStep;
-    const auto r = primal::smooth_hexes_around(mesh_, seeds, o, primal::kFeatureAngle, &start);
+    const auto r = primal::smooth_hexes_around(mesh_, seeds, o, &start);
     add_smoothing(r);
     measure(r.region);
     defects.clear();

@@ -64,8 +64,10 @@ struct ConformOptions {
   // them keeps most of its quality (the paper's is 24 x 14 x 24; 24 x 10 x 24 suits the tet
   // side's default thickness).
   Eigen::Vector3d template_box{24.0, 12.0, 24.0};
-  // The worst-first smoother (primal/local_smooth.hpp), model boundary nodes sliding in their
-  // plane, along their feature edge or on the diced boundary triangulation. kLocal: patches
+  // The worst-first smoother (primal/local_smooth.hpp); materials never move: nodes on the
+  // model boundary and on the faces between output blocks slide in their plane or along their
+  // straight edge where those are flat, and stay fixed elsewhere (curved surfaces, corners), so
+  // every block keeps its volume (primal::boundary_slide_constraints). kLocal: patches
   // seeded near the geode hexes (see smooth_target), on the submesh around them; kGlobal: by
   // every hex, with a higher target so that the diced parts are improved too, then kLocal's
   // automatic passes wherever a hex is still below the yardstick; kNone: nothing but

@@ -307,8 +307,8 @@ void transfinite_box(int volume, double h) {
   for (int s : boundary_surfaces(volume)) surfaces.push_back({2, s});
   gmsh::model::getBoundary(surfaces, curves, false, false, false);
   for (const auto& [dim, tag] : curves) {
-    const Box b = bounding_box(1, tag);
-    const double length = std::max({b[3] - b[0], b[4] - b[1], b[5] - b[2]});
+    double length = 0.0;  // the curve's own length: boxes may be tilted
+    gmsh::model::occ::getMass(1, std::abs(tag), length);
     gmsh::model::mesh::setTransfiniteCurve(std::abs(tag), std::max(1, static_cast<int>(std::lround(length / h))) + 1);
   }
   for (int s : boundary_surfaces(volume)) {
@@ -676,6 +676,52 @@ std::vector<int> shared_boxes(const std::vector<std::array<double, 6>>& boxes) {
   gmsh::model::occ::synchronize();
   std::vector<int> volumes;
   for (const auto& m : map) volumes.push_back(m.front().second);
+namespace {
+
+// One part of the potting model: `build` adds its OCC volumes (fragmented where they touch) and
+// sets their meshing; they become block `id` named `name`.
+Model potting_part(int id, const std::string& name, const std::function<gmsh::vectorpair()>& build) {
+  return hex_part_from_gmsh(name, [&] {
+    const gmsh::vectorpair volumes = build();
+    std::vector<int> tags;
+    for (const auto& [dim, tag] : volumes) tags.push_back(tag);
+    gmsh::model::addPhysicalGroup(3, tags, id);
+    gmsh::model::setPhysicalName(3, id, name);
+  });
+}
+
+// Structured boxes (each {x0, y0, z0, x1, y1, z1}; touching ones must meet in whole faces, so
+// that each stays a six-faced transfinite block), fragmented so that they share those faces,
+// optionally rotated by `angle` about the axis through `centre`.
+gmsh::vectorpair structured_boxes(const std::vector<Box>& boxes, double h, const Point& centre = Point::Zero(),
+                                  const Point& axis = Point::UnitZ(), double angle = 0.0) {
+  gmsh::vectorpair volumes, fragments;
+  for (const Box& b : boxes)
+    volumes.push_back({3, gmsh::model::occ::addBox(b[0], b[1], b[2], b[3] - b[0], b[4] - b[1], b[5] - b[2])});
+  std::vector<gmsh::vectorpair> map;
+  if (volumes.size() > 1) gmsh::model::occ::fragment(volumes, {}, fragments, map);
+  else fragments = volumes;
+  if (angle != 0.0)
+    gmsh::model::occ::rotate(fragments, centre.x(), centre.y(), centre.z(), axis.x(), axis.y(), axis.z(), angle);
+  gmsh::model::occ::synchronize();
+  for (const auto& [dim, tag] : fragments) transfinite_box(tag, h);
+  return fragments;
+}
+
+// A disk of radius r about `centre` in the plane normal to `axis` (x or z), its unstructured
+// recombined quads swept along the axis over `length` in layers of about h.
+gmsh::vectorpair swept_cylinder(const Point& centre, double r, int axis, double length, double h) {
+  const int disk = gmsh::model::occ::addDisk(centre.x(), centre.y(), centre.z(), r, r);
+  if (axis == 0) gmsh::model::occ::rotate({{2, disk}}, centre.x(), centre.y(), centre.z(), 0, 1, 0, std::numbers::pi / 2);
+  gmsh::vectorpair out, volumes;
+  const Point along = length * (axis == 0 ? Point::UnitX() : Point::UnitZ());
+  gmsh::model::occ::extrude({{2, disk}}, along.x(), along.y(), along.z(), out,
+                            {std::max(1, static_cast<int>(std::lround(length / h)))}, {}, true);
+  gmsh::model::occ::synchronize();
+  gmsh::option::setNumber("Mesh.MeshSizeMax", h);
+  gmsh::model::mesh::setRecombine(2, disk);
+  for (const auto& dt : out)
+    if (dt.first == 3) volumes.push_back(dt);
   return volumes;
 }
 
@@ -765,13 +811,108 @@ Model demo_hexdominant(int n) {
     name_volume(v[1], 2, "tet");
     for (const auto& [dim, tag] : layer)
       if (dim == 3) name_volume(tag, 4, "wedge layer");
+Model demo_potting(int n) {
+  if (n < 2) throw InvalidInput("demo_potting: n = " + std::to_string(n) + " must be >= 2");
+  const double h = 1.0 / n;
+  return run_gmsh("demo_potting", [&] {
+    std::vector<Model> parts;
+    parts.push_back(potting_part(1, "block_a", [&] { return structured_boxes({{0.5, 0.5, 0.6, 1.5, 1.5, 1.6}}, h); }));
+    parts.push_back(potting_part(2, "slab_b", [&] { return structured_boxes({{2.2, 0.5, 0.5, 4.2, 1.1, 1.5}}, h); }));
+    parts.push_back(potting_part(3, "pin_z", [&] { return swept_cylinder(Point(1.0, 3.0, 0.5), 0.4, 2, 1.4, h); }));
+    parts.push_back(potting_part(4, "pin_x", [&] { return swept_cylinder(Point(2.2, 3.5, 1.3), 0.3, 0, 2.1, h); }));
+    parts.push_back(potting_part(5, "tilted", [&] {
+      return structured_boxes({{2.8, 1.8, 0.8, 3.6, 2.6, 1.6}}, h, Point(3.2, 2.2, 1.2), Point(1, 1, 0), 0.5);
+    }));
+    // An L-shaped bracket: a concave edge and saddle corners where it meets its convex ones.
+    parts.push_back(potting_part(6, "bracket", [&] {
+      return structured_boxes({{4.7, 0.5, 0.6, 5.2, 1.0, 1.6}, {5.2, 0.5, 0.6, 5.7, 1.0, 1.6}, {4.7, 1.0, 0.6, 5.2, 2.0, 1.6}}, h);
+    }));
+    gmsh::option::setNumber("Mesh.MeshSizeMax", 1e22);
+    Shell outer;
+    append_solid_boundary(
+        outer, 1.5 * h, [] { gmsh::model::occ::addBox(0, 0, 0, 6.2, 4.4, 2.2); },
+        [](const Box&) { return false; }, [](const Box&) { return true; });
+    std::vector<Shell> holes(parts.size());
+    Model hexes;
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+      append_interface_triangles(holes[i], parts[i], [](const Point&) { return true; },
+                                 diagonal_chooser(DemoDiagonals::kRandom, h), four_chooser(false));
+      const Index offset = static_cast<Index>(hexes.points.size());
+      hexes.points.insert(hexes.points.end(), parts[i].points.begin(), parts[i].points.end());
+      for (auto hex : parts[i].hexes) {
+        for (Index& v : hex) v += offset;
+        hexes.hexes.push_back(hex);
+      }
+      hexes.hex_block.insert(hexes.hex_block.end(), parts[i].hex_block.begin(), parts[i].hex_block.end());
+      hexes.block_names.insert(parts[i].block_names.begin(), parts[i].block_names.end());
+    }
+    return join(std::move(hexes), tet_fill(outer, holes, 7, "potting"));
+  });
+}
+
+Model demo_wedge(int n, double angle) {
+  if (n < 2) throw InvalidInput("demo_wedge: n = " + std::to_string(n) + " must be >= 2");
+  if (!(angle >= 30.0 && angle <= 330.0))
+    throw InvalidInput("demo_wedge: angle " + std::to_string(angle) + " must be in [30, 330] degrees");
+  const double h = 1.0 / n;  // the tet box's boundary cells: 1.5 h
+  // k kites around the origin, each spanning angle / k there, right angles where its sides meet
+  // the rays at distance 1.
+  const int k = static_cast<int>(std::ceil(angle / 120.0));
+  const double span = angle / k * std::numbers::pi / 180.0;
+  return run_gmsh("demo_wedge", [&] {
+    Model hexes = hex_part_from_gmsh("wedge", [&] {
+      auto ray = [](double a, double r) { return gmsh::model::occ::addPoint(r * std::cos(a), r * std::sin(a), 0.0); };
+      const int o = gmsh::model::occ::addPoint(0, 0, 0);
+      std::vector<int> rim;
+      for (int i = 0; i <= k; ++i) rim.push_back(ray(i * span, 1.0));
+      gmsh::vectorpair kites;
+      for (int i = 0; i < k; ++i) {
+        const int tip = ray((i + 0.5) * span, 1.0 / std::cos(span / 2));
+        const std::vector<int> corners{o, rim[static_cast<std::size_t>(i)], tip, rim[static_cast<std::size_t>(i + 1)]};
+        std::vector<int> lines;
+        for (std::size_t c = 0; c < 4; ++c) lines.push_back(gmsh::model::occ::addLine(corners[c], corners[(c + 1) % 4]));
+        kites.push_back({2, gmsh::model::occ::addPlaneSurface({gmsh::model::occ::addCurveLoop(lines)})});
+      }
+      gmsh::vectorpair faces, out, volumes;
+      std::vector<gmsh::vectorpair> map;
+      if (k > 1) gmsh::model::occ::fragment(kites, {}, faces, map);
+      else faces = kites;
+      gmsh::model::occ::extrude(faces, 0, 0, 1, out, {n}, {}, true);
+      gmsh::model::occ::synchronize();
+      // Opposite sides of a transfinite kite have equal counts, and neighbours share rays: n
+      // cells on every side (the rim sides, tan(span / 2) long, get cells of their own size).
+      gmsh::vectorpair curves;
+      gmsh::model::getBoundary(faces, curves, false, false, false);
+      for (const auto& [dim, tag] : curves) gmsh::model::mesh::setTransfiniteCurve(std::abs(tag), n + 1);
+      for (const auto& [dim, tag] : faces) {
+        gmsh::model::mesh::setTransfiniteSurface(tag);
+        gmsh::model::mesh::setRecombine(2, tag);
+      }
+      std::vector<int> tags;
+      for (const auto& [dim, tag] : out)
+        if (dim == 3) tags.push_back(tag);
+      gmsh::model::addPhysicalGroup(3, tags, 1);
+      gmsh::model::setPhysicalName(3, 1, "wedge");
+    });
+    Box box{1e9, 1e9, 1e9, -1e9, -1e9, -1e9};
+    for (const Point& p : hexes.points)
+      for (int a = 0; a < 3; ++a) box[a] = std::min(box[a], p[a]), box[a + 3] = std::max(box[a + 3], p[a]);
+    Shell outer, inner;
+    append_solid_boundary(
+        outer, 1.5 * h,
+        [&] { gmsh::model::occ::addBox(box[0] - 1, box[1] - 1, box[2] - 1, box[3] - box[0] + 2, box[4] - box[1] + 2, box[5] - box[2] + 2); },
+        [](const Box&) { return false; }, [](const Box&) { return true; });
+    append_interface_triangles(inner, hexes, [](const Point&) { return true; },
+                               diagonal_chooser(DemoDiagonals::kRandom, h), four_chooser(false));
+    return join(std::move(hexes), tet_fill(outer, {inner}, 2, "tet"));
   });
 }
 
 const std::vector<std::string>& demo_model_names() {
   static const std::vector<std::string> names{"half", "delaunay", "delaunay-random", "cylinder",
                                               "lshape", "nugget", "fulcher", "fourtri", "fourtri-cylinder",
-                                              "hybrid", "hybrid-cylinder", "boundary-layer", "hexdominant"};
+                                              "hybrid", "hybrid-cylinder", "boundary-layer", "hexdominant",
+                                              "potting"};
   return names;
 }
 
@@ -789,9 +930,10 @@ Model demo_model(const std::string& name, int n) {
   if (name == "hybrid-cylinder") return demo_hybrid_cylinder(n);
   if (name == "boundary-layer") return demo_boundary_layer(n);
   if (name == "hexdominant") return demo_hexdominant(n);
-  throw InvalidInput("demo model '" + name +
-                     "': expected one of half, delaunay, delaunay-random, cylinder, lshape, nugget, fulcher, "
-                     "fourtri, fourtri-cylinder, hybrid, hybrid-cylinder, boundary-layer, hexdominant");
+  if (name == "potting") return demo_potting(n);
+  std::string names;
+  for (const std::string& known : demo_model_names()) names += (names.empty() ? "" : ", ") + known;
+  throw InvalidInput("demo model '" + name + "': expected one of " + names);
 }
 
 }  // namespace geode::demo

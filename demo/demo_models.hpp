@@ -82,10 +82,25 @@ Model demo_boundary_layer(int n = 4);
 // gave only tets or crashed, so the kinds come from transfinite, extruded and Delaunay volumes.)
 Model demo_hexdominant(int n = 4);
 
+// (f) The paper's proposed example, the complement of simple parts: six hex parts in a tet potting
+// box [0, 6.2] x [0, 4.4] x [0, 2.2] (block 7 "potting", Delaunay): a cube (block 1
+// "block_a"), a slab (2 "slab_b"), two swept cylinders along z and x (3 "pin_z", 4 "pin_x"), a
+// box tilted 0.5 rad about (1, 1, 0) (5 "tilted") and an L-shaped bracket (6 "bracket": a
+// concave edge, saddle corners). Boxes structured, cylinders swept from recombined disks; the
+// potting's boundary around each part is that part's quads split in two. n >= 2.
+Model demo_potting(int n = 4);
+
+// (g) One dihedral angle (degrees, 30 to 330) at a hex-part edge, for studies: a prism over
+// [0, 1] in z whose cross-section has the angle at the origin (k = ceil(angle / 120) kites
+// with unit sides on the rays, transfinite, swept in n layers; block 1 "wedge"), in a Delaunay
+// tet box one unit larger all round (block 2 "tet"). Its ends make 90-degree edges and corners
+// with the edge (convex below 180 degrees, saddles above). Not in demo_model_names.
+Model demo_wedge(int n, double angle);
+
 // The names `geode demo --model` takes: half, delaunay, delaunay-random, cylinder, lshape,
 // nugget (d: a convex Delaunay tet nugget in structured blocks), fulcher (e), fourtri (a,
 // random diagonals, four-triangle quads), fourtri-cylinder (b with four-triangle quads),
-// hybrid, hybrid-cylinder, boundary-layer, hexdominant.
+// hybrid, hybrid-cylinder, boundary-layer, hexdominant, potting (f).
 const std::vector<std::string>& demo_model_names();
 // The model of that name with size parameter n (made even where the model needs it); throws
 // InvalidInput naming an unknown name.

@@ -143,6 +143,24 @@ std::vector<BoundaryQuad> boundary_quads(const HexMesh& mesh) {
   return out;
 }
 
+std::vector<BoundaryQuad> block_interface_quads(const HexMesh& mesh) {
+  check_indices(mesh);
+  std::vector<BoundaryQuad> out;
+  if (mesh.block.empty()) return out;
+  if (mesh.block.size() != mesh.hexes.size())
+    throw InvalidInput("block_interface_quads: " + std::to_string(mesh.block.size()) + " block ids for " +
+                       std::to_string(mesh.hexes.size()) + " hexes");
+  KeyMap<4> first_use(mesh.hexes.size() * 3);
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
+    for (int f = 0; f < topo::kHexFaces; ++f) {
+      const auto nodes = hex_face_nodes(mesh.hexes[h], f);
+      const auto [slot, inserted] = first_use.try_emplace(face_key(nodes), static_cast<Index>(6 * h + f));
+      if (!inserted && mesh.block[static_cast<std::size_t>(*slot / 6)] != mesh.block[h])
+        out.push_back(BoundaryQuad{static_cast<Index>(h), f, nodes});
+    }
+  return out;
+}
+
 BoundarySurface extract_boundary(const HexMesh& mesh) {
   return extract_boundary(mesh.points, boundary_quads(mesh));
 }

@@ -60,6 +60,12 @@ struct BoundaryQuad {
 
 std::vector<BoundaryQuad> boundary_quads(const HexMesh& mesh);
 
+// The faces shared by two hexes of different blocks (mesh.block; none when it is empty): the
+// material interfaces, once each, as a BoundaryQuad of the second hex using the face (its
+// nodes ordered outward of that hex), in order of that use. Throws InvalidInput when mesh.block
+// is neither empty nor one per hex.
+std::vector<BoundaryQuad> block_interface_quads(const HexMesh& mesh);
+
 // The nodes of the boundary quads, ascending.
 std::vector<Index> boundary_nodes(const HexMesh& mesh);
 

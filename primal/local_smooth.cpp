@@ -517,6 +517,12 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
       throw InvalidInput("smooth_hexes_local: seed hex " + std::to_string(s) + " out of range");
   if (start && (start->scaled_jacobian.size() != nh || start->shortest_edge.size() != nh))
     throw InvalidInput("smooth_hexes_local: the start values are not one per hex");
+  if ((!options.hex_targets.empty() && options.hex_targets.size() != nh) ||
+      (!options.hex_goals.empty() && options.hex_goals.size() != nh))
+    throw InvalidInput("smooth_hexes_local: the per-hex targets or goals are not one per hex");
+  auto target_of = [&](Index h) { return options.hex_targets.empty() ? options.target : options.hex_targets[static_cast<std::size_t>(h)]; };
+  const bool goals = options.goal > 0.0 || !options.hex_goals.empty();
+  auto goal_of = [&](Index h) { return options.hex_goals.empty() ? options.goal : options.hex_goals[static_cast<std::size_t>(h)]; };
   std::unique_ptr<SurfaceProjector> projector;
   for (std::size_t v = 0; v < constraints.size(); ++v) {
     const NodeConstraint& c = constraints[v];
@@ -574,12 +580,12 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
     std::vector<std::size_t> cand;  // positions in pool
     for (std::size_t i = 0; i < pool.size(); ++i) {
       const Index h = pool[i];
-      if (sj[h] < options.target && visits[h] < options.max_visits && dirty[h]) cand.push_back(i);
+      if (sj[h] < target_of(h) && visits[h] < options.max_visits && dirty[h]) cand.push_back(i);
     }
     if (options.progress) options.progress(pool.size() - cand.size(), pool.size());
     if (cand.empty()) break;
     // The caller's aim is met: the target above it only gave the hexes room to get there.
-    if (options.goal > 0.0 && std::all_of(pool.begin(), pool.end(), [&](Index h) { return sj[h] >= options.goal; }))
+    if (goals && std::all_of(pool.begin(), pool.end(), [&](Index h) { return sj[h] >= goal_of(h); }))
       break;
     std::sort(cand.begin(), cand.end(), [&](std::size_t i, std::size_t j) {
       const Index a = pool[i], b = pool[j];
@@ -633,8 +639,7 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
 }
 
 LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seeds,
-                                      const LocalSmoothOptions& options, double feature_angle,
-                                      const SmoothStart* start) {
+                                      const LocalSmoothOptions& options, const SmoothStart* start) {
   for (Index s : seeds)
     if (s < 0 || static_cast<std::size_t>(s) >= mesh.hexes.size())
       throw InvalidInput("smooth_hexes_around: seed hex " + std::to_string(s) + " out of range");
@@ -657,6 +662,7 @@ LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seed
       c[k] = l;
     }
     sub.hexes.push_back(c);
+    if (!mesh.block.empty()) sub.block.push_back(mesh.block[static_cast<std::size_t>(h)]);
   }
   sub.points.reserve(global.size());
   for (Index g : global) sub.points.push_back(mesh.points[g]);
@@ -670,10 +676,14 @@ LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seed
       in_region[i] = r < region.size() && region[r] == outer[i];
     }
   }
+  // Every face between two blocks of the submesh is one of the model's (both its hexes are in
+  // it), and at a moving node both are in the region.
   std::vector<BoundaryQuad> boundary;
   for (const BoundaryQuad& q : boundary_quads(sub))
     if (in_region[static_cast<std::size_t>(q.hex)]) boundary.push_back(q);
-  auto constraints = boundary_slide_constraints(sub, boundary, feature_angle);
+  const std::vector<BoundaryQuad> between = block_interface_quads(sub);
+  boundary.insert(boundary.end(), between.begin(), between.end());
+  auto constraints = boundary_slide_constraints(sub, boundary);
   // Only the seeds' nodes move; the rest of the submesh is there to be measured.
   std::vector<char> moves(sub.points.size(), 0);
   std::vector<Index> local_seeds;
@@ -685,59 +695,81 @@ LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seed
     if (std::binary_search(sorted.begin(), sorted.end(), outer[i])) local_seeds.push_back(static_cast<Index>(i));
   for (std::size_t v = 0; v < constraints.size(); ++v)
     if (!moves[v]) constraints[v] = NodeConstraint::fixed();
-  const TriMesh surface = boundary_triangulation(sub.points, boundary);
   SmoothStart sub_start;
   if (start)
     for (Index h : outer) {
       sub_start.scaled_jacobian.push_back(start->scaled_jacobian[static_cast<std::size_t>(h)]);
       sub_start.shortest_edge.push_back(start->shortest_edge[static_cast<std::size_t>(h)]);
     }
-  LocalSmoothResult res = smooth_hexes_local(sub, constraints, &surface, local_seeds, options, start ? &sub_start : nullptr);
+  LocalSmoothOptions sub_options = options;
+  auto restrict_to_outer = [&](std::vector<double>& per_hex) {
+    if (per_hex.empty()) return;
+    if (per_hex.size() != mesh.hexes.size())
+      throw InvalidInput("smooth_hexes_around: the per-hex targets or goals are not one per hex");
+    std::vector<double> sub_values;
+    sub_values.reserve(outer.size());
+    for (Index h : outer) sub_values.push_back(per_hex[static_cast<std::size_t>(h)]);
+    per_hex = std::move(sub_values);
+  };
+  restrict_to_outer(sub_options.hex_targets);
+  restrict_to_outer(sub_options.hex_goals);
+  LocalSmoothResult res = smooth_hexes_local(sub, constraints, nullptr, local_seeds, sub_options, start ? &sub_start : nullptr);
   for (std::size_t v = 0; v < global.size(); ++v)
     if (moves[v]) mesh.points[global[v]] = sub.points[v];
   res.region = region;
   return res;
 }
 
-std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh, double feature_angle) {
-  return boundary_slide_constraints(mesh, boundary_quads(mesh), feature_angle);
+std::vector<BoundaryQuad> material_surface_quads(const HexMesh& mesh) {
+  std::vector<BoundaryQuad> out = boundary_quads(mesh);
+  const std::vector<BoundaryQuad> between = block_interface_quads(mesh);
+  out.insert(out.end(), between.begin(), between.end());
+  return out;
 }
 
-std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh, std::span<const BoundaryQuad> boundary,
-                                                       double feature_angle) {
-  std::vector<NodeConstraint> out(mesh.points.size());
-  std::vector<std::vector<Point>> normals(mesh.points.size());
-  for (const BoundaryQuad& q : boundary) {
-    const auto& p = mesh.points;
-    const Point n = (p[q.nodes[2]] - p[q.nodes[0]]).cross(p[q.nodes[3]] - p[q.nodes[1]]);
-    if (!(n.norm() > 0.0)) continue;
-    for (Index v : q.nodes) normals[v].push_back(n.normalized());
+std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh) {
+  return boundary_slide_constraints(mesh, material_surface_quads(mesh));
+}
+
+std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh, std::span<const BoundaryQuad> surfaces) {
+  const auto& p = mesh.points;
+  std::vector<NodeConstraint> out(p.size());
+  // Per node, the unit normals of its surface quads; a warped quad (corners off one plane)
+  // fixes its nodes: any move of a corner would change the bilinear surface it spans.
+  std::vector<std::vector<Point>> normals(p.size());
+  std::vector<char> fixed(p.size(), 0);
+  constexpr double kFlat = 1e-9;      // corner off the quad's plane, relative to its diagonals
+  constexpr double kParallel = 1e-9;  // |n1 x n2| of two normals taken as one plane
+  for (const BoundaryQuad& q : surfaces) {
+    const Point d0 = p[q.nodes[2]] - p[q.nodes[0]], d1 = p[q.nodes[3]] - p[q.nodes[1]];
+    const Point n = d0.cross(d1);
+    const double scale = std::max(d0.norm(), d1.norm());
+    bool flat = n.norm() > 0.0;
+    if (flat) {
+      const Point u = n.normalized();
+      const Point c = 0.25 * (p[q.nodes[0]] + p[q.nodes[1]] + p[q.nodes[2]] + p[q.nodes[3]]);
+      for (Index v : q.nodes) flat = flat && std::abs((p[v] - c).dot(u)) <= kFlat * scale;
+    }
+    for (Index v : q.nodes) {
+      if (!flat) fixed[v] = 1;
+      else normals[v].push_back(n.normalized());
+    }
   }
-  const double cos_feature = std::cos(feature_angle * M_PI / 180.0);
-  constexpr double kParallel = 1e-9;
   for (std::size_t v = 0; v < normals.size(); ++v) {
-    if (normals[v].empty()) continue;
-    // Group the normals: each joins the first group whose first normal is within the angle.
-    std::vector<std::vector<Point>> groups;
-    for (const Point& n : normals[v]) {
-      auto g = std::find_if(groups.begin(), groups.end(), [&](const auto& gr) { return gr[0].dot(n) >= cos_feature; });
-      if (g == groups.end()) groups.push_back({n});
-      else g->push_back(n);
-    }
-    auto planar = [&](const std::vector<Point>& gr) {
-      return std::all_of(gr.begin(), gr.end(), [&](const Point& n) { return n.cross(gr[0]).norm() <= kParallel; });
-    };
-    const Point& p = mesh.points[v];
-    if (groups.size() == 1) {
-      Point mean = Point::Zero();
-      for (const Point& n : groups[0]) mean += n;
-      out[v] = planar(groups[0]) ? NodeConstraint::plane(p, groups[0][0])
-                                 : NodeConstraint::surface(p, mean.normalized());
-    } else if (groups.size() == 2 && planar(groups[0]) && planar(groups[1])) {
-      out[v] = NodeConstraint::line(p, groups[0][0].cross(groups[1][0]).normalized());
-    } else {
+    if (fixed[v]) {
       out[v] = NodeConstraint::fixed();
+      continue;
     }
+    if (normals[v].empty()) continue;
+    // The distinct planes through the node (normals parallel either way: an interface quad is
+    // oriented by one of its two hexes).
+    std::vector<Point> planes;
+    for (const Point& n : normals[v])
+      if (std::none_of(planes.begin(), planes.end(), [&](const Point& m) { return m.cross(n).norm() <= kParallel; }))
+        planes.push_back(n);
+    if (planes.size() == 1) out[v] = NodeConstraint::plane(p[v], planes[0]);
+    else if (planes.size() == 2) out[v] = NodeConstraint::line(p[v], planes[0].cross(planes[1]).normalized());
+    else out[v] = NodeConstraint::fixed();
   }
   return out;
 }

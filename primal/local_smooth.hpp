@@ -27,7 +27,9 @@
 //    frame), then runs them in parallel (TBB). The result does not depend on the thread count.
 //  - Constraints (primal/smooth.hpp's NodeConstraint): plane and line nodes stay on them exactly;
 //    kSurface nodes move in their tangent plane and are projected back onto the nearest triangle
-//    of the given surface triangulation after every step.
+//    of the given surface triangulation after every step (the bilinear faces around them then
+//    change by up to their chord error, and so do the volumes they enclose: for callers that
+//    accept that; boundary_slide_constraints fixes such nodes instead).
 #include <cstddef>
 #include <functional>
 #include <span>
@@ -39,8 +41,8 @@
 
 namespace geode::primal {
 
-// Boundary normals more than this many degrees apart make a feature edge or corner (see
-// boundary_slide_constraints).
+// Boundary normals more than this many degrees apart make a feature edge or corner (the
+// buffer layer's mitred offsets, conform/buffer_layer.hpp).
 inline constexpr double kFeatureAngle = 30.0;
 
 struct LocalSmoothOptions {
@@ -60,6 +62,10 @@ struct LocalSmoothOptions {
   double sharpness = 60.0;    // soft minimum of scaled Jacobians
   double untangle_sharpness = 20.0;  // soft minimum of Jacobians / L^3
   double min_gain = 1e-4;     // soft-minimum rise counted as progress
+  // Per hex of the mesh (each empty, or one per hex): that hex's own target and goal instead of
+  // `target` and `goal`, for callers whose aim differs from hex to hex (conform's local
+  // yardstick). A goal of 0 is met by any hex.
+  std::vector<double> hex_targets, hex_goals;
   int threads = 0;            // 0: TBB's default; 1: serial
   // Called before each round and at the end with (seed hexes not waiting for a patch, seeds).
   std::function<void(std::size_t settled, std::size_t seeds)> progress;
@@ -100,33 +106,32 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
                                      const LocalSmoothOptions& options = {},
                                      const SmoothStart* start = nullptr);
 
-// smooth_hexes_local with the model's boundary sliding (boundary_slide_constraints and
-// boundary_triangulation, `feature_angle`), run on the submesh of the hexes around the seeds
-// only: a patch moves the nodes of its seed hex, so every hex whose quality can change shares a
-// node with a seed, and the boundary there is told from one more ring of hexes. Finding the
-// rings still scans the mesh once per ring, but the costly parts (boundary faces, constraints,
-// patches) follow the seeds, not the mesh (the whole-mesh boundary of a million hexes costs
-// seconds).
+// smooth_hexes_local with the model's boundary and its material interfaces kept
+// (boundary_slide_constraints), run on the submesh of the hexes around the seeds only: a patch
+// moves the nodes of its seed hex, so every hex whose quality can change shares a node with a
+// seed, and the boundary there is told from one more ring of hexes. Finding the rings still
+// scans the mesh once per ring, but the costly parts (boundary faces, constraints, patches)
+// follow the seeds, not the mesh (the whole-mesh boundary of a million hexes costs seconds).
 // Same result as smooth_hexes_local over the whole mesh with those constraints. The result's
 // minima are over the hexes around the seeds.
 LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seeds,
                                       const LocalSmoothOptions& options = {},
-                                      double feature_angle = kFeatureAngle,
                                       const SmoothStart* start = nullptr);
 
-// Constraints that keep the mesh's boundary where it is while letting it slide: a boundary
-// node whose boundary quads all lie in one plane slides in it; where their normals fall in two
-// groups more than `feature_angle` (degrees) apart and each group is planar, the node slides
-// along the feature edge (the planes' intersection line); where the boundary is curved
-// (normals within the angle but not parallel), the node is kSurface; otherwise (corners,
-// curved feature edges) fixed. Interior nodes are free.
-std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh,
-                                                       double feature_angle = kFeatureAngle);
-// The same from boundary quads found otherwise (e.g. of a submesh whose own boundary is
-// larger than the model's); nodes on none of them are free.
-std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh,
-                                                       std::span<const BoundaryQuad> boundary,
-                                                       double feature_angle = kFeatureAngle);
+// The surfaces smoothing must keep: the mesh's boundary quads, then the faces between blocks
+// (block_interface_quads; none when mesh.block is empty).
+std::vector<BoundaryQuad> material_surface_quads(const HexMesh& mesh);
+
+// Constraints that keep every block's volume (materials never move): each node on one of the
+// `surfaces` quads (default: material_surface_quads) moves only where the surfaces through it
+// keep their shape. A node whose surface quads are all flat and lie in one plane slides in it;
+// in two planes, along their intersection line (a straight feature edge, or an interface
+// meeting the boundary); otherwise (corners, curved surfaces, warped quads) it is fixed.
+// Sliding in a plane, the quads around a node keep covering the same planar region (the
+// smoother keeps them untangled), so each block's volume, the flux of x.n / 3 through its
+// faces, does not change (to rounding). Interior nodes are free.
+std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh);
+std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh, std::span<const BoundaryQuad> surfaces);
 
 // The mesh's boundary quads, each split into two triangles (along the 0-2 diagonal): the
 // surface kSurface nodes slide on when no input triangulation is at hand.

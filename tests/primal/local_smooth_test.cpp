@@ -1,11 +1,13 @@
 // The worst-first local smoother (primal/local_smooth.hpp): analytic derivatives against finite
-// differences, untangling, the per-hex floors, boundary nodes kept on their plane / edge /
-// triangulation, and the same result for any thread count.
+// differences, untangling, the per-hex floors, boundary and block-interface nodes kept on their
+// plane / edge (every block's volume kept), kSurface nodes on their triangulation, and the same
+// result for any thread count.
 #include <doctest/doctest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <vector>
 
 #include "primal/errors.hpp"
@@ -267,8 +269,25 @@ TEST_CASE("seeds limit the smoothing to their neighbourhood") {
   CHECK(moved > 0);
 }
 
-TEST_CASE("curved boundary nodes stay on the boundary triangulation") {
-  // A grid whose top bulges (z = 3 + 0.4 sin): top nodes are kSurface, and the sides planes.
+// Volume of each block (mesh.block; 0 for all when empty): the exact volumes of the trilinear hexes.
+std::map<int, double> block_volumes(const HexMesh& m) {
+  std::map<int, double> v;
+  for (Index h = 0; h < static_cast<Index>(m.hexes.size()); ++h)
+    v[m.block.empty() ? 0 : m.block[static_cast<std::size_t>(h)]] += gp::hex_volume(gp::hex_corners(m, h));
+  return v;
+}
+
+void check_volumes_kept(const HexMesh& before, const HexMesh& after) {
+  const auto a = block_volumes(before), b = block_volumes(after);
+  REQUIRE(a.size() == b.size());
+  for (const auto& [id, volume] : a) {
+    CAPTURE(id);
+    CHECK(std::abs(b.at(id) - volume) <= 1e-9 * volume);
+  }
+}
+
+TEST_CASE("curved boundary nodes are fixed: the volume is kept; given kSurface nodes stay on the triangulation") {
+  // A grid whose top bulges (z = 3 + 0.4 sin): top nodes on a curved surface, the sides planes.
   HexMesh mesh = grid(3, [](const Point& p) {
     return Point(p.x(), p.y(), p.z() * (1.0 + 0.13 * std::sin(p.x()) * std::sin(p.y())));
   });
@@ -276,23 +295,88 @@ TEST_CASE("curved boundary nodes stay on the boundary triangulation") {
   for (Point& p : mesh.points)  // skew the interior so that the top nodes want to move
     if (p.minCoeff() > 0 && p.x() < 3 && p.y() < 3) p.x() += 0.35 * r.next(), p.y() += 0.35 * r.next();
   const auto cons = gp::boundary_slide_constraints(mesh);
-  const gp::TriMesh surface = gp::boundary_triangulation(mesh);
+  int planes = 0, curved = 0;
+  for (std::size_t v = 0; v < mesh.points.size(); ++v) {
+    CHECK(cons[v].kind != NodeConstraint::Kind::kSurface);
+    planes += cons[v].kind == NodeConstraint::Kind::kPlane;
+    // Inside the bulging top (off its edges): fixed.
+    const Point& p = mesh.points[v];
+    if (p.z() > 3.0 && p.x() > 0 && p.x() < 3 && p.y() > 0 && p.y() < 3) {
+      ++curved;
+      CHECK(cons[v].kind == NodeConstraint::Kind::kFixed);
+    }
+  }
+  CHECK(planes > 0);
+  CHECK(curved == 4);
   const HexMesh before = mesh;
   gp::LocalSmoothOptions o;
   o.target = 0.95;
-  const auto res = gp::smooth_hexes_local(mesh, cons, &surface, {}, o);
-  CHECK(res.final_min_scaled_jacobian >= res.initial_min_scaled_jacobian);
-  int surface_nodes = 0, moved = 0;
-  for (std::size_t v = 0; v < mesh.points.size(); ++v) {
-    if (cons[v].kind != NodeConstraint::Kind::kSurface) continue;
-    ++surface_nodes;
-    CHECK(distance_to(surface, mesh.points[v]) < 1e-9);
-    moved += (mesh.points[v] - before.points[v]).norm() > 1e-3;
+  const auto res = gp::smooth_hexes_local(mesh, cons, nullptr, {}, o);
+  CHECK(res.final_min_scaled_jacobian > res.initial_min_scaled_jacobian);
+  check_volumes_kept(before, mesh);
+
+  // kSurface constraints given explicitly: those nodes move on the boundary triangulation.
+  HexMesh sliding = before;
+  auto surface_cons = cons;
+  const gp::TriMesh surface = gp::boundary_triangulation(sliding);
+  for (std::size_t v = 0; v < sliding.points.size(); ++v)
+    if (cons[v].kind == NodeConstraint::Kind::kFixed && sliding.points[v].z() > 3.0)
+      surface_cons[v] = NodeConstraint::surface(sliding.points[v], Point::UnitZ());
+  gp::smooth_hexes_local(sliding, surface_cons, &surface, {}, o);
+  int moved = 0;
+  for (std::size_t v = 0; v < sliding.points.size(); ++v) {
+    if (surface_cons[v].kind != NodeConstraint::Kind::kSurface) continue;
+    CHECK(distance_to(surface, sliding.points[v]) < 1e-9);
+    moved += (sliding.points[v] - before.points[v]).norm() > 1e-3;
   }
-  CHECK(surface_nodes > 0);
   CHECK(moved > 0);
   gp::HexMesh unconstrained = before;
-  CHECK_THROWS_AS(gp::smooth_hexes_local(unconstrained, cons), geode::InvalidInput);
+  CHECK_THROWS_AS(gp::smooth_hexes_local(unconstrained, surface_cons), geode::InvalidInput);
+}
+
+TEST_CASE("materials never move: block interfaces slide in their plane or stay, every block's volume kept") {
+  // A jittered 6^3 grid in three blocks: a curved interface (a sphere's octant: the hexes whose
+  // centre is within 3.5 of the origin), a planar one (x = 4, flat: its nodes slide in it) and
+  // the boundary.
+  HexMesh mesh = jittered_grid(6, 0.3, 41);
+  for (Point& p : mesh.points)  // the x = 4 plane flat again
+    if (std::abs(p.x() - 4.0) < 0.31 && p.x() != 4.0 && std::abs(std::round(p.x()) - 4.0) < 0.5) p.x() = 4.0;
+  for (Index h = 0; h < static_cast<Index>(mesh.hexes.size()); ++h) {
+    Point c = Point::Zero();
+    for (Index v : mesh.hexes[static_cast<std::size_t>(h)]) c += mesh.points[static_cast<std::size_t>(v)] / 8.0;
+    mesh.block.push_back(c.norm() < 3.5 ? 1 : c.x() > 4.0 ? 3 : 2);
+  }
+  const auto between = gp::block_interface_quads(mesh);
+  CHECK(!between.empty());
+  const auto cons = gp::boundary_slide_constraints(mesh);
+  int on_interface_plane = 0;
+  for (const auto& q : between)
+    for (Index v : q.nodes) {
+      CHECK(cons[static_cast<std::size_t>(v)].kind != NodeConstraint::Kind::kFree);
+      on_interface_plane += cons[static_cast<std::size_t>(v)].kind == NodeConstraint::Kind::kPlane;
+    }
+  CHECK(on_interface_plane > 0);  // x = 4 inside the grid
+  const HexMesh before = mesh;
+  gp::LocalSmoothOptions o;
+  o.target = 0.95;
+  const auto res = gp::smooth_hexes_local(mesh, cons, nullptr, {}, o);
+  CHECK(res.final_min_scaled_jacobian > res.initial_min_scaled_jacobian);
+  check_volumes_kept(before, mesh);
+  int slid = 0;  // nodes of the x = 4 interface that moved, in it
+  for (std::size_t v = 0; v < mesh.points.size(); ++v)
+    if (cons[v].kind == NodeConstraint::Kind::kPlane && before.points[v].x() == 4.0 && before.points[v].y() > 0 &&
+        before.points[v].y() < 6 && before.points[v].z() > 0 && before.points[v].z() < 6) {
+      CHECK(std::abs(mesh.points[v].x() - 4.0) < 1e-12);
+      slid += (mesh.points[v] - before.points[v]).norm() > 1e-3;
+    }
+  CHECK(slid > 0);
+  // The submesh smoother keeps them too.
+  HexMesh around = before;
+  std::vector<Index> seeds;
+  for (Index h = 0; h < static_cast<Index>(around.hexes.size()); h += 2) seeds.push_back(h);
+  gp::smooth_hexes_around(around, seeds, o);
+  check_volumes_kept(before, around);
+  CHECK(gp::min_scaled_jacobian(around) > gp::min_scaled_jacobian(before));
 }
 
 TEST_CASE("one thread and two threads give the same mesh") {
