@@ -1,5 +1,5 @@
 // geode conform INPUT: the geode algorithm on a whole hex + tet model; geode demo: the same on
-// a demo model built with Gmsh (conform/demo_models).
+// a demo model built with Gmsh (demo/demo_models).
 #include <algorithm>
 #include <filesystem>
 #include <iostream>

@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include "conform/conform.hpp"
-#include "conform/demo_models.hpp"
+#include "demo/demo_models.hpp"
 #include "conform/report.hpp"
 #include "primal/model.hpp"
 #include "python/arrays.hpp"
@@ -140,12 +140,12 @@ void bind_conform(py::module_& m) {
         primal::Model model;
         {
           py::gil_scoped_release free;
-          model = conform::demo_model(name, n);
+          model = demo::demo_model(name, n);
         }
         return model_dict(std::move(model));
       },
       py::arg("name"), py::arg("n"));
-  m.def("demo_model_names", [] { return conform::demo_model_names(); },
+  m.def("demo_model_names", [] { return demo::demo_model_names(); },
         "The demo models (meshed with the Gmsh API), as `geode demo --model` names them.");
 }
 

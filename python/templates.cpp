@@ -11,7 +11,7 @@
 #include <sstream>
 
 #include "primal/boundary.hpp"
-#include "primal/io_html.hpp"
+#include "viewer/html.hpp"
 #include "primal/quality.hpp"
 #include "primal/quality_report.hpp"
 #include "python/arrays.hpp"
@@ -123,8 +123,8 @@ void note_conditions(TemplateResult& r) {
 
 // The arrangement's sheets contoured in the domain for the viewer, mapped like the nodes, each
 // with its layer of cells (as `geode template --format html` draws them).
-std::vector<primal::ViewSheet> view_sheets(const TemplateResult& r) {
-  std::vector<primal::ViewSheet> out(r.sheets.size());
+std::vector<viewer::ViewSheet> view_sheets(const TemplateResult& r) {
+  std::vector<viewer::ViewSheet> out(r.sheets.size());
   for (std::size_t s = 0; s < r.sheets.size(); ++s) out[s].name = r.sheets[s].name, out[s].kind = r.sheets[s].kind;
   if (r.domain.dim == 3) {
     auto surfaces = stc::contour_sheets(r.sheets, r.domain);
@@ -150,7 +150,7 @@ std::vector<primal::ViewSheet> view_sheets(const TemplateResult& r) {
 
 std::string template_html(const TemplateResult& r) {
   const auto& T = r.t;
-  primal::ViewScene scene;
+  viewer::ViewScene scene;
   scene.title = "geode template " + r.name;
   std::ostringstream caption;
   caption << r.caption << ": " << (T.dim == 3 ? T.hex.hexes.size() : T.quad.quads.size()) << (T.dim == 3 ? " hexes" : " quads");
@@ -163,10 +163,10 @@ std::string template_html(const TemplateResult& r) {
              "the smoothed cells need not follow them. Layers: the cells dual to each sheet.";
   scene.caption = caption.str();
   scene.sheets = view_sheets(r);
-  if (T.dim == 2) return primal::html_view(T.quad, scene);
+  if (T.dim == 2) return viewer::html_view(T.quad, scene);
   // The tet and hex sides as face groups (the paper's Figure 1), when the template knows its box faces.
   if (T.node_faces.size() == T.hex.points.size()) {
-    primal::ViewFaceGroup tet{"tet side", {}}, hex{"hex side", {}};
+    viewer::ViewFaceGroup tet{"tet side", {}}, hex{"hex side", {}};
     for (const auto& q : primal::boundary_quads(T.hex)) {
       unsigned common = ~0u;
       for (auto n : q.nodes) common &= T.node_faces[static_cast<std::size_t>(n)];
@@ -175,7 +175,7 @@ std::string template_html(const TemplateResult& r) {
     }
     scene.groups = {tet, hex};
   }
-  return primal::html_view(T.hex, scene);
+  return viewer::html_view(T.hex, scene);
 }
 
 // ---- template() ---------------------------------------------------------------------------------

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "conform/conform.hpp"
-#include "conform/demo_models.hpp"
+#include "demo/demo_models.hpp"
 #include "primal/boundary.hpp"
 #include "primal/local_smooth.hpp"
 #include "primal/quality.hpp"
@@ -52,7 +52,7 @@ TEST_CASE("materials never move: every smoothing mode keeps each block's volume 
   for (const auto& model : models) {
     const std::string model_name = model.name;
     CAPTURE(model_name);
-    const primal::Model input = conform::demo_model(model.name, model.n);
+    const primal::Model input = demo::demo_model(model.name, model.n);
     conform::ConformOptions none;
     none.smooth = conform::ConformSmooth::kNone;
     const conform::ConformResult base = conform::conform(input, none);

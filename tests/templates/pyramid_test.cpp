@@ -12,7 +12,7 @@
 
 #include "primal/boundary.hpp"
 #include "primal/errors.hpp"
-#include "primal/io_gmsh.hpp"
+#include "io/gmsh.hpp"
 #include "primal/quality.hpp"
 #include "primal/realizability.hpp"
 #include "primal/validity.hpp"
@@ -34,7 +34,7 @@ std::array<Point, 5> equilateral() {
 // One pyramid refined by Gmsh's all-hex subdivision (Mesh.SubdivisionAlgorithm = 2, the
 // RefineMesh of `gmsh -refine`): hexes in Gmsh's order (VTK's for linear hexes).
 primal::HexMesh gmsh_pyramid_filling(const std::array<Point, 5>& c) {
-  primal::GmshSession session;
+  io::GmshSession session;
   gmsh::model::add("pyramid");
   const int volume = gmsh::model::addDiscreteEntity(3);
   std::vector<double> xyz;
