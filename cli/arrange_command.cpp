@@ -29,7 +29,7 @@ void run_arrange(const ArrangeArgs& a) {
   // The smoother's constraints keep nodes on axis-aligned box faces.
   if (a.smooth && spec.domain.corners)
     throw InvalidInput(a.spec + ": --smooth needs a box domain (this spec's domain is a " +
-                       (spec.dim == 3 ? "hexahedron)" : "quadrilateral)"));
+                       (spec.domain.is_pyramid ? "pyramid)" : spec.dim == 3 ? "hexahedron)" : "quadrilateral)"));
   templates::Template t = templates::build_template(spec);
   const std::string name = std::filesystem::path(a.spec).stem().string();
   TemplateOutput out;

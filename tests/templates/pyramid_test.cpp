@@ -19,6 +19,7 @@
 #include "stc/mesh_dual.hpp"
 #include "stc/surface_chords.hpp"
 #include "templates/pyramid.hpp"
+#include "templates/spec.hpp"
 
 using namespace geode;
 using primal::Index;
@@ -145,4 +146,30 @@ TEST_CASE("pyramid: Gmsh's all-hex subdivision of one pyramid, measured") {
   MESSAGE("gmsh 88-hex pyramid, height 1: min scaled Jacobian " << rlo);
   CHECK(rlo > 0.11);
   CHECK(rlo < 0.125);
+}
+
+TEST_CASE("pyramid: specs take a pyramid domain and write it back") {
+  const nlohmann::json j = nlohmann::json::parse(R"({"dim": 3,
+    "domain": {"pyramid": [[-1, 0, -1], [-1, 0, 1], [1, 0, 1], [1, 0, -1], [0, 1.5, 0]]},
+    "sheets": [{"name": "x", "plane": {"point": [0.1, 0.4, 0.13], "normal": [1, 0, 0]}},
+               {"name": "y", "plane": {"point": [0.1, 0.4, 0.13], "normal": [0, 1, 0]}},
+               {"name": "z", "plane": {"point": [0.1, 0.4, 0.13], "normal": [0, 0, 1]}}]})");
+  const auto spec = templates::parse_spec(j, "p.json");
+  CHECK(spec.domain.is_pyramid);
+  REQUIRE(spec.domain.corners);
+  CHECK(((*spec.domain.corners)[7] - Point(0, 1.5, 0)).norm() == 0.0);
+  const auto back = templates::spec_json(spec);
+  CHECK(back["domain"] == j["domain"]);
+  CHECK(templates::parse_spec(back, "back.json").domain.is_pyramid);
+  nlohmann::json bad = j;
+  bad["domain"]["pyramid"].erase(4);
+  try {
+    templates::parse_spec(bad, "p.json");
+    FAIL("four corners accepted");
+  } catch (const InvalidInput& e) {
+    CHECK(std::string(e.what()).find("domain.pyramid") != std::string::npos);
+  }
+  bad = j;
+  std::swap(bad["domain"]["pyramid"][1], bad["domain"]["pyramid"][3]);  // clockwise base
+  CHECK_THROWS_AS(templates::parse_spec(bad, "p.json"), InvalidInput);
 }
