@@ -24,6 +24,7 @@
 #include "primal/quality.hpp"
 #include "primal/quality_report.hpp"
 #include "primal/smooth.hpp"
+#include "primal/split_pyramids.hpp"
 #include "primal/topology.hpp"
 
 namespace geode::conform {
@@ -52,10 +53,9 @@ OutputBlocks output_blocks(const primal::Model& input, const std::string& geode_
   o.names = input.block_names;
   if (geode_block.empty()) return o;
   int top = 0;
-  for (std::size_t h = 0; h < input.hexes.size(); ++h)
-    top = std::max(top, primal::block_of(input, {primal::ElementKind::Hex, static_cast<Index>(h)}));
-  for (std::size_t t = 0; t < input.tets.size(); ++t)
-    top = std::max(top, primal::block_of(input, {primal::ElementKind::Tet, static_cast<Index>(t)}));
+  for (primal::ElementKind kind : primal::kElementKinds)
+    for (std::size_t e = 0; e < primal::element_count(input, kind); ++e)
+      top = std::max(top, primal::block_of(input, {kind, static_cast<Index>(e)}));
   o.geode_id = top + 1;
   o.names[o.geode_id] = geode_block;
   return o;
@@ -135,6 +135,7 @@ class Conformer {
   }
 
   void find_interface();
+  void check_wedges() const;
   void insert_buffer();
   void dice_and_merge();
   void place_templates();
@@ -183,23 +184,64 @@ class Conformer {
 void Conformer::find_interface() {
   res_.input_hexes = static_cast<Index>(input_.hexes.size());
   res_.input_tets = static_cast<Index>(input_.tets.size());
-  if (input_.hexes.empty() || input_.tets.empty())
-    throw InvalidInput("conform: the model needs a hex part and a tet part (it has " +
-                       std::to_string(input_.hexes.size()) + " hexes, " +
-                       std::to_string(input_.tets.size()) + " tets)");
+  res_.input_wedges = static_cast<Index>(input_.wedges.size());
+  if (primal::element_count(input_) == 0) throw InvalidInput("conform: the model has no elements");
   t0_ = Clock::now();
   res_.input_diced_hex_min_scaled_jacobian = primal::diced_min_scaled_jacobian(input_.points, input_.hexes);
   res_.input_diced_tet_min_scaled_jacobian = primal::diced_min_scaled_jacobian(input_.points, input_.tets);
-  interface_ = primal::find_interface(input_, options_.interface_tolerance);
-  if (interface_.quads.empty())
-    throw InvalidInput("conform: the hex part and the tet part share no interface quad");
+  res_.input_diced_wedge_min_scaled_jacobian = primal::diced_wedge_min_scaled_jacobian(input_.points, input_.wedges);
+  // A model without a hex part or a tet part has no transition to make: it is simply diced.
+  if (!input_.hexes.empty() && !input_.tets.empty())
+    interface_ = primal::find_interface(input_, options_.interface_tolerance);
+  check_wedges();
   res_.interface_quads = static_cast<Index>(interface_.quads.size());
   say("interface: " + std::to_string(interface_.quads.size()) + " quads" + took());
+}
+
+// Wedges are diced in place (6 hexes each, their faces matching the diced hexes and tets
+// beside them), never moved: a wedge quad meeting two tet triangles (a pyramid split on a
+// wedge) would need the transition carved beside a wedge, and a wedge at a node of the hex/tet
+// interface would be torn by the buffer layer's duplicated nodes. Both are refused, naming the
+// wedge, until the buffer layer carves next to wedges.
+void Conformer::check_wedges() const {
+  if (input_.wedges.empty()) return;
+  std::vector<char> on_interface(input_.points.size(), 0);
+  for (Index v : interface_.nodes) on_interface[static_cast<std::size_t>(v)] = 1;
+  const primal::FaceOwners faces(input_);
+  const auto& topo = primal::cell_topology(primal::ElementKind::Wedge);
+  for (std::size_t w = 0; w < input_.wedges.size(); ++w) {
+    const primal::ElementRef ref{primal::ElementKind::Wedge, static_cast<Index>(w)};
+    const auto& c = input_.wedges[w];
+    for (Index v : c)
+      if (on_interface[static_cast<std::size_t>(v)])
+        throw TopologyError("conform: " + primal::describe_element(input_, ref) + " touches the hex/tet interface at " +
+                            primal::describe_node(input_, v) +
+                            "; a transition beside wedges is not supported yet (the wedge is diced in place)");
+    for (int f = 0; f < topo.faces; ++f) {
+      const auto& face = topo.face[static_cast<std::size_t>(f)];
+      if (face.size != 4) continue;
+      const auto q = [&](int k) { return c[static_cast<std::size_t>(face.corners[static_cast<std::size_t>(k)])]; };
+      for (int d = 0; d < 2; ++d) {
+        const std::array<Index, 3> tri{q(d), q(d + 1), q(d + 2)};
+        const primal::Side* owner = faces.find(tri);
+        if (owner && owner->element.kind == primal::ElementKind::Tet)
+          throw TopologyError("conform: face " + std::to_string(f + 1) + " of " + primal::describe_element(input_, ref) +
+                              " (nodes " + primal::node_list(input_, std::array<Index, 4>{q(0), q(1), q(2), q(3)}) +
+                              ") meets the triangles of " + primal::describe_element(input_, owner->element) +
+                              " (a pyramid on the wedge, split); a transition beside wedges is not supported yet");
+      }
+    }
+  }
 }
 
 void Conformer::insert_buffer() {
   t0_ = Clock::now();
   res_.buffer_side = options_.buffer.side;
+  if (interface_.quads.empty()) {  // nothing to carve: the model is diced as it is
+    layer_.model = input_;
+    layer_.top_node.assign(input_.points.size(), kInvalidIndex);
+    return;
+  }
   try {
     layer_ = insert_buffer_layer(input_, interface_, options_.buffer);
   } catch (const TopologyError& e) {
@@ -247,8 +289,10 @@ void Conformer::dice_and_merge() {
   diced_ = primal::dice_model(layer_.model, shareable);
   res_.diced_hexes = static_cast<Index>(diced_.hex_children.size());
   res_.diced_tet_hexes = static_cast<Index>(diced_.tet_children.size());
+  res_.diced_wedge_hexes = static_cast<Index>(diced_.wedge_children.size());
   say("dicing: " + std::to_string(res_.diced_hexes) + " hexes from hexes, " +
-      std::to_string(res_.diced_tet_hexes) + " from tets" + took());
+      std::to_string(res_.diced_tet_hexes) + " from tets, " + std::to_string(res_.diced_wedge_hexes) + " from wedges" +
+      took());
 }
 
 // A template in every buffer hex: tet/hex-side nodes become their diced node, interior nodes
@@ -257,6 +301,7 @@ void Conformer::place_templates() {
   t0_ = Clock::now();
   // The four-triangle template only when some buffer hex needs it (it costs time); the
   // templates built in parallel (each once per process).
+  if (layer_.hexes.empty()) return;  // no interface: no template
   const bool any_four = std::any_of(layer_.hexes.begin(), layer_.hexes.end(), [](const BufferHex& b) { return b.centre != kInvalidIndex; });
   tbb::parallel_invoke([&] { refs_[0] = &reference_template(options_.template_box, {4, 6}); },
                        [&] { refs_[1] = &reference_template(options_.template_box, {5, 7}); },
@@ -364,7 +409,7 @@ void Conformer::assemble() {
   const std::size_t nb = layer_.hexes.size();
   std::vector<std::array<Index, 8>> hexes;
   std::vector<int> block;
-  hexes.reserve(diced_.hex_children.size() + res_.geode_hexes + diced_.tet_children.size());
+  hexes.reserve(diced_.hex_children.size() + res_.geode_hexes + diced_.tet_children.size() + diced_.wedge_children.size());
   block.reserve(hexes.capacity());
   // Each output hex is in the input block of the element it comes from; a geode hex in the
   // block of the element its buffer hex was carved from, or in a block of its own.
@@ -387,6 +432,9 @@ void Conformer::assemble() {
   for (std::size_t k = 0; k < diced_.tet_children.size(); ++k)
     hexes.push_back(diced_.tet_children[k]),
         block.push_back(primal::block_of(lm, {primal::ElementKind::Tet, diced_.tet_parent[k]}));
+  for (std::size_t k = 0; k < diced_.wedge_children.size(); ++k)
+    hexes.push_back(diced_.wedge_children[k]),
+        block.push_back(primal::block_of(lm, {primal::ElementKind::Wedge, diced_.wedge_parent[k]}));
   inst_global_ = {};
   std::vector<Index> renum(diced_.points.size(), kInvalidIndex);
   mesh_.points.reserve(diced_.points.size());
@@ -682,8 +730,20 @@ ConformQuality parse_conform_quality(const std::string& word) {
   throw InvalidInput("quality report '" + word + "': expected sj or full");
 }
 
+ConformPyramids parse_conform_pyramids(const std::string& word) {
+  if (word == "split") return ConformPyramids::kSplit;
+  throw InvalidInput("pyramid treatment '" + word + "': expected split");
+}
+
 ConformResult conform(const primal::Model& input, const ConformOptions& options) {
-  return Conformer(input, options).run();
+  if (input.pyramids.empty()) return Conformer(input, options).run();
+  // kSplit, the only treatment so far: each pyramid as its better two tets (split_pyramids);
+  // a pyramid template (a ConformPyramids value of its own) would fill the pyramids in place.
+  const primal::PyramidSplit split = primal::split_pyramids(input);
+  ConformResult r = Conformer(split.model, options).run();
+  r.input_pyramids = static_cast<Index>(input.pyramids.size());
+  r.input_tets -= 2 * r.input_pyramids;
+  return r;
 }
 
 }  // namespace geode::conform

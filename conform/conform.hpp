@@ -39,7 +39,17 @@ enum class ConformQuality { kScaledJacobian, kFull };
 // "sj" or "full"; InvalidInput naming the word otherwise.
 ConformQuality parse_conform_quality(const std::string& word);
 
+// What becomes of the pyramids of a hybrid mesh: kSplit, each pyramid as two tets along the
+// base diagonal giving the better tets (primal/split_pyramids.hpp), its base quad then getting
+// the transition as any two-triangle interface quad does. (A pyramid template is the place for
+// a second value.)
+enum class ConformPyramids { kSplit };
+
+// "split"; InvalidInput naming the word otherwise.
+ConformPyramids parse_conform_pyramids(const std::string& word);
+
 struct ConformOptions {
+  ConformPyramids pyramids = ConformPyramids::kSplit;
   BufferLayerOptions buffer;
   // When no buffer layer can be carved from buffer.side (a node where that part's copy cannot
   // move off the interface, e.g. on the hex part's flat boundary where a tet part covers only
@@ -115,15 +125,21 @@ struct ConformResult {
   // the diced edge / face nodes whose origin nodes are all in the set. Side sets: every input
   // side becomes the diced children's faces lying on it (4 per hex face, 3 per tet face).
   primal::Model model;
-  primal::Index input_hexes = 0, input_tets = 0, interface_quads = 0;
-  primal::Index diced_hexes = 0, geode_hexes = 0, diced_tet_hexes = 0;
+  // input_tets: the input's own; its pyramids are split into two tets each before the rest.
+  primal::Index input_hexes = 0, input_tets = 0, input_pyramids = 0, input_wedges = 0, interface_quads = 0;
+  primal::Index diced_hexes = 0, geode_hexes = 0, diced_tet_hexes = 0, diced_wedge_hexes = 0;
   BufferLayerReport buffer;
   BufferSide buffer_side = BufferSide::kHex;  // the part the buffer layer was carved from
   double template_min_scaled_jacobian = 0.0;  // the reference templates used, after smoothing
   // The yardstick for the transition: the input's hexes and tets each diced alone
   // (primal::diced_min_scaled_jacobian), before the buffer layer moves anything.
+  // Pyramids count as their two tets (the tet figure), wedges diced alone as their own.
   double input_diced_hex_min_scaled_jacobian = 1.0, input_diced_tet_min_scaled_jacobian = 1.0;
-  double yardstick() const { return std::min(input_diced_hex_min_scaled_jacobian, input_diced_tet_min_scaled_jacobian); }
+  double input_diced_wedge_min_scaled_jacobian = 1.0;
+  double yardstick() const {
+    return std::min({input_diced_hex_min_scaled_jacobian, input_diced_tet_min_scaled_jacobian,
+                     input_diced_wedge_min_scaled_jacobian});
+  }
   double min_scaled_jacobian_before_smoothing = 0.0;
   // Buffer hexes whose template the map inverted, re-smoothed inside the buffer hex (interior
   // template nodes only, every other node fixed) before any smoothing.
@@ -141,9 +157,12 @@ struct ConformResult {
   double seconds = 0.0;
 };
 
-// Throws TopologyError from find_interface / insert_buffer_layer (named by them), when a side
-// face is shared by more than two buffer hexes, or when the side faces of two buffer hexes do
-// not match; InvalidInput when the model has no hexes, no tets or no interface. A result whose
+// Pyramids first become tets (ConformOptions::pyramids); wedges are diced in place, 6 hexes
+// each, after the diced tets in the output. A model without a hex part or a tet part (wedges and
+// tets, tets only) has no interface and is simply diced. Throws TopologyError from
+// find_interface / insert_buffer_layer (named by them), when a side face is shared by more
+// than two buffer hexes, when the side faces of two buffer hexes do not match, or when a wedge
+// touches the hex/tet interface (not supported yet); InvalidInput when the model is empty. A result whose
 // validity is not ok() is still returned (with warnings) so that it can be inspected.
 ConformResult conform(const primal::Model& input, const ConformOptions& options = {});
 

@@ -190,12 +190,19 @@ Model read_exodus(const std::filesystem::path& path, const ReadOptions& options)
       if (static_cast<std::int64_t>(global.size()) + count > num_elem)
         throw InvalidInput(where + ": more elements in the blocks than the header's " + std::to_string(num_elem));
       const std::string type = upper(type_buffer);
-      const bool hex = per_elem == 8 && (type == "HEX8" || type == "HEX" || type == "HEXAHEDRON");
-      const bool tet = per_elem == 4 && (type == "TETRA4" || type == "TETRA" || type == "TET4" || type == "TET");
-      if (!hex && !tet)
+      const ExodusCell* cell = nullptr;
+      ElementKind kind = ElementKind::Hex;
+      for (std::size_t k = 0; k < kExodusCells.size() && !cell; ++k)
+        for (const char* alias : kExodusCells[k].aliases)
+          if (alias && type == alias && per_elem == kExodusCells[k].corners) {
+            cell = &kExodusCells[k];
+            kind = kElementKinds[k];
+            break;
+          }
+      if (!cell)
         throw InvalidInput(where + ": element " + std::to_string(global.size() + 1) + ": element type '" +
                            std::string(type_buffer) + "' with " + std::to_string(per_elem) +
-                           " nodes is not supported; only HEX8 and TETRA4 are");
+                           " nodes is not supported; only HEX8, TETRA4, PYRAMID5 and WEDGE6 are");
       std::vector<int> conn(static_cast<std::size_t>(count) * static_cast<std::size_t>(per_elem));
       if (count > 0) check(ex_get_conn(exo, EX_ELEM_BLOCK, id, conn.data(), nullptr, nullptr), where, "reading connectivity");
       for (int e = 0; e < count; ++e) {
@@ -208,21 +215,10 @@ Model read_exodus(const std::filesystem::path& path, const ReadOptions& options)
                                ", out of range [1, " + std::to_string(num_nodes) + "]");
           return static_cast<Index>(n - 1);
         };
-        if (hex) {
-          std::array<Index, 8> h{};
-          for (std::size_t c = 0; c < 8; ++c) h[c] = node(kExodusHexToVtk[c]);
-          model.hex_ids.push_back(element_file_id(global.size()));
-          global.push_back({ElementKind::Hex, static_cast<Index>(model.hexes.size())});
-          model.hexes.push_back(h);
-          model.hex_block.push_back(block_id);
-        } else {
-          std::array<Index, 4> t{};
-          for (std::size_t c = 0; c < 4; ++c) t[c] = node(kExodusTetToVtk[c]);
-          model.tet_ids.push_back(element_file_id(global.size()));
-          global.push_back({ElementKind::Tet, static_cast<Index>(model.tets.size())});
-          model.tets.push_back(t);
-          model.tet_block.push_back(block_id);
-        }
+        std::array<Index, 8> c{};
+        for (std::size_t k = 0; k < static_cast<std::size_t>(cell->corners); ++k) c[k] = node(cell->order[k]);
+        global.push_back({kind, static_cast<Index>(element_count(model, kind))});
+        add_element(model, kind, c, block_id, element_file_id(global.size() - 1));
       }
     }
   }
@@ -272,7 +268,7 @@ Model read_exodus(const std::filesystem::path& path, const ReadOptions& options)
         if (elems[i] < 1 || static_cast<std::size_t>(elems[i]) > global.size())
           throw InvalidInput(entry + " refers to element " + std::to_string(elems[i]) + ", out of range");
         const ElementRef element = global[static_cast<std::size_t>(elems[i] - 1)];
-        const int faces = element.kind == ElementKind::Hex ? topology::kHexFaces : 4;
+        const int faces = cell_topology(element.kind).faces;
         if (sides[i] < 1 || sides[i] > faces)
           throw InvalidInput(entry + ": element " + std::to_string(elems[i]) + ": side " +
                              std::to_string(sides[i]) + " out of range [1, " + std::to_string(faces) + "]");
@@ -292,20 +288,22 @@ void write_exodus(const Model& model, const std::filesystem::path& path) {
   validate(model, target);
 
   // Blocks in ascending id, each of one element type; global numbering follows.
-  std::map<int, std::pair<std::vector<Index>, std::vector<Index>>> blocks;  // id -> (hexes, tets)
-  for (std::size_t h = 0; h < model.hexes.size(); ++h)
-    blocks[block_of(model, {ElementKind::Hex, static_cast<Index>(h)})].first.push_back(static_cast<Index>(h));
-  for (std::size_t t = 0; t < model.tets.size(); ++t)
-    blocks[block_of(model, {ElementKind::Tet, static_cast<Index>(t)})].second.push_back(static_cast<Index>(t));
-  std::vector<int> hex_global(model.hexes.size()), tet_global(model.tets.size());
+  std::map<int, std::vector<ElementRef>> blocks;  // id -> its elements, one kind
+  for (ElementKind kind : kElementKinds)
+    for (std::size_t e = 0; e < element_count(model, kind); ++e) {
+      const ElementRef ref{kind, static_cast<Index>(e)};
+      auto& members = blocks[block_of(model, ref)];
+      if (!members.empty() && members.front().kind != kind)
+        throw InvalidInput(target + ": block " + std::to_string(block_of(model, ref)) + " holds both " +
+                           element_kind_name(members.front().kind) + "s and " + element_kind_name(kind) +
+                           "s; an Exodus block holds one element type");
+      members.push_back(ref);
+    }
+  std::array<std::vector<int>, 4> global;  // per kind and element: its 1-based file number
+  for (ElementKind kind : kElementKinds) global[static_cast<std::size_t>(kind)].resize(element_count(model, kind));
   int next = 1;
-  for (const auto& [id, members] : blocks) {
-    if (!members.first.empty() && !members.second.empty())
-      throw InvalidInput(target + ": block " + std::to_string(id) +
-                         " holds both hexes and tets; an Exodus block holds one element type");
-    for (Index h : members.first) hex_global[static_cast<std::size_t>(h)] = next++;
-    for (Index t : members.second) tet_global[static_cast<std::size_t>(t)] = next++;
-  }
+  for (const auto& [id, members] : blocks)
+    for (const ElementRef& e : members) global[static_cast<std::size_t>(e.kind)][static_cast<std::size_t>(e.index)] = next++;
 
   write_path_atomically(path, "", [&](const std::filesystem::path& temp) {
     ex_opts(0);
@@ -315,7 +313,7 @@ void write_exodus(const Model& model, const std::filesystem::path& path) {
     const int exo = file.id();
     check(ex_set_max_name_length(exo, kNameLength), target, "setting the name length");
     check(ex_put_init(exo, "geode", 3, static_cast<int64_t>(model.points.size()),
-                      static_cast<int64_t>(model.hexes.size() + model.tets.size()),
+                      static_cast<int64_t>(element_count(model)),
                       static_cast<int64_t>(blocks.size()), static_cast<int64_t>(model.node_sets.size()),
                       static_cast<int64_t>(model.side_sets.size())),
           target, "writing the header");
@@ -335,23 +333,17 @@ void write_exodus(const Model& model, const std::filesystem::path& path) {
     NameBuffers block_names(blocks.size());
     std::size_t b = 0;
     for (const auto& [id, members] : blocks) {
-      const bool hex = !members.first.empty();
-      const auto& list = hex ? members.first : members.second;
-      const int per_elem = hex ? 8 : 4;
-      check(ex_put_block(exo, EX_ELEM_BLOCK, id, hex ? "HEX8" : "TETRA4", static_cast<int64_t>(list.size()),
-                         per_elem, 0, 0, 0),
+      const ExodusCell& cell = kExodusCells[static_cast<std::size_t>(members.front().kind)];
+      const int per_elem = cell.corners;
+      check(ex_put_block(exo, EX_ELEM_BLOCK, id, cell.name, static_cast<int64_t>(members.size()), per_elem, 0, 0, 0),
             target, "writing block " + std::to_string(id));
-      std::vector<int> conn(list.size() * static_cast<std::size_t>(per_elem));
-      for (std::size_t i = 0; i < list.size(); ++i) {
-        const auto e = static_cast<std::size_t>(list[i]);
+      std::vector<int> conn(members.size() * static_cast<std::size_t>(per_elem));
+      for (std::size_t i = 0; i < members.size(); ++i) {
+        const auto corners = element_corners(model, members[i]);
         const std::size_t base = i * static_cast<std::size_t>(per_elem);
-        // exodus_corner[k*ToVtk[c]] = vtk_corner[c]
-        for (std::size_t c = 0; c < static_cast<std::size_t>(per_elem); ++c) {
-          if (hex)
-            conn[base + static_cast<std::size_t>(kExodusHexToVtk[c])] = model.hexes[e][c] + 1;
-          else
-            conn[base + static_cast<std::size_t>(kExodusTetToVtk[c])] = model.tets[e][c] + 1;
-        }
+        // exodus_corner[order[c]] = model_corner[c]
+        for (std::size_t c = 0; c < static_cast<std::size_t>(per_elem); ++c)
+          conn[base + static_cast<std::size_t>(cell.order[c])] = corners[c] + 1;
       }
       if (!conn.empty())
         check(ex_put_conn(exo, EX_ELEM_BLOCK, id, conn.data(), nullptr, nullptr), target,
@@ -383,8 +375,7 @@ void write_exodus(const Model& model, const std::filesystem::path& path) {
             "writing side set " + std::to_string(set.id));
       std::vector<int> elems, sides;
       for (const Side& side : set.sides) {
-        const auto e = static_cast<std::size_t>(side.element.index);
-        elems.push_back(side.element.kind == ElementKind::Hex ? hex_global[e] : tet_global[e]);
+        elems.push_back(global[static_cast<std::size_t>(side.element.kind)][static_cast<std::size_t>(side.element.index)]);
         sides.push_back(side.face + 1);
       }
       if (!elems.empty())

@@ -1,14 +1,14 @@
 #pragma once
-// Exodus II input and output of a mixed hex + tet model (libexodusII): coordinates, element
-// blocks 'HEX8' / 'TETRA4', named node sets and side sets, block names.
+// Exodus II input and output of a mixed model (libexodusII): coordinates, element blocks
+// 'HEX8' / 'TETRA4' / 'PYRAMID5' / 'WEDGE6', named node sets and side sets, block names.
 //
 // Node order: Exodus HEX8 and TETRA4 number their corners as VTK does (Exodus II manual,
 // "Element Types"; primal/topology.hpp), so kExodusHexToVtk / kExodusTetToVtk are the identity;
 // they are kept as data so that the conversion is visible. Side numbers are 1-based in the
 // file and 0-based (topology.hpp face order, which is Exodus's side order) in the Model.
 // Elements are numbered globally in block order in the file; the reader keeps the blocks in
-// file order, the writer writes them in ascending id (hexes and tets of one id cannot share an
-// Exodus block: writing such a model throws InvalidInput).
+// file order, the writer writes them in ascending id (elements of two kinds with one id cannot
+// share an Exodus block: writing such a model throws InvalidInput).
 #include <array>
 #include <filesystem>
 
@@ -20,13 +20,29 @@ namespace geode::io {
 inline constexpr std::array<int, 8> kExodusHexToVtk{0, 1, 2, 3, 4, 5, 6, 7};
 inline constexpr std::array<int, 4> kExodusTetToVtk{0, 1, 2, 3};
 
+// The element types per primal::ElementKind (hex, tet, pyramid, wedge): the name the writer
+// gives, the names the reader accepts with that node count (aliases Cubit, SEACAS and meshio
+// write), and model_corner[i] = exodus_corner[order[i]] (the identity: the model's corner
+// order is Exodus's for all four, topology.hpp).
+struct ExodusCell {
+  const char* name;
+  int corners;
+  std::array<const char*, 4> aliases;  // nullptr-padded
+  std::array<int, 8> order;
+};
+inline constexpr std::array<ExodusCell, 4> kExodusCells{{
+    {"HEX8", 8, {"HEX8", "HEX", "HEXAHEDRON", nullptr}, {0, 1, 2, 3, 4, 5, 6, 7}},
+    {"TETRA4", 4, {"TETRA4", "TETRA", "TET4", "TET"}, {0, 1, 2, 3}},
+    {"PYRAMID5", 5, {"PYRAMID5", "PYRAMID", nullptr, nullptr}, {0, 1, 2, 3, 4}},
+    {"WEDGE6", 6, {"WEDGE6", "WEDGE", nullptr, nullptr}, {0, 1, 2, 3, 4, 5}},
+}};
+
 // The file is checked for the netCDF / HDF5 signature (file_format.hpp) before libexodusII
 // opens it. Node and element number maps, when present (Cubit writes them), are the model's
 // file ids; otherwise 1-based numbers. Block ids are the file's; a file with a block id <= 0
 // (meshio numbers blocks from 0) gets its blocks numbered 1, 2, ... in file order. Throws InvalidInput naming the file, the block / element
 // / set entry and the reason: missing or unreadable file, not an Exodus file (e.g. truncated),
-// an element type other than HEX8 / TETRA4 (HEX / HEXAHEDRON / TETRA / TET4 with 8 / 4 nodes
-// are accepted as aliases), a node or element number out of range, a side number out of
+// an element type other than those of kExodusCells with their node counts, a node or element number out of range, a side number out of
 // range; then check_geometry (model.hpp) unless options say otherwise.
 primal::Model read_exodus(const std::filesystem::path& path, const primal::ReadOptions& options = {});
 

@@ -124,31 +124,21 @@ Model model_from_gmsh(std::string_view source_view) {
     for (std::size_t t = 0; t < types.size(); ++t) {
       const auto& tags = element_tags[t];
       const auto& nodes = element_nodes[t];
-      if (types[t] != kGmshHex8 && types[t] != kGmshTet4) {
+      const ElementKind* kind = gmsh_cell_kind(types[t]);
+      if (!kind) {
         if (!tags.empty())
-          throw InvalidInput(source + ": element " + std::to_string(tags.front()) + ": " +
-                             gmsh_type_name(types[t]) +
-                             " is not supported; only 4-node tetrahedra and 8-node "
-                             "hexahedra are");
+          throw InvalidInput(source + ": element " + std::to_string(tags.front()) + ": " + gmsh_type_name(types[t]) +
+                             " is not supported; only linear cells are (4-node tetrahedra, 8-node hexahedra, "
+                             "6-node prisms, 5-node pyramids)");
         continue;
       }
+      const GmshCell& cell = kGmshCells[static_cast<std::size_t>(*kind)];
+      const auto n = static_cast<std::size_t>(cell.corners);
       for (std::size_t e = 0; e < tags.size(); ++e) {
         const std::string what = "element " + std::to_string(tags[e]);
-        if (types[t] == kGmshHex8) {
-          std::array<Index, 8> hex{};
-          for (int c = 0; c < 8; ++c)
-            hex[static_cast<std::size_t>(c)] =
-                node(nodes[8 * e + static_cast<std::size_t>(kGmshHexToVtk[static_cast<std::size_t>(c)])], what);
-          model.hexes.push_back(hex);
-          model.hex_block.push_back(block);
-        } else {
-          std::array<Index, 4> tet{};
-          for (int c = 0; c < 4; ++c)
-            tet[static_cast<std::size_t>(c)] =
-                node(nodes[4 * e + static_cast<std::size_t>(kGmshTetToVtk[static_cast<std::size_t>(c)])], what);
-          model.tets.push_back(tet);
-          model.tet_block.push_back(block);
-        }
+        std::array<Index, 8> c{};
+        for (std::size_t k = 0; k < n; ++k) c[k] = node(nodes[n * e + static_cast<std::size_t>(cell.order[k])], what);
+        add_element(model, *kind, c, block, static_cast<std::int64_t>(tags[e]));
       }
     }
   }
@@ -156,27 +146,12 @@ Model model_from_gmsh(std::string_view source_view) {
   // Physical groups of lower dimension: side sets (dim 2) and node sets (dim 0, 1).
   gmsh::vectorpair groups;
   gmsh::model::getPhysicalGroups(groups);
-  std::unordered_map<FaceKey, Side, IndexArrayHash> face_owner;
+  FaceOwners face_owner;
   bool faces_built = false;
   auto build_faces = [&] {
     if (faces_built) return;
     faces_built = true;
-    for (std::size_t h = 0; h < model.hexes.size(); ++h)
-      for (int f = 0; f < topology::kHexFaces; ++f) {
-        std::array<Index, 4> q{};
-        for (int i = 0; i < 4; ++i)
-          q[static_cast<std::size_t>(i)] =
-              model.hexes[h][static_cast<std::size_t>(topology::kHexFaceCorners[static_cast<std::size_t>(f)][static_cast<std::size_t>(i)])];
-        face_owner.emplace(face_key(q), Side{{ElementKind::Hex, static_cast<Index>(h)}, f});
-      }
-    for (std::size_t t = 0; t < model.tets.size(); ++t)
-      for (int f = 0; f < 4; ++f) {
-        std::array<Index, 3> tri{};
-        for (int i = 0; i < 3; ++i)
-          tri[static_cast<std::size_t>(i)] =
-              model.tets[t][static_cast<std::size_t>(topology::kTetFaceCorners[static_cast<std::size_t>(f)][static_cast<std::size_t>(i)])];
-        face_owner.emplace(face_key(tri), Side{{ElementKind::Tet, static_cast<Index>(t)}, f});
-      }
+    face_owner = FaceOwners(model);
   };
   for (const auto& [dim, ptag] : groups) {
     if (dim == 3) continue;
@@ -206,10 +181,9 @@ Model model_from_gmsh(std::string_view source_view) {
             std::vector<Index> face;
             for (std::size_t i = 0; i < n; ++i)
               face.push_back(node(element_nodes[t][n * e + i], where + ": " + what));
-            auto it = face_owner.find(face_key(face));
-            if (it == face_owner.end())
-              throw InvalidInput(where + ": " + what + " is not a face of any hex or tet");
-            set.sides.push_back(it->second);
+            const Side* owner = face_owner.find(face);
+            if (!owner) throw InvalidInput(where + ": " + what + " is not a face of any volume element");
+            set.sides.push_back(*owner);
           }
         }
       }

@@ -1,5 +1,5 @@
 #pragma once
-// Gmsh .msh input and output of a mixed hex + tet model. Reading is our own (gmsh_read.cpp:
+// Gmsh .msh input and output of a mixed model (hexes, tets, pyramids, prisms). Reading is our own (gmsh_read.cpp:
 // versions 2.2 and 4.1, ASCII and binary), so that a user's file never reaches libgmsh, which
 // would run any text that is not a mesh as a Gmsh script. Writing is our own too
 // (gmsh_write.cpp: 4.1 and 2.2, ASCII and binary, every write error reported); only the demo
@@ -36,6 +36,26 @@ namespace geode::io {
 inline constexpr std::array<int, 8> kGmshHexToVtk{0, 1, 2, 3, 4, 5, 6, 7};
 inline constexpr std::array<int, 4> kGmshTetToVtk{0, 1, 2, 3};
 
+// The volume cells per primal::ElementKind (hex, tet, pyramid, wedge): the Gmsh element type
+// and model_corner[i] = gmsh_corner[order[i]]. Gmsh's 5-node pyramid (type 7) is in VTK/Exodus
+// order, its 6-node prism (type 6) in Exodus WEDGE6 order, the model's (reference manual,
+// "Node ordering": prism 0-1-2 at the bottom counter-clockwise seen from 3-4-5 above).
+struct GmshCell {
+  int type;
+  int corners;
+  std::array<int, 8> order;
+};
+inline constexpr std::array<GmshCell, 4> kGmshCells{{{5, 8, {0, 1, 2, 3, 4, 5, 6, 7}},
+                                                     {4, 4, {0, 1, 2, 3}},
+                                                     {7, 5, {0, 1, 2, 3, 4}},
+                                                     {6, 6, {0, 1, 2, 3, 4, 5}}}};
+// The kind of a Gmsh volume type, or nullptr when it is not a linear cell the model holds.
+inline const primal::ElementKind* gmsh_cell_kind(long long type) {
+  for (std::size_t k = 0; k < kGmshCells.size(); ++k)
+    if (kGmshCells[k].type == type) return &primal::kElementKinds[k];
+  return nullptr;
+}
+
 enum class GmshFormat { Ascii, Binary };
 // MSH 4.1 (Gmsh 4's own) or 2.2 (what older solvers' readers and converters still expect).
 enum class GmshVersion { k41, k22 };
@@ -44,7 +64,7 @@ enum class GmshVersion { k41, k22 };
 // model's file ids. Throws InvalidInput naming the file, the line (byte in binary files) or
 // the element / node tag and the reason: missing or unreadable file, a file that does not
 // start with $MeshFormat (a script, another format), another version, a truncated section or
-// one without its $End line, a volume element that is not a linear hex or tet, an element
+// one without its $End line, a volume element that is not a linear hex, tet, pyramid or prism, an element
 // referring to a node not in $Nodes, a node given twice at two places, a side-set face that is
 // no face of a hex or tet; then check_geometry (model.hpp) unless options say otherwise.
 primal::Model read_gmsh(const std::filesystem::path& path, const primal::ReadOptions& options = {});

@@ -555,14 +555,16 @@ class MshReader {
       const RawElement& e = elements_[i];
       const GmshType& type = *gmsh_type(e.type);
       if (type.dim != 3) continue;
-      if (e.type != kHex8 && e.type != kTet4)
+      const ElementKind* kind = gmsh_cell_kind(e.type);
+      if (!kind)
         throw InvalidInput(source_ + ": element " + std::to_string(e.tag) + ": " + type.name + " (Gmsh type " +
-                           std::to_string(e.type) + ") is not supported; only 4-node tetrahedra and 8-node hexahedra are");
+                           std::to_string(e.type) + ") is not supported; only linear cells are (4-node tetrahedra, "
+                           "8-node hexahedra, 6-node prisms, 5-node pyramids)");
       const std::vector<int> physicals = physicals_of(e, 3);
       int block = physicals.empty() ? model_entity(e, 3) : block_among(physicals);
       for (int p : physicals) volume_groups.insert(p);
       // meshio writes 0 for a missing physical and entity tag: the model's default block.
-      if (block == 0) block = e.type == kHex8 ? 1 : 2;
+      if (block == 0) block = default_block(*kind);
       if (block < 0)
         throw InvalidInput(source_ + ": element " + std::to_string(e.tag) + ": block (physical or entity tag) " +
                            std::to_string(block) + " is not positive");
@@ -585,19 +587,12 @@ class MshReader {
       const RawElement& e = elements_[v.element];
       if (auto it = physical_names_.find({3, v.block}); it != physical_names_.end() && !it->second.empty())
         model.block_names[v.block] = it->second;
-      if (e.type == kHex8) {
-        std::array<Index, 8> hex{};
-        for (std::size_t c = 0; c < 8; ++c) hex[c] = node(e, static_cast<std::size_t>(kGmshHexToVtk[c]));
-        model.hexes.push_back(hex);
-        model.hex_block.push_back(v.block);
-        model.hex_ids.push_back(e.tag);
-      } else {
-        std::array<Index, 4> tet{};
-        for (std::size_t c = 0; c < 4; ++c) tet[c] = node(e, static_cast<std::size_t>(kGmshTetToVtk[c]));
-        model.tets.push_back(tet);
-        model.tet_block.push_back(v.block);
-        model.tet_ids.push_back(e.tag);
-      }
+      const ElementKind kind = *gmsh_cell_kind(e.type);
+      const GmshCell& cell = kGmshCells[static_cast<std::size_t>(kind)];
+      std::array<Index, 8> c{};
+      for (std::size_t k = 0; k < static_cast<std::size_t>(cell.corners); ++k)
+        c[k] = node(e, static_cast<std::size_t>(cell.order[k]));
+      add_element(model, kind, c, v.block, e.tag);
     }
 
     // Lower-dimensional physical groups: side sets (dim 2), node sets (dim 0 and 1), in
@@ -611,23 +606,9 @@ class MshReader {
       if (dim < 3)
         for (int p : physicals_of(elements_[i], dim)) groups[{dim, p}].push_back(i);
     }
-    std::unordered_map<FaceKey, Side, IndexArrayHash> face_owner;
-    if (std::any_of(groups.begin(), groups.end(), [](const auto& g) { return g.first.first == 2; })) {
-      for (std::size_t h = 0; h < model.hexes.size(); ++h)
-        for (int f = 0; f < topology::kHexFaces; ++f) {
-          std::array<Index, 4> q{};
-          for (std::size_t i = 0; i < 4; ++i)
-            q[i] = model.hexes[h][static_cast<std::size_t>(topology::kHexFaceCorners[static_cast<std::size_t>(f)][i])];
-          face_owner.emplace(face_key(q), Side{{ElementKind::Hex, static_cast<Index>(h)}, f});
-        }
-      for (std::size_t t = 0; t < model.tets.size(); ++t)
-        for (int f = 0; f < 4; ++f) {
-          std::array<Index, 3> tri{};
-          for (std::size_t i = 0; i < 3; ++i)
-            tri[i] = model.tets[t][static_cast<std::size_t>(topology::kTetFaceCorners[static_cast<std::size_t>(f)][i])];
-          face_owner.emplace(face_key(tri), Side{{ElementKind::Tet, static_cast<Index>(t)}, f});
-        }
-    }
+    FaceOwners face_owner;
+    if (std::any_of(groups.begin(), groups.end(), [](const auto& g) { return g.first.first == 2; }))
+      face_owner = FaceOwners(model);
     for (const auto& [key, members] : groups) {
       const auto [dim, tag] = key;
       std::string name;
@@ -643,10 +624,10 @@ class MshReader {
                                ") is not supported; only 3-node triangles and 4-node quads are");
           std::vector<Index> face;
           for (std::size_t k = 0; k < (e.type == kTri3 ? 3u : 4u); ++k) face.push_back(node(e, k));
-          const auto it = face_owner.find(face_key(face));
-          if (it == face_owner.end())
-            throw InvalidInput(where + ": element " + std::to_string(e.tag) + " is not a face of any hex or tet");
-          set.sides.push_back(it->second);
+          const Side* owner = face_owner.find(face);
+          if (!owner)
+            throw InvalidInput(where + ": element " + std::to_string(e.tag) + " is not a face of any volume element");
+          set.sides.push_back(*owner);
         }
         std::sort(set.sides.begin(), set.sides.end());
         set.sides.erase(std::unique(set.sides.begin(), set.sides.end()), set.sides.end());

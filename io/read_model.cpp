@@ -1,5 +1,6 @@
 #include "io/read_model.hpp"
 
+#include <algorithm>
 #include <string>
 
 #include "primal/errors.hpp"
@@ -25,26 +26,20 @@ Model model_from_vtk(const VtkGrid& grid, const ReadOptions& options) {
   for (std::size_t c = 0; c < grid.cells.size(); ++c) {
     const int type = grid.cell_types[c];
     if (type == kVtkTriangle || type == kVtkQuad) continue;
-    if (type != kVtkHexahedron && type != kVtkTetra)
+    const auto it = std::find(kVtkCellTypes.begin(), kVtkCellTypes.end(), type);
+    if (it == kVtkCellTypes.end())
       throw InvalidInput(grid.source + ": cell " + std::to_string(c) + ": VTK cell type " + std::to_string(type) +
-                         " is not supported; only hexahedra (12) and tetrahedra (10) are");
-    const int block = blocks ? (*blocks)[c] : (type == kVtkHexahedron ? 1 : 2);
+                         " is not supported; only hexahedra (12), tetrahedra (10), wedges (13) and pyramids (14) are");
+    const ElementKind kind = kElementKinds[static_cast<std::size_t>(it - kVtkCellTypes.begin())];
+    const int block = blocks ? (*blocks)[c] : default_block(kind);
     if (block <= 0)
       throw InvalidInput(grid.source + ": cell " + std::to_string(c) + ": block id " + std::to_string(block) +
                          " (cell array '" + block_array + "') is not positive");
-    if (type == kVtkHexahedron) {
-      std::array<Index, 8> h{};
-      std::copy(grid.cells[c].begin(), grid.cells[c].end(), h.begin());
-      model.hexes.push_back(h);
-      model.hex_block.push_back(block);
-      model.hex_ids.push_back(static_cast<std::int64_t>(c));
-    } else {
-      std::array<Index, 4> t{};
-      std::copy(grid.cells[c].begin(), grid.cells[c].end(), t.begin());
-      model.tets.push_back(t);
-      model.tet_block.push_back(block);
-      model.tet_ids.push_back(static_cast<std::int64_t>(c));
-    }
+    std::array<Index, 8> corners{};
+    const auto& cell = grid.cells[c];
+    for (std::size_t k = 0; k < cell.size() && k < 8; ++k)
+      corners[k] = cell[kind == ElementKind::Wedge ? static_cast<std::size_t>(topology::kVtkWedgeOrder[k]) : k];
+    add_element(model, kind, corners, block, static_cast<std::int64_t>(c));
   }
   validate(model, grid.source);
   options.check_geometry ? check_geometry(model, grid.source) : check_points(model, grid.source);

@@ -166,21 +166,49 @@ Grid grid_of(const std::filesystem::path& path, const QuadMesh& m, const VtkCell
   return single_type_grid(path, m.points, m.quads, kVtkQuad, quad_sj, {}, extra);
 }
 
-// A model: hexes then tets, each with its element block (block_of).
+// The scaled Jacobian of a pyramid or wedge: its corner frames' least det(e1, e2, e3) /
+// (|e1| |e2| |e3|) (topology.hpp's frames; a pyramid's base corners, with the apex as third
+// edge), the definition Verdict applies to hexes and tets.
+double frame_sj(const Point& o, const Point& a, const Point& b, const Point& c) {
+  const Point e1 = a - o, e2 = b - o, e3 = c - o;
+  const double n = e1.norm() * e2.norm() * e3.norm();
+  return n > 0.0 ? e1.cross(e2).dot(e3) / n : 0.0;
+}
+double pyramid_sj(const std::array<Point, 5>& p) {
+  double s = 1.0;
+  for (std::size_t k = 0; k < 4; ++k) s = std::min(s, frame_sj(p[k], p[(k + 1) % 4], p[(k + 3) % 4], p[4]));
+  return s;
+}
+double wedge_sj(const std::array<Point, 6>& p) {
+  double s = 1.0;
+  for (std::size_t k = 0; k < 6; ++k) {
+    const auto& n = topology::kWedgeCornerNeighbors[k];
+    s = std::min(s, frame_sj(p[k], p[static_cast<std::size_t>(n[0])], p[static_cast<std::size_t>(n[1])], p[static_cast<std::size_t>(n[2])]));
+  }
+  return s;
+}
+
+// A model: hexes, tets, pyramids, then wedges (VTK's corner order), each with its element
+// block (block_of).
 Grid grid_of(const std::filesystem::path& path, const Model& m, const VtkCellData& extra) {
   const std::string file = path.string();
   validate(m, file);
   Grid g = start_grid(file, m.points);
+  std::vector<std::array<Index, 6>> vtk_wedges(m.wedges.size());
+  for (std::size_t w = 0; w < m.wedges.size(); ++w)
+    for (std::size_t k = 0; k < 6; ++k) vtk_wedges[w][k] = m.wedges[w][static_cast<std::size_t>(topology::kVtkWedgeOrder[k])];
   add_cells(g, file, m.hexes, kVtkHexahedron);
   add_cells(g, file, m.tets, kVtkTetra);
+  add_cells(g, file, m.pyramids, kVtkPyramid);
+  add_cells(g, file, vtk_wedges, kVtkWedge);
   std::vector<double> sj;
   append_quality(sj, m.points, m.hexes, hex_sj);
   append_quality(sj, m.points, m.tets, tet_sj);
+  append_quality(sj, m.points, m.pyramids, pyramid_sj);
+  append_quality(sj, m.points, m.wedges, wedge_sj);
   std::vector<int> block;
-  for (std::size_t h = 0; h < m.hexes.size(); ++h)
-    block.push_back(block_of(m, {ElementKind::Hex, static_cast<Index>(h)}));
-  for (std::size_t t = 0; t < m.tets.size(); ++t)
-    block.push_back(block_of(m, {ElementKind::Tet, static_cast<Index>(t)}));
+  for (ElementKind kind : kElementKinds)
+    for (std::size_t e = 0; e < element_count(m, kind); ++e) block.push_back(block_of(m, {kind, static_cast<Index>(e)}));
   // The block again as "mat_id", the cell array of material ids Python solvers read (SfePy's
   // name; meshio hands it on), so that they find the materials without knowing ours.
   VtkCellData data = extra;

@@ -15,6 +15,10 @@ inline const char* cell_type_name(int type) {
       return "tetra";
     case kVtkHexahedron:
       return "hexahedron";
+    case kVtkWedge:
+      return "wedge";
+    case kVtkPyramid:
+      return "pyramid";
     default:
       return nullptr;
   }
@@ -30,6 +34,10 @@ inline int cell_type_size(int type) {
       return 4;
     case kVtkHexahedron:
       return 8;
+    case kVtkWedge:
+      return 6;
+    case kVtkPyramid:
+      return 5;
     default:
       return 0;
   }

@@ -4,6 +4,8 @@
 #include <set>
 
 #include "primal/dice.hpp"
+#include "primal/errors.hpp"
+#include "primal/quality.hpp"
 #include "primal/topology.hpp"
 
 namespace geode::primal {
@@ -32,7 +34,94 @@ Index DicedModel::find(const FaceKey& key) const {
   return id ? *id : kInvalidIndex;
 }
 
+namespace {
+
+// Wedges, one hex per corner c with axes along its edges (r, s, t) = kWedgeCornerNeighbors[c]:
+// corners c, mid(c r), centre(c r s), mid(c s), mid(c t), centre(c r t), cell centre,
+// centre(c s t) in VTK hex order, a right-handed hex for a positive wedge. Every edge and
+// face node goes through the shared map (each of its nodes is shareable), at the centroid of
+// its origin nodes, as dice() places those of hexes and tets.
+void dice_wedges(const Model& model, DicedModel& out) {
+  const auto& topo = cell_topology(ElementKind::Wedge);
+  out.wedge_children.reserve(6 * model.wedges.size());
+  out.wedge_parent.reserve(6 * model.wedges.size());
+  for (std::size_t w = 0; w < model.wedges.size(); ++w) {
+    const auto& c = model.wedges[w];
+    auto node_of = [&](std::initializer_list<int> local) {
+      FaceKey key = kNoOrigin;
+      Point p = Point::Zero();
+      std::size_t k = 0;
+      for (int l : local) {
+        key[k++] = c[static_cast<std::size_t>(l)];
+        p += model.points[static_cast<std::size_t>(c[static_cast<std::size_t>(l)])];
+      }
+      key = normalized_origin(key);
+      auto [id, inserted] = out.shared.try_emplace(key, kInvalidIndex);
+      if (inserted) *id = out.add_node(p / static_cast<double>(local.size()), key);
+      return *id;
+    };
+    // The face through corners a, b, d of this wedge (each pair of edges at a corner spans one).
+    auto face_of = [&](int a, int b, int d) {
+      for (int f = 0; f < topo.faces; ++f) {
+        const auto& face = topo.face[static_cast<std::size_t>(f)];
+        auto has = [&](int x) { return std::find(face.corners.begin(), face.corners.begin() + face.size, x) != face.corners.begin() + face.size; };
+        if (has(a) && has(b) && has(d)) {
+          if (face.size == 3) return node_of({face.corners[0], face.corners[1], face.corners[2]});
+          return node_of({face.corners[0], face.corners[1], face.corners[2], face.corners[3]});
+        }
+      }
+      return kInvalidIndex;
+    };
+    Point centre = Point::Zero();
+    for (Index v : c) centre += model.points[static_cast<std::size_t>(v)] / 6.0;
+    const Index mid = out.add_node(centre);
+    for (int k = 0; k < 6; ++k) {
+      const auto& n = topology::kWedgeCornerNeighbors[static_cast<std::size_t>(k)];
+      out.wedge_children.push_back({c[static_cast<std::size_t>(k)], node_of({k, n[0]}), face_of(k, n[0], n[1]), node_of({k, n[1]}),
+                                    node_of({k, n[2]}), face_of(k, n[0], n[2]), mid, face_of(k, n[1], n[2])});
+      out.wedge_parent.push_back(static_cast<Index>(w));
+    }
+  }
+}
+
+}  // namespace
+
+double diced_wedge_min_scaled_jacobian(std::span<const Point> points, std::span<const std::array<Index, 6>> wedges) {
+  double lowest = 1.0;
+  for (const auto& c : wedges) {
+    auto at = [&](std::initializer_list<int> local) {
+      Point p = Point::Zero();
+      for (int l : local) p += points[static_cast<std::size_t>(c[static_cast<std::size_t>(l)])];
+      return Point(p / static_cast<double>(local.size()));
+    };
+    Point centre = Point::Zero();
+    for (Index v : c) centre += points[static_cast<std::size_t>(v)] / 6.0;
+    // The face centroid through corners k, a, b (wedge_face_corners picks the face).
+    for (int k = 0; k < 6; ++k) {
+      const auto& n = topology::kWedgeCornerNeighbors[static_cast<std::size_t>(k)];
+      auto face = [&](int a, int b) {
+        for (const auto& f : cell_topology(ElementKind::Wedge).face) {
+          auto has = [&](int x) { return std::find(f.corners.begin(), f.corners.begin() + f.size, x) != f.corners.begin() + f.size; };
+          if (f.size && has(k) && has(a) && has(b)) {
+            Point p = Point::Zero();
+            for (int i = 0; i < f.size; ++i) p += points[static_cast<std::size_t>(c[static_cast<std::size_t>(f.corners[static_cast<std::size_t>(i)])])];
+            return Point(p / static_cast<double>(f.size));
+          }
+        }
+        return centre;
+      };
+      const HexCorners h{points[static_cast<std::size_t>(c[static_cast<std::size_t>(k)])], at({k, n[0]}), face(n[0], n[1]), at({k, n[1]}),
+                         at({k, n[2]}), face(n[0], n[2]), centre, face(n[1], n[2])};
+      lowest = std::min(lowest, hex_scaled_jacobian(h));
+    }
+  }
+  return lowest;
+}
+
 DicedModel dice_model(const Model& model, std::span<const char> shareable) {
+  if (!model.pyramids.empty())
+    throw InvalidInput("dice_model: " + describe_element(model, {ElementKind::Pyramid, 0}) +
+                       ": pyramids are not diced; split them into tets first (split_pyramids)");
   const Index V = static_cast<Index>(model.points.size());
   DicedModel out;
   out.points = model.points;
@@ -46,6 +135,8 @@ DicedModel dice_model(const Model& model, std::span<const char> shareable) {
     std::size_t interface_nodes = 0;
     for (const auto& t : model.tets)
       for (Index v : t) share[v] |= in_hex[v];
+    for (const auto& w : model.wedges)
+      for (Index v : w) share[v] = 1;
     for (std::size_t v = 0; v < share.size(); ++v) {
       if (v < shareable.size()) share[v] |= shareable[v];
       interface_nodes += share[v];
@@ -92,6 +183,7 @@ DicedModel dice_model(const Model& model, std::span<const char> shareable) {
   };
   take(dice(hex_part(model)), out.hex_children, out.hex_parent);
   take(dice(tet_part(model)), out.tet_children, out.tet_parent);
+  dice_wedges(model, out);
   return out;
 }
 
@@ -129,24 +221,33 @@ std::vector<NodeSet> diced_node_sets(const Model& model, const DicedModel& diced
 }
 
 std::vector<SideSet> diced_side_sets(const Model& model, const DicedModel& diced,
-                                     Index hex_offset, Index tet_offset) {
+                                     Index hex_offset, Index tet_offset, Index wedge_offset) {
   std::vector<SideSet> sets;
   if (model.side_sets.empty()) return sets;
-  std::vector<std::vector<Index>> hex_children(model.hexes.size()), tet_children(model.tets.size());
-  for (std::size_t c = 0; c < diced.hex_parent.size(); ++c)
-    hex_children[diced.hex_parent[c]].push_back(static_cast<Index>(c));
-  for (std::size_t c = 0; c < diced.tet_parent.size(); ++c)
-    tet_children[diced.tet_parent[c]].push_back(static_cast<Index>(c));
+  if (wedge_offset == kInvalidIndex) wedge_offset = tet_offset + static_cast<Index>(diced.tet_children.size());
+  // Per kind (pyramids have none: they are split before dicing): children, their hexes, offset.
+  struct Part {
+    std::vector<std::vector<Index>> children;
+    const std::vector<std::array<Index, 8>>* hexes = nullptr;
+    Index offset = 0;
+  };
+  std::array<Part, 4> parts;
+  auto part = [&](ElementKind kind, const std::vector<Index>& parent, const std::vector<std::array<Index, 8>>& hexes, Index offset) {
+    Part& p = parts[static_cast<std::size_t>(kind)];
+    p.children.resize(element_count(model, kind));
+    for (std::size_t c = 0; c < parent.size(); ++c) p.children[parent[c]].push_back(static_cast<Index>(c));
+    p.hexes = &hexes;
+    p.offset = offset;
+  };
+  part(ElementKind::Hex, diced.hex_parent, diced.hex_children, hex_offset);
+  part(ElementKind::Tet, diced.tet_parent, diced.tet_children, tet_offset);
+  part(ElementKind::Wedge, diced.wedge_parent, diced.wedge_children, wedge_offset);
   for (const SideSet& ss : model.side_sets) {
     SideSet o{ss.id, ss.name, {}};
     for (const Side& side : ss.sides) {
-      const bool is_hex = side.element.kind == ElementKind::Hex;
-      std::vector<Index> face;
-      if (is_hex) {
-        for (int c : topo::kHexFaceCorners[side.face]) face.push_back(model.hexes[side.element.index][c]);
-      } else {
-        for (int c : topo::kTetFaceCorners[side.face]) face.push_back(model.tets[side.element.index][c]);
-      }
+      const std::vector<Index> face = element_face(model, side);
+      const Part& p = parts[static_cast<std::size_t>(side.element.kind)];
+      if (!p.hexes) continue;
       // A diced node lies on the face when every node it was made from does.
       auto on_face = [&](Index node) {
         const FaceKey& og = diced.origin[node];
@@ -155,13 +256,11 @@ std::vector<SideSet> diced_side_sets(const Model& model, const DicedModel& diced
           if (v != kInvalidIndex && std::find(face.begin(), face.end(), v) == face.end()) return false;
         return true;
       };
-      const auto& children = is_hex ? hex_children[side.element.index] : tet_children[side.element.index];
-      const auto& hexes = is_hex ? diced.hex_children : diced.tet_children;
-      for (Index c : children)
+      for (Index c : p.children[static_cast<std::size_t>(side.element.index)])
         for (int f = 0; f < 6; ++f) {
           bool all = true;
-          for (int k : topo::kHexFaceCorners[f]) all = all && on_face(hexes[c][k]);
-          if (all) o.sides.push_back({{ElementKind::Hex, (is_hex ? hex_offset : tet_offset) + c}, f});
+          for (int k : topo::kHexFaceCorners[f]) all = all && on_face((*p.hexes)[c][k]);
+          if (all) o.sides.push_back({{ElementKind::Hex, p.offset + c}, f});
         }
     }
     sets.push_back(std::move(o));

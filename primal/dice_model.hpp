@@ -1,12 +1,15 @@
 #pragma once
 // Dicing a whole mixed model (primal/model.hpp) over one node array: the hex part 8 per hex,
-// the tet part 4 per tet (primal/dice.hpp), every diced node keeping its origin (the sorted
+// the tet part 4 per tet (primal/dice.hpp), wedges 6 per wedge (one hex at each corner, its
+// axes the corner's edges, topology::kWedgeCornerNeighbors), every diced node keeping its origin (the sorted
 // input nodes it was made from), and the model's node and side sets carried onto the result.
 //
 // A diced edge or face node is made once per part by dice(); the two parts meet it twice only
 // where every origin node is used by both parts (the hex/tet interface) or was marked
 // `shareable` by the caller. Only those nodes go through a hash map (DicedModel::find), so
 // merging costs a few probes per interface face instead of one per diced edge and face.
+// Wedges meet both parts (their quads hexes, their triangles tets): every node of a wedge is
+// shareable. Pyramids are not diced (conform splits them into tets first): InvalidInput.
 #include <span>
 #include <vector>
 
@@ -29,8 +32,8 @@ struct DicedModel {
   // midpoint: its 2 nodes; a face centre: 3 or 4), kNoOrigin for cell centres and added nodes.
   std::vector<FaceKey> origin;
   // Children in global node numbers, each part in its parent's order (dice.hpp's corner order).
-  std::vector<std::array<Index, 8>> hex_children, tet_children;
-  std::vector<Index> hex_parent, tet_parent;  // per child: index into Model::hexes / tets
+  std::vector<std::array<Index, 8>> hex_children, tet_children, wedge_children;
+  std::vector<Index> hex_parent, tet_parent, wedge_parent;  // per child: index into Model::hexes / tets / wedges
 
   Index add_node(const Point& p, const FaceKey& origin_key = kNoOrigin);
   // The node made from the (unsorted) origin nodes `key`: an input node itself, else an edge or
@@ -44,6 +47,11 @@ struct DicedModel {
 // edge and face nodes the caller will look up with find(). Throws InvalidInput from dice().
 DicedModel dice_model(const Model& model, std::span<const char> shareable = {});
 
+// The lowest scaled Jacobian of the 6 hexes each wedge dices into (as dice_model makes them),
+// wedge by wedge: the wedges' part of the yardstick (dice.hpp's diced_min_scaled_jacobian for
+// hexes and tets). 1 when empty.
+double diced_wedge_min_scaled_jacobian(std::span<const Point> points, std::span<const std::array<Index, 6>> wedges);
+
 // The model's node sets on the diced nodes: every input node of a set plus every diced node
 // whose origin nodes are all in it. `renumber` maps a diced node to its output number
 // (kInvalidIndex: dropped).
@@ -51,9 +59,10 @@ std::vector<NodeSet> diced_node_sets(const Model& model, const DicedModel& diced
                                      std::span<const Index> renumber);
 
 // The model's side sets on the diced hexes: each input side becomes the faces of its parent's
-// children lying on it (4 per hex face, 3 per tet face). Output hex numbers are
-// hex_offset + child for hex children and tet_offset + child for tet children.
+// children lying on it (4 per quad, 3 per triangle). Output hex numbers are hex_offset + child
+// for hex children, tet_offset + child for tet children and wedge_offset + child for wedge
+// children (kInvalidIndex: right after the tet children).
 std::vector<SideSet> diced_side_sets(const Model& model, const DicedModel& diced,
-                                     Index hex_offset, Index tet_offset);
+                                     Index hex_offset, Index tet_offset, Index wedge_offset = kInvalidIndex);
 
 }  // namespace geode::primal

@@ -13,10 +13,136 @@
 
 namespace geode::primal {
 
+const topology::CellKindTopology& cell_topology(ElementKind kind) {
+  return topology::kCellKinds[static_cast<std::size_t>(kind)];
+}
+
+const char* element_kind_name(ElementKind kind) { return cell_topology(kind).name; }
+
+int default_block(ElementKind kind) { return static_cast<int>(kind) + 1; }
+
+std::size_t element_count(const Model& model, ElementKind kind) {
+  switch (kind) {
+    case ElementKind::Hex: return model.hexes.size();
+    case ElementKind::Tet: return model.tets.size();
+    case ElementKind::Pyramid: return model.pyramids.size();
+    case ElementKind::Wedge: return model.wedges.size();
+  }
+  return 0;
+}
+
+std::size_t element_count(const Model& model) {
+  std::size_t n = 0;
+  for (ElementKind k : kElementKinds) n += element_count(model, k);
+  return n;
+}
+
+std::span<const Index> element_corners(const Model& model, ElementRef e) {
+  if (e.index < 0 || static_cast<std::size_t>(e.index) >= element_count(model, e.kind)) return {};
+  const auto i = static_cast<std::size_t>(e.index);
+  switch (e.kind) {
+    case ElementKind::Hex: return model.hexes[i];
+    case ElementKind::Tet: return model.tets[i];
+    case ElementKind::Pyramid: return model.pyramids[i];
+    case ElementKind::Wedge: return model.wedges[i];
+  }
+  return {};
+}
+
+std::vector<int>& element_blocks(Model& model, ElementKind kind) {
+  switch (kind) {
+    case ElementKind::Hex: return model.hex_block;
+    case ElementKind::Tet: return model.tet_block;
+    case ElementKind::Pyramid: return model.pyramid_block;
+    case ElementKind::Wedge: break;
+  }
+  return model.wedge_block;
+}
+
+const std::vector<int>& element_blocks(const Model& model, ElementKind kind) {
+  return element_blocks(const_cast<Model&>(model), kind);
+}
+
+std::vector<std::int64_t>& element_ids(Model& model, ElementKind kind) {
+  switch (kind) {
+    case ElementKind::Hex: return model.hex_ids;
+    case ElementKind::Tet: return model.tet_ids;
+    case ElementKind::Pyramid: return model.pyramid_ids;
+    case ElementKind::Wedge: break;
+  }
+  return model.wedge_ids;
+}
+
+const std::vector<std::int64_t>& element_ids(const Model& model, ElementKind kind) {
+  return element_ids(const_cast<Model&>(model), kind);
+}
+
+std::vector<Index> element_face(const Model& model, const Side& side) {
+  const auto corners = element_corners(model, side.element);
+  const auto& topo = cell_topology(side.element.kind);
+  std::vector<Index> face;
+  if (corners.empty() || side.face < 0 || side.face >= topo.faces) return face;
+  const auto& f = topo.face[static_cast<std::size_t>(side.face)];
+  for (int k = 0; k < f.size; ++k) face.push_back(corners[static_cast<std::size_t>(f.corners[static_cast<std::size_t>(k)])]);
+  return face;
+}
+
+void add_element(Model& model, ElementKind kind, std::span<const Index> corners, int block, std::int64_t file_id) {
+  const auto n = static_cast<std::size_t>(cell_topology(kind).corners);
+  auto put = [&](auto& cells) {
+    auto& c = cells.emplace_back();
+    for (std::size_t k = 0; k < n; ++k) c[k] = corners[k];
+  };
+  switch (kind) {
+    case ElementKind::Hex: put(model.hexes); break;
+    case ElementKind::Tet: put(model.tets); break;
+    case ElementKind::Pyramid: put(model.pyramids); break;
+    case ElementKind::Wedge: put(model.wedges); break;
+  }
+  element_blocks(model, kind).push_back(block);
+  element_ids(model, kind).push_back(file_id);
+}
+
+namespace {
+std::array<Index, 4> sorted_key(std::span<const Index> nodes) {
+  std::array<Index, 4> k{kInvalidIndex, kInvalidIndex, kInvalidIndex, kInvalidIndex};
+  std::copy_n(nodes.begin(), std::min<std::size_t>(nodes.size(), 4), k.begin());
+  std::sort(k.begin(), k.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(nodes.size(), 4)));
+  return k;
+}
+}  // namespace
+
+std::size_t FaceOwners::Hash::operator()(const std::array<Index, 4>& k) const {
+  std::size_t h = 0;
+  for (Index v : k) h = h * 0x9E3779B97F4A7C15ull + static_cast<std::size_t>(static_cast<std::uint32_t>(v));
+  return h ^ (h >> 29);
+}
+
+FaceOwners::FaceOwners(const Model& model) {
+  for (ElementKind kind : kElementKinds) {
+    const auto& topo = cell_topology(kind);
+    for (std::size_t e = 0; e < element_count(model, kind); ++e) {
+      const ElementRef ref{kind, static_cast<Index>(e)};
+      const auto corners = element_corners(model, ref);
+      for (int f = 0; f < topo.faces; ++f) {
+        const auto& face = topo.face[static_cast<std::size_t>(f)];
+        std::array<Index, 4> nodes{};
+        for (int k = 0; k < face.size; ++k)
+          nodes[static_cast<std::size_t>(k)] = corners[static_cast<std::size_t>(face.corners[static_cast<std::size_t>(k)])];
+        owner_.emplace(sorted_key(std::span<const Index>(nodes.data(), static_cast<std::size_t>(face.size))), Side{ref, f});
+      }
+    }
+  }
+}
+
+const Side* FaceOwners::find(std::span<const Index> nodes) const {
+  const auto it = owner_.find(sorted_key(nodes));
+  return it == owner_.end() ? nullptr : &it->second;
+}
+
 int block_of(const Model& model, ElementRef element) {
-  if (element.kind == ElementKind::Hex)
-    return model.hex_block.empty() ? 1 : model.hex_block[static_cast<std::size_t>(element.index)];
-  return model.tet_block.empty() ? 2 : model.tet_block[static_cast<std::size_t>(element.index)];
+  const auto& blocks = element_blocks(model, element.kind);
+  return blocks.empty() ? default_block(element.kind) : blocks[static_cast<std::size_t>(element.index)];
 }
 
 std::int64_t node_id(const Model& model, Index node) {
@@ -25,7 +151,7 @@ std::int64_t node_id(const Model& model, Index node) {
 }
 
 std::int64_t element_id(const Model& model, ElementRef element) {
-  const auto& ids = element.kind == ElementKind::Hex ? model.hex_ids : model.tet_ids;
+  const auto& ids = element_ids(model, element.kind);
   const auto e = static_cast<std::size_t>(element.index);
   return e < ids.size() ? ids[e] : std::int64_t{element.index} + 1;
 }
@@ -55,21 +181,13 @@ std::string node_list(const Model& model, std::span<const Index> nodes) {
 
 namespace {
 
-const char* kind_name(ElementKind kind) { return kind == ElementKind::Hex ? "hex" : "tet"; }
-
-// The element's corners, or an empty span when it does not exist.
-std::span<const Index> corners_of(const Model& model, ElementRef e) {
-  const auto i = static_cast<std::size_t>(e.index);
-  if (e.kind == ElementKind::Hex)
-    return e.index >= 0 && i < model.hexes.size() ? std::span<const Index>(model.hexes[i]) : std::span<const Index>();
-  return e.index >= 0 && i < model.tets.size() ? std::span<const Index>(model.tets[i]) : std::span<const Index>();
-}
+const char* kind_name(ElementKind kind) { return element_kind_name(kind); }
 
 }  // namespace
 
 std::string describe_element(const Model& model, ElementRef element) {
   std::string s = std::string(kind_name(element.kind)) + " " + std::to_string(element_id(model, element));
-  const auto corners = corners_of(model, element);
+  const auto corners = element_corners(model, element);
   if (corners.empty()) return s;
   Point centre = Point::Zero();
   for (Index v : corners) {
@@ -81,24 +199,24 @@ std::string describe_element(const Model& model, ElementRef element) {
 
 namespace {
 
-template <std::size_t N>
-void check_elements(const Model& model, const std::vector<std::array<Index, N>>& elements,
-                    ElementKind kind, std::string_view source) {
+void check_elements(const Model& model, ElementKind kind, std::string_view source) {
   const auto num_points = static_cast<Index>(model.points.size());
-  for (std::size_t e = 0; e < elements.size(); ++e)
-    for (std::size_t c = 0; c < N; ++c) {
-      const Index n = elements[e][c];
+  for (std::size_t e = 0; e < element_count(model, kind); ++e) {
+    const auto corners = element_corners(model, {kind, static_cast<Index>(e)});
+    for (std::size_t c = 0; c < corners.size(); ++c) {
+      const Index n = corners[c];
       if (n < 0 || n >= num_points)
         throw InvalidInput(std::string(source) + ": " + kind_name(kind) + " " +
                            std::to_string(element_id(model, {kind, static_cast<Index>(e)})) +
                            ": corner " + std::to_string(c + 1) + " refers to node index " +
                            std::to_string(n) + ", out of range [0, " + std::to_string(num_points) + ")");
     }
+  }
 }
 
-void check_blocks(const Model& model, const std::vector<int>& blocks, ElementKind kind,
-                  std::string_view source) {
-  const std::size_t count = kind == ElementKind::Hex ? model.hexes.size() : model.tets.size();
+void check_blocks(const Model& model, ElementKind kind, std::string_view source) {
+  const std::vector<int>& blocks = element_blocks(model, kind);
+  const std::size_t count = element_count(model, kind);
   if (!blocks.empty() && blocks.size() != count)
     throw InvalidInput(std::string(source) + ": " + kind_name(kind) + " block ids: " +
                        std::to_string(blocks.size()) + " ids for " + std::to_string(count) +
@@ -122,12 +240,11 @@ void check_ids(const std::vector<std::int64_t>& ids, std::size_t count, std::str
 void validate(const Model& model, std::string_view source) {
   const auto num_points = static_cast<Index>(model.points.size());
   check_ids(model.node_ids, model.points.size(), source, "node");
-  check_ids(model.hex_ids, model.hexes.size(), source, "hex");
-  check_ids(model.tet_ids, model.tets.size(), source, "tet");
-  check_elements(model, model.hexes, ElementKind::Hex, source);
-  check_elements(model, model.tets, ElementKind::Tet, source);
-  check_blocks(model, model.hex_block, ElementKind::Hex, source);
-  check_blocks(model, model.tet_block, ElementKind::Tet, source);
+  for (ElementKind kind : kElementKinds) {
+    check_ids(element_ids(model, kind), element_count(model, kind), source, kind_name(kind));
+    check_elements(model, kind, source);
+    check_blocks(model, kind, source);
+  }
   std::unordered_set<int> node_set_ids, side_set_ids;
   for (const NodeSet& set : model.node_sets)
     if (!node_set_ids.insert(set.id).second)
@@ -156,12 +273,11 @@ void validate(const Model& model, std::string_view source) {
     if (set.id <= 0) throw InvalidInput(where + ": id is not positive");
     for (std::size_t i = 0; i < set.sides.size(); ++i) {
       const Side& s = set.sides[i];
-      const bool hex = s.element.kind == ElementKind::Hex;
-      const std::size_t count = hex ? model.hexes.size() : model.tets.size();
-      const int faces = hex ? topology::kHexFaces : 4;
+      const std::size_t count = element_count(model, s.element.kind);
+      const int faces = cell_topology(s.element.kind).faces;
       if (s.element.index < 0 || static_cast<std::size_t>(s.element.index) >= count)
         throw InvalidInput(where + ": entry " + std::to_string(i + 1) + " refers to " +
-                           (hex ? "hex index " : "tet index ") + std::to_string(s.element.index) +
+                           kind_name(s.element.kind) + " index " + std::to_string(s.element.index) +
                            ", out of range");
       if (s.face < 0 || s.face >= faces)
         throw InvalidInput(where + ": entry " + std::to_string(i + 1) + ": " +
@@ -204,6 +320,39 @@ void check_geometry(const Model& model, std::string_view source) {
                            describe_node(model, model.hexes[h][c]) + " (corner Jacobian " +
                            number_text(jacobians[c]) + "; nodes " + node_list(model, model.hexes[h]) + ")");
       }
+  }
+  // A wedge's corner Jacobian: the determinant of its three edges there (topology.hpp's
+  // right-handed kWedgeCornerNeighbors), positive at all six corners.
+  for (std::size_t w = 0; w < model.wedges.size(); ++w) {
+    const auto& c = model.wedges[w];
+    for (std::size_t k = 0; k < 6; ++k) {
+      const auto& n = topology::kWedgeCornerNeighbors[k];
+      const double j = tet_volume(pt(c[k]), pt(c[static_cast<std::size_t>(n[0])]), pt(c[static_cast<std::size_t>(n[1])]),
+                                  pt(c[static_cast<std::size_t>(n[2])])) * 6.0;
+      if (!(j > 0.0)) {
+        const ElementRef e{ElementKind::Wedge, static_cast<Index>(w)};
+        throw InvalidInput(where + ": " + describe_element(model, e) + " is " + (j < 0.0 ? "inverted" : "flat") +
+                           " at its corner " + describe_node(model, c[k]) + " (corner Jacobian " + number_text(j) +
+                           "; nodes " + node_list(model, c) + ")");
+      }
+    }
+  }
+  // A pyramid must split into two positive tets along one of its base diagonals (the tets at
+  // base corners 1 and 3 for the diagonal 0-2, at 0 and 2 for 1-3): what conform makes of it.
+  for (std::size_t p = 0; p < model.pyramids.size(); ++p) {
+    const auto& c = model.pyramids[p];
+    std::array<double, 4> corner{};
+    for (std::size_t k = 0; k < 4; ++k)
+      corner[k] = tet_volume(pt(c[(k + 3) % 4]), pt(c[k]), pt(c[(k + 1) % 4]), pt(c[4]));
+    const bool d02 = corner[1] > 0.0 && corner[3] > 0.0, d13 = corner[0] > 0.0 && corner[2] > 0.0;
+    if (!d02 && !d13) {
+      const auto worst = static_cast<std::size_t>(std::min_element(corner.begin(), corner.end()) - corner.begin());
+      const ElementRef e{ElementKind::Pyramid, static_cast<Index>(p)};
+      throw InvalidInput(where + ": " + describe_element(model, e) + " is " + (corner[worst] < 0.0 ? "inverted" : "flat") +
+                         " at its base corner " + describe_node(model, c[worst]) + " (signed volume " +
+                         number_text(corner[worst]) + " of the tet there, and neither base diagonal gives two " +
+                         "positive tets; nodes " + node_list(model, c) + ")");
+    }
   }
 }
 
@@ -300,6 +449,10 @@ Index merge_coincident_nodes(Model& model, double tolerance) {
     for (Index& v : h) v = map(v);
   for (auto& t : model.tets)
     for (Index& v : t) v = map(v);
+  for (auto& p : model.pyramids)
+    for (Index& v : p) v = map(v);
+  for (auto& w : model.wedges)
+    for (Index& v : w) v = map(v);
   for (NodeSet& set : model.node_sets) {
     for (Index& v : set.nodes) v = map(v);
     for (auto& piece : set.pieces)

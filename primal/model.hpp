@@ -1,34 +1,43 @@
 #pragma once
-// A mixed hex + tet model as read from an input file (Exodus II, Gmsh): one point array shared
-// by both parts, element blocks, named node sets and side sets. This is the input of the
+// A mixed model of linear cells (hexes, tets, pyramids, wedges) as read from an input file
+// (Exodus II, Gmsh, VTK): one point array shared by every part, element blocks, named node sets
+// and side sets. This is the input of the
 // whole-model geode pipeline (interface detection, buffer layer, dicing, templates).
 //
 // Conventions:
 // - Element connectivity is in VTK/Exodus order (primal/topology.hpp); readers convert.
 // - Element order after reading is block by block (Gmsh: ascending block id; Exodus: file
-//   order), hexes and tets in their own arrays; writers emit blocks in ascending id, so a
+//   order), each kind in its own array; writers emit blocks in ascending id, so a
 //   model whose elements are already grouped by ascending block round-trips exactly.
 // - A side is (element, local face) with the face numbered as in topology.hpp
-//   (kHexFaceCorners / kTetFaceCorners), which is the Exodus side number minus one.
+//   (kCellKinds[kind].face), which is the Exodus side number minus one.
+// - Per kind, generic code reads topology::kCellKinds[kind] (corners, faces, edges) and the
+//   accessors below (element_count, element_corners, block_of, element_id) instead of naming
+//   the arrays.
 #include <compare>
 #include <cstdint>
 #include <map>
 #include <span>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 #include <Eigen/Geometry>
 
 #include "primal/mesh.hpp"
+#include "primal/topology.hpp"
 
 namespace geode::primal {
 
-enum class ElementKind : std::uint8_t { Hex, Tet };
+// The index into topology::kCellKinds.
+enum class ElementKind : std::uint8_t { Hex, Tet, Pyramid, Wedge };
+inline constexpr std::array<ElementKind, 4> kElementKinds{ElementKind::Hex, ElementKind::Tet, ElementKind::Pyramid,
+                                                         ElementKind::Wedge};
 
 struct ElementRef {
   ElementKind kind = ElementKind::Hex;
-  Index index = kInvalidIndex;  // into Model::hexes or Model::tets
+  Index index = kInvalidIndex;  // into the kind's array (Model::hexes, tets, pyramids, wedges)
   auto operator<=>(const ElementRef&) const = default;
 };
 
@@ -59,9 +68,14 @@ struct Model {
   std::vector<Point> points;
   std::vector<std::array<Index, 8>> hexes;  // VTK/Exodus HEX8 order
   std::vector<std::array<Index, 4>> tets;   // VTK/Exodus TETRA4 order
-  // Element block id (> 0) per element. Empty means "all in one block": 1 for hexes, 2 for tets.
+  std::vector<std::array<Index, 5>> pyramids;  // VTK/Exodus PYRAMID5 order
+  std::vector<std::array<Index, 6>> wedges;    // Exodus WEDGE6 order (topology.hpp; VTK's is mirrored)
+  // Element block id (> 0) per element. Empty means "all in one block": 1 for hexes, 2 for
+  // tets, 3 for pyramids, 4 for wedges (default_block).
   std::vector<int> hex_block;
   std::vector<int> tet_block;
+  std::vector<int> pyramid_block;
+  std::vector<int> wedge_block;
   std::map<int, std::string> block_names;  // optional
   std::vector<NodeSet> node_sets;
   std::vector<SideSet> side_sets;
@@ -70,6 +84,41 @@ struct Model {
   std::vector<std::int64_t> node_ids;
   std::vector<std::int64_t> hex_ids;
   std::vector<std::int64_t> tet_ids;
+  std::vector<std::int64_t> pyramid_ids;
+  std::vector<std::int64_t> wedge_ids;
+};
+
+// Per kind (kElementKinds): the table, the element count and corners, the block and file-id
+// vectors. element_corners is empty for an element that does not exist.
+const topology::CellKindTopology& cell_topology(ElementKind kind);
+const char* element_kind_name(ElementKind kind);  // "hex", "tet", "pyramid", "wedge"
+int default_block(ElementKind kind);              // 1, 2, 3, 4
+std::size_t element_count(const Model& model, ElementKind kind);
+std::size_t element_count(const Model& model);    // every kind
+std::span<const Index> element_corners(const Model& model, ElementRef element);
+const std::vector<int>& element_blocks(const Model& model, ElementKind kind);
+std::vector<int>& element_blocks(Model& model, ElementKind kind);
+const std::vector<std::int64_t>& element_ids(const Model& model, ElementKind kind);
+std::vector<std::int64_t>& element_ids(Model& model, ElementKind kind);
+// The nodes of local face `face` of the element (topology order: outward), 3 or 4 of them.
+std::vector<Index> element_face(const Model& model, const Side& side);
+// Appends an element of `kind` (its first cell_topology(kind).corners corners), pushing its
+// block and file id onto the kind's vectors (readers fill them for every element).
+void add_element(Model& model, ElementKind kind, std::span<const Index> corners, int block, std::int64_t file_id);
+
+// Every face of every element by its node set -> its first side (kinds in kElementKinds order,
+// elements ascending): what readers match a side set given as faces (Gmsh, VTK) against.
+class FaceOwners {
+ public:
+  explicit FaceOwners(const Model& model);
+  FaceOwners() = default;
+  const Side* find(std::span<const Index> nodes) const;  // 3 or 4 nodes, any order
+
+ private:
+  struct Hash {
+    std::size_t operator()(const std::array<Index, 4>& k) const;
+  };
+  std::unordered_map<std::array<Index, 4>, Side, Hash> owner_;
 };
 
 // What readers check beyond the file's structure.
@@ -102,8 +151,9 @@ void validate(const Model& model, std::string_view source);
 // A node with a NaN or infinite coordinate (every node, used or not): InvalidInput naming
 // `source` and the node by its file id, with its coordinates. Readers always check it.
 void check_points(const Model& model, std::string_view source);
-// What readers refuse beyond structure (validate): check_points, then a tet of signed volume <= 0 and a hex with a corner Jacobian <= 0
-// (topology.hpp's corner frames: inverted, flat or folded). Throws InvalidInput naming `source`
+// What readers refuse beyond structure (validate): check_points, then a tet of signed volume
+// <= 0, a hex or wedge with a corner Jacobian <= 0 (topology.hpp's corner frames: inverted,
+// flat or folded), a pyramid that splits along neither base diagonal into two positive tets. Throws InvalidInput naming `source`
 // and the node or element by its file id, with coordinates.
 void check_geometry(const Model& model, std::string_view source);
 

@@ -62,6 +62,59 @@ inline constexpr std::array<std::array<int, 2>, 6> kTetEdgeCorners{{
 // Triangle: corners counter-clockwise.
 inline constexpr std::array<std::array<int, 2>, 3> kTriEdgeCorners{{{0, 1}, {1, 2}, {2, 0}}};
 
+// Pyramid (VTK_PYRAMID / Exodus PYRAMID5 / Gmsh 5-node pyramid, one order in all three): base
+// 0-1-2-3 counter-clockwise seen from the apex 4. Faces outward in the Exodus side order (the
+// four triangles, then the base).
+inline constexpr int kPyramidApex = 4;
+
+// Wedge (Exodus WEDGE6 / Gmsh 6-node prism order): triangle 0-1-2 counter-clockwise seen from
+// the other triangle 3-4-5, corner 3 + i above corner i. VTK_WEDGE lists the triangles the
+// other way round (its 0-1-2 is clockwise seen from 3-4-5): the VTK readers and writers swap
+// corners 1 <-> 2 and 4 <-> 5 (kVtkWedgeOrder). Faces outward in the Exodus side order: the
+// three quads (0-1 side, 1-2 side, 2-0 side), then the triangles 0-2-1 and 3-4-5.
+inline constexpr std::array<int, 6> kVtkWedgeOrder{0, 2, 1, 3, 5, 4};  // an involution
+
+// The three edges at each corner of a wedge, pointing away from it, in the order making them a
+// right-handed frame (as kHexCornerNeighbors): a wedge's corner Jacobians, and the axes of the
+// hex its dicing puts at that corner.
+inline constexpr std::array<std::array<int, 3>, 6> kWedgeCornerNeighbors{{
+    {1, 2, 3}, {2, 0, 4}, {0, 1, 5}, {5, 4, 0}, {3, 5, 1}, {4, 3, 2}}};
+// The same for a tetrahedron: (1, 2, 3) at 0 is right-handed for a positive tet, and every
+// even permutation keeps it.
+inline constexpr std::array<std::array<int, 3>, 4> kTetCornerNeighbors{{
+    {1, 2, 3}, {0, 3, 2}, {3, 0, 1}, {2, 1, 0}}};
+
+// The linear cell kinds of a model as one table, indexed by primal::ElementKind (hex, tet,
+// pyramid, wedge): corner count, faces (outward, counter-clockwise seen from outside, in the
+// Exodus side order, so local face f is Exodus side f + 1) and edges. Generic code (model
+// checks, face maps of readers, side sets, dicing) reads these instead of spelling kinds out.
+struct CellFace {
+  int size = 0;                  // 3 or 4
+  std::array<int, 4> corners{};  // the first `size` are used
+};
+
+struct CellKindTopology {
+  const char* name;  // as messages name the cell: "hex", "tet", "pyramid", "wedge"
+  int corners;
+  int faces;
+  std::array<CellFace, 6> face;
+  int edges;
+  std::array<std::array<int, 2>, 12> edge;
+};
+
+inline constexpr std::array<CellKindTopology, 4> kCellKinds{{
+    {"hex", 8, 6,
+     {{{4, {0, 1, 5, 4}}, {4, {1, 2, 6, 5}}, {4, {2, 3, 7, 6}}, {4, {3, 0, 4, 7}}, {4, {0, 3, 2, 1}}, {4, {4, 5, 6, 7}}}},
+     12,
+     {{{0, 1}, {3, 2}, {4, 5}, {7, 6}, {0, 3}, {1, 2}, {4, 7}, {5, 6}, {0, 4}, {1, 5}, {2, 6}, {3, 7}}}},
+    {"tet", 4, 4, {{{3, {0, 1, 3}}, {3, {1, 2, 3}}, {3, {2, 0, 3}}, {3, {0, 2, 1}}}}, 6,
+     {{{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}}}},
+    {"pyramid", 5, 5, {{{3, {0, 1, 4}}, {3, {1, 2, 4}}, {3, {2, 3, 4}}, {3, {3, 0, 4}}, {4, {0, 3, 2, 1}}}}, 8,
+     {{{0, 1}, {1, 2}, {2, 3}, {3, 0}, {0, 4}, {1, 4}, {2, 4}, {3, 4}}}},
+    {"wedge", 6, 5, {{{4, {0, 1, 4, 3}}, {4, {1, 2, 5, 4}}, {4, {2, 0, 3, 5}}, {3, {0, 2, 1}}, {3, {3, 4, 5}}}}, 9,
+     {{{0, 1}, {1, 2}, {2, 0}, {3, 4}, {4, 5}, {5, 3}, {0, 3}, {1, 4}, {2, 5}}}},
+}};
+
 // The cells of a d-dimensional mesh as one trait, for code written once for hex (3) and quad
 // (2) meshes: corners, facets (what two neighbouring cells share: hex faces, quad edges),
 // edges and their parallel class.

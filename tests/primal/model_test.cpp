@@ -1,0 +1,135 @@
+// The cell-kind table (topology::kCellKinds) checked on reference cells: every face outward
+// (its area vector points away from the centre, and they sum to zero: a closed surface), every
+// edge on exactly two faces, Euler's V - E + F = 2; the corner frames right-handed; and the
+// read-time geometry checks refusing inverted wedges and pyramids by their file ids.
+#include "primal/model.hpp"
+
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <string>
+
+#include "primal/errors.hpp"
+#include "primal/topology.hpp"
+
+using namespace geode::primal;
+namespace topo = geode::primal::topology;
+
+namespace {
+
+// Reference cells in the table's corner order, positively oriented.
+std::vector<Point> reference_corners(ElementKind kind) {
+  switch (kind) {
+    case ElementKind::Hex: {
+      std::vector<Point> p;
+      for (const auto& c : topo::kHexCornerCoords) p.emplace_back(c[0], c[1], c[2]);
+      return p;
+    }
+    case ElementKind::Tet: return {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    case ElementKind::Pyramid: return {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0.5, 0.5, 1}};
+    case ElementKind::Wedge: return {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {0, 1, 1}};
+  }
+  return {};
+}
+
+Model one_cell(ElementKind kind, std::vector<Point> points) {
+  Model m;
+  m.points = std::move(points);
+  std::vector<Index> c(m.points.size());
+  for (std::size_t i = 0; i < c.size(); ++i) c[i] = static_cast<Index>(i);
+  switch (kind) {
+    case ElementKind::Hex: m.hexes.push_back({c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]}); m.hex_ids = {41}; break;
+    case ElementKind::Tet: m.tets.push_back({c[0], c[1], c[2], c[3]}); m.tet_ids = {42}; break;
+    case ElementKind::Pyramid: m.pyramids.push_back({c[0], c[1], c[2], c[3], c[4]}); m.pyramid_ids = {43}; break;
+    case ElementKind::Wedge: m.wedges.push_back({c[0], c[1], c[2], c[3], c[4], c[5]}); m.wedge_ids = {44}; break;
+  }
+  return m;
+}
+
+}  // namespace
+
+TEST_CASE("cell kinds: faces outward and closed, edges on two faces, Euler") {
+  for (ElementKind kind : kElementKinds) {
+    const auto& t = cell_topology(kind);
+    const auto p = reference_corners(kind);
+    CAPTURE(t.name);
+    REQUIRE(static_cast<int>(p.size()) == t.corners);
+    Point centre = Point::Zero();
+    for (const Point& x : p) centre += x / static_cast<double>(p.size());
+    Point total = Point::Zero();
+    std::vector<int> edge_uses(static_cast<std::size_t>(t.edges), 0);
+    for (int f = 0; f < t.faces; ++f) {
+      const auto& face = t.face[static_cast<std::size_t>(f)];
+      Point area = Point::Zero(), fc = Point::Zero();
+      for (int k = 0; k < face.size; ++k) {
+        const Point& a = p[static_cast<std::size_t>(face.corners[static_cast<std::size_t>(k)])];
+        const Point& b = p[static_cast<std::size_t>(face.corners[static_cast<std::size_t>((k + 1) % face.size)])];
+        area += a.cross(b) / 2.0;
+        fc += a / face.size;
+        const auto [lo, hi] = std::minmax(face.corners[static_cast<std::size_t>(k)],
+                                          face.corners[static_cast<std::size_t>((k + 1) % face.size)]);
+        int found = 0;
+        for (int e = 0; e < t.edges; ++e) {
+          const auto& ed = t.edge[static_cast<std::size_t>(e)];
+          if (std::min(ed[0], ed[1]) == lo && std::max(ed[0], ed[1]) == hi) ++edge_uses[static_cast<std::size_t>(e)], ++found;
+        }
+        CHECK(found == 1);
+      }
+      CHECK(area.dot(fc - centre) > 0.0);
+      total += area;
+    }
+    CHECK(total.norm() < 1e-12);
+    for (int u : edge_uses) CHECK(u == 2);
+    CHECK(t.corners - t.edges + t.faces == 2);
+  }
+  CHECK(topo::kCellKinds[0].face[3].corners == std::array<int, 4>{3, 0, 4, 7});  // the hex table agrees
+  for (int f = 0; f < 6; ++f)
+    for (int k = 0; k < 4; ++k)
+      CHECK(topo::kCellKinds[0].face[static_cast<std::size_t>(f)].corners[static_cast<std::size_t>(k)] ==
+            topo::kHexFaceCorners[static_cast<std::size_t>(f)][static_cast<std::size_t>(k)]);
+}
+
+TEST_CASE("cell kinds: wedge and tet corner frames are right-handed on the reference cells") {
+  const auto w = reference_corners(ElementKind::Wedge);
+  for (std::size_t c = 0; c < 6; ++c) {
+    const auto& n = topo::kWedgeCornerNeighbors[c];
+    CHECK(tet_volume(w[c], w[static_cast<std::size_t>(n[0])], w[static_cast<std::size_t>(n[1])], w[static_cast<std::size_t>(n[2])]) > 0.0);
+  }
+  const auto t = reference_corners(ElementKind::Tet);
+  for (std::size_t c = 0; c < 4; ++c) {
+    const auto& n = topo::kTetCornerNeighbors[c];
+    CHECK(tet_volume(t[c], t[static_cast<std::size_t>(n[0])], t[static_cast<std::size_t>(n[1])], t[static_cast<std::size_t>(n[2])]) > 0.0);
+  }
+}
+
+TEST_CASE("model: accessors, blocks and ids per kind") {
+  Model m = one_cell(ElementKind::Wedge, reference_corners(ElementKind::Wedge));
+  CHECK(element_count(m) == 1);
+  CHECK(block_of(m, {ElementKind::Wedge, 0}) == default_block(ElementKind::Wedge));
+  CHECK(element_id(m, {ElementKind::Wedge, 0}) == 44);
+  CHECK(describe_element(m, {ElementKind::Wedge, 0}).rfind("wedge 44 (centre", 0) == 0);
+  CHECK(element_face(m, {{ElementKind::Wedge, 0}, 4}) == std::vector<Index>{3, 4, 5});
+  CHECK_NOTHROW(validate(m, "w.msh"));
+  CHECK_NOTHROW(check_geometry(m, "w.msh"));
+  m.wedge_block = {0};
+  CHECK_THROWS_WITH_AS(validate(m, "w.msh"), doctest::Contains("wedge 44: block id 0"), geode::InvalidInput);
+  m.wedge_block = {};
+  m.side_sets.push_back({1, "s", {{{ElementKind::Wedge, 0}, 5}}});
+  CHECK_THROWS_WITH_AS(validate(m, "w.msh"), doctest::Contains("face 6 out of range [1, 5]"), geode::InvalidInput);
+}
+
+TEST_CASE("model: inverted wedges and pyramids refused by their file ids") {
+  auto w = reference_corners(ElementKind::Wedge);
+  std::swap(w[1], w[2]), std::swap(w[4], w[5]);  // VTK's order read as ours: mirrored
+  CHECK_THROWS_WITH_AS(check_geometry(one_cell(ElementKind::Wedge, w), "in.vtu"),
+                       doctest::Contains("in.vtu: wedge 44 (centre"), geode::InvalidInput);
+  auto p = reference_corners(ElementKind::Pyramid);
+  CHECK_NOTHROW(check_geometry(one_cell(ElementKind::Pyramid, p), "in.msh"));
+  p[4].z() = -1.0;  // apex below the base
+  CHECK_THROWS_WITH_AS(check_geometry(one_cell(ElementKind::Pyramid, p), "in.msh"),
+                       doctest::Contains("in.msh: pyramid 43 (centre"), geode::InvalidInput);
+  // A non-convex base: one diagonal still gives two positive tets, so it is accepted.
+  p = reference_corners(ElementKind::Pyramid);
+  p[2] = Point(0.3, 0.3, 0.0);
+  CHECK_NOTHROW(check_geometry(one_cell(ElementKind::Pyramid, p), "in.msh"));
+}
