@@ -14,7 +14,7 @@
 // already taken gets id + 10^k, 10^k the smallest power of ten above every id in the model
 // (side sets first, then node sets, each in model order).
 // Node tags are index + 1; element tags run from 1 over the blocks in ascending id (cell kinds
-// in the table's order within a block), then the side sets' faces, then the node sets' points.
+// in primal::kElementKinds order within a block: hexes, tets, pyramids, wedges), then the side sets' faces, then the node sets' points.
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -38,39 +38,6 @@ using namespace primal;
 namespace {
 
 constexpr int kTri3 = 2, kQuad4 = 3, kPoint = 15;
-
-// The Model's volume cell kinds as Gmsh element types, in the order they are written within a
-// block: gmsh corner gmsh_from_vtk[i] of a cell is VTK corner i (gmsh.hpp's kGmsh*ToVtk).
-// A new cell kind of the Model is one row here and one case in cells_of below.
-struct VolumeKind {
-  ElementKind kind;
-  int gmsh_type;
-  std::size_t corners;
-  std::array<int, 8> gmsh_from_vtk;
-};
-constexpr VolumeKind kVolumeKinds[] = {
-    {ElementKind::Hex, 5, 8, kGmshHexToVtk},
-    {ElementKind::Tet, 4, 4, {kGmshTetToVtk[0], kGmshTetToVtk[1], kGmshTetToVtk[2], kGmshTetToVtk[3]}},
-    // pyramid (Gmsh 7, 5 corners) and wedge (Gmsh 6, 6 corners): rows to add with the Model's
-    // pyramid and wedge arrays (branch hybrid).
-};
-
-// The cells of one kind as (count, corners of cell i).
-struct CellArray {
-  std::size_t size = 0;
-  std::size_t stride = 0;
-  const Index* data = nullptr;
-  std::span<const Index> corners(std::size_t i) const { return {data + i * stride, stride}; }
-};
-CellArray cells_of(const Model& m, ElementKind kind) {
-  switch (kind) {
-    case ElementKind::Hex:
-      return {m.hexes.size(), 8, m.hexes.empty() ? nullptr : m.hexes.front().data()};
-    case ElementKind::Tet:
-      return {m.tets.size(), 4, m.tets.empty() ? nullptr : m.tets.front().data()};
-  }
-  return {};
-}
 
 // One entity block of $Elements: its entity and type, and each element's Gmsh node tags.
 struct ElementBlock {
@@ -137,20 +104,24 @@ class MshLayout {
   }
 
   void volumes() {
+    // Every cell kind of the model through gmsh.hpp's table (kGmshCells: the Gmsh type and
+    // corner order per primal::ElementKind), in its order within a block.
     std::map<int, std::vector<ElementBlock>> by_block;
-    for (const VolumeKind& k : kVolumeKinds) {
-      const CellArray cells = cells_of(m_, k.kind);
-      for (std::size_t i = 0; i < cells.size; ++i) {
-        const int block = block_of(m_, {k.kind, static_cast<Index>(i)});
+    for (ElementKind kind : kElementKinds) {
+      const GmshCell& cell = kGmshCells[static_cast<std::size_t>(kind)];
+      const auto corners = static_cast<std::size_t>(cell.corners);
+      for (std::size_t i = 0; i < element_count(m_, kind); ++i) {
+        const ElementRef ref{kind, static_cast<Index>(i)};
+        const int block = block_of(m_, ref);
         auto& list = by_block[block];
-        if (list.empty() || list.back().type != k.gmsh_type)
-          list.push_back({3, block, block, k.gmsh_type, k.corners, {}, 0});
+        if (list.empty() || list.back().type != cell.type) list.push_back({3, block, block, cell.type, corners, {}, 0});
         auto& tags = list.back().node_tags;
         const std::size_t base = tags.size();
-        tags.resize(base + k.corners);
-        const auto c = cells.corners(i);
-        for (std::size_t v = 0; v < k.corners; ++v)
-          tags[base + static_cast<std::size_t>(k.gmsh_from_vtk[v])] = static_cast<std::size_t>(c[v]) + 1;
+        tags.resize(base + corners);
+        const auto c = element_corners(m_, ref);
+        // gmsh_corner[order[i]] = model_corner[i]
+        for (std::size_t v = 0; v < corners; ++v)
+          tags[base + static_cast<std::size_t>(cell.order[v])] = static_cast<std::size_t>(c[v]) + 1;
       }
     }
     for (auto& [block, list] : by_block) {
@@ -205,13 +176,8 @@ class MshLayout {
       const int physical = side_tags_[s], entity = physical;
       ElementBlock tri{2, entity, physical, kTri3, 3, {}, 0}, quad{2, entity, physical, kQuad4, 4, {}, 0};
       for (const Side& side : set.sides) {
-        const auto e = static_cast<std::size_t>(side.element.index);
-        const auto f = static_cast<std::size_t>(side.face);
-        if (side.element.kind == ElementKind::Hex) {
-          for (int c : topology::kHexFaceCorners[f]) quad.node_tags.push_back(static_cast<std::size_t>(m_.hexes[e][static_cast<std::size_t>(c)]) + 1);
-        } else {
-          for (int c : topology::kTetFaceCorners[f]) tri.node_tags.push_back(static_cast<std::size_t>(m_.tets[e][static_cast<std::size_t>(c)]) + 1);
-        }
+        const std::vector<Index> face = element_face(m_, side);
+        for (Index v : face) (face.size() == 4 ? quad : tri).node_tags.push_back(static_cast<std::size_t>(v) + 1);
       }
       std::vector<std::size_t> all = tri.node_tags;
       all.insert(all.end(), quad.node_tags.begin(), quad.node_tags.end());

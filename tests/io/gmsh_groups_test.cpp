@@ -9,6 +9,8 @@
 #include <fstream>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "io/gmsh.hpp"
 #include "io/read_warnings.hpp"
 #include "primal/dice_model.hpp"
@@ -145,4 +147,20 @@ TEST_CASE("a node set from a physical curve on two parallel edges stays on those
     CHECK(p.z() == 0.0);
     CHECK((p.y() == 0.0 || p.y() == 1.0));  // on edge 1-2 or 4-3, never the face centre (0.5, 0.5)
   }
+}
+
+TEST_CASE("names read from a file are made safe: no bad UTF-8 reaches a JSON report") {
+  // A block name with a byte that is not UTF-8 once made `conform --report` exit 1 after all
+  // the work (nlohmann::json type_error 316); readers now apply io/names.hpp's rule.
+  const std::string text =
+      "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
+      "$PhysicalNames\n1\n3 4 \"st\xff\x01\"\n$EndPhysicalNames\n"
+      "$Nodes\n8\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n5 0 0 1\n6 1 0 1\n7 1 1 1\n8 0 1 1\n$EndNodes\n"
+      "$Elements\n1\n1 5 2 4 1 1 2 3 4 5 6 7 8\n$EndElements\n";
+  const test::TempDir dir;
+  const fs::path file = dir.path / "name.msh";
+  write_text(file, text);
+  const Model m = read_gmsh(file);
+  CHECK(m.block_names.at(4) == "st\xEF\xBF\xBD");
+  CHECK_NOTHROW((void)nlohmann::json(m.block_names.at(4)).dump());
 }

@@ -221,3 +221,34 @@ TEST_CASE("a write that fails (full disk, file size limit) says so, naming the o
   CHECK(exo_message.find(".tmp") == std::string::npos);
   CHECK(fs::is_empty(dir.path));  // no output, no temporary file
 }
+
+TEST_CASE("write_gmsh: pyramids and wedges (every cell kind of the model) read back, by us and by Gmsh") {
+  Model m;
+  m.points = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0.5, 0.5, 1},                  // pyramid
+              {2, 0, 0}, {3, 0, 0}, {2, 1, 0}, {2, 0, 1}, {3, 0, 1}, {2, 1, 1}};           // wedge
+  m.pyramids.push_back({0, 1, 2, 3, 4});
+  m.wedges.push_back({5, 6, 7, 8, 9, 10});
+  m.pyramid_block = {3};
+  m.wedge_block = {4};
+  m.block_names = {{3, "pyramid"}, {4, "wedge"}};
+  m.side_sets.push_back({7, "bases", {{{ElementKind::Pyramid, 0}, 4}, {{ElementKind::Wedge, 0}, 3}}});
+  const test::TempDir dir;
+  for (const Variant& v : kVariants) {
+    CAPTURE(v.name);
+    const fs::path file = dir.path / (std::string(v.name) + ".msh");
+    write_gmsh(m, file, v.format, v.version);
+    const Model r = read_gmsh(file);
+    CHECK(r.points == m.points);
+    CHECK(r.pyramids == m.pyramids);
+    CHECK(r.wedges == m.wedges);
+    CHECK(r.pyramid_block == m.pyramid_block);
+    CHECK(r.wedge_block == m.wedge_block);
+    CHECK(r.block_names == m.block_names);
+    REQUIRE(r.side_sets.size() == 1);
+    CHECK(r.side_sets[0].sides == m.side_sets[0].sides);
+    const auto groups = gmsh_groups(file);
+    CHECK(groups.at({3, 3}) == std::pair<std::string, std::size_t>{"pyramid", 1});
+    CHECK(groups.at({3, 4}) == std::pair<std::string, std::size_t>{"wedge", 1});
+    CHECK(groups.at({2, 7}) == std::pair<std::string, std::size_t>{"bases", 2});
+  }
+}
