@@ -193,6 +193,9 @@ void Conformer::find_interface() {
   // A model without a hex part or a tet part has no transition to make: it is simply diced.
   if (!input_.hexes.empty() && !input_.tets.empty())
     interface_ = primal::find_interface(input_, options_.interface_tolerance);
+  // Both parts but no shared quad: the parts were meshed apart (unmerged nodes, a gap).
+  if (!input_.hexes.empty() && !input_.tets.empty() && interface_.quads.empty())
+    throw InvalidInput("conform: the hex part and the tet part share no interface quad");
   check_wedges();
   res_.interface_quads = static_cast<Index>(interface_.quads.size());
   say("interface: " + std::to_string(interface_.quads.size()) + " quads" + took());
@@ -453,7 +456,18 @@ void Conformer::assemble() {
       if (r == kInvalidIndex) r = used++;
       v = r;
     }
-  node_sets_ = primal::diced_node_sets(lm, diced_, renum);
+  // A node set keeps its interface nodes' tet-side duplicates too (the layer model's sets hold
+  // the hex-side copies only), so that a set on the boundary loses no node along the interface.
+  primal::Model sets;
+  sets.points.resize(lm.points.size());
+  sets.node_sets = lm.node_sets;
+  for (primal::NodeSet& ns : sets.node_sets) {
+    const std::size_t n = ns.nodes.size();
+    for (std::size_t i = 0; i < n; ++i)
+      if (const auto v = static_cast<std::size_t>(ns.nodes[i]); v < layer_.top_node.size() && layer_.top_node[v] != kInvalidIndex)
+        ns.nodes.push_back(layer_.top_node[v]);
+  }
+  node_sets_ = primal::diced_node_sets(sets, diced_, renum);
   diced_.origin = {};
   // The points permuted in place: follow each cycle of the renumbering (dropped nodes go to
   // the tail, then are cut off).

@@ -164,7 +164,8 @@ struct ConformResult {
 // tets, tets only) has no interface and is simply diced. Throws TopologyError from
 // find_interface / insert_buffer_layer (named by them), when a side face is shared by more
 // than two buffer hexes, when the side faces of two buffer hexes do not match, or when a wedge
-// touches the hex/tet interface (not supported yet); InvalidInput when the model is empty. A result whose
+// touches the hex/tet interface (not supported yet); InvalidInput when the model is empty or
+// has both parts but no interface quad. A result whose
 // validity is not ok() is still returned (with warnings) so that it can be inspected.
 ConformResult conform(const primal::Model& input, const ConformOptions& options = {});
 

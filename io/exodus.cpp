@@ -288,16 +288,27 @@ void write_exodus(const Model& model, const std::filesystem::path& path) {
   validate(model, target);
 
   // Blocks in ascending id, each of one element type; global numbering follows.
+  // An Exodus block holds one element type. A model block of several kinds (Gmsh puts the
+  // pyramids in the tet volume's block) keeps its id for its first kind (kElementKinds order);
+  // each further kind gets a block of its own above every model id, named after it.
   std::map<int, std::vector<ElementRef>> blocks;  // id -> its elements, one kind
+  std::map<std::pair<int, ElementKind>, int> exodus_id;
+  int top = 0;
+  for (ElementKind kind : kElementKinds)
+    for (std::size_t e = 0; e < element_count(model, kind); ++e) top = std::max(top, block_of(model, {kind, static_cast<Index>(e)}));
+  std::map<int, std::string> names = model.block_names;
   for (ElementKind kind : kElementKinds)
     for (std::size_t e = 0; e < element_count(model, kind); ++e) {
       const ElementRef ref{kind, static_cast<Index>(e)};
-      auto& members = blocks[block_of(model, ref)];
-      if (!members.empty() && members.front().kind != kind)
-        throw InvalidInput(target + ": block " + std::to_string(block_of(model, ref)) + " holds both " +
-                           element_kind_name(members.front().kind) + "s and " + element_kind_name(kind) +
-                           "s; an Exodus block holds one element type");
-      members.push_back(ref);
+      const int id = block_of(model, ref);
+      auto [it, inserted] = exodus_id.try_emplace({id, kind}, id);
+      if (inserted && blocks.count(id) && blocks[id].front().kind != kind) {
+        it->second = ++top;
+        const auto name = model.block_names.find(id);
+        names[top] = (name != model.block_names.end() ? name->second : "block " + std::to_string(id)) + " " +
+                     element_kind_name(kind) + "s";
+      }
+      blocks[it->second].push_back(ref);
     }
   std::array<std::vector<int>, 4> global;  // per kind and element: its 1-based file number
   for (ElementKind kind : kElementKinds) global[static_cast<std::size_t>(kind)].resize(element_count(model, kind));
@@ -348,7 +359,7 @@ void write_exodus(const Model& model, const std::filesystem::path& path) {
       if (!conn.empty())
         check(ex_put_conn(exo, EX_ELEM_BLOCK, id, conn.data(), nullptr, nullptr), target,
               "writing block " + std::to_string(id) + " connectivity");
-      if (auto it = model.block_names.find(id); it != model.block_names.end()) block_names.set(b, it->second);
+      if (auto it = names.find(id); it != names.end()) block_names.set(b, it->second);
       ++b;
     }
     if (!blocks.empty()) check(ex_put_names(exo, EX_ELEM_BLOCK, block_names.pointers.data()), target, "writing block names");

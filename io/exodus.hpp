@@ -7,8 +7,10 @@
 // they are kept as data so that the conversion is visible. Side numbers are 1-based in the
 // file and 0-based (topology.hpp face order, which is Exodus's side order) in the Model.
 // Elements are numbered globally in block order in the file; the reader keeps the blocks in
-// file order, the writer writes them in ascending id (elements of two kinds with one id cannot
-// share an Exodus block: writing such a model throws InvalidInput).
+// file order, the writer writes them in ascending id. An Exodus block holds one element type:
+// a model block of several kinds (Gmsh's tet volume with its pyramids) is written as one block
+// per kind, the first kind (hex, tet, pyramid, wedge order) keeping the id, each other one a new
+// id above every model id, named "<block name> <kind>s".
 #include <array>
 #include <filesystem>
 
