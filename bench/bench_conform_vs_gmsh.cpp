@@ -14,6 +14,12 @@
 //                         (defaults: read, interface, buffer layer, dice, templates, local
 //                         smoothing, verify, scaled Jacobian per block, write Exodus)
 //   geode --smooth none   the same without smoothing
+//   floor                 bench_floor model.msh floor.exo: read, dice (hexes 8, tets 4, nodes
+//                         shared through per-node tables), write Exodus; one thread, nothing else
+//   geode --threads 1     the defaults on one thread (the 2-core speed-up)
+//   geode -o .msh/.vtu/.vtk  the defaults writing every other output format (against .exo)
+// Each row prints wall and CPU seconds (user + system, from rusage: on a shared machine the CPU
+// ratio is the steadier one) and the ratios to gmsh subdivide and to the floor.
 // The local smoothing's CPU milliseconds per buffer hex come from geode's report (its
 // smoothing stage alone); the wall-time difference of the two runs is printed beside it.
 // Every child runs `repeats` times; the fastest run is shown (the machine is shared). Output hex

@@ -464,8 +464,10 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     return q;
   };
 
-  // Faces. face_lead[6 p + f]: the first use of that face; face_info[first use]: the number of
-  // uses (1, 2, 3 = more) in bits 0-1, bit 2 set when two uses see it in the same cyclic order.
+  // Faces. face_lead[6 p + f]: the first use of that face; face_info[6 p + f]: the number of
+  // uses (1, 2, 3 = more) in bits 0-1, bit 2 set when two uses see it in the same cyclic order,
+  // the same at every use: the node pass below reads it next to face_lead, at the hex in hand,
+  // instead of at the face's first use (a random read per face and node).
   std::vector<Index> face_lead(6 * nh, kInvalidIndex);
   std::vector<std::uint8_t> face_info(6 * nh, 0);
   // Each face is handled at its smallest node only, so nodes write disjoint slots and run in
@@ -494,7 +496,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
           if (!opposite_cycles(face_nodes(lead / 6, lead % 6), face_nodes(u1 / 6, u1 % 6)))
             info |= 4;
         }
-        face_info[static_cast<std::size_t>(lead)] = info;
+        for (std::size_t k = i; k < j; ++k) face_info[static_cast<std::size_t>(local[k].second)] = info;
         i = j;
       }
     }
@@ -511,7 +513,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     if (uses == 1) boundary.push_back(BoundaryQuad{original[static_cast<std::size_t>(p)], lf, face_nodes(p, lf)});
   }
   auto face_uses = [&](Index p, int lf) {
-    return face_info[static_cast<std::size_t>(face_lead[static_cast<std::size_t>(6 * p + lf)])] & 3;
+    return face_info[static_cast<std::size_t>(6 * p + lf)] & 3;
   };
 
   // Vertices and the edges starting at them (other end larger). An edge's hexes must form one
