@@ -344,7 +344,9 @@ void add_conform_commands(CLI::App& app) {
                  "nugget: a Delaunay tet cube in 26 structured blocks; fulcher: the same with circles\n"
                  "imprinted on three nugget faces, those blocks swept from unstructured quads; fourtri:\n"
                  "beside a Delaunay tet box whose interface quads are split into two or four triangles\n"
-                 "(at random); fourtri-cylinder: the cylinder with half its interface quads in four triangles")
+                 "(at random); fourtri-cylinder: the cylinder with half its interface quads in four triangles;\n"
+                 "potting: six hex parts (boxes, swept cylinders, a tilted box, an L bracket), each its own\n"
+                 "block, in a Delaunay tet potting (n >= 2)")
       ->check(CLI::IsMember(conform::demo_model_names()))
       ->capture_default_str();
   d->add_option("-n,--size", dargs->n, "cells per unit length (1 to 64; default 4; nugget, fulcher round up to even)")
