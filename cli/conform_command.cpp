@@ -37,6 +37,7 @@ struct ConformArgs {
   std::string save_input;
   double merge_tolerance = -1;  // < 0: no merging
   double buffer_thickness = 0;  // 0: the side's default
+  double feature_thickness = conform::BufferLayerOptions{}.feature_thickness;
   std::string buffer_side = "hex";
   std::string pyramids = "split";
   double smooth_target = 0.0;
@@ -59,7 +60,13 @@ void print_summary(const conform::ConformResult& r, std::ostream& os, bool table
      << r.seconds << " s\n";
   for (const auto& b : r.quality) {
     os << "block " << b.block << " \"" << b.name << "\": " << b.report.num_hexes
-       << " hexes, min scaled Jacobian " << conform::block_min_scaled_jacobian(b.report) << "\n";
+       << " hexes, min scaled Jacobian " << conform::block_min_scaled_jacobian(b.report) << " (diced alone "
+       << b.input_diced_min_scaled_jacobian << ")";
+    // Its geode hexes against the input cells around their buffer hexes (the local yardstick).
+    if (b.geode_hexes > 0)
+      os << "; " << b.geode_hexes << " geode hexes, min " << b.geode_min_scaled_jacobian << ", local yardstick "
+         << b.local_yardstick << ", >= " << b.local_ratio << " x their own";
+    os << "\n";
     if (tables) os << primal::format_quality_table(b.report) << "\n";
   }
   // The transition against the input's own elements diced alone (the yardstick).
@@ -70,7 +77,7 @@ void print_summary(const conform::ConformResult& r, std::ostream& os, bool table
   if (r.input_wedges) os << ", " << r.input_diced_wedge_min_scaled_jacobian << " (wedges)";
   os << "; output " << output;
   if (yardstick > 0) os << " = " << output / yardstick << " x the lower";
-  os << "\n";
+  os << "; geode hexes >= " << r.local_yardstick_ratio << " x their local yardstick\n";
 }
 
 // --template-box: three sizes, checked as template --box checks its box.
@@ -123,6 +130,7 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
   opts.geode_block = a.geode_block;
   opts.buffer.side = conform::parse_buffer_side(a.buffer_side);
   opts.buffer.thickness = std::max(a.buffer_thickness, 0.0);  // 0: the side's default
+  opts.buffer.feature_thickness = a.feature_thickness;
   opts.smooth_target = a.smooth_target;
   if (!a.template_box.empty()) opts.template_box = template_box(a.template_box);
   opts.progress = [&progress](const std::string& line) { progress.stage(line); };
@@ -182,17 +190,21 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
       ->capture_default_str();
   c->add_option("--report", a.report, "write a JSON report (counts, validity, quality per output block) to FILE.json");
   c->add_option("--smooth", a.smooth,
-                "worst-first smoothing, model boundary nodes sliding on the boundary; local (default):\n"
-                "near the geode hexes (see --smooth-target); global: every hex below 0.5, then local's\n"
-                "passes where a hex is still below the input diced alone; none: only hexes the placement\n"
-                "inverted are untangled (the report counts them)")
+                "worst-first smoothing; materials never move: nodes on the model boundary and between\n"
+                "blocks slide only in their plane or along their straight edge, and are fixed on curved\n"
+                "surfaces and at corners, so every block keeps its volume; local (default): near the\n"
+                "geode hexes (see --smooth-target); global: every hex below min(0.5, 3 x the input diced\n"
+                "alone), then local's passes where a hex is still below its aim; none: only hexes the\n"
+                "placement inverted are untangled (the report counts them)")
       ->check(CLI::IsMember({"local", "global", "none"}))
       ->capture_default_str();
   c->add_option("--smooth-target", a.smooth_target,
-                "local smoothing: 0 (default) works where the result is worse than the input's own hexes\n"
-                "and tets diced alone (the yardstick), on hexes below 1.1 x it around those until none is\n"
-                "below it, again where they remain (up to 8 passes); a value > 0 works on every geode hex\n"
-                "and neighbour below it (e.g. 0.35: more quality on good inputs, more time)")
+                "local smoothing: 0 (default) works where a hex is below its aim: the input's own hexes\n"
+                "and tets diced alone (the yardstick); for a geode hex 0.9 x its local yardstick (the\n"
+                "input cells around its buffer hex, diced alone; capped by the template's own minimum);\n"
+                "for a diced hex 0.5 x its input hex diced alone; on hexes below 1.1 x their aim around\n"
+                "those until none is below it, again where they remain (up to 8 passes); a value > 0\n"
+                "works on every geode hex and neighbour below it (e.g. 0.35: more quality, more time)")
       ->check(number_check(0, 1))
       ->capture_default_str();
   c->add_option("--quality", a.quality,
@@ -222,6 +234,12 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
                 "of the shortest edge at each interface node; default 0.5 with --buffer-side hex (at most 0.9),\n"
                 "0.3 with tet (at most 0.45)")
       ->check(number_check(0.01, conform::max_buffer_thickness(conform::BufferSide::kHex)));
+  c->add_option("--feature-thickness", a.feature_thickness,
+                "at convex interface corners (faces in three directions more than 30 degrees apart) the\n"
+                "layer is this fraction of its thickness: buffer hexes there taper by their height in two\n"
+                "directions, a thinner layer keeps the geode nearer a box (1: as thick as elsewhere)")
+      ->check(number_check(0.1, 1))
+      ->capture_default_str();
   c->add_option("--template-box", a.template_box,
                 "proportions WxHxD of the box the reference geode template is smoothed in once per\n"
                 "run (H: the buffer hex's thickness direction; default 24x12x24, near the buffer hexes' own;\n"
@@ -266,7 +284,8 @@ void add_conform_commands(CLI::App& app) {
                  "hybrid meshes Gmsh makes in one generate(3), with its pyramids: hybrid (a transfinite hex\n"
                  "box beside a Delaunay tet box), hybrid-cylinder (a swept hex cylinder in a Delaunay box),\n"
                  "boundary-layer (wedge layers extruded on a tet box), hexdominant (hexes, tets, pyramids\n"
-                 "and wedges side by side)")
+                 "and wedges side by side); potting: six hex parts (boxes, swept cylinders, a tilted box, an\n"
+                 "L bracket), each its own block, in a Delaunay tet potting (n >= 2)")
       ->check(CLI::IsMember(demo::demo_model_names()))
       ->capture_default_str();
   d->add_option("-n,--size", dargs->n, "cells per unit length (1 to 64; default 4; nugget, fulcher round up to even)")

@@ -104,6 +104,7 @@ private:
   std::vector<std::vector<Point>> corner_normals_, outer_normals_;
   std::vector<double> shortest_, step_, safe_;
   std::vector<Point> direction_;
+  std::vector<double> feature_;  // per moving node: its thickness factor (feature_thickness at edges and corners)
   GradedEdges quad_edges_;
   std::vector<Index> centre_of_;  // per input node: the quad it is the four-triangle centre of
   std::vector<Index> touched_;    // moving-part cells with a moved node (or a moved centre)
@@ -206,6 +207,14 @@ void BufferBuilder::directions() {
   const char* part = buffer_side_name(opt_.side);
   const double feature_cos = std::cos(opt_.feature_angle * M_PI / 180.0);
   direction_.assign(n_moved_, Point::Zero());
+  feature_.assign(n_moved_, 1.0);
+  // Per node, the sum of (its interface quads' centres - the node): it leans into the moving
+  // part where that part is convex at the node.
+  std::vector<Point> lean(n_moved_, Point::Zero());
+  for (const InterfaceQuad& q : itf_.quads) {
+    const Point c = (pt(q.corners[0]) + pt(q.corners[1]) + pt(q.corners[2]) + pt(q.corners[3])) / 4.0;
+    for (Index v : q.corners) lean[slot(v)] += c - pt(v);
+  }
   for (std::size_t k = 0; k < n_moved_; ++k) {
     const Index v = itf_.nodes[k];
     // Cluster the outer normals into features.
@@ -244,6 +253,17 @@ void BufferBuilder::directions() {
     // concave edges and corners a buffer hex's top stays parallel to its bottom instead of
     // tilting towards the edge (and folding along its diagonal where its neighbour's does not).
     direction_[k] = d / std::max(m, opt_.min_mitre_cos);
+    // At a corner where the moving part is convex (interface faces in three or more directions
+    // more than the feature angle apart) the buffer hexes narrow towards it in two directions by
+    // their height, so a thinner layer there keeps the geode nearer a box. (Along an edge, where
+    // they taper in one, and at concave corners, where they widen, the thinner geode loses more
+    // than the taper costs: tried on lshape, cylinder and nugget.)
+    std::vector<Point> directions_at;
+    for (const Point& n : corner_normals_[k])
+      if (std::none_of(directions_at.begin(), directions_at.end(),
+                       [&](const Point& f) { return f.normalized().dot(n.normalized()) >= feature_cos; }))
+        directions_at.push_back(n);
+    if (directions_at.size() >= 3 && d.dot(lean[k]) > 0.0) feature_[k] = opt_.feature_thickness;
   }
 }
 
@@ -270,13 +290,13 @@ void BufferBuilder::heights() {
       ++quads_at[slot(a)];
     }
   step_.assign(n_moved_, 0.0);  // the node's height; it moves step x direction
-  for (std::size_t k = 0; k < n_moved_; ++k) step_[k] = thickness_ * shortest_[k];
+  for (std::size_t k = 0; k < n_moved_; ++k) step_[k] = feature_[k] * thickness_ * shortest_[k];
   std::vector<double> raised = step_;
   grade_up(raised, quad_edges_, opt_.raise_rate);
   grade_down(step_, quad_edges_, opt_.smooth_rate);
   safe_ = step_;
   for (std::size_t k = 0; k < n_moved_; ++k)
-    step_[k] = std::max(step_[k], std::min(raised[k], thickness_ * mean_quad_edge[k] / (2.0 * quads_at[k])));
+    step_[k] = std::max(step_[k], std::min(raised[k], feature_[k] * thickness_ * mean_quad_edge[k] / (2.0 * quads_at[k])));
   grade_down(step_, quad_edges_, opt_.smooth_rate);
 }
 

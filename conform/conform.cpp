@@ -147,6 +147,7 @@ class Conformer {
   void add_smoothing(const primal::LocalSmoothResult& r);
   void smooth();
   void smooth_defects(primal::LocalSmoothOptions o);
+  std::vector<double> aims() const;
   double measure();                             // every hex, then scan()
   void measure(std::span<const Index> hexes);   // these only, the others unchanged since
   double scan();                                // inverted_ and the minimum from sj_
@@ -178,6 +179,8 @@ class Conformer {
   // by BufferLayerOptions::side), whose block its geode hexes join by default: they fill space
   // that part had.
   std::vector<primal::ElementRef> carved_from_;
+  std::vector<double> hex_diced_, tet_diced_;  // per input hex and tet: diced alone
+  std::vector<Index> diced_parent_;  // per output diced hex (the first ones): its input hex
   std::vector<Index> geode_first_;  // per buffer hex: its first output hex (then one past the last)
 };
 
@@ -187,8 +190,10 @@ void Conformer::find_interface() {
   res_.input_wedges = static_cast<Index>(input_.wedges.size());
   if (primal::element_count(input_) == 0) throw InvalidInput("conform: the model has no elements");
   t0_ = Clock::now();
-  res_.input_diced_hex_min_scaled_jacobian = primal::diced_min_scaled_jacobian(input_.points, input_.hexes);
-  res_.input_diced_tet_min_scaled_jacobian = primal::diced_min_scaled_jacobian(input_.points, input_.tets);
+  hex_diced_ = primal::diced_scaled_jacobian_per_cell(input_.points, input_.hexes);
+  tet_diced_ = primal::diced_scaled_jacobian_per_cell(input_.points, input_.tets);
+  if (!hex_diced_.empty()) res_.input_diced_hex_min_scaled_jacobian = *std::min_element(hex_diced_.begin(), hex_diced_.end());
+  if (!tet_diced_.empty()) res_.input_diced_tet_min_scaled_jacobian = *std::min_element(tet_diced_.begin(), tet_diced_.end());
   res_.input_diced_wedge_min_scaled_jacobian = primal::diced_wedge_min_scaled_jacobian(input_.points, input_.wedges);
   // A model without a hex part or a tet part has no transition to make: it is simply diced.
   if (!input_.hexes.empty() && !input_.tets.empty())
@@ -197,6 +202,19 @@ void Conformer::find_interface() {
   if (!input_.hexes.empty() && !input_.tets.empty() && interface_.quads.empty())
     throw InvalidInput("conform: the hex part and the tet part share no interface quad");
   check_wedges();
+  // The local yardstick: per interface node the lowest element around it, per quad over its nodes.
+  std::vector<double> node_min(input_.points.size(), 1.0);
+  for (std::size_t h = 0; h < input_.hexes.size(); ++h)
+    for (Index v : input_.hexes[h]) node_min[static_cast<std::size_t>(v)] = std::min(node_min[static_cast<std::size_t>(v)], hex_diced_[h]);
+  for (std::size_t t = 0; t < input_.tets.size(); ++t)
+    for (Index v : input_.tets[t]) node_min[static_cast<std::size_t>(v)] = std::min(node_min[static_cast<std::size_t>(v)], tet_diced_[t]);
+  res_.local_yardstick.reserve(interface_.quads.size());
+  for (const primal::InterfaceQuad& q : interface_.quads) {
+    double m = 1.0;
+    for (Index v : q.corners) m = std::min(m, node_min[static_cast<std::size_t>(v)]);
+    if (q.centre != kInvalidIndex) m = std::min(m, node_min[static_cast<std::size_t>(q.centre)]);
+    res_.local_yardstick.push_back(m);
+  }
   res_.interface_quads = static_cast<Index>(interface_.quads.size());
   say("interface: " + std::to_string(interface_.quads.size()) + " quads" + took());
 }
@@ -425,6 +443,7 @@ void Conformer::assemble() {
   std::vector<int> block;
   block.reserve(total);
   for (Index parent : diced_.hex_parent) block.push_back(primal::block_of(lm, {primal::ElementKind::Hex, parent}));
+  diced_parent_ = std::move(diced_.hex_parent);  // per output diced hex: its input hex
   diced_.hex_parent = {};
   geode_first_.reserve(nb + 1);
   for (std::size_t b = 0; b < nb; ++b) {
@@ -626,6 +645,7 @@ void Conformer::smooth() {
     smooth_defects(o);
   } else {
     const auto constraints = primal::boundary_slide_constraints(mesh_);
+    o.target = std::min(o.target, options_.global_target_factor * res_.yardstick());
     add_smoothing(primal::smooth_hexes_local(mesh_, constraints, nullptr, {}, o));
     sj_ = primal::scaled_jacobian_per_hex(mesh_);
     // The global target lifts the whole mesh a little, not a defect to the yardstick: the
@@ -647,45 +667,70 @@ void Conformer::smooth() {
       std::to_string(res_.smoothing.final_min_scaled_jacobian) + took());
 }
 
-// Automatic target. The defects are the hexes below the yardstick (the input's own hexes and
-// tets diced alone: every hex the transition did not touch is above it). Patches start on them
+// Automatic target. The defects are the hexes below their aim (aims(): the yardstick, the
+// input's own hexes and tets diced alone, which every hex the transition did not touch is
+// above; for a geode hex also 0.9 x its local yardstick, so that a transition next to good
+// cells is not measured against the worst tet far away). Patches start on them
 // and on the hexes sharing a node with them (a defect is lifted by moving its neighbours too),
-// at hexes below a target a little above the yardstick, so that the smoother works only where
+// at hexes below a target a little above their aim, so that the smoother works only where
 // the transition is worse than dicing makes anyway and its cost follows the defects; a pass
-// ends as soon as no seed is below the yardstick (the target only gives room to get there). A
+// ends as soon as no seed is below its aim (the target only gives room to get there). A
 // defect whose neighbours are above that target has no room to rise: where defects remain, the
 // pass is repeated around them with a slightly higher target (small steps: a pass costs what
 // lies below its target around the defects). Within a pass each hex seeds one patch: a second
 // one, after a neighbour moved its nodes, mostly repeats work, while the next pass seeds afresh
 // where defects are left.
 constexpr int kDefectRings = 1;
-constexpr double kDefectTarget = 1.1;       // x the yardstick, first pass
+constexpr double kDefectTarget = 1.1;       // x the aim, first pass
 constexpr double kDefectTargetStep = 0.02;  // added to it by each further pass
 constexpr int kDefectPasses = 8;
 constexpr int kDefectVisits = 1;            // patches seeded by one hex in one pass
+constexpr double kLocalAim = 0.9;           // x a geode hex's local yardstick (capped), see aims()
+constexpr double kPartAim = 0.5;            // x a diced hex's input hex diced alone, see aims()
 
 // Keeps sj_ up to date. A pass changes only the hexes sharing a node with its seeds (its
 // region), and every defect was a seed, so the next pass's defects are in the region.
 void Conformer::smooth_defects(primal::LocalSmoothOptions o) {
-  const double yardstick = res_.yardstick();
+  const std::vector<double> aim = aims();
   std::vector<Index> defects;
   for (std::size_t h = 0; h < sj_.size(); ++h)
-    if (sj_[h] < yardstick) defects.push_back(static_cast<Index>(h));
+    if (sj_[h] < aim[h]) defects.push_back(static_cast<Index>(h));
   if (defects.empty()) return;
   const primal::SmoothStart start{sj_, primal::shortest_edge_per_hex(mesh_)};  // floors over all passes
-  o.goal = yardstick;
+  o.goal = 0.0;
+  o.hex_goals = aim;
   o.max_visits = kDefectVisits;
   for (int pass = 0; pass < kDefectPasses && !defects.empty(); ++pass) {
     std::vector<Index> seeds = defects;
     for (int ring = 0; ring < kDefectRings; ++ring) seeds = primal::hexes_around(mesh_, seeds);
-    o.target = kDefectTarget * yardstick + pass * kDefectTargetStep;
+    o.hex_targets.resize(aim.size());
+    for (std::size_t h = 0; h < aim.size(); ++h) o.hex_targets[h] = kDefectTarget * aim[h] + pass * kDefectTargetStep;
     const auto r = primal::smooth_hexes_around(mesh_, seeds, o, &start);
     add_smoothing(r);
     measure(r.region);
     defects.clear();
     for (Index h : r.region)
-      if (sj_[static_cast<std::size_t>(h)] < yardstick) defects.push_back(h);
+      if (sj_[static_cast<std::size_t>(h)] < aim[static_cast<std::size_t>(h)]) defects.push_back(h);
   }
+}
+
+// Per output hex, what the automatic passes aim at: the yardstick; for a geode hex kLocalAim x
+// the lower of its buffer hex's local yardstick and the template's own minimum (what it
+// reaches in an undistorted cell); for a diced hex kPartAim x its input hex diced alone (the
+// hexes the buffer layer squashed); each only where higher than the yardstick.
+std::vector<double> Conformer::aims() const {
+  const double yardstick = res_.yardstick();
+  std::vector<double> aim(sj_.size(), yardstick);
+  // A diced hex squashed by the buffer layer: at least kPartAim x its input hex diced alone,
+  // so that the part keeps its own quality behind the layer.
+  for (std::size_t k = 0; k < diced_parent_.size(); ++k)
+    aim[k] = std::max(yardstick, kPartAim * hex_diced_[static_cast<std::size_t>(diced_parent_[k])]);
+  for (std::size_t b = 0; b + 1 < geode_first_.size(); ++b) {
+    const double local = res_.local_yardstick[static_cast<std::size_t>(layer_.hexes[b].quad)];
+    const double a = std::max(yardstick, kLocalAim * std::min(local, res_.template_min_scaled_jacobian));
+    for (Index h = geode_first_[b]; h < geode_first_[b + 1]; ++h) aim[static_cast<std::size_t>(h)] = a;
+  }
+  return aim;
 }
 
 double Conformer::measure() {
@@ -734,8 +779,29 @@ void Conformer::verify() {
       report.num_hexes = static_cast<Index>(sel.size());
       report.metrics.push_back(primal::summarize_metric(primal::HexMetric::kScaledJacobian, values, sel));
     }
-    res_.quality.push_back({id, name != blocks_.names.end() ? name->second : "block " + std::to_string(id),
-                            std::move(report)});
+    BlockQuality q{id, name != blocks_.names.end() ? name->second : "block " + std::to_string(id),
+                   std::move(report)};
+    for (std::size_t h = 0; h < input_.hexes.size(); ++h)
+      if (primal::block_of(input_, {primal::ElementKind::Hex, static_cast<Index>(h)}) == id)
+        q.input_diced_min_scaled_jacobian = std::min(q.input_diced_min_scaled_jacobian, hex_diced_[h]);
+    for (std::size_t t = 0; t < input_.tets.size(); ++t)
+      if (primal::block_of(input_, {primal::ElementKind::Tet, static_cast<Index>(t)}) == id)
+        q.input_diced_min_scaled_jacobian = std::min(q.input_diced_min_scaled_jacobian, tet_diced_[t]);
+    res_.quality.push_back(std::move(q));
+  }
+  // The geode hexes against their local yardsticks, per block and over all.
+  for (std::size_t b = 0; b + 1 < geode_first_.size(); ++b) {
+    const double local = res_.local_yardstick[static_cast<std::size_t>(layer_.hexes[b].quad)];
+    for (Index h = geode_first_[b]; h < geode_first_[b + 1]; ++h) {
+      const int id = mesh_.block[static_cast<std::size_t>(h)];
+      auto it = std::find_if(res_.quality.begin(), res_.quality.end(), [&](const BlockQuality& q) { return q.block == id; });
+      const double sj = sj_[static_cast<std::size_t>(h)];
+      ++it->geode_hexes;
+      it->geode_min_scaled_jacobian = std::min(it->geode_min_scaled_jacobian, sj);
+      it->local_yardstick = std::min(it->local_yardstick, local);
+      it->local_ratio = std::min(it->local_ratio, sj / local);
+      res_.local_yardstick_ratio = std::min(res_.local_yardstick_ratio, sj / local);
+    }
   }
   sj_ = {};
   say("verification: " + std::string(res_.validity.ok() ? "valid" : "INVALID") + took());

@@ -70,8 +70,18 @@ nlohmann::json report_json(const ConformResult& r) {
   j["seconds"] = r.seconds;
   j["warnings"] = r.warnings;
   j["blocks"] = nlohmann::json::array();
-  for (const auto& b : r.quality)
-    j["blocks"].push_back({{"id", b.block}, {"name", b.name}, {"quality", primal::quality_report_json(b.report)}});
+  j["local_yardstick_ratio"] = r.local_yardstick_ratio;
+  for (const auto& b : r.quality) {
+    nlohmann::json block = {{"id", b.block}, {"name", b.name},
+                            {"quality", primal::quality_report_json(b.report)},
+                            {"input_diced_alone_min_scaled_jacobian", b.input_diced_min_scaled_jacobian}};
+    if (b.geode_hexes > 0)
+      block["geode"] = {{"hexes", b.geode_hexes},
+                        {"min_scaled_jacobian", b.geode_min_scaled_jacobian},
+                        {"local_yardstick", b.local_yardstick},
+                        {"local_ratio", b.local_ratio}};
+    j["blocks"].push_back(std::move(block));
+  }
   return j;
 }
 

@@ -3,7 +3,8 @@
 
 Run: /usr/bin/python3 notebooks-data/plot.py   (needs Debian's python3-matplotlib)
 Writes next to this script: sj-histogram-geode3d.png, shape-height.png, shape-distorted.png,
-interleave-geode3d.png, interleave-geode4tri.png, interleave-geode4tri-domes.png. Reads only CSVs written by `geode study`.
+interleave-geode3d.png, interleave-geode4tri.png, interleave-geode4tri-domes.png, transition-corners.png. Reads only CSVs
+written by `geode study` and bench_transition_study.
 """
 import csv
 import os
@@ -198,6 +199,30 @@ def domes():
     save(fig, f"interleave-{name}.png")
 
 
+def corners():
+    """Geode hexes at hex-part edges and corners, per dihedral angle and kind (bench_transition_study)."""
+    data = rows("transition-corners.csv")
+    kinds = ["flat", "convex edge", "concave edge", "convex corner", "concave corner", "saddle corner"]
+    colours = dict(zip(kinds, ["0.6", "tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple"]))
+    fig, ax = plt.subplots(figsize=(7.5, 4.4))
+    for kind in kinds:
+        sel = [r for r in data if r["kind"] == kind]
+        if not sel:
+            continue
+        x = [float(r["angle"]) for r in sel]
+        ax.scatter(x, [float(r["min_sj_none"]) for r in sel], facecolors="none", edgecolors=colours[kind], s=28)
+        ax.scatter(x, [float(r["min_sj_default"]) for r in sel], color=colours[kind], s=18, label=kind)
+    ax.axhline(0.25, color="k", lw=0.6, ls="--")
+    ax.text(62, 0.255, "target 0.25", fontsize=7)
+    ax.set_xlabel("dihedral angle inside the hex part (degrees; 180 flat)")
+    ax.set_ylabel("min scaled Jacobian of the geode hexes")
+    ax.set_title("Transition at hex-part edges and corners (open: --smooth none, filled: defaults;\n"
+                 "nugget, lshape, potting, cylinder, demo_wedge; bench_transition_study)", fontsize=9)
+    ax.legend(fontsize=7, loc="lower right")
+    ax.set_ylim(0, 0.5)
+    save(fig, "transition-corners.png")
+
+
 if __name__ == "__main__":
     histogram()
     height()
@@ -205,3 +230,4 @@ if __name__ == "__main__":
     interleave("geode3d")
     interleave("geode4tri")
     domes()
+    corners()

@@ -5,6 +5,7 @@
 #include <string>
 
 #include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
 #include "primal/errors.hpp"
@@ -313,7 +314,38 @@ double diced_min(std::span<const Point> points, std::span<const std::array<Index
       [](double a, double b) { return std::min(a, b); });
 }
 
+// Per cell, in parallel.
+template <class Mesh, std::size_t N>
+std::vector<double> diced_each(std::span<const Point> points, std::span<const std::array<Index, N>> cells) {
+  static const auto children = child_weights<Mesh, N>();
+  std::vector<double> out(cells.size(), 1.0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 4096),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t k = range.begin(); k != range.end(); ++k)
+                        for (const auto& w : children) {
+                          HexCorners p;
+                          for (int c = 0; c < 8; ++c) {
+                            Point s = Point::Zero();
+                            for (int i : w[c]) s += points[static_cast<std::size_t>(cells[k][static_cast<std::size_t>(i)])];
+                            p[c] = s / static_cast<double>(w[c].size());
+                          }
+                          out[k] = std::min(out[k], hex_scaled_jacobian(p));
+                        }
+                    });
+  return out;
+}
+
 }  // namespace
+
+std::vector<double> diced_scaled_jacobian_per_cell(std::span<const Point> points,
+                                                   std::span<const std::array<Index, 4>> tets) {
+  return diced_each<TetMesh, 4>(points, tets);
+}
+
+std::vector<double> diced_scaled_jacobian_per_cell(std::span<const Point> points,
+                                                   std::span<const std::array<Index, 8>> hexes) {
+  return diced_each<HexMesh, 8>(points, hexes);
+}
 
 double diced_min_scaled_jacobian(std::span<const Point> points, std::span<const std::array<Index, 4>> tets) {
   return diced_min<TetMesh, 4>(points, tets);

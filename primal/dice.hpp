@@ -53,4 +53,11 @@ DicedQuadMesh dice(const TriMesh& mesh);   // 3 per triangle; like tets
 double diced_min_scaled_jacobian(std::span<const Point> points, std::span<const std::array<Index, 4>> tets);
 double diced_min_scaled_jacobian(std::span<const Point> points, std::span<const std::array<Index, 8>> hexes);
 
+// The same per element: each one's lowest diced scaled Jacobian, in element order (the local
+// yardstick of a transition next to it).
+std::vector<double> diced_scaled_jacobian_per_cell(std::span<const Point> points,
+                                                   std::span<const std::array<Index, 4>> tets);
+std::vector<double> diced_scaled_jacobian_per_cell(std::span<const Point> points,
+                                                   std::span<const std::array<Index, 8>> hexes);
+
 }  // namespace geode::primal

@@ -197,6 +197,7 @@ TEST_CASE("insert_buffer_layer: the nugget's corners move along the cavity diago
     CAPTURE(static_cast<int>(side));
     BufferLayerOptions o = on_side(side);
     o.thickness = 0.25;
+    o.feature_thickness = 1.0;  // one height everywhere (the thinner corner: its own test below)
     const BufferLayer layer = insert_buffer_layer(m, find_interface(m), o);
     CHECK(layer.report.halvings == 0);
     const auto& p = layer.model.points;
@@ -238,6 +239,7 @@ TEST_CASE("insert_buffer_layer: buffer tops parallel to their bottoms at convex 
       REQUIRE(itf.quads.size() == c.quads);
       BufferLayerOptions o = on_side(side);
       o.thickness = height;
+      o.feature_thickness = 1.0;  // one height everywhere
       const BufferLayer layer = insert_buffer_layer(m, itf, o);
       CHECK(layer.report.halvings == 0);
       const auto& p = layer.model.points;
@@ -253,6 +255,37 @@ TEST_CASE("insert_buffer_layer: buffer tops parallel to their bottoms at convex 
       }
       CHECK(layer.report.min_scaled_jacobian > 0.0);
     }
+}
+
+TEST_CASE("insert_buffer_layer: a thinner layer at corners where the moving part is convex only") {
+  // A 2 x 2 x 2 hex block inside tets (hex side: the hexes are convex at the block's corners)
+  // and the same cavity as tets inside hexes (hex side: concave there). The corner copies stand
+  // feature_thickness x the height from each of their three faces where the moving part is
+  // convex, the full height where it is concave.
+  const double height = 0.25;
+  for (const bool block : {true, false}) {
+    CAPTURE(block);
+    const Model m = grid_model({4, 4, 4}, 1.0, [block](int i, int j, int k) {
+      const bool inside = i >= 1 && i <= 2 && j >= 1 && j <= 2 && k >= 1 && k <= 2;
+      return block ? !inside : inside;
+    });
+    BufferLayerOptions o = on_side(BufferSide::kHex);
+    o.thickness = height;
+    const BufferLayer layer = insert_buffer_layer(m, find_interface(m), o);
+    const auto& p = layer.model.points;
+    int corners = 0;
+    for (int x : {1, 3})
+      for (int y : {1, 3})
+        for (int z : {1, 3}) {
+          const Index v = x + 5 * (y + 5 * z);
+          const Point d = (p[static_cast<std::size_t>(layer.top_node[static_cast<std::size_t>(v)])] - p[static_cast<std::size_t>(v)]).cwiseAbs();
+          const double expected = block ? o.feature_thickness * height : height;
+          for (int a = 0; a < 3; ++a) CHECK(d[a] == doctest::Approx(expected).epsilon(1e-12));
+          ++corners;
+        }
+    CHECK(corners == 8);
+    CHECK(layer.report.min_scaled_jacobian > 0.0);
+  }
 }
 
 TEST_CASE("insert_buffer_layer: one short tet edge does not twist the buffer tops around it") {

@@ -109,17 +109,23 @@ TEST_CASE("buffer carved from the hex part: the tets stay as meshed, geode hexes
 }
 
 TEST_CASE("realistic models, default and global smoothing: valid, untangled, at least the yardstick") {
+  // The floor as a multiple of the yardstick: 1, but on the n = 2 nugget, where every buffer
+  // hex is at a nugget edge or corner and the nodes on the nugget's faces may only slide in
+  // them (its edges' along them, its corners not at all: materials never move), smoothing
+  // lifts the geode hexes from 0.129 to 0.248 (0.86 x) locally, 0.221 (0.77 x) with global
+  // smoothing; they reached the yardstick only by moving the interface.
   const struct {
     const char* name;
     int n;
     conform::ConformSmooth smooth;
-  } models[] = {{"delaunay-random", 2, conform::ConformSmooth::kLocal},
-                {"cylinder", 2, conform::ConformSmooth::kLocal},
-                {"nugget", 2, conform::ConformSmooth::kLocal},
-                {"fulcher", 4, conform::ConformSmooth::kLocal},
-                {"nugget", 2, conform::ConformSmooth::kGlobal},
-                {"lshape", 2, conform::ConformSmooth::kGlobal}};
-  for (const auto& [name, n, smooth] : models) {
+    double floor;
+  } models[] = {{"delaunay-random", 2, conform::ConformSmooth::kLocal, 1.0},
+                {"cylinder", 2, conform::ConformSmooth::kLocal, 1.0},
+                {"nugget", 2, conform::ConformSmooth::kLocal, 0.85},
+                {"fulcher", 4, conform::ConformSmooth::kLocal, 1.0},
+                {"nugget", 2, conform::ConformSmooth::kGlobal, 0.75},
+                {"lshape", 2, conform::ConformSmooth::kGlobal, 1.0}};
+  for (const auto& [name, n, smooth, floor] : models) {
     CAPTURE(name);
     const bool global = smooth == conform::ConformSmooth::kGlobal;
     CAPTURE(global);
@@ -133,7 +139,7 @@ TEST_CASE("realistic models, default and global smoothing: valid, untangled, at 
     // lifted there). Global smoothing's own target (0.5) leaves such defects to the local passes
     // that follow it.
     const double yardstick = r.yardstick();
-    CHECK(r.smoothing.final_min_scaled_jacobian >= yardstick);
+    CHECK(r.smoothing.final_min_scaled_jacobian >= floor * yardstick);
     // The yardstick is measured on the input itself: Delaunay tets are far from the diced
     // Kuhn cube's 0.29, the swept hexes of the cylinder and the imprinted faces far from 1.
     CHECK(r.input_diced_tet_min_scaled_jacobian > 0.0);

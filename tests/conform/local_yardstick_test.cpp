@@ -1,0 +1,91 @@
+// The local yardstick (ConformResult::local_yardstick): per buffer hex, the lowest of the input
+// hexes and tets sharing a node with its interface quad, each diced alone, recomputed here
+// from its definition on the potting and lshape demos; the per-block figures (input diced
+// alone, geode minimum, local ratio) read back from the output mesh.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <array>
+#include <map>
+#include <span>
+#include <string>
+
+#include "conform/conform.hpp"
+#include "conform/demo_models.hpp"
+#include "primal/dice.hpp"
+#include "primal/interface.hpp"
+#include "primal/quality.hpp"
+#include "support/conform_checks.hpp"
+
+using namespace geode;
+using primal::Index;
+
+TEST_CASE("the local yardstick: the input cells around each buffer hex, diced alone; per block figures") {
+  for (const auto& [name, n] : {std::pair{"potting", 2}, std::pair{"lshape", 3}}) {
+    const std::string model_name = name;
+    CAPTURE(model_name);
+    const primal::Model input = conform::demo_model(name, n);
+    const conform::ConformResult r = conform::conform(input);
+    test::check_conform_result(r);
+    const primal::Interface itf = primal::find_interface(input);
+    REQUIRE(r.local_yardstick.size() == itf.quads.size());
+    // Each element diced alone, one at a time.
+    auto hex_alone = [&](std::size_t h) {
+      return primal::diced_min_scaled_jacobian(input.points, std::span(&input.hexes[h], 1));
+    };
+    auto tet_alone = [&](std::size_t t) {
+      return primal::diced_min_scaled_jacobian(input.points, std::span(&input.tets[t], 1));
+    };
+    double lowest_local = 1.0;
+    for (std::size_t q = 0; q < itf.quads.size(); ++q) {
+      const auto& c = itf.quads[q].corners;
+      auto touches = [&](std::span<const Index> nodes) {
+        return std::any_of(nodes.begin(), nodes.end(), [&](Index v) { return std::find(c.begin(), c.end(), v) != c.end(); });
+      };
+      double expected = 1.0;
+      for (std::size_t h = 0; h < input.hexes.size(); ++h)
+        if (touches(input.hexes[h])) expected = std::min(expected, hex_alone(h));
+      for (std::size_t t = 0; t < input.tets.size(); ++t)
+        if (touches(input.tets[t])) expected = std::min(expected, tet_alone(t));
+      CHECK(r.local_yardstick[q] == doctest::Approx(expected).epsilon(1e-12));
+      CHECK(r.local_yardstick[q] >= r.yardstick());
+      lowest_local = std::min(lowest_local, expected);
+    }
+    // Per block, from the output: geode hexes (26 per buffer hex, after the diced hexes) and
+    // their ratio to their buffer hex's local yardstick; the input elements of the block diced alone.
+    std::map<int, double> geode_min, ratio, input_min;
+    std::map<int, Index> geode_count;
+    double overall = 1e9;
+    const primal::HexMesh out = primal::hex_part(r.model);
+    for (Index b = 0; b < r.interface_quads; ++b)
+      for (Index h = r.diced_hexes + 26 * b; h < r.diced_hexes + 26 * (b + 1); ++h) {
+        const int id = r.model.hex_block[static_cast<std::size_t>(h)];
+        const double sj = primal::hex_scaled_jacobian(primal::hex_corners(out, h));
+        geode_min.try_emplace(id, 1.0), ratio.try_emplace(id, 1.0);
+        geode_min[id] = std::min(geode_min[id], sj);
+        ratio[id] = std::min(ratio[id], sj / r.local_yardstick[static_cast<std::size_t>(b)]);
+        overall = std::min(overall, sj / r.local_yardstick[static_cast<std::size_t>(b)]);
+        ++geode_count[id];
+      }
+    for (std::size_t h = 0; h < input.hexes.size(); ++h) {
+      const int id = primal::block_of(input, {primal::ElementKind::Hex, static_cast<Index>(h)});
+      input_min.try_emplace(id, 1.0);
+      input_min[id] = std::min(input_min[id], hex_alone(h));
+    }
+    for (std::size_t t = 0; t < input.tets.size(); ++t) {
+      const int id = primal::block_of(input, {primal::ElementKind::Tet, static_cast<Index>(t)});
+      input_min.try_emplace(id, 1.0);
+      input_min[id] = std::min(input_min[id], tet_alone(t));
+    }
+    CHECK(r.local_yardstick_ratio == doctest::Approx(overall).epsilon(1e-9));
+    for (const conform::BlockQuality& b : r.quality) {
+      CAPTURE(b.name);
+      CHECK(b.input_diced_min_scaled_jacobian == doctest::Approx(input_min.at(b.block)).epsilon(1e-12));
+      CHECK(b.geode_hexes == geode_count[b.block]);
+      if (b.geode_hexes == 0) continue;
+      CHECK(b.geode_min_scaled_jacobian == doctest::Approx(geode_min.at(b.block)).epsilon(1e-9));
+      CHECK(b.local_ratio == doctest::Approx(ratio.at(b.block)).epsilon(1e-9));
+      CHECK(b.local_yardstick >= lowest_local);
+    }
+  }
+}
