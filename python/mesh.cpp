@@ -181,6 +181,9 @@ py::dict dual_dict(const Dual& dual, std::size_t nodes, std::size_t cells) {
     x["self_intersecting"] = sh.self_intersecting;
     x["trace_pieces"] = sh.trace.size();
     x["closed_trace_pieces"] = closed;
+    py::list trace;  // the boundary trace: each piece's boundary edges (ids into "edges") in order
+    for (const auto& t : sh.trace) trace.append(py::dict(py::arg("edges") = t.edges, py::arg("closed") = t.closed));
+    x["trace"] = trace;
     sheets.append(x);
   }
   d["sheets"] = sheets;

@@ -196,7 +196,7 @@ def conform(mesh=None, *, points=None, cells=None, cell_blocks=None, name="mesh"
 
     mesh: a meshio.Mesh (hexahedron and tetra cells; Gmsh's surface and point entities are
     skipped; blocks from gmsh:physical, else one per cell block; block names from field_data;
-    point sets become node sets), or points and cells ([(type, array)] or {type: array}) with
+    point sets become node sets; side sets are not read: meshio has no form for them), or points and cells ([(type, array)] or {type: array}) with
     cell_blocks (one block id per cell block). The options are those of `geode conform`.
     Returns (meshio.Mesh, report): the output with one cell block and one cell set per block,
     block ids as gmsh:physical, node sets as point sets; the report as `--report` writes it,

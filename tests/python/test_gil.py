@@ -40,3 +40,12 @@ def test_conform_releases_the_gil():
     (mesh, report), seconds, gap = longest_stall(lambda: geode.conform(model))  # big enough to take time anyway
     assert report["valid"]
     assert seconds > 0.2 and gap < 0.5 * seconds, (seconds, gap)
+
+
+def test_the_check_sees_a_held_gil():
+    # The control: libc's sleep called through ctypes.PyDLL keeps the GIL for the whole call, and
+    # the ticking thread stalls for about as long.
+    import ctypes
+
+    _, seconds, gap = longest_stall(lambda: ctypes.PyDLL(None).usleep(300000))
+    assert seconds > 0.25 and gap >= 0.5 * seconds, (seconds, gap)

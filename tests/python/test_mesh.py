@@ -72,6 +72,11 @@ def test_dual_rebuild_gives_the_mesh_back():
     pts[inner, 0] += 0.2 * (pts[inner, 2] - 1)  # moved interior nodes: kinked sheets, the box still filled
     d = geode.dual(pts, hexes, rebuild=True)
     assert len(d["sheets"]) == 3 + 2 + 2
+    for s, sheet in enumerate(d["sheets"]):  # each a disk across the box: one closed trace loop of its own edges
+        assert len(sheet["trace"]) == 1 and sheet["trace"][0]["closed"]
+        assert all(d["edge_sheet"][e] == s for e in sheet["trace"][0]["edges"])
+    loops = sorted(len(sheet["trace"][0]["edges"]) for sheet in d["sheets"])
+    assert loops == [8, 8, 8, 10, 10, 10, 10]  # around 2 x 2 (x sheets), 3 x 2 (y and z sheets) cells
     r = d["rebuild"]
     m = geode.isomorphism(r["cells"], hexes)
     assert m is not None
