@@ -35,6 +35,12 @@ std::string replaced(std::string s, const std::string& from, const std::string& 
   return s.replace(at, from.size(), to);
 }
 
+std::string repeated(const std::string& s, int n) {
+  std::string out;
+  for (int i = 0; i < n; ++i) out += s;
+  return out;
+}
+
 struct BadInput {
   const char* what;
   std::string command;  // {in}, {out}, {marker}: see substituted
@@ -96,6 +102,17 @@ TEST_CASE("bad input: refused with one line naming the file and the node or elem
       {"a legacy .vtk with a NaN point", "dual {in}", "nan.vtk",
        "# vtk DataFile Version 4.2\nx\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 1 double\n0 nan 0\n", 2,
        {"nan.vtk", "point 0", "non-finite"}},
+      // File formats (branch ioreliab, issue 21): hostile structure refused before it costs.
+      {"a .vtu of 30,000 nested tags (once a stack overflow)", "check {in}", "nested.vtu",
+       "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\">\n" + repeated("<a>", 30000) + repeated("</a>", 30000) +
+           "</VTKFile>\n",
+       2, {"nested.vtu", "nested.vtu:3:", "nested more than 64 deep"}},
+      {"$PartitionedEntities in a .msh 2.2", "conform {in} -o {out}.exo", "part22.msh",
+       "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PartitionedEntities\n1\n0\n0 0 0 0\n$EndPartitionedEntities\n", 2,
+       {"part22.msh", "line 4", "$PartitionedEntities in a version 2 file"}},
+      {"a partitioned entity count larger than the file", "conform {in} -o {out}.exo", "partcount.msh",
+       "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PartitionedEntities\n2\n0\n0 0 0 99999999\n$EndPartitionedEntities\n", 2,
+       {"partcount.msh", "a partitioned entity count 99999999 is more than the rest of the file can hold"}},
   };
   for (const BadInput& row : table) {
     CAPTURE(row.what);
