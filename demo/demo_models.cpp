@@ -676,52 +676,6 @@ std::vector<int> shared_boxes(const std::vector<std::array<double, 6>>& boxes) {
   gmsh::model::occ::synchronize();
   std::vector<int> volumes;
   for (const auto& m : map) volumes.push_back(m.front().second);
-namespace {
-
-// One part of the potting model: `build` adds its OCC volumes (fragmented where they touch) and
-// sets their meshing; they become block `id` named `name`.
-Model potting_part(int id, const std::string& name, const std::function<gmsh::vectorpair()>& build) {
-  return hex_part_from_gmsh(name, [&] {
-    const gmsh::vectorpair volumes = build();
-    std::vector<int> tags;
-    for (const auto& [dim, tag] : volumes) tags.push_back(tag);
-    gmsh::model::addPhysicalGroup(3, tags, id);
-    gmsh::model::setPhysicalName(3, id, name);
-  });
-}
-
-// Structured boxes (each {x0, y0, z0, x1, y1, z1}; touching ones must meet in whole faces, so
-// that each stays a six-faced transfinite block), fragmented so that they share those faces,
-// optionally rotated by `angle` about the axis through `centre`.
-gmsh::vectorpair structured_boxes(const std::vector<Box>& boxes, double h, const Point& centre = Point::Zero(),
-                                  const Point& axis = Point::UnitZ(), double angle = 0.0) {
-  gmsh::vectorpair volumes, fragments;
-  for (const Box& b : boxes)
-    volumes.push_back({3, gmsh::model::occ::addBox(b[0], b[1], b[2], b[3] - b[0], b[4] - b[1], b[5] - b[2])});
-  std::vector<gmsh::vectorpair> map;
-  if (volumes.size() > 1) gmsh::model::occ::fragment(volumes, {}, fragments, map);
-  else fragments = volumes;
-  if (angle != 0.0)
-    gmsh::model::occ::rotate(fragments, centre.x(), centre.y(), centre.z(), axis.x(), axis.y(), axis.z(), angle);
-  gmsh::model::occ::synchronize();
-  for (const auto& [dim, tag] : fragments) transfinite_box(tag, h);
-  return fragments;
-}
-
-// A disk of radius r about `centre` in the plane normal to `axis` (x or z), its unstructured
-// recombined quads swept along the axis over `length` in layers of about h.
-gmsh::vectorpair swept_cylinder(const Point& centre, double r, int axis, double length, double h) {
-  const int disk = gmsh::model::occ::addDisk(centre.x(), centre.y(), centre.z(), r, r);
-  if (axis == 0) gmsh::model::occ::rotate({{2, disk}}, centre.x(), centre.y(), centre.z(), 0, 1, 0, std::numbers::pi / 2);
-  gmsh::vectorpair out, volumes;
-  const Point along = length * (axis == 0 ? Point::UnitX() : Point::UnitZ());
-  gmsh::model::occ::extrude({{2, disk}}, along.x(), along.y(), along.z(), out,
-                            {std::max(1, static_cast<int>(std::lround(length / h)))}, {}, true);
-  gmsh::model::occ::synchronize();
-  gmsh::option::setNumber("Mesh.MeshSizeMax", h);
-  gmsh::model::mesh::setRecombine(2, disk);
-  for (const auto& dt : out)
-    if (dt.first == 3) volumes.push_back(dt);
   return volumes;
 }
 
@@ -811,6 +765,60 @@ Model demo_hexdominant(int n) {
     name_volume(v[1], 2, "tet");
     for (const auto& [dim, tag] : layer)
       if (dim == 3) name_volume(tag, 4, "wedge layer");
+  });
+}
+
+namespace {
+
+// One part of the potting model: `build` adds its OCC volumes (fragmented where they touch) and
+// sets their meshing; they become block `id` named `name`.
+Model potting_part(int id, const std::string& name, const std::function<gmsh::vectorpair()>& build) {
+  return hex_part_from_gmsh(name, [&] {
+    const gmsh::vectorpair volumes = build();
+    std::vector<int> tags;
+    for (const auto& [dim, tag] : volumes) tags.push_back(tag);
+    gmsh::model::addPhysicalGroup(3, tags, id);
+    gmsh::model::setPhysicalName(3, id, name);
+  });
+}
+
+// Structured boxes (each {x0, y0, z0, x1, y1, z1}; touching ones must meet in whole faces, so
+// that each stays a six-faced transfinite block), fragmented so that they share those faces,
+// optionally rotated by `angle` about the axis through `centre`.
+gmsh::vectorpair structured_boxes(const std::vector<Box>& boxes, double h, const Point& centre = Point::Zero(),
+                                  const Point& axis = Point::UnitZ(), double angle = 0.0) {
+  gmsh::vectorpair volumes, fragments;
+  for (const Box& b : boxes)
+    volumes.push_back({3, gmsh::model::occ::addBox(b[0], b[1], b[2], b[3] - b[0], b[4] - b[1], b[5] - b[2])});
+  std::vector<gmsh::vectorpair> map;
+  if (volumes.size() > 1) gmsh::model::occ::fragment(volumes, {}, fragments, map);
+  else fragments = volumes;
+  if (angle != 0.0)
+    gmsh::model::occ::rotate(fragments, centre.x(), centre.y(), centre.z(), axis.x(), axis.y(), axis.z(), angle);
+  gmsh::model::occ::synchronize();
+  for (const auto& [dim, tag] : fragments) transfinite_box(tag, h);
+  return fragments;
+}
+
+// A disk of radius r about `centre` in the plane normal to `axis` (x or z), its unstructured
+// recombined quads swept along the axis over `length` in layers of about h.
+gmsh::vectorpair swept_cylinder(const Point& centre, double r, int axis, double length, double h) {
+  const int disk = gmsh::model::occ::addDisk(centre.x(), centre.y(), centre.z(), r, r);
+  if (axis == 0) gmsh::model::occ::rotate({{2, disk}}, centre.x(), centre.y(), centre.z(), 0, 1, 0, std::numbers::pi / 2);
+  gmsh::vectorpair out, volumes;
+  const Point along = length * (axis == 0 ? Point::UnitX() : Point::UnitZ());
+  gmsh::model::occ::extrude({{2, disk}}, along.x(), along.y(), along.z(), out,
+                            {std::max(1, static_cast<int>(std::lround(length / h)))}, {}, true);
+  gmsh::model::occ::synchronize();
+  gmsh::option::setNumber("Mesh.MeshSizeMax", h);
+  gmsh::model::mesh::setRecombine(2, disk);
+  for (const auto& dt : out)
+    if (dt.first == 3) volumes.push_back(dt);
+  return volumes;
+}
+
+}  // namespace
+
 Model demo_potting(int n) {
   if (n < 2) throw InvalidInput("demo_potting: n = " + std::to_string(n) + " must be >= 2");
   const double h = 1.0 / n;
@@ -907,6 +915,7 @@ Model demo_wedge(int n, double angle) {
     return join(std::move(hexes), tet_fill(outer, {inner}, 2, "tet"));
   });
 }
+
 
 const std::vector<std::string>& demo_model_names() {
   static const std::vector<std::string> names{"half", "delaunay", "delaunay-random", "cylinder",

@@ -147,13 +147,13 @@ TEST_CASE("read_exodus rejects bad input naming the file, element and reason") {
     const std::string what = message_of(cut);
     CHECK(what.find(cut.string()) != std::string::npos);
   }
-  SUBCASE("unknown element type") {
-    const fs::path file = dir / "wedge.exo";
-    write_raw(file, "WEDGE6", {1, 2, 3, 4, 5, 6}, 6);
+  SUBCASE("unknown element type: a quadratic tet") {
+    const fs::path file = dir / "tetra10.exo";
+    write_raw(file, "TETRA10", {1, 2, 3, 4, 5, 6, 7, 8, 9, 10}, 10);
     const std::string what = message_of(file);
     CHECK(what.find(file.string()) != std::string::npos);
     CHECK(what.find("element block 3: element 1") != std::string::npos);
-    CHECK(what.find("'WEDGE6'") != std::string::npos);
+    CHECK(what.find("'TETRA10'") != std::string::npos);
   }
   SUBCASE("node index out of range") {
     const fs::path file = dir / "range.exo";
