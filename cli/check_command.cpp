@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "cli/commands.hpp"
+#include "cli/conventions.hpp"
 #include "primal/errors.hpp"
 #include "primal/quality.hpp"
 #include "primal/quality_report.hpp"
@@ -72,6 +73,8 @@ Checked check_quads(const primal::QuadMesh& mesh, const primal::RealizabilityOpt
 }
 
 void run_check(const CheckArgs& a) {
+  check_output_path(a.output);
+  check_not_input(a.output, a.input, false);  // a report never replaces the mesh it is about
   const MeshFile m = read_mesh_file(a.input);
   primal::RealizabilityOptions options;
   options.planar_angle_degrees = a.planar_angle;

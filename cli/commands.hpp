@@ -69,6 +69,9 @@ struct TemplateOutput {
   bool slide = false;
   bool quality = false;
   bool check_conditions = true;  // the paper's interleave conditions (geode templates only)
+  // An invalid mesh (cli/conventions.hpp invalid_mesh_reason) is refused (exit 4, nothing
+  // written) unless this is set; it is then written and the exit code is still 4.
+  bool write_invalid = false;
   std::string note;              // e.g. what a fix-up did; printed with the smoothing note
   // Replaces templates::smooth_template (e.g. the refinement template's own smoothing).
   std::function<primal::SmoothResult(templates::Template&)> smoother;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -16,6 +17,7 @@
 #include "primal/errors.hpp"
 #include "primal/quality.hpp"
 #include "primal/quality_report.hpp"
+#include "primal/topology.hpp"
 
 namespace geode::cli {
 namespace {
@@ -45,6 +47,7 @@ struct ConformArgs {
   int n = 4;
   bool quiet = false;
   bool write_invalid = false;
+  bool force = false;
 };
 
 void print_summary(const conform::ConformResult& r, std::ostream& os, bool tables) {
@@ -110,6 +113,7 @@ std::string check_outputs(const ConformArgs& a) {
     if (!a.output.empty() && fs::weakly_canonical(a.report) == fs::weakly_canonical(a.output))
       throw InvalidInput(a.report + ": the report and the mesh are the same file");
   }
+  for (const std::string* out : {&a.output, &a.report, &a.save_input}) check_not_input(*out, a.input, a.force);
   return format;
 }
 
@@ -120,6 +124,30 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
   const std::string prefix = source.empty() ? "" : source + ": ";
   Progress progress = Progress::for_stderr(a.quiet);
   if (a.merge_tolerance >= 0) {
+    // A tolerance as long as an element's edge merges that element's own nodes: refuse it
+    // rather than report the collapsed elements it would leave.
+    double shortest = std::numeric_limits<double>::infinity();
+    primal::Index where = 0;
+    bool in_hex = true;
+    const auto scan = [&](const auto& cells, const auto& edges, bool hex) {
+      for (std::size_t e = 0; e < cells.size(); ++e)
+        for (const auto& ed : edges) {
+          const double l = (model.points[static_cast<std::size_t>(cells[e][static_cast<std::size_t>(ed[0])])] -
+                            model.points[static_cast<std::size_t>(cells[e][static_cast<std::size_t>(ed[1])])])
+                               .norm();
+          if (l < shortest) shortest = l, where = static_cast<primal::Index>(e), in_hex = hex;
+        }
+    };
+    scan(model.hexes, primal::topology::kHexEdgeCorners, true);
+    scan(model.tets, primal::topology::kTetEdgeCorners, false);
+    if (a.merge_tolerance >= shortest) {
+      std::ostringstream m;
+      m << prefix << "--merge-tolerance " << a.merge_tolerance << " is not below the shortest element edge, " << shortest
+        << " (" << primal::describe_element(model, {in_hex ? primal::ElementKind::Hex : primal::ElementKind::Tet, where})
+        << "): it would merge an element's own nodes; give a distance below that edge (and above the gap between "
+        << "duplicated interface nodes)";
+      throw InvalidInput(m.str());
+    }
     const primal::Index merged = primal::merge_coincident_nodes(model, a.merge_tolerance);
     progress.stage("merged " + std::to_string(merged) + " coincident nodes");
   }
@@ -246,6 +274,7 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
                 "24x10x24 suits --buffer-side tet)");
   c->add_flag("--write-invalid", a.write_invalid,
               "write the mesh and report even when verification fails (the exit code is still 4)");
+  add_force_flag(c, a.force);
   c->add_flag("--quiet", a.quiet, "no progress and no summary (errors and the invalid-result message still print)");
 }
 

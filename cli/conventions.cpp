@@ -12,7 +12,9 @@
 #include "cli/commands.hpp"
 #include "primal/errors.hpp"
 #include "io/exodus.hpp"
+#include "io/atomic_file.hpp"
 #include "io/gmsh.hpp"
+#include "primal/validity.hpp"
 
 #ifndef GEODE_VERSION
 #define GEODE_VERSION "unknown"
@@ -170,6 +172,17 @@ void check_output_path(const std::string& path) {
     throw InvalidInput(path + ": exists and is not writable");
 }
 
+void check_not_input(const std::string& output, const std::string& input, bool force) {
+  if (force || output.empty() || output == "-" || input.empty()) return;
+  std::error_code ec;
+  if (fs::equivalent(output, input, ec) && !ec)
+    throw InvalidInput(output + ": is the input file " + input + "; writing it would destroy the input (--force overwrites it)");
+}
+
+CLI::Option* add_force_flag(CLI::App* app, bool& flag) {
+  return app->add_flag("--force", flag, "allow an output to overwrite the input file");
+}
+
 void write_mesh(const primal::Model& model, const fs::path& path, const std::string& format,
                 io::VtuEncoding vtu) {
   if (format == "exo") return io::write_exodus(model, path);
@@ -180,15 +193,103 @@ void write_mesh(const primal::Model& model, const fs::path& path, const std::str
   throw InvalidInput(path.string() + ": '" + format + "' is not a mesh format");
 }
 
+namespace {
+
+// "3 hexes with a repeated node: 2 5 9": a count, what they are, and the first few ids.
+template <class T, class Show>
+void finding(std::vector<std::string>& out, const std::vector<T>& items, const std::string& what, Show&& show) {
+  if (items.empty()) return;
+  std::string s = std::to_string(items.size()) + " " + what + ":";
+  for (std::size_t i = 0; i < items.size() && i < 5; ++i) s += " " + show(items[i]);
+  out.push_back(s + (items.size() > 5 ? " ..." : ""));
+}
+
+template <std::size_t N>
+std::string show_nodes(const std::array<primal::Index, N>& k, primal::Index base) {
+  std::string s;
+  for (auto n : k)
+    if (n != primal::kInvalidIndex) s += (s.empty() ? "" : "-") + std::to_string(n + base);
+  return s;
+}
+
+std::string joined(const std::vector<std::string>& parts) {
+  std::string s;
+  for (const auto& p : parts) s += (s.empty() ? "" : "; ") + p;
+  return s;
+}
+
+}  // namespace
+
+std::string invalid_mesh_reason(const primal::HexMesh& mesh, primal::Index base) {
+  const primal::HexValidityReport r = primal::check_validity(mesh);
+  if (r.ok()) return {};
+  const auto id = [base](primal::Index i) { return std::to_string(i + base); };
+  const auto face = [base](const primal::FaceKey& k) { return show_nodes(k, base); };
+  const auto edge = [base](const primal::EdgeKey& k) { return show_nodes(k, base); };
+  std::vector<std::string> f;
+  finding(f, r.out_of_range_hexes, "hexes with a node out of range", id);
+  finding(f, r.non_finite_nodes, "nodes with a non-finite coordinate", id);
+  finding(f, r.repeated_node_hexes, "hexes with a repeated node", id);
+  finding(f, r.inverted_hexes, "of " + std::to_string(r.num_hexes) + " hexes inverted (a corner Jacobian <= 0), hexes", id);
+  finding(f, r.overlapping_nodes, "nodes covered more than once (overlapping hexes), nodes",
+          [base](const primal::NodeCoverage& c) { return std::to_string(c.node + base); });
+  finding(f, r.overshared_faces, "faces in more than two hexes, by their nodes", face);
+  finding(f, r.misoriented_faces, "faces seen in the same order by both hexes, by their nodes", face);
+  finding(f, r.nonmanifold_edges, "non-manifold edges, by their nodes", edge);
+  finding(f, r.nonmanifold_vertices, "non-manifold nodes", id);
+  if (!r.boundary.closed) f.push_back("the boundary is not closed");
+  if (!r.boundary.manifold) f.push_back("the boundary is not manifold");
+  return joined(f);
+}
+
+std::string invalid_mesh_reason(const primal::QuadMesh& mesh, primal::Index base) {
+  const primal::QuadValidityReport r = primal::check_validity(mesh);
+  if (r.ok()) return {};
+  const auto id = [base](primal::Index i) { return std::to_string(i + base); };
+  const auto edge = [base](const primal::EdgeKey& k) { return show_nodes(k, base); };
+  std::vector<std::string> f;
+  finding(f, r.out_of_range_quads, "quads with a node out of range", id);
+  finding(f, r.non_finite_nodes, "nodes with a non-finite coordinate", id);
+  finding(f, r.repeated_node_quads, "quads with a repeated node", id);
+  finding(f, r.inverted_quads, "of " + std::to_string(r.num_quads) + " quads inverted (a corner <= 0), quads", id);
+  finding(f, r.overlapping_nodes, "nodes covered more than once (overlapping quads), nodes",
+          [base](const primal::NodeCoverage& c) { return std::to_string(c.node + base); });
+  finding(f, r.overshared_edges, "edges in more than two quads, by their nodes", edge);
+  finding(f, r.misoriented_edges, "edges run the same way by both quads, by their nodes", edge);
+  finding(f, r.nonmanifold_vertices, "non-manifold nodes", id);
+  if (!r.planar) f.push_back("not planar");
+  if (f.empty()) f.push_back("not a valid quad mesh");
+  return joined(f);
+}
+
+primal::Index output_index_base(const std::string& format) { return format == "vtu" || format == "vtk" ? 0 : 1; }
+
+void refuse_invalid(const std::string& what, const std::string& reason, bool write_invalid) {
+  if (reason.empty() || write_invalid) return;
+  throw InvalidResult(what + " is invalid: " + reason + " (nothing written; --write-invalid writes it anyway)");
+}
+
+void invalid_written(const std::string& what, const std::string& reason) {
+  if (reason.empty()) return;
+  throw InvalidResult(what + " is invalid: " + reason + " (written anyway: --write-invalid)");
+}
+
+CLI::Option* add_write_invalid_flag(CLI::App* app, bool& flag) {
+  return app->add_flag("--write-invalid", flag,
+                       "write the mesh even when it fails the validity check (inverted or overlapping cells,\n"
+                       "faces not shared by two cells); the exit code is still 4. Without it an invalid mesh\n"
+                       "is not written");
+}
+
 void OutputFiles::add(const fs::path& target, Writer write) {
-  const fs::path dir = target.parent_path();
-  const std::string name = "." + target.stem().string() + ".geode-" + std::to_string(::getpid()) + "-" +
-                           std::to_string(entries_.size()) + target.extension().string();
-  entries_.push_back({target, dir / name, std::move(write)});
+  entries_.push_back({target, io::resolve_output(target), {}, std::move(write)});
 }
 
 void OutputFiles::commit() {
-  for (const Entry& e : entries_) {
+  // Each output to a registered temporary (io/atomic_file.hpp: removed on signals too) with the
+  // target's extension, for writers that go by it; a symbolic link is written through.
+  for (Entry& e : entries_) {
+    e.temp = io::create_temporary(e.resolved, e.target.extension().string());
     pending_.push_back(e.temp);
     try {
       e.write(e.temp);
@@ -201,22 +302,33 @@ void OutputFiles::commit() {
       throw InvalidInput(what);
     }
   }
+  // The targets renamed so far are registered like temporaries until all are in place: a
+  // signal between two renames removes them, so a mesh never stands without its report.
   std::vector<fs::path> renamed;
+  const auto forget = [&renamed] {
+    for (const auto& r : renamed) io::unregister_temporary(r);
+  };
   for (const Entry& e : entries_) {
-    std::error_code ec;
-    fs::rename(e.temp, e.target, ec);
-    if (ec) {
+    try {
+      io::publish_temporary(e.temp, e.resolved, e.target);
+    } catch (const InvalidInput& x) {
+      std::error_code ec;
       for (const auto& r : renamed) fs::remove(r, ec);
-      throw InvalidInput(e.target.string() + ": cannot write (" + ec.message() + "); nothing written");
+      forget();
+      throw InvalidInput(std::string(x.what()) + "; nothing written");
     }
-    renamed.push_back(e.target);
+    pending_.erase(std::find(pending_.begin(), pending_.end(), e.temp));
+    if (e.resolved.regular) {
+      renamed.push_back(e.resolved.file);
+      io::register_temporary(e.resolved.file);
+    }
   }
+  forget();
   pending_.clear();
 }
 
 OutputFiles::~OutputFiles() {
-  std::error_code ec;
-  for (const auto& p : pending_) fs::remove(p, ec);
+  for (const auto& p : pending_) io::remove_temporary(p);
 }
 
 }  // namespace geode::cli

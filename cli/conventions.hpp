@@ -23,7 +23,9 @@
 #include <string>
 #include <vector>
 
+#include "io/atomic_file.hpp"
 #include "io/vtk.hpp"
+#include "primal/mesh.hpp"
 #include "primal/model.hpp"
 
 namespace geode::cli {
@@ -66,13 +68,39 @@ bool is_mesh_format(const std::string& format);
 // before any long work; InvalidInput naming the path otherwise. Empty and "-" pass.
 void check_output_path(const std::string& path);
 
+// An output that is the input itself (the same file, also through links) would destroy it:
+// InvalidInput naming both unless `force` (--force). Paths that do not exist yet pass.
+void check_not_input(const std::string& output, const std::string& input, bool force);
+CLI::Option* add_force_flag(CLI::App* app, bool& flag);
+
 // Writes a model in a mesh format; `vtu` is the encoding for .vtu.
 void write_mesh(const primal::Model& model, const std::filesystem::path& path,
                 const std::string& format, io::VtuEncoding vtu = io::VtuEncoding::kBinary);
 
+// ---- Validity before writing -----------------------------------------------------------------
+
+// The one check every derived mesh goes through before it is written (primal/validity.hpp
+// check_validity: faces shared by two cells, manifold, closed boundary, positive corners, every
+// node covered once): "" when valid, else one line of what is wrong, elements and nodes numbered
+// from `base` as the output will number them (1: appendix, csv, json, .msh, .exo; 0: .vtu, .vtk).
+std::string invalid_mesh_reason(const primal::HexMesh& mesh, primal::Index base);
+std::string invalid_mesh_reason(const primal::QuadMesh& mesh, primal::Index base);
+// The numbering base of a format's node and element ids (0 for vtu and vtk, else 1).
+primal::Index output_index_base(const std::string& format);
+
+// Before writing `what` (e.g. "the rebuilt mesh"): nothing when `reason` is empty; InvalidResult
+// (exit 4, nothing written) unless `write_invalid`, which lets the caller write it and then call
+// invalid_written (InvalidResult again: the exit code stays 4, the output is there).
+void refuse_invalid(const std::string& what, const std::string& reason, bool write_invalid);
+void invalid_written(const std::string& what, const std::string& reason);
+
+// The same --write-invalid flag on every command that writes a mesh.
+CLI::Option* add_write_invalid_flag(CLI::App* app, bool& flag);
+
 // Several outputs written as one: each goes to a temporary file next to its target (same
-// extension, so writers that go by it still work), and only when all are written are they
-// renamed over their targets. If any write fails, every temporary is removed and nothing is
+// extension, so writers that go by it still work; registered for removal on signals), and only
+// when all are written are they renamed over their targets (through symbolic links; copied into
+// a target that is not a regular file, e.g. a device). If any write fails, every temporary is removed and nothing is
 // written; if a rename fails, the outputs already renamed are removed (never half a result).
 class OutputFiles {
  public:
@@ -83,7 +111,9 @@ class OutputFiles {
 
  private:
   struct Entry {
-    std::filesystem::path target, temp;
+    std::filesystem::path target;  // as given
+    io::OutputTarget resolved;     // symbolic links followed
+    std::filesystem::path temp;
     Writer write;
   };
   std::vector<Entry> entries_;

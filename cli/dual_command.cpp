@@ -10,6 +10,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/conventions.hpp"
+#include "cli/progress.hpp"
 #include "primal/errors.hpp"
 #include "io/vtk.hpp"
 #include "primal/model.hpp"
@@ -30,6 +31,8 @@ struct DualArgs {
   std::string output;
   std::string rebuild;
   std::string vtu_encoding = "binary";
+  bool write_invalid = false;
+  bool force = false;
 };
 
 template <class Dual>
@@ -94,6 +97,8 @@ void run_dual(const DualArgs& a) {
     check_output_path(a.rebuild);
     rebuild_format = output_format(a.rebuild, "", {"vtu", "vtk", "msh", "exo"}, "");
   }
+  check_not_input(a.output, a.input, a.force);
+  check_not_input(a.rebuild, a.input, a.force);
   const fs::path in(a.input);
   const MeshFile m = read_mesh_file(in);
   if (m.dim == 2 && !rebuild_format.empty() && rebuild_format != "vtu" && rebuild_format != "vtk")
@@ -117,7 +122,12 @@ void run_dual(const DualArgs& a) {
     // Name the input in what the engine reports (it only knows hexes and sheets by number).
     try {
       const stc::MeshArrangementInput fields = m.dim == 3 ? stc::sheet_fields(m.hex) : stc::sheet_fields(m.quad);
-      D = stc::dualize(stc::compute_arrangement(fields.sheets, fields.domain));
+      // A large mesh has many sheets and the engine meets every pair: say how far it is.
+      Progress progress = Progress::for_stderr(false);
+      stc::ArrangementOptions options;
+      options.progress = [&progress, what = std::string(m.dim == 3 ? "sheet pairs traced" : "chords traced")](
+                             std::size_t done, std::size_t total) { progress.step(what, done, total); };
+      D = stc::dualize(stc::compute_arrangement(fields.sheets, fields.domain, options));
     } catch (const InvalidInput& x) {
       throw InvalidInput(a.input + ": cannot rebuild: " + x.what());
     } catch (const TopologyError& x) {
@@ -145,7 +155,15 @@ void run_dual(const DualArgs& a) {
               "\n";
     }
   }
-  // The rebuilt mesh and the report file are written as one (both or neither).
+  // The rebuilt mesh passes the one validity check before anything is written (its ids as the
+  // rebuilt file numbers them); the report and the mesh are written as one (both or neither).
+  std::string invalid;
+  const std::string what = a.input + ": the rebuilt mesh " + a.rebuild;
+  if (!a.rebuild.empty()) {
+    const primal::Index base = output_index_base(rebuild_format);
+    invalid = m.dim == 3 ? invalid_mesh_reason(D.hex, base) : invalid_mesh_reason(D.quad, base);
+    refuse_invalid(what, invalid, a.write_invalid);
+  }
   OutputFiles files;
   if (!a.rebuild.empty())
     files.add(a.rebuild, [&](const fs::path& temp) {
@@ -163,6 +181,7 @@ void run_dual(const DualArgs& a) {
   if (to_file) files.add(a.output, [&](const fs::path& temp) { write_or_print(temp.string(), [&](std::ostream& os) { os << text; }); });
   files.commit();
   if (!to_file) std::cout << text;
+  invalid_written(what, invalid);
 }
 
 }  // namespace
@@ -185,6 +204,8 @@ void add_dual_command(CLI::App& app) {
   d->add_option("--rebuild", a->rebuild,
                 "Rebuild the mesh from its sheets through the arrangement engine; write it here, the\n"
                 "format by the extension: .vtu (binary), .vtk, .msh, .exo/.e (hexes; quads: .vtu, .vtk)");
+  add_write_invalid_flag(d, a->write_invalid);
+  add_force_flag(d, a->force);
   d->add_option("--vtu-encoding", a->vtu_encoding, "binary (base64, default) or ascii DataArrays in .vtu")
       ->check(CLI::IsMember({"binary", "ascii"}))
       ->capture_default_str();

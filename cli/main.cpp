@@ -1,11 +1,13 @@
 // geode: all-hex meshing through the dual (the Spatial Twist Continuum).
 #include <iostream>
 #include <memory>
+#include <new>
 
 #include <tbb/global_control.h>
 
 #include "cli/commands.hpp"
 #include "cli/conventions.hpp"
+#include "io/atomic_file.hpp"
 #include "primal/errors.hpp"
 
 namespace {
@@ -38,6 +40,8 @@ int main(int argc, char** argv) {
       "geode: all-hex transition templates derived from completed dual sheet arrangements, and the\n"
       "geode algorithm that conforms a diced hex mesh to a diced tet mesh with them.\n"
       "Exit codes: 0 done, 2 usage or input error, 3 topology refusal, 4 invalid result."};
+  // An interrupted run removes its hidden temporary files (io/atomic_file.hpp).
+  geode::io::install_signal_cleanup();
   app.require_subcommand(1);
   app.set_version_flag("--version", geode::cli::version_text(), "print the version and exit");
   // --threads before or after the command: subcommands pass options they do not know to here
@@ -75,6 +79,15 @@ int main(int argc, char** argv) {
   } catch (const geode::cli::InvalidResult& e) {
     std::cerr << "geode: invalid result: " << one_line(e.what()) << "\n";
     return 4;
+  } catch (const std::bad_alloc&) {
+    // An input whose counts were not bounded somewhere: still one line and exit 2, not a crash.
+    std::cerr << command_path(app) << ": error: out of memory: the input needs more memory than this machine "
+              << "gives (nothing written)\n";
+    return 2;
+  } catch (const std::length_error& e) {
+    std::cerr << command_path(app) << ": error: the input asks for a container larger than memory can hold ("
+              << one_line(e.what()) << "; nothing written)\n";
+    return 2;
   } catch (const std::exception& e) {
     std::cerr << "geode: error: " << one_line(e.what()) << "\n";
     return 1;

@@ -36,6 +36,23 @@ templates::PushGrid default_grid(const std::string& name) {
           {0.2, 0.4, 0.6, 0.8}};
 }
 
+// At most this many sweep points (the product of the axes' counts): 20,000 runs of the geode
+// take hours on two cores, and every run is kept in memory for the summary.
+constexpr double kMaxSweepPoints = 20000;
+
+void check_sweep_size(const std::vector<std::size_t>& counts, const std::string& where) {
+  double product = 1;
+  for (std::size_t c : counts) product *= static_cast<double>(c);
+  if (product > kMaxSweepPoints) {
+    std::string f;
+    for (std::size_t c : counts) f += (f.empty() ? "" : " x ") + std::to_string(c);
+    std::ostringstream m;
+    m << where << ": " << f << " = " << product << " sweep points; at most " << kMaxSweepPoints
+      << " (sweep fewer values, or split the study)";
+    throw InvalidInput(m.str());
+  }
+}
+
 // The spec's sweep block, then --sweep options (replacing an axis of the same path).
 templates::InterleaveStudy spec_study(const InterleaveArgs& a) {
   const nlohmann::json spec = templates::read_spec_json(a.spec);
@@ -50,6 +67,9 @@ templates::InterleaveStudy spec_study(const InterleaveArgs& a) {
     if (same != axes.end()) *same = axis; else axes.push_back(axis);
   }
   if (axes.empty()) throw InvalidInput(source + ": nothing to sweep (give --sweep PATH=FROM:TO:COUNT or a sweep block)");
+  std::vector<std::size_t> counts;
+  for (const auto& x : axes) counts.push_back(x.values.size());
+  check_sweep_size(counts, source);
   Progress progress = Progress::for_stderr(a.quiet);
   auto study = templates::interleave_study(spec, source, axes, std::filesystem::path(a.spec).stem().string(),
                                            [&](const std::string& what, std::size_t done, std::size_t total) {
@@ -76,6 +96,8 @@ void run_interleave(const InterleaveArgs& a) {
     if (!a.low.empty()) grid.low_roof = a.low;
     if (!a.depth.empty()) grid.dome_depth = a.depth;
     if (!a.radius.empty()) grid.dome_radius = a.radius;
+    check_sweep_size({grid.high_roof.size(), grid.low_roof.size(), grid.dome_depth.size(), grid.dome_radius.size()},
+                     "study interleave");
     templates::GeodeOptions o;
     if (a.name == "geode4tri") o.split = templates::TopSplit::FourTriangles;
     Progress progress = Progress::for_stderr(a.quiet);
@@ -84,9 +106,21 @@ void run_interleave(const InterleaveArgs& a) {
     });
     if (study.runs.empty()) throw InvalidInput("study interleave: no grid point has 0 < low < high < 1");
   }
-  write_or_print(a.output, [&](std::ostream& s) { templates::write_interleave_csv(s, study); });
-  if (!a.summary.empty())
-    write_or_print(a.summary, [&](std::ostream& s) { templates::write_interleave_summary(s, study); });
+  // The runs and the summary are written as one (both or neither); the runs to stdout otherwise.
+  OutputFiles files;
+  const bool runs_to_file = !a.output.empty() && a.output != "-";
+  if (runs_to_file)
+    files.add(a.output, [&](const std::filesystem::path& temp) {
+      write_or_print(temp.string(), [&](std::ostream& s) { templates::write_interleave_csv(s, study); });
+    });
+  const bool summary_to_file = !a.summary.empty() && a.summary != "-";
+  if (summary_to_file)
+    files.add(a.summary, [&](const std::filesystem::path& temp) {
+      write_or_print(temp.string(), [&](std::ostream& s) { templates::write_interleave_summary(s, study); });
+    });
+  files.commit();
+  if (!runs_to_file) templates::write_interleave_csv(std::cout, study);
+  if (a.summary == "-") templates::write_interleave_summary(std::cout, study);
   double total = 0;
   for (const auto& r : study.runs) total += r.seconds;
   std::ostream& log = a.output.empty() ? std::cerr : std::cout;

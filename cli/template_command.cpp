@@ -39,6 +39,7 @@ struct TemplateArgs {
   bool no_smooth = false;
   bool no_fixup = false;
   bool quality = false;
+  bool write_invalid = false;
   templates::PushParameters push;
   templates::RefineOptions refine;
   bool refine_roofs = false;  // --high-roof / --low-roof given: they apply to refine3 too
@@ -213,6 +214,7 @@ void run_template(const TemplateArgs& a) {
   out.name = a.name, out.title = "box " + box_text, out.format = format, out.output = a.output;
   out.vtu_encoding = a.vtu_encoding;
   out.smooth = !a.no_smooth, out.slide = a.slide, out.quality = a.quality;
+  out.write_invalid = a.write_invalid;
   templates::Template T;
   if (refine) {
     T = a.name == "refine3" ? templates::build_refine3(ro) : templates::build_refine3_2d(ro);
@@ -294,6 +296,12 @@ void write_template(templates::Template& T, const TemplateOutput& a) {
                 << primal::format_obstructions(obstructions, T.dim, 1);
   }
   const int dim = T.dim;
+  // The one validity check before anything holding the mesh is written: tables, JSON, the
+  // viewer and the mesh formats alike (the quality tables alone describe it, they are not it).
+  const std::string what = a.name + " (" + a.title + "): the " + (dim == 3 ? "hex" : "quad") + " mesh";
+  const primal::Index base = output_index_base(a.format);
+  const std::string invalid = dim == 3 ? invalid_mesh_reason(T.hex, base) : invalid_mesh_reason(T.quad, base);
+  refuse_invalid(what, invalid, a.write_invalid);
   const auto& pts = dim == 3 ? T.hex.points : T.quad.points;
   std::string text;
   if (a.format == "appendix") {
@@ -305,7 +313,7 @@ void write_template(templates::Template& T, const TemplateOutput& a) {
   } else if (a.format == "json") {
     text = to_json(T, a.name).dump(1) + "\n";
   }
-  if (a.quality && dim == 3) text += "\nQuality report (Verdict definitions)\n" + primal::format_quality_table(primal::hex_quality_report(T.hex));
+  if (a.quality && dim == 3) text += "\nQuality report (Verdict definitions, but Element Volume is the exact trilinear volume)\n" + primal::format_quality_table(primal::hex_quality_report(T.hex));
   if (a.quality && dim == 2) {
     double lo = 1e300, hi = -1e300;
     for (std::size_t q = 0; q < T.quad.quads.size(); ++q) {
@@ -320,6 +328,7 @@ void write_template(templates::Template& T, const TemplateOutput& a) {
     if (a.output.empty()) throw InvalidInput("--format html needs -o FILE.html");
     write_template_html(a, T, smooth_note);
     if (!text.empty()) std::cout << text;
+    invalid_written(what, invalid);
     return;
   }
   if (is_mesh_format(a.format)) {
@@ -338,9 +347,11 @@ void write_template(templates::Template& T, const TemplateOutput& a) {
       write_mesh(m, a.output, a.format, vtu);
     }
     if (!text.empty()) std::cout << text;
+    invalid_written(what, invalid);
     return;
   }
   write_or_print(a.output, [&](std::ostream& os) { os << text; });
+  invalid_written(what, invalid);
 }
 
 void add_template_command(CLI::App& app) {
@@ -349,7 +360,8 @@ void add_template_command(CLI::App& app) {
       "template",
       "Derive a transition template from its completed, pushed-together sheet arrangement (no\n"
       "connectivity is typed in) and print or write it. Tet- and hex-side nodes sit where dicing\n"
-      "puts them; the rest are placed by optimization unless --no-smooth.");
+      "puts them; the rest are placed by optimization unless --no-smooth. A mesh that fails the validity\n"
+      "check (inverted or overlapping cells) exits 4 and nothing is written (see --write-invalid).");
   t->add_option("NAME", args->name,
                 "geode3d: the 26-hex geode (tet side split by a diagonal into 2 triangles);\n"
                 "geode2d: the 5-quad 2D geode; geode4tri: the tet side split into 4 triangles;\n"
@@ -391,6 +403,7 @@ void add_template_command(CLI::App& app) {
               "geode4tri: the plain dual of the arrangement, without pillowing away the obstructions to a\n"
               "positive-Jacobian placement (its pinched corners cannot be untangled)");
   t->add_flag("--quality", args->quality, "append the quality report (the paper's Table 1 metrics)");
+  add_write_invalid_flag(t, args->write_invalid);
   // Every push parameter (and refine3's layer): a number with its default shown.
   auto number_option = [t](const std::string& name, double& value, const std::string& help) {
     t->add_option(name, value, help)->check(number_check())->capture_default_str();

@@ -8,6 +8,7 @@
 #include <type_traits>
 
 #include "cli/commands.hpp"
+#include "cli/conventions.hpp"
 #include "primal/errors.hpp"
 #include "stc/mesh_dual.hpp"
 #include "stc/sheet_surfaces.hpp"
@@ -67,6 +68,7 @@ std::vector<viewer::ViewSheet> mesh_view_sheets(const Mesh& mesh, const Surfaces
 }
 
 void run_view(const ViewArgs& a) {
+  check_not_input(a.output, a.input, false);  // the page never replaces the mesh it shows
   const std::filesystem::path out(a.output);
   if (file_extension(out) != ".html")
     throw InvalidInput(a.output + ": unknown output format '" + file_extension(out) + "' (expected .html)");

@@ -195,7 +195,11 @@ void impose_geode_sides(RefTemplate& four, const RefTemplate& geode, const Eigen
 
 }  // namespace
 
-const RefTemplate& reference_template(const Eigen::Vector3d& box, std::array<int, 2> diagonal) {
+const RefTemplate& reference_template(const Eigen::Vector3d& given_box, std::array<int, 2> diagonal) {
+  // Only the box's proportions matter (the templates are kept in reference coordinates): build
+  // them with the largest side 24, the scale the arrangement engine and smoother were tuned at,
+  // so that --template-box 1e6x1e6x1e6 gives what 24x24x24 does.
+  const Eigen::Vector3d box = given_box * (24.0 / given_box.maxCoeff());
   // One slot per box and diagonal (kCentreCorner: the four-triangle template), built once;
   // the lock only finds the slot, so that different templates are built at the same time
   // (conform builds both diagonals in parallel). std::map nodes never move.

@@ -1,6 +1,7 @@
 #include "io/atomic_file.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -14,77 +15,210 @@
 
 namespace geode::io {
 
+namespace fs = std::filesystem;
+
 namespace {
 
 std::string reason(int err) { return std::strerror(err); }
 
+// The temporaries a signal must remove: a fixed table (no allocation, no locks), each slot
+// free (0), being filled (1) or holding a path (2). std::atomic<int> is lock-free here, so the
+// handler may read it.
+constexpr int kSlots = 64;
+constexpr std::size_t kPathBytes = 4096;
+struct Slot {
+  std::atomic<int> state{0};
+  char path[kPathBytes];
+};
+Slot g_slots[kSlots];
+static_assert(std::atomic<int>::is_always_lock_free);
+
+extern "C" void unlink_temporaries_and_reraise(int sig) {
+  for (Slot& s : g_slots)
+    if (s.state.load() == 2) ::unlink(s.path);
+  ::signal(sig, SIG_DFL);
+  ::raise(sig);
+}
+
 // Removes the temporary file unless released, so that every exit path cleans up.
 class TempFileGuard {
  public:
-  explicit TempFileGuard(std::filesystem::path p) : path_(std::move(p)) {}
+  explicit TempFileGuard(fs::path p) : path_(std::move(p)) {}
   ~TempFileGuard() {
-    if (!path_.empty()) {
-      std::error_code ec;
-      std::filesystem::remove(path_, ec);
-    }
+    if (!path_.empty()) remove_temporary(path_);
   }
   TempFileGuard(const TempFileGuard&) = delete;
   TempFileGuard& operator=(const TempFileGuard&) = delete;
   void release() { path_.clear(); }
 
  private:
-  std::filesystem::path path_;
+  fs::path path_;
 };
 
-void write_atomically(const std::filesystem::path& path, const std::string& suffix,
-                      const std::function<void(const std::filesystem::path& temp)>& write,
-                      bool require_content) {
+// Copies a finished file into a target that is not a regular file (a device, a FIFO): what a
+// write to it says (ENOSPC from /dev/full) is the error.
+void copy_into(const fs::path& from, const fs::path& to, const fs::path& shown) {
+  const int in = ::open(from.c_str(), O_RDONLY);
+  if (in < 0) throw InvalidInput(shown.string() + ": cannot reopen the temporary file: " + reason(errno));
+  const int out = ::open(to.c_str(), O_WRONLY | O_TRUNC);
+  if (out < 0) {
+    const int e = errno;
+    ::close(in);
+    throw InvalidInput(shown.string() + ": cannot open " + to.string() + " for writing: " + reason(e));
+  }
+  char buf[1 << 16];
+  int failure = 0;
+  for (;;) {
+    const ssize_t n = ::read(in, buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      failure = errno;
+      break;
+    }
+    if (n == 0) break;
+    for (ssize_t done = 0; done < n;) {
+      const ssize_t w = ::write(out, buf + done, static_cast<std::size_t>(n - done));
+      if (w < 0 && errno == EINTR) continue;
+      if (w <= 0) {
+        failure = w < 0 ? errno : EIO;
+        break;
+      }
+      done += w;
+    }
+    if (failure) break;
+  }
+  ::close(in);
+  if (::close(out) != 0 && !failure) failure = errno;
+  if (failure) throw InvalidInput(shown.string() + ": write failed: " + reason(failure));
+}
+
+void write_atomically(const fs::path& path, const std::string& suffix,
+                      const std::function<void(const fs::path& temp)>& write, bool require_content) {
   if (path.filename().empty()) throw InvalidInput(path.string() + ": not a file name");
-  const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : ".";
-  // O_CREAT|O_EXCL with a per-process counter gives a name no concurrent writer of the same
-  // target uses; the kernel applies the umask to mode 0666 like for any new file.
-  static std::atomic<unsigned> counter{0};
-  std::filesystem::path tmp;
-  int fd = -1;
-  for (int attempt = 0; attempt < 100 && fd < 0; ++attempt) {
-    tmp = dir / ("." + path.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
-                 std::to_string(counter++) + suffix);
-    fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0666);
-    if (fd < 0 && errno != EEXIST) break;
-  }
-  if (fd < 0) {
-    throw InvalidInput(path.string() + ": cannot create a temporary file in " + dir.string() +
-                       ": " + reason(errno));
-  }
+  const OutputTarget target = resolve_output(path);
+  const fs::path tmp = create_temporary(target, suffix);
   TempFileGuard guard(tmp);
-  ::close(fd);  // the writer reopens it by name; the name stays ours until renamed or removed
   write(tmp);
   std::error_code ec;
-  if (require_content && (std::filesystem::file_size(tmp, ec) == 0 || ec))
-    throw InvalidInput(path.string() + ": the writer left the temporary file " + tmp.string() + " empty");
+  if (require_content && (fs::file_size(tmp, ec) == 0 || ec))
+    throw InvalidInput(path.string() + ": the writer left its temporary file empty");
   // Sync the data before the rename so that a crash cannot leave an empty file under the name.
   const int sfd = ::open(tmp.c_str(), O_RDONLY);
   if (sfd >= 0) {
     ::fsync(sfd);
     ::close(sfd);
   }
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) throw InvalidInput(path.string() + ": cannot rename temporary file: " + ec.message());
+  publish_temporary(tmp, target, path);
   guard.release();
 }
 
 }  // namespace
 
-void write_path_atomically(const std::filesystem::path& path, const std::string& suffix,
-                           const std::function<void(const std::filesystem::path& temp)>& write) {
+void register_temporary(const fs::path& temp) {
+  const std::string& s = temp.native();
+  if (s.size() >= kPathBytes) return;
+  for (Slot& slot : g_slots) {
+    int expected = 0;
+    if (!slot.state.compare_exchange_strong(expected, 1)) continue;
+    std::memcpy(slot.path, s.c_str(), s.size() + 1);
+    slot.state.store(2);
+    return;
+  }
+}
+
+void unregister_temporary(const fs::path& temp) {
+  for (Slot& slot : g_slots)
+    if (slot.state.load() == 2 && temp.native() == slot.path) {
+      slot.state.store(0);
+      return;
+    }
+}
+
+void install_signal_cleanup() {
+  struct sigaction sa {};
+  sa.sa_handler = unlink_temporaries_and_reraise;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = 0;
+  for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) {
+    struct sigaction old {};
+    // A signal ignored by whoever started us (nohup) stays ignored.
+    if (::sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+    ::sigaction(sig, &sa, nullptr);
+  }
+}
+
+OutputTarget resolve_output(const fs::path& path) {
+  fs::path p = path;
+  std::error_code ec;
+  int hops = 0;
+  while (fs::is_symlink(p, ec)) {
+    if (++hops > 40) throw InvalidInput(path.string() + ": too many levels of symbolic links");
+    const fs::path link = fs::read_symlink(p, ec);
+    if (ec) throw InvalidInput(path.string() + ": cannot read the symbolic link: " + ec.message());
+    p = link.is_absolute() ? link : p.parent_path() / link;
+  }
+  OutputTarget t{p, true};
+  const fs::file_status st = fs::status(p, ec);
+  if (!ec && fs::exists(st)) {
+    if (fs::is_directory(st)) throw InvalidInput(path.string() + ": is a directory, not an output file");
+    t.regular = fs::is_regular_file(st);
+  }
+  return t;
+}
+
+fs::path create_temporary(const OutputTarget& target, const std::string& suffix) {
+  std::error_code ec;
+  const fs::path dir = !target.regular ? fs::temp_directory_path(ec)
+                       : target.file.has_parent_path() ? target.file.parent_path()
+                                                       : fs::path(".");
+  // O_CREAT|O_EXCL with a per-process counter gives a name no concurrent writer of the same
+  // target uses; the kernel applies the umask to mode 0666 like for any new file.
+  static std::atomic<unsigned> counter{0};
+  fs::path tmp;
+  int fd = -1;
+  for (int attempt = 0; attempt < 100 && fd < 0; ++attempt) {
+    tmp = dir / ("." + target.file.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
+                 std::to_string(counter++) + suffix);
+    // Registered before it exists: a signal between open and registration cannot leave it.
+    register_temporary(tmp);
+    fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0666);
+    if (fd < 0) unregister_temporary(tmp);
+    if (fd < 0 && errno != EEXIST) break;
+  }
+  if (fd < 0)
+    throw InvalidInput(target.file.string() + ": cannot create a temporary file in " + dir.string() + ": " +
+                       reason(errno));
+  ::close(fd);  // the writer reopens it by name; the name stays ours until renamed or removed
+  return tmp;
+}
+
+void publish_temporary(const fs::path& temp, const OutputTarget& target, const fs::path& shown) {
+  if (!target.regular) {
+    copy_into(temp, target.file, shown);
+    remove_temporary(temp);
+    return;
+  }
+  std::error_code ec;
+  fs::rename(temp, target.file, ec);
+  if (ec) throw InvalidInput(shown.string() + ": cannot rename the temporary file: " + ec.message());
+  unregister_temporary(temp);
+}
+
+void remove_temporary(const fs::path& temp) {
+  std::error_code ec;
+  fs::remove(temp, ec);
+  unregister_temporary(temp);
+}
+
+void write_path_atomically(const fs::path& path, const std::string& suffix,
+                           const std::function<void(const fs::path& temp)>& write) {
   write_atomically(path, suffix, write, true);
 }
 
-void write_file_atomically(const std::filesystem::path& path,
-                           const std::function<void(std::ostream&)>& write) {
-  write_atomically(path, "", [&](const std::filesystem::path& tmp) {
+void write_file_atomically(const fs::path& path, const std::function<void(std::ostream&)>& write) {
+  write_atomically(path, "", [&](const fs::path& tmp) {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw InvalidInput(path.string() + ": cannot open temporary file " + tmp.string());
+    if (!out) throw InvalidInput(path.string() + ": cannot open its temporary file");
     write(out);
     out.flush();
     if (!out) throw InvalidInput(path.string() + ": write failed (disk full?)");

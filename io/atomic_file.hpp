@@ -2,10 +2,18 @@
 // Write a file so that readers never see it half-written: the content goes to a temporary file
 // in the same directory (so that the final rename stays on one file system and is atomic under
 // POSIX), which replaces the target only once it has been written, flushed and synced.
+//
+// Every temporary is registered while it exists, and install_signal_cleanup() (called once by
+// the `geode` command) makes SIGINT, SIGTERM, SIGHUP and SIGQUIT unlink the registered ones
+// before the signal takes its default action: an interrupted run leaves no hidden file behind.
+//
+// The target is followed through symbolic links: a link is written through to the file it
+// names (and stays a link). A target that is not a regular file (a device such as /dev/full, a
+// FIFO) gets the finished content copied into it, a failed write (a full device) being an error.
 #include <filesystem>
 #include <functional>
-#include <string>
 #include <ostream>
+#include <string>
 
 namespace geode::io {
 
@@ -20,5 +28,37 @@ void write_file_atomically(const std::filesystem::path& path,
 // format by extension) and must fill it; an empty file afterwards counts as a failed write.
 void write_path_atomically(const std::filesystem::path& path, const std::string& suffix,
                            const std::function<void(const std::filesystem::path& temp)>& write);
+
+// Where output `path` really goes: symbolic links followed to the file they name (which need not
+// exist yet); `regular` is false for an existing target that is not a regular file (a device, a
+// FIFO), which is written by copying into it instead of renaming over it.
+struct OutputTarget {
+  std::filesystem::path file;
+  bool regular = true;
+};
+OutputTarget resolve_output(const std::filesystem::path& path);
+
+// A fresh temporary file name for `target`: hidden, next to the file (the system's temporary
+// directory for a target that is not a regular file), with the pid, a counter and `suffix`;
+// created empty (O_EXCL) and registered for removal on signals. InvalidInput when it cannot be.
+std::filesystem::path create_temporary(const OutputTarget& target, const std::string& suffix);
+
+// Moves a finished temporary to its target (rename, or copy into a non-regular target and remove
+// the temporary); InvalidInput naming `shown` (the path the user gave) when that fails.
+void publish_temporary(const std::filesystem::path& temp, const OutputTarget& target,
+                       const std::filesystem::path& shown);
+
+// Removes a temporary (if it is still there) and forgets it.
+void remove_temporary(const std::filesystem::path& temp);
+
+// Registers / forgets a path to unlink on a signal (create_temporary registers its own;
+// publish_temporary and remove_temporary forget them). At most 64 at once; more are not
+// cleaned up on signals (they are still removed on every ordinary exit path).
+void register_temporary(const std::filesystem::path& temp);
+void unregister_temporary(const std::filesystem::path& temp);
+
+// Installs the handlers for SIGINT, SIGTERM, SIGHUP and SIGQUIT: unlink every registered
+// temporary (async-signal-safe: a fixed table, unlink), then re-raise with the default action.
+void install_signal_cleanup();
 
 }  // namespace geode::io

@@ -1,6 +1,7 @@
 #include "primal/interface.hpp"
 
 #include <algorithm>
+#include <sstream>
 #include <string>
 #include <unordered_map>
 #include <unordered_set>
@@ -48,6 +49,30 @@ bool on_triangle(const Point& p, const Point& a, const Point& b, const Point& c,
   return la >= -tol && lb >= -tol && lc >= -tol;
 }
 
+// Two elements of one kind on the same nodes (a duplicated element, or one block read twice)
+// hide the faces between them, so that the interface would seem to vanish there; name them
+// instead. First pair in element order.
+template <std::size_t N>
+void refuse_duplicates(const Model& model, const std::vector<std::array<Index, N>>& cells, ElementKind kind) {
+  std::unordered_map<std::array<Index, N>, Index, IndexArrayHash> first;
+  first.reserve(cells.size());
+  for (std::size_t e = 0; e < cells.size(); ++e) {
+    std::array<Index, N> key = cells[e];
+    std::sort(key.begin(), key.end());
+    const auto [it, inserted] = first.try_emplace(key, static_cast<Index>(e));
+    if (!inserted)
+      throw TopologyError("find_interface: " + describe_element(model, {kind, static_cast<Index>(e)}) +
+                          " has the same nodes as " + describe_element(model, {kind, it->second}) + " (nodes " +
+                          node_list(model, cells[e]) + "): a duplicated element (an element or a block given twice?)");
+  }
+}
+
+// How far (relative to its mean edge) a four-triangle split's centre node may lie off the plane
+// through the quad's centre point: enough for a centre put on a curved surface the quad
+// approximates (the sag of a quad spanning 30 degrees is 0.03 of its edge), far less than a
+// gap or an overlap between the parts.
+constexpr double kFanCentreOffset = 0.05;
+
 }  // namespace
 
 namespace {
@@ -72,6 +97,8 @@ std::vector<std::array<Index, 3>> interface_triangles(const InterfaceQuad& q) {
 
 Interface find_interface(const Model& model, double tol) {
   validate(model, "find_interface");
+  refuse_duplicates(model, model.hexes, ElementKind::Hex);
+  refuse_duplicates(model, model.tets, ElementKind::Tet);
   const auto& P = model.points;
   auto pt = [&](Index v) -> const Point& { return P[static_cast<std::size_t>(v)]; };
 
@@ -160,6 +187,30 @@ Interface find_interface(const Model& model, double tol) {
     if (centre != kInvalidIndex && in_hex[static_cast<std::size_t>(centre)])
       throw TopologyError("find_interface: " + name + " is split into four triangles around " +
                           describe_node(model, centre) + ", a node of the hex part too");
+    if (centre != kInvalidIndex) {
+      // The four triangles must cover the quad as its two triangles would: the centre near the
+      // quad's surface (off it is a gap between the parts, or an overlap) and every triangle
+      // facing the way the quad does (else the centre lies outside the quad).
+      const Point normal = (pt(c[2]) - pt(c[0])).cross(pt(c[3]) - pt(c[1])).normalized();
+      const Point middle = (pt(c[0]) + pt(c[1]) + pt(c[2]) + pt(c[3])) / 4.0;
+      double edge = 0;
+      for (std::size_t i = 0; i < 4; ++i) edge += (pt(c[(i + 1) % 4]) - pt(c[i])).norm() / 4.0;
+      const double off = (pt(centre) - middle).dot(normal);
+      if (std::abs(off) > kFanCentreOffset * edge) {
+        std::ostringstream m;
+        m << "find_interface: " << name << " is split into four triangles around " << describe_node(model, centre)
+          << ", which lies " << std::abs(off) << " " << (off > 0 ? "outside the hex face (a gap between the parts)"
+                                                                 : "inside the hex (the parts overlap)")
+          << "; at most " << kFanCentreOffset << " x the quad's mean edge (" << edge << ") off its centre "
+          << point_text(middle);
+        throw TopologyError(m.str());
+      }
+      for (std::size_t i = 0; i < 4; ++i)
+        if ((pt(c[(i + 1) % 4]) - pt(c[i])).cross(pt(centre) - pt(c[i])).dot(normal) <= 0)
+          throw TopologyError("find_interface: " + name + " is split into four triangles around " +
+                              describe_node(model, centre) + ", which lies outside the quad (the triangle on nodes " +
+                              node_list(model, std::array<Index, 3>{c[i], c[(i + 1) % 4], centre}) + " folds over)");
+    }
     const bool d0 = found[0][0] && found[0][1], d1 = found[1][0] && found[1][1];
     if (centre == kInvalidIndex && (count != 2 || !(d0 || d1))) {
       std::string detail;

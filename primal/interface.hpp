@@ -44,7 +44,10 @@ std::vector<std::array<Index, 3>> interface_triangles(const InterfaceQuad& quad)
 // do not conform:
 // - a boundary quad of the hex part matched by only one triangle of the tet part (or by
 //   triangles of both diagonals);
-// - a four-triangle centre node that is a node of the hex part too;
+// - a four-triangle centre node that is a node of the hex part too, lies more than 0.05 of the
+//   quad's mean edge off the plane through the quad's centre point (a gap between the parts
+//   when outside the hex, an overlap when inside), or outside the quad (a triangle folds);
+// - two hexes (or two tets) on the same nodes (a duplicated element);
 // - a node of one side lying on a boundary face of the other side without being one of its
 //   corners (hanging node, different refinement, unmerged duplicate node);
 // - a node used by both parts that is on no interface quad (the parts touch along an edge

@@ -31,7 +31,7 @@ geode_install() {
   fi
 }
 
-# geode_fuzz: the libFuzzer targets of the file readers (tests/fuzz), built with clang in
+# geode_fuzz: the libFuzzer targets of the file readers and the JSON spec reader (tests/fuzz), built with clang in
 # build-fuzz, each run for GEODE_FUZZ_RUNS inputs (1,000,000; 25 to 55 s each here) from its
 # seed corpus with a fixed seed, so a run is repeatable for a given build (a longer search:
 # GEODE_FUZZ_RUNS=-1 GEODE_FUZZ_SECONDS=600). A crash fails, its input kept as
@@ -40,8 +40,8 @@ geode_fuzz() {
   local runs=${GEODE_FUZZ_RUNS:-1000000} seconds=${GEODE_FUZZ_SECONDS:-120} dir="$GEODE_ROOT/build-fuzz"
   CC=clang CXX=clang++ cmake -S "$GEODE_ROOT" -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGEODE_FUZZ=ON \
     -DGEODE_BENCH=OFF "${GEODE_LAUNCHER[@]}" >/dev/null
-  cmake --build "$dir" -j "$JOBS" --target fuzz_msh fuzz_vtu fuzz_vtk fuzz_exo
-  for reader in msh vtu vtk exo; do
+  cmake --build "$dir" -j "$JOBS" --target fuzz_msh fuzz_vtu fuzz_vtk fuzz_exo fuzz_spec
+  for reader in msh vtu vtk exo spec; do
     local work
     work=$(mktemp -d)
     echo "== fuzz $reader ($runs inputs, at most $seconds s)"

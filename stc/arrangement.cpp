@@ -835,7 +835,9 @@ Arrangement Engine::run() {
   else
     for (int a = 0; a < m; ++a)
       for (int b = a + 1; b < m; ++b) subsets.push_back({a, b});
-  for (const auto& S : subsets) {
+  for (std::size_t k = 0; k < subsets.size(); ++k) {
+    if (options_.progress) options_.progress(k, subsets.size());
+    const auto& S = subsets[k];
     std::vector<Curve> found;
     for (const Point& s : seeds(S)) {
       bool covered = false;
@@ -851,6 +853,7 @@ Arrangement Engine::run() {
     }
     for (auto& c : found) A.curves.push_back(std::move(c));
   }
+  if (options_.progress) options_.progress(subsets.size(), subsets.size());
 
   // 2. Events along each curve, vertices, and 1-cells.
   struct RawEdge {

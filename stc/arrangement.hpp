@@ -36,6 +36,7 @@
 // plane) can pass unseen, as can a touching within two cells of a traced curve of the same
 // two sheets. Raising seed_resolution tightens all of these.
 #include <array>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -99,6 +100,9 @@ struct ArrangementOptions {
   double step = 0.004;
   // Newton tolerance on field values, relative to the field gradient (a length).
   double tolerance = 1e-11;
+  // Told how many of the sheet pairs (2D: sheets) have been traced, for a progress display;
+  // empty: silent. Does not change the result.
+  std::function<void(std::size_t done, std::size_t total)> progress;
 };
 
 // A 0-cell: d sheets meet transversally at x.

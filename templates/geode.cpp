@@ -309,9 +309,7 @@ Template dual_template(const stc::DualMesh& D, const std::vector<stc::Sheet>& sh
   return T;
 }
 
-}  // namespace
-
-Template build_template(const ArrangementSpec& spec, const stc::ArrangementOptions& options) {
+Template build_in_place(const ArrangementSpec& spec, const stc::ArrangementOptions& options) {
   const std::vector<stc::Sheet> sheets = spec_sheets(spec);
   const stc::Arrangement A = stc::compute_arrangement(sheets, spec.domain, options);
   const stc::DualMesh D = stc::dualize(A);
@@ -332,10 +330,70 @@ Template build_template(const ArrangementSpec& spec, const stc::ArrangementOptio
   return T;
 }
 
+// The arrangement engine's and the smoother's tolerances are absolute, set for cells of the
+// paper's size (24 x 14 x 24): a template is derived and smoothed in a copy of its box centred
+// at the origin with its largest side kReferenceSize, and mapped back, so that it depends on
+// the box's proportions alone (a box of 1e6 gives the 24 box's template scaled).
+constexpr double kReferenceSize = 24.0;
+
+struct ReferenceFrame {
+  Point centre = Point::Zero();
+  double scale = 1.0;  // reference = scale * (x - centre)
+  bool identity() const { return scale == 1.0 && centre == Point::Zero(); }
+  Point to_reference(const Point& x) const { return scale * (x - centre); }
+  Point from_reference(const Point& r) const { return centre + r / scale; }
+};
+
+ReferenceFrame frame_of(const Point& lo, const Point& hi, int dim) {
+  ReferenceFrame f;
+  const Point size = hi - lo;
+  const double largest = dim == 3 ? size.maxCoeff() : std::max(size.x(), size.y());
+  if (!(largest > 0) || !std::isfinite(largest)) return f;
+  f.centre = 0.5 * (lo + hi);
+  if (dim == 2) f.centre.z() = 0;
+  f.scale = kReferenceSize / largest;
+  return f;
+}
+
+std::vector<Point>& template_points(Template& t) { return t.dim == 3 ? t.hex.points : t.quad.points; }
+
+primal::SmoothResult smooth_in_place(Template& t, bool slide_faces);
+
+}  // namespace
+
+Template build_template(const ArrangementSpec& spec, const stc::ArrangementOptions& options) {
+  // A completion's sheets live in the box's reference frame, so only its coordinates scale.
+  // Sheets given as shapes are in the spec's own units and are left as they are.
+  if (!spec.completion || !spec.sheets.empty() || spec.domain.corners) return build_in_place(spec, options);
+  const ReferenceFrame f = frame_of(spec.domain.lo, spec.domain.hi, spec.dim);
+  if (f.identity()) return build_in_place(spec, options);
+  ArrangementSpec s = spec;
+  s.domain = stc::Domain(f.to_reference(spec.domain.lo), f.to_reference(spec.domain.hi), spec.dim);
+  for (InterfacePatch* p : {&s.completion->hex_side, &s.completion->tet_side})
+    for (Point& x : p->points) x = f.to_reference(x);
+  Template T = build_in_place(s, options);
+  for (Point& x : template_points(T)) x = f.from_reference(x);
+  return T;
+}
+
 Template build_geode3d(const GeodeOptions& options) { return build_template(geode_spec(options, 3), options.arrangement); }
 Template build_geode2d(const GeodeOptions& options) { return build_template(geode_spec(options, 2), options.arrangement); }
 
 primal::SmoothResult smooth_template(Template& t, bool slide_faces) {
+  // In the reference frame of the template's bounding box (see kReferenceSize).
+  Point lo = Point::Constant(1e300), up = Point::Constant(-1e300);
+  for (const auto& p : template_points(t)) lo = lo.cwiseMin(p), up = up.cwiseMax(p);
+  const ReferenceFrame f = template_points(t).empty() ? ReferenceFrame{} : frame_of(lo, up, t.dim);
+  if (f.identity()) return smooth_in_place(t, slide_faces);
+  for (Point& x : template_points(t)) x = f.to_reference(x);
+  const primal::SmoothResult r = smooth_in_place(t, slide_faces);
+  for (Point& x : template_points(t)) x = f.from_reference(x);
+  return r;
+}
+
+namespace {
+
+primal::SmoothResult smooth_in_place(Template& t, bool slide_faces) {
   if (t.dim == 3) {
     Point lo = Point::Constant(1e300), up = Point::Constant(-1e300);
     for (const auto& p : t.hex.points) lo = lo.cwiseMin(p), up = up.cwiseMax(p);
@@ -358,6 +416,8 @@ primal::SmoothResult smooth_template(Template& t, bool slide_faces) {
   }
   return primal::smooth_quad_mesh(t.quad, Point::UnitZ(), c);
 }
+
+}  // namespace
 
 std::vector<primal::Obstruction> template_obstructions(const Template& t) {
   primal::RealizabilityOptions o;

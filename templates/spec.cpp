@@ -23,6 +23,14 @@ const std::map<std::string, int>& shape_dims() {
   return d;
 }
 
+// Bounds: a spec is a handful of sheets, each a shape of a few nested parts. Deeper nesting
+// (20,000 nested offsets) would recurse the reader off the stack, and thousands of sheets would
+// take the arrangement hours (it meets every triple of sheets) before it could say anything.
+constexpr int kMaxJsonDepth = 64;      // nesting of objects and arrays in the file
+constexpr int kMaxShapeDepth = 16;     // shapes inside union / intersection / offset / scaled
+constexpr std::size_t kMaxShapeParts = 256;  // shapes in one sheet, all levels
+constexpr std::size_t kMaxSheets = 256;
+
 // Validates spec JSON against the format, naming the spec and the JSON path of every fault.
 class Reader {
  public:
@@ -80,9 +88,13 @@ class Reader {
   InterfacePatch patch(const json& j, const std::string& path, const stc::Domain& box, bool top,
                        bool prescribed = false) const;
   PushParameters push(const json& j) const;
-  stc::Field shape(const json& j, const std::string& path) const;
+  stc::Field shape(const json& j, const std::string& path) const {
+    std::size_t parts = 0;
+    return shape(j, path, 0, parts);
+  }
 
  private:
+  stc::Field shape(const json& j, const std::string& path, int level, std::size_t& parts) const;
   // An orthonormal frame from optional "axes" (3D: the first two, 2D: the first), else x, y, z.
   std::array<Point, 3> frame(const json& j, const std::string& path) const;
   std::string source_;
@@ -202,7 +214,9 @@ std::array<Point, 3> Reader::frame(const json& j, const std::string& path) const
   return e;
 }
 
-stc::Field Reader::shape(const json& j, const std::string& path) const {
+stc::Field Reader::shape(const json& j, const std::string& path, int level, std::size_t& parts) const {
+  if (level > kMaxShapeDepth) fail(path, "shapes nested deeper than " + std::to_string(kMaxShapeDepth) + " levels");
+  if (++parts > kMaxShapeParts) fail(path, "more than " + std::to_string(kMaxShapeParts) + " shapes in one sheet");
   if (!j.is_object()) fail(path, "must be an object holding one shape");
   std::string kind;
   for (const auto& [key, value] : j.items())
@@ -223,16 +237,18 @@ stc::Field Reader::shape(const json& j, const std::string& path) const {
   const json& s = j[kind];
 
   if (kind == "union" || kind == "intersection") {
-    std::vector<stc::Field> parts;
-    each(s, at, 2, [&](const json& q, const std::string& p) { parts.push_back(shape(q, p)); });
-    stc::Field f = parts[0];
-    for (std::size_t i = 1; i < parts.size(); ++i)
-      f = kind == "union" ? stc::field_union(f, parts[i]) : stc::field_intersection(f, parts[i]);
+    if (s.is_array() && s.size() > kMaxShapeParts)
+      fail(at, "more than " + std::to_string(kMaxShapeParts) + " shapes in one sheet");
+    std::vector<stc::Field> fields;
+    each(s, at, 2, [&](const json& q, const std::string& p) { fields.push_back(shape(q, p, level + 1, parts)); });
+    stc::Field f = fields[0];
+    for (std::size_t i = 1; i < fields.size(); ++i)
+      f = kind == "union" ? stc::field_union(f, fields[i]) : stc::field_intersection(f, fields[i]);
     return f;
   }
   if (kind == "offset" || kind == "scaled") {
     object(s, at, {"of", "by"});
-    const stc::Field of = shape(member(s, at, "of"), join(at, "of"));
+    const stc::Field of = shape(member(s, at, "of"), join(at, "of"), level + 1, parts);
     const double by = number(member(s, at, "by"), join(at, "by"));
     if (kind == "offset") return stc::field_offset(of, by);
     if (by == 0) fail(join(at, "by"), "must not be zero");
@@ -430,6 +446,28 @@ json::json_pointer pointer(const std::string& path, const std::string& source) {
   return json::json_pointer(p);
 }
 
+// Whether two validated sheet shapes are one surface: the same JSON, or two planes (lines) with
+// parallel normals through one another's point (a plane's field is its signed distance, so the
+// sign of the normal does not change the surface).
+bool coincident(const json& a, const json& b, int dim) {
+  if (a == b) return true;
+  const auto plane = [dim](const json& s, Point& p, Point& n) {
+    const char* key = s.contains("plane") ? "plane" : s.contains("line") ? "line" : nullptr;
+    if (!key) return false;
+    p = n = Point::Zero();
+    for (int i = 0; i < dim; ++i) {
+      p[i] = s[key]["point"][static_cast<std::size_t>(i)].get<double>();
+      n[i] = s[key]["normal"][static_cast<std::size_t>(i)].get<double>();
+    }
+    n.normalize();
+    return true;
+  };
+  Point pa, na, pb, nb;
+  if (!plane(a, pa, na) || !plane(b, pb, nb)) return false;
+  const double scale = std::max({1.0, pa.norm(), pb.norm()});
+  return na.cross(nb).norm() < 1e-12 && std::abs(na.dot(pb - pa)) < 1e-12 * scale;
+}
+
 }  // namespace
 
 ArrangementSpec parse_spec(const json& j, const std::string& source) {
@@ -469,6 +507,9 @@ ArrangementSpec parse_spec(const json& j, const std::string& source) {
   }
 
   std::set<std::string> names;
+  if (j.contains("sheets") && j["sheets"].is_array() && j["sheets"].size() > kMaxSheets)
+    r.fail("sheets", std::to_string(j["sheets"].size()) + " sheets; at most " + std::to_string(kMaxSheets) +
+                         " (the arrangement meets every triple of sheets)");
   if (j.contains("sheets"))
     r.each(j["sheets"], "sheets", 0, [&](const json& s, const std::string& at) {
       if (!s.is_object()) r.fail(at, "must be an object");
@@ -485,6 +526,12 @@ ArrangementSpec parse_spec(const json& j, const std::string& source) {
       for (const auto& [key, value] : s.items())
         if (shape_dims().count(key)) sh.shape = json{{key, value}}, sh.kind = key;
       if (s.contains("kind")) sh.kind = s["kind"].get<std::string>();
+      // Two sheets that are one surface are never in general position; say so now, not after
+      // tracing every curve between them.
+      for (std::size_t o = 0; o < spec.sheets.size(); ++o)
+        if (coincident(spec.sheets[o].shape, sh.shape, spec.dim))
+          r.fail(where, "the same surface as sheets[" + std::to_string(o) + "] (" + spec.sheets[o].name +
+                            "): coincident sheets cannot be arranged");
       spec.sheets.push_back(sh);
     });
   else if (!spec.completion)
@@ -508,8 +555,19 @@ json read_spec_json(const std::filesystem::path& path) {
   std::stringstream text;
   text << in.rdbuf();
   if (!in && !in.eof()) throw InvalidInput(name + ": cannot be read");
+  return parse_spec_text(text.str(), name);
+}
+
+json parse_spec_text(std::string_view text, const std::string& name) {
   try {
-    json j = json::parse(text.str(), nullptr, true, /*ignore_comments=*/true);
+    // Nesting is bounded while parsing, before a deep tree is built (and torn down recursively).
+    const json::parser_callback_t depth_check = [&name](int depth, json::parse_event_t event, json&) {
+      if ((event == json::parse_event_t::object_start || event == json::parse_event_t::array_start) &&
+          depth >= kMaxJsonDepth)
+        throw InvalidInput(name + ": nested deeper than " + std::to_string(kMaxJsonDepth) + " levels, not a spec");
+      return true;
+    };
+    json j = json::parse(text, depth_check, true, /*ignore_comments=*/true);
     if (!j.is_object()) throw InvalidInput(name + ": must be a JSON object");
     return j;
   } catch (const json::parse_error& e) {

@@ -24,6 +24,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "stc/arrangement.hpp"
@@ -69,6 +70,9 @@ struct ArrangementSpec {
 ArrangementSpec parse_spec(const nlohmann::json& spec, const std::string& source);
 // A file: checked to be a JSON object of reasonable size before parsing.
 nlohmann::json read_spec_json(const std::filesystem::path& path);
+// The same for text in memory (`name` in messages): JSON with comments, nested at most 64
+// levels (checked while parsing, before a deep tree is built), a JSON object.
+nlohmann::json parse_spec_text(std::string_view text, const std::string& name);
 ArrangementSpec read_spec(const std::filesystem::path& path);
 
 // The spec as JSON (parse_spec(spec_json(s)) == s), and as text: objects one key a line,
