@@ -14,8 +14,6 @@
 
 namespace geode::io {
 
-using namespace primal;
-
 namespace {
 
 std::string reason(int err) { return std::strerror(err); }

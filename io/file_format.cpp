@@ -9,8 +9,6 @@
 
 namespace geode::io {
 
-using namespace primal;
-
 namespace {
 
 bool starts_with(std::string_view s, std::string_view prefix) { return s.substr(0, prefix.size()) == prefix; }
