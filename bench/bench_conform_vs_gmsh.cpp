@@ -161,8 +161,8 @@ int main(int argc, char** argv) {
   const fs::path dir = dir_template;
 
   const gp::Model model = geode::demo::demo_delaunay_block(n);
-  gp::write_gmsh(model, dir / "model.msh", gp::GmshFormat::Binary);
-  gp::write_gmsh(tet_model(model), dir / "tets.msh", gp::GmshFormat::Binary);
+  geode::io::write_gmsh(model, dir / "model.msh", geode::io::GmshFormat::Binary);
+  geode::io::write_gmsh(tet_model(model), dir / "tets.msh", geode::io::GmshFormat::Binary);
   std::printf("n %d: %zu hexes + %zu tets (%zu nodes); inputs in %s\n", n, model.hexes.size(),
               model.tets.size(), model.points.size(), dir.c_str());
 
@@ -193,7 +193,7 @@ int main(int argc, char** argv) {
   double smoothing_cpu = 0.0;
   std::vector<std::string> block_min;
   try {
-    const gp::Model g = gp::read_gmsh(dir / "gmsh.msh");
+    const gp::Model g = geode::io::read_gmsh(dir / "gmsh.msh");
     gmsh_hexes = g.hexes.size();
     if (!g.tets.empty()) std::printf("warning: gmsh's output still has %zu tets\n", g.tets.size());
     std::ifstream is(dir / "report.json");

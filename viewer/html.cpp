@@ -212,12 +212,12 @@ std::string html_view(const QuadMesh& mesh, const ViewScene& scene) {
 
 void write_html(const std::filesystem::path& path, const HexMesh& mesh, const ViewScene& scene) {
   const std::string text = html_view(mesh, scene);
-  write_file_atomically(path, [&](std::ostream& os) { os << text; });
+  io::write_file_atomically(path, [&](std::ostream& os) { os << text; });
 }
 
 void write_html(const std::filesystem::path& path, const QuadMesh& mesh, const ViewScene& scene) {
   const std::string text = html_view(mesh, scene);
-  write_file_atomically(path, [&](std::ostream& os) { os << text; });
+  io::write_file_atomically(path, [&](std::ostream& os) { os << text; });
 }
 
 }  // namespace geode::viewer

@@ -21,8 +21,8 @@ namespace geode::viewer {
 struct ViewSheet {
   std::string name;
   std::string kind;          // e.g. "tunnel", "dome", "mesh"; tunnels and domes get their own colours
-  TriMesh surface;           // 3D
-  SegmentMesh curve;         // 2D
+  primal::TriMesh surface;           // 3D
+  primal::SegmentMesh curve;         // 2D
   bool smooth = false;       // consistently oriented: shade with interpolated normals
   std::vector<primal::Index> layer;  // cells dual to the sheet
 };
