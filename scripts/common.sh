@@ -5,7 +5,7 @@ GEODE_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 GEODE_PACKAGES=(cmake g++ make libopenmesh-dev libeigen3-dev doctest-dev libcli11-dev
   nlohmann-json3-dev libexodusii-dev libgmsh-dev gmsh python3-vtk9 python3-matplotlib
   zlib1g-dev python3-meshio python3-netcdf4 clang libclang-rt-14-dev libjs-three chromium
-  libtbb-dev ccache)
+  libtbb-dev ccache clang-format clang-tidy)
 JOBS=${JOBS:-$(nproc)}
 # ccache keeps compiled objects between runs (and between clones: paths below the root are
 # hashed relative to it, the build directory not at all), so a second build costs little.
