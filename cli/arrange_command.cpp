@@ -27,7 +27,7 @@ struct ArrangeArgs {
 void run_arrange(const ArrangeArgs& a) {
   check_output_path(a.output);
   const std::string format =
-      output_format(a.output, a.format, {"appendix", "csv", "json", "vtu", "vtk", "msh", "msh22", "exo", "html"}, "appendix");
+      output_format(a.output, a.format, with_mesh_formats({"appendix", "csv", "json"}, {"html"}), "appendix");
   check_not_input(a.output, a.spec, a.force);
   const templates::ArrangementSpec spec = templates::read_spec(a.spec);
   // The smoother's constraints keep nodes on axis-aligned box faces.
@@ -72,9 +72,10 @@ void add_arrange_command(CLI::App& app) {
   c->add_option("SPEC", args->spec, "the spec, a JSON file")->required();
   c->add_option("--format", args->format,
                 "appendix: node and element tables (1-based); csv; json: with sheets, their\n"
-                "intersections and the interleave checks; vtu, vtk, msh, msh22, exo: the mesh (needs -o); html: a\n"
-                "self-contained viewer of the mesh, the sheets and their layers (needs -o)")
-      ->check(CLI::IsMember({"appendix", "csv", "json", "vtu", "vtk", "msh", "msh22", "exo", "html"}));
+                "intersections and the interleave checks; " + mesh_formats_help() +
+                    ":\nthe mesh (needs -o); html: a self-contained viewer of the mesh, the sheets and their\n"
+                    "layers (needs -o)")
+      ->check(CLI::IsMember(with_mesh_formats({"appendix", "csv", "json"}, {"html"})));
   c->add_option("-o,--output", args->output, "write to FILE (atomically) instead of standard output");
   c->add_flag("--smooth", args->smooth,
               "place the nodes by optimization (untangle, then maximise the minimum scaled Jacobian);\n"

@@ -122,7 +122,7 @@ void add_check_command(CLI::App& app) {
       "embedding with its planar boundary faces kept planar: doublets, pinched corners, a hex with two\n"
       "faces on one planar boundary face, flat corners, two-quad boundary nodes (primal/realizability.hpp\n"
       "says why each blocks). Exit 0 whenever the file could be checked.");
-  c->add_option("mesh", a->input, "All-hex mesh (.vtu, .vtk, .msh, .exo, .e) or planar quad mesh in z = 0 (.vtu, .vtk)")
+  c->add_option("mesh", a->input, hex_or_quad_input_help())
       ->required();
   c->add_option("--format", a->format,
                 "text, or json: {\"valid\", \"validity\", \"quality\", \"obstructions\": [{\"kind\", \"hexes\", \"nodes\"}]}\n"

@@ -1,8 +1,8 @@
 #pragma once
 // Sub-commands of the `geode` command line; each file registers its own. A new command follows
 // cli/conventions.hpp (exit codes, number_check / parse_box for numbers, output_format +
-// check_output_path before any work, OutputFiles for outputs written as one, write_mesh for
-// every mesh format) and reports long work through cli/progress.hpp.
+// check_output_path before any work, OutputFiles for outputs written as one, io::write_model
+// for every mesh format) and reports long work through cli/progress.hpp.
 #include <CLI/CLI.hpp>
 #include <filesystem>
 #include <functional>
@@ -29,15 +29,17 @@ void add_dual_command(CLI::App& app);       // cli/dual_command.cpp
 void add_check_command(CLI::App& app);      // cli/check_command.cpp
 void add_arrange_command(CLI::App& app);    // cli/arrange_command.cpp
 void add_view_command(CLI::App& app);       // cli/view_command.cpp
+void add_formats_command(CLI::App& app);    // cli/formats_command.cpp
 
 // Shared by the commands (cli/files.cpp): the extension in lower case (".msh"), and a model
-// read by extension and checked content (io/read_model.hpp: .msh, .exo, .e, .vtu, .vtk);
+// read by extension and checked content (io/read_model.hpp, any format of io/formats.hpp);
 // InvalidInput naming the file when it is missing or of another format.
 std::string file_extension(const std::filesystem::path& p);
 primal::Model read_model(const std::filesystem::path& path);
-// An all-hex mesh, or a planar quad mesh in z = 0 (.vtu / .vtk only), read by extension (.vtu,
-// .vtk, .msh, .exo, .e); InvalidInput naming the file otherwise (tets included). index_base is
-// how the file numbers its nodes and elements: 0 for VTK, 1 for Gmsh and Exodus.
+// An all-hex mesh, or a planar quad mesh in z = 0 (formats with PlainReader only), read by
+// extension (io::read_plain_mesh); InvalidInput naming the file otherwise (tets included).
+// index_base is how the file numbers its nodes and elements (io::MeshFormat::index_base: 0 for
+// VTK, 1 for Gmsh and Exodus).
 struct MeshFile {
   int dim = 3;
   primal::HexMesh hex;

@@ -24,8 +24,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const std::vector<std::string> kMeshFormats{"exo", "msh", "msh22", "vtu", "vtk"};
-
 struct ConformArgs {
   std::string input;
   std::string output;
@@ -102,7 +100,7 @@ std::string check_outputs(const ConformArgs& a) {
   if (!a.output.empty()) {
     if (a.output == "-") throw InvalidInput("-o -: a mesh is written to a file, not to standard output");
     check_output_path(a.output);
-    format = output_format(a.output, a.format, kMeshFormats, "");
+    format = output_format(a.output, a.format, mesh_format_names(), "");
   } else if (!a.format.empty()) {
     throw InvalidInput("--format " + a.format + " needs -o FILE");
   }
@@ -178,8 +176,7 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
     OutputFiles files;
     if (!a.output.empty())
       files.add(a.output, [&](const fs::path& temp) {
-        write_mesh(r.model, temp, format,
-                   a.vtu_encoding == "ascii" ? io::VtuEncoding::kAscii : io::VtuEncoding::kBinary);
+        io::write_model(r.model, temp, format, write_options(a.vtu_encoding));
       });
     if (!a.report.empty()) {
       files.add(a.report, [text = conform::report_json(r).dump(2) + "\n"](const fs::path& temp) {
@@ -206,13 +203,13 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
 // Options conform and demo share: where to write, the report, smoothing, quiet.
 void add_run_options(CLI::App* c, ConformArgs& a) {
   c->add_option("-o,--output", a.output,
-                "output mesh; the format follows the extension: .exo/.e (Exodus II), .msh (Gmsh 4.1),\n"
-                ".vtu (VTK XML, binary), .vtk (VTK legacy); written only if the result is valid\n"
-                "(see --write-invalid), together with --report (both or neither)");
+                "output mesh; the format follows the extension (" + mesh_formats_help() +
+                    ");\nwritten only if the result is valid (see --write-invalid), together with --report\n"
+                    "(both or neither)");
   c->add_option("--format", a.format,
-                "mesh format, when it must be named: exo, msh, msh22 (Gmsh 2.2, .msh), vtu, vtk;\n"
-                "one that contradicts the extension of -o is refused")
-      ->check(CLI::IsMember(kMeshFormats));
+                "mesh format, when it must be named (msh22 for Gmsh 2.2 in a .msh); one that\n"
+                "contradicts the extension of -o is refused")
+      ->check(CLI::IsMember(mesh_format_names()));
   c->add_option("--vtu-encoding", a.vtu_encoding, "binary (base64, default) or ascii DataArrays in .vtu")
       ->check(CLI::IsMember({"binary", "ascii"}))
       ->capture_default_str();
@@ -290,7 +287,7 @@ void add_conform_commands(CLI::App& app) {
       "around a centre node), smoothing where the result is below the input's own diced elements.\n"
       "Input element blocks, node sets and side sets are carried to the output. Exit 4 when the result\n"
       "fails verification.");
-  c->add_option("INPUT", args->input, "input model (.msh, .exo, .e, .vtu, .vtk)")->required();
+  c->add_option("INPUT", args->input, "input model (" + input_extensions_help() + ")")->required();
   add_run_options(c, *args);
   c->callback([args] {
     const std::string format = check_outputs(*args);  // before the long run, not after it
@@ -320,22 +317,21 @@ void add_conform_commands(CLI::App& app) {
   d->add_option("-n,--size", dargs->n, "cells per unit length (1 to 64; default 4; nugget, fulcher round up to even)")
       ->check(number_check(1, 64, true));
   d->add_option("--save-input", dargs->save_input,
-                "write the demo's input model (.msh, .exo, .e, .vtu, .vtk) to try `geode conform` on it;\n"
-                "without -o or --report nothing is conformed");
+                "write the demo's input model (" + io::extension_list(io::FormatRole::kWrite, ", ", ", ") +
+                    ") to try `geode conform` on it;\nwithout -o or --report nothing is conformed");
   add_run_options(d, *dargs);
   d->callback([dargs] {
     const std::string format = check_outputs(*dargs);
     std::string save_format;
     if (!dargs->save_input.empty()) {
       check_output_path(dargs->save_input);
-      save_format = output_format(dargs->save_input, "", kMeshFormats, "");
+      save_format = output_format(dargs->save_input, "", mesh_format_names(), "");
     }
     primal::Model model = demo::demo_model(dargs->model, dargs->n);
     if (!dargs->save_input.empty()) {
       OutputFiles files;
       files.add(dargs->save_input, [&](const fs::path& temp) {
-        write_mesh(model, temp, save_format,
-                   dargs->vtu_encoding == "ascii" ? io::VtuEncoding::kAscii : io::VtuEncoding::kBinary);
+        io::write_model(model, temp, save_format, write_options(dargs->vtu_encoding));
       });
       files.commit();
       if (!dargs->quiet)

@@ -11,9 +11,7 @@
 
 #include "cli/commands.hpp"
 #include "primal/errors.hpp"
-#include "io/exodus.hpp"
 #include "io/atomic_file.hpp"
-#include "io/gmsh.hpp"
 #include "primal/validity.hpp"
 
 #ifndef GEODE_VERSION
@@ -45,17 +43,26 @@ std::optional<double> finite_number(const std::string& text) {
 }
 
 struct FormatInfo {
-  const char* name;
+  std::string name;
   std::vector<std::string> extensions;
   bool mesh;
 };
 
+// The mesh formats that write (io/formats.hpp), then the text formats of the commands.
 const std::vector<FormatInfo>& formats() {
-  static const std::vector<FormatInfo> table{
-      {"exo", {".exo", ".e"}, true},  {"msh", {".msh"}, true},    {"msh22", {".msh"}, true},
-      {"vtu", {".vtu"}, true},        {"vtk", {".vtk"}, true},    {"json", {".json"}, false},   {"spec", {".json"}, false},
-      {"csv", {".csv"}, false},       {"appendix", {".txt"}, false}, {"text", {".txt"}, false},
-      {"html", {".html", ".htm"}, false}};
+  static const std::vector<FormatInfo> table = [] {
+    std::vector<FormatInfo> t;
+    for (const io::MeshFormat& f : io::mesh_formats())
+      if (f.write) t.push_back({std::string(f.name), {f.extensions.begin(), f.extensions.end()}, true});
+    for (FormatInfo text : std::vector<FormatInfo>{{"json", {".json"}, false},
+                                                   {"spec", {".json"}, false},
+                                                   {"csv", {".csv"}, false},
+                                                   {"appendix", {".txt"}, false},
+                                                   {"text", {".txt"}, false},
+                                                   {"html", {".html", ".htm"}, false}})
+      t.push_back(std::move(text));
+    return t;
+  }();
   return table;
 }
 
@@ -99,19 +106,19 @@ std::array<double, 3> parse_box(const std::string& option, const std::string& te
     }
   }
   parts.push_back(part);
-  if (static_cast<int>(parts.size()) != dim)
+  if (primal::index_cast<int>(parts.size()) != dim)
     throw InvalidInput(option + " '" + text + "': " + std::to_string(parts.size()) + " number" +
                        (parts.size() == 1 ? "" : "s") + " for a " + std::to_string(dim) +
                        "D template; expected " + expected);
   std::array<double, 3> box{};
   for (int a = 0; a < dim; ++a) {
-    const auto x = finite_number(parts[static_cast<std::size_t>(a)]);
+    const auto x = finite_number(parts[primal::index_cast<std::size_t>(a)]);
     if (!x)
-      throw InvalidInput(option + " '" + text + "': '" + parts[static_cast<std::size_t>(a)] +
+      throw InvalidInput(option + " '" + text + "': '" + parts[primal::index_cast<std::size_t>(a)] +
                          "' is not a finite number; expected " + expected);
     if (!(*x >= 1e-6 && *x <= 1e6))
       throw InvalidInput(option + " '" + text + "': every dimension must lie in [1e-6, 1e6]");
-    box[static_cast<std::size_t>(a)] = *x;
+    box[primal::index_cast<std::size_t>(a)] = *x;
   }
   if (dim == 2) box[2] = box[0];
   const auto [lo, hi] = std::minmax_element(box.begin(), box.begin() + dim);
@@ -183,14 +190,40 @@ CLI::Option* add_force_flag(CLI::App* app, bool& flag) {
   return app->add_flag("--force", flag, "allow an output to overwrite the input file");
 }
 
-void write_mesh(const primal::Model& model, const fs::path& path, const std::string& format,
-                io::VtuEncoding vtu) {
-  if (format == "exo") return io::write_exodus(model, path);
-  if (format == "msh") return io::write_gmsh(model, path);
-  if (format == "msh22") return io::write_gmsh(model, path, io::GmshFormat::Ascii, io::GmshVersion::k22);
-  if (format == "vtu") return io::write_vtu(path, model, {}, vtu);
-  if (format == "vtk") return io::write_vtk(path, model);
-  throw InvalidInput(path.string() + ": '" + format + "' is not a mesh format");
+std::vector<std::string> mesh_format_names(bool quads) {
+  return io::format_names(quads ? io::FormatRole::kWriteQuads : io::FormatRole::kWrite);
+}
+
+std::vector<std::string> with_mesh_formats(std::vector<std::string> before, const std::vector<std::string>& after) {
+  for (const auto& f : mesh_format_names()) before.push_back(f);
+  before.insert(before.end(), after.begin(), after.end());
+  return before;
+}
+
+std::string mesh_formats_help(bool quads) {
+  std::string s;
+  for (const io::MeshFormat& f : io::mesh_formats()) {
+    if (!(quads ? f.write_quads != nullptr : f.write != nullptr)) continue;
+    std::string ext;
+    for (std::string_view e : f.extensions) ext += " " + std::string(e);
+    s += (s.empty() ? "" : ", ") + std::string(f.name) + " (" + std::string(f.title) + "," + ext + ")";
+  }
+  return s;
+}
+
+std::string input_extensions_help() { return io::extension_list(io::FormatRole::kRead, ", ", ", "); }
+
+std::string hex_or_quad_input_help() {
+  return "All-hex mesh (" + input_extensions_help() + ") or planar quad mesh in z = 0 (" +
+         io::extension_list(io::FormatRole::kReadQuads, ", ", ", ") + ")";
+}
+
+std::string quad_output_extensions() { return io::extension_list(io::FormatRole::kWriteQuads); }
+
+io::WriteOptions write_options(const std::string& vtu_encoding) {
+  io::WriteOptions o;
+  o.vtu_encoding = vtu_encoding == "ascii" ? io::VtuEncoding::kAscii : io::VtuEncoding::kBinary;
+  return o;
 }
 
 namespace {

@@ -7,13 +7,12 @@
 //   parse_box() for WIDTHxHEIGHT[xDEPTH] with the dimension count the command needs.
 // - Outputs: output_format() picks the format from the extension (a --format that contradicts
 //   it is refused), check_output_path() refuses a missing or unwritable directory before any
-//   work, OutputFiles writes several outputs as one (all or none), write_mesh() writes a model
-//   in any mesh format of the matrix below.
+//   work, OutputFiles writes several outputs as one (all or none); io::write_model writes a
+//   model in any mesh format of the format table (io/formats.hpp).
 //
-// Output formats (name: extensions):
-//   exo: .exo .e   msh: .msh (v4.1)   msh22: .msh (v2.2)   vtu: .vtu (binary, or --vtu-encoding
-//   ascii)   vtk: .vtk (legacy ASCII); text formats a command may add: json .json, csv .csv,
-//   appendix .txt, text .txt.
+// Output formats: the mesh formats of io/formats.hpp (mesh_format_names(), their extensions
+// there), and the text formats a command may add: json .json, spec .json, csv .csv, appendix
+// .txt, text .txt, html .html .htm.
 #include <CLI/CLI.hpp>
 #include <array>
 #include <filesystem>
@@ -24,7 +23,7 @@
 #include <vector>
 
 #include "io/atomic_file.hpp"
-#include "io/vtk.hpp"
+#include "io/formats.hpp"
 #include "primal/mesh.hpp"
 #include "primal/model.hpp"
 
@@ -73,9 +72,22 @@ void check_output_path(const std::string& path);
 void check_not_input(const std::string& output, const std::string& input, bool force);
 CLI::Option* add_force_flag(CLI::App* app, bool& flag);
 
-// Writes a model in a mesh format; `vtu` is the encoding for .vtu.
-void write_mesh(const primal::Model& model, const std::filesystem::path& path,
-                const std::string& format, io::VtuEncoding vtu = io::VtuEncoding::kBinary);
+// The mesh formats every command that writes a mesh offers (io/formats.hpp), in table order:
+// exo, msh, msh22, vtu, vtk. quads: those that write planar quad meshes.
+std::vector<std::string> mesh_format_names(bool quads = false);
+// `before`, the mesh formats, then `after`: a command's --format choices.
+std::vector<std::string> with_mesh_formats(std::vector<std::string> before,
+                                           const std::vector<std::string>& after = {});
+// For help texts, from the format table: "exo (Exodus II, .exo .e), msh (Gmsh .msh 4.1 ASCII,
+// .msh), ..." and the extensions read ".exo, .e, .msh, .vtu, .vtk".
+std::string mesh_formats_help(bool quads = false);
+std::string input_extensions_help();
+// "All-hex mesh (.exo, .e, .msh, .vtu, .vtk) or planar quad mesh in z = 0 (.vtu, .vtk)".
+std::string hex_or_quad_input_help();
+// ".vtu or .vtk": where a planar quad mesh can be written.
+std::string quad_output_extensions();
+// --vtu-encoding's text (binary, ascii) as writer options.
+io::WriteOptions write_options(const std::string& vtu_encoding);
 
 // ---- Validity before writing -----------------------------------------------------------------
 

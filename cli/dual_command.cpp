@@ -12,7 +12,7 @@
 #include "cli/conventions.hpp"
 #include "cli/progress.hpp"
 #include "primal/errors.hpp"
-#include "io/vtk.hpp"
+#include "io/formats.hpp"
 #include "primal/model.hpp"
 #include "stc/arrangement.hpp"
 #include "stc/dualize.hpp"
@@ -95,14 +95,14 @@ void run_dual(const DualArgs& a) {
   std::string rebuild_format;
   if (!a.rebuild.empty()) {
     check_output_path(a.rebuild);
-    rebuild_format = output_format(a.rebuild, "", {"vtu", "vtk", "msh", "exo"}, "");
+    rebuild_format = output_format(a.rebuild, "", mesh_format_names(), "");
   }
   check_not_input(a.output, a.input, a.force);
   check_not_input(a.rebuild, a.input, a.force);
   const fs::path in(a.input);
   const MeshFile m = read_mesh_file(in);
-  if (m.dim == 2 && !rebuild_format.empty() && rebuild_format != "vtu" && rebuild_format != "vtk")
-    throw InvalidInput(a.rebuild + ": " + a.input + " is a quad mesh; rebuild it as .vtu or .vtk");
+  if (m.dim == 2 && !rebuild_format.empty() && !io::find_mesh_format(rebuild_format)->write_quads)
+    throw InvalidInput(a.rebuild + ": " + a.input + " is a quad mesh; rebuild it as " + quad_output_extensions());
   nlohmann::json j;
   std::vector<Index> counts;
   if (m.dim == 3) {
@@ -167,14 +167,14 @@ void run_dual(const DualArgs& a) {
   OutputFiles files;
   if (!a.rebuild.empty())
     files.add(a.rebuild, [&](const fs::path& temp) {
-      const auto vtu = a.vtu_encoding == "ascii" ? io::VtuEncoding::kAscii : io::VtuEncoding::kBinary;
+      const io::WriteOptions options = write_options(a.vtu_encoding);
       if (m.dim == 2) {
-        rebuild_format == "vtu" ? io::write_vtu(temp, D.quad, {}, vtu) : io::write_vtk(temp, D.quad);
+        io::write_quad_mesh(D.quad, temp, rebuild_format, options);
       } else {
         primal::Model model;
         model.points = D.hex.points;
         model.hexes = D.hex.hexes;
-        write_mesh(model, temp, rebuild_format, vtu);
+        io::write_model(model, temp, rebuild_format, options);
       }
     });
   const bool to_file = !a.output.empty() && a.output != "-";
@@ -194,7 +194,7 @@ void add_dual_command(CLI::App& app) {
       "hexes each triple of sheets meets in. --rebuild realizes those sheets as fields, computes their\n"
       "arrangement and dualizes it back (stc/mesh_fields.hpp): for a mesh that fills a box with positively\n"
       "oriented cells and sheets that do not cross themselves, the result is the same mesh up to numbering.");
-  d->add_option("mesh", a->input, "All-hex mesh (.vtu, .vtk, .msh, .exo, .e) or planar quad mesh in z = 0 (.vtu, .vtk)")
+  d->add_option("mesh", a->input, hex_or_quad_input_help())
       ->required();
   d->add_option("--format", a->format,
                 "report format: text (tables; default) or json; without it the extension of -o decides\n"
@@ -203,7 +203,8 @@ void add_dual_command(CLI::App& app) {
   d->add_option("-o,--output", a->output, "Write the report here instead of standard output");
   d->add_option("--rebuild", a->rebuild,
                 "Rebuild the mesh from its sheets through the arrangement engine; write it here, the\n"
-                "format by the extension: .vtu (binary), .vtk, .msh, .exo/.e (hexes; quads: .vtu, .vtk)");
+                "format by the extension: " + io::extension_list(io::FormatRole::kWrite, ", ", ", ") +
+                    " (hexes; quads: " + io::extension_list(io::FormatRole::kWriteQuads, ", ", ", ") + ")");
   add_write_invalid_flag(d, a->write_invalid);
   add_force_flag(d, a->force);
   d->add_option("--vtu-encoding", a->vtu_encoding, "binary (base64, default) or ascii DataArrays in .vtu")

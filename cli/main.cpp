@@ -63,6 +63,7 @@ int main(int argc, char** argv) {
   geode::cli::add_check_command(app);
   geode::cli::add_arrange_command(app);
   geode::cli::add_view_command(app);
+  geode::cli::add_formats_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -12,6 +12,7 @@
 #include "primal/errors.hpp"
 #include "templates/spec.hpp"
 #include "templates/study.hpp"
+#include "templates/template_table.hpp"
 
 namespace geode::cli {
 namespace {
@@ -25,16 +26,6 @@ struct InterleaveArgs {
   std::vector<std::string> sweep;
   bool quiet = false;
 };
-
-// Default grids: 5-6 values per parameter inside the valid ranges, including the paper's
-// geode push (0.85, 0.6, 0.9, 0.6); geode4tri gets a coarser grid.
-templates::PushGrid default_grid(const std::string& name) {
-  if (name == "geode4tri") return {{0.65, 0.85, 0.95}, {0.35, 0.6, 0.8}, {0.5, 0.7, 0.9}, {0.3, 0.6, 0.8}};
-  return {{0.55, 0.65, 0.75, 0.85, 0.95},
-          {0.2, 0.35, 0.5, 0.6, 0.7, 0.8},
-          {0.3, 0.5, 0.7, 0.9, 0.97},
-          {0.2, 0.4, 0.6, 0.8}};
-}
 
 // At most this many sweep points (the product of the axes' counts): 20,000 runs of the geode
 // take hours on two cores, and every run is kept in memory for the summary.
@@ -89,17 +80,21 @@ void run_interleave(const InterleaveArgs& a) {
     study = spec_study(a);
   } else {
     if (!a.sweep.empty()) throw InvalidInput("study interleave: --sweep needs --spec");
-    if (a.name != "geode3d" && a.name != "geode4tri")
-      throw InvalidInput("study interleave: unknown template '" + a.name + "' (geode3d or geode4tri)");
-    templates::PushGrid grid = default_grid(a.name);
+    // The template table says which templates are studied and on what default grid.
+    const templates::TemplateEntry* entry = templates::find_template(a.name);
+    if (!entry || !entry->study_grid) {
+      std::string names;
+      for (const auto& n : templates::template_names(true)) names += (names.empty() ? "" : ", ") + n;
+      throw InvalidInput("study interleave: unknown template '" + a.name + "' (" + names + ")");
+    }
+    templates::PushGrid grid = entry->study_grid();
     if (!a.high.empty()) grid.high_roof = a.high;
     if (!a.low.empty()) grid.low_roof = a.low;
     if (!a.depth.empty()) grid.dome_depth = a.depth;
     if (!a.radius.empty()) grid.dome_radius = a.radius;
     check_sweep_size({grid.high_roof.size(), grid.low_roof.size(), grid.dome_depth.size(), grid.dome_radius.size()},
                      "study interleave");
-    templates::GeodeOptions o;
-    if (a.name == "geode4tri") o.split = templates::TopSplit::FourTriangles;
+    const templates::GeodeOptions o = entry->defaults.geode;
     Progress progress = Progress::for_stderr(a.quiet);
     study = templates::interleave_study(o, grid, a.name, [&](const std::string& what, std::size_t done, std::size_t total) {
       progress.step(what, done, total);
@@ -191,8 +186,8 @@ void add_study_commands(CLI::App& app) {
       "Sweep the push parameters (high roof, low roof, dome depth, dome radius) and classify what each push "
       "dualizes to: a template class (hex count, sheet-kind triples, colour-refinement hash) with the paper's "
       "two conditions, or the TopologyError's diagnosis with numbers stripped");
-  inter->add_option("--template", ia->name, "geode3d (default) or geode4tri")
-      ->check(CLI::IsMember({"geode3d", "geode4tri"}));
+  inter->add_option("--template", ia->name, "the template to sweep (default geode3d): " + templates::template_help(true))
+      ->check(CLI::IsMember(templates::template_names(true)));
   inter->add_option("-o,--output", ia->output, "per-run CSV (default: stdout)");
   inter->add_option("--summary", ia->summary, "per-class summary CSV");
   inter->add_option("--high", ia->high, "high roof values (default grid if omitted)")->check(number_check(0, 1));

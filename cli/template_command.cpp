@@ -14,7 +14,7 @@
 #include "primal/boundary.hpp"
 #include "primal/errors.hpp"
 #include "viewer/html.hpp"
-#include "io/vtk.hpp"
+#include "io/formats.hpp"
 #include "primal/model.hpp"
 #include "primal/quality.hpp"
 #include "primal/quality_report.hpp"
@@ -23,6 +23,7 @@
 #include "templates/pyramid.hpp"
 #include "templates/refine.hpp"
 #include "templates/spec.hpp"
+#include "templates/template_table.hpp"
 
 namespace geode::cli {
 namespace {
@@ -135,7 +136,7 @@ nlohmann::json to_json(const templates::Template& T, const std::string& name) {
   }
   for (const auto& [sheets, count] : table) {
     nlohmann::json names;
-    for (int s : sheets) names.push_back(T.sheets[static_cast<std::size_t>(s)].name);
+    for (int s : sheets) names.push_back(T.sheets[primal::index_cast<std::size_t>(s)].name);
     j["intersections"].push_back({{"sheets", names}, {"elements", count}});
   }
   j["obstructions"] = primal::obstructions_json(templates::template_obstructions(T), 1);
@@ -165,7 +166,7 @@ void write_template_html(const TemplateOutput& a, const templates::Template& T, 
   viewer::ViewFaceGroup tet{"tet side", {}}, hex{"hex side", {}};
   for (const auto& q : primal::boundary_quads(T.hex)) {
     unsigned common = ~0u;
-    for (auto n : q.nodes) common &= T.node_faces[static_cast<std::size_t>(n)];
+    for (auto n : q.nodes) common &= T.node_faces[primal::index_cast<std::size_t>(n)];
     if (common & (1u << stc::box_face(1, true))) tet.quads.push_back(q.nodes);
     if (common & (1u << stc::box_face(1, false))) hex.quads.push_back(q.nodes);
   }
@@ -173,25 +174,17 @@ void write_template_html(const TemplateOutput& a, const templates::Template& T, 
   viewer::write_html(a.output, T.hex, scene);
 }
 
-const std::vector<std::string> kTemplateFormats{"appendix", "csv", "json", "vtu", "vtk", "msh", "msh22", "exo", "spec", "html"};
+const std::vector<std::string> kTemplateFormats = with_mesh_formats({"appendix", "csv", "json"}, {"spec", "html"});
 
 void run_template(const TemplateArgs& a) {
   // Refuse a bad output before the derivation, not after it.
   check_output_path(a.output);
   const std::string format = output_format(a.output, a.format, kTemplateFormats, "appendix");
-  if (a.name == "pyramid") {
-    // Schneiders' surface on the equilateral pyramid (edges 2): the derivation stops at the
-    // certificate, computed from the surface, until the engine represents immersed sheets.
-    const double h = std::sqrt(2.0);
-    const auto c = templates::pyramid_certificate({primal::Point(-1, 0, -1), primal::Point(-1, 0, 1),
-                                                   primal::Point(1, 0, 1), primal::Point(1, 0, -1),
-                                                   primal::Point(0, h, 0)});
-    throw TopologyError("template pyramid: " + c.statement +
-                        " (self-intersecting sheets are not represented yet; templates/pyramid.hpp)");
-  }
-  const int dim = a.name == "geode2d" || a.name == "refine3-2d" ? 2 : 3;
-  if (dim == 2 && is_mesh_format(format) && format != "vtu" && format != "vtk")
-    throw InvalidInput(a.output + ": " + a.name + " is a quad mesh; write it as .vtu or .vtk");
+  const templates::TemplateEntry* entry = templates::find_template(a.name);
+  if (!entry) throw InvalidInput("template: unknown template '" + a.name + "'");
+  const int dim = entry->dim;
+  if (dim == 2 && is_mesh_format(format) && !io::find_mesh_format(format)->write_quads)
+    throw InvalidInput(a.output + ": " + a.name + " is a quad mesh; write it as " + quad_output_extensions());
   const std::string box_text = a.box.empty() ? (dim == 3 ? "24x14x24" : "24x14") : a.box;
   const auto box = parse_box("--box", box_text, dim);
   templates::GeodeOptions o;
@@ -199,13 +192,14 @@ void run_template(const TemplateArgs& a) {
   o.diagonal = a.diagonal == "anti" ? templates::Diagonal::Anti : templates::Diagonal::Main;
   o.higher = a.higher == "z" ? templates::Higher::Z : templates::Higher::X;
   o.push = a.push;
-  const bool refine = a.name == "refine3" || a.name == "refine3-2d";
-  if (a.name == "geode4tri") o.split = templates::TopSplit::FourTriangles;
+  const bool refine = entry->family == templates::TemplateFamily::kRefine;
   templates::RefineOptions ro = a.refine;
   ro.box = o.box;
   if (a.refine_roofs) ro.high_roof = a.push.high_roof, ro.low_roof = a.push.low_roof;
+  const templates::TemplateOptions options = templates::template_options(*entry, o, ro);
+  o = options.geode;  // with the entry's split
   if (format == "spec") {
-    const auto spec = refine ? templates::refine_spec(ro, dim) : templates::geode_spec(o, dim);
+    const auto spec = entry->spec(options);
     const std::string text = templates::format_spec(templates::spec_json(spec));
     write_or_print(a.output, [&](std::ostream& os) { os << text; });
     return;
@@ -215,19 +209,17 @@ void run_template(const TemplateArgs& a) {
   out.vtu_encoding = a.vtu_encoding;
   out.smooth = !a.no_smooth, out.slide = a.slide, out.quality = a.quality;
   out.write_invalid = a.write_invalid;
-  templates::Template T;
+  templates::Template T = entry->build(options);
+  out.check_conditions = entry->interleave_conditions;
+  if (entry->smooth)
+    out.smoother = [entry, options, slide = a.slide](templates::Template& t) { return entry->smooth(t, options, slide); };
   if (refine) {
-    T = a.name == "refine3" ? templates::build_refine3(ro) : templates::build_refine3_2d(ro);
-    out.check_conditions = false;
-    out.smoother = [ro, fixed = !a.slide](templates::Template& t) { return templates::smooth_refine3(t, ro, fixed); };
     if (format == "html") {
       // The refinement's spec is in the box already.
-      const templates::ArrangementSpec spec = templates::refine_spec(ro, dim);
+      const templates::ArrangementSpec spec = entry->spec(options);
       out.sheets = templates::spec_sheets(spec), out.domain = spec.domain;
     }
   } else {
-    T = dim == 2 ? templates::build_geode2d(o) : templates::build_geode3d(o);
-    out.check_conditions = dim == 3;
     if (format == "html") {
       const templates::GeodeArrangement G = templates::geode_arrangement(o, dim);
       out.sheets = G.sheets, out.domain = G.domain;
@@ -254,7 +246,7 @@ void run_template(const TemplateArgs& a) {
   }
   if (a.slide) cmd << " --slide";
   out.caption = cmd.str();
-  if (a.name == "geode4tri" && !a.no_fixup) {
+  if (entry->fix_up && !a.no_fixup) {
     const auto f = templates::fix_up(T);
     std::ostringstream s;
     s << "fix-up: " << f.obstructions_before << " -> " << f.obstructions_after << " obstructions, " << T.hex.hexes.size()
@@ -317,7 +309,7 @@ void write_template(templates::Template& T, const TemplateOutput& a) {
   if (a.quality && dim == 2) {
     double lo = 1e300, hi = -1e300;
     for (std::size_t q = 0; q < T.quad.quads.size(); ++q) {
-      const double v = primal::quad_scaled_jacobian(primal::quad_corners(T.quad, static_cast<primal::Index>(q)), primal::Point::UnitZ());
+      const double v = primal::quad_scaled_jacobian(primal::quad_corners(T.quad, primal::index_cast(q)), primal::Point::UnitZ());
       lo = std::min(lo, v), hi = std::max(hi, v);
     }
     std::ostringstream s;
@@ -335,16 +327,14 @@ void write_template(templates::Template& T, const TemplateOutput& a) {
     // The mesh goes to the file (the writers add the scaled Jacobian cell array); the quality
     // tables, if asked for, to standard output.
     if (a.output.empty()) throw InvalidInput("--format " + a.format + " needs -o FILE");
-    const auto vtu = a.vtu_encoding == "ascii" ? io::VtuEncoding::kAscii : io::VtuEncoding::kBinary;
+    const io::WriteOptions options = write_options(a.vtu_encoding);
     if (dim == 2) {
-      if (a.format != "vtu" && a.format != "vtk")
-        throw InvalidInput(a.output + ": a quad mesh is written as .vtu or .vtk");
-      a.format == "vtu" ? io::write_vtu(a.output, T.quad, {}, vtu) : io::write_vtk(a.output, T.quad);
+      io::write_quad_mesh(T.quad, a.output, a.format, options);  // refuses formats without quads
     } else {
       primal::Model m;
       m.points = T.hex.points;
       m.hexes = T.hex.hexes;
-      write_mesh(m, a.output, a.format, vtu);
+      io::write_model(m, a.output, a.format, options);
     }
     if (!text.empty()) std::cout << text;
     invalid_written(what, invalid);
@@ -362,14 +352,9 @@ void add_template_command(CLI::App& app) {
       "connectivity is typed in) and print or write it. Tet- and hex-side nodes sit where dicing\n"
       "puts them; the rest are placed by optimization unless --no-smooth. A mesh that fails the validity\n"
       "check (inverted or overlapping cells) exits 4 and nothing is written (see --write-invalid).");
-  t->add_option("NAME", args->name,
-                "geode3d: the 26-hex geode (tet side split by a diagonal into 2 triangles);\n"
-                "geode2d: the 5-quad 2D geode; geode4tri: the tet side split into 4 triangles;\n"
-                "refine3: one coarse quad on top over 3 x 3 fine quads below (13 hexes); refine3-2d: one\n"
-                "coarse edge over three fine ones (4 quads); pyramid: Schneiders' 16-quad pyramid (exits 3\n"
-                "with the certificate that its dual needs a self-intersecting sheet, which the engine lacks)")
+  t->add_option("NAME", args->name, templates::template_help() + " (the template table, templates/template_table.hpp)")
       ->required()
-      ->check(CLI::IsMember({"geode3d", "geode2d", "geode4tri", "refine3", "refine3-2d", "pyramid"}));
+      ->check(CLI::IsMember(templates::template_names()));
   t->add_option("--box", args->box,
                 "buffer cell WIDTHxHEIGHTxDEPTH (x, y up, z; WIDTHxHEIGHT for the 2D templates), centred at\n"
                 "the origin, tet side on top; each in [1e-6, 1e6], at most 1e4 between largest and smallest\n"
@@ -383,11 +368,13 @@ void add_template_command(CLI::App& app) {
       ->capture_default_str();
   t->add_option("--format", args->format,
                 "appendix (default): the paper's Tables 2 and 3 (1-based); csv: node and element tables;\n"
-                "json: with sheets, their intersections and the interleave checks; vtu, vtk, msh, msh22,\n"
-                "exo: the mesh (needs -o); spec: the template as an arrangement spec for `geode arrange`\n"
-                "(nothing is derived); html: a self-contained viewer of the hexes, the arrangement's sheets\n"
-                "and their layers (needs -o). Without it, the extension of -o decides (.txt .csv .json\n"
-                ".vtu .vtk .msh .exo .e .html); one that contradicts the extension is refused")
+                "json: with sheets, their intersections and the interleave checks; " + mesh_formats_help() +
+                    ":\nthe mesh (needs -o; 2D templates: " + mesh_formats_help(true) +
+                    "); spec: the template as an\narrangement spec for `geode arrange` (nothing is derived); html: a "
+                    "self-contained viewer of\nthe hexes, the arrangement's sheets and their layers (needs -o). "
+                    "Without it, the extension\nof -o decides (.txt .csv .json " +
+                    io::extension_list(io::FormatRole::kWrite, " ", " ") +
+                    " .html); one that contradicts the extension is refused")
       ->check(CLI::IsMember(kTemplateFormats));
   t->add_option("--vtu-encoding", args->vtu_encoding, "binary (base64, default) or ascii DataArrays in .vtu")
       ->check(CLI::IsMember({"binary", "ascii"}))

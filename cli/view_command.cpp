@@ -103,7 +103,7 @@ void add_view_command(CLI::App& app) {
       "surface through its layer of hexes, each with a toggle; each sheet's layer alone or highlighted;\n"
       "colour by scaled Jacobian; node and hex ids on hover (1-based, as the CSV and appendix outputs).\n"
       "URL hash parameters (FILE.html#layer=sheet-0&peel=1) select a view; see viewer/viewer.js.");
-  v->add_option("mesh", a->input, "All-hex mesh (.vtu, .vtk, .msh, .exo, .e) or planar quad mesh in z = 0 (.vtu, .vtk)")
+  v->add_option("mesh", a->input, hex_or_quad_input_help())
       ->required();
   v->add_option("-o,--output", a->output, "The HTML file to write (atomically)")->required();
   v->add_option("--title", a->title, "Title shown in the page (default: the input's file name)");

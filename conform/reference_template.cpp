@@ -13,6 +13,7 @@
 #include "primal/smooth.hpp"
 #include "primal/topology.hpp"
 #include "templates/side_faces.hpp"
+#include "templates/template_table.hpp"
 
 namespace geode::conform {
 namespace {
@@ -20,7 +21,6 @@ namespace {
 using primal::Index;
 using primal::Point;
 namespace topo = primal::topology;
-using templates::build_geode3d;
 using templates::Diagonal;
 using templates::GeodeOptions;
 using templates::smooth_template;
@@ -84,20 +84,17 @@ void check_distinct(const std::vector<Point>& pts, const Eigen::Vector3d& box) {
 RefTemplate make_reference(const Eigen::Vector3d& box, std::array<int, 2> diagonal,
                            templates::TopSplit split = templates::TopSplit::TwoTriangles) {
   RefTemplate ref;
-  GeodeOptions o;
+  const bool four = split == templates::TopSplit::FourTriangles;
+  // Which template fills this interface cell, and with what push, is the template table's
+  // (templates/template_table.hpp; for four triangles the superquadric-dome class found free
+  // of obstructions: 44 hexes, no fix-up needed).
+  const templates::TemplateEntry& entry = templates::conform_template(
+      four ? templates::ConformUse::kFourTriangles : templates::ConformUse::kTwoTriangles);
+  GeodeOptions o = entry.defaults.geode;
   o.box = box;
   o.diagonal = diagonal == std::array<int, 2>{5, 7} ? Diagonal::Main : Diagonal::Anti;
-  o.split = split;
-  const bool four = split == templates::TopSplit::FourTriangles;
-  if (four) {
-    // The superquadric-dome class found free of obstructions (notebooks-data, interleave
-    // geode4tri-domes): 44 hexes, no fix-up needed.
-    o.push.dome_exponent = 3.0;
-    o.push.centre_depth = 0.45;
-    o.push.dome_radius = 0.8;
-    o.push.centre_radius = 0.6;
-  }
-  ref.tpl = build_geode3d(o);
+  o.push = entry.conform_push;
+  ref.tpl = entry.build(templates::template_options(entry, o, {}));
   // This class has no obstruction to untangling (primal/realizability.hpp), so it needs no
   // fix-up; a box that gave it one would be refused here rather than pillowed silently.
   if (four && !templates::template_obstructions(ref.tpl).empty())

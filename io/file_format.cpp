@@ -19,7 +19,9 @@ std::string_view skip_space(std::string_view s) {
   return s;
 }
 
-bool is_exodus(std::string_view head) {
+}  // namespace
+
+bool looks_like_exodus(std::string_view head) {
   for (std::string_view cdf : {std::string_view("CDF\x01", 4), std::string_view("CDF\x02", 4),
                                std::string_view("CDF\x05", 4)})
     if (starts_with(head, cdf)) return true;
@@ -29,15 +31,21 @@ bool is_exodus(std::string_view head) {
   return false;
 }
 
-}  // namespace
+bool looks_like_gmsh(std::string_view head) { return starts_with(skip_space(head), "$MeshFormat"); }
+
+bool looks_like_vtk(std::string_view head) { return starts_with(skip_space(head), "# vtk DataFile Version"); }
+
+bool looks_like_vtu(std::string_view head) {
+  const std::string_view text = skip_space(head);
+  return starts_with(text, "<VTKFile") ||
+         (starts_with(text, "<?xml") && text.find("<VTKFile") != std::string_view::npos);
+}
 
 MeshFileFormat sniff_mesh_format(std::string_view head) {
-  if (is_exodus(head)) return MeshFileFormat::kExodus;
-  const std::string_view text = skip_space(head);
-  if (starts_with(text, "$MeshFormat")) return MeshFileFormat::kGmsh;
-  if (starts_with(text, "# vtk DataFile Version")) return MeshFileFormat::kVtk;
-  if (starts_with(text, "<VTKFile")) return MeshFileFormat::kVtu;
-  if (starts_with(text, "<?xml") && text.find("<VTKFile") != std::string_view::npos) return MeshFileFormat::kVtu;
+  if (looks_like_exodus(head)) return MeshFileFormat::kExodus;
+  if (looks_like_gmsh(head)) return MeshFileFormat::kGmsh;
+  if (looks_like_vtk(head)) return MeshFileFormat::kVtk;
+  if (looks_like_vtu(head)) return MeshFileFormat::kVtu;
   return MeshFileFormat::kUnknown;
 }
 

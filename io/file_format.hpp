@@ -17,6 +17,11 @@ enum class MeshFileFormat { kUnknown, kGmsh, kExodus, kVtu, kVtk };
 
 // The format the content starts like (kUnknown for anything else).
 MeshFileFormat sniff_mesh_format(std::string_view head);
+// Each signature alone (the format table, formats.hpp, holds them per format).
+bool looks_like_gmsh(std::string_view head);
+bool looks_like_exodus(std::string_view head);
+bool looks_like_vtu(std::string_view head);
+bool looks_like_vtk(std::string_view head);
 // By extension, case-insensitive: .msh, .exo / .e, .vtu, .vtk; kUnknown for others.
 MeshFileFormat mesh_format_from_extension(const std::filesystem::path& path);
 // "Gmsh .msh", "Exodus II", "VTK XML .vtu", "legacy VTK .vtk", "unknown".

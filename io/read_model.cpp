@@ -5,8 +5,7 @@
 
 #include "primal/errors.hpp"
 #include "io/file_format.hpp"
-#include "io/exodus.hpp"
-#include "io/gmsh.hpp"
+#include "io/formats.hpp"
 
 namespace geode::io {
 
@@ -47,26 +46,14 @@ Model model_from_vtk(const VtkGrid& grid, const ReadOptions& options) {
 }
 
 Model read_model(const std::filesystem::path& path, const ReadOptions& options) {
-  const MeshFileFormat format = mesh_format_from_extension(path);
-  if (format == MeshFileFormat::kUnknown) {
+  const MeshFormat* format = reader_for(path);
+  if (!format) {
     (void)read_file_head(path);  // a missing file is named as such first
-    throw InvalidInput(path.string() + ": unknown input format '" + path.extension().string() +
-                       "' (expected .msh, .exo, .e, .vtu or .vtk)");
+    throw InvalidInput(path.string() + ": unknown input format '" + path.extension().string() + "' (expected " +
+                       extension_list(FormatRole::kRead) + ")");
   }
-  check_mesh_format(path, format);
-  switch (format) {
-    case MeshFileFormat::kGmsh:
-      return read_gmsh(path, options);
-    case MeshFileFormat::kExodus:
-      return read_exodus(path, options);
-    case MeshFileFormat::kVtu:
-      return model_from_vtk(read_vtu(path), options);
-    case MeshFileFormat::kVtk:
-      return model_from_vtk(read_vtk(path), options);
-    case MeshFileFormat::kUnknown:
-      break;
-  }
-  throw InvalidInput(path.string() + ": unknown input format");
+  check_signature(path, *format);
+  return format->read(path, options);
 }
 
 }  // namespace geode::io

@@ -1,7 +1,7 @@
 #pragma once
 // One entry point for reading a whole model (hex part, tet part, blocks, sets) from any input
-// format, chosen by extension and checked against the content before any parser sees it
-// (file_format.hpp): .msh (Gmsh 2.2 / 4.1), .exo / .e (Exodus II), .vtu, .vtk.
+// format of the format table (formats.hpp), chosen by extension and checked against the
+// content before any parser sees it. io::write_model (formats.hpp) is its counterpart.
 #include <filesystem>
 
 #include "io/vtk.hpp"
@@ -10,7 +10,7 @@
 namespace geode::io {
 
 // Throws InvalidInput naming the file: missing, unknown extension, content of another format,
-// and whatever the format's reader refuses (gmsh.hpp, exodus.hpp, vtk.hpp), then
+// and whatever the format's reader refuses (gmsh.hpp, exodus.hpp, vtk.hpp, ...), then
 // check_geometry unless options say otherwise.
 primal::Model read_model(const std::filesystem::path& path, const primal::ReadOptions& options = {});
 

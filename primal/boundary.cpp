@@ -1,5 +1,6 @@
 #include "primal/boundary.hpp"
 
+#include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 #include <algorithm>
 #include <cassert>
 #include <mutex>
@@ -7,6 +8,7 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "primal/boundary_surface.hpp"
 #include "primal/errors.hpp"
 #include "primal/key_map.hpp"
 #include "primal/topology.hpp"
@@ -60,7 +62,7 @@ private:
 
 
 void check_indices(const HexMesh& mesh) {
-  const auto n = static_cast<Index>(mesh.points.size());
+  const auto n = index_cast(mesh.points.size());
   for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
     for (Index v : mesh.hexes[h]) {
       if (v < 0 || v >= n) {
@@ -90,7 +92,7 @@ std::vector<UniqueFace> unique_faces(const HexMesh& mesh) {
       const FaceKey key = face_key(nodes);
       auto [it, inserted] = index.try_emplace(key, faces.size());
       if (inserted) faces.push_back(UniqueFace{key, nodes, {}});
-      faces[it->second].uses.push_back(HexFaceUse{static_cast<Index>(h), f});
+      faces[it->second].uses.push_back(HexFaceUse{index_cast(h), f});
     }
   }
   return faces;
@@ -113,10 +115,10 @@ std::vector<EdgeKey> unique_edges(const HexMesh& mesh) {
 std::vector<Index> boundary_nodes(const HexMesh& mesh) {
   std::vector<char> on(mesh.points.size(), 0);
   for (const auto& q : boundary_quads(mesh))
-    for (Index v : q.nodes) on[static_cast<std::size_t>(v)] = 1;
+    for (Index v : q.nodes) on[index_cast<std::size_t>(v)] = 1;
   std::vector<Index> out;
   for (std::size_t i = 0; i < on.size(); ++i)
-    if (on[i]) out.push_back(static_cast<Index>(i));
+    if (on[i]) out.push_back(index_cast(i));
   return out;
 }
 
@@ -130,15 +132,15 @@ std::vector<BoundaryQuad> boundary_quads(const HexMesh& mesh) {
   for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
     for (int f = 0; f < topo::kHexFaces; ++f) {
       const auto [slot, inserted] =
-          first_use.try_emplace(face_key(hex_face_nodes(mesh.hexes[h], f)), static_cast<Index>(6 * h + f));
+          first_use.try_emplace(face_key(hex_face_nodes(mesh.hexes[h], f)), index_cast(6 * h + f));
       if (!inserted) *slot = kShared;
     }
   std::vector<BoundaryQuad> out;
   for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
     for (int f = 0; f < topo::kHexFaces; ++f) {
       const auto nodes = hex_face_nodes(mesh.hexes[h], f);
-      if (*first_use.find(face_key(nodes)) == static_cast<Index>(6 * h + f))
-        out.push_back(BoundaryQuad{static_cast<Index>(h), f, nodes});
+      if (*first_use.find(face_key(nodes)) == index_cast(6 * h + f))
+        out.push_back(BoundaryQuad{index_cast(h), f, nodes});
     }
   return out;
 }
@@ -166,7 +168,14 @@ BoundarySurface extract_boundary(const HexMesh& mesh) {
 }
 
 BoundarySurface extract_boundary(const std::vector<Point>& points, std::vector<BoundaryQuad> quads) {
+  SurfaceMesh surface;
+  return extract_boundary(points, std::move(quads), surface);
+}
+
+BoundarySurface extract_boundary(const std::vector<Point>& points, std::vector<BoundaryQuad> quads,
+                                 SurfaceMesh& surface) {
   BoundarySurface b;
+  surface.clear();
 
   // Combinatorial Euler characteristic, independent of what OpenMesh accepts.
   std::unordered_map<Index, SurfaceMesh::VertexHandle> vertex_of;
@@ -177,16 +186,16 @@ BoundarySurface extract_boundary(const std::vector<Point>& points, std::vector<B
       ++edge_uses[edge_key(q.nodes[i], q.nodes[(i + 1) % 4])];
     }
   }
-  b.euler = static_cast<int>(vertex_of.size()) - static_cast<int>(edge_uses.size()) +
-            static_cast<int>(quads.size());
+  b.euler = index_cast<int>(vertex_of.size()) - index_cast<int>(edge_uses.size()) +
+            index_cast<int>(quads.size());
 
   // Vertices in order of first appearance so that the surface is deterministic.
   for (const auto& q : quads) {
     for (Index v : q.nodes) {
       auto& vh = vertex_of[v];
       if (!vh.is_valid()) {
-        const Point& p = points[static_cast<std::size_t>(v)];
-        vh = b.surface.add_vertex(SurfaceMesh::Point(
+        const Point& p = points[index_cast<std::size_t>(v)];
+        vh = surface.add_vertex(SurfaceMesh::Point(
             static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())));
         b.vertex_node.push_back(v);
       }
@@ -196,9 +205,9 @@ BoundarySurface extract_boundary(const std::vector<Point>& points, std::vector<B
   for (const auto& q : quads) {
     std::vector<SurfaceMesh::VertexHandle> vhs;
     for (Index v : q.nodes) vhs.push_back(vertex_of[v]);
-    const auto fh = b.surface.add_face(vhs);
+    const auto fh = surface.add_face(vhs);
     if (fh.is_valid()) {
-      assert(static_cast<std::size_t>(fh.idx()) == b.faces.size());
+      assert(index_cast<std::size_t>(fh.idx()) == b.faces.size());
       b.faces.push_back(q);
     } else {
       b.rejected.push_back(q);
@@ -208,8 +217,8 @@ BoundarySurface extract_boundary(const std::vector<Point>& points, std::vector<B
   b.closed = std::all_of(edge_uses.begin(), edge_uses.end(),
                          [](const auto& kv) { return kv.second == 2; });
   b.manifold = b.rejected.empty();
-  for (auto vh : b.surface.vertices()) {
-    if (!b.surface.is_manifold(vh)) b.manifold = false;
+  for (auto vh : surface.vertices()) {
+    if (!surface.is_manifold(vh)) b.manifold = false;
   }
   return b;
 }

@@ -1,7 +1,8 @@
 #pragma once
 // Shared entities of a hex mesh (edges and faces identified by their sorted node numbers) and
-// its boundary: the faces used by exactly one hex, as a list and as an OpenMesh quad surface.
-#include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
+// its boundary: the faces used by exactly one hex, as a list and as a quad surface checked by
+// OpenMesh (the OpenMesh surface itself: primal/boundary_surface.hpp, the one header that
+// exposes OpenMesh).
 #include <array>
 #include <cstddef>
 #include <functional>
@@ -69,12 +70,9 @@ std::vector<BoundaryQuad> block_interface_quads(const HexMesh& mesh);
 // The nodes of the boundary quads, ascending.
 std::vector<Index> boundary_nodes(const HexMesh& mesh);
 
-// The boundary as an OpenMesh surface (float points, the library's default traits; exact
-// coordinates are mesh.points[vertex_node[v]]).
-using SurfaceMesh = OpenMesh::PolyMesh_ArrayKernelT<>;
-
+// The boundary as a quad surface, built with OpenMesh (which refuses complex edges and
+// vertices); boundary_surface.hpp returns the OpenMesh surface too.
 struct BoundarySurface {
-  SurfaceMesh surface;
   std::vector<Index> vertex_node;      // surface vertex index -> hex mesh node
   std::vector<BoundaryQuad> faces;     // surface face index -> boundary quad
   std::vector<BoundaryQuad> rejected;  // quads OpenMesh refused (complex edge or vertex)

@@ -4,15 +4,31 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>  // cross products on Point
 #include <array>
+#include <cassert>
 #include <cstdint>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace geode::primal {
 
+// The index convention: node and element numbers are Index (32 bits, signed, so that
+// kInvalidIndex can mark "none"); sizes and positions in containers are std::size_t. Between
+// the two, index_cast, which checks (in builds with assertions) that the value fits: the one
+// place a number crosses from one to the other, instead of a bare static_cast.
 using Index = std::int32_t;  // node or element number, 0-based
 using Point = Eigen::Vector3d;
 
 inline constexpr Index kInvalidIndex = -1;
+
+// `value` as a `To` (Index by default, std::size_t for a container position); asserts that it
+// fits (std::in_range: no negative size, no number past Index's range).
+template <typename To = Index, typename From>
+constexpr To index_cast(From value) noexcept {
+  static_assert(std::is_integral_v<To> && std::is_integral_v<From>, "index_cast converts integers");
+  assert(std::in_range<To>(value) && "index out of range of its type");
+  return static_cast<To>(value);
+}
 
 struct HexMesh {
   std::vector<Point> points;

@@ -74,8 +74,8 @@ TEST_CASE("validity: 3x3x3 block is a valid ball") {
   CHECK(r.num_cells == 27);
   CHECK(r.euler == 1);
   // Boundary: 6 x 9 quads on the 64 - 8 = 56 non-interior nodes, a sphere (chi = 2).
-  CHECK(r.boundary.surface.n_faces() == 54);
-  CHECK(r.boundary.surface.n_vertices() == 56);
+  CHECK(r.boundary.faces.size() == 54);
+  CHECK(r.boundary.vertex_node.size() == 56);
   CHECK(r.boundary.closed);
   CHECK(r.boundary.manifold);
   CHECK(r.boundary.euler == 2);
@@ -128,7 +128,7 @@ TEST_CASE("validity: a ring of 8 hexes is a solid torus") {
   CHECK(r.num_faces == 40);
   CHECK(r.boundary.closed);
   CHECK(r.boundary.manifold);
-  CHECK(r.boundary.surface.n_faces() == 32);
+  CHECK(r.boundary.faces.size() == 32);
   CHECK(r.boundary.euler == 0);
 }
 

@@ -1,0 +1,295 @@
+// The format table (io/formats.hpp) and the dispatch that reads it.
+#include "io/formats.hpp"
+
+#include <algorithm>
+#include <cctype>
+
+#include "io/exodus.hpp"
+#include "io/file_format.hpp"
+#include "io/gmsh.hpp"
+#include "io/read_model.hpp"
+#include "io/vtk.hpp"
+#include "primal/errors.hpp"
+
+namespace geode::io {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// A VTK file's cells as given: all quads (a planar quad mesh), or hexes (with triangles and
+// quads, boundary annotations, left out by to_hex_mesh naming the first other cell).
+std::optional<PlainMesh> read_vtk_plain(const fs::path& path) {
+  const VtkGrid g = read_vtk_file(path);
+  PlainMesh m;
+  const bool quads = !g.cell_types.empty() && std::all_of(g.cell_types.begin(), g.cell_types.end(),
+                                                          [](int t) { return t == kVtkQuad; });
+  if (quads) {
+    m.dim = 2;
+    m.quad = to_quad_mesh(g);
+  } else {
+    m.hex = to_hex_mesh(g);  // names the first cell that is not a hex
+  }
+  return m;
+}
+
+constexpr FormatCarries kExodusCarries{Carried::kYes, Carried::kYes, Carried::kYes,
+                                       Carried::kYes, Carried::kYes, "hex, tet"};
+constexpr FormatCarries kGmshCarries{Carried::kYes, Carried::kYes, Carried::kYes,
+                                     Carried::kYes, Carried::kYes, "hex, tet"};
+constexpr std::string_view kGmshHint =
+    "it does not start with $MeshFormat; Gmsh scripts are not read";
+
+// The table. One entry per format; the reader and writer live in the format's own file. Fields
+// left out keep their defaults (GCC's -Wextra would ask for every field of a designated
+// initializer).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+const std::vector<MeshFormat>& table() {
+  static const std::vector<MeshFormat> formats{
+      {.name = "exo",
+       .title = "Exodus II",
+       .extensions = {".exo", ".e"},
+       .signature = looks_like_exodus,
+       .signature_hint = "no netCDF or HDF5 signature",
+       .read = read_exodus,
+       .write = [](const primal::Model& m, const fs::path& p,
+                   const WriteOptions&) { write_exodus(m, p); },
+       .carries = kExodusCarries,
+       .read_variants =
+           "netCDF classic, 64-bit, CDF-5 or netCDF-4/HDF5, as Cubit, SEACAS and meshio write it",
+       .written_as = "netCDF, with coordinate names x y z"},
+      {.name = "msh",
+       .title = "Gmsh .msh",
+       .extensions = {".msh"},
+       .signature = looks_like_gmsh,
+       .signature_hint = kGmshHint,
+       .read = read_gmsh,
+       .write = [](const primal::Model& m, const fs::path& p,
+                   const WriteOptions&) { write_gmsh(m, p); },
+       .carries = kGmshCarries,
+       .read_variants = "2.2 and 4.1, ASCII and binary",
+       .written_as = "4.1 ASCII"},
+      {.name = "msh22",
+       .title = "Gmsh .msh 2.2",
+       .extensions = {".msh"},
+       .signature = looks_like_gmsh,
+       .signature_hint = kGmshHint,
+       .write = [](const primal::Model& m, const fs::path& p,
+                   const WriteOptions&) { write_gmsh(m, p, GmshFormat::Ascii, GmshVersion::k22); },
+       // Node and side sets do not come back from a 2.2 file (tests/io/formats_test.cpp).
+       .carries = {Carried::kYes, Carried::kYes, Carried::kNo, Carried::kNo, Carried::kNo,
+                   "hex, tet"},
+       .written_as = "2.2 ASCII (`--format msh22`)"},
+      {.name = "vtu",
+       .title = "VTK XML .vtu",
+       .extensions = {".vtu"},
+       .signature = looks_like_vtu,
+       .read = [](const fs::path& p,
+                  const primal::ReadOptions& o) { return model_from_vtk(read_vtu(p), o); },
+       .write = [](const primal::Model& m, const fs::path& p,
+                   const WriteOptions& o) { write_vtu(p, m, {}, o.vtu_encoding); },
+       .write_quads = [](const primal::QuadMesh& m, const fs::path& p,
+                         const WriteOptions& o) { write_vtu(p, m, {}, o.vtu_encoding); },
+       .read_plain = read_vtk_plain,
+       .index_base = 0,
+       .carries = {Carried::kYes, Carried::kWritten, Carried::kNo, Carried::kNo, Carried::kNo,
+                   "hex, tet; planar quad"},
+       .read_variants = "ascii, binary (base64), appended (raw and base64), zlib-compressed, "
+                        "UInt32 or UInt64 headers",
+       .written_as =
+           "binary (base64; `--vtu-encoding ascii`); cell arrays `block`, `scaled_jacobian`, "
+           "block names as field data `block:NAME`"},
+      {.name = "vtk",
+       .title = "legacy VTK .vtk",
+       .extensions = {".vtk"},
+       .signature = looks_like_vtk,
+       .read = [](const fs::path& p,
+                  const primal::ReadOptions& o) { return model_from_vtk(read_vtk(p), o); },
+       .write = [](const primal::Model& m, const fs::path& p,
+                   const WriteOptions&) { write_vtk(p, m); },
+       .write_quads = [](const primal::QuadMesh& m, const fs::path& p,
+                         const WriteOptions&) { write_vtk(p, m); },
+       .read_plain = read_vtk_plain,
+       .index_base = 0,
+       .carries = {Carried::kYes, Carried::kNo, Carried::kNo, Carried::kNo, Carried::kNo,
+                   "hex, tet; planar quad"},
+       .read_variants = "ASCII and BINARY, classic and 5.1 cell layouts",
+       .written_as = "4.2 ASCII; cell arrays `block`, `scaled_jacobian`"},
+  };
+  return formats;
+}
+#pragma GCC diagnostic pop
+
+std::string lower_extension(const fs::path& path) {
+  std::string e = path.extension().string();
+  std::transform(e.begin(), e.end(), e.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return e;
+}
+
+bool has_extension(const MeshFormat& f, std::string_view e) {
+  return std::find(f.extensions.begin(), f.extensions.end(), e) != f.extensions.end();
+}
+
+bool plays(const MeshFormat& f, FormatRole role) {
+  switch (role) {
+    case FormatRole::kRead:
+      return f.read != nullptr;
+    case FormatRole::kReadQuads:
+      return f.read_plain != nullptr;
+    case FormatRole::kWrite:
+      return f.write != nullptr;
+    case FormatRole::kWriteQuads:
+      return f.write_quads != nullptr;
+  }
+  return false;
+}
+
+const MeshFormat& resolve(const fs::path& path, std::string_view format, FormatRole role) {
+  const MeshFormat* f = format.empty() ? writer_for(path) : find_mesh_format(format);
+  if (!f && format.empty())
+    throw InvalidInput(path.string() + ": unknown output format '" + lower_extension(path) +
+                       "' (expected " + extension_list(role) + ")");
+  if (!f || !plays(*f, role))
+    throw InvalidInput(path.string() + ": '" + std::string(format) + "' is not a mesh format" +
+                       (role == FormatRole::kWriteQuads ? " for quad meshes" : "") + " (expected " +
+                       [&] {
+                         std::string s;
+                         for (const auto& n : format_names(role)) s += (s.empty() ? "" : ", ") + n;
+                         return s;
+                       }() +
+                       ")");
+  return *f;
+}
+
+const char* carried_text(Carried c) {
+  switch (c) {
+    case Carried::kNo:
+      return "no";
+    case Carried::kWritten:
+      return "written";
+    case Carried::kYes:
+      return "yes";
+  }
+  return "no";
+}
+
+}  // namespace
+
+std::span<const MeshFormat> mesh_formats() { return table(); }
+
+const MeshFormat* find_mesh_format(std::string_view name) {
+  for (const MeshFormat& f : table())
+    if (f.name == name) return &f;
+  return nullptr;
+}
+
+const MeshFormat* reader_for(const fs::path& path) {
+  const std::string e = lower_extension(path);
+  for (const MeshFormat& f : table())
+    if (f.read && has_extension(f, e)) return &f;
+  return nullptr;
+}
+
+const MeshFormat* writer_for(const fs::path& path) {
+  const std::string e = lower_extension(path);
+  for (const MeshFormat& f : table())
+    if (f.write && has_extension(f, e)) return &f;
+  return nullptr;
+}
+
+std::string extension_list(FormatRole role, std::string_view separator,
+                           std::string_view last_separator) {
+  std::vector<std::string_view> all;
+  for (const MeshFormat& f : table())
+    if (plays(f, role))
+      for (std::string_view e : f.extensions)
+        if (std::find(all.begin(), all.end(), e) == all.end()) all.push_back(e);
+  std::string s;
+  for (std::size_t i = 0; i < all.size(); ++i)
+    s += (i == 0                ? ""
+          : i + 1 == all.size() ? std::string(last_separator)
+                                : std::string(separator)) +
+         std::string(all[i]);
+  return s;
+}
+
+std::vector<std::string> format_names(FormatRole role) {
+  std::vector<std::string> names;
+  for (const MeshFormat& f : table())
+    if (plays(f, role)) names.emplace_back(f.name);
+  return names;
+}
+
+void check_signature(const fs::path& path, const MeshFormat& format) {
+  const std::string head = read_file_head(path);
+  if (format.signature(head)) return;
+  std::string what = path.string() + ": not in " + std::string(format.title) + " format";
+  const MeshFormat* found = nullptr;
+  for (const MeshFormat& f : table())
+    if (f.read && f.signature(head)) {
+      found = &f;
+      break;
+    }
+  if (head.empty())
+    what += " (the file is empty)";
+  else if (found)
+    what += " (its content is " + std::string(found->title) + ")";
+  else if (!format.signature_hint.empty())
+    what += " (" + std::string(format.signature_hint) + ")";
+  throw InvalidInput(what);
+}
+
+PlainMesh read_plain_mesh(const fs::path& path, const MeshFormat** format) {
+  const MeshFormat* f = reader_for(path);
+  if (!f) {
+    (void)read_file_head(path);  // a missing file is named as such first
+    throw InvalidInput(path.string() + ": unknown input format '" + lower_extension(path) +
+                       "' (expected " + extension_list(FormatRole::kRead) + ")");
+  }
+  if (format) *format = f;
+  check_signature(path, *f);
+  if (f->read_plain)
+    if (auto m = f->read_plain(path)) return std::move(*m);
+  const primal::Model model = read_model(path);
+  for (primal::ElementKind kind : {primal::ElementKind::Tet, primal::ElementKind::Pyramid, primal::ElementKind::Wedge})
+    if (const std::size_t n = primal::element_count(model, kind))
+      throw InvalidInput(path.string() + ": holds " + std::to_string(n) + " " + primal::element_kind_name(kind) +
+                         "s; expected an all-hex mesh (use `geode conform` first)");
+  PlainMesh m;
+  m.hex = primal::hex_part(model);
+  return m;
+}
+
+void write_model(const primal::Model& model, const fs::path& path, std::string_view format,
+                 const WriteOptions& options) {
+  resolve(path, format, FormatRole::kWrite).write(model, path, options);
+}
+
+void write_quad_mesh(const primal::QuadMesh& mesh, const fs::path& path, std::string_view format,
+                     const WriteOptions& options) {
+  resolve(path, format, FormatRole::kWriteQuads).write_quads(mesh, path, options);
+}
+
+std::string format_matrix_markdown() {
+  std::string s =
+      "| extension | format (`--format`) | read | written | cells | blocks | block names | node "
+      "sets | side sets "
+      "| set names |\n|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const MeshFormat& f : table()) {
+    std::string ext;
+    for (std::string_view e : f.extensions)
+      ext += (ext.empty() ? "`" : ", `") + std::string(e) + "`";
+    const FormatCarries& c = f.carries;
+    s += "| " + ext + " | " + std::string(f.title) + " (`" + std::string(f.name) + "`) | " +
+         (f.read ? std::string(f.read_variants) : std::string("by `msh`")) + " | " +
+         (f.write ? std::string(f.written_as) : std::string("no")) + " | " + std::string(c.cells) +
+         " | " + carried_text(c.blocks) + " | " + carried_text(c.block_names) + " | " +
+         carried_text(c.node_sets) + " | " + carried_text(c.side_sets) + " | " +
+         carried_text(c.set_names) + " |\n";
+  }
+  return s;
+}
+
+}  // namespace geode::io

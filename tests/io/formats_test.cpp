@@ -1,0 +1,147 @@
+// The format table (io/formats.hpp): every entry's writer and reader round-trip a model with
+// what the entry says it carries, and drop what it says it drops; signatures tell the formats
+// apart; dispatch by extension and by name; the docs' matrix is the table's.
+#include <doctest/doctest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include "io/file_format.hpp"
+#include "io/formats.hpp"
+#include "io/read_model.hpp"
+#include "primal/errors.hpp"
+#include "primal/grid_model.hpp"
+#include "support/temp_dir.hpp"
+
+namespace fs = std::filesystem;
+using namespace geode;
+using namespace geode::primal;
+using namespace geode::io;
+
+namespace {
+
+// Hexes (block 1 "steel") beside Kuhn tets (block 2), a node set and a side set with names.
+Model sample_model() {
+  Model m = grid_model({2, 2, 1}, 0.5, [](int i, int, int) { return i >= 1; });
+  m.block_names[1] = "steel";
+  m.node_sets.push_back({11, "bottom", {0, 2, 4, 8}});
+  SideSet outside{21, "outside", {}};
+  outside.sides.push_back({{ElementKind::Hex, 0}, 0});
+  m.side_sets.push_back(outside);
+  return m;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+}  // namespace
+
+TEST_CASE("format table: names unique, extensions lower case, every entry reads or writes") {
+  std::set<std::string_view> names;
+  for (const MeshFormat& f : mesh_formats()) {
+    CAPTURE(f.name);
+    CHECK(names.insert(f.name).second);
+    CHECK(!f.extensions.empty());
+    for (std::string_view e : f.extensions) {
+      CHECK(e.size() >= 2);
+      CHECK(e.front() == '.');
+      for (char c : e) CHECK(!(c >= 'A' && c <= 'Z'));
+    }
+    CHECK((f.signature != nullptr));
+    CHECK((f.read != nullptr || f.write != nullptr));
+    CHECK(find_mesh_format(f.name) == &f);
+    // Every extension is read by some entry: a file we write can be read back.
+    for (std::string_view e : f.extensions)
+      CHECK(reader_for(fs::path("x") += std::string(e)) != nullptr);
+  }
+  CHECK(find_mesh_format("stl") == nullptr);
+  CHECK(reader_for("mesh.obj") == nullptr);
+  CHECK(reader_for("MESH.EXO")->name == "exo");  // any case
+  CHECK(writer_for("out.msh")->name == "msh");   // 4.1 before 2.2
+  CHECK(extension_list(FormatRole::kWriteQuads) == ".vtu or .vtk");
+}
+
+TEST_CASE(
+    "format table: each writer's output has its signature and no other's, and reads back with what "
+    "it carries") {
+  const geode::test::TempDir dir;
+  const Model m = sample_model();
+  for (const MeshFormat& f : mesh_formats()) {
+    if (!f.write) continue;
+    CAPTURE(f.name);
+    const fs::path path = dir.path / ("model" + std::string(f.extensions.front()));
+    write_model(m, path, f.name);
+    const std::string head = read_file_head(path);
+    CHECK(f.signature(head));
+    for (const MeshFormat& g : mesh_formats())
+      if (g.signature != f.signature) CHECK_FALSE(g.signature(head));
+    const Model r = read_model(path);
+    CHECK(r.hexes.size() == m.hexes.size());
+    CHECK(r.tets.size() == m.tets.size());
+    const FormatCarries& c = f.carries;
+    if (c.blocks == Carried::kYes) {
+      CHECK(r.hex_block == std::vector<int>(m.hexes.size(), 1));
+      CHECK(r.tet_block == std::vector<int>(m.tets.size(), 2));
+    }
+    CHECK((r.block_names.count(1) && r.block_names.at(1) == "steel") ==
+          (c.block_names == Carried::kYes));
+    if (c.block_names == Carried::kWritten) CHECK(slurp(path).find("steel") != std::string::npos);
+    if (c.block_names == Carried::kNo) CHECK(slurp(path).find("steel") == std::string::npos);
+    CHECK((r.node_sets.size() == 1) == (c.node_sets == Carried::kYes));
+    CHECK((r.side_sets.size() == 1) == (c.side_sets == Carried::kYes));
+    if (c.set_names == Carried::kYes) {
+      REQUIRE(r.node_sets.size() == 1);
+      CHECK(r.node_sets[0].name == "bottom");
+      CHECK(r.side_sets[0].name == "outside");
+    }
+    if (f.write_quads) {
+      QuadMesh q;
+      q.points = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+      q.quads = {{0, 1, 2, 3}};
+      const fs::path qp = dir.path / ("quad" + std::string(f.extensions.front()));
+      write_quad_mesh(q, qp, f.name);
+      const PlainMesh p = read_plain_mesh(qp);
+      CHECK(p.dim == 2);
+      CHECK(p.quad.quads.size() == 1);
+    }
+  }
+}
+
+TEST_CASE(
+    "format table: dispatch refuses unknown formats and content of another format, naming the "
+    "file") {
+  const geode::test::TempDir dir;
+  const Model m = sample_model();
+  CHECK_THROWS_WITH_AS(write_model(m, dir.path / "out.stl"),
+                       doctest::Contains("unknown output format '.stl'"), InvalidInput);
+  CHECK_THROWS_WITH_AS(write_model(m, dir.path / "out.vtu", "obj"),
+                       doctest::Contains("'obj' is not a mesh format"), InvalidInput);
+  QuadMesh q;
+  CHECK_THROWS_WITH_AS(write_quad_mesh(q, dir.path / "q.exo"), doctest::Contains("for quad meshes"),
+                       InvalidInput);
+  const fs::path fake = dir.path / "fake.exo";
+  write_model(m, dir.path / "real.vtu");
+  fs::copy_file(dir.path / "real.vtu", fake);
+  CHECK_THROWS_WITH_AS(
+      read_model(fake),
+      doctest::Contains("fake.exo: not in Exodus II format (its content is VTK XML"), InvalidInput);
+  CHECK_THROWS_WITH_AS(read_model(dir.path / "mesh.obj"), doctest::Contains("no such file"),
+                       InvalidInput);
+  std::ofstream(dir.path / "mesh.obj") << "v 0 0 0\n";
+  CHECK_THROWS_WITH_AS(
+      read_model(dir.path / "mesh.obj"),
+      doctest::Contains("unknown input format '.obj' (expected .exo, .e, .msh, .vtu or .vtk)"),
+      InvalidInput);
+}
+
+TEST_CASE("format table: docs/formats.md holds the table's matrix (geode formats prints it)") {
+  const std::string doc = slurp(fs::path(GEODE_SOURCE_DIR) / "docs" / "formats.md");
+  CHECK(doc.find(format_matrix_markdown()) != std::string::npos);
+}
