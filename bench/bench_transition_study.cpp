@@ -26,7 +26,7 @@
 #include <vector>
 
 #include "conform/conform.hpp"
-#include "conform/demo_models.hpp"
+#include "demo/demo_models.hpp"
 #include "primal/boundary.hpp"
 #include "primal/interface.hpp"
 #include "primal/quality.hpp"
@@ -118,9 +118,9 @@ int main(int argc, char** argv) {
   const std::string csv = argc > 2 ? argv[2] : std::string(GEODE_SOURCE_DIR) + "/notebooks-data/transition-corners.csv";
   std::vector<std::pair<std::string, std::function<primal::Model()>>> models;
   for (const char* name : {"nugget", "lshape", "potting", "cylinder"})
-    models.emplace_back(name, [name, n] { return conform::demo_model(name, n); });
+    models.emplace_back(name, [name, n] { return demo::demo_model(name, n); });
   for (double a : {60.0, 90.0, 120.0, 150.0, 210.0, 240.0, 270.0, 300.0})
-    models.emplace_back("wedge-" + std::to_string(static_cast<int>(a)), [a, n] { return conform::demo_wedge(n, a); });
+    models.emplace_back("wedge-" + std::to_string(static_cast<int>(a)), [a, n] { return demo::demo_wedge(n, a); });
   std::ofstream out(csv);
   out << "model,n,kind,angle,buffer_hexes,min_sj_none,min_sj_default,min_local_ratio_default,min_local_yardstick\n";
   std::printf("%-10s %-15s %6s %6s %9s %9s %9s %9s\n", "model", "kind", "angle", "count", "none", "default",

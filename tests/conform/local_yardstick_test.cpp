@@ -11,7 +11,7 @@
 #include <string>
 
 #include "conform/conform.hpp"
-#include "conform/demo_models.hpp"
+#include "demo/demo_models.hpp"
 #include "primal/dice.hpp"
 #include "primal/interface.hpp"
 #include "primal/quality.hpp"
@@ -24,7 +24,7 @@ TEST_CASE("the local yardstick: the input cells around each buffer hex, diced al
   for (const auto& [name, n] : {std::pair{"potting", 2}, std::pair{"lshape", 3}}) {
     const std::string model_name = name;
     CAPTURE(model_name);
-    const primal::Model input = conform::demo_model(name, n);
+    const primal::Model input = demo::demo_model(name, n);
     const conform::ConformResult r = conform::conform(input);
     test::check_conform_result(r);
     const primal::Interface itf = primal::find_interface(input);
