@@ -294,7 +294,7 @@ TEST_CASE("insert_buffer_layer: no layer where no direction sees all interface f
 TEST_CASE("Gmsh demo models: conforming interface and a valid buffer layer") {
   SUBCASE("half block, structured hexes | transfinite tets") {
     const int n = 3;
-    const Model m = demo_half_block(n);
+    const Model m = demo::demo_half_block(n);
     CHECK(m.hexes.size() == static_cast<std::size_t>(n * n * n));
     CHECK(m.tets.size() == static_cast<std::size_t>(6 * n * n * n));
     CHECK(m.points.size() == static_cast<std::size_t>((2 * n + 1) * (n + 1) * (n + 1)));  // interface merged
@@ -311,7 +311,7 @@ TEST_CASE("Gmsh demo models: conforming interface and a valid buffer layer") {
   }
   SUBCASE("tet nugget inside sweepable hex blocks (Figure 8, simplified)") {
     const int n = 4;
-    const Model m = demo_nugget(n);
+    const Model m = demo::demo_nugget(n);
     // 26 blocks on a 4 x 4 x 4 structured grid of cells of size 0.5 minus the nugget's 4^3.
     CHECK(m.hexes.size() == static_cast<std::size_t>(8 * 8 * 8 - 4 * 4 * 4));
     CHECK(m.side_sets.at(0).sides.size() == static_cast<std::size_t>(6 * 8 * 8));

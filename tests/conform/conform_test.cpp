@@ -192,9 +192,15 @@ TEST_CASE("the result round-trips through Exodus") {
   CHECK(back.tets.empty());
 }
 
-TEST_CASE("conform rejects models without both parts") {
+TEST_CASE("conform dices a model without both parts, and refuses an empty one") {
   const auto hexes = primal::grid_model({2, 1, 1}, 1.0, [](int, int, int) { return false; });
-  CHECK_THROWS_AS(conform::conform(hexes), InvalidInput);
+  const auto h = conform::conform(hexes);
+  CHECK(h.interface_quads == 0);
+  CHECK(h.model.hexes.size() == 8 * hexes.hexes.size());
+  CHECK(h.validity.ok());
   const auto tets = primal::grid_model({2, 1, 1}, 1.0, [](int, int, int) { return true; });
-  CHECK_THROWS_AS(conform::conform(tets), InvalidInput);
+  const auto t = conform::conform(tets);
+  CHECK(t.model.hexes.size() == 4 * tets.tets.size());
+  CHECK(t.validity.ok());
+  CHECK_THROWS_AS(conform::conform(primal::Model{}), InvalidInput);
 }
