@@ -27,6 +27,14 @@ using namespace io;
 
 namespace {
 
+// A demo model's elements are numbered as its writers number them (index + 1), not by the tags
+// of the Gmsh model it was built in: the parts are joined and re-oriented after meshing.
+Model without_file_ids(Model m) {
+  for (ElementKind kind : kElementKinds) element_ids(m, kind).clear();
+  m.node_ids.clear();
+  return m;
+}
+
 // Transfinite curves with cells of size h (by the curve's bounding box length).
 void transfinite_curves(double h) {
   gmsh::vectorpair curves;
@@ -71,7 +79,7 @@ Model with_gmsh(const std::string& name, F&& build) {
     gmsh::model::add(name);
     build();
     gmsh::model::mesh::generate(3);
-    Model m = model_from_gmsh(name);
+    Model m = without_file_ids(model_from_gmsh(name));
     // The separately meshed volumes meet at coincident nodes: merge them.
     merge_coincident_nodes(m, 1e-9);
     orient_positively(m);
@@ -189,7 +197,7 @@ Model tet_fill(const Shell& shell, const std::vector<Shell>& holes, int block,
   gmsh::model::addPhysicalGroup(3, {volume}, block);
   gmsh::model::setPhysicalName(3, block, block_name);
   gmsh::model::mesh::generate(3);
-  Model m = model_from_gmsh("tet_fill");
+  Model m = without_file_ids(model_from_gmsh("tet_fill"));
   gmsh::model::remove();
   return m;
 }
@@ -234,7 +242,7 @@ Model hex_part_from_gmsh(const std::string& name, F&& build) {
   gmsh::model::add(name);
   build();
   gmsh::model::mesh::generate(3);
-  Model m = model_from_gmsh(name);
+  Model m = without_file_ids(model_from_gmsh(name));
   m.tets.clear(), m.tet_block.clear();
   merge_coincident_nodes(m, 1e-9);
   orient_positively(m);
@@ -648,7 +656,7 @@ Model hybrid_gmsh(const std::string& name, F&& build) {
     gmsh::model::add(name);
     build();
     gmsh::model::mesh::generate(3);
-    Model m = model_from_gmsh(name);
+    Model m = without_file_ids(model_from_gmsh(name));
     auto pt = [&](Index v) -> const Point& { return m.points[static_cast<std::size_t>(v)]; };
     orient_positively(m);
     for (auto& p : m.pyramids)

@@ -223,9 +223,42 @@ TEST_CASE("the result round-trips through Exodus") {
   CHECK(back.tets.empty());
 }
 
-TEST_CASE("conform rejects models without both parts") {
+TEST_CASE("conform dices a model without both parts, and refuses an empty one") {
   const auto hexes = primal::grid_model({2, 1, 1}, 1.0, [](int, int, int) { return false; });
-  CHECK_THROWS_AS(conform::conform(hexes), InvalidInput);
+  const auto h = conform::conform(hexes);
+  CHECK(h.interface_quads == 0);
+  CHECK(h.model.hexes.size() == 8 * hexes.hexes.size());
+  CHECK(h.validity.ok());
   const auto tets = primal::grid_model({2, 1, 1}, 1.0, [](int, int, int) { return true; });
-  CHECK_THROWS_AS(conform::conform(tets), InvalidInput);
+  const auto t = conform::conform(tets);
+  CHECK(t.model.hexes.size() == 4 * tets.tets.size());
+  CHECK(t.validity.ok());
+  CHECK_THROWS_AS(conform::conform(primal::Model{}), InvalidInput);
+}
+
+TEST_CASE("conform refuses a wedge at the hex/tet interface, naming the wedge") {
+  // A hex cell beside a tet cell (grid_model), and a wedge extruded up off a top triangle of the
+  // tet part that touches the interface plane x = 1: the buffer layer would tear it.
+  primal::Model m = primal::grid_model({2, 1, 1}, 1.0, [](int i, int, int) { return i == 1; });
+  std::array<Index, 3> tri{-1, -1, -1};
+  for (const auto& t : m.tets)
+    for (const auto& f : primal::topology::kTetFaceCorners) {
+      const std::array<Index, 3> c{t[static_cast<std::size_t>(f[0])], t[static_cast<std::size_t>(f[1])], t[static_cast<std::size_t>(f[2])]};
+      bool top = true, at_interface = false;
+      for (Index v : c) {
+        top = top && m.points[static_cast<std::size_t>(v)].z() > 1.0 - 1e-12;
+        at_interface = at_interface || m.points[static_cast<std::size_t>(v)].x() < 1.0 + 1e-12;
+      }
+      if (top && at_interface && tri[0] < 0) tri = c;  // outward: counter-clockwise seen from above
+    }
+  REQUIRE(tri[0] >= 0);
+  std::array<Index, 6> w{tri[0], tri[1], tri[2], 0, 0, 0};
+  for (int k = 0; k < 3; ++k) {
+    w[static_cast<std::size_t>(3 + k)] = static_cast<Index>(m.points.size());
+    m.points.push_back(m.points[static_cast<std::size_t>(tri[static_cast<std::size_t>(k)])] + primal::Point(0, 0, 0.5));
+  }
+  m.wedges.push_back(w);
+  REQUIRE_NOTHROW(primal::check_geometry(m, "w.msh"));
+  CHECK_THROWS_WITH_AS(conform::conform(m), doctest::Contains("wedge 1 (centre"), TopologyError);
+  CHECK_THROWS_WITH_AS(conform::conform(m), doctest::Contains("touches the hex/tet interface"), TopologyError);
 }

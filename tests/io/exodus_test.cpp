@@ -147,13 +147,18 @@ TEST_CASE("read_exodus rejects bad input naming the file, element and reason") {
     const std::string what = message_of(cut);
     CHECK(what.find(cut.string()) != std::string::npos);
   }
-  SUBCASE("unknown element type: a quadratic tet") {
-    const fs::path file = dir / "tetra10.exo";
-    write_raw(file, "TETRA10", {1, 2, 3, 4, 5, 6, 7, 8, 9, 10}, 10);
+  SUBCASE("unknown element type") {
+    const fs::path file = dir / "shell.exo";
+    write_raw(file, "SHELL4", {1, 2, 3, 4}, 4);
     const std::string what = message_of(file);
     CHECK(what.find(file.string()) != std::string::npos);
     CHECK(what.find("element block 3: element 1") != std::string::npos);
-    CHECK(what.find("'TETRA10'") != std::string::npos);
+    CHECK(what.find("'SHELL4'") != std::string::npos);
+  }
+  SUBCASE("a wedge with the wrong node count") {
+    const fs::path file = dir / "wedge5.exo";
+    write_raw(file, "WEDGE", {1, 2, 3, 4, 5}, 5);
+    CHECK(message_of(file).find("'WEDGE' with 5 nodes is not supported") != std::string::npos);
   }
   SUBCASE("node index out of range") {
     const fs::path file = dir / "range.exo";
@@ -164,12 +169,26 @@ TEST_CASE("read_exodus rejects bad input naming the file, element and reason") {
   }
 }
 
-TEST_CASE("write_exodus is atomic and rejects blocks mixing hexes and tets") {
-  const fs::path file = scratch_dir() / "atomic.exo";
-  std::ofstream(file) << "previous content";
+TEST_CASE("write_exodus writes a block of two kinds as one block per kind") {
+  const fs::path file = scratch_dir() / "mixed.exo";
   Model mixed = sample_model();
   mixed.tet_block.assign(mixed.tets.size(), 1);  // block 1 now holds both
-  CHECK_THROWS_WITH_AS(write_exodus(mixed, file), doctest::Contains("block 1 holds both"), InvalidInput);
+  mixed.block_names[1] = "steel";
+  write_exodus(mixed, file);
+  const Model back = read_exodus(file);
+  CHECK(back.hexes.size() == mixed.hexes.size());
+  CHECK(back.tets.size() == mixed.tets.size());
+  REQUIRE(!back.tets.empty());
+  int top = 0;
+  for (std::size_t h = 0; h < mixed.hexes.size(); ++h) top = std::max(top, mixed.hex_block[h]);
+  CHECK(back.hex_block.front() == 1);  // hexes first: they keep the id
+  CHECK(back.tet_block.front() == top + 1);
+  CHECK(back.block_names.at(top + 1) == "steel tets");
+}
+
+TEST_CASE("write_exodus is atomic") {
+  const fs::path file = scratch_dir() / "atomic.exo";
+  std::ofstream(file) << "previous content";
   Model bad = sample_model();
   bad.side_sets[0].sides[0].face = 4;  // tets have faces 0..3
   CHECK_THROWS_WITH_AS(write_exodus(bad, file), doctest::Contains("face 5 out of range"), InvalidInput);

@@ -164,9 +164,9 @@ TEST_CASE("read_gmsh rejects bad input naming the file, element and reason") {
     write_text(file, full.substr(0, full.find("1 1 0\n0 1 0")));  // cut inside $Nodes
     CHECK_THROWS_WITH_AS(read_gmsh(file), doctest::Contains(file.string().c_str()), InvalidInput);
   }
-  SUBCASE("unsupported element type: a quadratic tet (Gmsh type 11)") {
+  SUBCASE("unsupported element type: a 10-node tetrahedron (Gmsh type 11)") {
     const fs::path file = dir / "tet10.msh";
-    write_text(file, hand_written_msh("3 1 11 1\n3 2 1 4 6 5 8 7 9 3 2\n3 1 4 1\n4 1 9 4 5\n"));
+    write_text(file, hand_written_msh("3 1 11 1\n3 1 2 3 4 5 6 7 8 9 10\n3 1 4 1\n4 1 9 4 5\n"));
     try {
       (void)read_gmsh(file);
       FAIL("no exception");
