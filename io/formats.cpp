@@ -34,9 +34,9 @@ std::optional<PlainMesh> read_vtk_plain(const fs::path& path) {
 }
 
 constexpr FormatCarries kExodusCarries{Carried::kYes, Carried::kYes, Carried::kYes,
-                                       Carried::kYes, Carried::kYes, "hex, tet"};
+                                       Carried::kYes, Carried::kYes, "hex, tet, pyramid, wedge"};
 constexpr FormatCarries kGmshCarries{Carried::kYes, Carried::kYes, Carried::kYes,
-                                     Carried::kYes, Carried::kYes, "hex, tet"};
+                                     Carried::kYes, Carried::kYes, "hex, tet, pyramid, wedge"};
 constexpr std::string_view kGmshHint =
     "it does not start with $MeshFormat; Gmsh scripts are not read";
 
@@ -77,9 +77,7 @@ const std::vector<MeshFormat>& table() {
        .signature_hint = kGmshHint,
        .write = [](const primal::Model& m, const fs::path& p,
                    const WriteOptions&) { write_gmsh(m, p, GmshFormat::Ascii, GmshVersion::k22); },
-       // Node and side sets do not come back from a 2.2 file (tests/io/formats_test.cpp).
-       .carries = {Carried::kYes, Carried::kYes, Carried::kNo, Carried::kNo, Carried::kNo,
-                   "hex, tet"},
+       .carries = kGmshCarries,
        .written_as = "2.2 ASCII (`--format msh22`)"},
       {.name = "vtu",
        .title = "VTK XML .vtu",
@@ -94,11 +92,11 @@ const std::vector<MeshFormat>& table() {
        .read_plain = read_vtk_plain,
        .index_base = 0,
        .carries = {Carried::kYes, Carried::kWritten, Carried::kNo, Carried::kNo, Carried::kNo,
-                   "hex, tet; planar quad"},
+                   "hex, tet, pyramid, wedge; planar quad"},
        .read_variants = "ascii, binary (base64), appended (raw and base64), zlib-compressed, "
                         "UInt32 or UInt64 headers",
        .written_as =
-           "binary (base64; `--vtu-encoding ascii`); cell arrays `block`, `scaled_jacobian`, "
+           "binary (base64; `--vtu-encoding ascii`); cell arrays `block`, `mat_id` (the block again, for Python solvers), `scaled_jacobian`, "
            "block names as field data `block:NAME`"},
       {.name = "vtk",
        .title = "legacy VTK .vtk",
@@ -113,7 +111,7 @@ const std::vector<MeshFormat>& table() {
        .read_plain = read_vtk_plain,
        .index_base = 0,
        .carries = {Carried::kYes, Carried::kNo, Carried::kNo, Carried::kNo, Carried::kNo,
-                   "hex, tet; planar quad"},
+                   "hex, tet, pyramid, wedge; planar quad"},
        .read_variants = "ASCII and BINARY, classic and 5.1 cell layouts",
        .written_as = "4.2 ASCII; cell arrays `block`, `scaled_jacobian`"},
   };

@@ -195,6 +195,9 @@ std::vector<NodeSet> diced_node_sets(const Model& model, const DicedModel& diced
     for (Index v : ns.nodes) in[v] = 1;
     NodeSet o{ns.id, ns.name, {}};
     // With pieces (model.hpp), a node made from nodes of one piece: its key's nodes, sorted.
+    // Pieces that are single points say nothing of which nodes belong together: a set given
+    // as points only (how a node set is written) follows the rule without pieces.
+    const bool by_pieces = std::any_of(ns.pieces.begin(), ns.pieces.end(), [](const auto& p) { return p.size() > 1; });
     std::set<FaceKey> within;
     for (const auto& piece : ns.pieces) {
       const std::size_t n = std::min<std::size_t>(piece.size(), 4);
@@ -211,7 +214,7 @@ std::vector<NodeSet> diced_node_sets(const Model& model, const DicedModel& diced
       bool all = true;
       for (Index v : diced.origin[g])
         if (v != kInvalidIndex) all = all && in[v];
-      if (all && !ns.pieces.empty()) all = within.count(normalized_origin(diced.origin[g])) > 0;
+      if (all && by_pieces) all = within.count(normalized_origin(diced.origin[g])) > 0;
       if (all) o.nodes.push_back(renumber[g]);
     }
     std::sort(o.nodes.begin(), o.nodes.end());

@@ -54,7 +54,7 @@ struct NodeSet {
   // Optional: the points, edges and faces the set was given as (a .msh physical point or
   // curve: each element's nodes). Dicing then adds a new node only when every node it is made
   // from lies in one piece, so that a set on two parallel edges does not grow onto the face
-  // between them; without pieces, when every such node is in the set.
+  // between them; without pieces (or with single points only), when every such node is in the set.
   std::vector<std::vector<Index>> pieces = {};
 };
 

@@ -80,7 +80,15 @@ def arrange(spec, smooth=False, slide=False):
     format of `geode arrange`); smooth=True places the nodes by optimization (box domains)."""
     if isinstance(spec, _os.PathLike):
         spec = _os.fspath(spec)
-    return _warn(_geode.arrange(spec, smooth, slide))
+    try:
+        return _warn(_geode.arrange(spec, smooth, slide))
+    except TopologyError as e:
+        # Input errors name the spec already (its file's name, or "spec"); topology refusals
+        # from the arrangement do not: name it the same way, as `geode arrange` does.
+        source = _os.path.basename(spec) if isinstance(spec, str) else "spec"
+        if str(e).startswith(source + ": "):
+            raise
+        raise TopologyError(source + ": " + str(e)) from None
 
 
 # ---- Template: meshio and the notebook viewer --------------------------------------------------

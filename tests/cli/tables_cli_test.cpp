@@ -49,12 +49,10 @@ TEST_CASE("cli tables: every writable format is offered by template -o and reads
     CAPTURE(f.name);
     const fs::path out = dir.path / ("t" + std::string(f.extensions.back()));
     const test::CliRun r = test::geode_cli(
-        "template geode3d --no-smooth --format " + std::string(f.name) + " -o " + out.string(),
+        "template geode3d --format " + std::string(f.name) + " -o " + out.string(),
         true);
     CHECK(r.code == 0);
-    primal::ReadOptions connectivity;  // unsmoothed: the dual's first guess is tangled
-    connectivity.check_geometry = false;
-    CHECK(io::read_model(out, connectivity).hexes.size() == 26);
+    CHECK(io::read_model(out).hexes.size() == 26);
   }
   const test::CliRun bad =
       test::geode_cli("template geode3d --format stl -o " + (dir.path / "t.stl").string(), true);

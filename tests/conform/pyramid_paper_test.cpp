@@ -49,7 +49,9 @@ TEST_CASE("pyramid as two tets over a hex, transition carved from the tets: 34 h
   }
   MESSAGE("pyramid as two tets, conform's transition: 34 hexes, min scaled Jacobian " << lo << ", mean "
                                                                                       << sum / 34.0);
-  CHECK(lo > 0.3);
+  // Far above the paper's 0.033; 0.29 since smoothing keeps the model boundary and the block
+  // interface on their surfaces (0.38 when it could move them).
+  CHECK(lo > 0.25);
   const auto v = primal::check_validity(pyramid);
   CHECK(v.ok());
   CHECK(v.boundary.faces.size() == 4 + 4 * (5 + 3));  // not Schneiders' 16

@@ -15,9 +15,9 @@ SPECS = SOURCE / "notebooks-data" / "specs"
 APPENDIX = SOURCE / "notebooks-data" / "appendix-a"
 
 
-def run_cli(*args, check=True):
-    """Runs `geode ARGS`; returns the CompletedProcess (text)."""
-    r = subprocess.run([CLI, *map(str, args)], capture_output=True, text=True)
+def run_cli(*args, check=True, cwd=None):
+    """Runs `geode ARGS` (in cwd, if given); returns the CompletedProcess (text)."""
+    r = subprocess.run([CLI, *map(str, args)], capture_output=True, text=True, cwd=cwd)
     if check and r.returncode != 0:
         raise AssertionError("geode {} exited {}: {}".format(" ".join(map(str, args)), r.returncode, r.stderr))
     return r

@@ -16,10 +16,13 @@ def test_topology_error_matches_cli(tmp_path):
     with pytest.raises(geode.TopologyError) as e:
         geode.arrange(path)
     assert e.value.exit_code == 3 and e.value.kind == "topology"
-    cli = run_cli("arrange", path, check=False)
+    assert str(e.value).startswith("tangent.json: ")
+    cli = run_cli("arrange", path.name, check=False, cwd=tmp_path)
     assert cli.returncode == 3
     # The module names the file as given (its name); the command does the same.
     assert one_line(str(e.value)) == cli_error(cli)
+    with pytest.raises(geode.TopologyError, match=r"^spec: arrangement: sheets 'a', 'c' meet"):
+        geode.arrange(spec)
 
 
 def test_input_errors_name_the_place(tmp_path):

@@ -36,7 +36,7 @@ def test_template_releases_the_gil():
 
 
 def test_conform_releases_the_gil():
-    model = geode.demo_model("delaunay", 10)  # the reference templates are built once per process: a model
+    model = geode.demo_model("delaunay", 18)  # the reference templates are built once per process: a model
     (mesh, report), seconds, gap = longest_stall(lambda: geode.conform(model))  # big enough to take time anyway
     assert report["valid"]
     assert seconds > 0.2 and gap < 0.5 * seconds, (seconds, gap)

@@ -12,7 +12,13 @@ def plain4tri(tmp_path_factory):
     t = geode.template("geode4tri", fixup=False, smooth=False)
     path = tmp_path_factory.mktemp("mesh") / "plain.vtu"
     from conftest import run_cli
-    run_cli("template", "geode4tri", "--no-fixup", "--no-smooth", "-o", path)
+    # Its pinched corners cannot be untangled: the command refuses to write it (exit 4) unless
+    # told to, and then still exits 4.
+    assert not geode.check(t.points, t.hexes)["valid"]
+    assert run_cli("template", "geode4tri", "--no-fixup", "--no-smooth", "-o", path, check=False).returncode == 4
+    assert not path.exists()
+    r = run_cli("template", "geode4tri", "--no-fixup", "--no-smooth", "--write-invalid", "-o", path, check=False)
+    assert r.returncode == 4 and "invalid result" in r.stderr and path.exists()
     return t, path
 
 
