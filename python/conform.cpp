@@ -24,6 +24,12 @@ std::vector<int> to_blocks(const py::handle& blocks, std::size_t n, const std::s
 }
 
 py::dict model_dict(primal::Model&& model) {
+  // The module hands out hexes and tets only so far: refuse rather than drop the other kinds.
+  for (primal::ElementKind kind : {primal::ElementKind::Pyramid, primal::ElementKind::Wedge})
+    if (const std::size_t n = primal::element_count(model, kind))
+      throw InvalidInput("the model holds " + std::to_string(n) + " " + primal::element_kind_name(kind) +
+                         "s, which the Python module does not hand out yet (the command writes them: "
+                         "geode demo --save-input)");
   py::dict d;
   const std::size_t nh = model.hexes.size(), nt = model.tets.size();
   std::vector<int> hb = model.hex_block, tb = model.tet_block;

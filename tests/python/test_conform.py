@@ -25,6 +25,12 @@ def test_demo_model(half):
     assert "half" in geode.demo_model_names()
 
 
+def test_demo_model_with_wedges_is_refused_not_truncated():
+    # The module hands out hexes and tets only so far: a model with wedges must not lose them.
+    with pytest.raises(geode.InputError, match="wedges"):
+        geode.demo_model("boundary-layer", 2)
+
+
 def test_conform_matches_cli(half, tmp_path):
     out, report = geode.conform(half)
     run_cli("demo", "--model", "half", "-n", "2", "--report", tmp_path / "r.json", "--quiet")
