@@ -23,9 +23,6 @@ namespace {
 
 constexpr int kGmshTri3 = 2;
 constexpr int kGmshQuad4 = 3;
-constexpr int kGmshTet4 = 4;
-constexpr int kGmshHex8 = 5;
-constexpr int kGmshPoint = 15;
 
 std::string gmsh_type_name(int type) {
   std::string name;

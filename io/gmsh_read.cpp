@@ -27,7 +27,7 @@ using namespace primal;
 
 namespace {
 
-constexpr int kTri3 = 2, kQuad4 = 3, kTet4 = 4, kHex8 = 5;
+constexpr int kTri3 = 2, kQuad4 = 3;
 
 struct GmshType {
   int type;

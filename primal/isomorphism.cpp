@@ -178,7 +178,11 @@ std::optional<MeshMapping> search(std::size_t na_nodes, const Cells<N>& a_cells,
   const Complex<N> a = build_complex<N>(na_nodes, a_cells, "first");
   const Complex<N> b = build_complex<N>(nb_nodes, b_cells, "second");
   if (na_nodes != nb_nodes || a_cells.size() != b_cells.size()) return std::nullopt;
-  const auto [ca, cb] = refine_colors(a, b, labels);
+  // Named members, not structured bindings: lambdas below capture them (clang 14 refuses
+  // capturing a structured binding).
+  const auto colors = refine_colors(a, b, labels);
+  const auto& ca = colors.first;
+  const auto& cb = colors.second;
   {
     auto ha = ca, hb = cb;
     std::sort(ha.begin(), ha.end());
@@ -242,8 +246,12 @@ std::optional<MeshMapping> search(std::size_t na_nodes, const Cells<N>& a_cells,
     }
     return std::pair{comp, keys};
   };
-  const auto [comp_a, keys_a] = components(a, ca);
-  const auto [comp_b, keys_b] = components(b, cb);
+  const auto components_a = components(a, ca);
+  const auto components_b = components(b, cb);
+  const auto& comp_a = components_a.first;
+  const auto& keys_a = components_a.second;
+  const auto& comp_b = components_b.first;
+  const auto& keys_b = components_b.second;
   {
     auto ka = keys_a, kb = keys_b;
     std::sort(ka.begin(), ka.end());
