@@ -15,9 +15,9 @@
 #include <functional>
 #include <vector>
 
-#include "stc/arrangement.hpp"
-#include "stc/dualize.hpp"
-#include "templates/geode.hpp"
+#include <geode/stc/arrangement.hpp>
+#include <geode/stc/dualize.hpp>
+#include <geode/templates/geode.hpp>
 
 namespace gt = geode::templates;
 using geode::primal::Point;

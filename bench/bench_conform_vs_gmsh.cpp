@@ -43,10 +43,10 @@
 #include <string>
 #include <vector>
 
-#include "demo/demo_models.hpp"
-#include "primal/errors.hpp"
-#include "io/exodus.hpp"
-#include "io/gmsh.hpp"
+#include <geode/demo/demo_models.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/io/exodus.hpp>
+#include <geode/io/gmsh.hpp>
 
 namespace fs = std::filesystem;
 namespace gp = geode::primal;

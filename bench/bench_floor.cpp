@@ -21,9 +21,9 @@
 #include <string>
 #include <vector>
 
-#include "io/gmsh.hpp"
-#include "primal/errors.hpp"
-#include "primal/model.hpp"
+#include <geode/io/gmsh.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/model.hpp>
 
 namespace gp = geode::primal;
 using gp::Index;

@@ -16,10 +16,10 @@
 #include <string>
 #include <vector>
 
-#include "conform/conform.hpp"
-#include "demo/demo_models.hpp"
-#include "primal/local_smooth.hpp"
-#include "primal/quality.hpp"
+#include <geode/conform/conform.hpp>
+#include <geode/demo/demo_models.hpp>
+#include <geode/primal/local_smooth.hpp>
+#include <geode/primal/quality.hpp>
 
 namespace {
 

@@ -19,9 +19,9 @@
 #include <string>
 #include <vector>
 
-#include "io/gmsh.hpp"
-#include "primal/grid_model.hpp"
-#include "primal/topology.hpp"
+#include <geode/io/gmsh.hpp>
+#include <geode/primal/grid_model.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace fs = std::filesystem;
 using namespace geode;

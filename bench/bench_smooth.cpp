@@ -6,10 +6,10 @@
 #include <cstdlib>
 #include <string>
 
-#include "primal/errors.hpp"
-#include "primal/quality.hpp"
-#include "primal/quality_report.hpp"
-#include "primal/smooth.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/quality_report.hpp>
+#include <geode/primal/smooth.hpp>
 #include "support/fixtures.hpp"
 
 namespace gp = geode::primal;

@@ -25,11 +25,11 @@
 #include <tuple>
 #include <vector>
 
-#include "conform/conform.hpp"
-#include "demo/demo_models.hpp"
-#include "primal/boundary.hpp"
-#include "primal/interface.hpp"
-#include "primal/quality.hpp"
+#include <geode/conform/conform.hpp>
+#include <geode/demo/demo_models.hpp>
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/interface.hpp>
+#include <geode/primal/quality.hpp>
 
 namespace {
 

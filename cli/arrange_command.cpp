@@ -6,9 +6,9 @@
 #include "cli/commands.hpp"
 #include "cli/conventions.hpp"
 #include "cli/progress.hpp"
-#include "primal/errors.hpp"
-#include "templates/geode.hpp"
-#include "templates/spec.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/templates/geode.hpp>
+#include <geode/templates/spec.hpp>
 
 namespace geode::cli {
 namespace {

@@ -9,11 +9,11 @@
 
 #include "cli/commands.hpp"
 #include "cli/conventions.hpp"
-#include "primal/errors.hpp"
-#include "primal/quality.hpp"
-#include "primal/quality_report.hpp"
-#include "primal/realizability.hpp"
-#include "primal/validity.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/quality_report.hpp>
+#include <geode/primal/realizability.hpp>
+#include <geode/primal/validity.hpp>
 
 namespace geode::cli {
 namespace {

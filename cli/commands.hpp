@@ -10,11 +10,11 @@
 #include <string>
 #include <vector>
 
-#include "viewer/html.hpp"
-#include "primal/model.hpp"
-#include "primal/smooth.hpp"
-#include "stc/arrangement.hpp"
-#include "stc/sheet.hpp"
+#include <geode/viewer/html.hpp>
+#include <geode/primal/model.hpp>
+#include <geode/primal/smooth.hpp>
+#include <geode/stc/arrangement.hpp>
+#include <geode/stc/sheet.hpp>
 
 namespace geode::templates {
 struct Template;

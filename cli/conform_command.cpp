@@ -11,13 +11,13 @@
 #include "cli/commands.hpp"
 #include "cli/conventions.hpp"
 #include "cli/progress.hpp"
-#include "conform/conform.hpp"
-#include "demo/demo_models.hpp"
-#include "conform/report.hpp"
-#include "primal/errors.hpp"
-#include "primal/quality.hpp"
-#include "primal/quality_report.hpp"
-#include "primal/topology.hpp"
+#include <geode/conform/conform.hpp>
+#include <geode/demo/demo_models.hpp>
+#include <geode/conform/report.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/quality_report.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::cli {
 namespace {

@@ -10,9 +10,9 @@
 #include <sstream>
 
 #include "cli/commands.hpp"
-#include "primal/errors.hpp"
-#include "io/atomic_file.hpp"
-#include "primal/validity.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/io/atomic_file.hpp>
+#include <geode/primal/validity.hpp>
 
 #ifndef GEODE_VERSION
 #define GEODE_VERSION "unknown"

@@ -22,10 +22,10 @@
 #include <string>
 #include <vector>
 
-#include "io/atomic_file.hpp"
-#include "io/formats.hpp"
-#include "primal/mesh.hpp"
-#include "primal/model.hpp"
+#include <geode/io/atomic_file.hpp>
+#include <geode/io/formats.hpp>
+#include <geode/primal/mesh.hpp>
+#include <geode/primal/model.hpp>
 
 namespace geode::cli {
 

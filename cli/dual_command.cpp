@@ -11,13 +11,13 @@
 #include "cli/commands.hpp"
 #include "cli/conventions.hpp"
 #include "cli/progress.hpp"
-#include "primal/errors.hpp"
-#include "io/formats.hpp"
-#include "primal/model.hpp"
-#include "stc/arrangement.hpp"
-#include "stc/dualize.hpp"
-#include "stc/mesh_dual.hpp"
-#include "stc/mesh_fields.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/io/formats.hpp>
+#include <geode/primal/model.hpp>
+#include <geode/stc/arrangement.hpp>
+#include <geode/stc/dualize.hpp>
+#include <geode/stc/mesh_dual.hpp>
+#include <geode/stc/mesh_fields.hpp>
 
 namespace geode::cli {
 namespace {

@@ -5,10 +5,10 @@
 #include <utility>
 
 #include "cli/commands.hpp"
-#include "io/atomic_file.hpp"
-#include "io/formats.hpp"
-#include "io/read_model.hpp"
-#include "primal/errors.hpp"
+#include <geode/io/atomic_file.hpp>
+#include <geode/io/formats.hpp>
+#include <geode/io/read_model.hpp>
+#include <geode/primal/errors.hpp>
 
 namespace geode::cli {
 

@@ -2,7 +2,7 @@
 #include <iostream>
 
 #include "cli/commands.hpp"
-#include "io/formats.hpp"
+#include <geode/io/formats.hpp>
 
 namespace geode::cli {
 

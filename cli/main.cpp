@@ -7,8 +7,8 @@
 
 #include "cli/commands.hpp"
 #include "cli/conventions.hpp"
-#include "io/atomic_file.hpp"
-#include "primal/errors.hpp"
+#include <geode/io/atomic_file.hpp>
+#include <geode/primal/errors.hpp>
 
 namespace {
 

@@ -9,10 +9,10 @@
 #include "cli/commands.hpp"
 #include "cli/conventions.hpp"
 #include "cli/progress.hpp"
-#include "primal/errors.hpp"
-#include "templates/spec.hpp"
-#include "templates/study.hpp"
-#include "templates/template_table.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/templates/spec.hpp>
+#include <geode/templates/study.hpp>
+#include <geode/templates/template_table.hpp>
 
 namespace geode::cli {
 namespace {

@@ -11,19 +11,19 @@
 
 #include "cli/commands.hpp"
 #include "cli/conventions.hpp"
-#include "primal/boundary.hpp"
-#include "primal/errors.hpp"
-#include "viewer/html.hpp"
-#include "io/formats.hpp"
-#include "primal/model.hpp"
-#include "primal/quality.hpp"
-#include "primal/quality_report.hpp"
-#include "templates/fixup.hpp"
-#include "templates/geode.hpp"
-#include "templates/pyramid.hpp"
-#include "templates/refine.hpp"
-#include "templates/spec.hpp"
-#include "templates/template_table.hpp"
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/viewer/html.hpp>
+#include <geode/io/formats.hpp>
+#include <geode/primal/model.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/quality_report.hpp>
+#include <geode/templates/fixup.hpp>
+#include <geode/templates/geode.hpp>
+#include <geode/templates/pyramid.hpp>
+#include <geode/templates/refine.hpp>
+#include <geode/templates/spec.hpp>
+#include <geode/templates/template_table.hpp>
 
 namespace geode::cli {
 namespace {

@@ -9,9 +9,9 @@
 
 #include "cli/commands.hpp"
 #include "cli/conventions.hpp"
-#include "primal/errors.hpp"
-#include "stc/mesh_dual.hpp"
-#include "stc/sheet_surfaces.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/stc/mesh_dual.hpp>
+#include <geode/stc/sheet_surfaces.hpp>
 
 namespace geode::cli {
 

@@ -1,4 +1,4 @@
-#include "conform/buffer_layer.hpp"
+#include <geode/conform/buffer_layer.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -6,12 +6,12 @@
 #include <string>
 #include <tuple>
 
-#include "primal/boundary.hpp"
-#include "primal/errors.hpp"
-#include "primal/gradation.hpp"
-#include "primal/key_map.hpp"
-#include "primal/quality.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/gradation.hpp>
+#include <geode/primal/key_map.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::conform {
 

@@ -20,9 +20,9 @@
 #include <string>
 #include <vector>
 
-#include "primal/interface.hpp"
-#include "primal/local_smooth.hpp"
-#include "primal/model.hpp"
+#include <geode/primal/interface.hpp>
+#include <geode/primal/local_smooth.hpp>
+#include <geode/primal/model.hpp>
 
 namespace geode::conform {
 

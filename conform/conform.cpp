@@ -1,4 +1,4 @@
-#include "conform/conform.hpp"
+#include <geode/conform/conform.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -13,19 +13,19 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 
-#include "conform/reference_template.hpp"
-#include "primal/boundary.hpp"
-#include "primal/dice.hpp"
-#include "primal/dice_model.hpp"
-#include "primal/disjoint_sets.hpp"
-#include "primal/errors.hpp"
-#include "primal/interface.hpp"
-#include "primal/multilinear.hpp"
-#include "primal/quality.hpp"
-#include "primal/quality_report.hpp"
-#include "primal/smooth.hpp"
-#include "primal/split_pyramids.hpp"
-#include "primal/topology.hpp"
+#include <geode/conform/reference_template.hpp>
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/dice.hpp>
+#include <geode/primal/dice_model.hpp>
+#include <geode/primal/disjoint_sets.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/interface.hpp>
+#include <geode/primal/multilinear.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/quality_report.hpp>
+#include <geode/primal/smooth.hpp>
+#include <geode/primal/split_pyramids.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::conform {
 namespace {

@@ -19,11 +19,11 @@
 #include <string>
 #include <vector>
 
-#include "conform/buffer_layer.hpp"
-#include "primal/model.hpp"
-#include "primal/quality_report.hpp"
-#include "primal/local_smooth.hpp"
-#include "primal/validity.hpp"
+#include <geode/conform/buffer_layer.hpp>
+#include <geode/primal/model.hpp>
+#include <geode/primal/quality_report.hpp>
+#include <geode/primal/local_smooth.hpp>
+#include <geode/primal/validity.hpp>
 
 namespace geode::conform {
 

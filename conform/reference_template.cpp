@@ -1,4 +1,4 @@
-#include "conform/reference_template.hpp"
+#include <geode/conform/reference_template.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -8,12 +8,12 @@
 #include <sstream>
 #include <tuple>
 
-#include "primal/errors.hpp"
-#include "primal/patch_match.hpp"
-#include "primal/smooth.hpp"
-#include "primal/topology.hpp"
-#include "templates/side_faces.hpp"
-#include "templates/template_table.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/patch_match.hpp>
+#include <geode/primal/smooth.hpp>
+#include <geode/primal/topology.hpp>
+#include <geode/templates/side_faces.hpp>
+#include <geode/templates/template_table.hpp>
 
 namespace geode::conform {
 namespace {

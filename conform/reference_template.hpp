@@ -10,8 +10,8 @@
 #include <unordered_map>
 #include <vector>
 
-#include "primal/mesh.hpp"
-#include "templates/geode.hpp"
+#include <geode/primal/mesh.hpp>
+#include <geode/templates/geode.hpp>
 
 namespace geode::conform {
 

@@ -1,5 +1,5 @@
 // The verdict and report of a conform run (conform/report.hpp).
-#include "conform/report.hpp"
+#include <geode/conform/report.hpp>
 
 #include <algorithm>
 #include <nlohmann/json.hpp>

@@ -4,7 +4,7 @@
 #include <nlohmann/json_fwd.hpp>
 #include <string>
 
-#include "conform/conform.hpp"
+#include <geode/conform/conform.hpp>
 
 namespace geode::conform {
 

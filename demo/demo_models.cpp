@@ -1,4 +1,4 @@
-#include "demo/demo_models.hpp"
+#include <geode/demo/demo_models.hpp>
 
 #include <gmsh.h>
 
@@ -13,10 +13,10 @@
 #include <random>
 #include <utility>
 
-#include "primal/boundary.hpp"
-#include "primal/errors.hpp"
-#include "io/gmsh.hpp"
-#include "primal/quality.hpp"
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/io/gmsh.hpp>
+#include <geode/primal/quality.hpp>
 
 namespace geode::demo {
 

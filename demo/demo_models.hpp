@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "primal/model.hpp"
+#include <geode/primal/model.hpp>
 
 namespace geode::demo {
 

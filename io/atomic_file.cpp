@@ -1,4 +1,4 @@
-#include "io/atomic_file.hpp"
+#include <geode/io/atomic_file.hpp>
 
 #include <fcntl.h>
 #include <signal.h>
@@ -11,7 +11,7 @@
 #include <string>
 #include <system_error>
 
-#include "primal/errors.hpp"
+#include <geode/primal/errors.hpp>
 
 namespace geode::io {
 

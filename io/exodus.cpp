@@ -1,6 +1,6 @@
-#include "io/exodus.hpp"
+#include <geode/io/exodus.hpp>
 
-#include "io/atomic_file.hpp"
+#include <geode/io/atomic_file.hpp>
 
 #include <exodusII.h>
 #include <netcdf.h>
@@ -16,10 +16,10 @@
 #include <string>
 #include <vector>
 
-#include "primal/errors.hpp"
-#include "io/file_format.hpp"
-#include "io/names.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/io/file_format.hpp>
+#include <geode/io/names.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::io {
 

@@ -14,7 +14,7 @@
 #include <array>
 #include <filesystem>
 
-#include "primal/model.hpp"
+#include <geode/primal/model.hpp>
 
 namespace geode::io {
 

@@ -1,11 +1,11 @@
-#include "io/file_format.hpp"
+#include <geode/io/file_format.hpp>
 
 #include <algorithm>
 #include <array>
 #include <cctype>
 #include <fstream>
 
-#include "primal/errors.hpp"
+#include <geode/primal/errors.hpp>
 
 namespace geode::io {
 

@@ -1,4 +1,4 @@
-#include "io/file_sink.hpp"
+#include <geode/io/file_sink.hpp>
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -7,7 +7,7 @@
 #include <charconv>
 #include <cstring>
 
-#include "primal/errors.hpp"
+#include <geode/primal/errors.hpp>
 
 namespace geode::io {
 

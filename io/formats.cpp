@@ -1,15 +1,15 @@
 // The format table (io/formats.hpp) and the dispatch that reads it.
-#include "io/formats.hpp"
+#include <geode/io/formats.hpp>
 
 #include <algorithm>
 #include <cctype>
 
-#include "io/exodus.hpp"
-#include "io/file_format.hpp"
-#include "io/gmsh.hpp"
-#include "io/read_model.hpp"
-#include "io/vtk.hpp"
-#include "primal/errors.hpp"
+#include <geode/io/exodus.hpp>
+#include <geode/io/file_format.hpp>
+#include <geode/io/gmsh.hpp>
+#include <geode/io/read_model.hpp>
+#include <geode/io/vtk.hpp>
+#include <geode/primal/errors.hpp>
 
 namespace geode::io {
 

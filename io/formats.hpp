@@ -14,9 +14,9 @@
 #include <string_view>
 #include <vector>
 
-#include "io/vtk.hpp"
-#include "primal/mesh.hpp"
-#include "primal/model.hpp"
+#include <geode/io/vtk.hpp>
+#include <geode/primal/mesh.hpp>
+#include <geode/primal/model.hpp>
 
 namespace geode::io {
 

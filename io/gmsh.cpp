@@ -1,4 +1,4 @@
-#include "io/gmsh.hpp"
+#include <geode/io/gmsh.hpp>
 
 #include <gmsh.h>
 #include <unistd.h>
@@ -9,11 +9,11 @@
 #include <string>
 #include <unordered_map>
 
-#include "primal/boundary.hpp"
-#include "primal/errors.hpp"
-#include "io/file_format.hpp"
-#include "io/mapped_file.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/io/file_format.hpp>
+#include <geode/io/mapped_file.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::io {
 

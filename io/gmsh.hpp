@@ -28,7 +28,7 @@
 #include <filesystem>
 #include <string_view>
 
-#include "primal/model.hpp"
+#include <geode/primal/model.hpp>
 
 namespace geode::io {
 

@@ -13,13 +13,13 @@
 #include <string>
 #include <unordered_map>
 
-#include "primal/boundary.hpp"
-#include "primal/errors.hpp"
-#include "io/file_format.hpp"
-#include "io/gmsh.hpp"
-#include "io/names.hpp"
-#include "io/read_warnings.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/io/file_format.hpp>
+#include <geode/io/gmsh.hpp>
+#include <geode/io/names.hpp>
+#include <geode/io/read_warnings.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::io {
 

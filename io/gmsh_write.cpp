@@ -24,12 +24,12 @@
 #include <string>
 #include <vector>
 
-#include "io/atomic_file.hpp"
-#include "io/file_sink.hpp"
-#include "io/gmsh.hpp"
-#include "io/names.hpp"
-#include "primal/errors.hpp"
-#include "primal/topology.hpp"
+#include <geode/io/atomic_file.hpp>
+#include <geode/io/file_sink.hpp>
+#include <geode/io/gmsh.hpp>
+#include <geode/io/names.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::io {
 

@@ -1,12 +1,12 @@
-#include "io/mapped_file.hpp"
+#include <geode/io/mapped_file.hpp>
 
 #include <fcntl.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "io/file_format.hpp"
-#include "primal/errors.hpp"
+#include <geode/io/file_format.hpp>
+#include <geode/primal/errors.hpp>
 
 namespace geode::io {
 

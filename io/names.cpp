@@ -1,4 +1,4 @@
-#include "io/names.hpp"
+#include <geode/io/names.hpp>
 
 namespace geode::io {
 

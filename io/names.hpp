@@ -11,7 +11,7 @@
 #include <string>
 #include <string_view>
 
-#include "primal/model.hpp"
+#include <geode/primal/model.hpp>
 
 namespace geode::io {
 

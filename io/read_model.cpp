@@ -1,11 +1,11 @@
-#include "io/read_model.hpp"
+#include <geode/io/read_model.hpp>
 
 #include <algorithm>
 #include <string>
 
-#include "primal/errors.hpp"
-#include "io/file_format.hpp"
-#include "io/formats.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/io/file_format.hpp>
+#include <geode/io/formats.hpp>
 
 namespace geode::io {
 

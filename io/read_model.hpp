@@ -4,8 +4,8 @@
 // content before any parser sees it. io::write_model (formats.hpp) is its counterpart.
 #include <filesystem>
 
-#include "io/vtk.hpp"
-#include "primal/model.hpp"
+#include <geode/io/vtk.hpp>
+#include <geode/primal/model.hpp>
 
 namespace geode::io {
 

@@ -1,4 +1,4 @@
-#include "io/read_warnings.hpp"
+#include <geode/io/read_warnings.hpp>
 
 #include <iostream>
 

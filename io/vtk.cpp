@@ -1,8 +1,8 @@
-#include "io/vtk.hpp"
+#include <geode/io/vtk.hpp>
 
-#include "io/names.hpp"
+#include <geode/io/names.hpp>
 
-#include "io/vtk_cells.hpp"
+#include <geode/io/vtk_cells.hpp>
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -20,10 +20,10 @@
 #include <sstream>
 
 
-#include "io/atomic_file.hpp"
-#include "primal/errors.hpp"
-#include "io/file_format.hpp"
-#include "primal/quality.hpp"
+#include <geode/io/atomic_file.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/io/file_format.hpp>
+#include <geode/primal/quality.hpp>
 
 namespace geode::io {
 

@@ -13,8 +13,8 @@
 #include <utility>
 #include <vector>
 
-#include "primal/mesh.hpp"
-#include "primal/model.hpp"
+#include <geode/primal/mesh.hpp>
+#include <geode/primal/model.hpp>
 
 namespace geode::io {
 

@@ -1,7 +1,7 @@
 #pragma once
 // VTK cell types as the .vtu / .vtk writers and readers (vtk.cpp, vtk_read.cpp) name
 // and size them. Internal to primal's VTK I/O.
-#include "io/vtk.hpp"
+#include <geode/io/vtk.hpp>
 
 namespace geode::io::vtk_cells {
 

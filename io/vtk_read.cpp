@@ -1,6 +1,6 @@
-#include "io/vtk.hpp"
+#include <geode/io/vtk.hpp>
 
-#include "io/vtk_cells.hpp"
+#include <geode/io/vtk_cells.hpp>
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -19,11 +19,11 @@
 
 #include <zlib.h>
 
-#include "io/atomic_file.hpp"
-#include "primal/errors.hpp"
-#include "io/file_format.hpp"
-#include "io/mapped_file.hpp"
-#include "primal/quality.hpp"
+#include <geode/io/atomic_file.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/io/file_format.hpp>
+#include <geode/io/mapped_file.hpp>
+#include <geode/primal/quality.hpp>
 
 namespace geode::io {
 

@@ -1,4 +1,4 @@
-#include "primal/boundary.hpp"
+#include <geode/primal/boundary.hpp>
 
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 #include <algorithm>
@@ -8,10 +8,10 @@
 #include <unordered_map>
 #include <unordered_set>
 
-#include "primal/boundary_surface.hpp"
-#include "primal/errors.hpp"
-#include "primal/key_map.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/boundary_surface.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/key_map.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::primal {
 

@@ -5,7 +5,7 @@
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 #include <vector>
 
-#include "primal/boundary.hpp"
+#include <geode/primal/boundary.hpp>
 
 namespace geode::primal {
 

@@ -1,4 +1,4 @@
-#include "primal/dice.hpp"
+#include <geode/primal/dice.hpp>
 
 #include <algorithm>
 #include <bit>
@@ -8,10 +8,10 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
-#include "primal/errors.hpp"
-#include "primal/key_map.hpp"
-#include "primal/quality.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/key_map.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::primal {
 

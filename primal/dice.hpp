@@ -13,8 +13,8 @@
 #include <span>
 #include <vector>
 
-#include "primal/boundary.hpp"
-#include "primal/mesh.hpp"
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/mesh.hpp>
 
 namespace geode::primal {
 

@@ -1,12 +1,12 @@
-#include "primal/dice_model.hpp"
+#include <geode/primal/dice_model.hpp>
 
 #include <algorithm>
 #include <set>
 
-#include "primal/dice.hpp"
-#include "primal/errors.hpp"
-#include "primal/quality.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/dice.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::primal {
 

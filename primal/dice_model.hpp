@@ -13,9 +13,9 @@
 #include <span>
 #include <vector>
 
-#include "primal/boundary.hpp"
-#include "primal/key_map.hpp"
-#include "primal/model.hpp"
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/key_map.hpp>
+#include <geode/primal/model.hpp>
 
 namespace geode::primal {
 

@@ -5,7 +5,7 @@
 #include <numeric>
 #include <vector>
 
-#include "primal/mesh.hpp"
+#include <geode/primal/mesh.hpp>
 
 namespace geode::primal {
 

@@ -1,2 +1,2 @@
 // Anchor translation unit so that every layer library has at least one source file.
-#include "primal/errors.hpp"
+#include <geode/primal/errors.hpp>

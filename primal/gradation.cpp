@@ -1,4 +1,4 @@
-#include "primal/gradation.hpp"
+#include <geode/primal/gradation.hpp>
 
 #include <functional>
 #include <queue>

@@ -1,4 +1,4 @@
-#include "primal/grid_model.hpp"
+#include <geode/primal/grid_model.hpp>
 
 #include <algorithm>
 #include <utility>

@@ -3,7 +3,7 @@
 #include <array>
 #include <functional>
 
-#include "primal/model.hpp"
+#include <geode/primal/model.hpp>
 
 namespace geode::primal {
 

@@ -1,4 +1,4 @@
-#include "primal/interface.hpp"
+#include <geode/primal/interface.hpp>
 
 #include <algorithm>
 #include <sstream>
@@ -6,10 +6,10 @@
 #include <unordered_map>
 #include <unordered_set>
 
-#include "primal/boundary.hpp"
-#include "primal/errors.hpp"
-#include "primal/key_map.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/key_map.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::primal {
 

@@ -7,7 +7,7 @@
 #include <array>
 #include <vector>
 
-#include "primal/model.hpp"
+#include <geode/primal/model.hpp>
 
 namespace geode::primal {
 

@@ -1,4 +1,4 @@
-#include "primal/isomorphism.hpp"
+#include <geode/primal/isomorphism.hpp>
 
 #include <algorithm>
 #include <map>
@@ -6,8 +6,8 @@
 #include <set>
 #include <string>
 
-#include "primal/errors.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::primal {
 namespace {

@@ -20,7 +20,7 @@
 #include <optional>
 #include <vector>
 
-#include "primal/mesh.hpp"
+#include <geode/primal/mesh.hpp>
 
 namespace geode::primal {
 

@@ -12,7 +12,7 @@
 #include <utility>
 #include <vector>
 
-#include "primal/mesh.hpp"
+#include <geode/primal/mesh.hpp>
 
 namespace geode::primal {
 

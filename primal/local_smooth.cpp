@@ -1,4 +1,4 @@
-#include "primal/local_smooth.hpp"
+#include <geode/primal/local_smooth.hpp>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -14,12 +14,12 @@
 #include <string>
 #include <unordered_map>
 
-#include "primal/boundary.hpp"
-#include "primal/detail/smooth_frames.hpp"
-#include "primal/errors.hpp"
-#include "primal/frame_derivatives.hpp"
-#include "primal/quality.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/detail/smooth_frames.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/frame_derivatives.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::primal {
 

@@ -35,9 +35,9 @@
 #include <span>
 #include <vector>
 
-#include "primal/boundary.hpp"
-#include "primal/mesh.hpp"
-#include "primal/smooth.hpp"
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/mesh.hpp>
+#include <geode/primal/smooth.hpp>
 
 namespace geode::primal {
 

@@ -1,4 +1,4 @@
-#include "primal/model.hpp"
+#include <geode/primal/model.hpp>
 
 #include <algorithm>
 #include <charconv>
@@ -7,9 +7,9 @@
 #include <unordered_map>
 #include <unordered_set>
 
-#include "primal/errors.hpp"
-#include "primal/quality.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::primal {
 

@@ -25,8 +25,8 @@
 
 #include <Eigen/Geometry>
 
-#include "primal/mesh.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/mesh.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::primal {
 

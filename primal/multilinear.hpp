@@ -8,8 +8,8 @@
 #include <Eigen/Core>
 #include <cstddef>
 
-#include "primal/mesh.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/mesh.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::primal {
 

@@ -1,4 +1,4 @@
-#include "primal/patch_match.hpp"
+#include <geode/primal/patch_match.hpp>
 
 #include <unordered_set>
 #include <vector>

@@ -1,10 +1,10 @@
-#include "primal/pillow.hpp"
+#include <geode/primal/pillow.hpp>
 
 #include <string>
 
-#include "primal/boundary.hpp"
-#include "primal/errors.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::primal {
 

@@ -13,7 +13,7 @@
 #include <span>
 #include <vector>
 
-#include "primal/mesh.hpp"
+#include <geode/primal/mesh.hpp>
 
 namespace geode::primal {
 

@@ -1,4 +1,4 @@
-#include "primal/quality.hpp"
+#include <geode/primal/quality.hpp>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -9,8 +9,8 @@
 #include <limits>
 #include <string>
 
-#include "primal/errors.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::primal {
 

@@ -17,7 +17,7 @@
 #include <string_view>
 #include <vector>
 
-#include "primal/mesh.hpp"
+#include <geode/primal/mesh.hpp>
 
 namespace geode::primal {
 

@@ -1,4 +1,4 @@
-#include "primal/quality_report.hpp"
+#include <geode/primal/quality_report.hpp>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -9,7 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <numeric>
 
-#include "primal/errors.hpp"
+#include <geode/primal/errors.hpp>
 
 namespace geode::primal {
 

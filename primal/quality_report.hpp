@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "primal/mesh.hpp"
-#include "primal/quality.hpp"
+#include <geode/primal/mesh.hpp>
+#include <geode/primal/quality.hpp>
 
 namespace geode::primal {
 

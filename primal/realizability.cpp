@@ -1,4 +1,4 @@
-#include "primal/realizability.hpp"
+#include <geode/primal/realizability.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -11,9 +11,9 @@
 #include <string>
 #include <unordered_map>
 
-#include "primal/boundary.hpp"
-#include "primal/errors.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::primal {
 

@@ -1,4 +1,4 @@
-#include "primal/smooth.hpp"
+#include <geode/primal/smooth.hpp>
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -8,10 +8,10 @@
 #include <limits>
 #include <string>
 
-#include "primal/detail/smooth_frames.hpp"
-#include "primal/errors.hpp"
-#include "primal/frame_derivatives.hpp"
-#include "primal/quality.hpp"
+#include <geode/primal/detail/smooth_frames.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/frame_derivatives.hpp>
+#include <geode/primal/quality.hpp>
 
 namespace geode::primal {
 

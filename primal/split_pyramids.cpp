@@ -1,9 +1,9 @@
-#include "primal/split_pyramids.hpp"
+#include <geode/primal/split_pyramids.hpp>
 
 #include <algorithm>
 #include <map>
 
-#include "primal/dice.hpp"
+#include <geode/primal/dice.hpp>
 
 namespace geode::primal {
 

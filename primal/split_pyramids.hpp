@@ -9,7 +9,7 @@
 // interface quad split into two triangles does, and gets the geode transition.
 #include <vector>
 
-#include "primal/model.hpp"
+#include <geode/primal/model.hpp>
 
 namespace geode::primal {
 

@@ -1,10 +1,10 @@
-#include "primal/validity.hpp"
+#include <geode/primal/validity.hpp>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "primal/disjoint_sets.hpp"
-#include "primal/errors.hpp"
+#include <geode/primal/disjoint_sets.hpp>
+#include <geode/primal/errors.hpp>
 
 #include <algorithm>
 #include <cassert>
@@ -18,8 +18,8 @@
 #include <unordered_map>
 #include <unordered_set>
 
-#include "primal/quality.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/quality.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::primal {
 

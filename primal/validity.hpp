@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "primal/boundary.hpp"
-#include "primal/mesh.hpp"
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/mesh.hpp>
 
 namespace geode::primal {
 

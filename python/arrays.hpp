@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "primal/errors.hpp"
-#include "primal/mesh.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/mesh.hpp>
 
 namespace geode::python {
 

@@ -6,10 +6,10 @@
 #include <optional>
 #include <sstream>
 
-#include "conform/conform.hpp"
-#include "demo/demo_models.hpp"
-#include "conform/report.hpp"
-#include "primal/model.hpp"
+#include <geode/conform/conform.hpp>
+#include <geode/demo/demo_models.hpp>
+#include <geode/conform/report.hpp>
+#include <geode/primal/model.hpp>
 #include "python/arrays.hpp"
 
 namespace geode::python {

@@ -6,18 +6,18 @@
 #include <tuple>
 #include <nlohmann/json.hpp>
 
-#include "primal/boundary.hpp"
-#include "primal/isomorphism.hpp"
-#include "primal/quality.hpp"
-#include "primal/quality_report.hpp"
-#include "primal/realizability.hpp"
-#include "primal/smooth.hpp"
-#include "primal/validity.hpp"
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/isomorphism.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/quality_report.hpp>
+#include <geode/primal/realizability.hpp>
+#include <geode/primal/smooth.hpp>
+#include <geode/primal/validity.hpp>
 #include "python/arrays.hpp"
-#include "stc/arrangement.hpp"
-#include "stc/dualize.hpp"
-#include "stc/mesh_dual.hpp"
-#include "stc/mesh_fields.hpp"
+#include <geode/stc/arrangement.hpp>
+#include <geode/stc/dualize.hpp>
+#include <geode/stc/mesh_dual.hpp>
+#include <geode/stc/mesh_fields.hpp>
 
 namespace geode::python {
 namespace {

@@ -10,17 +10,17 @@
 #include <optional>
 #include <sstream>
 
-#include "primal/boundary.hpp"
-#include "viewer/html.hpp"
-#include "primal/quality.hpp"
-#include "primal/quality_report.hpp"
+#include <geode/primal/boundary.hpp>
+#include <geode/viewer/html.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/quality_report.hpp>
 #include "python/arrays.hpp"
-#include "stc/sheet_surfaces.hpp"
-#include "templates/fixup.hpp"
-#include "templates/geode.hpp"
-#include "templates/refine.hpp"
-#include "templates/spec.hpp"
-#include "templates/study.hpp"
+#include <geode/stc/sheet_surfaces.hpp>
+#include <geode/templates/fixup.hpp>
+#include <geode/templates/geode.hpp>
+#include <geode/templates/refine.hpp>
+#include <geode/templates/spec.hpp>
+#include <geode/templates/study.hpp>
 
 namespace geode::python {
 namespace {

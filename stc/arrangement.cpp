@@ -1,4 +1,4 @@
-#include "stc/arrangement.hpp"
+#include <geode/stc/arrangement.hpp>
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -8,10 +8,10 @@
 #include <sstream>
 #include <unordered_map>
 
-#include "primal/disjoint_sets.hpp"
-#include "primal/errors.hpp"
-#include "primal/multilinear.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/disjoint_sets.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/multilinear.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::stc {
 

@@ -41,8 +41,8 @@
 #include <string>
 #include <vector>
 
-#include "primal/mesh.hpp"
-#include "stc/sheet.hpp"
+#include <geode/primal/mesh.hpp>
+#include <geode/stc/sheet.hpp>
 
 namespace geode::stc {
 

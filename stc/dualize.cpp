@@ -1,11 +1,11 @@
-#include "stc/dualize.hpp"
+#include <geode/stc/dualize.hpp>
 
 #include <algorithm>
 #include <set>
 
-#include "primal/errors.hpp"
-#include "primal/topology.hpp"
-#include "primal/validity.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/topology.hpp>
+#include <geode/primal/validity.hpp>
 
 namespace geode::stc {
 namespace {

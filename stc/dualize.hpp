@@ -6,8 +6,8 @@
 // (primal/topology.hpp numbering).
 #include <vector>
 
-#include "primal/mesh.hpp"
-#include "stc/arrangement.hpp"
+#include <geode/primal/mesh.hpp>
+#include <geode/stc/arrangement.hpp>
 
 namespace geode::stc {
 

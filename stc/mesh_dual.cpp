@@ -1,6 +1,6 @@
-#include "stc/mesh_dual.hpp"
+#include <geode/stc/mesh_dual.hpp>
 
-#include "primal/disjoint_sets.hpp"
+#include <geode/primal/disjoint_sets.hpp>
 
 #include <algorithm>
 #include <cassert>
@@ -9,8 +9,8 @@
 #include <string>
 #include <unordered_map>
 
-#include "primal/errors.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::stc {
 namespace {

@@ -17,7 +17,7 @@
 #include <map>
 #include <vector>
 
-#include "primal/mesh.hpp"
+#include <geode/primal/mesh.hpp>
 
 namespace geode::stc {
 

@@ -1,4 +1,4 @@
-#include "stc/mesh_fields.hpp"
+#include <geode/stc/mesh_fields.hpp>
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -10,10 +10,10 @@
 #include <memory>
 #include <string>
 
-#include "primal/disjoint_sets.hpp"
-#include "primal/errors.hpp"
-#include "primal/multilinear.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/disjoint_sets.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/multilinear.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::stc {
 namespace {

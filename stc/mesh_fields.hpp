@@ -24,10 +24,10 @@
 // single-threaded.
 #include <vector>
 
-#include "primal/mesh.hpp"
-#include "stc/arrangement.hpp"
-#include "stc/mesh_dual.hpp"
-#include "stc/sheet.hpp"
+#include <geode/primal/mesh.hpp>
+#include <geode/stc/arrangement.hpp>
+#include <geode/stc/mesh_dual.hpp>
+#include <geode/stc/sheet.hpp>
 
 namespace geode::stc {
 

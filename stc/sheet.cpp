@@ -1,4 +1,4 @@
-#include "stc/sheet.hpp"
+#include <geode/stc/sheet.hpp>
 
 #include <algorithm>
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "primal/mesh.hpp"
+#include <geode/primal/mesh.hpp>
 
 namespace geode::stc {
 

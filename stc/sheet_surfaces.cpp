@@ -1,4 +1,4 @@
-#include "stc/sheet_surfaces.hpp"
+#include <geode/stc/sheet_surfaces.hpp>
 
 #include <algorithm>
 #include <array>
@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <unordered_map>
 
-#include "primal/errors.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::stc {
 namespace {

@@ -8,10 +8,10 @@
 // Both are for display; neither feeds back into the arrangement engine.
 #include <vector>
 
-#include "primal/mesh.hpp"
-#include "stc/arrangement.hpp"
-#include "stc/mesh_dual.hpp"
-#include "stc/sheet.hpp"
+#include <geode/primal/mesh.hpp>
+#include <geode/stc/arrangement.hpp>
+#include <geode/stc/mesh_dual.hpp>
+#include <geode/stc/sheet.hpp>
 
 namespace geode::stc {
 

@@ -1,11 +1,11 @@
-#include "stc/surface_chords.hpp"
+#include <geode/stc/surface_chords.hpp>
 
 #include <algorithm>
 #include <map>
 #include <string>
 
-#include "primal/disjoint_sets.hpp"
-#include "primal/errors.hpp"
+#include <geode/primal/disjoint_sets.hpp>
+#include <geode/primal/errors.hpp>
 
 namespace geode::stc {
 

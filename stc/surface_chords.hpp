@@ -13,7 +13,7 @@
 #include <array>
 #include <vector>
 
-#include "primal/mesh.hpp"
+#include <geode/primal/mesh.hpp>
 
 namespace geode::stc {
 

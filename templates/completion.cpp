@@ -1,12 +1,12 @@
-#include "templates/completion.hpp"
+#include <geode/templates/completion.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
 
-#include "primal/dice.hpp"
-#include "primal/errors.hpp"
+#include <geode/primal/dice.hpp>
+#include <geode/primal/errors.hpp>
 
 namespace geode::templates {
 namespace {

@@ -9,8 +9,8 @@
 #include <functional>
 #include <vector>
 
-#include "primal/mesh.hpp"
-#include "stc/sheet.hpp"
+#include <geode/primal/mesh.hpp>
+#include <geode/stc/sheet.hpp>
 
 namespace geode::templates {
 

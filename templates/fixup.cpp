@@ -1,12 +1,12 @@
-#include "templates/fixup.hpp"
+#include <geode/templates/fixup.hpp>
 
 #include <algorithm>
 #include <sstream>
 
-#include "primal/errors.hpp"
-#include "primal/realizability.hpp"
-#include "primal/topology.hpp"
-#include "primal/validity.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/realizability.hpp>
+#include <geode/primal/topology.hpp>
+#include <geode/primal/validity.hpp>
 
 namespace geode::templates {
 namespace {

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "primal/pillow.hpp"
-#include "templates/geode.hpp"
+#include <geode/primal/pillow.hpp>
+#include <geode/templates/geode.hpp>
 
 namespace geode::templates {
 

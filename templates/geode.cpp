@@ -1,4 +1,4 @@
-#include "templates/geode.hpp"
+#include <geode/templates/geode.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -7,12 +7,12 @@
 #include <set>
 #include <tuple>
 
-#include "primal/errors.hpp"
-#include "primal/topology.hpp"
-#include "stc/arrangement.hpp"
-#include "stc/dualize.hpp"
-#include "templates/completion.hpp"
-#include "templates/spec.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/topology.hpp>
+#include <geode/stc/arrangement.hpp>
+#include <geode/stc/dualize.hpp>
+#include <geode/templates/completion.hpp>
+#include <geode/templates/spec.hpp>
 
 namespace geode::templates {
 namespace {

@@ -6,12 +6,12 @@
 #include <string>
 #include <vector>
 
-#include "primal/mesh.hpp"
-#include "primal/realizability.hpp"
-#include "primal/smooth.hpp"
-#include "stc/arrangement.hpp"
-#include "stc/dualize.hpp"
-#include "templates/completion.hpp"
+#include <geode/primal/mesh.hpp>
+#include <geode/primal/realizability.hpp>
+#include <geode/primal/smooth.hpp>
+#include <geode/stc/arrangement.hpp>
+#include <geode/stc/dualize.hpp>
+#include <geode/templates/completion.hpp>
 
 namespace geode::templates {
 

@@ -1,8 +1,8 @@
-#include "templates/pyramid.hpp"
+#include <geode/templates/pyramid.hpp>
 
 #include <sstream>
 
-#include "stc/arrangement.hpp"
+#include <geode/stc/arrangement.hpp>
 
 namespace geode::templates {
 

@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "primal/mesh.hpp"
-#include "stc/surface_chords.hpp"
+#include <geode/primal/mesh.hpp>
+#include <geode/stc/surface_chords.hpp>
 
 namespace geode::templates {
 

@@ -1,4 +1,4 @@
-#include "templates/refine.hpp"
+#include <geode/templates/refine.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -6,8 +6,8 @@
 #include <set>
 #include <string>
 
-#include "primal/errors.hpp"
-#include "templates/spec.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/templates/spec.hpp>
 
 namespace geode::templates {
 namespace {

@@ -12,8 +12,8 @@
 // planes, one layer; 2D: one of each.
 #include <Eigen/Core>
 
-#include "stc/arrangement.hpp"
-#include "templates/geode.hpp"
+#include <geode/stc/arrangement.hpp>
+#include <geode/templates/geode.hpp>
 
 namespace geode::templates {
 

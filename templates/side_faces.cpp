@@ -1,13 +1,13 @@
-#include "templates/side_faces.hpp"
+#include <geode/templates/side_faces.hpp>
 
 #include <cmath>
 #include <map>
 #include <string>
 
-#include "primal/errors.hpp"
-#include "primal/patch_match.hpp"
-#include "primal/topology.hpp"
-#include "stc/arrangement.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/patch_match.hpp>
+#include <geode/primal/topology.hpp>
+#include <geode/stc/arrangement.hpp>
 
 namespace geode::templates {
 namespace {

@@ -7,8 +7,8 @@
 #include <array>
 #include <vector>
 
-#include "primal/smooth.hpp"
-#include "templates/geode.hpp"
+#include <geode/primal/smooth.hpp>
+#include <geode/templates/geode.hpp>
 
 namespace geode::templates {
 

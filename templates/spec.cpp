@@ -1,4 +1,4 @@
-#include "templates/spec.hpp"
+#include <geode/templates/spec.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <set>
 #include <sstream>
 
-#include "primal/errors.hpp"
+#include <geode/primal/errors.hpp>
 
 namespace geode::templates {
 namespace {

@@ -27,9 +27,9 @@
 #include <string_view>
 #include <vector>
 
-#include "stc/arrangement.hpp"
-#include "templates/completion.hpp"
-#include "templates/geode.hpp"
+#include <geode/stc/arrangement.hpp>
+#include <geode/templates/completion.hpp>
+#include <geode/templates/geode.hpp>
 
 namespace geode::templates {
 

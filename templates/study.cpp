@@ -1,4 +1,4 @@
-#include "templates/study.hpp"
+#include <geode/templates/study.hpp>
 
 #include <Eigen/Geometry>
 
@@ -17,10 +17,10 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "primal/errors.hpp"
-#include "primal/multilinear.hpp"
-#include "primal/quality.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/multilinear.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::templates {
 namespace {

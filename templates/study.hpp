@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "primal/quality_report.hpp"
-#include "templates/geode.hpp"
-#include "templates/spec.hpp"
+#include <geode/primal/quality_report.hpp>
+#include <geode/templates/geode.hpp>
+#include <geode/templates/spec.hpp>
 
 namespace geode::templates {
 

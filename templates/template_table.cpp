@@ -1,11 +1,11 @@
 // The template table (templates/template_table.hpp).
-#include "templates/template_table.hpp"
+#include <geode/templates/template_table.hpp>
 
 #include <cmath>
 #include <vector>
 
-#include "primal/errors.hpp"
-#include "templates/pyramid.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/templates/pyramid.hpp>
 
 namespace geode::templates {
 

@@ -9,11 +9,11 @@
 #include <string_view>
 #include <vector>
 
-#include "primal/smooth.hpp"
-#include "templates/geode.hpp"
-#include "templates/refine.hpp"
-#include "templates/spec.hpp"
-#include "templates/study.hpp"
+#include <geode/primal/smooth.hpp>
+#include <geode/templates/geode.hpp>
+#include <geode/templates/refine.hpp>
+#include <geode/templates/spec.hpp>
+#include <geode/templates/study.hpp>
 
 namespace geode::templates {
 

@@ -1,14 +1,14 @@
-#include "viewer/html.hpp"
+#include <geode/viewer/html.hpp>
 
 #include <cmath>
 #include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
 
-#include "io/atomic_file.hpp"
-#include "primal/errors.hpp"
-#include "primal/quality.hpp"
-#include "primal/topology.hpp"
+#include <geode/io/atomic_file.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::viewer {
 

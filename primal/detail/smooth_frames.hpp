@@ -5,8 +5,8 @@
 #include <array>
 #include <cmath>
 
-#include "primal/mesh.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/mesh.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::primal::detail {
 

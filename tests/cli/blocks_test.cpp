@@ -15,11 +15,11 @@
 #include <sstream>
 #include <string>
 
-#include "primal/grid_model.hpp"
-#include "io/exodus.hpp"
-#include "io/gmsh.hpp"
-#include "io/vtk.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/grid_model.hpp>
+#include <geode/io/exodus.hpp>
+#include <geode/io/gmsh.hpp>
+#include <geode/io/vtk.hpp>
+#include <geode/primal/topology.hpp>
 #include "support/cli_run.hpp"
 
 using namespace geode;

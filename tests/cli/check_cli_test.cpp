@@ -9,11 +9,11 @@
 #include <set>
 #include <string>
 
-#include "primal/boundary.hpp"
-#include "io/gmsh.hpp"
-#include "io/vtk.hpp"
-#include "primal/grid_model.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/boundary.hpp>
+#include <geode/io/gmsh.hpp>
+#include <geode/io/vtk.hpp>
+#include <geode/primal/grid_model.hpp>
+#include <geode/primal/topology.hpp>
 #include "support/cli_run.hpp"
 #include "support/fixtures.hpp"
 

@@ -10,13 +10,13 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "primal/grid_model.hpp"
-#include "io/exodus.hpp"
-#include "io/gmsh.hpp"
-#include "primal/validity.hpp"
+#include <geode/primal/grid_model.hpp>
+#include <geode/io/exodus.hpp>
+#include <geode/io/gmsh.hpp>
+#include <geode/primal/validity.hpp>
 #include "support/cli_run.hpp"
 #include "support/fixtures.hpp"
-#include "conform/conform.hpp"
+#include <geode/conform/conform.hpp>
 
 using namespace geode;
 namespace fs = std::filesystem;

@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include "primal/grid_model.hpp"
-#include "io/exodus.hpp"
-#include "io/gmsh.hpp"
-#include "io/vtk.hpp"
+#include <geode/primal/grid_model.hpp>
+#include <geode/io/exodus.hpp>
+#include <geode/io/gmsh.hpp>
+#include <geode/io/vtk.hpp>
 #include "support/cli_run.hpp"
 
 using namespace geode;

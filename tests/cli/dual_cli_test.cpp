@@ -7,9 +7,9 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "io/gmsh.hpp"
-#include "io/vtk.hpp"
-#include "primal/grid_model.hpp"
+#include <geode/io/gmsh.hpp>
+#include <geode/io/vtk.hpp>
+#include <geode/primal/grid_model.hpp>
 #include "support/cli_run.hpp"
 #include "support/fixtures.hpp"
 #include "support/isomorphism.hpp"

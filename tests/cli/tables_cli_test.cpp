@@ -6,10 +6,10 @@
 #include <filesystem>
 #include <string>
 
-#include "io/formats.hpp"
-#include "io/read_model.hpp"
+#include <geode/io/formats.hpp>
+#include <geode/io/read_model.hpp>
 #include "support/cli_run.hpp"
-#include "templates/template_table.hpp"
+#include <geode/templates/template_table.hpp>
 
 using namespace geode;
 namespace fs = std::filesystem;

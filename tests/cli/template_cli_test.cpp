@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "io/vtk.hpp"
-#include "primal/validity.hpp"
+#include <geode/io/vtk.hpp>
+#include <geode/primal/validity.hpp>
 #include "support/cli_run.hpp"
 #include "support/fixtures.hpp"
 #include "support/isomorphism.hpp"

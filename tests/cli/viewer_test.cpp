@@ -10,7 +10,7 @@
 #include <sstream>
 #include <string>
 
-#include "io/vtk.hpp"
+#include <geode/io/vtk.hpp>
 #include "support/cli_run.hpp"
 #include "support/fixtures.hpp"
 #include "support/png.hpp"

@@ -11,12 +11,12 @@
 #include <set>
 #include <string>
 
-#include "conform/buffer_layer.hpp"
-#include "demo/demo_models.hpp"
-#include "primal/grid_model.hpp"
-#include "primal/errors.hpp"
-#include "primal/quality.hpp"
-#include "primal/topology.hpp"
+#include <geode/conform/buffer_layer.hpp>
+#include <geode/demo/demo_models.hpp>
+#include <geode/primal/grid_model.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/topology.hpp>
 
 using namespace geode;
 using namespace geode::primal;

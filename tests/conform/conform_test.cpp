@@ -12,16 +12,16 @@
 
 #include <tbb/global_control.h>
 
-#include "primal/boundary.hpp"
-#include "demo/demo_models.hpp"
-#include "primal/grid_model.hpp"
-#include "primal/errors.hpp"
-#include "io/exodus.hpp"
-#include "primal/quality.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/boundary.hpp>
+#include <geode/demo/demo_models.hpp>
+#include <geode/primal/grid_model.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/io/exodus.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/topology.hpp>
 #include "support/fixtures.hpp"
-#include "conform/conform.hpp"
-#include "conform/reference_template.hpp"
+#include <geode/conform/conform.hpp>
+#include <geode/conform/reference_template.hpp>
 #include "support/conform_checks.hpp"
 
 using namespace geode;

@@ -10,11 +10,11 @@
 #include <span>
 #include <string>
 
-#include "conform/conform.hpp"
-#include "demo/demo_models.hpp"
-#include "primal/dice.hpp"
-#include "primal/interface.hpp"
-#include "primal/quality.hpp"
+#include <geode/conform/conform.hpp>
+#include <geode/demo/demo_models.hpp>
+#include <geode/primal/dice.hpp>
+#include <geode/primal/interface.hpp>
+#include <geode/primal/quality.hpp>
 #include "support/conform_checks.hpp"
 
 using namespace geode;

@@ -8,11 +8,11 @@
 #include <map>
 #include <string>
 
-#include "conform/conform.hpp"
-#include "demo/demo_models.hpp"
-#include "primal/boundary.hpp"
-#include "primal/local_smooth.hpp"
-#include "primal/quality.hpp"
+#include <geode/conform/conform.hpp>
+#include <geode/demo/demo_models.hpp>
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/local_smooth.hpp>
+#include <geode/primal/quality.hpp>
 #include "support/conform_checks.hpp"
 
 using namespace geode;

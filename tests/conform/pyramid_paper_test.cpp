@@ -9,11 +9,11 @@
 #include <cmath>
 #include <map>
 
-#include "conform/conform.hpp"
-#include "primal/quality.hpp"
-#include "primal/realizability.hpp"
-#include "primal/topology.hpp"
-#include "primal/validity.hpp"
+#include <geode/conform/conform.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/realizability.hpp>
+#include <geode/primal/topology.hpp>
+#include <geode/primal/validity.hpp>
 
 using namespace geode;
 using primal::Index;

@@ -12,11 +12,11 @@
 #include <cmath>
 #include <string>
 
-#include "conform/conform.hpp"
-#include "demo/demo_models.hpp"
-#include "conform/reference_template.hpp"
-#include "primal/interface.hpp"
-#include "primal/quality.hpp"
+#include <geode/conform/conform.hpp>
+#include <geode/demo/demo_models.hpp>
+#include <geode/conform/reference_template.hpp>
+#include <geode/primal/interface.hpp>
+#include <geode/primal/quality.hpp>
 #include "support/conform_checks.hpp"
 
 using namespace geode;

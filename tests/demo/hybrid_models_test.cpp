@@ -13,14 +13,14 @@
 #include <set>
 #include <string>
 
-#include "conform/conform.hpp"
-#include "io/exodus.hpp"
-#include "io/gmsh.hpp"
-#include "io/read_model.hpp"
-#include "io/vtk.hpp"
-#include "primal/quality.hpp"
-#include "primal/validity.hpp"
-#include "primal/boundary.hpp"
+#include <geode/conform/conform.hpp>
+#include <geode/io/exodus.hpp>
+#include <geode/io/gmsh.hpp>
+#include <geode/io/read_model.hpp>
+#include <geode/io/vtk.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/validity.hpp>
+#include <geode/primal/boundary.hpp>
 #include "support/ball_checks.hpp"
 #include "support/cli_run.hpp"
 #include "support/temp_dir.hpp"

@@ -13,8 +13,8 @@
 #include <filesystem>
 #include <string>
 
-#include "io/exodus.hpp"
-#include "primal/errors.hpp"
+#include <geode/io/exodus.hpp>
+#include <geode/primal/errors.hpp>
 
 namespace {
 const std::string& scratch() {

@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <string_view>
 
-#include "primal/errors.hpp"
-#include "io/gmsh.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/io/gmsh.hpp>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   try {

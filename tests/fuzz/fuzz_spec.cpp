@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <string_view>
 
-#include "primal/errors.hpp"
-#include "templates/spec.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/templates/spec.hpp>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   try {

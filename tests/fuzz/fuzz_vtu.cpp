@@ -4,9 +4,9 @@
 #include <cstdint>
 #include <string_view>
 
-#include "primal/errors.hpp"
-#include "io/vtk.hpp"
-#include "io/read_model.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/io/vtk.hpp>
+#include <geode/io/read_model.hpp>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   try {

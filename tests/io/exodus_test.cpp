@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "support/temp_dir.hpp"
-#include "primal/grid_model.hpp"
-#include "primal/errors.hpp"
-#include "io/exodus.hpp"
+#include <geode/primal/grid_model.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/io/exodus.hpp>
 
 namespace fs = std::filesystem;
 using namespace geode;

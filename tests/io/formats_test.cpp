@@ -9,11 +9,11 @@
 #include <sstream>
 #include <string>
 
-#include "io/file_format.hpp"
-#include "io/formats.hpp"
-#include "io/read_model.hpp"
-#include "primal/errors.hpp"
-#include "primal/grid_model.hpp"
+#include <geode/io/file_format.hpp>
+#include <geode/io/formats.hpp>
+#include <geode/io/read_model.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/grid_model.hpp>
 #include "support/temp_dir.hpp"
 
 namespace fs = std::filesystem;

@@ -6,12 +6,12 @@
 #include <filesystem>
 #include <string>
 
-#include "primal/errors.hpp"
-#include "io/file_format.hpp"
-#include "io/exodus.hpp"
-#include "io/gmsh.hpp"
-#include "io/vtk.hpp"
-#include "io/read_model.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/io/file_format.hpp>
+#include <geode/io/exodus.hpp>
+#include <geode/io/gmsh.hpp>
+#include <geode/io/vtk.hpp>
+#include <geode/io/read_model.hpp>
 
 namespace fs = std::filesystem;
 using namespace geode;

@@ -11,10 +11,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "io/gmsh.hpp"
-#include "io/read_warnings.hpp"
-#include "primal/dice_model.hpp"
-#include "primal/errors.hpp"
+#include <geode/io/gmsh.hpp>
+#include <geode/io/read_warnings.hpp>
+#include <geode/primal/dice_model.hpp>
+#include <geode/primal/errors.hpp>
 #include "support/temp_dir.hpp"
 
 namespace fs = std::filesystem;

@@ -9,10 +9,10 @@
 #include <unistd.h>
 
 #include "support/temp_dir.hpp"
-#include "primal/grid_model.hpp"
-#include "primal/errors.hpp"
-#include "io/gmsh.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/grid_model.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/io/gmsh.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace fs = std::filesystem;
 using namespace geode;

@@ -13,12 +13,12 @@
 #include <sstream>
 #include <string>
 
-#include "io/exodus.hpp"
-#include "io/gmsh.hpp"
-#include "io/names.hpp"
-#include "io/vtk.hpp"
-#include "primal/errors.hpp"
-#include "primal/grid_model.hpp"
+#include <geode/io/exodus.hpp>
+#include <geode/io/gmsh.hpp>
+#include <geode/io/names.hpp>
+#include <geode/io/vtk.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/grid_model.hpp>
 #include "support/temp_dir.hpp"
 
 namespace fs = std::filesystem;

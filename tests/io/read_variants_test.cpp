@@ -11,11 +11,11 @@
 #include <filesystem>
 #include <string>
 
-#include "primal/errors.hpp"
-#include "primal/grid_model.hpp"
-#include "io/gmsh.hpp"
-#include "io/vtk.hpp"
-#include "io/read_model.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/grid_model.hpp>
+#include <geode/io/gmsh.hpp>
+#include <geode/io/vtk.hpp>
+#include <geode/io/read_model.hpp>
 #include "support/fixtures.hpp"
 #include "support/temp_dir.hpp"
 

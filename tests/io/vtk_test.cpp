@@ -1,7 +1,7 @@
 // VTK I/O: exact round trips (.vtu and legacy .vtk) for hex, tet and quad meshes with cell
 // arrays; each kind of bad input rejected with the file, the line and the reason; atomic
 // writes; and, when python3-vtk9 is installed, VTK's own readers open what we write.
-#include "io/vtk.hpp"
+#include <geode/io/vtk.hpp>
 
 #include <doctest/doctest.h>
 #include <unistd.h>
@@ -14,10 +14,10 @@
 #include <memory>
 #include <sstream>
 
-#include "io/atomic_file.hpp"
-#include "primal/dice.hpp"
-#include "primal/errors.hpp"
-#include "primal/quality.hpp"
+#include <geode/io/atomic_file.hpp>
+#include <geode/primal/dice.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/quality.hpp>
 #include "support/fixtures.hpp"
 #include "support/temp_dir.hpp"
 

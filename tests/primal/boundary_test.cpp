@@ -12,7 +12,7 @@
 #include <thread>
 #include <vector>
 
-#include "primal/boundary.hpp"
+#include <geode/primal/boundary.hpp>
 #include "support/fixtures.hpp"
 
 using namespace geode::primal;

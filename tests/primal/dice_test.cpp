@@ -1,7 +1,7 @@
 // Dicing: node counts V' = V + E + F + C counted by hand, conformity and orientation through the
 // validity report, exact volume preservation element by element (the children of a hex are
 // its trilinear map restricted to the 8 sub-cubes), and the node-origin map.
-#include "primal/dice.hpp"
+#include <geode/primal/dice.hpp>
 
 #include <doctest/doctest.h>
 
@@ -10,10 +10,10 @@
 #include <cmath>
 #include <map>
 
-#include "primal/errors.hpp"
-#include "primal/quality.hpp"
-#include "primal/topology.hpp"
-#include "primal/validity.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/topology.hpp>
+#include <geode/primal/validity.hpp>
 #include "support/fixtures.hpp"
 #include "support/isomorphism.hpp"
 

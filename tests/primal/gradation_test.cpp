@@ -5,7 +5,7 @@
 #include <cmath>
 #include <random>
 
-#include "primal/gradation.hpp"
+#include <geode/primal/gradation.hpp>
 
 using namespace geode::primal;
 

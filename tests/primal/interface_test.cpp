@@ -8,10 +8,10 @@
 #include <set>
 #include <string>
 
-#include "primal/grid_model.hpp"
-#include "primal/errors.hpp"
-#include "primal/interface.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/grid_model.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/interface.hpp>
+#include <geode/primal/topology.hpp>
 #include "support/fixtures.hpp"
 
 using namespace geode;

@@ -7,8 +7,8 @@
 #include <random>
 #include <set>
 
-#include "primal/errors.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/topology.hpp>
 #include "support/fixtures.hpp"
 #include "support/isomorphism.hpp"
 

@@ -4,7 +4,7 @@
 
 #include <map>
 
-#include "primal/key_map.hpp"
+#include <geode/primal/key_map.hpp>
 
 using namespace geode::primal;
 

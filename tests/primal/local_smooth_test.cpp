@@ -10,11 +10,11 @@
 #include <map>
 #include <vector>
 
-#include "primal/errors.hpp"
-#include "primal/frame_derivatives.hpp"
-#include "primal/local_smooth.hpp"
-#include "primal/quality.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/frame_derivatives.hpp>
+#include <geode/primal/local_smooth.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace {
 

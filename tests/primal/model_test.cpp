@@ -2,15 +2,15 @@
 // (its area vector points away from the centre, and they sum to zero: a closed surface), every
 // edge on exactly two faces, Euler's V - E + F = 2; the corner frames right-handed; and the
 // read-time geometry checks refusing inverted wedges and pyramids by their file ids.
-#include "primal/model.hpp"
+#include <geode/primal/model.hpp>
 
 #include <doctest/doctest.h>
 
 #include <algorithm>
 #include <string>
 
-#include "primal/errors.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/topology.hpp>
 
 using namespace geode::primal;
 namespace topo = geode::primal::topology;

@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-#include "primal/patch_match.hpp"
+#include <geode/primal/patch_match.hpp>
 
 namespace {
 

@@ -7,11 +7,11 @@
 #include <map>
 #include <set>
 
-#include "primal/boundary.hpp"
-#include "primal/errors.hpp"
-#include "primal/pillow.hpp"
-#include "primal/topology.hpp"
-#include "primal/validity.hpp"
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/pillow.hpp>
+#include <geode/primal/topology.hpp>
+#include <geode/primal/validity.hpp>
 #include "support/fixtures.hpp"
 
 using namespace geode;

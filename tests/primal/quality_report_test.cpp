@@ -7,8 +7,8 @@
 #include <sstream>
 #include <string>
 
-#include "primal/errors.hpp"
-#include "primal/quality_report.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/quality_report.hpp>
 
 namespace {
 

@@ -7,9 +7,9 @@
 #include <array>
 #include <vector>
 
-#include "primal/errors.hpp"
-#include "primal/realizability.hpp"
-#include "primal/validity.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/realizability.hpp>
+#include <geode/primal/validity.hpp>
 #include "support/fixtures.hpp"
 
 using namespace geode::primal;

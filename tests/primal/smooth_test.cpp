@@ -9,10 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "primal/errors.hpp"
-#include "primal/quality.hpp"
-#include "primal/smooth.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/smooth.hpp>
+#include <geode/primal/topology.hpp>
 #include "support/fixtures.hpp"
 
 namespace {

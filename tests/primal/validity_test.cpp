@@ -14,13 +14,13 @@
 #include <random>
 #include <string>
 
-#include "primal/boundary.hpp"
-#include "primal/dice.hpp"
-#include "primal/grid_model.hpp"
-#include "primal/quality.hpp"
-#include "primal/smooth.hpp"
-#include "primal/topology.hpp"
-#include "primal/validity.hpp"
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/dice.hpp>
+#include <geode/primal/grid_model.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/smooth.hpp>
+#include <geode/primal/topology.hpp>
+#include <geode/primal/validity.hpp>
 #include "support/ball_checks.hpp"
 #include "support/fixtures.hpp"
 

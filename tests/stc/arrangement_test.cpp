@@ -5,13 +5,13 @@
 
 #include <string>
 
-#include "primal/errors.hpp"
-#include "stc/arrangement.hpp"
-#include "stc/dualize.hpp"
-#include "stc/mesh_dual.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/stc/arrangement.hpp>
+#include <geode/stc/dualize.hpp>
+#include <geode/stc/mesh_dual.hpp>
 #include "support/fixtures.hpp"
 #include "support/isomorphism.hpp"
-#include "templates/geode.hpp"
+#include <geode/templates/geode.hpp>
 
 using namespace geode;
 using stc::Point;

@@ -7,14 +7,14 @@
 #include <Eigen/Dense>
 #include <string>
 
-#include "primal/errors.hpp"
-#include "primal/topology.hpp"
-#include "primal/validity.hpp"
-#include "stc/arrangement.hpp"
-#include "stc/dualize.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/topology.hpp>
+#include <geode/primal/validity.hpp>
+#include <geode/stc/arrangement.hpp>
+#include <geode/stc/dualize.hpp>
 #include "support/fixtures.hpp"
 #include "support/isomorphism.hpp"
-#include "templates/geode.hpp"
+#include <geode/templates/geode.hpp>
 
 using namespace geode;
 using stc::Point;

@@ -8,9 +8,9 @@
 #include <cmath>
 #include <string>
 
-#include "primal/errors.hpp"
-#include "stc/arrangement.hpp"
-#include "stc/dualize.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/stc/arrangement.hpp>
+#include <geode/stc/dualize.hpp>
 
 using namespace geode;
 using stc::Point;

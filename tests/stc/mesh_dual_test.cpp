@@ -14,9 +14,9 @@
 
 #include <unistd.h>
 
-#include "primal/errors.hpp"
-#include "primal/topology.hpp"
-#include "stc/mesh_dual.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/topology.hpp>
+#include <geode/stc/mesh_dual.hpp>
 #include "support/fixtures.hpp"
 #include "support/isomorphism.hpp"
 

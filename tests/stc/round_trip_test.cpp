@@ -6,17 +6,17 @@
 #include <cmath>
 #include <string>
 
-#include "primal/grid_model.hpp"
-#include "primal/dice.hpp"
-#include "primal/errors.hpp"
-#include "primal/model.hpp"
-#include "primal/quality.hpp"
-#include "primal/smooth.hpp"
-#include "primal/validity.hpp"
-#include "stc/arrangement.hpp"
-#include "stc/dualize.hpp"
-#include "stc/mesh_dual.hpp"
-#include "stc/mesh_fields.hpp"
+#include <geode/primal/grid_model.hpp>
+#include <geode/primal/dice.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/model.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/smooth.hpp>
+#include <geode/primal/validity.hpp>
+#include <geode/stc/arrangement.hpp>
+#include <geode/stc/dualize.hpp>
+#include <geode/stc/mesh_dual.hpp>
+#include <geode/stc/mesh_fields.hpp>
 #include "support/fixtures.hpp"
 #include "support/isomorphism.hpp"
 

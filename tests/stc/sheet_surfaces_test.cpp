@@ -7,10 +7,10 @@
 #include <map>
 #include <set>
 
-#include "stc/mesh_dual.hpp"
-#include "stc/sheet_surfaces.hpp"
+#include <geode/stc/mesh_dual.hpp>
+#include <geode/stc/sheet_surfaces.hpp>
 #include "support/fixtures.hpp"
-#include "templates/geode.hpp"
+#include <geode/templates/geode.hpp>
 
 using namespace geode;
 using primal::Index;

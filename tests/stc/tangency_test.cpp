@@ -6,10 +6,10 @@
 #include <cmath>
 #include <string>
 
-#include "primal/errors.hpp"
-#include "primal/validity.hpp"
-#include "stc/arrangement.hpp"
-#include "stc/dualize.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/validity.hpp>
+#include <geode/stc/arrangement.hpp>
+#include <geode/stc/dualize.hpp>
 
 using namespace geode;
 using stc::Point;

@@ -2,7 +2,7 @@
 // A doctest check shared by the template tests: the mesh is a combinatorial ball.
 #include <doctest/doctest.h>
 
-#include "primal/validity.hpp"
+#include <geode/primal/validity.hpp>
 
 namespace geode::test {
 

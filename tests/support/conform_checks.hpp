@@ -2,9 +2,9 @@
 // A doctest check shared by the conform tests: what every conform() result must satisfy.
 #include <doctest/doctest.h>
 
-#include "conform/conform.hpp"
-#include "primal/quality.hpp"
-#include "primal/validity.hpp"
+#include <geode/conform/conform.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/validity.hpp>
 #include "support/ball_checks.hpp"
 
 namespace geode::test {

@@ -5,10 +5,10 @@
 #include <sstream>
 #include <vector>
 
-#include "primal/boundary.hpp"
-#include "primal/errors.hpp"
-#include "primal/grid_model.hpp"
-#include "primal/topology.hpp"
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/grid_model.hpp>
+#include <geode/primal/topology.hpp>
 
 namespace geode::test {
 namespace {

@@ -4,8 +4,8 @@
 #include <functional>
 #include <string>
 
-#include "primal/mesh.hpp"
-#include "primal/model.hpp"
+#include <geode/primal/mesh.hpp>
+#include <geode/primal/model.hpp>
 
 namespace geode::test {
 

@@ -1,7 +1,7 @@
 #pragma once
 // The mesh isomorphism checker is a primal operation (primal/isomorphism.hpp; the Python module
 // exposes it); the tests keep calling it by its geode::test names.
-#include "primal/isomorphism.hpp"
+#include <geode/primal/isomorphism.hpp>
 
 namespace geode::test {
 using primal::find_isomorphism;

@@ -9,12 +9,12 @@
 #include <set>
 #include <map>
 
-#include "primal/boundary.hpp"
-#include "primal/realizability.hpp"
-#include "primal/validity.hpp"
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/realizability.hpp>
+#include <geode/primal/validity.hpp>
 #include "support/fixtures.hpp"
 #include "support/isomorphism.hpp"
-#include "templates/fixup.hpp"
+#include <geode/templates/fixup.hpp>
 
 using namespace geode;
 using templates::GeodeOptions;

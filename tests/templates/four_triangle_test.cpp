@@ -21,11 +21,11 @@
 #include <algorithm>
 #include <cmath>
 
-#include "primal/errors.hpp"
-#include "stc/arrangement.hpp"
-#include "templates/completion.hpp"
-#include "templates/geode.hpp"
-#include "templates/study.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/stc/arrangement.hpp>
+#include <geode/templates/completion.hpp>
+#include <geode/templates/geode.hpp>
+#include <geode/templates/study.hpp>
 
 using namespace geode;
 using primal::Point;

@@ -6,12 +6,12 @@
 #include <cmath>
 #include <set>
 
-#include "primal/errors.hpp"
-#include "primal/validity.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/validity.hpp>
 #include "support/ball_checks.hpp"
 #include "support/fixtures.hpp"
 #include "support/isomorphism.hpp"
-#include "templates/geode.hpp"
+#include <geode/templates/geode.hpp>
 
 using namespace geode;
 using templates::GeodeOptions;

@@ -10,16 +10,16 @@
 #include <map>
 #include <set>
 
-#include "primal/boundary.hpp"
-#include "primal/errors.hpp"
-#include "io/gmsh.hpp"
-#include "primal/quality.hpp"
-#include "primal/realizability.hpp"
-#include "primal/validity.hpp"
-#include "stc/mesh_dual.hpp"
-#include "stc/surface_chords.hpp"
-#include "templates/pyramid.hpp"
-#include "templates/spec.hpp"
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/io/gmsh.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/realizability.hpp>
+#include <geode/primal/validity.hpp>
+#include <geode/stc/mesh_dual.hpp>
+#include <geode/stc/surface_chords.hpp>
+#include <geode/templates/pyramid.hpp>
+#include <geode/templates/spec.hpp>
 
 using namespace geode;
 using primal::Index;

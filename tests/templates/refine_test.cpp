@@ -10,14 +10,14 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
-#include "primal/errors.hpp"
-#include "primal/quality.hpp"
-#include "primal/validity.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/validity.hpp>
 #include "support/ball_checks.hpp"
 #include "support/fixtures.hpp"
 #include "support/isomorphism.hpp"
-#include "templates/refine.hpp"
-#include "templates/spec.hpp"
+#include <geode/templates/refine.hpp>
+#include <geode/templates/spec.hpp>
 
 using namespace geode;
 using primal::Point;

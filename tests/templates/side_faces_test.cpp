@@ -8,9 +8,9 @@
 #include <array>
 #include <vector>
 
-#include "primal/quality.hpp"
-#include "templates/geode.hpp"
-#include "templates/side_faces.hpp"
+#include <geode/primal/quality.hpp>
+#include <geode/templates/geode.hpp>
+#include <geode/templates/side_faces.hpp>
 
 using namespace geode;
 

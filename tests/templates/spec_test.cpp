@@ -6,11 +6,11 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
-#include "primal/errors.hpp"
-#include "primal/validity.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/validity.hpp>
 #include "support/isomorphism.hpp"
-#include "templates/geode.hpp"
-#include "templates/spec.hpp"
+#include <geode/templates/geode.hpp>
+#include <geode/templates/spec.hpp>
 
 using namespace geode;
 using nlohmann::json;

@@ -11,11 +11,11 @@
 
 #include <tbb/global_control.h>
 
-#include "primal/errors.hpp"
-#include "primal/quality.hpp"
-#include "primal/topology.hpp"
-#include "primal/validity.hpp"
-#include "templates/study.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/topology.hpp>
+#include <geode/primal/validity.hpp>
+#include <geode/templates/study.hpp>
 
 using namespace geode;
 using templates::GeodeOptions;

@@ -5,8 +5,8 @@
 #include <set>
 #include <string>
 
-#include "primal/errors.hpp"
-#include "templates/template_table.hpp"
+#include <geode/primal/errors.hpp>
+#include <geode/templates/template_table.hpp>
 
 using namespace geode;
 using namespace geode::templates;
