@@ -46,8 +46,10 @@ Timing time_it(int repeats, const std::function<void()>& f) {
 }
 
 void report(const char* what, const Timing& t, double target, int repeats) {
-  std::printf("%-44s min %8.2f ms  median %8.2f ms  (%2d runs)  target < %6.0f ms  %s  peak RSS %ld KiB\n", what,
-              1e3 * t.min, 1e3 * t.median, repeats, 1e3 * target, t.median < target ? "ok  " : "SLOW", peak_kib());
+  std::printf(
+      "%-44s min %8.2f ms  median %8.2f ms  (%2d runs)  target < %6.0f ms  %s  peak RSS %ld KiB\n",
+      what, 1e3 * t.min, 1e3 * t.median, repeats, 1e3 * target, t.median < target ? "ok  " : "SLOW",
+      peak_kib());
 }
 
 }  // namespace
@@ -62,7 +64,8 @@ int main(int argc, char** argv) {
   const auto& sheets = G.sheets;
   const geode::stc::Domain& dom = G.domain;
   std::size_t hexes = 0, vertices = 0;
-  const Timing arr = time_it(repeats, [&] { vertices = geode::stc::compute_arrangement(sheets, dom).vertices.size(); });
+  const Timing arr = time_it(
+      repeats, [&] { vertices = geode::stc::compute_arrangement(sheets, dom).vertices.size(); });
   report("(a1) compute_arrangement (6 sheets)", arr, 0.050, repeats);
   const auto A = geode::stc::compute_arrangement(sheets, dom);
   const Timing dual = time_it(repeats, [&] { hexes = geode::stc::dualize(A).hex.hexes.size(); });
@@ -73,7 +76,8 @@ int main(int argc, char** argv) {
   report("(a) compute_arrangement + dualize", both, 0.050, repeats);
   std::printf("    %zu sheets, %zu vertices, %zu hexes\n", sheets.size(), vertices, hexes);
 
-  const Timing build = time_it(repeats, [&] { hexes = gt::build_geode3d(gt::GeodeOptions{}).hex.hexes.size(); });
+  const Timing build =
+      time_it(repeats, [&] { hexes = gt::build_geode3d(gt::GeodeOptions{}).hex.hexes.size(); });
   report("(b) build_geode3d end to end", build, 0.100, repeats);
   std::printf("    %zu hexes\n", hexes);
 
@@ -86,8 +90,9 @@ int main(int argc, char** argv) {
       const auto r = gt::smooth_template(T, slide);
       sj = r.final_min_scaled_jacobian, it = r.iterations;
     });
-    report(slide ? "(c) smooth_template (tet/hex side slides)" : "(c) smooth_template (tet/hex side fixed)", s, 1.0,
-           smooth_repeats);
+    report(slide ? "(c) smooth_template (tet/hex side slides)"
+                 : "(c) smooth_template (tet/hex side fixed)",
+           s, 1.0, smooth_repeats);
     std::printf("    min scaled Jacobian %.4f after %d iterations\n", sj, it);
   }
   return 0;

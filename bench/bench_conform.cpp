@@ -8,10 +8,10 @@
 #include <cstdlib>
 #include <string>
 
+#include <geode/conform/conform.hpp>
+#include <geode/primal/errors.hpp>
 #include <geode/primal/grid_model.hpp>
 #include <geode/primal/quality.hpp>
-#include <geode/primal/errors.hpp>
-#include <geode/conform/conform.hpp>
 
 int main(int argc, char** argv) {
   using namespace geode;

@@ -44,9 +44,9 @@
 #include <vector>
 
 #include <geode/demo/demo_models.hpp>
-#include <geode/primal/errors.hpp>
 #include <geode/io/exodus.hpp>
 #include <geode/io/gmsh.hpp>
+#include <geode/primal/errors.hpp>
 
 namespace fs = std::filesystem;
 namespace gp = geode::primal;
@@ -138,10 +138,13 @@ gp::Model tet_model(const gp::Model& m) {
   return t;
 }
 
-void print_row(const char* what, const Run& r, std::size_t hexes, const Run& reference, const Run& floor) {
-  std::printf("%-22s %7.2f s %7.2f s CPU %8.1f MiB %9zu hexes %5.0f B/hex   x gmsh %.2f  x floor %.2f (CPU %.2f)\n",
-              what, r.seconds, r.cpu_seconds, r.peak_mib, hexes, r.peak_mib * 1048576.0 / hexes,
-              r.seconds / reference.seconds, r.seconds / floor.seconds, r.cpu_seconds / floor.cpu_seconds);
+void print_row(const char* what, const Run& r, std::size_t hexes, const Run& reference,
+               const Run& floor) {
+  std::printf(
+      "%-22s %7.2f s %7.2f s CPU %8.1f MiB %9zu hexes %5.0f B/hex   x gmsh %.2f  x floor %.2f (CPU "
+      "%.2f)\n",
+      what, r.seconds, r.cpu_seconds, r.peak_mib, hexes, r.peak_mib * 1048576.0 / hexes,
+      r.seconds / reference.seconds, r.seconds / floor.seconds, r.cpu_seconds / floor.cpu_seconds);
 }
 
 }  // namespace
@@ -192,28 +195,30 @@ int main(int argc, char** argv) {
               {geode, "conform", (dir / "model.msh").string(), "-o", (dir / "geode.exo").string(),
                "--report", (dir / "report.json").string(), "--quiet"},
               dir / "geode.log", "geode conform");
-  const Run conform_none =
-      best_of(repeats,
-              {geode, "conform", (dir / "model.msh").string(), "-o", (dir / "geode_none.exo").string(),
-               "--report", (dir / "report_none.json").string(), "--smooth", "none", "--quiet"},
-              dir / "geode_none.log", "geode conform --smooth none");
+  const Run conform_none = best_of(
+      repeats,
+      {geode, "conform", (dir / "model.msh").string(), "-o", (dir / "geode_none.exo").string(),
+       "--report", (dir / "report_none.json").string(), "--smooth", "none", "--quiet"},
+      dir / "geode_none.log", "geode conform --smooth none");
 
-  const Run floor = best_of(repeats, {floor_exe, (dir / "model.msh").string(), (dir / "floor.exo").string()},
-                            dir / "floor.log", "floor");
+  const Run floor =
+      best_of(repeats, {floor_exe, (dir / "model.msh").string(), (dir / "floor.exo").string()},
+              dir / "floor.log", "floor");
   // The same defaults on one thread (--threads 1): the 2-core speed-up, wall and CPU.
-  const Run conform_one =
-      best_of(repeats,
-              {geode, "conform", (dir / "model.msh").string(), "-o", (dir / "geode_one.exo").string(),
-               "--report", (dir / "report_one.json").string(), "--threads", "1", "--quiet"},
-              dir / "geode_one.log", "geode conform --threads 1");
+  const Run conform_one = best_of(
+      repeats,
+      {geode, "conform", (dir / "model.msh").string(), "-o", (dir / "geode_one.exo").string(),
+       "--report", (dir / "report_one.json").string(), "--threads", "1", "--quiet"},
+      dir / "geode_one.log", "geode conform --threads 1");
   // Every other output format against .exo (the same defaults).
   std::vector<std::pair<std::string, Run>> formats;
   for (const char* ext : {"msh", "vtu", "vtk"}) {
     const std::string out = (dir / (std::string("geode.") + ext)).string();
-    formats.emplace_back(ext, best_of(repeats,
-                                      {geode, "conform", (dir / "model.msh").string(), "-o", out, "--report",
-                                       (dir / (std::string("report_") + ext + ".json")).string(), "--quiet"},
-                                      dir / (std::string("geode_") + ext + ".log"), ext));
+    formats.emplace_back(
+        ext, best_of(repeats,
+                     {geode, "conform", (dir / "model.msh").string(), "-o", out, "--report",
+                      (dir / (std::string("report_") + ext + ".json")).string(), "--quiet"},
+                     dir / (std::string("geode_") + ext + ".log"), ext));
     std::error_code ec;
     fs::remove(out, ec);
   }
@@ -237,7 +242,8 @@ int main(int argc, char** argv) {
     for (const auto& b : j.at("blocks"))
       for (const auto& m : b.at("quality").at("metrics"))
         if (m.at("key") == "scaled_jacobian")
-          block_min.push_back(b.at("name").get<std::string>() + " " + std::to_string(m.at("min").get<double>()));
+          block_min.push_back(b.at("name").get<std::string>() + " " +
+                              std::to_string(m.at("min").get<double>()));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_conform_vs_gmsh: reading the outputs back: %s\n", e.what());
     return 1;
@@ -247,8 +253,9 @@ int main(int argc, char** argv) {
     return 1;
   }
 
-  std::printf("best of %d; ratios against gmsh subdivide (read + RefineMesh, no output) and the floor\n",
-              repeats);
+  std::printf(
+      "best of %d; ratios against gmsh subdivide (read + RefineMesh, no output) and the floor\n",
+      repeats);
   print_row("floor (read+dice+exo)", floor, floor_hexes, sub, floor);
   print_row("gmsh subdivide", sub, gmsh_hexes, sub, floor);
   print_row("gmsh subdivide+save", sub_save, gmsh_hexes, sub, floor);
@@ -261,11 +268,13 @@ int main(int argc, char** argv) {
               conform.seconds / floor.seconds, conform.cpu_seconds / floor.cpu_seconds,
               conform_one.seconds / conform.seconds);
   for (const auto& [ext, r] : formats)
-    std::printf("-o .%s / -o .exo: time %.2fx, CPU %.2fx\n", ext.c_str(), r.seconds / conform.seconds,
-                r.cpu_seconds / conform.cpu_seconds);
-  std::printf("local smoothing: %.2f ms CPU per buffer hex (%zu buffer hexes); the two runs differ by %.2f s wall\n",
-              1e3 * smoothing_cpu / static_cast<double>(buffer_hexes), buffer_hexes,
-              conform.seconds - conform_none.seconds);
+    std::printf("-o .%s / -o .exo: time %.2fx, CPU %.2fx\n", ext.c_str(),
+                r.seconds / conform.seconds, r.cpu_seconds / conform.cpu_seconds);
+  std::printf(
+      "local smoothing: %.2f ms CPU per buffer hex (%zu buffer hexes); the two runs differ by %.2f "
+      "s wall\n",
+      1e3 * smoothing_cpu / static_cast<double>(buffer_hexes), buffer_hexes,
+      conform.seconds - conform_none.seconds);
   std::printf("min scaled Jacobian per block:");
   for (const auto& b : block_min) std::printf("  %s", b.c_str());
   std::printf("\n");

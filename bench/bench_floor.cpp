@@ -32,7 +32,9 @@ using gp::Point;
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 // Per-node lists in one array (CSR with room for every use): entries of node a at
 // [start[a], start[a] + size[a]).
@@ -40,7 +42,8 @@ template <typename Entry>
 struct NodeTable {
   std::vector<Index> start, size;
   std::vector<Entry> entries;
-  explicit NodeTable(const std::vector<Index>& uses) : start(uses.size() + 1, 0), size(uses.size(), 0) {
+  explicit NodeTable(const std::vector<Index>& uses)
+      : start(uses.size() + 1, 0), size(uses.size(), 0) {
     for (std::size_t v = 0; v < uses.size(); ++v) start[v + 1] = start[v] + uses[v];
     entries.resize(static_cast<std::size_t>(start.back()));
   }
@@ -118,11 +121,12 @@ struct TetTables {
       std::sort(s.begin(), s.end());
       return static_cast<int>(std::find(sets.begin(), sets.end(), s) - sets.begin());
     };
-    constexpr std::array<std::array<int, 4>, 4> kFrame{{{0, 1, 2, 3}, {1, 0, 3, 2}, {2, 3, 0, 1}, {3, 2, 1, 0}}};
+    constexpr std::array<std::array<int, 4>, 4> kFrame{
+        {{0, 1, 2, 3}, {1, 0, 3, 2}, {2, 3, 0, 1}, {3, 2, 1, 0}}};
     for (int c = 0; c < 4; ++c) {
       const auto [o, a, b, d] = kFrame[c];
-      child[c] = {id({o}), id({o, a}), id({o, a, b}), id({o, b}), id({o, d}), id({o, a, d}), id({0, 1, 2, 3}),
-                  id({o, b, d})};
+      child[c] = {id({o}),    id({o, a}),    id({o, a, b}),    id({o, b}),
+                  id({o, d}), id({o, a, d}), id({0, 1, 2, 3}), id({o, b, d})};
     }
   }
 };
@@ -180,16 +184,19 @@ int main(int argc, char** argv) {
     for (int c : set) sum += model.points[cell[c]];
     const Point at = sum / static_cast<double>(set.size());
     if (centre) return add(at);
-    std::array<Index, 4> v{gp::kInvalidIndex, gp::kInvalidIndex, gp::kInvalidIndex, gp::kInvalidIndex};
+    std::array<Index, 4> v{gp::kInvalidIndex, gp::kInvalidIndex, gp::kInvalidIndex,
+                           gp::kInvalidIndex};
     for (std::size_t i = 0; i < set.size(); ++i) v[i] = cell[set[i]];
     std::sort(v.begin(), v.begin() + static_cast<long>(set.size()));
-    if (set.size() == 2) return edges.find_or_add(v[0], EdgeEntry{v[1], 0}, [&] { return add(at); });
+    if (set.size() == 2)
+      return edges.find_or_add(v[0], EdgeEntry{v[1], 0}, [&] { return add(at); });
     FaceEntry key{{v[1], v[2], set.size() == 4 ? v[3] : gp::kInvalidIndex}, 0};
     return faces.find_or_add(v[0], key, [&] { return add(at); });
   };
   std::array<Index, 27> local{};
   for (const auto& h : model.hexes) {
-    for (int g = 0; g < 27; ++g) local[g] = node_of(h, hex_t.corners_of[g], hex_t.corners_of[g].size() == 8);
+    for (int g = 0; g < 27; ++g)
+      local[g] = node_of(h, hex_t.corners_of[g], hex_t.corners_of[g].size() == 8);
     for (const auto& ch : hex_t.child) {
       std::array<int, 8>& c = conn.emplace_back();
       for (int k = 0; k < 8; ++k) c[k] = local[ch[k]] + 1;
@@ -217,20 +224,23 @@ int main(int argc, char** argv) {
   const std::size_t tet_children = conn.size() - hex_children;
   const int blocks = (hex_children ? 1 : 0) + (tet_children ? 1 : 0);
   std::size_t nodes = 0;
-  bool ok = ex_put_init(exo, "floor", 3, static_cast<int64_t>(points.size()), static_cast<int64_t>(conn.size()), blocks,
-                        0, 0) >= 0;
+  bool ok = ex_put_init(exo, "floor", 3, static_cast<int64_t>(points.size()),
+                        static_cast<int64_t>(conn.size()), blocks, 0, 0) >= 0;
   {
     std::vector<double> x(points.size()), y(points.size()), z(points.size());
-    for (std::size_t i = 0; i < points.size(); ++i) x[i] = points[i].x(), y[i] = points[i].y(), z[i] = points[i].z();
+    for (std::size_t i = 0; i < points.size(); ++i)
+      x[i] = points[i].x(), y[i] = points[i].y(), z[i] = points[i].z();
     nodes = points.size();
     points = {};
     ok = ok && ex_put_coord(exo, x.data(), y.data(), z.data()) >= 0;
   }
   int id = 0;
-  for (const auto& [first, n] : {std::pair{std::size_t{0}, hex_children}, std::pair{hex_children, tet_children}}) {
+  for (const auto& [first, n] :
+       {std::pair{std::size_t{0}, hex_children}, std::pair{hex_children, tet_children}}) {
     if (n == 0) continue;
     ++id;
-    ok = ok && ex_put_block(exo, EX_ELEM_BLOCK, id, "HEX8", static_cast<int64_t>(n), 8, 0, 0, 0) >= 0;
+    ok = ok &&
+         ex_put_block(exo, EX_ELEM_BLOCK, id, "HEX8", static_cast<int64_t>(n), 8, 0, 0, 0) >= 0;
     ok = ok && ex_put_conn(exo, EX_ELEM_BLOCK, id, conn[first].data(), nullptr, nullptr) >= 0;
   }
   ok = ex_close(exo) >= 0 && ok;
@@ -239,7 +249,9 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "bench_floor: writing %s failed\n", argv[2]);
     return 2;
   }
-  std::printf("floor: read %.3f s, dice %.3f s, write %.3f s; %zu hexes + %zu tets -> %zu hexes, %zu nodes\n", read_s,
-              dice_s, write_s, model.hexes.size(), model.tets.size(), conn.size(), nodes);
+  std::printf(
+      "floor: read %.3f s, dice %.3f s, write %.3f s; %zu hexes + %zu tets -> %zu hexes, %zu "
+      "nodes\n",
+      read_s, dice_s, write_s, model.hexes.size(), model.tets.size(), conn.size(), nodes);
   return 0;
 }

@@ -7,11 +7,11 @@
 // Usage: bench_local_smooth [--defaults] [n] [target] [max_visits] [max_iterations] [model...]
 //        (defaults 4, LocalSmoothOptions' own, every demo model); --defaults: only the whole
 //        conform with its default options.
-#include <chrono>
-#include <ctime>
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <map>
 #include <string>
 #include <vector>
@@ -41,7 +41,8 @@ void print_blocks(const char* label, const std::map<int, double>& b) {
   std::printf("\n");
 }
 
-void run(const std::string& name, const primal::Model& input, const primal::LocalSmoothOptions& base) {
+void run(const std::string& name, const primal::Model& input,
+         const primal::LocalSmoothOptions& base) {
   conform::ConformOptions o;
   o.smooth = conform::ConformSmooth::kNone;
   o.geode_block = "geode";  // reported apart from the diced tets' block
@@ -56,32 +57,37 @@ void run(const std::string& name, const primal::Model& input, const primal::Loca
   for (primal::Index h = r.diced_hexes; h < r.diced_hexes + r.geode_hexes; ++h) geode.push_back(h);
   const auto seeds = primal::hexes_around(mesh, geode);
   const auto cons = primal::boundary_slide_constraints(mesh);  // boundary and block interfaces kept
-  std::printf("%s: %zu tets, %zu input hexes -> %zu hexes, %.0f buffer hexes, %zu seeds\n", name.c_str(),
-              input.tets.size(), input.hexes.size(), mesh.hexes.size(), buffer, seeds.size());
+  std::printf("%s: %zu tets, %zu input hexes -> %zu hexes, %.0f buffer hexes, %zu seeds\n",
+              name.c_str(), input.tets.size(), input.hexes.size(), mesh.hexes.size(), buffer,
+              seeds.size());
   print_blocks("before", block_minima(mesh));
   const double yardstick = r.yardstick();
-  std::printf("    --smooth none: valid %s, min SJ %.4f; input diced alone %.4f (hexes) %.4f (tets): %.2f x the lower\n",
-              r.validity.ok() && primal::min_scaled_jacobian(mesh) > 0 ? "yes" : "NO", primal::min_scaled_jacobian(mesh),
-              r.input_diced_hex_min_scaled_jacobian, r.input_diced_tet_min_scaled_jacobian,
-              primal::min_scaled_jacobian(mesh) / yardstick);
+  std::printf(
+      "    --smooth none: valid %s, min SJ %.4f; input diced alone %.4f (hexes) %.4f (tets): %.2f "
+      "x the lower\n",
+      r.validity.ok() && primal::min_scaled_jacobian(mesh) > 0 ? "yes" : "NO",
+      primal::min_scaled_jacobian(mesh), r.input_diced_hex_min_scaled_jacobian,
+      r.input_diced_tet_min_scaled_jacobian, primal::min_scaled_jacobian(mesh) / yardstick);
   struct Mode {
     const char* label;
     bool global;
     int threads;
-  } modes[] = {{"local, 1 thread", false, 1}, {"local, default threads", false, 0},
+  } modes[] = {{"local, 1 thread", false, 1},
+               {"local, default threads", false, 0},
                {"global, default threads", true, 0}};
   for (const Mode& m : modes) {
     primal::HexMesh work = mesh;
     primal::LocalSmoothOptions lo = base;
     if (m.global) lo.target = conform::ConformOptions{}.global_smooth_options.target;
     lo.threads = m.threads;
-    const auto res = primal::smooth_hexes_local(work, cons, nullptr,
-                                                m.global ? std::span<const primal::Index>{} : seeds, lo);
+    const auto res = primal::smooth_hexes_local(
+        work, cons, nullptr, m.global ? std::span<const primal::Index>{} : seeds, lo);
     const double cpu = res.cpu_seconds;
-    std::printf("  %-24s %.3f ms CPU per buffer hex (%.3f s CPU, %.3f s wall), %d patches, %d rounds,"
-                " %ld iterations, inverted %d -> %d\n",
-                m.label, 1e3 * cpu / buffer, cpu, res.seconds, res.patches, res.rounds, res.iterations,
-                res.initial_inverted, res.final_inverted);
+    std::printf(
+        "  %-24s %.3f ms CPU per buffer hex (%.3f s CPU, %.3f s wall), %d patches, %d rounds,"
+        " %ld iterations, inverted %d -> %d\n",
+        m.label, 1e3 * cpu / buffer, cpu, res.seconds, res.patches, res.rounds, res.iterations,
+        res.initial_inverted, res.final_inverted);
     print_blocks("after", block_minima(work));
   }
 }
@@ -98,8 +104,9 @@ int main(int argc, char** argv) {
     return std::find(names.begin(), names.end(), m) != names.end();
   });
   if (n < 1 || n > 64 || !known) {
-    std::fprintf(stderr, "usage: bench_local_smooth [--defaults] [n 1..64] [target] [max_visits] "
-                         "[max_iterations] [model...]\n");
+    std::fprintf(stderr,
+                 "usage: bench_local_smooth [--defaults] [n 1..64] [target] [max_visits] "
+                 "[max_iterations] [model...]\n");
     return 2;
   }
   primal::LocalSmoothOptions o;
@@ -124,13 +131,15 @@ int main(int argc, char** argv) {
     const conform::ConformResult r = conform::conform(input, co);
     const double yardstick = r.yardstick();
     const double buffer = static_cast<double>(r.interface_quads);
-    std::printf("  whole conform (defaults): %.3f s CPU, %.3f s wall, valid %s, min SJ %.4f = %.2f x the input diced alone;"
-                " its smoothing %.3f s wall, %.3f s CPU = %.2f ms CPU per buffer hex, %d patches\n",
-                static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC,
-                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
-                r.validity.ok() ? "yes" : "NO", r.smoothing.final_min_scaled_jacobian,
-                r.smoothing.final_min_scaled_jacobian / yardstick, r.smoothing.seconds,
-                r.smoothing.cpu_seconds, 1e3 * r.smoothing.cpu_seconds / buffer, r.smoothing.patches);
+    std::printf(
+        "  whole conform (defaults): %.3f s CPU, %.3f s wall, valid %s, min SJ %.4f = %.2f x the "
+        "input diced alone;"
+        " its smoothing %.3f s wall, %.3f s CPU = %.2f ms CPU per buffer hex, %d patches\n",
+        static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC,
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+        r.validity.ok() ? "yes" : "NO", r.smoothing.final_min_scaled_jacobian,
+        r.smoothing.final_min_scaled_jacobian / yardstick, r.smoothing.seconds,
+        r.smoothing.cpu_seconds, 1e3 * r.smoothing.cpu_seconds / buffer, r.smoothing.patches);
   }
   return 0;
 }

@@ -87,7 +87,8 @@ int main(int argc, char** argv) {
   const int n = argc > 1 ? std::atoi(argv[1]) : 60;
   const int repeats = argc > 2 ? std::atoi(argv[2]) : 1;
   const Model model = grid_model({2 * n, n, n}, 1.0 / n, [n](int i, int, int) { return i >= n; });
-  const fs::path dir = fs::temp_directory_path() / ("geode-bench-msh-" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("geode-bench-msh-" + std::to_string(::getpid()));
   fs::create_directories(dir);
   std::printf("model: %zu nodes, %zu hexes, %zu tets; the parent holds it (peak RSS includes it)\n",
               model.points.size(), model.hexes.size(), model.tets.size());
@@ -99,10 +100,11 @@ int main(int argc, char** argv) {
     const char* name;
     bool binary, v22;
   };
-  for (const Case& c : {Case{"4.1 ASCII", false, false}, Case{"4.1 binary", true, false}, Case{"2.2 ASCII", false, true},
-                        Case{"2.2 binary", true, true}}) {
+  for (const Case& c : {Case{"4.1 ASCII", false, false}, Case{"4.1 binary", true, false},
+                        Case{"2.2 ASCII", false, true}, Case{"2.2 binary", true, true}}) {
     for (int who = 0; who < 2; ++who) {
-      const fs::path file = dir / (std::string(who ? "gmsh-" : "geode-") + (c.binary ? "b" : "a") + (c.v22 ? "22" : "41") + ".msh");
+      const fs::path file = dir / (std::string(who ? "gmsh-" : "geode-") + (c.binary ? "b" : "a") +
+                                   (c.v22 ? "22" : "41") + ".msh");
       double best = 1e30, mem = 0;
       for (int r = 0; r < repeats; ++r) {
         const auto [s, mib] = in_child([&] {
@@ -115,9 +117,11 @@ int main(int argc, char** argv) {
         if (s < best) best = s, mem = mib;
       }
       const Model back = io::read_gmsh(file, {false});
-      std::printf("%-10s %-7s %8.3f s %8.1f MiB peak %8.1f MiB file, read back %zu hexes %zu tets\n", c.name,
-                  who ? "libgmsh" : "geode", best, mem, static_cast<double>(fs::file_size(file)) / (1 << 20),
-                  back.hexes.size(), back.tets.size());
+      std::printf(
+          "%-10s %-7s %8.3f s %8.1f MiB peak %8.1f MiB file, read back %zu hexes %zu tets\n",
+          c.name, who ? "libgmsh" : "geode", best, mem,
+          static_cast<double>(fs::file_size(file)) / (1 << 20), back.hexes.size(),
+          back.tets.size());
     }
   }
   fs::remove_all(dir);

@@ -54,13 +54,17 @@ std::vector<QuadClass> classify(const primal::Model& m, const primal::Interface&
     auto at = [&](int i) { return p[static_cast<std::size_t>(c[static_cast<std::size_t>(i)])]; };
     normal.push_back((at(2) - at(0)).cross(at(3) - at(1)).normalized());  // towards the tets
     centre.push_back((at(0) + at(1) + at(2) + at(3)) / 4.0);
-    for (int i = 0; i < 4; ++i) edges[primal::edge_key(c[static_cast<std::size_t>(i)], c[static_cast<std::size_t>((i + 1) % 4)])].push_back(q);
+    for (int i = 0; i < 4; ++i)
+      edges[primal::edge_key(c[static_cast<std::size_t>(i)],
+                             c[static_cast<std::size_t>((i + 1) % 4)])]
+          .push_back(q);
   }
-  std::map<primal::EdgeKey, double> angle;  // inside the hex part
+  std::map<primal::EdgeKey, double> angle;       // inside the hex part
   std::map<Index, std::pair<int, int>> at_node;  // convex, concave feature edges
   for (const auto& [e, qs] : edges) {
     if (qs.size() != 2) continue;
-    const double phi = std::acos(std::clamp(normal[qs[0]].dot(normal[qs[1]]), -1.0, 1.0)) * 180.0 / M_PI;
+    const double phi =
+        std::acos(std::clamp(normal[qs[0]].dot(normal[qs[1]]), -1.0, 1.0)) * 180.0 / M_PI;
     const bool convex = (centre[qs[1]] - centre[qs[0]]).dot(normal[qs[0]]) < 0.0;
     const double a = convex ? 180.0 - phi : 180.0 + phi;
     angle[e] = a;
@@ -72,8 +76,11 @@ std::vector<QuadClass> classify(const primal::Model& m, const primal::Interface&
     QuadClass k;
     double sharpest = 180.0;
     for (int i = 0; i < 4; ++i) {
-      const auto it = angle.find(primal::edge_key(q.corners[static_cast<std::size_t>(i)], q.corners[static_cast<std::size_t>((i + 1) % 4)]));
-      if (it != angle.end() && std::abs(it->second - 180.0) > std::abs(sharpest - 180.0)) sharpest = it->second;
+      const auto it =
+          angle.find(primal::edge_key(q.corners[static_cast<std::size_t>(i)],
+                                      q.corners[static_cast<std::size_t>((i + 1) % 4)]));
+      if (it != angle.end() && std::abs(it->second - 180.0) > std::abs(sharpest - 180.0))
+        sharpest = it->second;
     }
     int rank = 0;  // 3 saddle, 2 convex corner, 1 concave corner
     for (Index v : q.corners) {
@@ -82,12 +89,12 @@ std::vector<QuadClass> classify(const primal::Model& m, const primal::Interface&
       const auto [convex, concave] = it->second;
       rank = std::max(rank, convex && concave ? 3 : convex ? 2 : 1);
     }
-    k.kind = rank == 3   ? "saddle corner"
-             : rank == 2 ? "convex corner"
-             : rank == 1 ? "concave corner"
+    k.kind = rank == 3                               ? "saddle corner"
+             : rank == 2                             ? "convex corner"
+             : rank == 1                             ? "concave corner"
              : std::abs(sharpest - 180.0) < kFeature ? "flat"
-             : sharpest < 180.0                       ? "convex edge"
-                                                      : "concave edge";
+             : sharpest < 180.0                      ? "convex edge"
+                                                     : "concave edge";
     k.angle = 5.0 * std::round(sharpest / 5.0);
     out.push_back(k);
   }
@@ -100,8 +107,11 @@ std::vector<double> geode_minima(const conform::ConformResult& r) {
   for (Index b = 0; b < r.interface_quads; ++b)
     for (Index h = r.diced_hexes + 26 * b; h < r.diced_hexes + 26 * (b + 1); ++h) {
       primal::HexCorners c;
-      for (int k = 0; k < 8; ++k) c[static_cast<std::size_t>(k)] = r.model.points[static_cast<std::size_t>(r.model.hexes[static_cast<std::size_t>(h)][static_cast<std::size_t>(k)])];
-      out[static_cast<std::size_t>(b)] = std::min(out[static_cast<std::size_t>(b)], primal::hex_scaled_jacobian(c));
+      for (int k = 0; k < 8; ++k)
+        c[static_cast<std::size_t>(k)] = r.model.points[static_cast<std::size_t>(
+            r.model.hexes[static_cast<std::size_t>(h)][static_cast<std::size_t>(k)])];
+      out[static_cast<std::size_t>(b)] =
+          std::min(out[static_cast<std::size_t>(b)], primal::hex_scaled_jacobian(c));
     }
   return out;
 }
@@ -115,16 +125,19 @@ struct Row {
 
 int main(int argc, char** argv) {
   const int n = argc > 1 ? std::atoi(argv[1]) : 3;
-  const std::string csv = argc > 2 ? argv[2] : std::string(GEODE_SOURCE_DIR) + "/notebooks-data/transition-corners.csv";
+  const std::string csv =
+      argc > 2 ? argv[2] : std::string(GEODE_SOURCE_DIR) + "/notebooks-data/transition-corners.csv";
   std::vector<std::pair<std::string, std::function<primal::Model()>>> models;
   for (const char* name : {"nugget", "lshape", "potting", "cylinder"})
     models.emplace_back(name, [name, n] { return demo::demo_model(name, n); });
   for (double a : {60.0, 90.0, 120.0, 150.0, 210.0, 240.0, 270.0, 300.0})
-    models.emplace_back("wedge-" + std::to_string(static_cast<int>(a)), [a, n] { return demo::demo_wedge(n, a); });
+    models.emplace_back("wedge-" + std::to_string(static_cast<int>(a)),
+                        [a, n] { return demo::demo_wedge(n, a); });
   std::ofstream out(csv);
-  out << "model,n,kind,angle,buffer_hexes,min_sj_none,min_sj_default,min_local_ratio_default,min_local_yardstick\n";
-  std::printf("%-10s %-15s %6s %6s %9s %9s %9s %9s\n", "model", "kind", "angle", "count", "none", "default",
-              "x local", "local");
+  out << "model,n,kind,angle,buffer_hexes,min_sj_none,min_sj_default,min_local_ratio_default,min_"
+         "local_yardstick\n";
+  std::printf("%-10s %-15s %6s %6s %9s %9s %9s %9s\n", "model", "kind", "angle", "count", "none",
+              "default", "x local", "local");
   for (const auto& [name, make] : models) {
     primal::Model input;
     try {
@@ -157,14 +170,14 @@ int main(int argc, char** argv) {
     }
     for (const auto& [key, r] : rows) {
       const auto& [kind, angle] = key;
-      std::printf("%-10s %-15s %6.0f %6d %9.3f %9.3f %9.2f %9.3f\n", name.c_str(), kind.c_str(), angle, r.count, r.none,
-                  r.smoothed, r.ratio, r.local);
-      out << name << "," << n << "," << kind << "," << angle << "," << r.count << "," << r.none << "," << r.smoothed
-          << "," << r.ratio << "," << r.local << "\n";
+      std::printf("%-10s %-15s %6.0f %6d %9.3f %9.3f %9.2f %9.3f\n", name.c_str(), kind.c_str(),
+                  angle, r.count, r.none, r.smoothed, r.ratio, r.local);
+      out << name << "," << n << "," << kind << "," << angle << "," << r.count << "," << r.none
+          << "," << r.smoothed << "," << r.ratio << "," << r.local << "\n";
     }
-    std::printf("%-10s valid %s / %s, %.2f s / %.2f s (none / default), smoothing %d patches\n", name.c_str(),
-                a.validity.ok() ? "yes" : "NO", b.validity.ok() ? "yes" : "NO", a.seconds, b.seconds,
-                static_cast<int>(b.smoothing.patches));
+    std::printf("%-10s valid %s / %s, %.2f s / %.2f s (none / default), smoothing %d patches\n",
+                name.c_str(), a.validity.ok() ? "yes" : "NO", b.validity.ok() ? "yes" : "NO",
+                a.seconds, b.seconds, static_cast<int>(b.smoothing.patches));
   }
   std::printf("wrote %s\n", csv.c_str());
   return 0;

@@ -3,12 +3,12 @@
 #include <filesystem>
 #include <memory>
 
-#include "cli/commands.hpp"
-#include "cli/conventions.hpp"
-#include "cli/progress.hpp"
 #include <geode/primal/errors.hpp>
 #include <geode/templates/geode.hpp>
 #include <geode/templates/spec.hpp>
+#include "cli/commands.hpp"
+#include "cli/conventions.hpp"
+#include "cli/progress.hpp"
 
 namespace geode::cli {
 namespace {
@@ -26,19 +26,22 @@ struct ArrangeArgs {
 
 void run_arrange(const ArrangeArgs& a) {
   check_output_path(a.output);
-  const std::string format =
-      output_format(a.output, a.format, with_mesh_formats({"appendix", "csv", "json"}, {"html"}), "appendix");
+  const std::string format = output_format(
+      a.output, a.format, with_mesh_formats({"appendix", "csv", "json"}, {"html"}), "appendix");
   check_not_input(a.output, a.spec, a.force);
   const templates::ArrangementSpec spec = templates::read_spec(a.spec);
   // The smoother's constraints keep nodes on axis-aligned box faces.
   if (a.smooth && spec.domain.corners)
     throw InvalidInput(a.spec + ": --smooth needs a box domain (this spec's domain is a " +
-                       (spec.domain.is_pyramid ? "pyramid)" : spec.dim == 3 ? "hexahedron)" : "quadrilateral)"));
+                       (spec.domain.is_pyramid ? "pyramid)"
+                        : spec.dim == 3        ? "hexahedron)"
+                                               : "quadrilateral)"));
   // Many sheets take the engine a while (it meets every pair): progress after 2 s. Its
   // diagnoses name sheets and places; the file is named here.
   Progress progress = Progress::for_stderr(false);
   stc::ArrangementOptions options;
-  options.progress = [&progress, what = std::string(spec.dim == 3 ? "sheet pairs traced" : "sheets traced")](
+  options.progress = [&progress,
+                      what = std::string(spec.dim == 3 ? "sheet pairs traced" : "sheets traced")](
                          std::size_t done, std::size_t total) { progress.step(what, done, total); };
   templates::Template t;
   try {
@@ -51,10 +54,12 @@ void run_arrange(const ArrangeArgs& a) {
   const std::string name = std::filesystem::path(a.spec).stem().string();
   TemplateOutput out;
   out.name = name, out.title = "spec " + std::filesystem::path(a.spec).filename().string();
-  out.format = format, out.output = a.output, out.smooth = a.smooth, out.slide = a.slide, out.quality = a.quality;
+  out.format = format, out.output = a.output, out.smooth = a.smooth, out.slide = a.slide,
+  out.quality = a.quality;
   out.write_invalid = a.write_invalid;
   if (format == "html") out.sheets = templates::spec_sheets(spec), out.domain = spec.domain;
-  out.caption = "geode arrange " + a.spec + (a.smooth ? " --smooth" : "") + (a.slide ? " --slide" : "");
+  out.caption =
+      "geode arrange " + a.spec + (a.smooth ? " --smooth" : "") + (a.slide ? " --slide" : "");
   write_template(t, out);
 }
 
@@ -64,7 +69,8 @@ void add_arrange_command(CLI::App& app) {
   auto args = std::make_shared<ArrangeArgs>();
   CLI::App* c = app.add_subcommand(
       "arrange",
-      "Compute the arrangement of the sheets a JSON spec gives (domain, sheets, optional completion\n"
+      "Compute the arrangement of the sheets a JSON spec gives (domain, sheets, optional "
+      "completion\n"
       "block and push; format in docs/specs.md), diagnose it, dualize it and\n"
       "print or write the mesh. Exit 2 for a bad spec (naming the JSON path), 3 when the\n"
       "arrangement does not dualize (naming the sheets and the place), 4 when the mesh is invalid\n"
@@ -72,16 +78,22 @@ void add_arrange_command(CLI::App& app) {
   c->add_option("SPEC", args->spec, "the spec, a JSON file")->required();
   c->add_option("--format", args->format,
                 "appendix: node and element tables (1-based); csv; json: with sheets, their\n"
-                "intersections and the interleave checks; " + mesh_formats_help() +
-                    ":\nthe mesh (needs -o); html: a self-contained viewer of the mesh, the sheets and their\n"
+                "intersections and the interleave checks; " +
+                    mesh_formats_help() +
+                    ":\nthe mesh (needs -o); html: a self-contained viewer of the mesh, the sheets "
+                    "and their\n"
                     "layers (needs -o)")
       ->check(CLI::IsMember(with_mesh_formats({"appendix", "csv", "json"}, {"html"})));
-  c->add_option("-o,--output", args->output, "write to FILE (atomically) instead of standard output");
-  c->add_flag("--smooth", args->smooth,
-              "place the nodes by optimization (untangle, then maximise the minimum scaled Jacobian);\n"
-              "without it, nodes sit at the dual's first guess (diced positions on a completion's faces)");
-  c->add_flag("--slide", args->slide, "with --smooth: tet- and hex-side nodes slide within their faces");
-  c->add_flag("--quality", args->quality, "append the quality report (the paper's Table 1 metrics)");
+  c->add_option("-o,--output", args->output,
+                "write to FILE (atomically) instead of standard output");
+  c->add_flag(
+      "--smooth", args->smooth,
+      "place the nodes by optimization (untangle, then maximise the minimum scaled Jacobian);\n"
+      "without it, nodes sit at the dual's first guess (diced positions on a completion's faces)");
+  c->add_flag("--slide", args->slide,
+              "with --smooth: tet- and hex-side nodes slide within their faces");
+  c->add_flag("--quality", args->quality,
+              "append the quality report (the paper's Table 1 metrics)");
   add_write_invalid_flag(c, args->write_invalid);
   add_force_flag(c, args->force);
   c->callback([args] { run_arrange(*args); });

@@ -7,13 +7,13 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "cli/commands.hpp"
-#include "cli/conventions.hpp"
 #include <geode/primal/errors.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/quality_report.hpp>
 #include <geode/primal/realizability.hpp>
 #include <geode/primal/validity.hpp>
+#include "cli/commands.hpp"
+#include "cli/conventions.hpp"
 
 namespace geode::cli {
 namespace {
@@ -30,7 +30,8 @@ struct CheckArgs {
 struct Checked {
   bool valid = false;
   std::string validity;  // the report's summary
-  bool analysable = false;  // every element's nodes in range and distinct: quality and obstructions computed
+  bool analysable =
+      false;  // every element's nodes in range and distinct: quality and obstructions computed
   nlohmann::json quality;
   std::string quality_text;
   std::vector<primal::Obstruction> obstructions;
@@ -41,7 +42,8 @@ Checked check_hexes(const primal::HexMesh& mesh, const primal::RealizabilityOpti
   const auto v = primal::check_validity(mesh);
   c.valid = v.ok();
   c.validity = v.summary();
-  c.analysable = v.out_of_range_hexes.empty() && v.repeated_node_hexes.empty() && !mesh.hexes.empty();
+  c.analysable =
+      v.out_of_range_hexes.empty() && v.repeated_node_hexes.empty() && !mesh.hexes.empty();
   if (!c.analysable) return c;
   const auto q = primal::hex_quality_report(mesh);
   c.quality = primal::quality_report_json(q);
@@ -55,16 +57,19 @@ Checked check_quads(const primal::QuadMesh& mesh, const primal::RealizabilityOpt
   const auto v = primal::check_validity(mesh);
   c.valid = v.ok();
   c.validity = v.summary();
-  c.analysable = v.out_of_range_quads.empty() && v.repeated_node_quads.empty() && !mesh.quads.empty();
+  c.analysable =
+      v.out_of_range_quads.empty() && v.repeated_node_quads.empty() && !mesh.quads.empty();
   if (!c.analysable) return c;
   double lo = 1e300, hi = -1e300;
   Index at = 0;
   for (std::size_t q = 0; q < mesh.quads.size(); ++q) {
-    const double s = primal::quad_scaled_jacobian(primal::quad_corners(mesh, static_cast<Index>(q)), primal::Point::UnitZ());
+    const double s = primal::quad_scaled_jacobian(primal::quad_corners(mesh, static_cast<Index>(q)),
+                                                  primal::Point::UnitZ());
     if (s < lo) lo = s, at = static_cast<Index>(q);
     hi = std::max(hi, s);
   }
-  c.quality = {{"num_quads", mesh.quads.size()}, {"scaled_jacobian", {{"min", lo}, {"max", hi}, {"min_quad", at}}}};
+  c.quality = {{"num_quads", mesh.quads.size()},
+               {"scaled_jacobian", {{"min", lo}, {"max", hi}, {"min_quad", at}}}};
   std::ostringstream s;
   s << "Quad scaled Jacobian: min " << lo << " (quad " << at << "), max " << hi << "\n";
   c.quality_text = s.str();
@@ -80,7 +85,9 @@ void run_check(const CheckArgs& a) {
   options.planar_angle_degrees = a.planar_angle;
   Checked c = m.dim == 3 ? check_hexes(m.hex, options) : check_quads(m.quad, options);
   const Index base = m.index_base;
-  if (c.quality.contains("num_quads")) c.quality["scaled_jacobian"]["min_quad"] = c.quality["scaled_jacobian"]["min_quad"].get<Index>() + base;
+  if (c.quality.contains("num_quads"))
+    c.quality["scaled_jacobian"]["min_quad"] =
+        c.quality["scaled_jacobian"]["min_quad"].get<Index>() + base;
   if (c.quality.contains("metrics"))
     for (auto& metric : c.quality["metrics"])
       for (const char* k : {"min_hex", "max_hex"}) metric[k] = metric[k].get<Index>() + base;
@@ -93,17 +100,21 @@ void run_check(const CheckArgs& a) {
     j["valid"] = c.valid;
     j["validity"] = c.validity;
     j["quality"] = c.analysable ? c.quality : nlohmann::json();
-    j["obstructions"] = c.analysable ? primal::obstructions_json(c.obstructions, base) : nlohmann::json();
+    j["obstructions"] =
+        c.analysable ? primal::obstructions_json(c.obstructions, base) : nlohmann::json();
     text = j.dump(1) + "\n";
   } else {
     std::ostringstream s;
-    s << a.input << " (" << (m.dim == 3 ? "elements" : "quads") << " and nodes numbered from " << base << ")\n"
+    s << a.input << " (" << (m.dim == 3 ? "elements" : "quads") << " and nodes numbered from "
+      << base << ")\n"
       << c.validity;
     if (c.analysable) {
-      s << "\n" << c.quality_text << "\nrealizability: "
+      s << "\n"
+        << c.quality_text << "\nrealizability: "
         << primal::format_obstructions(c.obstructions, m.dim, base, static_cast<std::size_t>(-1));
     } else {
-      s << "\nquality and realizability not checked: some elements have out-of-range or repeated nodes\n";
+      s << "\nquality and realizability not checked: some elements have out-of-range or repeated "
+           "nodes\n";
     }
     text = s.str();
   }
@@ -116,22 +127,27 @@ void add_check_command(CLI::App& app) {
   auto a = std::make_shared<CheckArgs>();
   CLI::App* c = app.add_subcommand(
       "check",
-      "Check a hex (or planar quad) mesh: its validity as a complex (faces shared by two hexes, manifold\n"
-      "edges and vertices, closed boundary, Euler characteristic, positive corner Jacobians), its quality\n"
+      "Check a hex (or planar quad) mesh: its validity as a complex (faces shared by two hexes, "
+      "manifold\n"
+      "edges and vertices, closed boundary, Euler characteristic, positive corner Jacobians), its "
+      "quality\n"
       "(the paper's Table 1 metrics), and the combinatorial obstructions to any positive-Jacobian\n"
-      "embedding with its planar boundary faces kept planar: doublets, pinched corners, a hex with two\n"
-      "faces on one planar boundary face, flat corners, two-quad boundary nodes (primal/realizability.hpp\n"
+      "embedding with its planar boundary faces kept planar: doublets, pinched corners, a hex with "
+      "two\n"
+      "faces on one planar boundary face, flat corners, two-quad boundary nodes "
+      "(primal/realizability.hpp\n"
       "says why each blocks). Exit 0 whenever the file could be checked.");
-  c->add_option("mesh", a->input, hex_or_quad_input_help())
-      ->required();
+  c->add_option("mesh", a->input, hex_or_quad_input_help())->required();
   c->add_option("--format", a->format,
-                "text, or json: {\"valid\", \"validity\", \"quality\", \"obstructions\": [{\"kind\", \"hexes\", \"nodes\"}]}\n"
+                "text, or json: {\"valid\", \"validity\", \"quality\", \"obstructions\": "
+                "[{\"kind\", \"hexes\", \"nodes\"}]}\n"
                 "with ids as the file numbers them (\"index_base\")")
       ->check(CLI::IsMember({"text", "json"}))
       ->capture_default_str();
   c->add_option("-o,--output", a->output, "Write the report here instead of standard output");
   c->add_option("--planar-angle", a->planar_angle,
-                "boundary quads whose normals differ by less than this many degrees (and that lie in one plane)\n"
+                "boundary quads whose normals differ by less than this many degrees (and that lie "
+                "in one plane)\n"
                 "form one planar boundary face")
       ->check(CLI::Range(0.0, 90.0))
       ->capture_default_str();

@@ -10,11 +10,11 @@
 #include <string>
 #include <vector>
 
-#include <geode/viewer/html.hpp>
 #include <geode/primal/model.hpp>
 #include <geode/primal/smooth.hpp>
 #include <geode/stc/arrangement.hpp>
 #include <geode/stc/sheet.hpp>
+#include <geode/viewer/html.hpp>
 
 namespace geode::templates {
 struct Template;
@@ -22,14 +22,14 @@ struct Template;
 
 namespace geode::cli {
 
-void add_template_command(CLI::App& app);   // cli/template_command.cpp
-void add_study_commands(CLI::App& app);     // cli/study_command.cpp
-void add_conform_commands(CLI::App& app);   // cli/conform_command.cpp: conform, demo
-void add_dual_command(CLI::App& app);       // cli/dual_command.cpp
-void add_check_command(CLI::App& app);      // cli/check_command.cpp
-void add_arrange_command(CLI::App& app);    // cli/arrange_command.cpp
-void add_view_command(CLI::App& app);       // cli/view_command.cpp
-void add_formats_command(CLI::App& app);    // cli/formats_command.cpp
+void add_template_command(CLI::App& app);  // cli/template_command.cpp
+void add_study_commands(CLI::App& app);    // cli/study_command.cpp
+void add_conform_commands(CLI::App& app);  // cli/conform_command.cpp: conform, demo
+void add_dual_command(CLI::App& app);      // cli/dual_command.cpp
+void add_check_command(CLI::App& app);     // cli/check_command.cpp
+void add_arrange_command(CLI::App& app);   // cli/arrange_command.cpp
+void add_view_command(CLI::App& app);      // cli/view_command.cpp
+void add_formats_command(CLI::App& app);   // cli/formats_command.cpp
 
 // Shared by the commands (cli/files.cpp): the extension in lower case (".msh"), and a model
 // read by extension and checked content (io/read_model.hpp, any format of io/formats.hpp);
@@ -51,9 +51,10 @@ MeshFile read_mesh_file(const std::filesystem::path& path);
 // The sheets of a computed arrangement for the HTML viewer (cli/view_command.cpp): each sheet
 // contoured from its field inside the domain (stc/sheet_surfaces.hpp), its points mapped by
 // `to_physical` (identity when empty), and its layer read off the dual's element_sheets.
-std::vector<viewer::ViewSheet> arrangement_view_sheets(const std::vector<stc::Sheet>& sheets, const stc::Domain& domain,
-                                                       const std::vector<std::vector<int>>& element_sheets,
-                                                       const std::function<primal::Point(const primal::Point&)>& to_physical);
+std::vector<viewer::ViewSheet> arrangement_view_sheets(
+    const std::vector<stc::Sheet>& sheets, const stc::Domain& domain,
+    const std::vector<std::vector<int>>& element_sheets,
+    const std::function<primal::Point(const primal::Point&)>& to_physical);
 
 // Standard output when `path` is empty or "-", else the file, written atomically.
 void write_or_print(const std::string& path, const std::function<void(std::ostream&)>& write);
@@ -74,7 +75,7 @@ struct TemplateOutput {
   // An invalid mesh (cli/conventions.hpp invalid_mesh_reason) is refused (exit 4, nothing
   // written) unless this is set; it is then written and the exit code is still 4.
   bool write_invalid = false;
-  std::string note;              // e.g. what a fix-up did; printed with the smoothing note
+  std::string note;  // e.g. what a fix-up did; printed with the smoothing note
   // Replaces templates::smooth_template (e.g. the refinement template's own smoothing).
   std::function<primal::SmoothResult(templates::Template&)> smoother;
   // --format html: the arrangement's sheets and domain (contoured for the viewer), the map from

@@ -8,16 +8,16 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "cli/commands.hpp"
-#include "cli/conventions.hpp"
-#include "cli/progress.hpp"
 #include <geode/conform/conform.hpp>
-#include <geode/demo/demo_models.hpp>
 #include <geode/conform/report.hpp>
+#include <geode/demo/demo_models.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/quality_report.hpp>
 #include <geode/primal/topology.hpp>
+#include "cli/commands.hpp"
+#include "cli/conventions.hpp"
+#include "cli/progress.hpp"
 
 namespace geode::cli {
 namespace {
@@ -56,25 +56,25 @@ void print_summary(const conform::ConformResult& r, std::ostream& os, bool table
   os << "output: " << r.model.hexes.size() << " hexes (" << r.diced_hexes << " diced hex, "
      << r.geode_hexes << " geode, " << r.diced_tet_hexes << " diced tet";
   if (r.diced_wedge_hexes) os << ", " << r.diced_wedge_hexes << " diced wedge";
-  os << "), "
-     << r.model.points.size() << " nodes, " << (conform::result_valid(r) ? "valid" : "INVALID") << ", "
-     << r.seconds << " s\n";
+  os << "), " << r.model.points.size() << " nodes, "
+     << (conform::result_valid(r) ? "valid" : "INVALID") << ", " << r.seconds << " s\n";
   for (const auto& b : r.quality) {
     os << "block " << b.block << " \"" << b.name << "\": " << b.report.num_hexes
-       << " hexes, min scaled Jacobian " << conform::block_min_scaled_jacobian(b.report) << " (diced alone "
-       << b.input_diced_min_scaled_jacobian << ")";
+       << " hexes, min scaled Jacobian " << conform::block_min_scaled_jacobian(b.report)
+       << " (diced alone " << b.input_diced_min_scaled_jacobian << ")";
     // Its geode hexes against the input cells around their buffer hexes (the local yardstick).
     if (b.geode_hexes > 0)
-      os << "; " << b.geode_hexes << " geode hexes, min " << b.geode_min_scaled_jacobian << ", local yardstick "
-         << b.local_yardstick << ", >= " << b.local_ratio << " x their own";
+      os << "; " << b.geode_hexes << " geode hexes, min " << b.geode_min_scaled_jacobian
+         << ", local yardstick " << b.local_yardstick << ", >= " << b.local_ratio << " x their own";
     os << "\n";
     if (tables) os << primal::format_quality_table(b.report) << "\n";
   }
   // The transition against the input's own elements diced alone (the yardstick).
   const double yardstick = r.yardstick();
   const double output = conform::output_min_scaled_jacobian(r);
-  os << "input diced alone: min scaled Jacobian " << r.input_diced_hex_min_scaled_jacobian << " (hexes), "
-     << r.input_diced_tet_min_scaled_jacobian << " (tets" << (r.input_pyramids ? ", pyramids as their two tets" : "") << ")";
+  os << "input diced alone: min scaled Jacobian " << r.input_diced_hex_min_scaled_jacobian
+     << " (hexes), " << r.input_diced_tet_min_scaled_jacobian << " (tets"
+     << (r.input_pyramids ? ", pyramids as their two tets" : "") << ")";
   if (r.input_wedges) os << ", " << r.input_diced_wedge_min_scaled_jacobian << " (wedges)";
   os << "; output " << output;
   if (yardstick > 0) os << " = " << output / yardstick << " x the lower";
@@ -93,12 +93,14 @@ std::string check_outputs(const ConformArgs& a) {
   if (const double most = conform::max_buffer_thickness(conform::parse_buffer_side(a.buffer_side));
       a.buffer_thickness > most) {
     std::ostringstream m;
-    m << "--buffer-thickness " << a.buffer_thickness << " with --buffer-side " << a.buffer_side << ": at most " << most;
+    m << "--buffer-thickness " << a.buffer_thickness << " with --buffer-side " << a.buffer_side
+      << ": at most " << most;
     throw InvalidInput(m.str());
   }
   std::string format;
   if (!a.output.empty()) {
-    if (a.output == "-") throw InvalidInput("-o -: a mesh is written to a file, not to standard output");
+    if (a.output == "-")
+      throw InvalidInput("-o -: a mesh is written to a file, not to standard output");
     check_output_path(a.output);
     format = output_format(a.output, a.format, mesh_format_names(), "");
   } else if (!a.format.empty()) {
@@ -111,7 +113,8 @@ std::string check_outputs(const ConformArgs& a) {
     if (!a.output.empty() && fs::weakly_canonical(a.report) == fs::weakly_canonical(a.output))
       throw InvalidInput(a.report + ": the report and the mesh are the same file");
   }
-  for (const std::string* out : {&a.output, &a.report, &a.save_input}) check_not_input(*out, a.input, a.force);
+  for (const std::string* out : {&a.output, &a.report, &a.save_input})
+    check_not_input(*out, a.input, a.force);
   return format;
 }
 
@@ -130,9 +133,10 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
     const auto scan = [&](const auto& cells, const auto& edges, bool hex) {
       for (std::size_t e = 0; e < cells.size(); ++e)
         for (const auto& ed : edges) {
-          const double l = (model.points[static_cast<std::size_t>(cells[e][static_cast<std::size_t>(ed[0])])] -
-                            model.points[static_cast<std::size_t>(cells[e][static_cast<std::size_t>(ed[1])])])
-                               .norm();
+          const double l =
+              (model.points[static_cast<std::size_t>(cells[e][static_cast<std::size_t>(ed[0])])] -
+               model.points[static_cast<std::size_t>(cells[e][static_cast<std::size_t>(ed[1])])])
+                  .norm();
           if (l < shortest) shortest = l, where = static_cast<primal::Index>(e), in_hex = hex;
         }
     };
@@ -140,9 +144,12 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
     scan(model.tets, primal::topology::kTetEdgeCorners, false);
     if (a.merge_tolerance >= shortest) {
       std::ostringstream m;
-      m << prefix << "--merge-tolerance " << a.merge_tolerance << " is not below the shortest element edge, " << shortest
-        << " (" << primal::describe_element(model, {in_hex ? primal::ElementKind::Hex : primal::ElementKind::Tet, where})
-        << "): it would merge an element's own nodes; give a distance below that edge (and above the gap between "
+      m << prefix << "--merge-tolerance " << a.merge_tolerance
+        << " is not below the shortest element edge, " << shortest << " ("
+        << primal::describe_element(
+               model, {in_hex ? primal::ElementKind::Hex : primal::ElementKind::Tet, where})
+        << "): it would merge an element's own nodes; give a distance below that edge (and above "
+           "the gap between "
         << "duplicated interface nodes)";
       throw InvalidInput(m.str());
     }
@@ -167,9 +174,11 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
   try {
     r = conform::conform(model, opts);
   } catch (const InvalidInput& e) {
-    throw InvalidInput(prefix + e.what() + conform::duplicate_node_hint(model, "--merge-tolerance"));
+    throw InvalidInput(prefix + e.what() +
+                       conform::duplicate_node_hint(model, "--merge-tolerance"));
   } catch (const TopologyError& e) {
-    throw TopologyError(prefix + e.what() + conform::duplicate_node_hint(model, "--merge-tolerance"));
+    throw TopologyError(prefix + e.what() +
+                        conform::duplicate_node_hint(model, "--merge-tolerance"));
   }
   const bool valid = conform::result_valid(r);
   if (valid || a.write_invalid) {
@@ -202,34 +211,39 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
 
 // Options conform and demo share: where to write, the report, smoothing, quiet.
 void add_run_options(CLI::App* c, ConformArgs& a) {
-  c->add_option("-o,--output", a.output,
-                "output mesh; the format follows the extension (" + mesh_formats_help() +
-                    ");\nwritten only if the result is valid (see --write-invalid), together with --report\n"
-                    "(both or neither)");
+  c->add_option(
+      "-o,--output", a.output,
+      "output mesh; the format follows the extension (" + mesh_formats_help() +
+          ");\nwritten only if the result is valid (see --write-invalid), together with --report\n"
+          "(both or neither)");
   c->add_option("--format", a.format,
                 "mesh format, when it must be named (msh22 for Gmsh 2.2 in a .msh); one that\n"
                 "contradicts the extension of -o is refused")
       ->check(CLI::IsMember(mesh_format_names()));
-  c->add_option("--vtu-encoding", a.vtu_encoding, "binary (base64, default) or ascii DataArrays in .vtu")
+  c->add_option("--vtu-encoding", a.vtu_encoding,
+                "binary (base64, default) or ascii DataArrays in .vtu")
       ->check(CLI::IsMember({"binary", "ascii"}))
       ->capture_default_str();
-  c->add_option("--report", a.report, "write a JSON report (counts, validity, quality per output block) to FILE.json");
-  c->add_option("--smooth", a.smooth,
-                "worst-first smoothing; materials never move: nodes on the model boundary and between\n"
-                "blocks slide only in their plane or along their straight edge, and are fixed on curved\n"
-                "surfaces and at corners, so every block keeps its volume; local (default): near the\n"
-                "geode hexes (see --smooth-target); global: every hex below min(0.5, 3 x the input diced\n"
-                "alone), then local's passes where a hex is still below its aim; none: only hexes the\n"
-                "placement inverted are untangled (the report counts them)")
+  c->add_option("--report", a.report,
+                "write a JSON report (counts, validity, quality per output block) to FILE.json");
+  c->add_option(
+       "--smooth", a.smooth,
+       "worst-first smoothing; materials never move: nodes on the model boundary and between\n"
+       "blocks slide only in their plane or along their straight edge, and are fixed on curved\n"
+       "surfaces and at corners, so every block keeps its volume; local (default): near the\n"
+       "geode hexes (see --smooth-target); global: every hex below min(0.5, 3 x the input diced\n"
+       "alone), then local's passes where a hex is still below its aim; none: only hexes the\n"
+       "placement inverted are untangled (the report counts them)")
       ->check(CLI::IsMember({"local", "global", "none"}))
       ->capture_default_str();
-  c->add_option("--smooth-target", a.smooth_target,
-                "local smoothing: 0 (default) works where a hex is below its aim: the input's own hexes\n"
-                "and tets diced alone (the yardstick); for a geode hex 0.9 x its local yardstick (the\n"
-                "input cells around its buffer hex, diced alone; capped by the template's own minimum);\n"
-                "for a diced hex 0.5 x its input hex diced alone; on hexes below 1.1 x their aim around\n"
-                "those until none is below it, again where they remain (up to 8 passes); a value > 0\n"
-                "works on every geode hex and neighbour below it (e.g. 0.35: more quality, more time)")
+  c->add_option(
+       "--smooth-target", a.smooth_target,
+       "local smoothing: 0 (default) works where a hex is below its aim: the input's own hexes\n"
+       "and tets diced alone (the yardstick); for a geode hex 0.9 x its local yardstick (the\n"
+       "input cells around its buffer hex, diced alone; capped by the template's own minimum);\n"
+       "for a diced hex 0.5 x its input hex diced alone; on hexes below 1.1 x their aim around\n"
+       "those until none is below it, again where they remain (up to 8 passes); a value > 0\n"
+       "works on every geode hex and neighbour below it (e.g. 0.35: more quality, more time)")
       ->check(number_check(0, 1))
       ->capture_default_str();
   c->add_option("--quality", a.quality,
@@ -237,42 +251,52 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
                 "metric of the paper's Table 1 per block")
       ->check(CLI::IsMember({"sj", "full"}))
       ->capture_default_str();
-  c->add_option("--geode-block", a.geode_block,
-                "put the geode hexes in a block of their own with this name (id one above every\n"
-                "input block); by default each goes to the block of the element its buffer hex was carved\n"
-                "from (the hex under it; with --buffer-side tet, the tet above it)");
+  c->add_option(
+      "--geode-block", a.geode_block,
+      "put the geode hexes in a block of their own with this name (id one above every\n"
+      "input block); by default each goes to the block of the element its buffer hex was carved\n"
+      "from (the hex under it; with --buffer-side tet, the tet above it)");
   c->add_option("--merge-tolerance", a.merge_tolerance,
                 "first merge nodes closer than this distance (model units), for parts meshed\n"
                 "separately whose interface nodes are duplicated")
       ->check(number_check(0, 1e300));
-  c->add_option("--pyramids", a.pyramids,
-                "what pyramids of a hybrid mesh become: split (default): two tets along the base diagonal\n"
-                "giving the better tets, the base quad then getting the geode transition")
+  c->add_option(
+       "--pyramids", a.pyramids,
+       "what pyramids of a hybrid mesh become: split (default): two tets along the base diagonal\n"
+       "giving the better tets, the base quad then getting the geode transition")
       ->capture_default_str();
-  c->add_option("--buffer-side", a.buffer_side,
-                "the part the buffer layer is carved from: hex (default; the tets stay as meshed, the\n"
-                "hexes at the interface are squashed) or tet (the hexes stay, the tets shrink off the interface)")
+  c->add_option(
+       "--buffer-side", a.buffer_side,
+       "the part the buffer layer is carved from: hex (default; the tets stay as meshed, the\n"
+       "hexes at the interface are squashed) or tet (the hexes stay, the tets shrink off the "
+       "interface)")
       ->check(CLI::IsMember({"hex", "tet"}))
       ->capture_default_str();
-  c->add_option("--buffer-thickness", a.buffer_thickness,
-                "how far that part shrinks off the interface (the buffer layer's thickness), as a fraction\n"
-                "of the shortest edge at each interface node; default 0.5 with --buffer-side hex (at most 0.9),\n"
-                "0.3 with tet (at most 0.45)")
+  c->add_option(
+       "--buffer-thickness", a.buffer_thickness,
+       "how far that part shrinks off the interface (the buffer layer's thickness), as a fraction\n"
+       "of the shortest edge at each interface node; default 0.5 with --buffer-side hex (at most "
+       "0.9),\n"
+       "0.3 with tet (at most 0.45)")
       ->check(number_check(0.01, conform::max_buffer_thickness(conform::BufferSide::kHex)));
-  c->add_option("--feature-thickness", a.feature_thickness,
-                "at convex interface corners (faces in three directions more than 30 degrees apart) the\n"
-                "layer is this fraction of its thickness: buffer hexes there taper by their height in two\n"
-                "directions, a thinner layer keeps the geode nearer a box (1: as thick as elsewhere)")
+  c->add_option(
+       "--feature-thickness", a.feature_thickness,
+       "at convex interface corners (faces in three directions more than 30 degrees apart) the\n"
+       "layer is this fraction of its thickness: buffer hexes there taper by their height in two\n"
+       "directions, a thinner layer keeps the geode nearer a box (1: as thick as elsewhere)")
       ->check(number_check(0.1, 1))
       ->capture_default_str();
-  c->add_option("--template-box", a.template_box,
-                "proportions WxHxD of the box the reference geode template is smoothed in once per\n"
-                "run (H: the buffer hex's thickness direction; default 24x12x24, near the buffer hexes' own;\n"
-                "24x10x24 suits --buffer-side tet)");
+  c->add_option(
+      "--template-box", a.template_box,
+      "proportions WxHxD of the box the reference geode template is smoothed in once per\n"
+      "run (H: the buffer hex's thickness direction; default 24x12x24, near the buffer hexes' "
+      "own;\n"
+      "24x10x24 suits --buffer-side tet)");
   c->add_flag("--write-invalid", a.write_invalid,
               "write the mesh and report even when verification fails (the exit code is still 4)");
   add_force_flag(c, a.force);
-  c->add_flag("--quiet", a.quiet, "no progress and no summary (errors and the invalid-result message still print)");
+  c->add_flag("--quiet", a.quiet,
+              "no progress and no summary (errors and the invalid-result message still print)");
 }
 
 }  // namespace
@@ -282,10 +306,13 @@ void add_conform_commands(CLI::App& app) {
   CLI::App* c = app.add_subcommand(
       "conform",
       "Conform the hex part of a model to its tet part with geode templates: buffer layer, dicing\n"
-      "(8 per hex, 4 per tet), 26 geode hexes per interface quad split into two triangles (44 hexes of\n"
-      "the superquadric-dome four-triangle template where the tet side splits a quad into four triangles\n"
+      "(8 per hex, 4 per tet), 26 geode hexes per interface quad split into two triangles (44 "
+      "hexes of\n"
+      "the superquadric-dome four-triangle template where the tet side splits a quad into four "
+      "triangles\n"
       "around a centre node), smoothing where the result is below the input's own diced elements.\n"
-      "Input element blocks, node sets and side sets are carried to the output. Exit 4 when the result\n"
+      "Input element blocks, node sets and side sets are carried to the output. Exit 4 when the "
+      "result\n"
       "fails verification.");
   c->add_option("INPUT", args->input, "input model (" + input_extensions_help() + ")")->required();
   add_run_options(c, *args);
@@ -296,28 +323,34 @@ void add_conform_commands(CLI::App& app) {
 
   auto dargs = std::make_shared<ConformArgs>();
   CLI::App* d = app.add_subcommand(
-      "demo", "Build a demo model with the Gmsh API (--model) and conform it, printing the quality\n"
-              "report per block; --save-input writes the model itself.");
-  d->add_option("--model", dargs->model,
-                 "half: structured hexes beside Kuhn-split transfinite tets (default); delaunay,\n"
-                 "delaunay-random: beside a Delaunay tet box, interface diagonals alternating or\n"
-                 "random; cylinder: a swept hex cylinder with unstructured quad caps in a tet box;\n"
-                 "lshape: a hex block in the notch of an L-shaped tet part (concave interface);\n"
-                 "nugget: a Delaunay tet cube in 26 structured blocks; fulcher: the same with circles\n"
-                 "imprinted on three nugget faces, those blocks swept from unstructured quads; fourtri:\n"
-                 "beside a Delaunay tet box whose interface quads are split into two or four triangles\n"
-                 "(at random); fourtri-cylinder: the cylinder with half its interface quads in four triangles;\n"
-                 "hybrid meshes Gmsh makes in one generate(3), with its pyramids: hybrid (a transfinite hex\n"
-                 "box beside a Delaunay tet box), hybrid-cylinder (a swept hex cylinder in a Delaunay box),\n"
-                 "boundary-layer (wedge layers extruded on a tet box), hexdominant (hexes, tets, pyramids\n"
-                 "and wedges side by side); potting: six hex parts (boxes, swept cylinders, a tilted box, an\n"
-                 "L bracket), each its own block, in a Delaunay tet potting (n >= 2)")
+      "demo",
+      "Build a demo model with the Gmsh API (--model) and conform it, printing the quality\n"
+      "report per block; --save-input writes the model itself.");
+  d->add_option(
+       "--model", dargs->model,
+       "half: structured hexes beside Kuhn-split transfinite tets (default); delaunay,\n"
+       "delaunay-random: beside a Delaunay tet box, interface diagonals alternating or\n"
+       "random; cylinder: a swept hex cylinder with unstructured quad caps in a tet box;\n"
+       "lshape: a hex block in the notch of an L-shaped tet part (concave interface);\n"
+       "nugget: a Delaunay tet cube in 26 structured blocks; fulcher: the same with circles\n"
+       "imprinted on three nugget faces, those blocks swept from unstructured quads; fourtri:\n"
+       "beside a Delaunay tet box whose interface quads are split into two or four triangles\n"
+       "(at random); fourtri-cylinder: the cylinder with half its interface quads in four "
+       "triangles;\n"
+       "hybrid meshes Gmsh makes in one generate(3), with its pyramids: hybrid (a transfinite hex\n"
+       "box beside a Delaunay tet box), hybrid-cylinder (a swept hex cylinder in a Delaunay box),\n"
+       "boundary-layer (wedge layers extruded on a tet box), hexdominant (hexes, tets, pyramids\n"
+       "and wedges side by side); potting: six hex parts (boxes, swept cylinders, a tilted box, "
+       "an\n"
+       "L bracket), each its own block, in a Delaunay tet potting (n >= 2)")
       ->check(CLI::IsMember(demo::demo_model_names()))
       ->capture_default_str();
-  d->add_option("-n,--size", dargs->n, "cells per unit length (1 to 64; default 4; nugget, fulcher round up to even)")
+  d->add_option("-n,--size", dargs->n,
+                "cells per unit length (1 to 64; default 4; nugget, fulcher round up to even)")
       ->check(number_check(1, 64, true));
   d->add_option("--save-input", dargs->save_input,
-                "write the demo's input model (" + io::extension_list(io::FormatRole::kWrite, ", ", ", ") +
+                "write the demo's input model (" +
+                    io::extension_list(io::FormatRole::kWrite, ", ", ", ") +
                     ") to try `geode conform` on it;\nwithout -o or --report nothing is conformed");
   add_run_options(d, *dargs);
   d->callback([dargs] {
@@ -336,8 +369,8 @@ void add_conform_commands(CLI::App& app) {
       files.commit();
       if (!dargs->quiet)
         std::cout << "wrote " << dargs->save_input << " (" << model.hexes.size() << " hexes, "
-                  << model.tets.size() << " tets, " << model.pyramids.size() << " pyramids, " << model.wedges.size()
-                  << " wedges)\n";
+                  << model.tets.size() << " tets, " << model.pyramids.size() << " pyramids, "
+                  << model.wedges.size() << " wedges)\n";
       if (dargs->output.empty() && dargs->report.empty()) return;
     }
     run(std::move(model), *dargs, format, true);

@@ -9,10 +9,10 @@
 #include <optional>
 #include <sstream>
 
-#include "cli/commands.hpp"
-#include <geode/primal/errors.hpp>
 #include <geode/io/atomic_file.hpp>
+#include <geode/primal/errors.hpp>
 #include <geode/primal/validity.hpp>
+#include "cli/commands.hpp"
 
 #ifndef GEODE_VERSION
 #define GEODE_VERSION "unknown"
@@ -53,7 +53,8 @@ const std::vector<FormatInfo>& formats() {
   static const std::vector<FormatInfo> table = [] {
     std::vector<FormatInfo> t;
     for (const io::MeshFormat& f : io::mesh_formats())
-      if (f.write) t.push_back({std::string(f.name), {f.extensions.begin(), f.extensions.end()}, true});
+      if (f.write)
+        t.push_back({std::string(f.name), {f.extensions.begin(), f.extensions.end()}, true});
     for (FormatInfo text : std::vector<FormatInfo>{{"json", {".json"}, false},
                                                    {"spec", {".json"}, false},
                                                    {"csv", {".csv"}, false},
@@ -94,7 +95,8 @@ CLI::Validator number_check(double lo, double hi, bool integer) {
 }
 
 std::array<double, 3> parse_box(const std::string& option, const std::string& text, int dim) {
-  const std::string expected = dim == 3 ? "WIDTHxHEIGHTxDEPTH such as 24x14x24" : "WIDTHxHEIGHT such as 24x14";
+  const std::string expected =
+      dim == 3 ? "WIDTHxHEIGHTxDEPTH such as 24x14x24" : "WIDTHxHEIGHT such as 24x14";
   std::vector<std::string> parts;
   std::string part;
   for (char c : text) {
@@ -123,7 +125,9 @@ std::array<double, 3> parse_box(const std::string& option, const std::string& te
   if (dim == 2) box[2] = box[0];
   const auto [lo, hi] = std::minmax_element(box.begin(), box.begin() + dim);
   if (*hi > 1e4 * *lo)
-    throw InvalidInput(option + " '" + text + "': degenerate box (the largest dimension is more than 1e4 times the smallest)");
+    throw InvalidInput(
+        option + " '" + text +
+        "': degenerate box (the largest dimension is more than 1e4 times the smallest)");
   return box;
 }
 
@@ -147,7 +151,8 @@ std::string output_format(const std::string& path, const std::string& format,
     const FormatInfo* f = find_format(name);
     if (!f) continue;
     for (const auto& x : f->extensions) {
-      if (std::find(extensions.begin(), extensions.end(), x) == extensions.end()) extensions.push_back(x);
+      if (std::find(extensions.begin(), extensions.end(), x) == extensions.end())
+        extensions.push_back(x);
       if (x == e) by_extension.push_back(name);
     }
   }
@@ -155,9 +160,11 @@ std::string output_format(const std::string& path, const std::string& format,
     // A text format may go to a file of any other name (report.out); a mesh needs its extension.
     bool known_elsewhere = false;
     for (const auto& f : formats())
-      known_elsewhere |= std::find(f.extensions.begin(), f.extensions.end(), e) != f.extensions.end();
+      known_elsewhere |=
+          std::find(f.extensions.begin(), f.extensions.end(), e) != f.extensions.end();
     if (!format.empty() && !is_mesh_format(format) && !known_elsewhere) return format;
-    throw InvalidInput(path + ": unknown output format '" + e + "' (expected " + join(extensions) + ")");
+    throw InvalidInput(path + ": unknown output format '" + e + "' (expected " + join(extensions) +
+                       ")");
   }
   if (format.empty()) return by_extension.front();  // .msh: msh (4.1) before msh22
   if (std::find(by_extension.begin(), by_extension.end(), format) == by_extension.end())
@@ -172,7 +179,8 @@ void check_output_path(const std::string& path) {
   std::error_code ec;
   if (fs::is_directory(p, ec)) throw InvalidInput(path + ": is a directory, not an output file");
   const fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
-  if (!fs::is_directory(dir, ec)) throw InvalidInput(path + ": directory " + dir.string() + " does not exist");
+  if (!fs::is_directory(dir, ec))
+    throw InvalidInput(path + ": directory " + dir.string() + " does not exist");
   if (::access(dir.c_str(), W_OK | X_OK) != 0)
     throw InvalidInput(path + ": directory " + dir.string() + " is not writable");
   if (fs::exists(p, ec) && ::access(p.c_str(), W_OK) != 0)
@@ -183,7 +191,8 @@ void check_not_input(const std::string& output, const std::string& input, bool f
   if (force || output.empty() || output == "-" || input.empty()) return;
   std::error_code ec;
   if (fs::equivalent(output, input, ec) && !ec)
-    throw InvalidInput(output + ": is the input file " + input + "; writing it would destroy the input (--force overwrites it)");
+    throw InvalidInput(output + ": is the input file " + input +
+                       "; writing it would destroy the input (--force overwrites it)");
 }
 
 CLI::Option* add_force_flag(CLI::App* app, bool& flag) {
@@ -194,7 +203,8 @@ std::vector<std::string> mesh_format_names(bool quads) {
   return io::format_names(quads ? io::FormatRole::kWriteQuads : io::FormatRole::kWrite);
 }
 
-std::vector<std::string> with_mesh_formats(std::vector<std::string> before, const std::vector<std::string>& after) {
+std::vector<std::string> with_mesh_formats(std::vector<std::string> before,
+                                           const std::vector<std::string>& after) {
   for (const auto& f : mesh_format_names()) before.push_back(f);
   before.insert(before.end(), after.begin(), after.end());
   return before;
@@ -206,12 +216,15 @@ std::string mesh_formats_help(bool quads) {
     if (!(quads ? f.write_quads != nullptr : f.write != nullptr)) continue;
     std::string ext;
     for (std::string_view e : f.extensions) ext += " " + std::string(e);
-    s += (s.empty() ? "" : ", ") + std::string(f.name) + " (" + std::string(f.title) + "," + ext + ")";
+    s += (s.empty() ? "" : ", ") + std::string(f.name) + " (" + std::string(f.title) + "," + ext +
+         ")";
   }
   return s;
 }
 
-std::string input_extensions_help() { return io::extension_list(io::FormatRole::kRead, ", ", ", "); }
+std::string input_extensions_help() {
+  return io::extension_list(io::FormatRole::kRead, ", ", ", ");
+}
 
 std::string hex_or_quad_input_help() {
   return "All-hex mesh (" + input_extensions_help() + ") or planar quad mesh in z = 0 (" +
@@ -230,7 +243,8 @@ namespace {
 
 // "3 hexes with a repeated node: 2 5 9": a count, what they are, and the first few ids.
 template <class T, class Show>
-void finding(std::vector<std::string>& out, const std::vector<T>& items, const std::string& what, Show&& show) {
+void finding(std::vector<std::string>& out, const std::vector<T>& items, const std::string& what,
+             Show&& show) {
   if (items.empty()) return;
   std::string s = std::to_string(items.size()) + " " + what + ":";
   for (std::size_t i = 0; i < items.size() && i < 5; ++i) s += " " + show(items[i]);
@@ -263,11 +277,14 @@ std::string invalid_mesh_reason(const primal::HexMesh& mesh, primal::Index base)
   finding(f, r.out_of_range_hexes, "hexes with a node out of range", id);
   finding(f, r.non_finite_nodes, "nodes with a non-finite coordinate", id);
   finding(f, r.repeated_node_hexes, "hexes with a repeated node", id);
-  finding(f, r.inverted_hexes, "of " + std::to_string(r.num_hexes) + " hexes inverted (a corner Jacobian <= 0), hexes", id);
+  finding(f, r.inverted_hexes,
+          "of " + std::to_string(r.num_hexes) + " hexes inverted (a corner Jacobian <= 0), hexes",
+          id);
   finding(f, r.overlapping_nodes, "nodes covered more than once (overlapping hexes), nodes",
           [base](const primal::NodeCoverage& c) { return std::to_string(c.node + base); });
   finding(f, r.overshared_faces, "faces in more than two hexes, by their nodes", face);
-  finding(f, r.misoriented_faces, "faces seen in the same order by both hexes, by their nodes", face);
+  finding(f, r.misoriented_faces, "faces seen in the same order by both hexes, by their nodes",
+          face);
   finding(f, r.nonmanifold_edges, "non-manifold edges, by their nodes", edge);
   finding(f, r.nonmanifold_vertices, "non-manifold nodes", id);
   if (!r.boundary.closed) f.push_back("the boundary is not closed");
@@ -284,7 +301,8 @@ std::string invalid_mesh_reason(const primal::QuadMesh& mesh, primal::Index base
   finding(f, r.out_of_range_quads, "quads with a node out of range", id);
   finding(f, r.non_finite_nodes, "nodes with a non-finite coordinate", id);
   finding(f, r.repeated_node_quads, "quads with a repeated node", id);
-  finding(f, r.inverted_quads, "of " + std::to_string(r.num_quads) + " quads inverted (a corner <= 0), quads", id);
+  finding(f, r.inverted_quads,
+          "of " + std::to_string(r.num_quads) + " quads inverted (a corner <= 0), quads", id);
   finding(f, r.overlapping_nodes, "nodes covered more than once (overlapping quads), nodes",
           [base](const primal::NodeCoverage& c) { return std::to_string(c.node + base); });
   finding(f, r.overshared_edges, "edges in more than two quads, by their nodes", edge);
@@ -295,11 +313,14 @@ std::string invalid_mesh_reason(const primal::QuadMesh& mesh, primal::Index base
   return joined(f);
 }
 
-primal::Index output_index_base(const std::string& format) { return format == "vtu" || format == "vtk" ? 0 : 1; }
+primal::Index output_index_base(const std::string& format) {
+  return format == "vtu" || format == "vtk" ? 0 : 1;
+}
 
 void refuse_invalid(const std::string& what, const std::string& reason, bool write_invalid) {
   if (reason.empty() || write_invalid) return;
-  throw InvalidResult(what + " is invalid: " + reason + " (nothing written; --write-invalid writes it anyway)");
+  throw InvalidResult(what + " is invalid: " + reason +
+                      " (nothing written; --write-invalid writes it anyway)");
 }
 
 void invalid_written(const std::string& what, const std::string& reason) {
@@ -308,10 +329,11 @@ void invalid_written(const std::string& what, const std::string& reason) {
 }
 
 CLI::Option* add_write_invalid_flag(CLI::App* app, bool& flag) {
-  return app->add_flag("--write-invalid", flag,
-                       "write the mesh even when it fails the validity check (inverted or overlapping cells,\n"
-                       "faces not shared by two cells); the exit code is still 4. Without it an invalid mesh\n"
-                       "is not written");
+  return app->add_flag(
+      "--write-invalid", flag,
+      "write the mesh even when it fails the validity check (inverted or overlapping cells,\n"
+      "faces not shared by two cells); the exit code is still 4. Without it an invalid mesh\n"
+      "is not written");
 }
 
 void OutputFiles::add(const fs::path& target, Writer write) {
@@ -330,7 +352,8 @@ void OutputFiles::commit() {
       // Writers name the file they were given; the user gave the target, not our temporary.
       std::string what = error.what();
       const std::string temp = e.temp.string();
-      for (auto at = what.find(temp); at != std::string::npos; at = what.find(temp, at + e.target.string().size()))
+      for (auto at = what.find(temp); at != std::string::npos;
+           at = what.find(temp, at + e.target.string().size()))
         what.replace(at, temp.size(), e.target.string());
       throw InvalidInput(what);
     }

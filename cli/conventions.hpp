@@ -112,8 +112,9 @@ CLI::Option* add_write_invalid_flag(CLI::App* app, bool& flag);
 // Several outputs written as one: each goes to a temporary file next to its target (same
 // extension, so writers that go by it still work; registered for removal on signals), and only
 // when all are written are they renamed over their targets (through symbolic links; copied into
-// a target that is not a regular file, e.g. a device). If any write fails, every temporary is removed and nothing is
-// written; if a rename fails, the outputs already renamed are removed (never half a result).
+// a target that is not a regular file, e.g. a device). If any write fails, every temporary is
+// removed and nothing is written; if a rename fails, the outputs already renamed are removed (never
+// half a result).
 class OutputFiles {
  public:
   using Writer = std::function<void(const std::filesystem::path& temp)>;

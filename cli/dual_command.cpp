@@ -8,16 +8,16 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "cli/commands.hpp"
-#include "cli/conventions.hpp"
-#include "cli/progress.hpp"
-#include <geode/primal/errors.hpp>
 #include <geode/io/formats.hpp>
+#include <geode/primal/errors.hpp>
 #include <geode/primal/model.hpp>
 #include <geode/stc/arrangement.hpp>
 #include <geode/stc/dualize.hpp>
 #include <geode/stc/mesh_dual.hpp>
 #include <geode/stc/mesh_fields.hpp>
+#include "cli/commands.hpp"
+#include "cli/conventions.hpp"
+#include "cli/progress.hpp"
 
 namespace geode::cli {
 namespace {
@@ -54,7 +54,8 @@ nlohmann::json dual_json(const Dual& dual, Index nodes, Index cells) {
   }
   j["intersections"] = nlohmann::json::array();
   for (const auto& [tuple, count] : dual.intersections)
-    j["intersections"].push_back({{"sheets", std::vector<Index>(tuple.begin(), tuple.end())}, {"cells", count}});
+    j["intersections"].push_back(
+        {{"sheets", std::vector<Index>(tuple.begin(), tuple.end())}, {"cells", count}});
   return j;
 }
 
@@ -64,11 +65,14 @@ std::string dual_text(const nlohmann::json& j, int dim) {
   const char* sheet = dim == 3 ? "sheets" : "chords";
   s << j["nodes"].get<Index>() << " nodes, " << j["cells"].get<Index>() << " " << cell << ", "
     << j["sheets"].size() << " " << sheet << "\n\n";
-  s << (dim == 3 ? "sheet" : "chord") << "\tedges\tcrossings\tself-intersecting\tboundary trace pieces (closed)\n";
+  s << (dim == 3 ? "sheet" : "chord")
+    << "\tedges\tcrossings\tself-intersecting\tboundary trace pieces (closed)\n";
   for (const auto& sh : j["sheets"])
-    s << sh["sheet"].get<Index>() << "\t" << sh["edges"].get<std::size_t>() << "\t" << sh["crossings"].get<std::size_t>()
-      << "\t" << (sh["self_intersecting"].get<bool>() ? "yes" : "no") << "\t"
-      << sh["trace_pieces"].get<std::size_t>() << " (" << sh["closed_trace_pieces"].get<int>() << ")\n";
+    s << sh["sheet"].get<Index>() << "\t" << sh["edges"].get<std::size_t>() << "\t"
+      << sh["crossings"].get<std::size_t>() << "\t"
+      << (sh["self_intersecting"].get<bool>() ? "yes" : "no") << "\t"
+      << sh["trace_pieces"].get<std::size_t>() << " (" << sh["closed_trace_pieces"].get<int>()
+      << ")\n";
   s << "\n" << (dim == 3 ? "triple" : "crossing") << "\t" << cell << " where they meet\n";
   for (const auto& t : j["intersections"]) {
     std::string tuple;
@@ -102,16 +106,19 @@ void run_dual(const DualArgs& a) {
   const fs::path in(a.input);
   const MeshFile m = read_mesh_file(in);
   if (m.dim == 2 && !rebuild_format.empty() && !io::find_mesh_format(rebuild_format)->write_quads)
-    throw InvalidInput(a.rebuild + ": " + a.input + " is a quad mesh; rebuild it as " + quad_output_extensions());
+    throw InvalidInput(a.rebuild + ": " + a.input + " is a quad mesh; rebuild it as " +
+                       quad_output_extensions());
   nlohmann::json j;
   std::vector<Index> counts;
   if (m.dim == 3) {
     const auto dual = stc::mesh_dual(m.hex);
-    j = dual_json(dual, static_cast<Index>(m.hex.points.size()), static_cast<Index>(m.hex.hexes.size()));
+    j = dual_json(dual, static_cast<Index>(m.hex.points.size()),
+                  static_cast<Index>(m.hex.hexes.size()));
     counts = tuple_counts(dual);
   } else {
     const auto dual = stc::mesh_dual(m.quad);
-    j = dual_json(dual, static_cast<Index>(m.quad.points.size()), static_cast<Index>(m.quad.quads.size()));
+    j = dual_json(dual, static_cast<Index>(m.quad.points.size()),
+                  static_cast<Index>(m.quad.quads.size()));
     counts = tuple_counts(dual);
   }
   j["input"] = a.input;
@@ -121,12 +128,14 @@ void run_dual(const DualArgs& a) {
   if (!a.rebuild.empty()) {
     // Name the input in what the engine reports (it only knows hexes and sheets by number).
     try {
-      const stc::MeshArrangementInput fields = m.dim == 3 ? stc::sheet_fields(m.hex) : stc::sheet_fields(m.quad);
+      const stc::MeshArrangementInput fields =
+          m.dim == 3 ? stc::sheet_fields(m.hex) : stc::sheet_fields(m.quad);
       // A large mesh has many sheets and the engine meets every pair: say how far it is.
       Progress progress = Progress::for_stderr(false);
       stc::ArrangementOptions options;
-      options.progress = [&progress, what = std::string(m.dim == 3 ? "sheet pairs traced" : "chords traced")](
-                             std::size_t done, std::size_t total) { progress.step(what, done, total); };
+      options.progress =
+          [&progress, what = std::string(m.dim == 3 ? "sheet pairs traced" : "chords traced")](
+              std::size_t done, std::size_t total) { progress.step(what, done, total); };
       D = stc::dualize(stc::compute_arrangement(fields.sheets, fields.domain, options));
     } catch (const InvalidInput& x) {
       throw InvalidInput(a.input + ": cannot rebuild: " + x.what());
@@ -137,7 +146,8 @@ void run_dual(const DualArgs& a) {
     r["file"] = a.rebuild;
     r["nodes"] = m.dim == 3 ? D.hex.points.size() : D.quad.points.size();
     r["cells"] = m.dim == 3 ? D.hex.hexes.size() : D.quad.quads.size();
-    const std::vector<Index> rebuilt = m.dim == 3 ? tuple_counts(stc::mesh_dual(D.hex)) : tuple_counts(stc::mesh_dual(D.quad));
+    const std::vector<Index> rebuilt =
+        m.dim == 3 ? tuple_counts(stc::mesh_dual(D.hex)) : tuple_counts(stc::mesh_dual(D.quad));
     r["same_counts"] = rebuilt == counts && r["nodes"] == j["nodes"] && r["cells"] == j["cells"];
     j["rebuild"] = r;
   }
@@ -149,10 +159,11 @@ void run_dual(const DualArgs& a) {
     text = dual_text(j, m.dim);
     if (j.contains("rebuild")) {
       const auto& r = j["rebuild"];
-      text += "\nrebuilt through the arrangement engine: " + std::to_string(r["nodes"].get<std::size_t>()) + " nodes, " +
-              std::to_string(r["cells"].get<std::size_t>()) + (m.dim == 3 ? " hexes" : " quads") + " -> " + a.rebuild +
-              "\n  same node, cell and intersection counts as the input: " + (r["same_counts"].get<bool>() ? "yes" : "NO") +
-              "\n";
+      text += "\nrebuilt through the arrangement engine: " +
+              std::to_string(r["nodes"].get<std::size_t>()) + " nodes, " +
+              std::to_string(r["cells"].get<std::size_t>()) + (m.dim == 3 ? " hexes" : " quads") +
+              " -> " + a.rebuild + "\n  same node, cell and intersection counts as the input: " +
+              (r["same_counts"].get<bool>() ? "yes" : "NO") + "\n";
     }
   }
   // The rebuilt mesh passes the one validity check before anything is written (its ids as the
@@ -178,7 +189,10 @@ void run_dual(const DualArgs& a) {
       }
     });
   const bool to_file = !a.output.empty() && a.output != "-";
-  if (to_file) files.add(a.output, [&](const fs::path& temp) { write_or_print(temp.string(), [&](std::ostream& os) { os << text; }); });
+  if (to_file)
+    files.add(a.output, [&](const fs::path& temp) {
+      write_or_print(temp.string(), [&](std::ostream& os) { os << text; });
+    });
   files.commit();
   if (!to_file) std::cout << text;
   invalid_written(what, invalid);
@@ -188,26 +202,32 @@ void run_dual(const DualArgs& a) {
 
 void add_dual_command(CLI::App& app) {
   auto a = std::make_shared<DualArgs>();
-  CLI::App* d = app.add_subcommand(
-      "dual",
-      "A mesh's dual: its sheets (chords in 2D), each sheet's crossings and boundary trace, and how many\n"
-      "hexes each triple of sheets meets in. --rebuild realizes those sheets as fields, computes their\n"
-      "arrangement and dualizes it back (stc/mesh_fields.hpp): for a mesh that fills a box with positively\n"
-      "oriented cells and sheets that do not cross themselves, the result is the same mesh up to numbering.");
-  d->add_option("mesh", a->input, hex_or_quad_input_help())
-      ->required();
-  d->add_option("--format", a->format,
-                "report format: text (tables; default) or json; without it the extension of -o decides\n"
-                "(.txt, .json); one that contradicts the extension is refused")
+  CLI::App* d = app.add_subcommand("dual",
+                                   "A mesh's dual: its sheets (chords in 2D), each sheet's "
+                                   "crossings and boundary trace, and how many\n"
+                                   "hexes each triple of sheets meets in. --rebuild realizes those "
+                                   "sheets as fields, computes their\n"
+                                   "arrangement and dualizes it back (stc/mesh_fields.hpp): for a "
+                                   "mesh that fills a box with positively\n"
+                                   "oriented cells and sheets that do not cross themselves, the "
+                                   "result is the same mesh up to numbering.");
+  d->add_option("mesh", a->input, hex_or_quad_input_help())->required();
+  d->add_option(
+       "--format", a->format,
+       "report format: text (tables; default) or json; without it the extension of -o decides\n"
+       "(.txt, .json); one that contradicts the extension is refused")
       ->check(CLI::IsMember({"text", "json"}));
   d->add_option("-o,--output", a->output, "Write the report here instead of standard output");
-  d->add_option("--rebuild", a->rebuild,
-                "Rebuild the mesh from its sheets through the arrangement engine; write it here, the\n"
-                "format by the extension: " + io::extension_list(io::FormatRole::kWrite, ", ", ", ") +
-                    " (hexes; quads: " + io::extension_list(io::FormatRole::kWriteQuads, ", ", ", ") + ")");
+  d->add_option(
+      "--rebuild", a->rebuild,
+      "Rebuild the mesh from its sheets through the arrangement engine; write it here, the\n"
+      "format by the extension: " +
+          io::extension_list(io::FormatRole::kWrite, ", ", ", ") +
+          " (hexes; quads: " + io::extension_list(io::FormatRole::kWriteQuads, ", ", ", ") + ")");
   add_write_invalid_flag(d, a->write_invalid);
   add_force_flag(d, a->force);
-  d->add_option("--vtu-encoding", a->vtu_encoding, "binary (base64, default) or ascii DataArrays in .vtu")
+  d->add_option("--vtu-encoding", a->vtu_encoding,
+                "binary (base64, default) or ascii DataArrays in .vtu")
       ->check(CLI::IsMember({"binary", "ascii"}))
       ->capture_default_str();
   d->callback([a] { run_dual(*a); });

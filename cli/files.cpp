@@ -4,11 +4,11 @@
 #include <iostream>
 #include <utility>
 
-#include "cli/commands.hpp"
 #include <geode/io/atomic_file.hpp>
 #include <geode/io/formats.hpp>
 #include <geode/io/read_model.hpp>
 #include <geode/primal/errors.hpp>
+#include "cli/commands.hpp"
 
 namespace geode::cli {
 

@@ -1,8 +1,8 @@
 // `geode formats`: the format table (io/formats.hpp) as the Markdown matrix of docs/formats.md.
 #include <iostream>
 
-#include "cli/commands.hpp"
 #include <geode/io/formats.hpp>
+#include "cli/commands.hpp"
 
 namespace geode::cli {
 

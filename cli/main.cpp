@@ -5,10 +5,10 @@
 
 #include <tbb/global_control.h>
 
-#include "cli/commands.hpp"
-#include "cli/conventions.hpp"
 #include <geode/io/atomic_file.hpp>
 #include <geode/primal/errors.hpp>
+#include "cli/commands.hpp"
+#include "cli/conventions.hpp"
 
 namespace {
 
@@ -37,7 +37,8 @@ std::string command_path(const CLI::App& app) {
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "geode: all-hex transition templates derived from completed dual sheet arrangements, and the\n"
+      "geode: all-hex transition templates derived from completed dual sheet arrangements, and "
+      "the\n"
       "geode algorithm that conforms a diced hex mesh to a diced tet mesh with them.\n"
       "Exit codes: 0 done, 2 usage or input error, 3 topology refusal, 4 invalid result."};
   // An interrupted run removes its hidden temporary files (io/atomic_file.hpp).
@@ -51,8 +52,8 @@ int main(int argc, char** argv) {
   app.add_option_function<int>(
          "--threads",
          [&threads](int n) {
-           threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                           static_cast<std::size_t>(n));
+           threads = std::make_unique<tbb::global_control>(
+               tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(n));
          },
          "worker threads (default: every core); every result is the same for any number")
       ->check(CLI::Range(1, 4096));
@@ -82,11 +83,13 @@ int main(int argc, char** argv) {
     return 4;
   } catch (const std::bad_alloc&) {
     // An input whose counts were not bounded somewhere: still one line and exit 2, not a crash.
-    std::cerr << command_path(app) << ": error: out of memory: the input needs more memory than this machine "
+    std::cerr << command_path(app)
+              << ": error: out of memory: the input needs more memory than this machine "
               << "gives (nothing written)\n";
     return 2;
   } catch (const std::length_error& e) {
-    std::cerr << command_path(app) << ": error: the input asks for a container larger than memory can hold ("
+    std::cerr << command_path(app)
+              << ": error: the input asks for a container larger than memory can hold ("
               << one_line(e.what()) << "; nothing written)\n";
     return 2;
   } catch (const std::exception& e) {

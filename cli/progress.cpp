@@ -39,8 +39,8 @@ void Progress::step(const std::string& what, std::size_t done, std::size_t total
   if (terminal_) {
     if (!finished && bar_drawn_ && now - last_ < kRedraw) return;
     const std::size_t width = 30, filled = total ? width * std::min(done, total) / total : width;
-    std::cerr << "\rgeode: [" << std::string(filled, '#') << std::string(width - filled, '.') << "] " << count
-              << " (" << seconds << " s)" << std::flush;
+    std::cerr << "\rgeode: [" << std::string(filled, '#') << std::string(width - filled, '.')
+              << "] " << count << " (" << seconds << " s)" << std::flush;
     bar_drawn_ = true;
     if (finished) end_bar();
   } else {

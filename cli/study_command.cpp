@@ -6,13 +6,13 @@
 #include <memory>
 #include <sstream>
 
-#include "cli/commands.hpp"
-#include "cli/conventions.hpp"
-#include "cli/progress.hpp"
 #include <geode/primal/errors.hpp>
 #include <geode/templates/spec.hpp>
 #include <geode/templates/study.hpp>
 #include <geode/templates/template_table.hpp>
+#include "cli/commands.hpp"
+#include "cli/conventions.hpp"
+#include "cli/progress.hpp"
 
 namespace geode::cli {
 namespace {
@@ -54,19 +54,26 @@ templates::InterleaveStudy spec_study(const InterleaveArgs& a) {
     templates::SweepAxis axis = templates::parse_sweep_option(text);
     nlohmann::json probe = spec;
     templates::set_spec_number(probe, axis.path, axis.values.front(), source);
-    auto same = std::find_if(axes.begin(), axes.end(), [&](const auto& x) { return x.path == axis.path; });
-    if (same != axes.end()) *same = axis; else axes.push_back(axis);
+    auto same =
+        std::find_if(axes.begin(), axes.end(), [&](const auto& x) { return x.path == axis.path; });
+    if (same != axes.end())
+      *same = axis;
+    else
+      axes.push_back(axis);
   }
-  if (axes.empty()) throw InvalidInput(source + ": nothing to sweep (give --sweep PATH=FROM:TO:COUNT or a sweep block)");
+  if (axes.empty())
+    throw InvalidInput(source +
+                       ": nothing to sweep (give --sweep PATH=FROM:TO:COUNT or a sweep block)");
   std::vector<std::size_t> counts;
   for (const auto& x : axes) counts.push_back(x.values.size());
   check_sweep_size(counts, source);
   Progress progress = Progress::for_stderr(a.quiet);
-  auto study = templates::interleave_study(spec, source, axes, std::filesystem::path(a.spec).stem().string(),
-                                           [&](const std::string& what, std::size_t done, std::size_t total) {
-                                             progress.step(what, done, total);
-                                           });
-  if (study.runs.empty()) throw InvalidInput(source + ": every sweep point is invalid input (e.g. low roof above high)");
+  auto study =
+      templates::interleave_study(spec, source, axes, std::filesystem::path(a.spec).stem().string(),
+                                  [&](const std::string& what, std::size_t done,
+                                      std::size_t total) { progress.step(what, done, total); });
+  if (study.runs.empty())
+    throw InvalidInput(source + ": every sweep point is invalid input (e.g. low roof above high)");
   return study;
 }
 
@@ -84,7 +91,8 @@ void run_interleave(const InterleaveArgs& a) {
     const templates::TemplateEntry* entry = templates::find_template(a.name);
     if (!entry || !entry->study_grid) {
       std::string names;
-      for (const auto& n : templates::template_names(true)) names += (names.empty() ? "" : ", ") + n;
+      for (const auto& n : templates::template_names(true))
+        names += (names.empty() ? "" : ", ") + n;
       throw InvalidInput("study interleave: unknown template '" + a.name + "' (" + names + ")");
     }
     templates::PushGrid grid = entry->study_grid();
@@ -92,26 +100,31 @@ void run_interleave(const InterleaveArgs& a) {
     if (!a.low.empty()) grid.low_roof = a.low;
     if (!a.depth.empty()) grid.dome_depth = a.depth;
     if (!a.radius.empty()) grid.dome_radius = a.radius;
-    check_sweep_size({grid.high_roof.size(), grid.low_roof.size(), grid.dome_depth.size(), grid.dome_radius.size()},
+    check_sweep_size({grid.high_roof.size(), grid.low_roof.size(), grid.dome_depth.size(),
+                      grid.dome_radius.size()},
                      "study interleave");
     const templates::GeodeOptions o = entry->defaults.geode;
     Progress progress = Progress::for_stderr(a.quiet);
-    study = templates::interleave_study(o, grid, a.name, [&](const std::string& what, std::size_t done, std::size_t total) {
-      progress.step(what, done, total);
-    });
-    if (study.runs.empty()) throw InvalidInput("study interleave: no grid point has 0 < low < high < 1");
+    study = templates::interleave_study(
+        o, grid, a.name, [&](const std::string& what, std::size_t done, std::size_t total) {
+          progress.step(what, done, total);
+        });
+    if (study.runs.empty())
+      throw InvalidInput("study interleave: no grid point has 0 < low < high < 1");
   }
   // The runs and the summary are written as one (both or neither); the runs to stdout otherwise.
   OutputFiles files;
   const bool runs_to_file = !a.output.empty() && a.output != "-";
   if (runs_to_file)
     files.add(a.output, [&](const std::filesystem::path& temp) {
-      write_or_print(temp.string(), [&](std::ostream& s) { templates::write_interleave_csv(s, study); });
+      write_or_print(temp.string(),
+                     [&](std::ostream& s) { templates::write_interleave_csv(s, study); });
     });
   const bool summary_to_file = !a.summary.empty() && a.summary != "-";
   if (summary_to_file)
     files.add(a.summary, [&](const std::filesystem::path& temp) {
-      write_or_print(temp.string(), [&](std::ostream& s) { templates::write_interleave_summary(s, study); });
+      write_or_print(temp.string(),
+                     [&](std::ostream& s) { templates::write_interleave_summary(s, study); });
     });
   files.commit();
   if (!runs_to_file) templates::write_interleave_csv(std::cout, study);
@@ -119,8 +132,8 @@ void run_interleave(const InterleaveArgs& a) {
   double total = 0;
   for (const auto& r : study.runs) total += r.seconds;
   std::ostream& log = a.output.empty() ? std::cerr : std::cout;
-  log << study.template_name << ": " << study.runs.size() << " runs, " << std::setprecision(3) << total << " s, "
-      << study.classes.size() << " outcome classes";
+  log << study.template_name << ": " << study.runs.size() << " runs, " << std::setprecision(3)
+      << total << " s, " << study.classes.size() << " outcome classes";
   if (study.skipped) log << ", " << study.skipped << " sweep points skipped as invalid input";
   log << "\n";
   for (const auto& c : study.classes) {
@@ -133,8 +146,8 @@ void run_interleave(const InterleaveArgs& a) {
           << (c.usable ? ": usable" : ": not usable");
     else
       log << "error";
-    log << "  e.g. push " << c.example.high_roof << " " << c.example.low_roof << " " << c.example.dome_depth << " "
-        << c.example.dome_radius;
+    log << "  e.g. push " << c.example.high_roof << " " << c.example.low_roof << " "
+        << c.example.dome_depth << " " << c.example.dome_radius;
     for (std::size_t i = 0; i < c.example_parameters.size(); ++i)
       log << (i ? ", " : "; ") << study.parameter_names[i] << " " << c.example_parameters[i];
     log << "\n      " << c.key << "\n";
@@ -151,7 +164,8 @@ void run_shape(const ShapeArgs& a) {
     output_format(*path, "", {"csv"}, "csv");
     check_output_path(*path);
   }
-  const bool any = !a.height_csv.empty() || !a.distorted_csv.empty() || !a.quality_csv.empty() || !a.sj_csv.empty();
+  const bool any = !a.height_csv.empty() || !a.distorted_csv.empty() || !a.quality_csv.empty() ||
+                   !a.sj_csv.empty();
   if (!a.height_csv.empty() || !any) {
     std::vector<double> h = a.heights;
     if (h.empty())
@@ -160,7 +174,8 @@ void run_shape(const ShapeArgs& a) {
     write_or_print(a.height_csv, [&](std::ostream& s) { templates::write_shape_csv(s, rows); });
   }
   if (!a.distorted_csv.empty()) {
-    const std::vector<double> shears = a.shears.empty() ? std::vector<double>{0, 10, 20, 30, 40} : a.shears;
+    const std::vector<double> shears =
+        a.shears.empty() ? std::vector<double>{0, 10, 20, 30, 40} : a.shears;
     const std::vector<double> tapers =
         a.tapers.empty() ? std::vector<double>{0.4, 0.6, 0.8, 1.0, 1.25, 1.5} : a.tapers;
     const auto rows = templates::distorted_study(shears, tapers);
@@ -169,7 +184,8 @@ void run_shape(const ShapeArgs& a) {
   if (!a.quality_csv.empty() || !a.sj_csv.empty()) {
     std::ostringstream report, per_hex;
     templates::write_geode_quality(report, &per_hex);
-    if (!a.quality_csv.empty()) write_or_print(a.quality_csv, [&](std::ostream& s) { s << report.str(); });
+    if (!a.quality_csv.empty())
+      write_or_print(a.quality_csv, [&](std::ostream& s) { s << report.str(); });
     if (!a.sj_csv.empty()) write_or_print(a.sj_csv, [&](std::ostream& s) { s << per_hex.str(); });
   }
 }
@@ -177,46 +193,70 @@ void run_shape(const ShapeArgs& a) {
 }  // namespace
 
 void add_study_commands(CLI::App& app) {
-  auto* study = app.add_subcommand("study", "Parameter studies of the geode templates (CSV output)");
+  auto* study =
+      app.add_subcommand("study", "Parameter studies of the geode templates (CSV output)");
   study->require_subcommand(1);
 
   auto ia = std::make_shared<InterleaveArgs>();
   auto* inter = study->add_subcommand(
       "interleave",
-      "Sweep the push parameters (high roof, low roof, dome depth, dome radius) and classify what each push "
-      "dualizes to: a template class (hex count, sheet-kind triples, colour-refinement hash) with the paper's "
+      "Sweep the push parameters (high roof, low roof, dome depth, dome radius) and classify what "
+      "each push "
+      "dualizes to: a template class (hex count, sheet-kind triples, colour-refinement hash) with "
+      "the paper's "
       "two conditions, or the TopologyError's diagnosis with numbers stripped");
-  inter->add_option("--template", ia->name, "the template to sweep (default geode3d): " + templates::template_help(true))
+  inter
+      ->add_option("--template", ia->name,
+                   "the template to sweep (default geode3d): " + templates::template_help(true))
       ->check(CLI::IsMember(templates::template_names(true)));
   inter->add_option("-o,--output", ia->output, "per-run CSV (default: stdout)");
   inter->add_option("--summary", ia->summary, "per-class summary CSV");
-  inter->add_option("--high", ia->high, "high roof values (default grid if omitted)")->check(number_check(0, 1));
+  inter->add_option("--high", ia->high, "high roof values (default grid if omitted)")
+      ->check(number_check(0, 1));
   inter->add_option("--low", ia->low, "low roof values")->check(number_check(0, 1));
   inter->add_option("--depth", ia->depth, "dome depth values")->check(number_check(0, 1));
   inter->add_option("--radius", ia->radius, "dome radius blend values")->check(number_check(0, 1));
-  inter->add_option("--spec", ia->spec,
-                    "sweep an arrangement spec (geode arrange's format) instead of a built-in template;\n"
-                    "its \"sweep\" block and --sweep say what to sweep")
-      ->excludes("--template")->excludes("--high")->excludes("--low")->excludes("--depth")->excludes("--radius");
-  inter->add_option("--sweep", ia->sweep,
-                    "with --spec: PATH=FROM:TO:COUNT or PATH=V1,V2,... for a number in the spec, e.g.\n"
-                    "push.high_roof=0.55:0.95:5 or sheets[3].sphere.radius=0.2,0.3 (repeat for a grid)");
-  inter->add_flag("--quiet", ia->quiet, "no progress lines (a bar on a terminal, a line every few seconds in a log)");
+  inter
+      ->add_option(
+          "--spec", ia->spec,
+          "sweep an arrangement spec (geode arrange's format) instead of a built-in template;\n"
+          "its \"sweep\" block and --sweep say what to sweep")
+      ->excludes("--template")
+      ->excludes("--high")
+      ->excludes("--low")
+      ->excludes("--depth")
+      ->excludes("--radius");
+  inter->add_option(
+      "--sweep", ia->sweep,
+      "with --spec: PATH=FROM:TO:COUNT or PATH=V1,V2,... for a number in the spec, e.g.\n"
+      "push.high_roof=0.55:0.95:5 or sheets[3].sphere.radius=0.2,0.3 (repeat for a grid)");
+  inter->add_flag("--quiet", ia->quiet,
+                  "no progress lines (a bar on a terminal, a line every few seconds in a log)");
   inter->callback([ia] { run_interleave(*ia); });
 
   auto sa = std::make_shared<ShapeArgs>();
   auto* shape = study->add_subcommand(
       "shape",
-      "Min scaled Jacobian of the smoothed geode (tet/hex-side nodes fixed or sliding) against the box height "
+      "Min scaled Jacobian of the smoothed geode (tet/hex-side nodes fixed or sliding) against the "
+      "box height "
       "(24 x h x 24), in sheared and tapered 24 x 14 x 24 cells, and the Table 1 report");
   shape->add_option("-o,--output,--height-csv", sa->height_csv,
                     "height study CSV (default when no other output is asked: stdout)");
   shape->add_option("--distorted-csv", sa->distorted_csv, "sheared/tapered cell study CSV");
-  shape->add_option("--quality-csv", sa->quality_csv, "Table 1 report of the smoothed geode with the paper's values");
-  shape->add_option("--sj-csv", sa->sj_csv, "per-hex scaled Jacobians of the smoothed geode (both modes)");
-  shape->add_option("--heights", sa->heights, "box heights (default 6, 8, ..., 30), in [0.1, 2400]")->check(number_check(0.1, 2400));
-  shape->add_option("--shears", sa->shears, "shear angles in degrees (default 0 10 20 30 40), in [0, 80]")->check(number_check(0, 80));
-  shape->add_option("--tapers", sa->tapers, "top/bottom taper ratios (default 0.4 0.6 0.8 1 1.25 1.5), in [0.01, 100]")->check(number_check(0.01, 100));
+  shape->add_option("--quality-csv", sa->quality_csv,
+                    "Table 1 report of the smoothed geode with the paper's values");
+  shape->add_option("--sj-csv", sa->sj_csv,
+                    "per-hex scaled Jacobians of the smoothed geode (both modes)");
+  shape->add_option("--heights", sa->heights, "box heights (default 6, 8, ..., 30), in [0.1, 2400]")
+      ->check(number_check(0.1, 2400));
+  shape
+      ->add_option("--shears", sa->shears,
+                   "shear angles in degrees (default 0 10 20 30 40), in [0, 80]")
+      ->check(number_check(0, 80));
+  shape
+      ->add_option("--tapers", sa->tapers,
+                   "top/bottom taper ratios (default 0.4 0.6 0.8 1 1.25 1.5), in [0.01, 100]")
+      ->check(number_check(0.01, 100));
   shape->callback([sa] { run_shape(*sa); });
 }
 

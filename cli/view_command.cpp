@@ -7,19 +7,21 @@
 #include <memory>
 #include <type_traits>
 
-#include "cli/commands.hpp"
-#include "cli/conventions.hpp"
 #include <geode/primal/errors.hpp>
 #include <geode/stc/mesh_dual.hpp>
 #include <geode/stc/sheet_surfaces.hpp>
+#include "cli/commands.hpp"
+#include "cli/conventions.hpp"
 
 namespace geode::cli {
 
-std::vector<viewer::ViewSheet> arrangement_view_sheets(const std::vector<stc::Sheet>& sheets, const stc::Domain& domain,
-                                                       const std::vector<std::vector<int>>& element_sheets,
-                                                       const std::function<primal::Point(const primal::Point&)>& to_physical) {
+std::vector<viewer::ViewSheet> arrangement_view_sheets(
+    const std::vector<stc::Sheet>& sheets, const stc::Domain& domain,
+    const std::vector<std::vector<int>>& element_sheets,
+    const std::function<primal::Point(const primal::Point&)>& to_physical) {
   std::vector<viewer::ViewSheet> out(sheets.size());
-  for (std::size_t s = 0; s < sheets.size(); ++s) out[s].name = sheets[s].name, out[s].kind = sheets[s].kind;
+  for (std::size_t s = 0; s < sheets.size(); ++s)
+    out[s].name = sheets[s].name, out[s].kind = sheets[s].kind;
   if (domain.dim == 3) {
     auto surfaces = stc::contour_sheets(sheets, domain);
     for (std::size_t s = 0; s < sheets.size(); ++s) {
@@ -38,7 +40,8 @@ std::vector<viewer::ViewSheet> arrangement_view_sheets(const std::vector<stc::Sh
   }
   for (std::size_t e = 0; e < element_sheets.size(); ++e)
     for (int s : element_sheets[e])
-      if (s >= 0 && static_cast<std::size_t>(s) < out.size()) out[static_cast<std::size_t>(s)].layer.push_back(static_cast<primal::Index>(e));
+      if (s >= 0 && static_cast<std::size_t>(s) < out.size())
+        out[static_cast<std::size_t>(s)].layer.push_back(static_cast<primal::Index>(e));
   return out;
 }
 
@@ -60,8 +63,10 @@ std::vector<viewer::ViewSheet> mesh_view_sheets(const Mesh& mesh, const Surfaces
   for (std::size_t s = 0; s < out.size(); ++s) {
     out[s].name = "sheet " + std::to_string(s);
     out[s].kind = "mesh";
-    if constexpr (std::is_same_v<Mesh, primal::HexMesh>) out[s].surface = std::move(shapes[s]);
-    else out[s].curve = std::move(shapes[s]);
+    if constexpr (std::is_same_v<Mesh, primal::HexMesh>)
+      out[s].surface = std::move(shapes[s]);
+    else
+      out[s].curve = std::move(shapes[s]);
     out[s].layer = layers[s];
   }
   return out;
@@ -71,25 +76,36 @@ void run_view(const ViewArgs& a) {
   check_not_input(a.output, a.input, false);  // the page never replaces the mesh it shows
   const std::filesystem::path out(a.output);
   if (file_extension(out) != ".html")
-    throw InvalidInput(a.output + ": unknown output format '" + file_extension(out) + "' (expected .html)");
+    throw InvalidInput(a.output + ": unknown output format '" + file_extension(out) +
+                       "' (expected .html)");
   const MeshFile m = read_mesh_file(a.input);
   viewer::ViewScene scene;
   scene.title = a.title.empty() ? std::filesystem::path(a.input).filename().string() : a.title;
   const char* cells = m.dim == 3 ? "hexes" : "quads";
   const std::size_t n = m.dim == 3 ? m.hex.hexes.size() : m.quad.quads.size();
-  scene.caption = "geode view " + a.input + ": " + std::to_string(n) + " " + cells + "; " +
-                  (m.dim == 3 ? "each sheet of the mesh's dual drawn as the quads through the mid-edge points of its layer"
-                              : "each chord of the mesh's dual drawn through the mid-edge points of its layer") +
-                  " (stc::mesh_dual, sheet numbers as in `geode dual`).";
+  scene.caption =
+      "geode view " + a.input + ": " + std::to_string(n) + " " + cells + "; " +
+      (m.dim == 3
+           ? "each sheet of the mesh's dual drawn as the quads through the mid-edge points of its "
+             "layer"
+           : "each chord of the mesh's dual drawn through the mid-edge points of its layer") +
+      " (stc::mesh_dual, sheet numbers as in `geode dual`).";
   // A mesh whose dual cannot be read (a face on three hexes, ...) is still worth looking at.
   try {
-    scene.sheets = m.dim == 3 ? mesh_view_sheets(m.hex, [](const auto& mesh, const auto& d) { return stc::dual_surfaces(mesh, d); })
-                              : mesh_view_sheets(m.quad, [](const auto& mesh, const auto& d) { return stc::dual_curves(mesh, d); });
+    scene.sheets = m.dim == 3 ? mesh_view_sheets(m.hex,
+                                                 [](const auto& mesh, const auto& d) {
+                                                   return stc::dual_surfaces(mesh, d);
+                                                 })
+                              : mesh_view_sheets(m.quad, [](const auto& mesh, const auto& d) {
+                                  return stc::dual_curves(mesh, d);
+                                });
   } catch (const TopologyError& e) {
     std::cerr << "geode: warning: " << a.input << ": no sheets shown: " << e.what() << "\n";
   }
-  if (m.dim == 3) viewer::write_html(out, m.hex, scene);
-  else viewer::write_html(out, m.quad, scene);
+  if (m.dim == 3)
+    viewer::write_html(out, m.hex, scene);
+  else
+    viewer::write_html(out, m.quad, scene);
 }
 
 }  // namespace
@@ -98,13 +114,16 @@ void add_view_command(CLI::App& app) {
   auto a = std::make_shared<ViewArgs>();
   CLI::App* v = app.add_subcommand(
       "view",
-      "Write a hex (or planar quad) mesh as one self-contained HTML file (three.js inlined, nothing fetched\n"
-      "when opened): the hexes with shrink, explode and peeling; every sheet of the mesh's dual as the\n"
-      "surface through its layer of hexes, each with a toggle; each sheet's layer alone or highlighted;\n"
-      "colour by scaled Jacobian; node and hex ids on hover (1-based, as the CSV and appendix outputs).\n"
+      "Write a hex (or planar quad) mesh as one self-contained HTML file (three.js inlined, "
+      "nothing fetched\n"
+      "when opened): the hexes with shrink, explode and peeling; every sheet of the mesh's dual as "
+      "the\n"
+      "surface through its layer of hexes, each with a toggle; each sheet's layer alone or "
+      "highlighted;\n"
+      "colour by scaled Jacobian; node and hex ids on hover (1-based, as the CSV and appendix "
+      "outputs).\n"
       "URL hash parameters (FILE.html#layer=sheet-0&peel=1) select a view; see viewer/viewer.js.");
-  v->add_option("mesh", a->input, hex_or_quad_input_help())
-      ->required();
+  v->add_option("mesh", a->input, hex_or_quad_input_help())->required();
   v->add_option("-o,--output", a->output, "The HTML file to write (atomically)")->required();
   v->add_option("--title", a->title, "Title shown in the page (default: the input's file name)");
   v->callback([a] { run_view(*a); });

@@ -66,14 +66,18 @@ std::pair<Point, double> best_direction(const std::vector<Point>& n, Project pro
 // (slot k of Interface::nodes) its geometry, direction and height, then the move-and-check
 // loop.
 class BufferBuilder {
-public:
+ public:
   BufferBuilder(const Model& input, const Interface& itf, const BufferLayerOptions& opt)
-      : input_(input), itf_(itf), opt_(opt), n_points_(input.points.size()), n_moved_(itf.nodes.size()),
+      : input_(input),
+        itf_(itf),
+        opt_(opt),
+        n_points_(input.points.size()),
+        n_moved_(itf.nodes.size()),
         hex_side_(opt.side == BufferSide::kHex),
         thickness_(opt.thickness > 0.0 ? opt.thickness : default_buffer_thickness(opt.side)) {}
   BufferLayer run();
 
-private:
+ private:
   const Point& pt(Index v) const { return input_.points[static_cast<std::size_t>(v)]; }
   std::size_t slot(Index v) const {
     return static_cast<std::size_t>(out_.top_node[static_cast<std::size_t>(v)]) - n_points_;
@@ -104,7 +108,8 @@ private:
   std::vector<std::vector<Point>> corner_normals_, outer_normals_;
   std::vector<double> shortest_, step_, safe_;
   std::vector<Point> direction_;
-  std::vector<double> feature_;  // per moving node: its thickness factor (feature_thickness at edges and corners)
+  std::vector<double>
+      feature_;  // per moving node: its thickness factor (feature_thickness at edges and corners)
   GradedEdges quad_edges_;
   std::vector<Index> centre_of_;  // per input node: the quad it is the four-triangle centre of
   std::vector<Index> touched_;    // moving-part cells with a moved node (or a moved centre)
@@ -125,9 +130,9 @@ void BufferBuilder::interface_geometry() {
       const Point es = pt(q.corners[(i + 3) % 4]) - pt(v);
       const Point n = er.cross(es);
       if (n.norm() <= 0.0)
-        throw TopologyError("insert_buffer_layer: interface face " + std::to_string(q.face + 1) + " of " +
-                            describe_element(input_, {ElementKind::Hex, q.hex}) + " is degenerate at " +
-                            describe_node(input_, v));
+        throw TopologyError("insert_buffer_layer: interface face " + std::to_string(q.face + 1) +
+                            " of " + describe_element(input_, {ElementKind::Hex, q.hex}) +
+                            " is degenerate at " + describe_node(input_, v));
       corner_normals_[slot(v)].push_back(into * n.normalized());
       shortest_[slot(v)] = std::min({shortest_[slot(v)], er.norm(), es.norm()});
     }
@@ -157,32 +162,39 @@ void BufferBuilder::moving_part(const Cells& cells, const Edges& edges, const Fa
   std::vector<Index> uses;
   for (std::size_t c = 0; c < cells.size(); ++c)
     for (std::size_t f = 0; f < nf; ++f) {
-      const auto [id, fresh] = ids.try_emplace(face_key(face_nodes(cells[c], faces[f])), static_cast<Index>(uses.size()));
+      const auto [id, fresh] = ids.try_emplace(face_key(face_nodes(cells[c], faces[f])),
+                                               static_cast<Index>(uses.size()));
       if (fresh) uses.push_back(0);
       face_id[c * nf + f] = *id;
       ++uses[static_cast<std::size_t>(*id)];
     }
   for (const auto& [cell, f] : interface_faces)
-    uses[static_cast<std::size_t>(face_id[static_cast<std::size_t>(cell) * nf + static_cast<std::size_t>(f)])] = -1;
+    uses[static_cast<std::size_t>(
+        face_id[static_cast<std::size_t>(cell) * nf + static_cast<std::size_t>(f)])] = -1;
   outer_normals_.assign(n_moved_, {});
   for (std::size_t c = 0; c < cells.size(); ++c) {
     const auto& cell = cells[c];
     bool touches = false;
-    for (Index v : cell) touches |= moved(v) || (!hex_side_ && centre_of_[static_cast<std::size_t>(v)] != kInvalidIndex);
+    for (Index v : cell)
+      touches |=
+          moved(v) || (!hex_side_ && centre_of_[static_cast<std::size_t>(v)] != kInvalidIndex);
     if (!touches) continue;
     touched_.push_back(static_cast<Index>(c));
     for (const auto& e : edges) {
-      const Index a = cell[static_cast<std::size_t>(e[0])], b = cell[static_cast<std::size_t>(e[1])];
+      const Index a = cell[static_cast<std::size_t>(e[0])],
+                  b = cell[static_cast<std::size_t>(e[1])];
       const double len = (pt(a) - pt(b)).norm();
       for (Index v : {a, b})
         if (moved(v)) shortest_[slot(v)] = std::min(shortest_[slot(v)], len);
     }
     for (std::size_t k = 0; k < nf; ++k) {
-      if (uses[static_cast<std::size_t>(face_id[c * nf + k])] != 1) continue;  // inner or interface face
+      if (uses[static_cast<std::size_t>(face_id[c * nf + k])] != 1)
+        continue;  // inner or interface face
       const auto f = face_nodes(cell, faces[k]);
       // Twice the outward area vector (triangle or quad: the cross product of the diagonals).
-      const Point area = kFaceSize == 3 ? Point((pt(f[1]) - pt(f[0])).cross(pt(f[2]) - pt(f[0])))
-                                        : Point((pt(f[2]) - pt(f[0])).cross(pt(f[kFaceSize - 1]) - pt(f[1])));
+      const Point area = kFaceSize == 3
+                             ? Point((pt(f[1]) - pt(f[0])).cross(pt(f[2]) - pt(f[0])))
+                             : Point((pt(f[2]) - pt(f[0])).cross(pt(f[kFaceSize - 1]) - pt(f[1])));
       for (Index v : f)
         if (moved(v)) outer_normals_[slot(v)].push_back(area);
     }
@@ -193,7 +205,8 @@ void BufferBuilder::measure_before() {
   for (Index c : touched_) {
     if (hex_side_) {
       HexCorners corners;
-      for (std::size_t i = 0; i < 8; ++i) corners[i] = pt(input_.hexes[static_cast<std::size_t>(c)][i]);
+      for (std::size_t i = 0; i < 8; ++i)
+        corners[i] = pt(input_.hexes[static_cast<std::size_t>(c)][i]);
       jacobians_before_.push_back(hex_jacobians(corners));
       before_.push_back(hex_scaled_jacobian(corners));
     } else {
@@ -212,7 +225,8 @@ void BufferBuilder::directions() {
   // part where that part is convex at the node.
   std::vector<Point> lean(n_moved_, Point::Zero());
   for (const InterfaceQuad& q : itf_.quads) {
-    const Point c = (pt(q.corners[0]) + pt(q.corners[1]) + pt(q.corners[2]) + pt(q.corners[3])) / 4.0;
+    const Point c =
+        (pt(q.corners[0]) + pt(q.corners[1]) + pt(q.corners[2]) + pt(q.corners[3])) / 4.0;
     for (Index v : q.corners) lean[slot(v)] += c - pt(v);
   }
   for (std::size_t k = 0; k < n_moved_; ++k) {
@@ -231,9 +245,10 @@ void BufferBuilder::directions() {
     }
     for (Point& f : features) f.normalize();
     if (features.size() >= 3)
-      throw TopologyError("insert_buffer_layer: " + describe_node(input_, v) + " is a corner of the " + part +
-                          " part's outer boundary (" + std::to_string(features.size()) +
-                          " feature faces meet there): its " + part + "-side copy cannot move off the interface");
+      throw TopologyError("insert_buffer_layer: " + describe_node(input_, v) +
+                          " is a corner of the " + part + " part's outer boundary (" +
+                          std::to_string(features.size()) + " feature faces meet there): its " +
+                          part + "-side copy cannot move off the interface");
     auto project = [&](Point d) -> Point {
       if (features.size() == 1) return d - d.dot(features[0]) * features[0];
       if (features.size() == 2) {
@@ -244,10 +259,11 @@ void BufferBuilder::directions() {
     };
     auto [d, m] = best_direction(corner_normals_[k], project);
     if (!(m >= opt_.min_visibility))
-      throw TopologyError("insert_buffer_layer: " + describe_node(input_, v) + ": no direction into the " + part +
-                          " side lies above all " + std::to_string(corner_normals_[k].size()) +
-                          " interface faces at it (best min cos " + std::to_string(m) +
-                          "), so no valid buffer layer can be placed there (the paper's Figure 9 right)");
+      throw TopologyError(
+          "insert_buffer_layer: " + describe_node(input_, v) + ": no direction into the " + part +
+          " side lies above all " + std::to_string(corner_normals_[k].size()) +
+          " interface faces at it (best min cos " + std::to_string(m) +
+          "), so no valid buffer layer can be placed there (the paper's Figure 9 right)");
     // The mitred offset: a step of height / (d . n) along d puts the node at distance height
     // from every interface face whose corner normal fixes the cap's rim, so at convex and
     // concave edges and corners a buffer hex's top stays parallel to its bottom instead of
@@ -260,8 +276,9 @@ void BufferBuilder::directions() {
     // than the taper costs: tried on lshape, cylinder and nugget.)
     std::vector<Point> directions_at;
     for (const Point& n : corner_normals_[k])
-      if (std::none_of(directions_at.begin(), directions_at.end(),
-                       [&](const Point& f) { return f.normalized().dot(n.normalized()) >= feature_cos; }))
+      if (std::none_of(directions_at.begin(), directions_at.end(), [&](const Point& f) {
+            return f.normalized().dot(n.normalized()) >= feature_cos;
+          }))
         directions_at.push_back(n);
     if (directions_at.size() >= 3 && d.dot(lean[k]) > 0.0) feature_[k] = opt_.feature_thickness;
   }
@@ -296,7 +313,8 @@ void BufferBuilder::heights() {
   grade_down(step_, quad_edges_, opt_.smooth_rate);
   safe_ = step_;
   for (std::size_t k = 0; k < n_moved_; ++k)
-    step_[k] = std::max(step_[k], std::min(raised[k], feature_[k] * thickness_ * mean_quad_edge[k] / (2.0 * quads_at[k])));
+    step_[k] = std::max(step_[k], std::min(raised[k], feature_[k] * thickness_ * mean_quad_edge[k] /
+                                                          (2.0 * quads_at[k])));
   grade_down(step_, quad_edges_, opt_.smooth_rate);
 }
 
@@ -352,16 +370,18 @@ std::string BufferBuilder::check(std::vector<char>& failing) {
       failing[static_cast<std::size_t>(v) - n_points_] = 1;
     } else if (hex_side_ && moved(v)) {
       failing[slot(v)] = 1;
-    } else if (const Index q = centre_of_[static_cast<std::size_t>(v)]; !hex_side_ && q != kInvalidIndex) {
+    } else if (const Index q = centre_of_[static_cast<std::size_t>(v)];
+               !hex_side_ && q != kInvalidIndex) {
       for (std::size_t i = 4; i < 8; ++i)
-        failing[static_cast<std::size_t>(out_.hexes[static_cast<std::size_t>(q)].corners[i]) - n_points_] = 1;
+        failing[static_cast<std::size_t>(out_.hexes[static_cast<std::size_t>(q)].corners[i]) -
+                n_points_] = 1;
     }
   };
   std::string first_failure;
   auto keeps_only = [&](ElementKind kind, Index c, double ratio, const char* what, Index v) {
     if (first_failure.empty())
-      first_failure = describe_node(input_, v) + ": " + describe_element(input_, {kind, c}) + " keeps only " +
-                      std::to_string(ratio) + " of its " + what;
+      first_failure = describe_node(input_, v) + ": " + describe_element(input_, {kind, c}) +
+                      " keeps only " + std::to_string(ratio) + " of its " + what;
   };
   out_.report.min_volume_ratio = 1.0;
   out_.report.min_scaled_jacobian = 1.0;
@@ -385,7 +405,8 @@ std::string BufferBuilder::check(std::vector<char>& failing) {
         const bool volume = ratio < opt_.min_volume_ratio;
         for (Index v : hex)
           if (moved(v))
-            keeps_only(ElementKind::Hex, h, volume ? ratio : sj_ratio, volume ? "volume" : "scaled Jacobian", v);
+            keeps_only(ElementKind::Hex, h, volume ? ratio : sj_ratio,
+                       volume ? "volume" : "scaled Jacobian", v);
       }
     }
   } else {
@@ -393,9 +414,10 @@ std::string BufferBuilder::check(std::vector<char>& failing) {
       const Index t = touched_[i];
       const auto& tet = input_.tets[static_cast<std::size_t>(t)];
       const auto& now = out_.model.tets[static_cast<std::size_t>(t)];
-      const double ratio = tet_volume(pts[static_cast<std::size_t>(now[0])], pts[static_cast<std::size_t>(now[1])],
-                                      pts[static_cast<std::size_t>(now[2])], pts[static_cast<std::size_t>(now[3])]) /
-                           before_[i];
+      const double ratio =
+          tet_volume(pts[static_cast<std::size_t>(now[0])], pts[static_cast<std::size_t>(now[1])],
+                     pts[static_cast<std::size_t>(now[2])], pts[static_cast<std::size_t>(now[3])]) /
+          before_[i];
       out_.report.min_volume_ratio = std::min(out_.report.min_volume_ratio, ratio);
       if (ratio < opt_.min_volume_ratio) {
         for (Index v : now) fail_node(v);
@@ -426,7 +448,8 @@ std::string BufferBuilder::check(std::vector<char>& failing) {
         if (first_failure.empty()) {
           const InterfaceQuad& q = itf_.quads[static_cast<std::size_t>(b.quad)];
           first_failure = describe_node(input_, b.corners[i - 4]) + ": the buffer hex on face " +
-                          std::to_string(q.face + 1) + " of " + describe_element(input_, {ElementKind::Hex, q.hex}) +
+                          std::to_string(q.face + 1) + " of " +
+                          describe_element(input_, {ElementKind::Hex, q.hex}) +
                           " has scaled Jacobian " + std::to_string(sj);
         }
       }
@@ -443,8 +466,8 @@ void BufferBuilder::move_and_check() {
     out_.report.halvings = halvings;
     if (first_failure.empty()) break;
     if (halvings >= opt_.max_halvings)
-      throw TopologyError("insert_buffer_layer: no valid buffer layer after " + std::to_string(halvings) +
-                          " halvings of the step: " + first_failure);
+      throw TopologyError("insert_buffer_layer: no valid buffer layer after " +
+                          std::to_string(halvings) + " halvings of the step: " + first_failure);
     bool halved = false;
     for (std::size_t k = 0; k < n_moved_; ++k)
       if (failing[k]) {  // a raised node falls back to its safe height first
@@ -475,12 +498,15 @@ BufferLayer BufferBuilder::run() {
   interface_geometry();
   std::vector<std::pair<Index, int>> interface_faces;  // (cell, local face) of the moving part
   for (const InterfaceQuad& q : itf_.quads) {
-    if (hex_side_) interface_faces.emplace_back(q.hex, q.face);
+    if (hex_side_)
+      interface_faces.emplace_back(q.hex, q.face);
     else
-      for (int i = 0; i < q.triangle_count(); ++i) interface_faces.emplace_back(q.tets[i], q.tet_faces[i]);
+      for (int i = 0; i < q.triangle_count(); ++i)
+        interface_faces.emplace_back(q.tets[i], q.tet_faces[i]);
   }
   if (hex_side_)
-    moving_part(input_.hexes, topology::kHexEdgeCorners, topology::kHexFaceCorners, interface_faces);
+    moving_part(input_.hexes, topology::kHexEdgeCorners, topology::kHexFaceCorners,
+                interface_faces);
   else
     moving_part(input_.tets, topology::kTetEdgeCorners, topology::kTetFaceCorners, interface_faces);
   measure_before();
@@ -501,11 +527,12 @@ BufferSide parse_buffer_side(const std::string& word) {
   throw InvalidInput("buffer side '" + word + "': expected hex or tet");
 }
 
-BufferLayer insert_buffer_layer(const Model& input, const Interface& itf, const BufferLayerOptions& opt) {
+BufferLayer insert_buffer_layer(const Model& input, const Interface& itf,
+                                const BufferLayerOptions& opt) {
   validate(input, "insert_buffer_layer");
   if (!(opt.thickness >= 0.0 && opt.thickness <= max_buffer_thickness(opt.side)))
-    throw InvalidInput("insert_buffer_layer: thickness " + std::to_string(opt.thickness) + " from the " +
-                       buffer_side_name(opt.side) + " part (at most " +
+    throw InvalidInput("insert_buffer_layer: thickness " + std::to_string(opt.thickness) +
+                       " from the " + buffer_side_name(opt.side) + " part (at most " +
                        std::to_string(max_buffer_thickness(opt.side)) + ")");
   return BufferBuilder(input, itf, opt).run();
 }

@@ -42,10 +42,14 @@ enum class BufferSide { kHex, kTet };
 
 // The default thickness per side: half the shortest edge from the hex part; 0.3 from the tet
 // part, whose first tets lose that fraction of their height.
-constexpr double default_buffer_thickness(BufferSide side) { return side == BufferSide::kHex ? 0.5 : 0.3; }
+constexpr double default_buffer_thickness(BufferSide side) {
+  return side == BufferSide::kHex ? 0.5 : 0.3;
+}
 // The largest thickness per side: a hex squashed by more than 0.9 of its edge is nearly flat;
 // tets beside the interface would lose more than 0.45 of their height.
-constexpr double max_buffer_thickness(BufferSide side) { return side == BufferSide::kHex ? 0.9 : 0.45; }
+constexpr double max_buffer_thickness(BufferSide side) {
+  return side == BufferSide::kHex ? 0.9 : 0.45;
+}
 
 // "hex" or "tet"; parse_buffer_side throws InvalidInput naming any other word.
 const char* buffer_side_name(BufferSide side);
@@ -101,10 +105,10 @@ struct BufferHex {
 };
 
 struct BufferLayerReport {
-  double min_volume_ratio = 1.0;        // over the elements that moved
-  double min_scaled_jacobian = 1.0;     // over the buffer hexes
+  double min_volume_ratio = 1.0;          // over the elements that moved
+  double min_scaled_jacobian = 1.0;       // over the buffer hexes
   double min_step = 0.0, max_step = 0.0;  // distances the moving copies moved
-  int halvings = 0;                     // rounds of step halving needed
+  int halvings = 0;                       // rounds of step halving needed
 };
 
 struct BufferLayer {
@@ -115,7 +119,7 @@ struct BufferLayer {
   // quads have moved. Hexes, blocks, node sets (which keep the hex-side nodes) and side sets
   // are unchanged; the buffer hexes are not in it.
   Model model;
-  std::vector<Index> top_node;  // per input node: its tet-side duplicate or kInvalidIndex
+  std::vector<Index> top_node;   // per input node: its tet-side duplicate or kInvalidIndex
   std::vector<BufferHex> hexes;  // one per interface quad, in Interface::quads order
   BufferLayerReport report;
 };

@@ -64,10 +64,11 @@ OutputBlocks output_blocks(const primal::Model& input, const std::string& geode_
 // A four-triangle top (a centre node, `centre`, at (r, s) = (1/2, 1/2)) at (r, s): linear over
 // each of its four triangles, as buffer_map's two-triangle tops are.
 Point four_triangle_top(const std::array<Point, 8>& P, const Point& centre, double r, double s) {
-  // Top corners 4..7 at (r, s) = (0,0), (1,0), (1,1), (0,1); triangle i is (4+i, 4+(i+1)%4, centre),
-  // the one whose side of the square is nearest to (r, s).
+  // Top corners 4..7 at (r, s) = (0,0), (1,0), (1,1), (0,1); triangle i is (4+i, 4+(i+1)%4,
+  // centre), the one whose side of the square is nearest to (r, s).
   const std::array<double, 4> side_distance{s, 1 - r, 1 - s, r};
-  const int i = static_cast<int>(std::min_element(side_distance.begin(), side_distance.end()) - side_distance.begin());
+  const int i = static_cast<int>(std::min_element(side_distance.begin(), side_distance.end()) -
+                                 side_distance.begin());
   constexpr std::array<std::array<double, 2>, 4> kAt{{{0, 0}, {1, 0}, {1, 1}, {0, 1}}};
   const auto& a = kAt[i];
   const auto& b = kAt[(i + 1) % 4];
@@ -84,8 +85,8 @@ Point four_triangle_top(const std::array<Point, 8>& P, const Point& centre, doub
 // them. The trilinear map would instead follow a twisted top's bilinear surface, whose
 // diagonal midpoint passes the template nodes under it; this one keeps every template hex
 // positive wherever the buffer hex is valid. With `centre`, the top is four_triangle_top.
-Point buffer_map(const std::array<Point, 8>& P, const std::array<int, 2>& diagonal, const Point& rst,
-                 const Point* centre = nullptr) {
+Point buffer_map(const std::array<Point, 8>& P, const std::array<int, 2>& diagonal,
+                 const Point& rst, const Point* centre = nullptr) {
   const double r = rst.x(), s = rst.y(), t = rst.z();
   const Point bottom = primal::multilinear_point(P, Point(r, s, 0.0), 2);
   // Top corners 4..7 at (r, s) = (0,0), (1,0), (1,1), (0,1).
@@ -148,9 +149,9 @@ class Conformer {
   void smooth();
   void smooth_defects(primal::LocalSmoothOptions o);
   std::vector<double> aims() const;
-  double measure();                             // every hex, then scan()
-  void measure(std::span<const Index> hexes);   // these only, the others unchanged since
-  double scan();                                // inverted_ and the minimum from sj_
+  double measure();                            // every hex, then scan()
+  void measure(std::span<const Index> hexes);  // these only, the others unchanged since
+  double scan();                               // inverted_ and the minimum from sj_
   void verify();
   void output();
 
@@ -192,9 +193,14 @@ void Conformer::find_interface() {
   t0_ = Clock::now();
   hex_diced_ = primal::diced_scaled_jacobian_per_cell(input_.points, input_.hexes);
   tet_diced_ = primal::diced_scaled_jacobian_per_cell(input_.points, input_.tets);
-  if (!hex_diced_.empty()) res_.input_diced_hex_min_scaled_jacobian = *std::min_element(hex_diced_.begin(), hex_diced_.end());
-  if (!tet_diced_.empty()) res_.input_diced_tet_min_scaled_jacobian = *std::min_element(tet_diced_.begin(), tet_diced_.end());
-  res_.input_diced_wedge_min_scaled_jacobian = primal::diced_wedge_min_scaled_jacobian(input_.points, input_.wedges);
+  if (!hex_diced_.empty())
+    res_.input_diced_hex_min_scaled_jacobian =
+        *std::min_element(hex_diced_.begin(), hex_diced_.end());
+  if (!tet_diced_.empty())
+    res_.input_diced_tet_min_scaled_jacobian =
+        *std::min_element(tet_diced_.begin(), tet_diced_.end());
+  res_.input_diced_wedge_min_scaled_jacobian =
+      primal::diced_wedge_min_scaled_jacobian(input_.points, input_.wedges);
   // A model without a hex part or a tet part has no transition to make: it is simply diced.
   if (!input_.hexes.empty() && !input_.tets.empty())
     interface_ = primal::find_interface(input_, options_.interface_tolerance);
@@ -205,9 +211,13 @@ void Conformer::find_interface() {
   // The local yardstick: per interface node the lowest element around it, per quad over its nodes.
   std::vector<double> node_min(input_.points.size(), 1.0);
   for (std::size_t h = 0; h < input_.hexes.size(); ++h)
-    for (Index v : input_.hexes[h]) node_min[static_cast<std::size_t>(v)] = std::min(node_min[static_cast<std::size_t>(v)], hex_diced_[h]);
+    for (Index v : input_.hexes[h])
+      node_min[static_cast<std::size_t>(v)] =
+          std::min(node_min[static_cast<std::size_t>(v)], hex_diced_[h]);
   for (std::size_t t = 0; t < input_.tets.size(); ++t)
-    for (Index v : input_.tets[t]) node_min[static_cast<std::size_t>(v)] = std::min(node_min[static_cast<std::size_t>(v)], tet_diced_[t]);
+    for (Index v : input_.tets[t])
+      node_min[static_cast<std::size_t>(v)] =
+          std::min(node_min[static_cast<std::size_t>(v)], tet_diced_[t]);
   res_.local_yardstick.reserve(interface_.quads.size());
   for (const primal::InterfaceQuad& q : interface_.quads) {
     double m = 1.0;
@@ -235,21 +245,26 @@ void Conformer::check_wedges() const {
     const auto& c = input_.wedges[w];
     for (Index v : c)
       if (on_interface[static_cast<std::size_t>(v)])
-        throw TopologyError("conform: " + primal::describe_element(input_, ref) + " touches the hex/tet interface at " +
-                            primal::describe_node(input_, v) +
-                            "; a transition beside wedges is not supported yet (the wedge is diced in place)");
+        throw TopologyError(
+            "conform: " + primal::describe_element(input_, ref) +
+            " touches the hex/tet interface at " + primal::describe_node(input_, v) +
+            "; a transition beside wedges is not supported yet (the wedge is diced in place)");
     for (int f = 0; f < topo.faces; ++f) {
       const auto& face = topo.face[static_cast<std::size_t>(f)];
       if (face.size != 4) continue;
-      const auto q = [&](int k) { return c[static_cast<std::size_t>(face.corners[static_cast<std::size_t>(k)])]; };
+      const auto q = [&](int k) {
+        return c[static_cast<std::size_t>(face.corners[static_cast<std::size_t>(k)])];
+      };
       for (int d = 0; d < 2; ++d) {
         const std::array<Index, 3> tri{q(d), q(d + 1), q(d + 2)};
         const primal::Side* owner = faces.find(tri);
         if (owner && owner->element.kind == primal::ElementKind::Tet)
-          throw TopologyError("conform: face " + std::to_string(f + 1) + " of " + primal::describe_element(input_, ref) +
-                              " (nodes " + primal::node_list(input_, std::array<Index, 4>{q(0), q(1), q(2), q(3)}) +
-                              ") meets the triangles of " + primal::describe_element(input_, owner->element) +
-                              " (a pyramid on the wedge, split); a transition beside wedges is not supported yet");
+          throw TopologyError(
+              "conform: face " + std::to_string(f + 1) + " of " +
+              primal::describe_element(input_, ref) + " (nodes " +
+              primal::node_list(input_, std::array<Index, 4>{q(0), q(1), q(2), q(3)}) +
+              ") meets the triangles of " + primal::describe_element(input_, owner->element) +
+              " (a pyramid on the wedge, split); a transition beside wedges is not supported yet");
       }
     }
   }
@@ -280,17 +295,18 @@ void Conformer::insert_buffer() {
     res_.buffer_side = other.side;
     const std::string thickness =
         options_.buffer.thickness > 0.0
-            ? " (its default thickness " + std::to_string(default_buffer_thickness(other.side)) + ", not the " +
-                  std::to_string(options_.buffer.thickness) + " given)"
+            ? " (its default thickness " + std::to_string(default_buffer_thickness(other.side)) +
+                  ", not the " + std::to_string(options_.buffer.thickness) + " given)"
             : "";
-    res_.warnings.push_back(std::string("buffer layer carved from the ") + second + " part" + thickness +
-                            ", not the " + first + " part: " + e.what());
+    res_.warnings.push_back(std::string("buffer layer carved from the ") + second + " part" +
+                            thickness + ", not the " + first + " part: " + e.what());
   }
   carved_from_.reserve(layer_.hexes.size());
   for (const BufferHex& b : layer_.hexes) {
     const primal::InterfaceQuad& q = interface_.quads[b.quad];
-    carved_from_.push_back(res_.buffer_side == BufferSide::kHex ? primal::ElementRef{primal::ElementKind::Hex, q.hex}
-                                                               : primal::ElementRef{primal::ElementKind::Tet, q.tets[0]});
+    carved_from_.push_back(res_.buffer_side == BufferSide::kHex
+                               ? primal::ElementRef{primal::ElementKind::Hex, q.hex}
+                               : primal::ElementRef{primal::ElementKind::Tet, q.tets[0]});
   }
   interface_ = {};
   res_.buffer = layer_.report;
@@ -312,8 +328,8 @@ void Conformer::dice_and_merge() {
   res_.diced_tet_hexes = static_cast<Index>(diced_.tet_children.size());
   res_.diced_wedge_hexes = static_cast<Index>(diced_.wedge_children.size());
   say("dicing: " + std::to_string(res_.diced_hexes) + " hexes from hexes, " +
-      std::to_string(res_.diced_tet_hexes) + " from tets, " + std::to_string(res_.diced_wedge_hexes) + " from wedges" +
-      took());
+      std::to_string(res_.diced_tet_hexes) + " from tets, " +
+      std::to_string(res_.diced_wedge_hexes) + " from wedges" + took());
 }
 
 // A template in every buffer hex: tet/hex-side nodes become their diced node, interior nodes
@@ -323,13 +339,23 @@ void Conformer::place_templates() {
   // The four-triangle template only when some buffer hex needs it (it costs time); the
   // templates built in parallel (each once per process).
   if (layer_.hexes.empty()) return;  // no interface: no template
-  const bool any_four = std::any_of(layer_.hexes.begin(), layer_.hexes.end(), [](const BufferHex& b) { return b.centre != kInvalidIndex; });
-  tbb::parallel_invoke([&] { refs_[0] = &reference_template(options_.template_box, {4, 6}); },
-                       [&] { refs_[1] = &reference_template(options_.template_box, {5, 7}); },
-                       [&] { if (any_four) refs_[2] = &reference_template_four_triangles(options_.template_box); });
+  const bool any_four = std::any_of(layer_.hexes.begin(), layer_.hexes.end(),
+                                    [](const BufferHex& b) { return b.centre != kInvalidIndex; });
+  tbb::parallel_invoke(
+      [&] {
+        refs_[0] = &reference_template(options_.template_box, {4, 6});
+      },
+      [&] {
+        refs_[1] = &reference_template(options_.template_box, {5, 7});
+      },
+      [&] {
+        if (any_four) refs_[2] = &reference_template_four_triangles(options_.template_box);
+      });
   res_.template_min_scaled_jacobian =
       std::min(refs_[0]->min_scaled_jacobian, refs_[1]->min_scaled_jacobian);
-  if (any_four) res_.template_min_scaled_jacobian = std::min(res_.template_min_scaled_jacobian, refs_[2]->min_scaled_jacobian);
+  if (any_four)
+    res_.template_min_scaled_jacobian =
+        std::min(res_.template_min_scaled_jacobian, refs_[2]->min_scaled_jacobian);
   const primal::Model& lm = layer_.model;
   const std::size_t nb = layer_.hexes.size();
   inst_global_.assign(nb, {});
@@ -389,8 +415,8 @@ void Conformer::match_sides() {
       std::ostringstream m;
       m << "side face (" << key[0] << " " << key[1] << " " << key[2] << " " << key[3]
         << ") of the buffer layer is shared by " << uses.size()
-        << " buffer hexes (the interface is non-manifold along edge " << key[0] << "-"
-        << key[1] << ")";
+        << " buffer hexes (the interface is non-manifold along edge " << key[0] << "-" << key[1]
+        << ")";
       throw TopologyError(m.str());
     }
     if (uses.size() < 2) continue;
@@ -436,13 +462,15 @@ void Conformer::assemble() {
   const primal::Model& lm = layer_.model;
   // Side sets read the children in diced numbers: taken before the children move.
   side_sets_ = primal::diced_side_sets(lm, diced_, 0, res_.diced_hexes + res_.geode_hexes);
-  const std::size_t total = diced_.hex_children.size() + static_cast<std::size_t>(res_.geode_hexes) +
+  const std::size_t total = diced_.hex_children.size() +
+                            static_cast<std::size_t>(res_.geode_hexes) +
                             diced_.tet_children.size() + diced_.wedge_children.size();
   std::vector<std::array<Index, 8>> hexes = std::move(diced_.hex_children);
   hexes.reserve(total);
   std::vector<int> block;
   block.reserve(total);
-  for (Index parent : diced_.hex_parent) block.push_back(primal::block_of(lm, {primal::ElementKind::Hex, parent}));
+  for (Index parent : diced_.hex_parent)
+    block.push_back(primal::block_of(lm, {primal::ElementKind::Hex, parent}));
   diced_parent_ = std::move(diced_.hex_parent);  // per output diced hex: its input hex
   diced_.hex_parent = {};
   geode_first_.reserve(nb + 1);
@@ -459,11 +487,13 @@ void Conformer::assemble() {
   inst_global_ = {};
   hexes.insert(hexes.end(), diced_.tet_children.begin(), diced_.tet_children.end());
   diced_.tet_children = {};
-  for (Index parent : diced_.tet_parent) block.push_back(primal::block_of(lm, {primal::ElementKind::Tet, parent}));
+  for (Index parent : diced_.tet_parent)
+    block.push_back(primal::block_of(lm, {primal::ElementKind::Tet, parent}));
   diced_.tet_parent = {};
   hexes.insert(hexes.end(), diced_.wedge_children.begin(), diced_.wedge_children.end());
   diced_.wedge_children = {};
-  for (Index parent : diced_.wedge_parent) block.push_back(primal::block_of(lm, {primal::ElementKind::Wedge, parent}));
+  for (Index parent : diced_.wedge_parent)
+    block.push_back(primal::block_of(lm, {primal::ElementKind::Wedge, parent}));
   diced_.wedge_parent = {};
   diced_.shared = primal::KeyMap<4>();
   // Nodes numbered in order of first use by the hexes (unused ones dropped).
@@ -483,7 +513,8 @@ void Conformer::assemble() {
   for (primal::NodeSet& ns : sets.node_sets) {
     const std::size_t n = ns.nodes.size();
     for (std::size_t i = 0; i < n; ++i)
-      if (const auto v = static_cast<std::size_t>(ns.nodes[i]); v < layer_.top_node.size() && layer_.top_node[v] != kInvalidIndex)
+      if (const auto v = static_cast<std::size_t>(ns.nodes[i]);
+          v < layer_.top_node.size() && layer_.top_node[v] != kInvalidIndex)
         ns.nodes.push_back(layer_.top_node[v]);
   }
   node_sets_ = primal::diced_node_sets(sets, diced_, renum);
@@ -530,7 +561,8 @@ std::vector<std::pair<Index, Point>> Conformer::settled(std::size_t b) const {
   std::vector<primal::NodeConstraint> constraints;
   for (std::size_t i = 0; i < global.size(); ++i) {
     m.points.push_back(mesh_.points[global[i]]);
-    constraints.push_back(rt.interior(i) ? primal::NodeConstraint::free() : primal::NodeConstraint::fixed());
+    constraints.push_back(rt.interior(i) ? primal::NodeConstraint::free()
+                                         : primal::NodeConstraint::fixed());
   }
   primal::SmoothOptions so;
   so.max_iterations = kSettleIterations;
@@ -538,7 +570,8 @@ std::vector<std::pair<Index, Point>> Conformer::settled(std::size_t b) const {
   std::vector<std::pair<Index, Point>> moved;
   if (r.final_min_scaled_jacobian <= r.initial_min_scaled_jacobian) return moved;
   for (std::size_t i = 0; i < global.size(); ++i)
-    if (constraints[i].kind == primal::NodeConstraint::Kind::kFree) moved.emplace_back(global[i], m.points[i]);
+    if (constraints[i].kind == primal::NodeConstraint::Kind::kFree)
+      moved.emplace_back(global[i], m.points[i]);
   return moved;
 }
 
@@ -553,7 +586,8 @@ void Conformer::settle_templates() {
   std::vector<std::size_t> buffer_hexes;  // those with an inverted geode hex, ascending
   for (Index h : inverted_) {
     if (h < geode_first_.front() || h >= geode_first_.back()) continue;
-    const auto b = static_cast<std::size_t>(std::upper_bound(geode_first_.begin(), geode_first_.end(), h) - geode_first_.begin() - 1);
+    const auto b = static_cast<std::size_t>(
+        std::upper_bound(geode_first_.begin(), geode_first_.end(), h) - geode_first_.begin() - 1);
     if (buffer_hexes.empty() || buffer_hexes.back() != b) buffer_hexes.push_back(b);
   }
   if (buffer_hexes.empty()) {
@@ -564,7 +598,8 @@ void Conformer::settle_templates() {
   std::vector<std::vector<std::pair<Index, Point>>> moved(buffer_hexes.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, buffer_hexes.size(), 1),
                     [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t j = range.begin(); j != range.end(); ++j) moved[j] = settled(buffer_hexes[j]);
+                      for (std::size_t j = range.begin(); j != range.end(); ++j)
+                        moved[j] = settled(buffer_hexes[j]);
                     });
   for (std::size_t j = 0; j < buffer_hexes.size(); ++j) {
     if (moved[j].empty()) continue;
@@ -578,8 +613,8 @@ void Conformer::settle_templates() {
   res_.min_scaled_jacobian_before_smoothing = scan();
   res_.placement_inverted = static_cast<Index>(inverted_.size());
   say("settling: " + std::to_string(buffer_hexes.size()) + " templates with an inverted hex, " +
-      std::to_string(res_.templates_settled) + " settled, " + std::to_string(res_.placement_inverted) +
-      " hexes left inverted" + took());
+      std::to_string(res_.templates_settled) + " settled, " +
+      std::to_string(res_.placement_inverted) + " hexes left inverted" + took());
 }
 
 // A hex is untangled by moving its neighbours too: the patches start on it and on the hexes
@@ -600,8 +635,8 @@ void Conformer::untangle() {
   measure(r.region);
   res_.smoothing.final_min_scaled_jacobian = scan();
   res_.smoothing.final_inverted = static_cast<Index>(inverted_.size());
-  say("untangling: " + std::to_string(before) + " inverted hexes, " + std::to_string(inverted_.size()) +
-      " left" + took());
+  say("untangling: " + std::to_string(before) + " inverted hexes, " +
+      std::to_string(inverted_.size()) + " left" + took());
 }
 
 // Several smoothing calls report as one: their work adds up; the minima and inverted counts
@@ -613,9 +648,10 @@ void Conformer::add_smoothing(const primal::LocalSmoothResult& r) {
 }
 
 // The worst-first smoother (primal/local_smooth.hpp); nodes on the model boundary and between
-// blocks slide only where that keeps every block's volume. Local: patches seeded near the geode hexes, on the submesh around the seeds, so
-// the cost follows the interface (or, with the automatic target, its defects); global: every
-// hex, then the automatic passes wherever a hex is still below the yardstick.
+// blocks slide only where that keeps every block's volume. Local: patches seeded near the geode
+// hexes, on the submesh around the seeds, so the cost follows the interface (or, with the automatic
+// target, its defects); global: every hex, then the automatic passes wherever a hex is still below
+// the yardstick.
 void Conformer::smooth() {
   t0_ = Clock::now();
   res_.smoothing.initial_min_scaled_jacobian = res_.min_scaled_jacobian_before_smoothing;
@@ -623,7 +659,8 @@ void Conformer::smooth() {
   res_.smoothing.initial_inverted = res_.smoothing.final_inverted = res_.placement_inverted;
   if (options_.smooth == ConformSmooth::kNone) return untangle();
   const bool local = options_.smooth == ConformSmooth::kLocal;
-  primal::LocalSmoothOptions o = local ? options_.local_smooth_options : options_.global_smooth_options;
+  primal::LocalSmoothOptions o =
+      local ? options_.local_smooth_options : options_.global_smooth_options;
   auto last = Clock::now();
   o.progress = [&](std::size_t settled, std::size_t total) {
     if (options_.smoothing_progress) {
@@ -661,8 +698,8 @@ void Conformer::smooth() {
   res_.smoothing.final_inverted = static_cast<Index>(inverted_.size());
   untangle();
   const Index patches = res_.smoothing.patches;
-  say("smoothing (" + std::string(local ? "local" : "global") + "): " +
-      std::to_string(patches) + " patches, min scaled Jacobian " +
+  say("smoothing (" + std::string(local ? "local" : "global") + "): " + std::to_string(patches) +
+      " patches, min scaled Jacobian " +
       std::to_string(res_.smoothing.initial_min_scaled_jacobian) + " -> " +
       std::to_string(res_.smoothing.final_min_scaled_jacobian) + took());
 }
@@ -684,9 +721,9 @@ constexpr int kDefectRings = 1;
 constexpr double kDefectTarget = 1.1;       // x the aim, first pass
 constexpr double kDefectTargetStep = 0.02;  // added to it by each further pass
 constexpr int kDefectPasses = 8;
-constexpr int kDefectVisits = 1;            // patches seeded by one hex in one pass
-constexpr double kLocalAim = 0.9;           // x a geode hex's local yardstick (capped), see aims()
-constexpr double kPartAim = 0.5;            // x a diced hex's input hex diced alone, see aims()
+constexpr int kDefectVisits = 1;   // patches seeded by one hex in one pass
+constexpr double kLocalAim = 0.9;  // x a geode hex's local yardstick (capped), see aims()
+constexpr double kPartAim = 0.5;   // x a diced hex's input hex diced alone, see aims()
 
 // Keeps sj_ up to date. A pass changes only the hexes sharing a node with its seeds (its
 // region), and every defect was a seed, so the next pass's defects are in the region.
@@ -696,7 +733,8 @@ void Conformer::smooth_defects(primal::LocalSmoothOptions o) {
   for (std::size_t h = 0; h < sj_.size(); ++h)
     if (sj_[h] < aim[h]) defects.push_back(static_cast<Index>(h));
   if (defects.empty()) return;
-  const primal::SmoothStart start{sj_, primal::shortest_edge_per_hex(mesh_)};  // floors over all passes
+  const primal::SmoothStart start{sj_,
+                                  primal::shortest_edge_per_hex(mesh_)};  // floors over all passes
   o.goal = 0.0;
   o.hex_goals = aim;
   o.max_visits = kDefectVisits;
@@ -704,7 +742,8 @@ void Conformer::smooth_defects(primal::LocalSmoothOptions o) {
     std::vector<Index> seeds = defects;
     for (int ring = 0; ring < kDefectRings; ++ring) seeds = primal::hexes_around(mesh_, seeds);
     o.hex_targets.resize(aim.size());
-    for (std::size_t h = 0; h < aim.size(); ++h) o.hex_targets[h] = kDefectTarget * aim[h] + pass * kDefectTargetStep;
+    for (std::size_t h = 0; h < aim.size(); ++h)
+      o.hex_targets[h] = kDefectTarget * aim[h] + pass * kDefectTargetStep;
     const auto r = primal::smooth_hexes_around(mesh_, seeds, o, &start);
     add_smoothing(r);
     measure(r.region);
@@ -727,8 +766,10 @@ std::vector<double> Conformer::aims() const {
     aim[k] = std::max(yardstick, kPartAim * hex_diced_[static_cast<std::size_t>(diced_parent_[k])]);
   for (std::size_t b = 0; b + 1 < geode_first_.size(); ++b) {
     const double local = res_.local_yardstick[static_cast<std::size_t>(layer_.hexes[b].quad)];
-    const double a = std::max(yardstick, kLocalAim * std::min(local, res_.template_min_scaled_jacobian));
-    for (Index h = geode_first_[b]; h < geode_first_[b + 1]; ++h) aim[static_cast<std::size_t>(h)] = a;
+    const double a =
+        std::max(yardstick, kLocalAim * std::min(local, res_.template_min_scaled_jacobian));
+    for (Index h = geode_first_[b]; h < geode_first_[b + 1]; ++h)
+      aim[static_cast<std::size_t>(h)] = a;
   }
   return aim;
 }
@@ -739,7 +780,8 @@ double Conformer::measure() {
 }
 
 void Conformer::measure(std::span<const Index> hexes) {
-  for (Index h : hexes) sj_[static_cast<std::size_t>(h)] = primal::hex_scaled_jacobian(primal::hex_corners(mesh_, h));
+  for (Index h : hexes)
+    sj_[static_cast<std::size_t>(h)] = primal::hex_scaled_jacobian(primal::hex_corners(mesh_, h));
 }
 
 double Conformer::scan() {
@@ -766,7 +808,8 @@ void Conformer::verify() {
     res_.warnings.push_back(m.str());
   }
   std::map<int, std::vector<Index>> members;  // output block -> its hexes, ascending id
-  for (std::size_t h = 0; h < mesh_.hexes.size(); ++h) members[mesh_.block[h]].push_back(static_cast<Index>(h));
+  for (std::size_t h = 0; h < mesh_.hexes.size(); ++h)
+    members[mesh_.block[h]].push_back(static_cast<Index>(h));
   for (const auto& [id, sel] : members) {
     const auto name = blocks_.names.find(id);
     primal::QualityReport report;
@@ -777,16 +820,19 @@ void Conformer::verify() {
       values.reserve(sel.size());
       for (Index h : sel) values.push_back(sj_[static_cast<std::size_t>(h)]);
       report.num_hexes = static_cast<Index>(sel.size());
-      report.metrics.push_back(primal::summarize_metric(primal::HexMetric::kScaledJacobian, values, sel));
+      report.metrics.push_back(
+          primal::summarize_metric(primal::HexMetric::kScaledJacobian, values, sel));
     }
     BlockQuality q{id, name != blocks_.names.end() ? name->second : "block " + std::to_string(id),
                    std::move(report)};
     for (std::size_t h = 0; h < input_.hexes.size(); ++h)
       if (primal::block_of(input_, {primal::ElementKind::Hex, static_cast<Index>(h)}) == id)
-        q.input_diced_min_scaled_jacobian = std::min(q.input_diced_min_scaled_jacobian, hex_diced_[h]);
+        q.input_diced_min_scaled_jacobian =
+            std::min(q.input_diced_min_scaled_jacobian, hex_diced_[h]);
     for (std::size_t t = 0; t < input_.tets.size(); ++t)
       if (primal::block_of(input_, {primal::ElementKind::Tet, static_cast<Index>(t)}) == id)
-        q.input_diced_min_scaled_jacobian = std::min(q.input_diced_min_scaled_jacobian, tet_diced_[t]);
+        q.input_diced_min_scaled_jacobian =
+            std::min(q.input_diced_min_scaled_jacobian, tet_diced_[t]);
     res_.quality.push_back(std::move(q));
   }
   // The geode hexes against their local yardsticks, per block and over all.
@@ -794,7 +840,8 @@ void Conformer::verify() {
     const double local = res_.local_yardstick[static_cast<std::size_t>(layer_.hexes[b].quad)];
     for (Index h = geode_first_[b]; h < geode_first_[b + 1]; ++h) {
       const int id = mesh_.block[static_cast<std::size_t>(h)];
-      auto it = std::find_if(res_.quality.begin(), res_.quality.end(), [&](const BlockQuality& q) { return q.block == id; });
+      auto it = std::find_if(res_.quality.begin(), res_.quality.end(),
+                             [&](const BlockQuality& q) { return q.block == id; });
       const double sj = sj_[static_cast<std::size_t>(h)];
       ++it->geode_hexes;
       it->geode_min_scaled_jacobian = std::min(it->geode_min_scaled_jacobian, sj);
@@ -810,7 +857,8 @@ void Conformer::verify() {
 void Conformer::output() {
   primal::Model& out = res_.model;
   for (const BlockQuality& q : res_.quality)
-    if (auto it = blocks_.names.find(q.block); it != blocks_.names.end()) out.block_names.insert(*it);
+    if (auto it = blocks_.names.find(q.block); it != blocks_.names.end())
+      out.block_names.insert(*it);
   out.hex_block = std::move(mesh_.block);
   out.hexes = std::move(mesh_.hexes);
   out.points = std::move(mesh_.points);

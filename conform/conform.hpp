@@ -1,28 +1,29 @@
 #pragma once
 // The geode algorithm on a whole model (the paper's Sections 1 and 4): find the hex/tet
-// interface, shrink one part off it (buffer layer; the hex part by default), dice the hex part (8 per hex) and the
-// tet part (4 hexes per tet), fill every buffer hex with the 26-hex geode template (or, where
-// the interface quad is split into four triangles around a centre node, the 44-hex
+// interface, shrink one part off it (buffer layer; the hex part by default), dice the hex part (8
+// per hex) and the tet part (4 hexes per tet), fill every buffer hex with the 26-hex geode template
+// (or, where the interface quad is split into four triangles around a centre node, the 44-hex
 // four-triangle template) mapped into it (a template the map inverts is settled inside its
 // buffer hex), merge, smooth locally and verify. The result is all-hex.
 //
 // Merging. Tet- and hex-side template nodes are identified with diced nodes by their origin
 // (corner, edge midpoint, quad centre, triangle centroid, a four-triangle top's centre node:
-// the keys of primal/dice's node-origin map), never by position, and take the diced position. Side-face nodes of two buffer hexes
-// sharing a side face are matched topologically (the side face's quad mesh, propagated from the
-// shared top/bottom nodes across quad edges) and merged. The reference template's four side
-// faces carry one mirror-symmetric mesh (templates/side_faces.hpp) and a side face is mapped
-// bilinearly from its four corners by both buffer hexes, so both place a merged node at the
-// same point: no position is reconciled, and a placement valid in each buffer hex stays valid.
+// the keys of primal/dice's node-origin map), never by position, and take the diced position.
+// Side-face nodes of two buffer hexes sharing a side face are matched topologically (the side
+// face's quad mesh, propagated from the shared top/bottom nodes across quad edges) and merged. The
+// reference template's four side faces carry one mirror-symmetric mesh (templates/side_faces.hpp)
+// and a side face is mapped bilinearly from its four corners by both buffer hexes, so both place a
+// merged node at the same point: no position is reconciled, and a placement valid in each buffer
+// hex stays valid.
 #include <algorithm>
 #include <functional>
 #include <string>
 #include <vector>
 
 #include <geode/conform/buffer_layer.hpp>
+#include <geode/primal/local_smooth.hpp>
 #include <geode/primal/model.hpp>
 #include <geode/primal/quality_report.hpp>
-#include <geode/primal/local_smooth.hpp>
 #include <geode/primal/validity.hpp>
 
 namespace geode::conform {
@@ -137,12 +138,14 @@ struct ConformResult {
   // two-triangle interface quad and the four-triangle template's count per four-triangle one,
   // in Interface order, diced_tet_hexes diced tets), each in an input block:
   // a diced hex or tet in its parent's, a geode hex in that of the hex (or, carved from the tet
-  // part, the tet) its buffer hex was carved from (or ConformOptions::geode_block); input block names kept. Node sets: every input node of the set plus
-  // the diced edge / face nodes whose origin nodes are all in the set. Side sets: every input
-  // side becomes the diced children's faces lying on it (4 per hex face, 3 per tet face).
+  // part, the tet) its buffer hex was carved from (or ConformOptions::geode_block); input block
+  // names kept. Node sets: every input node of the set plus the diced edge / face nodes whose
+  // origin nodes are all in the set. Side sets: every input side becomes the diced children's faces
+  // lying on it (4 per hex face, 3 per tet face).
   primal::Model model;
   // input_tets: the input's own; its pyramids are split into two tets each before the rest.
-  primal::Index input_hexes = 0, input_tets = 0, input_pyramids = 0, input_wedges = 0, interface_quads = 0;
+  primal::Index input_hexes = 0, input_tets = 0, input_pyramids = 0, input_wedges = 0,
+                interface_quads = 0;
   primal::Index diced_hexes = 0, geode_hexes = 0, diced_tet_hexes = 0, diced_wedge_hexes = 0;
   BufferLayerReport buffer;
   BufferSide buffer_side = BufferSide::kHex;  // the part the buffer layer was carved from
@@ -176,8 +179,10 @@ struct ConformResult {
   // mesh's before and after (kNone: no patches when nothing was inverted).
   primal::LocalSmoothResult smoothing;
   primal::HexValidityReport validity;
-  std::vector<BlockQuality> quality;  // one per output block, ascending id ("block N" unnamed); ConformOptions::quality
-  std::vector<std::string> warnings;  // e.g. "3 hexes with scaled Jacobian <= 0 (1-based output elements): 12 40 ..."
+  std::vector<BlockQuality>
+      quality;  // one per output block, ascending id ("block N" unnamed); ConformOptions::quality
+  std::vector<std::string>
+      warnings;  // e.g. "3 hexes with scaled Jacobian <= 0 (1-based output elements): 12 40 ..."
   double seconds = 0.0;
 };
 

@@ -74,9 +74,9 @@ void check_distinct(const std::vector<Point>& pts, const Eigen::Vector3d& box) {
     for (std::size_t j = i + 1; j < pts.size(); ++j)
       if ((pts[i] - pts[j]).norm() < 1e-6 * box.norm()) {
         std::ostringstream m;
-        m << "the smoothed geode template in a " << box.x() << " x " << box.y() << " x "
-          << box.z() << " box has nodes " << i << " and " << j << " at one place ("
-          << pts[i].transpose() << "); choose other template proportions";
+        m << "the smoothed geode template in a " << box.x() << " x " << box.y() << " x " << box.z()
+          << " box has nodes " << i << " and " << j << " at one place (" << pts[i].transpose()
+          << "); choose other template proportions";
         throw TopologyError(m.str());
       }
 }
@@ -98,12 +98,14 @@ RefTemplate make_reference(const Eigen::Vector3d& box, std::array<int, 2> diagon
   // This class has no obstruction to untangling (primal/realizability.hpp), so it needs no
   // fix-up; a box that gave it one would be refused here rather than pillowed silently.
   if (four && !templates::template_obstructions(ref.tpl).empty())
-    throw TopologyError("the four-triangle template in a " + std::to_string(box.x()) + " x " + std::to_string(box.y()) +
-                        " x " + std::to_string(box.z()) + " box has obstructions to untangling");
+    throw TopologyError("the four-triangle template in a " + std::to_string(box.x()) + " x " +
+                        std::to_string(box.y()) + " x " + std::to_string(box.z()) +
+                        " box has obstructions to untangling");
   // The geode's four side faces become one shared mesh (templates/side_faces.hpp); the
   // four-triangle template takes the geode's afterwards (impose_geode_sides).
-  ref.min_scaled_jacobian = four ? smooth_template(ref.tpl, false).final_min_scaled_jacobian
-                                 : templates::smooth_template_shared_sides(ref.tpl).final_min_scaled_jacobian;
+  ref.min_scaled_jacobian =
+      four ? smooth_template(ref.tpl, false).final_min_scaled_jacobian
+           : templates::smooth_template_shared_sides(ref.tpl).final_min_scaled_jacobian;
   const auto& pts = ref.tpl.hex.points;
   const std::size_t n = pts.size();
   check_distinct(pts, box);
@@ -134,21 +136,25 @@ RefTemplate make_reference(const Eigen::Vector3d& box, std::array<int, 2> diagon
     } else if (b == 1 && a >= 0 && a != 1) {
       key = {corner_at(a / 2, 0, t), corner_at(a / 2, 1, t)};
     } else if (a == 1 && b == 1) {
-      if (bottom) key = {0, 1, 2, 3};
-      else key = {diagonal[0], diagonal[1]};
+      if (bottom)
+        key = {0, 1, 2, 3};
+      else
+        key = {diagonal[0], diagonal[1]};
     } else if (top) {
       // A triangle centroid: the triangle of the split top face containing the point.
       const bool d46 = diagonal == std::array<int, 2>{4, 6};
-      if (d46) key = q.x() > q.y() ? std::vector<int>{4, 5, 6} : std::vector<int>{4, 6, 7};
-      else key = q.x() + q.y() < 1 ? std::vector<int>{4, 5, 7} : std::vector<int>{5, 6, 7};
+      if (d46)
+        key = q.x() > q.y() ? std::vector<int>{4, 5, 6} : std::vector<int>{4, 6, 7};
+      else
+        key = q.x() + q.y() < 1 ? std::vector<int>{4, 5, 7} : std::vector<int>{5, 6, 7};
       double cr = 0, cs = 0;
       for (int c : key) cr += topo::kHexCornerCoords[c][0], cs += topo::kHexCornerCoords[c][1];
       if (std::abs(cr / 3 - q.x()) > kTol || std::abs(cs / 3 - q.y()) > kTol) key.clear();
     }
     if (key.empty() || std::find(key.begin(), key.end(), -1) != key.end()) {
       std::ostringstream m;
-      m << "geode template node " << i << " at (" << p.transpose()
-        << ") lies on the " << (top ? "tet" : "hex")
+      m << "geode template node " << i << " at (" << p.transpose() << ") lies on the "
+        << (top ? "tet" : "hex")
         << " side but at no diced position (corner, edge midpoint, face centre)";
       throw TopologyError(m.str());
     }
@@ -161,8 +167,8 @@ RefTemplate make_reference(const Eigen::Vector3d& box, std::array<int, 2> diagon
   return ref;
 }
 
-// Gives `four`'s side faces the reference positions of `geode`'s (node by node as match_side pairs them,
-// face k with face k, starting from the nodes both have on the tet and hex sides) and smooths
+// Gives `four`'s side faces the reference positions of `geode`'s (node by node as match_side pairs
+// them, face k with face k, starting from the nodes both have on the tet and hex sides) and smooths
 // its other nodes with every box face fixed: a four-triangle template then meets a geode
 // across a side face as two geodes meet, instead of at positions of its own.
 void impose_geode_sides(RefTemplate& four, const RefTemplate& geode, const Eigen::Vector3d& box) {
@@ -181,18 +187,22 @@ void impose_geode_sides(RefTemplate& four, const RefTemplate& geode, const Eigen
   const std::vector<Index> g4 = ids(four), gg = ids(geode);
   auto& pts = four.tpl.hex.points;
   for (int k = 0; k < 4; ++k)
-    for (const auto& [a, b] : match_side(four, k, g4, geode, k, gg, "the four-triangle template and the geode"))
+    for (const auto& [a, b] :
+         match_side(four, k, g4, geode, k, gg, "the four-triangle template and the geode"))
       if (four.key_corners[a].empty()) pts[a] = box_position(geode.rst[b], box);
   const Point lo = -0.5 * box, hi = 0.5 * box;
-  const auto constraints = primal::box_constraints(pts, lo, hi, {true, true, true, true, true, true});
-  four.min_scaled_jacobian = primal::smooth_hex_mesh(four.tpl.hex, constraints).final_min_scaled_jacobian;
+  const auto constraints =
+      primal::box_constraints(pts, lo, hi, {true, true, true, true, true, true});
+  four.min_scaled_jacobian =
+      primal::smooth_hex_mesh(four.tpl.hex, constraints).final_min_scaled_jacobian;
   check_distinct(pts, box);
   for (std::size_t i = 0; i < pts.size(); ++i) four.rst[i] = reference_coordinates(pts[i], box);
 }
 
 }  // namespace
 
-const RefTemplate& reference_template(const Eigen::Vector3d& given_box, std::array<int, 2> diagonal) {
+const RefTemplate& reference_template(const Eigen::Vector3d& given_box,
+                                      std::array<int, 2> diagonal) {
   // Only the box's proportions matter (the templates are kept in reference coordinates): build
   // them with the largest side 24, the scale the arrangement engine and smoother were tuned at,
   // so that --template-box 1e6x1e6x1e6 gives what 24x24x24 does.
@@ -222,7 +232,8 @@ const RefTemplate& reference_template(const Eigen::Vector3d& given_box, std::arr
     // hexes positive where the geode's box does not. Only reference coordinates are kept, so the
     // sides still match the geode's.
     const Eigen::Vector3d four_box(box.x(), 0.7 * box.y(), box.z());
-    auto four = std::make_unique<RefTemplate>(make_reference(four_box, {4, 6}, templates::TopSplit::FourTriangles));
+    auto four = std::make_unique<RefTemplate>(
+        make_reference(four_box, {4, 6}, templates::TopSplit::FourTriangles));
     impose_geode_sides(*four, geode, four_box);
     slot->value = std::move(four);
   });
@@ -233,9 +244,8 @@ const RefTemplate& reference_template_four_triangles(const Eigen::Vector3d& box)
   return reference_template(box, {kCentreCorner, kCentreCorner});
 }
 
-std::unordered_map<int, int> match_side(const RefTemplate& A, int ka,
-                                        const std::vector<Index>& ga, const RefTemplate& B,
-                                        int kb, const std::vector<Index>& gb,
+std::unordered_map<int, int> match_side(const RefTemplate& A, int ka, const std::vector<Index>& ga,
+                                        const RefTemplate& B, int kb, const std::vector<Index>& gb,
                                         const std::string& where) {
   auto fail = [&](const std::string& why) {
     throw TopologyError("side faces of " + where + " do not correspond: " + why);

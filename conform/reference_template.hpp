@@ -21,8 +21,9 @@ inline constexpr int kCentreCorner = 8;
 struct RefTemplate {
   templates::Template tpl;
   double min_scaled_jacobian = 0.0;
-  std::vector<primal::Point> rst;             // reference coordinates in [0, 1]^3
-  std::vector<std::vector<int>> key_corners;  // empty: not a tet/hex-side node; else corners 0..7 or kCentreCorner
+  std::vector<primal::Point> rst;  // reference coordinates in [0, 1]^3
+  std::vector<std::vector<int>>
+      key_corners;  // empty: not a tet/hex-side node; else corners 0..7 or kCentreCorner
   // Node i is used by this template alone: not a tet/hex-side node, not on a side face.
   bool interior(std::size_t i) const { return key_corners[i].empty() && tpl.node_faces[i] == 0; }
   // Per buffer hex side face 0..3 (topology order): its template nodes and quads.
@@ -53,9 +54,8 @@ const RefTemplate& reference_template_four_triangles(const Eigen::Vector3d& box)
 // images as an edge and agreeing with every match made so far. Returns A node -> B node;
 // throws TopologyError naming `where` when the face meshes do not correspond.
 std::unordered_map<int, int> match_side(const RefTemplate& A, int ka,
-                                        const std::vector<primal::Index>& ga,
-                                        const RefTemplate& B, int kb,
-                                        const std::vector<primal::Index>& gb,
+                                        const std::vector<primal::Index>& ga, const RefTemplate& B,
+                                        int kb, const std::vector<primal::Index>& gb,
                                         const std::string& where);
 
 }  // namespace geode::conform

@@ -21,8 +21,9 @@ double output_min_scaled_jacobian(const ConformResult& r) {
 
 bool result_valid(const ConformResult& r) {
   if (!r.validity.ok()) return false;
-  return std::all_of(r.quality.begin(), r.quality.end(),
-                     [](const BlockQuality& b) { return block_min_scaled_jacobian(b.report) > 0.0; });
+  return std::all_of(r.quality.begin(), r.quality.end(), [](const BlockQuality& b) {
+    return block_min_scaled_jacobian(b.report) > 0.0;
+  });
 }
 
 std::string invalid_reason(const ConformResult& r) {
@@ -40,18 +41,23 @@ std::string duplicate_node_hint(const primal::Model& model, const std::string& m
   const primal::Index merged = primal::merge_coincident_nodes(copy, tolerance);
   if (merged == 0) return {};
   std::ostringstream s;
-  s << "; hint: " << merged << " nodes lie at the same place as others (parts meshed separately?): "
-    << merge_option << (merge_option.ends_with('=') ? "" : " ") << tolerance << " merges them";
+  s << "; hint: " << merged
+    << " nodes lie at the same place as others (parts meshed separately?): " << merge_option
+    << (merge_option.ends_with('=') ? "" : " ") << tolerance << " merges them";
   return s.str();
 }
 
 nlohmann::json report_json(const ConformResult& r) {
   nlohmann::json j;
-  j["input"] = {{"hexes", r.input_hexes}, {"tets", r.input_tets}, {"pyramids", r.input_pyramids},
-                {"wedges", r.input_wedges}, {"interface_quads", r.interface_quads}};
-  j["output"] = {{"hexes", r.model.hexes.size()},    {"nodes", r.model.points.size()},
-                 {"diced_hexes", r.diced_hexes},     {"geode_hexes", r.geode_hexes},
-                 {"diced_tet_hexes", r.diced_tet_hexes}, {"diced_wedge_hexes", r.diced_wedge_hexes}};
+  j["input"] = {{"hexes", r.input_hexes},
+                {"tets", r.input_tets},
+                {"pyramids", r.input_pyramids},
+                {"wedges", r.input_wedges},
+                {"interface_quads", r.interface_quads}};
+  j["output"] = {
+      {"hexes", r.model.hexes.size()},        {"nodes", r.model.points.size()},
+      {"diced_hexes", r.diced_hexes},         {"geode_hexes", r.geode_hexes},
+      {"diced_tet_hexes", r.diced_tet_hexes}, {"diced_wedge_hexes", r.diced_wedge_hexes}};
   j["valid"] = r.validity.ok();
   j["template_min_scaled_jacobian"] = r.template_min_scaled_jacobian;
   j["min_scaled_jacobian_before_smoothing"] = r.min_scaled_jacobian_before_smoothing;
@@ -63,18 +69,21 @@ nlohmann::json report_json(const ConformResult& r) {
                     {"cpu_seconds", r.smoothing.cpu_seconds}};
   j["buffer_layer_min_scaled_jacobian"] = r.buffer.min_scaled_jacobian;
   j["buffer_side"] = buffer_side_name(r.buffer_side);
-  j["input_diced_alone_min_scaled_jacobian"] = {{"hexes", r.input_diced_hex_min_scaled_jacobian},
-                                                {"tets", r.input_diced_tet_min_scaled_jacobian},
-                                                {"wedges", r.input_diced_wedge_min_scaled_jacobian}};
+  j["input_diced_alone_min_scaled_jacobian"] = {
+      {"hexes", r.input_diced_hex_min_scaled_jacobian},
+      {"tets", r.input_diced_tet_min_scaled_jacobian},
+      {"wedges", r.input_diced_wedge_min_scaled_jacobian}};
   j["output_min_scaled_jacobian"] = output_min_scaled_jacobian(r);
   j["seconds"] = r.seconds;
   j["warnings"] = r.warnings;
   j["blocks"] = nlohmann::json::array();
   j["local_yardstick_ratio"] = r.local_yardstick_ratio;
   for (const auto& b : r.quality) {
-    nlohmann::json block = {{"id", b.block}, {"name", b.name},
-                            {"quality", primal::quality_report_json(b.report)},
-                            {"input_diced_alone_min_scaled_jacobian", b.input_diced_min_scaled_jacobian}};
+    nlohmann::json block = {
+        {"id", b.block},
+        {"name", b.name},
+        {"quality", primal::quality_report_json(b.report)},
+        {"input_diced_alone_min_scaled_jacobian", b.input_diced_min_scaled_jacobian}};
     if (b.geode_hexes > 0)
       block["geode"] = {{"hexes", b.geode_hexes},
                         {"min_scaled_jacobian", b.geode_min_scaled_jacobian},

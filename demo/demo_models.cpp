@@ -4,18 +4,18 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
-#include <string>
 #include <functional>
 #include <map>
 #include <memory>
 #include <numbers>
 #include <random>
+#include <stdexcept>
+#include <string>
 #include <utility>
 
+#include <geode/io/gmsh.hpp>
 #include <geode/primal/boundary.hpp>
 #include <geode/primal/errors.hpp>
-#include <geode/io/gmsh.hpp>
 #include <geode/primal/quality.hpp>
 
 namespace geode::demo {
@@ -89,7 +89,6 @@ Model with_gmsh(const std::string& name, F&& build) {
   }
 }
 
-
 // A closed triangulated surface being assembled for tet_fill: points merged by position.
 struct Shell {
   std::vector<Point> points;
@@ -147,11 +146,15 @@ void append_interface_triangles(Shell& shell, const Model& hexes, OnInterface on
     }
     // A split folding a non-convex quad (a triangle facing away from the quad) is not taken.
     const Point normal = (p[2] - p[0]).cross(p[3] - p[1]);
-    auto folds = [&](int a, int b, int d) { return (p[b] - p[a]).cross(p[d] - p[a]).dot(normal) <= 0; };
-    const bool folds02 = folds(0, 1, 2) || folds(0, 2, 3), folds13 = folds(0, 1, 3) || folds(1, 2, 3);
+    auto folds = [&](int a, int b, int d) {
+      return (p[b] - p[a]).cross(p[d] - p[a]).dot(normal) <= 0;
+    };
+    const bool folds02 = folds(0, 1, 2) || folds(0, 2, 3),
+               folds13 = folds(0, 1, 3) || folds(1, 2, 3);
     bool along13 = split(count++, c);
     bool four_folds = false;  // a triangle around the centre facing away (non-convex quad)
-    for (int k = 0; k < 4; ++k) four_folds |= (p[(k + 1) % 4] - p[k]).cross(c - p[k]).dot(normal) <= 0;
+    for (int k = 0; k < 4; ++k)
+      four_folds |= (p[(k + 1) % 4] - p[k]).cross(c - p[k]).dot(normal) <= 0;
     if (four(c) && !four_folds) {
       const Index m = shell.node(c);
       for (int k = 0; k < 4; ++k) shell.tris.push_back({n[k], n[(k + 1) % 4], m});
@@ -273,7 +276,8 @@ void append_solid_boundary(Shell& shell, double h, Build build, FixedCurve fixed
     const Box b = bounding_box(dim, tag);
     if (!fixed_curve(b)) continue;
     const double length = std::max({b[3] - b[0], b[4] - b[1], b[5] - b[2]});
-    gmsh::model::mesh::setTransfiniteCurve(tag, std::max(1, static_cast<int>(std::lround(length / h))) + 1);
+    gmsh::model::mesh::setTransfiniteCurve(
+        tag, std::max(1, static_cast<int>(std::lround(length / h))) + 1);
   }
   gmsh::model::mesh::generate(2);
   append_gmsh_triangles(shell, [&](int tag) { return keep(bounding_box(2, tag)); });
@@ -286,8 +290,8 @@ void append_solid_boundary(Shell& shell, double h, Build build, FixedCurve fixed
 std::function<bool(int, const Point&)> diagonal_chooser(DemoDiagonals d, double h) {
   if (d == DemoDiagonals::kAlternate)
     return [h](int, const Point& c) {
-      const long long s = std::llround(std::floor(c.x() / h)) + std::llround(std::floor(c.y() / h)) +
-                          std::llround(std::floor(c.z() / h));
+      const long long s = std::llround(std::floor(c.x() / h)) +
+                          std::llround(std::floor(c.y() / h)) + std::llround(std::floor(c.z() / h));
       return (s & 1) != 0;
     };
   auto rng = std::make_shared<std::mt19937>(12345u);
@@ -317,7 +321,8 @@ void transfinite_box(int volume, double h) {
   for (const auto& [dim, tag] : curves) {
     double length = 0.0;  // the curve's own length: boxes may be tilted
     gmsh::model::occ::getMass(1, std::abs(tag), length);
-    gmsh::model::mesh::setTransfiniteCurve(std::abs(tag), std::max(1, static_cast<int>(std::lround(length / h))) + 1);
+    gmsh::model::mesh::setTransfiniteCurve(
+        std::abs(tag), std::max(1, static_cast<int>(std::lround(length / h))) + 1);
   }
   for (int s : boundary_surfaces(volume)) {
     gmsh::model::mesh::setTransfiniteSurface(s);
@@ -348,8 +353,9 @@ gmsh::vectorpair split_box_blocks(Keep keep) {
     for (int j = 0; j < 3; ++j)
       for (int k = 0; k < 3; ++k)
         if (keep(i, j, k))
-          blocks.push_back({3, gmsh::model::occ::addBox(edges[i], edges[j], edges[k], edges[i + 1] - edges[i],
-                                                        edges[j + 1] - edges[j], edges[k + 1] - edges[k])});
+          blocks.push_back(
+              {3, gmsh::model::occ::addBox(edges[i], edges[j], edges[k], edges[i + 1] - edges[i],
+                                           edges[j + 1] - edges[j], edges[k + 1] - edges[k])});
   gmsh::vectorpair fragments;
   std::vector<gmsh::vectorpair> map;
   gmsh::model::occ::fragment(blocks, {}, fragments, map);
@@ -362,7 +368,8 @@ void add_outside_side_set(Model& m) {
   for (const BoundaryQuad& q : boundary_quads(hex_part(m))) {
     Point c = Point::Zero();
     for (Index v : q.nodes) c += m.points[static_cast<std::size_t>(v)] / 4.0;
-    if (c.cwiseAbs().maxCoeff() > 2.0 - 1e-9) outside.sides.push_back({{ElementKind::Hex, q.hex}, q.local_face});
+    if (c.cwiseAbs().maxCoeff() > 2.0 - 1e-9)
+      outside.sides.push_back({{ElementKind::Hex, q.hex}, q.local_face});
   }
   m.side_sets.push_back(std::move(outside));
 }
@@ -401,10 +408,12 @@ Model demo_half_block(int n) {
 }
 
 Model demo_nugget(int n) {
-  if (n < 2 || n % 2 != 0) throw InvalidInput("demo_nugget: n = " + std::to_string(n) + " must be even and >= 2");
+  if (n < 2 || n % 2 != 0)
+    throw InvalidInput("demo_nugget: n = " + std::to_string(n) + " must be even and >= 2");
   Model m = with_gmsh("demo_nugget", [n] {
     // Shared faces between the hex blocks (not with the nugget: its faces carry triangles).
-    const gmsh::vectorpair fragments = split_box_blocks([](int i, int j, int k) { return i != 1 || j != 1 || k != 1; });
+    const gmsh::vectorpair fragments =
+        split_box_blocks([](int i, int j, int k) { return i != 1 || j != 1 || k != 1; });
     const int nugget = gmsh::model::occ::addBox(-1, -1, -1, 2, 2, 2);
     gmsh::model::occ::synchronize();
     transfinite_curves(2.0 / n);
@@ -441,8 +450,9 @@ Model demo_delaunay_block(int n, DemoDiagonals diagonals, bool four_triangles) {
     append_solid_boundary(
         shell, h, [] { gmsh::model::occ::addBox(1, 0, 0, 1, 1, 1); },
         [](const Box& b) { return b[3] < 1 + kEps; }, [](const Box& b) { return b[3] > 1 + kEps; });
-    append_interface_triangles(shell, hexes, [](const Point& c) { return c.x() > 1 - kEps; },
-                               diagonal_chooser(diagonals, h), four_chooser(four_triangles));
+    append_interface_triangles(
+        shell, hexes, [](const Point& c) { return c.x() > 1 - kEps; },
+        diagonal_chooser(diagonals, h), four_chooser(four_triangles));
     return join(std::move(hexes), tet_fill(shell, {}, 2, "tet"));
   });
 }
@@ -469,8 +479,9 @@ Model demo_cylinder(int n, bool four_triangles) {
     append_solid_boundary(
         outer, 2 * h, [] { gmsh::model::occ::addBox(-1, -1, -1, 2, 2, 2); },
         [](const Box&) { return false; }, [](const Box&) { return true; });
-    append_interface_triangles(inner, hexes, [](const Point&) { return true; },
-                               diagonal_chooser(DemoDiagonals::kRandom, h), four_chooser(four_triangles));
+    append_interface_triangles(
+        inner, hexes, [](const Point&) { return true; },
+        diagonal_chooser(DemoDiagonals::kRandom, h), four_chooser(four_triangles));
     return join(std::move(hexes), tet_fill(outer, {inner}, 2, "tet box"));
   });
 }
@@ -564,8 +575,8 @@ SquareQuads mesh_imprinted_square(int n, double r, int algorithm, int circle_seg
   gmsh::model::mesh::getElementsByType(2, triangles, triangle_nodes);
   gmsh::model::remove();
   for (std::size_t e = 0; e + 3 < quad_nodes.size(); e += 4)
-    f.quads.push_back({index.at(quad_nodes[e]), index.at(quad_nodes[e + 1]), index.at(quad_nodes[e + 2]),
-                       index.at(quad_nodes[e + 3])});
+    f.quads.push_back({index.at(quad_nodes[e]), index.at(quad_nodes[e + 1]),
+                       index.at(quad_nodes[e + 2]), index.at(quad_nodes[e + 3])});
   if (!triangles.empty() || !tiles_square(f)) f.quads.clear();
   return f;
 }
@@ -578,8 +589,9 @@ SquareQuads imprinted_square(int n, double r) {
       SquareQuads f = mesh_imprinted_square(n, r, algorithm, segments + extra);
       if (!f.quads.empty()) return f;
     }
-  throw std::runtime_error("demo_fulcher: Gmsh's quads do not tile the face with a circle of radius " +
-                           std::to_string(r) + " at n = " + std::to_string(n) + " (triangles left or quads folded)");
+  throw std::runtime_error(
+      "demo_fulcher: Gmsh's quads do not tile the face with a circle of radius " +
+      std::to_string(r) + " at n = " + std::to_string(n) + " (triangles left or quads folded)");
 }
 
 // The face quads swept along `axis` from the nugget face (coordinate 1) to the box (2) in
@@ -610,14 +622,15 @@ void append_swept_slab(Model& m, const SquareQuads& face, int axis, int layers) 
 }  // namespace
 
 Model demo_fulcher(int n) {
-  if (n < 2 || n % 2 != 0) throw InvalidInput("demo_fulcher: n = " + std::to_string(n) + " must be even and >= 2");
+  if (n < 2 || n % 2 != 0)
+    throw InvalidInput("demo_fulcher: n = " + std::to_string(n) + " must be even and >= 2");
   // Circle radii on the nugget faces x = 1, y = 1, z = 1.
   constexpr std::array<double, 3> radii{0.3, 0.5, 0.7};
   return run_gmsh("demo_fulcher", [&] {
     Model hexes = hex_part_from_gmsh("fulcher blocks", [n] {
       // The nugget and the three swept slabs (added below) are not structured blocks.
-      const gmsh::vectorpair fragments =
-          split_box_blocks([](int i, int j, int k) { return (i == 1) + (j == 1) + (k == 1) < 2 || i + j + k < 3; });
+      const gmsh::vectorpair fragments = split_box_blocks(
+          [](int i, int j, int k) { return (i == 1) + (j == 1) + (k == 1) < 2 || i + j + k < 3; });
       gmsh::model::occ::synchronize();
       std::vector<int> volumes;
       for (const auto& [dim, tag] : fragments) {
@@ -628,13 +641,15 @@ Model demo_fulcher(int n) {
       gmsh::model::setPhysicalName(3, 1, "hex blocks");
     });
     for (int axis = 0; axis < 3; ++axis)
-      append_swept_slab(hexes, imprinted_square(n, radii[static_cast<std::size_t>(axis)]), axis, n / 2);
+      append_swept_slab(hexes, imprinted_square(n, radii[static_cast<std::size_t>(axis)]), axis,
+                        n / 2);
     merge_coincident_nodes(hexes, 1e-9);
     orient_positively(hexes);
     // The whole nugget boundary is interface: its triangles are the hex quads split in two.
     Shell shell;
-    append_interface_triangles(shell, hexes, [](const Point& c) { return c.cwiseAbs().maxCoeff() < 1 + kEps; },
-                               diagonal_chooser(DemoDiagonals::kRandom, 2.0 / n), four_chooser(false));
+    append_interface_triangles(
+        shell, hexes, [](const Point& c) { return c.cwiseAbs().maxCoeff() < 1 + kEps; },
+        diagonal_chooser(DemoDiagonals::kRandom, 2.0 / n), four_chooser(false));
     Model m = join(std::move(hexes), tet_fill(shell, {}, 2, "tet nugget"));
     add_outside_side_set(m);
     return m;
@@ -662,7 +677,8 @@ Model hybrid_gmsh(const std::string& name, F&& build) {
     for (auto& p : m.pyramids)
       if (tet_volume(pt(p[0]), pt(p[1]), pt(p[2]), pt(p[4])) < 0) std::swap(p[1], p[3]);
     for (auto& w : m.wedges)
-      if (tet_volume(pt(w[0]), pt(w[1]), pt(w[2]), pt(w[3])) < 0) std::swap(w[1], w[2]), std::swap(w[4], w[5]);
+      if (tet_volume(pt(w[0]), pt(w[1]), pt(w[2]), pt(w[3])) < 0)
+        std::swap(w[1], w[2]), std::swap(w[4], w[5]);
     return m;
   } catch (const std::string& s) {
     throw std::runtime_error(name + ": Gmsh failed: " + s);
@@ -677,7 +693,8 @@ void name_volume(int volume, int block, const std::string& name) {
 // OCC boxes fragmented so that neighbours share their faces; returns the volumes in input order.
 std::vector<int> shared_boxes(const std::vector<std::array<double, 6>>& boxes) {
   gmsh::vectorpair in;
-  for (const auto& b : boxes) in.push_back({3, gmsh::model::occ::addBox(b[0], b[1], b[2], b[3], b[4], b[5])});
+  for (const auto& b : boxes)
+    in.push_back({3, gmsh::model::occ::addBox(b[0], b[1], b[2], b[3], b[4], b[5])});
   gmsh::vectorpair fragments;
   std::vector<gmsh::vectorpair> map;
   gmsh::model::occ::fragment(in, {}, fragments, map);
@@ -722,7 +739,8 @@ Model demo_hybrid_cylinder(int n) {
     for (const auto& [dim, tag] : map[0])
       if (tag != cylinder) potting = tag;
     gmsh::option::setNumber("Mesh.MeshSizeMax", h);
-    gmsh::option::setNumber("Mesh.RecombinationAlgorithm", 3);  // blossom full-quad: no triangle left
+    gmsh::option::setNumber("Mesh.RecombinationAlgorithm",
+                            3);  // blossom full-quad: no triangle left
     gmsh::model::mesh::setRecombine(2, disk);
     name_volume(cylinder, 1, "hex cylinder");
     name_volume(potting, 2, "tet box");
@@ -780,7 +798,8 @@ namespace {
 
 // One part of the potting model: `build` adds its OCC volumes (fragmented where they touch) and
 // sets their meshing; they become block `id` named `name`.
-Model potting_part(int id, const std::string& name, const std::function<gmsh::vectorpair()>& build) {
+Model potting_part(int id, const std::string& name,
+                   const std::function<gmsh::vectorpair()>& build) {
   return hex_part_from_gmsh(name, [&] {
     const gmsh::vectorpair volumes = build();
     std::vector<int> tags;
@@ -793,16 +812,21 @@ Model potting_part(int id, const std::string& name, const std::function<gmsh::ve
 // Structured boxes (each {x0, y0, z0, x1, y1, z1}; touching ones must meet in whole faces, so
 // that each stays a six-faced transfinite block), fragmented so that they share those faces,
 // optionally rotated by `angle` about the axis through `centre`.
-gmsh::vectorpair structured_boxes(const std::vector<Box>& boxes, double h, const Point& centre = Point::Zero(),
+gmsh::vectorpair structured_boxes(const std::vector<Box>& boxes, double h,
+                                  const Point& centre = Point::Zero(),
                                   const Point& axis = Point::UnitZ(), double angle = 0.0) {
   gmsh::vectorpair volumes, fragments;
   for (const Box& b : boxes)
-    volumes.push_back({3, gmsh::model::occ::addBox(b[0], b[1], b[2], b[3] - b[0], b[4] - b[1], b[5] - b[2])});
+    volumes.push_back(
+        {3, gmsh::model::occ::addBox(b[0], b[1], b[2], b[3] - b[0], b[4] - b[1], b[5] - b[2])});
   std::vector<gmsh::vectorpair> map;
-  if (volumes.size() > 1) gmsh::model::occ::fragment(volumes, {}, fragments, map);
-  else fragments = volumes;
+  if (volumes.size() > 1)
+    gmsh::model::occ::fragment(volumes, {}, fragments, map);
+  else
+    fragments = volumes;
   if (angle != 0.0)
-    gmsh::model::occ::rotate(fragments, centre.x(), centre.y(), centre.z(), axis.x(), axis.y(), axis.z(), angle);
+    gmsh::model::occ::rotate(fragments, centre.x(), centre.y(), centre.z(), axis.x(), axis.y(),
+                             axis.z(), angle);
   gmsh::model::occ::synchronize();
   for (const auto& [dim, tag] : fragments) transfinite_box(tag, h);
   return fragments;
@@ -812,7 +836,9 @@ gmsh::vectorpair structured_boxes(const std::vector<Box>& boxes, double h, const
 // recombined quads swept along the axis over `length` in layers of about h.
 gmsh::vectorpair swept_cylinder(const Point& centre, double r, int axis, double length, double h) {
   const int disk = gmsh::model::occ::addDisk(centre.x(), centre.y(), centre.z(), r, r);
-  if (axis == 0) gmsh::model::occ::rotate({{2, disk}}, centre.x(), centre.y(), centre.z(), 0, 1, 0, std::numbers::pi / 2);
+  if (axis == 0)
+    gmsh::model::occ::rotate({{2, disk}}, centre.x(), centre.y(), centre.z(), 0, 1, 0,
+                             std::numbers::pi / 2);
   gmsh::vectorpair out, volumes;
   const Point along = length * (axis == 0 ? Point::UnitX() : Point::UnitZ());
   gmsh::model::occ::extrude({{2, disk}}, along.x(), along.y(), along.z(), out,
@@ -832,16 +858,26 @@ Model demo_potting(int n) {
   const double h = 1.0 / n;
   return run_gmsh("demo_potting", [&] {
     std::vector<Model> parts;
-    parts.push_back(potting_part(1, "block_a", [&] { return structured_boxes({{0.5, 0.5, 0.6, 1.5, 1.5, 1.6}}, h); }));
-    parts.push_back(potting_part(2, "slab_b", [&] { return structured_boxes({{2.2, 0.5, 0.5, 4.2, 1.1, 1.5}}, h); }));
-    parts.push_back(potting_part(3, "pin_z", [&] { return swept_cylinder(Point(1.0, 3.0, 0.5), 0.4, 2, 1.4, h); }));
-    parts.push_back(potting_part(4, "pin_x", [&] { return swept_cylinder(Point(2.2, 3.5, 1.3), 0.3, 0, 2.1, h); }));
+    parts.push_back(potting_part(1, "block_a", [&] {
+      return structured_boxes({{0.5, 0.5, 0.6, 1.5, 1.5, 1.6}}, h);
+    }));
+    parts.push_back(potting_part(2, "slab_b", [&] {
+      return structured_boxes({{2.2, 0.5, 0.5, 4.2, 1.1, 1.5}}, h);
+    }));
+    parts.push_back(potting_part(
+        3, "pin_z", [&] { return swept_cylinder(Point(1.0, 3.0, 0.5), 0.4, 2, 1.4, h); }));
+    parts.push_back(potting_part(
+        4, "pin_x", [&] { return swept_cylinder(Point(2.2, 3.5, 1.3), 0.3, 0, 2.1, h); }));
     parts.push_back(potting_part(5, "tilted", [&] {
-      return structured_boxes({{2.8, 1.8, 0.8, 3.6, 2.6, 1.6}}, h, Point(3.2, 2.2, 1.2), Point(1, 1, 0), 0.5);
+      return structured_boxes({{2.8, 1.8, 0.8, 3.6, 2.6, 1.6}}, h, Point(3.2, 2.2, 1.2),
+                              Point(1, 1, 0), 0.5);
     }));
     // An L-shaped bracket: a concave edge and saddle corners where it meets its convex ones.
     parts.push_back(potting_part(6, "bracket", [&] {
-      return structured_boxes({{4.7, 0.5, 0.6, 5.2, 1.0, 1.6}, {5.2, 0.5, 0.6, 5.7, 1.0, 1.6}, {4.7, 1.0, 0.6, 5.2, 2.0, 1.6}}, h);
+      return structured_boxes({{4.7, 0.5, 0.6, 5.2, 1.0, 1.6},
+                               {5.2, 0.5, 0.6, 5.7, 1.0, 1.6},
+                               {4.7, 1.0, 0.6, 5.2, 2.0, 1.6}},
+                              h);
     }));
     gmsh::option::setNumber("Mesh.MeshSizeMax", 1e22);
     Shell outer;
@@ -851,15 +887,17 @@ Model demo_potting(int n) {
     std::vector<Shell> holes(parts.size());
     Model hexes;
     for (std::size_t i = 0; i < parts.size(); ++i) {
-      append_interface_triangles(holes[i], parts[i], [](const Point&) { return true; },
-                                 diagonal_chooser(DemoDiagonals::kRandom, h), four_chooser(false));
+      append_interface_triangles(
+          holes[i], parts[i], [](const Point&) { return true; },
+          diagonal_chooser(DemoDiagonals::kRandom, h), four_chooser(false));
       const Index offset = static_cast<Index>(hexes.points.size());
       hexes.points.insert(hexes.points.end(), parts[i].points.begin(), parts[i].points.end());
       for (auto hex : parts[i].hexes) {
         for (Index& v : hex) v += offset;
         hexes.hexes.push_back(hex);
       }
-      hexes.hex_block.insert(hexes.hex_block.end(), parts[i].hex_block.begin(), parts[i].hex_block.end());
+      hexes.hex_block.insert(hexes.hex_block.end(), parts[i].hex_block.begin(),
+                             parts[i].hex_block.end());
       hexes.block_names.insert(parts[i].block_names.begin(), parts[i].block_names.end());
     }
     return join(std::move(hexes), tet_fill(outer, holes, 7, "potting"));
@@ -869,7 +907,8 @@ Model demo_potting(int n) {
 Model demo_wedge(int n, double angle) {
   if (n < 2) throw InvalidInput("demo_wedge: n = " + std::to_string(n) + " must be >= 2");
   if (!(angle >= 30.0 && angle <= 330.0))
-    throw InvalidInput("demo_wedge: angle " + std::to_string(angle) + " must be in [30, 330] degrees");
+    throw InvalidInput("demo_wedge: angle " + std::to_string(angle) +
+                       " must be in [30, 330] degrees");
   const double h = 1.0 / n;  // the tet box's boundary cells: 1.5 h
   // k kites around the origin, each spanning angle / k there, right angles where its sides meet
   // the rays at distance 1.
@@ -877,29 +916,37 @@ Model demo_wedge(int n, double angle) {
   const double span = angle / k * std::numbers::pi / 180.0;
   return run_gmsh("demo_wedge", [&] {
     Model hexes = hex_part_from_gmsh("wedge", [&] {
-      auto ray = [](double a, double r) { return gmsh::model::occ::addPoint(r * std::cos(a), r * std::sin(a), 0.0); };
+      auto ray = [](double a, double r) {
+        return gmsh::model::occ::addPoint(r * std::cos(a), r * std::sin(a), 0.0);
+      };
       const int o = gmsh::model::occ::addPoint(0, 0, 0);
       std::vector<int> rim;
       for (int i = 0; i <= k; ++i) rim.push_back(ray(i * span, 1.0));
       gmsh::vectorpair kites;
       for (int i = 0; i < k; ++i) {
         const int tip = ray((i + 0.5) * span, 1.0 / std::cos(span / 2));
-        const std::vector<int> corners{o, rim[static_cast<std::size_t>(i)], tip, rim[static_cast<std::size_t>(i + 1)]};
+        const std::vector<int> corners{o, rim[static_cast<std::size_t>(i)], tip,
+                                       rim[static_cast<std::size_t>(i + 1)]};
         std::vector<int> lines;
-        for (std::size_t c = 0; c < 4; ++c) lines.push_back(gmsh::model::occ::addLine(corners[c], corners[(c + 1) % 4]));
-        kites.push_back({2, gmsh::model::occ::addPlaneSurface({gmsh::model::occ::addCurveLoop(lines)})});
+        for (std::size_t c = 0; c < 4; ++c)
+          lines.push_back(gmsh::model::occ::addLine(corners[c], corners[(c + 1) % 4]));
+        kites.push_back(
+            {2, gmsh::model::occ::addPlaneSurface({gmsh::model::occ::addCurveLoop(lines)})});
       }
       gmsh::vectorpair faces, out, volumes;
       std::vector<gmsh::vectorpair> map;
-      if (k > 1) gmsh::model::occ::fragment(kites, {}, faces, map);
-      else faces = kites;
+      if (k > 1)
+        gmsh::model::occ::fragment(kites, {}, faces, map);
+      else
+        faces = kites;
       gmsh::model::occ::extrude(faces, 0, 0, 1, out, {n}, {}, true);
       gmsh::model::occ::synchronize();
       // Opposite sides of a transfinite kite have equal counts, and neighbours share rays: n
       // cells on every side (the rim sides, tan(span / 2) long, get cells of their own size).
       gmsh::vectorpair curves;
       gmsh::model::getBoundary(faces, curves, false, false, false);
-      for (const auto& [dim, tag] : curves) gmsh::model::mesh::setTransfiniteCurve(std::abs(tag), n + 1);
+      for (const auto& [dim, tag] : curves)
+        gmsh::model::mesh::setTransfiniteCurve(std::abs(tag), n + 1);
       for (const auto& [dim, tag] : faces) {
         gmsh::model::mesh::setTransfiniteSurface(tag);
         gmsh::model::mesh::setRecombine(2, tag);
@@ -912,24 +959,29 @@ Model demo_wedge(int n, double angle) {
     });
     Box box{1e9, 1e9, 1e9, -1e9, -1e9, -1e9};
     for (const Point& p : hexes.points)
-      for (int a = 0; a < 3; ++a) box[a] = std::min(box[a], p[a]), box[a + 3] = std::max(box[a + 3], p[a]);
+      for (int a = 0; a < 3; ++a)
+        box[a] = std::min(box[a], p[a]), box[a + 3] = std::max(box[a + 3], p[a]);
     Shell outer, inner;
     append_solid_boundary(
         outer, 1.5 * h,
-        [&] { gmsh::model::occ::addBox(box[0] - 1, box[1] - 1, box[2] - 1, box[3] - box[0] + 2, box[4] - box[1] + 2, box[5] - box[2] + 2); },
+        [&] {
+          gmsh::model::occ::addBox(box[0] - 1, box[1] - 1, box[2] - 1, box[3] - box[0] + 2,
+                                   box[4] - box[1] + 2, box[5] - box[2] + 2);
+        },
         [](const Box&) { return false; }, [](const Box&) { return true; });
-    append_interface_triangles(inner, hexes, [](const Point&) { return true; },
-                               diagonal_chooser(DemoDiagonals::kRandom, h), four_chooser(false));
+    append_interface_triangles(
+        inner, hexes, [](const Point&) { return true; },
+        diagonal_chooser(DemoDiagonals::kRandom, h), four_chooser(false));
     return join(std::move(hexes), tet_fill(outer, {inner}, 2, "tet"));
   });
 }
 
-
 const std::vector<std::string>& demo_model_names() {
-  static const std::vector<std::string> names{"half", "delaunay", "delaunay-random", "cylinder",
-                                              "lshape", "nugget", "fulcher", "fourtri", "fourtri-cylinder",
-                                              "hybrid", "hybrid-cylinder", "boundary-layer", "hexdominant",
-                                              "potting"};
+  static const std::vector<std::string> names{"half",        "delaunay",        "delaunay-random",
+                                              "cylinder",    "lshape",          "nugget",
+                                              "fulcher",     "fourtri",         "fourtri-cylinder",
+                                              "hybrid",      "hybrid-cylinder", "boundary-layer",
+                                              "hexdominant", "potting"};
   return names;
 }
 

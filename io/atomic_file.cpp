@@ -59,12 +59,14 @@ class TempFileGuard {
 // write to it says (ENOSPC from /dev/full) is the error.
 void copy_into(const fs::path& from, const fs::path& to, const fs::path& shown) {
   const int in = ::open(from.c_str(), O_RDONLY);
-  if (in < 0) throw InvalidInput(shown.string() + ": cannot reopen the temporary file: " + reason(errno));
+  if (in < 0)
+    throw InvalidInput(shown.string() + ": cannot reopen the temporary file: " + reason(errno));
   const int out = ::open(to.c_str(), O_WRONLY | O_TRUNC);
   if (out < 0) {
     const int e = errno;
     ::close(in);
-    throw InvalidInput(shown.string() + ": cannot open " + to.string() + " for writing: " + reason(e));
+    throw InvalidInput(shown.string() + ": cannot open " + to.string() +
+                       " for writing: " + reason(e));
   }
   char buf[1 << 16];
   int failure = 0;
@@ -93,7 +95,8 @@ void copy_into(const fs::path& from, const fs::path& to, const fs::path& shown) 
 }
 
 void write_atomically(const fs::path& path, const std::string& suffix,
-                      const std::function<void(const fs::path& temp)>& write, bool require_content) {
+                      const std::function<void(const fs::path& temp)>& write,
+                      bool require_content) {
   if (path.filename().empty()) throw InvalidInput(path.string() + ": not a file name");
   const OutputTarget target = resolve_output(path);
   const fs::path tmp = create_temporary(target, suffix);
@@ -160,7 +163,8 @@ OutputTarget resolve_output(const fs::path& path) {
   OutputTarget t{p, true};
   const fs::file_status st = fs::status(p, ec);
   if (!ec && fs::exists(st)) {
-    if (fs::is_directory(st)) throw InvalidInput(path.string() + ": is a directory, not an output file");
+    if (fs::is_directory(st))
+      throw InvalidInput(path.string() + ": is a directory, not an output file");
     t.regular = fs::is_regular_file(st);
   }
   return t;
@@ -168,7 +172,7 @@ OutputTarget resolve_output(const fs::path& path) {
 
 fs::path create_temporary(const OutputTarget& target, const std::string& suffix) {
   std::error_code ec;
-  const fs::path dir = !target.regular ? fs::temp_directory_path(ec)
+  const fs::path dir = !target.regular                 ? fs::temp_directory_path(ec)
                        : target.file.has_parent_path() ? target.file.parent_path()
                                                        : fs::path(".");
   // O_CREAT|O_EXCL with a per-process counter gives a name no concurrent writer of the same
@@ -177,8 +181,8 @@ fs::path create_temporary(const OutputTarget& target, const std::string& suffix)
   fs::path tmp;
   int fd = -1;
   for (int attempt = 0; attempt < 100 && fd < 0; ++attempt) {
-    tmp = dir / ("." + target.file.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
-                 std::to_string(counter++) + suffix);
+    tmp = dir / ("." + target.file.filename().string() + ".tmp-" + std::to_string(::getpid()) +
+                 "-" + std::to_string(counter++) + suffix);
     // Registered before it exists: a signal between open and registration cannot leave it.
     register_temporary(tmp);
     fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0666);
@@ -186,8 +190,8 @@ fs::path create_temporary(const OutputTarget& target, const std::string& suffix)
     if (fd < 0 && errno != EEXIST) break;
   }
   if (fd < 0)
-    throw InvalidInput(target.file.string() + ": cannot create a temporary file in " + dir.string() + ": " +
-                       reason(errno));
+    throw InvalidInput(target.file.string() + ": cannot create a temporary file in " +
+                       dir.string() + ": " + reason(errno));
   ::close(fd);  // the writer reopens it by name; the name stays ours until renamed or removed
   return tmp;
 }
@@ -200,7 +204,8 @@ void publish_temporary(const fs::path& temp, const OutputTarget& target, const f
   }
   std::error_code ec;
   fs::rename(temp, target.file, ec);
-  if (ec) throw InvalidInput(shown.string() + ": cannot rename the temporary file: " + ec.message());
+  if (ec)
+    throw InvalidInput(shown.string() + ": cannot rename the temporary file: " + ec.message());
   unregister_temporary(temp);
 }
 
@@ -216,13 +221,16 @@ void write_path_atomically(const fs::path& path, const std::string& suffix,
 }
 
 void write_file_atomically(const fs::path& path, const std::function<void(std::ostream&)>& write) {
-  write_atomically(path, "", [&](const fs::path& tmp) {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw InvalidInput(path.string() + ": cannot open its temporary file");
-    write(out);
-    out.flush();
-    if (!out) throw InvalidInput(path.string() + ": write failed (disk full?)");
-  }, false);
+  write_atomically(
+      path, "",
+      [&](const fs::path& tmp) {
+        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+        if (!out) throw InvalidInput(path.string() + ": cannot open its temporary file");
+        write(out);
+        out.flush();
+        if (!out) throw InvalidInput(path.string() + ": write failed (disk full?)");
+      },
+      false);
 }
 
 }  // namespace geode::io

@@ -42,11 +42,13 @@ inline constexpr std::array<ExodusCell, 4> kExodusCells{{
 // The file is checked for the netCDF / HDF5 signature (file_format.hpp) before libexodusII
 // opens it. Node and element number maps, when present (Cubit writes them), are the model's
 // file ids; otherwise 1-based numbers. Block ids are the file's; a file with a block id <= 0
-// (meshio numbers blocks from 0) gets its blocks numbered 1, 2, ... in file order. Throws InvalidInput naming the file, the block / element
-// / set entry and the reason: missing or unreadable file, not an Exodus file (e.g. truncated),
-// an element type other than those of kExodusCells with their node counts, a node or element number out of range, a side number out of
+// (meshio numbers blocks from 0) gets its blocks numbered 1, 2, ... in file order. Throws
+// InvalidInput naming the file, the block / element / set entry and the reason: missing or
+// unreadable file, not an Exodus file (e.g. truncated), an element type other than those of
+// kExodusCells with their node counts, a node or element number out of range, a side number out of
 // range; then check_geometry (model.hpp) unless options say otherwise.
-primal::Model read_exodus(const std::filesystem::path& path, const primal::ReadOptions& options = {});
+primal::Model read_exodus(const std::filesystem::path& path,
+                          const primal::ReadOptions& options = {});
 
 // Writes atomically (a temporary file in the same directory, then rename).
 void write_exodus(const primal::Model& model, const std::filesystem::path& path);

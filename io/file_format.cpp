@@ -11,7 +11,9 @@ namespace geode::io {
 
 namespace {
 
-bool starts_with(std::string_view s, std::string_view prefix) { return s.substr(0, prefix.size()) == prefix; }
+bool starts_with(std::string_view s, std::string_view prefix) {
+  return s.substr(0, prefix.size()) == prefix;
+}
 
 std::string_view skip_space(std::string_view s) {
   if (starts_with(s, "\xEF\xBB\xBF")) s.remove_prefix(3);  // UTF-8 byte-order mark
@@ -27,13 +29,16 @@ bool looks_like_exodus(std::string_view head) {
     if (starts_with(head, cdf)) return true;
   constexpr std::string_view kHdf5("\x89HDF\r\n\x1a\n", 8);
   for (std::size_t offset : {0u, 512u, 1024u, 2048u})
-    if (head.size() >= offset + kHdf5.size() && head.substr(offset, kHdf5.size()) == kHdf5) return true;
+    if (head.size() >= offset + kHdf5.size() && head.substr(offset, kHdf5.size()) == kHdf5)
+      return true;
   return false;
 }
 
 bool looks_like_gmsh(std::string_view head) { return starts_with(skip_space(head), "$MeshFormat"); }
 
-bool looks_like_vtk(std::string_view head) { return starts_with(skip_space(head), "# vtk DataFile Version"); }
+bool looks_like_vtk(std::string_view head) {
+  return starts_with(skip_space(head), "# vtk DataFile Version");
+}
 
 bool looks_like_vtu(std::string_view head) {
   const std::string_view text = skip_space(head);
@@ -51,7 +56,8 @@ MeshFileFormat sniff_mesh_format(std::string_view head) {
 
 MeshFileFormat mesh_format_from_extension(const std::filesystem::path& path) {
   std::string e = path.extension().string();
-  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(e.begin(), e.end(), e.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   if (e == ".msh") return MeshFileFormat::kGmsh;
   if (e == ".exo" || e == ".e") return MeshFileFormat::kExodus;
   if (e == ".vtu") return MeshFileFormat::kVtu;
@@ -78,7 +84,8 @@ const char* mesh_format_name(MeshFileFormat format) {
 std::string read_file_head(const std::filesystem::path& path, std::size_t max_bytes) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) throw InvalidInput(path.string() + ": no such file");
-  if (!std::filesystem::is_regular_file(path, ec)) throw InvalidInput(path.string() + ": not a regular file");
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw InvalidInput(path.string() + ": not a regular file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InvalidInput(path.string() + ": cannot open for reading");
   std::string head(max_bytes, '\0');
@@ -92,7 +99,8 @@ std::string read_file_bytes(const std::filesystem::path& path) {
   if (!in) throw InvalidInput(path.string() + ": cannot open for reading");
   std::string bytes;
   char buf[1 << 16];
-  while (in.read(buf, sizeof buf) || in.gcount() > 0) bytes.append(buf, static_cast<std::size_t>(in.gcount()));
+  while (in.read(buf, sizeof buf) || in.gcount() > 0)
+    bytes.append(buf, static_cast<std::size_t>(in.gcount()));
   if (in.bad()) throw InvalidInput(path.string() + ": read error");
   return bytes;
 }

@@ -95,9 +95,9 @@ const std::vector<MeshFormat>& table() {
                    "hex, tet, pyramid, wedge; planar quad"},
        .read_variants = "ascii, binary (base64), appended (raw and base64), zlib-compressed, "
                         "UInt32 or UInt64 headers",
-       .written_as =
-           "binary (base64; `--vtu-encoding ascii`); cell arrays `block`, `mat_id` (the block again, for Python solvers), `scaled_jacobian`, "
-           "block names as field data `block:NAME`"},
+       .written_as = "binary (base64; `--vtu-encoding ascii`); cell arrays `block`, `mat_id` (the "
+                     "block again, for Python solvers), `scaled_jacobian`, "
+                     "block names as field data `block:NAME`"},
       {.name = "vtk",
        .title = "legacy VTK .vtk",
        .extensions = {".vtk"},
@@ -251,9 +251,11 @@ PlainMesh read_plain_mesh(const fs::path& path, const MeshFormat** format) {
   if (f->read_plain)
     if (auto m = f->read_plain(path)) return std::move(*m);
   const primal::Model model = read_model(path);
-  for (primal::ElementKind kind : {primal::ElementKind::Tet, primal::ElementKind::Pyramid, primal::ElementKind::Wedge})
+  for (primal::ElementKind kind :
+       {primal::ElementKind::Tet, primal::ElementKind::Pyramid, primal::ElementKind::Wedge})
     if (const std::size_t n = primal::element_count(model, kind))
-      throw InvalidInput(path.string() + ": holds " + std::to_string(n) + " " + primal::element_kind_name(kind) +
+      throw InvalidInput(path.string() + ": holds " + std::to_string(n) + " " +
+                         primal::element_kind_name(kind) +
                          "s; expected an all-hex mesh (use `geode conform` first)");
   PlainMesh m;
   m.hex = primal::hex_part(model);

@@ -9,10 +9,10 @@
 #include <string>
 #include <unordered_map>
 
-#include <geode/primal/boundary.hpp>
-#include <geode/primal/errors.hpp>
 #include <geode/io/file_format.hpp>
 #include <geode/io/mapped_file.hpp>
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/errors.hpp>
 #include <geode/primal/topology.hpp>
 
 namespace geode::io {
@@ -29,8 +29,7 @@ std::string gmsh_type_name(int type) {
   int dim = 0, order = 0, num_nodes = 0, num_primary = 0;
   std::vector<double> local;
   try {
-    gmsh::model::mesh::getElementProperties(type, name, dim, order, num_nodes, local,
-                                            num_primary);
+    gmsh::model::mesh::getElementProperties(type, name, dim, order, num_nodes, local, num_primary);
   } catch (...) {
     name = "unknown";
   }
@@ -108,8 +107,8 @@ Model model_from_gmsh(std::string_view source_view) {
       if (!name.empty()) model.block_names[block] = name;
     }
     if (block <= 0)
-      throw InvalidInput(source + ": volume entity " + std::to_string(tag) +
-                         ": block id " + std::to_string(block) + " is not positive");
+      throw InvalidInput(source + ": volume entity " + std::to_string(tag) + ": block id " +
+                         std::to_string(block) + " is not positive");
     block_entity.emplace_back(block, tag);
   }
   std::stable_sort(block_entity.begin(), block_entity.end(),
@@ -124,9 +123,11 @@ Model model_from_gmsh(std::string_view source_view) {
       const ElementKind* kind = gmsh_cell_kind(types[t]);
       if (!kind) {
         if (!tags.empty())
-          throw InvalidInput(source + ": element " + std::to_string(tags.front()) + ": " + gmsh_type_name(types[t]) +
-                             " is not supported; only linear cells are (4-node tetrahedra, 8-node hexahedra, "
-                             "6-node prisms, 5-node pyramids)");
+          throw InvalidInput(
+              source + ": element " + std::to_string(tags.front()) + ": " +
+              gmsh_type_name(types[t]) +
+              " is not supported; only linear cells are (4-node tetrahedra, 8-node hexahedra, "
+              "6-node prisms, 5-node pyramids)");
         continue;
       }
       const GmshCell& cell = kGmshCells[static_cast<std::size_t>(*kind)];
@@ -134,7 +135,8 @@ Model model_from_gmsh(std::string_view source_view) {
       for (std::size_t e = 0; e < tags.size(); ++e) {
         const std::string what = "element " + std::to_string(tags[e]);
         std::array<Index, 8> c{};
-        for (std::size_t k = 0; k < n; ++k) c[k] = node(nodes[n * e + static_cast<std::size_t>(cell.order[k])], what);
+        for (std::size_t k = 0; k < n; ++k)
+          c[k] = node(nodes[n * e + static_cast<std::size_t>(cell.order[k])], what);
         add_element(model, *kind, c, block, static_cast<std::int64_t>(tags[e]));
       }
     }
@@ -179,7 +181,8 @@ Model model_from_gmsh(std::string_view source_view) {
             for (std::size_t i = 0; i < n; ++i)
               face.push_back(node(element_nodes[t][n * e + i], where + ": " + what));
             const Side* owner = face_owner.find(face);
-            if (!owner) throw InvalidInput(where + ": " + what + " is not a face of any volume element");
+            if (!owner)
+              throw InvalidInput(where + ": " + what + " is not a face of any volume element");
             set.sides.push_back(*owner);
           }
         }

@@ -1,7 +1,7 @@
 #pragma once
-// Gmsh .msh input and output of a mixed model (hexes, tets, pyramids, prisms). Reading is our own (gmsh_read.cpp:
-// versions 2.2 and 4.1, ASCII and binary), so that a user's file never reaches libgmsh, which
-// would run any text that is not a mesh as a Gmsh script. Writing is our own too
+// Gmsh .msh input and output of a mixed model (hexes, tets, pyramids, prisms). Reading is our own
+// (gmsh_read.cpp: versions 2.2 and 4.1, ASCII and binary), so that a user's file never reaches
+// libgmsh, which would run any text that is not a mesh as a Gmsh script. Writing is our own too
 // (gmsh_write.cpp: 4.1 and 2.2, ASCII and binary, every write error reported); only the demo
 // models use the Gmsh C++ API (GmshSession, model_from_gmsh).
 //
@@ -18,12 +18,11 @@
 // Written physical tags are distinct across dimensions (gmsh_write.cpp: a set whose id is a
 // block's, or another set's, is moved by a power of ten). Names go through io/names.hpp.
 // Entries of node sets come back sorted by node number, those of side sets sorted (hex sides
-// first, by element and face), since Gmsh groups elements by type. Nodes are numbered by ascending Gmsh
-// tag; the writer uses tag = index + 1, so models round-trip.
-// Node order: Gmsh's 4-node tetrahedron (type 4) and 8-node hexahedron (type 5) use the same
-// corner order as VTK/Exodus (Gmsh reference manual, "Node ordering"); the tables
-// kGmshHexToVtk / kGmshTetToVtk below carry that fact as data and the tests check it on a
-// hand-written file.
+// first, by element and face), since Gmsh groups elements by type. Nodes are numbered by ascending
+// Gmsh tag; the writer uses tag = index + 1, so models round-trip. Node order: Gmsh's 4-node
+// tetrahedron (type 4) and 8-node hexahedron (type 5) use the same corner order as VTK/Exodus (Gmsh
+// reference manual, "Node ordering"); the tables kGmshHexToVtk / kGmshTetToVtk below carry that
+// fact as data and the tests check it on a hand-written file.
 #include <array>
 #include <filesystem>
 #include <string_view>
@@ -64,12 +63,13 @@ enum class GmshVersion { k41, k22 };
 // model's file ids. Throws InvalidInput naming the file, the line (byte in binary files) or
 // the element / node tag and the reason: missing or unreadable file, a file that does not
 // start with $MeshFormat (a script, another format), another version, a truncated section or
-// one without its $End line, a volume element that is not a linear hex, tet, pyramid or prism, an element
-// referring to a node not in $Nodes, a node given twice at two places, a side-set face that is
-// no face of a hex or tet; then check_geometry (model.hpp) unless options say otherwise.
+// one without its $End line, a volume element that is not a linear hex, tet, pyramid or prism, an
+// element referring to a node not in $Nodes, a node given twice at two places, a side-set face that
+// is no face of a hex or tet; then check_geometry (model.hpp) unless options say otherwise.
 primal::Model read_gmsh(const std::filesystem::path& path, const primal::ReadOptions& options = {});
 // The same on a file's content; `source` names it in messages.
-primal::Model parse_gmsh(std::string_view content, const std::string& source, const primal::ReadOptions& options = {});
+primal::Model parse_gmsh(std::string_view content, const std::string& source,
+                         const primal::ReadOptions& options = {});
 
 // Writes .msh (v4.1 or 2.2) atomically (a temporary file in the same directory, then rename).
 // Block ids must be positive; a block may hold both hexes and tets. Blocks become physical

@@ -13,12 +13,12 @@
 #include <string>
 #include <unordered_map>
 
-#include <geode/primal/boundary.hpp>
-#include <geode/primal/errors.hpp>
 #include <geode/io/file_format.hpp>
 #include <geode/io/gmsh.hpp>
 #include <geode/io/names.hpp>
 #include <geode/io/read_warnings.hpp>
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/errors.hpp>
 #include <geode/primal/topology.hpp>
 
 namespace geode::io {
@@ -39,17 +39,39 @@ struct GmshType {
 // Element types as the reference manual numbers them ("MSH file format", elm-type), with
 // their dimension and node count: enough to step over any element a mesh may hold.
 constexpr GmshType kGmshTypes[] = {
-    {1, 1, 2, "2-node line"},          {2, 2, 3, "3-node triangle"},      {3, 2, 4, "4-node quadrangle"},
-    {4, 3, 4, "4-node tetrahedron"},   {5, 3, 8, "8-node hexahedron"},    {6, 3, 6, "6-node prism"},
-    {7, 3, 5, "5-node pyramid"},       {8, 1, 3, "3-node line"},          {9, 2, 6, "6-node triangle"},
-    {10, 2, 9, "9-node quadrangle"},   {11, 3, 10, "10-node tetrahedron"}, {12, 3, 27, "27-node hexahedron"},
-    {13, 3, 18, "18-node prism"},      {14, 3, 14, "14-node pyramid"},    {15, 0, 1, "1-node point"},
-    {16, 2, 8, "8-node quadrangle"},   {17, 3, 20, "20-node hexahedron"}, {18, 3, 15, "15-node prism"},
-    {19, 3, 13, "13-node pyramid"},    {20, 2, 9, "9-node triangle"},     {21, 2, 10, "10-node triangle"},
-    {22, 2, 12, "12-node triangle"},   {23, 2, 15, "15-node triangle"},   {24, 2, 15, "15-node triangle"},
-    {25, 2, 21, "21-node triangle"},   {26, 1, 4, "4-node line"},         {27, 1, 5, "5-node line"},
-    {28, 1, 6, "6-node line"},         {29, 3, 20, "20-node tetrahedron"}, {30, 3, 35, "35-node tetrahedron"},
-    {31, 3, 56, "56-node tetrahedron"}, {92, 3, 64, "64-node hexahedron"}, {93, 3, 125, "125-node hexahedron"},
+    {1, 1, 2, "2-node line"},
+    {2, 2, 3, "3-node triangle"},
+    {3, 2, 4, "4-node quadrangle"},
+    {4, 3, 4, "4-node tetrahedron"},
+    {5, 3, 8, "8-node hexahedron"},
+    {6, 3, 6, "6-node prism"},
+    {7, 3, 5, "5-node pyramid"},
+    {8, 1, 3, "3-node line"},
+    {9, 2, 6, "6-node triangle"},
+    {10, 2, 9, "9-node quadrangle"},
+    {11, 3, 10, "10-node tetrahedron"},
+    {12, 3, 27, "27-node hexahedron"},
+    {13, 3, 18, "18-node prism"},
+    {14, 3, 14, "14-node pyramid"},
+    {15, 0, 1, "1-node point"},
+    {16, 2, 8, "8-node quadrangle"},
+    {17, 3, 20, "20-node hexahedron"},
+    {18, 3, 15, "15-node prism"},
+    {19, 3, 13, "13-node pyramid"},
+    {20, 2, 9, "9-node triangle"},
+    {21, 2, 10, "10-node triangle"},
+    {22, 2, 12, "12-node triangle"},
+    {23, 2, 15, "15-node triangle"},
+    {24, 2, 15, "15-node triangle"},
+    {25, 2, 21, "21-node triangle"},
+    {26, 1, 4, "4-node line"},
+    {27, 1, 5, "5-node line"},
+    {28, 1, 6, "6-node line"},
+    {29, 3, 20, "20-node tetrahedron"},
+    {30, 3, 35, "35-node tetrahedron"},
+    {31, 3, 56, "56-node tetrahedron"},
+    {92, 3, 64, "64-node hexahedron"},
+    {93, 3, 125, "125-node hexahedron"},
 };
 
 const GmshType* gmsh_type(long long type) {
@@ -62,7 +84,7 @@ struct RawElement {
   std::int64_t tag = 0;
   int type = 0;
   int entity = 0;
-  int physical = 0;  // version 2.2: the element's own physical tag (0: none)
+  int physical = 0;       // version 2.2: the element's own physical tag (0: none)
   std::size_t first = 0;  // into MshReader::element_nodes_
 };
 
@@ -72,7 +94,9 @@ class MshReader {
 
   Model read() {
     if (sniff_mesh_format(s_) != MeshFileFormat::kGmsh)
-      fail_at(0, "not in Gmsh .msh format (it does not start with $MeshFormat; Gmsh scripts are not read)");
+      fail_at(0,
+              "not in Gmsh .msh format (it does not start with $MeshFormat; Gmsh scripts are not "
+              "read)");
     bool have_nodes = false, have_elements = false;
     while (true) {
       skip_space();
@@ -114,7 +138,7 @@ class MshReader {
   std::size_t pos_ = 0;
   int version_ = 0;  // 2 (2.x) or 4 (4.1); 0 before $MeshFormat
   bool binary_ = false;
-  std::map<std::pair<int, int>, std::string> physical_names_;       // (dim, tag) -> name
+  std::map<std::pair<int, int>, std::string> physical_names_;         // (dim, tag) -> name
   std::map<std::pair<int, int>, std::vector<int>> entity_physicals_;  // (dim, entity) -> tags
   // $PartitionedEntities (a partitioned 4.1 file): elements then name these entities, each
   // with its parent entity of $Entities and physical tags of its own (Gmsh copies the
@@ -135,7 +159,10 @@ class MshReader {
   [[noreturn]] void fail_at(std::size_t at, const std::string& what) const {
     std::string where = source_ + ": ";
     if (!binary_ || version_ == 0) {
-      const auto line = std::count(s_.begin(), s_.begin() + static_cast<std::ptrdiff_t>(std::min(at, s_.size())), '\n') + 1;
+      const auto line =
+          std::count(s_.begin(), s_.begin() + static_cast<std::ptrdiff_t>(std::min(at, s_.size())),
+                     '\n') +
+          1;
       where += "line " + std::to_string(line) + ": ";
     } else {
       where += "byte " + std::to_string(at) + ": ";
@@ -153,7 +180,8 @@ class MshReader {
     skip_space();
     const std::size_t start = pos_;
     while (pos_ < s_.size() && !std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
-    if (start == pos_) fail(std::string("unexpected end of file reading ") + what + " (truncated file?)");
+    if (start == pos_)
+      fail(std::string("unexpected end of file reading ") + what + " (truncated file?)");
     const std::string_view t = s_.substr(start, pos_ - start);
     if (t.front() == '$') {
       pos_ = start;
@@ -167,7 +195,8 @@ class MshReader {
     T x{};
     const auto res = std::from_chars(t.data(), t.data() + t.size(), x);
     if (res.ec != std::errc() || res.ptr != t.data() + t.size())
-      fail_at(pos_ - t.size(), std::string(what) + ": '" + std::string(t) + "' is not an integer in range");
+      fail_at(pos_ - t.size(),
+              std::string(what) + ": '" + std::string(t) + "' is not an integer in range");
     return x;
   }
   double ascii_real(const char* what) {
@@ -180,26 +209,31 @@ class MshReader {
         t.find_first_of("eE") != std::string_view::npos && t.find("e-") == std::string_view::npos &&
         t.find("E-") == std::string_view::npos)
       return t.front() == '-' ? -HUGE_VAL : HUGE_VAL;
-    if (res.ec == std::errc::result_out_of_range && res.ptr == t.data() + t.size()) return 0.0;  // underflow
+    if (res.ec == std::errc::result_out_of_range && res.ptr == t.data() + t.size())
+      return 0.0;  // underflow
     if (res.ec != std::errc() || res.ptr != t.data() + t.size())
       fail_at(pos_ - t.size(), std::string(what) + ": '" + std::string(t) + "' is not a number");
     return x;
   }
   template <class T>
   T raw(const char* what) {
-    if (s_.size() - pos_ < sizeof(T)) fail(std::string("unexpected end of file reading ") + what + " (truncated file?)");
+    if (s_.size() - pos_ < sizeof(T))
+      fail(std::string("unexpected end of file reading ") + what + " (truncated file?)");
     T x;
     std::memcpy(&x, s_.data() + pos_, sizeof(T));
     pos_ += sizeof(T);
     return x;
   }
   // Fields: 4-byte int, size_t (8 bytes in 4.1 binary; int in 2.2 binary), double.
-  long long int_field(const char* what) { return binary_ ? raw<std::int32_t>(what) : ascii_integer<long long>(what); }
+  long long int_field(const char* what) {
+    return binary_ ? raw<std::int32_t>(what) : ascii_integer<long long>(what);
+  }
   long long size_field(const char* what) {
     if (!binary_) return ascii_integer<long long>(what);
     if (version_ == 2) return raw<std::int32_t>(what);
     const std::uint64_t v = raw<std::uint64_t>(what);
-    if (v > static_cast<std::uint64_t>(INT64_MAX)) fail_at(pos_ - 8, std::string(what) + ": " + std::to_string(v) + " is out of range");
+    if (v > static_cast<std::uint64_t>(INT64_MAX))
+      fail_at(pos_ - 8, std::string(what) + ": " + std::to_string(v) + " is out of range");
     return static_cast<long long>(v);
   }
   double real_field(const char* what) { return binary_ ? raw<double>(what) : ascii_real(what); }
@@ -209,8 +243,10 @@ class MshReader {
     const std::size_t at = pos_;
     const long long n = size_field(what);
     if (n < 0) fail_at(at, std::string(what) + " " + std::to_string(n) + " is negative");
-    if (static_cast<unsigned long long>(n) > (s_.size() - pos_) / std::max<std::size_t>(min_bytes, 1))
-      fail_at(at, std::string(what) + " " + std::to_string(n) + " is more than the rest of the file can hold (truncated file?)");
+    if (static_cast<unsigned long long>(n) >
+        (s_.size() - pos_) / std::max<std::size_t>(min_bytes, 1))
+      fail_at(at, std::string(what) + " " + std::to_string(n) +
+                      " is more than the rest of the file can hold (truncated file?)");
     return static_cast<std::size_t>(n);
   }
   // Per-item minimum sizes for count_field: ASCII items are at least "d " per number.
@@ -222,28 +258,36 @@ class MshReader {
   // ---- Sections --------------------------------------------------------------------------
 
   std::string section_name() {
-    if (s_[pos_] != '$') fail("expected a section ($Name), found '" + std::string(s_.substr(pos_, 20)) + "'");
+    if (s_[pos_] != '$')
+      fail("expected a section ($Name), found '" + std::string(s_.substr(pos_, 20)) + "'");
     const std::size_t start = ++pos_;
     while (pos_ < s_.size() && !std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
     const std::string name(s_.substr(start, pos_ - start));
     // The rest of the line: binary data starts right after it.
-    while (pos_ < s_.size() && s_[pos_] != '\n' && std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
+    while (pos_ < s_.size() && s_[pos_] != '\n' &&
+           std::isspace(static_cast<unsigned char>(s_[pos_])))
+      ++pos_;
     if (pos_ < s_.size() && s_[pos_] == '\n') ++pos_;
     return name;
   }
   void end_section(const std::string& name, std::size_t start) {
     skip_space();
     const std::string end = "$End" + name;
-    if (s_.substr(pos_, end.size()) != end || (pos_ + end.size() < s_.size() && !std::isspace(static_cast<unsigned char>(s_[pos_ + end.size()])))) {
+    if (s_.substr(pos_, end.size()) != end ||
+        (pos_ + end.size() < s_.size() &&
+         !std::isspace(static_cast<unsigned char>(s_[pos_ + end.size()])))) {
       if (pos_ >= s_.size()) fail_at(start, "$" + name + " has no " + end + " (truncated file?)");
-      fail("$" + name + " ends without " + end + " (found '" + std::string(s_.substr(pos_, std::min<std::size_t>(20, s_.find('\n', pos_) - pos_))) + "')");
+      fail("$" + name + " ends without " + end + " (found '" +
+           std::string(s_.substr(pos_, std::min<std::size_t>(20, s_.find('\n', pos_) - pos_))) +
+           "')");
     }
     pos_ += end.size();
   }
   void skip_section(const std::string& name, std::size_t start) {
     const std::string end = "$End" + name;
     const std::size_t e = s_.find(end, pos_);
-    if (e == std::string_view::npos) fail_at(start, "$" + name + " has no " + end + " (truncated file?)");
+    if (e == std::string_view::npos)
+      fail_at(start, "$" + name + " has no " + end + " (truncated file?)");
     pos_ = e + end.size();
   }
 
@@ -258,15 +302,21 @@ class MshReader {
       version_ = 2;
     else
       fail_at(at, "MSH version " + std::string(v) + " is not read (versions 2.2 and 4.1 are)");
-    if (file_type != 0 && file_type != 1) fail_at(at, "file type " + std::to_string(file_type) + " is neither 0 (ASCII) nor 1 (binary)");
-    if (data_size != 8) fail_at(at, "data size " + std::to_string(data_size) + " is not read (8 is)");
+    if (file_type != 0 && file_type != 1)
+      fail_at(at,
+              "file type " + std::to_string(file_type) + " is neither 0 (ASCII) nor 1 (binary)");
+    if (data_size != 8)
+      fail_at(at, "data size " + std::to_string(data_size) + " is not read (8 is)");
     binary_ = file_type == 1;
     if (binary_) {
       if (pos_ < s_.size() && s_[pos_] == '\r') ++pos_;
-      if (pos_ >= s_.size() || s_[pos_] != '\n') fail("binary $MeshFormat: no line end after the header");
+      if (pos_ >= s_.size() || s_[pos_] != '\n')
+        fail("binary $MeshFormat: no line end after the header");
       ++pos_;
       const std::int32_t one = raw<std::int32_t>("the endianness check");
-      if (one != 1) fail_at(pos_ - 4, "binary file of another byte order (the check integer reads " + std::to_string(one) + ")");
+      if (one != 1)
+        fail_at(pos_ - 4, "binary file of another byte order (the check integer reads " +
+                              std::to_string(one) + ")");
     }
   }
 
@@ -278,10 +328,12 @@ class MshReader {
       const int dim = static_cast<int>(ascii_integer<int>("a physical dimension"));
       const int tag = ascii_integer<int>("a physical tag");
       skip_space();
-      if (pos_ >= s_.size() || s_[pos_] != '"') fail("physical name " + std::to_string(tag) + ": expected a quoted name");
+      if (pos_ >= s_.size() || s_[pos_] != '"')
+        fail("physical name " + std::to_string(tag) + ": expected a quoted name");
       const std::size_t close = s_.find('"', pos_ + 1);
       const std::size_t eol = s_.find('\n', pos_);
-      if (close == std::string_view::npos || close > eol) fail("physical name " + std::to_string(tag) + ": no closing quote on its line");
+      if (close == std::string_view::npos || close > eol)
+        fail("physical name " + std::to_string(tag) + ": no closing quote on its line");
       physical_names_[{dim, tag}] = std::string(s_.substr(pos_ + 1, close - pos_ - 1));
       pos_ = close + 1;
     }
@@ -290,14 +342,16 @@ class MshReader {
 
   void entities() {
     std::array<std::size_t, 4> counts{};
-    for (std::size_t d = 0; d < 4; ++d) counts[d] = count_field("an entity count", item_bytes(5, 36));
+    for (std::size_t d = 0; d < 4; ++d)
+      counts[d] = count_field("an entity count", item_bytes(5, 36));
     for (int dim = 0; dim < 4; ++dim)
       for (std::size_t i = 0; i < counts[static_cast<std::size_t>(dim)]; ++i) {
         const int tag = static_cast<int>(int_field("an entity tag"));
         for (int k = 0; k < (dim == 0 ? 3 : 6); ++k) real_field("an entity bounding box");
         const std::size_t np = count_field("a physical tag count", item_bytes(1, 4));
         std::vector<int> physicals;
-        for (std::size_t p = 0; p < np; ++p) physicals.push_back(static_cast<int>(int_field("a physical tag")));
+        for (std::size_t p = 0; p < np; ++p)
+          physicals.push_back(static_cast<int>(int_field("a physical tag")));
         entity_physicals_[{dim, tag}] = std::move(physicals);
         if (dim > 0) {
           const std::size_t nb = count_field("a bounding entity count", item_bytes(1, 4));
@@ -315,7 +369,8 @@ class MshReader {
       int_field("a ghost entity's partition");
     }
     std::array<std::size_t, 4> counts{};
-    for (std::size_t d = 0; d < 4; ++d) counts[d] = count_field("a partitioned entity count", item_bytes(8, 48));
+    for (std::size_t d = 0; d < 4; ++d)
+      counts[d] = count_field("a partitioned entity count", item_bytes(8, 48));
     for (int dim = 0; dim < 4; ++dim)
       for (std::size_t i = 0; i < counts[static_cast<std::size_t>(dim)]; ++i) {
         const int tag = static_cast<int>(int_field("a partitioned entity tag"));
@@ -326,7 +381,8 @@ class MshReader {
         for (std::size_t k = 0; k < np; ++k) int_field("a partition tag");
         for (int k = 0; k < (dim == 0 ? 3 : 6); ++k) real_field("an entity bounding box");
         const std::size_t nph = count_field("a physical tag count", item_bytes(1, 4));
-        for (std::size_t k = 0; k < nph; ++k) p.physicals.push_back(static_cast<int>(int_field("a physical tag")));
+        for (std::size_t k = 0; k < nph; ++k)
+          p.physicals.push_back(static_cast<int>(int_field("a physical tag")));
         if (dim > 0) {
           const std::size_t nb = count_field("a bounding entity count", item_bytes(1, 4));
           for (std::size_t b = 0; b < nb; ++b) int_field("a bounding entity tag");
@@ -342,9 +398,12 @@ class MshReader {
 
   // The header of $Nodes and $Elements in 4.1: block count, item count, smallest and largest
   // tag (the tags are checked one by one instead).
-  std::pair<std::size_t, std::size_t> blocks_header(const char* items, std::size_t ascii_min, std::size_t binary_min) {
-    const std::size_t blocks = count_field((std::string("the number of ") + items + " blocks").c_str(), item_bytes(4, 20));
-    const std::size_t total = count_field((std::string("the number of ") + items + "s").c_str(), item_bytes(ascii_min, binary_min));
+  std::pair<std::size_t, std::size_t> blocks_header(const char* items, std::size_t ascii_min,
+                                                    std::size_t binary_min) {
+    const std::size_t blocks =
+        count_field((std::string("the number of ") + items + " blocks").c_str(), item_bytes(4, 20));
+    const std::size_t total = count_field((std::string("the number of ") + items + "s").c_str(),
+                                          item_bytes(ascii_min, binary_min));
     size_field("the smallest tag");
     size_field("the largest tag");
     return {blocks, total};
@@ -358,10 +417,14 @@ class MshReader {
       const long long dim = int_field("a node block's entity dimension");
       int_field("a node block's entity tag");
       const long long parametric = int_field("a node block's parametric flag");
-      if (dim < 0 || dim > 3) fail("node block " + std::to_string(b + 1) + ": entity dimension " + std::to_string(dim));
-      if (parametric != 0 && parametric != 1) fail("node block " + std::to_string(b + 1) + ": parametric flag " + std::to_string(parametric));
+      if (dim < 0 || dim > 3)
+        fail("node block " + std::to_string(b + 1) + ": entity dimension " + std::to_string(dim));
+      if (parametric != 0 && parametric != 1)
+        fail("node block " + std::to_string(b + 1) + ": parametric flag " +
+             std::to_string(parametric));
       const std::size_t extra = parametric ? static_cast<std::size_t>(dim) : 0;
-      const std::size_t n = count_field("a node block's node count", item_bytes(4 + extra, 32 + 8 * extra));
+      const std::size_t n =
+          count_field("a node block's node count", item_bytes(4 + extra, 32 + 8 * extra));
       std::vector<std::int64_t> tags(n);
       for (std::size_t i = 0; i < n; ++i) tags[i] = size_field("a node tag");
       for (std::size_t i = 0; i < n; ++i) {
@@ -372,17 +435,21 @@ class MshReader {
       }
     }
     if (node_tags_.size() != total)
-      fail("$Nodes announces " + std::to_string(total) + " nodes, its blocks hold " + std::to_string(node_tags_.size()));
+      fail("$Nodes announces " + std::to_string(total) + " nodes, its blocks hold " +
+           std::to_string(node_tags_.size()));
   }
 
   // A count written as text even in binary files (version 2.2), then its line end.
-  std::size_t text_count(const char* what, std::size_t ascii_min_bytes, std::size_t binary_min_bytes) {
+  std::size_t text_count(const char* what, std::size_t ascii_min_bytes,
+                         std::size_t binary_min_bytes) {
     const bool was_binary = binary_;
     binary_ = false;
     const std::size_t n = count_field(what, was_binary ? binary_min_bytes : ascii_min_bytes);
     binary_ = was_binary;
     if (binary_) {
-      while (pos_ < s_.size() && s_[pos_] != '\n' && std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
+      while (pos_ < s_.size() && s_[pos_] != '\n' &&
+             std::isspace(static_cast<unsigned char>(s_[pos_])))
+        ++pos_;
       if (pos_ >= s_.size() || s_[pos_] != '\n') fail(std::string("no line end after ") + what);
       ++pos_;
     }
@@ -394,7 +461,8 @@ class MshReader {
     node_tags_.reserve(n);
     node_points_.reserve(n);
     for (std::size_t i = 0; i < n; ++i) {
-      const std::int64_t tag = binary_ ? raw<std::int32_t>("a node tag") : ascii_integer<long long>("a node tag");
+      const std::int64_t tag =
+          binary_ ? raw<std::int32_t>("a node tag") : ascii_integer<long long>("a node tag");
       Point p;
       for (int k = 0; k < 3; ++k) p[k] = real_field("a node coordinate");
       add_node(tag, p);
@@ -403,7 +471,9 @@ class MshReader {
 
   const GmshType& known_type(long long type, std::size_t at) const {
     const GmshType* t = gmsh_type(type);
-    if (!t) fail_at(at, "element type " + std::to_string(type) + " is not a Gmsh element type this reader knows");
+    if (!t)
+      fail_at(at, "element type " + std::to_string(type) +
+                      " is not a Gmsh element type this reader knows");
     return *t;
   }
 
@@ -416,15 +486,18 @@ class MshReader {
       const std::size_t at = pos_;
       const GmshType& type = known_type(int_field("an element block's element type"), at);
       const auto nn = static_cast<std::size_t>(type.nodes);
-      const std::size_t n = count_field("an element block's element count", item_bytes(1 + nn, 8 * (1 + nn)));
+      const std::size_t n =
+          count_field("an element block's element count", item_bytes(1 + nn, 8 * (1 + nn)));
       for (std::size_t e = 0; e < n; ++e) {
         RawElement el{size_field("an element tag"), type.type, entity, 0, element_nodes_.size()};
-        for (std::size_t k = 0; k < nn; ++k) element_nodes_.push_back(size_field("an element's node tag"));
+        for (std::size_t k = 0; k < nn; ++k)
+          element_nodes_.push_back(size_field("an element's node tag"));
         elements_.push_back(el);
       }
     }
     if (elements_.size() != total)
-      fail("$Elements announces " + std::to_string(total) + " elements, its blocks hold " + std::to_string(elements_.size()));
+      fail("$Elements announces " + std::to_string(total) + " elements, its blocks hold " +
+           std::to_string(elements_.size()));
   }
 
   void elements22() {
@@ -433,7 +506,8 @@ class MshReader {
     auto element = [&](std::int64_t tag, const GmshType& type, const std::vector<long long>& tags) {
       RawElement el{tag, type.type, tags.size() > 1 ? static_cast<int>(tags[1]) : 0,
                     tags.empty() ? 0 : static_cast<int>(tags[0]), element_nodes_.size()};
-      for (int k = 0; k < type.nodes; ++k) element_nodes_.push_back(int_field("an element's node tag"));
+      for (int k = 0; k < type.nodes; ++k)
+        element_nodes_.push_back(int_field("an element's node tag"));
       elements_.push_back(el);
     };
     std::vector<long long> tags;
@@ -444,7 +518,8 @@ class MshReader {
         const GmshType& type = known_type(ascii_integer<long long>("an element type"), at);
         const std::size_t nt = count_field("an element's tag count", 2);
         tags.clear();
-        for (std::size_t k = 0; k < nt; ++k) tags.push_back(ascii_integer<long long>("an element tag"));
+        for (std::size_t k = 0; k < nt; ++k)
+          tags.push_back(ascii_integer<long long>("an element tag"));
         element(tag, type, tags);
       }
       return;
@@ -456,9 +531,12 @@ class MshReader {
       const std::size_t follow = count_field("an element header's element count", 4);
       const std::int32_t nt = raw<std::int32_t>("an element header's tag count");
       if (nt < 0 || nt > 64) fail_at(nt_at, "element header: tag count " + std::to_string(nt));
-      if (follow > total - elements_.size()) fail_at(at, "element header: more elements than $Elements announces");
-      if (follow * (1 + static_cast<std::size_t>(nt) + static_cast<std::size_t>(type.nodes)) > (s_.size() - pos_) / 4)
-        fail_at(at, "element header: " + std::to_string(follow) + " elements are more than the rest of the file can hold (truncated file?)");
+      if (follow > total - elements_.size())
+        fail_at(at, "element header: more elements than $Elements announces");
+      if (follow * (1 + static_cast<std::size_t>(nt) + static_cast<std::size_t>(type.nodes)) >
+          (s_.size() - pos_) / 4)
+        fail_at(at, "element header: " + std::to_string(follow) +
+                        " elements are more than the rest of the file can hold (truncated file?)");
       for (std::size_t e = 0; e < follow; ++e) {
         const std::int64_t tag = raw<std::int32_t>("an element tag");
         tags.clear();
@@ -476,7 +554,9 @@ class MshReader {
   int model_entity(const RawElement& e, int dim) const {
     if (!partitioned_) return e.entity;
     const auto it = partitioned_entities_.find({dim, e.entity});
-    return it == partitioned_entities_.end() || it->second.parent_dim != dim ? e.entity : it->second.parent_tag;
+    return it == partitioned_entities_.end() || it->second.parent_dim != dim
+               ? e.entity
+               : it->second.parent_tag;
   }
   // Physical groups of an element: its entity's (4.1; a partitioned entity's own, else its
   // parent's) or its own tag (2.2).
@@ -516,7 +596,8 @@ class MshReader {
     // Nodes by ascending tag; a tag listed twice must name one point.
     std::vector<std::size_t> order(node_tags_.size());
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return node_tags_[a] < node_tags_[b]; });
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t a, std::size_t b) { return node_tags_[a] < node_tags_[b]; });
     std::unordered_map<std::int64_t, Index> index_of;
     index_of.reserve(order.size());
     for (std::size_t i : order) {
@@ -528,7 +609,8 @@ class MshReader {
                              point_text(first) + " and " + point_text(node_points_[i]));
         continue;
       }
-      if (tag <= 0) throw InvalidInput(source_ + ": node tag " + std::to_string(tag) + " is not positive");
+      if (tag <= 0)
+        throw InvalidInput(source_ + ": node tag " + std::to_string(tag) + " is not positive");
       if (model.points.size() >= static_cast<std::size_t>(INT32_MAX))
         throw InvalidInput(source_ + ": more nodes than this reader can number");
       index_of.emplace(tag, static_cast<Index>(model.points.size()));
@@ -539,8 +621,9 @@ class MshReader {
       const std::int64_t tag = element_nodes_[e.first + k];
       const auto it = index_of.find(tag);
       if (it == index_of.end())
-        throw InvalidInput(source_ + ": element " + std::to_string(e.tag) + ": corner " + std::to_string(k + 1) +
-                           " refers to node " + std::to_string(tag) + ", which is not in $Nodes");
+        throw InvalidInput(source_ + ": element " + std::to_string(e.tag) + ": corner " +
+                           std::to_string(k + 1) + " refers to node " + std::to_string(tag) +
+                           ", which is not in $Nodes");
       return it->second;
     };
 
@@ -557,8 +640,9 @@ class MshReader {
       if (type.dim != 3) continue;
       const ElementKind* kind = gmsh_cell_kind(e.type);
       if (!kind)
-        throw InvalidInput(source_ + ": element " + std::to_string(e.tag) + ": " + type.name + " (Gmsh type " +
-                           std::to_string(e.type) + ") is not supported; only linear cells are (4-node tetrahedra, "
+        throw InvalidInput(source_ + ": element " + std::to_string(e.tag) + ": " + type.name +
+                           " (Gmsh type " + std::to_string(e.type) +
+                           ") is not supported; only linear cells are (4-node tetrahedra, "
                            "8-node hexahedra, 6-node prisms, 5-node pyramids)");
       const std::vector<int> physicals = physicals_of(e, 3);
       int block = physicals.empty() ? model_entity(e, 3) : block_among(physicals);
@@ -566,11 +650,13 @@ class MshReader {
       // meshio writes 0 for a missing physical and entity tag: the model's default block.
       if (block == 0) block = default_block(*kind);
       if (block < 0)
-        throw InvalidInput(source_ + ": element " + std::to_string(e.tag) + ": block (physical or entity tag) " +
-                           std::to_string(block) + " is not positive");
+        throw InvalidInput(source_ + ": element " + std::to_string(e.tag) +
+                           ": block (physical or entity tag) " + std::to_string(block) +
+                           " is not positive");
       volumes.push_back({block, i});
     }
-    std::stable_sort(volumes.begin(), volumes.end(), [](const Volume& a, const Volume& b) { return a.block < b.block; });
+    std::stable_sort(volumes.begin(), volumes.end(),
+                     [](const Volume& a, const Volume& b) { return a.block < b.block; });
     {
       std::set<int> blocks;
       for (const Volume& v : volumes) blocks.insert(v.block);
@@ -578,14 +664,17 @@ class MshReader {
         if (!blocks.count(p)) {
           const auto it = physical_names_.find({3, p});
           read_warning(source_ + ": physical volume " + std::to_string(p) +
-                       (it == physical_names_.end() ? std::string() : " '" + sanitize_name(it->second) + "'") +
-                       " is not a block of its own: each of its entities is also in a physical volume over fewer "
+                       (it == physical_names_.end() ? std::string()
+                                                    : " '" + sanitize_name(it->second) + "'") +
+                       " is not a block of its own: each of its entities is also in a physical "
+                       "volume over fewer "
                        "entities, which is the block of its elements");
         }
     }
     for (const Volume& v : volumes) {
       const RawElement& e = elements_[v.element];
-      if (auto it = physical_names_.find({3, v.block}); it != physical_names_.end() && !it->second.empty())
+      if (auto it = physical_names_.find({3, v.block});
+          it != physical_names_.end() && !it->second.empty())
         model.block_names[v.block] = it->second;
       const ElementKind kind = *gmsh_cell_kind(e.type);
       const GmshCell& cell = kGmshCells[static_cast<std::size_t>(kind)];
@@ -619,14 +708,15 @@ class MshReader {
         for (std::size_t i : members) {
           const RawElement& e = elements_[i];
           if (e.type != kTri3 && e.type != kQuad4)
-            throw InvalidInput(where + ": element " + std::to_string(e.tag) + ": " + gmsh_type(e.type)->name +
-                               " (Gmsh type " + std::to_string(e.type) +
+            throw InvalidInput(where + ": element " + std::to_string(e.tag) + ": " +
+                               gmsh_type(e.type)->name + " (Gmsh type " + std::to_string(e.type) +
                                ") is not supported; only 3-node triangles and 4-node quads are");
           std::vector<Index> face;
           for (std::size_t k = 0; k < (e.type == kTri3 ? 3u : 4u); ++k) face.push_back(node(e, k));
           const Side* owner = face_owner.find(face);
           if (!owner)
-            throw InvalidInput(where + ": element " + std::to_string(e.tag) + " is not a face of any volume element");
+            throw InvalidInput(where + ": element " + std::to_string(e.tag) +
+                               " is not a face of any volume element");
           set.sides.push_back(*owner);
         }
         std::sort(set.sides.begin(), set.sides.end());
@@ -639,7 +729,8 @@ class MshReader {
         for (std::size_t i : members) {
           const RawElement& e = elements_[i];
           std::vector<Index> piece;
-          for (int k = 0; k < gmsh_type(e.type)->nodes; ++k) piece.push_back(node(e, static_cast<std::size_t>(k)));
+          for (int k = 0; k < gmsh_type(e.type)->nodes; ++k)
+            piece.push_back(node(e, static_cast<std::size_t>(k)));
           set.nodes.insert(set.nodes.end(), piece.begin(), piece.end());
           set.pieces.push_back(std::move(piece));
         }

@@ -14,7 +14,8 @@
 // already taken gets id + 10^k, 10^k the smallest power of ten above every id in the model
 // (side sets first, then node sets, each in model order).
 // Node tags are index + 1; element tags run from 1 over the blocks in ascending id (cell kinds
-// in primal::kElementKinds order within a block: hexes, tets, pyramids, wedges), then the side sets' faces, then the node sets' points.
+// in primal::kElementKinds order within a block: hexes, tets, pyramids, wedges), then the side
+// sets' faces, then the node sets' points.
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -114,7 +115,8 @@ class MshLayout {
         const ElementRef ref{kind, static_cast<Index>(i)};
         const int block = block_of(m_, ref);
         auto& list = by_block[block];
-        if (list.empty() || list.back().type != cell.type) list.push_back({3, block, block, cell.type, corners, {}, 0});
+        if (list.empty() || list.back().type != cell.type)
+          list.push_back({3, block, block, cell.type, corners, {}, 0});
         auto& tags = list.back().node_tags;
         const std::size_t base = tags.size();
         tags.resize(base + corners);
@@ -131,7 +133,8 @@ class MshLayout {
         blocks_.push_back(std::move(b));
       }
       entities_.push_back(bounded(3, block, block, all));
-      if (auto it = m_.block_names.find(block); it != m_.block_names.end() && !sanitize_name(it->second).empty())
+      if (auto it = m_.block_names.find(block);
+          it != m_.block_names.end() && !sanitize_name(it->second).empty())
         names_.push_back({3, block, sanitize_name(it->second)});
     }
     if (by_block.empty()) {
@@ -174,17 +177,20 @@ class MshLayout {
     for (std::size_t s = 0; s < m_.side_sets.size(); ++s) {
       const SideSet& set = m_.side_sets[s];
       const int physical = side_tags_[s], entity = physical;
-      ElementBlock tri{2, entity, physical, kTri3, 3, {}, 0}, quad{2, entity, physical, kQuad4, 4, {}, 0};
+      ElementBlock tri{2, entity, physical, kTri3, 3, {}, 0},
+          quad{2, entity, physical, kQuad4, 4, {}, 0};
       for (const Side& side : set.sides) {
         const std::vector<Index> face = element_face(m_, side);
-        for (Index v : face) (face.size() == 4 ? quad : tri).node_tags.push_back(static_cast<std::size_t>(v) + 1);
+        for (Index v : face)
+          (face.size() == 4 ? quad : tri).node_tags.push_back(static_cast<std::size_t>(v) + 1);
       }
       std::vector<std::size_t> all = tri.node_tags;
       all.insert(all.end(), quad.node_tags.begin(), quad.node_tags.end());
       entities_.push_back(bounded(2, entity, physical, all));
       if (!tri.node_tags.empty()) blocks_.push_back(std::move(tri));
       if (!quad.node_tags.empty()) blocks_.push_back(std::move(quad));
-      if (const std::string name = sanitize_name(set.name); !name.empty()) names_.push_back({2, physical, name});
+      if (const std::string name = sanitize_name(set.name); !name.empty())
+        names_.push_back({2, physical, name});
     }
   }
 
@@ -196,7 +202,8 @@ class MshLayout {
       for (Index v : set.nodes) points.node_tags.push_back(static_cast<std::size_t>(v) + 1);
       entities_.push_back(bounded(0, entity, physical, points.node_tags));
       if (!points.node_tags.empty()) blocks_.push_back(std::move(points));
-      if (const std::string name = sanitize_name(set.name); !name.empty()) names_.push_back({0, physical, name});
+      if (const std::string name = sanitize_name(set.name); !name.empty())
+        names_.push_back({0, physical, name});
     }
   }
 };
@@ -370,7 +377,8 @@ class MshWriter {
           out_.raw<std::int32_t>(static_cast<std::int32_t>(b.first_tag + e));
           out_.raw<std::int32_t>(b.physical);
           out_.raw<std::int32_t>(b.entity);
-          for (std::size_t k = 0; k < b.nodes_per_element; ++k) out_.raw<std::int32_t>(static_cast<std::int32_t>(nodes[k]));
+          for (std::size_t k = 0; k < b.nodes_per_element; ++k)
+            out_.raw<std::int32_t>(static_cast<std::int32_t>(nodes[k]));
         } else {
           num(static_cast<std::int64_t>(b.first_tag + e));
           sp();
@@ -394,12 +402,15 @@ class MshWriter {
 
 }  // namespace
 
-void write_gmsh(const Model& model, const std::filesystem::path& path, GmshFormat format, GmshVersion version) {
+void write_gmsh(const Model& model, const std::filesystem::path& path, GmshFormat format,
+                GmshVersion version) {
   const std::string target = path.string();
   validate(model, target);
   const MshLayout layout(model, target);
-  if (version == GmshVersion::k22 && (model.points.size() >= INT32_MAX || layout.elements_ >= INT32_MAX))
-    throw InvalidInput(target + ": more nodes or elements than .msh 2.2's 32-bit tags can number; write .msh 4.1");
+  if (version == GmshVersion::k22 &&
+      (model.points.size() >= INT32_MAX || layout.elements_ >= INT32_MAX))
+    throw InvalidInput(
+        target + ": more nodes or elements than .msh 2.2's 32-bit tags can number; write .msh 4.1");
   write_path_atomically(path, ".msh", [&](const std::filesystem::path& temp) {
     FileSink out(temp, target);
     MshWriter(layout, out, format == GmshFormat::Binary, version).write();

@@ -12,7 +12,8 @@ namespace geode::io {
 // Throws InvalidInput naming the file: missing, unknown extension, content of another format,
 // and whatever the format's reader refuses (gmsh.hpp, exodus.hpp, vtk.hpp, ...), then
 // check_geometry unless options say otherwise.
-primal::Model read_model(const std::filesystem::path& path, const primal::ReadOptions& options = {});
+primal::Model read_model(const std::filesystem::path& path,
+                         const primal::ReadOptions& options = {});
 
 // A VTK grid as a model: hexes and tets (triangles and quads, boundary annotations, are left
 // out), VTK's 0-based point and cell ids (as ParaView shows them) as file ids, blocks from the

@@ -7,22 +7,20 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <bit>
-#include <cstdint>
-#include <cstring>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
-#include <limits>
-#include <memory>
 #include <fstream>
+#include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 #include <sstream>
 
-
 #include <geode/io/atomic_file.hpp>
-#include <geode/primal/errors.hpp>
 #include <geode/io/file_format.hpp>
+#include <geode/primal/errors.hpp>
 #include <geode/primal/quality.hpp>
 
 namespace geode::io {
@@ -176,14 +174,16 @@ double frame_sj(const Point& o, const Point& a, const Point& b, const Point& c) 
 }
 double pyramid_sj(const std::array<Point, 5>& p) {
   double s = 1.0;
-  for (std::size_t k = 0; k < 4; ++k) s = std::min(s, frame_sj(p[k], p[(k + 1) % 4], p[(k + 3) % 4], p[4]));
+  for (std::size_t k = 0; k < 4; ++k)
+    s = std::min(s, frame_sj(p[k], p[(k + 1) % 4], p[(k + 3) % 4], p[4]));
   return s;
 }
 double wedge_sj(const std::array<Point, 6>& p) {
   double s = 1.0;
   for (std::size_t k = 0; k < 6; ++k) {
     const auto& n = topology::kWedgeCornerNeighbors[k];
-    s = std::min(s, frame_sj(p[k], p[static_cast<std::size_t>(n[0])], p[static_cast<std::size_t>(n[1])], p[static_cast<std::size_t>(n[2])]));
+    s = std::min(s, frame_sj(p[k], p[static_cast<std::size_t>(n[0])],
+                             p[static_cast<std::size_t>(n[1])], p[static_cast<std::size_t>(n[2])]));
   }
   return s;
 }
@@ -196,7 +196,8 @@ Grid grid_of(const std::filesystem::path& path, const Model& m, const VtkCellDat
   Grid g = start_grid(file, m.points);
   std::vector<std::array<Index, 6>> vtk_wedges(m.wedges.size());
   for (std::size_t w = 0; w < m.wedges.size(); ++w)
-    for (std::size_t k = 0; k < 6; ++k) vtk_wedges[w][k] = m.wedges[w][static_cast<std::size_t>(topology::kVtkWedgeOrder[k])];
+    for (std::size_t k = 0; k < 6; ++k)
+      vtk_wedges[w][k] = m.wedges[w][static_cast<std::size_t>(topology::kVtkWedgeOrder[k])];
   add_cells(g, file, m.hexes, kVtkHexahedron);
   add_cells(g, file, m.tets, kVtkTetra);
   add_cells(g, file, m.pyramids, kVtkPyramid);
@@ -208,7 +209,8 @@ Grid grid_of(const std::filesystem::path& path, const Model& m, const VtkCellDat
   append_quality(sj, m.points, m.wedges, wedge_sj);
   std::vector<int> block;
   for (ElementKind kind : kElementKinds)
-    for (std::size_t e = 0; e < element_count(m, kind); ++e) block.push_back(block_of(m, {kind, static_cast<Index>(e)}));
+    for (std::size_t e = 0; e < element_count(m, kind); ++e)
+      block.push_back(block_of(m, {kind, static_cast<Index>(e)}));
   // The block again as "mat_id", the cell array of material ids Python solvers read (SfePy's
   // name; meshio hands it on), so that they find the materials without knowing ours.
   VtkCellData data = extra;
@@ -277,7 +279,8 @@ std::string base64(const std::string& bytes) {
   }
   if (i < bytes.size()) {
     auto b = static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[i])) << 16;
-    if (i + 1 < bytes.size()) b |= static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[i + 1])) << 8;
+    if (i + 1 < bytes.size())
+      b |= static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[i + 1])) << 8;
     out += kDigits[(b >> 18) & 63], out += kDigits[(b >> 12) & 63];
     out += i + 1 < bytes.size() ? kDigits[(b >> 6) & 63] : '=';
     out += '=';
@@ -289,8 +292,8 @@ std::string base64(const std::string& bytes) {
 // by the little-endian values, the layout VTK writes for uncompressed inline binary data.
 template <typename Out, typename T, typename F>
 void write_data_array(std::ostream& os, VtuEncoding encoding, const char* type,
-                      const std::string& attributes, const std::vector<T>& v,
-                      std::size_t per_line, F&& fmt) {
+                      const std::string& attributes, const std::vector<T>& v, std::size_t per_line,
+                      F&& fmt) {
   static_assert(std::endian::native == std::endian::little, "binary .vtu is written little-endian");
   os << "        <DataArray type=\"" << type << "\"" << attributes << " format=\""
      << (encoding == VtuEncoding::kAscii ? "ascii" : "binary") << "\">\n";
@@ -324,7 +327,8 @@ void write_vtu_grid(std::ostream& os, const Grid& g, VtuEncoding encoding) {
          << "\" NumberOfTuples=\"1\" format=\"ascii\">" << id << "</DataArray>\n";
     os << "    </FieldData>\n";
   }
-  os << "    <Piece NumberOfPoints=\"" << pts.size() << "\" NumberOfCells=\"" << g.cells() << "\">\n"
+  os << "    <Piece NumberOfPoints=\"" << pts.size() << "\" NumberOfCells=\"" << g.cells()
+     << "\">\n"
      << "      <Points>\n";
   std::vector<double> xyz;
   xyz.reserve(3 * pts.size());
@@ -337,7 +341,8 @@ void write_vtu_grid(std::ostream& os, const Grid& g, VtuEncoding encoding) {
   // Int32 like Index: node numbers fit, and half the bytes of Int64.
   write_data_array<std::int32_t>(os, encoding, "Int32", " Name=\"connectivity\"", g.connectivity, 8,
                                  integer);
-  write_data_array<std::int32_t>(os, encoding, "Int32", " Name=\"offsets\"", g.offsets, 10, integer);
+  write_data_array<std::int32_t>(os, encoding, "Int32", " Name=\"offsets\"", g.offsets, 10,
+                                 integer);
   write_data_array<std::uint8_t>(os, encoding, "UInt8", " Name=\"types\"", g.types, 20, integer);
   os << "      </Cells>\n"
      << "      <CellData Scalars=\"scaled_jacobian\">\n";
@@ -345,8 +350,8 @@ void write_vtu_grid(std::ostream& os, const Grid& g, VtuEncoding encoding) {
     write_data_array<double>(os, encoding, "Float64", " Name=\"" + xml_escape(name) + "\"", v, 6,
                              format_double);
   for (const auto& [name, v] : g.data.ints)
-    write_data_array<std::int32_t>(os, encoding, "Int32", " Name=\"" + xml_escape(name) + "\"", v, 10,
-                                   integer);
+    write_data_array<std::int32_t>(os, encoding, "Int32", " Name=\"" + xml_escape(name) + "\"", v,
+                                   10, integer);
   os << "      </CellData>\n"
      << "    </Piece>\n"
      << "  </UnstructuredGrid>\n"
@@ -369,7 +374,8 @@ void write_vtk_grid(std::ostream& os, const Grid& g) {
   Index begin = 0;
   for (std::size_t c = 0; c < ncells; ++c) {
     os << g.offsets[c] - begin;
-    for (Index k = begin; k < g.offsets[c]; ++k) os << ' ' << g.connectivity[static_cast<std::size_t>(k)];
+    for (Index k = begin; k < g.offsets[c]; ++k)
+      os << ' ' << g.connectivity[static_cast<std::size_t>(k)];
     os << '\n';
     begin = g.offsets[c];
   }
@@ -390,15 +396,15 @@ void write_vtk_grid(std::ostream& os, const Grid& g) {
 
 // ---- Writers ----------------------------------------------------------------------------------
 
-#define GEODE_VTK_WRITERS(Mesh)                                                             \
-  void write_vtu(const std::filesystem::path& path, const Mesh& mesh, const VtkCellData& extra, \
-                 VtuEncoding encoding) {                                                       \
-    const Grid g = grid_of(path, mesh, extra);                                                 \
-    write_file_atomically(path, [&](std::ostream& os) { write_vtu_grid(os, g, encoding); });   \
-  }                                                                                            \
+#define GEODE_VTK_WRITERS(Mesh)                                                                   \
+  void write_vtu(const std::filesystem::path& path, const Mesh& mesh, const VtkCellData& extra,   \
+                 VtuEncoding encoding) {                                                          \
+    const Grid g = grid_of(path, mesh, extra);                                                    \
+    write_file_atomically(path, [&](std::ostream& os) { write_vtu_grid(os, g, encoding); });      \
+  }                                                                                               \
   void write_vtk(const std::filesystem::path& path, const Mesh& mesh, const VtkCellData& extra) { \
-    const Grid g = grid_of(path, mesh, extra);                                                 \
-    write_file_atomically(path, [&](std::ostream& os) { write_vtk_grid(os, g); });             \
+    const Grid g = grid_of(path, mesh, extra);                                                    \
+    write_file_atomically(path, [&](std::ostream& os) { write_vtk_grid(os, g); });                \
   }
 GEODE_VTK_WRITERS(HexMesh)
 GEODE_VTK_WRITERS(TetMesh)

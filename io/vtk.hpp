@@ -1,9 +1,9 @@
 #pragma once
 // VTK output for viewers (ParaView, VisIt) and reading it back: XML unstructured grid (.vtu,
-// ASCII or base64 binary DataArrays) and legacy (.vtk, "# vtk DataFile Version 4.2": the classic CELLS n size
-// layout every legacy reader since VTK 4 opens, without the 5.1 OFFSETS/CONNECTIVITY form).
-// Hexes, tets and quads (quads as VTK_QUAD in 3D space), or a whole Model (hexes, tets, pyramids, wedges). Writes are atomic
-// (io/atomic_file.hpp): a failure leaves no half-written file.
+// ASCII or base64 binary DataArrays) and legacy (.vtk, "# vtk DataFile Version 4.2": the classic
+// CELLS n size layout every legacy reader since VTK 4 opens, without the 5.1 OFFSETS/CONNECTIVITY
+// form). Hexes, tets and quads (quads as VTK_QUAD in 3D space), or a whole Model (hexes, tets,
+// pyramids, wedges). Writes are atomic (io/atomic_file.hpp): a failure leaves no half-written file.
 //
 // Every written grid carries the cell arrays "scaled_jacobian" ([Verdict] hex, tet or quad
 // scaled Jacobian) and "block" (mesh.block, when not empty), then the caller's arrays.
@@ -23,10 +23,11 @@ inline constexpr int kVtkTriangle = 5;
 inline constexpr int kVtkQuad = 9;
 inline constexpr int kVtkTetra = 10;
 inline constexpr int kVtkHexahedron = 12;
-inline constexpr int kVtkWedge = 13;    // corners in VTK's order: primal::topology::kVtkWedgeOrder
+inline constexpr int kVtkWedge = 13;  // corners in VTK's order: primal::topology::kVtkWedgeOrder
 inline constexpr int kVtkPyramid = 14;
 // The VTK type per primal::ElementKind (hex, tet, pyramid, wedge).
-inline constexpr std::array<int, 4> kVtkCellTypes{kVtkHexahedron, kVtkTetra, kVtkPyramid, kVtkWedge};
+inline constexpr std::array<int, 4> kVtkCellTypes{kVtkHexahedron, kVtkTetra, kVtkPyramid,
+                                                  kVtkWedge};
 
 // Named per-cell arrays, written in this order. Names: non-empty, no white space (the legacy
 // format separates tokens by white space).
@@ -93,6 +94,5 @@ VtkGrid read_vtk_file(const std::filesystem::path& path);
 primal::HexMesh to_hex_mesh(const VtkGrid& grid);
 primal::TetMesh to_tet_mesh(const VtkGrid& grid);
 primal::QuadMesh to_quad_mesh(const VtkGrid& grid);
-
 
 }  // namespace geode::io

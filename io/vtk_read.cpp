@@ -5,24 +5,23 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <bit>
-#include <cstdint>
-#include <cstring>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
-#include <limits>
-#include <memory>
 #include <fstream>
+#include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 #include <sstream>
 
 #include <zlib.h>
 
 #include <geode/io/atomic_file.hpp>
-#include <geode/primal/errors.hpp>
 #include <geode/io/file_format.hpp>
 #include <geode/io/mapped_file.hpp>
+#include <geode/primal/errors.hpp>
 #include <geode/primal/quality.hpp>
 
 namespace geode::io {
@@ -45,8 +44,10 @@ template <typename LineOf>
 void check_cells(const VtkGrid& g, LineOf&& line_of_cell) {
   if (g.cell_types.size() != g.cells.size())  // named at the first cell or type without a partner
     fail(g.source,
-         g.cell_types.size() > g.cells.size() ? line_of_cell(g.cells.size(), true) : line_of_cell(g.cell_types.size(), false),
-         std::to_string(g.cells.size()) + " cells but " + std::to_string(g.cell_types.size()) + " cell types");
+         g.cell_types.size() > g.cells.size() ? line_of_cell(g.cells.size(), true)
+                                              : line_of_cell(g.cell_types.size(), false),
+         std::to_string(g.cells.size()) + " cells but " + std::to_string(g.cell_types.size()) +
+             " cell types");
   for (std::size_t c = 0; c < g.cells.size(); ++c) {
     const int type = g.cell_types[c];
     const char* name = cell_type_name(type);
@@ -240,7 +241,8 @@ class XmlParser {
 
   XmlElement element(int depth) {
     if (depth >= kMaxDepth)
-      fail(file_, line_, "elements nested more than " + std::to_string(kMaxDepth) + " deep (not a VTK file)");
+      fail(file_, line_,
+           "elements nested more than " + std::to_string(kMaxDepth) + " deep (not a VTK file)");
     XmlElement el;
     el.line = line_;
     advance(1);  // '<'
@@ -351,7 +353,8 @@ std::string decode_base64(std::string_view text, const std::string& file, int li
       quantum[n++] = v;
     }
     if (n == 4) {
-      const unsigned bits = static_cast<unsigned>(quantum[0] << 18 | quantum[1] << 12 | quantum[2] << 6 | quantum[3]);
+      const unsigned bits =
+          static_cast<unsigned>(quantum[0] << 18 | quantum[1] << 12 | quantum[2] << 6 | quantum[3]);
       out += static_cast<char>(bits >> 16);
       if (pad < 2) out += static_cast<char>(bits >> 8 & 0xff);
       if (pad < 1) out += static_cast<char>(bits & 0xff);
@@ -378,7 +381,8 @@ std::string array_bytes(std::string_view stream, const VtuStorage& enc, std::siz
                         const std::string& file, int line, const std::string& what) {
   std::size_t at = 0;
   auto header = [&]() -> std::uint64_t {
-    if (stream.size() - at < enc.header_bytes) fail(file, line, what + ": binary header cut short (truncated?)");
+    if (stream.size() - at < enc.header_bytes)
+      fail(file, line, what + ": binary header cut short (truncated?)");
     std::uint64_t v = 0;
     if (enc.header_bytes == 4) {
       std::uint32_t x;
@@ -392,39 +396,57 @@ std::string array_bytes(std::string_view stream, const VtuStorage& enc, std::siz
   };
   if (!enc.zlib) {
     const std::uint64_t n = header();
-    if (n != want) fail(file, line, what + ": binary data of " + std::to_string(n) + " bytes, expected " + std::to_string(want));
+    if (n != want)
+      fail(file, line,
+           what + ": binary data of " + std::to_string(n) + " bytes, expected " +
+               std::to_string(want));
     if (stream.size() - at < n) fail(file, line, what + ": binary data cut short (truncated?)");
     return std::string(stream.substr(at, n));
   }
   const std::uint64_t blocks = header(), block_size = header(), last_size = header();
-  if (blocks > stream.size() / enc.header_bytes) fail(file, line, what + ": compressed header announces " + std::to_string(blocks) + " blocks");
+  if (blocks > stream.size() / enc.header_bytes)
+    fail(file, line, what + ": compressed header announces " + std::to_string(blocks) + " blocks");
   const std::uint64_t last = last_size == 0 ? block_size : last_size;
   // block_size is the nominal size of every block but the last (meshio writes 32768 for one
   // short block); the sizes must add up to what the array holds.
-  if (blocks > 0 && (last > block_size || last > want || (blocks > 1 && block_size > want / (blocks - 1)) ||
-                     (blocks - 1) * block_size + last != want))
-    fail(file, line, what + ": compressed blocks do not add up to the " + std::to_string(want) + " bytes expected");
-  if (blocks == 0 && want != 0) fail(file, line, what + ": no compressed blocks for " + std::to_string(want) + " bytes");
+  if (blocks > 0 &&
+      (last > block_size || last > want || (blocks > 1 && block_size > want / (blocks - 1)) ||
+       (blocks - 1) * block_size + last != want))
+    fail(file, line,
+         what + ": compressed blocks do not add up to the " + std::to_string(want) +
+             " bytes expected");
+  if (blocks == 0 && want != 0)
+    fail(file, line, what + ": no compressed blocks for " + std::to_string(want) + " bytes");
   // zlib inflates at most about 1032:1: a header that promises more is corrupt, and is refused
   // before anything of that size is allocated.
-  if (want / 1032 > stream.size()) fail(file, line, what + ": " + std::to_string(want) + " bytes cannot come from " + std::to_string(stream.size()) + " compressed bytes");
+  if (want / 1032 > stream.size())
+    fail(file, line,
+         what + ": " + std::to_string(want) + " bytes cannot come from " +
+             std::to_string(stream.size()) + " compressed bytes");
   if (want > enc.inflate_budget)
-    fail(file, line, what + ": inflating to " + std::to_string(want) + " bytes would pass the file's bound of " +
-                         std::to_string(enc.inflate_budget) + " more bytes (64 MiB plus 64 times the file's size: a zlib bomb?)");
+    fail(file, line,
+         what + ": inflating to " + std::to_string(want) +
+             " bytes would pass the file's bound of " + std::to_string(enc.inflate_budget) +
+             " more bytes (64 MiB plus 64 times the file's size: a zlib bomb?)");
   enc.inflate_budget -= want;
   std::vector<std::uint64_t> sizes;
   for (std::uint64_t b = 0; b < blocks; ++b) sizes.push_back(header());
   std::string out;
   out.reserve(want);
   for (std::uint64_t b = 0; b < blocks; ++b) {
-    if (stream.size() - at < sizes[b]) fail(file, line, what + ": compressed block " + std::to_string(b + 1) + " cut short (truncated?)");
+    if (stream.size() - at < sizes[b])
+      fail(file, line,
+           what + ": compressed block " + std::to_string(b + 1) + " cut short (truncated?)");
     const std::uint64_t size = b + 1 == blocks ? last : block_size;
     std::string block(size, '\0');
     uLongf got = static_cast<uLongf>(size);
     const int status = uncompress(reinterpret_cast<Bytef*>(block.data()), &got,
-                                  reinterpret_cast<const Bytef*>(stream.data() + at), static_cast<uLong>(sizes[b]));
+                                  reinterpret_cast<const Bytef*>(stream.data() + at),
+                                  static_cast<uLong>(sizes[b]));
     if (status != Z_OK || got != size)
-      fail(file, line, what + ": compressed block " + std::to_string(b + 1) + " does not inflate to " + std::to_string(size) + " bytes (zlib status " + std::to_string(status) + ")");
+      fail(file, line,
+           what + ": compressed block " + std::to_string(b + 1) + " does not inflate to " +
+               std::to_string(size) + " bytes (zlib status " + std::to_string(status) + ")");
     out += block;
     at += sizes[b];
   }
@@ -444,12 +466,13 @@ void append_values(std::string& text, const std::string& bytes) {
 }
 
 // A binary DataArray's values as text tokens, so that ASCII and binary arrays share one path.
-Numbers binary_values(const std::string& file, const XmlElement& a, std::size_t expected, const std::string& what,
-                      const VtuStorage& enc) {
+Numbers binary_values(const std::string& file, const XmlElement& a, std::size_t expected,
+                      const std::string& what, const VtuStorage& enc) {
   const std::string type = a.attr("type"), format = a.attr("format");
   const std::size_t size = type_size(type);
   if (size == 0) fail(file, a.line, what + ": unsupported type \"" + type + "\"");
-  if (expected > (std::numeric_limits<std::size_t>::max() / 16) / size) fail(file, a.line, what + ": too many values");
+  if (expected > (std::numeric_limits<std::size_t>::max() / 16) / size)
+    fail(file, a.line, what + ": too many values");
   const std::size_t want = expected * size;
   std::string bytes;
   if (format == "binary") {
@@ -457,16 +480,21 @@ Numbers binary_values(const std::string& file, const XmlElement& a, std::size_t 
   } else {
     const std::string offset_text = a.attr("offset");
     std::size_t offset = 0;
-    const auto res = std::from_chars(offset_text.data(), offset_text.data() + offset_text.size(), offset);
-    if (offset_text.empty() || res.ec != std::errc() || res.ptr != offset_text.data() + offset_text.size())
+    const auto res =
+        std::from_chars(offset_text.data(), offset_text.data() + offset_text.size(), offset);
+    if (offset_text.empty() || res.ec != std::errc() ||
+        res.ptr != offset_text.data() + offset_text.size())
       fail(file, a.line, what + ": appended DataArray without a valid offset");
-    if (offset > enc.appended.size()) fail(file, a.line, what + ": offset " + offset_text + " lies beyond the appended data (truncated?)");
+    if (offset > enc.appended.size())
+      fail(file, a.line,
+           what + ": offset " + offset_text + " lies beyond the appended data (truncated?)");
     const std::string_view rest = enc.appended.substr(offset);
     if (enc.appended_base64) {
       // Decoded to the end: the array's header and data, encoded apart or together, come
       // first; the arrays after it follow and are ignored.
-      std::string_view piece = rest.substr(0, rest.find_first_not_of(
-          "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/="));
+      std::string_view piece =
+          rest.substr(0, rest.find_first_not_of(
+                             "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/="));
       piece = piece.substr(0, piece.size() - piece.size() % 4);
       const std::string decoded = decode_base64(piece, file, a.line);
       bytes = array_bytes(decoded, enc, want, file, a.line, what);
@@ -495,10 +523,12 @@ Numbers binary_values(const std::string& file, const XmlElement& a, std::size_t 
 Numbers data_array_values(const std::string& file, const XmlElement& a, std::size_t expected,
                           const std::string& what, const VtuStorage& enc) {
   const std::string format = a.attr("format");
-  if (format == "binary" || format == "appended") return binary_values(file, a, expected, what, enc);
+  if (format == "binary" || format == "appended")
+    return binary_values(file, a, expected, what, enc);
   if (format != "ascii") {
     fail(file, a.line,
-         what + ": format=\"" + format + "\" is not supported (ascii, binary and appended are read)");
+         what + ": format=\"" + format +
+             "\" is not supported (ascii, binary and appended are read)");
   }
   Numbers n = split_numbers(a.text, a.text_line);
   if (n.tokens.size() != expected) {
@@ -553,7 +583,10 @@ VtkGrid parse_vtu(std::string_view content, const std::string& source) {
     const auto underscore = close == std::string::npos ? close : xml.find('_', close);
     const auto end = xml.rfind("</AppendedData>");
     if (underscore == std::string::npos || end == std::string::npos || end < underscore)
-      fail(file, static_cast<int>(std::count(xml.begin(), xml.begin() + static_cast<std::ptrdiff_t>(tag), '\n')) + 1,
+      fail(file,
+           static_cast<int>(
+               std::count(xml.begin(), xml.begin() + static_cast<std::ptrdiff_t>(tag), '\n')) +
+               1,
            "<AppendedData> without its '_' marker or its end tag (truncated file?)");
     appended_bytes = xml.substr(underscore + 1, end - underscore - 1);
     // Keep the line count of what follows for messages.
@@ -566,14 +599,17 @@ VtkGrid parse_vtu(std::string_view content, const std::string& source) {
     fail(file, root.line, "header_type \"" + h + "\" is not supported (UInt32 and UInt64 are)");
   enc.header_bytes = root.attr("header_type") == "UInt64" ? 8 : 4;
   if (const std::string c = root.attr("compressor"); !c.empty()) {
-    if (c != "vtkZLibDataCompressor") fail(file, root.line, "compressor \"" + c + "\" is not supported (vtkZLibDataCompressor is)");
+    if (c != "vtkZLibDataCompressor")
+      fail(file, root.line, "compressor \"" + c + "\" is not supported (vtkZLibDataCompressor is)");
     enc.zlib = true;
   }
   if (const std::string order = root.attr("byte_order"); !order.empty() && order != "LittleEndian")
     fail(file, root.line, "byte_order \"" + order + "\" is not supported (LittleEndian is)");
   if (const XmlElement* ad = root.child("AppendedData")) {
     const std::string e = ad->attr("encoding");
-    if (e != "raw" && e != "base64") fail(file, ad->line, "AppendedData encoding \"" + e + "\" is not supported (raw and base64 are)");
+    if (e != "raw" && e != "base64")
+      fail(file, ad->line,
+           "AppendedData encoding \"" + e + "\" is not supported (raw and base64 are)");
     enc.appended_base64 = e == "base64";
   }
   if (root.name != "VTKFile" || root.attr("type") != "UnstructuredGrid") {
@@ -680,7 +716,8 @@ namespace {
 // Token stream over the body of a legacy file (after the 3 header lines).
 class Tokens {
  public:
-  Tokens(std::string_view text, int first_line, std::string file) : s_(text), line_(first_line), file_(std::move(file)) {}
+  Tokens(std::string_view text, int first_line, std::string file)
+      : s_(text), line_(first_line), file_(std::move(file)) {}
   bool done() {
     skip_space();
     return pos_ >= s_.size();
@@ -690,7 +727,8 @@ class Tokens {
     return line_;
   }
   std::string_view next(const std::string& what) {
-    if (done()) fail(file_, line_, "unexpected end of file while reading " + what + " (truncated file?)");
+    if (done())
+      fail(file_, line_, "unexpected end of file while reading " + what + " (truncated file?)");
     const std::size_t start = pos_;
     while (pos_ < s_.size() && !std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
     token_line_ = line_;
@@ -726,16 +764,25 @@ class Tokens {
   void begin_array(std::string_view type, const std::string& what) {
     if (!binary_) return;
     const std::string t = lower(type);
-    if (t == "float") size_ = 4, real_ = true;
-    else if (t == "double") size_ = 8, real_ = true;
-    else if (t == "char" || t == "unsigned_char" || t == "bit") size_ = 1, real_ = false;
-    else if (t == "short" || t == "unsigned_short") size_ = 2, real_ = false;
-    else if (t == "int" || t == "unsigned_int" || t == "vtktypeint32") size_ = 4, real_ = false;
-    else if (t == "long" || t == "unsigned_long" || t == "vtktypeint64" || t == "vtktypeuint64" || t == "vtkidtype") size_ = 8, real_ = false;
-    else fail(file_, line_, what + ": binary type '" + std::string(type) + "' is not supported");
+    if (t == "float")
+      size_ = 4, real_ = true;
+    else if (t == "double")
+      size_ = 8, real_ = true;
+    else if (t == "char" || t == "unsigned_char" || t == "bit")
+      size_ = 1, real_ = false;
+    else if (t == "short" || t == "unsigned_short")
+      size_ = 2, real_ = false;
+    else if (t == "int" || t == "unsigned_int" || t == "vtktypeint32")
+      size_ = 4, real_ = false;
+    else if (t == "long" || t == "unsigned_long" || t == "vtktypeint64" || t == "vtktypeuint64" ||
+             t == "vtkidtype")
+      size_ = 8, real_ = false;
+    else
+      fail(file_, line_, what + ": binary type '" + std::string(type) + "' is not supported");
     unsigned_ = t.rfind("unsigned", 0) == 0 || t == "vtktypeuint64";
     const std::size_t eol = s_.find('\n', pos_);
-    if (eol == std::string_view::npos) fail(file_, line_, what + ": no binary data (truncated file?)");
+    if (eol == std::string_view::npos)
+      fail(file_, line_, what + ": no binary data (truncated file?)");
     pos_ = eol + 1;
     ++line_;
     in_array_ = true;
@@ -800,13 +847,16 @@ class Tokens {
   }
   void skip_space() {
     if (in_array_) return;
-    while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_]))) line_ += s_[pos_++] == '\n';
+    while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_])))
+      line_ += s_[pos_++] == '\n';
   }
   // One big-endian value of the current array type, as its bits.
   std::uint64_t raw_bits(const std::string& what) {
-    if (s_.size() - pos_ < size_) fail(file_, line_, what + ": binary data cut short (truncated file?)");
+    if (s_.size() - pos_ < size_)
+      fail(file_, line_, what + ": binary data cut short (truncated file?)");
     std::uint64_t bits = 0;
-    for (std::size_t k = 0; k < size_; ++k) bits = bits << 8 | static_cast<unsigned char>(s_[pos_ + k]);
+    for (std::size_t k = 0; k < size_; ++k)
+      bits = bits << 8 | static_cast<unsigned char>(s_[pos_ + k]);
     pos_ += size_;
     return bits;
   }
@@ -827,7 +877,8 @@ class Tokens {
     if (unsigned_) return static_cast<double>(bits);
     if (size_ == 8) return static_cast<double>(static_cast<std::int64_t>(bits));
     const std::uint64_t sign = std::uint64_t{1} << (8 * size_ - 1);
-    return static_cast<double>(static_cast<std::int64_t>(bits ^ sign) - static_cast<std::int64_t>(sign));
+    return static_cast<double>(static_cast<std::int64_t>(bits ^ sign) -
+                               static_cast<std::int64_t>(sign));
   }
 };
 
@@ -880,7 +931,8 @@ VtkGrid parse_vtk(std::string_view content, const std::string& source) {
     const std::string key = upper(t.next("a section keyword"));
     const int key_line = t.line_before();
     // Each section once: a repeated one would append to arrays already checked against others.
-    if ((key == "POINTS" && have_points) || (key == "CELLS" && have_cells) || (key == "CELL_TYPES" && have_types))
+    if ((key == "POINTS" && have_points) || (key == "CELLS" && have_cells) ||
+        (key == "CELL_TYPES" && have_types))
       fail(file, key_line, key + " given twice");
     if (key == "POINTS") {
       const std::size_t np = t.count("the number of points");
@@ -949,8 +1001,7 @@ VtkGrid parse_vtk(std::string_view content, const std::string& source) {
       }
       t.begin_array("int", "CELL_TYPES");
       for (std::size_t c = 0; c < n; ++c) {
-        g.cell_types.push_back(
-            (t.int32("the type of cell " + std::to_string(c))));
+        g.cell_types.push_back((t.int32("the type of cell " + std::to_string(c))));
         type_line.push_back(t.line_before());
       }
       t.end_array();

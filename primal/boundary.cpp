@@ -39,7 +39,7 @@ namespace {
 // to the disabled stream is buffered under OpenMesh's own lock); the stream is disabled while
 // any extraction is adding faces and restored to its previous state when the last one ends.
 class OpenMeshErrorsSilenced {
-public:
+ public:
   OpenMeshErrorsSilenced() {
     const std::lock_guard<std::mutex> lock(mutex_);
     if (active_++ == 0) {
@@ -54,12 +54,11 @@ public:
   OpenMeshErrorsSilenced(const OpenMeshErrorsSilenced&) = delete;
   OpenMeshErrorsSilenced& operator=(const OpenMeshErrorsSilenced&) = delete;
 
-private:
+ private:
   static inline std::mutex mutex_;
   static inline int active_ = 0;
   static inline bool was_enabled_ = true;
 };
-
 
 void check_indices(const HexMesh& mesh) {
   const auto n = index_cast(mesh.points.size());
@@ -150,13 +149,14 @@ std::vector<BoundaryQuad> block_interface_quads(const HexMesh& mesh) {
   std::vector<BoundaryQuad> out;
   if (mesh.block.empty()) return out;
   if (mesh.block.size() != mesh.hexes.size())
-    throw InvalidInput("block_interface_quads: " + std::to_string(mesh.block.size()) + " block ids for " +
-                       std::to_string(mesh.hexes.size()) + " hexes");
+    throw InvalidInput("block_interface_quads: " + std::to_string(mesh.block.size()) +
+                       " block ids for " + std::to_string(mesh.hexes.size()) + " hexes");
   KeyMap<4> first_use(mesh.hexes.size() * 3);
   for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
     for (int f = 0; f < topo::kHexFaces; ++f) {
       const auto nodes = hex_face_nodes(mesh.hexes[h], f);
-      const auto [slot, inserted] = first_use.try_emplace(face_key(nodes), static_cast<Index>(6 * h + f));
+      const auto [slot, inserted] =
+          first_use.try_emplace(face_key(nodes), static_cast<Index>(6 * h + f));
       if (!inserted && mesh.block[static_cast<std::size_t>(*slot / 6)] != mesh.block[h])
         out.push_back(BoundaryQuad{static_cast<Index>(h), f, nodes});
     }
@@ -167,7 +167,8 @@ BoundarySurface extract_boundary(const HexMesh& mesh) {
   return extract_boundary(mesh.points, boundary_quads(mesh));
 }
 
-BoundarySurface extract_boundary(const std::vector<Point>& points, std::vector<BoundaryQuad> quads) {
+BoundarySurface extract_boundary(const std::vector<Point>& points,
+                                 std::vector<BoundaryQuad> quads) {
   SurfaceMesh surface;
   return extract_boundary(points, std::move(quads), surface);
 }

@@ -271,9 +271,12 @@ template <class Mesh, std::size_t N>
 std::vector<std::array<std::vector<int>, 8>> child_weights() {
   Mesh ref;
   std::array<Index, N> cell{};
-  for (std::size_t i = 0; i < N; ++i) ref.points.push_back(Point::Zero()), cell[i] = static_cast<Index>(i);
-  if constexpr (N == 4) ref.tets.push_back(cell);
-  else ref.hexes.push_back(cell);
+  for (std::size_t i = 0; i < N; ++i)
+    ref.points.push_back(Point::Zero()), cell[i] = static_cast<Index>(i);
+  if constexpr (N == 4)
+    ref.tets.push_back(cell);
+  else
+    ref.hexes.push_back(cell);
   const DicedHexMesh d = dice(ref);
   std::vector<std::array<std::vector<int>, 8>> children;
   for (const auto& h : d.mesh.hexes) {
@@ -304,7 +307,8 @@ double diced_min(std::span<const Point> points, std::span<const std::array<Index
             HexCorners p;
             for (int c = 0; c < 8; ++c) {
               Point s = Point::Zero();
-              for (int i : w[c]) s += points[static_cast<std::size_t>(cells[k][static_cast<std::size_t>(i)])];
+              for (int i : w[c])
+                s += points[static_cast<std::size_t>(cells[k][static_cast<std::size_t>(i)])];
               p[c] = s / static_cast<double>(w[c].size());
             }
             lowest = std::min(lowest, hex_scaled_jacobian(p));
@@ -316,22 +320,25 @@ double diced_min(std::span<const Point> points, std::span<const std::array<Index
 
 // Per cell, in parallel.
 template <class Mesh, std::size_t N>
-std::vector<double> diced_each(std::span<const Point> points, std::span<const std::array<Index, N>> cells) {
+std::vector<double> diced_each(std::span<const Point> points,
+                               std::span<const std::array<Index, N>> cells) {
   static const auto children = child_weights<Mesh, N>();
   std::vector<double> out(cells.size(), 1.0);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 4096),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t k = range.begin(); k != range.end(); ++k)
-                        for (const auto& w : children) {
-                          HexCorners p;
-                          for (int c = 0; c < 8; ++c) {
-                            Point s = Point::Zero();
-                            for (int i : w[c]) s += points[static_cast<std::size_t>(cells[k][static_cast<std::size_t>(i)])];
-                            p[c] = s / static_cast<double>(w[c].size());
-                          }
-                          out[k] = std::min(out[k], hex_scaled_jacobian(p));
-                        }
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, cells.size(), 4096),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t k = range.begin(); k != range.end(); ++k)
+          for (const auto& w : children) {
+            HexCorners p;
+            for (int c = 0; c < 8; ++c) {
+              Point s = Point::Zero();
+              for (int i : w[c])
+                s += points[static_cast<std::size_t>(cells[k][static_cast<std::size_t>(i)])];
+              p[c] = s / static_cast<double>(w[c].size());
+            }
+            out[k] = std::min(out[k], hex_scaled_jacobian(p));
+          }
+      });
   return out;
 }
 
@@ -347,11 +354,13 @@ std::vector<double> diced_scaled_jacobian_per_cell(std::span<const Point> points
   return diced_each<HexMesh, 8>(points, hexes);
 }
 
-double diced_min_scaled_jacobian(std::span<const Point> points, std::span<const std::array<Index, 4>> tets) {
+double diced_min_scaled_jacobian(std::span<const Point> points,
+                                 std::span<const std::array<Index, 4>> tets) {
   return diced_min<TetMesh, 4>(points, tets);
 }
 
-double diced_min_scaled_jacobian(std::span<const Point> points, std::span<const std::array<Index, 8>> hexes) {
+double diced_min_scaled_jacobian(std::span<const Point> points,
+                                 std::span<const std::array<Index, 8>> hexes) {
   return diced_min<HexMesh, 8>(points, hexes);
 }
 

@@ -50,8 +50,10 @@ DicedQuadMesh dice(const TriMesh& mesh);   // 3 per triangle; like tets
 // The lowest scaled Jacobian (primal/quality.hpp) of the hexes `dice` would make of these
 // elements, computed element by element without building the diced mesh: what an element
 // part gives when diced alone, the yardstick for a transition placed beside it. 1 when empty.
-double diced_min_scaled_jacobian(std::span<const Point> points, std::span<const std::array<Index, 4>> tets);
-double diced_min_scaled_jacobian(std::span<const Point> points, std::span<const std::array<Index, 8>> hexes);
+double diced_min_scaled_jacobian(std::span<const Point> points,
+                                 std::span<const std::array<Index, 4>> tets);
+double diced_min_scaled_jacobian(std::span<const Point> points,
+                                 std::span<const std::array<Index, 8>> hexes);
 
 // The same per element: each one's lowest diced scaled Jacobian, in element order (the local
 // yardstick of a transition next to it).

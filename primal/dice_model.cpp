@@ -64,7 +64,10 @@ void dice_wedges(const Model& model, DicedModel& out) {
     auto face_of = [&](int a, int b, int d) {
       for (int f = 0; f < topo.faces; ++f) {
         const auto& face = topo.face[static_cast<std::size_t>(f)];
-        auto has = [&](int x) { return std::find(face.corners.begin(), face.corners.begin() + face.size, x) != face.corners.begin() + face.size; };
+        auto has = [&](int x) {
+          return std::find(face.corners.begin(), face.corners.begin() + face.size, x) !=
+                 face.corners.begin() + face.size;
+        };
         if (has(a) && has(b) && has(d)) {
           if (face.size == 3) return node_of({face.corners[0], face.corners[1], face.corners[2]});
           return node_of({face.corners[0], face.corners[1], face.corners[2], face.corners[3]});
@@ -77,8 +80,9 @@ void dice_wedges(const Model& model, DicedModel& out) {
     const Index mid = out.add_node(centre);
     for (int k = 0; k < 6; ++k) {
       const auto& n = topology::kWedgeCornerNeighbors[static_cast<std::size_t>(k)];
-      out.wedge_children.push_back({c[static_cast<std::size_t>(k)], node_of({k, n[0]}), face_of(k, n[0], n[1]), node_of({k, n[1]}),
-                                    node_of({k, n[2]}), face_of(k, n[0], n[2]), mid, face_of(k, n[1], n[2])});
+      out.wedge_children.push_back({c[static_cast<std::size_t>(k)], node_of({k, n[0]}),
+                                    face_of(k, n[0], n[1]), node_of({k, n[1]}), node_of({k, n[2]}),
+                                    face_of(k, n[0], n[2]), mid, face_of(k, n[1], n[2])});
       out.wedge_parent.push_back(static_cast<Index>(w));
     }
   }
@@ -86,7 +90,8 @@ void dice_wedges(const Model& model, DicedModel& out) {
 
 }  // namespace
 
-double diced_wedge_min_scaled_jacobian(std::span<const Point> points, std::span<const std::array<Index, 6>> wedges) {
+double diced_wedge_min_scaled_jacobian(std::span<const Point> points,
+                                       std::span<const std::array<Index, 6>> wedges) {
   double lowest = 1.0;
   for (const auto& c : wedges) {
     auto at = [&](std::initializer_list<int> local) {
@@ -101,17 +106,28 @@ double diced_wedge_min_scaled_jacobian(std::span<const Point> points, std::span<
       const auto& n = topology::kWedgeCornerNeighbors[static_cast<std::size_t>(k)];
       auto face = [&](int a, int b) {
         for (const auto& f : cell_topology(ElementKind::Wedge).face) {
-          auto has = [&](int x) { return std::find(f.corners.begin(), f.corners.begin() + f.size, x) != f.corners.begin() + f.size; };
+          auto has = [&](int x) {
+            return std::find(f.corners.begin(), f.corners.begin() + f.size, x) !=
+                   f.corners.begin() + f.size;
+          };
           if (f.size && has(k) && has(a) && has(b)) {
             Point p = Point::Zero();
-            for (int i = 0; i < f.size; ++i) p += points[static_cast<std::size_t>(c[static_cast<std::size_t>(f.corners[static_cast<std::size_t>(i)])])];
+            for (int i = 0; i < f.size; ++i)
+              p += points[static_cast<std::size_t>(
+                  c[static_cast<std::size_t>(f.corners[static_cast<std::size_t>(i)])])];
             return Point(p / static_cast<double>(f.size));
           }
         }
         return centre;
       };
-      const HexCorners h{points[static_cast<std::size_t>(c[static_cast<std::size_t>(k)])], at({k, n[0]}), face(n[0], n[1]), at({k, n[1]}),
-                         at({k, n[2]}), face(n[0], n[2]), centre, face(n[1], n[2])};
+      const HexCorners h{points[static_cast<std::size_t>(c[static_cast<std::size_t>(k)])],
+                         at({k, n[0]}),
+                         face(n[0], n[1]),
+                         at({k, n[1]}),
+                         at({k, n[2]}),
+                         face(n[0], n[2]),
+                         centre,
+                         face(n[1], n[2])};
       lowest = std::min(lowest, hex_scaled_jacobian(h));
     }
   }
@@ -197,7 +213,8 @@ std::vector<NodeSet> diced_node_sets(const Model& model, const DicedModel& diced
     // With pieces (model.hpp), a node made from nodes of one piece: its key's nodes, sorted.
     // Pieces that are single points say nothing of which nodes belong together: a set given
     // as points only (how a node set is written) follows the rule without pieces.
-    const bool by_pieces = std::any_of(ns.pieces.begin(), ns.pieces.end(), [](const auto& p) { return p.size() > 1; });
+    const bool by_pieces =
+        std::any_of(ns.pieces.begin(), ns.pieces.end(), [](const auto& p) { return p.size() > 1; });
     std::set<FaceKey> within;
     for (const auto& piece : ns.pieces) {
       const std::size_t n = std::min<std::size_t>(piece.size(), 4);
@@ -223,11 +240,12 @@ std::vector<NodeSet> diced_node_sets(const Model& model, const DicedModel& diced
   return sets;
 }
 
-std::vector<SideSet> diced_side_sets(const Model& model, const DicedModel& diced,
-                                     Index hex_offset, Index tet_offset, Index wedge_offset) {
+std::vector<SideSet> diced_side_sets(const Model& model, const DicedModel& diced, Index hex_offset,
+                                     Index tet_offset, Index wedge_offset) {
   std::vector<SideSet> sets;
   if (model.side_sets.empty()) return sets;
-  if (wedge_offset == kInvalidIndex) wedge_offset = tet_offset + static_cast<Index>(diced.tet_children.size());
+  if (wedge_offset == kInvalidIndex)
+    wedge_offset = tet_offset + static_cast<Index>(diced.tet_children.size());
   // Per kind (pyramids have none: they are split before dicing): children, their hexes, offset.
   struct Part {
     std::vector<std::vector<Index>> children;
@@ -235,10 +253,12 @@ std::vector<SideSet> diced_side_sets(const Model& model, const DicedModel& diced
     Index offset = 0;
   };
   std::array<Part, 4> parts;
-  auto part = [&](ElementKind kind, const std::vector<Index>& parent, const std::vector<std::array<Index, 8>>& hexes, Index offset) {
+  auto part = [&](ElementKind kind, const std::vector<Index>& parent,
+                  const std::vector<std::array<Index, 8>>& hexes, Index offset) {
     Part& p = parts[static_cast<std::size_t>(kind)];
     p.children.resize(element_count(model, kind));
-    for (std::size_t c = 0; c < parent.size(); ++c) p.children[parent[c]].push_back(static_cast<Index>(c));
+    for (std::size_t c = 0; c < parent.size(); ++c)
+      p.children[parent[c]].push_back(static_cast<Index>(c));
     p.hexes = &hexes;
     p.offset = offset;
   };
@@ -256,7 +276,8 @@ std::vector<SideSet> diced_side_sets(const Model& model, const DicedModel& diced
         const FaceKey& og = diced.origin[node];
         if (og[0] == kInvalidIndex) return false;
         for (Index v : og)
-          if (v != kInvalidIndex && std::find(face.begin(), face.end(), v) == face.end()) return false;
+          if (v != kInvalidIndex && std::find(face.begin(), face.end(), v) == face.end())
+            return false;
         return true;
       };
       for (Index c : p.children[static_cast<std::size_t>(side.element.index)])

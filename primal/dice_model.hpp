@@ -1,8 +1,9 @@
 #pragma once
 // Dicing a whole mixed model (primal/model.hpp) over one node array: the hex part 8 per hex,
 // the tet part 4 per tet (primal/dice.hpp), wedges 6 per wedge (one hex at each corner, its
-// axes the corner's edges, topology::kWedgeCornerNeighbors), every diced node keeping its origin (the sorted
-// input nodes it was made from), and the model's node and side sets carried onto the result.
+// axes the corner's edges, topology::kWedgeCornerNeighbors), every diced node keeping its origin
+// (the sorted input nodes it was made from), and the model's node and side sets carried onto the
+// result.
 //
 // A diced edge or face node is made once per part by dice(); the two parts meet it twice only
 // where every origin node is used by both parts (the hex/tet interface) or was marked
@@ -33,7 +34,8 @@ struct DicedModel {
   std::vector<FaceKey> origin;
   // Children in global node numbers, each part in its parent's order (dice.hpp's corner order).
   std::vector<std::array<Index, 8>> hex_children, tet_children, wedge_children;
-  std::vector<Index> hex_parent, tet_parent, wedge_parent;  // per child: index into Model::hexes / tets / wedges
+  std::vector<Index> hex_parent, tet_parent,
+      wedge_parent;  // per child: index into Model::hexes / tets / wedges
 
   Index add_node(const Point& p, const FaceKey& origin_key = kNoOrigin);
   // The node made from the (unsorted) origin nodes `key`: an input node itself, else an edge or
@@ -50,7 +52,8 @@ DicedModel dice_model(const Model& model, std::span<const char> shareable = {});
 // The lowest scaled Jacobian of the 6 hexes each wedge dices into (as dice_model makes them),
 // wedge by wedge: the wedges' part of the yardstick (dice.hpp's diced_min_scaled_jacobian for
 // hexes and tets). 1 when empty.
-double diced_wedge_min_scaled_jacobian(std::span<const Point> points, std::span<const std::array<Index, 6>> wedges);
+double diced_wedge_min_scaled_jacobian(std::span<const Point> points,
+                                       std::span<const std::array<Index, 6>> wedges);
 
 // The model's node sets on the diced nodes: every input node of a set plus every diced node
 // whose origin nodes are all in it. `renumber` maps a diced node to its output number
@@ -62,7 +65,7 @@ std::vector<NodeSet> diced_node_sets(const Model& model, const DicedModel& diced
 // children lying on it (4 per quad, 3 per triangle). Output hex numbers are hex_offset + child
 // for hex children, tet_offset + child for tet children and wedge_offset + child for wedge
 // children (kInvalidIndex: right after the tet children).
-std::vector<SideSet> diced_side_sets(const Model& model, const DicedModel& diced,
-                                     Index hex_offset, Index tet_offset, Index wedge_offset = kInvalidIndex);
+std::vector<SideSet> diced_side_sets(const Model& model, const DicedModel& diced, Index hex_offset,
+                                     Index tet_offset, Index wedge_offset = kInvalidIndex);
 
 }  // namespace geode::primal

@@ -12,7 +12,9 @@ namespace geode::primal {
 class DisjointSets {
  public:
   DisjointSets() = default;
-  explicit DisjointSets(std::size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), Index{0}); }
+  explicit DisjointSets(std::size_t n) : parent_(n) {
+    std::iota(parent_.begin(), parent_.end(), Index{0});
+  }
 
   // Back to n singletons, reusing the storage (for many small problems in a row).
   void reset(std::size_t n) {
@@ -27,7 +29,8 @@ class DisjointSets {
   }
   Index find(Index x) {
     while (parent_[static_cast<std::size_t>(x)] != x)
-      x = parent_[static_cast<std::size_t>(x)] = parent_[static_cast<std::size_t>(parent_[static_cast<std::size_t>(x)])];
+      x = parent_[static_cast<std::size_t>(x)] =
+          parent_[static_cast<std::size_t>(parent_[static_cast<std::size_t>(x)])];
     return x;
   }
   void unite(Index a, Index b) {
@@ -39,7 +42,8 @@ class DisjointSets {
   // Number of sets.
   std::size_t count() {
     std::size_t n = 0;
-    for (std::size_t i = 0; i < parent_.size(); ++i) n += find(static_cast<Index>(i)) == static_cast<Index>(i);
+    for (std::size_t i = 0; i < parent_.size(); ++i)
+      n += find(static_cast<Index>(i)) == static_cast<Index>(i);
     return n;
   }
 

@@ -103,8 +103,9 @@ inline double corner_shape_derivatives(const FrameVector& v, int dim, FrameVecto
   if (!three) gs.segment<3>(6).setZero();
   if (grad) *grad = (dnum / sum) * gd - (s / sum) * gs;
   if (hess) {
-    const double ddnum =
-        three && root > 0.0 ? -2.0 / 3.0 * std::copysign(1.0, d) / (root * root * root * root) : 0.0;
+    const double ddnum = three && root > 0.0
+                             ? -2.0 / 3.0 * std::copysign(1.0, d) / (root * root * root * root)
+                             : 0.0;
     const FrameVector gn = dnum * gd, gr = -gs / (sum * sum);
     FrameMatrix hs = FrameMatrix::Zero();
     hs.diagonal().head(3 * dim).setConstant(2.0);

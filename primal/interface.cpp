@@ -29,11 +29,13 @@ struct TriangleUses {
 
 // Messages speak in the file's ids (model.hpp: describe_element, node_list).
 std::string quad_name(const Model& model, Index hex, const std::array<Index, 4>& corners) {
-  return describe_element(model, {ElementKind::Hex, hex}) + " face (nodes " + node_list(model, corners) + ")";
+  return describe_element(model, {ElementKind::Hex, hex}) + " face (nodes " +
+         node_list(model, corners) + ")";
 }
 
 std::string tet_face_name(const Model& model, const TetFaceUse& use) {
-  return describe_element(model, {ElementKind::Tet, use.tet}) + " face (nodes " + node_list(model, use.nodes) + ")";
+  return describe_element(model, {ElementKind::Tet, use.tet}) + " face (nodes " +
+         node_list(model, use.nodes) + ")";
 }
 
 // Whether p lies on triangle (a, b, c), edges and corners included, within tol * longest edge.
@@ -53,7 +55,8 @@ bool on_triangle(const Point& p, const Point& a, const Point& b, const Point& c,
 // hide the faces between them, so that the interface would seem to vanish there; name them
 // instead. First pair in element order.
 template <std::size_t N>
-void refuse_duplicates(const Model& model, const std::vector<std::array<Index, N>>& cells, ElementKind kind) {
+void refuse_duplicates(const Model& model, const std::vector<std::array<Index, N>>& cells,
+                       ElementKind kind) {
   std::unordered_map<std::array<Index, N>, Index, IndexArrayHash> first;
   first.reserve(cells.size());
   for (std::size_t e = 0; e < cells.size(); ++e) {
@@ -61,9 +64,11 @@ void refuse_duplicates(const Model& model, const std::vector<std::array<Index, N
     std::sort(key.begin(), key.end());
     const auto [it, inserted] = first.try_emplace(key, static_cast<Index>(e));
     if (!inserted)
-      throw TopologyError("find_interface: " + describe_element(model, {kind, static_cast<Index>(e)}) +
-                          " has the same nodes as " + describe_element(model, {kind, it->second}) + " (nodes " +
-                          node_list(model, cells[e]) + "): a duplicated element (an element or a block given twice?)");
+      throw TopologyError(
+          "find_interface: " + describe_element(model, {kind, static_cast<Index>(e)}) +
+          " has the same nodes as " + describe_element(model, {kind, it->second}) + " (nodes " +
+          node_list(model, cells[e]) +
+          "): a duplicated element (an element or a block given twice?)");
   }
 }
 
@@ -91,7 +96,8 @@ std::vector<std::array<Index, 3>> interface_triangles(const InterfaceQuad& q) {
     return {two.begin(), two.end()};
   }
   std::vector<std::array<Index, 3>> four;
-  for (std::size_t i = 0; i < 4; ++i) four.push_back({q.corners[i], q.corners[(i + 1) % 4], q.centre});
+  for (std::size_t i = 0; i < 4; ++i)
+    four.push_back({q.corners[i], q.corners[(i + 1) % 4], q.centre});
   return four;
 }
 
@@ -106,7 +112,8 @@ Interface find_interface(const Model& model, double tol) {
   KeyMap<4> tri_index(2 * model.tets.size());
   std::vector<TriangleUses> tris;
   tris.reserve(2 * model.tets.size() + 2);
-  std::vector<Index> tet_face_tri(4 * model.tets.size());  // tris index of face f of tet t at 4 t + f
+  std::vector<Index> tet_face_tri(4 *
+                                  model.tets.size());  // tris index of face f of tet t at 4 t + f
   for (std::size_t t = 0; t < model.tets.size(); ++t)
     for (int f = 0; f < 4; ++f) {
       TetFaceUse use{static_cast<Index>(t), f, {}};
@@ -123,7 +130,8 @@ Interface find_interface(const Model& model, double tol) {
                             ") is a face of more than two tets (" +
                             describe_element(model, {ElementKind::Tet, uses.use[0].tet}) + ", " +
                             describe_element(model, {ElementKind::Tet, uses.use[1].tet}) + ", " +
-                            describe_element(model, {ElementKind::Tet, static_cast<Index>(t)}) + ")");
+                            describe_element(model, {ElementKind::Tet, static_cast<Index>(t)}) +
+                            ")");
       uses.use[static_cast<std::size_t>(uses.count++)] = use;
     }
   // The boundary triangle with this key, or nullptr.
@@ -156,7 +164,8 @@ Interface find_interface(const Model& model, double tol) {
       bool all = true;
       for (std::size_t i = 1; i < 4 && all; ++i)
         all = boundary_triangle(face_key(std::array<Index, 3>{c[i], c[(i + 1) % 4], x})) != nullptr;
-      if (all && (best == kInvalidIndex || (pt(x) - middle).norm() < (pt(best) - middle).norm())) best = x;
+      if (all && (best == kInvalidIndex || (pt(x) - middle).norm() < (pt(best) - middle).norm()))
+        best = x;
     }
     return best;
   };
@@ -198,18 +207,21 @@ Interface find_interface(const Model& model, double tol) {
       const double off = (pt(centre) - middle).dot(normal);
       if (std::abs(off) > kFanCentreOffset * edge) {
         std::ostringstream m;
-        m << "find_interface: " << name << " is split into four triangles around " << describe_node(model, centre)
-          << ", which lies " << std::abs(off) << " " << (off > 0 ? "outside the hex face (a gap between the parts)"
-                                                                 : "inside the hex (the parts overlap)")
-          << "; at most " << kFanCentreOffset << " x the quad's mean edge (" << edge << ") off its centre "
-          << point_text(middle);
+        m << "find_interface: " << name << " is split into four triangles around "
+          << describe_node(model, centre) << ", which lies " << std::abs(off) << " "
+          << (off > 0 ? "outside the hex face (a gap between the parts)"
+                      : "inside the hex (the parts overlap)")
+          << "; at most " << kFanCentreOffset << " x the quad's mean edge (" << edge
+          << ") off its centre " << point_text(middle);
         throw TopologyError(m.str());
       }
       for (std::size_t i = 0; i < 4; ++i)
         if ((pt(c[(i + 1) % 4]) - pt(c[i])).cross(pt(centre) - pt(c[i])).dot(normal) <= 0)
           throw TopologyError("find_interface: " + name + " is split into four triangles around " +
-                              describe_node(model, centre) + ", which lies outside the quad (the triangle on nodes " +
-                              node_list(model, std::array<Index, 3>{c[i], c[(i + 1) % 4], centre}) + " folds over)");
+                              describe_node(model, centre) +
+                              ", which lies outside the quad (the triangle on nodes " +
+                              node_list(model, std::array<Index, 3>{c[i], c[(i + 1) % 4], centre}) +
+                              " folds over)");
     }
     const bool d0 = found[0][0] && found[0][1], d1 = found[1][0] && found[1][1];
     if (centre == kInvalidIndex && (count != 2 || !(d0 || d1))) {
@@ -235,18 +247,22 @@ Interface find_interface(const Model& model, double tol) {
     const Point middle = (pt(c[0]) + pt(c[1]) + pt(c[2]) + pt(c[3])) / 4.0;
     const auto triangles = interface_triangles(q);
     for (std::size_t i = 0; i < triangles.size(); ++i) {
-      const TetFaceUse& u = centre == kInvalidIndex ? *found[static_cast<std::size_t>(q.diagonal)][i]
-                                                    : *boundary_triangle(face_key(triangles[i]));
+      const TetFaceUse& u = centre == kInvalidIndex
+                                ? *found[static_cast<std::size_t>(q.diagonal)][i]
+                                : *boundary_triangle(face_key(triangles[i]));
       q.tets[i] = u.tet;
       q.tet_faces[i] = u.face;
-      tris[static_cast<std::size_t>(tet_face_tri[4 * static_cast<std::size_t>(u.tet) + static_cast<std::size_t>(u.face)])].matched = true;
+      tris[static_cast<std::size_t>(tet_face_tri[4 * static_cast<std::size_t>(u.tet) +
+                                                 static_cast<std::size_t>(u.face)])]
+          .matched = true;
       const auto& tet = model.tets[static_cast<std::size_t>(u.tet)];
       Index apex = kInvalidIndex;
       for (Index v : tet)
         if (std::find(u.nodes.begin(), u.nodes.end(), v) == u.nodes.end()) apex = v;
       if ((pt(apex) - middle).dot(normal) <= 0.0)
-        throw TopologyError("find_interface: " + describe_element(model, {ElementKind::Tet, u.tet}) + " on " + name +
-                            " lies on the hex side of it (the parts overlap or are inverted)");
+        throw TopologyError(
+            "find_interface: " + describe_element(model, {ElementKind::Tet, u.tet}) + " on " +
+            name + " lies on the hex side of it (the parts overlap or are inverted)");
     }
     out.quads.push_back(q);
   }
@@ -280,7 +296,8 @@ Interface find_interface(const Model& model, double tol) {
                 on_triangle(pt(p), pt(c[1]), pt(c[2]), pt(c[3]), tol))
               throw TopologyError(
                   "find_interface: " + describe_node(model, p) + " of the tet part (" +
-                  describe_element(model, {ElementKind::Tet, tri.tet}) + ") lies on " + quad_name(model, bq->hex, c) +
+                  describe_element(model, {ElementKind::Tet, tri.tet}) + ") lies on " +
+                  quad_name(model, bq->hex, c) +
                   " but is not one of its corners: the parts do not conform node-wise");
           }
           for (Index p : c) {
@@ -288,7 +305,8 @@ Interface find_interface(const Model& model, double tol) {
             if (on_triangle(pt(p), pt(tri.nodes[0]), pt(tri.nodes[1]), pt(tri.nodes[2]), tol))
               throw TopologyError(
                   "find_interface: " + describe_node(model, p) + " of the hex part (" +
-                  describe_element(model, {ElementKind::Hex, bq->hex}) + ") lies on " + tet_face_name(model, tri) +
+                  describe_element(model, {ElementKind::Hex, bq->hex}) + ") lies on " +
+                  tet_face_name(model, tri) +
                   " but is not one of its corners: the parts do not conform node-wise");
           }
         }

@@ -12,8 +12,8 @@
 namespace geode::primal {
 
 struct InterfaceQuad {
-  Index hex = kInvalidIndex;   // the hex owning the quad
-  int face = -1;               // its local face (topology::kHexFaceCorners)
+  Index hex = kInvalidIndex;  // the hex owning the quad
+  int face = -1;              // its local face (topology::kHexFaceCorners)
   // The face's corners in kHexFaceCorners order: counter-clockwise seen from outside the hex,
   // i.e. from the tet side.
   std::array<Index, 4> corners{};

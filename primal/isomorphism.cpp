@@ -59,8 +59,8 @@ struct Complex {
   Index n_nodes = 0;
   std::vector<std::vector<Index>> node_cells;
   std::vector<std::array<Index, K::kFacets>> neighbor;  // cell across each facet, or -1
-  std::vector<char> boundary;                          // node on a facet of one cell only
-  std::vector<std::vector<Index>> node_neighbors;      // distinct nodes joined by an edge
+  std::vector<char> boundary;                           // node on a facet of one cell only
+  std::vector<std::vector<Index>> node_neighbors;       // distinct nodes joined by an edge
 };
 
 template <int N>
@@ -202,8 +202,8 @@ std::optional<MeshMapping> search(std::size_t na_nodes, const Cells<N>& a_cells,
   std::stable_sort(by_rarity.begin(), by_rarity.end(), [&](Index x, Index y) {
     return a_sig_count[signature<N>(a_cells[x], ca)] < a_sig_count[signature<N>(a_cells[y], ca)];
   });
-  std::vector<Index> order;                        // cells of a in search order
-  std::vector<std::pair<Index, int>> parent;       // (parent cell, its facet) or (-1, -1)
+  std::vector<Index> order;                   // cells of a in search order
+  std::vector<std::pair<Index, int>> parent;  // (parent cell, its facet) or (-1, -1)
   {
     std::vector<char> seen(n_cells, 0);
     for (Index seed : by_rarity) {

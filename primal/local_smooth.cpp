@@ -7,8 +7,8 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <chrono>
-#include <ctime>
 #include <cmath>
+#include <ctime>
 #include <limits>
 #include <memory>
 #include <string>
@@ -74,7 +74,8 @@ class SurfaceProjector {
     cell_ = std::max(2.0 * edges / (3.0 * static_cast<double>(s.tris.size())), 1e-12);
     for (std::size_t i = 0; i < s.tris.size(); ++i) {
       Point a = s.points[s.tris[i][0]], b = a;
-      for (int k = 1; k < 3; ++k) a = a.cwiseMin(s.points[s.tris[i][k]]), b = b.cwiseMax(s.points[s.tris[i][k]]);
+      for (int k = 1; k < 3; ++k)
+        a = a.cwiseMin(s.points[s.tris[i][k]]), b = b.cwiseMax(s.points[s.tris[i][k]]);
       const auto ca = cell_of(a), cb = cell_of(b);
       for (Index x = ca[0]; x <= cb[0]; ++x)
         for (Index y = ca[1]; y <= cb[1]; ++y)
@@ -96,8 +97,8 @@ class SurfaceProjector {
             if (it == grid_.end()) continue;
             for (Index t : it->second) {
               const auto& tri = s_.tris[t];
-              const Point q = closest_on_triangle(p, s_.points[tri[0]], s_.points[tri[1]],
-                                                  s_.points[tri[2]]);
+              const Point q =
+                  closest_on_triangle(p, s_.points[tri[0]], s_.points[tri[1]], s_.points[tri[2]]);
               const double d = (q - p).squaredNorm();
               if (d < best || (d == best && t < best_tri)) best = d, out = q, best_tri = t;
             }
@@ -135,8 +136,8 @@ struct Context {
   const SurfaceProjector* projector;
   const LocalSmoothOptions& options;
   std::vector<Index> node_start, node_hexes;  // node -> hexes (CSR)
-  std::vector<double> start;                  // per hex, its scaled Jacobian at the start (SmoothStart)
-  std::vector<double> edge_floor;             // per hex, the shortest edge it may have
+  std::vector<double> start;       // per hex, its scaled Jacobian at the start (SmoothStart)
+  std::vector<double> edge_floor;  // per hex, the shortest edge it may have
 };
 
 bool is_fixed(const Context& ctx, Index v) {
@@ -200,7 +201,8 @@ struct PatchOutcome {
 // One patch: the free nodes of a seed hex move; every frame with a moving node is counted.
 class Patch {
  public:
-  Patch(const Context& ctx, Index seed, std::span<const Index> affected, const std::vector<double>& sj)
+  Patch(const Context& ctx, Index seed, std::span<const Index> affected,
+        const std::vector<double>& sj)
       : ctx_(ctx), hex_(affected.begin(), affected.end()) {
     for (Index v : ctx.mesh.hexes[seed])
       if (!is_fixed(ctx, v) && std::find(node_.begin(), node_.end(), v) == node_.end())
@@ -220,13 +222,16 @@ class Patch {
     for (std::size_t h = 0; h < hex_.size(); ++h)
       for (int f = 0; f < 9; ++f) {
         bool has = false;
-        for (int k = 0; k < shapes[f].nodes; ++k) has = has || local_[h][shapes[f].corner[k]] < moving_;
+        for (int k = 0; k < shapes[f].nodes; ++k)
+          has = has || local_[h][shapes[f].corner[k]] < moving_;
         if (has) frames_.push_back({static_cast<int>(h), f});
       }
     // Length unit: the mean edge of the seed hex.
     double sum = 0.0;
     for (const auto& e : topo::kHexEdgeCorners)
-      sum += (ctx.mesh.points[ctx.mesh.hexes[seed][e[0]]] - ctx.mesh.points[ctx.mesh.hexes[seed][e[1]]]).norm();
+      sum += (ctx.mesh.points[ctx.mesh.hexes[seed][e[0]]] -
+              ctx.mesh.points[ctx.mesh.hexes[seed][e[1]]])
+                 .norm();
     length_ = std::max(sum / 12.0, 1e-300);
     unit_ = length_ * length_ * length_;
     // Floors (see the header): the patch's worst never drops; hexes within `margin` of it keep
@@ -237,7 +242,7 @@ class Patch {
     const double keep = std::max(worst, 0.0) + ctx.options.margin;
     for (Index h : hex_) {
       const double s = ctx.start[h];
-      const double f = s <= 0.0 ? -std::numeric_limits<double>::infinity()
+      const double f = s <= 0.0   ? -std::numeric_limits<double>::infinity()
                        : s < keep ? s
                                   : std::max(keep, s - ctx.options.loss);
       floor_.push_back(sj[h] <= 0.0 ? f : std::min(sj[h], std::max(f, worst)));
@@ -270,7 +275,8 @@ class Patch {
     if (out.moved) {
       // Patches of one round write disjoint nodes and hexes (see the round selection).
       for (int i = 0; i < moving_; ++i) ctx_.mesh.points[node_[i]] = pos_[i];
-      for (std::size_t h = 0; h < hex_.size(); ++h) sj[hex_[h]] = hex_scaled_jacobian(corners(pos_, h));
+      for (std::size_t h = 0; h < hex_.size(); ++h)
+        sj[hex_[h]] = hex_scaled_jacobian(corners(pos_, h));
     }
     return out;
   }
@@ -303,7 +309,8 @@ class Patch {
 
   double min_untangle_frame() const {
     double m = std::numeric_limits<double>::max();
-    for (const FrameRef& r : frames_) m = std::min(m, measure(columns(pos_, r), r, true, nullptr, nullptr));
+    for (const FrameRef& r : frames_)
+      m = std::min(m, measure(columns(pos_, r), r, true, nullptr, nullptr));
     return m;
   }
 
@@ -322,7 +329,8 @@ class Patch {
     const std::size_t n = frames_.size();
     if (!q_known) {
       q_.resize(n);
-      for (std::size_t k = 0; k < n; ++k) q_[k] = measure(columns(p, frames_[k]), frames_[k], untangle, nullptr, nullptr);
+      for (std::size_t k = 0; k < n; ++k)
+        q_[k] = measure(columns(p, frames_[k]), frames_[k], untangle, nullptr, nullptr);
     }
     const auto [qmin, sum, value] = soft_of_q(t);
     if (!grad) return value;
@@ -369,7 +377,8 @@ class Patch {
         for (int b = 0; b < count; ++b) {
           Eigen::Matrix3d blk = Eigen::Matrix3d::Zero();
           for (int j = 0; j < 3; ++j) blk += s.coef[j][slot[b]] * row.block<3, 3>(0, 3 * j);
-          hess->block<3, 3>(3 * node[a], 3 * node[b]) += -w * blk + t * w * gn[a] * gn[b].transpose();
+          hess->block<3, 3>(3 * node[a], 3 * node[b]) +=
+              -w * blk + t * w * gn[a] * gn[b].transpose();
         }
       }
     }
@@ -400,7 +409,8 @@ class Patch {
   // The soft minimum at the positions feasible() accepted last, from the frame values it
   // measured (the shape phase's frame measure is the scaled Jacobian itself).
   double accepted_soft_min(double t) {
-    for (std::size_t k = 0; k < frames_.size(); ++k) q_[k] = trial_q_[frames_[k].hex][frames_[k].frame];
+    for (std::size_t k = 0; k < frames_.size(); ++k)
+      q_[k] = trial_q_[frames_[k].hex][frames_[k].frame];
     return soft_of_q(t).value;
   }
 
@@ -463,9 +473,11 @@ class Patch {
     trial_ = pos_;
     for (double step = 1.0; step > 0.01; step *= 0.5) {
       for (int i = 0; i < moving_; ++i)
-        trial_[i] = constrain(ctx_, node_[i], pos_[i] + step * (basis[i] * d.segment(offset[i], basis[i].cols())));
+        trial_[i] = constrain(ctx_, node_[i],
+                              pos_[i] + step * (basis[i] * d.segment(offset[i], basis[i].cols())));
       if (!feasible(trial_, untangle)) continue;
-      const double f = untangle ? -soft_min(trial_, untangle, t, nullptr, nullptr) : -accepted_soft_min(t);
+      const double f =
+          untangle ? -soft_min(trial_, untangle, t, nullptr, nullptr) : -accepted_soft_min(t);
       if (std::isfinite(f) && f <= f0 + 1e-4 * step * slope && f < f0) {
         last_gain_ = f0 - f;
         lambda_ = step == 1.0 ? lambda_ / 4.0 : std::max(4.0 * lambda_, 1e-8 * scale);
@@ -478,8 +490,8 @@ class Patch {
   }
 
   const Context& ctx_;
-  std::vector<Index> hex_;                // affected hexes
-  std::vector<Index> node_;               // local -> global; the first moving_ move
+  std::vector<Index> hex_;                 // affected hexes
+  std::vector<Index> node_;                // local -> global; the first moving_ move
   std::vector<std::array<int, 8>> local_;  // per affected hex, its corners' local numbers
   std::vector<Point> pos_, trial_;
   std::vector<FrameRef> frames_;
@@ -520,9 +532,15 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
   if ((!options.hex_targets.empty() && options.hex_targets.size() != nh) ||
       (!options.hex_goals.empty() && options.hex_goals.size() != nh))
     throw InvalidInput("smooth_hexes_local: the per-hex targets or goals are not one per hex");
-  auto target_of = [&](Index h) { return options.hex_targets.empty() ? options.target : options.hex_targets[static_cast<std::size_t>(h)]; };
+  auto target_of = [&](Index h) {
+    return options.hex_targets.empty() ? options.target
+                                       : options.hex_targets[static_cast<std::size_t>(h)];
+  };
   const bool goals = options.goal > 0.0 || !options.hex_goals.empty();
-  auto goal_of = [&](Index h) { return options.hex_goals.empty() ? options.goal : options.hex_goals[static_cast<std::size_t>(h)]; };
+  auto goal_of = [&](Index h) {
+    return options.hex_goals.empty() ? options.goal
+                                     : options.hex_goals[static_cast<std::size_t>(h)];
+  };
   std::unique_ptr<SurfaceProjector> projector;
   for (std::size_t v = 0; v < constraints.size(); ++v) {
     const NodeConstraint& c = constraints[v];
@@ -557,10 +575,12 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
   std::vector<double> sj = start ? scaled_jacobian_per_hex(mesh) : now.scaled_jacobian;
   ctx.start = from.scaled_jacobian;
   ctx.edge_floor.resize(nh);
-  for (std::size_t h = 0; h < nh; ++h) ctx.edge_floor[h] = options.min_edge_fraction * from.shortest_edge[h];
+  for (std::size_t h = 0; h < nh; ++h)
+    ctx.edge_floor[h] = options.min_edge_fraction * from.shortest_edge[h];
   auto summarise = [&](double& min_sj, Index& inverted) {
     min_sj = nh ? *std::min_element(sj.begin(), sj.end()) : 0.0;
-    inverted = static_cast<Index>(std::count_if(sj.begin(), sj.end(), [](double q) { return q <= 0.0; }));
+    inverted =
+        static_cast<Index>(std::count_if(sj.begin(), sj.end(), [](double q) { return q <= 0.0; }));
   };
   summarise(res.initial_min_scaled_jacobian, res.initial_inverted);
 
@@ -585,7 +605,8 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
     if (options.progress) options.progress(pool.size() - cand.size(), pool.size());
     if (cand.empty()) break;
     // The caller's aim is met: the target above it only gave the hexes room to get there.
-    if (goals && std::all_of(pool.begin(), pool.end(), [&](Index h) { return sj[h] >= goal_of(h); }))
+    if (goals &&
+        std::all_of(pool.begin(), pool.end(), [&](Index h) { return sj[h] >= goal_of(h); }))
       break;
     std::sort(cand.begin(), cand.end(), [&](std::size_t i, std::size_t j) {
       const Index a = pool[i], b = pool[j];
@@ -600,7 +621,8 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
       if (a.empty()) {  // not found yet (a hex found with none is never a candidate again)
         for (Index v : mesh.hexes[h])
           if (!is_fixed(ctx, v))
-            for (Index k = ctx.node_start[v]; k < ctx.node_start[v + 1]; ++k) a.push_back(ctx.node_hexes[k]);
+            for (Index k = ctx.node_start[v]; k < ctx.node_start[v + 1]; ++k)
+              a.push_back(ctx.node_hexes[k]);
         std::sort(a.begin(), a.end());
         a.erase(std::unique(a.begin(), a.end()), a.end());
       }
@@ -633,7 +655,8 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
     res.rounds = round + 1;
   }
   summarise(res.final_min_scaled_jacobian, res.final_inverted);
-  res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
+  res.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
   res.cpu_seconds = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
   return res;
 }
@@ -643,13 +666,15 @@ LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seed
   for (Index s : seeds)
     if (s < 0 || static_cast<std::size_t>(s) >= mesh.hexes.size())
       throw InvalidInput("smooth_hexes_around: seed hex " + std::to_string(s) + " out of range");
-  if (start && (start->scaled_jacobian.size() != mesh.hexes.size() || start->shortest_edge.size() != mesh.hexes.size()))
+  if (start && (start->scaled_jacobian.size() != mesh.hexes.size() ||
+                start->shortest_edge.size() != mesh.hexes.size()))
     throw InvalidInput("smooth_hexes_around: the start values are not one per hex");
   if (seeds.empty()) return {};
   std::vector<Index> sorted(seeds.begin(), seeds.end());
   std::sort(sorted.begin(), sorted.end());
   const std::vector<Index> region = hexes_around(mesh, seeds);  // hexes a patch can change
-  const std::vector<Index> outer = hexes_around(mesh, region);  // every hex sharing a face with them
+  const std::vector<Index> outer =
+      hexes_around(mesh, region);  // every hex sharing a face with them
   // The submesh of `outer`, nodes numbered in order of first use.
   HexMesh sub;
   std::vector<Index> local(mesh.points.size(), kInvalidIndex), global;
@@ -658,7 +683,8 @@ LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seed
     std::array<Index, 8> c{};
     for (int k = 0; k < 8; ++k) {
       Index& l = local[mesh.hexes[h][k]];
-      if (l == kInvalidIndex) l = static_cast<Index>(global.size()), global.push_back(mesh.hexes[h][k]);
+      if (l == kInvalidIndex)
+        l = static_cast<Index>(global.size()), global.push_back(mesh.hexes[h][k]);
       c[k] = l;
     }
     sub.hexes.push_back(c);
@@ -692,7 +718,8 @@ LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seed
     for (Index v : mesh.hexes[s]) moves[local[v]] = 1;
   }
   for (std::size_t i = 0; i < outer.size(); ++i)
-    if (std::binary_search(sorted.begin(), sorted.end(), outer[i])) local_seeds.push_back(static_cast<Index>(i));
+    if (std::binary_search(sorted.begin(), sorted.end(), outer[i]))
+      local_seeds.push_back(static_cast<Index>(i));
   for (std::size_t v = 0; v < constraints.size(); ++v)
     if (!moves[v]) constraints[v] = NodeConstraint::fixed();
   SmoothStart sub_start;
@@ -713,7 +740,8 @@ LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seed
   };
   restrict_to_outer(sub_options.hex_targets);
   restrict_to_outer(sub_options.hex_goals);
-  LocalSmoothResult res = smooth_hexes_local(sub, constraints, nullptr, local_seeds, sub_options, start ? &sub_start : nullptr);
+  LocalSmoothResult res = smooth_hexes_local(sub, constraints, nullptr, local_seeds, sub_options,
+                                             start ? &sub_start : nullptr);
   for (std::size_t v = 0; v < global.size(); ++v)
     if (moves[v]) mesh.points[global[v]] = sub.points[v];
   res.region = region;
@@ -731,7 +759,8 @@ std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh) {
   return boundary_slide_constraints(mesh, material_surface_quads(mesh));
 }
 
-std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh, std::span<const BoundaryQuad> surfaces) {
+std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh,
+                                                       std::span<const BoundaryQuad> surfaces) {
   const auto& p = mesh.points;
   std::vector<NodeConstraint> out(p.size());
   // Per node, the unit normals of its surface quads; a warped quad (corners off one plane)
@@ -751,8 +780,10 @@ std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh, std:
       for (Index v : q.nodes) flat = flat && std::abs((p[v] - c).dot(u)) <= kFlat * scale;
     }
     for (Index v : q.nodes) {
-      if (!flat) fixed[v] = 1;
-      else normals[v].push_back(n.normalized());
+      if (!flat)
+        fixed[v] = 1;
+      else
+        normals[v].push_back(n.normalized());
     }
   }
   for (std::size_t v = 0; v < normals.size(); ++v) {
@@ -765,11 +796,15 @@ std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh, std:
     // oriented by one of its two hexes).
     std::vector<Point> planes;
     for (const Point& n : normals[v])
-      if (std::none_of(planes.begin(), planes.end(), [&](const Point& m) { return m.cross(n).norm() <= kParallel; }))
+      if (std::none_of(planes.begin(), planes.end(),
+                       [&](const Point& m) { return m.cross(n).norm() <= kParallel; }))
         planes.push_back(n);
-    if (planes.size() == 1) out[v] = NodeConstraint::plane(p[v], planes[0]);
-    else if (planes.size() == 2) out[v] = NodeConstraint::line(p[v], planes[0].cross(planes[1]).normalized());
-    else out[v] = NodeConstraint::fixed();
+    if (planes.size() == 1)
+      out[v] = NodeConstraint::plane(p[v], planes[0]);
+    else if (planes.size() == 2)
+      out[v] = NodeConstraint::line(p[v], planes[0].cross(planes[1]).normalized());
+    else
+      out[v] = NodeConstraint::fixed();
   }
   return out;
 }
@@ -778,7 +813,8 @@ TriMesh boundary_triangulation(const HexMesh& mesh) {
   return boundary_triangulation(mesh.points, boundary_quads(mesh));
 }
 
-TriMesh boundary_triangulation(const std::vector<Point>& points, std::span<const BoundaryQuad> boundary) {
+TriMesh boundary_triangulation(const std::vector<Point>& points,
+                               std::span<const BoundaryQuad> boundary) {
   TriMesh t;
   t.points = points;
   for (const BoundaryQuad& q : boundary) {

@@ -46,27 +46,27 @@ namespace geode::primal {
 inline constexpr double kFeatureAngle = 30.0;
 
 struct LocalSmoothOptions {
-  double target = 0.35;       // hexes with a scaled Jacobian below it seed patches
+  double target = 0.35;  // hexes with a scaled Jacobian below it seed patches
   // > 0: the call ends as soon as every seed hex is at or above it, before the target is
   // reached (a caller whose aim is below the target sets the target higher only to give the
   // hexes room to rise).
   double goal = 0.0;
-  double margin = 0.1;        // hexes this close to a patch's worst never lose (see Floors)
-  double loss = 0.1;          // how far a better hex may fall from its start
+  double margin = 0.1;  // hexes this close to a patch's worst never lose (see Floors)
+  double loss = 0.1;    // how far a better hex may fall from its start
   // Improving shape, no hex's shortest edge drops below this fraction of its shortest edge when
   // the call began (or below its current one, if untangling shortened it further): the scaled
   // Jacobian normalises edge lengths, so it would let an edge shrink to nothing.
   double min_edge_fraction = 0.5;
-  int max_visits = 2;         // patches seeded by one hex
-  int max_iterations = 5;     // Newton iterations per patch (per phase)
-  double sharpness = 60.0;    // soft minimum of scaled Jacobians
+  int max_visits = 2;                // patches seeded by one hex
+  int max_iterations = 5;            // Newton iterations per patch (per phase)
+  double sharpness = 60.0;           // soft minimum of scaled Jacobians
   double untangle_sharpness = 20.0;  // soft minimum of Jacobians / L^3
-  double min_gain = 1e-4;     // soft-minimum rise counted as progress
+  double min_gain = 1e-4;            // soft-minimum rise counted as progress
   // Per hex of the mesh (each empty, or one per hex): that hex's own target and goal instead of
   // `target` and `goal`, for callers whose aim differs from hex to hex (conform's local
   // yardstick). A goal of 0 is met by any hex.
   std::vector<double> hex_targets, hex_goals;
-  int threads = 0;            // 0: TBB's default; 1: serial
+  int threads = 0;  // 0: TBB's default; 1: serial
   // Called before each round and at the end with (seed hexes not waiting for a patch, seeds).
   std::function<void(std::size_t settled, std::size_t seeds)> progress;
 };
@@ -76,8 +76,8 @@ struct LocalSmoothResult {
   double final_min_scaled_jacobian = 0.0;
   Index initial_inverted = 0, final_inverted = 0;  // hexes with scaled Jacobian <= 0
   Index patches = 0, rounds = 0;
-  long iterations = 0;  // Newton iterations over all patches
-  double seconds = 0.0;  // wall clock
+  long iterations = 0;       // Newton iterations over all patches
+  double seconds = 0.0;      // wall clock
   double cpu_seconds = 0.0;  // the process's CPU time over all threads (std::clock)
   // smooth_hexes_around: the hexes whose scaled Jacobian it can have changed (those sharing a
   // node with a seed), ascending; empty from smooth_hexes_local.
@@ -131,12 +131,14 @@ std::vector<BoundaryQuad> material_surface_quads(const HexMesh& mesh);
 // smoother keeps them untangled), so each block's volume, the flux of x.n / 3 through its
 // faces, does not change (to rounding). Interior nodes are free.
 std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh);
-std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh, std::span<const BoundaryQuad> surfaces);
+std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh,
+                                                       std::span<const BoundaryQuad> surfaces);
 
 // The mesh's boundary quads, each split into two triangles (along the 0-2 diagonal): the
 // surface kSurface nodes slide on when no input triangulation is at hand.
 TriMesh boundary_triangulation(const HexMesh& mesh);
-TriMesh boundary_triangulation(const std::vector<Point>& points, std::span<const BoundaryQuad> boundary);
+TriMesh boundary_triangulation(const std::vector<Point>& points,
+                               std::span<const BoundaryQuad> boundary);
 
 // Every hex sharing a node with one of `hexes` (those included), ascending.
 std::vector<Index> hexes_around(const HexMesh& mesh, std::span<const Index> hexes);

@@ -33,7 +33,8 @@ constexpr To index_cast(From value) noexcept {
 struct HexMesh {
   std::vector<Point> points;
   std::vector<std::array<Index, 8>> hexes;  // VTK/Exodus corner order (primal/topology.hpp)
-  std::vector<int> block;  // per hex, an origin tag (e.g. diced hex / geode / diced tet); may be empty
+  std::vector<int>
+      block;  // per hex, an origin tag (e.g. diced hex / geode / diced tet); may be empty
 };
 
 struct TetMesh {

@@ -23,10 +23,14 @@ int default_block(ElementKind kind) { return static_cast<int>(kind) + 1; }
 
 std::size_t element_count(const Model& model, ElementKind kind) {
   switch (kind) {
-    case ElementKind::Hex: return model.hexes.size();
-    case ElementKind::Tet: return model.tets.size();
-    case ElementKind::Pyramid: return model.pyramids.size();
-    case ElementKind::Wedge: return model.wedges.size();
+    case ElementKind::Hex:
+      return model.hexes.size();
+    case ElementKind::Tet:
+      return model.tets.size();
+    case ElementKind::Pyramid:
+      return model.pyramids.size();
+    case ElementKind::Wedge:
+      return model.wedges.size();
   }
   return 0;
 }
@@ -41,20 +45,28 @@ std::span<const Index> element_corners(const Model& model, ElementRef e) {
   if (e.index < 0 || static_cast<std::size_t>(e.index) >= element_count(model, e.kind)) return {};
   const auto i = static_cast<std::size_t>(e.index);
   switch (e.kind) {
-    case ElementKind::Hex: return model.hexes[i];
-    case ElementKind::Tet: return model.tets[i];
-    case ElementKind::Pyramid: return model.pyramids[i];
-    case ElementKind::Wedge: return model.wedges[i];
+    case ElementKind::Hex:
+      return model.hexes[i];
+    case ElementKind::Tet:
+      return model.tets[i];
+    case ElementKind::Pyramid:
+      return model.pyramids[i];
+    case ElementKind::Wedge:
+      return model.wedges[i];
   }
   return {};
 }
 
 std::vector<int>& element_blocks(Model& model, ElementKind kind) {
   switch (kind) {
-    case ElementKind::Hex: return model.hex_block;
-    case ElementKind::Tet: return model.tet_block;
-    case ElementKind::Pyramid: return model.pyramid_block;
-    case ElementKind::Wedge: break;
+    case ElementKind::Hex:
+      return model.hex_block;
+    case ElementKind::Tet:
+      return model.tet_block;
+    case ElementKind::Pyramid:
+      return model.pyramid_block;
+    case ElementKind::Wedge:
+      break;
   }
   return model.wedge_block;
 }
@@ -65,10 +77,14 @@ const std::vector<int>& element_blocks(const Model& model, ElementKind kind) {
 
 std::vector<std::int64_t>& element_ids(Model& model, ElementKind kind) {
   switch (kind) {
-    case ElementKind::Hex: return model.hex_ids;
-    case ElementKind::Tet: return model.tet_ids;
-    case ElementKind::Pyramid: return model.pyramid_ids;
-    case ElementKind::Wedge: break;
+    case ElementKind::Hex:
+      return model.hex_ids;
+    case ElementKind::Tet:
+      return model.tet_ids;
+    case ElementKind::Pyramid:
+      return model.pyramid_ids;
+    case ElementKind::Wedge:
+      break;
   }
   return model.wedge_ids;
 }
@@ -83,21 +99,31 @@ std::vector<Index> element_face(const Model& model, const Side& side) {
   std::vector<Index> face;
   if (corners.empty() || side.face < 0 || side.face >= topo.faces) return face;
   const auto& f = topo.face[static_cast<std::size_t>(side.face)];
-  for (int k = 0; k < f.size; ++k) face.push_back(corners[static_cast<std::size_t>(f.corners[static_cast<std::size_t>(k)])]);
+  for (int k = 0; k < f.size; ++k)
+    face.push_back(corners[static_cast<std::size_t>(f.corners[static_cast<std::size_t>(k)])]);
   return face;
 }
 
-void add_element(Model& model, ElementKind kind, std::span<const Index> corners, int block, std::int64_t file_id) {
+void add_element(Model& model, ElementKind kind, std::span<const Index> corners, int block,
+                 std::int64_t file_id) {
   const auto n = static_cast<std::size_t>(cell_topology(kind).corners);
   auto put = [&](auto& cells) {
     auto& c = cells.emplace_back();
     for (std::size_t k = 0; k < n; ++k) c[k] = corners[k];
   };
   switch (kind) {
-    case ElementKind::Hex: put(model.hexes); break;
-    case ElementKind::Tet: put(model.tets); break;
-    case ElementKind::Pyramid: put(model.pyramids); break;
-    case ElementKind::Wedge: put(model.wedges); break;
+    case ElementKind::Hex:
+      put(model.hexes);
+      break;
+    case ElementKind::Tet:
+      put(model.tets);
+      break;
+    case ElementKind::Pyramid:
+      put(model.pyramids);
+      break;
+    case ElementKind::Wedge:
+      put(model.wedges);
+      break;
   }
   element_blocks(model, kind).push_back(block);
   element_ids(model, kind).push_back(file_id);
@@ -107,14 +133,16 @@ namespace {
 std::array<Index, 4> sorted_key(std::span<const Index> nodes) {
   std::array<Index, 4> k{kInvalidIndex, kInvalidIndex, kInvalidIndex, kInvalidIndex};
   std::copy_n(nodes.begin(), std::min<std::size_t>(nodes.size(), 4), k.begin());
-  std::sort(k.begin(), k.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(nodes.size(), 4)));
+  std::sort(k.begin(),
+            k.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(nodes.size(), 4)));
   return k;
 }
 }  // namespace
 
 std::size_t FaceOwners::Hash::operator()(const std::array<Index, 4>& k) const {
   std::size_t h = 0;
-  for (Index v : k) h = h * 0x9E3779B97F4A7C15ull + static_cast<std::size_t>(static_cast<std::uint32_t>(v));
+  for (Index v : k)
+    h = h * 0x9E3779B97F4A7C15ull + static_cast<std::size_t>(static_cast<std::uint32_t>(v));
   return h ^ (h >> 29);
 }
 
@@ -128,8 +156,11 @@ FaceOwners::FaceOwners(const Model& model) {
         const auto& face = topo.face[static_cast<std::size_t>(f)];
         std::array<Index, 4> nodes{};
         for (int k = 0; k < face.size; ++k)
-          nodes[static_cast<std::size_t>(k)] = corners[static_cast<std::size_t>(face.corners[static_cast<std::size_t>(k)])];
-        owner_.emplace(sorted_key(std::span<const Index>(nodes.data(), static_cast<std::size_t>(face.size))), Side{ref, f});
+          nodes[static_cast<std::size_t>(k)] =
+              corners[static_cast<std::size_t>(face.corners[static_cast<std::size_t>(k)])];
+        owner_.emplace(
+            sorted_key(std::span<const Index>(nodes.data(), static_cast<std::size_t>(face.size))),
+            Side{ref, f});
       }
     }
   }
@@ -142,7 +173,8 @@ const Side* FaceOwners::find(std::span<const Index> nodes) const {
 
 int block_of(const Model& model, ElementRef element) {
   const auto& blocks = element_blocks(model, element.kind);
-  return blocks.empty() ? default_block(element.kind) : blocks[static_cast<std::size_t>(element.index)];
+  return blocks.empty() ? default_block(element.kind)
+                        : blocks[static_cast<std::size_t>(element.index)];
 }
 
 std::int64_t node_id(const Model& model, Index node) {
@@ -186,7 +218,8 @@ const char* kind_name(ElementKind kind) { return element_kind_name(kind); }
 }  // namespace
 
 std::string describe_element(const Model& model, ElementRef element) {
-  std::string s = std::string(kind_name(element.kind)) + " " + std::to_string(element_id(model, element));
+  std::string s =
+      std::string(kind_name(element.kind)) + " " + std::to_string(element_id(model, element));
   const auto corners = element_corners(model, element);
   if (corners.empty()) return s;
   Point centre = Point::Zero();
@@ -209,7 +242,8 @@ void check_elements(const Model& model, ElementKind kind, std::string_view sourc
         throw InvalidInput(std::string(source) + ": " + kind_name(kind) + " " +
                            std::to_string(element_id(model, {kind, static_cast<Index>(e)})) +
                            ": corner " + std::to_string(c + 1) + " refers to node index " +
-                           std::to_string(n) + ", out of range [0, " + std::to_string(num_points) + ")");
+                           std::to_string(n) + ", out of range [0, " + std::to_string(num_points) +
+                           ")");
     }
   }
 }
@@ -218,9 +252,9 @@ void check_blocks(const Model& model, ElementKind kind, std::string_view source)
   const std::vector<int>& blocks = element_blocks(model, kind);
   const std::size_t count = element_count(model, kind);
   if (!blocks.empty() && blocks.size() != count)
-    throw InvalidInput(std::string(source) + ": " + kind_name(kind) + " block ids: " +
-                       std::to_string(blocks.size()) + " ids for " + std::to_string(count) +
-                       " elements");
+    throw InvalidInput(std::string(source) + ": " + kind_name(kind) +
+                       " block ids: " + std::to_string(blocks.size()) + " ids for " +
+                       std::to_string(count) + " elements");
   for (std::size_t e = 0; e < blocks.size(); ++e)
     if (blocks[e] <= 0)
       throw InvalidInput(std::string(source) + ": " + kind_name(kind) + " " +
@@ -231,8 +265,9 @@ void check_blocks(const Model& model, ElementKind kind, std::string_view source)
 void check_ids(const std::vector<std::int64_t>& ids, std::size_t count, std::string_view source,
                const char* what) {
   if (!ids.empty() && ids.size() != count)
-    throw InvalidInput(std::string(source) + ": " + what + " file ids: " + std::to_string(ids.size()) +
-                       " ids for " + std::to_string(count) + " entries");
+    throw InvalidInput(std::string(source) + ": " + what +
+                       " file ids: " + std::to_string(ids.size()) + " ids for " +
+                       std::to_string(count) + " entries");
 }
 
 }  // namespace
@@ -255,8 +290,8 @@ void validate(const Model& model, std::string_view source) {
       throw InvalidInput(std::string(source) + ": side set id " + std::to_string(set.id) +
                          " is used twice");
   for (const NodeSet& set : model.node_sets) {
-    const std::string where = std::string(source) + ": node set " + std::to_string(set.id) +
-                              " '" + set.name + "'";
+    const std::string where =
+        std::string(source) + ": node set " + std::to_string(set.id) + " '" + set.name + "'";
     if (set.id <= 0) throw InvalidInput(where + ": id is not positive");
     for (std::size_t i = 0; i < set.nodes.size(); ++i)
       if (set.nodes[i] < 0 || set.nodes[i] >= num_points)
@@ -265,11 +300,12 @@ void validate(const Model& model, std::string_view source) {
     for (const auto& piece : set.pieces)
       for (Index v : piece)
         if (v < 0 || v >= num_points)
-          throw InvalidInput(where + ": a piece refers to node index " + std::to_string(v) + ", out of range");
+          throw InvalidInput(where + ": a piece refers to node index " + std::to_string(v) +
+                             ", out of range");
   }
   for (const SideSet& set : model.side_sets) {
-    const std::string where = std::string(source) + ": side set " + std::to_string(set.id) +
-                              " '" + set.name + "'";
+    const std::string where =
+        std::string(source) + ": side set " + std::to_string(set.id) + " '" + set.name + "'";
     if (set.id <= 0) throw InvalidInput(where + ": id is not positive");
     for (std::size_t i = 0; i < set.sides.size(); ++i) {
       const Side& s = set.sides[i];
@@ -282,7 +318,8 @@ void validate(const Model& model, std::string_view source) {
       if (s.face < 0 || s.face >= faces)
         throw InvalidInput(where + ": entry " + std::to_string(i + 1) + ": " +
                            describe_element(model, s.element) + ": face " +
-                           std::to_string(s.face + 1) + " out of range [1, " + std::to_string(faces) + "]");
+                           std::to_string(s.face + 1) + " out of range [1, " +
+                           std::to_string(faces) + "]");
     }
   }
 }
@@ -318,7 +355,8 @@ void check_geometry(const Model& model, std::string_view source) {
         throw InvalidInput(where + ": " + describe_element(model, e) + " is " +
                            (jacobians[c] < 0.0 ? "inverted" : "flat") + " at its corner " +
                            describe_node(model, model.hexes[h][c]) + " (corner Jacobian " +
-                           number_text(jacobians[c]) + "; nodes " + node_list(model, model.hexes[h]) + ")");
+                           number_text(jacobians[c]) + "; nodes " +
+                           node_list(model, model.hexes[h]) + ")");
       }
   }
   // A wedge's corner Jacobian: the determinant of its three edges there (topology.hpp's
@@ -327,12 +365,15 @@ void check_geometry(const Model& model, std::string_view source) {
     const auto& c = model.wedges[w];
     for (std::size_t k = 0; k < 6; ++k) {
       const auto& n = topology::kWedgeCornerNeighbors[k];
-      const double j = tet_volume(pt(c[k]), pt(c[static_cast<std::size_t>(n[0])]), pt(c[static_cast<std::size_t>(n[1])]),
-                                  pt(c[static_cast<std::size_t>(n[2])])) * 6.0;
+      const double j =
+          tet_volume(pt(c[k]), pt(c[static_cast<std::size_t>(n[0])]),
+                     pt(c[static_cast<std::size_t>(n[1])]), pt(c[static_cast<std::size_t>(n[2])])) *
+          6.0;
       if (!(j > 0.0)) {
         const ElementRef e{ElementKind::Wedge, static_cast<Index>(w)};
-        throw InvalidInput(where + ": " + describe_element(model, e) + " is " + (j < 0.0 ? "inverted" : "flat") +
-                           " at its corner " + describe_node(model, c[k]) + " (corner Jacobian " + number_text(j) +
+        throw InvalidInput(where + ": " + describe_element(model, e) + " is " +
+                           (j < 0.0 ? "inverted" : "flat") + " at its corner " +
+                           describe_node(model, c[k]) + " (corner Jacobian " + number_text(j) +
                            "; nodes " + node_list(model, c) + ")");
       }
     }
@@ -346,11 +387,14 @@ void check_geometry(const Model& model, std::string_view source) {
       corner[k] = tet_volume(pt(c[(k + 3) % 4]), pt(c[k]), pt(c[(k + 1) % 4]), pt(c[4]));
     const bool d02 = corner[1] > 0.0 && corner[3] > 0.0, d13 = corner[0] > 0.0 && corner[2] > 0.0;
     if (!d02 && !d13) {
-      const auto worst = static_cast<std::size_t>(std::min_element(corner.begin(), corner.end()) - corner.begin());
+      const auto worst =
+          static_cast<std::size_t>(std::min_element(corner.begin(), corner.end()) - corner.begin());
       const ElementRef e{ElementKind::Pyramid, static_cast<Index>(p)};
-      throw InvalidInput(where + ": " + describe_element(model, e) + " is " + (corner[worst] < 0.0 ? "inverted" : "flat") +
-                         " at its base corner " + describe_node(model, c[worst]) + " (signed volume " +
-                         number_text(corner[worst]) + " of the tet there, and neither base diagonal gives two " +
+      throw InvalidInput(where + ": " + describe_element(model, e) + " is " +
+                         (corner[worst] < 0.0 ? "inverted" : "flat") + " at its base corner " +
+                         describe_node(model, c[worst]) + " (signed volume " +
+                         number_text(corner[worst]) +
+                         " of the tet there, and neither base diagonal gives two " +
                          "positive tets; nodes " + node_list(model, c) + ")");
     }
   }
@@ -384,12 +428,14 @@ Index merge_coincident_nodes(Model& model, double tolerance) {
   const std::size_t n = model.points.size();
   if (n == 0) return 0;
   if (!(tolerance >= 0.0) || !std::isfinite(tolerance))
-    throw InvalidInput("merge_coincident_nodes: tolerance " + std::to_string(tolerance) + " is not a finite value >= 0");
+    throw InvalidInput("merge_coincident_nodes: tolerance " + std::to_string(tolerance) +
+                       " is not a finite value >= 0");
   // Cells no smaller than 1e-12 of the largest coordinate keep every cell index below 1e12 in
   // size (the float -> integer cast must not overflow), whatever the tolerance.
   double largest = 0.0;
   for (const Point& p : model.points) largest = std::max(largest, p.cwiseAbs().maxCoeff());
-  if (!std::isfinite(largest)) throw InvalidInput("merge_coincident_nodes: a node has a non-finite coordinate");
+  if (!std::isfinite(largest))
+    throw InvalidInput("merge_coincident_nodes: a node has a non-finite coordinate");
   const double cell = std::max({2.0 * tolerance, 1e-12 * largest, 1e-300});
   // Hash each point into a grid of cells of size 2*tol; a partner lies in one of the 27
   // neighbouring cells.

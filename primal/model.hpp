@@ -32,8 +32,8 @@ namespace geode::primal {
 
 // The index into topology::kCellKinds.
 enum class ElementKind : std::uint8_t { Hex, Tet, Pyramid, Wedge };
-inline constexpr std::array<ElementKind, 4> kElementKinds{ElementKind::Hex, ElementKind::Tet, ElementKind::Pyramid,
-                                                         ElementKind::Wedge};
+inline constexpr std::array<ElementKind, 4> kElementKinds{ElementKind::Hex, ElementKind::Tet,
+                                                          ElementKind::Pyramid, ElementKind::Wedge};
 
 struct ElementRef {
   ElementKind kind = ElementKind::Hex;
@@ -66,10 +66,11 @@ struct SideSet {
 
 struct Model {
   std::vector<Point> points;
-  std::vector<std::array<Index, 8>> hexes;  // VTK/Exodus HEX8 order
-  std::vector<std::array<Index, 4>> tets;   // VTK/Exodus TETRA4 order
+  std::vector<std::array<Index, 8>> hexes;     // VTK/Exodus HEX8 order
+  std::vector<std::array<Index, 4>> tets;      // VTK/Exodus TETRA4 order
   std::vector<std::array<Index, 5>> pyramids;  // VTK/Exodus PYRAMID5 order
-  std::vector<std::array<Index, 6>> wedges;    // Exodus WEDGE6 order (topology.hpp; VTK's is mirrored)
+  std::vector<std::array<Index, 6>>
+      wedges;  // Exodus WEDGE6 order (topology.hpp; VTK's is mirrored)
   // Element block id (> 0) per element. Empty means "all in one block": 1 for hexes, 2 for
   // tets, 3 for pyramids, 4 for wedges (default_block).
   std::vector<int> hex_block;
@@ -94,7 +95,7 @@ const topology::CellKindTopology& cell_topology(ElementKind kind);
 const char* element_kind_name(ElementKind kind);  // "hex", "tet", "pyramid", "wedge"
 int default_block(ElementKind kind);              // 1, 2, 3, 4
 std::size_t element_count(const Model& model, ElementKind kind);
-std::size_t element_count(const Model& model);    // every kind
+std::size_t element_count(const Model& model);  // every kind
 std::span<const Index> element_corners(const Model& model, ElementRef element);
 const std::vector<int>& element_blocks(const Model& model, ElementKind kind);
 std::vector<int>& element_blocks(Model& model, ElementKind kind);
@@ -104,7 +105,8 @@ std::vector<std::int64_t>& element_ids(Model& model, ElementKind kind);
 std::vector<Index> element_face(const Model& model, const Side& side);
 // Appends an element of `kind` (its first cell_topology(kind).corners corners), pushing its
 // block and file id onto the kind's vectors (readers fill them for every element).
-void add_element(Model& model, ElementKind kind, std::span<const Index> corners, int block, std::int64_t file_id);
+void add_element(Model& model, ElementKind kind, std::span<const Index> corners, int block,
+                 std::int64_t file_id);
 
 // Every face of every element by its node set -> its first side (kinds in kElementKinds order,
 // elements ascending): what readers match a side set given as faces (Gmsh, VTK) against.
@@ -153,8 +155,8 @@ void validate(const Model& model, std::string_view source);
 void check_points(const Model& model, std::string_view source);
 // What readers refuse beyond structure (validate): check_points, then a tet of signed volume
 // <= 0, a hex or wedge with a corner Jacobian <= 0 (topology.hpp's corner frames: inverted,
-// flat or folded), a pyramid that splits along neither base diagonal into two positive tets. Throws InvalidInput naming `source`
-// and the node or element by its file id, with coordinates.
+// flat or folded), a pyramid that splits along neither base diagonal into two positive tets. Throws
+// InvalidInput naming `source` and the node or element by its file id, with coordinates.
 void check_geometry(const Model& model, std::string_view source);
 
 // The two parts over the model's whole point array (unused points included), so that node

@@ -17,7 +17,9 @@ namespace geode::primal {
 inline double multilinear_shape(int c, const Point& r, int dim) {
   double w = 1.0;
   for (int a = 0; a < dim; ++a)
-    w *= topology::kHexCornerCoords[static_cast<std::size_t>(c)][static_cast<std::size_t>(a)] ? r[a] : 1.0 - r[a];
+    w *= topology::kHexCornerCoords[static_cast<std::size_t>(c)][static_cast<std::size_t>(a)]
+             ? r[a]
+             : 1.0 - r[a];
   return w;
 }
 
@@ -25,7 +27,8 @@ inline double multilinear_shape(int c, const Point& r, int dim) {
 template <class Corners>
 Point multilinear_point(const Corners& corners, const Point& r, int dim) {
   Point x = Point::Zero();
-  for (int c = 0; c < (1 << dim); ++c) x += multilinear_shape(c, r, dim) * corners[static_cast<std::size_t>(c)];
+  for (int c = 0; c < (1 << dim); ++c)
+    x += multilinear_shape(c, r, dim) * corners[static_cast<std::size_t>(c)];
   return x;
 }
 

@@ -8,14 +8,18 @@
 
 namespace geode::primal {
 
-PillowResult pillow(const HexMesh& mesh, std::span<const Index> shrink_set, const PillowOptions& options) {
+PillowResult pillow(const HexMesh& mesh, std::span<const Index> shrink_set,
+                    const PillowOptions& options) {
   if (shrink_set.empty()) throw InvalidInput("pillow: the shrink set is empty");
-  if (!(options.shrink > 0 && options.shrink < 1)) throw InvalidInput("pillow: the shrink fraction must be in (0, 1)");
+  if (!(options.shrink > 0 && options.shrink < 1))
+    throw InvalidInput("pillow: the shrink fraction must be in (0, 1)");
   const auto hexes = static_cast<Index>(mesh.hexes.size());
   std::vector<char> in_set(mesh.hexes.size(), 0);
   for (Index h : shrink_set) {
-    if (h < 0 || h >= hexes) throw InvalidInput("pillow: hex " + std::to_string(h) + " of the shrink set is out of range");
-    if (in_set[static_cast<std::size_t>(h)]) throw InvalidInput("pillow: hex " + std::to_string(h) + " is twice in the shrink set");
+    if (h < 0 || h >= hexes)
+      throw InvalidInput("pillow: hex " + std::to_string(h) + " of the shrink set is out of range");
+    if (in_set[static_cast<std::size_t>(h)])
+      throw InvalidInput("pillow: hex " + std::to_string(h) + " is twice in the shrink set");
     in_set[static_cast<std::size_t>(h)] = 1;
   }
 

@@ -24,14 +24,15 @@ struct PillowOptions {
 };
 
 struct PillowResult {
-  HexMesh mesh;                  // the old hexes first (same numbers), then the new layer
-  std::vector<Index> layer;      // the new hexes
-  std::vector<Index> copy_of;    // per new node (numbered from the old node count): its node
+  HexMesh mesh;                // the old hexes first (same numbers), then the new layer
+  std::vector<Index> layer;    // the new hexes
+  std::vector<Index> copy_of;  // per new node (numbered from the old node count): its node
 };
 
 // The shrink set's boundary surface must be a manifold (every node's set hexes connected
 // through faces of the set), since a node is copied once. InvalidInput for an empty set, a hex
 // number out of range or repeated, or a shrink fraction outside (0, 1).
-PillowResult pillow(const HexMesh& mesh, std::span<const Index> shrink_set, const PillowOptions& options = {});
+PillowResult pillow(const HexMesh& mesh, std::span<const Index> shrink_set,
+                    const PillowOptions& options = {});
 
 }  // namespace geode::primal

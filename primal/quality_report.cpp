@@ -25,11 +25,11 @@ nlohmann::json bound(double v) { return std::isfinite(v) ? nlohmann::json(v) : n
 
 }  // namespace
 
-MetricSummary summarize_metric(HexMetric metric, std::span<const double> q, std::span<const Index> hexes,
-                               StdDevKind kind) {
+MetricSummary summarize_metric(HexMetric metric, std::span<const double> q,
+                               std::span<const Index> hexes, StdDevKind kind) {
   if (q.empty() || q.size() != hexes.size())
-    throw InvalidInput("metric summary: " + std::to_string(q.size()) + " values for " + std::to_string(hexes.size()) +
-                       " hexes");
+    throw InvalidInput("metric summary: " + std::to_string(q.size()) + " values for " +
+                       std::to_string(hexes.size()) + " hexes");
   const double n = static_cast<double>(q.size());
   MetricSummary s;
   s.metric = metric;
@@ -81,7 +81,8 @@ QualityReport hex_quality_report(const HexMesh& mesh, std::span<const Index> hex
                         for (std::size_t i = r.begin(); i != r.end(); ++i) {
                           HexCorners c;
                           const auto& hex = mesh.hexes[static_cast<std::size_t>(hexes[i])];
-                          for (int k = 0; k < 8; ++k) c[k] = mesh.points[static_cast<std::size_t>(hex[k])];
+                          for (int k = 0; k < 8; ++k)
+                            c[k] = mesh.points[static_cast<std::size_t>(hex[k])];
                           q[i] = info.evaluate(c);
                         }
                       });
@@ -92,7 +93,8 @@ QualityReport hex_quality_report(const HexMesh& mesh, std::span<const Index> hex
 
 std::string format_quality_table(const QualityReport& report) {
   std::size_t width = std::string("Quality Measure").size();
-  for (const auto& s : report.metrics) width = std::max(width, hex_metric_info(s.metric).name.size());
+  for (const auto& s : report.metrics)
+    width = std::max(width, hex_metric_info(s.metric).name.size());
   auto pad = [](std::string s, std::size_t w) {
     s.resize(std::max(s.size(), w), ' ');
     return s;

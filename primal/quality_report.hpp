@@ -39,8 +39,8 @@ QualityReport hex_quality_report(const HexMesh& mesh, std::span<const Index> hex
 
 // The summary of one metric from values already computed: values[i] belongs to hexes[i]
 // (hex numbers for min_hex / max_hex). Throws geode::InvalidInput when empty or the sizes differ.
-MetricSummary summarize_metric(HexMetric metric, std::span<const double> values, std::span<const Index> hexes,
-                               StdDevKind kind = StdDevKind::kSample);
+MetricSummary summarize_metric(HexMetric metric, std::span<const double> values,
+                               std::span<const Index> hexes, StdDevKind kind = StdDevKind::kSample);
 
 // The table of the paper's Table 1: a header `Quality Measure  Average  Std. Dev.  Minimum
 // Maximum` and one row per metric, numbers with 3 significant digits like CUBIT's report.

@@ -21,11 +21,16 @@ namespace topo = topology;
 
 std::string_view to_string(ObstructionKind kind) {
   switch (kind) {
-    case ObstructionKind::kDoublet: return "doublet";
-    case ObstructionKind::kPinchedCorner: return "pinched-corner";
-    case ObstructionKind::kTwoFacesOnBoundaryFace: return "two-faces-on-boundary-face";
-    case ObstructionKind::kFlatCorner: return "flat-corner";
-    case ObstructionKind::kTwoQuadBoundaryNode: return "two-quad-boundary-node";
+    case ObstructionKind::kDoublet:
+      return "doublet";
+    case ObstructionKind::kPinchedCorner:
+      return "pinched-corner";
+    case ObstructionKind::kTwoFacesOnBoundaryFace:
+      return "two-faces-on-boundary-face";
+    case ObstructionKind::kFlatCorner:
+      return "flat-corner";
+    case ObstructionKind::kTwoQuadBoundaryNode:
+      return "two-quad-boundary-node";
   }
   return "unknown";
 }
@@ -43,11 +48,12 @@ bool has_repeated(const std::array<Index, N>& a) {
 }
 
 template <std::size_t N>
-void check_range(const std::array<Index, N>& cell, std::size_t nodes, const char* what, std::size_t id) {
+void check_range(const std::array<Index, N>& cell, std::size_t nodes, const char* what,
+                 std::size_t id) {
   for (Index v : cell)
     if (v < 0 || static_cast<std::size_t>(v) >= nodes)
-      throw InvalidInput(std::string(what) + " " + std::to_string(id) + ": node " + std::to_string(v) +
-                         " out of range [0, " + std::to_string(nodes) + ")");
+      throw InvalidInput(std::string(what) + " " + std::to_string(id) + ": node " +
+                         std::to_string(v) + " out of range [0, " + std::to_string(nodes) + ")");
 }
 
 void sort_unique(std::vector<Index>& v) {
@@ -65,8 +71,10 @@ double bbox_diagonal(const std::vector<Point>& points) {
 // Region growing: element i joins the patch of seed s (reached through `neighbours`) when
 // fits(s, i); elements that cannot seed (flat(i) false) stay on no patch. Patches are numbered
 // by their seed's order, so the result does not depend on hashing.
-std::vector<Index> grow_patches(std::size_t n, const std::function<std::vector<Index>(Index)>& neighbours,
-                                const std::function<bool(Index)>& flat, const std::function<bool(Index, Index)>& fits) {
+std::vector<Index> grow_patches(std::size_t n,
+                                const std::function<std::vector<Index>(Index)>& neighbours,
+                                const std::function<bool(Index)>& flat,
+                                const std::function<bool(Index, Index)>& fits) {
   std::vector<Index> patch(n, kNoPatch);
   Index next = 0;
   for (std::size_t s = 0; s < n; ++s) {
@@ -89,12 +97,15 @@ std::vector<Index> grow_patches(std::size_t n, const std::function<std::vector<I
   return patch;
 }
 
-bool contains(const std::vector<Index>& sorted, Index x) { return std::binary_search(sorted.begin(), sorted.end(), x); }
+bool contains(const std::vector<Index>& sorted, Index x) {
+  return std::binary_search(sorted.begin(), sorted.end(), x);
+}
 
 void check_node_faces(const RealizabilityOptions& options, std::size_t nodes) {
   if (!options.node_faces.empty() && options.node_faces.size() != nodes)
-    throw InvalidInput("realizability: node_faces has " + std::to_string(options.node_faces.size()) +
-                       " entries for " + std::to_string(nodes) + " nodes");
+    throw InvalidInput("realizability: node_faces has " +
+                       std::to_string(options.node_faces.size()) + " entries for " +
+                       std::to_string(nodes) + " nodes");
 }
 
 // Nodes' planar faces from the template's bits: face f for bit f.
@@ -124,7 +135,8 @@ struct SharedCorner {
   std::vector<Index> quads;
 };
 
-std::vector<SharedCorner> shared_corners(std::size_t n, const std::function<const std::array<Index, 4>*(std::size_t)>& quad) {
+std::vector<SharedCorner> shared_corners(
+    std::size_t n, const std::function<const std::array<Index, 4>*(std::size_t)>& quad) {
   std::map<std::array<Index, 3>, std::vector<Index>> by_corner;
   std::vector<std::array<Index, 3>> order;
   for (std::size_t i = 0; i < n; ++i) {
@@ -151,7 +163,8 @@ std::vector<SharedCorner> shared_corners(std::size_t n, const std::function<cons
 
 class HexFinder {
  public:
-  HexFinder(const HexMesh& mesh, const RealizabilityOptions& options) : mesh_(mesh), options_(options) {}
+  HexFinder(const HexMesh& mesh, const RealizabilityOptions& options)
+      : mesh_(mesh), options_(options) {}
 
   std::vector<Obstruction> run() {
     collect_faces();
@@ -162,13 +175,14 @@ class HexFinder {
     find_flat_corners();
     find_two_quad_nodes();
     std::vector<Obstruction> out;
-    for (auto* list : {&doublets_, &pinched_, &two_faces_, &flat_, &two_quad_}) out.insert(out.end(), list->begin(), list->end());
+    for (auto* list : {&doublets_, &pinched_, &two_faces_, &flat_, &two_quad_})
+      out.insert(out.end(), list->begin(), list->end());
     return out;
   }
 
  private:
   struct Face {
-    std::array<Index, 4> nodes{};  // as the first hex using it sees it
+    std::array<Index, 4> nodes{};             // as the first hex using it sees it
     std::vector<std::pair<Index, int>> uses;  // (hex, local face)
   };
 
@@ -182,8 +196,11 @@ class HexFinder {
       if (has_repeated(hex)) continue;
       for (int f = 0; f < topo::kHexFaces; ++f) {
         std::array<Index, 4> q{};
-        for (int i = 0; i < 4; ++i) q[static_cast<std::size_t>(i)] = hex[static_cast<std::size_t>(topo::kHexFaceCorners[static_cast<std::size_t>(f)][static_cast<std::size_t>(i)])];
-        const auto [it, inserted] = face_id.try_emplace(face_key(q), static_cast<Index>(faces_.size()));
+        for (int i = 0; i < 4; ++i)
+          q[static_cast<std::size_t>(i)] = hex[static_cast<std::size_t>(
+              topo::kHexFaceCorners[static_cast<std::size_t>(f)][static_cast<std::size_t>(i)])];
+        const auto [it, inserted] =
+            face_id.try_emplace(face_key(q), static_cast<Index>(faces_.size()));
         if (inserted) faces_.push_back(Face{q, {}});
         faces_[static_cast<std::size_t>(it->second)].uses.emplace_back(static_cast<Index>(h), f);
       }
@@ -198,10 +215,12 @@ class HexFinder {
     node_patches_.assign(mesh_.points.size(), {});
     boundary_quads_at_.assign(mesh_.points.size(), {});
     for (std::size_t b = 0; b < nb; ++b)
-      for (Index v : face(b).nodes) boundary_quads_at_[static_cast<std::size_t>(v)].push_back(static_cast<Index>(b));
+      for (Index v : face(b).nodes)
+        boundary_quads_at_[static_cast<std::size_t>(v)].push_back(static_cast<Index>(b));
     if (!options_.node_faces.empty()) {
       quad_patch_.resize(nb);
-      for (std::size_t b = 0; b < nb; ++b) quad_patch_[b] = patch_from_bits(options_.node_faces, face(b).nodes);
+      for (std::size_t b = 0; b < nb; ++b)
+        quad_patch_[b] = patch_from_bits(options_.node_faces, face(b).nodes);
       node_patches_ = node_patches_from_bits(options_.node_faces);
       return;
     }
@@ -212,7 +231,8 @@ class HexFinder {
     auto pt = [&](Index v) -> const Point& { return mesh_.points[static_cast<std::size_t>(v)]; };
     auto off_plane = [&](std::size_t plane, std::size_t quad) {
       double d = 0.0;
-      for (Index v : face(quad).nodes) d = std::max(d, std::abs(normal[plane].dot(pt(v) - centre[plane])));
+      for (Index v : face(quad).nodes)
+        d = std::max(d, std::abs(normal[plane].dot(pt(v) - centre[plane])));
       return d;
     };
     for (std::size_t b = 0; b < nb; ++b) {
@@ -227,7 +247,9 @@ class HexFinder {
     std::unordered_map<EdgeKey, std::vector<Index>, IndexArrayHash> by_edge;
     for (std::size_t b = 0; b < nb; ++b) {
       const auto& q = face(b).nodes;
-      for (int i = 0; i < 4; ++i) by_edge[edge_key(q[static_cast<std::size_t>(i)], q[static_cast<std::size_t>((i + 1) % 4)])].push_back(static_cast<Index>(b));
+      for (int i = 0; i < 4; ++i)
+        by_edge[edge_key(q[static_cast<std::size_t>(i)], q[static_cast<std::size_t>((i + 1) % 4)])]
+            .push_back(static_cast<Index>(b));
     }
     quad_patch_ = grow_patches(
         nb,
@@ -235,7 +257,8 @@ class HexFinder {
           std::vector<Index> out;
           const auto& q = face(static_cast<std::size_t>(b)).nodes;
           for (int i = 0; i < 4; ++i)
-            for (Index o : by_edge.at(edge_key(q[static_cast<std::size_t>(i)], q[static_cast<std::size_t>((i + 1) % 4)])))
+            for (Index o : by_edge.at(edge_key(q[static_cast<std::size_t>(i)],
+                                               q[static_cast<std::size_t>((i + 1) % 4)])))
               if (o != b) out.push_back(o);
           return out;
         },
@@ -246,7 +269,8 @@ class HexFinder {
         });
     for (std::size_t b = 0; b < nb; ++b)
       if (quad_patch_[b] != kNoPatch)
-        for (Index v : face(b).nodes) node_patches_[static_cast<std::size_t>(v)].push_back(quad_patch_[b]);
+        for (Index v : face(b).nodes)
+          node_patches_[static_cast<std::size_t>(v)].push_back(quad_patch_[b]);
     for (auto& p : node_patches_) sort_unique(p);
   }
 
@@ -258,7 +282,8 @@ class HexFinder {
       const auto& hex = mesh_.hexes[h];
       if (has_repeated(hex)) continue;
       for (const auto& e : topo::kHexEdgeCorners) {
-        const EdgeKey k = edge_key(hex[static_cast<std::size_t>(e[0])], hex[static_cast<std::size_t>(e[1])]);
+        const EdgeKey k =
+            edge_key(hex[static_cast<std::size_t>(e[0])], hex[static_cast<std::size_t>(e[1])]);
         auto [it, inserted] = edge_hexes.try_emplace(k);
         if (inserted) order.push_back(k);
         it->second.push_back(static_cast<Index>(h));
@@ -267,7 +292,9 @@ class HexFinder {
     std::unordered_map<EdgeKey, bool, IndexArrayHash> on_boundary;
     for (Index f : boundary_) {
       const auto& q = faces_[static_cast<std::size_t>(f)].nodes;
-      for (int i = 0; i < 4; ++i) on_boundary[edge_key(q[static_cast<std::size_t>(i)], q[static_cast<std::size_t>((i + 1) % 4)])] = true;
+      for (int i = 0; i < 4; ++i)
+        on_boundary[edge_key(q[static_cast<std::size_t>(i)],
+                             q[static_cast<std::size_t>((i + 1) % 4)])] = true;
     }
     std::map<std::vector<Index>, std::size_t> by_hexes;
     for (const auto& k : order) {
@@ -292,7 +319,8 @@ class HexFinder {
         for (const auto& [h, lf] : faces_[static_cast<std::size_t>(f)].uses) hexes.push_back(h);
       sort_unique(hexes);
       if (explained_by_doublet(corner[0], hexes)) continue;
-      pinched_.push_back(Obstruction{ObstructionKind::kPinchedCorner, hexes, {corner[0], corner[1], corner[2]}});
+      pinched_.push_back(
+          Obstruction{ObstructionKind::kPinchedCorner, hexes, {corner[0], corner[1], corner[2]}});
     }
   }
 
@@ -301,7 +329,8 @@ class HexFinder {
     const auto [lo, hi] = doublet_ends_.equal_range(v);
     for (auto it = lo; it != hi; ++it) {
       const auto& pair = doublets_[it->second].hexes;
-      if (std::all_of(pair.begin(), pair.end(), [&](Index h) { return contains(hexes, h); })) return true;
+      if (std::all_of(pair.begin(), pair.end(), [&](Index h) { return contains(hexes, h); }))
+        return true;
     }
     return false;
   }
@@ -321,7 +350,8 @@ class HexFinder {
         if (local.size() < 2) continue;
         Obstruction o{ObstructionKind::kTwoFacesOnBoundaryFace, {h}, {}};
         for (int lf : local)
-          for (int c : topo::kHexFaceCorners[static_cast<std::size_t>(lf)]) o.nodes.push_back(hex(h)[static_cast<std::size_t>(c)]);
+          for (int c : topo::kHexFaceCorners[static_cast<std::size_t>(lf)])
+            o.nodes.push_back(hex(h)[static_cast<std::size_t>(c)]);
         sort_unique(o.nodes);
         two_faces_.push_back(o);
         // Corners on two of these faces: already explained, not repeated as flat corners.
@@ -347,12 +377,16 @@ class HexFinder {
         const Index v = hx[static_cast<std::size_t>(c)];
         const auto& nb = topo::kHexCornerNeighbors[static_cast<std::size_t>(c)];
         const bool flat = std::any_of(patches(v).begin(), patches(v).end(), [&](Index p) {
-          return std::all_of(nb.begin(), nb.end(), [&](int n) { return contains(patches(hx[static_cast<std::size_t>(n)]), p); });
+          return std::all_of(nb.begin(), nb.end(), [&](int n) {
+            return contains(patches(hx[static_cast<std::size_t>(n)]), p);
+          });
         });
         if (!flat) continue;
-        flat_.push_back(Obstruction{ObstructionKind::kFlatCorner,
-                                    {static_cast<Index>(h)},
-                                    {v, hx[static_cast<std::size_t>(nb[0])], hx[static_cast<std::size_t>(nb[1])], hx[static_cast<std::size_t>(nb[2])]}});
+        flat_.push_back(Obstruction{
+            ObstructionKind::kFlatCorner,
+            {static_cast<Index>(h)},
+            {v, hx[static_cast<std::size_t>(nb[0])], hx[static_cast<std::size_t>(nb[1])],
+             hx[static_cast<std::size_t>(nb[2])]}});
       }
     }
   }
@@ -363,7 +397,8 @@ class HexFinder {
       const auto& quads = boundary_quads_at_[v];
       if (quads.empty() || node_patches_[v].size() != 1) continue;
       const Index p = node_patches_[v].front();
-      if (!std::all_of(quads.begin(), quads.end(), [&](Index b) { return quad_patch_[static_cast<std::size_t>(b)] == p; }))
+      if (!std::all_of(quads.begin(), quads.end(),
+                       [&](Index b) { return quad_patch_[static_cast<std::size_t>(b)] == p; }))
         continue;
       if (quads.size() >= 3) continue;
       Obstruction o{ObstructionKind::kTwoQuadBoundaryNode, {}, {static_cast<Index>(v)}};
@@ -373,18 +408,24 @@ class HexFinder {
     }
   }
 
-  const Face& face(std::size_t boundary_index) const { return faces_[static_cast<std::size_t>(boundary_[boundary_index])]; }
-  const std::array<Index, 8>& hex(Index h) const { return mesh_.hexes[static_cast<std::size_t>(h)]; }
-  const std::vector<Index>& patches(Index v) const { return node_patches_[static_cast<std::size_t>(v)]; }
+  const Face& face(std::size_t boundary_index) const {
+    return faces_[static_cast<std::size_t>(boundary_[boundary_index])];
+  }
+  const std::array<Index, 8>& hex(Index h) const {
+    return mesh_.hexes[static_cast<std::size_t>(h)];
+  }
+  const std::vector<Index>& patches(Index v) const {
+    return node_patches_[static_cast<std::size_t>(v)];
+  }
 
   const HexMesh& mesh_;
   const RealizabilityOptions& options_;
   std::vector<Face> faces_;
-  std::vector<Index> boundary_;                       // faces used by one hex
-  std::vector<Index> quad_patch_;                     // per boundary_ entry
-  std::vector<std::vector<Index>> node_patches_;      // sorted
+  std::vector<Index> boundary_;                        // faces used by one hex
+  std::vector<Index> quad_patch_;                      // per boundary_ entry
+  std::vector<std::vector<Index>> node_patches_;       // sorted
   std::vector<std::vector<Index>> boundary_quads_at_;  // per node, boundary_ entries
-  std::multimap<Index, std::size_t> doublet_ends_;    // node -> doublet
+  std::multimap<Index, std::size_t> doublet_ends_;     // node -> doublet
   std::set<std::pair<Index, int>> explained_corners_;  // (hex, corner) in a two-faces finding
   std::vector<Obstruction> doublets_, pinched_, two_faces_, flat_, two_quad_;
 };
@@ -393,7 +434,8 @@ class HexFinder {
 
 class QuadFinder {
  public:
-  QuadFinder(const QuadMesh& mesh, const RealizabilityOptions& options) : mesh_(mesh), options_(options) {}
+  QuadFinder(const QuadMesh& mesh, const RealizabilityOptions& options)
+      : mesh_(mesh), options_(options) {}
 
   std::vector<Obstruction> run() {
     collect_edges();
@@ -494,13 +536,15 @@ class QuadFinder {
       return has_repeated(mesh_.quads[q]) ? nullptr : &mesh_.quads[q];
     });
     for (const auto& [corner, quads] : groups)
-      doublets_.push_back(Obstruction{ObstructionKind::kDoublet, quads, {corner[0], corner[1], corner[2]}});
+      doublets_.push_back(
+          Obstruction{ObstructionKind::kDoublet, quads, {corner[0], corner[1], corner[2]}});
   }
 
   void find_two_edges_and_flat_corners() {
     std::map<Index, std::vector<std::pair<int, Index>>> per_quad;  // quad -> (local edge, side)
     for (std::size_t b = 0; b < boundary_.size(); ++b)
-      if (side_[b] != kNoPatch) per_quad[boundary_[b].first].emplace_back(boundary_[b].second, side_[b]);
+      if (side_[b] != kNoPatch)
+        per_quad[boundary_[b].first].emplace_back(boundary_[b].second, side_[b]);
     std::set<std::pair<Index, int>> explained;  // (quad, corner) between two edges on one side
     for (const auto& [q, list] : per_quad) {
       std::map<Index, std::vector<int>> by_side;
@@ -511,7 +555,8 @@ class QuadFinder {
         std::map<int, int> corner_uses;
         for (int e : local)
           for (int c : {e, (e + 1) % 4}) {
-            o.nodes.push_back(mesh_.quads[static_cast<std::size_t>(q)][static_cast<std::size_t>(c)]);
+            o.nodes.push_back(
+                mesh_.quads[static_cast<std::size_t>(q)][static_cast<std::size_t>(c)]);
             ++corner_uses[c];
           }
         sort_unique(o.nodes);
@@ -525,13 +570,17 @@ class QuadFinder {
       if (has_repeated(quad)) continue;
       for (int c = 0; c < 4; ++c) {
         if (explained.count({static_cast<Index>(q), c})) continue;
-        const Index v = quad[static_cast<std::size_t>(c)], a = quad[static_cast<std::size_t>((c + 1) % 4)],
+        const Index v = quad[static_cast<std::size_t>(c)],
+                    a = quad[static_cast<std::size_t>((c + 1) % 4)],
                     b = quad[static_cast<std::size_t>((c + 3) % 4)];
         const auto& sv = node_sides_[static_cast<std::size_t>(v)];
         const bool flat = std::any_of(sv.begin(), sv.end(), [&](Index s) {
-          return contains(node_sides_[static_cast<std::size_t>(a)], s) && contains(node_sides_[static_cast<std::size_t>(b)], s);
+          return contains(node_sides_[static_cast<std::size_t>(a)], s) &&
+                 contains(node_sides_[static_cast<std::size_t>(b)], s);
         });
-        if (flat) flat_.push_back(Obstruction{ObstructionKind::kFlatCorner, {static_cast<Index>(q)}, {v, a, b}});
+        if (flat)
+          flat_.push_back(
+              Obstruction{ObstructionKind::kFlatCorner, {static_cast<Index>(q)}, {v, a, b}});
       }
     }
   }
@@ -539,29 +588,34 @@ class QuadFinder {
   const QuadMesh& mesh_;
   const RealizabilityOptions& options_;
   std::vector<std::pair<Index, int>> boundary_;  // boundary edges as (quad, local edge)
-  std::vector<Index> side_;                        // per boundary edge
-  std::vector<std::vector<Index>> node_sides_;     // sorted
+  std::vector<Index> side_;                      // per boundary edge
+  std::vector<std::vector<Index>> node_sides_;   // sorted
   std::vector<Obstruction> doublets_, two_edges_, flat_;
 };
 
 }  // namespace
 
-std::vector<Obstruction> find_obstructions(const HexMesh& mesh, const RealizabilityOptions& options) {
+std::vector<Obstruction> find_obstructions(const HexMesh& mesh,
+                                           const RealizabilityOptions& options) {
   return HexFinder(mesh, options).run();
 }
 
-std::vector<Obstruction> find_obstructions(const QuadMesh& mesh, const RealizabilityOptions& options) {
+std::vector<Obstruction> find_obstructions(const QuadMesh& mesh,
+                                           const RealizabilityOptions& options) {
   return QuadFinder(mesh, options).run();
 }
 
-std::string format_obstructions(const std::vector<Obstruction>& obstructions, int dim, Index base, std::size_t limit) {
+std::string format_obstructions(const std::vector<Obstruction>& obstructions, int dim, Index base,
+                                std::size_t limit) {
   std::ostringstream os;
   if (obstructions.empty()) return "no obstructions found\n";
   std::map<ObstructionKind, int> count;
   for (const auto& o : obstructions) ++count[o.kind];
-  os << obstructions.size() << (obstructions.size() == 1 ? " obstruction" : " obstructions") << " (";
+  os << obstructions.size() << (obstructions.size() == 1 ? " obstruction" : " obstructions")
+     << " (";
   bool first = true;
-  for (const auto& [kind, n] : count) os << (first ? "" : ", ") << n << " " << to_string(kind), first = false;
+  for (const auto& [kind, n] : count)
+    os << (first ? "" : ", ") << n << " " << to_string(kind), first = false;
   os << ")\n";
   auto list = [&](const std::vector<Index>& ids) {
     for (std::size_t i = 0; i < ids.size(); ++i) os << (i ? " " : "") << ids[i] + base;
@@ -586,7 +640,9 @@ nlohmann::json obstructions_json(const std::vector<Obstruction>& obstructions, I
     return out;
   };
   for (const auto& o : obstructions)
-    j.push_back({{"kind", std::string(to_string(o.kind))}, {"hexes", shifted(o.hexes)}, {"nodes", shifted(o.nodes)}});
+    j.push_back({{"kind", std::string(to_string(o.kind))},
+                 {"hexes", shifted(o.hexes)},
+                 {"nodes", shifted(o.nodes)}});
   return j;
 }
 

@@ -50,15 +50,23 @@
 
 namespace geode::primal {
 
-enum class ObstructionKind { kDoublet, kPinchedCorner, kTwoFacesOnBoundaryFace, kFlatCorner, kTwoQuadBoundaryNode };
+enum class ObstructionKind {
+  kDoublet,
+  kPinchedCorner,
+  kTwoFacesOnBoundaryFace,
+  kFlatCorner,
+  kTwoQuadBoundaryNode
+};
 
-// "doublet", "pinched-corner", "two-faces-on-boundary-face", "flat-corner", "two-quad-boundary-node".
+// "doublet", "pinched-corner", "two-faces-on-boundary-face", "flat-corner",
+// "two-quad-boundary-node".
 std::string_view to_string(ObstructionKind kind);
 
 struct Obstruction {
   ObstructionKind kind;
   std::vector<Index> hexes;  // quads for a quad mesh; 0-based, ascending
-  std::vector<Index> nodes;  // 0-based: the edge (doublet), v a b (pinched), the corner first (flat), the node
+  std::vector<Index>
+      nodes;  // 0-based: the edge (doublet), v a b (pinched), the corner first (flat), the node
 };
 
 struct RealizabilityOptions {
@@ -74,20 +82,22 @@ struct RealizabilityOptions {
 // Hexes with a repeated node are left out (primal::check_validity reports them); throws
 // InvalidInput naming the hex if a node number is out of range, or if node_faces has the
 // wrong size.
-std::vector<Obstruction> find_obstructions(const HexMesh& mesh, const RealizabilityOptions& options = {});
+std::vector<Obstruction> find_obstructions(const HexMesh& mesh,
+                                           const RealizabilityOptions& options = {});
 
 // The same for a planar quad mesh: its boundary edges grouped into straight sides (by direction
 // and distance, as above; node_faces bits name the sides of a template's rectangle). Kinds
 // found: doublet (two quads sharing two consecutive edges), two faces on one boundary face (a
 // quad with two edges on one straight side), flat corner. The 3D pinched corner and two-quad
 // node have no separate 2D form: they are the doublet and the two-edges quad.
-std::vector<Obstruction> find_obstructions(const QuadMesh& mesh, const RealizabilityOptions& options = {});
+std::vector<Obstruction> find_obstructions(const QuadMesh& mesh,
+                                           const RealizabilityOptions& options = {});
 
 // One line per obstruction, "  doublet: hexes 3 7; nodes 5 9" (quads for dim 2), numbers plus
 // `base` (1 for files that number from 1), at most `limit` lines and then how many more; a
 // first line counts them by kind ("no obstructions found" when there are none).
-std::string format_obstructions(const std::vector<Obstruction>& obstructions, int dim, Index base = 0,
-                                std::size_t limit = 50);
+std::string format_obstructions(const std::vector<Obstruction>& obstructions, int dim,
+                                Index base = 0, std::size_t limit = 50);
 // [{"kind": "doublet", "hexes": [...], "nodes": [...]}, ...], numbers plus `base`.
 nlohmann::json obstructions_json(const std::vector<Obstruction>& obstructions, Index base = 0);
 

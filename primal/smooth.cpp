@@ -150,7 +150,8 @@ std::vector<NodeSpace> node_spaces(const std::vector<Point>& points,
       }
     }
     s.basis.resize(3, static_cast<Eigen::Index>(dirs.size()));
-    for (std::size_t k = 0; k < dirs.size(); ++k) s.basis.col(static_cast<Eigen::Index>(k)) = dirs[k];
+    for (std::size_t k = 0; k < dirs.size(); ++k)
+      s.basis.col(static_cast<Eigen::Index>(k)) = dirs[k];
   }
   // Followers take their leader's coordinates through the link's map; the others get their own.
   std::vector<char> follows(points.size(), 0);
@@ -158,8 +159,9 @@ std::vector<NodeSpace> node_spaces(const std::vector<Point>& points,
     const auto n = static_cast<std::size_t>(l.node), lead = static_cast<std::size_t>(l.leader);
     if (l.node < 0 || n >= points.size() || l.leader < 0 || lead >= points.size() || n == lead ||
         !l.map.allFinite())
-      throw InvalidInput("smooth: a node link names node " + std::to_string(l.node) + " and leader " +
-                         std::to_string(l.leader) + " (" + std::to_string(points.size()) + " nodes)");
+      throw InvalidInput("smooth: a node link names node " + std::to_string(l.node) +
+                         " and leader " + std::to_string(l.leader) + " (" +
+                         std::to_string(points.size()) + " nodes)");
     follows[n] = 1;
   }
   for (const NodeLink& l : links)
@@ -190,7 +192,8 @@ enum class Measure { kJacobian, kShape };
 // Jacobian and divides a guard frame's shape.
 double column_value(const FrameVector& v, Measure measure, int guard, double scale,
                     FrameVector* grad, FrameMatrix* hess = nullptr) {
-  if (measure == Measure::kShape && guard == 0) return scaled_determinant_derivatives(v, grad, hess);
+  if (measure == Measure::kShape && guard == 0)
+    return scaled_determinant_derivatives(v, grad, hess);
   const double factor = measure == Measure::kJacobian ? scale : 1.0 / scale;
   const double q = measure == Measure::kJacobian ? determinant_derivatives(v, grad, hess)
                                                  : corner_shape_derivatives(v, guard, grad, hess);
@@ -208,7 +211,8 @@ class Problem {
   Problem(const std::vector<Frame>& frames, std::vector<NodeSpace> spaces, double unit,
           double guard)
       : spaces_(std::move(spaces)), unit_(unit), guard_(guard) {
-    for (const auto& s : spaces_) dof_ = std::max(dof_, s.offset + static_cast<int>(s.basis.cols()));
+    for (const auto& s : spaces_)
+      dof_ = std::max(dof_, s.offset + static_cast<int>(s.basis.cols()));
     for (const Frame& f : frames) {
       if (f.guard != 0 && !(guard > 0.0)) continue;
       Local l;
@@ -235,7 +239,8 @@ class Problem {
         }
       }
       l.map.resize(9, static_cast<Eigen::Index>(cols.size()));
-      for (std::size_t k = 0; k < cols.size(); ++k) l.map.col(static_cast<Eigen::Index>(k)) = cols[k];
+      for (std::size_t k = 0; k < cols.size(); ++k)
+        l.map.col(static_cast<Eigen::Index>(k)) = cols[k];
       locals_.push_back(std::move(l));
     }
   }
@@ -265,8 +270,7 @@ class Problem {
   //   grad f = -sum w_k g_k,  hess f = -sum w_k H_k + t (sum w_k g_k g_k^T - gbar gbar^T)
   // with w the softmax weights, g_k, H_k the derivatives of q_k, gbar = sum w_k g_k (H_k the
   // analytic 9 x 9 Hessian of the frame's columns, then mapped by M).
-  double soft_min(const Vec& x, Measure m, double t, Vec* grad,
-                  Eigen::MatrixXd* hess = nullptr) {
+  double soft_min(const Vec& x, Measure m, double t, Vec* grad, Eigen::MatrixXd* hess = nullptr) {
     const std::size_t n = locals_.size();
     q_.resize(n);
     if (grad) dq_.resize(n);
@@ -500,8 +504,8 @@ SmoothResult run(std::vector<Point>& points, std::vector<Frame> frames,
     };
     auto untangled = [&](const Vec& at, double) { return min_of(at, false) > 0.0; };
     result.untangle_iterations =
-        lbfgs(x, f, untangled, std::min(budget, options.max_untangle_iterations),
-              options.history, 0.05 * length);
+        lbfgs(x, f, untangled, std::min(budget, options.max_untangle_iterations), options.history,
+              0.05 * length);
     budget -= result.untangle_iterations;
   }
 
@@ -537,8 +541,7 @@ SmoothResult run(std::vector<Point>& points, std::vector<Frame> frames,
   result.untangled = result.final_min_jacobian > 0.0;
   result.final_min_scaled_jacobian = min_of(x, true);
   result.final_max_scaled_jacobian = *std::max_element(q.begin(), q.end());
-  result.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
 

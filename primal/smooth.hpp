@@ -57,8 +57,7 @@ struct NodeConstraint {
 // corner) is fixed; other nodes are free. A node on a face flagged in `fixed_faces` (order
 // x-, x+, y-, y+, z-, z+) is fixed.
 std::vector<NodeConstraint> box_constraints(std::span<const Point> points, const Point& lo,
-                                            const Point& hi,
-                                            std::array<bool, 6> fixed_faces = {},
+                                            const Point& hi, std::array<bool, 6> fixed_faces = {},
                                             double tol = 1e-9);
 
 // A node that moves with another (its leader): p = p0 + map (q - q0), p0 and q0 their places
@@ -72,14 +71,14 @@ struct NodeLink {
 };
 
 struct SmoothOptions {
-  int max_iterations = 3000;           // L-BFGS iterations over all phases
+  int max_iterations = 3000;  // L-BFGS iterations over all phases
   int max_untangle_iterations = 1000;
-  int max_stage_iterations = 300;      // per sharpness value of the shape phase
+  int max_stage_iterations = 300;  // per sharpness value of the shape phase
   std::vector<double> sharpness = {10, 20, 40, 80, 160, 320, 640, 1280, 2560};
   double untangle_sharpness = 20;
-  double tolerance = 1e-7;             // soft-minimum improvement counted as progress
+  double tolerance = 1e-7;  // soft-minimum improvement counted as progress
   int patience = 8;
-  int history = 8;                     // L-BFGS memory (untangling)
+  int history = 8;  // L-BFGS memory (untangling)
   // The scaled Jacobian does not see edge lengths: a node may slide onto its neighbour with
   // every corner keeping a fine scaled Jacobian. So the shape phase maximises the soft
   // minimum over the scaled Jacobians and, per corner, Verdict's shape (3 det^(2/3) /
@@ -90,16 +89,16 @@ struct SmoothOptions {
 };
 
 struct SmoothResult {
-  bool untangled = false;              // every corner and centre Jacobian > 0 at the end
+  bool untangled = false;  // every corner and centre Jacobian > 0 at the end
   int untangle_iterations = 0;
   int shape_iterations = 0;
-  int iterations = 0;                  // sum of the two
-  double initial_min_jacobian = 0.0;   // hex_jacobian / quad_jacobian minimum over the mesh
+  int iterations = 0;                 // sum of the two
+  double initial_min_jacobian = 0.0;  // hex_jacobian / quad_jacobian minimum over the mesh
   double final_min_jacobian = 0.0;
   double initial_min_scaled_jacobian = 0.0;  // Verdict: 8 corners and centre (quads: corners)
   double final_min_scaled_jacobian = 0.0;
   double final_max_scaled_jacobian = 0.0;
-  double seconds = 0.0;                // wall-clock time of the call
+  double seconds = 0.0;  // wall-clock time of the call
 };
 
 // Moves the nodes of `mesh` in place. `constraints` has one entry per node (empty: all free).

@@ -32,7 +32,8 @@ PyramidSplit split_pyramids(const Model& model) {
   // Pyramids by base quad (its sorted nodes); a diagonal as its sorted node pair.
   std::map<std::array<Index, 4>, std::vector<std::size_t>> by_base;
   for (std::size_t p = 0; p < np; ++p) {
-    std::array<Index, 4> key{model.pyramids[p][0], model.pyramids[p][1], model.pyramids[p][2], model.pyramids[p][3]};
+    std::array<Index, 4> key{model.pyramids[p][0], model.pyramids[p][1], model.pyramids[p][2],
+                             model.pyramids[p][3]};
     std::sort(key.begin(), key.end());
     by_base[key].push_back(p);
   }
@@ -54,10 +55,13 @@ PyramidSplit split_pyramids(const Model& model) {
     for (std::size_t p : members) out.diagonal[p] = pair_of(p, 0) == chosen ? 0 : 1;
   }
 
-  const bool blocks = !model.tet_block.empty() || !model.pyramid_block.empty() || !model.tets.empty() || np > 0;
-  if (blocks && m.tet_block.empty()) m.tet_block.assign(model.tets.size(), default_block(ElementKind::Tet));
+  const bool blocks =
+      !model.tet_block.empty() || !model.pyramid_block.empty() || !model.tets.empty() || np > 0;
+  if (blocks && m.tet_block.empty())
+    m.tet_block.assign(model.tets.size(), default_block(ElementKind::Tet));
   if (m.tet_ids.empty())
-    for (std::size_t t = 0; t < model.tets.size(); ++t) m.tet_ids.push_back(static_cast<std::int64_t>(t) + 1);
+    for (std::size_t t = 0; t < model.tets.size(); ++t)
+      m.tet_ids.push_back(static_cast<std::int64_t>(t) + 1);
   std::vector<Index> first_tet(np);
   for (std::size_t p = 0; p < np; ++p) {
     first_tet[p] = static_cast<Index>(m.tets.size());
@@ -82,7 +86,10 @@ PyramidSplit split_pyramids(const Model& model) {
         for (int f = 0; f < 4; ++f) {
           bool on = true;
           for (int k : topology::kTetFaceCorners[static_cast<std::size_t>(f)])
-            on = on && std::find(face.begin(), face.end(), m.tets[static_cast<std::size_t>(t)][static_cast<std::size_t>(k)]) != face.end();
+            on =
+                on && std::find(face.begin(), face.end(),
+                                m.tets[static_cast<std::size_t>(t)][static_cast<std::size_t>(k)]) !=
+                          face.end();
           if (on) sides.push_back({{ElementKind::Tet, t}, f});
         }
     }

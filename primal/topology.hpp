@@ -25,39 +25,46 @@ inline constexpr int kHexFaces = 6;
 inline constexpr int kHexEdges = 12;
 
 // Unit-cube coordinates of the corners (r, s, t).
-inline constexpr std::array<std::array<int, 3>, 8> kHexCornerCoords{{
-    {0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
-    {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}}};
+inline constexpr std::array<std::array<int, 3>, 8> kHexCornerCoords{
+    {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}}};
 
 // Faces with outward normals (corners counter-clockwise seen from outside), in the VTK/Exodus
 // side order: 0 = s-min (front), 1 = r-max (right), 2 = s-max (back), 3 = r-min (left),
 // 4 = t-min (bottom), 5 = t-max (top).
-inline constexpr std::array<std::array<int, 4>, 6> kHexFaceCorners{{
-    {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}, {0, 3, 2, 1}, {4, 5, 6, 7}}};
+inline constexpr std::array<std::array<int, 4>, 6> kHexFaceCorners{
+    {{0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}, {0, 3, 2, 1}, {4, 5, 6, 7}}};
 
 // Opposite face of each face.
 inline constexpr std::array<int, 6> kHexOppositeFace{2, 3, 0, 1, 5, 4};
 
 // Edges; edge e belongs to parallel class e / 4 (0: along r, 1: along s, 2: along t).
-inline constexpr std::array<std::array<int, 2>, 12> kHexEdgeCorners{{
-    {0, 1}, {3, 2}, {4, 5}, {7, 6},   // along r
-    {0, 3}, {1, 2}, {4, 7}, {5, 6},   // along s
-    {0, 4}, {1, 5}, {2, 6}, {3, 7}}};  // along t
+inline constexpr std::array<std::array<int, 2>, 12> kHexEdgeCorners{{{0, 1},
+                                                                     {3, 2},
+                                                                     {4, 5},
+                                                                     {7, 6},  // along r
+                                                                     {0, 3},
+                                                                     {1, 2},
+                                                                     {4, 7},
+                                                                     {5, 6},  // along s
+                                                                     {0, 4},
+                                                                     {1, 5},
+                                                                     {2, 6},
+                                                                     {3, 7}}};  // along t
 
 // The three edges at each corner, pointing away from it, ordered (r, s, t) so that their
 // directions form a right-handed frame: the corner Jacobian is det(e_r, e_s, e_t).
-inline constexpr std::array<std::array<int, 3>, 8> kHexCornerNeighbors{{
-    {1, 3, 4}, {2, 0, 5}, {3, 1, 6}, {0, 2, 7},
-    {7, 5, 0}, {4, 6, 1}, {5, 7, 2}, {6, 4, 3}}};
+inline constexpr std::array<std::array<int, 3>, 8> kHexCornerNeighbors{
+    {{1, 3, 4}, {2, 0, 5}, {3, 1, 6}, {0, 2, 7}, {7, 5, 0}, {4, 6, 1}, {5, 7, 2}, {6, 4, 3}}};
 
 // Quad: corners counter-clockwise; edge i joins corner i and i+1. Opposite edges: i, i+2.
-inline constexpr std::array<std::array<int, 2>, 4> kQuadEdgeCorners{{{0, 1}, {1, 2}, {2, 3}, {3, 0}}};
+inline constexpr std::array<std::array<int, 2>, 4> kQuadEdgeCorners{
+    {{0, 1}, {1, 2}, {2, 3}, {3, 0}}};
 
 // Tetrahedron (VTK_TETRA / Exodus TET4): 0-1-2 counter-clockwise seen from corner 3.
-inline constexpr std::array<std::array<int, 3>, 4> kTetFaceCorners{{
-    {0, 1, 3}, {1, 2, 3}, {2, 0, 3}, {0, 2, 1}}};
-inline constexpr std::array<std::array<int, 2>, 6> kTetEdgeCorners{{
-    {0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}}};
+inline constexpr std::array<std::array<int, 3>, 4> kTetFaceCorners{
+    {{0, 1, 3}, {1, 2, 3}, {2, 0, 3}, {0, 2, 1}}};
+inline constexpr std::array<std::array<int, 2>, 6> kTetEdgeCorners{
+    {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}}};
 
 // Triangle: corners counter-clockwise.
 inline constexpr std::array<std::array<int, 2>, 3> kTriEdgeCorners{{{0, 1}, {1, 2}, {2, 0}}};
@@ -77,12 +84,12 @@ inline constexpr std::array<int, 6> kVtkWedgeOrder{0, 2, 1, 3, 5, 4};  // an inv
 // The three edges at each corner of a wedge, pointing away from it, in the order making them a
 // right-handed frame (as kHexCornerNeighbors): a wedge's corner Jacobians, and the axes of the
 // hex its dicing puts at that corner.
-inline constexpr std::array<std::array<int, 3>, 6> kWedgeCornerNeighbors{{
-    {1, 2, 3}, {2, 0, 4}, {0, 1, 5}, {5, 4, 0}, {3, 5, 1}, {4, 3, 2}}};
+inline constexpr std::array<std::array<int, 3>, 6> kWedgeCornerNeighbors{
+    {{1, 2, 3}, {2, 0, 4}, {0, 1, 5}, {5, 4, 0}, {3, 5, 1}, {4, 3, 2}}};
 // The same for a tetrahedron: (1, 2, 3) at 0 is right-handed for a positive tet, and every
 // even permutation keeps it.
-inline constexpr std::array<std::array<int, 3>, 4> kTetCornerNeighbors{{
-    {1, 2, 3}, {0, 3, 2}, {3, 0, 1}, {2, 1, 0}}};
+inline constexpr std::array<std::array<int, 3>, 4> kTetCornerNeighbors{
+    {{1, 2, 3}, {0, 3, 2}, {3, 0, 1}, {2, 1, 0}}};
 
 // The linear cell kinds of a model as one table, indexed by primal::ElementKind (hex, tet,
 // pyramid, wedge): corner count, faces (outward, counter-clockwise seen from outside, in the
@@ -103,15 +110,45 @@ struct CellKindTopology {
 };
 
 inline constexpr std::array<CellKindTopology, 4> kCellKinds{{
-    {"hex", 8, 6,
-     {{{4, {0, 1, 5, 4}}, {4, {1, 2, 6, 5}}, {4, {2, 3, 7, 6}}, {4, {3, 0, 4, 7}}, {4, {0, 3, 2, 1}}, {4, {4, 5, 6, 7}}}},
+    {"hex",
+     8,
+     6,
+     {{{4, {0, 1, 5, 4}},
+       {4, {1, 2, 6, 5}},
+       {4, {2, 3, 7, 6}},
+       {4, {3, 0, 4, 7}},
+       {4, {0, 3, 2, 1}},
+       {4, {4, 5, 6, 7}}}},
      12,
-     {{{0, 1}, {3, 2}, {4, 5}, {7, 6}, {0, 3}, {1, 2}, {4, 7}, {5, 6}, {0, 4}, {1, 5}, {2, 6}, {3, 7}}}},
-    {"tet", 4, 4, {{{3, {0, 1, 3}}, {3, {1, 2, 3}}, {3, {2, 0, 3}}, {3, {0, 2, 1}}}}, 6,
+     {{{0, 1},
+       {3, 2},
+       {4, 5},
+       {7, 6},
+       {0, 3},
+       {1, 2},
+       {4, 7},
+       {5, 6},
+       {0, 4},
+       {1, 5},
+       {2, 6},
+       {3, 7}}}},
+    {"tet",
+     4,
+     4,
+     {{{3, {0, 1, 3}}, {3, {1, 2, 3}}, {3, {2, 0, 3}}, {3, {0, 2, 1}}}},
+     6,
      {{{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}}}},
-    {"pyramid", 5, 5, {{{3, {0, 1, 4}}, {3, {1, 2, 4}}, {3, {2, 3, 4}}, {3, {3, 0, 4}}, {4, {0, 3, 2, 1}}}}, 8,
+    {"pyramid",
+     5,
+     5,
+     {{{3, {0, 1, 4}}, {3, {1, 2, 4}}, {3, {2, 3, 4}}, {3, {3, 0, 4}}, {4, {0, 3, 2, 1}}}},
+     8,
      {{{0, 1}, {1, 2}, {2, 3}, {3, 0}, {0, 4}, {1, 4}, {2, 4}, {3, 4}}}},
-    {"wedge", 6, 5, {{{4, {0, 1, 4, 3}}, {4, {1, 2, 5, 4}}, {4, {2, 0, 3, 5}}, {3, {0, 2, 1}}, {3, {3, 4, 5}}}}, 9,
+    {"wedge",
+     6,
+     5,
+     {{{4, {0, 1, 4, 3}}, {4, {1, 2, 5, 4}}, {4, {2, 0, 3, 5}}, {3, {0, 2, 1}}, {3, {3, 4, 5}}}},
+     9,
      {{{0, 1}, {1, 2}, {2, 0}, {3, 4}, {4, 5}, {5, 3}, {0, 3}, {1, 4}, {2, 5}}}},
 }};
 

@@ -8,13 +8,13 @@
 
 #include <algorithm>
 #include <cassert>
-#include <cstdint>
-#include <tuple>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 #include <numeric>
 #include <optional>
 #include <sstream>
+#include <tuple>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -74,7 +74,8 @@ const HexIncidence& hex_incidence() {
       for (int k = 0; k < 3; ++k) {
         for (int f : t.corner_faces[c]) {
           const auto& q = topo::kHexFaceCorners[f];
-          if (std::find(q.begin(), q.end(), topo::kHexCornerNeighbors[c][k]) == q.end()) t.corner_face_without[c][k] = f;
+          if (std::find(q.begin(), q.end(), topo::kHexCornerNeighbors[c][k]) == q.end())
+            t.corner_face_without[c][k] = f;
         }
       }
     }
@@ -142,7 +143,8 @@ std::string show_key(const std::array<Index, N>& k) {
 std::string show_coverage(const NodeCoverage& c) {
   std::ostringstream os;
   os.precision(3);
-  os << c.node << ": " << c.angle / std::numbers::pi << " pi, not " << c.expected / std::numbers::pi << " pi";
+  os << c.node << ": " << c.angle / std::numbers::pi << " pi, not " << c.expected / std::numbers::pi
+     << " pi";
   return os.str();
 }
 
@@ -230,8 +232,10 @@ class ProbeCount {
         for (int k = 0; k < 3 && !out; ++k) {
           const int i = (k + 1) % 3, j = (k + 2) % 3;
           const double t = d.dot(e[i].cross(e[j]));
-          if (t * t <= kProbeMargin * length2[i] * length2[j]) near = true;
-          else out = t < 0.0;
+          if (t * t <= kProbeMargin * length2[i] * length2[j])
+            near = true;
+          else
+            out = t < 0.0;
         }
         k_code = out ? kOut : near ? kNear : kInside;
       }
@@ -244,10 +248,17 @@ class ProbeCount {
     for (int c = 0; c < 8; ++c) {
       const auto v = static_cast<std::size_t>(hex[c]);
       switch ((code >> (2 * c)) & 3) {
-        case kNotPositiveCorner: flags_[v] |= kNotPositive; break;
-        case kNear: flags_[v] |= kNearFace; break;
-        case kInside: ++containing_[v]; break;
-        default: break;
+        case kNotPositiveCorner:
+          flags_[v] |= kNotPositive;
+          break;
+        case kNear:
+          flags_[v] |= kNearFace;
+          break;
+        case kInside:
+          ++containing_[v];
+          break;
+        default:
+          break;
       }
     }
   }
@@ -284,7 +295,8 @@ std::optional<NodeCoverage> hex_coverage(const std::vector<Point>& points, Index
     }
   }
   if (wedges.empty()) return c;
-  std::sort(wedges.begin(), wedges.end(), [](const BoundaryWedge& a, const BoundaryWedge& b) { return a.end < b.end; });
+  std::sort(wedges.begin(), wedges.end(),
+            [](const BoundaryWedge& a, const BoundaryWedge& b) { return a.end < b.end; });
   double exterior = 0.0;
   for (std::size_t i = 0; i < wedges.size(); i += 2) {
     if (i + 1 == wedges.size() || wedges[i + 1].end != wedges[i].end ||
@@ -307,7 +319,8 @@ struct QuadCornerAt {
   bool leaving_boundary, arriving_boundary;
 };
 
-std::optional<NodeCoverage> quad_coverage(Index v, const std::vector<QuadCornerAt>& corners, const Point& normal) {
+std::optional<NodeCoverage> quad_coverage(Index v, const std::vector<QuadCornerAt>& corners,
+                                          const Point& normal) {
   NodeCoverage c{v, 0.0, 2.0 * kPi};
   const Point *out = nullptr, *in = nullptr;
   int leaving = 0, arriving = 0;
@@ -364,7 +377,8 @@ std::string HexValidityReport::summary() const {
   list(os, "boundary quads OpenMesh rejected (hex)", boundary.rejected,
        [](const BoundaryQuad& q) { return std::to_string(q.hex); });
   list(os, "hexes with a non-positive corner Jacobian", inverted_hexes, show_index);
-  list(os, "nodes the hexes cover more than once (corner solid angles)", overlapping_nodes, show_coverage);
+  list(os, "nodes the hexes cover more than once (corner solid angles)", overlapping_nodes,
+       show_coverage);
   return os.str();
 }
 
@@ -401,21 +415,24 @@ HexValidityReport check_validity(const HexMesh& mesh) {
   {
     constexpr std::uint32_t kInverted = 1u << 16, kMeasured = 1u << 17;
     std::vector<std::uint32_t> found(mesh.hexes.size(), 0);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.hexes.size(), 4096),
-                      [&](const tbb::blocked_range<std::size_t>& range) {
-                        for (std::size_t h = range.begin(); h != range.end(); ++h) {
-                          if (!in_range(mesh.hexes[h], mesh.points.size())) continue;
-                          const HexCorners corners = hex_corners(mesh, static_cast<Index>(h));
-                          const auto j = hex_jacobians(corners);
-                          // Corners 0..7 only: the centre value (index 8) is not a corner Jacobian.
-                          const bool positive = std::all_of(j.begin(), j.begin() + 8, [](double d) { return d > 0.0; });
-                          found[h] = kMeasured | (positive ? 0u : kInverted) | ProbeCount::classify(corners, j);
-                        }
-                      });
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, mesh.hexes.size(), 4096),
+        [&](const tbb::blocked_range<std::size_t>& range) {
+          for (std::size_t h = range.begin(); h != range.end(); ++h) {
+            if (!in_range(mesh.hexes[h], mesh.points.size())) continue;
+            const HexCorners corners = hex_corners(mesh, static_cast<Index>(h));
+            const auto j = hex_jacobians(corners);
+            // Corners 0..7 only: the centre value (index 8) is not a corner Jacobian.
+            const bool positive =
+                std::all_of(j.begin(), j.begin() + 8, [](double d) { return d > 0.0; });
+            found[h] = kMeasured | (positive ? 0u : kInverted) | ProbeCount::classify(corners, j);
+          }
+        });
     for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
       if (!(found[h] & kMeasured)) continue;
       if (found[h] & kInverted) r.inverted_hexes.push_back(static_cast<Index>(h));
-      if (!has_repeated(mesh.hexes[h])) probe.add(mesh.hexes[h], static_cast<std::uint16_t>(found[h] & 0xffffu));
+      if (!has_repeated(mesh.hexes[h]))
+        probe.add(mesh.hexes[h], static_cast<std::uint16_t>(found[h] & 0xffffu));
     }
   }
 
@@ -450,7 +467,8 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     for (std::size_t p = 0; p < nh; ++p) {
       const auto& h = hex(static_cast<Index>(p));
       for (int c = 0; c < 8; ++c)
-        around[static_cast<std::size_t>(fill[static_cast<std::size_t>(h[c])]++)] = static_cast<Index>(8 * p + static_cast<std::size_t>(c));
+        around[static_cast<std::size_t>(fill[static_cast<std::size_t>(h[c])]++)] =
+            static_cast<Index>(8 * p + static_cast<std::size_t>(c));
     }
   }
   // An incidence entry: the hex and the node's corner in it.
@@ -472,35 +490,39 @@ HexValidityReport check_validity(const HexMesh& mesh) {
   std::vector<std::uint8_t> face_info(6 * nh, 0);
   // Each face is handled at its smallest node only, so nodes write disjoint slots and run in
   // parallel (TBB) with the same result for any thread count.
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv, 4096), [&](const tbb::blocked_range<std::size_t>& range) {
-    std::vector<std::pair<FaceKey, Index>> local;  // faces whose smallest node is v, with use
-    for (std::size_t v = range.begin(); v != range.end(); ++v) {
-      local.clear();
-      for (Index k = start[v]; k < start[v + 1]; ++k) {
-        const auto [p, c] = use_at(k);
-        for (int lf : inc.corner_faces[c]) {
-          const auto q = face_nodes(p, lf);
-          if (*std::min_element(q.begin(), q.end()) != static_cast<Index>(v)) continue;
-          local.emplace_back(face_key(q), 6 * p + lf);
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, nv, 4096),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        std::vector<std::pair<FaceKey, Index>> local;  // faces whose smallest node is v, with use
+        for (std::size_t v = range.begin(); v != range.end(); ++v) {
+          local.clear();
+          for (Index k = start[v]; k < start[v + 1]; ++k) {
+            const auto [p, c] = use_at(k);
+            for (int lf : inc.corner_faces[c]) {
+              const auto q = face_nodes(p, lf);
+              if (*std::min_element(q.begin(), q.end()) != static_cast<Index>(v)) continue;
+              local.emplace_back(face_key(q), 6 * p + lf);
+            }
+          }
+          std::sort(local.begin(), local.end());
+          for (std::size_t i = 0; i < local.size();) {
+            std::size_t j = i + 1;
+            while (j < local.size() && local[j].first == local[i].first) ++j;
+            const Index lead = local[i].second;
+            for (std::size_t k = i; k < j; ++k)
+              face_lead[static_cast<std::size_t>(local[k].second)] = lead;
+            std::uint8_t info = static_cast<std::uint8_t>(std::min<std::size_t>(j - i, 3));
+            if (j - i == 2) {
+              const Index u1 = local[i + 1].second;
+              if (!opposite_cycles(face_nodes(lead / 6, lead % 6), face_nodes(u1 / 6, u1 % 6)))
+                info |= 4;
+            }
+            for (std::size_t k = i; k < j; ++k)
+              face_info[static_cast<std::size_t>(local[k].second)] = info;
+            i = j;
+          }
         }
-      }
-      std::sort(local.begin(), local.end());
-      for (std::size_t i = 0; i < local.size();) {
-        std::size_t j = i + 1;
-        while (j < local.size() && local[j].first == local[i].first) ++j;
-        const Index lead = local[i].second;
-        for (std::size_t k = i; k < j; ++k) face_lead[static_cast<std::size_t>(local[k].second)] = lead;
-        std::uint8_t info = static_cast<std::uint8_t>(std::min<std::size_t>(j - i, 3));
-        if (j - i == 2) {
-          const Index u1 = local[i + 1].second;
-          if (!opposite_cycles(face_nodes(lead / 6, lead % 6), face_nodes(u1 / 6, u1 % 6)))
-            info |= 4;
-        }
-        for (std::size_t k = i; k < j; ++k) face_info[static_cast<std::size_t>(local[k].second)] = info;
-        i = j;
-      }
-    }
-  });
+      });
   std::vector<BoundaryQuad> boundary;
   for (std::size_t u = 0; u < 6 * nh; ++u) {
     if (face_lead[u] != static_cast<Index>(u)) continue;
@@ -510,7 +532,9 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     const auto uses = face_info[u] & 3;
     if (uses == 3) r.overshared_faces.push_back(face_key(face_nodes(p, lf)));
     if (face_info[u] & 4) r.misoriented_faces.push_back(face_key(face_nodes(p, lf)));
-    if (uses == 1) boundary.push_back(BoundaryQuad{original[static_cast<std::size_t>(p)], lf, face_nodes(p, lf)});
+    if (uses == 1)
+      boundary.push_back(
+          BoundaryQuad{original[static_cast<std::size_t>(p)], lf, face_nodes(p, lf)});
   }
   auto face_uses = [&](Index p, int lf) {
     return face_info[static_cast<std::size_t>(6 * p + lf)] & 3;
@@ -527,7 +551,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     Index use;    // 12 p + local edge
   };
   struct Scratch {
-    DisjointSets uses_joined;                           // over the local uses
+    DisjointSets uses_joined;  // over the local uses
     std::vector<EdgeUse> edge_uses;
     std::vector<std::pair<Index, int>> first_use_of_face;  // (face lead, local use)
     std::vector<Index> others;
@@ -550,7 +574,8 @@ HexValidityReport check_validity(const HexMesh& mesh) {
       return NodeCoverage{v, 4.0 * kPi * k, 4.0 * kPi};
     }
     s.stars.clear();
-    for (Index i = start[static_cast<std::size_t>(v)]; i < start[static_cast<std::size_t>(v) + 1]; ++i) {
+    for (Index i = start[static_cast<std::size_t>(v)]; i < start[static_cast<std::size_t>(v) + 1];
+         ++i) {
       const auto [p, c] = use_at(i);
       CornerStar& star = s.stars.emplace_back();
       for (int k = 0; k < 3; ++k) {
@@ -586,8 +611,10 @@ HexValidityReport check_validity(const HexMesh& mesh) {
         const Index f = face_lead[static_cast<std::size_t>(6 * p + lf)];
         auto it = std::find_if(first_use_of_face.begin(), first_use_of_face.end(),
                                [f](const auto& x) { return x.first == f; });
-        if (it == first_use_of_face.end()) first_use_of_face.emplace_back(f, i);
-        else uses_joined.unite(it->second, i);
+        if (it == first_use_of_face.end())
+          first_use_of_face.emplace_back(f, i);
+        else
+          uses_joined.unite(it->second, i);
       }
       for (int nc : topo::kHexCornerNeighbors[c]) {
         const Index b = hex(p)[nc];
@@ -599,15 +626,16 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     const auto link_vertices = std::unique(others.begin(), others.end()) - others.begin();
     const auto link_euler = static_cast<long>(link_vertices) -
                             static_cast<long>(first_use_of_face.size()) + static_cast<long>(n);
-    if (overshared || uses_joined.count() != 1 ||
-        link_euler != (on_boundary ? 1 : 2)) {
+    if (overshared || uses_joined.count() != 1 || link_euler != (on_boundary ? 1 : 2)) {
       r.nonmanifold_vertices.push_back(static_cast<Index>(v));
-    } else if (const auto cover = covering(static_cast<Index>(v), on_boundary, s); cover && overlaps(*cover)) {
+    } else if (const auto cover = covering(static_cast<Index>(v), on_boundary, s);
+               cover && overlaps(*cover)) {
       r.overlapping_nodes.push_back(*cover);
     }
 
-    std::sort(edge_uses.begin(), edge_uses.end(),
-              [](const EdgeUse& a, const EdgeUse& b) { return std::tie(a.other, a.use) < std::tie(b.other, b.use); });
+    std::sort(edge_uses.begin(), edge_uses.end(), [](const EdgeUse& a, const EdgeUse& b) {
+      return std::tie(a.other, a.use) < std::tie(b.other, b.use);
+    });
     for (std::size_t i = 0; i < edge_uses.size();) {
       std::size_t j = i + 1;
       while (j < edge_uses.size() && edge_uses[j].other == edge_uses[i].other) ++j;
@@ -624,30 +652,37 @@ HexValidityReport check_validity(const HexMesh& mesh) {
           const Index f = face_lead[static_cast<std::size_t>(6 * p + lf)];
           auto it = std::find_if(first_use_of_face.begin(), first_use_of_face.end(),
                                  [f](const auto& x) { return x.first == f; });
-          if (it == first_use_of_face.end()) first_use_of_face.emplace_back(f, static_cast<int>(k));
-          else uses_joined.unite(it->second, static_cast<Index>(k));
+          if (it == first_use_of_face.end())
+            first_use_of_face.emplace_back(f, static_cast<int>(k));
+          else
+            uses_joined.unite(it->second, static_cast<Index>(k));
         }
       }
       if (edge_overshared || uses_joined.count() != 1)
-        bad_edges.emplace_back(edge_uses[i].use, edge_key(static_cast<Index>(v), edge_uses[i].other));
+        bad_edges.emplace_back(edge_uses[i].use,
+                               edge_key(static_cast<Index>(v), edge_uses[i].other));
       i = j;
     }
   };
   constexpr std::size_t kChunk = 4096;
   const std::size_t chunks = (nv + kChunk - 1) / kChunk;
   std::vector<Found> found(chunks);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks), [&](const tbb::blocked_range<std::size_t>& range) {
-    Scratch scratch;
-    for (std::size_t c = range.begin(); c != range.end(); ++c)
-      for (std::size_t v = c * kChunk; v < std::min(nv, (c + 1) * kChunk); ++v) visit(v, scratch, found[c]);
-  });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      Scratch scratch;
+                      for (std::size_t c = range.begin(); c != range.end(); ++c)
+                        for (std::size_t v = c * kChunk; v < std::min(nv, (c + 1) * kChunk); ++v)
+                          visit(v, scratch, found[c]);
+                    });
   std::vector<std::pair<Index, EdgeKey>> bad_edges;
   for (Found& f : found) {
     r.unused_nodes += f.unused_nodes;
     r.num_vertices += f.num_vertices;
     r.num_edges += f.num_edges;
-    r.nonmanifold_vertices.insert(r.nonmanifold_vertices.end(), f.nonmanifold_vertices.begin(), f.nonmanifold_vertices.end());
-    r.overlapping_nodes.insert(r.overlapping_nodes.end(), f.overlapping_nodes.begin(), f.overlapping_nodes.end());
+    r.nonmanifold_vertices.insert(r.nonmanifold_vertices.end(), f.nonmanifold_vertices.begin(),
+                                  f.nonmanifold_vertices.end());
+    r.overlapping_nodes.insert(r.overlapping_nodes.end(), f.overlapping_nodes.begin(),
+                               f.overlapping_nodes.end());
     bad_edges.insert(bad_edges.end(), f.bad_edges.begin(), f.bad_edges.end());
   }
   std::sort(bad_edges.begin(), bad_edges.end());
@@ -686,7 +721,8 @@ std::string QuadValidityReport::summary() const {
   list(os, "edges run in the same direction by both quads", misoriented_edges, show_key<2>);
   list(os, "non-manifold vertices", nonmanifold_vertices, show_index);
   list(os, "quads with a non-positive corner", inverted_quads, show_index);
-  list(os, "nodes the quads cover more than once (corner angles)", overlapping_nodes, show_coverage);
+  list(os, "nodes the quads cover more than once (corner angles)", overlapping_nodes,
+       show_coverage);
   return os.str();
 }
 
@@ -773,13 +809,15 @@ QuadValidityReport check_validity(const QuadMesh& mesh, const Point& normal_in) 
     const Point& o = mesh.points[v];
     for (std::size_t i = 0; i < uses.size(); ++i) {
       const auto [q, c] = uses[i];
-      corners.push_back({mesh.points[proper[q][(c + 1) % 4]] - o, mesh.points[proper[q][(c + 3) % 4]] - o, false, false});
+      corners.push_back({mesh.points[proper[q][(c + 1) % 4]] - o,
+                         mesh.points[proper[q][(c + 3) % 4]] - o, false, false});
       // The two edges at corner c: edge c (leaving it) and edge c-1 (arriving).
       for (int le : {c, (c + 3) % 4}) {
         const auto& lc = topo::kQuadEdgeCorners[le];
         const Index e = edge_id.at(edge_key(proper[q][lc[0]], proper[q][lc[1]]));
         overshared |= edge_uses[e].size() > 2;
-        (le == c ? corners.back().leaving_boundary : corners.back().arriving_boundary) = edge_uses[e].size() == 1;
+        (le == c ? corners.back().leaving_boundary : corners.back().arriving_boundary) =
+            edge_uses[e].size() == 1;
         auto [it, inserted] = first_use_of_edge.try_emplace(e, static_cast<int>(i));
         if (!inserted) sets.unite(it->second, static_cast<int>(i));
       }

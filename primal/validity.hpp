@@ -15,8 +15,9 @@ namespace geode::primal {
 // than once although every corner is positive.
 struct NodeCoverage {
   Index node = kInvalidIndex;
-  double angle = 0.0;     // sum of the incident corners' solid angles (angles in 2D)
-  double expected = 0.0;  // 4 pi (2 pi in 2D) inside; on the boundary what the boundary leaves inside
+  double angle = 0.0;  // sum of the incident corners' solid angles (angles in 2D)
+  double expected =
+      0.0;  // 4 pi (2 pi in 2D) inside; on the boundary what the boundary leaves inside
 };
 
 // The direction along which check_validity counts the corner cones at an interior hex node (the

@@ -41,7 +41,8 @@ std::vector<std::array<Index, K>> to_cells(const py::handle& object, const std::
   const py::array any = py::array::ensure(object);
   if (any && any.size() > 0 && any.dtype().kind() != 'i' && any.dtype().kind() != 'u')
     throw InvalidInput(what + ": node numbers must be integers");
-  const auto a = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(object);
+  const auto a =
+      py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(object);
   if (!a || a.ndim() != 2 || a.shape(1) != K)
     throw InvalidInput(what + ": expected an M x " + std::to_string(K) + " array of node numbers");
   const auto r = a.unchecked<2>();
@@ -84,12 +85,18 @@ py::array double_array(std::vector<double>&& values) {
 
 py::object to_python(const nlohmann::json& j) {
   switch (j.type()) {
-    case nlohmann::json::value_t::null: return py::none();
-    case nlohmann::json::value_t::boolean: return py::bool_(j.get<bool>());
-    case nlohmann::json::value_t::number_integer: return py::int_(j.get<std::int64_t>());
-    case nlohmann::json::value_t::number_unsigned: return py::int_(j.get<std::uint64_t>());
-    case nlohmann::json::value_t::number_float: return py::float_(j.get<double>());
-    case nlohmann::json::value_t::string: return py::str(j.get<std::string>());
+    case nlohmann::json::value_t::null:
+      return py::none();
+    case nlohmann::json::value_t::boolean:
+      return py::bool_(j.get<bool>());
+    case nlohmann::json::value_t::number_integer:
+      return py::int_(j.get<std::int64_t>());
+    case nlohmann::json::value_t::number_unsigned:
+      return py::int_(j.get<std::uint64_t>());
+    case nlohmann::json::value_t::number_float:
+      return py::float_(j.get<double>());
+    case nlohmann::json::value_t::string:
+      return py::str(j.get<std::string>());
     case nlohmann::json::value_t::array: {
       py::list l;
       for (const auto& x : j) l.append(to_python(x));
@@ -100,7 +107,8 @@ py::object to_python(const nlohmann::json& j) {
       for (const auto& [k, v] : j.items()) d[py::str(k)] = to_python(v);
       return d;
     }
-    default: return py::none();
+    default:
+      return py::none();
   }
 }
 

@@ -7,8 +7,8 @@
 #include <sstream>
 
 #include <geode/conform/conform.hpp>
-#include <geode/demo/demo_models.hpp>
 #include <geode/conform/report.hpp>
+#include <geode/demo/demo_models.hpp>
 #include <geode/primal/model.hpp>
 #include "python/arrays.hpp"
 
@@ -19,7 +19,8 @@ std::vector<int> to_blocks(const py::handle& blocks, std::size_t n, const std::s
   if (blocks.is_none()) return {};
   auto b = blocks.cast<std::vector<int>>();
   if (b.size() != n)
-    throw InvalidInput(what + ": " + std::to_string(b.size()) + " block ids for " + std::to_string(n) + " elements");
+    throw InvalidInput(what + ": " + std::to_string(b.size()) + " block ids for " +
+                       std::to_string(n) + " elements");
   return b;
 }
 
@@ -27,9 +28,10 @@ py::dict model_dict(primal::Model&& model) {
   // The module hands out hexes and tets only so far: refuse rather than drop the other kinds.
   for (primal::ElementKind kind : {primal::ElementKind::Pyramid, primal::ElementKind::Wedge})
     if (const std::size_t n = primal::element_count(model, kind))
-      throw InvalidInput("the model holds " + std::to_string(n) + " " + primal::element_kind_name(kind) +
-                         "s, which the Python module does not hand out yet (the command writes them: "
-                         "geode demo --save-input)");
+      throw InvalidInput(
+          "the model holds " + std::to_string(n) + " " + primal::element_kind_name(kind) +
+          "s, which the Python module does not hand out yet (the command writes them: "
+          "geode demo --save-input)");
   py::dict d;
   const std::size_t nh = model.hexes.size(), nt = model.tets.size();
   std::vector<int> hb = model.hex_block, tb = model.tet_block;
@@ -43,15 +45,18 @@ py::dict model_dict(primal::Model&& model) {
   d["block_names"] = model.block_names;
   py::list node_sets, side_sets;
   for (auto& s : model.node_sets)
-    node_sets.append(py::dict(py::arg("id") = s.id, py::arg("name") = s.name, py::arg("nodes") = index_array(std::move(s.nodes))));
+    node_sets.append(py::dict(py::arg("id") = s.id, py::arg("name") = s.name,
+                              py::arg("nodes") = index_array(std::move(s.nodes))));
   for (const auto& s : model.side_sets) {
     std::vector<Index> sides;  // (element, local face) pairs: hexes in conform's all-hex output
     for (const auto& side : s.sides) {
       sides.push_back(side.element.index);
       sides.push_back(side.face);
     }
-    auto a = index_array(std::move(sides)).reshape({static_cast<py::ssize_t>(s.sides.size()), py::ssize_t{2}});
-    side_sets.append(py::dict(py::arg("id") = s.id, py::arg("name") = s.name, py::arg("sides") = a));
+    auto a = index_array(std::move(sides))
+                 .reshape({static_cast<py::ssize_t>(s.sides.size()), py::ssize_t{2}});
+    side_sets.append(
+        py::dict(py::arg("id") = s.id, py::arg("name") = s.name, py::arg("sides") = a));
   }
   d["node_sets"] = node_sets;
   d["side_sets"] = side_sets;
@@ -59,12 +64,14 @@ py::dict model_dict(primal::Model&& model) {
 }
 
 // The model as arrays; conform's options by name, as `geode conform` spells them (with _).
-py::dict conform_arrays(const py::handle& points, const py::handle& hexes, const py::handle& hex_block,
-                        const py::handle& tets, const py::handle& tet_block, const std::map<int, std::string>& block_names,
-                        const py::list& node_sets, const std::string& source, const std::string& smooth,
-                        const std::string& quality, const std::string& geode_block, const std::string& buffer_side,
-                        double buffer_thickness, double smooth_target, const py::object& template_box,
-                        const py::object& merge_tolerance) {
+py::dict conform_arrays(const py::handle& points, const py::handle& hexes,
+                        const py::handle& hex_block, const py::handle& tets,
+                        const py::handle& tet_block, const std::map<int, std::string>& block_names,
+                        const py::list& node_sets, const std::string& source,
+                        const std::string& smooth, const std::string& quality,
+                        const std::string& geode_block, const std::string& buffer_side,
+                        double buffer_thickness, double smooth_target,
+                        const py::object& template_box, const py::object& merge_tolerance) {
   primal::Model model;
   model.points = to_points(points, source + ": points");
   model.hexes = to_cells<8>(hexes, source + ": hexes");
@@ -90,18 +97,21 @@ py::dict conform_arrays(const py::handle& points, const py::handle& hexes, const
   opts.quality = conform::parse_conform_quality(quality);
   opts.geode_block = geode_block;
   opts.buffer.side = conform::parse_buffer_side(buffer_side);
-  if (!(buffer_thickness >= 0) || buffer_thickness > conform::max_buffer_thickness(opts.buffer.side)) {
+  if (!(buffer_thickness >= 0) ||
+      buffer_thickness > conform::max_buffer_thickness(opts.buffer.side)) {
     std::ostringstream m;
-    m << "buffer_thickness " << buffer_thickness << " with buffer_side " << buffer_side << ": at most "
-      << conform::max_buffer_thickness(opts.buffer.side);
+    m << "buffer_thickness " << buffer_thickness << " with buffer_side " << buffer_side
+      << ": at most " << conform::max_buffer_thickness(opts.buffer.side);
     throw InvalidInput(m.str());
   }
   opts.buffer.thickness = buffer_thickness;
-  if (!(smooth_target >= 0 && smooth_target <= 1)) throw InvalidInput("smooth_target must lie in [0, 1]");
+  if (!(smooth_target >= 0 && smooth_target <= 1))
+    throw InvalidInput("smooth_target must lie in [0, 1]");
   opts.smooth_target = smooth_target;
   if (!template_box.is_none()) {
     const auto b = template_box.cast<std::vector<double>>();
-    if (b.size() != 3 || !std::all_of(b.begin(), b.end(), [](double x) { return std::isfinite(x) && x > 0; }))
+    if (b.size() != 3 ||
+        !std::all_of(b.begin(), b.end(), [](double x) { return std::isfinite(x) && x > 0; }))
       throw InvalidInput("template_box must be three positive numbers");
     opts.template_box = {b[0], b[1], b[2]};
   }
@@ -118,14 +128,17 @@ py::dict conform_arrays(const py::handle& points, const py::handle& hexes, const
     try {
       r = conform::conform(model, opts);
     } catch (const InvalidInput& e) {
-      throw InvalidInput(source + ": " + e.what() + conform::duplicate_node_hint(model, "merge_tolerance="));
+      throw InvalidInput(source + ": " + e.what() +
+                         conform::duplicate_node_hint(model, "merge_tolerance="));
     } catch (const TopologyError& e) {
-      throw TopologyError(source + ": " + e.what() + conform::duplicate_node_hint(model, "merge_tolerance="));
+      throw TopologyError(source + ": " + e.what() +
+                          conform::duplicate_node_hint(model, "merge_tolerance="));
     }
   }
   py::dict d;
   d["valid"] = conform::result_valid(r);
-  d["invalid_reason"] = d["valid"].cast<bool>() ? std::string() : source + ": " + conform::invalid_reason(r);
+  d["invalid_reason"] =
+      d["valid"].cast<bool>() ? std::string() : source + ": " + conform::invalid_reason(r);
   d["report"] = to_python(conform::report_json(r));
   d["merged_nodes"] = merged;
   d["model"] = model_dict(std::move(r.model));
@@ -135,10 +148,11 @@ py::dict conform_arrays(const py::handle& points, const py::handle& hexes, const
 }  // namespace
 
 void bind_conform(py::module_& m) {
-  m.def("_conform", &conform_arrays, py::arg("points"), py::arg("hexes"), py::arg("hex_block"), py::arg("tets"),
-        py::arg("tet_block"), py::arg("block_names"), py::arg("node_sets"), py::arg("source"), py::arg("smooth"),
-        py::arg("quality"), py::arg("geode_block"), py::arg("buffer_side"), py::arg("buffer_thickness"),
-        py::arg("smooth_target"), py::arg("template_box"), py::arg("merge_tolerance"));
+  m.def("_conform", &conform_arrays, py::arg("points"), py::arg("hexes"), py::arg("hex_block"),
+        py::arg("tets"), py::arg("tet_block"), py::arg("block_names"), py::arg("node_sets"),
+        py::arg("source"), py::arg("smooth"), py::arg("quality"), py::arg("geode_block"),
+        py::arg("buffer_side"), py::arg("buffer_thickness"), py::arg("smooth_target"),
+        py::arg("template_box"), py::arg("merge_tolerance"));
   m.def(
       "_demo_model",
       [](const std::string& name, int n) {
@@ -151,8 +165,9 @@ void bind_conform(py::module_& m) {
         return model_dict(std::move(model));
       },
       py::arg("name"), py::arg("n"));
-  m.def("demo_model_names", [] { return demo::demo_model_names(); },
-        "The demo models (meshed with the Gmsh API), as `geode demo --model` names them.");
+  m.def(
+      "demo_model_names", [] { return demo::demo_model_names(); },
+      "The demo models (meshed with the Gmsh API), as `geode demo --model` names them.");
 }
 
 }  // namespace geode::python

@@ -2,9 +2,9 @@
 // planar quad mesh) given as arrays, as `geode check` and `geode dual` take files
 // (cli/check_command.cpp, cli/dual_command.cpp). Every id in and out is 0-based.
 #include <algorithm>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <tuple>
-#include <nlohmann/json.hpp>
 
 #include <geode/primal/boundary.hpp>
 #include <geode/primal/isomorphism.hpp>
@@ -13,11 +13,11 @@
 #include <geode/primal/realizability.hpp>
 #include <geode/primal/smooth.hpp>
 #include <geode/primal/validity.hpp>
-#include "python/arrays.hpp"
 #include <geode/stc/arrangement.hpp>
 #include <geode/stc/dualize.hpp>
 #include <geode/stc/mesh_dual.hpp>
 #include <geode/stc/mesh_fields.hpp>
+#include "python/arrays.hpp"
 
 namespace geode::python {
 namespace {
@@ -40,7 +40,8 @@ py::list face_keys(const std::vector<primal::FaceKey>& keys) {
   py::list l;
   for (const auto& k : keys) {
     py::list nodes;
-    for (Index n : k) if (n != primal::kInvalidIndex) nodes.append(n);
+    for (Index n : k)
+      if (n != primal::kInvalidIndex) nodes.append(n);
     l.append(py::tuple(nodes));
   }
   return l;
@@ -55,7 +56,8 @@ py::list edge_keys(const std::vector<primal::EdgeKey>& keys) {
 py::list coverage(const std::vector<primal::NodeCoverage>& nodes) {
   py::list l;
   for (const auto& c : nodes)
-    l.append(py::dict(py::arg("node") = c.node, py::arg("angle") = c.angle, py::arg("expected") = c.expected));
+    l.append(py::dict(py::arg("node") = c.node, py::arg("angle") = c.angle,
+                      py::arg("expected") = c.expected));
   return l;
 }
 
@@ -91,7 +93,8 @@ py::dict check(const py::handle& points, const py::handle& cells, double planar_
     r["inverted_hexes"] = v.inverted_hexes;
     r["overlapping_nodes"] = coverage(v.overlapping_nodes);
     d["report"] = r;
-    const bool analysable = v.out_of_range_hexes.empty() && v.repeated_node_hexes.empty() && !mesh.hexes.empty();
+    const bool analysable =
+        v.out_of_range_hexes.empty() && v.repeated_node_hexes.empty() && !mesh.hexes.empty();
     d["quality"] = py::none();
     d["obstructions"] = py::none();
     if (analysable) {
@@ -132,12 +135,15 @@ py::dict check(const py::handle& points, const py::handle& cells, double planar_
     double lo = 1e300, hi = -1e300;
     Index at = 0;
     for (std::size_t q = 0; q < mesh.quads.size(); ++q) {
-      const double s = primal::quad_scaled_jacobian(primal::quad_corners(mesh, static_cast<Index>(q)), Point::UnitZ());
+      const double s = primal::quad_scaled_jacobian(
+          primal::quad_corners(mesh, static_cast<Index>(q)), Point::UnitZ());
       if (s < lo) lo = s, at = static_cast<Index>(q);
       hi = std::max(hi, s);
     }
-    d["quality"] = to_python({{"num_quads", mesh.quads.size()}, {"scaled_jacobian", {{"min", lo}, {"max", hi}, {"min_quad", at}}}});
-    d["obstructions"] = to_python(primal::obstructions_json(primal::find_obstructions(mesh, options), 0));
+    d["quality"] = to_python({{"num_quads", mesh.quads.size()},
+                              {"scaled_jacobian", {{"min", lo}, {"max", hi}, {"min_quad", at}}}});
+    d["obstructions"] =
+        to_python(primal::obstructions_json(primal::find_obstructions(mesh, options), 0));
   }
   return d;
 }
@@ -155,7 +161,8 @@ py::dict quality(const py::handle& points, const py::handle& hexes, bool per_hex
     py::dict values;
     for (const auto& info : primal::hex_metrics()) {
       std::vector<double> v(mesh.hexes.size());
-      for (std::size_t h = 0; h < v.size(); ++h) v[h] = info.evaluate(primal::hex_corners(mesh, static_cast<Index>(h)));
+      for (std::size_t h = 0; h < v.size(); ++h)
+        v[h] = info.evaluate(primal::hex_corners(mesh, static_cast<Index>(h)));
       values[py::str(std::string(info.key))] = double_array(std::move(v));
     }
     d["per_hex"] = values;
@@ -182,14 +189,16 @@ py::dict dual_dict(const Dual& dual, std::size_t nodes, std::size_t cells) {
     x["trace_pieces"] = sh.trace.size();
     x["closed_trace_pieces"] = closed;
     py::list trace;  // the boundary trace: each piece's boundary edges (ids into "edges") in order
-    for (const auto& t : sh.trace) trace.append(py::dict(py::arg("edges") = t.edges, py::arg("closed") = t.closed));
+    for (const auto& t : sh.trace)
+      trace.append(py::dict(py::arg("edges") = t.edges, py::arg("closed") = t.closed));
     x["trace"] = trace;
     sheets.append(x);
   }
   d["sheets"] = sheets;
   py::list triples;
   for (const auto& [tuple, count] : dual.intersections)
-    triples.append(py::dict(py::arg("sheets") = std::vector<Index>(tuple.begin(), tuple.end()), py::arg("cells") = count));
+    triples.append(py::dict(py::arg("sheets") = std::vector<Index>(tuple.begin(), tuple.end()),
+                            py::arg("cells") = count));
   d["intersections"] = triples;
   std::vector<std::array<Index, 2>> edges = dual.edges;
   std::vector<Index> edge_sheet = dual.edge_sheet;
@@ -198,7 +207,8 @@ py::dict dual_dict(const Dual& dual, std::size_t nodes, std::size_t cells) {
   d["edges"] = py::array(py::cast(edges));
   d["edge_sheet"] = index_array(std::move(edge_sheet));
   constexpr py::ssize_t kDim = std::tuple_size_v<typename decltype(dual.cell_sheets)::value_type>;
-  d["cell_sheets"] = index_array(std::move(cell_sheets)).reshape({static_cast<py::ssize_t>(dual.cell_sheets.size()), kDim});
+  d["cell_sheets"] = index_array(std::move(cell_sheets))
+                         .reshape({static_cast<py::ssize_t>(dual.cell_sheets.size()), kDim});
   return d;
 }
 
@@ -208,8 +218,10 @@ py::dict dual(const py::handle& points, const py::handle& cells, bool rebuild) {
   const bool hexes = cell_width(cells, "cells") == 8;
   primal::HexMesh hex;
   primal::QuadMesh quad;
-  if (hexes) hex = hex_mesh(points, cells);
-  else quad = quad_mesh(points, cells);
+  if (hexes)
+    hex = hex_mesh(points, cells);
+  else
+    quad = quad_mesh(points, cells);
   py::dict d;
   stc::DualMesh D;
   {
@@ -217,16 +229,20 @@ py::dict dual(const py::handle& points, const py::handle& cells, bool rebuild) {
     std::optional<stc::QuadDual> qd;
     {
       py::gil_scoped_release free;
-      if (hexes) hd = stc::mesh_dual(hex);
-      else qd = stc::mesh_dual(quad);
+      if (hexes)
+        hd = stc::mesh_dual(hex);
+      else
+        qd = stc::mesh_dual(quad);
     }
-    d = hexes ? dual_dict(*hd, hex.points.size(), hex.hexes.size()) : dual_dict(*qd, quad.points.size(), quad.quads.size());
+    d = hexes ? dual_dict(*hd, hex.points.size(), hex.hexes.size())
+              : dual_dict(*qd, quad.points.size(), quad.quads.size());
   }
   d["dimension"] = hexes ? 3 : 2;
   if (!rebuild) return d;
   {
     py::gil_scoped_release free;
-    const stc::MeshArrangementInput fields = hexes ? stc::sheet_fields(hex) : stc::sheet_fields(quad);
+    const stc::MeshArrangementInput fields =
+        hexes ? stc::sheet_fields(hex) : stc::sheet_fields(quad);
     D = stc::dualize(stc::compute_arrangement(fields.sheets, fields.domain));
   }
   py::dict r;
@@ -245,8 +261,10 @@ py::dict dual(const py::handle& points, const py::handle& cells, bool rebuild) {
 // Which nodes may move: "fixed" boundary (default), "free", or "box": nodes on the faces of the
 // bounding box slide in them (along box edges, box corners fixed); `fixed` nodes never move.
 template <class Mesh>
-std::vector<primal::NodeConstraint> constraints(const Mesh& mesh, const std::vector<Index>& boundary_nodes,
-                                                const std::string& boundary, const std::vector<Index>& fixed) {
+std::vector<primal::NodeConstraint> constraints(const Mesh& mesh,
+                                                const std::vector<Index>& boundary_nodes,
+                                                const std::string& boundary,
+                                                const std::vector<Index>& fixed) {
   std::vector<primal::NodeConstraint> c(mesh.points.size(), primal::NodeConstraint::free());
   if (boundary == "box") {
     Eigen::AlignedBox3d box;
@@ -315,7 +333,8 @@ py::object isomorphism(const py::handle& a, const py::handle& b, const py::objec
     l.first = pair.first, l.second = pair.second;
   }
   const int k = cell_width(a, "a");
-  if (cell_width(b, "b") != k) throw InvalidInput("isomorphism: a and b must both be hexes or both quads");
+  if (cell_width(b, "b") != k)
+    throw InvalidInput("isomorphism: a and b must both be hexes or both quads");
   std::optional<primal::MeshMapping> map;
   auto nodes = [](const auto& cells) {
     Index n = 0;
@@ -326,13 +345,15 @@ py::object isomorphism(const py::handle& a, const py::handle& b, const py::objec
   if (k == 8) {
     primal::HexMesh x, y;
     x.hexes = to_cells<8>(a, "a"), y.hexes = to_cells<8>(b, "b");
-    x.points.resize(static_cast<std::size_t>(nodes(x.hexes))), y.points.resize(static_cast<std::size_t>(nodes(y.hexes)));
+    x.points.resize(static_cast<std::size_t>(nodes(x.hexes))),
+        y.points.resize(static_cast<std::size_t>(nodes(y.hexes)));
     py::gil_scoped_release free;
     map = primal::find_isomorphism(x, y, l);
   } else {
     primal::QuadMesh x, y;
     x.quads = to_cells<4>(a, "a"), y.quads = to_cells<4>(b, "b");
-    x.points.resize(static_cast<std::size_t>(nodes(x.quads))), y.points.resize(static_cast<std::size_t>(nodes(y.quads)));
+    x.points.resize(static_cast<std::size_t>(nodes(x.quads))),
+        y.points.resize(static_cast<std::size_t>(nodes(y.quads)));
     py::gil_scoped_release free;
     map = primal::find_isomorphism(x, y, l);
   }
@@ -347,21 +368,30 @@ py::object isomorphism(const py::handle& a, const py::handle& b, const py::objec
 
 void bind_mesh(py::module_& m) {
   m.def("check", &check, py::arg("points"), py::arg("cells"), py::arg("planar_angle") = 1.0,
-        "Validity (faces shared by two hexes, manifold, closed boundary, positive Jacobians, covering), quality and "
-        "the combinatorial obstructions to untangling of a hex (M x 8) or planar quad (M x 4, z = 0) mesh; ids 0-based.");
+        "Validity (faces shared by two hexes, manifold, closed boundary, positive Jacobians, "
+        "covering), quality and "
+        "the combinatorial obstructions to untangling of a hex (M x 8) or planar quad (M x 4, z = "
+        "0) mesh; ids 0-based.");
   m.def("quality", &quality, py::arg("points"), py::arg("hexes"), py::arg("per_hex") = false,
-        "The paper's Table 1 metrics (Verdict definitions) over the hexes: {'metrics': [...], 'table': text}, and with "
+        "The paper's Table 1 metrics (Verdict definitions) over the hexes: {'metrics': [...], "
+        "'table': text}, and with "
         "per_hex=True {'per_hex': {key: array}}.");
   m.def("dual", &dual, py::arg("points"), py::arg("cells"), py::arg("rebuild") = false,
-        "The mesh's sheets (chords in 2D), their crossings and traces, and the cells per sheet triple; rebuild=True also "
-        "rebuilds the mesh from those sheets through the arrangement engine ({'rebuild': {'points', 'cells'}}).");
+        "The mesh's sheets (chords in 2D), their crossings and traces, and the cells per sheet "
+        "triple; rebuild=True also "
+        "rebuilds the mesh from those sheets through the arrangement engine ({'rebuild': "
+        "{'points', 'cells'}}).");
   m.def("smooth", &smooth, py::arg("points"), py::arg("cells"), py::arg("boundary") = "fixed",
         py::arg("fixed") = std::vector<Index>{}, py::arg("max_iterations") = 3000,
-        "Untangle, then maximise the minimum scaled Jacobian (primal/smooth.hpp). boundary: 'fixed' (default), 'free', "
-        "or 'box' (nodes slide in the faces of the bounding box); `fixed` nodes stay. Returns {'points', ...}.");
+        "Untangle, then maximise the minimum scaled Jacobian (primal/smooth.hpp). boundary: "
+        "'fixed' (default), 'free', "
+        "or 'box' (nodes slide in the faces of the bounding box); `fixed` nodes stay. Returns "
+        "{'points', ...}.");
   m.def("isomorphism", &isomorphism, py::arg("a"), py::arg("b"), py::arg("labels") = py::none(),
-        "A combinatorial isomorphism between two hex (or quad) meshes given by their cells, each cell mapped as the "
-        "same cube: {'node_map', 'cell_map'} (a -> b), or None. labels=(first, second): nodes keep their label.");
+        "A combinatorial isomorphism between two hex (or quad) meshes given by their cells, each "
+        "cell mapped as the "
+        "same cube: {'node_map', 'cell_map'} (a -> b), or None. labels=(first, second): nodes keep "
+        "their label.");
 }
 
 }  // namespace geode::python

@@ -13,8 +13,8 @@
 namespace geode::python {
 namespace {
 
-py::object new_exception(py::module_& m, const char* name, py::handle bases, const char* kind, int exit_code,
-                         const char* doc) {
+py::object new_exception(py::module_& m, const char* name, py::handle bases, const char* kind,
+                         int exit_code, const char* doc) {
   const std::string full = std::string("geode.") + name;
   PyObject* type = PyErr_NewExceptionWithDoc(full.c_str(), doc, bases.ptr(), nullptr);
   if (!type) throw py::error_already_set();
@@ -32,17 +32,19 @@ PYBIND11_MODULE(_geode, m) {
   using namespace geode::python;
   m.doc() = "geode: all-hex meshing through the dual sheet arrangement (C++ core)";
   m.attr("__version__") = GEODE_VERSION;
-  py::object error = new_exception(m, "Error", PyExc_Exception, "error", 1, "A geode failure; see kind and exit_code.");
+  py::object error = new_exception(m, "Error", PyExc_Exception, "error", 1,
+                                   "A geode failure; see kind and exit_code.");
   // Kept for the life of the process (the translator outlives any module object).
   static PyObject* input_error =
-      new_exception(m, "InputError", py::make_tuple(error, py::handle(PyExc_ValueError)), "input", 2,
-                    "Bad input: the message names the argument, element or node.")
+      new_exception(m, "InputError", py::make_tuple(error, py::handle(PyExc_ValueError)), "input",
+                    2, "Bad input: the message names the argument, element or node.")
           .release()
           .ptr();
-  static PyObject* topology_error = new_exception(m, "TopologyError", py::make_tuple(error), "topology", 3,
-                                                  "Well-formed input that is topologically unusable (the diagnosis).")
-                                        .release()
-                                        .ptr();
+  static PyObject* topology_error =
+      new_exception(m, "TopologyError", py::make_tuple(error), "topology", 3,
+                    "Well-formed input that is topologically unusable (the diagnosis).")
+          .release()
+          .ptr();
   new_exception(m, "InvalidResultError", py::make_tuple(error), "invalid result", 4,
                 "A computed result that fails verification.");
   py::register_exception_translator([](std::exception_ptr p) {

@@ -11,16 +11,16 @@
 #include <sstream>
 
 #include <geode/primal/boundary.hpp>
-#include <geode/viewer/html.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/quality_report.hpp>
-#include "python/arrays.hpp"
 #include <geode/stc/sheet_surfaces.hpp>
 #include <geode/templates/fixup.hpp>
 #include <geode/templates/geode.hpp>
 #include <geode/templates/refine.hpp>
 #include <geode/templates/spec.hpp>
 #include <geode/templates/study.hpp>
+#include <geode/viewer/html.hpp>
+#include "python/arrays.hpp"
 
 namespace geode::python {
 namespace {
@@ -42,11 +42,15 @@ struct TemplateEntry {
 const std::vector<TemplateEntry>& template_table() {
   using templates::TopSplit;
   static const std::vector<TemplateEntry> table{
-      {"geode3d", 3, Family::kGeode, TopSplit::TwoTriangles, "the 26-hex geode (tet side in 2 triangles)"},
+      {"geode3d", 3, Family::kGeode, TopSplit::TwoTriangles,
+       "the 26-hex geode (tet side in 2 triangles)"},
       {"geode2d", 2, Family::kGeode, TopSplit::TwoTriangles, "the 5-quad 2D geode"},
-      {"geode4tri", 3, Family::kGeode, TopSplit::FourTriangles, "the tet side in 4 triangles, fixed up"},
-      {"refine3", 3, Family::kRefine, TopSplit::TwoTriangles, "one coarse quad over 3 x 3 fine (13 hexes)"},
-      {"refine3-2d", 2, Family::kRefine, TopSplit::TwoTriangles, "one coarse edge over three fine (4 quads)"}};
+      {"geode4tri", 3, Family::kGeode, TopSplit::FourTriangles,
+       "the tet side in 4 triangles, fixed up"},
+      {"refine3", 3, Family::kRefine, TopSplit::TwoTriangles,
+       "one coarse quad over 3 x 3 fine (13 hexes)"},
+      {"refine3-2d", 2, Family::kRefine, TopSplit::TwoTriangles,
+       "one coarse edge over three fine (4 quads)"}};
   return table;
 }
 
@@ -106,9 +110,11 @@ void smooth(TemplateResult& r, bool slide) {
   }
   const auto obstructions = templates::template_obstructions(r.t);
   if (!r.smoothing->untangled)
-    r.warnings.push_back("smoothing could not untangle every element; " +
-                         (obstructions.empty() ? std::string("no combinatorial obstruction found")
-                                               : "no placement can: " + primal::format_obstructions(obstructions, r.t.dim, 0)));
+    r.warnings.push_back(
+        "smoothing could not untangle every element; " +
+        (obstructions.empty()
+             ? std::string("no combinatorial obstruction found")
+             : "no placement can: " + primal::format_obstructions(obstructions, r.t.dim, 0)));
   else if (!obstructions.empty())
     r.warnings.push_back("every corner Jacobian is positive, but the cells overlap: " +
                          primal::format_obstructions(obstructions, r.t.dim, 0));
@@ -125,7 +131,8 @@ void note_conditions(TemplateResult& r) {
 // with its layer of cells (as `geode template --format html` draws them).
 std::vector<viewer::ViewSheet> view_sheets(const TemplateResult& r) {
   std::vector<viewer::ViewSheet> out(r.sheets.size());
-  for (std::size_t s = 0; s < r.sheets.size(); ++s) out[s].name = r.sheets[s].name, out[s].kind = r.sheets[s].kind;
+  for (std::size_t s = 0; s < r.sheets.size(); ++s)
+    out[s].name = r.sheets[s].name, out[s].kind = r.sheets[s].kind;
   if (r.domain.dim == 3) {
     auto surfaces = stc::contour_sheets(r.sheets, r.domain);
     for (std::size_t s = 0; s < out.size(); ++s) {
@@ -144,7 +151,8 @@ std::vector<viewer::ViewSheet> view_sheets(const TemplateResult& r) {
   }
   for (std::size_t e = 0; e < r.t.element_sheets.size(); ++e)
     for (int s : r.t.element_sheets[e])
-      if (s >= 0 && static_cast<std::size_t>(s) < out.size()) out[static_cast<std::size_t>(s)].layer.push_back(static_cast<Index>(e));
+      if (s >= 0 && static_cast<std::size_t>(s) < out.size())
+        out[static_cast<std::size_t>(s)].layer.push_back(static_cast<Index>(e));
   return out;
 }
 
@@ -153,18 +161,21 @@ std::string template_html(const TemplateResult& r) {
   viewer::ViewScene scene;
   scene.title = "geode template " + r.name;
   std::ostringstream caption;
-  caption << r.caption << ": " << (T.dim == 3 ? T.hex.hexes.size() : T.quad.quads.size()) << (T.dim == 3 ? " hexes" : " quads");
+  caption << r.caption << ": " << (T.dim == 3 ? T.hex.hexes.size() : T.quad.quads.size())
+          << (T.dim == 3 ? " hexes" : " quads");
   if (r.smoothing)
-    caption << ", smoothed: min scaled Jacobian " << r.smoothing->initial_min_scaled_jacobian << " -> "
-            << r.smoothing->final_min_scaled_jacobian;
+    caption << ", smoothed: min scaled Jacobian " << r.smoothing->initial_min_scaled_jacobian
+            << " -> " << r.smoothing->final_min_scaled_jacobian;
   else
     caption << ", not smoothed";
-  caption << ". Sheets: the arrangement's fields contoured in the cell (marching tetrahedra), mapped like the nodes; "
+  caption << ". Sheets: the arrangement's fields contoured in the cell (marching tetrahedra), "
+             "mapped like the nodes; "
              "the smoothed cells need not follow them. Layers: the cells dual to each sheet.";
   scene.caption = caption.str();
   scene.sheets = view_sheets(r);
   if (T.dim == 2) return viewer::html_view(T.quad, scene);
-  // The tet and hex sides as face groups (the paper's Figure 1), when the template knows its box faces.
+  // The tet and hex sides as face groups (the paper's Figure 1), when the template knows its box
+  // faces.
   if (T.node_faces.size() == T.hex.points.size()) {
     viewer::ViewFaceGroup tet{"tet side", {}}, hex{"hex side", {}};
     for (const auto& q : primal::boundary_quads(T.hex)) {
@@ -188,10 +199,11 @@ Eigen::Vector3d parse_box(const py::handle& box, int dim) {
     throw InvalidInput("template: box must be a sequence of numbers");
   }
   if (b.size() != static_cast<std::size_t>(dim))
-    throw InvalidInput("template: box has " + std::to_string(b.size()) + " numbers for a " + std::to_string(dim) +
-                       "D template");
+    throw InvalidInput("template: box has " + std::to_string(b.size()) + " numbers for a " +
+                       std::to_string(dim) + "D template");
   for (double x : b)
-    if (!std::isfinite(x) || x <= 0) throw InvalidInput("template: every box dimension must be positive and finite");
+    if (!std::isfinite(x) || x <= 0)
+      throw InvalidInput("template: every box dimension must be positive and finite");
   return {b[0], b[1], dim == 3 ? b[2] : b[0]};
 }
 
@@ -204,17 +216,19 @@ struct PushArgs {
 PushArgs parse_push(const py::dict& kwargs, bool refine) {
   PushArgs a;
   auto& p = a.push;
-  const std::map<std::string, double*> numbers{{"high_roof", &p.high_roof},           {"low_roof", &p.low_roof},
-                                               {"dome_depth", &p.dome_depth},         {"dome_radius", &p.dome_radius},
-                                               {"centre_depth", &p.centre_depth},     {"centre_radius", &p.centre_radius},
-                                               {"dome_exponent", &p.dome_exponent},   {"centre_exponent", &p.centre_exponent},
-                                               {"dome_offset", &p.dome_offset}};
+  const std::map<std::string, double*> numbers{
+      {"high_roof", &p.high_roof},         {"low_roof", &p.low_roof},
+      {"dome_depth", &p.dome_depth},       {"dome_radius", &p.dome_radius},
+      {"centre_depth", &p.centre_depth},   {"centre_radius", &p.centre_radius},
+      {"dome_exponent", &p.dome_exponent}, {"centre_exponent", &p.centre_exponent},
+      {"dome_offset", &p.dome_offset}};
   for (const auto& [k, v] : kwargs) {
     const std::string key = k.cast<std::string>();
     try {
       if (key == "centre_offset") {
         const auto xz = v.cast<std::vector<double>>();
-        if (xz.size() != 2) throw InvalidInput("template: centre_offset must be two numbers (x, z)");
+        if (xz.size() != 2)
+          throw InvalidInput("template: centre_offset must be two numbers (x, z)");
         p.centre_offset = {xz[0], xz[1]};
       } else if (key == "layer") {
         if (!refine) throw InvalidInput("template: layer is refine3's parameter");
@@ -226,7 +240,8 @@ PushArgs parse_push(const py::dict& kwargs, bool refine) {
       } else {
         std::string names = "centre_offset, layer";
         for (const auto& [n, _] : numbers) names += ", " + n;
-        throw InvalidInput("template: unknown push parameter '" + key + "' (expected " + names + ")");
+        throw InvalidInput("template: unknown push parameter '" + key + "' (expected " + names +
+                           ")");
       }
     } catch (const py::cast_error&) {
       throw InvalidInput("template: " + key + " must be a number");
@@ -238,13 +253,16 @@ PushArgs parse_push(const py::dict& kwargs, bool refine) {
 }
 
 std::unique_ptr<TemplateResult> make_template(const std::string& name, const py::handle& box_arg,
-                                              const std::string& diagonal, const std::string& higher, bool smooth_it,
-                                              bool slide, bool fixup, const py::dict& kwargs) {
+                                              const std::string& diagonal,
+                                              const std::string& higher, bool smooth_it, bool slide,
+                                              bool fixup, const py::dict& kwargs) {
   const TemplateEntry& entry = find_template(name);
-  if (diagonal != "main" && diagonal != "anti") throw InvalidInput("template: diagonal must be 'main' or 'anti'");
+  if (diagonal != "main" && diagonal != "anti")
+    throw InvalidInput("template: diagonal must be 'main' or 'anti'");
   if (higher != "x" && higher != "z") throw InvalidInput("template: higher must be 'x' or 'z'");
   const int dim = entry.dim;
-  const Eigen::Vector3d box = box_arg.is_none() ? Eigen::Vector3d(24, 14, 24) : parse_box(box_arg, dim);
+  const Eigen::Vector3d box =
+      box_arg.is_none() ? Eigen::Vector3d(24, 14, 24) : parse_box(box_arg, dim);
   const PushArgs push = parse_push(kwargs, entry.family == Family::kRefine);
   auto r = std::make_unique<TemplateResult>();
   r->name = name;
@@ -265,7 +283,9 @@ std::unique_ptr<TemplateResult> make_template(const std::string& name, const py:
       r->spec = templates::spec_json(spec);
       r->sheets = templates::spec_sheets(spec), r->domain = spec.domain;
       r->t = dim == 3 ? templates::build_refine3(ro) : templates::build_refine3_2d(ro);
-      r->smoother = [ro](templates::Template& t, bool s) { return templates::smooth_refine3(t, ro, !s); };
+      r->smoother = [ro](templates::Template& t, bool s) {
+        return templates::smooth_refine3(t, ro, !s);
+      };
     } else {
       templates::GeodeOptions o;
       o.box = box;
@@ -279,12 +299,14 @@ std::unique_ptr<TemplateResult> make_template(const std::string& name, const py:
       const templates::GeodeArrangement G = templates::geode_arrangement(o, dim);
       r->sheets = G.sheets, r->domain = G.domain;
       r->to_physical = [box, dim](const Point& p) { return templates::box_point(p, box, dim); };
-      if (entry.split == templates::TopSplit::FourTriangles && fixup) r->fixup = templates::fix_up(r->t);
+      if (entry.split == templates::TopSplit::FourTriangles && fixup)
+        r->fixup = templates::fix_up(r->t);
     }
   }
   note_conditions(*r);
   if (r->fixup && r->fixup->obstructions_after > 0)
-    r->warnings.push_back("fix-up left " + std::to_string(r->fixup->obstructions_after) + " obstructions");
+    r->warnings.push_back("fix-up left " + std::to_string(r->fixup->obstructions_after) +
+                          " obstructions");
   if (smooth_it) smooth(*r, slide);
   return r;
 }
@@ -298,7 +320,8 @@ nlohmann::json spec_argument(const py::handle& spec, std::string& source, std::s
     return to_json(spec, "spec");
   }
   if (py::isinstance<py::str>(spec) || py::hasattr(spec, "__fspath__")) {
-    const fs::path path(py::str(py::module_::import("os").attr("fspath")(spec)).cast<std::string>());
+    const fs::path path(
+        py::str(py::module_::import("os").attr("fspath")(spec)).cast<std::string>());
     source = path.filename().string(), stem = path.stem().string();
     return templates::read_spec_json(path);
   }
@@ -331,17 +354,20 @@ std::unique_ptr<TemplateResult> arrange(const py::handle& spec_arg, bool smooth_
 
 py::dict push_dict(const templates::PushParameters& p) {
   py::dict d;
-  d["high_roof"] = p.high_roof, d["low_roof"] = p.low_roof, d["dome_depth"] = p.dome_depth, d["dome_radius"] = p.dome_radius;
+  d["high_roof"] = p.high_roof, d["low_roof"] = p.low_roof, d["dome_depth"] = p.dome_depth,
+  d["dome_radius"] = p.dome_radius;
   return d;
 }
 
-py::tuple study_interleave(const py::handle& spec_arg, const py::object& sweep, const py::object& progress) {
+py::tuple study_interleave(const py::handle& spec_arg, const py::object& sweep,
+                           const py::object& progress) {
   std::string source, stem;
   nlohmann::json spec;
   if (py::isinstance<py::str>(spec_arg) && !fs::exists(spec_arg.cast<std::string>())) {
     // A built-in geode template by name: its spec, swept the same way.
     const TemplateEntry& e = find_template(spec_arg.cast<std::string>());
-    if (e.family != Family::kGeode) throw InvalidInput("study_interleave: " + std::string(e.name) + " has no push to sweep");
+    if (e.family != Family::kGeode)
+      throw InvalidInput("study_interleave: " + std::string(e.name) + " has no push to sweep");
     templates::GeodeOptions o;
     o.split = e.split;
     spec = templates::spec_json(templates::geode_spec(o, e.dim));
@@ -352,7 +378,8 @@ py::tuple study_interleave(const py::handle& spec_arg, const py::object& sweep, 
   templates::parse_spec(spec, source);  // the unswept spec must be valid too
   std::vector<templates::SweepAxis> axes = templates::spec_sweep(spec, source);
   if (!sweep.is_none()) {
-    if (!py::isinstance<py::dict>(sweep)) throw InvalidInput("study_interleave: sweep must be a dict {path: values}");
+    if (!py::isinstance<py::dict>(sweep))
+      throw InvalidInput("study_interleave: sweep must be a dict {path: values}");
     for (const auto& [k, v] : sweep.cast<py::dict>()) {
       const std::string path = k.cast<std::string>();
       templates::SweepAxis axis;
@@ -367,11 +394,16 @@ py::tuple study_interleave(const py::handle& spec_arg, const py::object& sweep, 
       }
       nlohmann::json probe = spec;
       templates::set_spec_number(probe, axis.path, axis.values.front(), source);
-      auto same = std::find_if(axes.begin(), axes.end(), [&](const auto& x) { return x.path == axis.path; });
-      if (same != axes.end()) *same = axis; else axes.push_back(axis);
+      auto same = std::find_if(axes.begin(), axes.end(),
+                               [&](const auto& x) { return x.path == axis.path; });
+      if (same != axes.end())
+        *same = axis;
+      else
+        axes.push_back(axis);
     }
   }
-  if (axes.empty()) throw InvalidInput(source + ": nothing to sweep (give sweep={path: values} or a sweep block)");
+  if (axes.empty())
+    throw InvalidInput(source + ": nothing to sweep (give sweep={path: values} or a sweep block)");
   templates::StudyProgress report;
   if (!progress.is_none())
     report = [&progress](const std::string& what, std::size_t done, std::size_t total) {
@@ -383,7 +415,8 @@ py::tuple study_interleave(const py::handle& spec_arg, const py::object& sweep, 
     py::gil_scoped_release free;
     study = templates::interleave_study(spec, source, axes, stem, report);
   }
-  if (study.runs.empty()) throw InvalidInput(source + ": every sweep point is invalid input (e.g. low roof above high)");
+  if (study.runs.empty())
+    throw InvalidInput(source + ": every sweep point is invalid input (e.g. low roof above high)");
   py::list runs, classes;
   for (const auto& r : study.runs) {
     py::dict d = push_dict(r.push);
@@ -393,7 +426,8 @@ py::tuple study_interleave(const py::handle& spec_arg, const py::object& sweep, 
     d["conditions_ok"] = r.valid ? py::object(py::bool_(r.conditions_ok)) : py::object(py::none());
     d["diagnosis"] = r.valid ? r.conditions : r.diagnosis;
     d["seconds"] = r.seconds;
-    for (std::size_t i = 0; i < r.parameters.size(); ++i) d[py::str(study.parameter_names[i])] = r.parameters[i];
+    for (std::size_t i = 0; i < r.parameters.size(); ++i)
+      d[py::str(study.parameter_names[i])] = r.parameters[i];
     runs.append(d);
   }
   for (const auto& c : study.classes) {
@@ -403,9 +437,11 @@ py::tuple study_interleave(const py::handle& spec_arg, const py::object& sweep, 
     d["count"] = c.count;
     d["hexes"] = c.hexes;
     d["conditions_ok"] = c.conditions_ok;
-    for (const auto& [k, v] : push_dict(c.example)) d[py::str("example_" + k.cast<std::string>())] = v;
+    for (const auto& [k, v] : push_dict(c.example))
+      d[py::str("example_" + k.cast<std::string>())] = v;
     d["key"] = c.key;
-    d["obstructions"] = c.valid ? py::object(obstructions_list(c.obstructions)) : py::object(py::none());
+    d["obstructions"] =
+        c.valid ? py::object(obstructions_list(c.obstructions)) : py::object(py::none());
     d["min_sj_fixed"] = c.valid ? py::object(py::float_(c.min_sj_fixed)) : py::object(py::none());
     d["min_sj_slide"] = c.valid ? py::object(py::float_(c.min_sj_slide)) : py::object(py::none());
     d["usable"] = c.valid ? py::object(py::bool_(c.usable)) : py::object(py::none());
@@ -419,36 +455,45 @@ py::tuple study_interleave(const py::handle& spec_arg, const py::object& sweep, 
 }  // namespace
 
 void bind_templates(py::module_& m) {
-  py::class_<TemplateResult>(m, "Template",
-                             "A template derived from its sheet arrangement: the mesh (points, cells), its sheets and "
-                             "their triples, the paper's conditions, quality; every id 0-based.")
+  py::class_<TemplateResult>(
+      m, "Template",
+      "A template derived from its sheet arrangement: the mesh (points, cells), its sheets and "
+      "their triples, the paper's conditions, quality; every id 0-based.")
       .def_readonly("name", &TemplateResult::name)
       .def_property_readonly("dim", [](const TemplateResult& r) { return r.t.dim; })
       // Copies (templates are small): fix_up() changes the mesh, which would leave a view dangling.
       .def_property_readonly(
-          "points", [](const TemplateResult& r) {
-            return points_array(std::vector<Point>(r.t.dim == 3 ? r.t.hex.points : r.t.quad.points));
+          "points",
+          [](const TemplateResult& r) {
+            return points_array(
+                std::vector<Point>(r.t.dim == 3 ? r.t.hex.points : r.t.quad.points));
           },
           "N x 3 float64 node positions (z = 0 in 2D)")
       .def_property_readonly(
-          "cells", [](const TemplateResult& r) {
-            return r.t.dim == 3 ? cells_array<8>(std::vector(r.t.hex.hexes)) : cells_array<4>(std::vector(r.t.quad.quads));
+          "cells",
+          [](const TemplateResult& r) {
+            return r.t.dim == 3 ? cells_array<8>(std::vector(r.t.hex.hexes))
+                                : cells_array<4>(std::vector(r.t.quad.quads));
           },
           "M x 8 hexes (VTK order) in 3D, M x 4 quads (counter-clockwise) in 2D, int32, 0-based")
       .def_property_readonly(
-          "hexes", [](const TemplateResult& r) -> py::object {
+          "hexes",
+          [](const TemplateResult& r) -> py::object {
             if (r.t.dim != 3) return py::none();
             return cells_array<8>(std::vector(r.t.hex.hexes));
           },
           "M x 8 int32 hexes in VTK order (None for a 2D template)")
-      .def_property_readonly("quads", [](const TemplateResult& r) -> py::object {
-        if (r.t.dim != 2) return py::none();
-        return cells_array<4>(std::vector(r.t.quad.quads));
-      })
+      .def_property_readonly("quads",
+                             [](const TemplateResult& r) -> py::object {
+                               if (r.t.dim != 2) return py::none();
+                               return cells_array<4>(std::vector(r.t.quad.quads));
+                             })
       .def_property_readonly(
-          "sheets", [](const TemplateResult& r) {
+          "sheets",
+          [](const TemplateResult& r) {
             py::list l;
-            for (const auto& s : r.t.sheets) l.append(py::dict(py::arg("name") = s.name, py::arg("kind") = s.kind));
+            for (const auto& s : r.t.sheets)
+              l.append(py::dict(py::arg("name") = s.name, py::arg("kind") = s.kind));
             return l;
           },
           "the arrangement's sheets: [{'name', 'kind'}] (tunnels, then domes)")
@@ -456,7 +501,8 @@ void bind_templates(py::module_& m) {
           "element_sheets", [](const TemplateResult& r) { return r.t.element_sheets; },
           "per cell, the sheets (indices into sheets) meeting at its vertex")
       .def_property_readonly(
-          "triples", [](const TemplateResult& r) {
+          "triples",
+          [](const TemplateResult& r) {
             std::map<std::vector<int>, int> table;
             for (const auto& e : r.t.element_sheets) ++table[e];
             py::list l;
@@ -467,9 +513,11 @@ void bind_templates(py::module_& m) {
             }
             return l;
           },
-          "the sheet triples (pairs in 2D) of the arrangement, each with the number of cells where they meet")
+          "the sheet triples (pairs in 2D) of the arrangement, each with the number of cells where "
+          "they meet")
       .def_property_readonly(
-          "conditions", [](const TemplateResult& r) -> py::object {
+          "conditions",
+          [](const TemplateResult& r) -> py::object {
             if (!r.check_conditions) return py::none();
             const auto& c = r.t.checks;
             py::dict d;
@@ -487,12 +535,14 @@ void bind_templates(py::module_& m) {
           "node_faces", [](const TemplateResult& r) { return py::array(py::cast(r.t.node_faces)); },
           "per node, the box faces it lies on as bits (bit 2 * axis + high side; y is up)")
       .def_property_readonly(
-          "quality", [](const TemplateResult& r) {
+          "quality",
+          [](const TemplateResult& r) {
             py::dict d;
             if (r.t.dim == 2) {
               std::vector<double> sj;
               for (std::size_t q = 0; q < r.t.quad.quads.size(); ++q)
-                sj.push_back(primal::quad_scaled_jacobian(primal::quad_corners(r.t.quad, static_cast<Index>(q)), Point::UnitZ()));
+                sj.push_back(primal::quad_scaled_jacobian(
+                    primal::quad_corners(r.t.quad, static_cast<Index>(q)), Point::UnitZ()));
               d["scaled_jacobian"] = double_array(std::move(sj));
               return d;
             }
@@ -504,15 +554,18 @@ void bind_templates(py::module_& m) {
             }
             return d;
           },
-          "per cell quality: {metric key: array} (Verdict definitions, the paper's Table 1 metrics; 2D: the scaled Jacobian)")
+          "per cell quality: {metric key: array} (Verdict definitions, the paper's Table 1 "
+          "metrics; 2D: the scaled Jacobian)")
       .def_property_readonly(
-          "smoothing", [](const TemplateResult& r) -> py::object {
+          "smoothing",
+          [](const TemplateResult& r) -> py::object {
             if (!r.smoothing) return py::none();
             return smooth_dict(*r.smoothing);
           },
           "what the last smoothing did (None when not smoothed)")
       .def_property_readonly(
-          "fixup", [](const TemplateResult& r) -> py::object {
+          "fixup",
+          [](const TemplateResult& r) -> py::object {
             if (!r.fixup) return py::none();
             py::dict d;
             d["obstructions_before"] = r.fixup->obstructions_before;
@@ -526,7 +579,10 @@ void bind_templates(py::module_& m) {
           "spec", [](const TemplateResult& r) { return to_python(r.spec); },
           "the arrangement as a spec dict (geode.arrange's input), or None")
       .def(
-          "obstructions", [](const TemplateResult& r) { return obstructions_list(templates::template_obstructions(r.t)); },
+          "obstructions",
+          [](const TemplateResult& r) {
+            return obstructions_list(templates::template_obstructions(r.t));
+          },
           "the combinatorial obstructions to untangling it (planar faces: its box faces), 0-based")
       .def(
           "fix_up",
@@ -544,34 +600,44 @@ void bind_templates(py::module_& m) {
             d["steps"] = f.steps;
             return d;
           },
-          "pillow small shrink sets of the obstructions away (templates/fixup.hpp); the boundary is kept")
+          "pillow small shrink sets of the obstructions away (templates/fixup.hpp); the boundary "
+          "is kept")
       .def(
-          "smooth", [](TemplateResult& r, bool slide) {
+          "smooth",
+          [](TemplateResult& r, bool slide) {
             smooth(r, slide);
             return smooth_dict(*r.smoothing);
           },
           py::arg("slide") = false,
-          "place the free nodes by optimization (tet- and hex-side nodes fixed, or sliding in their faces)")
-      .def("quality_report", [](const TemplateResult& r) -> py::object {
-        if (r.t.dim != 3) throw InvalidInput(r.name + ": the quality report is for hexes");
-        const auto q = primal::hex_quality_report(r.t.hex);
-        py::dict d = to_python(primal::quality_report_json(q));
-        d["table"] = primal::format_quality_table(q);
-        return d;
-      }, "the paper's Table 1 over the hexes: {'metrics': [...], 'table': text}")
-      .def("html", &template_html, "the self-contained viewer page (three.js inlined): cells, sheets, layers, quality");
+          "place the free nodes by optimization (tet- and hex-side nodes fixed, or sliding in "
+          "their faces)")
+      .def(
+          "quality_report",
+          [](const TemplateResult& r) -> py::object {
+            if (r.t.dim != 3) throw InvalidInput(r.name + ": the quality report is for hexes");
+            const auto q = primal::hex_quality_report(r.t.hex);
+            py::dict d = to_python(primal::quality_report_json(q));
+            d["table"] = primal::format_quality_table(q);
+            return d;
+          },
+          "the paper's Table 1 over the hexes: {'metrics': [...], 'table': text}")
+      .def("html", &template_html,
+           "the self-contained viewer page (three.js inlined): cells, sheets, layers, quality");
 
-  m.def("_template", &make_template, py::arg("name"), py::arg("box"), py::arg("diagonal"), py::arg("higher"),
-        py::arg("smooth"), py::arg("slide"), py::arg("fixup"), py::arg("push"));
+  m.def("_template", &make_template, py::arg("name"), py::arg("box"), py::arg("diagonal"),
+        py::arg("higher"), py::arg("smooth"), py::arg("slide"), py::arg("fixup"), py::arg("push"));
   m.def("_template_names", [] {
     py::dict d;
     for (const auto& e : template_table()) d[e.name] = e.what;
     return d;
   });
-  m.def("arrange", &arrange, py::arg("spec"), py::arg("smooth") = false, py::arg("slide") = false,
-        "Compute the arrangement of a spec's sheets (a dict or a JSON file, the format of `geode arrange`), "
-        "dualize it and return the Template; smooth places the nodes by optimization (box domains).");
-  m.def("_study_interleave", &study_interleave, py::arg("spec"), py::arg("sweep"), py::arg("progress"));
+  m.def(
+      "arrange", &arrange, py::arg("spec"), py::arg("smooth") = false, py::arg("slide") = false,
+      "Compute the arrangement of a spec's sheets (a dict or a JSON file, the format of `geode "
+      "arrange`), "
+      "dualize it and return the Template; smooth places the nodes by optimization (box domains).");
+  m.def("_study_interleave", &study_interleave, py::arg("spec"), py::arg("sweep"),
+        py::arg("progress"));
 }
 
 }  // namespace geode::python

@@ -50,12 +50,14 @@ Domain make_cell_domain(const std::array<Point, 8>& P, int dim, bool pyramid = f
   Point lo = Point::Constant(1e300), hi = Point::Constant(-1e300);
   for (int c = 0; c < n; ++c) {
     if (!P[static_cast<std::size_t>(c)].allFinite())
-      throw InvalidInput(std::string("domain: ") + what + " corner " + std::to_string(c) + " is not finite");
+      throw InvalidInput(std::string("domain: ") + what + " corner " + std::to_string(c) +
+                         " is not finite");
     lo = lo.cwiseMin(P[static_cast<std::size_t>(c)]);
     hi = hi.cwiseMax(P[static_cast<std::size_t>(c)]);
   }
   const double size = norm_d(hi - lo, dim);
-  if (!(size > 0)) throw InvalidInput(std::string("domain: degenerate ") + what + " (all corners coincide)");
+  if (!(size > 0))
+    throw InvalidInput(std::string("domain: degenerate ") + what + " (all corners coincide)");
   // Positive at every corner and at the centre: the test the mesh-quality literature uses
   // for a valid trilinear element (Knupp's corner Jacobians plus the centre). Relative to the
   // cell's size so that a flattened cell is refused too.
@@ -64,17 +66,21 @@ Domain make_cell_domain(const std::array<Point, 8>& P, int dim, bool pyramid = f
     if (pyramid && c >= 4 && c < n) continue;  // the apex: the map's Jacobian vanishes there
     Point r = Point::Constant(0.5);
     if (c < n)
-      for (int a = 0; a < 3; ++a) r[a] = primal::topology::kHexCornerCoords[static_cast<std::size_t>(c)][static_cast<std::size_t>(a)];
+      for (int a = 0; a < 3; ++a)
+        r[a] = primal::topology::kHexCornerCoords[static_cast<std::size_t>(c)]
+                                                 [static_cast<std::size_t>(a)];
     const double j = multilinear_jacobian(P, r, dim);
     if (!(j > floor))
-      throw InvalidInput(std::string("domain: the ") + what + "'s Jacobian is not positive at " +
-                         (c < n ? "corner " + std::to_string(c) + " " + format_point(P[static_cast<std::size_t>(c)], dim)
-                                : std::string("its centre")) +
-                         " (det " + std::to_string(j) + "): corners must be in VTK order" +
-                         (pyramid    ? " (base 0-1-2-3 counter-clockwise seen from the apex 4)"
-                          : dim == 3 ? " (bottom 0-1-2-3 counter-clockwise seen from above, 4-7 above them)"
-                                     : " (counter-clockwise)") +
-                         " and the cell not inverted or flat");
+      throw InvalidInput(
+          std::string("domain: the ") + what + "'s Jacobian is not positive at " +
+          (c < n ? "corner " + std::to_string(c) + " " +
+                       format_point(P[static_cast<std::size_t>(c)], dim)
+                 : std::string("its centre")) +
+          " (det " + std::to_string(j) + "): corners must be in VTK order" +
+          (pyramid    ? " (base 0-1-2-3 counter-clockwise seen from the apex 4)"
+           : dim == 3 ? " (bottom 0-1-2-3 counter-clockwise seen from above, 4-7 above them)"
+                      : " (counter-clockwise)") +
+          " and the cell not inverted or flat");
   }
   Domain d(lo, hi, dim);
   if (dim == 2) d.lo[2] = d.hi[2] = 0.0;
@@ -132,7 +138,8 @@ class Engine {
         if (!(d.hi[i] > d.lo[i])) throw InvalidInput("arrangement: empty domain");
       return Domain(d.lo, d.hi, d.dim);
     }
-    make_cell_domain(*d.corners, d.dim, d.is_pyramid);  // throws on bad corners (they may be filled in by hand)
+    make_cell_domain(*d.corners, d.dim,
+                     d.is_pyramid);  // throws on bad corners (they may be filled in by hand)
     const auto& P = *d.corners;
     Point len = Point::Zero();
     for (const auto& e : primal::topology::kHexEdgeCorners) {
@@ -154,7 +161,8 @@ class Engine {
     std::vector<Sheet> out;
     for (const Sheet& s : sheets) {
       Sheet m{s.name, {}, s.kind};
-      m.field = [f = &s.field, P = *user_.corners, lo = domain_.lo, hi = domain_.hi, dim = user_.dim](const Point& u) {
+      m.field = [f = &s.field, P = *user_.corners, lo = domain_.lo, hi = domain_.hi,
+                 dim = user_.dim](const Point& u) {
         Point r = Point::Zero();
         for (int a = 0; a < dim; ++a) r[a] = (u[a] - lo[a]) / (hi[a] - lo[a]);
         return (*f)(multilinear(P, r, dim));
@@ -173,7 +181,9 @@ class Engine {
   // Positions in messages are physical.
   std::string fmt_point(const Point& u, int dim) const { return format_point(physical(u), dim); }
 
-  double value(int s, const Point& x) const { return sheets_[static_cast<std::size_t>(s)].field(x); }
+  double value(int s, const Point& x) const {
+    return sheets_[static_cast<std::size_t>(s)].field(x);
+  }
   Point grad(int s, const Point& x) const {
     return gradient(sheets_[static_cast<std::size_t>(s)].field, x, grad_h_, dim_);
   }
@@ -269,7 +279,9 @@ class Engine {
     int axis = 0;
     double at = 0.0;
   };
-  double eval(const Equation& e, const Point& x) const { return e.sheet >= 0 ? value(e.sheet, x) : x[e.axis] - e.at; }
+  double eval(const Equation& e, const Point& x) const {
+    return e.sheet >= 0 ? value(e.sheet, x) : x[e.axis] - e.at;
+  }
   Point eval_grad(const Equation& e, const Point& x) const {
     return e.sheet >= 0 ? grad(e.sheet, x) : Point::Unit(e.axis);
   }
@@ -300,8 +312,8 @@ class Engine {
   std::array<int, 3> n_{1, 1, 1};
   std::vector<std::vector<double>> grid_;
 
-  Domain user_;    // as given
-  Domain domain_;  // the reference box (user_ itself for a box)
+  Domain user_;                // as given
+  Domain domain_;              // the reference box (user_ itself for a box)
   std::vector<Sheet> mapped_;  // the fields composed with the map, for a hexahedron
   const std::vector<Sheet>& sheets_;
   const std::vector<Sheet>& given_;  // the fields in physical space
@@ -319,7 +331,8 @@ Point Engine::grid_node(int i, int j, int k) const {
   Point p = domain_.lo;
   const std::array<int, 3> ijk{i, j, k};
   for (int a = 0; a < dim_; ++a)
-    p[a] = domain_.lo[a] + (domain_.hi[a] - domain_.lo[a]) * ijk[static_cast<std::size_t>(a)] / n_[static_cast<std::size_t>(a)];
+    p[a] = domain_.lo[a] + (domain_.hi[a] - domain_.lo[a]) * ijk[static_cast<std::size_t>(a)] /
+                               n_[static_cast<std::size_t>(a)];
   if (dim_ == 2) p[2] = 0.0;
   return p;
 }
@@ -329,15 +342,17 @@ void Engine::sample_grid() {
   for (int i = 0; i < dim_; ++i) longest = std::max(longest, domain_.hi[i] - domain_.lo[i]);
   n_ = {1, 1, 0};
   for (int i = 0; i < dim_; ++i)
-    n_[static_cast<std::size_t>(i)] = std::max(
-        2, static_cast<int>(std::lround(options_.seed_resolution * (domain_.hi[i] - domain_.lo[i]) / longest)));
+    n_[static_cast<std::size_t>(i)] =
+        std::max(2, static_cast<int>(std::lround(options_.seed_resolution *
+                                                 (domain_.hi[i] - domain_.lo[i]) / longest)));
   const std::size_t nn = static_cast<std::size_t>((n_[0] + 1) * (n_[1] + 1) * (n_[2] + 1));
   grid_.assign(sheets_.size(), std::vector<double>(nn));
   for (int k = 0; k <= n_[2]; ++k)
     for (int j = 0; j <= n_[1]; ++j)
       for (int i = 0; i <= n_[0]; ++i) {
         const Point p = grid_node(i, j, k);
-        for (std::size_t s = 0; s < sheets_.size(); ++s) grid_[s][grid_id(i, j, k)] = value(static_cast<int>(s), p);
+        for (std::size_t s = 0; s < sheets_.size(); ++s)
+          grid_[s][grid_id(i, j, k)] = value(static_cast<int>(s), p);
       }
 }
 
@@ -355,14 +370,16 @@ std::vector<Point> Engine::seeds(const std::vector<int>& S) const {
           const auto& val = grid_[static_cast<std::size_t>(S[s])];
           double lo = 1e300, hi = -1e300;
           for (int c = 0; c < corners; ++c) {
-            const double v = val[grid_id(i + (c & 1), j + ((c >> 1) & 1), dim_ == 3 ? k + ((c >> 2) & 1) : 0)];
+            const double v =
+                val[grid_id(i + (c & 1), j + ((c >> 1) & 1), dim_ == 3 ? k + ((c >> 2) & 1) : 0)];
             lo = std::min(lo, v);
             hi = std::max(hi, v);
           }
           all = lo <= 0.0 && hi >= 0.0;
         }
         if (!all) continue;
-        Point c = 0.5 * (grid_node(i, j, dim_ == 3 ? k : 0) + grid_node(i + 1, j + 1, dim_ == 3 ? k + 1 : 0));
+        Point c = 0.5 * (grid_node(i, j, dim_ == 3 ? k : 0) +
+                         grid_node(i + 1, j + 1, dim_ == 3 ? k + 1 : 0));
         if (project(S, c) && inside(c)) out.push_back(c);
       }
   return out;
@@ -392,10 +409,12 @@ std::vector<Point> Engine::walk(const std::vector<int>& S, const Point& x0, Poin
       auto attempt = [&](const Point& dir, bool at_kink) {
         xp = x + hh * dir;
         std::array<Point, 3> g;
-        if (!project(S, xp, 0, &g) || (xp - x).norm() >= 2.0 * hh || (xp - x).dot(dir) < 0.25 * hh) return false;
+        if (!project(S, xp, 0, &g) || (xp - x).norm() >= 2.0 * hh || (xp - x).dot(dir) < 0.25 * hh)
+          return false;
         tn = sigma * tangent_of(g);
         if (tn.norm() < 1e-12) return false;
-        const double transversal = !at_kink || dim_ == 2 ? 1.0 : tn.norm() / (g[0].norm() * g[1].norm());
+        const double transversal =
+            !at_kink || dim_ == 2 ? 1.0 : tn.norm() / (g[0].norm() * g[1].norm());
         tn.normalize();
         return tn.dot(dir) > 0.9 && transversal > 0.05;
       };
@@ -433,12 +452,14 @@ std::vector<Point> Engine::walk(const std::vector<int>& S, const Point& x0, Poin
       Point y = x + best * (xp - x);
       y[axis] = high ? domain_.hi[axis] : domain_.lo[axis];
       if (!project(S, y, 1u << axis) || !inside(y, 1e-9 * diag_))
-        throw TopologyError("arrangement: the curve where sheets " + names(S) + " meet leaves the domain near " +
-                            fmt_point(xp, dim_) + " where it cannot be followed (it grazes the boundary)");
+        throw TopologyError("arrangement: the curve where sheets " + names(S) +
+                            " meet leaves the domain near " + fmt_point(xp, dim_) +
+                            " where it cannot be followed (it grazes the boundary)");
       for (int a = 0; a < dim_; ++a) {
         if (a == axis) continue;
         if (std::min(std::abs(y[a] - domain_.lo[a]), std::abs(y[a] - domain_.hi[a])) < 1e-6 * diag_)
-          throw TopologyError("arrangement: the curve where sheets " + names(S) + " meet leaves the domain through " +
+          throw TopologyError("arrangement: the curve where sheets " + names(S) +
+                              " meet leaves the domain through " +
                               std::string(dim_ == 3 ? "an edge" : "a corner") + " of the box at " +
                               fmt_point(y, dim_) + " (not in general position)");
       }
@@ -459,8 +480,8 @@ std::vector<Point> Engine::walk(const std::vector<int>& S, const Point& x0, Poin
     // A curve longer than many domain diagonals, or one that needs far more steps than its
     // length asks for, is hopping between branches near a tangency: report, do not spin.
     if (travelled > 20.0 * diag_ || ++steps > 40 * static_cast<long>(20.0 * diag_ / h_))
-      throw TopologyError("arrangement: the curve where sheets " + names(S) + " meet does not close or end (near " +
-                          fmt_point(xp, dim_) + ")");
+      throw TopologyError("arrangement: the curve where sheets " + names(S) +
+                          " meet does not close or end (near " + fmt_point(xp, dim_) + ")");
     pts.push_back(xp);
     x = xp;
     t = tn;
@@ -515,8 +536,8 @@ std::vector<Event> Engine::events(const Curve& c) const {
       // Sub-sample a segment where the sheet comes close without a sign change: it may cross
       // twice within one step.
       std::vector<std::pair<double, Point>> sub{{0.0, P[i]}, {1.0, P[j]}};
-      if ((v[i] < 0) == (v[j] < 0) &&
-          std::min(std::abs(v[i]), std::abs(v[j])) < 2.0 * grad(s, P[i]).norm() * (P[j] - P[i]).norm()) {
+      if ((v[i] < 0) == (v[j] < 0) && std::min(std::abs(v[i]), std::abs(v[j])) <
+                                          2.0 * grad(s, P[i]).norm() * (P[j] - P[i]).norm()) {
         sub.clear();
         for (int q = 0; q <= 16; ++q) {
           Point y = P[i] + (q / 16.0) * (P[j] - P[i]);
@@ -547,21 +568,25 @@ std::vector<Event> Engine::events(const Curve& c) const {
         const double f = a / (a - b);
         Point x = sub[q].second + f * (sub[q + 1].second - sub[q].second);
         if (!project(T, x))
-          throw TopologyError("arrangement: sheets " + names(T) + " cross near " + fmt_point(x, dim_) +
+          throw TopologyError("arrangement: sheets " + names(T) + " cross near " +
+                              fmt_point(x, dim_) +
                               " but their meeting point cannot be solved (tangency?)");
-        out.push_back({static_cast<double>(i) + sub[q].first + f * (sub[q + 1].first - sub[q].first), s, x});
+        out.push_back(
+            {static_cast<double>(i) + sub[q].first + f * (sub[q + 1].first - sub[q].first), s, x});
       }
     }
     for (const Point& y : touch) {
       bool crossing = false;
-      for (const Event& e : out) crossing = crossing || (e.sheet == s && (e.x - y).norm() < 1e-6 * diag_);
+      for (const Event& e : out)
+        crossing = crossing || (e.sheet == s && (e.x - y).norm() < 1e-6 * diag_);
       if (!crossing)
-        throw TopologyError("arrangement: the curve where sheets " + names(c.sheets) + " meet touches sheet " +
-                            name(s) + " at " + fmt_point(y, dim_) +
+        throw TopologyError("arrangement: the curve where sheets " + names(c.sheets) +
+                            " meet touches sheet " + name(s) + " at " + fmt_point(y, dim_) +
                             " without crossing it (tangent there; not in general position)");
     }
   }
-  std::sort(out.begin(), out.end(), [](const Event& a, const Event& b) { return a.param < b.param; });
+  std::sort(out.begin(), out.end(),
+            [](const Event& a, const Event& b) { return a.param < b.param; });
   return out;
 }
 
@@ -614,14 +639,16 @@ void Engine::check_touching(const std::vector<Curve>& curves) const {
   const int m = static_cast<int>(sheets_.size());
   std::array<double, 3> step{};
   for (int a = 0; a < dim_; ++a)
-    step[static_cast<std::size_t>(a)] = (domain_.hi[a] - domain_.lo[a]) / n_[static_cast<std::size_t>(a)];
+    step[static_cast<std::size_t>(a)] =
+        (domain_.hi[a] - domain_.lo[a]) / n_[static_cast<std::size_t>(a)];
   auto corner_id = [&](int i, int j, int k, int c) {
     return grid_id(i + (c & 1), j + ((c >> 1) & 1), dim_ == 3 ? k + ((c >> 2) & 1) : 0);
   };
   // Per sheet and cell: is the zero set within about one cell (the smallest corner value no
   // larger than the spread over the corners, which for a linear field is the gradient times
   // the cell's extent along it).
-  std::vector<std::vector<char>> near(static_cast<std::size_t>(m), std::vector<char>(static_cast<std::size_t>(ncell), 0));
+  std::vector<std::vector<char>> near(static_cast<std::size_t>(m),
+                                      std::vector<char>(static_cast<std::size_t>(ncell), 0));
   for (int s = 0; s < m; ++s) {
     const auto& val = grid_[static_cast<std::size_t>(s)];
     for (int k = 0; k < kcells; ++k)
@@ -632,7 +659,8 @@ void Engine::check_touching(const std::vector<Curve>& curves) const {
             const double v = val[corner_id(i, j, k, c)];
             lo = std::min(lo, v), hi = std::max(hi, v), least = std::min(least, std::abs(v));
           }
-          near[static_cast<std::size_t>(s)][static_cast<std::size_t>(cell_id(i, j, k))] = least <= hi - lo;
+          near[static_cast<std::size_t>(s)][static_cast<std::size_t>(cell_id(i, j, k))] =
+              least <= hi - lo;
         }
   }
   // The field's gradient in a cell, estimated from its corners.
@@ -690,7 +718,9 @@ void Engine::check_touching(const std::vector<Curve>& curves) const {
       }
       for (int id = 0; id < ncell; ++id) {
         const auto I = static_cast<std::size_t>(id);
-        if (covered[I] || !near[static_cast<std::size_t>(a)][I] || !near[static_cast<std::size_t>(b)][I]) continue;
+        if (covered[I] || !near[static_cast<std::size_t>(a)][I] ||
+            !near[static_cast<std::size_t>(b)][I])
+          continue;
         // Zero sets crossing at more than 45 degrees here: a crossing, not a touching.
         const Point ga = slope(a, id), gb = slope(b, id);
         if (ga.norm() > 0 && gb.norm() > 0 && sine(ga, gb) > 0.7) continue;
@@ -701,16 +731,18 @@ void Engine::check_touching(const std::vector<Curve>& curves) const {
         if (inside(x)) mark(covered, x, 1);  // later starts nearby would end there too
         if (!zero || !inside(x)) continue;
         if (sine(grad(a, x), grad(b, x)) < kParallel)
-          throw TopologyError("arrangement: sheets " + names(S) + " touch at " + fmt_point(x, dim_) +
+          throw TopologyError("arrangement: sheets " + names(S) + " touch at " +
+                              fmt_point(x, dim_) +
                               " without crossing (tangent there; not in general position)");
         double best = 1e300;
         for (const Curve* c : mine)
           for (const Point& p : c->polyline) best = std::min(best, (p - x).norm());
         for (const Point& p : crossings) best = std::min(best, (p - x).norm());
         if (best > (dim_ == 3 ? 2.0 * h_ : 1e-6 * diag_))
-          throw TopologyError("arrangement: sheets " + names(S) + " meet at " + fmt_point(x, dim_) + " but no " +
-                              (dim_ == 3 ? "curve traced for them passes there" : "vertex was found there") +
-                              ": a piece smaller than the seeding grid was missed (raise the seed resolution)");
+          throw TopologyError(
+              "arrangement: sheets " + names(S) + " meet at " + fmt_point(x, dim_) + " but no " +
+              (dim_ == 3 ? "curve traced for them passes there" : "vertex was found there") +
+              ": a piece smaller than the seeding grid was missed (raise the seed resolution)");
       }
     }
 
@@ -734,7 +766,9 @@ void Engine::check_touching(const std::vector<Curve>& curves) const {
               const double v = val[grid_id(p[0], p[1], p[2])];
               bool extremum = true;
               double spread = 0.0;
-              int sign = v < 0 ? -1 : v > 0 ? 1 : 0;  // of the node, or of its first nonzero neighbour
+              int sign = v < 0   ? -1
+                         : v > 0 ? 1
+                                 : 0;  // of the node, or of its first nonzero neighbour
               for (int d = 0; d < 27 && extremum; ++d) {
                 std::array<int, 3> q{p[0] + d % 3 - 1, p[1] + (d / 3) % 3 - 1, p[2] + d / 9 - 1};
                 if (q[A] != p[A] || q == p) continue;
@@ -752,9 +786,10 @@ void Engine::check_touching(const std::vector<Curve>& curves) const {
               // On the face only to the solver's tolerance: allow for that, not more.
               if (!common_zero({s}, face, x) || !inside(x, 1e-6 * diag_)) continue;
               if (sine(grad(s, x), Point::Unit(axis)) < kParallel)
-                throw TopologyError("arrangement: sheet " + name(s) + " touches the domain boundary (face " +
-                                    std::to_string(box_face(axis, high == 1)) + ") at " + fmt_point(x, dim_) +
-                                    " without crossing it (tangent to it; not in general position)");
+                throw TopologyError(
+                    "arrangement: sheet " + name(s) + " touches the domain boundary (face " +
+                    std::to_string(box_face(axis, high == 1)) + ") at " + fmt_point(x, dim_) +
+                    " without crossing it (tangent to it; not in general position)");
             }
       }
     }
@@ -769,7 +804,8 @@ void Engine::check_apex() const {
     const double g = gradient(f, apex, grad_h_, dim_).norm();
     if (std::abs(f(apex)) < 1e-6 * diag_ * std::max(g, 1e-300))
       throw TopologyError("arrangement: sheet " + name(s) + " passes through the pyramid's apex " +
-                          format_point(apex, dim_) + " (its curves would end in one point; not in general position)");
+                          format_point(apex, dim_) +
+                          " (its curves would end in one point; not in general position)");
   }
 }
 
@@ -791,7 +827,8 @@ int Engine::register_vertex(std::vector<int> S, const Point& x) {
   v.x = x;
   v.found = 1;
   Eigen::MatrixXd J(dim_, dim_);
-  for (int r = 0; r < dim_; ++r) J.row(r) = grad(S[static_cast<std::size_t>(r)], x).head(dim_).transpose();
+  for (int r = 0; r < dim_; ++r)
+    J.row(r) = grad(S[static_cast<std::size_t>(r)], x).head(dim_).transpose();
   v.orientation = J.determinant() > 0 ? 1 : -1;
   check_vertex(v, J);
   vertices_.push_back(v);
@@ -804,19 +841,21 @@ void Engine::check_vertex(const Vertex& v, const Eigen::MatrixXd& J) const {
   double prod = 1.0;
   for (int r = 0; r < dim_; ++r) prod *= J.row(r).norm();
   if (std::abs(J.determinant()) < 1e-6 * prod)
-    throw TopologyError("arrangement: sheets " + names(v.sheets) + " meet tangentially at " + fmt_point(v.x, dim_) +
-                        " (not in general position)");
+    throw TopologyError("arrangement: sheets " + names(v.sheets) + " meet tangentially at " +
+                        fmt_point(v.x, dim_) + " (not in general position)");
   for (int e = 0; e < static_cast<int>(sheets_.size()); ++e) {
     if (std::find(v.sheets.begin(), v.sheets.end(), e) != v.sheets.end()) continue;
     const double g = grad(e, v.x).norm();
     if (std::abs(value(e, v.x)) < 1e-7 * diag_ * std::max(g, 1e-300))
-      throw TopologyError("arrangement: " + std::to_string(dim_ + 1) + " sheets " + names(v.sheets) + " and " +
-                          name(e) + " pass through one point " + fmt_point(v.x, dim_) + " (not in general position)");
+      throw TopologyError("arrangement: " + std::to_string(dim_ + 1) + " sheets " +
+                          names(v.sheets) + " and " + name(e) + " pass through one point " +
+                          fmt_point(v.x, dim_) + " (not in general position)");
   }
   for (int a = 0; a < dim_; ++a)
     if (std::min(std::abs(v.x[a] - domain_.lo[a]), std::abs(v.x[a] - domain_.hi[a])) < 1e-6 * diag_)
-      throw TopologyError("arrangement: sheets " + names(v.sheets) + " meet on the domain boundary at " +
-                          fmt_point(v.x, dim_) + " (not in general position)");
+      throw TopologyError("arrangement: sheets " + names(v.sheets) +
+                          " meet on the domain boundary at " + fmt_point(v.x, dim_) +
+                          " (not in general position)");
 }
 
 Arrangement Engine::run() {
@@ -858,9 +897,9 @@ Arrangement Engine::run() {
   // 2. Events along each curve, vertices, and 1-cells.
   struct RawEdge {
     std::vector<int> sheets;
-    int va, vb;          // vertex or -1
-    int sa, sb;          // the vertex's extra sheet (toward the edge)
-    int fa, fb;          // face when no vertex
+    int va, vb;  // vertex or -1
+    int sa, sb;  // the vertex's extra sheet (toward the edge)
+    int fa, fb;  // face when no vertex
     Point xa, xb;
     std::vector<int> side;
   };
@@ -868,11 +907,14 @@ Arrangement Engine::run() {
   for (const Curve& c : A.curves) {
     std::vector<Event> ev = events(c);
     if (ev.empty()) {
-      std::string where = c.closed ? "a closed loop" : "a curve from boundary face " + std::to_string(c.end_faces[0]) +
-                                                           " to face " + std::to_string(c.end_faces[1]);
-      throw TopologyError("arrangement: sheets " + names(c.sheets) + " meet in " + where + " through " +
-                          fmt_point(c.polyline.front(), dim_) +
-                          " that no other sheet crosses: a 1-cell with no vertex has no dual element");
+      std::string where = c.closed
+                              ? "a closed loop"
+                              : "a curve from boundary face " + std::to_string(c.end_faces[0]) +
+                                    " to face " + std::to_string(c.end_faces[1]);
+      throw TopologyError(
+          "arrangement: sheets " + names(c.sheets) + " meet in " + where + " through " +
+          fmt_point(c.polyline.front(), dim_) +
+          " that no other sheet crosses: a 1-cell with no vertex has no dual element");
     }
     for (Event& e : ev) {
       std::vector<int> T = c.sheets;
@@ -889,8 +931,8 @@ Arrangement Engine::run() {
       project(c.sheets, y);
       return y;
     };
-    auto make = [&](int va, int sa, int fa, const Point& xa, double pa, int vb, int sb, int fb, const Point& xb,
-                    double pb) {
+    auto make = [&](int va, int sa, int fa, const Point& xa, double pa, int vb, int sb, int fb,
+                    const Point& xb, double pb) {
       RawEdge r{c.sheets, va, vb, sa, sb, fa, fb, xa, xb, {}};
       const Point mid = point_at(0.5 * (pa + pb));
       for (int s = 0; s < m; ++s) r.side.push_back(value(s, mid) < 0 ? -1 : 1);
@@ -904,22 +946,23 @@ Arrangement Engine::run() {
         make(a.vertex, a.sheet, -1, a.x, a.param, b.vertex, b.sheet, -1, b.x, pb);
       }
     } else {
-      make(-1, -1, c.end_faces[0], P.front(), 0.0, ev.front().vertex, ev.front().sheet, -1, ev.front().x,
-           ev.front().param);
+      make(-1, -1, c.end_faces[0], P.front(), 0.0, ev.front().vertex, ev.front().sheet, -1,
+           ev.front().x, ev.front().param);
       for (std::size_t i = 0; i + 1 < ev.size(); ++i)
-        make(ev[i].vertex, ev[i].sheet, -1, ev[i].x, ev[i].param, ev[i + 1].vertex, ev[i + 1].sheet, -1,
-             ev[i + 1].x, ev[i + 1].param);
-      make(ev.back().vertex, ev.back().sheet, -1, ev.back().x, ev.back().param, -1, -1, c.end_faces[1], P.back(),
-           n - 1.0);
+        make(ev[i].vertex, ev[i].sheet, -1, ev[i].x, ev[i].param, ev[i + 1].vertex, ev[i + 1].sheet,
+             -1, ev[i + 1].x, ev[i + 1].param);
+      make(ev.back().vertex, ev.back().sheet, -1, ev.back().x, ev.back().param, -1, -1,
+           c.end_faces[1], P.back(), n - 1.0);
     }
   }
   check_touching(A.curves);
   for (const Vertex& v : vertices_)
     if (v.found != dim_)
-      throw TopologyError("arrangement: the vertex of sheets " + names(v.sheets) + " at " + fmt_point(v.x, dim_) +
-                          " was found on " + std::to_string(v.found) + " of its " + std::to_string(dim_) +
-                          " curves: part of a curve was missed (raise the seed resolution) or the sheets are not "
-                          "in general position");
+      throw TopologyError(
+          "arrangement: the vertex of sheets " + names(v.sheets) + " at " + fmt_point(v.x, dim_) +
+          " was found on " + std::to_string(v.found) + " of its " + std::to_string(dim_) +
+          " curves: part of a curve was missed (raise the seed resolution) or the sheets are not "
+          "in general position");
 
   // 3. Deterministic vertex order: by sheets, then by position.
   std::vector<int> order(vertices_.size());
@@ -930,7 +973,8 @@ Arrangement Engine::run() {
     return k;
   };
   std::sort(order.begin(), order.end(), [&](int a, int b) {
-    return key(vertices_[static_cast<std::size_t>(a)]) < key(vertices_[static_cast<std::size_t>(b)]);
+    return key(vertices_[static_cast<std::size_t>(a)]) <
+           key(vertices_[static_cast<std::size_t>(b)]);
   });
   std::vector<int> rank(vertices_.size());
   for (std::size_t i = 0; i < order.size(); ++i) {
@@ -943,7 +987,8 @@ Arrangement Engine::run() {
   const int nv = static_cast<int>(A.vertices.size());
   primal::DisjointSets uf(static_cast<std::size_t>(nv * octants));
   std::vector<unsigned> faces(static_cast<std::size_t>(nv * octants), 0u);
-  auto octant_bits = [&](int v, const std::vector<int>& S, int sigma, int extra, const std::vector<int>& side) {
+  auto octant_bits = [&](int v, const std::vector<int>& S, int sigma, int extra,
+                         const std::vector<int>& side) {
     const Vertex& V = A.vertices[static_cast<std::size_t>(v)];
     int bits = 0;
     for (int i = 0; i < dim_; ++i) {
@@ -981,7 +1026,8 @@ Arrangement Engine::run() {
   A.region.assign(static_cast<std::size_t>(nv), {-1, -1, -1, -1, -1, -1, -1, -1});
   for (int v = 0; v < nv; ++v) {
     const Vertex& V = A.vertices[static_cast<std::size_t>(v)];
-    const Eigen::MatrixXd Jinv = jacobians_[static_cast<std::size_t>(order[static_cast<std::size_t>(v)])].inverse();
+    const Eigen::MatrixXd Jinv =
+        jacobians_[static_cast<std::size_t>(order[static_cast<std::size_t>(v)])].inverse();
     for (int b = 0; b < octants; ++b) {
       const int root = uf.find(v * octants + b);
       int& l = label[static_cast<std::size_t>(root)];
@@ -992,7 +1038,8 @@ Arrangement Engine::run() {
         A.region_signs.emplace_back();
       }
       A.region[static_cast<std::size_t>(v)][static_cast<std::size_t>(b)] = l;
-      A.region_faces[static_cast<std::size_t>(l)] |= faces[static_cast<std::size_t>(v * octants + b)];
+      A.region_faces[static_cast<std::size_t>(l)] |=
+          faces[static_cast<std::size_t>(v * octants + b)];
       // Sign vector of the region, sampled just inside this octant.
       Eigen::VectorXd sigma(dim_);
       for (int i = 0; i < dim_; ++i) sigma[i] = (b >> i) & 1 ? 1.0 : -1.0;
@@ -1005,9 +1052,10 @@ Arrangement Engine::run() {
       if (fresh)
         rs = sg;
       else if (rs != sg)
-        throw TopologyError("arrangement: one region joins octants of different sign vectors (near " +
-                            fmt_point(V.x, dim_) + " where sheets " + names(V.sheets) +
-                            " meet): the curves were traced inconsistently");
+        throw TopologyError(
+            "arrangement: one region joins octants of different sign vectors (near " +
+            fmt_point(V.x, dim_) + " where sheets " + names(V.sheets) +
+            " meet): the curves were traced inconsistently");
     }
   }
   // A pyramid's apex touches the domain only at face 5, where no curve ends: its region is
@@ -1030,13 +1078,18 @@ Arrangement Engine::run() {
     }
     if (hits.size() != 1) {
       std::string masks;
-      for (int r : hits) masks += (masks.empty() ? "" : ", ") + std::to_string(A.region_faces[static_cast<std::size_t>(r)]);
-      throw TopologyError("arrangement: " + std::to_string(hits.size()) +
-                          " regions have the sign vector of the pyramid's apex " + format_point(apex, dim_) +
-                          (hits.empty() ? ": its region has no vertex around it"
-                                        : ": the apex's region is split where no 1-cell joins its vertices (its hexes "
-                                          "would not meet face to face around its node), or another region has its "
-                                          "sides (boundary faces touched, as masks: " + masks + ")"));
+      for (int r : hits)
+        masks += (masks.empty() ? "" : ", ") +
+                 std::to_string(A.region_faces[static_cast<std::size_t>(r)]);
+      throw TopologyError(
+          "arrangement: " + std::to_string(hits.size()) +
+          " regions have the sign vector of the pyramid's apex " + format_point(apex, dim_) +
+          (hits.empty()
+               ? ": its region has no vertex around it"
+               : ": the apex's region is split where no 1-cell joins its vertices (its hexes "
+                 "would not meet face to face around its node), or another region has its "
+                 "sides (boundary faces touched, as masks: " +
+                     masks + ")"));
     }
     A.region_faces[static_cast<std::size_t>(hits[0])] |= 1u << box_face(2, true);
   }
@@ -1046,8 +1099,9 @@ Arrangement Engine::run() {
   for (Vertex& v : A.vertices) {
     v.local = local(v.x);
     if (user_.corners && !(multilinear_jacobian(*user_.corners, v.local, dim_) > 0))
-      throw InvalidInput("arrangement: the domain cell folds over (Jacobian not positive) where sheets " +
-                         names(v.sheets) + " meet at " + fmt_point(v.x, dim_));
+      throw InvalidInput(
+          "arrangement: the domain cell folds over (Jacobian not positive) where sheets " +
+          names(v.sheets) + " meet at " + fmt_point(v.x, dim_));
     v.x = physical(v.x);
   }
   if (user_.corners) {
@@ -1060,7 +1114,9 @@ Arrangement Engine::run() {
 
 }  // namespace
 
-Domain Domain::hexahedron(const std::array<Point, 8>& corners) { return make_cell_domain(corners, 3); }
+Domain Domain::hexahedron(const std::array<Point, 8>& corners) {
+  return make_cell_domain(corners, 3);
+}
 
 Domain Domain::pyramid(const std::array<Point, 5>& corners) {
   std::array<Point, 8> P;

@@ -109,7 +109,7 @@ struct ArrangementOptions {
 struct Vertex {
   std::vector<int> sheets;  // sorted ascending, d entries
   Point x;
-  Point local;  // x in the domain's local coordinates (domain_point(domain, local) == x)
+  Point local;          // x in the domain's local coordinates (domain_point(domain, local) == x)
   int orientation = 1;  // sign of det of the sheets' gradients, in sheet order
   int found = 0;        // how many of its d curves reported it (must be d)
 };
@@ -125,7 +125,7 @@ struct CurveEnd {
 struct Edge1 {
   std::vector<int> sheets;  // d-1 sheets, sorted
   CurveEnd a, b;
-  std::vector<int> side;    // sign (+1/-1) of every sheet at the 1-cell's midpoint
+  std::vector<int> side;  // sign (+1/-1) of every sheet at the 1-cell's midpoint
 };
 
 // One traced component of the meeting curve of d-1 sheets.

@@ -29,8 +29,10 @@ std::vector<int> link_euler(const DualMesh& D, std::size_t nodes) {
   if (D.dim == 3) {
     for (const auto& h : D.hex.hexes) {
       for (const auto& e : primal::topology::kHexEdgeCorners) {
-        edges[static_cast<std::size_t>(h[static_cast<std::size_t>(e[0])])].insert(key(h[static_cast<std::size_t>(e[0])], h[static_cast<std::size_t>(e[1])]));
-        edges[static_cast<std::size_t>(h[static_cast<std::size_t>(e[1])])].insert(key(h[static_cast<std::size_t>(e[0])], h[static_cast<std::size_t>(e[1])]));
+        edges[static_cast<std::size_t>(h[static_cast<std::size_t>(e[0])])].insert(
+            key(h[static_cast<std::size_t>(e[0])], h[static_cast<std::size_t>(e[1])]));
+        edges[static_cast<std::size_t>(h[static_cast<std::size_t>(e[1])])].insert(
+            key(h[static_cast<std::size_t>(e[0])], h[static_cast<std::size_t>(e[1])]));
       }
       for (const auto& f : primal::topology::kHexFaceCorners) {
         std::vector<int> q;
@@ -93,8 +95,9 @@ DualMesh dualize(const Arrangement& A) {
     }
     std::set<primal::Index> distinct(cell.begin(), cell.begin() + corners);
     if (static_cast<int>(distinct.size()) != corners)
-      throw TopologyError("dualize: around the vertex of sheets " + sheet_list(A, V.sheets) + " at " +
-                          format_point(V.x, dim) + " two octants are one region: its element would repeat a node");
+      throw TopologyError("dualize: around the vertex of sheets " + sheet_list(A, V.sheets) +
+                          " at " + format_point(V.x, dim) +
+                          " two octants are one region: its element would repeat a node");
     if (dim == 3)
       D.hex.hexes.push_back(cell);
     else
@@ -122,7 +125,10 @@ DualMesh dualize(const Arrangement& A) {
         ++count[static_cast<std::size_t>(n)];
       }
   };
-  if (dim == 3) accumulate(D.hex.hexes); else accumulate(D.quad.quads);
+  if (dim == 3)
+    accumulate(D.hex.hexes);
+  else
+    accumulate(D.quad.quads);
   std::vector<primal::Point> pts(nodes);
   for (std::size_t n = 0; n < nodes; ++n) {
     const int r = region_of_node[n];
@@ -136,7 +142,10 @@ DualMesh dualize(const Arrangement& A) {
     D.node_faces.push_back(f);
     D.node_signs.push_back(A.region_signs[static_cast<std::size_t>(r)]);
   }
-  if (dim == 3) D.hex.points = pts; else D.quad.points = pts;
+  if (dim == 3)
+    D.hex.points = pts;
+  else
+    D.quad.points = pts;
 
   // Every region must be a ball, or a half-ball where it touches the domain boundary. Unlike
   // primal::check_validity, which judges a node against the mesh's own boundary, this holds
@@ -150,10 +159,11 @@ DualMesh dualize(const Arrangement& A) {
       std::string s;
       for (std::size_t i = 0; i < D.node_signs[n].size(); ++i)
         s += std::string(i ? ", " : "") + A.sheet_names[i] + (D.node_signs[n][i] > 0 ? "+" : "-");
-      throw TopologyError("dualize: the region on sides {" + s + "} near " + format_point(pts[n], dim) + " is not a " +
+      throw TopologyError("dualize: the region on sides {" + s + "} near " +
+                          format_point(pts[n], dim) + " is not a " +
                           (boundary ? "half-ball meeting the boundary in one disk" : "ball") +
-                          " (its node's link has Euler characteristic " + std::to_string(chi[n]) + ", expected " +
-                          std::to_string(expect) + ")");
+                          " (its node's link has Euler characteristic " + std::to_string(chi[n]) +
+                          ", expected " + std::to_string(expect) + ")");
     }
   }
 
@@ -169,25 +179,31 @@ DualMesh dualize(const Arrangement& A) {
   std::string found;
   if (dim == 3) {
     const primal::HexValidityReport v = primal::check_validity(D.hex);
-    ball = v.overshared_faces.empty() && v.nonmanifold_edges.empty() && v.nonmanifold_vertices.empty() &&
-           v.euler == 1 && v.boundary.closed && v.boundary.euler == 2;
-    found = "V - E + F - C = " + std::to_string(v.euler) + ", boundary V - E + F = " + std::to_string(v.boundary.euler);
+    ball = v.overshared_faces.empty() && v.nonmanifold_edges.empty() &&
+           v.nonmanifold_vertices.empty() && v.euler == 1 && v.boundary.closed &&
+           v.boundary.euler == 2;
+    found = "V - E + F - C = " + std::to_string(v.euler) +
+            ", boundary V - E + F = " + std::to_string(v.boundary.euler);
     for (primal::Index n : v.boundary.vertex_node) on_boundary[static_cast<std::size_t>(n)] = 1;
   } else {
     const primal::QuadValidityReport v = primal::check_validity(D.quad);
-    ball = v.overshared_edges.empty() && v.nonmanifold_vertices.empty() && v.euler == 1 && v.boundary_loops.size() == 1;
-    found = "V - E + F = " + std::to_string(v.euler) + ", " + std::to_string(v.boundary_loops.size()) + " boundary loop(s)";
+    ball = v.overshared_edges.empty() && v.nonmanifold_vertices.empty() && v.euler == 1 &&
+           v.boundary_loops.size() == 1;
+    found = "V - E + F = " + std::to_string(v.euler) + ", " +
+            std::to_string(v.boundary_loops.size()) + " boundary loop(s)";
     for (const auto& loop : v.boundary_loops)
       for (primal::Index n : loop) on_boundary[static_cast<std::size_t>(n)] = 1;
   }
   if (!ball)
-    throw TopologyError("dualize: the dual of the arrangement is not a " + std::string(dim == 3 ? "ball" : "disk") +
-                        " (" + found + ", expected 1 and " + (dim == 3 ? "2" : "one loop") +
+    throw TopologyError("dualize: the dual of the arrangement is not a " +
+                        std::string(dim == 3 ? "ball" : "disk") + " (" + found +
+                        ", expected 1 and " + (dim == 3 ? "2" : "one loop") +
                         "): a piece of sheet with a hole, or a region split where no curve runs");
   for (std::size_t n = 0; n < nodes; ++n)
     if ((D.node_faces[n] != 0) != (on_boundary[n] != 0))
-      throw TopologyError("dualize: the node of the region near " + format_point(pts[n], dim) + " is " +
-                          (on_boundary[n] ? "" : "not ") + "on the dual's boundary but its region " +
+      throw TopologyError("dualize: the node of the region near " + format_point(pts[n], dim) +
+                          " is " + (on_boundary[n] ? "" : "not ") +
+                          "on the dual's boundary but its region " +
                           (D.node_faces[n] ? "touches" : "does not touch") +
                           " the domain boundary as the traced curves show it");
   return D;

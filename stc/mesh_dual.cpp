@@ -213,8 +213,8 @@ std::vector<std::vector<TraceCurve>> split(const MeshDual<Dim>& dual, Index shee
         throw InvalidInput("trace_by_region: sheet " + std::to_string(sheet) + ", " +
                            (Dim == 3 ? "hex " : "quad ") + std::to_string(curve.facets[i].cell) +
                            " facet " + std::to_string(curve.facets[i].local) + " is in region " +
-                           std::to_string(region[i]) + ", outside [0, " +
-                           std::to_string(regions) + ")");
+                           std::to_string(region[i]) + ", outside [0, " + std::to_string(regions) +
+                           ")");
     }
     if (n == 0) continue;
     if (std::all_of(region.begin(), region.end(), [&](int r) { return r == region[0]; })) {
@@ -252,8 +252,8 @@ FacetClassifier box_classifier(const std::vector<primal::Point>& points,
     for (int axis = 0; axis < axes; ++axis)
       for (int high = 0; high < 2; ++high) {
         const double plane = high ? hi[axis] : lo[axis];
-        const bool on = std::all_of(
-            facet_table[f.local].begin(), facet_table[f.local].end(), [&](int corner) {
+        const bool on =
+            std::all_of(facet_table[f.local].begin(), facet_table[f.local].end(), [&](int corner) {
               return std::abs(points[cells[f.cell][corner]][axis] - plane) <= tol;
             });
         if (on) return 2 * axis + high;
@@ -271,14 +271,12 @@ QuadDual mesh_dual(const primal::QuadMesh& mesh) {
 }
 
 std::vector<std::vector<TraceCurve>> trace_by_region(const HexDual& dual, Index sheet,
-                                                     const FacetClassifier& classify,
-                                                     int regions) {
+                                                     const FacetClassifier& classify, int regions) {
   return split(dual, sheet, classify, regions);
 }
 
 std::vector<std::vector<TraceCurve>> trace_by_region(const QuadDual& dual, Index sheet,
-                                                     const FacetClassifier& classify,
-                                                     int regions) {
+                                                     const FacetClassifier& classify, int regions) {
   return split(dual, sheet, classify, regions);
 }
 

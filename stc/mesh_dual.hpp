@@ -89,11 +89,9 @@ using FacetClassifier = std::function<int(const CellFacet&)>;
 // Throws geode::InvalidInput when the classifier returns a region outside [0, regions) for a
 // facet of the trace.
 std::vector<std::vector<TraceCurve>> trace_by_region(const HexDual& dual, primal::Index sheet,
-                                                     const FacetClassifier& classify,
-                                                     int regions);
+                                                     const FacetClassifier& classify, int regions);
 std::vector<std::vector<TraceCurve>> trace_by_region(const QuadDual& dual, primal::Index sheet,
-                                                     const FacetClassifier& classify,
-                                                     int regions);
+                                                     const FacetClassifier& classify, int regions);
 
 // Classifies a boundary facet by the axis-aligned box face [lo, hi] whose plane holds all its
 // corners within `tol`: face 2 * axis + (0 low, 1 high), as stc::box_face numbers them; -1 when

@@ -40,7 +40,8 @@ class CellLocator {
   CellLocator(const std::vector<Point>& points, const std::vector<CellArray<Dim>>& cells)
       : points_(points), cells_(cells) {
     // NaN never compares equal: an empty cache slot matches no point.
-    for (auto& entry : cache_) entry.first = Vec::Constant(std::numeric_limits<double>::quiet_NaN());
+    for (auto& entry : cache_)
+      entry.first = Vec::Constant(std::numeric_limits<double>::quiet_NaN());
     lo_ = Vec::Constant(1e300);
     hi_ = Vec::Constant(-1e300);
     for (const auto& c : cells_)
@@ -51,7 +52,8 @@ class CellLocator {
     scale_ = std::max((hi_ - lo_).norm(), 1e-300);
     // About one or two cells per bucket along each axis.
     const double per_axis = std::pow(static_cast<double>(cells_.size()), 1.0 / Dim);
-    for (int a = 0; a < Dim; ++a) n_[a] = std::clamp(static_cast<int>(std::lround(1.5 * per_axis)), 1, 64);
+    for (int a = 0; a < Dim; ++a)
+      n_[a] = std::clamp(static_cast<int>(std::lround(1.5 * per_axis)), 1, 64);
     std::size_t buckets = 1;
     for (int a = 0; a < Dim; ++a) buckets *= static_cast<std::size_t>(n_[a]);
     buckets_.resize(buckets);
@@ -80,8 +82,10 @@ class CellLocator {
   Vec map(Index cell, const Vec& u, Mat* jacobian = nullptr) const {
     std::array<Point, kCorners> P;
     for (int c = 0; c < kCorners; ++c)
-      P[static_cast<std::size_t>(c)] = points_[static_cast<std::size_t>(cells_[static_cast<std::size_t>(cell)][static_cast<std::size_t>(c)])];
-    if (jacobian) *jacobian = primal::multilinear_jacobian(P, local(u), Dim).template topLeftCorner<Dim, Dim>();
+      P[static_cast<std::size_t>(c)] = points_[static_cast<std::size_t>(
+          cells_[static_cast<std::size_t>(cell)][static_cast<std::size_t>(c)])];
+    if (jacobian)
+      *jacobian = primal::multilinear_jacobian(P, local(u), Dim).template topLeftCorner<Dim, Dim>();
     return primal::multilinear_point(P, local(u), Dim).template head<Dim>();
   }
 
@@ -102,7 +106,9 @@ class CellLocator {
     return u;
   }
 
-  static double outside(const Vec& u) { return std::max(0.0, std::max((-u).maxCoeff(), (u - Vec::Ones()).maxCoeff())); }
+  static double outside(const Vec& u) {
+    return std::max(0.0, std::max((-u).maxCoeff(), (u - Vec::Ones()).maxCoeff()));
+  }
 
   Hit locate(const Point& p) const {
     const Vec x = p.template head<Dim>();
@@ -169,7 +175,8 @@ class CellLocator {
   }
   std::size_t bucket_id(const std::array<int, Dim>& b) const {
     std::size_t id = 0;
-    for (int a = Dim - 1; a >= 0; --a) id = id * static_cast<std::size_t>(n_[a]) + static_cast<std::size_t>(b[a]);
+    for (int a = Dim - 1; a >= 0; --a)
+      id = id * static_cast<std::size_t>(n_[a]) + static_cast<std::size_t>(b[a]);
     return id;
   }
   template <class F>
@@ -207,10 +214,12 @@ const char* cell_word(int dim) { return dim == 3 ? "hex" : "quad"; }
 
 // make_classifier(lo, hi, tol): stc::box_face_classifier for the mesh at hand.
 template <int Dim, class Dual, class MakeClassifier>
-MeshArrangementInput build(const std::vector<Point>& points, const std::vector<CellArray<Dim>>& cells,
-                           const Dual& dual, MakeClassifier make_classifier) {
+MeshArrangementInput build(const std::vector<Point>& points,
+                           const std::vector<CellArray<Dim>>& cells, const Dual& dual,
+                           MakeClassifier make_classifier) {
   constexpr int kCorners = 1 << Dim;
-  if (cells.empty()) throw InvalidInput(std::string("sheet_fields: the mesh has no ") + cell_word(Dim) + "es");
+  if (cells.empty())
+    throw InvalidInput(std::string("sheet_fields: the mesh has no ") + cell_word(Dim) + "es");
   auto data = std::make_shared<MeshFieldData<Dim>>();
   data->points = points;
   data->cells = cells;
@@ -236,12 +245,14 @@ MeshArrangementInput build(const std::vector<Point>& points, const std::vector<C
     // Sides: the nodes joined by edges of other sheets.
     primal::DisjointSets sides(nn);
     for (std::size_t e = 0; e < dual.edges.size(); ++e)
-      if (dual.edge_sheet[e] != static_cast<Index>(s)) sides.unite(dual.edges[e][0], dual.edges[e][1]);
+      if (dual.edge_sheet[e] != static_cast<Index>(s))
+        sides.unite(dual.edges[e][0], dual.edges[e][1]);
     for (Index e : sheet.edges) {
       const auto& E = dual.edges[static_cast<std::size_t>(e)];
       if (sides.find(E[0]) == sides.find(E[1]))
-        throw TopologyError(who + " does not separate the mesh: the ends of its edge " + std::to_string(E[0]) +
-                            "-" + std::to_string(E[1]) + " are joined by edges of other sheets");
+        throw TopologyError(who + " does not separate the mesh: the ends of its edge " +
+                            std::to_string(E[0]) + "-" + std::to_string(E[1]) +
+                            " are joined by edges of other sheets");
     }
     const Index first = sides.find(dual.edges[static_cast<std::size_t>(sheet.edges.front())][0]);
     const Index second = sides.find(dual.edges[static_cast<std::size_t>(sheet.edges.front())][1]);
@@ -250,7 +261,8 @@ MeshArrangementInput build(const std::vector<Point>& points, const std::vector<C
     std::deque<Index> queue;
     for (Index e : sheet.edges)
       for (Index n : dual.edges[static_cast<std::size_t>(e)])
-        if (layer[static_cast<std::size_t>(n)] < 0) layer[static_cast<std::size_t>(n)] = 1, queue.push_back(n);
+        if (layer[static_cast<std::size_t>(n)] < 0)
+          layer[static_cast<std::size_t>(n)] = 1, queue.push_back(n);
     while (!queue.empty()) {
       const Index n = queue.front();
       queue.pop_front();
@@ -277,7 +289,8 @@ MeshArrangementInput build(const std::vector<Point>& points, const std::vector<C
       const auto& v = data->values[id];
       double r = 0.0;
       for (int c = 0; c < kCorners; ++c)
-        r += CellLocator<Dim>::shape(c, hit.u) * v[static_cast<std::size_t>(cell[static_cast<std::size_t>(c)])];
+        r += CellLocator<Dim>::shape(c, hit.u) *
+             v[static_cast<std::size_t>(cell[static_cast<std::size_t>(c)])];
       return r;
     };
     out.sheets.push_back({"sheet " + std::to_string(s), std::move(f), "mesh"});
@@ -287,13 +300,15 @@ MeshArrangementInput build(const std::vector<Point>& points, const std::vector<C
   for (std::size_t c = 0; c < cells.size(); ++c)
     for (int k = 0; k < kCorners; ++k) {
       typename CellLocator<Dim>::Vec u;
-      for (int a = 0; a < Dim; ++a) u[a] = topo::kHexCornerCoords[static_cast<std::size_t>(k)][static_cast<std::size_t>(a)];
+      for (int a = 0; a < Dim; ++a)
+        u[a] = topo::kHexCornerCoords[static_cast<std::size_t>(k)][static_cast<std::size_t>(a)];
       typename CellLocator<Dim>::Mat J;
       loc.map(static_cast<Index>(c), u, &J);
       if (!(J.determinant() > 0.0))
-        throw InvalidInput(std::string("sheet_fields: ") + cell_word(Dim) + " " + std::to_string(c) +
-                           " is inverted or flat at its corner " + std::to_string(k) +
-                           " (Jacobian " + std::to_string(J.determinant()) + "); place the nodes first");
+        throw InvalidInput(std::string("sheet_fields: ") + cell_word(Dim) + " " +
+                           std::to_string(c) + " is inverted or flat at its corner " +
+                           std::to_string(k) + " (Jacobian " + std::to_string(J.determinant()) +
+                           "); place the nodes first");
     }
 
   // The mesh must fill its bounding box: every boundary facet on a box face.
@@ -308,10 +323,11 @@ MeshArrangementInput build(const std::vector<Point>& points, const std::vector<C
   for (const CellFacet& f : dual.boundary) {
     const bool on = classify(f) >= 0;
     if (!on)
-      throw InvalidInput(std::string("sheet_fields: boundary ") + (Dim == 3 ? "face " : "edge ") +
-                         std::to_string(f.local) + " of " + cell_word(Dim) + " " + std::to_string(f.cell) +
-                         " lies on no face of the bounding box: the arrangement domain is a box, so the "
-                         "mesh must fill one");
+      throw InvalidInput(
+          std::string("sheet_fields: boundary ") + (Dim == 3 ? "face " : "edge ") +
+          std::to_string(f.local) + " of " + cell_word(Dim) + " " + std::to_string(f.cell) +
+          " lies on no face of the bounding box: the arrangement domain is a box, so the "
+          "mesh must fill one");
   }
 
   out.domain = Domain{lo, hi, Dim};
@@ -321,15 +337,17 @@ MeshArrangementInput build(const std::vector<Point>& points, const std::vector<C
 }  // namespace
 
 MeshArrangementInput sheet_fields(const primal::HexMesh& mesh) {
-  return build<3>(mesh.points, mesh.hexes, mesh_dual(mesh), [&](const Point& lo, const Point& hi, double tol) {
-    return box_face_classifier(mesh, lo, hi, tol);
-  });
+  return build<3>(mesh.points, mesh.hexes, mesh_dual(mesh),
+                  [&](const Point& lo, const Point& hi, double tol) {
+                    return box_face_classifier(mesh, lo, hi, tol);
+                  });
 }
 
 MeshArrangementInput sheet_fields(const primal::QuadMesh& mesh) {
-  return build<2>(mesh.points, mesh.quads, mesh_dual(mesh), [&](const Point& lo, const Point& hi, double tol) {
-    return box_face_classifier(mesh, lo, hi, tol);
-  });
+  return build<2>(mesh.points, mesh.quads, mesh_dual(mesh),
+                  [&](const Point& lo, const Point& hi, double tol) {
+                    return box_face_classifier(mesh, lo, hi, tol);
+                  });
 }
 
 }  // namespace geode::stc

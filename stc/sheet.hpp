@@ -29,7 +29,7 @@ Point gradient(const Field& f, const Point& x, double h, int dim);
 // seam crossing another sheet is reported by the engine as a failure to trace, never hidden).
 Field field_union(Field a, Field b);
 Field field_intersection(Field a, Field b);
-Field field_offset(Field a, double d);          // a - d
-Field field_scaled(Field a, double s);           // s * a (flips the sides for s < 0)
+Field field_offset(Field a, double d);  // a - d
+Field field_scaled(Field a, double s);  // s * a (flips the sides for s < 0)
 
 }  // namespace geode::stc

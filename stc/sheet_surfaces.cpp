@@ -19,7 +19,8 @@ using primal::Index;
 // triangles), which match across shared faces, so the zero set comes out without cracks.
 class GridContour {
  public:
-  GridContour(const Domain& domain, const ContourOptions& options) : domain_(domain), options_(options) {
+  GridContour(const Domain& domain, const ContourOptions& options)
+      : domain_(domain), options_(options) {
     if (options.resolution < 2) throw InvalidInput("contour: resolution must be at least 2");
     const int dim = domain.dim;
     const Point extent = domain.hi - domain.lo;
@@ -27,12 +28,17 @@ class GridContour {
     for (int a = 0; a < dim; ++a) longest = std::max(longest, extent[a]);
     if (!(longest > 0)) throw InvalidInput("contour: the domain is empty");
     for (int a = 0; a < 3; ++a)
-      n_[a] = a < dim ? std::max(2, static_cast<int>(std::lround(options.resolution * extent[a] / longest))) : 0;
+      n_[a] =
+          a < dim
+              ? std::max(2, static_cast<int>(std::lround(options.resolution * extent[a] / longest)))
+              : 0;
     // Kuhn simplices: a path from corner 0 to the opposite corner, one axis at a time.
     std::array<int, 3> axes{0, 1, 2};
     do {
       std::array<int, 4> s{0, 0, 0, 0};
-      for (int k = 0; k < dim; ++k) s[static_cast<std::size_t>(k + 1)] = s[static_cast<std::size_t>(k)] | (1 << axes[static_cast<std::size_t>(k)]);
+      for (int k = 0; k < dim; ++k)
+        s[static_cast<std::size_t>(k + 1)] =
+            s[static_cast<std::size_t>(k)] | (1 << axes[static_cast<std::size_t>(k)]);
       simplices_.push_back(s);
     } while (std::next_permutation(axes.begin(), axes.begin() + dim));
   }
@@ -41,7 +47,8 @@ class GridContour {
   void run(const Field& f, std::vector<Point>& points, std::vector<std::array<Index, 3>>* tris,
            std::vector<std::array<Index, 2>>* segs) {
     const int dim = domain_.dim;
-    const std::size_t nodes = static_cast<std::size_t>(n_[0] + 1) * (n_[1] + 1) * (dim == 3 ? n_[2] + 1 : 1);
+    const std::size_t nodes =
+        static_cast<std::size_t>(n_[0] + 1) * (n_[1] + 1) * (dim == 3 ? n_[2] + 1 : 1);
     values_.assign(nodes, 0.0);
     for (std::size_t i = 0; i < nodes; ++i) values_[i] = f(domain_point(domain_, local(i)));
     edge_vertex_.clear();
@@ -53,7 +60,8 @@ class GridContour {
             std::array<std::size_t, 4> g{};
             for (int c = 0; c <= dim; ++c) {
               const int b = s[static_cast<std::size_t>(c)];
-              g[static_cast<std::size_t>(c)] = node(i + (b & 1), j + ((b >> 1) & 1), k + ((b >> 2) & 1));
+              g[static_cast<std::size_t>(c)] =
+                  node(i + (b & 1), j + ((b >> 1) & 1), k + ((b >> 2) & 1));
             }
             simplex(f, g, points, tris, segs);
           }
@@ -61,10 +69,12 @@ class GridContour {
 
  private:
   std::size_t node(int i, int j, int k) const {
-    return (static_cast<std::size_t>(k) * (n_[1] + 1) + static_cast<std::size_t>(j)) * (n_[0] + 1) + static_cast<std::size_t>(i);
+    return (static_cast<std::size_t>(k) * (n_[1] + 1) + static_cast<std::size_t>(j)) * (n_[0] + 1) +
+           static_cast<std::size_t>(i);
   }
   Point local(std::size_t id) const {
-    const std::size_t nx = static_cast<std::size_t>(n_[0] + 1), ny = static_cast<std::size_t>(n_[1] + 1);
+    const std::size_t nx = static_cast<std::size_t>(n_[0] + 1),
+                      ny = static_cast<std::size_t>(n_[1] + 1);
     Point r = Point::Zero();
     r[0] = static_cast<double>(id % nx) / n_[0];
     r[1] = static_cast<double>((id / nx) % ny) / n_[1];
@@ -111,23 +121,29 @@ class GridContour {
     int nn = 0, np = 0;
     for (int c = 0; c <= dim; ++c) {
       const std::size_t v = g[static_cast<std::size_t>(c)];
-      if (values_[v] < 0) neg[static_cast<std::size_t>(nn++)] = v;
-      else pos[static_cast<std::size_t>(np++)] = v;
+      if (values_[v] < 0)
+        neg[static_cast<std::size_t>(nn++)] = v;
+      else
+        pos[static_cast<std::size_t>(np++)] = v;
     }
     if (nn == 0 || np == 0) return;
     if (dim == 2) {
       const std::size_t lone = nn == 1 ? neg[0] : pos[0];
       const auto& others = nn == 1 ? pos : neg;
-      segs->push_back({edge_vertex(f, lone, others[0], points), edge_vertex(f, lone, others[1], points)});
+      segs->push_back(
+          {edge_vertex(f, lone, others[0], points), edge_vertex(f, lone, others[1], points)});
       return;
     }
     // Normal towards the positive side: from the negative corners' centroid to the positive.
     Point towards = Point::Zero();
-    for (int c = 0; c < np; ++c) towards += domain_point(domain_, local(pos[static_cast<std::size_t>(c)])) / np;
-    for (int c = 0; c < nn; ++c) towards -= domain_point(domain_, local(neg[static_cast<std::size_t>(c)])) / nn;
+    for (int c = 0; c < np; ++c)
+      towards += domain_point(domain_, local(pos[static_cast<std::size_t>(c)])) / np;
+    for (int c = 0; c < nn; ++c)
+      towards -= domain_point(domain_, local(neg[static_cast<std::size_t>(c)])) / nn;
     auto add = [&](Index a, Index b, Index c) {
-      const Point n = (points[static_cast<std::size_t>(b)] - points[static_cast<std::size_t>(a)])
-                          .cross(points[static_cast<std::size_t>(c)] - points[static_cast<std::size_t>(a)]);
+      const Point n =
+          (points[static_cast<std::size_t>(b)] - points[static_cast<std::size_t>(a)])
+              .cross(points[static_cast<std::size_t>(c)] - points[static_cast<std::size_t>(a)]);
       if (n.dot(towards) < 0) std::swap(b, c);
       tris->push_back({a, b, c});
     };
@@ -139,8 +155,10 @@ class GridContour {
       return;
     }
     // Two and two: the crossed edges form a quad n0p0, n0p1, n1p1, n1p0.
-    const Index q0 = edge_vertex(f, neg[0], pos[0], points), q1 = edge_vertex(f, neg[0], pos[1], points);
-    const Index q2 = edge_vertex(f, neg[1], pos[1], points), q3 = edge_vertex(f, neg[1], pos[0], points);
+    const Index q0 = edge_vertex(f, neg[0], pos[0], points),
+                q1 = edge_vertex(f, neg[0], pos[1], points);
+    const Index q2 = edge_vertex(f, neg[1], pos[1], points),
+                q3 = edge_vertex(f, neg[1], pos[0], points);
     add(q0, q1, q2);
     add(q0, q2, q3);
   }
@@ -159,8 +177,10 @@ std::array<std::array<int, 4>, 3> quad_order() {
   std::array<std::array<int, 4>, 3> order{};
   for (int k = 0; k < 3; ++k)
     for (int i = 0; i < 4; ++i) {
-      const auto& c = primal::topology::kHexCornerCoords[static_cast<std::size_t>(primal::topology::kHexEdgeCorners[static_cast<std::size_t>(4 * k + i)][0])];
-      const int u = c[static_cast<std::size_t>((k + 1) % 3)], v = c[static_cast<std::size_t>((k + 2) % 3)];
+      const auto& c = primal::topology::kHexCornerCoords[static_cast<std::size_t>(
+          primal::topology::kHexEdgeCorners[static_cast<std::size_t>(4 * k + i)][0])];
+      const int u = c[static_cast<std::size_t>((k + 1) % 3)],
+                v = c[static_cast<std::size_t>((k + 2) % 3)];
       const int slot = v == 0 ? u : 3 - u;  // (0,0) 0, (1,0) 1, (1,1) 2, (0,1) 3
       order[static_cast<std::size_t>(k)][static_cast<std::size_t>(slot)] = 4 * k + i;
     }
@@ -172,7 +192,9 @@ template <class Out>
 Index midpoint_vertex(const std::vector<Point>& nodes, const std::array<Index, 2>& edge, Index e,
                       std::unordered_map<Index, Index>& ids, Out& out) {
   const auto [it, added] = ids.emplace(e, static_cast<Index>(out.points.size()));
-  if (added) out.points.push_back(0.5 * (nodes[static_cast<std::size_t>(edge[0])] + nodes[static_cast<std::size_t>(edge[1])]));
+  if (added)
+    out.points.push_back(0.5 * (nodes[static_cast<std::size_t>(edge[0])] +
+                                nodes[static_cast<std::size_t>(edge[1])]));
   return it->second;
 }
 
@@ -180,19 +202,24 @@ Index midpoint_vertex(const std::vector<Point>& nodes, const std::array<Index, 2
 
 std::vector<primal::TriMesh> contour_sheets(const std::vector<Sheet>& sheets, const Domain& domain,
                                             const ContourOptions& options) {
-  if (domain.dim != 3) throw InvalidInput("contour_sheets: a 3D domain is needed (contour_curves for 2D)");
+  if (domain.dim != 3)
+    throw InvalidInput("contour_sheets: a 3D domain is needed (contour_curves for 2D)");
   GridContour grid(domain, options);
   std::vector<primal::TriMesh> out(sheets.size());
-  for (std::size_t s = 0; s < sheets.size(); ++s) grid.run(sheets[s].field, out[s].points, &out[s].tris, nullptr);
+  for (std::size_t s = 0; s < sheets.size(); ++s)
+    grid.run(sheets[s].field, out[s].points, &out[s].tris, nullptr);
   return out;
 }
 
-std::vector<primal::SegmentMesh> contour_curves(const std::vector<Sheet>& sheets, const Domain& domain,
+std::vector<primal::SegmentMesh> contour_curves(const std::vector<Sheet>& sheets,
+                                                const Domain& domain,
                                                 const ContourOptions& options) {
-  if (domain.dim != 2) throw InvalidInput("contour_curves: a 2D domain is needed (contour_sheets for 3D)");
+  if (domain.dim != 2)
+    throw InvalidInput("contour_curves: a 2D domain is needed (contour_sheets for 3D)");
   GridContour grid(domain, options);
   std::vector<primal::SegmentMesh> out(sheets.size());
-  for (std::size_t s = 0; s < sheets.size(); ++s) grid.run(sheets[s].field, out[s].points, nullptr, &out[s].segments);
+  for (std::size_t s = 0; s < sheets.size(); ++s)
+    grid.run(sheets[s].field, out[s].points, nullptr, &out[s].segments);
   return out;
 }
 
@@ -206,7 +233,8 @@ std::vector<primal::TriMesh> dual_surfaces(const primal::HexMesh& mesh, const He
       std::array<Index, 4> q{};
       for (std::size_t i = 0; i < 4; ++i) {
         const Index e = dual.cell_edges[c][static_cast<std::size_t>(order[k][i])];
-        q[i] = midpoint_vertex(mesh.points, dual.edges[static_cast<std::size_t>(e)], e, ids[s], out[s]);
+        q[i] = midpoint_vertex(mesh.points, dual.edges[static_cast<std::size_t>(e)], e, ids[s],
+                               out[s]);
       }
       out[s].tris.push_back({q[0], q[1], q[2]});
       out[s].tris.push_back({q[0], q[2], q[3]});
@@ -221,8 +249,10 @@ std::vector<primal::SegmentMesh> dual_curves(const primal::QuadMesh& mesh, const
     for (std::size_t k = 0; k < 2; ++k) {
       const auto s = static_cast<std::size_t>(dual.cell_sheets[c][k]);
       const Index a = dual.cell_edges[c][k], b = dual.cell_edges[c][k + 2];  // opposite edges
-      out[s].segments.push_back({midpoint_vertex(mesh.points, dual.edges[static_cast<std::size_t>(a)], a, ids[s], out[s]),
-                                 midpoint_vertex(mesh.points, dual.edges[static_cast<std::size_t>(b)], b, ids[s], out[s])});
+      out[s].segments.push_back(
+          {midpoint_vertex(mesh.points, dual.edges[static_cast<std::size_t>(a)], a, ids[s], out[s]),
+           midpoint_vertex(mesh.points, dual.edges[static_cast<std::size_t>(b)], b, ids[s],
+                           out[s])});
     }
   return out;
 }

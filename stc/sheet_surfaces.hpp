@@ -29,7 +29,8 @@ struct ContourOptions {
 std::vector<primal::TriMesh> contour_sheets(const std::vector<Sheet>& sheets, const Domain& domain,
                                             const ContourOptions& options = {});
 // One polyline per sheet (2D domains, z = 0).
-std::vector<primal::SegmentMesh> contour_curves(const std::vector<Sheet>& sheets, const Domain& domain,
+std::vector<primal::SegmentMesh> contour_curves(const std::vector<Sheet>& sheets,
+                                                const Domain& domain,
                                                 const ContourOptions& options = {});
 
 // The dual surface of every sheet of `dual` (computed from `mesh`), in dual's sheet order, as

@@ -19,15 +19,17 @@ std::vector<SurfaceChord> surface_chords(const std::vector<std::array<primal::In
     for (std::size_t e = 0; e < 4; ++e) {
       const Index a = quads[q][e], b = quads[q][(e + 1) % 4];
       const auto key = std::minmax(a, b);
-      auto [it, fresh] = edge_id.emplace(std::make_pair(key.first, key.second), static_cast<Index>(uses.size()));
+      auto [it, fresh] =
+          edge_id.emplace(std::make_pair(key.first, key.second), static_cast<Index>(uses.size()));
       if (fresh) uses.push_back(0);
       ++uses[static_cast<std::size_t>(it->second)];
       quad_edges[q][e] = it->second;
     }
   for (const auto& [key, id] : edge_id)
     if (uses[static_cast<std::size_t>(id)] != 2)
-      throw TopologyError("surface chords: edge " + std::to_string(key.first) + "-" + std::to_string(key.second) +
-                          " is in " + std::to_string(uses[static_cast<std::size_t>(id)]) + " quads (expected 2)");
+      throw TopologyError(
+          "surface chords: edge " + std::to_string(key.first) + "-" + std::to_string(key.second) +
+          " is in " + std::to_string(uses[static_cast<std::size_t>(id)]) + " quads (expected 2)");
   primal::DisjointSets chords(uses.size());
   for (const auto& e : quad_edges) {
     chords.unite(e[0], e[2]);

@@ -19,9 +19,12 @@ Point flat(const Point& p) { return Point(p[0], 0.0, p[2]); }
 std::vector<Tunnel> complete_tunnels(const InterfacePatch& patch,
                                      const std::function<double(const Point& along)>& height) {
   std::vector<Tunnel> out;
-  if (patch.cells.size() != 1) throw InvalidInput("complete_tunnels: a template is built over one interface cell");
+  if (patch.cells.size() != 1)
+    throw InvalidInput("complete_tunnels: a template is built over one interface cell");
   const auto& cell = patch.cells.front();
-  const auto P = [&](int i) { return flat(patch.points[static_cast<std::size_t>(cell[static_cast<std::size_t>(i)])]); };
+  const auto P = [&](int i) {
+    return flat(patch.points[static_cast<std::size_t>(cell[static_cast<std::size_t>(i)])]);
+  };
   if (patch.dim == 2) {
     if (cell.size() != 2) throw InvalidInput("complete_tunnels: a 2D interface cell is a segment");
     // The dual of a segment is its midpoint; dicing doubles it at the quarter points.
@@ -29,15 +32,18 @@ std::vector<Tunnel> complete_tunnels(const InterfacePatch& patch,
     const double a = 0.25 * (P(1) - P(0)).norm();
     const double h = height(Point::Zero());
     Tunnel t;
-    t.sheet = {"tunnel", [mid, a, h](const Point& x) {
+    t.sheet = {"tunnel",
+               [mid, a, h](const Point& x) {
                  const double d = std::abs(x[0] - mid[0]) / a, y = x[1] / h;
                  return d * d + y * y - 1.0;
-               }, "tunnel"};
+               },
+               "tunnel"};
     t.along = Point::Zero();
     out.push_back(t);
     return out;
   }
-  if (cell.size() != 4) throw InvalidInput("complete_tunnels: a 3D hex-side interface cell is a quad");
+  if (cell.size() != 4)
+    throw InvalidInput("complete_tunnels: a 3D hex-side interface cell is a quad");
   // A quad has two chords; chord i crosses edges i and i+2 (primal/topology.hpp quad edges).
   for (int i = 0; i < 2; ++i) {
     const Point m0 = 0.5 * (P(i) + P(i + 1));
@@ -47,12 +53,14 @@ std::vector<Tunnel> complete_tunnels(const InterfacePatch& patch,
     const double h = height(dir);
     Tunnel t;
     t.along = dir;
-    t.sheet = {"tunnel " + std::to_string(i), [m0, dir, a, h](const Point& x) {
+    t.sheet = {"tunnel " + std::to_string(i),
+               [m0, dir, a, h](const Point& x) {
                  Point q = flat(x) - m0;
                  q -= q.dot(dir) * dir;
                  const double d = q.norm() / a, y = x[1] / h;
                  return d * d + y * y - 1.0;
-               }, "tunnel"};
+               },
+               "tunnel"};
     out.push_back(t);
   }
   return out;
@@ -65,7 +73,8 @@ DicedPatch dice_patch(const InterfacePatch& p) {
     for (std::size_t i = 0; i < p.points.size(); ++i) d.owners.push_back({static_cast<int>(i)});
     for (const auto& c : p.cells) {
       if (c.size() != 2) throw InvalidInput("dice_patch: a 2D interface cell is a segment");
-      d.nodes.push_back(0.5 * (p.points[static_cast<std::size_t>(c[0])] + p.points[static_cast<std::size_t>(c[1])]));
+      d.nodes.push_back(0.5 * (p.points[static_cast<std::size_t>(c[0])] +
+                               p.points[static_cast<std::size_t>(c[1])]));
       d.owners.push_back({c[0], c[1]});
       const int m = static_cast<int>(d.nodes.size() - 1);
       d.cells.push_back({c[0], m});
@@ -86,8 +95,10 @@ DicedPatch dice_patch(const InterfacePatch& p) {
       d.owners.push_back(own);
     }
   };
-  const bool quads = std::all_of(p.cells.begin(), p.cells.end(), [](const auto& c) { return c.size() == 4; });
-  const bool tris = std::all_of(p.cells.begin(), p.cells.end(), [](const auto& c) { return c.size() == 3; });
+  const bool quads =
+      std::all_of(p.cells.begin(), p.cells.end(), [](const auto& c) { return c.size() == 4; });
+  const bool tris =
+      std::all_of(p.cells.begin(), p.cells.end(), [](const auto& c) { return c.size() == 3; });
   if (quads) {
     primal::QuadMesh m{p.points, {}};
     for (const auto& c : p.cells) m.quads.push_back({c[0], c[1], c[2], c[3]});
@@ -102,8 +113,11 @@ DicedPatch dice_patch(const InterfacePatch& p) {
   return d;
 }
 
-std::vector<Dome> complete_domes(const InterfacePatch& patch, double v_top, double k, double blend) {
-  return complete_domes(patch, v_top, [k, blend](int) { return DomeShape{k, blend, 2.0, Point::Zero()}; });
+std::vector<Dome> complete_domes(const InterfacePatch& patch, double v_top, double k,
+                                 double blend) {
+  return complete_domes(patch, v_top, [k, blend](int) {
+    return DomeShape{k, blend, 2.0, Point::Zero()};
+  });
 }
 
 std::vector<Dome> complete_domes(const InterfacePatch& patch, double v_top,
@@ -116,14 +130,16 @@ std::vector<Dome> complete_domes(const InterfacePatch& patch, double v_top,
     if (!used) continue;
     const DomeShape s = shape(v);
     const double p = s.exponent;
-    if (!(p >= 1) || !std::isfinite(p)) throw InvalidInput("complete_domes: the exponent must be >= 1 and finite");
+    if (!(p >= 1) || !std::isfinite(p))
+      throw InvalidInput("complete_domes: the exponent must be >= 1 and finite");
     const bool round = p == 2.0;
     const Point V = flat(patch.points[static_cast<std::size_t>(v)]) + flat(s.offset);
     // In-plane distance from the dome's centre: Euclidean for p = 2 (the spheroid's own
     // formula), else the p-norm whose unit ball is the superquadric's trace.
     const auto distance = [V, p, round](const Point& x) {
       const Point d = flat(x) - V;
-      return round ? d.norm() : std::pow(std::pow(std::abs(d[0]), p) + std::pow(std::abs(d[2]), p), 1.0 / p);
+      return round ? d.norm()
+                   : std::pow(std::pow(std::abs(d[0]), p) + std::pow(std::abs(d[2]), p), 1.0 / p);
     };
     // The trace around v encloses the diced nodes that belong to v (v itself, the midpoints of
     // its edges, the centres of its cells) and leaves out all others.
@@ -137,7 +153,8 @@ std::vector<Dome> complete_domes(const InterfacePatch& patch, double v_top,
         outside = std::min(outside, d);
     }
     if (!(inside < outside))
-      throw TopologyError("complete_domes: no " + std::string(round ? "circle" : "superquadric trace") +
+      throw TopologyError("complete_domes: no " +
+                          std::string(round ? "circle" : "superquadric trace") +
                           " around interface vertex " + std::to_string(v) +
                           " separates its diced nodes from the others");
     const double R = inside + s.blend * (outside - inside);
@@ -146,16 +163,20 @@ std::vector<Dome> complete_domes(const InterfacePatch& patch, double v_top,
     d.vertex = v;
     d.radius = R;
     if (round)
-      d.sheet = {"dome " + std::to_string(v), [V, R, depth, v_top](const Point& x) {
+      d.sheet = {"dome " + std::to_string(v),
+                 [V, R, depth, v_top](const Point& x) {
                    const double r = (flat(x) - V).norm() / R, y = (v_top - x[1]) / depth;
                    return r * r + y * y - 1.0;
-                 }, "dome"};
+                 },
+                 "dome"};
     else
-      d.sheet = {"dome " + std::to_string(v), [V, R, depth, v_top, p](const Point& x) {
+      d.sheet = {"dome " + std::to_string(v),
+                 [V, R, depth, v_top, p](const Point& x) {
                    const Point q = flat(x) - V;
                    return std::pow(std::abs(q[0]) / R, p) + std::pow(std::abs(q[2]) / R, p) +
                           std::pow(std::abs(v_top - x[1]) / depth, p) - 1.0;
-                 }, "dome"};
+                 },
+                 "dome"};
     out.push_back(d);
   }
   return out;

@@ -61,7 +61,7 @@ struct Dome {
   double radius;  // R
 };
 std::vector<Dome> complete_domes(const InterfacePatch& triangles, double v_top, double depth,
-                                double blend = 0.5);
+                                 double blend = 0.5);
 
 // A wider dome family: each vertex's dome gets its own depth and blend, a superquadric shape
 // f = |dx / R|^p + |dz / R|^p + |(v_top - v) / depth|^p - 1 (p = 2 is the spheroid above,

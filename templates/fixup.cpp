@@ -13,7 +13,8 @@ namespace {
 
 using primal::Index;
 
-std::vector<primal::Obstruction> obstructions(const primal::HexMesh& mesh, const std::vector<unsigned>& node_faces) {
+std::vector<primal::Obstruction> obstructions(const primal::HexMesh& mesh,
+                                              const std::vector<unsigned>& node_faces) {
   primal::RealizabilityOptions o;
   o.node_faces = node_faces;
   return primal::find_obstructions(mesh, o);
@@ -26,7 +27,8 @@ int sheet_across(const Template& t, Index h, int f) {
   const auto& face = primal::topology::kHexFaceCorners[static_cast<std::size_t>(f)];
   for (int s : t.element_sheets[static_cast<std::size_t>(h)]) {
     const auto sign = [&](int i) {
-      return t.node_signs[static_cast<std::size_t>(hex[static_cast<std::size_t>(face[static_cast<std::size_t>(i)])])][static_cast<std::size_t>(s)];
+      return t.node_signs[static_cast<std::size_t>(hex[static_cast<std::size_t>(
+          face[static_cast<std::size_t>(i)])])][static_cast<std::size_t>(s)];
     };
     if (sign(0) == sign(1) && sign(1) == sign(2) && sign(2) == sign(3)) return s;
   }
@@ -48,7 +50,9 @@ void apply(Template& t, const std::vector<Index>& set, primal::PillowResult r) {
       for (int f = 0; f < 6; ++f) {
         bool same = true;
         for (int i = 0; i < 4; ++i)
-          same &= hex[static_cast<std::size_t>(primal::topology::kHexFaceCorners[static_cast<std::size_t>(f)][static_cast<std::size_t>(i)])] ==
+          same &= hex[static_cast<std::size_t>(
+                      primal::topology::kHexFaceCorners[static_cast<std::size_t>(f)]
+                                                       [static_cast<std::size_t>(i)])] ==
                   lh[static_cast<std::size_t>(i) + 4];
         if (!same) continue;
         const int across = sheet_across(t, h, f);
@@ -61,19 +65,22 @@ void apply(Template& t, const std::vector<Index>& set, primal::PillowResult r) {
   }
   std::vector<char> inside(r.mesh.points.size(), 0);
   for (Index h : set)
-    for (Index n : r.mesh.hexes[static_cast<std::size_t>(h)]) inside[static_cast<std::size_t>(n)] = 1;
+    for (Index n : r.mesh.hexes[static_cast<std::size_t>(h)])
+      inside[static_cast<std::size_t>(n)] = 1;
   for (std::size_t i = 0; i < r.copy_of.size(); ++i) {
     t.node_signs.push_back(t.node_signs[static_cast<std::size_t>(r.copy_of[i])]);
     t.node_faces.push_back(0u);
   }
-  for (std::size_t n = 0; n < t.node_signs.size(); ++n) t.node_signs[n].push_back(inside[n] ? -1 : 1);
+  for (std::size_t n = 0; n < t.node_signs.size(); ++n)
+    t.node_signs[n].push_back(inside[n] ? -1 : 1);
   for (auto& s : layer_sheets) t.element_sheets.push_back(s);
   t.hex = std::move(r.mesh);
 }
 
 // Shrink sets to try for one obstruction: every non-empty subset of its hexes, smallest first
 // (fewer new hexes), or each hex alone and all of them when there are too many for subsets.
-std::vector<std::vector<Index>> candidate_sets(const std::vector<Index>& hexes, int max_subset_hexes) {
+std::vector<std::vector<Index>> candidate_sets(const std::vector<Index>& hexes,
+                                               int max_subset_hexes) {
   std::vector<std::vector<Index>> c;
   const int k = static_cast<int>(hexes.size());
   if (k > max_subset_hexes) {
@@ -87,7 +94,8 @@ std::vector<std::vector<Index>> candidate_sets(const std::vector<Index>& hexes, 
       if ((m >> i) & 1u) set.push_back(hexes[static_cast<std::size_t>(i)]);
     c.push_back(set);
   }
-  std::stable_sort(c.begin(), c.end(), [](const auto& a, const auto& b) { return a.size() < b.size(); });
+  std::stable_sort(c.begin(), c.end(),
+                   [](const auto& a, const auto& b) { return a.size() < b.size(); });
   return c;
 }
 
@@ -111,7 +119,8 @@ FixupResult fix_up(Template& t, const FixupOptions& options) {
     for (const auto& o : current) {
       for (const auto& set : candidate_sets(o.hexes, options.max_subset_hexes)) {
         const auto r = primal::pillow(t.hex, set, options.pillow);
-        if (!combinatorially_valid(primal::check_validity(r.mesh))) continue;  // the set's surface is not manifold
+        if (!combinatorially_valid(primal::check_validity(r.mesh)))
+          continue;  // the set's surface is not manifold
         std::vector<unsigned> faces = t.node_faces;
         faces.resize(r.mesh.points.size(), 0u);
         const std::size_t left = obstructions(r.mesh, faces).size();
@@ -123,7 +132,8 @@ FixupResult fix_up(Template& t, const FixupOptions& options) {
     std::ostringstream s;
     s << "pillow hexes";
     for (Index h : best_set) s << " " << h;
-    s << " (" << primal::to_string(fixed->kind) << "): " << current.size() << " -> " << best << " obstructions";
+    s << " (" << primal::to_string(fixed->kind) << "): " << current.size() << " -> " << best
+      << " obstructions";
     out.steps.push_back(s.str());
     apply(t, best_set, primal::pillow(t.hex, best_set, options.pillow));
     current = obstructions(t.hex, t.node_faces);

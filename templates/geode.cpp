@@ -47,8 +47,9 @@ unsigned faces_of(const Point& r, const stc::Domain& D) {
 // face matches the diced node whose neighbourhood inside the cell has the same sides of every
 // sheet and which lies on the same box faces. Then every diced cell must be a boundary
 // element face of the template: the boundary is the prescribed one.
-void place_interface(const stc::DualMesh& D, const std::vector<stc::Sheet>& sheets, const DicedPatch& diced,
-                     int face, const stc::Domain& dom, std::vector<Point>& pts, const char* side_name) {
+void place_interface(const stc::DualMesh& D, const std::vector<stc::Sheet>& sheets,
+                     const DicedPatch& diced, int face, const stc::Domain& dom,
+                     std::vector<Point>& pts, const char* side_name) {
   const std::size_t nodes = D.node_faces.size();
   std::vector<int> node_of(diced.nodes.size(), -1);
   const Point centre = 0.5 * (dom.lo + dom.hi);
@@ -62,13 +63,15 @@ void place_interface(const stc::DualMesh& D, const std::vector<stc::Sheet>& shee
     for (std::size_t n = 0; n < nodes; ++n) {
       if (D.node_faces[n] != f || D.node_signs[n] != sg) continue;
       if (node_of[i] >= 0)
-        throw TopologyError(std::string("geode: two template nodes match the diced ") + side_name + " node " +
-                            std::to_string(i) + ": the boundary is not the prescribed one");
+        throw TopologyError(std::string("geode: two template nodes match the diced ") + side_name +
+                            " node " + std::to_string(i) +
+                            ": the boundary is not the prescribed one");
       node_of[i] = static_cast<int>(n);
     }
     if (node_of[i] < 0)
-      throw TopologyError(std::string("geode: no template node matches the diced ") + side_name + " node " +
-                          std::to_string(i) + ": the boundary is not the prescribed one");
+      throw TopologyError(std::string("geode: no template node matches the diced ") + side_name +
+                          " node " + std::to_string(i) +
+                          ": the boundary is not the prescribed one");
   }
   // Every dual node on that face must be matched, and every diced cell must be a face of it.
   std::set<int> matched(node_of.begin(), node_of.end());
@@ -95,10 +98,12 @@ void place_interface(const stc::DualMesh& D, const std::vector<stc::Sheet>& shee
     for (int i : c) k.push_back(node_of[static_cast<std::size_t>(i)]);
     std::sort(k.begin(), k.end());
     if (!faces.count(k))
-      throw TopologyError(std::string("geode: a diced ") + side_name +
-                          " cell is not a face of the template: the boundary is not the prescribed one");
+      throw TopologyError(
+          std::string("geode: a diced ") + side_name +
+          " cell is not a face of the template: the boundary is not the prescribed one");
   }
-  for (std::size_t i = 0; i < diced.nodes.size(); ++i) pts[static_cast<std::size_t>(node_of[i])] = diced.nodes[i];
+  for (std::size_t i = 0; i < diced.nodes.size(); ++i)
+    pts[static_cast<std::size_t>(node_of[i])] = diced.nodes[i];
 }
 
 InterleaveChecks check_interleave(const stc::Arrangement& A, const std::vector<SheetInfo>& info,
@@ -124,13 +129,16 @@ InterleaveChecks check_interleave(const stc::Arrangement& A, const std::vector<S
     ++c.triple_dome_points;
     if (!in_all_tunnels(v.x)) {
       c.triple_domes_in_pocket = false;
-      c.failures.push_back("condition 1: the point where three domes meet is not inside both tunnels");
+      c.failures.push_back(
+          "condition 1: the point where three domes meet is not inside both tunnels");
     }
   }
   const int top = stc::box_face(1, true);
   c.dome_curves_exit_in_tunnels = true;
   for (const auto& cv : A.curves) {
-    if (A.domain.dim != 3 || cv.sheets.size() != 2 || !is_dome(cv.sheets[0]) || !is_dome(cv.sheets[1])) continue;
+    if (A.domain.dim != 3 || cv.sheets.size() != 2 || !is_dome(cv.sheets[0]) ||
+        !is_dome(cv.sheets[1]))
+      continue;
     ++c.dome_curves;
     if (cv.closed) {
       c.dome_curves_exit_in_tunnels = false;
@@ -147,7 +155,8 @@ InterleaveChecks check_interleave(const stc::Arrangement& A, const std::vector<S
       const Point x = e == 0 ? cv.polyline.front() : cv.polyline.back();
       if (f == stc::box_face(1, false) || !in_some_tunnel(x)) {
         c.dome_curves_exit_in_tunnels = false;
-        c.failures.push_back("condition 2: the curve of " + info[static_cast<std::size_t>(cv.sheets[0])].name + " and " +
+        c.failures.push_back("condition 2: the curve of " +
+                             info[static_cast<std::size_t>(cv.sheets[0])].name + " and " +
                              info[static_cast<std::size_t>(cv.sheets[1])].name +
                              " leaves the cell outside every tunnel entrance");
       }
@@ -196,10 +205,13 @@ std::string push_error(const PushParameters& p, std::string* key) {
     return std::string(why);
   };
   if (!(0 < p.low_roof && p.low_roof < p.high_roof && p.high_roof < 1))
-    return fault("low_roof", "tunnel roofs must satisfy 0 < low < high < 1 (tunnels must not reach the tet side)");
+    return fault(
+        "low_roof",
+        "tunnel roofs must satisfy 0 < low < high < 1 (tunnels must not reach the tet side)");
   if (!(0 < p.dome_depth && p.dome_depth < 1))
     return fault("dome_depth", "dome depth must be in (0, 1) (domes must not reach the hex side)");
-  if (!(0 < p.dome_radius && p.dome_radius < 1)) return fault("dome_radius", "dome radius blend must be in (0, 1)");
+  if (!(0 < p.dome_radius && p.dome_radius < 1))
+    return fault("dome_radius", "dome radius blend must be in (0, 1)");
   if (!(p.centre_depth >= 0 && p.centre_depth < 1 && p.centre_radius >= 0 && p.centre_radius < 1))
     return fault(p.centre_depth >= 0 && p.centre_depth < 1 ? "centre_radius" : "centre_depth",
                  "centre dome depth and radius blend must be in [0, 1) (0: as the corner domes)");
@@ -207,9 +219,11 @@ std::string push_error(const PushParameters& p, std::string* key) {
   if (!(p.dome_exponent >= 1 && p.dome_exponent <= 20))
     return fault("dome_exponent", "dome exponent must be in [1, 20] (2: spheroids)");
   if (!(p.centre_exponent == 0 || (p.centre_exponent >= 1 && p.centre_exponent <= 20)))
-    return fault("centre_exponent", "centre dome exponent must be 0 (as the corner domes) or in [1, 20]");
+    return fault("centre_exponent",
+                 "centre dome exponent must be 0 (as the corner domes) or in [1, 20]");
   if (!(p.dome_offset >= 0 && p.dome_offset < 1))
-    return fault("dome_offset", "dome offset must be in [0, 1) (a fraction of the way to the tet side's centre)");
+    return fault("dome_offset",
+                 "dome offset must be in [0, 1) (a fraction of the way to the tet side's centre)");
   for (int a = 0; a < 2; ++a)
     if (!(std::abs(p.centre_offset[static_cast<std::size_t>(a)]) < 1))
       return fault(a == 0 ? "centre_offset[0]" : "centre_offset[1]",
@@ -287,14 +301,16 @@ struct PrescribedFace {
 
 // The dual as a Template: nodes on the bottom (hex- or fine-side) and top faces placed at their
 // prescribed cells' nodes when those are given.
-Template dual_template(const stc::DualMesh& D, const std::vector<stc::Sheet>& sheets, const stc::Domain& dom,
-                       const PrescribedFace* bottom, const PrescribedFace* top) {
+Template dual_template(const stc::DualMesh& D, const std::vector<stc::Sheet>& sheets,
+                       const stc::Domain& dom, const PrescribedFace* bottom,
+                       const PrescribedFace* top) {
   const int dim = D.dim;
   Template T;
   T.dim = dim;
   for (const auto& s : sheets) T.sheets.push_back({s.name, s.kind});
   std::vector<Point> pts = dim == 3 ? D.hex.points : D.quad.points;
-  if (bottom) place_interface(D, sheets, bottom->cells, stc::box_face(1, false), dom, pts, bottom->name);
+  if (bottom)
+    place_interface(D, sheets, bottom->cells, stc::box_face(1, false), dom, pts, bottom->name);
   if (top) place_interface(D, sheets, top->cells, stc::box_face(1, true), dom, pts, top->name);
   if (dim == 3) {
     T.hex.hexes = D.hex.hexes;
@@ -321,9 +337,12 @@ Template build_in_place(const ArrangementSpec& spec, const stc::ArrangementOptio
   } else {
     // A "faces" block's cells are taken as they are, not diced.
     const auto as_given = [](const std::optional<InterfacePatch>& p, const char* name) {
-      return p ? std::optional<PrescribedFace>(PrescribedFace{DicedPatch{p->points, p->cells, {}}, name}) : std::nullopt;
+      return p ? std::optional<PrescribedFace>(
+                     PrescribedFace{DicedPatch{p->points, p->cells, {}}, name})
+               : std::nullopt;
     };
-    const auto bottom = as_given(spec.bottom_face, "faces.bottom"), top = as_given(spec.top_face, "faces.top");
+    const auto bottom = as_given(spec.bottom_face, "faces.bottom"),
+               top = as_given(spec.top_face, "faces.top");
     T = dual_template(D, sheets, spec.domain, bottom ? &*bottom : nullptr, top ? &*top : nullptr);
   }
   T.checks = check_interleave(A, T.sheets, sheets);
@@ -355,7 +374,9 @@ ReferenceFrame frame_of(const Point& lo, const Point& hi, int dim) {
   return f;
 }
 
-std::vector<Point>& template_points(Template& t) { return t.dim == 3 ? t.hex.points : t.quad.points; }
+std::vector<Point>& template_points(Template& t) {
+  return t.dim == 3 ? t.hex.points : t.quad.points;
+}
 
 primal::SmoothResult smooth_in_place(Template& t, bool slide_faces);
 
@@ -364,7 +385,8 @@ primal::SmoothResult smooth_in_place(Template& t, bool slide_faces);
 Template build_template(const ArrangementSpec& spec, const stc::ArrangementOptions& options) {
   // A completion's sheets live in the box's reference frame, so only its coordinates scale.
   // Sheets given as shapes are in the spec's own units and are left as they are.
-  if (!spec.completion || !spec.sheets.empty() || spec.domain.corners) return build_in_place(spec, options);
+  if (!spec.completion || !spec.sheets.empty() || spec.domain.corners)
+    return build_in_place(spec, options);
   const ReferenceFrame f = frame_of(spec.domain.lo, spec.domain.hi, spec.dim);
   if (f.identity()) return build_in_place(spec, options);
   ArrangementSpec s = spec;
@@ -376,8 +398,12 @@ Template build_template(const ArrangementSpec& spec, const stc::ArrangementOptio
   return T;
 }
 
-Template build_geode3d(const GeodeOptions& options) { return build_template(geode_spec(options, 3), options.arrangement); }
-Template build_geode2d(const GeodeOptions& options) { return build_template(geode_spec(options, 2), options.arrangement); }
+Template build_geode3d(const GeodeOptions& options) {
+  return build_template(geode_spec(options, 3), options.arrangement);
+}
+Template build_geode2d(const GeodeOptions& options) {
+  return build_template(geode_spec(options, 2), options.arrangement);
+}
 
 primal::SmoothResult smooth_template(Template& t, bool slide_faces) {
   // In the reference frame of the template's bounding box (see kReferenceSize).
@@ -409,10 +435,14 @@ primal::SmoothResult smooth_in_place(Template& t, bool slide_faces) {
   for (const auto& p : t.quad.points) {
     const bool on_x = std::abs(p.x() - lo.x()) < 1e-9 || std::abs(p.x() - up.x()) < 1e-9;
     const bool on_y = std::abs(p.y() - lo.y()) < 1e-9 || std::abs(p.y() - up.y()) < 1e-9;
-    if ((on_x && on_y) || (on_y && !slide_faces)) c.push_back(primal::NodeConstraint::fixed());
-    else if (on_x) c.push_back(primal::NodeConstraint::line(p, Point::UnitY()));
-    else if (on_y) c.push_back(primal::NodeConstraint::line(p, Point::UnitX()));
-    else c.push_back(primal::NodeConstraint::plane(p, Point::UnitZ()));
+    if ((on_x && on_y) || (on_y && !slide_faces))
+      c.push_back(primal::NodeConstraint::fixed());
+    else if (on_x)
+      c.push_back(primal::NodeConstraint::line(p, Point::UnitY()));
+    else if (on_y)
+      c.push_back(primal::NodeConstraint::line(p, Point::UnitX()));
+    else
+      c.push_back(primal::NodeConstraint::plane(p, Point::UnitZ()));
   }
   return primal::smooth_quad_mesh(t.quad, Point::UnitZ(), c);
 }
@@ -430,10 +460,12 @@ Point box_point(const Point& r, const Eigen::Vector3d& box, int dim) {
 }
 
 Eigen::Vector3d parse_box(const std::string& text) {
-  static const std::regex re(R"(^\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*[xX]\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)(?:\s*[xX]\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?))?\s*$)");
+  static const std::regex re(
+      R"(^\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*[xX]\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)(?:\s*[xX]\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?))?\s*$)");
   std::smatch m;
   if (!std::regex_match(text, m, re))
-    throw InvalidInput("--box '" + text + "': expected WIDTHxHEIGHTxDEPTH such as 24x14x24 (or 24x14 in 2D)");
+    throw InvalidInput("--box '" + text +
+                       "': expected WIDTHxHEIGHTxDEPTH such as 24x14x24 (or 24x14 in 2D)");
   Eigen::Vector3d b(std::stod(m[1]), std::stod(m[2]), m[3].matched ? std::stod(m[3]) : 0.0);
   for (int a = 0; a < (m[3].matched ? 3 : 2); ++a)
     if (!(b[a] > 0)) throw InvalidInput("--box '" + text + "': every dimension must be positive");

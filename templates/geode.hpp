@@ -122,7 +122,8 @@ std::string push_error(const PushParameters& push, std::string* key = nullptr);
 // them together, in the reference cell: the tunnels first ("tunnel x", "tunnel z"; 2D
 // "tunnel"), then the domes ("dome (-x,+z)", "dome centre"; 2D "dome -x"). The tunnel whose
 // chord runs along `higher` gets the high roof.
-std::vector<stc::Sheet> complete_interface(const InterfacePatch& hex_side, const InterfacePatch& tet_side,
+std::vector<stc::Sheet> complete_interface(const InterfacePatch& hex_side,
+                                           const InterfacePatch& tet_side,
                                            const PushParameters& push, Higher higher, int dim);
 
 // The template as an arrangement spec (templates/spec.hpp): the buffer cell's box, its two

@@ -31,7 +31,8 @@ InterfacePatch grid_face(int k, double y, const Eigen::Vector3d& box, int dim) {
     for (int i = 0; i <= k; ++i) d.points.push_back(Point(at(i, box.x()), y, at(j, box.z())));
   const auto n = [k](int i, int j) { return i + (k + 1) * j; };
   for (int j = 0; j < k; ++j)
-    for (int i = 0; i < k; ++i) d.cells.push_back({n(i, j), n(i + 1, j), n(i + 1, j + 1), n(i, j + 1)});
+    for (int i = 0; i < k; ++i)
+      d.cells.push_back({n(i, j), n(i + 1, j), n(i + 1, j + 1), n(i, j + 1)});
   return d;
 }
 
@@ -46,7 +47,9 @@ std::vector<double> chord_offsets(const InterfacePatch& face, int axis) {
   return mid;
 }
 
-json vec(const Point& p, int dim) { return dim == 3 ? json{p.x(), p.y(), p.z()} : json{p.x(), p.y()}; }
+json vec(const Point& p, int dim) {
+  return dim == 3 ? json{p.x(), p.y(), p.z()} : json{p.x(), p.y()};
+}
 
 SheetSpec sheet(const std::string& name, const std::string& kind, json shape) {
   return {name, kind, json{{kind, std::move(shape)}}};
@@ -55,11 +58,13 @@ SheetSpec sheet(const std::string& name, const std::string& kind, json shape) {
 // The sheets completing the fine side's chords that cross axis `axis` (x = 0, z = 2): the
 // chord the coarse side shares becomes a plane; the two outer ones pair into a tunnel of roof
 // height `roof` over them (the spec's tunnel shape, footed on the fine face at y = foot).
-void complete_chords(const InterfacePatch& fine, const InterfacePatch& coarse, int axis, double roof, double foot,
-                     const std::string& suffix, int dim, std::vector<SheetSpec>& tunnels, std::vector<SheetSpec>& planes) {
+void complete_chords(const InterfacePatch& fine, const InterfacePatch& coarse, int axis,
+                     double roof, double foot, const std::string& suffix, int dim,
+                     std::vector<SheetSpec>& tunnels, std::vector<SheetSpec>& planes) {
   const std::vector<double> f = chord_offsets(fine, axis), c = chord_offsets(coarse, axis);
   const double width = f.empty() ? 0.0 : f.back() - f.front();
-  if (f.size() != static_cast<std::size_t>(kRefinement) || c.size() != 1 || std::abs(f[1] - c[0]) > 1e-12 * width)
+  if (f.size() != static_cast<std::size_t>(kRefinement) || c.size() != 1 ||
+      std::abs(f[1] - c[0]) > 1e-12 * width)
     throw InvalidInput("refine3: the fine side must be the 3-refinement of the coarse side");
   Point centre = Point::Zero(), normal = Point::Zero();
   centre[axis] = 0.5 * (f.front() + f.back());
@@ -71,10 +76,13 @@ void complete_chords(const InterfacePatch& fine, const InterfacePatch& coarse, i
   tunnels.push_back(sheet("tunnel" + suffix, "tunnel", tunnel));
   Point mid = Point::Zero();
   mid[axis] = c[0];
-  planes.push_back(sheet("middle" + suffix, "plane", {{"point", vec(mid, dim)}, {"normal", vec(normal, dim)}}));
+  planes.push_back(
+      sheet("middle" + suffix, "plane", {{"point", vec(mid, dim)}, {"normal", vec(normal, dim)}}));
 }
 
-Template build(const RefineOptions& o, int dim) { return build_template(refine_spec(o, dim), o.arrangement); }
+Template build(const RefineOptions& o, int dim) {
+  return build_template(refine_spec(o, dim), o.arrangement);
+}
 
 int sheet_index(const Template& t, const std::string& name) {
   for (std::size_t s = 0; s < t.sheets.size(); ++s)
@@ -87,12 +95,15 @@ int sheet_index(const Template& t, const std::string& name) {
 ArrangementSpec refine_spec(const RefineOptions& o, int dim) {
   if (dim != 2 && dim != 3) throw InvalidInput("refine3: dimension must be 2 or 3");
   for (int a = 0; a < dim; ++a)
-    if (!(o.box[a] > 0) || !std::isfinite(o.box[a])) throw InvalidInput("refine3: box dimensions must be positive and finite");
-  const bool order = dim == 2 ? 0 < o.layer && o.layer < o.high_roof && o.high_roof < 1
-                              : 0 < o.layer && o.layer < o.low_roof && o.low_roof < o.high_roof && o.high_roof < 1;
+    if (!(o.box[a] > 0) || !std::isfinite(o.box[a]))
+      throw InvalidInput("refine3: box dimensions must be positive and finite");
+  const bool order =
+      dim == 2 ? 0 < o.layer && o.layer < o.high_roof && o.high_roof < 1
+               : 0 < o.layer && o.layer < o.low_roof && o.low_roof < o.high_roof && o.high_roof < 1;
   if (!order)
-    throw InvalidInput(dim == 2 ? "refine3: heights must satisfy 0 < layer < roof < 1"
-                                : "refine3: heights must satisfy 0 < layer < low roof < high roof < 1");
+    throw InvalidInput(dim == 2
+                           ? "refine3: heights must satisfy 0 < layer < roof < 1"
+                           : "refine3: heights must satisfy 0 < layer < low roof < high roof < 1");
   ArrangementSpec spec;
   spec.dim = dim;
   const Point half(0.5 * o.box.x(), 0.5 * o.box.y(), dim == 3 ? 0.5 * o.box.z() : 0.0);
@@ -102,16 +113,20 @@ ArrangementSpec refine_spec(const RefineOptions& o, int dim) {
   spec.top_face = grid_face(1, half.y(), o.box, dim);
   std::vector<SheetSpec> tunnels, planes;
   if (dim == 2) {
-    complete_chords(*spec.bottom_face, *spec.top_face, 0, o.high_roof * height, bottom, "", dim, tunnels, planes);
+    complete_chords(*spec.bottom_face, *spec.top_face, 0, o.high_roof * height, bottom, "", dim,
+                    tunnels, planes);
   } else {
     // Chords running along x cross the z axis (2), those along z the x axis (0).
-    complete_chords(*spec.bottom_face, *spec.top_face, 2, o.high_roof * height, bottom, " x", dim, tunnels, planes);
-    complete_chords(*spec.bottom_face, *spec.top_face, 0, o.low_roof * height, bottom, " z", dim, tunnels, planes);
+    complete_chords(*spec.bottom_face, *spec.top_face, 2, o.high_roof * height, bottom, " x", dim,
+                    tunnels, planes);
+    complete_chords(*spec.bottom_face, *spec.top_face, 0, o.low_roof * height, bottom, " z", dim,
+                    tunnels, planes);
   }
   spec.sheets = tunnels;
   spec.sheets.insert(spec.sheets.end(), planes.begin(), planes.end());
   spec.sheets.push_back(sheet("layer", "plane",
-                              {{"point", vec(Point(0, bottom + o.layer * height, 0), dim)}, {"normal", vec(Point::UnitY(), dim)}}));
+                              {{"point", vec(Point(0, bottom + o.layer * height, 0), dim)},
+                               {"normal", vec(Point::UnitY(), dim)}}));
   return spec;
 }
 
@@ -147,17 +162,20 @@ primal::SmoothResult smooth_refine3(Template& t, const RefineOptions& o, bool ma
       for (bool high : {false, true}) {
         if (!((f >> stc::box_face(s.axis, high)) & 1u)) continue;
         const auto& sg = t.node_signs[n];
-        const std::vector<int> signs{sg[static_cast<std::size_t>(tunnel)], sg[static_cast<std::size_t>(middle)],
+        const std::vector<int> signs{sg[static_cast<std::size_t>(tunnel)],
+                                     sg[static_cast<std::size_t>(middle)],
                                      sg[static_cast<std::size_t>(layer)]};
         const unsigned faces = ((f >> (2 * s.across)) & 3u) | (((f >> 2) & 3u) << 2);
         const auto it = where.find({signs, faces});
         if (it == where.end())
-          throw TopologyError("refine3: a side-face node has no counterpart in the 2D refinement template");
+          throw TopologyError(
+              "refine3: a side-face node has no counterpart in the 2D refinement template");
         Point p = t.hex.points[n];
         p[s.across] = it->second.x();
         p[1] = it->second.y();
         if (placed[n] && (p - t.hex.points[n]).norm() > 1e-9 * o.box.norm())
-          throw TopologyError("refine3: two side faces place a node on their common edge differently");
+          throw TopologyError(
+              "refine3: two side faces place a node on their common edge differently");
         t.hex.points[n] = p;
         placed[n] = 1;
       }
@@ -165,7 +183,8 @@ primal::SmoothResult smooth_refine3(Template& t, const RefineOptions& o, bool ma
   }
   Point lo = Point::Constant(1e300), up = Point::Constant(-1e300);
   for (const auto& p : t.hex.points) lo = lo.cwiseMin(p), up = up.cwiseMax(p);
-  auto constraints = primal::box_constraints(t.hex.points, lo, up, {true, true, true, true, true, true});
+  auto constraints =
+      primal::box_constraints(t.hex.points, lo, up, {true, true, true, true, true, true});
   return primal::smooth_hex_mesh(t.hex, constraints);
 }
 

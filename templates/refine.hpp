@@ -21,9 +21,9 @@ namespace geode::templates {
 // roof, the tunnel's top hex would have three faces on the fine side.
 struct RefineOptions {
   Eigen::Vector3d box{24.0, 14.0, 24.0};  // fine side at the bottom (y = -box.y/2), coarse on top
-  double high_roof = 0.75;  // roof of the tunnel along x (3D; the 2D tunnel's roof)
-  double low_roof = 0.6;    // roof of the tunnel along z (3D)
-  double layer = 0.35;      // the horizontal sheet through the side faces
+  double high_roof = 0.75;                // roof of the tunnel along x (3D; the 2D tunnel's roof)
+  double low_roof = 0.6;                  // roof of the tunnel along z (3D)
+  double layer = 0.35;                    // the horizontal sheet through the side faces
   stc::ArrangementOptions arrangement;
 };
 
@@ -45,6 +45,7 @@ Template build_refine3_2d(const RefineOptions& options);
 // with match_sides, every side-face node is first fixed where the smoothed 2D template of that
 // face's width puts it, so all four side faces are the same 2D mesh and neighbouring cells
 // (translated or rotated copies) match node for node; otherwise side nodes slide in their face.
-primal::SmoothResult smooth_refine3(Template& t, const RefineOptions& options, bool match_sides = true);
+primal::SmoothResult smooth_refine3(Template& t, const RefineOptions& options,
+                                    bool match_sides = true);
 
 }  // namespace geode::templates

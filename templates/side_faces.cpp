@@ -53,7 +53,8 @@ std::map<std::pair<int, int>, int> edge_nodes(const Template& t, const SideFace&
     const double u = face_u(t.hex.points[n], f, b);
     const double k = std::round(u);
     if (std::abs(u - k) > 1e-6)
-      throw TopologyError("side faces: a top or bottom node of a side face lies between its corners and midpoint");
+      throw TopologyError(
+          "side faces: a top or bottom node of a side face lies between its corners and midpoint");
     keyed[{(nf & top) ? 1 : 0, static_cast<int>(k)}] = n;
   }
   return keyed;
@@ -67,7 +68,8 @@ struct Image {
   std::unordered_map<int, int> map;  // face 0 node -> its image
 };
 
-std::vector<Image> face_images(const Template& t, const std::array<SideFace, 4>& faces, const Box& box) {
+std::vector<Image> face_images(const Template& t, const std::array<SideFace, 4>& faces,
+                               const Box& box) {
   std::array<std::map<std::pair<int, int>, int>, 4> keyed;
   for (int k = 0; k < 4; ++k) keyed[k] = edge_nodes(t, faces[k], box);
   std::vector<Image> images;
@@ -92,7 +94,8 @@ Eigen::Matrix3d image_map(const std::array<SideFace, 4>& faces, const Image& im,
   const FaceFrame f0 = frame(faces[0]), fk = frame(faces[im.face]);
   Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
   m(1, 1) = 1.0;
-  m(fk.along, f0.along) = fk.sign * (im.mirror ? -1.0 : 1.0) * f0.sign * box.half[fk.along] / box.half[f0.along];
+  m(fk.along, f0.along) =
+      fk.sign * (im.mirror ? -1.0 : 1.0) * f0.sign * box.half[fk.along] / box.half[f0.along];
   m(faces[im.face].axis, faces[0].axis) = 1.0;
   return m;
 }

@@ -17,17 +17,17 @@ using nlohmann::json;
 // Shapes by name: the dimension they live in (0: both) and their fields' definitions.
 const std::map<std::string, int>& shape_dims() {
   static const std::map<std::string, int> d = {
-      {"plane", 0},    {"line", 2},         {"sphere", 3},  {"circle", 2},   {"ellipsoid", 3},
-      {"ellipse", 2},  {"superquadric", 0}, {"cylinder", 3}, {"tunnel", 0},  {"dome", 3},
-      {"union", 0},    {"intersection", 0}, {"offset", 0},  {"scaled", 0}};
+      {"plane", 0},   {"line", 2},         {"sphere", 3},   {"circle", 2}, {"ellipsoid", 3},
+      {"ellipse", 2}, {"superquadric", 0}, {"cylinder", 3}, {"tunnel", 0}, {"dome", 3},
+      {"union", 0},   {"intersection", 0}, {"offset", 0},   {"scaled", 0}};
   return d;
 }
 
 // Bounds: a spec is a handful of sheets, each a shape of a few nested parts. Deeper nesting
 // (20,000 nested offsets) would recurse the reader off the stack, and thousands of sheets would
 // take the arrangement hours (it meets every triple of sheets) before it could say anything.
-constexpr int kMaxJsonDepth = 64;      // nesting of objects and arrays in the file
-constexpr int kMaxShapeDepth = 16;     // shapes inside union / intersection / offset / scaled
+constexpr int kMaxJsonDepth = 64;            // nesting of objects and arrays in the file
+constexpr int kMaxShapeDepth = 16;           // shapes inside union / intersection / offset / scaled
 constexpr std::size_t kMaxShapeParts = 256;  // shapes in one sheet, all levels
 constexpr std::size_t kMaxSheets = 256;
 
@@ -79,8 +79,12 @@ class Reader {
     for (std::size_t i = 0; i < j.size(); ++i) f(j[i], index(path, static_cast<int>(i)));
   }
 
-  static std::string join(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
-  static std::string index(const std::string& path, int i) { return path + "[" + std::to_string(i) + "]"; }
+  static std::string join(const std::string& path, const std::string& key) {
+    return path.empty() ? key : path + "." + key;
+  }
+  static std::string index(const std::string& path, int i) {
+    return path + "[" + std::to_string(i) + "]";
+  }
 
   stc::Domain domain(const json& j) const;
   // prescribed: a "faces" block's face (quads or segments, any number), else a completion's
@@ -103,26 +107,32 @@ class Reader {
 
 stc::Domain Reader::domain(const json& j) const {
   object(j, "domain", {"box", "hexahedron", "pyramid", "quadrilateral"});
-  if (j.size() != 1) fail("domain", "give exactly one of box, hexahedron, pyramid (3D), quadrilateral (2D)");
+  if (j.size() != 1)
+    fail("domain", "give exactly one of box, hexahedron, pyramid (3D), quadrilateral (2D)");
   if (j.contains("box")) {
     const json& b = j["box"];
     if (!b.is_array() || b.size() != 2) fail("domain.box", "must be [low corner, high corner]");
     const Point lo = point(b[0], "domain.box[0]"), hi = point(b[1], "domain.box[1]");
     for (int a = 0; a < dim_; ++a)
-      if (!(lo[a] < hi[a])) fail("domain.box", "the low corner must be below the high corner on every axis");
+      if (!(lo[a] < hi[a]))
+        fail("domain.box", "the low corner must be below the high corner on every axis");
     return stc::Domain(lo, hi, dim_);
   }
   const bool pyramid = j.contains("pyramid");
   const bool hex = j.contains("hexahedron") || pyramid;
   const std::string key = pyramid ? "pyramid" : hex ? "hexahedron" : "quadrilateral";
-  if (hex != (dim_ == 3)) fail("domain." + key, "is a " + std::string(hex ? "3D" : "2D") + " domain");
+  if (hex != (dim_ == 3))
+    fail("domain." + key, "is a " + std::string(hex ? "3D" : "2D") + " domain");
   const json& c = j[key];
   const std::size_t n = pyramid ? 5 : hex ? 8 : 4;
-  if (!c.is_array() || c.size() != n) fail("domain." + key, "must be " + std::to_string(n) + " corners");
+  if (!c.is_array() || c.size() != n)
+    fail("domain." + key, "must be " + std::to_string(n) + " corners");
   std::array<Point, 8> corners;
-  for (std::size_t i = 0; i < n; ++i) corners[i] = point(c[i], index("domain." + key, static_cast<int>(i)));
+  for (std::size_t i = 0; i < n; ++i)
+    corners[i] = point(c[i], index("domain." + key, static_cast<int>(i)));
   try {
-    if (pyramid) return stc::Domain::pyramid({corners[0], corners[1], corners[2], corners[3], corners[4]});
+    if (pyramid)
+      return stc::Domain::pyramid({corners[0], corners[1], corners[2], corners[3], corners[4]});
     return hex ? stc::Domain::hexahedron(corners)
                : stc::Domain::quadrilateral({corners[0], corners[1], corners[2], corners[3]});
   } catch (const InvalidInput& e) {
@@ -130,27 +140,32 @@ stc::Domain Reader::domain(const json& j) const {
   }
 }
 
-InterfacePatch Reader::patch(const json& j, const std::string& path, const stc::Domain& box, bool top,
-                             bool prescribed) const {
+InterfacePatch Reader::patch(const json& j, const std::string& path, const stc::Domain& box,
+                             bool top, bool prescribed) const {
   object(j, path, {"points", "cells"});
   InterfacePatch p;
   p.dim = dim_;
   const double y = top ? box.hi.y() : box.lo.y();
   const double eps = 1e-9 * (box.hi - box.lo).norm();
-  each(member(j, path, "points"), join(path, "points"), 2, [&](const json& q, const std::string& at) {
-    const Point x = point(q, at);
-    if (std::abs(x.y() - y) > eps)
-      fail(at, std::string("must lie on the domain's ") + (top ? "high" : "low") + "-y face (y = " + std::to_string(y) + ")");
-    for (int a = 0; a < dim_; ++a)
-      if (x[a] < box.lo[a] - eps || x[a] > box.hi[a] + eps) fail(at, "must lie in the domain");
-    p.points.push_back(x);
-  });
+  each(member(j, path, "points"), join(path, "points"), 2,
+       [&](const json& q, const std::string& at) {
+         const Point x = point(q, at);
+         if (std::abs(x.y() - y) > eps)
+           fail(at, std::string("must lie on the domain's ") + (top ? "high" : "low") +
+                        "-y face (y = " + std::to_string(y) + ")");
+         for (int a = 0; a < dim_; ++a)
+           if (x[a] < box.lo[a] - eps || x[a] > box.hi[a] + eps) fail(at, "must lie in the domain");
+         p.points.push_back(x);
+       });
   const bool triangles = top && !prescribed;
   const std::size_t k = dim_ == 2 ? 2 : (triangles ? 3 : 4);
   each(member(j, path, "cells"), join(path, "cells"), 1, [&](const json& c, const std::string& at) {
     if (!c.is_array() || c.size() != k)
       fail(at, "must be " + std::to_string(k) + " point indices (" +
-                   (dim_ == 2 ? "a segment" : triangles ? "a triangle" : "a quad") + ")");
+                   (dim_ == 2   ? "a segment"
+                    : triangles ? "a triangle"
+                                : "a quad") +
+                   ")");
     std::vector<int> cell;
     for (std::size_t i = 0; i < k; ++i) {
       if (!c[i].is_number_integer() || c[i].get<long long>() < 0 ||
@@ -166,8 +181,9 @@ InterfacePatch Reader::patch(const json& j, const std::string& path, const stc::
 }
 
 PushParameters Reader::push(const json& j) const {
-  object(j, "push", {"high_roof", "low_roof", "dome_depth", "dome_radius", "centre_depth", "centre_radius",
-                     "dome_exponent", "centre_exponent", "dome_offset", "centre_offset"});
+  object(j, "push",
+         {"high_roof", "low_roof", "dome_depth", "dome_radius", "centre_depth", "centre_radius",
+          "dome_exponent", "centre_exponent", "dome_offset", "centre_offset"});
   PushParameters p;
   const auto get = [&](const char* key, double& x) {
     if (j.contains(key)) x = number(j[key], join("push", key));
@@ -183,8 +199,10 @@ PushParameters Reader::push(const json& j) const {
   get("dome_offset", p.dome_offset);
   if (j.contains("centre_offset")) {
     const json& c = j["centre_offset"];
-    if (!c.is_array() || c.size() != 2) fail("push.centre_offset", "must be [x, z] (fractions of the half-width)");
-    for (std::size_t a = 0; a < 2; ++a) p.centre_offset[a] = number(c[a], index("push.centre_offset", static_cast<int>(a)));
+    if (!c.is_array() || c.size() != 2)
+      fail("push.centre_offset", "must be [x, z] (fractions of the half-width)");
+    for (std::size_t a = 0; a < 2; ++a)
+      p.centre_offset[a] = number(c[a], index("push.centre_offset", static_cast<int>(a)));
   }
   std::string key;
   if (const std::string why = push_error(p, &key); !why.empty()) {
@@ -200,7 +218,8 @@ std::array<Point, 3> Reader::frame(const json& j, const std::string& path) const
   const std::string at = join(path, "axes");
   const json& a = j["axes"];
   const std::size_t n = dim_ == 3 ? 2 : 1;
-  if (!a.is_array() || a.size() != n) fail(at, dim_ == 3 ? "must be the first two axes" : "must be the first axis");
+  if (!a.is_array() || a.size() != n)
+    fail(at, dim_ == 3 ? "must be the first two axes" : "must be the first axis");
   e[0] = direction(a[0], index(at, 0));
   if (dim_ == 2) {
     e[1] = Point(-e[0].y(), e[0].x(), 0);
@@ -214,9 +233,12 @@ std::array<Point, 3> Reader::frame(const json& j, const std::string& path) const
   return e;
 }
 
-stc::Field Reader::shape(const json& j, const std::string& path, int level, std::size_t& parts) const {
-  if (level > kMaxShapeDepth) fail(path, "shapes nested deeper than " + std::to_string(kMaxShapeDepth) + " levels");
-  if (++parts > kMaxShapeParts) fail(path, "more than " + std::to_string(kMaxShapeParts) + " shapes in one sheet");
+stc::Field Reader::shape(const json& j, const std::string& path, int level,
+                         std::size_t& parts) const {
+  if (level > kMaxShapeDepth)
+    fail(path, "shapes nested deeper than " + std::to_string(kMaxShapeDepth) + " levels");
+  if (++parts > kMaxShapeParts)
+    fail(path, "more than " + std::to_string(kMaxShapeParts) + " shapes in one sheet");
   if (!j.is_object()) fail(path, "must be an object holding one shape");
   std::string kind;
   for (const auto& [key, value] : j.items())
@@ -233,14 +255,17 @@ stc::Field Reader::shape(const json& j, const std::string& path, int level, std:
   }
   const int d = shape_dims().at(kind);
   const std::string at = join(path, kind);
-  if (d != 0 && d != dim_) fail(at, "is a " + std::to_string(d) + "D shape; the spec's dim is " + std::to_string(dim_));
+  if (d != 0 && d != dim_)
+    fail(at, "is a " + std::to_string(d) + "D shape; the spec's dim is " + std::to_string(dim_));
   const json& s = j[kind];
 
   if (kind == "union" || kind == "intersection") {
     if (s.is_array() && s.size() > kMaxShapeParts)
       fail(at, "more than " + std::to_string(kMaxShapeParts) + " shapes in one sheet");
     std::vector<stc::Field> fields;
-    each(s, at, 2, [&](const json& q, const std::string& p) { fields.push_back(shape(q, p, level + 1, parts)); });
+    each(s, at, 2, [&](const json& q, const std::string& p) {
+      fields.push_back(shape(q, p, level + 1, parts));
+    });
     stc::Field f = fields[0];
     for (std::size_t i = 1; i < fields.size(); ++i)
       f = kind == "union" ? stc::field_union(f, fields[i]) : stc::field_intersection(f, fields[i]);
@@ -286,7 +311,8 @@ stc::Field Reader::shape(const json& j, const std::string& path, int level, std:
     const int dim = dim_;
     return [c, r, e, p, dim](const Point& x) {
       double f = -1.0;
-      for (int a = 0; a < dim; ++a) f += std::pow(std::abs(e[static_cast<std::size_t>(a)].dot(x - c) / r[a]), p);
+      for (int a = 0; a < dim; ++a)
+        f += std::pow(std::abs(e[static_cast<std::size_t>(a)].dot(x - c) / r[a]), p);
       return f;
     };
   }
@@ -296,7 +322,8 @@ stc::Field Reader::shape(const json& j, const std::string& path, int level, std:
     const Point axis = direction(member(s, at, "axis"), join(at, "axis"));
     double a = 0, b = 0;
     Point up;
-    if (s.contains("radius") == s.contains("radii")) fail(at, "give radius (circular) or radii with up (elliptic)");
+    if (s.contains("radius") == s.contains("radii"))
+      fail(at, "give radius (circular) or radii with up (elliptic)");
     if (s.contains("radius")) {
       a = b = positive(s["radius"], join(at, "radius"));
       up = axis.unitOrthogonal();
@@ -377,11 +404,15 @@ json patch_json(const InterfacePatch& p) {
 
 // Keys in the order a reader expects them (the rest after, alphabetically).
 int key_rank(const std::string& key) {
-  static const std::vector<std::string> order = {"dim", "domain", "completion", "hex_side", "tet_side", "higher",
-                                                 "faces", "bottom", "top",
-                                                 "push", "high_roof", "low_roof", "dome_depth", "dome_radius", "centre_depth", "centre_radius",
-                                                 "dome_exponent", "centre_exponent", "dome_offset", "centre_offset",
-                                                 "sheets", "name", "kind", "sweep"};
+  static const std::vector<std::string> order = {
+      "dim",           "domain",        "completion",
+      "hex_side",      "tet_side",      "higher",
+      "faces",         "bottom",        "top",
+      "push",          "high_roof",     "low_roof",
+      "dome_depth",    "dome_radius",   "centre_depth",
+      "centre_radius", "dome_exponent", "centre_exponent",
+      "dome_offset",   "centre_offset", "sheets",
+      "name",          "kind",          "sweep"};
   const auto it = std::find(order.begin(), order.end(), key);
   return it == order.end() ? static_cast<int>(order.size()) : static_cast<int>(it - order.begin());
 }
@@ -390,12 +421,15 @@ int key_rank(const std::string& key) {
 bool one_line(const json& j) {
   if (!j.is_array()) return j.is_primitive();
   return std::all_of(j.begin(), j.end(), [](const json& x) {
-    return x.is_primitive() || (x.is_array() && std::all_of(x.begin(), x.end(), [](const json& y) { return y.is_primitive(); }));
+    return x.is_primitive() || (x.is_array() && std::all_of(x.begin(), x.end(), [](const json& y) {
+                                  return y.is_primitive();
+                                }));
   });
 }
 
 void format(const json& j, int indent, std::ostream& out) {
-  const std::string pad(static_cast<std::size_t>(indent + 2), ' '), end(static_cast<std::size_t>(indent), ' ');
+  const std::string pad(static_cast<std::size_t>(indent + 2), ' '),
+      end(static_cast<std::size_t>(indent), ' ');
   if (one_line(j) || j.empty()) {
     if (!j.is_array()) {
       out << j.dump();
@@ -410,7 +444,8 @@ void format(const json& j, int indent, std::ostream& out) {
   } else if (j.is_object()) {
     std::vector<std::string> keys;
     for (const auto& [key, value] : j.items()) keys.push_back(key);
-    std::stable_sort(keys.begin(), keys.end(), [](const auto& a, const auto& b) { return key_rank(a) < key_rank(b); });
+    std::stable_sort(keys.begin(), keys.end(),
+                     [](const auto& a, const auto& b) { return key_rank(a) < key_rank(b); });
     out << "{\n";
     for (std::size_t i = 0; i < keys.size(); ++i) {
       out << pad << json(keys[i]).dump() << ": ";
@@ -438,8 +473,10 @@ json::json_pointer pointer(const std::string& path, const std::string& source) {
     token.clear();
   };
   for (char ch : path) {
-    if (ch == '.' || ch == '[' || ch == ']') flush();
-    else token += ch;
+    if (ch == '.' || ch == '[' || ch == ']')
+      flush();
+    else
+      token += ch;
   }
   flush();
   if (p.empty()) throw InvalidInput(source + ": sweep: empty path");
@@ -475,7 +512,8 @@ ArrangementSpec parse_spec(const json& j, const std::string& source) {
   top.object(j, "", {"dim", "domain", "completion", "faces", "push", "sheets", "sweep", "comment"});
   ArrangementSpec spec;
   const json& d = top.member(j, "", "dim");
-  if (!d.is_number_integer() || (d.get<long long>() != 2 && d.get<long long>() != 3)) top.fail("dim", "must be 2 or 3");
+  if (!d.is_number_integer() || (d.get<long long>() != 2 && d.get<long long>() != 3))
+    top.fail("dim", "must be 2 or 3");
   spec.dim = d.get<int>();
   const Reader r(source, spec.dim);
   spec.domain = r.domain(r.member(j, "", "domain"));
@@ -483,12 +521,16 @@ ArrangementSpec parse_spec(const json& j, const std::string& source) {
   if (j.contains("completion")) {
     const json& c = j["completion"];
     r.object(c, "completion", {"hex_side", "tet_side", "higher"});
-    if (spec.domain.corners) r.fail("completion", "needs a box domain (the builders work in its reference frame)");
+    if (spec.domain.corners)
+      r.fail("completion", "needs a box domain (the builders work in its reference frame)");
     CompletionSpec cs;
-    cs.hex_side = r.patch(r.member(c, "completion", "hex_side"), "completion.hex_side", spec.domain, false);
-    cs.tet_side = r.patch(r.member(c, "completion", "tet_side"), "completion.tet_side", spec.domain, true);
+    cs.hex_side =
+        r.patch(r.member(c, "completion", "hex_side"), "completion.hex_side", spec.domain, false);
+    cs.tet_side =
+        r.patch(r.member(c, "completion", "tet_side"), "completion.tet_side", spec.domain, true);
     if (c.contains("higher")) {
-      if (c["higher"] != "x" && c["higher"] != "z") r.fail("completion.higher", "must be \"x\" or \"z\"");
+      if (c["higher"] != "x" && c["higher"] != "z")
+        r.fail("completion.higher", "must be \"x\" or \"z\"");
       cs.higher = c["higher"] == "z" ? Higher::Z : Higher::X;
     }
     if (j.contains("push")) cs.push = r.push(j["push"]);
@@ -500,28 +542,34 @@ ArrangementSpec parse_spec(const json& j, const std::string& source) {
     const json& f = j["faces"];
     r.object(f, "faces", {"bottom", "top"});
     if (spec.completion) r.fail("faces", "a completion block prescribes both faces already");
-    if (spec.domain.corners) r.fail("faces", "needs a box domain (the faces are its low-y and high-y faces)");
+    if (spec.domain.corners)
+      r.fail("faces", "needs a box domain (the faces are its low-y and high-y faces)");
     if (f.empty()) r.fail("faces", "give bottom, top or both");
-    if (f.contains("bottom")) spec.bottom_face = r.patch(f["bottom"], "faces.bottom", spec.domain, false, true);
+    if (f.contains("bottom"))
+      spec.bottom_face = r.patch(f["bottom"], "faces.bottom", spec.domain, false, true);
     if (f.contains("top")) spec.top_face = r.patch(f["top"], "faces.top", spec.domain, true, true);
   }
 
   std::set<std::string> names;
   if (j.contains("sheets") && j["sheets"].is_array() && j["sheets"].size() > kMaxSheets)
-    r.fail("sheets", std::to_string(j["sheets"].size()) + " sheets; at most " + std::to_string(kMaxSheets) +
+    r.fail("sheets", std::to_string(j["sheets"].size()) + " sheets; at most " +
+                         std::to_string(kMaxSheets) +
                          " (the arrangement meets every triple of sheets)");
   if (j.contains("sheets"))
     r.each(j["sheets"], "sheets", 0, [&](const json& s, const std::string& at) {
       if (!s.is_object()) r.fail(at, "must be an object");
       const json& name = r.member(s, at, "name");
-      if (!name.is_string() || name.get<std::string>().empty()) r.fail(Reader::join(at, "name"), "must be a non-empty string");
+      if (!name.is_string() || name.get<std::string>().empty())
+        r.fail(Reader::join(at, "name"), "must be a non-empty string");
       SheetSpec sh;
       sh.name = name.get<std::string>();
       const std::string where = at + " (" + sh.name + ")";
       if (!names.insert(sh.name).second) r.fail(where, "a second sheet of this name");
       for (const auto& [key, value] : s.items())
-        if (key != "name" && key != "kind" && !shape_dims().count(key)) r.fail(Reader::join(at, key), "unknown key (sheet '" + sh.name + "')");
-      if (s.contains("kind") && !s["kind"].is_string()) r.fail(Reader::join(at, "kind"), "must be a string");
+        if (key != "name" && key != "kind" && !shape_dims().count(key))
+          r.fail(Reader::join(at, key), "unknown key (sheet '" + sh.name + "')");
+      if (s.contains("kind") && !s["kind"].is_string())
+        r.fail(Reader::join(at, "kind"), "must be a string");
       r.shape(s, at);  // validates
       for (const auto& [key, value] : s.items())
         if (shape_dims().count(key)) sh.shape = json{{key, value}}, sh.kind = key;
@@ -530,8 +578,8 @@ ArrangementSpec parse_spec(const json& j, const std::string& source) {
       // tracing every curve between them.
       for (std::size_t o = 0; o < spec.sheets.size(); ++o)
         if (coincident(spec.sheets[o].shape, sh.shape, spec.dim))
-          r.fail(where, "the same surface as sheets[" + std::to_string(o) + "] (" + spec.sheets[o].name +
-                            "): coincident sheets cannot be arranged");
+          r.fail(where, "the same surface as sheets[" + std::to_string(o) + "] (" +
+                            spec.sheets[o].name + "): coincident sheets cannot be arranged");
       spec.sheets.push_back(sh);
     });
   else if (!spec.completion)
@@ -550,7 +598,8 @@ json read_spec_json(const std::filesystem::path& path) {
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) throw InvalidInput(name + ": no such file");
   // A spec is a few kilobytes; anything much larger is not one.
-  if (fs::file_size(path, ec) > (16u << 20)) throw InvalidInput(name + ": larger than 16 MiB, not a spec");
+  if (fs::file_size(path, ec) > (16u << 20))
+    throw InvalidInput(name + ": larger than 16 MiB, not a spec");
   std::ifstream in(path, std::ios::binary);
   std::stringstream text;
   text << in.rdbuf();
@@ -561,10 +610,13 @@ json read_spec_json(const std::filesystem::path& path) {
 json parse_spec_text(std::string_view text, const std::string& name) {
   try {
     // Nesting is bounded while parsing, before a deep tree is built (and torn down recursively).
-    const json::parser_callback_t depth_check = [&name](int depth, json::parse_event_t event, json&) {
-      if ((event == json::parse_event_t::object_start || event == json::parse_event_t::array_start) &&
+    const json::parser_callback_t depth_check = [&name](int depth, json::parse_event_t event,
+                                                        json&) {
+      if ((event == json::parse_event_t::object_start ||
+           event == json::parse_event_t::array_start) &&
           depth >= kMaxJsonDepth)
-        throw InvalidInput(name + ": nested deeper than " + std::to_string(kMaxJsonDepth) + " levels, not a spec");
+        throw InvalidInput(name + ": nested deeper than " + std::to_string(kMaxJsonDepth) +
+                           " levels, not a spec");
       return true;
     };
     json j = json::parse(text, depth_check, true, /*ignore_comments=*/true);
@@ -607,7 +659,8 @@ json spec_json(const ArrangementSpec& s) {
     if (c.push.dome_exponent != 2.0) j["push"]["dome_exponent"] = c.push.dome_exponent;
     if (c.push.centre_exponent > 0) j["push"]["centre_exponent"] = c.push.centre_exponent;
     if (c.push.dome_offset > 0) j["push"]["dome_offset"] = c.push.dome_offset;
-    if (c.push.centre_offset[0] != 0 || c.push.centre_offset[1] != 0) j["push"]["centre_offset"] = c.push.centre_offset;
+    if (c.push.centre_offset[0] != 0 || c.push.centre_offset[1] != 0)
+      j["push"]["centre_offset"] = c.push.centre_offset;
   }
   if (s.bottom_face) j["faces"]["bottom"] = patch_json(*s.bottom_face);
   if (s.top_face) j["faces"]["top"] = patch_json(*s.top_face);
@@ -646,14 +699,16 @@ std::vector<stc::Sheet> spec_sheets(const ArrangementSpec& spec) {
     }
   }
   const Reader r("spec", spec.dim);
-  for (const auto& sh : spec.sheets) sheets.push_back({sh.name, r.shape(sh.shape, sh.name), sh.kind});
+  for (const auto& sh : spec.sheets)
+    sheets.push_back({sh.name, r.shape(sh.shape, sh.name), sh.kind});
   return sheets;
 }
 
 SweepAxis parse_sweep_option(const std::string& text) {
   const auto eq = text.find('=');
   const std::string where = "--sweep '" + text + "'";
-  if (eq == std::string::npos || eq == 0) throw InvalidInput(where + ": expected PATH=FROM:TO:COUNT or PATH=V1,V2,...");
+  if (eq == std::string::npos || eq == 0)
+    throw InvalidInput(where + ": expected PATH=FROM:TO:COUNT or PATH=V1,V2,...");
   SweepAxis axis{text.substr(0, eq), {}};
   const std::string values = text.substr(eq + 1);
   const auto number = [&](const std::string& s) {
@@ -664,7 +719,8 @@ SweepAxis parse_sweep_option(const std::string& text) {
     } catch (const std::exception&) {
       used = 0;
     }
-    if (used == 0 || used != s.size() || !std::isfinite(x)) throw InvalidInput(where + ": '" + s + "' is not a number");
+    if (used == 0 || used != s.size() || !std::isfinite(x))
+      throw InvalidInput(where + ": '" + s + "' is not a number");
     return x;
   };
   std::vector<std::string> parts;
@@ -675,9 +731,11 @@ SweepAxis parse_sweep_option(const std::string& text) {
     if (parts.size() != 3) throw InvalidInput(where + ": expected FROM:TO:COUNT");
     const double from = number(parts[0]), to = number(parts[1]);
     const double count = number(parts[2]);
-    if (!(count >= 1) || count != std::floor(count) || count > 10000) throw InvalidInput(where + ": COUNT must be a whole number from 1 to 10000");
+    if (!(count >= 1) || count != std::floor(count) || count > 10000)
+      throw InvalidInput(where + ": COUNT must be a whole number from 1 to 10000");
     const int n = static_cast<int>(count);
-    for (int i = 0; i < n; ++i) axis.values.push_back(n == 1 ? from : from + (to - from) * i / (n - 1));
+    for (int i = 0; i < n; ++i)
+      axis.values.push_back(n == 1 ? from : from + (to - from) * i / (n - 1));
   } else {
     for (const auto& p : parts) axis.values.push_back(number(p));
   }
@@ -690,12 +748,14 @@ std::vector<SweepAxis> spec_sweep(const json& spec, const std::string& source) {
   if (!spec.contains("sweep")) return axes;
   const Reader r(source, 3);
   const json& s = spec["sweep"];
-  if (!s.is_object()) r.fail("sweep", "must be an object {\"path\": [values] or {\"from\", \"to\", \"count\"}}");
+  if (!s.is_object())
+    r.fail("sweep", "must be an object {\"path\": [values] or {\"from\", \"to\", \"count\"}}");
   for (const auto& [path, v] : s.items()) {
     const std::string at = "sweep." + path;
     SweepAxis axis{path, {}};
     if (v.is_array()) {
-      r.each(v, at, 1, [&](const json& x, const std::string& p) { axis.values.push_back(r.number(x, p)); });
+      r.each(v, at, 1,
+             [&](const json& x, const std::string& p) { axis.values.push_back(r.number(x, p)); });
     } else {
       r.object(v, at, {"from", "to", "count"});
       const double from = r.number(r.member(v, at, "from"), at + ".from");
@@ -704,7 +764,8 @@ std::vector<SweepAxis> spec_sweep(const json& spec, const std::string& source) {
       if (!c.is_number_integer() || c.get<long long>() < 1 || c.get<long long>() > 10000)
         r.fail(at + ".count", "must be a whole number from 1 to 10000");
       const int n = c.get<int>();
-      for (int i = 0; i < n; ++i) axis.values.push_back(n == 1 ? from : from + (to - from) * i / (n - 1));
+      for (int i = 0; i < n; ++i)
+        axis.values.push_back(n == 1 ? from : from + (to - from) * i / (n - 1));
     }
     json probe = spec;
     set_spec_number(probe, path, axis.values.front(), source);
@@ -718,7 +779,8 @@ void set_spec_number(json& spec, const std::string& path, double value, const st
   try {
     p = pointer(path, source);
   } catch (const json::exception&) {
-    throw InvalidInput(source + ": sweep: '" + path + "' is not a path such as push.high_roof or sheets[1].sphere.radius");
+    throw InvalidInput(source + ": sweep: '" + path +
+                       "' is not a path such as push.high_roof or sheets[1].sphere.radius");
   }
   bool found = false;
   try {

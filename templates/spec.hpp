@@ -4,8 +4,8 @@
 // ("Arrangements as files"); in short:
 //
 //   {"dim": 3,
-//    "domain": {"box": [[x0, y0, z0], [x1, y1, z1]]}  or {"hexahedron": [8 corners]} or {"pyramid": [5]}
-//    "sheets": [{"name": "x", "plane": {"point": [..], "normal": [..]}},
+//    "domain": {"box": [[x0, y0, z0], [x1, y1, z1]]}  or {"hexahedron": [8 corners]} or {"pyramid":
+//    [5]} "sheets": [{"name": "x", "plane": {"point": [..], "normal": [..]}},
 //               {"name": "s", "sphere": {"center": [..], "radius": r}}, ...],
 //    "completion": {"hex_side": {...}, "tet_side": {...}, "higher": "x"},   (optional)
 //    "push": {"high_roof": .., "low_roof": .., "dome_depth": .., "dome_radius": ..},
@@ -96,6 +96,7 @@ SweepAxis parse_sweep_option(const std::string& text);
 // The spec's "sweep" block: {"PATH": [values] | {"from": a, "to": b, "count": n}}.
 std::vector<SweepAxis> spec_sweep(const nlohmann::json& spec, const std::string& source);
 // Sets the number at `path`; InvalidInput naming the path when it does not lead to a number.
-void set_spec_number(nlohmann::json& spec, const std::string& path, double value, const std::string& source);
+void set_spec_number(nlohmann::json& spec, const std::string& path, double value,
+                     const std::string& source);
 
 }  // namespace geode::templates

@@ -92,7 +92,8 @@ std::string obstruction_counts(const std::vector<primal::Obstruction>& obstructi
   std::map<primal::ObstructionKind, int> count;
   for (const auto& o : obstructions) ++count[o.kind];
   std::string r;
-  for (const auto& [kind, n] : count) r += (r.empty() ? "" : ";") + std::string(primal::to_string(kind)) + ":" + std::to_string(n);
+  for (const auto& [kind, n] : count)
+    r += (r.empty() ? "" : ";") + std::string(primal::to_string(kind)) + ":" + std::to_string(n);
   return r;
 }
 
@@ -119,10 +120,14 @@ std::string template_class_key(const Template& t) {
     }
   }
   std::vector<std::uint64_t> colour(nodes + elements);
-  for (std::size_t n = 0; n < nodes; ++n) colour[n] = fnv(fnv(kFnvSeed, 1), node_class(t.node_faces[n]));
-  for (std::size_t e = 0; e < elements; ++e) colour[nodes + e] = fnv(fnv(kFnvSeed, 2), fnv(element_kind[e]));
+  for (std::size_t n = 0; n < nodes; ++n)
+    colour[n] = fnv(fnv(kFnvSeed, 1), node_class(t.node_faces[n]));
+  for (std::size_t e = 0; e < elements; ++e)
+    colour[nodes + e] = fnv(fnv(kFnvSeed, 2), fnv(element_kind[e]));
   // Refine until the number of colour classes stops growing (an isomorphism-invariant stop).
-  auto classes = [](const std::vector<std::uint64_t>& c) { return std::set<std::uint64_t>(c.begin(), c.end()).size(); };
+  auto classes = [](const std::vector<std::uint64_t>& c) {
+    return std::set<std::uint64_t>(c.begin(), c.end()).size();
+  };
   std::size_t count = classes(colour);
   for (std::size_t round = 0; round < adj.size(); ++round) {
     std::vector<std::uint64_t> next(colour.size());
@@ -156,8 +161,10 @@ std::string strip_numbers(const std::string& message) {
   static const std::regex tuple(R"(\(\s*#(?:\s*,\s*#)*\s*\))");
   std::string s;
   std::size_t last = 0;
-  for (auto it = std::sregex_iterator(message.begin(), message.end(), number); it != std::sregex_iterator(); ++it) {
-    const auto pos = static_cast<std::size_t>(it->position()), len = static_cast<std::size_t>(it->length());
+  for (auto it = std::sregex_iterator(message.begin(), message.end(), number);
+       it != std::sregex_iterator(); ++it) {
+    const auto pos = static_cast<std::size_t>(it->position()),
+               len = static_cast<std::size_t>(it->length());
     const bool names = message.compare(pos + len, 5, "-cell") == 0 ||
                        (pos >= 10 && message.compare(pos - 10, 10, "condition ") == 0);
     s += message.substr(last, pos - last) + (names ? it->str() : "#");
@@ -184,8 +191,8 @@ InterleaveStudy interleave_study(const GeodeOptions& base, const PushGrid& grid,
 }
 
 InterleaveStudy interleave_study(const nlohmann::json& spec, const std::string& source,
-                                 const std::vector<SweepAxis>& axes, const std::string& template_name,
-                                 const StudyProgress& progress) {
+                                 const std::vector<SweepAxis>& axes,
+                                 const std::string& template_name, const StudyProgress& progress) {
   std::vector<InterleaveCase> cases;
   std::vector<std::string> names;
   for (const auto& a : axes) names.push_back(a.path);
@@ -221,8 +228,10 @@ InterleaveStudy interleave_study(const nlohmann::json& spec, const std::string& 
   return study;
 }
 
-InterleaveStudy interleave_study(const std::vector<InterleaveCase>& cases, const std::string& template_name,
-                                 const std::vector<std::string>& parameter_names, const StudyProgress& progress) {
+InterleaveStudy interleave_study(const std::vector<InterleaveCase>& cases,
+                                 const std::string& template_name,
+                                 const std::vector<std::string>& parameter_names,
+                                 const StudyProgress& progress) {
   InterleaveStudy study;
   study.template_name = template_name;
   study.parameter_names = parameter_names;
@@ -253,37 +262,41 @@ InterleaveStudy interleave_study(const std::vector<InterleaveCase>& cases, const
     std::lock_guard lock(progress_mutex);
     progress(what, d, total);
   };
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cases.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
-    for (std::size_t i = range.begin(); i != range.end(); ++i) {
-      const InterleaveCase& cs = cases[i];
-      InterleaveRun& run = built[i].run;
-      run.push = cs.push;
-      run.parameters = cs.parameters;
-      const auto t0 = std::chrono::steady_clock::now();
-      try {
-        Template& t = built[i].t;
-        t = cs.build();
-        run.valid = true;
-        run.hexes = static_cast<int>(t.dim == 3 ? t.hex.hexes.size() : t.quad.quads.size());
-        run.conditions_ok = t.checks.ok();
-        std::set<std::string> failed;
-        for (const auto& f : t.checks.failures) failed.insert(strip_numbers(f));
-        for (const auto& f : failed) run.conditions += (run.conditions.empty() ? "" : "; ") + f;
-        built[i].key = template_class_key(t);
-      } catch (const TopologyError& e) {
-        run.diagnosis = strip_numbers(e.what());
-        built[i].key = run.diagnosis;
-      }
-      run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      report("pushes", cases.size());
-    }
-  });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, cases.size(), 1),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+          const InterleaveCase& cs = cases[i];
+          InterleaveRun& run = built[i].run;
+          run.push = cs.push;
+          run.parameters = cs.parameters;
+          const auto t0 = std::chrono::steady_clock::now();
+          try {
+            Template& t = built[i].t;
+            t = cs.build();
+            run.valid = true;
+            run.hexes = static_cast<int>(t.dim == 3 ? t.hex.hexes.size() : t.quad.quads.size());
+            run.conditions_ok = t.checks.ok();
+            std::set<std::string> failed;
+            for (const auto& f : t.checks.failures) failed.insert(strip_numbers(f));
+            for (const auto& f : failed) run.conditions += (run.conditions.empty() ? "" : "; ") + f;
+            built[i].key = template_class_key(t);
+          } catch (const TopologyError& e) {
+            run.diagnosis = strip_numbers(e.what());
+            built[i].key = run.diagnosis;
+          }
+          run.seconds =
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+          report("pushes", cases.size());
+        }
+      });
   std::map<std::pair<bool, std::string>, Outcome> outcomes;
   std::vector<std::string> keys;  // per run
   for (Built& b : built) {
     InterleaveRun& run = b.run;
     auto& oc = outcomes[{run.valid, b.key}];
-    if (oc.count == 0) oc = {run.valid, b.key, run.hexes, 0, 0, run.push, run.parameters, std::move(b.t)};
+    if (oc.count == 0)
+      oc = {run.valid, b.key, run.hexes, 0, 0, run.push, run.parameters, std::move(b.t)};
     ++oc.count;
     oc.ok += run.conditions_ok ? 1 : 0;
     keys.push_back(std::move(b.key));
@@ -315,12 +328,14 @@ InterleaveStudy interleave_study(const std::vector<InterleaveCase>& cases, const
   }
   // Each valid class's example smoothed (twice) on its own, in parallel, into its own slot.
   done = 0;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
-    for (std::size_t i = range.begin(); i != range.end(); ++i) {
-      if (study.classes[i].valid) measure_class(study.classes[i], order[i]->example_template);
-      report("classes", order.size());
-    }
-  });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), 1),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                        if (study.classes[i].valid)
+                          measure_class(study.classes[i], order[i]->example_template);
+                        report("classes", order.size());
+                      }
+                    });
   for (std::size_t r = 0; r < study.runs.size(); ++r)
     study.runs[r].class_label = label.at({study.runs[r].valid, keys[r]});
   return study;
@@ -331,9 +346,9 @@ void write_interleave_csv(std::ostream& out, const InterleaveStudy& study) {
   for (const auto& p : study.parameter_names) out << "," << csv_quote(p);
   out << "\n";
   for (const auto& r : study.runs) {
-    out << fmt(r.push.high_roof) << "," << fmt(r.push.low_roof) << "," << fmt(r.push.dome_depth) << ","
-        << fmt(r.push.dome_radius) << "," << (r.valid ? "valid" : "error") << "," << r.hexes << "," << r.class_label
-        << "," << (r.valid ? (r.conditions_ok ? "1" : "0") : "") << ","
+    out << fmt(r.push.high_roof) << "," << fmt(r.push.low_roof) << "," << fmt(r.push.dome_depth)
+        << "," << fmt(r.push.dome_radius) << "," << (r.valid ? "valid" : "error") << "," << r.hexes
+        << "," << r.class_label << "," << (r.valid ? (r.conditions_ok ? "1" : "0") : "") << ","
         << csv_quote(r.valid ? r.conditions : r.diagnosis);
     for (double p : r.parameters) out << "," << fmt(p);
     out << "\n";
@@ -341,17 +356,19 @@ void write_interleave_csv(std::ostream& out, const InterleaveStudy& study) {
 }
 
 void write_interleave_summary(std::ostream& out, const InterleaveStudy& study) {
-  out << "class,outcome,count,hexes,conditions_ok,example_high_roof,example_low_roof,example_dome_depth,"
+  out << "class,outcome,count,hexes,conditions_ok,example_high_roof,example_low_roof,example_dome_"
+         "depth,"
          "example_dome_radius,key,obstructions,min_sj_fixed,min_sj_slide,usable";
   for (const auto& p : study.parameter_names) out << "," << csv_quote("example_" + p);
   out << "\n";
   for (const auto& c : study.classes) {
-    out << c.label << "," << (c.valid ? "valid" : "error") << "," << c.count << "," << c.hexes << ","
-        << c.conditions_ok << "," << fmt(c.example.high_roof) << "," << fmt(c.example.low_roof) << ","
-        << fmt(c.example.dome_depth) << "," << fmt(c.example.dome_radius) << "," << csv_quote(c.key) << ",";
+    out << c.label << "," << (c.valid ? "valid" : "error") << "," << c.count << "," << c.hexes
+        << "," << c.conditions_ok << "," << fmt(c.example.high_roof) << ","
+        << fmt(c.example.low_roof) << "," << fmt(c.example.dome_depth) << ","
+        << fmt(c.example.dome_radius) << "," << csv_quote(c.key) << ",";
     if (c.valid)
-      out << obstruction_counts(c.obstructions) << "," << fmt(c.min_sj_fixed) << "," << fmt(c.min_sj_slide) << ","
-          << (c.usable ? 1 : 0);
+      out << obstruction_counts(c.obstructions) << "," << fmt(c.min_sj_fixed) << ","
+          << fmt(c.min_sj_slide) << "," << (c.usable ? 1 : 0);
     else
       out << ",,,";
     for (double p : c.example_parameters) out << "," << fmt(p);
@@ -364,8 +381,9 @@ void write_interleave_summary(std::ostream& out, const InterleaveStudy& study) {
 CellCorners box_cell(const Eigen::Vector3d& box) {
   CellCorners c;
   for (int i = 0; i < 8; ++i)
-    c[static_cast<std::size_t>(i)] = Point((i & 1 ? 0.5 : -0.5) * box.x(), (i & 2 ? 0.5 : -0.5) * box.y(),
-                                           (i & 4 ? 0.5 : -0.5) * box.z());
+    c[static_cast<std::size_t>(i)] =
+        Point((i & 1 ? 0.5 : -0.5) * box.x(), (i & 2 ? 0.5 : -0.5) * box.y(),
+              (i & 4 ? 0.5 : -0.5) * box.z());
   return c;
 }
 
@@ -380,12 +398,13 @@ CellCorners sheared_cell(const Eigen::Vector3d& box, double angle_degrees) {
 CellCorners tapered_cell(const Eigen::Vector3d& box, double ratio) {
   CellCorners c = box_cell(box);
   for (int i = 0; i < 8; ++i)
-    if (i & 2) c[static_cast<std::size_t>(i)].x() *= ratio, c[static_cast<std::size_t>(i)].z() *= ratio;
+    if (i & 2)
+      c[static_cast<std::size_t>(i)].x() *= ratio, c[static_cast<std::size_t>(i)].z() *= ratio;
   return c;
 }
 
-primal::SmoothResult smooth_in_cell(Template& t, const Eigen::Vector3d& box_of_t, const CellCorners& cell,
-                                    bool slide) {
+primal::SmoothResult smooth_in_cell(Template& t, const Eigen::Vector3d& box_of_t,
+                                    const CellCorners& cell, bool slide) {
   if (t.dim != 3) throw InvalidInput("smooth_in_cell: needs a 3D template");
   // Face planes: face 2*axis + high holds the corners whose bit `axis` equals high.
   std::array<Point, 6> origin, normal;
@@ -399,7 +418,8 @@ primal::SmoothResult smooth_in_cell(Template& t, const Eigen::Vector3d& box_of_t
       const Point centre = 0.25 * (q[0] + q[1] + q[2] + q[3]);
       for (const auto& p : q)
         if (std::abs(n.normalized().dot(p - centre)) > 1e-9 * (q[3] - q[0]).norm())
-          throw InvalidInput("smooth_in_cell: face " + std::to_string(2 * axis + high) + " of the cell is not planar");
+          throw InvalidInput("smooth_in_cell: face " + std::to_string(2 * axis + high) +
+                             " of the cell is not planar");
       origin[static_cast<std::size_t>(2 * axis + high)] = centre;
       normal[static_cast<std::size_t>(2 * axis + high)] = n.normalized();
     }
@@ -409,21 +429,26 @@ primal::SmoothResult smooth_in_cell(Template& t, const Eigen::Vector3d& box_of_t
   std::array<Point, 8> vtk;
   for (int c = 0; c < 8; ++c) {
     const auto& rc = primal::topology::kHexCornerCoords[static_cast<std::size_t>(c)];
-    vtk[static_cast<std::size_t>(c)] = cell[static_cast<std::size_t>(rc[0] + 2 * rc[1] + 4 * rc[2])];
+    vtk[static_cast<std::size_t>(c)] =
+        cell[static_cast<std::size_t>(rc[0] + 2 * rc[1] + 4 * rc[2])];
   }
   for (auto& p : t.hex.points)
     p = primal::multilinear_point(
-        vtk, Point(p.x() / box_of_t.x() + 0.5, p.y() / box_of_t.y() + 0.5, p.z() / box_of_t.z() + 0.5), 3);
+        vtk,
+        Point(p.x() / box_of_t.x() + 0.5, p.y() / box_of_t.y() + 0.5, p.z() / box_of_t.z() + 0.5),
+        3);
   std::vector<primal::NodeConstraint> c;
   for (std::size_t n = 0; n < t.hex.points.size(); ++n) {
     std::vector<int> faces;
     for (int f = 0; f < 6; ++f)
       if ((t.node_faces[n] >> f) & 1u) faces.push_back(f);
-    const bool tet_or_hex_side = std::any_of(faces.begin(), faces.end(), [](int f) { return f / 2 == 1; });
+    const bool tet_or_hex_side =
+        std::any_of(faces.begin(), faces.end(), [](int f) { return f / 2 == 1; });
     if (faces.size() >= 3 || (tet_or_hex_side && !slide)) {
       c.push_back(primal::NodeConstraint::fixed());
     } else if (faces.size() == 2) {
-      const Point d = normal[static_cast<std::size_t>(faces[0])].cross(normal[static_cast<std::size_t>(faces[1])]);
+      const Point d = normal[static_cast<std::size_t>(faces[0])].cross(
+          normal[static_cast<std::size_t>(faces[1])]);
       c.push_back(primal::NodeConstraint::line(t.hex.points[n], d));
     } else if (faces.size() == 1) {
       const auto f = static_cast<std::size_t>(faces[0]);
@@ -437,7 +462,8 @@ primal::SmoothResult smooth_in_cell(Template& t, const Eigen::Vector3d& box_of_t
 
 namespace {
 
-ShapeRow shape_row(const std::string& cell, double parameter, bool slide, const primal::SmoothResult& r) {
+ShapeRow shape_row(const std::string& cell, double parameter, bool slide,
+                   const primal::SmoothResult& r) {
   ShapeRow row;
   row.cell = cell;
   row.parameter = parameter;
@@ -467,7 +493,8 @@ std::vector<ShapeRow> height_study(const std::vector<double>& heights, double ba
   return rows;
 }
 
-std::vector<ShapeRow> distorted_study(const std::vector<double>& shear_degrees, const std::vector<double>& taper_ratios) {
+std::vector<ShapeRow> distorted_study(const std::vector<double>& shear_degrees,
+                                      const std::vector<double>& taper_ratios) {
   std::vector<ShapeRow> rows;
   GeodeOptions o;
   const Eigen::Vector3d box = o.box;
@@ -475,38 +502,42 @@ std::vector<ShapeRow> distorted_study(const std::vector<double>& shear_degrees, 
   for (double a : shear_degrees)
     for (bool slide : {false, true}) {
       Template t = reference;
-      rows.push_back(shape_row("shear", a, slide, smooth_in_cell(t, box, sheared_cell(box, a), slide)));
+      rows.push_back(
+          shape_row("shear", a, slide, smooth_in_cell(t, box, sheared_cell(box, a), slide)));
     }
   for (double r : taper_ratios)
     for (bool slide : {false, true}) {
       Template t = reference;
-      rows.push_back(shape_row("taper", r, slide, smooth_in_cell(t, box, tapered_cell(box, r), slide)));
+      rows.push_back(
+          shape_row("taper", r, slide, smooth_in_cell(t, box, tapered_cell(box, r), slide)));
     }
   return rows;
 }
 
 void write_shape_csv(std::ostream& out, const std::vector<ShapeRow>& rows) {
-  out << "cell,parameter,mode,initial_min_sj,final_min_sj,final_max_sj,untangled,iterations,seconds\n";
+  out << "cell,parameter,mode,initial_min_sj,final_min_sj,final_max_sj,untangled,iterations,"
+         "seconds\n";
   for (const auto& r : rows)
     out << r.cell << "," << fmt(r.parameter) << "," << r.mode << "," << fmt(r.initial_min_sj) << ","
-        << fmt(r.final_min_sj) << "," << fmt(r.final_max_sj) << "," << (r.untangled ? 1 : 0) << "," << r.iterations
-        << "," << fmt(r.seconds) << "\n";
+        << fmt(r.final_min_sj) << "," << fmt(r.final_max_sj) << "," << (r.untangled ? 1 : 0) << ","
+        << r.iterations << "," << fmt(r.seconds) << "\n";
 }
 
 const std::vector<PaperRow>& paper_table1() {
   // The paper's Table 1, "CUBIT quality report for a 24 x 14 x 24 geode-template".
   using M = primal::HexMetric;
   static const std::vector<PaperRow> rows = {
-      {M::kAspectRatio, 1.75, 0.55, 1.07, 3.07}, {M::kSkew, 0.54, 0.16, 0.17, 0.76},
-      {M::kTaper, 0.30, 0.13, 0.038, 0.76},      {M::kVolume, 300, 223, 97, 786},
-      {M::kStretch, 0.41, 0.13, 0.25, 0.63},     {M::kDiagonal, 0.53, 0.09, 0.38, 0.74},
-      {M::kDimension, 3.19, 0.94, 1.97, 5.00},   {M::kJacobian, 69.9, 44, 26, 164},
+      {M::kAspectRatio, 1.75, 0.55, 1.07, 3.07},   {M::kSkew, 0.54, 0.16, 0.17, 0.76},
+      {M::kTaper, 0.30, 0.13, 0.038, 0.76},        {M::kVolume, 300, 223, 97, 786},
+      {M::kStretch, 0.41, 0.13, 0.25, 0.63},       {M::kDiagonal, 0.53, 0.09, 0.38, 0.74},
+      {M::kDimension, 3.19, 0.94, 1.97, 5.00},     {M::kJacobian, 69.9, 44, 26, 164},
       {M::kScaledJacobian, 0.34, 0.09, 0.26, 0.53}};
   return rows;
 }
 
 void write_geode_quality(std::ostream& report_csv, std::ostream* per_hex_csv) {
-  report_csv << "metric,key,mode,average,std_dev,min,max,paper_average,paper_std_dev,paper_min,paper_max\n";
+  report_csv << "metric,key,mode,average,std_dev,min,max,paper_average,paper_std_dev,paper_min,"
+                "paper_max\n";
   if (per_hex_csv) *per_hex_csv << "mode,hex,scaled_jacobian\n";
   std::vector<primal::HexMetric> metrics;
   for (const auto& p : paper_table1()) metrics.push_back(p.metric);
@@ -520,14 +551,17 @@ void write_geode_quality(std::ostream& report_csv, std::ostream* per_hex_csv) {
       const auto& m = report.metrics[i];
       const auto& p = paper_table1()[i];
       const auto& info = primal::hex_metric_info(m.metric);
-      report_csv << info.name << "," << info.key << "," << mode << "," << fmt(m.average) << "," << fmt(m.std_dev)
-                 << "," << fmt(m.minimum) << "," << fmt(m.maximum) << "," << fmt(p.average) << ","
-                 << fmt(p.std_dev) << "," << fmt(p.minimum) << "," << fmt(p.maximum) << "\n";
+      report_csv << info.name << "," << info.key << "," << mode << "," << fmt(m.average) << ","
+                 << fmt(m.std_dev) << "," << fmt(m.minimum) << "," << fmt(m.maximum) << ","
+                 << fmt(p.average) << "," << fmt(p.std_dev) << "," << fmt(p.minimum) << ","
+                 << fmt(p.maximum) << "\n";
     }
     if (per_hex_csv)
       for (std::size_t h = 0; h < t.hex.hexes.size(); ++h)
         *per_hex_csv << mode << "," << h + 1 << ","
-                     << fmt(primal::hex_scaled_jacobian(primal::hex_corners(t.hex, static_cast<Index>(h)))) << "\n";
+                     << fmt(primal::hex_scaled_jacobian(
+                            primal::hex_corners(t.hex, static_cast<Index>(h))))
+                     << "\n";
   }
 }
 

@@ -40,9 +40,9 @@ struct PushGrid {
 struct InterleaveRun {
   PushParameters push;
   std::vector<double> parameters;  // the swept values, one per InterleaveStudy::parameter_names
-  bool valid = false;        // the arrangement dualized to a template
+  bool valid = false;              // the arrangement dualized to a template
   int hexes = 0;
-  std::string class_label;   // "V1", "V2", ... for template classes, "E1", ... for diagnoses
+  std::string class_label;     // "V1", "V2", ... for template classes, "E1", ... for diagnoses
   bool conditions_ok = false;  // the paper's two interleave conditions (valid runs only)
   std::string conditions;      // the failed conditions, stripped of numbers (valid runs)
   std::string diagnosis;       // the TopologyError, stripped (error runs)
@@ -55,8 +55,8 @@ struct InterleaveClass {
   std::string key;  // template_class_key, or the stripped diagnosis
   int hexes = 0;
   int count = 0;
-  int conditions_ok = 0;  // runs of the class meeting the paper's conditions
-  PushParameters example;  // the first run of the class in sweep order
+  int conditions_ok = 0;                   // runs of the class meeting the paper's conditions
+  PushParameters example;                  // the first run of the class in sweep order
   std::vector<double> example_parameters;  // its swept values (spec studies)
   // Valid classes, measured on the example's template: the obstructions to untangling it
   // (template_obstructions), and its smoothed minimum scaled Jacobian with tet- and hex-side
@@ -71,18 +71,20 @@ struct InterleaveStudy {
   std::string template_name;
   std::vector<std::string> parameter_names;  // swept spec paths (spec studies; else empty)
   int skipped = 0;                           // sweep points whose spec is invalid input
-  std::vector<InterleaveRun> runs;       // sweep order: high, low, depth, radius
-  std::vector<InterleaveClass> classes;  // valid classes, then errors; each by count, then key
+  std::vector<InterleaveRun> runs;           // sweep order: high, low, depth, radius
+  std::vector<InterleaveClass> classes;      // valid classes, then errors; each by count, then key
 };
 
 // Called with (what, done, total) as a sweep goes: "pushes" built, then "classes" measured.
-using StudyProgress = std::function<void(const std::string& what, std::size_t done, std::size_t total)>;
+using StudyProgress =
+    std::function<void(const std::string& what, std::size_t done, std::size_t total)>;
 
 // Builds the template for every grid point with 0 < low < high < 1 (others are skipped:
-// build_geode3d rejects them as invalid input), then measures each valid class. split picks geode3d or geode4tri; the rest of
-// `base` (box, diagonal, higher) is kept.
+// build_geode3d rejects them as invalid input), then measures each valid class. split picks geode3d
+// or geode4tri; the rest of `base` (box, diagonal, higher) is kept.
 InterleaveStudy interleave_study(const GeodeOptions& base, const PushGrid& grid,
-                                 const std::string& template_name, const StudyProgress& progress = {});
+                                 const std::string& template_name,
+                                 const StudyProgress& progress = {});
 
 // One point of a sweep: the push and swept values the CSV records, and how to build it.
 struct InterleaveCase {
@@ -90,7 +92,8 @@ struct InterleaveCase {
   std::vector<double> parameters;
   std::function<Template()> build;
 };
-InterleaveStudy interleave_study(const std::vector<InterleaveCase>& cases, const std::string& template_name,
+InterleaveStudy interleave_study(const std::vector<InterleaveCase>& cases,
+                                 const std::string& template_name,
                                  const std::vector<std::string>& parameter_names = {},
                                  const StudyProgress& progress = {});
 
@@ -98,7 +101,8 @@ InterleaveStudy interleave_study(const std::vector<InterleaveCase>& cases, const
 // axis slowest); points whose spec is invalid input (e.g. low roof above high) are skipped
 // and counted. `source` names the spec in messages.
 InterleaveStudy interleave_study(const nlohmann::json& spec, const std::string& source,
-                                 const std::vector<SweepAxis>& axes, const std::string& template_name,
+                                 const std::vector<SweepAxis>& axes,
+                                 const std::string& template_name,
                                  const StudyProgress& progress = {});
 
 // CSV: high_roof,low_roof,dome_depth,dome_radius,outcome,hexes,class,conditions_ok,diagnosis,
@@ -128,9 +132,9 @@ primal::SmoothResult smooth_in_cell(Template& t, const Eigen::Vector3d& box_of_t
                                     const CellCorners& cell, bool slide);
 
 struct ShapeRow {
-  std::string cell;   // "box", "shear", "taper"
+  std::string cell;        // "box", "shear", "taper"
   double parameter = 0.0;  // height, shear angle (degrees) or taper ratio
-  std::string mode;   // "fixed" or "slide"
+  std::string mode;        // "fixed" or "slide"
   double initial_min_sj = 0.0, final_min_sj = 0.0, final_max_sj = 0.0;
   bool untangled = false;
   int iterations = 0;

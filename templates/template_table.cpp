@@ -52,9 +52,9 @@ primal::SmoothResult smooth_refine(Template& t, const TemplateOptions& o, bool s
 // certificate, computed from the surface, until the engine represents immersed sheets.
 [[noreturn]] void refuse_pyramid() {
   const double h = std::sqrt(2.0);
-  const PyramidCertificate c = pyramid_certificate({primal::Point(-1, 0, -1), primal::Point(-1, 0, 1),
-                                                    primal::Point(1, 0, 1), primal::Point(1, 0, -1),
-                                                    primal::Point(0, h, 0)});
+  const PyramidCertificate c = pyramid_certificate(
+      {primal::Point(-1, 0, -1), primal::Point(-1, 0, 1), primal::Point(1, 0, 1),
+       primal::Point(1, 0, -1), primal::Point(0, h, 0)});
   throw TopologyError("template pyramid: " + c.statement +
                       " (self-intersecting sheets are not represented yet; templates/pyramid.hpp)");
 }

@@ -25,11 +25,27 @@ namespace {
 // small; strings go through nlohmann::json for escaping.
 class JsonOut {
  public:
-  void key(const char* k) { comma(); s_ += '"'; s_ += k; s_ += "\":"; first_ = true; }
-  void raw(const std::string& v) { comma(); s_ += v; }
+  void key(const char* k) {
+    comma();
+    s_ += '"';
+    s_ += k;
+    s_ += "\":";
+    first_ = true;
+  }
+  void raw(const std::string& v) {
+    comma();
+    s_ += v;
+  }
   void str(const std::string& v) { raw(nlohmann::json(v).dump()); }
-  void open(char c) { comma(); s_ += c; first_ = true; }
-  void close(char c) { s_ += c; first_ = false; }
+  void open(char c) {
+    comma();
+    s_ += c;
+    first_ = true;
+  }
+  void close(char c) {
+    s_ += c;
+    first_ = false;
+  }
   void number(double v) {
     char b[32];
     std::snprintf(b, sizeof b, "%.7g", std::isfinite(v) ? v : 0.0);
@@ -70,17 +86,23 @@ void check_ids(const Rows& rows, std::size_t n, const std::string& what) {
     for (auto v : rows[r])
       if (v < 0 || static_cast<std::size_t>(v) >= n)
         throw InvalidInput("html viewer: " + what + " " + std::to_string(r + 1) + " refers to id " +
-                           std::to_string(static_cast<long long>(v) + 1) + ", out of 1.." + std::to_string(n));
+                           std::to_string(static_cast<long long>(v) + 1) + ", out of 1.." +
+                           std::to_string(n));
 }
 
 std::string html_escape(const std::string& t) {
   std::string out;
   for (char c : t) {
-    if (c == '&') out += "&amp;";
-    else if (c == '<') out += "&lt;";
-    else if (c == '>') out += "&gt;";
-    else if (c == '"') out += "&quot;";
-    else out += c;
+    if (c == '&')
+      out += "&amp;";
+    else if (c == '<')
+      out += "&lt;";
+    else if (c == '>')
+      out += "&gt;";
+    else if (c == '"')
+      out += "&quot;";
+    else
+      out += c;
   }
   return out;
 }
@@ -92,7 +114,8 @@ std::string fill(const std::string& page, const std::map<std::string, std::strin
   while (true) {
     const std::size_t a = page.find('@', at);
     const std::size_t b = a == std::string::npos ? a : page.find('@', a + 1);
-    const auto it = b == std::string::npos ? values.end() : values.find(page.substr(a + 1, b - a - 1));
+    const auto it =
+        b == std::string::npos ? values.end() : values.find(page.substr(a + 1, b - a - 1));
     if (it == values.end()) {
       if (a == std::string::npos) break;
       out.append(page, at, a + 1 - at);
@@ -108,8 +131,8 @@ std::string fill(const std::string& page, const std::map<std::string, std::strin
 }
 
 template <std::size_t K, std::size_t C, class Facets>
-void write_topology(JsonOut& j, int dim, const std::array<std::array<int, K>, C>& faces, const Facets& facets,
-              const std::vector<std::array<int, 2>>& edges) {
+void write_topology(JsonOut& j, int dim, const std::array<std::array<int, K>, C>& faces,
+                    const Facets& facets, const std::vector<std::array<int, 2>>& edges) {
   j.key("dim"), j.index(dim);
   j.key("faces"), j.open('[');
   for (const auto& f : faces) j.rows(std::array<std::array<int, K>, 1>{f});
@@ -123,8 +146,9 @@ void write_topology(JsonOut& j, int dim, const std::array<std::array<int, K>, C>
 }
 
 template <class Cells>
-std::string page(const std::vector<Point>& points, const Cells& cells, const std::vector<int>* block,
-                 const std::vector<double>& quality, const ViewScene& scene, int dim, JsonOut& j) {
+std::string page(const std::vector<Point>& points, const Cells& cells,
+                 const std::vector<int>* block, const std::vector<double>& quality,
+                 const ViewScene& scene, int dim, JsonOut& j) {
   const std::size_t n = points.size();
   check_ids(cells, n, dim == 3 ? "hex" : "quad");
   j.key("title"), j.str(scene.title);
@@ -132,7 +156,8 @@ std::string page(const std::vector<Point>& points, const Cells& cells, const std
   j.key("corners"), j.index(dim == 3 ? 8 : 4);
   j.key("nodes"), j.points(points);
   j.key("cells"), j.rows(cells);
-  j.key("quality_name"), j.str(dim == 3 ? "scaled Jacobian (Verdict, hex)" : "scaled Jacobian (Verdict, quad)");
+  j.key("quality_name"),
+      j.str(dim == 3 ? "scaled Jacobian (Verdict, hex)" : "scaled Jacobian (Verdict, quad)");
   j.key("quality"), j.open('[');
   for (double q : quality) j.number(q);
   j.close(']');
@@ -144,19 +169,23 @@ std::string page(const std::vector<Point>& points, const Cells& cells, const std
   j.key("sheets"), j.open('[');
   for (const auto& s : scene.sheets) {
     const bool tris = dim == 3;
-    if (tris) check_ids(s.surface.tris, s.surface.points.size(), "sheet '" + s.name + "' triangle");
-    else check_ids(s.curve.segments, s.curve.points.size(), "sheet '" + s.name + "' segment");
+    if (tris)
+      check_ids(s.surface.tris, s.surface.points.size(), "sheet '" + s.name + "' triangle");
+    else
+      check_ids(s.curve.segments, s.curve.points.size(), "sheet '" + s.name + "' segment");
     for (Index c : s.layer)
       if (c < 0 || static_cast<std::size_t>(c) >= cells.size())
-        throw InvalidInput("html viewer: sheet '" + s.name + "' layer has cell " + std::to_string(c + 1) + ", out of 1.." +
-                           std::to_string(cells.size()));
+        throw InvalidInput("html viewer: sheet '" + s.name + "' layer has cell " +
+                           std::to_string(c + 1) + ", out of 1.." + std::to_string(cells.size()));
     j.open('{');
     j.key("name"), j.str(s.name);
     j.key("kind"), j.str(s.kind);
     j.key("smooth"), j.raw(s.smooth ? "true" : "false");
     j.key("points"), j.points(tris ? s.surface.points : s.curve.points);
-    if (tris) j.key("triangles"), j.rows(s.surface.tris);
-    else j.key("segments"), j.rows(s.curve.segments);
+    if (tris)
+      j.key("triangles"), j.rows(s.surface.tris);
+    else
+      j.key("segments"), j.rows(s.curve.segments);
     j.key("layer"), j.open('[');
     for (Index c : s.layer) j.index(c);
     j.close(']');
@@ -184,10 +213,12 @@ std::string page(const std::vector<Point>& points, const Cells& cells, const std
 std::string html_view(const HexMesh& mesh, const ViewScene& scene) {
   check_ids(mesh.hexes, mesh.points.size(), "hex");
   std::vector<double> q;
-  for (std::size_t h = 0; h < mesh.hexes.size(); ++h) q.push_back(hex_scaled_jacobian(hex_corners(mesh, static_cast<Index>(h))));
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
+    q.push_back(hex_scaled_jacobian(hex_corners(mesh, static_cast<Index>(h))));
   JsonOut j;
   j.open('{');
-  std::vector<std::array<int, 2>> edges(topology::kHexEdgeCorners.begin(), topology::kHexEdgeCorners.end());
+  std::vector<std::array<int, 2>> edges(topology::kHexEdgeCorners.begin(),
+                                        topology::kHexEdgeCorners.end());
   write_topology(j, 3, topology::kHexFaceCorners, topology::kHexFaceCorners, edges);
   return page(mesh.points, mesh.hexes, &mesh.block, q, scene, 3, j);
 }
@@ -205,8 +236,10 @@ std::string html_view(const QuadMesh& mesh, const ViewScene& scene) {
   }
   JsonOut j;
   j.open('{');
-  std::vector<std::array<int, 2>> edges(topology::kQuadEdgeCorners.begin(), topology::kQuadEdgeCorners.end());
-  write_topology(j, 2, std::array<std::array<int, 4>, 1>{{{0, 1, 2, 3}}}, topology::kQuadEdgeCorners, edges);
+  std::vector<std::array<int, 2>> edges(topology::kQuadEdgeCorners.begin(),
+                                        topology::kQuadEdgeCorners.end());
+  write_topology(j, 2, std::array<std::array<int, 4>, 1>{{{0, 1, 2, 3}}},
+                 topology::kQuadEdgeCorners, edges);
   return page(mesh.points, mesh.quads, nullptr, q, scene, 2, j);
 }
 

@@ -20,10 +20,10 @@ namespace geode::viewer {
 // the cells of its layer (0-based).
 struct ViewSheet {
   std::string name;
-  std::string kind;          // e.g. "tunnel", "dome", "mesh"; tunnels and domes get their own colours
-  primal::TriMesh surface;   // 3D
-  primal::SegmentMesh curve; // 2D
-  bool smooth = false;       // consistently oriented: shade with interpolated normals
+  std::string kind;  // e.g. "tunnel", "dome", "mesh"; tunnels and domes get their own colours
+  primal::TriMesh surface;           // 3D
+  primal::SegmentMesh curve;         // 2D
+  bool smooth = false;               // consistently oriented: shade with interpolated normals
   std::vector<primal::Index> layer;  // cells dual to the sheet
 };
 
@@ -46,7 +46,9 @@ std::string html_view(const primal::HexMesh& mesh, const ViewScene& scene);
 std::string html_view(const primal::QuadMesh& mesh, const ViewScene& scene);  // quads in any plane
 
 // Written atomically (io/atomic_file.hpp).
-void write_html(const std::filesystem::path& path, const primal::HexMesh& mesh, const ViewScene& scene);
-void write_html(const std::filesystem::path& path, const primal::QuadMesh& mesh, const ViewScene& scene);
+void write_html(const std::filesystem::path& path, const primal::HexMesh& mesh,
+                const ViewScene& scene);
+void write_html(const std::filesystem::path& path, const primal::QuadMesh& mesh,
+                const ViewScene& scene);
 
 }  // namespace geode::viewer

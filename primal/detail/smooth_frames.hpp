@@ -14,10 +14,10 @@ namespace geode::primal::detail {
 // (primal/quality.hpp): corner c has v_i = p[kHexCornerNeighbors[c][i]] - p[c], the centre the
 // principal axes X1, X2, X3 (sums over the 8 corners), its Jacobian det / 64.
 struct HexFrameShape {
-  int nodes = 0;                          // corner[0 .. nodes) are used
-  std::array<int, 8> corner{};            // hex corners
+  int nodes = 0;                // corner[0 .. nodes) are used
+  std::array<int, 8> corner{};  // hex corners
   std::array<std::array<double, 8>, 3> coef{};
-  double det_scale = 1.0;                 // Jacobian = det[v0, v1, v2] * det_scale
+  double det_scale = 1.0;  // Jacobian = det[v0, v1, v2] * det_scale
 };
 
 inline const std::array<HexFrameShape, 9>& hex_frame_shapes() {
@@ -35,8 +35,7 @@ inline const std::array<HexFrameShape, 9>& hex_frame_shapes() {
     centre.det_scale = 1.0 / 64.0;
     for (int c = 0; c < 8; ++c) {
       centre.corner[c] = c;
-      for (int i = 0; i < 3; ++i)
-        centre.coef[i][c] = topology::kHexCornerCoords[c][i] ? 1.0 : -1.0;
+      for (int i = 0; i < 3; ++i) centre.coef[i][c] = topology::kHexCornerCoords[c][i] ? 1.0 : -1.0;
     }
     return s;
   }();

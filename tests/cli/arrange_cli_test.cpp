@@ -25,7 +25,9 @@ std::string read_text(const std::filesystem::path& p) {
   return s.str();
 }
 
-void write_text(const std::filesystem::path& p, const std::string& text) { std::ofstream(p) << text; }
+void write_text(const std::filesystem::path& p, const std::string& text) {
+  std::ofstream(p) << text;
+}
 
 // The mesh of a `--format json` output (1-based cells), as a hex or quad mesh.
 struct JsonMesh {
@@ -37,7 +39,8 @@ JsonMesh mesh_of(const nlohmann::json& j) {
   JsonMesh m;
   m.dim = j.contains("hexes") ? 3 : 2;
   std::vector<primal::Point> pts;
-  for (const auto& p : j["nodes"]) pts.emplace_back(p[0].get<double>(), p[1].get<double>(), m.dim == 3 ? p[2].get<double>() : 0.0);
+  for (const auto& p : j["nodes"])
+    pts.emplace_back(p[0].get<double>(), p[1].get<double>(), m.dim == 3 ? p[2].get<double>() : 0.0);
   if (m.dim == 3) {
     m.hex.points = pts;
     for (const auto& h : j["hexes"]) {
@@ -70,15 +73,18 @@ std::string three_planes_and(const std::string& extra) {
 TEST_CASE("geode arrange: the shipped specs are the built-in templates") {
   for (const std::string name : {"geode3d", "geode2d", "geode4tri", "refine3", "refine3-2d"}) {
     CAPTURE(name);
-    const std::filesystem::path shipped = std::filesystem::path(GEODE_SOURCE_DIR) / "notebooks-data/specs" / (name + ".json");
+    const std::filesystem::path shipped =
+        std::filesystem::path(GEODE_SOURCE_DIR) / "notebooks-data/specs" / (name + ".json");
     const auto spec = geode_cli("template " + name + " --format spec");
     REQUIRE(spec.code == 0);
     CHECK(spec.out == read_text(shipped));  // regenerate with the command when this fails
 
     // The plain dual: the arrangement has no fix-up. Unsmoothed it may be invalid (exit 4, both
     // alike: one validity check), so both are written on request.
-    const auto built = geode_cli("template " + name + " --no-smooth --no-fixup --write-invalid --format json");
-    const auto arranged = geode_cli("arrange " + shipped.string() + " --write-invalid --format json");
+    const auto built =
+        geode_cli("template " + name + " --no-smooth --no-fixup --write-invalid --format json");
+    const auto arranged =
+        geode_cli("arrange " + shipped.string() + " --write-invalid --format json");
     REQUIRE((built.code == 0 || built.code == 4));
     REQUIRE(arranged.code == built.code);
     const auto a = nlohmann::json::parse(built.out), b = nlohmann::json::parse(arranged.out);
@@ -99,7 +105,8 @@ TEST_CASE("geode arrange: the shipped specs are the built-in templates") {
 TEST_CASE("geode arrange: the README's examples, the pillowed hex and the pillowed quad") {
   const auto specs = std::filesystem::path(GEODE_SOURCE_DIR) / "notebooks-data/specs";
   const auto out = temp_path("pillow-out.json");
-  const auto r = geode_cli("arrange " + (specs / "pillow.json").string() + " --smooth --format json -o " + out.string());
+  const auto r = geode_cli("arrange " + (specs / "pillow.json").string() +
+                           " --smooth --format json -o " + out.string());
   REQUIRE(r.code == 0);
   const auto j = nlohmann::json::parse(read_text(out));
   CHECK(j["hexes"].size() == 7);  // three planes and a sphere around their crossing
@@ -116,11 +123,14 @@ TEST_CASE("geode arrange: the README's examples, the pillowed hex and the pillow
   const auto s = geode_cli("study interleave --spec " + (specs / "pillow2d.json").string());
   REQUIRE(s.code == 0);
   CHECK(s.out.find("valid,5,V1,1,\"\",0.4\n") != std::string::npos);
-  CHECK(s.out.find("error,0,E1,,\"arrangement: sheets 'a', 'c' meet on the domain boundary") != std::string::npos);
+  CHECK(s.out.find("error,0,E1,,\"arrangement: sheets 'a', 'c' meet on the domain boundary") !=
+        std::string::npos);
   CHECK(s.out.find("valid,3,V2,1,\"\",0.6\n") != std::string::npos);
   // The summary names each class's example by its swept values.
   const auto summary = temp_path("pillow2d-summary.csv");
-  REQUIRE(geode_cli("study interleave --quiet --spec " + (specs / "pillow2d.json").string() + " --summary " + summary.string()).code == 0);
+  REQUIRE(geode_cli("study interleave --quiet --spec " + (specs / "pillow2d.json").string() +
+                    " --summary " + summary.string())
+              .code == 0);
   const std::string table = read_text(summary);
   CHECK(table.find(",usable,\"example_sheets[2].circle.radius\"\n") != std::string::npos);
   CHECK(table.find(",1,0.6\n") != std::string::npos);  // V2, usable, first seen at radius 0.6
@@ -137,21 +147,27 @@ TEST_CASE("geode arrange: bad specs exit 2 naming the JSON path, non-dualizing o
     const char* message;
   };
   const std::vector<Case> cases = {
-      {"zero normal", three_planes_and(R"(, {"name": "w", "plane": {"point": [0, 0, 0], "normal": [0, 0, 0]}})"), 2,
-       ": sheets[3].plane.normal: must not be zero"},
-      {"too large for a double", three_planes_and(R"(, {"name": "s", "sphere": {"center": [0.5, 0.5, 0.5], "radius": 1e999}})"), 2,
-       ": not valid JSON: [json.exception.out_of_range.406] number overflow"},
-      {"NaN is not JSON", three_planes_and(R"(, {"name": "s", "sphere": {"center": [0.5, 0.5, 0.5], "radius": NaN}})"), 2,
-       ": not valid JSON"},
-      {"wrong dim", R"({"dim": 4, "domain": {"box": [[0, 0], [1, 1]]}, "sheets": []})", 2, ": dim: must be 2 or 3"},
+      {"zero normal",
+       three_planes_and(R"(, {"name": "w", "plane": {"point": [0, 0, 0], "normal": [0, 0, 0]}})"),
+       2, ": sheets[3].plane.normal: must not be zero"},
+      {"too large for a double",
+       three_planes_and(
+           R"(, {"name": "s", "sphere": {"center": [0.5, 0.5, 0.5], "radius": 1e999}})"),
+       2, ": not valid JSON: [json.exception.out_of_range.406] number overflow"},
+      {"NaN is not JSON",
+       three_planes_and(R"(, {"name": "s", "sphere": {"center": [0.5, 0.5, 0.5], "radius": NaN}})"),
+       2, ": not valid JSON"},
+      {"wrong dim", R"({"dim": 4, "domain": {"box": [[0, 0], [1, 1]]}, "sheets": []})", 2,
+       ": dim: must be 2 or 3"},
       {"sphere through the box faces' crossing",
-       three_planes_and(R"(, {"name": "s", "sphere": {"center": [0.5, 0.5, 0.5], "radius": 0.5}})"), 3,
-       "arrangement: sheets 'x', 'y', 's' meet on the domain boundary"},
+       three_planes_and(R"(, {"name": "s", "sphere": {"center": [0.5, 0.5, 0.5], "radius": 0.5}})"),
+       3, "arrangement: sheets 'x', 'y', 's' meet on the domain boundary"},
   };
   for (const auto& c : cases) {
     CAPTURE(c.what);
     write_text(spec, c.text);
-    const auto r = geode_cli("arrange " + spec.string() + " --format json -o " + out.string(), true);
+    const auto r =
+        geode_cli("arrange " + spec.string() + " --format json -o " + out.string(), true);
     CHECK(r.code == c.code);
     CHECK(r.out.find(c.message) != std::string::npos);
     CHECK(std::count(r.out.begin(), r.out.end(), '\n') == 1);
@@ -161,11 +177,14 @@ TEST_CASE("geode arrange: bad specs exit 2 naming the JSON path, non-dualizing o
   std::filesystem::remove(spec);
 }
 
-TEST_CASE("geode study interleave --spec: a spec swept by path classifies as the built-in study does") {
-  const std::string shipped = (std::filesystem::path(GEODE_SOURCE_DIR) / "notebooks-data/specs/geode3d.json").string();
+TEST_CASE(
+    "geode study interleave --spec: a spec swept by path classifies as the built-in study does") {
+  const std::string shipped =
+      (std::filesystem::path(GEODE_SOURCE_DIR) / "notebooks-data/specs/geode3d.json").string();
   const auto swept = geode_cli("study interleave --spec " + shipped +
                                " --sweep push.high_roof=0.75,0.85 --sweep push.low_roof=0.6:0.8:2");
-  const auto builtin = geode_cli("study interleave --high 0.75 0.85 --low 0.6 0.8 --depth 0.9 --radius 0.6");
+  const auto builtin =
+      geode_cli("study interleave --high 0.75 0.85 --low 0.6 0.8 --depth 0.9 --radius 0.6");
   REQUIRE(swept.code == 0);
   REQUIRE(builtin.code == 0);
   // The same rows (0.75 / 0.8 is skipped by both: low above high), plus the swept columns.
@@ -184,13 +203,17 @@ TEST_CASE("geode study interleave --spec: a spec swept by path classifies as the
 
   // A sheet's radius swept in a plain spec: the pillow, then a sphere through the box's faces.
   const auto spec = temp_path("sweep.json");
-  write_text(spec, R"({"dim": 3, "domain": {"box": [[0, 0, 0], [1, 1, 1]]},
+  write_text(spec,
+             R"({"dim": 3, "domain": {"box": [[0, 0, 0], [1, 1, 1]]},
                        "sweep": {"sheets[3].sphere.radius": [0.3, 0.5]}, )" +
-                       kPlanes + R"(, {"name": "s", "sphere": {"center": [0.5, 0.5, 0.5], "radius": 0.3}}]})");
+                 kPlanes +
+                 R"(, {"name": "s", "sphere": {"center": [0.5, 0.5, 0.5], "radius": 0.3}}]})");
   const auto r = geode_cli("study interleave --spec " + spec.string());
   REQUIRE(r.code == 0);
   CHECK(r.out.find("valid,7,V1,1,\"\",0.3\n") != std::string::npos);
   CHECK(r.out.find("error,0,E1,,") != std::string::npos);
-  CHECK(geode_cli("study interleave --spec " + spec.string() + " --sweep sheets[3].sphere.radios=1:2:2").code == 2);
+  CHECK(geode_cli("study interleave --spec " + spec.string() +
+                  " --sweep sheets[3].sphere.radios=1:2:2")
+            .code == 2);
   std::filesystem::remove(spec);
 }

@@ -15,10 +15,10 @@
 #include <sstream>
 #include <string>
 
-#include <geode/primal/grid_model.hpp>
 #include <geode/io/exodus.hpp>
 #include <geode/io/gmsh.hpp>
 #include <geode/io/vtk.hpp>
+#include <geode/primal/grid_model.hpp>
 #include <geode/primal/topology.hpp>
 #include "support/cli_run.hpp"
 
@@ -43,7 +43,8 @@ primal::Model steel_rubber() {
     for (int f = 0; f < 4; ++f) {
       bool on = true;
       for (int c : primal::topology::kTetFaceCorners[static_cast<std::size_t>(f)])
-        on = on && m.points[static_cast<std::size_t>(m.tets[t][static_cast<std::size_t>(c)])].x() == 4.0;
+        on = on &&
+             m.points[static_cast<std::size_t>(m.tets[t][static_cast<std::size_t>(c)])].x() == 4.0;
       if (on) load.sides.push_back({{primal::ElementKind::Tet, static_cast<primal::Index>(t)}, f});
     }
   m.side_sets = {load};
@@ -92,8 +93,8 @@ TEST_CASE("conform carries blocks and sets: steel and rubber keep their ids and 
 
   SUBCASE(".exo") {
     const fs::path out = dir.path / "out.exo", report = dir.path / "r.json";
-    const test::CliRun r = test::geode_cli("conform " + in.string() + " -o " + out.string() + " --report " +
-                                               report.string() + " --quiet",
+    const test::CliRun r = test::geode_cli("conform " + in.string() + " -o " + out.string() +
+                                               " --report " + report.string() + " --quiet",
                                            true);
     INFO(r.out);
     REQUIRE(r.code == 0);
@@ -122,22 +123,28 @@ TEST_CASE("conform carries blocks and sets: steel and rubber keep their ids and 
   }
   SUBCASE(".msh: physical volumes, a physical surface for the side set, physical points") {
     const fs::path out = dir.path / "out.msh";
-    REQUIRE(test::geode_cli("conform " + in.string() + " -o " + out.string() + " --quiet").code == 0);
+    REQUIRE(test::geode_cli("conform " + in.string() + " -o " + out.string() + " --quiet").code ==
+            0);
     check_carried(io::read_gmsh(out), model);
   }
   SUBCASE(".vtu: the block cell array and the names as field data") {
     const fs::path out = dir.path / "out.vtu";
-    REQUIRE(test::geode_cli("conform " + in.string() + " --vtu-encoding ascii -o " + out.string() + " --quiet").code == 0);
+    REQUIRE(test::geode_cli("conform " + in.string() + " --vtu-encoding ascii -o " + out.string() +
+                            " --quiet")
+                .code == 0);
     const io::VtkGrid g = io::read_vtu(out);
     REQUIRE(g.cell_data.find_int("block") != nullptr);
     CHECK(block_counts(*g.cell_data.find_int("block")) == kExpected);
     const std::string xml = slurp(out);
-    CHECK(xml.find("Name=\"block:steel\" NumberOfTuples=\"1\" format=\"ascii\">7<") != std::string::npos);
-    CHECK(xml.find("Name=\"block:rubber\" NumberOfTuples=\"1\" format=\"ascii\">9<") != std::string::npos);
+    CHECK(xml.find("Name=\"block:steel\" NumberOfTuples=\"1\" format=\"ascii\">7<") !=
+          std::string::npos);
+    CHECK(xml.find("Name=\"block:rubber\" NumberOfTuples=\"1\" format=\"ascii\">9<") !=
+          std::string::npos);
   }
   SUBCASE("--geode-block: the geode hexes in a block of their own") {
     const fs::path out = dir.path / "out.exo";
-    REQUIRE(test::geode_cli("conform " + in.string() + " --geode-block transition -o " + out.string() + " --quiet")
+    REQUIRE(test::geode_cli("conform " + in.string() + " --geode-block transition -o " +
+                            out.string() + " --quiet")
                 .code == 0);
     const primal::Model o = io::read_exodus(out);
     CHECK(block_counts(o.hex_block) == std::map<int, std::size_t>{{7, 64}, {9, 192}, {10, 104}});
@@ -146,7 +153,9 @@ TEST_CASE("conform carries blocks and sets: steel and rubber keep their ids and 
   }
   SUBCASE("--buffer-side tet: the geode hexes fill the rubber's space and join it") {
     const fs::path out = dir.path / "out.exo";
-    REQUIRE(test::geode_cli("conform " + in.string() + " --buffer-side tet -o " + out.string() + " --quiet").code == 0);
+    REQUIRE(test::geode_cli("conform " + in.string() + " --buffer-side tet -o " + out.string() +
+                            " --quiet")
+                .code == 0);
     const primal::Model o = io::read_exodus(out);
     CHECK(block_counts(o.hex_block) == std::map<int, std::size_t>{{7, 64}, {9, 104 + 192}});
   }
@@ -162,13 +171,15 @@ TEST_CASE("conform: parts meshed separately get a hint, and --merge-tolerance jo
     for (auto& v : t) v += static_cast<primal::Index>(n);
   const fs::path in = dir.path / "in.exo", out = dir.path / "out.exo";
   io::write_exodus(m, in);
-  const test::CliRun r = test::geode_cli("conform " + in.string() + " -o " + out.string() + " --quiet", true);
+  const test::CliRun r =
+      test::geode_cli("conform " + in.string() + " -o " + out.string() + " --quiet", true);
   INFO(r.out);
   CHECK((r.code == 2 || r.code == 3));
   CHECK(r.out.find("nodes lie at the same place as others") != std::string::npos);
   CHECK(r.out.find("--merge-tolerance") != std::string::npos);
   CHECK(!fs::exists(out));
-  const test::CliRun merged = test::geode_cli("conform " + in.string() + " --merge-tolerance 1e-9 -o " + out.string() + " --quiet", true);
+  const test::CliRun merged = test::geode_cli(
+      "conform " + in.string() + " --merge-tolerance 1e-9 -o " + out.string() + " --quiet", true);
   INFO(merged.out);
   CHECK(merged.code == 0);
   CHECK(io::read_exodus(out).hexes.size() == 360);

@@ -9,9 +9,9 @@
 #include <set>
 #include <string>
 
-#include <geode/primal/boundary.hpp>
 #include <geode/io/gmsh.hpp>
 #include <geode/io/vtk.hpp>
+#include <geode/primal/boundary.hpp>
 #include <geode/primal/grid_model.hpp>
 #include <geode/primal/topology.hpp>
 #include "support/cli_run.hpp"
@@ -58,20 +58,26 @@ nlohmann::json check_json(const std::filesystem::path& file) {
 }
 
 std::size_t count_kind(const nlohmann::json& j, const std::string& kind) {
-  return static_cast<std::size_t>(std::count_if(j["obstructions"].begin(), j["obstructions"].end(),
-                                                [&](const nlohmann::json& o) { return o["kind"] == kind; }));
+  return static_cast<std::size_t>(
+      std::count_if(j["obstructions"].begin(), j["obstructions"].end(),
+                    [&](const nlohmann::json& o) { return o["kind"] == kind; }));
 }
 
 }  // namespace
 
 TEST_CASE("geode check: the geode has no obstruction, the four-triangle duals do") {
   test::TempDir dir;
-  const auto geode = dir.path / "geode.vtu", plain = dir.path / "plain4.vtu", c24 = dir.path / "class24.vtu";
+  const auto geode = dir.path / "geode.vtu", plain = dir.path / "plain4.vtu",
+             c24 = dir.path / "class24.vtu";
   REQUIRE(geode_cli("template geode3d --format vtu -o " + geode.string()).code == 0);
   // The plain four-triangle duals are invalid (exit 4); written on request to be checked.
-  REQUIRE(geode_cli("template geode4tri --no-fixup --no-smooth --write-invalid --format vtu -o " + plain.string()).code == 4);
-  REQUIRE(geode_cli("template geode4tri --no-fixup --no-smooth --write-invalid --high-roof 0.5 --low-roof 0.45 "
-                    "--dome-depth 0.9 --dome-radius 0.4 --format vtu -o " + c24.string())
+  REQUIRE(geode_cli("template geode4tri --no-fixup --no-smooth --write-invalid --format vtu -o " +
+                    plain.string())
+              .code == 4);
+  REQUIRE(geode_cli("template geode4tri --no-fixup --no-smooth --write-invalid --high-roof 0.5 "
+                    "--low-roof 0.45 "
+                    "--dome-depth 0.9 --dome-radius 0.4 --format vtu -o " +
+                    c24.string())
               .code == 4);
 
   const auto g = check_json(geode);
@@ -110,7 +116,8 @@ TEST_CASE("geode check: the geode has no obstruction, the four-triangle duals do
   }
 
   SUBCASE("template --format json and the warning name the same obstructions") {
-    const auto t = geode_cli("template geode4tri --no-fixup --no-smooth --write-invalid --format json");
+    const auto t =
+        geode_cli("template geode4tri --no-fixup --no-smooth --write-invalid --format json");
     REQUIRE(t.code == 4);
     const auto tj = nlohmann::json::parse(t.out);
     const auto cj = check_json(plain);
@@ -119,12 +126,15 @@ TEST_CASE("geode check: the geode has no obstruction, the four-triangle duals do
       CHECK(tj["obstructions"][i]["kind"] == cj["obstructions"][i]["kind"]);
       // The template numbers from 1, the .vtu file from 0.
       for (std::size_t k = 0; k < cj["obstructions"][i]["nodes"].size(); ++k)
-        CHECK(tj["obstructions"][i]["nodes"][k].get<int>() == cj["obstructions"][i]["nodes"][k].get<int>() + 1);
+        CHECK(tj["obstructions"][i]["nodes"][k].get<int>() ==
+              cj["obstructions"][i]["nodes"][k].get<int>() + 1);
     }
-    const auto smoothed = geode_cli("template geode4tri --no-fixup --write-invalid --format csv", true);
+    const auto smoothed =
+        geode_cli("template geode4tri --no-fixup --write-invalid --format csv", true);
     const std::size_t n = cj["obstructions"].size();
-    CHECK(smoothed.out.find("smoothing could not untangle every element; no placement can: " + std::to_string(n) +
-                            (n == 1 ? " obstruction" : " obstructions")) != std::string::npos);
+    CHECK(smoothed.out.find(
+              "smoothing could not untangle every element; no placement can: " + std::to_string(n) +
+              (n == 1 ? " obstruction" : " obstructions")) != std::string::npos);
     CHECK(smoothed.out.find("pinched-corner: hexes") != std::string::npos);
   }
 }

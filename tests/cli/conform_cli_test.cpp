@@ -10,13 +10,13 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include <geode/primal/grid_model.hpp>
+#include <geode/conform/conform.hpp>
 #include <geode/io/exodus.hpp>
 #include <geode/io/gmsh.hpp>
+#include <geode/primal/grid_model.hpp>
 #include <geode/primal/validity.hpp>
 #include "support/cli_run.hpp"
 #include "support/fixtures.hpp"
-#include <geode/conform/conform.hpp>
 
 using namespace geode;
 namespace fs = std::filesystem;
@@ -78,22 +78,27 @@ TEST_CASE("geode conform: .msh and .exo input -> valid all-hex Exodus matching t
     CHECK(j.at("valid") == true);
     // The input's blocks (1: hexes, 2: tets, by default): the geode hexes join the hexes' (the
     // buffer layer is carved from the hex part).
-    auto in_block = [&](int b) { return std::count(result.hex_block.begin(), result.hex_block.end(), b); };
+    auto in_block = [&](int b) {
+      return std::count(result.hex_block.begin(), result.hex_block.end(), b);
+    };
     CHECK(in_block(1) == 64 + 104);
     CHECK(in_block(2) == 192);
     std::size_t block_hexes = 0;
-    for (const auto& b : j.at("blocks")) block_hexes += b.at("quality").at("num_hexes").get<std::size_t>();
+    for (const auto& b : j.at("blocks"))
+      block_hexes += b.at("quality").at("num_hexes").get<std::size_t>();
     CHECK(block_hexes == 360);
   }
 }
 
 TEST_CASE("geode conform: a hex-only model has no transition to make and is simply diced") {
   TempDir dir;
-  const primal::Model hexes = primal::grid_model({2, 2, 2}, 1.0, [](int, int, int) { return false; });
+  const primal::Model hexes =
+      primal::grid_model({2, 2, 2}, 1.0, [](int, int, int) { return false; });
   io::write_gmsh(hexes, dir.path / "hexes.msh");
   const fs::path report = dir.path / "r.json";
-  const Run r = geode_cli("conform " + (dir.path / "hexes.msh").string() + " -o " + (dir.path / "out.exo").string() +
-                          " --report " + report.string() + " --quiet");
+  const Run r =
+      geode_cli("conform " + (dir.path / "hexes.msh").string() + " -o " +
+                (dir.path / "out.exo").string() + " --report " + report.string() + " --quiet");
   INFO(r.out);
   REQUIRE(r.code == 0);
   const nlohmann::json j = nlohmann::json::parse(std::ifstream(report));
@@ -144,11 +149,13 @@ TEST_CASE("geode conform: a warning reaches stderr with --quiet, and the report 
   TempDir dir;
   io::write_gmsh(test::tet_cell_on_hex_top(), dir.path / "in.msh");
   const fs::path report = dir.path / "r.json";
-  const Run r = geode_cli("conform " + (dir.path / "in.msh").string() + " -o " + (dir.path / "out.exo").string() +
-                          " --report " + report.string() + " --quiet");
+  const Run r =
+      geode_cli("conform " + (dir.path / "in.msh").string() + " -o " +
+                (dir.path / "out.exo").string() + " --report " + report.string() + " --quiet");
   CHECK(r.code == 0);
   // Nothing but the warning, on one line.
-  CHECK(r.out.rfind("geode: warning: buffer layer carved from the tet part, not the hex part", 0) == 0);
+  CHECK(r.out.rfind("geode: warning: buffer layer carved from the tet part, not the hex part", 0) ==
+        0);
   CHECK(std::count(r.out.begin(), r.out.end(), '\n') == 1);
   std::ifstream is(report);
   const nlohmann::json j = nlohmann::json::parse(is);

@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include <geode/primal/grid_model.hpp>
 #include <geode/io/exodus.hpp>
 #include <geode/io/gmsh.hpp>
 #include <geode/io/vtk.hpp>
+#include <geode/primal/grid_model.hpp>
 #include "support/cli_run.hpp"
 
 using namespace geode;
@@ -33,7 +33,9 @@ std::string slurp(const fs::path& p) {
   return s.str();
 }
 
-std::size_t lines(const std::string& s) { return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n')); }
+std::size_t lines(const std::string& s) {
+  return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n'));
+}
 
 // 4 x 2 x 2 unit cells, cells with i >= 2 split into 6 tets: 8 hexes, 48 tets, 4 interface quads.
 primal::Model small_model() {
@@ -42,7 +44,9 @@ primal::Model small_model() {
 
 }  // namespace
 
-TEST_CASE("cli conventions: usage errors and bad numbers are one line on stderr, exit 2, nothing written") {
+TEST_CASE(
+    "cli conventions: usage errors and bad numbers are one line on stderr, exit 2, nothing "
+    "written") {
   TempDir dir;
   const std::string d = dir.path.string() + "/";
   const fs::path in = dir.path / "in.msh";
@@ -82,10 +86,13 @@ TEST_CASE("cli conventions: usage errors and bad numbers are one line on stderr,
       {"conform " + in.string() + " --buffer-side both", "--buffer-side"},
       {"conform " + in.string() + " --buffer-side tet --buffer-thickness 0.6", "at most 0.45"},
       {"conform " + in.string() + " --smooth-target 2", "out of range [0, 1]"},
-      {"conform " + in.string() + " --template-box 24x0x24 -o " + d + "out.exo", "--template-box '24x0x24'"},
+      {"conform " + in.string() + " --template-box 24x0x24 -o " + d + "out.exo",
+       "--template-box '24x0x24'"},
       // Outputs: format by extension, contradictions, unknown extensions, missing directories.
-      {"template geode3d -o " + d + "t.vtu --format csv", "--format csv contradicts the extension '.vtu'"},
-      {"template geode3d --format vtu -o " + d + "t.vtk", "--format vtu contradicts the extension '.vtk'"},
+      {"template geode3d -o " + d + "t.vtu --format csv",
+       "--format csv contradicts the extension '.vtu'"},
+      {"template geode3d --format vtu -o " + d + "t.vtk",
+       "--format vtu contradicts the extension '.vtk'"},
       {"template geode3d -o " + d + "t.xyz", "unknown output format '.xyz'"},
       {"template geode3d --format vtu", "needs -o FILE"},
       {"template geode2d -o " + d + "t.exo", "quad mesh"},
@@ -93,7 +100,8 @@ TEST_CASE("cli conventions: usage errors and bad numbers are one line on stderr,
       {"conform " + in.string() + " -o " + d + "out.stl", "unknown output format '.stl'"},
       {"conform " + in.string() + " -o " + d + "out.exo --format vtu", "contradicts"},
       {"conform " + in.string() + " -o " + d + "out.exo --report " + d + "r.txt", "JSON"},
-      {"conform " + in.string() + " -o " + d + "out.exo --report " + d + "missing/r.json", "missing"},
+      {"conform " + in.string() + " -o " + d + "out.exo --report " + d + "missing/r.json",
+       "missing"},
       {"conform " + in.string() + " -o " + d, "is a directory"},
       {"dual " + in.string() + " --rebuild " + d + "r.stl", "unknown output format '.stl'"},
       {"dual " + in.string() + " -o " + d + "r.json --format text", "contradicts"},
@@ -116,16 +124,18 @@ TEST_CASE("cli conventions: --version and --help") {
   CHECK(v.code == 0);
   CHECK(v.out.rfind("geode ", 0) == 0);
   CHECK(lines(v.out) == 1);
-  for (const char* cmd : {"template", "conform", "demo", "dual", "study interleave", "study shape"}) {
+  for (const char* cmd :
+       {"template", "conform", "demo", "dual", "study interleave", "study shape"}) {
     CAPTURE(cmd);
     const test::CliRun h = test::geode_cli(std::string(cmd) + " --help");
     CHECK(h.code == 0);
     CHECK(h.out.find("--help") != std::string::npos);
   }
   const test::CliRun h = test::geode_cli("conform --help");
-  for (const char* opt : {"--output", "--format", "--report", "--smooth", "--geode-block", "--merge-tolerance",
-                          "--write-invalid", "--quiet", "--vtu-encoding", "--smooth-target", "--buffer-thickness",
-                          "--buffer-side", "--template-box"})
+  for (const char* opt :
+       {"--output", "--format", "--report", "--smooth", "--geode-block", "--merge-tolerance",
+        "--write-invalid", "--quiet", "--vtu-encoding", "--smooth-target", "--buffer-thickness",
+        "--buffer-side", "--template-box"})
     CHECK(h.out.find(opt) != std::string::npos);
 }
 
@@ -136,9 +146,9 @@ TEST_CASE("cli conventions: template -o picks the format from the extension") {
     std::string starts_with;
   };
   const std::vector<Case> cases{{"t.vtu", "<?xml"},       {"t.vtk", "# vtk DataFile"},
-                                {"t.msh", "$MeshFormat"},  {"t.txt", "# geode template geode3d"},
-                                {"t.csv", "node,x,y,z"},   {"t.json", "{"},
-                                {"t.exo", "CDF"},          {"t.e", "CDF"}};
+                                {"t.msh", "$MeshFormat"}, {"t.txt", "# geode template geode3d"},
+                                {"t.csv", "node,x,y,z"},  {"t.json", "{"},
+                                {"t.exo", "CDF"},         {"t.e", "CDF"}};
   for (const Case& c : cases) {
     CAPTURE(c.name);
     const fs::path out = dir.path / c.name;
@@ -154,7 +164,8 @@ TEST_CASE("cli conventions: template -o picks the format from the extension") {
   CHECK(slurp(dir.path / "t.vtu").find("format=\"binary\"") != std::string::npos);
   CHECK(slurp(dir.path / "t.vtu").find("Table") == std::string::npos);
   // .msh as Gmsh 2.2 when asked.
-  REQUIRE(test::geode_cli("template geode3d --format msh22 -o " + (dir.path / "t22.msh").string()).code == 0);
+  REQUIRE(test::geode_cli("template geode3d --format msh22 -o " + (dir.path / "t22.msh").string())
+              .code == 0);
   CHECK(slurp(dir.path / "t22.msh").rfind("$MeshFormat\n2.2", 0) == 0);
   CHECK(io::read_gmsh(dir.path / "t22.msh").hexes.size() == 26);
 }
@@ -220,14 +231,17 @@ TEST_CASE("cli conventions: a binary .vtu holds the same points and cell data as
   CHECK(sj == *a.cell_data.find_double("scaled_jacobian"));
 }
 
-TEST_CASE("cli conventions: conform checks its outputs before work and writes mesh and report both or neither") {
+TEST_CASE(
+    "cli conventions: conform checks its outputs before work and writes mesh and report both or "
+    "neither") {
   TempDir dir;
   const fs::path in = dir.path / "in.msh", out = dir.path / "out.exo", report = dir.path / "r.json";
   io::write_gmsh(small_model(), in);
   SUBCASE("a report in a missing directory: no mesh, exit 2, named") {
-    const test::CliRun r = test::geode_cli("conform " + in.string() + " -o " + out.string() + " --report " +
-                                               (dir.path / "missing" / "r.json").string(),
-                                           true);
+    const test::CliRun r =
+        test::geode_cli("conform " + in.string() + " -o " + out.string() + " --report " +
+                            (dir.path / "missing" / "r.json").string(),
+                        true);
     CHECK(r.code == 2);
     CHECK(r.out.find("missing") != std::string::npos);
     CHECK(r.out.find("interface") == std::string::npos);  // refused before the first stage
@@ -236,15 +250,16 @@ TEST_CASE("cli conventions: conform checks its outputs before work and writes me
   SUBCASE("a directory in the report's place: refused before work, no mesh either") {
     fs::create_directory(report);
     fs::create_directory(report / "keep");  // a non-empty directory cannot be replaced
-    const test::CliRun r = test::geode_cli("conform " + in.string() + " -o " + out.string() + " --report " +
-                                               report.string() + " --quiet",
+    const test::CliRun r = test::geode_cli("conform " + in.string() + " -o " + out.string() +
+                                               " --report " + report.string() + " --quiet",
                                            true);
     CHECK(r.code == 2);
     CHECK(!fs::exists(out));
   }
   SUBCASE("both written") {
-    const test::CliRun r = test::geode_cli(
-        "conform " + in.string() + " -o " + out.string() + " --report " + report.string() + " --quiet", true);
+    const test::CliRun r = test::geode_cli("conform " + in.string() + " -o " + out.string() +
+                                               " --report " + report.string() + " --quiet",
+                                           true);
     INFO(r.out);
     CHECK(r.code == 0);
     CHECK(r.out.empty());
@@ -254,7 +269,9 @@ TEST_CASE("cli conventions: conform checks its outputs before work and writes me
   }
 }
 
-TEST_CASE("cli conventions: an invalid result exits 4, says so even with --quiet, writes only with --write-invalid") {
+TEST_CASE(
+    "cli conventions: an invalid result exits 4, says so even with --quiet, writes only with "
+    "--write-invalid") {
   TempDir dir;
   // The small model plus one hex meeting the hex part along an edge only: its diced hexes make
   // that edge non-manifold, so the output cannot be valid whatever the algorithm does.
@@ -266,14 +283,15 @@ TEST_CASE("cli conventions: an invalid result exits 4, says so even with --quiet
     return static_cast<primal::Index>(m.points.size() - 1);
   };
   std::array<primal::Index, 8> h{};
-  const double x[8] = {-1, 0, 0, -1, -1, 0, 0, -1}, y[8] = {-1, -1, 0, 0, -1, -1, 0, 0}, z[8] = {0, 0, 0, 0, 1, 1, 1, 1};
+  const double x[8] = {-1, 0, 0, -1, -1, 0, 0, -1}, y[8] = {-1, -1, 0, 0, -1, -1, 0, 0},
+               z[8] = {0, 0, 0, 0, 1, 1, 1, 1};
   for (int c = 0; c < 8; ++c) h[static_cast<std::size_t>(c)] = node_at({x[c], y[c], z[c]});
   m.hexes.push_back(h);
   if (!m.hex_block.empty()) m.hex_block.push_back(m.hex_block.front());
   const fs::path in = dir.path / "in.exo", out = dir.path / "out.vtu", report = dir.path / "r.json";
   io::write_exodus(m, in);
-  const std::string args = "conform " + in.string() + " -o " + out.string() + " --report " + report.string() +
-                           " --smooth none --quiet";
+  const std::string args = "conform " + in.string() + " -o " + out.string() + " --report " +
+                           report.string() + " --smooth none --quiet";
   const test::CliRun r = test::geode_cli(args, true);
   INFO(r.out);
   CHECK(r.code == 4);
@@ -287,15 +305,17 @@ TEST_CASE("cli conventions: an invalid result exits 4, says so even with --quiet
   CHECK(fs::exists(report));
 }
 
-TEST_CASE("cli conventions: dual --rebuild writes every mesh format, by the extension, with its report as one") {
+TEST_CASE(
+    "cli conventions: dual --rebuild writes every mesh format, by the extension, with its report "
+    "as one") {
   TempDir dir;
   const fs::path in = dir.path / "grid.exo";
   io::write_exodus(primal::grid_model({2, 2, 2}, 1.0, [](int, int, int) { return false; }), in);
   for (const char* name : {"r.msh", "r.exo", "r.e", "r.vtk", "r.vtu"}) {
     CAPTURE(name);
     const fs::path out = dir.path / name, report = dir.path / (std::string(name) + ".json");
-    const test::CliRun r =
-        test::geode_cli("dual " + in.string() + " --rebuild " + out.string() + " -o " + report.string(), true);
+    const test::CliRun r = test::geode_cli(
+        "dual " + in.string() + " --rebuild " + out.string() + " -o " + report.string(), true);
     INFO(r.out);
     REQUIRE(r.code == 0);
     CHECK(fs::exists(report));  // the report's format from its extension: JSON

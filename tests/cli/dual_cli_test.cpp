@@ -26,7 +26,8 @@ primal::HexMesh moved_grid() {
   primal::HexMesh g = test::structured_hex_grid(3, 2, 2);
   for (std::size_t n = 0; n < g.points.size(); ++n) {
     Point& p = g.points[n];
-    const bool interior = p.x() > 0 && p.x() < 3 && p.y() > 0 && p.y() < 2 && p.z() > 0 && p.z() < 2;
+    const bool interior =
+        p.x() > 0 && p.x() < 3 && p.y() > 0 && p.y() < 2 && p.z() > 0 && p.z() < 2;
     if (interior) p += 0.2 * Point(std::sin(1.0 * n), std::cos(2.0 * n), std::sin(3.0 * n));
   }
   return g;
@@ -38,7 +39,8 @@ TEST_CASE("geode dual: sheets and triples of a grid, and its rebuild") {
   const auto in = temp_path("grid.vtu"), out = temp_path("grid-rebuilt.vtu");
   const primal::HexMesh g = moved_grid();
   io::write_vtu(in, g);
-  const auto r = geode_cli("dual " + in.string() + " --format json --vtu-encoding ascii --rebuild " + out.string());
+  const auto r = geode_cli("dual " + in.string() +
+                           " --format json --vtu-encoding ascii --rebuild " + out.string());
   REQUIRE(r.code == 0);
   const auto j = nlohmann::json::parse(r.out);
   CHECK(j["cells"] == 12);
@@ -63,7 +65,9 @@ TEST_CASE("geode dual: a quad mesh gives chords, in text") {
 }
 
 TEST_CASE("geode dual: refusals name the file and write nothing") {
-  SUBCASE("no such file") { CHECK(geode_cli("dual " + temp_path("missing.vtu").string()).code == 2); }
+  SUBCASE("no such file") {
+    CHECK(geode_cli("dual " + temp_path("missing.vtu").string()).code == 2);
+  }
   SUBCASE("a model with tets") {
     const auto in = temp_path("mixed.msh");
     io::write_gmsh(primal::grid_model({2, 1, 1}, 1.0, [](int i, int, int) { return i == 1; }), in);

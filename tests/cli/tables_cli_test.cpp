@@ -8,8 +8,8 @@
 
 #include <geode/io/formats.hpp>
 #include <geode/io/read_model.hpp>
-#include "support/cli_run.hpp"
 #include <geode/templates/template_table.hpp>
+#include "support/cli_run.hpp"
 
 using namespace geode;
 namespace fs = std::filesystem;
@@ -49,8 +49,7 @@ TEST_CASE("cli tables: every writable format is offered by template -o and reads
     CAPTURE(f.name);
     const fs::path out = dir.path / ("t" + std::string(f.extensions.back()));
     const test::CliRun r = test::geode_cli(
-        "template geode3d --format " + std::string(f.name) + " -o " + out.string(),
-        true);
+        "template geode3d --format " + std::string(f.name) + " -o " + out.string(), true);
     CHECK(r.code == 0);
     CHECK(io::read_model(out).hexes.size() == 26);
   }

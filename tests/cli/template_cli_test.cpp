@@ -26,12 +26,14 @@ using Run = test::CliRun;
 using test::geode_cli;
 using test::temp_path;
 
-primal::HexMesh hex_from_tables(const std::vector<primal::Point>& pts, const std::vector<std::array<int, 8>>& hexes) {
+primal::HexMesh hex_from_tables(const std::vector<primal::Point>& pts,
+                                const std::vector<std::array<int, 8>>& hexes) {
   primal::HexMesh m;
   m.points = pts;
   for (const auto& h : hexes) {
     std::array<primal::Index, 8> c{};
-    for (int i = 0; i < 8; ++i) c[static_cast<std::size_t>(i)] = h[static_cast<std::size_t>(i)] - 1;  // 1-based
+    for (int i = 0; i < 8; ++i)
+      c[static_cast<std::size_t>(i)] = h[static_cast<std::size_t>(i)] - 1;  // 1-based
     m.hexes.push_back(c);
   }
   return m;
@@ -40,7 +42,8 @@ primal::HexMesh hex_from_tables(const std::vector<primal::Point>& pts, const std
 // The hex mesh of `geode template --format json` output.
 primal::HexMesh hex_from_json(const nlohmann::json& j) {
   std::vector<primal::Point> pts;
-  for (const auto& p : j["nodes"]) pts.emplace_back(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
+  for (const auto& p : j["nodes"])
+    pts.emplace_back(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
   std::vector<std::array<int, 8>> hexes;
   for (const auto& h : j["hexes"]) hexes.push_back(h.get<std::array<int, 8>>());
   return hex_from_tables(pts, hexes);
@@ -53,7 +56,8 @@ TEST_CASE("geode template: json output is the Appendix A template with its sheet
   REQUIRE(r.code == 0);
   const auto j = nlohmann::json::parse(r.out);
   std::vector<primal::Point> pts;
-  for (const auto& p : j["nodes"]) pts.emplace_back(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
+  for (const auto& p : j["nodes"])
+    pts.emplace_back(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
   std::vector<std::array<int, 8>> hexes;
   for (const auto& h : j["hexes"]) hexes.push_back(h.get<std::array<int, 8>>());
   CHECK(hexes.size() == 26);
@@ -80,7 +84,10 @@ TEST_CASE("geode template: appendix, csv and vtu outputs agree") {
   int nodes = 0, hexes = 0;
   bool second = false;
   while (std::getline(in, line)) {
-    if (line.empty()) { second = true; continue; }
+    if (line.empty()) {
+      second = true;
+      continue;
+    }
     if (line.rfind("hex,", 0) == 0) continue;
     (second ? hexes : nodes) += 1;
   }
@@ -89,13 +96,16 @@ TEST_CASE("geode template: appendix, csv and vtu outputs agree") {
   std::filesystem::remove(csv);
 
   const auto vtu = temp_path("g.vtu");
-  REQUIRE(geode_cli("template geode3d --format vtu --vtu-encoding ascii -o " + vtu.string()).code == 0);
+  REQUIRE(geode_cli("template geode3d --format vtu --vtu-encoding ascii -o " + vtu.string()).code ==
+          0);
   const primal::HexMesh m = io::to_hex_mesh(io::read_vtu(vtu));
   CHECK(test::find_isomorphism(m, test::appendix_a_geode()).has_value());
   std::filesystem::remove(vtu);
 
   const auto vtu2 = temp_path("g2.vtu");
-  REQUIRE(geode_cli("template geode2d --format vtu --vtu-encoding ascii -o " + vtu2.string()).code == 0);
+  REQUIRE(
+      geode_cli("template geode2d --format vtu --vtu-encoding ascii -o " + vtu2.string()).code ==
+      0);
   CHECK(io::to_quad_mesh(io::read_vtu(vtu2)).quads.size() == 5);
   std::filesystem::remove(vtu2);
 }
@@ -166,7 +176,8 @@ TEST_CASE("geode template: the result depends on the box's proportions, not its 
     REQUIRE(ma.hexes == mb.hexes);  // the same connectivity, node for node
     const double scale = std::stod(large) / std::stod(small);
     double worst = 0;
-    for (std::size_t n = 0; n < ma.points.size(); ++n) worst = std::max(worst, (mb.points[n] / scale - ma.points[n]).norm());
+    for (std::size_t n = 0; n < ma.points.size(); ++n)
+      worst = std::max(worst, (mb.points[n] / scale - ma.points[n]).norm());
     // Positions equal up to the scale, to 1e-4 of the cell: the scaled box differs from the
     // small one by rounding (24 / 240000 is not exact), and the smoother stops within that of
     // its optimum (measured: 7e-11 for the cube, 3.6e-4 of 24 for the flat cell).
@@ -178,7 +189,8 @@ TEST_CASE("geode conform: --template-box is proportions, whatever their size") {
   test::TempDir dir;
   const auto run = [&](const std::string& box, const std::string& name) {
     const auto report = dir.path / (name + ".json");
-    const Run r = geode_cli("demo --model half -n 2 --smooth none --quiet --template-box " + box + " --report " + report.string());
+    const Run r = geode_cli("demo --model half -n 2 --smooth none --quiet --template-box " + box +
+                            " --report " + report.string());
     REQUIRE(r.code == 0);
     std::ifstream f(report);
     return nlohmann::json::parse(f);

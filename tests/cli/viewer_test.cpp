@@ -31,8 +31,11 @@ std::string slurp(const std::filesystem::path& p) {
 // standard output. The network is off: a dead proxy and no host names resolve.
 std::string chromium(const test::TempDir& dir, const std::string& mode, const std::string& url) {
   const std::string cmd =
-      "chromium --headless --no-sandbox --disable-gpu --no-first-run --disable-background-networking"
-      " --disable-component-update --disable-sync --user-data-dir='" + (dir.path / "profile").string() + "'"
+      "chromium --headless --no-sandbox --disable-gpu --no-first-run "
+      "--disable-background-networking"
+      " --disable-component-update --disable-sync --user-data-dir='" +
+      (dir.path / "profile").string() +
+      "'"
       " --use-angle=swiftshader --enable-unsafe-swiftshader --proxy-server=127.0.0.1:9"
       " --host-resolver-rules='MAP * ~NOTFOUND' --window-size=480,360 --virtual-time-budget=5000 " +
       mode + " '" + url + "' 2>/dev/null";
@@ -66,7 +69,8 @@ test::Image screenshot(const test::TempDir& dir, const std::string& url, const s
 
 double fraction_not_white(const test::Image& im) {
   std::size_t n = 0;
-  for (std::size_t i = 0; i < im.rgb.size(); i += 3) n += im.rgb[i] < 245 || im.rgb[i + 1] < 245 || im.rgb[i + 2] < 245;
+  for (std::size_t i = 0; i < im.rgb.size(); i += 3)
+    n += im.rgb[i] < 245 || im.rgb[i + 1] < 245 || im.rgb[i + 2] < 245;
   return static_cast<double>(n) / (im.rgb.size() / 3);
 }
 
@@ -108,27 +112,40 @@ TEST_CASE("viewer: the geode's HTML opens offline, draws, and hiding a sheet cha
   // Nothing to fetch: no element loads a file, and the only URLs are inside three.js's own code
   // (the XHTML namespace it passes to createElementNS, a reference in a shader comment).
   const std::string markup = markup_only(text);
-  for (const char* load : {"src=", "href=", "url(", "<link", "<iframe", "<object", "<embed", "@import"})
-    CHECK_MESSAGE(markup.find(load) == std::string::npos, "the page's markup loads something: " << load);
+  for (const char* load :
+       {"src=", "href=", "url(", "<link", "<iframe", "<object", "<embed", "@import"})
+    CHECK_MESSAGE(markup.find(load) == std::string::npos,
+                  "the page's markup loads something: " << load);
   const std::regex url("https?://[^\"' )]*");
-  for (auto it = std::sregex_iterator(text.begin(), text.end(), url); it != std::sregex_iterator(); ++it) {
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), url); it != std::sregex_iterator();
+       ++it) {
     const std::string u = it->str();
-    CHECK_MESSAGE((u == "http://www.w3.org/1999/xhtml" || u == "https://graphics.stanford.edu/papers/envmap/envmap.pdf"),
+    CHECK_MESSAGE((u == "http://www.w3.org/1999/xhtml" ||
+                   u == "https://graphics.stanford.edu/papers/envmap/envmap.pdf"),
                   "unexpected URL in the page: " << u);
   }
-  CHECK(text.find("default-src 'none'") != std::string::npos);  // and the page's policy forbids loads
+  CHECK(text.find("default-src 'none'") !=
+        std::string::npos);  // and the page's policy forbids loads
 
   const std::string file = "file://" + html.string();
   // Loaded with the sheets hidden and a layer picked, then hovered at the centre: the tip names a
   // hex and its nodes exactly as the CSV output numbers them (1-based).
   const std::string status = page_status(dir, file + "#sheets=none&layer=tunnel-x&probe=240,180");
-  CHECK_MESSAGE(status.rfind("viewer-ok hexes=26 sheets=6 shown=0 layer=tunnel-x peel=0 depth=1 probe: hex ", 0) == 0, status);
+  CHECK_MESSAGE(
+      status.rfind("viewer-ok hexes=26 sheets=6 shown=0 layer=tunnel-x peel=0 depth=1 probe: hex ",
+                   0) == 0,
+      status);
   std::smatch tip;
-  REQUIRE_MESSAGE(std::regex_search(status, tip, std::regex("probe: hex ([0-9]+) .*nodes ([0-9 ]+) \\| node ([0-9]+) ")), status);
+  REQUIRE_MESSAGE(
+      std::regex_search(status, tip,
+                        std::regex("probe: hex ([0-9]+) .*nodes ([0-9 ]+) \\| node ([0-9]+) ")),
+      status);
   const auto csv = geode_cli("template geode3d --format csv");
   REQUIRE(csv.code == 0);
-  const std::string row = "\n" + tip[1].str() + "," + std::regex_replace(tip[2].str(), std::regex(" "), ",") + "\n";
-  CHECK_MESSAGE(csv.out.find(row) != std::string::npos, "hex row " << row << " not in the CSV output");
+  const std::string row =
+      "\n" + tip[1].str() + "," + std::regex_replace(tip[2].str(), std::regex(" "), ",") + "\n";
+  CHECK_MESSAGE(csv.out.find(row) != std::string::npos,
+                "hex row " << row << " not in the CSV output");
   CHECK((" " + tip[2].str() + " ").find(" " + tip[3].str() + " ") != std::string::npos);
 
   const test::Image all = screenshot(dir, file + "#hexes=0&ui=0", "all.png");
@@ -148,7 +165,8 @@ TEST_CASE("viewer: geode view shows any hex or quad mesh with its dual sheets") 
   REQUIRE(geode_cli("view " + hex.string() + " -o " + h.string()).code == 0);
   REQUIRE(geode_cli("view " + quad.string() + " -o " + q.string()).code == 0);
   // A 3 x 2 x 2 grid has 3 + 2 + 2 sheets (planes); a 3 x 2 quad grid 5 chords.
-  const std::string hs = page_status(dir, "file://" + h.string()), qs = page_status(dir, "file://" + q.string());
+  const std::string hs = page_status(dir, "file://" + h.string()),
+                    qs = page_status(dir, "file://" + q.string());
   CHECK_MESSAGE(hs.rfind("viewer-ok hexes=12 sheets=7 shown=7", 0) == 0, hs);
   CHECK_MESSAGE(qs.rfind("viewer-ok quads=6 sheets=5", 0) == 0, qs);
   // Refusals: an output that is not .html, a missing input.

@@ -13,8 +13,8 @@
 
 #include <geode/conform/buffer_layer.hpp>
 #include <geode/demo/demo_models.hpp>
-#include <geode/primal/grid_model.hpp>
 #include <geode/primal/errors.hpp>
+#include <geode/primal/grid_model.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/topology.hpp>
 
@@ -25,7 +25,9 @@ using namespace geode::conform;
 namespace {
 
 double tri_flux(const std::vector<Point>& p, Index a, Index b, Index c) {
-  return p[static_cast<std::size_t>(a)].dot(p[static_cast<std::size_t>(b)].cross(p[static_cast<std::size_t>(c)])) / 6.0;
+  return p[static_cast<std::size_t>(a)].dot(
+             p[static_cast<std::size_t>(b)].cross(p[static_cast<std::size_t>(c)])) /
+         6.0;
 }
 
 // Quad (outward, counter-clockwise) split along corners (k, k+2).
@@ -38,7 +40,8 @@ int canonical_split(const std::array<Index, 4>& q) {
   return static_cast<int>(std::min_element(q.begin(), q.end()) - q.begin()) % 2;
 }
 
-double hex_flux_volume(const std::vector<Point>& p, const std::array<Index, 8>& h, int top_split = -1) {
+double hex_flux_volume(const std::vector<Point>& p, const std::array<Index, 8>& h,
+                       int top_split = -1) {
   double v = 0;
   for (int f = 0; f < 6; ++f) {
     std::array<Index, 4> q{};
@@ -81,18 +84,21 @@ void check_layer(const Case& c, BufferSide side) {
   if (side == BufferSide::kHex) {
     for (std::size_t t = 0; t < m.tets.size(); ++t)
       for (std::size_t i = 0; i < 4; ++i)
-        CHECK(p[static_cast<std::size_t>(layer.model.tets[t][i])] == m.points[static_cast<std::size_t>(m.tets[t][i])]);
+        CHECK(p[static_cast<std::size_t>(layer.model.tets[t][i])] ==
+              m.points[static_cast<std::size_t>(m.tets[t][i])]);
     for (const auto& h : m.hexes) {
       HexCorners before, after;
       for (std::size_t i = 0; i < 8; ++i) {
         before[i] = m.points[static_cast<std::size_t>(h[i])];
         after[i] = p[static_cast<std::size_t>(h[i])];
       }
-      CHECK(hex_scaled_jacobian(after) >= BufferLayerOptions{}.min_hex_quality_ratio * hex_scaled_jacobian(before));
+      CHECK(hex_scaled_jacobian(after) >=
+            BufferLayerOptions{}.min_hex_quality_ratio * hex_scaled_jacobian(before));
     }
   } else {
     for (const auto& h : m.hexes)
-      for (Index v : h) CHECK(p[static_cast<std::size_t>(v)] == m.points[static_cast<std::size_t>(v)]);
+      for (Index v : h)
+        CHECK(p[static_cast<std::size_t>(v)] == m.points[static_cast<std::size_t>(v)]);
   }
 
   double total = 0;
@@ -102,15 +108,17 @@ void check_layer(const Case& c, BufferSide side) {
     const InterfaceQuad& q = itf.quads[static_cast<std::size_t>(bh.quad)];
     CHECK(bh.quad == static_cast<Index>(b));
     for (std::size_t i = 0; i < 4; ++i) {
-      CHECK(bh.corners[i] == q.corners[i]);                                          // hex side
-      CHECK(bh.corners[i + 4] == layer.top_node[static_cast<std::size_t>(q.corners[i])]);  // tet side
+      CHECK(bh.corners[i] == q.corners[i]);  // hex side
+      CHECK(bh.corners[i + 4] ==
+            layer.top_node[static_cast<std::size_t>(q.corners[i])]);  // tet side
     }
     CHECK(bh.diagonal == (q.diagonal == 0 ? std::array<int, 2>{4, 6} : std::array<int, 2>{5, 7}));
     // The top triangles along the diagonal are faces of the two (renumbered) tets.
     const auto& k = bh.corners;
     const std::array<std::array<Index, 3>, 2> top =
-        q.diagonal == 0 ? std::array<std::array<Index, 3>, 2>{{{k[4], k[5], k[6]}, {k[4], k[6], k[7]}}}
-                        : std::array<std::array<Index, 3>, 2>{{{k[4], k[5], k[7]}, {k[5], k[6], k[7]}}};
+        q.diagonal == 0
+            ? std::array<std::array<Index, 3>, 2>{{{k[4], k[5], k[6]}, {k[4], k[6], k[7]}}}
+            : std::array<std::array<Index, 3>, 2>{{{k[4], k[5], k[7]}, {k[5], k[6], k[7]}}};
     for (std::size_t i = 0; i < 2; ++i) {
       const auto& t = layer.model.tets[static_cast<std::size_t>(q.tets[i])];
       std::set<Index> face;
@@ -126,8 +134,9 @@ void check_layer(const Case& c, BufferSide side) {
     total += v;
   }
   for (const auto& t : layer.model.tets) {
-    const double v = tet_volume(p[static_cast<std::size_t>(t[0])], p[static_cast<std::size_t>(t[1])],
-                                p[static_cast<std::size_t>(t[2])], p[static_cast<std::size_t>(t[3])]);
+    const double v =
+        tet_volume(p[static_cast<std::size_t>(t[0])], p[static_cast<std::size_t>(t[1])],
+                   p[static_cast<std::size_t>(t[2])], p[static_cast<std::size_t>(t[3])]);
     CHECK(v > 0.0);
     total += v;
   }
@@ -141,19 +150,44 @@ void check_layer(const Case& c, BufferSide side) {
 TEST_CASE("insert_buffer_layer: valid, gap-free layers on convex and concave interfaces") {
   const Case cases[] = {
       {"one hex, tets on one face", {1, 1, 2}, [](int, int, int k) { return k == 1; }, 1},
-      {"half block (interface meets the outer boundary)", {2, 2, 2}, [](int i, int, int) { return i == 1; }, 4},
-      {"L-shaped interface (concave edge)", {2, 2, 1}, [](int i, int j, int) { return i == 1 && j == 1; }, 2},
-      {"tets around a hex edge (convex edge)", {2, 2, 1}, [](int i, int j, int) { return i == 1 || j == 1; }, 2},
-      {"tets around a hex corner (convex corner)", {2, 2, 2},
-       [](int i, int j, int k) { return i == 1 || j == 1 || k == 1; }, 3},
-      {"hex block around an L-shaped tet region", {4, 4, 3},
-       [](int i, int j, int k) { return k == 1 && ((i == 1 && (j == 1 || j == 2)) || (i == 2 && j == 1)); }, 14},
-      {"enclosed tet nugget (hex block with a tet cavity)", {3, 3, 3},
-       [](int i, int j, int k) { return i == 1 && j == 1 && k == 1; }, 6},
-      {"one layer of hexes between two tet layers", {2, 2, 3}, [](int, int, int k) { return k != 1; }, 8},
-      {"one layer of tets between two hex layers", {2, 2, 3}, [](int, int, int k) { return k == 1; }, 8},
-      {"enclosed hex nugget (a hex inside tets)", {3, 3, 3},
-       [](int i, int j, int k) { return !(i == 1 && j == 1 && k == 1); }, 6},
+      {"half block (interface meets the outer boundary)",
+       {2, 2, 2},
+       [](int i, int, int) { return i == 1; },
+       4},
+      {"L-shaped interface (concave edge)",
+       {2, 2, 1},
+       [](int i, int j, int) { return i == 1 && j == 1; },
+       2},
+      {"tets around a hex edge (convex edge)",
+       {2, 2, 1},
+       [](int i, int j, int) { return i == 1 || j == 1; },
+       2},
+      {"tets around a hex corner (convex corner)",
+       {2, 2, 2},
+       [](int i, int j, int k) { return i == 1 || j == 1 || k == 1; },
+       3},
+      {"hex block around an L-shaped tet region",
+       {4, 4, 3},
+       [](int i, int j, int k) {
+         return k == 1 && ((i == 1 && (j == 1 || j == 2)) || (i == 2 && j == 1));
+       },
+       14},
+      {"enclosed tet nugget (hex block with a tet cavity)",
+       {3, 3, 3},
+       [](int i, int j, int k) { return i == 1 && j == 1 && k == 1; },
+       6},
+      {"one layer of hexes between two tet layers",
+       {2, 2, 3},
+       [](int, int, int k) { return k != 1; },
+       8},
+      {"one layer of tets between two hex layers",
+       {2, 2, 3},
+       [](int, int, int k) { return k == 1; },
+       8},
+      {"enclosed hex nugget (a hex inside tets)",
+       {3, 3, 3},
+       [](int i, int j, int k) { return !(i == 1 && j == 1 && k == 1); },
+       6},
   };
   for (const BufferSide side : kSides)
     for (const Case& c : cases) check_layer(c, side);
@@ -185,7 +219,8 @@ TEST_CASE("insert_buffer_layer: one hex under tets, positions by hand") {
 }
 
 TEST_CASE("insert_buffer_layer: the nugget's corners move along the cavity diagonal") {
-  const Model m = grid_model({3, 3, 3}, 1.0, [](int i, int j, int k) { return i == 1 && j == 1 && k == 1; });
+  const Model m =
+      grid_model({3, 3, 3}, 1.0, [](int i, int j, int k) { return i == 1 && j == 1 && k == 1; });
   // Corner (1,1,1) of the cavity: three faces with normals +x, +y, +z towards the tets; the
   // best direction is the diagonal, into the tets (tet side) or the hexes (hex side); the
   // shortest edge there is 1, so the height is the thickness (0.25: thicker, the hex touching
@@ -202,16 +237,19 @@ TEST_CASE("insert_buffer_layer: the nugget's corners move along the cavity diago
     CHECK(layer.report.halvings == 0);
     const auto& p = layer.model.points;
     const Point& hex_copy = p[static_cast<std::size_t>(v)];
-    const Point& tet_copy = p[static_cast<std::size_t>(layer.top_node[static_cast<std::size_t>(v)])];
+    const Point& tet_copy =
+        p[static_cast<std::size_t>(layer.top_node[static_cast<std::size_t>(v)])];
     const double height = o.thickness;
     const Point moved = side == BufferSide::kHex ? Point(Point(1, 1, 1) - height * Point(1, 1, 1))
-                                                : Point(Point(1, 1, 1) + height * Point(1, 1, 1));
+                                                 : Point(Point(1, 1, 1) + height * Point(1, 1, 1));
     CHECK(((side == BufferSide::kHex ? hex_copy : tet_copy) - moved).norm() < 1e-12);
     CHECK((side == BufferSide::kHex ? tet_copy : hex_copy) == Point(1, 1, 1));
   }
 }
 
-TEST_CASE("insert_buffer_layer: buffer tops parallel to their bottoms at convex and concave edges and corners") {
+TEST_CASE(
+    "insert_buffer_layer: buffer tops parallel to their bottoms at convex and concave edges and "
+    "corners") {
   // Kuhn-split tets and unit hexes: the shortest edge is 1 at every interface node, so the
   // layer has one height, thickness x 1, and every buffer hex's moving corners lie that far
   // from the plane of its face on the part that stays (tet side: tops above the bottom quad;
@@ -222,12 +260,22 @@ TEST_CASE("insert_buffer_layer: buffer tops parallel to their bottoms at convex 
   // node keep 0.44 of their scaled Jacobian; thicker, they would fall below
   // min_hex_quality_ratio (0.4) and the layer be halved there.
   const Case cases[] = {
-      {"tet cavity (convex edges and corners seen from the tets)", {4, 4, 4},
-       [](int i, int j, int k) { return i >= 1 && i <= 2 && j >= 1 && j <= 2 && k >= 1 && k <= 2; }, 24},
-      {"hex block inside tets (concave edges and corners seen from the tets)", {4, 4, 4},
-       [](int i, int j, int k) { return !(i >= 1 && i <= 2 && j >= 1 && j <= 2 && k >= 1 && k <= 2); }, 24},
-      {"L-shaped tet region in a hex block (a concave edge)", {4, 4, 3},
-       [](int i, int j, int k) { return k == 1 && ((i == 1 && (j == 1 || j == 2)) || (i == 2 && j == 1)); }, 14},
+      {"tet cavity (convex edges and corners seen from the tets)",
+       {4, 4, 4},
+       [](int i, int j, int k) { return i >= 1 && i <= 2 && j >= 1 && j <= 2 && k >= 1 && k <= 2; },
+       24},
+      {"hex block inside tets (concave edges and corners seen from the tets)",
+       {4, 4, 4},
+       [](int i, int j, int k) {
+         return !(i >= 1 && i <= 2 && j >= 1 && j <= 2 && k >= 1 && k <= 2);
+       },
+       24},
+      {"L-shaped tet region in a hex block (a concave edge)",
+       {4, 4, 3},
+       [](int i, int j, int k) {
+         return k == 1 && ((i == 1 && (j == 1 || j == 2)) || (i == 2 && j == 1));
+       },
+       14},
   };
   const double height = 0.25;
   for (const BufferSide side : kSides)
@@ -244,13 +292,17 @@ TEST_CASE("insert_buffer_layer: buffer tops parallel to their bottoms at convex 
       CHECK(layer.report.halvings == 0);
       const auto& p = layer.model.points;
       for (const BufferHex& b : layer.hexes) {
-        auto at = [&](int i) -> const Point& { return p[static_cast<std::size_t>(b.corners[static_cast<std::size_t>(i)])]; };
+        auto at = [&](int i) -> const Point& {
+          return p[static_cast<std::size_t>(b.corners[static_cast<std::size_t>(i)])];
+        };
         if (side == BufferSide::kTet) {
           const Point n = (at(1) - at(0)).cross(at(3) - at(0)).normalized();  // into the tet side
-          for (int i = 4; i < 8; ++i) CHECK(n.dot(at(i) - at(0)) == doctest::Approx(height).epsilon(1e-12));
+          for (int i = 4; i < 8; ++i)
+            CHECK(n.dot(at(i) - at(0)) == doctest::Approx(height).epsilon(1e-12));
         } else {
           const Point n = (at(5) - at(4)).cross(at(7) - at(4)).normalized();  // into the tet side
-          for (int i = 0; i < 4; ++i) CHECK(n.dot(at(4) - at(i)) == doctest::Approx(height).epsilon(1e-12));
+          for (int i = 0; i < 4; ++i)
+            CHECK(n.dot(at(4) - at(i)) == doctest::Approx(height).epsilon(1e-12));
         }
       }
       CHECK(layer.report.min_scaled_jacobian > 0.0);
@@ -278,7 +330,10 @@ TEST_CASE("insert_buffer_layer: a thinner layer at corners where the moving part
       for (int y : {1, 3})
         for (int z : {1, 3}) {
           const Index v = x + 5 * (y + 5 * z);
-          const Point d = (p[static_cast<std::size_t>(layer.top_node[static_cast<std::size_t>(v)])] - p[static_cast<std::size_t>(v)]).cwiseAbs();
+          const Point d =
+              (p[static_cast<std::size_t>(layer.top_node[static_cast<std::size_t>(v)])] -
+               p[static_cast<std::size_t>(v)])
+                  .cwiseAbs();
           const double expected = block ? o.feature_thickness * height : height;
           for (int a = 0; a < 3; ++a) CHECK(d[a] == doctest::Approx(expected).epsilon(1e-12));
           ++corners;
@@ -302,12 +357,16 @@ TEST_CASE("insert_buffer_layer: one short tet edge does not twist the buffer top
   const BufferLayerOptions o = on_side(BufferSide::kTet);
   const BufferLayer layer = insert_buffer_layer(m, itf, o);
   auto height = [&](Index v) {
-    return layer.model.points[static_cast<std::size_t>(layer.top_node[static_cast<std::size_t>(v)])].z() - 1.0;
+    return layer.model.points[static_cast<std::size_t>(layer.top_node[static_cast<std::size_t>(v)])]
+               .z() -
+           1.0;
   };
-  CHECK(height(static_cast<Index>(node(1, 1, 1))) > default_buffer_thickness(BufferSide::kTet) * 0.5 + 0.05);
+  CHECK(height(static_cast<Index>(node(1, 1, 1))) >
+        default_buffer_thickness(BufferSide::kTet) * 0.5 + 0.05);
   for (const InterfaceQuad& q : itf.quads)
     for (std::size_t i = 0; i < 4; ++i)
-      CHECK(std::abs(height(q.corners[i]) - height(q.corners[(i + 1) % 4])) <= o.smooth_rate * 1.0 + 1e-12);
+      CHECK(std::abs(height(q.corners[i]) - height(q.corners[(i + 1) % 4])) <=
+            o.smooth_rate * 1.0 + 1e-12);
   CHECK(layer.report.min_volume_ratio > 0.2);
   CHECK(layer.report.min_scaled_jacobian > 0.9);
 }
@@ -321,7 +380,8 @@ TEST_CASE("insert_buffer_layer: no layer where no direction sees all interface f
   });
   const Interface itf = find_interface(m);
   CHECK(itf.quads.size() == 6);
-  CHECK_THROWS_WITH_AS(insert_buffer_layer(m, itf), doctest::Contains("node 14 (1, 1, 1): no direction"), TopologyError);
+  CHECK_THROWS_WITH_AS(insert_buffer_layer(m, itf),
+                       doctest::Contains("node 14 (1, 1, 1): no direction"), TopologyError);
 }
 
 TEST_CASE("Gmsh demo models: conforming interface and a valid buffer layer") {
@@ -330,17 +390,21 @@ TEST_CASE("Gmsh demo models: conforming interface and a valid buffer layer") {
     const Model m = demo::demo_half_block(n);
     CHECK(m.hexes.size() == static_cast<std::size_t>(n * n * n));
     CHECK(m.tets.size() == static_cast<std::size_t>(6 * n * n * n));
-    CHECK(m.points.size() == static_cast<std::size_t>((2 * n + 1) * (n + 1) * (n + 1)));  // interface merged
+    CHECK(m.points.size() ==
+          static_cast<std::size_t>((2 * n + 1) * (n + 1) * (n + 1)));  // interface merged
     const Interface itf = find_interface(m);
     CHECK(itf.quads.size() == static_cast<std::size_t>(n * n));
     CHECK(itf.nodes.size() == static_cast<std::size_t>((n + 1) * (n + 1)));
     for (const InterfaceQuad& q : itf.quads)
-      for (Index v : q.corners) CHECK(m.points[static_cast<std::size_t>(v)].x() == doctest::Approx(1.0));
+      for (Index v : q.corners)
+        CHECK(m.points[static_cast<std::size_t>(v)].x() == doctest::Approx(1.0));
     const BufferLayer layer = insert_buffer_layer(m, itf);
     CHECK(layer.report.min_scaled_jacobian > 0.5);  // a flat interface: near-box buffer hexes
     for (const auto& t : layer.model.tets)
-      CHECK(tet_volume(layer.model.points[static_cast<std::size_t>(t[0])], layer.model.points[static_cast<std::size_t>(t[1])],
-                       layer.model.points[static_cast<std::size_t>(t[2])], layer.model.points[static_cast<std::size_t>(t[3])]) > 0);
+      CHECK(tet_volume(layer.model.points[static_cast<std::size_t>(t[0])],
+                       layer.model.points[static_cast<std::size_t>(t[1])],
+                       layer.model.points[static_cast<std::size_t>(t[2])],
+                       layer.model.points[static_cast<std::size_t>(t[3])]) > 0);
   }
   SUBCASE("tet nugget inside sweepable hex blocks (Figure 8, simplified)") {
     const int n = 4;
@@ -350,12 +414,14 @@ TEST_CASE("Gmsh demo models: conforming interface and a valid buffer layer") {
     CHECK(m.side_sets.at(0).sides.size() == static_cast<std::size_t>(6 * 8 * 8));
     const Interface itf = find_interface(m);
     CHECK(itf.quads.size() == static_cast<std::size_t>(6 * n * n));
-    CHECK(itf.nodes.size() == static_cast<std::size_t>(6 * n * n + 2));  // closed surface: V = F + 2
+    CHECK(itf.nodes.size() ==
+          static_cast<std::size_t>(6 * n * n + 2));  // closed surface: V = F + 2
     const BufferLayer layer = insert_buffer_layer(m, itf);
     CHECK(layer.report.min_scaled_jacobian > 0.0);
     CHECK(layer.report.min_volume_ratio > 0.0);
-    MESSAGE("nugget demo: ", m.tets.size(), " tets, buffer min scaled Jacobian ", layer.report.min_scaled_jacobian,
-            ", min volume ratio of the moved hexes ", layer.report.min_volume_ratio, ", halvings ", layer.report.halvings);
+    MESSAGE("nugget demo: ", m.tets.size(), " tets, buffer min scaled Jacobian ",
+            layer.report.min_scaled_jacobian, ", min volume ratio of the moved hexes ",
+            layer.report.min_volume_ratio, ", halvings ", layer.report.halvings);
   }
 }
 
@@ -369,7 +435,8 @@ TEST_CASE("insert_buffer_layer: a thickness beyond the side's bound is refused b
     CHECK_NOTHROW(insert_buffer_layer(m, itf, o));
     o.thickness = max_buffer_thickness(side) + 0.01;
     const std::string words = std::string("from the ") + buffer_side_name(side) + " part";
-    CHECK_THROWS_WITH_AS(insert_buffer_layer(m, itf, o), doctest::Contains(words.c_str()), InvalidInput);
+    CHECK_THROWS_WITH_AS(insert_buffer_layer(m, itf, o), doctest::Contains(words.c_str()),
+                         InvalidInput);
   }
   CHECK(parse_buffer_side("hex") == BufferSide::kHex);
   CHECK(parse_buffer_side("tet") == BufferSide::kTet);

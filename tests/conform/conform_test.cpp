@@ -4,25 +4,25 @@
 // template's count per four-triangle quad), 4 per tet.
 #include <doctest/doctest.h>
 
-#include <thread>
 #include <unistd.h>
+#include <thread>
 
 #include <filesystem>
 #include <set>
 
 #include <tbb/global_control.h>
 
-#include <geode/primal/boundary.hpp>
-#include <geode/demo/demo_models.hpp>
-#include <geode/primal/grid_model.hpp>
-#include <geode/primal/errors.hpp>
-#include <geode/io/exodus.hpp>
-#include <geode/primal/quality.hpp>
-#include <geode/primal/topology.hpp>
-#include "support/fixtures.hpp"
 #include <geode/conform/conform.hpp>
 #include <geode/conform/reference_template.hpp>
+#include <geode/demo/demo_models.hpp>
+#include <geode/io/exodus.hpp>
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/grid_model.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/topology.hpp>
 #include "support/conform_checks.hpp"
+#include "support/fixtures.hpp"
 
 using namespace geode;
 using primal::Index;
@@ -55,7 +55,7 @@ void check_result(const conform::ConformResult& r, const Expected& e) {
   // stay in 2.
   const int geode_block = r.buffer_side == conform::BufferSide::kHex ? 1 : 2;
   for (std::size_t h = 0; h < r.model.hexes.size(); ++h) {
-    const int expected = h < static_cast<std::size_t>(8 * e.hexes)                ? 1
+    const int expected = h < static_cast<std::size_t>(8 * e.hexes)                   ? 1
                          : h < static_cast<std::size_t>(8 * e.hexes + r.geode_hexes) ? geode_block
                                                                                      : 2;
     if (r.model.hex_block[h] != expected) {
@@ -70,7 +70,8 @@ void check_result(const conform::ConformResult& r, const Expected& e) {
 
 TEST_CASE("one hex with six tets on one face: 8 + 26 + 24 hexes, valid") {
   // Cells (0,0,0) hex, (1,0,0) six Kuhn tets; the shared face x = 1 is one interface quad.
-  const primal::Model m = primal::grid_model({2, 1, 1}, 1.0, [](int i, int, int) { return i == 1; });
+  const primal::Model m =
+      primal::grid_model({2, 1, 1}, 1.0, [](int i, int, int) { return i == 1; });
   const auto r = conform::conform(m);
   check_result(r, {1, 6, 1});
   CHECK(r.model.hexes.size() == 58);
@@ -95,12 +96,14 @@ TEST_CASE("one hex under a fan of four tets: the four-triangle template, valid")
 
 TEST_CASE("L-shaped interfaces: buffer hexes meeting at a concave edge merge their sides") {
   SUBCASE("2 x 2 cells, one tet cell: 2 interface quads at right angles") {
-    const auto m = primal::grid_model({2, 2, 1}, 1.0, [](int i, int j, int) { return i == 1 && j == 1; });
+    const auto m =
+        primal::grid_model({2, 2, 1}, 1.0, [](int i, int j, int) { return i == 1 && j == 1; });
     // 3 hexes, 6 tets; quads: hex (0,1) x+ face and hex (1,0) y+ face.
     check_result(conform::conform(m), {3, 6, 2});
   }
   SUBCASE("3 x 3 x 2 cells, tets where i, j >= 1: 8 quads, coplanar and L neighbours") {
-    const auto m = primal::grid_model({3, 3, 2}, 1.0, [](int i, int j, int) { return i >= 1 && j >= 1; });
+    const auto m =
+        primal::grid_model({3, 3, 2}, 1.0, [](int i, int j, int) { return i >= 1 && j >= 1; });
     // Hexes: 5 cells per layer x 2 = 10; tets: 4 cells x 2 x 6 = 48; quads: per layer 2 on
     // x = 1 (j = 1, 2) and 2 on y = 1 (i = 1, 2), x 2 layers = 8.
     check_result(conform::conform(m), {10, 48, 8});
@@ -115,12 +118,13 @@ TEST_CASE("a tet part over part of a hex face: carved from the tet part when the
   const primal::Model m = test::tet_cell_on_hex_top();
   const primal::Interface itf = primal::find_interface(m);
   REQUIRE(itf.quads.size() == 1);
-  CHECK_THROWS_WITH_AS(conform::insert_buffer_layer(m, itf), doctest::Contains("no direction into the hex side"),
-                       TopologyError);
+  CHECK_THROWS_WITH_AS(conform::insert_buffer_layer(m, itf),
+                       doctest::Contains("no direction into the hex side"), TopologyError);
   auto r = conform::conform(m);
   CHECK(r.buffer_side == conform::BufferSide::kTet);
   REQUIRE(r.warnings.size() == 1);
-  CHECK(r.warnings[0].find("buffer layer carved from the tet part, not the hex part") != std::string::npos);
+  CHECK(r.warnings[0].find("buffer layer carved from the tet part, not the hex part") !=
+        std::string::npos);
   r.warnings.clear();  // the one expected; check_result wants none
   check_result(r, {4, 6, 1});
   conform::ConformOptions strict;
@@ -132,7 +136,8 @@ TEST_CASE("a tet part over part of a hex face: carved from the tet part when the
   const auto rt = conform::conform(m, thick);
   CHECK(rt.buffer_side == conform::BufferSide::kTet);
   REQUIRE(rt.warnings.size() == 1);
-  CHECK(rt.warnings[0].find("carved from the tet part (its default thickness 0.3") != std::string::npos);
+  CHECK(rt.warnings[0].find("carved from the tet part (its default thickness 0.3") !=
+        std::string::npos);
   CHECK(rt.warnings[0].find("not the 0.6") != std::string::npos);
 }
 
@@ -144,7 +149,8 @@ TEST_CASE("reference templates: one per box and diagonal, from several threads a
   std::vector<std::thread> threads;
   for (int i = 0; i < 4; ++i)
     threads.emplace_back([&got, &box, i] {
-      got[static_cast<std::size_t>(i)] = &conform::reference_template(box, i % 2 ? std::array<int, 2>{5, 7} : std::array<int, 2>{4, 6});
+      got[static_cast<std::size_t>(i)] = &conform::reference_template(
+          box, i % 2 ? std::array<int, 2>{5, 7} : std::array<int, 2>{4, 6});
     });
   for (auto& t : threads) t.join();
   CHECK(got[0] == got[2]);
@@ -243,7 +249,9 @@ TEST_CASE("conform refuses a wedge at the hex/tet interface, naming the wedge") 
   std::array<Index, 3> tri{-1, -1, -1};
   for (const auto& t : m.tets)
     for (const auto& f : primal::topology::kTetFaceCorners) {
-      const std::array<Index, 3> c{t[static_cast<std::size_t>(f[0])], t[static_cast<std::size_t>(f[1])], t[static_cast<std::size_t>(f[2])]};
+      const std::array<Index, 3> c{t[static_cast<std::size_t>(f[0])],
+                                   t[static_cast<std::size_t>(f[1])],
+                                   t[static_cast<std::size_t>(f[2])]};
       bool top = true, at_interface = false;
       for (Index v : c) {
         top = top && m.points[static_cast<std::size_t>(v)].z() > 1.0 - 1e-12;
@@ -255,10 +263,12 @@ TEST_CASE("conform refuses a wedge at the hex/tet interface, naming the wedge") 
   std::array<Index, 6> w{tri[0], tri[1], tri[2], 0, 0, 0};
   for (int k = 0; k < 3; ++k) {
     w[static_cast<std::size_t>(3 + k)] = static_cast<Index>(m.points.size());
-    m.points.push_back(m.points[static_cast<std::size_t>(tri[static_cast<std::size_t>(k)])] + primal::Point(0, 0, 0.5));
+    m.points.push_back(m.points[static_cast<std::size_t>(tri[static_cast<std::size_t>(k)])] +
+                       primal::Point(0, 0, 0.5));
   }
   m.wedges.push_back(w);
   REQUIRE_NOTHROW(primal::check_geometry(m, "w.msh"));
   CHECK_THROWS_WITH_AS(conform::conform(m), doctest::Contains("wedge 1 (centre"), TopologyError);
-  CHECK_THROWS_WITH_AS(conform::conform(m), doctest::Contains("touches the hex/tet interface"), TopologyError);
+  CHECK_THROWS_WITH_AS(conform::conform(m), doctest::Contains("touches the hex/tet interface"),
+                       TopologyError);
 }

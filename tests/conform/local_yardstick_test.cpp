@@ -20,7 +20,8 @@
 using namespace geode;
 using primal::Index;
 
-TEST_CASE("the local yardstick: the input cells around each buffer hex, diced alone; per block figures") {
+TEST_CASE(
+    "the local yardstick: the input cells around each buffer hex, diced alone; per block figures") {
   for (const auto& [name, n] : {std::pair{"potting", 2}, std::pair{"lshape", 3}}) {
     const std::string model_name = name;
     CAPTURE(model_name);
@@ -40,7 +41,8 @@ TEST_CASE("the local yardstick: the input cells around each buffer hex, diced al
     for (std::size_t q = 0; q < itf.quads.size(); ++q) {
       const auto& c = itf.quads[q].corners;
       auto touches = [&](std::span<const Index> nodes) {
-        return std::any_of(nodes.begin(), nodes.end(), [&](Index v) { return std::find(c.begin(), c.end(), v) != c.end(); });
+        return std::any_of(nodes.begin(), nodes.end(),
+                           [&](Index v) { return std::find(c.begin(), c.end(), v) != c.end(); });
       };
       double expected = 1.0;
       for (std::size_t h = 0; h < input.hexes.size(); ++h)
@@ -52,7 +54,8 @@ TEST_CASE("the local yardstick: the input cells around each buffer hex, diced al
       lowest_local = std::min(lowest_local, expected);
     }
     // Per block, from the output: geode hexes (26 per buffer hex, after the diced hexes) and
-    // their ratio to their buffer hex's local yardstick; the input elements of the block diced alone.
+    // their ratio to their buffer hex's local yardstick; the input elements of the block diced
+    // alone.
     std::map<int, double> geode_min, ratio, input_min;
     std::map<int, Index> geode_count;
     double overall = 1e9;
@@ -80,7 +83,8 @@ TEST_CASE("the local yardstick: the input cells around each buffer hex, diced al
     CHECK(r.local_yardstick_ratio == doctest::Approx(overall).epsilon(1e-9));
     for (const conform::BlockQuality& b : r.quality) {
       CAPTURE(b.name);
-      CHECK(b.input_diced_min_scaled_jacobian == doctest::Approx(input_min.at(b.block)).epsilon(1e-12));
+      CHECK(b.input_diced_min_scaled_jacobian ==
+            doctest::Approx(input_min.at(b.block)).epsilon(1e-12));
       CHECK(b.geode_hexes == geode_count[b.block]);
       if (b.geode_hexes == 0) continue;
       CHECK(b.geode_min_scaled_jacobian == doctest::Approx(geode_min.at(b.block)).epsilon(1e-9));

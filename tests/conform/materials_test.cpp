@@ -24,7 +24,9 @@ std::map<int, double> block_volumes(const primal::Model& m) {
   std::map<int, double> v;
   for (std::size_t h = 0; h < m.hexes.size(); ++h) {
     primal::HexCorners c;
-    for (int k = 0; k < 8; ++k) c[static_cast<std::size_t>(k)] = m.points[static_cast<std::size_t>(m.hexes[h][static_cast<std::size_t>(k)])];
+    for (int k = 0; k < 8; ++k)
+      c[static_cast<std::size_t>(k)] =
+          m.points[static_cast<std::size_t>(m.hexes[h][static_cast<std::size_t>(k)])];
     v[m.hex_block[h]] += primal::hex_volume(c);
   }
   return v;

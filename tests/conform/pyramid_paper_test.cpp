@@ -19,7 +19,8 @@ using namespace geode;
 using primal::Index;
 using primal::Point;
 
-TEST_CASE("pyramid as two tets over a hex, transition carved from the tets: 34 hexes in the pyramid") {
+TEST_CASE(
+    "pyramid as two tets over a hex, transition carved from the tets: 34 hexes in the pyramid") {
   primal::Model m;
   // Base counter-clockwise seen from the apex (+y); every pyramid edge 2 long; the hex below.
   const Point base[4] = {Point(-1, 0, -1), Point(-1, 0, 1), Point(1, 0, 1), Point(1, 0, -1)};
@@ -47,8 +48,8 @@ TEST_CASE("pyramid as two tets over a hex, transition carved from the tets: 34 h
     lo = std::min(lo, sj);
     sum += sj;
   }
-  MESSAGE("pyramid as two tets, conform's transition: 34 hexes, min scaled Jacobian " << lo << ", mean "
-                                                                                      << sum / 34.0);
+  MESSAGE("pyramid as two tets, conform's transition: 34 hexes, min scaled Jacobian "
+          << lo << ", mean " << sum / 34.0);
   // Far above the paper's 0.033; 0.29 since smoothing keeps the model boundary and the block
   // interface on their surfaces (0.38 when it could move them).
   CHECK(lo > 0.25);

@@ -13,8 +13,8 @@
 #include <string>
 
 #include <geode/conform/conform.hpp>
-#include <geode/demo/demo_models.hpp>
 #include <geode/conform/reference_template.hpp>
+#include <geode/demo/demo_models.hpp>
 #include <geode/primal/interface.hpp>
 #include <geode/primal/quality.hpp>
 #include "support/conform_checks.hpp"
@@ -34,7 +34,8 @@ Index mixed_geode_hexes(const primal::Model& m) {
   CHECK(four > 0);
   CHECK(four < quads);
   const auto per_four = static_cast<Index>(
-      conform::reference_template_four_triangles(conform::ConformOptions{}.template_box).tpl.hex.hexes.size());
+      conform::reference_template_four_triangles(conform::ConformOptions{}.template_box)
+          .tpl.hex.hexes.size());
   return 26 * (quads - four) + per_four * four;
 }
 
@@ -55,8 +56,8 @@ TEST_CASE("realistic models, --smooth none: valid; the placement inverts nothing
     primal::Index quads;
     int n;
     primal::Index settled;  // templates the map inverted, re-smoothed inside their buffer hex
-  } models[] = {{"delaunay", 9, 3, 0}, {"delaunay-random", 9, 3, 0}, {"lshape", 18, 3, 0}, {"nugget", 96, 3, 0},
-                {"cylinder", 146, 3, 0}, {"fulcher", 143, 4, 0},
+  } models[] = {{"delaunay", 9, 3, 0}, {"delaunay-random", 9, 3, 0}, {"lshape", 18, 3, 0},
+                {"nugget", 96, 3, 0},  {"cylinder", 146, 3, 0},      {"fulcher", 143, 4, 0},
                 {"fulcher", 73, 2, 3}};
   for (const auto& [name, quads, n, settled] : models) {
     CAPTURE(name);
@@ -71,7 +72,9 @@ TEST_CASE("realistic models, --smooth none: valid; the placement inverts nothing
   }
 }
 
-TEST_CASE("buffer carved from the hex part: the tets stay as meshed, geode hexes >= 0.25 on planar interfaces") {
+TEST_CASE(
+    "buffer carved from the hex part: the tets stay as meshed, geode hexes >= 0.25 on planar "
+    "interfaces") {
   // Planar interfaces beside Gmsh Delaunay tets (alternating, random, two- and four-triangle
   // splits) and beside Kuhn tets. Carved from the hex part, every tet keeps its nodes, so the
   // diced tets are exactly the input's own (the output's minimum is the yardstick, nothing to
@@ -108,7 +111,8 @@ TEST_CASE("buffer carved from the hex part: the tets stay as meshed, geode hexes
   }
 }
 
-TEST_CASE("realistic models, default and global smoothing: valid, untangled, at least the yardstick") {
+TEST_CASE(
+    "realistic models, default and global smoothing: valid, untangled, at least the yardstick") {
   // The floor as a multiple of the yardstick: 1, but on the n = 2 nugget, where every buffer
   // hex is at a nugget edge or corner and the nodes on the nugget's faces may only slide in
   // them (its edges' along them, its corners not at all: materials never move), smoothing
@@ -184,7 +188,8 @@ TEST_CASE("fulcher demo: circles imprinted on three nugget faces, the parts conf
   // The parts fill the box: nugget [-1,1]^3 of tets, the 26 blocks around it of hexes.
   double tet_volume = 0, hex_volume = 0;
   for (const auto& t : m.tets) {
-    const double v = primal::tet_volume(m.points[t[0]], m.points[t[1]], m.points[t[2]], m.points[t[3]]);
+    const double v =
+        primal::tet_volume(m.points[t[0]], m.points[t[1]], m.points[t[2]], m.points[t[3]]);
     CHECK(v > 0);
     tet_volume += v;
   }
@@ -217,7 +222,8 @@ TEST_CASE("fulcher demo: circles imprinted on three nugget faces, the parts conf
     for (primal::Index v : in.nodes) {
       const primal::Point& p = m.points[static_cast<std::size_t>(v)];
       const double u = p[(axis + 1) % 3], w = p[(axis + 2) % 3];
-      if (std::abs(p[axis] - 1.0) < 1e-9 && std::abs(std::hypot(u, w) - radii[axis]) < 1e-6) ++on_circle;
+      if (std::abs(p[axis] - 1.0) < 1e-9 && std::abs(std::hypot(u, w) - radii[axis]) < 1e-6)
+        ++on_circle;
     }
     CHECK(on_circle >= 8);
   }
@@ -225,5 +231,6 @@ TEST_CASE("fulcher demo: circles imprinted on three nugget faces, the parts conf
   // their imprinted faces.
   REQUIRE(m.side_sets.size() == 1);
   CHECK(m.side_sets[0].sides.size() ==
-        static_cast<std::size_t>(21 * n * n + quads_on_face[1] + quads_on_face[3] + quads_on_face[5]));
+        static_cast<std::size_t>(21 * n * n + quads_on_face[1] + quads_on_face[3] +
+                                 quads_on_face[5]));
 }

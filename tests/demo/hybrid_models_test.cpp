@@ -18,9 +18,9 @@
 #include <geode/io/gmsh.hpp>
 #include <geode/io/read_model.hpp>
 #include <geode/io/vtk.hpp>
+#include <geode/primal/boundary.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/validity.hpp>
-#include <geode/primal/boundary.hpp>
 #include "support/ball_checks.hpp"
 #include "support/cli_run.hpp"
 #include "support/temp_dir.hpp"
@@ -35,16 +35,19 @@ struct HybridCase {
   const char* name;
   bool pyramids, wedges;
 };
-constexpr HybridCase kHybrid[] = {
-    {"hybrid", true, false}, {"hybrid-cylinder", true, false}, {"boundary-layer", false, true}, {"hexdominant", true, true}};
+constexpr HybridCase kHybrid[] = {{"hybrid", true, false},
+                                  {"hybrid-cylinder", true, false},
+                                  {"boundary-layer", false, true},
+                                  {"hexdominant", true, true}};
 
 // The demo model built by the command in a process of its own (Gmsh 4.8's pyramid relocation
 // trips an Eigen assertion in libgmsh on the second hybrid generate(3) of one process), saved as
 // .vtu (as `--save-input` does) and read back: what a user's conform run reads.
 primal::Model hybrid_input(const std::string& name, int n, const test::TempDir& dir) {
   const auto path = dir.path / (name + ".vtu");
-  const auto run = test::geode_cli("demo --model " + name + " -n " + std::to_string(n) + " --quiet --save-input " +
-                                   path.string(), true);
+  const auto run = test::geode_cli("demo --model " + name + " -n " + std::to_string(n) +
+                                       " --quiet --save-input " + path.string(),
+                                   true);
   INFO(run.out);
   REQUIRE(run.code == 0);
   return io::read_model(path);
@@ -53,7 +56,8 @@ primal::Model hybrid_input(const std::string& name, int n, const test::TempDir& 
 std::set<int> blocks_of(const primal::Model& m) {
   std::set<int> b;
   for (ElementKind kind : primal::kElementKinds)
-    for (std::size_t e = 0; e < primal::element_count(m, kind); ++e) b.insert(primal::block_of(m, {kind, static_cast<Index>(e)}));
+    for (std::size_t e = 0; e < primal::element_count(m, kind); ++e)
+      b.insert(primal::block_of(m, {kind, static_cast<Index>(e)}));
   return b;
 }
 
@@ -92,7 +96,8 @@ std::size_t skin_subfaces(const primal::Model& m) {  // diced: 4 per quad, 3 per
 
 }  // namespace
 
-TEST_CASE("hybrid demos: Gmsh's pyramids and wedges conform to a valid all-hex mesh at the yardstick") {
+TEST_CASE(
+    "hybrid demos: Gmsh's pyramids and wedges conform to a valid all-hex mesh at the yardstick") {
   test::TempDir dir;
   for (const HybridCase& c : kHybrid) {
     const std::string name = c.name;
@@ -124,7 +129,8 @@ TEST_CASE("hybrid demos: Gmsh's pyramids and wedges conform to a valid all-hex m
       CHECK(r.diced_wedge_hexes == 6 * static_cast<Index>(in.wedges.size()));
       CHECK(r.geode_hexes == 26 * r.interface_quads);
       CHECK(r.model.hexes.size() ==
-            static_cast<std::size_t>(r.diced_hexes + r.geode_hexes + r.diced_tet_hexes + r.diced_wedge_hexes));
+            static_cast<std::size_t>(r.diced_hexes + r.geode_hexes + r.diced_tet_hexes +
+                                     r.diced_wedge_hexes));
       // Gmsh puts one pyramid on every quad a tet volume meets: each is an interface quad.
       if (c.pyramids) CHECK(r.interface_quads == static_cast<Index>(in.pyramids.size()));
       CHECK(blocks_of(r.model) == blocks_of(in));
@@ -143,7 +149,8 @@ TEST_CASE("hybrid demos: Gmsh's pyramids and wedges conform to a valid all-hex m
       }
       CHECK(on_boundary == r.model.side_sets.front().sides.size());
       REQUIRE(r.model.node_sets.size() == 1);
-      std::set<Index> skin_nodes(r.model.node_sets.front().nodes.begin(), r.model.node_sets.front().nodes.end());
+      std::set<Index> skin_nodes(r.model.node_sets.front().nodes.begin(),
+                                 r.model.node_sets.front().nodes.end());
       std::size_t covered = 0;
       for (const primal::Side& s : r.model.side_sets.front().sides)
         for (Index n : primal::element_face(r.model, s)) covered += skin_nodes.count(n) == 0;
@@ -152,7 +159,8 @@ TEST_CASE("hybrid demos: Gmsh's pyramids and wedges conform to a valid all-hex m
   }
 }
 
-TEST_CASE("hybrid demos round-trip with their pyramids and wedges through .msh, .vtu, .vtk and .exo") {
+TEST_CASE(
+    "hybrid demos round-trip with their pyramids and wedges through .msh, .vtu, .vtk and .exo") {
   test::TempDir dir;
   const primal::Model in = hybrid_input("hexdominant", 2, dir);
   REQUIRE(!in.pyramids.empty());
@@ -166,11 +174,14 @@ TEST_CASE("hybrid demos round-trip with their pyramids and wedges through .msh, 
     if (e == ".vtk") io::write_vtk(path, in);
     if (e == ".exo") io::write_exodus(in, path);
     const primal::Model back = io::read_model(path);  // check_geometry: every cell still positive
-    for (ElementKind kind : primal::kElementKinds) CHECK(primal::element_count(back, kind) == primal::element_count(in, kind));
+    for (ElementKind kind : primal::kElementKinds)
+      CHECK(primal::element_count(back, kind) == primal::element_count(in, kind));
     CHECK(back.points.size() == in.points.size());
     // The corners come back in the model's order (VTK's mirrored wedge converted both ways).
     CHECK(back.wedges == in.wedges);
     CHECK(back.pyramids == in.pyramids);
-    if (e != ".exo") CHECK(blocks_of(back) == blocks_of(in));  // Exodus: the tet block's pyramids get a block of their own
+    if (e != ".exo")
+      CHECK(blocks_of(back) ==
+            blocks_of(in));  // Exodus: the tet block's pyramids get a block of their own
   }
 }

@@ -18,8 +18,9 @@
 
 namespace {
 const std::string& scratch() {
-  static const std::string path =
-      (std::filesystem::temp_directory_path() / ("geode-fuzz-exo-" + std::to_string(::getpid()) + ".exo")).string();
+  static const std::string path = (std::filesystem::temp_directory_path() /
+                                   ("geode-fuzz-exo-" + std::to_string(::getpid()) + ".exo"))
+                                      .string();
   return path;
 }
 }  // namespace
@@ -31,7 +32,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   std::fclose(f);
   try {
     (void)geode::io::read_exodus(scratch());
-  } catch (const geode::InvalidInput&) {
-  }
+  } catch (const geode::InvalidInput&) {}
   return 0;
 }

@@ -5,13 +5,13 @@
 #include <cstdint>
 #include <string_view>
 
-#include <geode/primal/errors.hpp>
 #include <geode/io/gmsh.hpp>
+#include <geode/primal/errors.hpp>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   try {
-    (void)geode::io::parse_gmsh(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz.msh");
-  } catch (const geode::InvalidInput&) {
-  }
+    (void)geode::io::parse_gmsh(std::string_view(reinterpret_cast<const char*>(data), size),
+                                "fuzz.msh");
+  } catch (const geode::InvalidInput&) {}
   return 0;
 }

@@ -11,8 +11,8 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   try {
-    const auto json = geode::templates::parse_spec_text(std::string_view(reinterpret_cast<const char*>(data), size),
-                                                         "fuzz.json");
+    const auto json = geode::templates::parse_spec_text(
+        std::string_view(reinterpret_cast<const char*>(data), size), "fuzz.json");
     const auto spec = geode::templates::parse_spec(json, "fuzz.json");
     const geode::primal::Point middle = 0.5 * (spec.domain.lo + spec.domain.hi);
     for (const auto& sheet : geode::templates::spec_sheets(spec)) (void)sheet.field(middle);

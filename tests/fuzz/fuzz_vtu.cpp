@@ -4,15 +4,15 @@
 #include <cstdint>
 #include <string_view>
 
-#include <geode/primal/errors.hpp>
-#include <geode/io/vtk.hpp>
 #include <geode/io/read_model.hpp>
+#include <geode/io/vtk.hpp>
+#include <geode/primal/errors.hpp>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   try {
-    const auto grid = geode::io::parse_vtu(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz.vtu");
+    const auto grid = geode::io::parse_vtu(
+        std::string_view(reinterpret_cast<const char*>(data), size), "fuzz.vtu");
     (void)geode::io::model_from_vtk(grid);
-  } catch (const geode::InvalidInput&) {
-  }
+  } catch (const geode::InvalidInput&) {}
   return 0;
 }

@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "support/temp_dir.hpp"
-#include <geode/primal/grid_model.hpp>
-#include <geode/primal/errors.hpp>
 #include <geode/io/exodus.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/grid_model.hpp>
+#include "support/temp_dir.hpp"
 
 namespace fs = std::filesystem;
 using namespace geode;
@@ -45,7 +45,8 @@ Model sample_model() {
 }
 
 // A raw Exodus file written with the C API: `type` block of one element with `conn`.
-void write_raw(const fs::path& file, const char* type, const std::vector<int>& conn, int num_nodes) {
+void write_raw(const fs::path& file, const char* type, const std::vector<int>& conn,
+               int num_nodes) {
   int cpu = 8, io = 8;
   const int exo = ex_create(file.string().c_str(), EX_CLOBBER, &cpu, &io);
   REQUIRE(exo >= 0);
@@ -53,7 +54,8 @@ void write_raw(const fs::path& file, const char* type, const std::vector<int>& c
   std::vector<double> x(static_cast<std::size_t>(num_nodes)), y(x.size()), z(x.size());
   for (std::size_t i = 0; i < x.size(); ++i) x[i] = static_cast<double>(i);
   REQUIRE(ex_put_coord(exo, x.data(), y.data(), z.data()) >= 0);
-  REQUIRE(ex_put_block(exo, EX_ELEM_BLOCK, 3, type, 1, static_cast<int64_t>(conn.size()), 0, 0, 0) >= 0);
+  REQUIRE(ex_put_block(exo, EX_ELEM_BLOCK, 3, type, 1, static_cast<int64_t>(conn.size()), 0, 0,
+                       0) >= 0);
   REQUIRE(ex_put_conn(exo, EX_ELEM_BLOCK, 3, conn.data(), nullptr, nullptr) >= 0);
   REQUIRE(ex_close(exo) >= 0);
 }
@@ -106,7 +108,10 @@ TEST_CASE("the written file follows Exodus's own HEX8 / TETRA4 / side convention
   REQUIRE(exo >= 0);
   std::vector<double> x(m.points.size()), y(x.size()), z(x.size());
   REQUIRE(ex_get_coord(exo, x.data(), y.data(), z.data()) >= 0);
-  auto p = [&](int n) { return Point(x[static_cast<std::size_t>(n - 1)], y[static_cast<std::size_t>(n - 1)], z[static_cast<std::size_t>(n - 1)]); };
+  auto p = [&](int n) {
+    return Point(x[static_cast<std::size_t>(n - 1)], y[static_cast<std::size_t>(n - 1)],
+                 z[static_cast<std::size_t>(n - 1)]);
+  };
   std::vector<int> hex(2 * 8), tet(12 * 4);
   REQUIRE(ex_get_conn(exo, EX_ELEM_BLOCK, 1, hex.data(), nullptr, nullptr) >= 0);
   REQUIRE(ex_get_conn(exo, EX_ELEM_BLOCK, 2, tet.data(), nullptr, nullptr) >= 0);
@@ -114,7 +119,8 @@ TEST_CASE("the written file follows Exodus's own HEX8 / TETRA4 / side convention
     const int* c = &hex[static_cast<std::size_t>(8 * h)];
     const Point up = (p(c[1]) - p(c[0])).cross(p(c[3]) - p(c[0]));
     CHECK(up.dot(p(c[4]) - p(c[0])) > 0);  // nodes 5-8 on the side the 1-2-3-4 normal points to
-    for (int i = 0; i < 4; ++i) CHECK((p(c[i + 4]) - p(c[i])).normalized().z() > 0.99);  // node i+5 above node i+1
+    for (int i = 0; i < 4; ++i)
+      CHECK((p(c[i + 4]) - p(c[i])).normalized().z() > 0.99);  // node i+5 above node i+1
   }
   for (int t = 0; t < 12; ++t) {
     const int* c = &tet[static_cast<std::size_t>(4 * t)];
@@ -191,7 +197,8 @@ TEST_CASE("write_exodus is atomic") {
   std::ofstream(file) << "previous content";
   Model bad = sample_model();
   bad.side_sets[0].sides[0].face = 4;  // tets have faces 0..3
-  CHECK_THROWS_WITH_AS(write_exodus(bad, file), doctest::Contains("face 5 out of range"), InvalidInput);
+  CHECK_THROWS_WITH_AS(write_exodus(bad, file), doctest::Contains("face 5 out of range"),
+                       InvalidInput);
   std::ifstream in(file);
   std::stringstream text;
   text << in.rdbuf();

@@ -6,12 +6,12 @@
 #include <filesystem>
 #include <string>
 
-#include <geode/primal/errors.hpp>
-#include <geode/io/file_format.hpp>
 #include <geode/io/exodus.hpp>
+#include <geode/io/file_format.hpp>
 #include <geode/io/gmsh.hpp>
-#include <geode/io/vtk.hpp>
 #include <geode/io/read_model.hpp>
+#include <geode/io/vtk.hpp>
+#include <geode/primal/errors.hpp>
 
 namespace fs = std::filesystem;
 using namespace geode;
@@ -36,7 +36,8 @@ TEST_CASE("fuzz regressions: every input the fuzzers found is read or refused wi
       if (format == MeshFileFormat::kExodus) (void)read_exodus(path);
     } catch (const InvalidInput& e) {
       // The message names the file first (the Exodus reader by its path).
-      CHECK((std::string(e.what()).find(source) == 0 || std::string(e.what()).find(path.string()) == 0));
+      CHECK((std::string(e.what()).find(source) == 0 ||
+             std::string(e.what()).find(path.string()) == 0));
     }
   }
   CHECK(files > 0);

@@ -87,7 +87,8 @@ TEST_CASE("a partitioned .msh 4.1 (ASCII and binary) gives the blocks of its phy
   }
 }
 
-TEST_CASE("an entity in several physical volumes: each element in the most specific, and a warning") {
+TEST_CASE(
+    "an entity in several physical volumes: each element in the most specific, and a warning") {
   // Tet entity 1 in physicals 2 "tets" and 1 "steel", hex entity 2 in 5 "hexes" and 1: the old
   // reader took the smallest tag, so one block 1 held everything and "tets" and "hexes"
   // vanished without a word.
@@ -117,14 +118,16 @@ TEST_CASE("an entity in several physical volumes: each element in the most speci
   CHECK(warnings.messages()[0].find(file.string() + ": physical volume 1 'steel'") == 0);
 }
 
-TEST_CASE("a node set from a physical curve on two parallel edges stays on those edges when diced") {
+TEST_CASE(
+    "a node set from a physical curve on two parallel edges stays on those edges when diced") {
   // One unit hex; the physical curve 7 holds its bottom edges 1-2 and 4-3 (parallel). The set
   // is those 4 nodes; diced, it gains the two edge midpoints, not the bottom face's centre
   // between them (the old result: all 4 corners of that face in the set, so its centre too).
   const std::string text =
       "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
       "$PhysicalNames\n1\n1 7 \"edges\"\n$EndPhysicalNames\n"
-      "$Nodes\n8\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n5 0 0 1\n6 1 0 1\n7 1 1 1\n8 0 1 1\n$EndNodes\n"
+      "$Nodes\n8\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n5 0 0 1\n6 1 0 1\n7 1 1 1\n8 0 1 "
+      "1\n$EndNodes\n"
       "$Elements\n3\n"
       "1 1 2 7 1 1 2\n"
       "2 1 2 7 1 4 3\n"
@@ -155,7 +158,8 @@ TEST_CASE("names read from a file are made safe: no bad UTF-8 reaches a JSON rep
   const std::string text =
       "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
       "$PhysicalNames\n1\n3 4 \"st\xff\x01\"\n$EndPhysicalNames\n"
-      "$Nodes\n8\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n5 0 0 1\n6 1 0 1\n7 1 1 1\n8 0 1 1\n$EndNodes\n"
+      "$Nodes\n8\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n5 0 0 1\n6 1 0 1\n7 1 1 1\n8 0 1 "
+      "1\n$EndNodes\n"
       "$Elements\n1\n1 5 2 4 1 1 2 3 4 5 6 7 8\n$EndElements\n";
   const test::TempDir dir;
   const fs::path file = dir.path / "name.msh";

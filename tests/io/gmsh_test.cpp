@@ -2,17 +2,17 @@
 // binary, and bad input rejected with messages that name the file, the element and the reason.
 #include <doctest/doctest.h>
 
+#include <unistd.h>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
-#include <unistd.h>
 
-#include "support/temp_dir.hpp"
-#include <geode/primal/grid_model.hpp>
-#include <geode/primal/errors.hpp>
 #include <geode/io/gmsh.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/grid_model.hpp>
 #include <geode/primal/topology.hpp>
+#include "support/temp_dir.hpp"
 
 namespace fs = std::filesystem;
 using namespace geode;
@@ -117,9 +117,10 @@ TEST_CASE("read_gmsh converts Gmsh's hex and tet corner order to VTK order") {
   }
   const auto& t = m.tets[0];
   // Translated reference tet: volume +1/6 in the VTK convention.
-  CHECK(tet_volume(m.points[static_cast<std::size_t>(t[0])], m.points[static_cast<std::size_t>(t[1])],
-                   m.points[static_cast<std::size_t>(t[2])], m.points[static_cast<std::size_t>(t[3])]) ==
-        doctest::Approx(1.0 / 6.0));
+  CHECK(tet_volume(m.points[static_cast<std::size_t>(t[0])],
+                   m.points[static_cast<std::size_t>(t[1])],
+                   m.points[static_cast<std::size_t>(t[2])],
+                   m.points[static_cast<std::size_t>(t[3])]) == doctest::Approx(1.0 / 6.0));
   CHECK(m.hex_block == std::vector<int>{4});
   CHECK(m.tet_block == std::vector<int>{4});
   CHECK(m.block_names.at(4) == "solid");
@@ -140,7 +141,8 @@ TEST_CASE("write_gmsh then read_gmsh gives the same model (ASCII and binary)") {
   REQUIRE(m.tets.size() == 12);
   for (GmshFormat format : {GmshFormat::Ascii, GmshFormat::Binary}) {
     CAPTURE(static_cast<int>(format));
-    const fs::path file = scratch_dir() / (format == GmshFormat::Ascii ? "rt_ascii.msh" : "rt_bin.msh");
+    const fs::path file =
+        scratch_dir() / (format == GmshFormat::Ascii ? "rt_ascii.msh" : "rt_bin.msh");
     write_gmsh(m, file, format);
     // Gmsh writes "4.1 <file-type>": 0 for ASCII, 1 for binary.
     std::ifstream in(file, std::ios::binary);
@@ -182,7 +184,8 @@ TEST_CASE("read_gmsh rejects bad input naming the file, element and reason") {
     std::string text = hand_written_msh(kHexAndTet);
     text.replace(text.find("2 6 5 8 7"), 9, "2 6 5 8 9");
     write_text(file, text);
-    CHECK_THROWS_WITH_AS(read_gmsh(file), doctest::Contains("element 2 is not a face"), InvalidInput);
+    CHECK_THROWS_WITH_AS(read_gmsh(file), doctest::Contains("element 2 is not a face"),
+                         InvalidInput);
   }
 }
 

@@ -66,7 +66,8 @@ std::string text_of(const fs::path& p) {
 }
 
 // What Gmsh sees in a file: per physical group (dim, tag), its name and element count.
-std::map<std::pair<int, int>, std::pair<std::string, std::size_t>> gmsh_groups(const fs::path& file) {
+std::map<std::pair<int, int>, std::pair<std::string, std::size_t>> gmsh_groups(
+    const fs::path& file) {
   GmshSession session;
   gmsh::open(file.string());
   std::map<std::pair<int, int>, std::pair<std::string, std::size_t>> out;
@@ -100,7 +101,8 @@ TEST_CASE("write_gmsh: every version and encoding reads back the same model") {
     write_gmsh(m, file, v.format, v.version);
     const std::string text = text_of(file);
     const std::string header = text.substr(text.find('\n') + 1, 5);
-    CHECK(header == std::string(v.version == GmshVersion::k41 ? "4.1 " : "2.2 ") + (v.format == GmshFormat::Binary ? "1" : "0"));
+    CHECK(header == std::string(v.version == GmshVersion::k41 ? "4.1 " : "2.2 ") +
+                        (v.format == GmshFormat::Binary ? "1" : "0"));
     const Model r = read_gmsh(file);
     CHECK(r.points == m.points);  // shortest round-trip text or raw doubles: exact
     CHECK(r.hexes == m.hexes);
@@ -160,8 +162,9 @@ TEST_CASE("names with quotes, newlines, control characters and bad UTF-8 never b
   m.side_sets[0].name = "out\rside\t\"x\"";
   const std::string block = "st'e el  \xEF\xBF\xBD", side = "out side 'x'";
   CHECK(sanitize_name(m.block_names[1]) == block);
-  CHECK(sanitize_name("caf\xC3\xA9 \xE2\x82\xAC") == "caf\xC3\xA9 \xE2\x82\xAC");  // valid UTF-8 kept
-  CHECK(sanitize_name("\xC0\x80") == "\xEF\xBF\xBD\xEF\xBF\xBD");                  // overlong NUL
+  CHECK(sanitize_name("caf\xC3\xA9 \xE2\x82\xAC") ==
+        "caf\xC3\xA9 \xE2\x82\xAC");                               // valid UTF-8 kept
+  CHECK(sanitize_name("\xC0\x80") == "\xEF\xBF\xBD\xEF\xBF\xBD");  // overlong NUL
   for (const Variant& v : kVariants) {
     CAPTURE(v.name);
     const fs::path file = dir.path / (std::string(v.name) + ".msh");
@@ -181,7 +184,9 @@ TEST_CASE("names with quotes, newlines, control characters and bad UTF-8 never b
   CHECK_NOTHROW((void)read_vtu(vtu));
 }
 
-TEST_CASE("a write that fails (full disk, file size limit) says so, naming the output, and leaves nothing") {
+TEST_CASE(
+    "a write that fails (full disk, file size limit) says so, naming the output, and leaves "
+    "nothing") {
   // RLIMIT_FSIZE makes write(2) fail with EFBIG past the limit, as ENOSPC does on a full disk;
   // the old .msh writer (libgmsh) ignored such errors and left a truncated file with exit 0.
   const test::TempDir dir;
@@ -222,16 +227,18 @@ TEST_CASE("a write that fails (full disk, file size limit) says so, naming the o
   CHECK(fs::is_empty(dir.path));  // no output, no temporary file
 }
 
-TEST_CASE("write_gmsh: pyramids and wedges (every cell kind of the model) read back, by us and by Gmsh") {
+TEST_CASE(
+    "write_gmsh: pyramids and wedges (every cell kind of the model) read back, by us and by Gmsh") {
   Model m;
-  m.points = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0.5, 0.5, 1},                  // pyramid
-              {2, 0, 0}, {3, 0, 0}, {2, 1, 0}, {2, 0, 1}, {3, 0, 1}, {2, 1, 1}};           // wedge
+  m.points = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0.5, 0.5, 1},              // pyramid
+              {2, 0, 0}, {3, 0, 0}, {2, 1, 0}, {2, 0, 1}, {3, 0, 1},     {2, 1, 1}};  // wedge
   m.pyramids.push_back({0, 1, 2, 3, 4});
   m.wedges.push_back({5, 6, 7, 8, 9, 10});
   m.pyramid_block = {3};
   m.wedge_block = {4};
   m.block_names = {{3, "pyramid"}, {4, "wedge"}};
-  m.side_sets.push_back({7, "bases", {{{ElementKind::Pyramid, 0}, 4}, {{ElementKind::Wedge, 0}, 3}}});
+  m.side_sets.push_back(
+      {7, "bases", {{{ElementKind::Pyramid, 0}, 4}, {{ElementKind::Wedge, 0}, 3}}});
   const test::TempDir dir;
   for (const Variant& v : kVariants) {
     CAPTURE(v.name);

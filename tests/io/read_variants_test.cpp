@@ -11,11 +11,11 @@
 #include <filesystem>
 #include <string>
 
+#include <geode/io/gmsh.hpp>
+#include <geode/io/read_model.hpp>
+#include <geode/io/vtk.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/grid_model.hpp>
-#include <geode/io/gmsh.hpp>
-#include <geode/io/vtk.hpp>
-#include <geode/io/read_model.hpp>
 #include "support/fixtures.hpp"
 #include "support/temp_dir.hpp"
 
@@ -30,7 +30,8 @@ namespace {
 // two blocks.
 HexMesh sample_hexes() {
   HexMesh m = test::structured_hex_grid(3, 2, 2);
-  for (std::size_t n = 0; n < m.points.size(); ++n) m.points[n] += 0.01 * Point(std::sin(1.0 * n), std::cos(2.0 * n), 0.3);
+  for (std::size_t n = 0; n < m.points.size(); ++n)
+    m.points[n] += 0.01 * Point(std::sin(1.0 * n), std::cos(2.0 * n), 0.3);
   m.block.assign(m.hexes.size(), 1);
   for (std::size_t h = 0; h < m.hexes.size() / 2; ++h) m.block[h] = 7;
   return m;
@@ -38,7 +39,8 @@ HexMesh sample_hexes() {
 
 void run_script(const std::string& kind, const fs::path& source, const fs::path& dir) {
   const std::string script = std::string(GEODE_SOURCE_DIR) + "/tests/io/write_variants.py";
-  const std::string cmd = "/usr/bin/python3 '" + script + "' " + kind + " '" + source.string() + "' '" + dir.string() + "'";
+  const std::string cmd = "/usr/bin/python3 '" + script + "' " + kind + " '" + source.string() +
+                          "' '" + dir.string() + "'";
   const int status = std::system(cmd.c_str());
   // The Python packages are required (scripts/common.sh): a missing one fails the test.
   REQUIRE_MESSAGE(status == 0, cmd);
@@ -62,9 +64,10 @@ void check_points(const std::vector<Point>& a, const std::vector<Point>& b, doub
 TEST_CASE("VTK's own writer: every .vtu encoding and legacy .vtk read back the same mesh") {
   test::TempDir dir;
   const HexMesh m = write_variants("vtk", dir.path);
-  for (const std::string name : {"ascii.vtu", "binary.vtu", "binary-zlib.vtu", "appended-raw.vtu", "appended-base64.vtu",
-                           "appended-raw-zlib.vtu", "binary-zlib-uint64.vtu", "appended-base64-zlib-uint64.vtu",
-                           "legacy-ascii.vtk", "legacy-binary.vtk"}) {
+  for (const std::string name :
+       {"ascii.vtu", "binary.vtu", "binary-zlib.vtu", "appended-raw.vtu", "appended-base64.vtu",
+        "appended-raw-zlib.vtu", "binary-zlib-uint64.vtu", "appended-base64-zlib-uint64.vtu",
+        "legacy-ascii.vtk", "legacy-binary.vtk"}) {
     CAPTURE(name);
     const VtkGrid g = read_vtk_file(dir.path / name);
     const HexMesh back = to_hex_mesh(g);
@@ -84,8 +87,8 @@ TEST_CASE("VTK's own writer: every .vtu encoding and legacy .vtk read back the s
 TEST_CASE("meshio's files: .exo, .msh 2.2 ASCII and binary, .vtu, .vtk read as models") {
   test::TempDir dir;
   const HexMesh m = write_variants("meshio", dir.path);
-  for (const std::string name : {"meshio.exo", "meshio-22-ascii.msh", "meshio-22-binary.msh", "meshio.vtu",
-                           "meshio-ascii.vtu", "meshio.vtk"}) {
+  for (const std::string name : {"meshio.exo", "meshio-22-ascii.msh", "meshio-22-binary.msh",
+                                 "meshio.vtu", "meshio-ascii.vtu", "meshio.vtk"}) {
     CAPTURE(name);
     const Model model = read_model(dir.path / name);
     // meshio's text formats print fewer digits than a double holds.
@@ -112,7 +115,8 @@ TEST_CASE("meshio's .exo with node sets numbered from 0: the sets numbered by po
   for (const Point& p : m.points) bottom += p.z() < low + 1e-9;
   CHECK(bottom >= 4);
   CHECK(model.node_sets[0].nodes.size() == bottom);
-  for (Index v : model.node_sets[0].nodes) CHECK(model.points[static_cast<std::size_t>(v)].z() < low + 1e-9);
+  for (Index v : model.node_sets[0].nodes)
+    CHECK(model.points[static_cast<std::size_t>(v)].z() < low + 1e-9);
 }
 
 TEST_CASE("Gmsh's own writer: .msh 2.2 and 4.1, ASCII and binary, read back the same model") {
@@ -127,7 +131,8 @@ TEST_CASE("Gmsh's own writer: .msh 2.2 and 4.1, ASCII and binary, read back the 
     for (const int binary : {0, 1}) {
       CAPTURE(version);
       CAPTURE(binary);
-      const fs::path file = dir.path / ("gmsh-" + std::to_string(version) + "-" + std::to_string(binary) + ".msh");
+      const fs::path file =
+          dir.path / ("gmsh-" + std::to_string(version) + "-" + std::to_string(binary) + ".msh");
       {
         GmshSession session;
         gmsh::open(ours.string());  // our own file, written above: never a user's

@@ -337,7 +337,8 @@ TEST_CASE("io_vtk: writes are atomic and check their input") {
                          geode::InvalidInput);
     HexMesh out = m;
     out.hexes[3][5] = 77;
-    CHECK_THROWS_WITH_AS(write_vtk(file, out), doctest::Contains("hexahedron 4: node 78 out of range"),
+    CHECK_THROWS_WITH_AS(write_vtk(file, out),
+                         doctest::Contains("hexahedron 4: node 78 out of range"),
                          geode::InvalidInput);
     CHECK(slurp(file) == before);
   }

@@ -30,7 +30,8 @@ HexMesh edge_contact() {
 
 }  // namespace
 
-TEST_CASE("extract_boundary: several threads at once, the first use of OpenMesh's error stream too") {
+TEST_CASE(
+    "extract_boundary: several threads at once, the first use of OpenMesh's error stream too") {
   const HexMesh m = edge_contact();
   constexpr int kThreads = 8;
   std::vector<BoundarySurface> got(kThreads);

@@ -283,8 +283,11 @@ TEST_CASE("diced_min_scaled_jacobian: the minimum over dice()'s hexes, without d
     const double hexes = diced_min_scaled_jacobian(h.points, h.hexes);
     CHECK(tets == doctest::Approx(min_scaled_jacobian(dice(t).mesh)).epsilon(1e-12));
     CHECK(hexes == doctest::Approx(min_scaled_jacobian(dice(h).mesh)).epsilon(1e-12));
-    if (amount == 0.0) CHECK(hexes == doctest::Approx(1.0));
-    else CHECK(tets < diced_min_scaled_jacobian(kuhn_grid(3).points, kuhn_grid(3).tets));
+    if (amount == 0.0)
+      CHECK(hexes == doctest::Approx(1.0));
+    else
+      CHECK(tets < diced_min_scaled_jacobian(kuhn_grid(3).points, kuhn_grid(3).tets));
   }
-  CHECK(diced_min_scaled_jacobian(std::vector<Point>{}, std::vector<std::array<Index, 4>>{}) == 1.0);
+  CHECK(diced_min_scaled_jacobian(std::vector<Point>{}, std::vector<std::array<Index, 4>>{}) ==
+        1.0);
 }

@@ -41,7 +41,8 @@ TEST_CASE("grade_down: the largest field below the input meeting the rate, on a 
     for (std::size_t e = 0; e < g.nodes.size(); ++e) {
       const auto [a, b] = g.nodes[e];
       for (const auto& [x, y] : {std::pair{a, b}, std::pair{b, a}})
-        if (slow[y] + rate * g.length[e] < slow[x]) slow[x] = slow[y] + rate * g.length[e], changed = true;
+        if (slow[y] + rate * g.length[e] < slow[x])
+          slow[x] = slow[y] + rate * g.length[e], changed = true;
     }
   }
   for (int v = 0; v < n; ++v) {

@@ -3,13 +3,13 @@
 // diagonal from its lowest to its highest corner).
 #include <doctest/doctest.h>
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <set>
 #include <string>
 
-#include <geode/primal/grid_model.hpp>
 #include <geode/primal/errors.hpp>
+#include <geode/primal/grid_model.hpp>
 #include <geode/primal/interface.hpp>
 #include <geode/primal/topology.hpp>
 #include "support/fixtures.hpp"
@@ -52,7 +52,8 @@ void check_consistent(const Model& m, const Interface& itf) {
     }
     // Kuhn diagonal: from the corner with the smallest coordinate sum to the largest.
     auto sum = [&](Index v) { return m.points[static_cast<std::size_t>(v)].sum(); };
-    const auto lo = std::min_element(q.corners.begin(), q.corners.end(), [&](Index a, Index b) { return sum(a) < sum(b); });
+    const auto lo = std::min_element(q.corners.begin(), q.corners.end(),
+                                     [&](Index a, Index b) { return sum(a) < sum(b); });
     const auto lo_pos = lo - q.corners.begin();
     CHECK(q.diagonal == lo_pos % 2);
   }
@@ -79,7 +80,11 @@ TEST_CASE("find_interface: known counts on small grids") {
       // two inner faces, convex seen from the tets: 2 quads, 6 nodes.
       {"convex edge", {2, 2, 1}, [](int i, int j, int) { return i == 1 || j == 1; }, 2, 6},
       // A tet nugget in the middle of a 3x3x3 block: the 6 faces of the cavity, 8 corners.
-      {"enclosed nugget", {3, 3, 3}, [](int i, int j, int k) { return i == 1 && j == 1 && k == 1; }, 6, 8},
+      {"enclosed nugget",
+       {3, 3, 3},
+       [](int i, int j, int k) { return i == 1 && j == 1 && k == 1; },
+       6,
+       8},
   };
   for (const Row& row : rows) {
     CAPTURE(row.name);
@@ -140,8 +145,11 @@ TEST_CASE("find_interface: rejects non-conforming interfaces, naming the face or
     const Index gone = itf.quads[0].tets[1];
     m.tets.erase(m.tets.begin() + gone);
     m.tet_block.erase(m.tet_block.begin() + gone);
-    CHECK_THROWS_WITH_AS(find_interface(m), doctest::Contains("hex 1 (centre (0.5, 0.5, 0.5)) face (nodes 5 6 8 7) is matched by only one triangle"),
-                         TopologyError);
+    CHECK_THROWS_WITH_AS(
+        find_interface(m),
+        doctest::Contains(
+            "hex 1 (centre (0.5, 0.5, 0.5)) face (nodes 5 6 8 7) is matched by only one triangle"),
+        TopologyError);
   }
   SUBCASE("a hanging tet node in the middle of a hex face edge") {
     Model m = grid_model({1, 1, 1}, 1.0, [](int, int, int) { return false; });
@@ -153,10 +161,13 @@ TEST_CASE("find_interface: rejects non-conforming interfaces, naming the face or
       m.tet_block.push_back(2);
     }
     for (const auto& t : m.tets)
-      REQUIRE(tet_volume(m.points[static_cast<std::size_t>(t[0])], m.points[static_cast<std::size_t>(t[1])],
-                         m.points[static_cast<std::size_t>(t[2])], m.points[static_cast<std::size_t>(t[3])]) > 0);
+      REQUIRE(tet_volume(m.points[static_cast<std::size_t>(t[0])],
+                         m.points[static_cast<std::size_t>(t[1])],
+                         m.points[static_cast<std::size_t>(t[2])],
+                         m.points[static_cast<std::size_t>(t[3])]) > 0);
     CHECK_THROWS_WITH_AS(find_interface(m),
-                         doctest::Contains("node 9 (0.5, 0, 1) of the tet part (tet 1 (centre (0.25, 0.375, 1.25))) lies on hex 1"),
+                         doctest::Contains("node 9 (0.5, 0, 1) of the tet part (tet 1 (centre "
+                                           "(0.25, 0.375, 1.25))) lies on hex 1"),
                          TopologyError);
   }
   SUBCASE("a four-triangle centre that is a hex node too") {
@@ -166,7 +177,8 @@ TEST_CASE("find_interface: rejects non-conforming interfaces, naming the face or
     for (int k = 0; k < 7; ++k) m.points.emplace_back(0.1 * k, -1.0, -1.0 - 0.1 * k);
     m.hexes.push_back({base, base + 1, base + 2, base + 3, base + 4, base + 5, base + 6, 8});
     m.hex_block.push_back(1);
-    CHECK_THROWS_WITH_AS(find_interface(m), doctest::Contains("a node of the hex part too"), TopologyError);
+    CHECK_THROWS_WITH_AS(find_interface(m), doctest::Contains("a node of the hex part too"),
+                         TopologyError);
   }
   SUBCASE("a finer hex side under one coarse tet cell") {
     Model m = grid_model({2, 2, 1}, 0.5, [](int, int, int) { return false; });
@@ -179,15 +191,18 @@ TEST_CASE("find_interface: rejects non-conforming interfaces, naming the face or
     Model m = grid_model({1, 1, 1}, 1.0, [](int, int, int) { return false; });
     append(m, grid_model({1, 1, 1}, 1.0, [](int, int, int) { return true; }), Point(1, 1, 0));
     CHECK(merge_coincident_nodes(m, 1e-9) == 2);
-    CHECK_THROWS_WITH_AS(find_interface(m), doctest::Contains("lies on no interface quad"), TopologyError);
+    CHECK_THROWS_WITH_AS(find_interface(m), doctest::Contains("lies on no interface quad"),
+                         TopologyError);
   }
 }
 
-TEST_CASE("merge_coincident_nodes: a zero tolerance merges exact copies only; bad ones are refused") {
+TEST_CASE(
+    "merge_coincident_nodes: a zero tolerance merges exact copies only; bad ones are refused") {
   Model m = grid_model({1, 1, 1}, 1.0, [](int, int, int) { return false; });
   append(m, grid_model({1, 1, 1}, 1.0, [](int, int, int) { return false; }), Point(1, 0, 0));
   m.points.push_back(Point(1e6, 1e6, 1e-300));  // far away and tiny: no overflow in the grid
   CHECK(merge_coincident_nodes(m, 0.0) == 4);   // the shared face's four nodes
-  CHECK_THROWS_WITH_AS(merge_coincident_nodes(m, -1.0), doctest::Contains("tolerance"), InvalidInput);
+  CHECK_THROWS_WITH_AS(merge_coincident_nodes(m, -1.0), doctest::Contains("tolerance"),
+                       InvalidInput);
   CHECK_THROWS_AS(merge_coincident_nodes(m, std::nan("")), InvalidInput);
 }

@@ -15,9 +15,10 @@ TEST_CASE("KeyMap agrees with std::map through rehashes") {
   for (Index a = 0; a < 40; ++a)
     for (Index b = 0; b < 40; ++b) {
       // Face-like keys (padded with kInvalidIndex) and their permutations are distinct keys.
-      for (const std::array<Index, 4> k : {std::array<Index, 4>{a, b, a + b, kInvalidIndex},
-                                           std::array<Index, 4>{b, a, a + b, kInvalidIndex},
-                                           std::array<Index, 4>{a, b, kInvalidIndex, kInvalidIndex}}) {
+      for (const std::array<Index, 4> k :
+           {std::array<Index, 4>{a, b, a + b, kInvalidIndex},
+            std::array<Index, 4>{b, a, a + b, kInvalidIndex},
+            std::array<Index, 4>{a, b, kInvalidIndex, kInvalidIndex}}) {
         const auto [slot, inserted] = map.try_emplace(k, next);
         const auto [it, ref_inserted] = reference.try_emplace(k, next);
         CHECK(inserted == ref_inserted);

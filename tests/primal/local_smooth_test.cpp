@@ -37,7 +37,9 @@ struct Lcg {
 template <class Map>
 HexMesh grid(int n, Map map) {
   HexMesh m;
-  auto id = [n](int i, int j, int k) { return static_cast<Index>(i + (n + 1) * (j + (n + 1) * k)); };
+  auto id = [n](int i, int j, int k) {
+    return static_cast<Index>(i + (n + 1) * (j + (n + 1) * k));
+  };
   for (int k = 0; k <= n; ++k)
     for (int j = 0; j <= n; ++j)
       for (int i = 0; i <= n; ++i) m.points.push_back(map(Point(i, j, k)));
@@ -110,10 +112,13 @@ TEST_CASE("frame derivatives match central differences") {
       for (int i = 0; i < 9; ++i) {
         gp::FrameVector vp = v, vm = v, gp_, gm;
         vp[i] += eps, vm[i] -= eps;
-        CHECK(g[i] == doctest::Approx((f(vp, nullptr, nullptr) - f(vm, nullptr, nullptr)) / (2 * eps)).epsilon(1e-6));
+        CHECK(g[i] ==
+              doctest::Approx((f(vp, nullptr, nullptr) - f(vm, nullptr, nullptr)) / (2 * eps))
+                  .epsilon(1e-6));
         f(vp, &gp_, nullptr), f(vm, &gm, nullptr);
         const gp::FrameVector col = (gp_ - gm) / (2 * eps);
-        for (int j = 0; j < 9; ++j) CHECK(h(j, i) == doctest::Approx(col[j]).epsilon(1e-5).scale(1.0));
+        for (int j = 0; j < 9; ++j)
+          CHECK(h(j, i) == doctest::Approx(col[j]).epsilon(1e-5).scale(1.0));
       }
       CHECK((h - h.transpose()).norm() < 1e-12);
     }
@@ -129,7 +134,8 @@ TEST_CASE("a tangled grid is untangled, boundary nodes on their planes") {
       for (int a = 0; a < 3; ++a) p[a] += 0.9 * r.next();
   const HexMesh before = mesh;
   const auto initial = scaled_jacobians(mesh);
-  const int inverted = static_cast<int>(std::count_if(initial.begin(), initial.end(), [](double q) { return q <= 0; }));
+  const int inverted = static_cast<int>(
+      std::count_if(initial.begin(), initial.end(), [](double q) { return q <= 0; }));
   REQUIRE(inverted > 0);
   const auto cons = gp::boundary_slide_constraints(mesh);
   const auto res = gp::smooth_hexes_local(mesh, cons);
@@ -160,7 +166,8 @@ TEST_CASE("hexes near the worst never lose; others lose at most `loss`") {
   const auto start = scaled_jacobians(mesh);
   const double worst = *std::min_element(start.begin(), start.end());
   REQUIRE(worst > 0.0);
-  const auto res = gp::smooth_hexes_local(mesh, gp::boundary_slide_constraints(mesh), nullptr, {}, o);
+  const auto res =
+      gp::smooth_hexes_local(mesh, gp::boundary_slide_constraints(mesh), nullptr, {}, o);
   const auto end = scaled_jacobians(mesh);
   int improved = 0;
   for (std::size_t h = 0; h < start.size(); ++h) {
@@ -181,11 +188,13 @@ TEST_CASE("the call ends when every seed reaches the goal") {
   o.target = 0.9;
   const HexMesh start = jittered_grid(5, 0.3, 11);
   HexMesh full = start;
-  const auto all = gp::smooth_hexes_local(full, gp::boundary_slide_constraints(full), nullptr, {}, o);
+  const auto all =
+      gp::smooth_hexes_local(full, gp::boundary_slide_constraints(full), nullptr, {}, o);
   o.goal = 0.5 * (all.initial_min_scaled_jacobian + all.final_min_scaled_jacobian);
   REQUIRE(o.goal > all.initial_min_scaled_jacobian + 0.02);
   HexMesh part = start;
-  const auto res = gp::smooth_hexes_local(part, gp::boundary_slide_constraints(part), nullptr, {}, o);
+  const auto res =
+      gp::smooth_hexes_local(part, gp::boundary_slide_constraints(part), nullptr, {}, o);
   CHECK(res.final_min_scaled_jacobian >= o.goal);
   CHECK(res.patches < all.patches);
   CHECK(res.final_min_scaled_jacobian < all.final_min_scaled_jacobian);
@@ -201,8 +210,11 @@ TEST_CASE("no edge ends below min_edge_fraction of its hex's shortest edge at th
     for (int a = 0; a < 8; ++a)
       for (int b = a + 1; b < 8; ++b)
         if (std::abs(gp::topology::kHexCornerCoords[a][0] - gp::topology::kHexCornerCoords[b][0]) +
-                std::abs(gp::topology::kHexCornerCoords[a][1] - gp::topology::kHexCornerCoords[b][1]) +
-                std::abs(gp::topology::kHexCornerCoords[a][2] - gp::topology::kHexCornerCoords[b][2]) == 1)
+                std::abs(gp::topology::kHexCornerCoords[a][1] -
+                         gp::topology::kHexCornerCoords[b][1]) +
+                std::abs(gp::topology::kHexCornerCoords[a][2] -
+                         gp::topology::kHexCornerCoords[b][2]) ==
+            1)
           s = std::min(s, (c[a] - c[b]).norm());
     return s;
   };
@@ -214,7 +226,8 @@ TEST_CASE("no edge ends below min_edge_fraction of its hex's shortest edge at th
     HexMesh mesh = start;
     gp::smooth_hexes_local(mesh, gp::boundary_slide_constraints(mesh), nullptr, {}, o);
     int n = 0;
-    for (Index h = 0; h < static_cast<Index>(mesh.hexes.size()); ++h) n += shortest(mesh, h) < 0.9 * shortest(start, h);
+    for (Index h = 0; h < static_cast<Index>(mesh.hexes.size()); ++h)
+      n += shortest(mesh, h) < 0.9 * shortest(start, h);
     return n;
   };
   CHECK(below(0.9) == 0);
@@ -226,9 +239,8 @@ TEST_CASE("no edge ends below min_edge_fraction of its hex's shortest edge at th
 // the hexes around it poor, and they rise only at their neighbours' expense.
 TEST_CASE("smoothing in passes from one SmoothStart keeps every hex within `loss` of it") {
   const int n = 4;
-  const HexMesh first = grid(n, [&](const Point& p) {
-    return p == Point(2, 2, 2) ? Point(2.6, 2.6, 2.6) : p;
-  });
+  const HexMesh first =
+      grid(n, [&](const Point& p) { return p == Point(2, 2, 2) ? Point(2.6, 2.6, 2.6) : p; });
   const gp::SmoothStart start = gp::smooth_start(first);
   auto lost = [&](bool shared) {
     HexMesh mesh = first;
@@ -242,7 +254,8 @@ TEST_CASE("smoothing in passes from one SmoothStart keeps every hex within `loss
     }
     const auto end = scaled_jacobians(mesh);
     int k = 0;
-    for (std::size_t h = 0; h < end.size(); ++h) k += end[h] < start.scaled_jacobian[h] - o.loss - 1e-12;
+    for (std::size_t h = 0; h < end.size(); ++h)
+      k += end[h] < start.scaled_jacobian[h] - o.loss - 1e-12;
     return k;
   };
   CHECK(lost(true) == 0);
@@ -269,11 +282,13 @@ TEST_CASE("seeds limit the smoothing to their neighbourhood") {
   CHECK(moved > 0);
 }
 
-// Volume of each block (mesh.block; 0 for all when empty): the exact volumes of the trilinear hexes.
+// Volume of each block (mesh.block; 0 for all when empty): the exact volumes of the trilinear
+// hexes.
 std::map<int, double> block_volumes(const HexMesh& m) {
   std::map<int, double> v;
   for (Index h = 0; h < static_cast<Index>(m.hexes.size()); ++h)
-    v[m.block.empty() ? 0 : m.block[static_cast<std::size_t>(h)]] += gp::hex_volume(gp::hex_corners(m, h));
+    v[m.block.empty() ? 0 : m.block[static_cast<std::size_t>(h)]] +=
+        gp::hex_volume(gp::hex_corners(m, h));
   return v;
 }
 
@@ -286,14 +301,17 @@ void check_volumes_kept(const HexMesh& before, const HexMesh& after) {
   }
 }
 
-TEST_CASE("curved boundary nodes are fixed: the volume is kept; given kSurface nodes stay on the triangulation") {
+TEST_CASE(
+    "curved boundary nodes are fixed: the volume is kept; given kSurface nodes stay on the "
+    "triangulation") {
   // A grid whose top bulges (z = 3 + 0.4 sin): top nodes on a curved surface, the sides planes.
   HexMesh mesh = grid(3, [](const Point& p) {
     return Point(p.x(), p.y(), p.z() * (1.0 + 0.13 * std::sin(p.x()) * std::sin(p.y())));
   });
   Lcg r{9};
   for (Point& p : mesh.points)  // skew the interior so that the top nodes want to move
-    if (p.minCoeff() > 0 && p.x() < 3 && p.y() < 3) p.x() += 0.35 * r.next(), p.y() += 0.35 * r.next();
+    if (p.minCoeff() > 0 && p.x() < 3 && p.y() < 3)
+      p.x() += 0.35 * r.next(), p.y() += 0.35 * r.next();
   const auto cons = gp::boundary_slide_constraints(mesh);
   int planes = 0, curved = 0;
   for (std::size_t v = 0; v < mesh.points.size(); ++v) {
@@ -334,16 +352,20 @@ TEST_CASE("curved boundary nodes are fixed: the volume is kept; given kSurface n
   CHECK_THROWS_AS(gp::smooth_hexes_local(unconstrained, surface_cons), geode::InvalidInput);
 }
 
-TEST_CASE("materials never move: block interfaces slide in their plane or stay, every block's volume kept") {
+TEST_CASE(
+    "materials never move: block interfaces slide in their plane or stay, every block's volume "
+    "kept") {
   // A jittered 6^3 grid in three blocks: a curved interface (a sphere's octant: the hexes whose
   // centre is within 3.5 of the origin), a planar one (x = 4, flat: its nodes slide in it) and
   // the boundary.
   HexMesh mesh = jittered_grid(6, 0.3, 41);
   for (Point& p : mesh.points)  // the x = 4 plane flat again
-    if (std::abs(p.x() - 4.0) < 0.31 && p.x() != 4.0 && std::abs(std::round(p.x()) - 4.0) < 0.5) p.x() = 4.0;
+    if (std::abs(p.x() - 4.0) < 0.31 && p.x() != 4.0 && std::abs(std::round(p.x()) - 4.0) < 0.5)
+      p.x() = 4.0;
   for (Index h = 0; h < static_cast<Index>(mesh.hexes.size()); ++h) {
     Point c = Point::Zero();
-    for (Index v : mesh.hexes[static_cast<std::size_t>(h)]) c += mesh.points[static_cast<std::size_t>(v)] / 8.0;
+    for (Index v : mesh.hexes[static_cast<std::size_t>(h)])
+      c += mesh.points[static_cast<std::size_t>(v)] / 8.0;
     mesh.block.push_back(c.norm() < 3.5 ? 1 : c.x() > 4.0 ? 3 : 2);
   }
   const auto between = gp::block_interface_quads(mesh);
@@ -364,8 +386,9 @@ TEST_CASE("materials never move: block interfaces slide in their plane or stay, 
   check_volumes_kept(before, mesh);
   int slid = 0;  // nodes of the x = 4 interface that moved, in it
   for (std::size_t v = 0; v < mesh.points.size(); ++v)
-    if (cons[v].kind == NodeConstraint::Kind::kPlane && before.points[v].x() == 4.0 && before.points[v].y() > 0 &&
-        before.points[v].y() < 6 && before.points[v].z() > 0 && before.points[v].z() < 6) {
+    if (cons[v].kind == NodeConstraint::Kind::kPlane && before.points[v].x() == 4.0 &&
+        before.points[v].y() > 0 && before.points[v].y() < 6 && before.points[v].z() > 0 &&
+        before.points[v].z() < 6) {
       CHECK(std::abs(mesh.points[v].x() - 4.0) < 1e-12);
       slid += (mesh.points[v] - before.points[v]).norm() > 1e-3;
     }
@@ -408,7 +431,8 @@ TEST_CASE("smooth_hexes_around: the submesh around the seeds gives the whole-mes
   o.target = 0.9;
   HexMesh whole = mesh, around = mesh;
   const gp::TriMesh surface = gp::boundary_triangulation(mesh);
-  const auto rw = gp::smooth_hexes_local(whole, gp::boundary_slide_constraints(mesh), &surface, seeds, o);
+  const auto rw =
+      gp::smooth_hexes_local(whole, gp::boundary_slide_constraints(mesh), &surface, seeds, o);
   const auto ra = gp::smooth_hexes_around(around, seeds, o);
   CHECK(ra.patches == rw.patches);
   CHECK(ra.patches > 10);

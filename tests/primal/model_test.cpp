@@ -25,9 +25,12 @@ std::vector<Point> reference_corners(ElementKind kind) {
       for (const auto& c : topo::kHexCornerCoords) p.emplace_back(c[0], c[1], c[2]);
       return p;
     }
-    case ElementKind::Tet: return {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-    case ElementKind::Pyramid: return {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0.5, 0.5, 1}};
-    case ElementKind::Wedge: return {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {0, 1, 1}};
+    case ElementKind::Tet:
+      return {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    case ElementKind::Pyramid:
+      return {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0.5, 0.5, 1}};
+    case ElementKind::Wedge:
+      return {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {0, 1, 1}};
   }
   return {};
 }
@@ -38,10 +41,22 @@ Model one_cell(ElementKind kind, std::vector<Point> points) {
   std::vector<Index> c(m.points.size());
   for (std::size_t i = 0; i < c.size(); ++i) c[i] = static_cast<Index>(i);
   switch (kind) {
-    case ElementKind::Hex: m.hexes.push_back({c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]}); m.hex_ids = {41}; break;
-    case ElementKind::Tet: m.tets.push_back({c[0], c[1], c[2], c[3]}); m.tet_ids = {42}; break;
-    case ElementKind::Pyramid: m.pyramids.push_back({c[0], c[1], c[2], c[3], c[4]}); m.pyramid_ids = {43}; break;
-    case ElementKind::Wedge: m.wedges.push_back({c[0], c[1], c[2], c[3], c[4], c[5]}); m.wedge_ids = {44}; break;
+    case ElementKind::Hex:
+      m.hexes.push_back({c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]});
+      m.hex_ids = {41};
+      break;
+    case ElementKind::Tet:
+      m.tets.push_back({c[0], c[1], c[2], c[3]});
+      m.tet_ids = {42};
+      break;
+    case ElementKind::Pyramid:
+      m.pyramids.push_back({c[0], c[1], c[2], c[3], c[4]});
+      m.pyramid_ids = {43};
+      break;
+    case ElementKind::Wedge:
+      m.wedges.push_back({c[0], c[1], c[2], c[3], c[4], c[5]});
+      m.wedge_ids = {44};
+      break;
   }
   return m;
 }
@@ -63,15 +78,18 @@ TEST_CASE("cell kinds: faces outward and closed, edges on two faces, Euler") {
       Point area = Point::Zero(), fc = Point::Zero();
       for (int k = 0; k < face.size; ++k) {
         const Point& a = p[static_cast<std::size_t>(face.corners[static_cast<std::size_t>(k)])];
-        const Point& b = p[static_cast<std::size_t>(face.corners[static_cast<std::size_t>((k + 1) % face.size)])];
+        const Point& b = p[static_cast<std::size_t>(
+            face.corners[static_cast<std::size_t>((k + 1) % face.size)])];
         area += a.cross(b) / 2.0;
         fc += a / face.size;
-        const auto [lo, hi] = std::minmax(face.corners[static_cast<std::size_t>(k)],
-                                          face.corners[static_cast<std::size_t>((k + 1) % face.size)]);
+        const auto [lo, hi] =
+            std::minmax(face.corners[static_cast<std::size_t>(k)],
+                        face.corners[static_cast<std::size_t>((k + 1) % face.size)]);
         int found = 0;
         for (int e = 0; e < t.edges; ++e) {
           const auto& ed = t.edge[static_cast<std::size_t>(e)];
-          if (std::min(ed[0], ed[1]) == lo && std::max(ed[0], ed[1]) == hi) ++edge_uses[static_cast<std::size_t>(e)], ++found;
+          if (std::min(ed[0], ed[1]) == lo && std::max(ed[0], ed[1]) == hi)
+            ++edge_uses[static_cast<std::size_t>(e)], ++found;
         }
         CHECK(found == 1);
       }
@@ -82,10 +100,13 @@ TEST_CASE("cell kinds: faces outward and closed, edges on two faces, Euler") {
     for (int u : edge_uses) CHECK(u == 2);
     CHECK(t.corners - t.edges + t.faces == 2);
   }
-  CHECK(topo::kCellKinds[0].face[3].corners == std::array<int, 4>{3, 0, 4, 7});  // the hex table agrees
+  CHECK(topo::kCellKinds[0].face[3].corners ==
+        std::array<int, 4>{3, 0, 4, 7});  // the hex table agrees
   for (int f = 0; f < 6; ++f)
     for (int k = 0; k < 4; ++k)
-      CHECK(topo::kCellKinds[0].face[static_cast<std::size_t>(f)].corners[static_cast<std::size_t>(k)] ==
+      CHECK(topo::kCellKinds[0]
+                .face[static_cast<std::size_t>(f)]
+                .corners[static_cast<std::size_t>(k)] ==
             topo::kHexFaceCorners[static_cast<std::size_t>(f)][static_cast<std::size_t>(k)]);
 }
 
@@ -93,12 +114,14 @@ TEST_CASE("cell kinds: wedge and tet corner frames are right-handed on the refer
   const auto w = reference_corners(ElementKind::Wedge);
   for (std::size_t c = 0; c < 6; ++c) {
     const auto& n = topo::kWedgeCornerNeighbors[c];
-    CHECK(tet_volume(w[c], w[static_cast<std::size_t>(n[0])], w[static_cast<std::size_t>(n[1])], w[static_cast<std::size_t>(n[2])]) > 0.0);
+    CHECK(tet_volume(w[c], w[static_cast<std::size_t>(n[0])], w[static_cast<std::size_t>(n[1])],
+                     w[static_cast<std::size_t>(n[2])]) > 0.0);
   }
   const auto t = reference_corners(ElementKind::Tet);
   for (std::size_t c = 0; c < 4; ++c) {
     const auto& n = topo::kTetCornerNeighbors[c];
-    CHECK(tet_volume(t[c], t[static_cast<std::size_t>(n[0])], t[static_cast<std::size_t>(n[1])], t[static_cast<std::size_t>(n[2])]) > 0.0);
+    CHECK(tet_volume(t[c], t[static_cast<std::size_t>(n[0])], t[static_cast<std::size_t>(n[1])],
+                     t[static_cast<std::size_t>(n[2])]) > 0.0);
   }
 }
 
@@ -112,10 +135,12 @@ TEST_CASE("model: accessors, blocks and ids per kind") {
   CHECK_NOTHROW(validate(m, "w.msh"));
   CHECK_NOTHROW(check_geometry(m, "w.msh"));
   m.wedge_block = {0};
-  CHECK_THROWS_WITH_AS(validate(m, "w.msh"), doctest::Contains("wedge 44: block id 0"), geode::InvalidInput);
+  CHECK_THROWS_WITH_AS(validate(m, "w.msh"), doctest::Contains("wedge 44: block id 0"),
+                       geode::InvalidInput);
   m.wedge_block = {};
   m.side_sets.push_back({1, "s", {{{ElementKind::Wedge, 0}, 5}}});
-  CHECK_THROWS_WITH_AS(validate(m, "w.msh"), doctest::Contains("face 6 out of range [1, 5]"), geode::InvalidInput);
+  CHECK_THROWS_WITH_AS(validate(m, "w.msh"), doctest::Contains("face 6 out of range [1, 5]"),
+                       geode::InvalidInput);
 }
 
 TEST_CASE("model: inverted wedges and pyramids refused by their file ids") {

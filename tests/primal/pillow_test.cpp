@@ -32,11 +32,14 @@ std::map<primal::EdgeKey, int> interior_edge_valence(const primal::HexMesh& m) {
   std::set<primal::EdgeKey> on_boundary;
   for (const auto& f : primal::unique_faces(m))
     if (f.uses.size() == 1)
-      for (int i = 0; i < 4; ++i) on_boundary.insert(primal::edge_key(f.nodes[static_cast<std::size_t>(i)], f.nodes[static_cast<std::size_t>((i + 1) % 4)]));
+      for (int i = 0; i < 4; ++i)
+        on_boundary.insert(primal::edge_key(f.nodes[static_cast<std::size_t>(i)],
+                                            f.nodes[static_cast<std::size_t>((i + 1) % 4)]));
   std::map<primal::EdgeKey, int> v;
   for (const auto& h : m.hexes)
     for (const auto& e : primal::topology::kHexEdgeCorners) {
-      const auto k = primal::edge_key(h[static_cast<std::size_t>(e[0])], h[static_cast<std::size_t>(e[1])]);
+      const auto k =
+          primal::edge_key(h[static_cast<std::size_t>(e[0])], h[static_cast<std::size_t>(e[1])]);
       if (!on_boundary.count(k)) ++v[k];
     }
   return v;
@@ -60,7 +63,8 @@ TEST_CASE("pillow: one hex becomes a hex wrapped in six, the boundary kept") {
 TEST_CASE("pillow: shrink sets inside and on the boundary of a grid") {
   const auto grid = test::structured_hex_grid(3, 3, 3);
   // Hex (i, j, k) is i + 3 (j + 3 k).
-  const std::vector<std::vector<Index>> sets{{13}, {0, 1, 3, 4}, {4, 13, 22}, {0, 1, 2, 3, 4, 5, 6, 7, 8}};
+  const std::vector<std::vector<Index>> sets{
+      {13}, {0, 1, 3, 4}, {4, 13, 22}, {0, 1, 2, 3, 4, 5, 6, 7, 8}};
   for (const auto& set : sets) {
     CAPTURE(set.size());
     const auto r = primal::pillow(grid, set);
@@ -69,10 +73,14 @@ TEST_CASE("pillow: shrink sets inside and on the boundary of a grid") {
     for (Index h : set)
       for (const auto& f : primal::topology::kHexFaceCorners) {
         std::array<Index, 4> n{};
-        for (int i = 0; i < 4; ++i) n[static_cast<std::size_t>(i)] = grid.hexes[static_cast<std::size_t>(h)][static_cast<std::size_t>(f[static_cast<std::size_t>(i)])];
+        for (int i = 0; i < 4; ++i)
+          n[static_cast<std::size_t>(i)] =
+              grid.hexes[static_cast<std::size_t>(h)]
+                        [static_cast<std::size_t>(f[static_cast<std::size_t>(i)])];
         ++uses[primal::face_key(n)];
       }
-    const auto surface = std::count_if(uses.begin(), uses.end(), [](const auto& u) { return u.second == 1; });
+    const auto surface =
+        std::count_if(uses.begin(), uses.end(), [](const auto& u) { return u.second == 1; });
     CHECK(r.layer.size() == static_cast<std::size_t>(surface));
     CHECK(r.mesh.hexes.size() == grid.hexes.size() + r.layer.size());
     const auto v = primal::check_validity(r.mesh);
@@ -93,7 +101,8 @@ TEST_CASE("pillow: pillowing one hex of a doublet removes it") {
   // and m-c2 (m is an interior node of valence 2), extruded one layer: the two hexes share two
   // faces and the vertical edge through m is an interior edge in only two hexes.
   primal::HexMesh m;
-  const Point base[] = {Point(0, 0, 0), Point(1, 0, 0), Point(1, 1, 0), Point(0, 1, 0), Point(0.5, 0.5, 0)};
+  const Point base[] = {Point(0, 0, 0), Point(1, 0, 0), Point(1, 1, 0), Point(0, 1, 0),
+                        Point(0.5, 0.5, 0)};
   for (double z : {0.0, 1.0})
     for (const auto& p : base) m.points.push_back(p + Point(0, 0, z));
   m.hexes = {{0, 1, 2, 4, 5, 6, 7, 9}, {2, 3, 0, 4, 7, 8, 5, 9}};

@@ -47,8 +47,8 @@ std::vector<HexCase> hex_cases() {
   // sqrt(3) * 1 / sqrt(3) = 1. Principal axes 4 e_i: centre Jacobian 64 / 64 = 1. Dimension: V = 1,
   // dV/dx_c has 3 components of magnitude 1/4, so sum |grad|^2 = 8 * 3 / 16 = 3/2 and
   // sqrt(0.5 / 1.5) = 1/sqrt(3).
-  cases.push_back({"unit cube", unit_cube(),
-                   {1, 1, 0, 0, 1, 1, 1, 1 / std::sqrt(3.0), 1, 1, 1, 1}});
+  cases.push_back(
+      {"unit cube", unit_cube(), {1, 1, 0, 0, 1, 1, 1, 1 / std::sqrt(3.0), 1, 1, 1, 1}});
 
   // Sheared: the top face of the unit cube moved by (1, 0, 0). A parallelepiped with edge
   // vectors u = (1,0,0), v = (0,1,0), w = (1,0,1), |w| = sqrt 2.
@@ -65,9 +65,10 @@ std::vector<HexCase> hex_cases() {
     HexCorners p = unit_cube();
     for (int c = 4; c < 8; ++c) p[c].x() += 1.0;
     const double r2 = std::sqrt(2.0);
-    cases.push_back({"sheared", p,
-                     {r2, r2, 1 / r2, 0, 1, 1 / r2, 1 / std::sqrt(3.0), 0.5, 1, 1 / r2, 4.0 / 3.0,
-                      0.75}});
+    cases.push_back(
+        {"sheared",
+         p,
+         {r2, r2, 1 / r2, 0, 1, 1 / r2, 1 / std::sqrt(3.0), 0.5, 1, 1 / r2, 4.0 / 3.0, 0.75}});
   }
 
   // Tapered: bottom 2 x 2 square, top 1 x 1 square centred above it, height 1 (a frustum).
@@ -87,10 +88,10 @@ std::vector<HexCase> hex_cases() {
     HexCorners p;
     p[0] = {0, 0, 0}, p[1] = {2, 0, 0}, p[2] = {2, 2, 0}, p[3] = {0, 2, 0};
     p[4] = {0.5, 0.5, 1}, p[5] = {1.5, 0.5, 1}, p[6] = {1.5, 1.5, 1}, p[7] = {0.5, 1.5, 1};
-    cases.push_back({"tapered", p,
+    cases.push_back({"tapered",
+                     p,
                      {2, 1.5, 0, 0.5, 7.0 / 3.0, std::sqrt(3.0 / 5.5), 1, kNotChecked, 1,
-                      std::sqrt(2.0 / 3.0), std::sqrt(247.0) / 12.0,
-                      3.0 * std::cbrt(16.0) / 9.5}});
+                      std::sqrt(2.0 / 3.0), std::sqrt(247.0) / 12.0, 3.0 * std::cbrt(16.0) / 9.5}});
   }
 
   // Flat: the top face of the unit cube laid into z = 0 and moved by (1,0,0), so that every
@@ -102,9 +103,8 @@ std::vector<HexCase> hex_cases() {
   {
     HexCorners p = unit_cube();
     for (int c = 4; c < 8; ++c) p[c] += Point(1, 0, -1);
-    cases.push_back({"flat", p,
-                     {1, 1, 1, 0, 0, std::sqrt(3.0 / 5.0), 1 / std::sqrt(5.0), 0, 0, 0, kHuge,
-                      0}});
+    cases.push_back(
+        {"flat", p, {1, 1, 1, 0, 0, std::sqrt(3.0 / 5.0), 1 / std::sqrt(5.0), 0, 0, 0, kHuge, 0}});
   }
 
   // Inverted: the unit cube with its bottom and top faces swapped (a mirror image). Lengths,
@@ -113,8 +113,7 @@ std::vector<HexCase> hex_cases() {
   {
     HexCorners p = unit_cube();
     for (int c = 0; c < 8; ++c) p[c].z() = 1.0 - p[c].z();
-    cases.push_back({"inverted", p,
-                     {1, 1, 0, 0, -1, 1, 1, 1 / std::sqrt(3.0), -1, -1, kHuge, 0}});
+    cases.push_back({"inverted", p, {1, 1, 0, 0, -1, 1, 1, 1 / std::sqrt(3.0), -1, -1, kHuge, 0}});
   }
   return cases;
 }
@@ -220,22 +219,30 @@ TEST_CASE("quad jacobian and scaled jacobian") {
   struct QuadCase {
     const char* name;
     QuadCorners p;
-    double jac, sj;            // Verdict: sign from the element's own centre normal
-    double jac_z, sj_z;        // sign relative to +z
+    double jac, sj;      // Verdict: sign from the element's own centre normal
+    double jac_z, sj_z;  // sign relative to +z
   };
   const double s3 = std::sqrt(3.0);
   const std::vector<QuadCase> cases = {
       // Square of side 2: every corner area 4, scaled 1.
       {"square", {Point(0, 0, 0), Point(2, 0, 0), Point(2, 2, 0), Point(0, 2, 0)}, 4, 1, 4, 1},
       // Rhombus with 60 degree angles, side 1: corner area sin 60 = sqrt3/2 at all corners.
-      {"rhombus", {Point(0, 0, 0), Point(1, 0, 0), Point(1.5, s3 / 2, 0), Point(0.5, s3 / 2, 0)},
-       s3 / 2, s3 / 2, s3 / 2, s3 / 2},
+      {"rhombus",
+       {Point(0, 0, 0), Point(1, 0, 0), Point(1.5, s3 / 2, 0), Point(0.5, s3 / 2, 0)},
+       s3 / 2,
+       s3 / 2,
+       s3 / 2,
+       s3 / 2},
       // The square traversed clockwise: fine for Verdict (its own normal is -z), inverted for +z.
       {"clockwise", {Point(0, 0, 0), Point(0, 2, 0), Point(2, 2, 0), Point(2, 0, 0)}, 4, 1, -4, -1},
       // Arrow (non-convex): corner 2 at (0.5, 0.5) is reflex. Its edges a = p3 - p2 = (-.5, 1.5),
       // b = p1 - p2 = (1.5, -.5): a x b = .25 - 2.25 = -2, scaled -2 / 2.5 = -0.8. Centre normal
       // (p2 - p0) x (p3 - p1) = (.5,.5) x (-2,2) = +2 z.
-      {"arrow", {Point(0, 0, 0), Point(2, 0, 0), Point(0.5, 0.5, 0), Point(0, 2, 0)}, -2, -0.8, -2,
+      {"arrow",
+       {Point(0, 0, 0), Point(2, 0, 0), Point(0.5, 0.5, 0), Point(0, 2, 0)},
+       -2,
+       -0.8,
+       -2,
        -0.8},
   };
   for (const auto& c : cases) {
@@ -254,7 +261,8 @@ TEST_CASE("hex metric registry: lookup by id, key and name; unknown names are re
     CHECK(&gp::hex_metric_info(m.name) == &m);
     CHECK(m.acceptable_min < m.acceptable_max);
   }
-  const bool same_fn = gp::hex_metric_info(HexMetric::kScaledJacobian).evaluate == &gp::hex_scaled_jacobian;
+  const bool same_fn =
+      gp::hex_metric_info(HexMetric::kScaledJacobian).evaluate == &gp::hex_scaled_jacobian;
   CHECK(same_fn);
   CHECK_THROWS_AS(gp::hex_metric_info("warpage"), geode::InvalidInput);
   CHECK_THROWS_WITH(gp::hex_metric_info("warpage"), doctest::Contains("warpage"));

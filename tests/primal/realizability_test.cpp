@@ -22,7 +22,8 @@ using Kind = ObstructionKind;
 
 std::vector<Obstruction> of_kind(const std::vector<Obstruction>& all, Kind k) {
   std::vector<Obstruction> out;
-  std::copy_if(all.begin(), all.end(), std::back_inserter(out), [k](const Obstruction& o) { return o.kind == k; });
+  std::copy_if(all.begin(), all.end(), std::back_inserter(out),
+               [k](const Obstruction& o) { return o.kind == k; });
   return out;
 }
 
@@ -33,7 +34,7 @@ Index grid_node(int nx, int ny, int i, int j, int k) { return i + (nx + 1) * (j 
 // through a new vertical edge on the column's axis: each new edge is in only two hexes.
 struct DoubletColumn {
   HexMesh mesh;
-  std::array<Index, 4> axis{};                 // the new nodes, bottom to top
+  std::array<Index, 4> axis{};                  // the new nodes, bottom to top
   std::array<std::array<Index, 2>, 3> pairs{};  // the two hexes of each layer
 };
 
@@ -92,8 +93,8 @@ TetSplit tet_split() {
     if (a.cross(b).dot(c) < 0) std::swap(o[0], o[1]);
     const int j = o[0], k = o[1], l = o[2];
     // Corners 1, 3, 4 along ij, ik, il; 2, 5, 7 the face centres between them; 6 the centroid.
-    t.mesh.hexes.push_back({corner[i], t.mid[i][j], t.face[l], t.mid[i][k], t.mid[i][l], t.face[k], t.centroid,
-                            t.face[j]});
+    t.mesh.hexes.push_back({corner[i], t.mid[i][j], t.face[l], t.mid[i][k], t.mid[i][l], t.face[k],
+                            t.centroid, t.face[j]});
     t.vertex_hex[i] = static_cast<Index>(t.mesh.hexes.size() - 1);
   }
   return t;
@@ -121,7 +122,8 @@ TEST_CASE("realizability: clean grids, a tet split and the Appendix A geode have
   CHECK(find_obstructions(a).empty());
 }
 
-TEST_CASE("realizability: a doublet column gives one doublet per layer and two-quad nodes at its ends") {
+TEST_CASE(
+    "realizability: a doublet column gives one doublet per layer and two-quad nodes at its ends") {
   const DoubletColumn d = doublet_column();
   const auto v = check_validity(d.mesh);
   CHECK(v.boundary.closed);
@@ -163,7 +165,8 @@ TEST_CASE("realizability: a face cut open at a tet split's centre pinches the ce
   CHECK(all[0].kind == Kind::kPinchedCorner);
   CHECK(all[0].hexes == std::vector<Index>{t.vertex_hex[0], t.vertex_hex[1]});
   // The centroid, then the centres of the two faces containing edge 01 (opposite 2 and 3).
-  CHECK(all[0].nodes == std::vector<Index>{t.centroid, std::min(t.face[2], t.face[3]), std::max(t.face[2], t.face[3])});
+  CHECK(all[0].nodes == std::vector<Index>{t.centroid, std::min(t.face[2], t.face[3]),
+                                           std::max(t.face[2], t.face[3])});
 }
 
 TEST_CASE("realizability: a hex with two faces on one plane, and a flat corner") {
@@ -184,7 +187,8 @@ TEST_CASE("realizability: a hex with two faces on one plane, and a flat corner")
   const auto n = static_cast<Index>(q.points.size());
   for (int layer = 0; layer < 2; ++layer)
     for (const auto& p : q.points) h.points.push_back(p + Point(0, 0, layer));
-  for (const auto& c : q.quads) h.hexes.push_back({c[0], c[1], c[2], c[3], c[0] + n, c[1] + n, c[2] + n, c[3] + n});
+  for (const auto& c : q.quads)
+    h.hexes.push_back({c[0], c[1], c[2], c[3], c[0] + n, c[1] + n, c[2] + n, c[3] + n});
   const auto h_all = find_obstructions(h);
   REQUIRE(h_all.size() == 1);
   CHECK(h_all[0].kind == Kind::kTwoFacesOnBoundaryFace);
@@ -200,7 +204,8 @@ TEST_CASE("realizability: a hex with two faces on one plane, and a flat corner")
   const auto c_all = find_obstructions(cube, o);
   REQUIRE(c_all.size() == 1);
   CHECK(c_all[0].kind == Kind::kFlatCorner);
-  CHECK(c_all[0].nodes == std::vector<Index>{cube.hexes[0][0], cube.hexes[0][1], cube.hexes[0][3], cube.hexes[0][4]});
+  CHECK(c_all[0].nodes ==
+        std::vector<Index>{cube.hexes[0][0], cube.hexes[0][1], cube.hexes[0][3], cube.hexes[0][4]});
   o.node_faces.pop_back();
   CHECK_THROWS_AS(find_obstructions(cube, o), geode::InvalidInput);
 }
@@ -227,5 +232,6 @@ TEST_CASE("realizability: a quad doublet inside a grid") {
 TEST_CASE("realizability: out-of-range nodes are named") {
   HexMesh m = structured_hex_grid(1, 1, 1);
   m.hexes[0][5] = 99;
-  CHECK_THROWS_WITH_AS(find_obstructions(m), "hex 0: node 99 out of range [0, 8)", geode::InvalidInput);
+  CHECK_THROWS_WITH_AS(find_obstructions(m), "hex 0: node 99 out of range [0, 8)",
+                       geode::InvalidInput);
 }

@@ -63,8 +63,8 @@ TEST_CASE("Appendix A corner order is VTK order") {
     positive += gp::hex_jacobians(gp::hex_corners(as_printed, h))[8] > 0.0;
     positive_mirrored += gp::hex_jacobians(gp::hex_corners(mirrored, h))[8] > 0.0;
   }
-  MESSAGE("centre Jacobian > 0: paper order " << positive << "/26, mirrored "
-                                              << positive_mirrored << "/26");
+  MESSAGE("centre Jacobian > 0: paper order " << positive << "/26, mirrored " << positive_mirrored
+                                              << "/26");
   CHECK(positive > 20);
   CHECK(positive_mirrored < 6);
   // The brief's observation: 8 hexes of the printed geode have a negative corner Jacobian.
@@ -204,8 +204,8 @@ TEST_CASE("a tilted plane and line constraint hold to rounding") {
   const Point n(1, 1, 1), d(1, 1, 0);
   c[6] = NodeConstraint::plane(Point(1, 1, 1), n);
   c[5] = NodeConstraint::line(Point(1, 0, 1), d);
-  m.points[6] = Point(1.5, 0.8, 0.7);   // on the plane
-  m.points[5] = Point(1.3, 0.3, 1.0);   // on the line
+  m.points[6] = Point(1.5, 0.8, 0.7);  // on the plane
+  m.points[5] = Point(1.3, 0.3, 1.0);  // on the line
   gp::smooth_hex_mesh(m, c);
   CHECK(std::abs((m.points[6] - Point(1, 1, 1)).dot(n.normalized())) < 1e-12);
   CHECK((m.points[5] - Point(1, 0, 1)).cross(d.normalized()).norm() < 1e-12);
@@ -234,7 +234,8 @@ TEST_CASE("linked nodes move as their leader's mirror image: a symmetric mesh st
     for (int j = 0; j < 2; ++j)
       for (int i = 0; i < 2; ++i)
         m.hexes.push_back({id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k),
-                           id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1), id(i, j + 1, k + 1)});
+                           id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1),
+                           id(i, j + 1, k + 1)});
   m.points[id(1, 1, 1)] = Point(0.0, 0.5, 0.4);
   m.points[id(0, 1, 1)] = Point(-1.0, 0.5, -0.5);
   m.points[id(2, 1, 1)] = Point(1.0, 0.5, -0.5);
@@ -250,8 +251,10 @@ TEST_CASE("linked nodes move as their leader's mirror image: a symmetric mesh st
       // A leader that is its own mirror image moves in the plane x = 0 only.
       auto& c = constraints[id(1, j, k)];
       const Point p = m.points[id(1, j, k)];
-      if (c.kind == NodeConstraint::Kind::kFree) c = NodeConstraint::plane(p, Point::UnitX());
-      else if (c.kind == NodeConstraint::Kind::kPlane) c = NodeConstraint::line(p, c.direction.cross(Point::UnitX()));
+      if (c.kind == NodeConstraint::Kind::kFree)
+        c = NodeConstraint::plane(p, Point::UnitX());
+      else if (c.kind == NodeConstraint::Kind::kPlane)
+        c = NodeConstraint::line(p, c.direction.cross(Point::UnitX()));
     }
   const HexMesh start = m;
   const auto r = gp::smooth_hex_mesh(m, constraints, o);

@@ -99,9 +99,8 @@ TEST_CASE("boundary_quads: outward, one per boundary face, with hex and local fa
                         .cross(m.points[q.nodes[3]] - m.points[q.nodes[0]]);
     CHECK(n.dot(face_centre - hex_centre) > 0);  // outward
     // A boundary face of the block lies on the box.
-    const bool on_box = std::ranges::any_of(std::array{0, 1, 2}, [&](int d) {
-      return face_centre[d] == 0.0 || face_centre[d] == 3.0;
-    });
+    const bool on_box = std::ranges::any_of(
+        std::array{0, 1, 2}, [&](int d) { return face_centre[d] == 0.0 || face_centre[d] == 3.0; });
     CHECK(on_box);
   }
   const auto faces = unique_faces(m);
@@ -153,12 +152,31 @@ TEST_CASE("validity: each hex defect is found where it was put") {
 
   const std::vector<HexDefectCase> cases{
       {"edge-only contact",
-       [] { return keep_hexes(structured_hex_grid(2, 2, 1), {0, 3}); },
-       {}, {}, {}, {shared_edge.begin(), shared_edge.end()}, {shared_edge}, {}, {},
-       /*closed: the edge has 4 boundary quads*/ false, false},
+       [] {
+         return keep_hexes(structured_hex_grid(2, 2, 1), {0, 3});
+       },
+       {},
+       {},
+       {},
+       {shared_edge.begin(), shared_edge.end()},
+       {shared_edge},
+       {},
+       {},
+       /*closed: the edge has 4 boundary quads*/ false,
+       false},
       {"vertex-only contact",
-       [] { return keep_hexes(structured_hex_grid(2, 2, 2), {0, 7}); },
-       {}, {}, {}, {centre}, {}, {}, {}, true, false},
+       [] {
+         return keep_hexes(structured_hex_grid(2, 2, 2), {0, 7});
+       },
+       {},
+       {},
+       {},
+       {centre},
+       {},
+       {},
+       {},
+       true,
+       false},
       {"face shared by three hexes",
        [] {
          HexMesh m = structured_hex_grid(2, 1, 1);
@@ -174,8 +192,15 @@ TEST_CASE("validity: each hex defect is found where it was put") {
          m.hexes.push_back(h);
          return m;
        },
-       {}, {}, {}, {1, 4, 7, 10}, {{1, 4}, {1, 7}, {4, 10}, {7, 10}}, {shared_face}, {},
-       /*closed: each edge of the face has 3 boundary quads*/ false, false},
+       {},
+       {},
+       {},
+       {1, 4, 7, 10},
+       {{1, 4}, {1, 7}, {4, 10}, {7, 10}},
+       {shared_face},
+       {},
+       /*closed: each edge of the face has 3 boundary quads*/ false,
+       false},
       {"flipped hex",
        [] {
          HexMesh m = structured_hex_grid(2, 1, 1);
@@ -183,21 +208,45 @@ TEST_CASE("validity: each hex defect is found where it was put") {
          std::swap_ranges(h.begin(), h.begin() + 4, h.begin() + 4);  // top <-> bottom
          return m;
        },
-       {}, {}, {1}, {}, {}, {}, {shared_face}, true, false},
+       {},
+       {},
+       {1},
+       {},
+       {},
+       {},
+       {shared_face},
+       true,
+       false},
       {"repeated node",
        [] {
          HexMesh m = structured_hex_grid(2, 1, 1);
          m.hexes[0][6] = m.hexes[0][5];
          return m;
        },
-       {}, {0}, {0}, {}, {}, {}, {}, true, true},
+       {},
+       {0},
+       {0},
+       {},
+       {},
+       {},
+       {},
+       true,
+       true},
       {"node out of range",
        [] {
          HexMesh m = structured_hex_grid(2, 1, 1);
          m.hexes[1][2] = 99;
          return m;
        },
-       {1}, {}, {}, {}, {}, {}, {}, true, true},
+       {1},
+       {},
+       {},
+       {},
+       {},
+       {},
+       {},
+       true,
+       true},
   };
   for (const auto& c : cases) {
     const HexMesh m = c.make();
@@ -401,8 +450,14 @@ TEST_CASE("covering: embedded meshes cover every node once, on the boundary too"
   // of diced tets; an interior node with 5 or 7 hexes comes with dicing.
   const std::vector<std::pair<const char*, std::function<HexMesh()>>> cases{
       {"3 x 3 x 3 grid", [] { return structured_hex_grid(3, 3, 3); }},
-      {"ring of 8 hexes", [] { return keep_hexes(structured_hex_grid(3, 3, 1), {0, 1, 2, 3, 5, 6, 7, 8}); }},
-      {"2 x 2 x 2 block without an octant", [] { return keep_hexes(structured_hex_grid(2, 2, 2), {0, 1, 2, 3, 4, 5, 6}); }},
+      {"ring of 8 hexes",
+       [] {
+         return keep_hexes(structured_hex_grid(3, 3, 1), {0, 1, 2, 3, 5, 6, 7, 8});
+       }},
+      {"2 x 2 x 2 block without an octant",
+       [] {
+         return keep_hexes(structured_hex_grid(2, 2, 2), {0, 1, 2, 3, 4, 5, 6});
+       }},
       {"jittered 4 x 4 x 4 grid", [] { return jittered_grid(4, 0.3); }},
       {"bent tube", bent_grid},
       {"Kuhn-diced 2 x 2 x 2 tets", kuhn_diced},
@@ -460,7 +515,8 @@ TEST_CASE("covering: hexes wrapping twice around nodes are found there, all corn
   REQUIRE(r.overlapping_nodes.size() == 3);
   CHECK(r.overlapping_nodes[1].angle == doctest::Approx(8 * kPi));
   CHECK(r.overlapping_nodes[1].expected == doctest::Approx(4 * kPi));
-  CHECK(r.summary().find("nodes the hexes cover more than once (corner solid angles): 3 (0: 4 pi, not 2 pi, 17: 8 pi, "
+  CHECK(r.summary().find("nodes the hexes cover more than once (corner solid angles): 3 (0: 4 pi, "
+                         "not 2 pi, 17: 8 pi, "
                          "not 4 pi, 34: 4 pi, not 2 pi)") != std::string::npos);
 }
 
@@ -468,7 +524,8 @@ TEST_CASE("covering: the same where the counting probe runs along the wrapped ed
   // Interior nodes are judged by counting the cones around the probe direction; turned so that
   // the hub line runs along it, the probe is on faces of every hub corner and the solid angles
   // decide, with the same answer.
-  const Eigen::Quaterniond turn = Eigen::Quaterniond::FromTwoVectors(Point::UnitZ(), coverage_probe());
+  const Eigen::Quaterniond turn =
+      Eigen::Quaterniond::FromTwoVectors(Point::UnitZ(), coverage_probe());
   for (int turns : {1, 2}) {
     CAPTURE(turns);
     HexMesh m = extrude(wrapped_star(turns), 2);
@@ -477,7 +534,8 @@ TEST_CASE("covering: the same where the counting probe runs along the wrapped ed
     INFO(r.summary());
     CHECK(r.ok() == (turns == 1));
     const Index per_layer = static_cast<Index>(m.points.size() / 3);
-    CHECK(nodes_of(r.overlapping_nodes) == (turns == 1 ? std::vector<Index>{} : std::vector<Index>{0, per_layer, 2 * per_layer}));
+    CHECK(nodes_of(r.overlapping_nodes) ==
+          (turns == 1 ? std::vector<Index>{} : std::vector<Index>{0, per_layer, 2 * per_layer}));
     if (turns == 2) {
       REQUIRE(r.overlapping_nodes.size() == 3);
       CHECK(r.overlapping_nodes[1].angle == doctest::Approx(8 * kPi));

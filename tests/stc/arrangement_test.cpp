@@ -9,9 +9,9 @@
 #include <geode/stc/arrangement.hpp>
 #include <geode/stc/dualize.hpp>
 #include <geode/stc/mesh_dual.hpp>
+#include <geode/templates/geode.hpp>
 #include "support/fixtures.hpp"
 #include "support/isomorphism.hpp"
-#include <geode/templates/geode.hpp>
 
 using namespace geode;
 using stc::Point;
@@ -26,9 +26,12 @@ stc::Sheet plane(int axis, double c, const std::string& name) {
 // y = 0.3, 0.6, z = 0.4, 0.8 in the unit box.
 std::vector<stc::Sheet> plane_family() {
   std::vector<stc::Sheet> s;
-  for (double c : {0.2, 0.5, 0.7}) s.push_back({"x", [c](const Point& x) { return x[0] - c + 0.05 * x[1]; }, "plane"});
-  for (double c : {0.3, 0.6}) s.push_back({"y", [c](const Point& x) { return x[1] - c - 0.04 * x[2]; }, "plane"});
-  for (double c : {0.4, 0.8}) s.push_back({"z", [c](const Point& x) { return x[2] - c + 0.03 * x[0]; }, "plane"});
+  for (double c : {0.2, 0.5, 0.7})
+    s.push_back({"x", [c](const Point& x) { return x[0] - c + 0.05 * x[1]; }, "plane"});
+  for (double c : {0.3, 0.6})
+    s.push_back({"y", [c](const Point& x) { return x[1] - c - 0.04 * x[2]; }, "plane"});
+  for (double c : {0.4, 0.8})
+    s.push_back({"z", [c](const Point& x) { return x[2] - c + 0.03 * x[0]; }, "plane"});
   return s;
 }
 
@@ -55,7 +58,8 @@ TEST_CASE("arrangement: planes dualize to the structured grid, and back") {
   // Every hex positively oriented by construction: its centre Jacobian is positive at the
   // first-guess positions of a planar arrangement.
   for (const auto& h : D.hex.hexes) {
-    const Point a = D.hex.points[h[1]] - D.hex.points[h[0]], b = D.hex.points[h[3]] - D.hex.points[h[0]],
+    const Point a = D.hex.points[h[1]] - D.hex.points[h[0]],
+                b = D.hex.points[h[3]] - D.hex.points[h[0]],
                 c = D.hex.points[h[4]] - D.hex.points[h[0]];
     CHECK(a.cross(b).dot(c) > 0);
   }
@@ -65,7 +69,8 @@ TEST_CASE("arrangement: lines in a rectangle dualize to the quad grid") {
   const stc::Domain rect{Point(0, 0, 0), Point(2, 1, 0), 2};
   std::vector<stc::Sheet> s;
   for (double c : {0.3, 0.9, 1.5, 1.8}) s.push_back(plane(0, c, "x"));
-  for (double c : {0.25, 0.5, 0.75}) s.push_back({"y", [c](const Point& x) { return x[1] - c - 0.05 * x[0]; }, "line"});
+  for (double c : {0.25, 0.5, 0.75})
+    s.push_back({"y", [c](const Point& x) { return x[1] - c - 0.05 * x[0]; }, "line"});
   const auto D = stc::dualize(stc::compute_arrangement(s, rect));
   CHECK(D.quad.quads.size() == 12);
   CHECK(test::find_isomorphism(D.quad, test::structured_quad_grid(4, 3)).has_value());
@@ -74,9 +79,12 @@ TEST_CASE("arrangement: lines in a rectangle dualize to the quad grid") {
 TEST_CASE("arrangement: the geode's mesh does not depend on sampling resolution or step") {
   // Reference: default options, through the template builder's own sheets.
   const auto ref = templates::build_geode3d({});
-  struct Case { int resolution; double step; };
-  for (const Case c : {Case{12, 0.004}, Case{16, 0.004}, Case{32, 0.004}, Case{48, 0.004}, Case{24, 0.002},
-                       Case{24, 0.008}}) {
+  struct Case {
+    int resolution;
+    double step;
+  };
+  for (const Case c : {Case{12, 0.004}, Case{16, 0.004}, Case{32, 0.004}, Case{48, 0.004},
+                       Case{24, 0.002}, Case{24, 0.008}}) {
     CAPTURE(c.resolution);
     CAPTURE(c.step);
     templates::GeodeOptions o;
@@ -85,7 +93,8 @@ TEST_CASE("arrangement: the geode's mesh does not depend on sampling resolution 
     const auto T = templates::build_geode3d(o);
     CHECK(T.hex.hexes == ref.hex.hexes);  // same numbering, not just isomorphic
     REQUIRE(T.hex.points.size() == ref.hex.points.size());
-    for (std::size_t i = 0; i < T.hex.points.size(); ++i) CHECK((T.hex.points[i] - ref.hex.points[i]).norm() < 1e-6);
+    for (std::size_t i = 0; i < T.hex.points.size(); ++i)
+      CHECK((T.hex.points[i] - ref.hex.points[i]).norm() < 1e-6);
   }
 }
 
@@ -95,23 +104,31 @@ TEST_CASE("arrangement: configurations out of general position are diagnosed") {
     auto s = plane_family();
     // A fourth plane through the vertex where x = 0.5, y = 0.6 and z = 0.4 meet: a combination
     // of their fields vanishes there.
-    s.push_back({"slanted", [f0 = s[1].field, f1 = s[4].field, f2 = s[5].field](const Point& x) {
+    s.push_back({"slanted",
+                 [f0 = s[1].field, f1 = s[4].field, f2 = s[5].field](const Point& x) {
                    return f0(x) + 0.5 * f1(x) + 0.7 * f2(x);
-                 }, "plane"});
+                 },
+                 "plane"});
     CHECK(diagnosis(s, box).find("pass through one point") != std::string::npos);
   }
   SUBCASE("three sheets meeting tangentially") {
     // f's gradient at (0.5, 0.4, 0.5) is (1, 0, 1): in the span of the two planes' normals.
-    std::vector<stc::Sheet> s{plane(0, 0.5, "x"), plane(2, 0.5, "z"), plane(1, 0.8, "y"),
-                              {"cubic", [](const Point& x) {
+    std::vector<stc::Sheet> s{plane(0, 0.5, "x"),
+                              plane(2, 0.5, "z"),
+                              plane(1, 0.8, "y"),
+                              {"cubic",
+                               [](const Point& x) {
                                  const double t = x[1] - 0.4;
                                  return (x[0] - 0.5) + (x[2] - 0.5) + t * t * t;
-                               }, "cubic"}};
+                               },
+                               "cubic"}};
     CHECK(diagnosis(s, box).find("tangen") != std::string::npos);
   }
   SUBCASE("a vertex on the boundary") {
-    std::vector<stc::Sheet> s{plane(0, 0.5, "x"), plane(1, 0.5, "y"),
-                              {"z", [](const Point& x) { return x[2] - 0.5 * (x[0] + x[1]) + 0.5; }, "plane"}};
+    std::vector<stc::Sheet> s{
+        plane(0, 0.5, "x"),
+        plane(1, 0.5, "y"),
+        {"z", [](const Point& x) { return x[2] - 0.5 * (x[0] + x[1]) + 0.5; }, "plane"}};
     // z = 0.5 (x + y) - 0.5 meets x = y = 0.5 at z = 0: on the bottom face.
     CHECK(diagnosis(s, box).find("meet on the domain boundary") != std::string::npos);
   }
@@ -120,8 +137,9 @@ TEST_CASE("arrangement: configurations out of general position are diagnosed") {
     CHECK(diagnosis(s, box).find("no vertex") != std::string::npos);
   }
   SUBCASE("bad domain") {
-    CHECK_THROWS_AS(stc::compute_arrangement(plane_family(), stc::Domain{Point(0, 0, 0), Point(1, 0, 1), 3}),
-                    InvalidInput);
+    CHECK_THROWS_AS(
+        stc::compute_arrangement(plane_family(), stc::Domain{Point(0, 0, 0), Point(1, 0, 1), 3}),
+        InvalidInput);
   }
 }
 
@@ -134,7 +152,9 @@ TEST_CASE("arrangement: sheets composed with the field algebra") {
   const stc::Field right = [](const Point& x) { return 0.7 - x[0]; };
   std::vector<stc::Sheet> sheets{
       {"x outer pair", stc::field_union(left, right), "union"},
-      {"x middle", stc::field_scaled(stc::field_offset([](const Point& x) { return x[0]; }, 0.5), -1.0), "offset"}};
+      {"x middle",
+       stc::field_scaled(stc::field_offset([](const Point& x) { return x[0]; }, 0.5), -1.0),
+       "offset"}};
   sheets.insert(sheets.end(), s.begin() + 3, s.end());  // the y and z planes
   const auto D = stc::dualize(stc::compute_arrangement(sheets, box));
   CHECK(D.hex.hexes.size() == 12);

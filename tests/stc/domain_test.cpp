@@ -12,9 +12,9 @@
 #include <geode/primal/validity.hpp>
 #include <geode/stc/arrangement.hpp>
 #include <geode/stc/dualize.hpp>
+#include <geode/templates/geode.hpp>
 #include "support/fixtures.hpp"
 #include "support/isomorphism.hpp"
-#include <geode/templates/geode.hpp>
 
 using namespace geode;
 using stc::Point;
@@ -27,7 +27,9 @@ Corners unit_cube(const Point& lo, const Point& hi) {
   Corners P;
   for (std::size_t c = 0; c < 8; ++c) {
     const auto& rc = primal::topology::kHexCornerCoords[c];
-    for (std::size_t a = 0; a < 3; ++a) P[c][static_cast<Eigen::Index>(a)] = rc[a] ? hi[static_cast<Eigen::Index>(a)] : lo[static_cast<Eigen::Index>(a)];
+    for (std::size_t a = 0; a < 3; ++a)
+      P[c][static_cast<Eigen::Index>(a)] =
+          rc[a] ? hi[static_cast<Eigen::Index>(a)] : lo[static_cast<Eigen::Index>(a)];
   }
   return P;
 }
@@ -107,14 +109,16 @@ std::vector<CellCase> hexahedra() {
   v.push_back({"sheared", sheared});
   // Tapered: a frustum, the top 0.4 times the bottom and off-centre.
   Corners tapered = unit_cube(Point(-1, -1, 0), Point(1, 1, 1));
-  for (std::size_t c = 4; c < 8; ++c) tapered[c] = Point(0.4 * tapered[c].x() + 0.3, 0.4 * tapered[c].y(), 1.2);
+  for (std::size_t c = 4; c < 8; ++c)
+    tapered[c] = Point(0.4 * tapered[c].x() + 0.3, 0.4 * tapered[c].y(), 1.2);
   v.push_back({"tapered", tapered});
   // Twisted: the top face turned 30 degrees, so the side faces are not planar.
   Corners twisted = unit_cube(Point(-1, -1, 0), Point(1, 1, 2));
   const double a = 0.5236;
   for (std::size_t c = 4; c < 8; ++c) {
     const Point p = twisted[c];
-    twisted[c] = Point(std::cos(a) * p.x() - std::sin(a) * p.y(), std::sin(a) * p.x() + std::cos(a) * p.y(), p.z());
+    twisted[c] = Point(std::cos(a) * p.x() - std::sin(a) * p.y(),
+                       std::sin(a) * p.x() + std::cos(a) * p.y(), p.z());
   }
   v.push_back({"twisted", twisted});
   return v;
@@ -127,48 +131,51 @@ TEST_CASE("domain: planes in a hexahedron dualize to the structured grid inside 
   // the single hex is the domain cell itself: its 8 regions each hold one corner.
   for (const CellCase& cc : hexahedra())
     for (int k : {1, 2}) {
-    CAPTURE(cc.name);
-    CAPTURE(k);
-    const stc::Domain d = stc::Domain::hexahedron(cc.corners);
-    const auto sheets = cell_planes(d, k);
-    const auto A = stc::compute_arrangement(sheets, d);
-    REQUIRE(A.vertices.size() == static_cast<std::size_t>(k * k * k));
-    if (k == 1) {
-      // At the cell's centre where the three planes meet: reported in physical space, with
-      // its local coordinates.
-      CHECK((A.vertices[0].x - stc::domain_point(d, Point(0.5, 0.5, 0.5))).norm() < 1e-9);
-      CHECK((A.vertices[0].local - Point(0.5, 0.5, 0.5)).norm() < 1e-9);
+      CAPTURE(cc.name);
+      CAPTURE(k);
+      const stc::Domain d = stc::Domain::hexahedron(cc.corners);
+      const auto sheets = cell_planes(d, k);
+      const auto A = stc::compute_arrangement(sheets, d);
+      REQUIRE(A.vertices.size() == static_cast<std::size_t>(k * k * k));
+      if (k == 1) {
+        // At the cell's centre where the three planes meet: reported in physical space, with
+        // its local coordinates.
+        CHECK((A.vertices[0].x - stc::domain_point(d, Point(0.5, 0.5, 0.5))).norm() < 1e-9);
+        CHECK((A.vertices[0].local - Point(0.5, 0.5, 0.5)).norm() < 1e-9);
+      }
+      for (const auto& v : A.vertices) CHECK((stc::domain_point(d, v.local) - v.x).norm() < 1e-12);
+      const auto D = stc::dualize(A);
+      CHECK(D.hex.hexes.size() == static_cast<std::size_t>(k * k * k));
+      CHECK(D.hex.points.size() == static_cast<std::size_t>((k + 1) * (k + 1) * (k + 1)));
+      CHECK(test::find_isomorphism(D.hex, test::structured_hex_grid(k, k, k)).has_value());
+      const auto report = primal::check_validity(D.hex);
+      CHECK_MESSAGE(report.ok(), report.summary());  // includes every corner Jacobian > 0
+      int corner_nodes = 0;
+      for (std::size_t n = 0; n < D.hex.points.size(); ++n) {
+        const Point r = local_of(d, D.hex.points[n]);
+        CAPTURE(n);
+        CHECK(r.minCoeff() > -1e-9);
+        CHECK(r.maxCoeff() < 1 + 1e-9);
+        // A node on three faces is on a corner of the hexahedron: the one the face bits name.
+        const unsigned f = D.node_faces[n];
+        if (__builtin_popcount(f) != 3) continue;
+        ++corner_nodes;
+        std::array<int, 3> rc{(f >> 1) & 1u ? 1 : 0, (f >> 3) & 1u ? 1 : 0, (f >> 5) & 1u ? 1 : 0};
+        for (std::size_t c = 0; c < 8; ++c)
+          if (primal::topology::kHexCornerCoords[c] == rc)
+            CHECK((D.hex.points[n] - cc.corners[c]).norm() < 1e-12);
+      }
+      CHECK(corner_nodes == 8);
+      // Curve polylines and 1-cell ends are physical too: on both of their planes.
+      for (const auto& c : A.curves)
+        for (const Point& p : c.polyline)
+          for (int s : c.sheets)
+            CHECK(std::abs(sheets[static_cast<std::size_t>(s)].field(p)) < 1e-8);
+      for (const auto& e : A.edges)
+        for (int s : e.sheets)
+          for (const Point& p : {e.a.x, e.b.x})
+            CHECK(std::abs(sheets[static_cast<std::size_t>(s)].field(p)) < 1e-8);
     }
-    for (const auto& v : A.vertices) CHECK((stc::domain_point(d, v.local) - v.x).norm() < 1e-12);
-    const auto D = stc::dualize(A);
-    CHECK(D.hex.hexes.size() == static_cast<std::size_t>(k * k * k));
-    CHECK(D.hex.points.size() == static_cast<std::size_t>((k + 1) * (k + 1) * (k + 1)));
-    CHECK(test::find_isomorphism(D.hex, test::structured_hex_grid(k, k, k)).has_value());
-    const auto report = primal::check_validity(D.hex);
-    CHECK_MESSAGE(report.ok(), report.summary());  // includes every corner Jacobian > 0
-    int corner_nodes = 0;
-    for (std::size_t n = 0; n < D.hex.points.size(); ++n) {
-      const Point r = local_of(d, D.hex.points[n]);
-      CAPTURE(n);
-      CHECK(r.minCoeff() > -1e-9);
-      CHECK(r.maxCoeff() < 1 + 1e-9);
-      // A node on three faces is on a corner of the hexahedron: the one the face bits name.
-      const unsigned f = D.node_faces[n];
-      if (__builtin_popcount(f) != 3) continue;
-      ++corner_nodes;
-      std::array<int, 3> rc{(f >> 1) & 1u ? 1 : 0, (f >> 3) & 1u ? 1 : 0, (f >> 5) & 1u ? 1 : 0};
-      for (std::size_t c = 0; c < 8; ++c)
-        if (primal::topology::kHexCornerCoords[c] == rc) CHECK((D.hex.points[n] - cc.corners[c]).norm() < 1e-12);
-    }
-    CHECK(corner_nodes == 8);
-    // Curve polylines and 1-cell ends are physical too: on both of their planes.
-    for (const auto& c : A.curves)
-      for (const Point& p : c.polyline)
-        for (int s : c.sheets) CHECK(std::abs(sheets[static_cast<std::size_t>(s)].field(p)) < 1e-8);
-    for (const auto& e : A.edges)
-      for (int s : e.sheets)
-        for (const Point& p : {e.a.x, e.b.x}) CHECK(std::abs(sheets[static_cast<std::size_t>(s)].field(p)) < 1e-8);
-  }
 }
 
 TEST_CASE("domain: lines in a quadrilateral dualize to the structured grid inside it") {
@@ -176,32 +183,34 @@ TEST_CASE("domain: lines in a quadrilateral dualize to the structured grid insid
     std::string name;
     std::array<Point, 4> corners;
   };
-  for (const Case& c : {Case{"sheared", {Point(0, 0, 0), Point(2, 0, 0), Point(2.8, 1, 0), Point(0.8, 1, 0)}},
-                        Case{"tapered", {Point(-1, 0, 0), Point(1, 0, 0), Point(0.6, 1.5, 0), Point(-0.2, 1.5, 0)}},
-                        Case{"kite", {Point(0, 0, 0), Point(3, 1, 0), Point(2, 2, 0), Point(0.5, 1.8, 0)}}}) {
+  for (const Case& c :
+       {Case{"sheared", {Point(0, 0, 0), Point(2, 0, 0), Point(2.8, 1, 0), Point(0.8, 1, 0)}},
+        Case{"tapered", {Point(-1, 0, 0), Point(1, 0, 0), Point(0.6, 1.5, 0), Point(-0.2, 1.5, 0)}},
+        Case{"kite", {Point(0, 0, 0), Point(3, 1, 0), Point(2, 2, 0), Point(0.5, 1.8, 0)}}}) {
     for (int k : {1, 2, 3}) {
-    CAPTURE(c.name);
-    CAPTURE(k);
-    const stc::Domain d = stc::Domain::quadrilateral(c.corners);
-    const auto D = stc::dualize(stc::compute_arrangement(cell_planes(d, k), d));
-    CHECK(D.quad.quads.size() == static_cast<std::size_t>(k * k));
-    CHECK(test::find_isomorphism(D.quad, test::structured_quad_grid(k, k)).has_value());
-    const auto report = primal::check_validity(D.quad);
-    CHECK_MESSAGE(report.ok(), report.summary());
-    int corner_nodes = 0;
-    for (std::size_t n = 0; n < D.quad.points.size(); ++n) {
-      const Point r = local_of(d, D.quad.points[n]);
-      CHECK(r.minCoeff() > -1e-9);
-      CHECK(r.maxCoeff() < 1 + 1e-9);
-      const unsigned f = D.node_faces[n];
-      if (__builtin_popcount(f) != 2) continue;
-      ++corner_nodes;
-      // Local (r, s) of the corner; quad corner k is hex corner k.
-      std::array<int, 3> rc{(f >> 1) & 1u ? 1 : 0, (f >> 3) & 1u ? 1 : 0, 0};
-      for (std::size_t k = 0; k < 4; ++k)
-        if (primal::topology::kHexCornerCoords[k] == rc) CHECK((D.quad.points[n] - c.corners[k]).norm() < 1e-12);
-    }
-    CHECK(corner_nodes == 4);
+      CAPTURE(c.name);
+      CAPTURE(k);
+      const stc::Domain d = stc::Domain::quadrilateral(c.corners);
+      const auto D = stc::dualize(stc::compute_arrangement(cell_planes(d, k), d));
+      CHECK(D.quad.quads.size() == static_cast<std::size_t>(k * k));
+      CHECK(test::find_isomorphism(D.quad, test::structured_quad_grid(k, k)).has_value());
+      const auto report = primal::check_validity(D.quad);
+      CHECK_MESSAGE(report.ok(), report.summary());
+      int corner_nodes = 0;
+      for (std::size_t n = 0; n < D.quad.points.size(); ++n) {
+        const Point r = local_of(d, D.quad.points[n]);
+        CHECK(r.minCoeff() > -1e-9);
+        CHECK(r.maxCoeff() < 1 + 1e-9);
+        const unsigned f = D.node_faces[n];
+        if (__builtin_popcount(f) != 2) continue;
+        ++corner_nodes;
+        // Local (r, s) of the corner; quad corner k is hex corner k.
+        std::array<int, 3> rc{(f >> 1) & 1u ? 1 : 0, (f >> 3) & 1u ? 1 : 0, 0};
+        for (std::size_t k = 0; k < 4; ++k)
+          if (primal::topology::kHexCornerCoords[k] == rc)
+            CHECK((D.quad.points[n] - c.corners[k]).norm() < 1e-12);
+      }
+      CHECK(corner_nodes == 4);
     }
   }
 }
@@ -214,7 +223,8 @@ TEST_CASE("domain: a hexahedron equal to a box gives the box's mesh") {
     const templates::GeodeArrangement G = templates::geode_arrangement({}, dim);
     const stc::Domain& box = G.domain;
     Corners P = unit_cube(box.lo, box.hi);
-    const stc::Domain cell = dim == 3 ? stc::Domain::hexahedron(P) : stc::Domain::quadrilateral({P[0], P[1], P[2], P[3]});
+    const stc::Domain cell = dim == 3 ? stc::Domain::hexahedron(P)
+                                      : stc::Domain::quadrilateral({P[0], P[1], P[2], P[3]});
     const auto a = stc::dualize(stc::compute_arrangement(G.sheets, box));
     const auto b = stc::dualize(stc::compute_arrangement(G.sheets, cell));
     const auto& pa = dim == 3 ? a.hex.points : a.quad.points;
@@ -242,8 +252,8 @@ TEST_CASE("domain: an inverted or flat hexahedron is refused, naming the corner"
   dented[6] = Point(0.3, 0.3, 0.3);
   Corners flat = cube;  // the top on the bottom
   for (std::size_t c = 4; c < 8; ++c) flat[c][2] = 0.0;
-  for (const Case& c : {Case{"mirrored", mirrored, "corner 0 "}, Case{"dented", dented, "corner 6 "},
-                        Case{"flat", flat, "corner 0 "}}) {
+  for (const Case& c : {Case{"mirrored", mirrored, "corner 0 "},
+                        Case{"dented", dented, "corner 6 "}, Case{"flat", flat, "corner 0 "}}) {
     CAPTURE(c.name);
     std::string msg;
     try {
@@ -256,10 +266,12 @@ TEST_CASE("domain: an inverted or flat hexahedron is refused, naming the corner"
     CHECK(msg.find("Jacobian is not positive") != std::string::npos);
   }
   // Clockwise quadrilateral.
-  CHECK_THROWS_WITH_AS(stc::Domain::quadrilateral({Point(0, 0, 0), Point(0, 1, 0), Point(1, 1, 0), Point(1, 0, 0)}),
-                       doctest::Contains("corner 0 "), InvalidInput);
+  CHECK_THROWS_WITH_AS(
+      stc::Domain::quadrilateral({Point(0, 0, 0), Point(0, 1, 0), Point(1, 1, 0), Point(1, 0, 0)}),
+      doctest::Contains("corner 0 "), InvalidInput);
   // Corners filled in by hand are checked by the engine as well.
   stc::Domain d;
   d.corners = mirrored;
-  CHECK_THROWS_AS(stc::compute_arrangement(cell_planes(stc::Domain::hexahedron(cube), 1), d), InvalidInput);
+  CHECK_THROWS_AS(stc::compute_arrangement(cell_planes(stc::Domain::hexahedron(cube), 1), d),
+                  InvalidInput);
 }

@@ -40,7 +40,8 @@ TEST_CASE("dualize: a region meeting the boundary in two pieces is refused") {
   const std::vector<stc::Sheet> s{
       {"tube", [](const Point& x) { return std::hypot(x[1] - 0.5, x[2] - 0.5) - 0.2; }, "tube"},
       {"y", [](const Point& x) { return x[1] - 0.5 - 0.01 * x[0]; }, "plane"},
-      sphere(Point(0.5, 0.5, 0.7), 0.1, "s1"), sphere(Point(0.5, 0.5, 0.3), 0.1, "s2")};
+      sphere(Point(0.5, 0.5, 0.7), 0.1, "s1"),
+      sphere(Point(0.5, 0.5, 0.3), 0.1, "s2")};
   const std::string d = diagnosis(s);
   CHECK(d.find("is not a half-ball meeting the boundary in one disk") != std::string::npos);
   CHECK(d.find("Euler characteristic") != std::string::npos);
@@ -60,12 +61,14 @@ TEST_CASE("dualize: a solid torus is not a ball") {
        },
        "torus"},
       {"z", [](const Point& x) { return x[2] - 0.5 - 0.01 * x[0]; }, "plane"},
-      sphere(Point(0.5 + R + r, 0.5, 0.505), 0.05, "outer"), sphere(Point(0.5 + R - r, 0.5, 0.505), 0.05, "inner")};
+      sphere(Point(0.5 + R + r, 0.5, 0.505), 0.05, "outer"),
+      sphere(Point(0.5 + R - r, 0.5, 0.505), 0.05, "inner")};
   // Regions are joined along 1-cells only, and no curve joins the outer and inner equators'
   // groups of vertices: each half of the solid torus comes out as two nodes that look like
   // balls. The global check sees what is left: the dual has Euler characteristic 0.
   const std::string d = diagnosis(s);
-  CHECK(d.find("the dual of the arrangement is not a ball (V - E + F - C = 0") != std::string::npos);
+  CHECK(d.find("the dual of the arrangement is not a ball (V - E + F - C = 0") !=
+        std::string::npos);
 }
 
 TEST_CASE("dualize: the same sheets cut into balls dualize") {

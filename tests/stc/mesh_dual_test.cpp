@@ -82,9 +82,9 @@ TEST_CASE("hex grids: nx + ny + nz planar sheets, every cross triple meets once"
     const auto dual = stc::mesh_dual(mesh);
     REQUIRE(dual.sheets.size() == static_cast<std::size_t>(nx + ny + nz));
     // Edges of an nx x ny x nz grid: nx(ny+1)(nz+1) + ... (one term per direction).
-    CHECK(dual.edges.size() == static_cast<std::size_t>(nx * (ny + 1) * (nz + 1) +
-                                                        (nx + 1) * ny * (nz + 1) +
-                                                        (nx + 1) * (ny + 1) * nz));
+    CHECK(dual.edges.size() ==
+          static_cast<std::size_t>(nx * (ny + 1) * (nz + 1) + (nx + 1) * ny * (nz + 1) +
+                                   (nx + 1) * (ny + 1) * nz));
     // Class k of hex (i,j,k) is the sheet of slab index[k] along axis k (class k = edges along
     // local axis k = grid axis k for structured_hex_grid): equal slab <=> equal sheet.
     const int idx_n[3] = {nx, ny, nz};
@@ -167,8 +167,8 @@ TEST_CASE("a chord crossing itself, and its extrusion: a self-intersecting sheet
   CHECK_FALSE(dual.sheets[1].self_intersecting);
   CHECK(dual.sheets[1].cells == std::vector<Index>{1});
   CHECK(dual.sheets[2].cells == std::vector<Index>{2});
-  CHECK(dual.intersections == std::map<std::array<Index, 2>, Index>{
-                                  {{0, 0}, 1}, {{0, 1}, 1}, {{0, 2}, 1}});
+  CHECK(dual.intersections ==
+        std::map<std::array<Index, 2>, Index>{{{0, 0}, 1}, {{0, 1}, 1}, {{0, 2}, 1}});
   check_trace_walk<2>(band, dual);
 
   // Extruded into hexes (quad nodes below, +6 above): the chords become sheets and the
@@ -182,8 +182,8 @@ TEST_CASE("a chord crossing itself, and its extrusion: a self-intersecting sheet
   CHECK(hd.sheets[0].self_intersecting);
   CHECK(hd.sheets[0].cells == std::vector<Index>{0, 0, 1, 2});
   CHECK(hd.sheets[1].cells == std::vector<Index>{0, 1, 2});
-  CHECK(hd.intersections == std::map<std::array<Index, 3>, Index>{
-                                {{0, 0, 1}, 1}, {{0, 1, 2}, 1}, {{0, 1, 3}, 1}});
+  CHECK(hd.intersections ==
+        std::map<std::array<Index, 3>, Index>{{{0, 0, 1}, 1}, {{0, 1, 2}, 1}, {{0, 1, 3}, 1}});
   // All 10 edges of A are horizontal, on the top or bottom: all on its trace.
   std::size_t trace_edges = 0;
   for (const auto& c : hd.sheets[0].trace) trace_edges += c.edges.size();
@@ -260,9 +260,9 @@ TEST_CASE("Appendix A geode: two tunnels and four domes") {
   // is the axis of those sides. Dome: trace on the top (tet side), none on the bottom; its
   // corner is the pair of sides it touches.
   struct Named {
-    std::string kind;     // "tunnel" or "dome"
-    int axis = -1;        // tunnel: 0 (x) or 2 (z)
-    int sx = 0, sz = 0;   // dome: corner signs
+    std::string kind;    // "tunnel" or "dome"
+    int axis = -1;       // tunnel: 0 (x) or 2 (z)
+    int sx = 0, sz = 0;  // dome: corner signs
     std::vector<std::vector<stc::TraceCurve>> pieces;
   };
   std::vector<Named> names;
@@ -474,9 +474,11 @@ TEST_CASE("bad input is reported with the element") {
   // A classifier answering outside the regions.
   const HexMesh cube = gt::structured_hex_grid(1, 1, 1);
   const auto d = stc::mesh_dual(cube);
-  CHECK_THROWS_AS(stc::trace_by_region(d, 0, [](const stc::CellFacet&) { return 7; }, 6),
+  CHECK_THROWS_AS(stc::trace_by_region(
+                      d, 0, [](const stc::CellFacet&) { return 7; }, 6),
                   geode::InvalidInput);
-  CHECK_THROWS_AS(stc::trace_by_region(d, 5, [](const stc::CellFacet&) { return 0; }, 6),
+  CHECK_THROWS_AS(stc::trace_by_region(
+                      d, 5, [](const stc::CellFacet&) { return 0; }, 6),
                   geode::InvalidInput);
 }
 

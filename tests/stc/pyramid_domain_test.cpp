@@ -19,7 +19,8 @@ namespace {
 // The equilateral pyramid: base [-1, 1]^2 at y = 0, counter-clockwise seen from the apex, every
 // edge 2 long.
 std::array<Point, 5> equilateral() {
-  return {Point(-1, 0, -1), Point(-1, 0, 1), Point(1, 0, 1), Point(1, 0, -1), Point(0, std::sqrt(2.0), 0)};
+  return {Point(-1, 0, -1), Point(-1, 0, 1), Point(1, 0, 1), Point(1, 0, -1),
+          Point(0, std::sqrt(2.0), 0)};
 }
 
 stc::Sheet plane(const Point& p, const Point& n, const std::string& name) {
@@ -38,7 +39,8 @@ TEST_CASE("pyramid domain: three planes give one hex, its apex node at the apex"
   CHECK(d.is_pyramid);
   const Point c(0.1, 0.45, 0.13);
   const auto A = stc::compute_arrangement(
-      {plane(c, Point::UnitX(), "x"), plane(c, Point::UnitY(), "y"), plane(c, Point::UnitZ(), "z")}, d);
+      {plane(c, Point::UnitX(), "x"), plane(c, Point::UnitY(), "y"), plane(c, Point::UnitZ(), "z")},
+      d);
   const auto D = stc::dualize(A);
   REQUIRE(D.hex.hexes.size() == 1);
   REQUIRE(D.hex.points.size() == 8);
@@ -48,7 +50,8 @@ TEST_CASE("pyramid domain: three planes give one hex, its apex node at the apex"
       ++at_apex;
       CHECK(((D.node_faces[n] >> stc::box_face(2, true)) & 1u) == 1u);
     }
-    for (int b = 0; b < 4; ++b) base_corners += (D.hex.points[n] - P[static_cast<std::size_t>(b)]).norm() < 1e-12;
+    for (int b = 0; b < 4; ++b)
+      base_corners += (D.hex.points[n] - P[static_cast<std::size_t>(b)]).norm() < 1e-12;
   }
   CHECK(at_apex == 1);
   CHECK(base_corners == 4);
@@ -61,9 +64,10 @@ TEST_CASE("pyramid domain: three planes give one hex, its apex node at the apex"
 TEST_CASE("pyramid domain: three planes and a sphere around their crossing give the pillowed hex") {
   const auto P = equilateral();
   const Point c(0.05, 0.5, -0.04);
-  const auto A = stc::compute_arrangement({plane(c, Point::UnitX(), "x"), plane(c, Point::UnitY(), "y"),
-                                           plane(c, Point::UnitZ(), "z"), sphere(c, 0.3, "s")},
-                                          stc::Domain::pyramid(P));
+  const auto A =
+      stc::compute_arrangement({plane(c, Point::UnitX(), "x"), plane(c, Point::UnitY(), "y"),
+                                plane(c, Point::UnitZ(), "z"), sphere(c, 0.3, "s")},
+                               stc::Domain::pyramid(P));
   const auto D = stc::dualize(A);
   CHECK(D.hex.hexes.size() == 7);
   CHECK(D.hex.points.size() == 16);
@@ -77,8 +81,8 @@ TEST_CASE("pyramid domain: a sheet through the apex and a clockwise base are ref
   const auto P = equilateral();
   const Point c(0.1, 0.45, 0.13);
   try {
-    stc::compute_arrangement({plane(P[4], Point(1, 0, 0.2), "through-apex"), plane(c, Point::UnitY(), "y"),
-                              plane(c, Point::UnitZ(), "z")},
+    stc::compute_arrangement({plane(P[4], Point(1, 0, 0.2), "through-apex"),
+                              plane(c, Point::UnitY(), "y"), plane(c, Point::UnitZ(), "z")},
                              stc::Domain::pyramid(P));
     FAIL("a sheet through the apex was accepted");
   } catch (const TopologyError& e) {

@@ -6,9 +6,9 @@
 #include <cmath>
 #include <string>
 
-#include <geode/primal/grid_model.hpp>
 #include <geode/primal/dice.hpp>
 #include <geode/primal/errors.hpp>
+#include <geode/primal/grid_model.hpp>
 #include <geode/primal/model.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/smooth.hpp>
@@ -71,8 +71,8 @@ TEST_CASE("round trip: structured hex grids, straight and with moved nodes") {
     int nx, ny, nz;
     double jiggle;
   };
-  for (const Case c : {Case{1, 1, 1, 0.0}, Case{3, 2, 2, 0.0}, Case{4, 3, 2, 0.0}, Case{3, 3, 3, 0.2},
-                       Case{4, 2, 3, 0.3}}) {
+  for (const Case c : {Case{1, 1, 1, 0.0}, Case{3, 2, 2, 0.0}, Case{4, 3, 2, 0.0},
+                       Case{3, 3, 3, 0.2}, Case{4, 2, 3, 0.3}}) {
     CAPTURE(c.nx);
     CAPTURE(c.ny);
     CAPTURE(c.nz);
@@ -98,7 +98,8 @@ TEST_CASE("round trip: structured hex grids, straight and with moved nodes") {
 }
 
 TEST_CASE("round trip: structured quad grids, straight and with moved nodes") {
-  for (const auto& [nx, ny, amount] : {std::tuple{1, 1, 0.0}, std::tuple{3, 2, 0.0}, std::tuple{5, 4, 0.25}}) {
+  for (const auto& [nx, ny, amount] :
+       {std::tuple{1, 1, 0.0}, std::tuple{3, 2, 0.0}, std::tuple{5, 4, 0.25}}) {
     CAPTURE(nx);
     CAPTURE(ny);
     QuadMesh g = gt::structured_quad_grid(nx, ny);
@@ -171,7 +172,8 @@ TEST_CASE("round trip: diced tet meshes (closed and hemispherical dome sheets) c
         primal::tet_part(primal::grid_model({n, n, n}, 1.0, [](int, int, int) { return true; }));
     const HexMesh g = primal::dice(tets).mesh;
     const auto dual = stc::mesh_dual(g);
-    CHECK(dual.sheets.size() == static_cast<std::size_t>((n + 1) * (n + 1) * (n + 1)));  // one per tet vertex
+    CHECK(dual.sheets.size() ==
+          static_cast<std::size_t>((n + 1) * (n + 1) * (n + 1)));  // one per tet vertex
     const auto D = round_trip(g);
     CHECK(D.hex.hexes.size() == g.hexes.size());
     const auto m = gt::find_isomorphism(D.hex, g);
@@ -184,19 +186,20 @@ TEST_CASE("round trip: meshes the fields cannot represent are refused with the r
   SUBCASE("a mesh that does not fill its bounding box") {
     HexMesh l = gt::structured_hex_grid(2, 2, 1);
     l.hexes.pop_back();  // an L: one boundary face inside the box
-    CHECK_THROWS_WITH_AS(stc::sheet_fields(l), doctest::Contains("lies on no face of the bounding box"),
-                         InvalidInput);
+    CHECK_THROWS_WITH_AS(stc::sheet_fields(l),
+                         doctest::Contains("lies on no face of the bounding box"), InvalidInput);
   }
   SUBCASE("an inverted hex") {
     HexMesh g = gt::structured_hex_grid(2, 1, 1);
     g.points[1] = Point(2.5, 0.0, 0.0);  // (1,0,0) pushed past (2,0,0): the second hex folds
-    CHECK_THROWS_WITH_AS(stc::sheet_fields(g), doctest::Contains("is inverted or flat at its corner"),
-                         InvalidInput);
+    CHECK_THROWS_WITH_AS(stc::sheet_fields(g),
+                         doctest::Contains("is inverted or flat at its corner"), InvalidInput);
   }
   SUBCASE("a chord that does not separate (an annulus: a 3 x 3 grid without its centre)") {
     QuadMesh ring = gt::structured_quad_grid(3, 3);
     ring.quads.erase(ring.quads.begin() + 4);  // quad (1, 1)
-    CHECK_THROWS_WITH_AS(stc::sheet_fields(ring), doctest::Contains("does not separate the mesh"), TopologyError);
+    CHECK_THROWS_WITH_AS(stc::sheet_fields(ring), doctest::Contains("does not separate the mesh"),
+                         TopologyError);
   }
   SUBCASE("a self-intersecting chord") {
     // The band of tests/stc/mesh_dual_test.cpp: chord 0 crosses itself in quad 0. Topology is
@@ -204,6 +207,7 @@ TEST_CASE("round trip: meshes the fields cannot represent are refused with the r
     QuadMesh band;
     band.points.assign(6, Point::Zero());
     band.quads = {{0, 1, 2, 3}, {2, 1, 4, 5}, {5, 4, 0, 1}};
-    CHECK_THROWS_WITH_AS(stc::sheet_fields(band), doctest::Contains("sheet 0 crosses itself"), TopologyError);
+    CHECK_THROWS_WITH_AS(stc::sheet_fields(band), doctest::Contains("sheet 0 crosses itself"),
+                         TopologyError);
   }
 }

@@ -9,8 +9,8 @@
 
 #include <geode/stc/mesh_dual.hpp>
 #include <geode/stc/sheet_surfaces.hpp>
-#include "support/fixtures.hpp"
 #include <geode/templates/geode.hpp>
+#include "support/fixtures.hpp"
 
 using namespace geode;
 using primal::Index;
@@ -22,7 +22,8 @@ double area(const primal::TriMesh& m) {
   double a = 0;
   for (const auto& t : m.tris)
     a += 0.5 * (m.points[static_cast<std::size_t>(t[1])] - m.points[static_cast<std::size_t>(t[0])])
-                   .cross(m.points[static_cast<std::size_t>(t[2])] - m.points[static_cast<std::size_t>(t[0])])
+                   .cross(m.points[static_cast<std::size_t>(t[2])] -
+                          m.points[static_cast<std::size_t>(t[0])])
                    .norm();
   return a;
 }
@@ -40,7 +41,8 @@ std::map<std::pair<Index, Index>, int> edge_uses(const primal::TriMesh& m) {
 
 }  // namespace
 
-TEST_CASE("contour_sheets: a sphere comes out closed, on the sphere, with its area, normals outwards") {
+TEST_CASE(
+    "contour_sheets: a sphere comes out closed, on the sphere, with its area, normals outwards") {
   const double r = 0.63;
   stc::Sheet s{"sphere", [r](const Point& x) { return x.norm() - r; }, "test"};
   const stc::Domain box(Point(-1, -1, -1), Point(1, 1, 1));
@@ -51,18 +53,23 @@ TEST_CASE("contour_sheets: a sphere comes out closed, on the sphere, with its ar
   CHECK(std::abs(area(m) - exact) / exact < 0.01);
   const auto uses = edge_uses(m);
   for (const auto& [e, n] : uses) CHECK(n == 2);  // watertight
-  CHECK(static_cast<long>(m.points.size()) - static_cast<long>(uses.size()) + static_cast<long>(m.tris.size()) == 2);
+  CHECK(static_cast<long>(m.points.size()) - static_cast<long>(uses.size()) +
+            static_cast<long>(m.tris.size()) ==
+        2);
   for (const auto& t : m.tris) {
-    const Point a = m.points[static_cast<std::size_t>(t[0])], b = m.points[static_cast<std::size_t>(t[1])],
+    const Point a = m.points[static_cast<std::size_t>(t[0])],
+                b = m.points[static_cast<std::size_t>(t[1])],
                 c = m.points[static_cast<std::size_t>(t[2])];
     CHECK((b - a).cross(c - a).dot(a + b + c) >= 0);  // towards the positive (outer) side
   }
 }
 
-TEST_CASE("contour_sheets: a slanted plane through a hexahedral domain is cut by the domain's faces") {
+TEST_CASE(
+    "contour_sheets: a slanted plane through a hexahedral domain is cut by the domain's faces") {
   // A sheared hexahedron; the plane x + 0.2 y = 0.5 meets it in a planar polygon.
-  const auto dom = stc::Domain::hexahedron({Point(0, 0, 0), Point(1, 0, 0), Point(1.2, 1, 0), Point(0.2, 1, 0),
-                                            Point(0, 0, 1), Point(1, 0, 1), Point(1.2, 1, 1), Point(0.2, 1, 1)});
+  const auto dom =
+      stc::Domain::hexahedron({Point(0, 0, 0), Point(1, 0, 0), Point(1.2, 1, 0), Point(0.2, 1, 0),
+                               Point(0, 0, 1), Point(1, 0, 1), Point(1.2, 1, 1), Point(0.2, 1, 1)});
   stc::Sheet s{"plane", [](const Point& x) { return x.x() + 0.2 * x.y() - 0.5; }, "test"};
   const auto m = stc::contour_sheets({s}, dom, {.resolution = 12})[0];
   REQUIRE(!m.tris.empty());
@@ -76,7 +83,8 @@ TEST_CASE("contour_sheets: a slanted plane through a hexahedral domain is cut by
 }
 
 TEST_CASE("contour_curves: a circle in a rectangle is one closed loop on the circle") {
-  stc::Sheet s{"circle", [](const Point& x) { return (x - Point(0.5, 0.4, 0)).norm() - 0.3; }, "test"};
+  stc::Sheet s{"circle", [](const Point& x) { return (x - Point(0.5, 0.4, 0)).norm() - 0.3; },
+               "test"};
   const stc::Domain rect(Point(0, 0, 0), Point(1, 0.8, 0), 2);
   const auto c = stc::contour_curves({s}, rect)[0];
   REQUIRE(!c.segments.empty());
@@ -84,7 +92,8 @@ TEST_CASE("contour_curves: a circle in a rectangle is one closed loop on the cir
   double length = 0;
   for (const auto& e : c.segments) {
     ++degree[e[0]], ++degree[e[1]];
-    length += (c.points[static_cast<std::size_t>(e[1])] - c.points[static_cast<std::size_t>(e[0])]).norm();
+    length += (c.points[static_cast<std::size_t>(e[1])] - c.points[static_cast<std::size_t>(e[0])])
+                  .norm();
   }
   for (const auto& [v, d] : degree) CHECK(d == 2);
   for (const auto& p : c.points) CHECK(std::abs((p - Point(0.5, 0.4, 0)).norm() - 0.3) < 1e-9);
@@ -131,7 +140,8 @@ TEST_CASE("dual_surfaces and dual_curves of the derived geodes: every cell in th
   CHECK(layers.size() == T.sheets.size());
   CHECK(total == 3 * T.hex.hexes.size());  // no sheet of the geode crosses itself
   const auto surfaces = stc::dual_surfaces(T.hex, dual);
-  for (std::size_t s = 0; s < surfaces.size(); ++s) CHECK(surfaces[s].tris.size() == 2 * layers[s].size());
+  for (std::size_t s = 0; s < surfaces.size(); ++s)
+    CHECK(surfaces[s].tris.size() == 2 * layers[s].size());
 
   const auto T2 = templates::build_geode2d(o);
   const auto dual2 = stc::mesh_dual(T2.quad);

@@ -52,8 +52,8 @@ const stc::Domain kSquare(Point(0, 0, 0), Point(1, 1, 0), 2);
 // octants: the dual is a cube inside a cube (7 hexes; in 2D 5 quads). The sheets under test
 // are added to it.
 // `flip` mirrors the offsets, so that two crosses side by side have their planes apart.
-std::vector<stc::Sheet> ball_in_cross(const Point& c, double r, int dim, const std::string& tag = "",
-                                      double flip = 1.0) {
+std::vector<stc::Sheet> ball_in_cross(const Point& c, double r, int dim,
+                                      const std::string& tag = "", double flip = 1.0) {
   std::vector<stc::Sheet> s{plane(c + flip * Point(-0.02, 0, 0), Point(1, 0.02, 0.01), "x" + tag),
                             plane(c + flip * Point(0, -0.03, 0), Point(-0.01, 1, 0.02), "y" + tag)};
   if (dim == 3) s.push_back(plane(c + flip * Point(0, 0, 0.03), Point(0.02, -0.01, 1), "z" + tag));
@@ -73,16 +73,16 @@ struct Case {
   std::string name;
   int dim;
   std::vector<stc::Sheet> sheets;
-  const char* expect;  // in the diagnosis; "" for a valid mesh
+  const char* expect;        // in the diagnosis; "" for a valid mesh
   std::size_t elements = 0;  // of the valid mesh
-  bool in_cell = false;       // in kCell instead of the unit box
+  bool in_cell = false;      // in kCell instead of the unit box
 };
 
 // A skewed, tapered hexahedron around the unit box whose top face is the box's (z = 1): the
 // engine works on the composed fields, where a touching must still be found.
-const stc::Domain kCell = stc::Domain::hexahedron({Point(-0.2, -0.1, 0), Point(1.1, -0.2, 0), Point(1.2, 1.1, 0),
-                                                   Point(-0.1, 1.0, 0), Point(0, 0, 1), Point(1, 0, 1), Point(1, 1, 1),
-                                                   Point(0, 1, 1)});
+const stc::Domain kCell = stc::Domain::hexahedron(
+    {Point(-0.2, -0.1, 0), Point(1.1, -0.2, 0), Point(1.2, 1.1, 0), Point(-0.1, 1.0, 0),
+     Point(0, 0, 1), Point(1, 0, 1), Point(1, 1, 1), Point(0, 1, 1)});
 
 std::vector<stc::Sheet> with(std::vector<stc::Sheet> a, const std::vector<stc::Sheet>& b) {
   a.insert(a.end(), b.begin(), b.end());
@@ -104,26 +104,29 @@ TEST_CASE("tangency: sheets that touch away from any vertex are diagnosed, near 
   // balls with crosses 0.06 apart: 8 vertices of three planes, one of each direction; each
   // ball is crossed twice by the 8 lines where two of its neighbouring planes meet (16 + 16).
   const Point left(0.45, 0.5, 0.5), far(0.85, 0.5, 0.5);  // balls of radius 0.3 and 0.1
-  const Point c2(0.5, 0.5, 0.0);  // 2D fields are evaluated at z = 0
+  const Point c2(0.5, 0.5, 0.0);                          // 2D fields are evaluated at z = 0
   const std::vector<Case> cases{
-      {"sphere touching plane", 3, with(ball_in_cross(c, 0.3, 3), {plane(Point(0.8, 0, 0), Point(1, 0, 0), "p")}),
-       "touch"},
-      {"sphere 1e-2 short of plane", 3, with(ball_in_cross(c, 0.3, 3), {plane(Point(0.81, 0, 0), Point(1, 0, 0), "p")}),
-       "", 8},
+      {"sphere touching plane", 3,
+       with(ball_in_cross(c, 0.3, 3), {plane(Point(0.8, 0, 0), Point(1, 0, 0), "p")}), "touch"},
+      {"sphere 1e-2 short of plane", 3,
+       with(ball_in_cross(c, 0.3, 3), {plane(Point(0.81, 0, 0), Point(1, 0, 0), "p")}), "", 8},
       {"sphere cutting plane in a circle", 3,
        with(ball_in_cross(c, 0.3, 3), {plane(Point(0.7, 0, 0), Point(1, 0, 0), "p")}), "", 12},
-      {"two spheres touching", 3, with(ball_in_cross(left, 0.3, 3), ball_in_cross(far, 0.1, 3, "'", -1.0)), "touch"},
-      {"two spheres 1e-2 apart", 3, with(ball_in_cross(left, 0.3, 3), ball_in_cross(Point(0.86, 0.5, 0.5), 0.1, 3, "'", -1.0)),
+      {"two spheres touching", 3,
+       with(ball_in_cross(left, 0.3, 3), ball_in_cross(far, 0.1, 3, "'", -1.0)), "touch"},
+      {"two spheres 1e-2 apart", 3,
+       with(ball_in_cross(left, 0.3, 3), ball_in_cross(Point(0.86, 0.5, 0.5), 0.1, 3, "'", -1.0)),
        "", 40},
-      {"circle touching line", 2, with(ball_in_cross(c2, 0.3, 2), {plane(Point(0.8, 0, 0), Point(1, 0, 0), "p")}),
-       "touch"},
+      {"circle touching line", 2,
+       with(ball_in_cross(c2, 0.3, 2), {plane(Point(0.8, 0, 0), Point(1, 0, 0), "p")}), "touch"},
       {"circle 1e-2 short of line", 2,
        with(ball_in_cross(c2, 0.3, 2), {plane(Point(0.81, 0, 0), Point(1, 0, 0), "p")}), "", 6},
-      {"circle cutting line", 2, with(ball_in_cross(c2, 0.3, 2), {plane(Point(0.7, 0, 0), Point(1, 0, 0), "p")}), "",
-       8},
+      {"circle cutting line", 2,
+       with(ball_in_cross(c2, 0.3, 2), {plane(Point(0.7, 0, 0), Point(1, 0, 0), "p")}), "", 8},
       // The circle where the plane y = 0.47 (untilted here) meets the ball has radius
       // rho = sqrt(0.3^2 - 0.03^2): the plane x = 0.5 + rho touches it, and crosses the ball.
-      {"curve touching a third sheet", 3, with(curve_cross(c), {plane(Point(0.5 + kRho, 0, 0), Point(1, 0, 0), "p")}),
+      {"curve touching a third sheet", 3,
+       with(curve_cross(c), {plane(Point(0.5 + kRho, 0, 0), Point(1, 0, 0), "p")}),
        "touches sheet"},
       {"curve 1e-2 short of a third sheet", 3,
        with(curve_cross(c), {plane(Point(0.51 + kRho, 0, 0), Point(1, 0, 0), "p")}), "", 8},
@@ -132,13 +135,16 @@ TEST_CASE("tangency: sheets that touch away from any vertex are diagnosed, near 
       {"sphere touching a box face", 3, ball_in_cross(Point(0.5, 0.5, 0.7), 0.3, 3), "touch"},
       {"sphere 1e-2 short of a box face", 3, ball_in_cross(Point(0.5, 0.5, 0.69), 0.3, 3), "", 7},
       {"in a hexahedron: sphere touching plane", 3,
-       with(ball_in_cross(c, 0.3, 3), {plane(Point(0.8, 0, 0), Point(1, 0, 0), "p")}), "touch", 0, true},
-      {"in a hexahedron: sphere 1e-2 short of plane", 3,
-       with(ball_in_cross(c, 0.3, 3), {plane(Point(0.81, 0, 0), Point(1, 0, 0), "p")}), "", 8, true},
-      {"in a hexahedron: sphere touching its top face", 3, ball_in_cross(Point(0.5, 0.5, 0.7), 0.3, 3),
-       "touches the domain boundary (face 5)", 0, true},
-      {"in a hexahedron: sphere 1e-2 short of its top face", 3, ball_in_cross(Point(0.5, 0.5, 0.69), 0.3, 3), "", 7,
+       with(ball_in_cross(c, 0.3, 3), {plane(Point(0.8, 0, 0), Point(1, 0, 0), "p")}), "touch", 0,
        true},
+      {"in a hexahedron: sphere 1e-2 short of plane", 3,
+       with(ball_in_cross(c, 0.3, 3), {plane(Point(0.81, 0, 0), Point(1, 0, 0), "p")}), "", 8,
+       true},
+      {"in a hexahedron: sphere touching its top face", 3,
+       ball_in_cross(Point(0.5, 0.5, 0.7), 0.3, 3), "touches the domain boundary (face 5)", 0,
+       true},
+      {"in a hexahedron: sphere 1e-2 short of its top face", 3,
+       ball_in_cross(Point(0.5, 0.5, 0.69), 0.3, 3), "", 7, true},
       {"circle touching a square side", 2, ball_in_cross(Point(0.5, 0.7, 0), 0.3, 2), "touch"},
       {"circle 1e-2 short of a square side", 2, ball_in_cross(Point(0.5, 0.69, 0), 0.3, 2), "", 5},
   };
@@ -149,8 +155,11 @@ TEST_CASE("tangency: sheets that touch away from any vertex are diagnosed, near 
       CAPTURE(resolution);
       CAPTURE(k.name);
       std::size_t elements = 0;
-      const std::string msg =
-          diagnosis(k.sheets, k.in_cell ? kCell : k.dim == 3 ? kBox : kSquare, elements, resolution);
+      const std::string msg = diagnosis(k.sheets,
+                                        k.in_cell    ? kCell
+                                        : k.dim == 3 ? kBox
+                                                     : kSquare,
+                                        elements, resolution);
       CAPTURE(msg);
       if (*k.expect) {
         CHECK(msg.find(k.expect) != std::string::npos);

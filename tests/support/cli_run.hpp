@@ -1,7 +1,7 @@
 #pragma once
 // Running the built `geode` command from a test (GEODE_CLI_PATH, set by CMake for the test
-// programs); scratch files come from support/temp_dir.hpp. Header-only: the path is known where the tests are
-// compiled, not in the fixtures library.
+// programs); scratch files come from support/temp_dir.hpp. Header-only: the path is known where the
+// tests are compiled, not in the fixtures library.
 #include <doctest/doctest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -22,7 +22,8 @@ struct CliRun {
 // when `with_stderr` (dropped otherwise).
 inline CliRun geode_cli(const std::string& args, bool with_stderr = false) {
   CliRun r;
-  const std::string cmd = std::string(GEODE_CLI_PATH) + " " + args + (with_stderr ? " 2>&1" : " 2>/dev/null");
+  const std::string cmd =
+      std::string(GEODE_CLI_PATH) + " " + args + (with_stderr ? " 2>&1" : " 2>/dev/null");
   FILE* p = ::popen(cmd.c_str(), "r");
   REQUIRE(p != nullptr);
   char buf[4096];

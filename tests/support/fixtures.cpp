@@ -36,8 +36,8 @@ std::vector<double> parse_row(const std::string& text, const std::string& file, 
     out.push_back(value);
   }
   if (out.size() != fields) {
-    fail(file, line, "expected " + std::to_string(fields) + " fields, got " +
-                         std::to_string(out.size()));
+    fail(file, line,
+         "expected " + std::to_string(fields) + " fields, got " + std::to_string(out.size()));
   }
   return out;
 }
@@ -55,8 +55,9 @@ std::vector<std::vector<double>> read_rows(const std::string& file, std::size_t 
     rows.push_back(parse_row(text, file, line, fields));
     // Rows are numbered 1..N in order; the number is the first field.
     if (rows.back()[0] != static_cast<double>(rows.size())) {
-      fail(file, line, "row number " + std::to_string(rows.back()[0]) + ", expected " +
-                           std::to_string(rows.size()));
+      fail(file, line,
+           "row number " + std::to_string(rows.back()[0]) + ", expected " +
+               std::to_string(rows.size()));
     }
   }
   return rows;
@@ -130,7 +131,8 @@ primal::QuadMesh boundary_quads(const primal::HexMesh& mesh,
   std::vector<primal::Index> renumber(mesh.points.size(), primal::kInvalidIndex);
   for (const primal::BoundaryQuad& b : primal::boundary_quads(mesh)) {
     const auto& f = b.nodes;
-    if (!std::all_of(f.begin(), f.end(), [&](primal::Index n) { return keep(mesh.points[n]); })) continue;
+    if (!std::all_of(f.begin(), f.end(), [&](primal::Index n) { return keep(mesh.points[n]); }))
+      continue;
     std::array<primal::Index, 4> q{};
     for (int c = 0; c < 4; ++c) {
       if (renumber[f[c]] == primal::kInvalidIndex) {
@@ -157,8 +159,10 @@ primal::Model four_tet_fan(const primal::Point& centre, const primal::Point& ape
 }
 
 primal::Model tet_cell_on_hex_top() {
-  primal::Model m = primal::grid_model({2, 2, 2}, 1.0, [](int i, int j, int k) { return i == 0 && j == 0 && k == 1; });
-  std::erase_if(m.hexes, [&](const auto& h) { return m.points[static_cast<std::size_t>(h[0])].z() > 0.5; });
+  primal::Model m = primal::grid_model(
+      {2, 2, 2}, 1.0, [](int i, int j, int k) { return i == 0 && j == 0 && k == 1; });
+  std::erase_if(m.hexes,
+                [&](const auto& h) { return m.points[static_cast<std::size_t>(h[0])].z() > 0.5; });
   m.hex_block.assign(m.hexes.size(), 1);
   return m;
 }

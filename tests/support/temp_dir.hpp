@@ -14,7 +14,8 @@ namespace geode::test {
 
 // A file name in the temporary directory, unique to this process.
 inline std::filesystem::path temp_path(const std::string& name) {
-  return std::filesystem::temp_directory_path() / ("geode-test-" + std::to_string(::getpid()) + "-" + name);
+  return std::filesystem::temp_directory_path() /
+         ("geode-test-" + std::to_string(::getpid()) + "-" + name);
 }
 
 // A fresh directory, removed with everything in it at the end of the test.
@@ -30,8 +31,8 @@ struct TempDir {
     std::filesystem::remove_all(path, ec);
   }
   std::size_t entries() const {
-    return static_cast<std::size_t>(
-        std::distance(std::filesystem::directory_iterator(path), std::filesystem::directory_iterator()));
+    return static_cast<std::size_t>(std::distance(std::filesystem::directory_iterator(path),
+                                                  std::filesystem::directory_iterator()));
   }
   TempDir(const TempDir&) = delete;
   TempDir& operator=(const TempDir&) = delete;

@@ -6,15 +6,15 @@
 
 #include <algorithm>
 #include <cmath>
-#include <set>
 #include <map>
+#include <set>
 
 #include <geode/primal/boundary.hpp>
 #include <geode/primal/realizability.hpp>
 #include <geode/primal/validity.hpp>
+#include <geode/templates/fixup.hpp>
 #include "support/fixtures.hpp"
 #include "support/isomorphism.hpp"
-#include <geode/templates/fixup.hpp>
 
 using namespace geode;
 using templates::GeodeOptions;
@@ -63,14 +63,16 @@ TEST_CASE("fix_up: the four-triangle dual's pinched corners are pillowed away, t
   CHECK(T.node_signs.size() == T.hex.points.size());
   CHECK(T.element_sheets.size() == T.hex.hexes.size());
   CHECK(T.sheets.size() == plain.sheets.size() + r.steps.size());  // a sheet per pillowing
-  for (const auto& s : T.element_sheets) CHECK(s.size() == 3);      // every hex is a sheet triple
+  for (const auto& s : T.element_sheets) CHECK(s.size() == 3);     // every hex is a sheet triple
   // Each node's signs: its side of every sheet, the new ones included.
   for (const auto& sg : T.node_signs) CHECK(sg.size() == T.sheets.size());
   // and every sheet of a hex passes through it: its corners lie on both sides.
   for (std::size_t h = 0; h < T.hex.hexes.size(); ++h)
     for (int sheet : T.element_sheets[h]) {
       int plus = 0, minus = 0;
-      for (auto n : T.hex.hexes[h]) (T.node_signs[static_cast<std::size_t>(n)][static_cast<std::size_t>(sheet)] > 0 ? plus : minus)++;
+      for (auto n : T.hex.hexes[h])
+        (T.node_signs[static_cast<std::size_t>(n)][static_cast<std::size_t>(sheet)] > 0 ? plus
+                                                                                        : minus)++;
       CAPTURE(h);
       CHECK((plus == 4 && minus == 4));
     }
@@ -87,22 +89,27 @@ TEST_CASE("fix_up: the fixed-up four-triangle template smooths to min scaled Jac
   auto T = templates::build_geode3d(four_triangles());
   templates::fix_up(T);
   const auto boundary_before = boundary_geometry(T.hex);
-  const auto s = templates::smooth_template(T, false);  // tet and hex faces fixed where dicing puts them
+  const auto s =
+      templates::smooth_template(T, false);  // tet and hex faces fixed where dicing puts them
   CHECK(s.untangled);
-  MESSAGE("geode4tri fixed up: " << T.hex.hexes.size() << " hexes, min scaled Jacobian " << s.final_min_scaled_jacobian);
+  MESSAGE("geode4tri fixed up: " << T.hex.hexes.size() << " hexes, min scaled Jacobian "
+                                 << s.final_min_scaled_jacobian);
   CHECK(s.final_min_scaled_jacobian >= 0.2);
   CHECK(primal::check_validity(T.hex).ok());
   // Tet and hex faces stay; the sides are the 2D geode (nodes slide in them).
   const auto on_face = [](int axis, double value) {
     return [=](const primal::Point& p) { return std::abs(p[axis] - value) < 1e-9; };
   };
-  const auto top = test::boundary_quads(T.hex, on_face(1, 7.0)), bottom = test::boundary_quads(T.hex, on_face(1, -7.0));
+  const auto top = test::boundary_quads(T.hex, on_face(1, 7.0)),
+             bottom = test::boundary_quads(T.hex, on_face(1, -7.0));
   CHECK(top.quads.size() == 12);
   CHECK(bottom.quads.size() == 4);
   const auto top_and_bottom = [](const auto& quads) {
     std::multiset<std::vector<std::array<long, 3>>> s;
     for (const auto& q : quads)
-      if (std::all_of(q.begin(), q.end(), [&](const auto& p) { return p[1] == q.front()[1] && std::abs(p[1]) == 7000000; }))
+      if (std::all_of(q.begin(), q.end(), [&](const auto& p) {
+            return p[1] == q.front()[1] && std::abs(p[1]) == 7000000;
+          }))
         s.insert(q);
     return s;
   };
@@ -110,7 +117,9 @@ TEST_CASE("fix_up: the fixed-up four-triangle template smooths to min scaled Jac
   CHECK(top_and_bottom(boundary_before).size() == 16);
   const auto T2 = templates::build_geode2d(GeodeOptions{});
   for (int axis : {0, 2})
-    for (double side : {-12.0, 12.0}) CHECK(test::find_isomorphism(test::boundary_quads(T.hex, on_face(axis, side)), T2.quad).has_value());
+    for (double side : {-12.0, 12.0})
+      CHECK(test::find_isomorphism(test::boundary_quads(T.hex, on_face(axis, side)), T2.quad)
+                .has_value());
 }
 
 TEST_CASE("fix_up: the geode has nothing to fix") {
@@ -122,7 +131,8 @@ TEST_CASE("fix_up: the geode has nothing to fix") {
   CHECK(T.hex.hexes == hexes);
 }
 
-TEST_CASE("fix_up: a centre dome of its own depth and radius needs one pillowing and smooths to >= 0.3") {
+TEST_CASE(
+    "fix_up: a centre dome of its own depth and radius needs one pillowing and smooths to >= 0.3") {
   auto o = four_triangles();
   o.push.dome_depth = 0.95;
   o.push.dome_radius = 0.8;
@@ -134,7 +144,8 @@ TEST_CASE("fix_up: a centre dome of its own depth and radius needs one pillowing
   CHECK(r.obstructions_after == 0);
   const auto s = templates::smooth_template(T, false);
   CHECK(s.untangled);
-  MESSAGE("geode4tri, own centre dome: " << T.hex.hexes.size() << " hexes, min scaled Jacobian " << s.final_min_scaled_jacobian);
+  MESSAGE("geode4tri, own centre dome: " << T.hex.hexes.size() << " hexes, min scaled Jacobian "
+                                         << s.final_min_scaled_jacobian);
   CHECK(s.final_min_scaled_jacobian >= 0.3);
   CHECK(primal::check_validity(T.hex).ok());
 }

@@ -116,7 +116,8 @@ TEST_CASE("geode4tri: the triple-dome points sit where the ratio says, outside t
         std::vector<double> ratio;
         for (int s : v.sheets) {
           const auto& d = domes[static_cast<std::size_t>(s) - first_dome];
-          ratio.push_back(planar(v.x, G.tet_side.points[static_cast<std::size_t>(d.vertex)]) / d.radius);
+          ratio.push_back(planar(v.x, G.tet_side.points[static_cast<std::size_t>(d.vertex)]) /
+                          d.radius);
         }
         CHECK(ratio[1] == doctest::Approx(ratio[0]).epsilon(1e-6));
         CHECK(ratio[2] == doctest::Approx(ratio[0]).epsilon(1e-6));
@@ -137,12 +138,14 @@ namespace {
 
 // The p-norm in the interface plane, as the superquadric dome's trace measures it.
 double planar_p(const Point& p, const Point& q, double e) {
-  return std::pow(std::pow(std::abs(p.x() - q.x()), e) + std::pow(std::abs(p.z() - q.z()), e), 1.0 / e);
+  return std::pow(std::pow(std::abs(p.x() - q.x()), e) + std::pow(std::abs(p.z() - q.z()), e),
+                  1.0 / e);
 }
 
 // R of the dome around vertex v centred at c in the p-norm: the blend between the farthest
 // diced node it must enclose and the nearest it must leave out.
-double radius_p(const templates::InterfacePatch& patch, int v, const Point& c, double e, double blend) {
+double radius_p(const templates::InterfacePatch& patch, int v, const Point& c, double e,
+                double blend) {
   const auto diced = templates::dice_patch(patch);
   double inside = 0.0, outside = 1e300;
   for (std::size_t n = 0; n < diced.nodes.size(); ++n) {
@@ -159,7 +162,8 @@ double radius_p(const templates::InterfacePatch& patch, int v, const Point& c, d
 
 }  // namespace
 
-TEST_CASE("geode4tri: spheroid domes on their vertices (p = 2, offset 0) are today's, bit for bit") {
+TEST_CASE(
+    "geode4tri: spheroid domes on their vertices (p = 2, offset 0) are today's, bit for bit") {
   GeodeOptions plain, given;
   plain.split = given.split = templates::TopSplit::FourTriangles;
   given.push.dome_exponent = given.push.centre_exponent = 2.0;
@@ -183,9 +187,11 @@ TEST_CASE("geode4tri: spheroid domes on their vertices (p = 2, offset 0) are tod
       else
         outside = std::min(outside, d);
     }
-    const double R = inside + given.push.dome_radius * (outside - inside), depth = given.push.dome_depth;
+    const double R = inside + given.push.dome_radius * (outside - inside),
+                 depth = given.push.dome_depth;
     const auto& field = G.sheets[static_cast<std::size_t>(2 + v)].field;
-    for (const Point& x : {Point(0.3, 0.7, -0.2), Point(-0.9, 0.95, 0.8), Point(0.01, 0.2, 0.6), Point(1, 1, -1)}) {
+    for (const Point& x :
+         {Point(0.3, 0.7, -0.2), Point(-0.9, 0.95, 0.8), Point(0.01, 0.2, 0.6), Point(1, 1, -1)}) {
       const double dx = x.x() - V.x(), dz = x.z() - V.z();
       const double r = std::sqrt(dx * dx + dz * dz) / R, y = (1.0 - x.y()) / depth;
       CHECK(field(x) == r * r + y * y - 1.0);
@@ -201,7 +207,8 @@ TEST_CASE("geode4tri: spheroid domes on their vertices (p = 2, offset 0) are tod
         "36h|dome+dome+dome:4,dome+dome+tunnel:20,dome+tunnel+tunnel:12|78280234cfcacad4");
 }
 
-TEST_CASE("geode4tri: superquadric and off-vertex domes move the triple points where the p-norm says") {
+TEST_CASE(
+    "geode4tri: superquadric and off-vertex domes move the triple points where the p-norm says") {
   // With one depth and one exponent p for all domes the depth term still cancels where three
   // meet: |x - c_a|_p / R_a is equal for the three. On the perpendicular from the centre to the
   // side w = 1 (corners (+-1, 1) moved by the offset f toward the centre), the point (0, t)
@@ -210,7 +217,8 @@ TEST_CASE("geode4tri: superquadric and off-vertex domes move the triple points w
     double p, f, blend;
   };
   int computed = 0;
-  for (const Case c : {Case{3.0, 0.0, 0.6}, Case{2.0, 0.3, 0.6}, Case{1.5, 0.2, 0.5}, Case{4.0, 0.4, 0.3}}) {
+  for (const Case c :
+       {Case{3.0, 0.0, 0.6}, Case{2.0, 0.3, 0.6}, Case{1.5, 0.2, 0.5}, Case{4.0, 0.4, 0.3}}) {
     CAPTURE(c.p);
     CAPTURE(c.f);
     GeodeOptions o;
@@ -223,7 +231,9 @@ TEST_CASE("geode4tri: superquadric and off-vertex domes move the triple points w
     const double r_corner = radius_p(G.tet_side, 0, corner, c.p, c.blend);
     const double r_centre = radius_p(G.tet_side, 4, centre, c.p, c.blend);
     double lo = 0.0, hi = 1.0;
-    const auto g = [&](double t) { return planar_p(Point(0, 1, t), corner, c.p) / r_corner - t / r_centre; };
+    const auto g = [&](double t) {
+      return planar_p(Point(0, 1, t), corner, c.p) / r_corner - t / r_centre;
+    };
     REQUIRE(g(lo) > 0);
     REQUIRE(g(hi) < 0);
     for (int i = 0; i < 100; ++i) (g(0.5 * (lo + hi)) > 0 ? lo : hi) = 0.5 * (lo + hi);

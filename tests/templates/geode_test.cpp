@@ -8,10 +8,10 @@
 
 #include <geode/primal/errors.hpp>
 #include <geode/primal/validity.hpp>
+#include <geode/templates/geode.hpp>
 #include "support/ball_checks.hpp"
 #include "support/fixtures.hpp"
 #include "support/isomorphism.hpp"
-#include <geode/templates/geode.hpp>
 
 using namespace geode;
 using templates::GeodeOptions;
@@ -25,11 +25,14 @@ int side_label(const primal::Point& p, const Eigen::Vector3d& box) {
   int l = 0;
   if (std::abs(p.y() - 0.5 * box.y()) < eps) l |= 1;
   if (std::abs(p.y() + 0.5 * box.y()) < eps) l |= 2;
-  if (std::abs(std::abs(p.x()) - 0.5 * box.x()) < eps || std::abs(std::abs(p.z()) - 0.5 * box.z()) < eps) l |= 4;
+  if (std::abs(std::abs(p.x()) - 0.5 * box.x()) < eps ||
+      std::abs(std::abs(p.z()) - 0.5 * box.z()) < eps)
+    l |= 4;
   return l;
 }
 
-test::NodeLabels labels(const primal::HexMesh& a, const primal::HexMesh& b, const Eigen::Vector3d& box) {
+test::NodeLabels labels(const primal::HexMesh& a, const primal::HexMesh& b,
+                        const Eigen::Vector3d& box) {
   test::NodeLabels L;
   for (const auto& p : a.points) L.first.push_back(side_label(p, box));
   for (const auto& p : b.points) L.second.push_back(side_label(p, box));
@@ -37,7 +40,8 @@ test::NodeLabels labels(const primal::HexMesh& a, const primal::HexMesh& b, cons
 }
 
 primal::QuadMesh side_face(const primal::HexMesh& m, int axis, double value) {
-  return test::boundary_quads(m, [=](const primal::Point& p) { return std::abs(p[axis] - value) < 1e-9; });
+  return test::boundary_quads(
+      m, [=](const primal::Point& p) { return std::abs(p[axis] - value) < 1e-9; });
 }
 
 }  // namespace
@@ -85,7 +89,11 @@ TEST_CASE("geode3d: tet-side and hex-side nodes sit exactly where dicing puts th
 
 TEST_CASE("geode3d: other boxes, diagonals and tunnel orders give the same template") {
   const primal::HexMesh ref = test::appendix_a_geode();
-  struct Case { Eigen::Vector3d box; templates::Diagonal d; templates::Higher h; };
+  struct Case {
+    Eigen::Vector3d box;
+    templates::Diagonal d;
+    templates::Higher h;
+  };
   for (const Case& c : {Case{{24, 14, 24}, templates::Diagonal::Anti, templates::Higher::X},
                         Case{{24, 14, 24}, templates::Diagonal::Main, templates::Higher::Z},
                         Case{{10, 30, 16}, templates::Diagonal::Main, templates::Higher::X}}) {
@@ -176,10 +184,13 @@ TEST_CASE("geode4tri: what the four-triangle variant yields") {
   CHECK_FALSE(T.checks.triple_domes_in_pocket);
   const auto T2 = templates::build_geode2d(GeodeOptions{});
   for (int axis : {0, 2})
-    for (double s : {-12.0, 12.0}) CHECK(test::find_isomorphism(side_face(T.hex, axis, s), T2.quad).has_value());
+    for (double s : {-12.0, 12.0})
+      CHECK(test::find_isomorphism(side_face(T.hex, axis, s), T2.quad).has_value());
 }
 
-TEST_CASE("geode4tri: superquadric domes over a shallow centre dome give an obstruction-free 44-hex template") {
+TEST_CASE(
+    "geode4tri: superquadric domes over a shallow centre dome give an obstruction-free 44-hex "
+    "template") {
   // The same push with spheroid domes (p = 2) has a pinched corner and fails condition 1; with
   // p = 3 for every dome the triple-dome points fall inside both tunnels and the dual has no
   // obstruction, so the plain dual (no fix-up) smooths to positive Jacobians.
@@ -206,10 +217,12 @@ TEST_CASE("geode4tri: superquadric domes over a shallow centre dome give an obst
   CHECK(side_face(T.hex, 1, -7.0).quads.size() == 4);
   const auto T2 = templates::build_geode2d(GeodeOptions{});
   for (int axis : {0, 2})
-    for (double s : {-12.0, 12.0}) CHECK(test::find_isomorphism(side_face(T.hex, axis, s), T2.quad).has_value());
+    for (double s : {-12.0, 12.0})
+      CHECK(test::find_isomorphism(side_face(T.hex, axis, s), T2.quad).has_value());
   const auto r = templates::smooth_template(T, false);
   CHECK(r.untangled);
   CHECK(primal::check_validity(T.hex).ok());
-  MESSAGE("geode4tri, p = 3 domes: min scaled Jacobian " << r.final_min_scaled_jacobian << " (faces fixed)");
+  MESSAGE("geode4tri, p = 3 domes: min scaled Jacobian " << r.final_min_scaled_jacobian
+                                                         << " (faces fixed)");
   CHECK(r.final_min_scaled_jacobian >= 0.4);
 }

@@ -10,9 +10,9 @@
 #include <map>
 #include <set>
 
+#include <geode/io/gmsh.hpp>
 #include <geode/primal/boundary.hpp>
 #include <geode/primal/errors.hpp>
-#include <geode/io/gmsh.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/realizability.hpp>
 #include <geode/primal/validity.hpp>
@@ -29,7 +29,8 @@ namespace {
 
 // Every edge 2 long, base [-1, 1]^2 at y = 0, counter-clockwise seen from the apex.
 std::array<Point, 5> equilateral() {
-  return {Point(-1, 0, -1), Point(-1, 0, 1), Point(1, 0, 1), Point(1, 0, -1), Point(0, std::sqrt(2.0), 0)};
+  return {Point(-1, 0, -1), Point(-1, 0, 1), Point(1, 0, 1), Point(1, 0, -1),
+          Point(0, std::sqrt(2.0), 0)};
 }
 
 // One pyramid refined by Gmsh's all-hex subdivision (Mesh.SubdivisionAlgorithm = 2, the
@@ -97,8 +98,9 @@ TEST_CASE("pyramid: Schneiders' surface has 16 quads and a chord crossing itself
   const auto chords = stc::surface_chords(s.quads);
   REQUIRE(chords.size() == 2);
   std::multiset<std::size_t> passes, crossings;
-  for (const auto& c : chords) passes.insert(c.quads.size()), crossings.insert(c.self_crossings.size());
-  CHECK(passes == std::multiset<std::size_t>{8, 24});         // 8 around the apex, 24 = 16 + 8
+  for (const auto& c : chords)
+    passes.insert(c.quads.size()), crossings.insert(c.self_crossings.size());
+  CHECK(passes == std::multiset<std::size_t>{8, 24});  // 8 around the apex, 24 = 16 + 8
   CHECK(crossings == std::multiset<std::size_t>{0, 8});
   const auto cert = templates::pyramid_certificate(equilateral());
   CHECK(cert.self_crossing_chords == 1);
@@ -107,8 +109,10 @@ TEST_CASE("pyramid: Schneiders' surface has 16 quads and a chord crossing itself
   Point centre = Point::Zero();
   for (int i = 0; i < 5; ++i) centre += s.points[static_cast<std::size_t>(i)] / 5.0;
   for (const auto& q : s.quads) {
-    const Point n = (s.points[static_cast<std::size_t>(q[2])] - s.points[static_cast<std::size_t>(q[0])])
-                        .cross(s.points[static_cast<std::size_t>(q[3])] - s.points[static_cast<std::size_t>(q[1])]);
+    const Point n =
+        (s.points[static_cast<std::size_t>(q[2])] - s.points[static_cast<std::size_t>(q[0])])
+            .cross(s.points[static_cast<std::size_t>(q[3])] -
+                   s.points[static_cast<std::size_t>(q[1])]);
     CHECK(n.dot(s.points[static_cast<std::size_t>(q[0])] - centre) > 0);
   }
   CHECK_THROWS_AS(stc::surface_chords({{0, 1, 2, 3}}), TopologyError);
@@ -135,7 +139,8 @@ TEST_CASE("pyramid: Gmsh's all-hex subdivision of one pyramid, measured") {
   // Its sheets: 5, two of them self-intersecting (the issue's count), as the surface demands.
   const auto dual = stc::mesh_dual(g);
   CHECK(dual.sheets.size() == 5);
-  CHECK(std::count_if(dual.sheets.begin(), dual.sheets.end(), [](const auto& s) { return s.self_intersecting; }) == 2);
+  CHECK(std::count_if(dual.sheets.begin(), dual.sheets.end(),
+                      [](const auto& s) { return s.self_intersecting; }) == 2);
   CHECK(primal::find_obstructions(g).empty());
   // Gmsh's own reference pyramid (base [-1, 1]^2, height 1): the issue's 0.117.
   const primal::HexMesh r = gmsh_pyramid_filling(

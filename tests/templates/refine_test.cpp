@@ -13,11 +13,11 @@
 #include <geode/primal/errors.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/validity.hpp>
+#include <geode/templates/refine.hpp>
+#include <geode/templates/spec.hpp>
 #include "support/ball_checks.hpp"
 #include "support/fixtures.hpp"
 #include "support/isomorphism.hpp"
-#include <geode/templates/refine.hpp>
-#include <geode/templates/spec.hpp>
 
 using namespace geode;
 using primal::Point;
@@ -45,15 +45,18 @@ void check_grid(const primal::QuadMesh& face, int k, double hx, double hz) {
   std::set<std::pair<long, long>> want, got;
   for (int i = 0; i <= k; ++i)
     for (int j = 0; j <= k; ++j)
-      want.insert({std::lround((-hx + 2 * hx * i / k) * 1e7), std::lround((-hz + 2 * hz * j / k) * 1e7)});
-  for (const auto& p : face.points) got.insert({std::lround(p.x() * 1e7), std::lround(p.z() * 1e7)});
+      want.insert(
+          {std::lround((-hx + 2 * hx * i / k) * 1e7), std::lround((-hz + 2 * hz * j / k) * 1e7)});
+  for (const auto& p : face.points)
+    got.insert({std::lround(p.x() * 1e7), std::lround(p.z() * 1e7)});
   CHECK(got == want);
 }
 
 double min_quad_sj(const primal::QuadMesh& m) {
   double lo = 1e300;
   for (std::size_t q = 0; q < m.quads.size(); ++q)
-    lo = std::min(lo, primal::quad_scaled_jacobian(primal::quad_corners(m, static_cast<primal::Index>(q)), Point::UnitZ()));
+    lo = std::min(lo, primal::quad_scaled_jacobian(
+                          primal::quad_corners(m, static_cast<primal::Index>(q)), Point::UnitZ()));
   return lo;
 }
 
@@ -74,7 +77,8 @@ TEST_CASE("refine3-2d: one coarse edge over three fine ones, four quads, untangl
     if (std::abs(p.y() + 7) < kTol) bottom.insert(std::lround(p.x() * 1e7));
     if (std::abs(p.y() - 7) < kTol) top.insert(std::lround(p.x() * 1e7));
   }
-  CHECK(bottom == std::set<long>{std::lround(-12e7), std::lround(-4e7), std::lround(4e7), std::lround(12e7)});
+  CHECK(bottom ==
+        std::set<long>{std::lround(-12e7), std::lround(-4e7), std::lround(4e7), std::lround(12e7)});
   CHECK(top == std::set<long>{std::lround(-12e7), std::lround(12e7)});
   const auto r = templates::smooth_refine3(T, o);
   CHECK(r.untangled);
@@ -83,7 +87,8 @@ TEST_CASE("refine3-2d: one coarse edge over three fine ones, four quads, untangl
   CHECK(min_quad_sj(T.quad) >= 0.5);
 }
 
-TEST_CASE("refine3: the dual of two tunnels, two middle planes and a layer is a valid 13-hex cell") {
+TEST_CASE(
+    "refine3: the dual of two tunnels, two middle planes and a layer is a valid 13-hex cell") {
   RefineOptions o;
   const auto T = templates::build_refine3(o);
   // Sheet triples by hand: the tunnels' two crossing curves meet the middle plane across them
@@ -120,7 +125,8 @@ TEST_CASE("refine3: every side face is the 2D refinement template") {
 TEST_CASE("refine3: smoothed, untangled, and neighbouring cells match on their side faces") {
   // Targets per box: the geode's box, and a flat, stretched one (the fixed side faces cost
   // quality there: they are the 2D optimum, not the 3D one).
-  const std::pair<Eigen::Vector3d, double> cases[] = {{Eigen::Vector3d(24, 14, 24), 0.4}, {Eigen::Vector3d(20, 10, 30), 0.25}};
+  const std::pair<Eigen::Vector3d, double> cases[] = {{Eigen::Vector3d(24, 14, 24), 0.4},
+                                                      {Eigen::Vector3d(20, 10, 30), 0.25}};
   for (const auto& [box, target] : cases) {
     CAPTURE(box.transpose());
     RefineOptions o;
@@ -131,7 +137,8 @@ TEST_CASE("refine3: smoothed, untangled, and neighbouring cells match on their s
     const auto v = primal::check_validity(T.hex);
     test::check_combinatorial_ball(v);
     CHECK(v.ok());
-    MESSAGE("refine3 " << box.transpose() << ": min scaled Jacobian " << r.final_min_scaled_jacobian);
+    MESSAGE("refine3 " << box.transpose() << ": min scaled Jacobian "
+                       << r.final_min_scaled_jacobian);
     CHECK(r.final_min_scaled_jacobian >= target);
     // Fine and coarse sides stay where the refinement puts them.
     check_grid(face_of(T.hex, 1, 0.5 * box.y()), 1, 0.5 * box.x(), 0.5 * box.z());
@@ -140,13 +147,15 @@ TEST_CASE("refine3: smoothed, untangled, and neighbouring cells match on their s
     // with its face x = -w/2 (z = -d/2): the two faces' nodes must coincide.
     for (int axis : {0, 2}) {
       const int across = 2 - axis;
-      const auto lo = face_of(T.hex, axis, -0.5 * box[axis]), hi = face_of(T.hex, axis, 0.5 * box[axis]);
+      const auto lo = face_of(T.hex, axis, -0.5 * box[axis]),
+                 hi = face_of(T.hex, axis, 0.5 * box[axis]);
       CHECK(face_positions(lo, across) == face_positions(hi, across));
       CHECK(lo.quads.size() == 4);
     }
     // Where the width equals the depth, a copy turned by 90 degrees matches too.
     if (box.x() == box.z())
-      CHECK(face_positions(face_of(T.hex, 0, -0.5 * box.x()), 2) == face_positions(face_of(T.hex, 2, -0.5 * box.z()), 0));
+      CHECK(face_positions(face_of(T.hex, 0, -0.5 * box.x()), 2) ==
+            face_positions(face_of(T.hex, 2, -0.5 * box.z()), 0));
   }
 }
 
@@ -162,7 +171,8 @@ TEST_CASE("refine3: heights out of order are rejected") {
   CHECK_THROWS_AS(templates::build_refine3_2d(o), InvalidInput);
 }
 
-TEST_CASE("refine3: the templates are arrangement specs (faces block and shapes), read back exactly") {
+TEST_CASE(
+    "refine3: the templates are arrangement specs (faces block and shapes), read back exactly") {
   for (int dim : {2, 3}) {
     CAPTURE(dim);
     RefineOptions o;

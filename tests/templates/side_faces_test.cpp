@@ -24,7 +24,8 @@ std::vector<std::array<double, 2>> face_points(const templates::Template& t, int
   const double plane = (high ? 0.5 : -0.5) * box[axis];
   for (const auto& p : t.hex.points) {
     if (std::abs(p[axis] - plane) > 1e-9) continue;
-    double u = axis == 0 ? (high ? -p.z() : p.z()) / (0.5 * box.z()) : (high ? p.x() : -p.x()) / (0.5 * box.x());
+    double u = axis == 0 ? (high ? -p.z() : p.z()) / (0.5 * box.z())
+                         : (high ? p.x() : -p.x()) / (0.5 * box.x());
     if (mirror) u = -u;
     out.push_back({u, p.y()});
   }
@@ -34,7 +35,8 @@ std::vector<std::array<double, 2>> face_points(const templates::Template& t, int
 
 }  // namespace
 
-TEST_CASE("smooth_template_shared_sides: four side faces, one symmetric mesh; top and bottom kept") {
+TEST_CASE(
+    "smooth_template_shared_sides: four side faces, one symmetric mesh; top and bottom kept") {
   for (auto diagonal : {templates::Diagonal::Main, templates::Diagonal::Anti}) {
     for (const Eigen::Vector3d& box : {Eigen::Vector3d(24, 8, 24), Eigen::Vector3d(24, 14, 24)}) {
       CAPTURE(static_cast<int>(diagonal));

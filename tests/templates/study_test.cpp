@@ -28,7 +28,8 @@ TEST_CASE("interleave study: the default push is the 26-hex geode, and other out
   const auto study = templates::interleave_study(GeodeOptions{}, grid, "geode3d");
   REQUIRE(study.runs.size() == 16);
   const auto def = std::find_if(study.runs.begin(), study.runs.end(), [](const auto& r) {
-    return r.push.high_roof == 0.85 && r.push.low_roof == 0.6 && r.push.dome_depth == 0.9 && r.push.dome_radius == 0.6;
+    return r.push.high_roof == 0.85 && r.push.low_roof == 0.6 && r.push.dome_depth == 0.9 &&
+           r.push.dome_radius == 0.6;
   });
   REQUIRE(def != study.runs.end());
   CHECK(def->valid);
@@ -42,7 +43,8 @@ TEST_CASE("interleave study: the default push is the 26-hex geode, and other out
   // Its key is the key of the template built directly.
   CHECK(cls->key == templates::template_class_key(templates::build_geode3d(GeodeOptions{})));
   CHECK(study.classes.size() >= 2);
-  const bool has_error = std::any_of(study.runs.begin(), study.runs.end(), [](const auto& r) { return !r.valid; });
+  const bool has_error =
+      std::any_of(study.runs.begin(), study.runs.end(), [](const auto& r) { return !r.valid; });
   CHECK(has_error);
   // Every run is counted in exactly one class.
   int total = 0;
@@ -59,16 +61,18 @@ TEST_CASE("interleave study: the default push is the 26-hex geode, and other out
   for (const auto& c : study.classes) {
     if (!c.valid || c.obstructions.empty()) continue;
     CHECK_FALSE(c.usable);
-    const bool absolute = std::any_of(c.obstructions.begin(), c.obstructions.end(), [](const primal::Obstruction& o) {
-      return o.kind != primal::ObstructionKind::kPinchedCorner;
-    });
+    const bool absolute =
+        std::any_of(c.obstructions.begin(), c.obstructions.end(), [](const primal::Obstruction& o) {
+          return o.kind != primal::ObstructionKind::kPinchedCorner;
+        });
     if (!absolute) continue;
     CHECK(c.min_sj_fixed <= 0.0);
     CHECK(c.min_sj_slide <= 0.0);
   }
 }
 
-TEST_CASE("a pinched corner the smoother 'untangles' is a double cover, and check_validity says so") {
+TEST_CASE(
+    "a pinched corner the smoother 'untangles' is a double cover, and check_validity says so") {
   // A 30-hex class meeting the paper's conditions with one pinched corner at an interior node:
   // with the tet and hex sides sliding, the smoother reaches positive Jacobians, but the hexes
   // around that node wrap twice around it (their corner solid angles sum to 8 pi).
@@ -87,18 +91,21 @@ TEST_CASE("a pinched corner the smoother 'untangles' is a double cover, and chec
   INFO(report.summary());
   // Never valid: inverted, or (what the smoother reaches today) positive but overlapping.
   CHECK_FALSE(report.ok());
-  if (r.final_min_scaled_jacobian <= 0.0) return;  // whether it untangles is the smoother's business
+  if (r.final_min_scaled_jacobian <= 0.0)
+    return;  // whether it untangles is the smoother's business
   CHECK(report.inverted_hexes.empty());
   // That node and no other, interior or boundary.
   REQUIRE(report.overlapping_nodes.size() == 1);
   CHECK(report.overlapping_nodes[0].node == v);
   CHECK(report.overlapping_nodes[0].angle == doctest::Approx(8 * M_PI));
   CHECK(report.overlapping_nodes[0].expected == doctest::Approx(4 * M_PI));
-  CHECK(report.summary().find("cover more than once (corner solid angles): 1 (" + std::to_string(v) + ": 8 pi, not 4 pi)") !=
-        std::string::npos);
+  CHECK(report.summary().find("cover more than once (corner solid angles): 1 (" +
+                              std::to_string(v) + ": 8 pi, not 4 pi)") != std::string::npos);
 }
 
-TEST_CASE("template_obstructions: none on the geode, pinched corners and doublets on four-triangle duals") {
+TEST_CASE(
+    "template_obstructions: none on the geode, pinched corners and doublets on four-triangle "
+    "duals") {
   auto kinds = [](const std::vector<primal::Obstruction>& o) {
     std::map<primal::ObstructionKind, int> n;
     for (const auto& x : o) ++n[x.kind];
@@ -171,10 +178,13 @@ TEST_CASE("template_class_key: invariant under renumbering, different for a diff
 TEST_CASE("strip_numbers: measures go, names stay") {
   CHECK(templates::strip_numbers("sheets 'dome (+x,-z)' meet at (0.25, -1e-3, 7) near node 12") ==
         "sheets 'dome (+x,-z)' meet at (#) near node #");
-  CHECK(templates::strip_numbers("condition 2: a 1-cell from face 3") == "condition 2: a 1-cell from face #");
+  CHECK(templates::strip_numbers("condition 2: a 1-cell from face 3") ==
+        "condition 2: a 1-cell from face #");
 }
 
-TEST_CASE("smooth_in_cell: a sheared cell keeps tet/hex-side nodes on their planes and side nodes on theirs") {
+TEST_CASE(
+    "smooth_in_cell: a sheared cell keeps tet/hex-side nodes on their planes and side nodes on "
+    "theirs") {
   const GeodeOptions o;
   const auto cell = templates::sheared_cell(o.box, 30.0);
   const double shift = 14.0 * std::tan(M_PI / 6);  // top face moved by h tan(30 deg) along +x
@@ -189,7 +199,8 @@ TEST_CASE("smooth_in_cell: a sheared cell keeps tet/hex-side nodes on their plan
     // The checks below only look at nodes on faces: make sure there are such nodes (9 on the
     // diced hex side, 11 on the diced tet side, and some on the x- and z-faces).
     int on_y = 0, on_x = 0, on_z = 0;
-    for (unsigned f : T.node_faces) on_y += (f & (3u << 2)) != 0, on_x += (f & 3u) != 0, on_z += (f & (3u << 4)) != 0;
+    for (unsigned f : T.node_faces)
+      on_y += (f & (3u << 2)) != 0, on_x += (f & 3u) != 0, on_z += (f & (3u << 4)) != 0;
     CHECK(on_y == 20);
     CHECK(on_x > 0);
     CHECK(on_z > 0);
@@ -206,7 +217,8 @@ TEST_CASE("smooth_in_cell: a sheared cell keeps tet/hex-side nodes on their plan
           CHECK(p.z() == doctest::Approx(q.z()));
         }
       }
-      // z-faces stay planes z = -12, 12; x-faces are the slanted planes x - (y + 7)/14 shift = +-12.
+      // z-faces stay planes z = -12, 12; x-faces are the slanted planes x - (y + 7)/14 shift =
+      // +-12.
       if (f & (3u << 4)) CHECK(std::abs(p.z()) == doctest::Approx(12));
       if (f & 3u) CHECK(std::abs(p.x() - (p.y() + 7) / 14 * shift) == doctest::Approx(12));
     }
