@@ -1,4 +1,6 @@
-// geode study interleave | shape: parameter studies of the geode templates (templates/study.hpp).
+// geode study interleave | shape | corners: parameter studies of the geode templates
+// (templates/study.hpp) and of the transition at hex-part edges and corners
+// (conform/corner_study.hpp).
 #include <algorithm>
 #include <filesystem>
 #include <iomanip>
@@ -6,6 +8,8 @@
 #include <memory>
 #include <sstream>
 
+#include <geode/conform/corner_study.hpp>
+#include <geode/demo/demo_models.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/templates/spec.hpp>
 #include <geode/templates/study.hpp>
@@ -190,6 +194,27 @@ void run_shape(const ShapeArgs& a) {
   }
 }
 
+struct CornersArgs {
+  int n = 3;
+  std::string output;
+  bool quiet = false;
+};
+
+void run_corners(const CornersArgs& a) {
+  output_format(a.output, "", {"csv"}, "csv");
+  check_output_path(a.output);
+  const auto study = conform::corner_study(
+      demo::corner_study_models(a.n), a.n, [&](const conform::CornerStudyModelSummary& s) {
+        if (!a.quiet) std::cerr << "study corners: " << s.name << " done\n";
+      });
+  if (a.output.empty()) {
+    conform::write_corner_table(std::cout, study);
+  } else {
+    write_or_print(a.output, [&](std::ostream& s) { conform::write_corner_csv(s, study); });
+    if (!a.quiet) conform::write_corner_table(std::cerr, study);
+  }
+}
+
 }  // namespace
 
 void add_study_commands(CLI::App& app) {
@@ -258,6 +283,19 @@ void add_study_commands(CLI::App& app) {
                    "top/bottom taper ratios (default 0.4 0.6 0.8 1 1.25 1.5), in [0.01, 100]")
       ->check(number_check(0.01, 100));
   shape->callback([sa] { run_shape(*sa); });
+
+  auto ca = std::make_shared<CornersArgs>();
+  auto* corners = study->add_subcommand(
+      "corners",
+      "The transition at hex-part edges and corners: per demo model (nugget, lshape, potting,\n"
+      "cylinder, wedges of 60 to 300 degrees), dihedral angle and corner kind, the geode hexes'\n"
+      "min scaled Jacobian with --smooth none and the defaults, and its ratio to the local\n"
+      "yardstick (a table; with -o the CSV notebooks-data/plot.py draws)");
+  corners->add_option("-n", ca->n, "demo model size (default 3), in [2, 8]")
+      ->check(CLI::Range(2, 8));
+  corners->add_option("-o,--output", ca->output, "CSV output (default: a table on stdout)");
+  corners->add_flag("--quiet", ca->quiet, "no progress lines or table on stderr");
+  corners->callback([ca] { run_corners(*ca); });
 }
 
 }  // namespace geode::cli

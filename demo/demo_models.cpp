@@ -1005,4 +1005,14 @@ Model demo_model(const std::string& name, int n) {
   throw InvalidInput("demo model '" + name + "': expected one of " + names);
 }
 
+std::vector<std::pair<std::string, std::function<Model()>>> corner_study_models(int n) {
+  std::vector<std::pair<std::string, std::function<Model()>>> models;
+  for (const char* name : {"nugget", "lshape", "potting", "cylinder"})
+    models.emplace_back(name, [name, n] { return demo_model(name, n); });
+  for (double a : {60.0, 90.0, 120.0, 150.0, 210.0, 240.0, 270.0, 300.0})
+    models.emplace_back("wedge-" + std::to_string(static_cast<int>(a)),
+                        [a, n] { return demo_wedge(n, a); });
+  return models;
+}
+
 }  // namespace geode::demo

@@ -4,6 +4,7 @@
 #include <array>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <geode/primal/model.hpp>
@@ -105,5 +106,10 @@ const std::vector<std::string>& demo_model_names();
 // The model of that name with size parameter n (made even where the model needs it); throws
 // InvalidInput naming an unknown name.
 Model demo_model(const std::string& name, int n);
+
+// The models of the edge-and-corner study (conform/corner_study.hpp), built when called: nugget,
+// lshape, potting and cylinder at n, and "wedge-A", demo_wedge(n, A) for A = 60, 90, 120, 150,
+// 210, 240, 270 and 300 degrees.
+std::vector<std::pair<std::string, std::function<Model()>>> corner_study_models(int n);
 
 }  // namespace geode::demo

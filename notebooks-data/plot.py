@@ -4,7 +4,7 @@
 Run: /usr/bin/python3 notebooks-data/plot.py   (needs Debian's python3-matplotlib)
 Writes next to this script: sj-histogram-geode3d.png, shape-height.png, shape-distorted.png,
 interleave-geode3d.png, interleave-geode4tri.png, interleave-geode4tri-domes.png, transition-corners.png. Reads only CSVs
-written by `geode study` and bench_transition_study.
+written by `geode study`.
 """
 import csv
 import os
@@ -200,7 +200,7 @@ def domes():
 
 
 def corners():
-    """Geode hexes at hex-part edges and corners, per dihedral angle and kind (bench_transition_study)."""
+    """Geode hexes at hex-part edges and corners, per dihedral angle and kind (geode study corners)."""
     data = rows("transition-corners.csv")
     kinds = ["flat", "convex edge", "concave edge", "convex corner", "concave corner", "saddle corner"]
     colours = dict(zip(kinds, ["0.6", "tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple"]))
@@ -217,7 +217,7 @@ def corners():
     ax.set_xlabel("dihedral angle inside the hex part (degrees; 180 flat)")
     ax.set_ylabel("min scaled Jacobian of the geode hexes")
     ax.set_title("Transition at hex-part edges and corners (open: --smooth none, filled: defaults;\n"
-                 "nugget, lshape, potting, cylinder, demo_wedge; bench_transition_study)", fontsize=9)
+                 "nugget, lshape, potting, cylinder, demo_wedge at n = 3; geode study corners)", fontsize=9)
     ax.legend(fontsize=7, loc="lower right")
     ax.set_ylim(0, 0.5)
     save(fig, "transition-corners.png")
