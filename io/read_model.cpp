@@ -6,6 +6,7 @@
 #include <geode/io/file_format.hpp>
 #include <geode/io/formats.hpp>
 #include <geode/primal/errors.hpp>
+#include <geode/primal/input_check.hpp>
 
 namespace geode::io {
 
@@ -51,7 +52,8 @@ Model model_from_vtk(const VtkGrid& grid, const ReadOptions& options) {
   return model;
 }
 
-Model read_model(const std::filesystem::path& path, const ReadOptions& options) {
+Model read_model(const std::filesystem::path& path, const ReadOptions& options,
+                 bool check_covering) {
   const MeshFormat* format = reader_for(path);
   if (!format) {
     (void)read_file_head(path);  // a missing file is named as such first
@@ -59,7 +61,9 @@ Model read_model(const std::filesystem::path& path, const ReadOptions& options) 
                        "' (expected " + extension_list(FormatRole::kRead) + ")");
   }
   check_signature(path, *format);
-  return format->read(path, options);
+  Model model = format->read(path, options);
+  if (options.check_geometry && check_covering) require_single_covering(model, path.string());
+  return model;
 }
 
 }  // namespace geode::io
