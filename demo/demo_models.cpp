@@ -625,7 +625,7 @@ Model demo_fulcher(int n) {
   if (n < 2 || n % 2 != 0)
     throw InvalidInput("demo_fulcher: n = " + std::to_string(n) + " must be even and >= 2");
   // Circle radii on the nugget faces x = 1, y = 1, z = 1.
-  constexpr std::array<double, 3> radii{0.3, 0.5, 0.7};
+  constexpr std::array<double, 3> kRadii{0.3, 0.5, 0.7};
   return run_gmsh("demo_fulcher", [&] {
     Model hexes = hex_part_from_gmsh("fulcher blocks", [n] {
       // The nugget and the three swept slabs (added below) are not structured blocks.
@@ -641,7 +641,7 @@ Model demo_fulcher(int n) {
       gmsh::model::setPhysicalName(3, 1, "hex blocks");
     });
     for (int axis = 0; axis < 3; ++axis)
-      append_swept_slab(hexes, imprinted_square(n, radii[static_cast<std::size_t>(axis)]), axis,
+      append_swept_slab(hexes, imprinted_square(n, kRadii[static_cast<std::size_t>(axis)]), axis,
                         n / 2);
     merge_coincident_nodes(hexes, 1e-9);
     orient_positively(hexes);

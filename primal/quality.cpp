@@ -328,7 +328,7 @@ double quad_scaled_jacobian(const QuadCorners& p, const Point& normal) {
 
 std::span<const HexMetricInfo> hex_metrics() {
   // Acceptable ranges from the [Verdict] hexahedron tables.
-  static const std::array<HexMetricInfo, 12> kTable{{
+  static const std::array<HexMetricInfo, 12> table{{
       {HexMetric::kEdgeRatio, "Edge Ratio", "edge_ratio", &hex_edge_ratio, 1.0, 1.3,
        "Lmax / Lmin over the 12 edges [Verdict hex edge ratio]"},
       {HexMetric::kAspectRatio, "Aspect Ratio", "aspect_ratio", &hex_aspect_ratio, 1.0, 1.3,
@@ -354,7 +354,7 @@ std::span<const HexMetricInfo> hex_metrics() {
       {HexMetric::kShape, "Shape", "shape", &hex_shape, 0.3, 1.0,
        "min corner 3 det^(2/3) / |A|_F^2 [Verdict hex shape; Knupp]"},
   }};
-  return kTable;
+  return table;
 }
 
 const HexMetricInfo& hex_metric_info(HexMetric metric) {
