@@ -75,6 +75,7 @@ class Distributor {
     stage("dicing", [&] { dice(); });
     stage("global ids", [&] { number(); });
     stage("assembly", [&] { assemble(); });
+    release();  // what only the stages before needed: the verification's room
     stage("verification", [&] { verify(); });
     return std::move(out_);
   }
@@ -102,6 +103,13 @@ class Distributor {
   void number();
   void assemble();
   void verify();
+  void release() {
+    own_ = {};
+    zone_at_ = {};
+    level_ = {}, in_zone_ = {}, part_ = {}, zone_node_ = {};
+    diced_gid_ = {}, diced_holders_ = {}, zone_holders_ = {};
+    split_ = {}, zone_out_ = {};
+  }
 
   const DistributedOptions& options_;
   MPI_Comm comm_;

@@ -14,14 +14,18 @@ std::vector<int> partition_elements(const primal::Model& model, int parts) {
   const std::size_t n = offsets.back();
   std::vector<int> part(n, 0);
   if (parts <= 1 || n == 0) return part;
-  std::vector<idx_t> eptr{0}, eind;
+  std::vector<idx_t> eptr{0}, eind, weight;
   eptr.reserve(n + 1);
   eind.reserve(n * 8);
+  weight.reserve(n);
   for (primal::ElementKind kind : primal::kElementKinds)
     for (std::size_t e = 0; e < primal::element_count(model, kind); ++e) {
-      for (primal::Index v : primal::element_corners(model, {kind, static_cast<primal::Index>(e)}))
-        eind.push_back(v);
+      const auto corners = primal::element_corners(model, {kind, static_cast<primal::Index>(e)});
+      for (primal::Index v : corners) eind.push_back(v);
       eptr.push_back(static_cast<idx_t>(eind.size()));
+      // The hexes it dices into (8, 4, 6; a pyramid as its two tets): the parts' output balanced.
+      weight.push_back(kind == primal::ElementKind::Pyramid ? 8
+                                                            : static_cast<idx_t>(corners.size()));
     }
   idx_t ne = static_cast<idx_t>(n), nn = static_cast<idx_t>(model.points.size()), ncommon = 3,
         np = parts, objval = 0;
@@ -30,7 +34,7 @@ std::vector<int> partition_elements(const primal::Model& model, int parts) {
   options[METIS_OPTION_SEED] = 1;
   std::vector<idx_t> epart(n), npart(model.points.size());
   const int status =
-      METIS_PartMeshDual(&ne, &nn, eptr.data(), eind.data(), nullptr, nullptr, &ncommon, &np,
+      METIS_PartMeshDual(&ne, &nn, eptr.data(), eind.data(), weight.data(), nullptr, &ncommon, &np,
                          nullptr, options, &objval, epart.data(), npart.data());
   if (status != METIS_OK)
     throw std::runtime_error("METIS_PartMeshDual failed (status " + std::to_string(status) + ")");

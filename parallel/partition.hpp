@@ -1,6 +1,7 @@
 #pragma once
 // Element partitioning by METIS (Debian libmetis-dev): the dual graph of a model's elements
-// (two elements adjacent when they share a face, 3 nodes), cut into balanced parts.
+// (two elements adjacent when they share a face, 3 nodes), cut into parts balanced by the hexes
+// each element dices into (8 per hex, 4 per tet, 6 per wedge).
 #include <vector>
 
 #include <geode/primal/model.hpp>
