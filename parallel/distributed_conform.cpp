@@ -4,8 +4,10 @@
 #include <bit>
 #include <chrono>
 #include <cstring>
+#include <map>
 #include <numeric>
 #include <unordered_map>
+#include <utility>
 
 #include <geode/parallel/partition.hpp>
 #include <geode/primal/dice.hpp>
@@ -440,37 +442,52 @@ void Distributor::assemble() {
   const std::int64_t zone_nodes = static_cast<std::int64_t>(zone_out_.points.size());
   for (std::size_t l = 0; l < gids.size(); ++l)
     if (gids[l] < zone_nodes) o.points[l] = zone_out_.points[static_cast<std::size_t>(gids[l])];
-  // Hexes in a first order (zone, then diced hex, tet, wedge children), then by block and id.
-  struct Hex {
-    int block;
-    std::int64_t gid;
-    std::array<Index, 8> corners;
-  };
-  std::vector<Hex> hexes;
-  std::vector<std::size_t> zone_local(zone_last_ - zone_first_);
-  for (std::size_t h = zone_first_; h < zone_last_; ++h) {
-    Hex x{zone_out_.hex_block[h], static_cast<std::int64_t>(h), {}};
-    for (int c = 0; c < 8; ++c) x.corners[c] = local(zone_out_.hexes[h][c]);
-    hexes.push_back(x);
-  }
-  const std::size_t first_diced = hexes.size();
+  // Hexes in a first order (zone, then diced hex, tet, wedge children), ids ascending in it;
+  // placed by block (a stable counting sort: by block, then by id), each written once into the
+  // output arrays, with no copy of the hexes beside them.
   const Model& om = own_.model;
-  const auto add = [&](const std::vector<std::array<Index, 8>>& children,
-                       const std::vector<Index>& parent, ElementKind kind) {
-    for (std::size_t k = 0; k < children.size(); ++k) {
-      Hex x{primal::block_of(om, {kind, parent[k]}),
-            diced_hex_first_ + static_cast<std::int64_t>(hexes.size() - first_diced),
-            {}};
-      for (int c = 0; c < 8; ++c) x.corners[c] = diced_local[children[k][c]];
-      hexes.push_back(x);
+  const std::size_t first_diced = zone_last_ - zone_first_;
+  const std::size_t nh = diced_.hex_children.size(), nt = diced_.tet_children.size();
+  const std::size_t total = first_diced + nh + nt + diced_.wedge_children.size();
+  std::vector<int> block(total);
+  for (std::size_t k = 0; k < first_diced; ++k) block[k] = zone_out_.hex_block[zone_first_ + k];
+  for (std::size_t k = 0; k < nh; ++k)
+    block[first_diced + k] = primal::block_of(om, {ElementKind::Hex, diced_.hex_parent[k]});
+  for (std::size_t k = 0; k < nt; ++k)
+    block[first_diced + nh + k] = primal::block_of(om, {ElementKind::Tet, diced_.tet_parent[k]});
+  for (std::size_t k = 0; k < diced_.wedge_children.size(); ++k)
+    block[first_diced + nh + nt + k] =
+        primal::block_of(om, {ElementKind::Wedge, diced_.wedge_parent[k]});
+  std::map<int, Index> next;  // per block: its next output position
+  for (int b : block) ++next[b];
+  Index start = 0;
+  for (auto& [b, n] : next) start += std::exchange(n, start);
+  std::vector<Index> position(total);
+  o.hexes.resize(total);
+  o.hex_block.resize(total);
+  out_.hex_gid.resize(total);
+  for (std::size_t k = 0; k < total; ++k) {
+    const Index at = next[block[k]]++;
+    position[k] = at;
+    const auto p = static_cast<std::size_t>(at);
+    o.hex_block[p] = block[k];
+    std::array<Index, 8>& x = o.hexes[p];
+    if (k < first_diced) {
+      out_.hex_gid[p] = static_cast<std::int64_t>(zone_first_ + k);
+      for (int c = 0; c < 8; ++c) x[c] = local(zone_out_.hexes[zone_first_ + k][c]);
+    } else {
+      const std::size_t j = k - first_diced;
+      out_.hex_gid[p] = diced_hex_first_ + static_cast<std::int64_t>(j);
+      const auto& child = j < nh        ? diced_.hex_children[j]
+                          : j < nh + nt ? diced_.tet_children[j - nh]
+                                        : diced_.wedge_children[j - nh - nt];
+      for (int c = 0; c < 8; ++c) x[c] = diced_local[static_cast<std::size_t>(child[c])];
     }
-  };
-  add(diced_.hex_children, diced_.hex_parent, ElementKind::Hex);
-  add(diced_.tet_children, diced_.tet_parent, ElementKind::Tet);
-  add(diced_.wedge_children, diced_.wedge_parent, ElementKind::Wedge);
-  const Index hex_children = static_cast<Index>(diced_.hex_children.size());
-  const Index tet_children = static_cast<Index>(diced_.tet_children.size());
-  // Side sets read the diced numbering: taken before the children go.
+  }
+  block = {};
+  const Index hex_children = static_cast<Index>(nh);
+  const Index tet_children = static_cast<Index>(nt);
+  // Side sets read the diced numbering.
   const auto diced_sides =
       primal::diced_side_sets(om, diced_, 0, hex_children, hex_children + tet_children);
   const auto diced_nodes = primal::diced_node_sets(om, diced_, diced_local);
@@ -478,21 +495,6 @@ void Distributor::assemble() {
     primal::DicedModel released;  // the dicing data, consumed
     diced_ = std::move(released);
   }
-  std::vector<std::size_t> order(hexes.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return std::tie(hexes[a].block, hexes[a].gid) < std::tie(hexes[b].block, hexes[b].gid);
-  });
-  std::vector<Index> position(hexes.size());
-  o.hexes.reserve(hexes.size());
-  for (std::size_t k = 0; k < order.size(); ++k) {
-    const Hex& x = hexes[order[k]];
-    position[order[k]] = static_cast<Index>(k);
-    o.hexes.push_back(x.corners);
-    o.hex_block.push_back(x.block);
-    out_.hex_gid.push_back(x.gid);
-  }
-  hexes = {};
   o.block_names = m().block_names;
   o.block_names.insert(zone_out_.block_names.begin(), zone_out_.block_names.end());
   // Sets: the zone's (on this rank's nodes and hexes) and the diced ones, by id.
