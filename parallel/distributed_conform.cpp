@@ -1,0 +1,632 @@
+#include <geode/parallel/distributed_conform.hpp>
+
+#include <algorithm>
+#include <bit>
+#include <chrono>
+#include <cstring>
+#include <map>
+#include <numeric>
+#include <unordered_map>
+#include <utility>
+
+#include <geode/parallel/partition.hpp>
+#include <geode/primal/dice.hpp>
+#include <geode/primal/dice_model.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/key_map.hpp>
+#include <geode/primal/split_pyramids.hpp>
+#include <geode/primal/submodel.hpp>
+#include <geode/primal/validity.hpp>
+
+namespace geode::parallel {
+namespace {
+
+using primal::ElementKind;
+using primal::FaceKey;
+using primal::Index;
+using primal::kInvalidIndex;
+using primal::Model;
+using primal::Point;
+using Clock = std::chrono::steady_clock;
+using Mask = std::uint64_t;  // ranks, one bit each (at most 64)
+
+// A point's exact bits, for matching diced nodes with the zone's nodes made by the same formula.
+struct PointBits {
+  std::array<std::uint64_t, 3> b;
+  bool operator==(const PointBits&) const = default;
+};
+struct PointBitsHash {
+  std::size_t operator()(const PointBits& p) const {
+    std::uint64_t h = 0x9e3779b97f4a7c15ull;
+    for (std::uint64_t x : p.b) h = (h ^ x) * 0x100000001b3ull, h ^= h >> 29;
+    return static_cast<std::size_t>(h);
+  }
+};
+PointBits bits(const Point& p) {
+  PointBits r;
+  for (int i = 0; i < 3; ++i) std::memcpy(&r.b[static_cast<std::size_t>(i)], &p[i], 8);
+  return r;
+}
+
+// conform_distributed's stages, in the order run() calls them.
+class Distributor {
+ public:
+  Distributor(const Model& input, const DistributedOptions& options, MPI_Comm comm,
+              DistributedReport& report)
+      : options_(options), comm_(comm), rep_(report) {
+    MPI_Comm_rank(comm, &rank_);
+    MPI_Comm_size(comm, &size_);
+    if (input.pyramids.empty()) {
+      model_ = &input;
+    } else {  // conform's own first step, element by element: the same tets
+      split_ = primal::split_pyramids(input).model;
+      model_ = &split_;
+    }
+  }
+
+  RankMesh run() {
+    const auto& opt = options_.conform;
+    if (size_ > 64) throw InvalidInput("geode_mpi: at most 64 ranks");
+    if (opt.smooth == conform::ConformSmooth::kGlobal)
+      throw InvalidInput("--smooth global moves every node: not available under MPI");
+    if (!opt.geode_block.empty())
+      throw InvalidInput("a named geode block is not available under MPI");
+    stage("partition", [&] { partition(); });
+    stage("yardstick", [&] { yardstick(); });
+    stage("zone", [&] { zone(); });
+    stage("dicing", [&] { dice(); });
+    stage("global ids", [&] { number(); });
+    stage("assembly", [&] { assemble(); });
+    release();  // what only the stages before needed: the verification's room
+    stage("verification", [&] { verify(); });
+    return std::move(out_);
+  }
+
+ private:
+  template <typename F>
+  void stage(const std::string& name, F&& f) {
+    const auto t0 = Clock::now();
+    f();
+    rep_.seconds[name] = std::chrono::duration<double>(Clock::now() - t0).count();
+  }
+  const Model& m() const { return *model_; }
+  std::size_t cells() const { return offsets_.back(); }
+  primal::ElementRef ref(std::size_t c) const {
+    std::size_t k = 0;
+    while (c >= offsets_[k + 1]) ++k;
+    return {primal::kElementKinds[k], static_cast<Index>(c - offsets_[k])};
+  }
+
+  void partition();
+  void yardstick();
+  void zone();
+  bool zone_at(int rings);
+  void dice();
+  void number();
+  void assemble();
+  void verify();
+  void release() {
+    own_ = {};
+    zone_at_ = {};
+    level_ = {}, in_zone_ = {}, part_ = {}, zone_node_ = {};
+    diced_gid_ = {}, diced_holders_ = {}, zone_holders_ = {};
+    split_ = {}, zone_out_ = {};
+  }
+
+  const DistributedOptions& options_;
+  MPI_Comm comm_;
+  DistributedReport& rep_;
+  int rank_ = 0, size_ = 1;
+  Model split_;
+  const Model* model_ = nullptr;
+  std::array<std::size_t, 5> offsets_{};
+  std::vector<int> part_;              // per flat element
+  std::vector<std::size_t> lowest_;    // elements setting the yardstick (one per kind)
+  std::vector<std::size_t> inverted_;  // elements diced with a scaled Jacobian <= 0
+  std::vector<signed char> level_;     // per flat element: ring in the zone, -1 outside
+  std::vector<char> in_zone_;
+  Model zone_out_;               // the zone conformed (same on every rank)
+  std::vector<char> zone_node_;  // per model node: used by a zone element
+  std::unordered_map<PointBits, Index, PointBitsHash> zone_at_;  // zone output node by position
+  std::size_t zone_first_ = 0, zone_last_ = 0;                   // this rank's zone hexes
+  primal::Submodel own_;  // this rank's elements outside the zone
+  primal::DicedModel diced_;
+  std::vector<std::int64_t> diced_gid_;  // per diced node
+  std::vector<Mask> diced_holders_;      // per diced node not in the zone: ranks holding it
+  std::vector<Mask> zone_holders_;       // per zone output node
+  std::int64_t diced_hex_first_ = 0;     // global id of this rank's first diced hex
+  RankMesh out_;
+};
+
+void Distributor::partition() {
+  offsets_ = primal::element_offsets(m());
+  part_.assign(cells(), 0);
+  if (size_ > 1) {
+    if (rank_ == 0) part_ = partition_elements(m(), size_);
+    MPI_Bcast(part_.data(), static_cast<int>(part_.size()), MPI_INT, 0, comm_);
+  }
+}
+
+// The serial run's yardstick is the lowest element of each kind diced alone over the whole
+// model: each rank measures its own elements, the lowest of each kind join the zone so that
+// conform measures the same minimum there. Inverted elements are smoothed by the serial run
+// wherever they are: they seed the zone.
+void Distributor::yardstick() {
+  struct {
+    double value;
+    int cell;
+  } low[3], all[3];
+  for (auto& l : low) l = {2.0, std::numeric_limits<int>::max()};
+  std::vector<int> inverted;
+  const auto consider = [&](int k, std::size_t c, double v) {
+    if (v < low[k].value || (v == low[k].value && static_cast<int>(c) < low[k].cell))
+      low[k] = {v, static_cast<int>(c)};
+    if (v <= 0.0) inverted.push_back(static_cast<int>(c));
+  };
+  std::vector<std::array<Index, 8>> hexes;
+  std::vector<std::array<Index, 4>> tets;
+  std::vector<std::size_t> hex_cell, tet_cell;
+  for (std::size_t c = 0; c < cells(); ++c) {
+    if (part_[c] != rank_) continue;
+    const auto r = ref(c);
+    if (r.kind == ElementKind::Hex)
+      hexes.push_back(m().hexes[static_cast<std::size_t>(r.index)]), hex_cell.push_back(c);
+    else if (r.kind == ElementKind::Tet)
+      tets.push_back(m().tets[static_cast<std::size_t>(r.index)]), tet_cell.push_back(c);
+    else if (r.kind == ElementKind::Wedge)
+      consider(2, c,
+               primal::diced_wedge_min_scaled_jacobian(
+                   m().points, std::span(&m().wedges[static_cast<std::size_t>(r.index)], 1)));
+  }
+  const auto h = primal::diced_scaled_jacobian_per_cell(m().points, hexes);
+  for (std::size_t i = 0; i < h.size(); ++i) consider(0, hex_cell[i], h[i]);
+  const auto t = primal::diced_scaled_jacobian_per_cell(m().points, tets);
+  for (std::size_t i = 0; i < t.size(); ++i) consider(1, tet_cell[i], t[i]);
+  MPI_Allreduce(low, all, 3, MPI_DOUBLE_INT, MPI_MINLOC, comm_);
+  for (const auto& a : all)
+    if (a.value <= 1.5) lowest_.push_back(static_cast<std::size_t>(a.cell));
+  int n = static_cast<int>(inverted.size());
+  std::vector<int> counts(static_cast<std::size_t>(size_)), displs(counts.size());
+  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
+  std::exclusive_scan(counts.begin(), counts.end(), displs.begin(), 0);
+  std::vector<int> every(static_cast<std::size_t>(displs.back() + counts.back()));
+  MPI_Allgatherv(inverted.data(), n, MPI_INT, every.data(), counts.data(), displs.data(), MPI_INT,
+                 comm_);
+  inverted_.assign(every.begin(), every.end());
+  std::sort(inverted_.begin(), inverted_.end());
+}
+
+void Distributor::zone() {
+  int rings = options_.rings;
+  while (!zone_at(rings)) {
+    if (rings * 2 > options_.max_rings)
+      throw TopologyError("geode_mpi: the transition reaches past " + std::to_string(rings) +
+                          " rings of elements around the interface");
+    rings *= 2;
+    rep_.warnings.push_back("transition zone grown to " + std::to_string(rings) + " rings");
+  }
+  rep_.rings = rings;
+}
+
+// The zone `rings` deep, conformed; false when its outer two rings are not plain dicing.
+bool Distributor::zone_at(int rings) {
+  const std::size_t nv = m().points.size();
+  std::vector<char> used_by_hex(nv, 0), used_by_tet(nv, 0), marked(nv, 0);
+  for (const auto& h : m().hexes)
+    for (Index v : h) used_by_hex[static_cast<std::size_t>(v)] = 1;
+  for (const auto& t : m().tets)
+    for (Index v : t) used_by_tet[static_cast<std::size_t>(v)] = 1;
+  for (std::size_t v = 0; v < nv; ++v) marked[v] = used_by_hex[v] && used_by_tet[v];
+  for (std::size_t c : inverted_)
+    for (Index v : primal::element_corners(m(), ref(c))) marked[static_cast<std::size_t>(v)] = 1;
+  // Wedges seed the zone too: dice_model places a wedge's edge and face nodes by summing over
+  // the corners of the first wedge making them, so their bits depend on which wedges a run
+  // dices; inside the zone they are the serial run's (its elements in the same order).
+  for (const auto& w : m().wedges)
+    for (Index v : w) marked[static_cast<std::size_t>(v)] = 1;
+  level_.assign(cells(), -1);
+  for (int ring = 0; ring <= rings; ++ring) {
+    std::vector<std::size_t> reached;
+    for (std::size_t c = 0; c < cells(); ++c) {
+      if (level_[c] >= 0) continue;
+      for (Index v : primal::element_corners(m(), ref(c)))
+        if (marked[static_cast<std::size_t>(v)]) {
+          reached.push_back(c);
+          break;
+        }
+    }
+    for (std::size_t c : reached) {
+      level_[c] = static_cast<signed char>(ring);
+      for (Index v : primal::element_corners(m(), ref(c))) marked[static_cast<std::size_t>(v)] = 1;
+    }
+  }
+  in_zone_.assign(cells(), 0);
+  for (std::size_t c = 0; c < cells(); ++c) in_zone_[c] = level_[c] >= 0;
+  for (std::size_t c : lowest_) in_zone_[c] = 1;
+  // The band: the zone's elements within two rings of the cut (the nodes it shares with the
+  // elements outside); none when the zone is the whole model.
+  std::vector<char> outside(nv, 0), near(nv, 0), band(cells(), 0);
+  for (std::size_t c = 0; c < cells(); ++c)
+    if (!in_zone_[c])
+      for (Index v : primal::element_corners(m(), ref(c))) outside[static_cast<std::size_t>(v)] = 1;
+  for (int ring = 0; ring < 2; ++ring) {
+    for (std::size_t c = 0; c < cells(); ++c) {
+      if (!in_zone_[c]) continue;
+      for (Index v : primal::element_corners(m(), ref(c)))
+        if (outside[static_cast<std::size_t>(v)]) band[c] = 1;
+    }
+    for (std::size_t c = 0; c < cells(); ++c)
+      if (band[c])
+        for (Index v : primal::element_corners(m(), ref(c))) near[static_cast<std::size_t>(v)] = 1;
+    outside.swap(near);
+  }
+  primal::Submodel zone = primal::extract_submodel(m(), in_zone_);
+  rep_.zone_cells = static_cast<std::int64_t>(std::count(in_zone_.begin(), in_zone_.end(), 1));
+  conform::ConformResult r = conform::conform(zone.model, options_.conform);
+  zone_at_.clear();
+  zone_at_.reserve(r.model.points.size());
+  for (std::size_t i = 0; i < r.model.points.size(); ++i)
+    zone_at_.emplace(bits(r.model.points[i]), static_cast<Index>(i));
+  // The band diced alone must be found in the zone's output, node for node.
+  primal::Submodel b = primal::extract_submodel(m(), band);
+  const primal::DicedModel d = primal::dice_model(b.model);
+  for (const Point& p : d.points)
+    if (!zone_at_.count(bits(p))) return false;
+  zone_node_.assign(nv, 0);
+  for (Index v : zone.node) zone_node_[static_cast<std::size_t>(v)] = 1;
+  zone_out_ = std::move(r.model);
+  rep_.zone = std::move(r);
+  rep_.zone.model = {};
+  // This rank's share of the zone's hexes: a contiguous run (the zone's output order follows
+  // the input's element order within each block).
+  const std::size_t nz = zone_out_.hexes.size();
+  zone_first_ = nz * static_cast<std::size_t>(rank_) / static_cast<std::size_t>(size_);
+  zone_last_ = nz * static_cast<std::size_t>(rank_ + 1) / static_cast<std::size_t>(size_);
+  return true;
+}
+
+void Distributor::dice() {
+  std::vector<char> mine(cells(), 0);
+  for (std::size_t c = 0; c < cells(); ++c) mine[c] = part_[c] == rank_ && !in_zone_[c];
+  own_ = primal::extract_submodel(m(), mine);
+  diced_ = primal::dice_model(own_.model);
+  rep_.cells = static_cast<std::int64_t>(std::count(mine.begin(), mine.end(), 1));
+}
+
+// Global ids: see the header.
+void Distributor::number() {
+  const std::size_t nv = m().points.size();
+  const std::int64_t zone_nodes = static_cast<std::int64_t>(zone_out_.points.size());
+  // Per model node: the ranks whose elements outside the zone use it.
+  std::vector<Mask> uses(nv, 0);
+  for (std::size_t c = 0; c < cells(); ++c)
+    if (!in_zone_[c])
+      for (Index v : primal::element_corners(m(), ref(c)))
+        uses[static_cast<std::size_t>(v)] |= Mask{1} << part_[c];
+  const std::size_t nd = diced_.points.size();
+  diced_gid_.assign(nd, -1);
+  diced_holders_.assign(nd, Mask{1} << rank_);
+  // Origins in model numbers (own_.node ascends, so normalized keys stay sorted).
+  std::vector<FaceKey> key(nd, primal::kNoOrigin);
+  std::vector<std::vector<std::size_t>> candidates(static_cast<std::size_t>(size_));
+  for (std::size_t i = 0; i < nd; ++i) {
+    const FaceKey& o = diced_.origin[i];
+    if (o[0] == kInvalidIndex) continue;  // a cell centre: this rank's alone
+    bool in_zone = true;
+    Mask holders = ~Mask{0};
+    for (std::size_t k = 0; k < 4 && o[k] != kInvalidIndex; ++k) {
+      const Index v = own_.node[static_cast<std::size_t>(o[k])];
+      key[i][k] = v;
+      in_zone = in_zone && zone_node_[static_cast<std::size_t>(v)];
+      holders &= uses[static_cast<std::size_t>(v)];
+    }
+    if (in_zone) {
+      const auto it = zone_at_.find(bits(diced_.points[i]));
+      if (it != zone_at_.end()) {
+        diced_gid_[i] = it->second;
+        continue;
+      }
+    }
+    holders &= ~(Mask{1} << rank_);
+    for (int q = 0; q < size_; ++q)
+      if (holders >> q & 1) candidates[static_cast<std::size_t>(q)].push_back(i);
+  }
+  // Exchange the candidates' origins with each rank that may hold them; the nodes in both lists
+  // are the ones shared.
+  const auto key_less = [&](std::size_t a, std::size_t b) { return key[a] < key[b]; };
+  std::vector<int> send_counts(static_cast<std::size_t>(size_)), recv_counts(send_counts.size());
+  std::vector<Index> send;
+  for (int q = 0; q < size_; ++q) {
+    auto& c = candidates[static_cast<std::size_t>(q)];
+    std::sort(c.begin(), c.end(), key_less);
+    for (std::size_t i : c) send.insert(send.end(), key[i].begin(), key[i].end());
+    send_counts[static_cast<std::size_t>(q)] = static_cast<int>(c.size() * 4);
+  }
+  MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm_);
+  std::vector<int> sd(send_counts.size()), rd(send_counts.size());
+  std::exclusive_scan(send_counts.begin(), send_counts.end(), sd.begin(), 0);
+  std::exclusive_scan(recv_counts.begin(), recv_counts.end(), rd.begin(), 0);
+  std::vector<Index> recv(static_cast<std::size_t>(rd.back() + recv_counts.back()));
+  MPI_Alltoallv(send.data(), send_counts.data(), sd.data(), MPI_INT, recv.data(),
+                recv_counts.data(), rd.data(), MPI_INT, comm_);
+  std::vector<std::vector<std::size_t>> shared(static_cast<std::size_t>(size_));
+  for (int q = 0; q < size_; ++q) {
+    const auto& c = candidates[static_cast<std::size_t>(q)];
+    const Index* theirs = recv.data() + rd[static_cast<std::size_t>(q)];
+    const std::size_t n = static_cast<std::size_t>(recv_counts[static_cast<std::size_t>(q)]) / 4;
+    std::size_t j = 0;
+    for (std::size_t i : c) {
+      FaceKey k{};
+      while (j < n && (std::copy_n(theirs + 4 * j, 4, k.begin()), k < key[i])) ++j;
+      if (j < n && k == key[i]) {
+        shared[static_cast<std::size_t>(q)].push_back(i);
+        diced_holders_[i] |= Mask{1} << q;
+      }
+    }
+  }
+  // This rank's own diced nodes (not the zone's, lowest holder here) numbered in diced order.
+  std::int64_t owned = 0;
+  for (std::size_t i = 0; i < nd; ++i)
+    if (diced_gid_[i] < 0 && std::countr_zero(diced_holders_[i]) == rank_) ++owned;
+  std::int64_t first = 0, total = 0;
+  MPI_Exscan(&owned, &first, 1, MPI_INT64_T, MPI_SUM, comm_);
+  if (rank_ == 0) first = 0;
+  MPI_Allreduce(&owned, &total, 1, MPI_INT64_T, MPI_SUM, comm_);
+  out_.global_nodes = zone_nodes + total;
+  std::int64_t next = zone_nodes + first;
+  for (std::size_t i = 0; i < nd; ++i)
+    if (diced_gid_[i] < 0 && std::countr_zero(diced_holders_[i]) == rank_) diced_gid_[i] = next++;
+  // The owners send the ids of the shared nodes, in the shared lists' order.
+  std::vector<std::int64_t> ids;
+  for (int q = 0; q < size_; ++q) {
+    std::size_t n = 0;
+    for (std::size_t i : shared[static_cast<std::size_t>(q)])
+      if (std::countr_zero(diced_holders_[i]) == rank_) ids.push_back(diced_gid_[i]), ++n;
+    send_counts[static_cast<std::size_t>(q)] = static_cast<int>(n);
+  }
+  MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm_);
+  std::exclusive_scan(send_counts.begin(), send_counts.end(), sd.begin(), 0);
+  std::exclusive_scan(recv_counts.begin(), recv_counts.end(), rd.begin(), 0);
+  std::vector<std::int64_t> got(static_cast<std::size_t>(rd.back() + recv_counts.back()));
+  MPI_Alltoallv(ids.data(), send_counts.data(), sd.data(), MPI_INT64_T, got.data(),
+                recv_counts.data(), rd.data(), MPI_INT64_T, comm_);
+  for (int q = 0; q < size_; ++q) {
+    std::size_t j = static_cast<std::size_t>(rd[static_cast<std::size_t>(q)]);
+    for (std::size_t i : shared[static_cast<std::size_t>(q)])
+      if (std::countr_zero(diced_holders_[i]) == q) diced_gid_[i] = got[j++];
+  }
+  // Zone nodes: held by the ranks owning a zone hex on them or a diced node at them.
+  zone_holders_.assign(static_cast<std::size_t>(zone_nodes), 0);
+  for (std::size_t h = zone_first_; h < zone_last_; ++h)
+    for (Index v : zone_out_.hexes[h])
+      zone_holders_[static_cast<std::size_t>(v)] |= Mask{1} << rank_;
+  for (std::size_t i = 0; i < nd; ++i)
+    if (diced_gid_[i] >= 0 && diced_gid_[i] < zone_nodes)
+      zone_holders_[static_cast<std::size_t>(diced_gid_[i])] |= Mask{1} << rank_;
+  MPI_Allreduce(MPI_IN_PLACE, zone_holders_.data(), static_cast<int>(zone_holders_.size()),
+                MPI_UINT64_T, MPI_BOR, comm_);
+  // Hexes: the zone's first, then the diced ones rank by rank.
+  const std::int64_t zone_hexes = static_cast<std::int64_t>(zone_out_.hexes.size());
+  const std::int64_t diced_hexes = static_cast<std::int64_t>(
+      diced_.hex_children.size() + diced_.tet_children.size() + diced_.wedge_children.size());
+  std::int64_t hex_first = 0, hex_total = 0;
+  MPI_Exscan(&diced_hexes, &hex_first, 1, MPI_INT64_T, MPI_SUM, comm_);
+  if (rank_ == 0) hex_first = 0;
+  MPI_Allreduce(&diced_hexes, &hex_total, 1, MPI_INT64_T, MPI_SUM, comm_);
+  diced_hex_first_ = zone_hexes + hex_first;
+  out_.global_hexes = zone_hexes + hex_total;
+  rep_.zone_hexes = static_cast<std::int64_t>(zone_last_ - zone_first_);
+  rep_.diced_hexes = diced_hexes;
+}
+
+// This rank's hexes (its zone hexes and its diced ones) over its nodes, ascending global id.
+void Distributor::assemble() {
+  const std::size_t nd = diced_.points.size();
+  std::vector<std::int64_t> gids;
+  gids.reserve(nd + 8 * (zone_last_ - zone_first_));
+  gids = diced_gid_;
+  for (std::size_t h = zone_first_; h < zone_last_; ++h)
+    for (Index v : zone_out_.hexes[h]) gids.push_back(v);
+  std::sort(gids.begin(), gids.end());
+  gids.erase(std::unique(gids.begin(), gids.end()), gids.end());
+  const auto local = [&](std::int64_t g) {
+    return static_cast<Index>(std::lower_bound(gids.begin(), gids.end(), g) - gids.begin());
+  };
+  Model& o = out_.model;
+  o.points.resize(gids.size());
+  std::vector<Index> diced_local(nd);
+  for (std::size_t i = 0; i < nd; ++i) {
+    diced_local[i] = local(diced_gid_[i]);
+    o.points[static_cast<std::size_t>(diced_local[i])] = diced_.points[i];
+  }
+  const std::int64_t zone_nodes = static_cast<std::int64_t>(zone_out_.points.size());
+  for (std::size_t l = 0; l < gids.size(); ++l)
+    if (gids[l] < zone_nodes) o.points[l] = zone_out_.points[static_cast<std::size_t>(gids[l])];
+  // Hexes in a first order (zone, then diced hex, tet, wedge children), ids ascending in it;
+  // placed by block (a stable counting sort: by block, then by id), each written once into the
+  // output arrays, with no copy of the hexes beside them.
+  const Model& om = own_.model;
+  const std::size_t first_diced = zone_last_ - zone_first_;
+  const std::size_t nh = diced_.hex_children.size(), nt = diced_.tet_children.size();
+  const std::size_t total = first_diced + nh + nt + diced_.wedge_children.size();
+  std::vector<int> block(total);
+  for (std::size_t k = 0; k < first_diced; ++k) block[k] = zone_out_.hex_block[zone_first_ + k];
+  for (std::size_t k = 0; k < nh; ++k)
+    block[first_diced + k] = primal::block_of(om, {ElementKind::Hex, diced_.hex_parent[k]});
+  for (std::size_t k = 0; k < nt; ++k)
+    block[first_diced + nh + k] = primal::block_of(om, {ElementKind::Tet, diced_.tet_parent[k]});
+  for (std::size_t k = 0; k < diced_.wedge_children.size(); ++k)
+    block[first_diced + nh + nt + k] =
+        primal::block_of(om, {ElementKind::Wedge, diced_.wedge_parent[k]});
+  std::map<int, Index> next;  // per block: its next output position
+  for (int b : block) ++next[b];
+  Index start = 0;
+  for (auto& [b, n] : next) start += std::exchange(n, start);
+  std::vector<Index> position(total);
+  o.hexes.resize(total);
+  o.hex_block.resize(total);
+  out_.hex_gid.resize(total);
+  for (std::size_t k = 0; k < total; ++k) {
+    const Index at = next[block[k]]++;
+    position[k] = at;
+    const auto p = static_cast<std::size_t>(at);
+    o.hex_block[p] = block[k];
+    std::array<Index, 8>& x = o.hexes[p];
+    if (k < first_diced) {
+      out_.hex_gid[p] = static_cast<std::int64_t>(zone_first_ + k);
+      for (int c = 0; c < 8; ++c) x[c] = local(zone_out_.hexes[zone_first_ + k][c]);
+    } else {
+      const std::size_t j = k - first_diced;
+      out_.hex_gid[p] = diced_hex_first_ + static_cast<std::int64_t>(j);
+      const auto& child = j < nh        ? diced_.hex_children[j]
+                          : j < nh + nt ? diced_.tet_children[j - nh]
+                                        : diced_.wedge_children[j - nh - nt];
+      for (int c = 0; c < 8; ++c) x[c] = diced_local[static_cast<std::size_t>(child[c])];
+    }
+  }
+  block = {};
+  const Index hex_children = static_cast<Index>(nh);
+  const Index tet_children = static_cast<Index>(nt);
+  // Side sets read the diced numbering.
+  const auto diced_sides =
+      primal::diced_side_sets(om, diced_, 0, hex_children, hex_children + tet_children);
+  const auto diced_nodes = primal::diced_node_sets(om, diced_, diced_local);
+  {
+    primal::DicedModel released;  // the dicing data, consumed
+    diced_ = std::move(released);
+  }
+  o.block_names = m().block_names;
+  o.block_names.insert(zone_out_.block_names.begin(), zone_out_.block_names.end());
+  // Sets: the zone's (on this rank's nodes and hexes) and the diced ones, by id.
+  for (std::size_t s = 0; s < zone_out_.node_sets.size(); ++s) {
+    const primal::NodeSet& z = zone_out_.node_sets[s];
+    primal::NodeSet ns{z.id, z.name, {}};
+    for (Index v : z.nodes) {
+      const auto it = std::lower_bound(gids.begin(), gids.end(), std::int64_t{v});
+      if (it != gids.end() && *it == v) ns.nodes.push_back(static_cast<Index>(it - gids.begin()));
+    }
+    for (const primal::NodeSet& d : diced_nodes)
+      if (d.id == z.id) ns.nodes.insert(ns.nodes.end(), d.nodes.begin(), d.nodes.end());
+    std::sort(ns.nodes.begin(), ns.nodes.end());
+    ns.nodes.erase(std::unique(ns.nodes.begin(), ns.nodes.end()), ns.nodes.end());
+    o.node_sets.push_back(std::move(ns));
+  }
+  for (std::size_t s = 0; s < zone_out_.side_sets.size(); ++s) {
+    const primal::SideSet& z = zone_out_.side_sets[s];
+    primal::SideSet ss{z.id, z.name, {}};
+    for (const primal::Side& side : z.sides) {
+      const auto h = static_cast<std::size_t>(side.element.index);
+      if (h >= zone_first_ && h < zone_last_)
+        ss.sides.push_back({{ElementKind::Hex, position[h - zone_first_]}, side.face});
+    }
+    for (const primal::SideSet& d : diced_sides)
+      if (d.id == z.id)
+        for (const primal::Side& side : d.sides)
+          ss.sides.push_back(
+              {{ElementKind::Hex,
+                position[first_diced + static_cast<std::size_t>(side.element.index)]},
+               side.face});
+    std::sort(ss.sides.begin(), ss.sides.end());
+    o.side_sets.push_back(std::move(ss));
+  }
+  // Shared nodes per neighbour, and the global counts.
+  std::vector<Mask> holders(gids.size(), 0);
+  for (std::size_t i = 0; i < nd; ++i)
+    holders[static_cast<std::size_t>(diced_local[i])] |= diced_holders_[i];
+  for (std::size_t l = 0; l < gids.size(); ++l)
+    if (gids[l] < zone_nodes) holders[l] |= zone_holders_[static_cast<std::size_t>(gids[l])];
+  for (std::size_t l = 0; l < gids.size(); ++l)
+    for (int q = 0; q < size_; ++q)
+      if (q != rank_ && (holders[l] >> q & 1))
+        out_.shared_nodes[q].push_back(static_cast<Index>(l));
+  out_.node_gid = std::move(gids);
+  std::map<int, std::int64_t> blocks;
+  for (int b : o.hex_block) ++blocks[b];
+  std::vector<int> ids;
+  for (const auto& [id, name] : o.block_names) ids.push_back(id);
+  for (int b : zone_out_.hex_block) ids.push_back(b);
+  for (const auto& b : own_.model.hex_block) ids.push_back(b);
+  for (const auto& b : own_.model.tet_block) ids.push_back(b);
+  for (const auto& b : own_.model.wedge_block) ids.push_back(b);
+  // Every rank must list the same blocks: the union over ranks.
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  int n = static_cast<int>(ids.size());
+  std::vector<int> counts(static_cast<std::size_t>(size_)), displs(counts.size());
+  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
+  std::exclusive_scan(counts.begin(), counts.end(), displs.begin(), 0);
+  std::vector<int> every(static_cast<std::size_t>(displs.back() + counts.back()));
+  MPI_Allgatherv(ids.data(), n, MPI_INT, every.data(), counts.data(), displs.data(), MPI_INT,
+                 comm_);
+  std::sort(every.begin(), every.end());
+  every.erase(std::unique(every.begin(), every.end()), every.end());
+  std::vector<std::int64_t> local_counts, global_counts(every.size());
+  for (int b : every) local_counts.push_back(blocks.count(b) ? blocks[b] : 0);
+  MPI_Allreduce(local_counts.data(), global_counts.data(), static_cast<int>(every.size()),
+                MPI_INT64_T, MPI_SUM, comm_);
+  for (std::size_t k = 0; k < every.size(); ++k)
+    out_.global_block_hexes[every[k]] = global_counts[k];
+  // A node set's nodes counted once, by their lowest holder.
+  std::vector<std::int64_t> set_counts;
+  for (const primal::NodeSet& ns : o.node_sets) {
+    std::int64_t c = 0;
+    for (Index v : ns.nodes)
+      if (std::countr_zero(holders[static_cast<std::size_t>(v)] | Mask{1} << rank_) == rank_) ++c;
+    set_counts.push_back(c);
+  }
+  out_.global_node_set_nodes.resize(set_counts.size());
+  MPI_Allreduce(set_counts.data(), out_.global_node_set_nodes.data(),
+                static_cast<int>(set_counts.size()), MPI_INT64_T, MPI_SUM, comm_);
+  set_counts.clear();
+  for (const primal::SideSet& ss : o.side_sets)
+    set_counts.push_back(static_cast<std::int64_t>(ss.sides.size()));
+  out_.global_side_set_sides.resize(set_counts.size());
+  MPI_Allreduce(set_counts.data(), out_.global_side_set_sides.data(),
+                static_cast<int>(set_counts.size()), MPI_INT64_T, MPI_SUM, comm_);
+}
+
+// What holds piece by piece of a hex mesh: nodes in range and finite, no repeated corner, no
+// face of three hexes, none seen twice in one order, no corner Jacobian <= 0, the covering at
+// the nodes not `exempt`. The boundary, the Euler characteristic and manifoldness are the whole
+// mesh's, not a piece's (two pieces may meet at an edge).
+bool piece_ok(const primal::HexValidityReport& v, const std::vector<char>& exempt) {
+  std::size_t overlapping = 0;
+  for (const auto& c : v.overlapping_nodes)
+    overlapping += exempt.empty() || !exempt[static_cast<std::size_t>(c.node)];
+  return v.out_of_range_hexes.empty() && v.non_finite_nodes.empty() &&
+         v.repeated_node_hexes.empty() && v.overshared_faces.empty() &&
+         v.misoriented_faces.empty() && v.inverted_hexes.empty() && overlapping == 0;
+}
+
+// Every rank's hexes checked as a piece (piece_ok, its shared nodes exempt from the covering),
+// and the zone as conform checked it, as a piece too (its cut is not the model's boundary).
+// The diced rest is the dicing of valid elements; the joined file (--join) can be checked
+// whole with `geode check`.
+void Distributor::verify() {
+  primal::HexMesh mesh;  // borrowed, not copied
+  mesh.points = std::move(out_.model.points);
+  mesh.hexes = std::move(out_.model.hexes);
+  const auto v = primal::check_validity(mesh);
+  out_.model.points = std::move(mesh.points);
+  out_.model.hexes = std::move(mesh.hexes);
+  std::vector<char> shared(out_.model.points.size(), 0);
+  for (const auto& [q, nodes] : out_.shared_nodes)
+    for (Index n : nodes) shared[static_cast<std::size_t>(n)] = 1;
+  const bool ok = piece_ok(v, shared);
+  if (!ok) rep_.warnings.push_back("rank " + std::to_string(rank_) + ": " + v.summary());
+  const bool zone_ok = piece_ok(rep_.zone.validity, {});
+  if (!zone_ok) rep_.warnings.push_back("the transition zone: " + rep_.zone.validity.summary());
+  int mine = ok && zone_ok ? 1 : 0, all = 0;
+  MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_MIN, comm_);
+  rep_.valid = all == 1;
+}
+
+}  // namespace
+
+RankMesh conform_distributed(const primal::Model& input, const DistributedOptions& options,
+                             MPI_Comm comm, DistributedReport* report) {
+  DistributedReport local;
+  return Distributor(input, options, comm, report ? *report : local).run();
+}
+
+}  // namespace geode::parallel

@@ -1,0 +1,68 @@
+#pragma once
+// conform (conform/conform.hpp) under MPI, with a result that does not depend on the number of
+// ranks: the output of every rank joined is the serial run's, node for node and hex for hex.
+//
+// Every rank reads the whole input (inputs are ~25x smaller than outputs). Its elements are
+// partitioned by METIS (parallel/partition.hpp). The transition zone Z, every element within
+// `rings` node rings of a node used by both a hex and a tet (plus the elements setting the
+// yardstick and any inverted element, which the serial run also smooths), is conformed on
+// every rank, the same computation everywhere; conform reads nothing outside it but the
+// yardstick, which the lowest elements carry in. Wedges seed the zone as well (their diced
+// nodes' bits depend on which wedge makes them first), so a model of many wedges is mostly zone.
+// The result is checked: the outer two rings of Z must come out as plain dicing, bit for bit (the
+// smoothing and the buffer layer stopped short of the cut), else Z is grown (rings doubled) and
+// conformed again. Everything else is plain dicing (primal/dice_model.hpp): each rank dices only
+// its own elements outside Z, and dicing depends only on an element and its nodes, so a rank's
+// hexes are the serial run's.
+//
+// Global ids (0-based): Z's output nodes and hexes first in Z's output order (the same on every
+// rank count); then the diced nodes and hexes, rank by rank, each owned by the lowest rank
+// holding it. A diced node on the cut takes Z's node at its position (the same bits: the same
+// formula over the same nodes). Diced nodes shared by ranks are found by their origin (the
+// sorted input nodes they are made from) exchanged between the ranks whose elements hold all of
+// them.
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <mpi.h>
+
+#include <geode/conform/conform.hpp>
+#include <geode/primal/model.hpp>
+
+namespace geode::parallel {
+
+struct DistributedOptions {
+  conform::ConformOptions conform;
+  int rings = 4;       // depth of the transition zone, doubled until the check passes
+  int max_rings = 64;  // TopologyError past this
+};
+
+// One rank's share of the output.
+struct RankMesh {
+  primal::Model model;  // hexes only, by block in ascending id then by global id
+  std::vector<std::int64_t> node_gid, hex_gid;  // per local node / hex
+  // Per other rank sharing nodes with this one: those local nodes, in ascending global id.
+  std::map<int, std::vector<primal::Index>> shared_nodes;
+  std::int64_t global_nodes = 0, global_hexes = 0;
+  std::map<int, std::int64_t> global_block_hexes;  // per block id: hexes over all ranks
+  std::vector<std::int64_t> global_node_set_nodes, global_side_set_sides;  // per set
+};
+
+struct DistributedReport {
+  conform::ConformResult zone;  // the transition zone's conform (its model moved out)
+  int rings = 0;                // the depth that passed the check
+  std::int64_t zone_cells = 0, cells = 0, zone_hexes = 0, diced_hexes = 0;  // this rank's diced
+  bool valid = true;  // the zone and every rank's piece valid (distributed_conform.cpp)
+  std::vector<std::string> warnings;
+  std::map<std::string, double> seconds;  // per stage, this rank
+};
+
+// Collective over `comm`. Throws InvalidInput / TopologyError as conform does, on every rank
+// alike (the zone is the same everywhere); InvalidInput for --smooth global (it moves every
+// node) and a named geode block.
+RankMesh conform_distributed(const primal::Model& input, const DistributedOptions& options,
+                             MPI_Comm comm, DistributedReport* report = nullptr);
+
+}  // namespace geode::parallel
