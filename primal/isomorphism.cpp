@@ -86,13 +86,13 @@ Complex<N> build_complex(std::size_t n_nodes, const Cells<N>& cells, const char*
           throw InvalidInput(name + ": node " + std::to_string(cell[c]) + " repeated");
       cx.node_cells[cell[c]].push_back(static_cast<Index>(i));
     }
-    for (const auto& e : K::kEdges) {
+    for (const auto& e : K::kEdgeTable) {
       cx.node_neighbors[cell[e[0]]].push_back(cell[e[1]]);
       cx.node_neighbors[cell[e[1]]].push_back(cell[e[0]]);
     }
     for (int f = 0; f < K::kFacets; ++f) {
       std::array<Index, K::kFacetSize> key{};
-      for (int k = 0; k < K::kFacetSize; ++k) key[k] = cell[K::kFacets[f][k]];
+      for (int k = 0; k < K::kFacetSize; ++k) key[k] = cell[K::kFacetTable[f][k]];
       std::sort(key.begin(), key.end());
       facets[key].push_back({static_cast<Index>(i), f});
     }
@@ -283,7 +283,7 @@ std::optional<MeshMapping> search(std::size_t na_nodes, const Cells<N>& a_cells,
     }
     // The image of the shared facet is known: the candidate is the other b cell on it.
     std::array<Index, K::kFacetSize> img{};
-    for (int k = 0; k < K::kFacetSize; ++k) img[k] = map[a_cells[pc][K::kFacets[pf][k]]];
+    for (int k = 0; k < K::kFacetSize; ++k) img[k] = map[a_cells[pc][K::kFacetTable[pf][k]]];
     for (Index c : b.node_cells[img[0]]) {
       if (used[c]) continue;
       const auto& bc = b_cells[c];

@@ -164,8 +164,8 @@ struct CellTopology<3> {
   static constexpr int kFacets = kHexFaces;
   static constexpr int kFacetSize = 4;
   static constexpr const char* kCellName = "hex";
-  static constexpr const auto& kEdges = kHexEdgeCorners;
-  static constexpr const auto& kFacets = kHexFaceCorners;
+  static constexpr const auto& kEdgeTable = kHexEdgeCorners;
+  static constexpr const auto& kFacetTable = kHexFaceCorners;
   static constexpr int edge_class(int e) { return e / 4; }
 };
 
@@ -175,8 +175,8 @@ struct CellTopology<2> {
   static constexpr int kFacets = 4;
   static constexpr int kFacetSize = 2;
   static constexpr const char* kCellName = "quad";
-  static constexpr const auto& kEdges = kQuadEdgeCorners;
-  static constexpr const auto& kFacets = kQuadEdgeCorners;
+  static constexpr const auto& kEdgeTable = kQuadEdgeCorners;
+  static constexpr const auto& kFacetTable = kQuadEdgeCorners;
   static constexpr int edge_class(int e) { return e % 2; }  // opposite edges i, i + 2
 };
 

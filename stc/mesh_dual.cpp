@@ -127,7 +127,7 @@ MeshDual<Dim> build(std::size_t n_nodes,
                              std::to_string(j) + " and " + std::to_string(k));
     }
     for (int e = 0; e < MeshDual<Dim>::kCellEdges; ++e) {
-      const Index a = cell[R::kEdges[e][0]], b = cell[R::kEdges[e][1]];
+      const Index a = cell[R::kEdgeTable[e][0]], b = cell[R::kEdgeTable[e][1]];
       auto [it, fresh] = edge_id.emplace(pair_key(a, b), static_cast<Index>(dual.edges.size()));
       if (fresh) dual.edges.push_back({std::min(a, b), std::max(a, b)});
       dual.cell_edges[c][e] = it->second;
@@ -171,19 +171,20 @@ MeshDual<Dim> build(std::size_t n_nodes,
   for (Index c = 0; c < n_cells; ++c)
     for (int f = 0; f < R::kFacets; ++f) {
       std::array<Index, R::kFacetSize> key{};
-      for (int k = 0; k < R::kFacetSize; ++k) key[k] = cells[c][R::kFacets[f][k]];
+      for (int k = 0; k < R::kFacetSize; ++k) key[k] = cells[c][R::kFacetTable[f][k]];
       std::sort(key.begin(), key.end());
       by_key[pair_key(key[0], key[1])].push_back({c, f});
     }
   for (Index c = 0; c < n_cells; ++c)
     for (int f = 0; f < R::kFacets; ++f) {
       std::array<Index, R::kFacetSize> key{};
-      for (int k = 0; k < R::kFacetSize; ++k) key[k] = cells[c][R::kFacets[f][k]];
+      for (int k = 0; k < R::kFacetSize; ++k) key[k] = cells[c][R::kFacetTable[f][k]];
       std::sort(key.begin(), key.end());
       std::vector<Index> users;
       for (const CellFacet& g : by_key[pair_key(key[0], key[1])]) {
         std::array<Index, R::kFacetSize> other{};
-        for (int k = 0; k < R::kFacetSize; ++k) other[k] = cells[g.cell][R::kFacets[g.local][k]];
+        for (int k = 0; k < R::kFacetSize; ++k)
+          other[k] = cells[g.cell][R::kFacetTable[g.local][k]];
         std::sort(other.begin(), other.end());
         if (other == key) users.push_back(g.cell);
       }
