@@ -32,6 +32,7 @@ struct ConformArgs {
   std::string report;
   std::string smooth = "local";
   std::string quality = "sj";
+  std::string verify = "local";
   std::string geode_block;
   std::string model = "half";
   std::string save_input;
@@ -160,6 +161,7 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
   opts.smooth = conform::parse_conform_smooth(a.smooth);
   opts.pyramids = conform::parse_conform_pyramids(a.pyramids);
   opts.quality = conform::parse_conform_quality(a.quality);
+  opts.verify = conform::parse_conform_verify(a.verify);
   opts.geode_block = a.geode_block;
   opts.buffer.side = conform::parse_buffer_side(a.buffer_side);
   opts.buffer.thickness = std::max(a.buffer_thickness, 0.0);  // 0: the side's default
@@ -250,6 +252,13 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
                 "sj: validity and the scaled Jacobian per block (default, cheap); full: every "
                 "metric of the paper's Table 1 per block")
       ->check(CLI::IsMember({"sj", "full"}))
+      ->capture_default_str();
+  c->add_option("--verify", a.verify,
+                "local (default): the full validity check on the geode hexes, what smoothing\n"
+                "moved and two rings around them, the diced parts against the dicing tables and\n"
+                "every hex's corner Jacobians; full: the full check on the whole output (slower;\n"
+                "--smooth global is always verified whole)")
+      ->check(CLI::IsMember({"local", "full"}))
       ->capture_default_str();
   c->add_option(
       "--geode-block", a.geode_block,
