@@ -40,6 +40,7 @@ TEST_CASE("local verification gives the full check's verdict on every demo model
     CAPTURE(name);
     const primal::Model m = demo_input(name, 2, dir);
     conform::ConformOptions local, full;
+    local.verify = conform::ConformVerify::kLocal;
     full.verify = conform::ConformVerify::kFull;
     const auto a = conform::conform(m, local);
     const auto b = conform::conform(m, full);
@@ -56,12 +57,14 @@ TEST_CASE("local verification gives the full check's verdict on every demo model
 }
 
 TEST_CASE("local verification reads the transition's surroundings, not the whole output") {
-  const auto r = conform::conform(demo::demo_model("delaunay", 4));
+  conform::ConformOptions local;
+  local.verify = conform::ConformVerify::kLocal;
+  const auto r = conform::conform(demo::demo_model("delaunay", 4), local);
   CHECK(conform::result_valid(r));
   CHECK(r.verified == conform::ConformVerify::kLocal);
   CHECK(r.verified_hexes >= r.geode_hexes);
   CHECK(r.verified_hexes < static_cast<Index>(r.model.hexes.size()));
-  conform::ConformOptions global;
+  conform::ConformOptions global = local;
   global.smooth = conform::ConformSmooth::kGlobal;  // moves every node: verified whole
   const auto g = conform::conform(demo::demo_model("delaunay", 2), global);
   CHECK(g.verified == conform::ConformVerify::kFull);
@@ -72,6 +75,7 @@ TEST_CASE(
     "the region check finds a torn transition, a flipped hex anywhere, and agrees when whole") {
   const auto r = conform::conform(demo::demo_model("delaunay", 2));
   REQUIRE(conform::result_valid(r));
+  CHECK(r.verified == conform::ConformVerify::kFull);  // the default, until inputs are checked
   primal::HexMesh mesh = primal::hex_part(r.model);
   const Index first_geode = r.diced_hexes;
   std::vector<Index> geode(static_cast<std::size_t>(r.geode_hexes));
