@@ -10,13 +10,13 @@
 
 #include <geode/conform/conform.hpp>
 #include <geode/conform/report.hpp>
-#include <geode/demo/demo_models.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/quality_report.hpp>
 #include <geode/primal/topology.hpp>
 #include "cli/commands.hpp"
 #include "cli/conventions.hpp"
+#include "cli/demo_module.hpp"
 #include "cli/progress.hpp"
 
 namespace geode::cli {
@@ -353,7 +353,16 @@ void add_conform_commands(CLI::App& app) {
        "and wedges side by side); potting: six hex parts (boxes, swept cylinders, a tilted box, "
        "an\n"
        "L bracket), each its own block, in a Delaunay tet potting (n >= 2)")
-      ->check(CLI::IsMember(demo::demo_model_names()))
+      // Checked against the module's names when given (loading libgmsh then, not at startup).
+      ->check(CLI::Validator(
+          [](std::string& name) {
+            const auto& names = demo_module().names();
+            if (std::find(names.begin(), names.end(), name) != names.end()) return std::string();
+            std::string list;
+            for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+            return name + " not in {" + list + "}";
+          },
+          "NAME"))
       ->capture_default_str();
   d->add_option("-n,--size", dargs->n,
                 "cells per unit length (1 to 64; default 4; nugget, fulcher round up to even)")
@@ -370,7 +379,7 @@ void add_conform_commands(CLI::App& app) {
       check_output_path(dargs->save_input);
       save_format = output_format(dargs->save_input, "", mesh_format_names(), "");
     }
-    primal::Model model = demo::demo_model(dargs->model, dargs->n);
+    primal::Model model = demo_module().model(dargs->model, dargs->n);
     if (!dargs->save_input.empty()) {
       OutputFiles files;
       files.add(dargs->save_input, [&](const fs::path& temp) {

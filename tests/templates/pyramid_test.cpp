@@ -10,6 +10,7 @@
 #include <map>
 #include <set>
 
+#include <geode/demo/gmsh_session.hpp>
 #include <geode/io/gmsh.hpp>
 #include <geode/primal/boundary.hpp>
 #include <geode/primal/errors.hpp>
@@ -36,7 +37,7 @@ std::array<Point, 5> equilateral() {
 // One pyramid refined by Gmsh's all-hex subdivision (Mesh.SubdivisionAlgorithm = 2, the
 // RefineMesh of `gmsh -refine`): hexes in Gmsh's order (VTK's for linear hexes).
 primal::HexMesh gmsh_pyramid_filling(const std::array<Point, 5>& c) {
-  io::GmshSession session;
+  demo::GmshSession session;
   gmsh::model::add("pyramid");
   const int volume = gmsh::model::addDiscreteEntity(3);
   std::vector<double> xyz;
