@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include <geode/demo/gmsh_session.hpp>
 #include <geode/io/gmsh.hpp>
 #include <geode/primal/grid_model.hpp>
 #include <geode/primal/topology.hpp>
@@ -30,7 +31,7 @@ using namespace geode::primal;
 namespace {
 
 void gmsh_write(const Model& model, const fs::path& file, bool binary, bool v22) {
-  io::GmshSession session;
+  demo::GmshSession session;
   gmsh::model::add("bench");
   std::vector<std::size_t> tags(model.points.size());
   std::vector<double> xyz;

@@ -26,6 +26,7 @@
 #include <geode/primal/smooth.hpp>
 #include <geode/primal/split_pyramids.hpp>
 #include <geode/primal/topology.hpp>
+#include <geode/primal/validity_local.hpp>
 
 namespace geode::conform {
 namespace {
@@ -152,6 +153,8 @@ class Conformer {
   double measure();                            // every hex, then scan()
   void measure(std::span<const Index> hexes);  // these only, the others unchanged since
   double scan();                               // inverted_ and the minimum from sj_
+  void check_dicing();
+  bool verify_locally() const;
   void verify();
   void output();
 
@@ -183,6 +186,9 @@ class Conformer {
   std::vector<double> hex_diced_, tet_diced_;  // per input hex and tet: diced alone
   std::vector<Index> diced_parent_;  // per output diced hex (the first ones): its input hex
   std::vector<Index> geode_first_;  // per buffer hex: its first output hex (then one past the last)
+  // The hexes whose nodes smoothing or untangling could move (their regions), for verify().
+  std::vector<Index> moved_;
+  double dicing_check_seconds_ = 0.0;  // check_dicing, run while the dicing data exist
 };
 
 void Conformer::find_interface() {
@@ -327,9 +333,24 @@ void Conformer::dice_and_merge() {
   res_.diced_hexes = static_cast<Index>(diced_.hex_children.size());
   res_.diced_tet_hexes = static_cast<Index>(diced_.tet_children.size());
   res_.diced_wedge_hexes = static_cast<Index>(diced_.wedge_children.size());
+  check_dicing();
   say("dicing: " + std::to_string(res_.diced_hexes) + " hexes from hexes, " +
       std::to_string(res_.diced_tet_hexes) + " from tets, " +
       std::to_string(res_.diced_wedge_hexes) + " from wedges" + took());
+}
+
+// Local verification: the diced children against the dicer's tables, now that they exist (the
+// dicing data are gone by verify()); the children's topology is final here, smoothing moves
+// nodes only.
+void Conformer::check_dicing() {
+  if (!verify_locally()) return;
+  const auto t = Clock::now();
+  res_.dicing = primal::check_dicing(layer_.model, diced_);
+  dicing_check_seconds_ = since(t);
+}
+
+bool Conformer::verify_locally() const {
+  return options_.verify == ConformVerify::kLocal && options_.smooth != ConformSmooth::kGlobal;
 }
 
 // A template in every buffer hex: tet/hex-side nodes become their diced node, interior nodes
@@ -642,6 +663,7 @@ void Conformer::untangle() {
 // Several smoothing calls report as one: their work adds up; the minima and inverted counts
 // are the whole mesh's (set in smooth() and untangle()).
 void Conformer::add_smoothing(const primal::LocalSmoothResult& r) {
+  moved_.insert(moved_.end(), r.region.begin(), r.region.end());
   auto& s = res_.smoothing;
   s.patches += r.patches, s.rounds += r.rounds, s.iterations += r.iterations;
   s.seconds += r.seconds, s.cpu_seconds += r.cpu_seconds;
@@ -825,7 +847,24 @@ double Conformer::scan() {
 
 void Conformer::verify() {
   t0_ = Clock::now();
-  res_.validity = primal::check_validity(mesh_);
+  if (verify_locally()) {
+    // Seeds: the geode hexes and whatever smoothing could move; the rest is diced, checked
+    // against the dicing tables in check_dicing().
+    std::vector<Index> seeds = std::move(moved_);
+    moved_ = {};
+    if (!geode_first_.empty())
+      for (Index h = geode_first_.front(); h < geode_first_.back(); ++h) seeds.push_back(h);
+    primal::RegionValidityOptions o;
+    o.scaled_jacobians = sj_;  // current: a hex above 0 has positive corners
+    res_.validity = primal::check_validity_around(mesh_, seeds, o);
+    res_.verified = ConformVerify::kLocal;
+    res_.verified_hexes = res_.validity.num_cells;
+    if (!res_.dicing.ok()) res_.warnings.push_back("invalid dicing: " + res_.dicing.summary());
+  } else {
+    res_.validity = primal::check_validity(mesh_);
+    res_.verified = ConformVerify::kFull;
+    res_.verified_hexes = static_cast<Index>(mesh_.hexes.size());
+  }
   if (!res_.validity.ok()) res_.warnings.push_back("invalid mesh: " + res_.validity.summary());
   if (!inverted_.empty()) {
     std::ostringstream m;
@@ -880,7 +919,11 @@ void Conformer::verify() {
     }
   }
   sj_ = {};
-  say("verification: " + std::string(res_.validity.ok() ? "valid" : "INVALID") + took());
+  const bool valid = res_.validity.ok() && res_.dicing.ok();
+  say("verification (" + std::string(res_.verified == ConformVerify::kLocal ? "local" : "full") +
+      ", " + std::to_string(res_.verified_hexes) +
+      " hexes checked whole): " + (valid ? "valid" : "INVALID") + " (" +
+      std::to_string(since(t0_) + dicing_check_seconds_) + " s)");
 }
 
 void Conformer::output() {
@@ -908,6 +951,12 @@ ConformQuality parse_conform_quality(const std::string& word) {
   if (word == "sj") return ConformQuality::kScaledJacobian;
   if (word == "full") return ConformQuality::kFull;
   throw InvalidInput("quality report '" + word + "': expected sj or full");
+}
+
+ConformVerify parse_conform_verify(const std::string& word) {
+  if (word == "local") return ConformVerify::kLocal;
+  if (word == "full") return ConformVerify::kFull;
+  throw InvalidInput("verification '" + word + "': expected local or full");
 }
 
 ConformPyramids parse_conform_pyramids(const std::string& word) {

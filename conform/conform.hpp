@@ -21,6 +21,7 @@
 #include <vector>
 
 #include <geode/conform/buffer_layer.hpp>
+#include <geode/primal/dice_model.hpp>
 #include <geode/primal/local_smooth.hpp>
 #include <geode/primal/model.hpp>
 #include <geode/primal/quality_report.hpp>
@@ -39,6 +40,17 @@ enum class ConformQuality { kScaledJacobian, kFull };
 
 // "sj" or "full"; InvalidInput naming the word otherwise.
 ConformQuality parse_conform_quality(const std::string& word);
+
+// How much of the output the verification checks. kLocal: check_validity's full check on the
+// geode hexes, the hexes smoothing could move and two rings around them
+// (primal/validity_local.hpp), the diced parts through the dicer's tables
+// (primal::check_dicing: children as their tables make them, no node made twice) and every
+// hex's corner Jacobians; the diced parts of a valid input are then valid by construction.
+// kFull: check_validity on the whole output (the cost of several dicings).
+enum class ConformVerify { kLocal, kFull };
+
+// "local" or "full"; InvalidInput naming the word otherwise.
+ConformVerify parse_conform_verify(const std::string& word);
 
 // What becomes of the pyramids of a hybrid mesh: kSplit, each pyramid as two tets along the
 // base diagonal giving the better tets (primal/split_pyramids.hpp), its base quad then getting
@@ -83,6 +95,12 @@ struct ConformOptions {
   // below this scaled Jacobian seed patches.
   double smooth_target = 0.0;
   ConformQuality quality = ConformQuality::kScaledJacobian;
+  // kLocal takes the diced parts as valid by construction, so it is sound only on a valid input
+  // (faces shared by at most two cells, manifold edges and vertices): the default becomes kLocal
+  // once the input is checked at read time (issue 28); a non-manifold input far from the
+  // interface would pass kLocal. kGlobal smoothing moves every node: its output is verified whole
+  // whatever this says.
+  ConformVerify verify = ConformVerify::kFull;
   // kLocal, kGlobal's automatic passes, and the untangling of hexes still inverted (with any
   // mode); the automatic target replaces its target, goal and max_visits. A narrower margin and
   // a larger loss than the primal defaults: hexes near the worst of a patch must give a little
@@ -178,7 +196,12 @@ struct ConformResult {
   // The smoothing and untangling calls added up; the minima and inverted counts are the whole
   // mesh's before and after (kNone: no patches when nothing was inverted).
   primal::LocalSmoothResult smoothing;
+  // The validity check (of the region ConformVerify::kLocal names, or of the whole output) and,
+  // kLocal, the dicing against its tables; result_valid (report.hpp) needs both ok().
   primal::HexValidityReport validity;
+  primal::DicingCheck dicing;
+  ConformVerify verified = ConformVerify::kFull;
+  primal::Index verified_hexes = 0;  // hexes check_validity read
   std::vector<BlockQuality>
       quality;  // one per output block, ascending id ("block N" unnamed); ConformOptions::quality
   std::vector<std::string>

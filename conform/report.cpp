@@ -20,7 +20,7 @@ double output_min_scaled_jacobian(const ConformResult& r) {
 }
 
 bool result_valid(const ConformResult& r) {
-  if (!r.validity.ok()) return false;
+  if (!r.validity.ok() || !r.dicing.ok()) return false;
   return std::all_of(r.quality.begin(), r.quality.end(), [](const BlockQuality& b) {
     return block_min_scaled_jacobian(b.report) > 0.0;
   });
@@ -58,7 +58,9 @@ nlohmann::json report_json(const ConformResult& r) {
       {"hexes", r.model.hexes.size()},        {"nodes", r.model.points.size()},
       {"diced_hexes", r.diced_hexes},         {"geode_hexes", r.geode_hexes},
       {"diced_tet_hexes", r.diced_tet_hexes}, {"diced_wedge_hexes", r.diced_wedge_hexes}};
-  j["valid"] = r.validity.ok();
+  j["valid"] = r.validity.ok() && r.dicing.ok();
+  j["verification"] = {{"scope", r.verified == ConformVerify::kLocal ? "local" : "full"},
+                       {"hexes_checked_whole", r.verified_hexes}};
   j["template_min_scaled_jacobian"] = r.template_min_scaled_jacobian;
   j["min_scaled_jacobian_before_smoothing"] = r.min_scaled_jacobian_before_smoothing;
   j["min_scaled_jacobian_after_smoothing"] = r.smoothing.final_min_scaled_jacobian;

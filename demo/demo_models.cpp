@@ -13,6 +13,7 @@
 #include <string>
 #include <utility>
 
+#include <geode/demo/gmsh_session.hpp>
 #include <geode/io/gmsh.hpp>
 #include <geode/primal/boundary.hpp>
 #include <geode/primal/errors.hpp>

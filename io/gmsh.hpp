@@ -2,8 +2,8 @@
 // Gmsh .msh input and output of a mixed model (hexes, tets, pyramids, prisms). Reading is our own
 // (gmsh_read.cpp: versions 2.2 and 4.1, ASCII and binary), so that a user's file never reaches
 // libgmsh, which would run any text that is not a mesh as a Gmsh script. Writing is our own too
-// (gmsh_write.cpp: 4.1 and 2.2, ASCII and binary, every write error reported); only the demo
-// models use the Gmsh C++ API (GmshSession, model_from_gmsh).
+// (gmsh_write.cpp: 4.1 and 2.2, ASCII and binary, every write error reported); io never calls
+// libgmsh: only the demo models use the Gmsh C++ API (demo/gmsh_session.hpp).
 //
 // Mapping between a Model and Gmsh's entities:
 // - element blocks  <-> volume entities; the block id is the entity's physical group of
@@ -77,20 +77,5 @@ primal::Model parse_gmsh(std::string_view content, const std::string& source,
 // points, each with its id and name.
 void write_gmsh(const primal::Model& model, const std::filesystem::path& path,
                 GmshFormat format = GmshFormat::Ascii, GmshVersion version = GmshVersion::k41);
-
-// RAII: initializes the Gmsh API (no config files, General.Terminal = 0) and finalizes it on
-// destruction. Gmsh's state is global: do not nest sessions or use them from several threads.
-class GmshSession {
- public:
-  GmshSession();
-  ~GmshSession();
-  GmshSession(const GmshSession&) = delete;
-  GmshSession& operator=(const GmshSession&) = delete;
-};
-
-// Converts Gmsh's current model (inside a GmshSession) to a Model, as read_gmsh does after
-// opening; `source` names it in error messages. Lets builders that mesh with the Gmsh API
-// (demo/demo_models.hpp) share the reader's conversion.
-primal::Model model_from_gmsh(std::string_view source);
 
 }  // namespace geode::io

@@ -241,16 +241,26 @@ void check_block(std::size_t block, std::size_t elements, const char* what) {
 
 }  // namespace
 
+const DicingTable8& hex_dicing_table() {
+  static const DicingTable8 table = tensor_children<3>();
+  return table;
+}
+
+const DicingTable4& tet_dicing_table() {
+  static const DicingTable4 table = simplex_children<3>();
+  return table;
+}
+
 DicedHexMesh dice(const HexMesh& mesh) {
   check_block(mesh.block.size(), mesh.hexes.size(), "hex");
-  static const auto table = tensor_children<3>();
-  return finish<DicedHexMesh>(dice_elements(mesh.points, mesh.hexes, table, "hex"), mesh.block);
+  return finish<DicedHexMesh>(dice_elements(mesh.points, mesh.hexes, hex_dicing_table(), "hex"),
+                              mesh.block);
 }
 
 DicedHexMesh dice(const TetMesh& mesh) {
   check_block(mesh.block.size(), mesh.tets.size(), "tet");
-  static const auto table = simplex_children<3>();
-  return finish<DicedHexMesh>(dice_elements(mesh.points, mesh.tets, table, "tet"), mesh.block);
+  return finish<DicedHexMesh>(dice_elements(mesh.points, mesh.tets, tet_dicing_table(), "tet"),
+                              mesh.block);
 }
 
 DicedQuadMesh dice(const QuadMesh& mesh) {

@@ -47,6 +47,14 @@ DicedHexMesh dice(const TetMesh& mesh);    // 4 per tet; child c has parent corn
 DicedQuadMesh dice(const QuadMesh& mesh);  // 4 per quad; like hexes
 DicedQuadMesh dice(const TriMesh& mesh);   // 3 per triangle; like tets
 
+// The dicing tables dice() works from: table[child][k] is the bit mask of the parent's local
+// corners whose centroid child corner k is (one bit: the corner itself; all bits: the cell
+// centre). check_dicing (dice_model.hpp) reads a diced model against them.
+using DicingTable8 = std::array<std::array<unsigned, 8>, 8>;
+using DicingTable4 = std::array<std::array<unsigned, 8>, 4>;
+const DicingTable8& hex_dicing_table();
+const DicingTable4& tet_dicing_table();
+
 // The lowest scaled Jacobian (primal/quality.hpp) of the hexes `dice` would make of these
 // elements, computed element by element without building the diced mesh: what an element
 // part gives when diced alone, the yardstick for a transition placed beside it. 1 when empty.

@@ -1,7 +1,13 @@
 #include <geode/primal/dice_model.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <set>
+#include <sstream>
+#include <tuple>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <geode/primal/dice.hpp>
 #include <geode/primal/errors.hpp>
@@ -88,7 +94,195 @@ void dice_wedges(const Model& model, DicedModel& out) {
   }
 }
 
+// The wedge rule of dice_wedges as a dicing table: child k's corners as masks over the wedge's
+// corners (k, its edges to n0, n1, n2, the faces spanned by two of them, the centre).
+std::array<std::array<unsigned, 8>, 6> wedge_dicing_table() {
+  const auto& topo = cell_topology(ElementKind::Wedge);
+  auto face_of = [&](int a, int b, int d) {
+    for (int f = 0; f < topo.faces; ++f) {
+      const auto& face = topo.face[static_cast<std::size_t>(f)];
+      unsigned m = 0;
+      for (int i = 0; i < face.size; ++i) m |= 1u << face.corners[static_cast<std::size_t>(i)];
+      if ((m >> a & 1) && (m >> b & 1) && (m >> d & 1)) return m;
+    }
+    return 0u;
+  };
+  std::array<std::array<unsigned, 8>, 6> t{};
+  for (int k = 0; k < 6; ++k) {
+    const auto& n = topology::kWedgeCornerNeighbors[static_cast<std::size_t>(k)];
+    const unsigned c = 1u << k;
+    t[static_cast<std::size_t>(k)] = {c,
+                                      c | 1u << n[0],
+                                      face_of(k, n[0], n[1]),
+                                      c | 1u << n[1],
+                                      c | 1u << n[2],
+                                      face_of(k, n[0], n[2]),
+                                      (1u << 6) - 1,
+                                      face_of(k, n[1], n[2])};
+  }
+  return t;
+}
+
+// One part's children against its table, parents in parallel (TBB), each writing its own
+// children's flags; `centre` receives each parent's centre node (kInvalidIndex when its
+// children do not agree on one).
+template <std::size_t NP, std::size_t NChildren>
+std::vector<Index> wrong_children(const std::vector<std::array<Index, NP>>& parents,
+                                  const std::array<std::array<unsigned, 8>, NChildren>& table,
+                                  const std::vector<std::array<Index, 8>>& children,
+                                  const std::vector<Index>& parent_of,
+                                  const std::vector<FaceKey>& origin, Index num_input_nodes,
+                                  std::vector<Index>& centre) {
+  constexpr unsigned kAll = (1u << NP) - 1;
+  const std::size_t n = std::min(children.size(), NChildren * parents.size());
+  std::vector<char> bad(children.size(), 0);
+  for (std::size_t i = n; i < children.size(); ++i) bad[i] = 1;  // children of no parent
+  centre.assign(parents.size(), kInvalidIndex);
+  const auto nodes = static_cast<Index>(origin.size());
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, parents.size(), 2048),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t e = range.begin(); e != range.end(); ++e) {
+          const auto& elem = parents[e];
+          Index mid = kInvalidIndex;
+          bool centre_agrees = true;
+          if (NChildren * e + NChildren > children.size()) {  // a parent without all its children
+            for (std::size_t i = NChildren * e; i < children.size(); ++i) bad[i] = 1;
+            continue;
+          }
+          for (std::size_t ch = 0; ch < NChildren; ++ch) {
+            const std::size_t i = NChildren * e + ch;
+            bool good = i < parent_of.size() && parent_of[i] == static_cast<Index>(e);
+            for (std::size_t k = 0; k < 8 && good; ++k) {
+              const Index v = children[i][k];
+              const unsigned s = table[ch][k];
+              if (v < 0 || v >= nodes) {
+                good = false;
+              } else if (std::popcount(s) == 1) {
+                good = v == elem[static_cast<std::size_t>(std::countr_zero(s))];
+              } else if (s == kAll) {
+                good = v >= num_input_nodes && origin[static_cast<std::size_t>(v)] == kNoOrigin &&
+                       (mid == kInvalidIndex || v == mid);
+                mid = v;
+              } else {
+                FaceKey key = kNoOrigin;
+                std::size_t m = 0;
+                for (std::size_t q = 0; q < NP; ++q)
+                  if (s >> q & 1) key[m++] = elem[q];
+                good = v >= num_input_nodes &&
+                       origin[static_cast<std::size_t>(v)] == normalized_origin(key);
+              }
+            }
+            if (!good) bad[i] = 1, centre_agrees = false;
+          }
+          centre[e] = centre_agrees ? mid : kInvalidIndex;
+        }
+      });
+  std::vector<Index> out;
+  for (std::size_t i = 0; i < bad.size(); ++i)
+    if (bad[i]) out.push_back(static_cast<Index>(i));
+  return out;
+}
+
+template <typename T>
+void list_first(std::ostringstream& os, const char* what, const std::vector<T>& items) {
+  if (items.empty()) return;
+  os << "  " << what << ": " << items.size() << " (";
+  for (std::size_t i = 0; i < std::min<std::size_t>(items.size(), 8); ++i)
+    os << (i ? ", " : "") << items[i];
+  os << (items.size() > 8 ? ", ...)\n" : ")\n");
+}
+
 }  // namespace
+
+bool DicingCheck::ok() const {
+  return wrong_hex_children.empty() && wrong_tet_children.empty() && wrong_wedge_children.empty() &&
+         duplicated_nodes.empty() && missing_children == 0;
+}
+
+std::string DicingCheck::summary() const {
+  std::ostringstream os;
+  os << "dicing: " << (ok() ? "as its tables make it" : "NOT as its tables make it") << "\n";
+  list_first(os, "hex children differing from the hex table", wrong_hex_children);
+  list_first(os, "tet children differing from the tet table", wrong_tet_children);
+  list_first(os, "wedge children differing from the wedge rule", wrong_wedge_children);
+  if (missing_children > 0) os << "  children missing: " << missing_children << "\n";
+  list_first(os, "nodes made from the origin of another node (cracks)", duplicated_nodes);
+  return os.str();
+}
+
+DicingCheck check_dicing(const Model& model, const DicedModel& diced) {
+  DicingCheck r;
+  const auto V = static_cast<Index>(model.points.size());
+  const auto& origin = diced.origin;
+  std::array<std::vector<Index>, 3> centres;
+  r.wrong_hex_children = wrong_children(model.hexes, hex_dicing_table(), diced.hex_children,
+                                        diced.hex_parent, origin, V, centres[0]);
+  r.wrong_tet_children = wrong_children(model.tets, tet_dicing_table(), diced.tet_children,
+                                        diced.tet_parent, origin, V, centres[1]);
+  static const auto wedge_table = wedge_dicing_table();
+  r.wrong_wedge_children = wrong_children(model.wedges, wedge_table, diced.wedge_children,
+                                          diced.wedge_parent, origin, V, centres[2]);
+  auto missing = [](std::size_t parents, std::size_t per, std::size_t children) {
+    return static_cast<Index>(per * parents > children ? per * parents - children : 0);
+  };
+  r.missing_children = missing(model.hexes.size(), 8, diced.hex_children.size()) +
+                       missing(model.tets.size(), 4, diced.tet_children.size()) +
+                       missing(model.wedges.size(), 6, diced.wedge_children.size());
+  // Each parent's centre is a node of its own: a second parent on it is a duplicate use.
+  std::vector<char> taken(origin.size(), 0);
+  std::vector<char> duplicated(origin.size(), 0);
+  for (const auto& part : centres)
+    for (Index c : part)
+      if (c != kInvalidIndex) {
+        if (taken[static_cast<std::size_t>(c)]) duplicated[static_cast<std::size_t>(c)] = 1;
+        taken[static_cast<std::size_t>(c)] = 1;
+      }
+  taken = {};
+  // Origins made twice: the diced nodes bucketed by their smallest origin node (a counting sort,
+  // no hashing), each bucket's few keys sorted and compared, buckets in parallel.
+  std::vector<Index> start(static_cast<std::size_t>(V) + 1, 0);
+  auto bucket = [&](std::size_t i) -> Index {
+    const FaceKey& k = origin[i];
+    if (k[0] == kInvalidIndex || k[0] < 0 || k[0] >= V) return kInvalidIndex;
+    if (static_cast<Index>(i) < V && k[1] == kInvalidIndex) return kInvalidIndex;  // itself
+    return k[0];
+  };
+  for (std::size_t i = 0; i < origin.size(); ++i)
+    if (const Index b = bucket(i); b != kInvalidIndex) ++start[static_cast<std::size_t>(b) + 1];
+  for (std::size_t v = 0; v < static_cast<std::size_t>(V); ++v) start[v + 1] += start[v];
+  std::vector<Index> members(static_cast<std::size_t>(start.back()));
+  {
+    std::vector<Index> fill(start.begin(), start.end() - 1);
+    for (std::size_t i = 0; i < origin.size(); ++i)
+      if (const Index b = bucket(i); b != kInvalidIndex)
+        members[static_cast<std::size_t>(fill[static_cast<std::size_t>(b)]++)] =
+            static_cast<Index>(i);
+  }
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, static_cast<std::size_t>(V), 4096),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t v = range.begin(); v != range.end(); ++v) {
+                        const auto first = members.begin() + start[v];
+                        const auto last = members.begin() + start[v + 1];
+                        std::sort(first, last, [&](Index a, Index b) {
+                          return std::tie(origin[static_cast<std::size_t>(a)], a) <
+                                 std::tie(origin[static_cast<std::size_t>(b)], b);
+                        });
+                        for (auto it = first; it != last; ++it) {
+                          const FaceKey& k = origin[static_cast<std::size_t>(*it)];
+                          // A single-node origin names an input node, made already as itself.
+                          const bool twice =
+                              k[1] == kInvalidIndex ||
+                              (it != first && origin[static_cast<std::size_t>(*(it - 1))] == k) ||
+                              (it + 1 != last && origin[static_cast<std::size_t>(*(it + 1))] == k);
+                          if (twice) duplicated[static_cast<std::size_t>(*it)] = 1;
+                        }
+                      }
+                    });
+  for (std::size_t i = 0; i < duplicated.size(); ++i)
+    if (duplicated[i]) r.duplicated_nodes.push_back(static_cast<Index>(i));
+  return r;
+}
 
 double diced_wedge_min_scaled_jacobian(std::span<const Point> points,
                                        std::span<const std::array<Index, 6>> wedges) {

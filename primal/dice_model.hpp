@@ -12,6 +12,7 @@
 // Wedges meet both parts (their quads hexes, their triangles tets): every node of a wedge is
 // shareable. Pyramids are not diced (conform splits them into tets first): InvalidInput.
 #include <span>
+#include <string>
 #include <vector>
 
 #include <geode/primal/boundary.hpp>
@@ -48,6 +49,28 @@ struct DicedModel {
 // `shareable` (per model point, may be empty) marks nodes besides the interface whose diced
 // edge and face nodes the caller will look up with find(). Throws InvalidInput from dice().
 DicedModel dice_model(const Model& model, std::span<const char> shareable = {});
+
+// A diced model read against the dicing tables (dice.hpp's hex_dicing_table and
+// tet_dicing_table, the wedge rule of dice_model): every child corner is the node its table
+// entry names (a corner of the parent itself; the node whose origin is the parent's edge or
+// face; the parent's own centre, a node of no other parent), and no origin is given to two
+// nodes. With a valid input model (faces shared by at most two cells, manifold, positive) the
+// diced children then form a valid mesh by construction: each parent face is diced once and
+// its sub-faces are shared, in opposite orders, by the children on both sides. Costs one pass
+// over the children and one over the nodes, with no hashing (what a full check_validity of
+// the diced part would cost several times over).
+struct DicingCheck {
+  // Children (index into hex_children / tet_children / wedge_children) that differ from what
+  // their table makes of their parent.
+  std::vector<Index> wrong_hex_children, wrong_tet_children, wrong_wedge_children;
+  Index missing_children = 0;  // children the tables make that the diced model lacks
+  // Nodes made from the same origin as another node (a crack), ascending.
+  std::vector<Index> duplicated_nodes;
+  bool ok() const;
+  std::string summary() const;
+};
+
+DicingCheck check_dicing(const Model& model, const DicedModel& diced);
 
 // The lowest scaled Jacobian of the 6 hexes each wedge dices into (as dice_model makes them),
 // wedge by wedge: the wedges' part of the yardstick (dice.hpp's diced_min_scaled_jacobian for

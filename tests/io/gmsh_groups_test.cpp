@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <geode/demo/gmsh_session.hpp>
 #include <geode/io/gmsh.hpp>
 #include <geode/io/read_warnings.hpp>
 #include <geode/primal/dice_model.hpp>
@@ -33,7 +34,7 @@ void write_text(const fs::path& path, const std::string& text) {
 // "hex", x in [2, 3] tets in physical volume 2 "tet", partitioned into `parts` and written as
 // .msh 4.1 (ASCII or binary): elements then live on partitioned entities.
 void partitioned_file(const fs::path& file, bool binary, int parts) {
-  GmshSession session;
+  demo::GmshSession session;
   gmsh::model::add("parts");
   // Apart, so that Gmsh puts no pyramids between the hexes' quads and the tets.
   const int a = gmsh::model::occ::addBox(0, 0, 0, 1, 1, 1);

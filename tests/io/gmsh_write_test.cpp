@@ -13,6 +13,7 @@
 #include <sstream>
 #include <string>
 
+#include <geode/demo/gmsh_session.hpp>
 #include <geode/io/exodus.hpp>
 #include <geode/io/gmsh.hpp>
 #include <geode/io/names.hpp>
@@ -68,7 +69,7 @@ std::string text_of(const fs::path& p) {
 // What Gmsh sees in a file: per physical group (dim, tag), its name and element count.
 std::map<std::pair<int, int>, std::pair<std::string, std::size_t>> gmsh_groups(
     const fs::path& file) {
-  GmshSession session;
+  demo::GmshSession session;
   gmsh::open(file.string());
   std::map<std::pair<int, int>, std::pair<std::string, std::size_t>> out;
   gmsh::vectorpair groups;

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <string>
 
+#include <geode/demo/gmsh_session.hpp>
 #include <geode/io/gmsh.hpp>
 #include <geode/io/read_model.hpp>
 #include <geode/io/vtk.hpp>
@@ -134,7 +135,7 @@ TEST_CASE("Gmsh's own writer: .msh 2.2 and 4.1, ASCII and binary, read back the 
       const fs::path file =
           dir.path / ("gmsh-" + std::to_string(version) + "-" + std::to_string(binary) + ".msh");
       {
-        GmshSession session;
+        demo::GmshSession session;
         gmsh::open(ours.string());  // our own file, written above: never a user's
         gmsh::option::setNumber("Mesh.MshFileVersion", version);
         gmsh::option::setNumber("Mesh.Binary", binary);

@@ -11,6 +11,7 @@
 #include <map>
 #include <set>
 
+#include <geode/demo/gmsh_session.hpp>
 #include <geode/io/gmsh.hpp>
 #include <geode/io/read_model.hpp>
 #include <geode/primal/boundary.hpp>
@@ -44,7 +45,7 @@ std::array<Point, 5> equilateral() {
 // One pyramid refined by Gmsh's all-hex subdivision (Mesh.SubdivisionAlgorithm = 2, the
 // RefineMesh of `gmsh -refine`): hexes in Gmsh's order (VTK's for linear hexes).
 primal::HexMesh gmsh_pyramid_filling(const std::array<Point, 5>& c) {
-  io::GmshSession session;
+  demo::GmshSession session;
   gmsh::model::add("pyramid");
   const int volume = gmsh::model::addDiscreteEntity(3);
   std::vector<double> xyz;

@@ -1,0 +1,184 @@
+#include <geode/primal/validity_local.hpp>
+
+#include <algorithm>
+#include <cstdint>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/quality.hpp>
+
+namespace geode::primal {
+
+namespace {
+
+template <std::size_t N>
+bool proper(const std::array<Index, N>& a, std::size_t nodes) {
+  for (std::size_t i = 0; i < N; ++i) {
+    if (a[i] < 0 || static_cast<std::size_t>(a[i]) >= nodes) return false;
+    for (std::size_t j = 0; j < i; ++j)
+      if (a[i] == a[j]) return false;
+  }
+  return true;
+}
+
+// Marks the nodes of the marked hexes, then the hexes with a marked node: one ring further.
+// Linear passes over the hex array (no incidence built), hexes in parallel.
+void mark_nodes(const HexMesh& mesh, const std::vector<char>& hex_in, std::vector<char>& node_in) {
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
+    if (hex_in[h])
+      for (Index v : mesh.hexes[h]) node_in[static_cast<std::size_t>(v)] = 1;
+}
+
+void mark_hexes(const HexMesh& mesh, const std::vector<char>& node_in,
+                const std::vector<char>& proper_hex, std::vector<char>& hex_in) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.hexes.size(), 8192),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t h = range.begin(); h != range.end(); ++h) {
+                        if (hex_in[h] || !proper_hex[h]) continue;
+                        for (Index v : mesh.hexes[h])
+                          if (node_in[static_cast<std::size_t>(v)]) {
+                            hex_in[h] = 1;
+                            break;
+                          }
+                      }
+                    });
+}
+
+}  // namespace
+
+HexValidityReport check_validity_around(const HexMesh& mesh, std::span<const Index> seeds,
+                                        const RegionValidityOptions& options) {
+  const std::size_t nv = mesh.points.size(), nh = mesh.hexes.size();
+  HexValidityReport r;
+  r.num_nodes = static_cast<Index>(nv);
+  r.num_hexes = static_cast<Index>(nh);
+
+  // Per hex and per node over the whole mesh, as check_validity finds them.
+  std::vector<char> proper_hex(nh, 0), used(nv, 0);
+  for (std::size_t h = 0; h < nh; ++h) {
+    const auto& hex = mesh.hexes[h];
+    const bool in_range = std::all_of(hex.begin(), hex.end(), [nv](Index v) {
+      return v >= 0 && static_cast<std::size_t>(v) < nv;
+    });
+    if (!in_range) {
+      r.out_of_range_hexes.push_back(static_cast<Index>(h));
+    } else if (!proper(hex, nv)) {
+      r.repeated_node_hexes.push_back(static_cast<Index>(h));
+    } else {
+      proper_hex[h] = 1;
+      for (Index v : hex) used[static_cast<std::size_t>(v)] = 1;
+    }
+  }
+  for (std::size_t v = 0; v < nv; ++v) {
+    if (!mesh.points[v].allFinite()) r.non_finite_nodes.push_back(static_cast<Index>(v));
+    r.unused_nodes += used[v] ? 0 : 1;
+  }
+  used = {};
+  {
+    std::vector<char> inverted(nh, 0);
+    const bool known = options.scaled_jacobians.size() == nh;
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, nh, 4096),
+        [&](const tbb::blocked_range<std::size_t>& range) {
+          for (std::size_t h = range.begin(); h != range.end(); ++h) {
+            const auto& hex = mesh.hexes[h];
+            if (!std::all_of(hex.begin(), hex.end(),
+                             [nv](Index v) { return v >= 0 && static_cast<std::size_t>(v) < nv; }))
+              continue;
+            if (known && options.scaled_jacobians[h] > 0.0) continue;  // all 9 dets > 0
+            const auto j = hex_jacobians(hex_corners(mesh, static_cast<Index>(h)));
+            // Corners 0..7 only, as check_validity (index 8 is the centre).
+            inverted[h] = !std::all_of(j.begin(), j.begin() + 8, [](double d) { return d > 0.0; });
+          }
+        });
+    for (std::size_t h = 0; h < nh; ++h)
+      if (inverted[h]) r.inverted_hexes.push_back(static_cast<Index>(h));
+  }
+
+  // The region: the checked nodes (within `rings` of the seeds) and every hex around them.
+  std::vector<char> hex_in(nh, 0), node_in(nv, 0);
+  for (Index h : seeds)
+    if (h >= 0 && static_cast<std::size_t>(h) < nh && proper_hex[static_cast<std::size_t>(h)])
+      hex_in[static_cast<std::size_t>(h)] = 1;
+  for (int ring = 0; ring < options.rings; ++ring) {
+    mark_nodes(mesh, hex_in, node_in);
+    mark_hexes(mesh, node_in, proper_hex, hex_in);
+  }
+  std::vector<char>& checked = node_in;
+  std::fill(checked.begin(), checked.end(), 0);
+  mark_nodes(mesh, hex_in, checked);
+  mark_hexes(mesh, checked, proper_hex, hex_in);
+
+  // The region as a mesh of its own, checked whole; its findings kept where they hold for the
+  // whole mesh: at checked nodes, which have all their hexes in it.
+  HexMesh sub;
+  std::vector<Index> sub_hex, sub_node, local(nv, kInvalidIndex);
+  for (std::size_t h = 0; h < nh; ++h) {
+    if (!hex_in[h]) continue;
+    sub_hex.push_back(static_cast<Index>(h));
+    std::array<Index, 8> q{};
+    for (int c = 0; c < 8; ++c) {
+      const auto v = static_cast<std::size_t>(mesh.hexes[h][c]);
+      if (local[v] == kInvalidIndex) {
+        local[v] = static_cast<Index>(sub_node.size());
+        sub_node.push_back(static_cast<Index>(v));
+        sub.points.push_back(mesh.points[v]);
+      }
+      q[c] = local[v];
+    }
+    sub.hexes.push_back(q);
+  }
+  local = {};
+  const HexValidityReport s = check_validity(sub);
+  auto node = [&](Index v) { return sub_node[static_cast<std::size_t>(v)]; };
+  auto is_checked = [&](Index v) { return checked[static_cast<std::size_t>(node(v))] != 0; };
+  auto global_key = [&](const FaceKey& k) {
+    std::array<Index, 4> q{};
+    std::size_t n = 0;
+    for (Index v : k)
+      if (v != kInvalidIndex) q[n++] = node(v);
+    return face_key(std::span<const Index>(q.data(), n));
+  };
+  auto touches = [&](const auto& key) {
+    return std::any_of(key.begin(), key.end(),
+                       [&](Index v) { return v != kInvalidIndex && is_checked(v); });
+  };
+  for (const FaceKey& k : s.overshared_faces)
+    if (touches(k)) r.overshared_faces.push_back(global_key(k));
+  for (const FaceKey& k : s.misoriented_faces)
+    if (touches(k)) r.misoriented_faces.push_back(global_key(k));
+  for (const EdgeKey& e : s.nonmanifold_edges)
+    if (touches(e)) {
+      const Index a = node(e[0]), b = node(e[1]);
+      r.nonmanifold_edges.push_back({std::min(a, b), std::max(a, b)});
+    }
+  for (Index v : s.nonmanifold_vertices)
+    if (is_checked(v)) r.nonmanifold_vertices.push_back(node(v));
+  for (NodeCoverage c : s.overlapping_nodes)
+    if (is_checked(c.node)) c.node = node(c.node), r.overlapping_nodes.push_back(c);
+  std::sort(r.nonmanifold_vertices.begin(), r.nonmanifold_vertices.end());
+  std::sort(r.overlapping_nodes.begin(), r.overlapping_nodes.end(),
+            [](const NodeCoverage& a, const NodeCoverage& b) { return a.node < b.node; });
+
+  r.num_vertices = s.num_vertices, r.num_edges = s.num_edges, r.num_faces = s.num_faces;
+  r.num_cells = s.num_cells, r.euler = s.euler;
+  auto keep_quad = [&](BoundaryQuad q) {
+    const bool near = std::any_of(q.nodes.begin(), q.nodes.end(), is_checked);
+    for (Index& v : q.nodes) v = node(v);
+    q.hex = sub_hex[static_cast<std::size_t>(q.hex)];
+    return std::pair{near, q};
+  };
+  for (const BoundaryQuad& q : s.boundary.faces)
+    if (auto [near, g] = keep_quad(q); near) r.boundary.faces.push_back(g);
+  for (const BoundaryQuad& q : s.boundary.rejected)
+    if (auto [near, g] = keep_quad(q); near) r.boundary.rejected.push_back(g);
+  r.boundary.euler = s.boundary.euler;
+  const bool manifold = r.nonmanifold_vertices.empty() && r.nonmanifold_edges.empty() &&
+                        r.overshared_faces.empty() && r.boundary.rejected.empty();
+  r.boundary.closed = r.boundary.manifold = manifold;
+  return r;
+}
+
+}  // namespace geode::primal

@@ -1,0 +1,36 @@
+#pragma once
+// The full validity check (validity.hpp) where a mesh can be wrong, not everywhere: around a
+// region of hexes (say a transition and the hexes a smoother moved), the rest of the mesh being
+// valid by construction (a dicing checked against its tables, dice_model.hpp's check_dicing).
+// Costs what the region costs, plus one pass over every hex for the corner Jacobians.
+#include <span>
+
+#include <geode/primal/mesh.hpp>
+#include <geode/primal/validity.hpp>
+
+namespace geode::primal {
+
+struct RegionValidityOptions {
+  // The checked nodes are those of the hexes within this many rings (hexes sharing a node) of
+  // the seeds; the check reads every hex around them. Two rings reach the far end of a diced
+  // edge from a node moved before dicing (a diced input edge is two hex edges long), whose
+  // corner cones the move turned.
+  int rings = 2;
+  // Empty, or one per hex: its scaled Jacobian (quality.hpp's hex_scaled_jacobian, over the
+  // corners and the centre) as the mesh is now. A hex above 0 then has positive corners and is
+  // not measured again; the others are.
+  std::span<const double> scaled_jacobians;
+};
+
+// check_validity's findings at the checked nodes, on the faces and edges with a checked node,
+// and over the whole mesh for what is per hex or per node (out-of-range and repeated nodes,
+// non-finite coordinates, unused nodes, non-positive corner Jacobians). Nodes, faces and edges
+// elsewhere are taken as valid. The counts (V, E, F, C, the Euler characteristic) and the
+// boundary quads are those of the checked region's hexes; `boundary.closed` and
+// `boundary.manifold` say that no checked vertex or edge is non-manifold (every vertex link a
+// disk or a sphere makes the boundary a closed manifold surface). With every hex seeded and
+// rings >= 0 the verdict (ok()) is check_validity's.
+HexValidityReport check_validity_around(const HexMesh& mesh, std::span<const Index> seeds,
+                                        const RegionValidityOptions& options = {});
+
+}  // namespace geode::primal
