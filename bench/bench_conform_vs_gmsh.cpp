@@ -26,6 +26,17 @@
 // counts are read back (gmsh's file through read_gmsh, geode's from its report), so a child that
 // did nothing cannot look fast.
 //
+// Hybrid mode (bench_conform_vs_gmsh hybrid [n] [repeats] [geode]): the model is
+// demo::demo_hexdominant(n), all four cell kinds side by side (two transfinite hex boxes, a
+// Delaunay tet box with Gmsh's pyramids on the quads it meets, wedge layers extruded off it; n
+// default 28: 126k tets; at 30 Gmsh's mesh holds a tet twice, which the read-time check refuses,
+// and at 32 (189k tets) no buffer layer fits at a sliver tet by the hex box's edge, exit 3),
+// written as binary .msh 4.1. Gmsh's side runs through the libgmsh API in
+// a fresh process (this program re-executed: gmsh::open, Mesh.SubdivisionAlgorithm = 2,
+// gmsh::model::mesh::refine, gmsh::write binary .msh); geode's is `geode conform model.msh -o
+// geode.msh --quiet`. Both outputs are read back and judged alike (check_validity, the minimum
+// scaled Jacobian, the hex count); wall time and peak RSS per child.
+//
 // Usage: bench_conform_vs_gmsh [n] [repeats] [geode-executable]
 //   n default 26, repeats default 1, geode default: `geode` next to this program; gmsh is
 //   /usr/bin/gmsh unless GMSH is set in the environment; GEODE_BENCH_KEEP set keeps the
@@ -43,10 +54,14 @@
 #include <string>
 #include <vector>
 
+#include <gmsh.h>
+
 #include <geode/demo/demo_models.hpp>
 #include <geode/io/exodus.hpp>
 #include <geode/io/gmsh.hpp>
 #include <geode/primal/errors.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/validity.hpp>
 
 namespace fs = std::filesystem;
 namespace gp = geode::primal;
@@ -147,10 +162,104 @@ void print_row(const char* what, const Run& r, std::size_t hexes, const Run& ref
       r.seconds / reference.seconds, r.seconds / floor.seconds, r.cpu_seconds / floor.cpu_seconds);
 }
 
+// The Gmsh side of the hybrid mode, in this process (re-executed as a child): libgmsh reads
+// `in`, subdivides every element into hexes (Mesh.SubdivisionAlgorithm = 2, RefineMesh) and
+// writes `out` as binary .msh.
+int gmsh_refine(const char* in, const char* out) {
+  gmsh::initialize(0, nullptr, false);
+  gmsh::option::setNumber("General.Terminal", 0);
+  gmsh::option::setNumber("General.NumThreads", 1);
+  gmsh::open(in);
+  gmsh::option::setNumber("Mesh.SubdivisionAlgorithm", 2);
+  gmsh::model::mesh::refine();
+  gmsh::option::setNumber("Mesh.Binary", 1);
+  gmsh::write(out);
+  gmsh::finalize();
+  return 0;
+}
+
+// An output read back without the reader's geometry checks (Gmsh's may hold inverted hexes)
+// and judged as every geode output is.
+struct Judged {
+  std::size_t hexes = 0, other_cells = 0, inverted = 0;
+  bool valid = false;
+  double min_sj = 0.0;
+};
+
+Judged judge(const fs::path& path) {
+  gp::ReadOptions o;
+  o.check_geometry = false;
+  const gp::Model m = geode::io::read_gmsh(path, o);
+  Judged j;
+  j.hexes = m.hexes.size();
+  j.other_cells = m.tets.size() + m.pyramids.size() + m.wedges.size();
+  const gp::HexMesh mesh = gp::hex_part(m);
+  const gp::HexValidityReport v = gp::check_validity(mesh);
+  j.valid = v.ok() && j.other_cells == 0;
+  j.inverted = v.inverted_hexes.size();
+  j.min_sj = gp::min_scaled_jacobian(mesh);
+  return j;
+}
+
+int hybrid_bench(int n, int repeats, const std::string& geode, const fs::path& dir) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const gp::Model model = geode::demo::demo_hexdominant(n);
+  const double build = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  geode::io::write_gmsh(model, dir / "model.msh", geode::io::GmshFormat::Binary);
+  std::printf(
+      "hybrid n %d: %zu hexes, %zu tets, %zu pyramids, %zu wedges (%zu nodes; built in %.1f s); "
+      "input in %s\n",
+      n, model.hexes.size(), model.tets.size(), model.pyramids.size(), model.wedges.size(),
+      model.points.size(), build, dir.c_str());
+  const std::string self = fs::canonical("/proc/self/exe").string();
+  const Run gmsh = best_of(
+      repeats, {self, "--gmsh-refine", (dir / "model.msh").string(), (dir / "gmsh.msh").string()},
+      dir / "gmsh.log", "libgmsh read + RefineMesh + save");
+  const Run conform = best_of(repeats,
+                              {geode, "conform", (dir / "model.msh").string(), "-o",
+                               (dir / "geode.msh").string(), "--quiet"},
+                              dir / "geode.log", "geode conform");
+  const Run none = best_of(repeats,
+                           {geode, "conform", (dir / "model.msh").string(), "-o",
+                            (dir / "geode_none.msh").string(), "--smooth", "none", "--quiet"},
+                           dir / "geode_none.log", "geode conform --smooth none");
+  Judged jg, jc, jn;
+  try {
+    jg = judge(dir / "gmsh.msh");
+    jc = judge(dir / "geode.msh");
+    jn = judge(dir / "geode_none.msh");
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_conform_vs_gmsh: reading the outputs back: %s\n", e.what());
+    return 1;
+  }
+  std::printf("best of %d\n", repeats);
+  auto row = [](const char* what, const Run& r, const Judged& j) {
+    std::printf(
+        "%-30s %7.2f s %7.2f s CPU %8.1f MiB %9zu hexes %5.0f B/hex  %s (%zu inverted, %zu other "
+        "cells)  min scaled Jacobian %.4f\n",
+        what, r.seconds, r.cpu_seconds, r.peak_mib, j.hexes,
+        j.hexes ? r.peak_mib * 1048576.0 / static_cast<double>(j.hexes) : 0.0,
+        j.valid ? "valid" : "INVALID", j.inverted, j.other_cells, j.min_sj);
+  };
+  row("gmsh read+RefineMesh+save", gmsh, jg);
+  row("geode conform", conform, jc);
+  row("geode conform --smooth none", none, jn);
+  std::printf(
+      "geode / gmsh: time %.2fx (target <= 0.5), memory %.0f B per output hex (target <= 300), "
+      "hexes %.2fx\n",
+      conform.seconds / gmsh.seconds,
+      conform.peak_mib * 1048576.0 / static_cast<double>(std::max<std::size_t>(jc.hexes, 1)),
+      static_cast<double>(jc.hexes) / static_cast<double>(std::max<std::size_t>(jg.hexes, 1)));
+  return jc.valid && jn.valid ? 0 : 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  const int n = argc > 1 ? std::atoi(argv[1]) : 26;
+  if (argc == 4 && std::string(argv[1]) == "--gmsh-refine") return gmsh_refine(argv[2], argv[3]);
+  const bool hybrid = argc > 1 && std::string(argv[1]) == "hybrid";
+  if (hybrid) ++argv, --argc;
+  const int n = argc > 1 ? std::atoi(argv[1]) : hybrid ? 28 : 26;
   const int repeats = argc > 2 ? std::atoi(argv[2]) : 1;
   const fs::path self = fs::canonical("/proc/self/exe");
   const std::string geode = argc > 3 ? argv[3] : (self.parent_path() / "geode").string();
@@ -158,10 +267,12 @@ int main(int argc, char** argv) {
   const char* gmsh_env = std::getenv("GMSH");
   const std::string gmsh = gmsh_env ? gmsh_env : "/usr/bin/gmsh";
   if (n < 2 || repeats < 1) {
-    std::fprintf(stderr, "usage: bench_conform_vs_gmsh [n >= 2] [repeats >= 1] [geode]\n");
+    std::fprintf(stderr, "usage: bench_conform_vs_gmsh [hybrid] [n >= 2] [repeats >= 1] [geode]\n");
     return 2;
   }
-  for (const auto& exe : {geode, gmsh, floor_exe})
+  // The hybrid mode runs Gmsh through libgmsh and has no floor row.
+  for (const auto& exe :
+       hybrid ? std::vector<std::string>{geode} : std::vector<std::string>{geode, gmsh, floor_exe})
     if (access(exe.c_str(), X_OK) != 0) {
       std::fprintf(stderr, "bench_conform_vs_gmsh: %s is not an executable\n", exe.c_str());
       return 2;
@@ -173,6 +284,16 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path dir = dir_template;
+  if (hybrid) {
+    const int status = hybrid_bench(n, repeats, geode, dir);
+    if (std::getenv("GEODE_BENCH_KEEP")) {
+      std::printf("kept %s\n", dir.c_str());
+    } else {
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+    }
+    return status;
+  }
 
   const gp::Model model = geode::demo::demo_delaunay_block(n);
   geode::io::write_gmsh(model, dir / "model.msh", geode::io::GmshFormat::Binary);

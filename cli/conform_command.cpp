@@ -11,7 +11,9 @@
 #include <geode/conform/conform.hpp>
 #include <geode/conform/report.hpp>
 #include <geode/demo/demo_models.hpp>
+#include <geode/io/read_model.hpp>
 #include <geode/primal/errors.hpp>
+#include <geode/primal/input_check.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/quality_report.hpp>
 #include <geode/primal/topology.hpp>
@@ -155,6 +157,8 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
     }
     const primal::Index merged = primal::merge_coincident_nodes(model, a.merge_tolerance);
     progress.stage("merged " + std::to_string(merged) + " coincident nodes");
+    // Read without the covering check (duplicated interface nodes look like a gap): run here.
+    if (!source.empty()) primal::require_single_covering(model, source);
   }
   conform::ConformOptions opts;
   opts.smooth = conform::parse_conform_smooth(a.smooth);
@@ -318,7 +322,8 @@ void add_conform_commands(CLI::App& app) {
   add_run_options(c, *args);
   c->callback([args] {
     const std::string format = check_outputs(*args);  // before the long run, not after it
-    run(read_model(args->input), *args, format, false, args->input);
+    run(io::read_model(args->input, {}, args->merge_tolerance < 0), *args, format, false,
+        args->input);
   });
 
   auto dargs = std::make_shared<ConformArgs>();

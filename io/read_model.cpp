@@ -12,6 +12,7 @@
 #include <geode/io/formats.hpp>
 #include <geode/io/names.hpp>
 #include <geode/primal/errors.hpp>
+#include <geode/primal/input_check.hpp>
 
 namespace geode::io {
 
@@ -133,7 +134,8 @@ InvalidInput out_of_memory_reading(const std::filesystem::path& path) {
                       " bytes): its model needs more memory than this process may use");
 }
 
-Model read_model(const std::filesystem::path& path, const ReadOptions& options) {
+Model read_model(const std::filesystem::path& path, const ReadOptions& options,
+                 bool check_covering) {
   const MeshFormat* format = reader_for(path);
   if (!format) {
     (void)read_file_head(path);  // a missing file is named as such first
@@ -142,7 +144,9 @@ Model read_model(const std::filesystem::path& path, const ReadOptions& options) 
   }
   check_signature(path, *format);
   try {
-    return format->read(path, options);
+    Model model = format->read(path, options);
+    if (options.check_geometry && check_covering) require_single_covering(model, path.string());
+    return model;
   } catch (const std::bad_alloc&) {
     throw out_of_memory_reading(path);
   }

@@ -12,9 +12,12 @@ namespace geode::io {
 
 // Throws InvalidInput naming the file: missing, unknown extension, content of another format,
 // and whatever the format's reader refuses (gmsh.hpp, exodus.hpp, vtk.hpp, ...), then
-// check_geometry unless options say otherwise.
-primal::Model read_model(const std::filesystem::path& path,
-                         const primal::ReadOptions& options = {});
+// check_geometry unless options say otherwise, then (with check_geometry and check_covering) the
+// covering check of primal/input_check.hpp: a folded model, overlapping parts, an interface with
+// a gap are refused naming the elements. check_covering false is for callers that merge nodes
+// after reading and run require_single_covering themselves.
+primal::Model read_model(const std::filesystem::path& path, const primal::ReadOptions& options = {},
+                         bool check_covering = true);
 
 // A VTK grid as a model: hexes, tets, pyramids and wedges (triangles and quads, boundary
 // annotations, are left out), VTK's 0-based point and cell ids (as ParaView shows them) as file

@@ -1,0 +1,645 @@
+#include <geode/primal/input_check.hpp>
+
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+#include <optional>
+#include <span>
+#include <sstream>
+#include <tuple>
+#include <unordered_map>
+
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/disjoint_sets.hpp>
+#include <geode/primal/errors.hpp>
+
+namespace geode::primal {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// Signed solid angle of the triangle a, b, c seen from the origin (Van Oosterom and Strackee,
+// IEEE Trans. Biomed. Eng. BME-30(2), 1983), as in validity.cpp: in (0, 2 pi) when det > 0.
+double solid_angle(const Point& a, const Point& b, const Point& c) {
+  const double la = a.norm(), lb = b.norm(), lc = c.norm();
+  const double den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
+  return 2.0 * std::atan2(a.dot(b.cross(c)), den);
+}
+
+double orient(const Point& a, const Point& b, const Point& c, const Point& d) {
+  return (b - a).cross(c - a).dot(d - a);
+}
+
+// One use of a face: its sorted key, the element and local face.
+struct FaceUse {
+  FaceKey key;
+  ElementRef element;
+  int face;
+  bool operator<(const FaceUse& o) const {
+    return std::tie(key, element, face) < std::tie(o.key, o.element, o.face);
+  }
+};
+
+// A boundary face: nodes in outward order (3 or 4), its element.
+struct BoundaryFace {
+  std::array<Index, 4> nodes;
+  int size;
+  ElementRef element;
+};
+
+// A boundary face seen from one of its corners v along one of its edges there (v, end): the
+// face's other edge at v and its outward normal at v; the two faces on each boundary edge at v
+// give the interior dihedral angle there.
+struct HalfEdge {
+  Index v, end, other;
+  Point normal;
+  Index face;
+  bool operator<(const HalfEdge& o) const { return std::tie(v, end) < std::tie(o.v, o.end); }
+};
+
+struct Triangle {
+  std::array<Index, 3> v;
+  Index face;  // into the boundary faces
+};
+
+// The interior dihedral angle at the boundary edge along `axis` from the face through `a` to the
+// face through `b`, turning through the side `inward` points to, in (0, 2 pi].
+double dihedral(const Point& axis, const Point& a, const Point& inward, const Point& b) {
+  const Point u = axis.normalized();
+  const Point pa = a - a.dot(u) * u;
+  auto turn = [&](const Point& x) { return std::atan2(u.dot(pa.cross(x)), pa.dot(x)); };
+  double t = turn(b);
+  if (turn(inward) < 0.0) t = -t;
+  return t > 0.0 ? t : t + 2.0 * kPi;
+}
+
+// The stages of check_input over one model, each adding findings.
+class InputChecker {
+ public:
+  InputChecker(const Model& model, const InputCheckOptions& options)
+      : model_(model), options_(options) {}
+
+  InputCheckResult run() {
+    pair_faces();
+    if (!full()) covering_at_nodes();
+    if (!full() && options_.contacts) boundary_contacts();
+    if (!full()) degree_of_components();
+    return std::move(result_);
+  }
+
+ private:
+  const Point& pt(Index v) const { return model_.points[static_cast<std::size_t>(v)]; }
+  bool full() const { return result_.findings.size() >= options_.max_findings; }
+  void add(InputFinding f) {
+    if (!full()) result_.findings.push_back(std::move(f));
+  }
+  std::span<const Index> corners(ElementRef e) const { return element_corners(model_, e); }
+  Point centre(ElementRef e) const {
+    Point c = Point::Zero();
+    const auto cs = corners(e);
+    for (Index v : cs) c += pt(v);
+    return c / static_cast<double>(cs.size());
+  }
+  // The nodes of a local face in outward order.
+  std::array<Index, 4> face_nodes(ElementRef e, int face, int* size = nullptr) const {
+    const auto& f = cell_topology(e.kind).face[static_cast<std::size_t>(face)];
+    const auto cs = corners(e);
+    std::array<Index, 4> n{kInvalidIndex, kInvalidIndex, kInvalidIndex, kInvalidIndex};
+    for (int i = 0; i < f.size; ++i)
+      n[static_cast<std::size_t>(i)] = cs[static_cast<std::size_t>(f.corners[i])];
+    if (size) *size = f.size;
+    return n;
+  }
+
+  // Faces by their node sets: pairs must be seen in opposite orders; a quad one side meets as
+  // two or four triangles of the other is an interface, not boundary.
+  void pair_faces() {
+    std::vector<FaceUse> uses;
+    uses.reserve(4 * element_count(model_) + 2 * model_.hexes.size());
+    for (ElementKind kind : kElementKinds) {
+      const auto& topo = cell_topology(kind);
+      for (std::size_t i = 0; i < element_count(model_, kind); ++i) {
+        const ElementRef e{kind, static_cast<Index>(i)};
+        for (int f = 0; f < topo.faces; ++f) {
+          int size = 0;
+          const auto n = face_nodes(e, f, &size);
+          uses.push_back(
+              {face_key(std::span<const Index>(n.data(), static_cast<std::size_t>(size))), e, f});
+        }
+      }
+    }
+    tbb::parallel_sort(uses.begin(), uses.end());
+    std::vector<std::size_t> single;  // uses of faces used once
+    for (std::size_t i = 0; i < uses.size();) {
+      std::size_t j = i + 1;
+      while (j < uses.size() && uses[j].key == uses[i].key) ++j;
+      std::size_t twin = j;  // a use whose element repeats another's nodes
+      for (std::size_t a = i; a < j && twin == j; ++a)
+        for (std::size_t b = a + 1; b < j && twin == j; ++b)
+          if (same_nodes(uses[a].element, uses[b].element)) twin = a;
+      if (j - i == 1) {
+        single.push_back(i);
+      } else if (twin != j) {
+        std::size_t other = twin + 1;
+        while (!same_nodes(uses[twin].element, uses[other].element)) ++other;
+        add({InputFault::kDuplicateElement,
+             {uses[twin].element, uses[other].element},
+             kInvalidIndex,
+             centre(uses[twin].element),
+             0.0});
+      } else if (j - i > 2) {
+        InputFinding f{InputFault::kOversharedFace, {}, kInvalidIndex, face_centre(uses[i]), 0.0};
+        for (std::size_t k = i; k < j && k < i + 3; ++k) f.elements.push_back(uses[k].element);
+        add(std::move(f));
+      } else if (!opposite(uses[i], uses[i + 1])) {
+        add({InputFault::kSameSideFace,
+             {uses[i].element, uses[i + 1].element},
+             kInvalidIndex,
+             face_centre(uses[i]),
+             0.0});
+      }
+      i = j;
+    }
+    // The quad-triangle interface: an unpaired quad whose nodes two unpaired triangles (a
+    // diagonal) or four around one more node cover.
+    std::unordered_map<FaceKey, std::size_t, IndexArrayHash> triangle;      // key -> use
+    std::unordered_map<EdgeKey, std::vector<Index>, IndexArrayHash> third;  // edge -> third nodes
+    for (std::size_t s : single) {
+      const FaceKey& k = uses[s].key;
+      if (k[3] != kInvalidIndex) continue;
+      triangle.emplace(k, s);
+      third[edge_key(k[0], k[1])].push_back(k[2]);
+      third[edge_key(k[1], k[2])].push_back(k[0]);
+      third[edge_key(k[0], k[2])].push_back(k[1]);
+    }
+    std::vector<bool> paired(uses.size(), false);
+    auto tri = [&](Index a, Index b, Index c) -> const std::size_t* {
+      const Index n[3] = {a, b, c};
+      const auto it = triangle.find(face_key(n));
+      return it == triangle.end() || paired[it->second] ? nullptr : &it->second;
+    };
+    for (std::size_t s : single) {
+      if (uses[s].key[3] == kInvalidIndex) continue;
+      const auto q = face_nodes(uses[s].element, uses[s].face);
+      std::vector<std::size_t> cover;
+      for (int d = 0; d < 2 && cover.empty(); ++d) {  // diagonal q[d] - q[d + 2]
+        const auto* t1 = tri(q[d], q[d + 1], q[d + 2]);
+        const auto* t2 = tri(q[d + 2], q[(d + 3) % 4], q[d]);
+        if (t1 && t2) cover = {*t1, *t2};
+      }
+      if (cover.empty()) {
+        const auto it = third.find(edge_key(q[0], q[1]));
+        if (it != third.end())
+          for (Index x : it->second) {
+            const auto *t1 = tri(q[0], q[1], x), *t2 = tri(q[1], q[2], x), *t3 = tri(q[2], q[3], x),
+                       *t4 = tri(q[3], q[0], x);
+            if (t1 && t2 && t3 && t4) {
+              cover = {*t1, *t2, *t3, *t4};
+              break;
+            }
+          }
+      }
+      if (cover.empty()) continue;
+      // The triangles' element must lie across the quad: their outward normals against its own.
+      const Point nq = (pt(q[2]) - pt(q[0])).cross(pt(q[3]) - pt(q[1]));
+      for (std::size_t t : cover) {
+        const auto n = face_nodes(uses[t].element, uses[t].face);
+        if ((pt(n[1]) - pt(n[0])).cross(pt(n[2]) - pt(n[0])).dot(nq) > 0.0) {
+          add({InputFault::kSameSideFace,
+               {uses[s].element, uses[t].element},
+               kInvalidIndex,
+               face_centre(uses[s]),
+               0.0});
+          break;
+        }
+      }
+      paired[s] = true;
+      for (std::size_t t : cover) paired[t] = true;
+      // A four-triangle centre lies on the quad, inside its element's face: that element covers
+      // the half space beyond it there (the quad's tangent plane).
+      if (cover.size() == 4) centre_on_quad_.push_back(third_node(uses[cover[0]].key, q));
+      ++result_.interface_quads;
+    }
+    for (std::size_t s : single) {
+      if (paired[s]) continue;
+      BoundaryFace b{};
+      b.nodes = face_nodes(uses[s].element, uses[s].face, &b.size);
+      b.element = uses[s].element;
+      boundary_.push_back(b);
+    }
+    result_.boundary_faces = boundary_.size();
+  }
+
+  bool same_nodes(ElementRef a, ElementRef b) const {
+    if (a.kind != b.kind) return false;
+    const auto x = corners(a), y = corners(b);
+    // Neighbours share a face but never all their nodes: their sums differ almost always.
+    std::int64_t sx = 0, sy = 0;
+    for (std::size_t i = 0; i < x.size(); ++i) sx += x[i], sy += y[i];
+    return sx == sy && std::is_permutation(x.begin(), x.end(), y.begin(), y.end());
+  }
+
+  // The node of triangle key k that is not a corner of quad q.
+  static Index third_node(const FaceKey& k, const std::array<Index, 4>& q) {
+    for (int i = 0; i < 3; ++i)
+      if (std::find(q.begin(), q.end(), k[static_cast<std::size_t>(i)]) == q.end())
+        return k[static_cast<std::size_t>(i)];
+    return kInvalidIndex;
+  }
+
+  bool opposite(const FaceUse& a, const FaceUse& b) const {
+    int n = 0;
+    const auto x = face_nodes(a.element, a.face, &n);
+    const auto y = face_nodes(b.element, b.face);
+    const int j = static_cast<int>(std::find(y.begin(), y.begin() + n, x[0]) - y.begin());
+    if (j == n) return false;
+    for (int i = 0; i < n; ++i)
+      if (y[static_cast<std::size_t>((j - i + n) % n)] != x[static_cast<std::size_t>(i)])
+        return false;
+    return true;
+  }
+
+  Point face_centre(const FaceUse& u) const {
+    int n = 0;
+    const auto f = face_nodes(u.element, u.face, &n);
+    Point c = Point::Zero();
+    for (int i = 0; i < n; ++i) c += pt(f[static_cast<std::size_t>(i)]);
+    return c / n;
+  }
+
+  // The corners' solid angles at every node against 4 pi inside and the boundary's enclosed
+  // solid angle on it. A pyramid counts as the two positive tets check_geometry found in it
+  // (their cones tile its corners'), every other corner as the cone of its three edges.
+  void covering_at_nodes() {
+    const std::size_t nv = model_.points.size();
+    std::vector<double> angle(nv, 0.0);
+    std::vector<ElementRef> at(nv, ElementRef{ElementKind::Hex, kInvalidIndex});
+    auto cone = [&](ElementRef e, Index v, Index a, Index b, Index c) {
+      const Point& o = pt(v);
+      angle[static_cast<std::size_t>(v)] += solid_angle(pt(a) - o, pt(b) - o, pt(c) - o);
+      if (at[static_cast<std::size_t>(v)].index == kInvalidIndex)
+        at[static_cast<std::size_t>(v)] = e;
+    };
+    auto tet = [&](ElementRef e, std::array<Index, 4> t) {
+      for (int k = 0; k < 4; ++k) {
+        const auto& n = topology::kTetCornerNeighbors[static_cast<std::size_t>(k)];
+        cone(e, t[static_cast<std::size_t>(k)], t[static_cast<std::size_t>(n[0])],
+             t[static_cast<std::size_t>(n[1])], t[static_cast<std::size_t>(n[2])]);
+      }
+    };
+    for (std::size_t i = 0; i < model_.hexes.size(); ++i) {
+      const auto& h = model_.hexes[i];
+      for (int c = 0; c < 8; ++c) {
+        const auto& n = topology::kHexCornerNeighbors[static_cast<std::size_t>(c)];
+        cone({ElementKind::Hex, static_cast<Index>(i)}, h[static_cast<std::size_t>(c)],
+             h[static_cast<std::size_t>(n[0])], h[static_cast<std::size_t>(n[1])],
+             h[static_cast<std::size_t>(n[2])]);
+      }
+    }
+    for (std::size_t i = 0; i < model_.wedges.size(); ++i) {
+      const auto& w = model_.wedges[i];
+      for (int c = 0; c < 6; ++c) {
+        const auto& n = topology::kWedgeCornerNeighbors[static_cast<std::size_t>(c)];
+        cone({ElementKind::Wedge, static_cast<Index>(i)}, w[static_cast<std::size_t>(c)],
+             w[static_cast<std::size_t>(n[0])], w[static_cast<std::size_t>(n[1])],
+             w[static_cast<std::size_t>(n[2])]);
+      }
+    }
+    for (std::size_t i = 0; i < model_.tets.size(); ++i)
+      tet({ElementKind::Tet, static_cast<Index>(i)}, model_.tets[i]);
+    for (Index x : centre_on_quad_) angle[static_cast<std::size_t>(x)] += 2.0 * kPi;
+    for (std::size_t i = 0; i < model_.pyramids.size(); ++i) {
+      const auto& p = model_.pyramids[i];
+      const ElementRef e{ElementKind::Pyramid, static_cast<Index>(i)};
+      const bool d02 = tet_volume(pt(p[0]), pt(p[1]), pt(p[2]), pt(p[4])) > 0.0 &&
+                       tet_volume(pt(p[0]), pt(p[2]), pt(p[3]), pt(p[4])) > 0.0;
+      if (d02) {
+        tet(e, {p[0], p[1], p[2], p[4]});
+        tet(e, {p[0], p[2], p[3], p[4]});
+      } else {
+        tet(e, {p[0], p[1], p[3], p[4]});
+        tet(e, {p[1], p[2], p[3], p[4]});
+      }
+    }
+
+    // Boundary nodes: the solid angle inside the spherical polygon of their boundary faces'
+    // sectors, 2 pi - sum(pi - interior dihedral angle) over the boundary edges there; a node
+    // where the boundary is not one disk (an edge on other than two boundary faces, two
+    // disks touching) is not judged.
+    std::vector<HalfEdge> half;
+    half.reserve(8 * boundary_.size());
+    for (std::size_t f = 0; f < boundary_.size(); ++f) {
+      const auto& b = boundary_[f];
+      for (int i = 0; i < b.size; ++i) {
+        const Index v = b.nodes[static_cast<std::size_t>(i)];
+        const Index next = b.nodes[static_cast<std::size_t>((i + 1) % b.size)];
+        const Index prev = b.nodes[static_cast<std::size_t>((i + b.size - 1) % b.size)];
+        const Point n = (pt(next) - pt(v)).cross(pt(prev) - pt(v));
+        half.push_back({v, next, prev, n, static_cast<Index>(f)});
+        half.push_back({v, prev, next, n, static_cast<Index>(f)});
+      }
+    }
+    tbb::parallel_sort(half.begin(), half.end());
+    std::vector<double> expected(nv, 4.0 * kPi);
+    std::vector<bool> judged(nv, true);
+    DisjointSets faces_at;
+    for (std::size_t i = 0; i < half.size();) {
+      const Index v = half[i].v;
+      std::size_t j = i;
+      while (j < half.size() && half[j].v == v) ++j;
+      // Faces at v, numbered locally by order of appearance.
+      std::vector<Index> local;
+      for (std::size_t k = i; k < j; ++k)
+        if (std::find(local.begin(), local.end(), half[k].face) == local.end())
+          local.push_back(half[k].face);
+      faces_at.reset(local.size());
+      auto slot = [&](Index f) {
+        return static_cast<Index>(std::find(local.begin(), local.end(), f) - local.begin());
+      };
+      double exterior = 0.0;
+      bool ok = true;
+      for (std::size_t k = i; k < j && ok; k += 2) {
+        if (k + 1 >= j || half[k + 1].end != half[k].end ||
+            (k + 2 < j && half[k + 2].end == half[k].end)) {
+          ok = false;
+          break;
+        }
+        const Point& o = pt(v);
+        exterior += kPi - dihedral(pt(half[k].end) - o, pt(half[k].other) - o, -half[k].normal,
+                                   pt(half[k + 1].other) - o);
+        faces_at.unite(slot(half[k].face), slot(half[k + 1].face));
+      }
+      if (ok && faces_at.count() == 1)
+        expected[static_cast<std::size_t>(v)] = 2.0 * kPi - exterior;
+      else
+        judged[static_cast<std::size_t>(v)] = false;
+      i = j;
+    }
+    for (std::size_t v = 0; v < nv && !full(); ++v) {
+      if (at[v].index == kInvalidIndex || !judged[v]) continue;
+      if (!(std::abs(angle[v] - expected[v]) > kPi)) continue;  // NaN: not judged
+      add({InputFault::kFoldedNode,
+           {at[v]},
+           static_cast<Index>(v),
+           pt(static_cast<Index>(v)),
+           angle[v] / expected[v]});
+    }
+  }
+
+  // Boundary faces without a common node that cross, or that face each other across a gap
+  // thinner than gap_fraction x their longest edge: pairs found through a uniform grid.
+  void boundary_contacts() {
+    for (std::size_t f = 0; f < boundary_.size(); ++f) {
+      const auto& b = boundary_[f];
+      triangles_.push_back({{b.nodes[0], b.nodes[1], b.nodes[2]}, static_cast<Index>(f)});
+      if (b.size == 4)
+        triangles_.push_back({{b.nodes[0], b.nodes[2], b.nodes[3]}, static_cast<Index>(f)});
+    }
+    const std::size_t nt = triangles_.size();
+    if (nt < 2) return;
+    std::vector<double> longest(nt);
+    std::vector<Point> lo(nt), hi(nt);
+    double mean = 0.0, most = 0.0;
+    Point all_lo = pt(triangles_[0].v[0]), all_hi = all_lo;
+    for (std::size_t t = 0; t < nt; ++t) {
+      const auto& v = triangles_[t].v;
+      double l = 0.0;
+      for (int k = 0; k < 3; ++k) l = std::max(l, (pt(v[k]) - pt(v[(k + 1) % 3])).norm());
+      longest[t] = l;
+      mean += l;
+      most = std::max(most, l);
+      const double pad = options_.gap_fraction * l;
+      lo[t] = pt(v[0]).cwiseMin(pt(v[1])).cwiseMin(pt(v[2])).array() - pad;
+      hi[t] = pt(v[0]).cwiseMax(pt(v[1])).cwiseMax(pt(v[2])).array() + pad;
+      all_lo = all_lo.cwiseMin(lo[t]);
+      all_hi = all_hi.cwiseMax(hi[t]);
+    }
+    mean /= static_cast<double>(nt);
+    if (!all_lo.allFinite() || !all_hi.allFinite() || !std::isfinite(mean)) return;
+    // Cells about the mean edge, but never so small that the longest triangle spans more than
+    // about 8 cells along an axis, nor more than 2^20 along the model; doubled until the
+    // triangles' boxes take at most 8 cells each on average (graded meshes).
+    double h = std::max({mean, most / 8.0, (all_hi - all_lo).maxCoeff() / double(1 << 20)});
+    for (;;) {
+      double cells = 0.0;
+      for (std::size_t t = 0; t < nt; ++t) {
+        const Eigen::Array3d a = ((lo[t] - all_lo) / h).array().floor();
+        const Eigen::Array3d b = ((hi[t] - all_lo) / h).array().floor();
+        cells += (b - a + 1.0).prod();
+      }
+      if (cells <= 8.0 * static_cast<double>(nt)) break;
+      h *= 2.0;
+    }
+    auto cell = [&](const Point& p) {
+      const Eigen::Array3d c = ((p - all_lo) / h).array().floor();
+      return std::array<std::int64_t, 3>{static_cast<std::int64_t>(c[0]),
+                                         static_cast<std::int64_t>(c[1]),
+                                         static_cast<std::int64_t>(c[2])};
+    };
+    auto code = [](const std::array<std::int64_t, 3>& c) {
+      return static_cast<std::uint64_t>(c[0]) << 42 | static_cast<std::uint64_t>(c[1]) << 21 |
+             static_cast<std::uint64_t>(c[2]);
+    };
+    std::vector<std::pair<std::uint64_t, Index>> binned;
+    binned.reserve(4 * nt);
+    for (std::size_t t = 0; t < nt; ++t) {
+      const auto a = cell(lo[t]), b = cell(hi[t]);
+      for (auto x = a[0]; x <= b[0]; ++x)
+        for (auto y = a[1]; y <= b[1]; ++y)
+          for (auto z = a[2]; z <= b[2]; ++z) binned.emplace_back(code({x, y, z}), Index(t));
+    }
+    tbb::parallel_sort(binned.begin(), binned.end());
+    for (std::size_t i = 0; i < binned.size() && !full();) {
+      std::size_t j = i + 1;
+      while (j < binned.size() && binned[j].first == binned[i].first) ++j;
+      for (std::size_t a = i; a < j && !full(); ++a)
+        for (std::size_t b = a + 1; b < j && !full(); ++b) {
+          const auto s = static_cast<std::size_t>(binned[a].second);
+          const auto t = static_cast<std::size_t>(binned[b].second);
+          if (((hi[s].array() < lo[t].array()) || (hi[t].array() < lo[s].array())).any()) continue;
+          // Each pair once: in the cell holding the lower corner of the boxes' overlap.
+          if (code(cell(lo[s].cwiseMax(lo[t]))) != binned[i].first) continue;
+          contact(s, t, std::max(longest[s], longest[t]));
+        }
+      i = j;
+    }
+  }
+
+  void contact(std::size_t s, std::size_t t, double length) {
+    const auto& a = triangles_[s].v;
+    const auto& b = triangles_[t].v;
+    for (Index x : a)
+      if (std::find(b.begin(), b.end(), x) != b.end()) return;
+    const ElementRef ea = boundary_[static_cast<std::size_t>(triangles_[s].face)].element;
+    const ElementRef eb = boundary_[static_cast<std::size_t>(triangles_[t].face)].element;
+    if (const auto x = crossing(a, b, length); x) {
+      add({InputFault::kCrossingFaces, {ea, eb}, kInvalidIndex, *x, 0.0});
+      return;
+    }
+    if (const auto x = crossing(b, a, length); x) {
+      add({InputFault::kCrossingFaces, {ea, eb}, kInvalidIndex, *x, 0.0});
+      return;
+    }
+    const Point na = (pt(a[1]) - pt(a[0])).cross(pt(a[2]) - pt(a[0])).normalized();
+    const Point nb = (pt(b[1]) - pt(b[0])).cross(pt(b[2]) - pt(b[0])).normalized();
+    if (!(na.dot(nb) < -0.9)) return;
+    if (const auto g = facing(a, b, nb, length); g)
+      add({InputFault::kGap, {ea, eb}, kInvalidIndex, g->first, g->second});
+    else if (const auto h = facing(b, a, na, length); h)
+      add({InputFault::kGap, {eb, ea}, kInvalidIndex, h->first, h->second});
+  }
+
+  // a's centre in front of b (in the void b's outward normal nb points to), closer than the
+  // gap fraction, over b: the point on b and the distance.
+  std::optional<std::pair<Point, double>> facing(const std::array<Index, 3>& a,
+                                                 const std::array<Index, 3>& b, const Point& nb,
+                                                 double length) const {
+    const Point g = (pt(a[0]) + pt(a[1]) + pt(a[2])) / 3.0;
+    const double d = (g - pt(b[0])).dot(nb);
+    if (d < -1e-9 * length || d > options_.gap_fraction * length) return std::nullopt;
+    const Point y = g - d * nb;
+    if (!inside(b, y, -1e-9)) return std::nullopt;
+    return std::pair<Point, double>{y, d > 1e-9 * length ? d : 0.0};  // 0: coincident
+  }
+
+  // Whether point y (in the triangle's plane) lies inside it, barycentric margin `margin`.
+  bool inside(const std::array<Index, 3>& t, const Point& y, double margin) const {
+    const Point n = (pt(t[1]) - pt(t[0])).cross(pt(t[2]) - pt(t[0]));
+    const double n2 = n.squaredNorm();
+    for (int k = 0; k < 3; ++k) {
+      const Point& p = pt(t[k]);
+      const Point& q = pt(t[(k + 1) % 3]);
+      if ((q - p).cross(y - p).dot(n) < margin * n2) return false;
+    }
+    return true;
+  }
+
+  // Where an edge of triangle a passes through triangle b's interior, if one does.
+  std::optional<Point> crossing(const std::array<Index, 3>& a, const std::array<Index, 3>& b,
+                                double length) const {
+    const double eps = 1e-9 * length * length * length;
+    for (int k = 0; k < 3; ++k) {
+      const Point& u = pt(a[k]);
+      const Point& w = pt(a[(k + 1) % 3]);
+      const double su = orient(pt(b[0]), pt(b[1]), pt(b[2]), u);
+      const double sw = orient(pt(b[0]), pt(b[1]), pt(b[2]), w);
+      if (!((su > eps && sw < -eps) || (su < -eps && sw > eps))) continue;
+      const Point x = u + (su / (su - sw)) * (w - u);
+      if (inside(b, x, 1e-9)) return x;
+    }
+    return std::nullopt;
+  }
+
+  // The winding number of the boundary (its faces as triangles) at the centre of one element of
+  // each boundary component must be 1.
+  void degree_of_components() {
+    if (boundary_.empty()) return;
+    if (triangles_.empty())
+      for (std::size_t f = 0; f < boundary_.size(); ++f) {
+        const auto& b = boundary_[f];
+        triangles_.push_back({{b.nodes[0], b.nodes[1], b.nodes[2]}, static_cast<Index>(f)});
+        if (b.size == 4)
+          triangles_.push_back({{b.nodes[0], b.nodes[2], b.nodes[3]}, static_cast<Index>(f)});
+      }
+    DisjointSets components(boundary_.size());
+    std::unordered_map<Index, Index> first_face;
+    for (std::size_t f = 0; f < boundary_.size(); ++f)
+      for (int i = 0; i < boundary_[f].size; ++i) {
+        const auto [it, fresh] = first_face.emplace(boundary_[f].nodes[static_cast<std::size_t>(i)],
+                                                    static_cast<Index>(f));
+        if (!fresh) components.unite(it->second, static_cast<Index>(f));
+      }
+    std::vector<Index> representative;
+    for (std::size_t f = 0; f < boundary_.size(); ++f)
+      if (components.find(static_cast<Index>(f)) == static_cast<Index>(f))
+        representative.push_back(static_cast<Index>(f));
+    result_.boundary_components = representative.size();
+    if (representative.size() < 2) return;  // one closed surface: its winding number is 1 inside
+    for (std::size_t r = 0; r < representative.size() && r < options_.max_components && !full();
+         ++r) {
+      const ElementRef e = boundary_[static_cast<std::size_t>(representative[r])].element;
+      const Point x = centre(e);
+      double omega = 0.0;
+      for (const Triangle& t : triangles_)
+        omega += solid_angle(pt(t.v[0]) - x, pt(t.v[1]) - x, pt(t.v[2]) - x);
+      const double winding = omega / (4.0 * kPi);
+      if (std::abs(winding - 1.0) > 0.5)
+        add({InputFault::kCoveredTwice, {e}, kInvalidIndex, x, winding});
+    }
+  }
+
+  const Model& model_;
+  const InputCheckOptions& options_;
+  InputCheckResult result_;
+  std::vector<BoundaryFace> boundary_;
+  std::vector<Index> centre_on_quad_;  // four-triangle centres, one per such interface quad
+  std::vector<Triangle> triangles_;
+};
+
+std::string number(double x) {
+  std::ostringstream os;
+  os.precision(3);
+  os << x;
+  return os.str();
+}
+
+}  // namespace
+
+std::string InputFinding::text(const Model& model) const {
+  auto named = [&](std::size_t i) {
+    return i < elements.size() ? describe_element(model, elements[i]) : std::string("?");
+  };
+  switch (fault) {
+    case InputFault::kOversharedFace: {
+      std::string s = "the face at " + point_text(place) + " is shared by " +
+                      std::to_string(elements.size()) + " elements (";
+      for (std::size_t i = 0; i < elements.size(); ++i)
+        s += (i ? ", " : "") + describe_element(model, elements[i]);
+      return s + "): the parts overlap there";
+    }
+    case InputFault::kDuplicateElement:
+      return named(0) + " and " + named(1) + " are one element twice (the same nodes " +
+             node_list(model, element_corners(model, elements[0])) + ")";
+    case InputFault::kSameSideFace:
+      return named(0) + " and " + named(1) + " lie on the same side of their shared face at " +
+             point_text(place) + ": the mesh folds over itself there";
+    case InputFault::kFoldedNode:
+      return "the elements around " + describe_node(model, node) + " (" + named(0) +
+             " among them) cover its neighbourhood " + number(measure) +
+             " times, not once (corner solid angles): the mesh folds over itself there";
+    case InputFault::kCrossingFaces:
+      return "the boundary of " + named(0) + " crosses the boundary of " + named(1) + " at " +
+             point_text(place) + ": two parts overlap";
+    case InputFault::kGap:
+      if (measure == 0.0)
+        return named(0) + " and " + named(1) + " lie against each other at " + point_text(place) +
+               " without sharing nodes: their nodes lie at the same place as others' (duplicated "
+               "interface nodes, which --merge-tolerance merges)";
+      return named(0) + " and " + named(1) + " face each other across a gap of " + number(measure) +
+             " at " + point_text(place) +
+             " without sharing nodes: an interface with a gap (or duplicated interface nodes, "
+             "which --merge-tolerance merges)";
+    case InputFault::kCoveredTwice:
+      return named(0) + " lies inside other elements (the boundary winds " + number(measure) +
+             " times around its centre, not once): two parts overlap";
+  }
+  return "covering check";
+}
+
+InputCheckResult check_input(const Model& model, const InputCheckOptions& options) {
+  return InputChecker(model, options).run();
+}
+
+void require_single_covering(const Model& model, std::string_view source,
+                             const InputCheckOptions& options) {
+  InputCheckOptions one = options;
+  one.max_findings = 1;
+  const InputCheckResult r = check_input(model, one);
+  if (!r.ok()) throw InvalidInput(std::string(source) + ": " + r.findings[0].text(model));
+}
+
+}  // namespace geode::primal

@@ -1,0 +1,291 @@
+// The read-time covering check (primal/input_check.hpp) on inputs made the way users make them:
+// every demo model (Gmsh's one-generate(3) hybrids with their pyramids and wedges, the potting,
+// the Delaunay and swept models) passes it as saved by `--save-input`; a Gmsh model and a TetGen
+// box with one tet folded over its neighbours (a node moved through a face, the tets it turned
+// inside out written positively, as a mesher re-orienting them would), two parts overlapping,
+// an interface opened by a gap and a part lying inside another are refused, naming the input
+// elements, and `geode conform` exits 2 on them with one line and nothing written.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include <geode/demo/demo_models.hpp>
+#include <geode/io/formats.hpp>
+#include <geode/io/read_model.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/input_check.hpp>
+#include "support/cli_run.hpp"
+#include "support/temp_dir.hpp"
+
+using namespace geode;
+using primal::ElementKind;
+using primal::Index;
+using primal::InputFault;
+using primal::Point;
+
+namespace {
+
+// The demo saved as .msh by the command (a process each: libgmsh 4.8 cannot mesh two hybrids in
+// one) and read back without the covering check.
+primal::Model saved_demo(const std::string& name, int n, const test::TempDir& dir) {
+  const auto path = dir.path / (name + ".msh");
+  const auto run = test::geode_cli("demo --model " + name + " -n " + std::to_string(n) +
+                                       " --quiet --save-input " + path.string(),
+                                   true);
+  INFO(run.out);
+  REQUIRE(run.code == 0);
+  return io::read_model(path, {}, false);
+}
+
+// A node with only tets around it and not on the boundary (every face at it shared).
+Index interior_tet_node(const primal::Model& m) {
+  std::vector<int> bad(m.points.size(), 0);
+  for (ElementKind kind : primal::kElementKinds)
+    if (kind != ElementKind::Tet)
+      for (std::size_t e = 0; e < primal::element_count(m, kind); ++e)
+        for (Index v : primal::element_corners(m, {kind, static_cast<Index>(e)}))
+          bad[static_cast<std::size_t>(v)] = 1;
+  const primal::InputCheckResult r = primal::check_input(m);
+  REQUIRE(r.ok());
+  // Boundary nodes: on a face used once (tets only, so a face key count).
+  std::map<std::array<Index, 3>, int> faces;
+  for (const auto& t : m.tets)
+    for (const auto& f : primal::topology::kTetFaceCorners) {
+      std::array<Index, 3> k{t[static_cast<std::size_t>(f[0])], t[static_cast<std::size_t>(f[1])],
+                             t[static_cast<std::size_t>(f[2])]};
+      std::sort(k.begin(), k.end());
+      ++faces[k];
+    }
+  for (const auto& [k, uses] : faces)
+    if (uses == 1)
+      for (Index v : k) bad[static_cast<std::size_t>(v)] = 1;
+  // The middle one of the candidates: far from the parts' corners.
+  std::vector<Index> candidates;
+  for (const auto& t : m.tets)
+    for (Index v : t)
+      if (!bad[static_cast<std::size_t>(v)]) candidates.push_back(v);
+  REQUIRE(!candidates.empty());
+  return candidates[candidates.size() / 2];
+}
+
+// Moves node v through the face opposite it in one of its tets (mirrored there) and re-orients
+// every tet that turned inside out (swapping two corners, as a mesher writing positive elements
+// does): all elements positive, the tet folded over its neighbours. Returns the moved tet.
+Index fold_tet_at(primal::Model& m, Index v) {
+  Index t = 0;
+  while (std::find(m.tets[static_cast<std::size_t>(t)].begin(),
+                   m.tets[static_cast<std::size_t>(t)].end(),
+                   v) == m.tets[static_cast<std::size_t>(t)].end())
+    ++t;
+  const auto& tet = m.tets[static_cast<std::size_t>(t)];
+  std::array<Point, 3> face;
+  int k = 0;
+  for (Index u : tet)
+    if (u != v) face[static_cast<std::size_t>(k++)] = m.points[static_cast<std::size_t>(u)];
+  const Point n = (face[1] - face[0]).cross(face[2] - face[0]).normalized();
+  Point& p = m.points[static_cast<std::size_t>(v)];
+  p -= 2.0 * (p - face[0]).dot(n) * n;
+  for (auto& c : m.tets) {
+    auto at = [&](int i) -> const Point& { return m.points[static_cast<std::size_t>(c[i])]; };
+    if (primal::tet_volume(at(0), at(1), at(2), at(3)) < 0.0) std::swap(c[1], c[2]);
+  }
+  return t;
+}
+
+// A copy of the model's hexes on nodes of their own, moved by `shift`: the hex part no longer
+// shares the interface nodes with the tets.
+void detach_hexes(primal::Model& m, const Point& shift) {
+  std::map<Index, Index> copy;
+  std::int64_t next_id =
+      m.node_ids.empty() ? 0 : *std::max_element(m.node_ids.begin(), m.node_ids.end());
+  for (auto& h : m.hexes)
+    for (Index& v : h) {
+      const auto [it, fresh] = copy.emplace(v, static_cast<Index>(m.points.size()));
+      if (fresh) {
+        m.points.push_back(m.points[static_cast<std::size_t>(v)] + shift);
+        if (!m.node_ids.empty()) m.node_ids.push_back(++next_id);
+      }
+      v = it->second;
+    }
+}
+
+// `geode conform` on the model saved as .msh: exit 2, one line naming the file and holding the
+// check's first finding on the file as read (its element and node ids are the file's) and
+// `words`, no output file.
+void refused_by_conform(const primal::Model& m, const std::string& name,
+                        const std::vector<std::string>& words, const test::TempDir& dir) {
+  const auto in = dir.path / (name + ".msh");
+  const auto out = dir.path / (name + "-out.exo");
+  io::write_model(m, in);
+  const primal::Model read = io::read_model(in, {}, false);
+  const primal::InputCheckResult r = primal::check_input(read);
+  REQUIRE(!r.ok());
+  const auto run = test::geode_cli("conform " + in.string() + " -o " + out.string(), true);
+  INFO(run.out);
+  CHECK(run.code == 2);
+  CHECK(std::count(run.out.begin(), run.out.end(), '\n') == 1);
+  CHECK(run.out.find(in.string() + ": " + r.findings[0].text(read)) != std::string::npos);
+  for (const auto& w : words) CHECK(run.out.find(w) != std::string::npos);
+  CHECK(!std::filesystem::exists(out));
+}
+
+// A TetGen mesh of the box [0,2] x [0,1] x [0,1] (quality mesh, volume bound 0.002), tets
+// oriented positively (TetGen's own orientation is the other way round).
+primal::Model tetgen_box(const test::TempDir& dir) {
+  const auto poly = dir.path / "box.poly";
+  {
+    std::ofstream f(poly);
+    f << "8 3 0 0\n1 0 0 0\n2 2 0 0\n3 2 1 0\n4 0 1 0\n5 0 0 1\n6 2 0 1\n7 2 1 1\n8 0 1 1\n"
+         "6 0\n1\n4 1 2 3 4\n1\n4 5 6 7 8\n1\n4 1 2 6 5\n1\n4 2 3 7 6\n1\n4 3 4 8 7\n1\n"
+         "4 4 1 5 8\n0\n0\n";
+  }
+  const std::string cmd = "tetgen -pqa0.002Q " + poly.string() + " > /dev/null 2>&1";
+  REQUIRE(std::system(cmd.c_str()) == 0);
+  primal::Model m;
+  std::ifstream nodes(dir.path / "box.1.node"), eles(dir.path / "box.1.ele");
+  REQUIRE(nodes);
+  REQUIRE(eles);
+  std::size_t nn = 0, ne = 0;
+  int dim = 0, attrs = 0, markers = 0;
+  nodes >> nn >> dim >> attrs >> markers;
+  for (std::size_t i = 0; i < nn; ++i) {
+    std::string line;
+    long id = 0;
+    double x = 0, y = 0, z = 0;
+    nodes >> id >> x >> y >> z;
+    std::getline(nodes, line);
+    m.points.emplace_back(x, y, z);
+  }
+  int per = 0;
+  eles >> ne >> per >> attrs;
+  for (std::size_t i = 0; i < ne; ++i) {
+    long id = 0;
+    std::array<Index, 4> t{};
+    eles >> id >> t[0] >> t[1] >> t[2] >> t[3];
+    for (Index& v : t) --v;
+    auto at = [&](int k) -> const Point& { return m.points[static_cast<std::size_t>(t[k])]; };
+    if (primal::tet_volume(at(0), at(1), at(2), at(3)) < 0.0) std::swap(t[1], t[2]);
+    primal::add_element(m, ElementKind::Tet, t, 2, static_cast<std::int64_t>(i + 1));
+  }
+  for (std::size_t i = 0; i < m.points.size(); ++i)
+    m.node_ids.push_back(static_cast<std::int64_t>(i + 1));
+  return m;
+}
+
+}  // namespace
+
+TEST_CASE("input check: every demo model, as saved, covers its domain once") {
+  test::TempDir dir;
+  for (const std::string& name : demo::demo_model_names()) {
+    CAPTURE(name);
+    const primal::Model m = saved_demo(name, name == "potting" ? 2 : 3, dir);
+    const primal::InputCheckResult r = primal::check_input(m);
+    INFO((r.ok() ? std::string() : r.findings[0].text(m)));
+    CHECK(r.ok());
+    CHECK(r.boundary_components == 1);
+    CHECK(r.boundary_faces > 0);
+    // Read again with the check: nothing refused.
+    CHECK_NOTHROW(io::read_model(dir.path / (name + ".msh")));
+  }
+}
+
+TEST_CASE("input check: a folded tet in a Gmsh hybrid and in a TetGen box is refused by name") {
+  test::TempDir dir;
+  for (const std::string source : {"hybrid", "tetgen"}) {
+    CAPTURE(source);
+    primal::Model m = source == "tetgen" ? tetgen_box(dir) : saved_demo("hybrid", 4, dir);
+    const Index v = interior_tet_node(m);
+    const Index t = fold_tet_at(m, v);
+    REQUIRE_NOTHROW(primal::check_geometry(m, source));  // every element positive
+    const primal::InputCheckResult r = primal::check_input(m);
+    REQUIRE(!r.ok());
+    const primal::InputFinding& f = r.findings[0];
+    CHECK((f.fault == InputFault::kSameSideFace || f.fault == InputFault::kFoldedNode));
+    // The finding is at the moved node: one of its elements holds it.
+    CHECK(std::any_of(f.elements.begin(), f.elements.end(), [&](const primal::ElementRef& e) {
+      const auto c = primal::element_corners(m, e);
+      return std::find(c.begin(), c.end(), v) != c.end();
+    }));
+    const std::string text = f.text(m);
+    CHECK(text.find("folds") != std::string::npos);
+    // The moved tet or one of its neighbours around the node.
+    CHECK(text.find(" tet ") != std::string::npos);
+    refused_by_conform(m, std::string("folded-") + source, {"folds"}, dir);
+    (void)t;
+  }
+}
+
+TEST_CASE("input check: overlapping parts, a gap at the interface, a part inside another") {
+  test::TempDir dir;
+  const primal::Model base = saved_demo("delaunay", 4, dir);  // hexes [0,1]^3, tets x in [1,2]
+  {
+    // The hex part misplaced 0.3 into the tet part (and 0.1 off along y and z): their
+    // boundaries cross.
+    primal::Model m = base;
+    detach_hexes(m, Point(0.3, 0.1, 0.1));
+    const primal::InputCheckResult r = primal::check_input(m);
+    REQUIRE(!r.ok());
+    CHECK(r.findings[0].fault == InputFault::kCrossingFaces);
+    REQUIRE(r.findings[0].elements.size() == 2);
+    std::set<ElementKind> kinds{r.findings[0].elements[0].kind, r.findings[0].elements[1].kind};
+    CHECK(kinds == std::set<ElementKind>{ElementKind::Hex, ElementKind::Tet});
+    CHECK(r.findings[0].place.x() > 0.99);
+    CHECK(r.findings[0].place.x() < 1.31);
+    refused_by_conform(m, "overlap", {"overlap", "crosses"}, dir);
+  }
+  {
+    // The hex part moved 0.004 away (a quarter-cell is 0.25 here): an interface with a gap.
+    primal::Model m = base;
+    detach_hexes(m, Point(-0.004, 0.0, 0.0));
+    const primal::InputCheckResult r = primal::check_input(m);
+    REQUIRE(!r.ok());
+    CHECK(r.findings[0].fault == InputFault::kGap);
+    CHECK(r.findings[0].measure == doctest::Approx(0.004).epsilon(0.01));
+    CHECK(r.findings[0].place.x() == doctest::Approx(1.0).epsilon(0.01));
+    refused_by_conform(m, "gap", {"gap"}, dir);
+  }
+  {
+    // Duplicated interface nodes in place: refused on read, conformed once merged.
+    primal::Model m = base;
+    detach_hexes(m, Point::Zero());
+    const primal::InputCheckResult r = primal::check_input(m);
+    REQUIRE(!r.ok());
+    CHECK(r.findings[0].fault == InputFault::kGap);
+    CHECK(r.findings[0].measure < 1e-12);
+    refused_by_conform(m, "duplicated", {"--merge-tolerance"}, dir);
+    const auto in = dir.path / "duplicated.msh";
+    const auto run =
+        test::geode_cli("conform " + in.string() + " --merge-tolerance 1e-6 --quiet -o " +
+                            (dir.path / "merged.exo").string(),
+                        true);
+    INFO(run.out);
+    CHECK(run.code == 0);
+  }
+  {
+    // A hex box [1.3, 1.7]^3 inside the tet box (no hole cut for it): covered twice.
+    primal::Model m = base;
+    m.hexes.resize(1);
+    m.hex_block.resize(std::min<std::size_t>(m.hex_block.size(), 1));
+    if (!m.hex_ids.empty()) m.hex_ids.resize(1);
+    detach_hexes(m, Point::Zero());
+    for (int c = 0; c < 8; ++c) {
+      const auto& r = primal::topology::kHexCornerCoords[static_cast<std::size_t>(c)];
+      m.points[static_cast<std::size_t>(m.hexes[0][static_cast<std::size_t>(c)])] =
+          Point(1.3, 0.3, 0.3) + 0.4 * Point(r[0], r[1], r[2]);
+    }
+    REQUIRE_NOTHROW(primal::check_geometry(m, "inside"));
+    const primal::InputCheckResult r = primal::check_input(m);
+    REQUIRE(!r.ok());
+    CHECK(r.findings[0].fault == InputFault::kCoveredTwice);
+    CHECK(r.findings[0].elements[0].kind == ElementKind::Hex);
+    CHECK(r.findings[0].measure == doctest::Approx(2.0).epsilon(0.01));
+    refused_by_conform(m, "inside", {"hex", "inside other elements"}, dir);
+  }
+}
