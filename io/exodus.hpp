@@ -41,9 +41,9 @@ inline constexpr std::array<ExodusCell, 4> kExodusCells{{
 
 // The file is checked for the netCDF / HDF5 signature (file_format.hpp) and screened
 // (netcdf_screen.hpp: a classic header parsed whole and bounded by the file's size, an HDF5
-// superblock checked) before libexodusII opens it; a netCDF-4 (HDF5) file is then read by
-// libexodusII in a child process under memory and CPU limits (isolated.hpp), so that a crash of
-// libhdf5 on a corrupt file is a refusal, not ours. Node and element number maps, when present
+// superblock checked) before libexodusII opens it, and libexodusII then reads it in a child
+// process under memory and CPU limits (isolated.hpp), so that a crash of libhdf5 or of
+// libexodusII on a corrupt file is a refusal, not ours. Node and element number maps, when present
 // (Cubit writes them), are the model's file ids; otherwise 1-based numbers. Block ids are the
 // file's; a file with a block id <= 0 (meshio numbers blocks from 0) gets its blocks numbered 1, 2,
 // ... in file order. Throws InvalidInput naming the file, the block / element / set entry and the
