@@ -358,28 +358,11 @@ void OutputFiles::commit() {
       throw InvalidInput(what);
     }
   }
-  // The targets renamed so far are registered like temporaries until all are in place: a
-  // signal between two renames removes them, so a mesh never stands without its report.
-  std::vector<fs::path> renamed;
-  const auto forget = [&renamed] {
-    for (const auto& r : renamed) io::unregister_temporary(r);
-  };
-  for (const Entry& e : entries_) {
-    try {
-      io::publish_temporary(e.temp, e.resolved, e.target);
-    } catch (const InvalidInput& x) {
-      std::error_code ec;
-      for (const auto& r : renamed) fs::remove(r, ec);
-      forget();
-      throw InvalidInput(std::string(x.what()) + "; nothing written");
-    }
-    pending_.erase(std::find(pending_.begin(), pending_.end(), e.temp));
-    if (e.resolved.regular) {
-      renamed.push_back(e.resolved.file);
-      io::register_temporary(e.resolved.file);
-    }
-  }
-  forget();
+  // All renamed as one (io/atomic_file.hpp): a failure or a signal between two renames puts
+  // back what the targets held, so a mesh never stands without its report.
+  std::vector<io::Publication> items;
+  for (const Entry& e : entries_) items.push_back({e.temp, e.resolved, e.target});
+  io::publish_together(items);
   pending_.clear();
 }
 

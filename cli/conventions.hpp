@@ -113,8 +113,9 @@ CLI::Option* add_write_invalid_flag(CLI::App* app, bool& flag);
 // extension, so writers that go by it still work; registered for removal on signals), and only
 // when all are written are they renamed over their targets (through symbolic links; copied into
 // a target that is not a regular file, e.g. a device). If any write fails, every temporary is
-// removed and nothing is written; if a rename fails, the outputs already renamed are removed (never
-// half a result).
+// removed and nothing is written; if a rename fails or a signal comes between two renames, the
+// targets already replaced get their former content back (io::publish_together: never half a
+// result).
 class OutputFiles {
  public:
   using Writer = std::function<void(const std::filesystem::path& temp)>;

@@ -65,36 +65,41 @@ int main(int argc, char** argv) {
   geode::cli::add_arrange_command(app);
   geode::cli::add_view_command(app);
   geode::cli::add_formats_command(app);
+  int code = 0;
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     const std::string cmd = command_path(app);
     std::cerr << cmd << ": usage error: " << one_line(e.what()) << " (see " << cmd << " --help)\n";
-    return 2;
+    code = 2;
   } catch (const geode::InvalidInput& e) {
     std::cerr << "geode: error: " << one_line(e.what()) << "\n";
-    return 2;
+    code = 2;
   } catch (const geode::TopologyError& e) {
     std::cerr << "geode: topology error: " << one_line(e.what()) << "\n";
-    return 3;
+    code = 3;
   } catch (const geode::cli::InvalidResult& e) {
     std::cerr << "geode: invalid result: " << one_line(e.what()) << "\n";
-    return 4;
+    code = 4;
   } catch (const std::bad_alloc&) {
-    // An input whose counts were not bounded somewhere: still one line and exit 2, not a crash.
+    // An input whose model does not fit: still one line and exit 2, not a crash.
     std::cerr << command_path(app)
               << ": error: out of memory: the input needs more memory than this machine "
               << "gives (nothing written)\n";
-    return 2;
+    code = 2;
   } catch (const std::length_error& e) {
     std::cerr << command_path(app)
               << ": error: the input asks for a container larger than memory can hold ("
               << one_line(e.what()) << "; nothing written)\n";
-    return 2;
+    code = 2;
   } catch (const std::exception& e) {
     std::cerr << "geode: error: " << one_line(e.what()) << "\n";
-    return 1;
+    code = 1;
   }
-  return 0;
+  // The --threads limit is left in place, never destroyed: lifting it would start TBB's
+  // worker threads on the way out, which fails (and aborts, a destructor throwing) when the
+  // run ended for want of memory.
+  (void)threads.release();
+  return code;
 }

@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <string>
@@ -21,23 +22,45 @@ namespace {
 
 std::string reason(int err) { return std::strerror(err); }
 
-// The temporaries a signal must remove: a fixed table (no allocation, no locks), each slot
-// free (0), being filled (1) or holding a path (2). std::atomic<int> is lock-free here, so the
-// handler may read it.
+// What a signal must undo: a fixed table (no allocation, no locks), each slot free (0), being
+// filled (1) or holding a path to remove (2) or a target to restore from its backup (3).
+// std::atomic<int> is lock-free here, so the handler may read it.
 constexpr int kSlots = 64;
 constexpr std::size_t kPathBytes = 4096;
 struct Slot {
   std::atomic<int> state{0};
   char path[kPathBytes];
+  char backup[kPathBytes];  // state 3: the target's former content ("" when it had none)
 };
 Slot g_slots[kSlots];
 static_assert(std::atomic<int>::is_always_lock_free);
 
 extern "C" void unlink_temporaries_and_reraise(int sig) {
-  for (Slot& s : g_slots)
-    if (s.state.load() == 2) ::unlink(s.path);
+  for (Slot& s : g_slots) {
+    const int state = s.state.load();
+    if (state == 2 || (state == 3 && s.backup[0] == '\0')) ::unlink(s.path);
+    if (state == 3 && s.backup[0] != '\0') {
+      ::rename(s.backup, s.path);  // a no-op when both still name the same file
+      ::unlink(s.backup);
+    }
+  }
   ::signal(sig, SIG_DFL);
   ::raise(sig);
+}
+
+// Claims a slot for `path` (and `backup`, state 3); -1 when none is free or a path is too long.
+int claim_slot(const std::string& path, const std::string* backup) {
+  if (path.size() >= kPathBytes || (backup && backup->size() >= kPathBytes)) return -1;
+  for (int i = 0; i < kSlots; ++i) {
+    Slot& slot = g_slots[i];
+    int expected = 0;
+    if (!slot.state.compare_exchange_strong(expected, 1)) continue;
+    std::memcpy(slot.path, path.c_str(), path.size() + 1);
+    if (backup) std::memcpy(slot.backup, backup->c_str(), backup->size() + 1);
+    slot.state.store(backup ? 3 : 2);
+    return i;
+  }
+  return -1;
 }
 
 // Removes the temporary file unless released, so that every exit path cleans up.
@@ -117,17 +140,7 @@ void write_atomically(const fs::path& path, const std::string& suffix,
 
 }  // namespace
 
-void register_temporary(const fs::path& temp) {
-  const std::string& s = temp.native();
-  if (s.size() >= kPathBytes) return;
-  for (Slot& slot : g_slots) {
-    int expected = 0;
-    if (!slot.state.compare_exchange_strong(expected, 1)) continue;
-    std::memcpy(slot.path, s.c_str(), s.size() + 1);
-    slot.state.store(2);
-    return;
-  }
-}
+void register_temporary(const fs::path& temp) { (void)claim_slot(temp.native(), nullptr); }
 
 void unregister_temporary(const fs::path& temp) {
   for (Slot& slot : g_slots)
@@ -207,6 +220,71 @@ void publish_temporary(const fs::path& temp, const OutputTarget& target, const f
   if (ec)
     throw InvalidInput(shown.string() + ": cannot rename the temporary file: " + ec.message());
   unregister_temporary(temp);
+}
+
+void publish_together(const std::vector<Publication>& items) {
+  // Regular targets first (each can be undone), then the others (a device copied into cannot).
+  std::vector<const Publication*> order;
+  for (const Publication& p : items)
+    if (p.target.regular) order.push_back(&p);
+  for (const Publication& p : items)
+    if (!p.target.regular) order.push_back(&p);
+  struct Undo {
+    fs::path target, backup;  // backup empty: the target did not exist
+    int slot = -1;
+  };
+  std::vector<Undo> undo;
+  // Puts every renamed target back as it was and frees the slots; also when none was renamed.
+  const auto roll_back = [&undo] {
+    std::error_code ec;
+    for (const Undo& u : undo) {
+      if (u.backup.empty())
+        fs::remove(u.target, ec);
+      else
+        fs::rename(u.backup, u.target, ec);
+      if (u.slot >= 0) g_slots[u.slot].state.store(0);
+    }
+    undo.clear();
+  };
+  static std::atomic<unsigned> counter{0};
+  std::size_t renamed = 0;
+  for (const Publication* p : order) {
+    if (p->target.regular && items.size() > 1) {
+      // The former content under a hidden hard link, registered with the target before the
+      // rename: a signal from here on restores it (or removes a target that was new).
+      Undo u{p->target.file, {}, -1};
+      const fs::path backup = p->target.file.parent_path() /
+                              ("." + p->target.file.filename().string() + ".old-" +
+                               std::to_string(::getpid()) + "-" + std::to_string(counter++));
+      if (::link(p->target.file.c_str(), backup.c_str()) == 0) u.backup = backup;
+      const std::string backup_text = u.backup.native();
+      u.slot = claim_slot(u.target.native(), &backup_text);
+      undo.push_back(u);
+    }
+    try {
+      publish_temporary(p->temp, p->target, p->shown);
+    } catch (const InvalidInput& x) {
+      if (p->target.regular && !undo.empty()) {
+        // This target was not replaced: its backup (if any) is only a second link to it.
+        std::error_code ec;
+        if (!undo.back().backup.empty()) fs::remove(undo.back().backup, ec);
+        if (undo.back().slot >= 0) g_slots[undo.back().slot].state.store(0);
+        undo.pop_back();
+      }
+      roll_back();
+      throw InvalidInput(std::string(x.what()) + "; nothing written");
+    }
+    if (p->target.regular) ++renamed;
+    // Test hook (tests/cli): a signal between two renames, where both or neither must stand.
+    if (renamed == 1 && items.size() > 1)
+      if (const char* sig = std::getenv("GEODE_TEST_SIGNAL_BETWEEN_RENAMES"); sig && *sig)
+        ::raise(std::atoi(sig));
+  }
+  std::error_code ec;
+  for (const Undo& u : undo) {
+    if (!u.backup.empty()) fs::remove(u.backup, ec);
+    if (u.slot >= 0) g_slots[u.slot].state.store(0);
+  }
 }
 
 void remove_temporary(const fs::path& temp) {

@@ -14,6 +14,7 @@
 #include <functional>
 #include <ostream>
 #include <string>
+#include <vector>
 
 namespace geode::io {
 
@@ -47,6 +48,22 @@ std::filesystem::path create_temporary(const OutputTarget& target, const std::st
 // the temporary); InvalidInput naming `shown` (the path the user gave) when that fails.
 void publish_temporary(const std::filesystem::path& temp, const OutputTarget& target,
                        const std::filesystem::path& shown);
+
+// Several finished temporaries published as one (a mesh and its report: both or neither).
+// Each regular target that exists is first given a hidden hard link ("..NAME.old-PID-N") and
+// registered with it for signals; then the temporaries are renamed (regular targets first,
+// copies into devices last). If a rename or copy fails, or SIGINT / SIGTERM / SIGHUP / SIGQUIT
+// arrives before the last one is done, every target already replaced gets its former content
+// back (a target that did not exist is removed): never one output without the other, never a
+// former output lost. InvalidInput naming the target that failed ("...; nothing written").
+// Test hook: GEODE_TEST_SIGNAL_BETWEEN_RENAMES=N raises signal N right after the first rename
+// of two or more (tests/cli/outputs_test.cpp).
+struct Publication {
+  std::filesystem::path temp;
+  OutputTarget target;
+  std::filesystem::path shown;  // the path the user gave, for messages
+};
+void publish_together(const std::vector<Publication>& items);
 
 // Removes a temporary (if it is still there) and forgets it.
 void remove_temporary(const std::filesystem::path& temp);

@@ -39,14 +39,17 @@ inline constexpr std::array<ExodusCell, 4> kExodusCells{{
     {"WEDGE6", 6, {"WEDGE6", "WEDGE", nullptr, nullptr}, {0, 1, 2, 3, 4, 5}},
 }};
 
-// The file is checked for the netCDF / HDF5 signature (file_format.hpp) before libexodusII
-// opens it. Node and element number maps, when present (Cubit writes them), are the model's
-// file ids; otherwise 1-based numbers. Block ids are the file's; a file with a block id <= 0
-// (meshio numbers blocks from 0) gets its blocks numbered 1, 2, ... in file order. Throws
-// InvalidInput naming the file, the block / element / set entry and the reason: missing or
-// unreadable file, not an Exodus file (e.g. truncated), an element type other than those of
-// kExodusCells with their node counts, a node or element number out of range, a side number out of
-// range; then check_geometry (model.hpp) unless options say otherwise.
+// The file is checked for the netCDF / HDF5 signature (file_format.hpp) and screened
+// (netcdf_screen.hpp: a classic header parsed whole and bounded by the file's size, an HDF5
+// superblock checked) before libexodusII opens it, and libexodusII then reads it in a child
+// process under memory and CPU limits (isolated.hpp), so that a crash of libhdf5 or of
+// libexodusII on a corrupt file is a refusal, not ours. Node and element number maps, when present
+// (Cubit writes them), are the model's file ids; otherwise 1-based numbers. Block ids are the
+// file's; a file with a block id <= 0 (meshio numbers blocks from 0) gets its blocks numbered 1, 2,
+// ... in file order. Throws InvalidInput naming the file, the block / element / set entry and the
+// reason: missing or unreadable file, not an Exodus file (e.g. truncated), an element type other
+// than those of kExodusCells with their node counts, a node or element number out of range, a side
+// number out of range; then check_geometry (model.hpp) unless options say otherwise.
 primal::Model read_exodus(const std::filesystem::path& path,
                           const primal::ReadOptions& options = {});
 

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <new>
 
 #include <geode/io/exodus.hpp>
 #include <geode/io/file_format.hpp>
@@ -91,13 +92,14 @@ const std::vector<MeshFormat>& table() {
                          const WriteOptions& o) { write_vtu(p, m, {}, o.vtu_encoding); },
        .read_plain = read_vtk_plain,
        .index_base = 0,
-       .carries = {Carried::kYes, Carried::kWritten, Carried::kNo, Carried::kNo, Carried::kNo,
+       .carries = {Carried::kYes, Carried::kYes, Carried::kYes, Carried::kYes, Carried::kYes,
                    "hex, tet, pyramid, wedge; planar quad"},
        .read_variants = "ascii, binary (base64), appended (raw and base64), zlib-compressed, "
                         "UInt32 or UInt64 headers",
        .written_as = "binary (base64; `--vtu-encoding ascii`); cell arrays `block`, `mat_id` (the "
                      "block again, for Python solvers), `scaled_jacobian`, "
-                     "block names as field data `block:NAME`"},
+                     "block names and sets as field data `block:NAME`, `node_set:ID:NAME`, "
+                     "`side_set:ID:NAME`"},
       {.name = "vtk",
        .title = "legacy VTK .vtk",
        .extensions = {".vtk"},
@@ -110,10 +112,11 @@ const std::vector<MeshFormat>& table() {
                          const WriteOptions&) { write_vtk(p, m); },
        .read_plain = read_vtk_plain,
        .index_base = 0,
-       .carries = {Carried::kYes, Carried::kNo, Carried::kNo, Carried::kNo, Carried::kNo,
+       .carries = {Carried::kYes, Carried::kYes, Carried::kYes, Carried::kYes, Carried::kYes,
                    "hex, tet, pyramid, wedge; planar quad"},
        .read_variants = "ASCII and BINARY, classic and 5.1 cell layouts",
-       .written_as = "4.2 ASCII; cell arrays `block`, `scaled_jacobian`"},
+       .written_as = "4.2 ASCII; cell arrays `block`, `scaled_jacobian`; block names and sets as "
+                     "dataset field data, named as in .vtu"},
   };
   return formats;
 }
@@ -248,8 +251,11 @@ PlainMesh read_plain_mesh(const fs::path& path, const MeshFormat** format) {
   }
   if (format) *format = f;
   check_signature(path, *f);
-  if (f->read_plain)
-    if (auto m = f->read_plain(path)) return std::move(*m);
+  if (f->read_plain) try {
+      if (auto m = f->read_plain(path)) return std::move(*m);
+    } catch (const std::bad_alloc&) {
+      throw out_of_memory_reading(path);
+    }
   const primal::Model model = read_model(path);
   for (primal::ElementKind kind :
        {primal::ElementKind::Tet, primal::ElementKind::Pyramid, primal::ElementKind::Wedge})

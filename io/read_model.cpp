@@ -1,16 +1,85 @@
 #include <geode/io/read_model.hpp>
 
 #include <algorithm>
+#include <charconv>
+#include <climits>
+#include <new>
+#include <optional>
 #include <string>
+#include <string_view>
 
 #include <geode/io/file_format.hpp>
 #include <geode/io/formats.hpp>
+#include <geode/io/names.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/input_check.hpp>
 
 namespace geode::io {
 
 using namespace primal;
+
+namespace {
+
+// "ID:NAME" after a field array's prefix: a positive id; the name may hold ':' itself.
+std::pair<int, std::string> id_and_name(std::string_view rest, const std::string& where) {
+  const auto colon = rest.find(':');
+  int id = 0;
+  const auto digits = rest.substr(0, colon);
+  const auto res = std::from_chars(digits.data(), digits.data() + digits.size(), id);
+  if (colon == std::string_view::npos || res.ec != std::errc() ||
+      res.ptr != digits.data() + digits.size() || id <= 0)
+    throw InvalidInput(where + ": expected a positive id and a name ('ID:NAME') after the prefix");
+  return {id, std::string(rest.substr(colon + 1))};
+}
+
+// Block names and sets from the field arrays write_vtu stores (vtk.hpp); `cells` maps the
+// file's cell indices to the model's elements (none for its triangles and quads).
+void read_field_data(const VtkGrid& grid, const std::vector<std::optional<ElementRef>>& cells,
+                     Model& model) {
+  for (const VtkGrid::FieldArray& a : grid.field_data) {
+    const std::string where = grid.source + ": field array '" + a.name + "'";
+    const std::string_view name = a.name;
+    if (name.rfind("block:", 0) == 0) {
+      if (a.components != 1 || a.values.size() != 1 || a.values[0] <= 0 || a.values[0] > INT_MAX)
+        throw InvalidInput(where + ": expected one positive block id");
+      model.block_names[static_cast<int>(a.values[0])] = std::string(name.substr(6));
+    } else if (name.rfind("node_set:", 0) == 0) {
+      auto [id, set_name] = id_and_name(name.substr(9), where);
+      if (a.components != 1) throw InvalidInput(where + ": expected 1 component");
+      NodeSet set{id, std::move(set_name), {}};
+      for (std::size_t i = 0; i < a.values.size(); ++i) {
+        if (a.values[i] < 0 || static_cast<std::size_t>(a.values[i]) >= grid.points.size())
+          throw InvalidInput(where + ": entry " + std::to_string(i) + " refers to point " +
+                             std::to_string(a.values[i]) + ", out of range [0, " +
+                             std::to_string(grid.points.size()) + ")");
+        set.nodes.push_back(static_cast<Index>(a.values[i]));
+      }
+      model.node_sets.push_back(std::move(set));
+    } else if (name.rfind("side_set:", 0) == 0) {
+      auto [id, set_name] = id_and_name(name.substr(9), where);
+      if (a.components != 2) throw InvalidInput(where + ": expected 2 components (cell, face)");
+      SideSet set{id, std::move(set_name), {}};
+      for (std::size_t i = 0; i + 1 < a.values.size(); i += 2) {
+        const long long cell = a.values[i], face = a.values[i + 1];
+        const std::string entry = where + ": entry " + std::to_string(i / 2);
+        if (cell < 0 || static_cast<std::size_t>(cell) >= cells.size() ||
+            !cells[static_cast<std::size_t>(cell)])
+          throw InvalidInput(entry + " refers to cell " + std::to_string(cell) +
+                             ", not a volume cell of the file");
+        const ElementRef element = *cells[static_cast<std::size_t>(cell)];
+        const int faces = cell_topology(element.kind).faces;
+        if (face < 0 || face >= faces)
+          throw InvalidInput(entry + ": cell " + std::to_string(cell) + ": face " +
+                             std::to_string(face) + " out of range [0, " + std::to_string(faces) +
+                             ")");
+        set.sides.push_back({element, static_cast<int>(face)});
+      }
+      model.side_sets.push_back(std::move(set));
+    }
+  }
+}
+
+}  // namespace
 
 Model model_from_vtk(const VtkGrid& grid, const ReadOptions& options) {
   Model model;
@@ -24,6 +93,7 @@ Model model_from_vtk(const VtkGrid& grid, const ReadOptions& options) {
       block_array = name;
       break;
     }
+  std::vector<std::optional<ElementRef>> cells(grid.cells.size());
   for (std::size_t c = 0; c < grid.cells.size(); ++c) {
     const int type = grid.cell_types[c];
     if (type == kVtkTriangle || type == kVtkQuad) continue;
@@ -45,11 +115,23 @@ Model model_from_vtk(const VtkGrid& grid, const ReadOptions& options) {
       corners[k] =
           cell[kind == ElementKind::Wedge ? static_cast<std::size_t>(topology::kVtkWedgeOrder[k])
                                           : k];
+    cells[c] = ElementRef{kind, static_cast<Index>(element_count(model, kind))};
     add_element(model, kind, corners, block, static_cast<std::int64_t>(c));
   }
+  read_field_data(grid, cells, model);
+  sanitize_names(model);
   validate(model, grid.source);
   options.check_geometry ? check_geometry(model, grid.source) : check_points(model, grid.source);
   return model;
+}
+
+InvalidInput out_of_memory_reading(const std::filesystem::path& path) {
+  // Every count is bounded by the file's size, but a model a file can describe may still not
+  // fit; the memory the reader took is given back by the time this message is made.
+  std::error_code ec;
+  return InvalidInput(path.string() + ": out of memory reading it (a file of " +
+                      std::to_string(std::filesystem::file_size(path, ec)) +
+                      " bytes): its model needs more memory than this process may use");
 }
 
 Model read_model(const std::filesystem::path& path, const ReadOptions& options,
@@ -61,9 +143,13 @@ Model read_model(const std::filesystem::path& path, const ReadOptions& options,
                        "' (expected " + extension_list(FormatRole::kRead) + ")");
   }
   check_signature(path, *format);
-  Model model = format->read(path, options);
-  if (options.check_geometry && check_covering) require_single_covering(model, path.string());
-  return model;
+  try {
+    Model model = format->read(path, options);
+    if (options.check_geometry && check_covering) require_single_covering(model, path.string());
+    return model;
+  } catch (const std::bad_alloc&) {
+    throw out_of_memory_reading(path);
+  }
 }
 
 }  // namespace geode::io

@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include <geode/io/vtk.hpp>
+#include <geode/primal/errors.hpp>
 #include <geode/primal/model.hpp>
 
 namespace geode::io {
@@ -18,11 +19,16 @@ namespace geode::io {
 primal::Model read_model(const std::filesystem::path& path, const primal::ReadOptions& options = {},
                          bool check_covering = true);
 
-// A VTK grid as a model: hexes and tets (triangles and quads, boundary annotations, are left
-// out), VTK's 0-based point and cell ids (as ParaView shows them) as file ids, blocks from the
-// first integer cell array named "block" (our writers), "gmsh:physical" (meshio) or
-// "CellEntityIds"; without one, all hexes in block 1 and all tets in block 2. Other cell types
-// are refused naming the cell.
+// A VTK grid as a model: hexes, tets, pyramids and wedges (triangles and quads, boundary
+// annotations, are left out), VTK's 0-based point and cell ids (as ParaView shows them) as file
+// ids, blocks from the first integer cell array named "block" (our writers), "gmsh:physical"
+// (meshio) or "CellEntityIds"; without one, all hexes in block 1 and all tets in block 2. Block
+// names, node sets and side sets from the field arrays write_vtu stores (vtk.hpp), each entry
+// checked. Other cell types are refused naming the cell.
 primal::Model model_from_vtk(const VtkGrid& grid, const primal::ReadOptions& options = {});
+
+// What a reader's std::bad_alloc becomes (read_model, read_plain_mesh): InvalidInput naming the
+// file and its size, so that the one-line message says which input did not fit.
+InvalidInput out_of_memory_reading(const std::filesystem::path& path);
 
 }  // namespace geode::io

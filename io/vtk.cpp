@@ -54,6 +54,8 @@ struct Grid {
   std::vector<Index> connectivity;  // corners per cell, flattened
   VtkCellData data;
   std::map<int, std::string> block_names;  // written as field data (a Model's named blocks)
+  // A Model's sets as field data: node indices; (cell index, face) pairs.
+  std::vector<std::pair<std::string, std::vector<Index>>> node_sets, side_sets;
   std::size_t cells() const { return types.size(); }
 };
 
@@ -217,6 +219,21 @@ Grid grid_of(const std::filesystem::path& path, const Model& m, const VtkCellDat
   data.ints.insert(data.ints.begin(), {"mat_id", block});
   finish_grid(g, file, std::move(sj), block, data);
   for (const auto& [id, name] : m.block_names) g.block_names[id] = sanitize_name(name);
+  // Sets by the written cells' numbers: hexes, then tets, pyramids and wedges.
+  std::array<Index, 4> first{};
+  for (std::size_t k = 1; k < kElementKinds.size(); ++k)
+    first[k] = first[k - 1] + static_cast<Index>(element_count(m, kElementKinds[k - 1]));
+  for (const NodeSet& set : m.node_sets)
+    g.node_sets.emplace_back(std::to_string(set.id) + ":" + sanitize_name(set.name), set.nodes);
+  for (const SideSet& set : m.side_sets) {
+    std::vector<Index> pairs;
+    for (const Side& side : set.sides)
+      pairs.insert(pairs.end(),
+                   {first[static_cast<std::size_t>(side.element.kind)] + side.element.index,
+                    static_cast<Index>(side.face)});
+    g.side_sets.emplace_back(std::to_string(set.id) + ":" + sanitize_name(set.name),
+                             std::move(pairs));
+  }
   return g;
 }
 
@@ -319,12 +336,23 @@ void write_vtu_grid(std::ostream& os, const Grid& g, VtuEncoding encoding) {
      << (encoding == VtuEncoding::kAscii ? "" : " header_type=\"UInt64\"") << ">\n"
      << "  <UnstructuredGrid>\n";
   // Block names, which the cell array "block" cannot carry: one-value field arrays
-  // "block:NAME" holding the block id (ParaView lists them under Field Data).
-  if (!g.block_names.empty()) {
+  // "block:NAME" holding the block id (ParaView lists them under Field Data); node sets as
+  // "node_set:ID:NAME" (point indices), side sets as "side_set:ID:NAME" (2 components: cell
+  // index, face number of primal/topology.hpp).
+  if (!g.block_names.empty() || !g.node_sets.empty() || !g.side_sets.empty()) {
     os << "    <FieldData>\n";
     for (const auto& [id, name] : g.block_names)
       os << "      <DataArray type=\"Int32\" Name=\"block:" << xml_escape(name)
          << "\" NumberOfTuples=\"1\" format=\"ascii\">" << id << "</DataArray>\n";
+    for (const auto* sets : {&g.node_sets, &g.side_sets})
+      for (const auto& [name, values] : *sets) {
+        const bool sides = sets == &g.side_sets;
+        os << "      <DataArray type=\"Int32\" Name=\"" << (sides ? "side_set:" : "node_set:")
+           << xml_escape(name) << "\" NumberOfComponents=\"" << (sides ? 2 : 1)
+           << "\" NumberOfTuples=\"" << values.size() / (sides ? 2 : 1) << "\" format=\"ascii\">\n";
+        write_values(os, values, 12, "          ", [](Index v) { return v; });
+        os << "      </DataArray>\n";
+      }
     os << "    </FieldData>\n";
   }
   os << "    <Piece NumberOfPoints=\"" << pts.size() << "\" NumberOfCells=\"" << g.cells()
@@ -358,14 +386,44 @@ void write_vtu_grid(std::ostream& os, const Grid& g, VtuEncoding encoding) {
      << "</VTKFile>\n";
 }
 
+// A legacy array name: one token, VTK's %XX escapes for bytes outside '!'..'~' and '%', '"'.
+std::string legacy_name(const std::string& name) {
+  std::string out;
+  for (const char ch : name) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c <= ' ' || c > '~' || c == '%' || c == '"') {
+      static constexpr char kHex[] = "0123456789ABCDEF";
+      out += {'%', kHex[c >> 4], kHex[c & 15]};
+    } else {
+      out += ch;
+    }
+  }
+  return out;
+}
+
 void write_vtk_grid(std::ostream& os, const Grid& g) {
   const auto& pts = *g.points;
   const std::size_t ncells = g.cells();
   os << "# vtk DataFile Version 4.2\n"
      << "geode mesh\n"
      << "ASCII\n"
-     << "DATASET UNSTRUCTURED_GRID\n"
-     << "POINTS " << pts.size() << " double\n";
+     << "DATASET UNSTRUCTURED_GRID\n";
+  // Block names and sets as in .vtu (write_vtu_grid), as dataset field data; array names with
+  // VTK's own escapes (%XX for white space, '%', '"' and non-ASCII bytes, as vtkDataWriter).
+  const std::size_t fields = g.block_names.size() + g.node_sets.size() + g.side_sets.size();
+  if (fields > 0) {
+    os << "FIELD FieldData " << fields << '\n';
+    for (const auto& [id, name] : g.block_names)
+      os << legacy_name("block:" + name) << " 1 1 int\n" << id << '\n';
+    for (const auto* sets : {&g.node_sets, &g.side_sets})
+      for (const auto& [name, values] : *sets) {
+        const bool sides = sets == &g.side_sets;
+        os << legacy_name((sides ? "side_set:" : "node_set:") + name) << ' ' << (sides ? 2 : 1)
+           << ' ' << values.size() / (sides ? 2 : 1) << " int\n";
+        write_values(os, values, 12, "", [](Index v) { return v; });
+      }
+  }
+  os << "POINTS " << pts.size() << " double\n";
   for (const auto& p : pts) {
     os << format_double(p.x()) << ' ' << format_double(p.y()) << ' ' << format_double(p.z())
        << '\n';

@@ -46,8 +46,12 @@ enum class VtuEncoding { kAscii, kBinary };
 
 // Throw geode::InvalidInput (naming the file and the array, or the node or element by its
 // 1-based number) for an array of the wrong length, a bad or repeated name, a node number out of
-// range, a non-finite point, or a file that cannot be written. A Model is written with its hexes
-// then its tets, the cell array "block" holding each element's block (block_of).
+// range, a non-finite point, or a file that cannot be written. A Model is written with its hexes,
+// tets, pyramids then wedges, the cell array "block" holding each element's block (block_of);
+// in .vtu its block names, node sets and side sets go into <FieldData> as Int32 arrays
+// "block:NAME" (one value, the block id), "node_set:ID:NAME" (point indices) and
+// "side_set:ID:NAME" (2 components: cell index, face number of primal/topology.hpp, which is
+// Exodus's side order from 0), which model_from_vtk reads back.
 void write_vtu(const std::filesystem::path& path, const primal::HexMesh& mesh,
                const VtkCellData& extra = {}, VtuEncoding encoding = VtuEncoding::kAscii);
 void write_vtu(const std::filesystem::path& path, const primal::TetMesh& mesh,
@@ -72,6 +76,14 @@ struct VtkGrid {
   std::vector<int> cell_types;
   std::vector<std::vector<primal::Index>> cells;
   VtkCellData cell_data;  // Float32/Float64 arrays as doubles, integer arrays as ints
+  // The dataset's integer field arrays (<FieldData>): block names and sets as the writer
+  // stores them (see write_vtu), and any others, which model_from_vtk ignores.
+  struct FieldArray {
+    std::string name;
+    std::size_t components = 1;
+    std::vector<long long> values;  // tuples x components
+  };
+  std::vector<FieldArray> field_data;
 };
 
 // Readers of ASCII files: .vtu with format="ascii" DataArrays (one Piece), legacy .vtk in

@@ -626,6 +626,27 @@ VtkGrid parse_vtu(std::string_view content, const std::string& source) {
   const std::size_t np = count_attr(file, piece, "NumberOfPoints");
   const std::size_t nc = count_attr(file, piece, "NumberOfCells");
 
+  // Integer field arrays of the dataset (block names, sets); others are skipped.
+  if (const XmlElement* fd = ug.child("FieldData")) {
+    for (const auto& a : fd->children) {
+      if (a.name != "DataArray" || !is_int_type(a.attr("type"))) continue;
+      const std::string nm = a.attr("Name");
+      const std::size_t tuples = count_attr(file, a, "NumberOfTuples");
+      const std::string comps = a.attr("NumberOfComponents");
+      const std::size_t components = comps.empty() ? 1 : count_attr(file, a, "NumberOfComponents");
+      if (components < 1 || components > 16)
+        fail(file, a.line, "FieldData '" + nm + "': " + comps + " components");
+      if (tuples > (std::numeric_limits<std::size_t>::max() >> 8))
+        fail(file, a.line, "FieldData '" + nm + "': too many tuples");
+      const Numbers n =
+          data_array_values(file, a, tuples * components, "FieldData '" + nm + "'", enc);
+      VtkGrid::FieldArray array{nm, components, {}};
+      for (std::size_t i = 0; i < n.tokens.size(); ++i)
+        array.values.push_back(parse_int(file, n.lines[i], n.tokens[i]));
+      g.field_data.push_back(std::move(array));
+    }
+  }
+
   // Points.
   const XmlElement& pts = required(file, piece, "Points");
   const XmlElement& pa = required(file, pts, "DataArray");
@@ -890,6 +911,31 @@ std::string upper(std::string_view s) {
 
 }  // namespace
 
+namespace {
+
+// VTK's legacy array name escapes (%XX, vtkDataReader::DecodeString).
+std::string decode_legacy_name(std::string_view token) {
+  std::string out;
+  for (std::size_t i = 0; i < token.size(); ++i) {
+    const auto hex = [](char c) {
+      return std::isdigit(static_cast<unsigned char>(c)) ? c - '0'
+             : (c >= 'A' && c <= 'F')                    ? c - 'A' + 10
+             : (c >= 'a' && c <= 'f')                    ? c - 'a' + 10
+                                                         : -1;
+    };
+    if (token[i] == '%' && i + 2 < token.size() && hex(token[i + 1]) >= 0 &&
+        hex(token[i + 2]) >= 0) {
+      out += static_cast<char>(hex(token[i + 1]) * 16 + hex(token[i + 2]));
+      i += 2;
+    } else {
+      out += token[i];
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 VtkGrid read_vtk(const std::filesystem::path& path) {
   check_mesh_format(path, MeshFileFormat::kVtk);
   return parse_vtk(MappedFile(path).bytes(), path.string());
@@ -1093,6 +1139,32 @@ VtkGrid parse_vtk(std::string_view content, const std::string& source) {
               g.cell_data.ints.emplace_back(name, std::move(iv));
           }
         }
+      }
+    } else if (key == "FIELD") {
+      // Dataset field data (block names, sets: write_vtk); integer arrays kept, others read
+      // past. Values are read one by one, so a count larger than the file only ends early.
+      t.next("the FIELD name");
+      const std::size_t k = t.count("the FIELD array count");
+      for (std::size_t a = 0; a < k; ++a) {
+        const std::string name = decode_legacy_name(t.next("a FIELD array name"));
+        const std::size_t components = t.count("the component count of " + name);
+        const std::size_t tuples = t.count("the tuple count of " + name);
+        const std::string type(t.next("the type of " + name));
+        if (components < 1 || components > 16)
+          fail(file, t.line_before(),
+               "FIELD array " + name + ": " + std::to_string(components) + " components");
+        const bool is_real = upper(type) == "FLOAT" || upper(type) == "DOUBLE";
+        VtkGrid::FieldArray array{name, components, {}};
+        t.begin_array(type, "FIELD array " + name);
+        for (std::size_t i = 0; i < tuples; ++i)
+          for (std::size_t c = 0; c < components; ++c) {
+            if (is_real)
+              (void)t.real("array " + name);
+            else
+              array.values.push_back(t.int32("array " + name));
+          }
+        t.end_array();
+        if (!is_real) g.field_data.push_back(std::move(array));
       }
     } else if (key == "METADATA") {
       // VTK 8+ writes METADATA blocks (array information) that end at a blank line.

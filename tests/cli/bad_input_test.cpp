@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,11 @@ std::string msh41(const std::string& coordinates = kNodes, const std::string& el
   return "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n"
          "$Nodes\n1 9 1 9\n3 1 0 9\n1\n2\n3\n4\n5\n6\n7\n8\n9\n" +
          coordinates + "$EndNodes\n$Elements\n2 2 1 2\n" + elements + end;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
 std::string replaced(std::string s, const std::string& from, const std::string& to) {
@@ -178,6 +184,25 @@ TEST_CASE(
        replaced(msh41(), "1 9 1 9\n", "1 999999999 1 9\n"),
        2,
        {"count.msh", "more than the rest of the file can hold"}},
+      {"a corrupt netCDF-4 .exo on which libhdf5 crashes (read in a child process)",
+       "conform {in} -o {out}.exo",
+       "segv.exo",
+       slurp(fs::path(GEODE_SOURCE_DIR) / "tests/fuzz/regressions/exo-netcdf4-hdf5-segv.exo"),
+       2,
+       {"segv.exo", "reading the netCDF-4 (HDF5) file failed"}},
+      {"a truncated netCDF-4 .exo",
+       "conform {in} -o {out}.exo",
+       "short.exo",
+       slurp(fs::path(GEODE_SOURCE_DIR) / "tests/fuzz/corpus/exo/meshio-netcdf4.exo")
+           .substr(0, 9000),
+       2,
+       {"short.exo", "not a consistent netCDF-4 (HDF5) file", "the file is truncated"}},
+      {"a classic .exo whose data goes past its end",
+       "conform {in} -o {out}.exo",
+       "cut.exo",
+       slurp(fs::path(GEODE_SOURCE_DIR) / "tests/fuzz/corpus/exo/classic.exo").substr(0, 1300),
+       2,
+       {"cut.exo", "not a consistent netCDF classic file", "past the end"}},
       {"a legacy .vtk with a NaN point",
        "dual {in}",
        "nan.vtk",

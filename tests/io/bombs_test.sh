@@ -53,4 +53,74 @@ check nested.vtu ulimit
 check zlib.vtu ulimit
 check nodes.exo ulimit
 check big.msh time
+
+# std::bad_alloc anywhere is one line and exit 2, nothing written. The base: the smallest
+# address space in which geode reads a unit hex (found to 32 MiB). nodes.msh (valid, read without
+# a cap as a control) needs more than the base + 96 MiB to be read: the reader's message names
+# it. grid.msh is read within a few MiB more than the base, its conform run needs more: under
+# caps from the base up in 8 MiB steps each run either finishes or fails in one line, exit 2,
+# nothing written, and some fail after reading ("geode conform: error: out of memory"). One
+# thread (--threads 1): a worker thread that cannot be created is another error than memory.
+runs() {  # LIMIT_KIB ARGS...: geode under the cap, output in $dir/out, status returned
+  local limit=$1
+  shift
+  (ulimit -v "$limit"; exec "$geode" "$@") >"$dir/out" 2>&1
+}
+lo=0
+hi=$((8192 * 1024))
+runs $hi check "$dir/small.msh" || { echo "FAIL: geode check small.msh fails with 8 GiB"; exit 1; }
+while [ $((hi - lo)) -gt 32768 ]; do
+  mid=$(((lo + hi) / 2))
+  if runs $mid check "$dir/small.msh"; then hi=$mid; else lo=$mid; fi
+done
+echo "     (geode reads a unit hex in $((hi / 1024)) MiB of address space)"
+
+refused_in_one_line() {  # WORDS: the last run exited 2 with one line holding WORDS, no output
+  local problem=""
+  [ "$status" -eq 2 ] || problem+=" exit $status, expected 2;"
+  [ "$(wc -l <"$dir/out")" -eq 1 ] || problem+=" $(wc -l <"$dir/out") lines of output, expected 1;"
+  grep -qF -- "$1" "$dir/out" || problem+=" no '$1' in the message;"
+  [ ! -e "$dir/o.exo" ] || problem+=" an output was written;"
+  echo "$problem"
+}
+
+"$geode" check "$dir/nodes.msh" >/dev/null 2>&1
+control=$?
+runs $((hi + 98304)) check "$dir/nodes.msh"
+status=$?
+problem=$(refused_in_one_line "$dir/nodes.msh: out of memory reading it")
+[ "$control" -eq 0 ] || problem+=" without a cap: exit $control, expected 0;"
+if [ -n "$problem" ]; then
+  echo "FAIL nodes.msh (reading under $(((hi + 98304) / 1024)) MiB):$problem"
+  sed 's/^/  output: /' "$dir/out" | head -5
+  failures=$((failures + 1))
+else
+  echo "ok   nodes.msh (reading under $(((hi + 98304) / 1024)) MiB): $(cat "$dir/out")"
+fi
+
+"$geode" conform "$dir/grid.msh" -o "$dir/o.exo" --quiet --threads 1 >/dev/null 2>&1
+control=$?
+rm -f "$dir/o.exo"
+later=0
+problem=""
+[ "$control" -eq 0 ] || problem+=" without a cap: exit $control, expected 0;"
+for add in 0 8 16 24 32 40 48 56 64; do
+  runs $((hi + add * 1024)) conform "$dir/grid.msh" -o "$dir/o.exo" --quiet --threads 1
+  status=$?
+  if [ "$status" -eq 0 ]; then
+    rm -f "$dir/o.exo"
+    continue
+  fi
+  p=$(refused_in_one_line "out of memory")
+  [ -z "$p" ] || problem+=" at +$add MiB:$p $(head -c 200 "$dir/out");"
+  grep -qF "geode conform: error: out of memory" "$dir/out" && later=$((later + 1))
+  rm -f "$dir/o.exo"
+done
+[ "$later" -gt 0 ] || problem+=" no run failed after reading the model;"
+if [ -n "$problem" ]; then
+  echo "FAIL grid.msh (conform):$problem"
+  failures=$((failures + 1))
+else
+  echo "ok   grid.msh (conform): $later runs out of memory after reading, in one line, exit 2"
+fi
 exit $((failures > 0))

@@ -9,7 +9,12 @@ usage: make_bombs.py OUTDIR
 - nodes.exo: a 19 KB netCDF-4 Exodus file whose header claims 2e9 nodes (never written: HDF5
   stores nothing for them), made from a meshio-written hex;
 - big.msh: a 6 GiB sparse .msh (no disk space used) with a bad token after its nodes, which a
-  reader that copies whole files into memory loads at once before finding it.
+  reader that copies whole files into memory loads at once before finding it;
+- small.msh: a valid unit hex (the memory a run needs to read a file at all);
+- nodes.msh: a valid 69 MB .msh of 2.5 million nodes and one hex: its model needs a few hundred
+  MB, honestly (read when the process may have enough);
+- grid.msh: a valid 20^3 hex grid (8,000 hexes, 470 KB), read in a few MB, whose conform run
+  (diced, smoothed) needs tens of MB more.
 Exit status 77 when a Python module is missing.
 """
 import os
@@ -86,9 +91,40 @@ def big_msh(outdir):
         f.truncate(6 << 30)
 
 
+UNIT = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)]
+
+
+def msh(path, points, hexes):
+    n = len(points)
+    with open(path, "w") as f:
+        f.write(f"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 {n} 1 {n}\n3 1 0 {n}\n")
+        f.write("".join(f"{i}\n" for i in range(1, n + 1)))
+        f.write("".join(f"{x} {y} {z}\n" for x, y, z in points))
+        f.write(f"$EndNodes\n$Elements\n1 {len(hexes)} 1 {len(hexes)}\n3 1 5 {len(hexes)}\n")
+        f.write("".join(f"{e + 1} " + " ".join(str(v + 1) for v in h) + "\n" for e, h in enumerate(hexes)))
+        f.write("$EndElements\n")
+
+
+def small_and_nodes(outdir):
+    msh(os.path.join(outdir, "small.msh"), UNIT, [list(range(8))])
+    extra = [(2 + (i % 1000) * 1e-3, (i // 1000 % 1000) * 1e-3, (i // 1000000) * 1e-3) for i in range(2500000 - 8)]
+    msh(os.path.join(outdir, "nodes.msh"), UNIT + extra, [list(range(8))])
+
+
+def grid(outdir, n=20):
+    index = lambda i, j, k: (k * (n + 1) + j) * (n + 1) + i
+    points = [(i, j, k) for k in range(n + 1) for j in range(n + 1) for i in range(n + 1)]
+    hexes = [[index(i + di, j + dj, k + dk) for di, dj, dk in
+              ((0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1))]
+             for k in range(n) for j in range(n) for i in range(n)]
+    msh(os.path.join(outdir, "grid.msh"), points, hexes)
+
+
 if __name__ == "__main__":
     outdir = sys.argv[1]
     nested(outdir)
     zlib_bomb(outdir)
     exodus_nodes(outdir)
     big_msh(outdir)
+    small_and_nodes(outdir)
+    grid(outdir)

@@ -1,0 +1,106 @@
+// A mesh and its report are both written or neither (io::publish_together), also when a signal
+// arrives between the two renames and when the second output fails after the first was renamed:
+// the outputs' former bytes come back, no hidden temporary or backup file is left.
+#include <doctest/doctest.h>
+#include <signal.h>
+#include <stdlib.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include <geode/io/gmsh.hpp>
+#include <geode/primal/grid_model.hpp>
+#include "support/cli_run.hpp"
+
+namespace fs = std::filesystem;
+using geode::test::geode_cli;
+using geode::test::TempDir;
+
+namespace {
+
+std::string bytes_of(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+std::vector<std::string> names_in(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// Sets an environment variable for the commands this test starts.
+struct ScopedEnv {
+  const char* name;
+  ScopedEnv(const char* n, const std::string& value) : name(n) { ::setenv(n, value.c_str(), 1); }
+  ~ScopedEnv() { ::unsetenv(name); }
+};
+
+}  // namespace
+
+TEST_CASE("conform -o and --report: a signal between the two renames leaves both or neither") {
+  struct Row {
+    int signal;
+    bool former_outputs;  // out.exo and r.json exist before the run
+  };
+  for (const Row row :
+       {Row{SIGINT, false}, Row{SIGTERM, false}, Row{SIGINT, true}, Row{SIGTERM, true}}) {
+    CAPTURE(row.signal);
+    CAPTURE(row.former_outputs);
+    TempDir dir;
+    geode::io::write_gmsh(
+        geode::primal::grid_model({2, 2, 2}, 1.0, [](int, int, int) { return false; }),
+        dir.path / "hexes.msh");
+    const fs::path out = dir.path / "out.exo", report = dir.path / "r.json";
+    if (row.former_outputs) {
+      std::ofstream(out) << "former mesh\n";
+      std::ofstream(report) << "former report\n";
+    }
+    const std::vector<std::string> before = names_in(dir.path);
+    const std::string command = "conform " + (dir.path / "hexes.msh").string() + " -o " +
+                                out.string() + " --report " + report.string() + " --quiet";
+    {
+      ScopedEnv hook("GEODE_TEST_SIGNAL_BETWEEN_RENAMES", std::to_string(row.signal));
+      const auto run = geode_cli(command, true);
+      INFO(run.out);
+      // Killed by the signal: the shell reports 128 + N, or the status is not an exit at all.
+      CHECK((run.code == -1 || run.code == 128 + row.signal));
+    }
+    CHECK(names_in(dir.path) == before);  // no temporary, no backup, no lone output
+    if (row.former_outputs) {
+      CHECK(bytes_of(out) == "former mesh\n");
+      CHECK(bytes_of(report) == "former report\n");
+    }
+    // The control: without the signal the same run writes both.
+    const auto run = geode_cli(command, true);
+    INFO(run.out);
+    CHECK(run.code == 0);
+    CHECK(fs::file_size(out) > 1000);
+    CHECK(bytes_of(report).find("\"valid\"") != std::string::npos);
+    CHECK(names_in(dir.path).size() == 3);
+  }
+}
+
+TEST_CASE("conform -o and --report: a report that cannot be written puts the former mesh back") {
+  TempDir dir;
+  geode::io::write_gmsh(
+      geode::primal::grid_model({2, 2, 2}, 1.0, [](int, int, int) { return false; }),
+      dir.path / "hexes.msh");
+  const fs::path out = dir.path / "out.exo", report = dir.path / "r.json";
+  std::ofstream(out) << "former mesh\n";
+  // The report goes to a full device (copied into last, after the mesh's rename).
+  fs::create_symlink("/dev/full", report);
+  const auto run = geode_cli("conform " + (dir.path / "hexes.msh").string() + " -o " +
+                                 out.string() + " --report " + report.string() + " --quiet",
+                             true);
+  INFO(run.out);
+  CHECK(run.code == 2);
+  CHECK(run.out.find("nothing written") != std::string::npos);
+  CHECK(bytes_of(out) == "former mesh\n");
+  CHECK(names_in(dir.path) == std::vector<std::string>{"hexes.msh", "out.exo", "r.json"});
+}
