@@ -9,13 +9,13 @@
 #include <sstream>
 
 #include <geode/conform/corner_study.hpp>
-#include <geode/demo/demo_models.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/templates/spec.hpp>
 #include <geode/templates/study.hpp>
 #include <geode/templates/template_table.hpp>
 #include "cli/commands.hpp"
 #include "cli/conventions.hpp"
+#include "cli/demo_module.hpp"
 #include "cli/progress.hpp"
 
 namespace geode::cli {
@@ -204,7 +204,7 @@ void run_corners(const CornersArgs& a) {
   output_format(a.output, "", {"csv"}, "csv");
   check_output_path(a.output);
   const auto study = conform::corner_study(
-      demo::corner_study_models(a.n), a.n, [&](const conform::CornerStudyModelSummary& s) {
+      demo_module().corner_study_models(a.n), a.n, [&](const conform::CornerStudyModelSummary& s) {
         if (!a.quiet) std::cerr << "study corners: " << s.name << " done\n";
       });
   if (a.output.empty()) {

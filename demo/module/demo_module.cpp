@@ -4,7 +4,7 @@
 
 extern "C" __attribute__((visibility("default"))) const geode::demo::DemoModule*
 geode_demo_module() {
-  static const geode::demo::DemoModule module{&geode::demo::demo_model,
-                                              &geode::demo::demo_model_names};
+  static const geode::demo::DemoModule module{
+      &geode::demo::demo_model, &geode::demo::demo_model_names, &geode::demo::corner_study_models};
   return &module;
 }
