@@ -206,7 +206,7 @@ int hybrid_bench(int n, int repeats, const std::string& geode, const fs::path& d
   const auto t0 = std::chrono::steady_clock::now();
   const gp::Model model = geode::demo::demo_hexdominant(n);
   const double build = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  geode::io::write_gmsh(model, dir / "model.msh", geode::io::GmshFormat::Binary);
+  geode::io::write_gmsh(model, dir / "model.msh", geode::io::GmshFormat::kBinary);
   std::printf(
       "hybrid n %d: %zu hexes, %zu tets, %zu pyramids, %zu wedges (%zu nodes; built in %.1f s); "
       "input in %s\n",
@@ -297,8 +297,8 @@ int main(int argc, char** argv) {
   }
 
   const gp::Model model = geode::demo::demo_delaunay_block(n);
-  geode::io::write_gmsh(model, dir / "model.msh", geode::io::GmshFormat::Binary);
-  geode::io::write_gmsh(tet_model(model), dir / "tets.msh", geode::io::GmshFormat::Binary);
+  geode::io::write_gmsh(model, dir / "model.msh", geode::io::GmshFormat::kBinary);
+  geode::io::write_gmsh(tet_model(model), dir / "tets.msh", geode::io::GmshFormat::kBinary);
   std::printf("n %d: %zu hexes + %zu tets (%zu nodes); inputs in %s\n", n, model.hexes.size(),
               model.tets.size(), model.points.size(), dir.c_str());
 

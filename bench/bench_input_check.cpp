@@ -78,7 +78,7 @@ int main(int argc, char** argv) {
 
   const fs::path file = fs::temp_directory_path() /
                         ("geode-bench-input-check-" + std::to_string(::getpid()) + ".msh");
-  geode::io::write_gmsh(model, file, geode::io::GmshFormat::Binary);
+  geode::io::write_gmsh(model, file, geode::io::GmshFormat::kBinary);
   const double with = best_seconds(repeats, [&] {
     try {
       (void)geode::io::read_model(file);

@@ -46,13 +46,13 @@ void gmsh_write(const Model& model, const fs::path& file, bool binary, bool v22)
   for (int b : {1, 2}) {
     std::vector<std::size_t> et, en;
     for (std::size_t h = 0; h < model.hexes.size(); ++h)
-      if (block_of(model, {ElementKind::Hex, static_cast<Index>(h)}) == b) {
+      if (block_of(model, {ElementKind::kHex, static_cast<Index>(h)}) == b) {
         et.push_back(next++);
         for (Index v : model.hexes[h]) en.push_back(static_cast<std::size_t>(v) + 1);
       }
     std::vector<std::size_t> tt, tn;
     for (std::size_t t = 0; t < model.tets.size(); ++t)
-      if (block_of(model, {ElementKind::Tet, static_cast<Index>(t)}) == b) {
+      if (block_of(model, {ElementKind::kTet, static_cast<Index>(t)}) == b) {
         tt.push_back(next++);
         for (Index v : model.tets[t]) tn.push_back(static_cast<std::size_t>(v) + 1);
       }
@@ -110,7 +110,7 @@ int main(int argc, char** argv) {
       for (int r = 0; r < repeats; ++r) {
         const auto [s, mib] = in_child([&] {
           if (who == 0)
-            io::write_gmsh(model, file, c.binary ? io::GmshFormat::Binary : io::GmshFormat::Ascii,
+            io::write_gmsh(model, file, c.binary ? io::GmshFormat::kBinary : io::GmshFormat::kAscii,
                            c.v22 ? io::GmshVersion::k22 : io::GmshVersion::k41);
           else
             gmsh_write(model, file, c.binary, c.v22);

@@ -150,7 +150,7 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
       m << prefix << "--merge-tolerance " << a.merge_tolerance
         << " is not below the shortest element edge, " << shortest << " ("
         << primal::describe_element(
-               model, {in_hex ? primal::ElementKind::Hex : primal::ElementKind::Tet, where})
+               model, {in_hex ? primal::ElementKind::kHex : primal::ElementKind::kTet, where})
         << "): it would merge an element's own nodes; give a distance below that edge (and above "
            "the gap between "
         << "duplicated interface nodes)";

@@ -197,8 +197,8 @@ void run_template(const TemplateArgs& a) {
   const auto box = parse_box("--box", box_text, dim);
   templates::GeodeOptions o;
   o.box = Eigen::Vector3d(box[0], box[1], box[2]);
-  o.diagonal = a.diagonal == "anti" ? templates::Diagonal::Anti : templates::Diagonal::Main;
-  o.higher = a.higher == "z" ? templates::Higher::Z : templates::Higher::X;
+  o.diagonal = a.diagonal == "anti" ? templates::Diagonal::kAnti : templates::Diagonal::kMain;
+  o.higher = a.higher == "z" ? templates::Higher::kZ : templates::Higher::kX;
   o.push = a.push;
   const bool refine = entry->family == templates::TemplateFamily::kRefine;
   templates::RefineOptions ro = a.refine;

@@ -131,7 +131,7 @@ void BufferBuilder::interface_geometry() {
       const Point n = er.cross(es);
       if (n.norm() <= 0.0)
         throw TopologyError("insert_buffer_layer: interface face " + std::to_string(q.face + 1) +
-                            " of " + describe_element(input_, {ElementKind::Hex, q.hex}) +
+                            " of " + describe_element(input_, {ElementKind::kHex, q.hex}) +
                             " is degenerate at " + describe_node(input_, v));
       corner_normals_[slot(v)].push_back(into * n.normalized());
       shortest_[slot(v)] = std::min({shortest_[slot(v)], er.norm(), es.norm()});
@@ -405,7 +405,7 @@ std::string BufferBuilder::check(std::vector<char>& failing) {
         const bool volume = ratio < opt_.min_volume_ratio;
         for (Index v : hex)
           if (moved(v))
-            keeps_only(ElementKind::Hex, h, volume ? ratio : sj_ratio,
+            keeps_only(ElementKind::kHex, h, volume ? ratio : sj_ratio,
                        volume ? "volume" : "scaled Jacobian", v);
       }
     }
@@ -423,7 +423,7 @@ std::string BufferBuilder::check(std::vector<char>& failing) {
         for (Index v : now) fail_node(v);
         for (Index v : tet)
           if (moved(v) || centre_of_[static_cast<std::size_t>(v)] != kInvalidIndex)
-            keeps_only(ElementKind::Tet, t, ratio, "volume", v);
+            keeps_only(ElementKind::kTet, t, ratio, "volume", v);
       }
     }
   }
@@ -449,7 +449,7 @@ std::string BufferBuilder::check(std::vector<char>& failing) {
           const InterfaceQuad& q = itf_.quads[static_cast<std::size_t>(b.quad)];
           first_failure = describe_node(input_, b.corners[i - 4]) + ": the buffer hex on face " +
                           std::to_string(q.face + 1) + " of " +
-                          describe_element(input_, {ElementKind::Hex, q.hex}) +
+                          describe_element(input_, {ElementKind::kHex, q.hex}) +
                           " has scaled Jacobian " + std::to_string(sj);
         }
       }

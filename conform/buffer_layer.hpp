@@ -14,8 +14,8 @@
 //   around `centre` (a tet-part node used by no hex, so it is not duplicated: carved from the
 //   tet side, it moves by the mean step of the quad's corners); the bottom face (local face 4,
 //   t = 0) is on the hex side. For the geode template of templates/geode.hpp (y up, top at
-//   y = +h/2) one right-handed map is r = z, s = x, t = y, under which Diagonal::Main (which
-//   joins (-x,+z) and (+x,-z)) is {5, 7} and Diagonal::Anti is {4, 6}.
+//   y = +h/2) one right-handed map is r = z, s = x, t = y, under which Diagonal::kMain (which
+//   joins (-x,+z) and (+x,-z)) is {5, 7} and Diagonal::kAnti is {4, 6}.
 #include <array>
 #include <string>
 #include <vector>

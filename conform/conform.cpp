@@ -245,9 +245,9 @@ void Conformer::check_wedges() const {
   std::vector<char> on_interface(input_.points.size(), 0);
   for (Index v : interface_.nodes) on_interface[static_cast<std::size_t>(v)] = 1;
   const primal::FaceOwners faces(input_);
-  const auto& topo = primal::cell_topology(primal::ElementKind::Wedge);
+  const auto& topo = primal::cell_topology(primal::ElementKind::kWedge);
   for (std::size_t w = 0; w < input_.wedges.size(); ++w) {
-    const primal::ElementRef ref{primal::ElementKind::Wedge, static_cast<Index>(w)};
+    const primal::ElementRef ref{primal::ElementKind::kWedge, static_cast<Index>(w)};
     const auto& c = input_.wedges[w];
     for (Index v : c)
       if (on_interface[static_cast<std::size_t>(v)])
@@ -264,7 +264,7 @@ void Conformer::check_wedges() const {
       for (int d = 0; d < 2; ++d) {
         const std::array<Index, 3> tri{q(d), q(d + 1), q(d + 2)};
         const primal::Side* owner = faces.find(tri);
-        if (owner && owner->element.kind == primal::ElementKind::Tet)
+        if (owner && owner->element.kind == primal::ElementKind::kTet)
           throw TopologyError(
               "conform: face " + std::to_string(f + 1) + " of " +
               primal::describe_element(input_, ref) + " (nodes " +
@@ -311,8 +311,8 @@ void Conformer::insert_buffer() {
   for (const BufferHex& b : layer_.hexes) {
     const primal::InterfaceQuad& q = interface_.quads[b.quad];
     carved_from_.push_back(res_.buffer_side == BufferSide::kHex
-                               ? primal::ElementRef{primal::ElementKind::Hex, q.hex}
-                               : primal::ElementRef{primal::ElementKind::Tet, q.tets[0]});
+                               ? primal::ElementRef{primal::ElementKind::kHex, q.hex}
+                               : primal::ElementRef{primal::ElementKind::kTet, q.tets[0]});
   }
   interface_ = {};
   res_.buffer = layer_.report;
@@ -491,7 +491,7 @@ void Conformer::assemble() {
   std::vector<int> block;
   block.reserve(total);
   for (Index parent : diced_.hex_parent)
-    block.push_back(primal::block_of(lm, {primal::ElementKind::Hex, parent}));
+    block.push_back(primal::block_of(lm, {primal::ElementKind::kHex, parent}));
   diced_parent_ = std::move(diced_.hex_parent);  // per output diced hex: its input hex
   diced_.hex_parent = {};
   geode_first_.reserve(nb + 1);
@@ -509,12 +509,12 @@ void Conformer::assemble() {
   hexes.insert(hexes.end(), diced_.tet_children.begin(), diced_.tet_children.end());
   diced_.tet_children = {};
   for (Index parent : diced_.tet_parent)
-    block.push_back(primal::block_of(lm, {primal::ElementKind::Tet, parent}));
+    block.push_back(primal::block_of(lm, {primal::ElementKind::kTet, parent}));
   diced_.tet_parent = {};
   hexes.insert(hexes.end(), diced_.wedge_children.begin(), diced_.wedge_children.end());
   diced_.wedge_children = {};
   for (Index parent : diced_.wedge_parent)
-    block.push_back(primal::block_of(lm, {primal::ElementKind::Wedge, parent}));
+    block.push_back(primal::block_of(lm, {primal::ElementKind::kWedge, parent}));
   diced_.wedge_parent = {};
   diced_.shared = primal::KeyMap<4>();
   // Nodes numbered in order of first use by the hexes (unused ones dropped).
@@ -894,11 +894,11 @@ void Conformer::verify() {
     BlockQuality q{id, name != blocks_.names.end() ? name->second : "block " + std::to_string(id),
                    std::move(report)};
     for (std::size_t h = 0; h < input_.hexes.size(); ++h)
-      if (primal::block_of(input_, {primal::ElementKind::Hex, static_cast<Index>(h)}) == id)
+      if (primal::block_of(input_, {primal::ElementKind::kHex, static_cast<Index>(h)}) == id)
         q.input_diced_min_scaled_jacobian =
             std::min(q.input_diced_min_scaled_jacobian, hex_diced_[h]);
     for (std::size_t t = 0; t < input_.tets.size(); ++t)
-      if (primal::block_of(input_, {primal::ElementKind::Tet, static_cast<Index>(t)}) == id)
+      if (primal::block_of(input_, {primal::ElementKind::kTet, static_cast<Index>(t)}) == id)
         q.input_diced_min_scaled_jacobian =
             std::min(q.input_diced_min_scaled_jacobian, tet_diced_[t]);
     res_.quality.push_back(std::move(q));

@@ -82,9 +82,9 @@ void check_distinct(const std::vector<Point>& pts, const Eigen::Vector3d& box) {
 }
 
 RefTemplate make_reference(const Eigen::Vector3d& box, std::array<int, 2> diagonal,
-                           templates::TopSplit split = templates::TopSplit::TwoTriangles) {
+                           templates::TopSplit split = templates::TopSplit::kTwoTriangles) {
   RefTemplate ref;
-  const bool four = split == templates::TopSplit::FourTriangles;
+  const bool four = split == templates::TopSplit::kFourTriangles;
   // Which template fills this interface cell, and with what push, is the template table's
   // (templates/template_table.hpp; for four triangles the superquadric-dome class found free
   // of obstructions: 44 hexes, no fix-up needed).
@@ -92,7 +92,7 @@ RefTemplate make_reference(const Eigen::Vector3d& box, std::array<int, 2> diagon
       four ? templates::ConformUse::kFourTriangles : templates::ConformUse::kTwoTriangles);
   GeodeOptions o = entry.defaults.geode;
   o.box = box;
-  o.diagonal = diagonal == std::array<int, 2>{5, 7} ? Diagonal::Main : Diagonal::Anti;
+  o.diagonal = diagonal == std::array<int, 2>{5, 7} ? Diagonal::kMain : Diagonal::kAnti;
   o.push = entry.conform_push;
   ref.tpl = entry.build(templates::template_options(entry, o, {}));
   // This class has no obstruction to untangling (primal/realizability.hpp), so it needs no
@@ -233,7 +233,7 @@ const RefTemplate& reference_template(const Eigen::Vector3d& given_box,
     // sides still match the geode's.
     const Eigen::Vector3d four_box(box.x(), 0.7 * box.y(), box.z());
     auto four = std::make_unique<RefTemplate>(
-        make_reference(four_box, {4, 6}, templates::TopSplit::FourTriangles));
+        make_reference(four_box, {4, 6}, templates::TopSplit::kFourTriangles));
     impose_geode_sides(*four, geode, four_box);
     slot->value = std::move(four);
   });

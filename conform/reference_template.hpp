@@ -38,7 +38,7 @@ struct RefTemplate {
 const RefTemplate& reference_template(const Eigen::Vector3d& box, std::array<int, 2> diagonal);
 
 // The same for a buffer hex whose top is split into four triangles around a centre node: the
-// four-triangle variant's arrangement (templates/geode.hpp, TopSplit::FourTriangles) with
+// four-triangle variant's arrangement (templates/geode.hpp, TopSplit::kFourTriangles) with
 // superquadric domes, a push class with no obstruction to untangling (checked: TopologyError
 // otherwise), smoothed. Its tet-side nodes are the corners, edge midpoints, the centre, the
 // midpoints of centre-corner edges and the four triangle centroids; its side faces have the

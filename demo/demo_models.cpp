@@ -370,7 +370,7 @@ void add_outside_side_set(Model& m) {
     Point c = Point::Zero();
     for (Index v : q.nodes) c += m.points[static_cast<std::size_t>(v)] / 4.0;
     if (c.cwiseAbs().maxCoeff() > 2.0 - 1e-9)
-      outside.sides.push_back({{ElementKind::Hex, q.hex}, q.local_face});
+      outside.sides.push_back({{ElementKind::kHex, q.hex}, q.local_face});
   }
   m.side_sets.push_back(std::move(outside));
 }

@@ -353,7 +353,7 @@ Model build_model(const Contents& c, const std::string& source) {
     const std::string where = source + ": element block " + std::to_string(block.id);
     const std::string type = upper(block.type);
     const ExodusCell* cell = nullptr;
-    ElementKind kind = ElementKind::Hex;
+    ElementKind kind = ElementKind::kHex;
     for (std::size_t k = 0; k < kExodusCells.size() && !cell; ++k)
       for (const char* alias : kExodusCells[k].aliases)
         if (alias && type == alias && block.per_elem == kExodusCells[k].corners) {

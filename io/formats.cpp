@@ -77,7 +77,7 @@ const std::vector<MeshFormat>& table() {
        .signature = looks_like_gmsh,
        .signature_hint = kGmshHint,
        .write = [](const primal::Model& m, const fs::path& p,
-                   const WriteOptions&) { write_gmsh(m, p, GmshFormat::Ascii, GmshVersion::k22); },
+                   const WriteOptions&) { write_gmsh(m, p, GmshFormat::kAscii, GmshVersion::k22); },
        .carries = kGmshCarries,
        .written_as = "2.2 ASCII (`--format msh22`)"},
       {.name = "vtu",
@@ -258,7 +258,7 @@ PlainMesh read_plain_mesh(const fs::path& path, const MeshFormat** format) {
     }
   const primal::Model model = read_model(path);
   for (primal::ElementKind kind :
-       {primal::ElementKind::Tet, primal::ElementKind::Pyramid, primal::ElementKind::Wedge})
+       {primal::ElementKind::kTet, primal::ElementKind::kPyramid, primal::ElementKind::kWedge})
     if (const std::size_t n = primal::element_count(model, kind))
       throw InvalidInput(path.string() + ": holds " + std::to_string(n) + " " +
                          primal::element_kind_name(kind) +

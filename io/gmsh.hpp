@@ -55,7 +55,7 @@ inline const primal::ElementKind* gmsh_cell_kind(long long type) {
   return nullptr;
 }
 
-enum class GmshFormat { Ascii, Binary };
+enum class GmshFormat { kAscii, kBinary };
 // MSH 4.1 (Gmsh 4's own) or 2.2 (what older solvers' readers and converters still expect).
 enum class GmshVersion { k41, k22 };
 
@@ -76,6 +76,6 @@ primal::Model parse_gmsh(std::string_view content, const std::string& source,
 // volumes, side sets physical surfaces (their faces as triangles / quads), node sets physical
 // points, each with its id and name.
 void write_gmsh(const primal::Model& model, const std::filesystem::path& path,
-                GmshFormat format = GmshFormat::Ascii, GmshVersion version = GmshVersion::k41);
+                GmshFormat format = GmshFormat::kAscii, GmshVersion version = GmshVersion::k41);
 
 }  // namespace geode::io

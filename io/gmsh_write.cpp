@@ -68,26 +68,26 @@ struct PhysicalName {
 // The model laid out as Gmsh entities, element blocks and physical groups.
 class MshLayout {
  public:
-  MshLayout(const Model& model, const std::string& target) : m_(model), target_(target) {
+  MshLayout(const Model& model, const std::string& target) : model(model), target(target) {
     volumes();
     assign_set_tags();
     side_sets();
     node_sets();
     std::size_t next = 1;
-    for (ElementBlock& b : blocks_) {
+    for (ElementBlock& b : blocks) {
       b.first_tag = next;
       next += b.count();
     }
-    elements_ = next - 1;
+    elements = next - 1;
   }
 
-  const Model& m_;
-  const std::string& target_;
-  std::vector<Entity> entities_;  // in dimension order 0, 1, 2, 3 once sorted
-  std::vector<ElementBlock> blocks_;
-  std::vector<PhysicalName> names_;
-  std::size_t elements_ = 0;
-  int node_entity_ = 1;
+  const Model& model;
+  const std::string& target;
+  std::vector<Entity> entities;  // in dimension order 0, 1, 2, 3 once sorted
+  std::vector<ElementBlock> blocks;
+  std::vector<PhysicalName> names;
+  std::size_t elements = 0;
+  int node_entity = 1;
 
  private:
   std::vector<int> side_tags_, node_tags_;
@@ -95,10 +95,10 @@ class MshLayout {
   Entity bounded(int dim, int tag, int physical, const std::vector<std::size_t>& nodes) const {
     Entity e{dim, tag, physical, Point::Zero(), Point::Zero()};
     if (!nodes.empty()) {
-      e.low = e.high = m_.points[nodes.front() - 1];
+      e.low = e.high = model.points[nodes.front() - 1];
       for (std::size_t n : nodes) {
-        e.low = e.low.cwiseMin(m_.points[n - 1]);
-        e.high = e.high.cwiseMax(m_.points[n - 1]);
+        e.low = e.low.cwiseMin(model.points[n - 1]);
+        e.high = e.high.cwiseMax(model.points[n - 1]);
       }
     }
     return e;
@@ -111,16 +111,16 @@ class MshLayout {
     for (ElementKind kind : kElementKinds) {
       const GmshCell& cell = kGmshCells[static_cast<std::size_t>(kind)];
       const auto corners = static_cast<std::size_t>(cell.corners);
-      for (std::size_t i = 0; i < element_count(m_, kind); ++i) {
+      for (std::size_t i = 0; i < element_count(model, kind); ++i) {
         const ElementRef ref{kind, static_cast<Index>(i)};
-        const int block = block_of(m_, ref);
+        const int block = block_of(model, ref);
         auto& list = by_block[block];
         if (list.empty() || list.back().type != cell.type)
           list.push_back({3, block, block, cell.type, corners, {}, 0});
         auto& tags = list.back().node_tags;
         const std::size_t base = tags.size();
         tags.resize(base + corners);
-        const auto c = element_corners(m_, ref);
+        const auto c = element_corners(model, ref);
         // gmsh_corner[order[i]] = model_corner[i]
         for (std::size_t v = 0; v < corners; ++v)
           tags[base + static_cast<std::size_t>(cell.order[v])] = static_cast<std::size_t>(c[v]) + 1;
@@ -130,32 +130,33 @@ class MshLayout {
       std::vector<std::size_t> all;
       for (ElementBlock& b : list) {
         all.insert(all.end(), b.node_tags.begin(), b.node_tags.end());
-        blocks_.push_back(std::move(b));
+        blocks.push_back(std::move(b));
       }
-      entities_.push_back(bounded(3, block, block, all));
-      if (auto it = m_.block_names.find(block);
-          it != m_.block_names.end() && !sanitize_name(it->second).empty())
-        names_.push_back({3, block, sanitize_name(it->second)});
+      entities.push_back(bounded(3, block, block, all));
+      if (auto it = model.block_names.find(block);
+          it != model.block_names.end() && !sanitize_name(it->second).empty())
+        names.push_back({3, block, sanitize_name(it->second)});
     }
     if (by_block.empty()) {
       // Nodes need an entity even without elements.
-      std::vector<std::size_t> all(m_.points.size());
+      std::vector<std::size_t> all(model.points.size());
       for (std::size_t i = 0; i < all.size(); ++i) all[i] = i + 1;
-      entities_.push_back(bounded(3, 1, 0, all));
+      entities.push_back(bounded(3, 1, 0, all));
     }
-    node_entity_ = entities_.front().tag;
+    node_entity = entities.front().tag;
   }
 
   void assign_set_tags() {
     std::set<int> used;
     long long largest = 0;
-    for (const auto& [block, list] : m_.block_names) largest = std::max<long long>(largest, block);
-    for (const Entity& e : entities_) {
+    for (const auto& [block, list] : model.block_names)
+      largest = std::max<long long>(largest, block);
+    for (const Entity& e : entities) {
       if (e.physical) used.insert(e.physical);
       largest = std::max<long long>(largest, e.physical);
     }
-    for (const SideSet& s : m_.side_sets) largest = std::max<long long>(largest, s.id);
-    for (const NodeSet& s : m_.node_sets) largest = std::max<long long>(largest, s.id);
+    for (const SideSet& s : model.side_sets) largest = std::max<long long>(largest, s.id);
+    for (const NodeSet& s : model.node_sets) largest = std::max<long long>(largest, s.id);
     long long offset = 10;
     while (offset <= largest) offset *= 10;
     auto tag_for = [&](int id, const std::string& what) {
@@ -163,47 +164,47 @@ class MshLayout {
       while (used.count(static_cast<int>(tag))) {
         tag += offset;
         if (tag > INT32_MAX)
-          throw InvalidInput(target_ + ": " + what + " " + std::to_string(id) +
+          throw InvalidInput(target + ": " + what + " " + std::to_string(id) +
                              ": no distinct physical tag is left for it");
       }
       used.insert(static_cast<int>(tag));
       return static_cast<int>(tag);
     };
-    for (const SideSet& s : m_.side_sets) side_tags_.push_back(tag_for(s.id, "side set"));
-    for (const NodeSet& s : m_.node_sets) node_tags_.push_back(tag_for(s.id, "node set"));
+    for (const SideSet& s : model.side_sets) side_tags_.push_back(tag_for(s.id, "side set"));
+    for (const NodeSet& s : model.node_sets) node_tags_.push_back(tag_for(s.id, "node set"));
   }
 
   void side_sets() {
-    for (std::size_t s = 0; s < m_.side_sets.size(); ++s) {
-      const SideSet& set = m_.side_sets[s];
+    for (std::size_t s = 0; s < model.side_sets.size(); ++s) {
+      const SideSet& set = model.side_sets[s];
       const int physical = side_tags_[s], entity = physical;
       ElementBlock tri{2, entity, physical, kTri3, 3, {}, 0},
           quad{2, entity, physical, kQuad4, 4, {}, 0};
       for (const Side& side : set.sides) {
-        const std::vector<Index> face = element_face(m_, side);
+        const std::vector<Index> face = element_face(model, side);
         for (Index v : face)
           (face.size() == 4 ? quad : tri).node_tags.push_back(static_cast<std::size_t>(v) + 1);
       }
       std::vector<std::size_t> all = tri.node_tags;
       all.insert(all.end(), quad.node_tags.begin(), quad.node_tags.end());
-      entities_.push_back(bounded(2, entity, physical, all));
-      if (!tri.node_tags.empty()) blocks_.push_back(std::move(tri));
-      if (!quad.node_tags.empty()) blocks_.push_back(std::move(quad));
+      entities.push_back(bounded(2, entity, physical, all));
+      if (!tri.node_tags.empty()) blocks.push_back(std::move(tri));
+      if (!quad.node_tags.empty()) blocks.push_back(std::move(quad));
       if (const std::string name = sanitize_name(set.name); !name.empty())
-        names_.push_back({2, physical, name});
+        names.push_back({2, physical, name});
     }
   }
 
   void node_sets() {
-    for (std::size_t s = 0; s < m_.node_sets.size(); ++s) {
-      const NodeSet& set = m_.node_sets[s];
+    for (std::size_t s = 0; s < model.node_sets.size(); ++s) {
+      const NodeSet& set = model.node_sets[s];
       const int physical = node_tags_[s], entity = physical;
       ElementBlock points{0, entity, physical, kPoint, 1, {}, 0};
       for (Index v : set.nodes) points.node_tags.push_back(static_cast<std::size_t>(v) + 1);
-      entities_.push_back(bounded(0, entity, physical, points.node_tags));
-      if (!points.node_tags.empty()) blocks_.push_back(std::move(points));
+      entities.push_back(bounded(0, entity, physical, points.node_tags));
+      if (!points.node_tags.empty()) blocks.push_back(std::move(points));
       if (const std::string name = sanitize_name(set.name); !name.empty())
-        names_.push_back({0, physical, name});
+        names.push_back({0, physical, name});
     }
   }
 };
@@ -261,11 +262,11 @@ class MshWriter {
   }
 
   void physical_names() {
-    if (l_.names_.empty()) return;
+    if (l_.names.empty()) return;
     out_.text("$PhysicalNames\n");
-    num(static_cast<std::int64_t>(l_.names_.size()));
+    num(static_cast<std::int64_t>(l_.names.size()));
     nl();
-    for (const PhysicalName& p : l_.names_) {
+    for (const PhysicalName& p : l_.names) {
       num(p.dim);
       sp();
       num(p.tag);
@@ -278,7 +279,7 @@ class MshWriter {
 
   void entities41() {
     std::array<std::vector<const Entity*>, 4> by_dim;
-    for (const Entity& e : l_.entities_) by_dim[static_cast<std::size_t>(e.dim)].push_back(&e);
+    for (const Entity& e : l_.entities) by_dim[static_cast<std::size_t>(e.dim)].push_back(&e);
     out_.text("$Entities\n");
     for (std::size_t d = 0; d < 4; ++d) size_field(by_dim[d].size(), d == 3);
     for (std::size_t d = 0; d < 4; ++d)
@@ -296,14 +297,14 @@ class MshWriter {
   }
 
   void nodes41() {
-    const auto& pts = l_.m_.points;
+    const auto& pts = l_.model.points;
     out_.text("$Nodes\n");
     size_field(1);
     size_field(pts.size());
     size_field(pts.empty() ? 0 : 1);
     size_field(pts.size(), true);
     int_field(3);
-    int_field(l_.node_entity_);
+    int_field(l_.node_entity);
     int_field(0);
     size_field(pts.size(), true);
     for (std::size_t i = 0; i < pts.size(); ++i) size_field(i + 1, true);
@@ -318,11 +319,11 @@ class MshWriter {
 
   void elements41() {
     out_.text("$Elements\n");
-    size_field(l_.blocks_.size());
-    size_field(l_.elements_);
-    size_field(l_.elements_ ? 1 : 0);
-    size_field(l_.elements_, true);
-    for (const ElementBlock& b : l_.blocks_) {
+    size_field(l_.blocks.size());
+    size_field(l_.elements);
+    size_field(l_.elements ? 1 : 0);
+    size_field(l_.elements, true);
+    for (const ElementBlock& b : l_.blocks) {
       int_field(b.dim);
       int_field(b.entity);
       int_field(b.type);
@@ -339,7 +340,7 @@ class MshWriter {
 
   // 2.2: counts as text lines; binary records are 4-byte ints and 8-byte doubles.
   void nodes22() {
-    const auto& pts = l_.m_.points;
+    const auto& pts = l_.model.points;
     out_.text("$Nodes\n");
     num(static_cast<std::int64_t>(pts.size()));
     nl();
@@ -363,9 +364,9 @@ class MshWriter {
 
   void elements22() {
     out_.text("$Elements\n");
-    num(static_cast<std::int64_t>(l_.elements_));
+    num(static_cast<std::int64_t>(l_.elements));
     nl();
-    for (const ElementBlock& b : l_.blocks_) {
+    for (const ElementBlock& b : l_.blocks) {
       if (binary_ && b.count() > 0) {
         out_.raw<std::int32_t>(b.type);
         out_.raw<std::int32_t>(static_cast<std::int32_t>(b.count()));
@@ -408,12 +409,12 @@ void write_gmsh(const Model& model, const std::filesystem::path& path, GmshForma
   validate(model, target);
   const MshLayout layout(model, target);
   if (version == GmshVersion::k22 &&
-      (model.points.size() >= INT32_MAX || layout.elements_ >= INT32_MAX))
+      (model.points.size() >= INT32_MAX || layout.elements >= INT32_MAX))
     throw InvalidInput(
         target + ": more nodes or elements than .msh 2.2's 32-bit tags can number; write .msh 4.1");
   write_path_atomically(path, ".msh", [&](const std::filesystem::path& temp) {
     FileSink out(temp, target);
-    MshWriter(layout, out, format == GmshFormat::Binary, version).write();
+    MshWriter(layout, out, format == GmshFormat::kBinary, version).write();
     out.close();
   });
 }

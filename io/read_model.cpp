@@ -113,8 +113,8 @@ Model model_from_vtk(const VtkGrid& grid, const ReadOptions& options) {
     const auto& cell = grid.cells[c];
     for (std::size_t k = 0; k < cell.size() && k < 8; ++k)
       corners[k] =
-          cell[kind == ElementKind::Wedge ? static_cast<std::size_t>(topology::kVtkWedgeOrder[k])
-                                          : k];
+          cell[kind == ElementKind::kWedge ? static_cast<std::size_t>(topology::kVtkWedgeOrder[k])
+                                           : k];
     cells[c] = ElementRef{kind, static_cast<Index>(element_count(model, kind))};
     add_element(model, kind, corners, block, static_cast<std::int64_t>(c));
   }

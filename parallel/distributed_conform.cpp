@@ -169,11 +169,11 @@ void Distributor::yardstick() {
   for (std::size_t c = 0; c < cells(); ++c) {
     if (part_[c] != rank_) continue;
     const auto r = ref(c);
-    if (r.kind == ElementKind::Hex)
+    if (r.kind == ElementKind::kHex)
       hexes.push_back(m().hexes[static_cast<std::size_t>(r.index)]), hex_cell.push_back(c);
-    else if (r.kind == ElementKind::Tet)
+    else if (r.kind == ElementKind::kTet)
       tets.push_back(m().tets[static_cast<std::size_t>(r.index)]), tet_cell.push_back(c);
-    else if (r.kind == ElementKind::Wedge)
+    else if (r.kind == ElementKind::kWedge)
       consider(2, c,
                primal::diced_wedge_min_scaled_jacobian(
                    m().points, std::span(&m().wedges[static_cast<std::size_t>(r.index)], 1)));
@@ -452,12 +452,12 @@ void Distributor::assemble() {
   std::vector<int> block(total);
   for (std::size_t k = 0; k < first_diced; ++k) block[k] = zone_out_.hex_block[zone_first_ + k];
   for (std::size_t k = 0; k < nh; ++k)
-    block[first_diced + k] = primal::block_of(om, {ElementKind::Hex, diced_.hex_parent[k]});
+    block[first_diced + k] = primal::block_of(om, {ElementKind::kHex, diced_.hex_parent[k]});
   for (std::size_t k = 0; k < nt; ++k)
-    block[first_diced + nh + k] = primal::block_of(om, {ElementKind::Tet, diced_.tet_parent[k]});
+    block[first_diced + nh + k] = primal::block_of(om, {ElementKind::kTet, diced_.tet_parent[k]});
   for (std::size_t k = 0; k < diced_.wedge_children.size(); ++k)
     block[first_diced + nh + nt + k] =
-        primal::block_of(om, {ElementKind::Wedge, diced_.wedge_parent[k]});
+        primal::block_of(om, {ElementKind::kWedge, diced_.wedge_parent[k]});
   std::map<int, Index> next;  // per block: its next output position
   for (int b : block) ++next[b];
   Index start = 0;
@@ -517,13 +517,13 @@ void Distributor::assemble() {
     for (const primal::Side& side : z.sides) {
       const auto h = static_cast<std::size_t>(side.element.index);
       if (h >= zone_first_ && h < zone_last_)
-        ss.sides.push_back({{ElementKind::Hex, position[h - zone_first_]}, side.face});
+        ss.sides.push_back({{ElementKind::kHex, position[h - zone_first_]}, side.face});
     }
     for (const primal::SideSet& d : diced_sides)
       if (d.id == z.id)
         for (const primal::Side& side : d.sides)
           ss.sides.push_back(
-              {{ElementKind::Hex,
+              {{ElementKind::kHex,
                 position[first_diced + static_cast<std::size_t>(side.element.index)]},
                side.face});
     std::sort(ss.sides.begin(), ss.sides.end());

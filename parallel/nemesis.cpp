@@ -171,7 +171,7 @@ Model canonical(const Model& model) {
     primal::SideSet o{ss.id, ss.name, {}};
     for (const auto& s : ss.sides)
       o.sides.push_back(
-          {{primal::ElementKind::Hex, hex_renumber[static_cast<std::size_t>(s.element.index)]},
+          {{primal::ElementKind::kHex, hex_renumber[static_cast<std::size_t>(s.element.index)]},
            s.face});
     std::sort(o.sides.begin(), o.sides.end());
     c.side_sets.push_back(std::move(o));
@@ -259,7 +259,7 @@ void write_joined(const RankMesh& mesh, const std::filesystem::path& output, MPI
   }
   for (std::size_t k = 0; k < all_sides.size(); k += 3)
     set_of(j.side_sets, all_sides[k])
-        .sides.push_back({{primal::ElementKind::Hex, static_cast<Index>(all_sides[k + 1])},
+        .sides.push_back({{primal::ElementKind::kHex, static_cast<Index>(all_sides[k + 1])},
                           static_cast<int>(all_sides[k + 2])});
   io::write_exodus(canonical(j), output);
 }

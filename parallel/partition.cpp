@@ -24,8 +24,8 @@ std::vector<int> partition_elements(const primal::Model& model, int parts) {
       for (primal::Index v : corners) eind.push_back(v);
       eptr.push_back(static_cast<idx_t>(eind.size()));
       // The hexes it dices into (8, 4, 6; a pyramid as its two tets): the parts' output balanced.
-      weight.push_back(kind == primal::ElementKind::Pyramid ? 8
-                                                            : static_cast<idx_t>(corners.size()));
+      weight.push_back(kind == primal::ElementKind::kPyramid ? 8
+                                                             : static_cast<idx_t>(corners.size()));
     }
   idx_t ne = static_cast<idx_t>(n), nn = static_cast<idx_t>(model.points.size()), ncommon = 3,
         np = parts, objval = 0;

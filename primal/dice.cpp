@@ -32,12 +32,12 @@ using ChildTable = std::array<std::array<Support, NCorners>, NChildren>;
 // first four entries are the quad's counter-clockwise corners.
 template <int Dim>
 ChildTable<(1u << Dim), (1u << Dim)> tensor_children() {
-  constexpr int n = 1 << Dim;
-  ChildTable<n, n> t{};
-  for (int c = 0; c < n; ++c) {
-    for (int k = 0; k < n; ++k) {
+  constexpr int kN = 1 << Dim;
+  ChildTable<kN, kN> t{};
+  for (int c = 0; c < kN; ++c) {
+    for (int k = 0; k < kN; ++k) {
       Support s = 0;
-      for (int q = 0; q < n; ++q) {
+      for (int q = 0; q < kN; ++q) {
         bool agrees = true;
         for (int d = 0; d < Dim; ++d) {
           const int p = topo::kHexCornerCoords[c][d] + topo::kHexCornerCoords[k][d];
@@ -57,19 +57,19 @@ ChildTable<(1u << Dim), (1u << Dim)> tensor_children() {
 // cube coordinates (r, s[, t]) is the centroid of {i} + {a if r} + {b if s} + {c if t}.
 template <int Dim>
 ChildTable<Dim + 1, (1u << Dim)> simplex_children() {
-  constexpr int n = Dim + 1;
-  ChildTable<n, (1u << Dim)> t{};
-  for (int i = 0; i < n; ++i) {
-    std::array<int, n> order{};
+  constexpr int kN = Dim + 1;
+  ChildTable<kN, (1u << Dim)> t{};
+  for (int i = 0; i < kN; ++i) {
+    std::array<int, kN> order{};
     order[0] = i;
-    for (int j = 0, m = 1; j < n; ++j) {
+    for (int j = 0, m = 1; j < kN; ++j) {
       if (j != i) order[m++] = j;
     }
     int inversions = 0;
-    for (int x = 0; x < n; ++x) {
-      for (int y = x + 1; y < n; ++y) inversions += order[x] > order[y];
+    for (int x = 0; x < kN; ++x) {
+      for (int y = x + 1; y < kN; ++y) inversions += order[x] > order[y];
     }
-    if (inversions % 2) std::swap(order[n - 2], order[n - 1]);
+    if (inversions % 2) std::swap(order[kN - 2], order[kN - 1]);
     for (int k = 0; k < (1 << Dim); ++k) {
       Support s = 1u << i;
       for (int d = 0; d < Dim; ++d) {

@@ -48,7 +48,7 @@ namespace {
 // face node goes through the shared map (each of its nodes is shareable), at the centroid of
 // its origin nodes, as dice() places those of hexes and tets.
 void dice_wedges(const Model& model, DicedModel& out) {
-  const auto& topo = cell_topology(ElementKind::Wedge);
+  const auto& topo = cell_topology(ElementKind::kWedge);
   out.wedge_children.reserve(6 * model.wedges.size());
   out.wedge_parent.reserve(6 * model.wedges.size());
   for (std::size_t w = 0; w < model.wedges.size(); ++w) {
@@ -97,7 +97,7 @@ void dice_wedges(const Model& model, DicedModel& out) {
 // The wedge rule of dice_wedges as a dicing table: child k's corners as masks over the wedge's
 // corners (k, its edges to n0, n1, n2, the faces spanned by two of them, the centre).
 std::array<std::array<unsigned, 8>, 6> wedge_dicing_table() {
-  const auto& topo = cell_topology(ElementKind::Wedge);
+  const auto& topo = cell_topology(ElementKind::kWedge);
   auto face_of = [&](int a, int b, int d) {
     for (int f = 0; f < topo.faces; ++f) {
       const auto& face = topo.face[static_cast<std::size_t>(f)];
@@ -299,7 +299,7 @@ double diced_wedge_min_scaled_jacobian(std::span<const Point> points,
     for (int k = 0; k < 6; ++k) {
       const auto& n = topology::kWedgeCornerNeighbors[static_cast<std::size_t>(k)];
       auto face = [&](int a, int b) {
-        for (const auto& f : cell_topology(ElementKind::Wedge).face) {
+        for (const auto& f : cell_topology(ElementKind::kWedge).face) {
           auto has = [&](int x) {
             return std::find(f.corners.begin(), f.corners.begin() + f.size, x) !=
                    f.corners.begin() + f.size;
@@ -330,7 +330,7 @@ double diced_wedge_min_scaled_jacobian(std::span<const Point> points,
 
 DicedModel dice_model(const Model& model, std::span<const char> shareable) {
   if (!model.pyramids.empty())
-    throw InvalidInput("dice_model: " + describe_element(model, {ElementKind::Pyramid, 0}) +
+    throw InvalidInput("dice_model: " + describe_element(model, {ElementKind::kPyramid, 0}) +
                        ": pyramids are not diced; split them into tets first (split_pyramids)");
   const Index V = static_cast<Index>(model.points.size());
   DicedModel out;
@@ -456,9 +456,9 @@ std::vector<SideSet> diced_side_sets(const Model& model, const DicedModel& diced
     p.hexes = &hexes;
     p.offset = offset;
   };
-  part(ElementKind::Hex, diced.hex_parent, diced.hex_children, hex_offset);
-  part(ElementKind::Tet, diced.tet_parent, diced.tet_children, tet_offset);
-  part(ElementKind::Wedge, diced.wedge_parent, diced.wedge_children, wedge_offset);
+  part(ElementKind::kHex, diced.hex_parent, diced.hex_children, hex_offset);
+  part(ElementKind::kTet, diced.tet_parent, diced.tet_children, tet_offset);
+  part(ElementKind::kWedge, diced.wedge_parent, diced.wedge_children, wedge_offset);
   for (const SideSet& ss : model.side_sets) {
     SideSet o{ss.id, ss.name, {}};
     for (const Side& side : ss.sides) {
@@ -478,7 +478,7 @@ std::vector<SideSet> diced_side_sets(const Model& model, const DicedModel& diced
         for (int f = 0; f < 6; ++f) {
           bool all = true;
           for (int k : topo::kHexFaceCorners[f]) all = all && on_face((*p.hexes)[c][k]);
-          if (all) o.sides.push_back({{ElementKind::Hex, p.offset + c}, f});
+          if (all) o.sides.push_back({{ElementKind::kHex, p.offset + c}, f});
         }
     }
     sets.push_back(std::move(o));

@@ -277,7 +277,7 @@ class InputChecker {
   void covering_at_nodes() {
     const std::size_t nv = model_.points.size();
     std::vector<double> angle(nv, 0.0);
-    std::vector<ElementRef> at(nv, ElementRef{ElementKind::Hex, kInvalidIndex});
+    std::vector<ElementRef> at(nv, ElementRef{ElementKind::kHex, kInvalidIndex});
     auto cone = [&](ElementRef e, Index v, Index a, Index b, Index c) {
       const Point& o = pt(v);
       angle[static_cast<std::size_t>(v)] += solid_angle(pt(a) - o, pt(b) - o, pt(c) - o);
@@ -295,7 +295,7 @@ class InputChecker {
       const auto& h = model_.hexes[i];
       for (int c = 0; c < 8; ++c) {
         const auto& n = topology::kHexCornerNeighbors[static_cast<std::size_t>(c)];
-        cone({ElementKind::Hex, static_cast<Index>(i)}, h[static_cast<std::size_t>(c)],
+        cone({ElementKind::kHex, static_cast<Index>(i)}, h[static_cast<std::size_t>(c)],
              h[static_cast<std::size_t>(n[0])], h[static_cast<std::size_t>(n[1])],
              h[static_cast<std::size_t>(n[2])]);
       }
@@ -304,17 +304,17 @@ class InputChecker {
       const auto& w = model_.wedges[i];
       for (int c = 0; c < 6; ++c) {
         const auto& n = topology::kWedgeCornerNeighbors[static_cast<std::size_t>(c)];
-        cone({ElementKind::Wedge, static_cast<Index>(i)}, w[static_cast<std::size_t>(c)],
+        cone({ElementKind::kWedge, static_cast<Index>(i)}, w[static_cast<std::size_t>(c)],
              w[static_cast<std::size_t>(n[0])], w[static_cast<std::size_t>(n[1])],
              w[static_cast<std::size_t>(n[2])]);
       }
     }
     for (std::size_t i = 0; i < model_.tets.size(); ++i)
-      tet({ElementKind::Tet, static_cast<Index>(i)}, model_.tets[i]);
+      tet({ElementKind::kTet, static_cast<Index>(i)}, model_.tets[i]);
     for (Index x : centre_on_quad_) angle[static_cast<std::size_t>(x)] += 2.0 * kPi;
     for (std::size_t i = 0; i < model_.pyramids.size(); ++i) {
       const auto& p = model_.pyramids[i];
-      const ElementRef e{ElementKind::Pyramid, static_cast<Index>(i)};
+      const ElementRef e{ElementKind::kPyramid, static_cast<Index>(i)};
       const bool d02 = tet_volume(pt(p[0]), pt(p[1]), pt(p[2]), pt(p[4])) > 0.0 &&
                        tet_volume(pt(p[0]), pt(p[2]), pt(p[3]), pt(p[4])) > 0.0;
       if (d02) {

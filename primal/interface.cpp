@@ -29,12 +29,12 @@ struct TriangleUses {
 
 // Messages speak in the file's ids (model.hpp: describe_element, node_list).
 std::string quad_name(const Model& model, Index hex, const std::array<Index, 4>& corners) {
-  return describe_element(model, {ElementKind::Hex, hex}) + " face (nodes " +
+  return describe_element(model, {ElementKind::kHex, hex}) + " face (nodes " +
          node_list(model, corners) + ")";
 }
 
 std::string tet_face_name(const Model& model, const TetFaceUse& use) {
-  return describe_element(model, {ElementKind::Tet, use.tet}) + " face (nodes " +
+  return describe_element(model, {ElementKind::kTet, use.tet}) + " face (nodes " +
          node_list(model, use.nodes) + ")";
 }
 
@@ -103,8 +103,8 @@ std::vector<std::array<Index, 3>> interface_triangles(const InterfaceQuad& q) {
 
 Interface find_interface(const Model& model, double tol) {
   validate(model, "find_interface");
-  refuse_duplicates(model, model.hexes, ElementKind::Hex);
-  refuse_duplicates(model, model.tets, ElementKind::Tet);
+  refuse_duplicates(model, model.hexes, ElementKind::kHex);
+  refuse_duplicates(model, model.tets, ElementKind::kTet);
   const auto& P = model.points;
   auto pt = [&](Index v) -> const Point& { return P[static_cast<std::size_t>(v)]; };
 
@@ -128,9 +128,9 @@ Interface find_interface(const Model& model, double tol) {
       if (uses.count == 2)
         throw TopologyError("find_interface: triangle (nodes " + node_list(model, use.nodes) +
                             ") is a face of more than two tets (" +
-                            describe_element(model, {ElementKind::Tet, uses.use[0].tet}) + ", " +
-                            describe_element(model, {ElementKind::Tet, uses.use[1].tet}) + ", " +
-                            describe_element(model, {ElementKind::Tet, static_cast<Index>(t)}) +
+                            describe_element(model, {ElementKind::kTet, uses.use[0].tet}) + ", " +
+                            describe_element(model, {ElementKind::kTet, uses.use[1].tet}) + ", " +
+                            describe_element(model, {ElementKind::kTet, static_cast<Index>(t)}) +
                             ")");
       uses.use[static_cast<std::size_t>(uses.count++)] = use;
     }
@@ -261,7 +261,7 @@ Interface find_interface(const Model& model, double tol) {
         if (std::find(u.nodes.begin(), u.nodes.end(), v) == u.nodes.end()) apex = v;
       if ((pt(apex) - middle).dot(normal) <= 0.0)
         throw TopologyError(
-            "find_interface: " + describe_element(model, {ElementKind::Tet, u.tet}) + " on " +
+            "find_interface: " + describe_element(model, {ElementKind::kTet, u.tet}) + " on " +
             name + " lies on the hex side of it (the parts overlap or are inverted)");
     }
     out.quads.push_back(q);
@@ -296,7 +296,7 @@ Interface find_interface(const Model& model, double tol) {
                 on_triangle(pt(p), pt(c[1]), pt(c[2]), pt(c[3]), tol))
               throw TopologyError(
                   "find_interface: " + describe_node(model, p) + " of the tet part (" +
-                  describe_element(model, {ElementKind::Tet, tri.tet}) + ") lies on " +
+                  describe_element(model, {ElementKind::kTet, tri.tet}) + ") lies on " +
                   quad_name(model, bq->hex, c) +
                   " but is not one of its corners: the parts do not conform node-wise");
           }
@@ -305,7 +305,7 @@ Interface find_interface(const Model& model, double tol) {
             if (on_triangle(pt(p), pt(tri.nodes[0]), pt(tri.nodes[1]), pt(tri.nodes[2]), tol))
               throw TopologyError(
                   "find_interface: " + describe_node(model, p) + " of the hex part (" +
-                  describe_element(model, {ElementKind::Hex, bq->hex}) + ") lies on " +
+                  describe_element(model, {ElementKind::kHex, bq->hex}) + ") lies on " +
                   tet_face_name(model, tri) +
                   " but is not one of its corners: the parts do not conform node-wise");
           }

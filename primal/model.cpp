@@ -23,13 +23,13 @@ int default_block(ElementKind kind) { return static_cast<int>(kind) + 1; }
 
 std::size_t element_count(const Model& model, ElementKind kind) {
   switch (kind) {
-    case ElementKind::Hex:
+    case ElementKind::kHex:
       return model.hexes.size();
-    case ElementKind::Tet:
+    case ElementKind::kTet:
       return model.tets.size();
-    case ElementKind::Pyramid:
+    case ElementKind::kPyramid:
       return model.pyramids.size();
-    case ElementKind::Wedge:
+    case ElementKind::kWedge:
       return model.wedges.size();
   }
   return 0;
@@ -45,13 +45,13 @@ std::span<const Index> element_corners(const Model& model, ElementRef e) {
   if (e.index < 0 || static_cast<std::size_t>(e.index) >= element_count(model, e.kind)) return {};
   const auto i = static_cast<std::size_t>(e.index);
   switch (e.kind) {
-    case ElementKind::Hex:
+    case ElementKind::kHex:
       return model.hexes[i];
-    case ElementKind::Tet:
+    case ElementKind::kTet:
       return model.tets[i];
-    case ElementKind::Pyramid:
+    case ElementKind::kPyramid:
       return model.pyramids[i];
-    case ElementKind::Wedge:
+    case ElementKind::kWedge:
       return model.wedges[i];
   }
   return {};
@@ -59,13 +59,13 @@ std::span<const Index> element_corners(const Model& model, ElementRef e) {
 
 std::vector<int>& element_blocks(Model& model, ElementKind kind) {
   switch (kind) {
-    case ElementKind::Hex:
+    case ElementKind::kHex:
       return model.hex_block;
-    case ElementKind::Tet:
+    case ElementKind::kTet:
       return model.tet_block;
-    case ElementKind::Pyramid:
+    case ElementKind::kPyramid:
       return model.pyramid_block;
-    case ElementKind::Wedge:
+    case ElementKind::kWedge:
       break;
   }
   return model.wedge_block;
@@ -77,13 +77,13 @@ const std::vector<int>& element_blocks(const Model& model, ElementKind kind) {
 
 std::vector<std::int64_t>& element_ids(Model& model, ElementKind kind) {
   switch (kind) {
-    case ElementKind::Hex:
+    case ElementKind::kHex:
       return model.hex_ids;
-    case ElementKind::Tet:
+    case ElementKind::kTet:
       return model.tet_ids;
-    case ElementKind::Pyramid:
+    case ElementKind::kPyramid:
       return model.pyramid_ids;
-    case ElementKind::Wedge:
+    case ElementKind::kWedge:
       break;
   }
   return model.wedge_ids;
@@ -112,16 +112,16 @@ void add_element(Model& model, ElementKind kind, std::span<const Index> corners,
     for (std::size_t k = 0; k < n; ++k) c[k] = corners[k];
   };
   switch (kind) {
-    case ElementKind::Hex:
+    case ElementKind::kHex:
       put(model.hexes);
       break;
-    case ElementKind::Tet:
+    case ElementKind::kTet:
       put(model.tets);
       break;
-    case ElementKind::Pyramid:
+    case ElementKind::kPyramid:
       put(model.pyramids);
       break;
-    case ElementKind::Wedge:
+    case ElementKind::kWedge:
       put(model.wedges);
       break;
   }
@@ -339,7 +339,7 @@ void check_geometry(const Model& model, std::string_view source) {
     const auto& c = model.tets[t];
     const double volume = tet_volume(pt(c[0]), pt(c[1]), pt(c[2]), pt(c[3]));
     if (!(volume > 0.0)) {
-      const ElementRef e{ElementKind::Tet, static_cast<Index>(t)};
+      const ElementRef e{ElementKind::kTet, static_cast<Index>(t)};
       throw InvalidInput(where + ": " + describe_element(model, e) + " is " +
                          (volume < 0.0 ? "inverted" : "flat") + " (signed volume " +
                          number_text(volume) + "; nodes " + node_list(model, c) + ")");
@@ -351,7 +351,7 @@ void check_geometry(const Model& model, std::string_view source) {
     const auto jacobians = hex_jacobians(corners);
     for (std::size_t c = 0; c < 8; ++c)
       if (!(jacobians[c] > 0.0)) {
-        const ElementRef e{ElementKind::Hex, static_cast<Index>(h)};
+        const ElementRef e{ElementKind::kHex, static_cast<Index>(h)};
         throw InvalidInput(where + ": " + describe_element(model, e) + " is " +
                            (jacobians[c] < 0.0 ? "inverted" : "flat") + " at its corner " +
                            describe_node(model, model.hexes[h][c]) + " (corner Jacobian " +
@@ -370,7 +370,7 @@ void check_geometry(const Model& model, std::string_view source) {
                      pt(c[static_cast<std::size_t>(n[1])]), pt(c[static_cast<std::size_t>(n[2])])) *
           6.0;
       if (!(j > 0.0)) {
-        const ElementRef e{ElementKind::Wedge, static_cast<Index>(w)};
+        const ElementRef e{ElementKind::kWedge, static_cast<Index>(w)};
         throw InvalidInput(where + ": " + describe_element(model, e) + " is " +
                            (j < 0.0 ? "inverted" : "flat") + " at its corner " +
                            describe_node(model, c[k]) + " (corner Jacobian " + number_text(j) +
@@ -389,7 +389,7 @@ void check_geometry(const Model& model, std::string_view source) {
     if (!d02 && !d13) {
       const auto worst =
           static_cast<std::size_t>(std::min_element(corner.begin(), corner.end()) - corner.begin());
-      const ElementRef e{ElementKind::Pyramid, static_cast<Index>(p)};
+      const ElementRef e{ElementKind::kPyramid, static_cast<Index>(p)};
       throw InvalidInput(where + ": " + describe_element(model, e) + " is " +
                          (corner[worst] < 0.0 ? "inverted" : "flat") + " at its base corner " +
                          describe_node(model, c[worst]) + " (signed volume " +
@@ -406,7 +406,7 @@ HexMesh hex_part(const Model& model) {
   mesh.hexes = model.hexes;
   mesh.block.resize(model.hexes.size());
   for (std::size_t h = 0; h < model.hexes.size(); ++h)
-    mesh.block[h] = block_of(model, {ElementKind::Hex, static_cast<Index>(h)});
+    mesh.block[h] = block_of(model, {ElementKind::kHex, static_cast<Index>(h)});
   return mesh;
 }
 
@@ -416,7 +416,7 @@ TetMesh tet_part(const Model& model) {
   mesh.tets = model.tets;
   mesh.block.resize(model.tets.size());
   for (std::size_t t = 0; t < model.tets.size(); ++t)
-    mesh.block[t] = block_of(model, {ElementKind::Tet, static_cast<Index>(t)});
+    mesh.block[t] = block_of(model, {ElementKind::kTet, static_cast<Index>(t)});
   return mesh;
 }
 

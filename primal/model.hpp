@@ -31,12 +31,12 @@
 namespace geode::primal {
 
 // The index into topology::kCellKinds.
-enum class ElementKind : std::uint8_t { Hex, Tet, Pyramid, Wedge };
-inline constexpr std::array<ElementKind, 4> kElementKinds{ElementKind::Hex, ElementKind::Tet,
-                                                          ElementKind::Pyramid, ElementKind::Wedge};
+enum class ElementKind : std::uint8_t { kHex, kTet, kPyramid, kWedge };
+inline constexpr std::array<ElementKind, 4> kElementKinds{
+    ElementKind::kHex, ElementKind::kTet, ElementKind::kPyramid, ElementKind::kWedge};
 
 struct ElementRef {
-  ElementKind kind = ElementKind::Hex;
+  ElementKind kind = ElementKind::kHex;
   Index index = kInvalidIndex;  // into the kind's array (Model::hexes, tets, pyramids, wedges)
   auto operator<=>(const ElementRef&) const = default;
 };

@@ -58,14 +58,14 @@ PyramidSplit split_pyramids(const Model& model) {
   const bool blocks =
       !model.tet_block.empty() || !model.pyramid_block.empty() || !model.tets.empty() || np > 0;
   if (blocks && m.tet_block.empty())
-    m.tet_block.assign(model.tets.size(), default_block(ElementKind::Tet));
+    m.tet_block.assign(model.tets.size(), default_block(ElementKind::kTet));
   if (m.tet_ids.empty())
     for (std::size_t t = 0; t < model.tets.size(); ++t)
       m.tet_ids.push_back(static_cast<std::int64_t>(t) + 1);
   std::vector<Index> first_tet(np);
   for (std::size_t p = 0; p < np; ++p) {
     first_tet[p] = static_cast<Index>(m.tets.size());
-    const ElementRef ref{ElementKind::Pyramid, static_cast<Index>(p)};
+    const ElementRef ref{ElementKind::kPyramid, static_cast<Index>(p)};
     for (const auto& t : pyramid_tets(model.pyramids[p], out.diagonal[p])) {
       m.tets.push_back(t);
       m.tet_block.push_back(block_of(model, ref));
@@ -77,7 +77,7 @@ PyramidSplit split_pyramids(const Model& model) {
   for (SideSet& set : m.side_sets) {
     std::vector<Side> sides;
     for (const Side& s : set.sides) {
-      if (s.element.kind != ElementKind::Pyramid) {
+      if (s.element.kind != ElementKind::kPyramid) {
         sides.push_back(s);
         continue;
       }
@@ -90,7 +90,7 @@ PyramidSplit split_pyramids(const Model& model) {
                 on && std::find(face.begin(), face.end(),
                                 m.tets[static_cast<std::size_t>(t)][static_cast<std::size_t>(k)]) !=
                           face.end();
-          if (on) sides.push_back({{ElementKind::Tet, t}, f});
+          if (on) sides.push_back({{ElementKind::kTet, t}, f});
         }
     }
     std::sort(sides.begin(), sides.end());

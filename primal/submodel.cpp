@@ -60,19 +60,19 @@ Submodel extract_submodel(const Model& model, std::span<const char> keep) {
   }
   take(model.hexes, model.hex_block, model.hex_ids, s.element[0], renumber, m.hexes, m.hex_block,
        m.hex_ids, [&](Index e) {
-         return element_id(model, {ElementKind::Hex, e});
+         return element_id(model, {ElementKind::kHex, e});
        });
   take(model.tets, model.tet_block, model.tet_ids, s.element[1], renumber, m.tets, m.tet_block,
        m.tet_ids, [&](Index e) {
-         return element_id(model, {ElementKind::Tet, e});
+         return element_id(model, {ElementKind::kTet, e});
        });
   take(model.pyramids, model.pyramid_block, model.pyramid_ids, s.element[2], renumber, m.pyramids,
        m.pyramid_block, m.pyramid_ids, [&](Index e) {
-         return element_id(model, {ElementKind::Pyramid, e});
+         return element_id(model, {ElementKind::kPyramid, e});
        });
   take(model.wedges, model.wedge_block, model.wedge_ids, s.element[3], renumber, m.wedges,
        m.wedge_block, m.wedge_ids, [&](Index e) {
-         return element_id(model, {ElementKind::Wedge, e});
+         return element_id(model, {ElementKind::kWedge, e});
        });
   m.block_names = model.block_names;
   for (const NodeSet& ns : model.node_sets) {

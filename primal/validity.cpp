@@ -443,7 +443,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     return mesh.hexes[static_cast<std::size_t>(original[static_cast<std::size_t>(p)])];
   };
   // Local edge joining two corners (-1 if they are not joined by an edge).
-  static const auto kEdgeOf = [] {
+  static const auto edge_of = [] {
     std::array<std::array<int, 8>, 8> t{};
     for (auto& row : t) row.fill(-1);
     for (int e = 0; e < topo::kHexEdges; ++e) {
@@ -619,7 +619,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
       for (int nc : topo::kHexCornerNeighbors[c]) {
         const Index b = hex(p)[nc];
         others.push_back(b);
-        if (b > static_cast<Index>(v)) edge_uses.push_back({b, 12 * p + kEdgeOf[c][nc]});
+        if (b > static_cast<Index>(v)) edge_uses.push_back({b, 12 * p + edge_of[c][nc]});
       }
     }
     std::sort(others.begin(), others.end());

@@ -26,7 +26,7 @@ std::vector<int> to_blocks(const py::handle& blocks, std::size_t n, const std::s
 
 py::dict model_dict(primal::Model&& model) {
   // The module hands out hexes and tets only so far: refuse rather than drop the other kinds.
-  for (primal::ElementKind kind : {primal::ElementKind::Pyramid, primal::ElementKind::Wedge})
+  for (primal::ElementKind kind : {primal::ElementKind::kPyramid, primal::ElementKind::kWedge})
     if (const std::size_t n = primal::element_count(model, kind))
       throw InvalidInput(
           "the model holds " + std::to_string(n) + " " + primal::element_kind_name(kind) +

@@ -42,14 +42,14 @@ struct TemplateEntry {
 const std::vector<TemplateEntry>& template_table() {
   using templates::TopSplit;
   static const std::vector<TemplateEntry> table{
-      {"geode3d", 3, Family::kGeode, TopSplit::TwoTriangles,
+      {"geode3d", 3, Family::kGeode, TopSplit::kTwoTriangles,
        "the 26-hex geode (tet side in 2 triangles)"},
-      {"geode2d", 2, Family::kGeode, TopSplit::TwoTriangles, "the 5-quad 2D geode"},
-      {"geode4tri", 3, Family::kGeode, TopSplit::FourTriangles,
+      {"geode2d", 2, Family::kGeode, TopSplit::kTwoTriangles, "the 5-quad 2D geode"},
+      {"geode4tri", 3, Family::kGeode, TopSplit::kFourTriangles,
        "the tet side in 4 triangles, fixed up"},
-      {"refine3", 3, Family::kRefine, TopSplit::TwoTriangles,
+      {"refine3", 3, Family::kRefine, TopSplit::kTwoTriangles,
        "one coarse quad over 3 x 3 fine (13 hexes)"},
-      {"refine3-2d", 2, Family::kRefine, TopSplit::TwoTriangles,
+      {"refine3-2d", 2, Family::kRefine, TopSplit::kTwoTriangles,
        "one coarse edge over three fine (4 quads)"}};
   return table;
 }
@@ -289,8 +289,8 @@ std::unique_ptr<TemplateResult> make_template(const std::string& name, const py:
     } else {
       templates::GeodeOptions o;
       o.box = box;
-      o.diagonal = diagonal == "anti" ? templates::Diagonal::Anti : templates::Diagonal::Main;
-      o.higher = higher == "z" ? templates::Higher::Z : templates::Higher::X;
+      o.diagonal = diagonal == "anti" ? templates::Diagonal::kAnti : templates::Diagonal::kMain;
+      o.higher = higher == "z" ? templates::Higher::kZ : templates::Higher::kX;
       o.split = entry.split;
       o.push = push.push;
       r->t = dim == 2 ? templates::build_geode2d(o) : templates::build_geode3d(o);
@@ -299,7 +299,7 @@ std::unique_ptr<TemplateResult> make_template(const std::string& name, const py:
       const templates::GeodeArrangement G = templates::geode_arrangement(o, dim);
       r->sheets = G.sheets, r->domain = G.domain;
       r->to_physical = [box, dim](const Point& p) { return templates::box_point(p, box, dim); };
-      if (entry.split == templates::TopSplit::FourTriangles && fixup)
+      if (entry.split == templates::TopSplit::kFourTriangles && fixup)
         r->fixup = templates::fix_up(r->t);
     }
   }

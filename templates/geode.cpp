@@ -185,10 +185,10 @@ std::pair<InterfacePatch, InterfacePatch> reference_patches(const GeodeOptions& 
     bottom.cells = {{0, 1, 2, 3}};
     // Top corners, counter-clockwise seen from above (y up): (-x,+z) (+x,+z) (+x,-z) (-x,-z).
     top.points = {Point(-1, 1, 1), Point(1, 1, 1), Point(1, 1, -1), Point(-1, 1, -1)};
-    if (o.split == TopSplit::FourTriangles) {
+    if (o.split == TopSplit::kFourTriangles) {
       top.points.push_back(Point(0, 1, 0));
       top.cells = {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}};
-    } else if (o.diagonal == Diagonal::Main) {
+    } else if (o.diagonal == Diagonal::kMain) {
       top.cells = {{0, 1, 2}, {0, 2, 3}};
     } else {
       top.cells = {{0, 1, 3}, {1, 2, 3}};
@@ -236,7 +236,7 @@ std::vector<stc::Sheet> complete_interface(const InterfacePatch& bottom, const I
   const auto tunnels = complete_tunnels(bottom, [&](const Point& along) {
     if (dim == 2) return p.high_roof;
     const bool along_x = std::abs(along.x()) > std::abs(along.z());
-    return along_x == (higher == Higher::X) ? p.high_roof : p.low_roof;
+    return along_x == (higher == Higher::kX) ? p.high_roof : p.low_roof;
   });
   const auto domes = complete_domes(top, 1.0, [&](int v) {
     const Point& x = top.points[static_cast<std::size_t>(v)];

@@ -18,15 +18,15 @@ namespace geode::templates {
 // Which diagonal splits the tet-side (top) quad into two triangles. Box corners are named in
 // (x, z) at the top face y = +h/2: Main joins (-x, +z) to (+x, -z) (as in the paper's
 // Appendix A, nodes 1 and 2); Anti joins (+x, +z) to (-x, -z).
-enum class Diagonal { Main, Anti };
+enum class Diagonal { kMain, kAnti };
 
 // Which tunnel's roof is higher where the two tunnels cross: the tunnel running along x (its
 // feet are the two dual chords of the diced bottom quad parallel to x) or along z.
-enum class Higher { X, Z };
+enum class Higher { kX, kZ };
 
 // How the tet-side quad is split: two triangles by a diagonal (the geode), or four around a
 // centre vertex (the paper's Section 5 variant).
-enum class TopSplit { TwoTriangles, FourTriangles };
+enum class TopSplit { kTwoTriangles, kFourTriangles };
 
 // How the two completed arrangements are pushed together, in reference units of the buffer
 // cell (height 1, half-width 1): the tunnels' roof heights, how deep the domes reach below
@@ -58,9 +58,9 @@ struct PushParameters {
 // box.x and box.y.
 struct GeodeOptions {
   Eigen::Vector3d box{24.0, 14.0, 24.0};
-  Diagonal diagonal = Diagonal::Main;
-  Higher higher = Higher::X;
-  TopSplit split = TopSplit::TwoTriangles;
+  Diagonal diagonal = Diagonal::kMain;
+  Higher higher = Higher::kX;
+  TopSplit split = TopSplit::kTwoTriangles;
   PushParameters push;
   stc::ArrangementOptions arrangement;  // sampling and tracing; the result does not depend on it
 };

@@ -531,7 +531,7 @@ ArrangementSpec parse_spec(const json& j, const std::string& source) {
     if (c.contains("higher")) {
       if (c["higher"] != "x" && c["higher"] != "z")
         r.fail("completion.higher", "must be \"x\" or \"z\"");
-      cs.higher = c["higher"] == "z" ? Higher::Z : Higher::X;
+      cs.higher = c["higher"] == "z" ? Higher::kZ : Higher::kX;
     }
     if (j.contains("push")) cs.push = r.push(j["push"]);
     spec.completion = cs;
@@ -647,7 +647,7 @@ json spec_json(const ArrangementSpec& s) {
   if (s.completion) {
     const CompletionSpec& c = *s.completion;
     j["completion"] = {{"hex_side", patch_json(c.hex_side)}, {"tet_side", patch_json(c.tet_side)}};
-    if (s.dim == 3) j["completion"]["higher"] = c.higher == Higher::Z ? "z" : "x";
+    if (s.dim == 3) j["completion"]["higher"] = c.higher == Higher::kZ ? "z" : "x";
     j["push"] = {{"high_roof", c.push.high_roof},
                  {"low_roof", c.push.low_roof},
                  {"dome_depth", c.push.dome_depth},

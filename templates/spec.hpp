@@ -49,7 +49,7 @@ struct SheetSpec {
 struct CompletionSpec {
   InterfacePatch hex_side;
   InterfacePatch tet_side;
-  Higher higher = Higher::X;
+  Higher higher = Higher::kX;
   PushParameters push;
 };
 

@@ -25,7 +25,7 @@ PushGrid geode4tri_grid() {
 
 GeodeOptions four_triangles() {
   GeodeOptions o;
-  o.split = TopSplit::FourTriangles;
+  o.split = TopSplit::kFourTriangles;
   return o;
 }
 

@@ -45,7 +45,7 @@ primal::Model steel_rubber() {
       for (int c : primal::topology::kTetFaceCorners[static_cast<std::size_t>(f)])
         on = on &&
              m.points[static_cast<std::size_t>(m.tets[t][static_cast<std::size_t>(c)])].x() == 4.0;
-      if (on) load.sides.push_back({{primal::ElementKind::Tet, static_cast<primal::Index>(t)}, f});
+      if (on) load.sides.push_back({{primal::ElementKind::kTet, static_cast<primal::Index>(t)}, f});
     }
   m.side_sets = {load};
   return m;

@@ -71,12 +71,12 @@ TEST_CASE(
         ++geode_count[id];
       }
     for (std::size_t h = 0; h < input.hexes.size(); ++h) {
-      const int id = primal::block_of(input, {primal::ElementKind::Hex, static_cast<Index>(h)});
+      const int id = primal::block_of(input, {primal::ElementKind::kHex, static_cast<Index>(h)});
       input_min.try_emplace(id, 1.0);
       input_min[id] = std::min(input_min[id], hex_alone(h));
     }
     for (std::size_t t = 0; t < input.tets.size(); ++t) {
-      const int id = primal::block_of(input, {primal::ElementKind::Tet, static_cast<Index>(t)});
+      const int id = primal::block_of(input, {primal::ElementKind::kTet, static_cast<Index>(t)});
       input_min.try_emplace(id, 1.0);
       input_min[id] = std::min(input_min[id], tet_alone(t));
     }

@@ -48,7 +48,7 @@ primal::Model saved_demo(const std::string& name, int n, const test::TempDir& di
 Index interior_tet_node(const primal::Model& m) {
   std::vector<int> bad(m.points.size(), 0);
   for (ElementKind kind : primal::kElementKinds)
-    if (kind != ElementKind::Tet)
+    if (kind != ElementKind::kTet)
       for (std::size_t e = 0; e < primal::element_count(m, kind); ++e)
         for (Index v : primal::element_corners(m, {kind, static_cast<Index>(e)}))
           bad[static_cast<std::size_t>(v)] = 1;
@@ -172,7 +172,7 @@ primal::Model tetgen_box(const test::TempDir& dir) {
     for (Index& v : t) --v;
     auto at = [&](int k) -> const Point& { return m.points[static_cast<std::size_t>(t[k])]; };
     if (primal::tet_volume(at(0), at(1), at(2), at(3)) < 0.0) std::swap(t[1], t[2]);
-    primal::add_element(m, ElementKind::Tet, t, 2, static_cast<std::int64_t>(i + 1));
+    primal::add_element(m, ElementKind::kTet, t, 2, static_cast<std::int64_t>(i + 1));
   }
   for (std::size_t i = 0; i < m.points.size(); ++i)
     m.node_ids.push_back(static_cast<std::int64_t>(i + 1));
@@ -235,7 +235,7 @@ TEST_CASE("input check: overlapping parts, a gap at the interface, a part inside
     CHECK(r.findings[0].fault == InputFault::kCrossingFaces);
     REQUIRE(r.findings[0].elements.size() == 2);
     std::set<ElementKind> kinds{r.findings[0].elements[0].kind, r.findings[0].elements[1].kind};
-    CHECK(kinds == std::set<ElementKind>{ElementKind::Hex, ElementKind::Tet});
+    CHECK(kinds == std::set<ElementKind>{ElementKind::kHex, ElementKind::kTet});
     CHECK(r.findings[0].place.x() > 0.99);
     CHECK(r.findings[0].place.x() < 1.31);
     refused_by_conform(m, "overlap", {"overlap", "crosses"}, dir);
@@ -284,7 +284,7 @@ TEST_CASE("input check: overlapping parts, a gap at the interface, a part inside
     const primal::InputCheckResult r = primal::check_input(m);
     REQUIRE(!r.ok());
     CHECK(r.findings[0].fault == InputFault::kCoveredTwice);
-    CHECK(r.findings[0].elements[0].kind == ElementKind::Hex);
+    CHECK(r.findings[0].elements[0].kind == ElementKind::kHex);
     CHECK(r.findings[0].measure == doctest::Approx(2.0).epsilon(0.01));
     refused_by_conform(m, "inside", {"hex", "inside other elements"}, dir);
   }

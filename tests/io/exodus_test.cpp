@@ -37,9 +37,9 @@ Model sample_model() {
   m.node_sets.push_back({11, "bottom", {8, 0, 4, 2}});
   m.node_sets.push_back({12, "", {17}});
   SideSet outside{21, "outside", {}};
-  outside.sides.push_back({{ElementKind::Tet, 5}, 3});
-  outside.sides.push_back({{ElementKind::Hex, 1}, 5});
-  outside.sides.push_back({{ElementKind::Hex, 0}, 0});
+  outside.sides.push_back({{ElementKind::kTet, 5}, 3});
+  outside.sides.push_back({{ElementKind::kHex, 1}, 5});
+  outside.sides.push_back({{ElementKind::kHex, 0}, 0});
   m.side_sets.push_back(outside);
   return m;
 }

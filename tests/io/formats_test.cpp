@@ -29,7 +29,7 @@ Model sample_model() {
   m.block_names[1] = "steel";
   m.node_sets.push_back({11, "bottom", {0, 2, 4, 8}});
   SideSet outside{21, "outside", {}};
-  outside.sides.push_back({{ElementKind::Hex, 0}, 0});
+  outside.sides.push_back({{ElementKind::kHex, 0}, 0});
   m.side_sets.push_back(outside);
   return m;
 }

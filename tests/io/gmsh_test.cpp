@@ -90,9 +90,9 @@ Model sample_model() {
   for (Index v = 0; v < 9; ++v) bottom.nodes.push_back(v);
   m.node_sets.push_back(bottom);
   SideSet outside{21, "outside", {}};
-  outside.sides.push_back({{ElementKind::Hex, 0}, 4});  // z = 0 face of hex 0
-  outside.sides.push_back({{ElementKind::Hex, 1}, 5});  // z = 1 face of hex 1
-  outside.sides.push_back({{ElementKind::Tet, 0}, 3});
+  outside.sides.push_back({{ElementKind::kHex, 0}, 4});  // z = 0 face of hex 0
+  outside.sides.push_back({{ElementKind::kHex, 1}, 5});  // z = 1 face of hex 1
+  outside.sides.push_back({{ElementKind::kTet, 0}, 3});
   m.side_sets.push_back(outside);
   return m;
 }
@@ -128,7 +128,7 @@ TEST_CASE("read_gmsh converts Gmsh's hex and tet corner order to VTK order") {
   CHECK(m.side_sets[0].id == 3);
   CHECK(m.side_sets[0].name == "top");
   REQUIRE(m.side_sets[0].sides.size() == 1);
-  CHECK(m.side_sets[0].sides[0] == Side{{ElementKind::Hex, 0}, 5});  // top face z = 1
+  CHECK(m.side_sets[0].sides[0] == Side{{ElementKind::kHex, 0}, 5});  // top face z = 1
   REQUIRE(m.node_sets.size() == 1);
   CHECK(m.node_sets[0].id == 5);
   CHECK(m.node_sets[0].name == "corner");
@@ -139,17 +139,17 @@ TEST_CASE("write_gmsh then read_gmsh gives the same model (ASCII and binary)") {
   const Model m = sample_model();
   REQUIRE(m.hexes.size() == 2);
   REQUIRE(m.tets.size() == 12);
-  for (GmshFormat format : {GmshFormat::Ascii, GmshFormat::Binary}) {
+  for (GmshFormat format : {GmshFormat::kAscii, GmshFormat::kBinary}) {
     CAPTURE(static_cast<int>(format));
     const fs::path file =
-        scratch_dir() / (format == GmshFormat::Ascii ? "rt_ascii.msh" : "rt_bin.msh");
+        scratch_dir() / (format == GmshFormat::kAscii ? "rt_ascii.msh" : "rt_bin.msh");
     write_gmsh(m, file, format);
     // Gmsh writes "4.1 <file-type>": 0 for ASCII, 1 for binary.
     std::ifstream in(file, std::ios::binary);
     std::string line;
     std::getline(in, line);
     std::getline(in, line);
-    CHECK(line.rfind(format == GmshFormat::Ascii ? "4.1 0" : "4.1 1", 0) == 0);
+    CHECK(line.rfind(format == GmshFormat::kAscii ? "4.1 0" : "4.1 1", 0) == 0);
     check_same(m, read_gmsh(file));
   }
 }

@@ -40,9 +40,9 @@ Model sample_model() {
   for (Index v = 0; v < 9; ++v) bottom.nodes.push_back(v);
   m.node_sets.push_back(bottom);
   SideSet outside{21, "outside", {}};
-  outside.sides.push_back({{ElementKind::Hex, 0}, 4});
-  outside.sides.push_back({{ElementKind::Hex, 1}, 5});
-  outside.sides.push_back({{ElementKind::Tet, 0}, 3});
+  outside.sides.push_back({{ElementKind::kHex, 0}, 4});
+  outside.sides.push_back({{ElementKind::kHex, 1}, 5});
+  outside.sides.push_back({{ElementKind::kTet, 0}, 3});
   m.side_sets.push_back(outside);
   return m;
 }
@@ -53,10 +53,10 @@ struct Variant {
   const char* name;
 };
 constexpr Variant kVariants[] = {
-    {GmshFormat::Ascii, GmshVersion::k41, "41-ascii"},
-    {GmshFormat::Binary, GmshVersion::k41, "41-binary"},
-    {GmshFormat::Ascii, GmshVersion::k22, "22-ascii"},
-    {GmshFormat::Binary, GmshVersion::k22, "22-binary"},
+    {GmshFormat::kAscii, GmshVersion::k41, "41-ascii"},
+    {GmshFormat::kBinary, GmshVersion::k41, "41-binary"},
+    {GmshFormat::kAscii, GmshVersion::k22, "22-ascii"},
+    {GmshFormat::kBinary, GmshVersion::k22, "22-binary"},
 };
 
 std::string text_of(const fs::path& p) {
@@ -103,7 +103,7 @@ TEST_CASE("write_gmsh: every version and encoding reads back the same model") {
     const std::string text = text_of(file);
     const std::string header = text.substr(text.find('\n') + 1, 5);
     CHECK(header == std::string(v.version == GmshVersion::k41 ? "4.1 " : "2.2 ") +
-                        (v.format == GmshFormat::Binary ? "1" : "0"));
+                        (v.format == GmshFormat::kBinary ? "1" : "0"));
     const Model r = read_gmsh(file);
     CHECK(r.points == m.points);  // shortest round-trip text or raw doubles: exact
     CHECK(r.hexes == m.hexes);
@@ -239,7 +239,7 @@ TEST_CASE(
   m.wedge_block = {4};
   m.block_names = {{3, "pyramid"}, {4, "wedge"}};
   m.side_sets.push_back(
-      {7, "bases", {{{ElementKind::Pyramid, 0}, 4}, {{ElementKind::Wedge, 0}, 3}}});
+      {7, "bases", {{{ElementKind::kPyramid, 0}, 4}, {{ElementKind::kWedge, 0}, 3}}});
   const test::TempDir dir;
   for (const Variant& v : kVariants) {
     CAPTURE(v.name);

@@ -125,7 +125,8 @@ TEST_CASE("Gmsh's own writer: .msh 2.2 and 4.1, ASCII and binary, read back the 
   Model m = grid_model({2, 2, 1}, 0.5, [](int i, int, int) { return i >= 1; });
   m.points[4] += Point(0.01, -0.02, 0.03);
   m.block_names[1] = "steel";
-  m.side_sets.push_back({21, "outside", {{{ElementKind::Hex, 0}, 4}, {{ElementKind::Tet, 0}, 3}}});
+  m.side_sets.push_back(
+      {21, "outside", {{{ElementKind::kHex, 0}, 4}, {{ElementKind::kTet, 0}, 3}}});
   const fs::path ours = dir.path / "ours.msh";
   write_gmsh(m, ours);
   for (const double version : {2.2, 4.1})

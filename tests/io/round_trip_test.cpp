@@ -46,11 +46,11 @@ Model sample_model() {
   m.block_names[2] = "rubber: soft";
   m.node_sets.push_back({11, "bottom", {0, 2, 4, 8}});
   SideSet outside{21, "outside", {}};
-  outside.sides.push_back({{ElementKind::Hex, 0}, 0});
-  outside.sides.push_back({{ElementKind::Hex, 1}, 0});
+  outside.sides.push_back({{ElementKind::kHex, 0}, 0});
+  outside.sides.push_back({{ElementKind::kHex, 1}, 0});
   m.side_sets.push_back(outside);
   SideSet tet_side{22, "tet side", {}};
-  tet_side.sides.push_back({{ElementKind::Tet, 3}, 2});
+  tet_side.sides.push_back({{ElementKind::kTet, 3}, 2});
   m.side_sets.push_back(tet_side);
   return m;
 }

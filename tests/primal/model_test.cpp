@@ -20,16 +20,16 @@ namespace {
 // Reference cells in the table's corner order, positively oriented.
 std::vector<Point> reference_corners(ElementKind kind) {
   switch (kind) {
-    case ElementKind::Hex: {
+    case ElementKind::kHex: {
       std::vector<Point> p;
       for (const auto& c : topo::kHexCornerCoords) p.emplace_back(c[0], c[1], c[2]);
       return p;
     }
-    case ElementKind::Tet:
+    case ElementKind::kTet:
       return {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-    case ElementKind::Pyramid:
+    case ElementKind::kPyramid:
       return {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0.5, 0.5, 1}};
-    case ElementKind::Wedge:
+    case ElementKind::kWedge:
       return {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {0, 1, 1}};
   }
   return {};
@@ -41,19 +41,19 @@ Model one_cell(ElementKind kind, std::vector<Point> points) {
   std::vector<Index> c(m.points.size());
   for (std::size_t i = 0; i < c.size(); ++i) c[i] = static_cast<Index>(i);
   switch (kind) {
-    case ElementKind::Hex:
+    case ElementKind::kHex:
       m.hexes.push_back({c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]});
       m.hex_ids = {41};
       break;
-    case ElementKind::Tet:
+    case ElementKind::kTet:
       m.tets.push_back({c[0], c[1], c[2], c[3]});
       m.tet_ids = {42};
       break;
-    case ElementKind::Pyramid:
+    case ElementKind::kPyramid:
       m.pyramids.push_back({c[0], c[1], c[2], c[3], c[4]});
       m.pyramid_ids = {43};
       break;
-    case ElementKind::Wedge:
+    case ElementKind::kWedge:
       m.wedges.push_back({c[0], c[1], c[2], c[3], c[4], c[5]});
       m.wedge_ids = {44};
       break;
@@ -111,13 +111,13 @@ TEST_CASE("cell kinds: faces outward and closed, edges on two faces, Euler") {
 }
 
 TEST_CASE("cell kinds: wedge and tet corner frames are right-handed on the reference cells") {
-  const auto w = reference_corners(ElementKind::Wedge);
+  const auto w = reference_corners(ElementKind::kWedge);
   for (std::size_t c = 0; c < 6; ++c) {
     const auto& n = topo::kWedgeCornerNeighbors[c];
     CHECK(tet_volume(w[c], w[static_cast<std::size_t>(n[0])], w[static_cast<std::size_t>(n[1])],
                      w[static_cast<std::size_t>(n[2])]) > 0.0);
   }
-  const auto t = reference_corners(ElementKind::Tet);
+  const auto t = reference_corners(ElementKind::kTet);
   for (std::size_t c = 0; c < 4; ++c) {
     const auto& n = topo::kTetCornerNeighbors[c];
     CHECK(tet_volume(t[c], t[static_cast<std::size_t>(n[0])], t[static_cast<std::size_t>(n[1])],
@@ -126,35 +126,35 @@ TEST_CASE("cell kinds: wedge and tet corner frames are right-handed on the refer
 }
 
 TEST_CASE("model: accessors, blocks and ids per kind") {
-  Model m = one_cell(ElementKind::Wedge, reference_corners(ElementKind::Wedge));
+  Model m = one_cell(ElementKind::kWedge, reference_corners(ElementKind::kWedge));
   CHECK(element_count(m) == 1);
-  CHECK(block_of(m, {ElementKind::Wedge, 0}) == default_block(ElementKind::Wedge));
-  CHECK(element_id(m, {ElementKind::Wedge, 0}) == 44);
-  CHECK(describe_element(m, {ElementKind::Wedge, 0}).rfind("wedge 44 (centre", 0) == 0);
-  CHECK(element_face(m, {{ElementKind::Wedge, 0}, 4}) == std::vector<Index>{3, 4, 5});
+  CHECK(block_of(m, {ElementKind::kWedge, 0}) == default_block(ElementKind::kWedge));
+  CHECK(element_id(m, {ElementKind::kWedge, 0}) == 44);
+  CHECK(describe_element(m, {ElementKind::kWedge, 0}).rfind("wedge 44 (centre", 0) == 0);
+  CHECK(element_face(m, {{ElementKind::kWedge, 0}, 4}) == std::vector<Index>{3, 4, 5});
   CHECK_NOTHROW(validate(m, "w.msh"));
   CHECK_NOTHROW(check_geometry(m, "w.msh"));
   m.wedge_block = {0};
   CHECK_THROWS_WITH_AS(validate(m, "w.msh"), doctest::Contains("wedge 44: block id 0"),
                        geode::InvalidInput);
   m.wedge_block = {};
-  m.side_sets.push_back({1, "s", {{{ElementKind::Wedge, 0}, 5}}});
+  m.side_sets.push_back({1, "s", {{{ElementKind::kWedge, 0}, 5}}});
   CHECK_THROWS_WITH_AS(validate(m, "w.msh"), doctest::Contains("face 6 out of range [1, 5]"),
                        geode::InvalidInput);
 }
 
 TEST_CASE("model: inverted wedges and pyramids refused by their file ids") {
-  auto w = reference_corners(ElementKind::Wedge);
+  auto w = reference_corners(ElementKind::kWedge);
   std::swap(w[1], w[2]), std::swap(w[4], w[5]);  // VTK's order read as ours: mirrored
-  CHECK_THROWS_WITH_AS(check_geometry(one_cell(ElementKind::Wedge, w), "in.vtu"),
+  CHECK_THROWS_WITH_AS(check_geometry(one_cell(ElementKind::kWedge, w), "in.vtu"),
                        doctest::Contains("in.vtu: wedge 44 (centre"), geode::InvalidInput);
-  auto p = reference_corners(ElementKind::Pyramid);
-  CHECK_NOTHROW(check_geometry(one_cell(ElementKind::Pyramid, p), "in.msh"));
+  auto p = reference_corners(ElementKind::kPyramid);
+  CHECK_NOTHROW(check_geometry(one_cell(ElementKind::kPyramid, p), "in.msh"));
   p[4].z() = -1.0;  // apex below the base
-  CHECK_THROWS_WITH_AS(check_geometry(one_cell(ElementKind::Pyramid, p), "in.msh"),
+  CHECK_THROWS_WITH_AS(check_geometry(one_cell(ElementKind::kPyramid, p), "in.msh"),
                        doctest::Contains("in.msh: pyramid 43 (centre"), geode::InvalidInput);
   // A non-convex base: one diagonal still gives two positive tets, so it is accepted.
-  p = reference_corners(ElementKind::Pyramid);
+  p = reference_corners(ElementKind::kPyramid);
   p[2] = Point(0.3, 0.3, 0.0);
-  CHECK_NOTHROW(check_geometry(one_cell(ElementKind::Pyramid, p), "in.msh"));
+  CHECK_NOTHROW(check_geometry(one_cell(ElementKind::kPyramid, p), "in.msh"));
 }

@@ -39,7 +39,7 @@ std::multiset<std::vector<std::array<long, 3>>> boundary_geometry(const primal::
 
 GeodeOptions four_triangles() {
   GeodeOptions o;
-  o.split = templates::TopSplit::FourTriangles;
+  o.split = templates::TopSplit::kFourTriangles;
   return o;
 }
 

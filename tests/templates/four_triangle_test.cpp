@@ -55,7 +55,7 @@ std::pair<double, double> radius_bounds(const templates::InterfacePatch& patch, 
 
 TEST_CASE("geode4tri: the diced nodes cap R_corner / R_centre below sqrt(5)") {
   GeodeOptions o;
-  o.split = templates::TopSplit::FourTriangles;
+  o.split = templates::TopSplit::kFourTriangles;
   const auto G = templates::geode_arrangement(o, 3);
   REQUIRE(G.tet_side.points.size() == 5);
   const int centre = 4;  // the added vertex (0, 1, 0)
@@ -80,7 +80,7 @@ TEST_CASE("geode4tri: the triple-dome points sit where the ratio says, outside t
       CAPTURE(blend);
       CAPTURE(depth);
       GeodeOptions o;
-      o.split = templates::TopSplit::FourTriangles;
+      o.split = templates::TopSplit::kFourTriangles;
       o.push.dome_radius = blend;
       o.push.dome_depth = depth;
       const auto G = templates::geode_arrangement(o, 3);
@@ -165,7 +165,7 @@ double radius_p(const templates::InterfacePatch& patch, int v, const Point& c, d
 TEST_CASE(
     "geode4tri: spheroid domes on their vertices (p = 2, offset 0) are today's, bit for bit") {
   GeodeOptions plain, given;
-  plain.split = given.split = templates::TopSplit::FourTriangles;
+  plain.split = given.split = templates::TopSplit::kFourTriangles;
   given.push.dome_exponent = given.push.centre_exponent = 2.0;
   given.push.dome_offset = 0.0;
   given.push.centre_offset = {0.0, 0.0};
@@ -222,7 +222,7 @@ TEST_CASE(
     CAPTURE(c.p);
     CAPTURE(c.f);
     GeodeOptions o;
-    o.split = templates::TopSplit::FourTriangles;
+    o.split = templates::TopSplit::kFourTriangles;
     o.push.dome_exponent = c.p;
     o.push.dome_offset = c.f;
     o.push.dome_radius = c.blend;

@@ -94,9 +94,9 @@ TEST_CASE("geode3d: other boxes, diagonals and tunnel orders give the same templ
     templates::Diagonal d;
     templates::Higher h;
   };
-  for (const Case& c : {Case{{24, 14, 24}, templates::Diagonal::Anti, templates::Higher::X},
-                        Case{{24, 14, 24}, templates::Diagonal::Main, templates::Higher::Z},
-                        Case{{10, 30, 16}, templates::Diagonal::Main, templates::Higher::X}}) {
+  for (const Case& c : {Case{{24, 14, 24}, templates::Diagonal::kAnti, templates::Higher::kX},
+                        Case{{24, 14, 24}, templates::Diagonal::kMain, templates::Higher::kZ},
+                        Case{{10, 30, 16}, templates::Diagonal::kMain, templates::Higher::kX}}) {
     GeodeOptions o;
     o.box = c.box;
     o.diagonal = c.d;
@@ -175,7 +175,7 @@ TEST_CASE("geode2d: the smoothed 2D geode is a valid quad mesh of the rectangle"
 // tests/templates/four_triangle_test.cpp), and the smoother does not untangle it.
 TEST_CASE("geode4tri: what the four-triangle variant yields") {
   GeodeOptions o;
-  o.split = templates::TopSplit::FourTriangles;
+  o.split = templates::TopSplit::kFourTriangles;
   auto T = templates::build_geode3d(o);
   CHECK(T.hex.hexes.size() == 36);
   CHECK(T.sheets.size() == 7);
@@ -195,7 +195,7 @@ TEST_CASE(
   // p = 3 for every dome the triple-dome points fall inside both tunnels and the dual has no
   // obstruction, so the plain dual (no fix-up) smooths to positive Jacobians.
   GeodeOptions o;
-  o.split = templates::TopSplit::FourTriangles;
+  o.split = templates::TopSplit::kFourTriangles;
   o.push.centre_depth = 0.45;
   o.push.dome_radius = 0.8;
   o.push.centre_radius = 0.6;

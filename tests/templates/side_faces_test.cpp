@@ -37,7 +37,7 @@ std::vector<std::array<double, 2>> face_points(const templates::Template& t, int
 
 TEST_CASE(
     "smooth_template_shared_sides: four side faces, one symmetric mesh; top and bottom kept") {
-  for (auto diagonal : {templates::Diagonal::Main, templates::Diagonal::Anti}) {
+  for (auto diagonal : {templates::Diagonal::kMain, templates::Diagonal::kAnti}) {
     for (const Eigen::Vector3d& box : {Eigen::Vector3d(24, 8, 24), Eigen::Vector3d(24, 14, 24)}) {
       CAPTURE(static_cast<int>(diagonal));
       CAPTURE(box.y());

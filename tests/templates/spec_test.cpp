@@ -132,7 +132,7 @@ TEST_CASE("spec: the built-in templates are specs, and read back to the same tem
   for (int variant = 0; variant < 3; ++variant) {
     CAPTURE(variant);
     templates::GeodeOptions o;
-    if (variant == 2) o.split = templates::TopSplit::FourTriangles;
+    if (variant == 2) o.split = templates::TopSplit::kFourTriangles;
     const int dim = variant == 1 ? 2 : 3;
     const auto text = templates::format_spec(templates::spec_json(templates::geode_spec(o, dim)));
     const auto read = templates::parse_spec(json::parse(text), "geode.json");
@@ -286,7 +286,7 @@ TEST_CASE(
     "spec: the wider dome family's values are read, written back, and named by JSON path when "
     "bad") {
   templates::GeodeOptions o;
-  o.split = templates::TopSplit::FourTriangles;
+  o.split = templates::TopSplit::kFourTriangles;
   o.push.dome_exponent = 3;
   o.push.centre_exponent = 1.5;
   o.push.dome_offset = 0.25;

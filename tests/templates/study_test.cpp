@@ -114,7 +114,7 @@ TEST_CASE(
   CHECK(templates::template_obstructions(templates::build_geode3d(GeodeOptions{})).empty());
   CHECK(templates::template_obstructions(templates::build_geode2d(GeodeOptions{})).empty());
   GeodeOptions four;
-  four.split = templates::TopSplit::FourTriangles;
+  four.split = templates::TopSplit::kFourTriangles;
   const auto plain = kinds(templates::template_obstructions(templates::build_geode3d(four)));
   CHECK(plain.count(primal::ObstructionKind::kPinchedCorner));
   four.push = {0.5, 0.45, 0.9, 0.4};
@@ -167,11 +167,11 @@ TEST_CASE("template_class_key: invariant under renumbering, different for a diff
   CHECK(templates::template_class_key(R) == key);
   // Swapping the two tunnels' heights mirrors the geode: same kinds, still the same class.
   GeodeOptions z;
-  z.higher = templates::Higher::Z;
+  z.higher = templates::Higher::kZ;
   CHECK(templates::template_class_key(templates::build_geode3d(z)) == key);
   // Four triangles on the tet side: five domes, a different template.
   GeodeOptions four;
-  four.split = templates::TopSplit::FourTriangles;
+  four.split = templates::TopSplit::kFourTriangles;
   CHECK(templates::template_class_key(templates::build_geode3d(four)) != key);
 }
 

@@ -30,9 +30,10 @@ TEST_CASE("template table: every entry is complete and its name unique") {
   CHECK(find_template("geode5d") == nullptr);
   CHECK(template_names(true) == std::vector<std::string>{"geode3d", "geode4tri"});
   CHECK(template_help().find("geode2d: the 5-quad 2D geode") != std::string::npos);
-  CHECK(conform_template(ConformUse::kTwoTriangles).defaults.geode.split == TopSplit::TwoTriangles);
+  CHECK(conform_template(ConformUse::kTwoTriangles).defaults.geode.split ==
+        TopSplit::kTwoTriangles);
   CHECK(conform_template(ConformUse::kFourTriangles).defaults.geode.split ==
-        TopSplit::FourTriangles);
+        TopSplit::kFourTriangles);
   CHECK_THROWS_AS(conform_template(ConformUse::kNone), TopologyError);
 }
 
@@ -60,6 +61,6 @@ TEST_CASE("template table: the options keep the entry's split whatever the calle
   GeodeOptions given;  // two triangles
   given.box = Eigen::Vector3d(20, 10, 20);
   const TemplateOptions o = template_options(e, given, {});
-  CHECK(o.geode.split == TopSplit::FourTriangles);
+  CHECK(o.geode.split == TopSplit::kFourTriangles);
   CHECK(o.geode.box == given.box);
 }
