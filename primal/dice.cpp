@@ -305,6 +305,24 @@ std::vector<std::array<std::vector<int>, 8>> child_weights() {
   return children;
 }
 
+// The lowest scaled Jacobian among one cell's children, each corner the mean of its weights'
+// parent corners.
+template <std::size_t N, class Children>
+double diced_cell_min(std::span<const Point> points, const std::array<Index, N>& cell,
+                      const Children& children) {
+  double lowest = 1.0;
+  for (const auto& w : children) {
+    HexCorners p;
+    for (int c = 0; c < 8; ++c) {
+      Point s = Point::Zero();
+      for (int i : w[c]) s += points[static_cast<std::size_t>(cell[static_cast<std::size_t>(i)])];
+      p[c] = s / static_cast<double>(w[c].size());
+    }
+    lowest = std::min(lowest, hex_scaled_jacobian(p));
+  }
+  return lowest;
+}
+
 // Cells in parallel (TBB): a minimum does not depend on the order it is taken in.
 template <class Mesh, std::size_t N>
 double diced_min(std::span<const Point> points, std::span<const std::array<Index, N>> cells) {
@@ -313,16 +331,7 @@ double diced_min(std::span<const Point> points, std::span<const std::array<Index
       tbb::blocked_range<std::size_t>(0, cells.size(), 4096), 1.0,
       [&](const tbb::blocked_range<std::size_t>& range, double lowest) {
         for (std::size_t k = range.begin(); k != range.end(); ++k)
-          for (const auto& w : children) {
-            HexCorners p;
-            for (int c = 0; c < 8; ++c) {
-              Point s = Point::Zero();
-              for (int i : w[c])
-                s += points[static_cast<std::size_t>(cells[k][static_cast<std::size_t>(i)])];
-              p[c] = s / static_cast<double>(w[c].size());
-            }
-            lowest = std::min(lowest, hex_scaled_jacobian(p));
-          }
+          lowest = std::min(lowest, diced_cell_min(points, cells[k], children));
         return lowest;
       },
       [](double a, double b) { return std::min(a, b); });
@@ -334,21 +343,11 @@ std::vector<double> diced_each(std::span<const Point> points,
                                std::span<const std::array<Index, N>> cells) {
   static const auto children = child_weights<Mesh, N>();
   std::vector<double> out(cells.size(), 1.0);
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, cells.size(), 4096),
-      [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t k = range.begin(); k != range.end(); ++k)
-          for (const auto& w : children) {
-            HexCorners p;
-            for (int c = 0; c < 8; ++c) {
-              Point s = Point::Zero();
-              for (int i : w[c])
-                s += points[static_cast<std::size_t>(cells[k][static_cast<std::size_t>(i)])];
-              p[c] = s / static_cast<double>(w[c].size());
-            }
-            out[k] = std::min(out[k], hex_scaled_jacobian(p));
-          }
-      });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 4096),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t k = range.begin(); k != range.end(); ++k)
+                        out[k] = diced_cell_min(points, cells[k], children);
+                    });
   return out;
 }
 

@@ -13,32 +13,19 @@
 #include <geode/primal/quality.hpp>
 #include <geode/primal/validity_local.hpp>
 #include "support/cli_run.hpp"
+#include "support/demo_input.hpp"
 #include "support/temp_dir.hpp"
 
 using namespace geode;
 using primal::Index;
 
-namespace {
-
-// The demo model built by the command in a process of its own (Gmsh 4.8 trips an Eigen assertion
-// on a second hybrid generate(3) in one process), saved and read back as a user's run reads it.
-primal::Model demo_input(const std::string& name, int n, const test::TempDir& dir) {
-  const auto path = dir.path / (name + ".vtu");
-  const auto run = test::geode_cli("demo --model " + name + " -n " + std::to_string(n) +
-                                       " --quiet --save-input " + path.string(),
-                                   true);
-  INFO(run.out);
-  REQUIRE(run.code == 0);
-  return io::read_model(path);
-}
-
-}  // namespace
+namespace {}  // namespace
 
 TEST_CASE("local verification gives the full check's verdict on every demo model") {
   const test::TempDir dir;
   for (const std::string& name : demo::demo_model_names()) {
     CAPTURE(name);
-    const primal::Model m = demo_input(name, 2, dir);
+    const primal::Model m = test::demo_input(name, 2, dir);
     conform::ConformOptions local, full;
     local.verify = conform::ConformVerify::kLocal;
     full.verify = conform::ConformVerify::kFull;

@@ -23,6 +23,7 @@
 #include <geode/primal/validity.hpp>
 #include "support/ball_checks.hpp"
 #include "support/cli_run.hpp"
+#include "support/demo_input.hpp"
 #include "support/temp_dir.hpp"
 
 using namespace geode;
@@ -39,19 +40,6 @@ constexpr HybridCase kHybrid[] = {{"hybrid", true, false},
                                   {"hybrid-cylinder", true, false},
                                   {"boundary-layer", false, true},
                                   {"hexdominant", true, true}};
-
-// The demo model built by the command in a process of its own (Gmsh 4.8's pyramid relocation
-// trips an Eigen assertion in libgmsh on the second hybrid generate(3) of one process), saved as
-// .vtu (as `--save-input` does) and read back: what a user's conform run reads.
-primal::Model hybrid_input(const std::string& name, int n, const test::TempDir& dir) {
-  const auto path = dir.path / (name + ".vtu");
-  const auto run = test::geode_cli("demo --model " + name + " -n " + std::to_string(n) +
-                                       " --quiet --save-input " + path.string(),
-                                   true);
-  INFO(run.out);
-  REQUIRE(run.code == 0);
-  return io::read_model(path);
-}
 
 std::set<int> blocks_of(const primal::Model& m) {
   std::set<int> b;
@@ -101,7 +89,7 @@ TEST_CASE(
   test::TempDir dir;
   for (const HybridCase& c : kHybrid) {
     const std::string name = c.name;
-    const primal::Model model = hybrid_input(name, 3, dir);
+    const primal::Model model = test::demo_input(name, 3, dir);
     for (const auto smooth : {conform::ConformSmooth::kLocal, conform::ConformSmooth::kNone}) {
       CAPTURE(name);
       CAPTURE(static_cast<int>(smooth));
@@ -162,7 +150,7 @@ TEST_CASE(
 TEST_CASE(
     "hybrid demos round-trip with their pyramids and wedges through .msh, .vtu, .vtk and .exo") {
   test::TempDir dir;
-  const primal::Model in = hybrid_input("hexdominant", 2, dir);
+  const primal::Model in = test::demo_input("hexdominant", 2, dir);
   REQUIRE(!in.pyramids.empty());
   REQUIRE(!in.wedges.empty());
   for (const char* ext : {".msh", ".vtu", ".vtk", ".exo"}) {

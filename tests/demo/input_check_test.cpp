@@ -22,6 +22,7 @@
 #include <geode/primal/errors.hpp>
 #include <geode/primal/input_check.hpp>
 #include "support/cli_run.hpp"
+#include "support/demo_input.hpp"
 #include "support/temp_dir.hpp"
 
 using namespace geode;
@@ -31,18 +32,6 @@ using primal::InputFault;
 using primal::Point;
 
 namespace {
-
-// The demo saved as .msh by the command (a process each: libgmsh 4.8 cannot mesh two hybrids in
-// one) and read back without the covering check.
-primal::Model saved_demo(const std::string& name, int n, const test::TempDir& dir) {
-  const auto path = dir.path / (name + ".msh");
-  const auto run = test::geode_cli("demo --model " + name + " -n " + std::to_string(n) +
-                                       " --quiet --save-input " + path.string(),
-                                   true);
-  INFO(run.out);
-  REQUIRE(run.code == 0);
-  return io::read_model(path, {}, false);
-}
 
 // A node with only tets around it and not on the boundary (every face at it shared).
 Index interior_tet_node(const primal::Model& m) {
@@ -185,7 +174,7 @@ TEST_CASE("input check: every demo model, as saved, covers its domain once") {
   test::TempDir dir;
   for (const std::string& name : demo::demo_model_names()) {
     CAPTURE(name);
-    const primal::Model m = saved_demo(name, name == "potting" ? 2 : 3, dir);
+    const primal::Model m = test::demo_input(name, name == "potting" ? 2 : 3, dir, ".msh", false);
     const primal::InputCheckResult r = primal::check_input(m);
     INFO((r.ok() ? std::string() : r.findings[0].text(m)));
     CHECK(r.ok());
@@ -200,7 +189,8 @@ TEST_CASE("input check: a folded tet in a Gmsh hybrid and in a TetGen box is ref
   test::TempDir dir;
   for (const std::string source : {"hybrid", "tetgen"}) {
     CAPTURE(source);
-    primal::Model m = source == "tetgen" ? tetgen_box(dir) : saved_demo("hybrid", 4, dir);
+    primal::Model m =
+        source == "tetgen" ? tetgen_box(dir) : test::demo_input("hybrid", 4, dir, ".msh", false);
     const Index v = interior_tet_node(m);
     const Index t = fold_tet_at(m, v);
     REQUIRE_NOTHROW(primal::check_geometry(m, source));  // every element positive
@@ -224,7 +214,8 @@ TEST_CASE("input check: a folded tet in a Gmsh hybrid and in a TetGen box is ref
 
 TEST_CASE("input check: overlapping parts, a gap at the interface, a part inside another") {
   test::TempDir dir;
-  const primal::Model base = saved_demo("delaunay", 4, dir);  // hexes [0,1]^3, tets x in [1,2]
+  const primal::Model base =
+      test::demo_input("delaunay", 4, dir, ".msh", false);  // hexes [0,1]^3, tets x in [1,2]
   {
     // The hex part misplaced 0.3 into the tet part (and 0.1 off along y and z): their
     // boundaries cross.

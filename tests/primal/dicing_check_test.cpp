@@ -11,6 +11,7 @@
 #include <geode/primal/dice_model.hpp>
 #include <geode/primal/split_pyramids.hpp>
 #include "support/cli_run.hpp"
+#include "support/demo_input.hpp"
 #include "support/temp_dir.hpp"
 
 using namespace geode;
@@ -19,17 +20,6 @@ using primal::Index;
 namespace {
 
 primal::DicedModel diced(const primal::Model& m) { return primal::dice_model(m); }
-
-// A hybrid demo built by the command in a process of its own (Gmsh 4.8 trips an Eigen assertion
-// on a second hybrid generate(3) in one process), saved and read back.
-primal::Model demo_input(const std::string& name, const test::TempDir& dir) {
-  const auto path = dir.path / (name + ".vtu");
-  const auto run =
-      test::geode_cli("demo --model " + name + " -n 2 --quiet --save-input " + path.string(), true);
-  INFO(run.out);
-  REQUIRE(run.code == 0);
-  return io::read_model(path);
-}
 
 bool has(const std::vector<Index>& v, Index x) {
   return std::find(v.begin(), v.end(), x) != v.end();
@@ -41,7 +31,7 @@ TEST_CASE("an intact dicing is what its tables make") {
   const test::TempDir dir;
   for (const char* name : {"delaunay", "boundary-layer", "hybrid"}) {
     CAPTURE(name);
-    primal::Model m = demo_input(name, dir);
+    primal::Model m = test::demo_input(name, 2, dir);
     if (!m.pyramids.empty()) m = primal::split_pyramids(m).model;
     const primal::DicedModel d = diced(m);
     const primal::DicingCheck c = primal::check_dicing(m, d);
@@ -53,7 +43,7 @@ TEST_CASE("an intact dicing is what its tables make") {
 TEST_CASE("a broken dicing is caught") {
   const primal::Model m = demo::demo_model("delaunay", 2);
   const test::TempDir dir;
-  const primal::Model w = demo_input("boundary-layer", dir);
+  const primal::Model w = test::demo_input("boundary-layer", 2, dir);
   REQUIRE(!w.wedges.empty());
   SUBCASE("a hex child with two corners swapped") {
     primal::DicedModel d = diced(m);

@@ -28,6 +28,7 @@
 #include <geode/templates/spec.hpp>
 
 #include "support/cli_run.hpp"
+#include "support/demo_input.hpp"
 #include "support/temp_dir.hpp"
 
 using namespace geode;
@@ -199,12 +200,7 @@ TEST_CASE("pyramid: on the Gmsh-made hybrid demos, splitting beats Gmsh's 88 at 
   test::TempDir dir;
   std::vector<std::pair<std::string, primal::Model>> models;
   for (const std::string name : {"hybrid", "hybrid-cylinder"}) {
-    const auto path = dir.path / (name + ".vtu");
-    const auto run =
-        test::geode_cli("demo --model " + name + " --quiet --save-input " + path.string(), true);
-    INFO(run.out);
-    REQUIRE(run.code == 0);
-    models.emplace_back(name, io::read_model(path));
+    models.emplace_back(name, test::demo_input(name, 0, dir));
   }
   for (const auto& [name, m] : models) {
     REQUIRE(!m.pyramids.empty());
