@@ -363,6 +363,30 @@ std::vector<double> diced_scaled_jacobian_per_cell(std::span<const Point> points
   return diced_each<HexMesh, 8>(points, hexes);
 }
 
+// The same children as weights on the four corners (a corner, an edge's midpoint, a face's or
+// the tet's centre), for a caller that evaluates one tet many times.
+double diced_tet_min_scaled_jacobian(const std::array<Point, 4>& corners) {
+  using Weights = std::array<std::array<std::array<double, 4>, 8>, 4>;
+  static const Weights weights = [] {
+    Weights w{};
+    const auto children = child_weights<TetMesh, 4>();
+    for (std::size_t h = 0; h < 4; ++h)
+      for (std::size_t c = 0; c < 8; ++c)
+        for (int i : children[h][c])
+          w[h][c][static_cast<std::size_t>(i)] = 1.0 / static_cast<double>(children[h][c].size());
+    return w;
+  }();
+  double lowest = 1.0;
+  for (const auto& child : weights) {
+    HexCorners p;
+    for (std::size_t c = 0; c < 8; ++c)
+      p[c] = child[c][0] * corners[0] + child[c][1] * corners[1] + child[c][2] * corners[2] +
+             child[c][3] * corners[3];
+    lowest = std::min(lowest, hex_scaled_jacobian(p));
+  }
+  return lowest;
+}
+
 double diced_min_scaled_jacobian(std::span<const Point> points,
                                  std::span<const std::array<Index, 4>> tets) {
   return diced_min<TetMesh, 4>(points, tets);

@@ -63,6 +63,9 @@ double diced_min_scaled_jacobian(std::span<const Point> points,
 double diced_min_scaled_jacobian(std::span<const Point> points,
                                  std::span<const std::array<Index, 8>> hexes);
 
+// One tet's lowest diced scaled Jacobian, from its four corners (for callers that move nodes).
+double diced_tet_min_scaled_jacobian(const std::array<Point, 4>& corners);
+
 // The same per element: each one's lowest diced scaled Jacobian, in element order (the local
 // yardstick of a transition next to it).
 std::vector<double> diced_scaled_jacobian_per_cell(std::span<const Point> points,

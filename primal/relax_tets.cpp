@@ -1,0 +1,239 @@
+#include <geode/primal/relax_tets.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <limits>
+#include <numeric>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <geode/primal/dice.hpp>
+
+namespace geode::primal {
+namespace {
+
+constexpr std::size_t kTetFaces[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
+
+// The relaxation's state: per free node its tets (compressed rows), the points moved in place.
+class Relaxer {
+ public:
+  Relaxer(std::vector<Point>& points, std::span<const std::array<Index, 4>> tets,
+          std::span<const Index> free_nodes)
+      : points_(points), tets_(tets), free_(free_nodes.begin(), free_nodes.end()) {
+    std::vector<Index> slot(points.size(), kInvalidIndex);
+    for (std::size_t k = 0; k < free_.size(); ++k)
+      slot[static_cast<std::size_t>(free_[k])] = static_cast<Index>(k);
+    first_.assign(free_.size() + 1, 0);
+    for (const auto& t : tets)
+      for (Index v : t)
+        if (slot[static_cast<std::size_t>(v)] != kInvalidIndex)
+          ++first_[static_cast<std::size_t>(slot[static_cast<std::size_t>(v)]) + 1];
+    std::partial_sum(first_.begin(), first_.end(), first_.begin());
+    around_.resize(first_.back());
+    std::vector<std::size_t> fill(first_.begin(), first_.end() - 1);
+    for (std::size_t c = 0; c < tets.size(); ++c)
+      for (Index v : tets[c])
+        if (const Index k = slot[static_cast<std::size_t>(v)]; k != kInvalidIndex)
+          around_[fill[static_cast<std::size_t>(k)]++] = static_cast<Index>(c);
+  }
+
+  std::size_t size() const { return free_.size(); }
+
+  // The lowest diced scaled Jacobian of free node k's tets, at the points as they are; once it
+  // is at or below `bound` the rest are not measured (a trial position that cannot win).
+  double lowest(std::size_t k, double bound = -2.0) const {
+    double m = 1.0;
+    for (std::size_t i = first_[k]; i < first_[k + 1] && m > bound; ++i) {
+      const auto& t = tets_[static_cast<std::size_t>(around_[i])];
+      std::array<Point, 4> c;
+      for (std::size_t j = 0; j < 4; ++j) c[j] = points_[static_cast<std::size_t>(t[j])];
+      m = std::min(m, diced_tet_min_scaled_jacobian(c));
+    }
+    return m;
+  }
+
+  double shortest_edge(std::size_t k) const {
+    const Point& p = points_[static_cast<std::size_t>(free_[k])];
+    double s = std::numeric_limits<double>::infinity();
+    for (std::size_t i = first_[k]; i < first_[k + 1]; ++i)
+      for (Index v : tets_[static_cast<std::size_t>(around_[i])])
+        if (v != free_[k]) s = std::min(s, (points_[static_cast<std::size_t>(v)] - p).norm());
+    return s;
+  }
+
+  // Compass search at free node k; true when it moved.
+  bool search(std::size_t k, const RelaxTetsOptions& o) {
+    Point& p = points_[static_cast<std::size_t>(free_[k])];
+    double best = lowest(k);
+    double step = o.initial_step * shortest_edge(k);
+    bool moved = false;
+    for (int halving = 0; halving <= o.halvings;) {
+      bool improved = false;
+      for (int axis = 0; axis < 3; ++axis)
+        for (double sign : {1.0, -1.0}) {
+          const Point old = p;
+          p[axis] += sign * step;
+          const double q = lowest(k, best + kMinGain);
+          if (q > best + kMinGain) {
+            best = q;
+            improved = moved = true;
+          } else {
+            p = old;
+          }
+        }
+      if (!improved) step *= 0.5, ++halving;
+    }
+    return moved;
+  }
+
+  Index node(std::size_t k) const { return free_[k]; }
+
+  // Every node of free node k's tets (itself included, repeatedly).
+  template <class F>
+  void for_each_neighbour(std::size_t k, F&& f) const {
+    for (std::size_t i = first_[k]; i < first_[k + 1]; ++i)
+      for (Index v : tets_[static_cast<std::size_t>(around_[i])]) f(v);
+  }
+
+ private:
+  static constexpr double kMinGain = 1e-9;  // a rise below rounding is not a move
+  std::vector<Point>& points_;
+  std::span<const std::array<Index, 4>> tets_;
+  std::vector<Index> free_;
+  std::vector<std::size_t> first_;
+  std::vector<Index> around_;
+};
+
+}  // namespace
+
+RelaxTetsResult relax_tet_nodes(std::vector<Point>& points,
+                                std::span<const std::array<Index, 4>> tets,
+                                std::span<const Index> free_nodes,
+                                const RelaxTetsOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  RelaxTetsResult r;
+  Relaxer relax(points, tets, free_nodes);
+  const std::size_t n = relax.size();
+  std::vector<char> moved(n, 0);
+  std::vector<double> low(n);
+  auto measure = [&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        for (std::size_t k = range.begin(); k != range.end(); ++k)
+                          low[k] = relax.lowest(k);
+                      });
+  };
+  measure();
+  r.min_before = n ? *std::min_element(low.begin(), low.end()) : 1.0;
+  std::vector<char> touched(points.size(), 0);
+  for (int sweep = 0; sweep < options.sweeps; ++sweep) {
+    // Worst first; ties by node number (free_nodes ascending keeps k in node order).
+    std::vector<std::size_t> order;
+    for (std::size_t k = 0; k < n; ++k)
+      if (low[k] < options.good) order.push_back(k);
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return low[a] != low[b] ? low[a] < low[b] : a < b;
+    });
+    // Rounds: in order, each node that shares no tet with one already taken in the round is
+    // taken, and a round's nodes search in parallel (none reads another's position), so the
+    // result does not depend on the thread count.
+    std::atomic<bool> any = false;
+    while (!order.empty()) {
+      std::vector<std::size_t> round, rest;
+      for (std::size_t k : order) {
+        if (touched[static_cast<std::size_t>(relax.node(k))]) {
+          rest.push_back(k);
+          continue;
+        }
+        round.push_back(k);
+        relax.for_each_neighbour(k, [&](Index v) { touched[static_cast<std::size_t>(v)] = 1; });
+      }
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, round.size(), 16),
+                        [&](const tbb::blocked_range<std::size_t>& range) {
+                          for (std::size_t i = range.begin(); i != range.end(); ++i)
+                            if (relax.search(round[i], options)) moved[round[i]] = 1, any = true;
+                        });
+      for (std::size_t k : round)
+        relax.for_each_neighbour(k, [&](Index v) { touched[static_cast<std::size_t>(v)] = 0; });
+      order.swap(rest);
+    }
+    measure();
+    if (!any) break;
+  }
+  r.min_after = n ? *std::min_element(low.begin(), low.end()) : 1.0;
+  r.nodes_moved = static_cast<Index>(std::count(moved.begin(), moved.end(), 1));
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
+std::vector<Index> tet_nodes_to_relax(const Model& model, int rings) {
+  const std::size_t n = model.points.size();
+  // Nodes any other kind uses, or a node set names: fixed.
+  std::vector<char> fixed(n, 0);
+  for (const auto& h : model.hexes)
+    for (Index v : h) fixed[static_cast<std::size_t>(v)] = 1;
+  for (const auto& w : model.wedges)
+    for (Index v : w) fixed[static_cast<std::size_t>(v)] = 1;
+  for (const auto& p : model.pyramids)
+    for (Index v : p) fixed[static_cast<std::size_t>(v)] = 1;
+  for (const NodeSet& s : model.node_sets)
+    for (Index v : s.nodes) fixed[static_cast<std::size_t>(v)] = 1;
+  // The region: rings of tets out from the hex part's nodes.
+  std::vector<char> near(n, 0), in_region(model.tets.size(), 0);
+  for (const auto& h : model.hexes)
+    for (Index v : h) near[static_cast<std::size_t>(v)] = 1;
+  for (int ring = 0; ring < rings; ++ring) {
+    for (std::size_t t = 0; t < model.tets.size(); ++t)
+      for (Index v : model.tets[t])
+        if (near[static_cast<std::size_t>(v)]) in_region[t] = 1;
+    for (std::size_t t = 0; t < model.tets.size(); ++t)
+      if (in_region[t])
+        for (Index v : model.tets[t]) near[static_cast<std::size_t>(v)] = 1;
+  }
+  // Per candidate node its tets' faces through it, as the other two nodes: an interior node
+  // has each such face twice (its star is closed), all in one block.
+  std::vector<std::size_t> first(n + 1, 0);
+  for (const auto& t : model.tets)
+    for (Index v : t)
+      if (near[static_cast<std::size_t>(v)] && !fixed[static_cast<std::size_t>(v)])
+        first[static_cast<std::size_t>(v) + 1] += 3;
+  std::partial_sum(first.begin(), first.end(), first.begin());
+  std::vector<std::array<Index, 2>> faces(first.back());
+  std::vector<std::size_t> fill(first.begin(), first.end() - 1);
+  std::vector<int> block(n, 0);
+  for (std::size_t t = 0; t < model.tets.size(); ++t) {
+    const auto& c = model.tets[t];
+    const int b = block_of(model, {ElementKind::kTet, static_cast<Index>(t)});
+    for (std::size_t i = 0; i < 4; ++i) {
+      const std::size_t v = static_cast<std::size_t>(c[i]);
+      if (!near[v] || fixed[v]) continue;
+      if (block[v] == 0) block[v] = b;
+      if (block[v] != b) fixed[v] = 1;
+      for (const auto& f : kTetFaces)
+        if (f[0] == i || f[1] == i || f[2] == i) {
+          std::array<Index, 2> e{};
+          std::size_t m = 0;
+          for (std::size_t j : f)
+            if (j != i) e[m++] = c[j];
+          if (e[0] > e[1]) std::swap(e[0], e[1]);
+          faces[fill[v]++] = e;
+        }
+    }
+  }
+  std::vector<Index> out;
+  for (std::size_t v = 0; v < n; ++v) {
+    if (!near[v] || fixed[v] || first[v] == first[v + 1]) continue;
+    auto b = faces.begin() + static_cast<std::ptrdiff_t>(first[v]);
+    auto e = faces.begin() + static_cast<std::ptrdiff_t>(first[v + 1]);
+    std::sort(b, e);
+    bool closed = (e - b) % 2 == 0;
+    for (auto it = b; closed && it != e; it += 2)
+      closed = *it == *(it + 1) && (it + 2 == e || *(it + 2) != *it);
+    if (closed) out.push_back(static_cast<Index>(v));
+  }
+  return out;
+}
+
+}  // namespace geode::primal
