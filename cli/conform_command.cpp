@@ -43,6 +43,7 @@ struct ConformArgs {
   double feature_thickness = conform::BufferLayerOptions{}.feature_thickness;
   std::string buffer_side = "hex";
   std::string pyramids = "split";
+  std::string relax = "interface";
   double smooth_target = 0.0;
   std::string template_box;
   int n = 4;
@@ -56,6 +57,10 @@ void print_summary(const conform::ConformResult& r, std::ostream& os, bool table
   if (r.input_pyramids) os << r.input_pyramids << " pyramids (split), ";
   if (r.input_wedges) os << r.input_wedges << " wedges, ";
   os << r.interface_quads << " interface quads\n";
+  if (r.relaxation.nodes_moved)
+    os << "tets relaxed near the hex part: " << r.relaxation.nodes_moved
+       << " nodes moved, their tets' diced minimum " << r.relaxation.min_before << " -> "
+       << r.relaxation.min_after << "\n";
   os << "output: " << r.model.hexes.size() << " hexes (" << r.diced_hexes << " diced hex, "
      << r.geode_hexes << " geode, " << r.diced_tet_hexes << " diced tet";
   if (r.diced_wedge_hexes) os << ", " << r.diced_wedge_hexes << " diced wedge";
@@ -164,6 +169,7 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
   conform::ConformOptions opts;
   opts.smooth = conform::parse_conform_smooth(a.smooth);
   opts.pyramids = conform::parse_conform_pyramids(a.pyramids);
+  opts.relax = conform::parse_conform_relax(a.relax);
   opts.quality = conform::parse_conform_quality(a.quality);
   opts.verify = conform::parse_conform_verify(a.verify);
   opts.geode_block = a.geode_block;
@@ -278,6 +284,14 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
        "--pyramids", a.pyramids,
        "what pyramids of a hybrid mesh become: split (default): two tets along the base diagonal\n"
        "giving the better tets, the base quad then getting the geode transition")
+      ->capture_default_str();
+  c->add_option(
+       "--relax", a.relax,
+       "interface (default): before the buffer layer, move the tet mesher's nodes within\n"
+       "two rings of tets of the hex part, each where its tets diced are best (never worse;\n"
+       "nodes on the boundary, between blocks or in a node set stay; the yardsticks are\n"
+       "measured after); none: every input node stays where it is")
+      ->check(CLI::IsMember({"interface", "none"}))
       ->capture_default_str();
   c->add_option(
        "--buffer-side", a.buffer_side,

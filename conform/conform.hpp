@@ -25,6 +25,7 @@
 #include <geode/primal/local_smooth.hpp>
 #include <geode/primal/model.hpp>
 #include <geode/primal/quality_report.hpp>
+#include <geode/primal/relax_tets.hpp>
 #include <geode/primal/validity.hpp>
 
 namespace geode::conform {
@@ -61,8 +62,19 @@ enum class ConformPyramids { kSplit };
 // "split"; InvalidInput naming the word otherwise.
 ConformPyramids parse_conform_pyramids(const std::string& word);
 
+// Whether the tet mesher's nodes near the hex part move before the buffer layer is carved
+// (primal/relax_tets.hpp): kInterface (default) relaxes the tet nodes within kRelaxRings rings
+// of tets of the hex part that lie inside one tet block (no boundary, material interface or
+// node set moves), raising the lowest diced scaled Jacobian of their tets; kNone keeps every
+// input node where it is.
+enum class ConformRelax { kNone, kInterface };
+
+// "none" or "interface"; InvalidInput naming the word otherwise.
+ConformRelax parse_conform_relax(const std::string& word);
+
 struct ConformOptions {
   ConformPyramids pyramids = ConformPyramids::kSplit;
+  ConformRelax relax = ConformRelax::kInterface;
   BufferLayerOptions buffer;
   // When no buffer layer can be carved from buffer.side (a node where that part's copy cannot
   // move off the interface, e.g. on the hex part's flat boundary where a tet part covers only
@@ -177,6 +189,10 @@ struct ConformResult {
     return std::min({input_diced_hex_min_scaled_jacobian, input_diced_tet_min_scaled_jacobian,
                      input_diced_wedge_min_scaled_jacobian});
   }
+  // ConformRelax::kInterface: the tet nodes moved and the lowest diced scaled Jacobian of their
+  // tets before and after. The yardsticks (above and local_yardstick) stay the input's own cells
+  // as given; what smoothing aims at follows the cells as relaxed.
+  primal::RelaxTetsResult relaxation;
   // The local yardstick, per buffer hex (Interface order): the lowest of the input hexes and tets
   // touching its interface quad (sharing a node with it), each diced alone. A transition next
   // to good cells is measured against them, not against the worst tet of the model. Smoothing

@@ -69,6 +69,10 @@ nlohmann::json report_json(const ConformResult& r) {
   j["smoothing"] = {{"patches", r.smoothing.patches},
                     {"seconds", r.smoothing.seconds},
                     {"cpu_seconds", r.smoothing.cpu_seconds}};
+  j["tet_relaxation"] = {{"nodes_moved", r.relaxation.nodes_moved},
+                         {"min_before", r.relaxation.min_before},
+                         {"min_after", r.relaxation.min_after},
+                         {"seconds", r.relaxation.seconds}};
   j["buffer_layer_min_scaled_jacobian"] = r.buffer.min_scaled_jacobian;
   j["buffer_side"] = buffer_side_name(r.buffer_side);
   j["input_diced_alone_min_scaled_jacobian"] = {
