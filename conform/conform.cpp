@@ -137,7 +137,6 @@ class Conformer {
   }
 
   void find_interface();
-  void check_wedges() const;
   void insert_buffer();
   void dice_and_merge();
   void place_templates();
@@ -207,13 +206,14 @@ void Conformer::find_interface() {
         *std::min_element(tet_diced_.begin(), tet_diced_.end());
   res_.input_diced_wedge_min_scaled_jacobian =
       primal::diced_wedge_min_scaled_jacobian(input_.points, input_.wedges);
-  // A model without a hex part or a tet part has no transition to make: it is simply diced.
-  if (!input_.hexes.empty() && !input_.tets.empty())
+  // A model without tets, or without hexes and wedges, has no transition to make: it is simply
+  // diced. Wedges are the hex part's where their quads meet tet triangles (a pyramid on a
+  // wedge, split), and find_interface refuses a wedge joining the two sides around a node.
+  if ((!input_.hexes.empty() || !input_.wedges.empty()) && !input_.tets.empty())
     interface_ = primal::find_interface(input_, options_.interface_tolerance);
   // Both parts but no shared quad: the parts were meshed apart (unmerged nodes, a gap).
   if (!input_.hexes.empty() && !input_.tets.empty() && interface_.quads.empty())
     throw InvalidInput("conform: the hex part and the tet part share no interface quad");
-  check_wedges();
   // The local yardstick: per interface node the lowest element around it, per quad over its nodes.
   std::vector<double> node_min(input_.points.size(), 1.0);
   for (std::size_t h = 0; h < input_.hexes.size(); ++h)
@@ -224,6 +224,13 @@ void Conformer::find_interface() {
     for (Index v : input_.tets[t])
       node_min[static_cast<std::size_t>(v)] =
           std::min(node_min[static_cast<std::size_t>(v)], tet_diced_[t]);
+  for (std::size_t w = 0; w < input_.wedges.size(); ++w) {
+    const double diced =
+        primal::diced_wedge_min_scaled_jacobian(input_.points, std::span(&input_.wedges[w], 1));
+    for (Index v : input_.wedges[w])
+      node_min[static_cast<std::size_t>(v)] =
+          std::min(node_min[static_cast<std::size_t>(v)], diced);
+  }
   res_.local_yardstick.reserve(interface_.quads.size());
   for (const primal::InterfaceQuad& q : interface_.quads) {
     double m = 1.0;
@@ -233,47 +240,6 @@ void Conformer::find_interface() {
   }
   res_.interface_quads = static_cast<Index>(interface_.quads.size());
   say("interface: " + std::to_string(interface_.quads.size()) + " quads" + took());
-}
-
-// Wedges are diced in place (6 hexes each, their faces matching the diced hexes and tets
-// beside them), never moved: a wedge quad meeting two tet triangles (a pyramid split on a
-// wedge) would need the transition carved beside a wedge, and a wedge at a node of the hex/tet
-// interface would be torn by the buffer layer's duplicated nodes. Both are refused, naming the
-// wedge, until the buffer layer carves next to wedges.
-void Conformer::check_wedges() const {
-  if (input_.wedges.empty()) return;
-  std::vector<char> on_interface(input_.points.size(), 0);
-  for (Index v : interface_.nodes) on_interface[static_cast<std::size_t>(v)] = 1;
-  const primal::FaceOwners faces(input_);
-  const auto& topo = primal::cell_topology(primal::ElementKind::kWedge);
-  for (std::size_t w = 0; w < input_.wedges.size(); ++w) {
-    const primal::ElementRef ref{primal::ElementKind::kWedge, static_cast<Index>(w)};
-    const auto& c = input_.wedges[w];
-    for (Index v : c)
-      if (on_interface[static_cast<std::size_t>(v)])
-        throw TopologyError(
-            "conform: " + primal::describe_element(input_, ref) +
-            " touches the hex/tet interface at " + primal::describe_node(input_, v) +
-            "; a transition beside wedges is not supported yet (the wedge is diced in place)");
-    for (int f = 0; f < topo.faces; ++f) {
-      const auto& face = topo.face[static_cast<std::size_t>(f)];
-      if (face.size != 4) continue;
-      const auto q = [&](int k) {
-        return c[static_cast<std::size_t>(face.corners[static_cast<std::size_t>(k)])];
-      };
-      for (int d = 0; d < 2; ++d) {
-        const std::array<Index, 3> tri{q(d), q(d + 1), q(d + 2)};
-        const primal::Side* owner = faces.find(tri);
-        if (owner && owner->element.kind == primal::ElementKind::kTet)
-          throw TopologyError(
-              "conform: face " + std::to_string(f + 1) + " of " +
-              primal::describe_element(input_, ref) + " (nodes " +
-              primal::node_list(input_, std::array<Index, 4>{q(0), q(1), q(2), q(3)}) +
-              ") meets the triangles of " + primal::describe_element(input_, owner->element) +
-              " (a pyramid on the wedge, split); a transition beside wedges is not supported yet");
-      }
-    }
-  }
 }
 
 void Conformer::insert_buffer() {
@@ -311,7 +277,7 @@ void Conformer::insert_buffer() {
   for (const BufferHex& b : layer_.hexes) {
     const primal::InterfaceQuad& q = interface_.quads[b.quad];
     carved_from_.push_back(res_.buffer_side == BufferSide::kHex
-                               ? primal::ElementRef{primal::ElementKind::kHex, q.hex}
+                               ? q.owner()
                                : primal::ElementRef{primal::ElementKind::kTet, q.tets[0]});
   }
   interface_ = {};
