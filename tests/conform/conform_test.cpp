@@ -21,6 +21,7 @@
 #include <geode/primal/boundary.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/grid_model.hpp>
+#include <geode/primal/interface.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/topology.hpp>
 #include "support/conform_checks.hpp"
@@ -351,4 +352,39 @@ TEST_CASE("conform refuses a wedge joining the two sides of an interface node, n
                        doctest::Contains("joins the two sides of the hex/tet interface at node"),
                        TopologyError);
   CHECK_THROWS_WITH_AS(conform::conform(m), doctest::Contains("wedge "), TopologyError);
+}
+
+TEST_CASE("conform: a wedge quad meeting two tet triangles gets the geode transition") {
+  // A hex cell beside a tet cell (grid_model), the hex cell split into two wedges standing on
+  // its bottom face's two triangles: one wedge's quad x = 1 meets the tets' two triangles (what
+  // a pyramid on a wedge leaves once split), an interface quad as a hex's would be.
+  primal::Model m = primal::grid_model({2, 1, 1}, 1.0, [](int i, int, int) { return i == 1; });
+  REQUIRE(m.hexes.size() == 1);
+  const auto h = m.hexes.front();
+  m.hexes.clear();
+  m.hex_block.clear();
+  m.wedges.push_back({h[0], h[1], h[2], h[4], h[5], h[6]});
+  m.wedges.push_back({h[0], h[2], h[3], h[4], h[6], h[7]});
+  REQUIRE_NOTHROW(primal::check_geometry(m, "w.msh"));
+  const primal::Interface itf = primal::find_interface(m);
+  REQUIRE(itf.quads.size() == 1);
+  CHECK(itf.quads.front().kind == primal::ElementKind::kWedge);
+  CHECK(itf.quads.front().hex == 0);
+  CHECK(itf.quads.front().face == 1);  // (1 2 5 4): x = 1
+  // Carved from the tet part (the wedges stay as they are): 26 geode hexes on the quad.
+  conform::ConformOptions o;
+  o.buffer.side = conform::BufferSide::kTet;
+  const conform::ConformResult r = conform::conform(m, o);
+  test::check_conform_result(r);
+  CHECK(r.interface_quads == 1);
+  CHECK(r.geode_hexes == 26);
+  CHECK(r.diced_wedge_hexes == 12);
+  CHECK(r.diced_tet_hexes == 4 * static_cast<Index>(m.tets.size()));
+  // With the defaults (from the hex part) the wedge would move: refused by name, then carved
+  // from the tet part with that reason as a warning.
+  const conform::ConformResult d = conform::conform(m);
+  CHECK(d.buffer_side == conform::BufferSide::kTet);
+  REQUIRE(d.warnings.size() == 1);
+  CHECK(d.warnings.front().find("would move wedge 1 (centre") != std::string::npos);
+  CHECK(primal::min_scaled_jacobian(primal::hex_part(d.model)) > 0.0);
 }
