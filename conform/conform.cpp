@@ -182,7 +182,7 @@ class Conformer {
   // by BufferLayerOptions::side), whose block its geode hexes join by default: they fill space
   // that part had.
   std::vector<primal::ElementRef> carved_from_;
-  std::vector<double> hex_diced_, tet_diced_;  // per input hex and tet: diced alone
+  std::vector<double> hex_diced_, tet_diced_, wedge_diced_;  // per input cell: diced alone
   std::vector<Index> diced_parent_;  // per output diced hex (the first ones): its input hex
   std::vector<Index> geode_first_;  // per buffer hex: its first output hex (then one past the last)
   // The hexes whose nodes smoothing or untangling could move (their regions), for verify().
@@ -224,12 +224,13 @@ void Conformer::find_interface() {
     for (Index v : input_.tets[t])
       node_min[static_cast<std::size_t>(v)] =
           std::min(node_min[static_cast<std::size_t>(v)], tet_diced_[t]);
+  wedge_diced_.reserve(input_.wedges.size());
   for (std::size_t w = 0; w < input_.wedges.size(); ++w) {
-    const double diced =
-        primal::diced_wedge_min_scaled_jacobian(input_.points, std::span(&input_.wedges[w], 1));
+    wedge_diced_.push_back(
+        primal::diced_wedge_min_scaled_jacobian(input_.points, std::span(&input_.wedges[w], 1)));
     for (Index v : input_.wedges[w])
       node_min[static_cast<std::size_t>(v)] =
-          std::min(node_min[static_cast<std::size_t>(v)], diced);
+          std::min(node_min[static_cast<std::size_t>(v)], wedge_diced_.back());
   }
   res_.local_yardstick.reserve(interface_.quads.size());
   for (const primal::InterfaceQuad& q : interface_.quads) {
@@ -867,6 +868,10 @@ void Conformer::verify() {
       if (primal::block_of(input_, {primal::ElementKind::kTet, static_cast<Index>(t)}) == id)
         q.input_diced_min_scaled_jacobian =
             std::min(q.input_diced_min_scaled_jacobian, tet_diced_[t]);
+    for (std::size_t w = 0; w < input_.wedges.size(); ++w)
+      if (primal::block_of(input_, {primal::ElementKind::kWedge, static_cast<Index>(w)}) == id)
+        q.input_diced_min_scaled_jacobian =
+            std::min(q.input_diced_min_scaled_jacobian, wedge_diced_[w]);
     res_.quality.push_back(std::move(q));
   }
   // The geode hexes against their local yardsticks, per block and over all.

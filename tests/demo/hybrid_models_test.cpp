@@ -20,6 +20,7 @@
 #include <geode/io/read_model.hpp>
 #include <geode/io/vtk.hpp>
 #include <geode/primal/boundary.hpp>
+#include <geode/primal/dice_model.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/validity.hpp>
 #include "support/ball_checks.hpp"
@@ -135,6 +136,20 @@ TEST_CASE(
       // Gmsh puts one pyramid on every quad a tet volume meets: each is an interface quad.
       if (c.pyramids) CHECK(r.interface_quads == static_cast<Index>(in.pyramids.size()));
       CHECK(blocks_of(r.model) == blocks_of(in));
+      // A block of wedges reports its wedges diced alone, as a block of hexes or tets does.
+      for (const conform::BlockQuality& q : r.quality) {
+        std::vector<std::array<Index, 6>> wedges;
+        bool only_wedges = true;
+        for (ElementKind kind : primal::kElementKinds)
+          for (std::size_t e = 0; e < primal::element_count(in, kind); ++e)
+            if (primal::block_of(in, {kind, static_cast<Index>(e)}) == q.block) {
+              only_wedges = only_wedges && kind == ElementKind::kWedge;
+              if (kind == ElementKind::kWedge) wedges.push_back(in.wedges[e]);
+            }
+        if (only_wedges && !wedges.empty())
+          CHECK(q.input_diced_min_scaled_jacobian ==
+                doctest::Approx(primal::diced_wedge_min_scaled_jacobian(in.points, wedges)));
+      }
       for (const auto& [id, name] : in.block_names) CHECK(r.model.block_names.at(id) == name);
       // The skin of every kind, diced: 4 quads per input quad, 3 per triangle, each a boundary
       // quad of the output. (The geode hexes' own faces on the boundary, where the interface
