@@ -210,10 +210,11 @@ std::vector<InterfaceNodeUse> node_uses(const Model& model, const Interface& itf
             "find_interface: " + describe_element(model, wedge != at.end() ? *wedge : at[c]) +
             " joins the two sides of the hex/tet interface at " + describe_node(model, v) +
             ": through the faces the cells share at that node it connects " +
-            describe_element(model, *hex_in[r]) + " on the hex side to " +
+            describe_element(model, *hex_in[r]) + " on the interface's quad side to " +
             describe_element(model, *tet_in[r]) +
-            " on the tet side, so the interface ends inside the mesh there and no buffer layer "
-            "can end at that node (it can where the interface meets the model boundary)");
+            " on its triangle side, so the interface ends inside the mesh there, and no buffer "
+            "layer can end at that node (one ends only where the interface meets the model "
+            "boundary)");
       }
       if (at[c].kind == ElementKind::kHex) continue;
       out.push_back({at[c], v,
