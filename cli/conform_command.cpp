@@ -369,8 +369,9 @@ void add_conform_commands(CLI::App& app) {
        "hybrid meshes Gmsh makes in one generate(3), with its pyramids: hybrid (a transfinite hex\n"
        "box beside a Delaunay tet box), hybrid-cylinder (a swept hex cylinder in a Delaunay box),\n"
        "boundary-layer (wedge layers extruded on a tet box), hexdominant (hexes, tets, pyramids\n"
-       "and wedges side by side); potting: six hex parts (boxes, swept cylinders, a tilted box, "
-       "an\n"
+       "and wedges side by side), layer-side (a wedge layer whose side quads meet tets, with\n"
+       "Gmsh's pyramids), layer-interface (a wedge layer at the hex/tet interface's edge);\n"
+       "potting: six hex parts (boxes, swept cylinders, a tilted box, an\n"
        "L bracket), each its own block, in a Delaunay tet potting (n >= 2)")
       // Checked against the module's names when given (loading libgmsh then, not at startup).
       ->check(CLI::Validator(

@@ -83,6 +83,13 @@ class BufferBuilder {
     return static_cast<std::size_t>(out_.top_node[static_cast<std::size_t>(v)]) - n_points_;
   }
   bool moved(Index v) const { return out_.top_node[static_cast<std::size_t>(v)] != kInvalidIndex; }
+  // Whether cell c of the moving part moves at node v: carved from the tet part, a tet on the
+  // hex side of the interface at v keeps v (sides()).
+  bool moves(Index c, Index v) const {
+    return moved(v) && (hex_side_ || !std::binary_search(kept_tets_.begin(), kept_tets_.end(),
+                                                         std::pair<Index, Index>{c, v}));
+  }
+  void sides();
   void interface_geometry();
   template <class Cells, class Edges, class Faces>
   void moving_part(const Cells& cells, const Edges& edges, const Faces& faces,
@@ -113,11 +120,40 @@ class BufferBuilder {
   GradedEdges quad_edges_;
   std::vector<Index> centre_of_;  // per input node: the quad it is the four-triangle centre of
   std::vector<Index> touched_;    // moving-part cells with a moved node (or a moved centre)
+  // (tet, node) pairs of tets that keep an interface node (on its hex side), and (wedge, node)
+  // pairs of wedges that take its copy (on its tet side, or loose beside a moving hex part),
+  // ascending.
+  std::vector<std::pair<Index, Index>> kept_tets_, copied_wedges_;
   // Per touched cell, as input: a hex's corner and centre Jacobians and its scaled Jacobian,
   // a tet's volume (in before_).
   std::vector<std::array<double, 9>> jacobians_before_;
   std::vector<double> before_;
 };
+
+// Which copy of each interface node the tets and wedges around it take (Interface::uses): the
+// hex side keeps the node, the tet side takes the copy, a loose cell the copy that stays where
+// the node was. The moving copy may move hexes (from the hex part) or tets (from the tet part)
+// only: wedges are diced in place, and carved from the hex part the tets stay as meshed.
+void BufferBuilder::sides() {
+  for (const InterfaceNodeUse& u : itf_.uses) {
+    const bool wedge = u.cell.kind == ElementKind::kWedge;
+    const bool moves_with =
+        hex_side_ ? u.side == InterfaceSide::kHex : u.side == InterfaceSide::kTet && wedge;
+    if (moves_with)
+      throw TopologyError("insert_buffer_layer: carved from the " +
+                          std::string(buffer_side_name(opt_.side)) + " part, the moving copy of " +
+                          describe_node(input_, u.node) + " would move " +
+                          describe_element(input_, u.cell) + " (on the " +
+                          (u.side == InterfaceSide::kHex ? "hex" : "tet") +
+                          " side of the interface there), which " +
+                          (wedge ? "is diced in place" : "stays as meshed from this side"));
+    if (!hex_side_ && !wedge && u.side == InterfaceSide::kHex)
+      kept_tets_.emplace_back(u.cell.index, u.node);
+    if (hex_side_ && wedge) copied_wedges_.emplace_back(u.cell.index, u.node);
+  }
+  std::sort(kept_tets_.begin(), kept_tets_.end());
+  std::sort(copied_wedges_.begin(), copied_wedges_.end());
+}
 
 void BufferBuilder::interface_geometry() {
   corner_normals_.assign(n_moved_, {});
@@ -131,8 +167,8 @@ void BufferBuilder::interface_geometry() {
       const Point n = er.cross(es);
       if (n.norm() <= 0.0)
         throw TopologyError("insert_buffer_layer: interface face " + std::to_string(q.face + 1) +
-                            " of " + describe_element(input_, {ElementKind::kHex, q.hex}) +
-                            " is degenerate at " + describe_node(input_, v));
+                            " of " + describe_element(input_, q.owner()) + " is degenerate at " +
+                            describe_node(input_, v));
       corner_normals_[slot(v)].push_back(into * n.normalized());
       shortest_[slot(v)] = std::min({shortest_[slot(v)], er.norm(), es.norm()});
     }
@@ -174,18 +210,19 @@ void BufferBuilder::moving_part(const Cells& cells, const Edges& edges, const Fa
   outer_normals_.assign(n_moved_, {});
   for (std::size_t c = 0; c < cells.size(); ++c) {
     const auto& cell = cells[c];
+    const auto ci = static_cast<Index>(c);
     bool touches = false;
     for (Index v : cell)
       touches |=
-          moved(v) || (!hex_side_ && centre_of_[static_cast<std::size_t>(v)] != kInvalidIndex);
+          moves(ci, v) || (!hex_side_ && centre_of_[static_cast<std::size_t>(v)] != kInvalidIndex);
     if (!touches) continue;
-    touched_.push_back(static_cast<Index>(c));
+    touched_.push_back(ci);
     for (const auto& e : edges) {
       const Index a = cell[static_cast<std::size_t>(e[0])],
                   b = cell[static_cast<std::size_t>(e[1])];
       const double len = (pt(a) - pt(b)).norm();
       for (Index v : {a, b})
-        if (moved(v)) shortest_[slot(v)] = std::min(shortest_[slot(v)], len);
+        if (moves(ci, v)) shortest_[slot(v)] = std::min(shortest_[slot(v)], len);
     }
     for (std::size_t k = 0; k < nf; ++k) {
       if (uses[static_cast<std::size_t>(face_id[c * nf + k])] != 1)
@@ -196,7 +233,7 @@ void BufferBuilder::moving_part(const Cells& cells, const Edges& edges, const Fa
                              ? Point((pt(f[1]) - pt(f[0])).cross(pt(f[2]) - pt(f[0])))
                              : Point((pt(f[2]) - pt(f[0])).cross(pt(f[kFaceSize - 1]) - pt(f[1])));
       for (Index v : f)
-        if (moved(v)) outer_normals_[slot(v)].push_back(area);
+        if (moves(ci, v)) outer_normals_[slot(v)].push_back(area);
     }
   }
 }
@@ -330,9 +367,14 @@ void BufferBuilder::make_hexes() {
     b.quad = static_cast<Index>(out_.hexes.size());
     out_.hexes.push_back(b);
   }
-  for (auto& t : out_.model.tets)
-    for (Index& v : t)
-      if (moved(v)) v = out_.top_node[static_cast<std::size_t>(v)];
+  for (std::size_t t = 0; t < out_.model.tets.size(); ++t)
+    for (Index& v : out_.model.tets[t])
+      if (moved(v) && !std::binary_search(kept_tets_.begin(), kept_tets_.end(),
+                                          std::pair<Index, Index>{static_cast<Index>(t), v}))
+        v = out_.top_node[static_cast<std::size_t>(v)];
+  for (const auto& [w, v] : copied_wedges_)
+    for (Index& x : out_.model.wedges[static_cast<std::size_t>(w)])
+      if (x == v) x = out_.top_node[static_cast<std::size_t>(v)];
 }
 
 // Points at the current steps: the moving copy of each interface node steps along its
@@ -422,7 +464,7 @@ std::string BufferBuilder::check(std::vector<char>& failing) {
       if (ratio < opt_.min_volume_ratio) {
         for (Index v : now) fail_node(v);
         for (Index v : tet)
-          if (moved(v) || centre_of_[static_cast<std::size_t>(v)] != kInvalidIndex)
+          if (moves(t, v) || centre_of_[static_cast<std::size_t>(v)] != kInvalidIndex)
             keeps_only(ElementKind::kTet, t, ratio, "volume", v);
       }
     }
@@ -449,8 +491,8 @@ std::string BufferBuilder::check(std::vector<char>& failing) {
           const InterfaceQuad& q = itf_.quads[static_cast<std::size_t>(b.quad)];
           first_failure = describe_node(input_, b.corners[i - 4]) + ": the buffer hex on face " +
                           std::to_string(q.face + 1) + " of " +
-                          describe_element(input_, {ElementKind::kHex, q.hex}) +
-                          " has scaled Jacobian " + std::to_string(sj);
+                          describe_element(input_, q.owner()) + " has scaled Jacobian " +
+                          std::to_string(sj);
         }
       }
   }
@@ -495,6 +537,7 @@ BufferLayer BufferBuilder::run() {
   out_.top_node.assign(n_points_, kInvalidIndex);
   for (std::size_t k = 0; k < n_moved_; ++k)
     out_.top_node[static_cast<std::size_t>(itf_.nodes[k])] = static_cast<Index>(n_points_ + k);
+  sides();
   interface_geometry();
   std::vector<std::pair<Index, int>> interface_faces;  // (cell, local face) of the moving part
   for (const InterfaceQuad& q : itf_.quads) {

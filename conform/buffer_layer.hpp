@@ -113,18 +113,23 @@ struct BufferLayerReport {
 
 struct BufferLayer {
   // The input model with one part shrunk: one duplicate per interface node appended to the
-  // points (model.points[top_node[v]]), every tet renumbered to the duplicates. Carved from the
-  // hex part, the hex-side nodes (the input's ids) have moved and the duplicates stand where
-  // the interface was; from the tet part, the duplicates and the centre nodes of four-triangle
-  // quads have moved. Hexes, blocks, node sets (which keep the hex-side nodes) and side sets
-  // are unchanged; the buffer hexes are not in it.
+  // points (model.points[top_node[v]]), the cells on the tet side of the interface at a node
+  // (primal::InterfaceSide: the tets, and wedges beside them) renumbered to its duplicate. Carved
+  // from the hex part, the hex-side nodes (the input's ids) have moved and the duplicates stand
+  // where the interface was; from the tet part, the duplicates and the centre nodes of
+  // four-triangle quads have moved. Hexes, blocks, node sets (which keep the hex-side nodes) and
+  // side sets are unchanged; the buffer hexes are not in it.
   Model model;
   std::vector<Index> top_node;   // per input node: its tet-side duplicate or kInvalidIndex
   std::vector<BufferHex> hexes;  // one per interface quad, in Interface::quads order
   BufferLayerReport report;
 };
 
-// Throws TopologyError naming the node (and the element) where no valid layer can be placed:
+// Wedges are diced in place and never moved: an interface quad of a wedge, or a tet on the hex
+// side of a node (Interface::uses), needs the layer carved from the tet part; a wedge on the
+// tet side of a node needs it carved from the hex part.
+// Throws TopologyError naming the node (and the element) where no valid layer can be placed
+// (a wedge the moving copy would move, named with the node);
 // no direction sees all interface faces at a node (the paper's Figure 9 right), a node at a
 // corner of the moving part's outer boundary, or an element still inverted / collapsed after
 // max_halvings halvings; InvalidInput for a thickness below 0 or above max_buffer_thickness.

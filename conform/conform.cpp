@@ -144,7 +144,6 @@ class Conformer {
 
   void find_interface();
   std::vector<double> local_minima(const std::vector<double>& tet) const;
-  void check_wedges() const;
   void insert_buffer();
   void dice_and_merge();
   void place_templates();
@@ -191,7 +190,7 @@ class Conformer {
   // by BufferLayerOptions::side), whose block its geode hexes join by default: they fill space
   // that part had.
   std::vector<primal::ElementRef> carved_from_;
-  std::vector<double> hex_diced_, tet_diced_;  // per input hex and tet: diced alone
+  std::vector<double> hex_diced_, tet_diced_, wedge_diced_;  // per input cell: diced alone
   std::vector<double> tet_given_;  // per input tet: diced alone where the caller gave it
   // What aims() reads: the yardstick and the local yardsticks of the cells as diced (above the
   // reported ones where conform relaxed the tets).
@@ -223,13 +222,18 @@ void Conformer::find_interface() {
         *std::min_element(tet_given_.begin(), tet_given_.end());
   res_.input_diced_wedge_min_scaled_jacobian =
       primal::diced_wedge_min_scaled_jacobian(input_.points, input_.wedges);
-  // A model without a hex part or a tet part has no transition to make: it is simply diced.
-  if (!input_.hexes.empty() && !input_.tets.empty())
+  // A model without tets, or without hexes and wedges, has no transition to make: it is simply
+  // diced. Wedges are the hex part's where their quads meet tet triangles (a pyramid on a
+  // wedge, split), and find_interface refuses a wedge joining the two sides around a node.
+  if ((!input_.hexes.empty() || !input_.wedges.empty()) && !input_.tets.empty())
     interface_ = primal::find_interface(input_, options_.interface_tolerance);
   // Both parts but no shared quad: the parts were meshed apart (unmerged nodes, a gap).
   if (!input_.hexes.empty() && !input_.tets.empty() && interface_.quads.empty())
     throw InvalidInput("conform: the hex part and the tet part share no interface quad");
-  check_wedges();
+  wedge_diced_.reserve(input_.wedges.size());
+  for (std::size_t w = 0; w < input_.wedges.size(); ++w)
+    wedge_diced_.push_back(
+        primal::diced_wedge_min_scaled_jacobian(input_.points, std::span(&input_.wedges[w], 1)));
   res_.local_yardstick = local_minima(tet_given_);
   aim_local_ = local_minima(tet_diced_);
   aim_yardstick_ = std::min(
@@ -240,7 +244,8 @@ void Conformer::find_interface() {
 }
 
 // The local yardstick per interface quad, with the tets diced as `tet` gives: per interface
-// node the lowest element around it, per quad over its nodes.
+// node the lowest element around it (hexes, tets and wedges diced alone), per quad over its
+// nodes.
 std::vector<double> Conformer::local_minima(const std::vector<double>& tet) const {
   std::vector<double> node_min(input_.points.size(), 1.0);
   for (std::size_t h = 0; h < input_.hexes.size(); ++h)
@@ -251,6 +256,10 @@ std::vector<double> Conformer::local_minima(const std::vector<double>& tet) cons
     for (Index v : input_.tets[t])
       node_min[static_cast<std::size_t>(v)] =
           std::min(node_min[static_cast<std::size_t>(v)], tet[t]);
+  for (std::size_t w = 0; w < input_.wedges.size(); ++w)
+    for (Index v : input_.wedges[w])
+      node_min[static_cast<std::size_t>(v)] =
+          std::min(node_min[static_cast<std::size_t>(v)], wedge_diced_[w]);
   std::vector<double> local;
   local.reserve(interface_.quads.size());
   for (const primal::InterfaceQuad& q : interface_.quads) {
@@ -260,47 +269,6 @@ std::vector<double> Conformer::local_minima(const std::vector<double>& tet) cons
     local.push_back(m);
   }
   return local;
-}
-
-// Wedges are diced in place (6 hexes each, their faces matching the diced hexes and tets
-// beside them), never moved: a wedge quad meeting two tet triangles (a pyramid split on a
-// wedge) would need the transition carved beside a wedge, and a wedge at a node of the hex/tet
-// interface would be torn by the buffer layer's duplicated nodes. Both are refused, naming the
-// wedge, until the buffer layer carves next to wedges.
-void Conformer::check_wedges() const {
-  if (input_.wedges.empty()) return;
-  std::vector<char> on_interface(input_.points.size(), 0);
-  for (Index v : interface_.nodes) on_interface[static_cast<std::size_t>(v)] = 1;
-  const primal::FaceOwners faces(input_);
-  const auto& topo = primal::cell_topology(primal::ElementKind::kWedge);
-  for (std::size_t w = 0; w < input_.wedges.size(); ++w) {
-    const primal::ElementRef ref{primal::ElementKind::kWedge, static_cast<Index>(w)};
-    const auto& c = input_.wedges[w];
-    for (Index v : c)
-      if (on_interface[static_cast<std::size_t>(v)])
-        throw TopologyError(
-            "conform: " + primal::describe_element(input_, ref) +
-            " touches the hex/tet interface at " + primal::describe_node(input_, v) +
-            "; a transition beside wedges is not supported yet (the wedge is diced in place)");
-    for (int f = 0; f < topo.faces; ++f) {
-      const auto& face = topo.face[static_cast<std::size_t>(f)];
-      if (face.size != 4) continue;
-      const auto q = [&](int k) {
-        return c[static_cast<std::size_t>(face.corners[static_cast<std::size_t>(k)])];
-      };
-      for (int d = 0; d < 2; ++d) {
-        const std::array<Index, 3> tri{q(d), q(d + 1), q(d + 2)};
-        const primal::Side* owner = faces.find(tri);
-        if (owner && owner->element.kind == primal::ElementKind::kTet)
-          throw TopologyError(
-              "conform: face " + std::to_string(f + 1) + " of " +
-              primal::describe_element(input_, ref) + " (nodes " +
-              primal::node_list(input_, std::array<Index, 4>{q(0), q(1), q(2), q(3)}) +
-              ") meets the triangles of " + primal::describe_element(input_, owner->element) +
-              " (a pyramid on the wedge, split); a transition beside wedges is not supported yet");
-      }
-    }
-  }
 }
 
 void Conformer::insert_buffer() {
@@ -338,7 +306,7 @@ void Conformer::insert_buffer() {
   for (const BufferHex& b : layer_.hexes) {
     const primal::InterfaceQuad& q = interface_.quads[b.quad];
     carved_from_.push_back(res_.buffer_side == BufferSide::kHex
-                               ? primal::ElementRef{primal::ElementKind::kHex, q.hex}
+                               ? q.owner()
                                : primal::ElementRef{primal::ElementKind::kTet, q.tets[0]});
   }
   interface_ = {};
@@ -928,6 +896,10 @@ void Conformer::verify() {
       if (primal::block_of(input_, {primal::ElementKind::kTet, static_cast<Index>(t)}) == id)
         q.input_diced_min_scaled_jacobian =
             std::min(q.input_diced_min_scaled_jacobian, tet_given_[t]);
+    for (std::size_t w = 0; w < input_.wedges.size(); ++w)
+      if (primal::block_of(input_, {primal::ElementKind::kWedge, static_cast<Index>(w)}) == id)
+        q.input_diced_min_scaled_jacobian =
+            std::min(q.input_diced_min_scaled_jacobian, wedge_diced_[w]);
     res_.quality.push_back(std::move(q));
   }
   // The geode hexes against their local yardsticks, per block and over all.

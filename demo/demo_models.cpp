@@ -769,6 +769,64 @@ Model demo_boundary_layer(int n) {
   });
 }
 
+Model demo_layer_side(int n) {
+  if (n < 1) throw InvalidInput("demo_layer_side: n = " + std::to_string(n) + " must be >= 1");
+  const double h = 1.0 / n;
+  return hybrid_gmsh("demo_layer_side", [&] {
+    // A Delaunay tet box [0,1]^3 with 3 graded layers of wedges extruded 0.2 off its top, and a
+    // Delaunay slab swept off the layer's side x = 1 (0.5 long, no layers): the slab's tets meet
+    // the layer's side quads, so Gmsh puts a pyramid on each, as beside a boundary layer that
+    // ends inside the domain.
+    const int box = gmsh::model::occ::addBox(0, 0, 0, 1, 1, 1);
+    gmsh::model::occ::synchronize();
+    int top = 0;
+    for (int s : boundary_surfaces(box))
+      if (bounding_box(2, s)[2] > 1.0 - kEps) top = s;
+    gmsh::vectorpair layer;
+    gmsh::model::occ::extrude({{2, top}}, 0, 0, 0.2, layer, {1, 1, 1}, {0.2, 0.5, 1.0}, true);
+    gmsh::model::occ::synchronize();
+    int wedges = 0;
+    for (const auto& [dim, tag] : layer)
+      if (dim == 3) wedges = tag;
+    int side = 0;
+    for (int s : boundary_surfaces(wedges)) {
+      const Box b = bounding_box(2, s);
+      if (b[0] > 1.0 - kEps && b[3] < 1.0 + kEps) side = s;
+    }
+    gmsh::vectorpair slab;
+    gmsh::model::occ::extrude({{2, side}}, 0.5, 0, 0, slab);
+    gmsh::model::occ::synchronize();
+    gmsh::option::setNumber("Mesh.MeshSizeMax", h);
+    name_volume(box, 2, "tet");
+    name_volume(wedges, 4, "boundary layer");
+    for (const auto& [dim, tag] : slab)
+      if (dim == 3) name_volume(tag, 5, "tet slab");
+  });
+}
+
+Model demo_layer_interface(int n) {
+  if (n < 1) throw InvalidInput("demo_layer_interface: n = " + std::to_string(n) + " must be >= 1");
+  const double h = 1.0 / n;
+  return hybrid_gmsh("demo_layer_interface", [&] {
+    // A transfinite hex box [0,1]^3 beside a Delaunay tet box [1,2] x [0,1]^2 (pyramids on the
+    // shared face), and 3 graded layers of wedges extruded 0.2 off the tet box's top: the
+    // layer's edge x = 1 lies on the hex/tet interface's top edge.
+    const auto v = shared_boxes({{0, 0, 0, 1, 1, 1}, {1, 0, 0, 1, 1, 1}});
+    transfinite_box(v[0], h);
+    int top = 0;
+    for (int s : boundary_surfaces(v[1]))
+      if (bounding_box(2, s)[2] > 1.0 - kEps) top = s;
+    gmsh::vectorpair layer;
+    gmsh::model::occ::extrude({{2, top}}, 0, 0, 0.2, layer, {1, 1, 1}, {0.2, 0.5, 1.0}, true);
+    gmsh::model::occ::synchronize();
+    gmsh::option::setNumber("Mesh.MeshSizeMax", h);
+    name_volume(v[0], 1, "hex");
+    name_volume(v[1], 2, "tet");
+    for (const auto& [dim, tag] : layer)
+      if (dim == 3) name_volume(tag, 4, "boundary layer");
+  });
+}
+
 Model demo_hexdominant(int n) {
   if (n < 1) throw InvalidInput("demo_hexdominant: n = " + std::to_string(n) + " must be >= 1");
   const double h = 1.0 / n;
@@ -982,7 +1040,8 @@ const std::vector<std::string>& demo_model_names() {
                                               "cylinder",    "lshape",          "nugget",
                                               "fulcher",     "fourtri",         "fourtri-cylinder",
                                               "hybrid",      "hybrid-cylinder", "boundary-layer",
-                                              "hexdominant", "potting"};
+                                              "hexdominant", "layer-side",      "layer-interface",
+                                              "potting"};
   return names;
 }
 
@@ -1000,6 +1059,8 @@ Model demo_model(const std::string& name, int n) {
   if (name == "hybrid-cylinder") return demo_hybrid_cylinder(n);
   if (name == "boundary-layer") return demo_boundary_layer(n);
   if (name == "hexdominant") return demo_hexdominant(n);
+  if (name == "layer-side") return demo_layer_side(n);
+  if (name == "layer-interface") return demo_layer_interface(n);
   if (name == "potting") return demo_potting(n);
   std::string names;
   for (const std::string& known : demo_model_names()) names += (names.empty() ? "" : ", ") + known;

@@ -82,6 +82,16 @@ Model demo_boundary_layer(int n = 4);
 // 0.15 off its face x = 2 (block 4 "wedge layer"). (Debian's Gmsh 4.8 Mesh.Recombine3DAll
 // gave only tets or crashed, so the kinds come from transfinite, extruded and Delaunay volumes.)
 Model demo_hexdominant(int n = 4);
+// layer-side: a Delaunay tet box [0,1]^3 (block 2 "tet"), 3 graded layers of wedges extruded
+// 0.2 off its top (block 4 "boundary layer") and a Delaunay slab [1,1.5] x [0,1] x [1,1.2]
+// swept off the layer's side (block 5 "tet slab"): Gmsh puts a pyramid on every wedge quad
+// the slab meets, so wedge quads meet tet triangles (the transition beside wedges).
+Model demo_layer_side(int n = 4);
+// layer-interface: a transfinite hex box [0,1]^3 (block 1 "hex") beside a Delaunay tet box
+// [1,2] x [0,1]^2 (block 2 "tet", pyramids on the shared face), 3 graded layers of wedges
+// extruded 0.2 off the tet box's top (block 4 "boundary layer"): wedges at the nodes of the
+// hex/tet interface's top edge.
+Model demo_layer_interface(int n = 4);
 
 // (f) The paper's proposed example, the complement of simple parts: six hex parts in a tet potting
 // box [0, 6.2] x [0, 4.4] x [0, 2.2] (block 7 "potting", Delaunay): a cube (block 1
@@ -101,7 +111,8 @@ Model demo_wedge(int n, double angle);
 // The names `geode demo --model` takes: half, delaunay, delaunay-random, cylinder, lshape,
 // nugget (d: a convex Delaunay tet nugget in structured blocks), fulcher (e), fourtri (a,
 // random diagonals, four-triangle quads), fourtri-cylinder (b with four-triangle quads),
-// hybrid, hybrid-cylinder, boundary-layer, hexdominant, potting (f).
+// hybrid, hybrid-cylinder, boundary-layer, hexdominant, layer-side, layer-interface, potting
+// (f).
 const std::vector<std::string>& demo_model_names();
 // The model of that name with size parameter n (made even where the model needs it); throws
 // InvalidInput naming an unknown name.

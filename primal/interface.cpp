@@ -7,6 +7,7 @@
 #include <unordered_set>
 
 #include <geode/primal/boundary.hpp>
+#include <geode/primal/disjoint_sets.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/key_map.hpp>
 #include <geode/primal/topology.hpp>
@@ -27,10 +28,17 @@ struct TriangleUses {
   bool matched = false;  // one of the two triangles of an interface quad
 };
 
+// A boundary quad of the hex part: a hex's, or a wedge's quad face used by no other cell of
+// the hex part.
+struct PartQuad {
+  ElementRef cell;
+  int face = -1;
+  std::array<Index, 4> nodes{};  // outward of the cell
+};
+
 // Messages speak in the file's ids (model.hpp: describe_element, node_list).
-std::string quad_name(const Model& model, Index hex, const std::array<Index, 4>& corners) {
-  return describe_element(model, {ElementKind::kHex, hex}) + " face (nodes " +
-         node_list(model, corners) + ")";
+std::string quad_name(const Model& model, ElementRef cell, const std::array<Index, 4>& corners) {
+  return describe_element(model, cell) + " face (nodes " + node_list(model, corners) + ")";
 }
 
 std::string tet_face_name(const Model& model, const TetFaceUse& use) {
@@ -88,6 +96,136 @@ std::array<std::array<Index, 3>, 2> split(const std::array<Index, 4>& c, int dia
   return {{{c[0], c[1], c[3]}, {c[1], c[2], c[3]}}};
 }
 
+// The hex part's boundary quads: the hexes' (boundary_quads' order), then the wedges' quad
+// faces that no hex or other wedge shares, in wedge order.
+std::vector<PartQuad> part_quads(const Model& model) {
+  std::vector<PartQuad> out;
+  for (const BoundaryQuad& q : boundary_quads(hex_part(model)))
+    out.push_back({{ElementKind::kHex, q.hex}, q.local_face, q.nodes});
+  if (model.wedges.empty()) return out;
+  const auto& faces = cell_topology(ElementKind::kWedge).face;
+  auto quad = [&](std::size_t w, const auto& f) {
+    std::array<Index, 4> c{};
+    for (std::size_t i = 0; i < 4; ++i)
+      c[i] = model.wedges[w][static_cast<std::size_t>(f.corners[i])];
+    return c;
+  };
+  KeyMap<4> uses(3 * model.wedges.size());
+  std::vector<Index> count;
+  for (std::size_t w = 0; w < model.wedges.size(); ++w)
+    for (const auto& f : faces)
+      if (f.size == 4) {
+        const auto [id, fresh] =
+            uses.try_emplace(face_key(quad(w, f)), static_cast<Index>(count.size()));
+        if (fresh) count.push_back(0);
+        ++count[static_cast<std::size_t>(*id)];
+      }
+  for (const PartQuad& q : out)
+    if (const Index* id = uses.find(face_key(q.nodes))) ++count[static_cast<std::size_t>(*id)];
+  for (std::size_t w = 0; w < model.wedges.size(); ++w)
+    for (std::size_t f = 0; f < faces.size(); ++f)
+      if (faces[f].size == 4) {
+        const auto c = quad(w, faces[f]);
+        if (count[static_cast<std::size_t>(*uses.find(face_key(c)))] == 1)
+          out.push_back({{ElementKind::kWedge, static_cast<Index>(w)}, static_cast<int>(f), c});
+      }
+  return out;
+}
+
+// Which copy of each interface node the tets and wedges around it take (InterfaceSide): per
+// node, its cells joined across the faces they share at the node; refuses a set of cells
+// joined to both sides, naming a wedge of it (only a wedge, sharing quads with the hex part
+// and triangles with the tet part, can join them).
+std::vector<InterfaceNodeUse> node_uses(const Model& model, const Interface& itf) {
+  std::vector<InterfaceNodeUse> out;
+  if (itf.nodes.empty()) return out;
+  std::vector<Index> slot(model.points.size(), kInvalidIndex);
+  for (std::size_t k = 0; k < itf.nodes.size(); ++k)
+    slot[static_cast<std::size_t>(itf.nodes[k])] = static_cast<Index>(k);
+  // Per node: its cells (every kind but pyramids, which conform splits first), and the owners
+  // of its interface quads (the hex side) and triangles (the tet side).
+  std::vector<std::vector<ElementRef>> cells(itf.nodes.size()), hex_side(itf.nodes.size()),
+      tet_side(itf.nodes.size());
+  for (ElementKind kind : {ElementKind::kHex, ElementKind::kTet, ElementKind::kWedge})
+    for (std::size_t e = 0; e < element_count(model, kind); ++e) {
+      const ElementRef ref{kind, static_cast<Index>(e)};
+      for (Index v : element_corners(model, ref))
+        if (const Index k = slot[static_cast<std::size_t>(v)]; k != kInvalidIndex)
+          cells[static_cast<std::size_t>(k)].push_back(ref);
+    }
+  for (const InterfaceQuad& q : itf.quads) {
+    for (Index v : q.corners)
+      hex_side[static_cast<std::size_t>(slot[static_cast<std::size_t>(v)])].push_back(q.owner());
+    const auto triangles = interface_triangles(q);
+    for (std::size_t i = 0; i < triangles.size(); ++i)
+      for (Index v : triangles[i])
+        if (const Index k = slot[static_cast<std::size_t>(v)]; k != kInvalidIndex)
+          tet_side[static_cast<std::size_t>(k)].push_back({ElementKind::kTet, q.tets[i]});
+  }
+  DisjointSets sets;
+  std::vector<std::pair<FaceKey, Index>> faces;  // a face at the node -> its first cell
+  for (std::size_t k = 0; k < itf.nodes.size(); ++k) {
+    const Index v = itf.nodes[k];
+    const auto& at = cells[k];
+    sets.reset(at.size());
+    faces.clear();
+    for (std::size_t c = 0; c < at.size(); ++c) {
+      const auto corners = element_corners(model, at[c]);
+      for (const auto& f : cell_topology(at[c].kind).face) {
+        if (f.size == 0) continue;
+        std::array<Index, 4> nodes{};
+        bool has = false;
+        for (int i = 0; i < f.size; ++i) {
+          nodes[static_cast<std::size_t>(i)] =
+              corners[static_cast<std::size_t>(f.corners[static_cast<std::size_t>(i)])];
+          has |= nodes[static_cast<std::size_t>(i)] == v;
+        }
+        if (!has) continue;
+        const FaceKey key = face_key(std::span<const Index>(nodes.data(), f.size));
+        const auto it =
+            std::find_if(faces.begin(), faces.end(), [&](const auto& e) { return e.first == key; });
+        if (it == faces.end())
+          faces.emplace_back(key, static_cast<Index>(c));
+        else
+          sets.unite(it->second, static_cast<Index>(c));
+      }
+    }
+    // Per set (its root): a hex-side cell and a tet-side cell in it, if any.
+    std::vector<const ElementRef*> hex_in(at.size(), nullptr), tet_in(at.size(), nullptr);
+    auto root_of = [&](const ElementRef& e) {
+      return static_cast<std::size_t>(
+          sets.find(static_cast<Index>(std::find(at.begin(), at.end(), e) - at.begin())));
+    };
+    for (const ElementRef& e : hex_side[k]) hex_in[root_of(e)] = &e;
+    for (std::size_t c = 0; c < at.size(); ++c)
+      if (at[c].kind == ElementKind::kHex) hex_in[root_of(at[c])] = &at[c];
+    for (const ElementRef& e : tet_side[k]) tet_in[root_of(e)] = &e;
+    for (std::size_t c = 0; c < at.size(); ++c) {
+      const std::size_t r = root_of(at[c]);
+      if (hex_in[r] && tet_in[r]) {
+        const auto wedge = std::find_if(at.begin(), at.end(), [&](const ElementRef& e) {
+          return e.kind == ElementKind::kWedge && root_of(e) == r;
+        });
+        throw TopologyError(
+            "find_interface: " + describe_element(model, wedge != at.end() ? *wedge : at[c]) +
+            " joins the two sides of the hex/tet interface at " + describe_node(model, v) +
+            ": through the faces the cells share at that node it connects " +
+            describe_element(model, *hex_in[r]) + " on the interface's quad side to " +
+            describe_element(model, *tet_in[r]) +
+            " on its triangle side, so the interface ends inside the mesh there, and no buffer "
+            "layer can end at that node (one ends only where the interface meets the model "
+            "boundary)");
+      }
+      if (at[c].kind == ElementKind::kHex) continue;
+      out.push_back({at[c], v,
+                     hex_in[r]   ? InterfaceSide::kHex
+                     : tet_in[r] ? InterfaceSide::kTet
+                                 : InterfaceSide::kLoose});
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 std::vector<std::array<Index, 3>> interface_triangles(const InterfaceQuad& q) {
@@ -105,6 +243,7 @@ Interface find_interface(const Model& model, double tol) {
   validate(model, "find_interface");
   refuse_duplicates(model, model.hexes, ElementKind::kHex);
   refuse_duplicates(model, model.tets, ElementKind::kTet);
+  refuse_duplicates(model, model.wedges, ElementKind::kWedge);
   const auto& P = model.points;
   auto pt = [&](Index v) -> const Point& { return P[static_cast<std::size_t>(v)]; };
 
@@ -170,11 +309,10 @@ Interface find_interface(const Model& model, double tol) {
     return best;
   };
 
-  const HexMesh hexes = hex_part(model);
-  const auto quads = boundary_quads(hexes);
+  const std::vector<PartQuad> quads = part_quads(model);
   Interface out;
-  std::vector<const BoundaryQuad*> unmatched_quads;
-  for (const BoundaryQuad& bq : quads) {
+  std::vector<const PartQuad*> unmatched_quads;
+  for (const PartQuad& bq : quads) {
     const auto& c = bq.nodes;
     const std::array<std::array<std::array<Index, 3>, 2>, 2> splits{split(c, 0), split(c, 1)};
     std::array<std::array<const TetFaceUse*, 2>, 2> found{};
@@ -192,7 +330,7 @@ Interface find_interface(const Model& model, double tol) {
       unmatched_quads.push_back(&bq);
       continue;
     }
-    const std::string name = quad_name(model, bq.hex, c);
+    const std::string name = quad_name(model, bq.cell, c);
     if (centre != kInvalidIndex && in_hex[static_cast<std::size_t>(centre)])
       throw TopologyError("find_interface: " + name + " is split into four triangles around " +
                           describe_node(model, centre) + ", a node of the hex part too");
@@ -237,8 +375,9 @@ Interface find_interface(const Model& model, double tol) {
                           ": " + detail);
     }
     InterfaceQuad q;
-    q.hex = bq.hex;
-    q.face = bq.local_face;
+    q.kind = bq.cell.kind;
+    q.hex = bq.cell.index;
+    q.face = bq.face;
     q.corners = c;
     q.diagonal = d0 ? 0 : 1;
     q.centre = centre;
@@ -269,8 +408,8 @@ Interface find_interface(const Model& model, double tol) {
 
   // Node-wise conformity: a node of one side must not lie on a face of the other side that
   // does not have it as a corner. Candidates are unmatched boundary faces sharing a node.
-  std::unordered_map<Index, std::vector<const BoundaryQuad*>> quads_at;
-  for (const BoundaryQuad* bq : unmatched_quads)
+  std::unordered_map<Index, std::vector<const PartQuad*>> quads_at;
+  for (const PartQuad* bq : unmatched_quads)
     for (Index v : bq->nodes) quads_at[v].push_back(bq);
   // In tet order, so that the first offence reported does not depend on hashing.
   for (std::size_t t = 0; t < model.tets.size(); ++t)
@@ -278,11 +417,11 @@ Interface find_interface(const Model& model, double tol) {
       const TriangleUses& uses = tris[static_cast<std::size_t>(tet_face_tri[4 * t + f])];
       if (uses.count != 1 || uses.matched) continue;
       const TetFaceUse& tri = uses.use[0];
-      std::unordered_set<const BoundaryQuad*> seen;
+      std::unordered_set<const PartQuad*> seen;
       for (Index v : tri.nodes) {
         auto it = quads_at.find(v);
         if (it == quads_at.end()) continue;
-        for (const BoundaryQuad* bq : it->second) {
+        for (const PartQuad* bq : it->second) {
           if (!seen.insert(bq).second) continue;
           const auto& c = bq->nodes;
           auto has = [](auto& arr, Index x) {
@@ -297,7 +436,7 @@ Interface find_interface(const Model& model, double tol) {
               throw TopologyError(
                   "find_interface: " + describe_node(model, p) + " of the tet part (" +
                   describe_element(model, {ElementKind::kTet, tri.tet}) + ") lies on " +
-                  quad_name(model, bq->hex, c) +
+                  quad_name(model, bq->cell, c) +
                   " but is not one of its corners: the parts do not conform node-wise");
           }
           for (Index p : c) {
@@ -305,8 +444,7 @@ Interface find_interface(const Model& model, double tol) {
             if (on_triangle(pt(p), pt(tri.nodes[0]), pt(tri.nodes[1]), pt(tri.nodes[2]), tol))
               throw TopologyError(
                   "find_interface: " + describe_node(model, p) + " of the hex part (" +
-                  describe_element(model, {ElementKind::kHex, bq->hex}) + ") lies on " +
-                  tet_face_name(model, tri) +
+                  describe_element(model, bq->cell) + ") lies on " + tet_face_name(model, tri) +
                   " but is not one of its corners: the parts do not conform node-wise");
           }
         }
@@ -328,6 +466,7 @@ Interface find_interface(const Model& model, double tol) {
       throw TopologyError("find_interface: " + describe_node(model, static_cast<Index>(v)) +
                           " is used by both the hex and the tet part but lies on no interface quad "
                           "(the parts touch along an edge or at a point only)");
+  out.uses = node_uses(model, out);
   return out;
 }
 

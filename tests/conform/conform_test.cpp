@@ -7,7 +7,9 @@
 #include <unistd.h>
 #include <thread>
 
+#include <cmath>
 #include <filesystem>
+#include <functional>
 #include <set>
 
 #include <tbb/global_control.h>
@@ -19,6 +21,7 @@
 #include <geode/primal/boundary.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/grid_model.hpp>
+#include <geode/primal/interface.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/topology.hpp>
 #include "support/conform_checks.hpp"
@@ -26,6 +29,7 @@
 
 using namespace geode;
 using primal::Index;
+using primal::Point;
 
 namespace {
 
@@ -242,33 +246,145 @@ TEST_CASE("conform dices a model without both parts, and refuses an empty one") 
   CHECK_THROWS_AS(conform::conform(primal::Model{}), InvalidInput);
 }
 
-TEST_CASE("conform refuses a wedge at the hex/tet interface, naming the wedge") {
-  // A hex cell beside a tet cell (grid_model), and a wedge extruded up off a top triangle of the
-  // tet part that touches the interface plane x = 1: the buffer layer would tear it.
-  primal::Model m = primal::grid_model({2, 1, 1}, 1.0, [](int i, int, int) { return i == 1; });
-  std::array<Index, 3> tri{-1, -1, -1};
+namespace {
+
+// The top triangles (all nodes at z = z0, outward: counter-clockwise seen from above) of the
+// tets of m whose nodes satisfy `keep`.
+std::vector<std::array<Index, 3>> top_triangles(const primal::Model& m, double z0,
+                                                const std::function<bool(const Point&)>& keep) {
+  std::vector<std::array<Index, 3>> out;
   for (const auto& t : m.tets)
     for (const auto& f : primal::topology::kTetFaceCorners) {
       const std::array<Index, 3> c{t[static_cast<std::size_t>(f[0])],
                                    t[static_cast<std::size_t>(f[1])],
                                    t[static_cast<std::size_t>(f[2])]};
-      bool top = true, at_interface = false;
+      bool top = true;
       for (Index v : c) {
-        top = top && m.points[static_cast<std::size_t>(v)].z() > 1.0 - 1e-12;
-        at_interface = at_interface || m.points[static_cast<std::size_t>(v)].x() < 1.0 + 1e-12;
+        const Point& p = m.points[static_cast<std::size_t>(v)];
+        top = top && std::abs(p.z() - z0) < 1e-12 && keep(p);
       }
-      if (top && at_interface && tri[0] < 0) tri = c;  // outward: counter-clockwise seen from above
+      if (top) out.push_back(c);
     }
-  REQUIRE(tri[0] >= 0);
+  return out;
+}
+
+// The wedge standing on triangle `tri` (outward of the tet below it), its top corners up(v).
+std::array<Index, 6> wedge_on(const std::array<Index, 3>& tri,
+                              const std::function<Index(Index)>& up) {
   std::array<Index, 6> w{tri[0], tri[1], tri[2], 0, 0, 0};
-  for (int k = 0; k < 3; ++k) {
-    w[static_cast<std::size_t>(3 + k)] = static_cast<Index>(m.points.size());
-    m.points.push_back(m.points[static_cast<std::size_t>(tri[static_cast<std::size_t>(k)])] +
-                       primal::Point(0, 0, 0.5));
-  }
-  m.wedges.push_back(w);
+  for (std::size_t k = 0; k < 3; ++k) w[3 + k] = up(tri[k]);
+  return w;
+}
+
+}  // namespace
+
+TEST_CASE("conform: a wedge on the tet side of an interface node takes the node's copy") {
+  // A hex cell beside a tet cell (grid_model), and a wedge extruded up off a top triangle of the
+  // tet part that touches the interface plane x = 1 at its top edge: around those nodes the
+  // wedge is joined to the tets (their shared triangle), so it takes the buffer layer's copy
+  // of the node, which stays in place when the layer is carved from the hex part.
+  primal::Model m = primal::grid_model({2, 1, 1}, 1.0, [](int i, int, int) { return i == 1; });
+  std::array<Index, 3> tri{-1, -1, -1};
+  for (const auto& c : top_triangles(m, 1.0, [](const Point&) { return true; }))
+    for (Index v : c)
+      if (m.points[static_cast<std::size_t>(v)].x() < 1.0 + 1e-12 && tri[0] < 0) tri = c;
+  REQUIRE(tri[0] >= 0);
+  m.wedges.push_back(wedge_on(tri, [&](Index v) {
+    m.points.push_back(m.points[static_cast<std::size_t>(v)] + Point(0, 0, 0.5));
+    return static_cast<Index>(m.points.size() - 1);
+  }));
   REQUIRE_NOTHROW(primal::check_geometry(m, "w.msh"));
-  CHECK_THROWS_WITH_AS(conform::conform(m), doctest::Contains("wedge 1 (centre"), TopologyError);
-  CHECK_THROWS_WITH_AS(conform::conform(m), doctest::Contains("touches the hex/tet interface"),
+  const conform::ConformResult r = conform::conform(m);
+  test::check_conform_result(r);
+  CHECK(r.buffer_side == conform::BufferSide::kHex);
+  CHECK(r.interface_quads == 1);
+  CHECK(r.diced_wedge_hexes == 6);
+  // The wedge is diced in place: its 6 hexes (the last ones) fill its own volume.
+  const auto& w = m.wedges.front();
+  const auto p = [&](std::size_t k) { return m.points[static_cast<std::size_t>(w[k])]; };
+  const double wedge_volume = 0.5 * 0.5 * (p(1) - p(0)).cross(p(2) - p(0)).norm();
+  const primal::HexMesh out = primal::hex_part(r.model);
+  double diced = 0.0;
+  for (std::size_t h = out.hexes.size() - 6; h < out.hexes.size(); ++h)
+    diced += primal::hex_volume(primal::hex_corners(out, static_cast<Index>(h)));
+  CHECK(diced == doctest::Approx(wedge_volume).epsilon(1e-9));
+  // Carved from the tet part, the moving copy would move the wedge: refused naming it (file
+  // id 1), then carved from the hex part with that reason as a warning.
+  conform::ConformOptions o;
+  o.buffer.side = conform::BufferSide::kTet;
+  const conform::ConformResult t = conform::conform(m, o);
+  CHECK(t.buffer_side == conform::BufferSide::kHex);
+  REQUIRE(t.warnings.size() == 1);
+  CHECK(t.warnings.front().find("would move wedge 1 (centre") != std::string::npos);
+  o.buffer_fallback = false;
+  CHECK_THROWS_WITH_AS(conform::conform(m, o), doctest::Contains("which is diced in place"),
                        TopologyError);
+}
+
+TEST_CASE("conform refuses a wedge joining the two sides of an interface node, naming it") {
+  // Hexes at (0,0,0) and (0,0,1), tets at (1,0,0), and the cell (1,0,1) as two wedges standing
+  // on the tets' top triangles: around the nodes of the interface's top edge the wedges share
+  // a quad with the upper hex and triangles with the tets, so the interface x = 1 ends inside
+  // the mesh there, where no buffer layer can end.
+  primal::Model m =
+      primal::grid_model({2, 1, 2}, 1.0, [](int i, int, int k) { return i == 1 && k == 0; });
+  std::size_t upper = m.hexes.size();
+  for (std::size_t h = 0; h < m.hexes.size(); ++h) {
+    Point c = Point::Zero();
+    for (Index v : m.hexes[h]) c += m.points[static_cast<std::size_t>(v)] / 8.0;
+    if (c.x() > 1.0 && c.z() > 1.0) upper = h;
+  }
+  REQUIRE(upper < m.hexes.size());
+  const auto hex = m.hexes[upper];
+  m.hexes.erase(m.hexes.begin() + static_cast<std::ptrdiff_t>(upper));
+  m.hex_block.erase(m.hex_block.begin() + static_cast<std::ptrdiff_t>(upper));
+  const auto tris = top_triangles(m, 1.0, [](const Point& p) { return p.x() > 1.0 - 1e-12; });
+  REQUIRE(tris.size() == 2);
+  for (const auto& tri : tris)
+    m.wedges.push_back(wedge_on(tri, [&](Index v) {
+      const Point above = m.points[static_cast<std::size_t>(v)] + Point(0, 0, 1);
+      for (Index x : hex)
+        if ((m.points[static_cast<std::size_t>(x)] - above).norm() < 1e-12) return x;
+      return primal::kInvalidIndex;
+    }));
+  REQUIRE_NOTHROW(primal::check_geometry(m, "w.msh"));
+  CHECK_THROWS_WITH_AS(conform::conform(m),
+                       doctest::Contains("joins the two sides of the hex/tet interface at node"),
+                       TopologyError);
+  CHECK_THROWS_WITH_AS(conform::conform(m), doctest::Contains("wedge "), TopologyError);
+}
+
+TEST_CASE("conform: a wedge quad meeting two tet triangles gets the geode transition") {
+  // A hex cell beside a tet cell (grid_model), the hex cell split into two wedges standing on
+  // its bottom face's two triangles: one wedge's quad x = 1 meets the tets' two triangles (what
+  // a pyramid on a wedge leaves once split), an interface quad as a hex's would be.
+  primal::Model m = primal::grid_model({2, 1, 1}, 1.0, [](int i, int, int) { return i == 1; });
+  REQUIRE(m.hexes.size() == 1);
+  const auto h = m.hexes.front();
+  m.hexes.clear();
+  m.hex_block.clear();
+  m.wedges.push_back({h[0], h[1], h[2], h[4], h[5], h[6]});
+  m.wedges.push_back({h[0], h[2], h[3], h[4], h[6], h[7]});
+  REQUIRE_NOTHROW(primal::check_geometry(m, "w.msh"));
+  const primal::Interface itf = primal::find_interface(m);
+  REQUIRE(itf.quads.size() == 1);
+  CHECK(itf.quads.front().kind == primal::ElementKind::kWedge);
+  CHECK(itf.quads.front().hex == 0);
+  CHECK(itf.quads.front().face == 1);  // (1 2 5 4): x = 1
+  // Carved from the tet part (the wedges stay as they are): 26 geode hexes on the quad.
+  conform::ConformOptions o;
+  o.buffer.side = conform::BufferSide::kTet;
+  const conform::ConformResult r = conform::conform(m, o);
+  test::check_conform_result(r);
+  CHECK(r.interface_quads == 1);
+  CHECK(r.geode_hexes == 26);
+  CHECK(r.diced_wedge_hexes == 12);
+  CHECK(r.diced_tet_hexes == 4 * static_cast<Index>(m.tets.size()));
+  // With the defaults (from the hex part) the wedge would move: refused by name, then carved
+  // from the tet part with that reason as a warning.
+  const conform::ConformResult d = conform::conform(m);
+  CHECK(d.buffer_side == conform::BufferSide::kTet);
+  REQUIRE(d.warnings.size() == 1);
+  CHECK(d.warnings.front().find("would move wedge 1 (centre") != std::string::npos);
+  CHECK(primal::min_scaled_jacobian(primal::hex_part(d.model)) > 0.0);
 }

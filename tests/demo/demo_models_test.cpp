@@ -76,10 +76,12 @@ TEST_CASE(
     "buffer carved from the hex part: the tets stay as meshed, geode hexes >= 0.25 on planar "
     "interfaces") {
   // Planar interfaces beside Gmsh Delaunay tets (alternating, random, two- and four-triangle
-  // splits) and beside Kuhn tets. Carved from the hex part, every tet keeps its nodes, so the
-  // diced tets are exactly the input's own (the output's minimum is the yardstick, nothing to
-  // smooth), and the buffer is half a hex edge thick, where the template keeps its quality;
-  // carved from the tet side (0.3 of the edge) the same geode hexes stay below 0.25.
+  // splits) and beside Kuhn tets. Carved from the hex part without tet relaxation
+  // (ConformRelax::kNone), every tet keeps its nodes, so the diced tets are exactly the input's
+  // own (the output's minimum is the yardstick, nothing to smooth), and the buffer is half a hex
+  // edge thick, where the template keeps its quality; carved from the tet side (0.3 of the edge)
+  // the same geode hexes stay below 0.25. With the relaxation (the default) the tets beside the
+  // hex part move and the output's minimum is at least the yardstick.
   const struct {
     const char* name;
     int n;
@@ -96,7 +98,13 @@ TEST_CASE(
     o.smooth = conform::ConformSmooth::kNone;
     o.geode_block = "geode";
     const bool four = std::string(name) == "fourtri";
+    conform::ConformOptions relaxed = o;
+    o.relax = conform::ConformRelax::kNone;
     const auto r = conform::conform(m, o);
+    const auto rr = conform::conform(m, relaxed);
+    test::check_conform_result(rr, four ? mixed_geode_hexes(m) : -1);
+    CHECK(rr.yardstick() == r.yardstick());
+    CHECK(rr.smoothing.final_min_scaled_jacobian >= r.yardstick());
     test::check_conform_result(r, four ? mixed_geode_hexes(m) : -1);
     CHECK(r.templates_settled == 0);
     CHECK(r.smoothing.patches == 0);

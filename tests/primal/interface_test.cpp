@@ -206,3 +206,72 @@ TEST_CASE(
                        InvalidInput);
   CHECK_THROWS_AS(merge_coincident_nodes(m, std::nan("")), InvalidInput);
 }
+
+TEST_CASE(
+    "find_interface: wedge quads meeting tet triangles, and the side of each cell at a node") {
+  // A hex cell beside a tet cell, the hex cell split into two wedges standing on its bottom
+  // face's triangles: one wedge quad (x = 1) meets the tets' two triangles.
+  Model m = grid_model({2, 1, 1}, 1.0, [](int i, int, int) { return i == 1; });
+  const auto h = m.hexes.front();
+  m.hexes.clear();
+  m.hex_block.clear();
+  m.wedges.push_back({h[0], h[1], h[2], h[4], h[5], h[6]});
+  m.wedges.push_back({h[0], h[2], h[3], h[4], h[6], h[7]});
+  const Interface itf = find_interface(m);
+  REQUIRE(itf.quads.size() == 1);
+  const InterfaceQuad& q = itf.quads.front();
+  CHECK(q.owner() == ElementRef{ElementKind::kWedge, 0});
+  CHECK(q.corners == std::array<Index, 4>{h[1], h[2], h[6], h[5]});
+  CHECK(itf.nodes.size() == 4);
+  // Around the quad's nodes: the first wedge (the quad's owner) on the hex side, every tet
+  // there on the tet side (the tets of a cell share faces), the second wedge at the nodes it
+  // has (h[2], h[6]) joined to the first through their diagonal quad: the hex side.
+  std::size_t tets = 0;
+  for (const InterfaceNodeUse& u : itf.uses) {
+    CAPTURE(u.node);
+    CHECK(std::binary_search(itf.nodes.begin(), itf.nodes.end(), u.node));
+    if (u.cell.kind == ElementKind::kTet) {
+      CHECK(u.side == InterfaceSide::kTet);
+      ++tets;
+    } else {
+      CHECK(u.side == InterfaceSide::kHex);
+    }
+  }
+  CHECK(tets > 0);
+  CHECK(std::count_if(itf.uses.begin(), itf.uses.end(), [](const InterfaceNodeUse& u) {
+          return u.cell == ElementRef{ElementKind::kWedge, 1};
+        }) == 2);
+
+  // A wedge on the tets' top face at the interface's top edge (beside a hex cell, not above
+  // it): joined to the tets by its bottom triangle, it is on the tet side at those nodes.
+  Model w = grid_model({2, 1, 1}, 1.0, [](int i, int, int) { return i == 1; });
+  std::array<Index, 3> tri{-1, -1, -1};
+  for (const auto& t : w.tets)
+    for (const auto& f : topology::kTetFaceCorners) {
+      const std::array<Index, 3> c{t[static_cast<std::size_t>(f[0])],
+                                   t[static_cast<std::size_t>(f[1])],
+                                   t[static_cast<std::size_t>(f[2])]};
+      int at_edge = 0;
+      bool top = true;
+      for (Index v : c) {
+        top = top && w.points[static_cast<std::size_t>(v)].z() > 1.0 - 1e-12;
+        at_edge += w.points[static_cast<std::size_t>(v)].x() < 1.0 + 1e-12;
+      }
+      if (top && at_edge == 2) tri = c;
+    }
+  REQUIRE(tri[0] >= 0);
+  std::array<Index, 6> wedge{tri[0], tri[1], tri[2], 0, 0, 0};
+  for (std::size_t k = 0; k < 3; ++k) {
+    wedge[3 + k] = static_cast<Index>(w.points.size());
+    w.points.push_back(w.points[static_cast<std::size_t>(tri[k])] + Point(0, 0, 0.5));
+  }
+  w.wedges.push_back(wedge);
+  const Interface wi = find_interface(w);
+  std::size_t wedge_uses = 0;
+  for (const InterfaceNodeUse& u : wi.uses)
+    if (u.cell.kind == ElementKind::kWedge) {
+      CHECK(u.side == InterfaceSide::kTet);
+      ++wedge_uses;
+    }
+  CHECK(wedge_uses == 2);  // the edge's two nodes
+}
