@@ -992,7 +992,8 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
   }
   primal::RelaxTetsResult relaxation;
   std::vector<primal::Point> given;  // the points before relaxation
-  if (options.relax == ConformRelax::kInterface && !model->hexes.empty() && !model->tets.empty()) {
+  if (options.relax == ConformRelax::kInterface &&
+      (!model->hexes.empty() || !model->wedges.empty()) && !model->tets.empty()) {
     const std::vector<Index> nodes = primal::tet_nodes_to_relax(*model, kRelaxRings);
     if (!nodes.empty()) {
       if (model == &input) own = input;

@@ -63,9 +63,9 @@ enum class ConformPyramids { kSplit };
 ConformPyramids parse_conform_pyramids(const std::string& word);
 
 // Whether the tet mesher's nodes near the hex part move before the buffer layer is carved
-// (primal/relax_tets.hpp): kInterface (default) relaxes the tet nodes within kRelaxRings rings
-// of tets of the hex part that lie inside one tet block (no boundary, material interface or
-// node set moves), raising the lowest diced scaled Jacobian of their tets; kNone keeps every
+// (primal/relax_tets.hpp): kInterface (default) relaxes the tet nodes within two rings of tets
+// of the hex part (hexes and wedges) that lie inside one tet block (no boundary, material interface
+// or node set moves), raising the lowest diced scaled Jacobian of their tets; kNone keeps every
 // input node where it is.
 enum class ConformRelax { kNone, kInterface };
 

@@ -180,10 +180,13 @@ std::vector<Index> tet_nodes_to_relax(const Model& model, int rings) {
     for (Index v : p) fixed[static_cast<std::size_t>(v)] = 1;
   for (const NodeSet& s : model.node_sets)
     for (Index v : s.nodes) fixed[static_cast<std::size_t>(v)] = 1;
-  // The region: rings of tets out from the hex part's nodes.
+  // The region: rings of tets out from the hex part's nodes (hexes and wedges: a wedge's quad
+  // may meet tets too).
   std::vector<char> near(n, 0), in_region(model.tets.size(), 0);
   for (const auto& h : model.hexes)
     for (Index v : h) near[static_cast<std::size_t>(v)] = 1;
+  for (const auto& w : model.wedges)
+    for (Index v : w) near[static_cast<std::size_t>(v)] = 1;
   for (int ring = 0; ring < rings; ++ring) {
     for (std::size_t t = 0; t < model.tets.size(); ++t)
       for (Index v : model.tets[t])
