@@ -1011,6 +1011,7 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
   ConformResult r =
       Conformer(*model, options, model == &own && relaxation.nodes_moved ? &given : nullptr).run();
   r.relaxation = relaxation;
+  r.seconds += relaxation.seconds;
   r.input_pyramids = static_cast<Index>(input.pyramids.size());
   r.input_tets -= 2 * r.input_pyramids;
   return r;

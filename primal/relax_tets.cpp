@@ -180,13 +180,32 @@ std::vector<Index> tet_nodes_to_relax(const Model& model, int rings) {
     for (Index v : p) fixed[static_cast<std::size_t>(v)] = 1;
   for (const NodeSet& s : model.node_sets)
     for (Index v : s.nodes) fixed[static_cast<std::size_t>(v)] = 1;
-  // The region: rings of tets out from the hex part's nodes (hexes and wedges: a wedge's quad
-  // may meet tets too).
-  std::vector<char> near(n, 0), in_region(model.tets.size(), 0);
-  for (const auto& h : model.hexes)
-    for (Index v : h) near[static_cast<std::size_t>(v)] = 1;
-  for (const auto& w : model.wedges)
-    for (Index v : w) near[static_cast<std::size_t>(v)] = 1;
+  // The region: rings of tets out from the quads of hexes and wedges whose four corners are
+  // all tet nodes (the quads a transition is made on: two or four tet triangles on them), not
+  // from every node tets share with them (a wedge layer's base lies on tet faces too).
+  std::vector<char> tet_node(n, 0), near(n, 0), in_region(model.tets.size(), 0);
+  for (const auto& t : model.tets)
+    for (Index v : t) tet_node[static_cast<std::size_t>(v)] = 1;
+  for (const ElementKind kind : {ElementKind::kHex, ElementKind::kWedge}) {
+    const auto& topo = cell_topology(kind);
+    for (std::size_t c = 0; c < element_count(model, kind); ++c) {
+      const auto corners = element_corners(model, {kind, static_cast<Index>(c)});
+      for (int f = 0; f < topo.faces; ++f) {
+        const auto& face = topo.face[static_cast<std::size_t>(f)];
+        if (face.size != 4) continue;
+        bool covered = true;
+        for (int i = 0; i < 4; ++i)
+          covered &=
+              tet_node[static_cast<std::size_t>(
+                  corners[static_cast<std::size_t>(face.corners[static_cast<std::size_t>(i)])])] !=
+              0;
+        if (covered)
+          for (int i = 0; i < 4; ++i)
+            near[static_cast<std::size_t>(
+                corners[static_cast<std::size_t>(face.corners[static_cast<std::size_t>(i)])])] = 1;
+      }
+    }
+  }
   for (int ring = 0; ring < rings; ++ring) {
     for (std::size_t t = 0; t < model.tets.size(); ++t)
       for (Index v : model.tets[t])

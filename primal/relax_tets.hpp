@@ -37,8 +37,9 @@ RelaxTetsResult relax_tet_nodes(std::vector<Point>& points,
                                 std::span<const Index> free_nodes,
                                 const RelaxTetsOptions& options = {});
 
-// The tet nodes of `model` within `rings` rings of tets from its hex part (the tets sharing a
-// node with a hex or a wedge, then the tets sharing a node with those, ...) that may move without
+// The tet nodes of `model` within `rings` rings of tets from the quads of its hexes and wedges
+// that tets cover (all four corners tet nodes: the tets sharing a node with such a quad, then
+// the tets sharing a node with those, ...) that may move without
 // changing the model's shape or its materials: used by tets only, all of one block, on no
 // boundary face (a face of one element; a quad's two triangles count as faces too) and in no
 // node set. Sorted ascending.
