@@ -37,15 +37,14 @@ namespace {
 struct HybridCase {
   const char* name;
   bool pyramids, wedges;
-  // Whether the defaults reach the yardstick (else: every geode hex at the smoother's aim,
-  // 0.9 x its local yardstick; layer-side's slab tets beside the thin layer quads, diced
-  // alone, are the model's worst cells and the geode hexes carved from them stay below them).
-  bool yardstick = true;
 };
-constexpr HybridCase kHybrid[] = {
-    {"hybrid", true, false},           {"hybrid-cylinder", true, false},
-    {"boundary-layer", false, true},   {"hexdominant", true, true},
-    {"layer-side", true, true, false}, {"layer-interface", true, true}};
+// With the defaults every one reaches its yardstick: the tet relaxation lifts the flat tets
+// Gmsh leaves beside the hex and wedge quads (layer-side's slab tets beside its thin first
+// layer kept it below without it). (Not every geode hex reaches 0.9 x its local yardstick:
+// hybrid-cylinder's curved interface at n = 3 gives 0.71 x.)
+constexpr HybridCase kHybrid[] = {{"hybrid", true, false},         {"hybrid-cylinder", true, false},
+                                  {"boundary-layer", false, true}, {"hexdominant", true, true},
+                                  {"layer-side", true, true},      {"layer-interface", true, true}};
 
 std::set<int> blocks_of(const primal::Model& m) {
   std::set<int> b;
@@ -120,10 +119,7 @@ TEST_CASE(
                << ": " << r.model.hexes.size() << " hexes, min scaled Jacobian " << sj
                << ", yardstick " << r.yardstick() << ", geode hexes >= " << r.local_yardstick_ratio
                << " x their local yardstick");
-      if (smooth == conform::ConformSmooth::kLocal && c.yardstick)
-        CHECK(sj >= r.yardstick() - 1e-9);
-      if (smooth == conform::ConformSmooth::kLocal && !c.yardstick)
-        CHECK(r.local_yardstick_ratio >= 0.9);
+      if (smooth == conform::ConformSmooth::kLocal) CHECK(sj >= r.yardstick() - 1e-9);
       // Per kind: 8 per hex, 4 per tet (a pyramid's two tets), 6 per wedge, 26 per interface quad.
       CHECK(r.input_pyramids == static_cast<Index>(in.pyramids.size()));
       CHECK(r.diced_hexes == 8 * static_cast<Index>(in.hexes.size()));
