@@ -4,6 +4,8 @@
 // written both or neither, an invalid result exits 4 and writes nothing unless asked.
 #include <doctest/doctest.h>
 
+#include <stdlib.h>
+
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
@@ -269,40 +271,51 @@ TEST_CASE(
   }
 }
 
+namespace {
+
+// An environment variable for one scope (the commands run as children inherit it).
+struct ScopedEnv {
+  const char* name;
+  ScopedEnv(const char* n, const std::string& value) : name(n) { ::setenv(n, value.c_str(), 1); }
+  ~ScopedEnv() { ::unsetenv(name); }
+};
+
+}  // namespace
+
 TEST_CASE(
     "cli conventions: an invalid result exits 4, says so even with --quiet, writes only with "
     "--write-invalid") {
-  TempDir dir;
-  // The small model plus one hex meeting the hex part along an edge only: its diced hexes make
-  // that edge non-manifold, so the output cannot be valid whatever the algorithm does.
-  primal::Model m = small_model();
-  auto node_at = [&](const primal::Point& p) {
-    for (std::size_t i = 0; i < m.points.size(); ++i)
-      if ((m.points[i] - p).norm() < 1e-12) return static_cast<primal::Index>(i);
-    m.points.push_back(p);
-    return static_cast<primal::Index>(m.points.size() - 1);
-  };
-  std::array<primal::Index, 8> h{};
-  const double x[8] = {-1, 0, 0, -1, -1, 0, 0, -1}, y[8] = {-1, -1, 0, 0, -1, -1, 0, 0},
-               z[8] = {0, 0, 0, 0, 1, 1, 1, 1};
-  for (int c = 0; c < 8; ++c) h[static_cast<std::size_t>(c)] = node_at({x[c], y[c], z[c]});
-  m.hexes.push_back(h);
-  if (!m.hex_block.empty()) m.hex_block.push_back(m.hex_block.front());
-  const fs::path in = dir.path / "in.exo", out = dir.path / "out.vtu", report = dir.path / "r.json";
-  io::write_exodus(m, in);
-  const std::string args = "conform " + in.string() + " -o " + out.string() + " --report " +
-                           report.string() + " --smooth none --quiet";
-  const test::CliRun r = test::geode_cli(args, true);
-  INFO(r.out);
-  CHECK(r.code == 4);
-  CHECK(lines(r.out) == 1);
-  CHECK(r.out.find("invalid result") != std::string::npos);
-  CHECK(r.out.find("--write-invalid") != std::string::npos);
-  CHECK(dir.entries() == 1);
-  const test::CliRun w = test::geode_cli(args + " --write-invalid", true);
-  CHECK(w.code == 4);
-  CHECK(fs::exists(out));
-  CHECK(fs::exists(report));
+  // A valid input whose result a faulty stage breaks: the test hook GEODE_TEST_INVERT_OUTPUT_HEX
+  // (docs/cli.md) moves a corner of output hex 1 (the first diced hex) through its centre just
+  // before verification, as a smoother gone wrong would; both --verify modes must catch it. (An
+  // input that cannot give a valid result, such as a hex on an edge of the part, is refused when
+  // read: no option of conform makes a valid input fail verification.)
+  for (const char* verify : {"local", "full"}) {
+    CAPTURE(verify);
+    TempDir dir;
+    const fs::path in = dir.path / "in.exo", out = dir.path / "out.vtu",
+                   report = dir.path / "r.json";
+    io::write_exodus(small_model(), in);
+    const std::string args = "conform " + in.string() + " -o " + out.string() + " --report " +
+                             report.string() + " --verify " + verify + " --smooth none --quiet";
+    const test::CliRun valid = test::geode_cli(args, true);  // without the hook: valid
+    INFO(valid.out);
+    REQUIRE(valid.code == 0);
+    fs::remove(out);
+    fs::remove(report);
+    ScopedEnv hook("GEODE_TEST_INVERT_OUTPUT_HEX", "1");
+    const test::CliRun r = test::geode_cli(args, true);
+    INFO(r.out);
+    CHECK(r.code == 4);
+    CHECK(lines(r.out) == 1);
+    CHECK(r.out.find("invalid result") != std::string::npos);
+    CHECK(r.out.find("--write-invalid") != std::string::npos);
+    CHECK(dir.entries() == 1);
+    const test::CliRun w = test::geode_cli(args + " --write-invalid", true);
+    CHECK(w.code == 4);
+    CHECK(fs::exists(out));
+    CHECK(fs::exists(report));
+  }
 }
 
 TEST_CASE(
