@@ -1,7 +1,11 @@
 // geode: all-hex meshing through the dual (the Spatial Twist Continuum).
+#include <execinfo.h>
+
 #include <iostream>
 #include <memory>
 #include <new>
+#include <string_view>
+#include <system_error>
 
 #include <tbb/global_control.h>
 
@@ -20,6 +24,17 @@ std::string one_line(std::string s) {
   return s;
 }
 
+// A worker thread that could not be started: TBB reports pthread_create's failure as a
+// std::runtime_error ("pthread_create has failed: Resource temporarily unavailable"), std::thread
+// as a std::system_error. Under a memory cap (ulimit -v) it is the new thread's stack that does
+// not fit, like an allocation that fails.
+bool thread_start_failed(const std::exception& e) {
+  if (const auto* s = dynamic_cast<const std::system_error*>(&e);
+      s && s->code() == std::errc::resource_unavailable_try_again)
+    return true;
+  return std::string_view(e.what()).find("pthread_create") != std::string_view::npos;
+}
+
 // "geode conform" for the deepest sub-command given, for the --help hint.
 std::string command_path(const CLI::App& app) {
   std::string path = "geode";
@@ -36,6 +51,13 @@ std::string command_path(const CLI::App& app) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // glibc unwinds through its own frames with libgcc_s, which it loads on first need; an
+  // exception thrown for want of memory (ulimit -v) could then find no memory to load it and
+  // abort ("libgcc_s.so.1 must be installed for unwinding to work"). backtrace() loads it now.
+  {
+    void* frame[1];
+    (void)backtrace(frame, 1);
+  }
   CLI::App app{
       "geode: all-hex transition templates derived from completed dual sheet arrangements, and "
       "the\n"
@@ -43,34 +65,36 @@ int main(int argc, char** argv) {
       "Exit codes: 0 done, 2 usage or input error, 3 topology refusal, 4 invalid result."};
   // An interrupted run removes its hidden temporary files (io/atomic_file.hpp).
   geode::io::install_signal_cleanup();
-  app.require_subcommand(1);
-  app.set_version_flag("--version", geode::cli::version_text(), "print the version and exit");
-  // --threads before or after the command: subcommands pass options they do not know to here
-  // (fallthrough, inherited by the commands added below). Its callback runs before any command's.
-  // The --threads limit is never destroyed: lifting it would start TBB's worker threads on the
-  // way out, which fails (and aborts, a destructor throwing) when the run ended for want of
-  // memory. Held by a static pointer, it stays reachable until exit (no leak to LeakSanitizer).
-  static tbb::global_control* threads = nullptr;
-  app.fallthrough();
-  app.add_option_function<int>(
-         "--threads",
-         [](int n) {
-           delete threads;
-           threads = new tbb::global_control(tbb::global_control::max_allowed_parallelism,
-                                             static_cast<std::size_t>(n));
-         },
-         "worker threads (default: every core); every result is the same for any number")
-      ->check(CLI::Range(1, 4096));
-  geode::cli::add_template_command(app);
-  geode::cli::add_study_commands(app);
-  geode::cli::add_conform_commands(app);
-  geode::cli::add_dual_command(app);
-  geode::cli::add_check_command(app);
-  geode::cli::add_arrange_command(app);
-  geode::cli::add_view_command(app);
-  geode::cli::add_formats_command(app);
+  // Building the commands allocates too: inside the try, so that running out of memory there
+  // is the one-line exit 2 as well.
   int code = 0;
   try {
+    app.require_subcommand(1);
+    app.set_version_flag("--version", geode::cli::version_text(), "print the version and exit");
+    // --threads before or after the command: subcommands pass options they do not know to here
+    // (fallthrough, inherited by the commands added below). Its callback runs before any command's.
+    // The --threads limit is never destroyed: lifting it would start TBB's worker threads on the
+    // way out, which fails (and aborts, a destructor throwing) when the run ended for want of
+    // memory. Held by a static pointer, it stays reachable until exit (no leak to LeakSanitizer).
+    static tbb::global_control* threads = nullptr;
+    app.fallthrough();
+    app.add_option_function<int>(
+           "--threads",
+           [](int n) {
+             delete threads;
+             threads = new tbb::global_control(tbb::global_control::max_allowed_parallelism,
+                                               static_cast<std::size_t>(n));
+           },
+           "worker threads (default: every core); every result is the same for any number")
+        ->check(CLI::Range(1, 4096));
+    geode::cli::add_template_command(app);
+    geode::cli::add_study_commands(app);
+    geode::cli::add_conform_commands(app);
+    geode::cli::add_dual_command(app);
+    geode::cli::add_check_command(app);
+    geode::cli::add_arrange_command(app);
+    geode::cli::add_view_command(app);
+    geode::cli::add_formats_command(app);
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
@@ -98,8 +122,16 @@ int main(int argc, char** argv) {
               << one_line(e.what()) << "; nothing written)\n";
     code = 2;
   } catch (const std::exception& e) {
-    std::cerr << "geode: error: " << one_line(e.what()) << "\n";
-    code = 1;
+    if (thread_start_failed(e)) {
+      std::cerr << command_path(app) << ": error: cannot start a worker thread ("
+                << one_line(e.what())
+                << "): the process may not take the memory (or the processes) one more thread "
+                   "needs; --threads 1 runs without them (nothing written)\n";
+      code = 2;
+    } else {
+      std::cerr << "geode: error: " << one_line(e.what()) << "\n";
+      code = 1;
+    }
   }
   return code;
 }

@@ -161,6 +161,7 @@ class Conformer {
   double scan();                               // inverted_ and the minimum from sj_
   void check_dicing();
   bool verify_locally() const;
+  void invert_for_test();
   void verify();
   void output();
 
@@ -840,7 +841,32 @@ double Conformer::scan() {
   return lowest;
 }
 
+// Test hook (docs/cli.md): GEODE_TEST_INVERT_OUTPUT_HEX=N moves the first corner of output hex
+// N (1-based) through the hex's centre before verification, then measures the hexes at that node
+// again and counts them as moved, as smoothing does: a faulty stage on a valid input, which both
+// --verify modes must find (tests/cli/conventions_test.cpp's exit 4).
+void Conformer::invert_for_test() {
+  const char* text = std::getenv("GEODE_TEST_INVERT_OUTPUT_HEX");
+  if (!text || !*text) return;
+  const long n = std::strtol(text, nullptr, 10);
+  if (n < 1 || static_cast<std::size_t>(n) > mesh_.hexes.size()) return;
+  const auto& h = mesh_.hexes[static_cast<std::size_t>(n - 1)];
+  Point centre = Point::Zero();
+  for (Index v : h) centre += mesh_.points[static_cast<std::size_t>(v)];
+  const Index corner = h[0];
+  Point& p = mesh_.points[static_cast<std::size_t>(corner)];
+  p = 2.0 * (centre / 8.0) - p;
+  std::vector<Index> at;
+  for (std::size_t k = 0; k < mesh_.hexes.size(); ++k)
+    if (std::find(mesh_.hexes[k].begin(), mesh_.hexes[k].end(), corner) != mesh_.hexes[k].end())
+      at.push_back(static_cast<Index>(k));
+  measure(at);
+  scan();
+  moved_.insert(moved_.end(), at.begin(), at.end());
+}
+
 void Conformer::verify() {
+  invert_for_test();
   t0_ = Clock::now();
   if (verify_locally()) {
     // Seeds: the geode hexes and whatever smoothing could move; the rest is diced, checked

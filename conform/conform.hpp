@@ -107,12 +107,13 @@ struct ConformOptions {
   // below this scaled Jacobian seed patches.
   double smooth_target = 0.0;
   ConformQuality quality = ConformQuality::kScaledJacobian;
-  // kLocal takes the diced parts as valid by construction, so it is sound only on a valid input
-  // (faces shared by at most two cells, manifold edges and vertices): the default becomes kLocal
-  // once the input is checked at read time (issue 28); a non-manifold input far from the
-  // interface would pass kLocal. kGlobal smoothing moves every node: its output is verified whole
+  // kLocal takes the diced parts as valid by construction, so it is sound on an input that passed
+  // primal::check_input (faces shared by at most two cells, covered once, a manifold boundary):
+  // io::read_model runs it, and so do the demo command and the Python module on the models they
+  // build; a caller handing conform() a model of its own runs primal::require_single_covering
+  // first or asks for kFull. kGlobal smoothing moves every node: its output is verified whole
   // whatever this says.
-  ConformVerify verify = ConformVerify::kFull;
+  ConformVerify verify = ConformVerify::kLocal;
   // kLocal, kGlobal's automatic passes, and the untangling of hexes still inverted (with any
   // mode); the automatic target replaces its target, goal and max_visits. A narrower margin and
   // a larger loss than the primal defaults: hexes near the worst of a patch must give a little

@@ -262,7 +262,11 @@ bool Distributor::zone_at(int rings) {
   }
   primal::Submodel zone = primal::extract_submodel(m(), in_zone_);
   rep_.zone_cells = static_cast<std::int64_t>(std::count(in_zone_.begin(), in_zone_.end(), 1));
-  conform::ConformResult r = conform::conform(zone.model, options_.conform);
+  // The zone is cut out of the model, so it need not pass the read-time check (cells of it may
+  // meet only along an edge of the cut), which local verification takes as given: verified whole.
+  conform::ConformOptions zone_options = options_.conform;
+  zone_options.verify = conform::ConformVerify::kFull;
+  conform::ConformResult r = conform::conform(zone.model, zone_options);
   zone_at_.clear();
   zone_at_.reserve(r.model.points.size());
   for (std::size_t i = 0; i < r.model.points.size(); ++i)

@@ -58,7 +58,10 @@ struct HalfEdge {
   Index v, end, other;
   Point normal;
   Index face;
-  bool operator<(const HalfEdge& o) const { return std::tie(v, end) < std::tie(o.v, o.end); }
+  // The face last: one order whatever the sort (the sums over a node's edges, the findings).
+  bool operator<(const HalfEdge& o) const {
+    return std::tie(v, end, face) < std::tie(o.v, o.end, o.face);
+  }
 };
 
 struct Triangle {
@@ -85,6 +88,7 @@ class InputChecker {
 
   InputCheckResult run() {
     pair_faces();
+    if (!full()) boundary_links();
     if (!full()) covering_at_nodes();
     if (!full() && options_.contacts) boundary_contacts();
     if (!full()) degree_of_components();
@@ -271,6 +275,96 @@ class InputChecker {
     return c / n;
   }
 
+  // The boundary as a surface, from its faces seen at each of their corners along both edges
+  // there (sorted by corner and edge): every boundary edge on exactly two boundary faces, and the
+  // faces around every boundary node one cycle (a disk); anything else is refused. Where it is a
+  // disk, the solid angle inside the spherical polygon of the faces' sectors, 2 pi - sum(pi -
+  // interior dihedral angle) over the boundary edges there, is what covering_at_nodes expects
+  // (4 pi off the boundary); elsewhere a node is not judged by it.
+  void boundary_links() {
+    const std::size_t nv = model_.points.size();
+    expected_.assign(nv, 4.0 * kPi);
+    judged_.assign(nv, 1);
+    std::vector<HalfEdge> half;
+    half.reserve(8 * boundary_.size());
+    for (std::size_t f = 0; f < boundary_.size(); ++f) {
+      const auto& b = boundary_[f];
+      for (int i = 0; i < b.size; ++i) {
+        const Index v = b.nodes[static_cast<std::size_t>(i)];
+        const Index next = b.nodes[static_cast<std::size_t>((i + 1) % b.size)];
+        const Index prev = b.nodes[static_cast<std::size_t>((i + b.size - 1) % b.size)];
+        const Point n = (pt(next) - pt(v)).cross(pt(prev) - pt(v));
+        half.push_back({v, next, prev, n, static_cast<Index>(f)});
+        half.push_back({v, prev, next, n, static_cast<Index>(f)});
+      }
+    }
+    tbb::parallel_sort(half.begin(), half.end());
+    DisjointSets faces_at;
+    std::vector<Index> local;  // the faces at v, numbered by order of appearance
+    for (std::size_t i = 0; i < half.size();) {
+      const Index v = half[i].v;
+      std::size_t j = i;
+      while (j < half.size() && half[j].v == v) ++j;
+      local.clear();
+      for (std::size_t k = i; k < j; ++k)
+        if (std::find(local.begin(), local.end(), half[k].face) == local.end())
+          local.push_back(half[k].face);
+      faces_at.reset(local.size());
+      auto slot = [&](Index f) {
+        return static_cast<Index>(std::find(local.begin(), local.end(), f) - local.begin());
+      };
+      double exterior = 0.0;
+      bool manifold = true;
+      for (std::size_t k = i; k < j;) {
+        std::size_t m = k + 1;  // [k, m): the faces on the edge v - end
+        while (m < j && half[m].end == half[k].end) ++m;
+        if (m - k != 2) {
+          manifold = false;
+          if (v < half[k].end) edge_finding(half, k, m);  // each edge once, from its lower end
+        } else {
+          const Point& o = pt(v);
+          exterior += kPi - dihedral(pt(half[k].end) - o, pt(half[k].other) - o, -half[k].normal,
+                                     pt(half[k + 1].other) - o);
+          faces_at.unite(slot(half[k].face), slot(half[k + 1].face));
+        }
+        k = m;
+      }
+      const std::size_t cycles = manifold ? faces_at.count() : 0;
+      if (cycles > 1) {
+        // One element of each of the first two cycles (their smallest local face: the root).
+        InputFinding f{InputFault::kNonManifoldNode, {}, v, pt(v), static_cast<double>(cycles)};
+        for (std::size_t r = 0; r < local.size() && f.elements.size() < 2; ++r)
+          if (faces_at.find(static_cast<Index>(r)) == static_cast<Index>(r))
+            f.elements.push_back(boundary_[static_cast<std::size_t>(local[r])].element);
+        add(std::move(f));
+      }
+      if (cycles == 1)
+        expected_[static_cast<std::size_t>(v)] = 2.0 * kPi - exterior;
+      else
+        judged_[static_cast<std::size_t>(v)] = 0;
+      i = j;
+    }
+  }
+
+  // A boundary edge on m - k boundary faces (half[k, m)), not two: the lowest and highest of
+  // their elements.
+  void edge_finding(const std::vector<HalfEdge>& half, std::size_t k, std::size_t m) {
+    ElementRef lo = boundary_[static_cast<std::size_t>(half[k].face)].element, hi = lo;
+    for (std::size_t x = k + 1; x < m; ++x) {
+      const ElementRef e = boundary_[static_cast<std::size_t>(half[x].face)].element;
+      lo = std::min(lo, e);
+      hi = std::max(hi, e);
+    }
+    InputFinding f{InputFault::kNonManifoldEdge,
+                   {lo},
+                   half[k].v,
+                   0.5 * (pt(half[k].v) + pt(half[k].end)),
+                   static_cast<double>(m - k)};
+    if (hi != lo) f.elements.push_back(hi);
+    f.edge_end = half[k].end;
+    add(std::move(f));
+  }
+
   // The corners' solid angles at every node against 4 pi inside and the boundary's enclosed
   // solid angle on it. A pyramid counts as the two positive tets check_geometry found in it
   // (their cones tile its corners'), every other corner as the cone of its three edges.
@@ -326,67 +420,14 @@ class InputChecker {
       }
     }
 
-    // Boundary nodes: the solid angle inside the spherical polygon of their boundary faces'
-    // sectors, 2 pi - sum(pi - interior dihedral angle) over the boundary edges there; a node
-    // where the boundary is not one disk (an edge on other than two boundary faces, two
-    // disks touching) is not judged.
-    std::vector<HalfEdge> half;
-    half.reserve(8 * boundary_.size());
-    for (std::size_t f = 0; f < boundary_.size(); ++f) {
-      const auto& b = boundary_[f];
-      for (int i = 0; i < b.size; ++i) {
-        const Index v = b.nodes[static_cast<std::size_t>(i)];
-        const Index next = b.nodes[static_cast<std::size_t>((i + 1) % b.size)];
-        const Index prev = b.nodes[static_cast<std::size_t>((i + b.size - 1) % b.size)];
-        const Point n = (pt(next) - pt(v)).cross(pt(prev) - pt(v));
-        half.push_back({v, next, prev, n, static_cast<Index>(f)});
-        half.push_back({v, prev, next, n, static_cast<Index>(f)});
-      }
-    }
-    tbb::parallel_sort(half.begin(), half.end());
-    std::vector<double> expected(nv, 4.0 * kPi);
-    std::vector<bool> judged(nv, true);
-    DisjointSets faces_at;
-    for (std::size_t i = 0; i < half.size();) {
-      const Index v = half[i].v;
-      std::size_t j = i;
-      while (j < half.size() && half[j].v == v) ++j;
-      // Faces at v, numbered locally by order of appearance.
-      std::vector<Index> local;
-      for (std::size_t k = i; k < j; ++k)
-        if (std::find(local.begin(), local.end(), half[k].face) == local.end())
-          local.push_back(half[k].face);
-      faces_at.reset(local.size());
-      auto slot = [&](Index f) {
-        return static_cast<Index>(std::find(local.begin(), local.end(), f) - local.begin());
-      };
-      double exterior = 0.0;
-      bool ok = true;
-      for (std::size_t k = i; k < j && ok; k += 2) {
-        if (k + 1 >= j || half[k + 1].end != half[k].end ||
-            (k + 2 < j && half[k + 2].end == half[k].end)) {
-          ok = false;
-          break;
-        }
-        const Point& o = pt(v);
-        exterior += kPi - dihedral(pt(half[k].end) - o, pt(half[k].other) - o, -half[k].normal,
-                                   pt(half[k + 1].other) - o);
-        faces_at.unite(slot(half[k].face), slot(half[k + 1].face));
-      }
-      if (ok && faces_at.count() == 1)
-        expected[static_cast<std::size_t>(v)] = 2.0 * kPi - exterior;
-      else
-        judged[static_cast<std::size_t>(v)] = false;
-      i = j;
-    }
     for (std::size_t v = 0; v < nv && !full(); ++v) {
-      if (at[v].index == kInvalidIndex || !judged[v]) continue;
-      if (!(std::abs(angle[v] - expected[v]) > kPi)) continue;  // NaN: not judged
+      if (at[v].index == kInvalidIndex || !judged_[v]) continue;
+      if (!(std::abs(angle[v] - expected_[v]) > kPi)) continue;  // NaN: not judged
       add({InputFault::kFoldedNode,
            {at[v]},
            static_cast<Index>(v),
            pt(static_cast<Index>(v)),
-           angle[v] / expected[v]});
+           angle[v] / expected_[v]});
     }
   }
 
@@ -577,6 +618,10 @@ class InputChecker {
   InputCheckResult result_;
   std::vector<BoundaryFace> boundary_;
   std::vector<Index> centre_on_quad_;  // four-triangle centres, one per such interface quad
+  // Per node, from boundary_links: the solid angle its elements must cover, and whether the
+  // boundary is a disk there (0: not judged by covering_at_nodes).
+  std::vector<double> expected_;
+  std::vector<char> judged_;
   std::vector<Triangle> triangles_;
 };
 
@@ -585,6 +630,13 @@ std::string number(double x) {
   os.precision(3);
   os << x;
   return os.str();
+}
+
+// "two" for 2, up to twelve, then digits.
+std::string count_text(long n) {
+  static const char* const kWords[] = {"no",    "one",   "two",  "three", "four",   "five",  "six",
+                                       "seven", "eight", "nine", "ten",   "eleven", "twelve"};
+  return n >= 0 && n <= 12 ? kWords[n] : std::to_string(n);
 }
 
 }  // namespace
@@ -607,6 +659,28 @@ std::string InputFinding::text(const Model& model) const {
     case InputFault::kSameSideFace:
       return named(0) + " and " + named(1) + " lie on the same side of their shared face at " +
              point_text(place) + ": the mesh folds over itself there";
+    case InputFault::kNonManifoldEdge: {
+      const auto faces = static_cast<long>(measure);
+      const std::string edge = "the edge of nodes " +
+                               node_list(model, std::array<Index, 2>{node, edge_end}) + " at " +
+                               point_text(place);
+      std::string through = named(0) + (elements.size() > 1 ? " and " + named(1) : "");
+      if (faces % 2 == 1)
+        return "the boundary is not closed along " + edge + ": it lies on " + count_text(faces) +
+               " boundary face" + (faces == 1 ? "" : "s") + " (of " + through +
+               "), not two: faces there are not matched node for node";
+      return "the boundary is not a manifold along " + edge + ": " + count_text(faces) +
+             " boundary faces meet there, " + count_text(faces / 2) + " surface sheets (through " +
+             through +
+             "; the model touches itself there: elements meeting the rest of it only "
+             "along this edge, or faces not matched node for node)";
+    }
+    case InputFault::kNonManifoldNode:
+      return "the boundary is not a manifold at " + describe_node(model, node) + ": " +
+             count_text(static_cast<long>(measure)) + " surface sheets meet there (through " +
+             named(0) + " and " + named(1) +
+             "; the model touches itself there: elements meeting the rest of it only at this "
+             "node, or faces not matched node for node)";
     case InputFault::kFoldedNode:
       return "the elements around " + describe_node(model, node) + " (" + named(0) +
              " among them) cover its neighbourhood " + number(measure) +
@@ -639,7 +713,10 @@ void require_single_covering(const Model& model, std::string_view source,
   InputCheckOptions one = options;
   one.max_findings = 1;
   const InputCheckResult r = check_input(model, one);
-  if (!r.ok()) throw InvalidInput(std::string(source) + ": " + r.findings[0].text(model));
+  if (r.ok()) return;
+  const std::string what = std::string(source) + ": " + r.findings[0].text(model);
+  if (r.findings[0].topological()) throw TopologyError(what);
+  throw InvalidInput(what);
 }
 
 }  // namespace geode::primal

@@ -9,6 +9,14 @@
 // - face pairing: a face used by more than two elements, or by two that see it in the same cyclic
 //   order (both on one side: a fold), or one element twice. A quad one side meets as two or four
 //   triangles of the other (the quad-triangle interface conform makes conforming) counts as paired.
+// - the boundary a 2-manifold: every boundary edge on exactly two boundary faces (four or more:
+//   parts touching along the edge only; one or three: faces not matched node for node), and at
+//   every boundary node the boundary faces around it one cycle (one disk; two or more: parts
+//   touching at that node only, or a finer part beside a coarser one sharing only corners, whose
+//   middle nodes hang). These are topology refusals (TopologyError). A node whose element star
+//   falls apart needs no test of its own: a component of the star with no boundary face at the
+//   node has a closed link of positive triangles, so it covers the node's neighbourhood once
+//   more, and the covering below counts 2 or more there.
 // - local covering at every node: the solid angles of the corners around it (the cones of their
 //   edges, as check_validity's local covering) add up to 4 pi inside and, on the boundary, to the
 //   solid angle the boundary faces there enclose (Gauss-Bonnet); more means the elements wrap
@@ -39,6 +47,8 @@ enum class InputFault {
   kOversharedFace,    // a face used by three or more elements
   kDuplicateElement,  // two elements of one kind on the same nodes
   kSameSideFace,      // two elements on the same side of their shared face
+  kNonManifoldEdge,   // a boundary edge on other than two boundary faces
+  kNonManifoldNode,   // the boundary faces around a node form two or more cycles (disks)
   kFoldedNode,        // the corners around a node cover it more (or less) than once
   kCrossingFaces,     // two boundary faces cross
   kGap,               // two boundary faces face each other across a gap without sharing nodes
@@ -48,11 +58,18 @@ enum class InputFault {
 struct InputFinding {
   InputFault fault = InputFault::kFoldedNode;
   std::vector<ElementRef> elements;  // the elements at fault (1 to 3)
-  Index node = kInvalidIndex;        // kFoldedNode: the node
+  Index node = kInvalidIndex;        // kFoldedNode, kNonManifoldNode: the node; kNonManifoldEdge:
+                                     // the edge's first node
   Point place = Point::Zero();       // where
   // kFoldedNode: covering count (angle sum / expected); kGap: the gap width (0: the faces
-  // coincide, duplicated nodes); kCoveredTwice: the winding number.
+  // coincide, duplicated nodes); kCoveredTwice: the winding number; kNonManifoldEdge: the
+  // boundary faces on the edge; kNonManifoldNode: the cycles of boundary faces around the node.
   double measure = 0.0;
+  Index edge_end = kInvalidIndex;  // kNonManifoldEdge: the edge's other node
+  // Whether the finding is a topology refusal (the non-manifold ones) rather than bad input.
+  bool topological() const {
+    return fault == InputFault::kNonManifoldEdge || fault == InputFault::kNonManifoldNode;
+  }
   // One line: the reason, the elements and node by the model's file ids, the place.
   std::string text(const Model& model) const;
 };
@@ -67,7 +84,9 @@ struct InputCheckResult {
 
 InputCheckResult check_input(const Model& model, const InputCheckOptions& options = {});
 
-// Throws InvalidInput "source: <the first finding's text>" when check_input finds anything.
+// Throws "source: <the first finding's text>" when check_input finds anything: TopologyError
+// (exit 3) for a non-manifold boundary, which is well-formed but no sheet arrangement can be the
+// dual of, InvalidInput (exit 2) for the rest, which is not a mesh of one domain at all.
 void require_single_covering(const Model& model, std::string_view source,
                              const InputCheckOptions& options = {});
 

@@ -9,6 +9,7 @@
 #include <geode/conform/conform.hpp>
 #include <geode/conform/report.hpp>
 #include <geode/demo/demo_models.hpp>
+#include <geode/primal/input_check.hpp>
 #include <geode/primal/model.hpp>
 #include "python/arrays.hpp"
 
@@ -125,6 +126,9 @@ py::dict conform_arrays(const py::handle& points, const py::handle& hexes,
   {
     py::gil_scoped_release free;
     if (merge) merged = primal::merge_coincident_nodes(model, *merge);
+    // The read-time check of a file (after merging: duplicated nodes look like a gap), which
+    // local verification, the default, takes as given; its messages name the source.
+    primal::require_single_covering(model, source);
     try {
       r = conform::conform(model, opts);
     } catch (const InvalidInput& e) {

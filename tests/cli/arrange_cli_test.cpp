@@ -146,7 +146,7 @@ TEST_CASE("geode arrange: bad specs exit 2 naming the JSON path, non-dualizing o
     int code;
     const char* message;
   };
-  const std::vector<Case> cases = {
+  std::vector<Case> cases = {
       {"zero normal",
        three_planes_and(R"(, {"name": "w", "plane": {"point": [0, 0, 0], "normal": [0, 0, 0]}})"),
        2, ": sheets[3].plane.normal: must not be zero"},
@@ -163,6 +163,12 @@ TEST_CASE("geode arrange: bad specs exit 2 naming the JSON path, non-dualizing o
        three_planes_and(R"(, {"name": "s", "sphere": {"center": [0.5, 0.5, 0.5], "radius": 0.5}})"),
        3, "arrangement: sheets 'x', 'y', 's' meet on the domain boundary"},
   };
+  // One sheet over the limit (documented in docs/specs.md): refused while the JSON is parsed.
+  std::string many;
+  for (int i = 0; i < 254; ++i)
+    many += R"(, {"name": "p)" + std::to_string(i) + R"(", "plane": {"point": [0.)" +
+            std::to_string(100 + i) + R"(, 0, 0], "normal": [1, 0, 0]}})";
+  cases.push_back({"257 sheets", three_planes_and(many), 2, ": sheets: more than 256 sheets"});
   for (const auto& c : cases) {
     CAPTURE(c.what);
     write_text(spec, c.text);

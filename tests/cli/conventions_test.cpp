@@ -1,8 +1,11 @@
 // Conventions every `geode` command follows (cli/conventions.hpp): usage errors are one line
 // with exit 2 and write nothing, numbers are validated, --version, the output format follows
 // the extension (a contradicting --format is refused), outputs are checked before any work and
-// written both or neither, an invalid result exits 4 and writes nothing unless asked.
+// written both or neither, a non-manifold input is refused when read (exit 3), an invalid result
+// exits 4 and writes nothing unless asked.
 #include <doctest/doctest.h>
+
+#include <stdlib.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -270,39 +273,107 @@ TEST_CASE(
 }
 
 TEST_CASE(
+    "cli conventions: an input whose boundary is not a manifold is refused when read, naming its "
+    "nodes: exit 3") {
+  // The small model plus one hex meeting the hex part along an edge only, or at one node only:
+  // its diced hexes would make that edge or node non-manifold, so no output could be valid; the
+  // read-time check refuses the input by the file's own node ids before any work.
+  struct Row {
+    const char* name;
+    double z0;           // the extra hex spans z in [z0, z0 + 1] at x, y in [-1, 0]
+    const char* reason;  // expected in the message
+  };
+  for (const Row row : {Row{"edge", 0.0, "not a manifold along the edge of nodes"},
+                        Row{"node", -1.0, "not a manifold at node"}}) {
+    CAPTURE(row.name);
+    TempDir dir;
+    primal::Model m = small_model();
+    auto node_at = [&](const primal::Point& p) {
+      for (std::size_t i = 0; i < m.points.size(); ++i)
+        if ((m.points[i] - p).norm() < 1e-12) return static_cast<primal::Index>(i);
+      m.points.push_back(p);
+      return static_cast<primal::Index>(m.points.size() - 1);
+    };
+    std::array<primal::Index, 8> h{};
+    const double x[8] = {-1, 0, 0, -1, -1, 0, 0, -1}, y[8] = {-1, -1, 0, 0, -1, -1, 0, 0},
+                 z[8] = {0, 0, 0, 0, 1, 1, 1, 1};
+    for (int c = 0; c < 8; ++c)
+      h[static_cast<std::size_t>(c)] = node_at({x[c], y[c], z[c] + row.z0});
+    m.hexes.push_back(h);
+    if (!m.hex_block.empty()) m.hex_block.push_back(m.hex_block.front());
+    const fs::path in = dir.path / "in.exo", out = dir.path / "out.vtu";
+    io::write_exodus(m, in);
+    // The node ids the file gives the touching nodes (0, 0, 0) and, along an edge, (0, 0, 1).
+    const primal::Model read = io::read_exodus(in);
+    auto id_at = [&](const primal::Point& p) {
+      for (std::size_t i = 0; i < read.points.size(); ++i)
+        if ((read.points[i] - p).norm() < 1e-12)
+          return std::to_string(primal::node_id(read, static_cast<primal::Index>(i)));
+      return std::string("?");
+    };
+    const std::string nodes = row.z0 == 0.0 ? "nodes " + id_at({0, 0, 0}) + " " + id_at({0, 0, 1})
+                                            : "node " + id_at({0, 0, 0});
+    for (const char* verify : {"local", "full"}) {
+      CAPTURE(verify);
+      const test::CliRun r = test::geode_cli(
+          "conform " + in.string() + " -o " + out.string() + " --verify " + verify + " --quiet",
+          true);
+      INFO(r.out);
+      CHECK(r.code == 3);
+      CHECK(lines(r.out) == 1);
+      CHECK(r.out.find(in.string() + ": the boundary is " + row.reason) != std::string::npos);
+      CHECK(r.out.find(nodes) != std::string::npos);
+      CHECK(r.out.find("surface sheets") != std::string::npos);
+      CHECK(dir.entries() == 1);
+    }
+  }
+}
+
+namespace {
+
+// An environment variable for one scope (the commands run as children inherit it).
+struct ScopedEnv {
+  const char* name;
+  ScopedEnv(const char* n, const std::string& value) : name(n) { ::setenv(n, value.c_str(), 1); }
+  ~ScopedEnv() { ::unsetenv(name); }
+};
+
+}  // namespace
+
+TEST_CASE(
     "cli conventions: an invalid result exits 4, says so even with --quiet, writes only with "
     "--write-invalid") {
-  TempDir dir;
-  // The small model plus one hex meeting the hex part along an edge only: its diced hexes make
-  // that edge non-manifold, so the output cannot be valid whatever the algorithm does.
-  primal::Model m = small_model();
-  auto node_at = [&](const primal::Point& p) {
-    for (std::size_t i = 0; i < m.points.size(); ++i)
-      if ((m.points[i] - p).norm() < 1e-12) return static_cast<primal::Index>(i);
-    m.points.push_back(p);
-    return static_cast<primal::Index>(m.points.size() - 1);
-  };
-  std::array<primal::Index, 8> h{};
-  const double x[8] = {-1, 0, 0, -1, -1, 0, 0, -1}, y[8] = {-1, -1, 0, 0, -1, -1, 0, 0},
-               z[8] = {0, 0, 0, 0, 1, 1, 1, 1};
-  for (int c = 0; c < 8; ++c) h[static_cast<std::size_t>(c)] = node_at({x[c], y[c], z[c]});
-  m.hexes.push_back(h);
-  if (!m.hex_block.empty()) m.hex_block.push_back(m.hex_block.front());
-  const fs::path in = dir.path / "in.exo", out = dir.path / "out.vtu", report = dir.path / "r.json";
-  io::write_exodus(m, in);
-  const std::string args = "conform " + in.string() + " -o " + out.string() + " --report " +
-                           report.string() + " --smooth none --quiet";
-  const test::CliRun r = test::geode_cli(args, true);
-  INFO(r.out);
-  CHECK(r.code == 4);
-  CHECK(lines(r.out) == 1);
-  CHECK(r.out.find("invalid result") != std::string::npos);
-  CHECK(r.out.find("--write-invalid") != std::string::npos);
-  CHECK(dir.entries() == 1);
-  const test::CliRun w = test::geode_cli(args + " --write-invalid", true);
-  CHECK(w.code == 4);
-  CHECK(fs::exists(out));
-  CHECK(fs::exists(report));
+  // A valid input whose result a faulty stage breaks: the test hook GEODE_TEST_INVERT_OUTPUT_HEX
+  // (docs/cli.md) moves a corner of output hex 1 (the first diced hex) through its centre just
+  // before verification, as a smoother gone wrong would; both --verify modes must catch it. (An
+  // input that cannot give a valid result, such as a hex on an edge of the part, is refused when
+  // read: no option of conform makes a valid input fail verification.)
+  for (const char* verify : {"local", "full"}) {
+    CAPTURE(verify);
+    TempDir dir;
+    const fs::path in = dir.path / "in.exo", out = dir.path / "out.vtu",
+                   report = dir.path / "r.json";
+    io::write_exodus(small_model(), in);
+    const std::string args = "conform " + in.string() + " -o " + out.string() + " --report " +
+                             report.string() + " --verify " + verify + " --smooth none --quiet";
+    const test::CliRun valid = test::geode_cli(args, true);  // without the hook: valid
+    INFO(valid.out);
+    REQUIRE(valid.code == 0);
+    fs::remove(out);
+    fs::remove(report);
+    ScopedEnv hook("GEODE_TEST_INVERT_OUTPUT_HEX", "1");
+    const test::CliRun r = test::geode_cli(args, true);
+    INFO(r.out);
+    CHECK(r.code == 4);
+    CHECK(lines(r.out) == 1);
+    CHECK(r.out.find("invalid result") != std::string::npos);
+    CHECK(r.out.find("--write-invalid") != std::string::npos);
+    CHECK(dir.entries() == 1);
+    const test::CliRun w = test::geode_cli(args + " --write-invalid", true);
+    CHECK(w.code == 4);
+    CHECK(fs::exists(out));
+    CHECK(fs::exists(report));
+  }
 }
 
 TEST_CASE(

@@ -62,7 +62,7 @@ TEST_CASE(
     "the region check finds a torn transition, a flipped hex anywhere, and agrees when whole") {
   const auto r = conform::conform(demo::demo_model("delaunay", 2));
   REQUIRE(conform::result_valid(r));
-  CHECK(r.verified == conform::ConformVerify::kFull);  // the default, until inputs are checked
+  CHECK(r.verified == conform::ConformVerify::kLocal);  // the default
   primal::HexMesh mesh = primal::hex_part(r.model);
   const Index first_geode = r.diced_hexes;
   std::vector<Index> geode(static_cast<std::size_t>(r.geode_hexes));

@@ -105,11 +105,12 @@ void detach_hexes(primal::Model& m, const Point& shift) {
     }
 }
 
-// `geode conform` on the model saved as .msh: exit 2, one line naming the file and holding the
-// check's first finding on the file as read (its element and node ids are the file's) and
-// `words`, no output file.
+// `geode conform` on the model saved as .msh: exit `code` (2: bad input, 3: a topology
+// refusal), one line naming the file and holding the check's first finding on the file as read
+// (its element and node ids are the file's) and `words`, no output file.
 void refused_by_conform(const primal::Model& m, const std::string& name,
-                        const std::vector<std::string>& words, const test::TempDir& dir) {
+                        const std::vector<std::string>& words, const test::TempDir& dir,
+                        int code = 2) {
   const auto in = dir.path / (name + ".msh");
   const auto out = dir.path / (name + "-out.exo");
   io::write_model(m, in);
@@ -118,7 +119,7 @@ void refused_by_conform(const primal::Model& m, const std::string& name,
   REQUIRE(!r.ok());
   const auto run = test::geode_cli("conform " + in.string() + " -o " + out.string(), true);
   INFO(run.out);
-  CHECK(run.code == 2);
+  CHECK(run.code == code);
   CHECK(std::count(run.out.begin(), run.out.end(), '\n') == 1);
   CHECK(run.out.find(in.string() + ": " + r.findings[0].text(read)) != std::string::npos);
   for (const auto& w : words) CHECK(run.out.find(w) != std::string::npos);
@@ -166,6 +167,78 @@ primal::Model tetgen_box(const test::TempDir& dir) {
   for (std::size_t i = 0; i < m.points.size(); ++i)
     m.node_ids.push_back(static_cast<std::int64_t>(i + 1));
   return m;
+}
+
+// The boundary node at the corner of the model's bounding box (smallest x + y + z) and the next
+// node up the box's edge through it (same x and y, smallest z above): a boundary edge.
+std::pair<Index, Index> corner_edge(const primal::Model& m) {
+  Index c = 0;
+  for (std::size_t i = 1; i < m.points.size(); ++i)
+    if (m.points[i].sum() < m.points[static_cast<std::size_t>(c)].sum()) c = static_cast<Index>(i);
+  const Point& pc = m.points[static_cast<std::size_t>(c)];
+  Index up = primal::kInvalidIndex;
+  for (std::size_t i = 0; i < m.points.size(); ++i) {
+    const Point& p = m.points[i];
+    if (std::abs(p.x() - pc.x()) > 1e-9 || std::abs(p.y() - pc.y()) > 1e-9 || p.z() <= pc.z())
+      continue;
+    if (up == primal::kInvalidIndex || p.z() < m.points[static_cast<std::size_t>(up)].z())
+      up = static_cast<Index>(i);
+  }
+  REQUIRE(up != primal::kInvalidIndex);
+  return {c, up};
+}
+
+// Appends an element of `kind` on `corners` (positively oriented), reusing the model's nodes at
+// those places and adding the others with file ids above the model's, in the first block of its
+// kind (or block 1): glued to the model where its corners are the model's nodes.
+void glue(primal::Model& m, ElementKind kind, const std::vector<Point>& corners) {
+  std::int64_t next_node =
+      m.node_ids.empty() ? 0 : *std::max_element(m.node_ids.begin(), m.node_ids.end());
+  std::vector<Index> c;
+  for (const Point& p : corners) {
+    Index v = primal::kInvalidIndex;
+    for (std::size_t i = 0; i < m.points.size() && v == primal::kInvalidIndex; ++i)
+      if ((m.points[i] - p).norm() < 1e-12) v = static_cast<Index>(i);
+    if (v == primal::kInvalidIndex) {
+      m.points.push_back(p);
+      if (!m.node_ids.empty()) m.node_ids.push_back(++next_node);
+      v = static_cast<Index>(m.points.size() - 1);
+    }
+    c.push_back(v);
+  }
+  std::int64_t next_element = 0;
+  for (ElementKind k : primal::kElementKinds)
+    for (std::int64_t id : primal::element_ids(m, k)) next_element = std::max(next_element, id);
+  const auto& blocks = kind == ElementKind::kHex ? m.hex_block : m.tet_block;
+  primal::add_element(m, kind, c, blocks.empty() ? 1 : blocks.front(), next_element + 1);
+}
+
+// A hex beside the corner edge (c, up) of the model, outside it (x and y below the corner's):
+// along that edge when `along_edge`, else below the corner (z below it), touching at c only.
+std::vector<Point> hex_beside(const primal::Model& m, Index c, Index up, bool along_edge) {
+  const Point pc = m.points[static_cast<std::size_t>(c)];
+  const double l = m.points[static_cast<std::size_t>(up)].z() - pc.z();
+  const double x[8] = {-1, 0, 0, -1, -1, 0, 0, -1}, y[8] = {-1, -1, 0, 0, -1, -1, 0, 0},
+               z[8] = {0, 0, 0, 0, 1, 1, 1, 1};
+  std::vector<Point> p;
+  for (int k = 0; k < 8; ++k)
+    p.push_back(pc + Point(l * x[k], l * y[k], l * (z[k] - (along_edge ? 0.0 : 1.0))));
+  return p;
+}
+
+// A tet outside the model at its corner edge (c, up): on that edge when `along_edge`, else
+// touching at c only; positively oriented.
+std::vector<Point> tet_beside(const primal::Model& m, Index c, Index up, bool along_edge) {
+  const Point pc = m.points[static_cast<std::size_t>(c)];
+  const Point pu = m.points[static_cast<std::size_t>(up)];
+  const double l = pu.z() - pc.z();
+  std::vector<Point> p =
+      along_edge
+          ? std::vector<Point>{pc, pu, pc + l * Point(-1, -0.2, 0.3), pc + l * Point(-0.2, -1, 0.6)}
+          : std::vector<Point>{pc, pc + l * Point(-1, -0.1, -0.1), pc + l * Point(-0.1, -1, -0.1),
+                               pc + l * Point(-0.1, -0.1, -1)};
+  if (primal::tet_volume(p[0], p[1], p[2], p[3]) < 0.0) std::swap(p[1], p[2]);
+  return p;
 }
 
 }  // namespace
@@ -279,4 +352,93 @@ TEST_CASE("input check: overlapping parts, a gap at the interface, a part inside
     CHECK(r.findings[0].measure == doctest::Approx(2.0).epsilon(0.01));
     refused_by_conform(m, "inside", {"hex", "inside other elements"}, dir);
   }
+}
+
+TEST_CASE(
+    "input check: a Gmsh hybrid and a TetGen box with one more element glued along an edge or at "
+    "a node are refused as non-manifold, by the file's node ids") {
+  test::TempDir dir;
+  for (const std::string source : {"hybrid", "tetgen"}) {
+    const primal::Model base =
+        source == "tetgen" ? tetgen_box(dir) : test::demo_input("hybrid", 4, dir, ".msh", false);
+    REQUIRE(primal::check_input(base).ok());
+    const auto [c, up] = corner_edge(base);
+    for (const bool along_edge : {true, false}) {
+      CAPTURE(source);
+      CAPTURE(along_edge);
+      primal::Model m = base;
+      // A hex on the Gmsh model, a tet on the TetGen one.
+      if (source == "hybrid")
+        glue(m, ElementKind::kHex, hex_beside(m, c, up, along_edge));
+      else
+        glue(m, ElementKind::kTet, tet_beside(m, c, up, along_edge));
+      REQUIRE_NOTHROW(primal::check_geometry(m, source));
+      const primal::InputCheckResult r = primal::check_input(m);
+      REQUIRE(!r.ok());
+      const primal::InputFinding& f = r.findings[0];
+      CHECK(f.topological());
+      if (along_edge) {
+        CHECK(f.fault == InputFault::kNonManifoldEdge);
+        CHECK(std::minmax(f.node, f.edge_end) == std::minmax(c, up));
+        CHECK(f.measure == 4);  // two faces of the glued element, two of the model's
+      } else {
+        CHECK(f.fault == InputFault::kNonManifoldNode);
+        CHECK(f.node == c);
+        CHECK(f.measure == 2);
+      }
+      // The extra element is among the named ones.
+      const ElementKind glued = source == "hybrid" ? ElementKind::kHex : ElementKind::kTet;
+      const primal::ElementRef extra{glued,
+                                     static_cast<Index>(primal::element_count(m, glued) - 1)};
+      CHECK(std::find(f.elements.begin(), f.elements.end(), extra) != f.elements.end());
+      // Refused when read, naming the nodes by the ids the file gives them (the model's).
+      const std::string name = source + (along_edge ? "-edge" : "-node");
+      refused_by_conform(m, name, {"not a manifold", "surface sheets"}, dir, 3);
+      const primal::Model read = io::read_model(dir.path / (name + ".msh"), {}, false);
+      const primal::InputCheckResult rr = primal::check_input(read);
+      REQUIRE(!rr.ok());
+      const primal::InputFinding& g = rr.findings[0];
+      auto id = [](const primal::Model& model, Index v) {
+        return std::to_string(primal::node_id(model, v));
+      };
+      if (along_edge) {
+        CHECK(std::set<std::string>{id(read, g.node), id(read, g.edge_end)} ==
+              std::set<std::string>{id(m, c), id(m, up)});
+        CHECK(g.text(read).find("nodes " + id(read, g.node) + " " + id(read, g.edge_end)) !=
+              std::string::npos);
+      } else {
+        CHECK(id(read, g.node) == id(m, c));
+        CHECK(g.text(read).find("at node " + id(m, c)) != std::string::npos);
+      }
+      CHECK_THROWS_AS(io::read_model(dir.path / (name + ".msh")), TopologyError);
+    }
+  }
+}
+
+TEST_CASE(
+    "input check: a part meshed finer beside a coarser one, sharing only their corners (hanging "
+    "nodes), is refused as non-manifold") {
+  test::TempDir dir;
+  // A unit hex on [0,1]^3 and 2 x 2 x 2 hexes on [1,2] x [0,1]^2: the face x = 1 is the big
+  // hex's one quad on one side and four quads on the other, whose middle nodes hang.
+  primal::Model m;
+  const double x[8] = {0, 1, 1, 0, 0, 1, 1, 0}, y[8] = {0, 0, 1, 1, 0, 0, 1, 1},
+               z[8] = {0, 0, 0, 0, 1, 1, 1, 1};
+  auto box = [&](const Point& lo, double size) {
+    std::vector<Point> p;
+    for (int k = 0; k < 8; ++k) p.push_back(lo + size * Point(x[k], y[k], z[k]));
+    return p;
+  };
+  glue(m, ElementKind::kHex, box(Point::Zero(), 1.0));
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j)
+      for (int k = 0; k < 2; ++k)
+        glue(m, ElementKind::kHex, box(Point(1.0 + 0.5 * i, 0.5 * j, 0.5 * k), 0.5));
+  REQUIRE(m.hexes.size() == 9);
+  REQUIRE_NOTHROW(primal::check_geometry(m, "hanging"));
+  const primal::InputCheckResult r = primal::check_input(m);
+  REQUIRE(!r.ok());
+  CHECK(r.findings[0].topological());
+  CHECK(m.points[static_cast<std::size_t>(r.findings[0].node)].x() == 1.0);  // on the interface
+  refused_by_conform(m, "hanging", {"not a manifold", "not matched node for node"}, dir, 3);
 }

@@ -14,7 +14,9 @@ usage: make_bombs.py OUTDIR
 - nodes.msh: a valid 69 MB .msh of 2.5 million nodes and one hex: its model needs a few hundred
   MB, honestly (read when the process may have enough);
 - grid.msh: a valid 20^3 hex grid (8,000 hexes, 470 KB), read in a few MB, whose conform run
-  (diced, smoothed) needs tens of MB more.
+  (diced, smoothed) needs tens of MB more;
+- sheets.json: an arrangement spec of 200,000 planes (13 MB), which once took 9.5 s and 243 MB
+  to be refused after parsing (at most 256 sheets).
 Exit status 77 when a Python module is missing.
 """
 import os
@@ -120,6 +122,14 @@ def grid(outdir, n=20):
     msh(os.path.join(outdir, "grid.msh"), points, hexes)
 
 
+def many_sheets(outdir, n=200000):
+    with open(os.path.join(outdir, "sheets.json"), "w") as f:
+        f.write('{"dim": 3, "domain": {"box": [[0, 0, 0], [1, 1, 1]]}, "sheets": [\n')
+        f.write(",\n".join(f'{{"name": "p{i}", "plane": {{"point": [{(i + 1) / (n + 1):.7f}, 0, 0], '
+                            f'"normal": [1, 0, 0]}}}}' for i in range(n)))
+        f.write("\n]}\n")
+
+
 if __name__ == "__main__":
     outdir = sys.argv[1]
     nested(outdir)
@@ -128,3 +138,4 @@ if __name__ == "__main__":
     big_msh(outdir)
     small_and_nodes(outdir)
     grid(outdir)
+    many_sheets(outdir)

@@ -111,3 +111,15 @@ def test_conform_refuses_bad_cells(half):
 def test_invalid_result_error_kind():
     assert geode.InvalidResultError.exit_code == 4 and issubclass(geode.InvalidResultError, geode.Error)
     assert geode.TopologyError.exit_code == 3 and geode.TopologyError.kind == "topology"
+
+
+def test_conform_refuses_a_non_manifold_model():
+    # Two hexes meeting along an edge only: the read-time check a file gets (local verification,
+    # the default, takes it as given) refuses the arrays too, naming the edge's nodes (1-based).
+    cube = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]], float)
+    points = np.concatenate([cube, cube - [1, 1, 0]])
+    hexes = np.array([list(range(8)), list(range(8, 16))])
+    points = np.concatenate([points[:8], points[[8, 9, 11, 12, 13, 15]]])
+    hexes[1] = [8, 9, 0, 10, 11, 12, 4, 13]  # its corners (0, 0, 0) and (0, 0, 1) are the cube's
+    with pytest.raises(geode.TopologyError, match="not a manifold along the edge of nodes 1 5"):
+        geode.conform(points=points, cells=[("hexahedron", hexes)])
