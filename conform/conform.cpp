@@ -995,14 +995,14 @@ ConformRelax parse_conform_relax(const std::string& word) {
   throw InvalidInput("tet relaxation '" + word + "': expected interface or none");
 }
 
-// Rings of tets out from the hex part that relax_tet_nodes moves: on the hexdominant demo
-// (n = 8) the first two rings take the lowest diced tet from 0.060 to 0.151 (Gmsh's flat
-// pyramids' apexes rise); more rings change nothing there.
+// Rings of tets out from the covered quads that relax_tet_nodes moves: two take in a pyramid's
+// apex and the tets around it (on the hexdominant demo, n = 8, the lowest diced tet among them
+// 0.060 -> 0.184); on the nugget (n = 3) one, two or three rings give the same output.
 constexpr int kRelaxRings = 2;
 // Only nodes with a tet diced below 0.3 (the geode template's own minimum is 0.33: a tet diced
 // at that level does not limit the transition), each step halved at most 3 times, 2 sweeps:
-// on the hexdominant demo at n = 28 (2,918 free nodes) 0.97 s instead of 3.7 s for all nodes and
-// 5 halvings, and the lowest diced tet there 0.175 instead of 0.167.
+// on the hexdominant demo at n = 28 (2,918 free nodes; load 0.5) 0.97 s instead of 1.85 s for
+// every node and 5 halvings, and the lowest diced tet there 0.175 instead of 0.167.
 constexpr primal::RelaxTetsOptions kRelax{
     .sweeps = 2, .halvings = 3, .initial_step = 0.25, .good = 0.3};
 

@@ -315,6 +315,20 @@ std::function<bool(const Point&)> four_chooser(bool on) {
 // Gmsh's OCC bounding boxes are enlarged by a tolerance; entity tests on them allow for it.
 constexpr double kEps = 1e-4;
 
+// A boundary layer as an analyst grows one on a wall: 3 graded layers of wedges (at 0.2, 0.5
+// and 1 of `thickness`) extruded `thickness` up off the top face of `volume` (the face at the
+// volume's highest z); the extrusion's entities, its volume among them.
+gmsh::vectorpair wedge_layer_on_top(int volume, double thickness) {
+  const double z = bounding_box(3, volume)[5];
+  int top = 0;
+  for (int s : boundary_surfaces(volume))
+    if (bounding_box(2, s)[2] > z - kEps) top = s;
+  gmsh::vectorpair layer;
+  gmsh::model::occ::extrude({{2, top}}, 0, 0, thickness, layer, {1, 1, 1}, {0.2, 0.5, 1.0}, true);
+  gmsh::model::occ::synchronize();
+  return layer;
+}
+
 void transfinite_box(int volume, double h) {
   gmsh::vectorpair surfaces, curves;
   for (int s : boundary_surfaces(volume)) surfaces.push_back({2, s});
@@ -756,12 +770,7 @@ Model demo_boundary_layer(int n) {
     // (0.1 thick, graded), as an analyst grows one on a wall.
     const int box = gmsh::model::occ::addBox(0, 0, 0, 1, 1, 1);
     gmsh::model::occ::synchronize();
-    int top = 0;
-    for (int s : boundary_surfaces(box))
-      if (bounding_box(2, s)[2] > 1.0 - kEps) top = s;
-    gmsh::vectorpair layer;
-    gmsh::model::occ::extrude({{2, top}}, 0, 0, 0.1, layer, {1, 1, 1}, {0.2, 0.5, 1.0}, true);
-    gmsh::model::occ::synchronize();
+    const gmsh::vectorpair layer = wedge_layer_on_top(box, 0.1);
     gmsh::option::setNumber("Mesh.MeshSizeMax", h);
     name_volume(box, 2, "tet");
     for (const auto& [dim, tag] : layer)
@@ -779,12 +788,7 @@ Model demo_layer_side(int n) {
     // ends inside the domain.
     const int box = gmsh::model::occ::addBox(0, 0, 0, 1, 1, 1);
     gmsh::model::occ::synchronize();
-    int top = 0;
-    for (int s : boundary_surfaces(box))
-      if (bounding_box(2, s)[2] > 1.0 - kEps) top = s;
-    gmsh::vectorpair layer;
-    gmsh::model::occ::extrude({{2, top}}, 0, 0, 0.2, layer, {1, 1, 1}, {0.2, 0.5, 1.0}, true);
-    gmsh::model::occ::synchronize();
+    const gmsh::vectorpair layer = wedge_layer_on_top(box, 0.2);
     int wedges = 0;
     for (const auto& [dim, tag] : layer)
       if (dim == 3) wedges = tag;
@@ -813,12 +817,7 @@ Model demo_layer_interface(int n) {
     // layer's edge x = 1 lies on the hex/tet interface's top edge.
     const auto v = shared_boxes({{0, 0, 0, 1, 1, 1}, {1, 0, 0, 1, 1, 1}});
     transfinite_box(v[0], h);
-    int top = 0;
-    for (int s : boundary_surfaces(v[1]))
-      if (bounding_box(2, s)[2] > 1.0 - kEps) top = s;
-    gmsh::vectorpair layer;
-    gmsh::model::occ::extrude({{2, top}}, 0, 0, 0.2, layer, {1, 1, 1}, {0.2, 0.5, 1.0}, true);
-    gmsh::model::occ::synchronize();
+    const gmsh::vectorpair layer = wedge_layer_on_top(v[1], 0.2);
     gmsh::option::setNumber("Mesh.MeshSizeMax", h);
     name_volume(v[0], 1, "hex");
     name_volume(v[1], 2, "tet");

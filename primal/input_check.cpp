@@ -634,9 +634,9 @@ std::string number(double x) {
 
 // "two" for 2, up to twelve, then digits.
 std::string count_text(long n) {
-  static const char* const kWords[] = {"no",    "one",   "two",  "three", "four",   "five",  "six",
-                                       "seven", "eight", "nine", "ten",   "eleven", "twelve"};
-  return n >= 0 && n <= 12 ? kWords[n] : std::to_string(n);
+  static const char* const words[] = {"no",    "one",   "two",  "three", "four",   "five",  "six",
+                                      "seven", "eight", "nine", "ten",   "eleven", "twelve"};
+  return n >= 0 && n <= 12 ? words[n] : std::to_string(n);
 }
 
 }  // namespace

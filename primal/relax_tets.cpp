@@ -24,19 +24,19 @@ class Relaxer {
       : points_(points), tets_(tets), free_(free_nodes.begin(), free_nodes.end()) {
     std::vector<Index> slot(points.size(), kInvalidIndex);
     for (std::size_t k = 0; k < free_.size(); ++k)
-      slot[static_cast<std::size_t>(free_[k])] = static_cast<Index>(k);
+      slot[index_cast<std::size_t>(free_[k])] = index_cast(k);
     first_.assign(free_.size() + 1, 0);
     for (const auto& t : tets)
       for (Index v : t)
-        if (slot[static_cast<std::size_t>(v)] != kInvalidIndex)
-          ++first_[static_cast<std::size_t>(slot[static_cast<std::size_t>(v)]) + 1];
+        if (slot[index_cast<std::size_t>(v)] != kInvalidIndex)
+          ++first_[index_cast<std::size_t>(slot[index_cast<std::size_t>(v)]) + 1];
     std::partial_sum(first_.begin(), first_.end(), first_.begin());
     around_.resize(first_.back());
     std::vector<std::size_t> fill(first_.begin(), first_.end() - 1);
     for (std::size_t c = 0; c < tets.size(); ++c)
       for (Index v : tets[c])
-        if (const Index k = slot[static_cast<std::size_t>(v)]; k != kInvalidIndex)
-          around_[fill[static_cast<std::size_t>(k)]++] = static_cast<Index>(c);
+        if (const Index k = slot[index_cast<std::size_t>(v)]; k != kInvalidIndex)
+          around_[fill[index_cast<std::size_t>(k)]++] = index_cast(c);
   }
 
   std::size_t size() const { return free_.size(); }
@@ -46,26 +46,26 @@ class Relaxer {
   double lowest(std::size_t k, double bound = -2.0) const {
     double m = 1.0;
     for (std::size_t i = first_[k]; i < first_[k + 1] && m > bound; ++i) {
-      const auto& t = tets_[static_cast<std::size_t>(around_[i])];
+      const auto& t = tets_[index_cast<std::size_t>(around_[i])];
       std::array<Point, 4> c;
-      for (std::size_t j = 0; j < 4; ++j) c[j] = points_[static_cast<std::size_t>(t[j])];
+      for (std::size_t j = 0; j < 4; ++j) c[j] = points_[index_cast<std::size_t>(t[j])];
       m = std::min(m, diced_tet_min_scaled_jacobian(c));
     }
     return m;
   }
 
   double shortest_edge(std::size_t k) const {
-    const Point& p = points_[static_cast<std::size_t>(free_[k])];
+    const Point& p = points_[index_cast<std::size_t>(free_[k])];
     double s = std::numeric_limits<double>::infinity();
     for (std::size_t i = first_[k]; i < first_[k + 1]; ++i)
-      for (Index v : tets_[static_cast<std::size_t>(around_[i])])
-        if (v != free_[k]) s = std::min(s, (points_[static_cast<std::size_t>(v)] - p).norm());
+      for (Index v : tets_[index_cast<std::size_t>(around_[i])])
+        if (v != free_[k]) s = std::min(s, (points_[index_cast<std::size_t>(v)] - p).norm());
     return s;
   }
 
   // Compass search at free node k; true when it moved.
   bool search(std::size_t k, const RelaxTetsOptions& o) {
-    Point& p = points_[static_cast<std::size_t>(free_[k])];
+    Point& p = points_[index_cast<std::size_t>(free_[k])];
     double best = lowest(k);
     double step = o.initial_step * shortest_edge(k);
     bool moved = false;
@@ -94,7 +94,7 @@ class Relaxer {
   template <class F>
   void for_each_neighbour(std::size_t k, F&& f) const {
     for (std::size_t i = first_[k]; i < first_[k + 1]; ++i)
-      for (Index v : tets_[static_cast<std::size_t>(around_[i])]) f(v);
+      for (Index v : tets_[index_cast<std::size_t>(around_[i])]) f(v);
   }
 
  private:
@@ -143,12 +143,12 @@ RelaxTetsResult relax_tet_nodes(std::vector<Point>& points,
     while (!order.empty()) {
       std::vector<std::size_t> round, rest;
       for (std::size_t k : order) {
-        if (touched[static_cast<std::size_t>(relax.node(k))]) {
+        if (touched[index_cast<std::size_t>(relax.node(k))]) {
           rest.push_back(k);
           continue;
         }
         round.push_back(k);
-        relax.for_each_neighbour(k, [&](Index v) { touched[static_cast<std::size_t>(v)] = 1; });
+        relax.for_each_neighbour(k, [&](Index v) { touched[index_cast<std::size_t>(v)] = 1; });
       }
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, round.size(), 16),
                         [&](const tbb::blocked_range<std::size_t>& range) {
@@ -156,14 +156,14 @@ RelaxTetsResult relax_tet_nodes(std::vector<Point>& points,
                             if (relax.search(round[i], options)) moved[round[i]] = 1, any = true;
                         });
       for (std::size_t k : round)
-        relax.for_each_neighbour(k, [&](Index v) { touched[static_cast<std::size_t>(v)] = 0; });
+        relax.for_each_neighbour(k, [&](Index v) { touched[index_cast<std::size_t>(v)] = 0; });
       order.swap(rest);
     }
     measure();
     if (!any) break;
   }
   r.min_after = n ? *std::min_element(low.begin(), low.end()) : 1.0;
-  r.nodes_moved = static_cast<Index>(std::count(moved.begin(), moved.end(), 1));
+  r.nodes_moved = index_cast(std::count(moved.begin(), moved.end(), 1));
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }
@@ -173,63 +173,62 @@ std::vector<Index> tet_nodes_to_relax(const Model& model, int rings) {
   // Nodes any other kind uses, or a node set names: fixed.
   std::vector<char> fixed(n, 0);
   for (const auto& h : model.hexes)
-    for (Index v : h) fixed[static_cast<std::size_t>(v)] = 1;
+    for (Index v : h) fixed[index_cast<std::size_t>(v)] = 1;
   for (const auto& w : model.wedges)
-    for (Index v : w) fixed[static_cast<std::size_t>(v)] = 1;
+    for (Index v : w) fixed[index_cast<std::size_t>(v)] = 1;
   for (const auto& p : model.pyramids)
-    for (Index v : p) fixed[static_cast<std::size_t>(v)] = 1;
+    for (Index v : p) fixed[index_cast<std::size_t>(v)] = 1;
   for (const NodeSet& s : model.node_sets)
-    for (Index v : s.nodes) fixed[static_cast<std::size_t>(v)] = 1;
+    for (Index v : s.nodes) fixed[index_cast<std::size_t>(v)] = 1;
   // The region: rings of tets out from the quads of hexes and wedges whose four corners are
   // all tet nodes (the quads a transition is made on: two or four tet triangles on them), not
   // from every node tets share with them (a wedge layer's base lies on tet faces too).
   std::vector<char> tet_node(n, 0), near(n, 0), in_region(model.tets.size(), 0);
   for (const auto& t : model.tets)
-    for (Index v : t) tet_node[static_cast<std::size_t>(v)] = 1;
+    for (Index v : t) tet_node[index_cast<std::size_t>(v)] = 1;
   for (const ElementKind kind : {ElementKind::kHex, ElementKind::kWedge}) {
     const auto& topo = cell_topology(kind);
     for (std::size_t c = 0; c < element_count(model, kind); ++c) {
-      const auto corners = element_corners(model, {kind, static_cast<Index>(c)});
+      const auto corners = element_corners(model, {kind, index_cast(c)});
       for (int f = 0; f < topo.faces; ++f) {
-        const auto& face = topo.face[static_cast<std::size_t>(f)];
+        const auto& face = topo.face[index_cast<std::size_t>(f)];
         if (face.size != 4) continue;
         bool covered = true;
         for (int i = 0; i < 4; ++i)
           covered &=
-              tet_node[static_cast<std::size_t>(
-                  corners[static_cast<std::size_t>(face.corners[static_cast<std::size_t>(i)])])] !=
-              0;
+              tet_node[index_cast<std::size_t>(
+                  corners[index_cast<std::size_t>(face.corners[index_cast<std::size_t>(i)])])] != 0;
         if (covered)
           for (int i = 0; i < 4; ++i)
-            near[static_cast<std::size_t>(
-                corners[static_cast<std::size_t>(face.corners[static_cast<std::size_t>(i)])])] = 1;
+            near[index_cast<std::size_t>(
+                corners[index_cast<std::size_t>(face.corners[index_cast<std::size_t>(i)])])] = 1;
       }
     }
   }
   for (int ring = 0; ring < rings; ++ring) {
     for (std::size_t t = 0; t < model.tets.size(); ++t)
       for (Index v : model.tets[t])
-        if (near[static_cast<std::size_t>(v)]) in_region[t] = 1;
+        if (near[index_cast<std::size_t>(v)]) in_region[t] = 1;
     for (std::size_t t = 0; t < model.tets.size(); ++t)
       if (in_region[t])
-        for (Index v : model.tets[t]) near[static_cast<std::size_t>(v)] = 1;
+        for (Index v : model.tets[t]) near[index_cast<std::size_t>(v)] = 1;
   }
   // Per candidate node its tets' faces through it, as the other two nodes: an interior node
   // has each such face twice (its star is closed), all in one block.
   std::vector<std::size_t> first(n + 1, 0);
   for (const auto& t : model.tets)
     for (Index v : t)
-      if (near[static_cast<std::size_t>(v)] && !fixed[static_cast<std::size_t>(v)])
-        first[static_cast<std::size_t>(v) + 1] += 3;
+      if (near[index_cast<std::size_t>(v)] && !fixed[index_cast<std::size_t>(v)])
+        first[index_cast<std::size_t>(v) + 1] += 3;
   std::partial_sum(first.begin(), first.end(), first.begin());
   std::vector<std::array<Index, 2>> faces(first.back());
   std::vector<std::size_t> fill(first.begin(), first.end() - 1);
   std::vector<int> block(n, 0);
   for (std::size_t t = 0; t < model.tets.size(); ++t) {
     const auto& c = model.tets[t];
-    const int b = block_of(model, {ElementKind::kTet, static_cast<Index>(t)});
+    const int b = block_of(model, {ElementKind::kTet, index_cast(t)});
     for (std::size_t i = 0; i < 4; ++i) {
-      const std::size_t v = static_cast<std::size_t>(c[i]);
+      const std::size_t v = index_cast<std::size_t>(c[i]);
       if (!near[v] || fixed[v]) continue;
       if (block[v] == 0) block[v] = b;
       if (block[v] != b) fixed[v] = 1;
@@ -253,7 +252,7 @@ std::vector<Index> tet_nodes_to_relax(const Model& model, int rings) {
     bool closed = (e - b) % 2 == 0;
     for (auto it = b; closed && it != e; it += 2)
       closed = *it == *(it + 1) && (it + 2 == e || *(it + 2) != *it);
-    if (closed) out.push_back(static_cast<Index>(v));
+    if (closed) out.push_back(index_cast(v));
   }
   return out;
 }
