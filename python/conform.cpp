@@ -72,7 +72,8 @@ py::dict conform_arrays(const py::handle& points, const py::handle& hexes,
                         const std::string& smooth, const std::string& quality,
                         const std::string& geode_block, const std::string& buffer_side,
                         double buffer_thickness, double smooth_target,
-                        const py::object& template_box, const py::object& merge_tolerance) {
+                        const py::object& template_box, const py::object& merge_tolerance,
+                        const std::string& relax) {
   primal::Model model;
   model.points = to_points(points, source + ": points");
   model.hexes = to_cells<8>(hexes, source + ": hexes");
@@ -97,6 +98,7 @@ py::dict conform_arrays(const py::handle& points, const py::handle& hexes,
   opts.smooth = conform::parse_conform_smooth(smooth);
   opts.quality = conform::parse_conform_quality(quality);
   opts.geode_block = geode_block;
+  opts.relax = conform::parse_conform_relax(relax);
   opts.buffer.side = conform::parse_buffer_side(buffer_side);
   if (!(buffer_thickness >= 0) ||
       buffer_thickness > conform::max_buffer_thickness(opts.buffer.side)) {
@@ -156,7 +158,7 @@ void bind_conform(py::module_& m) {
         py::arg("tets"), py::arg("tet_block"), py::arg("block_names"), py::arg("node_sets"),
         py::arg("source"), py::arg("smooth"), py::arg("quality"), py::arg("geode_block"),
         py::arg("buffer_side"), py::arg("buffer_thickness"), py::arg("smooth_target"),
-        py::arg("template_box"), py::arg("merge_tolerance"));
+        py::arg("template_box"), py::arg("merge_tolerance"), py::arg("relax"));
   m.def(
       "_demo_model",
       [](const std::string& name, int n) {

@@ -199,7 +199,7 @@ def _model_to_meshio(model, cell_data_extra=None):
 
 def conform(mesh=None, *, points=None, cells=None, cell_blocks=None, name="mesh", smooth="local", quality="sj",
             geode_block="", buffer_side="hex", buffer_thickness=0.0, smooth_target=0.0, template_box=None,
-            merge_tolerance=None, allow_invalid=False):
+            merge_tolerance=None, relax="interface", allow_invalid=False):
     """Conform a hex + tet model into one valid all-hex mesh, as `geode conform` does.
 
     mesh: a meshio.Mesh (hexahedron and tetra cells; Gmsh's surface and point entities are
@@ -214,7 +214,7 @@ def conform(mesh=None, *, points=None, cells=None, cell_blocks=None, name="mesh"
     pts, arrays, names, node_sets = _model_arrays(mesh, points, cells, cell_blocks, name)
     out = _geode._conform(pts, arrays["hexes"], arrays["hex_block"], arrays["tets"], arrays["tet_block"], names,
                           node_sets, name, smooth, quality, geode_block, buffer_side, float(buffer_thickness),
-                          float(smooth_target), template_box, merge_tolerance)
+                          float(smooth_target), template_box, merge_tolerance, relax)
     if not out["valid"] and not allow_invalid:
         raise InvalidResultError(out["invalid_reason"] + " (nothing returned; allow_invalid=True returns it anyway)")
     model = out["model"]

@@ -123,3 +123,20 @@ def test_conform_refuses_a_non_manifold_model():
     hexes[1] = [8, 9, 0, 10, 11, 12, 4, 13]  # its corners (0, 0, 0) and (0, 0, 1) are the cube's
     with pytest.raises(geode.TopologyError, match="not a manifold along the edge of nodes 1 5"):
         geode.conform(points=points, cells=[("hexahedron", hexes)])
+
+
+def test_conform_relax_option_matches_cli(tmp_path):
+    # relax= as --relax: the default moves the Delaunay tets beside the hex part, "none" keeps
+    # every node; the yardstick (the input's own cells) is the same either way.
+    mesh = geode.demo_model("delaunay", 4)
+    _, relaxed = geode.conform(mesh)
+    _, kept = geode.conform(mesh, relax="none")
+    assert relaxed["tet_relaxation"]["nodes_moved"] > 0
+    assert kept["tet_relaxation"]["nodes_moved"] == 0
+    assert relaxed["input_diced_alone_min_scaled_jacobian"] == kept["input_diced_alone_min_scaled_jacobian"]
+    run_cli("demo", "--model", "delaunay", "-n", "4", "--relax", "none", "--report", tmp_path / "r.json",
+            "--quiet")
+    cli = json.loads((tmp_path / "r.json").read_text())
+    assert kept["output_min_scaled_jacobian"] == pytest.approx(cli["output_min_scaled_jacobian"], abs=1e-9)
+    with pytest.raises(geode.InputError, match="tet relaxation"):
+        geode.conform(mesh, relax="all")
