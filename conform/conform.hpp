@@ -226,14 +226,15 @@ struct ConformResult {
   double seconds = 0.0;
 };
 
-// Pyramids first become tets (ConformOptions::pyramids); wedges are diced in place, 6 hexes
-// each, after the diced tets in the output. A model without a hex part or a tet part (wedges and
-// tets, tets only) has no interface and is simply diced. Throws TopologyError from
-// find_interface / insert_buffer_layer (named by them), when a side face is shared by more
-// than two buffer hexes, when the side faces of two buffer hexes do not match, or when a wedge
-// touches the hex/tet interface (not supported yet); InvalidInput when the model is empty or
-// has both parts but no interface quad. A result whose
-// validity is not ok() is still returned (with warnings) so that it can be inspected.
+// Pyramids first become tets (ConformOptions::pyramids), then the tets near the transition are
+// relaxed (ConformOptions::relax); wedges are diced in place, 6 hexes each, after the diced tets
+// in the output, and a wedge quad meeting tet triangles gets the transition as a hex quad does.
+// A model without tets, or without hexes and wedges, has no interface and is simply diced.
+// Throws TopologyError from find_interface / insert_buffer_layer (named by them: e.g. a wedge
+// joining the two sides around an interface node), when a side face is shared by more than two
+// buffer hexes or when the side faces of two buffer hexes do not match; InvalidInput when the
+// model is empty or has both parts but no interface quad. A result whose validity is not ok()
+// is still returned (with warnings) so that it can be inspected.
 ConformResult conform(const primal::Model& input, const ConformOptions& options = {});
 
 }  // namespace geode::conform
