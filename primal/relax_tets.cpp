@@ -14,8 +14,6 @@
 namespace geode::primal {
 namespace {
 
-constexpr std::size_t kTetFaces[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
-
 // The relaxation's state: per free node its tets (compressed rows), the points moved in place.
 class Relaxer {
  public:
@@ -232,15 +230,12 @@ std::vector<Index> tet_nodes_to_relax(const Model& model, int rings) {
       if (!near[v] || fixed[v]) continue;
       if (block[v] == 0) block[v] = b;
       if (block[v] != b) fixed[v] = 1;
-      for (const auto& f : kTetFaces)
-        if (f[0] == i || f[1] == i || f[2] == i) {
-          std::array<Index, 2> e{};
-          std::size_t m = 0;
-          for (std::size_t j : f)
-            if (j != i) e[m++] = c[j];
-          if (e[0] > e[1]) std::swap(e[0], e[1]);
-          faces[fill[v]++] = e;
-        }
+      // The three faces through corner i: the other three corners taken in pairs.
+      const std::array<Index, 3> o{c[(i + 1) % 4], c[(i + 2) % 4], c[(i + 3) % 4]};
+      for (std::size_t j = 0; j < 3; ++j) {
+        const Index x = o[j], y = o[(j + 1) % 3];
+        faces[fill[v]++] = {std::min(x, y), std::max(x, y)};
+      }
     }
   }
   std::vector<Index> out;

@@ -22,13 +22,10 @@ namespace {
 
 double tet_volume(const primal::Model& m) {
   double v = 0.0;
-  for (const auto& t : m.tets) {
-    const auto& a = m.points[static_cast<std::size_t>(t[0])];
-    v += (m.points[static_cast<std::size_t>(t[1])] - a)
-             .cross(m.points[static_cast<std::size_t>(t[2])] - a)
-             .dot(m.points[static_cast<std::size_t>(t[3])] - a) /
-         6.0;
-  }
+  for (const auto& t : m.tets)
+    v += primal::tet_volume(
+        m.points[static_cast<std::size_t>(t[0])], m.points[static_cast<std::size_t>(t[1])],
+        m.points[static_cast<std::size_t>(t[2])], m.points[static_cast<std::size_t>(t[3])]);
   return v;
 }
 
