@@ -58,6 +58,8 @@ std::vector<std::array<Index, K>> to_cells(const py::handle& object, const std::
   return cells;
 }
 template std::vector<std::array<Index, 4>> to_cells<4>(const py::handle&, const std::string&);
+template std::vector<std::array<Index, 5>> to_cells<5>(const py::handle&, const std::string&);
+template std::vector<std::array<Index, 6>> to_cells<6>(const py::handle&, const std::string&);
 template std::vector<std::array<Index, 8>> to_cells<8>(const py::handle&, const std::string&);
 
 py::array points_array(std::vector<Point>&& points) {
@@ -71,6 +73,8 @@ py::array cells_array(std::vector<std::array<Index, K>>&& cells) {
   return owned(std::move(cells), {n, K}, py::dtype::of<Index>());
 }
 template py::array cells_array<4>(std::vector<std::array<Index, 4>>&&);
+template py::array cells_array<5>(std::vector<std::array<Index, 5>>&&);
+template py::array cells_array<6>(std::vector<std::array<Index, 6>>&&);
 template py::array cells_array<8>(std::vector<std::array<Index, 8>>&&);
 
 py::array index_array(std::vector<Index>&& values) {

@@ -21,14 +21,16 @@ using primal::Point;
 
 // N x 3 (or N x 2, z = 0) numbers as points; InvalidInput naming `what` for another shape.
 std::vector<Point> to_points(const py::handle& array, const std::string& what);
-// M x K node numbers (any integer dtype) as cells; InvalidInput naming `what` for another shape or
-// a number outside the 32-bit index range. Node ranges are checked by the library functions.
+// M x K node numbers (any integer dtype) as cells, K = 4, 5, 6 or 8 (tets or quads, pyramids,
+// wedges, hexes); InvalidInput naming `what` for another shape or a number outside the 32-bit
+// index range. Node ranges are checked by the library functions.
 template <int K>
 std::vector<std::array<Index, K>> to_cells(const py::handle& array, const std::string& what);
 // The number of columns of a 2D cell array (4 or 8 picks quads or hexes); InvalidInput otherwise.
 int cell_width(const py::handle& array, const std::string& what);
 
-// Arrays that own their data: the vector is moved to the heap and freed with the array.
+// Arrays that own their data: the vector is moved to the heap and freed with the array (cells:
+// K as for to_cells).
 py::array points_array(std::vector<Point>&& points);
 template <int K>
 py::array cells_array(std::vector<std::array<Index, K>>&& cells);

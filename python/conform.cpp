@@ -1,8 +1,11 @@
-// geode.conform's core and the demo models: a hex + tet model given as arrays (the package's
-// geode.conform converts a meshio.Mesh to them and back), conformed as `geode conform` does
-// (cli/conform_command.cpp) with the same options, messages and verdict (conform/report.hpp).
+// geode.conform's core and the demo models: a model of hexes, tets, pyramids and wedges given as
+// arrays (the package's geode.conform converts a meshio.Mesh to them and back), conformed as
+// `geode conform` does (cli/conform_command.cpp) with the same options, messages and verdict
+// (conform/report.hpp).
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <optional>
 #include <sstream>
 
@@ -16,48 +19,86 @@
 namespace geode::python {
 namespace {
 
-std::vector<int> to_blocks(const py::handle& blocks, std::size_t n, const std::string& what) {
-  if (blocks.is_none()) return {};
-  auto b = blocks.cast<std::vector<int>>();
-  if (b.size() != n)
-    throw InvalidInput(what + ": " + std::to_string(b.size()) + " block ids for " +
-                       std::to_string(n) + " elements");
-  return b;
+// Each cell kind's entries in the dicts of arrays geode.conform passes in and the module hands
+// out (python/geode/__init__.py), in primal::kElementKinds order: M x corners node numbers in
+// the model's corner order (meshio's for all four: its linear wedge is Gmsh's prism), M block
+// ids, and on the way in M file ids for messages.
+struct KindKeys {
+  primal::ElementKind kind;
+  const char* cells;
+  const char* block;
+  const char* ids;
+};
+constexpr std::array<KindKeys, 4> kKindKeys{{
+    {primal::ElementKind::kHex, "hexes", "hex_block", "hex_ids"},
+    {primal::ElementKind::kTet, "tets", "tet_block", "tet_ids"},
+    {primal::ElementKind::kPyramid, "pyramids", "pyramid_block", "pyramid_ids"},
+    {primal::ElementKind::kWedge, "wedges", "wedge_block", "wedge_ids"},
+}};
+
+// One kind's arrays appended to the model, each element with its block and file id.
+void add_cells(primal::Model& model, const KindKeys& keys, const py::dict& arrays,
+               const std::string& source) {
+  const std::string what = source + ": " + keys.cells;
+  const auto blocks = py::object(arrays[keys.block]).cast<std::vector<int>>();
+  const auto ids = py::object(arrays[keys.ids]).cast<std::vector<std::int64_t>>();
+  auto add = [&](const auto& cells) {
+    if (blocks.size() != cells.size() || ids.size() != cells.size())
+      throw InvalidInput(what + ": " + std::to_string(blocks.size()) + " block ids and " +
+                         std::to_string(ids.size()) + " element ids for " +
+                         std::to_string(cells.size()) + " elements");
+    for (std::size_t i = 0; i < cells.size(); ++i)
+      primal::add_element(model, keys.kind, cells[i], blocks[i], ids[i]);
+  };
+  const py::object cells = arrays[keys.cells];
+  switch (primal::cell_topology(keys.kind).corners) {
+    case 4:
+      add(to_cells<4>(cells, what));
+      break;
+    case 5:
+      add(to_cells<5>(cells, what));
+      break;
+    case 6:
+      add(to_cells<6>(cells, what));
+      break;
+    default:
+      add(to_cells<8>(cells, what));
+  }
 }
 
+// Every kind's cells and blocks (a kind's default block where the model leaves them implicit),
+// block names, node sets and side sets.
 py::dict model_dict(primal::Model&& model) {
-  // The module hands out hexes and tets only so far: refuse rather than drop the other kinds.
-  for (primal::ElementKind kind : {primal::ElementKind::kPyramid, primal::ElementKind::kWedge})
-    if (const std::size_t n = primal::element_count(model, kind))
-      throw InvalidInput(
-          "the model holds " + std::to_string(n) + " " + primal::element_kind_name(kind) +
-          "s, which the Python module does not hand out yet (the command writes them: "
-          "geode demo --save-input)");
   py::dict d;
-  const std::size_t nh = model.hexes.size(), nt = model.tets.size();
-  std::vector<int> hb = model.hex_block, tb = model.tet_block;
-  if (hb.empty()) hb.assign(nh, 1);
-  if (tb.empty()) tb.assign(nt, 2);
+  for (const KindKeys& keys : kKindKeys) {
+    std::vector<int> blocks = primal::element_blocks(model, keys.kind);
+    if (blocks.empty())
+      blocks.assign(primal::element_count(model, keys.kind), primal::default_block(keys.kind));
+    d[keys.block] = py::array_t<int>(static_cast<py::ssize_t>(blocks.size()), blocks.data());
+  }
   d["points"] = points_array(std::move(model.points));
   d["hexes"] = cells_array<8>(std::move(model.hexes));
   d["tets"] = cells_array<4>(std::move(model.tets));
-  d["hex_block"] = py::array(py::cast(hb));
-  d["tet_block"] = py::array(py::cast(tb));
+  d["pyramids"] = cells_array<5>(std::move(model.pyramids));
+  d["wedges"] = cells_array<6>(std::move(model.wedges));
   d["block_names"] = model.block_names;
   py::list node_sets, side_sets;
   for (auto& s : model.node_sets)
     node_sets.append(py::dict(py::arg("id") = s.id, py::arg("name") = s.name,
                               py::arg("nodes") = index_array(std::move(s.nodes))));
   for (const auto& s : model.side_sets) {
-    std::vector<Index> sides;  // (element, local face) pairs: hexes in conform's all-hex output
+    // (element, local face) pairs, the element an index into its kind's array; the kinds as
+    // primal::ElementKind numbers (conform's all-hex output: every one 0).
+    std::vector<Index> sides, kinds;
     for (const auto& side : s.sides) {
       sides.push_back(side.element.index);
       sides.push_back(side.face);
+      kinds.push_back(static_cast<Index>(side.element.kind));
     }
     auto a = index_array(std::move(sides))
                  .reshape({static_cast<py::ssize_t>(s.sides.size()), py::ssize_t{2}});
-    side_sets.append(
-        py::dict(py::arg("id") = s.id, py::arg("name") = s.name, py::arg("sides") = a));
+    side_sets.append(py::dict(py::arg("id") = s.id, py::arg("name") = s.name, py::arg("sides") = a,
+                              py::arg("kinds") = index_array(std::move(kinds))));
   }
   d["node_sets"] = node_sets;
   d["side_sets"] = side_sets;
@@ -65,21 +106,16 @@ py::dict model_dict(primal::Model&& model) {
 }
 
 // The model as arrays; conform's options by name, as `geode conform` spells them (with _).
-py::dict conform_arrays(const py::handle& points, const py::handle& hexes,
-                        const py::handle& hex_block, const py::handle& tets,
-                        const py::handle& tet_block, const std::map<int, std::string>& block_names,
-                        const py::list& node_sets, const std::string& source,
-                        const std::string& smooth, const std::string& quality,
-                        const std::string& geode_block, const std::string& buffer_side,
-                        double buffer_thickness, double smooth_target,
-                        const py::object& template_box, const py::object& merge_tolerance,
-                        const std::string& relax) {
+py::dict conform_arrays(const py::handle& points, const py::dict& cells,
+                        const std::map<int, std::string>& block_names, const py::list& node_sets,
+                        const std::string& source, const std::string& smooth,
+                        const std::string& quality, const std::string& geode_block,
+                        const std::string& buffer_side, double buffer_thickness,
+                        double smooth_target, const py::object& template_box,
+                        const py::object& merge_tolerance, const std::string& relax) {
   primal::Model model;
   model.points = to_points(points, source + ": points");
-  model.hexes = to_cells<8>(hexes, source + ": hexes");
-  model.tets = to_cells<4>(tets, source + ": tets");
-  model.hex_block = to_blocks(hex_block, model.hexes.size(), source + ": hex blocks");
-  model.tet_block = to_blocks(tet_block, model.tets.size(), source + ": tet blocks");
+  for (const KindKeys& keys : kKindKeys) add_cells(model, keys, cells, source);
   model.block_names = block_names;
   for (const auto& s : node_sets) {
     const auto d = s.cast<py::dict>();
@@ -89,8 +125,10 @@ py::dict conform_arrays(const py::handle& points, const py::handle& hexes,
     set.nodes = d["nodes"].cast<std::vector<Index>>();
     model.node_sets.push_back(std::move(set));
   }
-  // What the readers check of a file, here of the arrays (ids are 0-based indices + 1, as
-  // written; messages name the source).
+  // What the readers check of a file, here of the arrays: a wedge or pyramid in another corner
+  // order is inverted, and refused as a file's is (the element ids are the package's: each
+  // cell's 1-based position among the mesh's cells, a .msh file's element tag when meshio or
+  // geode wrote it; messages name the source).
   primal::validate(model, source);
   primal::check_geometry(model, source);
 
@@ -154,11 +192,11 @@ py::dict conform_arrays(const py::handle& points, const py::handle& hexes,
 }  // namespace
 
 void bind_conform(py::module_& m) {
-  m.def("_conform", &conform_arrays, py::arg("points"), py::arg("hexes"), py::arg("hex_block"),
-        py::arg("tets"), py::arg("tet_block"), py::arg("block_names"), py::arg("node_sets"),
-        py::arg("source"), py::arg("smooth"), py::arg("quality"), py::arg("geode_block"),
-        py::arg("buffer_side"), py::arg("buffer_thickness"), py::arg("smooth_target"),
-        py::arg("template_box"), py::arg("merge_tolerance"), py::arg("relax"));
+  m.def("_conform", &conform_arrays, py::arg("points"), py::arg("cells"), py::arg("block_names"),
+        py::arg("node_sets"), py::arg("source"), py::arg("smooth"), py::arg("quality"),
+        py::arg("geode_block"), py::arg("buffer_side"), py::arg("buffer_thickness"),
+        py::arg("smooth_target"), py::arg("template_box"), py::arg("merge_tolerance"),
+        py::arg("relax"));
   m.def(
       "_demo_model",
       [](const std::string& name, int n) {

@@ -2,8 +2,8 @@
 
 The library behind the `geode` command, for notebooks: templates derived from their sheet
 arrangements, arrangements given as specs, the dual of any hex mesh, validity and
-realizability checks, smoothing, the paper's Table 1 metrics, and whole hex + tet models
-conformed into one all-hex mesh. Arrays are numpy (points N x 3 float64, cells int32 in VTK
+realizability checks, smoothing, the paper's Table 1 metrics, and whole models of hexes, tets,
+pyramids and wedges conformed into one all-hex mesh. Arrays are numpy (points N x 3 float64, cells int32 in VTK
 order, every id 0-based); meshes in and out of conform are meshio.Mesh objects.
 
     import geode
@@ -126,12 +126,22 @@ Template.__repr__ = _template_repr
 
 # ---- Whole models ------------------------------------------------------------------------------
 
-_VOLUME = {"hexahedron": "hexes", "tetra": "tets"}
+# The linear volume cells geode takes, as meshio names them, and their arrays in the dicts of
+# the C++ module (python/conform.cpp), in the library's kind order: meshio type, cells key,
+# block key, ids key, corners. meshio's corner orders are the library's for all four (VTK's for
+# hexahedron, tetra and pyramid; its linear wedge is Gmsh's prism, 0-1-2 counter-clockwise seen
+# from 3-4-5, which its VTK reader and writer mirror as geode's do).
+_KINDS = (("hexahedron", "hexes", "hex_block", "hex_ids", 8), ("tetra", "tets", "tet_block", "tet_ids", 4),
+          ("pyramid", "pyramids", "pyramid_block", "pyramid_ids", 5),
+          ("wedge", "wedges", "wedge_block", "wedge_ids", 6))
+_VOLUME = {kind[0]: kind for kind in _KINDS}
 _SURFACE = {"vertex", "line", "triangle", "quad"}  # boundary entities of a Gmsh file: not elements
 
 
 def _model_arrays(mesh=None, points=None, cells=None, cell_blocks=None, name="mesh"):
-    """A meshio.Mesh (or points + [(type, array)] cell blocks) as conform's arrays."""
+    """A meshio.Mesh (or points + [(type, array)] cell blocks) as conform's arrays. Each element's
+    id (messages name it) is its 1-based position among all the cells, surface cells counted:
+    the element tag of a .msh file meshio or geode wrote."""
     if mesh is not None:
         points = mesh.points
         cells = [(c.type, c.data) for c in mesh.cells]
@@ -144,43 +154,50 @@ def _model_arrays(mesh=None, points=None, cells=None, cell_blocks=None, name="me
         cells = list(cells.items()) if isinstance(cells, dict) else list(cells)
         physical, names, point_sets = None, {}, {}
     points = _np.asarray(points, dtype=float)
-    parts = {"hexes": [], "tets": []}
-    blocks = {"hexes": [], "tets": []}
+    parts = {kind[1]: [] for kind in _KINDS}
+    blocks = {kind[1]: [] for kind in _KINDS}
+    ids = {kind[1]: [] for kind in _KINDS}
     volume_index = 0
+    position = 0  # cells before this block
     for i, (kind, data) in enumerate(cells):
+        data = _np.asarray(data)
+        first, position = position + 1, position + len(data)
         if kind in _SURFACE:
             continue
         if kind not in _VOLUME:
-            raise InputError("{}: cell block {} holds '{}' cells; geode.conform takes linear hexahedra and tetra"
-                             .format(name, i, kind))
-        data = _np.asarray(data)
+            raise InputError("{}: cell block {} holds '{}' cells; geode.conform takes linear hexahedron, tetra, "
+                             "pyramid and wedge cells".format(name, i, kind))
+        key = _VOLUME[kind][1]
         if cell_blocks is not None:
-            ids = _np.full(len(data), int(cell_blocks[i]))
+            block = _np.full(len(data), int(cell_blocks[i]))
         elif physical is not None and len(physical[i]) == len(data):
-            ids = _np.asarray(physical[i], dtype=int)
+            block = _np.asarray(physical[i], dtype=int)
         else:
-            ids = _np.full(len(data), volume_index + 1)
+            block = _np.full(len(data), volume_index + 1)
         volume_index += 1
-        parts[_VOLUME[kind]].append(data)
-        blocks[_VOLUME[kind]].append(ids)
+        parts[key].append(data)
+        blocks[key].append(block)
+        ids[key].append(_np.arange(first, position + 1, dtype=_np.int64))
     arrays = {}
-    for key, block_key, width in (("hexes", "hex_block", 8), ("tets", "tet_block", 4)):
+    for _, key, block_key, ids_key, width in _KINDS:
         arrays[key] = _np.concatenate(parts[key]) if parts[key] else _np.zeros((0, width), dtype=_np.int64)
         arrays[block_key] = _np.concatenate(blocks[key]) if blocks[key] else _np.zeros(0, dtype=int)
+        arrays[ids_key] = _np.concatenate(ids[key]) if ids[key] else _np.zeros(0, dtype=_np.int64)
     node_sets = [{"id": k + 1, "name": n, "nodes": [int(x) for x in _np.asarray(v).ravel()]}
                  for k, (n, v) in enumerate(point_sets.items())]
     return points, arrays, names, node_sets
 
 
 def _model_to_meshio(model, cell_data_extra=None):
-    """Conform's (or a demo's) arrays as a meshio.Mesh: one cell block per element block, each
-    block a cell set named as the block, block ids as gmsh:physical, node sets as point sets."""
+    """Conform's (or a demo's) arrays as a meshio.Mesh: one cell block per element block and
+    cell kind (kinds in the order hexahedron, tetra, pyramid, wedge), each block a cell set named
+    as the block, block ids as gmsh:physical, node sets as point sets."""
     import meshio
 
     cells, physical, cell_sets, field_data = [], [], {}, {}
     names = model["block_names"]
     groups = []
-    for kind, key, block_key in (("hexahedron", "hexes", "hex_block"), ("tetra", "tets", "tet_block")):
+    for kind, key, block_key, _, _ in _KINDS:
         ids = _np.asarray(model[block_key])
         for b in sorted(set(ids.tolist())):
             groups.append((kind, b, _np.asarray(model[key])[ids == b]))
@@ -200,21 +217,26 @@ def _model_to_meshio(model, cell_data_extra=None):
 def conform(mesh=None, *, points=None, cells=None, cell_blocks=None, name="mesh", smooth="local", quality="sj",
             geode_block="", buffer_side="hex", buffer_thickness=0.0, smooth_target=0.0, template_box=None,
             merge_tolerance=None, relax="interface", allow_invalid=False):
-    """Conform a hex + tet model into one valid all-hex mesh, as `geode conform` does.
+    """Conform a model of hexes, tets, pyramids and wedges into one valid all-hex mesh, as
+    `geode conform` does.
 
-    mesh: a meshio.Mesh (hexahedron and tetra cells; Gmsh's surface and point entities are
-    skipped; blocks from gmsh:physical, else one per cell block; block names from field_data;
-    point sets become node sets; side sets are not read: meshio has no form for them), or points and cells ([(type, array)] or {type: array}) with
-    cell_blocks (one block id per cell block). The options are those of `geode conform`.
+    mesh: a meshio.Mesh (hexahedron, tetra, pyramid and wedge cells in meshio's corner orders, a
+    wedge's 0-1-2 counter-clockwise seen from 3-4-5 as Gmsh's prism; Gmsh's surface and point
+    entities are skipped; blocks from gmsh:physical, else one per cell block; block names from
+    field_data; point sets become node sets; side sets are not read: meshio has no form for
+    them), or points and cells ([(type, array)] or {type: array}) with cell_blocks (one block id
+    per cell block). The input gets the checks a file gets when read: a cell in another corner
+    order (a wedge in VTK's mirrored order, a pyramid's base clockwise) is inverted and raises
+    InputError naming it by its 1-based position among the cells (a .msh file's element tag).
+    The options are those of `geode conform`.
     Returns (meshio.Mesh, report): the output with one cell block and one cell set per block,
     block ids as gmsh:physical, node sets as point sets; the report as `--report` writes it,
     with "side_sets" ([{id, name, sides: K x 2 (hex in the output's order, local face)}]).
     A result that fails verification raises InvalidResultError, unless allow_invalid=True.
     """
     pts, arrays, names, node_sets = _model_arrays(mesh, points, cells, cell_blocks, name)
-    out = _geode._conform(pts, arrays["hexes"], arrays["hex_block"], arrays["tets"], arrays["tet_block"], names,
-                          node_sets, name, smooth, quality, geode_block, buffer_side, float(buffer_thickness),
-                          float(smooth_target), template_box, merge_tolerance, relax)
+    out = _geode._conform(pts, arrays, names, node_sets, name, smooth, quality, geode_block, buffer_side,
+                          float(buffer_thickness), float(smooth_target), template_box, merge_tolerance, relax)
     if not out["valid"] and not allow_invalid:
         raise InvalidResultError(out["invalid_reason"] + " (nothing returned; allow_invalid=True returns it anyway)")
     model = out["model"]
@@ -231,8 +253,9 @@ def conform(mesh=None, *, points=None, cells=None, cell_blocks=None, name="mesh"
 
 
 def demo_model(name="half", n=4):
-    """A demo hex + tet model meshed with the Gmsh API (demo_model_names(); `geode demo --model`),
-    as a meshio.Mesh."""
+    """A demo model meshed with the Gmsh API (demo_model_names(); `geode demo --model`), as a
+    meshio.Mesh: its hexahedron, tetra, pyramid and wedge cells, one cell block per block and
+    kind, as `geode demo --save-input` writes it."""
     return _model_to_meshio(_geode._demo_model(name, int(n)))
 
 
