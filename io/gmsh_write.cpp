@@ -40,16 +40,37 @@ namespace {
 
 constexpr int kTri3 = 2, kQuad4 = 3, kPoint = 15;
 
-// One entity block of $Elements: its entity and type, and each element's Gmsh node tags.
+// One entity block of $Elements: its entity and type, and each element's Gmsh node tags. A
+// volume block names the model's elements of one kind and their tags are made as they are
+// written (a copy of an all-hex output's connectivity in 8-byte tags would be the largest
+// array of a conform run); side and node sets hold their tags.
 struct ElementBlock {
   int dim = 0;
   int entity = 0;
   int physical = 0;
   int type = 0;
   std::size_t nodes_per_element = 0;
-  std::vector<std::size_t> node_tags;  // nodes_per_element per element
+  std::vector<std::size_t> node_tags;  // nodes_per_element per element (dim < 3)
   std::size_t first_tag = 0;
-  std::size_t count() const { return nodes_per_element ? node_tags.size() / nodes_per_element : 0; }
+  ElementKind kind = ElementKind::kHex;  // dim 3: the elements' kind
+  std::vector<Index> elements;           // dim 3: into the kind's array
+  std::size_t count() const {
+    if (dim == 3) return elements.size();
+    return nodes_per_element ? node_tags.size() / nodes_per_element : 0;
+  }
+  // Element e's Gmsh node tags, in Gmsh's corner order (gmsh.hpp's kGmshCells).
+  void tags(const Model& model, std::size_t e, std::array<std::size_t, 8>& out) const {
+    if (dim != 3) {
+      std::copy_n(node_tags.begin() + static_cast<std::ptrdiff_t>(e * nodes_per_element),
+                  nodes_per_element, out.begin());
+      return;
+    }
+    const GmshCell& cell = kGmshCells[static_cast<std::size_t>(kind)];
+    const auto c = element_corners(model, {kind, elements[e]});
+    // gmsh_corner[order[i]] = model_corner[i]
+    for (std::size_t v = 0; v < nodes_per_element; ++v)
+      out[static_cast<std::size_t>(cell.order[v])] = index_cast<std::size_t>(c[v]) + 1;
+  }
 };
 
 struct Entity {
@@ -116,23 +137,24 @@ class MshLayout {
         const int block = block_of(model, ref);
         auto& list = by_block[block];
         if (list.empty() || list.back().type != cell.type)
-          list.push_back({3, block, block, cell.type, corners, {}, 0});
-        auto& tags = list.back().node_tags;
-        const std::size_t base = tags.size();
-        tags.resize(base + corners);
-        const auto c = element_corners(model, ref);
-        // gmsh_corner[order[i]] = model_corner[i]
-        for (std::size_t v = 0; v < corners; ++v)
-          tags[base + static_cast<std::size_t>(cell.order[v])] = static_cast<std::size_t>(c[v]) + 1;
+          list.push_back({3, block, block, cell.type, corners, {}, 0, kind, {}});
+        list.back().elements.push_back(ref.index);
       }
     }
     for (auto& [block, list] : by_block) {
-      std::vector<std::size_t> all;
+      Entity e{3, block, block, Point::Zero(), Point::Zero()};
+      bool first = true;
       for (ElementBlock& b : list) {
-        all.insert(all.end(), b.node_tags.begin(), b.node_tags.end());
+        for (Index i : b.elements)
+          for (Index v : element_corners(model, {b.kind, i})) {
+            const Point& p = model.points[index_cast<std::size_t>(v)];
+            e.low = first ? p : e.low.cwiseMin(p);
+            e.high = first ? p : e.high.cwiseMax(p);
+            first = false;
+          }
         blocks.push_back(std::move(b));
       }
-      entities.push_back(bounded(3, block, block, all));
+      entities.push_back(e);
       if (auto it = model.block_names.find(block);
           it != model.block_names.end() && !sanitize_name(it->second).empty())
         names.push_back({3, block, sanitize_name(it->second)});
@@ -178,8 +200,8 @@ class MshLayout {
     for (std::size_t s = 0; s < model.side_sets.size(); ++s) {
       const SideSet& set = model.side_sets[s];
       const int physical = side_tags_[s], entity = physical;
-      ElementBlock tri{2, entity, physical, kTri3, 3, {}, 0},
-          quad{2, entity, physical, kQuad4, 4, {}, 0};
+      ElementBlock tri{2, entity, physical, kTri3, 3, {}, 0, ElementKind::kHex, {}},
+          quad{2, entity, physical, kQuad4, 4, {}, 0, ElementKind::kHex, {}};
       for (const Side& side : set.sides) {
         const std::vector<Index> face = element_face(model, side);
         for (Index v : face)
@@ -199,7 +221,7 @@ class MshLayout {
     for (std::size_t s = 0; s < model.node_sets.size(); ++s) {
       const NodeSet& set = model.node_sets[s];
       const int physical = node_tags_[s], entity = physical;
-      ElementBlock points{0, entity, physical, kPoint, 1, {}, 0};
+      ElementBlock points{0, entity, physical, kPoint, 1, {}, 0, ElementKind::kHex, {}};
       for (Index v : set.nodes) points.node_tags.push_back(static_cast<std::size_t>(v) + 1);
       entities.push_back(bounded(0, entity, physical, points.node_tags));
       if (!points.node_tags.empty()) blocks.push_back(std::move(points));
@@ -328,10 +350,12 @@ class MshWriter {
       int_field(b.entity);
       int_field(b.type);
       size_field(b.count(), true);
+      std::array<std::size_t, 8> nodes{};
       for (std::size_t e = 0; e < b.count(); ++e) {
         size_field(b.first_tag + e);
+        b.tags(l_.model, e, nodes);
         for (std::size_t k = 0; k < b.nodes_per_element; ++k)
-          size_field(b.node_tags[e * b.nodes_per_element + k], k + 1 == b.nodes_per_element);
+          size_field(nodes[k], k + 1 == b.nodes_per_element);
       }
     }
     if (binary_) nl();
@@ -372,8 +396,9 @@ class MshWriter {
         out_.raw<std::int32_t>(static_cast<std::int32_t>(b.count()));
         out_.raw<std::int32_t>(2);  // tags: physical, elementary entity
       }
+      std::array<std::size_t, 8> nodes{};
       for (std::size_t e = 0; e < b.count(); ++e) {
-        const std::size_t* nodes = b.node_tags.data() + e * b.nodes_per_element;
+        b.tags(l_.model, e, nodes);
         if (binary_) {
           out_.raw<std::int32_t>(static_cast<std::int32_t>(b.first_tag + e));
           out_.raw<std::int32_t>(b.physical);
