@@ -25,8 +25,6 @@ def test_demo_model(half):
     assert "half" in geode.demo_model_names()
 
 
-
-
 def test_conform_matches_cli(half, tmp_path):
     out, report = geode.conform(half)
     run_cli("demo", "--model", "half", "-n", "2", "--report", tmp_path / "r.json", "--quiet")
