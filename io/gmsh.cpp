@@ -12,4 +12,10 @@ Model read_gmsh(const std::filesystem::path& path, const ReadOptions& options) {
   return parse_gmsh(MappedFile(path).bytes(), path.string(), options);
 }
 
+Model read_gmsh_partitioned(const std::filesystem::path& path, const ReadOptions& options,
+                            FilePartition* partition) {
+  check_mesh_format(path, MeshFileFormat::kGmsh);
+  return parse_gmsh(MappedFile(path).bytes(), path.string(), options, partition);
+}
+
 }  // namespace geode::io

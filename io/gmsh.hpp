@@ -27,6 +27,7 @@
 #include <filesystem>
 #include <string_view>
 
+#include <geode/io/file_partition.hpp>
 #include <geode/primal/model.hpp>
 
 namespace geode::io {
@@ -67,9 +68,18 @@ enum class GmshVersion { k41, k22 };
 // element referring to a node not in $Nodes, a node given twice at two places, a side-set face that
 // is no face of a hex or tet; then check_geometry (model.hpp) unless options say otherwise.
 primal::Model read_gmsh(const std::filesystem::path& path, const primal::ReadOptions& options = {});
+// A partitioned 4.1 file ($PartitionedEntities, as gmsh.model.mesh.partition writes it): the
+// model is the unpartitioned file's (the elements Gmsh adds on the boundaries between
+// partitions are left out; elements of a block by ascending tag, the order partitioning
+// regroups), and `partition` gets each volume element's partition (Gmsh's tag
+// - 1). A file of Gmsh's Mesh.PartitionSplitMeshFiles=1 set (one partition's elements) is
+// refused. A file without partitions gives partition->parts == 0.
+primal::Model read_gmsh_partitioned(const std::filesystem::path& path,
+                                    const primal::ReadOptions& options, FilePartition* partition);
 // The same on a file's content; `source` names it in messages.
 primal::Model parse_gmsh(std::string_view content, const std::string& source,
-                         const primal::ReadOptions& options = {});
+                         const primal::ReadOptions& options = {},
+                         FilePartition* partition = nullptr);
 
 // Writes .msh (v4.1 or 2.2) atomically (a temporary file in the same directory, then rename).
 // Block ids must be positive; a block may hold both hexes and tets. Blocks become physical

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <numeric>
 #include <set>
 #include <string>
 #include <unordered_map>
@@ -90,7 +91,8 @@ struct RawElement {
 
 class MshReader {
  public:
-  MshReader(std::string_view data, std::string source) : s_(data), source_(std::move(source)) {}
+  MshReader(std::string_view data, std::string source, FilePartition* partition)
+      : s_(data), source_(std::move(source)), partition_(partition) {}
 
   Model read() {
     if (sniff_mesh_format(s_) != MeshFileFormat::kGmsh)
@@ -145,9 +147,12 @@ class MshReader {
   // parent's; when none are given the parent's hold).
   struct Partitioned {
     int parent_dim = 0, parent_tag = 0;
+    std::vector<int> partitions;  // Gmsh's tags, 1-based
     std::vector<int> physicals;
   };
   bool partitioned_ = false;
+  std::size_t partitions_ = 0;  // $PartitionedEntities' count
+  FilePartition* partition_;    // filled when not null
   std::map<std::pair<int, int>, Partitioned> partitioned_entities_;
   std::vector<std::int64_t> node_tags_;
   std::vector<Point> node_points_;
@@ -362,7 +367,7 @@ class MshReader {
 
   void partitioned_entities() {
     partitioned_ = true;
-    size_field("the number of partitions");
+    partitions_ = count_field("the number of partitions", item_bytes(1, 4));
     const std::size_t ghosts = count_field("the number of ghost entities", item_bytes(2, 8));
     for (std::size_t g = 0; g < ghosts; ++g) {
       int_field("a ghost entity tag");
@@ -378,7 +383,8 @@ class MshReader {
         p.parent_dim = static_cast<int>(int_field("a partitioned entity's parent dimension"));
         p.parent_tag = static_cast<int>(int_field("a partitioned entity's parent tag"));
         const std::size_t np = count_field("a partition count", item_bytes(1, 4));
-        for (std::size_t k = 0; k < np; ++k) int_field("a partition tag");
+        for (std::size_t k = 0; k < np; ++k)
+          p.partitions.push_back(static_cast<int>(int_field("a partition tag")));
         for (int k = 0; k < (dim == 0 ? 3 : 6); ++k) real_field("an entity bounding box");
         const std::size_t nph = count_field("a physical tag count", item_bytes(1, 4));
         for (std::size_t k = 0; k < nph; ++k)
@@ -558,6 +564,41 @@ class MshReader {
                ? e.entity
                : it->second.parent_tag;
   }
+  // Gmsh meshes the boundaries between partitions (Mesh.PartitionCreateTopology): their
+  // triangles, quads, lines and points live on partitioned entities whose parent has a higher
+  // dimension (a volume for the faces between two parts), and carry the parent's physical tags,
+  // a volume's among the surfaces. They are no part of the user's model: skipped, else a
+  // physical volume would come back as a side set of interior faces as well.
+  bool on_partition_boundary(const RawElement& e, int dim) const {
+    if (!partitioned_) return false;
+    const auto it = partitioned_entities_.find({dim, e.entity});
+    return it != partitioned_entities_.end() && it->second.parent_dim > dim;
+  }
+  // A volume element's part (0-based): its partitioned entity's one partition.
+  int part_of(const RawElement& e) const {
+    const auto it = partitioned_entities_.find({3, e.entity});
+    if (it == partitioned_entities_.end())
+      throw InvalidInput(source_ + ": element " + std::to_string(e.tag) + ": its volume " +
+                         std::to_string(e.entity) + " is not in $PartitionedEntities");
+    const std::vector<int>& p = it->second.partitions;
+    if (p.size() != 1 || p[0] < 1 || static_cast<std::size_t>(p[0]) > partitions_)
+      throw InvalidInput(source_ + ": element " + std::to_string(e.tag) +
+                         ": its partitioned volume " + std::to_string(e.entity) +
+                         " is not in one partition of 1.." + std::to_string(partitions_));
+    return p[0] - 1;
+  }
+  // One file of a set Gmsh writes with Mesh.PartitionSplitMeshFiles=1 (name_1.msh, ...) holds
+  // one partition's elements: refused, since reading it alone would drop the other parts.
+  void check_one_file(const std::vector<int>& volume_part) const {
+    if (partitions_ < 2 || volume_part.empty()) return;
+    if (std::all_of(volume_part.begin(), volume_part.end(),
+                    [&](int p) { return p == volume_part.front(); }))
+      throw InvalidInput(source_ + ": holds partition " + std::to_string(volume_part.front() + 1) +
+                         " of " + std::to_string(partitions_) +
+                         " only (one file of a mesh Gmsh wrote with "
+                         "Mesh.PartitionSplitMeshFiles=1): not read; write the partitioned mesh "
+                         "as one file");
+  }
   // Physical groups of an element: its entity's (4.1; a partitioned entity's own, else its
   // parent's) or its own tag (2.2).
   std::vector<int> physicals_of(const RawElement& e, int dim) const {
@@ -633,7 +674,8 @@ class MshReader {
       std::size_t element;
     };
     std::vector<Volume> volumes;
-    std::set<int> volume_groups;  // every physical volume holding elements
+    std::set<int> volume_groups;   // every physical volume holding elements
+    std::vector<int> volume_part;  // per element of elements_ that is a volume: 0-based
     for (std::size_t i = 0; i < elements_.size(); ++i) {
       const RawElement& e = elements_[i];
       const GmshType& type = *gmsh_type(e.type);
@@ -654,9 +696,17 @@ class MshReader {
                            ": block (physical or entity tag) " + std::to_string(block) +
                            " is not positive");
       volumes.push_back({block, i});
+      if (partitioned_) volume_part.push_back(part_of(e));
     }
-    std::stable_sort(volumes.begin(), volumes.end(),
-                     [](const Volume& a, const Volume& b) { return a.block < b.block; });
+    if (partitioned_) check_one_file(volume_part);
+    std::vector<std::size_t> volume_order(volumes.size());
+    std::iota(volume_order.begin(), volume_order.end(), std::size_t{0});
+    // A partitioned file lists the elements partition by partition; their tags are the
+    // unpartitioned file's, whose order (ascending tags) they take again.
+    std::stable_sort(volume_order.begin(), volume_order.end(), [&](std::size_t a, std::size_t b) {
+      if (volumes[a].block != volumes[b].block) return volumes[a].block < volumes[b].block;
+      return partitioned_ && elements_[volumes[a].element].tag < elements_[volumes[b].element].tag;
+    });
     {
       std::set<int> blocks;
       for (const Volume& v : volumes) blocks.insert(v.block);
@@ -671,7 +721,9 @@ class MshReader {
                        "entities, which is the block of its elements");
         }
     }
-    for (const Volume& v : volumes) {
+    std::array<std::vector<int>, 4> part_by_kind;
+    for (std::size_t o : volume_order) {
+      const Volume& v = volumes[o];
       const RawElement& e = elements_[v.element];
       if (auto it = physical_names_.find({3, v.block});
           it != physical_names_.end() && !it->second.empty())
@@ -682,6 +734,13 @@ class MshReader {
       for (std::size_t k = 0; k < static_cast<std::size_t>(cell.corners); ++k)
         c[k] = node(e, static_cast<std::size_t>(cell.order[k]));
       add_element(model, kind, c, v.block, e.tag);
+      if (partitioned_) part_by_kind[static_cast<std::size_t>(kind)].push_back(volume_part[o]);
+    }
+    if (partitioned_ && partition_) {
+      partition_->parts = static_cast<int>(partitions_);
+      partition_->part.clear();
+      for (const auto& parts : part_by_kind)
+        partition_->part.insert(partition_->part.end(), parts.begin(), parts.end());
     }
 
     // Lower-dimensional physical groups: side sets (dim 2), node sets (dim 0 and 1), in
@@ -692,7 +751,7 @@ class MshReader {
         for (int p : physicals) groups[{key.first, p}];
     for (std::size_t i = 0; i < elements_.size(); ++i) {
       const int dim = gmsh_type(elements_[i].type)->dim;
-      if (dim < 3)
+      if (dim < 3 && !on_partition_boundary(elements_[i], dim))
         for (int p : physicals_of(elements_[i], dim)) groups[{dim, p}].push_back(i);
     }
     FaceOwners face_owner;
@@ -747,8 +806,10 @@ class MshReader {
 
 }  // namespace
 
-Model parse_gmsh(std::string_view content, const std::string& source, const ReadOptions& options) {
-  Model model = MshReader(content, source).read();
+Model parse_gmsh(std::string_view content, const std::string& source, const ReadOptions& options,
+                 FilePartition* partition) {
+  if (partition) *partition = {};
+  Model model = MshReader(content, source, partition).read();
   options.check_geometry ? check_geometry(model, source) : check_points(model, source);
   return model;
 }

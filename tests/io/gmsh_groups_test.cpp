@@ -7,7 +7,9 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -32,8 +34,12 @@ void write_text(const fs::path& path, const std::string& text) {
 
 // Two boxes meshed by Gmsh: x in [0, 1] hexes (transfinite, recombined) in physical volume 1
 // "hex", x in [2, 3] tets in physical volume 2 "tet", partitioned into `parts` and written as
-// .msh 4.1 (ASCII or binary): elements then live on partitioned entities.
-void partitioned_file(const fs::path& file, bool binary, int parts) {
+// .msh 4.1 (ASCII or binary): elements then live on partitioned entities. With `groups`, also
+// physical surface 10 "far" (the tet box's face x = 3) and physical curve 20 "edge" (its edge
+// x = 3, y = 0), which the partitions' boundaries cut; `parts` 0: not partitioned. `split`:
+// one file per partition (Mesh.PartitionSplitMeshFiles=1: file_1.msh, ...).
+void partitioned_file(const fs::path& file, bool binary, int parts, bool groups = false,
+                      bool split = false) {
   demo::GmshSession session;
   gmsh::model::add("parts");
   // Apart, so that Gmsh puts no pyramids between the hexes' quads and the tets.
@@ -56,11 +62,31 @@ void partitioned_file(const fs::path& file, bool binary, int parts) {
   gmsh::model::setPhysicalName(3, 1, "hex");
   gmsh::model::addPhysicalGroup(3, {b}, 2);
   gmsh::model::setPhysicalName(3, 2, "tet");
+  if (groups) {
+    const auto at = [](int dim, auto test) {
+      std::vector<int> tags;
+      gmsh::vectorpair entities;
+      gmsh::model::getEntities(entities, dim);
+      for (const auto& [d, tag] : entities) {
+        double x0, y0, z0, x1, y1, z1;
+        gmsh::model::getBoundingBox(d, tag, x0, y0, z0, x1, y1, z1);
+        if (test(x0, y0, x1, y1)) tags.push_back(tag);
+      }
+      return tags;
+    };
+    gmsh::model::addPhysicalGroup(
+        2, at(2, [](double x0, double, double, double) { return x0 > 3 - 1e-6; }), 10);
+    gmsh::model::setPhysicalName(2, 10, "far");
+    gmsh::model::addPhysicalGroup(
+        1, at(1, [](double x0, double, double, double y1) { return x0 > 3 - 1e-6 && y1 < 1e-6; }),
+        20);
+    gmsh::model::setPhysicalName(1, 20, "edge");
+  }
   gmsh::model::mesh::generate(3);
-  gmsh::model::mesh::partition(parts);
+  if (parts > 0) gmsh::model::mesh::partition(parts);
   gmsh::option::setNumber("Mesh.MshFileVersion", 4.1);
   gmsh::option::setNumber("Mesh.Binary", binary ? 1 : 0);
-  gmsh::option::setNumber("Mesh.PartitionSplitMeshFiles", 0);
+  gmsh::option::setNumber("Mesh.PartitionSplitMeshFiles", split ? 1 : 0);
   gmsh::write(file.string());
 }
 
@@ -86,6 +112,52 @@ TEST_CASE("a partitioned .msh 4.1 (ASCII and binary) gives the blocks of its phy
     CHECK(m.tet_block == std::vector<int>(m.tets.size(), 2));
     CHECK(m.block_names == std::map<int, std::string>{{1, "hex"}, {2, "tet"}});
   }
+}
+
+TEST_CASE("a partitioned .msh 4.1 is the unpartitioned model, with each element's partition") {
+  // Gmsh meshes the partitions' boundaries with triangles, lines and points on partitioned
+  // entities carrying their parent volume's (or curve's) physical tags: read as the user's
+  // groups, they made a side set 1 and 2 of interior faces, a node set 20 of points.
+  const test::TempDir dir;
+  for (bool binary : {false, true}) {
+    CAPTURE(binary);
+    // The same mesh unpartitioned, in the same encoding (ASCII keeps 16 digits).
+    const fs::path whole_file = dir.path / (binary ? "whole-bin.msh" : "whole.msh");
+    partitioned_file(whole_file, binary, 0, true);
+    const Model whole = read_gmsh(whole_file);
+    REQUIRE(whole.side_sets.size() == 1);
+    REQUIRE(whole.node_sets.size() == 1);
+    const fs::path file = dir.path / (binary ? "parts-bin.msh" : "parts.msh");
+    partitioned_file(file, binary, 3, true);
+    FilePartition partition;
+    const Model m = read_gmsh_partitioned(file, {}, &partition);
+    CHECK(m.points == whole.points);
+    CHECK(m.hexes.size() == whole.hexes.size());
+    CHECK(m.tets.size() == whole.tets.size());
+    REQUIRE(m.side_sets.size() == 1);
+    CHECK(m.side_sets[0].id == 10);
+    CHECK(m.side_sets[0].name == "far");
+    CHECK(m.side_sets[0].sides.size() == whole.side_sets[0].sides.size());
+    REQUIRE(m.node_sets.size() == 1);
+    CHECK(m.node_sets[0].id == 20);
+    CHECK(m.node_sets[0].nodes == whole.node_sets[0].nodes);
+    CHECK(partition.parts == 3);
+    REQUIRE(partition.part.size() == m.hexes.size() + m.tets.size());
+    std::map<int, std::size_t> per_part;
+    for (int p : partition.part) ++per_part[p];
+    CHECK(per_part.size() == 3);
+    CHECK(per_part.begin()->first == 0);
+    CHECK(per_part.rbegin()->first == 2);
+    FilePartition none;
+    read_gmsh_partitioned(whole_file, {}, &none);
+    CHECK(none.parts == 0);
+    CHECK(none.part.empty());
+  }
+  // One file per partition: refused by name, not read as the whole model.
+  partitioned_file(dir.path / "split.msh", false, 3, true, true);
+  const std::string message = (dir.path / "split_1.msh").string() + ": holds partition 1 of 3 only";
+  CHECK_THROWS_WITH_AS(read_gmsh(dir.path / "split_1.msh"), doctest::Contains(message.c_str()),
+                       InvalidInput);
 }
 
 TEST_CASE(
