@@ -12,6 +12,7 @@
 // per kind, the first kind (hex, tet, pyramid, wedge order) keeping the id, each other one a new
 // id above every model id, named "<block name> <kind>s".
 #include <array>
+#include <cstdint>
 #include <filesystem>
 
 #include <geode/primal/model.hpp>
@@ -52,6 +53,16 @@ inline constexpr std::array<ExodusCell, 4> kExodusCells{{
 // number out of range; then check_geometry (model.hpp) unless options say otherwise.
 primal::Model read_exodus(const std::filesystem::path& path,
                           const primal::ReadOptions& options = {});
+
+// A piece of a Nemesis set (nemesis_set.hpp) carries, beside its model, Nemesis I's processor
+// count and global counts; processors 0 when the file has none.
+struct NemesisInfo {
+  int processors = 0;
+  std::int64_t global_nodes = 0, global_elements = 0;
+};
+// read_exodus, and the file's Nemesis I counts in `nemesis` when not null.
+primal::Model read_exodus_piece(const std::filesystem::path& path,
+                                const primal::ReadOptions& options, NemesisInfo* nemesis);
 
 // Writes atomically (a temporary file in the same directory, then rename).
 void write_exodus(const primal::Model& model, const std::filesystem::path& path);

@@ -74,6 +74,7 @@ struct SetData {
 };
 struct Contents {
   int num_dim = 0, num_nodes = 0, num_elem = 0;
+  NemesisInfo nemesis;
   std::vector<double> x, y, z;
   std::vector<int> node_map, element_map;
   std::vector<BlockData> blocks;
@@ -189,6 +190,16 @@ Contents read_contents(const std::string& source, ExodusBounds bound) {
   };
   read_sets(EX_NODE_SET, num_node_sets, "node set", 4, c.node_sets);
   read_sets(EX_SIDE_SET, num_side_sets, "side set", 8, c.side_sets);
+  // Nemesis I (a piece of a partitioned set): absent from a plain file, which the library
+  // reports as an error.
+  int processors = 0, in_file = 0;
+  char ftype[2] = {};
+  int global_nodes = 0, global_elems = 0, global_blocks = 0, global_node_sets = 0,
+      global_side_sets = 0;
+  if (ex_get_init_info(exo, &processors, &in_file, ftype) >= 0 && processors > 0 &&
+      ex_get_init_global(exo, &global_nodes, &global_elems, &global_blocks, &global_node_sets,
+                         &global_side_sets) >= 0)
+    c.nemesis = {processors, global_nodes, global_elems};
   return c;
 }
 
@@ -255,7 +266,9 @@ class Unpacker {
 
 std::string pack(const Contents& c) {
   Packer p;
-  for (int v : {c.num_dim, c.num_nodes, c.num_elem}) p.i64(v);
+  for (int v : {c.num_dim, c.num_nodes, c.num_elem, c.nemesis.processors}) p.i64(v);
+  p.i64(c.nemesis.global_nodes);
+  p.i64(c.nemesis.global_elements);
   p.array(c.x);
   p.array(c.y);
   p.array(c.z);
@@ -287,6 +300,9 @@ Contents unpack(std::string_view bytes, const std::string& source) {
   c.num_dim = static_cast<int>(u.i64());
   c.num_nodes = static_cast<int>(u.i64());
   c.num_elem = static_cast<int>(u.i64());
+  c.nemesis.processors = static_cast<int>(u.i64());
+  c.nemesis.global_nodes = u.i64();
+  c.nemesis.global_elements = u.i64();
   c.x = u.array<double>();
   c.y = u.array<double>();
   c.z = u.array<double>();
@@ -426,6 +442,11 @@ Model build_model(const Contents& c, const std::string& source) {
 }  // namespace
 
 Model read_exodus(const std::filesystem::path& path, const ReadOptions& options) {
+  return read_exodus_piece(path, options, nullptr);
+}
+
+Model read_exodus_piece(const std::filesystem::path& path, const ReadOptions& options,
+                        NemesisInfo* nemesis) {
   const std::string source = path.string();
   check_mesh_format(path, MeshFileFormat::kExodus);
   const NetcdfKind kind = screen_netcdf(path, source);
@@ -445,6 +466,7 @@ Model read_exodus(const std::filesystem::path& path, const ReadOptions& options)
       kind == NetcdfKind::kClassic ? "reading the netCDF file" : "reading the netCDF-4 (HDF5) file",
       limits);
   const Contents contents = unpack(answer, source);
+  if (nemesis) *nemesis = contents.nemesis;
   Model model = build_model(contents, source);
   sanitize_names(model);
   validate(model, source);

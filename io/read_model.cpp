@@ -10,7 +10,9 @@
 
 #include <geode/io/file_format.hpp>
 #include <geode/io/formats.hpp>
+#include <geode/io/gmsh.hpp>
 #include <geode/io/names.hpp>
+#include <geode/io/nemesis_set.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/input_check.hpp>
 
@@ -134,8 +136,19 @@ InvalidInput out_of_memory_reading(const std::filesystem::path& path) {
                       " bytes): its model needs more memory than this process may use");
 }
 
-Model read_model(const std::filesystem::path& path, const ReadOptions& options,
-                 bool check_covering) {
+Model read_model(const std::filesystem::path& path, const ReadOptions& options, bool check_covering,
+                 FilePartition* partition) {
+  if (partition) *partition = {};
+  if (const auto set = find_nemesis_set(path)) {
+    try {
+      Model model = read_nemesis_set(*set, options, partition);
+      if (options.check_geometry && check_covering)
+        require_single_covering(model, set->base.string());
+      return model;
+    } catch (const std::bad_alloc&) {
+      throw out_of_memory_reading(set->files.front());
+    }
+  }
   const MeshFormat* format = reader_for(path);
   if (!format) {
     (void)read_file_head(path);  // a missing file is named as such first
@@ -144,7 +157,9 @@ Model read_model(const std::filesystem::path& path, const ReadOptions& options,
   }
   check_signature(path, *format);
   try {
-    Model model = format->read(path, options);
+    Model model = partition && format->read == read_gmsh
+                      ? read_gmsh_partitioned(path, options, partition)
+                      : format->read(path, options);
     if (options.check_geometry && check_covering) require_single_covering(model, path.string());
     return model;
   } catch (const std::bad_alloc&) {

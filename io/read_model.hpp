@@ -4,6 +4,7 @@
 // content before any parser sees it. io::write_model (formats.hpp) is its counterpart.
 #include <filesystem>
 
+#include <geode/io/file_partition.hpp>
 #include <geode/io/vtk.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/model.hpp>
@@ -16,8 +17,13 @@ namespace geode::io {
 // covering check of primal/input_check.hpp: a folded model, overlapping parts, an interface with
 // a gap are refused naming the elements. check_covering false is for callers that merge nodes
 // after reading and run require_single_covering themselves.
+//
+// Partitioned inputs: a Nemesis set (nemesis_set.hpp: `path` one of its pieces IN.exo.N.r, or
+// IN.exo when that file does not exist and its pieces do) is read joined; a partitioned .msh 4.1
+// as the unpartitioned file (gmsh.hpp). With `partition` not null, the partition such a file
+// carries goes there (parts 0 for every other input).
 primal::Model read_model(const std::filesystem::path& path, const primal::ReadOptions& options = {},
-                         bool check_covering = true);
+                         bool check_covering = true, FilePartition* partition = nullptr);
 
 // A VTK grid as a model: hexes, tets, pyramids and wedges (triangles and quads, boundary
 // annotations, are left out), VTK's 0-based point and cell ids (as ParaView shows them) as file
