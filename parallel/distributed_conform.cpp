@@ -6,6 +6,7 @@
 #include <cstring>
 #include <map>
 #include <numeric>
+#include <stdexcept>
 #include <unordered_map>
 #include <utility>
 
@@ -53,13 +54,15 @@ class Distributor {
  public:
   Distributor(const Model& input, const DistributedOptions& options, MPI_Comm comm,
               DistributedReport& report)
-      : options_(options), comm_(comm), rep_(report) {
+      : options_(options), comm_(comm), rep_(report), input_(input) {
     MPI_Comm_rank(comm, &rank_);
     MPI_Comm_size(comm, &size_);
     if (input.pyramids.empty()) {
       model_ = &input;
     } else {  // conform's own first step, element by element: the same tets
-      split_ = primal::split_pyramids(input).model;
+      auto split = primal::split_pyramids(input);
+      split_ = std::move(split.model);
+      tet_pyramid_ = std::move(split.tet_pyramid);
       model_ = &split_;
     }
   }
@@ -110,14 +113,16 @@ class Distributor {
     zone_at_ = {};
     level_ = {}, in_zone_ = {}, part_ = {}, zone_node_ = {};
     diced_gid_ = {}, diced_holders_ = {}, zone_holders_ = {};
-    split_ = {}, zone_out_ = {};
+    split_ = {}, zone_out_ = {}, tet_pyramid_ = {};
   }
 
   const DistributedOptions& options_;
   MPI_Comm comm_;
   DistributedReport& rep_;
+  const Model& input_;
   int rank_ = 0, size_ = 1;
   Model split_;
+  std::vector<Index> tet_pyramid_;  // per tet of split_: its pyramid of the input, or invalid
   const Model* model_ = nullptr;
   std::array<std::size_t, 5> offsets_{};
   std::vector<int> part_;              // per flat element
@@ -141,7 +146,29 @@ class Distributor {
 void Distributor::partition() {
   offsets_ = primal::element_offsets(m());
   part_.assign(cells(), 0);
-  if (size_ > 1) {
+  if (!options_.partition.empty()) {  // the input's own, per input element
+    const auto in = primal::element_offsets(input_);
+    if (options_.partition.size() != in.back())
+      throw std::invalid_argument("conform_distributed: a partition of " +
+                                  std::to_string(options_.partition.size()) +
+                                  " elements for a model of " + std::to_string(in.back()));
+    for (int r : options_.partition)
+      if (r < 0 || r >= size_)
+        throw std::invalid_argument("conform_distributed: rank " + std::to_string(r) +
+                                    " in a partition for " + std::to_string(size_) + " ranks");
+    // The split model: hexes, tets (the input's, then two per pyramid), wedges.
+    const auto of = [&](ElementKind kind, std::size_t i) {
+      return options_.partition[in[static_cast<std::size_t>(kind)] + i];
+    };
+    for (std::size_t c = 0; c < cells(); ++c) {
+      const auto r = ref(c);
+      const auto i = primal::index_cast<std::size_t>(r.index);
+      part_[c] =
+          r.kind == ElementKind::kTet && i < tet_pyramid_.size() && tet_pyramid_[i] != kInvalidIndex
+              ? of(ElementKind::kPyramid, primal::index_cast<std::size_t>(tet_pyramid_[i]))
+              : of(r.kind, i);
+    }
+  } else if (size_ > 1) {
     if (rank_ == 0) part_ = partition_elements(m(), size_);
     MPI_Bcast(part_.data(), static_cast<int>(part_.size()), MPI_INT, 0, comm_);
   }

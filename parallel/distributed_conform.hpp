@@ -3,17 +3,17 @@
 // ranks: the output of every rank joined is the serial run's, node for node and hex for hex.
 //
 // Every rank reads the whole input (inputs are ~25x smaller than outputs). Its elements are
-// partitioned by METIS (parallel/partition.hpp). The transition zone Z, every element within
-// `rings` node rings of a node used by both a hex and a tet (plus the elements setting the
-// yardstick and any inverted element, which the serial run also smooths), is conformed on
-// every rank, the same computation everywhere; conform reads nothing outside it but the
-// yardstick, which the lowest elements carry in. Wedges seed the zone as well (their diced
-// nodes' bits depend on which wedge makes them first), so a model of many wedges is mostly zone.
-// The result is checked: the outer two rings of Z must come out as plain dicing, bit for bit (the
-// smoothing and the buffer layer stopped short of the cut), else Z is grown (rings doubled) and
-// conformed again. Everything else is plain dicing (primal/dice_model.hpp): each rank dices only
-// its own elements outside Z, and dicing depends only on an element and its nodes, so a rank's
-// hexes are the serial run's.
+// partitioned by METIS (parallel/partition.hpp), or as the input file was (options.partition). The
+// transition zone Z, every element within `rings` node rings of a node used by both a hex and a tet
+// (plus the elements setting the yardstick and any inverted element, which the serial run also
+// smooths), is conformed on every rank, the same computation everywhere; conform reads nothing
+// outside it but the yardstick, which the lowest elements carry in. Wedges seed the zone as well
+// (their diced nodes' bits depend on which wedge makes them first), so a model of many wedges is
+// mostly zone. The result is checked: the outer two rings of Z must come out as plain dicing, bit
+// for bit (the smoothing and the buffer layer stopped short of the cut), else Z is grown (rings
+// doubled) and conformed again. Everything else is plain dicing (primal/dice_model.hpp): each rank
+// dices only its own elements outside Z, and dicing depends only on an element and its nodes, so a
+// rank's hexes are the serial run's.
 //
 // Global ids (0-based): Z's output nodes and hexes first in Z's output order (the same on every
 // rank count); then the diced nodes and hexes, rank by rank, each owned by the lowest rank
@@ -37,6 +37,10 @@ struct DistributedOptions {
   conform::ConformOptions conform;
   int rings = 4;       // depth of the transition zone, doubled until the check passes
   int max_rings = 64;  // TopologyError past this
+  // Per flat element of the input (primal::element_offsets), its rank: used instead of METIS
+  // when not empty (the input's own partition, parallel/partition.hpp ranks_of_parts); the same
+  // on every rank. Only the load balance depends on it, not the result.
+  std::vector<int> partition;
 };
 
 // One rank's share of the output.

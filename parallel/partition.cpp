@@ -2,6 +2,7 @@
 
 #include <metis.h>
 
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 
@@ -40,6 +41,14 @@ std::vector<int> partition_elements(const primal::Model& model, int parts) {
     throw std::runtime_error("METIS_PartMeshDual failed (status " + std::to_string(status) + ")");
   for (std::size_t e = 0; e < n; ++e) part[e] = static_cast<int>(epart[e]);
   return part;
+}
+
+std::vector<int> ranks_of_parts(const std::vector<int>& part, int parts, int ranks) {
+  if (parts < ranks || ranks < 1) return {};
+  std::vector<int> rank(part.size());
+  for (std::size_t e = 0; e < part.size(); ++e)
+    rank[e] = static_cast<int>(static_cast<std::int64_t>(part[e]) * ranks / parts);
+  return rank;
 }
 
 }  // namespace geode::parallel

@@ -12,4 +12,10 @@ namespace geode::parallel {
 // model and part count (METIS seeded). parts == 1: all zero.
 std::vector<int> partition_elements(const primal::Model& model, int parts);
 
+// A partition the input carries (io/file_partition.hpp: a partitioned .msh, a Nemesis set) of
+// `parts` parts, as ranks: the parts themselves when parts == ranks; with more parts than
+// ranks, part p to rank p * ranks / parts (consecutive parts joined, each rank parts / ranks of
+// them, one more or less); with fewer, empty (the caller partitions with METIS instead).
+std::vector<int> ranks_of_parts(const std::vector<int>& part, int parts, int ranks);
+
 }  // namespace geode::parallel

@@ -14,6 +14,7 @@
 #include <geode/io/read_model.hpp>
 #include <geode/parallel/distributed_conform.hpp>
 #include <geode/parallel/nemesis.hpp>
+#include <geode/parallel/partition.hpp>
 #include <geode/primal/errors.hpp>
 
 namespace {
@@ -34,7 +35,11 @@ int run(int argc, char** argv, int rank, int size) {
   bool join = false, quiet = false;
   int rings = 4, threads = 1;
   double thickness = 0;
-  conform->add_option("input", input, "input mesh (.msh, .exo, .vtk, .vtu)")->required();
+  conform
+      ->add_option("input", input,
+                   "input mesh (.msh, .exo, .vtk, .vtu; a partitioned .msh 4.1 or a Nemesis set "
+                   "IN.exo.N.r: its partition instead of METIS)")
+      ->required();
   conform
       ->add_option("-o,--output", output,
                    "OUT.exo: writes OUT.exo.N.r per rank (Nemesis; N ranks, r = 0..N-1)")
@@ -62,7 +67,18 @@ int run(int argc, char** argv, int rank, int size) {
     options.conform.buffer.side = conform::parse_buffer_side(side);
     options.conform.buffer.thickness = thickness;
     options.rings = rings;
-    const primal::Model model = io::read_model(input);
+    io::FilePartition file_partition;
+    const primal::Model model = io::read_model(input, {}, true, &file_partition);
+    // The input's own partition (a partitioned .msh, a Nemesis set) unless it has fewer parts
+    // than there are ranks: then METIS (parallel/partition.hpp).
+    std::string partitioned_by = size > 1 ? "METIS" : "one rank";
+    if (file_partition.parts > 0) {
+      options.partition = parallel::ranks_of_parts(file_partition.part, file_partition.parts, size);
+      const std::string parts = "the input's " + std::to_string(file_partition.parts) + " parts";
+      partitioned_by =
+          options.partition.empty() ? "METIS (" + parts + " are fewer than the ranks)" : parts;
+    }
+    file_partition = {};
     const double t_read = MPI_Wtime() - t0;
     parallel::DistributedReport report;
     const parallel::RankMesh mesh =
@@ -90,8 +106,8 @@ int run(int argc, char** argv, int rank, int size) {
     if (rank == 0 && !quiet) {
       std::cout << "geode_mpi: " << size << " ranks, " << mesh.global_hexes << " hexes, "
                 << mesh.global_nodes << " nodes, transition zone " << report.zone_cells
-                << " input elements (" << report.rings << " rings), "
-                << (report.valid ? "valid" : "INVALID") << ", " << t_all << " s\n";
+                << " input elements (" << report.rings << " rings), partition: " << partitioned_by
+                << ", " << (report.valid ? "valid" : "INVALID") << ", " << t_all << " s\n";
       for (int r = 0; r < size; ++r)
         std::cout << "  "
                   << all.substr(static_cast<std::size_t>(displs[static_cast<std::size_t>(r)]),

@@ -1,4 +1,5 @@
-// parallel_check same SERIAL.exo JOINED.exo: the two models identical after the canonical
+// parallel_check same SERIAL.exo JOINED.exo: the two models (either may be a Nemesis set, named
+// by a piece) identical after the canonical
 // ordering (parallel/nemesis.hpp canonical()): coordinates bit for bit, hexes corner for corner
 // in each block, block names, node and side sets with ids and names.
 // parallel_check ranks OUT.exo N: the per-rank files OUT.exo.N.r read by libexodusII, their
@@ -15,6 +16,7 @@
 #include <set>
 
 #include <geode/io/exodus.hpp>
+#include <geode/io/read_model.hpp>
 #include <geode/parallel/nemesis.hpp>
 
 namespace {
@@ -28,8 +30,9 @@ int fail(const std::string& what) {
 }
 
 int same(const std::string& a_path, const std::string& b_path) {
-  const Model a = parallel::canonical(io::read_exodus(a_path));
-  const Model b = parallel::canonical(io::read_exodus(b_path));
+  // read_model: either may name a Nemesis set (io/nemesis_set.hpp), read joined.
+  const Model a = parallel::canonical(io::read_model(a_path));
+  const Model b = parallel::canonical(io::read_model(b_path));
   if (a.points.size() != b.points.size())
     return fail("nodes: " + std::to_string(a.points.size()) + " vs " +
                 std::to_string(b.points.size()));
