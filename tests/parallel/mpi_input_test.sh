@@ -8,8 +8,9 @@
 #   METIS (4 ranks: more), the output identical every time;
 # - geode_mpi's own per-rank output read back as a Nemesis input set (a hex-only model, which
 #   conform dices) by `geode conform` and by geode_mpi: the same as the joined file conformed;
-# - the refusals: a piece missing, pieces of two sets mixed (global counts differ), two sets
-#   beside a missing base name, one file of Gmsh's Mesh.PartitionSplitMeshFiles=1 set.
+# - the refusals: a piece missing, pieces of two sets mixed (global counts differ), a shared
+#   node moved in one piece, an element given in two pieces (tests/parallel/corrupt_piece.py),
+#   two sets beside a missing base name, one file of Gmsh's Mesh.PartitionSplitMeshFiles=1 set.
 # usage: mpi_input_test.sh GEODE GEODE_MPI PARALLEL_CHECK MPIEXEC MODEL SIZE WORKDIR
 set -euo pipefail
 geode=$1 geode_mpi=$2 check=$3 mpiexec=$4 model=$5 size=$6 dir=$7
@@ -82,6 +83,13 @@ mkdir -p mixed && cp out3.exo.3.0 out3.exo.3.1 mixed/ && cp nem3.exo.3.2 mixed/o
 refused 2 "mixed/out3.exo.3.2: global counts" -- "$geode" conform mixed/out3.exo.3.0 -o x.exo
 refused 2 "mixed/out3.exo.3.2: global counts" -- \
   "$mpiexec" --oversubscribe -np 2 "$geode_mpi" conform mixed/out3.exo.3.0 -o x.exo
+mkdir -p moved && cp out3.exo.3.* moved/
+g=$(/usr/bin/python3 "$here/corrupt_piece.py" moved/out3.exo.3.1 moved/out3.exo.3.0 moved)
+refused 2 "moved/out3.exo.3.1: global node $g is at" -- "$geode" conform moved/out3.exo.3.0 -o x.exo
+mkdir -p twice && cp out3.exo.3.* twice/
+g=$(/usr/bin/python3 "$here/corrupt_piece.py" twice/out3.exo.3.2 twice/out3.exo.3.0 element)
+refused 2 "twice/out3.exo.3.2: element $g is also in twice/out3.exo.3.0" -- \
+  "$geode" conform twice/out3.exo.3.0 -o x.exo
 mkdir -p two && cp out3.exo.3.* two/ && cp out2.exo.2.* two/ && for f in two/out2.exo.2.*; do
   mv "$f" "two/out3.exo.2.${f##*.}"; done
 refused 2 "two/out3.exo: missing, and pieces of 2 Nemesis sets" -- \
