@@ -49,7 +49,7 @@ void write_small_model(const fs::path& path, std::uint64_t skipped) {
 
 // About `bytes` of node lines (one entity), the unit hex on nodes 1..8, the rest unused.
 std::size_t write_nodes_model(const fs::path& path, std::uint64_t bytes) {
-  const std::size_t n = static_cast<std::size_t>(bytes / 48);
+  const std::size_t n = geode::primal::index_cast<std::size_t>(bytes / 48);
   std::FILE* f = std::fopen(path.c_str(), "wb");
   std::fprintf(f, "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 %zu 1 %zu\n3 1 0 %zu\n", n, n,
                n);
@@ -109,7 +109,7 @@ void measure(const char* label, const fs::path& path, std::uint64_t budget) {
   std::string answer;
   char buf[4096];
   for (ssize_t n; (n = ::read(pipe_fds[0], buf, sizeof buf)) > 0;)
-    answer.append(buf, static_cast<std::size_t>(n));
+    answer.append(buf, geode::primal::index_cast<std::size_t>(n));
   ::close(pipe_fds[0]);
   int status = 0;
   ::waitpid(pid, &status, 0);

@@ -143,12 +143,14 @@ gp::Model tet_model(const gp::Model& m) {
   for (const auto& tet : m.tets) {
     std::array<gp::Index, 4> o{};
     for (int c = 0; c < 4; ++c) {
-      gp::Index& r = renum[static_cast<std::size_t>(tet[static_cast<std::size_t>(c)])];
+      gp::Index& r = renum[geode::primal::index_cast<std::size_t>(
+          tet[geode::primal::index_cast<std::size_t>(c)])];
       if (r == gp::kInvalidIndex) {
         r = static_cast<gp::Index>(t.points.size());
-        t.points.push_back(m.points[static_cast<std::size_t>(tet[static_cast<std::size_t>(c)])]);
+        t.points.push_back(m.points[geode::primal::index_cast<std::size_t>(
+            tet[geode::primal::index_cast<std::size_t>(c)])]);
       }
-      o[static_cast<std::size_t>(c)] = r;
+      o[geode::primal::index_cast<std::size_t>(c)] = r;
     }
     t.tets.push_back(o);
   }

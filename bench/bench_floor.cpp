@@ -45,7 +45,7 @@ struct NodeTable {
   explicit NodeTable(const std::vector<Index>& uses)
       : start(uses.size() + 1, 0), size(uses.size(), 0) {
     for (std::size_t v = 0; v < uses.size(); ++v) start[v + 1] = start[v] + uses[v];
-    entries.resize(static_cast<std::size_t>(start.back()));
+    entries.resize(geode::primal::index_cast<std::size_t>(start.back()));
   }
   // The node of `key` listed at a, made by make() the first time.
   template <typename Make>
@@ -175,7 +175,7 @@ int main(int argc, char** argv) {
   conn.reserve(8 * model.hexes.size() + 4 * model.tets.size());
   auto add = [&](const Point& p) {
     points.push_back(p);
-    return static_cast<Index>(points.size() - 1);
+    return geode::primal::index_cast(points.size() - 1);
   };
   // The node of a set of the cell's corners (1, 2, 3 or 4 corners; 8 or 4 for the centre).
   auto node_of = [&](const auto& cell, const std::vector<int>& set, bool centre) -> Index {
@@ -224,8 +224,8 @@ int main(int argc, char** argv) {
   const std::size_t tet_children = conn.size() - hex_children;
   const int blocks = (hex_children ? 1 : 0) + (tet_children ? 1 : 0);
   std::size_t nodes = 0;
-  bool ok = ex_put_init(exo, "floor", 3, static_cast<int64_t>(points.size()),
-                        static_cast<int64_t>(conn.size()), blocks, 0, 0) >= 0;
+  bool ok = ex_put_init(exo, "floor", 3, geode::primal::index_cast<int64_t>(points.size()),
+                        geode::primal::index_cast<int64_t>(conn.size()), blocks, 0, 0) >= 0;
   {
     std::vector<double> x(points.size()), y(points.size()), z(points.size());
     for (std::size_t i = 0; i < points.size(); ++i)

@@ -27,7 +27,7 @@ using namespace geode;
 
 std::map<int, double> block_minima(const primal::HexMesh& m) {
   std::map<int, double> out;
-  for (primal::Index h = 0; h < static_cast<primal::Index>(m.hexes.size()); ++h) {
+  for (primal::Index h = 0; h < primal::index_cast(m.hexes.size()); ++h) {
     const double q = primal::hex_scaled_jacobian(primal::hex_corners(m, h));
     auto [it, fresh] = out.emplace(m.block[h], q);
     if (!fresh) it->second = std::min(it->second, q);

@@ -46,15 +46,15 @@ void gmsh_write(const Model& model, const fs::path& file, bool binary, bool v22)
   for (int b : {1, 2}) {
     std::vector<std::size_t> et, en;
     for (std::size_t h = 0; h < model.hexes.size(); ++h)
-      if (block_of(model, {ElementKind::kHex, static_cast<Index>(h)}) == b) {
+      if (block_of(model, {ElementKind::kHex, index_cast(h)}) == b) {
         et.push_back(next++);
-        for (Index v : model.hexes[h]) en.push_back(static_cast<std::size_t>(v) + 1);
+        for (Index v : model.hexes[h]) en.push_back(index_cast<std::size_t>(v) + 1);
       }
     std::vector<std::size_t> tt, tn;
     for (std::size_t t = 0; t < model.tets.size(); ++t)
-      if (block_of(model, {ElementKind::kTet, static_cast<Index>(t)}) == b) {
+      if (block_of(model, {ElementKind::kTet, index_cast(t)}) == b) {
         tt.push_back(next++);
-        for (Index v : model.tets[t]) tn.push_back(static_cast<std::size_t>(v) + 1);
+        for (Index v : model.tets[t]) tn.push_back(index_cast<std::size_t>(v) + 1);
       }
     if (!et.empty()) gmsh::model::mesh::addElementsByType(b, 5, et, en);
     if (!tt.empty()) gmsh::model::mesh::addElementsByType(b, 4, tt, tn);

@@ -63,9 +63,9 @@ Checked check_quads(const primal::QuadMesh& mesh, const primal::RealizabilityOpt
   double lo = 1e300, hi = -1e300;
   Index at = 0;
   for (std::size_t q = 0; q < mesh.quads.size(); ++q) {
-    const double s = primal::quad_scaled_jacobian(primal::quad_corners(mesh, static_cast<Index>(q)),
+    const double s = primal::quad_scaled_jacobian(primal::quad_corners(mesh, primal::index_cast(q)),
                                                   primal::Point::UnitZ());
-    if (s < lo) lo = s, at = static_cast<Index>(q);
+    if (s < lo) lo = s, at = primal::index_cast(q);
     hi = std::max(hi, s);
   }
   c.quality = {{"num_quads", mesh.quads.size()},

@@ -141,11 +141,12 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
     const auto scan = [&](const auto& cells, const auto& edges, bool hex) {
       for (std::size_t e = 0; e < cells.size(); ++e)
         for (const auto& ed : edges) {
-          const double l =
-              (model.points[static_cast<std::size_t>(cells[e][static_cast<std::size_t>(ed[0])])] -
-               model.points[static_cast<std::size_t>(cells[e][static_cast<std::size_t>(ed[1])])])
-                  .norm();
-          if (l < shortest) shortest = l, where = static_cast<primal::Index>(e), in_hex = hex;
+          const double l = (model.points[primal::index_cast<std::size_t>(
+                                cells[e][primal::index_cast<std::size_t>(ed[0])])] -
+                            model.points[primal::index_cast<std::size_t>(
+                                cells[e][primal::index_cast<std::size_t>(ed[1])])])
+                               .norm();
+          if (l < shortest) shortest = l, where = primal::index_cast(e), in_hex = hex;
         }
     };
     scan(model.hexes, primal::topology::kHexEdgeCorners, true);

@@ -112,13 +112,13 @@ void run_dual(const DualArgs& a) {
   std::vector<Index> counts;
   if (m.dim == 3) {
     const auto dual = stc::mesh_dual(m.hex);
-    j = dual_json(dual, static_cast<Index>(m.hex.points.size()),
-                  static_cast<Index>(m.hex.hexes.size()));
+    j = dual_json(dual, primal::index_cast(m.hex.points.size()),
+                  primal::index_cast(m.hex.hexes.size()));
     counts = tuple_counts(dual);
   } else {
     const auto dual = stc::mesh_dual(m.quad);
-    j = dual_json(dual, static_cast<Index>(m.quad.points.size()),
-                  static_cast<Index>(m.quad.quads.size()));
+    j = dual_json(dual, primal::index_cast(m.quad.points.size()),
+                  primal::index_cast(m.quad.quads.size()));
     counts = tuple_counts(dual);
   }
   j["input"] = a.input;

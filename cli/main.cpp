@@ -83,7 +83,7 @@ int main(int argc, char** argv) {
            [](int n) {
              delete threads;
              threads = new tbb::global_control(tbb::global_control::max_allowed_parallelism,
-                                               static_cast<std::size_t>(n));
+                                               geode::primal::index_cast<std::size_t>(n));
            },
            "worker threads (default: every core); every result is the same for any number")
         ->check(CLI::Range(1, 4096));

@@ -40,8 +40,8 @@ std::vector<viewer::ViewSheet> arrangement_view_sheets(
   }
   for (std::size_t e = 0; e < element_sheets.size(); ++e)
     for (int s : element_sheets[e])
-      if (s >= 0 && static_cast<std::size_t>(s) < out.size())
-        out[static_cast<std::size_t>(s)].layer.push_back(static_cast<primal::Index>(e));
+      if (s >= 0 && primal::index_cast<std::size_t>(s) < out.size())
+        out[primal::index_cast<std::size_t>(s)].layer.push_back(primal::index_cast(e));
   return out;
 }
 

@@ -78,11 +78,11 @@ class BufferBuilder {
   BufferLayer run();
 
  private:
-  const Point& pt(Index v) const { return input_.points[static_cast<std::size_t>(v)]; }
+  const Point& pt(Index v) const { return input_.points[index_cast<std::size_t>(v)]; }
   std::size_t slot(Index v) const {
-    return static_cast<std::size_t>(out_.top_node[static_cast<std::size_t>(v)]) - n_points_;
+    return index_cast<std::size_t>(out_.top_node[index_cast<std::size_t>(v)]) - n_points_;
   }
-  bool moved(Index v) const { return out_.top_node[static_cast<std::size_t>(v)] != kInvalidIndex; }
+  bool moved(Index v) const { return out_.top_node[index_cast<std::size_t>(v)] != kInvalidIndex; }
   // Whether cell c of the moving part moves at node v: carved from the tet part, a tet on the
   // hex side of the interface at v keeps v (sides()).
   bool moves(Index c, Index v) const {
@@ -175,7 +175,7 @@ void BufferBuilder::interface_geometry() {
   centre_of_.assign(n_points_, kInvalidIndex);
   for (std::size_t q = 0; q < itf_.quads.size(); ++q)
     if (itf_.quads[q].centre != kInvalidIndex)
-      centre_of_[static_cast<std::size_t>(itf_.quads[q].centre)] = static_cast<Index>(q);
+      centre_of_[index_cast<std::size_t>(itf_.quads[q].centre)] = index_cast(q);
 }
 
 // The moving part's cells at moved nodes (with a four-triangle centre on the tet side), their
@@ -189,7 +189,7 @@ void BufferBuilder::moving_part(const Cells& cells, const Edges& edges, const Fa
   const std::size_t nf = faces.size();
   auto face_nodes = [&](const auto& cell, const auto& fc) {
     std::array<Index, kFaceSize> f{};
-    for (std::size_t i = 0; i < kFaceSize; ++i) f[i] = cell[static_cast<std::size_t>(fc[i])];
+    for (std::size_t i = 0; i < kFaceSize; ++i) f[i] = cell[index_cast<std::size_t>(fc[i])];
     return f;
   };
   // Each cell face numbered once (its id), with its number of uses; interface faces get -1.
@@ -198,34 +198,33 @@ void BufferBuilder::moving_part(const Cells& cells, const Edges& edges, const Fa
   std::vector<Index> uses;
   for (std::size_t c = 0; c < cells.size(); ++c)
     for (std::size_t f = 0; f < nf; ++f) {
-      const auto [id, fresh] = ids.try_emplace(face_key(face_nodes(cells[c], faces[f])),
-                                               static_cast<Index>(uses.size()));
+      const auto [id, fresh] =
+          ids.try_emplace(face_key(face_nodes(cells[c], faces[f])), index_cast(uses.size()));
       if (fresh) uses.push_back(0);
       face_id[c * nf + f] = *id;
-      ++uses[static_cast<std::size_t>(*id)];
+      ++uses[index_cast<std::size_t>(*id)];
     }
   for (const auto& [cell, f] : interface_faces)
-    uses[static_cast<std::size_t>(
-        face_id[static_cast<std::size_t>(cell) * nf + static_cast<std::size_t>(f)])] = -1;
+    uses[index_cast<std::size_t>(
+        face_id[index_cast<std::size_t>(cell) * nf + index_cast<std::size_t>(f)])] = -1;
   outer_normals_.assign(n_moved_, {});
   for (std::size_t c = 0; c < cells.size(); ++c) {
     const auto& cell = cells[c];
-    const auto ci = static_cast<Index>(c);
+    const auto ci = index_cast(c);
     bool touches = false;
     for (Index v : cell)
       touches |=
-          moves(ci, v) || (!hex_side_ && centre_of_[static_cast<std::size_t>(v)] != kInvalidIndex);
+          moves(ci, v) || (!hex_side_ && centre_of_[index_cast<std::size_t>(v)] != kInvalidIndex);
     if (!touches) continue;
     touched_.push_back(ci);
     for (const auto& e : edges) {
-      const Index a = cell[static_cast<std::size_t>(e[0])],
-                  b = cell[static_cast<std::size_t>(e[1])];
+      const Index a = cell[index_cast<std::size_t>(e[0])], b = cell[index_cast<std::size_t>(e[1])];
       const double len = (pt(a) - pt(b)).norm();
       for (Index v : {a, b})
         if (moves(ci, v)) shortest_[slot(v)] = std::min(shortest_[slot(v)], len);
     }
     for (std::size_t k = 0; k < nf; ++k) {
-      if (uses[static_cast<std::size_t>(face_id[c * nf + k])] != 1)
+      if (uses[index_cast<std::size_t>(face_id[c * nf + k])] != 1)
         continue;  // inner or interface face
       const auto f = face_nodes(cell, faces[k]);
       // Twice the outward area vector (triangle or quad: the cross product of the diagonals).
@@ -243,11 +242,11 @@ void BufferBuilder::measure_before() {
     if (hex_side_) {
       HexCorners corners;
       for (std::size_t i = 0; i < 8; ++i)
-        corners[i] = pt(input_.hexes[static_cast<std::size_t>(c)][i]);
+        corners[i] = pt(input_.hexes[index_cast<std::size_t>(c)][i]);
       jacobians_before_.push_back(hex_jacobians(corners));
       before_.push_back(hex_scaled_jacobian(corners));
     } else {
-      const auto& tet = input_.tets[static_cast<std::size_t>(c)];
+      const auto& tet = input_.tets[index_cast<std::size_t>(c)];
       before_.push_back(tet_volume(pt(tet[0]), pt(tet[1]), pt(tet[2]), pt(tet[3])));
     }
   }
@@ -338,7 +337,7 @@ void BufferBuilder::heights() {
     for (std::size_t i = 0; i < 4; ++i) {
       const Index a = q.corners[i], b = q.corners[(i + 1) % 4];
       const double len = (pt(a) - pt(b)).norm();
-      quad_edges_.nodes.push_back({static_cast<Index>(slot(a)), static_cast<Index>(slot(b))});
+      quad_edges_.nodes.push_back({index_cast(slot(a)), index_cast(slot(b))});
       quad_edges_.length.push_back(len);
       mean_quad_edge[slot(a)] += len, mean_quad_edge[slot(b)] += len;
       ++quads_at[slot(a)];
@@ -360,21 +359,21 @@ void BufferBuilder::make_hexes() {
     BufferHex b;
     for (std::size_t i = 0; i < 4; ++i) {
       b.corners[i] = q.corners[i];
-      b.corners[i + 4] = out_.top_node[static_cast<std::size_t>(q.corners[i])];
+      b.corners[i + 4] = out_.top_node[index_cast<std::size_t>(q.corners[i])];
     }
     b.diagonal = q.diagonal == 0 ? std::array<int, 2>{4, 6} : std::array<int, 2>{5, 7};
     b.centre = q.centre;
-    b.quad = static_cast<Index>(out_.hexes.size());
+    b.quad = index_cast(out_.hexes.size());
     out_.hexes.push_back(b);
   }
   for (std::size_t t = 0; t < out_.model.tets.size(); ++t)
     for (Index& v : out_.model.tets[t])
       if (moved(v) && !std::binary_search(kept_tets_.begin(), kept_tets_.end(),
-                                          std::pair<Index, Index>{static_cast<Index>(t), v}))
-        v = out_.top_node[static_cast<std::size_t>(v)];
+                                          std::pair<Index, Index>{index_cast(t), v}))
+        v = out_.top_node[index_cast<std::size_t>(v)];
   for (const auto& [w, v] : copied_wedges_)
-    for (Index& x : out_.model.wedges[static_cast<std::size_t>(w)])
-      if (x == v) x = out_.top_node[static_cast<std::size_t>(v)];
+    for (Index& x : out_.model.wedges[index_cast<std::size_t>(w)])
+      if (x == v) x = out_.top_node[index_cast<std::size_t>(v)];
 }
 
 // Points at the current steps: the moving copy of each interface node steps along its
@@ -384,7 +383,7 @@ void BufferBuilder::place() {
   auto& pts = out_.model.points;
   pts.assign(input_.points.begin(), input_.points.end());
   for (std::size_t k = 0; k < n_moved_; ++k) {
-    const std::size_t v = static_cast<std::size_t>(itf_.nodes[k]);
+    const std::size_t v = index_cast<std::size_t>(itf_.nodes[k]);
     const Point p = input_.points[v] + step_[k] * direction_[k];
     if (hex_side_) {
       pts.push_back(input_.points[v]);
@@ -398,8 +397,8 @@ void BufferBuilder::place() {
     if (b.centre == kInvalidIndex) continue;
     Point shift = Point::Zero();
     for (std::size_t i = 0; i < 4; ++i)
-      shift += (pts[static_cast<std::size_t>(b.corners[i + 4])] - pt(b.corners[i])) / 4.0;
-    pts[static_cast<std::size_t>(b.centre)] = pt(b.centre) + shift;
+      shift += (pts[index_cast<std::size_t>(b.corners[i + 4])] - pt(b.corners[i])) / 4.0;
+    pts[index_cast<std::size_t>(b.centre)] = pt(b.centre) + shift;
   }
 }
 
@@ -408,14 +407,14 @@ std::string BufferBuilder::check(std::vector<char>& failing) {
   const auto& pts = out_.model.points;
   // A failing centre's steps are its quad's corners'.
   auto fail_node = [&](Index v) {
-    if (static_cast<std::size_t>(v) >= n_points_) {
-      failing[static_cast<std::size_t>(v) - n_points_] = 1;
+    if (index_cast<std::size_t>(v) >= n_points_) {
+      failing[index_cast<std::size_t>(v) - n_points_] = 1;
     } else if (hex_side_ && moved(v)) {
       failing[slot(v)] = 1;
-    } else if (const Index q = centre_of_[static_cast<std::size_t>(v)];
+    } else if (const Index q = centre_of_[index_cast<std::size_t>(v)];
                !hex_side_ && q != kInvalidIndex) {
       for (std::size_t i = 4; i < 8; ++i)
-        failing[static_cast<std::size_t>(out_.hexes[static_cast<std::size_t>(q)].corners[i]) -
+        failing[index_cast<std::size_t>(out_.hexes[index_cast<std::size_t>(q)].corners[i]) -
                 n_points_] = 1;
     }
   };
@@ -432,9 +431,9 @@ std::string BufferBuilder::check(std::vector<char>& failing) {
     // corners and the centre.
     for (std::size_t i = 0; i < touched_.size(); ++i) {
       const Index h = touched_[i];
-      const auto& hex = input_.hexes[static_cast<std::size_t>(h)];
+      const auto& hex = input_.hexes[index_cast<std::size_t>(h)];
       HexCorners after;
-      for (std::size_t k = 0; k < 8; ++k) after[k] = pts[static_cast<std::size_t>(hex[k])];
+      for (std::size_t k = 0; k < 8; ++k) after[k] = pts[index_cast<std::size_t>(hex[k])];
       const auto& jb = jacobians_before_[i];
       const auto ja = hex_jacobians(after);
       double ratio = std::numeric_limits<double>::infinity();
@@ -454,29 +453,29 @@ std::string BufferBuilder::check(std::vector<char>& failing) {
   } else {
     for (std::size_t i = 0; i < touched_.size(); ++i) {
       const Index t = touched_[i];
-      const auto& tet = input_.tets[static_cast<std::size_t>(t)];
-      const auto& now = out_.model.tets[static_cast<std::size_t>(t)];
+      const auto& tet = input_.tets[index_cast<std::size_t>(t)];
+      const auto& now = out_.model.tets[index_cast<std::size_t>(t)];
       const double ratio =
-          tet_volume(pts[static_cast<std::size_t>(now[0])], pts[static_cast<std::size_t>(now[1])],
-                     pts[static_cast<std::size_t>(now[2])], pts[static_cast<std::size_t>(now[3])]) /
+          tet_volume(pts[index_cast<std::size_t>(now[0])], pts[index_cast<std::size_t>(now[1])],
+                     pts[index_cast<std::size_t>(now[2])], pts[index_cast<std::size_t>(now[3])]) /
           before_[i];
       out_.report.min_volume_ratio = std::min(out_.report.min_volume_ratio, ratio);
       if (ratio < opt_.min_volume_ratio) {
         for (Index v : now) fail_node(v);
         for (Index v : tet)
-          if (moves(t, v) || centre_of_[static_cast<std::size_t>(v)] != kInvalidIndex)
+          if (moves(t, v) || centre_of_[index_cast<std::size_t>(v)] != kInvalidIndex)
             keeps_only(ElementKind::kTet, t, ratio, "volume", v);
       }
     }
   }
   for (const BufferHex& b : out_.hexes) {
     HexCorners c;
-    for (std::size_t i = 0; i < 8; ++i) c[i] = pts[static_cast<std::size_t>(b.corners[i])];
+    for (std::size_t i = 0; i < 8; ++i) c[i] = pts[index_cast<std::size_t>(b.corners[i])];
     double sj = hex_scaled_jacobian(c);
     if (b.centre != kInvalidIndex) {
       // A four-triangle top: each triangle must face away from the bottom face's centre,
       // measured as a scaled Jacobian (the tet's volume over its edge lengths at the centre).
-      const Point& top = pts[static_cast<std::size_t>(b.centre)];
+      const Point& top = pts[index_cast<std::size_t>(b.centre)];
       const Point bottom = (c[0] + c[1] + c[2] + c[3]) / 4.0;
       for (std::size_t i = 0; i < 4; ++i) {
         const Point a = c[4 + i] - bottom, e = c[4 + (i + 1) % 4] - bottom, m = top - bottom;
@@ -486,9 +485,9 @@ std::string BufferBuilder::check(std::vector<char>& failing) {
     out_.report.min_scaled_jacobian = std::min(out_.report.min_scaled_jacobian, sj);
     if (sj < opt_.min_scaled_jacobian)
       for (std::size_t i = 4; i < 8; ++i) {
-        failing[static_cast<std::size_t>(b.corners[i]) - n_points_] = 1;
+        failing[index_cast<std::size_t>(b.corners[i]) - n_points_] = 1;
         if (first_failure.empty()) {
-          const InterfaceQuad& q = itf_.quads[static_cast<std::size_t>(b.quad)];
+          const InterfaceQuad& q = itf_.quads[index_cast<std::size_t>(b.quad)];
           first_failure = describe_node(input_, b.corners[i - 4]) + ": the buffer hex on face " +
                           std::to_string(q.face + 1) + " of " +
                           describe_element(input_, q.owner()) + " has scaled Jacobian " +
@@ -536,7 +535,7 @@ BufferLayer BufferBuilder::run() {
   out_.model = input_;
   out_.top_node.assign(n_points_, kInvalidIndex);
   for (std::size_t k = 0; k < n_moved_; ++k)
-    out_.top_node[static_cast<std::size_t>(itf_.nodes[k])] = static_cast<Index>(n_points_ + k);
+    out_.top_node[index_cast<std::size_t>(itf_.nodes[k])] = index_cast(n_points_ + k);
   sides();
   interface_geometry();
   std::vector<std::pair<Index, int>> interface_faces;  // (cell, local face) of the moving part

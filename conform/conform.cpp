@@ -58,7 +58,7 @@ OutputBlocks output_blocks(const primal::Model& input, const std::string& geode_
   int top = 0;
   for (primal::ElementKind kind : primal::kElementKinds)
     for (std::size_t e = 0; e < primal::element_count(input, kind); ++e)
-      top = std::max(top, primal::block_of(input, {kind, static_cast<Index>(e)}));
+      top = std::max(top, primal::block_of(input, {kind, primal::index_cast(e)}));
   o.geode_id = top + 1;
   o.names[o.geode_id] = geode_block;
   return o;
@@ -205,9 +205,9 @@ class Conformer {
 };
 
 void Conformer::find_interface() {
-  res_.input_hexes = static_cast<Index>(input_.hexes.size());
-  res_.input_tets = static_cast<Index>(input_.tets.size());
-  res_.input_wedges = static_cast<Index>(input_.wedges.size());
+  res_.input_hexes = primal::index_cast(input_.hexes.size());
+  res_.input_tets = primal::index_cast(input_.tets.size());
+  res_.input_wedges = primal::index_cast(input_.wedges.size());
   if (primal::element_count(input_) == 0) throw InvalidInput("conform: the model has no elements");
   t0_ = Clock::now();
   hex_diced_ = primal::diced_scaled_jacobian_per_cell(input_.points, input_.hexes);
@@ -220,7 +220,8 @@ void Conformer::find_interface() {
     std::vector<std::array<Index, 4>> cells;
     for (std::size_t t = 0; t < input_.tets.size(); ++t)
       for (Index v : input_.tets[t])
-        if (given_[static_cast<std::size_t>(v)] != input_.points[static_cast<std::size_t>(v)]) {
+        if (given_[primal::index_cast<std::size_t>(v)] !=
+            input_.points[primal::index_cast<std::size_t>(v)]) {
           moved.push_back(t);
           cells.push_back(input_.tets[t]);
           break;
@@ -253,7 +254,7 @@ void Conformer::find_interface() {
   aim_yardstick_ = std::min(
       {res_.input_diced_hex_min_scaled_jacobian, res_.input_diced_wedge_min_scaled_jacobian,
        tet_diced_.empty() ? 1.0 : *std::min_element(tet_diced_.begin(), tet_diced_.end())});
-  res_.interface_quads = static_cast<Index>(interface_.quads.size());
+  res_.interface_quads = primal::index_cast(interface_.quads.size());
   say("interface: " + std::to_string(interface_.quads.size()) + " quads" + took());
 }
 
@@ -264,22 +265,23 @@ std::vector<double> Conformer::local_minima(const std::vector<double>& tet) cons
   std::vector<double> node_min(input_.points.size(), 1.0);
   for (std::size_t h = 0; h < input_.hexes.size(); ++h)
     for (Index v : input_.hexes[h])
-      node_min[static_cast<std::size_t>(v)] =
-          std::min(node_min[static_cast<std::size_t>(v)], hex_diced_[h]);
+      node_min[primal::index_cast<std::size_t>(v)] =
+          std::min(node_min[primal::index_cast<std::size_t>(v)], hex_diced_[h]);
   for (std::size_t t = 0; t < input_.tets.size(); ++t)
     for (Index v : input_.tets[t])
-      node_min[static_cast<std::size_t>(v)] =
-          std::min(node_min[static_cast<std::size_t>(v)], tet[t]);
+      node_min[primal::index_cast<std::size_t>(v)] =
+          std::min(node_min[primal::index_cast<std::size_t>(v)], tet[t]);
   for (std::size_t w = 0; w < input_.wedges.size(); ++w)
     for (Index v : input_.wedges[w])
-      node_min[static_cast<std::size_t>(v)] =
-          std::min(node_min[static_cast<std::size_t>(v)], wedge_diced_[w]);
+      node_min[primal::index_cast<std::size_t>(v)] =
+          std::min(node_min[primal::index_cast<std::size_t>(v)], wedge_diced_[w]);
   std::vector<double> local;
   local.reserve(interface_.quads.size());
   for (const primal::InterfaceQuad& q : interface_.quads) {
     double m = 1.0;
-    for (Index v : q.corners) m = std::min(m, node_min[static_cast<std::size_t>(v)]);
-    if (q.centre != kInvalidIndex) m = std::min(m, node_min[static_cast<std::size_t>(q.centre)]);
+    for (Index v : q.corners) m = std::min(m, node_min[primal::index_cast<std::size_t>(v)]);
+    if (q.centre != kInvalidIndex)
+      m = std::min(m, node_min[primal::index_cast<std::size_t>(q.centre)]);
     local.push_back(m);
   }
   return local;
@@ -339,9 +341,9 @@ void Conformer::dice_and_merge() {
     if (b.centre != kInvalidIndex) shareable[b.centre] = 1;
   }
   diced_ = primal::dice_model(layer_.model, shareable);
-  res_.diced_hexes = static_cast<Index>(diced_.hex_children.size());
-  res_.diced_tet_hexes = static_cast<Index>(diced_.tet_children.size());
-  res_.diced_wedge_hexes = static_cast<Index>(diced_.wedge_children.size());
+  res_.diced_hexes = primal::index_cast(diced_.hex_children.size());
+  res_.diced_tet_hexes = primal::index_cast(diced_.tet_children.size());
+  res_.diced_wedge_hexes = primal::index_cast(diced_.wedge_children.size());
   check_dicing();
   say("dicing: " + std::to_string(res_.diced_hexes) + " hexes from hexes, " +
       std::to_string(res_.diced_tet_hexes) + " from tets, " +
@@ -400,7 +402,7 @@ void Conformer::place_templates() {
     const std::size_t n = rt.rst.size();
     inst_global_[b].assign(n, kInvalidIndex);
     inst_side_[b].assign(n, kInvalidIndex);
-    res_.geode_hexes += static_cast<Index>(rt.tpl.hex.hexes.size());
+    res_.geode_hexes += primal::index_cast(rt.tpl.hex.hexes.size());
     for (std::size_t i = 0; i < n; ++i) {
       const Point x = buffer_map(P, bh.diagonal, rt.rst[i], four ? &centre : nullptr);
       if (!rt.key_corners[i].empty()) {
@@ -464,7 +466,7 @@ void Conformer::match_sides() {
     }
   }
   auto& uf = side_sets_uf_;
-  const Index ns = static_cast<Index>(uf.size());
+  const Index ns = primal::index_cast(uf.size());
   std::vector<Point> sum(ns, Point::Zero());
   std::vector<int> cnt(ns, 0);
   for (Index s = 0; s < ns; ++s) sum[uf.find(s)] += side_pos_[s], ++cnt[uf.find(s)];
@@ -493,7 +495,7 @@ void Conformer::assemble() {
   // Side sets read the children in diced numbers: taken before the children move.
   side_sets_ = primal::diced_side_sets(lm, diced_, 0, res_.diced_hexes + res_.geode_hexes);
   const std::size_t total = diced_.hex_children.size() +
-                            static_cast<std::size_t>(res_.geode_hexes) +
+                            primal::index_cast<std::size_t>(res_.geode_hexes) +
                             diced_.tet_children.size() + diced_.wedge_children.size();
   std::vector<std::array<Index, 8>> hexes = std::move(diced_.hex_children);
   hexes.reserve(total);
@@ -505,7 +507,7 @@ void Conformer::assemble() {
   diced_.hex_parent = {};
   geode_first_.reserve(nb + 1);
   for (std::size_t b = 0; b < nb; ++b) {
-    geode_first_.push_back(static_cast<Index>(hexes.size()));
+    geode_first_.push_back(primal::index_cast(hexes.size()));
     const int id = blocks_.geode_id ? blocks_.geode_id : primal::block_of(lm, carved_from_[b]);
     for (const auto& h : ref(b).tpl.hex.hexes) {
       std::array<Index, 8> o{};
@@ -513,7 +515,7 @@ void Conformer::assemble() {
       hexes.push_back(o), block.push_back(id);
     }
   }
-  geode_first_.push_back(static_cast<Index>(hexes.size()));
+  geode_first_.push_back(primal::index_cast(hexes.size()));
   inst_global_ = {};
   hexes.insert(hexes.end(), diced_.tet_children.begin(), diced_.tet_children.end());
   diced_.tet_children = {};
@@ -531,7 +533,7 @@ void Conformer::assemble() {
   Index used = 0;
   for (auto& h : hexes)
     for (Index& v : h) {
-      Index& r = renum[static_cast<std::size_t>(v)];
+      Index& r = renum[primal::index_cast<std::size_t>(v)];
       if (r == kInvalidIndex) r = used++;
       v = r;
     }
@@ -543,7 +545,7 @@ void Conformer::assemble() {
   for (primal::NodeSet& ns : sets.node_sets) {
     const std::size_t n = ns.nodes.size();
     for (std::size_t i = 0; i < n; ++i)
-      if (const auto v = static_cast<std::size_t>(ns.nodes[i]);
+      if (const auto v = primal::index_cast<std::size_t>(ns.nodes[i]);
           v < layer_.top_node.size() && layer_.top_node[v] != kInvalidIndex)
         ns.nodes.push_back(layer_.top_node[v]);
   }
@@ -557,14 +559,14 @@ void Conformer::assemble() {
     for (Index& r : renum)
       if (r == kInvalidIndex) r = tail++;
     for (std::size_t i = 0; i < renum.size(); ++i)
-      while (renum[i] != static_cast<Index>(i)) {
-        const auto j = static_cast<std::size_t>(renum[i]);
+      while (renum[i] != primal::index_cast(i)) {
+        const auto j = primal::index_cast<std::size_t>(renum[i]);
         std::swap(points[i], points[j]);
         std::swap(renum[i], renum[j]);
       }
   }
   renum = {};
-  points.resize(static_cast<std::size_t>(used));
+  points.resize(primal::index_cast<std::size_t>(used));
   points.shrink_to_fit();
   mesh_.points = std::move(points);
   mesh_.hexes = std::move(hexes);
@@ -616,12 +618,12 @@ void Conformer::settle_templates() {
   std::vector<std::size_t> buffer_hexes;  // those with an inverted geode hex, ascending
   for (Index h : inverted_) {
     if (h < geode_first_.front() || h >= geode_first_.back()) continue;
-    const auto b = static_cast<std::size_t>(
+    const auto b = primal::index_cast<std::size_t>(
         std::upper_bound(geode_first_.begin(), geode_first_.end(), h) - geode_first_.begin() - 1);
     if (buffer_hexes.empty() || buffer_hexes.back() != b) buffer_hexes.push_back(b);
   }
   if (buffer_hexes.empty()) {
-    res_.placement_inverted = static_cast<Index>(inverted_.size());
+    res_.placement_inverted = primal::index_cast(inverted_.size());
     return;
   }
   // Templates share no interior node: settled in parallel (TBB), written back in order.
@@ -636,12 +638,13 @@ void Conformer::settle_templates() {
     ++res_.templates_settled;
     for (const auto& [v, x] : moved[j]) mesh_.points[v] = x;
     const std::size_t b = buffer_hexes[j];
-    std::vector<Index> hexes(static_cast<std::size_t>(geode_first_[b + 1] - geode_first_[b]));
+    std::vector<Index> hexes(
+        primal::index_cast<std::size_t>(geode_first_[b + 1] - geode_first_[b]));
     std::iota(hexes.begin(), hexes.end(), geode_first_[b]);
     measure(hexes);
   }
   res_.min_scaled_jacobian_before_smoothing = scan();
-  res_.placement_inverted = static_cast<Index>(inverted_.size());
+  res_.placement_inverted = primal::index_cast(inverted_.size());
   say("settling: " + std::to_string(buffer_hexes.size()) + " templates with an inverted hex, " +
       std::to_string(res_.templates_settled) + " settled, " +
       std::to_string(res_.placement_inverted) + " hexes left inverted" + took());
@@ -664,7 +667,7 @@ void Conformer::untangle() {
   add_smoothing(r);
   measure(r.region);
   res_.smoothing.final_min_scaled_jacobian = scan();
-  res_.smoothing.final_inverted = static_cast<Index>(inverted_.size());
+  res_.smoothing.final_inverted = primal::index_cast(inverted_.size());
   say("untangling: " + std::to_string(before) + " inverted hexes, " +
       std::to_string(inverted_.size()) + " left" + took());
 }
@@ -703,7 +706,7 @@ void Conformer::smooth() {
     }
   };
   if (local && options_.smooth_target > 0.0) {
-    std::vector<Index> geode(static_cast<std::size_t>(res_.geode_hexes));
+    std::vector<Index> geode(primal::index_cast<std::size_t>(res_.geode_hexes));
     std::iota(geode.begin(), geode.end(), res_.diced_hexes);
     o.target = options_.smooth_target;
     const auto r = primal::smooth_hexes_around(mesh_, primal::hexes_around(mesh_, geode), o);
@@ -726,7 +729,7 @@ void Conformer::smooth() {
     smooth_defects(d);
   }
   res_.smoothing.final_min_scaled_jacobian = scan();
-  res_.smoothing.final_inverted = static_cast<Index>(inverted_.size());
+  res_.smoothing.final_inverted = primal::index_cast(inverted_.size());
   untangle();
   const Index patches = res_.smoothing.patches;
   say("smoothing (" + std::string(local ? "local" : "global") + "): " + std::to_string(patches) +
@@ -776,7 +779,7 @@ void Conformer::smooth_defects(primal::LocalSmoothOptions o) {
   double worst = 1.0;  // the lowest defect
   for (std::size_t h = 0; h < sj_.size(); ++h)
     if (sj_[h] < aim[h]) {
-      defects.push_back(static_cast<Index>(h));
+      defects.push_back(primal::index_cast(h));
       worst = std::min(worst, sj_[h]);
     }
   if (defects.empty()) return;
@@ -799,9 +802,9 @@ void Conformer::smooth_defects(primal::LocalSmoothOptions o) {
     defects.clear();
     worst = 1.0;
     for (Index h : r.region)
-      if (sj_[static_cast<std::size_t>(h)] < aim[static_cast<std::size_t>(h)]) {
+      if (sj_[primal::index_cast<std::size_t>(h)] < aim[primal::index_cast<std::size_t>(h)]) {
         defects.push_back(h);
-        worst = std::min(worst, sj_[static_cast<std::size_t>(h)]);
+        worst = std::min(worst, sj_[primal::index_cast<std::size_t>(h)]);
       }
     if (pass + 1 >= kDefectMinPasses &&
         static_cast<double>(defects.size()) >
@@ -822,14 +825,15 @@ std::vector<double> Conformer::aims() const {
   // A diced hex squashed by the buffer layer: at least kPartAim x its input hex diced alone,
   // so that the part keeps its own quality behind the layer.
   for (std::size_t k = 0; k < diced_parent_.size(); ++k)
-    aim[k] = std::max(yardstick, kPartAim * hex_diced_[static_cast<std::size_t>(diced_parent_[k])]);
+    aim[k] = std::max(yardstick,
+                      kPartAim * hex_diced_[primal::index_cast<std::size_t>(diced_parent_[k])]);
   for (std::size_t b = 0; b + 1 < geode_first_.size(); ++b) {
-    const double local = aim_local_[static_cast<std::size_t>(layer_.hexes[b].quad)];
+    const double local = aim_local_[primal::index_cast<std::size_t>(layer_.hexes[b].quad)];
     const double tpl = res_.template_min_scaled_jacobian;
     const double a = std::max(
         {yardstick, kLocalAim * std::min(local, tpl), std::min(kGeodeFloor, kLocalAim * tpl)});
     for (Index h = geode_first_[b]; h < geode_first_[b + 1]; ++h)
-      aim[static_cast<std::size_t>(h)] = a;
+      aim[primal::index_cast<std::size_t>(h)] = a;
   }
   return aim;
 }
@@ -841,7 +845,8 @@ double Conformer::measure() {
 
 void Conformer::measure(std::span<const Index> hexes) {
   for (Index h : hexes)
-    sj_[static_cast<std::size_t>(h)] = primal::hex_scaled_jacobian(primal::hex_corners(mesh_, h));
+    sj_[primal::index_cast<std::size_t>(h)] =
+        primal::hex_scaled_jacobian(primal::hex_corners(mesh_, h));
 }
 
 double Conformer::scan() {
@@ -849,7 +854,7 @@ double Conformer::scan() {
   double lowest = 1.0;
   for (std::size_t h = 0; h < sj_.size(); ++h) {
     lowest = std::min(lowest, sj_[h]);
-    if (sj_[h] <= 0.0) inverted_.push_back(static_cast<Index>(h));
+    if (sj_[h] <= 0.0) inverted_.push_back(primal::index_cast(h));
   }
   return lowest;
 }
@@ -862,17 +867,17 @@ void Conformer::invert_for_test() {
   const char* text = std::getenv("GEODE_TEST_INVERT_OUTPUT_HEX");
   if (!text || !*text) return;
   const long n = std::strtol(text, nullptr, 10);
-  if (n < 1 || static_cast<std::size_t>(n) > mesh_.hexes.size()) return;
-  const auto& h = mesh_.hexes[static_cast<std::size_t>(n - 1)];
+  if (n < 1 || primal::index_cast<std::size_t>(n) > mesh_.hexes.size()) return;
+  const auto& h = mesh_.hexes[primal::index_cast<std::size_t>(n - 1)];
   Point centre = Point::Zero();
-  for (Index v : h) centre += mesh_.points[static_cast<std::size_t>(v)];
+  for (Index v : h) centre += mesh_.points[primal::index_cast<std::size_t>(v)];
   const Index corner = h[0];
-  Point& p = mesh_.points[static_cast<std::size_t>(corner)];
+  Point& p = mesh_.points[primal::index_cast<std::size_t>(corner)];
   p = 2.0 * (centre / 8.0) - p;
   std::vector<Index> at;
   for (std::size_t k = 0; k < mesh_.hexes.size(); ++k)
     if (std::find(mesh_.hexes[k].begin(), mesh_.hexes[k].end(), corner) != mesh_.hexes[k].end())
-      at.push_back(static_cast<Index>(k));
+      at.push_back(primal::index_cast(k));
   measure(at);
   scan();
   moved_.insert(moved_.end(), at.begin(), at.end());
@@ -897,7 +902,7 @@ void Conformer::verify() {
   } else {
     res_.validity = primal::check_validity(mesh_);
     res_.verified = ConformVerify::kFull;
-    res_.verified_hexes = static_cast<Index>(mesh_.hexes.size());
+    res_.verified_hexes = primal::index_cast(mesh_.hexes.size());
   }
   if (!res_.validity.ok()) res_.warnings.push_back("invalid mesh: " + res_.validity.summary());
   if (!inverted_.empty()) {
@@ -911,7 +916,7 @@ void Conformer::verify() {
   }
   std::map<int, std::vector<Index>> members;  // output block -> its hexes, ascending id
   for (std::size_t h = 0; h < mesh_.hexes.size(); ++h)
-    members[mesh_.block[h]].push_back(static_cast<Index>(h));
+    members[mesh_.block[h]].push_back(primal::index_cast(h));
   for (const auto& [id, sel] : members) {
     const auto name = blocks_.names.find(id);
     primal::QualityReport report;
@@ -920,35 +925,36 @@ void Conformer::verify() {
     } else {  // the scaled Jacobians measured after smoothing
       std::vector<double> values;
       values.reserve(sel.size());
-      for (Index h : sel) values.push_back(sj_[static_cast<std::size_t>(h)]);
-      report.num_hexes = static_cast<Index>(sel.size());
+      for (Index h : sel) values.push_back(sj_[primal::index_cast<std::size_t>(h)]);
+      report.num_hexes = primal::index_cast(sel.size());
       report.metrics.push_back(
           primal::summarize_metric(primal::HexMetric::kScaledJacobian, values, sel));
     }
     BlockQuality q{id, name != blocks_.names.end() ? name->second : "block " + std::to_string(id),
                    std::move(report)};
     for (std::size_t h = 0; h < input_.hexes.size(); ++h)
-      if (primal::block_of(input_, {primal::ElementKind::kHex, static_cast<Index>(h)}) == id)
+      if (primal::block_of(input_, {primal::ElementKind::kHex, primal::index_cast(h)}) == id)
         q.input_diced_min_scaled_jacobian =
             std::min(q.input_diced_min_scaled_jacobian, hex_diced_[h]);
     for (std::size_t t = 0; t < input_.tets.size(); ++t)
-      if (primal::block_of(input_, {primal::ElementKind::kTet, static_cast<Index>(t)}) == id)
+      if (primal::block_of(input_, {primal::ElementKind::kTet, primal::index_cast(t)}) == id)
         q.input_diced_min_scaled_jacobian =
             std::min(q.input_diced_min_scaled_jacobian, tet_given_[t]);
     for (std::size_t w = 0; w < input_.wedges.size(); ++w)
-      if (primal::block_of(input_, {primal::ElementKind::kWedge, static_cast<Index>(w)}) == id)
+      if (primal::block_of(input_, {primal::ElementKind::kWedge, primal::index_cast(w)}) == id)
         q.input_diced_min_scaled_jacobian =
             std::min(q.input_diced_min_scaled_jacobian, wedge_diced_[w]);
     res_.quality.push_back(std::move(q));
   }
   // The geode hexes against their local yardsticks, per block and over all.
   for (std::size_t b = 0; b + 1 < geode_first_.size(); ++b) {
-    const double local = res_.local_yardstick[static_cast<std::size_t>(layer_.hexes[b].quad)];
+    const double local =
+        res_.local_yardstick[primal::index_cast<std::size_t>(layer_.hexes[b].quad)];
     for (Index h = geode_first_[b]; h < geode_first_[b + 1]; ++h) {
-      const int id = mesh_.block[static_cast<std::size_t>(h)];
+      const int id = mesh_.block[primal::index_cast<std::size_t>(h)];
       auto it = std::find_if(res_.quality.begin(), res_.quality.end(),
                              [&](const BlockQuality& q) { return q.block == id; });
-      const double sj = sj_[static_cast<std::size_t>(h)];
+      const double sj = sj_[primal::index_cast<std::size_t>(h)];
       ++it->geode_hexes;
       it->geode_min_scaled_jacobian = std::min(it->geode_min_scaled_jacobian, sj);
       it->local_yardstick = std::min(it->local_yardstick, local);
@@ -1051,7 +1057,7 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
       Conformer(*model, options, model == &own && relaxation.nodes_moved ? &given : nullptr).run();
   r.relaxation = relaxation;
   r.seconds += relaxation.seconds;
-  r.input_pyramids = static_cast<Index>(input.pyramids.size());
+  r.input_pyramids = primal::index_cast(input.pyramids.size());
   r.input_tets -= 2 * r.input_pyramids;
   return r;
 }

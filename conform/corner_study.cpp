@@ -21,12 +21,14 @@ std::vector<QuadClass> classify_interface_quads(const primal::Model& m,
   std::map<primal::EdgeKey, std::vector<std::size_t>> edges;
   for (std::size_t q = 0; q < itf.quads.size(); ++q) {
     const auto& c = itf.quads[q].corners;
-    auto at = [&](int i) { return p[static_cast<std::size_t>(c[static_cast<std::size_t>(i)])]; };
+    auto at = [&](int i) {
+      return p[primal::index_cast<std::size_t>(c[primal::index_cast<std::size_t>(i)])];
+    };
     normal.push_back((at(2) - at(0)).cross(at(3) - at(1)).normalized());  // towards the tets
     centre.push_back((at(0) + at(1) + at(2) + at(3)) / 4.0);
     for (int i = 0; i < 4; ++i)
-      edges[primal::edge_key(c[static_cast<std::size_t>(i)],
-                             c[static_cast<std::size_t>((i + 1) % 4)])]
+      edges[primal::edge_key(c[primal::index_cast<std::size_t>(i)],
+                             c[primal::index_cast<std::size_t>((i + 1) % 4)])]
           .push_back(q);
   }
   std::map<primal::EdgeKey, double> angle;       // inside the hex part
@@ -47,8 +49,8 @@ std::vector<QuadClass> classify_interface_quads(const primal::Model& m,
     double sharpest = 180.0;
     for (int i = 0; i < 4; ++i) {
       const auto it =
-          angle.find(primal::edge_key(q.corners[static_cast<std::size_t>(i)],
-                                      q.corners[static_cast<std::size_t>((i + 1) % 4)]));
+          angle.find(primal::edge_key(q.corners[primal::index_cast<std::size_t>(i)],
+                                      q.corners[primal::index_cast<std::size_t>((i + 1) % 4)]));
       if (it != angle.end() && std::abs(it->second - 180.0) > std::abs(sharpest - 180.0))
         sharpest = it->second;
     }
@@ -73,17 +75,17 @@ std::vector<QuadClass> classify_interface_quads(const primal::Model& m,
 
 std::vector<double> geode_minima(const ConformResult& r) {
   const Index nb = r.interface_quads;
-  std::vector<double> out(static_cast<std::size_t>(nb), 1.0);
+  std::vector<double> out(primal::index_cast<std::size_t>(nb), 1.0);
   if (nb == 0) return out;
   const Index per = r.geode_hexes / nb;  // one template kind per model in the studied demos
   for (Index b = 0; b < nb; ++b)
     for (Index h = r.diced_hexes + per * b; h < r.diced_hexes + per * (b + 1); ++h) {
       primal::HexCorners c;
       for (int k = 0; k < 8; ++k)
-        c[static_cast<std::size_t>(k)] = r.model.points[static_cast<std::size_t>(
-            r.model.hexes[static_cast<std::size_t>(h)][static_cast<std::size_t>(k)])];
-      out[static_cast<std::size_t>(b)] =
-          std::min(out[static_cast<std::size_t>(b)], primal::hex_scaled_jacobian(c));
+        c[primal::index_cast<std::size_t>(k)] = r.model.points[primal::index_cast<std::size_t>(
+            r.model.hexes[primal::index_cast<std::size_t>(h)][primal::index_cast<std::size_t>(k)])];
+      out[primal::index_cast<std::size_t>(b)] =
+          std::min(out[primal::index_cast<std::size_t>(b)], primal::hex_scaled_jacobian(c));
     }
   return out;
 }

@@ -180,7 +180,7 @@ void impose_geode_sides(RefTemplate& four, const RefTemplate& geode, const Eigen
       if (t.key_corners[i].empty()) continue;
       std::vector<int> key = t.key_corners[i];
       std::sort(key.begin(), key.end());
-      g[i] = id_of.try_emplace(key, static_cast<Index>(id_of.size())).first->second;
+      g[i] = id_of.try_emplace(key, primal::index_cast(id_of.size())).first->second;
     }
     return g;
   };

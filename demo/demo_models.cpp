@@ -62,13 +62,13 @@ std::vector<int> boundary_surfaces(int volume) {
 void orient_positively(Model& m) {
   for (auto& t : m.tets) {
     const auto& p = m.points;
-    if (tet_volume(p[static_cast<std::size_t>(t[0])], p[static_cast<std::size_t>(t[1])],
-                   p[static_cast<std::size_t>(t[2])], p[static_cast<std::size_t>(t[3])]) < 0)
+    if (tet_volume(p[index_cast<std::size_t>(t[0])], p[index_cast<std::size_t>(t[1])],
+                   p[index_cast<std::size_t>(t[2])], p[index_cast<std::size_t>(t[3])]) < 0)
       std::swap(t[1], t[2]);
   }
   for (auto& h : m.hexes) {
     HexCorners c;
-    for (std::size_t i = 0; i < 8; ++i) c[i] = m.points[static_cast<std::size_t>(h[i])];
+    for (std::size_t i = 0; i < 8; ++i) c[i] = m.points[index_cast<std::size_t>(h[i])];
     if (hex_volume(c) < 0) h = {h[4], h[5], h[6], h[7], h[0], h[1], h[2], h[3]};
   }
 }
@@ -100,7 +100,7 @@ struct Shell {
     // Positions from different Gmsh models agree to rounding error; 1e-8 cells merge them.
     const std::array<long long, 3> key{std::llround(p.x() * 1e8), std::llround(p.y() * 1e8),
                                        std::llround(p.z() * 1e8)};
-    auto [it, inserted] = by_position.try_emplace(key, static_cast<Index>(points.size()));
+    auto [it, inserted] = by_position.try_emplace(key, index_cast(points.size()));
     if (inserted) points.push_back(p);
     return it->second;
   }
@@ -137,12 +137,12 @@ void append_interface_triangles(Shell& shell, const Model& hexes, OnInterface on
   int count = 0;
   for (const BoundaryQuad& q : boundary_quads(hex_part(hexes))) {
     Point c = Point::Zero();
-    for (Index v : q.nodes) c += hexes.points[static_cast<std::size_t>(v)] / 4.0;
+    for (Index v : q.nodes) c += hexes.points[index_cast<std::size_t>(v)] / 4.0;
     if (!on_interface(c)) continue;
     std::array<Index, 4> n{};
     std::array<Point, 4> p;
     for (int k = 0; k < 4; ++k) {
-      p[k] = hexes.points[static_cast<std::size_t>(q.nodes[k])];
+      p[k] = hexes.points[index_cast<std::size_t>(q.nodes[k])];
       n[k] = shell.node(p[k]);
     }
     // A split folding a non-convex quad (a triangle facing away from the quad) is not taken.
@@ -189,7 +189,7 @@ Model tet_fill(const Shell& shell, const std::vector<Shell>& holes, int block,
     }
     std::vector<std::size_t> tri_nodes;
     for (const auto& t : s.tris)
-      for (Index v : t) tri_nodes.push_back(node_tags[static_cast<std::size_t>(v)]);
+      for (Index v : t) tri_nodes.push_back(node_tags[index_cast<std::size_t>(v)]);
     gmsh::model::mesh::addNodes(2, tag, node_tags, coords);
     gmsh::model::mesh::addElementsByType(tag, 2, {}, tri_nodes);
     return tag;
@@ -208,7 +208,7 @@ Model tet_fill(const Shell& shell, const std::vector<Shell>& holes, int block,
 
 // hexes + tets as one model, coincident nodes merged, every element positively oriented.
 Model join(Model hexes, const Model& tets) {
-  const Index offset = static_cast<Index>(hexes.points.size());
+  const Index offset = index_cast(hexes.points.size());
   hexes.points.insert(hexes.points.end(), tets.points.begin(), tets.points.end());
   for (auto t : tets.tets) {
     for (Index& v : t) v += offset;
@@ -223,11 +223,11 @@ Model join(Model hexes, const Model& tets) {
   std::vector<Index> renum(hexes.points.size(), kInvalidIndex);
   std::vector<Point> points;
   auto use = [&](Index& v) {
-    if (renum[static_cast<std::size_t>(v)] == kInvalidIndex) {
-      renum[static_cast<std::size_t>(v)] = static_cast<Index>(points.size());
-      points.push_back(hexes.points[static_cast<std::size_t>(v)]);
+    if (renum[index_cast<std::size_t>(v)] == kInvalidIndex) {
+      renum[index_cast<std::size_t>(v)] = index_cast(points.size());
+      points.push_back(hexes.points[index_cast<std::size_t>(v)]);
     }
-    v = renum[static_cast<std::size_t>(v)];
+    v = renum[index_cast<std::size_t>(v)];
   };
   for (auto& h : hexes.hexes)
     for (Index& v : h) use(v);
@@ -382,7 +382,7 @@ void add_outside_side_set(Model& m) {
   SideSet outside{1, "outside", {}};
   for (const BoundaryQuad& q : boundary_quads(hex_part(m))) {
     Point c = Point::Zero();
-    for (Index v : q.nodes) c += m.points[static_cast<std::size_t>(v)] / 4.0;
+    for (Index v : q.nodes) c += m.points[index_cast<std::size_t>(v)] / 4.0;
     if (c.cwiseAbs().maxCoeff() > 2.0 - 1e-9)
       outside.sides.push_back({{ElementKind::kHex, q.hex}, q.local_face});
   }
@@ -543,9 +543,9 @@ bool tiles_square(const SquareQuads& f) {
   double area = 0;
   for (const auto& q : f.quads) {
     for (std::size_t k = 0; k < 4; ++k) {
-      const Point& a = f.points[static_cast<std::size_t>(q[(k + 3) % 4])];
-      const Point& b = f.points[static_cast<std::size_t>(q[k])];
-      const Point& c = f.points[static_cast<std::size_t>(q[(k + 1) % 4])];
+      const Point& a = f.points[index_cast<std::size_t>(q[(k + 3) % 4])];
+      const Point& b = f.points[index_cast<std::size_t>(q[k])];
+      const Point& c = f.points[index_cast<std::size_t>(q[(k + 1) % 4])];
       if ((c - b).cross(a - b).z() <= 0) return false;
       area += 0.5 * b.head<2>().homogeneous().cross(c.head<2>().homogeneous()).z();
     }
@@ -582,7 +582,7 @@ SquareQuads mesh_imprinted_square(int n, double r, int algorithm, int circle_seg
   gmsh::model::mesh::getNodes(tags, coords, parametric, -1, -1, true, false);
   std::map<std::size_t, Index> index;
   for (std::size_t i = 0; i < tags.size(); ++i)
-    if (index.try_emplace(tags[i], static_cast<Index>(f.points.size())).second)
+    if (index.try_emplace(tags[i], index_cast(f.points.size())).second)
       f.points.emplace_back(coords[3 * i], coords[3 * i + 1], 0.0);
   // Fresh output vectors per call: Gmsh takes non-empty ones as preallocated.
   std::vector<std::size_t> quads, quad_nodes, triangles, triangle_nodes;
@@ -612,8 +612,8 @@ SquareQuads imprinted_square(int n, double r) {
 // The face quads swept along `axis` from the nugget face (coordinate 1) to the box (2) in
 // `layers` equal layers, the face's (u, v) on the two other axes in cyclic order; block 1.
 void append_swept_slab(Model& m, const SquareQuads& face, int axis, int layers) {
-  const Index base = static_cast<Index>(m.points.size());
-  const Index count = static_cast<Index>(face.points.size());
+  const Index base = index_cast(m.points.size());
+  const Index count = index_cast(face.points.size());
   for (int k = 0; k <= layers; ++k)
     for (const Point& p : face.points) {
       Point q;
@@ -656,7 +656,7 @@ Model demo_fulcher(int n) {
       gmsh::model::setPhysicalName(3, 1, "hex blocks");
     });
     for (int axis = 0; axis < 3; ++axis)
-      append_swept_slab(hexes, imprinted_square(n, kRadii[static_cast<std::size_t>(axis)]), axis,
+      append_swept_slab(hexes, imprinted_square(n, kRadii[index_cast<std::size_t>(axis)]), axis,
                         n / 2);
     merge_coincident_nodes(hexes, 1e-9);
     orient_positively(hexes);
@@ -687,7 +687,7 @@ Model hybrid_gmsh(const std::string& name, F&& build) {
     build();
     gmsh::model::mesh::generate(3);
     Model m = without_file_ids(model_from_gmsh(name));
-    auto pt = [&](Index v) -> const Point& { return m.points[static_cast<std::size_t>(v)]; };
+    auto pt = [&](Index v) -> const Point& { return m.points[index_cast<std::size_t>(v)]; };
     orient_positively(m);
     for (auto& p : m.pyramids)
       if (tet_volume(pt(p[0]), pt(p[1]), pt(p[2]), pt(p[4])) < 0) std::swap(p[1], p[3]);
@@ -948,7 +948,7 @@ Model demo_potting(int n) {
       append_interface_triangles(
           holes[i], parts[i], [](const Point&) { return true; },
           diagonal_chooser(DemoDiagonals::kRandom, h), four_chooser(false));
-      const Index offset = static_cast<Index>(hexes.points.size());
+      const Index offset = index_cast(hexes.points.size());
       hexes.points.insert(hexes.points.end(), parts[i].points.begin(), parts[i].points.end());
       for (auto hex : parts[i].hexes) {
         for (Index& v : hex) v += offset;
@@ -983,8 +983,8 @@ Model demo_wedge(int n, double angle) {
       gmsh::vectorpair kites;
       for (int i = 0; i < k; ++i) {
         const int tip = ray((i + 0.5) * span, 1.0 / std::cos(span / 2));
-        const std::vector<int> corners{o, rim[static_cast<std::size_t>(i)], tip,
-                                       rim[static_cast<std::size_t>(i + 1)]};
+        const std::vector<int> corners{o, rim[index_cast<std::size_t>(i)], tip,
+                                       rim[index_cast<std::size_t>(i + 1)]};
         std::vector<int> lines;
         for (std::size_t c = 0; c < 4; ++c)
           lines.push_back(gmsh::model::occ::addLine(corners[c], corners[(c + 1) % 4]));

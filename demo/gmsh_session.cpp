@@ -80,7 +80,7 @@ Model model_from_gmsh(std::string_view source_view) {
   index_of.reserve(node_tags.size());
   model.points.reserve(node_tags.size());
   for (std::size_t i : order) {
-    if (!index_of.emplace(node_tags[i], static_cast<Index>(model.points.size())).second)
+    if (!index_of.emplace(node_tags[i], index_cast(model.points.size())).second)
       continue;  // the same node listed twice (shared entity boundary)
     model.points.emplace_back(coords[3 * i], coords[3 * i + 1], coords[3 * i + 2]);
   }
@@ -131,12 +131,12 @@ Model model_from_gmsh(std::string_view source_view) {
         continue;
       }
       const GmshCell& cell = kGmshCells[static_cast<std::size_t>(*kind)];
-      const auto n = static_cast<std::size_t>(cell.corners);
+      const auto n = index_cast<std::size_t>(cell.corners);
       for (std::size_t e = 0; e < tags.size(); ++e) {
         const std::string what = "element " + std::to_string(tags[e]);
         std::array<Index, 8> c{};
         for (std::size_t k = 0; k < n; ++k)
-          c[k] = node(nodes[n * e + static_cast<std::size_t>(cell.order[k])], what);
+          c[k] = node(nodes[n * e + index_cast<std::size_t>(cell.order[k])], what);
         add_element(model, *kind, c, block, static_cast<std::int64_t>(tags[e]));
       }
     }

@@ -29,11 +29,11 @@ void write_exodus(const Model& model, const std::filesystem::path& path) {
   int top = 0;
   for (ElementKind kind : kElementKinds)
     for (std::size_t e = 0; e < element_count(model, kind); ++e)
-      top = std::max(top, block_of(model, {kind, static_cast<Index>(e)}));
+      top = std::max(top, block_of(model, {kind, index_cast(e)}));
   std::map<int, std::string> names = model.block_names;
   for (ElementKind kind : kElementKinds)
     for (std::size_t e = 0; e < element_count(model, kind); ++e) {
-      const ElementRef ref{kind, static_cast<Index>(e)};
+      const ElementRef ref{kind, index_cast(e)};
       const int id = block_of(model, ref);
       auto [it, inserted] = exodus_id.try_emplace({id, kind}, id);
       if (inserted && blocks.count(id) && blocks[id].front().kind != kind) {
@@ -51,7 +51,7 @@ void write_exodus(const Model& model, const std::filesystem::path& path) {
   int next = 1;
   for (const auto& [id, members] : blocks)
     for (const ElementRef& e : members)
-      global[static_cast<std::size_t>(e.kind)][static_cast<std::size_t>(e.index)] = next++;
+      global[static_cast<std::size_t>(e.kind)][index_cast<std::size_t>(e.index)] = next++;
 
   write_path_atomically(path, "", [&](const std::filesystem::path& temp) {
     ex_opts(0);
@@ -61,10 +61,10 @@ void write_exodus(const Model& model, const std::filesystem::path& path) {
     const int exo = file.id();
     check(ex_set_max_name_length(exo, kNameLength), target, "setting the name length");
     check(
-        ex_put_init(exo, "geode", 3, static_cast<int64_t>(model.points.size()),
-                    static_cast<int64_t>(element_count(model)), static_cast<int64_t>(blocks.size()),
-                    static_cast<int64_t>(model.node_sets.size()),
-                    static_cast<int64_t>(model.side_sets.size())),
+        ex_put_init(exo, "geode", 3, index_cast<int64_t>(model.points.size()),
+                    static_cast<int64_t>(element_count(model)), index_cast<int64_t>(blocks.size()),
+                    index_cast<int64_t>(model.node_sets.size()),
+                    index_cast<int64_t>(model.side_sets.size())),
         target, "writing the header");
     if (!model.points.empty()) {
       std::vector<double> x, y, z;
@@ -84,16 +84,16 @@ void write_exodus(const Model& model, const std::filesystem::path& path) {
     for (const auto& [id, members] : blocks) {
       const ExodusCell& cell = kExodusCells[static_cast<std::size_t>(members.front().kind)];
       const int per_elem = cell.corners;
-      check(ex_put_block(exo, EX_ELEM_BLOCK, id, cell.name, static_cast<int64_t>(members.size()),
+      check(ex_put_block(exo, EX_ELEM_BLOCK, id, cell.name, index_cast<int64_t>(members.size()),
                          per_elem, 0, 0, 0),
             target, "writing block " + std::to_string(id));
-      std::vector<int> conn(members.size() * static_cast<std::size_t>(per_elem));
+      std::vector<int> conn(members.size() * index_cast<std::size_t>(per_elem));
       for (std::size_t i = 0; i < members.size(); ++i) {
         const auto corners = element_corners(model, members[i]);
-        const std::size_t base = i * static_cast<std::size_t>(per_elem);
+        const std::size_t base = i * index_cast<std::size_t>(per_elem);
         // exodus_corner[order[c]] = model_corner[c]
-        for (std::size_t c = 0; c < static_cast<std::size_t>(per_elem); ++c)
-          conn[base + static_cast<std::size_t>(cell.order[c])] = corners[c] + 1;
+        for (std::size_t c = 0; c < index_cast<std::size_t>(per_elem); ++c)
+          conn[base + index_cast<std::size_t>(cell.order[c])] = corners[c] + 1;
       }
       if (!conn.empty())
         check(ex_put_conn(exo, EX_ELEM_BLOCK, id, conn.data(), nullptr, nullptr), target,
@@ -108,7 +108,7 @@ void write_exodus(const Model& model, const std::filesystem::path& path) {
     NameBuffers node_set_names(model.node_sets.size());
     for (std::size_t s = 0; s < model.node_sets.size(); ++s) {
       const NodeSet& set = model.node_sets[s];
-      check(ex_put_set_param(exo, EX_NODE_SET, set.id, static_cast<int64_t>(set.nodes.size()), 0),
+      check(ex_put_set_param(exo, EX_NODE_SET, set.id, index_cast<int64_t>(set.nodes.size()), 0),
             target, "writing node set " + std::to_string(set.id));
       std::vector<int> nodes;
       for (Index v : set.nodes) nodes.push_back(v + 1);
@@ -124,12 +124,12 @@ void write_exodus(const Model& model, const std::filesystem::path& path) {
     NameBuffers side_set_names(model.side_sets.size());
     for (std::size_t s = 0; s < model.side_sets.size(); ++s) {
       const SideSet& set = model.side_sets[s];
-      check(ex_put_set_param(exo, EX_SIDE_SET, set.id, static_cast<int64_t>(set.sides.size()), 0),
+      check(ex_put_set_param(exo, EX_SIDE_SET, set.id, index_cast<int64_t>(set.sides.size()), 0),
             target, "writing side set " + std::to_string(set.id));
       std::vector<int> elems, sides;
       for (const Side& side : set.sides) {
         elems.push_back(global[static_cast<std::size_t>(side.element.kind)]
-                              [static_cast<std::size_t>(side.element.index)]);
+                              [index_cast<std::size_t>(side.element.index)]);
         sides.push_back(side.face + 1);
       }
       if (!elems.empty())

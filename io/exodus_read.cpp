@@ -111,13 +111,13 @@ Contents read_contents(const std::string& source, ExodusBounds bound) {
   if (c.num_dim < 2 || c.num_dim > 3)
     throw InvalidInput(source + ": " + std::to_string(c.num_dim) +
                        "-dimensional model; expected 3 (or 2)");
-  bound.take(c.num_nodes, static_cast<std::size_t>(c.num_dim) * 4, "nodes");
+  bound.take(c.num_nodes, index_cast<std::size_t>(c.num_dim) * 4, "nodes");
   bound.check(c.num_elem, 4, "elements");
   bound.check(num_blocks, 4, "element blocks");
   bound.check(num_node_sets, 4, "node sets");
   bound.check(num_side_sets, 4, "side sets");
 
-  const auto nodes = static_cast<std::size_t>(c.num_nodes);
+  const auto nodes = index_cast<std::size_t>(c.num_nodes);
   c.x.resize(nodes);
   c.y.resize(nodes);
   c.z.assign(nodes, 0.0);
@@ -130,14 +130,14 @@ Contents read_contents(const std::string& source, ExodusBounds bound) {
           "reading the node number map");
   }
   if (c.num_elem > 0) {
-    c.element_map.resize(static_cast<std::size_t>(c.num_elem));
+    c.element_map.resize(index_cast<std::size_t>(c.num_elem));
     check(ex_get_id_map(exo, EX_ELEM_MAP, c.element_map.data()), source,
           "reading the element number map");
   }
 
   std::int64_t elements = 0;
   if (num_blocks > 0) {
-    std::vector<int> ids(static_cast<std::size_t>(num_blocks));
+    std::vector<int> ids(index_cast<std::size_t>(num_blocks));
     check(ex_get_ids(exo, EX_ELEM_BLOCK, ids.data()), source, "reading element block ids");
     const std::vector<std::string> names = names_of(exo, EX_ELEM_BLOCK, ids.size());
     for (std::size_t b = 0; b < ids.size(); ++b) {
@@ -153,13 +153,13 @@ Contents read_contents(const std::string& source, ExodusBounds bound) {
       block.type.assign(type_buffer, strnlen(type_buffer, MAX_STR_LENGTH));
       if (block.per_elem < 0 || block.per_elem > 64)
         throw InvalidInput(where + ": " + std::to_string(block.per_elem) + " nodes per element");
-      bound.take(count, 4 * static_cast<std::size_t>(std::max(block.per_elem, 1)),
+      bound.take(count, 4 * index_cast<std::size_t>(std::max(block.per_elem, 1)),
                  "elements in the block");
       if (elements + count > c.num_elem)
         throw InvalidInput(where + ": more elements in the blocks than the header's " +
                            std::to_string(c.num_elem));
       elements += count;
-      block.conn.resize(static_cast<std::size_t>(count) * static_cast<std::size_t>(block.per_elem));
+      block.conn.resize(index_cast<std::size_t>(count) * index_cast<std::size_t>(block.per_elem));
       if (!block.conn.empty())
         check(ex_get_conn(exo, EX_ELEM_BLOCK, block.id, block.conn.data(), nullptr, nullptr), where,
               "reading connectivity");
@@ -170,7 +170,7 @@ Contents read_contents(const std::string& source, ExodusBounds bound) {
   const auto read_sets = [&](ex_entity_type type, int n, const char* what, std::size_t each,
                              std::vector<SetData>& out) {
     if (n <= 0) return;
-    std::vector<int> ids(static_cast<std::size_t>(n));
+    std::vector<int> ids(index_cast<std::size_t>(n));
     check(ex_get_ids(exo, type, ids.data()), source, std::string("reading ") + what + " ids");
     const std::vector<std::string> names = names_of(exo, type, ids.size());
     for (std::size_t s = 0; s < ids.size(); ++s) {
@@ -179,7 +179,7 @@ Contents read_contents(const std::string& source, ExodusBounds bound) {
       int count = 0, factors = 0;
       check(ex_get_set_param(exo, type, ids[s], &count, &factors), where, "reading the set header");
       bound.take(count, each, type == EX_NODE_SET ? "node set entries" : "side set entries");
-      set.entries.resize(static_cast<std::size_t>(count));
+      set.entries.resize(index_cast<std::size_t>(count));
       if (type == EX_SIDE_SET) set.sides.resize(set.entries.size());
       if (count > 0)
         check(ex_get_set(exo, type, ids[s], set.entries.data(),
@@ -210,11 +210,11 @@ class Packer {
   void i64(std::int64_t v) { raw(&v, sizeof v); }
   template <typename T>
   void array(const std::vector<T>& v) {
-    i64(static_cast<std::int64_t>(v.size()));
+    i64(index_cast<std::int64_t>(v.size()));
     raw(v.data(), v.size() * sizeof(T));
   }
   void text(const std::string& s) {
-    i64(static_cast<std::int64_t>(s.size()));
+    i64(index_cast<std::int64_t>(s.size()));
     raw(s.data(), s.size());
   }
   std::string out;
@@ -274,7 +274,7 @@ std::string pack(const Contents& c) {
   p.array(c.z);
   p.array(c.node_map);
   p.array(c.element_map);
-  p.i64(static_cast<std::int64_t>(c.blocks.size()));
+  p.i64(index_cast<std::int64_t>(c.blocks.size()));
   for (const BlockData& b : c.blocks) {
     p.i64(b.id);
     p.text(b.name);
@@ -283,7 +283,7 @@ std::string pack(const Contents& c) {
     p.array(b.conn);
   }
   for (const auto* sets : {&c.node_sets, &c.side_sets}) {
-    p.i64(static_cast<std::int64_t>(sets->size()));
+    p.i64(index_cast<std::int64_t>(sets->size()));
     for (const SetData& s : *sets) {
       p.i64(s.id);
       p.text(s.name);
@@ -312,7 +312,7 @@ Contents unpack(std::string_view bytes, const std::string& source) {
     const std::int64_t n = u.i64();
     if (n < 0 || static_cast<std::uint64_t>(n) > bytes.size() / least)
       throw std::runtime_error(source + ": the Exodus reader process's answer is malformed");
-    return static_cast<std::size_t>(n);
+    return index_cast<std::size_t>(n);
   };
   for (std::size_t b = count(40); b-- > 0;) {
     BlockData block;
@@ -332,8 +332,8 @@ Contents unpack(std::string_view bytes, const std::string& source) {
       set.sides = u.array<int>();
       sets->push_back(std::move(set));
     }
-  if (!u.done() || c.x.size() != static_cast<std::size_t>(c.num_nodes) ||
-      c.y.size() != c.x.size() || c.z.size() != c.x.size())
+  if (!u.done() || c.x.size() != index_cast<std::size_t>(c.num_nodes) || c.y.size() != c.x.size() ||
+      c.z.size() != c.x.size())
     throw std::runtime_error(source + ": the Exodus reader process's answer is malformed");
   return c;
 }
@@ -382,19 +382,19 @@ Model build_model(const Contents& c, const std::string& source) {
                          ": element type '" + block.type + "' with " +
                          std::to_string(block.per_elem) +
                          " nodes is not supported; only HEX8, TETRA4, PYRAMID5 and WEDGE6 are");
-    const auto per_elem = static_cast<std::size_t>(block.per_elem);
+    const auto per_elem = index_cast<std::size_t>(block.per_elem);
     for (std::size_t base = 0; base + per_elem <= block.conn.size(); base += per_elem) {
       auto node = [&](int corner) {
-        const int n = block.conn[base + static_cast<std::size_t>(corner)];
+        const int n = block.conn[base + index_cast<std::size_t>(corner)];
         if (n < 1 || n > c.num_nodes)
           throw InvalidInput(where + ": element " + std::to_string(global.size() + 1) +
                              ": corner " + std::to_string(corner + 1) + " refers to node " +
                              std::to_string(n) + ", out of range [1, " +
                              std::to_string(c.num_nodes) + "]");
-        return static_cast<Index>(n - 1);
+        return index_cast(n - 1);
       };
       std::array<Index, 8> corners{};
-      for (std::size_t k = 0; k < static_cast<std::size_t>(cell->corners); ++k)
+      for (std::size_t k = 0; k < index_cast<std::size_t>(cell->corners); ++k)
         corners[k] = node(cell->order[k]);
       global.push_back({kind, static_cast<Index>(element_count(model, kind))});
       add_element(model, kind, corners, block_id, element_file_id(global.size() - 1));
@@ -410,7 +410,7 @@ Model build_model(const Contents& c, const std::string& source) {
       if (in.entries[i] < 1 || in.entries[i] > c.num_nodes)
         throw InvalidInput(where + ": entry " + std::to_string(i + 1) + " refers to node " +
                            std::to_string(in.entries[i]) + ", out of range");
-      set.nodes.push_back(static_cast<Index>(in.entries[i] - 1));
+      set.nodes.push_back(index_cast(in.entries[i] - 1));
     }
     model.node_sets.push_back(std::move(set));
   }
@@ -423,10 +423,10 @@ Model build_model(const Contents& c, const std::string& source) {
     for (std::size_t i = 0; i < in.entries.size() && i < in.sides.size(); ++i) {
       const std::string entry = where + ": entry " + std::to_string(i + 1);
       const int element_number = in.entries[i], side = in.sides[i];
-      if (element_number < 1 || static_cast<std::size_t>(element_number) > global.size())
+      if (element_number < 1 || index_cast<std::size_t>(element_number) > global.size())
         throw InvalidInput(entry + " refers to element " + std::to_string(element_number) +
                            ", out of range");
-      const ElementRef element = global[static_cast<std::size_t>(element_number - 1)];
+      const ElementRef element = global[index_cast<std::size_t>(element_number - 1)];
       const int faces = cell_topology(element.kind).faces;
       if (side < 1 || side > faces)
         throw InvalidInput(entry + ": element " + std::to_string(element_number) + ": side " +

@@ -252,7 +252,7 @@ class MshReader {
         (s_.size() - pos_) / std::max<std::size_t>(min_bytes, 1))
       fail_at(at, std::string(what) + " " + std::to_string(n) +
                       " is more than the rest of the file can hold (truncated file?)");
-    return static_cast<std::size_t>(n);
+    return index_cast<std::size_t>(n);
   }
   // Per-item minimum sizes for count_field: ASCII items are at least "d " per number.
   std::size_t item_bytes(std::size_t ascii_numbers, std::size_t binary_bytes) const {
@@ -350,7 +350,7 @@ class MshReader {
     for (std::size_t d = 0; d < 4; ++d)
       counts[d] = count_field("an entity count", item_bytes(5, 36));
     for (int dim = 0; dim < 4; ++dim)
-      for (std::size_t i = 0; i < counts[static_cast<std::size_t>(dim)]; ++i) {
+      for (std::size_t i = 0; i < counts[index_cast<std::size_t>(dim)]; ++i) {
         const int tag = static_cast<int>(int_field("an entity tag"));
         for (int k = 0; k < (dim == 0 ? 3 : 6); ++k) real_field("an entity bounding box");
         const std::size_t np = count_field("a physical tag count", item_bytes(1, 4));
@@ -377,7 +377,7 @@ class MshReader {
     for (std::size_t d = 0; d < 4; ++d)
       counts[d] = count_field("a partitioned entity count", item_bytes(8, 48));
     for (int dim = 0; dim < 4; ++dim)
-      for (std::size_t i = 0; i < counts[static_cast<std::size_t>(dim)]; ++i) {
+      for (std::size_t i = 0; i < counts[index_cast<std::size_t>(dim)]; ++i) {
         const int tag = static_cast<int>(int_field("a partitioned entity tag"));
         Partitioned p;
         p.parent_dim = static_cast<int>(int_field("a partitioned entity's parent dimension"));
@@ -428,7 +428,7 @@ class MshReader {
       if (parametric != 0 && parametric != 1)
         fail("node block " + std::to_string(b + 1) + ": parametric flag " +
              std::to_string(parametric));
-      const std::size_t extra = parametric ? static_cast<std::size_t>(dim) : 0;
+      const std::size_t extra = parametric ? index_cast<std::size_t>(dim) : 0;
       const std::size_t n =
           count_field("a node block's node count", item_bytes(4 + extra, 32 + 8 * extra));
       std::vector<std::int64_t> tags(n);
@@ -491,7 +491,7 @@ class MshReader {
       const int entity = static_cast<int>(int_field("an element block's entity tag"));
       const std::size_t at = pos_;
       const GmshType& type = known_type(int_field("an element block's element type"), at);
-      const auto nn = static_cast<std::size_t>(type.nodes);
+      const auto nn = index_cast<std::size_t>(type.nodes);
       const std::size_t n =
           count_field("an element block's element count", item_bytes(1 + nn, 8 * (1 + nn)));
       for (std::size_t e = 0; e < n; ++e) {
@@ -539,7 +539,7 @@ class MshReader {
       if (nt < 0 || nt > 64) fail_at(nt_at, "element header: tag count " + std::to_string(nt));
       if (follow > total - elements_.size())
         fail_at(at, "element header: more elements than $Elements announces");
-      if (follow * (1 + static_cast<std::size_t>(nt) + static_cast<std::size_t>(type.nodes)) >
+      if (follow * (1 + index_cast<std::size_t>(nt) + index_cast<std::size_t>(type.nodes)) >
           (s_.size() - pos_) / 4)
         fail_at(at, "element header: " + std::to_string(follow) +
                         " elements are more than the rest of the file can hold (truncated file?)");
@@ -581,7 +581,7 @@ class MshReader {
       throw InvalidInput(source_ + ": element " + std::to_string(e.tag) + ": its volume " +
                          std::to_string(e.entity) + " is not in $PartitionedEntities");
     const std::vector<int>& p = it->second.partitions;
-    if (p.size() != 1 || p[0] < 1 || static_cast<std::size_t>(p[0]) > partitions_)
+    if (p.size() != 1 || p[0] < 1 || index_cast<std::size_t>(p[0]) > partitions_)
       throw InvalidInput(source_ + ": element " + std::to_string(e.tag) +
                          ": its partitioned volume " + std::to_string(e.entity) +
                          " is not in one partition of 1.." + std::to_string(partitions_));
@@ -644,7 +644,7 @@ class MshReader {
     for (std::size_t i : order) {
       const std::int64_t tag = node_tags_[i];
       if (auto it = index_of.find(tag); it != index_of.end()) {
-        const Point& first = model.points[static_cast<std::size_t>(it->second)];
+        const Point& first = model.points[index_cast<std::size_t>(it->second)];
         if (first != node_points_[i] && !(first.hasNaN() && node_points_[i].hasNaN()))
           throw InvalidInput(source_ + ": node " + std::to_string(tag) + " is given twice, at " +
                              point_text(first) + " and " + point_text(node_points_[i]));
@@ -652,9 +652,9 @@ class MshReader {
       }
       if (tag <= 0)
         throw InvalidInput(source_ + ": node tag " + std::to_string(tag) + " is not positive");
-      if (model.points.size() >= static_cast<std::size_t>(INT32_MAX))
+      if (model.points.size() >= index_cast<std::size_t>(INT32_MAX))
         throw InvalidInput(source_ + ": more nodes than this reader can number");
-      index_of.emplace(tag, static_cast<Index>(model.points.size()));
+      index_of.emplace(tag, index_cast(model.points.size()));
       model.points.push_back(node_points_[i]);
       model.node_ids.push_back(tag);
     }
@@ -731,8 +731,8 @@ class MshReader {
       const ElementKind kind = *gmsh_cell_kind(e.type);
       const GmshCell& cell = kGmshCells[static_cast<std::size_t>(kind)];
       std::array<Index, 8> c{};
-      for (std::size_t k = 0; k < static_cast<std::size_t>(cell.corners); ++k)
-        c[k] = node(e, static_cast<std::size_t>(cell.order[k]));
+      for (std::size_t k = 0; k < index_cast<std::size_t>(cell.corners); ++k)
+        c[k] = node(e, index_cast<std::size_t>(cell.order[k]));
       add_element(model, kind, c, v.block, e.tag);
       if (partitioned_) part_by_kind[static_cast<std::size_t>(kind)].push_back(volume_part[o]);
     }
@@ -789,7 +789,7 @@ class MshReader {
           const RawElement& e = elements_[i];
           std::vector<Index> piece;
           for (int k = 0; k < gmsh_type(e.type)->nodes; ++k)
-            piece.push_back(node(e, static_cast<std::size_t>(k)));
+            piece.push_back(node(e, index_cast<std::size_t>(k)));
           set.nodes.insert(set.nodes.end(), piece.begin(), piece.end());
           set.pieces.push_back(std::move(piece));
         }

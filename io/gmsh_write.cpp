@@ -69,7 +69,7 @@ struct ElementBlock {
     const auto c = element_corners(model, {kind, elements[e]});
     // gmsh_corner[order[i]] = model_corner[i]
     for (std::size_t v = 0; v < nodes_per_element; ++v)
-      out[static_cast<std::size_t>(cell.order[v])] = index_cast<std::size_t>(c[v]) + 1;
+      out[index_cast<std::size_t>(cell.order[v])] = index_cast<std::size_t>(c[v]) + 1;
   }
 };
 
@@ -131,9 +131,9 @@ class MshLayout {
     std::map<int, std::vector<ElementBlock>> by_block;
     for (ElementKind kind : kElementKinds) {
       const GmshCell& cell = kGmshCells[static_cast<std::size_t>(kind)];
-      const auto corners = static_cast<std::size_t>(cell.corners);
+      const auto corners = index_cast<std::size_t>(cell.corners);
       for (std::size_t i = 0; i < element_count(model, kind); ++i) {
-        const ElementRef ref{kind, static_cast<Index>(i)};
+        const ElementRef ref{kind, index_cast(i)};
         const int block = block_of(model, ref);
         auto& list = by_block[block];
         if (list.empty() || list.back().type != cell.type)
@@ -205,7 +205,7 @@ class MshLayout {
       for (const Side& side : set.sides) {
         const std::vector<Index> face = element_face(model, side);
         for (Index v : face)
-          (face.size() == 4 ? quad : tri).node_tags.push_back(static_cast<std::size_t>(v) + 1);
+          (face.size() == 4 ? quad : tri).node_tags.push_back(index_cast<std::size_t>(v) + 1);
       }
       std::vector<std::size_t> all = tri.node_tags;
       all.insert(all.end(), quad.node_tags.begin(), quad.node_tags.end());
@@ -222,7 +222,7 @@ class MshLayout {
       const NodeSet& set = model.node_sets[s];
       const int physical = node_tags_[s], entity = physical;
       ElementBlock points{0, entity, physical, kPoint, 1, {}, 0, ElementKind::kHex, {}};
-      for (Index v : set.nodes) points.node_tags.push_back(static_cast<std::size_t>(v) + 1);
+      for (Index v : set.nodes) points.node_tags.push_back(index_cast<std::size_t>(v) + 1);
       entities.push_back(bounded(0, entity, physical, points.node_tags));
       if (!points.node_tags.empty()) blocks.push_back(std::move(points));
       if (const std::string name = sanitize_name(set.name); !name.empty())
@@ -286,7 +286,7 @@ class MshWriter {
   void physical_names() {
     if (l_.names.empty()) return;
     out_.text("$PhysicalNames\n");
-    num(static_cast<std::int64_t>(l_.names.size()));
+    num(index_cast<std::int64_t>(l_.names.size()));
     nl();
     for (const PhysicalName& p : l_.names) {
       num(p.dim);
@@ -301,7 +301,7 @@ class MshWriter {
 
   void entities41() {
     std::array<std::vector<const Entity*>, 4> by_dim;
-    for (const Entity& e : l_.entities) by_dim[static_cast<std::size_t>(e.dim)].push_back(&e);
+    for (const Entity& e : l_.entities) by_dim[index_cast<std::size_t>(e.dim)].push_back(&e);
     out_.text("$Entities\n");
     for (std::size_t d = 0; d < 4; ++d) size_field(by_dim[d].size(), d == 3);
     for (std::size_t d = 0; d < 4; ++d)
@@ -366,7 +366,7 @@ class MshWriter {
   void nodes22() {
     const auto& pts = l_.model.points;
     out_.text("$Nodes\n");
-    num(static_cast<std::int64_t>(pts.size()));
+    num(index_cast<std::int64_t>(pts.size()));
     nl();
     for (std::size_t i = 0; i < pts.size(); ++i) {
       if (binary_) {
@@ -393,7 +393,7 @@ class MshWriter {
     for (const ElementBlock& b : l_.blocks) {
       if (binary_ && b.count() > 0) {
         out_.raw<std::int32_t>(b.type);
-        out_.raw<std::int32_t>(static_cast<std::int32_t>(b.count()));
+        out_.raw<std::int32_t>(index_cast<std::int32_t>(b.count()));
         out_.raw<std::int32_t>(2);  // tags: physical, elementary entity
       }
       std::array<std::size_t, 8> nodes{};

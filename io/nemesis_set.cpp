@@ -76,7 +76,7 @@ class SetReader {
   SetReader(const NemesisSet& set, FilePartition* partition) : set_(set), partition_(partition) {}
 
   Model read() {
-    const int n = static_cast<int>(set_.files.size());
+    const int n = index_cast<int>(set_.files.size());
     pieces_.resize(set_.files.size());
     std::vector<NemesisInfo> info(set_.files.size());
     std::int64_t local_nodes = 0, local_elements = 0;
@@ -110,8 +110,8 @@ class SetReader {
           " elements, more than the set's pieces hold (" + std::to_string(local_nodes) +
           " nodes, " + std::to_string(local_elements) + " elements)");
     Model model;
-    join_nodes(model, static_cast<std::size_t>(info[0].global_nodes));
-    join_elements(model, static_cast<std::size_t>(info[0].global_elements));
+    join_nodes(model, index_cast<std::size_t>(info[0].global_nodes));
+    join_elements(model, index_cast<std::size_t>(info[0].global_elements));
     join_sets(model);
     sanitize_names(model);
     validate(model, set_.base.string());
@@ -133,14 +133,14 @@ class SetReader {
           throw InvalidInput(file(p) + ": node " + std::to_string(i + 1) + ": global id " +
                              std::to_string(gid) + " out of range [1, " + std::to_string(count) +
                              "]");
-        const auto g = static_cast<std::size_t>(gid - 1);
+        const auto g = index_cast<std::size_t>(gid - 1);
         if (from[g] < 0) {
           from[g] = static_cast<int>(p);
           model.points[g] = m.points[i];
         } else if (model.points[g] != m.points[i]) {
           throw InvalidInput(file(p) + ": global node " + std::to_string(gid) + " is at " +
                              point_text(m.points[i]) + ", in " +
-                             file(static_cast<std::size_t>(from[g])) + " at " +
+                             file(index_cast<std::size_t>(from[g])) + " at " +
                              point_text(model.points[g]));
         }
         node_index_[p].push_back(index_cast<Index>(g));
@@ -165,10 +165,10 @@ class SetReader {
           if (gid < 1 || gid > index_cast<std::int64_t>(count))
             throw InvalidInput(file(p) + ": element " + std::to_string(gid) +
                                ": global id out of range [1, " + std::to_string(count) + "]");
-          Slot& s = slot[static_cast<std::size_t>(gid - 1)];
+          Slot& s = slot[index_cast<std::size_t>(gid - 1)];
           if (s.piece >= 0)
             throw InvalidInput(file(p) + ": element " + std::to_string(gid) + " is also in " +
-                               file(static_cast<std::size_t>(s.piece)));
+                               file(index_cast<std::size_t>(s.piece)));
           s = {static_cast<int>(p), ref};
         }
     for (std::size_t g = 0; g < count; ++g)
@@ -180,22 +180,22 @@ class SetReader {
     for (std::size_t p = 0; p < pieces_.size(); ++p)
       for (ElementKind kind : kElementKinds)
         element_index_[p][static_cast<std::size_t>(kind)].resize(element_count(pieces_[p], kind));
-    if (partition_) *partition_ = {static_cast<int>(pieces_.size()), {}};
+    if (partition_) *partition_ = {index_cast<int>(pieces_.size()), {}};
     for (ElementKind kind : kElementKinds)
       for (std::size_t g = 0; g < count; ++g) {
         const Slot& s = slot[g];
         if (s.element.kind != kind) continue;
-        const auto p = static_cast<std::size_t>(s.piece);
+        const auto p = index_cast<std::size_t>(s.piece);
         const Model& m = pieces_[p];
         std::array<Index, 8> corners{};
         const auto local = element_corners(m, s.element);
         for (std::size_t k = 0; k < local.size(); ++k)
-          corners[k] = node_index_[p][static_cast<std::size_t>(local[k])];
+          corners[k] = node_index_[p][index_cast<std::size_t>(local[k])];
         const int block = element_blocks(m, kind).empty()
                               ? default_block(kind)
-                              : element_blocks(m, kind)[static_cast<std::size_t>(s.element.index)];
+                              : element_blocks(m, kind)[index_cast<std::size_t>(s.element.index)];
         element_index_[p][static_cast<std::size_t>(kind)]
-                      [static_cast<std::size_t>(s.element.index)] =
+                      [index_cast<std::size_t>(s.element.index)] =
                           index_cast<Index>(element_count(model, kind));
         add_element(model, kind, corners, block, index_cast<std::int64_t>(g + 1));
         if (partition_) partition_->part.push_back(s.piece);
@@ -226,7 +226,7 @@ class SetReader {
         agree(kNodeSet, s.id, s.name, p);
         NodeSet& out = node_sets[s.id];
         out.id = s.id, out.name = s.name;
-        for (Index v : s.nodes) out.nodes.push_back(node_index_[p][static_cast<std::size_t>(v)]);
+        for (Index v : s.nodes) out.nodes.push_back(node_index_[p][index_cast<std::size_t>(v)]);
       }
       for (const SideSet& s : pieces_[p].side_sets) {
         agree(kSideSet, s.id, s.name, p);
@@ -235,7 +235,7 @@ class SetReader {
         for (const Side& side : s.sides) {
           const ElementRef e{side.element.kind,
                              element_index_[p][static_cast<std::size_t>(side.element.kind)]
-                                           [static_cast<std::size_t>(side.element.index)]};
+                                           [index_cast<std::size_t>(side.element.index)]};
           out.sides.push_back({e, side.face});
         }
       }

@@ -50,11 +50,11 @@ void read_field_data(const VtkGrid& grid, const std::vector<std::optional<Elemen
       if (a.components != 1) throw InvalidInput(where + ": expected 1 component");
       NodeSet set{id, std::move(set_name), {}};
       for (std::size_t i = 0; i < a.values.size(); ++i) {
-        if (a.values[i] < 0 || static_cast<std::size_t>(a.values[i]) >= grid.points.size())
+        if (a.values[i] < 0 || index_cast<std::size_t>(a.values[i]) >= grid.points.size())
           throw InvalidInput(where + ": entry " + std::to_string(i) + " refers to point " +
                              std::to_string(a.values[i]) + ", out of range [0, " +
                              std::to_string(grid.points.size()) + ")");
-        set.nodes.push_back(static_cast<Index>(a.values[i]));
+        set.nodes.push_back(index_cast(a.values[i]));
       }
       model.node_sets.push_back(std::move(set));
     } else if (name.rfind("side_set:", 0) == 0) {
@@ -64,11 +64,11 @@ void read_field_data(const VtkGrid& grid, const std::vector<std::optional<Elemen
       for (std::size_t i = 0; i + 1 < a.values.size(); i += 2) {
         const long long cell = a.values[i], face = a.values[i + 1];
         const std::string entry = where + ": entry " + std::to_string(i / 2);
-        if (cell < 0 || static_cast<std::size_t>(cell) >= cells.size() ||
-            !cells[static_cast<std::size_t>(cell)])
+        if (cell < 0 || index_cast<std::size_t>(cell) >= cells.size() ||
+            !cells[index_cast<std::size_t>(cell)])
           throw InvalidInput(entry + " refers to cell " + std::to_string(cell) +
                              ", not a volume cell of the file");
-        const ElementRef element = *cells[static_cast<std::size_t>(cell)];
+        const ElementRef element = *cells[index_cast<std::size_t>(cell)];
         const int faces = cell_topology(element.kind).faces;
         if (face < 0 || face >= faces)
           throw InvalidInput(entry + ": cell " + std::to_string(cell) + ": face " +
@@ -105,7 +105,7 @@ Model model_from_vtk(const VtkGrid& grid, const ReadOptions& options) {
                          std::to_string(type) +
                          " is not supported; only hexahedra (12), tetrahedra (10), wedges (13) and "
                          "pyramids (14) are");
-    const ElementKind kind = kElementKinds[static_cast<std::size_t>(it - kVtkCellTypes.begin())];
+    const ElementKind kind = kElementKinds[index_cast<std::size_t>(it - kVtkCellTypes.begin())];
     const int block = blocks ? (*blocks)[c] : default_block(kind);
     if (block <= 0)
       throw InvalidInput(grid.source + ": cell " + std::to_string(c) + ": block id " +
@@ -115,7 +115,7 @@ Model model_from_vtk(const VtkGrid& grid, const ReadOptions& options) {
     const auto& cell = grid.cells[c];
     for (std::size_t k = 0; k < cell.size() && k < 8; ++k)
       corners[k] =
-          cell[kind == ElementKind::kWedge ? static_cast<std::size_t>(topology::kVtkWedgeOrder[k])
+          cell[kind == ElementKind::kWedge ? index_cast<std::size_t>(topology::kVtkWedgeOrder[k])
                                            : k];
     cells[c] = ElementRef{kind, static_cast<Index>(element_count(model, kind))};
     add_element(model, kind, corners, block, static_cast<std::int64_t>(c));

@@ -66,7 +66,7 @@ void add_cells(Grid& g, const std::string& file, const std::vector<std::array<In
   const std::size_t np = g.points->size();
   for (std::size_t c = 0; c < cells.size(); ++c) {
     for (Index v : cells[c]) {
-      if (v < 0 || static_cast<std::size_t>(v) >= np) {
+      if (v < 0 || index_cast<std::size_t>(v) >= np) {
         throw InvalidInput(file + ": " + cell_type_name(type) + " " + std::to_string(c + 1) +
                            ": node " + std::to_string(v + 1) + " out of range [1, " +
                            std::to_string(np) + "]");
@@ -74,7 +74,7 @@ void add_cells(Grid& g, const std::string& file, const std::vector<std::array<In
       g.connectivity.push_back(v);
     }
     g.types.push_back(static_cast<std::uint8_t>(type));
-    g.offsets.push_back(static_cast<Index>(g.connectivity.size()));
+    g.offsets.push_back(index_cast(g.connectivity.size()));
   }
 }
 
@@ -124,14 +124,14 @@ void append_quality(std::vector<double>& sj, const std::vector<Point>& pts,
                     const std::vector<std::array<Index, N>>& cells, F&& metric) {
   for (const auto& c : cells) {
     const bool in_range = std::all_of(c.begin(), c.end(), [&](Index v) {
-      return v >= 0 && static_cast<std::size_t>(v) < pts.size();
+      return v >= 0 && index_cast<std::size_t>(v) < pts.size();
     });
     if (!in_range) {
       sj.push_back(0.0);
       continue;
     }
     std::array<Point, N> p;
-    for (std::size_t k = 0; k < N; ++k) p[k] = pts[static_cast<std::size_t>(c[k])];
+    for (std::size_t k = 0; k < N; ++k) p[k] = pts[index_cast<std::size_t>(c[k])];
     sj.push_back(metric(p));
   }
 }
@@ -184,8 +184,8 @@ double wedge_sj(const std::array<Point, 6>& p) {
   double s = 1.0;
   for (std::size_t k = 0; k < 6; ++k) {
     const auto& n = topology::kWedgeCornerNeighbors[k];
-    s = std::min(s, frame_sj(p[k], p[static_cast<std::size_t>(n[0])],
-                             p[static_cast<std::size_t>(n[1])], p[static_cast<std::size_t>(n[2])]));
+    s = std::min(s, frame_sj(p[k], p[index_cast<std::size_t>(n[0])],
+                             p[index_cast<std::size_t>(n[1])], p[index_cast<std::size_t>(n[2])]));
   }
   return s;
 }
@@ -199,7 +199,7 @@ Grid grid_of(const std::filesystem::path& path, const Model& m, const VtkCellDat
   std::vector<std::array<Index, 6>> vtk_wedges(m.wedges.size());
   for (std::size_t w = 0; w < m.wedges.size(); ++w)
     for (std::size_t k = 0; k < 6; ++k)
-      vtk_wedges[w][k] = m.wedges[w][static_cast<std::size_t>(topology::kVtkWedgeOrder[k])];
+      vtk_wedges[w][k] = m.wedges[w][index_cast<std::size_t>(topology::kVtkWedgeOrder[k])];
   add_cells(g, file, m.hexes, kVtkHexahedron);
   add_cells(g, file, m.tets, kVtkTetra);
   add_cells(g, file, m.pyramids, kVtkPyramid);
@@ -212,7 +212,7 @@ Grid grid_of(const std::filesystem::path& path, const Model& m, const VtkCellDat
   std::vector<int> block;
   for (ElementKind kind : kElementKinds)
     for (std::size_t e = 0; e < element_count(m, kind); ++e)
-      block.push_back(block_of(m, {kind, static_cast<Index>(e)}));
+      block.push_back(block_of(m, {kind, index_cast(e)}));
   // The block again as "mat_id", the cell array of material ids Python solvers read (SfePy's
   // name; meshio hands it on), so that they find the materials without knowing ours.
   VtkCellData data = extra;
@@ -222,7 +222,7 @@ Grid grid_of(const std::filesystem::path& path, const Model& m, const VtkCellDat
   // Sets by the written cells' numbers: hexes, then tets, pyramids and wedges.
   std::array<Index, 4> first{};
   for (std::size_t k = 1; k < kElementKinds.size(); ++k)
-    first[k] = first[k - 1] + static_cast<Index>(element_count(m, kElementKinds[k - 1]));
+    first[k] = first[k - 1] + index_cast(element_count(m, kElementKinds[k - 1]));
   for (const NodeSet& set : m.node_sets)
     g.node_sets.emplace_back(std::to_string(set.id) + ":" + sanitize_name(set.name), set.nodes);
   for (const SideSet& set : m.side_sets) {
@@ -230,7 +230,7 @@ Grid grid_of(const std::filesystem::path& path, const Model& m, const VtkCellDat
     for (const Side& side : set.sides)
       pairs.insert(pairs.end(),
                    {first[static_cast<std::size_t>(side.element.kind)] + side.element.index,
-                    static_cast<Index>(side.face)});
+                    index_cast(side.face)});
     g.side_sets.emplace_back(std::to_string(set.id) + ":" + sanitize_name(set.name),
                              std::move(pairs));
   }
@@ -433,7 +433,7 @@ void write_vtk_grid(std::ostream& os, const Grid& g) {
   for (std::size_t c = 0; c < ncells; ++c) {
     os << g.offsets[c] - begin;
     for (Index k = begin; k < g.offsets[c]; ++k)
-      os << ' ' << g.connectivity[static_cast<std::size_t>(k)];
+      os << ' ' << g.connectivity[index_cast<std::size_t>(k)];
     os << '\n';
     begin = g.offsets[c];
   }

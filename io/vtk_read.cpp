@@ -56,14 +56,14 @@ void check_cells(const VtkGrid& g, LineOf&& line_of_cell) {
            "cell " + std::to_string(c) + ": unknown or unsupported cell type " +
                std::to_string(type) + " (supported: 5 triangle, 9 quad, 10 tetra, 12 hexahedron)");
     }
-    if (static_cast<int>(g.cells[c].size()) != cell_type_size(type)) {
+    if (index_cast<int>(g.cells[c].size()) != cell_type_size(type)) {
       fail(g.source, line_of_cell(c, false),
            "cell " + std::to_string(c) + ": type " + std::to_string(type) + " (" + name +
                ") needs " + std::to_string(cell_type_size(type)) + " nodes, has " +
                std::to_string(g.cells[c].size()));
     }
     for (Index v : g.cells[c]) {
-      if (v < 0 || static_cast<std::size_t>(v) >= g.points.size()) {
+      if (v < 0 || index_cast<std::size_t>(v) >= g.points.size()) {
         fail(g.source, line_of_cell(c, false),
              "cell " + std::to_string(c) + ": node " + std::to_string(v) + " out of range [0, " +
                  std::to_string(g.points.size()) + ")");
@@ -551,7 +551,7 @@ std::size_t count_attr(const std::string& file, const XmlElement& el, const std:
   const long long n =
       parse_int(file, el.line, v.empty() ? std::string_view("missing") : std::string_view(v));
   if (n < 0) fail(file, el.line, key + " is negative");
-  return static_cast<std::size_t>(n);
+  return index_cast<std::size_t>(n);
 }
 
 bool is_float_type(const std::string& t) { return t == "Float32" || t == "Float64"; }
@@ -591,7 +591,7 @@ VtkGrid parse_vtu(std::string_view content, const std::string& source) {
     appended_bytes = xml.substr(underscore + 1, end - underscore - 1);
     // Keep the line count of what follows for messages.
     const auto lines = std::count(appended_bytes.begin(), appended_bytes.end(), '\n');
-    xml.replace(underscore, end - underscore, std::string(static_cast<std::size_t>(lines), '\n'));
+    xml.replace(underscore, end - underscore, std::string(index_cast<std::size_t>(lines), '\n'));
     enc.appended = appended_bytes;
   }
   const XmlElement root = XmlParser(std::move(xml), file).parse();
@@ -679,12 +679,12 @@ VtkGrid parse_vtu(std::string_view content, const std::string& source) {
   std::vector<std::size_t> offsets;
   for (std::size_t c = 0; c < nc; ++c) {
     const long long o = parse_int(file, on.lines[c], on.tokens[c]);
-    if (o < 0 || (c > 0 && static_cast<std::size_t>(o) < offsets.back())) {
+    if (o < 0 || (c > 0 && index_cast<std::size_t>(o) < offsets.back())) {
       fail(file, on.lines[c],
            "offsets: cell " + std::to_string(c) + ": offset " + std::to_string(o) +
                " is negative or decreasing");
     }
-    offsets.push_back(static_cast<std::size_t>(o));
+    offsets.push_back(index_cast<std::size_t>(o));
   }
   const Numbers cn = data_array_values(file, *conn, nc ? offsets.back() : 0, "connectivity", enc);
   std::vector<int> cell_line(nc, conn->line), type_line(nc, types->line);
@@ -843,7 +843,7 @@ class Tokens {
   std::size_t count(const std::string& what) {
     const long long n = integer(what);
     if (n < 0) fail(file_, line_before(), what + " is negative");
-    return static_cast<std::size_t>(n);
+    return index_cast<std::size_t>(n);
   }
   void expect(std::string_view word, const std::string& what) {
     const auto t = next(what);

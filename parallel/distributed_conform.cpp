@@ -40,12 +40,12 @@ struct PointBitsHash {
   std::size_t operator()(const PointBits& p) const {
     std::uint64_t h = 0x9e3779b97f4a7c15ull;
     for (std::uint64_t x : p.b) h = (h ^ x) * 0x100000001b3ull, h ^= h >> 29;
-    return static_cast<std::size_t>(h);
+    return primal::index_cast<std::size_t>(h);
   }
 };
 PointBits bits(const Point& p) {
   PointBits r;
-  for (int i = 0; i < 3; ++i) std::memcpy(&r.b[static_cast<std::size_t>(i)], &p[i], 8);
+  for (int i = 0; i < 3; ++i) std::memcpy(&r.b[primal::index_cast<std::size_t>(i)], &p[i], 8);
   return r;
 }
 
@@ -97,7 +97,7 @@ class Distributor {
   primal::ElementRef ref(std::size_t c) const {
     std::size_t k = 0;
     while (c >= offsets_[k + 1]) ++k;
-    return {primal::kElementKinds[k], static_cast<Index>(c - offsets_[k])};
+    return {primal::kElementKinds[k], primal::index_cast(c - offsets_[k])};
   }
 
   void partition();
@@ -170,7 +170,7 @@ void Distributor::partition() {
     }
   } else if (size_ > 1) {
     if (rank_ == 0) part_ = partition_elements(m(), size_);
-    MPI_Bcast(part_.data(), static_cast<int>(part_.size()), MPI_INT, 0, comm_);
+    MPI_Bcast(part_.data(), primal::index_cast<int>(part_.size()), MPI_INT, 0, comm_);
   }
 }
 
@@ -197,13 +197,14 @@ void Distributor::yardstick() {
     if (part_[c] != rank_) continue;
     const auto r = ref(c);
     if (r.kind == ElementKind::kHex)
-      hexes.push_back(m().hexes[static_cast<std::size_t>(r.index)]), hex_cell.push_back(c);
+      hexes.push_back(m().hexes[primal::index_cast<std::size_t>(r.index)]), hex_cell.push_back(c);
     else if (r.kind == ElementKind::kTet)
-      tets.push_back(m().tets[static_cast<std::size_t>(r.index)]), tet_cell.push_back(c);
+      tets.push_back(m().tets[primal::index_cast<std::size_t>(r.index)]), tet_cell.push_back(c);
     else if (r.kind == ElementKind::kWedge)
-      consider(2, c,
-               primal::diced_wedge_min_scaled_jacobian(
-                   m().points, std::span(&m().wedges[static_cast<std::size_t>(r.index)], 1)));
+      consider(
+          2, c,
+          primal::diced_wedge_min_scaled_jacobian(
+              m().points, std::span(&m().wedges[primal::index_cast<std::size_t>(r.index)], 1)));
   }
   const auto h = primal::diced_scaled_jacobian_per_cell(m().points, hexes);
   for (std::size_t i = 0; i < h.size(); ++i) consider(0, hex_cell[i], h[i]);
@@ -211,12 +212,12 @@ void Distributor::yardstick() {
   for (std::size_t i = 0; i < t.size(); ++i) consider(1, tet_cell[i], t[i]);
   MPI_Allreduce(low, all, 3, MPI_DOUBLE_INT, MPI_MINLOC, comm_);
   for (const auto& a : all)
-    if (a.value <= 1.5) lowest_.push_back(static_cast<std::size_t>(a.cell));
-  int n = static_cast<int>(inverted.size());
-  std::vector<int> counts(static_cast<std::size_t>(size_)), displs(counts.size());
+    if (a.value <= 1.5) lowest_.push_back(primal::index_cast<std::size_t>(a.cell));
+  int n = primal::index_cast<int>(inverted.size());
+  std::vector<int> counts(primal::index_cast<std::size_t>(size_)), displs(counts.size());
   MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
   std::exclusive_scan(counts.begin(), counts.end(), displs.begin(), 0);
-  std::vector<int> every(static_cast<std::size_t>(displs.back() + counts.back()));
+  std::vector<int> every(primal::index_cast<std::size_t>(displs.back() + counts.back()));
   MPI_Allgatherv(inverted.data(), n, MPI_INT, every.data(), counts.data(), displs.data(), MPI_INT,
                  comm_);
   inverted_.assign(every.begin(), every.end());
@@ -240,31 +241,33 @@ bool Distributor::zone_at(int rings) {
   const std::size_t nv = m().points.size();
   std::vector<char> used_by_hex(nv, 0), used_by_tet(nv, 0), marked(nv, 0);
   for (const auto& h : m().hexes)
-    for (Index v : h) used_by_hex[static_cast<std::size_t>(v)] = 1;
+    for (Index v : h) used_by_hex[primal::index_cast<std::size_t>(v)] = 1;
   for (const auto& t : m().tets)
-    for (Index v : t) used_by_tet[static_cast<std::size_t>(v)] = 1;
+    for (Index v : t) used_by_tet[primal::index_cast<std::size_t>(v)] = 1;
   for (std::size_t v = 0; v < nv; ++v) marked[v] = used_by_hex[v] && used_by_tet[v];
   for (std::size_t c : inverted_)
-    for (Index v : primal::element_corners(m(), ref(c))) marked[static_cast<std::size_t>(v)] = 1;
+    for (Index v : primal::element_corners(m(), ref(c)))
+      marked[primal::index_cast<std::size_t>(v)] = 1;
   // Wedges seed the zone too: dice_model places a wedge's edge and face nodes by summing over
   // the corners of the first wedge making them, so their bits depend on which wedges a run
   // dices; inside the zone they are the serial run's (its elements in the same order).
   for (const auto& w : m().wedges)
-    for (Index v : w) marked[static_cast<std::size_t>(v)] = 1;
+    for (Index v : w) marked[primal::index_cast<std::size_t>(v)] = 1;
   level_.assign(cells(), -1);
   for (int ring = 0; ring <= rings; ++ring) {
     std::vector<std::size_t> reached;
     for (std::size_t c = 0; c < cells(); ++c) {
       if (level_[c] >= 0) continue;
       for (Index v : primal::element_corners(m(), ref(c)))
-        if (marked[static_cast<std::size_t>(v)]) {
+        if (marked[primal::index_cast<std::size_t>(v)]) {
           reached.push_back(c);
           break;
         }
     }
     for (std::size_t c : reached) {
       level_[c] = static_cast<signed char>(ring);
-      for (Index v : primal::element_corners(m(), ref(c))) marked[static_cast<std::size_t>(v)] = 1;
+      for (Index v : primal::element_corners(m(), ref(c)))
+        marked[primal::index_cast<std::size_t>(v)] = 1;
     }
   }
   in_zone_.assign(cells(), 0);
@@ -275,16 +278,18 @@ bool Distributor::zone_at(int rings) {
   std::vector<char> outside(nv, 0), near(nv, 0), band(cells(), 0);
   for (std::size_t c = 0; c < cells(); ++c)
     if (!in_zone_[c])
-      for (Index v : primal::element_corners(m(), ref(c))) outside[static_cast<std::size_t>(v)] = 1;
+      for (Index v : primal::element_corners(m(), ref(c)))
+        outside[primal::index_cast<std::size_t>(v)] = 1;
   for (int ring = 0; ring < 2; ++ring) {
     for (std::size_t c = 0; c < cells(); ++c) {
       if (!in_zone_[c]) continue;
       for (Index v : primal::element_corners(m(), ref(c)))
-        if (outside[static_cast<std::size_t>(v)]) band[c] = 1;
+        if (outside[primal::index_cast<std::size_t>(v)]) band[c] = 1;
     }
     for (std::size_t c = 0; c < cells(); ++c)
       if (band[c])
-        for (Index v : primal::element_corners(m(), ref(c))) near[static_cast<std::size_t>(v)] = 1;
+        for (Index v : primal::element_corners(m(), ref(c)))
+          near[primal::index_cast<std::size_t>(v)] = 1;
     outside.swap(near);
   }
   primal::Submodel zone = primal::extract_submodel(m(), in_zone_);
@@ -297,22 +302,24 @@ bool Distributor::zone_at(int rings) {
   zone_at_.clear();
   zone_at_.reserve(r.model.points.size());
   for (std::size_t i = 0; i < r.model.points.size(); ++i)
-    zone_at_.emplace(bits(r.model.points[i]), static_cast<Index>(i));
+    zone_at_.emplace(bits(r.model.points[i]), primal::index_cast(i));
   // The band diced alone must be found in the zone's output, node for node.
   primal::Submodel b = primal::extract_submodel(m(), band);
   const primal::DicedModel d = primal::dice_model(b.model);
   for (const Point& p : d.points)
     if (!zone_at_.count(bits(p))) return false;
   zone_node_.assign(nv, 0);
-  for (Index v : zone.node) zone_node_[static_cast<std::size_t>(v)] = 1;
+  for (Index v : zone.node) zone_node_[primal::index_cast<std::size_t>(v)] = 1;
   zone_out_ = std::move(r.model);
   rep_.zone = std::move(r);
   rep_.zone.model = {};
   // This rank's share of the zone's hexes: a contiguous run (the zone's output order follows
   // the input's element order within each block).
   const std::size_t nz = zone_out_.hexes.size();
-  zone_first_ = nz * static_cast<std::size_t>(rank_) / static_cast<std::size_t>(size_);
-  zone_last_ = nz * static_cast<std::size_t>(rank_ + 1) / static_cast<std::size_t>(size_);
+  zone_first_ =
+      nz * primal::index_cast<std::size_t>(rank_) / primal::index_cast<std::size_t>(size_);
+  zone_last_ =
+      nz * primal::index_cast<std::size_t>(rank_ + 1) / primal::index_cast<std::size_t>(size_);
   return true;
 }
 
@@ -327,29 +334,29 @@ void Distributor::dice() {
 // Global ids: see the header.
 void Distributor::number() {
   const std::size_t nv = m().points.size();
-  const std::int64_t zone_nodes = static_cast<std::int64_t>(zone_out_.points.size());
+  const std::int64_t zone_nodes = primal::index_cast<std::int64_t>(zone_out_.points.size());
   // Per model node: the ranks whose elements outside the zone use it.
   std::vector<Mask> uses(nv, 0);
   for (std::size_t c = 0; c < cells(); ++c)
     if (!in_zone_[c])
       for (Index v : primal::element_corners(m(), ref(c)))
-        uses[static_cast<std::size_t>(v)] |= Mask{1} << part_[c];
+        uses[primal::index_cast<std::size_t>(v)] |= Mask{1} << part_[c];
   const std::size_t nd = diced_.points.size();
   diced_gid_.assign(nd, -1);
   diced_holders_.assign(nd, Mask{1} << rank_);
   // Origins in model numbers (own_.node ascends, so normalized keys stay sorted).
   std::vector<FaceKey> key(nd, primal::kNoOrigin);
-  std::vector<std::vector<std::size_t>> candidates(static_cast<std::size_t>(size_));
+  std::vector<std::vector<std::size_t>> candidates(primal::index_cast<std::size_t>(size_));
   for (std::size_t i = 0; i < nd; ++i) {
     const FaceKey& o = diced_.origin[i];
     if (o[0] == kInvalidIndex) continue;  // a cell centre: this rank's alone
     bool in_zone = true;
     Mask holders = ~Mask{0};
     for (std::size_t k = 0; k < 4 && o[k] != kInvalidIndex; ++k) {
-      const Index v = own_.node[static_cast<std::size_t>(o[k])];
+      const Index v = own_.node[primal::index_cast<std::size_t>(o[k])];
       key[i][k] = v;
-      in_zone = in_zone && zone_node_[static_cast<std::size_t>(v)];
-      holders &= uses[static_cast<std::size_t>(v)];
+      in_zone = in_zone && zone_node_[primal::index_cast<std::size_t>(v)];
+      holders &= uses[primal::index_cast<std::size_t>(v)];
     }
     if (in_zone) {
       const auto it = zone_at_.find(bits(diced_.points[i]));
@@ -360,37 +367,39 @@ void Distributor::number() {
     }
     holders &= ~(Mask{1} << rank_);
     for (int q = 0; q < size_; ++q)
-      if (holders >> q & 1) candidates[static_cast<std::size_t>(q)].push_back(i);
+      if (holders >> q & 1) candidates[primal::index_cast<std::size_t>(q)].push_back(i);
   }
   // Exchange the candidates' origins with each rank that may hold them; the nodes in both lists
   // are the ones shared.
   const auto key_less = [&](std::size_t a, std::size_t b) { return key[a] < key[b]; };
-  std::vector<int> send_counts(static_cast<std::size_t>(size_)), recv_counts(send_counts.size());
+  std::vector<int> send_counts(primal::index_cast<std::size_t>(size_)),
+      recv_counts(send_counts.size());
   std::vector<Index> send;
   for (int q = 0; q < size_; ++q) {
-    auto& c = candidates[static_cast<std::size_t>(q)];
+    auto& c = candidates[primal::index_cast<std::size_t>(q)];
     std::sort(c.begin(), c.end(), key_less);
     for (std::size_t i : c) send.insert(send.end(), key[i].begin(), key[i].end());
-    send_counts[static_cast<std::size_t>(q)] = static_cast<int>(c.size() * 4);
+    send_counts[primal::index_cast<std::size_t>(q)] = static_cast<int>(c.size() * 4);
   }
   MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm_);
   std::vector<int> sd(send_counts.size()), rd(send_counts.size());
   std::exclusive_scan(send_counts.begin(), send_counts.end(), sd.begin(), 0);
   std::exclusive_scan(recv_counts.begin(), recv_counts.end(), rd.begin(), 0);
-  std::vector<Index> recv(static_cast<std::size_t>(rd.back() + recv_counts.back()));
+  std::vector<Index> recv(primal::index_cast<std::size_t>(rd.back() + recv_counts.back()));
   MPI_Alltoallv(send.data(), send_counts.data(), sd.data(), MPI_INT, recv.data(),
                 recv_counts.data(), rd.data(), MPI_INT, comm_);
-  std::vector<std::vector<std::size_t>> shared(static_cast<std::size_t>(size_));
+  std::vector<std::vector<std::size_t>> shared(primal::index_cast<std::size_t>(size_));
   for (int q = 0; q < size_; ++q) {
-    const auto& c = candidates[static_cast<std::size_t>(q)];
-    const Index* theirs = recv.data() + rd[static_cast<std::size_t>(q)];
-    const std::size_t n = static_cast<std::size_t>(recv_counts[static_cast<std::size_t>(q)]) / 4;
+    const auto& c = candidates[primal::index_cast<std::size_t>(q)];
+    const Index* theirs = recv.data() + rd[primal::index_cast<std::size_t>(q)];
+    const std::size_t n =
+        primal::index_cast<std::size_t>(recv_counts[primal::index_cast<std::size_t>(q)]) / 4;
     std::size_t j = 0;
     for (std::size_t i : c) {
       FaceKey k{};
       while (j < n && (std::copy_n(theirs + 4 * j, 4, k.begin()), k < key[i])) ++j;
       if (j < n && k == key[i]) {
-        shared[static_cast<std::size_t>(q)].push_back(i);
+        shared[primal::index_cast<std::size_t>(q)].push_back(i);
         diced_holders_[i] |= Mask{1} << q;
       }
     }
@@ -411,33 +420,33 @@ void Distributor::number() {
   std::vector<std::int64_t> ids;
   for (int q = 0; q < size_; ++q) {
     std::size_t n = 0;
-    for (std::size_t i : shared[static_cast<std::size_t>(q)])
+    for (std::size_t i : shared[primal::index_cast<std::size_t>(q)])
       if (std::countr_zero(diced_holders_[i]) == rank_) ids.push_back(diced_gid_[i]), ++n;
-    send_counts[static_cast<std::size_t>(q)] = static_cast<int>(n);
+    send_counts[primal::index_cast<std::size_t>(q)] = static_cast<int>(n);
   }
   MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm_);
   std::exclusive_scan(send_counts.begin(), send_counts.end(), sd.begin(), 0);
   std::exclusive_scan(recv_counts.begin(), recv_counts.end(), rd.begin(), 0);
-  std::vector<std::int64_t> got(static_cast<std::size_t>(rd.back() + recv_counts.back()));
+  std::vector<std::int64_t> got(primal::index_cast<std::size_t>(rd.back() + recv_counts.back()));
   MPI_Alltoallv(ids.data(), send_counts.data(), sd.data(), MPI_INT64_T, got.data(),
                 recv_counts.data(), rd.data(), MPI_INT64_T, comm_);
   for (int q = 0; q < size_; ++q) {
-    std::size_t j = static_cast<std::size_t>(rd[static_cast<std::size_t>(q)]);
-    for (std::size_t i : shared[static_cast<std::size_t>(q)])
+    std::size_t j = primal::index_cast<std::size_t>(rd[primal::index_cast<std::size_t>(q)]);
+    for (std::size_t i : shared[primal::index_cast<std::size_t>(q)])
       if (std::countr_zero(diced_holders_[i]) == q) diced_gid_[i] = got[j++];
   }
   // Zone nodes: held by the ranks owning a zone hex on them or a diced node at them.
-  zone_holders_.assign(static_cast<std::size_t>(zone_nodes), 0);
+  zone_holders_.assign(primal::index_cast<std::size_t>(zone_nodes), 0);
   for (std::size_t h = zone_first_; h < zone_last_; ++h)
     for (Index v : zone_out_.hexes[h])
-      zone_holders_[static_cast<std::size_t>(v)] |= Mask{1} << rank_;
+      zone_holders_[primal::index_cast<std::size_t>(v)] |= Mask{1} << rank_;
   for (std::size_t i = 0; i < nd; ++i)
     if (diced_gid_[i] >= 0 && diced_gid_[i] < zone_nodes)
-      zone_holders_[static_cast<std::size_t>(diced_gid_[i])] |= Mask{1} << rank_;
-  MPI_Allreduce(MPI_IN_PLACE, zone_holders_.data(), static_cast<int>(zone_holders_.size()),
+      zone_holders_[primal::index_cast<std::size_t>(diced_gid_[i])] |= Mask{1} << rank_;
+  MPI_Allreduce(MPI_IN_PLACE, zone_holders_.data(), primal::index_cast<int>(zone_holders_.size()),
                 MPI_UINT64_T, MPI_BOR, comm_);
   // Hexes: the zone's first, then the diced ones rank by rank.
-  const std::int64_t zone_hexes = static_cast<std::int64_t>(zone_out_.hexes.size());
+  const std::int64_t zone_hexes = primal::index_cast<std::int64_t>(zone_out_.hexes.size());
   const std::int64_t diced_hexes = static_cast<std::int64_t>(
       diced_.hex_children.size() + diced_.tet_children.size() + diced_.wedge_children.size());
   std::int64_t hex_first = 0, hex_total = 0;
@@ -461,18 +470,19 @@ void Distributor::assemble() {
   std::sort(gids.begin(), gids.end());
   gids.erase(std::unique(gids.begin(), gids.end()), gids.end());
   const auto local = [&](std::int64_t g) {
-    return static_cast<Index>(std::lower_bound(gids.begin(), gids.end(), g) - gids.begin());
+    return primal::index_cast(std::lower_bound(gids.begin(), gids.end(), g) - gids.begin());
   };
   Model& o = out_.model;
   o.points.resize(gids.size());
   std::vector<Index> diced_local(nd);
   for (std::size_t i = 0; i < nd; ++i) {
     diced_local[i] = local(diced_gid_[i]);
-    o.points[static_cast<std::size_t>(diced_local[i])] = diced_.points[i];
+    o.points[primal::index_cast<std::size_t>(diced_local[i])] = diced_.points[i];
   }
-  const std::int64_t zone_nodes = static_cast<std::int64_t>(zone_out_.points.size());
+  const std::int64_t zone_nodes = primal::index_cast<std::int64_t>(zone_out_.points.size());
   for (std::size_t l = 0; l < gids.size(); ++l)
-    if (gids[l] < zone_nodes) o.points[l] = zone_out_.points[static_cast<std::size_t>(gids[l])];
+    if (gids[l] < zone_nodes)
+      o.points[l] = zone_out_.points[primal::index_cast<std::size_t>(gids[l])];
   // Hexes in a first order (zone, then diced hex, tet, wedge children), ids ascending in it;
   // placed by block (a stable counting sort: by block, then by id), each written once into the
   // output arrays, with no copy of the hexes beside them.
@@ -500,7 +510,7 @@ void Distributor::assemble() {
   for (std::size_t k = 0; k < total; ++k) {
     const Index at = next[block[k]]++;
     position[k] = at;
-    const auto p = static_cast<std::size_t>(at);
+    const auto p = primal::index_cast<std::size_t>(at);
     o.hex_block[p] = block[k];
     std::array<Index, 8>& x = o.hexes[p];
     if (k < first_diced) {
@@ -512,12 +522,12 @@ void Distributor::assemble() {
       const auto& child = j < nh        ? diced_.hex_children[j]
                           : j < nh + nt ? diced_.tet_children[j - nh]
                                         : diced_.wedge_children[j - nh - nt];
-      for (int c = 0; c < 8; ++c) x[c] = diced_local[static_cast<std::size_t>(child[c])];
+      for (int c = 0; c < 8; ++c) x[c] = diced_local[primal::index_cast<std::size_t>(child[c])];
     }
   }
   block = {};
-  const Index hex_children = static_cast<Index>(nh);
-  const Index tet_children = static_cast<Index>(nt);
+  const Index hex_children = primal::index_cast(nh);
+  const Index tet_children = primal::index_cast(nt);
   // Side sets read the diced numbering.
   const auto diced_sides =
       primal::diced_side_sets(om, diced_, 0, hex_children, hex_children + tet_children);
@@ -534,7 +544,7 @@ void Distributor::assemble() {
     primal::NodeSet ns{z.id, z.name, {}};
     for (Index v : z.nodes) {
       const auto it = std::lower_bound(gids.begin(), gids.end(), std::int64_t{v});
-      if (it != gids.end() && *it == v) ns.nodes.push_back(static_cast<Index>(it - gids.begin()));
+      if (it != gids.end() && *it == v) ns.nodes.push_back(primal::index_cast(it - gids.begin()));
     }
     for (const primal::NodeSet& d : diced_nodes)
       if (d.id == z.id) ns.nodes.insert(ns.nodes.end(), d.nodes.begin(), d.nodes.end());
@@ -546,7 +556,7 @@ void Distributor::assemble() {
     const primal::SideSet& z = zone_out_.side_sets[s];
     primal::SideSet ss{z.id, z.name, {}};
     for (const primal::Side& side : z.sides) {
-      const auto h = static_cast<std::size_t>(side.element.index);
+      const auto h = primal::index_cast<std::size_t>(side.element.index);
       if (h >= zone_first_ && h < zone_last_)
         ss.sides.push_back({{ElementKind::kHex, position[h - zone_first_]}, side.face});
     }
@@ -555,7 +565,7 @@ void Distributor::assemble() {
         for (const primal::Side& side : d.sides)
           ss.sides.push_back(
               {{ElementKind::kHex,
-                position[first_diced + static_cast<std::size_t>(side.element.index)]},
+                position[first_diced + primal::index_cast<std::size_t>(side.element.index)]},
                side.face});
     std::sort(ss.sides.begin(), ss.sides.end());
     o.side_sets.push_back(std::move(ss));
@@ -563,13 +573,13 @@ void Distributor::assemble() {
   // Shared nodes per neighbour, and the global counts.
   std::vector<Mask> holders(gids.size(), 0);
   for (std::size_t i = 0; i < nd; ++i)
-    holders[static_cast<std::size_t>(diced_local[i])] |= diced_holders_[i];
+    holders[primal::index_cast<std::size_t>(diced_local[i])] |= diced_holders_[i];
   for (std::size_t l = 0; l < gids.size(); ++l)
-    if (gids[l] < zone_nodes) holders[l] |= zone_holders_[static_cast<std::size_t>(gids[l])];
+    if (gids[l] < zone_nodes) holders[l] |= zone_holders_[primal::index_cast<std::size_t>(gids[l])];
   for (std::size_t l = 0; l < gids.size(); ++l)
     for (int q = 0; q < size_; ++q)
       if (q != rank_ && (holders[l] >> q & 1))
-        out_.shared_nodes[q].push_back(static_cast<Index>(l));
+        out_.shared_nodes[q].push_back(primal::index_cast(l));
   out_.node_gid = std::move(gids);
   std::map<int, std::int64_t> blocks;
   for (int b : o.hex_block) ++blocks[b];
@@ -582,18 +592,18 @@ void Distributor::assemble() {
   // Every rank must list the same blocks: the union over ranks.
   std::sort(ids.begin(), ids.end());
   ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-  int n = static_cast<int>(ids.size());
-  std::vector<int> counts(static_cast<std::size_t>(size_)), displs(counts.size());
+  int n = primal::index_cast<int>(ids.size());
+  std::vector<int> counts(primal::index_cast<std::size_t>(size_)), displs(counts.size());
   MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
   std::exclusive_scan(counts.begin(), counts.end(), displs.begin(), 0);
-  std::vector<int> every(static_cast<std::size_t>(displs.back() + counts.back()));
+  std::vector<int> every(primal::index_cast<std::size_t>(displs.back() + counts.back()));
   MPI_Allgatherv(ids.data(), n, MPI_INT, every.data(), counts.data(), displs.data(), MPI_INT,
                  comm_);
   std::sort(every.begin(), every.end());
   every.erase(std::unique(every.begin(), every.end()), every.end());
   std::vector<std::int64_t> local_counts, global_counts(every.size());
   for (int b : every) local_counts.push_back(blocks.count(b) ? blocks[b] : 0);
-  MPI_Allreduce(local_counts.data(), global_counts.data(), static_cast<int>(every.size()),
+  MPI_Allreduce(local_counts.data(), global_counts.data(), primal::index_cast<int>(every.size()),
                 MPI_INT64_T, MPI_SUM, comm_);
   for (std::size_t k = 0; k < every.size(); ++k)
     out_.global_block_hexes[every[k]] = global_counts[k];
@@ -602,18 +612,19 @@ void Distributor::assemble() {
   for (const primal::NodeSet& ns : o.node_sets) {
     std::int64_t c = 0;
     for (Index v : ns.nodes)
-      if (std::countr_zero(holders[static_cast<std::size_t>(v)] | Mask{1} << rank_) == rank_) ++c;
+      if (std::countr_zero(holders[primal::index_cast<std::size_t>(v)] | Mask{1} << rank_) == rank_)
+        ++c;
     set_counts.push_back(c);
   }
   out_.global_node_set_nodes.resize(set_counts.size());
   MPI_Allreduce(set_counts.data(), out_.global_node_set_nodes.data(),
-                static_cast<int>(set_counts.size()), MPI_INT64_T, MPI_SUM, comm_);
+                primal::index_cast<int>(set_counts.size()), MPI_INT64_T, MPI_SUM, comm_);
   set_counts.clear();
   for (const primal::SideSet& ss : o.side_sets)
-    set_counts.push_back(static_cast<std::int64_t>(ss.sides.size()));
+    set_counts.push_back(primal::index_cast<std::int64_t>(ss.sides.size()));
   out_.global_side_set_sides.resize(set_counts.size());
   MPI_Allreduce(set_counts.data(), out_.global_side_set_sides.data(),
-                static_cast<int>(set_counts.size()), MPI_INT64_T, MPI_SUM, comm_);
+                primal::index_cast<int>(set_counts.size()), MPI_INT64_T, MPI_SUM, comm_);
 }
 
 // What holds piece by piece of a hex mesh: nodes in range and finite, no repeated corner, no
@@ -623,7 +634,7 @@ void Distributor::assemble() {
 bool piece_ok(const primal::HexValidityReport& v, const std::vector<char>& exempt) {
   std::size_t overlapping = 0;
   for (const auto& c : v.overlapping_nodes)
-    overlapping += exempt.empty() || !exempt[static_cast<std::size_t>(c.node)];
+    overlapping += exempt.empty() || !exempt[primal::index_cast<std::size_t>(c.node)];
   return v.out_of_range_hexes.empty() && v.non_finite_nodes.empty() &&
          v.repeated_node_hexes.empty() && v.overshared_faces.empty() &&
          v.misoriented_faces.empty() && v.inverted_hexes.empty() && overlapping == 0;
@@ -642,7 +653,7 @@ void Distributor::verify() {
   out_.model.hexes = std::move(mesh.hexes);
   std::vector<char> shared(out_.model.points.size(), 0);
   for (const auto& [q, nodes] : out_.shared_nodes)
-    for (Index n : nodes) shared[static_cast<std::size_t>(n)] = 1;
+    for (Index n : nodes) shared[primal::index_cast<std::size_t>(n)] = 1;
   const bool ok = piece_ok(v, shared);
   if (!ok) rep_.warnings.push_back("rank " + std::to_string(rank_) + ": " + v.summary());
   const bool zone_ok = piece_ok(rep_.zone.validity, {});

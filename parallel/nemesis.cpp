@@ -63,9 +63,9 @@ void write_nemesis(const RankMesh& mesh, const std::filesystem::path& output, in
     char type[] = "p";
     check(ex_put_init_info(exo, ranks, 1, type), path, "Nemesis init info");
     check(ex_put_init_global(exo, mesh.global_nodes, mesh.global_hexes,
-                             static_cast<int64_t>(mesh.global_block_hexes.size()),
-                             static_cast<int64_t>(mesh.model.node_sets.size()),
-                             static_cast<int64_t>(mesh.model.side_sets.size())),
+                             primal::index_cast<int64_t>(mesh.global_block_hexes.size()),
+                             primal::index_cast<int64_t>(mesh.model.node_sets.size()),
+                             primal::index_cast<int64_t>(mesh.model.side_sets.size())),
           path, "Nemesis global counts");
     std::vector<int> ids, counts;
     for (const auto& [id, n] : mesh.global_block_hexes)
@@ -90,19 +90,20 @@ void write_nemesis(const RankMesh& mesh, const std::filesystem::path& output, in
     // Load balance: internal / border nodes and elements (1-based local numbers).
     std::vector<char> border(mesh.model.points.size(), 0);
     for (const auto& [q, shared] : mesh.shared_nodes)
-      for (Index v : shared) border[static_cast<std::size_t>(v)] = 1;
+      for (Index v : shared) border[primal::index_cast<std::size_t>(v)] = 1;
     std::vector<int> node_int, node_bor, elem_int, elem_bor;
     for (std::size_t v = 0; v < border.size(); ++v)
       (border[v] ? node_bor : node_int).push_back(static_cast<int>(v + 1));
     for (std::size_t h = 0; h < mesh.model.hexes.size(); ++h) {
       bool on = false;
-      for (Index v : mesh.model.hexes[h]) on = on || border[static_cast<std::size_t>(v)];
+      for (Index v : mesh.model.hexes[h]) on = on || border[primal::index_cast<std::size_t>(v)];
       (on ? elem_bor : elem_int).push_back(static_cast<int>(h + 1));
     }
-    check(ex_put_loadbal_param(
-              exo, static_cast<int64_t>(node_int.size()), static_cast<int64_t>(node_bor.size()), 0,
-              static_cast<int64_t>(elem_int.size()), static_cast<int64_t>(elem_bor.size()),
-              static_cast<int64_t>(mesh.shared_nodes.size()), 0, rank),
+    check(ex_put_loadbal_param(exo, primal::index_cast<int64_t>(node_int.size()),
+                               primal::index_cast<int64_t>(node_bor.size()), 0,
+                               primal::index_cast<int64_t>(elem_int.size()),
+                               primal::index_cast<int64_t>(elem_bor.size()),
+                               primal::index_cast<int64_t>(mesh.shared_nodes.size()), 0, rank),
           path, "Nemesis load balance");
     check(ex_put_processor_node_maps(exo, node_int.data(), node_bor.data(), nullptr, rank), path,
           "Nemesis node maps");
@@ -111,7 +112,7 @@ void write_nemesis(const RankMesh& mesh, const std::filesystem::path& output, in
     if (!mesh.shared_nodes.empty()) {
       std::vector<int> map_ids, map_counts;
       for (const auto& [q, shared] : mesh.shared_nodes)
-        map_ids.push_back(q), map_counts.push_back(static_cast<int>(shared.size()));
+        map_ids.push_back(q), map_counts.push_back(primal::index_cast<int>(shared.size()));
       check(ex_put_cmap_params(exo, map_ids.data(), map_counts.data(), nullptr, nullptr, rank),
             path, "Nemesis communication map sizes");
       for (const auto& [q, shared] : mesh.shared_nodes) {
@@ -134,21 +135,21 @@ Model canonical(const Model& model) {
   std::vector<Index> order(n);
   std::iota(order.begin(), order.end(), 0);
   const auto less = [&](Index a, Index b) {
-    const Point &p = model.points[static_cast<std::size_t>(a)],
-                &q = model.points[static_cast<std::size_t>(b)];
+    const Point &p = model.points[primal::index_cast<std::size_t>(a)],
+                &q = model.points[primal::index_cast<std::size_t>(b)];
     return std::tie(p.x(), p.y(), p.z()) < std::tie(q.x(), q.y(), q.z());
   };
   std::sort(order.begin(), order.end(), less);
   std::vector<Index> renumber(n);
   for (std::size_t k = 0; k < n; ++k)
-    renumber[static_cast<std::size_t>(order[k])] = static_cast<Index>(k);
+    renumber[primal::index_cast<std::size_t>(order[k])] = primal::index_cast(k);
   Model c;
   c.block_names = model.block_names;
-  for (Index v : order) c.points.push_back(model.points[static_cast<std::size_t>(v)]);
+  for (Index v : order) c.points.push_back(model.points[primal::index_cast<std::size_t>(v)]);
   std::vector<std::pair<int, std::array<Index, 8>>> hexes;
   for (std::size_t h = 0; h < model.hexes.size(); ++h) {
     std::array<Index, 8> x = model.hexes[h];
-    for (Index& v : x) v = renumber[static_cast<std::size_t>(v)];
+    for (Index& v : x) v = renumber[primal::index_cast<std::size_t>(v)];
     hexes.push_back({model.hex_block.empty() ? 1 : model.hex_block[h], x});
   }
   std::vector<std::size_t> hex_order(hexes.size());
@@ -157,22 +158,22 @@ Model canonical(const Model& model) {
             [&](std::size_t a, std::size_t b) { return hexes[a] < hexes[b]; });
   std::vector<Index> hex_renumber(hexes.size());
   for (std::size_t k = 0; k < hex_order.size(); ++k) {
-    hex_renumber[hex_order[k]] = static_cast<Index>(k);
+    hex_renumber[hex_order[k]] = primal::index_cast(k);
     c.hexes.push_back(hexes[hex_order[k]].second);
     c.hex_block.push_back(hexes[hex_order[k]].first);
   }
   for (const auto& ns : model.node_sets) {
     primal::NodeSet o{ns.id, ns.name, {}};
-    for (Index v : ns.nodes) o.nodes.push_back(renumber[static_cast<std::size_t>(v)]);
+    for (Index v : ns.nodes) o.nodes.push_back(renumber[primal::index_cast<std::size_t>(v)]);
     std::sort(o.nodes.begin(), o.nodes.end());
     c.node_sets.push_back(std::move(o));
   }
   for (const auto& ss : model.side_sets) {
     primal::SideSet o{ss.id, ss.name, {}};
     for (const auto& s : ss.sides)
-      o.sides.push_back(
-          {{primal::ElementKind::kHex, hex_renumber[static_cast<std::size_t>(s.element.index)]},
-           s.face});
+      o.sides.push_back({{primal::ElementKind::kHex,
+                          hex_renumber[primal::index_cast<std::size_t>(s.element.index)]},
+                         s.face});
     std::sort(o.sides.begin(), o.sides.end());
     c.side_sets.push_back(std::move(o));
   }
@@ -191,11 +192,12 @@ std::vector<T> gather(const std::vector<T>& local, MPI_Datatype type, MPI_Comm c
   int rank = 0, size = 1;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
-  int n = static_cast<int>(local.size());
-  std::vector<int> counts(static_cast<std::size_t>(size)), displs(counts.size());
+  int n = primal::index_cast<int>(local.size());
+  std::vector<int> counts(primal::index_cast<std::size_t>(size)), displs(counts.size());
   MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm);
   std::exclusive_scan(counts.begin(), counts.end(), displs.begin(), 0);
-  std::vector<T> all(rank == 0 ? static_cast<std::size_t>(displs.back() + counts.back()) : 0);
+  std::vector<T> all(rank == 0 ? primal::index_cast<std::size_t>(displs.back() + counts.back())
+                               : 0);
   MPI_Gatherv(local.data(), n, type, all.data(), counts.data(), displs.data(), type, 0, comm);
   return all;
 }
@@ -216,17 +218,17 @@ void write_joined(const RankMesh& mesh, const std::filesystem::path& output, MPI
   for (std::size_t h = 0; h < m.hexes.size(); ++h) {
     hexes.push_back(mesh.hex_gid[h]);
     hexes.push_back(m.hex_block[h]);
-    for (Index v : m.hexes[h]) hexes.push_back(mesh.node_gid[static_cast<std::size_t>(v)]);
+    for (Index v : m.hexes[h]) hexes.push_back(mesh.node_gid[primal::index_cast<std::size_t>(v)]);
   }
   std::vector<std::int64_t> sets;  // per set: its nodes' global ids / (hex gid, face) pairs
   for (const auto& ns : m.node_sets)
     for (Index v : ns.nodes)
-      sets.push_back(ns.id), sets.push_back(mesh.node_gid[static_cast<std::size_t>(v)]);
+      sets.push_back(ns.id), sets.push_back(mesh.node_gid[primal::index_cast<std::size_t>(v)]);
   std::vector<std::int64_t> sides;
   for (const auto& ss : m.side_sets)
     for (const auto& s : ss.sides)
       sides.insert(sides.end(),
-                   {ss.id, mesh.hex_gid[static_cast<std::size_t>(s.element.index)], s.face});
+                   {ss.id, mesh.hex_gid[primal::index_cast<std::size_t>(s.element.index)], s.face});
   const auto all_ids = gather(node_ids, MPI_INT64_T, comm);
   const auto all_xyz = gather(xyz, MPI_DOUBLE, comm);
   const auto all_hexes = gather(hexes, MPI_INT64_T, comm);
@@ -235,16 +237,16 @@ void write_joined(const RankMesh& mesh, const std::filesystem::path& output, MPI
   if (rank != 0) return;
   Model j;
   j.block_names = m.block_names;
-  j.points.resize(static_cast<std::size_t>(mesh.global_nodes));
+  j.points.resize(primal::index_cast<std::size_t>(mesh.global_nodes));
   for (std::size_t k = 0; k < all_ids.size(); ++k)
-    j.points[static_cast<std::size_t>(all_ids[k])] =
+    j.points[primal::index_cast<std::size_t>(all_ids[k])] =
         Point(all_xyz[3 * k], all_xyz[3 * k + 1], all_xyz[3 * k + 2]);
-  j.hexes.resize(static_cast<std::size_t>(mesh.global_hexes));
+  j.hexes.resize(primal::index_cast<std::size_t>(mesh.global_hexes));
   j.hex_block.resize(j.hexes.size());
   for (std::size_t k = 0; k < all_hexes.size(); k += 10) {
-    const auto h = static_cast<std::size_t>(all_hexes[k]);
+    const auto h = primal::index_cast<std::size_t>(all_hexes[k]);
     j.hex_block[h] = static_cast<int>(all_hexes[k + 1]);
-    for (int c = 0; c < 8; ++c) j.hexes[h][c] = static_cast<Index>(all_hexes[k + 2 + c]);
+    for (int c = 0; c < 8; ++c) j.hexes[h][c] = primal::index_cast(all_hexes[k + 2 + c]);
   }
   for (const auto& ns : m.node_sets) j.node_sets.push_back({ns.id, ns.name, {}});
   for (const auto& ss : m.side_sets) j.side_sets.push_back({ss.id, ss.name, {}});
@@ -252,14 +254,14 @@ void write_joined(const RankMesh& mesh, const std::filesystem::path& output, MPI
     return *std::find_if(sets_.begin(), sets_.end(), [&](const auto& s) { return s.id == id; });
   };
   for (std::size_t k = 0; k < all_sets.size(); k += 2)
-    set_of(j.node_sets, all_sets[k]).nodes.push_back(static_cast<Index>(all_sets[k + 1]));
+    set_of(j.node_sets, all_sets[k]).nodes.push_back(primal::index_cast(all_sets[k + 1]));
   for (auto& ns : j.node_sets) {
     std::sort(ns.nodes.begin(), ns.nodes.end());
     ns.nodes.erase(std::unique(ns.nodes.begin(), ns.nodes.end()), ns.nodes.end());
   }
   for (std::size_t k = 0; k < all_sides.size(); k += 3)
     set_of(j.side_sets, all_sides[k])
-        .sides.push_back({{primal::ElementKind::kHex, static_cast<Index>(all_sides[k + 1])},
+        .sides.push_back({{primal::ElementKind::kHex, primal::index_cast(all_sides[k + 1])},
                           static_cast<int>(all_sides[k + 2])});
   io::write_exodus(canonical(j), output);
 }

@@ -21,7 +21,7 @@ std::vector<int> partition_elements(const primal::Model& model, int parts) {
   weight.reserve(n);
   for (primal::ElementKind kind : primal::kElementKinds)
     for (std::size_t e = 0; e < primal::element_count(model, kind); ++e) {
-      const auto corners = primal::element_corners(model, {kind, static_cast<primal::Index>(e)});
+      const auto corners = primal::element_corners(model, {kind, primal::index_cast(e)});
       for (primal::Index v : corners) eind.push_back(v);
       eptr.push_back(static_cast<idx_t>(eind.size()));
       // The hexes it dices into (8, 4, 6; a pyramid as its two tets): the parts' output balanced.

@@ -155,10 +155,9 @@ std::vector<BoundaryQuad> block_interface_quads(const HexMesh& mesh) {
   for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
     for (int f = 0; f < topo::kHexFaces; ++f) {
       const auto nodes = hex_face_nodes(mesh.hexes[h], f);
-      const auto [slot, inserted] =
-          first_use.try_emplace(face_key(nodes), static_cast<Index>(6 * h + f));
-      if (!inserted && mesh.block[static_cast<std::size_t>(*slot / 6)] != mesh.block[h])
-        out.push_back(BoundaryQuad{static_cast<Index>(h), f, nodes});
+      const auto [slot, inserted] = first_use.try_emplace(face_key(nodes), index_cast(6 * h + f));
+      if (!inserted && mesh.block[index_cast<std::size_t>(*slot / 6)] != mesh.block[h])
+        out.push_back(BoundaryQuad{index_cast(h), f, nodes});
     }
   return out;
 }

@@ -27,7 +27,7 @@ struct IndexArrayHash {
   std::size_t operator()(const std::array<Index, N>& a) const noexcept {
     std::size_t h = 0x9e3779b97f4a7c15ull;
     for (Index i : a)
-      h = (h ^ static_cast<std::size_t>(static_cast<std::uint32_t>(i))) * 0x100000001b3ull;
+      h = (h ^ index_cast<std::size_t>(static_cast<std::uint32_t>(i))) * 0x100000001b3ull;
     return h;
   }
 };

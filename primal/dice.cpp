@@ -96,7 +96,7 @@ Diced<std::array<Index, NC>> dice_elements(const std::vector<Point>& points,
                                            const std::vector<std::array<Index, NP>>& elements,
                                            const ChildTable<NChildren, NC>& table,
                                            const char* what) {
-  const auto nv = static_cast<Index>(points.size());
+  const auto nv = index_cast(points.size());
   for (std::size_t e = 0; e < elements.size(); ++e) {
     for (std::size_t c = 0; c < NP; ++c) {
       const Index v = elements[e][c];
@@ -146,13 +146,13 @@ Diced<std::array<Index, NC>> dice_elements(const std::vector<Point>& points,
       const bool edge = std::popcount(s) == 2;
       auto& ids = edge ? edge_id : face_id;
       auto& keys = edge ? edge_keys : face_keys;
-      const auto [id, inserted] = ids.try_emplace(k, static_cast<Index>(keys.size()));
+      const auto [id, inserted] = ids.try_emplace(k, index_cast(keys.size()));
       if (inserted) keys.push_back(k);
       element_ids[e * ns + i] = *id;
     }
   }
-  const auto ne = static_cast<Index>(edge_keys.size());
-  const auto nf = static_cast<Index>(face_keys.size());
+  const auto ne = index_cast(edge_keys.size());
+  const auto nf = index_cast(face_keys.size());
 
   Diced<std::array<Index, NC>> out;
   const std::size_t total = points.size() + edge_keys.size() + face_keys.size() + elements.size();
@@ -187,7 +187,7 @@ Diced<std::array<Index, NC>> dice_elements(const std::vector<Point>& points,
     out.points.push_back(p / static_cast<double>(NP));
     NodeOrigin o;
     o.kind = NodeOriginKind::kCell;
-    o.element = static_cast<Index>(e);
+    o.element = index_cast(e);
     out.origin.push_back(o);
   }
 
@@ -200,16 +200,16 @@ Diced<std::array<Index, NC>> dice_elements(const std::vector<Point>& points,
         const Support s = table[ch][k];
         const int count = std::popcount(s);
         if (count == 1) {
-          c[k] = elem[static_cast<std::size_t>(std::countr_zero(s))];
+          c[k] = elem[index_cast<std::size_t>(std::countr_zero(s))];
         } else if (s == kAll) {
-          c[k] = nv + ne + nf + static_cast<Index>(e);
+          c[k] = nv + ne + nf + index_cast(e);
         } else {
-          const Index id = element_ids[e * ns + static_cast<std::size_t>(slot_of[ch][k])];
+          const Index id = element_ids[e * ns + index_cast<std::size_t>(slot_of[ch][k])];
           c[k] = count == 2 ? nv + id : nv + ne + id;
         }
       }
       out.elements.push_back(c);
-      out.parent.push_back(static_cast<Index>(e));
+      out.parent.push_back(index_cast(e));
     }
   }
   return out;
@@ -224,7 +224,7 @@ Result finish(Diced&& d, const std::vector<int>& block) {
   if constexpr (std::is_same_v<Result, DicedHexMesh>) {
     r.mesh.hexes = std::move(d.elements);
     if (!block.empty()) {
-      for (Index p : r.parent) r.mesh.block.push_back(block.at(static_cast<std::size_t>(p)));
+      for (Index p : r.parent) r.mesh.block.push_back(block.at(index_cast<std::size_t>(p)));
     }
   } else {
     r.mesh.quads = std::move(d.elements);
@@ -281,8 +281,7 @@ template <class Mesh, std::size_t N>
 std::vector<std::array<std::vector<int>, 8>> child_weights() {
   Mesh ref;
   std::array<Index, N> cell{};
-  for (std::size_t i = 0; i < N; ++i)
-    ref.points.push_back(Point::Zero()), cell[i] = static_cast<Index>(i);
+  for (std::size_t i = 0; i < N; ++i) ref.points.push_back(Point::Zero()), cell[i] = index_cast(i);
   if constexpr (N == 4)
     ref.tets.push_back(cell);
   else
@@ -292,7 +291,7 @@ std::vector<std::array<std::vector<int>, 8>> child_weights() {
   for (const auto& h : d.mesh.hexes) {
     std::array<std::vector<int>, 8> w;
     for (int c = 0; c < 8; ++c) {
-      const NodeOrigin& o = d.origin[static_cast<std::size_t>(h[c])];
+      const NodeOrigin& o = d.origin[index_cast<std::size_t>(h[c])];
       if (o.kind == NodeOriginKind::kCell) {
         for (std::size_t i = 0; i < N; ++i) w[c].push_back(static_cast<int>(i));
       } else {
@@ -315,7 +314,7 @@ double diced_cell_min(std::span<const Point> points, const std::array<Index, N>&
     HexCorners p;
     for (int c = 0; c < 8; ++c) {
       Point s = Point::Zero();
-      for (int i : w[c]) s += points[static_cast<std::size_t>(cell[static_cast<std::size_t>(i)])];
+      for (int i : w[c]) s += points[index_cast<std::size_t>(cell[index_cast<std::size_t>(i)])];
       p[c] = s / static_cast<double>(w[c].size());
     }
     lowest = std::min(lowest, hex_scaled_jacobian(p));
@@ -373,7 +372,7 @@ double diced_tet_min_scaled_jacobian(const std::array<Point, 4>& corners) {
     for (std::size_t h = 0; h < 4; ++h)
       for (std::size_t c = 0; c < 8; ++c)
         for (int i : children[h][c])
-          w[h][c][static_cast<std::size_t>(i)] = 1.0 / static_cast<double>(children[h][c].size());
+          w[h][c][index_cast<std::size_t>(i)] = 1.0 / static_cast<double>(children[h][c].size());
     return w;
   }();
   double lowest = 1.0;

@@ -29,7 +29,7 @@ FaceKey normalized_origin(FaceKey k) {
 Index DicedModel::add_node(const Point& p, const FaceKey& origin_key) {
   points.push_back(p);
   origin.push_back(origin_key);
-  return static_cast<Index>(points.size() - 1);
+  return index_cast(points.size() - 1);
 }
 
 Index DicedModel::find(const FaceKey& key) const {
@@ -58,8 +58,8 @@ void dice_wedges(const Model& model, DicedModel& out) {
       Point p = Point::Zero();
       std::size_t k = 0;
       for (int l : local) {
-        key[k++] = c[static_cast<std::size_t>(l)];
-        p += model.points[static_cast<std::size_t>(c[static_cast<std::size_t>(l)])];
+        key[k++] = c[index_cast<std::size_t>(l)];
+        p += model.points[index_cast<std::size_t>(c[index_cast<std::size_t>(l)])];
       }
       key = normalized_origin(key);
       auto [id, inserted] = out.shared.try_emplace(key, kInvalidIndex);
@@ -69,7 +69,7 @@ void dice_wedges(const Model& model, DicedModel& out) {
     // The face through corners a, b, d of this wedge (each pair of edges at a corner spans one).
     auto face_of = [&](int a, int b, int d) {
       for (int f = 0; f < topo.faces; ++f) {
-        const auto& face = topo.face[static_cast<std::size_t>(f)];
+        const auto& face = topo.face[index_cast<std::size_t>(f)];
         auto has = [&](int x) {
           return std::find(face.corners.begin(), face.corners.begin() + face.size, x) !=
                  face.corners.begin() + face.size;
@@ -82,14 +82,14 @@ void dice_wedges(const Model& model, DicedModel& out) {
       return kInvalidIndex;
     };
     Point centre = Point::Zero();
-    for (Index v : c) centre += model.points[static_cast<std::size_t>(v)] / 6.0;
+    for (Index v : c) centre += model.points[index_cast<std::size_t>(v)] / 6.0;
     const Index mid = out.add_node(centre);
     for (int k = 0; k < 6; ++k) {
-      const auto& n = topology::kWedgeCornerNeighbors[static_cast<std::size_t>(k)];
-      out.wedge_children.push_back({c[static_cast<std::size_t>(k)], node_of({k, n[0]}),
+      const auto& n = topology::kWedgeCornerNeighbors[index_cast<std::size_t>(k)];
+      out.wedge_children.push_back({c[index_cast<std::size_t>(k)], node_of({k, n[0]}),
                                     face_of(k, n[0], n[1]), node_of({k, n[1]}), node_of({k, n[2]}),
                                     face_of(k, n[0], n[2]), mid, face_of(k, n[1], n[2])});
-      out.wedge_parent.push_back(static_cast<Index>(w));
+      out.wedge_parent.push_back(index_cast(w));
     }
   }
 }
@@ -100,25 +100,25 @@ std::array<std::array<unsigned, 8>, 6> wedge_dicing_table() {
   const auto& topo = cell_topology(ElementKind::kWedge);
   auto face_of = [&](int a, int b, int d) {
     for (int f = 0; f < topo.faces; ++f) {
-      const auto& face = topo.face[static_cast<std::size_t>(f)];
+      const auto& face = topo.face[index_cast<std::size_t>(f)];
       unsigned m = 0;
-      for (int i = 0; i < face.size; ++i) m |= 1u << face.corners[static_cast<std::size_t>(i)];
+      for (int i = 0; i < face.size; ++i) m |= 1u << face.corners[index_cast<std::size_t>(i)];
       if ((m >> a & 1) && (m >> b & 1) && (m >> d & 1)) return m;
     }
     return 0u;
   };
   std::array<std::array<unsigned, 8>, 6> t{};
   for (int k = 0; k < 6; ++k) {
-    const auto& n = topology::kWedgeCornerNeighbors[static_cast<std::size_t>(k)];
+    const auto& n = topology::kWedgeCornerNeighbors[index_cast<std::size_t>(k)];
     const unsigned c = 1u << k;
-    t[static_cast<std::size_t>(k)] = {c,
-                                      c | 1u << n[0],
-                                      face_of(k, n[0], n[1]),
-                                      c | 1u << n[1],
-                                      c | 1u << n[2],
-                                      face_of(k, n[0], n[2]),
-                                      (1u << 6) - 1,
-                                      face_of(k, n[1], n[2])};
+    t[index_cast<std::size_t>(k)] = {c,
+                                     c | 1u << n[0],
+                                     face_of(k, n[0], n[1]),
+                                     c | 1u << n[1],
+                                     c | 1u << n[2],
+                                     face_of(k, n[0], n[2]),
+                                     (1u << 6) - 1,
+                                     face_of(k, n[1], n[2])};
   }
   return t;
 }
@@ -138,7 +138,7 @@ std::vector<Index> wrong_children(const std::vector<std::array<Index, NP>>& pare
   std::vector<char> bad(children.size(), 0);
   for (std::size_t i = n; i < children.size(); ++i) bad[i] = 1;  // children of no parent
   centre.assign(parents.size(), kInvalidIndex);
-  const auto nodes = static_cast<Index>(origin.size());
+  const auto nodes = index_cast(origin.size());
   tbb::parallel_for(
       tbb::blocked_range<std::size_t>(0, parents.size(), 2048),
       [&](const tbb::blocked_range<std::size_t>& range) {
@@ -152,16 +152,16 @@ std::vector<Index> wrong_children(const std::vector<std::array<Index, NP>>& pare
           }
           for (std::size_t ch = 0; ch < NChildren; ++ch) {
             const std::size_t i = NChildren * e + ch;
-            bool good = i < parent_of.size() && parent_of[i] == static_cast<Index>(e);
+            bool good = i < parent_of.size() && parent_of[i] == index_cast(e);
             for (std::size_t k = 0; k < 8 && good; ++k) {
               const Index v = children[i][k];
               const unsigned s = table[ch][k];
               if (v < 0 || v >= nodes) {
                 good = false;
               } else if (std::popcount(s) == 1) {
-                good = v == elem[static_cast<std::size_t>(std::countr_zero(s))];
+                good = v == elem[index_cast<std::size_t>(std::countr_zero(s))];
               } else if (s == kAll) {
-                good = v >= num_input_nodes && origin[static_cast<std::size_t>(v)] == kNoOrigin &&
+                good = v >= num_input_nodes && origin[index_cast<std::size_t>(v)] == kNoOrigin &&
                        (mid == kInvalidIndex || v == mid);
                 mid = v;
               } else {
@@ -170,7 +170,7 @@ std::vector<Index> wrong_children(const std::vector<std::array<Index, NP>>& pare
                 for (std::size_t q = 0; q < NP; ++q)
                   if (s >> q & 1) key[m++] = elem[q];
                 good = v >= num_input_nodes &&
-                       origin[static_cast<std::size_t>(v)] == normalized_origin(key);
+                       origin[index_cast<std::size_t>(v)] == normalized_origin(key);
               }
             }
             if (!good) bad[i] = 1, centre_agrees = false;
@@ -180,7 +180,7 @@ std::vector<Index> wrong_children(const std::vector<std::array<Index, NP>>& pare
       });
   std::vector<Index> out;
   for (std::size_t i = 0; i < bad.size(); ++i)
-    if (bad[i]) out.push_back(static_cast<Index>(i));
+    if (bad[i]) out.push_back(index_cast(i));
   return out;
 }
 
@@ -213,7 +213,7 @@ std::string DicingCheck::summary() const {
 
 DicingCheck check_dicing(const Model& model, const DicedModel& diced) {
   DicingCheck r;
-  const auto V = static_cast<Index>(model.points.size());
+  const auto V = index_cast(model.points.size());
   const auto& origin = diced.origin;
   std::array<std::vector<Index>, 3> centres;
   r.wrong_hex_children = wrong_children(model.hexes, hex_dicing_table(), diced.hex_children,
@@ -224,7 +224,7 @@ DicingCheck check_dicing(const Model& model, const DicedModel& diced) {
   r.wrong_wedge_children = wrong_children(model.wedges, wedge_table, diced.wedge_children,
                                           diced.wedge_parent, origin, V, centres[2]);
   auto missing = [](std::size_t parents, std::size_t per, std::size_t children) {
-    return static_cast<Index>(per * parents > children ? per * parents - children : 0);
+    return index_cast(per * parents > children ? per * parents - children : 0);
   };
   r.missing_children = missing(model.hexes.size(), 8, diced.hex_children.size()) +
                        missing(model.tets.size(), 4, diced.tet_children.size()) +
@@ -235,52 +235,51 @@ DicingCheck check_dicing(const Model& model, const DicedModel& diced) {
   for (const auto& part : centres)
     for (Index c : part)
       if (c != kInvalidIndex) {
-        if (taken[static_cast<std::size_t>(c)]) duplicated[static_cast<std::size_t>(c)] = 1;
-        taken[static_cast<std::size_t>(c)] = 1;
+        if (taken[index_cast<std::size_t>(c)]) duplicated[index_cast<std::size_t>(c)] = 1;
+        taken[index_cast<std::size_t>(c)] = 1;
       }
   taken = {};
   // Origins made twice: the diced nodes bucketed by their smallest origin node (a counting sort,
   // no hashing), each bucket's few keys sorted and compared, buckets in parallel.
-  std::vector<Index> start(static_cast<std::size_t>(V) + 1, 0);
+  std::vector<Index> start(index_cast<std::size_t>(V) + 1, 0);
   auto bucket = [&](std::size_t i) -> Index {
     const FaceKey& k = origin[i];
     if (k[0] == kInvalidIndex || k[0] < 0 || k[0] >= V) return kInvalidIndex;
-    if (static_cast<Index>(i) < V && k[1] == kInvalidIndex) return kInvalidIndex;  // itself
+    if (index_cast(i) < V && k[1] == kInvalidIndex) return kInvalidIndex;  // itself
     return k[0];
   };
   for (std::size_t i = 0; i < origin.size(); ++i)
-    if (const Index b = bucket(i); b != kInvalidIndex) ++start[static_cast<std::size_t>(b) + 1];
-  for (std::size_t v = 0; v < static_cast<std::size_t>(V); ++v) start[v + 1] += start[v];
-  std::vector<Index> members(static_cast<std::size_t>(start.back()));
+    if (const Index b = bucket(i); b != kInvalidIndex) ++start[index_cast<std::size_t>(b) + 1];
+  for (std::size_t v = 0; v < index_cast<std::size_t>(V); ++v) start[v + 1] += start[v];
+  std::vector<Index> members(index_cast<std::size_t>(start.back()));
   {
     std::vector<Index> fill(start.begin(), start.end() - 1);
     for (std::size_t i = 0; i < origin.size(); ++i)
       if (const Index b = bucket(i); b != kInvalidIndex)
-        members[static_cast<std::size_t>(fill[static_cast<std::size_t>(b)]++)] =
-            static_cast<Index>(i);
+        members[index_cast<std::size_t>(fill[index_cast<std::size_t>(b)]++)] = index_cast(i);
   }
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, static_cast<std::size_t>(V), 4096),
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, index_cast<std::size_t>(V), 4096),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t v = range.begin(); v != range.end(); ++v) {
                         const auto first = members.begin() + start[v];
                         const auto last = members.begin() + start[v + 1];
                         std::sort(first, last, [&](Index a, Index b) {
-                          return std::tie(origin[static_cast<std::size_t>(a)], a) <
-                                 std::tie(origin[static_cast<std::size_t>(b)], b);
+                          return std::tie(origin[index_cast<std::size_t>(a)], a) <
+                                 std::tie(origin[index_cast<std::size_t>(b)], b);
                         });
                         for (auto it = first; it != last; ++it) {
-                          const FaceKey& k = origin[static_cast<std::size_t>(*it)];
+                          const FaceKey& k = origin[index_cast<std::size_t>(*it)];
                           // A single-node origin names an input node, made already as itself.
                           const bool twice =
                               k[1] == kInvalidIndex ||
-                              (it != first && origin[static_cast<std::size_t>(*(it - 1))] == k) ||
-                              (it + 1 != last && origin[static_cast<std::size_t>(*(it + 1))] == k);
-                          if (twice) duplicated[static_cast<std::size_t>(*it)] = 1;
+                              (it != first && origin[index_cast<std::size_t>(*(it - 1))] == k) ||
+                              (it + 1 != last && origin[index_cast<std::size_t>(*(it + 1))] == k);
+                          if (twice) duplicated[index_cast<std::size_t>(*it)] = 1;
                         }
                       }
                     });
   for (std::size_t i = 0; i < duplicated.size(); ++i)
-    if (duplicated[i]) r.duplicated_nodes.push_back(static_cast<Index>(i));
+    if (duplicated[i]) r.duplicated_nodes.push_back(index_cast(i));
   return r;
 }
 
@@ -290,14 +289,14 @@ double diced_wedge_min_scaled_jacobian(std::span<const Point> points,
   for (const auto& c : wedges) {
     auto at = [&](std::initializer_list<int> local) {
       Point p = Point::Zero();
-      for (int l : local) p += points[static_cast<std::size_t>(c[static_cast<std::size_t>(l)])];
+      for (int l : local) p += points[index_cast<std::size_t>(c[index_cast<std::size_t>(l)])];
       return Point(p / static_cast<double>(local.size()));
     };
     Point centre = Point::Zero();
-    for (Index v : c) centre += points[static_cast<std::size_t>(v)] / 6.0;
+    for (Index v : c) centre += points[index_cast<std::size_t>(v)] / 6.0;
     // The face centroid through corners k, a, b (wedge_face_corners picks the face).
     for (int k = 0; k < 6; ++k) {
-      const auto& n = topology::kWedgeCornerNeighbors[static_cast<std::size_t>(k)];
+      const auto& n = topology::kWedgeCornerNeighbors[index_cast<std::size_t>(k)];
       auto face = [&](int a, int b) {
         for (const auto& f : cell_topology(ElementKind::kWedge).face) {
           auto has = [&](int x) {
@@ -307,14 +306,14 @@ double diced_wedge_min_scaled_jacobian(std::span<const Point> points,
           if (f.size && has(k) && has(a) && has(b)) {
             Point p = Point::Zero();
             for (int i = 0; i < f.size; ++i)
-              p += points[static_cast<std::size_t>(
-                  c[static_cast<std::size_t>(f.corners[static_cast<std::size_t>(i)])])];
+              p += points[index_cast<std::size_t>(
+                  c[index_cast<std::size_t>(f.corners[index_cast<std::size_t>(i)])])];
             return Point(p / static_cast<double>(f.size));
           }
         }
         return centre;
       };
-      const HexCorners h{points[static_cast<std::size_t>(c[static_cast<std::size_t>(k)])],
+      const HexCorners h{points[index_cast<std::size_t>(c[index_cast<std::size_t>(k)])],
                          at({k, n[0]}),
                          face(n[0], n[1]),
                          at({k, n[1]}),
@@ -332,14 +331,14 @@ DicedModel dice_model(const Model& model, std::span<const char> shareable) {
   if (!model.pyramids.empty())
     throw InvalidInput("dice_model: " + describe_element(model, {ElementKind::kPyramid, 0}) +
                        ": pyramids are not diced; split them into tets first (split_pyramids)");
-  const Index V = static_cast<Index>(model.points.size());
+  const Index V = index_cast(model.points.size());
   DicedModel out;
   out.points = model.points;
   out.origin.resize(V);
   for (Index v = 0; v < V; ++v) out.origin[v] = {v, kInvalidIndex, kInvalidIndex, kInvalidIndex};
-  std::vector<char> share(static_cast<std::size_t>(V), 0);
+  std::vector<char> share(index_cast<std::size_t>(V), 0);
   {
-    std::vector<char> in_hex(static_cast<std::size_t>(V), 0);
+    std::vector<char> in_hex(index_cast<std::size_t>(V), 0);
     for (const auto& h : model.hexes)
       for (Index v : h) in_hex[v] = 1;
     std::size_t interface_nodes = 0;
@@ -362,8 +361,8 @@ DicedModel dice_model(const Model& model, std::span<const char> shareable) {
   auto global_of = [&](const DicedHexMesh& d) {
     std::vector<Index> g(d.mesh.points.size());
     for (std::size_t i = 0; i < g.size(); ++i) {
-      if (static_cast<Index>(i) < V) {
-        g[i] = static_cast<Index>(i);
+      if (index_cast(i) < V) {
+        g[i] = index_cast(i);
         continue;
       }
       const NodeOrigin& o = d.origin[i];
@@ -439,7 +438,7 @@ std::vector<SideSet> diced_side_sets(const Model& model, const DicedModel& diced
   std::vector<SideSet> sets;
   if (model.side_sets.empty()) return sets;
   if (wedge_offset == kInvalidIndex)
-    wedge_offset = tet_offset + static_cast<Index>(diced.tet_children.size());
+    wedge_offset = tet_offset + index_cast(diced.tet_children.size());
   // Per kind (pyramids have none: they are split before dicing): children, their hexes, offset.
   struct Part {
     std::vector<std::vector<Index>> children;
@@ -451,8 +450,7 @@ std::vector<SideSet> diced_side_sets(const Model& model, const DicedModel& diced
                   const std::vector<std::array<Index, 8>>& hexes, Index offset) {
     Part& p = parts[static_cast<std::size_t>(kind)];
     p.children.resize(element_count(model, kind));
-    for (std::size_t c = 0; c < parent.size(); ++c)
-      p.children[parent[c]].push_back(static_cast<Index>(c));
+    for (std::size_t c = 0; c < parent.size(); ++c) p.children[parent[c]].push_back(index_cast(c));
     p.hexes = &hexes;
     p.offset = offset;
   };
@@ -474,7 +472,7 @@ std::vector<SideSet> diced_side_sets(const Model& model, const DicedModel& diced
             return false;
         return true;
       };
-      for (Index c : p.children[static_cast<std::size_t>(side.element.index)])
+      for (Index c : p.children[index_cast<std::size_t>(side.element.index)])
         for (int f = 0; f < 6; ++f) {
           bool all = true;
           for (int k : topo::kHexFaceCorners[f]) all = all && on_face((*p.hexes)[c][k]);

@@ -24,26 +24,25 @@ class DisjointSets {
 
   // Adds a singleton set and returns its element.
   Index add() {
-    parent_.push_back(static_cast<Index>(parent_.size()));
+    parent_.push_back(index_cast(parent_.size()));
     return parent_.back();
   }
   Index find(Index x) {
-    while (parent_[static_cast<std::size_t>(x)] != x)
-      x = parent_[static_cast<std::size_t>(x)] =
-          parent_[static_cast<std::size_t>(parent_[static_cast<std::size_t>(x)])];
+    while (parent_[index_cast<std::size_t>(x)] != x)
+      x = parent_[index_cast<std::size_t>(x)] =
+          parent_[index_cast<std::size_t>(parent_[index_cast<std::size_t>(x)])];
     return x;
   }
   void unite(Index a, Index b) {
     a = find(a), b = find(b);
-    if (a < b) parent_[static_cast<std::size_t>(b)] = a;
-    if (b < a) parent_[static_cast<std::size_t>(a)] = b;
+    if (a < b) parent_[index_cast<std::size_t>(b)] = a;
+    if (b < a) parent_[index_cast<std::size_t>(a)] = b;
   }
   std::size_t size() const { return parent_.size(); }
   // Number of sets.
   std::size_t count() {
     std::size_t n = 0;
-    for (std::size_t i = 0; i < parent_.size(); ++i)
-      n += find(static_cast<Index>(i)) == static_cast<Index>(i);
+    for (std::size_t i = 0; i < parent_.size(); ++i) n += find(index_cast(i)) == index_cast(i);
     return n;
   }
 

@@ -9,8 +9,8 @@ void grade_down(std::vector<double>& value, const GradedEdges& edges, double rat
   const std::size_t n = value.size();
   std::vector<std::vector<std::pair<std::size_t, double>>> adjacent(n);
   for (std::size_t e = 0; e < edges.nodes.size(); ++e) {
-    const auto a = static_cast<std::size_t>(edges.nodes[e].first),
-               b = static_cast<std::size_t>(edges.nodes[e].second);
+    const auto a = index_cast<std::size_t>(edges.nodes[e].first),
+               b = index_cast<std::size_t>(edges.nodes[e].second);
     adjacent[a].push_back({b, rate * edges.length[e]});
     adjacent[b].push_back({a, rate * edges.length[e]});
   }

@@ -10,9 +10,7 @@ Model grid_model(std::array<int, 3> cells, double h,
   // Plain variables, not a structured binding: clang 14 (the fuzz build) cannot capture those.
   const int nx = cells[0], ny = cells[1], nz = cells[2];
   Model model;
-  auto id = [&](int i, int j, int k) {
-    return static_cast<Index>(i + (nx + 1) * (j + (ny + 1) * k));
-  };
+  auto id = [&](int i, int j, int k) { return index_cast(i + (nx + 1) * (j + (ny + 1) * k)); };
   for (int k = 0; k <= nz; ++k)
     for (int j = 0; j <= ny; ++j)
       for (int i = 0; i <= nx; ++i) model.points.emplace_back(i * h, j * h, k * h);
@@ -34,13 +32,13 @@ Model grid_model(std::array<int, 3> cells, double h,
           std::array<Index, 4> tet{};
           tet[0] = id(at[0], at[1], at[2]);
           for (int s = 0; s < 3; ++s) {
-            ++at[static_cast<std::size_t>(axes[static_cast<std::size_t>(s)])];
-            tet[static_cast<std::size_t>(s + 1)] = id(at[0], at[1], at[2]);
+            ++at[index_cast<std::size_t>(axes[index_cast<std::size_t>(s)])];
+            tet[index_cast<std::size_t>(s + 1)] = id(at[0], at[1], at[2]);
           }
           const auto& p = model.points;
-          if (tet_volume(p[static_cast<std::size_t>(tet[0])], p[static_cast<std::size_t>(tet[1])],
-                         p[static_cast<std::size_t>(tet[2])],
-                         p[static_cast<std::size_t>(tet[3])]) < 0)
+          if (tet_volume(p[index_cast<std::size_t>(tet[0])], p[index_cast<std::size_t>(tet[1])],
+                         p[index_cast<std::size_t>(tet[2])],
+                         p[index_cast<std::size_t>(tet[3])]) < 0)
             std::swap(tet[1], tet[2]);
           model.tets.push_back(tet);
           model.tet_block.push_back(2);

@@ -96,7 +96,7 @@ class InputChecker {
   }
 
  private:
-  const Point& pt(Index v) const { return model_.points[static_cast<std::size_t>(v)]; }
+  const Point& pt(Index v) const { return model_.points[index_cast<std::size_t>(v)]; }
   bool full() const { return result_.findings.size() >= options_.max_findings; }
   void add(InputFinding f) {
     if (!full()) result_.findings.push_back(std::move(f));
@@ -110,11 +110,11 @@ class InputChecker {
   }
   // The nodes of a local face in outward order.
   std::array<Index, 4> face_nodes(ElementRef e, int face, int* size = nullptr) const {
-    const auto& f = cell_topology(e.kind).face[static_cast<std::size_t>(face)];
+    const auto& f = cell_topology(e.kind).face[index_cast<std::size_t>(face)];
     const auto cs = corners(e);
     std::array<Index, 4> n{kInvalidIndex, kInvalidIndex, kInvalidIndex, kInvalidIndex};
     for (int i = 0; i < f.size; ++i)
-      n[static_cast<std::size_t>(i)] = cs[static_cast<std::size_t>(f.corners[i])];
+      n[index_cast<std::size_t>(i)] = cs[index_cast<std::size_t>(f.corners[i])];
     if (size) *size = f.size;
     return n;
   }
@@ -127,12 +127,12 @@ class InputChecker {
     for (ElementKind kind : kElementKinds) {
       const auto& topo = cell_topology(kind);
       for (std::size_t i = 0; i < element_count(model_, kind); ++i) {
-        const ElementRef e{kind, static_cast<Index>(i)};
+        const ElementRef e{kind, index_cast(i)};
         for (int f = 0; f < topo.faces; ++f) {
           int size = 0;
           const auto n = face_nodes(e, f, &size);
           uses.push_back(
-              {face_key(std::span<const Index>(n.data(), static_cast<std::size_t>(size))), e, f});
+              {face_key(std::span<const Index>(n.data(), index_cast<std::size_t>(size))), e, f});
         }
       }
     }
@@ -250,8 +250,8 @@ class InputChecker {
   // The node of triangle key k that is not a corner of quad q.
   static Index third_node(const FaceKey& k, const std::array<Index, 4>& q) {
     for (int i = 0; i < 3; ++i)
-      if (std::find(q.begin(), q.end(), k[static_cast<std::size_t>(i)]) == q.end())
-        return k[static_cast<std::size_t>(i)];
+      if (std::find(q.begin(), q.end(), k[index_cast<std::size_t>(i)]) == q.end())
+        return k[index_cast<std::size_t>(i)];
     return kInvalidIndex;
   }
 
@@ -262,7 +262,7 @@ class InputChecker {
     const int j = static_cast<int>(std::find(y.begin(), y.begin() + n, x[0]) - y.begin());
     if (j == n) return false;
     for (int i = 0; i < n; ++i)
-      if (y[static_cast<std::size_t>((j - i + n) % n)] != x[static_cast<std::size_t>(i)])
+      if (y[index_cast<std::size_t>((j - i + n) % n)] != x[index_cast<std::size_t>(i)])
         return false;
     return true;
   }
@@ -271,7 +271,7 @@ class InputChecker {
     int n = 0;
     const auto f = face_nodes(u.element, u.face, &n);
     Point c = Point::Zero();
-    for (int i = 0; i < n; ++i) c += pt(f[static_cast<std::size_t>(i)]);
+    for (int i = 0; i < n; ++i) c += pt(f[index_cast<std::size_t>(i)]);
     return c / n;
   }
 
@@ -290,12 +290,12 @@ class InputChecker {
     for (std::size_t f = 0; f < boundary_.size(); ++f) {
       const auto& b = boundary_[f];
       for (int i = 0; i < b.size; ++i) {
-        const Index v = b.nodes[static_cast<std::size_t>(i)];
-        const Index next = b.nodes[static_cast<std::size_t>((i + 1) % b.size)];
-        const Index prev = b.nodes[static_cast<std::size_t>((i + b.size - 1) % b.size)];
+        const Index v = b.nodes[index_cast<std::size_t>(i)];
+        const Index next = b.nodes[index_cast<std::size_t>((i + 1) % b.size)];
+        const Index prev = b.nodes[index_cast<std::size_t>((i + b.size - 1) % b.size)];
         const Point n = (pt(next) - pt(v)).cross(pt(prev) - pt(v));
-        half.push_back({v, next, prev, n, static_cast<Index>(f)});
-        half.push_back({v, prev, next, n, static_cast<Index>(f)});
+        half.push_back({v, next, prev, n, index_cast(f)});
+        half.push_back({v, prev, next, n, index_cast(f)});
       }
     }
     tbb::parallel_sort(half.begin(), half.end());
@@ -311,7 +311,7 @@ class InputChecker {
           local.push_back(half[k].face);
       faces_at.reset(local.size());
       auto slot = [&](Index f) {
-        return static_cast<Index>(std::find(local.begin(), local.end(), f) - local.begin());
+        return index_cast(std::find(local.begin(), local.end(), f) - local.begin());
       };
       double exterior = 0.0;
       bool manifold = true;
@@ -334,14 +334,14 @@ class InputChecker {
         // One element of each of the first two cycles (their smallest local face: the root).
         InputFinding f{InputFault::kNonManifoldNode, {}, v, pt(v), static_cast<double>(cycles)};
         for (std::size_t r = 0; r < local.size() && f.elements.size() < 2; ++r)
-          if (faces_at.find(static_cast<Index>(r)) == static_cast<Index>(r))
-            f.elements.push_back(boundary_[static_cast<std::size_t>(local[r])].element);
+          if (faces_at.find(index_cast(r)) == index_cast(r))
+            f.elements.push_back(boundary_[index_cast<std::size_t>(local[r])].element);
         add(std::move(f));
       }
       if (cycles == 1)
-        expected_[static_cast<std::size_t>(v)] = 2.0 * kPi - exterior;
+        expected_[index_cast<std::size_t>(v)] = 2.0 * kPi - exterior;
       else
-        judged_[static_cast<std::size_t>(v)] = 0;
+        judged_[index_cast<std::size_t>(v)] = 0;
       i = j;
     }
   }
@@ -349,9 +349,9 @@ class InputChecker {
   // A boundary edge on m - k boundary faces (half[k, m)), not two: the lowest and highest of
   // their elements.
   void edge_finding(const std::vector<HalfEdge>& half, std::size_t k, std::size_t m) {
-    ElementRef lo = boundary_[static_cast<std::size_t>(half[k].face)].element, hi = lo;
+    ElementRef lo = boundary_[index_cast<std::size_t>(half[k].face)].element, hi = lo;
     for (std::size_t x = k + 1; x < m; ++x) {
-      const ElementRef e = boundary_[static_cast<std::size_t>(half[x].face)].element;
+      const ElementRef e = boundary_[index_cast<std::size_t>(half[x].face)].element;
       lo = std::min(lo, e);
       hi = std::max(hi, e);
     }
@@ -374,41 +374,40 @@ class InputChecker {
     std::vector<ElementRef> at(nv, ElementRef{ElementKind::kHex, kInvalidIndex});
     auto cone = [&](ElementRef e, Index v, Index a, Index b, Index c) {
       const Point& o = pt(v);
-      angle[static_cast<std::size_t>(v)] += solid_angle(pt(a) - o, pt(b) - o, pt(c) - o);
-      if (at[static_cast<std::size_t>(v)].index == kInvalidIndex)
-        at[static_cast<std::size_t>(v)] = e;
+      angle[index_cast<std::size_t>(v)] += solid_angle(pt(a) - o, pt(b) - o, pt(c) - o);
+      if (at[index_cast<std::size_t>(v)].index == kInvalidIndex) at[index_cast<std::size_t>(v)] = e;
     };
     auto tet = [&](ElementRef e, std::array<Index, 4> t) {
       for (int k = 0; k < 4; ++k) {
-        const auto& n = topology::kTetCornerNeighbors[static_cast<std::size_t>(k)];
-        cone(e, t[static_cast<std::size_t>(k)], t[static_cast<std::size_t>(n[0])],
-             t[static_cast<std::size_t>(n[1])], t[static_cast<std::size_t>(n[2])]);
+        const auto& n = topology::kTetCornerNeighbors[index_cast<std::size_t>(k)];
+        cone(e, t[index_cast<std::size_t>(k)], t[index_cast<std::size_t>(n[0])],
+             t[index_cast<std::size_t>(n[1])], t[index_cast<std::size_t>(n[2])]);
       }
     };
     for (std::size_t i = 0; i < model_.hexes.size(); ++i) {
       const auto& h = model_.hexes[i];
       for (int c = 0; c < 8; ++c) {
-        const auto& n = topology::kHexCornerNeighbors[static_cast<std::size_t>(c)];
-        cone({ElementKind::kHex, static_cast<Index>(i)}, h[static_cast<std::size_t>(c)],
-             h[static_cast<std::size_t>(n[0])], h[static_cast<std::size_t>(n[1])],
-             h[static_cast<std::size_t>(n[2])]);
+        const auto& n = topology::kHexCornerNeighbors[index_cast<std::size_t>(c)];
+        cone({ElementKind::kHex, index_cast(i)}, h[index_cast<std::size_t>(c)],
+             h[index_cast<std::size_t>(n[0])], h[index_cast<std::size_t>(n[1])],
+             h[index_cast<std::size_t>(n[2])]);
       }
     }
     for (std::size_t i = 0; i < model_.wedges.size(); ++i) {
       const auto& w = model_.wedges[i];
       for (int c = 0; c < 6; ++c) {
-        const auto& n = topology::kWedgeCornerNeighbors[static_cast<std::size_t>(c)];
-        cone({ElementKind::kWedge, static_cast<Index>(i)}, w[static_cast<std::size_t>(c)],
-             w[static_cast<std::size_t>(n[0])], w[static_cast<std::size_t>(n[1])],
-             w[static_cast<std::size_t>(n[2])]);
+        const auto& n = topology::kWedgeCornerNeighbors[index_cast<std::size_t>(c)];
+        cone({ElementKind::kWedge, index_cast(i)}, w[index_cast<std::size_t>(c)],
+             w[index_cast<std::size_t>(n[0])], w[index_cast<std::size_t>(n[1])],
+             w[index_cast<std::size_t>(n[2])]);
       }
     }
     for (std::size_t i = 0; i < model_.tets.size(); ++i)
-      tet({ElementKind::kTet, static_cast<Index>(i)}, model_.tets[i]);
-    for (Index x : centre_on_quad_) angle[static_cast<std::size_t>(x)] += 2.0 * kPi;
+      tet({ElementKind::kTet, index_cast(i)}, model_.tets[i]);
+    for (Index x : centre_on_quad_) angle[index_cast<std::size_t>(x)] += 2.0 * kPi;
     for (std::size_t i = 0; i < model_.pyramids.size(); ++i) {
       const auto& p = model_.pyramids[i];
-      const ElementRef e{ElementKind::kPyramid, static_cast<Index>(i)};
+      const ElementRef e{ElementKind::kPyramid, index_cast(i)};
       const bool d02 = tet_volume(pt(p[0]), pt(p[1]), pt(p[2]), pt(p[4])) > 0.0 &&
                        tet_volume(pt(p[0]), pt(p[2]), pt(p[3]), pt(p[4])) > 0.0;
       if (d02) {
@@ -425,8 +424,8 @@ class InputChecker {
       if (!(std::abs(angle[v] - expected_[v]) > kPi)) continue;  // NaN: not judged
       add({InputFault::kFoldedNode,
            {at[v]},
-           static_cast<Index>(v),
-           pt(static_cast<Index>(v)),
+           index_cast(v),
+           pt(index_cast(v)),
            angle[v] / expected_[v]});
     }
   }
@@ -436,9 +435,8 @@ class InputChecker {
   void boundary_contacts() {
     for (std::size_t f = 0; f < boundary_.size(); ++f) {
       const auto& b = boundary_[f];
-      triangles_.push_back({{b.nodes[0], b.nodes[1], b.nodes[2]}, static_cast<Index>(f)});
-      if (b.size == 4)
-        triangles_.push_back({{b.nodes[0], b.nodes[2], b.nodes[3]}, static_cast<Index>(f)});
+      triangles_.push_back({{b.nodes[0], b.nodes[1], b.nodes[2]}, index_cast(f)});
+      if (b.size == 4) triangles_.push_back({{b.nodes[0], b.nodes[2], b.nodes[3]}, index_cast(f)});
     }
     const std::size_t nt = triangles_.size();
     if (nt < 2) return;
@@ -499,8 +497,8 @@ class InputChecker {
       while (j < binned.size() && binned[j].first == binned[i].first) ++j;
       for (std::size_t a = i; a < j && !full(); ++a)
         for (std::size_t b = a + 1; b < j && !full(); ++b) {
-          const auto s = static_cast<std::size_t>(binned[a].second);
-          const auto t = static_cast<std::size_t>(binned[b].second);
+          const auto s = index_cast<std::size_t>(binned[a].second);
+          const auto t = index_cast<std::size_t>(binned[b].second);
           if (((hi[s].array() < lo[t].array()) || (hi[t].array() < lo[s].array())).any()) continue;
           // Each pair once: in the cell holding the lower corner of the boxes' overlap.
           if (code(cell(lo[s].cwiseMax(lo[t]))) != binned[i].first) continue;
@@ -515,8 +513,8 @@ class InputChecker {
     const auto& b = triangles_[t].v;
     for (Index x : a)
       if (std::find(b.begin(), b.end(), x) != b.end()) return;
-    const ElementRef ea = boundary_[static_cast<std::size_t>(triangles_[s].face)].element;
-    const ElementRef eb = boundary_[static_cast<std::size_t>(triangles_[t].face)].element;
+    const ElementRef ea = boundary_[index_cast<std::size_t>(triangles_[s].face)].element;
+    const ElementRef eb = boundary_[index_cast<std::size_t>(triangles_[t].face)].element;
     if (const auto x = crossing(a, b, length); x) {
       add({InputFault::kCrossingFaces, {ea, eb}, kInvalidIndex, *x, 0.0});
       return;
@@ -582,27 +580,26 @@ class InputChecker {
     if (triangles_.empty())
       for (std::size_t f = 0; f < boundary_.size(); ++f) {
         const auto& b = boundary_[f];
-        triangles_.push_back({{b.nodes[0], b.nodes[1], b.nodes[2]}, static_cast<Index>(f)});
+        triangles_.push_back({{b.nodes[0], b.nodes[1], b.nodes[2]}, index_cast(f)});
         if (b.size == 4)
-          triangles_.push_back({{b.nodes[0], b.nodes[2], b.nodes[3]}, static_cast<Index>(f)});
+          triangles_.push_back({{b.nodes[0], b.nodes[2], b.nodes[3]}, index_cast(f)});
       }
     DisjointSets components(boundary_.size());
     std::unordered_map<Index, Index> first_face;
     for (std::size_t f = 0; f < boundary_.size(); ++f)
       for (int i = 0; i < boundary_[f].size; ++i) {
-        const auto [it, fresh] = first_face.emplace(boundary_[f].nodes[static_cast<std::size_t>(i)],
-                                                    static_cast<Index>(f));
-        if (!fresh) components.unite(it->second, static_cast<Index>(f));
+        const auto [it, fresh] =
+            first_face.emplace(boundary_[f].nodes[index_cast<std::size_t>(i)], index_cast(f));
+        if (!fresh) components.unite(it->second, index_cast(f));
       }
     std::vector<Index> representative;
     for (std::size_t f = 0; f < boundary_.size(); ++f)
-      if (components.find(static_cast<Index>(f)) == static_cast<Index>(f))
-        representative.push_back(static_cast<Index>(f));
+      if (components.find(index_cast(f)) == index_cast(f)) representative.push_back(index_cast(f));
     result_.boundary_components = representative.size();
     if (representative.size() < 2) return;  // one closed surface: its winding number is 1 inside
     for (std::size_t r = 0; r < representative.size() && r < options_.max_components && !full();
          ++r) {
-      const ElementRef e = boundary_[static_cast<std::size_t>(representative[r])].element;
+      const ElementRef e = boundary_[index_cast<std::size_t>(representative[r])].element;
       const Point x = centre(e);
       double omega = 0.0;
       for (const Triangle& t : triangles_)

@@ -70,13 +70,12 @@ void refuse_duplicates(const Model& model, const std::vector<std::array<Index, N
   for (std::size_t e = 0; e < cells.size(); ++e) {
     std::array<Index, N> key = cells[e];
     std::sort(key.begin(), key.end());
-    const auto [it, inserted] = first.try_emplace(key, static_cast<Index>(e));
+    const auto [it, inserted] = first.try_emplace(key, index_cast(e));
     if (!inserted)
-      throw TopologyError(
-          "find_interface: " + describe_element(model, {kind, static_cast<Index>(e)}) +
-          " has the same nodes as " + describe_element(model, {kind, it->second}) + " (nodes " +
-          node_list(model, cells[e]) +
-          "): a duplicated element (an element or a block given twice?)");
+      throw TopologyError("find_interface: " + describe_element(model, {kind, index_cast(e)}) +
+                          " has the same nodes as " + describe_element(model, {kind, it->second}) +
+                          " (nodes " + node_list(model, cells[e]) +
+                          "): a duplicated element (an element or a block given twice?)");
   }
 }
 
@@ -107,7 +106,7 @@ std::vector<PartQuad> part_quads(const Model& model) {
   auto quad = [&](std::size_t w, const auto& f) {
     std::array<Index, 4> c{};
     for (std::size_t i = 0; i < 4; ++i)
-      c[i] = model.wedges[w][static_cast<std::size_t>(f.corners[i])];
+      c[i] = model.wedges[w][index_cast<std::size_t>(f.corners[i])];
     return c;
   };
   KeyMap<4> uses(3 * model.wedges.size());
@@ -115,19 +114,18 @@ std::vector<PartQuad> part_quads(const Model& model) {
   for (std::size_t w = 0; w < model.wedges.size(); ++w)
     for (const auto& f : faces)
       if (f.size == 4) {
-        const auto [id, fresh] =
-            uses.try_emplace(face_key(quad(w, f)), static_cast<Index>(count.size()));
+        const auto [id, fresh] = uses.try_emplace(face_key(quad(w, f)), index_cast(count.size()));
         if (fresh) count.push_back(0);
-        ++count[static_cast<std::size_t>(*id)];
+        ++count[index_cast<std::size_t>(*id)];
       }
   for (const PartQuad& q : out)
-    if (const Index* id = uses.find(face_key(q.nodes))) ++count[static_cast<std::size_t>(*id)];
+    if (const Index* id = uses.find(face_key(q.nodes))) ++count[index_cast<std::size_t>(*id)];
   for (std::size_t w = 0; w < model.wedges.size(); ++w)
     for (std::size_t f = 0; f < faces.size(); ++f)
       if (faces[f].size == 4) {
         const auto c = quad(w, faces[f]);
-        if (count[static_cast<std::size_t>(*uses.find(face_key(c)))] == 1)
-          out.push_back({{ElementKind::kWedge, static_cast<Index>(w)}, static_cast<int>(f), c});
+        if (count[index_cast<std::size_t>(*uses.find(face_key(c)))] == 1)
+          out.push_back({{ElementKind::kWedge, index_cast(w)}, static_cast<int>(f), c});
       }
   return out;
 }
@@ -141,26 +139,26 @@ std::vector<InterfaceNodeUse> node_uses(const Model& model, const Interface& itf
   if (itf.nodes.empty()) return out;
   std::vector<Index> slot(model.points.size(), kInvalidIndex);
   for (std::size_t k = 0; k < itf.nodes.size(); ++k)
-    slot[static_cast<std::size_t>(itf.nodes[k])] = static_cast<Index>(k);
+    slot[index_cast<std::size_t>(itf.nodes[k])] = index_cast(k);
   // Per node: its cells (every kind but pyramids, which conform splits first), and the owners
   // of its interface quads (the hex side) and triangles (the tet side).
   std::vector<std::vector<ElementRef>> cells(itf.nodes.size()), hex_side(itf.nodes.size()),
       tet_side(itf.nodes.size());
   for (ElementKind kind : {ElementKind::kHex, ElementKind::kTet, ElementKind::kWedge})
     for (std::size_t e = 0; e < element_count(model, kind); ++e) {
-      const ElementRef ref{kind, static_cast<Index>(e)};
+      const ElementRef ref{kind, index_cast(e)};
       for (Index v : element_corners(model, ref))
-        if (const Index k = slot[static_cast<std::size_t>(v)]; k != kInvalidIndex)
-          cells[static_cast<std::size_t>(k)].push_back(ref);
+        if (const Index k = slot[index_cast<std::size_t>(v)]; k != kInvalidIndex)
+          cells[index_cast<std::size_t>(k)].push_back(ref);
     }
   for (const InterfaceQuad& q : itf.quads) {
     for (Index v : q.corners)
-      hex_side[static_cast<std::size_t>(slot[static_cast<std::size_t>(v)])].push_back(q.owner());
+      hex_side[index_cast<std::size_t>(slot[index_cast<std::size_t>(v)])].push_back(q.owner());
     const auto triangles = interface_triangles(q);
     for (std::size_t i = 0; i < triangles.size(); ++i)
       for (Index v : triangles[i])
-        if (const Index k = slot[static_cast<std::size_t>(v)]; k != kInvalidIndex)
-          tet_side[static_cast<std::size_t>(k)].push_back({ElementKind::kTet, q.tets[i]});
+        if (const Index k = slot[index_cast<std::size_t>(v)]; k != kInvalidIndex)
+          tet_side[index_cast<std::size_t>(k)].push_back({ElementKind::kTet, q.tets[i]});
   }
   DisjointSets sets;
   std::vector<std::pair<FaceKey, Index>> faces;  // a face at the node -> its first cell
@@ -176,25 +174,25 @@ std::vector<InterfaceNodeUse> node_uses(const Model& model, const Interface& itf
         std::array<Index, 4> nodes{};
         bool has = false;
         for (int i = 0; i < f.size; ++i) {
-          nodes[static_cast<std::size_t>(i)] =
-              corners[static_cast<std::size_t>(f.corners[static_cast<std::size_t>(i)])];
-          has |= nodes[static_cast<std::size_t>(i)] == v;
+          nodes[index_cast<std::size_t>(i)] =
+              corners[index_cast<std::size_t>(f.corners[index_cast<std::size_t>(i)])];
+          has |= nodes[index_cast<std::size_t>(i)] == v;
         }
         if (!has) continue;
         const FaceKey key = face_key(std::span<const Index>(nodes.data(), f.size));
         const auto it =
             std::find_if(faces.begin(), faces.end(), [&](const auto& e) { return e.first == key; });
         if (it == faces.end())
-          faces.emplace_back(key, static_cast<Index>(c));
+          faces.emplace_back(key, index_cast(c));
         else
-          sets.unite(it->second, static_cast<Index>(c));
+          sets.unite(it->second, index_cast(c));
       }
     }
     // Per set (its root): a hex-side cell and a tet-side cell in it, if any.
     std::vector<const ElementRef*> hex_in(at.size(), nullptr), tet_in(at.size(), nullptr);
     auto root_of = [&](const ElementRef& e) {
-      return static_cast<std::size_t>(
-          sets.find(static_cast<Index>(std::find(at.begin(), at.end(), e) - at.begin())));
+      return index_cast<std::size_t>(
+          sets.find(index_cast(std::find(at.begin(), at.end(), e) - at.begin())));
     };
     for (const ElementRef& e : hex_side[k]) hex_in[root_of(e)] = &e;
     for (std::size_t c = 0; c < at.size(); ++c)
@@ -245,7 +243,7 @@ Interface find_interface(const Model& model, double tol) {
   refuse_duplicates(model, model.tets, ElementKind::kTet);
   refuse_duplicates(model, model.wedges, ElementKind::kWedge);
   const auto& P = model.points;
-  auto pt = [&](Index v) -> const Point& { return P[static_cast<std::size_t>(v)]; };
+  auto pt = [&](Index v) -> const Point& { return P[index_cast<std::size_t>(v)]; };
 
   // Triangles of the tet part with the tets using them (boundary triangles: one use).
   KeyMap<4> tri_index(2 * model.tets.size());
@@ -255,29 +253,28 @@ Interface find_interface(const Model& model, double tol) {
                                   model.tets.size());  // tris index of face f of tet t at 4 t + f
   for (std::size_t t = 0; t < model.tets.size(); ++t)
     for (int f = 0; f < 4; ++f) {
-      TetFaceUse use{static_cast<Index>(t), f, {}};
+      TetFaceUse use{index_cast(t), f, {}};
       for (std::size_t i = 0; i < 3; ++i)
-        use.nodes[i] = model.tets[t][static_cast<std::size_t>(
-            topology::kTetFaceCorners[static_cast<std::size_t>(f)][i])];
+        use.nodes[i] = model.tets[t][index_cast<std::size_t>(
+            topology::kTetFaceCorners[index_cast<std::size_t>(f)][i])];
       const auto [id, inserted] =
-          tri_index.try_emplace(face_key(use.nodes), static_cast<Index>(tris.size()));
+          tri_index.try_emplace(face_key(use.nodes), index_cast(tris.size()));
       if (inserted) tris.emplace_back();
-      tet_face_tri[4 * t + static_cast<std::size_t>(f)] = *id;
-      TriangleUses& uses = tris[static_cast<std::size_t>(*id)];
+      tet_face_tri[4 * t + index_cast<std::size_t>(f)] = *id;
+      TriangleUses& uses = tris[index_cast<std::size_t>(*id)];
       if (uses.count == 2)
         throw TopologyError("find_interface: triangle (nodes " + node_list(model, use.nodes) +
                             ") is a face of more than two tets (" +
                             describe_element(model, {ElementKind::kTet, uses.use[0].tet}) + ", " +
                             describe_element(model, {ElementKind::kTet, uses.use[1].tet}) + ", " +
-                            describe_element(model, {ElementKind::kTet, static_cast<Index>(t)}) +
-                            ")");
-      uses.use[static_cast<std::size_t>(uses.count++)] = use;
+                            describe_element(model, {ElementKind::kTet, index_cast(t)}) + ")");
+      uses.use[index_cast<std::size_t>(uses.count++)] = use;
     }
   // The boundary triangle with this key, or nullptr.
   auto boundary_triangle = [&](const FaceKey& key) -> const TetFaceUse* {
     const Index* id = tri_index.find(key);
-    if (!id || tris[static_cast<std::size_t>(*id)].count != 1) return nullptr;
-    return &tris[static_cast<std::size_t>(*id)].use[0];
+    if (!id || tris[index_cast<std::size_t>(*id)].count != 1) return nullptr;
+    return &tris[index_cast<std::size_t>(*id)].use[0];
   };
 
   // Per boundary-triangle edge, the third nodes of the boundary triangles on it: the candidate
@@ -290,7 +287,7 @@ Interface find_interface(const Model& model, double tol) {
             uses.use[0].nodes[(i + 2) % 3]);
   std::vector<char> in_hex(P.size(), 0);
   for (const auto& h : model.hexes)
-    for (Index v : h) in_hex[static_cast<std::size_t>(v)] = 1;
+    for (Index v : h) in_hex[index_cast<std::size_t>(v)] = 1;
   // The node x for which (c_i, c_i+1, x) are boundary triangles for all four sides of the quad;
   // of several (a single tet layer's outer faces can fan around the quad too) the nearest to the
   // quad's middle.
@@ -320,8 +317,8 @@ Interface find_interface(const Model& model, double tol) {
     for (int d = 0; d < 2; ++d)
       for (int i = 0; i < 2; ++i) {
         if (const TetFaceUse* u = boundary_triangle(
-                face_key(splits[static_cast<std::size_t>(d)][static_cast<std::size_t>(i)]))) {
-          found[static_cast<std::size_t>(d)][static_cast<std::size_t>(i)] = u;
+                face_key(splits[index_cast<std::size_t>(d)][index_cast<std::size_t>(i)]))) {
+          found[index_cast<std::size_t>(d)][index_cast<std::size_t>(i)] = u;
           ++count;
         }
       }
@@ -331,7 +328,7 @@ Interface find_interface(const Model& model, double tol) {
       continue;
     }
     const std::string name = quad_name(model, bq.cell, c);
-    if (centre != kInvalidIndex && in_hex[static_cast<std::size_t>(centre)])
+    if (centre != kInvalidIndex && in_hex[index_cast<std::size_t>(centre)])
       throw TopologyError("find_interface: " + name + " is split into four triangles around " +
                           describe_node(model, centre) + ", a node of the hex part too");
     if (centre != kInvalidIndex) {
@@ -366,7 +363,7 @@ Interface find_interface(const Model& model, double tol) {
       std::string detail;
       for (int d = 0; d < 2; ++d)
         for (int i = 0; i < 2; ++i)
-          if (const TetFaceUse* u = found[static_cast<std::size_t>(d)][static_cast<std::size_t>(i)])
+          if (const TetFaceUse* u = found[index_cast<std::size_t>(d)][index_cast<std::size_t>(i)])
             detail += (detail.empty() ? "" : ", ") + tet_face_name(model, *u);
       throw TopologyError("find_interface: " + name + " is matched by " +
                           (count == 1
@@ -386,15 +383,14 @@ Interface find_interface(const Model& model, double tol) {
     const Point middle = (pt(c[0]) + pt(c[1]) + pt(c[2]) + pt(c[3])) / 4.0;
     const auto triangles = interface_triangles(q);
     for (std::size_t i = 0; i < triangles.size(); ++i) {
-      const TetFaceUse& u = centre == kInvalidIndex
-                                ? *found[static_cast<std::size_t>(q.diagonal)][i]
-                                : *boundary_triangle(face_key(triangles[i]));
+      const TetFaceUse& u = centre == kInvalidIndex ? *found[index_cast<std::size_t>(q.diagonal)][i]
+                                                    : *boundary_triangle(face_key(triangles[i]));
       q.tets[i] = u.tet;
       q.tet_faces[i] = u.face;
-      tris[static_cast<std::size_t>(tet_face_tri[4 * static_cast<std::size_t>(u.tet) +
-                                                 static_cast<std::size_t>(u.face)])]
+      tris[index_cast<std::size_t>(
+               tet_face_tri[4 * index_cast<std::size_t>(u.tet) + index_cast<std::size_t>(u.face)])]
           .matched = true;
-      const auto& tet = model.tets[static_cast<std::size_t>(u.tet)];
+      const auto& tet = model.tets[index_cast<std::size_t>(u.tet)];
       Index apex = kInvalidIndex;
       for (Index v : tet)
         if (std::find(u.nodes.begin(), u.nodes.end(), v) == u.nodes.end()) apex = v;
@@ -414,7 +410,7 @@ Interface find_interface(const Model& model, double tol) {
   // In tet order, so that the first offence reported does not depend on hashing.
   for (std::size_t t = 0; t < model.tets.size(); ++t)
     for (std::size_t f = 0; f < 4; ++f) {
-      const TriangleUses& uses = tris[static_cast<std::size_t>(tet_face_tri[4 * t + f])];
+      const TriangleUses& uses = tris[index_cast<std::size_t>(tet_face_tri[4 * t + f])];
       if (uses.count != 1 || uses.matched) continue;
       const TetFaceUse& tri = uses.use[0];
       std::unordered_set<const PartQuad*> seen;
@@ -459,11 +455,11 @@ Interface find_interface(const Model& model, double tol) {
   // Nodes shared by both parts must be interface nodes.
   std::vector<char> in_tet(P.size(), 0);
   for (const auto& t : model.tets)
-    for (Index v : t) in_tet[static_cast<std::size_t>(v)] = 1;
+    for (Index v : t) in_tet[index_cast<std::size_t>(v)] = 1;
   for (std::size_t v = 0; v < P.size(); ++v)
     if (in_hex[v] && in_tet[v] &&
-        !std::binary_search(out.nodes.begin(), out.nodes.end(), static_cast<Index>(v)))
-      throw TopologyError("find_interface: " + describe_node(model, static_cast<Index>(v)) +
+        !std::binary_search(out.nodes.begin(), out.nodes.end(), index_cast(v)))
+      throw TopologyError("find_interface: " + describe_node(model, index_cast(v)) +
                           " is used by both the hex and the tet part but lies on no interface quad "
                           "(the parts touch along an edge or at a point only)");
   out.uses = node_uses(model, out);

@@ -68,7 +68,7 @@ Complex<N> build_complex(std::size_t n_nodes, const Cells<N>& cells, const char*
   using K = Kind<N>;
   Complex<N> cx;
   cx.cells = &cells;
-  cx.n_nodes = static_cast<Index>(n_nodes);
+  cx.n_nodes = index_cast(n_nodes);
   cx.node_cells.resize(n_nodes);
   cx.node_neighbors.resize(n_nodes);
   cx.boundary.assign(n_nodes, 0);
@@ -84,7 +84,7 @@ Complex<N> build_complex(std::size_t n_nodes, const Cells<N>& cells, const char*
       for (int d = 0; d < c; ++d)
         if (cell[c] == cell[d])
           throw InvalidInput(name + ": node " + std::to_string(cell[c]) + " repeated");
-      cx.node_cells[cell[c]].push_back(static_cast<Index>(i));
+      cx.node_cells[cell[c]].push_back(index_cast(i));
     }
     for (const auto& e : K::kEdgeTable) {
       cx.node_neighbors[cell[e[0]]].push_back(cell[e[1]]);
@@ -94,7 +94,7 @@ Complex<N> build_complex(std::size_t n_nodes, const Cells<N>& cells, const char*
       std::array<Index, K::kFacetSize> key{};
       for (int k = 0; k < K::kFacetSize; ++k) key[k] = cell[K::kFacetTable[f][k]];
       std::sort(key.begin(), key.end());
-      facets[key].push_back({static_cast<Index>(i), f});
+      facets[key].push_back({index_cast(i), f});
     }
     cx.neighbor[i].fill(-1);
   }
@@ -189,7 +189,7 @@ std::optional<MeshMapping> search(std::size_t na_nodes, const Cells<N>& a_cells,
     std::sort(hb.begin(), hb.end());
     if (ha != hb) return std::nullopt;
   }
-  const Index n_cells = static_cast<Index>(a_cells.size());
+  const Index n_cells = index_cast(a_cells.size());
 
   // Cells of b by signature (seed candidates); cells of a ordered breadth-first through
   // facets, each component seeded at the cell whose signature is rarest.
@@ -233,7 +233,7 @@ std::optional<MeshMapping> search(std::size_t na_nodes, const Cells<N>& a_cells,
     std::vector<std::vector<std::array<int, N>>> keys;
     for (Index s = 0; s < n_cells; ++s) {
       if (comp[s] >= 0) continue;
-      const Index id = static_cast<Index>(keys.size());
+      const Index id = index_cast(keys.size());
       std::vector<Index> queue{s};
       comp[s] = id;
       for (std::size_t h = 0; h < queue.size(); ++h)
@@ -342,9 +342,9 @@ std::optional<MeshMapping> search(std::size_t na_nodes, const Cells<N>& a_cells,
 
   // Nodes in no cell: pair them up colour by colour (their colour carries the label).
   std::map<int, std::vector<Index>> free_b;
-  for (Index y = 0; y < static_cast<Index>(nb_nodes); ++y)
+  for (Index y = 0; y < index_cast(nb_nodes); ++y)
     if (inv[y] < 0) free_b[cb[y]].push_back(y);
-  for (Index x = 0; x < static_cast<Index>(na_nodes); ++x) {
+  for (Index x = 0; x < index_cast(na_nodes); ++x) {
     if (map[x] >= 0) continue;
     auto& pool = free_b[ca[x]];
     if (pool.empty()) return std::nullopt;
@@ -364,7 +364,7 @@ bool check(std::size_t na_nodes, const Cells<N>& a_cells, std::size_t nb_nodes,
   auto is_bijection = [](const std::vector<Index>& f, std::size_t n) {
     std::vector<char> hit(n, 0);
     for (Index y : f) {
-      if (y < 0 || static_cast<std::size_t>(y) >= n || hit[y]) return false;
+      if (y < 0 || index_cast<std::size_t>(y) >= n || hit[y]) return false;
       hit[y] = 1;
     }
     return true;

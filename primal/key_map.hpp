@@ -71,7 +71,7 @@ class KeyMap {
     }
     h *= 0x94d049bb133111ebull;
     h ^= h >> 29;
-    return static_cast<std::size_t>(h) & mask_;
+    return index_cast<std::size_t>(h) & mask_;
   }
 
   void rehash(std::size_t capacity) {

@@ -79,7 +79,7 @@ class SurfaceProjector {
       const auto ca = cell_of(a), cb = cell_of(b);
       for (Index x = ca[0]; x <= cb[0]; ++x)
         for (Index y = ca[1]; y <= cb[1]; ++y)
-          for (Index z = ca[2]; z <= cb[2]; ++z) grid_[{x, y, z}].push_back(static_cast<Index>(i));
+          for (Index z = ca[2]; z <= cb[2]; ++z) grid_[{x, y, z}].push_back(index_cast(i));
     }
   }
 
@@ -207,7 +207,7 @@ class Patch {
     for (Index v : ctx.mesh.hexes[seed])
       if (!is_fixed(ctx, v) && std::find(node_.begin(), node_.end(), v) == node_.end())
         node_.push_back(v);
-    moving_ = static_cast<int>(node_.size());
+    moving_ = index_cast<int>(node_.size());
     local_.resize(hex_.size());
     for (std::size_t h = 0; h < hex_.size(); ++h)
       for (int c = 0; c < 8; ++c) {
@@ -438,7 +438,7 @@ class Patch {
     for (int i = 0; i < moving_; ++i) {
       basis[i] = motion_basis(ctx_, node_[i], pos_[i]);
       offset[i] = dof;
-      dof += static_cast<int>(basis[i].cols());
+      dof += index_cast<int>(basis[i].cols());
     }
     if (dof == 0) return false;
     PatchVector g(dof);
@@ -521,11 +521,11 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
                        " constraints for " + std::to_string(np) + " nodes");
   for (std::size_t h = 0; h < nh; ++h)
     for (Index v : mesh.hexes[h])
-      if (v < 0 || static_cast<std::size_t>(v) >= np)
+      if (v < 0 || index_cast<std::size_t>(v) >= np)
         throw InvalidInput("smooth_hexes_local: hex " + std::to_string(h) + " names node " +
                            std::to_string(v) + ", out of range");
   for (Index s : seeds)
-    if (s < 0 || static_cast<std::size_t>(s) >= nh)
+    if (s < 0 || index_cast<std::size_t>(s) >= nh)
       throw InvalidInput("smooth_hexes_local: seed hex " + std::to_string(s) + " out of range");
   if (start && (start->scaled_jacobian.size() != nh || start->shortest_edge.size() != nh))
     throw InvalidInput("smooth_hexes_local: the start values are not one per hex");
@@ -534,12 +534,11 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
     throw InvalidInput("smooth_hexes_local: the per-hex targets or goals are not one per hex");
   auto target_of = [&](Index h) {
     return options.hex_targets.empty() ? options.target
-                                       : options.hex_targets[static_cast<std::size_t>(h)];
+                                       : options.hex_targets[index_cast<std::size_t>(h)];
   };
   const bool goals = options.goal > 0.0 || !options.hex_goals.empty();
   auto goal_of = [&](Index h) {
-    return options.hex_goals.empty() ? options.goal
-                                     : options.hex_goals[static_cast<std::size_t>(h)];
+    return options.hex_goals.empty() ? options.goal : options.hex_goals[index_cast<std::size_t>(h)];
   };
   std::unique_ptr<SurfaceProjector> projector;
   for (std::size_t v = 0; v < constraints.size(); ++v) {
@@ -563,11 +562,11 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
   {
     std::vector<Index> fill(ctx.node_start.begin(), ctx.node_start.end() - 1);
     for (std::size_t h = 0; h < nh; ++h)
-      for (Index v : mesh.hexes[h]) ctx.node_hexes[fill[v]++] = static_cast<Index>(h);
+      for (Index v : mesh.hexes[h]) ctx.node_hexes[fill[v]++] = index_cast(h);
   }
   // Constrained nodes start exactly on their plane, line or surface.
   for (std::size_t v = 0; v < constraints.size(); ++v)
-    mesh.points[v] = constrain(ctx, static_cast<Index>(v), mesh.points[v]);
+    mesh.points[v] = constrain(ctx, index_cast(v), mesh.points[v]);
 
   LocalSmoothResult res;
   const SmoothStart now = start ? SmoothStart{} : smooth_start(mesh);
@@ -586,7 +585,7 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
 
   std::vector<Index> pool(seeds.begin(), seeds.end());
   if (seeds.empty())
-    for (std::size_t h = 0; h < nh; ++h) pool.push_back(static_cast<Index>(h));
+    for (std::size_t h = 0; h < nh; ++h) pool.push_back(index_cast(h));
   std::sort(pool.begin(), pool.end());
   pool.erase(std::unique(pool.begin(), pool.end()), pool.end());
   std::vector<int> visits(nh, 0);
@@ -651,7 +650,7 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
         for (Index a : *affected[i])
           if (a != chosen[i]) dirty[a] = 1;
     }
-    res.patches += static_cast<Index>(chosen.size());
+    res.patches += index_cast(chosen.size());
     res.rounds = round + 1;
   }
   summarise(res.final_min_scaled_jacobian, res.final_inverted);
@@ -664,7 +663,7 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
 LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seeds,
                                       const LocalSmoothOptions& options, const SmoothStart* start) {
   for (Index s : seeds)
-    if (s < 0 || static_cast<std::size_t>(s) >= mesh.hexes.size())
+    if (s < 0 || index_cast<std::size_t>(s) >= mesh.hexes.size())
       throw InvalidInput("smooth_hexes_around: seed hex " + std::to_string(s) + " out of range");
   if (start && (start->scaled_jacobian.size() != mesh.hexes.size() ||
                 start->shortest_edge.size() != mesh.hexes.size()))
@@ -683,12 +682,11 @@ LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seed
     std::array<Index, 8> c{};
     for (int k = 0; k < 8; ++k) {
       Index& l = local[mesh.hexes[h][k]];
-      if (l == kInvalidIndex)
-        l = static_cast<Index>(global.size()), global.push_back(mesh.hexes[h][k]);
+      if (l == kInvalidIndex) l = index_cast(global.size()), global.push_back(mesh.hexes[h][k]);
       c[k] = l;
     }
     sub.hexes.push_back(c);
-    if (!mesh.block.empty()) sub.block.push_back(mesh.block[static_cast<std::size_t>(h)]);
+    if (!mesh.block.empty()) sub.block.push_back(mesh.block[index_cast<std::size_t>(h)]);
   }
   sub.points.reserve(global.size());
   for (Index g : global) sub.points.push_back(mesh.points[g]);
@@ -706,7 +704,7 @@ LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seed
   // it), and at a moving node both are in the region.
   std::vector<BoundaryQuad> boundary;
   for (const BoundaryQuad& q : boundary_quads(sub))
-    if (in_region[static_cast<std::size_t>(q.hex)]) boundary.push_back(q);
+    if (in_region[index_cast<std::size_t>(q.hex)]) boundary.push_back(q);
   const std::vector<BoundaryQuad> between = block_interface_quads(sub);
   boundary.insert(boundary.end(), between.begin(), between.end());
   auto constraints = boundary_slide_constraints(sub, boundary);
@@ -719,14 +717,14 @@ LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seed
   }
   for (std::size_t i = 0; i < outer.size(); ++i)
     if (std::binary_search(sorted.begin(), sorted.end(), outer[i]))
-      local_seeds.push_back(static_cast<Index>(i));
+      local_seeds.push_back(index_cast(i));
   for (std::size_t v = 0; v < constraints.size(); ++v)
     if (!moves[v]) constraints[v] = NodeConstraint::fixed();
   SmoothStart sub_start;
   if (start)
     for (Index h : outer) {
-      sub_start.scaled_jacobian.push_back(start->scaled_jacobian[static_cast<std::size_t>(h)]);
-      sub_start.shortest_edge.push_back(start->shortest_edge[static_cast<std::size_t>(h)]);
+      sub_start.scaled_jacobian.push_back(start->scaled_jacobian[index_cast<std::size_t>(h)]);
+      sub_start.shortest_edge.push_back(start->shortest_edge[index_cast<std::size_t>(h)]);
     }
   LocalSmoothOptions sub_options = options;
   auto restrict_to_outer = [&](std::vector<double>& per_hex) {
@@ -735,7 +733,7 @@ LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seed
       throw InvalidInput("smooth_hexes_around: the per-hex targets or goals are not one per hex");
     std::vector<double> sub_values;
     sub_values.reserve(outer.size());
-    for (Index h : outer) sub_values.push_back(per_hex[static_cast<std::size_t>(h)]);
+    for (Index h : outer) sub_values.push_back(per_hex[index_cast<std::size_t>(h)]);
     per_hex = std::move(sub_values);
   };
   restrict_to_outer(sub_options.hex_targets);
@@ -831,7 +829,7 @@ std::vector<Index> hexes_around(const HexMesh& mesh, std::span<const Index> hexe
   std::vector<Index> out;
   for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
     if (std::any_of(mesh.hexes[h].begin(), mesh.hexes[h].end(), [&](Index v) { return node[v]; }))
-      out.push_back(static_cast<Index>(h));
+      out.push_back(index_cast(h));
   return out;
 }
 

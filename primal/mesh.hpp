@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>  // cross products on Point
 #include <array>
 #include <cassert>
+#include <concepts>
 #include <cstdint>
 #include <type_traits>
 #include <utility>
@@ -23,9 +24,10 @@ inline constexpr Index kInvalidIndex = -1;
 
 // `value` as a `To` (Index by default, std::size_t for a container position); asserts that it
 // fits (std::in_range: no negative size, no number past Index's range).
-template <typename To = Index, typename From>
+// Integers only (std::integral): an enum or a real number is not an index, and a call with one
+// does not compile.
+template <std::integral To = Index, std::integral From>
 constexpr To index_cast(From value) noexcept {
-  static_assert(std::is_integral_v<To> && std::is_integral_v<From>, "index_cast converts integers");
   assert(std::in_range<To>(value) && "index out of range of its type");
   return static_cast<To>(value);
 }

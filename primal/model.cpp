@@ -42,8 +42,8 @@ std::size_t element_count(const Model& model) {
 }
 
 std::span<const Index> element_corners(const Model& model, ElementRef e) {
-  if (e.index < 0 || static_cast<std::size_t>(e.index) >= element_count(model, e.kind)) return {};
-  const auto i = static_cast<std::size_t>(e.index);
+  if (e.index < 0 || index_cast<std::size_t>(e.index) >= element_count(model, e.kind)) return {};
+  const auto i = index_cast<std::size_t>(e.index);
   switch (e.kind) {
     case ElementKind::kHex:
       return model.hexes[i];
@@ -98,9 +98,9 @@ std::vector<Index> element_face(const Model& model, const Side& side) {
   const auto& topo = cell_topology(side.element.kind);
   std::vector<Index> face;
   if (corners.empty() || side.face < 0 || side.face >= topo.faces) return face;
-  const auto& f = topo.face[static_cast<std::size_t>(side.face)];
+  const auto& f = topo.face[index_cast<std::size_t>(side.face)];
   for (int k = 0; k < f.size; ++k)
-    face.push_back(corners[static_cast<std::size_t>(f.corners[static_cast<std::size_t>(k)])]);
+    face.push_back(corners[index_cast<std::size_t>(f.corners[index_cast<std::size_t>(k)])]);
   return face;
 }
 
@@ -142,7 +142,7 @@ std::array<Index, 4> sorted_key(std::span<const Index> nodes) {
 std::size_t FaceOwners::Hash::operator()(const std::array<Index, 4>& k) const {
   std::size_t h = 0;
   for (Index v : k)
-    h = h * 0x9E3779B97F4A7C15ull + static_cast<std::size_t>(static_cast<std::uint32_t>(v));
+    h = h * 0x9E3779B97F4A7C15ull + index_cast<std::size_t>(static_cast<std::uint32_t>(v));
   return h ^ (h >> 29);
 }
 
@@ -150,16 +150,16 @@ FaceOwners::FaceOwners(const Model& model) {
   for (ElementKind kind : kElementKinds) {
     const auto& topo = cell_topology(kind);
     for (std::size_t e = 0; e < element_count(model, kind); ++e) {
-      const ElementRef ref{kind, static_cast<Index>(e)};
+      const ElementRef ref{kind, index_cast(e)};
       const auto corners = element_corners(model, ref);
       for (int f = 0; f < topo.faces; ++f) {
-        const auto& face = topo.face[static_cast<std::size_t>(f)];
+        const auto& face = topo.face[index_cast<std::size_t>(f)];
         std::array<Index, 4> nodes{};
         for (int k = 0; k < face.size; ++k)
-          nodes[static_cast<std::size_t>(k)] =
-              corners[static_cast<std::size_t>(face.corners[static_cast<std::size_t>(k)])];
+          nodes[index_cast<std::size_t>(k)] =
+              corners[index_cast<std::size_t>(face.corners[index_cast<std::size_t>(k)])];
         owner_.emplace(
-            sorted_key(std::span<const Index>(nodes.data(), static_cast<std::size_t>(face.size))),
+            sorted_key(std::span<const Index>(nodes.data(), index_cast<std::size_t>(face.size))),
             Side{ref, f});
       }
     }
@@ -174,17 +174,17 @@ const Side* FaceOwners::find(std::span<const Index> nodes) const {
 int block_of(const Model& model, ElementRef element) {
   const auto& blocks = element_blocks(model, element.kind);
   return blocks.empty() ? default_block(element.kind)
-                        : blocks[static_cast<std::size_t>(element.index)];
+                        : blocks[index_cast<std::size_t>(element.index)];
 }
 
 std::int64_t node_id(const Model& model, Index node) {
-  const auto n = static_cast<std::size_t>(node);
+  const auto n = index_cast<std::size_t>(node);
   return n < model.node_ids.size() ? model.node_ids[n] : std::int64_t{node} + 1;
 }
 
 std::int64_t element_id(const Model& model, ElementRef element) {
   const auto& ids = element_ids(model, element.kind);
-  const auto e = static_cast<std::size_t>(element.index);
+  const auto e = index_cast<std::size_t>(element.index);
   return e < ids.size() ? ids[e] : std::int64_t{element.index} + 1;
 }
 
@@ -200,8 +200,8 @@ std::string point_text(const Point& p) {
 
 std::string describe_node(const Model& model, Index node) {
   std::string s = "node " + std::to_string(node_id(model, node));
-  if (node >= 0 && static_cast<std::size_t>(node) < model.points.size())
-    s += " " + point_text(model.points[static_cast<std::size_t>(node)]);
+  if (node >= 0 && index_cast<std::size_t>(node) < model.points.size())
+    s += " " + point_text(model.points[index_cast<std::size_t>(node)]);
   return s;
 }
 
@@ -224,8 +224,8 @@ std::string describe_element(const Model& model, ElementRef element) {
   if (corners.empty()) return s;
   Point centre = Point::Zero();
   for (Index v : corners) {
-    if (v < 0 || static_cast<std::size_t>(v) >= model.points.size()) return s;
-    centre += model.points[static_cast<std::size_t>(v)];
+    if (v < 0 || index_cast<std::size_t>(v) >= model.points.size()) return s;
+    centre += model.points[index_cast<std::size_t>(v)];
   }
   return s + " (centre " + point_text(centre / static_cast<double>(corners.size())) + ")";
 }
@@ -233,17 +233,16 @@ std::string describe_element(const Model& model, ElementRef element) {
 namespace {
 
 void check_elements(const Model& model, ElementKind kind, std::string_view source) {
-  const auto num_points = static_cast<Index>(model.points.size());
+  const auto num_points = index_cast(model.points.size());
   for (std::size_t e = 0; e < element_count(model, kind); ++e) {
-    const auto corners = element_corners(model, {kind, static_cast<Index>(e)});
+    const auto corners = element_corners(model, {kind, index_cast(e)});
     for (std::size_t c = 0; c < corners.size(); ++c) {
       const Index n = corners[c];
       if (n < 0 || n >= num_points)
         throw InvalidInput(std::string(source) + ": " + kind_name(kind) + " " +
-                           std::to_string(element_id(model, {kind, static_cast<Index>(e)})) +
-                           ": corner " + std::to_string(c + 1) + " refers to node index " +
-                           std::to_string(n) + ", out of range [0, " + std::to_string(num_points) +
-                           ")");
+                           std::to_string(element_id(model, {kind, index_cast(e)})) + ": corner " +
+                           std::to_string(c + 1) + " refers to node index " + std::to_string(n) +
+                           ", out of range [0, " + std::to_string(num_points) + ")");
     }
   }
 }
@@ -258,8 +257,8 @@ void check_blocks(const Model& model, ElementKind kind, std::string_view source)
   for (std::size_t e = 0; e < blocks.size(); ++e)
     if (blocks[e] <= 0)
       throw InvalidInput(std::string(source) + ": " + kind_name(kind) + " " +
-                         std::to_string(element_id(model, {kind, static_cast<Index>(e)})) +
-                         ": block id " + std::to_string(blocks[e]) + " is not positive");
+                         std::to_string(element_id(model, {kind, index_cast(e)})) + ": block id " +
+                         std::to_string(blocks[e]) + " is not positive");
 }
 
 void check_ids(const std::vector<std::int64_t>& ids, std::size_t count, std::string_view source,
@@ -273,7 +272,7 @@ void check_ids(const std::vector<std::int64_t>& ids, std::size_t count, std::str
 }  // namespace
 
 void validate(const Model& model, std::string_view source) {
-  const auto num_points = static_cast<Index>(model.points.size());
+  const auto num_points = index_cast(model.points.size());
   check_ids(model.node_ids, model.points.size(), source, "node");
   for (ElementKind kind : kElementKinds) {
     check_ids(element_ids(model, kind), element_count(model, kind), source, kind_name(kind));
@@ -311,7 +310,7 @@ void validate(const Model& model, std::string_view source) {
       const Side& s = set.sides[i];
       const std::size_t count = element_count(model, s.element.kind);
       const int faces = cell_topology(s.element.kind).faces;
-      if (s.element.index < 0 || static_cast<std::size_t>(s.element.index) >= count)
+      if (s.element.index < 0 || index_cast<std::size_t>(s.element.index) >= count)
         throw InvalidInput(where + ": entry " + std::to_string(i + 1) + " refers to " +
                            kind_name(s.element.kind) + " index " + std::to_string(s.element.index) +
                            ", out of range");
@@ -327,19 +326,19 @@ void validate(const Model& model, std::string_view source) {
 void check_points(const Model& model, std::string_view source) {
   for (std::size_t n = 0; n < model.points.size(); ++n)
     if (!model.points[n].allFinite())
-      throw InvalidInput(std::string(source) + ": " + describe_node(model, static_cast<Index>(n)) +
+      throw InvalidInput(std::string(source) + ": " + describe_node(model, index_cast(n)) +
                          " has a non-finite coordinate");
 }
 
 void check_geometry(const Model& model, std::string_view source) {
   const std::string where(source);
   check_points(model, source);
-  auto pt = [&](Index v) -> const Point& { return model.points[static_cast<std::size_t>(v)]; };
+  auto pt = [&](Index v) -> const Point& { return model.points[index_cast<std::size_t>(v)]; };
   for (std::size_t t = 0; t < model.tets.size(); ++t) {
     const auto& c = model.tets[t];
     const double volume = tet_volume(pt(c[0]), pt(c[1]), pt(c[2]), pt(c[3]));
     if (!(volume > 0.0)) {
-      const ElementRef e{ElementKind::kTet, static_cast<Index>(t)};
+      const ElementRef e{ElementKind::kTet, index_cast(t)};
       throw InvalidInput(where + ": " + describe_element(model, e) + " is " +
                          (volume < 0.0 ? "inverted" : "flat") + " (signed volume " +
                          number_text(volume) + "; nodes " + node_list(model, c) + ")");
@@ -351,7 +350,7 @@ void check_geometry(const Model& model, std::string_view source) {
     const auto jacobians = hex_jacobians(corners);
     for (std::size_t c = 0; c < 8; ++c)
       if (!(jacobians[c] > 0.0)) {
-        const ElementRef e{ElementKind::kHex, static_cast<Index>(h)};
+        const ElementRef e{ElementKind::kHex, index_cast(h)};
         throw InvalidInput(where + ": " + describe_element(model, e) + " is " +
                            (jacobians[c] < 0.0 ? "inverted" : "flat") + " at its corner " +
                            describe_node(model, model.hexes[h][c]) + " (corner Jacobian " +
@@ -366,11 +365,11 @@ void check_geometry(const Model& model, std::string_view source) {
     for (std::size_t k = 0; k < 6; ++k) {
       const auto& n = topology::kWedgeCornerNeighbors[k];
       const double j =
-          tet_volume(pt(c[k]), pt(c[static_cast<std::size_t>(n[0])]),
-                     pt(c[static_cast<std::size_t>(n[1])]), pt(c[static_cast<std::size_t>(n[2])])) *
+          tet_volume(pt(c[k]), pt(c[index_cast<std::size_t>(n[0])]),
+                     pt(c[index_cast<std::size_t>(n[1])]), pt(c[index_cast<std::size_t>(n[2])])) *
           6.0;
       if (!(j > 0.0)) {
-        const ElementRef e{ElementKind::kWedge, static_cast<Index>(w)};
+        const ElementRef e{ElementKind::kWedge, index_cast(w)};
         throw InvalidInput(where + ": " + describe_element(model, e) + " is " +
                            (j < 0.0 ? "inverted" : "flat") + " at its corner " +
                            describe_node(model, c[k]) + " (corner Jacobian " + number_text(j) +
@@ -388,8 +387,8 @@ void check_geometry(const Model& model, std::string_view source) {
     const bool d02 = corner[1] > 0.0 && corner[3] > 0.0, d13 = corner[0] > 0.0 && corner[2] > 0.0;
     if (!d02 && !d13) {
       const auto worst =
-          static_cast<std::size_t>(std::min_element(corner.begin(), corner.end()) - corner.begin());
-      const ElementRef e{ElementKind::kPyramid, static_cast<Index>(p)};
+          index_cast<std::size_t>(std::min_element(corner.begin(), corner.end()) - corner.begin());
+      const ElementRef e{ElementKind::kPyramid, index_cast(p)};
       throw InvalidInput(where + ": " + describe_element(model, e) + " is " +
                          (corner[worst] < 0.0 ? "inverted" : "flat") + " at its base corner " +
                          describe_node(model, c[worst]) + " (signed volume " +
@@ -406,7 +405,7 @@ HexMesh hex_part(const Model& model) {
   mesh.hexes = model.hexes;
   mesh.block.resize(model.hexes.size());
   for (std::size_t h = 0; h < model.hexes.size(); ++h)
-    mesh.block[h] = block_of(model, {ElementKind::kHex, static_cast<Index>(h)});
+    mesh.block[h] = block_of(model, {ElementKind::kHex, index_cast(h)});
   return mesh;
 }
 
@@ -416,7 +415,7 @@ TetMesh tet_part(const Model& model) {
   mesh.tets = model.tets;
   mesh.block.resize(model.tets.size());
   for (std::size_t t = 0; t < model.tets.size(); ++t)
-    mesh.block[t] = block_of(model, {ElementKind::kTet, static_cast<Index>(t)});
+    mesh.block[t] = block_of(model, {ElementKind::kTet, index_cast(t)});
   return mesh;
 }
 
@@ -446,9 +445,9 @@ Index merge_coincident_nodes(Model& model, double tolerance) {
   struct KeyHash {
     std::size_t operator()(const Key& k) const {
       // Unsigned arithmetic: wraps instead of overflowing.
-      return static_cast<std::size_t>(static_cast<unsigned long long>(k.x) * 73856093ull ^
-                                      static_cast<unsigned long long>(k.y) * 19349663ull ^
-                                      static_cast<unsigned long long>(k.z) * 83492791ull);
+      return index_cast<std::size_t>(static_cast<unsigned long long>(k.x) * 73856093ull ^
+                                     static_cast<unsigned long long>(k.y) * 19349663ull ^
+                                     static_cast<unsigned long long>(k.z) * 83492791ull);
     }
   };
   auto key_of = [&](const Point& p) {
@@ -468,7 +467,7 @@ Index merge_coincident_nodes(Model& model, double tolerance) {
           auto it = grid.find(Key{k.x + dx, k.y + dy, k.z + dz});
           if (it == grid.end()) continue;
           for (Index j : it->second)
-            if ((model.points[static_cast<std::size_t>(j)] - p).norm() <= tolerance) {
+            if ((model.points[index_cast<std::size_t>(j)] - p).norm() <= tolerance) {
               found = j;
               break;
             }
@@ -476,20 +475,20 @@ Index merge_coincident_nodes(Model& model, double tolerance) {
     if (found >= 0) {
       representative[i] = found;
     } else {
-      representative[i] = static_cast<Index>(i);
-      grid[k].push_back(static_cast<Index>(i));
+      representative[i] = index_cast(i);
+      grid[k].push_back(index_cast(i));
     }
   }
   // Compact: new number of each kept point.
   std::vector<Index> new_index(n, kInvalidIndex);
   std::vector<Point> points;
   for (std::size_t i = 0; i < n; ++i)
-    if (representative[i] == static_cast<Index>(i)) {
-      new_index[i] = static_cast<Index>(points.size());
+    if (representative[i] == index_cast(i)) {
+      new_index[i] = index_cast(points.size());
       points.push_back(model.points[i]);
     }
   auto map = [&](Index v) {
-    return new_index[static_cast<std::size_t>(representative[static_cast<std::size_t>(v)])];
+    return new_index[index_cast<std::size_t>(representative[index_cast<std::size_t>(v)])];
   };
   for (auto& h : model.hexes)
     for (Index& v : h) v = map(v);
@@ -512,10 +511,10 @@ Index merge_coincident_nodes(Model& model, double tolerance) {
   if (!model.node_ids.empty()) {
     std::vector<std::int64_t> ids;
     for (std::size_t i = 0; i < n; ++i)
-      if (representative[i] == static_cast<Index>(i)) ids.push_back(model.node_ids[i]);
+      if (representative[i] == index_cast(i)) ids.push_back(model.node_ids[i]);
     model.node_ids = std::move(ids);
   }
-  const auto removed = static_cast<Index>(n - points.size());
+  const auto removed = index_cast(n - points.size());
   model.points = std::move(points);
   return removed;
 }

@@ -17,7 +17,7 @@ namespace geode::primal {
 inline double multilinear_shape(int c, const Point& r, int dim) {
   double w = 1.0;
   for (int a = 0; a < dim; ++a)
-    w *= topology::kHexCornerCoords[static_cast<std::size_t>(c)][static_cast<std::size_t>(a)]
+    w *= topology::kHexCornerCoords[index_cast<std::size_t>(c)][index_cast<std::size_t>(a)]
              ? r[a]
              : 1.0 - r[a];
   return w;
@@ -28,7 +28,7 @@ template <class Corners>
 Point multilinear_point(const Corners& corners, const Point& r, int dim) {
   Point x = Point::Zero();
   for (int c = 0; c < (1 << dim); ++c)
-    x += multilinear_shape(c, r, dim) * corners[static_cast<std::size_t>(c)];
+    x += multilinear_shape(c, r, dim) * corners[index_cast<std::size_t>(c)];
   return x;
 }
 
@@ -37,12 +37,12 @@ template <class Corners>
 Eigen::Matrix3d multilinear_jacobian(const Corners& corners, const Point& r, int dim) {
   Eigen::Matrix3d J = Eigen::Matrix3d::Zero();
   for (int c = 0; c < (1 << dim); ++c) {
-    const auto& rc = topology::kHexCornerCoords[static_cast<std::size_t>(c)];
+    const auto& rc = topology::kHexCornerCoords[index_cast<std::size_t>(c)];
     for (int d = 0; d < dim; ++d) {
-      double w = rc[static_cast<std::size_t>(d)] ? 1.0 : -1.0;
+      double w = rc[index_cast<std::size_t>(d)] ? 1.0 : -1.0;
       for (int a = 0; a < dim; ++a)
-        if (a != d) w *= rc[static_cast<std::size_t>(a)] ? r[a] : 1.0 - r[a];
-      J.col(d) += w * corners[static_cast<std::size_t>(c)];
+        if (a != d) w *= rc[index_cast<std::size_t>(a)] ? r[a] : 1.0 - r[a];
+      J.col(d) += w * corners[index_cast<std::size_t>(c)];
     }
   }
   return J;

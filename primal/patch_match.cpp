@@ -3,6 +3,8 @@
 #include <unordered_set>
 #include <vector>
 
+#include <geode/primal/mesh.hpp>
+
 namespace geode::primal {
 namespace {
 
@@ -72,12 +74,12 @@ PatchMatch match_quad_patches(std::span<const std::array<int, 4>> qa,
         }
       }
       if (candidates != 1) continue;  // none yet or ambiguous: wait for more matches
-      const auto& p = qb[static_cast<std::size_t>(found)];
+      const auto& p = qb[index_cast<std::size_t>(found)];
       for (int k = 0; k < 4; ++k) {
         const int a = q[(found_e + k) % 4], b = p[(found_s + k * found_dir) % 4];
         m[a] = b, inv[b] = a;
       }
-      done_a[i] = done_b[static_cast<std::size_t>(found)] = true;
+      done_a[i] = done_b[index_cast<std::size_t>(found)] = true;
       progress = true;
     }
   }

@@ -376,14 +376,14 @@ const HexMetricInfo& hex_metric_info(std::string_view key_or_name) {
 }
 
 HexCorners hex_corners(const HexMesh& mesh, Index h) {
-  if (h < 0 || static_cast<std::size_t>(h) >= mesh.hexes.size()) {
+  if (h < 0 || index_cast<std::size_t>(h) >= mesh.hexes.size()) {
     throw InvalidInput("hex_corners: hex " + std::to_string(h) + " out of range (mesh has " +
                        std::to_string(mesh.hexes.size()) + " hexes)");
   }
   HexCorners p;
   for (int c = 0; c < 8; ++c) {
     const Index n = mesh.hexes[h][c];
-    if (n < 0 || static_cast<std::size_t>(n) >= mesh.points.size()) {
+    if (n < 0 || index_cast<std::size_t>(n) >= mesh.points.size()) {
       throw InvalidInput("hex_corners: hex " + std::to_string(h) + " corner " + std::to_string(c) +
                          " names node " + std::to_string(n) + ", out of range (mesh has " +
                          std::to_string(mesh.points.size()) + " nodes)");
@@ -399,7 +399,7 @@ std::vector<double> scaled_jacobian_per_hex(const HexMesh& mesh) {
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sj.size(), 4096),
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t h = r.begin(); h != r.end(); ++h)
-                        sj[h] = hex_scaled_jacobian(hex_corners(mesh, static_cast<Index>(h)));
+                        sj[h] = hex_scaled_jacobian(hex_corners(mesh, index_cast(h)));
                     });
   return sj;
 }
@@ -414,7 +414,7 @@ std::vector<double> shortest_edge_per_hex(const HexMesh& mesh) {
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, e.size(), 4096),
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t h = r.begin(); h != r.end(); ++h)
-                        e[h] = hex_shortest_edge(hex_corners(mesh, static_cast<Index>(h)));
+                        e[h] = hex_shortest_edge(hex_corners(mesh, index_cast(h)));
                     });
   return e;
 }
@@ -424,20 +424,20 @@ double min_scaled_jacobian(const HexMesh& mesh, std::vector<Index>* inverted) {
   double mn = 1.0;
   for (std::size_t h = 0; h < sj.size(); ++h) {
     mn = std::min(mn, sj[h]);
-    if (inverted && sj[h] <= 0) inverted->push_back(static_cast<Index>(h));
+    if (inverted && sj[h] <= 0) inverted->push_back(index_cast(h));
   }
   return mn;
 }
 
 QuadCorners quad_corners(const QuadMesh& mesh, Index q) {
-  if (q < 0 || static_cast<std::size_t>(q) >= mesh.quads.size()) {
+  if (q < 0 || index_cast<std::size_t>(q) >= mesh.quads.size()) {
     throw InvalidInput("quad_corners: quad " + std::to_string(q) + " out of range (mesh has " +
                        std::to_string(mesh.quads.size()) + " quads)");
   }
   QuadCorners p;
   for (int c = 0; c < 4; ++c) {
     const Index n = mesh.quads[q][c];
-    if (n < 0 || static_cast<std::size_t>(n) >= mesh.points.size()) {
+    if (n < 0 || index_cast<std::size_t>(n) >= mesh.points.size()) {
       throw InvalidInput("quad_corners: quad " + std::to_string(q) + " corner " +
                          std::to_string(c) + " names node " + std::to_string(n) +
                          ", out of range (mesh has " + std::to_string(mesh.points.size()) +

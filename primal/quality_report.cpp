@@ -37,8 +37,8 @@ MetricSummary summarize_metric(HexMetric metric, std::span<const double> q,
   const auto hi = std::max_element(q.begin(), q.end());
   s.minimum = *lo;
   s.maximum = *hi;
-  s.min_hex = hexes[static_cast<std::size_t>(lo - q.begin())];
-  s.max_hex = hexes[static_cast<std::size_t>(hi - q.begin())];
+  s.min_hex = hexes[index_cast<std::size_t>(lo - q.begin())];
+  s.max_hex = hexes[index_cast<std::size_t>(hi - q.begin())];
   s.average = std::accumulate(q.begin(), q.end(), 0.0) / n;
   double ss = 0.0;  // two-pass: no cancellation for large, nearly equal values (volumes)
   for (double v : q) ss += (v - s.average) * (v - s.average);
@@ -69,7 +69,7 @@ QualityReport hex_quality_report(const HexMesh& mesh, std::span<const Index> hex
   for (Index h : hexes) hex_corners(mesh, h);
 
   QualityReport report;
-  report.num_hexes = static_cast<Index>(hexes.size());
+  report.num_hexes = index_cast(hexes.size());
   report.std_dev_kind = kind;
   std::vector<double> q(hexes.size());
   for (HexMetric id : chosen) {
@@ -80,9 +80,9 @@ QualityReport hex_quality_report(const HexMesh& mesh, std::span<const Index> hex
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         for (std::size_t i = r.begin(); i != r.end(); ++i) {
                           HexCorners c;
-                          const auto& hex = mesh.hexes[static_cast<std::size_t>(hexes[i])];
+                          const auto& hex = mesh.hexes[index_cast<std::size_t>(hexes[i])];
                           for (int k = 0; k < 8; ++k)
-                            c[k] = mesh.points[static_cast<std::size_t>(hex[k])];
+                            c[k] = mesh.points[index_cast<std::size_t>(hex[k])];
                           q[i] = info.evaluate(c);
                         }
                       });

@@ -51,7 +51,7 @@ template <std::size_t N>
 void check_range(const std::array<Index, N>& cell, std::size_t nodes, const char* what,
                  std::size_t id) {
   for (Index v : cell)
-    if (v < 0 || static_cast<std::size_t>(v) >= nodes)
+    if (v < 0 || index_cast<std::size_t>(v) >= nodes)
       throw InvalidInput(std::string(what) + " " + std::to_string(id) + ": node " +
                          std::to_string(v) + " out of range [0, " + std::to_string(nodes) + ")");
 }
@@ -78,7 +78,7 @@ std::vector<Index> grow_patches(std::size_t n,
   std::vector<Index> patch(n, kNoPatch);
   Index next = 0;
   for (std::size_t s = 0; s < n; ++s) {
-    const auto seed = static_cast<Index>(s);
+    const auto seed = index_cast(s);
     if (patch[s] != kNoPatch || !flat(seed)) continue;
     patch[s] = next;
     std::deque<Index> queue{seed};
@@ -86,7 +86,7 @@ std::vector<Index> grow_patches(std::size_t n,
       const Index e = queue.front();
       queue.pop_front();
       for (Index o : neighbours(e)) {
-        auto& p = patch[static_cast<std::size_t>(o)];
+        auto& p = patch[index_cast<std::size_t>(o)];
         if (p != kNoPatch || !flat(o) || !fits(seed, o)) continue;
         p = next;
         queue.push_back(o);
@@ -113,7 +113,7 @@ std::vector<std::vector<Index>> node_patches_from_bits(const std::vector<unsigne
   std::vector<std::vector<Index>> out(bits.size());
   for (std::size_t v = 0; v < bits.size(); ++v)
     for (unsigned f = 0; f < 32; ++f)
-      if ((bits[v] >> f) & 1u) out[v].push_back(static_cast<Index>(f));
+      if ((bits[v] >> f) & 1u) out[v].push_back(index_cast(f));
   return out;
 }
 
@@ -121,9 +121,9 @@ std::vector<std::vector<Index>> node_patches_from_bits(const std::vector<unsigne
 template <std::size_t N>
 Index patch_from_bits(const std::vector<unsigned>& bits, const std::array<Index, N>& nodes) {
   unsigned common = ~0u;
-  for (Index v : nodes) common &= bits[static_cast<std::size_t>(v)];
+  for (Index v : nodes) common &= bits[index_cast<std::size_t>(v)];
   for (unsigned f = 0; f < 32; ++f)
-    if ((common >> f) & 1u) return static_cast<Index>(f);
+    if ((common >> f) & 1u) return index_cast(f);
   return kNoPatch;
 }
 
@@ -147,7 +147,7 @@ std::vector<SharedCorner> shared_corners(
       const std::array<Index, 3> key{v, std::min(a, b), std::max(a, b)};
       auto& list = by_corner[key];
       if (list.empty()) order.push_back(key);
-      list.push_back(static_cast<Index>(i));
+      list.push_back(index_cast(i));
     }
   }
   std::vector<SharedCorner> out;
@@ -197,16 +197,15 @@ class HexFinder {
       for (int f = 0; f < topo::kHexFaces; ++f) {
         std::array<Index, 4> q{};
         for (int i = 0; i < 4; ++i)
-          q[static_cast<std::size_t>(i)] = hex[static_cast<std::size_t>(
-              topo::kHexFaceCorners[static_cast<std::size_t>(f)][static_cast<std::size_t>(i)])];
-        const auto [it, inserted] =
-            face_id.try_emplace(face_key(q), static_cast<Index>(faces_.size()));
+          q[index_cast<std::size_t>(i)] = hex[index_cast<std::size_t>(
+              topo::kHexFaceCorners[index_cast<std::size_t>(f)][index_cast<std::size_t>(i)])];
+        const auto [it, inserted] = face_id.try_emplace(face_key(q), index_cast(faces_.size()));
         if (inserted) faces_.push_back(Face{q, {}});
-        faces_[static_cast<std::size_t>(it->second)].uses.emplace_back(static_cast<Index>(h), f);
+        faces_[index_cast<std::size_t>(it->second)].uses.emplace_back(index_cast(h), f);
       }
     }
     for (std::size_t f = 0; f < faces_.size(); ++f)
-      if (faces_[f].uses.size() == 1) boundary_.push_back(static_cast<Index>(f));
+      if (faces_[f].uses.size() == 1) boundary_.push_back(index_cast(f));
   }
 
   // Patch of each boundary quad (index into boundary_) and the patches at each node.
@@ -216,7 +215,7 @@ class HexFinder {
     boundary_quads_at_.assign(mesh_.points.size(), {});
     for (std::size_t b = 0; b < nb; ++b)
       for (Index v : face(b).nodes)
-        boundary_quads_at_[static_cast<std::size_t>(v)].push_back(static_cast<Index>(b));
+        boundary_quads_at_[index_cast<std::size_t>(v)].push_back(index_cast(b));
     if (!options_.node_faces.empty()) {
       quad_patch_.resize(nb);
       for (std::size_t b = 0; b < nb; ++b)
@@ -228,7 +227,7 @@ class HexFinder {
     const double cos_tol = std::cos(options_.planar_angle_degrees * M_PI / 180.0);
     std::vector<Point> normal(nb), centre(nb);
     std::vector<char> flat(nb, 0);
-    auto pt = [&](Index v) -> const Point& { return mesh_.points[static_cast<std::size_t>(v)]; };
+    auto pt = [&](Index v) -> const Point& { return mesh_.points[index_cast<std::size_t>(v)]; };
     auto off_plane = [&](std::size_t plane, std::size_t quad) {
       double d = 0.0;
       for (Index v : face(quad).nodes)
@@ -248,29 +247,29 @@ class HexFinder {
     for (std::size_t b = 0; b < nb; ++b) {
       const auto& q = face(b).nodes;
       for (int i = 0; i < 4; ++i)
-        by_edge[edge_key(q[static_cast<std::size_t>(i)], q[static_cast<std::size_t>((i + 1) % 4)])]
-            .push_back(static_cast<Index>(b));
+        by_edge[edge_key(q[index_cast<std::size_t>(i)], q[index_cast<std::size_t>((i + 1) % 4)])]
+            .push_back(index_cast(b));
     }
     quad_patch_ = grow_patches(
         nb,
         [&](Index b) {
           std::vector<Index> out;
-          const auto& q = face(static_cast<std::size_t>(b)).nodes;
+          const auto& q = face(index_cast<std::size_t>(b)).nodes;
           for (int i = 0; i < 4; ++i)
-            for (Index o : by_edge.at(edge_key(q[static_cast<std::size_t>(i)],
-                                               q[static_cast<std::size_t>((i + 1) % 4)])))
+            for (Index o : by_edge.at(edge_key(q[index_cast<std::size_t>(i)],
+                                               q[index_cast<std::size_t>((i + 1) % 4)])))
               if (o != b) out.push_back(o);
           return out;
         },
-        [&](Index b) { return flat[static_cast<std::size_t>(b)] != 0; },
+        [&](Index b) { return flat[index_cast<std::size_t>(b)] != 0; },
         [&](Index s, Index b) {
-          const auto su = static_cast<std::size_t>(s), bu = static_cast<std::size_t>(b);
+          const auto su = index_cast<std::size_t>(s), bu = index_cast<std::size_t>(b);
           return normal[su].dot(normal[bu]) >= cos_tol && off_plane(su, bu) <= tol;
         });
     for (std::size_t b = 0; b < nb; ++b)
       if (quad_patch_[b] != kNoPatch)
         for (Index v : face(b).nodes)
-          node_patches_[static_cast<std::size_t>(v)].push_back(quad_patch_[b]);
+          node_patches_[index_cast<std::size_t>(v)].push_back(quad_patch_[b]);
     for (auto& p : node_patches_) sort_unique(p);
   }
 
@@ -283,18 +282,18 @@ class HexFinder {
       if (has_repeated(hex)) continue;
       for (const auto& e : topo::kHexEdgeCorners) {
         const EdgeKey k =
-            edge_key(hex[static_cast<std::size_t>(e[0])], hex[static_cast<std::size_t>(e[1])]);
+            edge_key(hex[index_cast<std::size_t>(e[0])], hex[index_cast<std::size_t>(e[1])]);
         auto [it, inserted] = edge_hexes.try_emplace(k);
         if (inserted) order.push_back(k);
-        it->second.push_back(static_cast<Index>(h));
+        it->second.push_back(index_cast(h));
       }
     }
     std::unordered_map<EdgeKey, bool, IndexArrayHash> on_boundary;
     for (Index f : boundary_) {
-      const auto& q = faces_[static_cast<std::size_t>(f)].nodes;
+      const auto& q = faces_[index_cast<std::size_t>(f)].nodes;
       for (int i = 0; i < 4; ++i)
-        on_boundary[edge_key(q[static_cast<std::size_t>(i)],
-                             q[static_cast<std::size_t>((i + 1) % 4)])] = true;
+        on_boundary[edge_key(q[index_cast<std::size_t>(i)],
+                             q[index_cast<std::size_t>((i + 1) % 4)])] = true;
     }
     std::map<std::vector<Index>, std::size_t> by_hexes;
     for (const auto& k : order) {
@@ -316,7 +315,7 @@ class HexFinder {
          shared_corners(faces_.size(), [&](std::size_t f) { return &faces_[f].nodes; })) {
       std::vector<Index> hexes;
       for (Index f : faces)
-        for (const auto& [h, lf] : faces_[static_cast<std::size_t>(f)].uses) hexes.push_back(h);
+        for (const auto& [h, lf] : faces_[index_cast<std::size_t>(f)].uses) hexes.push_back(h);
       sort_unique(hexes);
       if (explained_by_doublet(corner[0], hexes)) continue;
       pinched_.push_back(
@@ -350,15 +349,15 @@ class HexFinder {
         if (local.size() < 2) continue;
         Obstruction o{ObstructionKind::kTwoFacesOnBoundaryFace, {h}, {}};
         for (int lf : local)
-          for (int c : topo::kHexFaceCorners[static_cast<std::size_t>(lf)])
-            o.nodes.push_back(hex(h)[static_cast<std::size_t>(c)]);
+          for (int c : topo::kHexFaceCorners[index_cast<std::size_t>(lf)])
+            o.nodes.push_back(hex(h)[index_cast<std::size_t>(c)]);
         sort_unique(o.nodes);
         two_faces_.push_back(o);
         // Corners on two of these faces: already explained, not repeated as flat corners.
         for (int c = 0; c < topo::kHexCorners; ++c) {
           int on = 0;
           for (int lf : local) {
-            const auto& fc = topo::kHexFaceCorners[static_cast<std::size_t>(lf)];
+            const auto& fc = topo::kHexFaceCorners[index_cast<std::size_t>(lf)];
             on += std::find(fc.begin(), fc.end(), c) != fc.end();
           }
           if (on >= 2) explained_corners_.insert({h, c});
@@ -373,20 +372,20 @@ class HexFinder {
       const auto& hx = mesh_.hexes[h];
       if (has_repeated(hx)) continue;
       for (int c = 0; c < topo::kHexCorners; ++c) {
-        if (explained_corners_.count({static_cast<Index>(h), c})) continue;
-        const Index v = hx[static_cast<std::size_t>(c)];
-        const auto& nb = topo::kHexCornerNeighbors[static_cast<std::size_t>(c)];
+        if (explained_corners_.count({index_cast(h), c})) continue;
+        const Index v = hx[index_cast<std::size_t>(c)];
+        const auto& nb = topo::kHexCornerNeighbors[index_cast<std::size_t>(c)];
         const bool flat = std::any_of(patches(v).begin(), patches(v).end(), [&](Index p) {
           return std::all_of(nb.begin(), nb.end(), [&](int n) {
-            return contains(patches(hx[static_cast<std::size_t>(n)]), p);
+            return contains(patches(hx[index_cast<std::size_t>(n)]), p);
           });
         });
         if (!flat) continue;
-        flat_.push_back(Obstruction{
-            ObstructionKind::kFlatCorner,
-            {static_cast<Index>(h)},
-            {v, hx[static_cast<std::size_t>(nb[0])], hx[static_cast<std::size_t>(nb[1])],
-             hx[static_cast<std::size_t>(nb[2])]}});
+        flat_.push_back(
+            Obstruction{ObstructionKind::kFlatCorner,
+                        {index_cast(h)},
+                        {v, hx[index_cast<std::size_t>(nb[0])], hx[index_cast<std::size_t>(nb[1])],
+                         hx[index_cast<std::size_t>(nb[2])]}});
       }
     }
   }
@@ -398,24 +397,22 @@ class HexFinder {
       if (quads.empty() || node_patches_[v].size() != 1) continue;
       const Index p = node_patches_[v].front();
       if (!std::all_of(quads.begin(), quads.end(),
-                       [&](Index b) { return quad_patch_[static_cast<std::size_t>(b)] == p; }))
+                       [&](Index b) { return quad_patch_[index_cast<std::size_t>(b)] == p; }))
         continue;
       if (quads.size() >= 3) continue;
-      Obstruction o{ObstructionKind::kTwoQuadBoundaryNode, {}, {static_cast<Index>(v)}};
-      for (Index b : quads) o.hexes.push_back(face(static_cast<std::size_t>(b)).uses.front().first);
+      Obstruction o{ObstructionKind::kTwoQuadBoundaryNode, {}, {index_cast(v)}};
+      for (Index b : quads) o.hexes.push_back(face(index_cast<std::size_t>(b)).uses.front().first);
       sort_unique(o.hexes);
       two_quad_.push_back(o);
     }
   }
 
   const Face& face(std::size_t boundary_index) const {
-    return faces_[static_cast<std::size_t>(boundary_[boundary_index])];
+    return faces_[index_cast<std::size_t>(boundary_[boundary_index])];
   }
-  const std::array<Index, 8>& hex(Index h) const {
-    return mesh_.hexes[static_cast<std::size_t>(h)];
-  }
+  const std::array<Index, 8>& hex(Index h) const { return mesh_.hexes[index_cast<std::size_t>(h)]; }
   const std::vector<Index>& patches(Index v) const {
-    return node_patches_[static_cast<std::size_t>(v)];
+    return node_patches_[index_cast<std::size_t>(v)];
   }
 
   const HexMesh& mesh_;
@@ -458,10 +455,10 @@ class QuadFinder {
       check_range(mesh_.quads[q], nv, "quad", q);
       if (has_repeated(mesh_.quads[q])) continue;
       for (int e = 0; e < 4; ++e) {
-        const auto k = key(static_cast<Index>(q), e);
+        const auto k = key(index_cast(q), e);
         auto [it, inserted] = uses.try_emplace(k);
         if (inserted) order.push_back(k);
-        it->second.emplace_back(static_cast<Index>(q), e);
+        it->second.emplace_back(index_cast(q), e);
       }
     }
     for (const auto& k : order)
@@ -469,8 +466,8 @@ class QuadFinder {
   }
 
   EdgeKey key(Index q, int e) const {
-    const auto& quad = mesh_.quads[static_cast<std::size_t>(q)];
-    return edge_key(quad[static_cast<std::size_t>(e)], quad[static_cast<std::size_t>((e + 1) % 4)]);
+    const auto& quad = mesh_.quads[index_cast<std::size_t>(q)];
+    return edge_key(quad[index_cast<std::size_t>(e)], quad[index_cast<std::size_t>((e + 1) % 4)]);
   }
 
   void find_sides() {
@@ -488,7 +485,7 @@ class QuadFinder {
     const double tol = options_.planar_distance * bbox_diagonal(mesh_.points);
     const double cos_tol = std::cos(options_.planar_angle_degrees * M_PI / 180.0);
     auto ends = [&](std::size_t b) { return key(boundary_[b].first, boundary_[b].second); };
-    auto pt = [&](Index v) -> const Point& { return mesh_.points[static_cast<std::size_t>(v)]; };
+    auto pt = [&](Index v) -> const Point& { return mesh_.points[index_cast<std::size_t>(v)]; };
     std::vector<Point> dir(nb);
     std::vector<char> flat(nb, 0);
     for (std::size_t b = 0; b < nb; ++b) {
@@ -509,24 +506,24 @@ class QuadFinder {
     };
     std::unordered_map<Index, std::vector<Index>> at_node;
     for (std::size_t b = 0; b < nb; ++b)
-      for (Index v : ends(b)) at_node[v].push_back(static_cast<Index>(b));
+      for (Index v : ends(b)) at_node[v].push_back(index_cast(b));
     side_ = grow_patches(
         nb,
         [&](Index b) {
           std::vector<Index> out;
-          for (Index v : ends(static_cast<std::size_t>(b)))
+          for (Index v : ends(index_cast<std::size_t>(b)))
             for (Index o : at_node.at(v))
               if (o != b) out.push_back(o);
           return out;
         },
-        [&](Index b) { return flat[static_cast<std::size_t>(b)] != 0; },
+        [&](Index b) { return flat[index_cast<std::size_t>(b)] != 0; },
         [&](Index s, Index b) {
-          const auto su = static_cast<std::size_t>(s), bu = static_cast<std::size_t>(b);
+          const auto su = index_cast<std::size_t>(s), bu = index_cast<std::size_t>(b);
           return std::abs(dir[su].dot(dir[bu])) >= cos_tol && off_line(su, bu) <= tol;
         });
     for (std::size_t b = 0; b < nb; ++b)
       if (side_[b] != kNoPatch)
-        for (Index v : ends(b)) node_sides_[static_cast<std::size_t>(v)].push_back(side_[b]);
+        for (Index v : ends(b)) node_sides_[index_cast<std::size_t>(v)].push_back(side_[b]);
     for (auto& s : node_sides_) sort_unique(s);
   }
 
@@ -555,8 +552,7 @@ class QuadFinder {
         std::map<int, int> corner_uses;
         for (int e : local)
           for (int c : {e, (e + 1) % 4}) {
-            o.nodes.push_back(
-                mesh_.quads[static_cast<std::size_t>(q)][static_cast<std::size_t>(c)]);
+            o.nodes.push_back(mesh_.quads[index_cast<std::size_t>(q)][index_cast<std::size_t>(c)]);
             ++corner_uses[c];
           }
         sort_unique(o.nodes);
@@ -569,18 +565,17 @@ class QuadFinder {
       const auto& quad = mesh_.quads[q];
       if (has_repeated(quad)) continue;
       for (int c = 0; c < 4; ++c) {
-        if (explained.count({static_cast<Index>(q), c})) continue;
-        const Index v = quad[static_cast<std::size_t>(c)],
-                    a = quad[static_cast<std::size_t>((c + 1) % 4)],
-                    b = quad[static_cast<std::size_t>((c + 3) % 4)];
-        const auto& sv = node_sides_[static_cast<std::size_t>(v)];
+        if (explained.count({index_cast(q), c})) continue;
+        const Index v = quad[index_cast<std::size_t>(c)],
+                    a = quad[index_cast<std::size_t>((c + 1) % 4)],
+                    b = quad[index_cast<std::size_t>((c + 3) % 4)];
+        const auto& sv = node_sides_[index_cast<std::size_t>(v)];
         const bool flat = std::any_of(sv.begin(), sv.end(), [&](Index s) {
-          return contains(node_sides_[static_cast<std::size_t>(a)], s) &&
-                 contains(node_sides_[static_cast<std::size_t>(b)], s);
+          return contains(node_sides_[index_cast<std::size_t>(a)], s) &&
+                 contains(node_sides_[index_cast<std::size_t>(b)], s);
         });
         if (flat)
-          flat_.push_back(
-              Obstruction{ObstructionKind::kFlatCorner, {static_cast<Index>(q)}, {v, a, b}});
+          flat_.push_back(Obstruction{ObstructionKind::kFlatCorner, {index_cast(q)}, {v, a, b}});
       }
     }
   }

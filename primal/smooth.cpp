@@ -156,7 +156,7 @@ std::vector<NodeSpace> node_spaces(const std::vector<Point>& points,
   // Followers take their leader's coordinates through the link's map; the others get their own.
   std::vector<char> follows(points.size(), 0);
   for (const NodeLink& l : links) {
-    const auto n = static_cast<std::size_t>(l.node), lead = static_cast<std::size_t>(l.leader);
+    const auto n = index_cast<std::size_t>(l.node), lead = index_cast<std::size_t>(l.leader);
     if (l.node < 0 || n >= points.size() || l.leader < 0 || lead >= points.size() || n == lead ||
         !l.map.allFinite())
       throw InvalidInput("smooth: a node link names node " + std::to_string(l.node) +
@@ -165,18 +165,18 @@ std::vector<NodeSpace> node_spaces(const std::vector<Point>& points,
     follows[n] = 1;
   }
   for (const NodeLink& l : links)
-    if (follows[static_cast<std::size_t>(l.leader)])
-      throw InvalidInput("smooth: " + node_name(static_cast<std::size_t>(l.leader)) +
+    if (follows[index_cast<std::size_t>(l.leader)])
+      throw InvalidInput("smooth: " + node_name(index_cast<std::size_t>(l.leader)) +
                          " leads a link but follows another");
   for (std::size_t i = 0; i < points.size(); ++i) {
     if (follows[i]) continue;
     spaces[i].offset = offset;
-    offset += static_cast<int>(spaces[i].basis.cols());
+    offset += index_cast<int>(spaces[i].basis.cols());
   }
   for (const NodeLink& l : links) {
-    NodeSpace& s = spaces[static_cast<std::size_t>(l.node)];
-    const NodeSpace& lead = spaces[static_cast<std::size_t>(l.leader)];
-    s.base = points[static_cast<std::size_t>(l.node)];
+    NodeSpace& s = spaces[index_cast<std::size_t>(l.node)];
+    const NodeSpace& lead = spaces[index_cast<std::size_t>(l.leader)];
+    s.base = points[index_cast<std::size_t>(l.node)];
     s.basis = l.map * lead.basis;
     s.offset = lead.offset;
   }
@@ -211,8 +211,7 @@ class Problem {
   Problem(const std::vector<Frame>& frames, std::vector<NodeSpace> spaces, double unit,
           double guard)
       : spaces_(std::move(spaces)), unit_(unit), guard_(guard) {
-    for (const auto& s : spaces_)
-      dof_ = std::max(dof_, s.offset + static_cast<int>(s.basis.cols()));
+    for (const auto& s : spaces_) dof_ = std::max(dof_, s.offset + index_cast<int>(s.basis.cols()));
     for (const Frame& f : frames) {
       if (f.guard != 0 && !(guard > 0.0)) continue;
       Local l;
@@ -229,7 +228,7 @@ class Problem {
           for (int k = 0; k < s.basis.cols(); ++k) {
             const int dof = s.offset + k;
             auto it = std::find(l.idx.begin(), l.idx.end(), dof);
-            const auto col = static_cast<std::size_t>(it - l.idx.begin());
+            const auto col = index_cast<std::size_t>(it - l.idx.begin());
             if (it == l.idx.end()) {
               l.idx.push_back(dof);
               cols.push_back(FrameVector::Zero());
@@ -403,7 +402,7 @@ int newton(Vec& x, F&& f, Done&& done, int max_iterations, double max_step) {
 // when it returns true. Returns the iterations taken.
 template <class F, class Done>
 int lbfgs(Vec& x, F&& f, Done&& done, int max_iterations, int history, double initial_step) {
-  const int n = static_cast<int>(x.size());
+  const int n = index_cast<int>(x.size());
   if (n == 0) return 0;
   std::deque<Vec> s_hist, y_hist;
   std::deque<double> rho_hist;
@@ -414,7 +413,7 @@ int lbfgs(Vec& x, F&& f, Done&& done, int max_iterations, int history, double in
     // Two-loop recursion for d = -H g.
     d = -g;
     std::vector<double> alpha(s_hist.size());
-    for (int i = static_cast<int>(s_hist.size()) - 1; i >= 0; --i) {
+    for (int i = index_cast<int>(s_hist.size()) - 1; i >= 0; --i) {
       alpha[i] = rho_hist[i] * s_hist[i].dot(d);
       d -= alpha[i] * y_hist[i];
     }
@@ -450,7 +449,7 @@ int lbfgs(Vec& x, F&& f, Done&& done, int max_iterations, int history, double in
     const double sy = s.dot(y);
     if (sy > 1e-16 * s.norm() * y.norm()) {
       s_hist.push_back(s), y_hist.push_back(y), rho_hist.push_back(1.0 / sy);
-      if (static_cast<int>(s_hist.size()) > history) {
+      if (index_cast<int>(s_hist.size()) > history) {
         s_hist.pop_front(), y_hist.pop_front(), rho_hist.pop_front();
       }
     }
@@ -546,7 +545,7 @@ SmoothResult run(std::vector<Point>& points, std::vector<Frame> frames,
 }
 
 void check_nodes(std::size_t num_points, Index node, const std::string& element) {
-  if (node < 0 || static_cast<std::size_t>(node) >= num_points) {
+  if (node < 0 || index_cast<std::size_t>(node) >= num_points) {
     throw InvalidInput("smooth: " + element + " names node " + std::to_string(node) +
                        ", out of range (mesh has " + std::to_string(num_points) + " nodes)");
   }

@@ -27,7 +27,7 @@ PyramidSplit split_pyramids(const Model& model) {
   for (std::size_t p = 0; p < np; ++p)
     for (int d = 0; d < 2; ++d) {
       const auto tets = pyramid_tets(model.pyramids[p], d);
-      quality[p][static_cast<std::size_t>(d)] = diced_min_scaled_jacobian(model.points, tets);
+      quality[p][index_cast<std::size_t>(d)] = diced_min_scaled_jacobian(model.points, tets);
     }
   // Pyramids by base quad (its sorted nodes); a diagonal as its sorted node pair.
   std::map<std::array<Index, 4>, std::vector<std::size_t>> by_base;
@@ -39,7 +39,7 @@ PyramidSplit split_pyramids(const Model& model) {
   }
   auto pair_of = [&](std::size_t p, int d) {
     const auto& c = model.pyramids[p];
-    const Index a = c[static_cast<std::size_t>(d)], b = c[static_cast<std::size_t>(d + 2)];
+    const Index a = c[index_cast<std::size_t>(d)], b = c[index_cast<std::size_t>(d + 2)];
     return std::pair<Index, Index>{std::min(a, b), std::max(a, b)};
   };
   for (const auto& [key, members] : by_base) {
@@ -64,13 +64,13 @@ PyramidSplit split_pyramids(const Model& model) {
       m.tet_ids.push_back(static_cast<std::int64_t>(t) + 1);
   std::vector<Index> first_tet(np);
   for (std::size_t p = 0; p < np; ++p) {
-    first_tet[p] = static_cast<Index>(m.tets.size());
-    const ElementRef ref{ElementKind::kPyramid, static_cast<Index>(p)};
+    first_tet[p] = index_cast(m.tets.size());
+    const ElementRef ref{ElementKind::kPyramid, index_cast(p)};
     for (const auto& t : pyramid_tets(model.pyramids[p], out.diagonal[p])) {
       m.tets.push_back(t);
       m.tet_block.push_back(block_of(model, ref));
       m.tet_ids.push_back(element_id(model, ref));
-      out.tet_pyramid.push_back(static_cast<Index>(p));
+      out.tet_pyramid.push_back(index_cast(p));
     }
   }
   // Sides of pyramids: the faces of its two tets whose nodes are all on the pyramid's face.
@@ -82,14 +82,13 @@ PyramidSplit split_pyramids(const Model& model) {
         continue;
       }
       const std::vector<Index> face = element_face(model, s);
-      for (Index t = first_tet[static_cast<std::size_t>(s.element.index)], e = t + 2; t < e; ++t)
+      for (Index t = first_tet[index_cast<std::size_t>(s.element.index)], e = t + 2; t < e; ++t)
         for (int f = 0; f < 4; ++f) {
           bool on = true;
-          for (int k : topology::kTetFaceCorners[static_cast<std::size_t>(f)])
-            on =
-                on && std::find(face.begin(), face.end(),
-                                m.tets[static_cast<std::size_t>(t)][static_cast<std::size_t>(k)]) !=
-                          face.end();
+          for (int k : topology::kTetFaceCorners[index_cast<std::size_t>(f)])
+            on = on && std::find(face.begin(), face.end(),
+                                 m.tets[index_cast<std::size_t>(t)][index_cast<std::size_t>(k)]) !=
+                           face.end();
           if (on) sides.push_back({{ElementKind::kTet, t}, f});
         }
     }

@@ -97,7 +97,7 @@ bool has_repeated(const std::array<Index, N>& a) {
 template <std::size_t N>
 bool in_range(const std::array<Index, N>& a, std::size_t n) {
   return std::all_of(a.begin(), a.end(),
-                     [n](Index v) { return v >= 0 && static_cast<std::size_t>(v) < n; });
+                     [n](Index v) { return v >= 0 && index_cast<std::size_t>(v) < n; });
 }
 
 // Two uses of a face (or edge) agree when one is the reverse cyclic order of the other.
@@ -114,7 +114,7 @@ bool opposite_cycles(const std::array<Index, N>& a, const std::array<Index, N>& 
 std::vector<Index> non_finite(const std::vector<Point>& points) {
   std::vector<Index> out;
   for (std::size_t i = 0; i < points.size(); ++i) {
-    if (!points[i].allFinite()) out.push_back(static_cast<Index>(i));
+    if (!points[i].allFinite()) out.push_back(index_cast(i));
   }
   return out;
 }
@@ -246,7 +246,7 @@ class ProbeCount {
 
   void add(const std::array<Index, 8>& hex, std::uint16_t code) {
     for (int c = 0; c < 8; ++c) {
-      const auto v = static_cast<std::size_t>(hex[c]);
+      const auto v = index_cast<std::size_t>(hex[c]);
       switch ((code >> (2 * c)) & 3) {
         case kNotPositiveCorner:
           flags_[v] |= kNotPositive;
@@ -279,12 +279,12 @@ class ProbeCount {
 std::optional<NodeCoverage> hex_coverage(const std::vector<Point>& points, Index v,
                                          const std::vector<CornerStar>& corners,
                                          std::vector<BoundaryWedge>& wedges) {
-  const Point& o = points[static_cast<std::size_t>(v)];
+  const Point& o = points[index_cast<std::size_t>(v)];
   NodeCoverage c{v, 0.0, 4.0 * kPi};
   wedges.clear();
   for (const CornerStar& s : corners) {
     std::array<Point, 3> e;
-    for (int k = 0; k < 3; ++k) e[k] = points[static_cast<std::size_t>(s.ends[k])] - o;
+    for (int k = 0; k < 3; ++k) e[k] = points[index_cast<std::size_t>(s.ends[k])] - o;
     if (!(e[0].dot(e[1].cross(e[2])) > 0.0)) return std::nullopt;
     c.angle += solid_angle(e[0], e[1], e[2]);
     for (int k = 0; k < 3; ++k) {
@@ -302,7 +302,7 @@ std::optional<NodeCoverage> hex_coverage(const std::vector<Point>& points, Index
     if (i + 1 == wedges.size() || wedges[i + 1].end != wedges[i].end ||
         (i + 2 < wedges.size() && wedges[i + 2].end == wedges[i].end))
       return std::nullopt;
-    const Point axis = points[static_cast<std::size_t>(wedges[i].end)] - o;
+    const Point axis = points[index_cast<std::size_t>(wedges[i].end)] - o;
     exterior += kPi - wedge_angle(axis, wedges[i].other, wedges[i].inward, wedges[i + 1].other);
   }
   c.expected = 2.0 * kPi - exterior;
@@ -388,8 +388,8 @@ HexValidityReport check_validity(const HexMesh& mesh) {
   // a face or edge are found among the few hexes around one node. A face or edge is numbered by
   // its first use (hex, local face / edge), which is the order of first appearance.
   HexValidityReport r;
-  r.num_nodes = static_cast<Index>(mesh.points.size());
-  r.num_hexes = static_cast<Index>(mesh.hexes.size());
+  r.num_nodes = index_cast(mesh.points.size());
+  r.num_hexes = index_cast(mesh.hexes.size());
   r.non_finite_nodes = non_finite(mesh.points);
 
   // The proper hexes, on which the topology is analysed; use p refers to mesh.hexes[original[p]].
@@ -398,11 +398,11 @@ HexValidityReport check_validity(const HexMesh& mesh) {
   for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
     const auto& hex = mesh.hexes[h];
     if (!in_range(hex, mesh.points.size())) {
-      r.out_of_range_hexes.push_back(static_cast<Index>(h));
+      r.out_of_range_hexes.push_back(index_cast(h));
     } else if (has_repeated(hex)) {
-      r.repeated_node_hexes.push_back(static_cast<Index>(h));
+      r.repeated_node_hexes.push_back(index_cast(h));
     } else {
-      original.push_back(static_cast<Index>(h));
+      original.push_back(index_cast(h));
     }
   }
 
@@ -420,7 +420,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
         [&](const tbb::blocked_range<std::size_t>& range) {
           for (std::size_t h = range.begin(); h != range.end(); ++h) {
             if (!in_range(mesh.hexes[h], mesh.points.size())) continue;
-            const HexCorners corners = hex_corners(mesh, static_cast<Index>(h));
+            const HexCorners corners = hex_corners(mesh, index_cast(h));
             const auto j = hex_jacobians(corners);
             // Corners 0..7 only: the centre value (index 8) is not a corner Jacobian.
             const bool positive =
@@ -430,7 +430,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
         });
     for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
       if (!(found[h] & kMeasured)) continue;
-      if (found[h] & kInverted) r.inverted_hexes.push_back(static_cast<Index>(h));
+      if (found[h] & kInverted) r.inverted_hexes.push_back(index_cast(h));
       if (!has_repeated(mesh.hexes[h]))
         probe.add(mesh.hexes[h], static_cast<std::uint16_t>(found[h] & 0xffffu));
     }
@@ -440,7 +440,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
   const std::size_t nh = original.size();
   const std::size_t nv = mesh.points.size();
   auto hex = [&](Index p) -> const std::array<Index, 8>& {
-    return mesh.hexes[static_cast<std::size_t>(original[static_cast<std::size_t>(p)])];
+    return mesh.hexes[index_cast<std::size_t>(original[index_cast<std::size_t>(p)])];
   };
   // Local edge joining two corners (-1 if they are not joined by an edge).
   static const auto edge_of = [] {
@@ -459,21 +459,21 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     throw InvalidInput("check_validity: " + std::to_string(nh) + " hexes, 2^28 or more");
   std::vector<Index> start(nv + 1, 0), around;
   for (std::size_t p = 0; p < nh; ++p)
-    for (Index v : hex(static_cast<Index>(p))) ++start[static_cast<std::size_t>(v) + 1];
+    for (Index v : hex(index_cast(p))) ++start[index_cast<std::size_t>(v) + 1];
   std::partial_sum(start.begin(), start.end(), start.begin());
-  around.resize(static_cast<std::size_t>(start.back()));
+  around.resize(index_cast<std::size_t>(start.back()));
   {
     std::vector<Index> fill(start.begin(), start.end() - 1);
     for (std::size_t p = 0; p < nh; ++p) {
-      const auto& h = hex(static_cast<Index>(p));
+      const auto& h = hex(index_cast(p));
       for (int c = 0; c < 8; ++c)
-        around[static_cast<std::size_t>(fill[static_cast<std::size_t>(h[c])]++)] =
-            static_cast<Index>(8 * p + static_cast<std::size_t>(c));
+        around[index_cast<std::size_t>(fill[index_cast<std::size_t>(h[c])]++)] =
+            index_cast(8 * p + index_cast<std::size_t>(c));
     }
   }
   // An incidence entry: the hex and the node's corner in it.
   auto use_at = [&](Index k) {
-    const Index a = around[static_cast<std::size_t>(k)];
+    const Index a = around[index_cast<std::size_t>(k)];
     return std::pair<Index, int>{a >> 3, a & 7};
   };
   auto face_nodes = [&](Index p, int lf) {
@@ -500,7 +500,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
             const auto [p, c] = use_at(k);
             for (int lf : inc.corner_faces[c]) {
               const auto q = face_nodes(p, lf);
-              if (*std::min_element(q.begin(), q.end()) != static_cast<Index>(v)) continue;
+              if (*std::min_element(q.begin(), q.end()) != index_cast(v)) continue;
               local.emplace_back(face_key(q), 6 * p + lf);
             }
           }
@@ -510,7 +510,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
             while (j < local.size() && local[j].first == local[i].first) ++j;
             const Index lead = local[i].second;
             for (std::size_t k = i; k < j; ++k)
-              face_lead[static_cast<std::size_t>(local[k].second)] = lead;
+              face_lead[index_cast<std::size_t>(local[k].second)] = lead;
             std::uint8_t info = static_cast<std::uint8_t>(std::min<std::size_t>(j - i, 3));
             if (j - i == 2) {
               const Index u1 = local[i + 1].second;
@@ -518,26 +518,25 @@ HexValidityReport check_validity(const HexMesh& mesh) {
                 info |= 4;
             }
             for (std::size_t k = i; k < j; ++k)
-              face_info[static_cast<std::size_t>(local[k].second)] = info;
+              face_info[index_cast<std::size_t>(local[k].second)] = info;
             i = j;
           }
         }
       });
   std::vector<BoundaryQuad> boundary;
   for (std::size_t u = 0; u < 6 * nh; ++u) {
-    if (face_lead[u] != static_cast<Index>(u)) continue;
+    if (face_lead[u] != index_cast(u)) continue;
     ++r.num_faces;
-    const Index p = static_cast<Index>(u / 6);
+    const Index p = index_cast(u / 6);
     const int lf = static_cast<int>(u % 6);
     const auto uses = face_info[u] & 3;
     if (uses == 3) r.overshared_faces.push_back(face_key(face_nodes(p, lf)));
     if (face_info[u] & 4) r.misoriented_faces.push_back(face_key(face_nodes(p, lf)));
     if (uses == 1)
-      boundary.push_back(
-          BoundaryQuad{original[static_cast<std::size_t>(p)], lf, face_nodes(p, lf)});
+      boundary.push_back(BoundaryQuad{original[index_cast<std::size_t>(p)], lf, face_nodes(p, lf)});
   }
   auto face_uses = [&](Index p, int lf) {
-    return face_info[static_cast<std::size_t>(6 * p + lf)] & 3;
+    return face_info[index_cast<std::size_t>(6 * p + lf)] & 3;
   };
 
   // Vertices and the edges starting at them (other end larger). An edge's hexes must form one
@@ -567,14 +566,14 @@ HexValidityReport check_validity(const HexMesh& mesh) {
   // The covering at a manifold node: counted along the probe inside, else from solid angles;
   // nothing where a corner is not positive (its hexes are listed as inverted).
   auto covering = [&](Index v, bool on_boundary, Scratch& s) -> std::optional<NodeCoverage> {
-    const auto flags = probe.flags(static_cast<std::size_t>(v));
+    const auto flags = probe.flags(index_cast<std::size_t>(v));
     if (flags & ProbeCount::kNotPositive) return std::nullopt;
     if (!on_boundary && !(flags & ProbeCount::kNearFace)) {
-      const int k = probe.containing(static_cast<std::size_t>(v));
+      const int k = probe.containing(index_cast<std::size_t>(v));
       return NodeCoverage{v, 4.0 * kPi * k, 4.0 * kPi};
     }
     s.stars.clear();
-    for (Index i = start[static_cast<std::size_t>(v)]; i < start[static_cast<std::size_t>(v) + 1];
+    for (Index i = start[index_cast<std::size_t>(v)]; i < start[index_cast<std::size_t>(v) + 1];
          ++i) {
       const auto [p, c] = use_at(i);
       CornerStar& star = s.stars.emplace_back();
@@ -597,7 +596,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
       return;
     }
     ++r.num_vertices;
-    uses_joined.reset(static_cast<std::size_t>(n));
+    uses_joined.reset(index_cast<std::size_t>(n));
     first_use_of_face.clear();
     others.clear();
     edge_uses.clear();
@@ -608,7 +607,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
         const auto uses = face_uses(p, lf);
         on_boundary |= uses == 1;
         overshared |= uses == 3;
-        const Index f = face_lead[static_cast<std::size_t>(6 * p + lf)];
+        const Index f = face_lead[index_cast<std::size_t>(6 * p + lf)];
         auto it = std::find_if(first_use_of_face.begin(), first_use_of_face.end(),
                                [f](const auto& x) { return x.first == f; });
         if (it == first_use_of_face.end())
@@ -619,7 +618,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
       for (int nc : topo::kHexCornerNeighbors[c]) {
         const Index b = hex(p)[nc];
         others.push_back(b);
-        if (b > static_cast<Index>(v)) edge_uses.push_back({b, 12 * p + edge_of[c][nc]});
+        if (b > index_cast(v)) edge_uses.push_back({b, 12 * p + edge_of[c][nc]});
       }
     }
     std::sort(others.begin(), others.end());
@@ -627,8 +626,8 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     const auto link_euler = static_cast<long>(link_vertices) -
                             static_cast<long>(first_use_of_face.size()) + static_cast<long>(n);
     if (overshared || uses_joined.count() != 1 || link_euler != (on_boundary ? 1 : 2)) {
-      r.nonmanifold_vertices.push_back(static_cast<Index>(v));
-    } else if (const auto cover = covering(static_cast<Index>(v), on_boundary, s);
+      r.nonmanifold_vertices.push_back(index_cast(v));
+    } else if (const auto cover = covering(index_cast(v), on_boundary, s);
                cover && overlaps(*cover)) {
       r.overlapping_nodes.push_back(*cover);
     }
@@ -649,18 +648,17 @@ HexValidityReport check_validity(const HexMesh& mesh) {
         const int le = edge_uses[i + k].use % 12;
         for (int lf : inc.edge_faces[le]) {
           edge_overshared |= face_uses(p, lf) == 3;
-          const Index f = face_lead[static_cast<std::size_t>(6 * p + lf)];
+          const Index f = face_lead[index_cast<std::size_t>(6 * p + lf)];
           auto it = std::find_if(first_use_of_face.begin(), first_use_of_face.end(),
                                  [f](const auto& x) { return x.first == f; });
           if (it == first_use_of_face.end())
             first_use_of_face.emplace_back(f, static_cast<int>(k));
           else
-            uses_joined.unite(it->second, static_cast<Index>(k));
+            uses_joined.unite(it->second, index_cast(k));
         }
       }
       if (edge_overshared || uses_joined.count() != 1)
-        bad_edges.emplace_back(edge_uses[i].use,
-                               edge_key(static_cast<Index>(v), edge_uses[i].other));
+        bad_edges.emplace_back(edge_uses[i].use, edge_key(index_cast(v), edge_uses[i].other));
       i = j;
     }
   };
@@ -688,7 +686,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
   std::sort(bad_edges.begin(), bad_edges.end());
   for (const auto& [use, e] : bad_edges) r.nonmanifold_edges.push_back(e);
 
-  r.num_cells = static_cast<Index>(nh);
+  r.num_cells = index_cast(nh);
   r.euler = r.num_vertices - r.num_edges + r.num_faces - r.num_cells;
 
   r.boundary = extract_boundary(mesh.points, std::move(boundary));
@@ -728,8 +726,8 @@ std::string QuadValidityReport::summary() const {
 
 QuadValidityReport check_validity(const QuadMesh& mesh, const Point& normal_in) {
   QuadValidityReport r;
-  r.num_nodes = static_cast<Index>(mesh.points.size());
-  r.num_quads = static_cast<Index>(mesh.quads.size());
+  r.num_nodes = index_cast(mesh.points.size());
+  r.num_quads = index_cast(mesh.quads.size());
   r.non_finite_nodes = non_finite(mesh.points);
   const Point normal = normal_in.normalized();
 
@@ -747,14 +745,14 @@ QuadValidityReport check_validity(const QuadMesh& mesh, const Point& normal_in) 
   for (std::size_t q = 0; q < mesh.quads.size(); ++q) {
     const auto& quad = mesh.quads[q];
     if (!in_range(quad, mesh.points.size())) {
-      r.out_of_range_quads.push_back(static_cast<Index>(q));
+      r.out_of_range_quads.push_back(index_cast(q));
       continue;
     }
-    if (quad_jacobian(quad_corners(mesh, static_cast<Index>(q)), normal) <= 0.0) {
-      r.inverted_quads.push_back(static_cast<Index>(q));
+    if (quad_jacobian(quad_corners(mesh, index_cast(q)), normal) <= 0.0) {
+      r.inverted_quads.push_back(index_cast(q));
     }
     if (has_repeated(quad)) {
-      r.repeated_node_quads.push_back(static_cast<Index>(q));
+      r.repeated_node_quads.push_back(index_cast(q));
     } else {
       proper.push_back(quad);
     }
@@ -768,12 +766,12 @@ QuadValidityReport check_validity(const QuadMesh& mesh, const Point& normal_in) 
     for (int e = 0; e < 4; ++e) {
       const auto& c = topo::kQuadEdgeCorners[e];
       const EdgeKey k = edge_key(proper[q][c[0]], proper[q][c[1]]);
-      auto [it, inserted] = edge_id.try_emplace(k, static_cast<Index>(edges.size()));
+      auto [it, inserted] = edge_id.try_emplace(k, index_cast(edges.size()));
       if (inserted) {
         edges.push_back(k);
         edge_uses.emplace_back();
       }
-      edge_uses[it->second].emplace_back(static_cast<Index>(q), e);
+      edge_uses[it->second].emplace_back(index_cast(q), e);
     }
   }
   auto tail = [&](const std::pair<Index, int>& u) {
@@ -793,7 +791,7 @@ QuadValidityReport check_validity(const QuadMesh& mesh, const Point& normal_in) 
   std::vector<std::vector<std::pair<Index, int>>> vertex_uses(mesh.points.size());
   std::vector<QuadCornerAt> corners;
   for (std::size_t q = 0; q < proper.size(); ++q) {
-    for (int c = 0; c < 4; ++c) vertex_uses[proper[q][c]].emplace_back(static_cast<Index>(q), c);
+    for (int c = 0; c < 4; ++c) vertex_uses[proper[q][c]].emplace_back(index_cast(q), c);
   }
   for (std::size_t v = 0; v < vertex_uses.size(); ++v) {
     const auto& uses = vertex_uses[v];
@@ -823,15 +821,15 @@ QuadValidityReport check_validity(const QuadMesh& mesh, const Point& normal_in) 
       }
     }
     if (overshared || sets.count() != 1) {
-      r.nonmanifold_vertices.push_back(static_cast<Index>(v));
+      r.nonmanifold_vertices.push_back(index_cast(v));
     } else if (r.planar) {
-      const auto cover = quad_coverage(static_cast<Index>(v), corners, normal);
+      const auto cover = quad_coverage(index_cast(v), corners, normal);
       if (cover && overlaps(*cover)) r.overlapping_nodes.push_back(*cover);
     }
   }
 
-  r.num_edges = static_cast<Index>(edges.size());
-  r.num_faces = static_cast<Index>(proper.size());
+  r.num_edges = index_cast(edges.size());
+  r.num_faces = index_cast(proper.size());
   r.euler = r.num_vertices - r.num_edges + r.num_faces;
 
   // Boundary loops: chain the boundary edges (used once) tail to head, in quad direction so

@@ -16,7 +16,7 @@ namespace {
 template <std::size_t N>
 bool proper(const std::array<Index, N>& a, std::size_t nodes) {
   for (std::size_t i = 0; i < N; ++i) {
-    if (a[i] < 0 || static_cast<std::size_t>(a[i]) >= nodes) return false;
+    if (a[i] < 0 || index_cast<std::size_t>(a[i]) >= nodes) return false;
     for (std::size_t j = 0; j < i; ++j)
       if (a[i] == a[j]) return false;
   }
@@ -28,7 +28,7 @@ bool proper(const std::array<Index, N>& a, std::size_t nodes) {
 void mark_nodes(const HexMesh& mesh, const std::vector<char>& hex_in, std::vector<char>& node_in) {
   for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
     if (hex_in[h])
-      for (Index v : mesh.hexes[h]) node_in[static_cast<std::size_t>(v)] = 1;
+      for (Index v : mesh.hexes[h]) node_in[index_cast<std::size_t>(v)] = 1;
 }
 
 void mark_hexes(const HexMesh& mesh, const std::vector<char>& node_in,
@@ -38,7 +38,7 @@ void mark_hexes(const HexMesh& mesh, const std::vector<char>& node_in,
                       for (std::size_t h = range.begin(); h != range.end(); ++h) {
                         if (hex_in[h] || !proper_hex[h]) continue;
                         for (Index v : mesh.hexes[h])
-                          if (node_in[static_cast<std::size_t>(v)]) {
+                          if (node_in[index_cast<std::size_t>(v)]) {
                             hex_in[h] = 1;
                             break;
                           }
@@ -52,27 +52,27 @@ HexValidityReport check_validity_around(const HexMesh& mesh, std::span<const Ind
                                         const RegionValidityOptions& options) {
   const std::size_t nv = mesh.points.size(), nh = mesh.hexes.size();
   HexValidityReport r;
-  r.num_nodes = static_cast<Index>(nv);
-  r.num_hexes = static_cast<Index>(nh);
+  r.num_nodes = index_cast(nv);
+  r.num_hexes = index_cast(nh);
 
   // Per hex and per node over the whole mesh, as check_validity finds them.
   std::vector<char> proper_hex(nh, 0), used(nv, 0);
   for (std::size_t h = 0; h < nh; ++h) {
     const auto& hex = mesh.hexes[h];
     const bool in_range = std::all_of(hex.begin(), hex.end(), [nv](Index v) {
-      return v >= 0 && static_cast<std::size_t>(v) < nv;
+      return v >= 0 && index_cast<std::size_t>(v) < nv;
     });
     if (!in_range) {
-      r.out_of_range_hexes.push_back(static_cast<Index>(h));
+      r.out_of_range_hexes.push_back(index_cast(h));
     } else if (!proper(hex, nv)) {
-      r.repeated_node_hexes.push_back(static_cast<Index>(h));
+      r.repeated_node_hexes.push_back(index_cast(h));
     } else {
       proper_hex[h] = 1;
-      for (Index v : hex) used[static_cast<std::size_t>(v)] = 1;
+      for (Index v : hex) used[index_cast<std::size_t>(v)] = 1;
     }
   }
   for (std::size_t v = 0; v < nv; ++v) {
-    if (!mesh.points[v].allFinite()) r.non_finite_nodes.push_back(static_cast<Index>(v));
+    if (!mesh.points[v].allFinite()) r.non_finite_nodes.push_back(index_cast(v));
     r.unused_nodes += used[v] ? 0 : 1;
   }
   used = {};
@@ -85,23 +85,23 @@ HexValidityReport check_validity_around(const HexMesh& mesh, std::span<const Ind
           for (std::size_t h = range.begin(); h != range.end(); ++h) {
             const auto& hex = mesh.hexes[h];
             if (!std::all_of(hex.begin(), hex.end(),
-                             [nv](Index v) { return v >= 0 && static_cast<std::size_t>(v) < nv; }))
+                             [nv](Index v) { return v >= 0 && index_cast<std::size_t>(v) < nv; }))
               continue;
             if (known && options.scaled_jacobians[h] > 0.0) continue;  // all 9 dets > 0
-            const auto j = hex_jacobians(hex_corners(mesh, static_cast<Index>(h)));
+            const auto j = hex_jacobians(hex_corners(mesh, index_cast(h)));
             // Corners 0..7 only, as check_validity (index 8 is the centre).
             inverted[h] = !std::all_of(j.begin(), j.begin() + 8, [](double d) { return d > 0.0; });
           }
         });
     for (std::size_t h = 0; h < nh; ++h)
-      if (inverted[h]) r.inverted_hexes.push_back(static_cast<Index>(h));
+      if (inverted[h]) r.inverted_hexes.push_back(index_cast(h));
   }
 
   // The region: the checked nodes (within `rings` of the seeds) and every hex around them.
   std::vector<char> hex_in(nh, 0), node_in(nv, 0);
   for (Index h : seeds)
-    if (h >= 0 && static_cast<std::size_t>(h) < nh && proper_hex[static_cast<std::size_t>(h)])
-      hex_in[static_cast<std::size_t>(h)] = 1;
+    if (h >= 0 && index_cast<std::size_t>(h) < nh && proper_hex[index_cast<std::size_t>(h)])
+      hex_in[index_cast<std::size_t>(h)] = 1;
   for (int ring = 0; ring < options.rings; ++ring) {
     mark_nodes(mesh, hex_in, node_in);
     mark_hexes(mesh, node_in, proper_hex, hex_in);
@@ -117,13 +117,13 @@ HexValidityReport check_validity_around(const HexMesh& mesh, std::span<const Ind
   std::vector<Index> sub_hex, sub_node, local(nv, kInvalidIndex);
   for (std::size_t h = 0; h < nh; ++h) {
     if (!hex_in[h]) continue;
-    sub_hex.push_back(static_cast<Index>(h));
+    sub_hex.push_back(index_cast(h));
     std::array<Index, 8> q{};
     for (int c = 0; c < 8; ++c) {
-      const auto v = static_cast<std::size_t>(mesh.hexes[h][c]);
+      const auto v = index_cast<std::size_t>(mesh.hexes[h][c]);
       if (local[v] == kInvalidIndex) {
-        local[v] = static_cast<Index>(sub_node.size());
-        sub_node.push_back(static_cast<Index>(v));
+        local[v] = index_cast(sub_node.size());
+        sub_node.push_back(index_cast(v));
         sub.points.push_back(mesh.points[v]);
       }
       q[c] = local[v];
@@ -132,8 +132,8 @@ HexValidityReport check_validity_around(const HexMesh& mesh, std::span<const Ind
   }
   local = {};
   const HexValidityReport s = check_validity(sub);
-  auto node = [&](Index v) { return sub_node[static_cast<std::size_t>(v)]; };
-  auto is_checked = [&](Index v) { return checked[static_cast<std::size_t>(node(v))] != 0; };
+  auto node = [&](Index v) { return sub_node[index_cast<std::size_t>(v)]; };
+  auto is_checked = [&](Index v) { return checked[index_cast<std::size_t>(node(v))] != 0; };
   auto global_key = [&](const FaceKey& k) {
     std::array<Index, 4> q{};
     std::size_t n = 0;
@@ -167,7 +167,7 @@ HexValidityReport check_validity_around(const HexMesh& mesh, std::span<const Ind
   auto keep_quad = [&](BoundaryQuad q) {
     const bool near = std::any_of(q.nodes.begin(), q.nodes.end(), is_checked);
     for (Index& v : q.nodes) v = node(v);
-    q.hex = sub_hex[static_cast<std::size_t>(q.hex)];
+    q.hex = sub_hex[index_cast<std::size_t>(q.hex)];
     return std::pair{near, q};
   };
   for (const BoundaryQuad& q : s.boundary.faces)

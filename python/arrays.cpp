@@ -23,9 +23,9 @@ std::vector<Point> to_points(const py::handle& object, const std::string& what) 
     throw InvalidInput(what + ": expected an N x 3 (or N x 2) array of coordinates");
   const auto r = a.unchecked<2>();
   const bool planar = a.shape(1) == 2;
-  std::vector<Point> points(static_cast<std::size_t>(a.shape(0)));
+  std::vector<Point> points(primal::index_cast<std::size_t>(a.shape(0)));
   for (py::ssize_t i = 0; i < a.shape(0); ++i)
-    points[static_cast<std::size_t>(i)] = Point(r(i, 0), r(i, 1), planar ? 0.0 : r(i, 2));
+    points[primal::index_cast<std::size_t>(i)] = Point(r(i, 0), r(i, 1), planar ? 0.0 : r(i, 2));
   return points;
 }
 
@@ -46,14 +46,15 @@ std::vector<std::array<Index, K>> to_cells(const py::handle& object, const std::
   if (!a || a.ndim() != 2 || a.shape(1) != K)
     throw InvalidInput(what + ": expected an M x " + std::to_string(K) + " array of node numbers");
   const auto r = a.unchecked<2>();
-  std::vector<std::array<Index, K>> cells(static_cast<std::size_t>(a.shape(0)));
+  std::vector<std::array<Index, K>> cells(primal::index_cast<std::size_t>(a.shape(0)));
   for (py::ssize_t i = 0; i < a.shape(0); ++i)
     for (int c = 0; c < K; ++c) {
       const std::int64_t v = r(i, c);
       if (v < std::numeric_limits<Index>::min() || v > std::numeric_limits<Index>::max())
         throw InvalidInput(what + ": cell " + std::to_string(i) + " has node " + std::to_string(v) +
                            ", outside the 32-bit index range");
-      cells[static_cast<std::size_t>(i)][static_cast<std::size_t>(c)] = static_cast<Index>(v);
+      cells[primal::index_cast<std::size_t>(i)][primal::index_cast<std::size_t>(c)] =
+          primal::index_cast(v);
     }
   return cells;
 }

@@ -136,8 +136,8 @@ py::dict check(const py::handle& points, const py::handle& cells, double planar_
     Index at = 0;
     for (std::size_t q = 0; q < mesh.quads.size(); ++q) {
       const double s = primal::quad_scaled_jacobian(
-          primal::quad_corners(mesh, static_cast<Index>(q)), Point::UnitZ());
-      if (s < lo) lo = s, at = static_cast<Index>(q);
+          primal::quad_corners(mesh, primal::index_cast(q)), Point::UnitZ());
+      if (s < lo) lo = s, at = primal::index_cast(q);
       hi = std::max(hi, s);
     }
     d["quality"] = to_python({{"num_quads", mesh.quads.size()},
@@ -162,7 +162,7 @@ py::dict quality(const py::handle& points, const py::handle& hexes, bool per_hex
     for (const auto& info : primal::hex_metrics()) {
       std::vector<double> v(mesh.hexes.size());
       for (std::size_t h = 0; h < v.size(); ++h)
-        v[h] = info.evaluate(primal::hex_corners(mesh, static_cast<Index>(h)));
+        v[h] = info.evaluate(primal::hex_corners(mesh, primal::index_cast(h)));
       values[py::str(std::string(info.key))] = double_array(std::move(v));
     }
     d["per_hex"] = values;
@@ -272,14 +272,15 @@ std::vector<primal::NodeConstraint> constraints(const Mesh& mesh,
     const double tol = 1e-9 * std::max(box.diagonal().norm(), 1.0);
     c = primal::box_constraints(mesh.points, box.min(), box.max(), {}, tol);
   } else if (boundary == "fixed") {
-    for (Index n : boundary_nodes) c[static_cast<std::size_t>(n)] = primal::NodeConstraint::fixed();
+    for (Index n : boundary_nodes)
+      c[primal::index_cast<std::size_t>(n)] = primal::NodeConstraint::fixed();
   } else if (boundary != "free") {
     throw InvalidInput("smooth: boundary must be 'fixed', 'free' or 'box'");
   }
   for (Index n : fixed) {
-    if (n < 0 || static_cast<std::size_t>(n) >= c.size())
+    if (n < 0 || primal::index_cast<std::size_t>(n) >= c.size())
       throw InvalidInput("smooth: fixed node " + std::to_string(n) + " is out of range");
-    c[static_cast<std::size_t>(n)] = primal::NodeConstraint::fixed();
+    c[primal::index_cast<std::size_t>(n)] = primal::NodeConstraint::fixed();
   }
   return c;
 }
@@ -345,15 +346,15 @@ py::object isomorphism(const py::handle& a, const py::handle& b, const py::objec
   if (k == 8) {
     primal::HexMesh x, y;
     x.hexes = to_cells<8>(a, "a"), y.hexes = to_cells<8>(b, "b");
-    x.points.resize(static_cast<std::size_t>(nodes(x.hexes))),
-        y.points.resize(static_cast<std::size_t>(nodes(y.hexes)));
+    x.points.resize(primal::index_cast<std::size_t>(nodes(x.hexes))),
+        y.points.resize(primal::index_cast<std::size_t>(nodes(y.hexes)));
     py::gil_scoped_release free;
     map = primal::find_isomorphism(x, y, l);
   } else {
     primal::QuadMesh x, y;
     x.quads = to_cells<4>(a, "a"), y.quads = to_cells<4>(b, "b");
-    x.points.resize(static_cast<std::size_t>(nodes(x.quads))),
-        y.points.resize(static_cast<std::size_t>(nodes(y.quads)));
+    x.points.resize(primal::index_cast<std::size_t>(nodes(x.quads))),
+        y.points.resize(primal::index_cast<std::size_t>(nodes(y.quads)));
     py::gil_scoped_release free;
     map = primal::find_isomorphism(x, y, l);
   }

@@ -151,8 +151,8 @@ std::vector<viewer::ViewSheet> view_sheets(const TemplateResult& r) {
   }
   for (std::size_t e = 0; e < r.t.element_sheets.size(); ++e)
     for (int s : r.t.element_sheets[e])
-      if (s >= 0 && static_cast<std::size_t>(s) < out.size())
-        out[static_cast<std::size_t>(s)].layer.push_back(static_cast<Index>(e));
+      if (s >= 0 && primal::index_cast<std::size_t>(s) < out.size())
+        out[primal::index_cast<std::size_t>(s)].layer.push_back(primal::index_cast(e));
   return out;
 }
 
@@ -180,7 +180,7 @@ std::string template_html(const TemplateResult& r) {
     viewer::ViewFaceGroup tet{"tet side", {}}, hex{"hex side", {}};
     for (const auto& q : primal::boundary_quads(T.hex)) {
       unsigned common = ~0u;
-      for (auto n : q.nodes) common &= T.node_faces[static_cast<std::size_t>(n)];
+      for (auto n : q.nodes) common &= T.node_faces[primal::index_cast<std::size_t>(n)];
       if (common & (1u << stc::box_face(1, true))) tet.quads.push_back(q.nodes);
       if (common & (1u << stc::box_face(1, false))) hex.quads.push_back(q.nodes);
     }
@@ -198,7 +198,7 @@ Eigen::Vector3d parse_box(const py::handle& box, int dim) {
   } catch (const py::cast_error&) {
     throw InvalidInput("template: box must be a sequence of numbers");
   }
-  if (b.size() != static_cast<std::size_t>(dim))
+  if (b.size() != primal::index_cast<std::size_t>(dim))
     throw InvalidInput("template: box has " + std::to_string(b.size()) + " numbers for a " +
                        std::to_string(dim) + "D template");
   for (double x : b)
@@ -508,7 +508,8 @@ void bind_templates(py::module_& m) {
             py::list l;
             for (const auto& [sheets, count] : table) {
               py::list names;
-              for (int s : sheets) names.append(r.t.sheets[static_cast<std::size_t>(s)].name);
+              for (int s : sheets)
+                names.append(r.t.sheets[primal::index_cast<std::size_t>(s)].name);
               l.append(py::dict(py::arg("sheets") = py::tuple(names), py::arg("cells") = count));
             }
             return l;
@@ -542,14 +543,14 @@ void bind_templates(py::module_& m) {
               std::vector<double> sj;
               for (std::size_t q = 0; q < r.t.quad.quads.size(); ++q)
                 sj.push_back(primal::quad_scaled_jacobian(
-                    primal::quad_corners(r.t.quad, static_cast<Index>(q)), Point::UnitZ()));
+                    primal::quad_corners(r.t.quad, primal::index_cast(q)), Point::UnitZ()));
               d["scaled_jacobian"] = double_array(std::move(sj));
               return d;
             }
             for (const auto& info : primal::hex_metrics()) {
               std::vector<double> v;
               for (std::size_t h = 0; h < r.t.hex.hexes.size(); ++h)
-                v.push_back(info.evaluate(primal::hex_corners(r.t.hex, static_cast<Index>(h))));
+                v.push_back(info.evaluate(primal::hex_corners(r.t.hex, primal::index_cast(h))));
               d[py::str(std::string(info.key))] = double_array(std::move(v));
             }
             return d;

@@ -49,11 +49,11 @@ Domain make_cell_domain(const std::array<Point, 8>& P, int dim, bool pyramid = f
   const int n = 1 << dim;
   Point lo = Point::Constant(1e300), hi = Point::Constant(-1e300);
   for (int c = 0; c < n; ++c) {
-    if (!P[static_cast<std::size_t>(c)].allFinite())
+    if (!P[primal::index_cast<std::size_t>(c)].allFinite())
       throw InvalidInput(std::string("domain: ") + what + " corner " + std::to_string(c) +
                          " is not finite");
-    lo = lo.cwiseMin(P[static_cast<std::size_t>(c)]);
-    hi = hi.cwiseMax(P[static_cast<std::size_t>(c)]);
+    lo = lo.cwiseMin(P[primal::index_cast<std::size_t>(c)]);
+    hi = hi.cwiseMax(P[primal::index_cast<std::size_t>(c)]);
   }
   const double size = norm_d(hi - lo, dim);
   if (!(size > 0))
@@ -67,14 +67,14 @@ Domain make_cell_domain(const std::array<Point, 8>& P, int dim, bool pyramid = f
     Point r = Point::Constant(0.5);
     if (c < n)
       for (int a = 0; a < 3; ++a)
-        r[a] = primal::topology::kHexCornerCoords[static_cast<std::size_t>(c)]
-                                                 [static_cast<std::size_t>(a)];
+        r[a] = primal::topology::kHexCornerCoords[primal::index_cast<std::size_t>(c)]
+                                                 [primal::index_cast<std::size_t>(a)];
     const double j = multilinear_jacobian(P, r, dim);
     if (!(j > floor))
       throw InvalidInput(
           std::string("domain: the ") + what + "'s Jacobian is not positive at " +
           (c < n ? "corner " + std::to_string(c) + " " +
-                       format_point(P[static_cast<std::size_t>(c)], dim)
+                       format_point(P[primal::index_cast<std::size_t>(c)], dim)
                  : std::string("its centre")) +
           " (det " + std::to_string(j) + "): corners must be in VTK order" +
           (pyramid    ? " (base 0-1-2-3 counter-clockwise seen from the apex 4)"
@@ -112,7 +112,7 @@ class Engine {
         given_(sheets),
         options_(opt),
         dim_(domain.dim) {
-    if (static_cast<int>(sheets.size()) < dim_)
+    if (primal::index_cast<int>(sheets.size()) < dim_)
       throw InvalidInput("arrangement: needs at least as many sheets as dimensions");
     diag_ = (domain_.hi - domain_.lo).head(dim_).norm();
     h_ = options_.step * diag_;
@@ -143,11 +143,13 @@ class Engine {
     const auto& P = *d.corners;
     Point len = Point::Zero();
     for (const auto& e : primal::topology::kHexEdgeCorners) {
-      const Point v = P[static_cast<std::size_t>(e[1])] - P[static_cast<std::size_t>(e[0])];
-      const auto& a = primal::topology::kHexCornerCoords[static_cast<std::size_t>(e[0])];
-      const auto& b = primal::topology::kHexCornerCoords[static_cast<std::size_t>(e[1])];
+      const Point v =
+          P[primal::index_cast<std::size_t>(e[1])] - P[primal::index_cast<std::size_t>(e[0])];
+      const auto& a = primal::topology::kHexCornerCoords[primal::index_cast<std::size_t>(e[0])];
+      const auto& b = primal::topology::kHexCornerCoords[primal::index_cast<std::size_t>(e[1])];
       int axis = 0;
-      while (a[static_cast<std::size_t>(axis)] == b[static_cast<std::size_t>(axis)]) ++axis;
+      while (a[primal::index_cast<std::size_t>(axis)] == b[primal::index_cast<std::size_t>(axis)])
+        ++axis;
       if (d.dim == 2 && (axis == 2 || a[2] || b[2])) continue;  // the quad's 4 edges only
       len[axis] += norm_d(v, d.dim) / (d.dim == 3 ? 4.0 : 2.0);
     }
@@ -182,12 +184,14 @@ class Engine {
   std::string fmt_point(const Point& u, int dim) const { return format_point(physical(u), dim); }
 
   double value(int s, const Point& x) const {
-    return sheets_[static_cast<std::size_t>(s)].field(x);
+    return sheets_[primal::index_cast<std::size_t>(s)].field(x);
   }
   Point grad(int s, const Point& x) const {
-    return gradient(sheets_[static_cast<std::size_t>(s)].field, x, grad_h_, dim_);
+    return gradient(sheets_[primal::index_cast<std::size_t>(s)].field, x, grad_h_, dim_);
   }
-  std::string name(int s) const { return "'" + sheets_[static_cast<std::size_t>(s)].name + "'"; }
+  std::string name(int s) const {
+    return "'" + sheets_[primal::index_cast<std::size_t>(s)].name + "'";
+  }
   std::string names(const std::vector<int>& S) const {
     std::string r;
     for (std::size_t i = 0; i < S.size(); ++i) r += (i ? ", " : "") + name(S[i]);
@@ -209,18 +213,18 @@ class Engine {
   // the convergence test has just computed: callers need them for the curve's tangent.
   bool project(const std::vector<int>& S, Point& x, unsigned fixed = 0,
                std::array<Point, 3>* grads = nullptr) const {
-    const int k = static_cast<int>(S.size());
+    const int k = primal::index_cast<int>(S.size());
     // At most 3 x 3: fixed capacity keeps the hot path off the heap.
     using Mat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3>;
     using Vec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1>;
     Mat J(k, dim_);
     Vec F(k), gnorm(k);
-    for (int r = 0; r < k; ++r) F[r] = value(S[static_cast<std::size_t>(r)], x);
+    for (int r = 0; r < k; ++r) F[r] = value(S[primal::index_cast<std::size_t>(r)], x);
     for (int it = 0; it < 40; ++it) {
       double err = 0.0;
       for (int r = 0; r < k; ++r) {
-        const Point g = grad(S[static_cast<std::size_t>(r)], x);
-        if (grads) (*grads)[static_cast<std::size_t>(r)] = g;
+        const Point g = grad(S[primal::index_cast<std::size_t>(r)], x);
+        if (grads) (*grads)[primal::index_cast<std::size_t>(r)] = g;
         for (int c = 0; c < dim_; ++c) J(r, c) = (fixed >> c) & 1u ? 0.0 : g[c];
         gnorm[r] = J.row(r).norm();
         if (gnorm[r] < 1e-14) return false;
@@ -238,7 +242,7 @@ class Engine {
         for (int c = 0; c < dim_; ++c) y[c] -= step * dx[c];
         double trial = 0.0;
         for (int r = 0; r < k; ++r) {
-          F[r] = value(S[static_cast<std::size_t>(r)], y);
+          F[r] = value(S[primal::index_cast<std::size_t>(r)], y);
           trial = std::max(trial, std::abs(F[r]) / gnorm[r]);
         }
         if (trial < err || trial < tol_) {
@@ -298,7 +302,7 @@ class Engine {
   std::array<int, 3> cell_of(const Point& x) const {
     std::array<int, 3> c{0, 0, 0};
     for (int a = 0; a < dim_; ++a) {
-      const auto A = static_cast<std::size_t>(a);
+      const auto A = primal::index_cast<std::size_t>(a);
       const double t = (x[a] - domain_.lo[a]) / (domain_.hi[a] - domain_.lo[a]) * n_[A];
       c[A] = std::clamp(static_cast<int>(std::floor(t)), 0, n_[A] - 1);
     }
@@ -307,7 +311,7 @@ class Engine {
   int cell_id(int i, int j, int k) const { return (k * n_[1] + j) * n_[0] + i; }
   Point grid_node(int i, int j, int k) const;
   std::size_t grid_id(int i, int j, int k) const {
-    return static_cast<std::size_t>((k * (n_[1] + 1) + j) * (n_[0] + 1) + i);
+    return primal::index_cast<std::size_t>((k * (n_[1] + 1) + j) * (n_[0] + 1) + i);
   }
   std::array<int, 3> n_{1, 1, 1};
   std::vector<std::vector<double>> grid_;
@@ -331,8 +335,9 @@ Point Engine::grid_node(int i, int j, int k) const {
   Point p = domain_.lo;
   const std::array<int, 3> ijk{i, j, k};
   for (int a = 0; a < dim_; ++a)
-    p[a] = domain_.lo[a] + (domain_.hi[a] - domain_.lo[a]) * ijk[static_cast<std::size_t>(a)] /
-                               n_[static_cast<std::size_t>(a)];
+    p[a] = domain_.lo[a] + (domain_.hi[a] - domain_.lo[a]) *
+                               ijk[primal::index_cast<std::size_t>(a)] /
+                               n_[primal::index_cast<std::size_t>(a)];
   if (dim_ == 2) p[2] = 0.0;
   return p;
 }
@@ -342,10 +347,10 @@ void Engine::sample_grid() {
   for (int i = 0; i < dim_; ++i) longest = std::max(longest, domain_.hi[i] - domain_.lo[i]);
   n_ = {1, 1, 0};
   for (int i = 0; i < dim_; ++i)
-    n_[static_cast<std::size_t>(i)] =
+    n_[primal::index_cast<std::size_t>(i)] =
         std::max(2, static_cast<int>(std::lround(options_.seed_resolution *
                                                  (domain_.hi[i] - domain_.lo[i]) / longest)));
-  const std::size_t nn = static_cast<std::size_t>((n_[0] + 1) * (n_[1] + 1) * (n_[2] + 1));
+  const std::size_t nn = primal::index_cast<std::size_t>((n_[0] + 1) * (n_[1] + 1) * (n_[2] + 1));
   grid_.assign(sheets_.size(), std::vector<double>(nn));
   for (int k = 0; k <= n_[2]; ++k)
     for (int j = 0; j <= n_[1]; ++j)
@@ -367,7 +372,7 @@ std::vector<Point> Engine::seeds(const std::vector<int>& S) const {
       for (int i = 0; i < n_[0]; ++i) {
         bool all = true;
         for (std::size_t s = 0; s < S.size() && all; ++s) {
-          const auto& val = grid_[static_cast<std::size_t>(S[s])];
+          const auto& val = grid_[primal::index_cast<std::size_t>(S[s])];
           double lo = 1e300, hi = -1e300;
           for (int c = 0; c < corners; ++c) {
             const double v =
@@ -521,7 +526,7 @@ std::vector<Event> Engine::events(const Curve& c) const {
   const auto& P = c.polyline;
   const std::size_t n = P.size();
   const std::size_t segs = c.closed ? n : n - 1;
-  for (int s = 0; s < static_cast<int>(sheets_.size()); ++s) {
+  for (int s = 0; s < primal::index_cast<int>(sheets_.size()); ++s) {
     if (std::find(c.sheets.begin(), c.sheets.end(), s) != c.sheets.end()) continue;
     std::vector<int> T = c.sheets;
     T.push_back(s);
@@ -636,21 +641,21 @@ void Engine::check_touching(const std::vector<Curve>& curves) const {
   const int kcells = dim_ == 3 ? n_[2] : 1;
   const int corners = dim_ == 3 ? 8 : 4;
   const int ncell = cell_count();
-  const int m = static_cast<int>(sheets_.size());
+  const int m = primal::index_cast<int>(sheets_.size());
   std::array<double, 3> step{};
   for (int a = 0; a < dim_; ++a)
-    step[static_cast<std::size_t>(a)] =
-        (domain_.hi[a] - domain_.lo[a]) / n_[static_cast<std::size_t>(a)];
+    step[primal::index_cast<std::size_t>(a)] =
+        (domain_.hi[a] - domain_.lo[a]) / n_[primal::index_cast<std::size_t>(a)];
   auto corner_id = [&](int i, int j, int k, int c) {
     return grid_id(i + (c & 1), j + ((c >> 1) & 1), dim_ == 3 ? k + ((c >> 2) & 1) : 0);
   };
   // Per sheet and cell: is the zero set within about one cell (the smallest corner value no
   // larger than the spread over the corners, which for a linear field is the gradient times
   // the cell's extent along it).
-  std::vector<std::vector<char>> near(static_cast<std::size_t>(m),
-                                      std::vector<char>(static_cast<std::size_t>(ncell), 0));
+  std::vector<std::vector<char>> near(primal::index_cast<std::size_t>(m),
+                                      std::vector<char>(primal::index_cast<std::size_t>(ncell), 0));
   for (int s = 0; s < m; ++s) {
-    const auto& val = grid_[static_cast<std::size_t>(s)];
+    const auto& val = grid_[primal::index_cast<std::size_t>(s)];
     for (int k = 0; k < kcells; ++k)
       for (int j = 0; j < n_[1]; ++j)
         for (int i = 0; i < n_[0]; ++i) {
@@ -659,19 +664,20 @@ void Engine::check_touching(const std::vector<Curve>& curves) const {
             const double v = val[corner_id(i, j, k, c)];
             lo = std::min(lo, v), hi = std::max(hi, v), least = std::min(least, std::abs(v));
           }
-          near[static_cast<std::size_t>(s)][static_cast<std::size_t>(cell_id(i, j, k))] =
-              least <= hi - lo;
+          near[primal::index_cast<std::size_t>(s)]
+              [primal::index_cast<std::size_t>(cell_id(i, j, k))] = least <= hi - lo;
         }
   }
   // The field's gradient in a cell, estimated from its corners.
   auto slope = [&](int s, int id) {
     const int i = id % n_[0], j = (id / n_[0]) % n_[1], k = id / (n_[0] * n_[1]);
-    const auto& val = grid_[static_cast<std::size_t>(s)];
+    const auto& val = grid_[primal::index_cast<std::size_t>(s)];
     Point g = Point::Zero();
     for (int c = 0; c < corners; ++c) {
       const double v = val[corner_id(i, j, k, c)];
       for (int a = 0; a < dim_; ++a)
-        g[a] += ((c >> a) & 1 ? v : -v) / (step[static_cast<std::size_t>(a)] * (corners / 2));
+        g[a] +=
+            ((c >> a) & 1 ? v : -v) / (step[primal::index_cast<std::size_t>(a)] * (corners / 2));
     }
     return g;
   };
@@ -689,13 +695,13 @@ void Engine::check_touching(const std::vector<Curve>& curves) const {
     for (int k = std::max(0, c[2] - r); k <= std::min(kcells - 1, c[2] + r); ++k)
       for (int j = std::max(0, c[1] - r); j <= std::min(n_[1] - 1, c[1] + r); ++j)
         for (int i = std::max(0, c[0] - r); i <= std::min(n_[0] - 1, c[0] + r); ++i)
-          covered[static_cast<std::size_t>(cell_id(i, j, k))] = 1;
+          covered[primal::index_cast<std::size_t>(cell_id(i, j, k))] = 1;
   };
 
   // Pairs of sheets. A common zero with parallel gradients is a touching point; one with
   // crossing gradients must lie on a traced curve (3D) or be a vertex (2D), else a piece of
   // the arrangement smaller than the seeding grid was missed.
-  std::vector<char> covered(static_cast<std::size_t>(ncell));
+  std::vector<char> covered(primal::index_cast<std::size_t>(ncell));
   for (int a = 0; a < m; ++a)
     for (int b = a + 1; b < m; ++b) {
       const std::vector<int> S{a, b};
@@ -717,9 +723,9 @@ void Engine::check_touching(const std::vector<Curve>& curves) const {
           }
       }
       for (int id = 0; id < ncell; ++id) {
-        const auto I = static_cast<std::size_t>(id);
-        if (covered[I] || !near[static_cast<std::size_t>(a)][I] ||
-            !near[static_cast<std::size_t>(b)][I])
+        const auto I = primal::index_cast<std::size_t>(id);
+        if (covered[I] || !near[primal::index_cast<std::size_t>(a)][I] ||
+            !near[primal::index_cast<std::size_t>(b)][I])
           continue;
         // Zero sets crossing at more than 45 degrees here: a crossing, not a touching.
         const Point ga = slope(a, id), gb = slope(b, id);
@@ -755,9 +761,9 @@ void Engine::check_touching(const std::vector<Curve>& curves) const {
     for (int high = 0; high < 2; ++high) {
       const Equation face{-1, axis, high ? domain_.hi[axis] : domain_.lo[axis]};
       std::array<int, 3> top{n_[0], n_[1], dim_ == 3 ? n_[2] : 0};
-      const auto A = static_cast<std::size_t>(axis);
+      const auto A = primal::index_cast<std::size_t>(axis);
       for (int s = 0; s < m; ++s) {
-        const auto& val = grid_[static_cast<std::size_t>(s)];
+        const auto& val = grid_[primal::index_cast<std::size_t>(s)];
         std::array<int, 3> p{0, 0, 0}, from{0, 0, 0}, to = top;
         from[A] = to[A] = high ? top[A] : 0;
         for (p[2] = from[2]; p[2] <= to[2]; ++p[2])
@@ -798,9 +804,9 @@ void Engine::check_touching(const std::vector<Curve>& curves) const {
 void Engine::check_apex() const {
   if (!user_.is_pyramid) return;
   const Point apex = (*user_.corners)[4];
-  for (int s = 0; s < static_cast<int>(sheets_.size()); ++s) {
+  for (int s = 0; s < primal::index_cast<int>(sheets_.size()); ++s) {
     // In physical space (the composed field's gradient vanishes at the apex).
-    const Field& f = given_[static_cast<std::size_t>(s)].field;
+    const Field& f = given_[primal::index_cast<std::size_t>(s)].field;
     const double g = gradient(f, apex, grad_h_, dim_).norm();
     if (std::abs(f(apex)) < 1e-6 * diag_ * std::max(g, 1e-300))
       throw TopologyError("arrangement: sheet " + name(s) + " passes through the pyramid's apex " +
@@ -816,7 +822,7 @@ int Engine::register_vertex(std::vector<int> S, const Point& x) {
   std::vector<int>& same = vertices_by_sheets_[key];
   // The first match in registration order, as a scan over all vertices would find.
   for (int i : same) {
-    Vertex& v = vertices_[static_cast<std::size_t>(i)];
+    Vertex& v = vertices_[primal::index_cast<std::size_t>(i)];
     if ((v.x - x).norm() < 1e-7 * diag_) {
       ++v.found;
       return i;
@@ -828,7 +834,7 @@ int Engine::register_vertex(std::vector<int> S, const Point& x) {
   v.found = 1;
   Eigen::MatrixXd J(dim_, dim_);
   for (int r = 0; r < dim_; ++r)
-    J.row(r) = grad(S[static_cast<std::size_t>(r)], x).head(dim_).transpose();
+    J.row(r) = grad(S[primal::index_cast<std::size_t>(r)], x).head(dim_).transpose();
   v.orientation = J.determinant() > 0 ? 1 : -1;
   check_vertex(v, J);
   vertices_.push_back(v);
@@ -843,7 +849,7 @@ void Engine::check_vertex(const Vertex& v, const Eigen::MatrixXd& J) const {
   if (std::abs(J.determinant()) < 1e-6 * prod)
     throw TopologyError("arrangement: sheets " + names(v.sheets) + " meet tangentially at " +
                         fmt_point(v.x, dim_) + " (not in general position)");
-  for (int e = 0; e < static_cast<int>(sheets_.size()); ++e) {
+  for (int e = 0; e < primal::index_cast<int>(sheets_.size()); ++e) {
     if (std::find(v.sheets.begin(), v.sheets.end(), e) != v.sheets.end()) continue;
     const double g = grad(e, v.x).norm();
     if (std::abs(value(e, v.x)) < 1e-7 * diag_ * std::max(g, 1e-300))
@@ -861,7 +867,7 @@ void Engine::check_vertex(const Vertex& v, const Eigen::MatrixXd& J) const {
 Arrangement Engine::run() {
   Arrangement A;
   A.domain = user_;
-  A.sheet_count = static_cast<int>(sheets_.size());
+  A.sheet_count = primal::index_cast<int>(sheets_.size());
   for (const auto& s : sheets_) A.sheet_names.push_back(s.name);
 
   check_apex();
@@ -973,29 +979,29 @@ Arrangement Engine::run() {
     return k;
   };
   std::sort(order.begin(), order.end(), [&](int a, int b) {
-    return key(vertices_[static_cast<std::size_t>(a)]) <
-           key(vertices_[static_cast<std::size_t>(b)]);
+    return key(vertices_[primal::index_cast<std::size_t>(a)]) <
+           key(vertices_[primal::index_cast<std::size_t>(b)]);
   });
   std::vector<int> rank(vertices_.size());
   for (std::size_t i = 0; i < order.size(); ++i) {
-    rank[static_cast<std::size_t>(order[i])] = static_cast<int>(i);
-    A.vertices.push_back(vertices_[static_cast<std::size_t>(order[i])]);
+    rank[primal::index_cast<std::size_t>(order[i])] = static_cast<int>(i);
+    A.vertices.push_back(vertices_[primal::index_cast<std::size_t>(order[i])]);
   }
 
   // 4. Regions: union the octants around each 1-cell at its two ends.
   const int octants = 1 << dim_;
-  const int nv = static_cast<int>(A.vertices.size());
-  primal::DisjointSets uf(static_cast<std::size_t>(nv * octants));
-  std::vector<unsigned> faces(static_cast<std::size_t>(nv * octants), 0u);
+  const int nv = primal::index_cast<int>(A.vertices.size());
+  primal::DisjointSets uf(primal::index_cast<std::size_t>(nv * octants));
+  std::vector<unsigned> faces(primal::index_cast<std::size_t>(nv * octants), 0u);
   auto octant_bits = [&](int v, const std::vector<int>& S, int sigma, int extra,
                          const std::vector<int>& side) {
-    const Vertex& V = A.vertices[static_cast<std::size_t>(v)];
+    const Vertex& V = A.vertices[primal::index_cast<std::size_t>(v)];
     int bits = 0;
     for (int i = 0; i < dim_; ++i) {
-      const int s = V.sheets[static_cast<std::size_t>(i)];
+      const int s = V.sheets[primal::index_cast<std::size_t>(i)];
       bool pos;
       if (s == extra)
-        pos = side[static_cast<std::size_t>(s)] > 0;
+        pos = side[primal::index_cast<std::size_t>(s)] > 0;
       else {
         const auto it = std::find(S.begin(), S.end(), s);
         assert(it != S.end());
@@ -1009,37 +1015,38 @@ Arrangement Engine::run() {
     Edge1 e;
     e.sheets = r.sheets;
     e.side = r.side;
-    if (r.va >= 0) r.va = rank[static_cast<std::size_t>(r.va)];
-    if (r.vb >= 0) r.vb = rank[static_cast<std::size_t>(r.vb)];
+    if (r.va >= 0) r.va = rank[primal::index_cast<std::size_t>(r.va)];
+    if (r.vb >= 0) r.vb = rank[primal::index_cast<std::size_t>(r.vb)];
     e.a = {r.va, r.fa, r.xa};
     e.b = {r.vb, r.fb, r.xb};
     for (int sigma = 0; sigma < (1 << (dim_ - 1)); ++sigma) {
       const int ka = r.va >= 0 ? octant_bits(r.va, r.sheets, sigma, r.sa, r.side) : -1;
       const int kb = r.vb >= 0 ? octant_bits(r.vb, r.sheets, sigma, r.sb, r.side) : -1;
       if (ka >= 0 && kb >= 0) uf.unite(ka, kb);
-      if (ka >= 0 && kb < 0) faces[static_cast<std::size_t>(ka)] |= 1u << r.fb;
-      if (kb >= 0 && ka < 0) faces[static_cast<std::size_t>(kb)] |= 1u << r.fa;
+      if (ka >= 0 && kb < 0) faces[primal::index_cast<std::size_t>(ka)] |= 1u << r.fb;
+      if (kb >= 0 && ka < 0) faces[primal::index_cast<std::size_t>(kb)] |= 1u << r.fa;
     }
     A.edges.push_back(std::move(e));
   }
-  std::vector<int> label(static_cast<std::size_t>(nv * octants), -1);
-  A.region.assign(static_cast<std::size_t>(nv), {-1, -1, -1, -1, -1, -1, -1, -1});
+  std::vector<int> label(primal::index_cast<std::size_t>(nv * octants), -1);
+  A.region.assign(primal::index_cast<std::size_t>(nv), {-1, -1, -1, -1, -1, -1, -1, -1});
   for (int v = 0; v < nv; ++v) {
-    const Vertex& V = A.vertices[static_cast<std::size_t>(v)];
+    const Vertex& V = A.vertices[primal::index_cast<std::size_t>(v)];
     const Eigen::MatrixXd Jinv =
-        jacobians_[static_cast<std::size_t>(order[static_cast<std::size_t>(v)])].inverse();
+        jacobians_[primal::index_cast<std::size_t>(order[primal::index_cast<std::size_t>(v)])]
+            .inverse();
     for (int b = 0; b < octants; ++b) {
       const int root = uf.find(v * octants + b);
-      int& l = label[static_cast<std::size_t>(root)];
+      int& l = label[primal::index_cast<std::size_t>(root)];
       const bool fresh = l < 0;
       if (fresh) {
         l = A.region_count++;
         A.region_faces.push_back(0u);
         A.region_signs.emplace_back();
       }
-      A.region[static_cast<std::size_t>(v)][static_cast<std::size_t>(b)] = l;
-      A.region_faces[static_cast<std::size_t>(l)] |=
-          faces[static_cast<std::size_t>(v * octants + b)];
+      A.region[primal::index_cast<std::size_t>(v)][primal::index_cast<std::size_t>(b)] = l;
+      A.region_faces[primal::index_cast<std::size_t>(l)] |=
+          faces[primal::index_cast<std::size_t>(v * octants + b)];
       // Sign vector of the region, sampled just inside this octant.
       Eigen::VectorXd sigma(dim_);
       for (int i = 0; i < dim_; ++i) sigma[i] = (b >> i) & 1 ? 1.0 : -1.0;
@@ -1048,7 +1055,7 @@ Arrangement Engine::run() {
       for (int i = 0; i < dim_; ++i) x[i] += 1e-5 * diag_ * d[i] / d.norm();
       std::vector<int> sg;
       for (int s = 0; s < m; ++s) sg.push_back(value(s, x) < 0 ? -1 : 1);
-      auto& rs = A.region_signs[static_cast<std::size_t>(l)];
+      auto& rs = A.region_signs[primal::index_cast<std::size_t>(l)];
       if (fresh)
         rs = sg;
       else if (rs != sg)
@@ -1067,20 +1074,21 @@ Arrangement Engine::run() {
     for (const Sheet& s : given_) sg.push_back(s.field(apex) < 0 ? -1 : 1);
     std::vector<int> hits;
     for (int r = 0; r < A.region_count; ++r)
-      if (A.region_signs[static_cast<std::size_t>(r)] == sg) hits.push_back(r);
+      if (A.region_signs[primal::index_cast<std::size_t>(r)] == sg) hits.push_back(r);
     // Two regions may share a sign vector; the apex's touches all four triangles near it, a
     // region far below rarely does.
     if (hits.size() > 1) {
       std::vector<int> around;
       for (int r : hits)
-        if ((A.region_faces[static_cast<std::size_t>(r)] & 0xFu) == 0xFu) around.push_back(r);
+        if ((A.region_faces[primal::index_cast<std::size_t>(r)] & 0xFu) == 0xFu)
+          around.push_back(r);
       if (around.size() == 1) hits = around;
     }
     if (hits.size() != 1) {
       std::string masks;
       for (int r : hits)
         masks += (masks.empty() ? "" : ", ") +
-                 std::to_string(A.region_faces[static_cast<std::size_t>(r)]);
+                 std::to_string(A.region_faces[primal::index_cast<std::size_t>(r)]);
       throw TopologyError(
           "arrangement: " + std::to_string(hits.size()) +
           " regions have the sign vector of the pyramid's apex " + format_point(apex, dim_) +
@@ -1091,7 +1099,7 @@ Arrangement Engine::run() {
                  "sides (boundary faces touched, as masks: " +
                      masks + ")"));
     }
-    A.region_faces[static_cast<std::size_t>(hits[0])] |= 1u << box_face(2, true);
+    A.region_faces[primal::index_cast<std::size_t>(hits[0])] |= 1u << box_face(2, true);
   }
   // Report physical positions (the identity for a box). A vertex's orientation was taken
   // from the composed fields' gradients: it is the physical one where the map's Jacobian is

@@ -13,7 +13,7 @@ namespace {
 std::string sheet_list(const Arrangement& A, const std::vector<int>& S) {
   std::string r;
   for (std::size_t i = 0; i < S.size(); ++i)
-    r += (i ? ", '" : "'") + A.sheet_names[static_cast<std::size_t>(S[i])] + "'";
+    r += (i ? ", '" : "'") + A.sheet_names[primal::index_cast<std::size_t>(S[i])] + "'";
   return r;
 }
 
@@ -29,34 +29,38 @@ std::vector<int> link_euler(const DualMesh& D, std::size_t nodes) {
   if (D.dim == 3) {
     for (const auto& h : D.hex.hexes) {
       for (const auto& e : primal::topology::kHexEdgeCorners) {
-        edges[static_cast<std::size_t>(h[static_cast<std::size_t>(e[0])])].insert(
-            key(h[static_cast<std::size_t>(e[0])], h[static_cast<std::size_t>(e[1])]));
-        edges[static_cast<std::size_t>(h[static_cast<std::size_t>(e[1])])].insert(
-            key(h[static_cast<std::size_t>(e[0])], h[static_cast<std::size_t>(e[1])]));
+        edges[primal::index_cast<std::size_t>(h[primal::index_cast<std::size_t>(e[0])])].insert(key(
+            h[primal::index_cast<std::size_t>(e[0])], h[primal::index_cast<std::size_t>(e[1])]));
+        edges[primal::index_cast<std::size_t>(h[primal::index_cast<std::size_t>(e[1])])].insert(key(
+            h[primal::index_cast<std::size_t>(e[0])], h[primal::index_cast<std::size_t>(e[1])]));
       }
       for (const auto& f : primal::topology::kHexFaceCorners) {
         std::vector<int> q;
-        for (int c : f) q.push_back(h[static_cast<std::size_t>(c)]);
+        for (int c : f) q.push_back(h[primal::index_cast<std::size_t>(c)]);
         std::sort(q.begin(), q.end());
-        for (int c : f) faces[static_cast<std::size_t>(h[static_cast<std::size_t>(c)])].insert(q);
+        for (int c : f)
+          faces[primal::index_cast<std::size_t>(h[primal::index_cast<std::size_t>(c)])].insert(q);
       }
-      for (int c : h) ++cells[static_cast<std::size_t>(c)];
+      for (int c : h) ++cells[primal::index_cast<std::size_t>(c)];
     }
     std::vector<int> chi(nodes);
     for (std::size_t v = 0; v < nodes; ++v)
-      chi[v] = static_cast<int>(edges[v].size()) - static_cast<int>(faces[v].size()) + cells[v];
+      chi[v] = primal::index_cast<int>(edges[v].size()) - primal::index_cast<int>(faces[v].size()) +
+               cells[v];
     return chi;
   }
   for (const auto& q : D.quad.quads) {
     for (const auto& e : primal::topology::kQuadEdgeCorners) {
-      const int a = q[static_cast<std::size_t>(e[0])], b = q[static_cast<std::size_t>(e[1])];
-      edges[static_cast<std::size_t>(a)].insert(key(a, b));
-      edges[static_cast<std::size_t>(b)].insert(key(a, b));
+      const int a = q[primal::index_cast<std::size_t>(e[0])],
+                b = q[primal::index_cast<std::size_t>(e[1])];
+      edges[primal::index_cast<std::size_t>(a)].insert(key(a, b));
+      edges[primal::index_cast<std::size_t>(b)].insert(key(a, b));
     }
-    for (int c : q) ++cells[static_cast<std::size_t>(c)];
+    for (int c : q) ++cells[primal::index_cast<std::size_t>(c)];
   }
   std::vector<int> chi(nodes);
-  for (std::size_t v = 0; v < nodes; ++v) chi[v] = static_cast<int>(edges[v].size()) - cells[v];
+  for (std::size_t v = 0; v < nodes; ++v)
+    chi[v] = primal::index_cast<int>(edges[v].size()) - cells[v];
   return chi;
 }
 
@@ -68,12 +72,12 @@ DualMesh dualize(const Arrangement& A) {
   D.dim = dim;
   const int corners = 1 << dim;
   // Number the nodes in the order they first appear as element corners.
-  std::vector<int> node_of_region(static_cast<std::size_t>(A.region_count), -1);
+  std::vector<int> node_of_region(primal::index_cast<std::size_t>(A.region_count), -1);
   std::vector<int> region_of_node;
   auto node = [&](int region) {
-    int& n = node_of_region[static_cast<std::size_t>(region)];
+    int& n = node_of_region[primal::index_cast<std::size_t>(region)];
     if (n < 0) {
-      n = static_cast<int>(region_of_node.size());
+      n = primal::index_cast<int>(region_of_node.size());
       region_of_node.push_back(region);
     }
     return n;
@@ -84,17 +88,18 @@ DualMesh dualize(const Arrangement& A) {
     for (int c = 0; c < corners; ++c) {
       // Corner c of the reference element sits on the positive side of sheet i when its
       // local coordinate i is 1; a negative orientation mirrors the first axis.
-      const auto& rc = primal::topology::kHexCornerCoords[static_cast<std::size_t>(c)];
+      const auto& rc = primal::topology::kHexCornerCoords[primal::index_cast<std::size_t>(c)];
       int bits = 0;
       for (int i = 0; i < dim; ++i) {
-        bool pos = rc[static_cast<std::size_t>(i)] == 1;
+        bool pos = rc[primal::index_cast<std::size_t>(i)] == 1;
         if (i == 0 && V.orientation < 0) pos = !pos;
         if (pos) bits |= 1 << i;
       }
-      cell[static_cast<std::size_t>(c)] = node(A.region[v][static_cast<std::size_t>(bits)]);
+      cell[primal::index_cast<std::size_t>(c)] =
+          node(A.region[v][primal::index_cast<std::size_t>(bits)]);
     }
     std::set<primal::Index> distinct(cell.begin(), cell.begin() + corners);
-    if (static_cast<int>(distinct.size()) != corners)
+    if (primal::index_cast<int>(distinct.size()) != corners)
       throw TopologyError("dualize: around the vertex of sheets " + sheet_list(A, V.sheets) +
                           " at " + format_point(V.x, dim) +
                           " two octants are one region: its element would repeat a node");
@@ -121,8 +126,8 @@ DualMesh dualize(const Arrangement& A) {
   auto accumulate = [&](const auto& elements) {
     for (std::size_t e = 0; e < elements.size(); ++e)
       for (auto n : elements[e]) {
-        sum[static_cast<std::size_t>(n)] += cell ? A.vertices[e].local : A.vertices[e].x;
-        ++count[static_cast<std::size_t>(n)];
+        sum[primal::index_cast<std::size_t>(n)] += cell ? A.vertices[e].local : A.vertices[e].x;
+        ++count[primal::index_cast<std::size_t>(n)];
       }
   };
   if (dim == 3)
@@ -133,14 +138,14 @@ DualMesh dualize(const Arrangement& A) {
   for (std::size_t n = 0; n < nodes; ++n) {
     const int r = region_of_node[n];
     primal::Point p = sum[n] / count[n];
-    const unsigned f = A.region_faces[static_cast<std::size_t>(r)];
+    const unsigned f = A.region_faces[primal::index_cast<std::size_t>(r)];
     for (int axis = 0; axis < dim; ++axis) {
       if ((f >> (2 * axis)) & 1u) p[axis] = cell ? 0.0 : A.domain.lo[axis];
       if ((f >> (2 * axis + 1)) & 1u) p[axis] = cell ? 1.0 : A.domain.hi[axis];
     }
     pts[n] = cell ? domain_point(A.domain, p) : p;
     D.node_faces.push_back(f);
-    D.node_signs.push_back(A.region_signs[static_cast<std::size_t>(r)]);
+    D.node_signs.push_back(A.region_signs[primal::index_cast<std::size_t>(r)]);
   }
   if (dim == 3)
     D.hex.points = pts;
@@ -184,7 +189,8 @@ DualMesh dualize(const Arrangement& A) {
            v.boundary.euler == 2;
     found = "V - E + F - C = " + std::to_string(v.euler) +
             ", boundary V - E + F = " + std::to_string(v.boundary.euler);
-    for (primal::Index n : v.boundary.vertex_node) on_boundary[static_cast<std::size_t>(n)] = 1;
+    for (primal::Index n : v.boundary.vertex_node)
+      on_boundary[primal::index_cast<std::size_t>(n)] = 1;
   } else {
     const primal::QuadValidityReport v = primal::check_validity(D.quad);
     ball = v.overshared_edges.empty() && v.nonmanifold_vertices.empty() && v.euler == 1 &&
@@ -192,7 +198,7 @@ DualMesh dualize(const Arrangement& A) {
     found = "V - E + F = " + std::to_string(v.euler) + ", " +
             std::to_string(v.boundary_loops.size()) + " boundary loop(s)";
     for (const auto& loop : v.boundary_loops)
-      for (primal::Index n : loop) on_boundary[static_cast<std::size_t>(n)] = 1;
+      for (primal::Index n : loop) on_boundary[primal::index_cast<std::size_t>(n)] = 1;
   }
   if (!ball)
     throw TopologyError("dualize: the dual of the arrangement is not a " +

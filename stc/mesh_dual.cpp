@@ -60,8 +60,8 @@ void build_traces(const std::vector<std::array<Index, 8>>&, MeshDual<3>& dual) {
   }
   std::vector<std::vector<Index>> at(dual.edges.size());  // links at each edge
   for (std::size_t l = 0; l < links.size(); ++l) {
-    at[links[l].a].push_back(static_cast<Index>(l));
-    at[links[l].b].push_back(static_cast<Index>(l));
+    at[links[l].a].push_back(primal::index_cast(l));
+    at[links[l].b].push_back(primal::index_cast(l));
   }
   for (std::size_t e = 0; e < at.size(); ++e) {
     if (!at[e].empty() && at[e].size() != 2) {
@@ -108,7 +108,7 @@ MeshDual<Dim> build(std::size_t n_nodes,
                     const std::vector<std::array<Index, Ref<Dim>::kCorners>>& cells) {
   using R = Ref<Dim>;
   MeshDual<Dim> dual;
-  const Index n_cells = static_cast<Index>(cells.size());
+  const Index n_cells = primal::index_cast(cells.size());
 
   // Validate and number the edges.
   std::unordered_map<std::uint64_t, Index> edge_id;
@@ -117,7 +117,7 @@ MeshDual<Dim> build(std::size_t n_nodes,
     const auto& cell = cells[c];
     const std::string name = std::string(R::kCellName) + " " + std::to_string(c);
     for (int k = 0; k < R::kCorners; ++k) {
-      if (cell[k] < 0 || static_cast<std::size_t>(cell[k]) >= n_nodes)
+      if (cell[k] < 0 || primal::index_cast<std::size_t>(cell[k]) >= n_nodes)
         throw InvalidInput(name + ": corner " + std::to_string(k) + " = " +
                            std::to_string(cell[k]) + " is not a node (mesh has " +
                            std::to_string(n_nodes) + ")");
@@ -128,7 +128,7 @@ MeshDual<Dim> build(std::size_t n_nodes,
     }
     for (int e = 0; e < MeshDual<Dim>::kCellEdges; ++e) {
       const Index a = cell[R::kEdgeTable[e][0]], b = cell[R::kEdgeTable[e][1]];
-      auto [it, fresh] = edge_id.emplace(pair_key(a, b), static_cast<Index>(dual.edges.size()));
+      auto [it, fresh] = edge_id.emplace(pair_key(a, b), primal::index_cast(dual.edges.size()));
       if (fresh) dual.edges.push_back({std::min(a, b), std::max(a, b)});
       dual.cell_edges[c][e] = it->second;
     }
@@ -146,7 +146,7 @@ MeshDual<Dim> build(std::size_t n_nodes,
     for (int e = 0; e < MeshDual<Dim>::kCellEdges; ++e) {
       Index& s = sheet_of_root[uf.find(dual.cell_edges[c][e])];
       if (s < 0) {
-        s = static_cast<Index>(dual.sheets.size());
+        s = primal::index_cast(dual.sheets.size());
         dual.sheets.emplace_back();
       }
       dual.cell_sheets[c][R::edge_class(e)] = s;
@@ -154,8 +154,8 @@ MeshDual<Dim> build(std::size_t n_nodes,
   }
   dual.edge_sheet.resize(dual.edges.size());
   for (std::size_t e = 0; e < dual.edges.size(); ++e) {
-    dual.edge_sheet[e] = sheet_of_root[uf.find(static_cast<Index>(e))];
-    dual.sheets[dual.edge_sheet[e]].edges.push_back(static_cast<Index>(e));
+    dual.edge_sheet[e] = sheet_of_root[uf.find(primal::index_cast(e))];
+    dual.sheets[dual.edge_sheet[e]].edges.push_back(primal::index_cast(e));
   }
   for (Index c = 0; c < n_cells; ++c) {
     auto tuple = dual.cell_sheets[c];
@@ -202,7 +202,7 @@ MeshDual<Dim> build(std::size_t n_nodes,
 template <int Dim>
 std::vector<std::vector<TraceCurve>> split(const MeshDual<Dim>& dual, Index sheet,
                                            const FacetClassifier& classify, int regions) {
-  if (sheet < 0 || static_cast<std::size_t>(sheet) >= dual.sheets.size())
+  if (sheet < 0 || primal::index_cast<std::size_t>(sheet) >= dual.sheets.size())
     throw InvalidInput("trace_by_region: no sheet " + std::to_string(sheet));
   std::vector<std::vector<TraceCurve>> out(regions);
   for (const TraceCurve& curve : dual.sheets[sheet].trace) {

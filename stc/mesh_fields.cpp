@@ -46,8 +46,8 @@ class CellLocator {
     hi_ = Vec::Constant(-1e300);
     for (const auto& c : cells_)
       for (Index n : c) {
-        lo_ = lo_.cwiseMin(points_[static_cast<std::size_t>(n)].template head<Dim>());
-        hi_ = hi_.cwiseMax(points_[static_cast<std::size_t>(n)].template head<Dim>());
+        lo_ = lo_.cwiseMin(points_[primal::index_cast<std::size_t>(n)].template head<Dim>());
+        hi_ = hi_.cwiseMax(points_[primal::index_cast<std::size_t>(n)].template head<Dim>());
       }
     scale_ = std::max((hi_ - lo_).norm(), 1e-300);
     // About one or two cells per bucket along each axis.
@@ -55,19 +55,19 @@ class CellLocator {
     for (int a = 0; a < Dim; ++a)
       n_[a] = std::clamp(static_cast<int>(std::lround(1.5 * per_axis)), 1, 64);
     std::size_t buckets = 1;
-    for (int a = 0; a < Dim; ++a) buckets *= static_cast<std::size_t>(n_[a]);
+    for (int a = 0; a < Dim; ++a) buckets *= primal::index_cast<std::size_t>(n_[a]);
     buckets_.resize(buckets);
     const double pad = 1e-9 * scale_;
     for (std::size_t c = 0; c < cells_.size(); ++c) {
       Vec blo = Vec::Constant(1e300), bhi = Vec::Constant(-1e300);
       for (Index n : cells_[c]) {
-        blo = blo.cwiseMin(points_[static_cast<std::size_t>(n)].template head<Dim>());
-        bhi = bhi.cwiseMax(points_[static_cast<std::size_t>(n)].template head<Dim>());
+        blo = blo.cwiseMin(points_[primal::index_cast<std::size_t>(n)].template head<Dim>());
+        bhi = bhi.cwiseMax(points_[primal::index_cast<std::size_t>(n)].template head<Dim>());
       }
       box_lo_.push_back(blo - Vec::Constant(pad));
       box_hi_.push_back(bhi + Vec::Constant(pad));
       const auto a = bucket_coords(box_lo_.back()), b = bucket_coords(box_hi_.back());
-      for_each_bucket(a, b, [&](std::size_t id) { buckets_[id].push_back(static_cast<Index>(c)); });
+      for_each_bucket(a, b, [&](std::size_t id) { buckets_[id].push_back(primal::index_cast(c)); });
     }
   }
 
@@ -82,8 +82,8 @@ class CellLocator {
   Vec map(Index cell, const Vec& u, Mat* jacobian = nullptr) const {
     std::array<Point, kCorners> P;
     for (int c = 0; c < kCorners; ++c)
-      P[static_cast<std::size_t>(c)] = points_[static_cast<std::size_t>(
-          cells_[static_cast<std::size_t>(cell)][static_cast<std::size_t>(c)])];
+      P[primal::index_cast<std::size_t>(c)] = points_[primal::index_cast<std::size_t>(
+          cells_[primal::index_cast<std::size_t>(cell)][primal::index_cast<std::size_t>(c)])];
     if (jacobian)
       *jacobian = primal::multilinear_jacobian(P, local(u), Dim).template topLeftCorner<Dim, Dim>();
     return primal::multilinear_point(P, local(u), Dim).template head<Dim>();
@@ -121,7 +121,7 @@ class CellLocator {
     for (int a = 0; a < Dim; ++a) {
       std::uint64_t bits;
       std::memcpy(&bits, &x[a], sizeof bits);
-      key = (key ^ static_cast<std::size_t>(bits)) * 0x9E3779B97F4A7C15ull;
+      key = (key ^ primal::index_cast<std::size_t>(bits)) * 0x9E3779B97F4A7C15ull;
     }
     auto& slot = cache_[(key >> 40) % cache_.size()];
     if (slot.first == x) return slot.second;
@@ -137,7 +137,7 @@ class CellLocator {
       return best_out <= 1e-12;
     };
     auto in_box = [&](Index c) {
-      const auto i = static_cast<std::size_t>(c);
+      const auto i = primal::index_cast<std::size_t>(c);
       return (x.array() >= box_lo_[i].array()).all() && (x.array() <= box_hi_[i].array()).all();
     };
     // Points come in runs along a curve: the last cell first, then the bucket's cells.
@@ -156,7 +156,7 @@ class CellLocator {
         nearest = std::min(nearest, gap[c]);
       }
       for (std::size_t c = 0; c < cells_.size(); ++c)
-        if (gap[c] <= nearest + 1e-6 * scale_) consider(static_cast<Index>(c), false);
+        if (gap[c] <= nearest + 1e-6 * scale_) consider(primal::index_cast(c), false);
     }
     last_ = best.cell;
     slot = {x, best};
@@ -176,7 +176,7 @@ class CellLocator {
   std::size_t bucket_id(const std::array<int, Dim>& b) const {
     std::size_t id = 0;
     for (int a = Dim - 1; a >= 0; --a)
-      id = id * static_cast<std::size_t>(n_[a]) + static_cast<std::size_t>(b[a]);
+      id = id * primal::index_cast<std::size_t>(n_[a]) + primal::index_cast<std::size_t>(b[a]);
     return id;
   }
   template <class F>
@@ -231,8 +231,8 @@ MeshArrangementInput build(const std::vector<Point>& points,
   std::vector<std::vector<std::pair<Index, Index>>> adjacent(nn);
   for (std::size_t e = 0; e < dual.edges.size(); ++e) {
     const auto& E = dual.edges[e];
-    adjacent[static_cast<std::size_t>(E[0])].emplace_back(E[1], dual.edge_sheet[e]);
-    adjacent[static_cast<std::size_t>(E[1])].emplace_back(E[0], dual.edge_sheet[e]);
+    adjacent[primal::index_cast<std::size_t>(E[0])].emplace_back(E[1], dual.edge_sheet[e]);
+    adjacent[primal::index_cast<std::size_t>(E[1])].emplace_back(E[0], dual.edge_sheet[e]);
   }
   MeshArrangementInput out;
   for (std::size_t s = 0; s < dual.sheets.size(); ++s) {
@@ -245,37 +245,40 @@ MeshArrangementInput build(const std::vector<Point>& points,
     // Sides: the nodes joined by edges of other sheets.
     primal::DisjointSets sides(nn);
     for (std::size_t e = 0; e < dual.edges.size(); ++e)
-      if (dual.edge_sheet[e] != static_cast<Index>(s))
+      if (dual.edge_sheet[e] != primal::index_cast(s))
         sides.unite(dual.edges[e][0], dual.edges[e][1]);
     for (Index e : sheet.edges) {
-      const auto& E = dual.edges[static_cast<std::size_t>(e)];
+      const auto& E = dual.edges[primal::index_cast<std::size_t>(e)];
       if (sides.find(E[0]) == sides.find(E[1]))
         throw TopologyError(who + " does not separate the mesh: the ends of its edge " +
                             std::to_string(E[0]) + "-" + std::to_string(E[1]) +
                             " are joined by edges of other sheets");
     }
-    const Index first = sides.find(dual.edges[static_cast<std::size_t>(sheet.edges.front())][0]);
-    const Index second = sides.find(dual.edges[static_cast<std::size_t>(sheet.edges.front())][1]);
+    const Index first =
+        sides.find(dual.edges[primal::index_cast<std::size_t>(sheet.edges.front())][0]);
+    const Index second =
+        sides.find(dual.edges[primal::index_cast<std::size_t>(sheet.edges.front())][1]);
     // Layers: breadth-first over edges of other sheets from the nodes ending an S edge.
     std::vector<int> layer(nn, -1);
     std::deque<Index> queue;
     for (Index e : sheet.edges)
-      for (Index n : dual.edges[static_cast<std::size_t>(e)])
-        if (layer[static_cast<std::size_t>(n)] < 0)
-          layer[static_cast<std::size_t>(n)] = 1, queue.push_back(n);
+      for (Index n : dual.edges[primal::index_cast<std::size_t>(e)])
+        if (layer[primal::index_cast<std::size_t>(n)] < 0)
+          layer[primal::index_cast<std::size_t>(n)] = 1, queue.push_back(n);
     while (!queue.empty()) {
       const Index n = queue.front();
       queue.pop_front();
-      for (const auto& [m, sheet_of_edge] : adjacent[static_cast<std::size_t>(n)])
-        if (sheet_of_edge != static_cast<Index>(s) && layer[static_cast<std::size_t>(m)] < 0) {
-          layer[static_cast<std::size_t>(m)] = layer[static_cast<std::size_t>(n)] + 1;
+      for (const auto& [m, sheet_of_edge] : adjacent[primal::index_cast<std::size_t>(n)])
+        if (sheet_of_edge != primal::index_cast(s) &&
+            layer[primal::index_cast<std::size_t>(m)] < 0) {
+          layer[primal::index_cast<std::size_t>(m)] = layer[primal::index_cast<std::size_t>(n)] + 1;
           queue.push_back(m);
         }
     }
     std::vector<double> value(nn, 0.0);
     for (std::size_t n = 0; n < nn; ++n) {
       if (layer[n] < 0) continue;  // a node of no cell
-      const Index root = sides.find(static_cast<Index>(n));
+      const Index root = sides.find(primal::index_cast(n));
       if (root != first && root != second)
         throw TopologyError(who + " leaves node " + std::to_string(n) +
                             " on neither of its two sides (the mesh is not connected)");
@@ -285,12 +288,12 @@ MeshArrangementInput build(const std::vector<Point>& points,
     const std::size_t id = data->values.size() - 1;
     Field f = [data, id](const Point& x) {
       const auto hit = data->locator->locate(x);
-      const auto& cell = data->cells[static_cast<std::size_t>(hit.cell)];
+      const auto& cell = data->cells[primal::index_cast<std::size_t>(hit.cell)];
       const auto& v = data->values[id];
       double r = 0.0;
       for (int c = 0; c < kCorners; ++c)
         r += CellLocator<Dim>::shape(c, hit.u) *
-             v[static_cast<std::size_t>(cell[static_cast<std::size_t>(c)])];
+             v[primal::index_cast<std::size_t>(cell[primal::index_cast<std::size_t>(c)])];
       return r;
     };
     out.sheets.push_back({"sheet " + std::to_string(s), std::move(f), "mesh"});
@@ -301,9 +304,10 @@ MeshArrangementInput build(const std::vector<Point>& points,
     for (int k = 0; k < kCorners; ++k) {
       typename CellLocator<Dim>::Vec u;
       for (int a = 0; a < Dim; ++a)
-        u[a] = topo::kHexCornerCoords[static_cast<std::size_t>(k)][static_cast<std::size_t>(a)];
+        u[a] = topo::kHexCornerCoords[primal::index_cast<std::size_t>(k)]
+                                     [primal::index_cast<std::size_t>(a)];
       typename CellLocator<Dim>::Mat J;
-      loc.map(static_cast<Index>(c), u, &J);
+      loc.map(primal::index_cast(c), u, &J);
       if (!(J.determinant() > 0.0))
         throw InvalidInput(std::string("sheet_fields: ") + cell_word(Dim) + " " +
                            std::to_string(c) + " is inverted or flat at its corner " +
@@ -315,8 +319,8 @@ MeshArrangementInput build(const std::vector<Point>& points,
   Point lo = Point::Constant(1e300), hi = Point::Constant(-1e300);
   for (const auto& cell : cells)
     for (Index n : cell) {
-      lo = lo.cwiseMin(points[static_cast<std::size_t>(n)]);
-      hi = hi.cwiseMax(points[static_cast<std::size_t>(n)]);
+      lo = lo.cwiseMin(points[primal::index_cast<std::size_t>(n)]);
+      hi = hi.cwiseMax(points[primal::index_cast<std::size_t>(n)]);
     }
   if (Dim == 2) lo[2] = hi[2] = 0.0;
   const FacetClassifier classify = make_classifier(lo, hi, 1e-9 * (hi - lo).norm());

@@ -37,8 +37,8 @@ class GridContour {
     do {
       std::array<int, 4> s{0, 0, 0, 0};
       for (int k = 0; k < dim; ++k)
-        s[static_cast<std::size_t>(k + 1)] =
-            s[static_cast<std::size_t>(k)] | (1 << axes[static_cast<std::size_t>(k)]);
+        s[primal::index_cast<std::size_t>(k + 1)] =
+            s[primal::index_cast<std::size_t>(k)] | (1 << axes[primal::index_cast<std::size_t>(k)]);
       simplices_.push_back(s);
     } while (std::next_permutation(axes.begin(), axes.begin() + dim));
   }
@@ -48,7 +48,7 @@ class GridContour {
            std::vector<std::array<Index, 2>>* segs) {
     const int dim = domain_.dim;
     const std::size_t nodes =
-        static_cast<std::size_t>(n_[0] + 1) * (n_[1] + 1) * (dim == 3 ? n_[2] + 1 : 1);
+        primal::index_cast<std::size_t>(n_[0] + 1) * (n_[1] + 1) * (dim == 3 ? n_[2] + 1 : 1);
     values_.assign(nodes, 0.0);
     for (std::size_t i = 0; i < nodes; ++i) values_[i] = f(domain_point(domain_, local(i)));
     edge_vertex_.clear();
@@ -59,8 +59,8 @@ class GridContour {
           for (const auto& s : simplices_) {
             std::array<std::size_t, 4> g{};
             for (int c = 0; c <= dim; ++c) {
-              const int b = s[static_cast<std::size_t>(c)];
-              g[static_cast<std::size_t>(c)] =
+              const int b = s[primal::index_cast<std::size_t>(c)];
+              g[primal::index_cast<std::size_t>(c)] =
                   node(i + (b & 1), j + ((b >> 1) & 1), k + ((b >> 2) & 1));
             }
             simplex(f, g, points, tris, segs);
@@ -69,12 +69,13 @@ class GridContour {
 
  private:
   std::size_t node(int i, int j, int k) const {
-    return (static_cast<std::size_t>(k) * (n_[1] + 1) + static_cast<std::size_t>(j)) * (n_[0] + 1) +
-           static_cast<std::size_t>(i);
+    return (primal::index_cast<std::size_t>(k) * (n_[1] + 1) + primal::index_cast<std::size_t>(j)) *
+               (n_[0] + 1) +
+           primal::index_cast<std::size_t>(i);
   }
   Point local(std::size_t id) const {
-    const std::size_t nx = static_cast<std::size_t>(n_[0] + 1),
-                      ny = static_cast<std::size_t>(n_[1] + 1);
+    const std::size_t nx = primal::index_cast<std::size_t>(n_[0] + 1),
+                      ny = primal::index_cast<std::size_t>(n_[1] + 1);
     Point r = Point::Zero();
     r[0] = static_cast<double>(id % nx) / n_[0];
     r[1] = static_cast<double>((id / nx) % ny) / n_[1];
@@ -108,7 +109,7 @@ class GridContour {
         kept = -1;
       }
     }
-    const Index v = static_cast<Index>(points.size());
+    const Index v = primal::index_cast(points.size());
     points.push_back(domain_point(domain_, ra + t * (rb - ra)));
     edge_vertex_.emplace(key, v);
     return v;
@@ -120,11 +121,11 @@ class GridContour {
     std::array<std::size_t, 4> neg{}, pos{};
     int nn = 0, np = 0;
     for (int c = 0; c <= dim; ++c) {
-      const std::size_t v = g[static_cast<std::size_t>(c)];
+      const std::size_t v = g[primal::index_cast<std::size_t>(c)];
       if (values_[v] < 0)
-        neg[static_cast<std::size_t>(nn++)] = v;
+        neg[primal::index_cast<std::size_t>(nn++)] = v;
       else
-        pos[static_cast<std::size_t>(np++)] = v;
+        pos[primal::index_cast<std::size_t>(np++)] = v;
     }
     if (nn == 0 || np == 0) return;
     if (dim == 2) {
@@ -137,13 +138,14 @@ class GridContour {
     // Normal towards the positive side: from the negative corners' centroid to the positive.
     Point towards = Point::Zero();
     for (int c = 0; c < np; ++c)
-      towards += domain_point(domain_, local(pos[static_cast<std::size_t>(c)])) / np;
+      towards += domain_point(domain_, local(pos[primal::index_cast<std::size_t>(c)])) / np;
     for (int c = 0; c < nn; ++c)
-      towards -= domain_point(domain_, local(neg[static_cast<std::size_t>(c)])) / nn;
+      towards -= domain_point(domain_, local(neg[primal::index_cast<std::size_t>(c)])) / nn;
     auto add = [&](Index a, Index b, Index c) {
       const Point n =
-          (points[static_cast<std::size_t>(b)] - points[static_cast<std::size_t>(a)])
-              .cross(points[static_cast<std::size_t>(c)] - points[static_cast<std::size_t>(a)]);
+          (points[primal::index_cast<std::size_t>(b)] - points[primal::index_cast<std::size_t>(a)])
+              .cross(points[primal::index_cast<std::size_t>(c)] -
+                     points[primal::index_cast<std::size_t>(a)]);
       if (n.dot(towards) < 0) std::swap(b, c);
       tris->push_back({a, b, c});
     };
@@ -177,12 +179,12 @@ std::array<std::array<int, 4>, 3> quad_order() {
   std::array<std::array<int, 4>, 3> order{};
   for (int k = 0; k < 3; ++k)
     for (int i = 0; i < 4; ++i) {
-      const auto& c = primal::topology::kHexCornerCoords[static_cast<std::size_t>(
-          primal::topology::kHexEdgeCorners[static_cast<std::size_t>(4 * k + i)][0])];
-      const int u = c[static_cast<std::size_t>((k + 1) % 3)],
-                v = c[static_cast<std::size_t>((k + 2) % 3)];
+      const auto& c = primal::topology::kHexCornerCoords[primal::index_cast<std::size_t>(
+          primal::topology::kHexEdgeCorners[primal::index_cast<std::size_t>(4 * k + i)][0])];
+      const int u = c[primal::index_cast<std::size_t>((k + 1) % 3)],
+                v = c[primal::index_cast<std::size_t>((k + 2) % 3)];
       const int slot = v == 0 ? u : 3 - u;  // (0,0) 0, (1,0) 1, (1,1) 2, (0,1) 3
-      order[static_cast<std::size_t>(k)][static_cast<std::size_t>(slot)] = 4 * k + i;
+      order[primal::index_cast<std::size_t>(k)][primal::index_cast<std::size_t>(slot)] = 4 * k + i;
     }
   return order;
 }
@@ -191,10 +193,10 @@ std::array<std::array<int, 4>, 3> quad_order() {
 template <class Out>
 Index midpoint_vertex(const std::vector<Point>& nodes, const std::array<Index, 2>& edge, Index e,
                       std::unordered_map<Index, Index>& ids, Out& out) {
-  const auto [it, added] = ids.emplace(e, static_cast<Index>(out.points.size()));
+  const auto [it, added] = ids.emplace(e, primal::index_cast(out.points.size()));
   if (added)
-    out.points.push_back(0.5 * (nodes[static_cast<std::size_t>(edge[0])] +
-                                nodes[static_cast<std::size_t>(edge[1])]));
+    out.points.push_back(0.5 * (nodes[primal::index_cast<std::size_t>(edge[0])] +
+                                nodes[primal::index_cast<std::size_t>(edge[1])]));
   return it->second;
 }
 
@@ -229,12 +231,12 @@ std::vector<primal::TriMesh> dual_surfaces(const primal::HexMesh& mesh, const He
   std::vector<std::unordered_map<Index, Index>> ids(dual.sheets.size());
   for (std::size_t c = 0; c < dual.cell_sheets.size(); ++c)
     for (std::size_t k = 0; k < 3; ++k) {
-      const auto s = static_cast<std::size_t>(dual.cell_sheets[c][k]);
+      const auto s = primal::index_cast<std::size_t>(dual.cell_sheets[c][k]);
       std::array<Index, 4> q{};
       for (std::size_t i = 0; i < 4; ++i) {
-        const Index e = dual.cell_edges[c][static_cast<std::size_t>(order[k][i])];
-        q[i] = midpoint_vertex(mesh.points, dual.edges[static_cast<std::size_t>(e)], e, ids[s],
-                               out[s]);
+        const Index e = dual.cell_edges[c][primal::index_cast<std::size_t>(order[k][i])];
+        q[i] = midpoint_vertex(mesh.points, dual.edges[primal::index_cast<std::size_t>(e)], e,
+                               ids[s], out[s]);
       }
       out[s].tris.push_back({q[0], q[1], q[2]});
       out[s].tris.push_back({q[0], q[2], q[3]});
@@ -247,11 +249,12 @@ std::vector<primal::SegmentMesh> dual_curves(const primal::QuadMesh& mesh, const
   std::vector<std::unordered_map<Index, Index>> ids(dual.sheets.size());
   for (std::size_t c = 0; c < dual.cell_sheets.size(); ++c)
     for (std::size_t k = 0; k < 2; ++k) {
-      const auto s = static_cast<std::size_t>(dual.cell_sheets[c][k]);
+      const auto s = primal::index_cast<std::size_t>(dual.cell_sheets[c][k]);
       const Index a = dual.cell_edges[c][k], b = dual.cell_edges[c][k + 2];  // opposite edges
       out[s].segments.push_back(
-          {midpoint_vertex(mesh.points, dual.edges[static_cast<std::size_t>(a)], a, ids[s], out[s]),
-           midpoint_vertex(mesh.points, dual.edges[static_cast<std::size_t>(b)], b, ids[s],
+          {midpoint_vertex(mesh.points, dual.edges[primal::index_cast<std::size_t>(a)], a, ids[s],
+                           out[s]),
+           midpoint_vertex(mesh.points, dual.edges[primal::index_cast<std::size_t>(b)], b, ids[s],
                            out[s])});
     }
   return out;

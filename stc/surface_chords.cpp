@@ -20,16 +20,17 @@ std::vector<SurfaceChord> surface_chords(const std::vector<std::array<primal::In
       const Index a = quads[q][e], b = quads[q][(e + 1) % 4];
       const auto key = std::minmax(a, b);
       auto [it, fresh] =
-          edge_id.emplace(std::make_pair(key.first, key.second), static_cast<Index>(uses.size()));
+          edge_id.emplace(std::make_pair(key.first, key.second), primal::index_cast(uses.size()));
       if (fresh) uses.push_back(0);
-      ++uses[static_cast<std::size_t>(it->second)];
+      ++uses[primal::index_cast<std::size_t>(it->second)];
       quad_edges[q][e] = it->second;
     }
   for (const auto& [key, id] : edge_id)
-    if (uses[static_cast<std::size_t>(id)] != 2)
-      throw TopologyError(
-          "surface chords: edge " + std::to_string(key.first) + "-" + std::to_string(key.second) +
-          " is in " + std::to_string(uses[static_cast<std::size_t>(id)]) + " quads (expected 2)");
+    if (uses[primal::index_cast<std::size_t>(id)] != 2)
+      throw TopologyError("surface chords: edge " + std::to_string(key.first) + "-" +
+                          std::to_string(key.second) + " is in " +
+                          std::to_string(uses[primal::index_cast<std::size_t>(id)]) +
+                          " quads (expected 2)");
   primal::DisjointSets chords(uses.size());
   for (const auto& e : quad_edges) {
     chords.unite(e[0], e[2]);
@@ -45,12 +46,12 @@ std::vector<SurfaceChord> surface_chords(const std::vector<std::array<primal::In
   };
   for (std::size_t q = 0; q < quads.size(); ++q) {
     const std::size_t a = chord_of(quad_edges[q][0]);
-    out[a].quads.push_back(static_cast<Index>(q));
+    out[a].quads.push_back(primal::index_cast(q));
     const std::size_t b = chord_of(quad_edges[q][1]);
-    out[b].quads.push_back(static_cast<Index>(q));
-    if (a == b) out[a].self_crossings.push_back(static_cast<Index>(q));
+    out[b].quads.push_back(primal::index_cast(q));
+    if (a == b) out[a].self_crossings.push_back(primal::index_cast(q));
   }
-  for (Index e = 0; e < static_cast<Index>(uses.size()); ++e) ++out[chord_of(e)].edges;
+  for (Index e = 0; e < primal::index_cast(uses.size()); ++e) ++out[chord_of(e)].edges;
   return out;
 }
 

@@ -23,7 +23,8 @@ std::vector<Tunnel> complete_tunnels(const InterfacePatch& patch,
     throw InvalidInput("complete_tunnels: a template is built over one interface cell");
   const auto& cell = patch.cells.front();
   const auto P = [&](int i) {
-    return flat(patch.points[static_cast<std::size_t>(cell[static_cast<std::size_t>(i)])]);
+    return flat(
+        patch.points[primal::index_cast<std::size_t>(cell[primal::index_cast<std::size_t>(i)])]);
   };
   if (patch.dim == 2) {
     if (cell.size() != 2) throw InvalidInput("complete_tunnels: a 2D interface cell is a segment");
@@ -73,8 +74,8 @@ DicedPatch dice_patch(const InterfacePatch& p) {
     for (std::size_t i = 0; i < p.points.size(); ++i) d.owners.push_back({static_cast<int>(i)});
     for (const auto& c : p.cells) {
       if (c.size() != 2) throw InvalidInput("dice_patch: a 2D interface cell is a segment");
-      d.nodes.push_back(0.5 * (p.points[static_cast<std::size_t>(c[0])] +
-                               p.points[static_cast<std::size_t>(c[1])]));
+      d.nodes.push_back(0.5 * (p.points[primal::index_cast<std::size_t>(c[0])] +
+                               p.points[primal::index_cast<std::size_t>(c[1])]));
       d.owners.push_back({c[0], c[1]});
       const int m = static_cast<int>(d.nodes.size() - 1);
       d.cells.push_back({c[0], m});
@@ -88,7 +89,7 @@ DicedPatch dice_patch(const InterfacePatch& p) {
     for (const auto& o : diced.origin) {
       std::vector<int> own;
       if (o.kind == primal::NodeOriginKind::kCell)
-        for (auto v : cells[static_cast<std::size_t>(o.element)]) own.push_back(v);
+        for (auto v : cells[primal::index_cast<std::size_t>(o.element)]) own.push_back(v);
       else
         for (auto v : o.nodes)
           if (v != primal::kInvalidIndex) own.push_back(v);
@@ -124,7 +125,7 @@ std::vector<Dome> complete_domes(const InterfacePatch& patch, double v_top,
                                  const std::function<DomeShape(int vertex)>& shape) {
   const DicedPatch diced = dice_patch(patch);
   std::vector<Dome> out;
-  for (int v = 0; v < static_cast<int>(patch.points.size()); ++v) {
+  for (int v = 0; v < primal::index_cast<int>(patch.points.size()); ++v) {
     bool used = false;
     for (const auto& c : patch.cells) used |= std::find(c.begin(), c.end(), v) != c.end();
     if (!used) continue;
@@ -133,7 +134,7 @@ std::vector<Dome> complete_domes(const InterfacePatch& patch, double v_top,
     if (!(p >= 1) || !std::isfinite(p))
       throw InvalidInput("complete_domes: the exponent must be >= 1 and finite");
     const bool round = p == 2.0;
-    const Point V = flat(patch.points[static_cast<std::size_t>(v)]) + flat(s.offset);
+    const Point V = flat(patch.points[primal::index_cast<std::size_t>(v)]) + flat(s.offset);
     // In-plane distance from the dome's centre: Euclidean for p = 2 (the spheroid's own
     // formula), else the p-norm whose unit ball is the superquadric's trace.
     const auto distance = [V, p, round](const Point& x) {

@@ -23,12 +23,12 @@ std::vector<primal::Obstruction> obstructions(const primal::HexMesh& mesh,
 // The sheet of hex h that separates its local face f from the opposite face: of the hex's
 // three sheets, the other two cut the face, this one leaves all its corners on one side.
 int sheet_across(const Template& t, Index h, int f) {
-  const auto& hex = t.hex.hexes[static_cast<std::size_t>(h)];
-  const auto& face = primal::topology::kHexFaceCorners[static_cast<std::size_t>(f)];
-  for (int s : t.element_sheets[static_cast<std::size_t>(h)]) {
+  const auto& hex = t.hex.hexes[primal::index_cast<std::size_t>(h)];
+  const auto& face = primal::topology::kHexFaceCorners[primal::index_cast<std::size_t>(f)];
+  for (int s : t.element_sheets[primal::index_cast<std::size_t>(h)]) {
     const auto sign = [&](int i) {
-      return t.node_signs[static_cast<std::size_t>(hex[static_cast<std::size_t>(
-          face[static_cast<std::size_t>(i)])])][static_cast<std::size_t>(s)];
+      return t.node_signs[primal::index_cast<std::size_t>(hex[primal::index_cast<std::size_t>(
+          face[primal::index_cast<std::size_t>(i)])])][primal::index_cast<std::size_t>(s)];
     };
     if (sign(0) == sign(1) && sign(1) == sign(2) && sign(2) == sign(3)) return s;
   }
@@ -38,25 +38,25 @@ int sheet_across(const Template& t, Index h, int f) {
 // Apply a pillowing to the template's bookkeeping: the new sheet, the signs of every node on
 // it, the new nodes' faces (none: interior), the layer hexes' sheets.
 void apply(Template& t, const std::vector<Index>& set, primal::PillowResult r) {
-  const int sheet = static_cast<int>(t.sheets.size());
+  const int sheet = primal::index_cast<int>(t.sheets.size());
   t.sheets.push_back({"pillow " + std::to_string(sheet), "pillow"});
   std::vector<std::vector<int>> layer_sheets;
   for (const Index l : r.layer) {
     // The layer hex's corners 4..7 are the old face's nodes; find the set hex and face.
-    const auto& lh = r.mesh.hexes[static_cast<std::size_t>(l)];
+    const auto& lh = r.mesh.hexes[primal::index_cast<std::size_t>(l)];
     std::vector<int> sheets{sheet};
     for (Index h : set) {
-      const auto& hex = t.hex.hexes[static_cast<std::size_t>(h)];
+      const auto& hex = t.hex.hexes[primal::index_cast<std::size_t>(h)];
       for (int f = 0; f < 6; ++f) {
         bool same = true;
         for (int i = 0; i < 4; ++i)
-          same &= hex[static_cast<std::size_t>(
-                      primal::topology::kHexFaceCorners[static_cast<std::size_t>(f)]
-                                                       [static_cast<std::size_t>(i)])] ==
-                  lh[static_cast<std::size_t>(i) + 4];
+          same &= hex[primal::index_cast<std::size_t>(
+                      primal::topology::kHexFaceCorners[primal::index_cast<std::size_t>(f)]
+                                                       [primal::index_cast<std::size_t>(i)])] ==
+                  lh[primal::index_cast<std::size_t>(i) + 4];
         if (!same) continue;
         const int across = sheet_across(t, h, f);
-        for (int s : t.element_sheets[static_cast<std::size_t>(h)])
+        for (int s : t.element_sheets[primal::index_cast<std::size_t>(h)])
           if (s != across) sheets.push_back(s);
       }
     }
@@ -65,10 +65,10 @@ void apply(Template& t, const std::vector<Index>& set, primal::PillowResult r) {
   }
   std::vector<char> inside(r.mesh.points.size(), 0);
   for (Index h : set)
-    for (Index n : r.mesh.hexes[static_cast<std::size_t>(h)])
-      inside[static_cast<std::size_t>(n)] = 1;
+    for (Index n : r.mesh.hexes[primal::index_cast<std::size_t>(h)])
+      inside[primal::index_cast<std::size_t>(n)] = 1;
   for (std::size_t i = 0; i < r.copy_of.size(); ++i) {
-    t.node_signs.push_back(t.node_signs[static_cast<std::size_t>(r.copy_of[i])]);
+    t.node_signs.push_back(t.node_signs[primal::index_cast<std::size_t>(r.copy_of[i])]);
     t.node_faces.push_back(0u);
   }
   for (std::size_t n = 0; n < t.node_signs.size(); ++n)
@@ -82,7 +82,7 @@ void apply(Template& t, const std::vector<Index>& set, primal::PillowResult r) {
 std::vector<std::vector<Index>> candidate_sets(const std::vector<Index>& hexes,
                                                int max_subset_hexes) {
   std::vector<std::vector<Index>> c;
-  const int k = static_cast<int>(hexes.size());
+  const int k = primal::index_cast<int>(hexes.size());
   if (k > max_subset_hexes) {
     for (Index h : hexes) c.push_back({h});
     if (k > 1) c.push_back(hexes);
@@ -91,7 +91,7 @@ std::vector<std::vector<Index>> candidate_sets(const std::vector<Index>& hexes,
   for (unsigned m = 1; m < (1u << k); ++m) {
     std::vector<Index> set;
     for (int i = 0; i < k; ++i)
-      if ((m >> i) & 1u) set.push_back(hexes[static_cast<std::size_t>(i)]);
+      if ((m >> i) & 1u) set.push_back(hexes[primal::index_cast<std::size_t>(i)]);
     c.push_back(set);
   }
   std::stable_sort(c.begin(), c.end(),
@@ -110,7 +110,7 @@ FixupResult fix_up(Template& t, const FixupOptions& options) {
   if (t.dim != 3) throw InvalidInput("fix_up: only 3D templates are fixed up");
   FixupResult out;
   auto current = obstructions(t.hex, t.node_faces);
-  out.obstructions_before = static_cast<int>(current.size());
+  out.obstructions_before = primal::index_cast<int>(current.size());
   for (int step = 0; step < options.max_steps && !current.empty(); ++step) {
     // The first obstruction (in find_obstructions' order) that some shrink set reduces.
     std::size_t best = current.size();
@@ -138,7 +138,7 @@ FixupResult fix_up(Template& t, const FixupOptions& options) {
     apply(t, best_set, primal::pillow(t.hex, best_set, options.pillow));
     current = obstructions(t.hex, t.node_faces);
   }
-  out.obstructions_after = static_cast<int>(current.size());
+  out.obstructions_after = primal::index_cast<int>(current.size());
   return out;
 }
 

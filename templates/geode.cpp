@@ -84,7 +84,7 @@ void place_interface(const stc::DualMesh& D, const std::vector<stc::Sheet>& shee
     for (const auto& e : elements)
       for (const auto& fc : table) {
         std::vector<int> k;
-        for (int c : fc) k.push_back(e[static_cast<std::size_t>(c)]);
+        for (int c : fc) k.push_back(e[primal::index_cast<std::size_t>(c)]);
         std::sort(k.begin(), k.end());
         faces.insert(k);
       }
@@ -95,7 +95,7 @@ void place_interface(const stc::DualMesh& D, const std::vector<stc::Sheet>& shee
     add_faces(D.quad.quads, primal::topology::kQuadEdgeCorners);
   for (const auto& c : diced.cells) {
     std::vector<int> k;
-    for (int i : c) k.push_back(node_of[static_cast<std::size_t>(i)]);
+    for (int i : c) k.push_back(node_of[primal::index_cast<std::size_t>(i)]);
     std::sort(k.begin(), k.end());
     if (!faces.count(k))
       throw TopologyError(
@@ -103,26 +103,26 @@ void place_interface(const stc::DualMesh& D, const std::vector<stc::Sheet>& shee
           " cell is not a face of the template: the boundary is not the prescribed one");
   }
   for (std::size_t i = 0; i < diced.nodes.size(); ++i)
-    pts[static_cast<std::size_t>(node_of[i])] = diced.nodes[i];
+    pts[primal::index_cast<std::size_t>(node_of[i])] = diced.nodes[i];
 }
 
 InterleaveChecks check_interleave(const stc::Arrangement& A, const std::vector<SheetInfo>& info,
                                   const std::vector<stc::Sheet>& sheets) {
   InterleaveChecks c;
   std::vector<int> tunnels, domes;
-  for (int s = 0; s < static_cast<int>(info.size()); ++s)
-    (info[static_cast<std::size_t>(s)].kind == "tunnel" ? tunnels : domes).push_back(s);
+  for (int s = 0; s < primal::index_cast<int>(info.size()); ++s)
+    (info[primal::index_cast<std::size_t>(s)].kind == "tunnel" ? tunnels : domes).push_back(s);
   auto in_all_tunnels = [&](const Point& x) {
     for (int t : tunnels)
-      if (sheets[static_cast<std::size_t>(t)].field(x) >= 0) return false;
+      if (sheets[primal::index_cast<std::size_t>(t)].field(x) >= 0) return false;
     return true;
   };
   auto in_some_tunnel = [&](const Point& x) {
     for (int t : tunnels)
-      if (sheets[static_cast<std::size_t>(t)].field(x) < 0) return true;
+      if (sheets[primal::index_cast<std::size_t>(t)].field(x) < 0) return true;
     return false;
   };
-  auto is_dome = [&](int s) { return info[static_cast<std::size_t>(s)].kind == "dome"; };
+  auto is_dome = [&](int s) { return info[primal::index_cast<std::size_t>(s)].kind == "dome"; };
   c.triple_domes_in_pocket = true;
   for (const auto& v : A.vertices) {
     if (!std::all_of(v.sheets.begin(), v.sheets.end(), is_dome)) continue;
@@ -150,14 +150,14 @@ InterleaveChecks check_interleave(const stc::Arrangement& A, const std::vector<S
       continue;
     }
     for (int e = 0; e < 2; ++e) {
-      const int f = cv.end_faces[static_cast<std::size_t>(e)];
+      const int f = cv.end_faces[primal::index_cast<std::size_t>(e)];
       if (f == top) continue;
       const Point x = e == 0 ? cv.polyline.front() : cv.polyline.back();
       if (f == stc::box_face(1, false) || !in_some_tunnel(x)) {
         c.dome_curves_exit_in_tunnels = false;
         c.failures.push_back("condition 2: the curve of " +
-                             info[static_cast<std::size_t>(cv.sheets[0])].name + " and " +
-                             info[static_cast<std::size_t>(cv.sheets[1])].name +
+                             info[primal::index_cast<std::size_t>(cv.sheets[0])].name + " and " +
+                             info[primal::index_cast<std::size_t>(cv.sheets[1])].name +
                              " leaves the cell outside every tunnel entrance");
       }
     }
@@ -225,7 +225,7 @@ std::string push_error(const PushParameters& p, std::string* key) {
     return fault("dome_offset",
                  "dome offset must be in [0, 1) (a fraction of the way to the tet side's centre)");
   for (int a = 0; a < 2; ++a)
-    if (!(std::abs(p.centre_offset[static_cast<std::size_t>(a)]) < 1))
+    if (!(std::abs(p.centre_offset[primal::index_cast<std::size_t>(a)]) < 1))
       return fault(a == 0 ? "centre_offset[0]" : "centre_offset[1]",
                    "centre dome offsets must be in (-1, 1) (fractions of the half-width)");
   return "";
@@ -239,7 +239,7 @@ std::vector<stc::Sheet> complete_interface(const InterfacePatch& bottom, const I
     return along_x == (higher == Higher::kX) ? p.high_roof : p.low_roof;
   });
   const auto domes = complete_domes(top, 1.0, [&](int v) {
-    const Point& x = top.points[static_cast<std::size_t>(v)];
+    const Point& x = top.points[primal::index_cast<std::size_t>(v)];
     DomeShape s{p.dome_depth, p.dome_radius, p.dome_exponent, Point::Zero()};
     if (is_face_centre(x)) {
       if (p.centre_depth > 0) s.depth = p.centre_depth;
@@ -260,7 +260,7 @@ std::vector<stc::Sheet> complete_interface(const InterfacePatch& bottom, const I
   }
   for (const auto& d : domes) {
     stc::Sheet s = d.sheet;
-    const Point& v = top.points[static_cast<std::size_t>(d.vertex)];
+    const Point& v = top.points[primal::index_cast<std::size_t>(d.vertex)];
     s.name = dim == 2 ? std::string("dome ") + (v.x() < 0 ? "-x" : "+x")
                       : (is_face_centre(v) ? std::string("dome centre") : "dome " + corner_name(v));
     // A spec's tet side may have several vertices in one quadrant: names must stay unique.

@@ -15,13 +15,15 @@ primal::QuadMesh schneiders_surface(const std::array<Point, 5>& c) {
   primal::QuadMesh s;
   s.points.assign(c.begin(), c.end());
   for (int i = 0; i < 4; ++i)
-    s.points.push_back(0.5 *
-                       (c[static_cast<std::size_t>(i)] + c[static_cast<std::size_t>((i + 1) % 4)]));
-  for (int i = 0; i < 4; ++i) s.points.push_back(0.5 * (c[static_cast<std::size_t>(i)] + c[4]));
+    s.points.push_back(0.5 * (c[primal::index_cast<std::size_t>(i)] +
+                              c[primal::index_cast<std::size_t>((i + 1) % 4)]));
+  for (int i = 0; i < 4; ++i)
+    s.points.push_back(0.5 * (c[primal::index_cast<std::size_t>(i)] + c[4]));
   s.points.push_back(0.25 * (c[0] + c[1] + c[2] + c[3]));
   for (int i = 0; i < 4; ++i)
-    s.points.push_back(
-        (c[static_cast<std::size_t>(i)] + c[static_cast<std::size_t>((i + 1) % 4)] + c[4]) / 3.0);
+    s.points.push_back((c[primal::index_cast<std::size_t>(i)] +
+                        c[primal::index_cast<std::size_t>((i + 1) % 4)] + c[4]) /
+                       3.0);
   // Base: counter-clockwise seen from below (outside).
   for (int i = 0; i < 4; ++i)
     s.quads.push_back({i, N::base_midpoint((i + 3) % 4), N::kBaseCentre, N::base_midpoint(i)});

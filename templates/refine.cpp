@@ -63,7 +63,7 @@ void complete_chords(const InterfacePatch& fine, const InterfacePatch& coarse, i
                      std::vector<SheetSpec>& tunnels, std::vector<SheetSpec>& planes) {
   const std::vector<double> f = chord_offsets(fine, axis), c = chord_offsets(coarse, axis);
   const double width = f.empty() ? 0.0 : f.back() - f.front();
-  if (f.size() != static_cast<std::size_t>(kRefinement) || c.size() != 1 ||
+  if (f.size() != primal::index_cast<std::size_t>(kRefinement) || c.size() != 1 ||
       std::abs(f[1] - c[0]) > 1e-12 * width)
     throw InvalidInput("refine3: the fine side must be the 3-refinement of the coarse side");
   Point centre = Point::Zero(), normal = Point::Zero();
@@ -162,9 +162,9 @@ primal::SmoothResult smooth_refine3(Template& t, const RefineOptions& o, bool ma
       for (bool high : {false, true}) {
         if (!((f >> stc::box_face(s.axis, high)) & 1u)) continue;
         const auto& sg = t.node_signs[n];
-        const std::vector<int> signs{sg[static_cast<std::size_t>(tunnel)],
-                                     sg[static_cast<std::size_t>(middle)],
-                                     sg[static_cast<std::size_t>(layer)]};
+        const std::vector<int> signs{sg[primal::index_cast<std::size_t>(tunnel)],
+                                     sg[primal::index_cast<std::size_t>(middle)],
+                                     sg[primal::index_cast<std::size_t>(layer)]};
         const unsigned faces = ((f >> (2 * s.across)) & 3u) | (((f >> 2) & 3u) << 2);
         const auto it = where.find({signs, faces});
         if (it == where.end())

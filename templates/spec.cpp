@@ -61,10 +61,11 @@ class Reader {
     return x;
   }
   Point point(const json& j, const std::string& path) const {
-    if (!j.is_array() || static_cast<int>(j.size()) != dim_)
+    if (!j.is_array() || primal::index_cast<int>(j.size()) != dim_)
       fail(path, "must be " + std::to_string(dim_) + " numbers (the spec's dim)");
     Point p = Point::Zero();
-    for (int a = 0; a < dim_; ++a) p[a] = number(j[static_cast<std::size_t>(a)], index(path, a));
+    for (int a = 0; a < dim_; ++a)
+      p[a] = number(j[primal::index_cast<std::size_t>(a)], index(path, a));
     return p;
   }
   Point direction(const json& j, const std::string& path) const {
@@ -312,7 +313,7 @@ stc::Field Reader::shape(const json& j, const std::string& path, int level,
     return [c, r, e, p, dim](const Point& x) {
       double f = -1.0;
       for (int a = 0; a < dim; ++a)
-        f += std::pow(std::abs(e[static_cast<std::size_t>(a)].dot(x - c) / r[a]), p);
+        f += std::pow(std::abs(e[primal::index_cast<std::size_t>(a)].dot(x - c) / r[a]), p);
       return f;
     };
   }
@@ -414,7 +415,8 @@ int key_rank(const std::string& key) {
       "dome_offset",   "centre_offset", "sheets",
       "name",          "kind",          "sweep"};
   const auto it = std::find(order.begin(), order.end(), key);
-  return it == order.end() ? static_cast<int>(order.size()) : static_cast<int>(it - order.begin());
+  return it == order.end() ? primal::index_cast<int>(order.size())
+                           : static_cast<int>(it - order.begin());
 }
 
 // Arrays of numbers, and arrays of those, on one line; everything else one entry a line.
@@ -428,8 +430,8 @@ bool one_line(const json& j) {
 }
 
 void format(const json& j, int indent, std::ostream& out) {
-  const std::string pad(static_cast<std::size_t>(indent + 2), ' '),
-      end(static_cast<std::size_t>(indent), ' ');
+  const std::string pad(primal::index_cast<std::size_t>(indent + 2), ' '),
+      end(primal::index_cast<std::size_t>(indent), ' ');
   if (one_line(j) || j.empty()) {
     if (!j.is_array()) {
       out << j.dump();
@@ -493,8 +495,8 @@ bool coincident(const json& a, const json& b, int dim) {
     if (!key) return false;
     p = n = Point::Zero();
     for (int i = 0; i < dim; ++i) {
-      p[i] = s[key]["point"][static_cast<std::size_t>(i)].get<double>();
-      n[i] = s[key]["normal"][static_cast<std::size_t>(i)].get<double>();
+      p[i] = s[key]["point"][primal::index_cast<std::size_t>(i)].get<double>();
+      n[i] = s[key]["normal"][primal::index_cast<std::size_t>(i)].get<double>();
     }
     n.normalize();
     return true;
@@ -654,7 +656,7 @@ json spec_json(const ArrangementSpec& s) {
   if (s.domain.corners) {
     json c = json::array();
     for (int i = 0; i < (s.domain.is_pyramid ? 5 : s.dim == 3 ? 8 : 4); ++i)
-      c.push_back(vector_json((*s.domain.corners)[static_cast<std::size_t>(i)], s.dim));
+      c.push_back(vector_json((*s.domain.corners)[primal::index_cast<std::size_t>(i)], s.dim));
     j["domain"][s.domain.is_pyramid ? "pyramid" : s.dim == 3 ? "hexahedron" : "quadrilateral"] = c;
   } else {
     j["domain"]["box"] = {vector_json(s.domain.lo, s.dim), vector_json(s.domain.hi, s.dim)};

@@ -48,7 +48,7 @@ std::uint64_t fnv(const std::string& s) {
 // "dome+dome+tunnel" for an element's sheets.
 std::string kind_triple(const Template& t, const std::vector<int>& sheets) {
   std::vector<std::string> k;
-  for (int s : sheets) k.push_back(t.sheets[static_cast<std::size_t>(s)].kind);
+  for (int s : sheets) k.push_back(t.sheets[primal::index_cast<std::size_t>(s)].kind);
   std::sort(k.begin(), k.end());
   std::string r;
   for (const auto& x : k) r += (r.empty() ? "" : "+") + x;
@@ -114,7 +114,7 @@ std::string template_class_key(const Template& t) {
   for (std::size_t e = 0; e < elements; ++e) {
     const std::size_t k = d3 ? 8 : 4;
     for (std::size_t c = 0; c < k; ++c) {
-      const auto n = static_cast<std::size_t>(d3 ? t.hex.hexes[e][c] : t.quad.quads[e][c]);
+      const auto n = primal::index_cast<std::size_t>(d3 ? t.hex.hexes[e][c] : t.quad.quads[e][c]);
       adj[n].push_back(nodes + e);
       adj[nodes + e].push_back(n);
     }
@@ -163,8 +163,8 @@ std::string strip_numbers(const std::string& message) {
   std::size_t last = 0;
   for (auto it = std::sregex_iterator(message.begin(), message.end(), number);
        it != std::sregex_iterator(); ++it) {
-    const auto pos = static_cast<std::size_t>(it->position()),
-               len = static_cast<std::size_t>(it->length());
+    const auto pos = primal::index_cast<std::size_t>(it->position()),
+               len = primal::index_cast<std::size_t>(it->length());
     const bool names = message.compare(pos + len, 5, "-cell") == 0 ||
                        (pos >= 10 && message.compare(pos - 10, 10, "condition ") == 0);
     s += message.substr(last, pos - last) + (names ? it->str() : "#");
@@ -381,7 +381,7 @@ void write_interleave_summary(std::ostream& out, const InterleaveStudy& study) {
 CellCorners box_cell(const Eigen::Vector3d& box) {
   CellCorners c;
   for (int i = 0; i < 8; ++i)
-    c[static_cast<std::size_t>(i)] =
+    c[primal::index_cast<std::size_t>(i)] =
         Point((i & 1 ? 0.5 : -0.5) * box.x(), (i & 2 ? 0.5 : -0.5) * box.y(),
               (i & 4 ? 0.5 : -0.5) * box.z());
   return c;
@@ -391,7 +391,7 @@ CellCorners sheared_cell(const Eigen::Vector3d& box, double angle_degrees) {
   CellCorners c = box_cell(box);
   const double shift = box.y() * std::tan(angle_degrees * M_PI / 180.0);
   for (int i = 0; i < 8; ++i)
-    if (i & 2) c[static_cast<std::size_t>(i)].x() += shift;
+    if (i & 2) c[primal::index_cast<std::size_t>(i)].x() += shift;
   return c;
 }
 
@@ -399,7 +399,8 @@ CellCorners tapered_cell(const Eigen::Vector3d& box, double ratio) {
   CellCorners c = box_cell(box);
   for (int i = 0; i < 8; ++i)
     if (i & 2)
-      c[static_cast<std::size_t>(i)].x() *= ratio, c[static_cast<std::size_t>(i)].z() *= ratio;
+      c[primal::index_cast<std::size_t>(i)].x() *= ratio,
+          c[primal::index_cast<std::size_t>(i)].z() *= ratio;
   return c;
 }
 
@@ -412,7 +413,7 @@ primal::SmoothResult smooth_in_cell(Template& t, const Eigen::Vector3d& box_of_t
     for (int high = 0; high < 2; ++high) {
       std::vector<Point> q;
       for (int i = 0; i < 8; ++i)
-        if (((i >> axis) & 1) == high) q.push_back(cell[static_cast<std::size_t>(i)]);
+        if (((i >> axis) & 1) == high) q.push_back(cell[primal::index_cast<std::size_t>(i)]);
       // q is ordered as the two remaining bits; its diagonals are q0-q3 and q1-q2.
       Point n = (q[3] - q[0]).cross(q[2] - q[1]);
       const Point centre = 0.25 * (q[0] + q[1] + q[2] + q[3]);
@@ -420,17 +421,17 @@ primal::SmoothResult smooth_in_cell(Template& t, const Eigen::Vector3d& box_of_t
         if (std::abs(n.normalized().dot(p - centre)) > 1e-9 * (q[3] - q[0]).norm())
           throw InvalidInput("smooth_in_cell: face " + std::to_string(2 * axis + high) +
                              " of the cell is not planar");
-      origin[static_cast<std::size_t>(2 * axis + high)] = centre;
-      normal[static_cast<std::size_t>(2 * axis + high)] = n.normalized();
+      origin[primal::index_cast<std::size_t>(2 * axis + high)] = centre;
+      normal[primal::index_cast<std::size_t>(2 * axis + high)] = n.normalized();
     }
   // Trilinear map (primal/multilinear.hpp) of the reference position in [0, 1]^3; the cell's
   // corners are numbered bitwise here (bx + 2 by + 4 bz), VTK corner c is the one at
   // kHexCornerCoords[c].
   std::array<Point, 8> vtk;
   for (int c = 0; c < 8; ++c) {
-    const auto& rc = primal::topology::kHexCornerCoords[static_cast<std::size_t>(c)];
-    vtk[static_cast<std::size_t>(c)] =
-        cell[static_cast<std::size_t>(rc[0] + 2 * rc[1] + 4 * rc[2])];
+    const auto& rc = primal::topology::kHexCornerCoords[primal::index_cast<std::size_t>(c)];
+    vtk[primal::index_cast<std::size_t>(c)] =
+        cell[primal::index_cast<std::size_t>(rc[0] + 2 * rc[1] + 4 * rc[2])];
   }
   for (auto& p : t.hex.points)
     p = primal::multilinear_point(
@@ -447,11 +448,11 @@ primal::SmoothResult smooth_in_cell(Template& t, const Eigen::Vector3d& box_of_t
     if (faces.size() >= 3 || (tet_or_hex_side && !slide)) {
       c.push_back(primal::NodeConstraint::fixed());
     } else if (faces.size() == 2) {
-      const Point d = normal[static_cast<std::size_t>(faces[0])].cross(
-          normal[static_cast<std::size_t>(faces[1])]);
+      const Point d = normal[primal::index_cast<std::size_t>(faces[0])].cross(
+          normal[primal::index_cast<std::size_t>(faces[1])]);
       c.push_back(primal::NodeConstraint::line(t.hex.points[n], d));
     } else if (faces.size() == 1) {
-      const auto f = static_cast<std::size_t>(faces[0]);
+      const auto f = primal::index_cast<std::size_t>(faces[0]);
       c.push_back(primal::NodeConstraint::plane(origin[f], normal[f]));
     } else {
       c.push_back(primal::NodeConstraint::free());
@@ -560,7 +561,7 @@ void write_geode_quality(std::ostream& report_csv, std::ostream* per_hex_csv) {
       for (std::size_t h = 0; h < t.hex.hexes.size(); ++h)
         *per_hex_csv << mode << "," << h + 1 << ","
                      << fmt(primal::hex_scaled_jacobian(
-                            primal::hex_corners(t.hex, static_cast<Index>(h))))
+                            primal::hex_corners(t.hex, primal::index_cast(h))))
                      << "\n";
   }
 }

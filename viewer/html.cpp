@@ -61,7 +61,7 @@ class JsonOut {
   void rows(const Rows& rows) {
     open('[');
     for (const auto& r : rows)
-      for (auto v : r) index(static_cast<Index>(v));
+      for (auto v : r) index(index_cast(v));
     close(']');
   }
   // '<' only occurs inside strings here; escaping it keeps "</script>" out of the page.
@@ -84,7 +84,7 @@ template <class Rows>
 void check_ids(const Rows& rows, std::size_t n, const std::string& what) {
   for (std::size_t r = 0; r < rows.size(); ++r)
     for (auto v : rows[r])
-      if (v < 0 || static_cast<std::size_t>(v) >= n)
+      if (v < 0 || index_cast<std::size_t>(v) >= n)
         throw InvalidInput("html viewer: " + what + " " + std::to_string(r + 1) + " refers to id " +
                            std::to_string(static_cast<long long>(v) + 1) + ", out of 1.." +
                            std::to_string(n));
@@ -174,7 +174,7 @@ std::string page(const std::vector<Point>& points, const Cells& cells,
     else
       check_ids(s.curve.segments, s.curve.points.size(), "sheet '" + s.name + "' segment");
     for (Index c : s.layer)
-      if (c < 0 || static_cast<std::size_t>(c) >= cells.size())
+      if (c < 0 || index_cast<std::size_t>(c) >= cells.size())
         throw InvalidInput("html viewer: sheet '" + s.name + "' layer has cell " +
                            std::to_string(c + 1) + ", out of 1.." + std::to_string(cells.size()));
     j.open('{');
@@ -214,7 +214,7 @@ std::string html_view(const HexMesh& mesh, const ViewScene& scene) {
   check_ids(mesh.hexes, mesh.points.size(), "hex");
   std::vector<double> q;
   for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
-    q.push_back(hex_scaled_jacobian(hex_corners(mesh, static_cast<Index>(h))));
+    q.push_back(hex_scaled_jacobian(hex_corners(mesh, index_cast(h))));
   JsonOut j;
   j.open('{');
   std::vector<std::array<int, 2>> edges(topology::kHexEdgeCorners.begin(),
@@ -231,7 +231,7 @@ std::string html_view(const QuadMesh& mesh, const ViewScene& scene) {
   for (const auto& p : mesh.points) planar = planar && p.z() == 0.0;
   std::vector<double> q;
   for (std::size_t i = 0; i < mesh.quads.size(); ++i) {
-    const QuadCorners c = quad_corners(mesh, static_cast<Index>(i));
+    const QuadCorners c = quad_corners(mesh, index_cast(i));
     q.push_back(planar ? quad_scaled_jacobian(c, Point::UnitZ()) : quad_scaled_jacobian(c));
   }
   JsonOut j;

@@ -59,7 +59,7 @@ int run(int argc, char** argv, int rank, int size) {
     return e.get_exit_code() == 0 ? 0 : 2;
   }
   tbb::global_control threads_limit(tbb::global_control::max_allowed_parallelism,
-                                    static_cast<std::size_t>(std::max(threads, 1)));
+                                    primal::index_cast<std::size_t>(std::max(threads, 1)));
   try {
     const double t0 = MPI_Wtime();
     parallel::DistributedOptions options;
@@ -96,11 +96,12 @@ int run(int argc, char** argv, int rank, int size) {
     for (const auto& [stage, s] : report.seconds) line << stage << " " << s << " s, ";
     line << "), write " << t_write << " s, total " << t_all << " s, peak " << peak_mib() << " MiB";
     const std::string text = line.str();
-    int n = static_cast<int>(text.size());
-    std::vector<int> counts(static_cast<std::size_t>(size)), displs(counts.size());
+    int n = primal::index_cast<int>(text.size());
+    std::vector<int> counts(primal::index_cast<std::size_t>(size)), displs(counts.size());
     MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
     std::exclusive_scan(counts.begin(), counts.end(), displs.begin(), 0);
-    std::string all(rank == 0 ? static_cast<std::size_t>(displs.back() + counts.back()) : 0, ' ');
+    std::string all(rank == 0 ? primal::index_cast<std::size_t>(displs.back() + counts.back()) : 0,
+                    ' ');
     MPI_Gatherv(text.data(), n, MPI_CHAR, all.data(), counts.data(), displs.data(), MPI_CHAR, 0,
                 MPI_COMM_WORLD);
     if (rank == 0 && !quiet) {
@@ -110,8 +111,10 @@ int run(int argc, char** argv, int rank, int size) {
                 << ", " << (report.valid ? "valid" : "INVALID") << ", " << t_all << " s\n";
       for (int r = 0; r < size; ++r)
         std::cout << "  "
-                  << all.substr(static_cast<std::size_t>(displs[static_cast<std::size_t>(r)]),
-                                static_cast<std::size_t>(counts[static_cast<std::size_t>(r)]))
+                  << all.substr(primal::index_cast<std::size_t>(
+                                    displs[primal::index_cast<std::size_t>(r)]),
+                                primal::index_cast<std::size_t>(
+                                    counts[primal::index_cast<std::size_t>(r)]))
                   << "\n";
       for (const auto& w : report.warnings) std::cout << "  warning: " << w << "\n";
     }

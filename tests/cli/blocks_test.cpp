@@ -36,16 +36,18 @@ primal::Model steel_rubber() {
   m.block_names = {{7, "steel"}, {9, "rubber"}};
   primal::NodeSet clamp{3, "clamp", {}};
   for (std::size_t v = 0; v < m.points.size(); ++v)
-    if (m.points[v].x() == 0.0) clamp.nodes.push_back(static_cast<primal::Index>(v));
+    if (m.points[v].x() == 0.0) clamp.nodes.push_back(primal::index_cast(v));
   m.node_sets = {clamp};
   primal::SideSet load{5, "load", {}};
   for (std::size_t t = 0; t < m.tets.size(); ++t)
     for (int f = 0; f < 4; ++f) {
       bool on = true;
-      for (int c : primal::topology::kTetFaceCorners[static_cast<std::size_t>(f)])
-        on = on &&
-             m.points[static_cast<std::size_t>(m.tets[t][static_cast<std::size_t>(c)])].x() == 4.0;
-      if (on) load.sides.push_back({{primal::ElementKind::kTet, static_cast<primal::Index>(t)}, f});
+      for (int c : primal::topology::kTetFaceCorners[primal::index_cast<std::size_t>(f)])
+        on =
+            on &&
+            m.points[primal::index_cast<std::size_t>(m.tets[t][primal::index_cast<std::size_t>(c)])]
+                    .x() == 4.0;
+      if (on) load.sides.push_back({{primal::ElementKind::kTet, primal::index_cast(t)}, f});
     }
   m.side_sets = {load};
   return m;
@@ -168,7 +170,7 @@ TEST_CASE("conform: parts meshed separately get a hint, and --merge-tolerance jo
   const std::size_t n = m.points.size();
   for (std::size_t v = 0; v < n; ++v) m.points.push_back(m.points[v]);
   for (auto& t : m.tets)
-    for (auto& v : t) v += static_cast<primal::Index>(n);
+    for (auto& v : t) v += primal::index_cast(n);
   const fs::path in = dir.path / "in.exo", out = dir.path / "out.exo";
   io::write_exodus(m, in);
   const test::CliRun r =

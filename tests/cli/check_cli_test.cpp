@@ -151,7 +151,7 @@ TEST_CASE("geode check: text report, quad meshes, the file's own numbering") {
   }
   SUBCASE("a quad doublet") {
     primal::QuadMesh q = test::structured_quad_grid(3, 3);
-    const Index e = static_cast<Index>(q.points.size());
+    const Index e = primal::index_cast(q.points.size());
     q.points.emplace_back(1.6, 1.4, 0.0);
     const auto c = q.quads[4];
     q.quads[4] = {c[0], c[1], c[2], e};

@@ -37,7 +37,7 @@ std::string slurp(const fs::path& p) {
 }
 
 std::size_t lines(const std::string& s) {
-  return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n'));
+  return primal::index_cast<std::size_t>(std::count(s.begin(), s.end(), '\n'));
 }
 
 // 4 x 2 x 2 unit cells, cells with i >= 2 split into 6 tets: 8 hexes, 48 tets, 4 interface quads.
@@ -228,7 +228,8 @@ TEST_CASE("cli conventions: a binary .vtu holds the same points and cell data as
   const std::vector<double> xyz = binary_doubles(xml, "NumberOfComponents=\"3\"");
   REQUIRE(xyz.size() == 3 * a.points.size());
   for (std::size_t i = 0; i < a.points.size(); ++i)
-    for (int k = 0; k < 3; ++k) CHECK(xyz[3 * i + static_cast<std::size_t>(k)] == a.points[i][k]);
+    for (int k = 0; k < 3; ++k)
+      CHECK(xyz[3 * i + primal::index_cast<std::size_t>(k)] == a.points[i][k]);
   const std::vector<double> sj = binary_doubles(xml, "Name=\"scaled_jacobian\"");
   REQUIRE(a.cell_data.find_double("scaled_jacobian") != nullptr);
   CHECK(sj == *a.cell_data.find_double("scaled_jacobian"));
@@ -290,15 +291,15 @@ TEST_CASE(
     primal::Model m = small_model();
     auto node_at = [&](const primal::Point& p) {
       for (std::size_t i = 0; i < m.points.size(); ++i)
-        if ((m.points[i] - p).norm() < 1e-12) return static_cast<primal::Index>(i);
+        if ((m.points[i] - p).norm() < 1e-12) return primal::index_cast(i);
       m.points.push_back(p);
-      return static_cast<primal::Index>(m.points.size() - 1);
+      return primal::index_cast(m.points.size() - 1);
     };
     std::array<primal::Index, 8> h{};
     const double x[8] = {-1, 0, 0, -1, -1, 0, 0, -1}, y[8] = {-1, -1, 0, 0, -1, -1, 0, 0},
                  z[8] = {0, 0, 0, 0, 1, 1, 1, 1};
     for (int c = 0; c < 8; ++c)
-      h[static_cast<std::size_t>(c)] = node_at({x[c], y[c], z[c] + row.z0});
+      h[primal::index_cast<std::size_t>(c)] = node_at({x[c], y[c], z[c] + row.z0});
     m.hexes.push_back(h);
     if (!m.hex_block.empty()) m.hex_block.push_back(m.hex_block.front());
     const fs::path in = dir.path / "in.exo", out = dir.path / "out.vtu";
@@ -308,7 +309,7 @@ TEST_CASE(
     auto id_at = [&](const primal::Point& p) {
       for (std::size_t i = 0; i < read.points.size(); ++i)
         if ((read.points[i] - p).norm() < 1e-12)
-          return std::to_string(primal::node_id(read, static_cast<primal::Index>(i)));
+          return std::to_string(primal::node_id(read, primal::index_cast(i)));
       return std::string("?");
     };
     const std::string nodes = row.z0 == 0.0 ? "nodes " + id_at({0, 0, 0}) + " " + id_at({0, 0, 1})

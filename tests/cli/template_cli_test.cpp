@@ -33,7 +33,7 @@ primal::HexMesh hex_from_tables(const std::vector<primal::Point>& pts,
   for (const auto& h : hexes) {
     std::array<primal::Index, 8> c{};
     for (int i = 0; i < 8; ++i)
-      c[static_cast<std::size_t>(i)] = h[static_cast<std::size_t>(i)] - 1;  // 1-based
+      c[primal::index_cast<std::size_t>(i)] = h[primal::index_cast<std::size_t>(i)] - 1;  // 1-based
     m.hexes.push_back(c);
   }
   return m;

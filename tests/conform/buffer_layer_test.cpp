@@ -25,14 +25,14 @@ using namespace geode::conform;
 namespace {
 
 double tri_flux(const std::vector<Point>& p, Index a, Index b, Index c) {
-  return p[static_cast<std::size_t>(a)].dot(
-             p[static_cast<std::size_t>(b)].cross(p[static_cast<std::size_t>(c)])) /
+  return p[index_cast<std::size_t>(a)].dot(
+             p[index_cast<std::size_t>(b)].cross(p[index_cast<std::size_t>(c)])) /
          6.0;
 }
 
 // Quad (outward, counter-clockwise) split along corners (k, k+2).
 double quad_flux(const std::vector<Point>& p, std::array<Index, 4> q, int k) {
-  auto at = [&](int i) { return q[static_cast<std::size_t>((i + k) % 4)]; };
+  auto at = [&](int i) { return q[index_cast<std::size_t>((i + k) % 4)]; };
   return tri_flux(p, at(0), at(1), at(2)) + tri_flux(p, at(0), at(2), at(3));
 }
 
@@ -46,7 +46,7 @@ double hex_flux_volume(const std::vector<Point>& p, const std::array<Index, 8>& 
   for (int f = 0; f < 6; ++f) {
     std::array<Index, 4> q{};
     for (std::size_t i = 0; i < 4; ++i)
-      q[i] = h[static_cast<std::size_t>(topology::kHexFaceCorners[static_cast<std::size_t>(f)][i])];
+      q[i] = h[index_cast<std::size_t>(topology::kHexFaceCorners[index_cast<std::size_t>(f)][i])];
     // Face 5 is 4 5 6 7: split 0 joins 4-6, split 1 joins 5-7.
     v += quad_flux(p, q, f == 5 && top_split >= 0 ? top_split : canonical_split(q));
   }
@@ -84,13 +84,13 @@ void check_layer(const Case& c, BufferSide side) {
   if (side == BufferSide::kHex) {
     for (std::size_t t = 0; t < m.tets.size(); ++t)
       for (std::size_t i = 0; i < 4; ++i)
-        CHECK(p[static_cast<std::size_t>(layer.model.tets[t][i])] ==
-              m.points[static_cast<std::size_t>(m.tets[t][i])]);
+        CHECK(p[index_cast<std::size_t>(layer.model.tets[t][i])] ==
+              m.points[index_cast<std::size_t>(m.tets[t][i])]);
     for (const auto& h : m.hexes) {
       HexCorners before, after;
       for (std::size_t i = 0; i < 8; ++i) {
-        before[i] = m.points[static_cast<std::size_t>(h[i])];
-        after[i] = p[static_cast<std::size_t>(h[i])];
+        before[i] = m.points[index_cast<std::size_t>(h[i])];
+        after[i] = p[index_cast<std::size_t>(h[i])];
       }
       CHECK(hex_scaled_jacobian(after) >=
             BufferLayerOptions{}.min_hex_quality_ratio * hex_scaled_jacobian(before));
@@ -98,19 +98,19 @@ void check_layer(const Case& c, BufferSide side) {
   } else {
     for (const auto& h : m.hexes)
       for (Index v : h)
-        CHECK(p[static_cast<std::size_t>(v)] == m.points[static_cast<std::size_t>(v)]);
+        CHECK(p[index_cast<std::size_t>(v)] == m.points[index_cast<std::size_t>(v)]);
   }
 
   double total = 0;
   for (const auto& h : m.hexes) total += hex_flux_volume(p, h);
   for (std::size_t b = 0; b < layer.hexes.size(); ++b) {
     const BufferHex& bh = layer.hexes[b];
-    const InterfaceQuad& q = itf.quads[static_cast<std::size_t>(bh.quad)];
-    CHECK(bh.quad == static_cast<Index>(b));
+    const InterfaceQuad& q = itf.quads[index_cast<std::size_t>(bh.quad)];
+    CHECK(bh.quad == index_cast(b));
     for (std::size_t i = 0; i < 4; ++i) {
       CHECK(bh.corners[i] == q.corners[i]);  // hex side
       CHECK(bh.corners[i + 4] ==
-            layer.top_node[static_cast<std::size_t>(q.corners[i])]);  // tet side
+            layer.top_node[index_cast<std::size_t>(q.corners[i])]);  // tet side
     }
     CHECK(bh.diagonal == (q.diagonal == 0 ? std::array<int, 2>{4, 6} : std::array<int, 2>{5, 7}));
     // The top triangles along the diagonal are faces of the two (renumbered) tets.
@@ -120,23 +120,22 @@ void check_layer(const Case& c, BufferSide side) {
             ? std::array<std::array<Index, 3>, 2>{{{k[4], k[5], k[6]}, {k[4], k[6], k[7]}}}
             : std::array<std::array<Index, 3>, 2>{{{k[4], k[5], k[7]}, {k[5], k[6], k[7]}}};
     for (std::size_t i = 0; i < 2; ++i) {
-      const auto& t = layer.model.tets[static_cast<std::size_t>(q.tets[i])];
+      const auto& t = layer.model.tets[index_cast<std::size_t>(q.tets[i])];
       std::set<Index> face;
-      for (int cc : topology::kTetFaceCorners[static_cast<std::size_t>(q.tet_faces[i])])
-        face.insert(t[static_cast<std::size_t>(cc)]);
+      for (int cc : topology::kTetFaceCorners[index_cast<std::size_t>(q.tet_faces[i])])
+        face.insert(t[index_cast<std::size_t>(cc)]);
       CHECK(face == std::set<Index>(top[i].begin(), top[i].end()));
     }
     HexCorners corners;
-    for (std::size_t i = 0; i < 8; ++i) corners[i] = p[static_cast<std::size_t>(k[i])];
+    for (std::size_t i = 0; i < 8; ++i) corners[i] = p[index_cast<std::size_t>(k[i])];
     CHECK(hex_scaled_jacobian(corners) > 0.0);
     const double v = hex_flux_volume(p, k, q.diagonal);
     CHECK(v > 0.0);
     total += v;
   }
   for (const auto& t : layer.model.tets) {
-    const double v =
-        tet_volume(p[static_cast<std::size_t>(t[0])], p[static_cast<std::size_t>(t[1])],
-                   p[static_cast<std::size_t>(t[2])], p[static_cast<std::size_t>(t[3])]);
+    const double v = tet_volume(p[index_cast<std::size_t>(t[0])], p[index_cast<std::size_t>(t[1])],
+                                p[index_cast<std::size_t>(t[2])], p[index_cast<std::size_t>(t[3])]);
     CHECK(v > 0.0);
     total += v;
   }
@@ -205,8 +204,8 @@ TEST_CASE("insert_buffer_layer: one hex under tets, positions by hand") {
     // down (-z) from the interface at z = 1, the tet side's up.
     for (const BufferHex& b : layer.hexes)
       for (std::size_t i = 0; i < 4; ++i) {
-        const Point& bottom = layer.model.points[static_cast<std::size_t>(b.corners[i])];
-        const Point& top = layer.model.points[static_cast<std::size_t>(b.corners[i + 4])];
+        const Point& bottom = layer.model.points[index_cast<std::size_t>(b.corners[i])];
+        const Point& top = layer.model.points[index_cast<std::size_t>(b.corners[i + 4])];
         CHECK((top - bottom - Point(0, 0, 0.25)).norm() < 1e-14);
         CHECK((side == BufferSide::kHex ? top : bottom).z() == 1.0);
       }
@@ -236,9 +235,8 @@ TEST_CASE("insert_buffer_layer: the nugget's corners move along the cavity diago
     const BufferLayer layer = insert_buffer_layer(m, find_interface(m), o);
     CHECK(layer.report.halvings == 0);
     const auto& p = layer.model.points;
-    const Point& hex_copy = p[static_cast<std::size_t>(v)];
-    const Point& tet_copy =
-        p[static_cast<std::size_t>(layer.top_node[static_cast<std::size_t>(v)])];
+    const Point& hex_copy = p[index_cast<std::size_t>(v)];
+    const Point& tet_copy = p[index_cast<std::size_t>(layer.top_node[index_cast<std::size_t>(v)])];
     const double height = o.thickness;
     const Point moved = side == BufferSide::kHex ? Point(Point(1, 1, 1) - height * Point(1, 1, 1))
                                                  : Point(Point(1, 1, 1) + height * Point(1, 1, 1));
@@ -293,7 +291,7 @@ TEST_CASE(
       const auto& p = layer.model.points;
       for (const BufferHex& b : layer.hexes) {
         auto at = [&](int i) -> const Point& {
-          return p[static_cast<std::size_t>(b.corners[static_cast<std::size_t>(i)])];
+          return p[index_cast<std::size_t>(b.corners[index_cast<std::size_t>(i)])];
         };
         if (side == BufferSide::kTet) {
           const Point n = (at(1) - at(0)).cross(at(3) - at(0)).normalized();  // into the tet side
@@ -330,10 +328,9 @@ TEST_CASE("insert_buffer_layer: a thinner layer at corners where the moving part
       for (int y : {1, 3})
         for (int z : {1, 3}) {
           const Index v = x + 5 * (y + 5 * z);
-          const Point d =
-              (p[static_cast<std::size_t>(layer.top_node[static_cast<std::size_t>(v)])] -
-               p[static_cast<std::size_t>(v)])
-                  .cwiseAbs();
+          const Point d = (p[index_cast<std::size_t>(layer.top_node[index_cast<std::size_t>(v)])] -
+                           p[index_cast<std::size_t>(v)])
+                              .cwiseAbs();
           const double expected = block ? o.feature_thickness * height : height;
           for (int a = 0; a < 3; ++a) CHECK(d[a] == doctest::Approx(expected).epsilon(1e-12));
           ++corners;
@@ -350,18 +347,18 @@ TEST_CASE("insert_buffer_layer: one short tet edge does not twist the buffer top
   // twisted by 0.15 over edges of length 1. Graded, the node is raised towards its neighbours
   // and no two neighbours differ by more than smooth_rate x their edge; the tets stay positive.
   Model m = grid_model({3, 3, 2}, 1.0, [](int, int, int k) { return k == 1; });
-  auto node = [](int i, int j, int k) { return static_cast<std::size_t>(i + 4 * (j + 4 * k)); };
+  auto node = [](int i, int j, int k) { return index_cast<std::size_t>(i + 4 * (j + 4 * k)); };
   m.points[node(1, 1, 2)].z() = 1.5;
   const Interface itf = find_interface(m);
   REQUIRE(itf.quads.size() == 9);
   const BufferLayerOptions o = on_side(BufferSide::kTet);
   const BufferLayer layer = insert_buffer_layer(m, itf, o);
   auto height = [&](Index v) {
-    return layer.model.points[static_cast<std::size_t>(layer.top_node[static_cast<std::size_t>(v)])]
+    return layer.model.points[index_cast<std::size_t>(layer.top_node[index_cast<std::size_t>(v)])]
                .z() -
            1.0;
   };
-  CHECK(height(static_cast<Index>(node(1, 1, 1))) >
+  CHECK(height(index_cast(node(1, 1, 1))) >
         default_buffer_thickness(BufferSide::kTet) * 0.5 + 0.05);
   for (const InterfaceQuad& q : itf.quads)
     for (std::size_t i = 0; i < 4; ++i)
@@ -388,34 +385,33 @@ TEST_CASE("Gmsh demo models: conforming interface and a valid buffer layer") {
   SUBCASE("half block, structured hexes | transfinite tets") {
     const int n = 3;
     const Model m = demo::demo_half_block(n);
-    CHECK(m.hexes.size() == static_cast<std::size_t>(n * n * n));
-    CHECK(m.tets.size() == static_cast<std::size_t>(6 * n * n * n));
+    CHECK(m.hexes.size() == index_cast<std::size_t>(n * n * n));
+    CHECK(m.tets.size() == index_cast<std::size_t>(6 * n * n * n));
     CHECK(m.points.size() ==
-          static_cast<std::size_t>((2 * n + 1) * (n + 1) * (n + 1)));  // interface merged
+          index_cast<std::size_t>((2 * n + 1) * (n + 1) * (n + 1)));  // interface merged
     const Interface itf = find_interface(m);
-    CHECK(itf.quads.size() == static_cast<std::size_t>(n * n));
-    CHECK(itf.nodes.size() == static_cast<std::size_t>((n + 1) * (n + 1)));
+    CHECK(itf.quads.size() == index_cast<std::size_t>(n * n));
+    CHECK(itf.nodes.size() == index_cast<std::size_t>((n + 1) * (n + 1)));
     for (const InterfaceQuad& q : itf.quads)
       for (Index v : q.corners)
-        CHECK(m.points[static_cast<std::size_t>(v)].x() == doctest::Approx(1.0));
+        CHECK(m.points[index_cast<std::size_t>(v)].x() == doctest::Approx(1.0));
     const BufferLayer layer = insert_buffer_layer(m, itf);
     CHECK(layer.report.min_scaled_jacobian > 0.5);  // a flat interface: near-box buffer hexes
     for (const auto& t : layer.model.tets)
-      CHECK(tet_volume(layer.model.points[static_cast<std::size_t>(t[0])],
-                       layer.model.points[static_cast<std::size_t>(t[1])],
-                       layer.model.points[static_cast<std::size_t>(t[2])],
-                       layer.model.points[static_cast<std::size_t>(t[3])]) > 0);
+      CHECK(tet_volume(layer.model.points[index_cast<std::size_t>(t[0])],
+                       layer.model.points[index_cast<std::size_t>(t[1])],
+                       layer.model.points[index_cast<std::size_t>(t[2])],
+                       layer.model.points[index_cast<std::size_t>(t[3])]) > 0);
   }
   SUBCASE("tet nugget inside sweepable hex blocks (Figure 8, simplified)") {
     const int n = 4;
     const Model m = demo::demo_nugget(n);
     // 26 blocks on a 4 x 4 x 4 structured grid of cells of size 0.5 minus the nugget's 4^3.
-    CHECK(m.hexes.size() == static_cast<std::size_t>(8 * 8 * 8 - 4 * 4 * 4));
-    CHECK(m.side_sets.at(0).sides.size() == static_cast<std::size_t>(6 * 8 * 8));
+    CHECK(m.hexes.size() == index_cast<std::size_t>(8 * 8 * 8 - 4 * 4 * 4));
+    CHECK(m.side_sets.at(0).sides.size() == index_cast<std::size_t>(6 * 8 * 8));
     const Interface itf = find_interface(m);
-    CHECK(itf.quads.size() == static_cast<std::size_t>(6 * n * n));
-    CHECK(itf.nodes.size() ==
-          static_cast<std::size_t>(6 * n * n + 2));  // closed surface: V = F + 2
+    CHECK(itf.quads.size() == index_cast<std::size_t>(6 * n * n));
+    CHECK(itf.nodes.size() == index_cast<std::size_t>(6 * n * n + 2));  // closed surface: V = F + 2
     const BufferLayer layer = insert_buffer_layer(m, itf);
     CHECK(layer.report.min_scaled_jacobian > 0.0);
     CHECK(layer.report.min_volume_ratio > 0.0);

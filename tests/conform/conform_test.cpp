@@ -47,7 +47,8 @@ void check_result(const conform::ConformResult& r, const Expected& e) {
   CHECK(r.diced_hexes == 8 * e.hexes);
   CHECK(r.geode_hexes == geode);
   CHECK(r.diced_tet_hexes == 4 * e.tets);
-  REQUIRE(r.model.hexes.size() == static_cast<std::size_t>(8 * e.hexes + geode + 4 * e.tets));
+  REQUIRE(r.model.hexes.size() ==
+          primal::index_cast<std::size_t>(8 * e.hexes + geode + 4 * e.tets));
   CHECK(r.model.tets.empty());
   test::check_conform_result(r, geode);
   // Nothing left unmerged: no two nodes at one place (an unmerged template side or top node
@@ -59,9 +60,10 @@ void check_result(const conform::ConformResult& r, const Expected& e) {
   // stay in 2.
   const int geode_block = r.buffer_side == conform::BufferSide::kHex ? 1 : 2;
   for (std::size_t h = 0; h < r.model.hexes.size(); ++h) {
-    const int expected = h < static_cast<std::size_t>(8 * e.hexes)                   ? 1
-                         : h < static_cast<std::size_t>(8 * e.hexes + r.geode_hexes) ? geode_block
-                                                                                     : 2;
+    const int expected = h < primal::index_cast<std::size_t>(8 * e.hexes) ? 1
+                         : h < primal::index_cast<std::size_t>(8 * e.hexes + r.geode_hexes)
+                             ? geode_block
+                             : 2;
     if (r.model.hex_block[h] != expected) {
       FAIL("hex " << h << " in block " << r.model.hex_block[h]);
       break;
@@ -88,7 +90,7 @@ TEST_CASE("one hex under a fan of four tets: the four-triangle template, valid")
   // centroids) must merge with the diced tets' or the boundary would not close.
   const primal::Model m = test::four_tet_fan({0.45, 0.55, 1.0}, {0.5, 0.5, 1.8});
   const conform::ConformOptions defaults;
-  const auto per_four = static_cast<Index>(
+  const auto per_four = primal::index_cast(
       conform::reference_template_four_triangles(defaults.template_box).tpl.hex.hexes.size());
   for (const auto smooth : {conform::ConformSmooth::kNone, conform::ConformSmooth::kLocal}) {
     CAPTURE(static_cast<int>(smooth));
@@ -153,7 +155,7 @@ TEST_CASE("reference templates: one per box and diagonal, from several threads a
   std::vector<std::thread> threads;
   for (int i = 0; i < 4; ++i)
     threads.emplace_back([&got, &box, i] {
-      got[static_cast<std::size_t>(i)] = &conform::reference_template(
+      got[primal::index_cast<std::size_t>(i)] = &conform::reference_template(
           box, i % 2 ? std::array<int, 2>{5, 7} : std::array<int, 2>{4, 6});
     });
   for (auto& t : threads) t.join();
@@ -175,7 +177,7 @@ TEST_CASE("nugget demo, n = 2: side set 'outside' carried to the diced hexes") {
   const primal::Model m = demo::demo_nugget(2);
   const auto r = conform::conform(m);
   // Interface: the nugget cube's 6 faces, n x n = 4 quads each.
-  check_result(r, {static_cast<Index>(m.hexes.size()), static_cast<Index>(m.tets.size()), 24});
+  check_result(r, {primal::index_cast(m.hexes.size()), primal::index_cast(m.tets.size()), 24});
   REQUIRE(m.side_sets.size() == 1);
   REQUIRE(r.model.side_sets.size() == 1);
   // Each outer quad is diced into 4 quads, each a boundary face of the output.
@@ -255,12 +257,12 @@ std::vector<std::array<Index, 3>> top_triangles(const primal::Model& m, double z
   std::vector<std::array<Index, 3>> out;
   for (const auto& t : m.tets)
     for (const auto& f : primal::topology::kTetFaceCorners) {
-      const std::array<Index, 3> c{t[static_cast<std::size_t>(f[0])],
-                                   t[static_cast<std::size_t>(f[1])],
-                                   t[static_cast<std::size_t>(f[2])]};
+      const std::array<Index, 3> c{t[primal::index_cast<std::size_t>(f[0])],
+                                   t[primal::index_cast<std::size_t>(f[1])],
+                                   t[primal::index_cast<std::size_t>(f[2])]};
       bool top = true;
       for (Index v : c) {
-        const Point& p = m.points[static_cast<std::size_t>(v)];
+        const Point& p = m.points[primal::index_cast<std::size_t>(v)];
         top = top && std::abs(p.z() - z0) < 1e-12 && keep(p);
       }
       if (top) out.push_back(c);
@@ -287,11 +289,11 @@ TEST_CASE("conform: a wedge on the tet side of an interface node takes the node'
   std::array<Index, 3> tri{-1, -1, -1};
   for (const auto& c : top_triangles(m, 1.0, [](const Point&) { return true; }))
     for (Index v : c)
-      if (m.points[static_cast<std::size_t>(v)].x() < 1.0 + 1e-12 && tri[0] < 0) tri = c;
+      if (m.points[primal::index_cast<std::size_t>(v)].x() < 1.0 + 1e-12 && tri[0] < 0) tri = c;
   REQUIRE(tri[0] >= 0);
   m.wedges.push_back(wedge_on(tri, [&](Index v) {
-    m.points.push_back(m.points[static_cast<std::size_t>(v)] + Point(0, 0, 0.5));
-    return static_cast<Index>(m.points.size() - 1);
+    m.points.push_back(m.points[primal::index_cast<std::size_t>(v)] + Point(0, 0, 0.5));
+    return primal::index_cast(m.points.size() - 1);
   }));
   REQUIRE_NOTHROW(primal::check_geometry(m, "w.msh"));
   const conform::ConformResult r = conform::conform(m);
@@ -301,12 +303,12 @@ TEST_CASE("conform: a wedge on the tet side of an interface node takes the node'
   CHECK(r.diced_wedge_hexes == 6);
   // The wedge is diced in place: its 6 hexes (the last ones) fill its own volume.
   const auto& w = m.wedges.front();
-  const auto p = [&](std::size_t k) { return m.points[static_cast<std::size_t>(w[k])]; };
+  const auto p = [&](std::size_t k) { return m.points[primal::index_cast<std::size_t>(w[k])]; };
   const double wedge_volume = 0.5 * 0.5 * (p(1) - p(0)).cross(p(2) - p(0)).norm();
   const primal::HexMesh out = primal::hex_part(r.model);
   double diced = 0.0;
   for (std::size_t h = out.hexes.size() - 6; h < out.hexes.size(); ++h)
-    diced += primal::hex_volume(primal::hex_corners(out, static_cast<Index>(h)));
+    diced += primal::hex_volume(primal::hex_corners(out, primal::index_cast(h)));
   CHECK(diced == doctest::Approx(wedge_volume).epsilon(1e-9));
   // Carved from the tet part, the moving copy would move the wedge: refused naming it (file
   // id 1), then carved from the hex part with that reason as a warning.
@@ -331,7 +333,7 @@ TEST_CASE("conform refuses a wedge joining the two sides of an interface node, n
   std::size_t upper = m.hexes.size();
   for (std::size_t h = 0; h < m.hexes.size(); ++h) {
     Point c = Point::Zero();
-    for (Index v : m.hexes[h]) c += m.points[static_cast<std::size_t>(v)] / 8.0;
+    for (Index v : m.hexes[h]) c += m.points[primal::index_cast<std::size_t>(v)] / 8.0;
     if (c.x() > 1.0 && c.z() > 1.0) upper = h;
   }
   REQUIRE(upper < m.hexes.size());
@@ -342,9 +344,9 @@ TEST_CASE("conform refuses a wedge joining the two sides of an interface node, n
   REQUIRE(tris.size() == 2);
   for (const auto& tri : tris)
     m.wedges.push_back(wedge_on(tri, [&](Index v) {
-      const Point above = m.points[static_cast<std::size_t>(v)] + Point(0, 0, 1);
+      const Point above = m.points[primal::index_cast<std::size_t>(v)] + Point(0, 0, 1);
       for (Index x : hex)
-        if ((m.points[static_cast<std::size_t>(x)] - above).norm() < 1e-12) return x;
+        if ((m.points[primal::index_cast<std::size_t>(x)] - above).norm() < 1e-12) return x;
       return primal::kInvalidIndex;
     }));
   REQUIRE_NOTHROW(primal::check_geometry(m, "w.msh"));
@@ -379,7 +381,7 @@ TEST_CASE("conform: a wedge quad meeting two tet triangles gets the geode transi
   CHECK(r.interface_quads == 1);
   CHECK(r.geode_hexes == 26);
   CHECK(r.diced_wedge_hexes == 12);
-  CHECK(r.diced_tet_hexes == 4 * static_cast<Index>(m.tets.size()));
+  CHECK(r.diced_tet_hexes == 4 * primal::index_cast(m.tets.size()));
   // With the defaults (from the hex part) the wedge would move: refused by name, then carved
   // from the tet part with that reason as a warning.
   const conform::ConformResult d = conform::conform(m);

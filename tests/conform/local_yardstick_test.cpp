@@ -62,21 +62,21 @@ TEST_CASE(
     const primal::HexMesh out = primal::hex_part(r.model);
     for (Index b = 0; b < r.interface_quads; ++b)
       for (Index h = r.diced_hexes + 26 * b; h < r.diced_hexes + 26 * (b + 1); ++h) {
-        const int id = r.model.hex_block[static_cast<std::size_t>(h)];
+        const int id = r.model.hex_block[primal::index_cast<std::size_t>(h)];
         const double sj = primal::hex_scaled_jacobian(primal::hex_corners(out, h));
         geode_min.try_emplace(id, 1.0), ratio.try_emplace(id, 1.0);
         geode_min[id] = std::min(geode_min[id], sj);
-        ratio[id] = std::min(ratio[id], sj / r.local_yardstick[static_cast<std::size_t>(b)]);
-        overall = std::min(overall, sj / r.local_yardstick[static_cast<std::size_t>(b)]);
+        ratio[id] = std::min(ratio[id], sj / r.local_yardstick[primal::index_cast<std::size_t>(b)]);
+        overall = std::min(overall, sj / r.local_yardstick[primal::index_cast<std::size_t>(b)]);
         ++geode_count[id];
       }
     for (std::size_t h = 0; h < input.hexes.size(); ++h) {
-      const int id = primal::block_of(input, {primal::ElementKind::kHex, static_cast<Index>(h)});
+      const int id = primal::block_of(input, {primal::ElementKind::kHex, primal::index_cast(h)});
       input_min.try_emplace(id, 1.0);
       input_min[id] = std::min(input_min[id], hex_alone(h));
     }
     for (std::size_t t = 0; t < input.tets.size(); ++t) {
-      const int id = primal::block_of(input, {primal::ElementKind::kTet, static_cast<Index>(t)});
+      const int id = primal::block_of(input, {primal::ElementKind::kTet, primal::index_cast(t)});
       input_min.try_emplace(id, 1.0);
       input_min[id] = std::min(input_min[id], tet_alone(t));
     }

@@ -25,8 +25,8 @@ std::map<int, double> block_volumes(const primal::Model& m) {
   for (std::size_t h = 0; h < m.hexes.size(); ++h) {
     primal::HexCorners c;
     for (int k = 0; k < 8; ++k)
-      c[static_cast<std::size_t>(k)] =
-          m.points[static_cast<std::size_t>(m.hexes[h][static_cast<std::size_t>(k)])];
+      c[primal::index_cast<std::size_t>(k)] =
+          m.points[primal::index_cast<std::size_t>(m.hexes[h][primal::index_cast<std::size_t>(k)])];
     v[m.hex_block[h]] += primal::hex_volume(c);
   }
   return v;
@@ -37,9 +37,9 @@ std::map<int, double> input_tet_volumes(const primal::Model& m) {
   for (std::size_t t = 0; t < m.tets.size(); ++t) {
     const auto& n = m.tets[t];
     const auto& p = m.points;
-    v[m.tet_block.empty() ? 0 : m.tet_block[t]] +=
-        primal::tet_volume(p[static_cast<std::size_t>(n[0])], p[static_cast<std::size_t>(n[1])],
-                           p[static_cast<std::size_t>(n[2])], p[static_cast<std::size_t>(n[3])]);
+    v[m.tet_block.empty() ? 0 : m.tet_block[t]] += primal::tet_volume(
+        p[primal::index_cast<std::size_t>(n[0])], p[primal::index_cast<std::size_t>(n[1])],
+        p[primal::index_cast<std::size_t>(n[2])], p[primal::index_cast<std::size_t>(n[3])]);
   }
   return v;
 }
@@ -70,7 +70,7 @@ TEST_CASE("materials never move: every smoothing mode keeps each block's volume 
     primal::HexMesh mesh = primal::hex_part(base.model);
     std::vector<char> on_surface(mesh.points.size(), 0);
     for (const auto& q : primal::material_surface_quads(mesh))
-      for (Index v : q.nodes) on_surface[static_cast<std::size_t>(v)] = 1;
+      for (Index v : q.nodes) on_surface[primal::index_cast<std::size_t>(v)] = 1;
     const struct {
       const char* label;
       conform::ConformSmooth smooth;

@@ -49,7 +49,7 @@ TEST_CASE(
   // The pyramid's hexes: all but the 8 diced from the hex below.
   primal::HexMesh pyramid{r.model.points, {r.model.hexes.begin() + 8, r.model.hexes.end()}, {}};
   double lo = 1.0, sum = 0.0;
-  for (Index h = 0; h < static_cast<Index>(pyramid.hexes.size()); ++h) {
+  for (Index h = 0; h < primal::index_cast(pyramid.hexes.size()); ++h) {
     const double sj = primal::hex_scaled_jacobian(primal::hex_corners(pyramid, h));
     lo = std::min(lo, sj);
     sum += sj;
@@ -84,7 +84,7 @@ TEST_CASE("conform's default on one pyramid over a hex: split, the geode in the 
   CHECK(r.validity.ok());
   double lo = 1.0, pyramid_lo = 1.0;
   primal::HexMesh all{r.model.points, r.model.hexes, {}};
-  for (Index h = 0; h < static_cast<Index>(all.hexes.size()); ++h) {
+  for (Index h = 0; h < primal::index_cast(all.hexes.size()); ++h) {
     const double sj = primal::hex_scaled_jacobian(primal::hex_corners(all, h));
     lo = std::min(lo, sj);
     if (h >= r.diced_hexes + r.geode_hexes) pyramid_lo = std::min(pyramid_lo, sj);
@@ -124,7 +124,9 @@ std::vector<std::array<Index, 4>> tetgen_pyramid(const primal::QuadMesh& s) {
   for (auto& a : tets) {
     ele >> k >> a[0] >> a[1] >> a[2] >> a[3];
     const auto& p = s.points;
-    auto at = [&](int i) { return p[static_cast<std::size_t>(a[static_cast<std::size_t>(i)])]; };
+    auto at = [&](int i) {
+      return p[primal::index_cast<std::size_t>(a[primal::index_cast<std::size_t>(i)])];
+    };
     if ((at(1) - at(0)).cross(at(2) - at(0)).dot(at(3) - at(0)) < 0) std::swap(a[0], a[1]);
   }
   REQUIRE(ele.good());
@@ -150,7 +152,7 @@ TEST_CASE("the paper's 512: Schneiders' 16 quads as the hex side of the geode, t
   m.points = s.points;
   const Point inside(0, h / 4, 0);
   for (const Point& p : s.points) m.points.push_back(inside + 1.5 * (p - inside));
-  const Index n = static_cast<Index>(s.points.size());
+  const Index n = primal::index_cast(s.points.size());
   for (const auto& q : s.quads)  // counter-clockwise seen from outside: the shell's hexes
     m.hexes.push_back({q[0], q[1], q[2], q[3], q[0] + n, q[1] + n, q[2] + n, q[3] + n});
   m.tets = tets;
@@ -172,7 +174,7 @@ TEST_CASE("the paper's 512: Schneiders' 16 quads as the hex side of the geode, t
   CHECK(v.boundary.faces.size() == 64);
   CHECK(primal::check_validity(primal::HexMesh{r.model.points, r.model.hexes, {}}).ok());
   double lo = 1.0, sum = 0.0;
-  for (Index k = 0; k < static_cast<Index>(pyramid.hexes.size()); ++k) {
+  for (Index k = 0; k < primal::index_cast(pyramid.hexes.size()); ++k) {
     const double sj = primal::hex_scaled_jacobian(primal::hex_corners(pyramid, k));
     lo = std::min(lo, sj);
     sum += sj;
@@ -187,12 +189,12 @@ TEST_CASE("the paper's 512: Schneiders' 16 quads as the hex side of the geode, t
   double off = 0.0;
   for (const auto& f : v.boundary.faces) {
     for (Index node : f.nodes) {
-      const Point& x = pyramid.points[static_cast<std::size_t>(node)];
+      const Point& x = pyramid.points[primal::index_cast<std::size_t>(node)];
       double d = 1e300;
       for (const auto& t : faces) {
-        const Point a = s.points[static_cast<std::size_t>(t[0])];
-        const Point nrm = (s.points[static_cast<std::size_t>(t[1])] - a)
-                              .cross(s.points[static_cast<std::size_t>(t[2])] - a)
+        const Point a = s.points[primal::index_cast<std::size_t>(t[0])];
+        const Point nrm = (s.points[primal::index_cast<std::size_t>(t[1])] - a)
+                              .cross(s.points[primal::index_cast<std::size_t>(t[2])] - a)
                               .normalized();
         d = std::min(d, std::abs(nrm.dot(x - a)));
       }

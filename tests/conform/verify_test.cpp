@@ -50,12 +50,12 @@ TEST_CASE("local verification reads the transition's surroundings, not the whole
   CHECK(conform::result_valid(r));
   CHECK(r.verified == conform::ConformVerify::kLocal);
   CHECK(r.verified_hexes >= r.geode_hexes);
-  CHECK(r.verified_hexes < static_cast<Index>(r.model.hexes.size()));
+  CHECK(r.verified_hexes < primal::index_cast(r.model.hexes.size()));
   conform::ConformOptions global = local;
   global.smooth = conform::ConformSmooth::kGlobal;  // moves every node: verified whole
   const auto g = conform::conform(demo::demo_model("delaunay", 2), global);
   CHECK(g.verified == conform::ConformVerify::kFull);
-  CHECK(g.verified_hexes == static_cast<Index>(g.model.hexes.size()));
+  CHECK(g.verified_hexes == primal::index_cast(g.model.hexes.size()));
 }
 
 TEST_CASE(
@@ -65,12 +65,13 @@ TEST_CASE(
   CHECK(r.verified == conform::ConformVerify::kLocal);  // the default
   primal::HexMesh mesh = primal::hex_part(r.model);
   const Index first_geode = r.diced_hexes;
-  std::vector<Index> geode(static_cast<std::size_t>(r.geode_hexes));
-  for (Index i = 0; i < r.geode_hexes; ++i) geode[static_cast<std::size_t>(i)] = first_geode + i;
+  std::vector<Index> geode(primal::index_cast<std::size_t>(r.geode_hexes));
+  for (Index i = 0; i < r.geode_hexes; ++i)
+    geode[primal::index_cast<std::size_t>(i)] = first_geode + i;
 
   // Seeded by every hex, the region is the whole mesh: check_validity's verdict and counts.
   std::vector<Index> all(mesh.hexes.size());
-  for (std::size_t h = 0; h < all.size(); ++h) all[h] = static_cast<Index>(h);
+  for (std::size_t h = 0; h < all.size(); ++h) all[h] = primal::index_cast(h);
   const auto whole = primal::check_validity_around(mesh, all);
   const auto reference = primal::check_validity(mesh);
   CHECK(whole.ok());
@@ -81,10 +82,10 @@ TEST_CASE(
 
   SUBCASE("a geode hex's node replaced by another geode node: found as the full check finds it") {
     primal::HexMesh torn = mesh;
-    auto& h = torn.hexes[static_cast<std::size_t>(first_geode)];
+    auto& h = torn.hexes[primal::index_cast<std::size_t>(first_geode)];
     Index v = primal::kInvalidIndex;
     for (Index k = first_geode + 1; v == primal::kInvalidIndex; ++k)
-      for (Index x : torn.hexes[static_cast<std::size_t>(k)])
+      for (Index x : torn.hexes[primal::index_cast<std::size_t>(k)])
         if (std::find(h.begin(), h.end(), x) == h.end()) {
           v = x;
           break;

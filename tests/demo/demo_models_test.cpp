@@ -28,12 +28,12 @@ namespace {
 // four-triangle template's count per four-triangle one (checked to be some but not all quads).
 Index mixed_geode_hexes(const primal::Model& m) {
   const primal::Interface itf = primal::find_interface(m);
-  const auto quads = static_cast<Index>(itf.quads.size());
+  const auto quads = primal::index_cast(itf.quads.size());
   Index four = 0;
   for (const auto& q : itf.quads) four += q.centre != primal::kInvalidIndex;
   CHECK(four > 0);
   CHECK(four < quads);
-  const auto per_four = static_cast<Index>(
+  const auto per_four = primal::index_cast(
       conform::reference_template_four_triangles(conform::ConformOptions{}.template_box)
           .tpl.hex.hexes.size());
   return 26 * (quads - four) + per_four * four;
@@ -203,7 +203,7 @@ TEST_CASE("fulcher demo: circles imprinted on three nugget faces, the parts conf
   }
   for (const auto& h : m.hexes) {
     primal::HexCorners c;
-    for (std::size_t i = 0; i < 8; ++i) c[i] = m.points[static_cast<std::size_t>(h[i])];
+    for (std::size_t i = 0; i < 8; ++i) c[i] = m.points[primal::index_cast<std::size_t>(h[i])];
     CHECK(primal::hex_volume(c) > 0);
     hex_volume += primal::hex_volume(c);
   }
@@ -215,20 +215,20 @@ TEST_CASE("fulcher demo: circles imprinted on three nugget faces, the parts conf
   std::array<int, 6> quads_on_face{};
   for (const auto& q : in.quads) {
     primal::Point c = primal::Point::Zero();
-    for (primal::Index v : q.corners) c += m.points[static_cast<std::size_t>(v)] / 4.0;
+    for (primal::Index v : q.corners) c += m.points[primal::index_cast<std::size_t>(v)] / 4.0;
     int axis = 0;
     c.cwiseAbs().maxCoeff(&axis);
     CHECK(std::abs(std::abs(c[axis]) - 1.0) < 1e-9);
-    ++quads_on_face[static_cast<std::size_t>(2 * axis + (c[axis] > 0 ? 1 : 0))];
+    ++quads_on_face[primal::index_cast<std::size_t>(2 * axis + (c[axis] > 0 ? 1 : 0))];
   }
   const double radii[3] = {0.3, 0.5, 0.7};
   for (int axis = 0; axis < 3; ++axis) {
     CAPTURE(axis);
-    CHECK(quads_on_face[static_cast<std::size_t>(2 * axis)] == n * n);
-    CHECK(quads_on_face[static_cast<std::size_t>(2 * axis + 1)] > 0);
+    CHECK(quads_on_face[primal::index_cast<std::size_t>(2 * axis)] == n * n);
+    CHECK(quads_on_face[primal::index_cast<std::size_t>(2 * axis + 1)] > 0);
     int on_circle = 0;
     for (primal::Index v : in.nodes) {
-      const primal::Point& p = m.points[static_cast<std::size_t>(v)];
+      const primal::Point& p = m.points[primal::index_cast<std::size_t>(v)];
       const double u = p[(axis + 1) % 3], w = p[(axis + 2) % 3];
       if (std::abs(p[axis] - 1.0) < 1e-9 && std::abs(std::hypot(u, w) - radii[axis]) < 1e-6)
         ++on_circle;
@@ -239,6 +239,6 @@ TEST_CASE("fulcher demo: circles imprinted on three nugget faces, the parts conf
   // their imprinted faces.
   REQUIRE(m.side_sets.size() == 1);
   CHECK(m.side_sets[0].sides.size() ==
-        static_cast<std::size_t>(21 * n * n + quads_on_face[1] + quads_on_face[3] +
-                                 quads_on_face[5]));
+        primal::index_cast<std::size_t>(21 * n * n + quads_on_face[1] + quads_on_face[3] +
+                                        quads_on_face[5]));
 }

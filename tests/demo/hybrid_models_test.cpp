@@ -53,7 +53,7 @@ std::set<int> blocks_of(const primal::Model& m) {
   std::set<int> b;
   for (ElementKind kind : primal::kElementKinds)
     for (std::size_t e = 0; e < primal::element_count(m, kind); ++e)
-      b.insert(primal::block_of(m, {kind, static_cast<Index>(e)}));
+      b.insert(primal::block_of(m, {kind, primal::index_cast(e)}));
   return b;
 }
 
@@ -63,7 +63,7 @@ void add_boundary_sets(primal::Model& m) {
   for (ElementKind kind : primal::kElementKinds)
     for (std::size_t e = 0; e < primal::element_count(m, kind); ++e)
       for (int f = 0; f < primal::cell_topology(kind).faces; ++f) {
-        const primal::Side side{{kind, static_cast<Index>(e)}, f};
+        const primal::Side side{{kind, primal::index_cast(e)}, f};
         auto nodes = primal::element_face(m, side);
         std::sort(nodes.begin(), nodes.end());
         std::array<Index, 4> key{-1, -1, -1, -1};
@@ -126,16 +126,16 @@ TEST_CASE(
       if (smooth == conform::ConformSmooth::kLocal && c.local_aim)
         CHECK(r.local_yardstick_ratio >= 0.9);
       // Per kind: 8 per hex, 4 per tet (a pyramid's two tets), 6 per wedge, 26 per interface quad.
-      CHECK(r.input_pyramids == static_cast<Index>(in.pyramids.size()));
-      CHECK(r.diced_hexes == 8 * static_cast<Index>(in.hexes.size()));
-      CHECK(r.diced_tet_hexes == 4 * static_cast<Index>(in.tets.size() + 2 * in.pyramids.size()));
-      CHECK(r.diced_wedge_hexes == 6 * static_cast<Index>(in.wedges.size()));
+      CHECK(r.input_pyramids == primal::index_cast(in.pyramids.size()));
+      CHECK(r.diced_hexes == 8 * primal::index_cast(in.hexes.size()));
+      CHECK(r.diced_tet_hexes == 4 * primal::index_cast(in.tets.size() + 2 * in.pyramids.size()));
+      CHECK(r.diced_wedge_hexes == 6 * primal::index_cast(in.wedges.size()));
       CHECK(r.geode_hexes == 26 * r.interface_quads);
       CHECK(r.model.hexes.size() ==
-            static_cast<std::size_t>(r.diced_hexes + r.geode_hexes + r.diced_tet_hexes +
-                                     r.diced_wedge_hexes));
+            primal::index_cast<std::size_t>(r.diced_hexes + r.geode_hexes + r.diced_tet_hexes +
+                                            r.diced_wedge_hexes));
       // Gmsh puts one pyramid on every quad a tet volume meets: each is an interface quad.
-      if (c.pyramids) CHECK(r.interface_quads == static_cast<Index>(in.pyramids.size()));
+      if (c.pyramids) CHECK(r.interface_quads == primal::index_cast(in.pyramids.size()));
       CHECK(blocks_of(r.model) == blocks_of(in));
       // A block of wedges reports its wedges diced alone, as a block of hexes or tets does.
       for (const conform::BlockQuality& q : r.quality) {
@@ -143,7 +143,7 @@ TEST_CASE(
         bool only_wedges = true;
         for (ElementKind kind : primal::kElementKinds)
           for (std::size_t e = 0; e < primal::element_count(in, kind); ++e)
-            if (primal::block_of(in, {kind, static_cast<Index>(e)}) == q.block) {
+            if (primal::block_of(in, {kind, primal::index_cast(e)}) == q.block) {
               only_wedges = only_wedges && kind == ElementKind::kWedge;
               if (kind == ElementKind::kWedge) wedges.push_back(in.wedges[e]);
             }

@@ -39,27 +39,28 @@ Index interior_tet_node(const primal::Model& m) {
   for (ElementKind kind : primal::kElementKinds)
     if (kind != ElementKind::kTet)
       for (std::size_t e = 0; e < primal::element_count(m, kind); ++e)
-        for (Index v : primal::element_corners(m, {kind, static_cast<Index>(e)}))
-          bad[static_cast<std::size_t>(v)] = 1;
+        for (Index v : primal::element_corners(m, {kind, primal::index_cast(e)}))
+          bad[primal::index_cast<std::size_t>(v)] = 1;
   const primal::InputCheckResult r = primal::check_input(m);
   REQUIRE(r.ok());
   // Boundary nodes: on a face used once (tets only, so a face key count).
   std::map<std::array<Index, 3>, int> faces;
   for (const auto& t : m.tets)
     for (const auto& f : primal::topology::kTetFaceCorners) {
-      std::array<Index, 3> k{t[static_cast<std::size_t>(f[0])], t[static_cast<std::size_t>(f[1])],
-                             t[static_cast<std::size_t>(f[2])]};
+      std::array<Index, 3> k{t[primal::index_cast<std::size_t>(f[0])],
+                             t[primal::index_cast<std::size_t>(f[1])],
+                             t[primal::index_cast<std::size_t>(f[2])]};
       std::sort(k.begin(), k.end());
       ++faces[k];
     }
   for (const auto& [k, uses] : faces)
     if (uses == 1)
-      for (Index v : k) bad[static_cast<std::size_t>(v)] = 1;
+      for (Index v : k) bad[primal::index_cast<std::size_t>(v)] = 1;
   // The middle one of the candidates: far from the parts' corners.
   std::vector<Index> candidates;
   for (const auto& t : m.tets)
     for (Index v : t)
-      if (!bad[static_cast<std::size_t>(v)]) candidates.push_back(v);
+      if (!bad[primal::index_cast<std::size_t>(v)]) candidates.push_back(v);
   REQUIRE(!candidates.empty());
   return candidates[candidates.size() / 2];
 }
@@ -69,20 +70,23 @@ Index interior_tet_node(const primal::Model& m) {
 // does): all elements positive, the tet folded over its neighbours. Returns the moved tet.
 Index fold_tet_at(primal::Model& m, Index v) {
   Index t = 0;
-  while (std::find(m.tets[static_cast<std::size_t>(t)].begin(),
-                   m.tets[static_cast<std::size_t>(t)].end(),
-                   v) == m.tets[static_cast<std::size_t>(t)].end())
+  while (std::find(m.tets[primal::index_cast<std::size_t>(t)].begin(),
+                   m.tets[primal::index_cast<std::size_t>(t)].end(),
+                   v) == m.tets[primal::index_cast<std::size_t>(t)].end())
     ++t;
-  const auto& tet = m.tets[static_cast<std::size_t>(t)];
+  const auto& tet = m.tets[primal::index_cast<std::size_t>(t)];
   std::array<Point, 3> face;
   int k = 0;
   for (Index u : tet)
-    if (u != v) face[static_cast<std::size_t>(k++)] = m.points[static_cast<std::size_t>(u)];
+    if (u != v)
+      face[primal::index_cast<std::size_t>(k++)] = m.points[primal::index_cast<std::size_t>(u)];
   const Point n = (face[1] - face[0]).cross(face[2] - face[0]).normalized();
-  Point& p = m.points[static_cast<std::size_t>(v)];
+  Point& p = m.points[primal::index_cast<std::size_t>(v)];
   p -= 2.0 * (p - face[0]).dot(n) * n;
   for (auto& c : m.tets) {
-    auto at = [&](int i) -> const Point& { return m.points[static_cast<std::size_t>(c[i])]; };
+    auto at = [&](int i) -> const Point& {
+      return m.points[primal::index_cast<std::size_t>(c[i])];
+    };
     if (primal::tet_volume(at(0), at(1), at(2), at(3)) < 0.0) std::swap(c[1], c[2]);
   }
   return t;
@@ -96,9 +100,9 @@ void detach_hexes(primal::Model& m, const Point& shift) {
       m.node_ids.empty() ? 0 : *std::max_element(m.node_ids.begin(), m.node_ids.end());
   for (auto& h : m.hexes)
     for (Index& v : h) {
-      const auto [it, fresh] = copy.emplace(v, static_cast<Index>(m.points.size()));
+      const auto [it, fresh] = copy.emplace(v, primal::index_cast(m.points.size()));
       if (fresh) {
-        m.points.push_back(m.points[static_cast<std::size_t>(v)] + shift);
+        m.points.push_back(m.points[primal::index_cast<std::size_t>(v)] + shift);
         if (!m.node_ids.empty()) m.node_ids.push_back(++next_id);
       }
       v = it->second;
@@ -160,7 +164,9 @@ primal::Model tetgen_box(const test::TempDir& dir) {
     std::array<Index, 4> t{};
     eles >> id >> t[0] >> t[1] >> t[2] >> t[3];
     for (Index& v : t) --v;
-    auto at = [&](int k) -> const Point& { return m.points[static_cast<std::size_t>(t[k])]; };
+    auto at = [&](int k) -> const Point& {
+      return m.points[primal::index_cast<std::size_t>(t[k])];
+    };
     if (primal::tet_volume(at(0), at(1), at(2), at(3)) < 0.0) std::swap(t[1], t[2]);
     primal::add_element(m, ElementKind::kTet, t, 2, static_cast<std::int64_t>(i + 1));
   }
@@ -174,15 +180,16 @@ primal::Model tetgen_box(const test::TempDir& dir) {
 std::pair<Index, Index> corner_edge(const primal::Model& m) {
   Index c = 0;
   for (std::size_t i = 1; i < m.points.size(); ++i)
-    if (m.points[i].sum() < m.points[static_cast<std::size_t>(c)].sum()) c = static_cast<Index>(i);
-  const Point& pc = m.points[static_cast<std::size_t>(c)];
+    if (m.points[i].sum() < m.points[primal::index_cast<std::size_t>(c)].sum())
+      c = primal::index_cast(i);
+  const Point& pc = m.points[primal::index_cast<std::size_t>(c)];
   Index up = primal::kInvalidIndex;
   for (std::size_t i = 0; i < m.points.size(); ++i) {
     const Point& p = m.points[i];
     if (std::abs(p.x() - pc.x()) > 1e-9 || std::abs(p.y() - pc.y()) > 1e-9 || p.z() <= pc.z())
       continue;
-    if (up == primal::kInvalidIndex || p.z() < m.points[static_cast<std::size_t>(up)].z())
-      up = static_cast<Index>(i);
+    if (up == primal::kInvalidIndex || p.z() < m.points[primal::index_cast<std::size_t>(up)].z())
+      up = primal::index_cast(i);
   }
   REQUIRE(up != primal::kInvalidIndex);
   return {c, up};
@@ -198,11 +205,11 @@ void glue(primal::Model& m, ElementKind kind, const std::vector<Point>& corners)
   for (const Point& p : corners) {
     Index v = primal::kInvalidIndex;
     for (std::size_t i = 0; i < m.points.size() && v == primal::kInvalidIndex; ++i)
-      if ((m.points[i] - p).norm() < 1e-12) v = static_cast<Index>(i);
+      if ((m.points[i] - p).norm() < 1e-12) v = primal::index_cast(i);
     if (v == primal::kInvalidIndex) {
       m.points.push_back(p);
       if (!m.node_ids.empty()) m.node_ids.push_back(++next_node);
-      v = static_cast<Index>(m.points.size() - 1);
+      v = primal::index_cast(m.points.size() - 1);
     }
     c.push_back(v);
   }
@@ -216,8 +223,8 @@ void glue(primal::Model& m, ElementKind kind, const std::vector<Point>& corners)
 // A hex beside the corner edge (c, up) of the model, outside it (x and y below the corner's):
 // along that edge when `along_edge`, else below the corner (z below it), touching at c only.
 std::vector<Point> hex_beside(const primal::Model& m, Index c, Index up, bool along_edge) {
-  const Point pc = m.points[static_cast<std::size_t>(c)];
-  const double l = m.points[static_cast<std::size_t>(up)].z() - pc.z();
+  const Point pc = m.points[primal::index_cast<std::size_t>(c)];
+  const double l = m.points[primal::index_cast<std::size_t>(up)].z() - pc.z();
   const double x[8] = {-1, 0, 0, -1, -1, 0, 0, -1}, y[8] = {-1, -1, 0, 0, -1, -1, 0, 0},
                z[8] = {0, 0, 0, 0, 1, 1, 1, 1};
   std::vector<Point> p;
@@ -229,8 +236,8 @@ std::vector<Point> hex_beside(const primal::Model& m, Index c, Index up, bool al
 // A tet outside the model at its corner edge (c, up): on that edge when `along_edge`, else
 // touching at c only; positively oriented.
 std::vector<Point> tet_beside(const primal::Model& m, Index c, Index up, bool along_edge) {
-  const Point pc = m.points[static_cast<std::size_t>(c)];
-  const Point pu = m.points[static_cast<std::size_t>(up)];
+  const Point pc = m.points[primal::index_cast<std::size_t>(c)];
+  const Point pu = m.points[primal::index_cast<std::size_t>(up)];
   const double l = pu.z() - pc.z();
   std::vector<Point> p =
       along_edge
@@ -340,8 +347,8 @@ TEST_CASE("input check: overlapping parts, a gap at the interface, a part inside
     if (!m.hex_ids.empty()) m.hex_ids.resize(1);
     detach_hexes(m, Point::Zero());
     for (int c = 0; c < 8; ++c) {
-      const auto& r = primal::topology::kHexCornerCoords[static_cast<std::size_t>(c)];
-      m.points[static_cast<std::size_t>(m.hexes[0][static_cast<std::size_t>(c)])] =
+      const auto& r = primal::topology::kHexCornerCoords[primal::index_cast<std::size_t>(c)];
+      m.points[primal::index_cast<std::size_t>(m.hexes[0][primal::index_cast<std::size_t>(c)])] =
           Point(1.3, 0.3, 0.3) + 0.4 * Point(r[0], r[1], r[2]);
     }
     REQUIRE_NOTHROW(primal::check_geometry(m, "inside"));
@@ -389,7 +396,7 @@ TEST_CASE(
       // The extra element is among the named ones.
       const ElementKind glued = source == "hybrid" ? ElementKind::kHex : ElementKind::kTet;
       const primal::ElementRef extra{glued,
-                                     static_cast<Index>(primal::element_count(m, glued) - 1)};
+                                     primal::index_cast(primal::element_count(m, glued) - 1)};
       CHECK(std::find(f.elements.begin(), f.elements.end(), extra) != f.elements.end());
       // Refused when read, naming the nodes by the ids the file gives them (the model's).
       const std::string name = source + (along_edge ? "-edge" : "-node");
@@ -439,6 +446,7 @@ TEST_CASE(
   const primal::InputCheckResult r = primal::check_input(m);
   REQUIRE(!r.ok());
   CHECK(r.findings[0].topological());
-  CHECK(m.points[static_cast<std::size_t>(r.findings[0].node)].x() == 1.0);  // on the interface
+  CHECK(m.points[primal::index_cast<std::size_t>(r.findings[0].node)].x() ==
+        1.0);  // on the interface
   refused_by_conform(m, "hanging", {"not a manifold", "not matched node for node"}, dir, 3);
 }

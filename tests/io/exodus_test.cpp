@@ -51,11 +51,11 @@ void write_raw(const fs::path& file, const char* type, const std::vector<int>& c
   const int exo = ex_create(file.string().c_str(), EX_CLOBBER, &cpu, &io);
   REQUIRE(exo >= 0);
   REQUIRE(ex_put_init(exo, "raw", 3, num_nodes, 1, 1, 0, 0) >= 0);
-  std::vector<double> x(static_cast<std::size_t>(num_nodes)), y(x.size()), z(x.size());
+  std::vector<double> x(index_cast<std::size_t>(num_nodes)), y(x.size()), z(x.size());
   for (std::size_t i = 0; i < x.size(); ++i) x[i] = static_cast<double>(i);
   REQUIRE(ex_put_coord(exo, x.data(), y.data(), z.data()) >= 0);
-  REQUIRE(ex_put_block(exo, EX_ELEM_BLOCK, 3, type, 1, static_cast<int64_t>(conn.size()), 0, 0,
-                       0) >= 0);
+  REQUIRE(ex_put_block(exo, EX_ELEM_BLOCK, 3, type, 1, index_cast<int64_t>(conn.size()), 0, 0, 0) >=
+          0);
   REQUIRE(ex_put_conn(exo, EX_ELEM_BLOCK, 3, conn.data(), nullptr, nullptr) >= 0);
   REQUIRE(ex_close(exo) >= 0);
 }
@@ -109,21 +109,21 @@ TEST_CASE("the written file follows Exodus's own HEX8 / TETRA4 / side convention
   std::vector<double> x(m.points.size()), y(x.size()), z(x.size());
   REQUIRE(ex_get_coord(exo, x.data(), y.data(), z.data()) >= 0);
   auto p = [&](int n) {
-    return Point(x[static_cast<std::size_t>(n - 1)], y[static_cast<std::size_t>(n - 1)],
-                 z[static_cast<std::size_t>(n - 1)]);
+    return Point(x[index_cast<std::size_t>(n - 1)], y[index_cast<std::size_t>(n - 1)],
+                 z[index_cast<std::size_t>(n - 1)]);
   };
   std::vector<int> hex(2 * 8), tet(12 * 4);
   REQUIRE(ex_get_conn(exo, EX_ELEM_BLOCK, 1, hex.data(), nullptr, nullptr) >= 0);
   REQUIRE(ex_get_conn(exo, EX_ELEM_BLOCK, 2, tet.data(), nullptr, nullptr) >= 0);
   for (int h = 0; h < 2; ++h) {
-    const int* c = &hex[static_cast<std::size_t>(8 * h)];
+    const int* c = &hex[index_cast<std::size_t>(8 * h)];
     const Point up = (p(c[1]) - p(c[0])).cross(p(c[3]) - p(c[0]));
     CHECK(up.dot(p(c[4]) - p(c[0])) > 0);  // nodes 5-8 on the side the 1-2-3-4 normal points to
     for (int i = 0; i < 4; ++i)
       CHECK((p(c[i + 4]) - p(c[i])).normalized().z() > 0.99);  // node i+5 above node i+1
   }
   for (int t = 0; t < 12; ++t) {
-    const int* c = &tet[static_cast<std::size_t>(4 * t)];
+    const int* c = &tet[index_cast<std::size_t>(4 * t)];
     CHECK(tet_volume(p(c[0]), p(c[1]), p(c[2]), p(c[3])) > 0);
   }
   std::vector<int> elems(3), sides(3);

@@ -214,12 +214,12 @@ TEST_CASE(
   CHECK(m.node_sets[0].nodes == std::vector<Index>{0, 1, 2, 3});
   const DicedModel diced = dice_model(m);
   std::vector<Index> identity(diced.points.size());
-  for (std::size_t i = 0; i < identity.size(); ++i) identity[i] = static_cast<Index>(i);
+  for (std::size_t i = 0; i < identity.size(); ++i) identity[i] = index_cast(i);
   const auto sets = diced_node_sets(m, diced, identity);
   REQUIRE(sets.size() == 1);
   REQUIRE(sets[0].nodes.size() == 6);
   for (Index v : sets[0].nodes) {
-    const Point& p = diced.points[static_cast<std::size_t>(v)];
+    const Point& p = diced.points[index_cast<std::size_t>(v)];
     CHECK(p.z() == 0.0);
     CHECK((p.y() == 0.0 || p.y() == 1.0));  // on edge 1-2 or 4-3, never the face centre (0.5, 0.5)
   }

@@ -111,16 +111,15 @@ TEST_CASE("read_gmsh converts Gmsh's hex and tet corner order to VTK order") {
   REQUIRE(m.tets.size() == 1);
   // VTK corner c of the unit hex sits at its unit-cube coordinates.
   for (int c = 0; c < 8; ++c) {
-    const auto& rst = topology::kHexCornerCoords[static_cast<std::size_t>(c)];
-    CHECK(m.points[static_cast<std::size_t>(m.hexes[0][static_cast<std::size_t>(c)])] ==
+    const auto& rst = topology::kHexCornerCoords[index_cast<std::size_t>(c)];
+    CHECK(m.points[index_cast<std::size_t>(m.hexes[0][index_cast<std::size_t>(c)])] ==
           Point(rst[0], rst[1], rst[2]));
   }
   const auto& t = m.tets[0];
   // Translated reference tet: volume +1/6 in the VTK convention.
-  CHECK(tet_volume(m.points[static_cast<std::size_t>(t[0])],
-                   m.points[static_cast<std::size_t>(t[1])],
-                   m.points[static_cast<std::size_t>(t[2])],
-                   m.points[static_cast<std::size_t>(t[3])]) == doctest::Approx(1.0 / 6.0));
+  CHECK(tet_volume(m.points[index_cast<std::size_t>(t[0])], m.points[index_cast<std::size_t>(t[1])],
+                   m.points[index_cast<std::size_t>(t[2])],
+                   m.points[index_cast<std::size_t>(t[3])]) == doctest::Approx(1.0 / 6.0));
   CHECK(m.hex_block == std::vector<int>{4});
   CHECK(m.tet_block == std::vector<int>{4});
   CHECK(m.block_names.at(4) == "solid");

@@ -117,7 +117,7 @@ TEST_CASE("meshio's .exo with node sets numbered from 0: the sets numbered by po
   CHECK(bottom >= 4);
   CHECK(model.node_sets[0].nodes.size() == bottom);
   for (Index v : model.node_sets[0].nodes)
-    CHECK(model.points[static_cast<std::size_t>(v)].z() < low + 1e-9);
+    CHECK(model.points[index_cast<std::size_t>(v)].z() < low + 1e-9);
 }
 
 TEST_CASE("Gmsh's own writer: .msh 2.2 and 4.1, ASCII and binary, read back the same model") {

@@ -34,7 +34,7 @@ Key key_of(const Point& p) {
 
 Point centroid(const Model& m, std::span<const Index> corners) {
   Point c(0, 0, 0);
-  for (Index v : corners) c += m.points[static_cast<std::size_t>(v)];
+  for (Index v : corners) c += m.points[index_cast<std::size_t>(v)];
   return c / static_cast<double>(corners.size());
 }
 
@@ -66,7 +66,7 @@ Summary summary(const Model& m, const FormatCarries& c) {
   Summary s;
   for (ElementKind kind : kElementKinds)
     for (std::size_t e = 0; e < element_count(m, kind); ++e) {
-      const ElementRef ref{kind, static_cast<Index>(e)};
+      const ElementRef ref{kind, index_cast(e)};
       s.blocks.insert({key_of(centroid(m, element_corners(m, ref))),
                        c.blocks == Carried::kYes ? block_of(m, ref) : 0});
     }
@@ -74,7 +74,7 @@ Summary summary(const Model& m, const FormatCarries& c) {
   if (c.node_sets == Carried::kYes)
     for (const NodeSet& set : m.node_sets) {
       std::set<Key> nodes;
-      for (Index v : set.nodes) nodes.insert(key_of(m.points[static_cast<std::size_t>(v)]));
+      for (Index v : set.nodes) nodes.insert(key_of(m.points[index_cast<std::size_t>(v)]));
       s.node_sets.insert({set.id, c.set_names == Carried::kYes ? set.name : "", nodes});
     }
   if (c.side_sets == Carried::kYes)
@@ -83,10 +83,10 @@ Summary summary(const Model& m, const FormatCarries& c) {
       for (const Side& side : set.sides) {
         const auto corners = element_corners(m, side.element);
         const topology::CellFace& f =
-            cell_topology(side.element.kind).face[static_cast<std::size_t>(side.face)];
+            cell_topology(side.element.kind).face[index_cast<std::size_t>(side.face)];
         std::vector<Index> face;
         for (int k = 0; k < f.size; ++k)
-          face.push_back(corners[static_cast<std::size_t>(f.corners[static_cast<std::size_t>(k)])]);
+          face.push_back(corners[index_cast<std::size_t>(f.corners[index_cast<std::size_t>(k)])]);
         faces.insert(key_of(centroid(m, face)));
       }
       s.side_sets.insert({set.id, c.set_names == Carried::kYes ? set.name : "", faces});

@@ -101,11 +101,11 @@ RankFile read_rank(const std::string& path, int ranks, int rank) {
   ex_get_id_map(exo, EX_NODE_MAP, f.node_map.data());
   ex_get_id_map(exo, EX_ELEM_MAP, f.elem_map.data());
   if (lb[5] > 0) {
-    std::vector<int> ids(static_cast<std::size_t>(lb[5])), counts(ids.size());
+    std::vector<int> ids(primal::index_cast<std::size_t>(lb[5])), counts(ids.size());
     if (ex_get_cmap_params(exo, ids.data(), counts.data(), nullptr, nullptr, rank) < 0)
       throw std::runtime_error(path + ": no communication map sizes");
     for (std::size_t k = 0; k < ids.size(); ++k) {
-      std::vector<int> nodes(static_cast<std::size_t>(counts[k])), procs_(nodes.size());
+      std::vector<int> nodes(primal::index_cast<std::size_t>(counts[k])), procs_(nodes.size());
       if (ex_get_node_cmap(exo, ids[k], nodes.data(), procs_.data(), rank) < 0)
         throw std::runtime_error(path + ": no communication map " + std::to_string(ids[k]));
       f.cmaps[ids[k]] = nodes;
@@ -129,46 +129,46 @@ int ranks(const std::string& out, int n) {
     return x;
   };
   for (int r = 0; r < n; ++r) {
-    const RankFile& f = files[static_cast<std::size_t>(r)];
+    const RankFile& f = files[primal::index_cast<std::size_t>(r)];
     const std::string name = parallel::rank_file(out, n, r).string();
-    if (f.nodes_g != static_cast<std::int64_t>(joined.points.size()) ||
-        f.elems_g != static_cast<std::int64_t>(joined.hexes.size()))
+    if (f.nodes_g != primal::index_cast<std::int64_t>(joined.points.size()) ||
+        f.elems_g != primal::index_cast<std::int64_t>(joined.hexes.size()))
       return fail(name + ": global counts " + std::to_string(f.nodes_g) + " nodes, " +
                   std::to_string(f.elems_g) + " hexes; the joined file has " +
                   std::to_string(joined.points.size()) + ", " +
                   std::to_string(joined.hexes.size()));
-    if (f.node_sets_g != static_cast<std::int64_t>(joined.node_sets.size()) ||
-        f.side_sets_g != static_cast<std::int64_t>(joined.side_sets.size()))
+    if (f.node_sets_g != primal::index_cast<std::int64_t>(joined.node_sets.size()) ||
+        f.side_sets_g != primal::index_cast<std::int64_t>(joined.side_sets.size()))
       return fail(name + ": global set counts differ from the joined file's");
-    if (f.int_nodes + f.bor_nodes != static_cast<std::int64_t>(f.model.points.size()) ||
+    if (f.int_nodes + f.bor_nodes != primal::index_cast<std::int64_t>(f.model.points.size()) ||
         f.ext_nodes != 0 ||
-        f.int_elems + f.bor_elems != static_cast<std::int64_t>(f.model.hexes.size()))
+        f.int_elems + f.bor_elems != primal::index_cast<std::int64_t>(f.model.hexes.size()))
       return fail(name + ": load balance counts do not add up to the file's");
     if (n > 1 && f.cmaps.empty()) return fail(name + ": no communication map");
     for (int g : f.node_map) node_ids.insert(g);
     for (int g : f.elem_map)
       if (!elem_ids.insert(g).second)
         return fail(name + ": element id " + std::to_string(g) + " also on another rank");
-    elems += static_cast<std::int64_t>(f.model.hexes.size());
+    elems += primal::index_cast<std::int64_t>(f.model.hexes.size());
     for (std::size_t h = 0; h < f.model.hexes.size(); ++h) from_ranks.insert(corners(f.model, h));
     for (const auto& [q, nodes] : f.cmaps) {
       if (q < 0 || q >= n || q == r)
         return fail(name + ": communication map to rank " + std::to_string(q));
-      const RankFile& o = files[static_cast<std::size_t>(q)];
+      const RankFile& o = files[primal::index_cast<std::size_t>(q)];
       const auto back = o.cmaps.find(r);
       if (back == o.cmaps.end() || back->second.size() != nodes.size())
         return fail(name + ": its map to rank " + std::to_string(q) + " is not matched there");
       for (std::size_t k = 0; k < nodes.size(); ++k) {
-        const auto a = static_cast<std::size_t>(nodes[k] - 1);
-        const auto b = static_cast<std::size_t>(back->second[k] - 1);
+        const auto a = primal::index_cast<std::size_t>(nodes[k] - 1);
+        const auto b = primal::index_cast<std::size_t>(back->second[k] - 1);
         if (f.node_map[a] != o.node_map[b] || f.model.points[a] != o.model.points[b])
           return fail(name + ": shared node " + std::to_string(k) + " with rank " +
                       std::to_string(q) + " differs there");
       }
     }
   }
-  if (static_cast<std::int64_t>(node_ids.size()) != files[0].nodes_g || *node_ids.begin() != 1 ||
-      *node_ids.rbegin() != files[0].nodes_g)
+  if (primal::index_cast<std::int64_t>(node_ids.size()) != files[0].nodes_g ||
+      *node_ids.begin() != 1 || *node_ids.rbegin() != files[0].nodes_g)
     return fail("the ranks' node ids are not 1..global nodes");
   if (elems != files[0].elems_g) return fail("the ranks' hexes do not add up to the global count");
   for (std::size_t h = 0; h < joined.hexes.size(); ++h) from_joined.insert(corners(joined, h));

@@ -36,9 +36,7 @@ TetMesh kuhn_grid(int n) {
   const HexMesh g = structured_hex_grid(n, n, n);
   TetMesh m;
   m.points = g.points;
-  auto id = [n](int i, int j, int k) {
-    return static_cast<Index>(i + (n + 1) * (j + (n + 1) * k));
-  };
+  auto id = [n](int i, int j, int k) { return index_cast(i + (n + 1) * (j + (n + 1) * k)); };
   std::array<int, 3> perm{0, 1, 2};
   for (int k = 0; k < n; ++k)
     for (int j = 0; j < n; ++j)
@@ -128,7 +126,7 @@ TEST_CASE("dice: 3x3x3 hex block -> the 6x6x6 block") {
   }
   // Parent map: child c of hex h contains parent corner c.
   for (std::size_t h = 0; h < d.mesh.hexes.size(); ++h) {
-    CHECK(d.parent[h] == static_cast<Index>(h / 8));
+    CHECK(d.parent[h] == index_cast(h / 8));
     CHECK(d.mesh.hexes[h][h % 8] == m.hexes[h / 8][h % 8]);
   }
 }
@@ -162,12 +160,11 @@ TEST_CASE("dice: distorted hexes keep their volume child by child and stay posit
   CHECK(r.ok());
   std::vector<double> sum(m.hexes.size(), 0.0);
   for (std::size_t h = 0; h < d.mesh.hexes.size(); ++h) {
-    sum[d.parent[h]] += hex_volume(hex_corners(d.mesh, static_cast<Index>(h)));
+    sum[d.parent[h]] += hex_volume(hex_corners(d.mesh, index_cast(h)));
     CHECK(d.mesh.block[h] == m.block[d.parent[h]]);
   }
   for (std::size_t h = 0; h < m.hexes.size(); ++h) {
-    CHECK(sum[h] ==
-          doctest::Approx(hex_volume(hex_corners(m, static_cast<Index>(h)))).epsilon(1e-12));
+    CHECK(sum[h] == doctest::Approx(hex_volume(hex_corners(m, index_cast(h)))).epsilon(1e-12));
   }
 }
 
@@ -207,7 +204,7 @@ TEST_CASE("dice: 48-tet Kuhn grid -> 192 positive hexes, conforming") {
   std::vector<double> sum(m.tets.size(), 0.0);
   double diced_total = 0.0;
   for (std::size_t h = 0; h < d.mesh.hexes.size(); ++h) {
-    const double v = hex_volume(hex_corners(d.mesh, static_cast<Index>(h)));
+    const double v = hex_volume(hex_corners(d.mesh, index_cast(h)));
     sum[d.parent[h]] += v;
     diced_total += v;
   }

@@ -56,8 +56,8 @@ TEST_CASE("a broken dicing is caught") {
     primal::DicedModel d = diced(m);
     auto& child = d.tet_children[5];
     const Index edge_node = child[1];  // corner 1 of a tet child: an edge midpoint
-    const Index twin = d.add_node(d.points[static_cast<std::size_t>(edge_node)],
-                                  d.origin[static_cast<std::size_t>(edge_node)]);
+    const Index twin = d.add_node(d.points[primal::index_cast<std::size_t>(edge_node)],
+                                  d.origin[primal::index_cast<std::size_t>(edge_node)]);
     child[1] = twin;
     const auto c = primal::check_dicing(m, d);
     CHECK(!c.ok());
@@ -70,7 +70,7 @@ TEST_CASE("a broken dicing is caught") {
     // Child corner 6 of a hex child is its parent's centre; hex 0's children take hex 1's.
     const Index own_centre = d.hex_children[0][6], other_centre = d.hex_children[8][6];
     for (int ch = 0; ch < 8; ++ch)
-      for (Index& v : d.hex_children[static_cast<std::size_t>(ch)])
+      for (Index& v : d.hex_children[primal::index_cast<std::size_t>(ch)])
         if (v == own_centre) v = other_centre;
     const auto c = primal::check_dicing(m, d);
     CHECK(!c.ok());

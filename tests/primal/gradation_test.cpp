@@ -25,7 +25,7 @@ TEST_CASE("grade_down: the largest field below the input meeting the rate, on a 
   const int n = 60;
   GradedEdges g;
   for (int e = 0; e < 150; ++e) {
-    const Index a = static_cast<Index>(rng() % n), b = static_cast<Index>(rng() % n);
+    const Index a = index_cast(rng() % n), b = index_cast(rng() % n);
     g.nodes.push_back({a, b});
     g.length.push_back(u(rng));
   }

@@ -21,7 +21,7 @@ namespace {
 
 // Appends b's points and elements to a (no sets), shifting b by `offset`.
 void append(Model& a, const Model& b, const Point& offset) {
-  const auto base = static_cast<Index>(a.points.size());
+  const auto base = index_cast(a.points.size());
   for (const Point& p : b.points) a.points.push_back(p + offset);
   for (auto h : b.hexes) {
     for (Index& v : h) v += base;
@@ -41,17 +41,17 @@ void append(Model& a, const Model& b, const Point& offset) {
 void check_consistent(const Model& m, const Interface& itf) {
   for (const InterfaceQuad& q : itf.quads) {
     for (std::size_t i = 0; i < 4; ++i)
-      CHECK(q.corners[i] == m.hexes[static_cast<std::size_t>(q.hex)][static_cast<std::size_t>(
-                                topology::kHexFaceCorners[static_cast<std::size_t>(q.face)][i])]);
+      CHECK(q.corners[i] == m.hexes[index_cast<std::size_t>(q.hex)][index_cast<std::size_t>(
+                                topology::kHexFaceCorners[index_cast<std::size_t>(q.face)][i])]);
     const auto tris = interface_triangles(q);
     for (std::size_t i = 0; i < 2; ++i) {
       std::set<Index> face;
-      for (int c : topology::kTetFaceCorners[static_cast<std::size_t>(q.tet_faces[i])])
-        face.insert(m.tets[static_cast<std::size_t>(q.tets[i])][static_cast<std::size_t>(c)]);
+      for (int c : topology::kTetFaceCorners[index_cast<std::size_t>(q.tet_faces[i])])
+        face.insert(m.tets[index_cast<std::size_t>(q.tets[i])][index_cast<std::size_t>(c)]);
       CHECK(face == std::set<Index>(tris[i].begin(), tris[i].end()));
     }
     // Kuhn diagonal: from the corner with the smallest coordinate sum to the largest.
-    auto sum = [&](Index v) { return m.points[static_cast<std::size_t>(v)].sum(); };
+    auto sum = [&](Index v) { return m.points[index_cast<std::size_t>(v)].sum(); };
     const auto lo = std::min_element(q.corners.begin(), q.corners.end(),
                                      [&](Index a, Index b) { return sum(a) < sum(b); });
     const auto lo_pos = lo - q.corners.begin();
@@ -127,8 +127,8 @@ TEST_CASE("find_interface: a quad split into four triangles around a tet node") 
   for (std::size_t i = 0; i < 4; ++i) {
     CHECK(tris[i] == std::array<Index, 3>{top[i], top[(i + 1) % 4], 8});
     std::set<Index> face;
-    for (int c : topology::kTetFaceCorners[static_cast<std::size_t>(q.tet_faces[i])])
-      face.insert(m.tets[static_cast<std::size_t>(q.tets[i])][static_cast<std::size_t>(c)]);
+    for (int c : topology::kTetFaceCorners[index_cast<std::size_t>(q.tet_faces[i])])
+      face.insert(m.tets[index_cast<std::size_t>(q.tets[i])][index_cast<std::size_t>(c)]);
     CHECK(face == std::set<Index>(tris[i].begin(), tris[i].end()));
   }
   SUBCASE("three of the four triangles: refused as a hanging node") {
@@ -161,10 +161,10 @@ TEST_CASE("find_interface: rejects non-conforming interfaces, naming the face or
       m.tet_block.push_back(2);
     }
     for (const auto& t : m.tets)
-      REQUIRE(tet_volume(m.points[static_cast<std::size_t>(t[0])],
-                         m.points[static_cast<std::size_t>(t[1])],
-                         m.points[static_cast<std::size_t>(t[2])],
-                         m.points[static_cast<std::size_t>(t[3])]) > 0);
+      REQUIRE(tet_volume(m.points[index_cast<std::size_t>(t[0])],
+                         m.points[index_cast<std::size_t>(t[1])],
+                         m.points[index_cast<std::size_t>(t[2])],
+                         m.points[index_cast<std::size_t>(t[3])]) > 0);
     CHECK_THROWS_WITH_AS(find_interface(m),
                          doctest::Contains("node 9 (0.5, 0, 1) of the tet part (tet 1 (centre "
                                            "(0.25, 0.375, 1.25))) lies on hex 1"),
@@ -173,7 +173,7 @@ TEST_CASE("find_interface: rejects non-conforming interfaces, naming the face or
   SUBCASE("a four-triangle centre that is a hex node too") {
     Model m = test::four_tet_fan({0.5, 0.5, 1.0}, {0.5, 0.5, 2.0});
     // A hex below the first one using node 8 as a corner (nonsense geometry, topology only).
-    const auto base = static_cast<Index>(m.points.size());
+    const auto base = index_cast(m.points.size());
     for (int k = 0; k < 7; ++k) m.points.emplace_back(0.1 * k, -1.0, -1.0 - 0.1 * k);
     m.hexes.push_back({base, base + 1, base + 2, base + 3, base + 4, base + 5, base + 6, 8});
     m.hex_block.push_back(1);
@@ -248,22 +248,22 @@ TEST_CASE(
   std::array<Index, 3> tri{-1, -1, -1};
   for (const auto& t : w.tets)
     for (const auto& f : topology::kTetFaceCorners) {
-      const std::array<Index, 3> c{t[static_cast<std::size_t>(f[0])],
-                                   t[static_cast<std::size_t>(f[1])],
-                                   t[static_cast<std::size_t>(f[2])]};
+      const std::array<Index, 3> c{t[index_cast<std::size_t>(f[0])],
+                                   t[index_cast<std::size_t>(f[1])],
+                                   t[index_cast<std::size_t>(f[2])]};
       int at_edge = 0;
       bool top = true;
       for (Index v : c) {
-        top = top && w.points[static_cast<std::size_t>(v)].z() > 1.0 - 1e-12;
-        at_edge += w.points[static_cast<std::size_t>(v)].x() < 1.0 + 1e-12;
+        top = top && w.points[index_cast<std::size_t>(v)].z() > 1.0 - 1e-12;
+        at_edge += w.points[index_cast<std::size_t>(v)].x() < 1.0 + 1e-12;
       }
       if (top && at_edge == 2) tri = c;
     }
   REQUIRE(tri[0] >= 0);
   std::array<Index, 6> wedge{tri[0], tri[1], tri[2], 0, 0, 0};
   for (std::size_t k = 0; k < 3; ++k) {
-    wedge[3 + k] = static_cast<Index>(w.points.size());
-    w.points.push_back(w.points[static_cast<std::size_t>(tri[k])] + Point(0, 0, 0.5));
+    wedge[3 + k] = index_cast(w.points.size());
+    w.points.push_back(w.points[index_cast<std::size_t>(tri[k])] + Point(0, 0, 0.5));
   }
   w.wedges.push_back(wedge);
   const Interface wi = find_interface(w);

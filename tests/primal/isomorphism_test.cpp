@@ -122,7 +122,7 @@ TEST_CASE("a hex mesh with one hex modified is not isomorphic") {
     // (b) One corner of one hex moved to a node the hex did not use.
     HexMesh moved = base;
     auto& hex = moved.hexes.back();
-    for (Index n = 0; n < static_cast<Index>(base.points.size()); ++n)
+    for (Index n = 0; n < geode::primal::index_cast(base.points.size()); ++n)
       if (std::find(hex.begin(), hex.end(), n) == hex.end()) {
         hex[6] = n;
         break;
@@ -147,7 +147,7 @@ TEST_CASE("different meshes with equal counts are not isomorphic") {
   for (Index n = 0; n < 18; ++n)
     if (n != 8 && n != 17) keep.push_back(n);
   std::vector<Index> renumber(18, -1);
-  for (std::size_t i = 0; i < keep.size(); ++i) renumber[keep[i]] = static_cast<Index>(i);
+  for (std::size_t i = 0; i < keep.size(); ++i) renumber[keep[i]] = geode::primal::index_cast(i);
   HexMesh ell16;
   for (Index n : keep) ell16.points.push_back(ell.points[n]);
   for (auto h : ell.hexes) {
@@ -227,7 +227,7 @@ TEST_CASE("bad input names the mesh and the cell") {
   CHECK_THROWS_AS(gt::find_isomorphism(repeated, repeated), geode::InvalidInput);
   HexMesh fan = gt::structured_hex_grid(1, 1, 1);
   for (int i = 0; i < 2; ++i) {  // three hexes on the bottom face of the cube
-    const Index base = static_cast<Index>(fan.points.size());
+    const Index base = geode::primal::index_cast(fan.points.size());
     fan.points.resize(fan.points.size() + 4, geode::primal::Point::Zero());
     fan.hexes.push_back({base, base + 1, base + 2, base + 3, 0, 1, 2, 3});
   }

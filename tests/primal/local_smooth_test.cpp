@@ -38,7 +38,7 @@ template <class Map>
 HexMesh grid(int n, Map map) {
   HexMesh m;
   auto id = [n](int i, int j, int k) {
-    return static_cast<Index>(i + (n + 1) * (j + (n + 1) * k));
+    return geode::primal::index_cast(i + (n + 1) * (j + (n + 1) * k));
   };
   for (int k = 0; k <= n; ++k)
     for (int j = 0; j <= n; ++j)
@@ -54,7 +54,7 @@ HexMesh grid(int n, Map map) {
 
 std::vector<double> scaled_jacobians(const HexMesh& m) {
   std::vector<double> q;
-  for (Index h = 0; h < static_cast<Index>(m.hexes.size()); ++h)
+  for (Index h = 0; h < geode::primal::index_cast(m.hexes.size()); ++h)
     q.push_back(gp::hex_scaled_jacobian(gp::hex_corners(m, h)));
   return q;
 }
@@ -226,7 +226,7 @@ TEST_CASE("no edge ends below min_edge_fraction of its hex's shortest edge at th
     HexMesh mesh = start;
     gp::smooth_hexes_local(mesh, gp::boundary_slide_constraints(mesh), nullptr, {}, o);
     int n = 0;
-    for (Index h = 0; h < static_cast<Index>(mesh.hexes.size()); ++h)
+    for (Index h = 0; h < geode::primal::index_cast(mesh.hexes.size()); ++h)
       n += shortest(mesh, h) < 0.9 * shortest(start, h);
     return n;
   };
@@ -245,7 +245,8 @@ TEST_CASE("smoothing in passes from one SmoothStart keeps every hex within `loss
   auto lost = [&](bool shared) {
     HexMesh mesh = first;
     auto cons = gp::boundary_slide_constraints(mesh);
-    cons[static_cast<std::size_t>(2 + (n + 1) * (2 + (n + 1) * 2))] = NodeConstraint::fixed();
+    cons[geode::primal::index_cast<std::size_t>(2 + (n + 1) * (2 + (n + 1) * 2))] =
+        NodeConstraint::fixed();
     gp::LocalSmoothOptions o;
     o.max_visits = 4;
     for (double target : {0.9, 0.95, 0.99}) {
@@ -286,8 +287,8 @@ TEST_CASE("seeds limit the smoothing to their neighbourhood") {
 // hexes.
 std::map<int, double> block_volumes(const HexMesh& m) {
   std::map<int, double> v;
-  for (Index h = 0; h < static_cast<Index>(m.hexes.size()); ++h)
-    v[m.block.empty() ? 0 : m.block[static_cast<std::size_t>(h)]] +=
+  for (Index h = 0; h < geode::primal::index_cast(m.hexes.size()); ++h)
+    v[m.block.empty() ? 0 : m.block[geode::primal::index_cast<std::size_t>(h)]] +=
         gp::hex_volume(gp::hex_corners(m, h));
   return v;
 }
@@ -362,10 +363,10 @@ TEST_CASE(
   for (Point& p : mesh.points)  // the x = 4 plane flat again
     if (std::abs(p.x() - 4.0) < 0.31 && p.x() != 4.0 && std::abs(std::round(p.x()) - 4.0) < 0.5)
       p.x() = 4.0;
-  for (Index h = 0; h < static_cast<Index>(mesh.hexes.size()); ++h) {
+  for (Index h = 0; h < geode::primal::index_cast(mesh.hexes.size()); ++h) {
     Point c = Point::Zero();
-    for (Index v : mesh.hexes[static_cast<std::size_t>(h)])
-      c += mesh.points[static_cast<std::size_t>(v)] / 8.0;
+    for (Index v : mesh.hexes[geode::primal::index_cast<std::size_t>(h)])
+      c += mesh.points[geode::primal::index_cast<std::size_t>(v)] / 8.0;
     mesh.block.push_back(c.norm() < 3.5 ? 1 : c.x() > 4.0 ? 3 : 2);
   }
   const auto between = gp::block_interface_quads(mesh);
@@ -374,8 +375,9 @@ TEST_CASE(
   int on_interface_plane = 0;
   for (const auto& q : between)
     for (Index v : q.nodes) {
-      CHECK(cons[static_cast<std::size_t>(v)].kind != NodeConstraint::Kind::kFree);
-      on_interface_plane += cons[static_cast<std::size_t>(v)].kind == NodeConstraint::Kind::kPlane;
+      CHECK(cons[geode::primal::index_cast<std::size_t>(v)].kind != NodeConstraint::Kind::kFree);
+      on_interface_plane +=
+          cons[geode::primal::index_cast<std::size_t>(v)].kind == NodeConstraint::Kind::kPlane;
     }
   CHECK(on_interface_plane > 0);  // x = 4 inside the grid
   const HexMesh before = mesh;
@@ -426,7 +428,7 @@ TEST_CASE("smooth_hexes_around: the submesh around the seeds gives the whole-mes
   for (Point& p : mesh.points)
     if (p.minCoeff() > 0 && p.maxCoeff() < 5) p += 0.3 * Point(r.next(), r.next(), r.next());
   std::vector<Index> seeds;
-  for (Index h = 0; h < static_cast<Index>(mesh.hexes.size()); h += 3) seeds.push_back(h);
+  for (Index h = 0; h < geode::primal::index_cast(mesh.hexes.size()); h += 3) seeds.push_back(h);
   gp::LocalSmoothOptions o;
   o.target = 0.9;
   HexMesh whole = mesh, around = mesh;

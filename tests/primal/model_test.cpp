@@ -39,7 +39,7 @@ Model one_cell(ElementKind kind, std::vector<Point> points) {
   Model m;
   m.points = std::move(points);
   std::vector<Index> c(m.points.size());
-  for (std::size_t i = 0; i < c.size(); ++i) c[i] = static_cast<Index>(i);
+  for (std::size_t i = 0; i < c.size(); ++i) c[i] = index_cast(i);
   switch (kind) {
     case ElementKind::kHex:
       m.hexes.push_back({c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]});
@@ -68,28 +68,28 @@ TEST_CASE("cell kinds: faces outward and closed, edges on two faces, Euler") {
     const auto& t = cell_topology(kind);
     const auto p = reference_corners(kind);
     CAPTURE(t.name);
-    REQUIRE(static_cast<int>(p.size()) == t.corners);
+    REQUIRE(index_cast<int>(p.size()) == t.corners);
     Point centre = Point::Zero();
     for (const Point& x : p) centre += x / static_cast<double>(p.size());
     Point total = Point::Zero();
-    std::vector<int> edge_uses(static_cast<std::size_t>(t.edges), 0);
+    std::vector<int> edge_uses(index_cast<std::size_t>(t.edges), 0);
     for (int f = 0; f < t.faces; ++f) {
-      const auto& face = t.face[static_cast<std::size_t>(f)];
+      const auto& face = t.face[index_cast<std::size_t>(f)];
       Point area = Point::Zero(), fc = Point::Zero();
       for (int k = 0; k < face.size; ++k) {
-        const Point& a = p[static_cast<std::size_t>(face.corners[static_cast<std::size_t>(k)])];
-        const Point& b = p[static_cast<std::size_t>(
-            face.corners[static_cast<std::size_t>((k + 1) % face.size)])];
+        const Point& a = p[index_cast<std::size_t>(face.corners[index_cast<std::size_t>(k)])];
+        const Point& b =
+            p[index_cast<std::size_t>(face.corners[index_cast<std::size_t>((k + 1) % face.size)])];
         area += a.cross(b) / 2.0;
         fc += a / face.size;
         const auto [lo, hi] =
-            std::minmax(face.corners[static_cast<std::size_t>(k)],
-                        face.corners[static_cast<std::size_t>((k + 1) % face.size)]);
+            std::minmax(face.corners[index_cast<std::size_t>(k)],
+                        face.corners[index_cast<std::size_t>((k + 1) % face.size)]);
         int found = 0;
         for (int e = 0; e < t.edges; ++e) {
-          const auto& ed = t.edge[static_cast<std::size_t>(e)];
+          const auto& ed = t.edge[index_cast<std::size_t>(e)];
           if (std::min(ed[0], ed[1]) == lo && std::max(ed[0], ed[1]) == hi)
-            ++edge_uses[static_cast<std::size_t>(e)], ++found;
+            ++edge_uses[index_cast<std::size_t>(e)], ++found;
         }
         CHECK(found == 1);
       }
@@ -105,23 +105,23 @@ TEST_CASE("cell kinds: faces outward and closed, edges on two faces, Euler") {
   for (int f = 0; f < 6; ++f)
     for (int k = 0; k < 4; ++k)
       CHECK(topo::kCellKinds[0]
-                .face[static_cast<std::size_t>(f)]
-                .corners[static_cast<std::size_t>(k)] ==
-            topo::kHexFaceCorners[static_cast<std::size_t>(f)][static_cast<std::size_t>(k)]);
+                .face[index_cast<std::size_t>(f)]
+                .corners[index_cast<std::size_t>(k)] ==
+            topo::kHexFaceCorners[index_cast<std::size_t>(f)][index_cast<std::size_t>(k)]);
 }
 
 TEST_CASE("cell kinds: wedge and tet corner frames are right-handed on the reference cells") {
   const auto w = reference_corners(ElementKind::kWedge);
   for (std::size_t c = 0; c < 6; ++c) {
     const auto& n = topo::kWedgeCornerNeighbors[c];
-    CHECK(tet_volume(w[c], w[static_cast<std::size_t>(n[0])], w[static_cast<std::size_t>(n[1])],
-                     w[static_cast<std::size_t>(n[2])]) > 0.0);
+    CHECK(tet_volume(w[c], w[index_cast<std::size_t>(n[0])], w[index_cast<std::size_t>(n[1])],
+                     w[index_cast<std::size_t>(n[2])]) > 0.0);
   }
   const auto t = reference_corners(ElementKind::kTet);
   for (std::size_t c = 0; c < 4; ++c) {
     const auto& n = topo::kTetCornerNeighbors[c];
-    CHECK(tet_volume(t[c], t[static_cast<std::size_t>(n[0])], t[static_cast<std::size_t>(n[1])],
-                     t[static_cast<std::size_t>(n[2])]) > 0.0);
+    CHECK(tet_volume(t[c], t[index_cast<std::size_t>(n[0])], t[index_cast<std::size_t>(n[1])],
+                     t[index_cast<std::size_t>(n[2])]) > 0.0);
   }
 }
 

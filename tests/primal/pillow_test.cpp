@@ -33,13 +33,13 @@ std::map<primal::EdgeKey, int> interior_edge_valence(const primal::HexMesh& m) {
   for (const auto& f : primal::unique_faces(m))
     if (f.uses.size() == 1)
       for (int i = 0; i < 4; ++i)
-        on_boundary.insert(primal::edge_key(f.nodes[static_cast<std::size_t>(i)],
-                                            f.nodes[static_cast<std::size_t>((i + 1) % 4)]));
+        on_boundary.insert(primal::edge_key(f.nodes[primal::index_cast<std::size_t>(i)],
+                                            f.nodes[primal::index_cast<std::size_t>((i + 1) % 4)]));
   std::map<primal::EdgeKey, int> v;
   for (const auto& h : m.hexes)
     for (const auto& e : primal::topology::kHexEdgeCorners) {
-      const auto k =
-          primal::edge_key(h[static_cast<std::size_t>(e[0])], h[static_cast<std::size_t>(e[1])]);
+      const auto k = primal::edge_key(h[primal::index_cast<std::size_t>(e[0])],
+                                      h[primal::index_cast<std::size_t>(e[1])]);
       if (!on_boundary.count(k)) ++v[k];
     }
   return v;
@@ -74,14 +74,14 @@ TEST_CASE("pillow: shrink sets inside and on the boundary of a grid") {
       for (const auto& f : primal::topology::kHexFaceCorners) {
         std::array<Index, 4> n{};
         for (int i = 0; i < 4; ++i)
-          n[static_cast<std::size_t>(i)] =
-              grid.hexes[static_cast<std::size_t>(h)]
-                        [static_cast<std::size_t>(f[static_cast<std::size_t>(i)])];
+          n[primal::index_cast<std::size_t>(i)] =
+              grid.hexes[primal::index_cast<std::size_t>(h)]
+                        [primal::index_cast<std::size_t>(f[primal::index_cast<std::size_t>(i)])];
         ++uses[primal::face_key(n)];
       }
     const auto surface =
         std::count_if(uses.begin(), uses.end(), [](const auto& u) { return u.second == 1; });
-    CHECK(r.layer.size() == static_cast<std::size_t>(surface));
+    CHECK(r.layer.size() == primal::index_cast<std::size_t>(surface));
     CHECK(r.mesh.hexes.size() == grid.hexes.size() + r.layer.size());
     const auto v = primal::check_validity(r.mesh);
     CAPTURE(v.summary());

@@ -42,7 +42,7 @@ DoubletColumn doublet_column() {
   DoubletColumn d;
   d.mesh = structured_hex_grid(3, 3, 3);
   for (int k = 0; k <= 3; ++k) {
-    d.axis[k] = static_cast<Index>(d.mesh.points.size());
+    d.axis[k] = index_cast(d.mesh.points.size());
     d.mesh.points.emplace_back(1.6, 1.4, k);  // off the diagonal: the split is not symmetric
   }
   for (int k = 0; k < 3; ++k) {
@@ -52,7 +52,7 @@ DoubletColumn doublet_column() {
     const Index e = d.axis[k], f = d.axis[k + 1];
     d.mesh.hexes[h] = {c[0], c[1], c[2], e, c[4], c[5], c[6], f};
     d.mesh.hexes.push_back({c[0], e, c[2], c[3], c[4], f, c[6], c[7]});
-    d.pairs[k] = {h, static_cast<Index>(d.mesh.hexes.size() - 1)};
+    d.pairs[k] = {h, index_cast(d.mesh.hexes.size() - 1)};
   }
   return d;
 }
@@ -72,7 +72,7 @@ TetSplit tet_split() {
   const std::array<Point, 4> v{Point(0, 0, 0), Point(1, 0, 0), Point(0, 1, 0), Point(0, 0, 1)};
   auto add = [&](const Point& p) {
     t.mesh.points.push_back(p);
-    return static_cast<Index>(t.mesh.points.size() - 1);
+    return index_cast(t.mesh.points.size() - 1);
   };
   std::array<Index, 4> corner{};
   for (int i = 0; i < 4; ++i) corner[i] = add(v[i]);
@@ -95,7 +95,7 @@ TetSplit tet_split() {
     // Corners 1, 3, 4 along ij, ik, il; 2, 5, 7 the face centres between them; 6 the centroid.
     t.mesh.hexes.push_back({corner[i], t.mid[i][j], t.face[l], t.mid[i][k], t.mid[i][l], t.face[k],
                             t.centroid, t.face[j]});
-    t.vertex_hex[i] = static_cast<Index>(t.mesh.hexes.size() - 1);
+    t.vertex_hex[i] = index_cast(t.mesh.hexes.size() - 1);
   }
   return t;
 }
@@ -153,7 +153,7 @@ TEST_CASE("realizability: a face cut open at a tet split's centre pinches the ce
   // itself there, so no embedding exists.
   TetSplit t = tet_split();
   const Index m = t.mid[0][1];
-  const Index copy = static_cast<Index>(t.mesh.points.size());
+  const Index copy = index_cast(t.mesh.points.size());
   t.mesh.points.push_back(t.mesh.points[m]);
   auto& h1 = t.mesh.hexes[t.vertex_hex[1]];
   std::replace(h1.begin(), h1.end(), m, copy);
@@ -184,7 +184,7 @@ TEST_CASE("realizability: a hex with two faces on one plane, and a flat corner")
   CHECK(q_all[0].nodes == std::vector<Index>{0, 1, 2});
 
   HexMesh h;
-  const auto n = static_cast<Index>(q.points.size());
+  const auto n = index_cast(q.points.size());
   for (int layer = 0; layer < 2; ++layer)
     for (const auto& p : q.points) h.points.push_back(p + Point(0, 0, layer));
   for (const auto& c : q.quads)
@@ -200,7 +200,7 @@ TEST_CASE("realizability: a hex with two faces on one plane, and a flat corner")
   HexMesh cube = structured_hex_grid(1, 1, 1);
   RealizabilityOptions o;
   o.node_faces.assign(8, 0u);
-  for (int c : {0, 1, 3, 4}) o.node_faces[static_cast<std::size_t>(cube.hexes[0][c])] = 1u;
+  for (int c : {0, 1, 3, 4}) o.node_faces[index_cast<std::size_t>(cube.hexes[0][c])] = 1u;
   const auto c_all = find_obstructions(cube, o);
   REQUIRE(c_all.size() == 1);
   CHECK(c_all[0].kind == Kind::kFlatCorner);
@@ -214,7 +214,7 @@ TEST_CASE("realizability: a quad doublet inside a grid") {
   // The centre quad of a 3 x 3 grid is split through a new node into two quads sharing both
   // edges at it.
   QuadMesh q = structured_quad_grid(3, 3);
-  const Index e = static_cast<Index>(q.points.size());
+  const Index e = index_cast(q.points.size());
   q.points.emplace_back(1.6, 1.4, 0.0);
   const auto c = q.quads[4];
   q.quads[4] = {c[0], c[1], c[2], e};

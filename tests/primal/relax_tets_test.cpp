@@ -23,9 +23,10 @@ namespace {
 double tet_volume(const primal::Model& m) {
   double v = 0.0;
   for (const auto& t : m.tets)
-    v += primal::tet_volume(
-        m.points[static_cast<std::size_t>(t[0])], m.points[static_cast<std::size_t>(t[1])],
-        m.points[static_cast<std::size_t>(t[2])], m.points[static_cast<std::size_t>(t[3])]);
+    v += primal::tet_volume(m.points[primal::index_cast<std::size_t>(t[0])],
+                            m.points[primal::index_cast<std::size_t>(t[1])],
+                            m.points[primal::index_cast<std::size_t>(t[2])],
+                            m.points[primal::index_cast<std::size_t>(t[3])]);
   return v;
 }
 
@@ -57,7 +58,7 @@ TEST_CASE("tet relaxation: Gmsh's flat pyramids beside a hex part rise, nothing 
                  << before << " -> " << after);
     // Only the listed nodes moved.
     std::vector<char> listed(m.points.size(), 0);
-    for (Index v : nodes) listed[static_cast<std::size_t>(v)] = 1;
+    for (Index v : nodes) listed[primal::index_cast<std::size_t>(v)] = 1;
     for (std::size_t v = 0; v < m.points.size(); ++v)
       if (!listed[v]) CHECK(a.points[v] == m.points[v]);
     // Every tet still positive; the tet part's volume (its boundary fixed) unchanged.

@@ -34,7 +34,7 @@ HexMesh appendix_a(bool reverse = false) {
 
 int hexes_with_negative_corner(const HexMesh& m) {
   int count = 0;
-  for (Index h = 0; h < static_cast<Index>(m.hexes.size()); ++h) {
+  for (Index h = 0; h < geode::primal::index_cast(m.hexes.size()); ++h) {
     const auto j = gp::hex_jacobians(gp::hex_corners(m, h));
     if (*std::min_element(j.begin(), j.begin() + 8) < 0.0) ++count;
   }
@@ -165,7 +165,7 @@ namespace {
 
 double min_quad_sj(const gp::QuadMesh& m) {
   double q = 1.0;
-  for (Index i = 0; i < static_cast<Index>(m.quads.size()); ++i) {
+  for (Index i = 0; i < geode::primal::index_cast(m.quads.size()); ++i) {
     q = std::min(q, gp::quad_scaled_jacobian(gp::quad_corners(m, i), Point(0, 0, 1)));
   }
   return q;
@@ -226,7 +226,7 @@ TEST_CASE("smoothing rejects malformed constraints") {
 TEST_CASE("linked nodes move as their leader's mirror image: a symmetric mesh stays symmetric") {
   // A 2 x 2 x 2 grid on [-1, 1]^3, perturbed symmetrically about x = 0.
   HexMesh m;
-  auto id = [](int i, int j, int k) { return static_cast<Index>(i + 3 * j + 9 * k); };
+  auto id = [](int i, int j, int k) { return geode::primal::index_cast(i + 3 * j + 9 * k); };
   for (int k = 0; k < 3; ++k)
     for (int j = 0; j < 3; ++j)
       for (int i = 0; i < 3; ++i) m.points.emplace_back(i - 1.0, j - 1.0, k - 1.0);

@@ -186,7 +186,7 @@ TEST_CASE("validity: each hex defect is found where it was put") {
          for (int c = 0; c < 8; ++c) {
            if (topology::kHexCornerCoords[c][0] == 1) {
              m.points.push_back(m.points[h[c]] + Point(0.5, 0.0, 0.25));
-             h[c] = static_cast<Index>(m.points.size() - 1);
+             h[c] = index_cast(m.points.size() - 1);
            }
          }
          m.hexes.push_back(h);
@@ -383,7 +383,7 @@ QuadMesh wrapped_star(int turns) {
   for (int i = 0; i < n; ++i) {
     const Index s = 1 + i, t = 1 + (i + 1) % n;
     m.points.push_back(m.points[s] + m.points[t]);
-    m.quads.push_back({0, s, static_cast<Index>(1 + n + i), t});
+    m.quads.push_back({0, s, index_cast(1 + n + i), t});
   }
   return m;
 }
@@ -392,7 +392,7 @@ QuadMesh wrapped_star(int turns) {
 // thick; node v of layer k is v + k * (number of quad nodes).
 HexMesh extrude(const QuadMesh& q, int layers) {
   HexMesh m;
-  const auto n = static_cast<Index>(q.points.size());
+  const auto n = index_cast(q.points.size());
   for (int k = 0; k <= layers; ++k)
     for (const Point& p : q.points) m.points.push_back(p + Point(0, 0, k));
   for (int k = 0; k < layers; ++k)
@@ -533,7 +533,7 @@ TEST_CASE("covering: the same where the counting probe runs along the wrapped ed
     const auto r = check_validity(m);
     INFO(r.summary());
     CHECK(r.ok() == (turns == 1));
-    const Index per_layer = static_cast<Index>(m.points.size() / 3);
+    const Index per_layer = index_cast(m.points.size() / 3);
     CHECK(nodes_of(r.overlapping_nodes) ==
           (turns == 1 ? std::vector<Index>{} : std::vector<Index>{0, per_layer, 2 * per_layer}));
     if (turns == 2) {

@@ -136,7 +136,7 @@ TEST_CASE("domain: planes in a hexahedron dualize to the structured grid inside 
       const stc::Domain d = stc::Domain::hexahedron(cc.corners);
       const auto sheets = cell_planes(d, k);
       const auto A = stc::compute_arrangement(sheets, d);
-      REQUIRE(A.vertices.size() == static_cast<std::size_t>(k * k * k));
+      REQUIRE(A.vertices.size() == primal::index_cast<std::size_t>(k * k * k));
       if (k == 1) {
         // At the cell's centre where the three planes meet: reported in physical space, with
         // its local coordinates.
@@ -145,8 +145,8 @@ TEST_CASE("domain: planes in a hexahedron dualize to the structured grid inside 
       }
       for (const auto& v : A.vertices) CHECK((stc::domain_point(d, v.local) - v.x).norm() < 1e-12);
       const auto D = stc::dualize(A);
-      CHECK(D.hex.hexes.size() == static_cast<std::size_t>(k * k * k));
-      CHECK(D.hex.points.size() == static_cast<std::size_t>((k + 1) * (k + 1) * (k + 1)));
+      CHECK(D.hex.hexes.size() == primal::index_cast<std::size_t>(k * k * k));
+      CHECK(D.hex.points.size() == primal::index_cast<std::size_t>((k + 1) * (k + 1) * (k + 1)));
       CHECK(test::find_isomorphism(D.hex, test::structured_hex_grid(k, k, k)).has_value());
       const auto report = primal::check_validity(D.hex);
       CHECK_MESSAGE(report.ok(), report.summary());  // includes every corner Jacobian > 0
@@ -170,11 +170,11 @@ TEST_CASE("domain: planes in a hexahedron dualize to the structured grid inside 
       for (const auto& c : A.curves)
         for (const Point& p : c.polyline)
           for (int s : c.sheets)
-            CHECK(std::abs(sheets[static_cast<std::size_t>(s)].field(p)) < 1e-8);
+            CHECK(std::abs(sheets[primal::index_cast<std::size_t>(s)].field(p)) < 1e-8);
       for (const auto& e : A.edges)
         for (int s : e.sheets)
           for (const Point& p : {e.a.x, e.b.x})
-            CHECK(std::abs(sheets[static_cast<std::size_t>(s)].field(p)) < 1e-8);
+            CHECK(std::abs(sheets[primal::index_cast<std::size_t>(s)].field(p)) < 1e-8);
     }
 }
 
@@ -192,7 +192,7 @@ TEST_CASE("domain: lines in a quadrilateral dualize to the structured grid insid
       CAPTURE(k);
       const stc::Domain d = stc::Domain::quadrilateral(c.corners);
       const auto D = stc::dualize(stc::compute_arrangement(cell_planes(d, k), d));
-      CHECK(D.quad.quads.size() == static_cast<std::size_t>(k * k));
+      CHECK(D.quad.quads.size() == primal::index_cast<std::size_t>(k * k));
       CHECK(test::find_isomorphism(D.quad, test::structured_quad_grid(k, k)).has_value());
       const auto report = primal::check_validity(D.quad);
       CHECK_MESSAGE(report.ok(), report.summary());

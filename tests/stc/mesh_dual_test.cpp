@@ -45,7 +45,7 @@ template <int Dim, typename Mesh>
 void check_trace_walk(const Mesh& mesh, const stc::MeshDual<Dim>& dual) {
   for (std::size_t s = 0; s < dual.sheets.size(); ++s) {
     for (const auto& curve : dual.sheets[s].trace) {
-      for (Index e : curve.edges) CHECK(dual.edge_sheet[e] == static_cast<Index>(s));
+      for (Index e : curve.edges) CHECK(dual.edge_sheet[e] == geode::primal::index_cast(s));
       if constexpr (Dim == 3) {
         REQUIRE(curve.closed);
         REQUIRE(curve.facets.size() == curve.edges.size());
@@ -80,11 +80,11 @@ TEST_CASE("hex grids: nx + ny + nz planar sheets, every cross triple meets once"
     CAPTURE(nz);
     const HexMesh mesh = gt::structured_hex_grid(nx, ny, nz);
     const auto dual = stc::mesh_dual(mesh);
-    REQUIRE(dual.sheets.size() == static_cast<std::size_t>(nx + ny + nz));
+    REQUIRE(dual.sheets.size() == geode::primal::index_cast<std::size_t>(nx + ny + nz));
     // Edges of an nx x ny x nz grid: nx(ny+1)(nz+1) + ... (one term per direction).
     CHECK(dual.edges.size() ==
-          static_cast<std::size_t>(nx * (ny + 1) * (nz + 1) + (nx + 1) * ny * (nz + 1) +
-                                   (nx + 1) * (ny + 1) * nz));
+          geode::primal::index_cast<std::size_t>(
+              nx * (ny + 1) * (nz + 1) + (nx + 1) * ny * (nz + 1) + (nx + 1) * (ny + 1) * nz));
     // Class k of hex (i,j,k) is the sheet of slab index[k] along axis k (class k = edges along
     // local axis k = grid axis k for structured_hex_grid): equal slab <=> equal sheet.
     const int idx_n[3] = {nx, ny, nz};
@@ -99,27 +99,28 @@ TEST_CASE("hex grids: nx + ny + nz planar sheets, every cross triple meets once"
         CHECK(sheets.size() == 1);
         all.insert(*sheets.begin());
       }
-      CHECK(all.size() == static_cast<std::size_t>(idx_n[axis]));
+      CHECK(all.size() == geode::primal::index_cast<std::size_t>(idx_n[axis]));
       // A sheet across axis a crosses the (n_b * n_c) hexes of its slab and leaves one loop
       // around the box crossing 2 (n_b + n_c) boundary edges.
       const int nb = idx_n[(axis + 1) % 3], nc = idx_n[(axis + 2) % 3];
       for (Index s : all) {
         const auto& sheet = dual.sheets[s];
-        CHECK(sheet.cells.size() == static_cast<std::size_t>(nb * nc));
+        CHECK(sheet.cells.size() == geode::primal::index_cast<std::size_t>(nb * nc));
         CHECK_FALSE(sheet.self_intersecting);
         REQUIRE(sheet.trace.size() == 1);
         CHECK(sheet.trace[0].closed);
-        CHECK(sheet.trace[0].edges.size() == static_cast<std::size_t>(2 * (nb + nc)));
+        CHECK(sheet.trace[0].edges.size() == geode::primal::index_cast<std::size_t>(2 * (nb + nc)));
       }
     }
     // One hex per triple, and only triples with one sheet of each family.
-    CHECK(dual.intersections.size() == static_cast<std::size_t>(nx * ny * nz));
+    CHECK(dual.intersections.size() == geode::primal::index_cast<std::size_t>(nx * ny * nz));
     for (const auto& [triple, count] : dual.intersections) {
       CHECK(count == 1);
       CHECK(triple[0] != triple[1]);
       CHECK(triple[1] != triple[2]);
     }
-    CHECK(dual.boundary.size() == static_cast<std::size_t>(2 * (nx * ny + ny * nz + nz * nx)));
+    CHECK(dual.boundary.size() ==
+          geode::primal::index_cast<std::size_t>(2 * (nx * ny + ny * nz + nz * nx)));
     check_trace_walk<3>(mesh, dual);
   }
 }
@@ -130,23 +131,23 @@ TEST_CASE("quad grids: nx + ny chords with two ends each, crossing once") {
     CAPTURE(ny);
     const QuadMesh mesh = gt::structured_quad_grid(nx, ny);
     const auto dual = stc::mesh_dual(mesh);
-    REQUIRE(dual.sheets.size() == static_cast<std::size_t>(nx + ny));
+    REQUIRE(dual.sheets.size() == geode::primal::index_cast<std::size_t>(nx + ny));
     std::size_t along_y = 0;  // chords of the x-edges (class 0) cross the ny quads of a column
     for (const auto& chord : dual.sheets) {
       CHECK_FALSE(chord.self_intersecting);
       CHECK(chord.trace.size() == 2);  // two ends on the boundary
-      CHECK((chord.cells.size() == static_cast<std::size_t>(ny) ||
-             chord.cells.size() == static_cast<std::size_t>(nx)));
+      CHECK((chord.cells.size() == geode::primal::index_cast<std::size_t>(ny) ||
+             chord.cells.size() == geode::primal::index_cast<std::size_t>(nx)));
     }
     for (int q = 0; q < nx * ny; ++q)
       if (dual.cell_sheets[q][0] == dual.cell_sheets[0][0]) ++along_y;
-    CHECK(along_y == static_cast<std::size_t>(ny));
-    CHECK(dual.intersections.size() == static_cast<std::size_t>(nx * ny));
+    CHECK(along_y == geode::primal::index_cast<std::size_t>(ny));
+    CHECK(dual.intersections.size() == geode::primal::index_cast<std::size_t>(nx * ny));
     for (const auto& [pair, count] : dual.intersections) {
       CHECK(count == 1);
       CHECK(pair[0] != pair[1]);
     }
-    CHECK(dual.boundary.size() == static_cast<std::size_t>(2 * (nx + ny)));
+    CHECK(dual.boundary.size() == geode::primal::index_cast<std::size_t>(2 * (nx + ny)));
     check_trace_walk<2>(mesh, dual);
   }
 }
@@ -462,7 +463,7 @@ TEST_CASE("bad input is reported with the element") {
   CHECK_THROWS_WITH_AS(stc::mesh_dual(twice), doctest::Contains("quad 0"), geode::InvalidInput);
   HexMesh fan = gt::structured_hex_grid(1, 1, 1);
   for (int i = 0; i < 2; ++i) {  // three hexes on one face
-    const Index base = static_cast<Index>(fan.points.size());
+    const Index base = geode::primal::index_cast(fan.points.size());
     fan.points.resize(fan.points.size() + 4, Point::Zero());
     fan.hexes.push_back({base, base + 1, base + 2, base + 3, 0, 1, 2, 3});
   }

@@ -51,7 +51,7 @@ TEST_CASE("pyramid domain: three planes give one hex, its apex node at the apex"
       CHECK(((D.node_faces[n] >> stc::box_face(2, true)) & 1u) == 1u);
     }
     for (int b = 0; b < 4; ++b)
-      base_corners += (D.hex.points[n] - P[static_cast<std::size_t>(b)]).norm() < 1e-12;
+      base_corners += (D.hex.points[n] - P[primal::index_cast<std::size_t>(b)]).norm() < 1e-12;
   }
   CHECK(at_apex == 1);
   CHECK(base_corners == 4);

@@ -89,9 +89,9 @@ TEST_CASE("round trip: structured hex grids, straight and with moved nodes") {
     // Each rebuilt hex sits at the centre of the hex it maps to: the triple point of the
     // sheets' mid-surfaces is the centre of the multilinear map.
     for (std::size_t h = 0; h < D.hex.hexes.size(); ++h) {
-      const auto& orig = g.hexes[static_cast<std::size_t>(m->cell_map[h])];
+      const auto& orig = g.hexes[primal::index_cast<std::size_t>(m->cell_map[h])];
       Point centre = Point::Zero();
-      for (Index n : orig) centre += g.points[static_cast<std::size_t>(n)] / 8.0;
+      for (Index n : orig) centre += g.points[primal::index_cast<std::size_t>(n)] / 8.0;
       CHECK((D.element_centres[h] - centre).norm() < 1e-6);
     }
   }
@@ -142,7 +142,7 @@ TEST_CASE("round trip: the Appendix A geode (2 tunnels, 4 domes) comes back") {
   // The element of each triple point is the hex whose three sheets meet there.
   const auto dual = stc::mesh_dual(g);
   for (std::size_t h = 0; h < D.hex.hexes.size(); ++h) {
-    auto want = dual.cell_sheets[static_cast<std::size_t>(m->cell_map[h])];
+    auto want = dual.cell_sheets[primal::index_cast<std::size_t>(m->cell_map[h])];
     std::sort(want.begin(), want.end());
     CHECK(std::vector<Index>(want.begin(), want.end()) ==
           std::vector<Index>(D.element_sheets[h].begin(), D.element_sheets[h].end()));
@@ -173,7 +173,7 @@ TEST_CASE("round trip: diced tet meshes (closed and hemispherical dome sheets) c
     const HexMesh g = primal::dice(tets).mesh;
     const auto dual = stc::mesh_dual(g);
     CHECK(dual.sheets.size() ==
-          static_cast<std::size_t>((n + 1) * (n + 1) * (n + 1)));  // one per tet vertex
+          primal::index_cast<std::size_t>((n + 1) * (n + 1) * (n + 1)));  // one per tet vertex
     const auto D = round_trip(g);
     CHECK(D.hex.hexes.size() == g.hexes.size());
     const auto m = gt::find_isomorphism(D.hex, g);

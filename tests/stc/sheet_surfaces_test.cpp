@@ -21,9 +21,10 @@ namespace {
 double area(const primal::TriMesh& m) {
   double a = 0;
   for (const auto& t : m.tris)
-    a += 0.5 * (m.points[static_cast<std::size_t>(t[1])] - m.points[static_cast<std::size_t>(t[0])])
-                   .cross(m.points[static_cast<std::size_t>(t[2])] -
-                          m.points[static_cast<std::size_t>(t[0])])
+    a += 0.5 * (m.points[primal::index_cast<std::size_t>(t[1])] -
+                m.points[primal::index_cast<std::size_t>(t[0])])
+                   .cross(m.points[primal::index_cast<std::size_t>(t[2])] -
+                          m.points[primal::index_cast<std::size_t>(t[0])])
                    .norm();
   return a;
 }
@@ -33,7 +34,8 @@ std::map<std::pair<Index, Index>, int> edge_uses(const primal::TriMesh& m) {
   std::map<std::pair<Index, Index>, int> uses;
   for (const auto& t : m.tris)
     for (int i = 0; i < 3; ++i) {
-      Index a = t[static_cast<std::size_t>(i)], b = t[static_cast<std::size_t>((i + 1) % 3)];
+      Index a = t[primal::index_cast<std::size_t>(i)],
+            b = t[primal::index_cast<std::size_t>((i + 1) % 3)];
       ++uses[{std::min(a, b), std::max(a, b)}];
     }
   return uses;
@@ -57,9 +59,9 @@ TEST_CASE(
             static_cast<long>(m.tris.size()) ==
         2);
   for (const auto& t : m.tris) {
-    const Point a = m.points[static_cast<std::size_t>(t[0])],
-                b = m.points[static_cast<std::size_t>(t[1])],
-                c = m.points[static_cast<std::size_t>(t[2])];
+    const Point a = m.points[primal::index_cast<std::size_t>(t[0])],
+                b = m.points[primal::index_cast<std::size_t>(t[1])],
+                c = m.points[primal::index_cast<std::size_t>(t[2])];
     CHECK((b - a).cross(c - a).dot(a + b + c) >= 0);  // towards the positive (outer) side
   }
 }
@@ -92,7 +94,8 @@ TEST_CASE("contour_curves: a circle in a rectangle is one closed loop on the cir
   double length = 0;
   for (const auto& e : c.segments) {
     ++degree[e[0]], ++degree[e[1]];
-    length += (c.points[static_cast<std::size_t>(e[1])] - c.points[static_cast<std::size_t>(e[0])])
+    length += (c.points[primal::index_cast<std::size_t>(e[1])] -
+               c.points[primal::index_cast<std::size_t>(e[0])])
                   .norm();
   }
   for (const auto& [v, d] : degree) CHECK(d == 2);

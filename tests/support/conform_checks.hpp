@@ -22,8 +22,9 @@ inline void check_conform_result(const conform::ConformResult& r, primal::Index 
   CHECK(v.overlapping_nodes.empty());
   CHECK(primal::min_scaled_jacobian(mesh) > 0.0);
   CHECK(r.geode_hexes == (geode_hexes < 0 ? 26 * r.interface_quads : geode_hexes));
-  CHECK(r.model.hexes.size() == static_cast<std::size_t>(r.diced_hexes + r.geode_hexes +
-                                                         r.diced_tet_hexes + r.diced_wedge_hexes));
+  CHECK(r.model.hexes.size() ==
+        primal::index_cast<std::size_t>(r.diced_hexes + r.geode_hexes + r.diced_tet_hexes +
+                                        r.diced_wedge_hexes));
   CHECK(r.warnings.empty());
 }
 

@@ -94,7 +94,7 @@ primal::HexMesh appendix_a_geode() {
 primal::HexMesh structured_hex_grid(int nx, int ny, int nz) {
   primal::HexMesh mesh;
   auto id = [&](int i, int j, int k) {
-    return static_cast<primal::Index>(i + (nx + 1) * (j + (ny + 1) * k));
+    return primal::index_cast(i + (nx + 1) * (j + (ny + 1) * k));
   };
   for (int k = 0; k <= nz; ++k)
     for (int j = 0; j <= ny; ++j)
@@ -115,7 +115,7 @@ primal::HexMesh structured_hex_grid(int nx, int ny, int nz) {
 
 primal::QuadMesh structured_quad_grid(int nx, int ny) {
   primal::QuadMesh mesh;
-  auto id = [&](int i, int j) { return static_cast<primal::Index>(i + (nx + 1) * j); };
+  auto id = [&](int i, int j) { return primal::index_cast(i + (nx + 1) * j); };
   for (int j = 0; j <= ny; ++j)
     for (int i = 0; i <= nx; ++i) mesh.points.emplace_back(i, j, 0.0);
   for (int j = 0; j < ny; ++j)
@@ -136,7 +136,7 @@ primal::QuadMesh boundary_quads(const primal::HexMesh& mesh,
     std::array<primal::Index, 4> q{};
     for (int c = 0; c < 4; ++c) {
       if (renumber[f[c]] == primal::kInvalidIndex) {
-        renumber[f[c]] = static_cast<primal::Index>(out.points.size());
+        renumber[f[c]] = primal::index_cast(out.points.size());
         out.points.push_back(mesh.points[f[c]]);
       }
       q[c] = renumber[f[c]];
@@ -161,8 +161,9 @@ primal::Model four_tet_fan(const primal::Point& centre, const primal::Point& ape
 primal::Model tet_cell_on_hex_top() {
   primal::Model m = primal::grid_model(
       {2, 2, 2}, 1.0, [](int i, int j, int k) { return i == 0 && j == 0 && k == 1; });
-  std::erase_if(m.hexes,
-                [&](const auto& h) { return m.points[static_cast<std::size_t>(h[0])].z() > 0.5; });
+  std::erase_if(m.hexes, [&](const auto& h) {
+    return m.points[primal::index_cast<std::size_t>(h[0])].z() > 0.5;
+  });
   m.hex_block.assign(m.hexes.size(), 1);
   return m;
 }

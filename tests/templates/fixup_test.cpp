@@ -28,7 +28,7 @@ std::multiset<std::vector<std::array<long, 3>>> boundary_geometry(const primal::
     if (f.uses.size() != 1) continue;
     std::vector<std::array<long, 3>> q;
     for (auto n : f.nodes) {
-      const auto& p = m.points[static_cast<std::size_t>(n)];
+      const auto& p = m.points[primal::index_cast<std::size_t>(n)];
       q.push_back({std::lround(p.x() * 1e6), std::lround(p.y() * 1e6), std::lround(p.z() * 1e6)});
     }
     std::sort(q.begin(), q.end());
@@ -53,7 +53,7 @@ TEST_CASE("fix_up: the four-triangle dual's pinched corners are pillowed away, t
   const auto before = primal::find_obstructions(T.hex, ro);
   REQUIRE_FALSE(before.empty());
   const auto r = templates::fix_up(T);
-  CHECK(r.obstructions_before == static_cast<int>(before.size()));
+  CHECK(r.obstructions_before == primal::index_cast<int>(before.size()));
   CHECK(r.obstructions_after == 0);
   CHECK_FALSE(r.steps.empty());
   ro.node_faces = T.node_faces;
@@ -71,8 +71,10 @@ TEST_CASE("fix_up: the four-triangle dual's pinched corners are pillowed away, t
     for (int sheet : T.element_sheets[h]) {
       int plus = 0, minus = 0;
       for (auto n : T.hex.hexes[h])
-        (T.node_signs[static_cast<std::size_t>(n)][static_cast<std::size_t>(sheet)] > 0 ? plus
-                                                                                        : minus)++;
+        (T.node_signs[primal::index_cast<std::size_t>(n)][primal::index_cast<std::size_t>(sheet)] >
+                 0
+             ? plus
+             : minus)++;
       CAPTURE(h);
       CHECK((plus == 4 && minus == 4));
     }

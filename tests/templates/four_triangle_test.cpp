@@ -41,7 +41,7 @@ std::pair<double, double> radius_bounds(const templates::InterfacePatch& patch, 
   const auto diced = templates::dice_patch(patch);
   double inside = 0.0, outside = 1e300;
   for (std::size_t n = 0; n < diced.nodes.size(); ++n) {
-    const double d = planar(diced.nodes[n], patch.points[static_cast<std::size_t>(v)]);
+    const double d = planar(diced.nodes[n], patch.points[primal::index_cast<std::size_t>(v)]);
     const auto& own = diced.owners[n];
     if (std::find(own.begin(), own.end(), v) != own.end())
       inside = std::max(inside, d);
@@ -109,15 +109,15 @@ TEST_CASE("geode4tri: the triple-dome points sit where the ratio says, outside t
       int points = 0;
       for (const auto& v : A.vertices) {
         if (!std::all_of(v.sheets.begin(), v.sheets.end(),
-                         [&](int s) { return static_cast<std::size_t>(s) >= first_dome; }))
+                         [&](int s) { return primal::index_cast<std::size_t>(s) >= first_dome; }))
           continue;
         ++points;
         // Equal r / R over the three domes: the depth term cancelled.
         std::vector<double> ratio;
         for (int s : v.sheets) {
-          const auto& d = domes[static_cast<std::size_t>(s) - first_dome];
-          ratio.push_back(planar(v.x, G.tet_side.points[static_cast<std::size_t>(d.vertex)]) /
-                          d.radius);
+          const auto& d = domes[primal::index_cast<std::size_t>(s) - first_dome];
+          ratio.push_back(
+              planar(v.x, G.tet_side.points[primal::index_cast<std::size_t>(d.vertex)]) / d.radius);
         }
         CHECK(ratio[1] == doctest::Approx(ratio[0]).epsilon(1e-6));
         CHECK(ratio[2] == doctest::Approx(ratio[0]).epsilon(1e-6));
@@ -175,7 +175,7 @@ TEST_CASE(
   REQUIRE(G.sheets.size() == 7);
   for (int v = 0; v < 5; ++v) {
     CAPTURE(v);
-    const Point V = G.tet_side.points[static_cast<std::size_t>(v)];
+    const Point V = G.tet_side.points[primal::index_cast<std::size_t>(v)];
     const auto diced = templates::dice_patch(G.tet_side);
     double inside = 0.0, outside = 1e300;
     for (std::size_t n = 0; n < diced.nodes.size(); ++n) {
@@ -189,7 +189,7 @@ TEST_CASE(
     }
     const double R = inside + given.push.dome_radius * (outside - inside),
                  depth = given.push.dome_depth;
-    const auto& field = G.sheets[static_cast<std::size_t>(2 + v)].field;
+    const auto& field = G.sheets[primal::index_cast<std::size_t>(2 + v)].field;
     for (const Point& x :
          {Point(0.3, 0.7, -0.2), Point(-0.9, 0.95, 0.8), Point(0.01, 0.2, 0.6), Point(1, 1, -1)}) {
       const double dx = x.x() - V.x(), dz = x.z() - V.z();

@@ -61,7 +61,7 @@ primal::HexMesh gmsh_pyramid_filling(const std::array<Point, 5>& c) {
   primal::HexMesh m;
   std::map<std::size_t, Index> id;
   for (std::size_t i = 0; i < tags.size(); ++i) {
-    id[tags[i]] = static_cast<Index>(m.points.size());
+    id[tags[i]] = primal::index_cast(m.points.size());
     m.points.emplace_back(coords[3 * i], coords[3 * i + 1], coords[3 * i + 2]);
   }
   std::vector<std::size_t> elements, nodes;
@@ -81,7 +81,7 @@ bool boundary_is(const primal::HexMesh& mesh, const primal::QuadMesh& surface, d
   if (b.faces.size() != surface.quads.size()) return false;
   auto nearest = [&](const Point& x) {
     for (std::size_t n = 0; n < surface.points.size(); ++n)
-      if ((surface.points[n] - x).norm() < tol) return static_cast<Index>(n);
+      if ((surface.points[n] - x).norm() < tol) return primal::index_cast(n);
     return primal::kInvalidIndex;
   };
   std::set<std::vector<Index>> want, got;
@@ -92,7 +92,7 @@ bool boundary_is(const primal::HexMesh& mesh, const primal::QuadMesh& surface, d
   }
   for (const auto& f : b.faces) {
     std::vector<Index> k;
-    for (Index n : f.nodes) k.push_back(nearest(mesh.points[static_cast<std::size_t>(n)]));
+    for (Index n : f.nodes) k.push_back(nearest(mesh.points[primal::index_cast<std::size_t>(n)]));
     std::sort(k.begin(), k.end());
     got.insert(k);
   }
@@ -117,13 +117,13 @@ TEST_CASE("pyramid: Schneiders' surface has 16 quads and a chord crossing itself
   CHECK(cert.statement.find("no arrangement") != std::string::npos);
   // Every quad counter-clockwise seen from outside (the centroid is inside).
   Point centre = Point::Zero();
-  for (int i = 0; i < 5; ++i) centre += s.points[static_cast<std::size_t>(i)] / 5.0;
+  for (int i = 0; i < 5; ++i) centre += s.points[primal::index_cast<std::size_t>(i)] / 5.0;
   for (const auto& q : s.quads) {
-    const Point n =
-        (s.points[static_cast<std::size_t>(q[2])] - s.points[static_cast<std::size_t>(q[0])])
-            .cross(s.points[static_cast<std::size_t>(q[3])] -
-                   s.points[static_cast<std::size_t>(q[1])]);
-    CHECK(n.dot(s.points[static_cast<std::size_t>(q[0])] - centre) > 0);
+    const Point n = (s.points[primal::index_cast<std::size_t>(q[2])] -
+                     s.points[primal::index_cast<std::size_t>(q[0])])
+                        .cross(s.points[primal::index_cast<std::size_t>(q[3])] -
+                               s.points[primal::index_cast<std::size_t>(q[1])]);
+    CHECK(n.dot(s.points[primal::index_cast<std::size_t>(q[0])] - centre) > 0);
   }
   CHECK_THROWS_AS(stc::surface_chords({{0, 1, 2, 3}}), TopologyError);
 }
@@ -138,7 +138,7 @@ TEST_CASE("pyramid: Gmsh's all-hex subdivision of one pyramid, measured") {
   CHECK(v.inverted_hexes.empty());
   CHECK(boundary_is(g, templates::schneiders_surface(P)));
   double lo = 1.0, sum = 0.0;
-  for (Index h = 0; h < static_cast<Index>(g.hexes.size()); ++h) {
+  for (Index h = 0; h < primal::index_cast(g.hexes.size()); ++h) {
     const double sj = primal::hex_scaled_jacobian(primal::hex_corners(g, h));
     lo = std::min(lo, sj);
     sum += sj;
@@ -156,7 +156,7 @@ TEST_CASE("pyramid: Gmsh's all-hex subdivision of one pyramid, measured") {
   const primal::HexMesh r = gmsh_pyramid_filling(
       {Point(-1, -1, 0), Point(1, -1, 0), Point(1, 1, 0), Point(-1, 1, 0), Point(0, 0, 1)});
   double rlo = 1.0;
-  for (Index h = 0; h < static_cast<Index>(r.hexes.size()); ++h)
+  for (Index h = 0; h < primal::index_cast(r.hexes.size()); ++h)
     rlo = std::min(rlo, primal::hex_scaled_jacobian(primal::hex_corners(r, h)));
   MESSAGE("gmsh 88-hex pyramid, height 1: min scaled Jacobian " << rlo);
   CHECK(rlo > 0.11);
@@ -213,7 +213,7 @@ TEST_CASE("pyramid: on the Gmsh-made hybrid demos, splitting beats Gmsh's 88 at 
         split = std::max(split, primal::diced_min_scaled_jacobian(m.points, t));
       }
       std::array<Point, 5> c;
-      for (std::size_t k = 0; k < 5; ++k) c[k] = m.points[static_cast<std::size_t>(p[k])];
+      for (std::size_t k = 0; k < 5; ++k) c[k] = m.points[primal::index_cast<std::size_t>(p[k])];
       const primal::HexMesh g = gmsh_pyramid_filling(c);
       REQUIRE(g.hexes.size() == 88);
       double lo = 1.0;
@@ -236,7 +236,8 @@ TEST_CASE("pyramid: Gmsh's 88 hexes smoothed by ours, the boundary at the diced 
   primal::HexMesh g = gmsh_pyramid_filling(equilateral());
   std::vector<primal::NodeConstraint> fix(g.points.size());
   for (const auto& f : primal::extract_boundary(g).faces)
-    for (Index n : f.nodes) fix[static_cast<std::size_t>(n)] = primal::NodeConstraint::fixed();
+    for (Index n : f.nodes)
+      fix[primal::index_cast<std::size_t>(n)] = primal::NodeConstraint::fixed();
   const primal::SmoothResult r = primal::smooth_hex_mesh(g, fix);
   double lo = 1.0, sum = 0.0;
   for (Index h = 0; h < 88; ++h) {

@@ -55,8 +55,8 @@ void check_grid(const primal::QuadMesh& face, int k, double hx, double hz) {
 double min_quad_sj(const primal::QuadMesh& m) {
   double lo = 1e300;
   for (std::size_t q = 0; q < m.quads.size(); ++q)
-    lo = std::min(lo, primal::quad_scaled_jacobian(
-                          primal::quad_corners(m, static_cast<primal::Index>(q)), Point::UnitZ()));
+    lo = std::min(lo, primal::quad_scaled_jacobian(primal::quad_corners(m, primal::index_cast(q)),
+                                                   Point::UnitZ()));
   return lo;
 }
 

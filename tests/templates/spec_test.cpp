@@ -168,7 +168,7 @@ TEST_CASE("spec: the geode's tunnels and domes written out as shapes give the ge
        {"tunnel",
         {{"point", {0, -7, 0}}, {"along", {0, 0, 1}}, {"half_width", 6}, {"height", 0.6 * 14}}}});
   for (const auto& d : domes) {
-    const Point v = G.tet_side.points[static_cast<std::size_t>(d.vertex)];
+    const Point v = G.tet_side.points[primal::index_cast<std::size_t>(d.vertex)];
     j["sheets"].push_back({{"name", "dome " + std::to_string(d.vertex)},
                            {"dome",
                             {{"vertex", {12 * v.x(), 7, 12 * v.z()}},

@@ -49,7 +49,7 @@ TEST_CASE("interleave study: the default push is the 26-hex geode, and other out
   // Every run is counted in exactly one class.
   int total = 0;
   for (const auto& c : study.classes) total += c.count;
-  CHECK(total == static_cast<int>(study.runs.size()));
+  CHECK(total == primal::index_cast<int>(study.runs.size()));
   for (const auto& r : study.runs)
     if (!r.valid) CHECK(r.diagnosis.find_first_of("0123456789.") == r.diagnosis.find("1-cell"));
   // The geode's class is a usable template; no class with an obstruction is ever untangled.
@@ -155,10 +155,10 @@ TEST_CASE("template_class_key: invariant under renumbering, different for a diff
   const std::string key = templates::template_class_key(T);
   // Reverse the node numbering and rotate the hex list: an isomorphic template.
   auto R = T;
-  const auto n = static_cast<primal::Index>(T.hex.points.size());
+  const auto n = primal::index_cast(T.hex.points.size());
   for (std::size_t i = 0; i < T.hex.points.size(); ++i) {
-    R.hex.points[static_cast<std::size_t>(n) - 1 - i] = T.hex.points[i];
-    R.node_faces[static_cast<std::size_t>(n) - 1 - i] = T.node_faces[i];
+    R.hex.points[primal::index_cast<std::size_t>(n) - 1 - i] = T.hex.points[i];
+    R.node_faces[primal::index_cast<std::size_t>(n) - 1 - i] = T.node_faces[i];
   }
   std::rotate(R.hex.hexes.begin(), R.hex.hexes.begin() + 5, R.hex.hexes.end());
   std::rotate(R.element_sheets.begin(), R.element_sheets.begin() + 5, R.element_sheets.end());
