@@ -177,15 +177,18 @@ int block_of(const Model& model, ElementRef element) {
                         : blocks[index_cast<std::size_t>(element.index)];
 }
 
+// A number outside the model's (kInvalidIndex in a message) is named as its 1-based self.
 std::int64_t node_id(const Model& model, Index node) {
-  const auto n = index_cast<std::size_t>(node);
-  return n < model.node_ids.size() ? model.node_ids[n] : std::int64_t{node} + 1;
+  return node >= 0 && index_cast<std::size_t>(node) < model.node_ids.size()
+             ? model.node_ids[index_cast<std::size_t>(node)]
+             : std::int64_t{node} + 1;
 }
 
 std::int64_t element_id(const Model& model, ElementRef element) {
   const auto& ids = element_ids(model, element.kind);
-  const auto e = index_cast<std::size_t>(element.index);
-  return e < ids.size() ? ids[e] : std::int64_t{element.index} + 1;
+  return element.index >= 0 && index_cast<std::size_t>(element.index) < ids.size()
+             ? ids[index_cast<std::size_t>(element.index)]
+             : std::int64_t{element.index} + 1;
 }
 
 std::string number_text(double x) {

@@ -156,13 +156,14 @@ std::vector<NodeSpace> node_spaces(const std::vector<Point>& points,
   // Followers take their leader's coordinates through the link's map; the others get their own.
   std::vector<char> follows(points.size(), 0);
   for (const NodeLink& l : links) {
-    const auto n = index_cast<std::size_t>(l.node), lead = index_cast<std::size_t>(l.leader);
-    if (l.node < 0 || n >= points.size() || l.leader < 0 || lead >= points.size() || n == lead ||
+    // The signs first: index_cast asserts that what it converts fits.
+    if (l.node < 0 || l.leader < 0 || index_cast<std::size_t>(l.node) >= points.size() ||
+        index_cast<std::size_t>(l.leader) >= points.size() || l.node == l.leader ||
         !l.map.allFinite())
       throw InvalidInput("smooth: a node link names node " + std::to_string(l.node) +
                          " and leader " + std::to_string(l.leader) + " (" +
                          std::to_string(points.size()) + " nodes)");
-    follows[n] = 1;
+    follows[index_cast<std::size_t>(l.node)] = 1;
   }
   for (const NodeLink& l : links)
     if (follows[index_cast<std::size_t>(l.leader)])

@@ -121,7 +121,7 @@ class CellLocator {
     for (int a = 0; a < Dim; ++a) {
       std::uint64_t bits;
       std::memcpy(&bits, &x[a], sizeof bits);
-      key = (key ^ primal::index_cast<std::size_t>(bits)) * 0x9E3779B97F4A7C15ull;
+      key = (key ^ static_cast<std::size_t>(bits)) * 0x9E3779B97F4A7C15ull;
     }
     auto& slot = cache_[(key >> 40) % cache_.size()];
     if (slot.first == x) return slot.second;
