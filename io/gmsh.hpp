@@ -73,7 +73,8 @@ primal::Model read_gmsh(const std::filesystem::path& path, const primal::ReadOpt
 // partitions are left out; elements of a block by ascending tag, the order partitioning
 // regroups), and `partition` gets each volume element's partition (Gmsh's tag
 // - 1). A file of Gmsh's Mesh.PartitionSplitMeshFiles=1 set (one partition's elements) is
-// refused. A file without partitions gives partition->parts == 0.
+// refused. A file without partitions, or one that does not give every volume element one,
+// gives partition->parts == 0.
 primal::Model read_gmsh_partitioned(const std::filesystem::path& path,
                                     const primal::ReadOptions& options, FilePartition* partition);
 // The same on a file's content; `source` names it in messages.

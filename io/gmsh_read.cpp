@@ -13,6 +13,7 @@
 #include <set>
 #include <string>
 #include <unordered_map>
+#include <utility>
 
 #include <geode/io/file_format.hpp>
 #include <geode/io/gmsh.hpp>
@@ -574,17 +575,13 @@ class MshReader {
     const auto it = partitioned_entities_.find({dim, e.entity});
     return it != partitioned_entities_.end() && it->second.parent_dim > dim;
   }
-  // A volume element's part (0-based): its partitioned entity's one partition.
+  // A volume element's part (0-based): its partitioned entity's one partition; -1 when the file
+  // does not say one (then the model is read without its partition: nothing else depends on it).
   int part_of(const RawElement& e) const {
     const auto it = partitioned_entities_.find({3, e.entity});
-    if (it == partitioned_entities_.end())
-      throw InvalidInput(source_ + ": element " + std::to_string(e.tag) + ": its volume " +
-                         std::to_string(e.entity) + " is not in $PartitionedEntities");
+    if (it == partitioned_entities_.end()) return -1;
     const std::vector<int>& p = it->second.partitions;
-    if (p.size() != 1 || p[0] < 1 || index_cast<std::size_t>(p[0]) > partitions_)
-      throw InvalidInput(source_ + ": element " + std::to_string(e.tag) +
-                         ": its partitioned volume " + std::to_string(e.entity) +
-                         " is not in one partition of 1.." + std::to_string(partitions_));
+    if (p.size() != 1 || p[0] < 1 || index_cast<std::size_t>(p[0]) > partitions_) return -1;
     return p[0] - 1;
   }
   // One file of a set Gmsh writes with Mesh.PartitionSplitMeshFiles=1 (name_1.msh, ...) holds
@@ -698,7 +695,11 @@ class MshReader {
       volumes.push_back({block, i});
       if (partitioned_) volume_part.push_back(part_of(e));
     }
-    if (partitioned_) check_one_file(volume_part);
+    // The partition is usable when every volume element has one part.
+    const bool parts_known =
+        partitioned_ && std::in_range<int>(partitions_) &&
+        std::none_of(volume_part.begin(), volume_part.end(), [](int p) { return p < 0; });
+    if (parts_known) check_one_file(volume_part);
     std::vector<std::size_t> volume_order(volumes.size());
     std::iota(volume_order.begin(), volume_order.end(), std::size_t{0});
     // A partitioned file lists the elements partition by partition; their tags are the
@@ -734,9 +735,9 @@ class MshReader {
       for (std::size_t k = 0; k < index_cast<std::size_t>(cell.corners); ++k)
         c[k] = node(e, index_cast<std::size_t>(cell.order[k]));
       add_element(model, kind, c, v.block, e.tag);
-      if (partitioned_) part_by_kind[static_cast<std::size_t>(kind)].push_back(volume_part[o]);
+      if (parts_known) part_by_kind[static_cast<std::size_t>(kind)].push_back(volume_part[o]);
     }
-    if (partitioned_ && partition_) {
+    if (parts_known && partition_) {
       partition_->parts = static_cast<int>(partitions_);
       partition_->part.clear();
       for (const auto& parts : part_by_kind)

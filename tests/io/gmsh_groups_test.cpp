@@ -5,6 +5,7 @@
 
 #include <gmsh.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -37,9 +38,10 @@ void write_text(const fs::path& path, const std::string& text) {
 // .msh 4.1 (ASCII or binary): elements then live on partitioned entities. With `groups`, also
 // physical surface 10 "far" (the tet box's face x = 3) and physical curve 20 "edge" (its edge
 // x = 3, y = 0), which the partitions' boundaries cut; `parts` 0: not partitioned. `split`:
-// one file per partition (Mesh.PartitionSplitMeshFiles=1: file_1.msh, ...).
-void partitioned_file(const fs::path& file, bool binary, int parts, bool groups = false,
-                      bool split = false) {
+// one file per partition (Mesh.PartitionSplitMeshFiles=1: file_1.msh, ...). Returns Gmsh's own
+// partition of each volume element (its tag -> the partition's tag - 1).
+std::map<std::int64_t, int> partitioned_file(const fs::path& file, bool binary, int parts,
+                                             bool groups = false, bool split = false) {
   demo::GmshSession session;
   gmsh::model::add("parts");
   // Apart, so that Gmsh puts no pyramids between the hexes' quads and the tets.
@@ -88,6 +90,20 @@ void partitioned_file(const fs::path& file, bool binary, int parts, bool groups 
   gmsh::option::setNumber("Mesh.Binary", binary ? 1 : 0);
   gmsh::option::setNumber("Mesh.PartitionSplitMeshFiles", split ? 1 : 0);
   gmsh::write(file.string());
+  std::map<std::int64_t, int> part_of;
+  gmsh::vectorpair volumes;
+  gmsh::model::getEntities(volumes, 3);
+  for (const auto& [dim, tag] : volumes) {
+    std::vector<int> partitions;
+    gmsh::model::getPartitions(dim, tag, partitions);
+    if (partitions.size() != 1) continue;  // an unpartitioned parent entity
+    std::vector<int> types;
+    std::vector<std::vector<std::size_t>> elements, nodes;
+    gmsh::model::mesh::getElements(types, elements, nodes, dim, tag);
+    for (const auto& of_type : elements)
+      for (std::size_t e : of_type) part_of[static_cast<std::int64_t>(e)] = partitions[0] - 1;
+  }
+  return part_of;
 }
 
 }  // namespace
@@ -128,26 +144,34 @@ TEST_CASE("a partitioned .msh 4.1 is the unpartitioned model, with each element'
     REQUIRE(whole.side_sets.size() == 1);
     REQUIRE(whole.node_sets.size() == 1);
     const fs::path file = dir.path / (binary ? "parts-bin.msh" : "parts.msh");
-    partitioned_file(file, binary, 3, true);
+    const std::map<std::int64_t, int> gmsh_part = partitioned_file(file, binary, 3, true);
     FilePartition partition;
     const Model m = read_gmsh_partitioned(file, {}, &partition);
     CHECK(m.points == whole.points);
-    CHECK(m.hexes.size() == whole.hexes.size());
-    CHECK(m.tets.size() == whole.tets.size());
+    // Element for element in the unpartitioned file's order, with its file tag.
+    CHECK(m.hexes == whole.hexes);
+    CHECK(m.tets == whole.tets);
+    CHECK(m.hex_ids == whole.hex_ids);
+    CHECK(m.tet_ids == whole.tet_ids);
     REQUIRE(m.side_sets.size() == 1);
     CHECK(m.side_sets[0].id == 10);
     CHECK(m.side_sets[0].name == "far");
-    CHECK(m.side_sets[0].sides.size() == whole.side_sets[0].sides.size());
+    CHECK(m.side_sets[0].sides == whole.side_sets[0].sides);
     REQUIRE(m.node_sets.size() == 1);
     CHECK(m.node_sets[0].id == 20);
     CHECK(m.node_sets[0].nodes == whole.node_sets[0].nodes);
     CHECK(partition.parts == 3);
     REQUIRE(partition.part.size() == m.hexes.size() + m.tets.size());
+    // Each element in the partition Gmsh put it in (flat order: hexes, then tets).
+    REQUIRE(gmsh_part.size() == partition.part.size());
     std::map<int, std::size_t> per_part;
-    for (int p : partition.part) ++per_part[p];
+    for (std::size_t e = 0; e < partition.part.size(); ++e) {
+      const std::int64_t tag = e < m.hexes.size() ? m.hex_ids[e] : m.tet_ids[e - m.hexes.size()];
+      REQUIRE(gmsh_part.count(tag) == 1);
+      CHECK(partition.part[e] == gmsh_part.at(tag));
+      ++per_part[partition.part[e]];
+    }
     CHECK(per_part.size() == 3);
-    CHECK(per_part.begin()->first == 0);
-    CHECK(per_part.rbegin()->first == 2);
     FilePartition none;
     read_gmsh_partitioned(whole_file, {}, &none);
     CHECK(none.parts == 0);
