@@ -114,7 +114,7 @@ class SetReader {
     join_elements(model, index_cast<std::size_t>(info[0].global_elements));
     join_sets(model);
     sanitize_names(model);
-    validate(model, set_.base.string());
+    validate(model, set_.name());
     return model;
   }
 
@@ -148,7 +148,7 @@ class SetReader {
     }
     const auto missing = std::find(from.begin(), from.end(), -1);
     if (missing != from.end())
-      throw InvalidInput(set_.base.string() + ": global node " +
+      throw InvalidInput(set_.name() + ": global node " +
                          std::to_string(missing - from.begin() + 1) + " is in no piece of " +
                          std::to_string(pieces_.size()));
     model.node_ids.resize(count);
@@ -173,7 +173,7 @@ class SetReader {
         }
     for (std::size_t g = 0; g < count; ++g)
       if (slot[g].piece < 0)
-        throw InvalidInput(set_.base.string() + ": global element " + std::to_string(g + 1) +
+        throw InvalidInput(set_.name() + ": global element " + std::to_string(g + 1) +
                            " is in no piece of " + std::to_string(pieces_.size()));
     // By kind, then ascending global id.
     element_index_.resize(pieces_.size());
@@ -295,8 +295,7 @@ std::optional<NemesisSet> find_nemesis_set(const fs::path& path) {
 Model read_nemesis_set(const NemesisSet& set, const ReadOptions& options,
                        FilePartition* partition) {
   Model model = SetReader(set, partition).read();
-  options.check_geometry ? check_geometry(model, set.base.string())
-                         : check_points(model, set.base.string());
+  options.check_geometry ? check_geometry(model, set.name()) : check_points(model, set.name());
   return model;
 }
 

@@ -1,10 +1,11 @@
 #pragma once
 // Nemesis input sets: the per-rank Exodus II files of a partitioned mesh (geode_mpi's output,
-// SEACAS decomp's: IN.exo.N.r, r = 0..N-1 zero-padded to the digits of N, each with node and
-// element number maps holding global ids and Nemesis I global counts), read as the one model
-// they cut, with each element's piece as its partition.
+// named as SEACAS decomp names them: IN.exo.N.r, r = 0..N-1 zero-padded to the digits of N, each
+// with node and element number maps holding global ids and Nemesis I global counts), read as the
+// one model they cut, with each element's piece as its partition.
 #include <filesystem>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <geode/io/file_partition.hpp>
@@ -15,6 +16,9 @@ namespace geode::io {
 struct NemesisSet {
   std::filesystem::path base;                // IN.exo
   std::vector<std::filesystem::path> files;  // IN.exo.N.0 .. IN.exo.N.(N-1)
+  // "IN.exo.N.*": how messages about the joined model name the set (IN.exo itself is usually
+  // absent, or another file, such as geode_mpi --join's).
+  std::string name() const { return base.string() + "." + std::to_string(files.size()) + ".*"; }
 };
 
 // The set `path` names: a piece itself (IN.exo.N.r), or IN.exo when no such file exists and

@@ -142,8 +142,7 @@ Model read_model(const std::filesystem::path& path, const ReadOptions& options, 
   if (const auto set = find_nemesis_set(path)) {
     try {
       Model model = read_nemesis_set(*set, options, partition);
-      if (options.check_geometry && check_covering)
-        require_single_covering(model, set->base.string());
+      if (options.check_geometry && check_covering) require_single_covering(model, set->name());
       return model;
     } catch (const std::bad_alloc&) {
       throw out_of_memory_reading(set->files.front());
