@@ -74,7 +74,9 @@ int run(int argc, char** argv, int rank, int size) {
     std::string partitioned_by = size > 1 ? "METIS" : "one rank";
     if (file_partition.parts > 0) {
       options.partition = parallel::ranks_of_parts(file_partition.part, file_partition.parts, size);
-      const std::string parts = "the input's " + std::to_string(file_partition.parts) + " parts";
+      std::string parts = "the input's " + std::to_string(file_partition.parts) + " parts";
+      if (file_partition.parts > size)
+        parts += " joined on " + std::to_string(size) + (size == 1 ? " rank" : " ranks");
       partitioned_by =
           options.partition.empty() ? "METIS (" + parts + " are fewer than the ranks)" : parts;
     }
