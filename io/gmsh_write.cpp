@@ -77,7 +77,13 @@ struct Entity {
   int dim = 0;
   int tag = 0;
   int physical = 0;
-  Point low = Point::Zero(), high = Point::Zero();
+  Point low = Point::Zero(), high = Point::Zero();  // the bounding box; zero while empty
+  bool empty = true;
+  void extend(const Point& p) {
+    low = empty ? p : low.cwiseMin(p);
+    high = empty ? p : high.cwiseMax(p);
+    empty = false;
+  }
 };
 
 struct PhysicalName {
@@ -114,14 +120,8 @@ class MshLayout {
   std::vector<int> side_tags_, node_tags_;
 
   Entity bounded(int dim, int tag, int physical, const std::vector<std::size_t>& nodes) const {
-    Entity e{dim, tag, physical, Point::Zero(), Point::Zero()};
-    if (!nodes.empty()) {
-      e.low = e.high = model.points[nodes.front() - 1];
-      for (std::size_t n : nodes) {
-        e.low = e.low.cwiseMin(model.points[n - 1]);
-        e.high = e.high.cwiseMax(model.points[n - 1]);
-      }
-    }
+    Entity e{dim, tag, physical, Point::Zero(), Point::Zero(), true};
+    for (std::size_t n : nodes) e.extend(model.points[n - 1]);
     return e;
   }
 
@@ -142,16 +142,11 @@ class MshLayout {
       }
     }
     for (auto& [block, list] : by_block) {
-      Entity e{3, block, block, Point::Zero(), Point::Zero()};
-      bool first = true;
+      Entity e{3, block, block, Point::Zero(), Point::Zero(), true};
       for (ElementBlock& b : list) {
         for (Index i : b.elements)
-          for (Index v : element_corners(model, {b.kind, i})) {
-            const Point& p = model.points[index_cast<std::size_t>(v)];
-            e.low = first ? p : e.low.cwiseMin(p);
-            e.high = first ? p : e.high.cwiseMax(p);
-            first = false;
-          }
+          for (Index v : element_corners(model, {b.kind, i}))
+            e.extend(model.points[index_cast<std::size_t>(v)]);
         blocks.push_back(std::move(b));
       }
       entities.push_back(e);
