@@ -35,22 +35,30 @@ refused() {
   fi
 }
 
+# on_1_to_4_ranks INPUT PREFIX REFERENCE: geode_mpi on 1 to 4 ranks (the input's 3 parts as they
+# are, joined on fewer ranks, METIS on more), each joined output REFERENCE after canonical
+# ordering, and the joined files of every rank count the same bytes.
+on_1_to_4_ranks() {
+  local input=$1 prefix=$2 reference=$3 n
+  for n in 1 2 3 4; do
+    "$mpiexec" --oversubscribe -np "$n" "$geode_mpi" conform "$input" -o "$prefix$n.exo" --join \
+      --rings 1 >"$prefix$n.txt"
+    case $n in
+      4) grep -q "partition: METIS (the input's 3 parts are fewer than the ranks)" "$prefix$n.txt" ;;
+      3) grep -q "partition: the input's 3 parts, " "$prefix$n.txt" ;;
+      *) grep -q "partition: the input's 3 parts joined on $n rank" "$prefix$n.txt" ;;
+    esac
+    "$check" same "$reference" "$prefix$n.exo"
+    "$check" ranks "$prefix$n.exo" "$n"
+  done
+  for n in 2 3 4; do cmp "${prefix}1.exo" "$prefix$n.exo"; done
+}
+
 # The partitioned file is the unpartitioned model (as Gmsh writes both): the same serial output.
 "$geode" conform whole.msh -o serial.exo --quiet
 "$geode" conform parts.msh -o serial-parts.exo --quiet
 "$check" same serial.exo serial-parts.exo
-for n in 1 2 3 4; do
-  "$mpiexec" --oversubscribe -np "$n" "$geode_mpi" conform parts.msh -o "out$n.exo" --join \
-    --rings 1 >"run$n.txt"
-  case $n in
-    4) grep -q "partition: METIS (the input's 3 parts are fewer than the ranks)" "run$n.txt" ;;
-    3) grep -q "partition: the input's 3 parts" "run$n.txt" && ! grep -q "joined on" "run$n.txt" ;;
-    *) grep -q "partition: the input's 3 parts joined on $n rank" "run$n.txt" ;;
-  esac
-  "$check" same serial.exo "out$n.exo"
-  "$check" ranks "out$n.exo" "$n"
-done
-for n in 2 3 4; do cmp out1.exo "out$n.exo"; done
+on_1_to_4_ranks parts.msh out serial.exo
 
 # geode_mpi's own output as a Nemesis input set: 3 pieces, named by one piece, and by the base
 # name when no joined file has that name. The set's model is the joined file's in another node
@@ -64,18 +72,7 @@ for n in 2 3 4; do cmp out1.exo "out$n.exo"; done
 mkdir -p set && cp out3.exo.3.* set/
 "$geode" conform set/out3.exo -o diced-base.exo --quiet
 "$check" same diced.exo diced-base.exo
-for n in 1 2 3 4; do
-  "$mpiexec" --oversubscribe -np "$n" "$geode_mpi" conform set/out3.exo -o "nem$n.exo" --join \
-    --rings 1 >"nem$n.txt"
-  case $n in
-    4) grep -q "partition: METIS" "nem$n.txt" ;;
-    3) grep -q "partition: the input's 3 parts" "nem$n.txt" && ! grep -q "joined on" "nem$n.txt" ;;
-    *) grep -q "partition: the input's 3 parts joined on $n rank" "nem$n.txt" ;;
-  esac
-  "$check" same diced.exo "nem$n.exo"
-  "$check" ranks "nem$n.exo" "$n"
-done
-for n in 2 3 4; do cmp nem1.exo "nem$n.exo"; done
+on_1_to_4_ranks set/out3.exo nem diced.exo
 
 # Inconsistent sets, refused naming the file.
 mkdir -p missing && cp out3.exo.3.0 out3.exo.3.2 missing/
