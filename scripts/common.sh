@@ -11,8 +11,12 @@ JOBS=${JOBS:-$(nproc)}
 # ccache keeps compiled objects between runs (and between clones: paths below the root are
 # hashed relative to it, the build directory not at all), so a second build costs little.
 export CCACHE_BASEDIR="$GEODE_ROOT" CCACHE_NOHASHDIR=1
-GEODE_LAUNCHER=()
-command -v ccache >/dev/null 2>&1 && GEODE_LAUNCHER=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+# Set again after geode_install: on a fresh machine ccache is one of the packages it installs.
+geode_launcher() {
+  GEODE_LAUNCHER=()
+  if command -v ccache >/dev/null 2>&1; then GEODE_LAUNCHER=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
+}
+geode_launcher
 
 geode_install() {
   local missing=()
@@ -29,6 +33,7 @@ geode_install() {
     apt-get update -qq
     apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
   fi
+  geode_launcher
 }
 
 # geode_fuzz: the libFuzzer targets of the file readers and the JSON spec reader (tests/fuzz), built with clang in
