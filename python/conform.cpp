@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <sstream>
 
@@ -36,19 +37,32 @@ constexpr std::array<KindKeys, 4> kKindKeys{{
     {primal::ElementKind::kWedge, "wedges", "wedge_block", "wedge_ids"},
 }};
 
+// A block id the files' 32-bit ids can hold; non-positive ones are refused by primal::validate,
+// naming the element the same way.
+void check_block_id(std::int64_t id, const std::string& where) {
+  if (id < std::numeric_limits<int>::min() || id > std::numeric_limits<int>::max())
+    throw InvalidInput(where + ": block id " + std::to_string(id) + " is out of range [1, " +
+                       std::to_string(std::numeric_limits<int>::max()) + "]");
+}
+
 // One kind's arrays appended to the model, each element with its block and file id.
 void add_cells(primal::Model& model, const KindKeys& keys, const py::dict& arrays,
                const std::string& source) {
   const std::string what = source + ": " + keys.cells;
-  const auto blocks = py::object(arrays[keys.block]).cast<std::vector<int>>();
+  // Block ids as 64-bit, so that one too large for the files' 32-bit ids is refused naming the
+  // element, as a reader does, rather than by pybind's cast error.
+  const auto blocks = py::object(arrays[keys.block]).cast<std::vector<std::int64_t>>();
   const auto ids = py::object(arrays[keys.ids]).cast<std::vector<std::int64_t>>();
   auto add = [&](const auto& cells) {
     if (blocks.size() != cells.size() || ids.size() != cells.size())
       throw InvalidInput(what + ": " + std::to_string(blocks.size()) + " block ids and " +
                          std::to_string(ids.size()) + " element ids for " +
                          std::to_string(cells.size()) + " elements");
-    for (std::size_t i = 0; i < cells.size(); ++i)
-      primal::add_element(model, keys.kind, cells[i], blocks[i], ids[i]);
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+      check_block_id(blocks[i], source + ": " + primal::element_kind_name(keys.kind) + " " +
+                                    std::to_string(ids[i]));
+      primal::add_element(model, keys.kind, cells[i], primal::index_cast<int>(blocks[i]), ids[i]);
+    }
   };
   const py::object cells = arrays[keys.cells];
   switch (primal::cell_topology(keys.kind).corners) {
@@ -107,16 +121,20 @@ py::dict model_dict(primal::Model&& model) {
 
 // The model as arrays; conform's options by name, as `geode conform` spells them (with _).
 py::dict conform_arrays(const py::handle& points, const py::dict& cells,
-                        const std::map<int, std::string>& block_names, const py::list& node_sets,
-                        const std::string& source, const std::string& smooth,
-                        const std::string& quality, const std::string& geode_block,
-                        const std::string& buffer_side, double buffer_thickness,
-                        double smooth_target, const py::object& template_box,
-                        const py::object& merge_tolerance, const std::string& relax) {
+                        const std::map<std::int64_t, std::string>& block_names,
+                        const py::list& node_sets, const std::string& source,
+                        const std::string& smooth, const std::string& quality,
+                        const std::string& geode_block, const std::string& buffer_side,
+                        double buffer_thickness, double smooth_target,
+                        const py::object& template_box, const py::object& merge_tolerance,
+                        const std::string& relax) {
   primal::Model model;
   model.points = to_points(points, source + ": points");
   for (const KindKeys& keys : kKindKeys) add_cells(model, keys, cells, source);
-  model.block_names = block_names;
+  for (const auto& [id, name] : block_names) {
+    check_block_id(id, source + ": block name '" + name + "'");
+    model.block_names[primal::index_cast<int>(id)] = name;
+  }
   for (const auto& s : node_sets) {
     const auto d = s.cast<py::dict>();
     primal::NodeSet set;

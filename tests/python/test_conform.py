@@ -73,6 +73,25 @@ def test_conform_arrays_and_sets(half):
     assert len(out.point_sets["x0"]) > len(ends)
 
 
+def test_block_ids_beyond_32_bits_are_refused_by_element(half):
+    # The files hold 32-bit block ids: a larger one is an input error naming the first element
+    # of the block (its 1-based position), not a failed conversion; so is a block name's id.
+    hexes = np.concatenate([c.data for c in half.cells if c.type == "hexahedron"])
+    tets = np.concatenate([c.data for c in half.cells if c.type == "tetra"])
+    cells = [("hexahedron", hexes), ("tetra", tets)]
+    with pytest.raises(geode.InputError, match=r"^mesh: tet {}: block id 2147483648 is out of range"
+                       .format(len(hexes) + 1)):
+        geode.conform(points=half.points, cells=cells, cell_blocks=[5, 2**31])
+    with pytest.raises(geode.InputError, match=r"^mesh: hex 1: block id -2147483649 is out of range"):
+        geode.conform(points=half.points, cells=cells, cell_blocks=[-2**31 - 1, 7])
+    with pytest.raises(geode.InputError, match=r"^mesh: hex 1: block id 0 is not positive"):
+        geode.conform(points=half.points, cells=cells, cell_blocks=[0, 7])
+    named = meshio.Mesh(half.points, half.cells, cell_data=half.cell_data,
+                        field_data={"big": np.array([2**32, 3])})
+    with pytest.raises(geode.InputError, match=r"^mesh: block name 'big': block id 4294967296 is out of range"):
+        geode.conform(named)
+
+
 def test_conform_errors_match_cli(half, tmp_path):
     # A tet-only model (conform takes it) with its first tet inverted, in a Gmsh file: element and
     # node ids are then the module's 1-based numbers, and the two messages must be the same line.
