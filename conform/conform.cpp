@@ -494,49 +494,28 @@ void Conformer::assemble() {
   const primal::Model& lm = layer_.model;
   // Side sets read the children in diced numbers: taken before the children move.
   side_sets_ = primal::diced_side_sets(lm, diced_, 0, res_.diced_hexes + res_.geode_hexes);
-  const std::size_t total = diced_.hex_children.size() +
-                            primal::index_cast<std::size_t>(res_.geode_hexes) +
-                            diced_.tet_children.size() + diced_.wedge_children.size();
-  std::vector<std::array<Index, 8>> hexes = std::move(diced_.hex_children);
-  hexes.reserve(total);
-  std::vector<int> block;
-  block.reserve(total);
-  for (Index parent : diced_.hex_parent)
-    block.push_back(primal::block_of(lm, {primal::ElementKind::kHex, parent}));
-  diced_parent_ = std::move(diced_.hex_parent);  // per output diced hex: its input hex
-  diced_.hex_parent = {};
-  geode_first_.reserve(nb + 1);
-  for (std::size_t b = 0; b < nb; ++b) {
-    geode_first_.push_back(primal::index_cast(hexes.size()));
-    const int id = blocks_.geode_id ? blocks_.geode_id : primal::block_of(lm, carved_from_[b]);
-    for (const auto& h : ref(b).tpl.hex.hexes) {
-      std::array<Index, 8> o{};
-      for (int c = 0; c < 8; ++c) o[c] = inst_global_[b][h[c]];
-      hexes.push_back(o), block.push_back(id);
-    }
-  }
-  geode_first_.push_back(primal::index_cast(hexes.size()));
-  inst_global_ = {};
-  hexes.insert(hexes.end(), diced_.tet_children.begin(), diced_.tet_children.end());
-  diced_.tet_children = {};
-  for (Index parent : diced_.tet_parent)
-    block.push_back(primal::block_of(lm, {primal::ElementKind::kTet, parent}));
-  diced_.tet_parent = {};
-  hexes.insert(hexes.end(), diced_.wedge_children.begin(), diced_.wedge_children.end());
-  diced_.wedge_children = {};
-  for (Index parent : diced_.wedge_parent)
-    block.push_back(primal::block_of(lm, {primal::ElementKind::kWedge, parent}));
-  diced_.wedge_parent = {};
-  diced_.shared = primal::KeyMap<4>();
-  // Nodes numbered in order of first use by the hexes (unused ones dropped).
+  // Nodes numbered in order of first use by the output hexes (unused ones dropped), read off
+  // the children where they are, so that the node sets (which need the origins) are made and
+  // the origins freed before the output's connectivity is built beside the children.
   std::vector<Index> renum(diced_.points.size(), kInvalidIndex);
   Index used = 0;
-  for (auto& h : hexes)
-    for (Index& v : h) {
+  auto number = [&](const std::array<Index, 8>& h) {
+    for (Index v : h) {
       Index& r = renum[primal::index_cast<std::size_t>(v)];
       if (r == kInvalidIndex) r = used++;
-      v = r;
     }
+  };
+  auto instance = [&](std::size_t b, const std::array<Index, 8>& h) {
+    std::array<Index, 8> o{};
+    for (int c = 0; c < 8; ++c) o[c] = inst_global_[b][h[c]];
+    return o;
+  };
+  for (const auto& h : diced_.hex_children) number(h);
+  for (std::size_t b = 0; b < nb; ++b)
+    for (const auto& h : ref(b).tpl.hex.hexes) number(instance(b, h));
+  for (const auto& h : diced_.tet_children) number(h);
+  for (const auto& h : diced_.wedge_children) number(h);
+  diced_.shared = primal::KeyMap<4>();
   // A node set keeps its interface nodes' tet-side duplicates too (the layer model's sets hold
   // the hex-side copies only), so that a set on the boundary loses no node along the interface.
   primal::Model sets;
@@ -551,6 +530,48 @@ void Conformer::assemble() {
   }
   node_sets_ = primal::diced_node_sets(sets, diced_, renum);
   diced_.origin = {};
+
+  // The output hexes in output numbers, each part's children freed once copied.
+  const std::size_t total = diced_.hex_children.size() +
+                            primal::index_cast<std::size_t>(res_.geode_hexes) +
+                            diced_.tet_children.size() + diced_.wedge_children.size();
+  std::vector<std::array<Index, 8>> hexes;
+  hexes.reserve(total);
+  std::vector<int> block;
+  block.reserve(total);
+  auto append = [&](std::vector<std::array<Index, 8>>& children) {
+    for (const auto& h : children) {
+      std::array<Index, 8> o{};
+      for (int c = 0; c < 8; ++c) o[c] = renum[primal::index_cast<std::size_t>(h[c])];
+      hexes.push_back(o);
+    }
+    children = {};
+  };
+  append(diced_.hex_children);
+  for (Index parent : diced_.hex_parent)
+    block.push_back(primal::block_of(lm, {primal::ElementKind::kHex, parent}));
+  diced_parent_ = std::move(diced_.hex_parent);  // per output diced hex: its input hex
+  diced_.hex_parent = {};
+  geode_first_.reserve(nb + 1);
+  for (std::size_t b = 0; b < nb; ++b) {
+    geode_first_.push_back(primal::index_cast(hexes.size()));
+    const int id = blocks_.geode_id ? blocks_.geode_id : primal::block_of(lm, carved_from_[b]);
+    for (const auto& h : ref(b).tpl.hex.hexes) {
+      std::array<Index, 8> o = instance(b, h);
+      for (Index& v : o) v = renum[primal::index_cast<std::size_t>(v)];
+      hexes.push_back(o), block.push_back(id);
+    }
+  }
+  geode_first_.push_back(primal::index_cast(hexes.size()));
+  inst_global_ = {};
+  append(diced_.tet_children);
+  for (Index parent : diced_.tet_parent)
+    block.push_back(primal::block_of(lm, {primal::ElementKind::kTet, parent}));
+  diced_.tet_parent = {};
+  append(diced_.wedge_children);
+  for (Index parent : diced_.wedge_parent)
+    block.push_back(primal::block_of(lm, {primal::ElementKind::kWedge, parent}));
+  diced_.wedge_parent = {};
   // The points permuted in place: follow each cycle of the renumbering (dropped nodes go to
   // the tail, then are cut off).
   std::vector<Point>& points = diced_.points;
@@ -566,8 +587,9 @@ void Conformer::assemble() {
       }
   }
   renum = {};
+  // No shrink_to_fit: dice_model reserved about what it made, and a shrinking copy of every
+  // point would be the run's peak.
   points.resize(primal::index_cast<std::size_t>(used));
-  points.shrink_to_fit();
   mesh_.points = std::move(points);
   mesh_.hexes = std::move(hexes);
   mesh_.block = std::move(block);

@@ -89,14 +89,12 @@ struct Diced {
   std::vector<Index> parent;
 };
 
-// The dicing engine shared by the four element types. `dim` tells whether a support that is
-// neither a corner, an edge nor the whole element is a face (3D).
+// The dicing engine shared by the four element types, without points: the edge and face
+// supports numbered, the children in dice()'s node numbers (V corners, E edges, F faces, C
+// centres). `what` names the element kind in messages.
 template <std::size_t NP, std::size_t NChildren, std::size_t NC>
-Diced<std::array<Index, NC>> dice_elements(const std::vector<Point>& points,
-                                           const std::vector<std::array<Index, NP>>& elements,
-                                           const ChildTable<NChildren, NC>& table,
-                                           const char* what) {
-  const auto nv = index_cast(points.size());
+DicedCellsOf<NC> dice_topology(Index nv, const std::vector<std::array<Index, NP>>& elements,
+                               const ChildTable<NChildren, NC>& table, const char* what) {
   for (std::size_t e = 0; e < elements.size(); ++e) {
     for (std::size_t c = 0; c < NP; ++c) {
       const Index v = elements[e][c];
@@ -125,73 +123,40 @@ Diced<std::array<Index, NC>> dice_elements(const std::vector<Point>& points,
   const std::size_t ns = supports.size();
 
   // Pass 1: number edges and faces in order of first appearance; remember each element's.
-  KeyMap<4> edge_id(elements.size() * 2), face_id(elements.size() * 2);
-  std::vector<FaceKey> edge_keys, face_keys;
+  DicedCellsOf<NC> out;
   std::vector<Index> element_ids(elements.size() * ns);  // per element and slot: edge or face id
-  auto key_of = [&](const std::array<Index, NP>& elem, Support s) {
-    std::array<Index, 4> nodes{};
-    std::size_t n = 0;
-    for (std::size_t q = 0; q < NP; ++q) {
-      if (s & (1u << q)) nodes[n++] = elem[q];
+  {
+    KeyMap<4> edge_id(elements.size() * 2), face_id(elements.size() * 2);
+    auto key_of = [&](const std::array<Index, NP>& elem, Support s) {
+      std::array<Index, 4> nodes{};
+      std::size_t n = 0;
+      for (std::size_t q = 0; q < NP; ++q) {
+        if (s & (1u << q)) nodes[n++] = elem[q];
+      }
+      FaceKey k = n == 2 ? FaceKey{std::min(nodes[0], nodes[1]), std::max(nodes[0], nodes[1]),
+                                   kInvalidIndex, kInvalidIndex}
+                         : face_key(std::span<const Index>(nodes.data(), n));
+      return k;
+    };
+    for (std::size_t e = 0; e < elements.size(); ++e) {
+      for (std::size_t i = 0; i < ns; ++i) {
+        const Support s = supports[i];
+        const FaceKey k = key_of(elements[e], s);
+        const bool edge = std::popcount(s) == 2;
+        auto& ids = edge ? edge_id : face_id;
+        auto& keys = edge ? out.edges : out.faces;
+        const auto [id, inserted] = ids.try_emplace(k, index_cast(keys.size()));
+        if (inserted) keys.push_back(k);
+        element_ids[e * ns + i] = *id;
+      }
     }
-    FaceKey k = n == 2 ? FaceKey{std::min(nodes[0], nodes[1]), std::max(nodes[0], nodes[1]),
-                                 kInvalidIndex, kInvalidIndex}
-                       : face_key(std::span<const Index>(nodes.data(), n));
-    return k;
-  };
-  for (std::size_t e = 0; e < elements.size(); ++e) {
-    for (std::size_t i = 0; i < ns; ++i) {
-      const Support s = supports[i];
-      const FaceKey k = key_of(elements[e], s);
-      const bool edge = std::popcount(s) == 2;
-      auto& ids = edge ? edge_id : face_id;
-      auto& keys = edge ? edge_keys : face_keys;
-      const auto [id, inserted] = ids.try_emplace(k, index_cast(keys.size()));
-      if (inserted) keys.push_back(k);
-      element_ids[e * ns + i] = *id;
-    }
   }
-  const auto ne = index_cast(edge_keys.size());
-  const auto nf = index_cast(face_keys.size());
-
-  Diced<std::array<Index, NC>> out;
-  const std::size_t total = points.size() + edge_keys.size() + face_keys.size() + elements.size();
-  out.points.reserve(total);
-  out.origin.reserve(total);
-  out.elements.reserve(elements.size() * NChildren);
-  out.parent.reserve(elements.size() * NChildren);
-  out.points = points;
-  out.origin.resize(points.size());
-  for (Index v = 0; v < nv; ++v) out.origin[v].nodes[0] = v;
-  auto centroid = [&](const FaceKey& k) {
-    Point p = Point::Zero();
-    int n = 0;
-    for (Index v : k) {
-      if (v == kInvalidIndex) break;
-      p += points[v];
-      ++n;
-    }
-    return Point(p / n);
-  };
-  for (const auto& k : edge_keys) {
-    out.points.push_back(centroid(k));
-    out.origin.push_back(NodeOrigin{NodeOriginKind::kEdge, k, kInvalidIndex});
-  }
-  for (const auto& k : face_keys) {
-    out.points.push_back(centroid(k));
-    out.origin.push_back(NodeOrigin{NodeOriginKind::kFace, k, kInvalidIndex});
-  }
-  for (std::size_t e = 0; e < elements.size(); ++e) {
-    Point p = Point::Zero();
-    for (Index v : elements[e]) p += points[v];
-    out.points.push_back(p / static_cast<double>(NP));
-    NodeOrigin o;
-    o.kind = NodeOriginKind::kCell;
-    o.element = index_cast(e);
-    out.origin.push_back(o);
-  }
+  const auto ne = index_cast(out.edges.size());
+  const auto nf = index_cast(out.faces.size());
 
   // Pass 2: children.
+  out.children.reserve(elements.size() * NChildren);
+  out.parent.reserve(elements.size() * NChildren);
   for (std::size_t e = 0; e < elements.size(); ++e) {
     const auto& elem = elements[e];
     for (std::size_t ch = 0; ch < NChildren; ++ch) {
@@ -208,10 +173,47 @@ Diced<std::array<Index, NC>> dice_elements(const std::vector<Point>& points,
           c[k] = count == 2 ? nv + id : nv + ne + id;
         }
       }
-      out.elements.push_back(c);
+      out.children.push_back(c);
       out.parent.push_back(index_cast(e));
     }
   }
+  return out;
+}
+
+// dice_topology with the nodes placed: input points as they are, each edge, face and element
+// node at the centroid of its origin (origin_centroid, corner_centroid).
+template <std::size_t NP, std::size_t NChildren, std::size_t NC>
+Diced<std::array<Index, NC>> dice_elements(const std::vector<Point>& points,
+                                           const std::vector<std::array<Index, NP>>& elements,
+                                           const ChildTable<NChildren, NC>& table,
+                                           const char* what) {
+  const auto nv = index_cast(points.size());
+  DicedCellsOf<NC> cells = dice_topology(nv, elements, table, what);
+  Diced<std::array<Index, NC>> out;
+  const std::size_t total =
+      points.size() + cells.edges.size() + cells.faces.size() + elements.size();
+  out.points.reserve(total);
+  out.origin.reserve(total);
+  out.points = points;
+  out.origin.resize(points.size());
+  for (Index v = 0; v < nv; ++v) out.origin[v].nodes[0] = v;
+  for (const auto& k : cells.edges) {
+    out.points.push_back(origin_centroid(points, k));
+    out.origin.push_back(NodeOrigin{NodeOriginKind::kEdge, k, kInvalidIndex});
+  }
+  for (const auto& k : cells.faces) {
+    out.points.push_back(origin_centroid(points, k));
+    out.origin.push_back(NodeOrigin{NodeOriginKind::kFace, k, kInvalidIndex});
+  }
+  for (std::size_t e = 0; e < elements.size(); ++e) {
+    out.points.push_back(corner_centroid(points, elements[e]));
+    NodeOrigin o;
+    o.kind = NodeOriginKind::kCell;
+    o.element = index_cast(e);
+    out.origin.push_back(o);
+  }
+  out.elements = std::move(cells.children);
+  out.parent = std::move(cells.parent);
   return out;
 }
 
@@ -249,6 +251,25 @@ const DicingTable8& hex_dicing_table() {
 const DicingTable4& tet_dicing_table() {
   static const DicingTable4 table = simplex_children<3>();
   return table;
+}
+
+Point corner_centroid(std::span<const Point> points, std::span<const Index> corners) {
+  Point p = Point::Zero();
+  for (Index v : corners) p += points[index_cast<std::size_t>(v)];
+  return p / static_cast<double>(corners.size());
+}
+
+Point origin_centroid(std::span<const Point> points, const FaceKey& key) {
+  const auto n = std::find(key.begin(), key.end(), kInvalidIndex) - key.begin();
+  return corner_centroid(points, std::span<const Index>(key.data(), index_cast<std::size_t>(n)));
+}
+
+DicedCells dice_cells(Index nodes, const std::vector<std::array<Index, 8>>& hexes) {
+  return dice_topology(nodes, hexes, hex_dicing_table(), "hex");
+}
+
+DicedCells dice_cells(Index nodes, const std::vector<std::array<Index, 4>>& tets) {
+  return dice_topology(nodes, tets, tet_dicing_table(), "tet");
 }
 
 DicedHexMesh dice(const HexMesh& mesh) {

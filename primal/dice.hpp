@@ -41,6 +41,25 @@ struct DicedQuadMesh {
   std::vector<Index> parent;
 };
 
+// dice()'s children without its points and origins, for callers that number and place the
+// diced nodes themselves (dice_model): children in dice()'s node numbers (above), V being the
+// `nodes` passed.
+template <std::size_t NC>
+struct DicedCellsOf {
+  std::vector<FaceKey> edges;  // per edge node (V, V + 1, ...): its 2 nodes, ascending, padded
+  std::vector<FaceKey> faces;  // per face node (after the edges): its 3 or 4 nodes, ascending
+  std::vector<std::array<Index, NC>> children;
+  std::vector<Index> parent;  // per child: the input element
+};
+using DicedCells = DicedCellsOf<8>;
+DicedCells dice_cells(Index nodes, const std::vector<std::array<Index, 8>>& hexes);
+DicedCells dice_cells(Index nodes, const std::vector<std::array<Index, 4>>& tets);
+
+// Where dice() places a node: the centroid of the corners (in their order: an element's
+// centre), or of an edge or face node's origin nodes (a padded FaceKey).
+Point corner_centroid(std::span<const Point> points, std::span<const Index> corners);
+Point origin_centroid(std::span<const Point> points, const FaceKey& key);
+
 // Throw geode::InvalidInput naming the element if a node number is out of range.
 DicedHexMesh dice(const HexMesh& mesh);    // 8 per hex; child c has parent corner c as corner c
 DicedHexMesh dice(const TetMesh& mesh);    // 4 per tet; child c has parent corner c as corner 0

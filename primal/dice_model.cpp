@@ -333,6 +333,13 @@ DicedModel dice_model(const Model& model, std::span<const char> shareable) {
                        ": pyramids are not diced; split them into tets first (split_pyramids)");
   const Index V = index_cast(model.points.size());
   DicedModel out;
+  // Room for the diced nodes, so that no doubling copies them at the run's peak: a connected
+  // hex part makes about 7 new nodes per hex, a tet part about 4.2 per tet (V + E + F + T with
+  // E ~ V + T, F ~ 2T), a wedge at most 16. Capacity never touched is never resident.
+  const std::size_t room = model.points.size() + 7 * model.hexes.size() + 5 * model.tets.size() +
+                           16 * model.wedges.size();
+  out.points.reserve(room);
+  out.origin.reserve(room);
   out.points = model.points;
   out.origin.resize(V);
   for (Index v = 0; v < V; ++v) out.origin[v] = {v, kInvalidIndex, kInvalidIndex, kInvalidIndex};
@@ -357,41 +364,39 @@ DicedModel dice_model(const Model& model, std::span<const char> shareable) {
       if (v != kInvalidIndex && !share[v]) return false;
     return true;
   };
-  // Diced node -> global node, merging by origin where both parts (or the caller) may meet it.
-  auto global_of = [&](const DicedHexMesh& d) {
-    std::vector<Index> g(d.mesh.points.size());
-    for (std::size_t i = 0; i < g.size(); ++i) {
-      if (index_cast(i) < V) {
-        g[i] = index_cast(i);
-        continue;
-      }
-      const NodeOrigin& o = d.origin[i];
-      if (o.kind == NodeOriginKind::kCell) {
-        g[i] = out.add_node(d.mesh.points[i]);
-        continue;
-      }
-      const FaceKey key = normalized_origin(o.nodes);
-      if (!may_meet(key)) {
-        g[i] = out.add_node(d.mesh.points[i], key);
-        continue;
-      }
-      auto [id, inserted] = out.shared.try_emplace(key, kInvalidIndex);
-      if (inserted) *id = out.add_node(d.mesh.points[i], key);
-      g[i] = *id;
-    }
-    return g;
-  };
-  auto take = [&](DicedHexMesh d, std::vector<std::array<Index, 8>>& children,
+  // Each part diced without building its diced mesh (dice_cells): its edge, face and centre
+  // nodes are made here in dice()'s order and at dice()'s places, merged by origin where both
+  // parts (or the caller) may meet them; the children are renumbered in place. What a part
+  // needs beyond the output is its edge and face keys and one number per diced node.
+  auto take = [&](const auto& elements, std::vector<std::array<Index, 8>>& children,
                   std::vector<Index>& parent) {
-    const std::vector<Index> g = global_of(d);
-    d.mesh.points = {}, d.origin = {};
-    children.resize(d.mesh.hexes.size());
-    for (std::size_t c = 0; c < children.size(); ++c)
-      for (int k = 0; k < 8; ++k) children[c][k] = g[d.mesh.hexes[c][k]];
+    DicedCells d = dice_cells(V, elements);
+    std::vector<Index> g(index_cast<std::size_t>(V) + d.edges.size() + d.faces.size() +
+                         elements.size());
+    for (Index v = 0; v < V; ++v) g[index_cast<std::size_t>(v)] = v;
+    std::size_t next = index_cast<std::size_t>(V);
+    for (const auto* keys : {&d.edges, &d.faces}) {
+      for (const FaceKey& k : *keys) {
+        const FaceKey key = normalized_origin(k);
+        const Point p = origin_centroid(model.points, key);
+        if (!may_meet(key)) {
+          g[next++] = out.add_node(p, key);
+          continue;
+        }
+        auto [id, inserted] = out.shared.try_emplace(key, kInvalidIndex);
+        if (inserted) *id = out.add_node(p, key);
+        g[next++] = *id;
+      }
+    }
+    d.edges = {}, d.faces = {};
+    for (const auto& e : elements) g[next++] = out.add_node(corner_centroid(model.points, e));
+    for (auto& c : d.children)
+      for (Index& v : c) v = g[index_cast<std::size_t>(v)];
+    children = std::move(d.children);
     parent = std::move(d.parent);
   };
-  take(dice(hex_part(model)), out.hex_children, out.hex_parent);
-  take(dice(tet_part(model)), out.tet_children, out.tet_parent);
+  take(model.hexes, out.hex_children, out.hex_parent);
+  take(model.tets, out.tet_children, out.tet_parent);
   dice_wedges(model, out);
   return out;
 }
