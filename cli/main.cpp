@@ -1,5 +1,6 @@
 // geode: all-hex meshing through the dual (the Spatial Twist Continuum).
 #include <execinfo.h>
+#include <malloc.h>
 
 #include <iostream>
 #include <memory>
@@ -58,6 +59,11 @@ int main(int argc, char** argv) {
     void* frame[1];
     (void)backtrace(frame, 1);
   }
+  // Arrays of a MiB or more get pages of their own, given back to the system when freed.
+  // glibc's default threshold rises to 32 MiB after the first such array is freed, and the
+  // arrays a stage frees then stay resident through the next: ~20 MB of the peak on the
+  // n = 36 Delaunay model (docs/results.md, "Memory").
+  mallopt(M_MMAP_THRESHOLD, 1 << 20);
   CLI::App app{
       "geode: all-hex transition templates derived from completed dual sheet arrangements, and "
       "the\n"
