@@ -594,6 +594,11 @@ void Conformer::assemble() {
   mesh_.hexes = std::move(hexes);
   mesh_.block = std::move(block);
   diced_ = primal::DicedModel();
+  // The stages after this one read the buffer hexes only (their quads), not the layer's model
+  // or the interface: freed before smoothing, verification and writing add their own.
+  layer_.model = primal::Model();
+  layer_.top_node = {};
+  interface_ = primal::Interface();
   res_.min_scaled_jacobian_before_smoothing = measure();
 }
 
