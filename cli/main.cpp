@@ -61,7 +61,7 @@ int main(int argc, char** argv) {
   }
   // Arrays of a MiB or more get pages of their own, given back to the system when freed.
   // glibc's default threshold rises to 32 MiB after the first such array is freed, and the
-  // arrays a stage frees then stay resident through the next: ~20 MB of the peak on the
+  // arrays a stage frees then stay resident through the next: 14 MB of the peak on the
   // n = 36 Delaunay model (docs/results.md, "Memory").
   mallopt(M_MMAP_THRESHOLD, 1 << 20);
   CLI::App app{
