@@ -120,6 +120,7 @@ class Conformer {
     const auto t_start = Clock::now();
     find_interface();
     insert_buffer();
+    build_references();
     dice_and_merge();
     place_templates();
     match_sides();
@@ -145,6 +146,7 @@ class Conformer {
   void find_interface();
   std::vector<double> local_minima(const std::vector<double>& tet) const;
   void insert_buffer();
+  void build_references();
   void dice_and_merge();
   void place_templates();
   void match_sides();
@@ -331,8 +333,35 @@ void Conformer::insert_buffer() {
       std::to_string(layer_.report.min_scaled_jacobian) + took());
 }
 
+// The reference templates the buffer hexes use, built in parallel (each once per process);
+// the four-triangle one only when some buffer hex needs it (it costs time). Before dicing, so
+// that dicing knows how many hexes the output will hold.
+void Conformer::build_references() {
+  if (layer_.hexes.empty()) return;  // no interface: no template
+  const bool any_four = std::any_of(layer_.hexes.begin(), layer_.hexes.end(),
+                                    [](const BufferHex& b) { return b.centre != kInvalidIndex; });
+  tbb::parallel_invoke(
+      [&] {
+        refs_[0] = &reference_template(options_.template_box, {4, 6});
+      },
+      [&] {
+        refs_[1] = &reference_template(options_.template_box, {5, 7});
+      },
+      [&] {
+        if (any_four) refs_[2] = &reference_template_four_triangles(options_.template_box);
+      });
+  res_.template_min_scaled_jacobian =
+      std::min(refs_[0]->min_scaled_jacobian, refs_[1]->min_scaled_jacobian);
+  if (any_four)
+    res_.template_min_scaled_jacobian =
+        std::min(res_.template_min_scaled_jacobian, refs_[2]->min_scaled_jacobian);
+}
+
 // Both parts diced over the layer model's point array, nodes merged by origin; the buffer
-// hex corners are shareable so that template nodes find their diced nodes by origin.
+// hex corners are shareable so that template nodes find their diced nodes by origin. The tet
+// children get room for every other output hex: assembly puts the hex children and the
+// templates in front of them and the wedge children after, without a copy of the tet
+// children (the largest part of most models) beside the output's connectivity.
 void Conformer::dice_and_merge() {
   t0_ = Clock::now();
   std::vector<char> shareable(layer_.model.points.size(), 0);
@@ -340,7 +369,9 @@ void Conformer::dice_and_merge() {
     for (Index v : b.corners) shareable[v] = 1;
     if (b.centre != kInvalidIndex) shareable[b.centre] = 1;
   }
-  diced_ = primal::dice_model(layer_.model, shareable);
+  std::size_t room = 8 * layer_.model.hexes.size() + 6 * layer_.model.wedges.size();
+  for (std::size_t b = 0; b < layer_.hexes.size(); ++b) room += ref(b).tpl.hex.hexes.size();
+  diced_ = primal::dice_model(layer_.model, shareable, room);
   res_.diced_hexes = primal::index_cast(diced_.hex_children.size());
   res_.diced_tet_hexes = primal::index_cast(diced_.tet_children.size());
   res_.diced_wedge_hexes = primal::index_cast(diced_.wedge_children.size());
@@ -368,26 +399,7 @@ bool Conformer::verify_locally() const {
 // new nodes, side-face nodes disjoint-sets items merged across shared faces by match_sides.
 void Conformer::place_templates() {
   t0_ = Clock::now();
-  // The four-triangle template only when some buffer hex needs it (it costs time); the
-  // templates built in parallel (each once per process).
   if (layer_.hexes.empty()) return;  // no interface: no template
-  const bool any_four = std::any_of(layer_.hexes.begin(), layer_.hexes.end(),
-                                    [](const BufferHex& b) { return b.centre != kInvalidIndex; });
-  tbb::parallel_invoke(
-      [&] {
-        refs_[0] = &reference_template(options_.template_box, {4, 6});
-      },
-      [&] {
-        refs_[1] = &reference_template(options_.template_box, {5, 7});
-      },
-      [&] {
-        if (any_four) refs_[2] = &reference_template_four_triangles(options_.template_box);
-      });
-  res_.template_min_scaled_jacobian =
-      std::min(refs_[0]->min_scaled_jacobian, refs_[1]->min_scaled_jacobian);
-  if (any_four)
-    res_.template_min_scaled_jacobian =
-        std::min(res_.template_min_scaled_jacobian, refs_[2]->min_scaled_jacobian);
   const primal::Model& lm = layer_.model;
   const std::size_t nb = layer_.hexes.size();
   inst_global_.assign(nb, {});
@@ -483,8 +495,8 @@ void Conformer::match_sides() {
 
 // The hexes by block in ascending id, unused nodes dropped, node and side sets carried over
 // (they depend only on the numbering). Memory: the output is built out of the dicing data,
-// not beside them: the diced hex children become the output's hex array, each dicing array is
-// released as soon as it is consumed, and the nodes are renumbered in place (no second copy
+// not beside them: the tet children's array becomes the output's hex array, each dicing array
+// is released as soon as it is consumed, and the nodes are renumbered in place (no second copy
 // of the output mesh); the smoothing and verification that follow need room of their own.
 void Conformer::assemble() {
   const std::size_t nb = layer_.hexes.size();
@@ -531,44 +543,56 @@ void Conformer::assemble() {
   node_sets_ = primal::diced_node_sets(sets, diced_, renum);
   diced_.origin = {};
 
-  // The output hexes in output numbers, each part's children freed once copied.
+  // The output hexes in output numbers: hex children, templates, tet children, wedge children.
+  // The tet children are renumbered where they are and the others put around them, in the
+  // room dicing left (dice_and_merge), so that no copy of them is made beside the output.
   const std::size_t total = diced_.hex_children.size() +
                             primal::index_cast<std::size_t>(res_.geode_hexes) +
                             diced_.tet_children.size() + diced_.wedge_children.size();
+  const std::size_t front =
+      diced_.hex_children.size() + primal::index_cast<std::size_t>(res_.geode_hexes);
+  auto renumbered = [&](std::array<Index, 8> h) {
+    for (Index& v : h) v = renum[primal::index_cast<std::size_t>(v)];
+    return h;
+  };
   std::vector<std::array<Index, 8>> hexes;
-  hexes.reserve(total);
+  const bool in_place = diced_.tet_children.capacity() >= total;
+  if (in_place) {
+    for (auto& h : diced_.tet_children) h = renumbered(h);
+    hexes = std::move(diced_.tet_children);
+    hexes.insert(hexes.begin(), front, std::array<Index, 8>{});  // within capacity: no copy
+  } else {
+    hexes.reserve(total);
+    hexes.resize(front);
+  }
   std::vector<int> block;
   block.reserve(total);
-  auto append = [&](std::vector<std::array<Index, 8>>& children) {
-    for (const auto& h : children) {
-      std::array<Index, 8> o{};
-      for (int c = 0; c < 8; ++c) o[c] = renum[primal::index_cast<std::size_t>(h[c])];
-      hexes.push_back(o);
-    }
-    children = {};
-  };
-  append(diced_.hex_children);
+  std::size_t at = 0;
+  for (const auto& h : diced_.hex_children) hexes[at++] = renumbered(h);
+  diced_.hex_children = {};
   for (Index parent : diced_.hex_parent)
     block.push_back(primal::block_of(lm, {primal::ElementKind::kHex, parent}));
   diced_parent_ = std::move(diced_.hex_parent);  // per output diced hex: its input hex
   diced_.hex_parent = {};
   geode_first_.reserve(nb + 1);
   for (std::size_t b = 0; b < nb; ++b) {
-    geode_first_.push_back(primal::index_cast(hexes.size()));
+    geode_first_.push_back(primal::index_cast(at));
     const int id = blocks_.geode_id ? blocks_.geode_id : primal::block_of(lm, carved_from_[b]);
     for (const auto& h : ref(b).tpl.hex.hexes) {
-      std::array<Index, 8> o = instance(b, h);
-      for (Index& v : o) v = renum[primal::index_cast<std::size_t>(v)];
-      hexes.push_back(o), block.push_back(id);
+      hexes[at++] = renumbered(instance(b, h));
+      block.push_back(id);
     }
   }
-  geode_first_.push_back(primal::index_cast(hexes.size()));
+  geode_first_.push_back(primal::index_cast(at));
   inst_global_ = {};
-  append(diced_.tet_children);
+  if (!in_place)
+    for (const auto& h : diced_.tet_children) hexes.push_back(renumbered(h));
+  diced_.tet_children = {};
   for (Index parent : diced_.tet_parent)
     block.push_back(primal::block_of(lm, {primal::ElementKind::kTet, parent}));
   diced_.tet_parent = {};
-  append(diced_.wedge_children);
+  for (const auto& h : diced_.wedge_children) hexes.push_back(renumbered(h));
+  diced_.wedge_children = {};
   for (Index parent : diced_.wedge_parent)
     block.push_back(primal::block_of(lm, {primal::ElementKind::kWedge, parent}));
   diced_.wedge_parent = {};

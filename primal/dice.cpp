@@ -91,10 +91,11 @@ struct Diced {
 
 // The dicing engine shared by the four element types, without points: the edge and face
 // supports numbered, the children in dice()'s node numbers (V corners, E edges, F faces, C
-// centres). `what` names the element kind in messages.
+// centres). `what` names the element kind in messages; `room`: dice_cells'.
 template <std::size_t NP, std::size_t NChildren, std::size_t NC>
 DicedCellsOf<NC> dice_topology(Index nv, const std::vector<std::array<Index, NP>>& elements,
-                               const ChildTable<NChildren, NC>& table, const char* what) {
+                               const ChildTable<NChildren, NC>& table, const char* what,
+                               std::size_t room = 0) {
   for (std::size_t e = 0; e < elements.size(); ++e) {
     for (std::size_t c = 0; c < NP; ++c) {
       const Index v = elements[e][c];
@@ -155,7 +156,7 @@ DicedCellsOf<NC> dice_topology(Index nv, const std::vector<std::array<Index, NP>
   const auto nf = index_cast(out.faces.size());
 
   // Pass 2: children.
-  out.children.reserve(elements.size() * NChildren);
+  out.children.reserve(elements.size() * NChildren + room);
   out.parent.reserve(elements.size() * NChildren);
   for (std::size_t e = 0; e < elements.size(); ++e) {
     const auto& elem = elements[e];
@@ -264,12 +265,14 @@ Point origin_centroid(std::span<const Point> points, const FaceKey& key) {
   return corner_centroid(points, std::span<const Index>(key.data(), index_cast<std::size_t>(n)));
 }
 
-DicedCells dice_cells(Index nodes, const std::vector<std::array<Index, 8>>& hexes) {
-  return dice_topology(nodes, hexes, hex_dicing_table(), "hex");
+DicedCells dice_cells(Index nodes, const std::vector<std::array<Index, 8>>& hexes,
+                      std::size_t room) {
+  return dice_topology(nodes, hexes, hex_dicing_table(), "hex", room);
 }
 
-DicedCells dice_cells(Index nodes, const std::vector<std::array<Index, 4>>& tets) {
-  return dice_topology(nodes, tets, tet_dicing_table(), "tet");
+DicedCells dice_cells(Index nodes, const std::vector<std::array<Index, 4>>& tets,
+                      std::size_t room) {
+  return dice_topology(nodes, tets, tet_dicing_table(), "tet", room);
 }
 
 DicedHexMesh dice(const HexMesh& mesh) {

@@ -43,7 +43,8 @@ struct DicedQuadMesh {
 
 // dice()'s children without its points and origins, for callers that number and place the
 // diced nodes themselves (dice_model): children in dice()'s node numbers (above), V being the
-// `nodes` passed.
+// `nodes` passed. `room`: capacity in `children` for that many more, which the caller adds
+// without a copy of the children.
 template <std::size_t NC>
 struct DicedCellsOf {
   std::vector<FaceKey> edges;  // per edge node (V, V + 1, ...): its 2 nodes, ascending, padded
@@ -52,8 +53,10 @@ struct DicedCellsOf {
   std::vector<Index> parent;  // per child: the input element
 };
 using DicedCells = DicedCellsOf<8>;
-DicedCells dice_cells(Index nodes, const std::vector<std::array<Index, 8>>& hexes);
-DicedCells dice_cells(Index nodes, const std::vector<std::array<Index, 4>>& tets);
+DicedCells dice_cells(Index nodes, const std::vector<std::array<Index, 8>>& hexes,
+                      std::size_t room = 0);
+DicedCells dice_cells(Index nodes, const std::vector<std::array<Index, 4>>& tets,
+                      std::size_t room = 0);
 
 // Where dice() places a node: the centroid of the corners (in their order: an element's
 // centre), or of an edge or face node's origin nodes (a padded FaceKey).

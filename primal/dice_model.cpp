@@ -327,7 +327,8 @@ double diced_wedge_min_scaled_jacobian(std::span<const Point> points,
   return lowest;
 }
 
-DicedModel dice_model(const Model& model, std::span<const char> shareable) {
+DicedModel dice_model(const Model& model, std::span<const char> shareable,
+                      std::size_t tet_room) {
   if (!model.pyramids.empty())
     throw InvalidInput("dice_model: " + describe_element(model, {ElementKind::kPyramid, 0}) +
                        ": pyramids are not diced; split them into tets first (split_pyramids)");
@@ -369,8 +370,8 @@ DicedModel dice_model(const Model& model, std::span<const char> shareable) {
   // parts (or the caller) may meet them; the children are renumbered in place. What a part
   // needs beyond the output is its edge and face keys and one number per diced node.
   auto take = [&](const auto& elements, std::vector<std::array<Index, 8>>& children,
-                  std::vector<Index>& parent) {
-    DicedCells d = dice_cells(V, elements);
+                  std::vector<Index>& parent, std::size_t room) {
+    DicedCells d = dice_cells(V, elements, room);
     std::vector<Index> g(index_cast<std::size_t>(V) + d.edges.size() + d.faces.size() +
                          elements.size());
     for (Index v = 0; v < V; ++v) g[index_cast<std::size_t>(v)] = v;
@@ -395,8 +396,8 @@ DicedModel dice_model(const Model& model, std::span<const char> shareable) {
     children = std::move(d.children);
     parent = std::move(d.parent);
   };
-  take(model.hexes, out.hex_children, out.hex_parent);
-  take(model.tets, out.tet_children, out.tet_parent);
+  take(model.hexes, out.hex_children, out.hex_parent, 0);
+  take(model.tets, out.tet_children, out.tet_parent, tet_room);
   dice_wedges(model, out);
   return out;
 }
