@@ -370,8 +370,8 @@ DicedModel dice_model(const Model& model, std::span<const char> shareable,
   // parts (or the caller) may meet them; the children are renumbered in place. What a part
   // needs beyond the output is its edge and face keys and one number per diced node.
   auto take = [&](const auto& elements, std::vector<std::array<Index, 8>>& children,
-                  std::vector<Index>& parent, std::size_t room) {
-    DicedCells d = dice_cells(V, elements, room);
+                  std::vector<Index>& parent, std::size_t child_room) {
+    DicedCells d = dice_cells(V, elements, child_room);
     std::vector<Index> g(index_cast<std::size_t>(V) + d.edges.size() + d.faces.size() +
                          elements.size());
     for (Index v = 0; v < V; ++v) g[index_cast<std::size_t>(v)] = v;
