@@ -389,6 +389,10 @@ std::vector<double> diced_scaled_jacobian_per_cell(std::span<const Point> points
 // The same children as weights on the four corners (a corner, an edge's midpoint, a face's or
 // the tet's centre), for a caller that evaluates one tet many times.
 double diced_tet_min_scaled_jacobian(const std::array<Point, 4>& corners) {
+  return diced_tet_min_scaled_jacobian(corners, -2.0);
+}
+
+double diced_tet_min_scaled_jacobian(const std::array<Point, 4>& corners, double bound) {
   using Weights = std::array<std::array<std::array<double, 4>, 8>, 4>;
   static const Weights weights = [] {
     Weights w{};
@@ -401,11 +405,12 @@ double diced_tet_min_scaled_jacobian(const std::array<Point, 4>& corners) {
   }();
   double lowest = 1.0;
   for (const auto& child : weights) {
+    if (lowest <= bound) break;
     HexCorners p;
     for (std::size_t c = 0; c < 8; ++c)
       p[c] = child[c][0] * corners[0] + child[c][1] * corners[1] + child[c][2] * corners[2] +
              child[c][3] * corners[3];
-    lowest = std::min(lowest, hex_scaled_jacobian(p));
+    lowest = std::min(lowest, hex_scaled_jacobian_bounded(p, bound));
   }
   return lowest;
 }

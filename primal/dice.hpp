@@ -87,6 +87,9 @@ double diced_min_scaled_jacobian(std::span<const Point> points,
 
 // One tet's lowest diced scaled Jacobian, from its four corners (for callers that move nodes).
 double diced_tet_min_scaled_jacobian(const std::array<Point, 4>& corners);
+// The same, except that once a child hex is at or below `bound` the rest are not measured: the
+// value is exact when above `bound`, and some value at or below it otherwise.
+double diced_tet_min_scaled_jacobian(const std::array<Point, 4>& corners, double bound);
 
 // The same per element: each one's lowest diced scaled Jacobian, in element order (the local
 // yardstick of a transition next to it).

@@ -58,6 +58,10 @@ double hex_jacobian(const HexCorners& p);         // min of hex_jacobians
 double hex_scaled_jacobian(const HexCorners& p);  // min of hex_scaled_jacobians
 double hex_condition(const HexCorners& p);        // max_c |A_c|_F |A_c^-1|_F / 3
 double hex_shape(const HexCorners& p);            // min_c 3 det(A_c)^(2/3) / |A_c|_F^2
+// hex_scaled_jacobian when above `bound`; otherwise some value at or below it (the frames after
+// the first at or below it are not measured: for searches that only ask whether a position
+// beats one).
+double hex_scaled_jacobian_bounded(const HexCorners& p, double bound);
 
 // ---- Quad metrics ([Verdict], quadrilateral chapter) -----------------------------------------
 // Corner c has edges a = p[c+1] - p[c], b = p[c-1] - p[c]; its signed area is (a x b) . n.

@@ -40,14 +40,21 @@ class Relaxer {
   std::size_t size() const { return free_.size(); }
 
   // The lowest diced scaled Jacobian of free node k's tets, at the points as they are; once it
-  // is at or below `bound` the rest are not measured (a trial position that cannot win).
-  double lowest(std::size_t k, double bound = -2.0) const {
+  // is at or below `bound` the rest are not measured (a trial position that cannot win). The
+  // tets are taken from the one at `*hint` (a position in k's row) on, and `*hint` is left at
+  // the one that reached the bound: most trial positions fail at the tet that failed the last
+  // one. The value is exact when above `bound`, whatever the order.
+  double lowest(std::size_t k, double bound = -2.0, std::size_t* hint = nullptr) const {
+    const std::size_t b = first_[k], n = first_[k + 1] - b;
+    const std::size_t from = hint && *hint < n ? *hint : 0;
     double m = 1.0;
-    for (std::size_t i = first_[k]; i < first_[k + 1] && m > bound; ++i) {
-      const auto& t = tets_[index_cast<std::size_t>(around_[i])];
+    for (std::size_t j = 0; j < n && m > bound; ++j) {
+      const std::size_t i = (from + j) % n;
+      const auto& t = tets_[index_cast<std::size_t>(around_[b + i])];
       std::array<Point, 4> c;
-      for (std::size_t j = 0; j < 4; ++j) c[j] = points_[index_cast<std::size_t>(t[j])];
-      m = std::min(m, diced_tet_min_scaled_jacobian(c));
+      for (std::size_t q = 0; q < 4; ++q) c[q] = points_[index_cast<std::size_t>(t[q])];
+      m = std::min(m, diced_tet_min_scaled_jacobian(c, bound));
+      if (hint && m <= bound) *hint = i;
     }
     return m;
   }
@@ -67,13 +74,17 @@ class Relaxer {
     double best = lowest(k);
     double step = o.initial_step * shortest_edge(k);
     bool moved = false;
+    // Per direction, the tet that failed a trial that way last (see lowest()).
+    std::array<std::size_t, 6> hint{};
     for (int halving = 0; halving <= o.halvings;) {
       bool improved = false;
       for (int axis = 0; axis < 3; ++axis)
-        for (double sign : {1.0, -1.0}) {
+        for (int side = 0; side < 2; ++side) {
+          const double sign = side == 0 ? 1.0 : -1.0;
           const Point old = p;
           p[axis] += sign * step;
-          const double q = lowest(k, best + kMinGain);
+          const double q =
+              lowest(k, best + kMinGain, &hint[index_cast<std::size_t>(2 * axis + side)]);
           if (q > best + kMinGain) {
             best = q;
             improved = moved = true;
