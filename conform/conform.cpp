@@ -338,6 +338,7 @@ void Conformer::insert_buffer() {
 // that dicing knows how many hexes the output will hold.
 void Conformer::build_references() {
   if (layer_.hexes.empty()) return;  // no interface: no template
+  t0_ = Clock::now();
   const bool any_four = std::any_of(layer_.hexes.begin(), layer_.hexes.end(),
                                     [](const BufferHex& b) { return b.centre != kInvalidIndex; });
   tbb::parallel_invoke(
@@ -355,6 +356,8 @@ void Conformer::build_references() {
   if (any_four)
     res_.template_min_scaled_jacobian =
         std::min(res_.template_min_scaled_jacobian, refs_[2]->min_scaled_jacobian);
+  say("reference templates: min scaled Jacobian " +
+      std::to_string(res_.template_min_scaled_jacobian) + took());
 }
 
 // Both parts diced over the layer model's point array, nodes merged by origin; the buffer
@@ -437,8 +440,7 @@ void Conformer::place_templates() {
     }
   }
   diced_.shared = primal::KeyMap<4>();  // every template node is placed
-  say("geode templates: " + std::to_string(nb) + " buffer hexes, reference min scaled Jacobian " +
-      std::to_string(res_.template_min_scaled_jacobian) + took());
+  say("geode templates: " + std::to_string(nb) + " buffer hexes placed" + took());
 }
 
 // Side faces shared by two buffer hexes: their template nodes matched topologically, one node
