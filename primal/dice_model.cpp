@@ -327,8 +327,7 @@ double diced_wedge_min_scaled_jacobian(std::span<const Point> points,
   return lowest;
 }
 
-DicedModel dice_model(const Model& model, std::span<const char> shareable,
-                      std::size_t tet_room) {
+DicedModel dice_model(const Model& model, std::span<const char> shareable, std::size_t tet_room) {
   if (!model.pyramids.empty())
     throw InvalidInput("dice_model: " + describe_element(model, {ElementKind::kPyramid, 0}) +
                        ": pyramids are not diced; split them into tets first (split_pyramids)");
