@@ -17,6 +17,7 @@
 #include <memory>
 #include <optional>
 #include <sstream>
+#include <string_view>
 
 #include <geode/io/atomic_file.hpp>
 #include <geode/io/file_format.hpp>
@@ -281,7 +282,7 @@ void write_values(std::ostream& os, const std::vector<T>& v, std::size_t per_lin
 }
 
 // Base64 (RFC 4648) of a byte string, as VTK's XML "binary" format wants it.
-std::string base64(const std::string& bytes) {
+std::string base64(std::string_view bytes) {
   static constexpr char kDigits[] =
       "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string out;
@@ -317,14 +318,26 @@ void write_data_array(std::ostream& os, VtuEncoding encoding, const char* type,
   if (encoding == VtuEncoding::kAscii) {
     write_values(os, v, per_line, "          ", fmt);
   } else {
-    std::string bytes(sizeof(std::uint64_t) + v.size() * sizeof(Out), '\0');
-    const std::uint64_t n = v.size() * sizeof(Out);
-    std::memcpy(bytes.data(), &n, sizeof n);
-    for (std::size_t i = 0; i < v.size(); ++i) {
-      const Out x = static_cast<Out>(v[i]);
-      std::memcpy(bytes.data() + sizeof n + i * sizeof(Out), &x, sizeof x);
-    }
-    os << "          " << base64(bytes) << "\n";
+    // Encoded a chunk at a time: base64 of whole 3-byte groups, concatenated, is the base64 of
+    // the whole, and neither the array's bytes nor their text are held at once (on a
+    // million-hex output those were the run's peak).
+    constexpr std::size_t kChunk = 3 * 16384;
+    std::string bytes;
+    bytes.reserve(kChunk + sizeof(std::uint64_t));
+    auto put = [&](const auto& x) {
+      const auto at = bytes.size();
+      bytes.resize(at + sizeof x);
+      std::memcpy(bytes.data() + at, &x, sizeof x);
+      if (bytes.size() >= kChunk) {
+        const std::size_t whole = bytes.size() / 3 * 3;
+        os << base64(std::string_view(bytes).substr(0, whole));
+        bytes.erase(0, whole);
+      }
+    };
+    os << "          ";
+    put(std::uint64_t{v.size() * sizeof(Out)});
+    for (const T& value : v) put(static_cast<Out>(value));
+    os << base64(bytes) << "\n";
   }
   os << "        </DataArray>\n";
 }
