@@ -557,16 +557,10 @@ void Conformer::assemble() {
     for (Index& v : h) v = renum[primal::index_cast<std::size_t>(v)];
     return h;
   };
-  std::vector<std::array<Index, 8>> hexes;
-  const bool in_place = diced_.tet_children.capacity() >= total;
-  if (in_place) {
-    for (auto& h : diced_.tet_children) h = renumbered(h);
-    hexes = std::move(diced_.tet_children);
-    hexes.insert(hexes.begin(), front, std::array<Index, 8>{});  // within capacity: no copy
-  } else {
-    hexes.reserve(total);
-    hexes.resize(front);
-  }
+  for (auto& h : diced_.tet_children) h = renumbered(h);
+  std::vector<std::array<Index, 8>> hexes = std::move(diced_.tet_children);
+  hexes.reserve(total);                                        // dicing's room: no copy
+  hexes.insert(hexes.begin(), front, std::array<Index, 8>{});  // shifted within capacity
   std::vector<int> block;
   block.reserve(total);
   std::size_t at = 0;
@@ -587,8 +581,6 @@ void Conformer::assemble() {
   }
   geode_first_.push_back(primal::index_cast(at));
   inst_global_ = {};
-  if (!in_place)
-    for (const auto& h : diced_.tet_children) hexes.push_back(renumbered(h));
   diced_.tet_children = {};
   for (Index parent : diced_.tet_parent)
     block.push_back(primal::block_of(lm, {primal::ElementKind::kTet, parent}));
@@ -804,13 +796,11 @@ void Conformer::smooth() {
 // lies below its target around the defects). Within a pass each hex seeds one patch: a second
 // one, after a neighbour moved its nodes, mostly repeats work, while the next pass seeds afresh
 // where defects are left. The passes after the first seed only around the defects within
-// kDefectBand of the lowest one of their output block: on the hexdominant demo at n = 28 the first
-// pass leaves 18,649 defects, nearly all geode hexes a little under kGeodeFloor, and two more
-// passes around all of them (38,000 seeds, 19,000 patches each) removed 3 % of them and lifted the
-// lowest 0.0962 -> 0.0974; two passes around the 30 to 50 lowest (about 600 patches) do as much.
-// Where the whole transition rises together (the n = 2 nugget) the lowest are most of it. On the
-// potting demo (n = 4) 47,898 -> 13,229 patches, the same minimum (the potting's 0.0684), one pin's
-// geode hexes 0.165 -> 0.133.
+// kDefectBand of the lowest one of their output block: after the first pass most defects are
+// geode hexes a little under kGeodeFloor, and passes around all of them again cost as much as
+// the first for little (hexdominant n = 28: 38,000 seeds a pass, the lowest 0.0962 -> 0.0974,
+// as much as about 600 patches around the lowest give). Where the whole transition rises
+// together (the n = 2 nugget) the lowest are most of it.
 constexpr int kDefectRings = 1;
 constexpr double kDefectBand = 0.05;
 constexpr double kDefectTarget = 1.1;       // x the aim, first pass

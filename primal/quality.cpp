@@ -280,10 +280,7 @@ double hex_jacobian(const HexCorners& p) {
 // [Verdict] hex scaled jacobian: min over the 8 corners and the centre (principal axes) of
 // det / product of the three column lengths. Verdict returns 1e30 when a column vanishes; we
 // return 0 for such a corner (a collapsed edge is a degenerate corner, not a perfect one).
-double hex_scaled_jacobian(const HexCorners& p) {
-  const auto q = hex_scaled_jacobians(p);
-  return *std::min_element(q.begin(), q.end());
-}
+double hex_scaled_jacobian(const HexCorners& p) { return hex_scaled_jacobian_bounded(p, -kInf); }
 
 double hex_scaled_jacobian_bounded(const HexCorners& p, double bound) {
   double m = kInf;
