@@ -162,6 +162,50 @@ std::vector<BoundaryQuad> block_interface_quads(const HexMesh& mesh) {
   return out;
 }
 
+std::vector<BoundaryQuad> surface_quads_at(const HexMesh& mesh, std::span<const Index> hexes,
+                                           std::span<const char> at) {
+  check_indices(mesh);
+  if (at.size() != mesh.points.size())
+    throw InvalidInput("surface_quads_at: " + std::to_string(at.size()) + " node flags for " +
+                       std::to_string(mesh.points.size()) + " nodes");
+  const bool blocks = !mesh.block.empty();
+  if (blocks && mesh.block.size() != mesh.hexes.size())
+    throw InvalidInput("surface_quads_at: " + std::to_string(mesh.block.size()) +
+                       " block ids for " + std::to_string(mesh.hexes.size()) + " hexes");
+  auto flagged = [&](const std::array<Index, 4>& q) {
+    return std::any_of(q.begin(), q.end(), [&](Index v) { return at[index_cast<std::size_t>(v)]; });
+  };
+  // Face key -> its first use (6 hex + local face), negated (-2 - use) once a second hex uses
+  // it; the interface quads are found at their later uses, as block_interface_quads does.
+  auto first_of = [](Index value) { return value >= 0 ? value : -2 - value; };
+  KeyMap<4> first_use(hexes.size() * 3);
+  std::vector<BoundaryQuad> between;
+  for (Index h : hexes) {
+    if (h < 0 || index_cast<std::size_t>(h) >= mesh.hexes.size())
+      throw InvalidInput("surface_quads_at: hex " + std::to_string(h) + " out of range");
+    for (int f = 0; f < topo::kHexFaces; ++f) {
+      const auto nodes = hex_face_nodes(mesh.hexes[index_cast<std::size_t>(h)], f);
+      if (!flagged(nodes)) continue;
+      const auto [slot, inserted] = first_use.try_emplace(face_key(nodes), 6 * h + f);
+      if (inserted) continue;
+      const Index first = first_of(*slot);
+      *slot = -2 - first;
+      if (blocks &&
+          mesh.block[index_cast<std::size_t>(first / 6)] != mesh.block[index_cast<std::size_t>(h)])
+        between.push_back(BoundaryQuad{h, f, nodes});
+    }
+  }
+  std::vector<BoundaryQuad> out;
+  for (Index h : hexes)
+    for (int f = 0; f < topo::kHexFaces; ++f) {
+      const auto nodes = hex_face_nodes(mesh.hexes[index_cast<std::size_t>(h)], f);
+      if (flagged(nodes) && *first_use.find(face_key(nodes)) == 6 * h + f)
+        out.push_back(BoundaryQuad{h, f, nodes});
+    }
+  out.insert(out.end(), between.begin(), between.end());
+  return out;
+}
+
 BoundarySurface extract_boundary(const HexMesh& mesh) {
   return extract_boundary(mesh.points, boundary_quads(mesh));
 }

@@ -67,6 +67,13 @@ std::vector<BoundaryQuad> boundary_quads(const HexMesh& mesh);
 // is neither empty nor one per hex.
 std::vector<BoundaryQuad> block_interface_quads(const HexMesh& mesh);
 
+// boundary_quads then block_interface_quads, each in its order, kept only where a quad has a
+// node flagged in `at` (one flag per node), found by matching the faces of `hexes` (ascending)
+// alone: the same quads when every hex holding a flagged node is among `hexes`, at the cost of
+// those hexes instead of the mesh's (local smoothing: the nodes of a few seeds in a large mesh).
+std::vector<BoundaryQuad> surface_quads_at(const HexMesh& mesh, std::span<const Index> hexes,
+                                           std::span<const char> at);
+
 // The nodes of the boundary quads, ascending.
 std::vector<Index> boundary_nodes(const HexMesh& mesh);
 

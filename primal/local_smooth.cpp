@@ -701,31 +701,25 @@ LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seed
   }
   sub.points.reserve(global.size());
   for (Index g : global) sub.points.push_back(mesh.points[g]);
-  // A face of a region hex is on the model's boundary iff it is on the submesh's: a hex on its
-  // other side would share a node with the region, so it is in `outer`.
-  std::vector<char> in_region(outer.size(), 0);
+  // Only the seeds' nodes move; the rest of the submesh is there to be measured. Their
+  // constraints come from the faces through them, whose hexes all hold a seed node, so are in
+  // the region: a face of one is on the model's boundary iff it is on the submesh's, and one
+  // between two blocks is one of the model's.
+  std::vector<char> moves(sub.points.size(), 0);
+  for (Index s : seeds)
+    for (Index v : mesh.hexes[s]) moves[local[v]] = 1;
+  std::vector<Index> sub_region;
+  sub_region.reserve(region.size());
   {
     std::size_t r = 0;
     for (std::size_t i = 0; i < outer.size(); ++i) {
       while (r < region.size() && region[r] < outer[i]) ++r;
-      in_region[i] = r < region.size() && region[r] == outer[i];
+      if (r < region.size() && region[r] == outer[i]) sub_region.push_back(index_cast(i));
     }
   }
-  // Every face between two blocks of the submesh is one of the model's (both its hexes are in
-  // it), and at a moving node both are in the region.
-  std::vector<BoundaryQuad> boundary;
-  for (const BoundaryQuad& q : boundary_quads(sub))
-    if (in_region[index_cast<std::size_t>(q.hex)]) boundary.push_back(q);
-  const std::vector<BoundaryQuad> between = block_interface_quads(sub);
-  boundary.insert(boundary.end(), between.begin(), between.end());
-  auto constraints = boundary_slide_constraints(sub, boundary);
-  // Only the seeds' nodes move; the rest of the submesh is there to be measured.
-  std::vector<char> moves(sub.points.size(), 0);
+  auto constraints = boundary_slide_constraints(sub, surface_quads_at(sub, sub_region, moves));
   std::vector<Index> local_seeds;
   local_seeds.reserve(seeds.size());
-  for (Index s : seeds) {
-    for (Index v : mesh.hexes[s]) moves[local[v]] = 1;
-  }
   for (std::size_t i = 0; i < outer.size(); ++i)
     if (std::binary_search(sorted.begin(), sorted.end(), outer[i]))
       local_seeds.push_back(index_cast(i));

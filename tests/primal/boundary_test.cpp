@@ -8,11 +8,13 @@
 
 #include <OpenMesh/Core/System/omstream.hh>
 
+#include <algorithm>
 #include <latch>
 #include <thread>
 #include <vector>
 
 #include <geode/primal/boundary.hpp>
+#include <geode/primal/errors.hpp>
 #include "support/fixtures.hpp"
 
 using namespace geode::primal;
@@ -62,4 +64,51 @@ TEST_CASE(
   (void)extract_boundary(m);
   CHECK_FALSE(omerr().is_enabled());
   omerr().enable();
+}
+
+TEST_CASE(
+    "surface_quads_at: the model's boundary and block interface quads at flagged nodes, from "
+    "the hexes around them alone") {
+  // A 4 x 4 x 3 grid in three blocks (x < 2; x >= 2 below z = 2; x >= 2 above): boundary quads,
+  // block interface quads in two planes, and quads inside each block. The flagged nodes are
+  // those of seed hexes at a corner, inside, and where the three blocks meet.
+  HexMesh mesh = structured_hex_grid(4, 4, 3);
+  for (const auto& h : mesh.hexes) {
+    Point c = Point::Zero();
+    for (Index v : h) c += mesh.points[index_cast<std::size_t>(v)] / 8.0;
+    mesh.block.push_back(c.x() < 2.0 ? 1 : c.z() < 2.0 ? 2 : 3);
+  }
+  std::vector<BoundaryQuad> all = boundary_quads(mesh);
+  const std::vector<BoundaryQuad> between = block_interface_quads(mesh);
+  REQUIRE(!between.empty());
+  all.insert(all.end(), between.begin(), between.end());
+  for (const std::vector<Index>& seeds :
+       std::vector<std::vector<Index>>{{0}, {21}, {0, 21, 22, 47}, {}}) {
+    std::vector<char> at(mesh.points.size(), 0);
+    for (Index s : seeds)
+      for (Index v : mesh.hexes[index_cast<std::size_t>(s)]) at[index_cast<std::size_t>(v)] = 1;
+    std::vector<Index> around;  // every hex holding a flagged node, ascending
+    for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
+      if (std::any_of(mesh.hexes[h].begin(), mesh.hexes[h].end(),
+                      [&](Index v) { return at[index_cast<std::size_t>(v)] != 0; }))
+        around.push_back(index_cast(h));
+    std::vector<BoundaryQuad> want;
+    for (const BoundaryQuad& q : all)
+      if (std::any_of(q.nodes.begin(), q.nodes.end(),
+                      [&](Index v) { return at[index_cast<std::size_t>(v)] != 0; }))
+        want.push_back(q);
+    const std::vector<BoundaryQuad> got = surface_quads_at(mesh, around, at);
+    CAPTURE(seeds.size());
+    REQUIRE(got.size() == want.size());
+    for (std::size_t i = 0; i < got.size(); ++i) {
+      CHECK(got[i].hex == want[i].hex);
+      CHECK(got[i].local_face == want[i].local_face);
+      CHECK(got[i].nodes == want[i].nodes);
+    }
+    if (!seeds.empty()) CHECK(!got.empty());
+  }
+  CHECK_THROWS_AS(surface_quads_at(mesh, {}, std::vector<char>(3, 0)), geode::InvalidInput);
+  const std::vector<Index> outside{index_cast(mesh.hexes.size())};
+  CHECK_THROWS_AS(surface_quads_at(mesh, outside, std::vector<char>(mesh.points.size(), 1)),
+                  geode::InvalidInput);
 }
