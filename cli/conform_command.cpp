@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include <geode/conform/conform.hpp>
+#include <geode/conform/reference_template.hpp>
 #include <geode/conform/report.hpp>
 #include <geode/io/read_model.hpp>
 #include <geode/primal/errors.hpp>
@@ -348,6 +349,10 @@ void add_conform_commands(CLI::App& app) {
   add_run_options(c, *args);
   c->callback([args] {
     const std::string format = check_outputs(*args);  // before the long run, not after it
+    // The templates depend on the options alone: built while the file is read.
+    const std::jthread templates = conform::build_reference_templates_ahead(
+        args->template_box.empty() ? conform::ConformOptions{}.template_box
+                                   : template_box(args->template_box));
     run(io::read_model(args->input, {}, args->merge_tolerance < 0), *args, format, false,
         args->input);
   });

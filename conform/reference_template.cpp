@@ -8,6 +8,8 @@
 #include <sstream>
 #include <tuple>
 
+#include <tbb/parallel_invoke.h>
+
 #include <geode/primal/errors.hpp>
 #include <geode/primal/patch_match.hpp>
 #include <geode/primal/smooth.hpp>
@@ -238,6 +240,21 @@ const RefTemplate& reference_template(const Eigen::Vector3d& given_box,
     slot->value = std::move(four);
   });
   return *slot->value;
+}
+
+std::jthread build_reference_templates_ahead(const Eigen::Vector3d& box) {
+  return std::jthread([box] {
+    try {
+      tbb::parallel_invoke(
+          [&] {
+            reference_template(box, {4, 6});
+          },
+          [&] {
+            reference_template(box, {5, 7});
+          });
+    } catch (...) {  // conform() builds it again and reports why
+    }
+  });
 }
 
 const RefTemplate& reference_template_four_triangles(const Eigen::Vector3d& box) {

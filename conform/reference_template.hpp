@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <string>
+#include <thread>
 #include <unordered_map>
 #include <vector>
 
@@ -46,6 +47,12 @@ const RefTemplate& reference_template(const Eigen::Vector3d& box, std::array<int
 // reference positions, the rest smoothed with them fixed in a box of 0.7 box.y (the buffer
 // hexes are flat; see the .cpp).
 const RefTemplate& reference_template_four_triangles(const Eigen::Vector3d& box);
+
+// Starts building both diagonals' templates for `box` (what conform() asks for first) on a thread
+// of its own, so that a caller can overlap them with reading its input: conform() then finds
+// them built, or waits for the build under way (the cache above). A failed build is left to
+// conform(), which builds again and reports it. The thread joins when the handle is destroyed.
+std::jthread build_reference_templates_ahead(const Eigen::Vector3d& box);
 
 // Matches the nodes of side face ka of template A with those of side face kb of template B
 // (the same face of the model), starting from the nodes both share on the tet and hex sides
