@@ -8,6 +8,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include <geode/primal/dice.hpp>
 #include <geode/primal/errors.hpp>
@@ -368,9 +369,8 @@ DicedModel dice_model(const Model& model, std::span<const char> shareable, std::
   // nodes are made here in dice()'s order and at dice()'s places, merged by origin where both
   // parts (or the caller) may meet them; the children are renumbered in place. What a part
   // needs beyond the output is its edge and face keys and one number per diced node.
-  auto take = [&](const auto& elements, std::vector<std::array<Index, 8>>& children,
-                  std::vector<Index>& parent, std::size_t child_room) {
-    DicedCells d = dice_cells(V, elements, child_room);
+  auto take = [&](const auto& elements, DicedCells d, std::vector<std::array<Index, 8>>& children,
+                  std::vector<Index>& parent) {
     std::vector<Index> g(index_cast<std::size_t>(V) + d.edges.size() + d.faces.size() +
                          elements.size());
     for (Index v = 0; v < V; ++v) g[index_cast<std::size_t>(v)] = v;
@@ -395,8 +395,13 @@ DicedModel dice_model(const Model& model, std::span<const char> shareable, std::
     children = std::move(d.children);
     parent = std::move(d.parent);
   };
-  take(model.hexes, out.hex_children, out.hex_parent, 0);
-  take(model.tets, out.tet_children, out.tet_parent, tet_room);
+  // The two parts' topologies need nothing of each other: diced side by side (TBB), merged in
+  // order, so the node numbers are those of one after the other.
+  DicedCells hexes, tets;
+  tbb::parallel_invoke([&] { hexes = dice_cells(V, model.hexes); },
+                       [&] { tets = dice_cells(V, model.tets, tet_room); });
+  take(model.hexes, std::move(hexes), out.hex_children, out.hex_parent);
+  take(model.tets, std::move(tets), out.tet_children, out.tet_parent);
   dice_wedges(model, out);
   return out;
 }
