@@ -133,8 +133,10 @@ std::vector<PartQuad> part_quads(const Model& model) {
 // Which copy of each interface node the tets and wedges around it take (InterfaceSide): per
 // node, its cells joined across the faces they share at the node; refuses a set of cells
 // joined to both sides, naming a wedge of it (only a wedge, sharing quads with the hex part
-// and triangles with the tet part, can join them).
-std::vector<InterfaceNodeUse> node_uses(const Model& model, const Interface& itf) {
+// and triangles with the tet part, can join them), or, given `joining`, adds that wedge to it
+// and goes on.
+std::vector<InterfaceNodeUse> node_uses(const Model& model, const Interface& itf,
+                                        std::vector<Index>* joining) {
   std::vector<InterfaceNodeUse> out;
   if (itf.nodes.empty()) return out;
   std::vector<Index> slot(model.points.size(), kInvalidIndex);
@@ -204,6 +206,10 @@ std::vector<InterfaceNodeUse> node_uses(const Model& model, const Interface& itf
         const auto wedge = std::find_if(at.begin(), at.end(), [&](const ElementRef& e) {
           return e.kind == ElementKind::kWedge && root_of(e) == r;
         });
+        if (joining && wedge != at.end()) {
+          joining->push_back(wedge->index);
+          continue;
+        }
         throw TopologyError(
             "find_interface: " + describe_element(model, wedge != at.end() ? *wedge : at[c]) +
             " joins the two sides of the hex/tet interface at " + describe_node(model, v) +
@@ -237,7 +243,7 @@ std::vector<std::array<Index, 3>> interface_triangles(const InterfaceQuad& q) {
   return four;
 }
 
-Interface find_interface(const Model& model, double tol) {
+Interface find_interface(const Model& model, double tol, std::vector<Index>* joining) {
   validate(model, "find_interface");
   refuse_duplicates(model, model.hexes, ElementKind::kHex);
   refuse_duplicates(model, model.tets, ElementKind::kTet);
@@ -462,7 +468,11 @@ Interface find_interface(const Model& model, double tol) {
       throw TopologyError("find_interface: " + describe_node(model, index_cast(v)) +
                           " is used by both the hex and the tet part but lies on no interface quad "
                           "(the parts touch along an edge or at a point only)");
-  out.uses = node_uses(model, out);
+  out.uses = node_uses(model, out, joining);
+  if (joining) {
+    std::sort(joining->begin(), joining->end());
+    joining->erase(std::unique(joining->begin(), joining->end()), joining->end());
+  }
   return out;
 }
 

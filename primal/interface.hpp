@@ -78,8 +78,12 @@ std::vector<std::array<Index, 3>> interface_triangles(const InterfaceQuad& quad)
 // - a cell joining the two sides around an interface node (see InterfaceSide: a wedge sharing
 //   faces there with a hex and with a tet of the interface, as where a wedge layer over the
 //   tet part meets a hex layer over the hex part): the interface ends inside the mesh there,
-//   where no buffer layer can end, and the message names that cell (a wedge) and the node.
+//   where no buffer layer can end, and the message names that cell (a wedge) and the node;
+//   given `joining`, every such wedge is put there instead, ascending (the interface's uses
+//   then leave the cells joined to both sides out: the caller splits those wedges and starts
+//   again, primal/split_wedges.hpp).
 // `tolerance` is relative to the local edge length (used by the hanging-node test).
-Interface find_interface(const Model& model, double tolerance = 1e-6);
+Interface find_interface(const Model& model, double tolerance = 1e-6,
+                         std::vector<Index>* joining = nullptr);
 
 }  // namespace geode::primal

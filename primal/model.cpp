@@ -104,6 +104,21 @@ std::vector<Index> element_face(const Model& model, const Side& side) {
   return face;
 }
 
+std::vector<Side> tet_sides_on(const Model& model, Index first, Index count,
+                               std::span<const Index> face) {
+  std::vector<Side> out;
+  for (Index t = first; t < first + count; ++t)
+    for (int f = 0; f < 4; ++f) {
+      bool on = true;
+      for (int k : topology::kTetFaceCorners[index_cast<std::size_t>(f)])
+        on = on && std::find(face.begin(), face.end(),
+                             model.tets[index_cast<std::size_t>(t)][index_cast<std::size_t>(k)]) !=
+                       face.end();
+      if (on) out.push_back({{ElementKind::kTet, t}, f});
+    }
+  return out;
+}
+
 void add_element(Model& model, ElementKind kind, std::span<const Index> corners, int block,
                  std::int64_t file_id) {
   const auto n = static_cast<std::size_t>(cell_topology(kind).corners);

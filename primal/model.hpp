@@ -103,6 +103,10 @@ const std::vector<std::int64_t>& element_ids(const Model& model, ElementKind kin
 std::vector<std::int64_t>& element_ids(Model& model, ElementKind kind);
 // The nodes of local face `face` of the element (topology order: outward), 3 or 4 of them.
 std::vector<Index> element_face(const Model& model, const Side& side);
+// The faces of tets [first, first + count) of `model` whose corners all lie on `face`: the sides
+// a side on a cell becomes where the cell is split into those tets (a pyramid, a wedge).
+std::vector<Side> tet_sides_on(const Model& model, Index first, Index count,
+                               std::span<const Index> face);
 // Appends an element of `kind` (its first cell_topology(kind).corners corners), pushing its
 // block and file id onto the kind's vectors (readers fill them for every element).
 void add_element(Model& model, ElementKind kind, std::span<const Index> corners, int block,

@@ -81,16 +81,9 @@ PyramidSplit split_pyramids(const Model& model) {
         sides.push_back(s);
         continue;
       }
-      const std::vector<Index> face = element_face(model, s);
-      for (Index t = first_tet[index_cast<std::size_t>(s.element.index)], e = t + 2; t < e; ++t)
-        for (int f = 0; f < 4; ++f) {
-          bool on = true;
-          for (int k : topology::kTetFaceCorners[index_cast<std::size_t>(f)])
-            on = on && std::find(face.begin(), face.end(),
-                                 m.tets[index_cast<std::size_t>(t)][index_cast<std::size_t>(k)]) !=
-                           face.end();
-          if (on) sides.push_back({{ElementKind::kTet, t}, f});
-        }
+      const auto on = tet_sides_on(m, first_tet[index_cast<std::size_t>(s.element.index)], 2,
+                                   element_face(model, s));
+      sides.insert(sides.end(), on.begin(), on.end());
     }
     std::sort(sides.begin(), sides.end());
     set.sides = std::move(sides);
