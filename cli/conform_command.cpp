@@ -57,6 +57,7 @@ void print_summary(const conform::ConformResult& r, std::ostream& os, bool table
   os << "input: " << r.input_hexes << " hexes, " << r.input_tets << " tets, ";
   if (r.input_pyramids) os << r.input_pyramids << " pyramids (split), ";
   if (r.input_wedges) os << r.input_wedges << " wedges, ";
+  if (r.wedges_split) os << "(" << r.wedges_split << " of them split), ";
   os << r.interface_quads << " interface quads\n";
   if (r.relaxation.nodes_moved)
     os << "tets relaxed near the hex part: " << r.relaxation.nodes_moved
@@ -83,8 +84,10 @@ void print_summary(const conform::ConformResult& r, std::ostream& os, bool table
   const double output = conform::output_min_scaled_jacobian(r);
   os << "input diced alone: min scaled Jacobian " << r.input_diced_hex_min_scaled_jacobian
      << " (hexes), " << r.input_diced_tet_min_scaled_jacobian << " (tets"
-     << (r.input_pyramids ? ", pyramids as their two tets" : "") << ")";
-  if (r.input_wedges) os << ", " << r.input_diced_wedge_min_scaled_jacobian << " (wedges)";
+     << (r.input_pyramids ? ", pyramids as their two tets" : "")
+     << (r.wedges_split ? ", split wedges as their three" : "") << ")";
+  if (r.input_wedges > r.wedges_split)
+    os << ", " << r.input_diced_wedge_min_scaled_jacobian << " (wedges)";
   os << "; output " << output;
   if (yardstick > 0) os << " = " << output / yardstick << " x the lower";
   os << "; geode hexes >= " << r.local_yardstick_ratio << " x their local yardstick\n";
@@ -377,7 +380,8 @@ void add_conform_commands(CLI::App& app) {
        "box beside a Delaunay tet box), hybrid-cylinder (a swept hex cylinder in a Delaunay box),\n"
        "boundary-layer (wedge layers extruded on a tet box), hexdominant (hexes, tets, pyramids\n"
        "and wedges side by side), layer-side (a wedge layer whose side quads meet tets, with\n"
-       "Gmsh's pyramids), layer-interface (a wedge layer at the hex/tet interface's edge);\n"
+       "Gmsh's pyramids), layer-interface (a wedge layer at the hex/tet interface's edge),\n"
+       "layer-mixed (hexes and wedges side by side in one layer on tets: the wedges are split);\n"
        "potting: six hex parts (boxes, swept cylinders, a tilted box, an\n"
        "L bracket), each its own block, in a Delaunay tet potting (n >= 2)")
       // Checked against the module's names when given (loading libgmsh then, not at startup).

@@ -561,6 +561,24 @@ BufferLayer BufferBuilder::run() {
 
 }  // namespace
 
+double buffer_height_ratio(const BufferLayer& layer) {
+  if (layer.hexes.empty()) return 0.0;
+  const auto& p = layer.model.points;
+  double sum = 0.0;
+  for (const BufferHex& b : layer.hexes) {
+    double edge = 0.0, height = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < 4; ++i) {
+      const auto at = [&](std::size_t k) -> const primal::Point& {
+        return p[primal::index_cast<std::size_t>(b.corners[k])];
+      };
+      edge += (at((i + 1) % 4) - at(i)).norm() / 4.0;
+      height = std::min(height, (at(i + 4) - at(i)).norm());
+    }
+    sum += edge > 0.0 ? height / edge : 0.0;
+  }
+  return sum / static_cast<double>(layer.hexes.size());
+}
+
 const char* buffer_side_name(BufferSide side) { return side == BufferSide::kHex ? "hex" : "tet"; }
 
 BufferSide parse_buffer_side(const std::string& word) {

@@ -125,6 +125,11 @@ struct BufferLayer {
   BufferLayerReport report;
 };
 
+// The mean over the buffer hexes of their height (the shortest of their four edges from the
+// interface quad to the top) over their interface quad's mean edge: how flat the geode
+// templates will be squashed (the reference box is half as high as wide); 0 without hexes.
+double buffer_height_ratio(const BufferLayer& layer);
+
 // Wedges are diced in place and never moved: an interface quad of a wedge, or a tet on the hex
 // side of a node (Interface::uses), needs the layer carved from the tet part; a wedge on the
 // tet side of a node needs it carved from the hex part.

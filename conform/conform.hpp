@@ -175,15 +175,19 @@ struct ConformResult {
   // lying on it (4 per hex face, 3 per tet face).
   primal::Model model;
   // input_tets: the input's own; its pyramids are split into two tets each before the rest.
+  // wedges_split: of input_wedges, those split into three tets each where a wedge layer joined
+  // the two sides of the interface (primal/split_wedges.hpp), the whole pieces of wedges they
+  // belong to.
   primal::Index input_hexes = 0, input_tets = 0, input_pyramids = 0, input_wedges = 0,
-                interface_quads = 0;
+                interface_quads = 0, wedges_split = 0;
   primal::Index diced_hexes = 0, geode_hexes = 0, diced_tet_hexes = 0, diced_wedge_hexes = 0;
   BufferLayerReport buffer;
   BufferSide buffer_side = BufferSide::kHex;  // the part the buffer layer was carved from
   double template_min_scaled_jacobian = 0.0;  // the reference templates used, after smoothing
   // The yardstick for the transition: the input's hexes and tets each diced alone
   // (primal::diced_min_scaled_jacobian), before the buffer layer moves anything.
-  // Pyramids count as their two tets (the tet figure), wedges diced alone as their own.
+  // Pyramids count as their two tets (the tet figure), wedges diced alone as their own (a split
+  // wedge as its three tets, the tet figure).
   double input_diced_hex_min_scaled_jacobian = 1.0, input_diced_tet_min_scaled_jacobian = 1.0;
   double input_diced_wedge_min_scaled_jacobian = 1.0;
   double yardstick() const {
