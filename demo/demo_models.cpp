@@ -826,6 +826,35 @@ Model demo_layer_interface(int n) {
   });
 }
 
+Model demo_layer_mixed(int n) {
+  if (n < 1) throw InvalidInput("demo_layer_mixed: n = " + std::to_string(n) + " must be >= 1");
+  const double h = 1.0 / n;
+  return hybrid_gmsh("demo_layer_mixed", [&] {
+    // Two Delaunay tet boxes [0,1]^3 and [1,2] x [0,1]^2 side by side, and 3 graded layers
+    // extruded 0.2 off their tops, the left top recombined into quads: a layer of hexes beside
+    // a layer of wedges, as an extrusion off a surface recombined only in part gives. Gmsh puts
+    // a pyramid on every hex quad the tets meet; the wedges meet the tets by their triangles.
+    const auto v = shared_boxes({{0, 0, 0, 1, 1, 1}, {1, 0, 0, 1, 1, 1}});
+    std::array<int, 2> top{};
+    for (std::size_t i = 0; i < 2; ++i)
+      for (int s : boundary_surfaces(v[i]))
+        if (bounding_box(2, s)[2] > 1.0 - kEps) top[i] = s;
+    gmsh::model::mesh::setRecombine(2, top[0]);
+    // Both tops in one extrusion, so that the wall over their shared edge is one surface.
+    gmsh::vectorpair layer;
+    gmsh::model::occ::extrude({{2, top[0]}, {2, top[1]}}, 0, 0, 0.2, layer, {1, 1, 1},
+                              {0.2, 0.5, 1.0}, true);
+    gmsh::model::occ::synchronize();
+    gmsh::option::setNumber("Mesh.MeshSizeMax", h);
+    gmsh::model::addPhysicalGroup(3, {v[0], v[1]}, 2);
+    gmsh::model::setPhysicalName(3, 2, "tet");
+    for (const auto& [dim, tag] : layer)
+      if (dim == 3)
+        name_volume(tag, bounding_box(3, tag)[3] < 1.0 + kEps ? 1 : 4,
+                    bounding_box(3, tag)[3] < 1.0 + kEps ? "hex layer" : "wedge layer");
+  });
+}
+
 Model demo_hexdominant(int n) {
   if (n < 1) throw InvalidInput("demo_hexdominant: n = " + std::to_string(n) + " must be >= 1");
   const double h = 1.0 / n;
@@ -1040,7 +1069,7 @@ const std::vector<std::string>& demo_model_names() {
                                               "fulcher",     "fourtri",         "fourtri-cylinder",
                                               "hybrid",      "hybrid-cylinder", "boundary-layer",
                                               "hexdominant", "layer-side",      "layer-interface",
-                                              "potting"};
+                                              "layer-mixed", "potting"};
   return names;
 }
 
@@ -1060,6 +1089,7 @@ Model demo_model(const std::string& name, int n) {
   if (name == "hexdominant") return demo_hexdominant(n);
   if (name == "layer-side") return demo_layer_side(n);
   if (name == "layer-interface") return demo_layer_interface(n);
+  if (name == "layer-mixed") return demo_layer_mixed(n);
   if (name == "potting") return demo_potting(n);
   std::string names;
   for (const std::string& known : demo_model_names()) names += (names.empty() ? "" : ", ") + known;

@@ -92,6 +92,11 @@ Model demo_layer_side(int n = 4);
 // extruded 0.2 off the tet box's top (block 4 "boundary layer"): wedges at the nodes of the
 // hex/tet interface's top edge.
 Model demo_layer_interface(int n = 4);
+// layer-mixed: Delaunay tet boxes [0,1]^3 and [1,2] x [0,1]^2 (block 2 "tet") under 3 graded
+// layers extruded 0.2 off their tops, the left one recombined: hexes (block 1 "hex layer")
+// beside wedges (block 4 "wedge layer"), pyramids on the hex quads the tets meet. The wedge
+// layer joins the two sides of the hex/tet interface: conform splits its wedges into tets.
+Model demo_layer_mixed(int n = 4);
 
 // (f) The paper's proposed example, the complement of simple parts: six hex parts in a tet potting
 // box [0, 6.2] x [0, 4.4] x [0, 2.2] (block 7 "potting", Delaunay): a cube (block 1
@@ -111,8 +116,8 @@ Model demo_wedge(int n, double angle);
 // The names `geode demo --model` takes: half, delaunay, delaunay-random, cylinder, lshape,
 // nugget (d: a convex Delaunay tet nugget in structured blocks), fulcher (e), fourtri (a,
 // random diagonals, four-triangle quads), fourtri-cylinder (b with four-triangle quads),
-// hybrid, hybrid-cylinder, boundary-layer, hexdominant, layer-side, layer-interface, potting
-// (f).
+// hybrid, hybrid-cylinder, boundary-layer, hexdominant, layer-side, layer-interface,
+// layer-mixed, potting (f).
 const std::vector<std::string>& demo_model_names();
 // The model of that name with size parameter n (made even where the model needs it); throws
 // InvalidInput naming an unknown name.

@@ -1,6 +1,7 @@
 // conform() on hybrid meshes as Gmsh makes them in one generate(3) (demo/demo_models.hpp:
-// hybrid, hybrid-cylinder, boundary-layer, hexdominant, and layer-side and layer-interface,
-// whose wedges meet the hex/tet transition): Gmsh's own pyramids (on every quad a Delaunay
+// hybrid, hybrid-cylinder, boundary-layer, hexdominant, and layer-side, layer-interface and
+// layer-mixed, whose wedges meet the hex/tet transition, layer-mixed's joining its two sides, so
+// split into tets): Gmsh's own pyramids (on every quad a Delaunay
 // volume meets, a wedge's too) and extruded wedges go in; out comes a valid all-hex ball (faces
 // shared by two hexes, closed manifold boundary, every node covered once) with every scaled
 // Jacobian positive, with the defaults at least the yardstick (each input cell diced alone, a
@@ -40,14 +41,20 @@ struct HybridCase {
   // Whether every geode hex reaches the smoother's aim, 0.9 x its local yardstick, with the
   // defaults (hybrid-cylinder's curved interface at n = 3 gives 0.71 x).
   bool local_aim = true;
+  // Whether conform splits its wedges into tets (all of them: one layer joining the two sides
+  // of the interface).
+  bool split = false;
 };
 // With the defaults every one reaches its yardstick: the tet relaxation lifts the flat tets
 // Gmsh leaves beside the hex and wedge quads (layer-side's slab tets beside its thin first
 // layer kept it below without it).
-constexpr HybridCase kHybrid[] = {
-    {"hybrid", true, false},         {"hybrid-cylinder", true, false, false},
-    {"boundary-layer", false, true}, {"hexdominant", true, true},
-    {"layer-side", true, true},      {"layer-interface", true, true}};
+constexpr HybridCase kHybrid[] = {{"hybrid", true, false},
+                                  {"hybrid-cylinder", true, false, false},
+                                  {"boundary-layer", false, true},
+                                  {"hexdominant", true, true},
+                                  {"layer-side", true, true},
+                                  {"layer-interface", true, true},
+                                  {"layer-mixed", true, true, false, true}};
 
 std::set<int> blocks_of(const primal::Model& m) {
   std::set<int> b;
@@ -125,17 +132,26 @@ TEST_CASE(
       if (smooth == conform::ConformSmooth::kLocal) CHECK(sj >= r.yardstick() - 1e-9);
       if (smooth == conform::ConformSmooth::kLocal && c.local_aim)
         CHECK(r.local_yardstick_ratio >= 0.9);
-      // Per kind: 8 per hex, 4 per tet (a pyramid's two tets), 6 per wedge, 26 per interface quad.
+      // Per kind: 8 per hex, 4 per tet (a pyramid's two tets, a split wedge's three), 6 per
+      // wedge, 26 per interface quad.
+      const std::size_t split = c.split ? in.wedges.size() : 0;
+      CHECK(r.wedges_split == primal::index_cast(split));
+      CHECK(r.input_wedges == primal::index_cast(in.wedges.size()));
+      CHECK(r.input_tets == primal::index_cast(in.tets.size()));
       CHECK(r.input_pyramids == primal::index_cast(in.pyramids.size()));
       CHECK(r.diced_hexes == 8 * primal::index_cast(in.hexes.size()));
-      CHECK(r.diced_tet_hexes == 4 * primal::index_cast(in.tets.size() + 2 * in.pyramids.size()));
-      CHECK(r.diced_wedge_hexes == 6 * primal::index_cast(in.wedges.size()));
+      CHECK(r.diced_tet_hexes ==
+            4 * primal::index_cast(in.tets.size() + 2 * in.pyramids.size() + 3 * split));
+      CHECK(r.diced_wedge_hexes == 6 * primal::index_cast(in.wedges.size() - split));
       CHECK(r.geode_hexes == 26 * r.interface_quads);
       CHECK(r.model.hexes.size() ==
             primal::index_cast<std::size_t>(r.diced_hexes + r.geode_hexes + r.diced_tet_hexes +
                                             r.diced_wedge_hexes));
-      // Gmsh puts one pyramid on every quad a tet volume meets: each is an interface quad.
-      if (c.pyramids) CHECK(r.interface_quads == primal::index_cast(in.pyramids.size()));
+      // Gmsh puts one pyramid on every quad a tet volume meets: each is an interface quad (and
+      // so is every hex quad a split wedge covered).
+      if (c.pyramids && !c.split)
+        CHECK(r.interface_quads == primal::index_cast(in.pyramids.size()));
+      if (c.split) CHECK(r.interface_quads > primal::index_cast(in.pyramids.size()));
       CHECK(blocks_of(r.model) == blocks_of(in));
       // A block of wedges reports its wedges diced alone, as a block of hexes or tets does.
       for (const conform::BlockQuality& q : r.quality) {
@@ -147,7 +163,7 @@ TEST_CASE(
               only_wedges = only_wedges && kind == ElementKind::kWedge;
               if (kind == ElementKind::kWedge) wedges.push_back(in.wedges[e]);
             }
-        if (only_wedges && !wedges.empty())
+        if (only_wedges && !wedges.empty() && !c.split)
           CHECK(q.input_diced_min_scaled_jacobian ==
                 doctest::Approx(primal::diced_wedge_min_scaled_jacobian(in.points, wedges)));
       }
@@ -156,7 +172,12 @@ TEST_CASE(
       // quad of the output. (The geode hexes' own faces on the boundary, where the interface
       // meets it, are in no side set: conform carries the input's sides.)
       REQUIRE(r.model.side_sets.size() == 1);
-      CHECK(r.model.side_sets.front().sides.size() == skin_subfaces(in));
+      // A split wedge's quad on the skin is two triangles: 6 quads diced, not 4.
+      std::size_t split_quads = 0;
+      if (c.split)
+        for (const primal::Side& side : in.side_sets.front().sides)
+          split_quads += side.element.kind == ElementKind::kWedge && side.face < 3;
+      CHECK(r.model.side_sets.front().sides.size() == skin_subfaces(in) + 2 * split_quads);
       std::set<std::array<Index, 4>> boundary;
       for (const auto& q : v.boundary.faces) boundary.insert(primal::face_key(q.nodes));
       std::size_t on_boundary = 0;
