@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
+#include <limits>
 #include <memory>
 #include <span>
+#include <stdexcept>
 #include <tuple>
 #include <utility>
 
@@ -14,29 +17,37 @@ namespace geode::primal {
 
 namespace {
 
+// Face slots: element e's local face k is slot e * kSlots + k (a division by a constant away
+// from its element; a hex has the most faces).
+constexpr std::size_t kSlots = 6;
+
 // One use of a face, filed under its lowest node: its other nodes ascending (a triangle's third
-// kInvalidIndex) and its slot (the element's first slot + the local face).
+// kInvalidIndex) and its slot.
 struct FaceUse {
   std::array<Index, 3> rest;
-  Index slot;
+  std::uint32_t slot;
+  Index element() const { return index_cast(slot / kSlots); }
   bool operator<(const FaceUse& o) const { return std::tie(rest, slot) < std::tie(o.rest, o.slot); }
 };
 
-// Calls f(its nodes, their count) for every local face of every element: elements in flat order
-// (element_offsets), faces in table order, so the n-th call is face slot n.
+// Calls f(its nodes, their count, its slot) for every local face of every element, elements in
+// flat order (element_offsets).
 template <typename F>
 void for_each_face(const Model& model, F&& f) {
+  std::uint32_t first = 0;  // slot of the element's face 0
   auto kind_faces = [&](const auto& elements, ElementKind kind) {
     const auto& topo = cell_topology(kind);
-    for (const auto& corners : elements)
+    for (const auto& corners : elements) {
       for (int k = 0; k < topo.faces; ++k) {
         const topology::CellFace& face = topo.face[index_cast<std::size_t>(k)];
         std::array<Index, 4> nodes{};
         for (int i = 0; i < face.size; ++i)
           nodes[index_cast<std::size_t>(i)] =
               corners[index_cast<std::size_t>(face.corners[index_cast<std::size_t>(i)])];
-        f(nodes, index_cast<std::size_t>(face.size));
+        f(nodes, index_cast<std::size_t>(face.size), first + index_cast<std::uint32_t>(k));
       }
+      first += kSlots;
+    }
   };
   static_assert(kElementKinds[0] == ElementKind::kHex && kElementKinds[1] == ElementKind::kTet &&
                 kElementKinds[2] == ElementKind::kPyramid &&
@@ -47,79 +58,51 @@ void for_each_face(const Model& model, F&& f) {
   kind_faces(model.wedges, ElementKind::kWedge);
 }
 
-// Face slots: the n-th face for_each_face visits is slot n; per kind its first element and
-// first slot, so that a slot's element and an element's slots are a division away.
-class Slots {
- public:
-  explicit Slots(const Model& model) {
-    for (std::size_t k = 0; k < kElementKinds.size(); ++k) {
-      const std::size_t count = element_count(model, kElementKinds[k]);
-      faces_[k] = index_cast<std::size_t>(cell_topology(kElementKinds[k]).faces);
-      element_[k + 1] = element_[k] + count;
-      slot_[k + 1] = slot_[k] + count * faces_[k];
-    }
-  }
-  std::size_t size() const { return slot_.back(); }
-  Index element(std::size_t slot) const {
-    std::size_t k = 0;
-    while (slot >= slot_[k + 1]) ++k;
-    return index_cast(element_[k] + (slot - slot_[k]) / faces_[k]);
-  }
-  // [first, last) slots of flat element e.
-  std::pair<std::size_t, std::size_t> of(std::size_t e) const {
-    std::size_t k = 0;
-    while (e >= element_[k + 1]) ++k;
-    const std::size_t first = slot_[k] + (e - element_[k]) * faces_[k];
-    return {first, first + faces_[k]};
-  }
-
- private:
-  std::array<std::size_t, 4> faces_{};
-  std::array<std::size_t, 5> element_{}, slot_{};
-};
-
 }  // namespace
 
 ElementGraph element_graph(const Model& model) {
   const std::size_t n = element_count(model);
-  const Slots slots(model);
+  if (n > std::numeric_limits<std::uint32_t>::max() / kSlots)
+    throw std::length_error("element_graph: more than 715 million elements");
+  const std::size_t slots = n * kSlots;
 
   // The face uses bucketed by lowest node (a counting sort), each bucket a few dozen uses paired
   // by sorting it: a hash of every face (primal/key_map.hpp, its table far larger than the
   // caches) took three times as long on 1.8 million elements.
   std::vector<std::size_t> start(model.points.size() + 1, 0);
-  for_each_face(model, [&](const std::array<Index, 4>& nodes, std::size_t size) {
+  for_each_face(model, [&](const std::array<Index, 4>& nodes, std::size_t size, std::uint32_t) {
     const Index low =
         std::min(std::min(nodes[0], nodes[1]), size == 4 ? std::min(nodes[2], nodes[3]) : nodes[2]);
     ++start[index_cast<std::size_t>(low) + 1];
   });
   for (std::size_t v = 0; v < model.points.size(); ++v) start[v + 1] += start[v];
   // Every entry is written below: no zeroing of the largest array.
-  const auto uses = std::make_unique_for_overwrite<FaceUse[]>(slots.size());
+  const auto uses = std::make_unique_for_overwrite<FaceUse[]>(start.back());
   {
     std::vector<std::size_t> fill(start.begin(), start.end() - 1);
-    Index slot = 0;
-    for_each_face(model, [&](const std::array<Index, 4>& nodes, std::size_t size) {
-      const FaceKey key = face_key(std::span<const Index>(nodes.data(), size));
-      uses[fill[index_cast<std::size_t>(key[0])]++] = {{key[1], key[2], key[3]}, slot++};
-    });
+    for_each_face(
+        model, [&](const std::array<Index, 4>& nodes, std::size_t size, std::uint32_t slot) {
+          const FaceKey key = face_key(std::span<const Index>(nodes.data(), size));
+          uses[fill[index_cast<std::size_t>(key[0])]++] = {{key[1], key[2], key[3]}, slot};
+        });
   }
   auto bucket = [&](std::size_t v) {
     return std::span<FaceUse>(uses.get() + start[v], start[v + 1] - start[v]);
   };
   // Per slot the element across that face, kInvalidIndex if none (yet).
-  std::vector<Index> across(slots.size(), kInvalidIndex);
+  std::vector<Index> across(slots, kInvalidIndex);
+  std::vector<std::pair<Index, FaceUse>> lonely_quads;  // unpaired: (lowest node, use)
   for (std::size_t v = 0; v < model.points.size(); ++v) {
     auto b = bucket(v);
     std::sort(b.begin(), b.end());
     // A face used more than twice (an invalid model) joins its uses two by two.
-    for (std::size_t i = 0; i + 1 < b.size(); ++i)
-      if (b[i].rest == b[i + 1].rest) {
-        const auto s = index_cast<std::size_t>(b[i].slot),
-                   t = index_cast<std::size_t>(b[i + 1].slot);
-        across[s] = slots.element(t);
-        across[t] = slots.element(s);
+    for (std::size_t i = 0; i < b.size(); ++i)
+      if (i + 1 < b.size() && b[i].rest == b[i + 1].rest) {
+        across[b[i].slot] = b[i + 1].element();
+        across[b[i + 1].slot] = b[i].element();
         ++i;
+      } else if (b[i].rest[2] != kInvalidIndex) {
+        lonely_quads.push_back({index_cast(v), b[i]});
       }
   }
   // An unpaired triangle on 3 nodes of an unpaired quad (filed under the triangle's lowest
@@ -128,27 +111,22 @@ ElementGraph element_graph(const Model& model) {
   std::vector<std::array<Index, 2>> extra;
   auto find_triangle = [&](Index a, Index b, Index c) -> const FaceUse* {
     const auto s = bucket(index_cast<std::size_t>(a));
-    const FaceUse probe{{b, c, kInvalidIndex}, kInvalidIndex};
+    const FaceUse probe{{b, c, kInvalidIndex}, 0};
     for (auto it = std::lower_bound(s.begin(), s.end(), probe);
          it != s.end() && it->rest == probe.rest; ++it)
-      if (across[index_cast<std::size_t>(it->slot)] == kInvalidIndex) return &*it;
+      if (across[it->slot] == kInvalidIndex) return &*it;
     return nullptr;
   };
-  for (std::size_t v = 0; v < model.points.size(); ++v)
-    for (const FaceUse& q : bucket(v)) {
-      const auto qs = index_cast<std::size_t>(q.slot);
-      if (q.rest[2] == kInvalidIndex || across[qs] != kInvalidIndex) continue;
-      const Index a = index_cast(v), b = q.rest[0], c = q.rest[1], d = q.rest[2];
-      for (const auto& [x, y, z] :
-           {std::array{a, b, c}, std::array{a, b, d}, std::array{a, c, d}, std::array{b, c, d}}) {
-        const FaceUse* t = find_triangle(x, y, z);
-        if (t == nullptr) continue;
-        const auto ts = index_cast<std::size_t>(t->slot);
-        if (slots.element(ts) == slots.element(qs)) continue;
-        across[ts] = slots.element(qs);  // the triangle is taken; the quad may take another
-        extra.push_back({slots.element(qs), slots.element(ts)});
-      }
+  for (const auto& [a, q] : lonely_quads) {
+    const Index b = q.rest[0], c = q.rest[1], d = q.rest[2];
+    for (const auto& [x, y, z] :
+         {std::array{a, b, c}, std::array{a, b, d}, std::array{a, c, d}, std::array{b, c, d}}) {
+      const FaceUse* t = find_triangle(x, y, z);
+      if (t == nullptr || t->element() == q.element()) continue;
+      across[t->slot] = q.element();  // the triangle is taken; the quad may take another
+      extra.push_back({q.element(), t->element()});
     }
+  }
   // The quad-triangle joins were set on the triangle's slot only: listed from the quad's side.
   std::vector<std::size_t> extra_count(n, 0);
   for (const auto& [quad, tri] : extra) ++extra_count[index_cast<std::size_t>(quad)];
@@ -156,16 +134,15 @@ ElementGraph element_graph(const Model& model) {
   g.offset.assign(n + 1, 0);
   for (std::size_t e = 0; e < n; ++e) {
     std::size_t degree = extra_count[e];
-    const auto [first, last] = slots.of(e);
-    for (std::size_t s = first; s < last; ++s) degree += across[s] != kInvalidIndex;
+    for (std::size_t s = e * kSlots; s < (e + 1) * kSlots; ++s)
+      degree += across[s] != kInvalidIndex;
     g.offset[e + 1] = g.offset[e] + degree;
   }
   g.neighbour.resize(g.offset[n]);
   std::vector<std::size_t> fill(n);
   for (std::size_t e = 0; e < n; ++e) {
     std::size_t k = g.offset[e];
-    const auto [first, last] = slots.of(e);
-    for (std::size_t s = first; s < last; ++s)
+    for (std::size_t s = e * kSlots; s < (e + 1) * kSlots; ++s)
       if (across[s] != kInvalidIndex) g.neighbour[k++] = across[s];
     fill[e] = k;
   }
