@@ -68,7 +68,7 @@ ElementGraph element_graph(const Model& model) {
 
   // The face uses bucketed by lowest node (a counting sort), each bucket a few dozen uses paired
   // by sorting it: a hash of every face (primal/key_map.hpp, its table far larger than the
-  // caches) took three times as long on 1.8 million elements.
+  // caches) took four times as long on 1.8 million elements.
   std::vector<std::size_t> start(model.points.size() + 1, 0);
   for_each_face(model, [&](const std::array<Index, 4>& nodes, std::size_t size, std::uint32_t) {
     const Index low =
