@@ -1,7 +1,9 @@
 #pragma once
 // Element partitioning by METIS (Debian libmetis-dev): the dual graph of a model's elements
-// (two elements adjacent when they share a face, 3 nodes), cut into parts balanced by the hexes
-// each element dices into (8 per hex, 4 per tet, 6 per wedge).
+// (primal/element_graph.hpp: two elements adjacent when they share a face, 3 nodes), cut into
+// parts balanced by the hexes each element dices into (8 per hex, 4 per tet, 6 per wedge, 8 per
+// pyramid). Past 64 clusters a part, METIS cuts the graph of clusters of ~16 connected elements
+// (edges weighted by the faces they share) and a greedy pass over the elements smooths the cut.
 #include <vector>
 
 #include <geode/primal/model.hpp>
@@ -9,7 +11,7 @@
 namespace geode::parallel {
 
 // Per flat element (primal::element_offsets): its part in [0, parts). Deterministic for a given
-// model and part count (METIS seeded). parts == 1: all zero.
+// model and part count (METIS seeded, the rest sequential). parts == 1: all zero.
 std::vector<int> partition_elements(const primal::Model& model, int parts);
 
 // A partition the input carries (io/file_partition.hpp: a partitioned .msh, a Nemesis set) of
