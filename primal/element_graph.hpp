@@ -2,8 +2,9 @@
 // The dual graph of a model's elements: two elements adjacent when they share a face (its 3 or 4
 // nodes), or where a quad of one meets a triangle on 3 of its nodes (a hex part facing a tet part
 // without pyramids: the quad split in two triangles). What METIS_PartMeshDual builds with
-// ncommon = 3, found by pairing face keys (primal/key_map.hpp) instead of counting the nodes
-// shared by every pair of elements around a node.
+// ncommon = 3, found by filing every face under its lowest node and sorting each node's few
+// faces (a KeyMap of every face costs four times as much on large models: its table outgrows the
+// cache) instead of counting the nodes shared by every pair of elements around a node.
 #include <cstddef>
 #include <vector>
 
