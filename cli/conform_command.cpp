@@ -57,7 +57,7 @@ void print_summary(const conform::ConformResult& r, std::ostream& os, bool table
   os << "input: " << r.input_hexes << " hexes, " << r.input_tets << " tets, ";
   if (r.input_pyramids) os << r.input_pyramids << " pyramids (split), ";
   if (r.input_wedges) os << r.input_wedges << " wedges, ";
-  if (r.wedges_split) os << "(" << r.wedges_split << " of them split), ";
+  if (r.wedges_split) os << r.wedges_split << " of them split into tets, ";
   os << r.interface_quads << " interface quads\n";
   if (r.relaxation.nodes_moved)
     os << "tets relaxed near the hex part: " << r.relaxation.nodes_moved

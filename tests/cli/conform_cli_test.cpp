@@ -163,3 +163,30 @@ TEST_CASE("geode conform: a warning reaches stderr with --quiet, and the report 
   CHECK(j.at("warnings").size() == 1);
   CHECK(j.at("valid") == true);
 }
+
+TEST_CASE("geode conform: a layer of hexes beside wedges on tets is split, warned and counted") {
+  // Gmsh's layer-mixed demo as a user saves it: the wedges join the two sides of the interface,
+  // where the run exited 3; now every wedge of the layer becomes three tets, a warning names one
+  // by the file's id, the buffer is carved from the tets (the hex layer's first cells are thin)
+  // and the report counts the split wedges among the input's.
+  TempDir dir;
+  const fs::path in = dir.path / "mixed.msh", report = dir.path / "r.json";
+  REQUIRE(geode_cli("demo --model layer-mixed -n 3 --quiet --save-input " + in.string()).code == 0);
+  const Run r = geode_cli("conform " + in.string() + " -o " + (dir.path / "out.exo").string() +
+                          " --report " + report.string() + " --quiet");
+  INFO(r.out);
+  CHECK(r.code == 0);
+  CHECK(r.out.find("geode: warning: 132 wedges split into three tets each: the layer of wedge ") !=
+        std::string::npos);
+  CHECK(r.out.find("geode: warning: buffer layer carved from the tet part, not the hex part") !=
+        std::string::npos);
+  std::ifstream is(report);
+  const nlohmann::json j = nlohmann::json::parse(is);
+  CHECK(j.at("input").at("wedges") == 132);
+  CHECK(j.at("input").at("wedges_split") == 132);
+  CHECK(j.at("output").at("diced_wedge_hexes") == 0);
+  CHECK(j.at("buffer_side") == "tet");
+  CHECK(j.at("valid") == true);
+  CHECK(j.at("output_min_scaled_jacobian").get<double>() >=
+        j.at("input_diced_alone_min_scaled_jacobian").at("tets").get<double>());
+}
