@@ -1178,7 +1178,7 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
       if (!given.empty()) own.points = std::move(given);
       const std::vector<Index> pieces = primal::wedge_pieces(*model, joining);
       warnings.push_back(
-          std::to_string(pieces.size()) + " wedges split into three tets each: " + "the layer of " +
+          std::to_string(pieces.size()) + " wedges split into three tets each: the layer of " +
           primal::describe_element(*model, {primal::ElementKind::kWedge, joining.front()}) +
           " joins the two sides of the hex/tet interface (hexes and wedges side "
           "by side in a layer against tets), where no buffer layer can end");
