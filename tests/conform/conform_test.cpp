@@ -323,11 +323,13 @@ TEST_CASE("conform: a wedge on the tet side of an interface node takes the node'
                        TopologyError);
 }
 
-TEST_CASE("conform refuses a wedge joining the two sides of an interface node, naming it") {
+TEST_CASE("conform splits wedges joining the two sides of an interface node, naming one") {
   // Hexes at (0,0,0) and (0,0,1), tets at (1,0,0), and the cell (1,0,1) as two wedges standing
   // on the tets' top triangles: around the nodes of the interface's top edge the wedges share
   // a quad with the upper hex and triangles with the tets, so the interface x = 1 ends inside
-  // the mesh there, where no buffer layer can end.
+  // the mesh there, where no buffer layer can end. find_interface refuses it naming a wedge;
+  // conform splits the two wedges into tets, so the upper hex's quad x = 1 is an interface quad
+  // too, and the result is valid.
   primal::Model m =
       primal::grid_model({2, 1, 2}, 1.0, [](int i, int, int k) { return i == 1 && k == 0; });
   std::size_t upper = m.hexes.size();
@@ -350,10 +352,23 @@ TEST_CASE("conform refuses a wedge joining the two sides of an interface node, n
       return primal::kInvalidIndex;
     }));
   REQUIRE_NOTHROW(primal::check_geometry(m, "w.msh"));
-  CHECK_THROWS_WITH_AS(conform::conform(m),
+  CHECK_THROWS_WITH_AS(primal::find_interface(m),
                        doctest::Contains("joins the two sides of the hex/tet interface at node"),
                        TopologyError);
-  CHECK_THROWS_WITH_AS(conform::conform(m), doctest::Contains("wedge "), TopologyError);
+  CHECK_THROWS_WITH_AS(primal::find_interface(m), doctest::Contains("wedge "), TopologyError);
+  const conform::ConformResult r = conform::conform(m);
+  test::check_conform_result(r, -1, 1);
+  CHECK(r.wedges_split == 2);
+  CHECK(r.input_wedges == 2);
+  CHECK(r.input_tets == primal::index_cast(m.tets.size()));
+  CHECK(r.diced_wedge_hexes == 0);
+  CHECK(r.diced_tet_hexes == 4 * primal::index_cast(m.tets.size() + 3 * m.wedges.size()));
+  CHECK(r.interface_quads == 2);  // the lower hex's quad x = 1, and now the upper hex's
+  REQUIRE(r.warnings.size() == 1);
+  CHECK(r.warnings.front().find("2 wedges split into three tets each: the layer of wedge ") == 0);
+  // Kuhn tets dice to 0.41, above the template's own 0.33: the transition is held to that.
+  CHECK(primal::min_scaled_jacobian(primal::hex_part(r.model)) >=
+        0.9 * r.template_min_scaled_jacobian);
 }
 
 TEST_CASE("conform: a wedge quad meeting two tet triangles gets the geode transition") {
