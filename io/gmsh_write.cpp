@@ -285,14 +285,14 @@ class MshWriter {
   bool v41_;
 
   // ASCII lines of items [0, n), made in parallel chunks (text_chunks.hpp): `line(i, at)`
-  // writes item i's line of `numbers` numbers at `at` and returns its end.
+  // writes item i's line, at most `room` characters, at `at` and returns its end.
   template <class Line>
-  void text_chunks(std::size_t n, std::size_t numbers, Line&& line) {
+  void text_chunks(std::size_t n, std::size_t room, Line&& line) {
     constexpr std::size_t kLines = 2048;
     write_in_chunks(
         n, kLines,
         [&](std::size_t begin, std::size_t end, std::string& text) {
-          text.resize((end - begin) * numbers * (kNumberText + 1));
+          text.resize((end - begin) * room);
           char* at = text.data();
           for (std::size_t i = begin; i < end; ++i) at = line(i, at);
           text.resize(index_cast<std::size_t>(at - text.data()));
@@ -376,12 +376,12 @@ class MshWriter {
       }
       nl();
     } else {
-      text_chunks(pts.size(), 1, [](std::size_t i, char* at) {
+      text_chunks(pts.size(), kIntegerText + 1, [](std::size_t i, char* at) {
         at = put_number(at, index_cast<std::int64_t>(i + 1));
         *at++ = '\n';
         return at;
       });
-      text_chunks(pts.size(), 3, [&pts](std::size_t i, char* at) {
+      text_chunks(pts.size(), 3 * (kRealText + 1), [&pts](std::size_t i, char* at) {
         for (int k = 0; k < 3; ++k) {
           at = put_number(at, pts[i][k]);
           *at++ = k < 2 ? ' ' : '\n';
@@ -404,17 +404,18 @@ class MshWriter {
       int_field(b.type);
       size_field(b.count(), true);
       if (!binary_) {
-        text_chunks(b.count(), 1 + b.nodes_per_element, [&](std::size_t e, char* at) {
-          std::array<std::size_t, 8> nodes{};
-          b.tags(l_.model, e, nodes);
-          at = put_number(at, index_cast<std::int64_t>(b.first_tag + e));
-          for (std::size_t k = 0; k < b.nodes_per_element; ++k) {
-            *at++ = ' ';
-            at = put_number(at, index_cast<std::int64_t>(nodes[k]));
-          }
-          *at++ = '\n';
-          return at;
-        });
+        text_chunks(b.count(), (1 + b.nodes_per_element) * (kIntegerText + 1),
+                    [&](std::size_t e, char* at) {
+                      std::array<std::size_t, 8> nodes{};
+                      b.tags(l_.model, e, nodes);
+                      at = put_number(at, index_cast<std::int64_t>(b.first_tag + e));
+                      for (std::size_t k = 0; k < b.nodes_per_element; ++k) {
+                        *at++ = ' ';
+                        at = put_number(at, index_cast<std::int64_t>(nodes[k]));
+                      }
+                      *at++ = '\n';
+                      return at;
+                    });
         continue;
       }
       std::array<std::size_t, 8> nodes{};

@@ -21,14 +21,14 @@ void write_in_chunks(
     const std::function<void(std::string_view bytes)>& write);
 
 // The shortest text that reads back to the same value (std::to_chars), written at `at`, which
-// has room for kNumberText characters (a double's shortest text is at most 24,
-// "-1.2345678901234567e-308"; an int64's 20); returns one past its end. Chunks write into a string
-// sized for their worst case and cut it to what was written: appending number by number cost more
-// than formatting.
-inline constexpr std::size_t kNumberText = 24;
+// has room for kIntegerText or kRealText characters (an int64 is at most 20, a double's
+// shortest text 24: "-1.2345678901234567e-308"); returns one past its end. Chunks write into a
+// string sized for their worst case and cut it to what was written: appending number by number
+// cost more than formatting.
+inline constexpr std::size_t kIntegerText = 20, kRealText = 24;
 inline char* put_number(char* at, std::int64_t x) {
-  return std::to_chars(at, at + kNumberText, x).ptr;
+  return std::to_chars(at, at + kIntegerText, x).ptr;
 }
-inline char* put_number(char* at, double x) { return std::to_chars(at, at + kNumberText, x).ptr; }
+inline char* put_number(char* at, double x) { return std::to_chars(at, at + kRealText, x).ptr; }
 
 }  // namespace geode::io

@@ -382,7 +382,8 @@ void write_rows(std::ostream& os, const Slices<T>& v, std::size_t per_line, cons
   write_chunks(os, v.size, kTextChunk, [&](std::size_t begin, std::size_t end, std::string& text) {
     std::vector<T> values(end - begin);
     v.fill(begin, end, values.data());
-    text.resize((end - begin) * (indent_size + kNumberText + 2));
+    text.resize((end - begin) *
+                (indent_size + (std::is_floating_point_v<T> ? kRealText : kIntegerText) + 2));
     char* at = text.data();
     for (std::size_t i = begin; i < end; ++i) {
       if (i % per_line == 0)
@@ -588,7 +589,7 @@ void write_vtk_output(std::ostream& os, const Output& o) {
   os << "POINTS " << pts.size() << " double\n";
   write_chunks(os, pts.size(), kTextChunk / 4,
                [&](std::size_t begin, std::size_t end, std::string& text) {
-                 text.resize((end - begin) * 3 * (kNumberText + 1));
+                 text.resize((end - begin) * 3 * (kRealText + 1));
                  char* at = text.data();
                  for (std::size_t i = begin; i < end; ++i) {
                    at = put_number(at, pts[i].x());
@@ -603,7 +604,7 @@ void write_vtk_output(std::ostream& os, const Output& o) {
   os << "CELLS " << ncells << ' ' << ncells + o.cells.corners << '\n';
   write_chunks(
       os, ncells, kTextChunk / 8, [&](std::size_t begin, std::size_t end, std::string& text) {
-        text.resize((end - begin) * 9 * (kNumberText + 1));
+        text.resize((end - begin) * 9 * (kIntegerText + 1));  // count, <= 8 corners
         char* at = text.data();
         o.cells.for_each(begin, end, [&](const CellRun& run, const auto& cell, std::size_t) {
           at = put_number(at, index_cast<std::int64_t>(cell.size()));
