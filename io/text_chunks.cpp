@@ -1,0 +1,40 @@
+#include <geode/io/text_chunks.hpp>
+
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+
+#include <geode/primal/mesh.hpp>
+
+namespace geode::io {
+
+using primal::index_cast;
+
+void write_in_chunks(
+    std::size_t n, std::size_t chunk,
+    const std::function<void(std::size_t begin, std::size_t end, std::string& out)>& make,
+    const std::function<void(std::string_view bytes)>& write) {
+  const std::size_t chunks = (n + chunk - 1) / chunk;
+  std::size_t next = 0;
+  // TBB's pipeline: chunk numbers in order, made in parallel, written in their order. Two chunks
+  // in flight per thread keep every thread busy while one is written, and few are held.
+  tbb::parallel_pipeline(
+      2 * index_cast<std::size_t>(tbb::this_task_arena::max_concurrency()),
+      tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
+                                          [&](tbb::flow_control& control) {
+                                            if (next == chunks) control.stop();
+                                            return next++;
+                                          }) &
+          tbb::make_filter<std::size_t, std::string>(tbb::filter_mode::parallel,
+                                                     [&](std::size_t c) {
+                                                       std::string out;
+                                                       make(c * chunk, std::min(n, (c + 1) * chunk),
+                                                            out);
+                                                       return out;
+                                                     }) &
+          tbb::make_filter<std::string, void>(tbb::filter_mode::serial_in_order,
+                                              [&](const std::string& out) { write(out); }));
+}
+
+}  // namespace geode::io
