@@ -225,13 +225,14 @@ Slices<double> scaled_jacobians(const Output& out) {
   return {out.cells.size, [&out](std::size_t begin, std::size_t end, double* sj) {
             const auto& pts = *out.points;
             out.cells.for_each(begin, end, [&](const CellRun& run, const auto& cell, std::size_t) {
-              constexpr std::size_t N = std::tuple_size_v<std::decay_t<decltype(cell)>>;
-              std::array<Point, N> p;
-              for (std::size_t k = 0; k < N; ++k) p[k] = pts[index_cast<std::size_t>(cell[k])];
-              if constexpr (N == 8) *sj++ = hex_sj(p);
-              if constexpr (N == 4) *sj++ = run.type == kVtkQuad ? quad_sj(p) : tet_sj(p);
-              if constexpr (N == 5) *sj++ = pyramid_sj(p);
-              if constexpr (N == 6) *sj++ = wedge_sj(p);
+              constexpr std::size_t kCorners = std::tuple_size_v<std::decay_t<decltype(cell)>>;
+              std::array<Point, kCorners> p;
+              for (std::size_t k = 0; k < kCorners; ++k)
+                p[k] = pts[index_cast<std::size_t>(cell[k])];
+              if constexpr (kCorners == 8) *sj++ = hex_sj(p);
+              if constexpr (kCorners == 4) *sj++ = run.type == kVtkQuad ? quad_sj(p) : tet_sj(p);
+              if constexpr (kCorners == 5) *sj++ = pyramid_sj(p);
+              if constexpr (kCorners == 6) *sj++ = wedge_sj(p);
             });
           }};
 }
