@@ -85,8 +85,10 @@ std::vector<Index> wedge_pieces(const Model& model, std::span<const Index> seeds
   const std::size_t n = model.wedges.size();
   DisjointSets sets(n);
   KeyMap<4> first(5 * n);  // a wedge face -> the first wedge on it
+  const auto& topo = cell_topology(ElementKind::kWedge);
   for (std::size_t w = 0; w < n; ++w)
-    for (const auto& f : cell_topology(ElementKind::kWedge).face) {
+    for (int face = 0; face < topo.faces; ++face) {  // the table holds a sixth, empty face
+      const auto& f = topo.face[index_cast<std::size_t>(face)];
       std::array<Index, 4> nodes{};
       for (int i = 0; i < f.size; ++i)
         nodes[index_cast<std::size_t>(i)] =

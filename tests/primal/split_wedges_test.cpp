@@ -161,6 +161,22 @@ TEST_CASE("split_wedges: shared quads split alike, kept wedges renumbered, sides
   }
 }
 
+TEST_CASE("wedge_pieces: the wedges joined through shared faces, whole pieces only") {
+  primal::Model m = two_wedges();
+  // A third wedge apart, the first two's shape moved 5 along x: no face shared with them.
+  const Index base = primal::index_cast(m.points.size());
+  for (Index v = 0; v < 6; ++v)
+    m.points.push_back(m.points[primal::index_cast<std::size_t>(v)] + Point(5, 0, 0));
+  primal::add_element(m, ElementKind::kWedge,
+                      std::array<Index, 6>{base, base + 1, base + 2, base + 3, base + 4, base + 5},
+                      4, 13);
+  CHECK(primal::wedge_pieces(m, std::vector<Index>{0}) == std::vector<Index>{0, 1});
+  CHECK(primal::wedge_pieces(m, std::vector<Index>{1}) == std::vector<Index>{0, 1});
+  CHECK(primal::wedge_pieces(m, std::vector<Index>{2}) == std::vector<Index>{2});
+  CHECK(primal::wedge_pieces(m, std::vector<Index>{2, 0}) == std::vector<Index>{0, 1, 2});
+  CHECK(primal::wedge_pieces(m, std::vector<Index>{}).empty());
+}
+
 TEST_CASE("split_wedges: Gmsh's layer of hexes beside wedges on tets, refused whole, split") {
   test::TempDir dir;
   const primal::Model in = test::demo_input("layer-mixed", 3, dir);
