@@ -458,8 +458,13 @@ Model read_exodus_piece(const std::filesystem::path& path, const ReadOptions& op
   // "stack smashing detected" in main's reader), and libhdf5 crashes on corrupt netCDF-4 ones.
   // The child may use what the data it returns needs, several times over, and not the
   // machine: 2 GiB, or 64 times the file's size for larger files.
+  // Its time is bounded by the file's size too: 3 s of CPU and 1 s more per MiB (libhdf5 reads
+  // hundreds of MiB a second), twice that and 2 s of wall-clock time; so a corrupt file that
+  // sends the library into a loop, or a child that never answers, ends in seconds.
   IsolationLimits limits;
   limits.memory_bytes = std::max<std::uint64_t>(limits.memory_bytes, 64 * size);
+  limits.cpu_seconds = static_cast<unsigned>(std::min<std::uint64_t>(3 + (size >> 20), 1u << 20));
+  limits.wall_seconds = 2 * limits.cpu_seconds + 2;
   limits.max_result_bytes = 8 * bound.capacity() + 4096;
   const std::string answer = run_isolated(
       [&] { return pack(read_contents(source, bound)); }, source,

@@ -1,12 +1,15 @@
 #include <geode/io/isolated.hpp>
 
 #include <fcntl.h>
+#include <poll.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <fstream>
 #include <new>
@@ -164,10 +167,22 @@ std::string run_isolated(const std::function<std::string()>& work, const std::st
   ::close(fds[1]);
   Child child(pid);
   std::string answer;
-  bool overlong = false;
+  bool overlong = false, late = false;
   {
+    using Clock = std::chrono::steady_clock;
+    const Clock::time_point deadline = Clock::now() + std::chrono::seconds(limits.wall_seconds);
     char buf[1 << 16];
     for (;;) {
+      const auto left =
+          std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
+      if (left <= 0) {
+        late = true;
+        break;
+      }
+      pollfd ready{fds[0], POLLIN, 0};
+      const int polled = ::poll(&ready, 1, static_cast<int>(std::min<long long>(left, 1 << 30)));
+      if (polled < 0 && errno == EINTR) continue;
+      if (polled == 0) continue;  // the deadline is checked above
       const ssize_t n = ::read(fds[0], buf, sizeof buf);
       if (n < 0 && errno == EINTR) continue;
       if (n <= 0) break;
@@ -179,6 +194,9 @@ std::string run_isolated(const std::function<std::string()>& work, const std::st
     }
   }
   ::close(fds[0]);
+  if (late)
+    throw InvalidInput(source + ": " + what + " failed: it took more than " +
+                       std::to_string(limits.wall_seconds) + " s (corrupt file?)");
   if (overlong)
     throw std::runtime_error(source + ": " + what + ": the reader process said too much");
   const int status = child.wait();

@@ -21,6 +21,10 @@ struct IsolationLimits {
   std::uint64_t memory_bytes = std::uint64_t{2} << 30;
   // CPU seconds for the child (RLIMIT_CPU): an endless loop on a corrupt file ends.
   unsigned cpu_seconds = 300;
+  // Seconds of wall-clock time the caller waits for the child's answer before killing it: a
+  // child that waits for ever spends no CPU time (a lock held, at the fork, by another thread
+  // of the caller's: the CLI builds templates on a thread while it reads).
+  unsigned wall_seconds = 600;
   // The most bytes the child may return (its answer is bounded like any input).
   std::uint64_t max_result_bytes = std::uint64_t{1} << 34;
 };
@@ -28,7 +32,7 @@ struct IsolationLimits {
 // Runs `work` in a forked child and returns the bytes it returned. In the child, an
 // InvalidInput (or std::bad_alloc, or any other exception) becomes the same InvalidInput in
 // the caller; a child killed by a signal or out of its limits becomes InvalidInput
-// "`source`: `what` failed: <how>", and so does a child that ends without its answer (the
+// "`source`: `what` failed: <how>" (a child out of its wall-clock time is killed), and so does a child that ends without its answer (the
 // library calling exit, or a sanitizer's heap check on the library's own corruption in sanitizer
 // builds). The child never returns into the caller's code: it ends with _exit; its output goes
 // to /dev/null (outside sanitizer builds). An exception in the child other than InvalidInput and

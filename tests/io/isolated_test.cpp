@@ -4,6 +4,7 @@
 #include <doctest/doctest.h>
 #include <signal.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
@@ -55,6 +56,17 @@ TEST_CASE("run_isolated: the child's bytes come back, its failures become Invali
                            },
                            "f.exo", "reading", one_second),
                        doctest::Contains("f.exo: reading failed: it took more than 1 s of CPU"),
+                       InvalidInput);
+  // A child that never answers and spends no CPU time (waiting on a lock another thread held
+  // at the fork) is killed at the wall-clock limit.
+  IsolationLimits one_wall_second;
+  one_wall_second.wall_seconds = 1;
+  CHECK_THROWS_WITH_AS(run_isolated(
+                           []() -> std::string {
+                             for (;;) ::pause();
+                           },
+                           "f.exo", "reading", one_wall_second),
+                       doctest::Contains("f.exo: reading failed: it took more than 1 s"),
                        InvalidInput);
   // An exception that is not about the file is a fault of ours, not a refusal of the input.
   CHECK_THROWS_AS(
