@@ -59,6 +59,8 @@
 
 #include <gmsh.h>
 
+#include "child_run.hpp"
+
 #include <geode/demo/demo_models.hpp>
 #include <geode/io/exodus.hpp>
 #include <geode/io/gmsh.hpp>
@@ -71,12 +73,7 @@ namespace gp = geode::primal;
 
 namespace {
 
-struct Run {
-  double seconds = 0.0;
-  double cpu_seconds = 0.0;  // user + system, from the child's rusage
-  double peak_mib = 0.0;
-  int status = 0;  // wait status; 0 when the child exited 0
-};
+using Run = geode::bench::ChildRun;
 
 // fork + execv `argv`, stdout and stderr to `log`; wall time from fork to wait4.
 Run run_child(const std::vector<std::string>& argv, const fs::path& log) {
@@ -97,19 +94,7 @@ Run run_child(const std::vector<std::string>& argv, const fs::path& log) {
     std::perror("execv");
     _exit(127);
   }
-  int status = 0;
-  rusage ru{};
-  if (wait4(pid, &status, 0, &ru) != pid) {
-    std::perror("bench_conform_vs_gmsh: wait4");
-    std::exit(2);
-  }
-  Run r;
-  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  r.cpu_seconds = static_cast<double>(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
-                  1e-6 * static_cast<double>(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
-  r.peak_mib = ru.ru_maxrss / 1024.0;  // ru_maxrss is in KiB on Linux
-  r.status = status;
-  return r;
+  return geode::bench::wait_child(pid, t0);
 }
 
 Run best_of(int repeats, const std::vector<std::string>& argv, const fs::path& log,

@@ -7,17 +7,16 @@
 //
 // Usage: bench_msh_writer [n] [repeats]   (n^3 hexes beside n^3 * 6 / 2 tets; default 60)
 #include <gmsh.h>
-#include <sys/resource.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <functional>
 #include <string>
 #include <vector>
+
+#include "child_run.hpp"
 
 #include <geode/demo/gmsh_session.hpp>
 #include <geode/io/gmsh.hpp>
@@ -66,22 +65,6 @@ void gmsh_write(const Model& model, const fs::path& file, bool binary, bool v22)
   gmsh::write(file.string());
 }
 
-// Runs f in a child; returns (seconds, peak RSS MiB) of the child.
-std::pair<double, double> in_child(const std::function<void()>& f) {
-  const auto start = std::chrono::steady_clock::now();
-  const pid_t pid = fork();
-  if (pid == 0) {
-    f();
-    std::_Exit(0);
-  }
-  int status = 0;
-  struct rusage ru {};
-  wait4(pid, &status, 0, &ru);
-  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) std::printf("  child failed\n");
-  return {s, static_cast<double>(ru.ru_maxrss) / 1024.0};
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -94,8 +77,8 @@ int main(int argc, char** argv) {
   std::printf("model: %zu nodes, %zu hexes, %zu tets; the parent holds it (peak RSS includes it)\n",
               model.points.size(), model.hexes.size(), model.tets.size());
   {
-    const auto [s, mib] = in_child([] {});
-    std::printf("%-28s %8.3f s %8.1f MiB\n", "(nothing: the baseline)", s, mib);
+    const bench::ChildRun r = bench::run_in_child([] {});
+    std::printf("%-28s %8.3f s %8.1f MiB\n", "(nothing: the baseline)", r.seconds, r.peak_mib);
   }
   struct Case {
     const char* name;
@@ -107,15 +90,15 @@ int main(int argc, char** argv) {
       const fs::path file = dir / (std::string(who ? "gmsh-" : "geode-") + (c.binary ? "b" : "a") +
                                    (c.v22 ? "22" : "41") + ".msh");
       double best = 1e30, mem = 0;
-      for (int r = 0; r < repeats; ++r) {
-        const auto [s, mib] = in_child([&] {
+      for (int i = 0; i < repeats; ++i) {
+        const bench::ChildRun r = bench::run_in_child([&] {
           if (who == 0)
             io::write_gmsh(model, file, c.binary ? io::GmshFormat::kBinary : io::GmshFormat::kAscii,
                            c.v22 ? io::GmshVersion::k22 : io::GmshVersion::k41);
           else
             gmsh_write(model, file, c.binary, c.v22);
         });
-        if (s < best) best = s, mem = mib;
+        if (r.seconds < best) best = r.seconds, mem = r.peak_mib;
       }
       const Model back = io::read_gmsh(file, {false});
       std::printf(

@@ -7,16 +7,13 @@
 // Usage: bench_writers model out_dir [repeats] [writer]
 //   model: any input geode reads (a `geode conform` output .exo: the writers' real load);
 //   writer: one of exo, msh, msh-binary, vtu, vtu-ascii, vtk (default: all), best of repeats.
-#include <sys/resource.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <functional>
 #include <string>
+
+#include "child_run.hpp"
 
 #include <geode/io/formats.hpp>
 #include <geode/io/gmsh.hpp>
@@ -24,32 +21,6 @@
 
 namespace fs = std::filesystem;
 using namespace geode;
-
-namespace {
-
-struct Run {
-  double wall = 0, cpu = 0, mib = 0;
-};
-
-double seconds(const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * t.tv_usec; }
-
-Run in_child(const std::function<void()>& f) {
-  const auto start = std::chrono::steady_clock::now();
-  const pid_t pid = fork();
-  if (pid == 0) {
-    f();
-    std::_Exit(0);
-  }
-  int status = 0;
-  struct rusage ru {};
-  wait4(pid, &status, 0, &ru);
-  const auto wall = std::chrono::steady_clock::now() - start;
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) std::printf("  child failed\n");
-  return {std::chrono::duration<double>(wall).count(), seconds(ru.ru_utime) + seconds(ru.ru_stime),
-          static_cast<double>(ru.ru_maxrss) / 1024};
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   if (argc < 3) {
@@ -82,13 +53,14 @@ int main(int argc, char** argv) {
   for (const Writer& w : writers) {
     if (!only.empty() && only != w.name) continue;
     const fs::path file = dir / (std::string("bench-") + w.name + w.extension);
-    Run best{1e30, 0, 0};
+    bench::ChildRun best;
+    best.seconds = 1e30;
     for (int r = 0; r < repeats; ++r) {
-      const Run run = in_child([&] { w.write(file); });
-      if (run.wall < best.wall) best = run;
+      const bench::ChildRun run = bench::run_in_child([&] { w.write(file); });
+      if (run.seconds < best.seconds) best = run;
     }
-    std::printf("%-10s %7.3f s wall %7.3f s CPU %7.1f MiB peak\n", w.name, best.wall, best.cpu,
-                best.mib);
+    std::printf("%-10s %7.3f s wall %7.3f s CPU %7.1f MiB peak\n", w.name, best.seconds,
+                best.cpu_seconds, best.peak_mib);
     std::fflush(stdout);
   }
   return 0;
