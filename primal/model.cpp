@@ -119,6 +119,15 @@ std::vector<Side> tet_sides_on(const Model& model, Index first, Index count,
   return out;
 }
 
+void rewrite_sides(Model& model, const std::function<void(const Side&, std::vector<Side>&)>& map) {
+  for (SideSet& set : model.side_sets) {
+    std::vector<Side> sides;
+    for (const Side& s : set.sides) map(s, sides);
+    std::sort(sides.begin(), sides.end());
+    set.sides = std::move(sides);
+  }
+}
+
 void add_element(Model& model, ElementKind kind, std::span<const Index> corners, int block,
                  std::int64_t file_id) {
   const auto n = static_cast<std::size_t>(cell_topology(kind).corners);

@@ -16,6 +16,7 @@
 //   the arrays.
 #include <compare>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <span>
 #include <string>
@@ -107,6 +108,10 @@ std::vector<Index> element_face(const Model& model, const Side& side);
 // a side on a cell becomes where the cell is split into those tets (a pyramid, a wedge).
 std::vector<Side> tet_sides_on(const Model& model, Index first, Index count,
                                std::span<const Index> face);
+// Rewrites every side set of `model`: each side becomes the sides `map` appends for it (the
+// side itself, renumbered, or the sides of the cells its element was split into); each set is
+// then sorted.
+void rewrite_sides(Model& model, const std::function<void(const Side&, std::vector<Side>&)>& map);
 // Appends an element of `kind` (its first cell_topology(kind).corners corners), pushing its
 // block and file id onto the kind's vectors (readers fill them for every element).
 void add_element(Model& model, ElementKind kind, std::span<const Index> corners, int block,

@@ -74,20 +74,15 @@ PyramidSplit split_pyramids(const Model& model) {
     }
   }
   // Sides of pyramids: the faces of its two tets whose nodes are all on the pyramid's face.
-  for (SideSet& set : m.side_sets) {
-    std::vector<Side> sides;
-    for (const Side& s : set.sides) {
-      if (s.element.kind != ElementKind::kPyramid) {
-        sides.push_back(s);
-        continue;
-      }
-      const auto on = tet_sides_on(m, first_tet[index_cast<std::size_t>(s.element.index)], 2,
-                                   element_face(model, s));
-      sides.insert(sides.end(), on.begin(), on.end());
+  rewrite_sides(m, [&](const Side& s, std::vector<Side>& sides) {
+    if (s.element.kind != ElementKind::kPyramid) {
+      sides.push_back(s);
+      return;
     }
-    std::sort(sides.begin(), sides.end());
-    set.sides = std::move(sides);
-  }
+    const auto on = tet_sides_on(m, first_tet[index_cast<std::size_t>(s.element.index)], 2,
+                                 element_face(model, s));
+    sides.insert(sides.end(), on.begin(), on.end());
+  });
   return out;
 }
 

@@ -158,24 +158,17 @@ Model split_wedges(const Model& model, std::span<const Index> wedges) {
       add_element(m, ElementKind::kTet, t, block_of(model, ref), element_id(model, ref));
   }
   // Sides of split wedges: the faces of its three tets whose nodes all lie on the wedge's face.
-  for (SideSet& set : m.side_sets) {
-    std::vector<Side> sides;
-    for (const Side& s : set.sides) {
-      if (s.element.kind != ElementKind::kWedge) {
-        sides.push_back(s);
-        continue;
-      }
-      const auto w = index_cast<std::size_t>(s.element.index);
-      if (!split[w]) {
-        sides.push_back({{ElementKind::kWedge, kept[w]}, s.face});
-        continue;
-      }
+  rewrite_sides(m, [&](const Side& s, std::vector<Side>& sides) {
+    const auto w = index_cast<std::size_t>(s.element.index);
+    if (s.element.kind != ElementKind::kWedge) {
+      sides.push_back(s);
+    } else if (!split[w]) {
+      sides.push_back({{ElementKind::kWedge, kept[w]}, s.face});
+    } else {
       const auto on = tet_sides_on(m, first_tet[w], 3, element_face(model, s));
       sides.insert(sides.end(), on.begin(), on.end());
     }
-    std::sort(sides.begin(), sides.end());
-    set.sides = std::move(sides);
-  }
+  });
   return m;
 }
 
