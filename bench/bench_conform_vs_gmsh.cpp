@@ -32,8 +32,9 @@
 // Hybrid mode (bench_conform_vs_gmsh hybrid [n] [repeats] [geode]): the model is
 // demo::demo_hexdominant(n), all four cell kinds side by side (two transfinite hex boxes, a
 // Delaunay tet box with Gmsh's pyramids on the quads it meets, wedge layers extruded off it; n
-// default 28: 126k tets; at 30 Gmsh's mesh holds a tet twice, which the read-time check refuses,
-// and at 32 (189k tets) no buffer layer fits at a sliver tet by the hex box's edge, exit 3),
+// default 28: 126k tets; at 30 Gmsh's mesh holds a tet twice, which the read-time check refuses;
+// 32 has 189k tets, and conforms once the default tet relaxation has moved a sliver by the hex
+// box's edge: with --relax none no buffer layer fits there, exit 3),
 // written as binary .msh 4.1. Gmsh's side runs through the libgmsh API in
 // a fresh process (this program re-executed: gmsh::open, Mesh.SubdivisionAlgorithm = 2,
 // gmsh::model::mesh::refine, gmsh::write binary .msh); geode's is `geode conform model.msh -o
