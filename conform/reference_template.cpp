@@ -6,9 +6,10 @@
 #include <memory>
 #include <mutex>
 #include <sstream>
+#include <stop_token>
 #include <tuple>
 
-#include <tbb/parallel_invoke.h>
+#include <tbb/task_group.h>
 
 #include <geode/primal/errors.hpp>
 #include <geode/primal/patch_match.hpp>
@@ -243,15 +244,16 @@ const RefTemplate& reference_template(const Eigen::Vector3d& given_box,
 }
 
 std::jthread build_reference_templates_ahead(const Eigen::Vector3d& box) {
-  return std::jthread([box] {
+  return std::jthread([box](const std::stop_token& stop) {
+    tbb::task_group group;
+    // A caller that no longer needs them (its input was refused) is not kept waiting for them:
+    // the handle's destruction requests a stop, which cancels the group; the smoother then
+    // throws out of the unfinished template, which is not cached (std::call_once).
+    const std::stop_callback cancel(stop, [&group] { group.cancel(); });
+    group.run([box] { reference_template(box, {4, 6}); });
+    group.run([box] { reference_template(box, {5, 7}); });
     try {
-      tbb::parallel_invoke(
-          [&] {
-            reference_template(box, {4, 6});
-          },
-          [&] {
-            reference_template(box, {5, 7});
-          });
+      group.wait();
     } catch (...) {  // conform() builds it again and reports why
     }
   });

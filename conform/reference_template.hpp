@@ -51,7 +51,9 @@ const RefTemplate& reference_template_four_triangles(const Eigen::Vector3d& box)
 // Starts building both diagonals' templates for `box` (what conform() asks for first) on a thread
 // of its own, so that a caller can overlap them with reading its input: conform() then finds
 // them built, or waits for the build under way (the cache above). A failed build is left to
-// conform(), which builds again and reports it. The thread joins when the handle is destroyed.
+// conform(), which builds again and reports it. Destroying the handle stops a build still
+// under way (the caller's input was refused: it need not wait for templates it will not use)
+// and joins the thread.
 std::jthread build_reference_templates_ahead(const Eigen::Vector3d& box);
 
 // Matches the nodes of side face ka of template A with those of side face kb of template B

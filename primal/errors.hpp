@@ -17,4 +17,12 @@ struct TopologyError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Work stopped because its caller no longer needs it: long loops (the smoother's) end when the
+// TBB task group they run in is cancelled, by its owner (conform's reference templates, built
+// while the input is read, when the input is refused) or by another task's exception. Never
+// shown to a user: whoever cancelled the group discards it.
+struct Cancelled : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 }  // namespace geode

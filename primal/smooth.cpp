@@ -1,6 +1,7 @@
 #include <geode/primal/smooth.hpp>
 
 #include <Eigen/Dense>
+#include <oneapi/tbb/task_group.h>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -344,6 +345,11 @@ class Problem {
   std::vector<FrameVector> dq_;
 };
 
+// An unfinished smoothing must not look finished: in a cancelled task group it throws.
+void stop_if_cancelled() {
+  if (tbb::is_current_task_group_canceling()) throw Cancelled("smoothing cancelled");
+}
+
 // Minimises f with a damped Newton method: solve (H + lambda I) d = -g by Cholesky, raising
 // lambda until H + lambda I is positive definite and lowering it after each success, then a
 // backtracking (Armijo) line search. `done(x, f)` is asked after every accepted step and stops
@@ -358,6 +364,7 @@ int newton(Vec& x, F&& f, Done&& done, int max_iterations, double max_step) {
   double lambda = 0.0;
   int it = 0;
   for (; it < max_iterations; ++it) {
+    stop_if_cancelled();
     const double scale = std::max(h.diagonal().cwiseAbs().maxCoeff(), 1e-300);
     Vec d;
     for (int attempt = 0; attempt < 60; ++attempt) {
@@ -411,6 +418,7 @@ int lbfgs(Vec& x, F&& f, Done&& done, int max_iterations, int history, double in
   double fx = f(x, &g);
   int it = 0;
   for (; it < max_iterations; ++it) {
+    stop_if_cancelled();
     // Two-loop recursion for d = -H g.
     d = -g;
     std::vector<double> alpha(s_hist.size());

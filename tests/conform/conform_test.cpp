@@ -7,6 +7,7 @@
 #include <unistd.h>
 #include <thread>
 
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <functional>
@@ -24,6 +25,7 @@
 #include <geode/primal/interface.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/topology.hpp>
+#include <geode/primal/validity.hpp>
 #include "support/conform_checks.hpp"
 #include "support/fixtures.hpp"
 
@@ -165,6 +167,28 @@ TEST_CASE("reference templates: one per box and diagonal, from several threads a
   CHECK(got[0] == &conform::reference_template(box, {4, 6}));
   CHECK(got[0]->min_scaled_jacobian > 0.0);
   CHECK(got[1]->min_scaled_jacobian > 0.0);
+}
+
+TEST_CASE("reference templates: a build stopped ahead is built whole when asked for") {
+  // conform's CLI builds the templates while it reads and stops the build when the input is
+  // refused. Stopped at several points, the build must leave no unfinished template behind: the
+  // one built afterwards is as good as that of a box a hair different, never stopped (the
+  // smoother's result moves continuously with the box; a template stopped after untangling or
+  // between sharpness stages is far lower).
+  const conform::RefTemplate& twin =
+      conform::reference_template(Eigen::Vector3d(24, 7.000001, 24), {4, 6});
+  int k = 0;
+  for (const int ms : {0, 5, 20, 80}) {
+    CAPTURE(ms);
+    const Eigen::Vector3d box(24, 7 + 1e-9 * ++k, 24);  // boxes no other test uses
+    {
+      const std::jthread ahead = conform::build_reference_templates_ahead(box);
+      std::this_thread::sleep_for(std::chrono::milliseconds(ms));
+    }
+    const conform::RefTemplate& t = conform::reference_template(box, {4, 6});
+    CHECK(t.min_scaled_jacobian == doctest::Approx(twin.min_scaled_jacobian).epsilon(1e-4));
+    CHECK(primal::check_validity(t.tpl.hex).ok());
+  }
 }
 
 TEST_CASE("half-block demo, n = 2") {

@@ -4,7 +4,10 @@
 #include <doctest/doctest.h>
 
 #include <Eigen/Geometry>
+#include <oneapi/tbb/task_group.h>
+
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -159,6 +162,28 @@ TEST_CASE("smoothing is deterministic") {
   CHECK(a.points == b.points);
   CHECK(ra.iterations == rb.iterations);
   CHECK(ra.final_min_scaled_jacobian == rb.final_min_scaled_jacobian);
+}
+
+TEST_CASE("smoothing in a cancelled task group throws Cancelled instead of returning unfinished") {
+  // The Appendix A geode is tangled: both phases have work to do.
+  HexMesh mesh = appendix_a();
+  const auto constraints = gp::box_constraints(mesh.points, kLo, kHi, kSlideAll);
+  std::atomic<int> outcome{0};  // 1: returned, 2: Cancelled
+  tbb::task_group group;
+  group.run([&] {
+    group.cancel();  // as a caller that no longer needs the result does
+    try {
+      gp::smooth_hex_mesh(mesh, constraints);
+      outcome = 1;
+    } catch (const geode::Cancelled&) {
+      outcome = 2;
+    }
+  });
+  group.wait();
+  CHECK(outcome == 2);
+  // Outside a cancelled group the same call runs to the end.
+  HexMesh again = appendix_a();
+  CHECK(gp::smooth_hex_mesh(again, constraints).untangled);
 }
 
 namespace {
