@@ -1,7 +1,8 @@
 #include <geode/primal/smooth.hpp>
 
+#include <tbb/task_group.h>
+
 #include <Eigen/Dense>
-#include <oneapi/tbb/task_group.h>
 #include <algorithm>
 #include <chrono>
 #include <cmath>

@@ -3,8 +3,9 @@
 // the planar quad version.
 #include <doctest/doctest.h>
 
+#include <tbb/task_group.h>
+
 #include <Eigen/Geometry>
-#include <oneapi/tbb/task_group.h>
 
 #include <algorithm>
 #include <atomic>
