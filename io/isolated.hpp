@@ -34,9 +34,10 @@ struct IsolationLimits {
 // the caller; a child killed by a signal or out of its limits (killed at its wall-clock limit)
 // becomes InvalidInput "`source`: `what` failed: <how>", and so does a child that ends without
 // its answer (the library calling exit, or a sanitizer's heap check on the library's own
-// corruption in sanitizer builds). The child never returns into the caller's code: it ends with _exit; its output goes
-// to /dev/null (outside sanitizer builds). An exception in the child other than InvalidInput and
-// std::bad_alloc is a fault of ours: std::runtime_error, so that tests and fuzzers report it.
+// corruption in sanitizer builds). The child never returns into the caller's code: it ends
+// with _exit; its output goes to /dev/null (outside sanitizer builds). An exception in the
+// child other than InvalidInput and std::bad_alloc is a fault of ours: std::runtime_error, so
+// that tests and fuzzers report it.
 std::string run_isolated(const std::function<std::string()>& work, const std::string& source,
                          const std::string& what, const IsolationLimits& limits = {});
 
