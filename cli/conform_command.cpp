@@ -7,6 +7,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <thread>
 
 #include <geode/conform/conform.hpp>
 #include <geode/conform/reference_template.hpp>
@@ -352,10 +353,13 @@ void add_conform_commands(CLI::App& app) {
   add_run_options(c, *args);
   c->callback([args] {
     const std::string format = check_outputs(*args);  // before the long run, not after it
-    // The templates depend on the options alone: built while the file is read.
-    const std::jthread templates = conform::build_reference_templates_ahead(
-        args->template_box.empty() ? conform::ConformOptions{}.template_box
-                                   : template_box(args->template_box));
+    // The templates depend on the options alone: built while the file is read, unless the
+    // reader forks (no thread of ours may be at work then; io/read_model.hpp).
+    std::jthread templates;
+    if (!io::read_forks(args->input))
+      templates = conform::build_reference_templates_ahead(
+          args->template_box.empty() ? conform::ConformOptions{}.template_box
+                                     : template_box(args->template_box));
     run(io::read_model(args->input, {}, args->merge_tolerance < 0), *args, format, false,
         args->input);
   });

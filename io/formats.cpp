@@ -56,6 +56,7 @@ const std::vector<MeshFormat>& table() {
        .read = read_exodus,
        .write = [](const primal::Model& m, const fs::path& p,
                    const WriteOptions&) { write_exodus(m, p); },
+       .reads_in_child = true,
        .carries = kExodusCarries,
        .read_variants =
            "netCDF classic, 64-bit, CDF-5 or netCDF-4/HDF5, as Cubit, SEACAS and meshio write it",

@@ -73,7 +73,9 @@ struct MeshFormat {
   ModelWriter write = nullptr;       // nullptr: read only
   QuadWriter write_quads = nullptr;  // planar quad meshes; nullptr: none
   PlainReader read_plain = nullptr;  // nullptr: read through `read`
-  primal::Index index_base = 1;      // how the file numbers nodes and elements (messages)
+  // Its reader runs a library in a forked child process (isolated.hpp): see read_forks.
+  bool reads_in_child = false;
+  primal::Index index_base = 1;  // how the file numbers nodes and elements (messages)
   FormatCarries carries;
   std::string_view read_variants;  // versions and encodings read
   std::string_view written_as;     // the version and encoding written

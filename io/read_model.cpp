@@ -136,6 +136,12 @@ InvalidInput out_of_memory_reading(const std::filesystem::path& path) {
                       " bytes): its model needs more memory than this process may use");
 }
 
+bool read_forks(const std::filesystem::path& path) {
+  if (find_nemesis_set(path)) return true;
+  const MeshFormat* format = reader_for(path);
+  return format && format->reads_in_child;
+}
+
 Model read_model(const std::filesystem::path& path, const ReadOptions& options, bool check_covering,
                  FilePartition* partition) {
   if (partition) *partition = {};

@@ -25,6 +25,13 @@ namespace geode::io {
 primal::Model read_model(const std::filesystem::path& path, const primal::ReadOptions& options = {},
                          bool check_covering = true, FilePartition* partition = nullptr);
 
+// Whether read_model(path) forks a child process to run a library in (isolated.hpp): an
+// Exodus file or a Nemesis set. A caller must then have no thread of its own at work during the
+// read: a lock such a thread holds at the fork stays held for ever in the child (seen with the
+// sanitizers' allocator: the child hung, and was killed at its time limit). Throws as
+// read_model does for a broken Nemesis set.
+bool read_forks(const std::filesystem::path& path);
+
 // A VTK grid as a model: hexes, tets, pyramids and wedges (triangles and quads, boundary
 // annotations, are left out), VTK's 0-based point and cell ids (as ParaView shows them) as file
 // ids, blocks from the first integer cell array named "block" (our writers), "gmsh:physical"

@@ -2,7 +2,9 @@
 // what the entry says it carries, and drop what it says it drops; signatures tell the formats
 // apart; dispatch by extension and by name; the docs' matrix is the table's.
 #include <doctest/doctest.h>
+#include <pthread.h>
 
+#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -139,6 +141,28 @@ TEST_CASE(
       read_model(dir.path / "mesh.obj"),
       doctest::Contains("unknown input format '.obj' (expected .exo, .e, .msh, .vtu or .vtk)"),
       InvalidInput);
+}
+
+namespace {
+std::atomic<int> forks{0};  // counted by a pthread_atfork handler in the parent
+}  // namespace
+
+TEST_CASE("read_forks says which reads fork a child (a caller's threads must rest then)") {
+  static const int registered = ::pthread_atfork(nullptr, [] { ++forks; }, nullptr);
+  REQUIRE(registered == 0);
+  const test::TempDir dir;
+  for (const MeshFormat& f : mesh_formats()) {
+    if (!f.read || !f.write) continue;
+    CAPTURE(f.name);
+    const fs::path file = dir.path / ("model" + std::string(f.extensions.front()));
+    write_model(sample_model(), file, f.name);
+    const int before = forks;
+    (void)read_model(file);
+    CHECK((forks > before) == read_forks(file));
+    CHECK(read_forks(file) == f.reads_in_child);
+  }
+  CHECK(read_forks("missing.exo"));  // by the extension, as read_model chooses its reader
+  CHECK(!read_forks("missing.vtu"));
 }
 
 TEST_CASE("format table: docs/formats.md holds the table's matrix (geode formats prints it)") {
