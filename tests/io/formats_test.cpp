@@ -148,7 +148,8 @@ std::atomic<int> forks{0};  // counted by a pthread_atfork handler in the parent
 }  // namespace
 
 TEST_CASE("read_forks says which reads fork a child (a caller's threads must rest then)") {
-  static const int registered = ::pthread_atfork(nullptr, [] { ++forks; }, nullptr);
+  static const int registered = ::pthread_atfork(
+      nullptr, [] { ++forks; }, nullptr);
   REQUIRE(registered == 0);
   const test::TempDir dir;
   for (const MeshFormat& f : mesh_formats()) {
