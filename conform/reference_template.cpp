@@ -9,6 +9,7 @@
 #include <stop_token>
 #include <tuple>
 
+#include <tbb/parallel_invoke.h>
 #include <tbb/task_group.h>
 
 #include <geode/primal/errors.hpp>
@@ -245,17 +246,31 @@ const RefTemplate& reference_template(const Eigen::Vector3d& given_box,
 
 std::jthread build_reference_templates_ahead(const Eigen::Vector3d& box) {
   return std::jthread([box](const std::stop_token& stop) {
-    tbb::task_group group;
-    // A caller that no longer needs them (its input was refused) is not kept waiting for them:
-    // the handle's destruction requests a stop, which cancels the group; the smoother then
-    // throws out of the unfinished template, which is not cached (std::call_once).
-    const std::stop_callback cancel(stop, [&group] { group.cancel(); });
-    group.run([box] { reference_template(box, {4, 6}); });
-    group.run([box] { reference_template(box, {5, 7}); });
+    // Nothing may leave the thread (std::terminate): not a failed build, which conform()
+    // repeats and reports, nor TBB's failure to start its workers or allocate its tasks when
+    // memory is short (tests/io/bombs_test.sh), which conform() meets again and reports. (A
+    // tbb::task_group cannot be used here: when its run() cannot allocate, its destructor
+    // cancels, which allocates, and that second bad_alloc during unwinding terminated.)
     try {
-      group.wait();
-    } catch (...) {  // conform() builds it again and reports why
-    }
+      tbb::task_group_context context;
+      // A caller that no longer needs them (its input was refused) is not kept waiting for
+      // them: the handle's destruction requests a stop, which cancels the tasks; the smoother
+      // then throws out of the unfinished template, which is not cached (std::call_once).
+      // Short of memory even to cancel, the build just runs to its end.
+      const std::stop_callback cancel(stop, [&context]() noexcept {
+        try {
+          context.cancel_group_execution();
+        } catch (...) {}
+      });
+      tbb::parallel_invoke(
+          [&] {
+            reference_template(box, {4, 6});
+          },
+          [&] {
+            reference_template(box, {5, 7});
+          },
+          context);
+    } catch (...) {}
   });
 }
 
