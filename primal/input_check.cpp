@@ -1,8 +1,11 @@
 #include <geode/primal/input_check.hpp>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
@@ -119,24 +122,58 @@ class InputChecker {
     return n;
   }
 
+  // Every face use, in FaceUse's order. Counted out by the face's lowest node first (in
+  // parallel, each use written once into place), then each node's few uses sorted: the order
+  // one sort of them all gives, without its passes over the whole array (`geode check` of 2.2
+  // million tets and hexes: 2.7 s -> 1.9 s; bench_input_check delaunay 36: 0.25 s -> 0.22 s).
+  std::vector<FaceUse> sorted_face_uses() const {
+    // visit(use) for every face of every element, the elements split among threads.
+    auto each_use = [&](auto&& visit) {
+      for (ElementKind kind : kElementKinds) {
+        const auto& topo = cell_topology(kind);
+        tbb::parallel_for(
+            tbb::blocked_range<std::size_t>(0, element_count(model_, kind), 4096),
+            [&](const tbb::blocked_range<std::size_t>& r) {
+              for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                const ElementRef e{kind, index_cast(i)};
+                for (int f = 0; f < topo.faces; ++f) {
+                  int size = 0;
+                  const auto n = face_nodes(e, f, &size);
+                  visit(FaceUse{
+                      face_key(std::span<const Index>(n.data(), index_cast<std::size_t>(size))),
+                      e, f});
+                }
+              }
+            });
+      }
+    };
+    auto slot = [](std::vector<std::size_t>& v, Index node) {
+      return std::atomic_ref<std::size_t>(v[index_cast<std::size_t>(node)]);
+    };
+    std::vector<std::size_t> start(model_.points.size() + 1, 0);
+    each_use([&](const FaceUse& u) {
+      slot(start, u.key[0] + 1).fetch_add(1, std::memory_order_relaxed);
+    });
+    for (std::size_t v = 1; v < start.size(); ++v) start[v] += start[v - 1];
+    std::vector<FaceUse> uses(start.back());
+    std::vector<std::size_t> next(start.begin(), start.end() - 1);
+    each_use([&](const FaceUse& u) {
+      uses[slot(next, u.key[0]).fetch_add(1, std::memory_order_relaxed)] = u;
+    });
+    // Within a node the threads' order varies; the sort by (key, element, face) fixes it.
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, model_.points.size(), 4096),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t v = r.begin(); v != r.end(); ++v)
+                          std::sort(uses.begin() + static_cast<std::ptrdiff_t>(start[v]),
+                                    uses.begin() + static_cast<std::ptrdiff_t>(start[v + 1]));
+                      });
+    return uses;
+  }
+
   // Faces by their node sets: pairs must be seen in opposite orders; a quad one side meets as
   // two or four triangles of the other is an interface, not boundary.
   void pair_faces() {
-    std::vector<FaceUse> uses;
-    uses.reserve(4 * element_count(model_) + 2 * model_.hexes.size());
-    for (ElementKind kind : kElementKinds) {
-      const auto& topo = cell_topology(kind);
-      for (std::size_t i = 0; i < element_count(model_, kind); ++i) {
-        const ElementRef e{kind, index_cast(i)};
-        for (int f = 0; f < topo.faces; ++f) {
-          int size = 0;
-          const auto n = face_nodes(e, f, &size);
-          uses.push_back(
-              {face_key(std::span<const Index>(n.data(), index_cast<std::size_t>(size))), e, f});
-        }
-      }
-    }
-    tbb::parallel_sort(uses.begin(), uses.end());
+    const std::vector<FaceUse> uses = sorted_face_uses();
     std::vector<std::size_t> single;  // uses of faces used once
     for (std::size_t i = 0; i < uses.size();) {
       std::size_t j = i + 1;
