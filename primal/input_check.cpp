@@ -122,6 +122,17 @@ class InputChecker {
     return n;
   }
 
+  // visit(use) for each face of e.
+  template <class Visit>
+  void face_uses(ElementRef e, Visit&& visit) const {
+    for (int f = 0; f < cell_topology(e.kind).faces; ++f) {
+      int size = 0;
+      const auto n = face_nodes(e, f, &size);
+      visit(
+          FaceUse{face_key(std::span<const Index>(n.data(), index_cast<std::size_t>(size))), e, f});
+    }
+  }
+
   // Every face use, in FaceUse's order. Counted out by the face's lowest node first (in
   // parallel, each use written once into place), then each node's few uses sorted: the order
   // one sort of them all gives, without its passes over the whole array (`geode check` of 2.2
@@ -130,21 +141,11 @@ class InputChecker {
     // visit(use) for every face of every element, the elements split among threads.
     auto each_use = [&](auto&& visit) {
       for (ElementKind kind : kElementKinds) {
-        const auto& topo = cell_topology(kind);
-        tbb::parallel_for(
-            tbb::blocked_range<std::size_t>(0, element_count(model_, kind), 4096),
-            [&](const tbb::blocked_range<std::size_t>& r) {
-              for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                const ElementRef e{kind, index_cast(i)};
-                for (int f = 0; f < topo.faces; ++f) {
-                  int size = 0;
-                  const auto n = face_nodes(e, f, &size);
-                  visit(FaceUse{
-                      face_key(std::span<const Index>(n.data(), index_cast<std::size_t>(size))),
-                      e, f});
-                }
-              }
-            });
+        const tbb::blocked_range<std::size_t> all(0, element_count(model_, kind), 4096);
+        tbb::parallel_for(all, [&](const tbb::blocked_range<std::size_t>& r) {
+          for (std::size_t i = r.begin(); i != r.end(); ++i)
+            face_uses({kind, index_cast(i)}, visit);
+        });
       }
     };
     auto slot = [](std::vector<std::size_t>& v, Index node) {
