@@ -19,17 +19,6 @@ namespace topo = topology;
 
 EdgeKey edge_key(Index a, Index b) { return a < b ? EdgeKey{a, b} : EdgeKey{b, a}; }
 
-FaceKey face_key(std::span<const Index> nodes) {
-  assert(nodes.size() == 3 || nodes.size() == 4);
-  FaceKey k{kInvalidIndex, kInvalidIndex, kInvalidIndex, kInvalidIndex};
-  std::copy(nodes.begin(), nodes.end(), k.begin());
-  // Insertion sort: std::sort on a 3-4 element prefix trips GCC 12's -Warray-bounds.
-  for (std::size_t i = 1; i < nodes.size(); ++i) {
-    for (std::size_t j = i; j > 0 && k[j - 1] > k[j]; --j) std::swap(k[j - 1], k[j]);
-  }
-  return k;
-}
-
 namespace {
 
 // OpenMesh reports refused faces on its process-wide error stream; extract_boundary reports them

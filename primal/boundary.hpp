@@ -3,10 +3,13 @@
 // its boundary: the faces used by exactly one hex, as a list and as a quad surface checked by
 // OpenMesh (the OpenMesh surface itself: primal/boundary_surface.hpp, the one header that
 // exposes OpenMesh).
+#include <algorithm>
 #include <array>
+#include <cassert>
 #include <cstddef>
 #include <functional>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include <geode/primal/mesh.hpp>
@@ -19,7 +22,18 @@ using EdgeKey = std::array<Index, 2>;
 using FaceKey = std::array<Index, 4>;
 
 EdgeKey edge_key(Index a, Index b);
-FaceKey face_key(std::span<const Index> nodes);  // 3 or 4 nodes
+
+// 3 or 4 nodes. Inline: dicing, the interface search and the boundary scans make millions.
+inline FaceKey face_key(std::span<const Index> nodes) {
+  assert(nodes.size() == 3 || nodes.size() == 4);
+  FaceKey k{kInvalidIndex, kInvalidIndex, kInvalidIndex, kInvalidIndex};
+  std::copy(nodes.begin(), nodes.end(), k.begin());
+  // Insertion sort: std::sort on a 3-4 element prefix trips GCC 12's -Warray-bounds.
+  for (std::size_t i = 1; i < nodes.size(); ++i) {
+    for (std::size_t j = i; j > 0 && k[j - 1] > k[j]; --j) std::swap(k[j - 1], k[j]);
+  }
+  return k;
+}
 
 // Hash for EdgeKey / FaceKey (and any std::array<Index, N>) in unordered containers.
 struct IndexArrayHash {
