@@ -187,6 +187,35 @@ TEST_CASE("find_interface: rejects non-conforming interfaces, naming the face or
     // Hex-side node (0.5, 0, 0.5) = grid node 1 lies on the edge of a coarse triangle.
     CHECK_THROWS_WITH_AS(find_interface(m), doctest::Contains("of the hex part"), TopologyError);
   }
+  SUBCASE("a triangle shared by three tets, named with the three") {
+    Model m = grid_model({1, 1, 2}, 1.0, [](int, int, int k) { return k == 1; });
+    // A third tet on the face the first two share.
+    std::vector<Index> shared;
+    for (Index v : m.tets[0])
+      if (std::find(m.tets[1].begin(), m.tets[1].end(), v) != m.tets[1].end()) shared.push_back(v);
+    REQUIRE(shared.size() == 3);
+    m.points.emplace_back(0.5, 0.5, 5.0);
+    m.tets.push_back({shared[0], shared[1], shared[2], index_cast(m.points.size() - 1)});
+    m.tet_block.push_back(2);
+    CHECK_THROWS_WITH_AS(find_interface(m),
+                         doctest::Contains("is a face of more than two tets (tet 1 (centre"),
+                         TopologyError);
+    CHECK_THROWS_WITH_AS(
+        find_interface(m),
+        doctest::Contains(("tet " + std::to_string(m.tets.size()) + " (centre").c_str()),
+        TopologyError);
+  }
+  SUBCASE("a tet given twice, named with its first copy") {
+    Model m = grid_model({1, 1, 2}, 1.0, [](int, int, int k) { return k == 1; });
+    m.tets.push_back(m.tets[2]);
+    m.tet_block.push_back(2);
+    CHECK_THROWS_WITH_AS(
+        find_interface(m),
+        doctest::Contains(("tet " + std::to_string(m.tets.size()) + " (centre").c_str()),
+        TopologyError);
+    CHECK_THROWS_WITH_AS(find_interface(m), doctest::Contains("has the same nodes as tet 3"),
+                         TopologyError);
+  }
   SUBCASE("parts touching along an edge only") {
     Model m = grid_model({1, 1, 1}, 1.0, [](int, int, int) { return false; });
     append(m, grid_model({1, 1, 1}, 1.0, [](int, int, int) { return true; }), Point(1, 1, 0));
