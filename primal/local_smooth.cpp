@@ -494,11 +494,14 @@ class Patch {
         lambda_ = step == 1.0 ? lambda_ / 4.0 : std::max(4.0 * lambda_, 1e-8 * scale);
         pos_.swap(trial_);
         q_at_pos_ = true;  // measured at this trial just above
-        // feasible() measured every hex at the new positions: their scaled Jacobians (the
-        // minimum of the nine frames, as hex_scaled_jacobian) without measuring them again.
+        // feasible() measured every hex at the new positions: their scaled Jacobians without
+        // measuring them again, folded as hex_scaled_jacobian folds its nine frames.
         accepted_sj_.resize(trial_q_.size());
-        for (std::size_t h = 0; h < trial_q_.size(); ++h)
-          accepted_sj_[h] = *std::min_element(trial_q_[h].begin(), trial_q_[h].end());
+        for (std::size_t h = 0; h < trial_q_.size(); ++h) {
+          double m = std::numeric_limits<double>::infinity();
+          for (double q : trial_q_[h]) m = std::min(m, q);
+          accepted_sj_[h] = m;
+        }
         return true;
       }
     }
