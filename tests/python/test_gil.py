@@ -36,8 +36,10 @@ def test_template_releases_the_gil():
 
 
 def test_conform_releases_the_gil():
-    model = geode.demo_model("delaunay", 18)  # the reference templates are built once per process: a model
-    (mesh, report), seconds, gap = longest_stall(lambda: geode.conform(model))  # big enough to take time anyway
+    # The reference templates are built once per process: a model big enough that the call
+    # alone takes well over the 0.2 s the check needs (n = 24: about 0.4 s on 2 cores).
+    model = geode.demo_model("delaunay", 24)
+    (mesh, report), seconds, gap = longest_stall(lambda: geode.conform(model))
     assert report["valid"]
     assert seconds > 0.2 and gap < 0.5 * seconds, (seconds, gap)
 
