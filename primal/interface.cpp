@@ -6,10 +6,12 @@
 #include <algorithm>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <unordered_map>
 #include <unordered_set>
 
 #include <geode/primal/boundary.hpp>
+#include <geode/primal/detail/lowest_node_sort.hpp>
 #include <geode/primal/disjoint_sets.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/key_map.hpp>
@@ -31,19 +33,20 @@ struct TriangleUses {
 };
 
 // The tet part's triangles with the tets using them, numbered in order of first use (tet by
-// tet, face by face). The face uses are sorted by their lowest node (a counting sort), then
-// each node's few by the other two, in parallel: a hash map of the half million triangles of a
-// 126k-tet part cost 0.12 s in random probes, most of the interface search.
+// tet, face by face). The face uses are sorted by their lowest node (detail/lowest_node_sort.hpp):
+// a hash map of the half million triangles of a 126k-tet part cost 0.12 s in random probes,
+// most of the interface search.
 class TetTriangles {
  public:
   explicit TetTriangles(const Model& model);
 
   // The triangle with this key (face_key of three nodes), or nullptr.
   const TriangleUses* find(const FaceKey& key) const {
-    const auto first = rec_.begin() + start_[index_cast<std::size_t>(key[0])];
-    const auto last = rec_.begin() + start_[index_cast<std::size_t>(key[0]) + 1];
-    const Record probe{key[1], key[2], -1};
-    const auto it = std::lower_bound(first, last, probe);
+    const auto first =
+        rec_.begin() + static_cast<std::ptrdiff_t>(start_[index_cast<std::size_t>(key[0])]);
+    const auto last =
+        rec_.begin() + static_cast<std::ptrdiff_t>(start_[index_cast<std::size_t>(key[0]) + 1]);
+    const auto it = std::lower_bound(first, last, Record{key[0], key[1], key[2], -1});
     if (it == last || it->b != key[1] || it->c != key[2]) return nullptr;
     return &tris[index_cast<std::size_t>(tri_of_rec_[index_cast<std::size_t>(it - rec_.begin())])];
   }
@@ -52,60 +55,47 @@ class TetTriangles {
   std::vector<Index> tet_face_tri;  // tris index of face f of tet t at 4 t + f
 
  private:
-  // A face use in its lowest node's bucket: the other two nodes, ascending, and 4 t + f.
+  // A face use: its nodes ascending, and 4 t + f.
   struct Record {
-    Index b, c, use;
+    Index a, b, c, use;
     bool operator<(const Record& o) const {
-      return b != o.b ? b < o.b : c != o.c ? c < o.c : use < o.use;
+      return std::tie(a, b, c, use) < std::tie(o.a, o.b, o.c, o.use);
     }
   };
-  std::vector<Index> start_;       // per node, its bucket's first record; one more at the end
-  std::vector<Record> rec_;        // the face uses, by lowest node, then (b, c, use)
-  std::vector<Index> tri_of_rec_;  // at a triangle's first record, its tris index
+  std::vector<std::size_t> start_;  // per node, its first record; the record count at the end
+  std::vector<Record> rec_;         // the face uses, by their nodes, then by use
+  std::vector<Index> tri_of_rec_;   // at a triangle's first record, its tris index
 };
 
 TetTriangles::TetTriangles(const Model& model) : tet_face_tri(4 * model.tets.size()) {
-  const std::size_t uses = 4 * model.tets.size();
-  std::vector<FaceKey> key(uses);
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, model.tets.size(), 4096),
-      [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t t = r.begin(); t != r.end(); ++t)
-          for (std::size_t f = 0; f < 4; ++f) {
-            std::array<Index, 3> nodes{};
-            for (std::size_t i = 0; i < 3; ++i)
-              nodes[i] = model.tets[t][index_cast<std::size_t>(topology::kTetFaceCorners[f][i])];
-            key[4 * t + f] = face_key(nodes);
-          }
-      });
-  start_.assign(model.points.size() + 1, 0);
-  for (const FaceKey& k : key) ++start_[index_cast<std::size_t>(k[0]) + 1];
-  for (std::size_t v = 0; v + 1 < start_.size(); ++v) start_[v + 1] += start_[v];
-  rec_.resize(uses);
-  {
-    std::vector<Index> fill(start_.begin(), start_.end() - 1);
-    for (std::size_t u = 0; u < uses; ++u)
-      rec_[index_cast<std::size_t>(fill[index_cast<std::size_t>(key[u][0])]++)] = {
-          key[u][1], key[u][2], index_cast(u)};
-  }
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, model.points.size(), 4096),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t v = r.begin(); v != r.end(); ++v)
-                        std::sort(rec_.begin() + start_[v], rec_.begin() + start_[v + 1]);
-                    });
+  auto each_use = [&](auto&& visit) {
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, model.tets.size(), 4096),
+        [&](const tbb::blocked_range<std::size_t>& r) {
+          for (std::size_t t = r.begin(); t != r.end(); ++t)
+            for (std::size_t f = 0; f < 4; ++f) {
+              std::array<Index, 3> nodes{};
+              for (std::size_t i = 0; i < 3; ++i)
+                nodes[i] = model.tets[t][index_cast<std::size_t>(topology::kTetFaceCorners[f][i])];
+              const FaceKey k = face_key(nodes);
+              visit(Record{k[0], k[1], k[2], index_cast(4 * t + f)});
+            }
+        });
+  };
+  rec_ = detail::sort_by_lowest_node<Record>(
+      model.points.size(), each_use, [](const Record& r) { return r.a; }, start_);
   // Per use, the record where its triangle's uses begin.
-  std::vector<Index> group(uses);
+  std::vector<Index> group(rec_.size());
   std::size_t count = 0;
-  for (std::size_t i = 0; i < uses; ++i) {
-    const bool first = i == 0 || rec_[i].b != rec_[i - 1].b || rec_[i].c != rec_[i - 1].c ||
-                       key[index_cast<std::size_t>(rec_[i].use)][0] !=
-                           key[index_cast<std::size_t>(rec_[i - 1].use)][0];
+  for (std::size_t i = 0; i < rec_.size(); ++i) {
+    const bool first = i == 0 || rec_[i].a != rec_[i - 1].a || rec_[i].b != rec_[i - 1].b ||
+                       rec_[i].c != rec_[i - 1].c;
     group[index_cast<std::size_t>(rec_[i].use)] =
         first ? index_cast(i) : group[index_cast<std::size_t>(rec_[i - 1].use)];
     count += first ? 1 : 0;
   }
   tris.reserve(count);
-  tri_of_rec_.assign(uses, kInvalidIndex);
+  tri_of_rec_.assign(rec_.size(), kInvalidIndex);
   for (std::size_t t = 0; t < model.tets.size(); ++t)
     for (int f = 0; f < 4; ++f) {
       TetFaceUse use{index_cast(t), f, {}};

@@ -1,0 +1,48 @@
+#pragma once
+// Face uses (or any records keyed by node numbers) in order, sorted by their lowest node first:
+// counted out per node, each record written once into place, then each node's few sorted. One
+// sort of them all gives the same order with passes over the whole array; this way the cost is
+// a scatter and many tiny sorts, in parallel (the read-time covering check and the interface
+// search's tet triangles).
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstddef>
+#include <vector>
+
+namespace geode::primal::detail {
+
+// The records `each(visit)` visits, ordered by lowest(record) (a node number below `nodes`),
+// then by Record's operator<, which must be a total order: `each` may call visit from several
+// threads at once (it is called twice, to count and to place), and the result does not depend
+// on them. `start` receives each node's first record, and the record count at the end.
+template <class Record, class Each, class Lowest>
+std::vector<Record> sort_by_lowest_node(std::size_t nodes, Each&& each, Lowest&& lowest,
+                                        std::vector<std::size_t>& start) {
+  auto slot = [&](std::vector<std::size_t>& v, std::size_t node) {
+    return std::atomic_ref<std::size_t>(v[node]);
+  };
+  start.assign(nodes + 1, 0);
+  each([&](const Record& r) {
+    slot(start, static_cast<std::size_t>(lowest(r)) + 1).fetch_add(1, std::memory_order_relaxed);
+  });
+  for (std::size_t v = 1; v < start.size(); ++v) start[v] += start[v - 1];
+  std::vector<Record> out(start.back());
+  std::vector<std::size_t> next(start.begin(), start.end() - 1);
+  each([&](const Record& r) {
+    out[slot(next, static_cast<std::size_t>(lowest(r))).fetch_add(1, std::memory_order_relaxed)] =
+        r;
+  });
+  // Within a node the threads' order varies; the sort fixes it.
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nodes, 4096),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t v = r.begin(); v != r.end(); ++v)
+                        std::sort(out.begin() + static_cast<std::ptrdiff_t>(start[v]),
+                                  out.begin() + static_cast<std::ptrdiff_t>(start[v + 1]));
+                    });
+  return out;
+}
+
+}  // namespace geode::primal::detail
