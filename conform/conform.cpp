@@ -244,8 +244,13 @@ void Conformer::find_interface() {
   if (!tet_given_.empty())
     res_.input_diced_tet_min_scaled_jacobian =
         *std::min_element(tet_given_.begin(), tet_given_.end());
-  res_.input_diced_wedge_min_scaled_jacobian =
-      primal::diced_wedge_min_scaled_jacobian(input_.points, input_.wedges);
+  wedge_diced_.reserve(input_.wedges.size());
+  for (std::size_t w = 0; w < input_.wedges.size(); ++w)
+    wedge_diced_.push_back(
+        primal::diced_wedge_min_scaled_jacobian(input_.points, std::span(&input_.wedges[w], 1)));
+  if (!wedge_diced_.empty())
+    res_.input_diced_wedge_min_scaled_jacobian =
+        *std::min_element(wedge_diced_.begin(), wedge_diced_.end());
   // A model without tets, or without hexes and wedges, has no transition to make: it is simply
   // diced. Wedges are the hex part's where their quads meet tet triangles (a pyramid on a
   // wedge, split), and find_interface refuses a wedge joining the two sides around a node.
@@ -255,10 +260,6 @@ void Conformer::find_interface() {
   // Both parts but no shared quad: the parts were meshed apart (unmerged nodes, a gap).
   if (!input_.hexes.empty() && !input_.tets.empty() && interface_.quads.empty())
     throw InvalidInput("conform: the hex part and the tet part share no interface quad");
-  wedge_diced_.reserve(input_.wedges.size());
-  for (std::size_t w = 0; w < input_.wedges.size(); ++w)
-    wedge_diced_.push_back(
-        primal::diced_wedge_min_scaled_jacobian(input_.points, std::span(&input_.wedges[w], 1)));
   res_.local_yardstick = local_minima(tet_given_);
   aim_local_ = local_minima(tet_diced_);
   aim_yardstick_ = std::min(
