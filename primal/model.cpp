@@ -259,18 +259,36 @@ std::string describe_element(const Model& model, ElementRef element) {
 
 namespace {
 
-void check_elements(const Model& model, ElementKind kind, std::string_view source) {
+// Typed per kind: element_corners' span per element was most of validating a written mesh.
+template <std::size_t N>
+void check_elements(const Model& model, ElementKind kind,
+                    const std::vector<std::array<Index, N>>& cells, std::string_view source) {
   const auto num_points = index_cast(model.points.size());
-  for (std::size_t e = 0; e < element_count(model, kind); ++e) {
-    const auto corners = element_corners(model, {kind, index_cast(e)});
-    for (std::size_t c = 0; c < corners.size(); ++c) {
-      const Index n = corners[c];
+  for (std::size_t e = 0; e < cells.size(); ++e) {
+    bool inside = true;
+    for (Index n : cells[e]) inside &= n >= 0 && n < num_points;
+    if (inside) continue;
+    for (std::size_t c = 0; c < N; ++c) {
+      const Index n = cells[e][c];
       if (n < 0 || n >= num_points)
         throw InvalidInput(std::string(source) + ": " + kind_name(kind) + " " +
                            std::to_string(element_id(model, {kind, index_cast(e)})) + ": corner " +
                            std::to_string(c + 1) + " refers to node index " + std::to_string(n) +
                            ", out of range [0, " + std::to_string(num_points) + ")");
     }
+  }
+}
+
+void check_elements(const Model& model, ElementKind kind, std::string_view source) {
+  switch (kind) {
+    case ElementKind::kHex:
+      return check_elements(model, kind, model.hexes, source);
+    case ElementKind::kTet:
+      return check_elements(model, kind, model.tets, source);
+    case ElementKind::kPyramid:
+      return check_elements(model, kind, model.pyramids, source);
+    case ElementKind::kWedge:
+      return check_elements(model, kind, model.wedges, source);
   }
 }
 
