@@ -25,6 +25,7 @@
 #include <geode/primal/quality.hpp>
 #include <geode/primal/quality_report.hpp>
 #include <geode/primal/relax_tets.hpp>
+#include <geode/primal/release.hpp>
 #include <geode/primal/smooth.hpp>
 #include <geode/primal/split_pyramids.hpp>
 #include <geode/primal/split_wedges.hpp>
@@ -533,7 +534,8 @@ void Conformer::match_sides() {
   for (std::size_t b = 0; b < nb; ++b)
     for (std::size_t i = 0; i < inst_side_[b].size(); ++i)
       if (inst_side_[b][i] != kInvalidIndex) inst_global_[b][i] = gid[uf.find(inst_side_[b][i])];
-  uf = {}, side_pos_ = {}, inst_side_ = {};
+  uf = {};
+  primal::release(side_pos_, inst_side_);
   say("side faces: " + std::to_string(shared_faces) + " shared by two buffer hexes, merged" +
       took());
 }
@@ -586,7 +588,7 @@ void Conformer::assemble() {
         ns.nodes.push_back(layer_.top_node[v]);
   }
   node_sets_ = primal::diced_node_sets(sets, diced_, renum);
-  diced_.origin = {};
+  primal::release(diced_.origin);
 
   // The output hexes in output numbers: hex children, templates, tet children, wedge children.
   // The tet children are renumbered where they are and the others put around them, in the
@@ -608,11 +610,11 @@ void Conformer::assemble() {
   block.reserve(total);
   std::size_t at = 0;
   for (const auto& h : diced_.hex_children) hexes[at++] = renumbered(h);
-  diced_.hex_children = {};
+  primal::release(diced_.hex_children);
   for (Index parent : diced_.hex_parent)
     block.push_back(primal::block_of(lm, {primal::ElementKind::kHex, parent}));
   diced_parent_ = std::move(diced_.hex_parent);  // per output diced hex: its input hex
-  diced_.hex_parent = {};
+  primal::release(diced_.hex_parent);
   geode_first_.reserve(nb + 1);
   for (std::size_t b = 0; b < nb; ++b) {
     geode_first_.push_back(primal::index_cast(at));
@@ -623,16 +625,15 @@ void Conformer::assemble() {
     }
   }
   geode_first_.push_back(primal::index_cast(at));
-  inst_global_ = {};
-  diced_.tet_children = {};
+  primal::release(inst_global_, diced_.tet_children);
   for (Index parent : diced_.tet_parent)
     block.push_back(primal::block_of(lm, {primal::ElementKind::kTet, parent}));
-  diced_.tet_parent = {};
+  primal::release(diced_.tet_parent);
   for (const auto& h : diced_.wedge_children) hexes.push_back(renumbered(h));
-  diced_.wedge_children = {};
+  primal::release(diced_.wedge_children);
   for (Index parent : diced_.wedge_parent)
     block.push_back(primal::block_of(lm, {primal::ElementKind::kWedge, parent}));
-  diced_.wedge_parent = {};
+  primal::release(diced_.wedge_parent);
   // The points permuted in place: follow each cycle of the renumbering (dropped nodes go to
   // the tail, then are cut off).
   std::vector<Point>& points = diced_.points;
@@ -647,7 +648,7 @@ void Conformer::assemble() {
         std::swap(renum[i], renum[j]);
       }
   }
-  renum = {};
+  primal::release(renum);
   // No shrink_to_fit: dice_model reserved about what it made, and a shrinking copy of every
   // point would be the run's peak.
   points.resize(primal::index_cast<std::size_t>(used));
@@ -658,7 +659,7 @@ void Conformer::assemble() {
   // The stages after this one read the buffer hexes only (their quads), not the layer's model
   // or the interface: freed before smoothing, verification and writing add their own.
   layer_.model = primal::Model();
-  layer_.top_node = {};
+  primal::release(layer_.top_node);
   interface_ = primal::Interface();
   res_.min_scaled_jacobian_before_smoothing = measure();
 }
@@ -1003,7 +1004,7 @@ void Conformer::verify() {
     // Seeds: the geode hexes and whatever smoothing could move; the rest is diced, checked
     // against the dicing tables in check_dicing().
     std::vector<Index> seeds = std::move(moved_);
-    moved_ = {};
+    primal::release(moved_);
     if (!geode_first_.empty())
       for (Index h = geode_first_.front(); h < geode_first_.back(); ++h) seeds.push_back(h);
     primal::RegionValidityOptions o;
@@ -1075,7 +1076,7 @@ void Conformer::verify() {
       res_.local_yardstick_ratio = std::min(res_.local_yardstick_ratio, sj / local);
     }
   }
-  sj_ = {};
+  primal::release(sj_);
   const bool valid = res_.validity.ok() && res_.dicing.ok();
   say("verification (" + std::string(res_.verified == ConformVerify::kLocal ? "local" : "full") +
       ", " + std::to_string(res_.verified_hexes) +

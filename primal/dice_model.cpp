@@ -13,6 +13,7 @@
 #include <geode/primal/dice.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/quality.hpp>
+#include <geode/primal/release.hpp>
 #include <geode/primal/topology.hpp>
 
 namespace geode::primal {
@@ -249,7 +250,7 @@ DicingCheck check_dicing(const Model& model, const DicedModel& diced) {
         if (taken[index_cast<std::size_t>(c)]) duplicated[index_cast<std::size_t>(c)] = 1;
         taken[index_cast<std::size_t>(c)] = 1;
       }
-  taken = {};
+  release(taken);
   // Origins made twice: the diced nodes bucketed by their smallest origin node (a counting sort,
   // no hashing), each bucket's few keys sorted and compared, buckets in parallel.
   std::vector<Index> start(index_cast<std::size_t>(V) + 1, 0);
@@ -398,7 +399,7 @@ DicedModel dice_model(const Model& model, std::span<const char> shareable, std::
         g[next++] = *id;
       }
     }
-    d.edges = {}, d.faces = {};
+    release(d.edges, d.faces);
     for (const auto& e : elements) g[next++] = out.add_node(corner_centroid(model.points, e));
     for (auto& c : d.children)
       for (Index& v : c) v = g[index_cast<std::size_t>(v)];

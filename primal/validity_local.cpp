@@ -8,6 +8,7 @@
 
 #include <geode/primal/boundary.hpp>
 #include <geode/primal/quality.hpp>
+#include <geode/primal/release.hpp>
 
 namespace geode::primal {
 
@@ -75,7 +76,7 @@ HexValidityReport check_validity_around(const HexMesh& mesh, std::span<const Ind
     if (!mesh.points[v].allFinite()) r.non_finite_nodes.push_back(index_cast(v));
     r.unused_nodes += used[v] ? 0 : 1;
   }
-  used = {};
+  release(used);
   {
     std::vector<char> inverted(nh, 0);
     const bool known = options.scaled_jacobians.size() == nh;
@@ -130,7 +131,7 @@ HexValidityReport check_validity_around(const HexMesh& mesh, std::span<const Ind
     }
     sub.hexes.push_back(q);
   }
-  local = {};
+  release(local);
   const HexValidityReport s = check_validity(sub);
   auto node = [&](Index v) { return sub_node[index_cast<std::size_t>(v)]; };
   auto is_checked = [&](Index v) { return checked[index_cast<std::size_t>(node(v))] != 0; };

@@ -20,6 +20,7 @@
 #include <geode/primal/errors.hpp>
 #include <geode/primal/multilinear.hpp>
 #include <geode/primal/quality.hpp>
+#include <geode/primal/release.hpp>
 #include <geode/primal/topology.hpp>
 
 namespace geode::templates {
@@ -303,7 +304,7 @@ InterleaveStudy interleave_study(const std::vector<InterleaveCase>& cases,
     study.runs.push_back(std::move(run));
     b.t = Template();  // only the first of a class is kept
   }
-  built = {};
+  primal::release(built);
   std::vector<const Outcome*> order;
   for (const auto& [k, oc] : outcomes) order.push_back(&oc);
   std::stable_sort(order.begin(), order.end(), [](const Outcome* a, const Outcome* b) {
