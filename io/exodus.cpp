@@ -4,9 +4,9 @@
 
 #include <algorithm>
 #include <map>
+#include <string>
 #include <tuple>
 #include <type_traits>
-#include <string>
 #include <vector>
 
 #include <geode/io/exodus_library.hpp>
@@ -18,6 +18,11 @@ namespace geode::io {
 using namespace primal;
 
 using namespace exodus_library;
+
+namespace {
+// Nodes or elements written per library call: 2^18 hexes are 8 MiB of connectivity.
+constexpr std::size_t kSlice = std::size_t{1} << 18;
+}  // namespace
 
 void write_exodus(const Model& model, const std::filesystem::path& path) {
   const std::string target = path.string();
@@ -80,14 +85,19 @@ void write_exodus(const Model& model, const std::filesystem::path& path) {
                     index_cast<int64_t>(model.node_sets.size()),
                     index_cast<int64_t>(model.side_sets.size())),
         target, "writing the header");
-    if (!model.points.empty()) {
-      std::vector<double> x(model.points.size()), y(x.size()), z(x.size());
-      for (std::size_t i = 0; i < x.size(); ++i) {
-        x[i] = model.points[i].x();
-        y[i] = model.points[i].y();
-        z[i] = model.points[i].z();
+    // Coordinates and connectivity in slices, so that writing adds a few MiB beside the model
+    // instead of a copy of it (on a conform run the write was the peak).
+    for (std::size_t first = 0; first < model.points.size(); first += kSlice) {
+      const std::size_t n = std::min(kSlice, model.points.size() - first);
+      std::vector<double> x(n), y(n), z(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        x[i] = model.points[first + i].x();
+        y[i] = model.points[first + i].y();
+        z[i] = model.points[first + i].z();
       }
-      check(ex_put_coord(exo, x.data(), y.data(), z.data()), target, "writing coordinates");
+      check(ex_put_partial_coord(exo, index_cast<int64_t>(first + 1), index_cast<int64_t>(n),
+                                 x.data(), y.data(), z.data()),
+            target, "writing coordinates");
     }
     // Post-processors (ParaView, Cubit) label the axes by these names; empty ones show as blanks.
     char cx[] = "x", cy[] = "y", cz[] = "z";
@@ -101,33 +111,37 @@ void write_exodus(const Model& model, const std::filesystem::path& path) {
       check(ex_put_block(exo, EX_ELEM_BLOCK, id, cell.name, index_cast<int64_t>(members.size()),
                          per_elem, 0, 0, 0),
             target, "writing block " + std::to_string(id));
-      std::vector<int> conn(members.size() * index_cast<std::size_t>(per_elem));
+      std::vector<int> conn;
       // exodus_corner[order[c]] = model_corner[c]
-      auto fill = [&](const auto& cells) {
+      auto put = [&](const auto& cells) {
         constexpr std::size_t kCorners = std::tuple_size_v<std::decay_t<decltype(cells[0])>>;
-        for (std::size_t i = 0; i < members.size(); ++i) {
-          const auto& corners = cells[index_cast<std::size_t>(members[i].index)];
-          int* out = conn.data() + i * kCorners;
-          for (std::size_t c = 0; c < kCorners; ++c) out[cell.order[c]] = corners[c] + 1;
+        for (std::size_t first = 0; first < members.size(); first += kSlice) {
+          const std::size_t n = std::min(kSlice, members.size() - first);
+          conn.resize(n * kCorners);
+          for (std::size_t i = 0; i < n; ++i) {
+            const auto& corners = cells[index_cast<std::size_t>(members[first + i].index)];
+            int* out = conn.data() + i * kCorners;
+            for (std::size_t c = 0; c < kCorners; ++c) out[cell.order[c]] = corners[c] + 1;
+          }
+          check(ex_put_partial_elem_conn(exo, id, index_cast<int64_t>(first + 1),
+                                         index_cast<int64_t>(n), conn.data()),
+                target, "writing block " + std::to_string(id) + " connectivity");
         }
       };
       switch (members.front().kind) {
         case ElementKind::kHex:
-          fill(model.hexes);
+          put(model.hexes);
           break;
         case ElementKind::kTet:
-          fill(model.tets);
+          put(model.tets);
           break;
         case ElementKind::kPyramid:
-          fill(model.pyramids);
+          put(model.pyramids);
           break;
         case ElementKind::kWedge:
-          fill(model.wedges);
+          put(model.wedges);
           break;
       }
-      if (!conn.empty())
-        check(ex_put_conn(exo, EX_ELEM_BLOCK, id, conn.data(), nullptr, nullptr), target,
-              "writing block " + std::to_string(id) + " connectivity");
       if (auto it = names.find(id); it != names.end()) block_names.set(b, it->second);
       ++b;
     }
