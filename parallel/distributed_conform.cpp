@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <map>
 #include <numeric>
@@ -15,9 +16,11 @@
 #include <geode/primal/dice_model.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/key_map.hpp>
+#include <geode/primal/release.hpp>
 #include <geode/primal/split_pyramids.hpp>
 #include <geode/primal/submodel.hpp>
 #include <geode/primal/validity.hpp>
+#include <geode/primal/validity_local.hpp>
 
 namespace geode::parallel {
 namespace {
@@ -107,13 +110,13 @@ class Distributor {
   void dice();
   void number();
   void assemble();
+  void break_for_test();
   void verify();
   void release() {
     own_ = {};
-    zone_at_ = {};
-    level_ = {}, in_zone_ = {}, part_ = {}, zone_node_ = {};
-    diced_gid_ = {}, diced_holders_ = {}, zone_holders_ = {};
-    split_ = {}, zone_out_ = {}, tet_pyramid_ = {};
+    primal::release(zone_at_, level_, in_zone_, part_, zone_node_, diced_gid_, diced_holders_,
+                    zone_holders_, tet_pyramid_);
+    split_ = {}, zone_out_ = {};
   }
 
   const DistributedOptions& options_;
@@ -136,6 +139,8 @@ class Distributor {
   std::size_t zone_first_ = 0, zone_last_ = 0;                   // this rank's zone hexes
   primal::Submodel own_;  // this rank's elements outside the zone
   primal::DicedModel diced_;
+  primal::DicingCheck dicing_;           // diced_ against the dicing tables (local verification)
+  std::int64_t zone_nodes_ = 0;          // the zone's output nodes: global ids below this
   std::vector<std::int64_t> diced_gid_;  // per diced node
   std::vector<Mask> diced_holders_;      // per diced node not in the zone: ranks holding it
   std::vector<Mask> zone_holders_;       // per zone output node
@@ -329,12 +334,35 @@ void Distributor::dice() {
   own_ = primal::extract_submodel(m(), mine);
   diced_ = primal::dice_model(own_.model);
   rep_.cells = static_cast<std::int64_t>(std::count(mine.begin(), mine.end(), 1));
+  break_for_test();
+  // Local verification reads the children against the tables while the dicing data exist.
+  if (options_.conform.verify == conform::ConformVerify::kLocal)
+    dicing_ = primal::check_dicing(own_.model, diced_);
+}
+
+// Test hook (docs/cli.md): GEODE_TEST_BREAK_DICED_HEX=N swaps the first two corners of this
+// rank's N-th diced hex (1-based; hex children, then tet and wedge children), as a faulty
+// dicing would: both --verify modes must find it on every rank that has one
+// (tests/parallel/mpi_verify_test.sh).
+void Distributor::break_for_test() {
+  const char* text = std::getenv("GEODE_TEST_BREAK_DICED_HEX");
+  if (!text || !*text) return;
+  const long n = std::strtol(text, nullptr, 10);
+  std::size_t k = n >= 1 ? static_cast<std::size_t>(n - 1) : ~std::size_t{0};
+  for (auto* part : {&diced_.hex_children, &diced_.tet_children, &diced_.wedge_children}) {
+    if (k < part->size()) {
+      std::swap((*part)[k][0], (*part)[k][1]);
+      return;
+    }
+    k -= std::min(k, part->size());
+  }
 }
 
 // Global ids: see the header.
 void Distributor::number() {
   const std::size_t nv = m().points.size();
   const std::int64_t zone_nodes = primal::index_cast<std::int64_t>(zone_out_.points.size());
+  zone_nodes_ = zone_nodes;
   // Per model node: the ranks whose elements outside the zone use it.
   std::vector<Mask> uses(nv, 0);
   for (std::size_t c = 0; c < cells(); ++c)
@@ -369,6 +397,7 @@ void Distributor::number() {
     for (int q = 0; q < size_; ++q)
       if (holders >> q & 1) candidates[primal::index_cast<std::size_t>(q)].push_back(i);
   }
+  primal::release(zone_at_);  // the zone's nodes by position: only the loop above reads them
   // Exchange the candidates' origins with each rank that may hold them; the nodes in both lists
   // are the ones shared.
   const auto key_less = [&](std::size_t a, std::size_t b) { return key[a] < key[b]; };
@@ -460,6 +489,9 @@ void Distributor::number() {
 }
 
 // This rank's hexes (its zone hexes and its diced ones) over its nodes, ascending global id.
+// Memory: the dicing data are released as the output takes them over (points and origins once
+// the output's points and node sets are made, each part's children once its hexes are placed),
+// so that the dicing and the output are never whole side by side.
 void Distributor::assemble() {
   const std::size_t nd = diced_.points.size();
   std::vector<std::int64_t> gids;
@@ -479,16 +511,33 @@ void Distributor::assemble() {
     diced_local[i] = local(diced_gid_[i]);
     o.points[primal::index_cast<std::size_t>(diced_local[i])] = diced_.points[i];
   }
+  primal::release(diced_.points, diced_gid_);
   const std::int64_t zone_nodes = primal::index_cast<std::int64_t>(zone_out_.points.size());
   for (std::size_t l = 0; l < gids.size(); ++l)
     if (gids[l] < zone_nodes)
       o.points[l] = zone_out_.points[primal::index_cast<std::size_t>(gids[l])];
+  // Shared nodes per neighbour, from the holders of each local node.
+  std::vector<Mask> holders(gids.size(), 0);
+  for (std::size_t i = 0; i < nd; ++i)
+    holders[primal::index_cast<std::size_t>(diced_local[i])] |= diced_holders_[i];
+  primal::release(diced_holders_);
+  for (std::size_t l = 0; l < gids.size(); ++l)
+    if (gids[l] < zone_nodes) holders[l] |= zone_holders_[primal::index_cast<std::size_t>(gids[l])];
+  for (std::size_t l = 0; l < gids.size(); ++l)
+    for (int q = 0; q < size_; ++q)
+      if (q != rank_ && (holders[l] >> q & 1))
+        out_.shared_nodes[q].push_back(primal::index_cast(l));
+  // Sets read the diced numbering: made before the children move, the origins freed after.
+  const Model& om = own_.model;
+  const std::size_t nh = diced_.hex_children.size(), nt = diced_.tet_children.size();
+  const auto diced_sides =
+      primal::diced_side_sets(om, diced_, 0, primal::index_cast(nh), primal::index_cast(nh + nt));
+  const auto diced_nodes = primal::diced_node_sets(om, diced_, diced_local);
+  primal::release(diced_.origin);
   // Hexes in a first order (zone, then diced hex, tet, wedge children), ids ascending in it;
   // placed by block (a stable counting sort: by block, then by id), each written once into the
   // output arrays, with no copy of the hexes beside them.
-  const Model& om = own_.model;
   const std::size_t first_diced = zone_last_ - zone_first_;
-  const std::size_t nh = diced_.hex_children.size(), nt = diced_.tet_children.size();
   const std::size_t total = first_diced + nh + nt + diced_.wedge_children.size();
   std::vector<int> block(total);
   for (std::size_t k = 0; k < first_diced; ++k) block[k] = zone_out_.hex_block[zone_first_ + k];
@@ -499,6 +548,7 @@ void Distributor::assemble() {
   for (std::size_t k = 0; k < diced_.wedge_children.size(); ++k)
     block[first_diced + nh + nt + k] =
         primal::block_of(om, {ElementKind::kWedge, diced_.wedge_parent[k]});
+  primal::release(diced_.hex_parent, diced_.tet_parent, diced_.wedge_parent);
   std::map<int, Index> next;  // per block: its next output position
   for (int b : block) ++next[b];
   Index start = 0;
@@ -507,35 +557,29 @@ void Distributor::assemble() {
   o.hexes.resize(total);
   o.hex_block.resize(total);
   out_.hex_gid.resize(total);
-  for (std::size_t k = 0; k < total; ++k) {
+  std::size_t k = 0;
+  auto place = [&](std::int64_t gid) {
     const Index at = next[block[k]]++;
-    position[k] = at;
+    position[k++] = at;
     const auto p = primal::index_cast<std::size_t>(at);
-    o.hex_block[p] = block[k];
-    std::array<Index, 8>& x = o.hexes[p];
-    if (k < first_diced) {
-      out_.hex_gid[p] = static_cast<std::int64_t>(zone_first_ + k);
-      for (int c = 0; c < 8; ++c) x[c] = local(zone_out_.hexes[zone_first_ + k][c]);
-    } else {
-      const std::size_t j = k - first_diced;
-      out_.hex_gid[p] = diced_hex_first_ + static_cast<std::int64_t>(j);
-      const auto& child = j < nh        ? diced_.hex_children[j]
-                          : j < nh + nt ? diced_.tet_children[j - nh]
-                                        : diced_.wedge_children[j - nh - nt];
+    o.hex_block[p] = block[k - 1];
+    out_.hex_gid[p] = gid;
+    return p;
+  };
+  for (std::size_t h = zone_first_; h < zone_last_; ++h) {
+    std::array<Index, 8>& x = o.hexes[place(static_cast<std::int64_t>(h))];
+    for (int c = 0; c < 8; ++c) x[c] = local(zone_out_.hexes[h][c]);
+  }
+  for (auto* part : {&diced_.hex_children, &diced_.tet_children, &diced_.wedge_children}) {
+    for (const auto& child : *part) {
+      std::array<Index, 8>& x =
+          o.hexes[place(diced_hex_first_ + static_cast<std::int64_t>(k - first_diced))];
       for (int c = 0; c < 8; ++c) x[c] = diced_local[primal::index_cast<std::size_t>(child[c])];
     }
+    primal::release(*part);  // consumed
   }
-  block = {};
-  const Index hex_children = primal::index_cast(nh);
-  const Index tet_children = primal::index_cast(nt);
-  // Side sets read the diced numbering.
-  const auto diced_sides =
-      primal::diced_side_sets(om, diced_, 0, hex_children, hex_children + tet_children);
-  const auto diced_nodes = primal::diced_node_sets(om, diced_, diced_local);
-  {
-    primal::DicedModel released;  // the dicing data, consumed
-    diced_ = std::move(released);
-  }
+  primal::release(block, diced_local);
+  diced_ = primal::DicedModel();
   o.block_names = m().block_names;
   o.block_names.insert(zone_out_.block_names.begin(), zone_out_.block_names.end());
   // Sets: the zone's (on this rank's nodes and hexes) and the diced ones, by id.
@@ -570,16 +614,7 @@ void Distributor::assemble() {
     std::sort(ss.sides.begin(), ss.sides.end());
     o.side_sets.push_back(std::move(ss));
   }
-  // Shared nodes per neighbour, and the global counts.
-  std::vector<Mask> holders(gids.size(), 0);
-  for (std::size_t i = 0; i < nd; ++i)
-    holders[primal::index_cast<std::size_t>(diced_local[i])] |= diced_holders_[i];
-  for (std::size_t l = 0; l < gids.size(); ++l)
-    if (gids[l] < zone_nodes) holders[l] |= zone_holders_[primal::index_cast<std::size_t>(gids[l])];
-  for (std::size_t l = 0; l < gids.size(); ++l)
-    for (int q = 0; q < size_; ++q)
-      if (q != rank_ && (holders[l] >> q & 1))
-        out_.shared_nodes[q].push_back(primal::index_cast(l));
+  // The global counts.
   out_.node_gid = std::move(gids);
   std::map<int, std::int64_t> blocks;
   for (int b : o.hex_block) ++blocks[b];
@@ -642,20 +677,38 @@ bool piece_ok(const primal::HexValidityReport& v, const std::vector<char>& exemp
 
 // Every rank's hexes checked as a piece (piece_ok, its shared nodes exempt from the covering),
 // and the zone as conform checked it, as a piece too (its cut is not the model's boundary).
-// The diced rest is the dicing of valid elements; the joined file (--join) can be checked
-// whole with `geode check`.
+// --verify local (the default), as the serial run verifies: the diced children against the
+// dicing tables (dice()), the whole check around the hexes on a zone node (the rank's zone
+// hexes and the diced hexes meeting them across the cut, where nodes were matched by position)
+// and every hex's corner Jacobians; --verify full: the whole check on every hex of the piece.
+// The joined file (--join) can be checked whole with `geode check`.
 void Distributor::verify() {
   primal::HexMesh mesh;  // borrowed, not copied
   mesh.points = std::move(out_.model.points);
   mesh.hexes = std::move(out_.model.hexes);
-  const auto v = primal::check_validity(mesh);
+  primal::HexValidityReport v;
+  if (options_.conform.verify == conform::ConformVerify::kLocal) {
+    std::vector<Index> seeds;
+    for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
+      for (Index n : mesh.hexes[h])
+        if (out_.node_gid[primal::index_cast<std::size_t>(n)] < zone_nodes_) {
+          seeds.push_back(primal::index_cast(h));
+          break;
+        }
+    v = primal::check_validity_around(mesh, seeds);
+  } else {
+    v = primal::check_validity(mesh);
+  }
   out_.model.points = std::move(mesh.points);
   out_.model.hexes = std::move(mesh.hexes);
   std::vector<char> shared(out_.model.points.size(), 0);
   for (const auto& [q, nodes] : out_.shared_nodes)
     for (Index n : nodes) shared[primal::index_cast<std::size_t>(n)] = 1;
-  const bool ok = piece_ok(v, shared);
-  if (!ok) rep_.warnings.push_back("rank " + std::to_string(rank_) + ": " + v.summary());
+  const bool ok = piece_ok(v, shared) && dicing_.ok();
+  if (!piece_ok(v, shared))
+    rep_.warnings.push_back("rank " + std::to_string(rank_) + ": " + v.summary());
+  if (!dicing_.ok())
+    rep_.warnings.push_back("rank " + std::to_string(rank_) + ": " + dicing_.summary());
   const bool zone_ok = piece_ok(rep_.zone.validity, {});
   if (!zone_ok) rep_.warnings.push_back("the transition zone: " + rep_.zone.validity.summary());
   int mine = ok && zone_ok ? 1 : 0, all = 0;

@@ -2,6 +2,7 @@
 // one Nemesis-partitioned Exodus file per rank, and on request one joined file. Run as
 // `mpirun -np N geode_mpi conform ...`. A separate executable so that the serial `geode` needs
 // neither MPI nor its runtime (an MPI program started without mpirun still initializes MPI).
+#include <malloc.h>
 #include <sys/resource.h>
 
 #include <CLI/CLI.hpp>
@@ -31,7 +32,7 @@ int run(int argc, char** argv, int rank, int size) {
   CLI::App app{"geode conform under MPI: mpirun -np N geode_mpi conform INPUT -o OUT.exo"};
   app.require_subcommand(1);
   CLI::App* conform = app.add_subcommand("conform", "conform a hex + tet model, partitioned");
-  std::string input, output, smooth = "local", side = "hex";
+  std::string input, output, smooth = "local", side = "hex", verify = "local";
   bool join = false, quiet = false;
   int rings = 4, threads = 1;
   double thickness = 0;
@@ -48,6 +49,12 @@ int run(int argc, char** argv, int rank, int size) {
   conform->add_option("--smooth", smooth, "local or none (global moves every node: not here)");
   conform->add_option("--buffer-side", side, "the part the buffer layer is carved from: hex, tet");
   conform->add_option("--buffer-thickness", thickness, "as geode conform (0: the side's default)");
+  conform
+      ->add_option("--verify", verify,
+                   "local (default): each rank's diced hexes against the dicing tables, the whole "
+                   "check around the transition zone's hexes and every hex's corner Jacobians; "
+                   "full: the whole check on every hex of each rank (about 5x the time)")
+      ->check(CLI::IsMember({"local", "full"}));
   conform->add_option("--rings", rings,
                       "depth of the transition zone conformed on every rank (grown as needed)");
   conform->add_option("--threads", threads, "TBB threads per rank (default 1: one core each)");
@@ -66,6 +73,7 @@ int run(int argc, char** argv, int rank, int size) {
     options.conform.smooth = conform::parse_conform_smooth(smooth);
     options.conform.buffer.side = conform::parse_buffer_side(side);
     options.conform.buffer.thickness = thickness;
+    options.conform.verify = conform::parse_conform_verify(verify);
     options.rings = rings;
     io::FilePartition file_partition;
     const primal::Model model = io::read_model(input, {}, true, &file_partition);
@@ -142,6 +150,10 @@ int run(int argc, char** argv, int rank, int size) {
 
 int main(int argc, char** argv) {
   MPI_Init(&argc, &argv);
+  // As the serial command (cli/main.cpp): arrays of a MiB or more go back to the system when
+  // freed, not kept resident through the next stage. After MPI_Init, which may set its own.
+  mallopt(M_MMAP_THRESHOLD, 1 << 20);
+  mallopt(M_MMAP_MAX, 1 << 20);
   int rank = 0, size = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &size);

@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# geode_mpi's verification (issue 26): --verify local (the default: the diced hexes against the
+# dicing tables, the whole check around the transition zone, every corner Jacobian) and --verify
+# full pass the same valid result; a dicing broken on purpose (the test hook
+# GEODE_TEST_BREAK_DICED_HEX, docs/cli.md) is found by both on 1 and 2 ranks: exit 4, the
+# failing check named, nothing written.
+# usage: mpi_verify_test.sh GEODE GEODE_MPI MPIEXEC WORKDIR
+set -euo pipefail
+geode=$1 geode_mpi=$2 mpiexec=$3 dir=$4
+if [ "$(id -u)" = 0 ]; then export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1; fi
+rm -rf "$dir" && mkdir -p "$dir" && cd "$dir"
+"$geode" demo --model half -n 8 --save-input in.exo >/dev/null
+for n in 1 2; do
+  for mode in local full; do
+    "$mpiexec" --oversubscribe -np "$n" "$geode_mpi" conform in.exo -o "ok_${mode}$n.exo" \
+      --verify "$mode" --join -q
+    status=0
+    GEODE_TEST_BREAK_DICED_HEX=1 "$mpiexec" --oversubscribe -np "$n" "$geode_mpi" conform in.exo \
+      -o "broken_${mode}$n.exo" --verify "$mode" -q 2>err.txt >/dev/null || status=$?
+    if [ "$status" != 4 ]; then
+      echo "verify $mode, $n ranks: a broken dicing exited $status, not 4"; cat err.txt; exit 1
+    fi
+    grep -q "invalid result, nothing written" err.txt
+    grep -q "hexes with a non-positive corner Jacobian" err.txt
+    if [ "$mode" = local ]; then grep -q "dicing: NOT as its tables make it" err.txt; fi
+    if ls broken_* >/dev/null 2>&1; then echo "verify $mode, $n ranks: wrote a file"; exit 1; fi
+  done
+  cmp "ok_local$n.exo" "ok_full$n.exo"
+done
+echo "mpi_verify_test: both modes pass the result and find the broken dicing on 1 and 2 ranks"
