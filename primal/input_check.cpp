@@ -5,6 +5,7 @@
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
@@ -12,12 +13,14 @@
 #include <span>
 #include <sstream>
 #include <tuple>
+#include <type_traits>
 #include <unordered_map>
 
 #include <geode/primal/boundary.hpp>
 #include <geode/primal/detail/lowest_node_sort.hpp>
 #include <geode/primal/disjoint_sets.hpp>
 #include <geode/primal/errors.hpp>
+#include <geode/primal/release.hpp>
 
 namespace geode::primal {
 
@@ -386,56 +389,81 @@ class InputChecker {
   // The corners' solid angles at every node against 4 pi inside and the boundary's enclosed
   // solid angle on it. A pyramid counts as the two positive tets check_geometry found in it
   // (their cones tile its corners'), every other corner as the cone of its three edges.
+  // Every corner cone of element i of `kind` (a pyramid as its two positive tets along a base
+  // diagonal): visit(k, v, a, b, c) for its k-th cone, at v spanned by a, b, c.
+  template <class Visit>
+  void element_cones(ElementKind kind, std::size_t i, Visit&& visit) const {
+    auto at = [&](const auto& cell, const auto& neighbors, int first) {
+      static_assert(std::tuple_size_v<std::decay_t<decltype(cell)>> ==
+                    std::tuple_size_v<std::decay_t<decltype(neighbors)>>);
+      for (std::size_t c = 0; c < cell.size(); ++c) {
+        const auto& n = neighbors[c];
+        visit(first + static_cast<int>(c), cell[c], cell[index_cast<std::size_t>(n[0])],
+              cell[index_cast<std::size_t>(n[1])], cell[index_cast<std::size_t>(n[2])]);
+      }
+    };
+    switch (kind) {
+      case ElementKind::kHex:
+        return at(model_.hexes[i], topology::kHexCornerNeighbors, 0);
+      case ElementKind::kWedge:
+        return at(model_.wedges[i], topology::kWedgeCornerNeighbors, 0);
+      case ElementKind::kTet:
+        return at(model_.tets[i], topology::kTetCornerNeighbors, 0);
+      case ElementKind::kPyramid: {
+        const auto& p = model_.pyramids[i];
+        const bool d02 = tet_volume(pt(p[0]), pt(p[1]), pt(p[2]), pt(p[4])) > 0.0 &&
+                         tet_volume(pt(p[0]), pt(p[2]), pt(p[3]), pt(p[4])) > 0.0;
+        const std::array<std::array<Index, 4>, 2> tets =
+            d02 ? std::array<std::array<Index, 4>, 2>{{{p[0], p[1], p[2], p[4]},
+                                                       {p[0], p[2], p[3], p[4]}}}
+                : std::array<std::array<Index, 4>, 2>{
+                      {{p[0], p[1], p[3], p[4]}, {p[1], p[2], p[3], p[4]}}};
+        at(tets[0], topology::kTetCornerNeighbors, 0);
+        return at(tets[1], topology::kTetCornerNeighbors, 4);
+      }
+    }
+  }
+
+  // The corner cones' solid angles (atan2, most of this pass) in parallel, one slot per cone;
+  // their sums per node then in one order (hexes, wedges, tets, the centres of quads met by
+  // four triangles, pyramids), so that the sums do not depend on the threads.
   void covering_at_nodes() {
     const std::size_t nv = model_.points.size();
+    constexpr std::array<std::pair<ElementKind, std::size_t>, 4> kOrder{
+        {{ElementKind::kHex, 8},
+         {ElementKind::kWedge, 6},
+         {ElementKind::kTet, 4},
+         {ElementKind::kPyramid, 8}}};
+    std::array<std::size_t, 5> base{};
+    for (std::size_t k = 0; k < kOrder.size(); ++k)
+      base[k + 1] = base[k] + kOrder[k].second * element_count(model_, kOrder[k].first);
+    std::vector<double> cone(base.back());
+    for (std::size_t k = 0; k < kOrder.size(); ++k) {
+      const auto [kind, per] = kOrder[k];
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, element_count(model_, kind), 2048),
+                        [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t i = r.begin(); i != r.end(); ++i)
+                            element_cones(kind, i, [&](int j, Index v, Index a, Index b, Index c) {
+                              const Point& o = pt(v);
+                              cone[base[k] + per * i + index_cast<std::size_t>(j)] =
+                                  solid_angle(pt(a) - o, pt(b) - o, pt(c) - o);
+                            });
+                        });
+    }
     std::vector<double> angle(nv, 0.0);
     std::vector<ElementRef> at(nv, ElementRef{ElementKind::kHex, kInvalidIndex});
-    auto cone = [&](ElementRef e, Index v, Index a, Index b, Index c) {
-      const Point& o = pt(v);
-      angle[index_cast<std::size_t>(v)] += solid_angle(pt(a) - o, pt(b) - o, pt(c) - o);
-      if (at[index_cast<std::size_t>(v)].index == kInvalidIndex) at[index_cast<std::size_t>(v)] = e;
-    };
-    auto tet = [&](ElementRef e, std::array<Index, 4> t) {
-      for (int k = 0; k < 4; ++k) {
-        const auto& n = topology::kTetCornerNeighbors[index_cast<std::size_t>(k)];
-        cone(e, t[index_cast<std::size_t>(k)], t[index_cast<std::size_t>(n[0])],
-             t[index_cast<std::size_t>(n[1])], t[index_cast<std::size_t>(n[2])]);
-      }
-    };
-    for (std::size_t i = 0; i < model_.hexes.size(); ++i) {
-      const auto& h = model_.hexes[i];
-      for (int c = 0; c < 8; ++c) {
-        const auto& n = topology::kHexCornerNeighbors[index_cast<std::size_t>(c)];
-        cone({ElementKind::kHex, index_cast(i)}, h[index_cast<std::size_t>(c)],
-             h[index_cast<std::size_t>(n[0])], h[index_cast<std::size_t>(n[1])],
-             h[index_cast<std::size_t>(n[2])]);
-      }
+    for (std::size_t k = 0; k < kOrder.size(); ++k) {
+      const auto [kind, per] = kOrder[k];
+      if (kind == ElementKind::kPyramid)
+        for (Index x : centre_on_quad_) angle[index_cast<std::size_t>(x)] += 2.0 * kPi;
+      for (std::size_t i = 0; i < element_count(model_, kind); ++i)
+        element_cones(kind, i, [&](int j, Index v, Index, Index, Index) {
+          const auto u = index_cast<std::size_t>(v);
+          angle[u] += cone[base[k] + per * i + index_cast<std::size_t>(j)];
+          if (at[u].index == kInvalidIndex) at[u] = {kind, index_cast(i)};
+        });
     }
-    for (std::size_t i = 0; i < model_.wedges.size(); ++i) {
-      const auto& w = model_.wedges[i];
-      for (int c = 0; c < 6; ++c) {
-        const auto& n = topology::kWedgeCornerNeighbors[index_cast<std::size_t>(c)];
-        cone({ElementKind::kWedge, index_cast(i)}, w[index_cast<std::size_t>(c)],
-             w[index_cast<std::size_t>(n[0])], w[index_cast<std::size_t>(n[1])],
-             w[index_cast<std::size_t>(n[2])]);
-      }
-    }
-    for (std::size_t i = 0; i < model_.tets.size(); ++i)
-      tet({ElementKind::kTet, index_cast(i)}, model_.tets[i]);
-    for (Index x : centre_on_quad_) angle[index_cast<std::size_t>(x)] += 2.0 * kPi;
-    for (std::size_t i = 0; i < model_.pyramids.size(); ++i) {
-      const auto& p = model_.pyramids[i];
-      const ElementRef e{ElementKind::kPyramid, index_cast(i)};
-      const bool d02 = tet_volume(pt(p[0]), pt(p[1]), pt(p[2]), pt(p[4])) > 0.0 &&
-                       tet_volume(pt(p[0]), pt(p[2]), pt(p[3]), pt(p[4])) > 0.0;
-      if (d02) {
-        tet(e, {p[0], p[1], p[2], p[4]});
-        tet(e, {p[0], p[2], p[3], p[4]});
-      } else {
-        tet(e, {p[0], p[1], p[3], p[4]});
-        tet(e, {p[1], p[2], p[3], p[4]});
-      }
-    }
+    release(cone);
 
     for (std::size_t v = 0; v < nv && !full(); ++v) {
       if (at[v].index == kInvalidIndex || !judged_[v]) continue;
