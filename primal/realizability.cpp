@@ -9,9 +9,14 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <unordered_map>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <geode/primal/boundary.hpp>
+#include <geode/primal/detail/lowest_node_sort.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/topology.hpp>
 
@@ -135,27 +140,68 @@ struct SharedCorner {
   std::vector<Index> quads;
 };
 
+// Keyed uses grouped by key, each group's uses in `at` order, groups in order of their first
+// use: group(key, first, last) for each. The uses are bucketed by key[0] and each bucket sorted
+// (detail/lowest_node_sort.hpp, in parallel); `each(visit)` visits every use, from any thread.
+// Hash maps of vectors over every face, edge or corner made `geode check` of a million hexes
+// take half a minute; this takes a second.
+template <std::size_t N>
+struct KeyedUse {
+  std::array<Index, N> key;
+  std::size_t at;  // the use's place in the input's order
+  bool operator<(const KeyedUse& o) const { return std::tie(key, at) < std::tie(o.key, o.at); }
+};
+
+template <std::size_t N, class Each, class Group>
+void group_by_key(std::size_t nodes, Each&& each, Group&& group) {
+  std::vector<std::size_t> start;
+  const std::vector<KeyedUse<N>> uses = detail::sort_by_lowest_node<KeyedUse<N>>(
+      nodes, each, [](const KeyedUse<N>& u) { return u.key[0]; }, start);
+  std::vector<std::pair<std::size_t, std::size_t>> groups;  // (first use's at, its place)
+  for (std::size_t g = 0; g < uses.size();) {
+    std::size_t e = g + 1;
+    while (e < uses.size() && uses[e].key == uses[g].key) ++e;
+    groups.emplace_back(uses[g].at, g);
+    g = e;
+  }
+  std::sort(groups.begin(), groups.end());
+  for (const auto& [at, g] : groups) {
+    std::size_t e = g + 1;
+    while (e < uses.size() && uses[e].key == uses[g].key) ++e;
+    group(uses[g].key, uses.data() + g, uses.data() + e);
+  }
+}
+
 std::vector<SharedCorner> shared_corners(
     std::size_t n, const std::function<const std::array<Index, 4>*(std::size_t)>& quad) {
-  std::map<std::array<Index, 3>, std::vector<Index>> by_corner;
-  std::vector<std::array<Index, 3>> order;
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto* q = quad(i);
-    if (!q) continue;
-    for (std::size_t c = 0; c < 4; ++c) {
-      const Index v = (*q)[c], a = (*q)[(c + 3) % 4], b = (*q)[(c + 1) % 4];
-      const std::array<Index, 3> key{v, std::min(a, b), std::max(a, b)};
-      auto& list = by_corner[key];
-      if (list.empty()) order.push_back(key);
-      list.push_back(index_cast(i));
-    }
-  }
+  Index nodes = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (const auto* q = quad(i))
+      for (Index v : *q) nodes = std::max(nodes, v + 1);
   std::vector<SharedCorner> out;
-  for (const auto& key : order) {
-    auto list = by_corner.at(key);
-    sort_unique(list);
-    if (list.size() >= 2) out.push_back({key, list});
-  }
+  group_by_key<3>(
+      index_cast<std::size_t>(nodes),
+      [&](auto&& visit) {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096),
+                          [&](const tbb::blocked_range<std::size_t>& r) {
+                            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                              const auto* q = quad(i);
+                              if (!q) continue;
+                              for (std::size_t c = 0; c < 4; ++c) {
+                                const Index v = (*q)[c], a = (*q)[(c + 3) % 4],
+                                            b = (*q)[(c + 1) % 4];
+                                visit(KeyedUse<3>{{v, std::min(a, b), std::max(a, b)}, 4 * i + c});
+                              }
+                            }
+                          });
+      },
+      [&](const std::array<Index, 3>& key, const KeyedUse<3>* first, const KeyedUse<3>* last) {
+        if (last - first < 2) return;
+        SharedCorner sc{key, {}};
+        for (const auto* u = first; u != last; ++u) sc.quads.push_back(index_cast(u->at / 4));
+        sort_unique(sc.quads);
+        if (sc.quads.size() >= 2) out.push_back(std::move(sc));
+      });
   return out;
 }
 
@@ -189,21 +235,36 @@ class HexFinder {
   void collect_faces() {
     const std::size_t nv = mesh_.points.size();
     check_node_faces(options_, nv);
-    std::unordered_map<FaceKey, Index, IndexArrayHash> face_id;
-    for (std::size_t h = 0; h < mesh_.hexes.size(); ++h) {
-      const auto& hex = mesh_.hexes[h];
-      check_range(hex, nv, "hex", h);
-      if (has_repeated(hex)) continue;
-      for (int f = 0; f < topo::kHexFaces; ++f) {
-        std::array<Index, 4> q{};
-        for (int i = 0; i < 4; ++i)
-          q[index_cast<std::size_t>(i)] = hex[index_cast<std::size_t>(
-              topo::kHexFaceCorners[index_cast<std::size_t>(f)][index_cast<std::size_t>(i)])];
-        const auto [it, inserted] = face_id.try_emplace(face_key(q), index_cast(faces_.size()));
-        if (inserted) faces_.push_back(Face{q, {}});
-        faces_[index_cast<std::size_t>(it->second)].uses.emplace_back(index_cast(h), f);
-      }
-    }
+    for (std::size_t h = 0; h < mesh_.hexes.size(); ++h) check_range(mesh_.hexes[h], nv, "hex", h);
+    auto face_of = [&](std::size_t h, int f) {
+      std::array<Index, 4> q{};
+      for (int i = 0; i < 4; ++i)
+        q[index_cast<std::size_t>(i)] = mesh_.hexes[h][index_cast<std::size_t>(
+            topo::kHexFaceCorners[index_cast<std::size_t>(f)][index_cast<std::size_t>(i)])];
+      return q;
+    };
+    // Faces numbered in order of first use, each as its first hex sees it.
+    group_by_key<4>(
+        nv,
+        [&](auto&& visit) {
+          tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh_.hexes.size(), 4096),
+                            [&](const tbb::blocked_range<std::size_t>& r) {
+                              for (std::size_t h = r.begin(); h != r.end(); ++h) {
+                                if (has_repeated(mesh_.hexes[h])) continue;
+                                for (int f = 0; f < topo::kHexFaces; ++f)
+                                  visit(KeyedUse<4>{face_key(face_of(h, f)),
+                                                    index_cast<std::size_t>(topo::kHexFaces) * h +
+                                                        index_cast<std::size_t>(f)});
+                              }
+                            });
+        },
+        [&](const FaceKey&, const KeyedUse<4>* first, const KeyedUse<4>* last) {
+          const std::size_t per = index_cast<std::size_t>(topo::kHexFaces);
+          Face face{face_of(first->at / per, index_cast<int>(first->at % per)), {}};
+          for (const auto* u = first; u != last; ++u)
+            face.uses.emplace_back(index_cast(u->at / per), index_cast<int>(u->at % per));
+          faces_.push_back(std::move(face));
+        });
     for (std::size_t f = 0; f < faces_.size(); ++f)
       if (faces_[f].uses.size() == 1) boundary_.push_back(index_cast(f));
   }
@@ -275,19 +336,6 @@ class HexFinder {
 
   // Interior edges in fewer than three hexes, merged by their pair of hexes.
   void find_doublets() {
-    std::unordered_map<EdgeKey, std::vector<Index>, IndexArrayHash> edge_hexes;
-    std::vector<EdgeKey> order;
-    for (std::size_t h = 0; h < mesh_.hexes.size(); ++h) {
-      const auto& hex = mesh_.hexes[h];
-      if (has_repeated(hex)) continue;
-      for (const auto& e : topo::kHexEdgeCorners) {
-        const EdgeKey k =
-            edge_key(hex[index_cast<std::size_t>(e[0])], hex[index_cast<std::size_t>(e[1])]);
-        auto [it, inserted] = edge_hexes.try_emplace(k);
-        if (inserted) order.push_back(k);
-        it->second.push_back(index_cast(h));
-      }
-    }
     std::unordered_map<EdgeKey, bool, IndexArrayHash> on_boundary;
     for (Index f : boundary_) {
       const auto& q = faces_[index_cast<std::size_t>(f)].nodes;
@@ -296,17 +344,36 @@ class HexFinder {
                              q[index_cast<std::size_t>((i + 1) % 4)])] = true;
     }
     std::map<std::vector<Index>, std::size_t> by_hexes;
-    for (const auto& k : order) {
-      auto hexes = edge_hexes.at(k);
-      sort_unique(hexes);
-      if (hexes.size() >= 3 || on_boundary.count(k)) continue;
-      auto [it, inserted] = by_hexes.try_emplace(hexes, doublets_.size());
-      if (inserted) doublets_.push_back(Obstruction{ObstructionKind::kDoublet, hexes, {}});
-      auto& nodes = doublets_[it->second].nodes;
-      nodes.insert(nodes.end(), k.begin(), k.end());
-      sort_unique(nodes);
-      for (Index v : k) doublet_ends_.emplace(v, it->second);
-    }
+    const std::size_t per = topo::kHexEdgeCorners.size();
+    group_by_key<2>(
+        mesh_.points.size(),
+        [&](auto&& visit) {
+          tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh_.hexes.size(), 4096),
+                            [&](const tbb::blocked_range<std::size_t>& r) {
+                              for (std::size_t h = r.begin(); h != r.end(); ++h) {
+                                const auto& hex = mesh_.hexes[h];
+                                if (has_repeated(hex)) continue;
+                                for (std::size_t e = 0; e < per; ++e) {
+                                  const auto& ends = topo::kHexEdgeCorners[e];
+                                  visit(KeyedUse<2>{edge_key(hex[index_cast<std::size_t>(ends[0])],
+                                                             hex[index_cast<std::size_t>(ends[1])]),
+                                                    per * h + e});
+                                }
+                              }
+                            });
+        },
+        [&](const EdgeKey& k, const KeyedUse<2>* first, const KeyedUse<2>* last) {
+          std::vector<Index> hexes;
+          for (const auto* u = first; u != last; ++u) hexes.push_back(index_cast(u->at / per));
+          sort_unique(hexes);
+          if (hexes.size() >= 3 || on_boundary.count(k)) return;
+          auto [it, inserted] = by_hexes.try_emplace(hexes, doublets_.size());
+          if (inserted) doublets_.push_back(Obstruction{ObstructionKind::kDoublet, hexes, {}});
+          auto& nodes = doublets_[it->second].nodes;
+          nodes.insert(nodes.end(), k.begin(), k.end());
+          sort_unique(nodes);
+          for (Index v : k) doublet_ends_.emplace(v, it->second);
+        });
   }
 
   // Distinct faces sharing both edges va, vb at a node v.
