@@ -105,7 +105,9 @@ void write_exodus(const Model& model, const std::filesystem::path& path) {
     check(ex_put_coord_names(exo, coordinate_names), target, "writing coordinate names");
     NameBuffers block_names(blocks.size());
     std::size_t b = 0;
-    for (const auto& [id, members] : blocks) {
+    for (const auto& entry : blocks) {
+      const int id = entry.first;  // named: a lambda below reads them
+      const std::vector<ElementRef>& members = entry.second;
       const ExodusCell& cell = kExodusCells[static_cast<std::size_t>(members.front().kind)];
       const int per_elem = cell.corners;
       check(ex_put_block(exo, EX_ELEM_BLOCK, id, cell.name, index_cast<int64_t>(members.size()),

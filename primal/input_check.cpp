@@ -439,7 +439,8 @@ class InputChecker {
       base[k + 1] = base[k] + kOrder[k].second * element_count(model_, kOrder[k].first);
     std::vector<double> cone(base.back());
     for (std::size_t k = 0; k < kOrder.size(); ++k) {
-      const auto [kind, per] = kOrder[k];
+      const ElementKind kind = kOrder[k].first;
+      const std::size_t per = kOrder[k].second;
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, element_count(model_, kind), 2048),
                         [&](const tbb::blocked_range<std::size_t>& r) {
                           for (std::size_t i = r.begin(); i != r.end(); ++i)
@@ -453,7 +454,8 @@ class InputChecker {
     std::vector<double> angle(nv, 0.0);
     std::vector<ElementRef> at(nv, ElementRef{ElementKind::kHex, kInvalidIndex});
     for (std::size_t k = 0; k < kOrder.size(); ++k) {
-      const auto [kind, per] = kOrder[k];
+      const ElementKind kind = kOrder[k].first;
+      const std::size_t per = kOrder[k].second;
       if (kind == ElementKind::kPyramid)
         for (Index x : centre_on_quad_) angle[index_cast<std::size_t>(x)] += 2.0 * kPi;
       for (std::size_t i = 0; i < element_count(model_, kind); ++i)

@@ -144,7 +144,7 @@ struct SharedCorner {
 // use: group(key, first, last) for each. The uses are bucketed by key[0] and each bucket sorted
 // (detail/lowest_node_sort.hpp, in parallel); `each(visit)` visits every use, from any thread.
 // Hash maps of vectors over every face, edge or corner made `geode check` of a million hexes
-// take half a minute; this takes a second.
+// take 36 s; with this, 8 s.
 template <std::size_t N>
 struct KeyedUse {
   std::array<Index, N> key;
