@@ -130,20 +130,7 @@ void write_exodus(const Model& model, const std::filesystem::path& path) {
                 target, "writing block " + std::to_string(id) + " connectivity");
         }
       };
-      switch (members.front().kind) {
-        case ElementKind::kHex:
-          put(model.hexes);
-          break;
-        case ElementKind::kTet:
-          put(model.tets);
-          break;
-        case ElementKind::kPyramid:
-          put(model.pyramids);
-          break;
-        case ElementKind::kWedge:
-          put(model.wedges);
-          break;
-      }
+      with_cells(model, members.front().kind, put);
       if (auto it = names.find(id); it != names.end()) block_names.set(b, it->second);
       ++b;
     }

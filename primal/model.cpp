@@ -135,20 +135,7 @@ void add_element(Model& model, ElementKind kind, std::span<const Index> corners,
     auto& c = cells.emplace_back();
     for (std::size_t k = 0; k < n; ++k) c[k] = corners[k];
   };
-  switch (kind) {
-    case ElementKind::kHex:
-      put(model.hexes);
-      break;
-    case ElementKind::kTet:
-      put(model.tets);
-      break;
-    case ElementKind::kPyramid:
-      put(model.pyramids);
-      break;
-    case ElementKind::kWedge:
-      put(model.wedges);
-      break;
-  }
+  with_cells(model, kind, put);
   element_blocks(model, kind).push_back(block);
   element_ids(model, kind).push_back(file_id);
 }
@@ -280,16 +267,7 @@ void check_elements(const Model& model, ElementKind kind,
 }
 
 void check_elements(const Model& model, ElementKind kind, std::string_view source) {
-  switch (kind) {
-    case ElementKind::kHex:
-      return check_elements(model, kind, model.hexes, source);
-    case ElementKind::kTet:
-      return check_elements(model, kind, model.tets, source);
-    case ElementKind::kPyramid:
-      return check_elements(model, kind, model.pyramids, source);
-    case ElementKind::kWedge:
-      return check_elements(model, kind, model.wedges, source);
-  }
+  with_cells(model, kind, [&](const auto& cells) { check_elements(model, kind, cells, source); });
 }
 
 void check_blocks(const Model& model, ElementKind kind, std::string_view source) {

@@ -102,6 +102,21 @@ const std::vector<int>& element_blocks(const Model& model, ElementKind kind);
 std::vector<int>& element_blocks(Model& model, ElementKind kind);
 const std::vector<std::int64_t>& element_ids(const Model& model, ElementKind kind);
 std::vector<std::int64_t>& element_ids(Model& model, ElementKind kind);
+// f(cells) with the typed element array of `kind` (model.hexes, .tets, .pyramids or .wedges),
+// for loops that need the corner count at compile time; `Model` may be const.
+template <class M, class F>
+void with_cells(M& model, ElementKind kind, F&& f) {
+  switch (kind) {
+    case ElementKind::kHex:
+      return f(model.hexes);
+    case ElementKind::kTet:
+      return f(model.tets);
+    case ElementKind::kPyramid:
+      return f(model.pyramids);
+    case ElementKind::kWedge:
+      return f(model.wedges);
+  }
+}
 // The nodes of local face `face` of the element (topology order: outward), 3 or 4 of them.
 std::vector<Index> element_face(const Model& model, const Side& side);
 // The faces of tets [first, first + count) of `model` whose corners all lie on `face`: the sides
