@@ -7,6 +7,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <span>
 #include <sstream>
 #include <string>
 #include <tuple>
@@ -140,11 +141,12 @@ struct SharedCorner {
   std::vector<Index> quads;
 };
 
-// Keyed uses grouped by key, each group's uses in `at` order, groups in order of their first
-// use: group(key, first, last) for each. The uses are bucketed by key[0] and each bucket sorted
+// Keyed uses grouped by key: group(key, first, last) for each key, its uses in `at` order (so
+// `first->at` is its first use). The uses are bucketed by key[0] and each bucket sorted
 // (detail/lowest_node_sort.hpp, in parallel); `each(visit)` visits every use, from any thread.
-// Hash maps of vectors over every face, edge or corner made `geode check` of a million hexes
-// take 36 s; with this, 8 s.
+// Groups come by key; a caller wanting them in order of first use sorts what it keeps by
+// `first->at` (most keep a few). Hash maps of vectors over every face, edge or corner made
+// `geode check` of a million hexes take 36 s and 1 GB; with this, 8 s.
 template <std::size_t N>
 struct KeyedUse {
   std::array<Index, N> key;
@@ -157,19 +159,23 @@ void group_by_key(std::size_t nodes, Each&& each, Group&& group) {
   std::vector<std::size_t> start;
   const std::vector<KeyedUse<N>> uses = detail::sort_by_lowest_node<KeyedUse<N>>(
       nodes, each, [](const KeyedUse<N>& u) { return u.key[0]; }, start);
-  std::vector<std::pair<std::size_t, std::size_t>> groups;  // (first use's at, its place)
   for (std::size_t g = 0; g < uses.size();) {
     std::size_t e = g + 1;
     while (e < uses.size() && uses[e].key == uses[g].key) ++e;
-    groups.emplace_back(uses[g].at, g);
+    group(uses[g].key, uses.data() + g, uses.data() + e);
     g = e;
   }
-  std::sort(groups.begin(), groups.end());
-  for (const auto& [at, g] : groups) {
-    std::size_t e = g + 1;
-    while (e < uses.size() && uses[e].key == uses[g].key) ++e;
-    group(uses[g].key, uses.data() + g, uses.data() + e);
-  }
+}
+
+// Items kept with the place of their first use, put in that order.
+template <class T>
+std::vector<T> in_first_use_order(std::vector<std::pair<std::size_t, T>> kept) {
+  std::sort(kept.begin(), kept.end(),
+            [](const auto& x, const auto& y) { return x.first < y.first; });
+  std::vector<T> out;
+  out.reserve(kept.size());
+  for (auto& [at, item] : kept) out.push_back(std::move(item));
+  return out;
 }
 
 std::vector<SharedCorner> shared_corners(
@@ -178,7 +184,7 @@ std::vector<SharedCorner> shared_corners(
   for (std::size_t i = 0; i < n; ++i)
     if (const auto* q = quad(i))
       for (Index v : *q) nodes = std::max(nodes, v + 1);
-  std::vector<SharedCorner> out;
+  std::vector<std::pair<std::size_t, SharedCorner>> kept;
   group_by_key<3>(
       index_cast<std::size_t>(nodes),
       [&](auto&& visit) {
@@ -200,9 +206,9 @@ std::vector<SharedCorner> shared_corners(
         SharedCorner sc{key, {}};
         for (const auto* u = first; u != last; ++u) sc.quads.push_back(index_cast(u->at / 4));
         sort_unique(sc.quads);
-        if (sc.quads.size() >= 2) out.push_back(std::move(sc));
+        if (sc.quads.size() >= 2) kept.emplace_back(first->at, std::move(sc));
       });
-  return out;
+  return in_first_use_order(std::move(kept));
 }
 
 // ---- Hex meshes ----------------------------------------------------------------------------
@@ -227,10 +233,15 @@ class HexFinder {
   }
 
  private:
+  using FaceUse = std::pair<Index, int>;  // (hex, local face)
   struct Face {
-    std::array<Index, 4> nodes{};             // as the first hex using it sees it
-    std::vector<std::pair<Index, int>> uses;  // (hex, local face)
+    std::array<Index, 4> nodes{};  // as the first hex using it sees it
+    std::size_t first_use = 0;     // its uses: face_uses_[first_use, first_use + uses)
+    std::size_t uses = 0;
   };
+  std::span<const FaceUse> uses(const Face& f) const {
+    return {face_uses_.data() + f.first_use, f.uses};
+  }
 
   void collect_faces() {
     const std::size_t nv = mesh_.points.size();
@@ -244,6 +255,8 @@ class HexFinder {
       return q;
     };
     // Faces numbered in order of first use, each as its first hex sees it.
+    const std::size_t per = index_cast<std::size_t>(topo::kHexFaces);
+    std::vector<std::pair<std::size_t, Face>> order;
     group_by_key<4>(
         nv,
         [&](auto&& visit) {
@@ -259,14 +272,18 @@ class HexFinder {
                             });
         },
         [&](const FaceKey&, const KeyedUse<4>* first, const KeyedUse<4>* last) {
-          const std::size_t per = index_cast<std::size_t>(topo::kHexFaces);
-          Face face{face_of(first->at / per, index_cast<int>(first->at % per)), {}};
+          Face face{{}, face_uses_.size(), index_cast<std::size_t>(last - first)};
           for (const auto* u = first; u != last; ++u)
-            face.uses.emplace_back(index_cast(u->at / per), index_cast<int>(u->at % per));
-          faces_.push_back(std::move(face));
+            face_uses_.emplace_back(index_cast(u->at / per), index_cast<int>(u->at % per));
+          order.emplace_back(first->at, face);
         });
+    faces_ = in_first_use_order(std::move(order));
+    for (Face& f : faces_) {
+      const FaceUse& u = face_uses_[f.first_use];
+      f.nodes = face_of(index_cast<std::size_t>(u.first), u.second);
+    }
     for (std::size_t f = 0; f < faces_.size(); ++f)
-      if (faces_[f].uses.size() == 1) boundary_.push_back(index_cast(f));
+      if (faces_[f].uses == 1) boundary_.push_back(index_cast(f));
   }
 
   // Patch of each boundary quad (index into boundary_) and the patches at each node.
@@ -345,6 +362,7 @@ class HexFinder {
     }
     std::map<std::vector<Index>, std::size_t> by_hexes;
     const std::size_t per = topo::kHexEdgeCorners.size();
+    std::vector<std::pair<std::size_t, std::pair<EdgeKey, std::vector<Index>>>> thin;
     group_by_key<2>(
         mesh_.points.size(),
         [&](auto&& visit) {
@@ -363,17 +381,22 @@ class HexFinder {
                             });
         },
         [&](const EdgeKey& k, const KeyedUse<2>* first, const KeyedUse<2>* last) {
+          if (last - first >= 3) return;  // in three hexes or more (or on the boundary below)
           std::vector<Index> hexes;
           for (const auto* u = first; u != last; ++u) hexes.push_back(index_cast(u->at / per));
           sort_unique(hexes);
-          if (hexes.size() >= 3 || on_boundary.count(k)) return;
-          auto [it, inserted] = by_hexes.try_emplace(hexes, doublets_.size());
-          if (inserted) doublets_.push_back(Obstruction{ObstructionKind::kDoublet, hexes, {}});
-          auto& nodes = doublets_[it->second].nodes;
-          nodes.insert(nodes.end(), k.begin(), k.end());
-          sort_unique(nodes);
-          for (Index v : k) doublet_ends_.emplace(v, it->second);
+          if (hexes.size() < 3 && !on_boundary.count(k))
+            thin.emplace_back(first->at, std::make_pair(k, std::move(hexes)));
         });
+    // Merged by their pair of hexes in order of first use.
+    for (auto& [k, hexes] : in_first_use_order(std::move(thin))) {
+      auto [it, inserted] = by_hexes.try_emplace(hexes, doublets_.size());
+      if (inserted) doublets_.push_back(Obstruction{ObstructionKind::kDoublet, hexes, {}});
+      auto& nodes = doublets_[it->second].nodes;
+      nodes.insert(nodes.end(), k.begin(), k.end());
+      sort_unique(nodes);
+      for (Index v : k) doublet_ends_.emplace(v, it->second);
+    }
   }
 
   // Distinct faces sharing both edges va, vb at a node v.
@@ -382,7 +405,7 @@ class HexFinder {
          shared_corners(faces_.size(), [&](std::size_t f) { return &faces_[f].nodes; })) {
       std::vector<Index> hexes;
       for (Index f : faces)
-        for (const auto& [h, lf] : faces_[index_cast<std::size_t>(f)].uses) hexes.push_back(h);
+        for (const auto& [h, lf] : uses(faces_[index_cast<std::size_t>(f)])) hexes.push_back(h);
       sort_unique(hexes);
       if (explained_by_doublet(corner[0], hexes)) continue;
       pinched_.push_back(
@@ -406,7 +429,7 @@ class HexFinder {
     std::map<Index, std::vector<std::pair<int, Index>>> per_hex;  // hex -> (local face, patch)
     for (std::size_t b = 0; b < boundary_.size(); ++b) {
       if (quad_patch_[b] == kNoPatch) continue;
-      const auto& use = face(b).uses.front();
+      const FaceUse& use = uses(face(b)).front();
       per_hex[use.first].emplace_back(use.second, quad_patch_[b]);
     }
     for (const auto& [h, list] : per_hex) {
@@ -468,7 +491,7 @@ class HexFinder {
         continue;
       if (quads.size() >= 3) continue;
       Obstruction o{ObstructionKind::kTwoQuadBoundaryNode, {}, {index_cast(v)}};
-      for (Index b : quads) o.hexes.push_back(face(index_cast<std::size_t>(b)).uses.front().first);
+      for (Index b : quads) o.hexes.push_back(uses(face(index_cast<std::size_t>(b))).front().first);
       sort_unique(o.hexes);
       two_quad_.push_back(o);
     }
@@ -485,6 +508,7 @@ class HexFinder {
   const HexMesh& mesh_;
   const RealizabilityOptions& options_;
   std::vector<Face> faces_;
+  std::vector<FaceUse> face_uses_;                     // every face's uses, face by face
   std::vector<Index> boundary_;                        // faces used by one hex
   std::vector<Index> quad_patch_;                      // per boundary_ entry
   std::vector<std::vector<Index>> node_patches_;       // sorted
