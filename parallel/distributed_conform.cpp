@@ -332,7 +332,11 @@ void Distributor::dice() {
   std::vector<char> mine(cells(), 0);
   for (std::size_t c = 0; c < cells(); ++c) mine[c] = part_[c] == rank_ && !in_zone_[c];
   own_ = primal::extract_submodel(m(), mine);
-  diced_ = primal::dice_model(own_.model);
+  // The tet children with room for this rank's other output hexes: assembly may make them the
+  // output's hex array where they are.
+  const std::size_t room =
+      zone_last_ - zone_first_ + 8 * own_.model.hexes.size() + 6 * own_.model.wedges.size();
+  diced_ = primal::dice_model(own_.model, {}, room);
   rep_.cells = static_cast<std::int64_t>(std::count(mine.begin(), mine.end(), 1));
   break_for_test();
   // Local verification reads the children against the tables while the dicing data exist.
@@ -554,7 +558,26 @@ void Distributor::assemble() {
   Index start = 0;
   for (auto& [b, n] : next) start += std::exchange(n, start);
   std::vector<Index> position(total);
-  o.hexes.resize(total);
+  // Where every tet child is in one block, their output positions are one run: the tet children
+  // become the output's hex array, renumbered where they are, the other hexes put around them
+  // in the room dicing left (as the serial path does), so the largest part is never copied.
+  const bool in_place =
+      nt > 0 && std::all_of(block.begin() + static_cast<std::ptrdiff_t>(first_diced + nh),
+                            block.begin() + static_cast<std::ptrdiff_t>(first_diced + nh + nt),
+                            [&](int b) { return b == block[first_diced + nh]; });
+  if (in_place) {
+    const int tet_block = block[first_diced + nh];
+    std::size_t lo = primal::index_cast<std::size_t>(next[tet_block]);
+    for (std::size_t j = 0; j < first_diced + nh; ++j) lo += block[j] == tet_block;
+    for (auto& child : diced_.tet_children)
+      for (Index& v : child) v = diced_local[primal::index_cast<std::size_t>(v)];
+    std::vector<std::array<Index, 8>> hexes = std::move(diced_.tet_children);
+    hexes.insert(hexes.begin(), lo, std::array<Index, 8>{});  // within dicing's room
+    hexes.resize(total);
+    o.hexes = std::move(hexes);
+  } else {
+    o.hexes.resize(total);
+  }
   o.hex_block.resize(total);
   out_.hex_gid.resize(total);
   std::size_t k = 0;
@@ -576,7 +599,10 @@ void Distributor::assemble() {
           o.hexes[place(diced_hex_first_ + static_cast<std::int64_t>(k - first_diced))];
       for (int c = 0; c < 8; ++c) x[c] = diced_local[primal::index_cast<std::size_t>(child[c])];
     }
-    primal::release(*part);  // consumed
+    primal::release(*part);                        // consumed
+    if (part == &diced_.hex_children && in_place)  // the tet children are in place already
+      for (std::size_t j = 0; j < nt; ++j)
+        place(diced_hex_first_ + static_cast<std::int64_t>(k - first_diced));
   }
   primal::release(block, diced_local);
   diced_ = primal::DicedModel();
