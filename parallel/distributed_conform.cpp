@@ -730,14 +730,13 @@ void Distributor::verify() {
   std::vector<char> shared(out_.model.points.size(), 0);
   for (const auto& [q, nodes] : out_.shared_nodes)
     for (Index n : nodes) shared[primal::index_cast<std::size_t>(n)] = 1;
-  const bool ok = piece_ok(v, shared) && dicing_.ok();
-  if (!piece_ok(v, shared))
-    rep_.warnings.push_back("rank " + std::to_string(rank_) + ": " + v.summary());
+  const bool piece = piece_ok(v, shared);
+  if (!piece) rep_.warnings.push_back("rank " + std::to_string(rank_) + ": " + v.summary());
   if (!dicing_.ok())
     rep_.warnings.push_back("rank " + std::to_string(rank_) + ": " + dicing_.summary());
   const bool zone_ok = piece_ok(rep_.zone.validity, {});
   if (!zone_ok) rep_.warnings.push_back("the transition zone: " + rep_.zone.validity.summary());
-  int mine = ok && zone_ok ? 1 : 0, all = 0;
+  int mine = piece && dicing_.ok() && zone_ok ? 1 : 0, all = 0;
   MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_MIN, comm_);
   rep_.valid = all == 1;
 }

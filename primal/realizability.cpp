@@ -257,6 +257,7 @@ class HexFinder {
     // Faces numbered in order of first use, each as its first hex sees it.
     const std::size_t per = index_cast<std::size_t>(topo::kHexFaces);
     std::vector<std::pair<std::size_t, Face>> order;
+    face_uses_.reserve(per * mesh_.hexes.size());
     group_by_key<4>(
         nv,
         [&](auto&& visit) {
@@ -266,8 +267,7 @@ class HexFinder {
                                 if (has_repeated(mesh_.hexes[h])) continue;
                                 for (int f = 0; f < topo::kHexFaces; ++f)
                                   visit(KeyedUse<4>{face_key(face_of(h, f)),
-                                                    index_cast<std::size_t>(topo::kHexFaces) * h +
-                                                        index_cast<std::size_t>(f)});
+                                                    per * h + index_cast<std::size_t>(f)});
                               }
                             });
         },
