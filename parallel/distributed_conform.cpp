@@ -8,6 +8,8 @@
 #include <map>
 #include <numeric>
 #include <stdexcept>
+#include <string>
+#include <type_traits>
 #include <unordered_map>
 #include <utility>
 
@@ -60,6 +62,8 @@ class Distributor {
       : options_(options), comm_(comm), rep_(report), input_(input) {
     MPI_Comm_rank(comm, &rank_);
     MPI_Comm_size(comm, &size_);
+    // The ranks but the zone rank, for what they share while it conforms the zone.
+    MPI_Comm_split(comm, rank_ == zone_rank() ? MPI_UNDEFINED : 0, rank_, &others_);
     if (input.pyramids.empty()) {
       model_ = &input;
     } else {  // conform's own first step, element by element: the same tets
@@ -70,6 +74,12 @@ class Distributor {
     }
   }
 
+  ~Distributor() {
+    if (others_ != MPI_COMM_NULL) MPI_Comm_free(&others_);
+  }
+  Distributor(const Distributor&) = delete;
+  Distributor& operator=(const Distributor&) = delete;
+
   RankMesh run() {
     const auto& opt = options_.conform;
     if (size_ > 64) throw InvalidInput("geode_mpi: at most 64 ranks");
@@ -77,10 +87,17 @@ class Distributor {
       throw InvalidInput("--smooth global moves every node: not available under MPI");
     if (!opt.geode_block.empty())
       throw InvalidInput("a named geode block is not available under MPI");
-    stage("partition", [&] { partition(); });
+    offsets_ = primal::element_offsets(m());
     stage("yardstick", [&] { yardstick(); });
-    stage("zone", [&] { zone(); });
-    stage("dicing", [&] { dice(); });
+    stage("zone selection", [&] { select_zone(options_.rings); });
+    // The zone rank conforms the zone while rank 0 partitions and the others wait for it.
+    if (rank_ == zone_rank()) stage("zone", [&] { conform_zone(); });
+    stage("partition", [&] { partition(); });
+    if (zone_failure_.empty()) stage("dicing", [&] { dice(); });
+    stage("zone shared", [&] {
+      share_zone();
+      share_zone_hexes();
+    });
     stage("global ids", [&] { number(); });
     stage("assembly", [&] { assemble(); });
     release();  // what only the stages before needed: the verification's room
@@ -93,7 +110,7 @@ class Distributor {
   void stage(const std::string& name, F&& f) {
     const auto t0 = Clock::now();
     f();
-    rep_.seconds[name] = std::chrono::duration<double>(Clock::now() - t0).count();
+    rep_.seconds[name] += std::chrono::duration<double>(Clock::now() - t0).count();
   }
   const Model& m() const { return *model_; }
   std::size_t cells() const { return offsets_.back(); }
@@ -102,25 +119,29 @@ class Distributor {
     while (c >= offsets_[k + 1]) ++k;
     return {primal::kElementKinds[k], primal::index_cast(c - offsets_[k])};
   }
+  // The rank conforming the zone: the last, so that rank 0 can partition meanwhile.
+  int zone_rank() const { return size_ - 1; }
 
-  void partition();
   void yardstick();
-  void zone();
-  bool zone_at(int rings);
+  void select_zone(int rings);
+  void conform_zone();
+  void partition();
   void dice();
+  void share_zone();
+  void share_zone_hexes();
   void number();
   void assemble();
   void break_for_test();
   void verify();
   void release() {
     own_ = {};
-    primal::release(zone_at_, level_, in_zone_, part_, zone_node_, diced_gid_, diced_holders_,
-                    zone_holders_, tet_pyramid_);
+    primal::release(zone_at_, level_, in_zone_, band_, part_, zone_node_, diced_gid_,
+                    diced_holders_, zone_holders_, tet_pyramid_);
     split_ = {}, zone_out_ = {};
   }
 
   const DistributedOptions& options_;
-  MPI_Comm comm_;
+  MPI_Comm comm_, others_ = MPI_COMM_NULL;
   DistributedReport& rep_;
   const Model& input_;
   int rank_ = 0, size_ = 1;
@@ -132,12 +153,21 @@ class Distributor {
   std::vector<std::size_t> lowest_;    // elements setting the yardstick (one per kind)
   std::vector<std::size_t> inverted_;  // elements diced with a scaled Jacobian <= 0
   std::vector<signed char> level_;     // per flat element: ring in the zone, -1 outside
-  std::vector<char> in_zone_;
-  Model zone_out_;               // the zone conformed (same on every rank)
+  std::vector<char> in_zone_, band_;   // per flat element: in the zone, in its outer two rings
+  int rings_ = 0;                      // the depth in_zone_ was selected at
+  MPI_Request partition_sent_ = MPI_REQUEST_NULL;  // rank 0's partition to the zone rank
+  // The zone conformed: the whole of it on the zone rank; elsewhere its points, sets (the side
+  // sets without sides) and block names, the rest being the zone rank's alone.
+  Model zone_out_;
+  std::size_t zone_hexes_ = 0;  // the zone's output hexes (on every rank)
+  // On the zone rank, when the zone could not be conformed: the error's kind and message.
+  std::string zone_failure_;
+  int zone_failure_kind_ = 0;
   std::vector<char> zone_node_;  // per model node: used by a zone element
   std::unordered_map<PointBits, Index, PointBitsHash> zone_at_;  // zone output node by position
-  std::size_t zone_first_ = 0, zone_last_ = 0;                   // this rank's zone hexes
-  primal::Submodel own_;  // this rank's elements outside the zone
+  std::size_t zone_first_ = 0, zone_last_ = 0;  // this rank's zone hexes, in the zone's numbers
+  std::size_t zone_base_ = 0;  // the zone's number of zone_out_.hexes[0] (this rank's first)
+  primal::Submodel own_;       // this rank's elements outside the zone
   primal::DicedModel diced_;
   primal::DicingCheck dicing_;           // diced_ against the dicing tables (local verification)
   std::int64_t zone_nodes_ = 0;          // the zone's output nodes: global ids below this
@@ -148,39 +178,9 @@ class Distributor {
   RankMesh out_;
 };
 
-void Distributor::partition() {
-  offsets_ = primal::element_offsets(m());
-  part_.assign(cells(), 0);
-  if (!options_.partition.empty()) {  // the input's own, per input element
-    const auto in = primal::element_offsets(input_);
-    if (options_.partition.size() != in.back())
-      throw std::invalid_argument("conform_distributed: a partition of " +
-                                  std::to_string(options_.partition.size()) +
-                                  " elements for a model of " + std::to_string(in.back()));
-    for (int r : options_.partition)
-      if (r < 0 || r >= size_)
-        throw std::invalid_argument("conform_distributed: rank " + std::to_string(r) +
-                                    " in a partition for " + std::to_string(size_) + " ranks");
-    // The split model: hexes, tets (the input's, then two per pyramid), wedges.
-    const auto of = [&](ElementKind kind, std::size_t i) {
-      return options_.partition[in[static_cast<std::size_t>(kind)] + i];
-    };
-    for (std::size_t c = 0; c < cells(); ++c) {
-      const auto r = ref(c);
-      const auto i = primal::index_cast<std::size_t>(r.index);
-      part_[c] =
-          r.kind == ElementKind::kTet && i < tet_pyramid_.size() && tet_pyramid_[i] != kInvalidIndex
-              ? of(ElementKind::kPyramid, primal::index_cast<std::size_t>(tet_pyramid_[i]))
-              : of(r.kind, i);
-    }
-  } else if (size_ > 1) {
-    if (rank_ == 0) part_ = partition_elements(m(), size_);
-    MPI_Bcast(part_.data(), primal::index_cast<int>(part_.size()), MPI_INT, 0, comm_);
-  }
-}
-
 // The serial run's yardstick is the lowest element of each kind diced alone over the whole
-// model: each rank measures its own elements, the lowest of each kind join the zone so that
+// model: each rank measures a run of the elements (a contiguous one: no partition is needed
+// yet, and neighbours share nodes in memory), the lowest of each kind join the zone so that
 // conform measures the same minimum there. Inverted elements are smoothed by the serial run
 // wherever they are: they seed the zone.
 void Distributor::yardstick() {
@@ -195,26 +195,28 @@ void Distributor::yardstick() {
       low[k] = {v, static_cast<int>(c)};
     if (v <= 0.0) inverted.push_back(static_cast<int>(c));
   };
-  std::vector<std::array<Index, 8>> hexes;
-  std::vector<std::array<Index, 4>> tets;
-  std::vector<std::size_t> hex_cell, tet_cell;
-  for (std::size_t c = 0; c < cells(); ++c) {
-    if (part_[c] != rank_) continue;
-    const auto r = ref(c);
-    if (r.kind == ElementKind::kHex)
-      hexes.push_back(m().hexes[primal::index_cast<std::size_t>(r.index)]), hex_cell.push_back(c);
-    else if (r.kind == ElementKind::kTet)
-      tets.push_back(m().tets[primal::index_cast<std::size_t>(r.index)]), tet_cell.push_back(c);
-    else if (r.kind == ElementKind::kWedge)
-      consider(
-          2, c,
-          primal::diced_wedge_min_scaled_jacobian(
-              m().points, std::span(&m().wedges[primal::index_cast<std::size_t>(r.index)], 1)));
+  const auto share = [&](std::size_t n, int r) {
+    return n * primal::index_cast<std::size_t>(r) / primal::index_cast<std::size_t>(size_);
+  };
+  const std::size_t nh = m().hexes.size(), nt = m().tets.size(), nw = m().wedges.size();
+  const auto cell_of = [&](ElementKind kind, std::size_t i) {
+    return offsets_[static_cast<std::size_t>(kind)] + i;
+  };
+  {
+    const std::size_t a = share(nh, rank_), b = share(nh, rank_ + 1);
+    const auto h =
+        primal::diced_scaled_jacobian_per_cell(m().points, std::span(m().hexes.data() + a, b - a));
+    for (std::size_t i = 0; i < h.size(); ++i) consider(0, cell_of(ElementKind::kHex, a + i), h[i]);
   }
-  const auto h = primal::diced_scaled_jacobian_per_cell(m().points, hexes);
-  for (std::size_t i = 0; i < h.size(); ++i) consider(0, hex_cell[i], h[i]);
-  const auto t = primal::diced_scaled_jacobian_per_cell(m().points, tets);
-  for (std::size_t i = 0; i < t.size(); ++i) consider(1, tet_cell[i], t[i]);
+  {
+    const std::size_t a = share(nt, rank_), b = share(nt, rank_ + 1);
+    const auto t =
+        primal::diced_scaled_jacobian_per_cell(m().points, std::span(m().tets.data() + a, b - a));
+    for (std::size_t i = 0; i < t.size(); ++i) consider(1, cell_of(ElementKind::kTet, a + i), t[i]);
+  }
+  for (std::size_t i = share(nw, rank_); i < share(nw, rank_ + 1); ++i)
+    consider(2, cell_of(ElementKind::kWedge, i),
+             primal::diced_wedge_min_scaled_jacobian(m().points, std::span(&m().wedges[i], 1)));
   MPI_Allreduce(low, all, 3, MPI_DOUBLE_INT, MPI_MINLOC, comm_);
   for (const auto& a : all)
     if (a.value <= 1.5) lowest_.push_back(primal::index_cast<std::size_t>(a.cell));
@@ -229,20 +231,10 @@ void Distributor::yardstick() {
   std::sort(inverted_.begin(), inverted_.end());
 }
 
-void Distributor::zone() {
-  int rings = options_.rings;
-  while (!zone_at(rings)) {
-    if (rings * 2 > options_.max_rings)
-      throw TopologyError("geode_mpi: the transition reaches past " + std::to_string(rings) +
-                          " rings of elements around the interface");
-    rings *= 2;
-    rep_.warnings.push_back("transition zone grown to " + std::to_string(rings) + " rings");
-  }
-  rep_.rings = rings;
-}
-
-// The zone `rings` deep, conformed; false when its outer two rings are not plain dicing.
-bool Distributor::zone_at(int rings) {
+// The zone `rings` deep (in_zone_), its outer two rings (band_) and its nodes (zone_node_): the
+// same on every rank.
+void Distributor::select_zone(int rings) {
+  rings_ = rings;
   const std::size_t nv = m().points.size();
   std::vector<char> used_by_hex(nv, 0), used_by_tet(nv, 0), marked(nv, 0);
   for (const auto& h : m().hexes)
@@ -280,7 +272,8 @@ bool Distributor::zone_at(int rings) {
   for (std::size_t c : lowest_) in_zone_[c] = 1;
   // The band: the zone's elements within two rings of the cut (the nodes it shares with the
   // elements outside); none when the zone is the whole model.
-  std::vector<char> outside(nv, 0), near(nv, 0), band(cells(), 0);
+  std::vector<char> outside(nv, 0), near(nv, 0);
+  band_.assign(cells(), 0);
   for (std::size_t c = 0; c < cells(); ++c)
     if (!in_zone_[c])
       for (Index v : primal::element_corners(m(), ref(c)))
@@ -289,43 +282,124 @@ bool Distributor::zone_at(int rings) {
     for (std::size_t c = 0; c < cells(); ++c) {
       if (!in_zone_[c]) continue;
       for (Index v : primal::element_corners(m(), ref(c)))
-        if (outside[primal::index_cast<std::size_t>(v)]) band[c] = 1;
+        if (outside[primal::index_cast<std::size_t>(v)]) band_[c] = 1;
     }
     for (std::size_t c = 0; c < cells(); ++c)
-      if (band[c])
+      if (band_[c])
         for (Index v : primal::element_corners(m(), ref(c)))
           near[primal::index_cast<std::size_t>(v)] = 1;
     outside.swap(near);
   }
-  primal::Submodel zone = primal::extract_submodel(m(), in_zone_);
-  rep_.zone_cells = static_cast<std::int64_t>(std::count(in_zone_.begin(), in_zone_.end(), 1));
-  // The zone is cut out of the model, so it need not pass the read-time check (cells of it may
-  // meet only along an edge of the cut), which local verification takes as given: verified whole.
-  conform::ConformOptions zone_options = options_.conform;
-  zone_options.verify = conform::ConformVerify::kFull;
-  conform::ConformResult r = conform::conform(zone.model, zone_options);
-  zone_at_.clear();
-  zone_at_.reserve(r.model.points.size());
-  for (std::size_t i = 0; i < r.model.points.size(); ++i)
-    zone_at_.emplace(bits(r.model.points[i]), primal::index_cast(i));
-  // The band diced alone must be found in the zone's output, node for node.
-  primal::Submodel b = primal::extract_submodel(m(), band);
-  const primal::DicedModel d = primal::dice_model(b.model);
-  for (const Point& p : d.points)
-    if (!zone_at_.count(bits(p))) return false;
   zone_node_.assign(nv, 0);
-  for (Index v : zone.node) zone_node_[primal::index_cast<std::size_t>(v)] = 1;
-  zone_out_ = std::move(r.model);
-  rep_.zone = std::move(r);
-  rep_.zone.model = {};
-  // This rank's share of the zone's hexes: a contiguous run (the zone's output order follows
-  // the input's element order within each block).
-  const std::size_t nz = zone_out_.hexes.size();
-  zone_first_ =
-      nz * primal::index_cast<std::size_t>(rank_) / primal::index_cast<std::size_t>(size_);
-  zone_last_ =
-      nz * primal::index_cast<std::size_t>(rank_ + 1) / primal::index_cast<std::size_t>(size_);
-  return true;
+  for (std::size_t c = 0; c < cells(); ++c)
+    if (in_zone_[c])
+      for (Index v : primal::element_corners(m(), ref(c)))
+        zone_node_[primal::index_cast<std::size_t>(v)] = 1;
+  rep_.zone_cells = static_cast<std::int64_t>(std::count(in_zone_.begin(), in_zone_.end(), 1));
+  rep_.rings = rings;
+}
+
+// On the zone rank: the zone conformed, grown (rings doubled) until its outer two rings come out
+// as plain dicing, bit for bit. A failure is kept for share_zone to raise on every rank alike.
+void Distributor::conform_zone() {
+  try {
+    for (;;) {
+      primal::Submodel zone = primal::extract_submodel(m(), in_zone_);
+      // Verified as the options say. Local verification's premise holds on the zone, a part of
+      // an input that passed the read-time check: its faces are shared by at most two cells and
+      // it covers its region once (its cut, unlike a model's boundary, may be non-manifold, which
+      // piece_ok does not judge); and verify() checks every zone hex again, each being on a zone
+      // node.
+      conform::ConformOptions zone_options = options_.conform;
+      conform::ConformResult r = conform::conform(zone.model, zone_options);
+      zone_at_.clear();
+      zone_at_.reserve(r.model.points.size());
+      for (std::size_t i = 0; i < r.model.points.size(); ++i)
+        zone_at_.emplace(bits(r.model.points[i]), primal::index_cast(i));
+      // The band diced alone must be found in the zone's output, node for node.
+      const primal::Submodel b = primal::extract_submodel(m(), band_);
+      const primal::DicedModel d = primal::dice_model(b.model);
+      if (std::all_of(d.points.begin(), d.points.end(),
+                      [&](const Point& p) { return zone_at_.count(bits(p)) > 0; })) {
+        zone_out_ = std::move(r.model);
+        zone_first_ = 0, zone_last_ = zone_out_.hexes.size();
+        rep_.zone = std::move(r);
+        rep_.zone.model = {};
+        return;
+      }
+      if (rings_ * 2 > options_.max_rings)
+        throw TopologyError("geode_mpi: the transition reaches past " + std::to_string(rings_) +
+                            " rings of elements around the interface");
+      select_zone(rings_ * 2);
+    }
+  } catch (const InvalidInput& e) {
+    zone_failure_kind_ = 1, zone_failure_ = e.what();
+  } catch (const TopologyError& e) {
+    zone_failure_kind_ = 2, zone_failure_ = e.what();
+  } catch (const std::exception& e) {
+    zone_failure_kind_ = 3, zone_failure_ = e.what();
+  }
+  primal::release(zone_at_);
+}
+
+// Output hexes a zone element stands for, against a diced element's one per child: the zone's
+// output per diced child, and its conform, full verification and writing on one rank (measured
+// on bench_mpi's half 68: the zone rank and rank 0 then reach the end together).
+constexpr double kZoneLoad = 1.2;
+
+// Per flat element its rank: the input's own partition, or METIS's on rank 0 (the elements
+// weighted by the hexes they dice into, the zone's elements only 1: the zone rank's share made
+// smaller by the zone's load), sent to the others; the zone rank takes it after the zone.
+void Distributor::partition() {
+  part_.assign(cells(), 0);
+  if (!options_.partition.empty()) {  // the input's own, per input element
+    const auto in = primal::element_offsets(input_);
+    if (options_.partition.size() != in.back())
+      throw std::invalid_argument("conform_distributed: a partition of " +
+                                  std::to_string(options_.partition.size()) +
+                                  " elements for a model of " + std::to_string(in.back()));
+    for (int r : options_.partition)
+      if (r < 0 || r >= size_)
+        throw std::invalid_argument("conform_distributed: rank " + std::to_string(r) +
+                                    " in a partition for " + std::to_string(size_) + " ranks");
+    // The split model: hexes, tets (the input's, then two per pyramid), wedges.
+    const auto of = [&](ElementKind kind, std::size_t i) {
+      return options_.partition[in[static_cast<std::size_t>(kind)] + i];
+    };
+    for (std::size_t c = 0; c < cells(); ++c) {
+      const auto r = ref(c);
+      const auto i = primal::index_cast<std::size_t>(r.index);
+      part_[c] =
+          r.kind == ElementKind::kTet && i < tet_pyramid_.size() && tet_pyramid_[i] != kInvalidIndex
+              ? of(ElementKind::kPyramid, primal::index_cast<std::size_t>(tet_pyramid_[i]))
+              : of(r.kind, i);
+    }
+    return;
+  }
+  if (size_ == 1) return;
+  const int count = primal::index_cast<int>(part_.size());
+  if (rank_ == 0) {
+    PartitionOptions po;
+    po.weight.resize(cells());
+    double diced = 0.0, zone = 0.0;
+    for (std::size_t c = 0; c < cells(); ++c) {
+      const ElementKind kind = ref(c).kind;
+      const Index children = primal::index_cast(primal::cell_topology(kind).corners);
+      po.weight[c] = in_zone_[c] ? 1 : children;
+      (in_zone_[c] ? zone : diced) += children;
+    }
+    const double load = (diced + kZoneLoad * zone) / size_;
+    const double zone_share = std::max(load - kZoneLoad * zone, 0.02 * load) / diced;
+    po.share.assign(primal::index_cast<std::size_t>(size_), (1.0 - zone_share) / (size_ - 1));
+    po.share.back() = zone_share;
+    part_ = partition_elements(m(), size_, po);
+    MPI_Isend(part_.data(), count, MPI_INT, zone_rank(), 0, comm_, &partition_sent_);
+  }
+  if (rank_ == zone_rank()) {
+    MPI_Recv(part_.data(), count, MPI_INT, 0, 0, comm_, MPI_STATUS_IGNORE);
+  } else {  // the ranks before it: from rank 0, without waiting for the zone rank
+    MPI_Bcast(part_.data(), count, MPI_INT, 0, others_);
+  }
 }
 
 void Distributor::dice() {
@@ -342,6 +416,186 @@ void Distributor::dice() {
   // Local verification reads the children against the tables while the dicing data exist.
   if (options_.conform.verify == conform::ConformVerify::kLocal)
     dicing_ = primal::check_dicing(own_.model, diced_);
+}
+
+// What the zone rank tells the others of the zone, but its points: bytes out and back.
+class Packet {
+ public:
+  template <typename T>
+  void put(const T& x) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    const auto* p = reinterpret_cast<const char*>(&x);
+    bytes_.insert(bytes_.end(), p, p + sizeof(T));
+  }
+  void put(const std::string& s) {
+    put(s.size());
+    bytes_.insert(bytes_.end(), s.begin(), s.end());
+  }
+  template <typename T>
+  T get() {
+    T x;
+    std::memcpy(&x, bytes_.data() + at_, sizeof(T));
+    at_ += sizeof(T);
+    return x;
+  }
+  std::string get_string() {
+    const auto n = get<std::size_t>();
+    std::string s(bytes_.data() + at_, n);
+    at_ += n;
+    return s;
+  }
+  std::vector<char>& bytes() { return bytes_; }
+
+ private:
+  std::vector<char> bytes_;
+  std::size_t at_ = 0;
+};
+
+// MPI_Bcast of n values of `type` from `root`, in pieces an int can count.
+void broadcast(void* data, std::size_t n, MPI_Datatype type, std::size_t size, int root,
+               MPI_Comm comm) {
+  constexpr std::size_t kPiece = std::size_t{1} << 28;
+  for (std::size_t i = 0; i < n; i += kPiece)
+    MPI_Bcast(static_cast<char*>(data) + i * size, primal::index_cast<int>(std::min(kPiece, n - i)),
+              type, root, comm);
+}
+
+// From the zone rank to every rank: the zone's depth and outcome, its points (for matching the
+// diced nodes on the cut), block names and sets. A rank that diced a zone since grown dices again.
+void Distributor::share_zone() {
+  const int root = zone_rank();
+  Packet packet;
+  if (rank_ == root) {
+    packet.put(zone_failure_kind_);
+    packet.put(zone_failure_);
+    packet.put(rings_);
+    packet.put(zone_out_.hexes.size());
+    packet.put(zone_out_.points.size());
+    packet.put(zone_out_.block_names.size());
+    for (const auto& [id, name] : zone_out_.block_names) packet.put(id), packet.put(name);
+    packet.put(zone_out_.node_sets.size());
+    for (const primal::NodeSet& ns : zone_out_.node_sets) {
+      packet.put(ns.id), packet.put(ns.name), packet.put(ns.nodes.size());
+      for (Index v : ns.nodes) packet.put(v);
+    }
+    packet.put(zone_out_.side_sets.size());
+    for (const primal::SideSet& ss : zone_out_.side_sets) packet.put(ss.id), packet.put(ss.name);
+  }
+  std::size_t bytes = packet.bytes().size();
+  MPI_Bcast(&bytes, 1, MPI_UINT64_T, root, comm_);
+  packet.bytes().resize(bytes);
+  broadcast(packet.bytes().data(), bytes, MPI_CHAR, 1, root, comm_);
+  // Every rank's share of the partition is with it by now.
+  MPI_Wait(&partition_sent_, MPI_STATUS_IGNORE);
+  const int kind = packet.get<int>();
+  const std::string failure = packet.get_string();
+  if (kind == 1) throw InvalidInput(failure);
+  if (kind == 2) throw TopologyError(failure);
+  if (kind != 0) throw std::runtime_error(failure);
+  const int rings = packet.get<int>();
+  zone_hexes_ = packet.get<std::size_t>();
+  const auto points = packet.get<std::size_t>();
+  if (rank_ != root) {
+    zone_out_.points.resize(points);
+    for (auto n = packet.get<std::size_t>(); n > 0; --n) {
+      const int id = packet.get<int>();
+      zone_out_.block_names[id] = packet.get_string();
+    }
+    for (auto n = packet.get<std::size_t>(); n > 0; --n) {
+      primal::NodeSet ns;
+      ns.id = packet.get<int>(), ns.name = packet.get_string();
+      ns.nodes.resize(packet.get<std::size_t>());
+      for (Index& v : ns.nodes) v = packet.get<Index>();
+      zone_out_.node_sets.push_back(std::move(ns));
+    }
+    for (auto n = packet.get<std::size_t>(); n > 0; --n) {
+      primal::SideSet ss;
+      ss.id = packet.get<int>(), ss.name = packet.get_string();
+      zone_out_.side_sets.push_back(std::move(ss));
+    }
+  }
+  broadcast(zone_out_.points.data(), 3 * points, MPI_DOUBLE, sizeof(double), root, comm_);
+  for (int r = options_.rings; r < rings; r *= 2)
+    rep_.warnings.push_back("transition zone grown to " + std::to_string(2 * r) + " rings");
+  if (rank_ == root) return;
+  if (rings != rings_) {  // grown on the zone rank: this rank's dicing was of a smaller zone
+    select_zone(rings);
+    diced_ = primal::DicedModel(), dicing_ = primal::DicingCheck(), own_ = {};
+    dice();
+  }
+  zone_at_.reserve(points);
+  for (std::size_t i = 0; i < points; ++i)
+    zone_at_.emplace(bits(zone_out_.points[i]), primal::index_cast(i));
+}
+
+// The zone's hexes shared out: each rank but the zone rank, in rank order, takes a run of them
+// up to the mean output per rank (none where the zone is small against the diced part, since
+// the partition gave the zone rank less to dice), the zone rank the rest; with their blocks and
+// their sides in the zone's side sets.
+void Distributor::share_zone_hexes() {
+  const int root = zone_rank();
+  const auto diced = primal::index_cast<std::int64_t>(
+      diced_.hex_children.size() + diced_.tet_children.size() + diced_.wedge_children.size());
+  std::vector<std::int64_t> every(primal::index_cast<std::size_t>(size_));
+  MPI_Allgather(&diced, 1, MPI_INT64_T, every.data(), 1, MPI_INT64_T, comm_);
+  const auto nz = primal::index_cast<std::int64_t>(zone_hexes_);
+  const std::int64_t mean =
+      (std::accumulate(every.begin(), every.end(), std::int64_t{0}) + nz) / size_;
+  std::vector<std::size_t> first(every.size() + 1, 0);
+  for (std::size_t r = 0; r < every.size(); ++r) {
+    const std::int64_t left = nz - primal::index_cast<std::int64_t>(first[r]);
+    const std::int64_t take = primal::index_cast<int>(r) == root
+                                  ? left
+                                  : std::clamp<std::int64_t>(mean - every[r], 0, left);
+    first[r + 1] = first[r] + primal::index_cast<std::size_t>(take);
+  }
+  const auto me = primal::index_cast<std::size_t>(rank_);
+  zone_first_ = first[me], zone_last_ = first[me + 1];
+  if (rank_ != root) zone_base_ = zone_first_;
+  if (first[every.size() - 1] == 0) return;  // all the zone rank's
+  // Per rank: its hexes (8 corners), their blocks, and its sides as (set, hex, face).
+  std::vector<int> hex_counts(every.size()), side_counts(every.size());
+  std::vector<int> hex_displs(every.size()), side_displs(every.size());
+  std::vector<Index> sides;
+  if (rank_ == root) {
+    std::vector<std::vector<Index>> per(every.size());
+    for (std::size_t set = 0; set < zone_out_.side_sets.size(); ++set)
+      for (const primal::Side& side : zone_out_.side_sets[set].sides) {
+        const auto h = primal::index_cast<std::size_t>(side.element.index);
+        const auto r = primal::index_cast<std::size_t>(
+            std::upper_bound(first.begin(), first.end(), h) - first.begin() - 1);
+        per[r].insert(per[r].end(), {primal::index_cast(set), side.element.index, side.face});
+      }
+    for (std::size_t r = 0; r < every.size(); ++r) {
+      hex_counts[r] = primal::index_cast<int>(first[r + 1] - first[r]);
+      hex_displs[r] = primal::index_cast<int>(first[r]);
+      side_counts[r] = primal::index_cast<int>(per[r].size());
+      side_displs[r] = primal::index_cast<int>(sides.size());
+      sides.insert(sides.end(), per[r].begin(), per[r].end());
+    }
+  }
+  const int mine = primal::index_cast<int>(zone_last_ - zone_first_);
+  std::vector<std::array<Index, 8>> hexes(rank_ == root ? 0 : zone_last_ - zone_first_);
+  std::vector<int> blocks(hexes.size());
+  MPI_Datatype hex_type;
+  MPI_Type_contiguous(8, MPI_INT, &hex_type);
+  MPI_Type_commit(&hex_type);
+  MPI_Scatterv(zone_out_.hexes.data(), hex_counts.data(), hex_displs.data(), hex_type,
+               rank_ == root ? MPI_IN_PLACE : hexes.data(), mine, hex_type, root, comm_);
+  MPI_Type_free(&hex_type);
+  MPI_Scatterv(zone_out_.hex_block.data(), hex_counts.data(), hex_displs.data(), MPI_INT,
+               rank_ == root ? MPI_IN_PLACE : blocks.data(), mine, MPI_INT, root, comm_);
+  int count = 0;
+  MPI_Scatter(side_counts.data(), 1, MPI_INT, &count, 1, MPI_INT, root, comm_);
+  std::vector<Index> got(primal::index_cast<std::size_t>(count));
+  MPI_Scatterv(sides.data(), side_counts.data(), side_displs.data(), MPI_INT,
+               rank_ == root ? MPI_IN_PLACE : got.data(), count, MPI_INT, root, comm_);
+  if (rank_ == root) return;
+  zone_out_.hexes = std::move(hexes);
+  zone_out_.hex_block = std::move(blocks);
+  for (std::size_t k = 0; k < got.size(); k += 3)
+    zone_out_.side_sets[primal::index_cast<std::size_t>(got[k])].sides.push_back(
+        {{ElementKind::kHex, got[k + 1]}, static_cast<int>(got[k + 2])});
 }
 
 // Test hook (docs/cli.md): GEODE_TEST_BREAK_DICED_HEX=N swaps the first two corners of this
@@ -471,7 +725,7 @@ void Distributor::number() {
   // Zone nodes: held by the ranks owning a zone hex on them or a diced node at them.
   zone_holders_.assign(primal::index_cast<std::size_t>(zone_nodes), 0);
   for (std::size_t h = zone_first_; h < zone_last_; ++h)
-    for (Index v : zone_out_.hexes[h])
+    for (Index v : zone_out_.hexes[h - zone_base_])
       zone_holders_[primal::index_cast<std::size_t>(v)] |= Mask{1} << rank_;
   for (std::size_t i = 0; i < nd; ++i)
     if (diced_gid_[i] >= 0 && diced_gid_[i] < zone_nodes)
@@ -479,7 +733,7 @@ void Distributor::number() {
   MPI_Allreduce(MPI_IN_PLACE, zone_holders_.data(), primal::index_cast<int>(zone_holders_.size()),
                 MPI_UINT64_T, MPI_BOR, comm_);
   // Hexes: the zone's first, then the diced ones rank by rank.
-  const std::int64_t zone_hexes = primal::index_cast<std::int64_t>(zone_out_.hexes.size());
+  const std::int64_t zone_hexes = primal::index_cast<std::int64_t>(zone_hexes_);
   const std::int64_t diced_hexes = static_cast<std::int64_t>(
       diced_.hex_children.size() + diced_.tet_children.size() + diced_.wedge_children.size());
   std::int64_t hex_first = 0, hex_total = 0;
@@ -502,7 +756,7 @@ void Distributor::assemble() {
   gids.reserve(nd + 8 * (zone_last_ - zone_first_));
   gids = diced_gid_;
   for (std::size_t h = zone_first_; h < zone_last_; ++h)
-    for (Index v : zone_out_.hexes[h]) gids.push_back(v);
+    for (Index v : zone_out_.hexes[h - zone_base_]) gids.push_back(v);
   std::sort(gids.begin(), gids.end());
   gids.erase(std::unique(gids.begin(), gids.end()), gids.end());
   const auto local = [&](std::int64_t g) {
@@ -544,7 +798,8 @@ void Distributor::assemble() {
   const std::size_t first_diced = zone_last_ - zone_first_;
   const std::size_t total = first_diced + nh + nt + diced_.wedge_children.size();
   std::vector<int> block(total);
-  for (std::size_t k = 0; k < first_diced; ++k) block[k] = zone_out_.hex_block[zone_first_ + k];
+  for (std::size_t k = 0; k < first_diced; ++k)
+    block[k] = zone_out_.hex_block[zone_first_ - zone_base_ + k];
   for (std::size_t k = 0; k < nh; ++k)
     block[first_diced + k] = primal::block_of(om, {ElementKind::kHex, diced_.hex_parent[k]});
   for (std::size_t k = 0; k < nt; ++k)
@@ -591,7 +846,7 @@ void Distributor::assemble() {
   };
   for (std::size_t h = zone_first_; h < zone_last_; ++h) {
     std::array<Index, 8>& x = o.hexes[place(static_cast<std::int64_t>(h))];
-    for (int c = 0; c < 8; ++c) x[c] = local(zone_out_.hexes[h][c]);
+    for (int c = 0; c < 8; ++c) x[c] = local(zone_out_.hexes[h - zone_base_][c]);
   }
   for (auto* part : {&diced_.hex_children, &diced_.tet_children, &diced_.wedge_children}) {
     for (const auto& child : *part) {

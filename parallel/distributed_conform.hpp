@@ -2,18 +2,23 @@
 // conform (conform/conform.hpp) under MPI, with a result that does not depend on the number of
 // ranks: the output of every rank joined is the serial run's, node for node and hex for hex.
 //
-// Every rank reads the whole input (inputs are ~25x smaller than outputs). Its elements are
-// partitioned by METIS (parallel/partition.hpp), or as the input file was (options.partition). The
-// transition zone Z, every element within `rings` node rings of a node used by both a hex and a tet
-// (plus the elements setting the yardstick and any inverted element, which the serial run also
-// smooths), is conformed on every rank, the same computation everywhere; conform reads nothing
-// outside it but the yardstick, which the lowest elements carry in. Wedges seed the zone as well
-// (their diced nodes' bits depend on which wedge makes them first), so a model of many wedges is
-// mostly zone. The result is checked: the outer two rings of Z must come out as plain dicing, bit
-// for bit (the smoothing and the buffer layer stopped short of the cut), else Z is grown (rings
-// doubled) and conformed again. Everything else is plain dicing (primal/dice_model.hpp): each rank
-// dices only its own elements outside Z, and dicing depends only on an element and its nodes, so a
-// rank's hexes are the serial run's.
+// Every rank reads the whole input (inputs are ~25x smaller than outputs). The transition zone
+// Z, every element within `rings` node rings of a node used by both a hex and a tet (plus the
+// elements setting the yardstick and any inverted element, which the serial run also smooths),
+// is conformed once, on the last rank (the zone rank), while rank 0 partitions the elements by
+// METIS (parallel/partition.hpp; the zone rank given less to dice, by the zone's load) or as the
+// input file was (options.partition), and the others wait for the partition. conform reads
+// nothing outside Z but the yardstick, which the lowest elements carry in. Wedges seed the zone
+// as well (their diced nodes' bits depend on which wedge makes them first), so a model of many
+// wedges is mostly zone. The result is checked: the outer two rings of Z must come out as plain
+// dicing, bit for bit (the smoothing and the buffer layer stopped short of the cut), else Z is
+// grown (rings doubled) and conformed again. Everything else is plain dicing
+// (primal/dice_model.hpp): each rank dices only its own elements outside Z, and dicing depends
+// only on an element and its nodes, so a rank's hexes are the serial run's (a rank that diced
+// before the zone grew dices again). The zone rank then sends every rank Z's points, sets and
+// block names, and Z's hexes are shared out: each other rank takes a run of them up to the mean
+// output per rank (none when the partition left the zone rank room for them), the zone rank the
+// rest.
 //
 // Global ids (0-based): Z's output nodes and hexes first in Z's output order (the same on every
 // rank count); then the diced nodes and hexes, rank by rank, each owned by the lowest rank
@@ -55,7 +60,7 @@ struct RankMesh {
 };
 
 struct DistributedReport {
-  conform::ConformResult zone;  // the transition zone's conform (its model moved out)
+  conform::ConformResult zone;  // on the zone rank: the zone's conform (its model moved out)
   int rings = 0;                // the depth that passed the check
   std::int64_t zone_cells = 0, cells = 0, zone_hexes = 0, diced_hexes = 0;  // this rank's diced
   bool valid = true;  // the zone and every rank's piece valid (distributed_conform.cpp)
@@ -64,7 +69,7 @@ struct DistributedReport {
 };
 
 // Collective over `comm`. Throws InvalidInput / TopologyError as conform does, on every rank
-// alike (the zone is the same everywhere); InvalidInput for --smooth global (it moves every
+// alike (the zone rank sends its outcome to all); InvalidInput for --smooth global (it moves every
 // node) and a named geode block.
 RankMesh conform_distributed(const primal::Model& input, const DistributedOptions& options,
                              MPI_Comm comm, DistributedReport* report = nullptr);

@@ -38,14 +38,18 @@ struct Graph {
   idx_t edge_weight(idx_t k) const { return adjwgt.empty() ? 1 : adjwgt[at(k)]; }
 };
 
-// The elements, weighted by the hexes each dices into (8, 4, 6; a pyramid as its two tets, 8),
-// joined across their faces.
-Graph element_level(const primal::Model& model) {
+// The elements, weighted by the hexes each dices into (8, 4, 6; a pyramid as its two tets, 8)
+// unless `weight` says otherwise, joined across their faces.
+Graph element_level(const primal::Model& model, const std::vector<idx_t>& weight) {
   primal::ElementGraph eg = primal::element_graph(model);
   Graph g;
   g.xadj.reserve(eg.offset.size());
   for (std::size_t o : eg.offset) g.xadj.push_back(primal::index_cast<idx_t>(o));
   g.adjncy = std::move(eg.neighbour);
+  if (!weight.empty()) {
+    g.vwgt = weight;
+    return g;
+  }
   g.vwgt.reserve(g.size());
   for (primal::ElementKind kind : primal::kElementKinds)
     g.vwgt.insert(g.vwgt.end(), primal::element_count(model, kind),
@@ -145,14 +149,16 @@ Graph contract(const Graph& g, const std::vector<idx_t>& cluster, idx_t count) {
 // vertices in order, moving one to the neighbouring part it shares most edges with when that
 // cuts fewer (or as many, towards a part lighter than its own after the move), within the
 // balance bound; each pass visits the vertices around the last one's moves.
-void refine(const Graph& g, int parts, std::vector<idx_t>& part) {
-  std::vector<std::int64_t> load(at(parts), 0);
+void refine(const Graph& g, const std::vector<double>& share, std::vector<idx_t>& part) {
+  std::vector<std::int64_t> load(share.size(), 0), bound(share.size());
   std::int64_t total = 0;
   for (std::size_t v = 0; v < g.size(); ++v) {
     load[at(part[v])] += g.vwgt[v];
     total += g.vwgt[v];
   }
-  const std::int64_t bound = total * kBalancePercent / (100 * parts);
+  for (std::size_t p = 0; p < share.size(); ++p)
+    bound[p] = static_cast<std::int64_t>(static_cast<double>(total) * share[p] *
+                                         static_cast<double>(kBalancePercent) / 100.0);
   std::vector<idx_t> visit, moved;
   for (std::size_t v = 0; v < g.size(); ++v)
     for (idx_t k = g.xadj[v]; k < g.xadj[v + 1]; ++k)
@@ -186,7 +192,7 @@ void refine(const Graph& g, int parts, std::vector<idx_t>& part) {
       std::int64_t best_gain = 0;
       for (const auto& [q, joined] : towards) {
         const std::int64_t gain = joined - inside;
-        if (load[at(q)] + w > bound || gain < best_gain) continue;
+        if (load[at(q)] + w > bound[at(q)] || gain < best_gain) continue;
         if (gain == best_gain && !(best >= 0 ? load[at(q)] < load[at(best)]
                                              : gain > 0 || load[at(q)] + w < load[at(own)] - w))
           continue;
@@ -211,11 +217,21 @@ void refine(const Graph& g, int parts, std::vector<idx_t>& part) {
 
 }  // namespace
 
-std::vector<int> partition_elements(const primal::Model& model, int parts) {
+std::vector<int> partition_elements(const primal::Model& model, int parts,
+                                    const PartitionOptions& options) {
   const std::size_t n = primal::element_offsets(model).back();
   std::vector<int> result(n, 0);
   if (parts <= 1 || n == 0) return result;
-  Graph elements = element_level(model);
+  if (!options.weight.empty() && options.weight.size() != n)
+    throw std::invalid_argument("partition_elements: " + std::to_string(options.weight.size()) +
+                                " weights for " + std::to_string(n) + " elements");
+  if (!options.share.empty() && options.share.size() != at(parts))
+    throw std::invalid_argument("partition_elements: " + std::to_string(options.share.size()) +
+                                " shares for " + std::to_string(parts) + " parts");
+  std::vector<double> share = options.share;
+  if (share.empty()) share.assign(at(parts), 1.0 / parts);
+  std::vector<real_t> tpwgts(share.begin(), share.end());
+  Graph elements = element_level(model, options.weight);
   // Small models (under 64 clusters a part) are partitioned element by element: fast anyway,
   // and clusters would leave the balance coarse.
   const bool cluster = primal::index_cast<std::int64_t>(n) >= kClusterSize * 64 * parts;
@@ -225,21 +241,21 @@ std::vector<int> partition_elements(const primal::Model& model, int parts) {
   Graph clusters = cluster ? contract(elements, element_cluster, count) : Graph();
   Graph& g = cluster ? clusters : elements;
   idx_t ncon = 1, np = parts, objval = 0;
-  idx_t options[METIS_NOPTIONS];
-  METIS_SetDefaultOptions(options);
-  options[METIS_OPTION_SEED] = 1;
+  idx_t metis[METIS_NOPTIONS];
+  METIS_SetDefaultOptions(metis);
+  metis[METIS_OPTION_SEED] = 1;
   std::vector<idx_t> part(g.size(), 0);
   const int status =
       METIS_PartGraphKway(&count, &ncon, g.xadj.data(), g.adjncy.data(), g.vwgt.data(), nullptr,
-                          g.adjwgt.empty() ? nullptr : g.adjwgt.data(), &np, nullptr, nullptr,
-                          options, &objval, part.data());
+                          g.adjwgt.empty() ? nullptr : g.adjwgt.data(), &np, tpwgts.data(), nullptr,
+                          metis, &objval, part.data());
   if (status != METIS_OK)
     throw std::runtime_error("METIS_PartGraphKway failed (status " + std::to_string(status) + ")");
   if (cluster) {
     std::vector<idx_t> element_part(n);
     for (std::size_t e = 0; e < n; ++e) element_part[e] = part[at(element_cluster[e])];
     part = std::move(element_part);
-    refine(elements, parts, part);
+    refine(elements, share, part);
   }
   for (std::size_t e = 0; e < n; ++e) result[e] = part[e];
   return result;

@@ -2,17 +2,26 @@
 // Element partitioning by METIS (Debian libmetis-dev): the dual graph of a model's elements
 // (primal/element_graph.hpp: two elements adjacent when they share a face, 3 nodes), cut into
 // parts balanced by the hexes each element dices into (8 per hex, 4 per tet, 6 per wedge, 8 per
-// pyramid). Past 64 clusters a part, METIS cuts the graph of clusters of ~16 connected elements
-// (edges weighted by the faces they share) and a greedy pass over the elements smooths the cut.
+// pyramid), or as the caller weighs them and shares them out. Past 64 clusters a part, METIS cuts
+// the graph of clusters of ~16 connected elements (edges weighted by the faces they share) and a
+// greedy pass over the elements smooths the cut.
 #include <vector>
 
 #include <geode/primal/model.hpp>
 
 namespace geode::parallel {
 
+struct PartitionOptions {
+  // Per flat element its weight (at least 1); empty: the hexes it dices into.
+  std::vector<primal::Index> weight;
+  // Per part the share of the total weight it is given (positive, summing to 1); empty: equal.
+  std::vector<double> share;
+};
+
 // Per flat element (primal::element_offsets): its part in [0, parts). Deterministic for a given
-// model and part count (METIS seeded, the rest sequential). parts == 1: all zero.
-std::vector<int> partition_elements(const primal::Model& model, int parts);
+// model, part count and options (METIS seeded, the rest sequential). parts == 1: all zero.
+std::vector<int> partition_elements(const primal::Model& model, int parts,
+                                    const PartitionOptions& options = {});
 
 // A partition the input carries (io/file_partition.hpp: a partitioned .msh, a Nemesis set) of
 // `parts` parts, as ranks: the parts themselves when parts == ranks; with more parts than

@@ -57,8 +57,9 @@ int run(int argc, char** argv, int rank, int size) {
           "full: the whole check on every hex of each rank (2.6x local's time on bench_mpi's "
           "10^7-hex model)")
       ->check(CLI::IsMember({"local", "full"}));
-  conform->add_option("--rings", rings,
-                      "depth of the transition zone conformed on every rank (grown as needed)");
+  conform->add_option(
+      "--rings", rings,
+      "depth of the transition zone, conformed once on the last rank (grown as needed)");
   conform->add_option("--threads", threads, "TBB threads per rank (default 1: one core each)");
   conform->add_flag("-q,--quiet", quiet, "no progress or summary");
   try {
