@@ -8,10 +8,12 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <numbers>
 #include <optional>
 #include <span>
 #include <sstream>
+#include <stdexcept>
 #include <tuple>
 #include <type_traits>
 #include <unordered_map>
@@ -93,6 +95,7 @@ class InputChecker {
       : model_(model), options_(options) {}
 
   InputCheckResult run() {
+    node_runs();
     pair_faces();
     if (!full()) boundary_links();
     if (!full()) covering_at_nodes();
@@ -139,13 +142,26 @@ class InputChecker {
   // Every face use, in FaceUse's order, sorted by lowest node first (detail/lowest_node_sort.hpp:
   // `geode check` of 2.2 million tets and hexes 2.7 s -> 1.9 s against one sort of them all).
   std::vector<FaceUse> sorted_face_uses() const {
-    // visit(use) for every face of every element, the elements split among threads.
+    const Index first = first_, last = last_;
+    const bool all_nodes = options_.shares <= 1;
+    // visit(use) for every face of every element with its lowest node in the run, the elements
+    // split among threads; an element with no node in the run or past it has none.
     auto each_use = [&](auto&& visit) {
       for (ElementKind kind : kElementKinds) {
         const tbb::blocked_range<std::size_t> all(0, element_count(model_, kind), 4096);
         tbb::parallel_for(all, [&](const tbb::blocked_range<std::size_t>& r) {
-          for (std::size_t i = r.begin(); i != r.end(); ++i)
-            face_uses({kind, index_cast(i)}, visit);
+          for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const ElementRef e{kind, index_cast(i)};
+            if (all_nodes) {
+              face_uses(e, visit);
+              continue;
+            }
+            const auto [lo, hi] = std::ranges::minmax(corners(e));
+            if (lo >= last || hi < first) continue;
+            face_uses(e, [&](const FaceUse& u) {
+              if (u.key[0] >= first && u.key[0] < last) visit(u);
+            });
+          }
         });
       }
     };
@@ -154,11 +170,114 @@ class InputChecker {
         model_.points.size(), each_use, [](const FaceUse& u) { return u.key[0]; }, start);
   }
 
+  // This share's run of the nodes [first_, last_): each share about as many corners (weighed by
+  // their element's faces per corner, a proxy for the faces whose lowest node they are), so that
+  // the shares pair about as many faces (the hex part's nodes often come first, a tet's node
+  // has more faces around it).
+  void node_runs() {
+    const std::size_t nv = model_.points.size();
+    first_ = 0, last_ = index_cast(nv);
+    if (options_.shares <= 1) return;
+    std::vector<double> weight(nv + 1, 0.0);
+    for (ElementKind kind : kElementKinds) {
+      const auto& t = cell_topology(kind);
+      const double w = static_cast<double>(t.faces) / t.corners;
+      for (std::size_t i = 0; i < element_count(model_, kind); ++i)
+        for (Index v : corners({kind, index_cast(i)})) weight[index_cast<std::size_t>(v) + 1] += w;
+    }
+    for (std::size_t v = 0; v < nv; ++v) weight[v + 1] += weight[v];
+    const auto cut = [&](int share) {
+      if (share >= options_.shares) return index_cast(nv);
+      const double aim = weight.back() * share / options_.shares;
+      return index_cast(std::lower_bound(weight.begin(), weight.end(), aim) - weight.begin());
+    };
+    first_ = options_.share == 0 ? 0 : cut(options_.share);
+    last_ = cut(options_.share + 1);
+  }
+  bool mine(Index v) const { return v >= first_ && v < last_; }
+
+  // With options_.exchange: the findings from `from` on of every share, in share order (each
+  // found them in its run of the nodes, in node order), in place of this share's.
+  void share_findings(std::size_t from) {
+    std::vector<char> out;
+    put_findings(out, from);
+    const std::vector<char> all = options_.exchange(out);
+    result_.findings.resize(from);
+    std::size_t at = 0;
+    for (int s = 0; s < options_.shares; ++s) get_findings(all, at);
+  }
+  template <typename T>
+  static void put(std::vector<char>& out, const T& x) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    const auto* p = reinterpret_cast<const char*>(&x);
+    out.insert(out.end(), p, p + sizeof(x));
+  }
+  template <typename T>
+  static void get(const std::vector<char>& in, std::size_t& at, T& x) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    if (at + sizeof(x) > in.size()) throw std::runtime_error("check_input: exchange too short");
+    std::memcpy(&x, in.data() + at, sizeof(x));
+    at += sizeof(x);
+  }
+  void put_findings(std::vector<char>& out, std::size_t from) const {
+    put(out, result_.findings.size() - from);
+    for (std::size_t k = from; k < result_.findings.size(); ++k) {
+      const InputFinding& f = result_.findings[k];
+      put(out, f.fault), put(out, f.node), put(out, f.measure), put(out, f.edge_end);
+      for (int c = 0; c < 3; ++c) put(out, f.place[c]);
+      put(out, f.elements.size());
+      for (const ElementRef& e : f.elements) put(out, e);
+    }
+  }
+  void get_findings(const std::vector<char>& in, std::size_t& at) {
+    std::size_t n = 0;
+    get(in, at, n);
+    for (; n > 0; --n) {
+      InputFinding f;
+      std::size_t elements = 0;
+      get(in, at, f.fault), get(in, at, f.node), get(in, at, f.measure), get(in, at, f.edge_end);
+      for (int c = 0; c < 3; ++c) get(in, at, f.place[c]);
+      get(in, at, elements);
+      f.elements.resize(elements);
+      for (ElementRef& e : f.elements) get(in, at, e);
+      add(std::move(f));
+    }
+  }
+
+  // With options_.exchange: the findings so far and the faces used once, of every share in
+  // share order (their order in one process's pairing, whose uses are by lowest node).
+  void share_pairing(std::vector<FaceUse>& single) {
+    std::vector<char> out;
+    put_findings(out, 0);
+    put(out, single.size());
+    out.insert(out.end(), reinterpret_cast<const char*>(single.data()),
+               reinterpret_cast<const char*>(single.data() + single.size()));
+    const std::vector<char> all = options_.exchange(out);
+    result_.findings.clear();
+    single.clear();
+    std::size_t at = 0;
+    for (int s = 0; s < options_.shares; ++s) {
+      get_findings(all, at);
+      std::size_t n = 0;
+      get(all, at, n);
+      for (; n > 0; --n) single.emplace_back(), get(all, at, single.back());
+    }
+  }
+
   // Faces by their node sets: pairs must be seen in opposite orders; a quad one side meets as
   // two or four triangles of the other is an interface, not boundary.
   void pair_faces() {
-    const std::vector<FaceUse> uses = sorted_face_uses();
-    std::vector<std::size_t> single;  // uses of faces used once
+    std::vector<FaceUse> single;  // faces used once
+    {
+      const std::vector<FaceUse> uses = sorted_face_uses();
+      pair_uses(uses, single);
+    }
+    if (options_.exchange) share_pairing(single);
+    match_interfaces(single);
+  }
+
+  // Faces used more than once: pairs must be seen in opposite orders; the rest into `single`.
+  void pair_uses(const std::vector<FaceUse>& uses, std::vector<FaceUse>& single) {
     for (std::size_t i = 0; i < uses.size();) {
       std::size_t j = i + 1;
       while (j < uses.size() && uses[j].key == uses[i].key) ++j;
@@ -167,7 +286,7 @@ class InputChecker {
         for (std::size_t b = a + 1; b < j && twin == j; ++b)
           if (same_nodes(uses[a].element, uses[b].element)) twin = a;
       if (j - i == 1) {
-        single.push_back(i);
+        single.push_back(uses[i]);
       } else if (twin != j) {
         std::size_t other = twin + 1;
         while (!same_nodes(uses[twin].element, uses[other].element)) ++other;
@@ -189,11 +308,14 @@ class InputChecker {
       }
       i = j;
     }
-    // The quad-triangle interface: an unpaired quad whose nodes two unpaired triangles (a
-    // diagonal) or four around one more node cover.
+  }
+
+  // The quad-triangle interface: an unpaired quad whose nodes two unpaired triangles (a
+  // diagonal) or four around one more node cover. The faces left are the boundary.
+  void match_interfaces(const std::vector<FaceUse>& uses) {                 // the faces used once
     std::unordered_map<FaceKey, std::size_t, IndexArrayHash> triangle;      // key -> use
     std::unordered_map<EdgeKey, std::vector<Index>, IndexArrayHash> third;  // edge -> third nodes
-    for (std::size_t s : single) {
+    for (std::size_t s = 0; s < uses.size(); ++s) {
       const FaceKey& k = uses[s].key;
       if (k[3] != kInvalidIndex) continue;
       triangle.emplace(k, s);
@@ -207,7 +329,7 @@ class InputChecker {
       const auto it = triangle.find(face_key(n));
       return it == triangle.end() || paired[it->second] ? nullptr : &it->second;
     };
-    for (std::size_t s : single) {
+    for (std::size_t s = 0; s < uses.size(); ++s) {
       if (uses[s].key[3] == kInvalidIndex) continue;
       const auto q = face_nodes(uses[s].element, uses[s].face);
       std::vector<std::size_t> cover;
@@ -249,7 +371,7 @@ class InputChecker {
       if (cover.size() == 4) centre_on_quad_.push_back(third_node(uses[cover[0]].key, q));
       ++result_.interface_quads;
     }
-    for (std::size_t s : single) {
+    for (std::size_t s = 0; s < uses.size(); ++s) {
       if (paired[s]) continue;
       BoundaryFace b{};
       b.nodes = face_nodes(uses[s].element, uses[s].face, &b.size);
@@ -426,7 +548,8 @@ class InputChecker {
 
   // The corner cones' solid angles (atan2, most of this pass) in parallel, one slot per cone;
   // their sums per node then in one order (hexes, wedges, tets, the centres of quads met by
-  // four triangles, pyramids), so that the sums do not depend on the threads.
+  // four triangles, pyramids), so that the sums do not depend on the threads. Shared, each
+  // share judges its run of the nodes, with the same sums.
   void covering_at_nodes() {
     const std::size_t nv = model_.points.size();
     constexpr std::array<std::pair<ElementKind, std::size_t>, 4> kOrder{
@@ -445,6 +568,7 @@ class InputChecker {
                         [&](const tbb::blocked_range<std::size_t>& r) {
                           for (std::size_t i = r.begin(); i != r.end(); ++i)
                             element_cones(kind, i, [&](int j, Index v, Index a, Index b, Index c) {
+                              if (!mine(v)) return;  // another share's node
                               const Point& o = pt(v);
                               cone[base[k] + per * i + index_cast<std::size_t>(j)] =
                                   solid_angle(pt(a) - o, pt(b) - o, pt(c) - o);
@@ -460,14 +584,16 @@ class InputChecker {
         for (Index x : centre_on_quad_) angle[index_cast<std::size_t>(x)] += 2.0 * kPi;
       for (std::size_t i = 0; i < element_count(model_, kind); ++i)
         element_cones(kind, i, [&](int j, Index v, Index, Index, Index) {
+          if (!mine(v)) return;
           const auto u = index_cast<std::size_t>(v);
           angle[u] += cone[base[k] + per * i + index_cast<std::size_t>(j)];
           if (at[u].index == kInvalidIndex) at[u] = {kind, index_cast(i)};
         });
     }
     release(cone);
-
-    for (std::size_t v = 0; v < nv && !full(); ++v) {
+    const std::size_t before = result_.findings.size();
+    for (auto v = index_cast<std::size_t>(first_); v < index_cast<std::size_t>(last_) && !full();
+         ++v) {
       if (at[v].index == kInvalidIndex || !judged_[v]) continue;
       if (!(std::abs(angle[v] - expected_[v]) > kPi)) continue;  // NaN: not judged
       add({InputFault::kFoldedNode,
@@ -476,6 +602,7 @@ class InputChecker {
            pt(index_cast(v)),
            angle[v] / expected_[v]});
     }
+    if (options_.exchange) share_findings(before);
   }
 
   // Boundary faces without a common node that cross, or that face each other across a gap
@@ -660,6 +787,7 @@ class InputChecker {
 
   const Model& model_;
   const InputCheckOptions& options_;
+  Index first_ = 0, last_ = 0;  // this share's run of the nodes (node_runs)
   InputCheckResult result_;
   std::vector<BoundaryFace> boundary_;
   std::vector<Index> centre_on_quad_;  // four-triangle centres, one per such interface quad

@@ -28,6 +28,7 @@
 //   the winding number of the whole boundary (a part lying inside another one).
 // Elements are assumed to have passed check_geometry (positive corners).
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -41,6 +42,12 @@ struct InputCheckOptions {
   double gap_fraction = 0.05;       // a gap thinner than this x the faces' longest edge is refused
   std::size_t max_components = 32;  // boundary components whose degree is checked
   std::size_t max_findings = 8;     // the check stops after this many
+  // The check shared among `shares` processes (geode_mpi's ranks), this one being `share`: each
+  // pairs the faces whose lowest node is in its run of the nodes, then `exchange`, an
+  // all-gather (every process's bytes, concatenated in share order), gives each the whole
+  // pairing, and every process goes on from the same data to the same findings.
+  int share = 0, shares = 1;
+  std::function<std::vector<char>(const std::vector<char>&)> exchange;
 };
 
 enum class InputFault {

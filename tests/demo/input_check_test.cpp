@@ -4,10 +4,12 @@
 // box with one tet folded over its neighbours (a node moved through a face, the tets it turned
 // inside out written positively, as a mesher re-orienting them would), two parts overlapping,
 // an interface opened by a gap and a part lying inside another are refused, naming the input
-// elements, and `geode conform` exits 2 on them with one line and nothing written.
+// elements, and `geode conform` exits 2 on them with one line and nothing written. Each of them,
+// checked in 2 and 3 shares as geode_mpi's ranks share the check, gives the same findings.
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <barrier>
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
@@ -15,6 +17,8 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include <geode/demo/demo_models.hpp>
 #include <geode/io/formats.hpp>
@@ -32,6 +36,49 @@ using primal::InputFault;
 using primal::Point;
 
 namespace {
+
+// The check shared among `shares` processes as geode_mpi shares it among ranks
+// (InputCheckOptions::share, exchange), here threads meeting at a barrier for the all-gather:
+// every share must find what one process finds, finding for finding.
+void require_same_when_shared(const primal::Model& m) {
+  const primal::InputCheckResult one = primal::check_input(m);
+  for (const int shares : {2, 3}) {
+    CAPTURE(shares);
+    std::vector<std::vector<char>> deposit(static_cast<std::size_t>(shares));
+    std::barrier meet(shares);
+    std::vector<primal::InputCheckResult> results(deposit.size());
+    std::vector<std::thread> threads;
+    for (int s = 0; s < shares; ++s)
+      threads.emplace_back([&, s] {
+        primal::InputCheckOptions o;
+        o.share = s, o.shares = shares;
+        o.exchange = [&, s](const std::vector<char>& mine) {
+          deposit[static_cast<std::size_t>(s)] = mine;
+          meet.arrive_and_wait();
+          std::vector<char> all;
+          for (const auto& d : deposit) all.insert(all.end(), d.begin(), d.end());
+          meet.arrive_and_wait();  // every share has read the deposits
+          return all;
+        };
+        results[static_cast<std::size_t>(s)] = primal::check_input(m, o);
+      });
+    for (auto& t : threads) t.join();
+    for (const primal::InputCheckResult& r : results) {
+      CHECK(r.boundary_faces == one.boundary_faces);
+      CHECK(r.interface_quads == one.interface_quads);
+      CHECK(r.boundary_components == one.boundary_components);
+      REQUIRE(r.findings.size() == one.findings.size());
+      for (std::size_t k = 0; k < r.findings.size(); ++k) {
+        CHECK(r.findings[k].fault == one.findings[k].fault);
+        CHECK(r.findings[k].elements == one.findings[k].elements);
+        CHECK(r.findings[k].node == one.findings[k].node);
+        CHECK(r.findings[k].edge_end == one.findings[k].edge_end);
+        CHECK(r.findings[k].place == one.findings[k].place);
+        CHECK(r.findings[k].measure == one.findings[k].measure);
+      }
+    }
+  }
+}
 
 // A node with only tets around it and not on the boundary (every face at it shared).
 Index interior_tet_node(const primal::Model& m) {
@@ -258,6 +305,7 @@ TEST_CASE("input check: every demo model, as saved, covers its domain once") {
     const primal::InputCheckResult r = primal::check_input(m);
     INFO((r.ok() ? std::string() : r.findings[0].text(m)));
     CHECK(r.ok());
+    require_same_when_shared(m);
     CHECK(r.boundary_components == 1);
     CHECK(r.boundary_faces > 0);
     // Read again with the check: nothing refused.
@@ -276,6 +324,7 @@ TEST_CASE("input check: a folded tet in a Gmsh hybrid and in a TetGen box is ref
     REQUIRE_NOTHROW(primal::check_geometry(m, source));  // every element positive
     const primal::InputCheckResult r = primal::check_input(m);
     REQUIRE(!r.ok());
+    require_same_when_shared(m);
     const primal::InputFinding& f = r.findings[0];
     CHECK((f.fault == InputFault::kSameSideFace || f.fault == InputFault::kFoldedNode));
     // The finding is at the moved node: one of its elements holds it.
@@ -303,6 +352,7 @@ TEST_CASE("input check: overlapping parts, a gap at the interface, a part inside
     detach_hexes(m, Point(0.3, 0.1, 0.1));
     const primal::InputCheckResult r = primal::check_input(m);
     REQUIRE(!r.ok());
+    require_same_when_shared(m);
     CHECK(r.findings[0].fault == InputFault::kCrossingFaces);
     REQUIRE(r.findings[0].elements.size() == 2);
     std::set<ElementKind> kinds{r.findings[0].elements[0].kind, r.findings[0].elements[1].kind};
@@ -317,6 +367,7 @@ TEST_CASE("input check: overlapping parts, a gap at the interface, a part inside
     detach_hexes(m, Point(-0.004, 0.0, 0.0));
     const primal::InputCheckResult r = primal::check_input(m);
     REQUIRE(!r.ok());
+    require_same_when_shared(m);
     CHECK(r.findings[0].fault == InputFault::kGap);
     CHECK(r.findings[0].measure == doctest::Approx(0.004).epsilon(0.01));
     CHECK(r.findings[0].place.x() == doctest::Approx(1.0).epsilon(0.01));
@@ -328,6 +379,7 @@ TEST_CASE("input check: overlapping parts, a gap at the interface, a part inside
     detach_hexes(m, Point::Zero());
     const primal::InputCheckResult r = primal::check_input(m);
     REQUIRE(!r.ok());
+    require_same_when_shared(m);
     CHECK(r.findings[0].fault == InputFault::kGap);
     CHECK(r.findings[0].measure < 1e-12);
     refused_by_conform(m, "duplicated", {"--merge-tolerance"}, dir);
@@ -354,6 +406,7 @@ TEST_CASE("input check: overlapping parts, a gap at the interface, a part inside
     REQUIRE_NOTHROW(primal::check_geometry(m, "inside"));
     const primal::InputCheckResult r = primal::check_input(m);
     REQUIRE(!r.ok());
+    require_same_when_shared(m);
     CHECK(r.findings[0].fault == InputFault::kCoveredTwice);
     CHECK(r.findings[0].elements[0].kind == ElementKind::kHex);
     CHECK(r.findings[0].measure == doctest::Approx(2.0).epsilon(0.01));
@@ -382,6 +435,7 @@ TEST_CASE(
       REQUIRE_NOTHROW(primal::check_geometry(m, source));
       const primal::InputCheckResult r = primal::check_input(m);
       REQUIRE(!r.ok());
+      require_same_when_shared(m);
       const primal::InputFinding& f = r.findings[0];
       CHECK(f.topological());
       if (along_edge) {
@@ -445,6 +499,7 @@ TEST_CASE(
   REQUIRE_NOTHROW(primal::check_geometry(m, "hanging"));
   const primal::InputCheckResult r = primal::check_input(m);
   REQUIRE(!r.ok());
+  require_same_when_shared(m);
   CHECK(r.findings[0].topological());
   CHECK(m.points[primal::index_cast<std::size_t>(r.findings[0].node)].x() ==
         1.0);  // on the interface
