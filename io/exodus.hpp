@@ -14,6 +14,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 
 #include <geode/primal/model.hpp>
 
@@ -64,7 +65,12 @@ struct NemesisInfo {
 primal::Model read_exodus_piece(const std::filesystem::path& path,
                                 const primal::ReadOptions& options, NemesisInfo* nemesis);
 
-// Writes atomically (a temporary file in the same directory, then rename).
-void write_exodus(const primal::Model& model, const std::filesystem::path& path);
+// Writes atomically (a temporary file in the same directory, then rename). The header is given
+// room for every definition, all made before the bulk data: netCDF's classic format moves the
+// whole data region whenever a definition outgrows the header. `define`, when given, is called
+// with the libexodusII file id once the model's variables are defined, to define more (Nemesis:
+// parallel/nemesis.cpp) and write it.
+void write_exodus(const primal::Model& model, const std::filesystem::path& path,
+                  const std::function<void(int exo)>& define = {});
 
 }  // namespace geode::io

@@ -40,21 +40,29 @@ class ExodusFile {
 
 // The cause libexodusII recorded for its last error: a system error (ENOSPC on a full disk)
 // or a netCDF / Exodus one, in words.
-inline std::string exodus_cause() {
-  const char* msg = nullptr;
-  const char* func = nullptr;
-  int err = 0;
-  ex_get_err(&msg, &func, &err);
+inline std::string error_cause(int err) {
   if (err > 0)
     return std::string(std::strerror(err)) +
            (err == ENOSPC || err == EDQUOT ? " (the disk is full)" : "");
   if (err < 0) return nc_strerror(err);
   return "Exodus error";
 }
+inline std::string exodus_cause() {
+  const char* msg = nullptr;
+  const char* func = nullptr;
+  int err = 0;
+  ex_get_err(&msg, &func, &err);
+  return error_cause(err);
+}
 
 // `where` names the file the user gave (never the temporary one a write goes through).
 inline void check(int status, const std::string& where, const std::string& what) {
   if (status < 0) throw InvalidInput(where + ": " + what + " failed: " + exodus_cause());
+}
+// A netCDF call's status (NC_NOERR, an errno, or a netCDF error).
+inline void check_netcdf(int status, const std::string& where, const std::string& what) {
+  if (status != NC_NOERR)
+    throw InvalidInput(where + ": " + what + " failed: " + error_cause(status));
 }
 
 // Names as Exodus wants them: an array of char* to buffers of kNameLength + 1.

@@ -44,22 +44,23 @@ std::filesystem::path rank_file(const std::filesystem::path& output, int ranks, 
 
 void write_nemesis(const RankMesh& mesh, const std::filesystem::path& output, int ranks, int rank) {
   const std::filesystem::path path = rank_file(output, ranks, rank);
-  const std::filesystem::path temp = path.string() + ".geode-tmp";
-  try {
-    io::write_exodus(mesh.model, temp);
-    ex_opts(0);
-    int cpu = 8, io_size = 8;
-    float version = 0;
-    const int exo = ex_open(temp.string().c_str(), EX_WRITE, &cpu, &io_size, &version);
-    if (exo < 0) throw std::runtime_error(temp.string() + ": cannot reopen the file");
-    struct Closer {
-      int id;
-      ~Closer() { ex_close(id); }
-    } closer{exo};
-    const auto nodes = one_based(mesh.node_gid, path);
-    const auto hexes = one_based(mesh.hex_gid, path);
-    if (!nodes.empty()) check(ex_put_id_map(exo, EX_NODE_MAP, nodes.data()), path, "node map");
-    if (!hexes.empty()) check(ex_put_id_map(exo, EX_ELEM_MAP, hexes.data()), path, "element map");
+  const auto nodes = one_based(mesh.node_gid, path);
+  const auto hexes = one_based(mesh.hex_gid, path);
+  // Load balance: internal / border nodes and elements (1-based local numbers).
+  std::vector<char> border(mesh.model.points.size(), 0);
+  for (const auto& [q, shared] : mesh.shared_nodes)
+    for (Index v : shared) border[primal::index_cast<std::size_t>(v)] = 1;
+  std::vector<int> node_int, node_bor, elem_int, elem_bor;
+  for (std::size_t v = 0; v < border.size(); ++v)
+    (border[v] ? node_bor : node_int).push_back(static_cast<int>(v + 1));
+  for (std::size_t h = 0; h < mesh.model.hexes.size(); ++h) {
+    bool on = false;
+    for (Index v : mesh.model.hexes[h]) on = on || border[primal::index_cast<std::size_t>(v)];
+    (on ? elem_bor : elem_int).push_back(static_cast<int>(h + 1));
+  }
+  // Nemesis's definitions made with the model's, before any bulk data (io/exodus.hpp): made on
+  // the finished file they had netCDF move all of it.
+  io::write_exodus(mesh.model, path, [&](int exo) {
     char type[] = "p";
     check(ex_put_init_info(exo, ranks, 1, type), path, "Nemesis init info");
     check(ex_put_init_global(exo, mesh.global_nodes, mesh.global_hexes,
@@ -87,47 +88,33 @@ void write_nemesis(const RankMesh& mesh, const std::filesystem::path& output, in
     if (!ids.empty())
       check(ex_put_ss_param_global(exo, ids.data(), counts.data(), zeros.data()), path,
             "global side sets");
-    // Load balance: internal / border nodes and elements (1-based local numbers).
-    std::vector<char> border(mesh.model.points.size(), 0);
-    for (const auto& [q, shared] : mesh.shared_nodes)
-      for (Index v : shared) border[primal::index_cast<std::size_t>(v)] = 1;
-    std::vector<int> node_int, node_bor, elem_int, elem_bor;
-    for (std::size_t v = 0; v < border.size(); ++v)
-      (border[v] ? node_bor : node_int).push_back(static_cast<int>(v + 1));
-    for (std::size_t h = 0; h < mesh.model.hexes.size(); ++h) {
-      bool on = false;
-      for (Index v : mesh.model.hexes[h]) on = on || border[primal::index_cast<std::size_t>(v)];
-      (on ? elem_bor : elem_int).push_back(static_cast<int>(h + 1));
-    }
     check(ex_put_loadbal_param(exo, primal::index_cast<int64_t>(node_int.size()),
                                primal::index_cast<int64_t>(node_bor.size()), 0,
                                primal::index_cast<int64_t>(elem_int.size()),
                                primal::index_cast<int64_t>(elem_bor.size()),
                                primal::index_cast<int64_t>(mesh.shared_nodes.size()), 0, rank),
           path, "Nemesis load balance");
-    check(ex_put_processor_node_maps(exo, node_int.data(), node_bor.data(), nullptr, rank), path,
-          "Nemesis node maps");
-    check(ex_put_processor_elem_maps(exo, elem_int.data(), elem_bor.data(), rank), path,
-          "Nemesis element maps");
     if (!mesh.shared_nodes.empty()) {
       std::vector<int> map_ids, map_counts;
       for (const auto& [q, shared] : mesh.shared_nodes)
         map_ids.push_back(q), map_counts.push_back(primal::index_cast<int>(shared.size()));
       check(ex_put_cmap_params(exo, map_ids.data(), map_counts.data(), nullptr, nullptr, rank),
             path, "Nemesis communication map sizes");
-      for (const auto& [q, shared] : mesh.shared_nodes) {
-        std::vector<int> local, procs(shared.size(), q);
-        for (Index v : shared) local.push_back(v + 1);
-        check(ex_put_node_cmap(exo, q, local.data(), procs.data(), rank), path,
-              "Nemesis node communication map to rank " + std::to_string(q));
-      }
     }
-  } catch (...) {
-    std::error_code ec;
-    std::filesystem::remove(temp, ec);
-    throw;
-  }
-  std::filesystem::rename(temp, path);
+    // The number maps (defined by their first write), then the data of what is defined.
+    if (!nodes.empty()) check(ex_put_id_map(exo, EX_NODE_MAP, nodes.data()), path, "node map");
+    if (!hexes.empty()) check(ex_put_id_map(exo, EX_ELEM_MAP, hexes.data()), path, "element map");
+    check(ex_put_processor_node_maps(exo, node_int.data(), node_bor.data(), nullptr, rank), path,
+          "Nemesis node maps");
+    check(ex_put_processor_elem_maps(exo, elem_int.data(), elem_bor.data(), rank), path,
+          "Nemesis element maps");
+    for (const auto& [q, shared] : mesh.shared_nodes) {
+      std::vector<int> local, procs(shared.size(), q);
+      for (Index v : shared) local.push_back(v + 1);
+      check(ex_put_node_cmap(exo, q, local.data(), procs.data(), rank), path,
+            "Nemesis node communication map to rank " + std::to_string(q));
+    }
+  });
 }
 
 Model canonical(const Model& model) {
