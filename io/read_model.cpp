@@ -143,12 +143,13 @@ bool read_forks(const std::filesystem::path& path) {
 }
 
 Model read_model(const std::filesystem::path& path, const ReadOptions& options, bool check_covering,
-                 FilePartition* partition) {
+                 FilePartition* partition, const primal::InputCheckOptions& covering) {
   if (partition) *partition = {};
   if (const auto set = find_nemesis_set(path)) {
     try {
       Model model = read_nemesis_set(*set, options, partition);
-      if (options.check_geometry && check_covering) require_single_covering(model, set->name());
+      if (options.check_geometry && check_covering)
+        require_single_covering(model, set->name(), covering);
       return model;
     } catch (const std::bad_alloc&) {
       throw out_of_memory_reading(set->files.front());
@@ -165,7 +166,8 @@ Model read_model(const std::filesystem::path& path, const ReadOptions& options, 
     Model model = partition && format->read == read_gmsh
                       ? read_gmsh_partitioned(path, options, partition)
                       : format->read(path, options);
-    if (options.check_geometry && check_covering) require_single_covering(model, path.string());
+    if (options.check_geometry && check_covering)
+      require_single_covering(model, path.string(), covering);
     return model;
   } catch (const std::bad_alloc&) {
     throw out_of_memory_reading(path);

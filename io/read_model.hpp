@@ -7,6 +7,7 @@
 #include <geode/io/file_partition.hpp>
 #include <geode/io/vtk.hpp>
 #include <geode/primal/errors.hpp>
+#include <geode/primal/input_check.hpp>
 #include <geode/primal/model.hpp>
 
 namespace geode::io {
@@ -16,14 +17,16 @@ namespace geode::io {
 // check_geometry unless options say otherwise, then (with check_geometry and check_covering) the
 // covering check of primal/input_check.hpp: a folded model, overlapping parts, an interface with
 // a gap are refused naming the elements. check_covering false is for callers that merge nodes
-// after reading and run require_single_covering themselves.
+// after reading and run require_single_covering themselves; `covering` is its options (geode_mpi
+// shares the check among its ranks).
 //
 // Partitioned inputs: a Nemesis set (nemesis_set.hpp: `path` one of its pieces IN.exo.N.r, or
 // IN.exo when that file does not exist and its pieces do) is read joined; a partitioned .msh 4.1
 // as the unpartitioned file (gmsh.hpp). With `partition` not null, the partition such a file
 // carries goes there (parts 0 for every other input).
 primal::Model read_model(const std::filesystem::path& path, const primal::ReadOptions& options = {},
-                         bool check_covering = true, FilePartition* partition = nullptr);
+                         bool check_covering = true, FilePartition* partition = nullptr,
+                         const primal::InputCheckOptions& covering = {});
 
 // Whether read_model(path) forks a child process to run a library in (isolated.hpp): an
 // Exodus file or a Nemesis set. A caller must then have no thread of its own at work during the

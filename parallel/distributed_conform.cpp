@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <stdexcept>
@@ -175,6 +176,7 @@ class Distributor {
   std::vector<Mask> diced_holders_;      // per diced node not in the zone: ranks holding it
   std::vector<Mask> zone_holders_;       // per zone output node
   std::int64_t diced_hex_first_ = 0;     // global id of this rank's first diced hex
+  std::int64_t owned_first_ = 0, owned_ = 0;  // the global ids this rank numbered: a run
   RankMesh out_;
 };
 
@@ -342,10 +344,11 @@ void Distributor::conform_zone() {
   primal::release(zone_at_);
 }
 
-// Output hexes a zone element stands for, against a diced element's one per child: the zone's
-// output per diced child, and its conform, full verification and writing on one rank (measured
-// on bench_mpi's half 68: the zone rank and rank 0 then reach the end together).
-constexpr double kZoneLoad = 1.2;
+// The zone rank's load per child of a zone element, against 1 per diced hex elsewhere: the
+// zone's output per child (1.2 on bench_mpi's half 68) with its conform, the check around the
+// cut and writing on one rank. Tuned on half 68, 2 ranks: 1.2 left rank 0 waiting 1.4 s for the
+// zone rank, 2.8 left the zone rank waiting 0.65 s for rank 0's writing; 2.0 ends within 0.4 s.
+constexpr double kZoneLoad = 2.0;
 
 // Per flat element its rank: the input's own partition, or METIS's on rank 0 (the elements
 // weighted by the hexes they dice into, the zone's elements only 1: the zone rank's share made
@@ -701,6 +704,7 @@ void Distributor::number() {
   MPI_Allreduce(&owned, &total, 1, MPI_INT64_T, MPI_SUM, comm_);
   out_.global_nodes = zone_nodes + total;
   std::int64_t next = zone_nodes + first;
+  owned_first_ = next, owned_ = owned;
   for (std::size_t i = 0; i < nd; ++i)
     if (diced_gid_[i] < 0 && std::countr_zero(diced_holders_[i]) == rank_) diced_gid_[i] = next++;
   // The owners send the ids of the shared nodes, in the shared lists' order.
@@ -759,7 +763,18 @@ void Distributor::assemble() {
     for (Index v : zone_out_.hexes[h - zone_base_]) gids.push_back(v);
   std::sort(gids.begin(), gids.end());
   gids.erase(std::unique(gids.begin(), gids.end()), gids.end());
+  // A global id's local number: the zone's through a table, the run this rank numbered by
+  // offset (no other id falls within it), the few others by search.
+  const std::int64_t zone_nodes = primal::index_cast<std::int64_t>(zone_out_.points.size());
+  std::vector<Index> zone_local(primal::index_cast<std::size_t>(zone_nodes), kInvalidIndex);
+  for (std::size_t l = 0; l < gids.size() && gids[l] < zone_nodes; ++l)
+    zone_local[primal::index_cast<std::size_t>(gids[l])] = primal::index_cast(l);
+  const std::int64_t owned_at =
+      std::lower_bound(gids.begin(), gids.end(), owned_first_) - gids.begin();
   const auto local = [&](std::int64_t g) {
+    if (g < zone_nodes) return zone_local[primal::index_cast<std::size_t>(g)];
+    if (g >= owned_first_ && g < owned_first_ + owned_)
+      return primal::index_cast(owned_at + (g - owned_first_));
     return primal::index_cast(std::lower_bound(gids.begin(), gids.end(), g) - gids.begin());
   };
   Model& o = out_.model;
@@ -770,7 +785,6 @@ void Distributor::assemble() {
     o.points[primal::index_cast<std::size_t>(diced_local[i])] = diced_.points[i];
   }
   primal::release(diced_.points, diced_gid_);
-  const std::int64_t zone_nodes = primal::index_cast<std::int64_t>(zone_out_.points.size());
   for (std::size_t l = 0; l < gids.size(); ++l)
     if (gids[l] < zone_nodes)
       o.points[l] = zone_out_.points[primal::index_cast<std::size_t>(gids[l])];
@@ -859,7 +873,7 @@ void Distributor::assemble() {
       for (std::size_t j = 0; j < nt; ++j)
         place(diced_hex_first_ + static_cast<std::int64_t>(k - first_diced));
   }
-  primal::release(block, diced_local);
+  primal::release(block, diced_local, zone_local);
   diced_ = primal::DicedModel();
   o.block_names = m().block_names;
   o.block_names.insert(zone_out_.block_names.begin(), zone_out_.block_names.end());
@@ -957,11 +971,12 @@ bool piece_ok(const primal::HexValidityReport& v, const std::vector<char>& exemp
 }
 
 // Every rank's hexes checked as a piece (piece_ok, its shared nodes exempt from the covering),
-// and the zone as conform checked it, as a piece too (its cut is not the model's boundary).
-// --verify local (the default), as the serial run verifies: the diced children against the
-// dicing tables (dice()), the whole check around the hexes on a zone node (the rank's zone
-// hexes and the diced hexes meeting them across the cut, where nodes were matched by position)
-// and every hex's corner Jacobians; --verify full: the whole check on every hex of the piece.
+// and the zone as its conform checked it, as a piece too (its cut is not the model's boundary).
+// --verify local (the default), as the serial run verifies: the zone by its conform (locally),
+// the diced children against the dicing tables (dice()), the whole check around the hexes on
+// the cut (zone nodes a diced hex uses or another rank holds: where nodes were matched by
+// position) and every hex's corner Jacobians; --verify full: the zone by its conform and every
+// hex of the piece, whole.
 // The joined file (--join) can be checked whole with `geode check`.
 void Distributor::verify() {
   primal::HexMesh mesh;  // borrowed, not copied
@@ -969,10 +984,19 @@ void Distributor::verify() {
   mesh.hexes = std::move(out_.model.hexes);
   primal::HexValidityReport v;
   if (options_.conform.verify == conform::ConformVerify::kLocal) {
+    // The cut: zone nodes that a diced hex here uses or that another rank holds too.
+    const auto zone_hexes = primal::index_cast<std::int64_t>(zone_hexes_);
+    std::vector<char> cut(mesh.points.size(), 0);
+    for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
+      if (out_.hex_gid[h] >= zone_hexes)
+        for (Index n : mesh.hexes[h]) cut[primal::index_cast<std::size_t>(n)] = 1;
+    for (const auto& [q, nodes] : out_.shared_nodes)
+      for (Index n : nodes) cut[primal::index_cast<std::size_t>(n)] = 1;
+    for (std::size_t n = 0; n < cut.size(); ++n) cut[n] = cut[n] && out_.node_gid[n] < zone_nodes_;
     std::vector<Index> seeds;
     for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
       for (Index n : mesh.hexes[h])
-        if (out_.node_gid[primal::index_cast<std::size_t>(n)] < zone_nodes_) {
+        if (cut[primal::index_cast<std::size_t>(n)]) {
           seeds.push_back(primal::index_cast(h));
           break;
         }
@@ -1002,6 +1026,31 @@ RankMesh conform_distributed(const primal::Model& input, const DistributedOption
                              MPI_Comm comm, DistributedReport* report) {
   DistributedReport local;
   return Distributor(input, options, comm, report ? *report : local).run();
+}
+
+primal::InputCheckOptions shared_input_check(MPI_Comm comm) {
+  primal::InputCheckOptions o;
+  MPI_Comm_rank(comm, &o.share);
+  MPI_Comm_size(comm, &o.shares);
+  o.exchange = [comm, shares = o.shares](const std::vector<char>& mine) {
+    // Faces used once and findings: the boundary, far below 2 GiB (an int's count) in all;
+    // past it every rank throws alike.
+    constexpr std::int64_t kMax = std::numeric_limits<int>::max();
+    const int n = std::cmp_less_equal(mine.size(), kMax) ? static_cast<int>(mine.size()) : -1;
+    std::vector<int> counts(primal::index_cast<std::size_t>(shares)), displs(counts.size());
+    MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
+    std::int64_t total = 0;
+    for (std::size_t r = 0; r < counts.size(); ++r) {
+      if (counts[r] < 0 || total + counts[r] > kMax)
+        throw std::runtime_error("the covering check's pairing exceeds 2 GiB across the ranks");
+      displs[r] = static_cast<int>(total), total += counts[r];
+    }
+    std::vector<char> all(primal::index_cast<std::size_t>(total));
+    MPI_Allgatherv(mine.data(), n, MPI_CHAR, all.data(), counts.data(), displs.data(), MPI_CHAR,
+                   comm);
+    return all;
+  };
+  return o;
 }
 
 }  // namespace geode::parallel

@@ -34,6 +34,7 @@
 #include <mpi.h>
 
 #include <geode/conform/conform.hpp>
+#include <geode/primal/input_check.hpp>
 #include <geode/primal/model.hpp>
 
 namespace geode::parallel {
@@ -73,5 +74,10 @@ struct DistributedReport {
 // node) and a named geode block.
 RankMesh conform_distributed(const primal::Model& input, const DistributedOptions& options,
                              MPI_Comm comm, DistributedReport* report = nullptr);
+
+// The read-time covering check (primal/input_check.hpp) shared among the ranks of `comm`, for
+// io::read_model: each rank pairs its share of the faces, MPI_Allgatherv joins the pairings, and
+// every rank reaches the same verdict. Collective: every rank must read the same file with it.
+primal::InputCheckOptions shared_input_check(MPI_Comm comm);
 
 }  // namespace geode::parallel

@@ -79,7 +79,8 @@ int run(int argc, char** argv, int rank, int size) {
     options.conform.verify = conform::parse_conform_verify(verify);
     options.rings = rings;
     io::FilePartition file_partition;
-    const primal::Model model = io::read_model(input, {}, true, &file_partition);
+    const primal::Model model = io::read_model(input, {}, true, &file_partition,
+                                               parallel::shared_input_check(MPI_COMM_WORLD));
     // The input's own partition (a partitioned .msh, a Nemesis set) unless it has fewer parts
     // than there are ranks: then METIS (parallel/partition.hpp).
     std::string partitioned_by = size > 1 ? "METIS" : "one rank";
