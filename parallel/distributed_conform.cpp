@@ -12,6 +12,7 @@
 #include <string>
 #include <type_traits>
 #include <unordered_map>
+#include <unordered_set>
 #include <utility>
 
 #include <geode/parallel/partition.hpp>
@@ -136,8 +137,8 @@ class Distributor {
   void verify();
   void release() {
     own_ = {};
-    primal::release(zone_at_, level_, in_zone_, band_, part_, zone_node_, diced_gid_,
-                    diced_holders_, zone_holders_, tet_pyramid_);
+    primal::release(level_, in_zone_, band_, part_, zone_node_, diced_gid_, diced_holders_,
+                    zone_holders_, tet_pyramid_);
     split_ = {}, zone_out_ = {};
   }
 
@@ -164,8 +165,7 @@ class Distributor {
   // On the zone rank, when the zone could not be conformed: the error's kind and message.
   std::string zone_failure_;
   int zone_failure_kind_ = 0;
-  std::vector<char> zone_node_;  // per model node: used by a zone element
-  std::unordered_map<PointBits, Index, PointBitsHash> zone_at_;  // zone output node by position
+  std::vector<char> zone_node_;                 // per model node: used by a zone element
   std::size_t zone_first_ = 0, zone_last_ = 0;  // this rank's zone hexes, in the zone's numbers
   std::size_t zone_base_ = 0;  // the zone's number of zone_out_.hexes[0] (this rank's first)
   primal::Submodel own_;       // this rank's elements outside the zone
@@ -310,19 +310,16 @@ void Distributor::conform_zone() {
       // Verified as the options say. Local verification's premise holds on the zone, a part of
       // an input that passed the read-time check: its faces are shared by at most two cells and
       // it covers its region once (its cut, unlike a model's boundary, may be non-manifold, which
-      // piece_ok does not judge); and verify() checks every zone hex again, each being on a zone
-      // node.
+      // piece_ok does not judge); verify() checks around the cut whole.
       conform::ConformOptions zone_options = options_.conform;
       conform::ConformResult r = conform::conform(zone.model, zone_options);
-      zone_at_.clear();
-      zone_at_.reserve(r.model.points.size());
-      for (std::size_t i = 0; i < r.model.points.size(); ++i)
-        zone_at_.emplace(bits(r.model.points[i]), primal::index_cast(i));
-      // The band diced alone must be found in the zone's output, node for node.
+      // The band diced alone must be found in the zone's output, node for node (its points, all
+      // distinct, looked for among the zone's).
       const primal::Submodel b = primal::extract_submodel(m(), band_);
-      const primal::DicedModel d = primal::dice_model(b.model);
-      if (std::all_of(d.points.begin(), d.points.end(),
-                      [&](const Point& p) { return zone_at_.count(bits(p)) > 0; })) {
+      std::unordered_set<PointBits, PointBitsHash> band;
+      for (const Point& p : primal::dice_model(b.model).points) band.insert(bits(p));
+      for (const Point& p : r.model.points) band.erase(bits(p));
+      if (band.empty()) {
         zone_out_ = std::move(r.model);
         zone_first_ = 0, zone_last_ = zone_out_.hexes.size();
         rep_.zone = std::move(r);
@@ -341,7 +338,6 @@ void Distributor::conform_zone() {
   } catch (const std::exception& e) {
     zone_failure_kind_ = 3, zone_failure_ = e.what();
   }
-  primal::release(zone_at_);
 }
 
 // The zone rank's load per child of a zone element, against 1 per diced hex elsewhere: the
@@ -526,9 +522,6 @@ void Distributor::share_zone() {
     diced_ = primal::DicedModel(), dicing_ = primal::DicingCheck(), own_ = {};
     dice();
   }
-  zone_at_.reserve(points);
-  for (std::size_t i = 0; i < points; ++i)
-    zone_at_.emplace(bits(zone_out_.points[i]), primal::index_cast(i));
 }
 
 // The zone's hexes shared out: each rank but the zone rank, in rank order, takes a run of them
@@ -633,42 +626,59 @@ void Distributor::number() {
   const std::size_t nd = diced_.points.size();
   diced_gid_.assign(nd, -1);
   diced_holders_.assign(nd, Mask{1} << rank_);
-  // Origins in model numbers (own_.node ascends, so normalized keys stay sorted).
-  std::vector<FaceKey> key(nd, primal::kNoOrigin);
+  // Origins in model numbers (own_.node ascends, so normalized keys stay sorted), made when
+  // read: only the candidates' are read again (a copy of them all was 16 B a diced node at the
+  // numbering's peak).
+  const auto key = [&](std::size_t i) {
+    FaceKey r = primal::kNoOrigin;
+    const FaceKey& o = diced_.origin[i];
+    for (std::size_t k = 0; k < 4 && o[k] != kInvalidIndex; ++k)
+      r[k] = own_.node[primal::index_cast<std::size_t>(o[k])];
+    return r;
+  };
+  // A diced node made from zone nodes alone takes the zone's node at its position: those few
+  // (the cut's) by position, the zone's points looked up among them.
+  {
+    std::unordered_map<PointBits, std::size_t, PointBitsHash> on_zone;
+    for (std::size_t i = 0; i < nd; ++i) {
+      const FaceKey& o = diced_.origin[i];
+      bool in_zone = o[0] != kInvalidIndex;  // not a cell centre
+      for (std::size_t k = 0; k < 4 && o[k] != kInvalidIndex && in_zone; ++k)
+        in_zone = zone_node_[primal::index_cast<std::size_t>(
+            own_.node[primal::index_cast<std::size_t>(o[k])])];
+      if (in_zone) on_zone.emplace(bits(diced_.points[i]), i);
+    }
+    for (std::size_t z = 0; z < zone_out_.points.size() && !on_zone.empty(); ++z)
+      if (const auto it = on_zone.find(bits(zone_out_.points[z])); it != on_zone.end())
+        diced_gid_[it->second] = primal::index_cast<std::int64_t>(z);
+  }
+  // The zone's points: the zone rank's and those holding zone hexes need them for assembly.
+  if (zone_last_ == zone_first_) primal::release(zone_out_.points);
   std::vector<std::vector<std::size_t>> candidates(primal::index_cast<std::size_t>(size_));
   for (std::size_t i = 0; i < nd; ++i) {
     const FaceKey& o = diced_.origin[i];
-    if (o[0] == kInvalidIndex) continue;  // a cell centre: this rank's alone
-    bool in_zone = true;
+    if (o[0] == kInvalidIndex || diced_gid_[i] >= 0) continue;  // a cell centre; the zone's
     Mask holders = ~Mask{0};
-    for (std::size_t k = 0; k < 4 && o[k] != kInvalidIndex; ++k) {
-      const Index v = own_.node[primal::index_cast<std::size_t>(o[k])];
-      key[i][k] = v;
-      in_zone = in_zone && zone_node_[primal::index_cast<std::size_t>(v)];
-      holders &= uses[primal::index_cast<std::size_t>(v)];
-    }
-    if (in_zone) {
-      const auto it = zone_at_.find(bits(diced_.points[i]));
-      if (it != zone_at_.end()) {
-        diced_gid_[i] = it->second;
-        continue;
-      }
-    }
+    for (std::size_t k = 0; k < 4 && o[k] != kInvalidIndex; ++k)
+      holders &=
+          uses[primal::index_cast<std::size_t>(own_.node[primal::index_cast<std::size_t>(o[k])])];
     holders &= ~(Mask{1} << rank_);
     for (int q = 0; q < size_; ++q)
       if (holders >> q & 1) candidates[primal::index_cast<std::size_t>(q)].push_back(i);
   }
-  primal::release(zone_at_);  // the zone's nodes by position: only the loop above reads them
   // Exchange the candidates' origins with each rank that may hold them; the nodes in both lists
   // are the ones shared.
-  const auto key_less = [&](std::size_t a, std::size_t b) { return key[a] < key[b]; };
+  const auto key_less = [&](std::size_t a, std::size_t b) { return key(a) < key(b); };
   std::vector<int> send_counts(primal::index_cast<std::size_t>(size_)),
       recv_counts(send_counts.size());
   std::vector<Index> send;
   for (int q = 0; q < size_; ++q) {
     auto& c = candidates[primal::index_cast<std::size_t>(q)];
     std::sort(c.begin(), c.end(), key_less);
-    for (std::size_t i : c) send.insert(send.end(), key[i].begin(), key[i].end());
+    for (std::size_t i : c) {
+      const FaceKey k = key(i);
+      send.insert(send.end(), k.begin(), k.end());
+    }
     send_counts[primal::index_cast<std::size_t>(q)] = static_cast<int>(c.size() * 4);
   }
   MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm_);
@@ -686,9 +696,10 @@ void Distributor::number() {
         primal::index_cast<std::size_t>(recv_counts[primal::index_cast<std::size_t>(q)]) / 4;
     std::size_t j = 0;
     for (std::size_t i : c) {
+      const FaceKey mine = key(i);
       FaceKey k{};
-      while (j < n && (std::copy_n(theirs + 4 * j, 4, k.begin()), k < key[i])) ++j;
-      if (j < n && k == key[i]) {
+      while (j < n && (std::copy_n(theirs + 4 * j, 4, k.begin()), k < mine)) ++j;
+      if (j < n && k == mine) {
         shared[primal::index_cast<std::size_t>(q)].push_back(i);
         diced_holders_[i] |= Mask{1} << q;
       }
@@ -756,16 +767,31 @@ void Distributor::number() {
 // so that the dicing and the output are never whole side by side.
 void Distributor::assemble() {
   const std::size_t nd = diced_.points.size();
-  std::vector<std::int64_t> gids;
-  gids.reserve(nd + 8 * (zone_last_ - zone_first_));
-  gids = diced_gid_;
+  const std::int64_t zone_nodes = zone_nodes_;
+  // The nodes: the diced ones and the zone's that this rank's zone hexes use and no diced node
+  // here took; the diced points get room for the latter now, before the output's arrays exist
+  // (they become the output's points in place).
+  std::vector<char> zone_only(
+      zone_last_ > zone_first_ ? primal::index_cast<std::size_t>(zone_nodes) : 0, 0);
   for (std::size_t h = zone_first_; h < zone_last_; ++h)
-    for (Index v : zone_out_.hexes[h - zone_base_]) gids.push_back(v);
+    for (Index v : zone_out_.hexes[h - zone_base_])
+      zone_only[primal::index_cast<std::size_t>(v)] = 1;
+  if (!zone_only.empty())
+    for (std::int64_t g : diced_gid_)
+      if (g < zone_nodes) zone_only[primal::index_cast<std::size_t>(g)] = 0;
+  const auto extra =
+      primal::index_cast<std::size_t>(std::count(zone_only.begin(), zone_only.end(), 1));
+  diced_.points.reserve(nd + extra);
+  std::vector<std::int64_t> gids;
+  gids.reserve(nd + extra);
+  gids = diced_gid_;
+  for (std::size_t v = 0; v < zone_only.size(); ++v)
+    if (zone_only[v]) gids.push_back(primal::index_cast<std::int64_t>(v));
+  primal::release(zone_only);
   std::sort(gids.begin(), gids.end());
   gids.erase(std::unique(gids.begin(), gids.end()), gids.end());
   // A global id's local number: the zone's through a table, the run this rank numbered by
   // offset (no other id falls within it), the few others by search.
-  const std::int64_t zone_nodes = primal::index_cast<std::int64_t>(zone_out_.points.size());
   std::vector<Index> zone_local(primal::index_cast<std::size_t>(zone_nodes), kInvalidIndex);
   for (std::size_t l = 0; l < gids.size() && gids[l] < zone_nodes; ++l)
     zone_local[primal::index_cast<std::size_t>(gids[l])] = primal::index_cast(l);
@@ -778,15 +804,34 @@ void Distributor::assemble() {
     return primal::index_cast(std::lower_bound(gids.begin(), gids.end(), g) - gids.begin());
   };
   Model& o = out_.model;
-  o.points.resize(gids.size());
   std::vector<Index> diced_local(nd);
-  for (std::size_t i = 0; i < nd; ++i) {
-    diced_local[i] = local(diced_gid_[i]);
-    o.points[primal::index_cast<std::size_t>(diced_local[i])] = diced_.points[i];
+  for (std::size_t i = 0; i < nd; ++i) diced_local[i] = local(diced_gid_[i]);
+  primal::release(diced_gid_);
+  // The diced points become the output's, each moved to its local number along the cycles of
+  // that map (one-to-one), so the points are never held twice; the zone's nodes come after.
+  o.points = std::move(diced_.points);
+  o.points.resize(gids.size());
+  {
+    std::vector<bool> moved(nd, false);
+    for (std::size_t start = 0; start < nd; ++start) {
+      if (moved[start]) continue;
+      Point carry = o.points[start];
+      moved[start] = true;
+      for (std::size_t j = start;;) {
+        const auto d = primal::index_cast<std::size_t>(diced_local[j]);
+        if (d < nd && !moved[d]) {
+          std::swap(carry, o.points[d]);
+          moved[d] = true;
+          j = d;
+        } else {
+          o.points[d] = carry;
+          break;
+        }
+      }
+    }
   }
-  primal::release(diced_.points, diced_gid_);
-  for (std::size_t l = 0; l < gids.size(); ++l)
-    if (gids[l] < zone_nodes)
+  if (!zone_out_.points.empty())  // the zone nodes no diced node took (the same bits where one did)
+    for (std::size_t l = 0; l < gids.size() && gids[l] < zone_nodes; ++l)
       o.points[l] = zone_out_.points[primal::index_cast<std::size_t>(gids[l])];
   // Shared nodes per neighbour, from the holders of each local node.
   std::vector<Mask> holders(gids.size(), 0);
