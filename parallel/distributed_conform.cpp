@@ -95,7 +95,7 @@ class Distributor {
     // The zone rank conforms the zone while rank 0 partitions and the others wait for it.
     if (rank_ == zone_rank()) stage("zone", [&] { conform_zone(); });
     stage("partition", [&] { partition(); });
-    if (zone_failure_.empty()) stage("dicing", [&] { dice(); });
+    if (zone_failure_kind_ == 0) stage("dicing", [&] { dice(); });
     stage("zone shared", [&] {
       share_zone();
       share_zone_hexes();

@@ -3,7 +3,8 @@
 # dicing tables, the whole check around the transition zone, every corner Jacobian) and --verify
 # full pass the same valid result; a dicing broken on purpose (the test hook
 # GEODE_TEST_BREAK_DICED_HEX, docs/cli.md) is found by both on 1 and 2 ranks: exit 4, the
-# failing check named, nothing written.
+# failing check named, nothing written. A transition zone made invalid on the zone rank (the last;
+# GEODE_TEST_INVERT_OUTPUT_HEX in its conform) fails every rank count alike.
 # usage: mpi_verify_test.sh GEODE GEODE_MPI MPIEXEC WORKDIR
 set -euo pipefail
 geode=$1 geode_mpi=$2 mpiexec=$3 dir=$4
@@ -27,4 +28,15 @@ for n in 1 2; do
   done
   cmp "ok_local$n.exo" "ok_full$n.exo"
 done
-echo "mpi_verify_test: both modes pass the result and find the broken dicing on 1 and 2 ranks"
+for n in 1 2 3; do
+  status=0
+  GEODE_TEST_INVERT_OUTPUT_HEX=1 "$mpiexec" --oversubscribe -np "$n" "$geode_mpi" conform in.exo \
+    -o "zone$n.exo" -q 2>err.txt >/dev/null || status=$?
+  if [ "$status" != 4 ]; then
+    echo "an invalid zone, $n ranks: exited $status, not 4"; cat err.txt; exit 1
+  fi
+  grep -q "the transition zone: hex mesh" err.txt
+  grep -q "invalid result, nothing written" err.txt
+  if ls zone"$n".exo* >/dev/null 2>&1; then echo "an invalid zone, $n ranks: wrote a file"; exit 1; fi
+done
+echo "mpi_verify_test: both modes pass the result and find the broken dicing on 1 and 2 ranks, an invalid zone on 1 to 3"
