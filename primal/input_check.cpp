@@ -878,6 +878,11 @@ std::string InputFinding::text(const Model& model) const {
 }
 
 InputCheckResult check_input(const Model& model, const InputCheckOptions& options) {
+  if (options.shares < 1 || options.share < 0 || options.share >= options.shares ||
+      (options.shares > 1 && !options.exchange))
+    throw std::invalid_argument("check_input: share " + std::to_string(options.share) + " of " +
+                                std::to_string(options.shares) +
+                                (options.exchange ? "" : " without an exchange"));
   return InputChecker(model, options).run();
 }
 

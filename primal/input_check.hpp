@@ -45,7 +45,8 @@ struct InputCheckOptions {
   // The check shared among `shares` processes (geode_mpi's ranks), this one being `share`: each
   // pairs the faces whose lowest node is in its run of the nodes, then `exchange`, an
   // all-gather (every process's bytes, concatenated in share order), gives each the whole
-  // pairing, and every process goes on from the same data to the same findings.
+  // pairing, and every process goes on from the same data to the same findings. More than one
+  // share without an exchange is refused (std::invalid_argument).
   int share = 0, shares = 1;
   std::function<std::vector<char>(const std::vector<char>&)> exchange;
 };

@@ -16,6 +16,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -42,6 +43,9 @@ namespace {
 // every share must find what one process finds, finding for finding.
 void require_same_when_shared(const primal::Model& m) {
   const primal::InputCheckResult one = primal::check_input(m);
+  primal::InputCheckOptions alone;  // shares without an exchange: refused, not half a check
+  alone.shares = 2;
+  CHECK_THROWS_AS(primal::check_input(m, alone), std::invalid_argument);
   for (const int shares : {2, 3}) {
     CAPTURE(shares);
     std::vector<std::vector<char>> deposit(static_cast<std::size_t>(shares));
