@@ -113,26 +113,23 @@ void write_exodus(const Model& model, const std::filesystem::path& path,
     if (!blocks.empty())
       check(ex_put_names(exo, EX_ELEM_BLOCK, block_names.pointers.data()), target,
             "writing block names");
-    NameBuffers node_set_names(model.node_sets.size());
-    for (std::size_t s = 0; s < model.node_sets.size(); ++s) {
-      const NodeSet& set = model.node_sets[s];
-      check(ex_put_set_param(exo, EX_NODE_SET, set.id, index_cast<int64_t>(set.nodes.size()), 0),
-            target, "writing node set " + std::to_string(set.id));
-      node_set_names.set(s, set.name);
-    }
-    if (!model.node_sets.empty())
-      check(ex_put_names(exo, EX_NODE_SET, node_set_names.pointers.data()), target,
-            "writing node set names");
-    NameBuffers side_set_names(model.side_sets.size());
-    for (std::size_t s = 0; s < model.side_sets.size(); ++s) {
-      const SideSet& set = model.side_sets[s];
-      check(ex_put_set_param(exo, EX_SIDE_SET, set.id, index_cast<int64_t>(set.sides.size()), 0),
-            target, "writing side set " + std::to_string(set.id));
-      side_set_names.set(s, set.name);
-    }
-    if (!model.side_sets.empty())
-      check(ex_put_names(exo, EX_SIDE_SET, side_set_names.pointers.data()), target,
-            "writing side set names");
+    // Node and side sets alike: each set's size, then their names.
+    auto define_sets = [&](ex_entity_type type, const auto& sets, const std::string& what,
+                           auto size) {
+      NameBuffers set_names(sets.size());
+      for (std::size_t s = 0; s < sets.size(); ++s) {
+        check(ex_put_set_param(exo, type, sets[s].id, index_cast<int64_t>(size(sets[s])), 0),
+              target, "writing " + what + " " + std::to_string(sets[s].id));
+        set_names.set(s, sets[s].name);
+      }
+      if (!sets.empty())
+        check(ex_put_names(exo, type, set_names.pointers.data()), target,
+              "writing " + what + " names");
+    };
+    define_sets(EX_NODE_SET, model.node_sets, "node set",
+                [](const NodeSet& set) { return set.nodes.size(); });
+    define_sets(EX_SIDE_SET, model.side_sets, "side set",
+                [](const SideSet& set) { return set.sides.size(); });
     if (define) define(exo);
 
     // Coordinates and connectivity in slices, so that writing adds a few MiB beside the model
