@@ -22,6 +22,15 @@ using namespace exodus_library;
 namespace {
 // Nodes or elements written per library call: 2^18 hexes are 8 MiB of connectivity.
 constexpr std::size_t kSlice = std::size_t{1} << 18;
+
+// An Exodus block's elements: runs of consecutive model elements of one kind (a block's
+// elements come in runs: one per block in a conform output), not a reference per element (8 B
+// a hex beside the model at a conform run's write).
+struct BlockMembers {
+  ElementKind kind;
+  std::vector<std::pair<std::size_t, std::size_t>> runs;  // first, count
+  std::size_t size = 0;
+};
 // Bytes kept free in the header (ex_put_init's definitions, blocks, sets, names, Nemesis's).
 constexpr std::size_t kHeaderRoom = std::size_t{1} << 17;
 }  // namespace
@@ -35,7 +44,7 @@ void write_exodus(const Model& model, const std::filesystem::path& path,
   // An Exodus block holds one element type. A model block of several kinds (Gmsh puts the
   // pyramids in the tet volume's block) keeps its id for its first kind (kElementKinds order);
   // each further kind gets a block of its own above every model id, named after it.
-  std::map<int, std::vector<ElementRef>> blocks;  // id -> its elements, one kind
+  std::map<int, BlockMembers> blocks;  // id -> its elements, one kind
   std::map<std::pair<int, ElementKind>, int> exodus_id;
   int top = 0;
   for (ElementKind kind : kElementKinds) {
@@ -47,33 +56,26 @@ void write_exodus(const Model& model, const std::filesystem::path& path,
   for (ElementKind kind : kElementKinds) {
     // Elements of one block come in runs: the maps are read once per run, not per element
     // (three map operations per element were a third of writing a million hexes).
-    std::vector<ElementRef>* into = nullptr;
+    BlockMembers* into = nullptr;
     int run_id = 0;
     for (std::size_t e = 0; e < element_count(model, kind); ++e) {
-      const ElementRef ref{kind, index_cast(e)};
-      const int id = block_of(model, ref);
+      const int id = block_of(model, {kind, index_cast(e)});
       if (!into || id != run_id) {
         auto [it, inserted] = exodus_id.try_emplace({id, kind}, id);
-        if (inserted && blocks.count(id) && blocks[id].front().kind != kind) {
+        if (inserted && blocks.count(id) && blocks.at(id).kind != kind) {
           it->second = ++top;
           const auto name = model.block_names.find(id);
           names[top] =
               (name != model.block_names.end() ? name->second : "block " + std::to_string(id)) +
               " " + element_kind_name(kind) + "s";
         }
-        into = &blocks[it->second];
+        into = &blocks.try_emplace(it->second, BlockMembers{kind, {}, 0}).first->second;
+        into->runs.emplace_back(e, 0);
         run_id = id;
       }
-      into->push_back(ref);
+      ++into->runs.back().second, ++into->size;
     }
   }
-  std::array<std::vector<int>, 4> global;  // per kind and element: its 1-based file number
-  for (ElementKind kind : kElementKinds)
-    global[static_cast<std::size_t>(kind)].resize(element_count(model, kind));
-  int next = 1;
-  for (const auto& [id, members] : blocks)
-    for (const ElementRef& e : members)
-      global[static_cast<std::size_t>(e.kind)][index_cast<std::size_t>(e.index)] = next++;
 
   write_path_atomically(path, "", [&](const std::filesystem::path& temp) {
     ex_opts(0);
@@ -103,8 +105,8 @@ void write_exodus(const Model& model, const std::filesystem::path& path,
     NameBuffers block_names(blocks.size());
     std::size_t b = 0;
     for (const auto& [id, members] : blocks) {
-      const ExodusCell& cell = kExodusCells[static_cast<std::size_t>(members.front().kind)];
-      check(ex_put_block(exo, EX_ELEM_BLOCK, id, cell.name, index_cast<int64_t>(members.size()),
+      const ExodusCell& cell = kExodusCells[static_cast<std::size_t>(members.kind)];
+      check(ex_put_block(exo, EX_ELEM_BLOCK, id, cell.name, index_cast<int64_t>(members.size),
                          cell.corners, 0, 0, 0),
             target, "writing block " + std::to_string(id));
       if (auto it = names.find(id); it != names.end()) block_names.set(b, it->second);
@@ -148,27 +150,45 @@ void write_exodus(const Model& model, const std::filesystem::path& path,
     }
     for (const auto& entry : blocks) {
       const int id = entry.first;  // named: a lambda below reads them
-      const std::vector<ElementRef>& members = entry.second;
-      const ExodusCell& cell = kExodusCells[static_cast<std::size_t>(members.front().kind)];
+      const BlockMembers& members = entry.second;
+      const ExodusCell& cell = kExodusCells[static_cast<std::size_t>(members.kind)];
       std::vector<int> conn;
       // exodus_corner[order[c]] = model_corner[c]
       auto put = [&](const auto& cells) {
         constexpr std::size_t kCorners = std::tuple_size_v<std::decay_t<decltype(cells[0])>>;
-        for (std::size_t first = 0; first < members.size(); first += kSlice) {
-          const std::size_t n = std::min(kSlice, members.size() - first);
-          conn.resize(n * kCorners);
-          for (std::size_t i = 0; i < n; ++i) {
-            const auto& corners = cells[index_cast<std::size_t>(members[first + i].index)];
-            int* out = conn.data() + i * kCorners;
-            for (std::size_t c = 0; c < kCorners; ++c) out[cell.order[c]] = corners[c] + 1;
-          }
-          check(ex_put_partial_elem_conn(exo, id, index_cast<int64_t>(first + 1),
+        conn.resize(std::min(kSlice, members.size) * kCorners);
+        std::size_t written = 0, n = 0;  // elements written, and in conn
+        const auto flush = [&] {
+          check(ex_put_partial_elem_conn(exo, id, index_cast<int64_t>(written + 1),
                                          index_cast<int64_t>(n), conn.data()),
                 target, "writing block " + std::to_string(id) + " connectivity");
-        }
+          written += n, n = 0;
+        };
+        for (const auto& [first, count] : members.runs)
+          for (std::size_t e = first; e < first + count; ++e) {
+            const auto& corners = cells[e];
+            int* out = conn.data() + n * kCorners;
+            for (std::size_t c = 0; c < kCorners; ++c) out[cell.order[c]] = corners[c] + 1;
+            if (++n == kSlice) flush();
+          }
+        if (n > 0) flush();
       };
-      with_cells(model, members.front().kind, put);
+      with_cells(model, members.kind, put);
     }
+    // A side's element by its 1-based file number: blocks in ascending id, each its runs in
+    // order.
+    std::map<std::pair<ElementKind, std::size_t>, std::size_t> run_start;  // (kind, first) -> no.
+    if (!model.side_sets.empty()) {
+      std::size_t next = 1;
+      for (const auto& [id, members] : blocks)
+        for (const auto& [first, count] : members.runs)
+          run_start[{members.kind, first}] = next, next += count;
+    }
+    const auto file_number = [&](const ElementRef& e) {
+      const auto at = static_cast<std::size_t>(e.index);
+      const auto it = std::prev(run_start.upper_bound({e.kind, at}));
+      return index_cast<int>(it->second + (at - it->first.second));
+    };
     for (const NodeSet& set : model.node_sets) {
       std::vector<int> nodes;
       for (Index v : set.nodes) nodes.push_back(v + 1);
@@ -179,8 +199,7 @@ void write_exodus(const Model& model, const std::filesystem::path& path,
     for (const SideSet& set : model.side_sets) {
       std::vector<int> elems, sides;
       for (const Side& side : set.sides) {
-        elems.push_back(global[static_cast<std::size_t>(side.element.kind)]
-                              [index_cast<std::size_t>(side.element.index)]);
+        elems.push_back(file_number(side.element));
         sides.push_back(side.face + 1);
       }
       if (!elems.empty())

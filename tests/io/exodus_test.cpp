@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -173,6 +174,40 @@ TEST_CASE("read_exodus rejects bad input naming the file, element and reason") {
     CHECK(what.find(file.string()) != std::string::npos);
     CHECK(what.find("element 1: corner 3 refers to node 99") != std::string::npos);
   }
+}
+
+TEST_CASE("write_exodus numbers a block's elements in runs: sides name the file's numbers") {
+  // Tets two by two between blocks 2 and 3: each block is three runs of two tets. The file
+  // numbers its elements block by block (ascending id), each block in model order: hexes 1-2
+  // (block 1), tets 0, 1, 4, 5, 8, 9 as 3-8 (block 2), tets 2, 3, 6, 7, 10, 11 as 9-14 (block 3).
+  Model m = sample_model();
+  for (std::size_t t = 0; t < m.tets.size(); ++t) m.tet_block[t] = t / 2 % 2 ? 3 : 2;
+  m.side_sets[0].sides = {{{ElementKind::kTet, 5}, 3},  {{ElementKind::kTet, 4}, 0},
+                          {{ElementKind::kHex, 1}, 5},  {{ElementKind::kTet, 11}, 1},
+                          {{ElementKind::kTet, 3}, 2}};
+  const fs::path file = scratch_dir() / "runs.exo";
+  write_exodus(m, file);
+  int cpu = 8, io = 0;
+  float version = 0;
+  const int exo = ex_open(file.string().c_str(), EX_READ, &cpu, &io, &version);
+  REQUIRE(exo >= 0);
+  std::vector<int> elems(5), sides(5);
+  REQUIRE(ex_get_set(exo, EX_SIDE_SET, 21, elems.data(), sides.data()) >= 0);
+  CHECK(elems == std::vector<int>{6, 5, 2, 14, 10});
+  // Block 3's connectivity: tets 2, 3, 6, 7, 10, 11 in order (the same corners, as the file
+  // orders them: compared as sets).
+  std::vector<int> conn(6 * 4);
+  REQUIRE(ex_get_conn(exo, EX_ELEM_BLOCK, 3, conn.data(), nullptr, nullptr) >= 0);
+  for (std::size_t k = 0; k < 6; ++k) {
+    std::multiset<int> file_corners(conn.begin() + static_cast<std::ptrdiff_t>(4 * k),
+                                    conn.begin() + static_cast<std::ptrdiff_t>(4 * k + 4));
+    std::multiset<int> model_corners;
+    for (Index v : m.tets[k / 2 * 4 + 2 + k % 2]) model_corners.insert(v + 1);
+    CHECK(file_corners == model_corners);
+  }
+  ex_close(exo);
+  const Model back = read_exodus(file);
+  CHECK(back.tet_block == std::vector<int>{2, 2, 2, 2, 2, 2, 3, 3, 3, 3, 3, 3});
 }
 
 TEST_CASE("write_exodus writes a block of two kinds as one block per kind") {
