@@ -44,22 +44,20 @@ std::filesystem::path rank_file(const std::filesystem::path& output, int ranks, 
 
 void write_nemesis(const RankMesh& mesh, const std::filesystem::path& output, int ranks, int rank) {
   const std::filesystem::path path = rank_file(output, ranks, rank);
-  const auto nodes = one_based(mesh.node_gid, path);
-  const auto hexes = one_based(mesh.hex_gid, path);
   // Load balance: internal / border nodes and elements (1-based local numbers).
   std::vector<char> border(mesh.model.points.size(), 0);
   for (const auto& [q, shared] : mesh.shared_nodes)
     for (Index v : shared) border[primal::index_cast<std::size_t>(v)] = 1;
-  std::vector<int> node_int, node_bor, elem_int, elem_bor;
-  for (std::size_t v = 0; v < border.size(); ++v)
-    (border[v] ? node_bor : node_int).push_back(static_cast<int>(v + 1));
-  for (std::size_t h = 0; h < mesh.model.hexes.size(); ++h) {
-    bool on = false;
-    for (Index v : mesh.model.hexes[h]) on = on || border[primal::index_cast<std::size_t>(v)];
-    (on ? elem_bor : elem_int).push_back(static_cast<int>(h + 1));
-  }
+  std::size_t border_nodes = 0, border_hexes = 0;
+  for (char b : border) border_nodes += b != 0;
+  for (const auto& hex : mesh.model.hexes)
+    border_hexes += std::any_of(hex.begin(), hex.end(),
+                                [&](Index v) { return border[primal::index_cast<std::size_t>(v)]; });
+  const std::size_t internal_nodes = border.size() - border_nodes,
+                    internal_hexes = mesh.model.hexes.size() - border_hexes;
   // Nemesis's definitions made with the model's, before any bulk data (io/exodus.hpp): made on
-  // the finished file they had netCDF move all of it.
+  // the finished file they had netCDF move all of it. Each map is made just before its write
+  // and freed after it, so that no two are held beside the model (a rank's peak was here).
   io::write_exodus(mesh.model, path, [&](int exo) {
     char type[] = "p";
     check(ex_put_init_info(exo, ranks, 1, type), path, "Nemesis init info");
@@ -88,10 +86,10 @@ void write_nemesis(const RankMesh& mesh, const std::filesystem::path& output, in
     if (!ids.empty())
       check(ex_put_ss_param_global(exo, ids.data(), counts.data(), zeros.data()), path,
             "global side sets");
-    check(ex_put_loadbal_param(exo, primal::index_cast<int64_t>(node_int.size()),
-                               primal::index_cast<int64_t>(node_bor.size()), 0,
-                               primal::index_cast<int64_t>(elem_int.size()),
-                               primal::index_cast<int64_t>(elem_bor.size()),
+    check(ex_put_loadbal_param(exo, primal::index_cast<int64_t>(internal_nodes),
+                               primal::index_cast<int64_t>(border_nodes), 0,
+                               primal::index_cast<int64_t>(internal_hexes),
+                               primal::index_cast<int64_t>(border_hexes),
                                primal::index_cast<int64_t>(mesh.shared_nodes.size()), 0, rank),
           path, "Nemesis load balance");
     if (!mesh.shared_nodes.empty()) {
@@ -102,12 +100,31 @@ void write_nemesis(const RankMesh& mesh, const std::filesystem::path& output, in
             path, "Nemesis communication map sizes");
     }
     // The number maps (defined by their first write), then the data of what is defined.
-    if (!nodes.empty()) check(ex_put_id_map(exo, EX_NODE_MAP, nodes.data()), path, "node map");
-    if (!hexes.empty()) check(ex_put_id_map(exo, EX_ELEM_MAP, hexes.data()), path, "element map");
-    check(ex_put_processor_node_maps(exo, node_int.data(), node_bor.data(), nullptr, rank), path,
-          "Nemesis node maps");
-    check(ex_put_processor_elem_maps(exo, elem_int.data(), elem_bor.data(), rank), path,
-          "Nemesis element maps");
+    if (!mesh.node_gid.empty())
+      check(ex_put_id_map(exo, EX_NODE_MAP, one_based(mesh.node_gid, path).data()), path,
+            "node map");
+    if (!mesh.hex_gid.empty())
+      check(ex_put_id_map(exo, EX_ELEM_MAP, one_based(mesh.hex_gid, path).data()), path,
+            "element map");
+    {
+      std::vector<int> internal, bordering;
+      internal.reserve(internal_nodes), bordering.reserve(border_nodes);
+      for (std::size_t v = 0; v < border.size(); ++v)
+        (border[v] ? bordering : internal).push_back(static_cast<int>(v + 1));
+      check(ex_put_processor_node_maps(exo, internal.data(), bordering.data(), nullptr, rank),
+            path, "Nemesis node maps");
+    }
+    {
+      std::vector<int> internal, bordering;
+      internal.reserve(internal_hexes), bordering.reserve(border_hexes);
+      for (std::size_t h = 0; h < mesh.model.hexes.size(); ++h) {
+        bool on = false;
+        for (Index v : mesh.model.hexes[h]) on = on || border[primal::index_cast<std::size_t>(v)];
+        (on ? bordering : internal).push_back(static_cast<int>(h + 1));
+      }
+      check(ex_put_processor_elem_maps(exo, internal.data(), bordering.data(), rank), path,
+            "Nemesis element maps");
+    }
     for (const auto& [q, shared] : mesh.shared_nodes) {
       std::vector<int> local, procs(shared.size(), q);
       for (Index v : shared) local.push_back(v + 1);
