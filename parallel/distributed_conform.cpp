@@ -104,6 +104,7 @@ class Distributor {
     stage("assembly", [&] { assemble(); });
     release();  // what only the stages before needed: the verification's room
     stage("verification", [&] { verify(); });
+    list_node_ids();
     return std::move(out_);
   }
 
@@ -135,9 +136,18 @@ class Distributor {
   void assemble();
   void break_for_test();
   void verify();
+  // The local nodes' global ids, whole (assembly lists those outside the rank's run).
+  void list_node_ids() {
+    auto& ids = out_.node_gid;
+    ids = std::move(low_ids_);
+    ids.reserve(ids.size() + primal::index_cast<std::size_t>(owned_) + high_ids_.size());
+    for (std::int64_t g = owned_first_; g < owned_first_ + owned_; ++g) ids.push_back(g);
+    ids.insert(ids.end(), high_ids_.begin(), high_ids_.end());
+    primal::release(high_ids_);
+  }
   void release() {
     own_ = {};
-    primal::release(level_, in_zone_, band_, part_, zone_node_, diced_gid_, diced_holders_,
+    primal::release(level_, in_zone_, band_, part_, zone_node_, diced_gid_, diced_shared_,
                     zone_holders_, tet_pyramid_);
     split_ = {}, zone_out_ = {};
   }
@@ -173,10 +183,16 @@ class Distributor {
   primal::DicingCheck dicing_;           // diced_ against the dicing tables (local verification)
   std::int64_t zone_nodes_ = 0;          // the zone's output nodes: global ids below this
   std::vector<std::int64_t> diced_gid_;  // per diced node
-  std::vector<Mask> diced_holders_;      // per diced node not in the zone: ranks holding it
+  // Per diced node that other ranks hold too (not the zone's), ascending: every rank holding it.
+  // Listed, not a mask per node: nearly all diced nodes are this rank's alone.
+  std::vector<std::pair<std::size_t, Mask>> diced_shared_;
   std::vector<Mask> zone_holders_;       // per zone output node
   std::int64_t diced_hex_first_ = 0;     // global id of this rank's first diced hex
   std::int64_t owned_first_ = 0, owned_ = 0;  // the global ids this rank numbered: a run
+  // The local nodes' global ids below and above that run, and how many of the first are the
+  // zone's.
+  std::vector<std::int64_t> low_ids_, high_ids_;
+  std::size_t zone_locals_ = 0;
   RankMesh out_;
 };
 
@@ -625,7 +641,7 @@ void Distributor::number() {
         uses[primal::index_cast<std::size_t>(v)] |= Mask{1} << part_[c];
   const std::size_t nd = diced_.points.size();
   diced_gid_.assign(nd, -1);
-  diced_holders_.assign(nd, Mask{1} << rank_);
+  diced_shared_.clear();
   // Origins in model numbers (own_.node ascends, so normalized keys stay sorted), made when
   // read: only the candidates' are read again (a copy of them all was 16 B a diced node at the
   // numbering's peak).
@@ -701,14 +717,30 @@ void Distributor::number() {
       while (j < n && (std::copy_n(theirs + 4 * j, 4, k.begin()), k < mine)) ++j;
       if (j < n && k == mine) {
         shared[primal::index_cast<std::size_t>(q)].push_back(i);
-        diced_holders_[i] |= Mask{1} << q;
+        diced_shared_.emplace_back(i, Mask{1} << q);
       }
     }
   }
-  // This rank's own diced nodes (not the zone's, lowest holder here) numbered in diced order.
-  std::int64_t owned = 0;
-  for (std::size_t i = 0; i < nd; ++i)
-    if (diced_gid_[i] < 0 && std::countr_zero(diced_holders_[i]) == rank_) ++owned;
+  std::sort(diced_shared_.begin(), diced_shared_.end());
+  std::size_t w = 0;  // one entry per node, with this rank's bit
+  for (const auto& [i, mask] : diced_shared_) {
+    if (w > 0 && diced_shared_[w - 1].first == i)
+      diced_shared_[w - 1].second |= mask;
+    else
+      diced_shared_[w++] = {i, mask | Mask{1} << rank_};
+  }
+  diced_shared_.resize(w);
+  const auto owner = [&](std::size_t i) {  // a shared node's lowest holder
+    return std::countr_zero(
+        std::lower_bound(diced_shared_.begin(), diced_shared_.end(), std::pair{i, Mask{0}})
+            ->second);
+  };
+  // This rank's own diced nodes (not the zone's, lowest holder here) numbered in diced order;
+  // those a lower rank numbers are marked, to take its ids below.
+  constexpr std::int64_t kTheirs = -2;
+  for (const auto& [i, mask] : diced_shared_)
+    if (std::countr_zero(mask) != rank_) diced_gid_[i] = kTheirs;
+  const std::int64_t owned = std::count(diced_gid_.begin(), diced_gid_.end(), -1);
   std::int64_t first = 0, total = 0;
   MPI_Exscan(&owned, &first, 1, MPI_INT64_T, MPI_SUM, comm_);
   if (rank_ == 0) first = 0;
@@ -716,14 +748,15 @@ void Distributor::number() {
   out_.global_nodes = zone_nodes + total;
   std::int64_t next = zone_nodes + first;
   owned_first_ = next, owned_ = owned;
-  for (std::size_t i = 0; i < nd; ++i)
-    if (diced_gid_[i] < 0 && std::countr_zero(diced_holders_[i]) == rank_) diced_gid_[i] = next++;
-  // The owners send the ids of the shared nodes, in the shared lists' order.
+  for (std::int64_t& g : diced_gid_)
+    if (g == -1) g = next++;
+  // The owners send the ids of the shared nodes (numbered here by now), in the shared lists'
+  // order.
   std::vector<std::int64_t> ids;
   for (int q = 0; q < size_; ++q) {
     std::size_t n = 0;
     for (std::size_t i : shared[primal::index_cast<std::size_t>(q)])
-      if (std::countr_zero(diced_holders_[i]) == rank_) ids.push_back(diced_gid_[i]), ++n;
+      if (diced_gid_[i] >= 0) ids.push_back(diced_gid_[i]), ++n;
     send_counts[primal::index_cast<std::size_t>(q)] = static_cast<int>(n);
   }
   MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm_);
@@ -735,7 +768,7 @@ void Distributor::number() {
   for (int q = 0; q < size_; ++q) {
     std::size_t j = primal::index_cast<std::size_t>(rd[primal::index_cast<std::size_t>(q)]);
     for (std::size_t i : shared[primal::index_cast<std::size_t>(q)])
-      if (std::countr_zero(diced_holders_[i]) == q) diced_gid_[i] = got[j++];
+      if (diced_gid_[i] == kTheirs && owner(i) == q) diced_gid_[i] = got[j++];
   }
   // Zone nodes: held by the ranks owning a zone hex on them or a diced node at them.
   zone_holders_.assign(primal::index_cast<std::size_t>(zone_nodes), 0);
@@ -782,26 +815,39 @@ void Distributor::assemble() {
   const auto extra =
       primal::index_cast<std::size_t>(std::count(zone_only.begin(), zone_only.end(), 1));
   diced_.points.reserve(nd + extra);
-  std::vector<std::int64_t> gids;
-  gids.reserve(nd + extra);
-  gids = diced_gid_;
+  // The local nodes, ascending global id: those below the run this rank numbered (the zone's
+  // and lower ranks'), the run, those above it (higher ranks'). Only those outside the run are
+  // listed here; the whole list waits for list_node_ids, past assembly's and verification's
+  // peak.
+  const std::int64_t run_end = owned_first_ + owned_;
+  for (std::int64_t g : diced_gid_)
+    if (g < owned_first_)
+      low_ids_.push_back(g);
+    else if (g >= run_end)
+      high_ids_.push_back(g);
   for (std::size_t v = 0; v < zone_only.size(); ++v)
-    if (zone_only[v]) gids.push_back(primal::index_cast<std::int64_t>(v));
+    if (zone_only[v]) low_ids_.push_back(primal::index_cast<std::int64_t>(v));
   primal::release(zone_only);
-  std::sort(gids.begin(), gids.end());
-  gids.erase(std::unique(gids.begin(), gids.end()), gids.end());
-  // A global id's local number: the zone's through a table, the run this rank numbered by
-  // offset (no other id falls within it), the few others by search.
+  for (auto* ids : {&low_ids_, &high_ids_}) {
+    std::sort(ids->begin(), ids->end());
+    ids->erase(std::unique(ids->begin(), ids->end()), ids->end());
+  }
+  const std::vector<std::int64_t>&low = low_ids_, &high = high_ids_;
+  zone_locals_ = primal::index_cast<std::size_t>(
+      std::lower_bound(low.begin(), low.end(), zone_nodes) - low.begin());
+  const std::size_t nl = low.size() + primal::index_cast<std::size_t>(owned_) + high.size();
+  // A global id's local number: the zone's through a table, the run by offset, the few others
+  // by search.
   std::vector<Index> zone_local(primal::index_cast<std::size_t>(zone_nodes), kInvalidIndex);
-  for (std::size_t l = 0; l < gids.size() && gids[l] < zone_nodes; ++l)
-    zone_local[primal::index_cast<std::size_t>(gids[l])] = primal::index_cast(l);
-  const std::int64_t owned_at =
-      std::lower_bound(gids.begin(), gids.end(), owned_first_) - gids.begin();
+  for (std::size_t l = 0; l < zone_locals_; ++l)
+    zone_local[primal::index_cast<std::size_t>(low[l])] = primal::index_cast(l);
   const auto local = [&](std::int64_t g) {
     if (g < zone_nodes) return zone_local[primal::index_cast<std::size_t>(g)];
-    if (g >= owned_first_ && g < owned_first_ + owned_)
-      return primal::index_cast(owned_at + (g - owned_first_));
-    return primal::index_cast(std::lower_bound(gids.begin(), gids.end(), g) - gids.begin());
+    if (g < owned_first_)
+      return primal::index_cast(std::lower_bound(low.begin(), low.end(), g) - low.begin());
+    if (g < run_end) return primal::index_cast(low.size() + (g - owned_first_));
+    return primal::index_cast(low.size() + owned_ +
+                              (std::lower_bound(high.begin(), high.end(), g) - high.begin()));
   };
   Model& o = out_.model;
   std::vector<Index> diced_local(nd);
@@ -810,7 +856,7 @@ void Distributor::assemble() {
   // The diced points become the output's, each moved to its local number along the cycles of
   // that map (one-to-one), so the points are never held twice; the zone's nodes come after.
   o.points = std::move(diced_.points);
-  o.points.resize(gids.size());
+  o.points.resize(nl);
   {
     std::vector<bool> moved(nd, false);
     for (std::size_t start = 0; start < nd; ++start) {
@@ -831,19 +877,28 @@ void Distributor::assemble() {
     }
   }
   if (!zone_out_.points.empty())  // the zone nodes no diced node took (the same bits where one did)
-    for (std::size_t l = 0; l < gids.size() && gids[l] < zone_nodes; ++l)
-      o.points[l] = zone_out_.points[primal::index_cast<std::size_t>(gids[l])];
-  // Shared nodes per neighbour, from the holders of each local node.
-  std::vector<Mask> holders(gids.size(), 0);
-  for (std::size_t i = 0; i < nd; ++i)
-    holders[primal::index_cast<std::size_t>(diced_local[i])] |= diced_holders_[i];
-  primal::release(diced_holders_);
-  for (std::size_t l = 0; l < gids.size(); ++l)
-    if (gids[l] < zone_nodes) holders[l] |= zone_holders_[primal::index_cast<std::size_t>(gids[l])];
-  for (std::size_t l = 0; l < gids.size(); ++l)
+    for (std::size_t l = 0; l < zone_locals_; ++l)
+      o.points[l] = zone_out_.points[primal::index_cast<std::size_t>(low[l])];
+  // Shared nodes per neighbour, from the holders of the local nodes other ranks hold too.
+  std::vector<std::pair<Index, Mask>> holders;
+  for (const auto& [i, mask] : diced_shared_) holders.emplace_back(diced_local[i], mask);
+  primal::release(diced_shared_);
+  for (std::size_t l = 0; l < zone_locals_; ++l)
+    if (const Mask mask = zone_holders_[primal::index_cast<std::size_t>(low[l])];
+        mask & ~(Mask{1} << rank_))
+      holders.emplace_back(primal::index_cast(l), mask);
+  std::sort(holders.begin(), holders.end());
+  std::size_t w = 0;  // one entry per node
+  for (const auto& [l, mask] : holders) {
+    if (w > 0 && holders[w - 1].first == l)
+      holders[w - 1].second |= mask;
+    else
+      holders[w++] = {l, mask};
+  }
+  holders.resize(w);
+  for (const auto& [l, mask] : holders)
     for (int q = 0; q < size_; ++q)
-      if (q != rank_ && (holders[l] >> q & 1))
-        out_.shared_nodes[q].push_back(primal::index_cast(l));
+      if (q != rank_ && (mask >> q & 1)) out_.shared_nodes[q].push_back(l);
   // Sets read the diced numbering: made before the children move, the origins freed after.
   const Model& om = own_.model;
   const std::size_t nh = diced_.hex_children.size(), nt = diced_.tet_children.size();
@@ -871,7 +926,24 @@ void Distributor::assemble() {
   for (int b : block) ++next[b];
   Index start = 0;
   for (auto& [b, n] : next) start += std::exchange(n, start);
-  std::vector<Index> position(total);
+  // The output positions of the hexes the side sets name (by their first order, ascending):
+  // those only, not a position per hex.
+  std::vector<std::size_t> sided;
+  for (const primal::SideSet& z : zone_out_.side_sets)
+    for (const primal::Side& side : z.sides)
+      if (const auto h = primal::index_cast<std::size_t>(side.element.index);
+          h >= zone_first_ && h < zone_last_)
+        sided.push_back(h - zone_first_);
+  for (const primal::SideSet& d : diced_sides)
+    for (const primal::Side& side : d.sides)
+      sided.push_back(first_diced + primal::index_cast<std::size_t>(side.element.index));
+  std::sort(sided.begin(), sided.end());
+  sided.erase(std::unique(sided.begin(), sided.end()), sided.end());
+  std::vector<Index> sided_at(sided.size());
+  const auto position = [&](std::size_t k) {
+    return sided_at[primal::index_cast<std::size_t>(
+        std::lower_bound(sided.begin(), sided.end(), k) - sided.begin())];
+  };
   // Where every tet child is in one block, their output positions are one run: the tet children
   // become the output's hex array, renumbered where they are, the other hexes put around them
   // in the room dicing left (as the serial path does), so the largest part is never copied.
@@ -894,10 +966,11 @@ void Distributor::assemble() {
   }
   o.hex_block.resize(total);
   out_.hex_gid.resize(total);
-  std::size_t k = 0;
+  std::size_t k = 0, sk = 0;  // in the first order; in sided
   auto place = [&](std::int64_t gid) {
     const Index at = next[block[k]]++;
-    position[k++] = at;
+    if (sk < sided.size() && sided[sk] == k) sided_at[sk++] = at;
+    ++k;
     const auto p = primal::index_cast<std::size_t>(at);
     o.hex_block[p] = block[k - 1];
     out_.hex_gid[p] = gid;
@@ -926,9 +999,10 @@ void Distributor::assemble() {
   for (std::size_t s = 0; s < zone_out_.node_sets.size(); ++s) {
     const primal::NodeSet& z = zone_out_.node_sets[s];
     primal::NodeSet ns{z.id, z.name, {}};
-    for (Index v : z.nodes) {
-      const auto it = std::lower_bound(gids.begin(), gids.end(), std::int64_t{v});
-      if (it != gids.end() && *it == v) ns.nodes.push_back(primal::index_cast(it - gids.begin()));
+    for (Index v : z.nodes) {  // zone nodes: in low's first zone_locals_
+      const auto end = low.begin() + static_cast<std::ptrdiff_t>(zone_locals_);
+      const auto it = std::lower_bound(low.begin(), end, std::int64_t{v});
+      if (it != end && *it == v) ns.nodes.push_back(primal::index_cast(it - low.begin()));
     }
     for (const primal::NodeSet& d : diced_nodes)
       if (d.id == z.id) ns.nodes.insert(ns.nodes.end(), d.nodes.begin(), d.nodes.end());
@@ -942,20 +1016,19 @@ void Distributor::assemble() {
     for (const primal::Side& side : z.sides) {
       const auto h = primal::index_cast<std::size_t>(side.element.index);
       if (h >= zone_first_ && h < zone_last_)
-        ss.sides.push_back({{ElementKind::kHex, position[h - zone_first_]}, side.face});
+        ss.sides.push_back({{ElementKind::kHex, position(h - zone_first_)}, side.face});
     }
     for (const primal::SideSet& d : diced_sides)
       if (d.id == z.id)
         for (const primal::Side& side : d.sides)
           ss.sides.push_back(
               {{ElementKind::kHex,
-                position[first_diced + primal::index_cast<std::size_t>(side.element.index)]},
+                position(first_diced + primal::index_cast<std::size_t>(side.element.index))},
                side.face});
     std::sort(ss.sides.begin(), ss.sides.end());
     o.side_sets.push_back(std::move(ss));
   }
   // The global counts.
-  out_.node_gid = std::move(gids);
   std::map<int, std::int64_t> blocks;
   for (int b : o.hex_block) ++blocks[b];
   std::vector<int> ids;
@@ -986,9 +1059,10 @@ void Distributor::assemble() {
   std::vector<std::int64_t> set_counts;
   for (const primal::NodeSet& ns : o.node_sets) {
     std::int64_t c = 0;
-    for (Index v : ns.nodes)
-      if (std::countr_zero(holders[primal::index_cast<std::size_t>(v)] | Mask{1} << rank_) == rank_)
-        ++c;
+    for (Index v : ns.nodes) {
+      const auto it = std::lower_bound(holders.begin(), holders.end(), std::pair{v, Mask{0}});
+      c += it == holders.end() || it->first != v || std::countr_zero(it->second) == rank_;
+    }
     set_counts.push_back(c);
   }
   out_.global_node_set_nodes.resize(set_counts.size());
@@ -1037,7 +1111,7 @@ void Distributor::verify() {
         for (Index n : mesh.hexes[h]) cut[primal::index_cast<std::size_t>(n)] = 1;
     for (const auto& [q, nodes] : out_.shared_nodes)
       for (Index n : nodes) cut[primal::index_cast<std::size_t>(n)] = 1;
-    for (std::size_t n = 0; n < cut.size(); ++n) cut[n] = cut[n] && out_.node_gid[n] < zone_nodes_;
+    std::fill(cut.begin() + static_cast<std::ptrdiff_t>(zone_locals_), cut.end(), 0);  // zone's
     std::vector<Index> seeds;
     for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
       for (Index n : mesh.hexes[h])
