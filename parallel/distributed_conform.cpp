@@ -853,28 +853,31 @@ void Distributor::assemble() {
   std::vector<Index> diced_local(nd);
   for (std::size_t i = 0; i < nd; ++i) diced_local[i] = local(diced_gid_[i]);
   primal::release(diced_gid_);
-  // The diced points become the output's, each moved to its local number along the cycles of
-  // that map (one-to-one), so the points are never held twice; the zone's nodes come after.
+  // The diced points become the output's in place. The run this rank numbered keeps the diced
+  // order (it was numbered in it), shifted by the nodes numbered elsewhere (the zone's, other
+  // ranks'): those few are set aside, then the run is moved from the last node back where the
+  // shift is forward and from the first on where it is backward (the shift only falls along
+  // the run), so that no point is overwritten before it moves and each is read once, in order.
   o.points = std::move(diced_.points);
   o.points.resize(nl);
   {
-    std::vector<bool> moved(nd, false);
-    for (std::size_t start = 0; start < nd; ++start) {
-      if (moved[start]) continue;
-      Point carry = o.points[start];
-      moved[start] = true;
-      for (std::size_t j = start;;) {
-        const auto d = primal::index_cast<std::size_t>(diced_local[j]);
-        if (d < nd && !moved[d]) {
-          std::swap(carry, o.points[d]);
-          moved[d] = true;
-          j = d;
-        } else {
-          o.points[d] = carry;
-          break;
-        }
-      }
-    }
+    const Index run_first = primal::index_cast(low.size()),
+                run_last = primal::index_cast(low.size() + owned_);
+    const auto in_run = [&](std::size_t i) {
+      return diced_local[i] >= run_first && diced_local[i] < run_last;
+    };
+    std::vector<std::pair<Index, Point>> aside;
+    std::size_t backward = nd;  // the first node of the run that moves backward
+    for (std::size_t i = 0; i < nd; ++i)
+      if (!in_run(i))
+        aside.emplace_back(diced_local[i], o.points[i]);
+      else if (backward == nd && primal::index_cast<std::size_t>(diced_local[i]) < i)
+        backward = i;
+    for (std::size_t i = backward; i-- > 0;)
+      if (in_run(i)) o.points[primal::index_cast<std::size_t>(diced_local[i])] = o.points[i];
+    for (std::size_t i = backward; i < nd; ++i)
+      if (in_run(i)) o.points[primal::index_cast<std::size_t>(diced_local[i])] = o.points[i];
+    for (const auto& [l, p] : aside) o.points[primal::index_cast<std::size_t>(l)] = p;
   }
   if (!zone_out_.points.empty())  // the zone nodes no diced node took (the same bits where one did)
     for (std::size_t l = 0; l < zone_locals_; ++l)
