@@ -16,6 +16,7 @@
 #include <utility>
 
 #include <geode/parallel/partition.hpp>
+#include <geode/primal/detail/byte_packet.hpp>
 #include <geode/primal/dice.hpp>
 #include <geode/primal/dice_model.hpp>
 #include <geode/primal/errors.hpp>
@@ -433,39 +434,6 @@ void Distributor::dice() {
     dicing_ = primal::check_dicing(own_.model, diced_);
 }
 
-// What the zone rank tells the others of the zone, but its points: bytes out and back.
-class Packet {
- public:
-  template <typename T>
-  void put(const T& x) {
-    static_assert(std::is_trivially_copyable_v<T>);
-    const auto* p = reinterpret_cast<const char*>(&x);
-    bytes_.insert(bytes_.end(), p, p + sizeof(T));
-  }
-  void put(const std::string& s) {
-    put(s.size());
-    bytes_.insert(bytes_.end(), s.begin(), s.end());
-  }
-  template <typename T>
-  T get() {
-    T x;
-    std::memcpy(&x, bytes_.data() + at_, sizeof(T));
-    at_ += sizeof(T);
-    return x;
-  }
-  std::string get_string() {
-    const auto n = get<std::size_t>();
-    std::string s(bytes_.data() + at_, n);
-    at_ += n;
-    return s;
-  }
-  std::vector<char>& bytes() { return bytes_; }
-
- private:
-  std::vector<char> bytes_;
-  std::size_t at_ = 0;
-};
-
 // MPI_Bcast of n values of `type` from `root`, in pieces an int can count.
 void broadcast(void* data, std::size_t n, MPI_Datatype type, std::size_t size, int root,
                MPI_Comm comm) {
@@ -479,7 +447,7 @@ void broadcast(void* data, std::size_t n, MPI_Datatype type, std::size_t size, i
 // diced nodes on the cut), block names and sets. A rank that diced a zone since grown dices again.
 void Distributor::share_zone() {
   const int root = zone_rank();
-  Packet packet;
+  primal::detail::BytePacket packet;
   if (rank_ == root) {
     packet.put(zone_failure_kind_);
     packet.put(zone_failure_);

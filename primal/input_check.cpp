@@ -8,7 +8,6 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <numbers>
 #include <optional>
 #include <span>
@@ -19,6 +18,7 @@
 #include <unordered_map>
 
 #include <geode/primal/boundary.hpp>
+#include <geode/primal/detail/byte_packet.hpp>
 #include <geode/primal/detail/lowest_node_sort.hpp>
 #include <geode/primal/disjoint_sets.hpp>
 #include <geode/primal/errors.hpp>
@@ -199,47 +199,29 @@ class InputChecker {
   // With options_.exchange: the findings from `from` on of every share, in share order (each
   // found them in its run of the nodes, in node order), in place of this share's.
   void share_findings(std::size_t from) {
-    std::vector<char> out;
+    detail::BytePacket out;
     put_findings(out, from);
-    const std::vector<char> all = options_.exchange(out);
+    detail::BytePacket all(options_.exchange(out.bytes()));
     result_.findings.resize(from);
-    std::size_t at = 0;
-    for (int s = 0; s < options_.shares; ++s) get_findings(all, at);
+    for (int s = 0; s < options_.shares; ++s) get_findings(all);
   }
-  template <typename T>
-  static void put(std::vector<char>& out, const T& x) {
-    static_assert(std::is_trivially_copyable_v<T>);
-    const auto* p = reinterpret_cast<const char*>(&x);
-    out.insert(out.end(), p, p + sizeof(x));
-  }
-  template <typename T>
-  static void get(const std::vector<char>& in, std::size_t& at, T& x) {
-    static_assert(std::is_trivially_copyable_v<T>);
-    if (at + sizeof(x) > in.size()) throw std::runtime_error("check_input: exchange too short");
-    std::memcpy(&x, in.data() + at, sizeof(x));
-    at += sizeof(x);
-  }
-  void put_findings(std::vector<char>& out, std::size_t from) const {
-    put(out, result_.findings.size() - from);
+  void put_findings(detail::BytePacket& out, std::size_t from) const {
+    out.put(result_.findings.size() - from);
     for (std::size_t k = from; k < result_.findings.size(); ++k) {
       const InputFinding& f = result_.findings[k];
-      put(out, f.fault), put(out, f.node), put(out, f.measure), put(out, f.edge_end);
-      for (int c = 0; c < 3; ++c) put(out, f.place[c]);
-      put(out, f.elements.size());
-      for (const ElementRef& e : f.elements) put(out, e);
+      out.put(f.fault), out.put(f.node), out.put(f.measure), out.put(f.edge_end);
+      for (int c = 0; c < 3; ++c) out.put(f.place[c]);
+      out.put(f.elements.size());
+      for (const ElementRef& e : f.elements) out.put(e);
     }
   }
-  void get_findings(const std::vector<char>& in, std::size_t& at) {
-    std::size_t n = 0;
-    get(in, at, n);
-    for (; n > 0; --n) {
+  void get_findings(detail::BytePacket& in) {
+    for (auto n = in.get<std::size_t>(); n > 0; --n) {
       InputFinding f;
-      std::size_t elements = 0;
-      get(in, at, f.fault), get(in, at, f.node), get(in, at, f.measure), get(in, at, f.edge_end);
-      for (int c = 0; c < 3; ++c) get(in, at, f.place[c]);
-      get(in, at, elements);
-      f.elements.resize(elements);
-      for (ElementRef& e : f.elements) get(in, at, e);
+      in.get(f.fault), in.get(f.node), in.get(f.measure), in.get(f.edge_end);
+      for (int c = 0; c < 3; ++c) in.get(f.place[c]);
+      f.elements.resize(in.get<std::size_t>());
+      for (ElementRef& e : f.elements) in.get(e);
       add(std::move(f));
     }
   }
@@ -247,20 +229,16 @@ class InputChecker {
   // With options_.exchange: the findings so far and the faces used once, of every share in
   // share order (their order in one process's pairing, whose uses are by lowest node).
   void share_pairing(std::vector<FaceUse>& single) {
-    std::vector<char> out;
+    detail::BytePacket out;
     put_findings(out, 0);
-    put(out, single.size());
-    out.insert(out.end(), reinterpret_cast<const char*>(single.data()),
-               reinterpret_cast<const char*>(single.data() + single.size()));
-    const std::vector<char> all = options_.exchange(out);
+    out.put(single.size());
+    for (const FaceUse& u : single) out.put(u);
+    detail::BytePacket all(options_.exchange(out.bytes()));
     result_.findings.clear();
     single.clear();
-    std::size_t at = 0;
     for (int s = 0; s < options_.shares; ++s) {
-      get_findings(all, at);
-      std::size_t n = 0;
-      get(all, at, n);
-      for (; n > 0; --n) single.emplace_back(), get(all, at, single.back());
+      get_findings(all);
+      for (auto n = all.get<std::size_t>(); n > 0; --n) single.push_back(all.get<FaceUse>());
     }
   }
 
