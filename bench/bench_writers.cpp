@@ -34,7 +34,7 @@ int main(int argc, char** argv) {
   std::printf("%zu nodes, %zu elements\n", model.points.size(), primal::element_count(model));
   fs::create_directories(dir);
   io::WriteOptions ascii;
-  ascii.vtu_encoding = io::VtuEncoding::kAscii;
+  ascii.vtk_encoding = io::VtkEncoding::kAscii;
   struct Writer {
     const char* name;
     std::function<void(const fs::path&)> write;

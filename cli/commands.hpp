@@ -67,7 +67,7 @@ struct TemplateOutput {
   std::string title;  // what follows the name in the appendix title, e.g. "box 24x14x24"
   std::string format = "appendix";  // resolved (cli/conventions.hpp: output_format)
   std::string output;
-  std::string vtu_encoding = "binary";
+  std::string vtk_encoding = "binary";
   bool smooth = true;
   bool slide = false;
   bool quality = false;

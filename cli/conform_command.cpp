@@ -32,7 +32,7 @@ struct ConformArgs {
   std::string input;
   std::string output;
   std::string format;
-  std::string vtu_encoding = "binary";
+  std::string vtk_encoding = "binary";
   std::string report;
   std::string smooth = "local";
   std::string quality = "sj";
@@ -203,7 +203,7 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
     OutputFiles files;
     if (!a.output.empty())
       files.add(a.output, [&](const fs::path& temp) {
-        io::write_model(r.model, temp, format, write_options(a.vtu_encoding));
+        io::write_model(r.model, temp, format, write_options(a.vtk_encoding));
       });
     if (!a.report.empty()) {
       files.add(a.report, [text = conform::report_json(r).dump(2) + "\n"](const fs::path& temp) {
@@ -238,8 +238,9 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
                 "mesh format, when it must be named (msh22 for Gmsh 2.2 in a .msh); one that\n"
                 "contradicts the extension of -o is refused")
       ->check(CLI::IsMember(mesh_format_names()));
-  c->add_option("--vtu-encoding", a.vtu_encoding,
-                "binary (base64, default) or ascii DataArrays in .vtu")
+  c->add_option("--vtk-encoding,--vtu-encoding", a.vtk_encoding,
+                "binary (default) or ascii values in VTK files: .vtu DataArrays (base64), "
+                "legacy .vtk data (BINARY, big-endian)")
       ->check(CLI::IsMember({"binary", "ascii"}))
       ->capture_default_str();
   c->add_option("--report", a.report,
@@ -421,7 +422,7 @@ void add_conform_commands(CLI::App& app) {
     if (!dargs->save_input.empty()) {
       OutputFiles files;
       files.add(dargs->save_input, [&](const fs::path& temp) {
-        io::write_model(model, temp, save_format, write_options(dargs->vtu_encoding));
+        io::write_model(model, temp, save_format, write_options(dargs->vtk_encoding));
       });
       files.commit();
       if (!dargs->quiet)

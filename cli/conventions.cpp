@@ -233,9 +233,9 @@ std::string hex_or_quad_input_help() {
 
 std::string quad_output_extensions() { return io::extension_list(io::FormatRole::kWriteQuads); }
 
-io::WriteOptions write_options(const std::string& vtu_encoding) {
+io::WriteOptions write_options(const std::string& vtk_encoding) {
   io::WriteOptions o;
-  o.vtu_encoding = vtu_encoding == "ascii" ? io::VtuEncoding::kAscii : io::VtuEncoding::kBinary;
+  o.vtk_encoding = vtk_encoding == "ascii" ? io::VtkEncoding::kAscii : io::VtkEncoding::kBinary;
   return o;
 }
 

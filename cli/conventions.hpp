@@ -86,8 +86,8 @@ std::string input_extensions_help();
 std::string hex_or_quad_input_help();
 // ".vtu or .vtk": where a planar quad mesh can be written.
 std::string quad_output_extensions();
-// --vtu-encoding's text (binary, ascii) as writer options.
-io::WriteOptions write_options(const std::string& vtu_encoding);
+// --vtk-encoding's text (binary, ascii) as writer options.
+io::WriteOptions write_options(const std::string& vtk_encoding);
 
 // ---- Validity before writing -----------------------------------------------------------------
 

@@ -88,16 +88,16 @@ const std::vector<MeshFormat>& table() {
        .read = [](const fs::path& p,
                   const primal::ReadOptions& o) { return model_from_vtk(read_vtu(p), o); },
        .write = [](const primal::Model& m, const fs::path& p,
-                   const WriteOptions& o) { write_vtu(p, m, {}, o.vtu_encoding); },
+                   const WriteOptions& o) { write_vtu(p, m, {}, o.vtk_encoding); },
        .write_quads = [](const primal::QuadMesh& m, const fs::path& p,
-                         const WriteOptions& o) { write_vtu(p, m, {}, o.vtu_encoding); },
+                         const WriteOptions& o) { write_vtu(p, m, {}, o.vtk_encoding); },
        .read_plain = read_vtk_plain,
        .index_base = 0,
        .carries = {Carried::kYes, Carried::kYes, Carried::kYes, Carried::kYes, Carried::kYes,
                    "hex, tet, pyramid, wedge; planar quad"},
        .read_variants = "ascii, binary (base64), appended (raw and base64), zlib-compressed, "
                         "UInt32 or UInt64 headers",
-       .written_as = "binary (base64; `--vtu-encoding ascii`); cell arrays `block`, `mat_id` (the "
+       .written_as = "binary (base64; `--vtk-encoding ascii`); cell arrays `block`, `mat_id` (the "
                      "block again, for Python solvers), `scaled_jacobian`, "
                      "block names and sets as field data `block:NAME`, `node_set:ID:NAME`, "
                      "`side_set:ID:NAME`"},
@@ -108,16 +108,17 @@ const std::vector<MeshFormat>& table() {
        .read = [](const fs::path& p,
                   const primal::ReadOptions& o) { return model_from_vtk(read_vtk(p), o); },
        .write = [](const primal::Model& m, const fs::path& p,
-                   const WriteOptions&) { write_vtk(p, m); },
+                   const WriteOptions& o) { write_vtk(p, m, {}, o.vtk_encoding); },
        .write_quads = [](const primal::QuadMesh& m, const fs::path& p,
-                         const WriteOptions&) { write_vtk(p, m); },
+                         const WriteOptions& o) { write_vtk(p, m, {}, o.vtk_encoding); },
        .read_plain = read_vtk_plain,
        .index_base = 0,
        .carries = {Carried::kYes, Carried::kYes, Carried::kYes, Carried::kYes, Carried::kYes,
                    "hex, tet, pyramid, wedge; planar quad"},
        .read_variants = "ASCII and BINARY, classic and 5.1 cell layouts",
-       .written_as = "4.2 ASCII; cell arrays `block`, `scaled_jacobian`; block names and sets as "
-                     "dataset field data, named as in .vtu"},
+       .written_as = "4.2 BINARY (`--vtk-encoding ascii`: ASCII); cell arrays `block`, "
+                     "`scaled_jacobian`; block names and sets as dataset field data, named as in "
+                     ".vtu"},
   };
   return formats;
 }

@@ -39,7 +39,7 @@ struct FormatCarries {
 
 // Options a writer may use; others ignore them.
 struct WriteOptions {
-  VtuEncoding vtu_encoding = VtuEncoding::kBinary;  // .vtu DataArrays
+  VtkEncoding vtk_encoding = VtkEncoding::kBinary;  // .vtu DataArrays, legacy .vtk data
 };
 
 // A hex or planar quad mesh as the file gives it, without the geometry checks of a Model's

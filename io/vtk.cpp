@@ -425,12 +425,12 @@ void append_base64(std::string& out, std::string_view bytes) {
 // One DataArray: ASCII rows of `per_line`, or (binary) base64 of a UInt64 byte count followed
 // by the little-endian values, the layout VTK writes for uncompressed inline binary data.
 template <typename Out, typename T>
-void write_data_array(std::ostream& os, VtuEncoding encoding, const char* type,
+void write_data_array(std::ostream& os, VtkEncoding encoding, const char* type,
                       const std::string& attributes, const Slices<T>& v, std::size_t per_line) {
   static_assert(std::endian::native == std::endian::little, "binary .vtu is written little-endian");
   os << "        <DataArray type=\"" << type << "\"" << attributes << " format=\""
-     << (encoding == VtuEncoding::kAscii ? "ascii" : "binary") << "\">\n";
-  if (encoding == VtuEncoding::kAscii) {
+     << (encoding == VtkEncoding::kAscii ? "ascii" : "binary") << "\">\n";
+  if (encoding == VtkEncoding::kAscii) {
     write_rows(os, v, per_line, "          ");
   } else {
     // The stream's bytes [begin, end) of each chunk: those of the values that overlap it, cut.
@@ -499,11 +499,11 @@ Slices<std::int64_t> types(const Cells& cells) {
           }};
 }
 
-void write_vtu_output(std::ostream& os, const Output& o, VtuEncoding encoding) {
+void write_vtu_output(std::ostream& os, const Output& o, VtkEncoding encoding) {
   const auto& pts = *o.points;
   os << "<?xml version=\"1.0\"?>\n"
      << "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\""
-     << (encoding == VtuEncoding::kAscii ? "" : " header_type=\"UInt64\"") << ">\n"
+     << (encoding == VtkEncoding::kAscii ? "" : " header_type=\"UInt64\"") << ">\n"
      << "  <UnstructuredGrid>\n";
   // Block names, which the cell array "block" cannot carry: one-value field arrays
   // "block:NAME" holding the block id (ParaView lists them under Field Data); node sets as
@@ -565,68 +565,130 @@ std::string legacy_name(const std::string& name) {
   return out;
 }
 
-void write_vtk_output(std::ostream& os, const Output& o) {
-  const auto& pts = *o.points;
+// Legacy VTK's binary values: each one's big-endian bytes (VTK's file-format manual, "Binary
+// Files").
+template <typename T>
+char* put_big_endian(char* at, T x) {
+  static_assert(std::is_trivially_copyable_v<T> && (sizeof(T) == 4 || sizeof(T) == 8));
+  using Bits = std::conditional_t<sizeof(T) == 4, std::uint32_t, std::uint64_t>;
+  Bits bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  for (int k = static_cast<int>(sizeof bits) - 1; k >= 0; --k)
+    *at++ = static_cast<char>(bits >> (8 * k));
+  return at;
+}
+
+// A legacy .vtk file's sections, ASCII or BINARY: the keyword lines are text either way; a
+// binary array's values follow the line that announces it, big-endian, and end with a newline.
+class LegacyWriter {
+ public:
+  LegacyWriter(std::ostream& os, VtkEncoding encoding)
+      : os_(os), binary_(encoding == VtkEncoding::kBinary) {}
+
+  void header() {
+    os_ << "# vtk DataFile Version 4.2\n"
+        << "geode mesh\n"
+        << (binary_ ? "BINARY\n" : "ASCII\n") << "DATASET UNSTRUCTURED_GRID\n";
+  }
+
+  // Values as `Wire` (std::int32_t for "int", double), `per_line` to a line in ASCII.
+  template <typename Wire, typename T>
+  void values(const Slices<T>& v, std::size_t per_line) {
+    if (!binary_) return write_rows(os_, v, per_line, "");
+    write_chunks(os_, v.size, kTextChunk,
+                 [&](std::size_t begin, std::size_t end, std::string& bytes) {
+                   std::vector<T> values(end - begin);
+                   v.fill(begin, end, values.data());
+                   bytes.resize((end - begin) * sizeof(Wire));
+                   char* at = bytes.data();
+                   for (const T& x : values) at = put_big_endian(at, static_cast<Wire>(x));
+                 });
+    os_ << '\n';
+  }
+
+  void points(const std::vector<Point>& pts) {
+    write_chunks(os_, pts.size(), binary_ ? kTextChunk : kTextChunk / 4,
+                 [&](std::size_t begin, std::size_t end, std::string& text) {
+                   text.resize((end - begin) * 3 * (binary_ ? sizeof(double) : kRealText + 1));
+                   char* at = text.data();
+                   for (std::size_t i = begin; i < end; ++i)
+                     for (int c = 0; c < 3; ++c) {
+                       if (binary_) {
+                         at = put_big_endian(at, pts[i][c]);
+                       } else {
+                         at = put_number(at, pts[i][c]);
+                         *at++ = c < 2 ? ' ' : '\n';
+                       }
+                     }
+                   text.resize(index_cast<std::size_t>(at - text.data()));
+                 });
+    if (binary_) os_ << '\n';
+  }
+
+  // The classic layout: per cell its corner count, then its corners.
+  void cells(const Cells& cells) {
+    write_chunks(
+        os_, cells.size, binary_ ? kTextChunk : kTextChunk / 8,
+        [&](std::size_t begin, std::size_t end, std::string& text) {
+          text.resize((end - begin) * 9 * (binary_ ? sizeof(std::int32_t) : kIntegerText + 1));
+          char* at = text.data();
+          cells.for_each(begin, end, [&](const CellRun& run, const auto& cell, std::size_t) {
+            for (std::size_t k = 0; k <= cell.size(); ++k) {  // the count, then the corners
+              const Index v = k == 0 ? index_cast(cell.size()) : vtk_corner(run, cell, k - 1);
+              if (binary_) {
+                at = put_big_endian(at, std::int32_t{v});
+              } else {
+                at = put_number(at, std::int64_t{v});
+                *at++ = k < cell.size() ? ' ' : '\n';
+              }
+            }
+          });
+          text.resize(index_cast<std::size_t>(at - text.data()));
+        });
+    if (binary_) os_ << '\n';
+  }
+
+ private:
+  std::ostream& os_;
+  bool binary_;
+};
+
+void write_vtk_output(std::ostream& os, const Output& o, VtkEncoding encoding) {
   const std::size_t ncells = o.cells.size;
-  os << "# vtk DataFile Version 4.2\n"
-     << "geode mesh\n"
-     << "ASCII\n"
-     << "DATASET UNSTRUCTURED_GRID\n";
+  LegacyWriter w(os, encoding);
+  w.header();
   // Block names and sets as in .vtu (write_vtu_output), as dataset field data; array names with
   // VTK's own escapes (%XX for white space, '%', '"' and non-ASCII bytes, as vtkDataWriter).
   const std::size_t fields = o.block_names.size() + o.node_sets.size() + o.side_sets.size();
   if (fields > 0) {
     os << "FIELD FieldData " << fields << '\n';
-    for (const auto& [id, name] : o.block_names)
-      os << legacy_name("block:" + name) << " 1 1 int\n" << id << '\n';
+    for (const auto& [id, name] : o.block_names) {
+      os << legacy_name("block:" + name) << " 1 1 int\n";
+      const std::vector<int> value{id};
+      w.values<std::int32_t>(slices_of<std::int64_t>(value), 12);
+    }
     for (const auto* sets : {&o.node_sets, &o.side_sets})
       for (const auto& [name, values] : *sets) {
         const bool sides = sets == &o.side_sets;
         os << legacy_name((sides ? "side_set:" : "node_set:") + name) << ' ' << (sides ? 2 : 1)
            << ' ' << values.size() / (sides ? 2 : 1) << " int\n";
-        write_values(os, values, 12, "", [](Index v) { return v; });
+        w.values<std::int32_t>(slices_of<std::int64_t>(values), 12);
       }
   }
-  os << "POINTS " << pts.size() << " double\n";
-  write_chunks(os, pts.size(), kTextChunk / 4,
-               [&](std::size_t begin, std::size_t end, std::string& text) {
-                 text.resize((end - begin) * 3 * (kRealText + 1));
-                 char* at = text.data();
-                 for (std::size_t i = begin; i < end; ++i) {
-                   at = put_number(at, pts[i].x());
-                   *at++ = ' ';
-                   at = put_number(at, pts[i].y());
-                   *at++ = ' ';
-                   at = put_number(at, pts[i].z());
-                   *at++ = '\n';
-                 }
-                 text.resize(index_cast<std::size_t>(at - text.data()));
-               });
+  os << "POINTS " << o.points->size() << " double\n";
+  w.points(*o.points);
   os << "CELLS " << ncells << ' ' << ncells + o.cells.corners << '\n';
-  write_chunks(
-      os, ncells, kTextChunk / 8, [&](std::size_t begin, std::size_t end, std::string& text) {
-        text.resize((end - begin) * 9 * (kIntegerText + 1));  // count, <= 8 corners
-        char* at = text.data();
-        o.cells.for_each(begin, end, [&](const CellRun& run, const auto& cell, std::size_t) {
-          at = put_number(at, index_cast<std::int64_t>(cell.size()));
-          for (std::size_t k = 0; k < cell.size(); ++k) {
-            *at++ = ' ';
-            at = put_number(at, std::int64_t{vtk_corner(run, cell, k)});
-          }
-          *at++ = '\n';
-        });
-        text.resize(index_cast<std::size_t>(at - text.data()));
-      });
+  w.cells(o.cells);
   os << "CELL_TYPES " << ncells << '\n';
-  write_rows(os, types(o.cells), 1, "");
+  w.values<std::int32_t>(types(o.cells), 1);
   os << "CELL_DATA " << ncells << '\n';
   for (const auto& [name, v] : o.doubles) {
     os << "SCALARS " << name << " double 1\nLOOKUP_TABLE default\n";
-    write_rows(os, v, 6, "");
+    w.values<double>(v, 6);
   }
   for (const auto& [name, v] : o.ints) {
     os << "SCALARS " << name << " int 1\nLOOKUP_TABLE default\n";
-    write_rows(os, v, 10, "");
+    w.values<std::int32_t>(v, 10);
   }
 }
 
@@ -634,17 +696,18 @@ void write_vtk_output(std::ostream& os, const Output& o) {
 
 // ---- Writers ----------------------------------------------------------------------------------
 
-#define GEODE_VTK_WRITERS(Mesh)                                                                   \
-  void write_vtu(const std::filesystem::path& path, const Mesh& mesh, const VtkCellData& extra,   \
-                 VtuEncoding encoding) {                                                          \
-    Output out;                                                                                   \
-    describe(out, path, mesh, extra);                                                             \
-    write_file_atomically(path, [&](std::ostream& os) { write_vtu_output(os, out, encoding); });  \
-  }                                                                                               \
-  void write_vtk(const std::filesystem::path& path, const Mesh& mesh, const VtkCellData& extra) { \
-    Output out;                                                                                   \
-    describe(out, path, mesh, extra);                                                             \
-    write_file_atomically(path, [&](std::ostream& os) { write_vtk_output(os, out); });            \
+#define GEODE_VTK_WRITERS(Mesh)                                                                  \
+  void write_vtu(const std::filesystem::path& path, const Mesh& mesh, const VtkCellData& extra,  \
+                 VtkEncoding encoding) {                                                         \
+    Output out;                                                                                  \
+    describe(out, path, mesh, extra);                                                            \
+    write_file_atomically(path, [&](std::ostream& os) { write_vtu_output(os, out, encoding); }); \
+  }                                                                                              \
+  void write_vtk(const std::filesystem::path& path, const Mesh& mesh, const VtkCellData& extra,  \
+                 VtkEncoding encoding) {                                                         \
+    Output out;                                                                                  \
+    describe(out, path, mesh, extra);                                                            \
+    write_file_atomically(path, [&](std::ostream& os) { write_vtk_output(os, out, encoding); }); \
   }
 GEODE_VTK_WRITERS(HexMesh)
 GEODE_VTK_WRITERS(TetMesh)

@@ -39,10 +39,12 @@ struct VtkCellData {
   const std::vector<int>* find_int(const std::string& name) const;
 };
 
-// How a .vtu stores its DataArrays: ASCII text, or "binary" (base64 of a UInt64 byte count and
-// the little-endian values; header_type="UInt64"), which ParaView, VTK and meshio read: exact
-// doubles without printing and parsing them as text.
-enum class VtuEncoding { kAscii, kBinary };
+// How a VTK file stores its values: ASCII text, or binary, which ParaView, VTK and meshio read:
+// exact doubles without printing and parsing them as text. In .vtu, "binary" DataArrays (base64
+// of a UInt64 byte count and the little-endian values; header_type="UInt64"); in legacy .vtk,
+// a BINARY file (each array's big-endian values after the line announcing it, as VTK's file
+// format manual lays them out).
+enum class VtkEncoding { kAscii, kBinary };
 
 // Throw geode::InvalidInput (naming the file and the array, or the node or element by its
 // 1-based number) for an array of the wrong length, a bad or repeated name, a node number out of
@@ -53,21 +55,21 @@ enum class VtuEncoding { kAscii, kBinary };
 // "side_set:ID:NAME" (2 components: cell index, face number of primal/topology.hpp, which is
 // Exodus's side order from 0), which model_from_vtk reads back.
 void write_vtu(const std::filesystem::path& path, const primal::HexMesh& mesh,
-               const VtkCellData& extra = {}, VtuEncoding encoding = VtuEncoding::kAscii);
+               const VtkCellData& extra = {}, VtkEncoding encoding = VtkEncoding::kAscii);
 void write_vtu(const std::filesystem::path& path, const primal::TetMesh& mesh,
-               const VtkCellData& extra = {}, VtuEncoding encoding = VtuEncoding::kAscii);
+               const VtkCellData& extra = {}, VtkEncoding encoding = VtkEncoding::kAscii);
 void write_vtu(const std::filesystem::path& path, const primal::QuadMesh& mesh,
-               const VtkCellData& extra = {}, VtuEncoding encoding = VtuEncoding::kAscii);
+               const VtkCellData& extra = {}, VtkEncoding encoding = VtkEncoding::kAscii);
 void write_vtu(const std::filesystem::path& path, const primal::Model& model,
-               const VtkCellData& extra = {}, VtuEncoding encoding = VtuEncoding::kAscii);
+               const VtkCellData& extra = {}, VtkEncoding encoding = VtkEncoding::kAscii);
 void write_vtk(const std::filesystem::path& path, const primal::HexMesh& mesh,
-               const VtkCellData& extra = {});
+               const VtkCellData& extra = {}, VtkEncoding encoding = VtkEncoding::kAscii);
 void write_vtk(const std::filesystem::path& path, const primal::TetMesh& mesh,
-               const VtkCellData& extra = {});
+               const VtkCellData& extra = {}, VtkEncoding encoding = VtkEncoding::kAscii);
 void write_vtk(const std::filesystem::path& path, const primal::QuadMesh& mesh,
-               const VtkCellData& extra = {});
+               const VtkCellData& extra = {}, VtkEncoding encoding = VtkEncoding::kAscii);
 void write_vtk(const std::filesystem::path& path, const primal::Model& model,
-               const VtkCellData& extra = {});
+               const VtkCellData& extra = {}, VtkEncoding encoding = VtkEncoding::kAscii);
 
 // An unstructured grid as read: points, cells (VTK corner order) and cell arrays.
 struct VtkGrid {

@@ -79,36 +79,42 @@ VtkCellData extra_arrays(std::size_t n) {
   return d;
 }
 
-// Writes then reads `mesh` in both formats and checks everything came back bit for bit.
+// Writes then reads `mesh` in both formats, ASCII and binary, and checks everything came back
+// bit for bit.
 template <typename Mesh, typename Cells, typename ToMesh>
 void check_round_trip(const Mesh& mesh, const Cells& cells, int type,
                       const std::vector<double>& scaled_jacobian, ToMesh&& to_mesh) {
   TempDir dir;
-  for (const char* ext : {".vtu", ".vtk"}) {
-    CAPTURE(ext);
-    const fs::path file = dir.path / (std::string("mesh") + ext);
-    const VtkCellData extra = extra_arrays(cells.size());
-    if (std::string(ext) == ".vtu")
-      write_vtu(file, mesh, extra);
-    else
-      write_vtk(file, mesh, extra);
-    const VtkGrid g = read_vtk_file(file);
-    CHECK(g.points == mesh.points);  // shortest round-trip decimal: exact
-    REQUIRE(g.cells.size() == cells.size());
-    for (std::size_t c = 0; c < cells.size(); ++c) {
-      CHECK(g.cell_types[c] == type);
-      CHECK(std::equal(g.cells[c].begin(), g.cells[c].end(), cells[c].begin(), cells[c].end()));
+  for (const char* ext : {".vtu", ".vtk"})
+    for (const VtkEncoding encoding : {VtkEncoding::kAscii, VtkEncoding::kBinary}) {
+      const bool binary = encoding == VtkEncoding::kBinary;
+      CAPTURE(ext);
+      CAPTURE(binary);
+      const fs::path file = dir.path / (std::string(binary ? "binary" : "ascii") + ext);
+      const VtkCellData extra = extra_arrays(cells.size());
+      if (std::string(ext) == ".vtu")
+        write_vtu(file, mesh, extra, encoding);
+      else
+        write_vtk(file, mesh, extra, encoding);
+      if (std::string(ext) == ".vtk")  // the header says which
+        CHECK(slurp(file).find(binary ? "\nBINARY\n" : "\nASCII\n") != std::string::npos);
+      const VtkGrid g = read_vtk_file(file);
+      CHECK(g.points == mesh.points);  // shortest round-trip decimal: exact
+      REQUIRE(g.cells.size() == cells.size());
+      for (std::size_t c = 0; c < cells.size(); ++c) {
+        CHECK(g.cell_types[c] == type);
+        CHECK(std::equal(g.cells[c].begin(), g.cells[c].end(), cells[c].begin(), cells[c].end()));
+      }
+      REQUIRE(g.cell_data.find_double("scaled_jacobian"));
+      CHECK(*g.cell_data.find_double("scaled_jacobian") == scaled_jacobian);
+      REQUIRE(g.cell_data.find_double("one_third"));
+      CHECK(*g.cell_data.find_double("one_third") == extra.doubles[0].second);
+      REQUIRE(g.cell_data.find_int("tag"));
+      CHECK(*g.cell_data.find_int("tag") == extra.ints[0].second);
+      const Mesh back = to_mesh(g);
+      CHECK(back.points == mesh.points);
+      if constexpr (requires { mesh.block; }) CHECK(back.block == mesh.block);
     }
-    REQUIRE(g.cell_data.find_double("scaled_jacobian"));
-    CHECK(*g.cell_data.find_double("scaled_jacobian") == scaled_jacobian);
-    REQUIRE(g.cell_data.find_double("one_third"));
-    CHECK(*g.cell_data.find_double("one_third") == extra.doubles[0].second);
-    REQUIRE(g.cell_data.find_int("tag"));
-    CHECK(*g.cell_data.find_int("tag") == extra.ints[0].second);
-    const Mesh back = to_mesh(g);
-    CHECK(back.points == mesh.points);
-    if constexpr (requires { mesh.block; }) CHECK(back.block == mesh.block);
-  }
 }
 
 }  // namespace
@@ -366,12 +372,16 @@ TEST_CASE("io_vtk: VTK's own readers (ParaView's) open what we write") {
   const HexMesh hexes = dice(test_hexes()).mesh;
   write_vtu(dir.path / "hex.vtu", hexes);
   write_vtk(dir.path / "hex.vtk", hexes);
+  write_vtk(dir.path / "hex-binary.vtk", hexes, {}, VtkEncoding::kBinary);
   check(dir.path / "hex.vtu", hexes.hexes.size());
   check(dir.path / "hex.vtk", hexes.hexes.size());
+  check(dir.path / "hex-binary.vtk", hexes.hexes.size());
   write_vtu(dir.path / "tet.vtu", test_tets());
   check(dir.path / "tet.vtu", 2);
   write_vtu(dir.path / "quad.vtu", test_quads());
   write_vtk(dir.path / "quad.vtk", test_quads());
+  write_vtk(dir.path / "quad-binary.vtk", test_quads(), {}, VtkEncoding::kBinary);
   check(dir.path / "quad.vtu", 2);
   check(dir.path / "quad.vtk", 2);
+  check(dir.path / "quad-binary.vtk", 2);
 }
