@@ -187,8 +187,8 @@ class Distributor {
   // Per diced node that other ranks hold too (not the zone's), ascending: every rank holding it.
   // Listed, not a mask per node: nearly all diced nodes are this rank's alone.
   std::vector<std::pair<std::size_t, Mask>> diced_shared_;
-  std::vector<Mask> zone_holders_;       // per zone output node
-  std::int64_t diced_hex_first_ = 0;     // global id of this rank's first diced hex
+  std::vector<Mask> zone_holders_;            // per zone output node
+  std::int64_t diced_hex_first_ = 0;          // global id of this rank's first diced hex
   std::int64_t owned_first_ = 0, owned_ = 0;  // the global ids this rank numbered: a run
   // The local nodes' global ids below and above that run, and how many of the first are the
   // zone's.

@@ -51,8 +51,9 @@ void write_nemesis(const RankMesh& mesh, const std::filesystem::path& output, in
   std::size_t border_nodes = 0, border_hexes = 0;
   for (char b : border) border_nodes += b != 0;
   for (const auto& hex : mesh.model.hexes)
-    border_hexes += std::any_of(hex.begin(), hex.end(),
-                                [&](Index v) { return border[primal::index_cast<std::size_t>(v)]; });
+    border_hexes += std::any_of(hex.begin(), hex.end(), [&](Index v) {
+      return border[primal::index_cast<std::size_t>(v)];
+    });
   const std::size_t internal_nodes = border.size() - border_nodes,
                     internal_hexes = mesh.model.hexes.size() - border_hexes;
   // Nemesis's definitions made with the model's, before any bulk data (io/exodus.hpp): made on
@@ -111,8 +112,8 @@ void write_nemesis(const RankMesh& mesh, const std::filesystem::path& output, in
       internal.reserve(internal_nodes), bordering.reserve(border_nodes);
       for (std::size_t v = 0; v < border.size(); ++v)
         (border[v] ? bordering : internal).push_back(static_cast<int>(v + 1));
-      check(ex_put_processor_node_maps(exo, internal.data(), bordering.data(), nullptr, rank),
-            path, "Nemesis node maps");
+      check(ex_put_processor_node_maps(exo, internal.data(), bordering.data(), nullptr, rank), path,
+            "Nemesis node maps");
     }
     {
       std::vector<int> internal, bordering;

@@ -182,8 +182,10 @@ TEST_CASE("write_exodus numbers a block's elements in runs: sides name the file'
   // (block 1), tets 0, 1, 4, 5, 8, 9 as 3-8 (block 2), tets 2, 3, 6, 7, 10, 11 as 9-14 (block 3).
   Model m = sample_model();
   for (std::size_t t = 0; t < m.tets.size(); ++t) m.tet_block[t] = t / 2 % 2 ? 3 : 2;
-  m.side_sets[0].sides = {{{ElementKind::kTet, 5}, 3},  {{ElementKind::kTet, 4}, 0},
-                          {{ElementKind::kHex, 1}, 5},  {{ElementKind::kTet, 11}, 1},
+  m.side_sets[0].sides = {{{ElementKind::kTet, 5}, 3},
+                          {{ElementKind::kTet, 4}, 0},
+                          {{ElementKind::kHex, 1}, 5},
+                          {{ElementKind::kTet, 11}, 1},
                           {{ElementKind::kTet, 3}, 2}};
   const fs::path file = scratch_dir() / "runs.exo";
   write_exodus(m, file);
