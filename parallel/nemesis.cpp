@@ -58,7 +58,7 @@ void write_nemesis(const RankMesh& mesh, const std::filesystem::path& output, in
                     internal_hexes = mesh.model.hexes.size() - border_hexes;
   // Nemesis's definitions made with the model's, before any bulk data (io/exodus.hpp): made on
   // the finished file they had netCDF move all of it. Each map is made just before its write
-  // and freed after it, so that no two are held beside the model (a rank's peak was here).
+  // and freed after it, so that no two are held beside the model and the writer's buffers.
   io::write_exodus(mesh.model, path, [&](int exo) {
     char type[] = "p";
     check(ex_put_init_info(exo, ranks, 1, type), path, "Nemesis init info");
