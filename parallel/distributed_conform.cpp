@@ -169,6 +169,7 @@ class Distributor {
   std::vector<char> in_zone_, band_;   // per flat element: in the zone, in its outer two rings
   int rings_ = 0;                      // the depth in_zone_ was selected at
   MPI_Request partition_sent_ = MPI_REQUEST_NULL;  // rank 0's partition to the zone rank
+  std::string partition_failure_;                  // on rank 0, why METIS gave no partition
   // The zone conformed: the whole of it on the zone rank; elsewhere its points, sets (the side
   // sets without sides) and block names, the rest being the zone rank's alone.
   Model zone_out_;
@@ -404,17 +405,36 @@ void Distributor::partition() {
       po.weight[c] = in_zone_[c] ? 1 : children;
       (in_zone_[c] ? zone : diced) += children;
     }
+    // The zone rank's share of the diced weight: what its zone leaves of the mean load, at least
+    // 2 % of it, and never more than an even share (where the zone is nearly the whole model,
+    // that floor alone would ask for more than there is to dice: METIS refuses such shares).
     const double load = (diced + kZoneLoad * zone) / size_;
-    const double zone_share = std::max(load - kZoneLoad * zone, 0.02 * load) / diced;
+    const double zone_share =
+        diced > 0.0 ? std::min(std::max(load - kZoneLoad * zone, 0.02 * load) / diced, 1.0 / size_)
+                    : 1.0 / size_;
     po.share.assign(primal::index_cast<std::size_t>(size_), (1.0 - zone_share) / (size_ - 1));
     po.share.back() = zone_share;
-    part_ = partition_elements(m(), size_, po);
+    // A failure here is sent as a partition of -1s, so that no rank waits for one that will not
+    // come: every rank then throws.
+    try {
+      if (std::getenv("GEODE_TEST_FAIL_PARTITION"))  // tests/parallel/mpi_verify_test.sh
+        throw std::runtime_error("GEODE_TEST_FAIL_PARTITION is set");
+      part_ = partition_elements(m(), size_, po);
+    } catch (const std::exception& e) {
+      partition_failure_ = e.what();
+      part_.assign(cells(), -1);
+    }
     MPI_Isend(part_.data(), count, MPI_INT, zone_rank(), 0, comm_, &partition_sent_);
   }
   if (rank_ == zone_rank()) {
     MPI_Recv(part_.data(), count, MPI_INT, 0, 0, comm_, MPI_STATUS_IGNORE);
   } else {  // the ranks before it: from rank 0, without waiting for the zone rank
     MPI_Bcast(part_.data(), count, MPI_INT, 0, others_);
+  }
+  if (count > 0 && part_[0] < 0) {
+    if (partition_sent_ != MPI_REQUEST_NULL) MPI_Wait(&partition_sent_, MPI_STATUS_IGNORE);
+    throw std::runtime_error(rank_ == 0 ? "the partition failed: " + partition_failure_
+                                        : "the partition failed on rank 0");
   }
 }
 

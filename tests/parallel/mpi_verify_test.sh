@@ -4,7 +4,8 @@
 # full pass the same valid result; a dicing broken on purpose (the test hook
 # GEODE_TEST_BREAK_DICED_HEX, docs/cli.md) is found by both on 1 and 2 ranks: exit 4, the
 # failing check named, nothing written. A transition zone made invalid on the zone rank (the last;
-# GEODE_TEST_INVERT_OUTPUT_HEX in its conform) fails every rank count alike.
+# GEODE_TEST_INVERT_OUTPUT_HEX in its conform) fails every rank count alike; so does a partition
+# failing on rank 0 (GEODE_TEST_FAIL_PARTITION), without a rank left waiting.
 # usage: mpi_verify_test.sh GEODE GEODE_MPI MPIEXEC WORKDIR
 set -euo pipefail
 geode=$1 geode_mpi=$2 mpiexec=$3 dir=$4
@@ -38,5 +39,17 @@ for n in 1 2 3; do
   grep -q "the transition zone: hex mesh" err.txt
   grep -q "invalid result, nothing written" err.txt
   if ls zone"$n".exo* >/dev/null 2>&1; then echo "an invalid zone, $n ranks: wrote a file"; exit 1; fi
+done
+# METIS failing on rank 0 (GEODE_TEST_FAIL_PARTITION) while the zone rank waits for its partition:
+# every rank stops with the reason, none waits (timeout: a wait would hang the suite).
+for n in 2 3; do
+  status=0
+  GEODE_TEST_FAIL_PARTITION=1 timeout 120 "$mpiexec" --oversubscribe -x GEODE_TEST_FAIL_PARTITION \
+    -np "$n" "$geode_mpi" conform in.exo -o "fail$n.exo" -q 2>err.txt >/dev/null || status=$?
+  if [ "$status" = 0 ] || [ "$status" = 124 ]; then
+    echo "a failed partition, $n ranks: exited $status"; cat err.txt; exit 1
+  fi
+  grep -q "the partition failed: GEODE_TEST_FAIL_PARTITION is set" err.txt
+  if ls fail"$n".exo* >/dev/null 2>&1; then echo "a failed partition, $n ranks: wrote a file"; exit 1; fi
 done
 echo "mpi_verify_test: both modes pass the result and find the broken dicing on 1 and 2 ranks, an invalid zone on 1 to 3"
