@@ -58,6 +58,20 @@ PointBits bits(const Point& p) {
 }
 
 // conform_distributed's stages, in the order run() calls them.
+// (node, holders) entries sorted by node, each node once with its holders joined.
+template <typename Node>
+void join_holders(std::vector<std::pair<Node, Mask>>& entries) {
+  std::sort(entries.begin(), entries.end());
+  std::size_t w = 0;
+  for (std::size_t k = 0; k < entries.size(); ++k) {
+    if (w > 0 && entries[w - 1].first == entries[k].first)
+      entries[w - 1].second |= entries[k].second;
+    else
+      entries[w++] = entries[k];
+  }
+  entries.resize(w);
+}
+
 class Distributor {
  public:
   Distributor(const Model& input, const DistributedOptions& options, MPI_Comm comm,
@@ -709,15 +723,8 @@ void Distributor::number() {
       }
     }
   }
-  std::sort(diced_shared_.begin(), diced_shared_.end());
-  std::size_t w = 0;  // one entry per node, with this rank's bit
-  for (const auto& [i, mask] : diced_shared_) {
-    if (w > 0 && diced_shared_[w - 1].first == i)
-      diced_shared_[w - 1].second |= mask;
-    else
-      diced_shared_[w++] = {i, mask | Mask{1} << rank_};
-  }
-  diced_shared_.resize(w);
+  join_holders(diced_shared_);
+  for (auto& [i, mask] : diced_shared_) mask |= Mask{1} << rank_;
   const auto owner = [&](std::size_t i) {  // a shared node's lowest holder
     return std::countr_zero(
         std::lower_bound(diced_shared_.begin(), diced_shared_.end(), std::pair{i, Mask{0}})
@@ -878,15 +885,7 @@ void Distributor::assemble() {
     if (const Mask mask = zone_holders_[primal::index_cast<std::size_t>(low[l])];
         mask & ~(Mask{1} << rank_))
       holders.emplace_back(primal::index_cast(l), mask);
-  std::sort(holders.begin(), holders.end());
-  std::size_t w = 0;  // one entry per node
-  for (const auto& [l, mask] : holders) {
-    if (w > 0 && holders[w - 1].first == l)
-      holders[w - 1].second |= mask;
-    else
-      holders[w++] = {l, mask};
-  }
-  holders.resize(w);
+  join_holders(holders);
   for (const auto& [l, mask] : holders)
     for (int q = 0; q < size_; ++q)
       if (q != rank_ && (mask >> q & 1)) out_.shared_nodes[q].push_back(l);

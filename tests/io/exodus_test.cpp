@@ -61,6 +61,15 @@ void write_raw(const fs::path& file, const char* type, const std::vector<int>& c
   REQUIRE(ex_close(exo) >= 0);
 }
 
+// A written file opened with the raw C API, to read it as the library lays it out.
+int open_raw(const fs::path& file) {
+  int cpu = 8, io = 0;
+  float version = 0;
+  const int exo = ex_open(file.string().c_str(), EX_READ, &cpu, &io, &version);
+  REQUIRE(exo >= 0);
+  return exo;
+}
+
 std::string message_of(const fs::path& file) {
   try {
     (void)read_exodus(file);
@@ -103,10 +112,7 @@ TEST_CASE("the written file follows Exodus's own HEX8 / TETRA4 / side convention
   const Model m = sample_model();
   const fs::path file = scratch_dir() / "raw.exo";
   write_exodus(m, file);
-  int cpu = 8, io = 0;
-  float version = 0;
-  const int exo = ex_open(file.string().c_str(), EX_READ, &cpu, &io, &version);
-  REQUIRE(exo >= 0);
+  const int exo = open_raw(file);
   std::vector<double> x(m.points.size()), y(x.size()), z(x.size());
   REQUIRE(ex_get_coord(exo, x.data(), y.data(), z.data()) >= 0);
   auto p = [&](int n) {
@@ -189,10 +195,7 @@ TEST_CASE("write_exodus numbers a block's elements in runs: sides name the file'
                           {{ElementKind::kTet, 3}, 2}};
   const fs::path file = scratch_dir() / "runs.exo";
   write_exodus(m, file);
-  int cpu = 8, io = 0;
-  float version = 0;
-  const int exo = ex_open(file.string().c_str(), EX_READ, &cpu, &io, &version);
-  REQUIRE(exo >= 0);
+  const int exo = open_raw(file);
   std::vector<int> elems(5), sides(5);
   REQUIRE(ex_get_set(exo, EX_SIDE_SET, 21, elems.data(), sides.data()) >= 0);
   CHECK(elems == std::vector<int>{6, 5, 2, 14, 10});
