@@ -22,6 +22,7 @@
 #include <vector>
 
 #include <geode/io/gmsh.hpp>
+#include <geode/primal/detail/node_table.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/model.hpp>
 
@@ -35,42 +36,6 @@ using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
-
-// Per-node lists in one array (CSR with room for every use): entries of node a at
-// [start[a], start[a] + size[a]).
-template <typename Entry>
-struct NodeTable {
-  std::vector<Index> start, size;
-  std::vector<Entry> entries;
-  explicit NodeTable(const std::vector<Index>& uses)
-      : start(uses.size() + 1, 0), size(uses.size(), 0) {
-    for (std::size_t v = 0; v < uses.size(); ++v) start[v + 1] = start[v] + uses[v];
-    entries.resize(geode::primal::index_cast<std::size_t>(start.back()));
-  }
-  // The node of `key` listed at a, made by make() the first time.
-  template <typename Make>
-  Index find_or_add(Index a, const Entry& key, Make&& make) {
-    Entry* first = entries.data() + start[a];
-    Entry* last = first + size[a];
-    for (Entry* e = first; e != last; ++e)
-      if (e->same(key)) return e->node;
-    Entry added = key;
-    added.node = make();
-    *last = added;
-    ++size[a];
-    return added.node;
-  }
-};
-
-struct EdgeEntry {
-  Index b = 0, node = 0;
-  bool same(const EdgeEntry& o) const { return b == o.b; }
-};
-struct FaceEntry {
-  std::array<Index, 3> rest{};  // the other nodes ascending (-1 last for a triangle)
-  Index node = 0;
-  bool same(const FaceEntry& o) const { return rest == o.rest; }
-};
 
 // The unit cube's 3 x 3 x 3 grid (i + 3 j + 9 k, each in 0..2) against the hex's corners
 // (VTK order): grid point g is made of the corners that agree with it on every axis where it is
@@ -165,8 +130,8 @@ int main(int argc, char** argv) {
   };
   for (const auto& h : model.hexes) count(h, hex_t.corners_of);
   for (const auto& t : model.tets) count(t, tet_t.corners_of);
-  NodeTable<EdgeEntry> edges(edge_uses);
-  NodeTable<FaceEntry> faces(face_uses);
+  gp::detail::NodeTable<1> edges(edge_uses);
+  gp::detail::NodeTable<3> faces(face_uses);
   edge_uses = {}, face_uses = {};
 
   std::vector<Point> points = model.points;
@@ -188,10 +153,9 @@ int main(int argc, char** argv) {
                            gp::kInvalidIndex};
     for (std::size_t i = 0; i < set.size(); ++i) v[i] = cell[set[i]];
     std::sort(v.begin(), v.begin() + static_cast<long>(set.size()));
-    if (set.size() == 2)
-      return edges.find_or_add(v[0], EdgeEntry{v[1], 0}, [&] { return add(at); });
-    FaceEntry key{{v[1], v[2], set.size() == 4 ? v[3] : gp::kInvalidIndex}, 0};
-    return faces.find_or_add(v[0], key, [&] { return add(at); });
+    if (set.size() == 2) return edges.find_or_add(v[0], {v[1]}, [&] { return add(at); });
+    return faces.find_or_add(v[0], {v[1], v[2], set.size() == 4 ? v[3] : gp::kInvalidIndex},
+                             [&] { return add(at); });
   };
   std::array<Index, 27> local{};
   for (const auto& h : model.hexes) {
@@ -210,7 +174,7 @@ int main(int argc, char** argv) {
       for (int k = 0; k < 8; ++k) c[k] = local[ch[k]] + 1;
     }
   }
-  edges = NodeTable<EdgeEntry>({}), faces = NodeTable<FaceEntry>({});
+  edges = gp::detail::NodeTable<1>({}), faces = gp::detail::NodeTable<3>({});
   const double dice_s = since(t_dice);
 
   const auto t_write = Clock::now();

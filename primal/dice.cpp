@@ -2,15 +2,17 @@
 
 #include <algorithm>
 #include <bit>
+#include <limits>
 #include <string>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
+#include <geode/primal/detail/node_table.hpp>
 #include <geode/primal/errors.hpp>
-#include <geode/primal/key_map.hpp>
 #include <geode/primal/quality.hpp>
+#include <geode/primal/release.hpp>
 #include <geode/primal/topology.hpp>
 
 namespace geode::primal {
@@ -127,7 +129,6 @@ DicedCellsOf<NC> dice_topology(Index nv, const std::vector<std::array<Index, NP>
   DicedCellsOf<NC> out;
   std::vector<Index> element_ids(elements.size() * ns);  // per element and slot: edge or face id
   {
-    KeyMap<4> edge_id(elements.size() * 2), face_id(elements.size() * 2);
     auto key_of = [&](const std::array<Index, NP>& elem, Support s) {
       std::array<Index, 4> nodes{};
       std::size_t n = 0;
@@ -139,16 +140,37 @@ DicedCellsOf<NC> dice_topology(Index nv, const std::vector<std::array<Index, NP>
                          : face_key(std::span<const Index>(nodes.data(), n));
       return k;
     };
-    for (std::size_t e = 0; e < elements.size(); ++e) {
+    // Room in the per-node tables: each edge or face use at its smallest node.
+    std::vector<Index> edge_uses(index_cast<std::size_t>(nv), 0), face_uses = edge_uses;
+    for (const auto& elem : elements)
       for (std::size_t i = 0; i < ns; ++i) {
-        const Support s = supports[i];
-        const FaceKey k = key_of(elements[e], s);
-        const bool edge = std::popcount(s) == 2;
-        auto& ids = edge ? edge_id : face_id;
-        auto& keys = edge ? out.edges : out.faces;
-        const auto [id, inserted] = ids.try_emplace(k, index_cast(keys.size()));
-        if (inserted) keys.push_back(k);
-        element_ids[e * ns + i] = *id;
+        Index low = std::numeric_limits<Index>::max();
+        for (std::size_t q = 0; q < NP; ++q)
+          if (supports[i] & (1u << q)) low = std::min(low, elem[q]);
+        ++(std::popcount(supports[i]) == 2 ? edge_uses : face_uses)[index_cast<std::size_t>(low)];
+      }
+    detail::NodeTable<1> edge_id(edge_uses);
+    detail::NodeTable<3> face_id(face_uses);
+    release(edge_uses, face_uses);
+    // The lists an element `kAhead` further on will search, fetched while this one searches
+    // (their slots are spread over the tables as its nodes are over the mesh).
+    constexpr std::size_t kAhead = 8;
+    for (std::size_t e = 0; e < elements.size(); ++e) {
+      if (e + kAhead < elements.size())
+        for (Index v : elements[e + kAhead]) edge_id.prefetch(v), face_id.prefetch(v);
+      for (std::size_t i = 0; i < ns; ++i) {
+        const FaceKey k = key_of(elements[e], supports[i]);
+        element_ids[e * ns + i] =
+            std::popcount(supports[i]) == 2
+                ? edge_id.find_or_add(k[0], {k[1]},
+                                      [&] {
+                                        out.edges.push_back(k);
+                                        return index_cast(out.edges.size() - 1);
+                                      })
+                : face_id.find_or_add(k[0], {k[1], k[2], k[3]}, [&] {
+                    out.faces.push_back(k);
+                    return index_cast(out.faces.size() - 1);
+                  });
       }
     }
   }
