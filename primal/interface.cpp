@@ -153,17 +153,39 @@ bool on_triangle(const Point& p, const Point& a, const Point& b, const Point& c,
 template <std::size_t N>
 void refuse_duplicates(const Model& model, const std::vector<std::array<Index, N>>& cells,
                        ElementKind kind) {
-  KeyMap<N> first(cells.size());
-  for (std::size_t e = 0; e < cells.size(); ++e) {
-    std::array<Index, N> key = cells[e];
-    std::sort(key.begin(), key.end());
-    const auto [slot, inserted] = first.try_emplace(key, index_cast(e));
-    if (!inserted)
-      throw TopologyError("find_interface: " + describe_element(model, {kind, index_cast(e)}) +
-                          " has the same nodes as " + describe_element(model, {kind, *slot}) +
-                          " (nodes " + node_list(model, cells[e]) +
-                          "): a duplicated element (an element or a block given twice?)");
-  }
+  // Each element's sorted nodes, sorted by the smallest (detail::sort_by_lowest_node, in
+  // parallel): duplicates sit together. The first pair in element order is the one whose later
+  // element comes first.
+  struct Use {
+    std::array<Index, N> key;
+    std::size_t e;
+    bool operator<(const Use& o) const { return key != o.key ? key < o.key : e < o.e; }
+  };
+  std::vector<std::size_t> start;
+  const std::vector<Use> uses = detail::sort_by_lowest_node<Use>(
+      model.points.size(),
+      [&](auto&& visit) {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 4096),
+                          [&](const tbb::blocked_range<std::size_t>& r) {
+                            for (std::size_t e = r.begin(); e != r.end(); ++e) {
+                              Use u{cells[e], e};
+                              std::sort(u.key.begin(), u.key.end());
+                              visit(u);
+                            }
+                          });
+      },
+      [](const Use& u) { return u.key[0]; }, start);
+  std::size_t later = cells.size(), earlier = 0;
+  for (std::size_t k = 1; k < uses.size(); ++k)
+    if (uses[k].key == uses[k - 1].key && uses[k].e < later &&
+        (k < 2 || uses[k - 2].key != uses[k].key))
+      later = uses[k].e, earlier = uses[k - 1].e;
+  if (later < cells.size())
+    throw TopologyError("find_interface: " + describe_element(model, {kind, index_cast(later)}) +
+                        " has the same nodes as " +
+                        describe_element(model, {kind, index_cast(earlier)}) + " (nodes " +
+                        node_list(model, cells[later]) +
+                        "): a duplicated element (an element or a block given twice?)");
 }
 
 // How far (relative to its mean edge) a four-triangle split's centre node may lie off the plane

@@ -1,6 +1,7 @@
 #include <geode/primal/validity_local.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
 
 #include <tbb/blocked_range.h>
@@ -56,24 +57,41 @@ HexValidityReport check_validity_around(const HexMesh& mesh, std::span<const Ind
   r.num_nodes = index_cast(nv);
   r.num_hexes = index_cast(nh);
 
-  // Per hex and per node over the whole mesh, as check_validity finds them.
+  // Per hex and per node over the whole mesh, as check_validity finds them: classified in
+  // parallel, one slot each, then listed in order (the same lists for any thread count).
+  enum : char { kProper = 1, kOutOfRange = 2, kRepeated = 3 };
   std::vector<char> proper_hex(nh, 0), used(nv, 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nh, 8192),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t h = range.begin(); h != range.end(); ++h) {
+                        const auto& hex = mesh.hexes[h];
+                        if (!std::all_of(hex.begin(), hex.end(), [nv](Index v) {
+                              return v >= 0 && index_cast<std::size_t>(v) < nv;
+                            })) {
+                          proper_hex[h] = kOutOfRange;
+                        } else if (!proper(hex, nv)) {
+                          proper_hex[h] = kRepeated;
+                        } else {
+                          proper_hex[h] = kProper;
+                          for (Index v : hex)
+                            std::atomic_ref<char>(used[index_cast<std::size_t>(v)])
+                                .store(1, std::memory_order_relaxed);
+                        }
+                      }
+                    });
   for (std::size_t h = 0; h < nh; ++h) {
-    const auto& hex = mesh.hexes[h];
-    const bool in_range = std::all_of(hex.begin(), hex.end(), [nv](Index v) {
-      return v >= 0 && index_cast<std::size_t>(v) < nv;
-    });
-    if (!in_range) {
-      r.out_of_range_hexes.push_back(index_cast(h));
-    } else if (!proper(hex, nv)) {
-      r.repeated_node_hexes.push_back(index_cast(h));
-    } else {
-      proper_hex[h] = 1;
-      for (Index v : hex) used[index_cast<std::size_t>(v)] = 1;
-    }
+    if (proper_hex[h] == kOutOfRange) r.out_of_range_hexes.push_back(index_cast(h));
+    if (proper_hex[h] == kRepeated) r.repeated_node_hexes.push_back(index_cast(h));
+    proper_hex[h] = proper_hex[h] == kProper;
   }
+  std::vector<char> finite(nv, 1);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv, 8192),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t v = range.begin(); v != range.end(); ++v)
+                        finite[v] = mesh.points[v].allFinite();
+                    });
   for (std::size_t v = 0; v < nv; ++v) {
-    if (!mesh.points[v].allFinite()) r.non_finite_nodes.push_back(index_cast(v));
+    if (!finite[v]) r.non_finite_nodes.push_back(index_cast(v));
     r.unused_nodes += used[v] ? 0 : 1;
   }
   release(used);
