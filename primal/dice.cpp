@@ -177,29 +177,33 @@ DicedCellsOf<NC> dice_topology(Index nv, const std::vector<std::array<Index, NP>
   const auto ne = index_cast(out.edges.size());
   const auto nf = index_cast(out.faces.size());
 
-  // Pass 2: children.
+  // Pass 2: children, elements in parallel (each writes its own).
   out.children.reserve(elements.size() * NChildren + room);
-  out.parent.reserve(elements.size() * NChildren);
-  for (std::size_t e = 0; e < elements.size(); ++e) {
-    const auto& elem = elements[e];
-    for (std::size_t ch = 0; ch < NChildren; ++ch) {
-      std::array<Index, NC> c{};
-      for (std::size_t k = 0; k < NC; ++k) {
-        const Support s = table[ch][k];
-        const int count = std::popcount(s);
-        if (count == 1) {
-          c[k] = elem[index_cast<std::size_t>(std::countr_zero(s))];
-        } else if (s == kAll) {
-          c[k] = nv + ne + nf + index_cast(e);
-        } else {
-          const Index id = element_ids[e * ns + index_cast<std::size_t>(slot_of[ch][k])];
-          c[k] = count == 2 ? nv + id : nv + ne + id;
-        }
-      }
-      out.children.push_back(c);
-      out.parent.push_back(index_cast(e));
-    }
-  }
+  out.children.resize(elements.size() * NChildren);
+  out.parent.resize(elements.size() * NChildren);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, elements.size(), 4096),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t e = r.begin(); e != r.end(); ++e) {
+                        const auto& elem = elements[e];
+                        for (std::size_t ch = 0; ch < NChildren; ++ch) {
+                          std::array<Index, NC>& c = out.children[e * NChildren + ch];
+                          for (std::size_t k = 0; k < NC; ++k) {
+                            const Support s = table[ch][k];
+                            const int count = std::popcount(s);
+                            if (count == 1) {
+                              c[k] = elem[index_cast<std::size_t>(std::countr_zero(s))];
+                            } else if (s == kAll) {
+                              c[k] = nv + ne + nf + index_cast(e);
+                            } else {
+                              const Index id =
+                                  element_ids[e * ns + index_cast<std::size_t>(slot_of[ch][k])];
+                              c[k] = count == 2 ? nv + id : nv + ne + id;
+                            }
+                          }
+                          out.parent[e * NChildren + ch] = index_cast(e);
+                        }
+                      }
+                    });
   return out;
 }
 
