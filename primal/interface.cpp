@@ -4,6 +4,8 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <tuple>
@@ -67,53 +69,82 @@ class TetTriangles {
   std::vector<Index> tri_of_rec_;   // at a triangle's first record, its tris index
 };
 
-TetTriangles::TetTriangles(const Model& model) : tet_face_tri(4 * model.tets.size()) {
+TetTriangles::TetTriangles(const Model& model)
+    : tet_face_tri(4 * model.tets.size(), kInvalidIndex) {
+  auto face_use = [&](Index use) {
+    const auto t = index_cast<std::size_t>(use / 4);
+    const auto f = index_cast<std::size_t>(use % 4);
+    TetFaceUse u{index_cast(t), static_cast<int>(f), {}};
+    for (std::size_t i = 0; i < 3; ++i)
+      u.nodes[i] = model.tets[t][index_cast<std::size_t>(topology::kTetFaceCorners[f][i])];
+    return u;
+  };
   auto each_use = [&](auto&& visit) {
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, model.tets.size(), 4096),
-        [&](const tbb::blocked_range<std::size_t>& r) {
-          for (std::size_t t = r.begin(); t != r.end(); ++t)
-            for (std::size_t f = 0; f < 4; ++f) {
-              std::array<Index, 3> nodes{};
-              for (std::size_t i = 0; i < 3; ++i)
-                nodes[i] = model.tets[t][index_cast<std::size_t>(topology::kTetFaceCorners[f][i])];
-              const FaceKey k = face_key(nodes);
-              visit(Record{k[0], k[1], k[2], index_cast(4 * t + f)});
-            }
-        });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, model.tets.size(), 4096),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t t = r.begin(); t != r.end(); ++t)
+                          for (Index f = 0; f < 4; ++f) {
+                            const FaceKey k = face_key(face_use(index_cast(4 * t) + f).nodes);
+                            visit(Record{k[0], k[1], k[2], index_cast(4 * t) + f});
+                          }
+                      });
   };
   rec_ = detail::sort_by_lowest_node<Record>(
       model.points.size(), each_use, [](const Record& r) { return r.a; }, start_);
-  // Per use, the record where its triangle's uses begin.
-  std::vector<Index> group(rec_.size());
-  std::size_t count = 0;
-  for (std::size_t i = 0; i < rec_.size(); ++i) {
-    const bool first = i == 0 || rec_[i].a != rec_[i - 1].a || rec_[i].b != rec_[i - 1].b ||
-                       rec_[i].c != rec_[i - 1].c;
-    group[index_cast<std::size_t>(rec_[i].use)] =
-        first ? index_cast(i) : group[index_cast<std::size_t>(rec_[i - 1].use)];
-    count += first ? 1 : 0;
+  // Each triangle's uses are a run of rec_, its first use first; runs within a node's records,
+  // nodes in parallel (each run writes its own slots).
+  auto same = [&](std::size_t i, std::size_t j) {
+    return rec_[i].a == rec_[j].a && rec_[i].b == rec_[j].b && rec_[i].c == rec_[j].c;
+  };
+  auto for_each_run = [&](auto&& f) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, model.points.size(), 4096),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        const std::size_t end = start_[r.end()];
+                        for (std::size_t k = start_[r.begin()]; k < end;) {
+                          std::size_t next = k + 1;
+                          while (next < end && same(k, next)) ++next;
+                          f(k, next);
+                          k = next;
+                        }
+                      });
+  };
+  // Numbered in order of first use: the first uses flagged, then counted in use order.
+  {
+    std::vector<char> first(tet_face_tri.size(), 0);
+    for_each_run(
+        [&](std::size_t b, std::size_t) { first[index_cast<std::size_t>(rec_[b].use)] = 1; });
+    Index count = 0;
+    for (std::size_t u = 0; u < first.size(); ++u)
+      if (first[u]) tet_face_tri[u] = count++;
+    tris.resize(index_cast<std::size_t>(count));
   }
-  tris.reserve(count);
   tri_of_rec_.assign(rec_.size(), kInvalidIndex);
-  for (std::size_t t = 0; t < model.tets.size(); ++t)
-    for (int f = 0; f < 4; ++f) {
-      TetFaceUse use{index_cast(t), f, {}};
-      for (std::size_t i = 0; i < 3; ++i)
-        use.nodes[i] = model.tets[t][index_cast<std::size_t>(
-            topology::kTetFaceCorners[index_cast<std::size_t>(f)][i])];
-      Index& id = tri_of_rec_[index_cast<std::size_t>(group[4 * t + index_cast<std::size_t>(f)])];
-      if (id == kInvalidIndex) id = index_cast(tris.size()), tris.emplace_back();
-      tet_face_tri[4 * t + index_cast<std::size_t>(f)] = id;
-      TriangleUses& at = tris[index_cast<std::size_t>(id)];
-      if (at.count == 2)
-        throw TopologyError("find_interface: triangle (nodes " + node_list(model, use.nodes) +
-                            ") is a face of more than two tets (" +
-                            describe_element(model, {ElementKind::kTet, at.use[0].tet}) + ", " +
-                            describe_element(model, {ElementKind::kTet, at.use[1].tet}) + ", " +
-                            describe_element(model, {ElementKind::kTet, index_cast(t)}) + ")");
-      at.use[index_cast<std::size_t>(at.count++)] = use;
+  // A triangle of three tets or more: reported at the third use that comes first in tet order.
+  std::atomic<Index> third = std::numeric_limits<Index>::max();
+  for_each_run([&](std::size_t b, std::size_t e) {
+    const Index id = tet_face_tri[index_cast<std::size_t>(rec_[b].use)];
+    tri_of_rec_[b] = id;
+    TriangleUses& at = tris[index_cast<std::size_t>(id)];
+    for (std::size_t k = b; k < e; ++k) {
+      tet_face_tri[index_cast<std::size_t>(rec_[k].use)] = id;
+      if (k - b < 2) at.use[k - b] = face_use(rec_[k].use);
     }
+    at.count = static_cast<int>(std::min<std::size_t>(e - b, 2));
+    if (e - b > 2) {
+      const Index u = rec_[b + 2].use;
+      Index seen = third.load();
+      while (u < seen && !third.compare_exchange_weak(seen, u)) {}
+    }
+  });
+  if (const Index u = third.load(); u != std::numeric_limits<Index>::max()) {
+    const TriangleUses& at =
+        tris[index_cast<std::size_t>(tet_face_tri[index_cast<std::size_t>(u)])];
+    throw TopologyError("find_interface: triangle (nodes " + node_list(model, face_use(u).nodes) +
+                        ") is a face of more than two tets (" +
+                        describe_element(model, {ElementKind::kTet, at.use[0].tet}) + ", " +
+                        describe_element(model, {ElementKind::kTet, at.use[1].tet}) + ", " +
+                        describe_element(model, {ElementKind::kTet, u / 4}) + ")");
+  }
 }
 
 // A boundary quad of the hex part: a hex's, or a wedge's quad face used by no other cell of
