@@ -190,7 +190,7 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
   };
   conform::ConformResult r;
   try {
-    r = conform::conform(model, opts);
+    r = conform::conform(std::move(model), opts);  // the hints below read what is left
   } catch (const InvalidInput& e) {
     throw InvalidInput(prefix + e.what() +
                        conform::duplicate_node_hint(model, "--merge-tolerance"));

@@ -114,9 +114,9 @@ class Conformer {
   // `given`: the input's points as the caller gave them, when conform moved some before
   // (ConformRelax): the yardsticks reported are the input's own cells; what smoothing aims at
   // follows the cells as they are diced.
-  // `disposable`: the input itself when it is conform's own copy (relaxed tets, split
-  // pyramids), which run() trims to its blocks, and `given` frees, once the buffer layer holds
-  // the model.
+  // `disposable`: the input itself when conform may change it (its own copy, with relaxed tets
+  // or split pyramids, or the caller's given up), which run() trims to its blocks, and `given`
+  // frees, once the buffer layer holds the model.
   Conformer(const primal::Model& input, const ConformOptions& options,
             std::vector<primal::Point>* given = nullptr, primal::Model* disposable = nullptr)
       : input_(input),
@@ -389,8 +389,8 @@ void Conformer::thicker_from_tets() {
 }
 
 // After the buffer layer the stages read the input for its blocks only (the layer's model is
-// a copy of it): where the input is conform's own copy, the rest is freed before dicing, the
-// run's peak (the n = 36 bench: 10.8 MiB of 148 with the tets relaxed).
+// a copy of it): where conform may change the input, the rest is freed before dicing, the
+// run's peak (the n = 36 bench: 10 MiB, with the points as given 2 MiB more).
 void Conformer::trim_input() {
   blocks_ = output_blocks(input_, options_.geode_block);
   if (given_copy_) primal::release(*given_copy_);
@@ -1162,15 +1162,23 @@ constexpr int kRelaxRings = 2;
 constexpr primal::RelaxTetsOptions kRelax{
     .sweeps = 2, .halvings = 3, .initial_step = 0.25, .good = 0.3};
 
-ConformResult conform(const primal::Model& input, const ConformOptions& options) {
+namespace {
+
+// conform() on `input`; `spare`: the same model when the caller gives it up (the Model&&
+// overload), then relaxed in place instead of copied, and trimmed once the buffer layer holds
+// the model.
+ConformResult conform_model(const primal::Model& input, primal::Model* spare,
+                            const ConformOptions& options) {
+  const auto input_pyramids = primal::index_cast(input.pyramids.size());
   // kSplit, the only pyramid treatment so far: each pyramid as its better two tets
   // (split_pyramids); a pyramid template (a ConformPyramids value of its own) would fill the
   // pyramids in place.
-  primal::Model own;  // the input as conform changes it, when it does
+  primal::Model own;             // the input as conform changes it, when it copies it
+  primal::Model* owned = spare;  // the model conform may change: the caller's, or own
   const primal::Model* model = &input;
   if (!input.pyramids.empty()) {
     own = primal::split_pyramids(input).model;
-    model = &own;
+    model = owned = &own;
   }
   Index wedges_split = 0;
   std::vector<std::string> warnings;
@@ -1181,10 +1189,12 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
         (!model->hexes.empty() || !model->wedges.empty()) && !model->tets.empty()) {
       const std::vector<Index> nodes = primal::tet_nodes_to_relax(*model, kRelaxRings);
       if (!nodes.empty()) {
-        if (model == &input) own = input;
-        given = own.points;
-        relaxation = primal::relax_tet_nodes(own.points, own.tets, nodes, kRelax);
-        model = &own;
+        if (!owned) {
+          own = input;
+          model = owned = &own;
+        }
+        given = owned->points;
+        relaxation = primal::relax_tet_nodes(owned->points, owned->tets, nodes, kRelax);
         if (options.progress)
           options.progress("tet relaxation: " + std::to_string(relaxation.nodes_moved) + " of " +
                            std::to_string(nodes.size()) + " free tet nodes moved, their tets' " +
@@ -1193,14 +1203,14 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
                            std::to_string(relaxation.seconds) + " s)");
       }
     }
-    Conformer conformer(*model, options, model == &own && relaxation.nodes_moved ? &given : nullptr,
-                        model == &own ? &own : nullptr);
+    Conformer conformer(*model, options, relaxation.nodes_moved ? &given : nullptr,
+                        model == owned ? owned : nullptr);
     ConformResult r = conformer.run();
     if (const auto& joining = conformer.joining(); !joining.empty()) {
       // A wedge layer joins the two sides of the interface: its pieces become tets (from the
       // points as given: the relaxation runs again on the split model), and the run starts
       // again; a hex quad they covered may join another piece to the sides, hence the loop.
-      if (!given.empty()) own.points = std::move(given);
+      if (!given.empty()) owned->points = std::move(given);
       const std::vector<Index> pieces = primal::wedge_pieces(*model, joining);
       warnings.push_back(
           std::to_string(pieces.size()) + " wedges split into three tets each: the layer of " +
@@ -1208,7 +1218,7 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
           " joins the two sides of the hex/tet interface (hexes and wedges side "
           "by side in a layer against tets), where no buffer layer can end");
       own = primal::split_wedges(*model, pieces);
-      model = &own;
+      model = owned = &own;
       wedges_split += primal::index_cast(pieces.size());
       if (options.progress)
         options.progress("wedges: " + std::to_string(pieces.size()) +
@@ -1217,13 +1227,23 @@ ConformResult conform(const primal::Model& input, const ConformOptions& options)
     }
     r.relaxation = relaxation;
     r.seconds += relaxation.seconds;
-    r.input_pyramids = primal::index_cast(input.pyramids.size());
+    r.input_pyramids = input_pyramids;
     r.wedges_split = wedges_split;
     r.warnings.insert(r.warnings.begin(), warnings.begin(), warnings.end());
     r.input_wedges += wedges_split;
     r.input_tets -= 2 * r.input_pyramids + 3 * wedges_split;
     return r;
   }
+}
+
+}  // namespace
+
+ConformResult conform(const primal::Model& input, const ConformOptions& options) {
+  return conform_model(input, nullptr, options);
+}
+
+ConformResult conform(primal::Model&& input, const ConformOptions& options) {
+  return conform_model(input, &input, options);
 }
 
 }  // namespace geode::conform

@@ -344,7 +344,7 @@ void Distributor::conform_zone() {
       // it covers its region once (its cut, unlike a model's boundary, may be non-manifold, which
       // piece_ok does not judge); verify() checks around the cut whole.
       conform::ConformOptions zone_options = options_.conform;
-      conform::ConformResult r = conform::conform(zone.model, zone_options);
+      conform::ConformResult r = conform::conform(std::move(zone.model), zone_options);
       // The band diced alone must be found in the zone's output, node for node (its points, all
       // distinct, looked for among the zone's).
       const primal::Submodel b = primal::extract_submodel(m(), band_);

@@ -188,7 +188,7 @@ py::dict conform_arrays(const py::handle& points, const py::dict& cells,
     // local verification, the default, takes as given; its messages name the source.
     primal::require_single_covering(model, source);
     try {
-      r = conform::conform(model, opts);
+      r = conform::conform(std::move(model), opts);  // the hints below read what is left
     } catch (const InvalidInput& e) {
       throw InvalidInput(source + ": " + e.what() +
                          conform::duplicate_node_hint(model, "merge_tolerance="));
