@@ -1,5 +1,7 @@
 // geode conform INPUT: the geode algorithm on a whole hex + tet model; geode demo: the same on
 // a demo model built with Gmsh (demo/demo_models).
+#include <tbb/global_control.h>
+
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
@@ -354,10 +356,12 @@ void add_conform_commands(CLI::App& app) {
   add_run_options(c, *args);
   c->callback([args] {
     const std::string format = check_outputs(*args);  // before the long run, not after it
-    // The templates depend on the options alone: built while the file is read, unless the
-    // reader forks (no thread of ours may be at work then; io/read_model.hpp).
+    // The templates depend on the options alone: built while the file is read, on a thread of
+    // their own, unless the reader forks (no thread of ours may be at work then;
+    // io/read_model.hpp) or --threads 1 asks for one thread.
     std::jthread templates;
-    if (!io::read_forks(args->input))
+    if (!io::read_forks(args->input) &&
+        tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism) > 1)
       templates = conform::build_reference_templates_ahead(
           args->template_box.empty() ? conform::ConformOptions{}.template_box
                                      : template_box(args->template_box));

@@ -140,16 +140,11 @@ std::vector<BoundaryQuad> boundary_quads(const HexMesh& mesh) {
       },
       [](const Use& u) { return u.key[0]; }, start);
   std::vector<char> once(6 * nh, 0);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.points.size(), 4096),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      const std::size_t end = start[r.end()];
-                      for (std::size_t k = start[r.begin()]; k < end;) {
-                        std::size_t next = k + 1;
-                        while (next < end && uses[next].key == uses[k].key) ++next;
-                        if (next == k + 1) once[uses[k].pos] = 1;
-                        k = next;
-                      }
-                    });
+  detail::for_each_run(
+      start, [&](std::size_t i, std::size_t j) { return uses[i].key == uses[j].key; },
+      [&](std::size_t b, std::size_t e) {
+        if (e == b + 1) once[uses[b].pos] = 1;
+      });
   std::vector<BoundaryQuad> out;
   for (std::size_t pos = 0; pos < once.size(); ++pos)
     if (once[pos]) {

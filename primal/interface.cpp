@@ -96,18 +96,7 @@ TetTriangles::TetTriangles(const Model& model)
   auto same = [&](std::size_t i, std::size_t j) {
     return rec_[i].a == rec_[j].a && rec_[i].b == rec_[j].b && rec_[i].c == rec_[j].c;
   };
-  auto for_each_run = [&](auto&& f) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, model.points.size(), 4096),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        const std::size_t end = start_[r.end()];
-                        for (std::size_t k = start_[r.begin()]; k < end;) {
-                          std::size_t next = k + 1;
-                          while (next < end && same(k, next)) ++next;
-                          f(k, next);
-                          k = next;
-                        }
-                      });
-  };
+  auto for_each_run = [&](auto&& f) { detail::for_each_run(start_, same, f); };
   // Numbered in order of first use: the first uses flagged, then counted in use order.
   {
     std::vector<char> first(tet_face_tri.size(), 0);

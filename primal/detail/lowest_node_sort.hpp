@@ -2,8 +2,8 @@
 // Face uses (or any records keyed by node numbers) in order, sorted by their lowest node first:
 // counted out per node, each record written once into place, then each node's few sorted. One
 // sort of them all gives the same order with passes over the whole array; this way the cost is
-// a scatter and many tiny sorts, in parallel (the read-time covering check and the interface
-// search's tet triangles).
+// a scatter and many tiny sorts, in parallel (the read-time covering check, the interface
+// search's tet triangles and duplicate check, the boundary quads of a hex mesh).
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -43,6 +43,23 @@ std::vector<Record> sort_by_lowest_node(std::size_t nodes, Each&& each, Lowest&&
                                   out.begin() + static_cast<std::ptrdiff_t>(start[v + 1]));
                     });
   return out;
+}
+
+// The runs of equal records (same(i, j) on their positions) in sort_by_lowest_node's result:
+// f(begin, end) once per run, nodes' records in parallel (a run never spans two nodes, its
+// records sharing their lowest node), so f may write what its run owns.
+template <class Same, class F>
+void for_each_run(const std::vector<std::size_t>& start, Same&& same, F&& f) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, start.size() - 1, 4096),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      const std::size_t end = start[r.end()];
+                      for (std::size_t k = start[r.begin()]; k < end;) {
+                        std::size_t next = k + 1;
+                        while (next < end && same(k, next)) ++next;
+                        f(k, next);
+                        k = next;
+                      }
+                    });
 }
 
 }  // namespace geode::primal::detail

@@ -4,9 +4,9 @@
 // mesher's output meet their edges and faces in an order that follows the node numbering, so
 // the lists they touch lie near each other in memory, where a hash table's slots are spread
 // over all of it, and take half the memory (dicing's edge and face numbering of the n = 36
-// Delaunay bench's tets: 0.10 s against 0.14 s with primal::KeyMap, whose 1.1 million edge
-// and 0.7 million face keys took 40 MB there; the floor program in bench/ numbers its nodes
-// with these tables too).
+// Delaunay bench's tets: 0.10 s against 0.14 s with primal::KeyMap, whose two tables of a
+// million slots took 40 MB there, against 22 MB for these; the floor program in bench/ numbers
+// its nodes with these tables too).
 #include <array>
 #include <cstddef>
 #include <vector>
