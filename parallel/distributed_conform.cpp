@@ -74,9 +74,10 @@ void join_holders(std::vector<std::pair<Node, Mask>>& entries) {
 
 class Distributor {
  public:
+  // `spare`: the input itself when the caller gives it up (freed once no stage reads it).
   Distributor(const Model& input, const DistributedOptions& options, MPI_Comm comm,
-              DistributedReport& report)
-      : options_(options), comm_(comm), rep_(report), input_(input) {
+              DistributedReport& report, Model* spare = nullptr)
+      : options_(options), comm_(comm), rep_(report), input_(input), spare_(spare) {
     MPI_Comm_rank(comm, &rank_);
     MPI_Comm_size(comm, &size_);
     // The ranks but the zone rank, for what they share while it conforms the zone.
@@ -160,6 +161,17 @@ class Distributor {
     ids.insert(ids.end(), high_ids_.begin(), high_ids_.end());
     primal::release(high_ids_);
   }
+  // The stages after the global ids' first step read the model's block names only, and no
+  // rank dices again (share_zone's grown zone is behind): the model this rank may change (the
+  // caller's given up, or the pyramids split) freed but those, before the numbering, assembly
+  // and verification add their own (the half 68 bench: about 90 MiB a rank).
+  void trim_model() {
+    Model* m = model_ == &split_ ? &split_ : model_ == spare_ ? spare_ : nullptr;
+    if (!m) return;
+    primal::release(m->points, m->hexes, m->tets, m->pyramids, m->wedges, m->hex_block,
+                    m->tet_block, m->pyramid_block, m->wedge_block, m->node_sets, m->side_sets,
+                    m->node_ids, m->hex_ids, m->tet_ids, m->pyramid_ids, m->wedge_ids);
+  }
   void release() {
     own_ = {};
     primal::release(level_, in_zone_, band_, part_, zone_node_, diced_gid_, diced_shared_,
@@ -171,6 +183,7 @@ class Distributor {
   MPI_Comm comm_, others_ = MPI_COMM_NULL;
   DistributedReport& rep_;
   const Model& input_;
+  Model* spare_;
   int rank_ = 0, size_ = 1;
   Model split_;
   std::vector<Index> tet_pyramid_;  // per tet of split_: its pyramid of the input, or invalid
@@ -374,9 +387,11 @@ void Distributor::conform_zone() {
 
 // The zone rank's load per child of a zone element, against 1 per diced hex elsewhere: the
 // zone's output per child (1.2 on bench_mpi's half 68) with its conform, the check around the
-// cut and writing on one rank. Tuned on half 68, 2 ranks: 1.2 left rank 0 waiting 1.4 s for the
-// zone rank, 2.8 left the zone rank waiting 0.65 s for rank 0's writing; 2.0 ends within 0.4 s.
-constexpr double kZoneLoad = 2.0;
+// cut and writing on one rank. Tuned on half 68, 2 ranks: with dicing as fast as it is now,
+// rank 0 waits about 0.7 s for the zone rank whether this is 1.6 or 2.0 (the same wall time),
+// so it balances the ranks' peaks instead: 1.6, 1.8 and 2.0 gave 597 / 606, 604 / 597 and
+// 629 / 585 MiB (rank 0 / the zone rank).
+constexpr double kZoneLoad = 1.8;
 
 // Per flat element its rank: the input's own partition, or METIS's on rank 0 (the elements
 // weighted by the hexes they dice into, the zone's elements only 1: the zone rank's share made
@@ -641,6 +656,7 @@ void Distributor::number() {
     if (!in_zone_[c])
       for (Index v : primal::element_corners(m(), ref(c)))
         uses[primal::index_cast<std::size_t>(v)] |= Mask{1} << part_[c];
+  trim_model();
   const std::size_t nd = diced_.points.size();
   diced_gid_.assign(nd, -1);
   diced_shared_.clear();
@@ -1135,6 +1151,12 @@ RankMesh conform_distributed(const primal::Model& input, const DistributedOption
                              MPI_Comm comm, DistributedReport* report) {
   DistributedReport local;
   return Distributor(input, options, comm, report ? *report : local).run();
+}
+
+RankMesh conform_distributed(primal::Model&& input, const DistributedOptions& options,
+                             MPI_Comm comm, DistributedReport* report) {
+  DistributedReport local;
+  return Distributor(input, options, comm, report ? *report : local, &input).run();
 }
 
 primal::InputCheckOptions shared_input_check(MPI_Comm comm) {

@@ -74,6 +74,11 @@ struct DistributedReport {
 // node) and a named geode block.
 RankMesh conform_distributed(const primal::Model& input, const DistributedOptions& options,
                              MPI_Comm comm, DistributedReport* report = nullptr);
+// The same on a model the caller gives up: freed but its block names once every rank has
+// diced its piece (a rank holds the whole input until then), so that the numbering, assembly
+// and verification hold it no more. Afterwards, or after an exception, it may be emptied.
+RankMesh conform_distributed(primal::Model&& input, const DistributedOptions& options,
+                             MPI_Comm comm, DistributedReport* report = nullptr);
 
 // The read-time covering check (primal/input_check.hpp) shared among the ranks of `comm`, for
 // io::read_model: each rank pairs its share of the faces, MPI_Allgatherv joins the pairings, and

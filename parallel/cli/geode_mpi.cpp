@@ -79,8 +79,8 @@ int run(int argc, char** argv, int rank, int size) {
     options.conform.verify = conform::parse_conform_verify(verify);
     options.rings = rings;
     io::FilePartition file_partition;
-    const primal::Model model = io::read_model(input, {}, true, &file_partition,
-                                               parallel::shared_input_check(MPI_COMM_WORLD));
+    primal::Model model = io::read_model(input, {}, true, &file_partition,
+                                         parallel::shared_input_check(MPI_COMM_WORLD));
     // The input's own partition (a partitioned .msh, a Nemesis set) unless it has fewer parts
     // than there are ranks: then METIS (parallel/partition.hpp).
     std::string partitioned_by = size > 1 ? "METIS" : "one rank";
@@ -96,7 +96,7 @@ int run(int argc, char** argv, int rank, int size) {
     const double t_read = MPI_Wtime() - t0;
     parallel::DistributedReport report;
     const parallel::RankMesh mesh =
-        parallel::conform_distributed(model, options, MPI_COMM_WORLD, &report);
+        parallel::conform_distributed(std::move(model), options, MPI_COMM_WORLD, &report);
     const double t_conform = MPI_Wtime() - t0 - t_read;
     if (report.valid) parallel::write_nemesis(mesh, output, size, rank);
     const double t_write = MPI_Wtime() - t0 - t_read - t_conform;
