@@ -57,7 +57,6 @@ PointBits bits(const Point& p) {
   return r;
 }
 
-// conform_distributed's stages, in the order run() calls them.
 // (node, holders) entries sorted by node, each node once with its holders joined.
 template <typename Node>
 void join_holders(std::vector<std::pair<Node, Mask>>& entries) {
@@ -72,6 +71,7 @@ void join_holders(std::vector<std::pair<Node, Mask>>& entries) {
   entries.resize(w);
 }
 
+// conform_distributed's stages, in the order run() calls them.
 class Distributor {
  public:
   // `spare`: the input itself when the caller gives it up (freed once no stage reads it).

@@ -120,11 +120,7 @@ std::vector<BoundaryQuad> boundary_quads(const HexMesh& mesh) {
   // uses sit together (detail::sort_by_lowest_node, in parallel: a hash map of first uses was
   // one thread's random accesses, 0.04 s on the n = 36 bench's hex part); a face used once is
   // on the boundary. Boundary faces in order of their use: the order of first appearance.
-  struct Use {
-    FaceKey key;
-    std::size_t pos;
-    bool operator<(const Use& o) const { return key != o.key ? key < o.key : pos < o.pos; }
-  };
+  using Use = detail::KeyedUse<4>;
   const std::size_t nh = mesh.hexes.size();
   std::vector<std::size_t> start;
   const std::vector<Use> uses = detail::sort_by_lowest_node<Use>(
@@ -143,7 +139,7 @@ std::vector<BoundaryQuad> boundary_quads(const HexMesh& mesh) {
   detail::for_each_run(
       start, [&](std::size_t i, std::size_t j) { return uses[i].key == uses[j].key; },
       [&](std::size_t b, std::size_t e) {
-        if (e == b + 1) once[uses[b].pos] = 1;
+        if (e == b + 1) once[uses[b].at] = 1;
       });
   std::vector<BoundaryQuad> out;
   for (std::size_t pos = 0; pos < once.size(); ++pos)

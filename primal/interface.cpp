@@ -176,11 +176,7 @@ void refuse_duplicates(const Model& model, const std::vector<std::array<Index, N
   // Each element's sorted nodes, sorted by the smallest (detail::sort_by_lowest_node, in
   // parallel): duplicates sit together. The first pair in element order is the one whose later
   // element comes first.
-  struct Use {
-    std::array<Index, N> key;
-    std::size_t e;
-    bool operator<(const Use& o) const { return key != o.key ? key < o.key : e < o.e; }
-  };
+  using Use = detail::KeyedUse<N>;
   std::vector<std::size_t> start;
   const std::vector<Use> uses = detail::sort_by_lowest_node<Use>(
       model.points.size(),
@@ -197,9 +193,9 @@ void refuse_duplicates(const Model& model, const std::vector<std::array<Index, N
       [](const Use& u) { return u.key[0]; }, start);
   std::size_t later = cells.size(), earlier = 0;
   for (std::size_t k = 1; k < uses.size(); ++k)
-    if (uses[k].key == uses[k - 1].key && uses[k].e < later &&
+    if (uses[k].key == uses[k - 1].key && uses[k].at < later &&
         (k < 2 || uses[k - 2].key != uses[k].key))
-      later = uses[k].e, earlier = uses[k - 1].e;
+      later = uses[k].at, earlier = uses[k - 1].at;
   if (later < cells.size())
     throw TopologyError("find_interface: " + describe_element(model, {kind, index_cast(later)}) +
                         " has the same nodes as " +

@@ -147,12 +147,8 @@ struct SharedCorner {
 // Groups come by key; a caller wanting them in order of first use sorts what it keeps by
 // `first->at` (most keep a few). Hash maps of vectors over every face, edge or corner made
 // `geode check` of a million hexes take 36 s and 1 GB; with this, 8 s.
-template <std::size_t N>
-struct KeyedUse {
-  std::array<Index, N> key;
-  std::size_t at;  // the use's place in the input's order
-  bool operator<(const KeyedUse& o) const { return std::tie(key, at) < std::tie(o.key, o.at); }
-};
+
+using detail::KeyedUse;
 
 template <std::size_t N, class Each, class Group>
 void group_by_key(std::size_t nodes, Each&& each, Group&& group) {

@@ -8,11 +8,24 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cstddef>
+#include <tuple>
 #include <vector>
 
+#include <geode/primal/mesh.hpp>
+
 namespace geode::primal::detail {
+
+// A use of a key of N node numbers (ascending), and its place in the caller's order: the record
+// most callers sort, grouped by key, first use first.
+template <std::size_t N>
+struct KeyedUse {
+  std::array<Index, N> key;
+  std::size_t at;
+  bool operator<(const KeyedUse& o) const { return std::tie(key, at) < std::tie(o.key, o.at); }
+};
 
 // The records `each(visit)` visits, ordered by lowest(record) (a node number below `nodes`),
 // then by Record's operator<, which must be a total order: `each` may call visit from several
