@@ -7,6 +7,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 #include <tbb/parallel_reduce.h>
 
 #include <geode/primal/detail/node_table.hpp>
@@ -126,54 +127,62 @@ DicedCellsOf<NC> dice_topology(Index nv, const std::vector<std::array<Index, NP>
   const std::size_t ns = supports.size();
 
   // Pass 1: number edges and faces in order of first appearance; remember each element's.
+  // Edges and faces are numbered apart (their numbers are independent), side by side (TBB):
+  // each pass reads every element, so one alone was the serial half of a conform run's dicing.
   DicedCellsOf<NC> out;
-  std::vector<Index> element_ids(elements.size() * ns);  // per element and slot: edge or face id
-  {
-    auto key_of = [&](const std::array<Index, NP>& elem, Support s) {
-      std::array<Index, 4> nodes{};
-      std::size_t n = 0;
-      for (std::size_t q = 0; q < NP; ++q) {
-        if (s & (1u << q)) nodes[n++] = elem[q];
-      }
-      FaceKey k = n == 2 ? FaceKey{std::min(nodes[0], nodes[1]), std::max(nodes[0], nodes[1]),
-                                   kInvalidIndex, kInvalidIndex}
-                         : face_key(std::span<const Index>(nodes.data(), n));
-      return k;
-    };
-    // Room in the per-node tables: each edge or face use at its smallest node.
-    std::vector<Index> edge_uses(index_cast<std::size_t>(nv), 0), face_uses = edge_uses;
+  // Per slot: an edge (true) or a face, and its position among the element's edges or faces.
+  std::vector<char> is_edge(ns);
+  std::vector<std::size_t> rank(ns);
+  std::size_t n_edge = 0, n_face = 0;
+  for (std::size_t i = 0; i < ns; ++i) {
+    is_edge[i] = std::popcount(supports[i]) == 2;
+    rank[i] = is_edge[i] ? n_edge++ : n_face++;
+  }
+  // Per element and edge (face) slot: its edge (face) id.
+  std::vector<Index> edge_ids(elements.size() * n_edge), face_ids(elements.size() * n_face);
+  // The keys of one kind numbered through a table of per-node lists (R: 1 for edges, 3 for
+  // faces), into `keys` and `ids`.
+  auto number = [&]<std::size_t R>(bool edges, std::vector<FaceKey>& keys, std::vector<Index>& ids,
+                                   std::size_t per_element) {
+    // Room in the per-node table: each use at its smallest node.
+    std::vector<Index> uses(index_cast<std::size_t>(nv), 0);
     for (const auto& elem : elements)
       for (std::size_t i = 0; i < ns; ++i) {
+        if (static_cast<bool>(is_edge[i]) != edges) continue;
         Index low = std::numeric_limits<Index>::max();
         for (std::size_t q = 0; q < NP; ++q)
           if (supports[i] & (1u << q)) low = std::min(low, elem[q]);
-        ++(std::popcount(supports[i]) == 2 ? edge_uses : face_uses)[index_cast<std::size_t>(low)];
+        ++uses[index_cast<std::size_t>(low)];
       }
-    detail::NodeTable<1> edge_id(edge_uses);
-    detail::NodeTable<3> face_id(face_uses);
-    release(edge_uses, face_uses);
+    detail::NodeTable<R> table(uses);
+    release(uses);
     // The lists an element `kAhead` further on will search, fetched while this one searches
-    // (their slots are spread over the tables as its nodes are over the mesh).
+    // (their slots are spread over the table as its nodes are over the mesh).
     constexpr std::size_t kAhead = 8;
     for (std::size_t e = 0; e < elements.size(); ++e) {
       if (e + kAhead < elements.size())
-        for (Index v : elements[e + kAhead]) edge_id.prefetch(v), face_id.prefetch(v);
+        for (Index v : elements[e + kAhead]) table.prefetch(v);
       for (std::size_t i = 0; i < ns; ++i) {
-        const FaceKey k = key_of(elements[e], supports[i]);
-        element_ids[e * ns + i] =
-            std::popcount(supports[i]) == 2
-                ? edge_id.find_or_add(k[0], {k[1]},
-                                      [&] {
-                                        out.edges.push_back(k);
-                                        return index_cast(out.edges.size() - 1);
-                                      })
-                : face_id.find_or_add(k[0], {k[1], k[2], k[3]}, [&] {
-                    out.faces.push_back(k);
-                    return index_cast(out.faces.size() - 1);
-                  });
+        if (static_cast<bool>(is_edge[i]) != edges) continue;
+        std::array<Index, 4> nodes{};
+        std::size_t n = 0;
+        for (std::size_t q = 0; q < NP; ++q)
+          if (supports[i] & (1u << q)) nodes[n++] = elements[e][q];
+        const FaceKey k = n == 2
+                              ? FaceKey{std::min(nodes[0], nodes[1]), std::max(nodes[0], nodes[1]),
+                                        kInvalidIndex, kInvalidIndex}
+                              : face_key(std::span<const Index>(nodes.data(), n));
+        typename detail::NodeTable<R>::Rest rest;
+        for (std::size_t r = 0; r < R; ++r) rest[r] = k[r + 1];
+        ids[e * per_element + rank[i]] = table.find_or_add(k[0], rest, [&] {
+          keys.push_back(k);
+          return index_cast(keys.size() - 1);
+        });
       }
     }
-  }
+  };
+  tbb::parallel_invoke([&] { number.template operator()<1>(true, out.edges, edge_ids, n_edge); },
+                       [&] { number.template operator()<3>(false, out.faces, face_ids, n_face); });
   const auto ne = index_cast(out.edges.size());
   const auto nf = index_cast(out.faces.size());
 
@@ -195,9 +204,9 @@ DicedCellsOf<NC> dice_topology(Index nv, const std::vector<std::array<Index, NP>
                             } else if (s == kAll) {
                               c[k] = nv + ne + nf + index_cast(e);
                             } else {
-                              const Index id =
-                                  element_ids[e * ns + index_cast<std::size_t>(slot_of[ch][k])];
-                              c[k] = count == 2 ? nv + id : nv + ne + id;
+                              const std::size_t i = index_cast<std::size_t>(slot_of[ch][k]);
+                              c[k] = count == 2 ? nv + edge_ids[e * n_edge + rank[i]]
+                                                : nv + ne + face_ids[e * n_face + rank[i]];
                             }
                           }
                           out.parent[e * NChildren + ch] = index_cast(e);
