@@ -625,17 +625,30 @@ void Conformer::assemble() {
     for (Index& v : h) v = renum[primal::index_cast<std::size_t>(v)];
     return h;
   };
-  for (auto& h : diced_.tet_children) h = renumbered(h);
+  // The children renumbered and their blocks read in parallel (each element its own slot).
+  auto each = [](std::size_t n, auto&& f) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 8192),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t i = r.begin(); i != r.end(); ++i) f(i);
+                      });
+  };
+  each(diced_.tet_children.size(),
+       [&](std::size_t i) { diced_.tet_children[i] = renumbered(diced_.tet_children[i]); });
   std::vector<std::array<Index, 8>> hexes = std::move(diced_.tet_children);
   hexes.reserve(total);                                        // dicing's room: no copy
   hexes.insert(hexes.begin(), front, std::array<Index, 8>{});  // shifted within capacity
-  std::vector<int> block;
-  block.reserve(total);
-  std::size_t at = 0;
-  for (const auto& h : diced_.hex_children) hexes[at++] = renumbered(h);
+  std::vector<int> block(total);
+  auto blocks_of = [&](primal::ElementKind kind, const std::vector<Index>& parents,
+                       std::size_t first) {
+    each(parents.size(), [&](std::size_t i) {
+      block[first + i] = primal::block_of(lm, {kind, parents[i]});
+    });
+  };
+  each(diced_.hex_children.size(),
+       [&](std::size_t i) { hexes[i] = renumbered(diced_.hex_children[i]); });
+  std::size_t at = diced_.hex_children.size();
   primal::release(diced_.hex_children);
-  for (Index parent : diced_.hex_parent)
-    block.push_back(primal::block_of(lm, {primal::ElementKind::kHex, parent}));
+  blocks_of(primal::ElementKind::kHex, diced_.hex_parent, 0);
   diced_parent_ = std::move(diced_.hex_parent);  // per output diced hex: its input hex
   primal::release(diced_.hex_parent);
   geode_first_.reserve(nb + 1);
@@ -643,35 +656,38 @@ void Conformer::assemble() {
     geode_first_.push_back(primal::index_cast(at));
     const int id = blocks_.geode_id ? blocks_.geode_id : primal::block_of(lm, carved_from_[b]);
     for (const auto& h : ref(b).tpl.hex.hexes) {
+      block[at] = id;
       hexes[at++] = renumbered(instance(b, h));
-      block.push_back(id);
     }
   }
   geode_first_.push_back(primal::index_cast(at));
   primal::release(inst_global_, diced_.tet_children);
-  for (Index parent : diced_.tet_parent)
-    block.push_back(primal::block_of(lm, {primal::ElementKind::kTet, parent}));
+  blocks_of(primal::ElementKind::kTet, diced_.tet_parent, at);
   primal::release(diced_.tet_parent);
   for (const auto& h : diced_.wedge_children) hexes.push_back(renumbered(h));
   primal::release(diced_.wedge_children);
-  for (Index parent : diced_.wedge_parent)
-    block.push_back(primal::block_of(lm, {primal::ElementKind::kWedge, parent}));
+  blocks_of(primal::ElementKind::kWedge, diced_.wedge_parent, total - diced_.wedge_parent.size());
   primal::release(diced_.wedge_parent);
-  // The points permuted in place: follow each cycle of the renumbering (dropped nodes go to
-  // the tail, then are cut off).
+  // The points permuted in place, one coordinate at a time through an array of one
+  // coordinate per node (gathered in parallel, then put back): following the permutation's
+  // cycles, one random access after another, was half of assembly; a second array of points
+  // would be the run's peak.
   std::vector<Point>& points = diced_.points;
   {
-    Index tail = used;
-    for (Index& r : renum)
-      if (r == kInvalidIndex) r = tail++;
-    for (std::size_t i = 0; i < renum.size(); ++i)
-      while (renum[i] != primal::index_cast(i)) {
-        const auto j = primal::index_cast<std::size_t>(renum[i]);
-        std::swap(points[i], points[j]);
-        std::swap(renum[i], renum[j]);
-      }
+    std::vector<Index> from(primal::index_cast<std::size_t>(used));  // per output node: its own
+    each(renum.size(), [&](std::size_t i) {
+      if (const Index r = renum[i]; r != kInvalidIndex)
+        from[primal::index_cast<std::size_t>(r)] = primal::index_cast(i);
+    });
+    primal::release(renum);
+    std::vector<double> coordinate(from.size());
+    for (int c = 0; c < 3; ++c) {
+      each(from.size(), [&](std::size_t r) {
+        coordinate[r] = points[primal::index_cast<std::size_t>(from[r])][c];
+      });
+      each(from.size(), [&](std::size_t r) { points[r][c] = coordinate[r]; });
+    }
   }
-  primal::release(renum);
   // No shrink_to_fit: dice_model reserved about what it made, and a shrinking copy of every
   // point would be the run's peak.
   points.resize(primal::index_cast<std::size_t>(used));
