@@ -15,6 +15,8 @@ namespace geode::primal {
 
 namespace {
 
+using Hexes = std::span<const std::array<Index, 8>>;
+
 template <std::size_t N>
 bool proper(const std::array<Index, N>& a, std::size_t nodes) {
   for (std::size_t i = 0; i < N; ++i) {
@@ -27,19 +29,19 @@ bool proper(const std::array<Index, N>& a, std::size_t nodes) {
 
 // Marks the nodes of the marked hexes, then the hexes with a marked node: one ring further.
 // Linear passes over the hex array (no incidence built), hexes in parallel.
-void mark_nodes(const HexMesh& mesh, const std::vector<char>& hex_in, std::vector<char>& node_in) {
-  for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
+void mark_nodes(Hexes hexes, const std::vector<char>& hex_in, std::vector<char>& node_in) {
+  for (std::size_t h = 0; h < hexes.size(); ++h)
     if (hex_in[h])
-      for (Index v : mesh.hexes[h]) node_in[index_cast<std::size_t>(v)] = 1;
+      for (Index v : hexes[h]) node_in[index_cast<std::size_t>(v)] = 1;
 }
 
-void mark_hexes(const HexMesh& mesh, const std::vector<char>& node_in,
-                const std::vector<char>& proper_hex, std::vector<char>& hex_in) {
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.hexes.size(), 8192),
+void mark_hexes(Hexes hexes, const std::vector<char>& node_in, const std::vector<char>& proper_hex,
+                std::vector<char>& hex_in) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, hexes.size(), 8192),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t h = range.begin(); h != range.end(); ++h) {
                         if (hex_in[h] || !proper_hex[h]) continue;
-                        for (Index v : mesh.hexes[h])
+                        for (Index v : hexes[h])
                           if (node_in[index_cast<std::size_t>(v)]) {
                             hex_in[h] = 1;
                             break;
@@ -52,7 +54,13 @@ void mark_hexes(const HexMesh& mesh, const std::vector<char>& node_in,
 
 HexValidityReport check_validity_around(const HexMesh& mesh, std::span<const Index> seeds,
                                         const RegionValidityOptions& options) {
-  const std::size_t nv = mesh.points.size(), nh = mesh.hexes.size();
+  return check_validity_around(mesh.points, mesh.hexes, seeds, options);
+}
+
+HexValidityReport check_validity_around(std::span<const Point> points, Hexes hexes,
+                                        std::span<const Index> seeds,
+                                        const RegionValidityOptions& options) {
+  const std::size_t nv = points.size(), nh = hexes.size();
   HexValidityReport r;
   r.num_nodes = index_cast(nv);
   r.num_hexes = index_cast(nh);
@@ -64,7 +72,7 @@ HexValidityReport check_validity_around(const HexMesh& mesh, std::span<const Ind
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nh, 8192),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t h = range.begin(); h != range.end(); ++h) {
-                        const auto& hex = mesh.hexes[h];
+                        const auto& hex = hexes[h];
                         if (!std::all_of(hex.begin(), hex.end(), [nv](Index v) {
                               return v >= 0 && index_cast<std::size_t>(v) < nv;
                             })) {
@@ -88,7 +96,7 @@ HexValidityReport check_validity_around(const HexMesh& mesh, std::span<const Ind
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv, 8192),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t v = range.begin(); v != range.end(); ++v)
-                        finite[v] = mesh.points[v].allFinite();
+                        finite[v] = points[v].allFinite();
                     });
   for (std::size_t v = 0; v < nv; ++v) {
     if (!finite[v]) r.non_finite_nodes.push_back(index_cast(v));
@@ -97,17 +105,19 @@ HexValidityReport check_validity_around(const HexMesh& mesh, std::span<const Ind
   release(used);
   {
     std::vector<char> inverted(nh, 0);
-    const bool known = options.scaled_jacobians.size() == nh;
+    const bool known = options.positive.size() == nh;
     tbb::parallel_for(
         tbb::blocked_range<std::size_t>(0, nh, 4096),
         [&](const tbb::blocked_range<std::size_t>& range) {
           for (std::size_t h = range.begin(); h != range.end(); ++h) {
-            const auto& hex = mesh.hexes[h];
+            const auto& hex = hexes[h];
             if (!std::all_of(hex.begin(), hex.end(),
                              [nv](Index v) { return v >= 0 && index_cast<std::size_t>(v) < nv; }))
               continue;
-            if (known && options.scaled_jacobians[h] > 0.0) continue;  // all 9 dets > 0
-            const auto j = hex_jacobians(hex_corners(mesh, index_cast(h)));
+            if (known && options.positive[h]) continue;  // all 9 dets > 0
+            HexCorners p;
+            for (std::size_t c = 0; c < 8; ++c) p[c] = points[index_cast<std::size_t>(hex[c])];
+            const auto j = hex_jacobians(p);
             // Corners 0..7 only, as check_validity (index 8 is the centre).
             inverted[h] = !std::all_of(j.begin(), j.begin() + 8, [](double d) { return d > 0.0; });
           }
@@ -122,13 +132,13 @@ HexValidityReport check_validity_around(const HexMesh& mesh, std::span<const Ind
     if (h >= 0 && index_cast<std::size_t>(h) < nh && proper_hex[index_cast<std::size_t>(h)])
       hex_in[index_cast<std::size_t>(h)] = 1;
   for (int ring = 0; ring < options.rings; ++ring) {
-    mark_nodes(mesh, hex_in, node_in);
-    mark_hexes(mesh, node_in, proper_hex, hex_in);
+    mark_nodes(hexes, hex_in, node_in);
+    mark_hexes(hexes, node_in, proper_hex, hex_in);
   }
   std::vector<char>& checked = node_in;
   std::fill(checked.begin(), checked.end(), 0);
-  mark_nodes(mesh, hex_in, checked);
-  mark_hexes(mesh, checked, proper_hex, hex_in);
+  mark_nodes(hexes, hex_in, checked);
+  mark_hexes(hexes, checked, proper_hex, hex_in);
 
   // The region as a mesh of its own, checked whole; its findings kept where they hold for the
   // whole mesh: at checked nodes, which have all their hexes in it.
@@ -139,11 +149,11 @@ HexValidityReport check_validity_around(const HexMesh& mesh, std::span<const Ind
     sub_hex.push_back(index_cast(h));
     std::array<Index, 8> q{};
     for (int c = 0; c < 8; ++c) {
-      const auto v = index_cast<std::size_t>(mesh.hexes[h][c]);
+      const auto v = index_cast<std::size_t>(hexes[h][c]);
       if (local[v] == kInvalidIndex) {
         local[v] = index_cast(sub_node.size());
         sub_node.push_back(index_cast(v));
-        sub.points.push_back(mesh.points[v]);
+        sub.points.push_back(points[v]);
       }
       q[c] = local[v];
     }

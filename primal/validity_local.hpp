@@ -3,6 +3,7 @@
 // region of hexes (say a transition and the hexes a smoother moved), the rest of the mesh being
 // valid by construction (a dicing checked against its tables, dice_model.hpp's check_dicing).
 // Costs what the region costs, plus one pass over every hex for the corner Jacobians.
+#include <array>
 #include <span>
 
 #include <geode/primal/mesh.hpp>
@@ -16,10 +17,10 @@ struct RegionValidityOptions {
   // edge from a node moved before dicing (a diced input edge is two hex edges long), whose
   // corner cones the move turned.
   int rings = 2;
-  // Empty, or one per hex: its scaled Jacobian (quality.hpp's hex_scaled_jacobian, over the
-  // corners and the centre) as the mesh is now. A hex above 0 then has positive corners and is
-  // not measured again; the others are.
-  std::span<const double> scaled_jacobians;
+  // Empty, or one per hex: nonzero where its scaled Jacobian (quality.hpp's
+  // hex_scaled_jacobian, over the corners and the centre) is above 0 as the mesh is now. Such a
+  // hex has positive corners and is not measured again; the others are.
+  std::span<const char> positive;
 };
 
 // check_validity's findings at the checked nodes, on the faces and edges with a checked node,
@@ -31,6 +32,11 @@ struct RegionValidityOptions {
 // disk or a sphere makes the boundary a closed manifold surface). With every hex seeded and
 // rings >= 0 the verdict (ok()) is check_validity's.
 HexValidityReport check_validity_around(const HexMesh& mesh, std::span<const Index> seeds,
+                                        const RegionValidityOptions& options = {});
+// The same on a mesh's arrays held elsewhere (a primal::Model's points and hexes).
+HexValidityReport check_validity_around(std::span<const Point> points,
+                                        std::span<const std::array<Index, 8>> hexes,
+                                        std::span<const Index> seeds,
                                         const RegionValidityOptions& options = {});
 
 }  // namespace geode::primal
