@@ -3,6 +3,7 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
+#include <exception>
 #include <filesystem>
 #include <iostream>
 #include <limits>
@@ -190,6 +191,24 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
   opts.smoothing_progress = [&progress](std::size_t done, std::size_t total) {
     progress.step("seed hexes settled", done, total);
   };
+  // The mesh is written to its temporary while conform verifies it (ConformOptions::write_ahead),
+  // and published (with the report) only if it is valid or --write-invalid asks for it.
+  OutputFiles files;
+  const primal::Model* written = nullptr;
+  std::exception_ptr write_failed;
+  if (!a.output.empty()) {
+    const std::size_t mesh_file = files.add(a.output, [&](const fs::path& temp) {
+      io::write_model(*written, temp, format, write_options(a.vtk_encoding));
+    });
+    opts.write_ahead = [&, mesh_file](const primal::Model& m) {
+      written = &m;
+      try {
+        files.write(mesh_file);
+      } catch (...) {  // reported after the run: not as the input's fault
+        write_failed = std::current_exception();
+      }
+    };
+  }
   conform::ConformResult r;
   try {
     r = conform::conform(std::move(model), opts);  // the hints below read what is left
@@ -201,12 +220,9 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
                         conform::duplicate_node_hint(model, "--merge-tolerance"));
   }
   const bool valid = conform::result_valid(r);
+  written = &r.model;
   if (valid || a.write_invalid) {
-    OutputFiles files;
-    if (!a.output.empty())
-      files.add(a.output, [&](const fs::path& temp) {
-        io::write_model(r.model, temp, format, write_options(a.vtk_encoding));
-      });
+    if (write_failed) std::rethrow_exception(write_failed);
     if (!a.report.empty()) {
       files.add(a.report, [text = conform::report_json(r).dump(2) + "\n"](const fs::path& temp) {
         write_or_print(temp.string(), [&](std::ostream& os) { os << text; });

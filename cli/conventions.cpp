@@ -336,28 +336,34 @@ CLI::Option* add_write_invalid_flag(CLI::App* app, bool& flag) {
       "is not written");
 }
 
-void OutputFiles::add(const fs::path& target, Writer write) {
+std::size_t OutputFiles::add(const fs::path& target, Writer write) {
   entries_.push_back({target, io::resolve_output(target), {}, std::move(write)});
+  return entries_.size() - 1;
+}
+
+void OutputFiles::write(std::size_t i) {
+  // Each output to a registered temporary (io/atomic_file.hpp: removed on signals too) with the
+  // target's extension, for writers that go by it; a symbolic link is written through.
+  Entry& e = entries_.at(i);
+  if (e.written) return;
+  e.temp = io::create_temporary(e.resolved, e.target.extension().string());
+  pending_.push_back(e.temp);
+  try {
+    e.write(e.temp);
+  } catch (const InvalidInput& error) {
+    // Writers name the file they were given; the user gave the target, not our temporary.
+    std::string what = error.what();
+    const std::string temp = e.temp.string();
+    for (auto at = what.find(temp); at != std::string::npos;
+         at = what.find(temp, at + e.target.string().size()))
+      what.replace(at, temp.size(), e.target.string());
+    throw InvalidInput(what);
+  }
+  e.written = true;
 }
 
 void OutputFiles::commit() {
-  // Each output to a registered temporary (io/atomic_file.hpp: removed on signals too) with the
-  // target's extension, for writers that go by it; a symbolic link is written through.
-  for (Entry& e : entries_) {
-    e.temp = io::create_temporary(e.resolved, e.target.extension().string());
-    pending_.push_back(e.temp);
-    try {
-      e.write(e.temp);
-    } catch (const InvalidInput& error) {
-      // Writers name the file they were given; the user gave the target, not our temporary.
-      std::string what = error.what();
-      const std::string temp = e.temp.string();
-      for (auto at = what.find(temp); at != std::string::npos;
-           at = what.find(temp, at + e.target.string().size()))
-        what.replace(at, temp.size(), e.target.string());
-      throw InvalidInput(what);
-    }
-  }
+  for (std::size_t i = 0; i < entries_.size(); ++i) write(i);
   // All renamed as one (io/atomic_file.hpp): a failure or a signal between two renames puts
   // back what the targets held, so a mesh never stands without its report.
   std::vector<io::Publication> items;

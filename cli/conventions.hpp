@@ -119,7 +119,11 @@ CLI::Option* add_write_invalid_flag(CLI::App* app, bool& flag);
 class OutputFiles {
  public:
   using Writer = std::function<void(const std::filesystem::path& temp)>;
-  void add(const std::filesystem::path& target, Writer write);
+  // Returns the output's number, for write().
+  std::size_t add(const std::filesystem::path& target, Writer write);
+  // Writes output `i` to its temporary now, once (commit() then publishes it as it is); a
+  // failure leaves nothing behind, as commit()'s.
+  void write(std::size_t i);
   void commit();
   ~OutputFiles();
 
@@ -129,6 +133,7 @@ class OutputFiles {
     io::OutputTarget resolved;     // symbolic links followed
     std::filesystem::path temp;
     Writer write;
+    bool written = false;
   };
   std::vector<Entry> entries_;
   std::vector<std::filesystem::path> pending_;  // temporaries to remove on failure

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
+#include <exception>
 #include <limits>
 #include <map>
 #include <numeric>
@@ -11,6 +12,7 @@
 #include <unordered_map>
 
 #include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 
@@ -141,8 +143,8 @@ class Conformer {
     assemble();
     settle_templates();
     smooth();
-    verify();
-    output();
+    invert_for_test();
+    verify_and_output();
     res_.seconds = since(t_start);
     return std::move(res_);
   }
@@ -180,8 +182,16 @@ class Conformer {
   void check_dicing();
   bool verify_locally() const;
   void invert_for_test();
-  void verify();
+  void check();
+  void report();
+  void announce() const;
   void output();
+  void verify_and_output();
+  // The output's arrays: in mesh_ until output() moves them into the result's model.
+  std::span<const Point> out_points() const { return output_ ? res_.model.points : mesh_.points; }
+  std::span<const std::array<Index, 8>> out_hexes() const {
+    return output_ ? res_.model.hexes : mesh_.hexes;
+  }
 
   const primal::Model& input_;
   const ConformOptions& options_;
@@ -220,9 +230,11 @@ class Conformer {
   std::vector<double> aim_local_;
   std::vector<Index> diced_parent_;  // per output diced hex (the first ones): its input hex
   std::vector<Index> geode_first_;  // per buffer hex: its first output hex (then one past the last)
-  // The hexes whose nodes smoothing or untangling could move (their regions), for verify().
+  // The hexes whose nodes smoothing or untangling could move (their regions), for check().
   std::vector<Index> moved_;
   double dicing_check_seconds_ = 0.0;  // check_dicing, run while the dicing data exist
+  std::vector<char> positive_;         // per output hex: its scaled Jacobian was above 0 (check())
+  bool output_ = false;                // output() has moved the mesh into res_.model
 };
 
 void Conformer::find_interface() {
@@ -453,7 +465,7 @@ void Conformer::dice_and_merge() {
 }
 
 // Local verification: the diced children against the dicer's tables, now that they exist (the
-// dicing data are gone by verify()); the children's topology is final here, smoothing moves
+// dicing data are gone by check()); the children's topology is final here, smoothing moves
 // nodes only.
 void Conformer::check_dicing() {
   if (!verify_locally()) return;
@@ -1036,9 +1048,8 @@ void Conformer::invert_for_test() {
   moved_.insert(moved_.end(), at.begin(), at.end());
 }
 
-void Conformer::verify() {
-  invert_for_test();
-  t0_ = Clock::now();
+// The output's validity (verify_locally(): around what was not diced).
+void Conformer::check() {
   if (verify_locally()) {
     // Seeds: the geode hexes and whatever smoothing could move; the rest is diced, checked
     // against the dicing tables in check_dicing().
@@ -1047,8 +1058,8 @@ void Conformer::verify() {
     if (!geode_first_.empty())
       for (Index h = geode_first_.front(); h < geode_first_.back(); ++h) seeds.push_back(h);
     primal::RegionValidityOptions o;
-    o.scaled_jacobians = sj_;  // current: a hex above 0 has positive corners
-    res_.validity = primal::check_validity_around(mesh_, seeds, o);
+    o.positive = positive_;
+    res_.validity = primal::check_validity_around(out_points(), out_hexes(), seeds, o);
     res_.verified = ConformVerify::kLocal;
     res_.verified_hexes = res_.validity.num_cells;
     if (!res_.dicing.ok()) res_.warnings.push_back("invalid dicing: " + res_.dicing.summary());
@@ -1067,9 +1078,13 @@ void Conformer::verify() {
     if (inverted_.size() > 20) m << " ...";
     res_.warnings.push_back(m.str());
   }
+}
+
+// The quality per output block.
+void Conformer::report() {
   std::map<int, std::vector<Index>> members;  // output block -> its hexes, ascending id
-  for (std::size_t h = 0; h < mesh_.hexes.size(); ++h)
-    members[mesh_.block[h]].push_back(primal::index_cast(h));
+  const std::vector<int>& block = mesh_.block;
+  for (std::size_t h = 0; h < block.size(); ++h) members[block[h]].push_back(primal::index_cast(h));
   for (const auto& [id, sel] : members) {
     const auto name = blocks_.names.find(id);
     primal::QualityReport report;
@@ -1105,7 +1120,7 @@ void Conformer::verify() {
     const double local =
         res_.local_yardstick[primal::index_cast<std::size_t>(layer_.hexes[b].quad)];
     for (Index h = geode_first_[b]; h < geode_first_[b + 1]; ++h) {
-      const int id = mesh_.block[primal::index_cast<std::size_t>(h)];
+      const int id = block[primal::index_cast<std::size_t>(h)];
       auto it = std::find_if(res_.quality.begin(), res_.quality.end(),
                              [&](const BlockQuality& q) { return q.block == id; });
       const double sj = sj_[primal::index_cast<std::size_t>(h)];
@@ -1116,7 +1131,10 @@ void Conformer::verify() {
       res_.local_yardstick_ratio = std::min(res_.local_yardstick_ratio, sj / local);
     }
   }
-  primal::release(sj_);
+}
+
+// Verification's verdict, as a progress line.
+void Conformer::announce() const {
   const bool valid = res_.validity.ok() && res_.dicing.ok();
   say("verification (" + std::string(res_.verified == ConformVerify::kLocal ? "local" : "full") +
       ", " + std::to_string(res_.verified_hexes) +
@@ -1134,6 +1152,48 @@ void Conformer::output() {
   out.points = std::move(mesh_.points);
   out.node_sets = std::move(node_sets_);
   out.side_sets = std::move(side_sets_);
+  output_ = true;
+}
+
+// Verification, and the output written (options_.write_ahead) while the default validity check
+// runs: both read the output's arrays only. The per-block report comes first, so that neither
+// its lists nor the scaled Jacobians (kept as their signs) are held beside the writer's buffers.
+// The whole-mesh checks (check_validity, the full quality report) read mesh_: those run before
+// the writer.
+void Conformer::verify_and_output() {
+  t0_ = Clock::now();
+  report();
+  positive_.resize(sj_.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sj_.size(), 8192),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t h = r.begin(); h != r.end(); ++h)
+                        positive_[h] = sj_[h] > 0.0;  // all 9 determinants above 0
+                    });
+  primal::release(sj_);
+  const bool ahead =
+      options_.write_ahead && verify_locally() &&
+      options_.quality == ConformQuality::kScaledJacobian &&
+      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism) > 1;
+  if (!ahead) {
+    check();
+    announce();
+    output();
+    if (options_.write_ahead) options_.write_ahead(res_.model);
+    return;
+  }
+  output();
+  std::exception_ptr failed;
+  tbb::parallel_invoke([&] { check(); },
+                       [&] {
+                         try {
+                           options_.write_ahead(res_.model);
+                         } catch (...) {
+                           failed = std::current_exception();
+                         }
+                       });
+  primal::release(positive_);
+  announce();
+  if (failed) std::rethrow_exception(failed);
 }
 
 }  // namespace

@@ -148,6 +148,12 @@ struct ConformOptions {
   // Called after each round of smoothing with (seed hexes settled, seed hexes), for a progress
   // bar; when empty, `progress` gets a line every few seconds instead.
   std::function<void(std::size_t done, std::size_t total)> smoothing_progress;
+  // Called once with the output model (ConformResult::model, before it is returned) when it is
+  // final: on a thread of its own while the default verification (ConformVerify::kLocal, the
+  // scaled Jacobian report) runs, else after verification, so that a caller writing it (to a
+  // temporary file: the result may yet be found invalid) waits for no write of its own. An
+  // exception it throws is rethrown once verification is done. May be empty.
+  std::function<void(const primal::Model&)> write_ahead;
 };
 
 struct BlockQuality {

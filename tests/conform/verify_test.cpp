@@ -3,12 +3,19 @@
 // verdict on every demo model, as Gmsh meshes them, and a fault in the transition caught.
 #include <doctest/doctest.h>
 
+#include <tbb/global_control.h>
+
 #include <algorithm>
+#include <array>
+#include <map>
+#include <string>
+#include <vector>
 
 #include <geode/conform/conform.hpp>
 #include <geode/conform/report.hpp>
 #include <geode/demo/demo_models.hpp>
 #include <geode/io/read_model.hpp>
+#include <geode/primal/errors.hpp>
 #include <geode/primal/model.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/validity_local.hpp>
@@ -110,10 +117,58 @@ TEST_CASE(
     const auto found = primal::check_validity_around(flipped, geode);
     CHECK(!found.ok());
     CHECK(found.inverted_hexes == std::vector<Index>{0});
-    // With the scaled Jacobians handed in, the hexes above 0 are not measured again: the same.
+    // With the signs of the scaled Jacobians handed in, the hexes above 0 are not measured
+    // again: the same.
     primal::RegionValidityOptions o;
     const std::vector<double> sj = primal::scaled_jacobian_per_hex(flipped);
-    o.scaled_jacobians = sj;
+    std::vector<char> positive(sj.size());
+    for (std::size_t h = 0; h < sj.size(); ++h) positive[h] = sj[h] > 0.0;
+    o.positive = positive;
     CHECK(primal::check_validity_around(flipped, geode, o).inverted_hexes == std::vector<Index>{0});
+    // The same on the mesh's arrays, as conform hands them over from its output model.
+    CHECK(primal::check_validity_around(flipped.points, flipped.hexes, geode, o).inverted_hexes ==
+          std::vector<Index>{0});
   }
+}
+
+TEST_CASE("write_ahead gets the final model once, beside verification or after it") {
+  const primal::Model input = demo::demo_model("delaunay", 3);
+  const auto plain = conform::conform(input);
+  REQUIRE(conform::result_valid(plain));
+  struct Case {
+    conform::ConformVerify verify;
+    int threads;
+  };
+  // Local verification on two threads writes beside the check; full verification, or one
+  // thread, after it: the model handed over and the result are the same in every case.
+  for (const Case c :
+       {Case{conform::ConformVerify::kLocal, 2}, Case{conform::ConformVerify::kLocal, 1},
+        Case{conform::ConformVerify::kFull, 2}}) {
+    CAPTURE(c.threads);
+    const tbb::global_control limit(tbb::global_control::max_allowed_parallelism,
+                                    static_cast<std::size_t>(c.threads));
+    conform::ConformOptions o;
+    o.verify = c.verify;
+    int calls = 0;
+    std::vector<primal::Point> points;
+    std::vector<std::array<Index, 8>> hexes;
+    std::map<int, std::string> names;
+    o.write_ahead = [&](const primal::Model& m) {
+      ++calls;
+      points = m.points, hexes = m.hexes, names = m.block_names;
+    };
+    const auto r = conform::conform(input, o);
+    CHECK(calls == 1);
+    CHECK(conform::result_valid(r));
+    CHECK(r.validity.ok() == plain.validity.ok());
+    CHECK(points == plain.model.points);
+    CHECK(hexes == plain.model.hexes);
+    CHECK(names == plain.model.block_names);
+    CHECK(r.model.hexes == plain.model.hexes);
+    CHECK(r.quality.size() == plain.quality.size());
+  }
+  // A writer's failure reaches the caller once verification is done.
+  conform::ConformOptions failing;
+  failing.write_ahead = [](const primal::Model&) { throw InvalidInput("disk full"); };
+  CHECK_THROWS_WITH_AS(conform::conform(input, failing), "disk full", InvalidInput);
 }
