@@ -53,6 +53,7 @@ class FileSink {
   std::string target_;
   std::vector<char> buffer_;
   std::size_t used_ = 0;
+  std::size_t written_ = 0, handed_ = 0;  // bytes written; of them, handed to the disk
 };
 
 }  // namespace geode::io
