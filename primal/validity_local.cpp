@@ -27,6 +27,16 @@ bool proper(const std::array<Index, N>& a, std::size_t nodes) {
   return true;
 }
 
+// Every corner Jacobian above 0 (hex_jacobians' corners, the same values; not its centre, as
+// check_validity), the first that is not ending the search.
+bool corners_positive(const HexCorners& p) {
+  for (int c = 0; c < 8; ++c) {
+    const auto f = hex_corner_frame(p, c);
+    if (!(f[0].dot(f[1].cross(f[2])) > 0.0)) return false;
+  }
+  return true;
+}
+
 // Marks the nodes of the marked hexes, then the hexes with a marked node: one ring further.
 // Linear passes over the hex array (no incidence built), hexes in parallel.
 void mark_nodes(Hexes hexes, const std::vector<char>& hex_in, std::vector<char>& node_in) {
@@ -106,22 +116,21 @@ HexValidityReport check_validity_around(std::span<const Point> points, Hexes hex
   {
     std::vector<char> inverted(nh, 0);
     const bool known = options.positive.size() == nh;
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, nh, 4096),
-        [&](const tbb::blocked_range<std::size_t>& range) {
-          for (std::size_t h = range.begin(); h != range.end(); ++h) {
-            const auto& hex = hexes[h];
-            if (!std::all_of(hex.begin(), hex.end(),
-                             [nv](Index v) { return v >= 0 && index_cast<std::size_t>(v) < nv; }))
-              continue;
-            if (known && options.positive[h]) continue;  // all 9 dets > 0
-            HexCorners p;
-            for (std::size_t c = 0; c < 8; ++c) p[c] = points[index_cast<std::size_t>(hex[c])];
-            const auto j = hex_jacobians(p);
-            // Corners 0..7 only, as check_validity (index 8 is the centre).
-            inverted[h] = !std::all_of(j.begin(), j.begin() + 8, [](double d) { return d > 0.0; });
-          }
-        });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nh, 4096),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        for (std::size_t h = range.begin(); h != range.end(); ++h) {
+                          const auto& hex = hexes[h];
+                          if (!std::all_of(hex.begin(), hex.end(), [nv](Index v) {
+                                return v >= 0 && index_cast<std::size_t>(v) < nv;
+                              }))
+                            continue;
+                          if (known && options.positive[h]) continue;  // all 9 dets > 0
+                          HexCorners p;
+                          for (std::size_t c = 0; c < 8; ++c)
+                            p[c] = points[index_cast<std::size_t>(hex[c])];
+                          inverted[h] = !corners_positive(p);
+                        }
+                      });
     for (std::size_t h = 0; h < nh; ++h)
       if (inverted[h]) r.inverted_hexes.push_back(index_cast(h));
   }
