@@ -393,10 +393,10 @@ void Distributor::conform_zone() {
 
 // The zone rank's load per child of a zone element, against 1 per diced hex elsewhere: the
 // zone's output per child (1.2 on bench_mpi's half 68) with its conform, the check around the
-// cut and writing on one rank. Tuned on half 68, 2 ranks: with dicing as fast as it is now,
-// rank 0 waits about 0.7 s for the zone rank whether this is 1.6 or 2.0 (the same wall time),
-// so it balances the ranks' peaks instead: 1.6, 1.8 and 2.0 gave 597 / 606, 604 / 597 and
-// 629 / 585 MiB (rank 0 / the zone rank).
+// cut and writing on one rank. Tuned on half 68, 2 ranks: rank 0 waits about 0.6-0.7 s for the
+// zone rank whether this is 1.8 or 2.6 (the zone's conform, 1.9 s, is what it waits for; the
+// same wall time), so it balances the ranks' peaks instead: 1.8, 2.0, 2.3 and 2.6 gave
+// 572 / 536, 595 / 556, 605 / 544 and 617 / 537 MiB (rank 0 / the zone rank).
 constexpr double kZoneLoad = 1.8;
 
 // Per flat element its rank: the input's own partition, or METIS's on rank 0 (the elements
@@ -487,7 +487,10 @@ void Distributor::dice() {
   // output's hex array where they are.
   const std::size_t room =
       zone_last_ - zone_first_ + 8 * own_.model.hexes.size() + 6 * own_.model.wedges.size();
-  diced_ = primal::dice_model(own_.model, {}, room);
+  // The zone rank's points get room for the zone's nodes its zone hexes use, which assembly
+  // puts beside them (at most the zone's nodes): a copy of them all, at its peak, otherwise.
+  diced_ = primal::dice_model(own_.model, {}, room,
+                              zone_out_.hexes.empty() ? 0 : zone_out_.points.size());
   rep_.cells = static_cast<std::int64_t>(std::count(mine.begin(), mine.end(), 1));
   break_for_test();
   // Local verification reads the children against the tables while the dicing data exist.
@@ -905,6 +908,7 @@ void Distributor::assemble() {
   if (!zone_out_.points.empty())  // the zone nodes no diced node took (the same bits where one did)
     for (std::size_t l = 0; l < zone_locals_; ++l)
       o.points[l] = zone_out_.points[primal::index_cast<std::size_t>(low[l])];
+  primal::release(zone_out_.points);  // consumed
   // Shared nodes per neighbour, from the holders of the local nodes other ranks hold too.
   std::vector<std::pair<Index, Mask>> holders;
   for (const auto& [i, mask] : diced_shared_) holders.emplace_back(diced_local[i], mask);
@@ -998,6 +1002,7 @@ void Distributor::assemble() {
     std::array<Index, 8>& x = o.hexes[place(static_cast<std::int64_t>(h))];
     for (int c = 0; c < 8; ++c) x[c] = local(zone_out_.hexes[h - zone_base_][c]);
   }
+  primal::release(zone_out_.hexes);  // consumed, before the children are placed
   for (auto* part : {&diced_.hex_children, &diced_.tet_children, &diced_.wedge_children}) {
     for (const auto& child : *part) {
       std::array<Index, 8>& x =

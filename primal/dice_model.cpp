@@ -339,7 +339,8 @@ double diced_wedge_min_scaled_jacobian(std::span<const Point> points,
   return lowest;
 }
 
-DicedModel dice_model(const Model& model, std::span<const char> shareable, std::size_t tet_room) {
+DicedModel dice_model(const Model& model, std::span<const char> shareable, std::size_t tet_room,
+                      std::size_t point_room) {
   if (!model.pyramids.empty())
     throw InvalidInput("dice_model: " + describe_element(model, {ElementKind::kPyramid, 0}) +
                        ": pyramids are not diced; split them into tets first (split_pyramids)");
@@ -350,7 +351,7 @@ DicedModel dice_model(const Model& model, std::span<const char> shareable, std::
   // E ~ V + T, F ~ 2T), a wedge at most 16. Capacity never touched is never resident.
   const std::size_t room = model.points.size() + 7 * model.hexes.size() + 5 * model.tets.size() +
                            16 * model.wedges.size();
-  out.points.reserve(room);
+  out.points.reserve(room + point_room);
   out.origin.reserve(room);
   out.points = model.points;
   out.origin.resize(V);

@@ -49,10 +49,11 @@ struct DicedModel {
 // `shareable` (per model point, may be empty) marks nodes besides the interface whose diced
 // edge and face nodes the caller will look up with find(). `tet_room`: capacity in
 // tet_children for that many more hexes, which the caller puts beside them without copying
-// them (conform inserts the hex children and its templates in front). Throws InvalidInput
-// from dice().
+// them (conform inserts the hex children and its templates in front). `point_room`: capacity
+// in points for that many more nodes, likewise (geode_mpi's zone rank adds the zone's).
+// Throws InvalidInput from dice().
 DicedModel dice_model(const Model& model, std::span<const char> shareable = {},
-                      std::size_t tet_room = 0);
+                      std::size_t tet_room = 0, std::size_t point_room = 0);
 
 // A diced model read against the dicing tables (dice.hpp's hex_dicing_table and
 // tet_dicing_table, the wedge rule of dice_model): every child corner is the node its table
