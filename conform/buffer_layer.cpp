@@ -192,30 +192,33 @@ void BufferBuilder::moving_part(const Cells& cells, const Edges& edges, const Fa
     for (std::size_t i = 0; i < kFaceSize; ++i) f[i] = cell[index_cast<std::size_t>(fc[i])];
     return f;
   };
-  // Each cell face numbered once (its id), with its number of uses; interface faces get -1.
-  KeyMap<4> ids(cells.size() * nf / 2);
-  std::vector<Index> face_id(cells.size() * nf);
-  std::vector<Index> uses;
-  for (std::size_t c = 0; c < cells.size(); ++c)
-    for (std::size_t f = 0; f < nf; ++f) {
-      const auto [id, fresh] =
-          ids.try_emplace(face_key(face_nodes(cells[c], faces[f])), index_cast(uses.size()));
-      if (fresh) uses.push_back(0);
-      face_id[c * nf + f] = *id;
-      ++uses[index_cast<std::size_t>(*id)];
-    }
-  for (const auto& [cell, f] : interface_faces)
-    uses[index_cast<std::size_t>(
-        face_id[index_cast<std::size_t>(cell) * nf + index_cast<std::size_t>(f)])] = -1;
-  outer_normals_.assign(n_moved_, {});
+  // The cells with a moving node (or a moving centre), whose faces on the moving part's outer
+  // boundary give the outward normals.
+  std::vector<Index> touched;
   for (std::size_t c = 0; c < cells.size(); ++c) {
-    const auto& cell = cells[c];
     const auto ci = index_cast(c);
     bool touches = false;
-    for (Index v : cell)
+    for (Index v : cells[c])
       touches |=
           moves(ci, v) || (!hex_side_ && centre_of_[index_cast<std::size_t>(v)] != kInvalidIndex);
-    if (!touches) continue;
+    if (touches) touched.push_back(ci);
+  }
+  // Their faces' uses over the whole part, counted in a table of those faces only (a table of
+  // every face of the part, filled and searched, was most of this stage); interface faces -1.
+  KeyMap<4> uses(touched.size() * nf);
+  for (Index c : touched)
+    for (std::size_t f = 0; f < nf; ++f)
+      uses.try_emplace(face_key(face_nodes(cells[index_cast<std::size_t>(c)], faces[f])), 0);
+  for (const auto& cell : cells)
+    for (std::size_t f = 0; f < nf; ++f)
+      if (Index* n = uses.find(face_key(face_nodes(cell, faces[f])))) ++*n;
+  for (const auto& [cell, f] : interface_faces)
+    if (Index* n = uses.find(face_key(
+            face_nodes(cells[index_cast<std::size_t>(cell)], faces[index_cast<std::size_t>(f)]))))
+      *n = -1;
+  outer_normals_.assign(n_moved_, {});
+  for (Index ci : touched) {
+    const auto& cell = cells[index_cast<std::size_t>(ci)];
     touched_.push_back(ci);
     for (const auto& e : edges) {
       const Index a = cell[index_cast<std::size_t>(e[0])], b = cell[index_cast<std::size_t>(e[1])];
@@ -224,9 +227,8 @@ void BufferBuilder::moving_part(const Cells& cells, const Edges& edges, const Fa
         if (moves(ci, v)) shortest_[slot(v)] = std::min(shortest_[slot(v)], len);
     }
     for (std::size_t k = 0; k < nf; ++k) {
-      if (uses[index_cast<std::size_t>(face_id[c * nf + k])] != 1)
-        continue;  // inner or interface face
       const auto f = face_nodes(cell, faces[k]);
+      if (*uses.find(face_key(f)) != 1) continue;  // inner or interface face
       // Twice the outward area vector (triangle or quad: the cross product of the diagonals).
       const Point area = kFaceSize == 3
                              ? Point((pt(f[1]) - pt(f[0])).cross(pt(f[2]) - pt(f[0])))
