@@ -387,21 +387,39 @@ DicedModel dice_model(const Model& model, std::span<const char> shareable, std::
                          elements.size());
     for (Index v = 0; v < V; ++v) g[index_cast<std::size_t>(v)] = v;
     std::size_t next = index_cast<std::size_t>(V);
+    // The new nodes numbered (and their origins listed) in dice()'s order first, on one core;
+    // then placed, in parallel: the centroid of their origin nodes, a cell centre its corners'.
+    const std::size_t first = out.origin.size();
     for (const auto* keys : {&d.edges, &d.faces}) {
       for (const FaceKey& k : *keys) {
         const FaceKey key = normalized_origin(k);
-        const Point p = origin_centroid(model.points, key);
+        const auto made = [&] {
+          out.origin.push_back(key);
+          return index_cast(out.origin.size() - 1);
+        };
         if (!may_meet(key)) {
-          g[next++] = out.add_node(p, key);
+          g[next++] = made();
           continue;
         }
         auto [id, inserted] = out.shared.try_emplace(key, kInvalidIndex);
-        if (inserted) *id = out.add_node(p, key);
+        if (inserted) *id = made();
         g[next++] = *id;
       }
     }
     release(d.edges, d.faces);
-    for (const auto& e : elements) g[next++] = out.add_node(corner_centroid(model.points, e));
+    const std::size_t centres = out.origin.size();
+    for (std::size_t e = 0; e < elements.size(); ++e) {
+      out.origin.push_back(kNoOrigin);
+      g[next++] = index_cast(centres + e);
+    }
+    out.points.resize(out.origin.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(first, out.points.size(), 4096),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t n = r.begin(); n != r.end(); ++n)
+                          out.points[n] =
+                              n < centres ? origin_centroid(model.points, out.origin[n])
+                                          : corner_centroid(model.points, elements[n - centres]);
+                      });
     for (auto& c : d.children)
       for (Index& v : c) v = g[index_cast<std::size_t>(v)];
     children = std::move(d.children);
