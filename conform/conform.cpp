@@ -9,6 +9,8 @@
 #include <numeric>
 #include <span>
 #include <sstream>
+#include <system_error>
+#include <thread>
 #include <unordered_map>
 
 #include <tbb/blocked_range.h>
@@ -1183,14 +1185,27 @@ void Conformer::verify_and_output() {
   }
   output();
   std::exception_ptr failed;
-  tbb::parallel_invoke([&] { check(); },
-                       [&] {
-                         try {
-                           options_.write_ahead(res_.model);
-                         } catch (...) {
-                           failed = std::current_exception();
-                         }
-                       });
+  auto write = [&] {
+    try {
+      options_.write_ahead(res_.model);
+    } catch (...) {
+      failed = std::current_exception();
+    }
+  };
+  {
+    // A thread of its own, not a TBB task: while the writer waits for the disk (its sync), the
+    // check's parallel loops have every TBB thread (a task would hold one, idle).
+    std::jthread writer;
+    try {
+      writer = std::jthread(write);
+    } catch (const std::system_error&) {  // no thread to be had: one after the other
+    }
+    check();
+    if (writer.joinable())
+      writer.join();
+    else
+      write();
+  }
   primal::release(positive_);
   announce();
   if (failed) std::rethrow_exception(failed);
