@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cstdint>
 #include <set>
 #include <sstream>
 #include <tuple>
@@ -21,14 +22,17 @@ namespace geode::primal {
 namespace topo = topology;
 
 FaceKey normalized_origin(FaceKey k) {
-  // Insertion sort of four (std::sort's call was 1 % of a conform run): kInvalidIndex after
-  // every node number.
-  auto before = [](Index a, Index b) {
-    if (a == kInvalidIndex || b == kInvalidIndex) return b == kInvalidIndex && a != kInvalidIndex;
-    return a < b;
+  // A sorting network of the four as unsigned numbers, branch-free (it is called for every edge
+  // and face node that dicing makes and its check reads): kInvalidIndex (-1) is then the
+  // largest, after every node number.
+  std::array<std::uint32_t, 4> u;
+  for (std::size_t i = 0; i < 4; ++i) u[i] = static_cast<std::uint32_t>(k[i]);
+  const auto order = [&u](std::size_t a, std::size_t b) {
+    const std::uint32_t lo = std::min(u[a], u[b]), hi = std::max(u[a], u[b]);
+    u[a] = lo, u[b] = hi;
   };
-  for (std::size_t i = 1; i < k.size(); ++i)
-    for (std::size_t j = i; j > 0 && before(k[j], k[j - 1]); --j) std::swap(k[j - 1], k[j]);
+  order(0, 1), order(2, 3), order(0, 2), order(1, 3), order(1, 2);
+  for (std::size_t i = 0; i < 4; ++i) k[i] = static_cast<Index>(u[i]);
   return k;
 }
 

@@ -97,3 +97,20 @@ TEST_CASE("a broken dicing is caught") {
     CHECK(!c.ok());
   }
 }
+
+TEST_CASE("normalized_origin: node numbers ascending, then kInvalidIndex") {
+  // Every key of four entries from a small alphabet (repeats and kInvalidIndex anywhere)
+  // against a sort that puts kInvalidIndex last.
+  const std::array<primal::Index, 5> values{primal::kInvalidIndex, 0, 1, 2, 2147483647};
+  for (std::size_t code = 0; code < 625; ++code) {
+    primal::FaceKey key{};
+    for (std::size_t i = 0, c = code; i < 4; ++i, c /= 5) key[i] = values[c % 5];
+    primal::FaceKey expected = key;
+    std::sort(expected.begin(), expected.end(), [](primal::Index a, primal::Index b) {
+      if (a == primal::kInvalidIndex) return false;
+      return b == primal::kInvalidIndex || a < b;
+    });
+    CAPTURE(code);
+    CHECK(primal::normalized_origin(key) == expected);
+  }
+}
