@@ -1086,7 +1086,11 @@ void Conformer::check() {
 void Conformer::report() {
   std::map<int, std::vector<Index>> members;  // output block -> its hexes, ascending id
   const std::vector<int>& block = mesh_.block;
-  for (std::size_t h = 0; h < block.size(); ++h) members[block[h]].push_back(primal::index_cast(h));
+  std::vector<Index>* list = nullptr;  // the run's block's (a block's hexes come in runs)
+  for (std::size_t h = 0; h < block.size(); ++h) {
+    if (h == 0 || block[h] != block[h - 1]) list = &members[block[h]];
+    list->push_back(primal::index_cast(h));
+  }
   for (const auto& [id, sel] : members) {
     const auto name = blocks_.names.find(id);
     primal::QualityReport report;
