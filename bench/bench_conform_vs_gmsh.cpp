@@ -83,6 +83,10 @@ Run run_child(const std::vector<std::string>& argv, const fs::path& log) {
   for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
   std::fflush(nullptr);
+  // Every run starts with no write pending: the files an earlier run left unsynced (gmsh and
+  // the floor do not sync theirs) would otherwise be written back during this one, and in the
+  // sync of geode's output (ext4 commits them together), by up to 0.2 s on this machine.
+  ::sync();
   const auto t0 = std::chrono::steady_clock::now();
   const pid_t pid = fork();
   if (pid < 0) {
