@@ -186,7 +186,7 @@ class Conformer {
   void invert_for_test();
   void check();
   void report();
-  void announce() const;
+  void announce(double seconds) const;
   void output();
   void verify_and_output();
   // The output's arrays: in mesh_ until output() moves them into the result's model.
@@ -1139,13 +1139,14 @@ void Conformer::report() {
   }
 }
 
-// Verification's verdict, as a progress line.
-void Conformer::announce() const {
+// Verification's verdict, as a progress line; `seconds`: the report and the check (not the
+// writing beside them).
+void Conformer::announce(double seconds) const {
   const bool valid = res_.validity.ok() && res_.dicing.ok();
   say("verification (" + std::string(res_.verified == ConformVerify::kLocal ? "local" : "full") +
       ", " + std::to_string(res_.verified_hexes) +
       " hexes checked whole): " + (valid ? "valid" : "INVALID") + " (" +
-      std::to_string(since(t0_) + dicing_check_seconds_) + " s)");
+      std::to_string(seconds + dicing_check_seconds_) + " s)");
 }
 
 void Conformer::output() {
@@ -1182,13 +1183,14 @@ void Conformer::verify_and_output() {
       tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism) > 1;
   if (!ahead) {
     check();
-    announce();
+    announce(since(t0_));
     output();
     if (options_.write_ahead) options_.write_ahead(res_.model);
     return;
   }
   output();
   std::exception_ptr failed;
+  double seconds = 0.0;  // the report and the check
   auto write = [&] {
     try {
       options_.write_ahead(res_.model);
@@ -1205,13 +1207,14 @@ void Conformer::verify_and_output() {
     } catch (const std::system_error&) {  // no thread to be had: one after the other
     }
     check();
+    seconds = since(t0_);
     if (writer.joinable())
       writer.join();
     else
       write();
   }
   primal::release(positive_);
-  announce();
+  announce(seconds);
   if (failed) std::rethrow_exception(failed);
 }
 
