@@ -3,6 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <geode/primal/detail/cell_nodes.hpp>
 #include <geode/primal/disjoint_sets.hpp>
 #include <geode/primal/errors.hpp>
 
@@ -84,21 +85,8 @@ const HexIncidence& hex_incidence() {
   return inc;
 }
 
-template <std::size_t N>
-bool has_repeated(const std::array<Index, N>& a) {
-  for (std::size_t i = 0; i < N; ++i) {
-    for (std::size_t j = i + 1; j < N; ++j) {
-      if (a[i] == a[j]) return true;
-    }
-  }
-  return false;
-}
-
-template <std::size_t N>
-bool in_range(const std::array<Index, N>& a, std::size_t n) {
-  return std::all_of(a.begin(), a.end(),
-                     [n](Index v) { return v >= 0 && index_cast<std::size_t>(v) < n; });
-}
+using detail::has_repeated;
+using detail::in_range;
 
 // Two uses of a face (or edge) agree when one is the reverse cyclic order of the other.
 template <std::size_t N>

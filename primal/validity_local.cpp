@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include <geode/primal/boundary.hpp>
+#include <geode/primal/detail/cell_nodes.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/release.hpp>
 
@@ -17,15 +18,8 @@ namespace {
 
 using Hexes = std::span<const std::array<Index, 8>>;
 
-template <std::size_t N>
-bool proper(const std::array<Index, N>& a, std::size_t nodes) {
-  for (std::size_t i = 0; i < N; ++i) {
-    if (a[i] < 0 || index_cast<std::size_t>(a[i]) >= nodes) return false;
-    for (std::size_t j = 0; j < i; ++j)
-      if (a[i] == a[j]) return false;
-  }
-  return true;
-}
+using detail::has_repeated;
+using detail::in_range;
 
 // Every corner Jacobian above 0 (hex_jacobians' corners, the same values; not its centre, as
 // check_validity), the first that is not ending the search.
@@ -83,11 +77,9 @@ HexValidityReport check_validity_around(std::span<const Point> points, Hexes hex
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t h = range.begin(); h != range.end(); ++h) {
                         const auto& hex = hexes[h];
-                        if (!std::all_of(hex.begin(), hex.end(), [nv](Index v) {
-                              return v >= 0 && index_cast<std::size_t>(v) < nv;
-                            })) {
+                        if (!in_range(hex, nv)) {
                           proper_hex[h] = kOutOfRange;
-                        } else if (!proper(hex, nv)) {
+                        } else if (has_repeated(hex)) {
                           proper_hex[h] = kRepeated;
                         } else {
                           proper_hex[h] = kProper;
@@ -120,10 +112,7 @@ HexValidityReport check_validity_around(std::span<const Point> points, Hexes hex
                       [&](const tbb::blocked_range<std::size_t>& range) {
                         for (std::size_t h = range.begin(); h != range.end(); ++h) {
                           const auto& hex = hexes[h];
-                          if (!std::all_of(hex.begin(), hex.end(), [nv](Index v) {
-                                return v >= 0 && index_cast<std::size_t>(v) < nv;
-                              }))
-                            continue;
+                          if (!in_range(hex, nv)) continue;
                           if (known && options.positive[h]) continue;  // all 9 dets > 0
                           HexCorners p;
                           for (std::size_t c = 0; c < 8; ++c)
