@@ -184,16 +184,11 @@ class Conformer {
   void check_dicing();
   bool verify_locally() const;
   void invert_for_test();
-  void check();
+  void check(std::span<const Point> points, std::span<const std::array<Index, 8>> hexes);
   void report();
   void announce(double seconds) const;
   void output();
   void verify_and_output();
-  // The output's arrays: in mesh_ until output() moves them into the result's model.
-  std::span<const Point> out_points() const { return output_ ? res_.model.points : mesh_.points; }
-  std::span<const std::array<Index, 8>> out_hexes() const {
-    return output_ ? res_.model.hexes : mesh_.hexes;
-  }
 
   const primal::Model& input_;
   const ConformOptions& options_;
@@ -236,7 +231,6 @@ class Conformer {
   std::vector<Index> moved_;
   double dicing_check_seconds_ = 0.0;  // check_dicing, run while the dicing data exist
   std::vector<char> positive_;         // per output hex: its scaled Jacobian was above 0 (check())
-  bool output_ = false;                // output() has moved the mesh into res_.model
 };
 
 void Conformer::find_interface() {
@@ -1050,8 +1044,10 @@ void Conformer::invert_for_test() {
   moved_.insert(moved_.end(), at.begin(), at.end());
 }
 
-// The output's validity (verify_locally(): around what was not diced).
-void Conformer::check() {
+// The output's validity (verify_locally(): around what was not diced) on the output's arrays,
+// where they are (mesh_, or the result's model once output() has moved them); the whole-mesh
+// check reads mesh_.
+void Conformer::check(std::span<const Point> points, std::span<const std::array<Index, 8>> hexes) {
   if (verify_locally()) {
     // Seeds: the geode hexes and whatever smoothing could move; the rest is diced, checked
     // against the dicing tables in check_dicing().
@@ -1061,7 +1057,8 @@ void Conformer::check() {
       for (Index h = geode_first_.front(); h < geode_first_.back(); ++h) seeds.push_back(h);
     primal::RegionValidityOptions o;
     o.positive = positive_;
-    res_.validity = primal::check_validity_around(out_points(), out_hexes(), seeds, o);
+    res_.validity = primal::check_validity_around(points, hexes, seeds, o);
+    primal::release(positive_);
     res_.verified = ConformVerify::kLocal;
     res_.verified_hexes = res_.validity.num_cells;
     if (!res_.dicing.ok()) res_.warnings.push_back("invalid dicing: " + res_.dicing.summary());
@@ -1159,7 +1156,6 @@ void Conformer::output() {
   out.points = std::move(mesh_.points);
   out.node_sets = std::move(node_sets_);
   out.side_sets = std::move(side_sets_);
-  output_ = true;
 }
 
 // Verification, and the output written (options_.write_ahead) while the default validity check
@@ -1170,19 +1166,21 @@ void Conformer::output() {
 void Conformer::verify_and_output() {
   t0_ = Clock::now();
   report();
-  positive_.resize(sj_.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sj_.size(), 8192),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t h = r.begin(); h != r.end(); ++h)
-                        positive_[h] = sj_[h] > 0.0;  // all 9 determinants above 0
-                    });
+  if (verify_locally()) {  // what the local check reads of the scaled Jacobians
+    positive_.resize(sj_.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sj_.size(), 8192),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t h = r.begin(); h != r.end(); ++h)
+                          positive_[h] = sj_[h] > 0.0;  // all 9 determinants above 0
+                      });
+  }
   primal::release(sj_);
   const bool ahead =
       options_.write_ahead && verify_locally() &&
       options_.quality == ConformQuality::kScaledJacobian &&
       tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism) > 1;
   if (!ahead) {
-    check();
+    check(mesh_.points, mesh_.hexes);
     announce(since(t0_));
     output();
     if (options_.write_ahead) options_.write_ahead(res_.model);
@@ -1206,14 +1204,13 @@ void Conformer::verify_and_output() {
       writer = std::jthread(write);
     } catch (const std::system_error&) {  // no thread to be had: one after the other
     }
-    check();
+    check(res_.model.points, res_.model.hexes);
     seconds = since(t0_);
     if (writer.joinable())
       writer.join();
     else
       write();
   }
-  primal::release(positive_);
   announce(seconds);
   if (failed) std::rethrow_exception(failed);
 }
