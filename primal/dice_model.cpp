@@ -395,8 +395,8 @@ DicedModel dice_model(const Model& model, std::span<const char> shareable, std::
     // then placed, in parallel: the centroid of their origin nodes, a cell centre its corners'.
     const std::size_t first = out.origin.size();
     for (const auto* keys : {&d.edges, &d.faces}) {
-      for (const FaceKey& k : *keys) {
-        const FaceKey key = normalized_origin(k);
+      // dice_cells' keys are normalized already (dice.hpp: ascending, padded): not sorted again.
+      for (const FaceKey& key : *keys) {
         const auto made = [&] {
           out.origin.push_back(key);
           return index_cast(out.origin.size() - 1);
