@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cstddef>
 #include <limits>
 #include <string>
 
@@ -363,8 +364,10 @@ std::vector<std::array<std::vector<int>, 8>> child_weights() {
   return children;
 }
 
-// The lowest scaled Jacobian among one cell's children, each corner the mean of its weights'
-// parent corners.
+// The lowest scaled Jacobian among one cell's children, each corner placed as dice() places
+// it: the centroid of its edge's or face's nodes in ascending order (origin_centroid's key),
+// of the cell's corners in their order. So the figure is, bit for bit, the minimum over the
+// children a dicing of the same points and numbers makes (conform reads it off them).
 template <std::size_t N, class Children>
 double diced_cell_min(std::span<const Point> points, const std::array<Index, N>& cell,
                       const Children& children) {
@@ -372,9 +375,11 @@ double diced_cell_min(std::span<const Point> points, const std::array<Index, N>&
   for (const auto& w : children) {
     HexCorners p;
     for (int c = 0; c < 8; ++c) {
-      Point s = Point::Zero();
-      for (int i : w[c]) s += points[index_cast<std::size_t>(cell[index_cast<std::size_t>(i)])];
-      p[c] = s / static_cast<double>(w[c].size());
+      std::array<Index, N> nodes{};
+      const std::size_t n = w[c].size();
+      for (std::size_t i = 0; i < n; ++i) nodes[i] = cell[index_cast<std::size_t>(w[c][i])];
+      if (n < N) std::sort(nodes.begin(), nodes.begin() + static_cast<std::ptrdiff_t>(n));
+      p[c] = corner_centroid(points, std::span<const Index>(nodes.data(), n));
     }
     lowest = std::min(lowest, hex_scaled_jacobian(p));
   }
