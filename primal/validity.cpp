@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <geode/primal/detail/cell_nodes.hpp>
+#include <geode/primal/detail/validity_focus.hpp>
 #include <geode/primal/disjoint_sets.hpp>
 #include <geode/primal/errors.hpp>
 
@@ -202,10 +203,13 @@ class ProbeCount {
   // kNear, kNotPositiveCorner), from its corner positions and Jacobians (hex_jacobians). Pure,
   // so hexes can be classified in parallel and added in order.
   enum : std::uint8_t { kOut = 0, kInside = 1, kNear = 2, kNotPositiveCorner = 3 };
-  static std::uint16_t classify(const HexCorners& p, const std::array<double, 9>& jacobians) {
+  // Corners outside `corners` (a bit mask) are left kOut, which add() ignores.
+  static std::uint16_t classify(const HexCorners& p, const std::array<double, 9>& jacobians,
+                                unsigned corners = 0xffu) {
     const Point& d = coverage_probe();
     std::uint16_t code = 0;
     for (int c = 0; c < 8; ++c) {
+      if (!(corners & (1u << c))) continue;
       std::uint16_t k_code = kNotPositiveCorner;
       if (jacobians[c] > 0.0) {
         std::array<Point, 3> e;
@@ -370,7 +374,11 @@ std::string HexValidityReport::summary() const {
   return os.str();
 }
 
-HexValidityReport check_validity(const HexMesh& mesh) {
+HexValidityReport check_validity(const HexMesh& mesh) { return detail::check_validity(mesh, {}); }
+
+namespace detail {
+
+HexValidityReport check_validity(const HexMesh& mesh, std::span<const char> focus) {
   // Everything is read off the node -> hex incidence (CSR) instead of hashing every face and
   // edge of the mesh: all hexes using a face (an edge) contain its smallest node, so the uses of
   // a face or edge are found among the few hexes around one node. A face or edge is numbered by
@@ -403,19 +411,32 @@ HexValidityReport check_validity(const HexMesh& mesh) {
   {
     constexpr std::uint32_t kInverted = 1u << 16, kMeasured = 1u << 17;
     std::vector<std::uint32_t> found(mesh.hexes.size(), 0);
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, mesh.hexes.size(), 4096),
-        [&](const tbb::blocked_range<std::size_t>& range) {
-          for (std::size_t h = range.begin(); h != range.end(); ++h) {
-            if (!in_range(mesh.hexes[h], mesh.points.size())) continue;
-            const HexCorners corners = hex_corners(mesh, index_cast(h));
-            const auto j = hex_jacobians(corners);
-            // Corners 0..7 only: the centre value (index 8) is not a corner Jacobian.
-            const bool positive =
-                std::all_of(j.begin(), j.begin() + 8, [](double d) { return d > 0.0; });
-            found[h] = kMeasured | (positive ? 0u : kInverted) | ProbeCount::classify(corners, j);
-          }
-        });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.hexes.size(), 4096),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        for (std::size_t h = range.begin(); h != range.end(); ++h) {
+                          const auto& hex = mesh.hexes[h];
+                          if (!in_range(hex, mesh.points.size())) continue;
+                          unsigned corners = 0xffu;  // the corners at focus nodes
+                          if (!focus.empty()) {
+                            corners = 0;
+                            for (int c = 0; c < 8; ++c)
+                              if (focus[index_cast<std::size_t>(hex[c])]) corners |= 1u << c;
+                          }
+                          const HexCorners p = hex_corners(mesh, index_cast(h));
+                          // The corner Jacobians (hex_jacobians' first eight), the centre's is no
+                          // corner's.
+                          std::array<double, 9> j{};
+                          bool positive = true;
+                          for (int c = 0; c < 8; ++c)
+                            if (corners & (1u << c)) {
+                              const auto f = hex_corner_frame(p, c);
+                              j[c] = f[0].dot(f[1].cross(f[2]));
+                              positive &= j[c] > 0.0;
+                            }
+                          found[h] = kMeasured | (positive ? 0u : kInverted) |
+                                     ProbeCount::classify(p, j, corners);
+                        }
+                      });
     for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
       if (!(found[h] & kMeasured)) continue;
       if (found[h] & kInverted) r.inverted_hexes.push_back(index_cast(h));
@@ -520,8 +541,13 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     const auto uses = face_info[u] & 3;
     if (uses == 3) r.overshared_faces.push_back(face_key(face_nodes(p, lf)));
     if (face_info[u] & 4) r.misoriented_faces.push_back(face_key(face_nodes(p, lf)));
-    if (uses == 1)
-      boundary.push_back(BoundaryQuad{original[index_cast<std::size_t>(p)], lf, face_nodes(p, lf)});
+    if (uses == 1) {
+      const auto q = face_nodes(p, lf);
+      if (focus.empty() || std::any_of(q.begin(), q.end(), [&](Index v) {
+            return focus[index_cast<std::size_t>(v)] != 0;
+          }))
+        boundary.push_back(BoundaryQuad{original[index_cast<std::size_t>(p)], lf, q});
+    }
   }
   auto face_uses = [&](Index p, int lf) {
     return face_info[index_cast<std::size_t>(6 * p + lf)] & 3;
@@ -584,6 +610,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
       return;
     }
     ++r.num_vertices;
+    const bool whole = focus.empty() || focus[v];  // else its edges to focus nodes only
     uses_joined.reset(index_cast<std::size_t>(n));
     first_use_of_face.clear();
     others.clear();
@@ -592,6 +619,7 @@ HexValidityReport check_validity(const HexMesh& mesh) {
     for (Index i = 0; i < n; ++i) {
       const auto [p, c] = use_at(start[v] + i);
       for (int lf : inc.corner_faces[c]) {
+        if (!whole) break;
         const auto uses = face_uses(p, lf);
         on_boundary |= uses == 1;
         overshared |= uses == 3;
@@ -605,19 +633,21 @@ HexValidityReport check_validity(const HexMesh& mesh) {
       }
       for (int nc : topo::kHexCornerNeighbors[c]) {
         const Index b = hex(p)[nc];
-        others.push_back(b);
+        if (whole) others.push_back(b);
         if (b > index_cast(v)) edge_uses.push_back({b, 12 * p + edge_of[c][nc]});
       }
     }
-    std::sort(others.begin(), others.end());
-    const auto link_vertices = std::unique(others.begin(), others.end()) - others.begin();
-    const auto link_euler = static_cast<long>(link_vertices) -
-                            static_cast<long>(first_use_of_face.size()) + static_cast<long>(n);
-    if (overshared || uses_joined.count() != 1 || link_euler != (on_boundary ? 1 : 2)) {
-      r.nonmanifold_vertices.push_back(index_cast(v));
-    } else if (const auto cover = covering(index_cast(v), on_boundary, s);
-               cover && overlaps(*cover)) {
-      r.overlapping_nodes.push_back(*cover);
+    if (whole) {
+      std::sort(others.begin(), others.end());
+      const auto link_vertices = std::unique(others.begin(), others.end()) - others.begin();
+      const auto link_euler = static_cast<long>(link_vertices) -
+                              static_cast<long>(first_use_of_face.size()) + static_cast<long>(n);
+      if (overshared || uses_joined.count() != 1 || link_euler != (on_boundary ? 1 : 2)) {
+        r.nonmanifold_vertices.push_back(index_cast(v));
+      } else if (const auto cover = covering(index_cast(v), on_boundary, s);
+                 cover && overlaps(*cover)) {
+        r.overlapping_nodes.push_back(*cover);
+      }
     }
 
     std::sort(edge_uses.begin(), edge_uses.end(), [](const EdgeUse& a, const EdgeUse& b) {
@@ -627,6 +657,10 @@ HexValidityReport check_validity(const HexMesh& mesh) {
       std::size_t j = i + 1;
       while (j < edge_uses.size() && edge_uses[j].other == edge_uses[i].other) ++j;
       ++r.num_edges;
+      if (!whole && !focus[index_cast<std::size_t>(edge_uses[i].other)]) {
+        i = j;
+        continue;
+      }
       const std::size_t m = j - i;
       uses_joined.reset(m);
       first_use_of_face.clear();
@@ -680,6 +714,8 @@ HexValidityReport check_validity(const HexMesh& mesh) {
   r.boundary = extract_boundary(mesh.points, std::move(boundary));
   return r;
 }
+
+}  // namespace detail
 
 // ---- Planar quad meshes --------------------------------------------------------------------
 

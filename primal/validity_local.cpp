@@ -9,6 +9,7 @@
 
 #include <geode/primal/boundary.hpp>
 #include <geode/primal/detail/cell_nodes.hpp>
+#include <geode/primal/detail/validity_focus.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/release.hpp>
 
@@ -31,28 +32,62 @@ bool corners_positive(const HexCorners& p) {
   return true;
 }
 
-// Marks the nodes of the marked hexes, then the hexes with a marked node: one ring further.
-// Linear passes over the hex array (no incidence built), hexes in parallel.
-void mark_nodes(Hexes hexes, const std::vector<char>& hex_in, std::vector<char>& node_in) {
-  for (std::size_t h = 0; h < hexes.size(); ++h)
-    if (hex_in[h])
-      for (Index v : hexes[h]) node_in[index_cast<std::size_t>(v)] = 1;
-}
+// The region grown a ring at a time: the nodes of the hexes in it marked, then the hexes with
+// a marked node added. Finding those is a pass over the hex array (no incidence built), hexes
+// in parallel; the rest follows the region's own list.
+class Region {
+ public:
+  Region(Hexes hexes, std::size_t nodes, const std::vector<char>& proper_hex)
+      : hexes_(hexes), proper_(proper_hex), hex_in_(hexes.size(), 0), node_in_(nodes, 0) {}
 
-void mark_hexes(Hexes hexes, const std::vector<char>& node_in, const std::vector<char>& proper_hex,
-                std::vector<char>& hex_in) {
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, hexes.size(), 8192),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t h = range.begin(); h != range.end(); ++h) {
-                        if (hex_in[h] || !proper_hex[h]) continue;
-                        for (Index v : hexes[h])
-                          if (node_in[index_cast<std::size_t>(v)]) {
-                            hex_in[h] = 1;
-                            break;
-                          }
-                      }
-                    });
-}
+  void add(Index h) {
+    if (h < 0 || index_cast<std::size_t>(h) >= hexes_.size()) return;
+    const auto i = index_cast<std::size_t>(h);
+    if (!proper_[i] || hex_in_[i]) return;
+    hex_in_[i] = 1;
+    list_.push_back(h);
+  }
+
+  // The nodes of the hexes added since the last call.
+  void mark_nodes() {
+    for (; marked_ < list_.size(); ++marked_)
+      for (Index v : hexes_[index_cast<std::size_t>(list_[marked_])])
+        node_in_[index_cast<std::size_t>(v)] = 1;
+  }
+
+  // Every proper hex with a marked node (listed in ascending order after the ones there).
+  void add_hexes_at_nodes() {
+    constexpr char kNew = 2;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, hexes_.size(), 8192),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        for (std::size_t h = range.begin(); h != range.end(); ++h) {
+                          if (hex_in_[h] || !proper_[h]) continue;
+                          for (Index v : hexes_[h])
+                            if (node_in_[index_cast<std::size_t>(v)]) {
+                              hex_in_[h] = kNew;
+                              break;
+                            }
+                        }
+                      });
+    for (std::size_t h = 0; h < hexes_.size(); ++h)
+      if (hex_in_[h] == kNew) hex_in_[h] = 1, list_.push_back(index_cast(h));
+  }
+
+  // The hexes in the region, ascending (its list is consumed).
+  std::vector<Index> take_hexes() {
+    std::sort(list_.begin(), list_.end());
+    release(hex_in_);
+    return std::move(list_);
+  }
+  const std::vector<char>& marked_nodes() const { return node_in_; }
+
+ private:
+  Hexes hexes_;
+  const std::vector<char>& proper_;
+  std::vector<char> hex_in_, node_in_;
+  std::vector<Index> list_;
+  std::size_t marked_ = 0;  // list_[0, marked_) have their nodes marked
+};
 
 }  // namespace
 
@@ -124,27 +159,27 @@ HexValidityReport check_validity_around(std::span<const Point> points, Hexes hex
       if (inverted[h]) r.inverted_hexes.push_back(index_cast(h));
   }
 
-  // The region: the checked nodes (within `rings` of the seeds) and every hex around them.
-  std::vector<char> hex_in(nh, 0), node_in(nv, 0);
-  for (Index h : seeds)
-    if (h >= 0 && index_cast<std::size_t>(h) < nh && proper_hex[index_cast<std::size_t>(h)])
-      hex_in[index_cast<std::size_t>(h)] = 1;
+  // The region: the checked nodes (those of the hexes within `rings` of the seeds) and every
+  // hex around them.
+  Region region(hexes, nv, proper_hex);
+  for (Index h : seeds) region.add(h);
   for (int ring = 0; ring < options.rings; ++ring) {
-    mark_nodes(hexes, hex_in, node_in);
-    mark_hexes(hexes, node_in, proper_hex, hex_in);
+    region.mark_nodes();
+    region.add_hexes_at_nodes();
   }
-  std::vector<char>& checked = node_in;
-  std::fill(checked.begin(), checked.end(), 0);
-  mark_nodes(hexes, hex_in, checked);
-  mark_hexes(hexes, checked, proper_hex, hex_in);
+  region.mark_nodes();
+  region.add_hexes_at_nodes();
+  const std::vector<char>& checked = region.marked_nodes();
 
-  // The region as a mesh of its own, checked whole; its findings kept where they hold for the
-  // whole mesh: at checked nodes, which have all their hexes in it.
+  // The region as a mesh of its own, checked at its checked nodes (detail::check_validity's
+  // focus): they have all their hexes in it, so its findings there hold for the whole mesh;
+  // at the others it would find the region's cut.
   HexMesh sub;
-  std::vector<Index> sub_hex, sub_node, local(nv, kInvalidIndex);
-  for (std::size_t h = 0; h < nh; ++h) {
-    if (!hex_in[h]) continue;
-    sub_hex.push_back(index_cast(h));
+  const std::vector<Index> sub_hex = region.take_hexes();
+  std::vector<Index> sub_node, local(nv, kInvalidIndex);
+  sub.hexes.reserve(sub_hex.size());
+  for (Index hi : sub_hex) {
+    const auto h = index_cast<std::size_t>(hi);
     std::array<Index, 8> q{};
     for (int c = 0; c < 8; ++c) {
       const auto v = index_cast<std::size_t>(hexes[h][c]);
@@ -158,7 +193,10 @@ HexValidityReport check_validity_around(std::span<const Point> points, Hexes hex
     sub.hexes.push_back(q);
   }
   release(local);
-  const HexValidityReport s = check_validity(sub);
+  std::vector<char> focus(sub_node.size());
+  for (std::size_t i = 0; i < sub_node.size(); ++i)
+    focus[i] = checked[index_cast<std::size_t>(sub_node[i])];
+  const HexValidityReport s = detail::check_validity(sub, focus);
   auto node = [&](Index v) { return sub_node[index_cast<std::size_t>(v)]; };
   auto is_checked = [&](Index v) { return checked[index_cast<std::size_t>(node(v))] != 0; };
   auto global_key = [&](const FaceKey& k) {
