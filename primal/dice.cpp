@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cassert>
 #include <cstddef>
 #include <limits>
 #include <string>
@@ -427,29 +428,43 @@ std::vector<double> diced_scaled_jacobian_per_cell(std::span<const Point> points
 }
 
 // The same children as weights on the four corners (a corner, an edge's midpoint, a face's or
-// the tet's centre), for a caller that evaluates one tet many times.
+// the tet's centre), for a caller that evaluates one tet many times (relax_tet_nodes): each
+// distinct child corner (4 corners, 6 edges, 4 faces, the centre) computed once per call.
 double diced_tet_min_scaled_jacobian(const std::array<Point, 4>& corners) {
   return diced_tet_min_scaled_jacobian(corners, -2.0);
 }
 
 double diced_tet_min_scaled_jacobian(const std::array<Point, 4>& corners, double bound) {
-  using Weights = std::array<std::array<std::array<double, 4>, 8>, 4>;
-  static const Weights weights = [] {
-    Weights w{};
+  constexpr std::size_t kDistinct = 15;  // 4 corners, 6 edges, 4 faces, the centre
+  struct Table {
+    std::vector<std::array<double, 4>> weights;      // per distinct child corner
+    std::array<std::array<std::size_t, 8>, 4> at{};  // child, corner -> its weights
+  };
+  static const Table table = [] {
+    Table t;
     const auto children = child_weights<TetMesh, 4>();
     for (std::size_t h = 0; h < 4; ++h)
-      for (std::size_t c = 0; c < 8; ++c)
+      for (std::size_t c = 0; c < 8; ++c) {
+        std::array<double, 4> w{};
         for (int i : children[h][c])
-          w[h][c][index_cast<std::size_t>(i)] = 1.0 / static_cast<double>(children[h][c].size());
-    return w;
+          w[index_cast<std::size_t>(i)] = 1.0 / static_cast<double>(children[h][c].size());
+        auto it = std::find(t.weights.begin(), t.weights.end(), w);
+        t.at[h][c] = static_cast<std::size_t>(it - t.weights.begin());
+        if (it == t.weights.end()) t.weights.push_back(w);
+      }
+    assert(t.weights.size() == kDistinct);
+    return t;
   }();
+  std::array<Point, kDistinct> x;
+  for (std::size_t k = 0; k < kDistinct; ++k) {
+    const auto& w = table.weights[k];
+    x[k] = w[0] * corners[0] + w[1] * corners[1] + w[2] * corners[2] + w[3] * corners[3];
+  }
   double lowest = 1.0;
-  for (const auto& child : weights) {
+  for (const auto& child : table.at) {
     if (lowest <= bound) break;
     HexCorners p;
-    for (std::size_t c = 0; c < 8; ++c)
-      p[c] = child[c][0] * corners[0] + child[c][1] * corners[1] + child[c][2] * corners[2] +
-             child[c][3] * corners[3];
+    for (std::size_t c = 0; c < 8; ++c) p[c] = x[child[c]];
     lowest = std::min(lowest, hex_scaled_jacobian_bounded(p, bound));
   }
   return lowest;

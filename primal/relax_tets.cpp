@@ -31,10 +31,13 @@ class Relaxer {
     std::partial_sum(first_.begin(), first_.end(), first_.begin());
     around_.resize(first_.back());
     std::vector<std::size_t> fill(first_.begin(), first_.end() - 1);
-    for (std::size_t c = 0; c < tets.size(); ++c)
+    for (std::size_t c = 0; c < tets.size(); ++c) {
+      bool near = false;
       for (Index v : tets[c])
         if (const Index k = slot[index_cast<std::size_t>(v)]; k != kInvalidIndex)
-          around_[fill[index_cast<std::size_t>(k)]++] = index_cast(c);
+          around_[fill[index_cast<std::size_t>(k)]++] = index_cast(c), near = true;
+      if (near) near_.push_back(index_cast(c));
+    }
   }
 
   std::size_t size() const { return free_.size(); }
@@ -57,6 +60,32 @@ class Relaxer {
       if (hint && m <= bound) *hint = i;
     }
     return m;
+  }
+
+  // Every free node's lowest(k) at the points as they are, into `low`: each tet around them
+  // measured once (most have several free nodes), then per node the minimum over its row in
+  // order, the same value lowest(k) gives.
+  void lowest_all(std::vector<double>& low) {
+    per_tet_.resize(tets_.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, near_.size(), 256),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                          const auto t = index_cast<std::size_t>(near_[i]);
+                          std::array<Point, 4> c;
+                          for (std::size_t q = 0; q < 4; ++q)
+                            c[q] = points_[index_cast<std::size_t>(tets_[t][q])];
+                          per_tet_[t] = diced_tet_min_scaled_jacobian(c);
+                        }
+                      });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, size(), 256),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        for (std::size_t k = range.begin(); k != range.end(); ++k) {
+                          double m = 1.0;
+                          for (std::size_t i = first_[k]; i < first_[k + 1]; ++i)
+                            m = std::min(m, per_tet_[index_cast<std::size_t>(around_[i])]);
+                          low[k] = m;
+                        }
+                      });
   }
 
   double shortest_edge(std::size_t k) const {
@@ -113,6 +142,8 @@ class Relaxer {
   std::vector<Index> free_;
   std::vector<std::size_t> first_;
   std::vector<Index> around_;
+  std::vector<Index> near_;      // the tets with a free node, ascending
+  std::vector<double> per_tet_;  // lowest_all's per tet (those in near_)
 };
 
 }  // namespace
@@ -127,13 +158,7 @@ RelaxTetsResult relax_tet_nodes(std::vector<Point>& points,
   const std::size_t n = relax.size();
   std::vector<char> moved(n, 0);
   std::vector<double> low(n);
-  auto measure = [&] {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256),
-                      [&](const tbb::blocked_range<std::size_t>& range) {
-                        for (std::size_t k = range.begin(); k != range.end(); ++k)
-                          low[k] = relax.lowest(k);
-                      });
-  };
+  auto measure = [&] { relax.lowest_all(low); };
   measure();
   r.min_before = n ? *std::min_element(low.begin(), low.end()) : 1.0;
   std::vector<char> touched(points.size(), 0);
