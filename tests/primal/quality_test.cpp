@@ -219,22 +219,30 @@ TEST_CASE("hex scaled jacobian takes the minimum over 8 corners and the centre")
 TEST_CASE("hex scaled jacobian: the same number as the nine values' minimum, bit for bit") {
   // Smoothing, verification and the reports compare hex_scaled_jacobian's values with
   // hex_scaled_jacobians' and the bounded form's (a hex above 0 has positive corners), so they
-  // must be the same doubles, not just close. Skewed, flat, inverted and collapsed hexes.
+  // must be the same doubles, not just close. Skewed, flat, inverted and collapsed hexes, at
+  // scales from 1e-4 to 1e4.
   std::uint64_t state = 12345;
   auto uniform = [&state] {  // 53-bit LCG draws in [0, 1): the same on every platform
     state = state * 6364136223846793005ULL + 1442695040888963407ULL;
     return static_cast<double>(state >> 11) * 0x1.0p-53;
   };
-  for (int trial = 0; trial < 2000; ++trial) {
+  for (int trial = 0; trial < 20000; ++trial) {
     HexCorners p = unit_cube();
     const double spread = trial % 4 == 0 ? 1.5 : 0.3;
-    for (auto& x : p)
+    const double scale = std::pow(10.0, trial % 9 - 4);
+    for (auto& x : p) {
       for (int i = 0; i < 3; ++i) x[i] += spread * (uniform() - 0.5);
+      x *= scale;
+    }
     if (trial % 50 == 0) p[6] = p[5];  // a collapsed edge: 0 at its corners
     const auto q = gp::hex_scaled_jacobians(p);
     const double lowest = *std::min_element(q.begin(), q.end());
     CHECK(gp::hex_scaled_jacobian(p) == lowest);
     CHECK(gp::hex_scaled_jacobian_bounded(p, -std::numeric_limits<double>::infinity()) == lowest);
+    // With a bound: exact above it, at or below it otherwise.
+    const double bound = uniform() - 0.5;
+    const double bounded = gp::hex_scaled_jacobian_bounded(p, bound);
+    CHECK((lowest > bound ? bounded == lowest : bounded <= bound));
   }
 }
 
