@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cassert>
 #include <cstdint>
 #include <set>
 #include <sstream>
@@ -149,6 +150,35 @@ std::vector<Index> wrong_children(const std::vector<std::array<Index, NP>>& pare
                                   const std::vector<FaceKey>& origin, Index num_input_nodes,
                                   std::vector<Index>& centre) {
   constexpr unsigned kAll = (1u << NP) - 1;
+  // Per table entry, read once: a parent corner (its index), the centre (-1), or an edge or
+  // face (-2: its corners in `of`, and `support`, its number among the parent's edges and faces:
+  // several children name each one, whose node is read off `origin` once per parent). The
+  // table is read once (std::popcount is a library call on the baseline x86-64).
+  struct Entry {
+    int corner = -2;
+    std::array<std::size_t, 4> of{};
+    std::size_t size = 0, support = 0;
+  };
+  std::array<std::array<Entry, 8>, NChildren> entries{};
+  std::vector<unsigned> supports;
+  for (std::size_t ch = 0; ch < NChildren; ++ch)
+    for (std::size_t k = 0; k < 8; ++k) {
+      const unsigned s = table[ch][k];
+      Entry& x = entries[ch][k];
+      if (std::popcount(s) == 1) {
+        x.corner = std::countr_zero(s);
+      } else if (s == kAll) {
+        x.corner = -1;
+      } else {
+        for (std::size_t q = 0; q < NP; ++q)
+          if (s >> q & 1) x.of[x.size++] = q;
+        x.support = static_cast<std::size_t>(std::find(supports.begin(), supports.end(), s) -
+                                             supports.begin());
+        if (x.support == supports.size()) supports.push_back(s);
+      }
+    }
+  constexpr std::size_t kMaxSupports = 32;  // a hex has 18 edges and faces, a wedge 14
+  assert(supports.size() <= kMaxSupports);
   const std::size_t n = std::min(children.size(), NChildren * parents.size());
   std::vector<char> bad(children.size(), 0);
   for (std::size_t i = n; i < children.size(); ++i) bad[i] = 1;  // children of no parent
@@ -159,6 +189,11 @@ std::vector<Index> wrong_children(const std::vector<std::array<Index, NP>>& pare
       [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t e = range.begin(); e != range.end(); ++e) {
           const auto& elem = parents[e];
+          // Per edge or face of this parent: the node last found for it, and whether its
+          // origin is that edge or face.
+          std::array<Index, kMaxSupports> seen;
+          std::array<bool, kMaxSupports> seen_good{};
+          seen.fill(kInvalidIndex);
           Index mid = kInvalidIndex;
           bool centre_agrees = true;
           if (NChildren * e + NChildren > children.size()) {  // a parent without all its children
@@ -170,23 +205,24 @@ std::vector<Index> wrong_children(const std::vector<std::array<Index, NP>>& pare
             bool good = i < parent_of.size() && parent_of[i] == index_cast(e);
             for (std::size_t k = 0; k < 8 && good; ++k) {
               const Index v = children[i][k];
-              const unsigned s = table[ch][k];
+              const Entry& x = entries[ch][k];
               if (v < 0 || v >= nodes) {
                 good = false;
-              } else if (std::popcount(s) == 1) {
-                good = v == elem[index_cast<std::size_t>(std::countr_zero(s))];
-              } else if (s == kAll) {
+              } else if (x.corner >= 0) {
+                good = v == elem[index_cast<std::size_t>(x.corner)];
+              } else if (x.corner == -1) {
                 good = v >= num_input_nodes &&
                        same_key(origin[index_cast<std::size_t>(v)], kNoOrigin) &&
                        (mid == kInvalidIndex || v == mid);
                 mid = v;
+              } else if (seen[x.support] == v) {
+                good = seen_good[x.support];
               } else {
                 FaceKey key = kNoOrigin;
-                std::size_t m = 0;
-                for (std::size_t q = 0; q < NP; ++q)
-                  if (s >> q & 1) key[m++] = elem[q];
+                for (std::size_t m = 0; m < x.size; ++m) key[m] = elem[x.of[m]];
                 good = v >= num_input_nodes &&
                        same_key(origin[index_cast<std::size_t>(v)], normalized_origin(key));
+                seen[x.support] = v, seen_good[x.support] = good;
               }
             }
             if (!good) bad[i] = 1, centre_agrees = false;
