@@ -439,6 +439,12 @@ double diced_tet_min_scaled_jacobian(const std::array<Point, 4>& corners) {
 }
 
 double diced_tet_min_scaled_jacobian(const std::array<Point, 4>& corners, double bound) {
+  int first = 0;
+  return diced_tet_min_scaled_jacobian(corners, bound, &first);
+}
+
+double diced_tet_min_scaled_jacobian(const std::array<Point, 4>& corners, double bound,
+                                     int* first) {
   constexpr std::size_t kDistinct = 15;  // 4 corners, 6 edges, 4 faces, the centre
   struct Table {
     std::vector<std::array<double, 4>> weights;      // per distinct child corner
@@ -464,12 +470,16 @@ double diced_tet_min_scaled_jacobian(const std::array<Point, 4>& corners, double
     const auto& w = table.weights[k];
     x[k] = w[0] * corners[0] + w[1] * corners[1] + w[2] * corners[2] + w[3] * corners[3];
   }
+  // The minimum does not depend on the children's order (the value below the bound is any).
   double lowest = 1.0;
-  for (const auto& child : table.at) {
-    if (lowest <= bound) break;
+  const int from = *first;
+  for (int j = 0; j < 4 && lowest > bound; ++j) {
+    const int h = (from + j) % 4;
+    const auto& child = table.at[static_cast<std::size_t>(h)];
     HexCorners p;
     for (std::size_t c = 0; c < 8; ++c) p[c] = x[child[c]];
     lowest = std::min(lowest, hex_scaled_jacobian_bounded(p, bound));
+    if (lowest <= bound) *first = h;
   }
   return lowest;
 }

@@ -42,29 +42,19 @@ class Relaxer {
 
   std::size_t size() const { return free_.size(); }
 
-  // The lowest diced scaled Jacobian of free node k's tets, at the points as they are; once it
-  // is at or below `bound` the rest are not measured (a trial position that cannot win). The
-  // tets are taken from the one at `*hint` (a position in k's row) on, and `*hint` is left at
-  // the one that reached the bound: most trial positions fail at the tet that failed the last
-  // one. The value is exact when above `bound`, whatever the order.
-  double lowest(std::size_t k, double bound = -2.0, std::size_t* hint = nullptr) const {
-    const std::size_t b = first_[k], n = first_[k + 1] - b;
-    const std::size_t from = hint && *hint < n ? *hint : 0;
-    double m = 1.0;
-    for (std::size_t j = 0; j < n && m > bound; ++j) {
-      const std::size_t i = (from + j) % n;
-      const auto& t = tets_[index_cast<std::size_t>(around_[b + i])];
-      std::array<Point, 4> c;
-      for (std::size_t q = 0; q < 4; ++q) c[q] = points_[index_cast<std::size_t>(t[q])];
-      m = std::min(m, diced_tet_min_scaled_jacobian(c, bound));
-      if (hint && m <= bound) *hint = i;
-    }
-    return m;
+  // Tet around_[at] diced: its lowest child, exact when above `bound`, some value at or below it
+  // otherwise; `child`: the child to try first, left at the one that failed.
+  double tet_value(std::size_t at, double bound, int* child = nullptr) const {
+    const auto& t = tets_[index_cast<std::size_t>(around_[at])];
+    std::array<Point, 4> c;
+    for (std::size_t q = 0; q < 4; ++q) c[q] = points_[index_cast<std::size_t>(t[q])];
+    int first = 0;
+    return diced_tet_min_scaled_jacobian(c, bound, child ? child : &first);
   }
 
-  // Every free node's lowest(k) at the points as they are, into `low`: each tet around them
-  // measured once (most have several free nodes), then per node the minimum over its row in
-  // order, the same value lowest(k) gives.
+  // Every free node's lowest diced scaled Jacobian over its tets at the points as they are,
+  // into `low`: each tet around them measured once (most have several free nodes), then per
+  // node the minimum over its row in order.
   void lowest_all(std::vector<double>& low) {
     per_tet_.resize(tets_.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, near_.size(), 256),
@@ -97,14 +87,34 @@ class Relaxer {
     return s;
   }
 
-  // Compass search at free node k; true when it moved.
+  // Compass search at free node k; true when it moved. A trial position wins when every tet
+  // around the node dices above the best so far: it fails at the first tet that does not,
+  // and the tets are tried in an order that finds that one soon (the lowest where the node
+  // stands first, the last to fail a trial moved to the front; each tet's failing child first
+  // too). The order changes the trials' cost, not their outcome: a winning trial measures every
+  // tet exactly, and its minimum is taken in the row's order.
   bool search(std::size_t k, const RelaxTetsOptions& o) {
     Point& p = points_[index_cast<std::size_t>(free_[k])];
-    double best = lowest(k);
+    const std::size_t b = first_[k], n = first_[k + 1] - b;
+    std::vector<double> value(n), trial(n);
+    std::vector<int> child(n, 0);
+    std::vector<std::size_t> order(n);
+    for (std::size_t i = 0; i < n; ++i) value[i] = tet_value(b + i, -2.0);
+    auto sort_order = [&] {
+      std::iota(order.begin(), order.end(), std::size_t{0});
+      std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) {
+        return value[x] != value[y] ? value[x] < value[y] : x < y;
+      });
+    };
+    sort_order();
+    auto row_min = [&](const std::vector<double>& v) {
+      double m = 1.0;
+      for (double x : v) m = std::min(m, x);
+      return m;
+    };
+    double best = row_min(value);
     double step = o.initial_step * shortest_edge(k);
     bool moved = false;
-    // Per direction, the tet that failed a trial that way last (see lowest()).
-    std::array<std::size_t, 6> hint{};
     for (int halving = 0; halving <= o.halvings;) {
       bool improved = false;
       for (int axis = 0; axis < 3; ++axis)
@@ -112,10 +122,21 @@ class Relaxer {
           const double sign = side == 0 ? 1.0 : -1.0;
           const Point old = p;
           p[axis] += sign * step;
-          const double q =
-              lowest(k, best + kMinGain, &hint[index_cast<std::size_t>(2 * axis + side)]);
-          if (q > best + kMinGain) {
-            best = q;
+          const double bound = best + kMinGain;
+          bool wins = true;
+          for (std::size_t j = 0; j < n && wins; ++j) {
+            const std::size_t i = order[j];
+            trial[i] = tet_value(b + i, bound, &child[i]);
+            if (trial[i] <= bound) {
+              wins = false;
+              std::rotate(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(j),
+                          order.begin() + static_cast<std::ptrdiff_t>(j) + 1);
+            }
+          }
+          if (wins) {
+            value.swap(trial);
+            best = row_min(value);
+            sort_order();
             improved = moved = true;
           } else {
             p = old;
