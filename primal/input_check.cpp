@@ -165,9 +165,30 @@ class InputChecker {
         });
       }
     };
+    // The counting pass: each face's lowest node only, from the cell tables (no key sorted, no
+    // use made).
+    auto each_lowest = [&](auto&& visit) {
+      for (ElementKind kind : kElementKinds) {
+        const auto& topo = cell_topology(kind);
+        const tbb::blocked_range<std::size_t> all(0, element_count(model_, kind), 4096);
+        tbb::parallel_for(all, [&](const tbb::blocked_range<std::size_t>& r) {
+          for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const auto cs = corners({kind, index_cast(i)});
+            for (int f = 0; f < topo.faces; ++f) {
+              const auto& face = topo.face[index_cast<std::size_t>(f)];
+              Index low = cs[index_cast<std::size_t>(face.corners[0])];
+              for (int q = 1; q < face.size; ++q)
+                low = std::min(low, cs[index_cast<std::size_t>(face.corners[q])]);
+              if (all_nodes || (low >= first && low < last)) visit(low);
+            }
+          }
+        });
+      }
+    };
     std::vector<std::size_t> start;
     return detail::sort_by_lowest_node<FaceUse>(
-        model_.points.size(), each_use, [](const FaceUse& u) { return u.key[0]; }, start);
+        model_.points.size(), each_lowest, each_use, [](const FaceUse& u) { return u.key[0]; },
+        start);
   }
 
   // This share's run of the nodes [first_, last_): each share about as many corners (weighed by

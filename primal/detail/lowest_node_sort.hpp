@@ -31,15 +31,18 @@ struct KeyedUse {
 // then by Record's operator<, which must be a total order: `each` may call visit from several
 // threads at once (it is called twice, to count and to place), and the result does not depend
 // on them. `start` receives each node's first record, and the record count at the end.
-template <class Record, class Each, class Lowest>
-std::vector<Record> sort_by_lowest_node(std::size_t nodes, Each&& each, Lowest&& lowest,
-                                        std::vector<std::size_t>& start) {
+// `count(visit)` calls visit(node) with the lowest node of each record `each` visits (in any
+// order, from any thread): where a record costs more to make than its lowest node, the counting
+// pass need not make it.
+template <class Record, class Count, class Each, class Lowest>
+std::vector<Record> sort_by_lowest_node(std::size_t nodes, Count&& count, Each&& each,
+                                        Lowest&& lowest, std::vector<std::size_t>& start) {
   auto slot = [&](std::vector<std::size_t>& v, std::size_t node) {
     return std::atomic_ref<std::size_t>(v[node]);
   };
   start.assign(nodes + 1, 0);
-  each([&](const Record& r) {
-    slot(start, static_cast<std::size_t>(lowest(r)) + 1).fetch_add(1, std::memory_order_relaxed);
+  count([&](Index node) {
+    slot(start, static_cast<std::size_t>(node) + 1).fetch_add(1, std::memory_order_relaxed);
   });
   for (std::size_t v = 1; v < start.size(); ++v) start[v] += start[v - 1];
   std::vector<Record> out(start.back());
@@ -56,6 +59,13 @@ std::vector<Record> sort_by_lowest_node(std::size_t nodes, Each&& each, Lowest&&
                                   out.begin() + static_cast<std::ptrdiff_t>(start[v + 1]));
                     });
   return out;
+}
+
+template <class Record, class Each, class Lowest>
+std::vector<Record> sort_by_lowest_node(std::size_t nodes, Each&& each, Lowest&& lowest,
+                                        std::vector<std::size_t>& start) {
+  auto count = [&](auto&& visit) { each([&](const Record& r) { visit(lowest(r)); }); };
+  return sort_by_lowest_node<Record>(nodes, count, each, lowest, start);
 }
 
 // The runs of equal records (same(i, j) on their positions) in sort_by_lowest_node's result:
