@@ -89,8 +89,20 @@ TetTriangles::TetTriangles(const Model& model)
                           }
                       });
   };
+  // Counted without making the records: of a tet's four faces, three have its lowest node as
+  // theirs and one its second lowest.
+  auto each_lowest = [&](auto&& visit) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, model.tets.size(), 4096),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t t = r.begin(); t != r.end(); ++t) {
+                          std::array<Index, 4> c = model.tets[t];
+                          std::partial_sort(c.begin(), c.begin() + 2, c.end());
+                          visit(c[0]), visit(c[0]), visit(c[0]), visit(c[1]);
+                        }
+                      });
+  };
   rec_ = detail::sort_by_lowest_node<Record>(
-      model.points.size(), each_use, [](const Record& r) { return r.a; }, start_);
+      model.points.size(), each_lowest, each_use, [](const Record& r) { return r.a; }, start_);
   // Each triangle's uses are a run of rec_, its first use first; runs within a node's records,
   // nodes in parallel (each run writes its own slots).
   auto same = [&](std::size_t i, std::size_t j) {
@@ -178,8 +190,15 @@ void refuse_duplicates(const Model& model, const std::vector<std::array<Index, N
   // element comes first.
   using Use = detail::KeyedUse<N>;
   std::vector<std::size_t> start;
+  auto each_lowest = [&](auto&& visit) {  // counted by their lowest node alone
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 4096),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t e = r.begin(); e != r.end(); ++e)
+                          visit(*std::min_element(cells[e].begin(), cells[e].end()));
+                      });
+  };
   const std::vector<Use> uses = detail::sort_by_lowest_node<Use>(
-      model.points.size(),
+      model.points.size(), each_lowest,
       [&](auto&& visit) {
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 4096),
                           [&](const tbb::blocked_range<std::size_t>& r) {
