@@ -4,6 +4,9 @@
 #include <tbb/parallel_for.h>
 
 #include <Eigen/Dense>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -280,7 +283,58 @@ double hex_jacobian(const HexCorners& p) {
 // [Verdict] hex scaled jacobian: min over the 8 corners and the centre (principal axes) of
 // det / product of the three column lengths. Verdict returns 1e30 when a column vanishes; we
 // return 0 for such a corner (a collapsed edge is a degenerate corner, not a perfect one).
-double hex_scaled_jacobian(const HexCorners& p) { return hex_scaled_jacobian_bounded(p, -kInf); }
+#if defined(__SSE2__)
+// Corners c and c + 1 at once (SSE2, two doubles a register): scaled_det of their corner_frame,
+// with the same operations in the same order as the scalar code (Eigen's cross, its dot and
+// squared norm summing (x + y) + z), so the same bits (quality_test checks them against
+// hex_scaled_jacobians); lanes [0] corner c, [1] corner c + 1.
+[[gnu::always_inline]] inline void corner_pair(const HexCorners& p, int c, double out[2]) {
+  const auto& n0 = topology::kHexCornerNeighbors[c];
+  const auto& n1 = topology::kHexCornerNeighbors[c + 1];
+  auto at = [&](int a, int b, int i) { return _mm_set_pd(p[b][i], p[a][i]); };
+  __m128d e[3][3];  // edge k, coordinate i
+  for (int i = 0; i < 3; ++i) {
+    const __m128d o = at(c, c + 1, i);
+    for (int k = 0; k < 3; ++k) e[k][i] = _mm_sub_pd(at(n0[k], n1[k], i), o);
+  }
+  const auto& a = e[0];
+  const auto& b = e[1];
+  const auto& d = e[2];
+  // b x d, then a . (b x d)
+  const __m128d x0 = _mm_sub_pd(_mm_mul_pd(b[1], d[2]), _mm_mul_pd(b[2], d[1]));
+  const __m128d x1 = _mm_sub_pd(_mm_mul_pd(b[2], d[0]), _mm_mul_pd(b[0], d[2]));
+  const __m128d x2 = _mm_sub_pd(_mm_mul_pd(b[0], d[1]), _mm_mul_pd(b[1], d[0]));
+  const __m128d det =
+      _mm_add_pd(_mm_add_pd(_mm_mul_pd(a[0], x0), _mm_mul_pd(a[1], x1)), _mm_mul_pd(a[2], x2));
+  auto norm = [](const __m128d* v) {
+    return _mm_sqrt_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(v[0], v[0]), _mm_mul_pd(v[1], v[1])),
+                                  _mm_mul_pd(v[2], v[2])));
+  };
+  const __m128d l = _mm_mul_pd(_mm_mul_pd(norm(a), norm(b)), norm(d));
+  // l > 0 ? det / l : +0 (the masked-off lane's quotient, inf or NaN, is dropped)
+  const __m128d q = _mm_and_pd(_mm_cmpgt_pd(l, _mm_setzero_pd()), _mm_div_pd(det, l));
+  _mm_storeu_pd(out, q);
+}
+#endif
+
+// Every corner measured (no bound to stop at), two at a time where SSE2 is there: 110 -> 83 ns
+// per hex on a million distorted cubes (one core); a conform run measures every output hex.
+// The bounded form stays one corner at a time: its searches mostly stop at the first corner.
+double hex_scaled_jacobian(const HexCorners& p) {
+#if defined(__SSE2__)
+  double m = kInf;
+  for (int c = 0; c < 8; c += 2) {
+    double q[2];
+    corner_pair(p, c, q);
+    m = std::min(m, q[0]);
+    m = std::min(m, q[1]);
+  }
+  const auto x = principal_axes(p);
+  return std::min(m, scaled_det(x[0], x[1], x[2]));
+#else
+  return hex_scaled_jacobian_bounded(p, -kInf);
+#endif
+}
 
 double hex_scaled_jacobian_bounded(const HexCorners& p, double bound) {
   double m = kInf;
