@@ -6,6 +6,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include <geode/primal/boundary.hpp>
 #include <geode/primal/detail/cell_nodes.hpp>
@@ -104,60 +105,70 @@ HexValidityReport check_validity_around(std::span<const Point> points, Hexes hex
   r.num_nodes = index_cast(nv);
   r.num_hexes = index_cast(nh);
 
-  // Per hex and per node over the whole mesh, as check_validity finds them: classified in
-  // parallel, one slot each, then listed in order (the same lists for any thread count).
-  enum : char { kProper = 1, kOutOfRange = 2, kRepeated = 3 };
+  // Per hex and per node over the whole mesh, as check_validity finds them, in one parallel
+  // pass each (one slot per hex or node); the lists are gathered in order (the same for any
+  // thread count) only when something was found.
+  enum : char { kProper = 1, kOutOfRange = 2, kRepeated = 4, kInverted = 8 };
   std::vector<char> proper_hex(nh, 0), used(nv, 0);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nh, 8192),
+  std::atomic<bool> faulty = false;
+  const bool known = options.positive.size() == nh;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nh, 4096),
                     [&](const tbb::blocked_range<std::size_t>& range) {
+                      bool found = false;
                       for (std::size_t h = range.begin(); h != range.end(); ++h) {
                         const auto& hex = hexes[h];
                         if (!in_range(hex, nv)) {
                           proper_hex[h] = kOutOfRange;
-                        } else if (has_repeated(hex)) {
-                          proper_hex[h] = kRepeated;
+                          found = true;
+                          continue;
+                        }
+                        char code = kProper;
+                        if (has_repeated(hex)) {
+                          code = kRepeated;
                         } else {
-                          proper_hex[h] = kProper;
                           for (Index v : hex)
                             std::atomic_ref<char>(used[index_cast<std::size_t>(v)])
                                 .store(1, std::memory_order_relaxed);
                         }
-                      }
-                    });
-  for (std::size_t h = 0; h < nh; ++h) {
-    if (proper_hex[h] == kOutOfRange) r.out_of_range_hexes.push_back(index_cast(h));
-    if (proper_hex[h] == kRepeated) r.repeated_node_hexes.push_back(index_cast(h));
-    proper_hex[h] = proper_hex[h] == kProper;
-  }
-  std::vector<char> finite(nv, 1);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv, 8192),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t v = range.begin(); v != range.end(); ++v)
-                        finite[v] = points[v].allFinite();
-                    });
-  for (std::size_t v = 0; v < nv; ++v) {
-    if (!finite[v]) r.non_finite_nodes.push_back(index_cast(v));
-    r.unused_nodes += used[v] ? 0 : 1;
-  }
-  release(used);
-  {
-    std::vector<char> inverted(nh, 0);
-    const bool known = options.positive.size() == nh;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nh, 4096),
-                      [&](const tbb::blocked_range<std::size_t>& range) {
-                        for (std::size_t h = range.begin(); h != range.end(); ++h) {
-                          const auto& hex = hexes[h];
-                          if (!in_range(hex, nv)) continue;
-                          if (known && options.positive[h]) continue;  // all 9 dets > 0
+                        if (!(known && options.positive[h])) {  // else all 9 dets > 0
                           HexCorners p;
                           for (std::size_t c = 0; c < 8; ++c)
                             p[c] = points[index_cast<std::size_t>(hex[c])];
-                          inverted[h] = !corners_positive(p);
+                          if (!corners_positive(p)) code |= kInverted;
                         }
-                      });
-    for (std::size_t h = 0; h < nh; ++h)
-      if (inverted[h]) r.inverted_hexes.push_back(index_cast(h));
+                        proper_hex[h] = code;
+                        found |= code != kProper;
+                      }
+                      if (found) faulty.store(true, std::memory_order_relaxed);
+                    });
+  if (faulty) {
+    for (std::size_t h = 0; h < nh; ++h) {
+      if (proper_hex[h] & kOutOfRange) r.out_of_range_hexes.push_back(index_cast(h));
+      if (proper_hex[h] & kRepeated) r.repeated_node_hexes.push_back(index_cast(h));
+      if (proper_hex[h] & kInverted) r.inverted_hexes.push_back(index_cast(h));
+    }
   }
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nh, 8192),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t h = range.begin(); h != range.end(); ++h)
+                        proper_hex[h] = (proper_hex[h] & kProper) != 0;
+                    });
+  // Unused nodes counted, non-finite ones flagged (in `used`), in one pass.
+  constexpr char kNonFinite = 2;
+  r.unused_nodes = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, nv, 8192), Index{0},
+      [&](const tbb::blocked_range<std::size_t>& range, Index unused) {
+        for (std::size_t v = range.begin(); v != range.end(); ++v) {
+          unused += used[v] ? 0 : 1;
+          if (!points[v].allFinite()) used[v] = kNonFinite, faulty = true;
+        }
+        return unused;
+      },
+      [](Index a, Index b) { return a + b; });
+  if (faulty)
+    for (std::size_t v = 0; v < nv; ++v)
+      if (used[v] == kNonFinite) r.non_finite_nodes.push_back(index_cast(v));
+  release(used);
 
   // The region: the checked nodes (those of the hexes within `rings` of the seeds) and every
   // hex around them.
