@@ -1,6 +1,7 @@
 #include <geode/primal/dice_model.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cassert>
 #include <cstdint>
@@ -300,15 +301,26 @@ DicingCheck check_dicing(const Model& model, const DicedModel& diced) {
     if (index_cast(i) < V && k[1] == kInvalidIndex) return kInvalidIndex;  // itself
     return k[0];
   };
-  for (std::size_t i = 0; i < origin.size(); ++i)
-    if (const Index b = bucket(i); b != kInvalidIndex) ++start[index_cast<std::size_t>(b) + 1];
+  // Counted and placed in parallel (a bucket's order then varies; its sort below fixes it).
+  auto each_in_bucket = [&](auto&& f) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, origin.size(), 8192),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        for (std::size_t i = range.begin(); i != range.end(); ++i)
+                          if (const Index b = bucket(i); b != kInvalidIndex)
+                            f(i, index_cast<std::size_t>(b));
+                      });
+  };
+  each_in_bucket([&](std::size_t, std::size_t b) {
+    std::atomic_ref<Index>(start[b + 1]).fetch_add(1, std::memory_order_relaxed);
+  });
   for (std::size_t v = 0; v < index_cast<std::size_t>(V); ++v) start[v + 1] += start[v];
   std::vector<Index> members(index_cast<std::size_t>(start.back()));
   {
     std::vector<Index> fill(start.begin(), start.end() - 1);
-    for (std::size_t i = 0; i < origin.size(); ++i)
-      if (const Index b = bucket(i); b != kInvalidIndex)
-        members[index_cast<std::size_t>(fill[index_cast<std::size_t>(b)]++)] = index_cast(i);
+    each_in_bucket([&](std::size_t i, std::size_t b) {
+      const Index at = std::atomic_ref<Index>(fill[b]).fetch_add(1, std::memory_order_relaxed);
+      members[index_cast<std::size_t>(at)] = index_cast(i);
+    });
   }
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, index_cast<std::size_t>(V), 4096),
                     [&](const tbb::blocked_range<std::size_t>& range) {
@@ -460,8 +472,11 @@ DicedModel dice_model(const Model& model, std::span<const char> shareable, std::
                               n < centres ? origin_centroid(model.points, out.origin[n])
                                           : corner_centroid(model.points, elements[n - centres]);
                       });
-    for (auto& c : d.children)
-      for (Index& v : c) v = g[index_cast<std::size_t>(v)];
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, d.children.size(), 8192),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t i = r.begin(); i != r.end(); ++i)
+                          for (Index& v : d.children[i]) v = g[index_cast<std::size_t>(v)];
+                      });
     children = std::move(d.children);
     parent = std::move(d.parent);
   };
