@@ -224,7 +224,10 @@ class Conformer {
   std::vector<primal::ElementRef> carved_from_;
   std::vector<double> hex_diced_, tet_diced_, wedge_diced_;  // per input cell: diced alone
   std::vector<double> tet_given_;  // per input tet: diced alone where the caller gave it
-  // Per input hex and tet: its figures are read off its children (measure_near_interface).
+  // Per input hex and tet: 0, its figures are measured; kLater, read off its children; a tet
+  // kLaterGiven, its figure as diced read off its children, as given measured apart (relaxed).
+  // See measure_near_interface.
+  static constexpr char kLater = 1, kLaterGiven = 2;
   std::vector<char> hex_later_, tet_later_;
   // What aims() reads: the yardstick and the local yardsticks of the cells as diced (above the
   // reported ones where conform relaxed the tets).
@@ -314,10 +317,10 @@ void measure_cells(std::span<const Point> points, const std::vector<std::array<I
 }  // namespace
 
 // The input's hexes and tets diced alone (the yardsticks): now, the cells at an interface node
-// (the local yardsticks read them) and the tets the caller's points differ for (relaxed). Every
-// other cell is diced as it stands, so its figure is read off its children once the output is
-// measured (diced_alone_from_children), not computed a second time: measuring every input cell
-// here was a tenth of a default run's CPU (the n = 36 bench).
+// (the local yardsticks read them), and the relaxed tets as the caller gave them. Every other
+// figure is of a cell diced as it stands, read off its children once the output is measured
+// (diced_alone_from_children), not computed a second time: measuring every input cell here was
+// a tenth of a default run's CPU (the n = 36 bench).
 void Conformer::measure_near_interface() {
   std::vector<char> at(input_.points.size(), 0);
   for (const primal::InterfaceQuad& q : interface_.quads) {
@@ -335,25 +338,39 @@ void Conformer::measure_near_interface() {
              return given_[i] != input_.points[i];
            });
   };
-  std::vector<std::size_t> now, moved_tets;
+  // Classified in parallel (each cell its own slot), then listed in order.
+  auto classify = [](std::size_t n, std::vector<char>& later, auto&& kind) {
+    later.resize(n);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 8192),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t c = r.begin(); c != r.end(); ++c) later[c] = kind(c);
+                      });
+  };
+  constexpr char kNowMoved = 3;  // a relaxed tet at the interface: measured now, both ways
+  classify(input_.hexes.size(), hex_later_,
+           [&](std::size_t h) { return touches(input_.hexes[h]) ? char{0} : kLater; });
+  classify(input_.tets.size(), tet_later_, [&](std::size_t t) {
+    const bool m = moved(input_.tets[t]);
+    if (touches(input_.tets[t])) return m ? kNowMoved : char{0};
+    return m ? kLaterGiven : kLater;
+  });
+  std::vector<std::size_t> now, given;
+  for (std::size_t h = 0; h < hex_later_.size(); ++h)
+    if (!hex_later_[h]) now.push_back(h);
   hex_diced_.assign(input_.hexes.size(), 1.0);
-  hex_later_.assign(input_.hexes.size(), 1);
-  for (std::size_t h = 0; h < input_.hexes.size(); ++h)
-    if (touches(input_.hexes[h])) now.push_back(h), hex_later_[h] = 0;
   measure_cells(input_.points, input_.hexes, now, hex_diced_);
   now.clear();
-  tet_diced_.assign(input_.tets.size(), 1.0);
-  tet_later_.assign(input_.tets.size(), 1);
-  for (std::size_t t = 0; t < input_.tets.size(); ++t) {
-    const bool m = moved(input_.tets[t]);
-    if (m) moved_tets.push_back(t);
-    if (m || touches(input_.tets[t])) now.push_back(t), tet_later_[t] = 0;
+  for (std::size_t t = 0; t < tet_later_.size(); ++t) {
+    if (tet_later_[t] == 0 || tet_later_[t] == kNowMoved) now.push_back(t);
+    if (tet_later_[t] == kNowMoved || tet_later_[t] == kLaterGiven) given.push_back(t);
+    if (tet_later_[t] == kNowMoved) tet_later_[t] = 0;
   }
+  tet_diced_.assign(input_.tets.size(), 1.0);
   measure_cells(input_.points, input_.tets, now, tet_diced_);
   // The tets as given differ only where a node moved: those measured again (the same function,
   // so that an unmoved tet's figure is the one --relax none reports).
   tet_given_ = tet_diced_;
-  measure_cells(given_, input_.tets, moved_tets, tet_given_);
+  measure_cells(given_, input_.tets, given, tet_given_);
 }
 
 // The cells left for later whose children will not be the input's (the buffer layer moved or
@@ -377,9 +394,11 @@ void Conformer::measure_changed() {
   };
   measure_cells(input_.points, input_.hexes, changed(input_.hexes, lm.hexes, hex_later_),
                 hex_diced_);
+  std::vector<char> was = tet_later_;
   const std::vector<std::size_t> tets = changed(input_.tets, lm.tets, tet_later_);
   measure_cells(input_.points, input_.tets, tets, tet_diced_);
-  for (std::size_t t : tets) tet_given_[t] = tet_diced_[t];  // not relaxed: left for later
+  for (std::size_t t : tets)
+    if (was[t] == kLater) tet_given_[t] = tet_diced_[t];  // not relaxed
 }
 
 // The cells left for later, diced alone: the lowest of their children as measured (sj_),
@@ -403,7 +422,7 @@ void Conformer::diced_alone_from_children(std::size_t tet_first) {
   from_children(hex_diced_, hex_later_, 0, 8);
   from_children(tet_diced_, tet_later_, tet_first, 4);
   for (std::size_t t = 0; t < tet_given_.size(); ++t)
-    if (tet_later_[t]) tet_given_[t] = tet_diced_[t];
+    if (tet_later_[t] == kLater) tet_given_[t] = tet_diced_[t];  // not relaxed
   primal::release(hex_later_, tet_later_);
   if (!hex_diced_.empty())
     res_.input_diced_hex_min_scaled_jacobian =
