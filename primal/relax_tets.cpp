@@ -281,6 +281,10 @@ std::vector<Index> tet_nodes_to_relax(const Model& model, int rings) {
   std::vector<int> block(n, 0);
   for (std::size_t t = 0; t < model.tets.size(); ++t) {
     const auto& c = model.tets[t];
+    if (std::none_of(c.begin(), c.end(), [&](Index v) {
+          return near[index_cast<std::size_t>(v)] && !fixed[index_cast<std::size_t>(v)];
+        }))
+      continue;
     const int b = block_of(model, {ElementKind::kTet, index_cast(t)});
     for (std::size_t i = 0; i < 4; ++i) {
       const std::size_t v = index_cast<std::size_t>(c[i]);
@@ -295,17 +299,24 @@ std::vector<Index> tet_nodes_to_relax(const Model& model, int rings) {
       }
     }
   }
+  // Each candidate's star judged on its own (in parallel), then listed in node order.
+  std::vector<char> relaxable(n, 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t v = r.begin(); v != r.end(); ++v) {
+                        if (!near[v] || fixed[v] || first[v] == first[v + 1]) continue;
+                        auto b = faces.begin() + static_cast<std::ptrdiff_t>(first[v]);
+                        auto e = faces.begin() + static_cast<std::ptrdiff_t>(first[v + 1]);
+                        std::sort(b, e);
+                        bool closed = (e - b) % 2 == 0;
+                        for (auto it = b; closed && it != e; it += 2)
+                          closed = *it == *(it + 1) && (it + 2 == e || *(it + 2) != *it);
+                        relaxable[v] = closed;
+                      }
+                    });
   std::vector<Index> out;
-  for (std::size_t v = 0; v < n; ++v) {
-    if (!near[v] || fixed[v] || first[v] == first[v + 1]) continue;
-    auto b = faces.begin() + static_cast<std::ptrdiff_t>(first[v]);
-    auto e = faces.begin() + static_cast<std::ptrdiff_t>(first[v + 1]);
-    std::sort(b, e);
-    bool closed = (e - b) % 2 == 0;
-    for (auto it = b; closed && it != e; it += 2)
-      closed = *it == *(it + 1) && (it + 2 == e || *(it + 2) != *it);
-    if (closed) out.push_back(index_cast(v));
-  }
+  for (std::size_t v = 0; v < n; ++v)
+    if (relaxable[v]) out.push_back(index_cast(v));
   return out;
 }
 
