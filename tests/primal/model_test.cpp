@@ -143,6 +143,36 @@ TEST_CASE("model: accessors, blocks and ids per kind") {
                        geode::InvalidInput);
 }
 
+TEST_CASE("model: a corner out of range found in any cell, named by the first offender's id") {
+  // validate scans runs of cells four node numbers at a time, then a tail; every kind (4 to 8
+  // corners), offenders first, last and in the middle of a run, below 0 and past the last node.
+  for (const ElementKind kind : kElementKinds) {
+    for (const std::size_t bad : {std::size_t{0}, std::size_t{300}, std::size_t{1002}}) {
+      for (const Index value : {Index{-1}, Index{10}, Index{1 << 30}}) {
+        Model m;
+        m.points.assign(10, Point::Zero());
+        const auto corners = index_cast<std::size_t>(cell_topology(kind).corners);
+        for (std::size_t e = 0; e < 1003; ++e) {  // pyramids, wedges: a tail of 3, 2 numbers
+          std::array<Index, 8> c{};
+          for (std::size_t k = 0; k < corners; ++k) c[k] = index_cast((e + k) % 10);
+          add_element(m, kind, c, default_block(kind), static_cast<std::int64_t>(e + 1));
+        }
+        CHECK_NOTHROW(validate(m, "big.msh"));
+        auto set_corner = [&](auto& cells) { cells[bad][corners - 1] = value; };
+        with_cells(m, kind, set_corner);
+        CAPTURE(element_kind_name(kind));
+        CAPTURE(bad);
+        CAPTURE(value);
+        const std::string expected = std::string(element_kind_name(kind)) + " " +
+                                     std::to_string(bad + 1) + ": corner " +
+                                     std::to_string(corners);
+        CHECK_THROWS_WITH_AS(validate(m, "big.msh"), doctest::Contains(expected.c_str()),
+                             geode::InvalidInput);
+      }
+    }
+  }
+}
+
 TEST_CASE("model: inverted wedges and pyramids refused by their file ids") {
   auto w = reference_corners(ElementKind::kWedge);
   std::swap(w[1], w[2]), std::swap(w[4], w[5]);  // VTK's order read as ours: mirrored
