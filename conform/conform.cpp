@@ -188,7 +188,7 @@ class Conformer {
   bool verify_locally() const;
   void invert_for_test();
   void check(std::span<const Point> points, std::span<const std::array<Index, 8>> hexes);
-  void report();
+  void report(const std::vector<int>& block);
   void announce(double seconds) const;
   void output();
   void verify_and_output();
@@ -1200,10 +1200,10 @@ void Conformer::check(std::span<const Point> points, std::span<const std::array<
 }
 
 // The quality per output block.
-void Conformer::report() {
+// `block`: the output's hex blocks, where they are (mesh_, or the result's model).
+void Conformer::report(const std::vector<int>& block) {
   std::map<int, std::vector<Index>> members;  // output block -> its hexes, ascending id
-  const std::vector<int>& block = mesh_.block;
-  std::vector<Index>* list = nullptr;  // the run's block's (a block's hexes come in runs)
+  std::vector<Index>* list = nullptr;         // the run's block's (a block's hexes come in runs)
   for (std::size_t h = 0; h < block.size(); ++h) {
     if (h == 0 || block[h] != block[h - 1]) list = &members[block[h]];
     list->push_back(primal::index_cast(h));
@@ -1268,9 +1268,11 @@ void Conformer::announce(double seconds) const {
 
 void Conformer::output() {
   primal::Model& out = res_.model;
-  for (const BlockQuality& q : res_.quality)
-    if (auto it = blocks_.names.find(q.block); it != blocks_.names.end())
-      out.block_names.insert(*it);
+  // The names of the blocks the output has (a block's hexes come in runs).
+  for (std::size_t h = 0; h < mesh_.block.size(); ++h)
+    if (h == 0 || mesh_.block[h] != mesh_.block[h - 1])
+      if (auto it = blocks_.names.find(mesh_.block[h]); it != blocks_.names.end())
+        out.block_names.insert(*it);
   out.hex_block = std::move(mesh_.block);
   out.hexes = std::move(mesh_.hexes);
   out.points = std::move(mesh_.points);
@@ -1278,14 +1280,11 @@ void Conformer::output() {
   out.side_sets = std::move(side_sets_);
 }
 
-// Verification, and the output written (options_.write_ahead) while the default validity check
-// runs: both read the output's arrays only. The per-block report comes first, so that neither
-// its lists nor the scaled Jacobians (kept as their signs) are held beside the writer's buffers.
-// The whole-mesh checks (check_validity, the full quality report) read mesh_: those run before
-// the writer.
+// Verification, and the output written (options_.write_ahead) while the per-block report and
+// the default validity check run: they read the output's arrays only. The whole-mesh checks
+// (check_validity, the full quality report) read mesh_: those run before the writer.
 void Conformer::verify_and_output() {
   t0_ = Clock::now();
-  report();
   if (verify_locally()) {  // what the local check reads of the scaled Jacobians
     positive_.resize(sj_.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sj_.size(), 8192),
@@ -1294,12 +1293,13 @@ void Conformer::verify_and_output() {
                           positive_[h] = sj_[h] > 0.0;  // all 9 determinants above 0
                       });
   }
-  primal::release(sj_);
   const bool ahead =
       options_.write_ahead && verify_locally() &&
       options_.quality == ConformQuality::kScaledJacobian &&
       tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism) > 1;
   if (!ahead) {
+    report(mesh_.block);
+    primal::release(sj_);
     check(mesh_.points, mesh_.hexes);
     announce(since(t0_));
     output();
@@ -1324,6 +1324,10 @@ void Conformer::verify_and_output() {
       writer = std::jthread(write);
     } catch (const std::system_error&) {  // no thread to be had: one after the other
     }
+    // The report first (on this thread, beside the writer), its lists and the scaled
+    // Jacobians freed before the check allocates its own.
+    report(res_.model.hex_block);
+    primal::release(sj_);
     check(res_.model.points, res_.model.hexes);
     seconds = since(t0_);
     if (writer.joinable())
