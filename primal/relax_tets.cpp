@@ -54,7 +54,9 @@ class Relaxer {
 
   // Every free node's lowest diced scaled Jacobian over its tets at the points as they are,
   // into `low`: each tet around them measured once (most have several free nodes), then per
-  // node the minimum over its row in order.
+  // node the minimum over its row in order. The tets' figures are kept (per_tet_) and kept
+  // current by every search, which moves only its node and leaves its row's figures where it
+  // stops: later searches and lowest_of_rows() read them instead of measuring again.
   void lowest_all(std::vector<double>& low) {
     per_tet_.resize(tets_.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, near_.size(), 256),
@@ -67,6 +69,11 @@ class Relaxer {
                           per_tet_[t] = diced_tet_min_scaled_jacobian(c);
                         }
                       });
+    lowest_of_rows(low);
+  }
+
+  // Every free node's lowest tet figure, from per_tet_ (current: see lowest_all).
+  void lowest_of_rows(std::vector<double>& low) const {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, size(), 256),
                       [&](const tbb::blocked_range<std::size_t>& range) {
                         for (std::size_t k = range.begin(); k != range.end(); ++k) {
@@ -99,7 +106,10 @@ class Relaxer {
     std::vector<double> value(n), trial(n);
     std::vector<int> child(n, 0);
     std::vector<std::size_t> order(n);
-    for (std::size_t i = 0; i < n; ++i) value[i] = tet_value(b + i, -2.0);
+    // Where the node stands, its tets' figures are per_tet_'s (the same computation: the tets
+    // of a search's row are no other search's in its round).
+    for (std::size_t i = 0; i < n; ++i)
+      value[i] = per_tet_[index_cast<std::size_t>(around_[b + i])];
     auto sort_order = [&] {
       std::iota(order.begin(), order.end(), std::size_t{0});
       std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) {
@@ -144,6 +154,8 @@ class Relaxer {
         }
       if (!improved) step *= 0.5, ++halving;
     }
+    for (std::size_t i = 0; i < n; ++i)
+      per_tet_[index_cast<std::size_t>(around_[b + i])] = value[i];
     return moved;
   }
 
@@ -164,7 +176,7 @@ class Relaxer {
   std::vector<std::size_t> first_;
   std::vector<Index> around_;
   std::vector<Index> near_;      // the tets with a free node, ascending
-  std::vector<double> per_tet_;  // lowest_all's per tet (those in near_)
+  std::vector<double> per_tet_;  // per tet of near_: its lowest diced child where it stands
 };
 
 }  // namespace
@@ -179,8 +191,7 @@ RelaxTetsResult relax_tet_nodes(std::vector<Point>& points,
   const std::size_t n = relax.size();
   std::vector<char> moved(n, 0);
   std::vector<double> low(n);
-  auto measure = [&] { relax.lowest_all(low); };
-  measure();
+  relax.lowest_all(low);
   r.min_before = n ? *std::min_element(low.begin(), low.end()) : 1.0;
   std::vector<char> touched(points.size(), 0);
   for (int sweep = 0; sweep < options.sweeps; ++sweep) {
@@ -214,7 +225,7 @@ RelaxTetsResult relax_tet_nodes(std::vector<Point>& points,
         relax.for_each_neighbour(k, [&](Index v) { touched[index_cast<std::size_t>(v)] = 0; });
       order.swap(rest);
     }
-    measure();
+    relax.lowest_of_rows(low);
     if (!any) break;
   }
   r.min_after = n ? *std::min_element(low.begin(), low.end()) : 1.0;
