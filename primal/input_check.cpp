@@ -280,6 +280,12 @@ class InputChecker {
     for (std::size_t i = 0; i < uses.size();) {
       std::size_t j = i + 1;
       while (j < uses.size() && uses[j].key == uses[i].key) ++j;
+      // The common case first: a face two elements see in opposite orders. Those are not one
+      // element twice: positive elements on the same nodes lie on the same side of each face.
+      if (j - i == 2 && opposite(uses[i], uses[i + 1])) {
+        i = j;
+        continue;
+      }
       std::size_t twin = j;  // a use whose element repeats another's nodes
       for (std::size_t a = i; a < j && twin == j; ++a)
         for (std::size_t b = a + 1; b < j && twin == j; ++b)

@@ -345,6 +345,34 @@ TEST_CASE("input check: a folded tet in a Gmsh hybrid and in a TetGen box is ref
   }
 }
 
+TEST_CASE("input check: a tet and a hex written twice in a Gmsh hybrid are named as such") {
+  // A mesher or a merge that writes an element twice: its faces are each used by the element
+  // and its copy, seen the same way round, which is one element twice, not a fold.
+  test::TempDir dir;
+  const primal::Model base = test::demo_input("hybrid", 4, dir, ".msh", false);
+  for (const ElementKind kind : {ElementKind::kTet, ElementKind::kHex}) {
+    CAPTURE(primal::element_kind_name(kind));
+    primal::Model m = base;
+    const Index copied = primal::index_cast(primal::element_count(m, kind) / 2);
+    const auto corners = primal::element_corners(m, {kind, copied});
+    const std::vector<Index> nodes(corners.begin(), corners.end());
+    primal::add_element(m, kind, nodes, primal::block_of(m, {kind, copied}), 999999);
+    const primal::InputCheckResult r = primal::check_input(m);
+    REQUIRE(!r.ok());
+    require_same_when_shared(m);
+    const primal::InputFinding& f = r.findings[0];
+    CHECK(f.fault == InputFault::kDuplicateElement);
+    REQUIRE(f.elements.size() == 2);
+    const Index copy = primal::index_cast(primal::element_count(m, kind) - 1);
+    CHECK(std::find(f.elements.begin(), f.elements.end(), primal::ElementRef{kind, copied}) !=
+          f.elements.end());
+    CHECK(std::find(f.elements.begin(), f.elements.end(), primal::ElementRef{kind, copy}) !=
+          f.elements.end());
+    CHECK(f.text(m).find("one element twice") != std::string::npos);
+    CHECK(f.text(m).find("999999") != std::string::npos);  // by the file's own id
+  }
+}
+
 TEST_CASE("input check: overlapping parts, a gap at the interface, a part inside another") {
   test::TempDir dir;
   const primal::Model base =
