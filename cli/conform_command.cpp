@@ -195,18 +195,27 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
   // and published (with the report) only if it is valid or --write-invalid asks for it.
   OutputFiles files;
   const primal::Model* written = nullptr;
+  std::span<const double> written_sj;  // the hexes' scaled Jacobians, while conform keeps them
   std::exception_ptr write_failed;
   if (!a.output.empty()) {
     const std::size_t mesh_file = files.add(a.output, [&](const fs::path& temp) {
-      io::write_model(*written, temp, format, write_options(a.vtk_encoding));
+      io::WriteOptions o = write_options(a.vtk_encoding);
+      o.scaled_jacobians = written_sj;
+      io::write_model(*written, temp, format, o);
     });
-    opts.write_ahead = [&, mesh_file](const primal::Model& m) {
+    // A format that writes each cell's scaled Jacobian takes conform's (the same values).
+    const io::MeshFormat* entry =
+        format.empty() ? io::writer_for(a.output) : io::find_mesh_format(format);
+    opts.write_ahead_scaled_jacobians = entry && entry->writes_scaled_jacobians;
+    opts.write_ahead = [&, mesh_file](const primal::Model& m, std::span<const double> sj) {
       written = &m;
+      written_sj = sj;
       try {
         files.write(mesh_file);
       } catch (...) {  // reported after the run: not as the input's fault
         write_failed = std::current_exception();
       }
+      written_sj = {};
     };
   }
   conform::ConformResult r;

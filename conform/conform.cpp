@@ -1293,25 +1293,33 @@ void Conformer::verify_and_output() {
                           positive_[h] = sj_[h] > 0.0;  // all 9 determinants above 0
                       });
   }
+  // The scaled Jacobians for the writer, when it asked for them (kept until it is done; else
+  // freed before the check allocates, which keeps the peak where dicing puts it).
+  const bool hand_on = options_.write_ahead && options_.write_ahead_scaled_jacobians;
+  auto write = [&] {
+    options_.write_ahead(res_.model,
+                         hand_on ? std::span<const double>(sj_) : std::span<const double>());
+  };
   const bool ahead =
       options_.write_ahead && verify_locally() &&
       options_.quality == ConformQuality::kScaledJacobian &&
       tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism) > 1;
   if (!ahead) {
     report(mesh_.block);
-    primal::release(sj_);
+    if (!hand_on) primal::release(sj_);
     check(mesh_.points, mesh_.hexes);
     announce(since(t0_));
     output();
-    if (options_.write_ahead) options_.write_ahead(res_.model);
+    if (options_.write_ahead) write();
+    primal::release(sj_);
     return;
   }
   output();
   std::exception_ptr failed;
   double seconds = 0.0;  // the report and the check
-  auto write = [&] {
+  auto write_caught = [&] {
     try {
-      options_.write_ahead(res_.model);
+      write();
     } catch (...) {
       failed = std::current_exception();
     }
@@ -1321,20 +1329,21 @@ void Conformer::verify_and_output() {
     // check's parallel loops have every TBB thread (a task would hold one, idle).
     std::jthread writer;
     try {
-      writer = std::jthread(write);
+      writer = std::jthread(write_caught);
     } catch (const std::system_error&) {  // no thread to be had: one after the other
     }
-    // The report first (on this thread, beside the writer), its lists and the scaled
-    // Jacobians freed before the check allocates its own.
+    // The report first (on this thread, beside the writer), its lists (and the scaled
+    // Jacobians, unless the writer reads them) freed before the check allocates its own.
     report(res_.model.hex_block);
-    primal::release(sj_);
+    if (!hand_on) primal::release(sj_);
     check(res_.model.points, res_.model.hexes);
     seconds = since(t0_);
     if (writer.joinable())
       writer.join();
     else
-      write();
+      write_caught();
   }
+  primal::release(sj_);
   announce(seconds);
   if (failed) std::rethrow_exception(failed);
 }

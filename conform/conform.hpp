@@ -17,6 +17,7 @@
 // hex stays valid.
 #include <algorithm>
 #include <functional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -152,8 +153,13 @@ struct ConformOptions {
   // final: on a thread of its own while the default verification (ConformVerify::kLocal, the
   // scaled Jacobian report) runs, else after verification, so that a caller writing it (to a
   // temporary file: the result may yet be found invalid) waits for no write of its own. An
-  // exception it throws is rethrown once verification is done. May be empty.
-  std::function<void(const primal::Model&)> write_ahead;
+  // exception it throws is rethrown once verification is done. May be empty. With
+  // write_ahead_scaled_jacobians, its second argument is each output hex's scaled Jacobian
+  // (primal::hex_scaled_jacobian, the same doubles), which conform has measured anyway, for a
+  // writer that writes them (io::WriteOptions::scaled_jacobians); they are then kept, 8 bytes
+  // a hex, until it returns. Else it is empty.
+  std::function<void(const primal::Model&, std::span<const double> scaled_jacobians)> write_ahead;
+  bool write_ahead_scaled_jacobians = false;
 };
 
 struct BlockQuality {

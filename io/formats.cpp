@@ -87,11 +87,14 @@ const std::vector<MeshFormat>& table() {
        .signature = looks_like_vtu,
        .read = [](const fs::path& p,
                   const primal::ReadOptions& o) { return model_from_vtk(read_vtu(p), o); },
-       .write = [](const primal::Model& m, const fs::path& p,
-                   const WriteOptions& o) { write_vtu(p, m, {}, o.vtk_encoding); },
+       .write =
+           [](const primal::Model& m, const fs::path& p, const WriteOptions& o) {
+             write_vtu(p, m, {}, o.vtk_encoding, o.scaled_jacobians);
+           },
        .write_quads = [](const primal::QuadMesh& m, const fs::path& p,
                          const WriteOptions& o) { write_vtu(p, m, {}, o.vtk_encoding); },
        .read_plain = read_vtk_plain,
+       .writes_scaled_jacobians = true,
        .index_base = 0,
        .carries = {Carried::kYes, Carried::kYes, Carried::kYes, Carried::kYes, Carried::kYes,
                    "hex, tet, pyramid, wedge; planar quad"},
@@ -107,11 +110,14 @@ const std::vector<MeshFormat>& table() {
        .signature = looks_like_vtk,
        .read = [](const fs::path& p,
                   const primal::ReadOptions& o) { return model_from_vtk(read_vtk(p), o); },
-       .write = [](const primal::Model& m, const fs::path& p,
-                   const WriteOptions& o) { write_vtk(p, m, {}, o.vtk_encoding); },
+       .write =
+           [](const primal::Model& m, const fs::path& p, const WriteOptions& o) {
+             write_vtk(p, m, {}, o.vtk_encoding, o.scaled_jacobians);
+           },
        .write_quads = [](const primal::QuadMesh& m, const fs::path& p,
                          const WriteOptions& o) { write_vtk(p, m, {}, o.vtk_encoding); },
        .read_plain = read_vtk_plain,
+       .writes_scaled_jacobians = true,
        .index_base = 0,
        .carries = {Carried::kYes, Carried::kYes, Carried::kYes, Carried::kYes, Carried::kYes,
                    "hex, tet, pyramid, wedge; planar quad"},

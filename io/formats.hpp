@@ -40,6 +40,10 @@ struct FormatCarries {
 // Options a writer may use; others ignore them.
 struct WriteOptions {
   VtkEncoding vtk_encoding = VtkEncoding::kBinary;  // .vtu DataArrays, legacy .vtk data
+  // Each element's scaled Jacobian (hexes, tets, pyramids, wedges in turn; primal/quality.hpp's
+  // per kind), for the formats that write them (MeshFormat::writes_scaled_jacobians), from a
+  // caller that has them already (conform measures every output hex); empty: computed.
+  std::span<const double> scaled_jacobians;
 };
 
 // A hex or planar quad mesh as the file gives it, without the geometry checks of a Model's
@@ -75,6 +79,8 @@ struct MeshFormat {
   PlainReader read_plain = nullptr;  // nullptr: read through `read`
   // Its reader runs a library in a forked child process (isolated.hpp): see read_forks.
   bool reads_in_child = false;
+  // Writes each cell's scaled Jacobian (WriteOptions::scaled_jacobians).
+  bool writes_scaled_jacobians = false;
   primal::Index index_base = 1;  // how the file numbers nodes and elements (messages)
   FormatCarries carries;
   std::string_view read_variants;  // versions and encodings read

@@ -279,7 +279,7 @@ void describe(Output& out, const std::filesystem::path& path, const QuadMesh& m,
 // A model: hexes, tets, pyramids, then wedges (VTK's corner order), each with its element
 // block (block_of).
 void describe(Output& out, const std::filesystem::path& path, const Model& m,
-              const VtkCellData& extra) {
+              const VtkCellData& extra, std::span<const double> given_sj = {}) {
   const std::string file = path.string();
   validate(m, file);
   out.points = &m.points;
@@ -301,7 +301,15 @@ void describe(Output& out, const std::filesystem::path& path, const Model& m,
             *b++ = blocks.empty() ? default_block(kind) : blocks[c - run.first_cell];
         }
       }};
-  out.doubles.emplace_back("scaled_jacobian", scaled_jacobians(out));
+  if (given_sj.size() == element_count(m))  // the caller's, as scaled_jacobians() makes them
+    out.doubles.emplace_back(
+        "scaled_jacobian",
+        Slices<double>{given_sj.size(), [given_sj](std::size_t begin, std::size_t end, double* to) {
+                         std::copy(given_sj.begin() + index_cast<std::ptrdiff_t>(begin),
+                                   given_sj.begin() + index_cast<std::ptrdiff_t>(end), to);
+                       }});
+  else
+    out.doubles.emplace_back("scaled_jacobian", scaled_jacobians(out));
   // The block again as "mat_id", the cell array of material ids Python solvers read (SfePy's
   // name; meshio hands it on), so that they find the materials without knowing ours.
   if (block.size > 0) out.ints.emplace_back("block", block);
@@ -712,8 +720,21 @@ void write_vtk_output(std::ostream& os, const Output& o, VtkEncoding encoding) {
 GEODE_VTK_WRITERS(HexMesh)
 GEODE_VTK_WRITERS(TetMesh)
 GEODE_VTK_WRITERS(QuadMesh)
-GEODE_VTK_WRITERS(Model)
 #undef GEODE_VTK_WRITERS
+
+void write_vtu(const std::filesystem::path& path, const Model& model, const VtkCellData& extra,
+               VtkEncoding encoding, std::span<const double> scaled_jacobians) {
+  Output out;
+  describe(out, path, model, extra, scaled_jacobians);
+  write_file_atomically(path, [&](std::ostream& os) { write_vtu_output(os, out, encoding); });
+}
+
+void write_vtk(const std::filesystem::path& path, const Model& model, const VtkCellData& extra,
+               VtkEncoding encoding, std::span<const double> scaled_jacobians) {
+  Output out;
+  describe(out, path, model, extra, scaled_jacobians);
+  write_file_atomically(path, [&](std::ostream& os) { write_vtk_output(os, out, encoding); });
+}
 
 // ---- Typed meshes -----------------------------------------------------------------------------
 

@@ -8,6 +8,7 @@
 // Every written grid carries the cell arrays "scaled_jacobian" ([Verdict] hex, tet or quad
 // scaled Jacobian) and "block" (mesh.block, when not empty), then the caller's arrays.
 #include <filesystem>
+#include <span>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -60,8 +61,11 @@ void write_vtu(const std::filesystem::path& path, const primal::TetMesh& mesh,
                const VtkCellData& extra = {}, VtkEncoding encoding = VtkEncoding::kAscii);
 void write_vtu(const std::filesystem::path& path, const primal::QuadMesh& mesh,
                const VtkCellData& extra = {}, VtkEncoding encoding = VtkEncoding::kAscii);
+// `scaled_jacobians`: each element's scaled Jacobian (hexes, tets, pyramids, wedges in turn) as
+// the scaled_jacobian array holds it, from a caller that has them (conform); else computed.
 void write_vtu(const std::filesystem::path& path, const primal::Model& model,
-               const VtkCellData& extra = {}, VtkEncoding encoding = VtkEncoding::kAscii);
+               const VtkCellData& extra = {}, VtkEncoding encoding = VtkEncoding::kAscii,
+               std::span<const double> scaled_jacobians = {});
 void write_vtk(const std::filesystem::path& path, const primal::HexMesh& mesh,
                const VtkCellData& extra = {}, VtkEncoding encoding = VtkEncoding::kAscii);
 void write_vtk(const std::filesystem::path& path, const primal::TetMesh& mesh,
@@ -69,7 +73,8 @@ void write_vtk(const std::filesystem::path& path, const primal::TetMesh& mesh,
 void write_vtk(const std::filesystem::path& path, const primal::QuadMesh& mesh,
                const VtkCellData& extra = {}, VtkEncoding encoding = VtkEncoding::kAscii);
 void write_vtk(const std::filesystem::path& path, const primal::Model& model,
-               const VtkCellData& extra = {}, VtkEncoding encoding = VtkEncoding::kAscii);
+               const VtkCellData& extra = {}, VtkEncoding encoding = VtkEncoding::kAscii,
+               std::span<const double> scaled_jacobians = {});
 
 // An unstructured grid as read: points, cells (VTK corner order) and cell arrays.
 struct VtkGrid {

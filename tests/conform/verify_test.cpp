@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <map>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -147,28 +148,48 @@ TEST_CASE("write_ahead gets the final model once, beside verification or after i
     CAPTURE(c.threads);
     const tbb::global_control limit(tbb::global_control::max_allowed_parallelism,
                                     static_cast<std::size_t>(c.threads));
-    conform::ConformOptions o;
-    o.verify = c.verify;
-    int calls = 0;
-    std::vector<primal::Point> points;
-    std::vector<std::array<Index, 8>> hexes;
-    std::map<int, std::string> names;
-    o.write_ahead = [&](const primal::Model& m) {
-      ++calls;
-      points = m.points, hexes = m.hexes, names = m.block_names;
-    };
-    const auto r = conform::conform(input, o);
-    CHECK(calls == 1);
-    CHECK(conform::result_valid(r));
-    CHECK(r.validity.ok() == plain.validity.ok());
-    CHECK(points == plain.model.points);
-    CHECK(hexes == plain.model.hexes);
-    CHECK(names == plain.model.block_names);
-    CHECK(r.model.hexes == plain.model.hexes);
-    CHECK(r.quality.size() == plain.quality.size());
+    for (const bool with_sj : {false, true}) {
+      CAPTURE(with_sj);
+      conform::ConformOptions o;
+      o.verify = c.verify;
+      o.write_ahead_scaled_jacobians = with_sj;
+      int calls = 0;
+      std::vector<primal::Point> points;
+      std::vector<std::array<Index, 8>> hexes;
+      std::map<int, std::string> names;
+      std::vector<double> sj;
+      o.write_ahead = [&](const primal::Model& m, std::span<const double> given) {
+        ++calls;
+        points = m.points, hexes = m.hexes, names = m.block_names;
+        sj.assign(given.begin(), given.end());
+      };
+      const auto r = conform::conform(input, o);
+      CHECK(calls == 1);
+      // Asked for, the scaled Jacobians handed on are those of the hexes handed on, bit for bit.
+      if (with_sj) {
+        REQUIRE(sj.size() == hexes.size());
+        for (std::size_t h = 0; h < hexes.size(); ++h) {
+          primal::HexCorners p;
+          for (std::size_t k = 0; k < 8; ++k)
+            p[k] = points[primal::index_cast<std::size_t>(hexes[h][k])];
+          REQUIRE(sj[h] == primal::hex_scaled_jacobian(p));
+        }
+      } else {
+        CHECK(sj.empty());
+      }
+      CHECK(conform::result_valid(r));
+      CHECK(r.validity.ok() == plain.validity.ok());
+      CHECK(points == plain.model.points);
+      CHECK(hexes == plain.model.hexes);
+      CHECK(names == plain.model.block_names);
+      CHECK(r.model.hexes == plain.model.hexes);
+      CHECK(r.quality.size() == plain.quality.size());
+    }
   }
   // A writer's failure reaches the caller once verification is done.
   conform::ConformOptions failing;
-  failing.write_ahead = [](const primal::Model&) { throw InvalidInput("disk full"); };
+  failing.write_ahead = [](const primal::Model&, std::span<const double>) {
+    throw InvalidInput("disk full");
+  };
   CHECK_THROWS_WITH_AS(conform::conform(input, failing), "disk full", InvalidInput);
 }

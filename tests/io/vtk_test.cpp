@@ -159,6 +159,38 @@ TEST_CASE("io_vtk: hex, tet and quad meshes round-trip exactly through .vtu and 
   }
 }
 
+TEST_CASE("io_vtk: a model's scaled Jacobians handed in are written as computed ones are") {
+  // conform hands the writers the scaled Jacobians it has measured (WriteOptions); the files
+  // must be the very bytes the writers make computing them, in both encodings; a list of the
+  // wrong length is not used.
+  const HexMesh hexes = test_hexes();
+  Model m;
+  m.points = hexes.points;
+  m.hexes = hexes.hexes;
+  std::vector<double> sj;
+  for (Index h = 0; h < index_cast(m.hexes.size()); ++h)
+    sj.push_back(hex_scaled_jacobian(hex_corners(hexes, h)));
+  const std::vector<double> wrong(sj.size() + 1, 0.5);
+  TempDir dir;
+  for (const VtkEncoding e : {VtkEncoding::kAscii, VtkEncoding::kBinary}) {
+    write_vtu(dir.path / "a.vtu", m, {}, e);
+    write_vtu(dir.path / "b.vtu", m, {}, e, sj);
+    write_vtu(dir.path / "c.vtu", m, {}, e, wrong);
+    CHECK(slurp(dir.path / "a.vtu") == slurp(dir.path / "b.vtu"));
+    CHECK(slurp(dir.path / "a.vtu") == slurp(dir.path / "c.vtu"));
+    write_vtk(dir.path / "a.vtk", m, {}, e);
+    write_vtk(dir.path / "b.vtk", m, {}, e, sj);
+    CHECK(slurp(dir.path / "a.vtk") == slurp(dir.path / "b.vtk"));
+  }
+  // Other values are written as given: the writer does not measure again.
+  std::vector<double> halves(sj.size(), 0.5);
+  write_vtu(dir.path / "h.vtu", m, {}, VtkEncoding::kAscii, halves);
+  const VtkGrid g = read_vtu(dir.path / "h.vtu");
+  const auto* written = g.cell_data.find_double("scaled_jacobian");
+  REQUIRE(written);
+  CHECK(*written == halves);
+}
+
 TEST_CASE("io_vtk: a grid of another cell type is refused by the typed conversion") {
   TempDir dir;
   write_vtk(dir.path / "h.vtk", test_hexes());
