@@ -17,10 +17,12 @@
 // in primal::kElementKinds order within a block: hexes, tets, pyramids, wedges), then the side
 // sets' faces, then the node sets' points.
 #include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <map>
 #include <set>
@@ -167,9 +169,11 @@ class MshLayout {
     node_entity = entities.front().tag;
   }
 
-  // Extends `e` by the corners of b's elements, in parallel (one loop was a sixth of the
-  // writer's time): min and max are exact, so any order gives that loop's box, unless a
-  // coordinate is not finite, whose comparisons depend on the order (then the one loop).
+  // Extends `e` by the corners of b's elements: min and max are exact, so any order gives the
+  // one loop's box, unless a coordinate is not finite, whose comparisons depend on the order
+  // (then the one loop). Otherwise the nodes b uses are marked, then the marked points read in
+  // order, both in parallel: reading a point per corner, 8 random reads a hex, was 2 % of a
+  // conform run writing .msh.
   void extend_by_elements(Entity& e, const ElementBlock& b, bool finite) const {
     auto extend = [&](Entity& box, std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i)
@@ -177,10 +181,19 @@ class MshLayout {
           box.extend(model.points[index_cast<std::size_t>(v)]);
     };
     if (!finite) return extend(e, 0, b.elements.size());
+    std::vector<char> used(model.points.size(), 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, b.elements.size(), 4096),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t i = r.begin(); i != r.end(); ++i)
+                          for (Index v : element_corners(model, {b.kind, b.elements[i]}))
+                            std::atomic_ref<char>(used[index_cast<std::size_t>(v)])
+                                .store(1, std::memory_order_relaxed);
+                      });
     const Entity box = tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, b.elements.size(), 4096), Entity{},
+        tbb::blocked_range<std::size_t>(0, used.size(), 8192), Entity{},
         [&](const tbb::blocked_range<std::size_t>& r, Entity box) {
-          extend(box, r.begin(), r.end());
+          for (std::size_t v = r.begin(); v != r.end(); ++v)
+            if (used[v]) box.extend(model.points[v]);
           return box;
         },
         [](Entity a, const Entity& c) {
