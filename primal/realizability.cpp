@@ -17,6 +17,7 @@
 #include <tbb/parallel_for.h>
 
 #include <geode/primal/boundary.hpp>
+#include <geode/primal/detail/cell_nodes.hpp>
 #include <geode/primal/detail/lowest_node_sort.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/topology.hpp>
@@ -45,13 +46,7 @@ namespace {
 
 constexpr Index kNoPatch = -1;
 
-template <std::size_t N>
-bool has_repeated(const std::array<Index, N>& a) {
-  for (std::size_t i = 0; i < N; ++i)
-    for (std::size_t j = i + 1; j < N; ++j)
-      if (a[i] == a[j]) return true;
-  return false;
-}
+using detail::has_repeated;
 
 template <std::size_t N>
 void check_range(const std::array<Index, N>& cell, std::size_t nodes, const char* what,

@@ -1,6 +1,7 @@
 #pragma once
-// What the validity checks (validity.cpp, validity_local.cpp) ask first of a cell's node
-// numbers: all of them nodes of the mesh, none twice.
+// What the validity and realizability checks (validity.cpp, validity_local.cpp,
+// realizability.cpp) ask first of a cell's node numbers: all of them nodes of the mesh, none
+// twice.
 #include <algorithm>
 #include <array>
 #include <cstddef>
