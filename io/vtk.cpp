@@ -123,13 +123,17 @@ struct Slices {
   std::function<void(std::size_t begin, std::size_t end, T* out)> fill;
 };
 
-// Values of a vector, in place.
+// Values of an array, in place.
 template <class T, class V>
-Slices<T> slices_of(const std::vector<V>& v) {
-  return {v.size(), [&v](std::size_t begin, std::size_t end, T* out) {
+Slices<T> slices_of(std::span<const V> v) {
+  return {v.size(), [v](std::size_t begin, std::size_t end, T* out) {
             std::copy(v.begin() + index_cast<std::ptrdiff_t>(begin),
                       v.begin() + index_cast<std::ptrdiff_t>(end), out);
           }};
+}
+template <class T, class V>
+Slices<T> slices_of(const std::vector<V>& v) {
+  return slices_of<T, V>(std::span<const V>(v));
 }
 
 // What a file holds beside points and cells: the cell arrays (standard, then the caller's) and
@@ -302,12 +306,7 @@ void describe(Output& out, const std::filesystem::path& path, const Model& m,
         }
       }};
   if (given_sj.size() == element_count(m))  // the caller's, as scaled_jacobians() makes them
-    out.doubles.emplace_back(
-        "scaled_jacobian",
-        Slices<double>{given_sj.size(), [given_sj](std::size_t begin, std::size_t end, double* to) {
-                         std::copy(given_sj.begin() + index_cast<std::ptrdiff_t>(begin),
-                                   given_sj.begin() + index_cast<std::ptrdiff_t>(end), to);
-                       }});
+    out.doubles.emplace_back("scaled_jacobian", slices_of<double, double>(given_sj));
   else
     out.doubles.emplace_back("scaled_jacobian", scaled_jacobians(out));
   // The block again as "mat_id", the cell array of material ids Python solvers read (SfePy's
