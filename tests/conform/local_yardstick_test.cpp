@@ -106,21 +106,17 @@ TEST_CASE("the input diced alone per block, whichever part the buffer layer is c
     o.buffer_fallback = false;
     const conform::ConformResult r = conform::conform(input, o);
     test::check_conform_result(r);
-    std::map<int, double> expected;
-    for (std::size_t h = 0; h < input.hexes.size(); ++h) {
-      const int id = primal::block_of(input, {primal::ElementKind::kHex, primal::index_cast(h)});
-      const double x =
-          primal::diced_min_scaled_jacobian(input.points, std::span(&input.hexes[h], 1));
-      expected.try_emplace(id, 1.0);
-      expected[id] = std::min(expected[id], x);
-    }
-    for (std::size_t t = 0; t < input.tets.size(); ++t) {
-      const int id = primal::block_of(input, {primal::ElementKind::kTet, primal::index_cast(t)});
-      const double x =
-          primal::diced_min_scaled_jacobian(input.points, std::span(&input.tets[t], 1));
-      expected.try_emplace(id, 1.0);
-      expected[id] = std::min(expected[id], x);
-    }
+    std::map<int, double> expected;  // per block: its cells, each diced alone
+    auto add = [&](primal::ElementKind kind, const auto& cells) {
+      for (std::size_t c = 0; c < cells.size(); ++c) {
+        const int id = primal::block_of(input, {kind, primal::index_cast(c)});
+        const double x = primal::diced_min_scaled_jacobian(input.points, std::span(&cells[c], 1));
+        expected.try_emplace(id, 1.0);
+        expected[id] = std::min(expected[id], x);
+      }
+    };
+    add(primal::ElementKind::kHex, input.hexes);
+    add(primal::ElementKind::kTet, input.tets);
     for (const conform::BlockQuality& b : r.quality) {
       CAPTURE(b.name);
       CHECK(b.input_diced_min_scaled_jacobian == expected.at(b.block));
