@@ -19,6 +19,7 @@
 
 #include <geode/primal/boundary.hpp>
 #include <geode/primal/detail/byte_packet.hpp>
+#include <geode/primal/detail/edge_thirds.hpp>
 #include <geode/primal/detail/lowest_node_sort.hpp>
 #include <geode/primal/disjoint_sets.hpp>
 #include <geode/primal/errors.hpp>
@@ -324,24 +325,17 @@ class InputChecker {
       FaceKey key;
       std::size_t use;
     };
-    struct Third {
-      EdgeKey edge;
-      Index node;
-    };
     std::vector<Triangle> triangle;  // by key: its first use
-    std::vector<Third> third;        // by edge: the third nodes of its triangles
+    detail::EdgeThirds third;        // by edge: the third nodes of its triangles
     for (std::size_t s = 0; s < uses.size(); ++s) {
       const FaceKey& k = uses[s].key;
       if (k[3] != kInvalidIndex) continue;
       triangle.push_back({k, s});
-      third.push_back({edge_key(k[0], k[1]), k[2]});
-      third.push_back({edge_key(k[1], k[2]), k[0]});
-      third.push_back({edge_key(k[0], k[2]), k[1]});
+      third.add(k[0], k[1], k[2]);
     }
     auto by_key = [](const Triangle& a, const Triangle& b) { return a.key < b.key; };
-    auto by_edge = [](const Third& a, const Third& b) { return a.edge < b.edge; };
     std::stable_sort(triangle.begin(), triangle.end(), by_key);
-    std::stable_sort(third.begin(), third.end(), by_edge);
+    third.sort();
     std::vector<bool> paired(uses.size(), false);
     auto tri = [&](Index a, Index b, Index c) -> const std::size_t* {
       const Index n[3] = {a, b, c};
@@ -359,10 +353,7 @@ class InputChecker {
         if (t1 && t2) cover = {*t1, *t2};
       }
       if (cover.empty()) {
-        const auto [first, last] =
-            std::equal_range(third.begin(), third.end(), Third{edge_key(q[0], q[1]), 0}, by_edge);
-        for (auto it = first; it != last; ++it) {
-          const Index x = it->node;
+        for (const auto& [edge, x] : third.on(q[0], q[1])) {
           const auto *t1 = tri(q[0], q[1], x), *t2 = tri(q[1], q[2], x), *t3 = tri(q[2], q[3], x),
                      *t4 = tri(q[3], q[0], x);
           if (t1 && t2 && t3 && t4) {

@@ -13,6 +13,7 @@
 #include <unordered_set>
 
 #include <geode/primal/boundary.hpp>
+#include <geode/primal/detail/edge_thirds.hpp>
 #include <geode/primal/detail/lowest_node_sort.hpp>
 #include <geode/primal/disjoint_sets.hpp>
 #include <geode/primal/errors.hpp>
@@ -405,20 +406,12 @@ Interface find_interface(const Model& model, double tol, std::vector<Index>* joi
   };
 
   // Per boundary-triangle edge, the third nodes of the boundary triangles on it: the candidate
-  // centres of a four-triangle split, in the triangles' order. A sorted list rather than a hash
-  // map of vectors (one allocation per edge: 5 ms of the n = 36 bench's interface search).
-  struct Third {
-    EdgeKey edge;
-    Index node;
-  };
-  std::vector<Third> thirds;
+  // centres of a four-triangle split.
+  detail::EdgeThirds thirds;
   for (const TriangleUses& uses : tris)
     if (uses.count == 1)
-      for (std::size_t i = 0; i < 3; ++i)
-        thirds.push_back({edge_key(uses.use[0].nodes[i], uses.use[0].nodes[(i + 1) % 3]),
-                          uses.use[0].nodes[(i + 2) % 3]});
-  auto by_edge = [](const Third& a, const Third& b) { return a.edge < b.edge; };
-  std::stable_sort(thirds.begin(), thirds.end(), by_edge);  // equal edges keep their order
+      thirds.add(uses.use[0].nodes[0], uses.use[0].nodes[1], uses.use[0].nodes[2]);
+  thirds.sort();
   std::vector<char> in_hex(P.size(), 0);
   for (const auto& h : model.hexes)
     for (Index v : h) in_hex[index_cast<std::size_t>(v)] = 1;
@@ -426,13 +419,11 @@ Interface find_interface(const Model& model, double tol, std::vector<Index>* joi
   // of several (a single tet layer's outer faces can fan around the quad too) the nearest to the
   // quad's middle.
   auto four_split_centre = [&](const std::array<Index, 4>& c) -> Index {
-    const auto [first, last] =
-        std::equal_range(thirds.begin(), thirds.end(), Third{edge_key(c[0], c[1]), 0}, by_edge);
-    if (first == last) return kInvalidIndex;
+    const auto on = thirds.on(c[0], c[1]);
+    if (on.empty()) return kInvalidIndex;
     const Point middle = (pt(c[0]) + pt(c[1]) + pt(c[2]) + pt(c[3])) / 4.0;
     Index best = kInvalidIndex;
-    for (auto it = first; it != last; ++it) {
-      const Index x = it->node;
+    for (const auto& [edge, x] : on) {
       bool all = true;
       for (std::size_t i = 1; i < 4 && all; ++i)
         all = boundary_triangle(face_key(std::array<Index, 3>{c[i], c[(i + 1) % 4], x})) != nullptr;
