@@ -35,13 +35,16 @@ struct TriangleUses {
   int count = 0;
 };
 
-// The tet part's triangles with the tets using them, numbered in order of first use (tet by
-// tet, face by face). The face uses are sorted by their lowest node (detail/lowest_node_sort.hpp):
-// a hash map of the half million triangles of a 126k-tet part cost 0.12 s in random probes,
-// most of the interface search.
+// The tet part's triangles with a node of the hex part (`near`), with the tets using them,
+// numbered in order of first use (tet by tet, face by face): the only ones the interface search
+// reads (an interface triangle has hex-part nodes, and so does any boundary triangle the
+// node-wise conformity test compares with a hex-part quad). The rest of the tet part is left to
+// check_input (conform.hpp): pairing its 740,000 face uses was half the search on the n = 36
+// bench. The face uses are sorted by their lowest node (detail/lowest_node_sort.hpp): a hash map
+// of the half million triangles of a 126k-tet part cost 0.12 s in random probes.
 class TetTriangles {
  public:
-  explicit TetTriangles(const Model& model);
+  TetTriangles(const Model& model, const std::vector<char>& near);
 
   // The triangle with this key (face_key of three nodes), or nullptr.
   const TriangleUses* find(const FaceKey& key) const {
@@ -55,7 +58,7 @@ class TetTriangles {
   }
 
   std::vector<TriangleUses> tris;
-  std::vector<Index> tet_face_tri;  // tris index of face f of tet t at 4 t + f
+  std::vector<Index> tet_face_tri;  // tris index of face f of tet t at 4 t + f (or invalid)
 
  private:
   // A face use: its nodes ascending, and 4 t + f.
@@ -70,7 +73,7 @@ class TetTriangles {
   std::vector<Index> tri_of_rec_;   // at a triangle's first record, its tris index
 };
 
-TetTriangles::TetTriangles(const Model& model)
+TetTriangles::TetTriangles(const Model& model, const std::vector<char>& near)
     : tet_face_tri(4 * model.tets.size(), kInvalidIndex) {
   auto face_use = [&](Index use) {
     const auto t = index_cast<std::size_t>(use / 4);
@@ -80,27 +83,27 @@ TetTriangles::TetTriangles(const Model& model)
       u.nodes[i] = model.tets[t][index_cast<std::size_t>(topology::kTetFaceCorners[f][i])];
     return u;
   };
-  auto each_use = [&](auto&& visit) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, model.tets.size(), 4096),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t t = r.begin(); t != r.end(); ++t)
-                          for (Index f = 0; f < 4; ++f) {
-                            const FaceKey k = face_key(face_use(index_cast(4 * t) + f).nodes);
-                            visit(Record{k[0], k[1], k[2], index_cast(4 * t) + f});
-                          }
-                      });
-  };
-  // Counted without making the records: of a tet's four faces, three have its lowest node as
-  // theirs and one its second lowest.
-  auto each_lowest = [&](auto&& visit) {
+  auto is_near = [&](Index v) { return near[index_cast<std::size_t>(v)] != 0; };
+  // visit(t, f, key) for every face with a near node.
+  auto each_face = [&](auto&& visit) {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, model.tets.size(), 4096),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         for (std::size_t t = r.begin(); t != r.end(); ++t) {
-                          std::array<Index, 4> c = model.tets[t];
-                          std::partial_sort(c.begin(), c.begin() + 2, c.end());
-                          visit(c[0]), visit(c[0]), visit(c[0]), visit(c[1]);
+                          const auto& tet = model.tets[t];
+                          if (std::none_of(tet.begin(), tet.end(), is_near)) continue;
+                          for (Index f = 0; f < 4; ++f) {
+                            const TetFaceUse u = face_use(index_cast(4 * t) + f);
+                            if (std::any_of(u.nodes.begin(), u.nodes.end(), is_near))
+                              visit(index_cast(4 * t) + f, face_key(u.nodes));
+                          }
                         }
                       });
+  };
+  auto each_use = [&](auto&& visit) {
+    each_face([&](Index use, const FaceKey& k) { visit(Record{k[0], k[1], k[2], use}); });
+  };
+  auto each_lowest = [&](auto&& visit) {
+    each_face([&](Index, const FaceKey& k) { visit(k[0]); });
   };
   rec_ = detail::sort_by_lowest_node<Record>(
       model.points.size(), each_lowest, each_use, [](const Record& r) { return r.a; }, start_);
@@ -182,10 +185,15 @@ bool on_triangle(const Point& p, const Point& a, const Point& b, const Point& c,
 
 // Two elements of one kind on the same nodes (a duplicated element, or one block read twice)
 // hide the faces between them, so that the interface would seem to vanish there; name them
-// instead. First pair in element order.
+// instead. First pair in element order. Given `near` (per node), only the elements with a node
+// there: the tets at the hex part (TetTriangles).
 template <std::size_t N>
 void refuse_duplicates(const Model& model, const std::vector<std::array<Index, N>>& cells,
-                       ElementKind kind) {
+                       ElementKind kind, const std::vector<char>* near = nullptr) {
+  auto skipped = [&](std::size_t e) {
+    return near && std::none_of(cells[e].begin(), cells[e].end(),
+                                [&](Index v) { return (*near)[index_cast<std::size_t>(v)] != 0; });
+  };
   // Each element's sorted nodes, sorted by the smallest (detail::sort_by_lowest_node, in
   // parallel): duplicates sit together. The first pair in element order is the one whose later
   // element comes first.
@@ -195,7 +203,8 @@ void refuse_duplicates(const Model& model, const std::vector<std::array<Index, N
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 4096),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         for (std::size_t e = r.begin(); e != r.end(); ++e)
-                          visit(*std::min_element(cells[e].begin(), cells[e].end()));
+                          if (!skipped(e))
+                            visit(*std::min_element(cells[e].begin(), cells[e].end()));
                       });
   };
   const std::vector<Use> uses = detail::sort_by_lowest_node<Use>(
@@ -204,6 +213,7 @@ void refuse_duplicates(const Model& model, const std::vector<std::array<Index, N
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 4096),
                           [&](const tbb::blocked_range<std::size_t>& r) {
                             for (std::size_t e = r.begin(); e != r.end(); ++e) {
+                              if (skipped(e)) continue;
                               Use u{cells[e], e};
                               std::sort(u.key.begin(), u.key.end());
                               visit(u);
@@ -390,14 +400,20 @@ std::vector<std::array<Index, 3>> interface_triangles(const InterfaceQuad& q) {
 
 Interface find_interface(const Model& model, double tol, std::vector<Index>* joining) {
   validate(model, "find_interface");
-  refuse_duplicates(model, model.hexes, ElementKind::kHex);
-  refuse_duplicates(model, model.tets, ElementKind::kTet);
-  refuse_duplicates(model, model.wedges, ElementKind::kWedge);
   const auto& P = model.points;
   auto pt = [&](Index v) -> const Point& { return P[index_cast<std::size_t>(v)]; };
+  std::vector<char> in_part(P.size(), 0);  // a node of the hex part (a hex's or a wedge's)
+  for (const auto& h : model.hexes)
+    for (Index v : h) in_part[index_cast<std::size_t>(v)] = 1;
+  for (const auto& w : model.wedges)
+    for (Index v : w) in_part[index_cast<std::size_t>(v)] = 1;
+  refuse_duplicates(model, model.hexes, ElementKind::kHex);
+  refuse_duplicates(model, model.tets, ElementKind::kTet, &in_part);
+  refuse_duplicates(model, model.wedges, ElementKind::kWedge);
 
-  // Triangles of the tet part with the tets using them (boundary triangles: one use).
-  const TetTriangles triangles_of(model);
+  // Triangles of the tet part at the hex part with the tets using them (boundary triangles: one
+  // use).
+  const TetTriangles triangles_of(model, in_part);
   const std::vector<TriangleUses>& tris = triangles_of.tris;
   // The boundary triangle with this key, or nullptr.
   auto boundary_triangle = [&](const FaceKey& key) -> const TetFaceUse* {
@@ -539,6 +555,7 @@ Interface find_interface(const Model& model, double tol, std::vector<Index>* joi
   for (std::size_t t = 0; t < model.tets.size(); ++t)
     for (std::size_t f = 0; f < 4; ++f) {
       const Index id = triangles_of.tet_face_tri[4 * t + f];
+      if (id == kInvalidIndex) continue;  // no hex-part node: it lies on no quad of it
       const TriangleUses& uses = tris[index_cast<std::size_t>(id)];
       if (uses.count != 1 || matched[index_cast<std::size_t>(id)]) continue;
       const TetFaceUse& tri = uses.use[0];

@@ -68,13 +68,14 @@ std::vector<std::array<Index, 3>> interface_triangles(const InterfaceQuad& quad)
 // - a four-triangle centre node that is a node of the hex part too, lies more than 0.05 of the
 //   quad's mean edge off the plane through the quad's centre point (a gap between the parts
 //   when outside the hex, an overlap when inside), or outside the quad (a triangle folds);
-// - two hexes (or two tets) on the same nodes (a duplicated element);
+// - two hexes, wedges or tets on the same nodes (a duplicated element; tets where they touch
+//   the hex part: the tet part away from it is check_input's, conform.hpp);
 // - a node of one side lying on a boundary face of the other side without being one of its
 //   corners (hanging node, different refinement, unmerged duplicate node);
 // - a node used by both parts that is on no interface quad (the parts touch along an edge
 //   or at a point only);
 // - a tet on the hex side of the interface quad it touches (the parts overlap);
-// - a face shared by more than two tets;
+// - a face with a node of the hex part shared by more than two tets;
 // - a cell joining the two sides around an interface node (see InterfaceSide: a wedge sharing
 //   faces there with a hex and with a tet of the interface, as where a wedge layer over the
 //   tet part meets a hex layer over the hex part): the interface ends inside the mesh there,
