@@ -277,10 +277,44 @@ class InputChecker {
   }
 
   // Faces used more than once: pairs must be seen in opposite orders; the rest into `single`.
+  // In fixed pieces of whole runs (one key each), in parallel; their findings and single faces
+  // put together in piece order are what one pass in order finds, for any thread count.
   void pair_uses(const std::vector<FaceUse>& uses, std::vector<FaceUse>& single) {
-    for (std::size_t i = 0; i < uses.size();) {
+    constexpr std::size_t kPieces = 64;
+    const std::size_t n = uses.size();
+    std::array<std::size_t, kPieces + 1> cut{};
+    for (std::size_t p = 0; p <= kPieces; ++p) {
+      std::size_t at = n * p / kPieces;
+      while (at > 0 && at < n && uses[at].key == uses[at - 1].key) ++at;  // a run's start
+      cut[p] = at;
+    }
+    std::vector<PairedPiece> pieces(kPieces);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kPieces, 1),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t p = r.begin(); p != r.end(); ++p)
+                          pair_piece(uses, cut[p], cut[p + 1], pieces[p]);
+                      });
+    for (PairedPiece& piece : pieces) {
+      for (InputFinding& f : piece.findings) add(std::move(f));
+      single.insert(single.end(), piece.single.begin(), piece.single.end());
+    }
+  }
+
+  struct PairedPiece {
+    std::vector<InputFinding> findings;
+    std::vector<FaceUse> single;
+  };
+
+  // pair_uses on the runs of uses [from, to) into `out` (findings past the most add() keeps
+  // are dropped here already).
+  void pair_piece(const std::vector<FaceUse>& uses, std::size_t from, std::size_t to,
+                  PairedPiece& out) const {
+    auto keep = [&](InputFinding f) {
+      if (out.findings.size() < options_.max_findings) out.findings.push_back(std::move(f));
+    };
+    for (std::size_t i = from; i < to;) {
       std::size_t j = i + 1;
-      while (j < uses.size() && uses[j].key == uses[i].key) ++j;
+      while (j < to && uses[j].key == uses[i].key) ++j;
       // The common case first: a face two elements see in opposite orders. Those are not one
       // element twice: positive elements on the same nodes lie on the same side of each face.
       if (j - i == 2 && opposite(uses[i], uses[i + 1])) {
@@ -292,25 +326,25 @@ class InputChecker {
         for (std::size_t b = a + 1; b < j && twin == j; ++b)
           if (same_nodes(uses[a].element, uses[b].element)) twin = a;
       if (j - i == 1) {
-        single.push_back(uses[i]);
+        out.single.push_back(uses[i]);
       } else if (twin != j) {
         std::size_t other = twin + 1;
         while (!same_nodes(uses[twin].element, uses[other].element)) ++other;
-        add({InputFault::kDuplicateElement,
-             {uses[twin].element, uses[other].element},
-             kInvalidIndex,
-             centre(uses[twin].element),
-             0.0});
+        keep({InputFault::kDuplicateElement,
+              {uses[twin].element, uses[other].element},
+              kInvalidIndex,
+              centre(uses[twin].element),
+              0.0});
       } else if (j - i > 2) {
         InputFinding f{InputFault::kOversharedFace, {}, kInvalidIndex, face_centre(uses[i]), 0.0};
         for (std::size_t k = i; k < j && k < i + 3; ++k) f.elements.push_back(uses[k].element);
-        add(std::move(f));
+        keep(std::move(f));
       } else if (!opposite(uses[i], uses[i + 1])) {
-        add({InputFault::kSameSideFace,
-             {uses[i].element, uses[i + 1].element},
-             kInvalidIndex,
-             face_centre(uses[i]),
-             0.0});
+        keep({InputFault::kSameSideFace,
+              {uses[i].element, uses[i + 1].element},
+              kInvalidIndex,
+              face_centre(uses[i]),
+              0.0});
       }
       i = j;
     }
