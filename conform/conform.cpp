@@ -385,11 +385,18 @@ void Conformer::measure_changed() {
         return false;
     return true;
   };
+  // Flagged in parallel (each cell its own slot), then listed in order.
   auto changed = [&](const auto& cells, const auto& layer_cells, std::vector<char>& later) {
+    const bool all = cells.size() != layer_cells.size();
+    std::vector<char> flag(cells.size(), 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 8192),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t c = r.begin(); c != r.end(); ++c)
+                          flag[c] = later[c] && (all || !same(cells[c], layer_cells[c]));
+                      });
     std::vector<std::size_t> which;
     for (std::size_t c = 0; c < cells.size(); ++c)
-      if (later[c] && (cells.size() != layer_cells.size() || !same(cells[c], layer_cells[c])))
-        which.push_back(c), later[c] = 0;
+      if (flag[c]) which.push_back(c), later[c] = 0;
     return which;
   };
   measure_cells(input_.points, input_.hexes, changed(input_.hexes, lm.hexes, hex_later_),
