@@ -205,13 +205,20 @@ void BufferBuilder::moving_part(const Cells& cells, const Edges& edges, const Fa
   }
   // Their faces' uses over the whole part, counted in a table of those faces only (a table of
   // every face of the part, filled and searched, was most of this stage); interface faces -1.
+  // Only a cell with a node of a touched cell can share a face with one: the others are passed
+  // over without a look-up (on the n = 36 bench, 280,000 of them on one thread).
   KeyMap<4> uses(touched.size() * nf);
-  for (Index c : touched)
-    for (std::size_t f = 0; f < nf; ++f)
-      uses.try_emplace(face_key(face_nodes(cells[index_cast<std::size_t>(c)], faces[f])), 0);
+  std::vector<char> near(n_points_, 0);
+  for (Index c : touched) {
+    const auto& cell = cells[index_cast<std::size_t>(c)];
+    for (Index v : cell) near[index_cast<std::size_t>(v)] = 1;
+    for (std::size_t f = 0; f < nf; ++f) uses.try_emplace(face_key(face_nodes(cell, faces[f])), 0);
+  }
   for (const auto& cell : cells)
-    for (std::size_t f = 0; f < nf; ++f)
-      if (Index* n = uses.find(face_key(face_nodes(cell, faces[f])))) ++*n;
+    if (std::any_of(cell.begin(), cell.end(),
+                    [&](Index v) { return near[index_cast<std::size_t>(v)] != 0; }))
+      for (std::size_t f = 0; f < nf; ++f)
+        if (Index* n = uses.find(face_key(face_nodes(cell, faces[f])))) ++*n;
   for (const auto& [cell, f] : interface_faces)
     if (Index* n = uses.find(face_key(
             face_nodes(cells[index_cast<std::size_t>(cell)], faces[index_cast<std::size_t>(f)]))))
