@@ -7,6 +7,7 @@
 // elements, and `geode conform` exits 2 on them with one line and nothing written. Each of them,
 // checked in 2 and 3 shares as geode_mpi's ranks share the check, gives the same findings.
 #include <doctest/doctest.h>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <barrier>
@@ -371,6 +372,50 @@ TEST_CASE("input check: a tet and a hex written twice in a Gmsh hybrid are named
     CHECK(f.text(m).find("one element twice") != std::string::npos);
     CHECK(f.text(m).find("999999") != std::string::npos);  // by the file's own id
   }
+}
+
+TEST_CASE("input check: many tets written twice, named in one order for any thread count") {
+  // Faces are paired in pieces in parallel: the findings, joined in piece order, must be those
+  // of one pass in order, the first max_findings of them when there are more.
+  test::TempDir dir;
+  primal::Model m = test::demo_input("hybrid", 4, dir, ".msh", false);
+  const std::size_t tets = m.tets.size();
+  for (std::size_t t = 0; t < tets; t += 7) {  // spread over the node range: over the pieces
+    const auto c = m.tets[t];
+    primal::add_element(m, ElementKind::kTet, std::vector<Index>(c.begin(), c.end()),
+                        m.tet_block[t], static_cast<std::int64_t>(900000 + t));
+  }
+  const std::size_t copies = (tets + 6) / 7;
+  REQUIRE(copies > 64);  // more than the pieces
+  primal::InputCheckOptions all;
+  all.max_findings = 100000;
+  auto elements = [](const primal::InputCheckResult& r) {
+    std::vector<std::vector<primal::ElementRef>> e;
+    for (const primal::InputFinding& f : r.findings) e.push_back(f.elements);
+    return e;
+  };
+  const primal::InputCheckResult two = primal::check_input(m, all);
+  primal::InputCheckResult one;
+  {
+    const tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
+    one = primal::check_input(m, all);
+  }
+  REQUIRE(two.findings.size() >= copies);
+  CHECK(elements(one) == elements(two));
+  // Every copy named as one, at one of its faces (a finding per face the copy hides; the later
+  // stages find more).
+  std::set<Index> named;
+  for (const primal::InputFinding& f : two.findings)
+    if (f.fault == InputFault::kDuplicateElement)
+      for (const primal::ElementRef& e : f.elements)
+        if (e.index >= primal::index_cast(tets)) named.insert(e.index);
+  CHECK(named.size() == copies);
+  CHECK(two.findings.front().fault == InputFault::kDuplicateElement);
+  const primal::InputCheckResult few = primal::check_input(m);  // the first 8
+  REQUIRE(few.findings.size() == 8);
+  auto first = elements(two);
+  first.resize(8);
+  CHECK(elements(few) == first);
 }
 
 TEST_CASE("input check: overlapping parts, a gap at the interface, a part inside another") {

@@ -134,6 +134,34 @@ TEST_CASE("read_gmsh converts Gmsh's hex and tet corner order to VTK order") {
   CHECK(m.node_sets[0].nodes == std::vector<Index>{5});  // tag 6 = (0,0,1)
 }
 
+TEST_CASE("read_gmsh: sparse node tags, and one entity's elements in two runs") {
+  // Tag 3000000000 makes the tags too sparse for a table (the reader's hash map); entity 1's
+  // tets come before and after entity 2's, so each run's block is found again.
+  const fs::path file = scratch_dir() / "sparse_tags.msh";
+  write_text(file,
+             "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n"
+             "$PhysicalNames\n2\n3 1 \"a\"\n3 2 \"b\"\n$EndPhysicalNames\n"
+             "$Entities\n0 0 0 2\n1 0 0 0 1 1 1 1 1 0\n2 0 0 0 1 1 1 1 2 0\n$EndEntities\n"
+             "$Nodes\n1 6 4 3000000000\n3 1 0 6\n7\n12\n3000000000\n5\n9\n4\n"
+             "0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 1\n1 1 0\n$EndNodes\n"
+             "$Elements\n3 3 1 3\n"
+             "3 1 4 1\n1 7 12 3000000000 5\n"
+             "3 2 4 1\n2 12 9 3000000000 5\n"
+             "3 1 4 1\n3 12 4 3000000000 9\n"
+             "$EndElements\n");
+  const Model m = read_gmsh(file);
+  CHECK(m.node_ids == std::vector<std::int64_t>{4, 5, 7, 9, 12, 3000000000});
+  CHECK(m.points[5] == Point(0, 1, 0));
+  REQUIRE(m.tets.size() == 3);
+  CHECK(m.tet_block == std::vector<int>{1, 1, 2});  // by block, file order within one
+  CHECK(m.tet_ids == std::vector<std::int64_t>{1, 3, 2});
+  CHECK(m.block_names.at(1) == "a");
+  CHECK(m.block_names.at(2) == "b");
+  // Tet 2 (file id 3) on tags 12 4 3000000000 9: indices 4 0 5 3 as read (VTK order is Gmsh's
+  // for tets).
+  CHECK(m.tets[1] == std::array<Index, 4>{4, 0, 5, 3});
+}
+
 TEST_CASE("write_gmsh then read_gmsh gives the same model (ASCII and binary)") {
   const Model m = sample_model();
   REQUIRE(m.hexes.size() == 2);

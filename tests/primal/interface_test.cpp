@@ -10,6 +10,7 @@
 
 #include <geode/primal/errors.hpp>
 #include <geode/primal/grid_model.hpp>
+#include <geode/primal/input_check.hpp>
 #include <geode/primal/interface.hpp>
 #include <geode/primal/topology.hpp>
 #include "support/fixtures.hpp"
@@ -204,6 +205,31 @@ TEST_CASE("find_interface: rejects non-conforming interfaces, naming the face or
         find_interface(m),
         doctest::Contains(("tet " + std::to_string(m.tets.size()) + " (centre").c_str()),
         TopologyError);
+  }
+  SUBCASE("away from the hex part, a triangle of three tets is check_input's") {
+    // The search pairs only tet faces with a hex-part node (conform's input passed check_input,
+    // which refuses this one).
+    Model m = grid_model({1, 1, 3}, 1.0, [](int, int, int k) { return k >= 1; });
+    std::vector<Index> shared;  // a face two tets of the top layer share, off the hex nodes
+    for (std::size_t a = 0; a < m.tets.size() && shared.empty(); ++a)
+      for (std::size_t b = a + 1; b < m.tets.size() && shared.empty(); ++b) {
+        std::vector<Index> common;
+        for (Index v : m.tets[a])
+          if (std::find(m.tets[b].begin(), m.tets[b].end(), v) != m.tets[b].end())
+            common.push_back(v);
+        if (common.size() == 3 && std::all_of(common.begin(), common.end(), [&](Index v) {
+              return m.points[index_cast<std::size_t>(v)].z() > 1.5;
+            }))
+          shared = common;
+      }
+    REQUIRE(shared.size() == 3);
+    m.points.emplace_back(0.5, 0.5, 9.0);
+    m.tets.push_back({shared[0], shared[1], shared[2], index_cast(m.points.size() - 1)});
+    m.tet_block.push_back(2);
+    CHECK(find_interface(m).quads.size() == 1);
+    const InputCheckResult r = check_input(m);
+    REQUIRE(!r.ok());
+    CHECK(r.findings[0].fault == InputFault::kOversharedFace);
   }
   SUBCASE("a tet given twice, named with its first copy") {
     Model m = grid_model({1, 1, 2}, 1.0, [](int, int, int k) { return k == 1; });
