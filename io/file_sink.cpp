@@ -34,9 +34,19 @@ void FileSink::fail(const std::string& what, int err) const {
 }
 
 void FileSink::flush() {
+  write_all(buffer_.data(), used_);
+  used_ = 0;
+}
+
+void FileSink::write_through(std::string_view s) {
+  flush();
+  write_all(s.data(), s.size());
+}
+
+void FileSink::write_all(const char* data, std::size_t size) {
   std::size_t done = 0;
-  while (done < used_) {
-    const ssize_t n = ::write(fd_, buffer_.data() + done, used_ - done);
+  while (done < size) {
+    const ssize_t n = ::write(fd_, data + done, size - done);
     if (n < 0) {
       if (errno == EINTR) continue;
       fail("write failed", errno);
@@ -44,7 +54,6 @@ void FileSink::flush() {
     if (n == 0) fail("write failed", EIO);
     done += static_cast<std::size_t>(n);
   }
-  used_ = 0;
   written_ += done;
   if (written_ - handed_ >= kWritebackBytes) {
     // A request only (Linux): close() still syncs, and reports what failed.
