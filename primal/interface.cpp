@@ -12,12 +12,10 @@
 #include <unordered_map>
 #include <unordered_set>
 
-#include <geode/primal/boundary.hpp>
 #include <geode/primal/detail/edge_thirds.hpp>
 #include <geode/primal/detail/lowest_node_sort.hpp>
 #include <geode/primal/disjoint_sets.hpp>
 #include <geode/primal/errors.hpp>
-#include <geode/primal/key_map.hpp>
 #include <geode/primal/topology.hpp>
 
 namespace geode::primal {
@@ -250,38 +248,58 @@ std::array<std::array<Index, 3>, 2> split(const std::array<Index, 4>& c, int dia
   return {{{c[0], c[1], c[3]}, {c[1], c[2], c[3]}}};
 }
 
-// The hex part's boundary quads: the hexes' (boundary_quads' order), then the wedges' quad
-// faces that no hex or other wedge shares, in wedge order.
-std::vector<PartQuad> part_quads(const Model& model) {
-  std::vector<PartQuad> out;
-  for (const BoundaryQuad& q : boundary_quads(hex_part(model)))
-    out.push_back({{ElementKind::kHex, q.hex}, q.local_face, q.nodes});
-  if (model.wedges.empty()) return out;
-  const auto& faces = cell_topology(ElementKind::kWedge).face;
-  auto quad = [&](std::size_t w, const auto& f) {
-    std::array<Index, 4> c{};
-    for (std::size_t i = 0; i < 4; ++i)
-      c[i] = model.wedges[w][index_cast<std::size_t>(f.corners[i])];
-    return c;
+// The hex part's boundary quads with a node of the tet part (`near`): the hexes' (in
+// boundary_quads' order: hex by hex, faces in table order), then the wedges' quad faces that no
+// hex or other wedge shares, in wedge order. A quad without such a node neither matches tet
+// triangles nor shares a node with one (the node-wise conformity test), and every cell using a
+// quad with such a node has it: the uses of those quads are counted among those cells only
+// (all 280,000 hex faces of the n = 36 bench were sorted, and the hex part copied, before).
+std::vector<PartQuad> part_quads(const Model& model, const std::vector<char>& near) {
+  auto is_near = [&](Index v) { return near[index_cast<std::size_t>(v)] != 0; };
+  struct Use {
+    FaceKey key;
+    PartQuad quad;
   };
-  KeyMap<4> uses(3 * model.wedges.size());
-  std::vector<Index> count;
-  for (std::size_t w = 0; w < model.wedges.size(); ++w)
-    for (const auto& f : faces)
-      if (f.size == 4) {
-        const auto [id, fresh] = uses.try_emplace(face_key(quad(w, f)), index_cast(count.size()));
-        if (fresh) count.push_back(0);
-        ++count[index_cast<std::size_t>(*id)];
+  std::vector<Use> hex_uses, wedge_uses;
+  auto gather = [&](ElementKind kind, const auto& cells, std::vector<Use>& uses) {
+    const auto& faces = cell_topology(kind).face;
+    for (std::size_t e = 0; e < cells.size(); ++e) {
+      if (std::none_of(cells[e].begin(), cells[e].end(), is_near)) continue;
+      for (std::size_t f = 0; f < faces.size(); ++f) {
+        if (faces[f].size != 4) continue;
+        std::array<Index, 4> c{};
+        for (std::size_t i = 0; i < 4; ++i)
+          c[i] = cells[e][index_cast<std::size_t>(faces[f].corners[i])];
+        if (std::any_of(c.begin(), c.end(), is_near))
+          uses.push_back({face_key(c), {{kind, index_cast(e)}, static_cast<int>(f), c}});
       }
-  for (const PartQuad& q : out)
-    if (const Index* id = uses.find(face_key(q.nodes))) ++count[index_cast<std::size_t>(*id)];
-  for (std::size_t w = 0; w < model.wedges.size(); ++w)
-    for (std::size_t f = 0; f < faces.size(); ++f)
-      if (faces[f].size == 4) {
-        const auto c = quad(w, faces[f]);
-        if (count[index_cast<std::size_t>(*uses.find(face_key(c)))] == 1)
-          out.push_back({{ElementKind::kWedge, index_cast(w)}, static_cast<int>(f), c});
-      }
+    }
+  };
+  gather(ElementKind::kHex, model.hexes, hex_uses);
+  gather(ElementKind::kWedge, model.wedges, wedge_uses);
+  // How many uses each key has among `uses` (and `also`, counted on top when given).
+  auto counts = [](const std::vector<Use>& uses, const std::vector<Use>* also) {
+    std::vector<FaceKey> keys;
+    for (const Use& u : uses) keys.push_back(u.key);
+    if (also)
+      for (const Use& u : *also) keys.push_back(u.key);
+    std::sort(keys.begin(), keys.end());
+    std::vector<int> n(uses.size());
+    for (std::size_t i = 0; i < uses.size(); ++i) {
+      const auto [lo, hi] = std::equal_range(keys.begin(), keys.end(), uses[i].key);
+      n[i] = static_cast<int>(hi - lo);
+    }
+    return n;
+  };
+  std::vector<PartQuad> out;
+  const std::vector<int> hex_count = counts(hex_uses, nullptr);
+  std::vector<Use> hex_boundary;
+  for (std::size_t i = 0; i < hex_uses.size(); ++i)
+    if (hex_count[i] == 1) out.push_back(hex_uses[i].quad), hex_boundary.push_back(hex_uses[i]);
+  if (wedge_uses.empty()) return out;
+  const std::vector<int> wedge_count = counts(wedge_uses, &hex_boundary);
+  for (std::size_t i = 0; i < wedge_uses.size(); ++i)
+    if (wedge_count[i] == 1) out.push_back(wedge_uses[i].quad);
   return out;
 }
 
@@ -449,7 +467,10 @@ Interface find_interface(const Model& model, double tol, std::vector<Index>* joi
     return best;
   };
 
-  const std::vector<PartQuad> quads = part_quads(model);
+  std::vector<char> in_tet(P.size(), 0);
+  for (const auto& t : model.tets)
+    for (Index v : t) in_tet[index_cast<std::size_t>(v)] = 1;
+  const std::vector<PartQuad> quads = part_quads(model, in_tet);
   std::vector<char> matched(tris.size(), 0);  // one of the two triangles of an interface quad
   Interface out;
   std::vector<const PartQuad*> unmatched_quads;
@@ -599,9 +620,6 @@ Interface find_interface(const Model& model, double tol, std::vector<Index>* joi
   out.nodes.erase(std::unique(out.nodes.begin(), out.nodes.end()), out.nodes.end());
 
   // Nodes shared by both parts must be interface nodes.
-  std::vector<char> in_tet(P.size(), 0);
-  for (const auto& t : model.tets)
-    for (Index v : t) in_tet[index_cast<std::size_t>(v)] = 1;
   for (std::size_t v = 0; v < P.size(); ++v)
     if (in_hex[v] && in_tet[v] &&
         !std::binary_search(out.nodes.begin(), out.nodes.end(), index_cast(v)))
