@@ -749,10 +749,12 @@ class MshReader {
     std::iota(volume_order.begin(), volume_order.end(), std::size_t{0});
     // A partitioned file lists the elements partition by partition; their tags are the
     // unpartitioned file's, whose order (ascending tags) they take again.
-    std::stable_sort(volume_order.begin(), volume_order.end(), [&](std::size_t a, std::size_t b) {
+    auto before = [&](std::size_t a, std::size_t b) {
       if (volumes[a].block != volumes[b].block) return volumes[a].block < volumes[b].block;
       return partitioned_ && elements_[volumes[a].element].tag < elements_[volumes[b].element].tag;
-    });
+    };
+    if (!std::is_sorted(volume_order.begin(), volume_order.end(), before))  // often in order
+      std::stable_sort(volume_order.begin(), volume_order.end(), before);
     {
       std::set<int> blocks;
       for (const Volume& v : volumes) blocks.insert(v.block);
