@@ -250,8 +250,19 @@ std::vector<Index> tet_nodes_to_relax(const Model& model, int rings) {
   // all tet nodes (the quads a transition is made on: two or four tet triangles on them), not
   // from every node tets share with them (a wedge layer's base lies on tet faces too).
   std::vector<char> tet_node(n, 0), near(n, 0), in_region(model.tets.size(), 0);
-  for (const auto& t : model.tets)
-    for (Index v : t) tet_node[index_cast<std::size_t>(v)] = 1;
+  // Passes over the tets in parallel: each tet its own slot, or nodes flagged 1 by any.
+  auto each_tet = [&](auto&& f) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, model.tets.size(), 8192),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t t = r.begin(); t != r.end(); ++t) f(t);
+                      });
+  };
+  auto flag = [](std::vector<char>& flags, Index v) {
+    std::atomic_ref<char>(flags[index_cast<std::size_t>(v)]).store(1, std::memory_order_relaxed);
+  };
+  each_tet([&](std::size_t t) {
+    for (Index v : model.tets[t]) flag(tet_node, v);
+  });
   for (const ElementKind kind : {ElementKind::kHex, ElementKind::kWedge}) {
     const auto& topo = cell_topology(kind);
     for (std::size_t c = 0; c < element_count(model, kind); ++c) {
@@ -272,12 +283,14 @@ std::vector<Index> tet_nodes_to_relax(const Model& model, int rings) {
     }
   }
   for (int ring = 0; ring < rings; ++ring) {
-    for (std::size_t t = 0; t < model.tets.size(); ++t)
+    each_tet([&](std::size_t t) {
       for (Index v : model.tets[t])
         if (near[index_cast<std::size_t>(v)]) in_region[t] = 1;
-    for (std::size_t t = 0; t < model.tets.size(); ++t)
+    });
+    each_tet([&](std::size_t t) {
       if (in_region[t])
-        for (Index v : model.tets[t]) near[index_cast<std::size_t>(v)] = 1;
+        for (Index v : model.tets[t]) flag(near, v);
+    });
   }
   // Per candidate node its tets' faces through it, as the other two nodes: an interior node
   // has each such face twice (its star is closed), all in one block.
