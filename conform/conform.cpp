@@ -1209,11 +1209,15 @@ void Conformer::check(std::span<const Point> points, std::span<const std::array<
 // The quality per output block.
 // `block`: the output's hex blocks, where they are (mesh_, or the result's model).
 void Conformer::report(const std::vector<int>& block) {
-  std::map<int, std::vector<Index>> members;  // output block -> its hexes, ascending id
-  std::vector<Index>* list = nullptr;         // the run's block's (a block's hexes come in runs)
-  for (std::size_t h = 0; h < block.size(); ++h) {
-    if (h == 0 || block[h] != block[h - 1]) list = &members[block[h]];
-    list->push_back(primal::index_cast(h));
+  std::map<int, std::vector<Index>> members;    // output block -> its hexes, ascending id
+  for (std::size_t h = 0; h < block.size();) {  // a block's hexes come in runs: a run at a time
+    std::size_t end = h + 1;
+    while (end < block.size() && block[end] == block[h]) ++end;
+    std::vector<Index>& list = members[block[h]];
+    const std::size_t at = list.size();
+    list.resize(at + end - h);
+    std::iota(list.begin() + static_cast<std::ptrdiff_t>(at), list.end(), primal::index_cast(h));
+    h = end;
   }
   for (const auto& [id, sel] : members) {
     const auto name = blocks_.names.find(id);

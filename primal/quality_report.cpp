@@ -33,13 +33,20 @@ MetricSummary summarize_metric(HexMetric metric, std::span<const double> q,
   const double n = static_cast<double>(q.size());
   MetricSummary s;
   s.metric = metric;
-  const auto lo = std::min_element(q.begin(), q.end());
-  const auto hi = std::max_element(q.begin(), q.end());
-  s.minimum = *lo;
-  s.maximum = *hi;
-  s.min_hex = hexes[index_cast<std::size_t>(lo - q.begin())];
-  s.max_hex = hexes[index_cast<std::size_t>(hi - q.begin())];
-  s.average = std::accumulate(q.begin(), q.end(), 0.0) / n;
+  // Extremes (the first of equal ones, as min_element and max_element) and the sum in one pass,
+  // summed in order as std::accumulate does.
+  std::size_t lo = 0, hi = 0;
+  double sum = 0.0;
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    if (q[i] < q[lo]) lo = i;
+    if (q[hi] < q[i]) hi = i;
+    sum += q[i];
+  }
+  s.minimum = q[lo];
+  s.maximum = q[hi];
+  s.min_hex = hexes[lo];
+  s.max_hex = hexes[hi];
+  s.average = sum / n;
   double ss = 0.0;  // two-pass: no cancellation for large, nearly equal values (volumes)
   for (double v : q) ss += (v - s.average) * (v - s.average);
   const double dof = kind == StdDevKind::kSample ? n - 1.0 : n;
