@@ -35,16 +35,21 @@ bool corners_positive(const HexCorners& p) {
 
 // The region grown a ring at a time: the nodes of the hexes in it marked, then the hexes with
 // a marked node added. Finding those is a pass over the hex array (no incidence built), hexes
-// in parallel; the rest follows the region's own list.
+// in parallel, in fixed chunks whose finds are joined in order; the rest follows the region's
+// own list. `proper` (per hex, bit 0): the hexes the region may take.
 class Region {
  public:
-  Region(Hexes hexes, std::size_t nodes, const std::vector<char>& proper_hex)
-      : hexes_(hexes), proper_(proper_hex), hex_in_(hexes.size(), 0), node_in_(nodes, 0) {}
+  static constexpr std::size_t kChunk = 8192;
 
-  void add(Index h) {
+  Region(Hexes hexes, std::size_t nodes, const std::vector<char>& proper)
+      : hexes_(hexes), proper_(proper), hex_in_(hexes.size(), 0), node_in_(nodes, 0) {}
+
+  // A seed: in range, in the mesh's range and with no node twice (a proper hex, told before the
+  // per-hex pass has run).
+  void add_seed(Index h) {
     if (h < 0 || index_cast<std::size_t>(h) >= hexes_.size()) return;
     const auto i = index_cast<std::size_t>(h);
-    if (!proper_[i] || hex_in_[i]) return;
+    if (hex_in_[i] || !in_range(hexes_[i], node_in_.size()) || has_repeated(hexes_[i])) return;
     hex_in_[i] = 1;
     list_.push_back(h);
   }
@@ -56,22 +61,36 @@ class Region {
         node_in_[index_cast<std::size_t>(v)] = 1;
   }
 
-  // Every proper hex with a marked node (listed in ascending order after the ones there).
-  void add_hexes_at_nodes() {
-    constexpr char kNew = 2;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, hexes_.size(), 8192),
+  // Hex h (in chunk c), proper, taken when it is not in yet and has a marked node.
+  void take_if_near(std::size_t c, std::size_t h, bool proper) {
+    if (hex_in_[h] || !proper) return;
+    for (Index v : hexes_[h])
+      if (node_in_[index_cast<std::size_t>(v)]) {
+        hex_in_[h] = 1;
+        found_[c].push_back(index_cast(h));
+        return;
+      }
+  }
+
+  // f(c, h) for every hex, chunk by chunk in parallel; then what take_if_near took, in order.
+  template <class F>
+  void pass(F&& f) {
+    const std::size_t chunks = (hexes_.size() + kChunk - 1) / kChunk;
+    found_.assign(chunks, {});
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1),
                       [&](const tbb::blocked_range<std::size_t>& range) {
-                        for (std::size_t h = range.begin(); h != range.end(); ++h) {
-                          if (hex_in_[h] || !proper_[h]) continue;
-                          for (Index v : hexes_[h])
-                            if (node_in_[index_cast<std::size_t>(v)]) {
-                              hex_in_[h] = kNew;
-                              break;
-                            }
-                        }
+                        for (std::size_t c = range.begin(); c != range.end(); ++c)
+                          for (std::size_t h = c * kChunk;
+                               h < std::min(hexes_.size(), (c + 1) * kChunk); ++h)
+                            f(c, h);
                       });
-    for (std::size_t h = 0; h < hexes_.size(); ++h)
-      if (hex_in_[h] == kNew) hex_in_[h] = 1, list_.push_back(index_cast(h));
+    for (const auto& f : found_) list_.insert(list_.end(), f.begin(), f.end());
+    found_.clear();
+  }
+
+  // Every proper hex with a marked node.
+  void add_hexes_at_nodes() {
+    pass([&](std::size_t c, std::size_t h) { take_if_near(c, h, (proper_[h] & 1) != 0); });
   }
 
   // The hexes in the region, ascending (its list is consumed).
@@ -87,7 +106,8 @@ class Region {
   const std::vector<char>& proper_;
   std::vector<char> hex_in_, node_in_;
   std::vector<Index> list_;
-  std::size_t marked_ = 0;  // list_[0, marked_) have their nodes marked
+  std::vector<std::vector<Index>> found_;  // per chunk of a pass: the hexes it took
+  std::size_t marked_ = 0;                 // list_[0, marked_) have their nodes marked
 };
 
 }  // namespace
@@ -107,40 +127,38 @@ HexValidityReport check_validity_around(std::span<const Point> points, Hexes hex
 
   // Per hex and per node over the whole mesh, as check_validity finds them, in one parallel
   // pass each (one slot per hex or node); the lists are gathered in order (the same for any
-  // thread count) only when something was found.
+  // thread count) only when something was found. The hex pass also takes the region's first
+  // ring (the hexes at the seeds' nodes), which saves a pass over the hexes.
   enum : char { kProper = 1, kOutOfRange = 2, kRepeated = 4, kInverted = 8 };
   std::vector<char> proper_hex(nh, 0), used(nv, 0);
+  Region region(hexes, nv, proper_hex);  // reads bit 0, kProper
+  for (Index h : seeds) region.add_seed(h);
+  region.mark_nodes();
   std::atomic<bool> faulty = false;
   const bool known = options.positive.size() == nh;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nh, 4096),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      bool found = false;
-                      for (std::size_t h = range.begin(); h != range.end(); ++h) {
-                        const auto& hex = hexes[h];
-                        if (!in_range(hex, nv)) {
-                          proper_hex[h] = kOutOfRange;
-                          found = true;
-                          continue;
-                        }
-                        char code = kProper;
-                        if (has_repeated(hex)) {
-                          code = kRepeated;
-                        } else {
-                          for (Index v : hex)
-                            std::atomic_ref<char>(used[index_cast<std::size_t>(v)])
-                                .store(1, std::memory_order_relaxed);
-                        }
-                        if (!(known && options.positive[h])) {  // else all 9 dets > 0
-                          HexCorners p;
-                          for (std::size_t c = 0; c < 8; ++c)
-                            p[c] = points[index_cast<std::size_t>(hex[c])];
-                          if (!corners_positive(p)) code |= kInverted;
-                        }
-                        proper_hex[h] = code;
-                        found |= code != kProper;
-                      }
-                      if (found) faulty.store(true, std::memory_order_relaxed);
-                    });
+  region.pass([&](std::size_t chunk, std::size_t h) {
+    const auto& hex = hexes[h];
+    if (!in_range(hex, nv)) {
+      proper_hex[h] = kOutOfRange;
+      faulty.store(true, std::memory_order_relaxed);
+      return;
+    }
+    char code = kProper;
+    if (has_repeated(hex)) {
+      code = kRepeated;
+    } else {
+      for (Index v : hex)
+        std::atomic_ref<char>(used[index_cast<std::size_t>(v)]).store(1, std::memory_order_relaxed);
+    }
+    if (!(known && options.positive[h])) {  // else all 9 dets > 0
+      HexCorners p;
+      for (std::size_t c = 0; c < 8; ++c) p[c] = points[index_cast<std::size_t>(hex[c])];
+      if (!corners_positive(p)) code |= kInverted;
+    }
+    proper_hex[h] = code;
+    if (code != kProper) faulty.store(true, std::memory_order_relaxed);
+    region.take_if_near(chunk, h, (code & kProper) != 0);
+  });
   if (faulty) {
     for (std::size_t h = 0; h < nh; ++h) {
       if (proper_hex[h] & kOutOfRange) r.out_of_range_hexes.push_back(index_cast(h));
@@ -148,11 +166,6 @@ HexValidityReport check_validity_around(std::span<const Point> points, Hexes hex
       if (proper_hex[h] & kInverted) r.inverted_hexes.push_back(index_cast(h));
     }
   }
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nh, 8192),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t h = range.begin(); h != range.end(); ++h)
-                        proper_hex[h] = (proper_hex[h] & kProper) != 0;
-                    });
   // Unused nodes counted, non-finite ones flagged (in `used`), in one pass.
   constexpr char kNonFinite = 2;
   r.unused_nodes = tbb::parallel_reduce(
@@ -171,15 +184,11 @@ HexValidityReport check_validity_around(std::span<const Point> points, Hexes hex
   release(used);
 
   // The region: the checked nodes (those of the hexes within `rings` of the seeds) and every
-  // hex around them.
-  Region region(hexes, nv, proper_hex);
-  for (Index h : seeds) region.add(h);
+  // hex around them; the first ring was taken above.
   for (int ring = 0; ring < options.rings; ++ring) {
     region.mark_nodes();
     region.add_hexes_at_nodes();
   }
-  region.mark_nodes();
-  region.add_hexes_at_nodes();
   const std::vector<char>& checked = region.marked_nodes();
 
   // The region as a mesh of its own, checked at its checked nodes (detail::check_validity's
