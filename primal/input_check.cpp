@@ -276,42 +276,49 @@ class InputChecker {
     match_interfaces(single);
   }
 
-  // Faces used more than once: pairs must be seen in opposite orders; the rest into `single`.
-  // In fixed pieces of whole runs (one key each), in parallel; their findings and single faces
-  // put together in piece order are what one pass in order finds, for any thread count.
-  void pair_uses(const std::vector<FaceUse>& uses, std::vector<FaceUse>& single) {
-    constexpr std::size_t kPieces = 64;
-    const std::size_t n = uses.size();
+  // f(piece, findings, begin, end) on [0, n) cut into kPieces pieces of whole runs (items i
+  // with same(i - 1, i) in one), pieces in parallel, each keeping its findings (keep()); then
+  // the pieces' findings added in piece order: what one pass in order finds, for any thread
+  // count.
+  static constexpr std::size_t kPieces = 64;
+  template <class Same, class F>
+  void in_pieces(std::size_t n, Same&& same, F&& f) {
     std::array<std::size_t, kPieces + 1> cut{};
     for (std::size_t p = 0; p <= kPieces; ++p) {
       std::size_t at = n * p / kPieces;
-      while (at > 0 && at < n && uses[at].key == uses[at - 1].key) ++at;  // a run's start
+      while (at > 0 && at < n && same(at - 1, at)) ++at;  // a run's start
       cut[p] = at;
     }
-    std::vector<PairedPiece> pieces(kPieces);
+    std::vector<std::vector<InputFinding>> found(kPieces);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kPieces, 1),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         for (std::size_t p = r.begin(); p != r.end(); ++p)
-                          pair_piece(uses, cut[p], cut[p + 1], pieces[p]);
+                          f(p, found[p], cut[p], cut[p + 1]);
                       });
-    for (PairedPiece& piece : pieces) {
-      for (InputFinding& f : piece.findings) add(std::move(f));
-      single.insert(single.end(), piece.single.begin(), piece.single.end());
-    }
+    for (std::vector<InputFinding>& piece : found)
+      for (InputFinding& x : piece) add(std::move(x));
+  }
+  // A piece's finding, unless it has as many as add() keeps already.
+  void keep(std::vector<InputFinding>& out, InputFinding f) const {
+    if (out.size() < options_.max_findings) out.push_back(std::move(f));
   }
 
-  struct PairedPiece {
-    std::vector<InputFinding> findings;
-    std::vector<FaceUse> single;
-  };
+  // Faces used more than once: pairs must be seen in opposite orders; the rest into `single`.
+  void pair_uses(const std::vector<FaceUse>& uses, std::vector<FaceUse>& single) {
+    std::vector<std::vector<FaceUse>> singles(kPieces);
+    in_pieces(
+        uses.size(), [&](std::size_t a, std::size_t b) { return uses[a].key == uses[b].key; },
+        [&](std::size_t p, std::vector<InputFinding>& out, std::size_t from, std::size_t to) {
+          pair_piece(uses, from, to, out, singles[p]);
+        });
+    for (const std::vector<FaceUse>& piece : singles)
+      single.insert(single.end(), piece.begin(), piece.end());
+  }
 
-  // pair_uses on the runs of uses [from, to) into `out` (findings past the most add() keeps
-  // are dropped here already).
+  // pair_uses on the runs of uses [from, to): findings into `out`, faces used once into
+  // `single`.
   void pair_piece(const std::vector<FaceUse>& uses, std::size_t from, std::size_t to,
-                  PairedPiece& out) const {
-    auto keep = [&](InputFinding f) {
-      if (out.findings.size() < options_.max_findings) out.findings.push_back(std::move(f));
-    };
+                  std::vector<InputFinding>& out, std::vector<FaceUse>& single) const {
     for (std::size_t i = from; i < to;) {
       std::size_t j = i + 1;
       while (j < to && uses[j].key == uses[i].key) ++j;
@@ -326,25 +333,25 @@ class InputChecker {
         for (std::size_t b = a + 1; b < j && twin == j; ++b)
           if (same_nodes(uses[a].element, uses[b].element)) twin = a;
       if (j - i == 1) {
-        out.single.push_back(uses[i]);
+        single.push_back(uses[i]);
       } else if (twin != j) {
         std::size_t other = twin + 1;
         while (!same_nodes(uses[twin].element, uses[other].element)) ++other;
-        keep({InputFault::kDuplicateElement,
-              {uses[twin].element, uses[other].element},
-              kInvalidIndex,
-              centre(uses[twin].element),
-              0.0});
+        keep(out, {InputFault::kDuplicateElement,
+                   {uses[twin].element, uses[other].element},
+                   kInvalidIndex,
+                   centre(uses[twin].element),
+                   0.0});
       } else if (j - i > 2) {
         InputFinding f{InputFault::kOversharedFace, {}, kInvalidIndex, face_centre(uses[i]), 0.0};
         for (std::size_t k = i; k < j && k < i + 3; ++k) f.elements.push_back(uses[k].element);
-        keep(std::move(f));
+        keep(out, std::move(f));
       } else if (!opposite(uses[i], uses[i + 1])) {
-        keep({InputFault::kSameSideFace,
-              {uses[i].element, uses[i + 1].element},
-              kInvalidIndex,
-              face_centre(uses[i]),
-              0.0});
+        keep(out, {InputFault::kSameSideFace,
+                   {uses[i].element, uses[i + 1].element},
+                   kInvalidIndex,
+                   face_centre(uses[i]),
+                   0.0});
       }
       i = j;
     }
@@ -488,12 +495,23 @@ class InputChecker {
       }
     }
     tbb::parallel_sort(half.begin(), half.end());
+    // Nodes in pieces in parallel (in_pieces): each writes its own expected_ and judged_.
+    in_pieces(
+        half.size(), [&](std::size_t a, std::size_t b) { return half[a].v == half[b].v; },
+        [&](std::size_t, std::vector<InputFinding>& out, std::size_t from, std::size_t to) {
+          link_nodes(half, from, to, out);
+        });
+  }
+
+  // boundary_links at the nodes of half[from, to) (whole runs of one node each).
+  void link_nodes(const std::vector<HalfEdge>& half, std::size_t from, std::size_t to,
+                  std::vector<InputFinding>& out) {
     DisjointSets faces_at;
     std::vector<Index> local;  // the faces at v, numbered by order of appearance
-    for (std::size_t i = 0; i < half.size();) {
+    for (std::size_t i = from; i < to;) {
       const Index v = half[i].v;
       std::size_t j = i;
-      while (j < half.size() && half[j].v == v) ++j;
+      while (j < to && half[j].v == v) ++j;
       local.clear();
       for (std::size_t k = i; k < j; ++k)
         if (std::find(local.begin(), local.end(), half[k].face) == local.end())
@@ -509,7 +527,8 @@ class InputChecker {
         while (m < j && half[m].end == half[k].end) ++m;
         if (m - k != 2) {
           manifold = false;
-          if (v < half[k].end) edge_finding(half, k, m);  // each edge once, from its lower end
+          if (v < half[k].end)  // each edge once, from its lower end
+            keep(out, edge_finding(half, k, m));
         } else {
           const Point& o = pt(v);
           exterior += kPi - dihedral(pt(half[k].end) - o, pt(half[k].other) - o, -half[k].normal,
@@ -525,7 +544,7 @@ class InputChecker {
         for (std::size_t r = 0; r < local.size() && f.elements.size() < 2; ++r)
           if (faces_at.find(index_cast(r)) == index_cast(r))
             f.elements.push_back(boundary_[index_cast<std::size_t>(local[r])].element);
-        add(std::move(f));
+        keep(out, std::move(f));
       }
       if (cycles == 1)
         expected_[index_cast<std::size_t>(v)] = 2.0 * kPi - exterior;
@@ -537,7 +556,7 @@ class InputChecker {
 
   // A boundary edge on m - k boundary faces (half[k, m)), not two: the lowest and highest of
   // their elements.
-  void edge_finding(const std::vector<HalfEdge>& half, std::size_t k, std::size_t m) {
+  InputFinding edge_finding(const std::vector<HalfEdge>& half, std::size_t k, std::size_t m) const {
     ElementRef lo = boundary_[index_cast<std::size_t>(half[k].face)].element, hi = lo;
     for (std::size_t x = k + 1; x < m; ++x) {
       const ElementRef e = boundary_[index_cast<std::size_t>(half[x].face)].element;
@@ -551,7 +570,7 @@ class InputChecker {
                    static_cast<double>(m - k)};
     if (hi != lo) f.elements.push_back(hi);
     f.edge_end = half[k].end;
-    add(std::move(f));
+    return f;
   }
 
   // The corners' solid angles at every node against 4 pi inside and the boundary's enclosed
@@ -713,44 +732,52 @@ class InputChecker {
           for (auto z = a[2]; z <= b[2]; ++z) binned.emplace_back(code({x, y, z}), Index(t));
     }
     tbb::parallel_sort(binned.begin(), binned.end());
-    for (std::size_t i = 0; i < binned.size() && !full();) {
-      std::size_t j = i + 1;
-      while (j < binned.size() && binned[j].first == binned[i].first) ++j;
-      for (std::size_t a = i; a < j && !full(); ++a)
-        for (std::size_t b = a + 1; b < j && !full(); ++b) {
-          const auto s = index_cast<std::size_t>(binned[a].second);
-          const auto t = index_cast<std::size_t>(binned[b].second);
-          if (((hi[s].array() < lo[t].array()) || (hi[t].array() < lo[s].array())).any()) continue;
-          // Each pair once: in the cell holding the lower corner of the boxes' overlap.
-          if (code(cell(lo[s].cwiseMax(lo[t]))) != binned[i].first) continue;
-          contact(s, t, std::max(longest[s], longest[t]));
-        }
-      i = j;
-    }
+    // Cells in pieces in parallel (in_pieces), a piece stopping once it holds as many findings
+    // as the check keeps.
+    in_pieces(
+        binned.size(),
+        [&](std::size_t a, std::size_t b) { return binned[a].first == binned[b].first; },
+        [&](std::size_t, std::vector<InputFinding>& out, std::size_t from, std::size_t to) {
+          auto more = [&] { return out.size() < options_.max_findings; };
+          for (std::size_t i = from; i < to && more();) {
+            std::size_t j = i + 1;
+            while (j < to && binned[j].first == binned[i].first) ++j;
+            for (std::size_t a = i; a < j && more(); ++a)
+              for (std::size_t b = a + 1; b < j && more(); ++b) {
+                const auto s = index_cast<std::size_t>(binned[a].second);
+                const auto t = index_cast<std::size_t>(binned[b].second);
+                if (((hi[s].array() < lo[t].array()) || (hi[t].array() < lo[s].array())).any())
+                  continue;
+                // Each pair once: in the cell holding the lower corner of the boxes' overlap.
+                if (code(cell(lo[s].cwiseMax(lo[t]))) != binned[i].first) continue;
+                if (auto f = contact(s, t, std::max(longest[s], longest[t])))
+                  keep(out, std::move(*f));
+              }
+            i = j;
+          }
+        });
   }
 
-  void contact(std::size_t s, std::size_t t, double length) {
+  // Boundary triangles s and t crossing, or facing across a thin gap: the finding.
+  std::optional<InputFinding> contact(std::size_t s, std::size_t t, double length) const {
     const auto& a = triangles_[s].v;
     const auto& b = triangles_[t].v;
     for (Index x : a)
-      if (std::find(b.begin(), b.end(), x) != b.end()) return;
+      if (std::find(b.begin(), b.end(), x) != b.end()) return std::nullopt;
     const ElementRef ea = boundary_[index_cast<std::size_t>(triangles_[s].face)].element;
     const ElementRef eb = boundary_[index_cast<std::size_t>(triangles_[t].face)].element;
-    if (const auto x = crossing(a, b, length); x) {
-      add({InputFault::kCrossingFaces, {ea, eb}, kInvalidIndex, *x, 0.0});
-      return;
-    }
-    if (const auto x = crossing(b, a, length); x) {
-      add({InputFault::kCrossingFaces, {ea, eb}, kInvalidIndex, *x, 0.0});
-      return;
-    }
+    if (const auto x = crossing(a, b, length); x)
+      return InputFinding{InputFault::kCrossingFaces, {ea, eb}, kInvalidIndex, *x, 0.0};
+    if (const auto x = crossing(b, a, length); x)
+      return InputFinding{InputFault::kCrossingFaces, {ea, eb}, kInvalidIndex, *x, 0.0};
     const Point na = (pt(a[1]) - pt(a[0])).cross(pt(a[2]) - pt(a[0])).normalized();
     const Point nb = (pt(b[1]) - pt(b[0])).cross(pt(b[2]) - pt(b[0])).normalized();
-    if (!(na.dot(nb) < -0.9)) return;
+    if (!(na.dot(nb) < -0.9)) return std::nullopt;
     if (const auto g = facing(a, b, nb, length); g)
-      add({InputFault::kGap, {ea, eb}, kInvalidIndex, g->first, g->second});
-    else if (const auto h = facing(b, a, na, length); h)
-      add({InputFault::kGap, {eb, ea}, kInvalidIndex, h->first, h->second});
+      return InputFinding{InputFault::kGap, {ea, eb}, kInvalidIndex, g->first, g->second};
+    if (const auto h = facing(b, a, na, length); h)
+      return InputFinding{InputFault::kGap, {eb, ea}, kInvalidIndex, h->first, h->second};
+    return std::nullopt;
   }
 
   // a's centre in front of b (in the void b's outward normal nb points to), closer than the
