@@ -576,7 +576,8 @@ Interface find_interface(const Model& model, double tol, std::vector<Index>* joi
   for (std::size_t t = 0; t < model.tets.size(); ++t)
     for (std::size_t f = 0; f < 4; ++f) {
       const Index id = triangles_of.tet_face_tri[4 * t + f];
-      if (id == kInvalidIndex) continue;  // no hex-part node: it lies on no quad of it
+      // No hex-part node: it shares none with a quad (only those are compared below).
+      if (id == kInvalidIndex) continue;
       const TriangleUses& uses = tris[index_cast<std::size_t>(id)];
       if (uses.count != 1 || matched[index_cast<std::size_t>(id)]) continue;
       const TetFaceUse& tri = uses.use[0];
