@@ -20,6 +20,7 @@ constexpr std::size_t kWritebackBytes = std::size_t{8} << 20;
 
 FileSink::FileSink(const std::filesystem::path& file, std::string target)
     : target_(std::move(target)), buffer_(kBufferBytes) {
+  static_assert(kThrough <= kBufferBytes, "text shorter than kThrough must fit the buffer");
   fd_ = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
   if (fd_ < 0) fail("cannot open for writing", errno);
 }
@@ -63,19 +64,14 @@ void FileSink::write_all(const char* data, std::size_t size) {
   }
 }
 
-void FileSink::make_room(std::size_t n) {
-  flush();
-  if (n > buffer_.size()) buffer_.resize(n);
-}
-
 void FileSink::integer(std::int64_t x) {
-  if (buffer_.size() - used_ < 24) make_room(24);
+  if (buffer_.size() - used_ < 24) flush();
   const auto r = std::to_chars(buffer_.data() + used_, buffer_.data() + buffer_.size(), x);
   used_ = static_cast<std::size_t>(r.ptr - buffer_.data());
 }
 
 void FileSink::real(double x) {
-  if (buffer_.size() - used_ < 32) make_room(32);
+  if (buffer_.size() - used_ < 32) flush();
   const auto r = std::to_chars(buffer_.data() + used_, buffer_.data() + buffer_.size(), x);
   used_ = static_cast<std::size_t>(r.ptr - buffer_.data());
 }

@@ -24,12 +24,12 @@ class FileSink {
 
   void text(std::string_view s) {
     if (s.size() >= kThrough) return write_through(s);
-    if (buffer_.size() - used_ < s.size()) make_room(s.size());
+    if (buffer_.size() - used_ < s.size()) flush();
     s.copy(buffer_.data() + used_, s.size());
     used_ += s.size();
   }
   void ch(char c) {
-    if (used_ == buffer_.size()) make_room(1);
+    if (used_ == buffer_.size()) flush();
     buffer_[used_++] = c;
   }
   void integer(std::int64_t x);
@@ -38,7 +38,7 @@ class FileSink {
   // with the integer 1 written first so that readers can tell).
   template <class T>
   void raw(const T& x) {
-    if (buffer_.size() - used_ < sizeof(T)) make_room(sizeof(T));
+    if (buffer_.size() - used_ < sizeof(T)) flush();
     std::memcpy(buffer_.data() + used_, &x, sizeof(T));
     used_ += sizeof(T);
   }
@@ -47,11 +47,11 @@ class FileSink {
 
  private:
   // Text this long (a writer's chunk of formatted lines) is written as it is, after what is
-  // buffered, instead of copied into the buffer first (150 MB for a million-hex ASCII .msh).
+  // buffered, instead of copied into the buffer first (150 MB for a million-hex ASCII .msh);
+  // anything shorter fits the emptied buffer (1 MiB).
   static constexpr std::size_t kThrough = std::size_t{64} << 10;
   void write_through(std::string_view s);
   void write_all(const char* data, std::size_t n);
-  void make_room(std::size_t n);
   void flush();
   [[noreturn]] void fail(const std::string& what, int err) const;
 
