@@ -289,6 +289,7 @@ class InputChecker {
       while (at > 0 && at < n && same(at - 1, at)) ++at;  // a run's start
       cut[p] = at;
     }
+    room_ = options_.max_findings - std::min(options_.max_findings, result_.findings.size());
     std::vector<std::vector<InputFinding>> found(kPieces);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kPieces, 1),
                       [&](const tbb::blocked_range<std::size_t>& r) {
@@ -298,11 +299,11 @@ class InputChecker {
     for (std::vector<InputFinding>& piece : found)
       for (InputFinding& x : piece) add(std::move(x));
   }
-  // A piece's finding, unless it has as many as add() keeps already.
+  // Whether a piece may keep more findings: fewer than add() has room for when it starts.
+  bool more(const std::vector<InputFinding>& out) const { return out.size() < room_; }
   void keep(std::vector<InputFinding>& out, InputFinding f) const {
-    if (out.size() < options_.max_findings) out.push_back(std::move(f));
+    if (more(out)) out.push_back(std::move(f));
   }
-
   // Faces used more than once: pairs must be seen in opposite orders; the rest into `single`.
   void pair_uses(const std::vector<FaceUse>& uses, std::vector<FaceUse>& single) {
     std::vector<std::vector<FaceUse>> singles(kPieces);
@@ -733,17 +734,16 @@ class InputChecker {
     }
     tbb::parallel_sort(binned.begin(), binned.end());
     // Cells in pieces in parallel (in_pieces), a piece stopping once it holds as many findings
-    // as the check keeps.
+    // as the check has room for.
     in_pieces(
         binned.size(),
         [&](std::size_t a, std::size_t b) { return binned[a].first == binned[b].first; },
         [&](std::size_t, std::vector<InputFinding>& out, std::size_t from, std::size_t to) {
-          auto more = [&] { return out.size() < options_.max_findings; };
-          for (std::size_t i = from; i < to && more();) {
+          for (std::size_t i = from; i < to && more(out);) {
             std::size_t j = i + 1;
             while (j < to && binned[j].first == binned[i].first) ++j;
-            for (std::size_t a = i; a < j && more(); ++a)
-              for (std::size_t b = a + 1; b < j && more(); ++b) {
+            for (std::size_t a = i; a < j && more(out); ++a)
+              for (std::size_t b = a + 1; b < j && more(out); ++b) {
                 const auto s = index_cast<std::size_t>(binned[a].second);
                 const auto t = index_cast<std::size_t>(binned[b].second);
                 if (((hi[s].array() < lo[t].array()) || (hi[t].array() < lo[s].array())).any())
@@ -866,6 +866,7 @@ class InputChecker {
   std::vector<Index> centre_on_quad_;  // four-triangle centres, one per such interface quad
   // Per node, from boundary_links: the solid angle its elements must cover, and whether the
   // boundary is a disk there (0: not judged by covering_at_nodes).
+  std::size_t room_ = 0;  // in_pieces: the findings add() still keeps
   std::vector<double> expected_;
   std::vector<char> judged_;
   std::vector<Triangle> triangles_;
