@@ -435,12 +435,8 @@ std::vector<double> diced_scaled_jacobian_per_cell(std::span<const Point> points
 // the tet's centre), for a caller that evaluates one tet many times (relax_tet_nodes): each
 // distinct child corner (4 corners, 6 edges, 4 faces, the centre) computed once per call.
 double diced_tet_min_scaled_jacobian(const std::array<Point, 4>& corners) {
-  return diced_tet_min_scaled_jacobian(corners, -2.0);
-}
-
-double diced_tet_min_scaled_jacobian(const std::array<Point, 4>& corners, double bound) {
   int first = 0;
-  return diced_tet_min_scaled_jacobian(corners, bound, &first);
+  return diced_tet_min_scaled_jacobian(corners, -2.0, &first);
 }
 
 double diced_tet_min_scaled_jacobian(const std::array<Point, 4>& corners, double bound,

@@ -88,10 +88,9 @@ double diced_min_scaled_jacobian(std::span<const Point> points,
 // One tet's lowest diced scaled Jacobian, from its four corners (for callers that move nodes).
 double diced_tet_min_scaled_jacobian(const std::array<Point, 4>& corners);
 // The same, except that once a child hex is at or below `bound` the rest are not measured: the
-// value is exact when above `bound`, and some value at or below it otherwise.
-double diced_tet_min_scaled_jacobian(const std::array<Point, 4>& corners, double bound);
-// The same, the children taken from child *first (0 to 3) on, which is left at the child found
-// at or below `bound`: a caller trying one node at many places meets the same child failing.
+// value is exact when above `bound`, and some value at or below it otherwise. The children are
+// taken from child *first (0 to 3) on, which is left at the child found at or below `bound`: a
+// caller trying one node at many places meets the same child failing.
 double diced_tet_min_scaled_jacobian(const std::array<Point, 4>& corners, double bound, int* first);
 
 // The same per element: each one's lowest diced scaled Jacobian, in element order (the local

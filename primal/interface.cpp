@@ -12,6 +12,7 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include <geode/primal/boundary.hpp>
 #include <geode/primal/detail/edge_thirds.hpp>
 #include <geode/primal/detail/lowest_node_sort.hpp>
 #include <geode/primal/disjoint_sets.hpp>

@@ -44,12 +44,11 @@ class Relaxer {
 
   // Tet around_[at] diced: its lowest child, exact when above `bound`, some value at or below it
   // otherwise; `child`: the child to try first, left at the one that failed.
-  double tet_value(std::size_t at, double bound, int* child = nullptr) const {
+  double tet_value(std::size_t at, double bound, int* child) const {
     const auto& t = tets_[index_cast<std::size_t>(around_[at])];
     std::array<Point, 4> c;
     for (std::size_t q = 0; q < 4; ++q) c[q] = points_[index_cast<std::size_t>(t[q])];
-    int first = 0;
-    return diced_tet_min_scaled_jacobian(c, bound, child ? child : &first);
+    return diced_tet_min_scaled_jacobian(c, bound, child);
   }
 
   // Every free node's lowest diced scaled Jacobian over its tets at the points as they are,
@@ -176,7 +175,7 @@ class Relaxer {
   std::vector<std::size_t> first_;
   std::vector<Index> around_;
   std::vector<Index> near_;      // the tets with a free node, ascending
-  std::vector<double> per_tet_;  // per tet of near_: its lowest diced child where it stands
+  std::vector<double> per_tet_;  // per tet (set for near_'s): its lowest diced child as it stands
 };
 
 }  // namespace
