@@ -421,11 +421,14 @@ Interface find_interface(const Model& model, double tol, std::vector<Index>* joi
   validate(model, "find_interface");
   const auto& P = model.points;
   auto pt = [&](Index v) -> const Point& { return P[index_cast<std::size_t>(v)]; };
-  std::vector<char> in_part(P.size(), 0);  // a node of the hex part (a hex's or a wedge's)
+  // Per node: kInHex for a hex's node, kInWedge for a wedge's (either: the hex part's).
+  constexpr char kInHex = 1, kInWedge = 2;
+  std::vector<char> in_part(P.size(), 0);
   for (const auto& h : model.hexes)
-    for (Index v : h) in_part[index_cast<std::size_t>(v)] = 1;
+    for (Index v : h) in_part[index_cast<std::size_t>(v)] |= kInHex;
   for (const auto& w : model.wedges)
-    for (Index v : w) in_part[index_cast<std::size_t>(v)] = 1;
+    for (Index v : w) in_part[index_cast<std::size_t>(v)] |= kInWedge;
+  auto in_hex = [&](Index v) { return (in_part[index_cast<std::size_t>(v)] & kInHex) != 0; };
   refuse_duplicates(model, model.hexes, ElementKind::kHex);
   refuse_duplicates(model, model.tets, ElementKind::kTet, &in_part);
   refuse_duplicates(model, model.wedges, ElementKind::kWedge);
@@ -447,9 +450,6 @@ Interface find_interface(const Model& model, double tol, std::vector<Index>* joi
     if (uses.count == 1)
       thirds.add(uses.use[0].nodes[0], uses.use[0].nodes[1], uses.use[0].nodes[2]);
   thirds.sort();
-  std::vector<char> in_hex(P.size(), 0);
-  for (const auto& h : model.hexes)
-    for (Index v : h) in_hex[index_cast<std::size_t>(v)] = 1;
   // The node x for which (c_i, c_i+1, x) are boundary triangles for all four sides of the quad;
   // of several (a single tet layer's outer faces can fan around the quad too) the nearest to the
   // quad's middle.
@@ -494,7 +494,7 @@ Interface find_interface(const Model& model, double tol, std::vector<Index>* joi
       continue;
     }
     const std::string name = quad_name(model, bq.cell, c);
-    if (centre != kInvalidIndex && in_hex[index_cast<std::size_t>(centre)])
+    if (centre != kInvalidIndex && in_hex(centre))
       throw TopologyError("find_interface: " + name + " is split into four triangles around " +
                           describe_node(model, centre) + ", a node of the hex part too");
     if (centre != kInvalidIndex) {
@@ -623,7 +623,7 @@ Interface find_interface(const Model& model, double tol, std::vector<Index>* joi
 
   // Nodes shared by both parts must be interface nodes.
   for (std::size_t v = 0; v < P.size(); ++v)
-    if (in_hex[v] && in_tet[v] &&
+    if (in_hex(index_cast(v)) && in_tet[v] &&
         !std::binary_search(out.nodes.begin(), out.nodes.end(), index_cast(v)))
       throw TopologyError("find_interface: " + describe_node(model, index_cast(v)) +
                           " is used by both the hex and the tet part but lies on no interface quad "
