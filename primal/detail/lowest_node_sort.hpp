@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cassert>
 #include <cstddef>
 #include <tuple>
 #include <vector>
@@ -51,6 +52,8 @@ std::vector<Record> sort_by_lowest_node(std::size_t nodes, Count&& count, Each&&
     out[slot(next, static_cast<std::size_t>(lowest(r))).fetch_add(1, std::memory_order_relaxed)] =
         r;
   });
+  // `count` and `each` must visit the same lowest nodes: every node's slots exactly filled.
+  assert(std::equal(next.begin(), next.end(), start.begin() + 1));
   // Within a node the threads' order varies; the sort fixes it.
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nodes, 4096),
                     [&](const tbb::blocked_range<std::size_t>& r) {
