@@ -377,6 +377,7 @@ void Conformer::measure_near_interface() {
 // renumbered a node of theirs): measured now, on the input, before trim_input frees it. None on
 // today's layers, which change only cells at interface nodes; checked rather than assumed.
 void Conformer::measure_changed() {
+  if (layer_.hexes.empty()) return;  // no interface: the layer's model is the input itself
   const primal::Model& lm = layer_.model;
   auto same = [&](std::span<const Index> a, std::span<const Index> b) {
     for (std::size_t i = 0; i < a.size(); ++i)
@@ -385,8 +386,8 @@ void Conformer::measure_changed() {
         return false;
     return true;
   };
-  // Flagged in parallel (each cell its own slot), then listed in order.
-  auto changed = [&](const auto& cells, const auto& layer_cells, std::vector<char>& later) {
+  // Flagged in parallel (each cell its own slot), then listed in order and measured now.
+  auto changed = [&](const auto& cells, const auto& layer_cells, const std::vector<char>& later) {
     const bool all = cells.size() != layer_cells.size();
     std::vector<char> flag(cells.size(), 0);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 8192),
@@ -396,16 +397,18 @@ void Conformer::measure_changed() {
                       });
     std::vector<std::size_t> which;
     for (std::size_t c = 0; c < cells.size(); ++c)
-      if (flag[c]) which.push_back(c), later[c] = 0;
+      if (flag[c]) which.push_back(c);
     return which;
   };
-  measure_cells(input_.points, input_.hexes, changed(input_.hexes, lm.hexes, hex_later_),
-                hex_diced_);
-  std::vector<char> was = tet_later_;
+  const std::vector<std::size_t> hexes = changed(input_.hexes, lm.hexes, hex_later_);
+  measure_cells(input_.points, input_.hexes, hexes, hex_diced_);
+  for (std::size_t h : hexes) hex_later_[h] = 0;
   const std::vector<std::size_t> tets = changed(input_.tets, lm.tets, tet_later_);
   measure_cells(input_.points, input_.tets, tets, tet_diced_);
-  for (std::size_t t : tets)
-    if (was[t] == kLater) tet_given_[t] = tet_diced_[t];  // not relaxed
+  for (std::size_t t : tets) {
+    if (tet_later_[t] == kLater) tet_given_[t] = tet_diced_[t];  // not relaxed
+    tet_later_[t] = 0;
+  }
 }
 
 // The cells left for later, diced alone: the lowest of their children as measured (sj_),
