@@ -618,19 +618,19 @@ HexValidityReport check_validity(const HexMesh& mesh, std::span<const char> focu
     bool on_boundary = false, overshared = false;
     for (Index i = 0; i < n; ++i) {
       const auto [p, c] = use_at(start[v] + i);
-      for (int lf : inc.corner_faces[c]) {
-        if (!whole) break;
-        const auto uses = face_uses(p, lf);
-        on_boundary |= uses == 1;
-        overshared |= uses == 3;
-        const Index f = face_lead[index_cast<std::size_t>(6 * p + lf)];
-        auto it = std::find_if(first_use_of_face.begin(), first_use_of_face.end(),
-                               [f](const auto& x) { return x.first == f; });
-        if (it == first_use_of_face.end())
-          first_use_of_face.emplace_back(f, i);
-        else
-          uses_joined.unite(it->second, i);
-      }
+      if (whole)
+        for (int lf : inc.corner_faces[c]) {
+          const auto uses = face_uses(p, lf);
+          on_boundary |= uses == 1;
+          overshared |= uses == 3;
+          const Index f = face_lead[index_cast<std::size_t>(6 * p + lf)];
+          auto it = std::find_if(first_use_of_face.begin(), first_use_of_face.end(),
+                                 [f](const auto& x) { return x.first == f; });
+          if (it == first_use_of_face.end())
+            first_use_of_face.emplace_back(f, i);
+          else
+            uses_joined.unite(it->second, i);
+        }
       for (int nc : topo::kHexCornerNeighbors[c]) {
         const Index b = hex(p)[nc];
         if (whole) others.push_back(b);

@@ -234,31 +234,28 @@ HexValidityReport check_validity_around(std::span<const Point> points, Hexes hex
     if (touches(k)) r.overshared_faces.push_back(global_key(k));
   for (const FaceKey& k : s.misoriented_faces)
     if (touches(k)) r.misoriented_faces.push_back(global_key(k));
-  for (const EdgeKey& e : s.nonmanifold_edges)
-    if (touches(e)) {
-      const Index a = node(e[0]), b = node(e[1]);
-      r.nonmanifold_edges.push_back({std::min(a, b), std::max(a, b)});
-    }
-  for (Index v : s.nonmanifold_vertices)
-    if (is_checked(v)) r.nonmanifold_vertices.push_back(node(v));
+  // The focus check reports vertices, coverings and edges at checked nodes only, and boundary
+  // quads with a checked node: theirs, in the mesh's numbers. Faces it reports everywhere.
+  for (const EdgeKey& e : s.nonmanifold_edges) {
+    const Index a = node(e[0]), b = node(e[1]);
+    r.nonmanifold_edges.push_back({std::min(a, b), std::max(a, b)});
+  }
+  for (Index v : s.nonmanifold_vertices) r.nonmanifold_vertices.push_back(node(v));
   for (NodeCoverage c : s.overlapping_nodes)
-    if (is_checked(c.node)) c.node = node(c.node), r.overlapping_nodes.push_back(c);
+    c.node = node(c.node), r.overlapping_nodes.push_back(c);
   std::sort(r.nonmanifold_vertices.begin(), r.nonmanifold_vertices.end());
   std::sort(r.overlapping_nodes.begin(), r.overlapping_nodes.end(),
             [](const NodeCoverage& a, const NodeCoverage& b) { return a.node < b.node; });
 
   r.num_vertices = s.num_vertices, r.num_edges = s.num_edges, r.num_faces = s.num_faces;
   r.num_cells = s.num_cells, r.euler = s.euler;
-  auto keep_quad = [&](BoundaryQuad q) {
-    const bool near = std::any_of(q.nodes.begin(), q.nodes.end(), is_checked);
+  auto global_quad = [&](BoundaryQuad q) {
     for (Index& v : q.nodes) v = node(v);
     q.hex = sub_hex[index_cast<std::size_t>(q.hex)];
-    return std::pair{near, q};
+    return q;
   };
-  for (const BoundaryQuad& q : s.boundary.faces)
-    if (auto [near, g] = keep_quad(q); near) r.boundary.faces.push_back(g);
-  for (const BoundaryQuad& q : s.boundary.rejected)
-    if (auto [near, g] = keep_quad(q); near) r.boundary.rejected.push_back(g);
+  for (const BoundaryQuad& q : s.boundary.faces) r.boundary.faces.push_back(global_quad(q));
+  for (const BoundaryQuad& q : s.boundary.rejected) r.boundary.rejected.push_back(global_quad(q));
   r.boundary.euler = s.boundary.euler;
   const bool manifold = r.nonmanifold_vertices.empty() && r.nonmanifold_edges.empty() &&
                         r.overshared_faces.empty() && r.boundary.rejected.empty();

@@ -26,8 +26,8 @@ struct RegionValidityOptions {
 // check_validity's findings at the checked nodes, on the faces and edges with a checked node,
 // and over the whole mesh for what is per hex or per node (out-of-range and repeated nodes,
 // non-finite coordinates, unused nodes, non-positive corner Jacobians). Nodes, faces and edges
-// elsewhere are taken as valid. The counts (V, E, F, C, the Euler characteristic) and the
-// boundary quads are those of the checked region's hexes; `boundary.closed` and
+// elsewhere are taken as valid. The counts (V, E, F, C, the Euler characteristic) are those of
+// the checked region's hexes, the boundary quads those with a checked node; `boundary.closed` and
 // `boundary.manifold` say that no checked vertex or edge is non-manifold (every vertex link a
 // disk or a sphere makes the boundary a closed manifold surface). With every hex seeded and
 // rings >= 0 the verdict (ok()) is check_validity's.
