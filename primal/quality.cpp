@@ -169,6 +169,11 @@ std::array<double, 4> quad_signed_corner_areas(const QuadCorners& p, const Point
 
 std::array<Point, 3> hex_corner_frame(const HexCorners& p, int c) { return corner_frame(p, c); }
 
+double hex_corner_jacobian(const HexCorners& p, int c) {
+  const auto f = corner_frame(p, c);
+  return det3(f[0], f[1], f[2]);
+}
+
 std::array<Point, 3> hex_principal_axes(const HexCorners& p) { return principal_axes(p); }
 
 double scaled_determinant(const Point& a, const Point& b, const Point& c) {
@@ -188,10 +193,7 @@ std::array<double, 9> hex_scaled_jacobians(const HexCorners& p) {
 
 std::array<double, 9> hex_jacobians(const HexCorners& p) {
   std::array<double, 9> j{};
-  for (int c = 0; c < 8; ++c) {
-    const auto f = hex_corner_frame(p, c);
-    j[c] = det3(f[0], f[1], f[2]);
-  }
+  for (int c = 0; c < 8; ++c) j[c] = hex_corner_jacobian(p, c);
   const auto x = hex_principal_axes(p);
   j[8] = det3(x[0], x[1], x[2]) / 64.0;
   return j;

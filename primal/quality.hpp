@@ -31,6 +31,8 @@ inline constexpr double kDegenerateMetric = 1.0e30;
 
 // Corner matrix columns [e_r, e_s, e_t] at corner c (0..7).
 std::array<Point, 3> hex_corner_frame(const HexCorners& p, int c);
+// The Jacobian at corner c: the determinant of its frame (hex_jacobians' c-th).
+double hex_corner_jacobian(const HexCorners& p, int c);
 // Principal axes X1, X2, X3 (see above).
 std::array<Point, 3> hex_principal_axes(const HexCorners& p);
 // det[a, b, c] / (|a| |b| |c|); 0 when a vector has zero length (a degenerate frame).

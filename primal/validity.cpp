@@ -429,8 +429,7 @@ HexValidityReport check_validity(const HexMesh& mesh, std::span<const char> focu
                           bool positive = true;
                           for (int c = 0; c < 8; ++c)
                             if (corners & (1u << c)) {
-                              const auto f = hex_corner_frame(p, c);
-                              j[c] = f[0].dot(f[1].cross(f[2]));
+                              j[c] = hex_corner_jacobian(p, c);
                               positive &= j[c] > 0.0;
                             }
                           found[h] = kMeasured | (positive ? 0u : kInverted) |

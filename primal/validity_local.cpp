@@ -26,10 +26,8 @@ using detail::in_range;
 // Every corner Jacobian above 0 (hex_jacobians' corners, the same values; not its centre, as
 // check_validity), the first that is not ending the search.
 bool corners_positive(const HexCorners& p) {
-  for (int c = 0; c < 8; ++c) {
-    const auto f = hex_corner_frame(p, c);
-    if (!(f[0].dot(f[1].cross(f[2])) > 0.0)) return false;
-  }
+  for (int c = 0; c < 8; ++c)
+    if (!(hex_corner_jacobian(p, c) > 0.0)) return false;
   return true;
 }
 
