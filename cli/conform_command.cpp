@@ -204,9 +204,7 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
       io::write_model(*written, temp, format, o);
     });
     // A format that writes each cell's scaled Jacobian takes conform's (the same values).
-    const io::MeshFormat* entry =
-        format.empty() ? io::writer_for(a.output) : io::find_mesh_format(format);
-    opts.write_ahead_scaled_jacobians = entry && entry->writes_scaled_jacobians;
+    opts.write_ahead_scaled_jacobians = io::output_format(a.output, format).writes_scaled_jacobians;
     opts.write_ahead = [&, mesh_file](const primal::Model& m, std::span<const double> sj) {
       written = &m;
       written_sj = sj;

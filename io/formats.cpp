@@ -276,9 +276,13 @@ PlainMesh read_plain_mesh(const fs::path& path, const MeshFormat** format) {
   return m;
 }
 
+const MeshFormat& output_format(const fs::path& path, std::string_view format) {
+  return resolve(path, format, FormatRole::kWrite);
+}
+
 void write_model(const primal::Model& model, const fs::path& path, std::string_view format,
                  const WriteOptions& options) {
-  resolve(path, format, FormatRole::kWrite).write(model, path, options);
+  output_format(path, format).write(model, path, options);
 }
 
 void write_quad_mesh(const primal::QuadMesh& mesh, const fs::path& path, std::string_view format,

@@ -97,6 +97,9 @@ const MeshFormat* find_mesh_format(std::string_view name);
 const MeshFormat* reader_for(const std::filesystem::path& path);
 // The entry that writes `path`: the first writer with its extension, or nullptr.
 const MeshFormat* writer_for(const std::filesystem::path& path);
+// The entry write_model uses for `path`: `format` by name, else by the path's extension;
+// InvalidInput naming the path when neither gives a model writer.
+const MeshFormat& output_format(const std::filesystem::path& path, std::string_view format);
 
 // Lists for messages and help texts: ".exo, .e, .msh, .vtu or .vtk" (each extension once, in
 // table order), of the formats that read (or read planar quad meshes, write, write planar quad
