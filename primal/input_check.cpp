@@ -21,6 +21,7 @@
 #include <geode/primal/detail/byte_packet.hpp>
 #include <geode/primal/detail/edge_thirds.hpp>
 #include <geode/primal/detail/lowest_node_sort.hpp>
+#include <geode/primal/detail/ordered_pieces.hpp>
 #include <geode/primal/disjoint_sets.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/release.hpp>
@@ -290,12 +291,11 @@ class InputChecker {
       cut[p] = at;
     }
     room_ = options_.max_findings - std::min(options_.max_findings, result_.findings.size());
-    std::vector<std::vector<InputFinding>> found(kPieces);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kPieces, 1),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t p = r.begin(); p != r.end(); ++p)
-                          f(p, found[p], cut[p], cut[p + 1]);
-                      });
+    auto found = detail::in_ordered_pieces<std::vector<InputFinding>>(
+        std::span<const std::size_t>(cut),
+        [&](std::size_t p, std::size_t from, std::size_t to, std::vector<InputFinding>& out) {
+          f(p, out, from, to);
+        });
     for (std::vector<InputFinding>& piece : found)
       for (InputFinding& x : piece) add(std::move(x));
   }

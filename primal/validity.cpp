@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <geode/primal/detail/cell_nodes.hpp>
+#include <geode/primal/detail/ordered_pieces.hpp>
 #include <geode/primal/detail/validity_focus.hpp>
 #include <geode/primal/disjoint_sets.hpp>
 #include <geode/primal/errors.hpp>
@@ -556,8 +557,8 @@ HexValidityReport check_validity(const HexMesh& mesh, std::span<const char> focu
   // chain or ring through shared faces. A vertex's link (triangles = hexes, edges = faces,
   // vertices = edges at the vertex) must be connected with Euler characteristic 2 (sphere,
   // interior) or 1 (disk, boundary).
-  // Per node, independently: chunks of nodes run in parallel (TBB), each with its own scratch
-  // and findings, which are then joined in node order (the same result for any thread count).
+  // Per node, independently: chunks of nodes run in parallel (detail/ordered_pieces.hpp), each
+  // with its own scratch and findings, which are then joined in node order.
   struct EdgeUse {
     Index other;  // the edge's other end
     Index use;    // 12 p + local edge
@@ -683,16 +684,11 @@ HexValidityReport check_validity(const HexMesh& mesh, std::span<const char> focu
       i = j;
     }
   };
-  constexpr std::size_t kChunk = 4096;
-  const std::size_t chunks = (nv + kChunk - 1) / kChunk;
-  std::vector<Found> found(chunks);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      Scratch scratch;
-                      for (std::size_t c = range.begin(); c != range.end(); ++c)
-                        for (std::size_t v = c * kChunk; v < std::min(nv, (c + 1) * kChunk); ++v)
-                          visit(v, scratch, found[c]);
-                    });
+  std::vector<Found> found = in_ordered_chunks<Found>(
+      nv, 4096, [&](std::size_t, std::size_t begin, std::size_t end, Found& out) {
+        Scratch scratch;
+        for (std::size_t v = begin; v < end; ++v) visit(v, scratch, out);
+      });
   std::vector<std::pair<Index, EdgeKey>> bad_edges;
   for (Found& f : found) {
     r.unused_nodes += f.unused_nodes;

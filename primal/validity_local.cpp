@@ -10,6 +10,7 @@
 
 #include <geode/primal/boundary.hpp>
 #include <geode/primal/detail/cell_nodes.hpp>
+#include <geode/primal/detail/ordered_pieces.hpp>
 #include <geode/primal/detail/validity_focus.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/release.hpp>
@@ -59,36 +60,34 @@ class Region {
         node_in_[index_cast<std::size_t>(v)] = 1;
   }
 
-  // Hex h (in chunk c), proper, taken when it is not in yet and has a marked node.
-  void take_if_near(std::size_t c, std::size_t h, bool proper) {
+  // Hex h, proper, taken (into its chunk's `found`) when it is not in yet and has a marked node.
+  void take_if_near(std::vector<Index>& found, std::size_t h, bool proper) {
     if (hex_in_[h] || !proper) return;
     for (Index v : hexes_[h])
       if (node_in_[index_cast<std::size_t>(v)]) {
         hex_in_[h] = 1;
-        found_[c].push_back(index_cast(h));
+        found.push_back(index_cast(h));
         return;
       }
   }
 
-  // f(c, h) for every hex, chunk by chunk in parallel; then what take_if_near took, in order.
+  // f(found, h) for every hex, chunk by chunk in parallel; then what take_if_near took, in
+  // order.
   template <class F>
   void pass(F&& f) {
-    const std::size_t chunks = (hexes_.size() + kChunk - 1) / kChunk;
-    found_.assign(chunks, {});
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1),
-                      [&](const tbb::blocked_range<std::size_t>& range) {
-                        for (std::size_t c = range.begin(); c != range.end(); ++c)
-                          for (std::size_t h = c * kChunk;
-                               h < std::min(hexes_.size(), (c + 1) * kChunk); ++h)
-                            f(c, h);
-                      });
-    for (const auto& f : found_) list_.insert(list_.end(), f.begin(), f.end());
-    found_.clear();
+    const auto found = detail::in_ordered_chunks<std::vector<Index>>(
+        hexes_.size(), kChunk,
+        [&](std::size_t, std::size_t begin, std::size_t end, std::vector<Index>& out) {
+          for (std::size_t h = begin; h < end; ++h) f(out, h);
+        });
+    for (const auto& taken : found) list_.insert(list_.end(), taken.begin(), taken.end());
   }
 
   // Every proper hex with a marked node.
   void add_hexes_at_nodes() {
-    pass([&](std::size_t c, std::size_t h) { take_if_near(c, h, (proper_[h] & 1) != 0); });
+    pass([&](std::vector<Index>& found, std::size_t h) {
+      take_if_near(found, h, (proper_[h] & 1) != 0);
+    });
   }
 
   // The hexes in the region, ascending (its list is consumed).
@@ -104,8 +103,7 @@ class Region {
   const std::vector<char>& proper_;
   std::vector<char> hex_in_, node_in_;
   std::vector<Index> list_;
-  std::vector<std::vector<Index>> found_;  // per chunk of a pass: the hexes it took
-  std::size_t marked_ = 0;                 // list_[0, marked_) have their nodes marked
+  std::size_t marked_ = 0;  // list_[0, marked_) have their nodes marked
 };
 
 }  // namespace
@@ -134,7 +132,7 @@ HexValidityReport check_validity_around(std::span<const Point> points, Hexes hex
   region.mark_nodes();
   std::atomic<bool> faulty = false;
   const bool known = options.positive.size() == nh;
-  region.pass([&](std::size_t chunk, std::size_t h) {
+  region.pass([&](std::vector<Index>& found, std::size_t h) {
     const auto& hex = hexes[h];
     if (!in_range(hex, nv)) {
       proper_hex[h] = kOutOfRange;
@@ -155,7 +153,7 @@ HexValidityReport check_validity_around(std::span<const Point> points, Hexes hex
     }
     proper_hex[h] = code;
     if (code != kProper) faulty.store(true, std::memory_order_relaxed);
-    region.take_if_near(chunk, h, (code & kProper) != 0);
+    region.take_if_near(found, h, (code & kProper) != 0);
   });
   if (faulty) {
     for (std::size_t h = 0; h < nh; ++h) {
