@@ -10,7 +10,6 @@
 #include <sstream>
 
 #include <geode/io/formats.hpp>
-#include <geode/primal/boundary.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/model.hpp>
 #include <geode/primal/quality.hpp>
@@ -169,14 +168,9 @@ void write_template_html(const TemplateOutput& a, const templates::Template& T,
     viewer::write_html(a.output, T.quad, scene);
     return;
   }
-  viewer::ViewFaceGroup tet{"tet side", {}}, hex{"hex side", {}};
-  for (const auto& q : primal::boundary_quads(T.hex)) {
-    unsigned common = ~0u;
-    for (auto n : q.nodes) common &= T.node_faces[primal::index_cast<std::size_t>(n)];
-    if (common & (1u << stc::box_face(1, true))) tet.quads.push_back(q.nodes);
-    if (common & (1u << stc::box_face(1, false))) hex.quads.push_back(q.nodes);
-  }
-  scene.groups = {tet, hex};
+  scene.groups = {
+      viewer::boundary_face_group("tet side", T.hex, T.node_faces, stc::box_face(1, true)),
+      viewer::boundary_face_group("hex side", T.hex, T.node_faces, stc::box_face(1, false))};
   viewer::write_html(a.output, T.hex, scene);
 }
 

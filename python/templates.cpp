@@ -10,7 +10,6 @@
 #include <optional>
 #include <sstream>
 
-#include <geode/primal/boundary.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/quality_report.hpp>
 #include <geode/stc/sheet_surfaces.hpp>
@@ -177,14 +176,9 @@ std::string template_html(const TemplateResult& r) {
   // The tet and hex sides as face groups (the paper's Figure 1), when the template knows its box
   // faces.
   if (T.node_faces.size() == T.hex.points.size()) {
-    viewer::ViewFaceGroup tet{"tet side", {}}, hex{"hex side", {}};
-    for (const auto& q : primal::boundary_quads(T.hex)) {
-      unsigned common = ~0u;
-      for (auto n : q.nodes) common &= T.node_faces[primal::index_cast<std::size_t>(n)];
-      if (common & (1u << stc::box_face(1, true))) tet.quads.push_back(q.nodes);
-      if (common & (1u << stc::box_face(1, false))) hex.quads.push_back(q.nodes);
-    }
-    scene.groups = {tet, hex};
+    scene.groups = {
+        viewer::boundary_face_group("tet side", T.hex, T.node_faces, stc::box_face(1, true)),
+        viewer::boundary_face_group("hex side", T.hex, T.node_faces, stc::box_face(1, false))};
   }
   return viewer::html_view(T.hex, scene);
 }

@@ -4,8 +4,11 @@
 #include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
 
 #include <geode/io/atomic_file.hpp>
+#include <geode/primal/boundary.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/topology.hpp>
@@ -209,6 +212,20 @@ std::string page(const std::vector<Point>& points, const Cells& cells,
 }
 
 }  // namespace
+
+ViewFaceGroup boundary_face_group(std::string name, const primal::HexMesh& mesh,
+                                  const std::vector<unsigned>& node_faces, int face) {
+  if (node_faces.size() != mesh.points.size())
+    throw std::invalid_argument("boundary_face_group: " + std::to_string(node_faces.size()) +
+                                " node masks for " + std::to_string(mesh.points.size()) + " nodes");
+  ViewFaceGroup group{std::move(name), {}};
+  for (const auto& q : primal::boundary_quads(mesh)) {
+    unsigned common = ~0u;
+    for (auto n : q.nodes) common &= node_faces[primal::index_cast<std::size_t>(n)];
+    if (common & (1u << face)) group.quads.push_back(q.nodes);
+  }
+  return group;
+}
 
 std::string html_view(const HexMesh& mesh, const ViewScene& scene) {
   check_ids(mesh.hexes, mesh.points.size(), "hex");

@@ -33,6 +33,13 @@ struct ViewFaceGroup {
   std::vector<std::array<primal::Index, 4>> quads;  // node ids, 0-based
 };
 
+// The boundary quads of `mesh` whose four nodes all have bit `face` in `node_faces` (one mask
+// per node: the box faces a template's node lies on, templates::Template::node_faces), in
+// boundary_quads order: a template's tet or hex side. Throws std::invalid_argument when
+// node_faces does not have one mask per node.
+ViewFaceGroup boundary_face_group(std::string name, const primal::HexMesh& mesh,
+                                  const std::vector<unsigned>& node_faces, int face);
+
 struct ViewScene {
   std::string title;
   std::string caption;  // how the file was made
