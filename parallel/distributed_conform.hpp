@@ -27,6 +27,7 @@
 // sorted input nodes they are made from) exchanged between the ranks whose elements hold all of
 // them.
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -47,6 +48,12 @@ struct DistributedOptions {
   // when not empty (the input's own partition, parallel/partition.hpp ranks_of_parts); the same
   // on every rank. Only the load balance depends on it, not the result.
   std::vector<int> partition;
+  // The input again, as it was given (geode_mpi reads its file again). With it, a rank of
+  // conform_distributed(Model&&) frees the input as soon as it has taken its piece, before
+  // dicing, and asks for it again only where the zone grows after that (rare: the zone rank
+  // sends the depth it needed once the other ranks have diced). Without it a rank holds the
+  // input until its numbering.
+  std::function<primal::Model()> reload;
 };
 
 // One rank's share of the output.
@@ -74,9 +81,10 @@ struct DistributedReport {
 // node) and a named geode block.
 RankMesh conform_distributed(const primal::Model& input, const DistributedOptions& options,
                              MPI_Comm comm, DistributedReport* report = nullptr);
-// The same on a model the caller gives up: freed but its block names once every rank has
-// diced its piece (a rank holds the whole input until then), so that the numbering, assembly
-// and verification hold it no more. Afterwards, or after an exception, it may be emptied.
+// The same on a model the caller gives up: freed but its block names once this rank has taken
+// its piece (options.reload given) or diced it, so that dicing (with a reload), the numbering,
+// assembly and verification hold it no more. Afterwards, or after an exception, it may be
+// emptied.
 RankMesh conform_distributed(primal::Model&& input, const DistributedOptions& options,
                              MPI_Comm comm, DistributedReport* report = nullptr);
 

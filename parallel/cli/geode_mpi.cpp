@@ -78,6 +78,9 @@ int run(int argc, char** argv, int rank, int size) {
     options.conform.buffer.thickness = thickness;
     options.conform.verify = conform::parse_conform_verify(verify);
     options.rings = rings;
+    // Each rank frees the input once it has its piece, and reads it again only if the zone
+    // grows after that (the read-time check passed already).
+    options.reload = [&input] { return io::read_model(input, {}, false); };
     io::FilePartition file_partition;
     primal::Model model = io::read_model(input, {}, true, &file_partition,
                                          parallel::shared_input_check(MPI_COMM_WORLD));
