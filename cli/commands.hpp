@@ -16,6 +16,8 @@
 #include <geode/stc/sheet.hpp>
 #include <geode/viewer/html.hpp>
 
+#include "cli/conventions.hpp"
+
 namespace geode::templates {
 struct Template;
 }
@@ -67,7 +69,7 @@ struct TemplateOutput {
   std::string title;  // what follows the name in the appendix title, e.g. "box 24x14x24"
   std::string format = "appendix";  // resolved (cli/conventions.hpp: output_format)
   std::string output;
-  std::string vtk_encoding = "binary";
+  EncodingArgs encoding;
   bool smooth = true;
   bool slide = false;
   bool quality = false;

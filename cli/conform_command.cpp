@@ -35,7 +35,7 @@ struct ConformArgs {
   std::string input;
   std::string output;
   std::string format;
-  std::string vtk_encoding = "binary";
+  EncodingArgs encoding;  // --vtk-encoding, --msh-encoding
   std::string report;
   std::string smooth = "local";
   std::string quality = "sj";
@@ -199,7 +199,7 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
   std::exception_ptr write_failed;
   if (!a.output.empty()) {
     const std::size_t mesh_file = files.add(a.output, [&](const fs::path& temp) {
-      io::WriteOptions o = write_options(a.vtk_encoding);
+      io::WriteOptions o = write_options(a.encoding);
       o.scaled_jacobians = written_sj;
       io::write_model(*written, temp, format, o);
     });
@@ -263,11 +263,7 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
                 "mesh format, when it must be named (msh22 for Gmsh 2.2 in a .msh); one that\n"
                 "contradicts the extension of -o is refused")
       ->check(CLI::IsMember(mesh_format_names()));
-  c->add_option("--vtk-encoding,--vtu-encoding", a.vtk_encoding,
-                "binary (default) or ascii values in VTK files: .vtu DataArrays (base64), "
-                "legacy .vtk data (BINARY, big-endian)")
-      ->check(CLI::IsMember({"binary", "ascii"}))
-      ->capture_default_str();
+  add_encoding_options(c, a.encoding);
   c->add_option("--report", a.report,
                 "write a JSON report (counts, validity, quality per output block) to FILE.json");
   c->add_option(
@@ -449,7 +445,7 @@ void add_conform_commands(CLI::App& app) {
     if (!dargs->save_input.empty()) {
       OutputFiles files;
       files.add(dargs->save_input, [&](const fs::path& temp) {
-        io::write_model(model, temp, save_format, write_options(dargs->vtk_encoding));
+        io::write_model(model, temp, save_format, write_options(dargs->encoding));
       });
       files.commit();
       if (!dargs->quiet)

@@ -233,9 +233,23 @@ std::string hex_or_quad_input_help() {
 
 std::string quad_output_extensions() { return io::extension_list(io::FormatRole::kWriteQuads); }
 
-io::WriteOptions write_options(const std::string& vtk_encoding) {
+void add_encoding_options(CLI::App* app, EncodingArgs& args) {
+  app->add_option("--vtk-encoding,--vtu-encoding", args.vtk,
+                  "binary (default) or ascii values in VTK files: .vtu DataArrays (base64), "
+                  "legacy .vtk data (BINARY, big-endian)")
+      ->check(CLI::IsMember({"binary", "ascii"}))
+      ->capture_default_str();
+  app->add_option("--msh-encoding", args.msh,
+                  "ascii (default, as Gmsh saves; some solvers read only that) or binary .msh "
+                  "(4.1 or 2.2;\nsmaller, and faster to write and read)")
+      ->check(CLI::IsMember({"ascii", "binary"}))
+      ->capture_default_str();
+}
+
+io::WriteOptions write_options(const EncodingArgs& args) {
   io::WriteOptions o;
-  o.vtk_encoding = vtk_encoding == "ascii" ? io::VtkEncoding::kAscii : io::VtkEncoding::kBinary;
+  o.vtk_encoding = args.vtk == "ascii" ? io::VtkEncoding::kAscii : io::VtkEncoding::kBinary;
+  o.msh_encoding = args.msh == "binary" ? io::GmshFormat::kBinary : io::GmshFormat::kAscii;
   return o;
 }
 

@@ -86,8 +86,13 @@ std::string input_extensions_help();
 std::string hex_or_quad_input_help();
 // ".vtu or .vtk": where a planar quad mesh can be written.
 std::string quad_output_extensions();
-// --vtk-encoding's text (binary, ascii) as writer options.
-io::WriteOptions write_options(const std::string& vtk_encoding);
+// --vtk-encoding and --msh-encoding (binary, ascii), for every command that writes a mesh.
+struct EncodingArgs {
+  std::string vtk = "binary";
+  std::string msh = "ascii";
+};
+void add_encoding_options(CLI::App* app, EncodingArgs& args);
+io::WriteOptions write_options(const EncodingArgs& args);
 
 // ---- Validity before writing -----------------------------------------------------------------
 

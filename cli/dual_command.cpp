@@ -30,7 +30,7 @@ struct DualArgs {
   std::string format;  // empty: by the extension of -o, else text
   std::string output;
   std::string rebuild;
-  std::string vtk_encoding = "binary";
+  EncodingArgs encoding;  // --vtk-encoding, --msh-encoding
   bool write_invalid = false;
   bool force = false;
 };
@@ -178,7 +178,7 @@ void run_dual(const DualArgs& a) {
   OutputFiles files;
   if (!a.rebuild.empty())
     files.add(a.rebuild, [&](const fs::path& temp) {
-      const io::WriteOptions options = write_options(a.vtk_encoding);
+      const io::WriteOptions options = write_options(a.encoding);
       if (m.dim == 2) {
         io::write_quad_mesh(D.quad, temp, rebuild_format, options);
       } else {
@@ -226,11 +226,7 @@ void add_dual_command(CLI::App& app) {
           " (hexes; quads: " + io::extension_list(io::FormatRole::kWriteQuads, ", ", ", ") + ")");
   add_write_invalid_flag(d, a->write_invalid);
   add_force_flag(d, a->force);
-  d->add_option("--vtk-encoding,--vtu-encoding", a->vtk_encoding,
-                "binary (default) or ascii values in VTK files: .vtu DataArrays (base64), "
-                "legacy .vtk data (BINARY, big-endian)")
-      ->check(CLI::IsMember({"binary", "ascii"}))
-      ->capture_default_str();
+  add_encoding_options(d, a->encoding);
   d->callback([a] { run_dual(*a); });
 }
 

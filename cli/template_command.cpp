@@ -32,8 +32,8 @@ struct TemplateArgs {
   std::string box;  // empty: 24x14x24 (24x14 in 2D)
   std::string diagonal = "main";
   std::string higher = "x";
-  std::string format;  // empty: by the extension of -o, else appendix
-  std::string vtk_encoding = "binary";
+  std::string format;     // empty: by the extension of -o, else appendix
+  EncodingArgs encoding;  // --vtk-encoding, --msh-encoding
   std::string output;
   bool slide = false;
   bool no_smooth = false;
@@ -208,7 +208,7 @@ void run_template(const TemplateArgs& a) {
   }
   TemplateOutput out;
   out.name = a.name, out.title = "box " + box_text, out.format = format, out.output = a.output;
-  out.vtk_encoding = a.vtk_encoding;
+  out.encoding = a.encoding;
   out.smooth = !a.no_smooth, out.slide = a.slide, out.quality = a.quality;
   out.write_invalid = a.write_invalid;
   templates::Template T = entry->build(options);
@@ -348,7 +348,7 @@ void write_template(templates::Template& T, const TemplateOutput& a) {
     // The mesh goes to the file (the writers add the scaled Jacobian cell array); the quality
     // tables, if asked for, to standard output.
     if (a.output.empty()) throw InvalidInput("--format " + a.format + " needs -o FILE");
-    const io::WriteOptions options = write_options(a.vtk_encoding);
+    const io::WriteOptions options = write_options(a.encoding);
     if (dim == 2) {
       io::write_quad_mesh(T.quad, a.output, a.format, options);  // refuses formats without quads
     } else {
@@ -406,11 +406,7 @@ void add_template_command(CLI::App& app) {
            io::extension_list(io::FormatRole::kWrite, " ", " ") +
            " .html); one that contradicts the extension is refused")
       ->check(CLI::IsMember(kTemplateFormats));
-  t->add_option("--vtk-encoding,--vtu-encoding", args->vtk_encoding,
-                "binary (default) or ascii values in VTK files: .vtu DataArrays (base64), "
-                "legacy .vtk data (BINARY, big-endian)")
-      ->check(CLI::IsMember({"binary", "ascii"}))
-      ->capture_default_str();
+  add_encoding_options(t, args->encoding);
   t->add_option(
       "-o,--output", args->output,
       "write to FILE (atomically) instead of standard output; its extension picks the format");

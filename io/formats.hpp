@@ -14,6 +14,7 @@
 #include <string_view>
 #include <vector>
 
+#include <geode/io/gmsh.hpp>
 #include <geode/io/vtk.hpp>
 #include <geode/primal/mesh.hpp>
 #include <geode/primal/model.hpp>
@@ -40,6 +41,9 @@ struct FormatCarries {
 // Options a writer may use; others ignore them.
 struct WriteOptions {
   VtkEncoding vtk_encoding = VtkEncoding::kBinary;  // .vtu DataArrays, legacy .vtk data
+  // .msh 4.1 and 2.2: ASCII unless asked, as Gmsh saves by default, since some solvers' readers
+  // take text only (GetFEM's import fails on binary .msh of either version).
+  GmshFormat msh_encoding = GmshFormat::kAscii;
   // Each element's scaled Jacobian (hexes, tets, pyramids, wedges in turn; primal/quality.hpp's
   // per kind), for the formats that write them (MeshFormat::writes_scaled_jacobians), from a
   // caller that has them already (conform measures every output hex); empty: computed.

@@ -129,6 +129,26 @@ TEST_CASE("conform carries blocks and sets: steel and rubber keep their ids and 
             0);
     check_carried(io::read_gmsh(out), model);
   }
+  SUBCASE("binary .msh, 4.1 and 2.2 (--msh-encoding binary): what the ASCII file holds") {
+    const fs::path text = dir.path / "text.msh";
+    REQUIRE(test::geode_cli("conform " + in.string() + " -o " + text.string() + " --quiet").code ==
+            0);
+    const primal::Model ascii = io::read_gmsh(text);
+    for (const char* version : {"msh", "msh22"}) {
+      CAPTURE(version);
+      const fs::path out = dir.path / (std::string(version) + ".msh");
+      REQUIRE(test::geode_cli("conform " + in.string() + " --msh-encoding binary --format " +
+                              version + " -o " + out.string() + " --quiet")
+                  .code == 0);
+      const std::string head = slurp(out).substr(0, 20);
+      CHECK(head ==
+            (version == std::string("msh") ? "$MeshFormat\n4.1 1 8\n" : "$MeshFormat\n2.2 1 8\n"));
+      const primal::Model binary = io::read_gmsh(out);
+      check_carried(binary, model);
+      CHECK(binary.points == ascii.points);  // the text is exact (shortest round trip)
+      CHECK(binary.hexes == ascii.hexes);
+    }
+  }
   SUBCASE(".vtu: the block cell array and the names as field data") {
     const fs::path out = dir.path / "out.vtu";
     REQUIRE(test::geode_cli("conform " + in.string() + " --vtu-encoding ascii -o " + out.string() +

@@ -137,8 +137,8 @@ TEST_CASE("cli conventions: --version and --help") {
   const test::CliRun h = test::geode_cli("conform --help");
   for (const char* opt :
        {"--output", "--format", "--report", "--smooth", "--geode-block", "--merge-tolerance",
-        "--write-invalid", "--quiet", "--vtk-encoding", "--smooth-target", "--buffer-thickness",
-        "--buffer-side", "--template-box"})
+        "--write-invalid", "--quiet", "--vtk-encoding", "--msh-encoding", "--smooth-target",
+        "--buffer-thickness", "--buffer-side", "--template-box"})
     CHECK(h.out.find(opt) != std::string::npos);
 }
 

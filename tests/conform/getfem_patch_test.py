@@ -92,11 +92,14 @@ def cut_along_interface(points, hexes, blocks):
 
 def run(geode, workdir, name, n):
     report = os.path.join(workdir, name + ".json")
-    files = {"msh41": name + ".msh", "msh22": name + "-22.msh", "vtu": name + ".vtu"}
+    files = {"msh41": name + ".msh", "msh22": name + "-22.msh", "vtu": name + ".vtu",
+             "msh41-binary": name + "-binary.msh", "msh22-binary": name + "-22-binary.msh"}
     for fmt, f in files.items():
         cmd = [geode, "demo", "--model", name, "-n", str(n), "--quiet", "-o", os.path.join(workdir, f)]
-        if fmt == "msh22":
+        if fmt.startswith("msh22"):
             cmd += ["--format", "msh22"]
+        if fmt.endswith("binary"):
+            cmd += ["--msh-encoding", "binary"]
         if fmt == "vtu":
             cmd += ["--report", report]
         subprocess.run(cmd, check=True)
@@ -123,6 +126,14 @@ def run(geode, workdir, name, n):
               f"{name} {fmt}: meshio reads the same blocks ({mc}) and their names ({sorted(mm.field_data)})")
         err = patch_error(m)
         check(err < 1e-10, f"{name} {fmt}: patch test, max relative error {err:.2e} over {m.nbpts()} nodes")
+    # GetFEM reads ASCII .msh only; meshio reads the binary files to the same mesh and blocks.
+    for fmt in ("msh41", "msh22"):
+        text, binary = (meshio.read(os.path.join(workdir, files[f])) for f in (fmt, fmt + "-binary"))
+        check(np.array_equal(text.points, binary.points)
+              and all(a.type == b.type and np.array_equal(a.data, b.data) for a, b in zip(text.cells, binary.cells))
+              and len(text.cells) == len(binary.cells)
+              and all(np.array_equal(a, b) for a, b in zip(text.cell_data["gmsh:physical"], binary.cell_data["gmsh:physical"])),
+              f"{name} {fmt}: the binary file (--msh-encoding binary) holds what the ASCII one does")
     mesh = meshio.read(os.path.join(workdir, files["vtu"]))
     hexes = np.vstack([c.data for c in mesh.cells if c.type == "hexahedron"])
     mat = np.concatenate([d for c, d in zip(mesh.cells, mesh.cell_data["mat_id"]) if c.type == "hexahedron"])
