@@ -16,7 +16,8 @@ namespace {
 struct ArrangeArgs {
   std::string spec;
   std::string output;
-  std::string format;  // empty: by the extension of -o, else appendix
+  std::string format;     // empty: by the extension of -o, else appendix
+  EncodingArgs encoding;  // --vtk-encoding, --msh-encoding
   bool smooth = false;
   bool slide = false;
   bool quality = false;
@@ -57,6 +58,7 @@ void run_arrange(const ArrangeArgs& a) {
   out.format = format, out.output = a.output, out.smooth = a.smooth, out.slide = a.slide,
   out.quality = a.quality;
   out.write_invalid = a.write_invalid;
+  out.encoding = a.encoding;
   if (format == "html") out.sheets = templates::spec_sheets(spec), out.domain = spec.domain;
   out.caption =
       "geode arrange " + a.spec + (a.smooth ? " --smooth" : "") + (a.slide ? " --slide" : "");
@@ -94,6 +96,7 @@ void add_arrange_command(CLI::App& app) {
               "with --smooth: tet- and hex-side nodes slide within their faces");
   c->add_flag("--quality", args->quality,
               "append the quality report (the paper's Table 1 metrics)");
+  add_encoding_options(c, args->encoding);
   add_write_invalid_flag(c, args->write_invalid);
   add_force_flag(c, args->force);
   c->callback([args] { run_arrange(*args); });

@@ -171,6 +171,20 @@ TEST_CASE("cli conventions: template -o picks the format from the extension") {
               .code == 0);
   CHECK(slurp(dir.path / "t22.msh").rfind("$MeshFormat\n2.2", 0) == 0);
   CHECK(io::read_gmsh(dir.path / "t22.msh").hexes.size() == 26);
+  // Binary .msh when asked, from template and arrange alike; the same hexes as the ASCII file.
+  const fs::path spec = fs::path(GEODE_SOURCE_DIR) / "notebooks-data/specs/pillow.json";
+  for (const std::string& command :
+       {std::string("template geode3d"), "arrange " + spec.string() + " --smooth"}) {
+    CAPTURE(command);
+    const fs::path text = dir.path / "text.msh", binary = dir.path / "binary.msh";
+    REQUIRE(test::geode_cli(command + " -o " + text.string()).code == 0);
+    REQUIRE(test::geode_cli(command + " --msh-encoding binary -o " + binary.string()).code == 0);
+    CHECK(slurp(binary).rfind("$MeshFormat\n4.1 1 8\n", 0) == 0);
+    const primal::Model a = io::read_gmsh(text), b = io::read_gmsh(binary);
+    CHECK(!b.hexes.empty());
+    CHECK(a.hexes == b.hexes);
+    CHECK(a.points == b.points);
+  }
 }
 
 namespace {
