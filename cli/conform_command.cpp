@@ -94,7 +94,8 @@ void print_summary(const conform::ConformResult& r, std::ostream& os, bool table
     os << ", " << r.input_diced_wedge_min_scaled_jacobian << " (wedges)";
   os << "; output " << output;
   if (yardstick > 0) os << " = " << output / yardstick << " x the lower";
-  os << "; geode hexes >= " << r.local_yardstick_ratio << " x their local yardstick\n";
+  os << "; geode hexes >= " << r.local_yardstick_ratio << " x their local yardstick ("
+     << r.capped_local_ratio << " x it capped by the templates' own minimum)\n";
 }
 
 // --template-box: three sizes, checked as template --box checks its box.

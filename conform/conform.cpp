@@ -1256,6 +1256,7 @@ void Conformer::report(const std::vector<int>& block) {
   for (std::size_t b = 0; b + 1 < geode_first_.size(); ++b) {
     const double local =
         res_.local_yardstick[primal::index_cast<std::size_t>(layer_.hexes[b].quad)];
+    const double capped = std::min(local, res_.template_min_scaled_jacobian);  // as aims() caps
     for (Index h = geode_first_[b]; h < geode_first_[b + 1]; ++h) {
       const int id = block[primal::index_cast<std::size_t>(h)];
       auto it = std::find_if(res_.quality.begin(), res_.quality.end(),
@@ -1265,7 +1266,9 @@ void Conformer::report(const std::vector<int>& block) {
       it->geode_min_scaled_jacobian = std::min(it->geode_min_scaled_jacobian, sj);
       it->local_yardstick = std::min(it->local_yardstick, local);
       it->local_ratio = std::min(it->local_ratio, sj / local);
+      it->capped_local_ratio = std::min(it->capped_local_ratio, sj / capped);
       res_.local_yardstick_ratio = std::min(res_.local_yardstick_ratio, sj / local);
+      res_.capped_local_ratio = std::min(res_.capped_local_ratio, sj / capped);
     }
   }
 }

@@ -82,6 +82,7 @@ nlohmann::json report_json(const ConformResult& r) {
   j["warnings"] = r.warnings;
   j["blocks"] = nlohmann::json::array();
   j["local_yardstick_ratio"] = r.local_yardstick_ratio;
+  j["capped_local_ratio"] = r.capped_local_ratio;
   for (const auto& b : r.quality) {
     nlohmann::json block = {
         {"id", b.block},
@@ -92,7 +93,8 @@ nlohmann::json report_json(const ConformResult& r) {
       block["geode"] = {{"hexes", b.geode_hexes},
                         {"min_scaled_jacobian", b.geode_min_scaled_jacobian},
                         {"local_yardstick", b.local_yardstick},
-                        {"local_ratio", b.local_ratio}};
+                        {"local_ratio", b.local_ratio},
+                        {"capped_local_ratio", b.capped_local_ratio}};
     j["blocks"].push_back(std::move(block));
   }
   return j;

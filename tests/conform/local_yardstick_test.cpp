@@ -1,7 +1,8 @@
 // The local yardstick (ConformResult::local_yardstick): per buffer hex, the lowest of the input
 // hexes and tets sharing a node with its interface quad, each diced alone, recomputed here
 // from its definition on the potting and lshape demos; the per-block figures (input diced
-// alone, geode minimum, local ratio) read back from the output mesh.
+// alone, geode minimum, local ratio, the ratio capped by the templates' own minimum) read
+// back from the output mesh.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -56,18 +57,23 @@ TEST_CASE(
     // Per block, from the output: geode hexes (26 per buffer hex, after the diced hexes) and
     // their ratio to their buffer hex's local yardstick; the input elements of the block diced
     // alone.
-    std::map<int, double> geode_min, ratio, input_min;
+    std::map<int, double> geode_min, ratio, capped, input_min;
     std::map<int, Index> geode_count;
-    double overall = 1.0;  // capped at 1 like the per-block ratios (">= 1 x their own")
+    double overall = 1.0;         // capped at 1 like the per-block ratios (">= 1 x their own")
+    double overall_capped = 1.0;  // against min(local yardstick, the templates' own minimum)
     const primal::HexMesh out = primal::hex_part(r.model);
     for (Index b = 0; b < r.interface_quads; ++b)
       for (Index h = r.diced_hexes + 26 * b; h < r.diced_hexes + 26 * (b + 1); ++h) {
         const int id = r.model.hex_block[primal::index_cast<std::size_t>(h)];
         const double sj = primal::hex_scaled_jacobian(primal::hex_corners(out, h));
-        geode_min.try_emplace(id, 1.0), ratio.try_emplace(id, 1.0);
+        geode_min.try_emplace(id, 1.0), ratio.try_emplace(id, 1.0), capped.try_emplace(id, 1.0);
         geode_min[id] = std::min(geode_min[id], sj);
-        ratio[id] = std::min(ratio[id], sj / r.local_yardstick[primal::index_cast<std::size_t>(b)]);
-        overall = std::min(overall, sj / r.local_yardstick[primal::index_cast<std::size_t>(b)]);
+        const double local = r.local_yardstick[primal::index_cast<std::size_t>(b)];
+        const double cap = std::min(local, r.template_min_scaled_jacobian);
+        ratio[id] = std::min(ratio[id], sj / local);
+        capped[id] = std::min(capped[id], sj / cap);
+        overall = std::min(overall, sj / local);
+        overall_capped = std::min(overall_capped, sj / cap);
         ++geode_count[id];
       }
     for (std::size_t h = 0; h < input.hexes.size(); ++h) {
@@ -81,6 +87,8 @@ TEST_CASE(
       input_min[id] = std::min(input_min[id], tet_alone(t));
     }
     CHECK(r.local_yardstick_ratio == doctest::Approx(overall).epsilon(1e-9));
+    CHECK(r.capped_local_ratio == doctest::Approx(overall_capped).epsilon(1e-9));
+    CHECK(r.capped_local_ratio >= r.local_yardstick_ratio);
     for (const conform::BlockQuality& b : r.quality) {
       CAPTURE(b.name);
       // Exactly: conform reads most cells' figures off their diced children, which dicing
@@ -90,6 +98,7 @@ TEST_CASE(
       if (b.geode_hexes == 0) continue;
       CHECK(b.geode_min_scaled_jacobian == doctest::Approx(geode_min.at(b.block)).epsilon(1e-9));
       CHECK(b.local_ratio == doctest::Approx(ratio.at(b.block)).epsilon(1e-9));
+      CHECK(b.capped_local_ratio == doctest::Approx(capped.at(b.block)).epsilon(1e-9));
       CHECK(b.local_yardstick >= lowest_local);
     }
   }
