@@ -259,4 +259,19 @@ HexValidityReport check_validity_around(std::span<const Point> points, Hexes hex
   return r;
 }
 
+std::vector<char> corner_jacobians_positive(std::span<const Point> points, Hexes hexes) {
+  std::vector<char> positive(hexes.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, hexes.size(), 8192),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t h = r.begin(); h != r.end(); ++h) {
+                        if (!in_range(hexes[h], points.size())) continue;
+                        HexCorners p;
+                        for (std::size_t c = 0; c < 8; ++c)
+                          p[c] = points[index_cast<std::size_t>(hexes[h][c])];
+                        positive[h] = corners_positive(p) ? 1 : 0;
+                      }
+                    });
+  return positive;
+}
+
 }  // namespace geode::primal

@@ -5,6 +5,7 @@
 // Costs what the region costs, plus one pass over every hex for the corner Jacobians.
 #include <array>
 #include <span>
+#include <vector>
 
 #include <geode/primal/mesh.hpp>
 #include <geode/primal/validity.hpp>
@@ -17,9 +18,10 @@ struct RegionValidityOptions {
   // edge from a node moved before dicing (a diced input edge is two hex edges long), whose
   // corner cones the move turned.
   int rings = 2;
-  // Empty, or one per hex: nonzero where its scaled Jacobian (quality.hpp's
-  // hex_scaled_jacobian, over the corners and the centre) is above 0 as the mesh is now. Such a
-  // hex has positive corners and is not measured again; the others are.
+  // Empty, or one per hex: nonzero where its corner Jacobians are known to be above 0 as the
+  // mesh is now (its scaled Jacobian, quality.hpp's hex_scaled_jacobian over the corners and the
+  // centre, above 0 says so; so does corner_jacobians_positive below). Such a hex is not measured
+  // again; the others are.
   std::span<const char> positive;
 };
 
@@ -38,5 +40,11 @@ HexValidityReport check_validity_around(std::span<const Point> points,
                                         std::span<const std::array<Index, 8>> hexes,
                                         std::span<const Index> seeds,
                                         const RegionValidityOptions& options = {});
+
+// Per hex, 1 where every corner Jacobian is above 0 (the measure check_validity_around takes;
+// hexes in parallel), 0 where one is not or a corner is out of range: the `positive` of hexes
+// measured ahead, e.g. by a rank while it waits for another's work.
+std::vector<char> corner_jacobians_positive(std::span<const Point> points,
+                                            std::span<const std::array<Index, 8>> hexes);
 
 }  // namespace geode::primal

@@ -129,6 +129,21 @@ TEST_CASE(
     // The same on the mesh's arrays, as conform hands them over from its output model.
     CHECK(primal::check_validity_around(flipped.points, flipped.hexes, geode, o).inverted_hexes ==
           std::vector<Index>{0});
+    // Measured ahead by corner_jacobians_positive (as geode_mpi's ranks do while they wait):
+    // 0 for the flipped hex alone, 1 wherever the scaled Jacobian is above 0, and the same
+    // finding when handed in.
+    const std::vector<char> ahead =
+        primal::corner_jacobians_positive(flipped.points, flipped.hexes);
+    REQUIRE(ahead.size() == sj.size());
+    CHECK(ahead[0] == 0);
+    for (std::size_t h = 1; h < sj.size(); ++h)
+      if (sj[h] > 0.0) REQUIRE(ahead[h] == 1);
+    o.positive = ahead;
+    CHECK(primal::check_validity_around(flipped, geode, o).inverted_hexes == std::vector<Index>{0});
+    // A hex with a node out of range is not taken as positive (the check names it).
+    primal::HexMesh broken = flipped;
+    broken.hexes[1][3] = primal::index_cast(broken.points.size());
+    CHECK(primal::corner_jacobians_positive(broken.points, broken.hexes)[1] == 0);
   }
 }
 
