@@ -95,7 +95,8 @@ void print_summary(const conform::ConformResult& r, std::ostream& os, bool table
   os << "; output " << output;
   if (yardstick > 0) os << " = " << output / yardstick << " x the lower";
   os << "; geode hexes >= " << r.local_yardstick_ratio << " x their local yardstick ("
-     << r.capped_local_ratio << " x it capped by the templates' own minimum)\n";
+     << r.capped_local_ratio
+     << " x it capped by the template's own minimum at its buffer hex's proportions)\n";
 }
 
 // --template-box: three sizes, checked as template --box checks its box.

@@ -588,6 +588,24 @@ double buffer_height_ratio(const BufferLayer& layer) {
   return sum / static_cast<double>(layer.hexes.size());
 }
 
+std::vector<double> buffer_proportions(const BufferLayer& layer) {
+  const auto& p = layer.model.points;
+  std::vector<double> ratio;
+  ratio.reserve(layer.hexes.size());
+  for (const BufferHex& b : layer.hexes) {
+    const auto at = [&](std::size_t k) -> const primal::Point& {
+      return p[primal::index_cast<std::size_t>(b.corners[k])];
+    };
+    double edge = 0.0, height = 0.0;
+    for (std::size_t i = 0; i < 4; ++i) {
+      edge += (at((i + 1) % 4) - at(i)).norm() / 4.0;
+      height += (at(i + 4) - at(i)).norm() / 4.0;
+    }
+    ratio.push_back(edge > 0.0 ? height / edge : 0.0);
+  }
+  return ratio;
+}
+
 const char* buffer_side_name(BufferSide side) { return side == BufferSide::kHex ? "hex" : "tet"; }
 
 BufferSide parse_buffer_side(const std::string& word) {

@@ -188,6 +188,7 @@ class Conformer {
   bool verify_locally() const;
   void invert_for_test();
   void check(std::span<const Point> points, std::span<const std::array<Index, 8>> hexes);
+  void ceilings();
   void report(const std::vector<int>& block);
   void announce(double seconds) const;
   void output();
@@ -233,6 +234,7 @@ class Conformer {
   // reported ones where conform relaxed the tets).
   double aim_yardstick_ = 0.0;
   std::vector<double> aim_local_;
+  std::vector<double> proportion_;   // per buffer hex: buffer_proportions, as placed
   std::vector<Index> diced_parent_;  // per output diced hex (the first ones): its input hex
   std::vector<Index> geode_first_;  // per buffer hex: its first output hex (then one past the last)
   // The hexes whose nodes smoothing or untangling could move (their regions), for check().
@@ -487,6 +489,7 @@ void Conformer::insert_buffer() {
                                : primal::ElementRef{primal::ElementKind::kTet, q.tets[0]});
   }
   interface_ = {};
+  proportion_ = buffer_proportions(layer_);
   res_.buffer = layer_.report;
   say("buffer layer: " + std::to_string(layer_.hexes.size()) + " hexes, min scaled Jacobian " +
       std::to_string(layer_.report.min_scaled_jacobian) + took());
@@ -1211,6 +1214,39 @@ void Conformer::check(std::span<const Point> points, std::span<const std::array<
 
 // The quality per output block.
 // `block`: the output's hex blocks, where they are (mesh_, or the result's model).
+// What each buffer hex's template reaches in an undistorted cell as flat as the buffer hex
+// (template_ceiling), where it matters: where its geode hexes fall short of kLocalAim x
+// min(local yardstick, the templates' own minimum). A buffer hex in a thin first cell of a
+// boundary layer is flatter than the template box, and there the template's minimum, not the
+// placement, is what stops the geode (layer-mixed, n = 7: 0.144 in a buffer hex of proportion
+// 0.19, where the template reaches 0.165). Only those buffer hexes are measured, the templates
+// of their distinct proportions built in parallel (about 0.07 s each), so a run that meets its
+// aims pays nothing.
+void Conformer::ceilings() {
+  const double tpl = res_.template_min_scaled_jacobian;
+  res_.template_ceiling.assign(res_.local_yardstick.size(), tpl);
+  std::vector<std::pair<std::size_t, std::array<int, 2>>> short_of;  // buffer hex, diagonal
+  for (std::size_t b = 0; b + 1 < geode_first_.size(); ++b) {
+    if (layer_.hexes[b].centre != kInvalidIndex) continue;  // four triangles: its own box
+    const double local =
+        res_.local_yardstick[primal::index_cast<std::size_t>(layer_.hexes[b].quad)];
+    const auto first = sj_.begin() + geode_first_[b], last = sj_.begin() + geode_first_[b + 1];
+    if (*std::min_element(first, last) < kLocalAim * std::min(local, tpl))
+      short_of.emplace_back(b, layer_.hexes[b].diagonal);
+  }
+  std::vector<double> found(short_of.size(), tpl);
+  tbb::parallel_for(std::size_t{0}, short_of.size(), [&](std::size_t k) {
+    try {
+      found[k] = std::min(tpl, template_ceiling(options_.template_box, short_of[k].second,
+                                                proportion_[short_of[k].first]));
+    } catch (const std::exception&) {  // no template in that box: the box's own figure
+    }
+  });
+  for (std::size_t k = 0; k < short_of.size(); ++k)
+    res_.template_ceiling[primal::index_cast<std::size_t>(layer_.hexes[short_of[k].first].quad)] =
+        found[k];
+}
+
 void Conformer::report(const std::vector<int>& block) {
   std::map<int, std::vector<Index>> members;    // output block -> its hexes, ascending id
   for (std::size_t h = 0; h < block.size();) {  // a block's hexes come in runs: a run at a time
@@ -1253,10 +1289,11 @@ void Conformer::report(const std::vector<int>& block) {
     res_.quality.push_back(std::move(q));
   }
   // The geode hexes against their local yardsticks, per block and over all.
+  ceilings();
   for (std::size_t b = 0; b + 1 < geode_first_.size(); ++b) {
-    const double local =
-        res_.local_yardstick[primal::index_cast<std::size_t>(layer_.hexes[b].quad)];
-    const double capped = std::min(local, res_.template_min_scaled_jacobian);  // as aims() caps
+    const auto quad = primal::index_cast<std::size_t>(layer_.hexes[b].quad);
+    const double local = res_.local_yardstick[quad];
+    const double capped = std::min(local, res_.template_ceiling[quad]);
     for (Index h = geode_first_[b]; h < geode_first_[b + 1]; ++h) {
       const int id = block[primal::index_cast<std::size_t>(h)];
       auto it = std::find_if(res_.quality.begin(), res_.quality.end(),

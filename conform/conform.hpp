@@ -172,7 +172,7 @@ struct BlockQuality {
   // The geode hexes the block holds (none: the figures stay 1): their lowest scaled Jacobian,
   // the lowest local yardstick of their buffer hexes (ConformResult::local_yardstick), and the
   // lowest ratio of a geode hex's scaled Jacobian to its own buffer hex's local yardstick, and
-  // to that capped by the templates' own minimum (ConformResult::capped_local_ratio).
+  // to that capped by what its template reaches (ConformResult::capped_local_ratio).
   primal::Index geode_hexes = 0;
   double geode_min_scaled_jacobian = 1.0, local_yardstick = 1.0, local_ratio = 1.0;
   double capped_local_ratio = 1.0;
@@ -218,11 +218,16 @@ struct ConformResult {
   // aims every geode hex at 0.9 x min(its local yardstick, template_min_scaled_jacobian) (what
   // the template reaches in an undistorted cell), and at least the yardstick.
   std::vector<double> local_yardstick;
+  // Per buffer hex (Interface order): what its template reaches in an undistorted cell as flat
+  // as the buffer hex (conform::template_ceiling of its buffer_proportions), where its geode
+  // hexes fall below 0.9 x min(local yardstick, template_min_scaled_jacobian); elsewhere
+  // template_min_scaled_jacobian (the template in --template-box), which it never exceeds.
+  std::vector<double> template_ceiling;
   // The lowest ratio of a geode hex's scaled Jacobian to its local yardstick (after smoothing),
-  // and to min(its local yardstick, template_min_scaled_jacobian: what the templates reach in an
-  // undistorted cell), the figure smoothing aims at 0.9 of. Below 0.9 the first can be the
-  // template's ceiling (a local yardstick above 0.330 / 0.9); the second says how far placement
-  // fell short.
+  // and to min(its local yardstick, its buffer hex's template_ceiling). Below 0.9 the first can
+  // be the template's ceiling (a local yardstick above 0.330 / 0.9, or a buffer hex flatter
+  // than the template box: a thin first cell of a boundary layer); the second says how far
+  // placement fell short.
   double local_yardstick_ratio = 1.0, capped_local_ratio = 1.0;
   double min_scaled_jacobian_before_smoothing = 0.0;
   // Buffer hexes whose template the map inverted, re-smoothed inside the buffer hex (interior

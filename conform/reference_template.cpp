@@ -244,6 +244,15 @@ const RefTemplate& reference_template(const Eigen::Vector3d& given_box,
   return *slot->value;
 }
 
+double template_ceiling(const Eigen::Vector3d& given_box, std::array<int, 2> diagonal,
+                        double height_ratio) {
+  const Eigen::Vector3d box = given_box * (24.0 / given_box.maxCoeff());
+  const double height = std::max(3.0, std::ceil(height_ratio * 0.5 * (box.x() + box.z()) - 1e-9));
+  if (!(height < box.y())) return reference_template(box, diagonal).min_scaled_jacobian;
+  return reference_template(Eigen::Vector3d(box.x(), height, box.z()), diagonal)
+      .min_scaled_jacobian;
+}
+
 std::jthread build_reference_templates_ahead(const Eigen::Vector3d& box) {
   return std::jthread([box](const std::stop_token& stop) {
     // Nothing may leave the thread (std::terminate): not a failed build, which conform()

@@ -48,6 +48,17 @@ const RefTemplate& reference_template(const Eigen::Vector3d& box, std::array<int
 // hexes are flat; see the .cpp).
 const RefTemplate& reference_template_four_triangles(const Eigen::Vector3d& box);
 
+// What the template reaches in an undistorted cell as flat as a buffer hex whose mean height is
+// `height_ratio` x its top's mean edge: the smoothed template's own minimum (its
+// min_scaled_jacobian) in `box` with its height (box.y()) lowered to height_ratio x its width
+// (the mean of box.x() and box.z()), rounded up to a whole 24th of the largest side and not
+// below 3 of them (a flatter box is given the 3/24 box's figure, which is higher: measured
+// 24x12x24 0.330, 24x8x24 0.248, 24x5x24 0.165, 24x3x24 0.102). Where the buffer hex is not
+// flatter than `box`, the box's own. Built and kept as reference_template() keeps them; throws
+// as it does.
+double template_ceiling(const Eigen::Vector3d& box, std::array<int, 2> diagonal,
+                        double height_ratio);
+
 // Starts building both diagonals' templates for `box` (what conform() asks for first) on a thread
 // of its own, so that a caller can overlap them with reading its input: conform() then finds
 // them built, or waits for the build under way (the cache above). A failed build is left to

@@ -191,6 +191,24 @@ TEST_CASE("reference templates: a build stopped ahead is built whole when asked 
   }
 }
 
+TEST_CASE("template ceilings: the template's own minimum in a box as flat as a buffer hex") {
+  const Eigen::Vector3d box(24, 12, 24);  // the default --template-box
+  for (const std::array<int, 2> d : {std::array{4, 6}, std::array{5, 7}}) {
+    CAPTURE(d[0]);
+    const double own = conform::reference_template(box, d).min_scaled_jacobian;
+    // Not flatter than the box: the box's own, at any scale of the box.
+    CHECK(conform::template_ceiling(box, d, 0.5) == own);
+    CHECK(conform::template_ceiling(box * 1e3, d, 0.9) == own);
+    // 0.2 x the width is 4.8 of 24: the 24 x 5 x 24 box's template; below 3/24 the 3/24 box's.
+    const double flat = conform::template_ceiling(box, d, 0.2);
+    CHECK(flat == conform::reference_template(Eigen::Vector3d(24, 5, 24), d).min_scaled_jacobian);
+    CHECK(flat < own);
+    CHECK(conform::template_ceiling(box, d, 0.01) ==
+          conform::reference_template(Eigen::Vector3d(24, 3, 24), d).min_scaled_jacobian);
+    CHECK(conform::template_ceiling(box, d, 0.01) < flat);
+  }
+}
+
 TEST_CASE("half-block demo, n = 2") {
   // n^3 = 8 hexes, 6 n^3 = 48 tets, n^2 = 4 interface quads.
   const auto r = conform::conform(demo::demo_half_block(2));

@@ -1,7 +1,7 @@
 // The local yardstick (ConformResult::local_yardstick): per buffer hex, the lowest of the input
 // hexes and tets sharing a node with its interface quad, each diced alone, recomputed here
 // from its definition on the potting and lshape demos; the per-block figures (input diced
-// alone, geode minimum, local ratio, the ratio capped by the templates' own minimum) read
+// alone, geode minimum, local ratio, the ratio capped by what its template reaches) read
 // back from the output mesh.
 #include <doctest/doctest.h>
 
@@ -12,6 +12,7 @@
 #include <string>
 
 #include <geode/conform/conform.hpp>
+#include <geode/conform/reference_template.hpp>
 #include <geode/demo/demo_models.hpp>
 #include <geode/primal/dice.hpp>
 #include <geode/primal/interface.hpp>
@@ -31,6 +32,8 @@ TEST_CASE(
     test::check_conform_result(r);
     const primal::Interface itf = primal::find_interface(input);
     REQUIRE(r.local_yardstick.size() == itf.quads.size());
+    REQUIRE(r.template_ceiling.size() == itf.quads.size());
+    for (double c : r.template_ceiling) CHECK(c <= r.template_min_scaled_jacobian);
     // Each element diced alone, one at a time.
     auto hex_alone = [&](std::size_t h) {
       return primal::diced_min_scaled_jacobian(input.points, std::span(&input.hexes[h], 1));
@@ -60,7 +63,7 @@ TEST_CASE(
     std::map<int, double> geode_min, ratio, capped, input_min;
     std::map<int, Index> geode_count;
     double overall = 1.0;         // capped at 1 like the per-block ratios (">= 1 x their own")
-    double overall_capped = 1.0;  // against min(local yardstick, the templates' own minimum)
+    double overall_capped = 1.0;  // against min(local yardstick, its template's ceiling)
     const primal::HexMesh out = primal::hex_part(r.model);
     for (Index b = 0; b < r.interface_quads; ++b)
       for (Index h = r.diced_hexes + 26 * b; h < r.diced_hexes + 26 * (b + 1); ++h) {
@@ -69,7 +72,8 @@ TEST_CASE(
         geode_min.try_emplace(id, 1.0), ratio.try_emplace(id, 1.0), capped.try_emplace(id, 1.0);
         geode_min[id] = std::min(geode_min[id], sj);
         const double local = r.local_yardstick[primal::index_cast<std::size_t>(b)];
-        const double cap = std::min(local, r.template_min_scaled_jacobian);
+        const double ceiling = r.template_ceiling[primal::index_cast<std::size_t>(b)];
+        const double cap = std::min(local, ceiling);
         ratio[id] = std::min(ratio[id], sj / local);
         capped[id] = std::min(capped[id], sj / cap);
         overall = std::min(overall, sj / local);
@@ -132,4 +136,41 @@ TEST_CASE("the input diced alone per block, whichever part the buffer layer is c
     }
     CHECK(r.input_diced_tet_min_scaled_jacobian < 1.0);
   }
+}
+
+TEST_CASE("template ceilings: a flat buffer hex measured against its template in its proportions") {
+  // layer-mixed: the hex cells at the interface are an extruded layer's thin first cells, so
+  // the buffer is carved from the tets, 0.17 of its quads' edge high on average: flatter than
+  // the template box (0.5). Two warnings: the wedges beside the hexes split, the buffer's side.
+  const conform::ConformResult r = conform::conform(demo::demo_model("layer-mixed", 3));
+  test::check_conform_result(r, -1, 2);
+  const double tpl = r.template_min_scaled_jacobian;
+  REQUIRE(r.template_ceiling.size() == r.local_yardstick.size());
+  const primal::HexMesh out = primal::hex_part(r.model);
+  const Eigen::Vector3d box(24, 3, 24);  // the flattest box template_ceiling builds
+  const double flattest = std::min(conform::reference_template(box, {4, 6}).min_scaled_jacobian,
+                                   conform::reference_template(box, {5, 7}).min_scaled_jacobian);
+  int lowered = 0;
+  double capped = 1.0;
+  for (Index b = 0; b < r.interface_quads; ++b) {
+    const auto q = primal::index_cast<std::size_t>(b);
+    double lo = 1.0;
+    for (Index h = r.diced_hexes + 26 * b; h < r.diced_hexes + 26 * (b + 1); ++h)
+      lo = std::min(lo, primal::hex_scaled_jacobian(primal::hex_corners(out, h)));
+    CHECK(r.template_ceiling[q] <= tpl);
+    if (r.template_ceiling[q] < tpl) {
+      ++lowered;
+      // Measured only where the geode hexes fall short of 0.9 x min(local yardstick, the
+      // template box's figure), and never below the flattest box's.
+      CHECK(lo < 0.9 * std::min(r.local_yardstick[q], tpl));
+      CHECK(r.template_ceiling[q] >= flattest);
+    }
+    capped = std::min(capped, lo / std::min(r.local_yardstick[q], r.template_ceiling[q]));
+  }
+  CHECK(lowered > 0);
+  CHECK(r.capped_local_ratio == doctest::Approx(capped).epsilon(1e-9));
+  CHECK(r.capped_local_ratio > r.local_yardstick_ratio);
+  MESSAGE("layer-mixed n = 3: " << lowered << " buffer hexes flatter than the template box, "
+                                << "local ratio " << r.local_yardstick_ratio << ", capped "
+                                << r.capped_local_ratio);
 }
