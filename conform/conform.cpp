@@ -1213,14 +1213,13 @@ void Conformer::check(std::span<const Point> points, std::span<const std::array<
 }
 
 // The quality per output block.
-// `block`: the output's hex blocks, where they are (mesh_, or the result's model).
 // What each buffer hex's template reaches in an undistorted cell as flat as the buffer hex
 // (template_ceiling), where it matters: where its geode hexes fall short of kLocalAim x
 // min(local yardstick, the templates' own minimum). A buffer hex in a thin first cell of a
 // boundary layer is flatter than the template box, and there the template's minimum, not the
 // placement, is what stops the geode (layer-mixed, n = 7: 0.144 in a buffer hex of proportion
-// 0.19, where the template reaches 0.165). Only those buffer hexes are measured, the templates
-// of their distinct proportions built in parallel (about 0.07 s each), so a run that meets its
+// 0.17, where the template reaches 0.166). Only those buffer hexes are measured, the templates
+// of their distinct proportions built in parallel (about 0.13 s each), so a run that meets its
 // aims pays nothing.
 void Conformer::ceilings() {
   const double tpl = res_.template_min_scaled_jacobian;
@@ -1247,6 +1246,7 @@ void Conformer::ceilings() {
         found[k];
 }
 
+// `block`: the output's hex blocks, where they are (mesh_, or the result's model).
 void Conformer::report(const std::vector<int>& block) {
   std::map<int, std::vector<Index>> members;    // output block -> its hexes, ascending id
   for (std::size_t h = 0; h < block.size();) {  // a block's hexes come in runs: a run at a time
