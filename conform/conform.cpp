@@ -1212,7 +1212,6 @@ void Conformer::check(std::span<const Point> points, std::span<const std::array<
   }
 }
 
-// The quality per output block.
 // What each buffer hex's template reaches in an undistorted cell as flat as the buffer hex
 // (template_ceiling), where it matters: where its geode hexes fall short of kLocalAim x
 // min(local yardstick, the templates' own minimum). A buffer hex in a thin first cell of a
@@ -1246,6 +1245,7 @@ void Conformer::ceilings() {
         found[k];
 }
 
+// The quality per output block.
 // `block`: the output's hex blocks, where they are (mesh_, or the result's model).
 void Conformer::report(const std::vector<int>& block) {
   std::map<int, std::vector<Index>> members;    // output block -> its hexes, ascending id
