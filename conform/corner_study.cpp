@@ -123,6 +123,8 @@ CornerStudy corner_study(const std::vector<CornerStudyModel>& models, int n,
         r.min_default = std::min(r.min_default, after[q]);
         r.min_local_yardstick = std::min(r.min_local_yardstick, b.local_yardstick[q]);
         r.min_local_ratio = std::min(r.min_local_ratio, after[q] / b.local_yardstick[q]);
+        r.min_capped_ratio = std::min(
+            r.min_capped_ratio, after[q] / std::min(b.local_yardstick[q], b.template_ceiling[q]));
       }
       for (auto& [key, r] : rows) {
         r.model = name;
@@ -143,22 +145,22 @@ CornerStudy corner_study(const std::vector<CornerStudyModel>& models, int n,
 
 void write_corner_csv(std::ostream& out, const CornerStudy& study) {
   out << "model,n,kind,angle,buffer_hexes,min_sj_none,min_sj_default,min_local_ratio_default,"
-         "min_local_yardstick\n";
+         "min_local_yardstick,min_capped_ratio_default\n";
   for (const auto& r : study.rows)
     out << r.model << "," << study.n << "," << r.kind << "," << r.angle << "," << r.buffer_hexes
         << "," << r.min_none << "," << r.min_default << "," << r.min_local_ratio << ","
-        << r.min_local_yardstick << "\n";
+        << r.min_local_yardstick << "," << r.min_capped_ratio << "\n";
 }
 
 void write_corner_table(std::ostream& out, const CornerStudy& study) {
   char line[256];
-  std::snprintf(line, sizeof line, "%-10s %-15s %6s %6s %9s %9s %9s %9s\n", "model", "kind",
-                "angle", "count", "none", "default", "x local", "local");
+  std::snprintf(line, sizeof line, "%-10s %-15s %6s %6s %9s %9s %9s %9s %9s\n", "model", "kind",
+                "angle", "count", "none", "default", "x local", "local", "x capped");
   out << line;
   for (const auto& r : study.rows) {
-    std::snprintf(line, sizeof line, "%-10s %-15s %6.0f %6d %9.3f %9.3f %9.2f %9.3f\n",
+    std::snprintf(line, sizeof line, "%-10s %-15s %6.0f %6d %9.3f %9.3f %9.2f %9.3f %9.2f\n",
                   r.model.c_str(), r.kind.c_str(), r.angle, r.buffer_hexes, r.min_none,
-                  r.min_default, r.min_local_ratio, r.min_local_yardstick);
+                  r.min_default, r.min_local_ratio, r.min_local_yardstick, r.min_capped_ratio);
     out << line;
   }
   for (const auto& s : study.models) {

@@ -48,6 +48,9 @@ struct CornerStudyRow {
   double min_none = 1.0, min_default = 1.0;  // geode hexes' minimum, --smooth none / defaults
   double min_local_ratio = 1e9;              // defaults: min of geode minimum / local yardstick
   double min_local_yardstick = 1.0;
+  // Defaults: min of geode minimum / min(local yardstick, ConformResult::template_ceiling): at
+  // or above 0.9 where min_local_ratio is not, the template's ceiling stops it, not placement.
+  double min_capped_ratio = 1e9;
 };
 
 struct CornerStudyModelSummary {
@@ -71,7 +74,7 @@ CornerStudy corner_study(const std::vector<CornerStudyModel>& models, int n,
                          const std::function<void(const CornerStudyModelSummary&)>& done = {});
 
 // model,n,kind,angle,buffer_hexes,min_sj_none,min_sj_default,min_local_ratio_default,
-// min_local_yardstick
+// min_local_yardstick,min_capped_ratio_default
 void write_corner_csv(std::ostream& out, const CornerStudy& study);
 // The same as a table, with one summary line per model.
 void write_corner_table(std::ostream& out, const CornerStudy& study);

@@ -49,6 +49,9 @@ TEST_CASE("corner study: geode hexes at lshape's 90-degree convex edge reach 0.2
     CAPTURE(r.kind);
     CHECK(r.min_none > 0.0);
     CHECK(r.min_default >= 0.25);  // measured 0.270 at the edge, 0.319 flat
+    // The capped ratio divides by a cap at most the local yardstick: never below the ratio.
+    CHECK(r.min_capped_ratio >= r.min_local_ratio);
+    CHECK(r.min_capped_ratio < 1e9);
     edge |= r.kind == "convex edge";
   }
   CHECK(edge);
