@@ -588,22 +588,24 @@ double buffer_height_ratio(const BufferLayer& layer) {
   return sum / static_cast<double>(layer.hexes.size());
 }
 
-std::vector<double> buffer_proportions(const BufferLayer& layer) {
+std::vector<Eigen::Vector3d> buffer_proportions(const BufferLayer& layer) {
   const auto& p = layer.model.points;
-  std::vector<double> ratio;
-  ratio.reserve(layer.hexes.size());
+  std::vector<Eigen::Vector3d> sides;
+  sides.reserve(layer.hexes.size());
   for (const BufferHex& b : layer.hexes) {
     const auto at = [&](std::size_t k) -> const primal::Point& {
       return p[primal::index_cast<std::size_t>(b.corners[k])];
     };
-    double edge = 0.0, height = 0.0;
-    for (std::size_t i = 0; i < 4; ++i) {
-      edge += (at((i + 1) % 4) - at(i)).norm() / 4.0;
-      height += (at(i + 4) - at(i)).norm() / 4.0;
-    }
-    ratio.push_back(edge > 0.0 ? height / edge : 0.0);
+    const auto mean = [&](std::array<std::array<std::size_t, 2>, 4> edges) {
+      double sum = 0.0;
+      for (const auto& [i, j] : edges) sum += (at(j) - at(i)).norm();
+      return sum / 4.0;
+    };
+    sides.emplace_back(mean({{{0, 3}, {1, 2}, {4, 7}, {5, 6}}}),
+                       mean({{{0, 4}, {1, 5}, {2, 6}, {3, 7}}}),
+                       mean({{{0, 1}, {3, 2}, {4, 5}, {7, 6}}}));
   }
-  return ratio;
+  return sides;
 }
 
 const char* buffer_side_name(BufferSide side) { return side == BufferSide::kHex ? "hex" : "tet"; }

@@ -130,10 +130,11 @@ struct BufferLayer {
 // templates will be squashed (the reference box is half as high as wide); 0 without hexes.
 double buffer_height_ratio(const BufferLayer& layer);
 
-// Per buffer hex: the mean of its four edges from the interface quad to the top over its
-// interface quad's mean edge (0 for a degenerate quad), the proportion of an undistorted cell
-// as flat as it (conform::template_ceiling).
-std::vector<double> buffer_proportions(const BufferLayer& layer);
+// Per buffer hex: its mean edge lengths along its three directions, in the template box's axes
+// (conform/reference_template.hpp): x along corners 0-3 (and 1-2, 4-7, 5-6), y its height (the
+// four edges from the interface quad to the top), z along 0-1 (and 3-2, 4-5, 7-6); the sides of
+// an undistorted cell of its proportions (conform::template_ceiling).
+std::vector<Eigen::Vector3d> buffer_proportions(const BufferLayer& layer);
 
 // Wedges are diced in place and never moved: an interface quad of a wedge, or a tet on the hex
 // side of a node (Interface::uses), needs the layer carved from the tet part; a wedge on the

@@ -234,8 +234,8 @@ class Conformer {
   // reported ones where conform relaxed the tets).
   double aim_yardstick_ = 0.0;
   std::vector<double> aim_local_;
-  std::vector<double> proportion_;   // per buffer hex: buffer_proportions, as placed
-  std::vector<Index> diced_parent_;  // per output diced hex (the first ones): its input hex
+  std::vector<Eigen::Vector3d> proportion_;  // per buffer hex: buffer_proportions, as placed
+  std::vector<Index> diced_parent_;          // per output diced hex (the first ones): its input hex
   std::vector<Index> geode_first_;  // per buffer hex: its first output hex (then one past the last)
   // The hexes whose nodes smoothing or untangling could move (their regions), for check().
   std::vector<Index> moved_;
@@ -1212,12 +1212,12 @@ void Conformer::check(std::span<const Point> points, std::span<const std::array<
   }
 }
 
-// What each buffer hex's template reaches in an undistorted cell as flat as the buffer hex
+// What each buffer hex's template reaches in an undistorted cell of the buffer hex's proportions
 // (template_ceiling), where it matters: where its geode hexes fall short of kLocalAim x
 // min(local yardstick, the templates' own minimum). A buffer hex in a thin first cell of a
 // boundary layer is flatter than the template box, and there the template's minimum, not the
-// placement, is what stops the geode (layer-mixed, n = 7: 0.144 in a buffer hex of proportion
-// 0.17, where the template reaches 0.166). Only those buffer hexes are measured, the templates
+// placement, is what stops the geode (layer-mixed, n = 7: 0.144 in a buffer hex 0.17 as high as
+// wide, where the template reaches 0.135). Only those buffer hexes are measured, the templates
 // of their distinct proportions built in parallel (about 0.13 s each), so a run that meets its
 // aims pays nothing.
 void Conformer::ceilings() {

@@ -218,8 +218,8 @@ struct ConformResult {
   // aims every geode hex at 0.9 x min(its local yardstick, template_min_scaled_jacobian) (what
   // the template reaches in an undistorted cell), and at least the yardstick.
   std::vector<double> local_yardstick;
-  // Per buffer hex (Interface order): what its template reaches in an undistorted cell as flat
-  // as the buffer hex (conform::template_ceiling of its buffer_proportions), where its geode
+  // Per buffer hex (Interface order): what its template reaches in an undistorted cell of the
+  // buffer hex's proportions (conform::template_ceiling of its buffer_proportions), where its geode
   // hexes fall below 0.9 x min(local yardstick, template_min_scaled_jacobian); elsewhere
   // template_min_scaled_jacobian (the template in --template-box), which it never exceeds.
   std::vector<double> template_ceiling;

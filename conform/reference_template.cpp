@@ -245,12 +245,15 @@ const RefTemplate& reference_template(const Eigen::Vector3d& given_box,
 }
 
 double template_ceiling(const Eigen::Vector3d& given_box, std::array<int, 2> diagonal,
-                        double height_ratio) {
+                        const Eigen::Vector3d& cell) {
   const Eigen::Vector3d box = given_box * (24.0 / given_box.maxCoeff());
-  const double height = std::max(3.0, std::ceil(height_ratio * 0.5 * (box.x() + box.z()) - 1e-9));
-  if (!(height < box.y())) return reference_template(box, diagonal).min_scaled_jacobian;
-  return reference_template(Eigen::Vector3d(box.x(), height, box.z()), diagonal)
-      .min_scaled_jacobian;
+  Eigen::Vector3d sides(24.0, 24.0, 24.0);  // a degenerate cell: measured as the box's own
+  if (cell.minCoeff() >= 0.0 && cell.maxCoeff() > 0.0)
+    for (int k = 0; k < 3; ++k)
+      sides[k] = std::max(3.0, std::ceil(cell[k] * 24.0 / cell.maxCoeff() - 1e-9));
+  if ((sides.array() >= box.array()).all())
+    return reference_template(box, diagonal).min_scaled_jacobian;
+  return reference_template(sides, diagonal).min_scaled_jacobian;
 }
 
 std::jthread build_reference_templates_ahead(const Eigen::Vector3d& box) {

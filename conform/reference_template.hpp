@@ -48,16 +48,16 @@ const RefTemplate& reference_template(const Eigen::Vector3d& box, std::array<int
 // hexes are flat; see the .cpp).
 const RefTemplate& reference_template_four_triangles(const Eigen::Vector3d& box);
 
-// What the template reaches in an undistorted cell as flat as a buffer hex whose mean height is
-// `height_ratio` x its top's mean edge: the smoothed template's own minimum (its
-// min_scaled_jacobian) in `box` with its height (box.y()) lowered to height_ratio x its width
-// (the mean of box.x() and box.z()), rounded up to a whole 24th of the largest side and not
-// below 3 of them (a flatter box is given the 3/24 box's figure, which is higher: measured
-// 24x12x24 0.330, 24x8x24 0.248, 24x5x24 0.165, 24x3x24 0.102). Where the buffer hex is not
-// flatter than `box`, the box's own. Built and kept as reference_template() keeps them; throws
-// as it does.
+// What the template reaches in an undistorted cell of a buffer hex's proportions: the
+// smoothed template's own minimum (its min_scaled_jacobian) in the box whose sides are `cell`,
+// the buffer hex's mean edge lengths in the template box's axes (x: along its corners 0-3, y:
+// its height, z: along 0-1; buffer_proportions), each rounded up to a whole 24th of the
+// longest and not below 3 of them (a thinner side is given 3/24, which gives a higher figure:
+// measured 24x12x24 0.330, 24x8x24 0.248, 24x5x24 0.165, 24x3x24 0.102, 24x5x8 0.114). Where
+// the cell is not thinner than `box` (--template-box) in any direction, the box's own. Built and
+// kept as reference_template() keeps them; throws as it does.
 double template_ceiling(const Eigen::Vector3d& box, std::array<int, 2> diagonal,
-                        double height_ratio);
+                        const Eigen::Vector3d& cell);
 
 // Starts building both diagonals' templates for `box` (what conform() asks for first) on a thread
 // of its own, so that a caller can overlap them with reading its input: conform() then finds

@@ -191,21 +191,27 @@ TEST_CASE("reference templates: a build stopped ahead is built whole when asked 
   }
 }
 
-TEST_CASE("template ceilings: the template's own minimum in a box as flat as a buffer hex") {
+TEST_CASE("template ceilings: the template's own minimum in a box of a buffer hex's proportions") {
   const Eigen::Vector3d box(24, 12, 24);  // the default --template-box
   for (const std::array<int, 2> d : {std::array{4, 6}, std::array{5, 7}}) {
     CAPTURE(d[0]);
     const double own = conform::reference_template(box, d).min_scaled_jacobian;
-    // Not flatter than the box: the box's own, at any scale of the box.
-    CHECK(conform::template_ceiling(box, d, 0.5) == own);
-    CHECK(conform::template_ceiling(box * 1e3, d, 0.9) == own);
-    // 0.2 x the width is 4.8 of 24: the 24 x 5 x 24 box's template; below 3/24 the 3/24 box's.
-    const double flat = conform::template_ceiling(box, d, 0.2);
-    CHECK(flat == conform::reference_template(Eigen::Vector3d(24, 5, 24), d).min_scaled_jacobian);
+    auto in = [&](double x, double y, double z) {
+      return conform::reference_template(Eigen::Vector3d(x, y, z), d).min_scaled_jacobian;
+    };
+    // Not thinner than the box in any direction: the box's own, at any scale of the cell.
+    CHECK(conform::template_ceiling(box, d, Eigen::Vector3d(1, 0.5, 1)) == own);
+    CHECK(conform::template_ceiling(box, d, Eigen::Vector3d(1e3, 900, 1e3)) == own);
+    // 0.2 x the side is 4.8 of 24: the 24 x 5 x 24 box's template; below 3/24 the 3/24 box's.
+    const double flat = conform::template_ceiling(box, d, Eigen::Vector3d(1, 0.2, 1));
+    CHECK(flat == in(24, 5, 24));
     CHECK(flat < own);
-    CHECK(conform::template_ceiling(box, d, 0.01) ==
-          conform::reference_template(Eigen::Vector3d(24, 3, 24), d).min_scaled_jacobian);
-    CHECK(conform::template_ceiling(box, d, 0.01) < flat);
+    CHECK(conform::template_ceiling(box, d, Eigen::Vector3d(1, 0.01, 1)) == in(24, 3, 24));
+    CHECK(in(24, 3, 24) < flat);
+    // A cell whose quad is itself elongated: its three sides, in the box's axes.
+    const double narrow = conform::template_ceiling(box, d, Eigen::Vector3d(2, 0.4, 0.6));
+    CHECK(narrow == in(24, 5, 8));
+    CHECK(narrow < flat);
   }
 }
 

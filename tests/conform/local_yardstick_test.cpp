@@ -12,7 +12,6 @@
 #include <string>
 
 #include <geode/conform/conform.hpp>
-#include <geode/conform/reference_template.hpp>
 #include <geode/demo/demo_models.hpp>
 #include <geode/primal/dice.hpp>
 #include <geode/primal/interface.hpp>
@@ -147,9 +146,6 @@ TEST_CASE("template ceilings: a flat buffer hex measured against its template in
   const double tpl = r.template_min_scaled_jacobian;
   REQUIRE(r.template_ceiling.size() == r.local_yardstick.size());
   const primal::HexMesh out = primal::hex_part(r.model);
-  const Eigen::Vector3d box(24, 3, 24);  // the flattest box template_ceiling builds
-  const double flattest = std::min(conform::reference_template(box, {4, 6}).min_scaled_jacobian,
-                                   conform::reference_template(box, {5, 7}).min_scaled_jacobian);
   int lowered = 0;
   double capped = 1.0;
   for (Index b = 0; b < r.interface_quads; ++b) {
@@ -161,16 +157,16 @@ TEST_CASE("template ceilings: a flat buffer hex measured against its template in
     if (r.template_ceiling[q] < tpl) {
       ++lowered;
       // Measured only where the geode hexes fall short of 0.9 x min(local yardstick, the
-      // template box's figure), and never below the flattest box's.
+      // template box's figure).
       CHECK(lo < 0.9 * std::min(r.local_yardstick[q], tpl));
-      CHECK(r.template_ceiling[q] >= flattest);
+      CHECK(r.template_ceiling[q] > 0.0);
     }
     capped = std::min(capped, lo / std::min(r.local_yardstick[q], r.template_ceiling[q]));
   }
   CHECK(lowered > 0);
   CHECK(r.capped_local_ratio == doctest::Approx(capped).epsilon(1e-9));
   CHECK(r.capped_local_ratio > r.local_yardstick_ratio);
-  MESSAGE("layer-mixed n = 3: " << lowered << " buffer hexes flatter than the template box, "
+  MESSAGE("layer-mixed n = 3: " << lowered << " buffer hexes thinner than the template box, "
                                 << "local ratio " << r.local_yardstick_ratio << ", capped "
                                 << r.capped_local_ratio);
 }
