@@ -25,6 +25,7 @@
 #include <geode/primal/quality.hpp>
 #include "support/conform_checks.hpp"
 #include "support/temp_dir.hpp"
+#include "support/tetgen_files.hpp"
 
 using namespace geode;
 using primal::ElementKind;
@@ -155,39 +156,21 @@ primal::Model tetgen_potting(const std::string& shape, int n, bool shear,
   const std::string cmd = "cd " + dir.path.string() + " && tetgen -pq1.4a0.01YQ " +
                           poly.filename().string() + " > /dev/null 2>&1";
   REQUIRE(std::system(cmd.c_str()) == 0);
-  std::ifstream nodes(dir.path / (shape + ".1.node")), eles(dir.path / (shape + ".1.ele"));
-  REQUIRE(nodes);
-  REQUIRE(eles);
-  std::size_t nn = 0, ne = 0;
-  int dim = 0, attrs = 0, markers = 0;
-  nodes >> nn >> dim >> attrs >> markers;
-  REQUIRE(nn >= surface.size() + outer.size());
-  std::vector<Index> model_of(nn);
-  for (std::size_t i = 0; i < nn; ++i) {
-    std::string rest;
-    long tid = 0;
-    Point p;
-    nodes >> tid >> p.x() >> p.y() >> p.z();
-    std::getline(nodes, rest);
+  // TetGen keeps the surface's nodes first, in order (the .poly numbers from 0).
+  const std::vector<Point> tetgen = test::read_tetgen_nodes(dir.path / (shape + ".1.node"));
+  REQUIRE(tetgen.size() >= surface.size() + outer.size());
+  std::vector<Index> model_of(tetgen.size());
+  for (std::size_t i = 0; i < tetgen.size(); ++i) {
     if (i < surface.size()) {  // the surface kept, node for node
-      REQUIRE((p - m.points[primal::index_cast<std::size_t>(surface[i])]).norm() < 1e-12);
+      REQUIRE((tetgen[i] - m.points[primal::index_cast<std::size_t>(surface[i])]).norm() < 1e-12);
       model_of[i] = surface[i];
     } else {
       model_of[i] = primal::index_cast(m.points.size());
-      m.points.push_back(p);
+      m.points.push_back(tetgen[i]);
     }
   }
-  int per = 0;
-  eles >> ne >> per >> attrs;
-  for (std::size_t i = 0; i < ne; ++i) {
-    long tid = 0;
-    std::array<Index, 4> t{};
-    eles >> tid >> t[0] >> t[1] >> t[2] >> t[3];
+  for (std::array<Index, 4> t : test::read_tetgen_tets(dir.path / (shape + ".1.ele"), 0, tetgen)) {
     for (Index& v : t) v = model_of[primal::index_cast<std::size_t>(v)];
-    auto at = [&](int c) -> const Point& {
-      return m.points[primal::index_cast<std::size_t>(t[static_cast<std::size_t>(c)])];
-    };
-    if (primal::tet_volume(at(0), at(1), at(2), at(3)) < 0.0) std::swap(t[1], t[2]);
     primal::add_element(m, ElementKind::kTet, t, 2, ++id);
   }
   for (std::size_t i = 0; i < m.points.size(); ++i)

@@ -30,6 +30,7 @@
 #include "support/cli_run.hpp"
 #include "support/demo_input.hpp"
 #include "support/temp_dir.hpp"
+#include "support/tetgen_files.hpp"
 
 using namespace geode;
 using primal::ElementKind;
@@ -195,33 +196,10 @@ primal::Model tetgen_box(const test::TempDir& dir) {
   const std::string cmd = "tetgen -pqa0.002Q " + poly.string() + " > /dev/null 2>&1";
   REQUIRE(std::system(cmd.c_str()) == 0);
   primal::Model m;
-  std::ifstream nodes(dir.path / "box.1.node"), eles(dir.path / "box.1.ele");
-  REQUIRE(nodes);
-  REQUIRE(eles);
-  std::size_t nn = 0, ne = 0;
-  int dim = 0, attrs = 0, markers = 0;
-  nodes >> nn >> dim >> attrs >> markers;
-  for (std::size_t i = 0; i < nn; ++i) {
-    std::string line;
-    long id = 0;
-    double x = 0, y = 0, z = 0;
-    nodes >> id >> x >> y >> z;
-    std::getline(nodes, line);
-    m.points.emplace_back(x, y, z);
-  }
-  int per = 0;
-  eles >> ne >> per >> attrs;
-  for (std::size_t i = 0; i < ne; ++i) {
-    long id = 0;
-    std::array<Index, 4> t{};
-    eles >> id >> t[0] >> t[1] >> t[2] >> t[3];
-    for (Index& v : t) --v;
-    auto at = [&](int k) -> const Point& {
-      return m.points[primal::index_cast<std::size_t>(t[k])];
-    };
-    if (primal::tet_volume(at(0), at(1), at(2), at(3)) < 0.0) std::swap(t[1], t[2]);
-    primal::add_element(m, ElementKind::kTet, t, 2, static_cast<std::int64_t>(i + 1));
-  }
+  m.points = test::read_tetgen_nodes(dir.path / "box.1.node");
+  std::int64_t id = 0;
+  for (const auto& t : test::read_tetgen_tets(dir.path / "box.1.ele", 1, m.points))
+    primal::add_element(m, ElementKind::kTet, t, 2, ++id);
   for (std::size_t i = 0; i < m.points.size(); ++i)
     m.node_ids.push_back(static_cast<std::int64_t>(i + 1));
   return m;
