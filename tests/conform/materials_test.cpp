@@ -18,34 +18,6 @@
 using namespace geode;
 using primal::Index;
 
-namespace {
-
-std::map<int, double> block_volumes(const primal::Model& m) {
-  std::map<int, double> v;
-  for (std::size_t h = 0; h < m.hexes.size(); ++h) {
-    primal::HexCorners c;
-    for (int k = 0; k < 8; ++k)
-      c[primal::index_cast<std::size_t>(k)] =
-          m.points[primal::index_cast<std::size_t>(m.hexes[h][primal::index_cast<std::size_t>(k)])];
-    v[m.hex_block[h]] += primal::hex_volume(c);
-  }
-  return v;
-}
-
-std::map<int, double> input_tet_volumes(const primal::Model& m) {
-  std::map<int, double> v;
-  for (std::size_t t = 0; t < m.tets.size(); ++t) {
-    const auto& n = m.tets[t];
-    const auto& p = m.points;
-    v[m.tet_block.empty() ? 0 : m.tet_block[t]] += primal::tet_volume(
-        p[primal::index_cast<std::size_t>(n[0])], p[primal::index_cast<std::size_t>(n[1])],
-        p[primal::index_cast<std::size_t>(n[2])], p[primal::index_cast<std::size_t>(n[3])]);
-  }
-  return v;
-}
-
-}  // namespace
-
 TEST_CASE("materials never move: every smoothing mode keeps each block's volume to 1e-9") {
   const struct {
     const char* name;
@@ -59,8 +31,8 @@ TEST_CASE("materials never move: every smoothing mode keeps each block's volume 
     none.smooth = conform::ConformSmooth::kNone;
     const conform::ConformResult base = conform::conform(input, none);
     test::check_conform_result(base);
-    const auto reference = block_volumes(base.model);
-    for (const auto& [id, volume] : input_tet_volumes(input)) {
+    const auto reference = test::hex_block_volumes(base.model);
+    for (const auto& [id, volume] : test::tet_block_volumes(input)) {
       CAPTURE(id);
       REQUIRE(reference.count(id));
       CHECK(std::abs(reference.at(id) - volume) <= 1e-9 * volume);
@@ -87,7 +59,7 @@ TEST_CASE("materials never move: every smoothing mode keeps each block's volume 
       const conform::ConformResult r = conform::conform(input, o);
       test::check_conform_result(r);
       REQUIRE(r.model.points.size() == base.model.points.size());
-      const auto volumes = block_volumes(r.model);
+      const auto volumes = test::hex_block_volumes(r.model);
       REQUIRE(volumes.size() == reference.size());
       for (const auto& [id, volume] : reference) {
         CAPTURE(id);

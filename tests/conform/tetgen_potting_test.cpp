@@ -179,24 +179,6 @@ primal::Model tetgen_potting(const std::string& shape, int n, bool shear,
   return m;
 }
 
-std::map<int, double> volumes(const primal::Model& m) {
-  std::map<int, double> v;
-  for (std::size_t h = 0; h < m.hexes.size(); ++h) {
-    primal::HexCorners c;
-    for (std::size_t k = 0; k < 8; ++k)
-      c[k] = m.points[primal::index_cast<std::size_t>(m.hexes[h][k])];
-    v[m.hex_block.empty() ? 1 : m.hex_block[h]] += primal::hex_volume(c);
-  }
-  for (std::size_t t = 0; t < m.tets.size(); ++t) {
-    const auto& n = m.tets[t];
-    const auto& p = m.points;
-    v[m.tet_block[t]] += primal::tet_volume(
-        p[primal::index_cast<std::size_t>(n[0])], p[primal::index_cast<std::size_t>(n[1])],
-        p[primal::index_cast<std::size_t>(n[2])], p[primal::index_cast<std::size_t>(n[3])]);
-  }
-  return v;
-}
-
 }  // namespace
 
 TEST_CASE("hex parts in a TetGen potting: valid, at or above the yardstick, volumes kept") {
@@ -218,14 +200,16 @@ TEST_CASE("hex parts in a TetGen potting: valid, at or above the yardstick, volu
     // part is its hexes' where their quads are planar, and whatever the shear, smoothing moves
     // neither (the sheared part's quads are not planar, so its hexes' trilinear volume is not
     // what the triangles TetGen kept enclose).
-    const auto in = volumes(input), out = volumes(r.model), placed = volumes(unsmoothed.model);
+    const auto out = test::hex_block_volumes(r.model);
+    const auto placed = test::hex_block_volumes(unsmoothed.model);
+    const auto part = test::hex_block_volumes(input), potting = test::tet_block_volumes(input);
     REQUIRE(out.size() == 2);
-    CHECK(std::abs(out.at(2) - in.at(2)) <= 1e-9 * in.at(2));
+    CHECK(std::abs(out.at(2) - potting.at(2)) <= 1e-9 * potting.at(2));
     for (int block : {1, 2}) {
       CAPTURE(block);
       CHECK(std::abs(out.at(block) - placed.at(block)) <= 1e-9 * placed.at(block));
     }
-    if (!shear) CHECK(std::abs(out.at(1) - in.at(1)) <= 1e-9 * in.at(1));
+    if (!shear) CHECK(std::abs(out.at(1) - part.at(1)) <= 1e-9 * part.at(1));
     for (const conform::BlockQuality& b : r.quality)
       if (b.geode_hexes > 0) CHECK(b.geode_min_scaled_jacobian > 0.12);
   }
