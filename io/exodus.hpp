@@ -69,8 +69,11 @@ primal::Model read_exodus_piece(const std::filesystem::path& path,
 // room for every definition, all made before the bulk data: netCDF's classic format moves the
 // whole data region whenever a definition outgrows the header. `define`, when given, is called
 // with the libexodusII file id once the model's variables are defined, to define more (Nemesis:
-// parallel/nemesis.cpp) and write it.
+// parallel/nemesis.cpp); `write_more` after the model's own data, to write the rest. Data
+// written early would leave a hole before it that netCDF reads, block by block, as the model's
+// data fills it.
 void write_exodus(const primal::Model& model, const std::filesystem::path& path,
-                  const std::function<void(int exo)>& define = {});
+                  const std::function<void(int exo)>& define = {},
+                  const std::function<void(int exo)>& write_more = {});
 
 }  // namespace geode::io

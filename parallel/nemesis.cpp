@@ -57,9 +57,10 @@ void write_nemesis(const RankMesh& mesh, const std::filesystem::path& output, in
   const std::size_t internal_nodes = border.size() - border_nodes,
                     internal_hexes = mesh.model.hexes.size() - border_hexes;
   // Nemesis's definitions made with the model's, before any bulk data (io/exodus.hpp): made on
-  // the finished file they had netCDF move all of it. Each map is made just before its write
-  // and freed after it, so that no two are held beside the model and the writer's buffers.
-  io::write_exodus(mesh.model, path, [&](int exo) {
+  // the finished file they had netCDF move all of it. Its maps written after the model's data,
+  // in file order. Each map is made just before its write and freed after it, so that no two
+  // are held beside the model and the writer's buffers.
+  const auto define = [&](int exo) {
     char type[] = "p";
     check(ex_put_init_info(exo, ranks, 1, type), path, "Nemesis init info");
     check(ex_put_init_global(exo, mesh.global_nodes, mesh.global_hexes,
@@ -100,6 +101,8 @@ void write_nemesis(const RankMesh& mesh, const std::filesystem::path& output, in
       check(ex_put_cmap_params(exo, map_ids.data(), map_counts.data(), nullptr, nullptr, rank),
             path, "Nemesis communication map sizes");
     }
+  };
+  const auto write_maps = [&](int exo) {
     // The number maps (defined by their first write), then the data of what is defined.
     if (!mesh.node_gid.empty())
       check(ex_put_id_map(exo, EX_NODE_MAP, one_based(mesh.node_gid, path).data()), path,
@@ -132,7 +135,8 @@ void write_nemesis(const RankMesh& mesh, const std::filesystem::path& output, in
       check(ex_put_node_cmap(exo, q, local.data(), procs.data(), rank), path,
             "Nemesis node communication map to rank " + std::to_string(q));
     }
-  });
+  };
+  io::write_exodus(mesh.model, path, define, write_maps);
 }
 
 Model canonical(const Model& model) {
