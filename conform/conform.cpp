@@ -191,7 +191,7 @@ class Conformer {
   bool verify_locally() const;
   void invert_for_test();
   void check(std::span<const Point> points, std::span<const std::array<Index, 8>> hexes);
-  void ceilings();
+  void ceilings(const std::vector<int>& block);
   void report(const std::vector<int>& block);
   void announce(double seconds) const;
   void output();
@@ -1284,32 +1284,74 @@ void Conformer::check(std::span<const Point> points, std::span<const std::array<
 // min(local yardstick, the templates' own minimum). A buffer hex in a thin first cell of a
 // boundary layer is flatter than the template box, and there the template's minimum, not the
 // placement, is what stops the geode (layer-mixed, n = 7: 0.144 in a buffer hex 0.17 as high as
-// wide, where the template reaches 0.135). Only those buffer hexes are measured, the templates
-// of their distinct proportions built in parallel (about 0.13 s each), so a run that meets its
-// aims pays nothing.
-void Conformer::ceilings() {
+// wide, where the template reaches 0.135). Only those buffer hexes are measured, and of them
+// only as many as can set their block's capped ratio (ConformOptions::all_template_ceilings:
+// all), the templates of their distinct proportions built in parallel (about 0.13 s each): a
+// run that meets its aims pays nothing, and one with --smooth none not a template per
+// proportion (the potting demo at n = 3: 6.1 -> 1.9 s of CPU).
+void Conformer::ceilings(const std::vector<int>& block) {
   const double tpl = res_.template_min_scaled_jacobian;
   res_.template_ceiling.assign(res_.local_yardstick.size(), tpl);
-  std::vector<std::pair<std::size_t, std::array<int, 2>>> short_of;  // buffer hex, diagonal
+  // The short buffer hexes: their lowest geode hex against min(local yardstick, tpl), which
+  // their ratio to min(local yardstick, their ceiling) is never below (a ceiling <= tpl).
+  struct Short {
+    double bound;  // the lowest geode hex / min(local, tpl)
+    std::size_t b;
+    double lowest, local;
+    int block;
+  };
+  std::vector<Short> short_of;
+  std::map<int, double> best;  // per output block, its lowest capped ratio found so far
+  const auto lower = [](std::map<int, double>& m, int id, double x) {
+    const auto [it, added] = m.try_emplace(id, x);
+    if (!added) it->second = std::min(it->second, x);
+  };
   for (std::size_t b = 0; b + 1 < geode_first_.size(); ++b) {
-    if (layer_.hexes[b].centre != kInvalidIndex) continue;  // four triangles: its own box
     const double local =
         res_.local_yardstick[primal::index_cast<std::size_t>(layer_.hexes[b].quad)];
     const auto first = sj_.begin() + geode_first_[b], last = sj_.begin() + geode_first_[b + 1];
-    if (*std::min_element(first, last) < kLocalAim * std::min(local, tpl))
-      short_of.emplace_back(b, layer_.hexes[b].diagonal);
+    const double lowest = *std::min_element(first, last);
+    const int id = block[primal::index_cast<std::size_t>(geode_first_[b])];
+    const double bound = lowest / std::min(local, tpl);
+    // Four triangles: its own box, no ceiling.
+    if (lowest < kLocalAim * std::min(local, tpl) && layer_.hexes[b].centre == kInvalidIndex)
+      short_of.push_back({bound, b, lowest, local, id});
+    else
+      lower(best, id, bound);
   }
-  std::vector<double> found(short_of.size(), tpl);
-  tbb::parallel_for(std::size_t{0}, short_of.size(), [&](std::size_t k) {
-    try {
-      found[k] = std::min(tpl, template_ceiling(options_.template_box, short_of[k].second,
-                                                proportion_[short_of[k].first]));
-    } catch (const std::exception&) {  // no template in that box: the box's own figure
-    }
+  std::sort(short_of.begin(), short_of.end(), [](const Short& x, const Short& y) {
+    return std::tie(x.bound, x.b) < std::tie(y.bound, y.b);
   });
-  for (std::size_t k = 0; k < short_of.size(); ++k)
-    res_.template_ceiling[primal::index_cast<std::size_t>(layer_.hexes[short_of[k].first].quad)] =
-        found[k];
+  // Lowest bound first, a few at a time (in parallel): a hex whose bound is not below its
+  // block's best so far cannot lower it.
+  constexpr std::size_t kBatch = 8;
+  std::vector<char> done(short_of.size(), 0);
+  for (;;) {
+    std::vector<std::size_t> batch;
+    for (std::size_t k = 0; k < short_of.size() && batch.size() < kBatch; ++k) {
+      const auto it = best.find(short_of[k].block);
+      if (!done[k] &&
+          (options_.all_template_ceilings || it == best.end() || short_of[k].bound < it->second))
+        batch.push_back(k);
+    }
+    if (batch.empty()) break;
+    std::vector<double> found(batch.size(), tpl);
+    tbb::parallel_for(std::size_t{0}, batch.size(), [&](std::size_t i) {
+      const Short& s = short_of[batch[i]];
+      try {
+        found[i] = std::min(tpl, template_ceiling(options_.template_box, layer_.hexes[s.b].diagonal,
+                                                  proportion_[s.b]));
+      } catch (const std::exception&) {  // no template in that box: the box's own figure
+      }
+    });
+    for (std::size_t i = 0; i < batch.size(); ++i) {
+      const Short& s = short_of[batch[i]];
+      done[batch[i]] = 1;
+      res_.template_ceiling[primal::index_cast<std::size_t>(layer_.hexes[s.b].quad)] = found[i];
+      const double ratio = s.lowest / std::min(s.local, found[i]);
+      lower(best, s.block, ratio);
+    }
+  }
 }
 
 // The quality per output block.
@@ -1356,7 +1398,7 @@ void Conformer::report(const std::vector<int>& block) {
     res_.quality.push_back(std::move(q));
   }
   // The geode hexes against their local yardsticks, per block and over all.
-  ceilings();
+  ceilings(block);
   for (std::size_t b = 0; b + 1 < geode_first_.size(); ++b) {
     const auto quad = primal::index_cast<std::size_t>(layer_.hexes[b].quad);
     const double local = res_.local_yardstick[quad];

@@ -90,6 +90,10 @@ struct ConformOptions {
   // them keeps most of its quality (the paper's is 24 x 14 x 24; 24 x 10 x 24 suits the tet
   // side's default thickness).
   Eigen::Vector3d template_box{24.0, 12.0, 24.0};
+  // ConformResult::template_ceiling for every buffer hex whose geode hexes fall short (each a
+  // template smoothed in a box of its proportions: with --smooth none, seconds on the potting
+  // demo), not only where it can set a block's capped_local_ratio (the default).
+  bool all_template_ceilings = false;
   // The worst-first smoother (primal/local_smooth.hpp); materials never move: nodes on the
   // model boundary and on the faces between output blocks slide in their plane or along their
   // straight edge where those are flat, and stay fixed elsewhere (curved surfaces, corners), so
@@ -220,7 +224,9 @@ struct ConformResult {
   std::vector<double> local_yardstick;
   // Per buffer hex (Interface order): what its template reaches in an undistorted cell of the
   // buffer hex's proportions (conform::template_ceiling of its buffer_proportions), where its geode
-  // hexes fall below 0.9 x min(local yardstick, template_min_scaled_jacobian); elsewhere
+  // hexes fall below 0.9 x min(local yardstick, template_min_scaled_jacobian) and can set their
+  // block's capped_local_ratio (taken lowest ratio first, until the rest cannot go below it;
+  // every such hex with ConformOptions::all_template_ceilings); elsewhere
   // template_min_scaled_jacobian (the template in --template-box), which it never exceeds.
   std::vector<double> template_ceiling;
   // The lowest ratio of a geode hex's scaled Jacobian to its local yardstick (after smoothing),

@@ -108,7 +108,9 @@ CornerStudy corner_study(const std::vector<CornerStudyModel>& models, int n,
         ConformOptions none;
         none.smooth = ConformSmooth::kNone;
         a = conform(input, none);
-        b = conform(input, {});
+        ConformOptions defaults;  // every short buffer hex's ceiling: the classes' capped ratios
+        defaults.all_template_ceilings = true;
+        b = conform(input, defaults);
       } catch (const std::exception& e) {
         s.failure = std::string("refused: ") + e.what();
       }

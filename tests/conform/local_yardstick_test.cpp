@@ -170,3 +170,36 @@ TEST_CASE("template ceilings: a flat buffer hex measured against its template in
                                 << "local ratio " << r.local_yardstick_ratio << ", capped "
                                 << r.capped_local_ratio);
 }
+
+TEST_CASE("template ceilings measured only where they can set a block's capped ratio") {
+  // With --smooth none most buffer hexes fall short, so the ceilings are taken lowest bound
+  // first and stop where the rest cannot lower a block's capped ratio: the same ratios as with
+  // every short buffer hex measured.
+  for (const auto& [name, n] : {std::pair{"potting", 2}, std::pair{"layer-mixed", 3}}) {
+    const std::string model_name = name;
+    CAPTURE(model_name);
+    const primal::Model input = demo::demo_model(name, n);
+    conform::ConformOptions some;
+    some.smooth = conform::ConformSmooth::kNone;
+    conform::ConformOptions all = some;
+    all.all_template_ceilings = true;
+    const conform::ConformResult a = conform::conform(input, some),
+                                 b = conform::conform(input, all);
+    const double tpl = a.template_min_scaled_jacobian;
+    const auto lowered = [&](const conform::ConformResult& r) {
+      return std::count_if(r.template_ceiling.begin(), r.template_ceiling.end(),
+                           [&](double c) { return c < tpl; });
+    };
+    CHECK(lowered(a) > 0);
+    CHECK(lowered(a) < lowered(b));
+    CHECK(a.capped_local_ratio == b.capped_local_ratio);
+    REQUIRE(a.quality.size() == b.quality.size());
+    for (std::size_t k = 0; k < a.quality.size(); ++k)
+      CHECK(a.quality[k].capped_local_ratio == b.quality[k].capped_local_ratio);
+    // Where both measured a ceiling, the same one.
+    for (std::size_t q = 0; q < a.template_ceiling.size(); ++q)
+      if (a.template_ceiling[q] < tpl) CHECK(a.template_ceiling[q] == b.template_ceiling[q]);
+    MESSAGE(model_name << ": ceilings measured " << lowered(a) << " of " << lowered(b)
+                       << ", capped ratio " << a.capped_local_ratio);
+  }
+}
