@@ -1323,18 +1323,16 @@ void Conformer::ceilings(const std::vector<int>& block) {
     return std::tie(x.bound, x.b) < std::tie(y.bound, y.b);
   });
   // Lowest bound first, a few at a time (in parallel): a hex whose bound is not below its
-  // block's best so far cannot lower it.
+  // block's best so far cannot lower it, nor later (the best only falls), so it is passed for
+  // good.
   constexpr std::size_t kBatch = 8;
-  std::vector<char> done(short_of.size(), 0);
-  for (;;) {
+  for (std::size_t k = 0; k < short_of.size();) {
     std::vector<std::size_t> batch;
-    for (std::size_t k = 0; k < short_of.size() && batch.size() < kBatch; ++k) {
+    for (; k < short_of.size() && batch.size() < kBatch; ++k) {
       const auto it = best.find(short_of[k].block);
-      if (!done[k] &&
-          (options_.all_template_ceilings || it == best.end() || short_of[k].bound < it->second))
+      if (options_.all_template_ceilings || it == best.end() || short_of[k].bound < it->second)
         batch.push_back(k);
     }
-    if (batch.empty()) break;
     std::vector<double> found(batch.size(), tpl);
     tbb::parallel_for(std::size_t{0}, batch.size(), [&](std::size_t i) {
       const Short& s = short_of[batch[i]];
@@ -1346,10 +1344,8 @@ void Conformer::ceilings(const std::vector<int>& block) {
     });
     for (std::size_t i = 0; i < batch.size(); ++i) {
       const Short& s = short_of[batch[i]];
-      done[batch[i]] = 1;
       res_.template_ceiling[primal::index_cast<std::size_t>(layer_.hexes[s.b].quad)] = found[i];
-      const double ratio = s.lowest / std::min(s.local, found[i]);
-      lower(best, s.block, ratio);
+      lower(best, s.block, s.lowest / std::min(s.local, found[i]));
     }
   }
 }
