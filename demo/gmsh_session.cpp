@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <string>
 #include <unordered_map>
+#include <vector>
 
 #include <geode/io/gmsh.hpp>
 #include <geode/primal/boundary.hpp>
@@ -57,12 +58,42 @@ void gmsh_call(const std::string& where, F&& f) {
 
 }  // namespace
 
+namespace {
+// Every option a session here sets (demo/, tests/, bench/), or that Gmsh sets as a side effect
+// of what they call (partitioning sets Mesh.NbPartitions), with Gmsh's default, read once.
+constexpr const char* kSessionOptions[] = {"General.NumThreads",
+                                           "General.Terminal",
+                                           "Mesh.Algorithm",
+                                           "Mesh.Binary",
+                                           "Mesh.MeshSizeMax",
+                                           "Mesh.MeshSizeMin",
+                                           "Mesh.MshFileVersion",
+                                           "Mesh.NbPartitions",
+                                           "Mesh.PartitionSplitMeshFiles",
+                                           "Mesh.RecombinationAlgorithm",
+                                           "Mesh.SaveAll",
+                                           "Mesh.SubdivisionAlgorithm"};
+std::vector<double>* g_defaults = nullptr;  // set by the first session; never freed
+}  // namespace
+
 GmshSession::GmshSession() {
-  gmsh::initialize(0, nullptr, false);
+  if (!g_defaults) {
+    gmsh::initialize(0, nullptr, false);
+    g_defaults = new std::vector<double>;
+    for (const char* name : kSessionOptions) {
+      double value = 0.0;
+      gmsh::option::getNumber(name, value);
+      g_defaults->push_back(value);
+    }
+  } else {
+    gmsh::clear();
+    for (std::size_t k = 0; k < std::size(kSessionOptions); ++k)
+      gmsh::option::setNumber(kSessionOptions[k], (*g_defaults)[k]);
+  }
   gmsh::option::setNumber("General.Terminal", 0);
 }
 
-GmshSession::~GmshSession() { gmsh::finalize(); }
+GmshSession::~GmshSession() { gmsh::clear(); }
 
 Model model_from_gmsh(std::string_view source_view) {
   const std::string source(source_view);

@@ -8,8 +8,12 @@
 
 namespace geode::demo {
 
-// RAII: initializes the Gmsh API (no config files, General.Terminal = 0) and finalizes it on
-// destruction. Gmsh's state is global: do not nest sessions or use them from several threads.
+// RAII: a clean Gmsh API state for one build: Gmsh initialized (no config files) the first time,
+// then per session an empty model, the options any session here sets back at Gmsh's defaults,
+// and General.Terminal = 0; the model cleared on destruction. Gmsh is never finalized: libgmsh
+// 4.8 aborts meshing pyramids after gmsh::finalize and gmsh::initialize (an Eigen assertion in
+// RelocateVerticesOfPyramids: a second hybrid demo in one process, tests/demo). Gmsh's state
+// is global: do not nest sessions or use them from several threads.
 class GmshSession {
  public:
   GmshSession();

@@ -16,6 +16,7 @@
 #include <string>
 
 #include <geode/conform/conform.hpp>
+#include <geode/demo/demo_models.hpp>
 #include <geode/io/exodus.hpp>
 #include <geode/io/gmsh.hpp>
 #include <geode/io/read_model.hpp>
@@ -222,4 +223,24 @@ TEST_CASE(
       CHECK(blocks_of(back) ==
             blocks_of(in));  // Exodus: the tet block's pyramids get a block of their own
   }
+}
+
+TEST_CASE("a hybrid demo built again in the same process, after others: the same model") {
+  // libgmsh 4.8 aborted meshing pyramids after a gmsh::finalize and gmsh::initialize (a second
+  // hybrid demo in one process, as a notebook builds them); Gmsh now stays initialized, each
+  // build with an empty model and the options sessions set back at their defaults.
+  const primal::Model first = demo::demo_model("hybrid", 3);
+  REQUIRE_FALSE(first.pyramids.empty());
+  const primal::Model other = demo::demo_model("hexdominant", 2);  // pyramids and wedges
+  CHECK_FALSE(other.pyramids.empty());
+  (void)demo::demo_model("delaunay", 3);  // another mesh size and algorithm
+  const primal::Model again = demo::demo_model("hybrid", 3);
+  CHECK(again.points == first.points);
+  CHECK(again.hexes == first.hexes);
+  CHECK(again.tets == first.tets);
+  CHECK(again.pyramids == first.pyramids);
+  CHECK(again.wedges == first.wedges);
+  CHECK(again.hex_block == first.hex_block);
+  CHECK(again.tet_block == first.tet_block);
+  CHECK(again.block_names == first.block_names);
 }
