@@ -180,8 +180,9 @@ class Conformer {
   void add_smoothing(const primal::LocalSmoothResult& r);
   void smooth();
   void smooth_defects(primal::LocalSmoothOptions o, bool neighbourhood);
-  // within: the hexes whose defects count (ascending; empty: all).
-  void smooth_defect_passes(primal::LocalSmoothOptions o, const primal::SmoothStart& start,
+  // within: the hexes whose defects count (ascending; empty: all); start: the floors, measured
+  // now if empty and a defect is found.
+  void smooth_defect_passes(primal::LocalSmoothOptions o, primal::SmoothStart& start,
                             std::span<const Index> within);
   std::vector<double> aims() const;
   double measure();                            // every hex, then scan()
@@ -1070,9 +1071,9 @@ constexpr std::size_t kNeighbourSeeds = 32;
 // Keeps sj_ up to date. A pass changes only the hexes sharing a node with its seeds (its
 // region): the defects outside it are left as they were.
 void Conformer::smooth_defects(primal::LocalSmoothOptions o, bool neighbourhood) {
-  primal::SmoothStart start{sj_, primal::shortest_edge_per_hex(mesh_)};
+  primal::SmoothStart start;  // measured by the passes if they find a defect
   smooth_defect_passes(o, start, {});
-  if (!neighbourhood) return;
+  if (!neighbourhood || start.scaled_jacobian.empty()) return;
   const std::vector<double> aim = aims();
   std::map<int, double> lowest;  // per output block, its lowest defect
   for (std::size_t h = 0; h < sj_.size(); ++h)
@@ -1112,7 +1113,7 @@ void Conformer::smooth_defects(primal::LocalSmoothOptions o, bool neighbourhood)
   smooth_defect_passes(o, start, r.region);
 }
 
-void Conformer::smooth_defect_passes(primal::LocalSmoothOptions o, const primal::SmoothStart& start,
+void Conformer::smooth_defect_passes(primal::LocalSmoothOptions o, primal::SmoothStart& start,
                                      std::span<const Index> within) {
   const std::vector<double> aim = aims();
   const auto considered = [&](std::size_t h) {
@@ -1126,6 +1127,8 @@ void Conformer::smooth_defect_passes(primal::LocalSmoothOptions o, const primal:
       worst = std::min(worst, sj_[h]);
     }
   if (defects.empty()) return;
+  // The floors over all passes, measured only where there is a defect (16 B per output hex).
+  if (start.scaled_jacobian.empty()) start = {sj_, primal::shortest_edge_per_hex(mesh_)};
   o.goal = 0.0;
   o.hex_goals = aim;
   o.max_visits = kDefectVisits;
