@@ -180,10 +180,10 @@ class Conformer {
   void add_smoothing(const primal::LocalSmoothResult& r);
   void smooth();
   void smooth_defects(primal::LocalSmoothOptions o, bool neighbourhood);
-  // within: the hexes whose defects count (ascending; empty: all); start: the floors, measured
-  // now if empty and a defect is found.
-  void smooth_defect_passes(primal::LocalSmoothOptions o, primal::SmoothStart& start,
-                            std::span<const Index> within);
+  // aim: aims(); within: the hexes whose defects count (ascending; empty: all); start: the
+  // floors, measured now if empty and a defect is found.
+  void smooth_defect_passes(primal::LocalSmoothOptions o, const std::vector<double>& aim,
+                            primal::SmoothStart& start, std::span<const Index> within);
   std::vector<double> aims() const;
   double measure();                            // every hex, then scan()
   void measure(std::span<const Index> hexes);  // these only, the others unchanged since
@@ -1071,10 +1071,10 @@ constexpr std::size_t kNeighbourSeeds = 32;
 // Keeps sj_ up to date. A pass changes only the hexes sharing a node with its seeds (its
 // region): the defects outside it are left as they were.
 void Conformer::smooth_defects(primal::LocalSmoothOptions o, bool neighbourhood) {
-  primal::SmoothStart start;  // measured by the passes if they find a defect
-  smooth_defect_passes(o, start, {});
+  const std::vector<double> aim = aims();  // fixed: the yardsticks do not move
+  primal::SmoothStart start;               // measured by the passes if they find a defect
+  smooth_defect_passes(o, aim, start, {});
   if (!neighbourhood || start.scaled_jacobian.empty()) return;
-  const std::vector<double> aim = aims();
   std::map<int, double> lowest;  // per output block, its lowest defect
   for (std::size_t h = 0; h < sj_.size(); ++h)
     if (sj_[h] < aim[h]) {
@@ -1110,12 +1110,11 @@ void Conformer::smooth_defects(primal::LocalSmoothOptions o, bool neighbourhood)
   const auto r = primal::smooth_hexes_around(mesh_, seeds, lift, &start);
   add_smoothing(r);
   measure(r.region);
-  smooth_defect_passes(o, start, r.region);
+  smooth_defect_passes(o, aim, start, r.region);
 }
 
-void Conformer::smooth_defect_passes(primal::LocalSmoothOptions o, primal::SmoothStart& start,
-                                     std::span<const Index> within) {
-  const std::vector<double> aim = aims();
+void Conformer::smooth_defect_passes(primal::LocalSmoothOptions o, const std::vector<double>& aim,
+                                     primal::SmoothStart& start, std::span<const Index> within) {
   const auto considered = [&](std::size_t h) {
     return within.empty() || std::binary_search(within.begin(), within.end(), h);
   };
