@@ -234,8 +234,8 @@ class Conformer {
   // See measure_near_interface.
   static constexpr char kLater = 1, kLaterGiven = 2;
   std::vector<char> hex_later_, tet_later_;
-  // What aims() reads: the yardstick and the local yardsticks of the cells as diced (above the
-  // reported ones where conform relaxed the tets).
+  // What aims() reads: the yardstick, and per interface quad the higher of its local yardsticks
+  // with the tets as diced (relaxed) and as given (reported).
   double aim_yardstick_ = 0.0;
   std::vector<double> aim_local_;
   std::vector<Eigen::Vector3d> proportion_;  // per buffer hex: buffer_proportions, as placed
@@ -272,6 +272,9 @@ void Conformer::find_interface() {
         *std::min_element(wedge_diced_.begin(), wedge_diced_.end());
   res_.local_yardstick = local_minima(tet_given_);
   aim_local_ = local_minima(tet_diced_);
+  // Aims at least the reported local yardstick: relaxing the tets lowers a few quads' minima.
+  for (std::size_t q = 0; q < aim_local_.size(); ++q)
+    aim_local_[q] = std::max(aim_local_[q], res_.local_yardstick[q]);
   res_.interface_quads = primal::index_cast(interface_.quads.size());
   say("interface: " + std::to_string(interface_.quads.size()) + " quads" + took());
 }
