@@ -1056,18 +1056,21 @@ constexpr double kGeodeFloor = 0.28;
 // Where defects remain after the passes, their neighbours are often what holds them: diced tets
 // above the yardstick (so no defect, and left alone by the passes) but poor, whose nodes a
 // defect's patch may not push further down. So the hexes within kNeighbourRings of the lowest
-// remaining defects (those within kDefectBand of their block's lowest, at most kNeighbourSeeds
-// of them a block, lowest first) are lifted as the global mode lifts every hex (towards
-// min(0.5, 3 x the yardstick), one patch each), and the passes run again there. Their floors are
-// measured after the first passes, so a hex may lose `loss` twice, as in the global mode, except
-// the diced hexes of hex parts, whose floors stay those from before all passes (measured
-// afresh, layer-mixed n = 5's hex layer gave up 0.65 -> 0.51 for 0.006 on the geode hexes).
-// Measured, the first passes only -> with this: the lowest geode hexes of the nugget at n = 5
-// 0.218 -> 0.227 (0.76 -> 0.79 x the local yardstick), hexdominant n = 5 0.167 -> 0.184 (0.79
+// remaining defects (per block at most kNeighbourSeeds within kDefectBand of its lowest, lowest
+// first, and as many lowest by their ratio to their aim: the one that sets the block's ratio to
+// its local yardstick may lie above that band) are lifted as the global mode lifts every hex
+// (towards min(0.5, 3 x the yardstick), one patch each), and the passes run again there. Their
+// floors are measured after the first passes, so a hex may lose `loss` twice, as in the global
+// mode, except the diced hexes of hex parts, whose floors stay those from before all passes
+// (measured afresh, layer-mixed n = 5's hex layer gave up 0.65 -> 0.51 for 0.006 on the geode
+// hexes). Measured, the first passes only -> with this: the lowest geode hexes of the nugget at
+// n = 5 0.218 -> 0.227 (0.76 -> 0.79 x the local yardstick), hexdominant n = 5 0.167 -> 0.184 (0.79
 // -> 0.94 x), the potting's pin_z and pin_x 0.128 / 0.105 -> 0.154 / 0.119, hexdominant n = 32
 // 0.116 -> 0.141 for 1.85 -> 1.93 s of smoothing. Around more defects, or again where the lowest
 // rose, cost that model 2.2 to 4 times the smoothing (the band then takes in the bulk of its
-// transition) for 0.145 at best.
+// transition) for 0.145 at best. The seeds by ratio: the fulcher at n = 5 and 6 0.755 -> 0.821
+// x the local yardstick (capped), the potting at n = 6 0.924 -> 0.952, hybrid-cylinder at n = 5
+// 0.907 -> 0.930, hexdominant n = 32's smoothing unchanged (1.7 s).
 constexpr int kNeighbourRings = 2;
 constexpr std::size_t kNeighbourSeeds = 32;
 
@@ -1084,18 +1087,25 @@ void Conformer::smooth_defects(primal::LocalSmoothOptions o, bool neighbourhood)
       auto [it, added] = lowest.try_emplace(mesh_.block[h], sj_[h]);
       if (!added) it->second = std::min(it->second, sj_[h]);
     }
-  std::map<int, std::vector<std::pair<double, Index>>> band;  // per block
-  for (std::size_t h = 0; h < sj_.size(); ++h)
-    if (sj_[h] < aim[h] && sj_[h] < lowest[mesh_.block[h]] + kDefectBand)
-      band[mesh_.block[h]].emplace_back(sj_[h], primal::index_cast(h));
+  // Per output block, the kNeighbourSeeds defects lowest by `key` among those `within` says.
   std::vector<Index> seeds;
-  for (auto& [block, hexes] : band) {
-    const std::size_t n = std::min(hexes.size(), kNeighbourSeeds);
-    std::partial_sort(hexes.begin(), hexes.begin() + static_cast<std::ptrdiff_t>(n), hexes.end());
-    for (std::size_t k = 0; k < n; ++k) seeds.push_back(hexes[k].second);
-  }
+  const auto take_lowest = [&](auto key, auto within) {
+    std::map<int, std::vector<std::pair<double, Index>>> defects;
+    for (std::size_t h = 0; h < sj_.size(); ++h)
+      if (sj_[h] < aim[h] && within(h))
+        defects[mesh_.block[h]].emplace_back(key(h), primal::index_cast(h));
+    for (auto& [block, hexes] : defects) {
+      const std::size_t n = std::min(hexes.size(), kNeighbourSeeds);
+      std::partial_sort(hexes.begin(), hexes.begin() + static_cast<std::ptrdiff_t>(n), hexes.end());
+      for (std::size_t k = 0; k < n; ++k) seeds.push_back(hexes[k].second);
+    }
+  };
+  take_lowest([&](std::size_t h) { return sj_[h]; },
+              [&](std::size_t h) { return sj_[h] < lowest[mesh_.block[h]] + kDefectBand; });
+  take_lowest([&](std::size_t h) { return sj_[h] / aim[h]; }, [](std::size_t) { return true; });
   if (seeds.empty()) return;
   std::sort(seeds.begin(), seeds.end());
+  seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
   for (int ring = 0; ring < kNeighbourRings; ++ring) seeds = primal::hexes_around(mesh_, seeds);
   // The floors from now on, but the hex parts' own: `start` updated in place (a second one would
   // be 16 B per output hex more at the peak).
