@@ -274,7 +274,7 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
        "blocks slide only in their plane or along their straight edge, and are fixed on curved\n"
        "surfaces and at corners, so every block keeps its volume; local (default): near the\n"
        "geode hexes (see --smooth-target); global: every hex below min(0.5, 3 x the input diced\n"
-       "alone), then local's passes where a hex is still below its aim; none: only hexes the\n"
+       "alone), then what local runs where a hex is still below its aim; none: only hexes the\n"
        "placement inverted are untangled (the report counts them)")
       ->check(CLI::IsMember({"local", "global", "none"}))
       ->capture_default_str();
