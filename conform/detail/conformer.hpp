@@ -1,0 +1,195 @@
+#pragma once
+// conform()'s private class, not part of the API: a long algorithm as one public function
+// (conform.hpp) whose stages are the methods of Conformer, defined by topic in conform.cpp (the
+// interface, the buffer layer, dicing, template placement, assembly), conform_smoothing.cpp
+// (settling, untangling, smoothing) and conform_output.cpp (verification, the report, the
+// output).
+#include <Eigen/Core>
+#include <array>
+#include <chrono>
+#include <map>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <geode/conform/buffer_layer.hpp>
+#include <geode/conform/conform.hpp>
+#include <geode/conform/reference_template.hpp>
+#include <geode/primal/dice_model.hpp>
+#include <geode/primal/disjoint_sets.hpp>
+#include <geode/primal/interface.hpp>
+#include <geode/primal/local_smooth.hpp>
+#include <geode/primal/mesh.hpp>
+#include <geode/primal/model.hpp>
+#include <geode/primal/topology.hpp>
+
+namespace geode::conform::detail {
+
+using primal::FaceKey;
+using primal::Index;
+using primal::kInvalidIndex;
+using primal::kNoOrigin;
+using primal::Point;
+namespace topo = primal::topology;
+
+using Clock = std::chrono::steady_clock;
+inline double since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// What smoothing aims a geode hex at, and the report measures it against: this x its local
+// yardstick, capped (Conformer::aims, Conformer::ceilings).
+inline constexpr double kLocalAim = 0.9;
+
+// The output's block ids and names: the input's, plus the geode block when it has a name.
+struct OutputBlocks {
+  int geode_id = 0;  // 0: geode hexes join the block of the element they were carved from
+  std::map<int, std::string> names;
+};
+
+// The map of the reference cell into a buffer hex: bilinear on the bottom (the hex side's
+// quad), piecewise linear over the two triangles of the top (so the tet side's diced nodes,
+// edge midpoints and triangle centroids, are images of the template's), linear in t between
+// them. The trilinear map would instead follow a twisted top's bilinear surface, whose
+// diagonal midpoint passes the template nodes under it; this one keeps every template hex
+// positive wherever the buffer hex is valid. With `centre`, the top is four_triangle_top.
+Point buffer_map(const std::array<Point, 8>& P, const std::array<int, 2>& diagonal,
+                 const Point& rst, const Point* centre = nullptr);
+
+// conform()'s stages, in the order run() calls them; each reads what the previous ones left.
+class Conformer {
+ public:
+  // `given`: the input's points as the caller gave them, when conform moved some before
+  // (ConformRelax): the yardsticks reported are the input's own cells; what smoothing aims at
+  // follows the cells as they are diced.
+  // `disposable`: the input itself when conform may change it (its own copy, with relaxed tets
+  // or split pyramids, or the caller's given up), which run() trims to its blocks, and `given`
+  // frees, once the buffer layer holds the model.
+  Conformer(const primal::Model& input, const ConformOptions& options,
+            std::vector<primal::Point>* given = nullptr, primal::Model* disposable = nullptr)
+      : input_(input),
+        options_(options),
+        given_(given ? *given : input.points),
+        given_copy_(given),
+        disposable_(disposable) {}
+
+  // The wedges run() found joining the two sides of the interface, where it stopped.
+  const std::vector<Index>& joining() const { return joining_; }
+
+  ConformResult run() {
+    const auto t_start = Clock::now();
+    find_interface();
+    if (!joining_.empty()) return {};  // conform() splits their wedge pieces and starts again
+    insert_buffer();
+    trim_input();
+    build_references();
+    dice_and_merge();
+    place_templates();
+    match_sides();
+    assemble();
+    settle_templates();
+    smooth();
+    invert_for_test();
+    verify_and_output();
+    res_.seconds = since(t_start);
+    return std::move(res_);
+  }
+
+ private:
+  void say(const std::string& line) const {
+    if (options_.progress) options_.progress(line);
+  }
+  std::string took() const { return " (" + std::to_string(since(t0_)) + " s)"; }
+  const RefTemplate& ref(std::size_t b) const {
+    if (layer_.hexes[b].centre != kInvalidIndex) return *refs_[2];
+    return layer_.hexes[b].diagonal[0] == 5 ? *refs_[1] : *refs_[0];
+  }
+
+  void find_interface();
+  void measure_near_interface();
+  std::vector<double> local_minima(const std::vector<double>& tet) const;
+  void insert_buffer();
+  void thicker_from_tets();
+  void measure_changed();
+  void trim_input();
+  void build_references();
+  void dice_and_merge();
+  void place_templates();
+  void match_sides();
+  void assemble();
+  void diced_alone_from_children(std::size_t tet_first);
+  void settle_templates();
+  std::vector<std::pair<Index, Point>> settled(std::size_t b) const;
+  void untangle();
+  void add_smoothing(const primal::LocalSmoothResult& r);
+  void smooth();
+  void smooth_defects(primal::LocalSmoothOptions o);
+  // aim: aims(); within: the hexes whose defects count (ascending; empty: all); start: the
+  // floors, measured now if empty and a defect is found.
+  void smooth_defect_passes(primal::LocalSmoothOptions o, const std::vector<double>& aim,
+                            primal::SmoothStart& start, std::span<const Index> within);
+  std::vector<double> aims() const;
+  double measure();                            // every hex, then scan()
+  void measure(std::span<const Index> hexes);  // these only, the others unchanged since
+  double scan();                               // inverted_ and the minimum from sj_
+  void check_dicing();
+  bool verify_locally() const;
+  void invert_for_test();
+  void check(std::span<const Point> points, std::span<const std::array<Index, 8>> hexes);
+  void ceilings(const std::vector<int>& block);
+  void report(const std::vector<int>& block);
+  void announce(double seconds) const;
+  void output();
+  void verify_and_output();
+
+  const primal::Model& input_;
+  const ConformOptions& options_;
+  const std::vector<primal::Point>& given_;
+  std::vector<primal::Point>* given_copy_;
+  primal::Model* disposable_;
+  ConformResult res_;
+  Clock::time_point t0_;
+  primal::Interface interface_;
+  std::vector<Index> joining_;  // wedges joining the two sides of the interface (none: go on)
+  BufferLayer layer_;
+  primal::DicedModel diced_;
+  std::array<const RefTemplate*, 3> refs_{};  // diagonal {4, 6}, {5, 7}, four triangles
+  // Per buffer hex and template node: its global node, or (side-face nodes, until
+  // match_sides) a disjoint-sets item at side_pos_.
+  std::vector<std::vector<Index>> inst_global_, inst_side_;
+  primal::DisjointSets side_sets_uf_;
+  std::vector<Point> side_pos_;
+  primal::HexMesh mesh_;
+  std::vector<primal::NodeSet> node_sets_;
+  std::vector<primal::SideSet> side_sets_;
+  // Every output hex's scaled Jacobian (kept current by assemble, settling and smoothing) and
+  // the hexes at or below 0 as of the last scan(); verification reads them.
+  std::vector<double> sj_;
+  std::vector<Index> inverted_;
+  OutputBlocks blocks_;
+  // Per buffer hex: the input element it was carved from (the hex under it or the tet above it,
+  // by BufferLayerOptions::side), whose block its geode hexes join by default: they fill space
+  // that part had.
+  std::vector<primal::ElementRef> carved_from_;
+  std::vector<double> hex_diced_, tet_diced_, wedge_diced_;  // per input cell: diced alone
+  std::vector<double> tet_given_;  // per input tet: diced alone where the caller gave it
+  // Per input hex and tet: 0, its figures are measured; kLater, read off its children; a tet
+  // kLaterGiven, its figure as diced read off its children, as given measured apart (relaxed).
+  // See measure_near_interface.
+  static constexpr char kLater = 1, kLaterGiven = 2;
+  std::vector<char> hex_later_, tet_later_;
+  // What aims() reads: the yardstick, and per interface quad the higher of its local yardsticks
+  // with the tets as diced (relaxed) and as given (reported).
+  double aim_yardstick_ = 0.0;
+  std::vector<double> aim_local_;
+  std::vector<Eigen::Vector3d> proportion_;  // per buffer hex: buffer_proportions, as placed
+  std::vector<Index> diced_parent_;          // per output diced hex (the first ones): its input hex
+  std::vector<Index> geode_first_;  // per buffer hex: its first output hex (then one past the last)
+  // The hexes whose nodes smoothing or untangling could move (their regions), for check().
+  std::vector<Index> moved_;
+  double dicing_check_seconds_ = 0.0;  // check_dicing, run while the dicing data exist
+  std::vector<char> positive_;         // per output hex: its scaled Jacobian was above 0 (check())
+};
+
+}  // namespace geode::conform::detail
