@@ -172,8 +172,8 @@ void Conformer::smooth() {
     // With the neighbourhood lift, as the local mode: the passes' floors hold the neighbours of
     // the defects they leave here too. Over the 17 demos at n = 3, 5, 6, against the passes
     // alone: the whole output's minimum up in 8 runs, down in none, block minima up in 29 of
-    // the 132 and down in 5, runs below 0.9 x the capped local yardstick 2 -> 0, the
-    // smoothing's CPU 26.1 -> 32.3 s.
+    // the 132 and down in 6, runs below 0.9 x the capped local yardstick 2 -> 0, the
+    // smoothing's CPU 26.1 -> 32.9 s.
     smooth_defects(d);
   }
   res_.smoothing.final_min_scaled_jacobian = scan();
@@ -233,22 +233,26 @@ constexpr double kGeodeFloor = 0.28;
 // above the yardstick (so no defect, and left alone by the passes) but poor, whose nodes a
 // defect's patch may not push further down. So the hexes within kNeighbourRings of the lowest
 // remaining defects (per block at most kNeighbourSeeds within kDefectBand of its lowest, lowest
-// first, and as many lowest by their ratio to their aim: the one that sets the block's ratio to
-// its local yardstick may lie above that band) are lifted as the global mode lifts every hex
-// (towards min(0.5, 3 x the yardstick), one patch each), and the passes run again there. Their
-// floors are measured after the first passes, so a hex may lose `loss` twice, as in the global
-// mode, except the diced hexes of hex parts, whose floors stay those from before all passes
-// (measured afresh, layer-mixed n = 5's hex layer gave up 0.65 -> 0.51 for 0.006 on the geode
-// hexes). Measured, the first passes only -> with this: the lowest geode hexes of the nugget at
-// n = 5 0.218 -> 0.227 (0.76 -> 0.79 x the local yardstick), hexdominant n = 5 0.167 -> 0.184 (0.79
-// -> 0.94 x), the potting's pin_z and pin_x 0.128 / 0.105 -> 0.154 / 0.119, hexdominant n = 32
-// 0.116 -> 0.141 for 1.85 -> 1.93 s of smoothing. Around more defects, or again where the lowest
-// rose, cost that model 2.2 to 4 times the smoothing (the band then takes in the bulk of its
-// transition) for 0.145 at best. The seeds by ratio: the fulcher at n = 5 and 6 0.755 -> 0.821
-// x the local yardstick (capped), the potting at n = 6 0.924 -> 0.952, hybrid-cylinder at n = 5
-// 0.907 -> 0.930, hexdominant n = 32's smoothing unchanged (1.7 s).
+// first, and its kRatioSeeds lowest against what the report measures them by: the one that sets
+// the block's ratio to its local yardstick may lie above that band) are lifted as the global mode
+// lifts every hex (towards min(0.5, 3 x the yardstick), one patch each), and the passes run again
+// there. Their floors are measured after the first passes, so a hex may lose `loss` twice, as in
+// the global mode, except the diced hexes of hex parts, whose floors stay those from before all
+// passes (measured afresh, layer-mixed n = 5's hex layer gave up 0.65 -> 0.51 for 0.006 on the
+// geode hexes). Measured, the first passes only -> with this: the lowest geode hexes of the nugget
+// at n = 5 0.218 -> 0.227 (0.76 -> 0.79 x the local yardstick), hexdominant n = 5 0.167 -> 0.184
+// (0.79 -> 0.94 x), the potting's pin_z and pin_x 0.128 / 0.105 -> 0.154 / 0.119, hexdominant
+// n = 32 0.116 -> 0.141 for 1.85 -> 1.93 s of smoothing. Around more defects, or again where the
+// lowest rose, cost that model 2.2 to 4 times the smoothing (the band then takes in the bulk of
+// its transition) for 0.145 at best. The seeds by ratio: the fulcher at n = 5 and 6 0.690 -> 0.821
+// x the local yardstick (capped 0.755 -> 0.821), the potting's 90-degree convex edges at n = 3
+// 0.214 -> 0.242, hexdominant n = 32 0.558 -> 0.578 (capped 0.761 both) for 1.37 -> 1.49 s of
+// smoothing (30,074 -> 32,508 patches); 32 of them instead of 8 gave the fulcher 0.903 capped
+// but hexdominant n = 32 2.1 s, and the 32 lowest by their ratio to the aim (0.28 for most geode
+// hexes, so nearly their scaled Jacobian) 0.821 capped for 1.70 s.
 constexpr int kNeighbourRings = 2;
 constexpr std::size_t kNeighbourSeeds = 32;
+constexpr std::size_t kRatioSeeds = 8;
 
 // Keeps sj_ up to date. A pass changes only the hexes sharing a node with its seeds (its
 // region): the defects outside it are left as they were.
@@ -263,22 +267,37 @@ void Conformer::smooth_defects(primal::LocalSmoothOptions o) {
       auto [it, added] = lowest.try_emplace(mesh_.block[h], sj_[h]);
       if (!added) it->second = std::min(it->second, sj_[h]);
     }
-  // Per output block, the kNeighbourSeeds defects lowest by `key` among those `within` says.
+  // Per output block, the `count` defects lowest by `key` among those `within` says.
   std::vector<Index> seeds;
-  const auto take_lowest = [&](auto key, auto within) {
+  const auto take_lowest = [&](std::size_t count, auto key, auto within) {
     std::map<int, std::vector<std::pair<double, Index>>> defects;
     for (std::size_t h = 0; h < sj_.size(); ++h)
       if (sj_[h] < aim[h] && within(h))
         defects[mesh_.block[h]].emplace_back(key(h), primal::index_cast(h));
     for (auto& [block, hexes] : defects) {
-      const std::size_t n = std::min(hexes.size(), kNeighbourSeeds);
+      const std::size_t n = std::min(hexes.size(), count);
       std::partial_sort(hexes.begin(), hexes.begin() + static_cast<std::ptrdiff_t>(n), hexes.end());
       for (std::size_t k = 0; k < n; ++k) seeds.push_back(hexes[k].second);
     }
   };
-  take_lowest([&](std::size_t h) { return sj_[h]; },
-              [&](std::size_t h) { return sj_[h] < lowest[mesh_.block[h]] + kDefectBand; });
-  take_lowest([&](std::size_t h) { return sj_[h] / aim[h]; }, [](std::size_t) { return true; });
+  take_lowest(
+      kNeighbourSeeds, [&](std::size_t h) { return sj_[h]; },
+      [&](std::size_t h) { return sj_[h] < lowest[mesh_.block[h]] + kDefectBand; });
+  // What the report divides a geode hex by: its local yardstick capped by the template's own
+  // minimum (any other hex: its aim).
+  const auto reported = [&](std::size_t h) {
+    const auto i = primal::index_cast(h);
+    if (geode_first_.size() < 2 || i < geode_first_.front() || i >= geode_first_.back())
+      return aim[h];
+    const auto b =
+        std::upper_bound(geode_first_.begin(), geode_first_.end(), i) - geode_first_.begin() - 1;
+    const auto quad = layer_.hexes[primal::index_cast<std::size_t>(b)].quad;
+    return std::min(res_.local_yardstick[primal::index_cast<std::size_t>(quad)],
+                    res_.template_min_scaled_jacobian);
+  };
+  take_lowest(
+      kRatioSeeds, [&](std::size_t h) { return sj_[h] / reported(h); },
+      [](std::size_t) { return true; });
   if (seeds.empty()) return;
   std::sort(seeds.begin(), seeds.end());
   seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
