@@ -71,7 +71,7 @@ struct DistributedReport {
   conform::ConformResult zone;  // on the zone rank: the zone's conform (its model moved out)
   int rings = 0;                // the depth that passed the check
   std::int64_t zone_cells = 0, cells = 0, zone_hexes = 0, diced_hexes = 0;  // this rank's diced
-  bool valid = true;  // the zone and every rank's piece valid (distributed_conform.cpp)
+  bool valid = true;  // the zone and every rank's piece valid (distributed_assembly.cpp)
   std::vector<std::string> warnings;
   std::map<std::string, double> seconds;  // per stage, this rank
 };
