@@ -263,13 +263,7 @@ void Distributor::assemble() {
   // Every rank must list the same blocks: the union over ranks.
   std::sort(ids.begin(), ids.end());
   ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-  int n = primal::index_cast<int>(ids.size());
-  std::vector<int> counts(primal::index_cast<std::size_t>(size_)), displs(counts.size());
-  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
-  std::exclusive_scan(counts.begin(), counts.end(), displs.begin(), 0);
-  std::vector<int> every(primal::index_cast<std::size_t>(displs.back() + counts.back()));
-  MPI_Allgatherv(ids.data(), n, MPI_INT, every.data(), counts.data(), displs.data(), MPI_INT,
-                 comm_);
+  std::vector<int> every = gather_all(ids, comm_, size_);
   std::sort(every.begin(), every.end());
   every.erase(std::unique(every.begin(), every.end()), every.end());
   std::vector<std::int64_t> local_counts, global_counts(every.size());

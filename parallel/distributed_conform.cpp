@@ -47,13 +47,7 @@ void Distributor::yardstick() {
   MPI_Allreduce(low, all, 3, MPI_DOUBLE_INT, MPI_MINLOC, comm_);
   for (const auto& a : all)
     if (a.value <= 1.5) lowest_.push_back(primal::index_cast<std::size_t>(a.cell));
-  int n = primal::index_cast<int>(inverted.size());
-  std::vector<int> counts(primal::index_cast<std::size_t>(size_)), displs(counts.size());
-  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
-  std::exclusive_scan(counts.begin(), counts.end(), displs.begin(), 0);
-  std::vector<int> every(primal::index_cast<std::size_t>(displs.back() + counts.back()));
-  MPI_Allgatherv(inverted.data(), n, MPI_INT, every.data(), counts.data(), displs.data(), MPI_INT,
-                 comm_);
+  const std::vector<int> every = gather_all(inverted, comm_, size_);
   inverted_.assign(every.begin(), every.end());
   std::sort(inverted_.begin(), inverted_.end());
 }

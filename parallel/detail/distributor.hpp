@@ -17,6 +17,9 @@
 #include <unordered_map>
 #include <unordered_set>
 #include <utility>
+#include <vector>
+
+#include <mpi.h>
 
 #include <geode/parallel/distributed_conform.hpp>
 #include <geode/parallel/partition.hpp>
@@ -58,6 +61,18 @@ inline PointBits bits(const Point& p) {
   PointBits r;
   for (int i = 0; i < 3; ++i) std::memcpy(&r.b[primal::index_cast<std::size_t>(i)], &p[i], 8);
   return r;
+}
+
+// Every rank's `mine`, concatenated in rank order (MPI_Allgatherv of ints).
+inline std::vector<int> gather_all(const std::vector<int>& mine, MPI_Comm comm, int ranks) {
+  const int n = primal::index_cast<int>(mine.size());
+  std::vector<int> counts(primal::index_cast<std::size_t>(ranks)), displs(counts.size());
+  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
+  std::exclusive_scan(counts.begin(), counts.end(), displs.begin(), 0);
+  std::vector<int> every(primal::index_cast<std::size_t>(displs.back() + counts.back()));
+  MPI_Allgatherv(mine.data(), n, MPI_INT, every.data(), counts.data(), displs.data(), MPI_INT,
+                 comm);
+  return every;
 }
 
 // (node, holders) entries sorted by node, each node once with its holders joined.
