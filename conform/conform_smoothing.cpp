@@ -59,12 +59,9 @@ std::vector<std::pair<Index, Point>> Conformer::settled(std::size_t b) const {
 void Conformer::settle_templates() {
   t0_ = Clock::now();
   std::vector<std::size_t> buffer_hexes;  // those with an inverted geode hex, ascending
-  for (Index h : inverted_) {
-    if (h < geode_first_.front() || h >= geode_first_.back()) continue;
-    const auto b = primal::index_cast<std::size_t>(
-        std::upper_bound(geode_first_.begin(), geode_first_.end(), h) - geode_first_.begin() - 1);
-    if (buffer_hexes.empty() || buffer_hexes.back() != b) buffer_hexes.push_back(b);
-  }
+  for (Index h : inverted_)
+    if (const std::size_t b = buffer_hex_of(h); b != kNone)
+      if (buffer_hexes.empty() || buffer_hexes.back() != b) buffer_hexes.push_back(b);
   if (buffer_hexes.empty()) {
     res_.placement_inverted = primal::index_cast(inverted_.size());
     return;
@@ -261,20 +258,21 @@ void Conformer::smooth_defects(primal::LocalSmoothOptions o) {
   primal::SmoothStart start;               // measured by the passes if they find a defect
   smooth_defect_passes(o, aim, start, {});
   if (start.scaled_jacobian.empty()) return;
-  std::map<int, double> lowest;  // per output block, its lowest defect
+  std::vector<std::size_t> defects;  // what the passes left below its aim
+  std::map<int, double> lowest;      // per output block, its lowest defect
   for (std::size_t h = 0; h < sj_.size(); ++h)
     if (sj_[h] < aim[h]) {
+      defects.push_back(h);
       auto [it, added] = lowest.try_emplace(mesh_.block[h], sj_[h]);
       if (!added) it->second = std::min(it->second, sj_[h]);
     }
   // Per output block, the `count` defects lowest by `key` among those `within` says.
   std::vector<Index> seeds;
   const auto take_lowest = [&](std::size_t count, auto key, auto within) {
-    std::map<int, std::vector<std::pair<double, Index>>> defects;
-    for (std::size_t h = 0; h < sj_.size(); ++h)
-      if (sj_[h] < aim[h] && within(h))
-        defects[mesh_.block[h]].emplace_back(key(h), primal::index_cast(h));
-    for (auto& [block, hexes] : defects) {
+    std::map<int, std::vector<std::pair<double, Index>>> by_block;
+    for (std::size_t h : defects)
+      if (within(h)) by_block[mesh_.block[h]].emplace_back(key(h), primal::index_cast(h));
+    for (auto& [block, hexes] : by_block) {
       const std::size_t n = std::min(hexes.size(), count);
       std::partial_sort(hexes.begin(), hexes.begin() + static_cast<std::ptrdiff_t>(n), hexes.end());
       for (std::size_t k = 0; k < n; ++k) seeds.push_back(hexes[k].second);
@@ -286,13 +284,9 @@ void Conformer::smooth_defects(primal::LocalSmoothOptions o) {
   // What the report divides a geode hex by: its local yardstick capped by the template's own
   // minimum (any other hex: its aim).
   const auto reported = [&](std::size_t h) {
-    const auto i = primal::index_cast(h);
-    if (geode_first_.size() < 2 || i < geode_first_.front() || i >= geode_first_.back())
-      return aim[h];
-    const auto b =
-        std::upper_bound(geode_first_.begin(), geode_first_.end(), i) - geode_first_.begin() - 1;
-    const auto quad = layer_.hexes[primal::index_cast<std::size_t>(b)].quad;
-    return std::min(res_.local_yardstick[primal::index_cast<std::size_t>(quad)],
+    const std::size_t b = buffer_hex_of(primal::index_cast(h));
+    if (b == kNone) return aim[h];
+    return std::min(res_.local_yardstick[primal::index_cast<std::size_t>(layer_.hexes[b].quad)],
                     res_.template_min_scaled_jacobian);
   };
   take_lowest(

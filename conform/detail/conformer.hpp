@@ -5,6 +5,7 @@
 // (settling, untangling, smoothing) and conform_output.cpp (verification, the report, the
 // output).
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <map>
@@ -101,6 +102,14 @@ class Conformer {
     if (options_.progress) options_.progress(line);
   }
   std::string took() const { return " (" + std::to_string(since(t0_)) + " s)"; }
+  // The buffer hex whose template output hex `h` is, or kNone when `h` is not a geode hex.
+  static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+  std::size_t buffer_hex_of(Index h) const {
+    if (geode_first_.size() < 2 || h < geode_first_.front() || h >= geode_first_.back())
+      return kNone;
+    return primal::index_cast<std::size_t>(
+        std::upper_bound(geode_first_.begin(), geode_first_.end(), h) - geode_first_.begin() - 1);
+  }
   const RefTemplate& ref(std::size_t b) const {
     if (layer_.hexes[b].centre != kInvalidIndex) return *refs_[2];
     return layer_.hexes[b].diagonal[0] == 5 ? *refs_[1] : *refs_[0];
