@@ -56,9 +56,6 @@ void gmsh_call(const std::string& where, F&& f) {
   }
 }
 
-}  // namespace
-
-namespace {
 // Every option a session here sets (demo/, tests/, bench/), or that Gmsh sets as a side effect
 // of what they call (partitioning sets Mesh.NbPartitions), with Gmsh's default, read once.
 constexpr const char* kSessionOptions[] = {"General.NumThreads",
