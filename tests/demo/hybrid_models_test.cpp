@@ -28,6 +28,7 @@
 #include "support/ball_checks.hpp"
 #include "support/cli_run.hpp"
 #include "support/demo_input.hpp"
+#include "support/model_checks.hpp"
 #include "support/temp_dir.hpp"
 
 using namespace geode;
@@ -235,12 +236,5 @@ TEST_CASE("a hybrid demo built again in the same process, after others: the same
   CHECK_FALSE(other.pyramids.empty());
   (void)demo::demo_model("delaunay", 3);  // another mesh size and algorithm
   const primal::Model again = demo::demo_model("hybrid", 3);
-  CHECK(again.points == first.points);
-  CHECK(again.hexes == first.hexes);
-  CHECK(again.tets == first.tets);
-  CHECK(again.pyramids == first.pyramids);
-  CHECK(again.wedges == first.wedges);
-  CHECK(again.hex_block == first.hex_block);
-  CHECK(again.tet_block == first.tet_block);
-  CHECK(again.block_names == first.block_names);
+  test::check_same_cells(again, first);
 }

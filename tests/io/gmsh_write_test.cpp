@@ -20,6 +20,7 @@
 #include <geode/io/vtk.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/grid_model.hpp>
+#include "support/model_checks.hpp"
 #include "support/temp_dir.hpp"
 
 namespace fs = std::filesystem;
@@ -246,12 +247,7 @@ TEST_CASE(
     const fs::path file = dir.path / (std::string(v.name) + ".msh");
     write_gmsh(m, file, v.format, v.version);
     const Model r = read_gmsh(file);
-    CHECK(r.points == m.points);
-    CHECK(r.pyramids == m.pyramids);
-    CHECK(r.wedges == m.wedges);
-    CHECK(r.pyramid_block == m.pyramid_block);
-    CHECK(r.wedge_block == m.wedge_block);
-    CHECK(r.block_names == m.block_names);
+    test::check_same_cells(r, m);
     REQUIRE(r.side_sets.size() == 1);
     CHECK(r.side_sets[0].sides == m.side_sets[0].sides);
     const auto groups = gmsh_groups(file);
