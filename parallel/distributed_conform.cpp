@@ -135,10 +135,14 @@ void Distributor::conform_zone() {
       // The band diced alone must be found in the zone's output, node for node (its points, all
       // distinct, looked for among the zone's).
       const primal::Submodel b = primal::extract_submodel(m(), band_);
-      std::unordered_set<PointBits, PointBitsHash> band;
-      for (const Point& p : primal::dice_model(b.model).points) band.insert(bits(p));
-      for (const Point& p : r.model.points) band.erase(bits(p));
-      if (band.empty()) {
+      const std::vector<Point> diced = primal::dice_model(b.model).points;
+      PointBitsMap band(diced.size());
+      for (std::size_t i = 0; i < diced.size(); ++i) band.emplace(bits(diced[i]), i);
+      std::vector<char> found(diced.size(), 0);
+      std::size_t missing = band.size();
+      for (const Point& p : r.model.points)
+        if (const std::size_t* i = band.find(bits(p)); i && !found[*i]) found[*i] = 1, --missing;
+      if (missing == 0) {
         zone_out_ = std::move(r.model);
         zone_first_ = 0, zone_last_ = zone_out_.hexes.size();
         rep_.zone = std::move(r);

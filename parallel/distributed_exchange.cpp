@@ -212,18 +212,20 @@ void Distributor::number() {
   // A diced node made from zone nodes alone takes the zone's node at its position: those few
   // (the cut's) by position, the zone's points looked up among them.
   {
-    std::unordered_map<PointBits, std::size_t, PointBitsHash> on_zone;
+    std::vector<std::size_t> zone_made;
     for (std::size_t i = 0; i < nd; ++i) {
       const FaceKey& o = diced_.origin[i];
       bool in_zone = o[0] != kInvalidIndex;  // not a cell centre
       for (std::size_t k = 0; k < 4 && o[k] != kInvalidIndex && in_zone; ++k)
         in_zone = zone_node_[primal::index_cast<std::size_t>(
             own_.node[primal::index_cast<std::size_t>(o[k])])];
-      if (in_zone) on_zone.emplace(bits(diced_.points[i]), i);
+      if (in_zone) zone_made.push_back(i);
     }
-    for (std::size_t z = 0; z < zone_out_.points.size() && !on_zone.empty(); ++z)
-      if (const auto it = on_zone.find(bits(zone_out_.points[z])); it != on_zone.end())
-        diced_gid_[it->second] = primal::index_cast<std::int64_t>(z);
+    PointBitsMap on_zone(zone_made.size());
+    for (std::size_t i : zone_made) on_zone.emplace(bits(diced_.points[i]), i);
+    for (std::size_t z = 0; z < zone_out_.points.size() && on_zone.size() > 0; ++z)
+      if (const std::size_t* i = on_zone.find(bits(zone_out_.points[z])))
+        diced_gid_[*i] = primal::index_cast<std::int64_t>(z);
   }
   // The zone's points: the zone rank's and those holding zone hexes need them for assembly.
   if (zone_last_ == zone_first_) primal::release(zone_out_.points);
