@@ -1,6 +1,6 @@
 #pragma once
-// VTK cell types as the .vtu / .vtk writers and readers (vtk.cpp, vtk_read.cpp) name
-// and size them. Internal to primal's VTK I/O.
+// VTK cell types as the .vtu / .vtk writers and readers (vtk.cpp, vtu_read.cpp, vtk_read.cpp) name
+// and size them. Internal to io's VTK I/O.
 #include <geode/io/vtk.hpp>
 
 namespace geode::io::vtk_cells {
