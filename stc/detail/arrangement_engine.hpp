@@ -1,9 +1,9 @@
 #pragma once
 // compute_arrangement's private engine, not part of the API: the Engine class, its geometry
 // helpers and the curve events. Its methods are defined by topic in arrangement.cpp (run(): the
-// curves, vertices and cells found and checked; vertex registration), arrangement_curves.cpp
-// (the sampling grid, seeds, curve walking and tracing, events along a curve) and
-// arrangement_checks.cpp (sheets touching, the pyramid's apex, degenerate vertices).
+// curves, vertices and cells found and checked; a vertex registered and its sheets' crossing
+// checked), arrangement_curves.cpp (the sampling grid, seeds, curve walking and tracing,
+// events along a curve) and arrangement_checks.cpp (sheets touching, the pyramid's apex).
 #include <Eigen/Dense>
 #include <algorithm>
 #include <array>
