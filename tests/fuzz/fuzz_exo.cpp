@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 
@@ -17,12 +18,19 @@
 #include <geode/primal/errors.hpp>
 
 namespace {
+void remove_scratch();
 const std::string& scratch() {
   static const std::string path = (std::filesystem::temp_directory_path() /
                                    ("geode-fuzz-exo-" + std::to_string(::getpid()) + ".exo"))
                                       .string();
+  // Removed when the run ends (libFuzzer exits through exit() after -runs or -max_total_time):
+  // every run left its file in the temporary directory before. Registered after `path` is
+  // made, so that it runs before `path` is destroyed.
+  static const bool removed_at_exit = std::atexit(remove_scratch) == 0;
+  (void)removed_at_exit;
   return path;
 }
+void remove_scratch() { std::remove(scratch().c_str()); }
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
