@@ -14,7 +14,6 @@
 #include <utility>
 
 #include <geode/demo/detail/model_building.hpp>
-#include <geode/demo/gmsh_session.hpp>
 #include <geode/io/gmsh.hpp>
 #include <geode/primal/boundary.hpp>
 #include <geode/primal/errors.hpp>
@@ -34,8 +33,7 @@ namespace {
 // merged), positively oriented.
 template <class F>
 Model with_gmsh(const std::string& name, F&& build) {
-  GmshSession session;
-  try {
+  return run_gmsh(name, [&] {
     gmsh::model::add(name);
     build();
     gmsh::model::mesh::generate(3);
@@ -44,9 +42,7 @@ Model with_gmsh(const std::string& name, F&& build) {
     merge_coincident_nodes(m, 1e-9);
     orient_positively(m);
     return m;
-  } catch (const std::string& s) {
-    throw std::runtime_error(name + ": Gmsh failed: " + s);
-  }
+  });
 }
 
 // Transfinite curves with cells of size h (by the curve's bounding box length).

@@ -42,8 +42,7 @@ gmsh::vectorpair wedge_layer_on_top(int volume, double thickness) {
 // back inverted re-oriented (orient_positively, with pyramids and wedges).
 template <class F>
 Model hybrid_gmsh(const std::string& name, F&& build) {
-  GmshSession session;
-  try {
+  return run_gmsh(name, [&] {
     gmsh::model::add(name);
     build();
     gmsh::model::mesh::generate(3);
@@ -56,9 +55,7 @@ Model hybrid_gmsh(const std::string& name, F&& build) {
       if (tet_volume(pt(w[0]), pt(w[1]), pt(w[2]), pt(w[3])) < 0)
         std::swap(w[1], w[2]), std::swap(w[4], w[5]);
     return m;
-  } catch (const std::string& s) {
-    throw std::runtime_error(name + ": Gmsh failed: " + s);
-  }
+  });
 }
 
 void name_volume(int volume, int block, const std::string& name) {
