@@ -164,7 +164,9 @@ TEST_CASE("geode template: the result depends on the box's proportions, not its 
   const std::vector<std::array<std::string, 2>> pairs = {{"24x24x24", "1e6x1e6x1e6"},
                                                          {"24x0.14x24", "240000x1400x240000"},
                                                          {"24x14x24", "2.4e-5x1.4e-5x2.4e-5"}};
-  for (const auto& [small, large] : pairs) {
+  for (const auto& [small, large_] : pairs) {
+    // Named again: clang 14 cannot capture a structured binding (CAPTURE's lambda).
+    const auto& large = large_;
     CAPTURE(large);
     const Run a = geode_cli("template geode3d --format json --box " + small);
     const Run b = geode_cli("template geode3d --format json --box " + large);

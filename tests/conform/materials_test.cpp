@@ -32,7 +32,9 @@ TEST_CASE("materials never move: every smoothing mode keeps each block's volume 
     const conform::ConformResult base = conform::conform(input, none);
     test::check_conform_result(base);
     const auto reference = test::hex_block_volumes(base.model);
-    for (const auto& [id, volume] : test::tet_block_volumes(input)) {
+    for (const auto& [id_, volume] : test::tet_block_volumes(input)) {
+      // Named again: clang 14 cannot capture a structured binding (CAPTURE's lambda).
+      const auto& id = id_;
       CAPTURE(id);
       REQUIRE(reference.count(id));
       CHECK(std::abs(reference.at(id) - volume) <= 1e-9 * volume);
@@ -61,7 +63,9 @@ TEST_CASE("materials never move: every smoothing mode keeps each block's volume 
       REQUIRE(r.model.points.size() == base.model.points.size());
       const auto volumes = test::hex_block_volumes(r.model);
       REQUIRE(volumes.size() == reference.size());
-      for (const auto& [id, volume] : reference) {
+      for (const auto& [id_, volume] : reference) {
+        // Named again: clang 14 cannot capture a structured binding (CAPTURE's lambda).
+        const auto& id = id_;
         CAPTURE(id);
         CHECK(std::abs(volumes.at(id) - volume) <= 1e-9 * volume);
       }

@@ -59,7 +59,9 @@ TEST_CASE("realistic models, --smooth none: valid; the placement inverts nothing
   } models[] = {{"delaunay", 9, 3, 0}, {"delaunay-random", 9, 3, 0}, {"lshape", 18, 3, 0},
                 {"nugget", 96, 3, 0},  {"cylinder", 146, 3, 0},      {"fulcher", 143, 4, 0},
                 {"fulcher", 73, 2, 3}};
-  for (const auto& [name, quads, n, settled] : models) {
+  for (const auto& [name_, quads, n, settled] : models) {
+    // Named again: clang 14 cannot capture a structured binding (CAPTURE's lambda).
+    const auto& name = name_;
     CAPTURE(name);
     const primal::Model m = demo::demo_model(name, n);
     REQUIRE(!m.tets.empty());
@@ -91,7 +93,9 @@ TEST_CASE(
       if (b.name == "geode") return b.report.metrics.at(0).minimum;
     return -1.0;
   };
-  for (const auto& [name, n] : models) {
+  for (const auto& [name_, n] : models) {
+    // Named again: clang 14 cannot capture a structured binding (CAPTURE's lambda).
+    const auto& name = name_;
     CAPTURE(name);
     const primal::Model m = demo::demo_model(name, n);
     conform::ConformOptions o;
@@ -137,7 +141,9 @@ TEST_CASE(
                 {"fulcher", 4, conform::ConformSmooth::kLocal, 1.0},
                 {"nugget", 2, conform::ConformSmooth::kGlobal, 0.75},
                 {"lshape", 2, conform::ConformSmooth::kGlobal, 1.0}};
-  for (const auto& [name, n, smooth, floor] : models) {
+  for (const auto& [name_, n, smooth, floor] : models) {
+    // Named again: clang 14 cannot capture a structured binding (CAPTURE's lambda).
+    const auto& name = name_;
     CAPTURE(name);
     const bool global = smooth == conform::ConformSmooth::kGlobal;
     CAPTURE(global);

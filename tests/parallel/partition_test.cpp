@@ -60,7 +60,9 @@ void require_shares(const std::vector<int>& part, const std::vector<gp::Index>& 
 
 TEST_CASE("partition_elements: parts get their shares, of the dicing weights or the caller's") {
   const geode::test::TempDir dir;
-  for (const auto& [name, n] : {std::pair{"half", 24}, std::pair{"hexdominant", 8}}) {
+  for (const auto& [name_, n] : {std::pair{"half", 24}, std::pair{"hexdominant", 8}}) {
+    // Named again: clang 14 cannot capture a structured binding (CAPTURE's lambda).
+    const auto& name = name_;
     CAPTURE(name);
     const gp::Model m = geode::test::demo_input(name, n, dir, ".exo");
     const std::size_t cells = gp::element_offsets(m).back();

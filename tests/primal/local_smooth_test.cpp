@@ -296,7 +296,9 @@ std::map<int, double> block_volumes(const HexMesh& m) {
 void check_volumes_kept(const HexMesh& before, const HexMesh& after) {
   const auto a = block_volumes(before), b = block_volumes(after);
   REQUIRE(a.size() == b.size());
-  for (const auto& [id, volume] : a) {
+  for (const auto& [id_, volume] : a) {
+    // Named again: clang 14 cannot capture a structured binding (CAPTURE's lambda).
+    const auto& id = id_;
     CAPTURE(id);
     CHECK(std::abs(b.at(id) - volume) <= 1e-9 * volume);
   }

@@ -464,7 +464,9 @@ TEST_CASE("covering: embedded meshes cover every node once, on the boundary too"
       {"Appendix A geode, smoothed", smoothed_geode},
       {"fan of 4 hexes, 2 layers", [] { return extrude(wrapped_star(1), 2); }},
   };
-  for (const auto& [name, make] : cases) {
+  for (const auto& [name_, make] : cases) {
+    // Named again: clang 14 cannot capture a structured binding (CAPTURE's lambda).
+    const auto& name = name_;
     CAPTURE(std::string(name));
     const HexMesh m = make();
     REQUIRE(min_scaled_jacobian(m) > 0.0);  // every node is judged

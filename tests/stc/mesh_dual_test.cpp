@@ -126,7 +126,10 @@ TEST_CASE("hex grids: nx + ny + nz planar sheets, every cross triple meets once"
 }
 
 TEST_CASE("quad grids: nx + ny chords with two ends each, crossing once") {
-  for (auto [nx, ny] : {std::pair{1, 1}, std::pair{4, 3}, std::pair{5, 1}}) {
+  for (auto [nx_, ny_] : {std::pair{1, 1}, std::pair{4, 3}, std::pair{5, 1}}) {
+    // Named again: clang 14 cannot capture a structured binding (CAPTURE's lambda).
+    const auto& nx = nx_;
+    const auto& ny = ny_;
     CAPTURE(nx);
     CAPTURE(ny);
     const QuadMesh mesh = gt::structured_quad_grid(nx, ny);

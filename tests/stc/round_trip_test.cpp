@@ -98,8 +98,11 @@ TEST_CASE("round trip: structured hex grids, straight and with moved nodes") {
 }
 
 TEST_CASE("round trip: structured quad grids, straight and with moved nodes") {
-  for (const auto& [nx, ny, amount] :
+  for (const auto& [nx_, ny_, amount] :
        {std::tuple{1, 1, 0.0}, std::tuple{3, 2, 0.0}, std::tuple{5, 4, 0.25}}) {
+    // Named again: clang 14 cannot capture a structured binding (CAPTURE's lambda).
+    const auto& nx = nx_;
+    const auto& ny = ny_;
     CAPTURE(nx);
     CAPTURE(ny);
     QuadMesh g = gt::structured_quad_grid(nx, ny);

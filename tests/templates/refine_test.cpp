@@ -127,7 +127,9 @@ TEST_CASE("refine3: smoothed, untangled, and neighbouring cells match on their s
   // quality there: they are the 2D optimum, not the 3D one).
   const std::pair<Eigen::Vector3d, double> cases[] = {{Eigen::Vector3d(24, 14, 24), 0.4},
                                                       {Eigen::Vector3d(20, 10, 30), 0.25}};
-  for (const auto& [box, target] : cases) {
+  for (const auto& [box_, target] : cases) {
+    // Named again: clang 14 cannot capture a structured binding (CAPTURE's lambda).
+    const auto& box = box_;
     CAPTURE(box.transpose());
     RefineOptions o;
     o.box = box;
