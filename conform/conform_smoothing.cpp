@@ -133,8 +133,7 @@ void Conformer::smooth() {
   res_.smoothing.initial_inverted = res_.smoothing.final_inverted = res_.placement_inverted;
   if (options_.smooth == ConformSmooth::kNone) return untangle();
   const bool local = options_.smooth == ConformSmooth::kLocal;
-  primal::LocalSmoothOptions o =
-      local ? options_.local_smooth_options : options_.global_smooth_options;
+  primal::LocalSmoothOptions o = options_.local_smooth_options;
   auto last = Clock::now();
   o.progress = [&](std::size_t settled, std::size_t total) {
     if (options_.smoothing_progress) {
@@ -156,22 +155,19 @@ void Conformer::smooth() {
     smooth_defects(o);
   } else {
     const auto constraints = primal::boundary_slide_constraints(mesh_);
-    o.target = std::min(o.target, options_.global_target_factor * aim_yardstick_);
-    add_smoothing(primal::smooth_hexes_local(mesh_, constraints, nullptr, {}, o));
+    add_smoothing(primal::smooth_hexes_local(mesh_, constraints, nullptr, {}, global_options(o)));
     sj_ = primal::scaled_jacobian_per_hex(mesh_);
     // The global target lifts the whole mesh a little, not a defect to the yardstick: the
     // local passes follow wherever a hex is still below it. Their floors are measured on the
     // globally smoothed mesh: from before it, the edges the global pass shortened would leave
     // the defects no room. So the bounds add up over the two: a hex may lose `loss` in each,
     // an edge shrink to half of half its length.
-    primal::LocalSmoothOptions d = options_.local_smooth_options;
-    d.progress = o.progress;
     // With the neighbourhood lift, as the local mode: the passes' floors hold the neighbours of
     // the defects they leave here too. Over the 17 demos at n = 3, 5, 6, against the passes
     // alone: the whole output's minimum up in 8 runs, down in none, block minima up in 29 of
     // the 132 and down in 6, runs below 0.9 x the capped local yardstick 2 -> 0, the
     // smoothing's CPU 26.1 -> 32.9 s.
-    smooth_defects(d);
+    smooth_defects(o);
   }
   res_.smoothing.final_min_scaled_jacobian = scan();
   res_.smoothing.final_inverted = primal::index_cast(inverted_.size());
@@ -281,8 +277,10 @@ void Conformer::smooth_defects(primal::LocalSmoothOptions o) {
   take_lowest(
       kNeighbourSeeds, [&](std::size_t h) { return sj_[h]; },
       [&](std::size_t h) { return sj_[h] < lowest[mesh_.block[h]] + kDefectBand; });
-  // What the report divides a geode hex by: its local yardstick capped by the template's own
-  // minimum (any other hex: its aim).
+  // What the report divides a geode hex by, as far as it is known before the report: its local
+  // yardstick capped by the template's own minimum (the report's cap, the template's ceiling at
+  // the buffer hex's proportions, is measured after smoothing and only lower); any other hex:
+  // its aim.
   const auto reported = [&](std::size_t h) {
     const std::size_t b = buffer_hex_of(primal::index_cast(h));
     if (b == kNone) return aim[h];
@@ -306,10 +304,7 @@ void Conformer::smooth_defects(primal::LocalSmoothOptions o) {
                             primal::hex_corners(mesh_, primal::index_cast(h)));
                       }
                     });
-  primal::LocalSmoothOptions lift = options_.global_smooth_options;
-  lift.progress = o.progress;
-  lift.target = std::min(lift.target, options_.global_target_factor * aim_yardstick_);
-  const auto r = primal::smooth_hexes_around(mesh_, seeds, lift, &start);
+  const auto r = primal::smooth_hexes_around(mesh_, seeds, global_options(o), &start);
   add_smoothing(r);
   measure(r.region);
   smooth_defect_passes(o, aim, start, r.region);

@@ -134,6 +134,14 @@ class Conformer {
   void add_smoothing(const primal::LocalSmoothResult& r);
   void smooth();
   void smooth_defects(primal::LocalSmoothOptions o);
+  // The global mode's options (its pass over every hex, and the lift), its target at most
+  // global_target_factor x the yardstick aimed at, reporting to the caller's options' progress.
+  primal::LocalSmoothOptions global_options(const primal::LocalSmoothOptions& caller) const {
+    primal::LocalSmoothOptions g = options_.global_smooth_options;
+    g.progress = caller.progress;
+    g.target = std::min(g.target, options_.global_target_factor * aim_yardstick_);
+    return g;
+  }
   // aim: aims(); within: the hexes whose defects count (ascending; empty: all); start: the
   // floors, measured now if empty and a defect is found.
   void smooth_defect_passes(primal::LocalSmoothOptions o, const std::vector<double>& aim,
