@@ -2,6 +2,8 @@
 
 #include <geode/parallel/detail/distributor.hpp>
 
+#include <thread>
+
 #include <geode/conform/reference_template.hpp>
 
 namespace geode::parallel {
@@ -18,9 +20,9 @@ constexpr double kReferenceChildren = 900000.0;
 // wherever they are: they seed the zone.
 //
 // The zone rank builds the reference templates its zone's conform will take from their cache
-// (conform/reference_template.hpp) here, and measures that many children fewer than the others:
-// they are the one stage of its critical path that does not wait for the zone (with 2 ranks,
-// rank 0 then waits that much less for it).
+// (conform/reference_template.hpp) here, beside its share, and measures that many children fewer
+// than the others: they are the one stage of its critical path that does not wait for the zone
+// (with 2 ranks, rank 0 then waits that much less for it).
 void Distributor::yardstick() {
   struct {
     double value;
@@ -36,6 +38,7 @@ void Distributor::yardstick() {
   const std::size_t nh = m().hexes.size(), nt = m().tets.size(), nw = m().wedges.size();
   // Ranks [0, r) measure this fraction of each kind's elements.
   std::vector<double> before(primal::index_cast<std::size_t>(size_) + 1, 0.0);
+  std::jthread references_built;  // joined before the ranks meet below
   {
     const double children = 8.0 * static_cast<double>(nh) + 4.0 * static_cast<double>(nt) +
                             6.0 * static_cast<double>(nw);
@@ -49,15 +52,10 @@ void Distributor::yardstick() {
     for (int r = 0; r < size_; ++r)
       before[primal::index_cast<std::size_t>(r) + 1] =
           r + 1 == size_ ? 1.0 : (r + 1) * (1.0 - zone_share) / (size_ - 1);
-    if (references && rank_ == zone_rank()) {
-      // A failure here (an odd --template-box) would leave the others waiting below: the
-      // zone's conform builds them again and raises it as a zone failure, on every rank.
-      try {
-        const Eigen::Vector3d& box = options_.conform.template_box;
-        (void)conform::reference_template(box, {4, 6});
-        (void)conform::reference_template(box, {5, 7});
-      } catch (const std::exception&) {}
-    }
+    // A failed build is left to the zone's conform, which raises it as a zone failure on
+    // every rank.
+    if (references && rank_ == zone_rank())
+      references_built = conform::build_reference_templates_ahead(options_.conform.template_box);
   }
   const auto share = [&](std::size_t n, int r) {
     return r >= size_
@@ -83,6 +81,7 @@ void Distributor::yardstick() {
   for (std::size_t i = share(nw, rank_); i < share(nw, rank_ + 1); ++i)
     consider(2, cell_of(ElementKind::kWedge, i),
              primal::diced_wedge_min_scaled_jacobian(m().points, std::span(&m().wedges[i], 1)));
+  if (references_built.joinable()) references_built.join();
   MPI_Allreduce(low, all, 3, MPI_DOUBLE_INT, MPI_MINLOC, comm_);
   for (const auto& a : all)
     if (a.value <= 1.5) lowest_.push_back(primal::index_cast<std::size_t>(a.cell));
