@@ -34,21 +34,19 @@
 #include <vector>
 
 #include <geode/primal/model.hpp>
+#include <geode/primal/shares.hpp>
 
 namespace geode::primal {
 
-struct InputCheckOptions {
+// Shares (shares.hpp): the check shared among `shares` processes, this one being `share`: each
+// pairs the faces whose lowest node is in its run of the nodes, then `exchange` gives each the
+// whole pairing, and every process goes on from the same data to the same findings. More than
+// one share without an exchange is refused (std::invalid_argument).
+struct InputCheckOptions : Shares {
   bool contacts = true;             // boundary faces crossing or facing across a thin gap
   double gap_fraction = 0.05;       // a gap thinner than this x the faces' longest edge is refused
   std::size_t max_components = 32;  // boundary components whose degree is checked
   std::size_t max_findings = 8;     // the check stops after this many
-  // The check shared among `shares` processes (geode_mpi's ranks), this one being `share`: each
-  // pairs the faces whose lowest node is in its run of the nodes, then `exchange`, an
-  // all-gather (every process's bytes, concatenated in share order), gives each the whole
-  // pairing, and every process goes on from the same data to the same findings. More than one
-  // share without an exchange is refused (std::invalid_argument).
-  int share = 0, shares = 1;
-  std::function<std::vector<char>(const std::vector<char>&)> exchange;
 };
 
 enum class InputFault {
