@@ -17,6 +17,7 @@
 #include <functional>
 
 #include <geode/primal/model.hpp>
+#include <geode/primal/shares.hpp>
 
 namespace geode::io {
 
@@ -54,6 +55,16 @@ inline constexpr std::array<ExodusCell, 4> kExodusCells{{
 // number out of range; then check_geometry (model.hpp) unless options say otherwise.
 primal::Model read_exodus(const std::filesystem::path& path,
                           const primal::ReadOptions& options = {});
+
+// read_exodus with the reading shared among processes (primal/shares.hpp; geode_mpi's ranks):
+// each reads, in its own child, the header, the block headers and names, and its run of the
+// nodes (coordinates, node map) and of each block's elements (connectivity, element map), the
+// first also the sets; the exchange gives every process all the runs, joined in share order
+// into what read_exodus reads, then checked as it checks them. Collective: each returns the
+// model read_exodus returns, or throws what it throws for the file (the first share's reason,
+// in share order, when several fail).
+primal::Model read_exodus_shared(const std::filesystem::path& path,
+                                 const primal::ReadOptions& options, const primal::Shares& shares);
 
 // A piece of a Nemesis set (nemesis_set.hpp) carries, beside its model, Nemesis I's processor
 // count and global counts; processors 0 when the file has none.

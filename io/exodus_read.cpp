@@ -10,10 +10,13 @@
 #include <array>
 #include <cctype>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include <geode/io/exodus_library.hpp>
@@ -21,6 +24,7 @@
 #include <geode/io/isolated.hpp>
 #include <geode/io/netcdf_screen.hpp>
 #include <geode/primal/errors.hpp>
+#include <geode/primal/shares.hpp>
 #include <geode/primal/topology.hpp>
 
 namespace geode::io {
@@ -65,7 +69,8 @@ struct BlockData {
   int id = 0;
   std::string name, type;
   int per_elem = 0;
-  std::vector<int> conn;  // count x per_elem
+  std::int64_t count = 0;  // the block's elements in the file
+  std::vector<int> conn;   // its run of them (all of them but in a shared read) x per_elem
 };
 struct SetData {
   int id = 0;
@@ -89,8 +94,17 @@ std::vector<std::string> names_of(int exo, ex_entity_type type, std::size_t n) {
   return out;
 }
 
+// Which part of the file a process reads: its run [first, last) of every n things, the runs of
+// `shares` processes one after another (Shares in read_exodus_shared; 0 of 1 reads the file).
+struct Slice {
+  int share = 0, shares = 1;
+  std::pair<std::int64_t, std::int64_t> run(std::int64_t n) const {
+    return {n * share / shares, n * (share + 1) / shares};
+  }
+};
+
 // Stage one: the library's reads; counts bounded before each allocation.
-Contents read_contents(const std::string& source, ExodusBounds bound) {
+Contents read_contents(const std::string& source, ExodusBounds bound, Slice slice) {
   ex_opts(0);  // we report errors ourselves, through exceptions
   int cpu_word_size = 8, io_word_size = 0;
   float version = 0.0f;
@@ -117,22 +131,32 @@ Contents read_contents(const std::string& source, ExodusBounds bound) {
   bound.check(num_node_sets, 4, "node sets");
   bound.check(num_side_sets, 4, "side sets");
 
-  const auto nodes = index_cast<std::size_t>(c.num_nodes);
+  const bool whole = slice.shares == 1;
+  const auto [first_node, last_node] = slice.run(c.num_nodes);
+  const auto nodes = index_cast<std::size_t>(last_node - first_node);
   c.x.resize(nodes);
   c.y.resize(nodes);
   c.z.assign(nodes, 0.0);
   if (nodes > 0) {
-    check(ex_get_coord(exo, c.x.data(), c.y.data(), c.num_dim == 3 ? c.z.data() : nullptr), source,
-          "reading coordinates");
+    double* z = c.num_dim == 3 ? c.z.data() : nullptr;
+    check(whole ? ex_get_coord(exo, c.x.data(), c.y.data(), z)
+                : ex_get_partial_coord(exo, first_node + 1, last_node - first_node, c.x.data(),
+                                       c.y.data(), z),
+          source, "reading coordinates");
     // Node and element number maps (Cubit's ids); without maps in the file, 1..n.
     c.node_map.resize(nodes);
-    check(ex_get_id_map(exo, EX_NODE_MAP, c.node_map.data()), source,
-          "reading the node number map");
+    check(whole ? ex_get_id_map(exo, EX_NODE_MAP, c.node_map.data())
+                : ex_get_partial_id_map(exo, EX_NODE_MAP, first_node + 1, last_node - first_node,
+                                        c.node_map.data()),
+          source, "reading the node number map");
   }
-  if (c.num_elem > 0) {
-    c.element_map.resize(index_cast<std::size_t>(c.num_elem));
-    check(ex_get_id_map(exo, EX_ELEM_MAP, c.element_map.data()), source,
-          "reading the element number map");
+  const auto [first_element, last_element] = slice.run(c.num_elem);
+  if (last_element > first_element) {
+    c.element_map.resize(index_cast<std::size_t>(last_element - first_element));
+    check(whole ? ex_get_id_map(exo, EX_ELEM_MAP, c.element_map.data())
+                : ex_get_partial_id_map(exo, EX_ELEM_MAP, first_element + 1,
+                                        last_element - first_element, c.element_map.data()),
+          source, "reading the element number map");
   }
 
   std::int64_t elements = 0;
@@ -159,10 +183,15 @@ Contents read_contents(const std::string& source, ExodusBounds bound) {
         throw InvalidInput(where + ": more elements in the blocks than the header's " +
                            std::to_string(c.num_elem));
       elements += count;
-      block.conn.resize(index_cast<std::size_t>(count) * index_cast<std::size_t>(block.per_elem));
+      block.count = count;
+      const auto [first, last] = slice.run(count);
+      block.conn.resize(index_cast<std::size_t>(last - first) *
+                        index_cast<std::size_t>(block.per_elem));
       if (!block.conn.empty())
-        check(ex_get_conn(exo, EX_ELEM_BLOCK, block.id, block.conn.data(), nullptr, nullptr), where,
-              "reading connectivity");
+        check(whole ? ex_get_conn(exo, EX_ELEM_BLOCK, block.id, block.conn.data(), nullptr, nullptr)
+                    : ex_get_partial_conn(exo, EX_ELEM_BLOCK, block.id, first + 1, last - first,
+                                          block.conn.data(), nullptr, nullptr),
+              where, "reading connectivity");
       c.blocks.push_back(std::move(block));
     }
   }
@@ -188,8 +217,10 @@ Contents read_contents(const std::string& source, ExodusBounds bound) {
       out.push_back(std::move(set));
     }
   };
-  read_sets(EX_NODE_SET, num_node_sets, "node set", 4, c.node_sets);
-  read_sets(EX_SIDE_SET, num_side_sets, "side set", 8, c.side_sets);
+  if (slice.share == 0) {  // the sets are the first share's to read
+    read_sets(EX_NODE_SET, num_node_sets, "node set", 4, c.node_sets);
+    read_sets(EX_SIDE_SET, num_side_sets, "side set", 8, c.side_sets);
+  }
   // Nemesis I (a piece of a partitioned set): absent from a plain file, which the library
   // reports as an error.
   int processors = 0, in_file = 0;
@@ -231,12 +262,13 @@ class Unpacker {
     raw(&v, sizeof v);
     return v;
   }
+  // An array appended to `v` (a shared read joins the shares' runs so).
   template <typename T>
-  std::vector<T> array() {
+  void array_onto(std::vector<T>& v) {
     const std::uint64_t n = length(sizeof(T));
-    std::vector<T> v(n);
-    raw(v.data(), n * sizeof(T));
-    return v;
+    const std::size_t at = v.size();
+    v.resize(at + n);
+    raw(v.data() + at, n * sizeof(T));
   }
   std::string text() {
     std::string s(length(1), '\0');
@@ -280,6 +312,7 @@ std::string pack(const Contents& c) {
     p.text(b.name);
     p.text(b.type);
     p.i64(b.per_elem);
+    p.i64(b.count);
     p.array(b.conn);
   }
   for (const auto* sets : {&c.node_sets, &c.side_sets}) {
@@ -294,48 +327,69 @@ std::string pack(const Contents& c) {
   return std::move(p.out);
 }
 
-Contents unpack(std::string_view bytes, const std::string& source) {
+// The child's answer appended to `c`: onto empty contents, or (a shared read, `later`) onto the
+// runs of the shares before it, whose header it must repeat.
+void unpack_onto(Contents& c, std::string_view bytes, const std::string& source, bool later) {
   Unpacker u(bytes, source);
-  Contents c;
-  c.num_dim = static_cast<int>(u.i64());
-  c.num_nodes = static_cast<int>(u.i64());
-  c.num_elem = static_cast<int>(u.i64());
-  c.nemesis.processors = static_cast<int>(u.i64());
-  c.nemesis.global_nodes = u.i64();
-  c.nemesis.global_elements = u.i64();
-  c.x = u.array<double>();
-  c.y = u.array<double>();
-  c.z = u.array<double>();
-  c.node_map = u.array<int>();
-  c.element_map = u.array<int>();
+  const auto changed = [&] {
+    return InvalidInput(source +
+                        ": the file changed while it was read (the processes sharing "
+                        "the read found different headers)");
+  };
+  const auto header = [&](auto& field) {
+    const auto v = static_cast<std::remove_reference_t<decltype(field)>>(u.i64());
+    if (later && v != field) throw changed();
+    field = v;
+  };
+  for (int* field : {&c.num_dim, &c.num_nodes, &c.num_elem, &c.nemesis.processors}) header(*field);
+  header(c.nemesis.global_nodes);
+  header(c.nemesis.global_elements);
+  for (auto* v : {&c.x, &c.y, &c.z}) u.array_onto(*v);
+  u.array_onto(c.node_map);
+  u.array_onto(c.element_map);
   const auto count = [&](std::size_t least) {
     const std::int64_t n = u.i64();
     if (n < 0 || static_cast<std::uint64_t>(n) > bytes.size() / least)
       throw std::runtime_error(source + ": the Exodus reader process's answer is malformed");
     return index_cast<std::size_t>(n);
   };
-  for (std::size_t b = count(40); b-- > 0;) {
-    BlockData block;
-    block.id = static_cast<int>(u.i64());
-    block.name = u.text();
-    block.type = u.text();
-    block.per_elem = static_cast<int>(u.i64());
-    block.conn = u.array<int>();
-    c.blocks.push_back(std::move(block));
+  const std::size_t blocks = count(40);
+  if (later && blocks != c.blocks.size()) throw changed();
+  c.blocks.resize(blocks);
+  for (BlockData& block : c.blocks) {
+    header(block.id);
+    std::string name = u.text(), type = u.text();
+    if (later && (name != block.name || type != block.type)) throw changed();
+    block.name = std::move(name), block.type = std::move(type);
+    header(block.per_elem);
+    header(block.count);
+    u.array_onto(block.conn);
   }
   for (auto* sets : {&c.node_sets, &c.side_sets})
     for (std::size_t s = count(32); s-- > 0;) {
+      if (later)  // only the first share reads the sets
+        throw std::runtime_error(source + ": the Exodus reader process's answer is malformed");
       SetData set;
       set.id = static_cast<int>(u.i64());
       set.name = u.text();
-      set.entries = u.array<int>();
-      set.sides = u.array<int>();
+      u.array_onto(set.entries);
+      u.array_onto(set.sides);
       sets->push_back(std::move(set));
     }
-  if (!u.done() || c.x.size() != index_cast<std::size_t>(c.num_nodes) || c.y.size() != c.x.size() ||
-      c.z.size() != c.x.size())
+  if (!u.done())
     throw std::runtime_error(source + ": the Exodus reader process's answer is malformed");
-  return c;
+}
+
+// Whether contents hold every node and element the header announces (a shared read's joined).
+void check_whole(const Contents& c, const std::string& source) {
+  bool whole = c.x.size() == index_cast<std::size_t>(c.num_nodes) && c.y.size() == c.x.size() &&
+               c.z.size() == c.x.size() && c.node_map.size() == c.x.size() &&
+               c.element_map.size() == index_cast<std::size_t>(c.num_elem);
+  for (const BlockData& b : c.blocks)
+    whole = whole &&
+            b.conn.size() == index_cast<std::size_t>(b.count) * index_cast<std::size_t>(b.per_elem);
+  if (!whole)
+    throw std::runtime_error(source + ": the Exodus reader process's answer is malformed");
 }
 
 std::string upper(std::string s) {
@@ -353,6 +407,7 @@ bool renumbered(const std::vector<T>& items) {
 // Stage two: the model, every entry checked (the file's ids in messages).
 Model build_model(const Contents& c, const std::string& source) {
   Model model;
+  model.points.reserve(c.x.size());
   for (std::size_t i = 0; i < c.x.size(); ++i) model.points.emplace_back(c.x[i], c.y[i], c.z[i]);
   model.node_ids.assign(c.node_map.begin(), c.node_map.end());
   const auto element_file_id = [&](std::size_t global_index) {
@@ -360,23 +415,35 @@ Model build_model(const Contents& c, const std::string& source) {
                                                : static_cast<int64_t>(global_index) + 1;
   };
 
+  // A block's cell, its index in kExodusCells by its type and node count; the table's size for
+  // another.
+  const auto cell_of = [](const BlockData& block) -> std::size_t {
+    const std::string type = upper(block.type);
+    for (std::size_t k = 0; k < kExodusCells.size(); ++k)
+      for (const char* alias : kExodusCells[k].aliases)
+        if (alias && type == alias && block.per_elem == kExodusCells[k].corners) return k;
+    return kExodusCells.size();
+  };
+  // Room for every element first: pushed one by one, the arrays would be copied as they grow.
+  std::array<std::size_t, kExodusCells.size() + 1> per_kind{};
+  for (const BlockData& block : c.blocks)
+    per_kind[cell_of(block)] += block.conn.size() / std::max(block.per_elem, 1);
+  for (std::size_t k = 0; k < kExodusCells.size(); ++k) {
+    with_cells(model, kElementKinds[k], [&](auto& cells) { cells.reserve(per_kind[k]); });
+    element_blocks(model, kElementKinds[k]).reserve(per_kind[k]);
+    element_ids(model, kElementKinds[k]).reserve(per_kind[k]);
+  }
   std::vector<ElementRef> global;  // global element number (1-based) - 1 -> element
+  global.reserve(index_cast<std::size_t>(std::max(c.num_elem, 0)));
   const bool renumber_blocks = renumbered(c.blocks);
   for (std::size_t b = 0; b < c.blocks.size(); ++b) {
     const BlockData& block = c.blocks[b];
     const int block_id = renumber_blocks ? static_cast<int>(b) + 1 : block.id;
     if (!block.name.empty()) model.block_names[block_id] = block.name;
     const std::string where = source + ": element block " + std::to_string(block.id);
-    const std::string type = upper(block.type);
-    const ExodusCell* cell = nullptr;
-    ElementKind kind = ElementKind::kHex;
-    for (std::size_t k = 0; k < kExodusCells.size() && !cell; ++k)
-      for (const char* alias : kExodusCells[k].aliases)
-        if (alias && type == alias && block.per_elem == kExodusCells[k].corners) {
-          cell = &kExodusCells[k];
-          kind = kElementKinds[k];
-          break;
-        }
+    const std::size_t k = cell_of(block);
+    const ExodusCell* cell = k < kExodusCells.size() ? &kExodusCells[k] : nullptr;
+    const ElementKind kind = cell ? kElementKinds[k] : ElementKind::kHex;
     if (!cell)
       throw InvalidInput(where + ": element " + std::to_string(global.size() + 1) +
                          ": element type '" + block.type + "' with " +
@@ -439,15 +506,8 @@ Model build_model(const Contents& c, const std::string& source) {
   return model;
 }
 
-}  // namespace
-
-Model read_exodus(const std::filesystem::path& path, const ReadOptions& options) {
-  return read_exodus_piece(path, options, nullptr);
-}
-
-Model read_exodus_piece(const std::filesystem::path& path, const ReadOptions& options,
-                        NemesisInfo* nemesis) {
-  const std::string source = path.string();
+// Stage one in a child: the answer (pack()) for `slice` of the file.
+std::string read_answer(const std::filesystem::path& path, const std::string& source, Slice slice) {
   check_mesh_format(path, MeshFileFormat::kExodus);
   const NetcdfKind kind = screen_netcdf(path, source);
   std::error_code ec;
@@ -466,17 +526,100 @@ Model read_exodus_piece(const std::filesystem::path& path, const ReadOptions& op
   limits.cpu_seconds = static_cast<unsigned>(std::min<std::uint64_t>(3 + (size >> 20), 1u << 20));
   limits.wall_seconds = 2 * limits.cpu_seconds + 2;
   limits.max_result_bytes = 8 * bound.capacity() + 4096;
-  const std::string answer = run_isolated(
-      [&] { return pack(read_contents(source, bound)); }, source,
+  return run_isolated(
+      [&] { return pack(read_contents(source, bound, slice)); }, source,
       kind == NetcdfKind::kClassic ? "reading the netCDF file" : "reading the netCDF-4 (HDF5) file",
       limits);
-  const Contents contents = unpack(answer, source);
-  if (nemesis) *nemesis = contents.nemesis;
+}
+
+// Stage two on the whole contents.
+Model model_of(const Contents& contents, const std::string& source, const ReadOptions& options) {
+  check_whole(contents, source);
   Model model = build_model(contents, source);
   sanitize_names(model);
   validate(model, source);
   options.check_geometry ? check_geometry(model, source) : check_points(model, source);
   return model;
+}
+
+// What a share of a shared read sends the others: its answer, or why it has none.
+enum class ShareOutcome : char { kRead, kInvalidInput, kOutOfMemory, kFault };
+
+}  // namespace
+
+Model read_exodus(const std::filesystem::path& path, const ReadOptions& options) {
+  return read_exodus_piece(path, options, nullptr);
+}
+
+Model read_exodus_piece(const std::filesystem::path& path, const ReadOptions& options,
+                        NemesisInfo* nemesis) {
+  const std::string source = path.string();
+  Contents contents;
+  unpack_onto(contents, read_answer(path, source, {}), source, false);
+  if (nemesis) *nemesis = contents.nemesis;
+  return model_of(contents, source, options);
+}
+
+Model read_exodus_shared(const std::filesystem::path& path, const ReadOptions& options,
+                         const Shares& shares) {
+  if (shares.shares <= 1) return read_exodus(path, options);
+  if (!shares.exchange || shares.share < 0 || shares.share >= shares.shares)
+    throw std::invalid_argument("read_exodus_shared: share " + std::to_string(shares.share) +
+                                " of " + std::to_string(shares.shares) + " without an exchange");
+  const std::string source = path.string();
+  // Every share reaches the exchange, whatever happened to its read: one that threw instead
+  // would leave the others waiting there.
+  ShareOutcome outcome = ShareOutcome::kRead;
+  std::string answer;
+  try {
+    // Test hook (docs/cli.md): GEODE_TEST_FAIL_READ_SHARE=N refuses share N's read alone.
+    if (const char* hook = std::getenv("GEODE_TEST_FAIL_READ_SHARE");
+        hook && *hook && std::atoi(hook) == shares.share)
+      throw InvalidInput(source + ": GEODE_TEST_FAIL_READ_SHARE is set");
+    answer = read_answer(path, source, {shares.share, shares.shares});
+  } catch (const InvalidInput& e) {
+    outcome = ShareOutcome::kInvalidInput, answer = e.what();
+  } catch (const std::bad_alloc&) {
+    outcome = ShareOutcome::kOutOfMemory, answer.clear();
+  } catch (const std::exception& e) {
+    outcome = ShareOutcome::kFault, answer = e.what();
+  }
+  std::vector<char> mine(sizeof(std::uint64_t) + 1 + answer.size());
+  const std::uint64_t length = answer.size();
+  std::memcpy(mine.data(), &length, sizeof length);
+  mine[sizeof length] = static_cast<char>(outcome);
+  std::memcpy(mine.data() + sizeof length + 1, answer.data(), answer.size());
+  std::string().swap(answer);
+  const std::vector<char> all = shares.exchange(mine);
+  std::vector<char>().swap(mine);
+  // The shares' answers in share order; the first failure is every process's.
+  std::vector<std::string_view> answers;
+  for (std::size_t at = 0; std::cmp_less(answers.size(), shares.shares);) {
+    std::uint64_t n = 0;
+    if (all.size() - at < sizeof n + 1)
+      throw std::runtime_error(source + ": a shared read's exchange is malformed");
+    std::memcpy(&n, all.data() + at, sizeof n);
+    const auto kind = static_cast<ShareOutcome>(all[at + sizeof n]);
+    at += sizeof n + 1;
+    if (n > all.size() - at)
+      throw std::runtime_error(source + ": a shared read's exchange is malformed");
+    const std::string_view body(all.data() + at, n);
+    at += n;
+    switch (kind) {
+      case ShareOutcome::kRead:
+        answers.push_back(body);
+        break;
+      case ShareOutcome::kInvalidInput:
+        throw InvalidInput(std::string(body));
+      case ShareOutcome::kOutOfMemory:
+        throw std::bad_alloc();
+      default:
+        throw std::runtime_error(std::string(body));
+    }
+  }
+  Contents contents;
+  for (std::size_t s = 0; s < answers.size(); ++s) unpack_onto(contents, answers[s], source, s > 0);
+  return model_of(contents, source, options);
 }
 
 }  // namespace geode::io

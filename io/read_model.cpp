@@ -8,6 +8,7 @@
 #include <string>
 #include <string_view>
 
+#include <geode/io/exodus.hpp>
 #include <geode/io/file_format.hpp>
 #include <geode/io/formats.hpp>
 #include <geode/io/gmsh.hpp>
@@ -165,6 +166,8 @@ Model read_model(const std::filesystem::path& path, const ReadOptions& options, 
   try {
     Model model = partition && format->read == read_gmsh
                       ? read_gmsh_partitioned(path, options, partition)
+                  : format->read == read_exodus && covering.shares > 1
+                      ? read_exodus_shared(path, options, covering)
                       : format->read(path, options);
     if (options.check_geometry && check_covering)
       require_single_covering(model, path.string(), covering);

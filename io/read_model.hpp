@@ -18,7 +18,8 @@ namespace geode::io {
 // covering check of primal/input_check.hpp: a folded model, overlapping parts, an interface with
 // a gap are refused naming the elements. check_covering false is for callers that merge nodes
 // after reading and run require_single_covering themselves; `covering` is its options (geode_mpi
-// shares the check among its ranks).
+// shares the check among its ranks, and with it the read of a single Exodus file:
+// exodus.hpp read_exodus_shared).
 //
 // Partitioned inputs: a Nemesis set (nemesis_set.hpp: `path` one of its pieces IN.exo.N.r, or
 // IN.exo when that file does not exist and its pieces do) is read joined; a partitioned .msh 4.1

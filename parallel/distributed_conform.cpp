@@ -343,28 +343,59 @@ RankMesh conform_distributed(primal::Model&& input, const DistributedOptions& op
   return detail::Distributor(input, options, comm, report ? *report : local, &input).run();
 }
 
+namespace {
+
+// MPI_Allgatherv of any sizes: its counts and displacements are ints, so past 2 GiB in all the
+// bytes go in rounds of at most kRound from each rank, each round's copied into place.
+std::vector<char> all_gather_bytes(const std::vector<char>& mine, MPI_Comm comm, int ranks) {
+  constexpr std::size_t kRound = std::size_t{1} << 28;
+  const auto n = static_cast<std::uint64_t>(mine.size());
+  std::vector<std::uint64_t> sizes(primal::index_cast<std::size_t>(ranks));
+  MPI_Allgather(&n, 1, MPI_UINT64_T, sizes.data(), 1, MPI_UINT64_T, comm);
+  std::vector<std::size_t> base(sizes.size() + 1, 0);
+  for (std::size_t r = 0; r < sizes.size(); ++r) base[r + 1] = base[r] + sizes[r];
+  std::vector<char> all(base.back());
+  std::vector<int> counts(sizes.size()), displs(sizes.size());
+  if (base.back() <= std::size_t{std::numeric_limits<int>::max()}) {  // one call, in place
+    for (std::size_t r = 0; r < sizes.size(); ++r)
+      counts[r] = static_cast<int>(sizes[r]), displs[r] = static_cast<int>(base[r]);
+    MPI_Allgatherv(mine.data(), static_cast<int>(n), MPI_CHAR, all.data(), counts.data(),
+                   displs.data(), MPI_CHAR, comm);
+    return all;
+  }
+  std::vector<char> round;
+  for (std::size_t from = 0; from < *std::ranges::max_element(sizes); from += kRound) {
+    int total = 0;
+    for (std::size_t r = 0; r < sizes.size(); ++r) {
+      counts[r] = static_cast<int>(std::min(kRound, sizes[r] - std::min(sizes[r], from)));
+      displs[r] = total, total += counts[r];
+    }
+    round.resize(primal::index_cast<std::size_t>(total));
+    const std::size_t own = std::min(kRound, mine.size() - std::min(mine.size(), from));
+    MPI_Allgatherv(mine.data() + std::min(mine.size(), from), static_cast<int>(own), MPI_CHAR,
+                   round.data(), counts.data(), displs.data(), MPI_CHAR, comm);
+    for (std::size_t r = 0; r < sizes.size(); ++r)
+      std::copy_n(round.data() + displs[r], counts[r],
+                  all.data() + base[r] + std::min<std::size_t>(from, sizes[r]));
+  }
+  return all;
+}
+
+}  // namespace
+
+primal::Shares rank_shares(MPI_Comm comm) {
+  primal::Shares s;
+  MPI_Comm_rank(comm, &s.share);
+  MPI_Comm_size(comm, &s.shares);
+  s.exchange = [comm, ranks = s.shares](const std::vector<char>& mine) {
+    return all_gather_bytes(mine, comm, ranks);
+  };
+  return s;
+}
+
 primal::InputCheckOptions shared_input_check(MPI_Comm comm) {
   primal::InputCheckOptions o;
-  MPI_Comm_rank(comm, &o.share);
-  MPI_Comm_size(comm, &o.shares);
-  o.exchange = [comm, shares = o.shares](const std::vector<char>& mine) {
-    // Faces used once and findings: the boundary, far below 2 GiB (an int's count) in all;
-    // past it every rank throws alike.
-    constexpr std::int64_t kMax = std::numeric_limits<int>::max();
-    const int n = std::cmp_less_equal(mine.size(), kMax) ? static_cast<int>(mine.size()) : -1;
-    std::vector<int> counts(primal::index_cast<std::size_t>(shares)), displs(counts.size());
-    MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
-    std::int64_t total = 0;
-    for (std::size_t r = 0; r < counts.size(); ++r) {
-      if (counts[r] < 0 || total + counts[r] > kMax)
-        throw std::runtime_error("the covering check's pairing exceeds 2 GiB across the ranks");
-      displs[r] = static_cast<int>(total), total += counts[r];
-    }
-    std::vector<char> all(primal::index_cast<std::size_t>(total));
-    MPI_Allgatherv(mine.data(), n, MPI_CHAR, all.data(), counts.data(), displs.data(), MPI_CHAR,
-                   comm);
-    return all;
-  };
+  static_cast<primal::Shares&>(o) = rank_shares(comm);
   return o;
 }
 

@@ -88,9 +88,15 @@ RankMesh conform_distributed(const primal::Model& input, const DistributedOption
 RankMesh conform_distributed(primal::Model&& input, const DistributedOptions& options,
                              MPI_Comm comm, DistributedReport* report = nullptr);
 
+// The ranks of `comm` as primal::Shares: this rank's number, their count, and an exchange by
+// MPI_Allgatherv (in rounds of 256 MiB a rank, so any sizes go).
+primal::Shares rank_shares(MPI_Comm comm);
+
 // The read-time covering check (primal/input_check.hpp) shared among the ranks of `comm`, for
-// io::read_model: each rank pairs its share of the faces, MPI_Allgatherv joins the pairings, and
-// every rank reaches the same verdict. Collective: every rank must read the same file with it.
+// io::read_model: each rank pairs its share of the faces, the exchange joins the pairings, and
+// every rank reaches the same verdict; with them the read of a single Exodus file (each rank
+// reads its run of the nodes and elements; io/exodus.hpp read_exodus_shared). Collective: every
+// rank must read the same file with it.
 primal::InputCheckOptions shared_input_check(MPI_Comm comm);
 
 }  // namespace geode::parallel

@@ -5,7 +5,8 @@
 # GEODE_TEST_BREAK_DICED_HEX, docs/cli.md) is found by both on 1 and 2 ranks: exit 4, the
 # failing check named, nothing written. A transition zone made invalid on the zone rank (the last;
 # GEODE_TEST_INVERT_OUTPUT_HEX in its conform) fails every rank count alike; so does a partition
-# failing on rank 0 (GEODE_TEST_FAIL_PARTITION), without a rank left waiting.
+# failing on rank 0 (GEODE_TEST_FAIL_PARTITION), and one rank's share of the read refused
+# (GEODE_TEST_FAIL_READ_SHARE), without a rank left waiting.
 # usage: mpi_verify_test.sh GEODE GEODE_MPI MPIEXEC WORKDIR
 set -euo pipefail
 geode=$1 geode_mpi=$2 mpiexec=$3 dir=$4
@@ -52,4 +53,27 @@ for n in 2 3; do
   grep -q "the partition failed: GEODE_TEST_FAIL_PARTITION is set" err.txt
   if ls fail"$n".exo* >/dev/null 2>&1; then echo "a failed partition, $n ranks: wrote a file"; exit 1; fi
 done
-echo "mpi_verify_test: both modes pass the result and find the broken dicing on 1 and 2 ranks, an invalid zone on 1 to 3"
+# One rank's share of the shared Exodus read refused (GEODE_TEST_FAIL_READ_SHARE, as a corrupt
+# run of the file would be) while the others read theirs: every rank stops with that reason,
+# exit 2, none waits at the exchange; and a truncated file is refused on every rank alike.
+for n in 2 3; do
+  for fail in 0 $((n - 1)); do
+    status=0
+    GEODE_TEST_FAIL_READ_SHARE=$fail timeout 120 "$mpiexec" --oversubscribe \
+      -x GEODE_TEST_FAIL_READ_SHARE -np "$n" "$geode_mpi" conform in.exo -o "read$n.exo" -q \
+      2>err.txt >/dev/null || status=$?
+    if [ "$status" != 2 ]; then
+      echo "share $fail of $n refused: exited $status, not 2"; cat err.txt; exit 1
+    fi
+    grep -q "in.exo: GEODE_TEST_FAIL_READ_SHARE is set" err.txt
+    if ls read"$n".exo* >/dev/null 2>&1; then echo "a refused share, $n ranks: wrote a file"; exit 1; fi
+  done
+done
+head -c $(($(stat -c %s in.exo) * 3 / 4)) in.exo >cut.exo
+status=0
+timeout 120 "$mpiexec" --oversubscribe -np 2 "$geode_mpi" conform cut.exo -o cut-out.exo -q \
+  2>err.txt >/dev/null || status=$?
+[ "$status" = 2 ] || { echo "a truncated file on 2 ranks: exited $status, not 2"; cat err.txt; exit 1; }
+grep -q "cut.exo: .*truncated" err.txt
+if ls cut-out.exo* >/dev/null 2>&1; then echo "a truncated file: wrote a file"; exit 1; fi
+echo "mpi_verify_test: both modes pass the result and find the broken dicing on 1 and 2 ranks, an invalid zone on 1 to 3, a refused share of the read on 2 and 3"
