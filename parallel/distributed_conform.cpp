@@ -2,6 +2,9 @@
 
 #include <geode/parallel/detail/distributor.hpp>
 
+#include <algorithm>
+#include <cstdint>
+#include <limits>
 #include <thread>
 
 #include <geode/conform/reference_template.hpp>
@@ -343,12 +346,10 @@ RankMesh conform_distributed(primal::Model&& input, const DistributedOptions& op
   return detail::Distributor(input, options, comm, report ? *report : local, &input).run();
 }
 
-namespace {
-
-// MPI_Allgatherv of any sizes: its counts and displacements are ints, so past 2 GiB in all the
-// bytes go in rounds of at most kRound from each rank, each round's copied into place.
-std::vector<char> all_gather_bytes(const std::vector<char>& mine, MPI_Comm comm, int ranks) {
-  constexpr std::size_t kRound = std::size_t{1} << 28;
+std::vector<char> all_gather_bytes(const std::vector<char>& mine, MPI_Comm comm,
+                                   std::size_t round) {
+  int ranks = 1;
+  MPI_Comm_size(comm, &ranks);
   const auto n = static_cast<std::uint64_t>(mine.size());
   std::vector<std::uint64_t> sizes(primal::index_cast<std::size_t>(ranks));
   MPI_Allgather(&n, 1, MPI_UINT64_T, sizes.data(), 1, MPI_UINT64_T, comm);
@@ -356,40 +357,40 @@ std::vector<char> all_gather_bytes(const std::vector<char>& mine, MPI_Comm comm,
   for (std::size_t r = 0; r < sizes.size(); ++r) base[r + 1] = base[r] + sizes[r];
   std::vector<char> all(base.back());
   std::vector<int> counts(sizes.size()), displs(sizes.size());
-  if (base.back() <= std::size_t{std::numeric_limits<int>::max()}) {  // one call, in place
+  // A round's counts add up in an int too.
+  constexpr auto kIntMax = static_cast<std::size_t>(std::numeric_limits<int>::max());
+  round = std::clamp<std::size_t>(round, 1, kIntMax / sizes.size());
+  const std::size_t largest = *std::ranges::max_element(sizes);
+  if (largest <= round && base.back() <= kIntMax) {  // one call, in place
     for (std::size_t r = 0; r < sizes.size(); ++r)
       counts[r] = static_cast<int>(sizes[r]), displs[r] = static_cast<int>(base[r]);
     MPI_Allgatherv(mine.data(), static_cast<int>(n), MPI_CHAR, all.data(), counts.data(),
                    displs.data(), MPI_CHAR, comm);
     return all;
   }
-  std::vector<char> round;
-  for (std::size_t from = 0; from < *std::ranges::max_element(sizes); from += kRound) {
+  std::vector<char> part;
+  for (std::size_t from = 0; from < largest; from += round) {
     int total = 0;
     for (std::size_t r = 0; r < sizes.size(); ++r) {
-      counts[r] = static_cast<int>(std::min(kRound, sizes[r] - std::min(sizes[r], from)));
+      counts[r] = static_cast<int>(std::min(round, sizes[r] - std::min(sizes[r], from)));
       displs[r] = total, total += counts[r];
     }
-    round.resize(primal::index_cast<std::size_t>(total));
-    const std::size_t own = std::min(kRound, mine.size() - std::min(mine.size(), from));
+    part.resize(primal::index_cast<std::size_t>(total));
+    const std::size_t own = std::min(round, mine.size() - std::min(mine.size(), from));
     MPI_Allgatherv(mine.data() + std::min(mine.size(), from), static_cast<int>(own), MPI_CHAR,
-                   round.data(), counts.data(), displs.data(), MPI_CHAR, comm);
+                   part.data(), counts.data(), displs.data(), MPI_CHAR, comm);
     for (std::size_t r = 0; r < sizes.size(); ++r)
-      std::copy_n(round.data() + displs[r], counts[r],
+      std::copy_n(part.data() + displs[r], counts[r],
                   all.data() + base[r] + std::min<std::size_t>(from, sizes[r]));
   }
   return all;
 }
 
-}  // namespace
-
 primal::Shares rank_shares(MPI_Comm comm) {
   primal::Shares s;
   MPI_Comm_rank(comm, &s.share);
   MPI_Comm_size(comm, &s.shares);
-  s.exchange = [comm, ranks = s.shares](const std::vector<char>& mine) {
-    return all_gather_bytes(mine, comm, ranks);
-  };
+  s.exchange = [comm](const std::vector<char>& mine) { return all_gather_bytes(mine, comm); };
   return s;
 }
 

@@ -26,6 +26,7 @@
 // formula over the same nodes). Diced nodes shared by ranks are found by their origin (the
 // sorted input nodes they are made from) exchanged between the ranks whose elements hold all of
 // them.
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -37,6 +38,7 @@
 #include <geode/conform/conform.hpp>
 #include <geode/primal/input_check.hpp>
 #include <geode/primal/model.hpp>
+#include <geode/primal/shares.hpp>
 
 namespace geode::parallel {
 
@@ -88,8 +90,14 @@ RankMesh conform_distributed(const primal::Model& input, const DistributedOption
 RankMesh conform_distributed(primal::Model&& input, const DistributedOptions& options,
                              MPI_Comm comm, DistributedReport* report = nullptr);
 
-// The ranks of `comm` as primal::Shares: this rank's number, their count, and an exchange by
-// MPI_Allgatherv (in rounds of 256 MiB a rank, so any sizes go).
+// Every rank's bytes, concatenated in rank order, on every rank: one MPI_Allgatherv, or, when a
+// rank has more than `round` bytes or all have more than 2 GiB (MPI's counts are ints), rounds
+// of at most `round` bytes a rank, each copied into place. Collective.
+std::vector<char> all_gather_bytes(const std::vector<char>& mine, MPI_Comm comm,
+                                   std::size_t round = std::size_t{1} << 28);
+
+// The ranks of `comm` as primal::Shares: this rank's number, their count, and all_gather_bytes
+// as the exchange.
 primal::Shares rank_shares(MPI_Comm comm);
 
 // The read-time covering check (primal/input_check.hpp) shared among the ranks of `comm`, for

@@ -8,15 +8,19 @@
 // neighbour's on the same global ids and coordinates) and their hexes together the joined
 // file's. Prints the first difference and exits 1.
 // parallel_check count FILE.exo: prints its number of hexes.
+// mpirun -np N parallel_check gather: parallel::all_gather_bytes, in one call and in rounds.
 #include <exodusII.h>
+#include <mpi.h>
 
 #include <array>
 #include <iostream>
 #include <map>
 #include <set>
+#include <vector>
 
 #include <geode/io/exodus.hpp>
 #include <geode/io/read_model.hpp>
+#include <geode/parallel/distributed_conform.hpp>
 #include <geode/parallel/nemesis.hpp>
 
 namespace {
@@ -180,9 +184,37 @@ int ranks(const std::string& out, int n) {
 
 }  // namespace
 
+// Under mpirun: parallel::all_gather_bytes of rank-dependent sizes (one rank with none), in one
+// call and in rounds of 16 and 1000 bytes, against the concatenation every rank can compute.
+int gather(int argc, char** argv) {
+  MPI_Init(&argc, &argv);
+  int rank = 0, ranks = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  const auto bytes_of = [](int r) {
+    std::vector<char> b(r == 1 ? 0 : static_cast<std::size_t>(r) * 37 + 11);
+    for (std::size_t i = 0; i < b.size(); ++i) b[i] = static_cast<char>((r * 131 + i) & 0xff);
+    return b;
+  };
+  std::vector<char> expected;
+  for (int r = 0; r < ranks; ++r) {
+    const std::vector<char> b = bytes_of(r);
+    expected.insert(expected.end(), b.begin(), b.end());
+  }
+  int bad = 0;
+  for (std::size_t round : {std::size_t{16}, std::size_t{1000}, std::size_t{1} << 28})
+    bad |= parallel::all_gather_bytes(bytes_of(rank), MPI_COMM_WORLD, round) != expected;
+  int any = 0;
+  MPI_Allreduce(&bad, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  if (rank == 0) std::cout << "gather on " << ranks << " ranks: " << (any ? "WRONG" : "ok") << "\n";
+  MPI_Finalize();
+  return any;
+}
+
 int main(int argc, char** argv) {
   try {
     const std::string mode = argc > 1 ? argv[1] : "";
+    if (mode == "gather" && argc == 2) return gather(argc, argv);
     if (mode == "same" && argc == 4) return same(argv[2], argv[3]);
     if (mode == "ranks" && argc == 4) return ranks(argv[2], std::stoi(argv[3]));
     if (mode == "count" && argc == 3) {
@@ -192,6 +224,7 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     return fail(e.what());
   }
-  std::cerr << "usage: parallel_check same A.exo B.exo | ranks OUT.exo N | count FILE.exo\n";
+  std::cerr << "usage: parallel_check same A.exo B.exo | ranks OUT.exo N | count FILE.exo | "
+               "gather (under mpirun)\n";
   return 2;
 }
