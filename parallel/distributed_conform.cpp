@@ -172,7 +172,9 @@ void Distributor::conform_zone() {
       // it covers its region once (its cut, unlike a model's boundary, may be non-manifold, which
       // piece_ok does not judge); verify() checks around the cut whole.
       conform::ConformOptions zone_options = options_.conform;
-      conform::ConformResult r = conform::conform(std::move(zone.model), zone_options);
+      conform::ConformResult r;
+      run_on_cpus(zone_cpus_, options_.zone_threads,
+                  [&] { r = conform::conform(std::move(zone.model), zone_options); });
       // The band diced alone must be found in the zone's output, node for node (its points, all
       // distinct, looked for among the zone's).
       const primal::Submodel b = primal::extract_submodel(m(), band_);
@@ -277,7 +279,9 @@ void Distributor::partition() {
   if (rank_ == zone_rank()) {
     MPI_Recv(part_.data(), count, MPI_INT, 0, 0, comm_, MPI_STATUS_IGNORE);
   } else {  // the ranks before it: from rank 0, without waiting for the zone rank
-    MPI_Bcast(part_.data(), count, MPI_INT, 0, others_);
+    MPI_Request received;
+    MPI_Ibcast(part_.data(), count, MPI_INT, 0, others_, &received);
+    wait_quietly(received);
   }
   if (count > 0 && part_[0] < 0) {
     if (partition_sent_ != MPI_REQUEST_NULL) MPI_Wait(&partition_sent_, MPI_STATUS_IGNORE);

@@ -56,6 +56,11 @@ struct DistributedOptions {
   // sends the depth it needed once the other ranks have diced). Without it a rank holds the
   // input until its numbering.
   std::function<primal::Model()> reload;
+  // TBB threads of the zone's conform on the zone rank: 0 for one per CPU of the ranks on its
+  // machine (parallel/machine_cpus.hpp), whose other ranks wait for the zone without spinning
+  // once their own dicing is done. The caller's tbb::global_control must allow that many. The
+  // result is the same for any count (conform's is).
+  int zone_threads = 0;
 };
 
 // One rank's share of the output.

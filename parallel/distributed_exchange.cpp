@@ -20,6 +20,10 @@ void broadcast(void* data, std::size_t n, MPI_Datatype type, std::size_t size, i
 // diced nodes on the cut), block names and sets. A rank that diced a zone since grown dices again.
 void Distributor::share_zone() {
   const int root = zone_rank();
+  // Every rank here once its dicing is done; the zone rank last, as a rule.
+  MPI_Request all_here;
+  MPI_Ibarrier(comm_, &all_here);
+  wait_quietly(all_here);
   primal::detail::BytePacket packet;
   if (rank_ == root) {
     packet.put(zone_failure_kind_);

@@ -8,9 +8,11 @@
 #include <CLI/CLI.hpp>
 #include <iostream>
 #include <sstream>
+#include <thread>
 
 #include <mpi.h>
 #include <tbb/global_control.h>
+#include <tbb/task_arena.h>
 
 #include <geode/io/read_model.hpp>
 #include <geode/parallel/distributed_conform.hpp>
@@ -34,7 +36,7 @@ int run(int argc, char** argv, int rank, int size) {
   CLI::App* conform = app.add_subcommand("conform", "conform a hex + tet model, partitioned");
   std::string input, output, smooth = "local", side = "hex", verify = "local";
   bool join = false, quiet = false;
-  int rings = 4, threads = 1;
+  int rings = 4, threads = 1, zone_threads = 0;
   double thickness = 0;
   conform
       ->add_option("input", input,
@@ -61,6 +63,11 @@ int run(int argc, char** argv, int rank, int size) {
       "--rings", rings,
       "depth of the transition zone, conformed once on the last rank (grown as needed)");
   conform->add_option("--threads", threads, "TBB threads per rank (default 1: one core each)");
+  conform->add_option(
+      "--zone-threads", zone_threads,
+      "TBB threads of the transition zone's conform on the last rank (default 0: one per CPU "
+      "the ranks on its machine were given; they wait for the zone without spinning once their "
+      "own dicing is done); the result is the same for any count");
   conform->add_flag("-q,--quiet", quiet, "no progress or summary");
   try {
     app.parse(argc, argv);
@@ -68,89 +75,104 @@ int run(int argc, char** argv, int rank, int size) {
     if (rank == 0) app.exit(e);
     return e.get_exit_code() == 0 ? 0 : 2;
   }
-  tbb::global_control threads_limit(tbb::global_control::max_allowed_parallelism,
-                                    primal::index_cast<std::size_t>(std::max(threads, 1)));
-  try {
-    const double t0 = MPI_Wtime();
-    parallel::DistributedOptions options;
-    options.conform.smooth = conform::parse_conform_smooth(smooth);
-    options.conform.buffer.side = conform::parse_buffer_side(side);
-    options.conform.buffer.thickness = thickness;
-    options.conform.verify = conform::parse_conform_verify(verify);
-    options.rings = rings;
-    // Each rank frees the input once it has its piece, and reads it again only if the zone
-    // grows after that (the read-time check passed already).
-    options.reload = [&input] { return io::read_model(input, {}, false); };
-    io::FilePartition file_partition;
-    primal::Model model = io::read_model(input, {}, true, &file_partition,
-                                         parallel::shared_input_check(MPI_COMM_WORLD));
-    // The input's own partition (a partitioned .msh, a Nemesis set) unless it has fewer parts
-    // than there are ranks: then METIS (parallel/partition.hpp).
-    std::string partitioned_by = size > 1 ? "METIS" : "one rank";
-    if (file_partition.parts > 0) {
-      options.partition = parallel::ranks_of_parts(file_partition.part, file_partition.parts, size);
-      std::string parts = "the input's " + std::to_string(file_partition.parts) + " parts";
-      if (file_partition.parts > size)
-        parts += " joined on " + std::to_string(size) + (size == 1 ? " rank" : " ranks");
-      partitioned_by =
-          options.partition.empty() ? "METIS (" + parts + " are fewer than the ranks)" : parts;
-    }
-    file_partition = {};
-    const double t_read = MPI_Wtime() - t0;
-    parallel::DistributedReport report;
-    const parallel::RankMesh mesh =
-        parallel::conform_distributed(std::move(model), options, MPI_COMM_WORLD, &report);
-    const double t_conform = MPI_Wtime() - t0 - t_read;
-    if (report.valid) parallel::write_nemesis(mesh, output, size, rank);
-    const double t_write = MPI_Wtime() - t0 - t_read - t_conform;
-    if (report.valid && join) parallel::write_joined(mesh, output, MPI_COMM_WORLD);
-    const double t_all = MPI_Wtime() - t0;
-    // Per rank: time per stage and peak memory, gathered to rank 0.
-    std::ostringstream line;
-    line << "rank " << rank << ": " << mesh.model.hexes.size() << " hexes (" << report.zone_hexes
-         << " of the transition zone, " << report.diced_hexes << " diced), read " << t_read
-         << " s, conform " << t_conform << " s (";
-    for (const auto& [stage, s] : report.seconds) line << stage << " " << s << " s, ";
-    line << "), write " << t_write << " s, total " << t_all << " s, peak " << peak_mib() << " MiB";
-    const std::string text = line.str();
-    int n = primal::index_cast<int>(text.size());
-    std::vector<int> counts(primal::index_cast<std::size_t>(size)), displs(counts.size());
-    MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
-    std::exclusive_scan(counts.begin(), counts.end(), displs.begin(), 0);
-    std::string all(rank == 0 ? primal::index_cast<std::size_t>(displs.back() + counts.back()) : 0,
-                    ' ');
-    MPI_Gatherv(text.data(), n, MPI_CHAR, all.data(), counts.data(), displs.data(), MPI_CHAR, 0,
-                MPI_COMM_WORLD);
-    if (rank == 0 && !quiet) {
-      std::cout << "geode_mpi: " << size << " ranks, " << mesh.global_hexes << " hexes, "
-                << mesh.global_nodes << " nodes, transition zone " << report.zone_cells
-                << " input elements (" << report.rings << " rings), partition: " << partitioned_by
-                << ", " << (report.valid ? "valid" : "INVALID") << ", " << t_all << " s\n";
-      for (int r = 0; r < size; ++r)
-        std::cout << "  "
-                  << all.substr(primal::index_cast<std::size_t>(
-                                    displs[primal::index_cast<std::size_t>(r)]),
-                                primal::index_cast<std::size_t>(
-                                    counts[primal::index_cast<std::size_t>(r)]))
-                  << "\n";
-      for (const auto& w : report.warnings) std::cout << "  warning: " << w << "\n";
-    }
-    if (!report.valid) {
-      for (const auto& w : report.warnings) std::cerr << "geode_mpi: " << w << "\n";
-      if (rank == 0) std::cerr << "geode_mpi: invalid result, nothing written\n";
+  // The rank's own work runs in an arena of `threads`; the zone's conform in one of its own,
+  // which may take every CPU of the machine (DistributedOptions::zone_threads): the process's
+  // limit is the larger (TBB's default is the CPUs mpirun bound the rank to).
+  const int cpus = std::max(static_cast<int>(std::thread::hardware_concurrency()), 1);
+  tbb::global_control threads_limit(
+      tbb::global_control::max_allowed_parallelism,
+      primal::index_cast<std::size_t>(std::max({threads, zone_threads, cpus, 1})));
+  // Everything after the options, in the rank's arena.
+  const auto conform_in_arena = [&]() -> int {
+    try {
+      const double t0 = MPI_Wtime();
+      parallel::DistributedOptions options;
+      options.conform.smooth = conform::parse_conform_smooth(smooth);
+      options.conform.buffer.side = conform::parse_buffer_side(side);
+      options.conform.buffer.thickness = thickness;
+      options.conform.verify = conform::parse_conform_verify(verify);
+      options.rings = rings;
+      options.zone_threads = zone_threads;
+      // Each rank frees the input once it has its piece, and reads it again only if the zone
+      // grows after that (the read-time check passed already).
+      options.reload = [&input] { return io::read_model(input, {}, false); };
+      io::FilePartition file_partition;
+      primal::Model model = io::read_model(input, {}, true, &file_partition,
+                                           parallel::shared_input_check(MPI_COMM_WORLD));
+      // The input's own partition (a partitioned .msh, a Nemesis set) unless it has fewer parts
+      // than there are ranks: then METIS (parallel/partition.hpp).
+      std::string partitioned_by = size > 1 ? "METIS" : "one rank";
+      if (file_partition.parts > 0) {
+        options.partition =
+            parallel::ranks_of_parts(file_partition.part, file_partition.parts, size);
+        std::string parts = "the input's " + std::to_string(file_partition.parts) + " parts";
+        if (file_partition.parts > size)
+          parts += " joined on " + std::to_string(size) + (size == 1 ? " rank" : " ranks");
+        partitioned_by =
+            options.partition.empty() ? "METIS (" + parts + " are fewer than the ranks)" : parts;
+      }
+      file_partition = {};
+      const double t_read = MPI_Wtime() - t0;
+      parallel::DistributedReport report;
+      const parallel::RankMesh mesh =
+          parallel::conform_distributed(std::move(model), options, MPI_COMM_WORLD, &report);
+      const double t_conform = MPI_Wtime() - t0 - t_read;
+      if (report.valid) parallel::write_nemesis(mesh, output, size, rank);
+      const double t_write = MPI_Wtime() - t0 - t_read - t_conform;
+      if (report.valid && join) parallel::write_joined(mesh, output, MPI_COMM_WORLD);
+      const double t_all = MPI_Wtime() - t0;
+      // Per rank: time per stage and peak memory, gathered to rank 0.
+      std::ostringstream line;
+      line << "rank " << rank << ": " << mesh.model.hexes.size() << " hexes (" << report.zone_hexes
+           << " of the transition zone, " << report.diced_hexes << " diced), read " << t_read
+           << " s, conform " << t_conform << " s (";
+      for (const auto& [stage, s] : report.seconds) line << stage << " " << s << " s, ";
+      line << "), write " << t_write << " s, total " << t_all << " s, peak " << peak_mib()
+           << " MiB";
+      const std::string text = line.str();
+      int n = primal::index_cast<int>(text.size());
+      std::vector<int> counts(primal::index_cast<std::size_t>(size)), displs(counts.size());
+      MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
+      std::exclusive_scan(counts.begin(), counts.end(), displs.begin(), 0);
+      std::string all(
+          rank == 0 ? primal::index_cast<std::size_t>(displs.back() + counts.back()) : 0, ' ');
+      MPI_Gatherv(text.data(), n, MPI_CHAR, all.data(), counts.data(), displs.data(), MPI_CHAR, 0,
+                  MPI_COMM_WORLD);
+      if (rank == 0 && !quiet) {
+        std::cout << "geode_mpi: " << size << " ranks, " << mesh.global_hexes << " hexes, "
+                  << mesh.global_nodes << " nodes, transition zone " << report.zone_cells
+                  << " input elements (" << report.rings << " rings), partition: " << partitioned_by
+                  << ", " << (report.valid ? "valid" : "INVALID") << ", " << t_all << " s\n";
+        for (int r = 0; r < size; ++r)
+          std::cout << "  "
+                    << all.substr(primal::index_cast<std::size_t>(
+                                      displs[primal::index_cast<std::size_t>(r)]),
+                                  primal::index_cast<std::size_t>(
+                                      counts[primal::index_cast<std::size_t>(r)]))
+                    << "\n";
+        for (const auto& w : report.warnings) std::cout << "  warning: " << w << "\n";
+      }
+      if (!report.valid) {
+        for (const auto& w : report.warnings) std::cerr << "geode_mpi: " << w << "\n";
+        if (rank == 0) std::cerr << "geode_mpi: invalid result, nothing written\n";
+        return 4;
+      }
+      return 0;
+    } catch (const InvalidInput& e) {
+      if (rank == 0) std::cerr << "geode_mpi: " << e.what() << "\n";
+      return 2;
+    } catch (const TopologyError& e) {
+      if (rank == 0) std::cerr << "geode_mpi: " << e.what() << "\n";
+      return 3;
+    } catch (const std::exception& e) {
+      std::cerr << "geode_mpi (rank " << rank << "): " << e.what() << "\n";
       return 4;
     }
-    return 0;
-  } catch (const InvalidInput& e) {
-    if (rank == 0) std::cerr << "geode_mpi: " << e.what() << "\n";
-    return 2;
-  } catch (const TopologyError& e) {
-    if (rank == 0) std::cerr << "geode_mpi: " << e.what() << "\n";
-    return 3;
-  } catch (const std::exception& e) {
-    std::cerr << "geode_mpi (rank " << rank << "): " << e.what() << "\n";
-    return 4;
-  }
+  };
+  tbb::task_arena arena(std::max(threads, 1));
+  int code = 0;
+  arena.execute([&] { code = conform_in_arena(); });
+  return code;
 }
 
 }  // namespace

@@ -20,6 +20,7 @@
 #include <mpi.h>
 
 #include <geode/parallel/distributed_conform.hpp>
+#include <geode/parallel/machine_cpus.hpp>
 #include <geode/parallel/partition.hpp>
 #include <geode/primal/detail/byte_packet.hpp>
 #include <geode/primal/dice.hpp>
@@ -147,6 +148,7 @@ class Distributor {
     MPI_Comm_size(comm, &size_);
     // The ranks but the zone rank, for what they share while it conforms the zone.
     MPI_Comm_split(comm, rank_ == zone_rank() ? MPI_UNDEFINED : 0, rank_, &others_);
+    zone_cpus_ = machine_cpus(comm);
     take_model(input);
   }
 
@@ -265,6 +267,7 @@ class Distributor {
   const Model& input_;
   Model* spare_;
   int rank_ = 0, size_ = 1;
+  cpu_set_t zone_cpus_;  // what the zone's conform may run on: the CPUs of this machine's ranks
   Model split_;
   Model reloaded_;        // the input read again (options_.reload) for a zone grown after trimming
   bool trimmed_ = false;  // the model's arrays freed before dicing (trim_model)
