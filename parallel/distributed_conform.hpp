@@ -2,7 +2,8 @@
 // conform (conform/conform.hpp) under MPI, with a result that does not depend on the number of
 // ranks: the output of every rank joined is the serial run's, node for node and hex for hex.
 //
-// Every rank reads the whole input (inputs are ~25x smaller than outputs). The transition zone
+// Every rank holds the whole input (inputs are ~25x smaller than outputs; geode_mpi reads a single
+// Exodus file in shares, io/exodus.hpp read_exodus_shared). The transition zone
 // Z, every element within `rings` node rings of a node used by both a hex and a tet (plus the
 // elements setting the yardstick and any inverted element, which the serial run also smooths),
 // is conformed once, on the last rank (the zone rank), while rank 0 partitions the elements by

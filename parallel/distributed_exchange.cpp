@@ -20,7 +20,8 @@ void broadcast(void* data, std::size_t n, MPI_Datatype type, std::size_t size, i
 // diced nodes on the cut), block names and sets. A rank that diced a zone since grown dices again.
 void Distributor::share_zone() {
   const int root = zone_rank();
-  // Every rank here once its dicing is done; the zone rank last, as a rule.
+  // Every rank here once its dicing is done, the zone rank last as a rule: the others wait
+  // for it without spinning, so that the zone's conform can use their cores.
   MPI_Request all_here;
   MPI_Ibarrier(comm_, &all_here);
   wait_quietly(all_here);
