@@ -63,11 +63,13 @@ int run(int argc, char** argv, int rank, int size) {
       "--rings", rings,
       "depth of the transition zone, conformed once on the last rank (grown as needed)");
   conform->add_option("--threads", threads, "TBB threads per rank (default 1: one core each)");
-  conform->add_option(
-      "--zone-threads", zone_threads,
-      "TBB threads of the transition zone's conform on the last rank (default 0: one per CPU "
-      "the ranks on its machine were given; they wait for the zone without spinning once their "
-      "own dicing is done); the result is the same for any count");
+  conform
+      ->add_option(
+          "--zone-threads", zone_threads,
+          "TBB threads of the transition zone's conform on the last rank (default 0: one per CPU "
+          "the ranks on its machine were given; they wait for the zone without spinning once their "
+          "own dicing is done); the result is the same for any count")
+      ->check(CLI::Range(0, 4096));
   conform->add_flag("-q,--quiet", quiet, "no progress or summary");
   try {
     app.parse(argc, argv);
