@@ -213,13 +213,16 @@ class MshReader {
 
   // ---- Lexing ----------------------------------------------------------------------------
 
+  // The C locale's white space, without std::isspace's call per character (most of a large
+  // ASCII file's lexing).
+  static bool space(char c) { return c == ' ' || (c >= '\t' && c <= '\r'); }
   void skip_space() {
-    while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
+    while (pos_ < s_.size() && space(s_[pos_])) ++pos_;
   }
   std::string_view token(const char* what) {
     skip_space();
     const std::size_t start = pos_;
-    while (pos_ < s_.size() && !std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
+    while (pos_ < s_.size() && !space(s_[pos_])) ++pos_;
     if (start == pos_)
       fail(std::string("unexpected end of file reading ") + what + " (truncated file?)");
     const std::string_view t = s_.substr(start, pos_ - start);
