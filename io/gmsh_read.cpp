@@ -15,6 +15,7 @@
 #include <unordered_map>
 #include <utility>
 
+#include <geode/io/detail/ascii_space.hpp>
 #include <geode/io/file_format.hpp>
 #include <geode/io/gmsh.hpp>
 #include <geode/io/names.hpp>
@@ -213,16 +214,13 @@ class MshReader {
 
   // ---- Lexing ----------------------------------------------------------------------------
 
-  // The C locale's white space, without std::isspace's call per character (most of a large
-  // ASCII file's lexing).
-  static bool space(char c) { return c == ' ' || (c >= '\t' && c <= '\r'); }
   void skip_space() {
-    while (pos_ < s_.size() && space(s_[pos_])) ++pos_;
+    while (pos_ < s_.size() && detail::ascii_space(s_[pos_])) ++pos_;
   }
   std::string_view token(const char* what) {
     skip_space();
     const std::size_t start = pos_;
-    while (pos_ < s_.size() && !space(s_[pos_])) ++pos_;
+    while (pos_ < s_.size() && !detail::ascii_space(s_[pos_])) ++pos_;
     if (start == pos_)
       fail(std::string("unexpected end of file reading ") + what + " (truncated file?)");
     const std::string_view t = s_.substr(start, pos_ - start);
@@ -304,12 +302,10 @@ class MshReader {
     if (s_[pos_] != '$')
       fail("expected a section ($Name), found '" + std::string(s_.substr(pos_, 20)) + "'");
     const std::size_t start = ++pos_;
-    while (pos_ < s_.size() && !std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
+    while (pos_ < s_.size() && !detail::ascii_space(s_[pos_])) ++pos_;
     const std::string name(s_.substr(start, pos_ - start));
     // The rest of the line: binary data starts right after it.
-    while (pos_ < s_.size() && s_[pos_] != '\n' &&
-           std::isspace(static_cast<unsigned char>(s_[pos_])))
-      ++pos_;
+    while (pos_ < s_.size() && s_[pos_] != '\n' && detail::ascii_space(s_[pos_])) ++pos_;
     if (pos_ < s_.size() && s_[pos_] == '\n') ++pos_;
     return name;
   }
@@ -317,8 +313,7 @@ class MshReader {
     skip_space();
     const std::string end = "$End" + name;
     if (s_.substr(pos_, end.size()) != end ||
-        (pos_ + end.size() < s_.size() &&
-         !std::isspace(static_cast<unsigned char>(s_[pos_ + end.size()])))) {
+        (pos_ + end.size() < s_.size() && !detail::ascii_space(s_[pos_ + end.size()]))) {
       if (pos_ >= s_.size()) fail_at(start, "$" + name + " has no " + end + " (truncated file?)");
       fail("$" + name + " ends without " + end + " (found '" +
            std::string(s_.substr(pos_, std::min<std::size_t>(20, s_.find('\n', pos_) - pos_))) +
@@ -491,9 +486,7 @@ class MshReader {
     const std::size_t n = count_field(what, was_binary ? binary_min_bytes : ascii_min_bytes);
     binary_ = was_binary;
     if (binary_) {
-      while (pos_ < s_.size() && s_[pos_] != '\n' &&
-             std::isspace(static_cast<unsigned char>(s_[pos_])))
-        ++pos_;
+      while (pos_ < s_.size() && s_[pos_] != '\n' && detail::ascii_space(s_[pos_])) ++pos_;
       if (pos_ >= s_.size() || s_[pos_] != '\n') fail(std::string("no line end after ") + what);
       ++pos_;
     }

@@ -43,15 +43,15 @@ class Tokens {
     if (done())
       fail(file_, line_, "unexpected end of file while reading " + what + " (truncated file?)");
     const std::size_t start = pos_;
-    while (pos_ < s_.size() && !std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
+    while (pos_ < s_.size() && !detail::ascii_space(s_[pos_])) ++pos_;
     token_line_ = line_;
     return s_.substr(start, pos_ - start);
   }
   std::string_view peek() const {
     std::size_t start = pos_;
-    while (start < s_.size() && std::isspace(static_cast<unsigned char>(s_[start]))) ++start;
+    while (start < s_.size() && detail::ascii_space(s_[start])) ++start;
     std::size_t end = start;
-    while (end < s_.size() && !std::isspace(static_cast<unsigned char>(s_[end]))) ++end;
+    while (end < s_.size() && !detail::ascii_space(s_[end])) ++end;
     return s_.substr(start, end - start);
   }
   // Skips up to the next blank line (VTK's METADATA blocks end there).
@@ -65,7 +65,7 @@ class Tokens {
       pos_ = eol + 1;
       ++line_;
       std::size_t p = pos_;
-      while (p < s_.size() && s_[p] != '\n' && std::isspace(static_cast<unsigned char>(s_[p]))) ++p;
+      while (p < s_.size() && s_[p] != '\n' && detail::ascii_space(s_[p])) ++p;
       if (p >= s_.size() || s_[p] == '\n') return;
     }
   }
@@ -160,8 +160,7 @@ class Tokens {
   }
   void skip_space() {
     if (in_array_) return;
-    while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_])))
-      line_ += s_[pos_++] == '\n';
+    while (pos_ < s_.size() && detail::ascii_space(s_[pos_])) line_ += s_[pos_++] == '\n';
   }
   // One big-endian value of the current array type, as its bits.
   std::uint64_t raw_bits(const std::string& what) {

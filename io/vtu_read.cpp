@@ -81,7 +81,7 @@ class XmlParser {
              " (truncated file?)");
   }
   void skip_space() {
-    while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_]))) advance(1);
+    while (pos_ < s_.size() && detail::ascii_space(s_[pos_])) advance(1);
   }
   void skip_until(std::string_view end, const std::string& what) {
     const int opened = line_;
@@ -239,7 +239,7 @@ std::string decode_base64(std::string_view text, const std::string& file, int li
   int quantum[4];
   int n = 0, pad = 0;
   for (char c : text) {
-    if (std::isspace(static_cast<unsigned char>(c))) continue;
+    if (detail::ascii_space(c)) continue;
     if (c == '=') {
       if (n < 2) fail(file, line, "base64: misplaced padding");
       ++pad;

@@ -2,7 +2,6 @@
 // What the two VTK readers (vtu_read.cpp: XML; vtk_read.cpp: legacy) share: the line-numbered
 // failure, the check of cells against their types and the points, and numbers parsed from text
 // (std::from_chars, every token whole, the file and line named on failure).
-#include <cctype>
 #include <charconv>
 #include <limits>
 #include <memory>
@@ -10,6 +9,7 @@
 #include <string_view>
 #include <vector>
 
+#include <geode/io/detail/ascii_space.hpp>
 #include <geode/io/vtk.hpp>
 #include <geode/io/vtk_cells.hpp>
 #include <geode/primal/errors.hpp>
@@ -66,12 +66,12 @@ inline Numbers split_numbers(std::string_view text, int first_line) {
   std::size_t i = 0;
   while (i < text.size()) {
     if (text[i] == '\n') ++line;
-    if (std::isspace(static_cast<unsigned char>(text[i]))) {
+    if (ascii_space(text[i])) {
       ++i;
       continue;
     }
     const std::size_t start = i;
-    while (i < text.size() && !std::isspace(static_cast<unsigned char>(text[i]))) ++i;
+    while (i < text.size() && !ascii_space(text[i])) ++i;
     n.tokens.push_back(text.substr(start, i - start));
     n.lines.push_back(line);
   }
