@@ -23,6 +23,7 @@
 #include <geode/io/file_format.hpp>
 #include <geode/io/isolated.hpp>
 #include <geode/io/netcdf_screen.hpp>
+#include <geode/primal/detail/byte_packet.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/shares.hpp>
 #include <geode/primal/topology.hpp>
@@ -584,27 +585,17 @@ Model read_exodus_shared(const std::filesystem::path& path, const ReadOptions& o
   } catch (const std::exception& e) {
     outcome = ShareOutcome::kFault, answer = e.what();
   }
-  std::vector<char> mine(sizeof(std::uint64_t) + 1 + answer.size());
-  const std::uint64_t length = answer.size();
-  std::memcpy(mine.data(), &length, sizeof length);
-  mine[sizeof length] = static_cast<char>(outcome);
-  std::memcpy(mine.data() + sizeof length + 1, answer.data(), answer.size());
+  primal::detail::BytePacket mine;
+  mine.put(outcome);
+  mine.put(answer);
   std::string().swap(answer);
-  const std::vector<char> all = shares.exchange(mine);
-  std::vector<char>().swap(mine);
+  primal::detail::BytePacket all(shares.exchange(mine.bytes()));
+  mine = {};
   // The shares' answers in share order; the first failure is every process's.
   std::vector<std::string_view> answers;
-  for (std::size_t at = 0; std::cmp_less(answers.size(), shares.shares);) {
-    std::uint64_t n = 0;
-    if (all.size() - at < sizeof n + 1)
-      throw std::runtime_error(source + ": a shared read's exchange is malformed");
-    std::memcpy(&n, all.data() + at, sizeof n);
-    const auto kind = static_cast<ShareOutcome>(all[at + sizeof n]);
-    at += sizeof n + 1;
-    if (n > all.size() - at)
-      throw std::runtime_error(source + ": a shared read's exchange is malformed");
-    const std::string_view body(all.data() + at, n);
-    at += n;
+  for (int s = 0; s < shares.shares; ++s) {
+    const auto kind = all.get<ShareOutcome>();
+    const std::string_view body = all.get_view();
     switch (kind) {
       case ShareOutcome::kRead:
         answers.push_back(body);

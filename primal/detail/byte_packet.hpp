@@ -3,6 +3,7 @@
 #include <cstring>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -40,9 +41,12 @@ class BytePacket {
   void get(T& x) {
     x = get<T>();
   }
-  std::string get_string() {
+  std::string get_string() { return std::string(get_view()); }
+  // A string's characters where they lie in the packet (valid as long as it is): a large one
+  // read without a copy.
+  std::string_view get_view() {
     const auto n = get<std::size_t>();
-    return std::string(take(n), n);
+    return std::string_view(take(n), n);
   }
 
   // The bytes, to send, or to fill before reading (a receiver resizes them).
