@@ -263,7 +263,7 @@ void Distributor::assemble() {
   // Every rank must list the same blocks: the union over ranks.
   std::sort(ids.begin(), ids.end());
   ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-  std::vector<int> every = gather_all(ids, comm_, size_);
+  std::vector<int> every = gather_all(ids, comm_);
   std::sort(every.begin(), every.end());
   every.erase(std::unique(every.begin(), every.end()), every.end());
   std::vector<std::int64_t> local_counts, global_counts(every.size());

@@ -88,7 +88,7 @@ void Distributor::yardstick() {
   MPI_Allreduce(low, all, 3, MPI_DOUBLE_INT, MPI_MINLOC, comm_);
   for (const auto& a : all)
     if (a.value <= 1.5) lowest_.push_back(primal::index_cast<std::size_t>(a.cell));
-  const std::vector<int> every = gather_all(inverted, comm_, size_);
+  const std::vector<int> every = gather_all(inverted, comm_);
   inverted_.assign(every.begin(), every.end());
   std::sort(inverted_.begin(), inverted_.end());
 }

@@ -2,6 +2,8 @@
 // hexes shared out from the zone rank, and the global node and hex ids.
 #include <geode/parallel/detail/distributor.hpp>
 
+#include <numeric>
+
 namespace geode::parallel::detail {
 namespace {
 

@@ -10,7 +10,6 @@
 #include <cstring>
 #include <limits>
 #include <map>
-#include <numeric>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -111,15 +110,13 @@ class PointBitsMap {
   std::size_t mask_ = 0, size_ = 0;
 };
 
-// Every rank's `mine`, concatenated in rank order (MPI_Allgatherv of ints).
-inline std::vector<int> gather_all(const std::vector<int>& mine, MPI_Comm comm, int ranks) {
-  const int n = primal::index_cast<int>(mine.size());
-  std::vector<int> counts(primal::index_cast<std::size_t>(ranks)), displs(counts.size());
-  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
-  std::exclusive_scan(counts.begin(), counts.end(), displs.begin(), 0);
-  std::vector<int> every(primal::index_cast<std::size_t>(displs.back() + counts.back()));
-  MPI_Allgatherv(mine.data(), n, MPI_INT, every.data(), counts.data(), displs.data(), MPI_INT,
-                 comm);
+// Every rank's `mine`, concatenated in rank order (all_gather_bytes of their bytes).
+inline std::vector<int> gather_all(const std::vector<int>& mine, MPI_Comm comm) {
+  std::vector<char> bytes(mine.size() * sizeof(int));
+  if (!mine.empty()) std::memcpy(bytes.data(), mine.data(), bytes.size());
+  const std::vector<char> all = all_gather_bytes(bytes, comm);
+  std::vector<int> every(all.size() / sizeof(int));
+  if (!every.empty()) std::memcpy(every.data(), all.data(), every.size() * sizeof(int));
   return every;
 }
 
