@@ -488,6 +488,10 @@ void Conformer::place_templates() {
       } else {
         inst_side_[b][i] = side_sets_uf_.add();
         side_pos_.push_back(x);
+        FaceKey origin = kNoOrigin;
+        for (std::size_t k = 0; k < rt.side_corners[i].size() && k < origin.size(); ++k)
+          origin[k] = bh.corners[rt.side_corners[i][k]];
+        side_origin_.push_back(primal::normalized_origin(origin));
       }
     }
   }
@@ -538,12 +542,12 @@ void Conformer::match_sides() {
   for (Index s = 0; s < ns; ++s) sum[uf.find(s)] += side_pos_[s], ++cnt[uf.find(s)];
   std::vector<Index> gid(ns, kInvalidIndex);
   for (Index s = 0; s < ns; ++s)
-    if (uf.find(s) == s) gid[s] = diced_.add_node(sum[s] / cnt[s]);
+    if (uf.find(s) == s) gid[s] = diced_.add_node(sum[s] / cnt[s], side_origin_[s]);
   for (std::size_t b = 0; b < nb; ++b)
     for (std::size_t i = 0; i < inst_side_[b].size(); ++i)
       if (inst_side_[b][i] != kInvalidIndex) inst_global_[b][i] = gid[uf.find(inst_side_[b][i])];
   uf = {};
-  primal::release(side_pos_, inst_side_);
+  primal::release(side_pos_, side_origin_, inst_side_);
   say("side faces: " + std::to_string(shared_faces) + " shared by two buffer hexes, merged" +
       took());
 }
@@ -559,7 +563,7 @@ void Conformer::assemble() {
   // block of the element its buffer hex was carved from, or in a block of its own.
   const primal::Model& lm = layer_.model;
   // Side sets read the children in diced numbers: taken before the children move.
-  side_sets_ = primal::diced_side_sets(lm, diced_, 0, res_.diced_hexes + res_.geode_hexes);
+  carry_side_sets();
   // Nodes numbered in order of first use by the output hexes (unused ones dropped), read off
   // the children where they are, so that the node sets (which need the origins) are made and
   // the origins freed before the output's connectivity is built beside the children.
@@ -582,19 +586,7 @@ void Conformer::assemble() {
   for (const auto& h : diced_.tet_children) number(h);
   for (const auto& h : diced_.wedge_children) number(h);
   diced_.shared = primal::KeyMap<4>();
-  // A node set keeps its interface nodes' tet-side duplicates too (the layer model's sets hold
-  // the hex-side copies only), so that a set on the boundary loses no node along the interface.
-  primal::Model sets;
-  sets.points.resize(lm.points.size());
-  sets.node_sets = lm.node_sets;
-  for (primal::NodeSet& ns : sets.node_sets) {
-    const std::size_t n = ns.nodes.size();
-    for (std::size_t i = 0; i < n; ++i)
-      if (const auto v = primal::index_cast<std::size_t>(ns.nodes[i]);
-          v < layer_.top_node.size() && layer_.top_node[v] != kInvalidIndex)
-        ns.nodes.push_back(layer_.top_node[v]);
-  }
-  node_sets_ = primal::diced_node_sets(sets, diced_, renum);
+  node_sets_ = primal::diced_node_sets(node_set_model(), diced_, renum);
   primal::release(diced_.origin);
 
   // The output hexes in output numbers: hex children, templates, tet children, wedge children.

@@ -34,6 +34,8 @@ using templates::smooth_template;
 // (conform/buffer_layer.hpp); the top and bottom as box-face bits (bit 2*axis + high).
 constexpr std::array<int, 4> kSideFace{0, 3, 1, 2};
 constexpr int kBottomBit = 2, kTopBit = 3;
+// The same side faces as box-face bits: x-, z+, x+, z-.
+constexpr std::array<int, 4> kSideBit{0, 5, 1, 4};
 
 int corner_at(int r, int s, int t) {
   for (int c = 0; c < 8; ++c)
@@ -168,6 +170,33 @@ RefTemplate make_reference(const Eigen::Vector3d& box, std::array<int, 2> diagon
     ref.side_nodes[k] = faces[kSideFace[k]].nodes;
     ref.side_quads[k] = faces[kSideFace[k]].quads;
   }
+  // The box-face bit of each buffer hex face: sides, bottom, top.
+  std::array<unsigned, 6> bit{};
+  for (int k = 0; k < 4; ++k) bit[k] = 1u << kSideBit[k];
+  bit[4] = 1u << kBottomBit, bit[5] = 1u << kTopBit;
+  ref.side_corners.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const unsigned f = ref.tpl.node_faces[i];
+    if (!ref.key_corners[i].empty() || f == 0) continue;
+    std::array<int, 8> count{};  // per corner: the side faces holding the node that hold it
+    int sides = 0;
+    for (int k = 0; k < 4; ++k)
+      if (f & bit[k]) {
+        ++sides;
+        for (int c : topo::kHexFaceCorners[k]) ++count[c];
+      }
+    for (int c = 0; c < 8; ++c)
+      if (sides > 0 && count[c] == sides) ref.side_corners[i].push_back(c);
+  }
+  const auto& hexes = ref.tpl.hex.hexes;
+  for (std::size_t h = 0; h < hexes.size(); ++h)
+    for (int lf = 0; lf < 6; ++lf)
+      for (int face = 0; face < 6; ++face) {
+        bool on = true;
+        for (int c : topo::kHexFaceCorners[lf])
+          on = on && (ref.tpl.node_faces[hexes[h][c]] & bit[face]);
+        if (on) ref.faces_on[face].push_back({static_cast<int>(h), lf});
+      }
   return ref;
 }
 

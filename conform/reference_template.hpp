@@ -30,6 +30,14 @@ struct RefTemplate {
   // Per buffer hex side face 0..3 (topology order): its template nodes and quads.
   std::array<std::vector<int>, 4> side_nodes;
   std::array<std::vector<std::array<int, 4>>, 4> side_quads;
+  // Per node on the side faces only (empty for the others): the buffer hex corners of the
+  // smallest face or edge holding it (a side face's 4, or a vertical edge's 2), which is what it
+  // is made from, as a diced node's origin says (primal/dice_model.hpp): node and side sets read
+  // it.
+  std::vector<std::vector<int>> side_corners;
+  // Per buffer hex face (0..3 its sides, 4 its bottom, 5 its top: topology order): the template
+  // hexes' faces lying on it, as (hex, local face).
+  std::array<std::vector<std::array<int, 2>>, 6> faces_on;
 };
 
 // The template for a buffer hex whose top is split along `diagonal` ({4, 6} or {5, 7},

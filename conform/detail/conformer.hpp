@@ -127,6 +127,8 @@ class Conformer {
   void place_templates();
   void match_sides();
   void assemble();
+  void carry_side_sets();
+  primal::Model node_set_model() const;
   void diced_alone_from_children(std::size_t tet_first);
   void settle_templates();
   std::vector<std::pair<Index, Point>> settled(std::size_t b) const;
@@ -177,6 +179,7 @@ class Conformer {
   std::vector<std::vector<Index>> inst_global_, inst_side_;
   primal::DisjointSets side_sets_uf_;
   std::vector<Point> side_pos_;
+  std::vector<primal::FaceKey> side_origin_;  // per item: the buffer hex corners it is made from
   primal::HexMesh mesh_;
   std::vector<primal::NodeSet> node_sets_;
   std::vector<primal::SideSet> side_sets_;

@@ -1,0 +1,176 @@
+// Node and side sets through conform (conform/conform_sets.cpp): a set on the hex/tet interface
+// stays on it, and a set on a surface or curve crossing the interface takes the buffer layer's
+// part of it, whichever part the layer is carved from.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <functional>
+#include <map>
+#include <set>
+#include <vector>
+
+#include <geode/conform/conform.hpp>
+#include <geode/demo/demo_models.hpp>
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/topology.hpp>
+
+namespace geode {
+
+namespace {
+
+using primal::Index;
+using primal::Point;
+
+bool near(double a, double b) { return std::abs(a - b) < 1e-12; }
+
+// A node set as a Gmsh physical curve gives it: its nodes, and its segments as pieces.
+primal::NodeSet curve_set(const primal::Model& m, int id,
+                          const std::function<bool(const Point&)>& on, int along) {
+  primal::NodeSet s{id, "curve " + std::to_string(id), {}, {}};
+  for (std::size_t v = 0; v < m.points.size(); ++v)
+    if (on(m.points[v])) s.nodes.push_back(primal::index_cast(v));
+  std::vector<Index> sorted = s.nodes;
+  std::sort(sorted.begin(), sorted.end(), [&](Index a, Index b) {
+    return m.points[primal::index_cast<std::size_t>(a)][along] <
+           m.points[primal::index_cast<std::size_t>(b)][along];
+  });
+  for (std::size_t i = 0; i + 1 < sorted.size(); ++i)
+    s.pieces.push_back({sorted[i], sorted[i + 1]});
+  return s;
+}
+
+// The sides of every element face whose nodes all satisfy `on`.
+primal::SideSet face_set(const primal::Model& m, int id,
+                         const std::function<bool(const Point&)>& on) {
+  primal::SideSet s{id, "faces " + std::to_string(id), {}};
+  for (primal::ElementKind kind : primal::kElementKinds) {
+    const auto& t = primal::cell_topology(kind);
+    for (std::size_t e = 0; e < primal::element_count(m, kind); ++e)
+      for (int f = 0; f < t.faces; ++f) {
+        const primal::Side side{{kind, primal::index_cast(e)}, f};
+        bool all = true;
+        for (Index v : primal::element_face(m, side))
+          all = all && on(m.points[primal::index_cast<std::size_t>(v)]);
+        if (all) s.sides.push_back(side);
+      }
+  }
+  return s;
+}
+
+// The half-block demo (Gmsh: a transfinite hex box [0,1]^3 beside a tet box [1,2] x [0,1]^2,
+// the interface x = 1) with the sets a user gives: the interface from the hex side (side set
+// 1), the face y = 0 of both boxes (side set 2), the interface's edge on y = 0 (node set 3), the
+// edge y = z = 0 across both boxes (node set 4) and the interface's corner (1, 1, 1) (node set 5).
+primal::Model half_with_sets(int n) {
+  primal::Model m = demo::demo_half_block(n);
+  m.side_sets.push_back(face_set(m, 1, [](const Point& p) { return near(p.x(), 1); }));
+  m.side_sets[0].sides.erase(
+      std::remove_if(
+          m.side_sets[0].sides.begin(), m.side_sets[0].sides.end(),
+          [](const primal::Side& s) { return s.element.kind != primal::ElementKind::kHex; }),
+      m.side_sets[0].sides.end());
+  m.side_sets.push_back(face_set(m, 2, [](const Point& p) { return near(p.y(), 0); }));
+  m.node_sets.push_back(curve_set(
+      m, 3, [](const Point& p) { return near(p.x(), 1) && near(p.y(), 0); }, 2));
+  m.node_sets.push_back(curve_set(
+      m, 4, [](const Point& p) { return near(p.y(), 0) && near(p.z(), 0); }, 0));
+  m.node_sets.push_back(curve_set(
+      m, 5, [](const Point& p) { return near(p.x(), 1) && near(p.y(), 1) && near(p.z(), 1); }, 0));
+  return m;
+}
+
+struct OutputFaces {
+  std::map<primal::FaceKey, std::vector<Index>> hexes;  // each face: the output hexes on it
+};
+
+OutputFaces output_faces(const primal::Model& out) {
+  OutputFaces o;
+  for (std::size_t h = 0; h < out.hexes.size(); ++h)
+    for (const auto& f : primal::topology::kHexFaceCorners) {
+      std::array<Index, 4> q{};
+      for (int k = 0; k < 4; ++k) q[k] = out.hexes[h][f[k]];
+      o.hexes[primal::face_key(q)].push_back(primal::index_cast(h));
+    }
+  return o;
+}
+
+std::set<primal::FaceKey> side_keys(const primal::Model& out, const primal::SideSet& s) {
+  std::set<primal::FaceKey> keys;
+  for (const primal::Side& side : s.sides)
+    keys.insert(primal::face_key(primal::element_face(out, side)));
+  return keys;
+}
+
+std::set<Index> nodes_where(const primal::Model& out, const std::function<bool(const Point&)>& on) {
+  std::set<Index> nodes;
+  for (std::size_t v = 0; v < out.points.size(); ++v)
+    if (on(out.points[v])) nodes.insert(primal::index_cast(v));
+  return nodes;
+}
+
+}  // namespace
+
+TEST_CASE("sets on the interface stay on it; sets across it take the buffer layer's part") {
+  const primal::Model in = half_with_sets(4);
+  struct Case {
+    const char* name;
+    conform::BufferSide side;
+    const char* geode_block;
+  };
+  for (const Case& c : {Case{"hex side", conform::BufferSide::kHex, ""},
+                        Case{"tet side", conform::BufferSide::kTet, ""},
+                        Case{"hex side, geode block", conform::BufferSide::kHex, "geode"}}) {
+    CAPTURE(c.name);
+    conform::ConformOptions o;
+    o.buffer.side = c.side;
+    o.geode_block = c.geode_block;
+    const conform::ConformResult r = conform::conform(in, o);
+    const primal::Model& out = r.model;
+    REQUIRE(out.side_sets.size() == 2);
+    REQUIRE(out.node_sets.size() == 3);
+    const OutputFaces faces = output_faces(out);
+    const auto block = [&](Index h) {
+      return primal::block_of(out, {primal::ElementKind::kHex, h});
+    };
+    // The hex block's face towards the others: the tet block, or the geode block.
+    const int other = *c.geode_block ? out.block_names.rbegin()->first : 2;
+    std::set<primal::FaceKey> between;
+    for (const auto& [key, hs] : faces.hexes)
+      if (hs.size() == 2 && std::min(block(hs[0]), block(hs[1])) == 1 &&
+          std::max(block(hs[0]), block(hs[1])) == other)
+        between.insert(key);
+    CHECK(!between.empty());
+    CHECK(side_keys(out, out.side_sets[0]) == between);
+    CHECK(out.side_sets[0].sides.size() == between.size());
+    if (!*c.geode_block)
+      for (const auto& key : between)
+        for (Index v : key)
+          if (v != primal::kInvalidIndex)
+            CHECK(near(out.points[primal::index_cast<std::size_t>(v)].x(), 1));
+    // The face y = 0: every boundary face of the output there.
+    std::set<primal::FaceKey> front;
+    for (const auto& [key, hs] : faces.hexes) {
+      bool all = hs.size() == 1;
+      for (Index v : key)
+        if (v != primal::kInvalidIndex)
+          all = all && near(out.points[primal::index_cast<std::size_t>(v)].y(), 0);
+      if (all) front.insert(key);
+    }
+    CHECK(side_keys(out, out.side_sets[1]) == front);
+    // Node sets: the output's nodes on their curves, as many as there are.
+    const auto set_of = [&](std::size_t i) {
+      return std::set<Index>(out.node_sets[i].nodes.begin(), out.node_sets[i].nodes.end());
+    };
+    if (!*c.geode_block)
+      CHECK(set_of(0) ==
+            nodes_where(out, [](const Point& p) { return near(p.x(), 1) && near(p.y(), 0); }));
+    CHECK(set_of(1) ==
+          nodes_where(out, [](const Point& p) { return near(p.y(), 0) && near(p.z(), 0); }));
+    CHECK(set_of(2) == nodes_where(out, [](const Point& p) {
+            return near(p.x(), 1) && near(p.y(), 1) && near(p.z(), 1);
+          }));
+    CHECK(set_of(2).size() == 1);
+  }
+}
+
+}  // namespace geode
