@@ -320,8 +320,8 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
        "--relax", a.relax,
        "interface (default): before the buffer layer, move the tet mesher's nodes within\n"
        "two rings of tets of the hex part, each where its tets diced are best (never worse;\n"
-       "nodes on the boundary, between blocks or in a node set stay; the yardsticks are\n"
-       "measured after); none: every input node stays where it is")
+       "nodes on the boundary, between blocks, in a node set or on a side set's faces stay;\n"
+       "the yardsticks are measured after); none: every input node stays where it is")
       ->check(CLI::IsMember({"interface", "none"}))
       ->capture_default_str();
   c->add_option(

@@ -235,7 +235,8 @@ RelaxTetsResult relax_tet_nodes(std::vector<Point>& points,
 
 std::vector<Index> tet_nodes_to_relax(const Model& model, int rings) {
   const std::size_t n = model.points.size();
-  // Nodes any other kind uses, or a node set names: fixed.
+  // Nodes any other kind uses, a node set names or a side set's face holds (a surface
+  // embedded in the tets stays where the user put it): fixed.
   std::vector<char> fixed(n, 0);
   for (const auto& h : model.hexes)
     for (Index v : h) fixed[index_cast<std::size_t>(v)] = 1;
@@ -245,6 +246,9 @@ std::vector<Index> tet_nodes_to_relax(const Model& model, int rings) {
     for (Index v : p) fixed[index_cast<std::size_t>(v)] = 1;
   for (const NodeSet& s : model.node_sets)
     for (Index v : s.nodes) fixed[index_cast<std::size_t>(v)] = 1;
+  for (const SideSet& s : model.side_sets)
+    for (const Side& side : s.sides)
+      for (Index v : element_face(model, side)) fixed[index_cast<std::size_t>(v)] = 1;
   // The region: rings of tets out from the quads of hexes and wedges whose four corners are
   // all tet nodes (the quads a transition is made on: two or four tet triangles on them), not
   // from every node tets share with them (a wedge layer's base lies on tet faces too).

@@ -41,8 +41,8 @@ RelaxTetsResult relax_tet_nodes(std::vector<Point>& points,
 // that tets cover (all four corners tet nodes: the tets sharing a node with such a quad, then
 // the tets sharing a node with those, ...) that may move without
 // changing the model's shape or its materials: used by tets only, all of one block, on no
-// boundary face (a face of one element; a quad's two triangles count as faces too) and in no
-// node set. Sorted ascending.
+// boundary face (a face of one element; a quad's two triangles count as faces too), in no
+// node set and on no face of a side set (a surface embedded in the tets). Sorted ascending.
 std::vector<Index> tet_nodes_to_relax(const Model& model, int rings);
 
 }  // namespace geode::primal

@@ -87,6 +87,22 @@ TEST_CASE("tet relaxation: node sets, block interfaces and the boundary stay") {
   CHECK(std::find(with_set.begin(), with_set.end(), all.front()) == with_set.end());
   CHECK(with_set.size() + 1 == all.size());
   m.node_sets.clear();
+  // A side set on a face inside the tets (an embedded surface) keeps the face's nodes.
+  {
+    std::size_t t = 0;
+    while (std::find(m.tets[t].begin(), m.tets[t].end(), all.front()) == m.tets[t].end()) ++t;
+    m.side_sets.push_back(
+        {8, "embedded", {{{primal::ElementKind::kTet, primal::index_cast(t)}, 0}}});
+    const std::vector<Index> face = primal::element_face(m, m.side_sets.back().sides.front());
+    const std::vector<Index> with_sides = primal::tet_nodes_to_relax(m, 2);
+    for (Index v : face)
+      CHECK(std::find(with_sides.begin(), with_sides.end(), v) == with_sides.end());
+    std::size_t free_on_face = 0;
+    for (Index v : face) free_on_face += std::binary_search(all.begin(), all.end(), v);
+    CHECK(free_on_face > 0);
+    CHECK(with_sides.size() + free_on_face == all.size());
+    m.side_sets.clear();
+  }
   // A tet of another block at a free node makes that node an interface between materials.
   std::size_t t = 0;
   while (std::find(m.tets[t].begin(), m.tets[t].end(), all.back()) == m.tets[t].end()) ++t;
