@@ -449,6 +449,20 @@ void check_geometry(const Model& model, std::string_view source) {
                          "positive tets; nodes " + node_list(model, c) + ")");
     }
   }
+  // A node set's node no element uses has no node in any output made from the elements: the
+  // set would lose it without a word (a Gmsh file saved without the elements of a volume in no
+  // physical group keeps that volume's points and curves).
+  if (model.node_sets.empty()) return;
+  std::vector<char> used(model.points.size(), 0);
+  for (ElementKind kind : kElementKinds)
+    for (std::size_t e = 0; e < element_count(model, kind); ++e)
+      for (Index v : element_corners(model, {kind, index_cast(e)}))
+        used[index_cast<std::size_t>(v)] = 1;
+  for (const NodeSet& set : model.node_sets)
+    for (Index v : set.nodes)
+      if (!used[index_cast<std::size_t>(v)])
+        throw InvalidInput(where + ": node set " + std::to_string(set.id) + " '" + set.name +
+                           "': " + describe_node(model, v) + " belongs to no element");
 }
 
 HexMesh hex_part(const Model& model) {

@@ -179,8 +179,9 @@ void validate(const Model& model, std::string_view source);
 void check_points(const Model& model, std::string_view source);
 // What readers refuse beyond structure (validate): check_points, then a tet of signed volume
 // <= 0, a hex or wedge with a corner Jacobian <= 0 (topology.hpp's corner frames: inverted,
-// flat or folded), a pyramid that splits along neither base diagonal into two positive tets. Throws
-// InvalidInput naming `source` and the node or element by its file id, with coordinates.
+// flat or folded), a pyramid that splits along neither base diagonal into two positive tets, a
+// node set's node that no element uses. Throws InvalidInput naming `source` and the node or
+// element by its file id, with coordinates.
 void check_geometry(const Model& model, std::string_view source);
 
 // The two parts over the model's whole point array (unused points included), so that node

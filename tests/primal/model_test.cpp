@@ -188,3 +188,18 @@ TEST_CASE("model: inverted wedges and pyramids refused by their file ids") {
   p[2] = Point(0.3, 0.3, 0.0);
   CHECK_NOTHROW(check_geometry(one_cell(ElementKind::kPyramid, p), "in.msh"));
 }
+
+TEST_CASE("model: a node set's node that no element uses is refused by its file id") {
+  // As a Gmsh file saved without the elements of a volume in no physical group: the volume's
+  // physical point stays, its elements do not.
+  Model m = one_cell(ElementKind::kTet, reference_corners(ElementKind::kTet));
+  m.points.push_back(Point(5.0, 0.0, 0.0));
+  m.node_ids = {11, 12, 13, 14, 15};
+  m.node_sets.push_back({7, "corner", {0}});
+  CHECK_NOTHROW(check_geometry(m, "in.msh"));
+  m.node_sets.push_back({8, "lost", {1, 4}});
+  CHECK_THROWS_WITH_AS(check_geometry(m, "in.msh"),
+                       doctest::Contains("in.msh: node set 8 'lost': node 15 (5, 0, 0) belongs to "
+                                         "no element"),
+                       geode::InvalidInput);
+}
