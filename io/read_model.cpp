@@ -91,7 +91,7 @@ Model model_from_vtk(const VtkGrid& grid, const ReadOptions& options) {
     model.node_ids.push_back(static_cast<std::int64_t>(n));
   const std::vector<int>* blocks = nullptr;
   std::string block_array;
-  for (const char* name : {"block", "gmsh:physical", "CellEntityIds"})
+  for (const char* name : {"block", "gmsh:physical", "CellEntityIds", "mat_id"})
     if ((blocks = grid.cell_data.find_int(name))) {
       block_array = name;
       break;

@@ -39,7 +39,8 @@ bool read_forks(const std::filesystem::path& path);
 // A VTK grid as a model: hexes, tets, pyramids and wedges (triangles and quads, boundary
 // annotations, are left out), VTK's 0-based point and cell ids (as ParaView shows them) as file
 // ids, blocks from the first integer cell array named "block" (our writers), "gmsh:physical"
-// (meshio) or "CellEntityIds"; without one, all hexes in block 1 and all tets in block 2. Block
+// (meshio), "CellEntityIds" or "mat_id" (SfePy's, meshio's material ids); without one, a
+// block per cell kind (primal::default_block: hexes 1, tets 2, pyramids 3, wedges 4). Block
 // names, node sets and side sets from the field arrays write_vtu stores (vtk.hpp), each entry
 // checked. Other cell types are refused naming the cell.
 primal::Model model_from_vtk(const VtkGrid& grid, const primal::ReadOptions& options = {});

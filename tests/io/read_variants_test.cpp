@@ -99,6 +99,18 @@ TEST_CASE("meshio's files: .exo, .msh 2.2 ASCII and binary, .vtu, .vtk read as m
   }
 }
 
+TEST_CASE("meshio's .vtu and .vtk with materials as mat_id: the blocks") {
+  test::TempDir dir;
+  const HexMesh m = write_variants("meshio", dir.path);
+  for (const std::string name : {"meshio-matid.vtu", "meshio-matid.vtk"}) {
+    CAPTURE(name);
+    const Model model = read_model(dir.path / name);
+    REQUIRE(model.hexes == m.hexes);
+    for (std::size_t h = 0; h < m.hexes.size(); ++h)
+      CHECK(block_of(model, {ElementKind::kHex, index_cast(h)}) == m.block[h]);
+  }
+}
+
 TEST_CASE("meshio's .exo with node sets numbered from 0: the sets numbered by position") {
   // The old reader refused the file ("node set 0 'ns_bottom': id is not positive") although it
   // renumbers meshio's block ids from 0 the same way.

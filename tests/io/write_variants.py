@@ -7,7 +7,8 @@ usage: write_variants.py vtk SOURCE.vtu OUTDIR    VTK's own writer: .vtu ascii, 
                                                    .vtk ascii and binary
        write_variants.py meshio SOURCE.vtu OUTDIR  meshio: .exo (also with node sets), .msh 2.2
                                                    ascii and binary, .vtu (its default: binary +
-                                                   zlib), .vtk
+                                                   zlib), .vtk, .vtu and .vtk with the blocks as a
+                                                   mat_id cell array
 
 SOURCE is an ASCII .vtu geode wrote; each output is named after its variant. Exit status 77 when
 the Python module is missing (the caller fails: the packages are required).
@@ -80,6 +81,11 @@ def meshio_variants(source, outdir):
     top = np.nonzero(mesh.points[:, 2] > mesh.points[:, 2].max() - 1e-9)[0]
     meshio.Mesh(mesh.points, mesh.cells, point_sets={"ns_bottom": bottom, "ns_top": top}).write(
         os.path.join(outdir, "meshio-sets.exo"))
+    # Materials as SfePy and meshio users give them: the source's blocks as the cell array mat_id.
+    blocks = meshio.read(source).cell_data["block"]
+    for name in ("meshio-matid.vtu", "meshio-matid.vtk"):
+        meshio.Mesh(mesh.points, mesh.cells, cell_data={"mat_id": blocks}).write(
+            os.path.join(outdir, name), binary=False)
 
 
 if __name__ == "__main__":
