@@ -1,46 +1,49 @@
 #pragma once
 // VTK cell types as the .vtu / .vtk writers and readers (vtk.cpp, vtu_read.cpp, vtk_read.cpp) name
-// and size them. Internal to io's VTK I/O.
+// and size them: one table, read by the lookups and by the readers' message naming what they take.
+// Internal to io's VTK I/O.
+#include <array>
+#include <string>
+
 #include <geode/io/vtk.hpp>
 
 namespace geode::io::vtk_cells {
 
+struct CellType {
+  int type;
+  const char* name;
+  int size;  // nodes
+};
+
+inline constexpr std::array<CellType, 6> kCellTypes{{{kVtkTriangle, "triangle", 3},
+                                                     {kVtkQuad, "quad", 4},
+                                                     {kVtkTetra, "tetra", 4},
+                                                     {kVtkHexahedron, "hexahedron", 8},
+                                                     {kVtkWedge, "wedge", 6},
+                                                     {kVtkPyramid, "pyramid", 5}}};
+
+inline const CellType* find_cell_type(int type) {
+  for (const CellType& t : kCellTypes)
+    if (t.type == type) return &t;
+  return nullptr;
+}
+
 inline const char* cell_type_name(int type) {
-  switch (type) {
-    case kVtkTriangle:
-      return "triangle";
-    case kVtkQuad:
-      return "quad";
-    case kVtkTetra:
-      return "tetra";
-    case kVtkHexahedron:
-      return "hexahedron";
-    case kVtkWedge:
-      return "wedge";
-    case kVtkPyramid:
-      return "pyramid";
-    default:
-      return nullptr;
-  }
+  const CellType* t = find_cell_type(type);
+  return t ? t->name : nullptr;
 }
 
 inline int cell_type_size(int type) {
-  switch (type) {
-    case kVtkTriangle:
-      return 3;
-    case kVtkQuad:
-      return 4;
-    case kVtkTetra:
-      return 4;
-    case kVtkHexahedron:
-      return 8;
-    case kVtkWedge:
-      return 6;
-    case kVtkPyramid:
-      return 5;
-    default:
-      return 0;
-  }
+  const CellType* t = find_cell_type(type);
+  return t ? t->size : 0;
+}
+
+// "5 triangle, 9 quad, ...": the types the readers take.
+inline std::string supported_cell_types() {
+  std::string s;
+  for (const CellType& t : kCellTypes)
+    s += (s.empty() ? "" : ", ") + std::to_string(t.type) + " " + t.name;
+  return s;
 }
 
 }  // namespace geode::io::vtk_cells

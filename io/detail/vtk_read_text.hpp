@@ -35,7 +35,7 @@ void check_cells(const VtkGrid& g, LineOf&& line_of_cell) {
     if (!name) {
       fail(g.source, line_of_cell(c, true),
            "cell " + std::to_string(c) + ": unknown or unsupported cell type " +
-               std::to_string(type) + " (supported: 5 triangle, 9 quad, 10 tetra, 12 hexahedron)");
+               std::to_string(type) + " (supported: " + vtk_cells::supported_cell_types() + ")");
     }
     if (primal::index_cast<int>(g.cells[c].size()) != vtk_cells::cell_type_size(type)) {
       fail(g.source, line_of_cell(c, false),
