@@ -5,8 +5,10 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <sstream>
 #include <string>
 
 #include <geode/io/gmsh.hpp>
@@ -183,5 +185,33 @@ TEST_CASE("geode check: text report, quad meshes, the file's own numbering") {
     CHECK(r.code == 2);
     CHECK(r.out.find(in.string() + ": holds") != std::string::npos);
     CHECK(geode_cli("check " + in.string() + " --format yaml").code != 0);
+  }
+}
+
+TEST_CASE("geode check: -o picks the report's format by its extension") {
+  test::TempDir dir;
+  const auto in = dir.path / "quads.vtk";
+  io::write_vtk(in, test::structured_quad_grid(3, 2));
+  const auto contents = [](const std::filesystem::path& p) {
+    std::ifstream f(p);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+  };
+  SUBCASE("-o r.json writes JSON, -o r.txt text") {
+    const auto json = dir.path / "r.json", text = dir.path / "r.txt";
+    REQUIRE(geode_cli("check " + in.string() + " -o " + json.string()).code == 0);
+    const auto j = nlohmann::json::parse(contents(json));
+    CHECK(j["dimension"] == 2);
+    CHECK(j["valid"] == true);
+    REQUIRE(geode_cli("check " + in.string() + " -o " + text.string()).code == 0);
+    CHECK(contents(text).find("realizability: no obstructions found") != std::string::npos);
+  }
+  SUBCASE("a --format that contradicts the extension is refused, nothing written") {
+    const auto out = dir.path / "r.txt";
+    const auto r = geode_cli("check " + in.string() + " --format json -o " + out.string(), true);
+    CHECK(r.code == 2);
+    CHECK(r.out.find("contradicts the extension") != std::string::npos);
+    CHECK(!std::filesystem::exists(out));
   }
 }
