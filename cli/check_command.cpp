@@ -80,7 +80,7 @@ Checked check_quads(const primal::QuadMesh& mesh, const primal::RealizabilityOpt
 void run_check(const CheckArgs& a) {
   check_output_path(a.output);
   const std::string format = output_format(a.output, a.format, {"text", "json"}, "text");
-  check_not_input(a.output, a.input, false);  // a report never replaces the mesh it is about
+  check_not_input(a.output, a.input);  // a report never replaces the mesh it is about
   const MeshFile m = read_mesh_file(a.input);
   primal::RealizabilityOptions options;
   options.planar_angle_degrees = a.planar_angle;
