@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <iostream>
+#include <new>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -205,6 +206,12 @@ int run(int argc, char** argv, int rank, int size) {
     } catch (const TopologyError& e) {
       if (rank == 0) std::cerr << "geode_mpi: " << e.what() << "\n";
       return 3;
+    } catch (const std::bad_alloc&) {
+      // As the serial command (cli/main.cpp): one line and exit 2, from the rank that ran out.
+      std::cerr << "geode_mpi conform (rank " << rank
+                << "): error: out of memory: the input needs more memory than this machine "
+                << "gives (nothing written)\n";
+      return 2;
     } catch (const std::exception& e) {
       std::cerr << "geode_mpi (rank " << rank << "): " << e.what() << "\n";
       return 4;
