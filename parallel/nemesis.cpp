@@ -259,8 +259,8 @@ void write_joined(const RankMesh& mesh, const std::filesystem::path& output, MPI
   }
   for (const auto& ns : m.node_sets) j.node_sets.push_back({ns.id, ns.name, {}});
   for (const auto& ss : m.side_sets) j.side_sets.push_back({ss.id, ss.name, {}});
-  const auto set_of = [](auto& sets_, std::int64_t id) -> auto& {
-    return *std::find_if(sets_.begin(), sets_.end(), [&](const auto& s) { return s.id == id; });
+  const auto set_of = [](auto& list, std::int64_t id) -> auto& {
+    return *std::find_if(list.begin(), list.end(), [&](const auto& s) { return s.id == id; });
   };
   for (std::size_t k = 0; k < all_sets.size(); k += 2)
     set_of(j.node_sets, all_sets[k]).nodes.push_back(primal::index_cast(all_sets[k + 1]));
