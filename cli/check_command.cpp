@@ -22,7 +22,7 @@ using primal::Index;
 
 struct CheckArgs {
   std::string input;
-  std::string format = "text";
+  std::string format;  // empty: by the extension of -o, else text
   std::string output;
   double planar_angle = primal::RealizabilityOptions{}.planar_angle_degrees;
 };
@@ -79,7 +79,8 @@ Checked check_quads(const primal::QuadMesh& mesh, const primal::RealizabilityOpt
 
 void run_check(const CheckArgs& a) {
   check_output_path(a.output);
-  check_not_input(a.output, a.input, false);  // a report never replaces the mesh it is about
+  const std::string format = output_format(a.output, a.format, {"text", "json"}, "text");
+  check_not_input(a.output, a.input);  // a report never replaces the mesh it is about
   const MeshFile m = read_mesh_file(a.input);
   primal::RealizabilityOptions options;
   options.planar_angle_degrees = a.planar_angle;
@@ -92,7 +93,7 @@ void run_check(const CheckArgs& a) {
     for (auto& metric : c.quality["metrics"])
       for (const char* k : {"min_hex", "max_hex"}) metric[k] = metric[k].get<Index>() + base;
   std::string text;
-  if (a.format == "json") {
+  if (format == "json") {
     nlohmann::json j;
     j["file"] = a.input;
     j["dimension"] = m.dim;
@@ -139,11 +140,11 @@ void add_check_command(CLI::App& app) {
       "says why each blocks). Exit 0 whenever the file could be checked.");
   c->add_option("mesh", a->input, hex_or_quad_input_help())->required();
   c->add_option("--format", a->format,
-                "text, or json: {\"valid\", \"validity\", \"quality\", \"obstructions\": "
-                "[{\"kind\", \"hexes\", \"nodes\"}]}\n"
-                "with ids as the file numbers them (\"index_base\")")
-      ->check(CLI::IsMember({"text", "json"}))
-      ->capture_default_str();
+                "text (default), or json: {\"valid\", \"validity\", \"quality\", "
+                "\"obstructions\": [{\"kind\", \"hexes\", \"nodes\"}]}\n"
+                "with ids as the file numbers them (\"index_base\"); without it the extension of "
+                "-o decides\n(.txt, .json); one that contradicts the extension is refused")
+      ->check(CLI::IsMember({"text", "json"}));
   c->add_option("-o,--output", a->output, "Write the report here instead of standard output");
   c->add_option("--planar-angle", a->planar_angle,
                 "boundary quads whose normals differ by less than this many degrees (and that lie "

@@ -187,12 +187,24 @@ void check_output_path(const std::string& path) {
     throw InvalidInput(path + ": exists and is not writable");
 }
 
-void check_not_input(const std::string& output, const std::string& input, bool force) {
-  if (force || output.empty() || output == "-" || input.empty()) return;
+namespace {
+
+void refuse_input_as_output(const std::string& output, const std::string& input, const char* hint) {
+  if (output.empty() || output == "-" || input.empty()) return;
   std::error_code ec;
   if (fs::equivalent(output, input, ec) && !ec)
     throw InvalidInput(output + ": is the input file " + input +
-                       "; writing it would destroy the input (--force overwrites it)");
+                       "; writing it would destroy the input" + hint);
+}
+
+}  // namespace
+
+void check_not_input(const std::string& output, const std::string& input, bool force) {
+  if (!force) refuse_input_as_output(output, input, " (--force overwrites it)");
+}
+
+void check_not_input(const std::string& output, const std::string& input) {
+  refuse_input_as_output(output, input, "");
 }
 
 CLI::Option* add_force_flag(CLI::App* app, bool& flag) {

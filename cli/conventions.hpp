@@ -70,6 +70,9 @@ void check_output_path(const std::string& path);
 // An output that is the input itself (the same file, also through links) would destroy it:
 // InvalidInput naming both unless `force` (--force). Paths that do not exist yet pass.
 void check_not_input(const std::string& output, const std::string& input, bool force);
+// The same for a command without --force (check, view): always refused, the message without
+// the --force hint.
+void check_not_input(const std::string& output, const std::string& input);
 CLI::Option* add_force_flag(CLI::App* app, bool& flag);
 
 // The mesh formats every command that writes a mesh offers (io/formats.hpp), in table order:

@@ -91,7 +91,8 @@ int main(int argc, char** argv) {
              threads = new tbb::global_control(tbb::global_control::max_allowed_parallelism,
                                                geode::primal::index_cast<std::size_t>(n));
            },
-           "worker threads (default: every core); every result is the same for any number")
+           "worker threads (default: every core), for every command, given before or after it;\n"
+           "every result is the same for any number")
         ->check(CLI::Range(1, 4096));
     geode::cli::add_template_command(app);
     geode::cli::add_study_commands(app);

@@ -73,7 +73,7 @@ std::vector<viewer::ViewSheet> mesh_view_sheets(const Mesh& mesh, const Surfaces
 }
 
 void run_view(const ViewArgs& a) {
-  check_not_input(a.output, a.input, false);  // the page never replaces the mesh it shows
+  check_not_input(a.output, a.input);  // the page never replaces the mesh it shows
   const std::filesystem::path out(a.output);
   if (file_extension(out) != ".html")
     throw InvalidInput(a.output + ": unknown output format '" + file_extension(out) +

@@ -133,12 +133,11 @@ void write_exodus(const Model& model, const std::filesystem::path& path,
                    "reserving the header");
       check_netcdf(nc_enddef(exo), target, "reserving the header");
     }
-    check(
-        ex_put_init(exo, "geode", 3, index_cast<int64_t>(model.points.size()),
-                    static_cast<int64_t>(element_count(model)), index_cast<int64_t>(blocks.size()),
-                    index_cast<int64_t>(model.node_sets.size()),
-                    index_cast<int64_t>(model.side_sets.size())),
-        target, "writing the header");
+    check(ex_put_init(exo, "geode", 3, index_cast<int64_t>(model.points.size()),
+                      index_cast<int64_t>(element_count(model)), index_cast<int64_t>(blocks.size()),
+                      index_cast<int64_t>(model.node_sets.size()),
+                      index_cast<int64_t>(model.side_sets.size())),
+          target, "writing the header");
     check_netcdf(nc_redef(exo), target, "reserving the header");
     check_netcdf(nc_del_att(exo, NC_GLOBAL, kRoom), target, "reserving the header");
     check_netcdf(nc_enddef(exo), target, "reserving the header");
@@ -231,7 +230,7 @@ void write_exodus(const Model& model, const std::filesystem::path& path,
           run_start[{members.kind, first}] = next, next += count;
     }
     const auto file_number = [&](const ElementRef& e) {
-      const auto at = static_cast<std::size_t>(e.index);
+      const auto at = index_cast<std::size_t>(e.index);
       const auto it = std::prev(run_start.upper_bound({e.kind, at}));
       return index_cast<int>(it->second + (at - it->first.second));
     };

@@ -199,7 +199,7 @@ void Distributor::assemble() {
     return p;
   };
   for (std::size_t h = zone_first_; h < zone_last_; ++h) {
-    std::array<Index, 8>& x = o.hexes[place(static_cast<std::int64_t>(h))];
+    std::array<Index, 8>& x = o.hexes[place(primal::index_cast<std::int64_t>(h))];
     for (int c = 0; c < 8; ++c) x[c] = local(zone_out_.hexes[h - zone_base_][c]);
   }
   primal::release(zone_out_.hexes);  // consumed, before the children are placed

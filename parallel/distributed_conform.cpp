@@ -34,9 +34,9 @@ void Distributor::yardstick() {
   for (auto& l : low) l = {2.0, std::numeric_limits<int>::max()};
   std::vector<int> inverted;
   const auto consider = [&](int k, std::size_t c, double v) {
-    if (v < low[k].value || (v == low[k].value && static_cast<int>(c) < low[k].cell))
-      low[k] = {v, static_cast<int>(c)};
-    if (v <= 0.0) inverted.push_back(static_cast<int>(c));
+    const int cell = primal::index_cast<int>(c);
+    if (v < low[k].value || (v == low[k].value && cell < low[k].cell)) low[k] = {v, cell};
+    if (v <= 0.0) inverted.push_back(cell);
   };
   const std::size_t nh = m().hexes.size(), nt = m().tets.size(), nw = m().wedges.size();
   // Ranks [0, r) measure this fraction of each kind's elements.
@@ -157,7 +157,8 @@ void Distributor::select_zone(int rings) {
     if (in_zone_[c])
       for (Index v : primal::element_corners(m(), ref(c)))
         zone_node_[primal::index_cast<std::size_t>(v)] = 1;
-  rep_.zone_cells = static_cast<std::int64_t>(std::count(in_zone_.begin(), in_zone_.end(), 1));
+  rep_.zone_cells =
+      primal::index_cast<std::int64_t>(std::count(in_zone_.begin(), in_zone_.end(), 1));
   rep_.rings = rings;
 }
 
@@ -320,7 +321,7 @@ void Distributor::dice() {
   // puts beside them (at most the zone's nodes): a copy of them all, at its peak, otherwise.
   diced_ = primal::dice_model(own_.model, {}, room,
                               zone_out_.hexes.empty() ? 0 : zone_out_.points.size());
-  rep_.cells = static_cast<std::int64_t>(std::count(mine.begin(), mine.end(), 1));
+  rep_.cells = primal::index_cast<std::int64_t>(std::count(mine.begin(), mine.end(), 1));
   break_for_test();
   // Local verification reads the children against the tables while the dicing data exist.
   if (options_.conform.verify == conform::ConformVerify::kLocal) {

@@ -261,7 +261,7 @@ void Distributor::number() {
       const FaceKey k = key(i);
       send.insert(send.end(), k.begin(), k.end());
     }
-    send_counts[primal::index_cast<std::size_t>(q)] = static_cast<int>(c.size() * 4);
+    send_counts[primal::index_cast<std::size_t>(q)] = primal::index_cast<int>(c.size() * 4);
   }
   MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm_);
   std::vector<int> sd(send_counts.size()), rd(send_counts.size());

@@ -114,7 +114,7 @@ void write_nemesis(const RankMesh& mesh, const std::filesystem::path& output, in
       std::vector<int> internal, bordering;
       internal.reserve(internal_nodes), bordering.reserve(border_nodes);
       for (std::size_t v = 0; v < border.size(); ++v)
-        (border[v] ? bordering : internal).push_back(static_cast<int>(v + 1));
+        (border[v] ? bordering : internal).push_back(primal::index_cast<int>(v + 1));
       check(ex_put_processor_node_maps(exo, internal.data(), bordering.data(), nullptr, rank), path,
             "Nemesis node maps");
     }
@@ -124,7 +124,7 @@ void write_nemesis(const RankMesh& mesh, const std::filesystem::path& output, in
       for (std::size_t h = 0; h < mesh.model.hexes.size(); ++h) {
         bool on = false;
         for (Index v : mesh.model.hexes[h]) on = on || border[primal::index_cast<std::size_t>(v)];
-        (on ? bordering : internal).push_back(static_cast<int>(h + 1));
+        (on ? bordering : internal).push_back(primal::index_cast<int>(h + 1));
       }
       check(ex_put_processor_elem_maps(exo, internal.data(), bordering.data(), rank), path,
             "Nemesis element maps");
@@ -259,8 +259,8 @@ void write_joined(const RankMesh& mesh, const std::filesystem::path& output, MPI
   }
   for (const auto& ns : m.node_sets) j.node_sets.push_back({ns.id, ns.name, {}});
   for (const auto& ss : m.side_sets) j.side_sets.push_back({ss.id, ss.name, {}});
-  const auto set_of = [](auto& sets_, std::int64_t id) -> auto& {
-    return *std::find_if(sets_.begin(), sets_.end(), [&](const auto& s) { return s.id == id; });
+  const auto set_of = [](auto& list, std::int64_t id) -> auto& {
+    return *std::find_if(list.begin(), list.end(), [&](const auto& s) { return s.id == id; });
   };
   for (std::size_t k = 0; k < all_sets.size(); k += 2)
     set_of(j.node_sets, all_sets[k]).nodes.push_back(primal::index_cast(all_sets[k + 1]));

@@ -471,7 +471,7 @@ double diced_tet_min_scaled_jacobian(const std::array<Point, 4>& corners, double
   const int from = *first;
   for (int j = 0; j < 4 && lowest > bound; ++j) {
     const int h = (from + j) % 4;
-    const auto& child = table.at[static_cast<std::size_t>(h)];
+    const auto& child = table.at[index_cast<std::size_t>(h)];
     HexCorners p;
     for (std::size_t c = 0; c < 8; ++c) p[c] = x[child[c]];
     lowest = std::min(lowest, hex_scaled_jacobian_bounded(p, bound));

@@ -75,7 +75,7 @@ const std::vector<TemplateEntry>& table() {
        .spec = [](const TemplateOptions& o) { return geode_spec(o.geode, 2); },
        .build = [](const TemplateOptions& o) { return build_geode2d(o.geode); }},
       {.name = "geode4tri",
-       .summary = "the tet side split into 4 triangles (fixed up unless --no-fixup)",
+       .summary = "the tet side split into 4 triangles",
        .dim = 3,
        .defaults = {four_triangles(), {}},
        .spec = [](const TemplateOptions& o) { return geode_spec(o.geode, 3); },
@@ -137,7 +137,9 @@ std::string template_help(bool studied) {
   std::string s;
   for (const TemplateEntry& e : table())
     if (!studied || e.study_grid)
-      s += (s.empty() ? "" : ";\n") + std::string(e.name) + ": " + std::string(e.summary);
+      s += (s.empty() ? "" : ";\n") + std::string(e.name) + ": " + std::string(e.summary) +
+           // `template` fixes it up; `study interleave` sweeps the plain dual, with no --no-fixup.
+           (e.fix_up && !studied ? " (fixed up unless --no-fixup)" : "");
   return s;
 }
 

@@ -61,7 +61,8 @@ const TemplateEntry& conform_template(ConformUse use);
 // Names of every entry (studied: those with a study grid), in table order.
 std::vector<std::string> template_names(bool studied = false);
 
-// "geode3d: ...;\ngeode2d: ..." for --help (studied: those with a study grid).
+// "geode3d: ...;\ngeode2d: ..." for --help (studied: those with a study grid, for `study
+// interleave`, which does not fix them up: without the --no-fixup note of a fix_up entry).
 std::string template_help(bool studied = false);
 
 // The options for `entry`: its defaults with the family's part replaced by what the caller

@@ -6,14 +6,18 @@
 #include <sys/resource.h>
 
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <iostream>
+#include <new>
 #include <sstream>
+#include <string>
 #include <thread>
 
 #include <mpi.h>
 #include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 
+#include <geode/conform/buffer_layer.hpp>
 #include <geode/io/read_model.hpp>
 #include <geode/parallel/distributed_conform.hpp>
 #include <geode/parallel/nemesis.hpp>
@@ -48,9 +52,33 @@ int run(int argc, char** argv, int rank, int size) {
                    "OUT.exo: writes OUT.exo.N.r per rank (Nemesis; N ranks, r = 0..N-1)")
       ->required();
   conform->add_flag("--join", join, "also write OUT.exo itself, every rank's hexes joined");
-  conform->add_option("--smooth", smooth, "local or none (global moves every node: not here)");
-  conform->add_option("--buffer-side", side, "the part the buffer layer is carved from: hex, tet");
-  conform->add_option("--buffer-thickness", thickness, "as geode conform (0: the side's default)");
+  conform->add_option("--smooth", smooth, "local or none (global moves every node: not here)")
+      ->check(CLI::IsMember({"local", "none"}))
+      ->capture_default_str();
+  conform->add_option("--buffer-side", side, "the part the buffer layer is carved from: hex or tet")
+      ->check(CLI::IsMember({"hex", "tet"}))
+      ->capture_default_str();
+  // As geode conform's (cli/conform_command.cpp): [0.01, 0.9], and at most the side's maximum.
+  const double thickest = conform::max_buffer_thickness(conform::BufferSide::kHex);
+  conform
+      ->add_option(
+          "--buffer-thickness", thickness,
+          "as for geode conform: how far that part shrinks off the interface, as a fraction of "
+          "the shortest edge at each interface node; default 0.5 with --buffer-side hex (at most "
+          "0.9), 0.3 with tet (at most 0.45)")
+      ->check(CLI::Validator(
+          [thickest](std::string& text) -> std::string {
+            double x = 0;
+            if (!CLI::detail::lexical_cast(text, x) || !std::isfinite(x))
+              return "'" + text + "' is not a finite number";
+            if (x < 0.01 || x > thickest) {
+              std::ostringstream m;
+              m << text << " is out of range [0.01, " << thickest << "]";
+              return m.str();
+            }
+            return {};
+          },
+          "NUMBER"));
   conform
       ->add_option(
           "--verify", verify,
@@ -59,9 +87,14 @@ int run(int argc, char** argv, int rank, int size) {
           "full: the whole check on every hex of each rank (2.6x local's time on bench_mpi's "
           "10^7-hex model)")
       ->check(CLI::IsMember({"local", "full"}));
-  conform->add_option(
-      "--rings", rings,
-      "depth of the transition zone, conformed once on the last rank (grown as needed)");
+  const int max_rings = parallel::DistributedOptions{}.max_rings;
+  conform
+      ->add_option("--rings", rings,
+                   "depth of the transition zone, conformed once on the last rank (grown as "
+                   "needed, to at most " +
+                       std::to_string(max_rings) + ")")
+      ->check(CLI::Range(1, max_rings))
+      ->capture_default_str();
   conform->add_option("--threads", threads, "TBB threads per rank (default 1: one core each)");
   conform
       ->add_option(
@@ -87,6 +120,13 @@ int run(int argc, char** argv, int rank, int size) {
   // Everything after the options, in the rank's arena.
   const auto conform_in_arena = [&]() -> int {
     try {
+      if (const double most = conform::max_buffer_thickness(conform::parse_buffer_side(side));
+          thickness > most) {
+        std::ostringstream m;
+        m << "--buffer-thickness " << thickness << " with --buffer-side " << side << ": at most "
+          << most;
+        throw InvalidInput(m.str());
+      }
       const double t0 = MPI_Wtime();
       parallel::DistributedOptions options;
       options.conform.smooth = conform::parse_conform_smooth(smooth);
@@ -166,6 +206,12 @@ int run(int argc, char** argv, int rank, int size) {
     } catch (const TopologyError& e) {
       if (rank == 0) std::cerr << "geode_mpi: " << e.what() << "\n";
       return 3;
+    } catch (const std::bad_alloc&) {
+      // As the serial command (cli/main.cpp): one line and exit 2, from the rank that ran out.
+      std::cerr << "geode_mpi conform (rank " << rank
+                << "): error: out of memory: the input needs more memory than this machine "
+                << "gives (nothing written)\n";
+      return 2;
     } catch (const std::exception& e) {
       std::cerr << "geode_mpi (rank " << rank << "): " << e.what() << "\n";
       return 4;

@@ -11,7 +11,8 @@
 namespace geode::primal::detail {
 
 // Values laid end to end as bytes and read back in the same order: what one rank or thread
-// hands the others (geode_mpi's transition zone, the shared input check's findings and faces).
+// hands the others (geode_mpi's transition zone, the shared input check's findings and faces,
+// the shared Exodus read's answers per share: io/exodus_read.cpp).
 // Trivially copyable values go as their bytes, strings as their length and characters. Reading
 // past the end throws rather than reading out of bounds.
 class BytePacket {

@@ -43,14 +43,13 @@ std::vector<Record> sort_by_lowest_node(std::size_t nodes, Count&& count, Each&&
   };
   start.assign(nodes + 1, 0);
   count([&](Index node) {
-    slot(start, static_cast<std::size_t>(node) + 1).fetch_add(1, std::memory_order_relaxed);
+    slot(start, index_cast<std::size_t>(node) + 1).fetch_add(1, std::memory_order_relaxed);
   });
   for (std::size_t v = 1; v < start.size(); ++v) start[v] += start[v - 1];
   std::vector<Record> out(start.back());
   std::vector<std::size_t> next(start.begin(), start.end() - 1);
   each([&](const Record& r) {
-    out[slot(next, static_cast<std::size_t>(lowest(r))).fetch_add(1, std::memory_order_relaxed)] =
-        r;
+    out[slot(next, index_cast<std::size_t>(lowest(r))).fetch_add(1, std::memory_order_relaxed)] = r;
   });
   // `count` and `each` must visit the same lowest nodes: every node's slots exactly filled.
   assert(std::equal(next.begin(), next.end(), start.begin() + 1));

@@ -5,8 +5,10 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <sstream>
 #include <string>
 
 #include <geode/io/gmsh.hpp>
@@ -183,5 +185,53 @@ TEST_CASE("geode check: text report, quad meshes, the file's own numbering") {
     CHECK(r.code == 2);
     CHECK(r.out.find(in.string() + ": holds") != std::string::npos);
     CHECK(geode_cli("check " + in.string() + " --format yaml").code != 0);
+  }
+}
+
+TEST_CASE("geode check: -o picks the report's format by its extension, the input is never -o") {
+  test::TempDir dir;
+  const auto in = dir.path / "quads.vtk";
+  io::write_vtk(in, test::structured_quad_grid(3, 2));
+  const auto contents = [](const std::filesystem::path& p) {
+    std::ifstream f(p);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+  };
+  SUBCASE("-o r.json writes JSON, -o r.txt text") {
+    const auto json = dir.path / "r.json", text = dir.path / "r.txt";
+    REQUIRE(geode_cli("check " + in.string() + " -o " + json.string()).code == 0);
+    const auto j = nlohmann::json::parse(contents(json));
+    CHECK(j["dimension"] == 2);
+    CHECK(j["valid"] == true);
+    REQUIRE(geode_cli("check " + in.string() + " -o " + text.string()).code == 0);
+    CHECK(contents(text).find("realizability: no obstructions found") != std::string::npos);
+  }
+  SUBCASE("a --format that contradicts the extension is refused, nothing written") {
+    const auto out = dir.path / "r.txt";
+    const auto r = geode_cli("check " + in.string() + " --format json -o " + out.string(), true);
+    CHECK(r.code == 2);
+    CHECK(r.out.find("contradicts the extension") != std::string::npos);
+    CHECK(!std::filesystem::exists(out));
+  }
+  SUBCASE("-o the input: refused without a --force hint (check has none), the input kept") {
+    // Through a link with a report's name: the mesh's own name is refused by its extension.
+    const auto link = dir.path / "r.txt";
+    std::filesystem::create_symlink(in, link);
+    const std::string before = contents(in);
+    const auto r = geode_cli("check " + in.string() + " -o " + link.string(), true);
+    CHECK(r.code == 2);
+    CHECK(r.out.find("is the input file") != std::string::npos);
+    CHECK(r.out.find("--force") == std::string::npos);
+    CHECK(contents(in) == before);
+    const auto v = geode_cli("view " + in.string() + " -o " + in.string(), true);
+    CHECK(v.code == 2);
+    CHECK(v.out.find("is the input file") != std::string::npos);
+    CHECK(v.out.find("--force") == std::string::npos);
+    CHECK(contents(in) == before);
+    // conform has --force: its refusal names it.
+    const auto c = geode_cli("conform " + in.string() + " -o " + in.string(), true);
+    CHECK(c.code == 2);
+    CHECK(c.out.find("(--force overwrites it)") != std::string::npos);
   }
 }

@@ -30,6 +30,9 @@ TEST_CASE("cli tables: help texts list every template and every format of the ta
   const test::CliRun s = test::geode_cli("study interleave --help");
   for (const std::string& name : templates::template_names(true))
     CHECK(s.out.find(name) != std::string::npos);
+  // A fixed-up entry's note names template's --no-fixup; study has no such option.
+  CHECK(t.out.find("(fixed up unless --no-fixup)") != std::string::npos);
+  CHECK(s.out.find("--no-fixup") == std::string::npos);
   for (const char* cmd : {"conform --help", "arrange --help", "template --help"}) {
     CAPTURE(cmd);
     const test::CliRun h = test::geode_cli(cmd);

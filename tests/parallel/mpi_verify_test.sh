@@ -6,7 +6,7 @@
 # failing check named, nothing written. A transition zone made invalid on the zone rank (the last;
 # GEODE_TEST_INVERT_OUTPUT_HEX in its conform) fails every rank count alike; so does a partition
 # failing on rank 0 (GEODE_TEST_FAIL_PARTITION), and one rank's share of the read refused
-# (GEODE_TEST_FAIL_READ_SHARE), without a rank left waiting.
+# (GEODE_TEST_FAIL_READ_SHARE), without a rank left waiting. Options out of range exit 2.
 # usage: mpi_verify_test.sh GEODE GEODE_MPI MPIEXEC WORKDIR
 set -euo pipefail
 geode=$1 geode_mpi=$2 mpiexec=$3 dir=$4
@@ -76,4 +76,16 @@ timeout 120 "$mpiexec" --oversubscribe -np 2 "$geode_mpi" conform cut.exo -o cut
 [ "$status" = 2 ] || { echo "a truncated file on 2 ranks: exited $status, not 2"; cat err.txt; exit 1; }
 grep -q "cut.exo: .*truncated" err.txt
 if ls cut-out.exo* >/dev/null 2>&1; then echo "a truncated file: wrote a file"; exit 1; fi
-echo "mpi_verify_test: both modes pass the result and find the broken dicing on 1 and 2 ranks, an invalid zone on 1 to 3, a refused share of the read on 2 and 3"
+# Options out of their range are usage errors (exit 2) before any work, as in geode conform:
+# --smooth global, an unknown side, --rings past 1..64, a thickness past its side's maximum.
+for args in "--smooth global" "--buffer-side wedge" "--rings 0" "--rings 65" \
+    "--buffer-thickness 0" "--buffer-thickness nan" "--buffer-side tet --buffer-thickness 0.5"; do
+  status=0
+  # shellcheck disable=SC2086
+  timeout 120 "$mpiexec" -np 1 "$geode_mpi" conform in.exo -o refused.exo $args -q \
+    2>err.txt >/dev/null || status=$?
+  [ "$status" = 2 ] || { echo "conform $args: exited $status, not 2"; cat err.txt; exit 1; }
+  if ls refused.exo* >/dev/null 2>&1; then echo "conform $args: wrote a file"; exit 1; fi
+done
+grep -q "with --buffer-side tet: at most 0.45" err.txt
+echo "mpi_verify_test: both modes pass the result and find the broken dicing on 1 and 2 ranks, an invalid zone on 1 to 3, a refused share of the read on 2 and 3, options out of range refused"
