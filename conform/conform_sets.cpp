@@ -119,6 +119,8 @@ primal::Model Conformer::node_set_model() const {
 //   faces there join the set.
 void Conformer::carry_side_sets() {
   primal::Model& lm = layer_.model;
+  side_sets_.clear();
+  if (lm.side_sets.empty()) return;
   const std::size_t nb = layer_.hexes.size();
   const bool hex_moves = res_.buffer_side == BufferSide::kHex;
   std::vector<Index> first(nb + 1, primal::index_cast(diced_.hex_children.size()));
