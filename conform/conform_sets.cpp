@@ -6,7 +6,10 @@
 #include <geode/conform/detail/conformer.hpp>
 
 #include <algorithm>
-#include <set>
+#include <cmath>
+#include <initializer_list>
+#include <map>
+#include <span>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -93,7 +96,7 @@ primal::Model Conformer::node_set_model() const {
     ns.nodes = std::move(nodes);
     const std::size_t given = ns.pieces.size();
     for (std::size_t p = 0; p < given; ++p) {
-      std::vector<Index> piece = ns.pieces[p], tet_side = piece, between;
+      std::vector<Index> tet_side = ns.pieces[p], between;
       for (Index& v : tet_side)
         if (const Index d = dup(v); d != kInvalidIndex) {
           between.push_back(v), between.push_back(d);
@@ -169,7 +172,7 @@ void Conformer::carry_side_sets() {
   for (std::size_t s = 0; s < lm.side_sets.size(); ++s) {
     std::vector<primal::Side>& sides = lm.side_sets[s].sides;
     std::vector<std::vector<Index>> face(sides.size());
-    std::unordered_map<std::size_t, std::vector<std::size_t>> on_buffer;  // buffer hex -> sides
+    std::map<std::size_t, std::vector<std::size_t>> on_buffer;  // buffer hex -> its sides here
     std::unordered_map<primal::EdgeKey, std::vector<std::size_t>, primal::IndexArrayHash> by_edge;
     for (std::size_t i = 0; i < sides.size(); ++i) {
       face[i] = primal::element_face(lm, sides[i]);

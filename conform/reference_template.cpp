@@ -195,7 +195,7 @@ RefTemplate make_reference(const Eigen::Vector3d& box, std::array<int, 2> diagon
         bool on = true;
         for (int c : topo::kHexFaceCorners[lf])
           on = on && (ref.tpl.node_faces[hexes[h][c]] & bit[face]);
-        if (on) ref.faces_on[face].push_back({static_cast<int>(h), lf});
+        if (on) ref.faces_on[face].push_back({primal::index_cast<int>(h), lf});
       }
   return ref;
 }

@@ -32,8 +32,7 @@ struct RefTemplate {
   std::array<std::vector<std::array<int, 4>>, 4> side_quads;
   // Per node on the side faces only (empty for the others): the buffer hex corners of the
   // smallest face or edge holding it (a side face's 4, or a vertical edge's 2), which is what it
-  // is made from, as a diced node's origin says (primal/dice_model.hpp): node and side sets read
-  // it.
+  // is made from, as a diced node's origin says (primal/dice_model.hpp): node sets read it.
   std::vector<std::vector<int>> side_corners;
   // Per buffer hex face (0..3 its sides, 4 its bottom, 5 its top: topology order): the template
   // hexes' faces lying on it, as (hex, local face).
