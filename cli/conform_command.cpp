@@ -108,13 +108,7 @@ Eigen::Vector3d template_box(const std::string& text) {
 // The output paths and format, checked before any work: names, directories, format agreement.
 std::string check_outputs(const ConformArgs& a) {
   if (!a.template_box.empty()) template_box(a.template_box);  // a usage error, before the work
-  if (const double most = conform::max_buffer_thickness(conform::parse_buffer_side(a.buffer_side));
-      a.buffer_thickness > most) {
-    std::ostringstream m;
-    m << "--buffer-thickness " << a.buffer_thickness << " with --buffer-side " << a.buffer_side
-      << ": at most " << most;
-    throw InvalidInput(m.str());
-  }
+  check_buffer_thickness(a.buffer_thickness, a.buffer_side);
   std::string format;
   if (!a.output.empty()) {
     if (a.output == "-")

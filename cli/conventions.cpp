@@ -9,6 +9,7 @@
 #include <optional>
 #include <sstream>
 
+#include <geode/conform/buffer_layer.hpp>
 #include <geode/io/atomic_file.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/validity.hpp>
@@ -92,6 +93,16 @@ CLI::Validator number_check(double lo, double hi, bool integer) {
         return {};
       },
       integer ? "INT" : "NUMBER");
+}
+
+void check_buffer_thickness(double thickness, const std::string& side) {
+  if (const double most = conform::max_buffer_thickness(conform::parse_buffer_side(side));
+      thickness > most) {
+    std::ostringstream m;
+    m << "--buffer-thickness " << thickness << " with --buffer-side " << side << ": at most "
+      << most;
+    throw InvalidInput(m.str());
+  }
 }
 
 std::array<double, 3> parse_box(const std::string& option, const std::string& text, int dim) {

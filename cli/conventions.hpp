@@ -46,6 +46,11 @@ std::string version_text();
 CLI::Validator number_check(double lo = std::numeric_limits<double>::lowest(),
                             double hi = std::numeric_limits<double>::max(), bool integer = false);
 
+// --buffer-thickness against --buffer-side's maximum (conform::max_buffer_thickness), before
+// any work: InvalidInput "--buffer-thickness 0.6 with --buffer-side tet: at most 0.45". `geode
+// conform` and `geode_mpi conform` (which compiles this file too) check it alike.
+void check_buffer_thickness(double thickness, const std::string& side);
+
 // "24x14x24" (dim 3) or "24x14" (dim 2): exactly `dim` finite numbers, each in [1e-6, 1e6] and
 // the largest at most 1e4 times the smallest (a flatter box is degenerate for the templates).
 // InvalidInput naming `option` otherwise. A 2D box gets depth = width.

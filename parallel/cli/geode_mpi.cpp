@@ -6,7 +6,6 @@
 #include <sys/resource.h>
 
 #include <CLI/CLI.hpp>
-#include <cmath>
 #include <iostream>
 #include <new>
 #include <sstream>
@@ -21,8 +20,10 @@
 #include <geode/io/read_model.hpp>
 #include <geode/parallel/distributed_conform.hpp>
 #include <geode/parallel/nemesis.hpp>
+
 #include <geode/parallel/partition.hpp>
 #include <geode/primal/errors.hpp>
+#include "cli/conventions.hpp"
 
 namespace {
 
@@ -66,19 +67,7 @@ int run(int argc, char** argv, int rank, int size) {
           "as for geode conform: how far that part shrinks off the interface, as a fraction of "
           "the shortest edge at each interface node; default 0.5 with --buffer-side hex (at most "
           "0.9), 0.3 with tet (at most 0.45)")
-      ->check(CLI::Validator(
-          [thickest](std::string& text) -> std::string {
-            double x = 0;
-            if (!CLI::detail::lexical_cast(text, x) || !std::isfinite(x))
-              return "'" + text + "' is not a finite number";
-            if (x < 0.01 || x > thickest) {
-              std::ostringstream m;
-              m << text << " is out of range [0.01, " << thickest << "]";
-              return m.str();
-            }
-            return {};
-          },
-          "NUMBER"));
+      ->check(cli::number_check(0.01, thickest));
   conform
       ->add_option(
           "--verify", verify,
@@ -120,13 +109,7 @@ int run(int argc, char** argv, int rank, int size) {
   // Everything after the options, in the rank's arena.
   const auto conform_in_arena = [&]() -> int {
     try {
-      if (const double most = conform::max_buffer_thickness(conform::parse_buffer_side(side));
-          thickness > most) {
-        std::ostringstream m;
-        m << "--buffer-thickness " << thickness << " with --buffer-side " << side << ": at most "
-          << most;
-        throw InvalidInput(m.str());
-      }
+      cli::check_buffer_thickness(thickness, side);
       const double t0 = MPI_Wtime();
       parallel::DistributedOptions options;
       options.conform.smooth = conform::parse_conform_smooth(smooth);
