@@ -2,6 +2,7 @@
 // hexes shared out from the zone rank, and the global node and hex ids.
 #include <geode/parallel/detail/distributor.hpp>
 
+#include <cstdint>
 #include <numeric>
 
 namespace geode::parallel::detail {
@@ -22,11 +23,6 @@ void broadcast(void* data, std::size_t n, MPI_Datatype type, std::size_t size, i
 // diced nodes on the cut), block names and sets. A rank that diced a zone since grown dices again.
 void Distributor::share_zone() {
   const int root = zone_rank();
-  // Every rank here once its dicing is done, the zone rank last as a rule: the others wait
-  // for it without spinning, so that the zone's conform can use their cores.
-  MPI_Request all_here;
-  MPI_Ibarrier(comm_, &all_here);
-  wait_quietly(all_here);
   primal::detail::BytePacket packet;
   if (rank_ == root) {
     packet.put(zone_failure_kind_);
@@ -44,8 +40,12 @@ void Distributor::share_zone() {
     packet.put(zone_out_.side_sets.size());
     for (const primal::SideSet& ss : zone_out_.side_sets) packet.put(ss.id), packet.put(ss.name);
   }
-  std::size_t bytes = packet.bytes().size();
-  MPI_Bcast(&bytes, 1, MPI_UINT64_T, root, comm_);
+  // Every rank here once its dicing is done, the zone rank last as a rule: the others wait for
+  // its packet's size without spinning, so that the zone's conform can use their cores.
+  std::uint64_t bytes = packet.bytes().size();
+  MPI_Request sized;
+  MPI_Ibcast(&bytes, 1, MPI_UINT64_T, root, comm_, &sized);
+  wait_quietly(sized);
   packet.bytes().resize(bytes);
   broadcast(packet.bytes().data(), bytes, MPI_CHAR, 1, root, comm_);
   // Every rank's share of the partition is with it by now.
