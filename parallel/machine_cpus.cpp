@@ -4,7 +4,6 @@
 #include <tbb/task_scheduler_observer.h>
 
 #include <chrono>
-#include <cstring>
 #include <thread>
 #include <vector>
 
