@@ -220,4 +220,28 @@ void Conformer::carry_side_sets() {
     side_sets_[s].sides.insert(side_sets_[s].sides.end(), added[s].begin(), added[s].end());
 }
 
+// The sets smoothing keeps (primal::KeptFeatures), in the output's numbers: the side sets'
+// faces, wherever they are (one embedded in a block, a surface the analyst loads or reads, moved
+// with the hexes around it under global smoothing: z 0.487-0.506 instead of 0.5 on a Gmsh
+// model's physical surface inside the tets), and the node sets' nodes (a load point, a curve).
+// The tet relaxation keeps them too (primal::tet_nodes_to_relax).
+void Conformer::keep_sets() {
+  kept_ = {};
+  const auto& hex = primal::cell_topology(primal::ElementKind::kHex);
+  for (const primal::SideSet& s : side_sets_) {
+    std::vector<std::array<Index, 4>> quads;
+    for (const primal::Side& side : s.sides) {
+      const auto& h = mesh_.hexes[primal::index_cast<std::size_t>(side.element.index)];
+      const auto& f = hex.face[primal::index_cast<std::size_t>(side.face)];
+      quads.push_back({h[primal::index_cast<std::size_t>(f.corners[0])],
+                       h[primal::index_cast<std::size_t>(f.corners[1])],
+                       h[primal::index_cast<std::size_t>(f.corners[2])],
+                       h[primal::index_cast<std::size_t>(f.corners[3])]});
+    }
+    kept_.surfaces.push_back(std::move(quads));
+  }
+  for (const primal::NodeSet& s : node_sets_)
+    kept_.nodes.insert(kept_.nodes.end(), s.nodes.begin(), s.nodes.end());
+}
+
 }  // namespace geode::conform::detail

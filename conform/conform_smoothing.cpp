@@ -103,7 +103,9 @@ void Conformer::untangle() {
   const std::size_t before = inverted_.size();
   std::vector<Index> seeds = inverted_;
   for (int ring = 0; ring < kUntangleRings; ++ring) seeds = primal::hexes_around(mesh_, seeds);
-  const auto r = primal::smooth_hexes_around(mesh_, seeds, options_.local_smooth_options);
+  primal::LocalSmoothOptions o = options_.local_smooth_options;
+  o.kept = &kept_;
+  const auto r = primal::smooth_hexes_around(mesh_, seeds, o);
   add_smoothing(r);
   measure(r.region);
   res_.smoothing.final_min_scaled_jacobian = scan();
@@ -121,19 +123,26 @@ void Conformer::add_smoothing(const primal::LocalSmoothResult& r) {
   s.seconds += r.seconds, s.cpu_seconds += r.cpu_seconds;
 }
 
-// The worst-first smoother (primal/local_smooth.hpp); nodes on the model boundary and between
-// blocks slide only where that keeps every block's volume. Local: patches seeded near the geode
-// hexes, on the submesh around the seeds, so the cost follows the interface (or, with the automatic
-// target, its defects); global: every hex, then the automatic passes wherever a hex is still below
-// the yardstick.
+// The worst-first smoother (primal/local_smooth.hpp); nodes on the model boundary, between
+// blocks and on the user's side sets slide only where that keeps every block's volume and the
+// sets' surfaces, the other nodes of node sets stay (keep_sets). Local: patches seeded near the
+// geode hexes, on the submesh around the seeds, so the cost follows the interface (or, with the
+// automatic target, its defects); global: every hex, then the automatic passes wherever a hex is
+// still below the yardstick.
 void Conformer::smooth() {
   t0_ = Clock::now();
   res_.smoothing.initial_min_scaled_jacobian = res_.min_scaled_jacobian_before_smoothing;
   res_.smoothing.final_min_scaled_jacobian = res_.min_scaled_jacobian_before_smoothing;
   res_.smoothing.initial_inverted = res_.smoothing.final_inverted = res_.placement_inverted;
-  if (options_.smooth == ConformSmooth::kNone) return untangle();
+  keep_sets();
+  if (options_.smooth == ConformSmooth::kNone) {
+    untangle();
+    kept_ = {};
+    return;
+  }
   const bool local = options_.smooth == ConformSmooth::kLocal;
   primal::LocalSmoothOptions o = options_.local_smooth_options;
+  o.kept = &kept_;
   auto last = Clock::now();
   o.progress = [&](std::size_t settled, std::size_t total) {
     if (options_.smoothing_progress) {
@@ -154,7 +163,7 @@ void Conformer::smooth() {
   } else if (local) {
     smooth_defects(o);
   } else {
-    const auto constraints = primal::boundary_slide_constraints(mesh_);
+    const auto constraints = primal::kept_slide_constraints(mesh_, kept_);
     add_smoothing(primal::smooth_hexes_local(mesh_, constraints, nullptr, {}, global_options(o)));
     sj_ = primal::scaled_jacobian_per_hex(mesh_);
     // The global target lifts the whole mesh a little, not a defect to the yardstick: the
@@ -172,6 +181,7 @@ void Conformer::smooth() {
   res_.smoothing.final_min_scaled_jacobian = scan();
   res_.smoothing.final_inverted = primal::index_cast(inverted_.size());
   untangle();
+  kept_ = {};
   const Index patches = res_.smoothing.patches;
   say("smoothing (" + std::string(local ? "local" : "global") + "): " + std::to_string(patches) +
       " patches, min scaled Jacobian " +

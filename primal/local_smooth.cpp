@@ -695,6 +695,56 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
   return res;
 }
 
+namespace {
+
+// boundary_slide_constraints over `surfaces` and kept.surfaces, then each kept surface's rim
+// (its quads' edges used once) and kept.nodes (KeptFeatures); nodes checked by the caller.
+std::vector<NodeConstraint> slide_constraints(const HexMesh& mesh,
+                                              std::vector<BoundaryQuad> surfaces,
+                                              const KeptFeatures& kept) {
+  for (const auto& surface : kept.surfaces)
+    for (const auto& q : surface) surfaces.push_back(BoundaryQuad{kInvalidIndex, -1, q});
+  std::vector<NodeConstraint> out = boundary_slide_constraints(mesh, surfaces);
+  const auto& p = mesh.points;
+  constexpr double kParallel = 1e-9;  // |d1 x d2| of unit directions taken as one line
+  std::unordered_map<Index, std::vector<Point>> rim;  // node -> its rim edges' directions
+  for (const auto& surface : kept.surfaces) {
+    std::unordered_map<EdgeKey, int, IndexArrayHash> uses;
+    for (const auto& q : surface)
+      for (int k = 0; k < 4; ++k) ++uses[edge_key(q[k], q[(k + 1) % 4])];
+    for (const auto& q : surface)
+      for (int k = 0; k < 4; ++k) {
+        const Index a = q[k], b = q[(k + 1) % 4];
+        if (uses[edge_key(a, b)] != 1) continue;
+        const Point d = (p[b] - p[a]).normalized();
+        rim[a].push_back(d), rim[b].push_back(d);
+      }
+  }
+  for (auto& [v, directions] : rim) {
+    NodeConstraint& c = out[index_cast<std::size_t>(v)];
+    const Point d = directions.front();
+    const bool straight = std::all_of(directions.begin(), directions.end(), [&](const Point& e) {
+      return d.cross(e).norm() <= kParallel;
+    });
+    if (!straight || c.kind == NodeConstraint::Kind::kFixed) {
+      c = NodeConstraint::fixed();
+    } else if (c.kind == NodeConstraint::Kind::kFree ||
+               (c.kind == NodeConstraint::Kind::kPlane &&
+                std::abs(c.direction.normalized().dot(d)) <= kParallel)) {
+      c = NodeConstraint::line(p[index_cast<std::size_t>(v)], d);
+    } else if (!(c.kind == NodeConstraint::Kind::kLine &&
+                 c.direction.normalized().cross(d).norm() <= kParallel)) {
+      c = NodeConstraint::fixed();
+    }
+  }
+  for (Index v : kept.nodes)
+    if (out[index_cast<std::size_t>(v)].kind == NodeConstraint::Kind::kFree)
+      out[index_cast<std::size_t>(v)] = NodeConstraint::fixed();
+  return out;
+}
+
+}  // namespace
+
 LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seeds,
                                       const LocalSmoothOptions& options, const SmoothStart* start) {
   for (Index s : seeds)
@@ -741,7 +791,32 @@ LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seed
       if (r < region.size() && region[r] == outer[i]) sub_region.push_back(index_cast(i));
     }
   }
-  auto constraints = boundary_slide_constraints(sub, surface_quads_at(sub, sub_region, moves));
+  // The kept features in submesh numbers: the surfaces' quads with a node that moves (every
+  // node of such a quad is in the submesh, its hex being in the region), so that every quad of a
+  // surface through a moving node is there and its rim through that node is told right.
+  KeptFeatures kept;
+  if (options.kept) {
+    const auto sub_node = [&](Index v) {
+      if (v < 0 || index_cast<std::size_t>(v) >= local.size())
+        throw InvalidInput("smooth_hexes_around: kept node " + std::to_string(v) + " out of range");
+      return local[index_cast<std::size_t>(v)];
+    };
+    const auto moving = [&](Index l) { return l != kInvalidIndex && moves[l]; };
+    for (const auto& surface : options.kept->surfaces) {
+      std::vector<std::array<Index, 4>> near;
+      for (const auto& q : surface) {
+        std::array<Index, 4> l{};
+        for (int k = 0; k < 4; ++k) l[k] = sub_node(q[k]);
+        if (std::any_of(l.begin(), l.end(), moving) &&
+            std::none_of(l.begin(), l.end(), [](Index x) { return x == kInvalidIndex; }))
+          near.push_back(l);
+      }
+      if (!near.empty()) kept.surfaces.push_back(std::move(near));
+    }
+    for (Index v : options.kept->nodes)
+      if (const Index l = sub_node(v); moving(l)) kept.nodes.push_back(l);
+  }
+  auto constraints = slide_constraints(sub, surface_quads_at(sub, sub_region, moves), kept);
   std::vector<Index> local_seeds;
   local_seeds.reserve(seeds.size());
   for (std::size_t i = 0; i < outer.size(); ++i)
@@ -834,6 +909,18 @@ std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh,
       out[v] = NodeConstraint::fixed();
   }
   return out;
+}
+
+std::vector<NodeConstraint> kept_slide_constraints(const HexMesh& mesh, const KeptFeatures& kept) {
+  const auto check = [&](Index v) {
+    if (v < 0 || index_cast<std::size_t>(v) >= mesh.points.size())
+      throw InvalidInput("kept_slide_constraints: node " + std::to_string(v) + " out of range");
+  };
+  for (const auto& surface : kept.surfaces)
+    for (const auto& q : surface)
+      for (Index v : q) check(v);
+  for (Index v : kept.nodes) check(v);
+  return slide_constraints(mesh, material_surface_quads(mesh), kept);
 }
 
 TriMesh boundary_triangulation(const HexMesh& mesh) {

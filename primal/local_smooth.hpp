@@ -30,6 +30,7 @@
 //    of the given surface triangulation after every step (the bilinear faces around them then
 //    change by up to their chord error, and so do the volumes they enclose: for callers that
 //    accept that; boundary_slide_constraints fixes such nodes instead).
+#include <array>
 #include <cstddef>
 #include <functional>
 #include <span>
@@ -44,6 +45,20 @@ namespace geode::primal {
 // Boundary normals more than this many degrees apart make a feature edge or corner (the
 // buffer layer's mitred offsets, conform/buffer_layer.hpp).
 inline constexpr double kFeatureAngle = 30.0;
+
+// What smoothing keeps besides the model's boundary and the faces between blocks, in the mesh's
+// node numbers (conform: the output's side sets and node sets: surfaces, curves and points an
+// analyst put in the model to load or read, which must stay where they are).
+struct KeptFeatures {
+  // Surfaces, each on its own (a side set's faces): a node on one slides in its plane, or along
+  // the line where two planes meet, as on the faces between blocks; a node on its rim (an edge
+  // of one of its quads only) slides along the rim where it is straight, so that the surface
+  // keeps its extent; otherwise the node is fixed.
+  std::vector<std::vector<std::array<Index, 4>>> surfaces;
+  // Fixed, unless a surface through them (the boundary, a face between blocks, a kept surface)
+  // lets them slide in it: a set's node on the model's boundary stays on it.
+  std::vector<Index> nodes;
+};
 
 struct LocalSmoothOptions {
   double target = 0.35;  // hexes with a scaled Jacobian below it seed patches
@@ -67,6 +82,9 @@ struct LocalSmoothOptions {
   // yardstick). A goal of 0 is met by any hex.
   std::vector<double> hex_targets, hex_goals;
   int threads = 0;  // 0: TBB's default; 1: serial
+  // smooth_hexes_around only (smooth_hexes_local takes its constraints from the caller:
+  // kept_slide_constraints): the features kept besides the boundary and the block interfaces.
+  const KeptFeatures* kept = nullptr;
   // Called before each round and at the end with (seed hexes not waiting for a patch, seeds).
   std::function<void(std::size_t settled, std::size_t seeds)> progress;
 };
@@ -106,8 +124,8 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
                                      const LocalSmoothOptions& options = {},
                                      const SmoothStart* start = nullptr);
 
-// smooth_hexes_local with the model's boundary and its material interfaces kept
-// (boundary_slide_constraints), run on the submesh of the hexes around the seeds only: a patch
+// smooth_hexes_local with the model's boundary, its material interfaces and options.kept kept
+// (kept_slide_constraints), run on the submesh of the hexes around the seeds only: a patch
 // moves the nodes of its seed hex, so every hex whose quality can change shares a node with a
 // seed, and the boundary there is told from one more ring of hexes. Finding the rings still
 // scans the mesh once per ring, but the costly parts (boundary faces, constraints, patches)
@@ -133,6 +151,10 @@ std::vector<BoundaryQuad> material_surface_quads(const HexMesh& mesh);
 std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh);
 std::vector<NodeConstraint> boundary_slide_constraints(const HexMesh& mesh,
                                                        std::span<const BoundaryQuad> surfaces);
+
+// boundary_slide_constraints with `kept` kept too (KeptFeatures). Throws InvalidInput on a
+// node out of range.
+std::vector<NodeConstraint> kept_slide_constraints(const HexMesh& mesh, const KeptFeatures& kept);
 
 // The mesh's boundary quads, each split into two triangles (along the 0-2 diagonal): the
 // surface kSurface nodes slide on when no input triangulation is at hand.

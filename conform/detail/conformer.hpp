@@ -129,6 +129,7 @@ class Conformer {
   void assemble();
   void carry_side_sets();
   primal::Model node_set_model() const;
+  void keep_sets();
   void diced_alone_from_children(std::size_t tet_first);
   void settle_templates();
   std::vector<std::pair<Index, Point>> settled(std::size_t b) const;
@@ -141,6 +142,7 @@ class Conformer {
   primal::LocalSmoothOptions global_options(const primal::LocalSmoothOptions& caller) const {
     primal::LocalSmoothOptions g = options_.global_smooth_options;
     g.progress = caller.progress;
+    g.kept = caller.kept;
     g.target = std::min(g.target, options_.global_target_factor * aim_yardstick_);
     return g;
   }
@@ -183,6 +185,7 @@ class Conformer {
   primal::HexMesh mesh_;
   std::vector<primal::NodeSet> node_sets_;
   std::vector<primal::SideSet> side_sets_;
+  primal::KeptFeatures kept_;  // the sets in mesh_'s numbers, for smoothing (keep_sets)
   // Every output hex's scaled Jacobian (kept current by assemble, settling and smoothing) and
   // the hexes at or below 0 as of the last scan(); verification reads them.
   std::vector<double> sj_;

@@ -4,15 +4,19 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <functional>
 #include <map>
 #include <set>
+#include <string>
 #include <vector>
 
 #include <geode/conform/conform.hpp>
 #include <geode/demo/demo_models.hpp>
+#include <geode/io/read_model.hpp>
 #include <geode/primal/boundary.hpp>
 #include <geode/primal/topology.hpp>
+#include "support/temp_dir.hpp"
 
 namespace geode {
 
@@ -170,6 +174,85 @@ TEST_CASE("sets on the interface stay on it; sets across it take the buffer laye
             return near(p.x(), 1) && near(p.y(), 1) && near(p.z(), 1);
           }));
     CHECK(set_of(2).size() == 1);
+  }
+}
+
+// Sets inside a block and on part of a face stay where the user put them, whatever the
+// smoothing: a Gmsh model (tests/conform/embedded_sets_model.py) with a physical surface
+// embedded in the tets beside the interface, one on a patch of the tet box's top face, a
+// physical point and a physical curve embedded there too. Global smoothing moved the embedded
+// surface off its plane (z 0.487-0.506) and its rim and the patch's in their planes (the
+// sheet's x from 1.04 to 1.039), and the curve's and the point's nodes with the tets.
+TEST_CASE("sets inside a block and on part of a face keep their place and extent") {
+  test::TempDir dir;
+  const std::string model = (dir.path / "embedded.msh").string();
+  const std::string cmd = "/usr/bin/python3 '" + std::string(GEODE_SOURCE_DIR) +
+                          "/tests/conform/embedded_sets_model.py' '" + model + "'";
+  // python3-gmsh is a required package (scripts/common.sh): a missing one fails the test.
+  REQUIRE_MESSAGE(std::system(cmd.c_str()) == 0, cmd);
+  const primal::Model in = io::read_model(model);
+  struct Rectangle {
+    int id;
+    Point low, high;  // the corners of an axis-aligned rectangle
+  };
+  const Rectangle sheet{3, {1.04, 0.15, 0.5}, {1.64, 0.75, 0.5}},
+      patch{4, {1.1, 0.2, 1.0}, {1.6, 0.7, 1.0}};
+  for (const auto smooth : {conform::ConformSmooth::kNone, conform::ConformSmooth::kLocal,
+                            conform::ConformSmooth::kGlobal}) {
+    CAPTURE(static_cast<int>(smooth));
+    conform::ConformOptions o;
+    o.smooth = smooth;
+    const conform::ConformResult r = conform::conform(in, o);
+    REQUIRE(r.validity.ok());
+    const primal::Model& out = r.model;
+    const auto side_set = [&](int id) -> const primal::SideSet& {
+      const auto it = std::find_if(out.side_sets.begin(), out.side_sets.end(),
+                                   [&](const primal::SideSet& s) { return s.id == id; });
+      REQUIRE(it != out.side_sets.end());
+      return *it;
+    };
+    const auto node_set = [&](int id) -> const primal::NodeSet& {
+      const auto it = std::find_if(out.node_sets.begin(), out.node_sets.end(),
+                                   [&](const primal::NodeSet& s) { return s.id == id; });
+      REQUIRE(it != out.node_sets.end());
+      return *it;
+    };
+    for (const Rectangle& rect : {sheet, patch}) {
+      CAPTURE(rect.id);
+      const primal::SideSet& s = side_set(rect.id);
+      REQUIRE(!s.sides.empty());
+      double area = 0.0;
+      int outside = 0;
+      for (const primal::Side& side : s.sides) {
+        const std::vector<Index> f = primal::element_face(out, side);
+        REQUIRE(f.size() == 4);
+        std::array<Point, 4> x;
+        for (int k = 0; k < 4; ++k) {
+          x[k] = out.points[primal::index_cast<std::size_t>(f[k])];
+          for (int d = 0; d < 3; ++d)
+            if (x[k][d] < rect.low[d] - 1e-12 || x[k][d] > rect.high[d] + 1e-12) ++outside;
+        }
+        area += 0.5 * (x[2] - x[0]).cross(x[3] - x[1]).norm();
+      }
+      CHECK(outside == 0);
+      const Point size = rect.high - rect.low;
+      CHECK(area == doctest::Approx(size.x() * size.y()).epsilon(1e-9));
+    }
+    const primal::NodeSet& point = node_set(5);
+    REQUIRE(point.nodes.size() == 1);
+    CHECK((out.points[primal::index_cast<std::size_t>(point.nodes[0])] - Point(1.7, 0.8, 0.3))
+              .norm() < 1e-12);
+    const primal::NodeSet& line = node_set(6);
+    REQUIRE(line.nodes.size() >= 2);
+    double low = 1.0, high = 0.0;
+    for (Index v : line.nodes) {
+      const Point& x = out.points[primal::index_cast<std::size_t>(v)];
+      CHECK(std::abs(x.x() - 1.2) < 1e-12);
+      CHECK(std::abs(x.y() - 0.9) < 1e-12);
+      low = std::min(low, x.z()), high = std::max(high, x.z());
+    }
+    CHECK(low == doctest::Approx(0.1));
+    CHECK(high == doctest::Approx(0.9));
   }
 }
 

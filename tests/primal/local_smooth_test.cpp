@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <map>
+#include <numeric>
 #include <vector>
 
 #include <geode/primal/errors.hpp>
@@ -404,6 +405,90 @@ TEST_CASE(
   gp::smooth_hexes_around(around, seeds, o);
   check_volumes_kept(before, around);
   CHECK(gp::min_scaled_jacobian(around) > gp::min_scaled_jacobian(before));
+}
+
+// A surface kept inside the mesh (conform: a side set embedded in a block) and kept nodes (a
+// node set's): the surface's nodes slide in its plane, its rim's along the rim where it is
+// straight, its corners and the kept interior node stay, a kept node on the boundary slides on
+// it; the same through smooth_hexes_local with kept_slide_constraints and smooth_hexes_around
+// with LocalSmoothOptions::kept.
+TEST_CASE("kept surfaces keep their plane and extent, kept nodes stay") {
+  constexpr int n = 4;
+  // The kept patch: the 2 x 2 quads of the plane z = 2 over [1, 3]^2; its centre (2, 2, 2) is
+  // jittered in the plane, every other interior node in 3D except the kept node (2, 2, 1).
+  const auto on_patch = [](const Point& p) {
+    return p.z() == 2 && p.x() >= 1 && p.x() <= 3 && p.y() >= 1 && p.y() <= 3;
+  };
+  Lcg r{17};
+  const HexMesh start = grid(n, [&](const Point& p) {
+    Point q = p;
+    if (p == Point(2, 2, 2)) return Point(2 + 0.3 * r.next(), 2 + 0.3 * r.next(), 2);
+    if (on_patch(p) || p == Point(2, 2, 1)) return q;
+    for (int a = 0; a < 3; ++a)
+      if (p[a] > 0 && p[a] < n) q[a] += 0.3 * r.next();
+    return q;
+  });
+  const auto id = [](int i, int j, int k) {
+    return gp::index_cast(i + (n + 1) * (j + (n + 1) * k));
+  };
+  gp::KeptFeatures kept;
+  kept.surfaces.emplace_back();
+  for (int j = 1; j < 3; ++j)
+    for (int i = 1; i < 3; ++i)
+      kept.surfaces[0].push_back(
+          {id(i, j, 2), id(i + 1, j, 2), id(i + 1, j + 1, 2), id(i, j + 1, 2)});
+  kept.nodes = {id(2, 2, 1), id(0, 2, 2)};  // interior; on the boundary face x = 0
+
+  // The constraints, node by node.
+  const auto cons = gp::kept_slide_constraints(start, kept);
+  using Kind = NodeConstraint::Kind;
+  struct Expected {
+    Index node;
+    Kind kind;
+    Point direction;  // the plane's normal or the line's direction, up to sign
+  };
+  for (const Expected& e : {Expected{id(2, 2, 2), Kind::kPlane, {0, 0, 1}},
+                            Expected{id(1, 2, 2), Kind::kLine, {0, 1, 0}},
+                            Expected{id(2, 3, 2), Kind::kLine, {1, 0, 0}},
+                            Expected{id(1, 1, 2), Kind::kFixed, {0, 0, 0}},
+                            Expected{id(3, 3, 2), Kind::kFixed, {0, 0, 0}},
+                            Expected{id(2, 2, 1), Kind::kFixed, {0, 0, 0}},
+                            Expected{id(0, 2, 2), Kind::kPlane, {1, 0, 0}},
+                            Expected{id(2, 1, 1), Kind::kFree, {0, 0, 0}}}) {
+    CAPTURE(e.node);
+    const NodeConstraint& c = cons[gp::index_cast<std::size_t>(e.node)];
+    CHECK(c.kind == e.kind);
+    if (e.kind == Kind::kPlane || e.kind == Kind::kLine)
+      CHECK(c.direction.normalized().cross(e.direction).norm() < 1e-12);
+  }
+
+  gp::LocalSmoothOptions o;
+  o.target = 0.99;
+  std::vector<Index> all(start.hexes.size());
+  std::iota(all.begin(), all.end(), 0);
+  HexMesh local = start, around = start;
+  gp::smooth_hexes_local(local, cons, nullptr, {}, o);
+  o.kept = &kept;
+  gp::smooth_hexes_around(around, all, o);
+  for (const HexMesh* m : {&local, &around}) {
+    double area = 0.0;
+    for (const auto& q : kept.surfaces[0]) {
+      for (Index v : q) {
+        const Point& x = m->points[gp::index_cast<std::size_t>(v)];
+        CHECK(x.z() == 2.0);
+        CHECK((x.x() >= 1.0 && x.x() <= 3.0 && x.y() >= 1.0 && x.y() <= 3.0));
+      }
+      const auto at = [&](int k) { return m->points[gp::index_cast<std::size_t>(q[k])]; };
+      area += 0.5 * (at(2) - at(0)).cross(at(3) - at(1)).norm();
+    }
+    CHECK(area == doctest::Approx(4.0).epsilon(1e-12));
+    CHECK(m->points[id(2, 2, 1)] == start.points[id(2, 2, 1)]);
+    CHECK(m->points[id(1, 1, 2)] == start.points[id(1, 1, 2)]);
+    CHECK(m->points[id(0, 2, 2)].x() == 0.0);
+    // The centre and the rims moved (the test would pass on fixed nodes otherwise).
+    CHECK((m->points[id(2, 2, 2)] - start.points[id(2, 2, 2)]).norm() > 1e-3);
+    CHECK((m->points[id(1, 2, 2)] - start.points[id(1, 2, 2)]).norm() > 1e-6);
+  }
 }
 
 TEST_CASE("one thread and two threads give the same mesh") {
