@@ -409,8 +409,11 @@ void OutputFiles::commit() {
   pending_.clear();
 }
 
-OutputFiles::~OutputFiles() {
+void OutputFiles::discard() {
   for (const auto& p : pending_) io::remove_temporary(p);
+  pending_.clear();
 }
+
+OutputFiles::~OutputFiles() { discard(); }
 
 }  // namespace geode::cli

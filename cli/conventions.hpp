@@ -138,6 +138,9 @@ class OutputFiles {
   // failure leaves nothing behind, as commit()'s.
   void write(std::size_t i);
   void commit();
+  // Removes the temporaries written so far, as the destructor does (for a process about to end
+  // without running destructors: geode_mpi's abort).
+  void discard();
   ~OutputFiles();
 
  private:

@@ -4,9 +4,9 @@
 
 #include <algorithm>
 #include <numeric>
-#include <stdexcept>
 
 #include <geode/io/exodus.hpp>
+#include <geode/primal/errors.hpp>
 
 namespace geode::parallel {
 namespace {
@@ -17,8 +17,8 @@ using primal::Point;
 
 void check(int status, const std::filesystem::path& path, const std::string& what) {
   if (status < 0)
-    throw std::runtime_error(path.string() + ": " + what + " failed (libexodusII status " +
-                             std::to_string(status) + ")");
+    throw InvalidInput(path.string() + ": " + what + " failed (libexodusII status " +
+                       std::to_string(status) + ")");
 }
 
 // Ids as libexodusII's int API takes them: 1-based, within int (checked).
@@ -27,7 +27,7 @@ std::vector<int> one_based(const std::vector<std::int64_t>& ids, const std::file
   r.reserve(ids.size());
   for (std::int64_t g : ids) {
     if (g + 1 > std::numeric_limits<int>::max())
-      throw std::runtime_error(p.string() + ": a global id past the 32-bit range");
+      throw InvalidInput(p.string() + ": a global id past the 32-bit range");
     r.push_back(static_cast<int>(g + 1));
   }
   return r;
@@ -42,8 +42,7 @@ std::filesystem::path rank_file(const std::filesystem::path& output, int ranks, 
   return output.string() + "." + n + "." + r;
 }
 
-void write_nemesis(const RankMesh& mesh, const std::filesystem::path& output, int ranks, int rank) {
-  const std::filesystem::path path = rank_file(output, ranks, rank);
+void write_nemesis(const RankMesh& mesh, const std::filesystem::path& path, int ranks, int rank) {
   // Load balance: internal / border nodes and elements (1-based local numbers).
   std::vector<char> border(mesh.model.points.size(), 0);
   for (const auto& [q, shared] : mesh.shared_nodes)

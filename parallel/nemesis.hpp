@@ -22,15 +22,17 @@ namespace geode::parallel {
 // "OUT.exo.4.0" ... "OUT.exo.4.3" (epu's naming).
 std::filesystem::path rank_file(const std::filesystem::path& output, int ranks, int rank);
 
-// Writes this rank's file (a temporary name, then renamed). Throws std::runtime_error naming
-// the file when libexodusII fails.
-void write_nemesis(const RankMesh& mesh, const std::filesystem::path& output, int ranks, int rank);
+// Writes this rank's piece to `file` (rank_file(OUT, ranks, rank), or a temporary the caller
+// renames to it once every rank has written its own). Throws InvalidInput naming `file` when
+// libexodusII fails.
+void write_nemesis(const RankMesh& mesh, const std::filesystem::path& file, int ranks, int rank);
 
 // The model in a canonical order, independent of how it was numbered: nodes by coordinates
 // (x, then y, then z), hexes by block, then by their corners' new numbers; sets sorted.
 primal::Model canonical(const primal::Model& model);
 
-// Collective: rank 0 gathers every rank's hexes and writes `output` (canonical order).
+// Collective: rank 0 gathers every rank's hexes and writes `output` (canonical order; the other
+// ranks' `output` is not used).
 void write_joined(const RankMesh& mesh, const std::filesystem::path& output, MPI_Comm comm);
 
 }  // namespace geode::parallel

@@ -6,6 +6,10 @@
 #include <sys/resource.h>
 
 #include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <functional>
 #include <iostream>
 #include <new>
 #include <sstream>
@@ -19,6 +23,7 @@
 #include <geode/conform/buffer_layer.hpp>
 #include <geode/io/read_model.hpp>
 #include <geode/parallel/distributed_conform.hpp>
+#include <geode/parallel/machine_cpus.hpp>
 #include <geode/parallel/nemesis.hpp>
 
 #include <geode/parallel/partition.hpp>
@@ -33,6 +38,93 @@ double peak_mib() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
   return static_cast<double>(u.ru_maxrss) / 1024.0;
+}
+
+// Test hook (tests/parallel/mpi_verify_test.sh, docs/cli.md): GEODE_TEST_FAIL_RANK=R:STAGE
+// makes rank R alone fail at STAGE (read: after reading, while the others go on into the
+// conform's collectives; write: before writing its piece, after the others wrote theirs).
+void fail_for_test(int rank, const std::string& stage) {
+  const char* v = std::getenv("GEODE_TEST_FAIL_RANK");
+  if (v && std::string(v) == std::to_string(rank) + ":" + stage)
+    throw InvalidInput("rank " + std::to_string(rank) + ": GEODE_TEST_FAIL_RANK is set (" + stage +
+                       ")");
+}
+
+// How long a rank that failed waits for the others to agree before it aborts the run: errors
+// every rank meets alike (the input, the zone, an invalid result) reach the agreement within
+// moments of each other; one that waits this long is not coming.
+constexpr double kAgreeSeconds = 10.0;
+
+MPI_Comm agreement = MPI_COMM_NULL;  // MPI_COMM_WORLD's duplicate for agree() (main)
+
+// The ranks' exit codes agreed by a non-blocking all-reduce, and the failure told once: by the
+// lowest rank that failed (every rank fails alike on a bad input: rank 0 then). A rank that
+// failed alone (its own piece of the file, its memory, its write) while the others wait in a
+// collective it will never join cannot be waited for: after kAgreeSeconds it says its failure
+// and aborts the run with its code (mpirun exits with it and stops the other ranks, whose
+// temporaries their signal handlers remove), instead of leaving every rank waiting forever.
+int agree(int code, const std::string& failure, int rank, const std::function<void()>& discard) {
+  int worst = 0;
+  MPI_Request request;
+  // On a communicator of its own (made by every rank at the start): a rank that failed early
+  // posts it while the others are still in the run's collectives, which it must not match.
+  MPI_Iallreduce(&code, &worst, 1, MPI_INT, MPI_MAX, agreement, &request);
+  if (code == 0) {
+    parallel::wait_quietly(request);
+  } else {
+    const double deadline = MPI_Wtime() + kAgreeSeconds;
+    for (int done = 0;;) {
+      MPI_Test(&request, &done, MPI_STATUS_IGNORE);
+      if (done) break;
+      if (MPI_Wtime() > deadline) {
+        std::cerr << failure << " (rank " << rank << " alone; the run is aborted)" << std::endl;
+        discard();  // its temporaries: MPI_Abort runs no destructor
+        MPI_Abort(MPI_COMM_WORLD, code);
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  }
+  // The lowest failing rank says why (the ranks are all here: a blocking reduction).
+  int size = 1;
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  const int mine = code != 0 ? rank : size;
+  int lowest = size;
+  MPI_Allreduce(&mine, &lowest, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  if (rank == lowest) std::cerr << failure << "\n";
+  return worst;
+}
+
+// What rank 0 prints of a run that got as far as every rank's hexes (valid or not): the run's
+// line, each rank's stages and peak, the warnings.
+struct Summary {
+  std::string head, line;
+  std::vector<std::string> warnings;
+};
+
+// Collective (after agree()): the ranks' lines gathered to rank 0 and printed there, when every
+// rank has one.
+void print_summary(const Summary& summary, int rank, int size) {
+  const int has = summary.line.empty() ? 0 : 1;
+  int all_have = 0;
+  MPI_Allreduce(&has, &all_have, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  if (!all_have) return;
+  const std::string& text = summary.line;
+  int n = primal::index_cast<int>(text.size());
+  std::vector<int> counts(primal::index_cast<std::size_t>(size)), displs(counts.size());
+  MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
+  std::exclusive_scan(counts.begin(), counts.end(), displs.begin(), 0);
+  std::string all(rank == 0 ? primal::index_cast<std::size_t>(displs.back() + counts.back()) : 0,
+                  ' ');
+  MPI_Gatherv(text.data(), n, MPI_CHAR, all.data(), counts.data(), displs.data(), MPI_CHAR, 0,
+              MPI_COMM_WORLD);
+  if (rank != 0) return;
+  std::cout << summary.head;
+  for (std::size_t r = 0; r < counts.size(); ++r)
+    std::cout << "  "
+              << all.substr(primal::index_cast<std::size_t>(displs[r]),
+                            primal::index_cast<std::size_t>(counts[r]))
+              << "\n";
+  for (const auto& w : summary.warnings) std::cout << "  warning: " << w << "\n";
 }
 
 int run(int argc, char** argv, int rank, int size) {
@@ -106,6 +198,11 @@ int run(int argc, char** argv, int rank, int size) {
   tbb::global_control threads_limit(
       tbb::global_control::max_allowed_parallelism,
       primal::index_cast<std::size_t>(std::max({threads, zone_threads, cpus, 1})));
+  // The outputs this rank writes (published by commit() after the agreement), and the one line
+  // its failure says (printed by the lowest rank that failed: agree()).
+  cli::OutputFiles files;
+  std::string failure;
+  Summary summary;  // filled once the rank has its hexes, printed by rank 0 (print_summary)
   // Everything after the options, in the rank's arena.
   const auto conform_in_arena = [&]() -> int {
     try {
@@ -124,6 +221,7 @@ int run(int argc, char** argv, int rank, int size) {
       io::FilePartition file_partition;
       primal::Model model = io::read_model(input, {}, true, &file_partition,
                                            parallel::shared_input_check(MPI_COMM_WORLD));
+      fail_for_test(rank, "read");
       // The input's own partition (a partitioned .msh, a Nemesis set) unless it has fewer parts
       // than there are ranks: then METIS (parallel/partition.hpp).
       std::string partitioned_by = size > 1 ? "METIS" : "one rank";
@@ -142,68 +240,76 @@ int run(int argc, char** argv, int rank, int size) {
       const parallel::RankMesh mesh =
           parallel::conform_distributed(std::move(model), options, MPI_COMM_WORLD, &report);
       const double t_conform = MPI_Wtime() - t0 - t_read;
-      if (report.valid) parallel::write_nemesis(mesh, output, size, rank);
-      const double t_write = MPI_Wtime() - t0 - t_read - t_conform;
-      if (report.valid && join) parallel::write_joined(mesh, output, MPI_COMM_WORLD);
+      // The joined file (rank 0 gathers: collective) and each rank's piece, to temporaries
+      // published only once every rank has written its own (agree(), then commit()): a rank
+      // failing to write leaves no set with a piece missing, and none waiting for it.
+      if (report.valid && join) {
+        if (rank == 0)
+          files.write(files.add(output, [&](const std::filesystem::path& temp) {
+            parallel::write_joined(mesh, temp, MPI_COMM_WORLD);
+          }));
+        else
+          parallel::write_joined(mesh, {}, MPI_COMM_WORLD);
+      }
+      if (report.valid) {
+        const std::size_t piece = files.add(parallel::rank_file(output, size, rank),
+                                            [&](const std::filesystem::path& temp) {
+                                              parallel::write_nemesis(mesh, temp, size, rank);
+                                            });
+        fail_for_test(rank, "write");
+        files.write(piece);
+      }
       const double t_all = MPI_Wtime() - t0;
-      // Per rank: time per stage and peak memory, gathered to rank 0.
+      // Per rank: time per stage and peak memory, gathered to rank 0 after the agreement.
       std::ostringstream line;
       line << "rank " << rank << ": " << mesh.model.hexes.size() << " hexes (" << report.zone_hexes
            << " of the transition zone, " << report.diced_hexes << " diced), read " << t_read
            << " s, conform " << t_conform << " s (";
       for (const auto& [stage, s] : report.seconds) line << stage << " " << s << " s, ";
-      line << "), write " << t_write << " s, total " << t_all << " s, peak " << peak_mib()
-           << " MiB";
-      const std::string text = line.str();
-      int n = primal::index_cast<int>(text.size());
-      std::vector<int> counts(primal::index_cast<std::size_t>(size)), displs(counts.size());
-      MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
-      std::exclusive_scan(counts.begin(), counts.end(), displs.begin(), 0);
-      std::string all(
-          rank == 0 ? primal::index_cast<std::size_t>(displs.back() + counts.back()) : 0, ' ');
-      MPI_Gatherv(text.data(), n, MPI_CHAR, all.data(), counts.data(), displs.data(), MPI_CHAR, 0,
-                  MPI_COMM_WORLD);
-      if (rank == 0 && !quiet) {
-        std::cout << "geode_mpi: " << size << " ranks, " << mesh.global_hexes << " hexes, "
-                  << mesh.global_nodes << " nodes, transition zone " << report.zone_cells
-                  << " input elements (" << report.rings << " rings), partition: " << partitioned_by
-                  << ", " << (report.valid ? "valid" : "INVALID") << ", " << t_all << " s\n";
-        for (int r = 0; r < size; ++r)
-          std::cout << "  "
-                    << all.substr(primal::index_cast<std::size_t>(
-                                      displs[primal::index_cast<std::size_t>(r)]),
-                                  primal::index_cast<std::size_t>(
-                                      counts[primal::index_cast<std::size_t>(r)]))
-                    << "\n";
-        for (const auto& w : report.warnings) std::cout << "  warning: " << w << "\n";
-      }
+      line << "), write " << t_all - t_read - t_conform << " s, total " << t_all << " s, peak "
+           << peak_mib() << " MiB";
+      std::ostringstream head;
+      head << "geode_mpi: " << size << " ranks, " << mesh.global_hexes << " hexes, "
+           << mesh.global_nodes << " nodes, transition zone " << report.zone_cells
+           << " input elements (" << report.rings << " rings), partition: " << partitioned_by
+           << ", " << (report.valid ? "valid" : "INVALID") << ", " << t_all << " s\n";
+      summary = {head.str(), line.str(), report.warnings};
       if (!report.valid) {
         for (const auto& w : report.warnings) std::cerr << "geode_mpi: " << w << "\n";
-        if (rank == 0) std::cerr << "geode_mpi: invalid result, nothing written\n";
+        failure = "geode_mpi: invalid result, nothing written";
         return 4;
       }
       return 0;
     } catch (const InvalidInput& e) {
-      if (rank == 0) std::cerr << "geode_mpi: " << e.what() << "\n";
+      failure = "geode_mpi: " + std::string(e.what());
       return 2;
     } catch (const TopologyError& e) {
-      if (rank == 0) std::cerr << "geode_mpi: " << e.what() << "\n";
+      failure = "geode_mpi: " + std::string(e.what());
       return 3;
     } catch (const std::bad_alloc&) {
-      // As the serial command (cli/main.cpp): one line and exit 2, from the rank that ran out.
-      std::cerr << "geode_mpi conform (rank " << rank
-                << "): error: out of memory: the input needs more memory than this machine "
-                << "gives (nothing written)\n";
+      // As the serial command (cli/main.cpp): one line and exit 2.
+      failure = "geode_mpi conform (rank " + std::to_string(rank) +
+                "): error: out of memory: the input needs more memory than this machine gives "
+                "(nothing written)";
       return 2;
     } catch (const std::exception& e) {
-      std::cerr << "geode_mpi (rank " << rank << "): " << e.what() << "\n";
+      failure = "geode_mpi (rank " + std::to_string(rank) + "): " + e.what();
       return 4;
     }
   };
   tbb::task_arena arena(std::max(threads, 1));
   int code = 0;
   arena.execute([&] { code = conform_in_arena(); });
-  return code;
+  const int worst = agree(code, failure, rank, [&] { files.discard(); });
+  if (!quiet) print_summary(summary, rank, size);
+  if (worst != 0) return worst;
+  try {
+    files.commit();  // every rank wrote its piece: all published
+  } catch (const std::exception& e) {
+    std::cerr << "geode_mpi (rank " << rank << "): " << e.what() << "\n";
+    return 2;
+  }
+  return 0;
 }
 
 }  // namespace
@@ -216,11 +322,9 @@ int main(int argc, char** argv) {
   int rank = 0, size = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &size);
-  const int code = run(argc, argv, rank, size);
-  // The same errors arise on every rank (the input and the zone are the same everywhere); a
-  // rank failing alone (its file) must not leave the others waiting.
-  int worst = 0;
-  MPI_Allreduce(&code, &worst, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  MPI_Comm_dup(MPI_COMM_WORLD, &agreement);
+  const int code = run(argc, argv, rank, size);  // every rank's worst (agree())
+  MPI_Comm_free(&agreement);
   MPI_Finalize();
-  return worst;
+  return code;
 }

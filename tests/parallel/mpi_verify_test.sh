@@ -6,7 +6,8 @@
 # failing check named, nothing written. A transition zone made invalid on the zone rank (the last;
 # GEODE_TEST_INVERT_OUTPUT_HEX in its conform) fails every rank count alike; so does a partition
 # failing on rank 0 (GEODE_TEST_FAIL_PARTITION), and one rank's share of the read refused
-# (GEODE_TEST_FAIL_READ_SHARE), without a rank left waiting. Options out of range exit 2.
+# (GEODE_TEST_FAIL_READ_SHARE), without a rank left waiting; so does one rank failing alone
+# (GEODE_TEST_FAIL_RANK). Options out of range exit 2.
 # usage: mpi_verify_test.sh GEODE GEODE_MPI MPIEXEC WORKDIR
 set -euo pipefail
 geode=$1 geode_mpi=$2 mpiexec=$3 dir=$4
@@ -69,6 +70,25 @@ for n in 2 3; do
     if ls read"$n".exo* >/dev/null 2>&1; then echo "a refused share, $n ranks: wrote a file"; exit 1; fi
   done
 done
+# One rank failing alone (GEODE_TEST_FAIL_RANK=R:STAGE): after reading, while the others go on
+# into the conform's collectives, it aborts the run after its wait for them (exit 2 with the
+# reason, no rank left waiting); before writing its piece, after the others wrote theirs, every
+# rank agrees on the failure: exit 2, the reason from that rank, no piece of the set written.
+for n in 2 3; do
+  for stage in read write; do
+    status=0
+    GEODE_TEST_FAIL_RANK=$((n - 1)):$stage timeout 120 "$mpiexec" --oversubscribe \
+      -x GEODE_TEST_FAIL_RANK -np "$n" "$geode_mpi" conform in.exo -o "alone$n.exo" --join -q \
+      2>err.txt >/dev/null || status=$?
+    if [ "$status" != 2 ]; then
+      echo "rank $((n - 1)) failing alone at $stage of $n: exited $status, not 2"; cat err.txt; exit 1
+    fi
+    grep -q "rank $((n - 1)): GEODE_TEST_FAIL_RANK is set ($stage)" err.txt
+    if ls alone"$n".exo* .alone* >/dev/null 2>&1; then
+      echo "rank $((n - 1)) failing alone at $stage: a file is left"; ls -a; exit 1
+    fi
+  done
+done
 head -c $(($(stat -c %s in.exo) * 3 / 4)) in.exo >cut.exo
 status=0
 timeout 120 "$mpiexec" --oversubscribe -np 2 "$geode_mpi" conform cut.exo -o cut-out.exo -q \
@@ -88,4 +108,4 @@ for args in "--smooth global" "--buffer-side wedge" "--rings 0" "--rings 65" \
   if ls refused.exo* >/dev/null 2>&1; then echo "conform $args: wrote a file"; exit 1; fi
 done
 grep -q "with --buffer-side tet: at most 0.45" err.txt
-echo "mpi_verify_test: both modes pass the result and find the broken dicing on 1 and 2 ranks, an invalid zone on 1 to 3, a refused share of the read on 2 and 3, options out of range refused"
+echo "mpi_verify_test: both modes pass the result and find the broken dicing on 1 and 2 ranks, an invalid zone on 1 to 3, a refused share of the read on 2 and 3, a rank failing alone on 2 and 3, options out of range refused"
