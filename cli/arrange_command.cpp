@@ -1,9 +1,12 @@
 // geode arrange SPEC.json: an arrangement given as a file (templates/spec.hpp) -> arrangement
 // -> diagnoses -> dual mesh -> optional smoothing -> the template command's outputs.
 #include <filesystem>
+#include <iostream>
 #include <memory>
+#include <sstream>
 
 #include <geode/primal/errors.hpp>
+#include <geode/templates/fixup.hpp>
 #include <geode/templates/geode.hpp>
 #include <geode/templates/spec.hpp>
 #include "cli/commands.hpp"
@@ -19,6 +22,7 @@ struct ArrangeArgs {
   std::string format;     // empty: by the extension of -o, else appendix
   EncodingArgs encoding;  // --vtk-encoding, --msh-encoding
   bool smooth = false;
+  bool fixup = false;
   bool slide = false;
   bool quality = false;
   bool write_invalid = false;
@@ -54,14 +58,26 @@ void run_arrange(const ArrangeArgs& a) {
   }
   const std::string name = std::filesystem::path(a.spec).stem().string();
   TemplateOutput out;
+  if (a.fixup) {  // as `geode template geode4tri` does (templates/fixup.hpp)
+    const auto f = templates::fix_up(t);
+    std::ostringstream note;
+    note << "fix-up: " << f.obstructions_before << " -> " << f.obstructions_after
+         << " obstructions, " << t.hex.hexes.size() << " hexes";
+    for (const auto& step : f.steps) note << "; " << step;
+    out.note = note.str();
+    if (f.obstructions_after > 0)
+      std::cerr << "geode: warning: fix-up left " << f.obstructions_after << " obstructions\n";
+  }
   out.name = name, out.title = "spec " + std::filesystem::path(a.spec).filename().string();
   out.format = format, out.output = a.output, out.smooth = a.smooth, out.slide = a.slide,
   out.quality = a.quality;
   out.write_invalid = a.write_invalid;
+  if (!a.fixup)
+    out.obstruction_hint = "--fixup pillows the obstructions away (templates/fixup.hpp)";
   out.encoding = a.encoding;
   if (format == "html") out.sheets = templates::spec_sheets(spec), out.domain = spec.domain;
-  out.caption =
-      "geode arrange " + a.spec + (a.smooth ? " --smooth" : "") + (a.slide ? " --slide" : "");
+  out.caption = "geode arrange " + a.spec + (a.fixup ? " --fixup" : "") +
+                (a.smooth ? " --smooth" : "") + (a.slide ? " --slide" : "");
   write_template(t, out);
 }
 
@@ -94,6 +110,10 @@ void add_arrange_command(CLI::App& app) {
       "without it, nodes sit at the dual's first guess (diced positions on a completion's faces)");
   c->add_flag("--slide", args->slide,
               "with --smooth: tet- and hex-side nodes slide within their faces");
+  c->add_flag("--fixup", args->fixup,
+              "pillow away the obstructions to a positive-Jacobian placement (pinched corners,\n"
+              "as `geode template geode4tri` does; docs/templates.md) before placing the nodes:\n"
+              "the boundary's quads are kept, the dual is no longer the arrangement's alone");
   c->add_flag("--quality", args->quality,
               "append the quality report (the paper's Table 1 metrics)");
   add_encoding_options(c, args->encoding);

@@ -78,6 +78,8 @@ struct TemplateOutput {
   // written) unless this is set; it is then written and the exit code is still 4.
   bool write_invalid = false;
   std::string note;  // e.g. what a fix-up did; printed with the smoothing note
+  // Said after obstructions that no placement can untangle (arrange: its --fixup).
+  std::string obstruction_hint;
   // Replaces templates::smooth_template (e.g. the refinement template's own smoothing).
   std::function<primal::SmoothResult(templates::Template&)> smoother;
   // --format html: the arrangement's sheets and domain (contoured for the viewer), the map from

@@ -296,6 +296,8 @@ void write_template(templates::Template& T, const TemplateOutput& a) {
                         ? "no combinatorial obstruction found (primal/realizability.hpp)\n"
                         : "no placement can: " +
                               primal::format_obstructions(obstructions, T.dim, 1));
+    if (!r.untangled && !obstructions.empty() && !a.obstruction_hint.empty())
+      std::cerr << "geode: " << a.obstruction_hint << "\n";
     else if (!obstructions.empty())
       std::cerr << "geode: warning: every corner Jacobian is positive, but the cells overlap: "
                 << primal::format_obstructions(obstructions, T.dim, 1);

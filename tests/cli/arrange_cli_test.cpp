@@ -102,6 +102,32 @@ TEST_CASE("geode arrange: the shipped specs are the built-in templates") {
   }
 }
 
+// --fixup pillows the plain dual's obstructions as `geode template geode4tri` does: the
+// four-triangle specs, whose pinched corners no placement untangles (exit 4 with --smooth
+// alone), give a valid template, geode4tri.json the built-in one (isomorphic, the same nodes).
+TEST_CASE("geode arrange --fixup: the four-triangle specs become valid templates") {
+  const std::filesystem::path specs =
+      std::filesystem::path(GEODE_SOURCE_DIR) / "notebooks-data/specs";
+  for (const std::string name : {"geode4tri", "geode4tri-domes"}) {
+    CAPTURE(name);
+    const std::string spec = (specs / (name + ".json")).string();
+    CHECK(geode_cli("arrange " + spec + " --smooth --format json").code == 4);
+    const auto fixed = geode_cli("arrange " + spec + " --fixup --smooth --format json");
+    REQUIRE(fixed.code == 0);
+    const auto j = nlohmann::json::parse(fixed.out);
+    CHECK(j["obstructions"].empty());
+    if (name != "geode4tri") continue;
+    const auto built = geode_cli("template geode4tri --format json");
+    REQUIRE(built.code == 0);
+    const JsonMesh ma = mesh_of(nlohmann::json::parse(built.out)), mb = mesh_of(j);
+    REQUIRE(ma.hex.points.size() == mb.hex.points.size());
+    CHECK(ma.hex.hexes.size() == mb.hex.hexes.size());
+    CHECK(test::find_isomorphism(ma.hex, mb.hex).has_value());
+    for (std::size_t i = 0; i < ma.hex.points.size(); ++i)
+      CHECK((ma.hex.points[i] - mb.hex.points[i]).norm() < 1e-9);
+  }
+}
+
 TEST_CASE("geode arrange: the README's examples, the pillowed hex and the pillowed quad") {
   const auto specs = std::filesystem::path(GEODE_SOURCE_DIR) / "notebooks-data/specs";
   const auto out = temp_path("pillow-out.json");
