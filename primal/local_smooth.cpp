@@ -15,6 +15,7 @@
 #include <memory>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 
 #include <geode/primal/boundary.hpp>
 #include <geode/primal/detail/smooth_frames.hpp>
@@ -709,10 +710,15 @@ std::vector<NodeConstraint> slide_constraints(const HexMesh& mesh,
   constexpr double kParallel = 1e-9;  // |d1 x d2| of unit directions taken as one line
   std::unordered_map<Index, std::vector<Point>> rim;  // node -> its rim edges' directions
   for (const auto& surface : kept.surfaces) {
+    // Each face once: a side set may list both sides of a face inside a block.
+    std::unordered_set<FaceKey, IndexArrayHash> seen;
+    std::vector<std::array<Index, 4>> faces;
+    for (const auto& q : surface)
+      if (seen.insert(face_key(q)).second) faces.push_back(q);
     std::unordered_map<EdgeKey, int, IndexArrayHash> uses;
-    for (const auto& q : surface)
+    for (const auto& q : faces)
       for (int k = 0; k < 4; ++k) ++uses[edge_key(q[k], q[(k + 1) % 4])];
-    for (const auto& q : surface)
+    for (const auto& q : faces)
       for (int k = 0; k < 4; ++k) {
         const Index a = q[k], b = q[(k + 1) % 4];
         if (uses[edge_key(a, b)] != 1) continue;

@@ -462,6 +462,15 @@ TEST_CASE("kept surfaces keep their plane and extent, kept nodes stay") {
       CHECK(c.direction.normalized().cross(e.direction).norm() < 1e-12);
   }
 
+  // A side set listing both sides of each face (as one inside a block may): the same.
+  gp::KeptFeatures both = kept;
+  for (const auto& q : kept.surfaces[0]) both.surfaces[0].push_back({q[0], q[3], q[2], q[1]});
+  const auto cons_both = gp::kept_slide_constraints(start, both);
+  for (std::size_t v = 0; v < cons.size(); ++v) {
+    CAPTURE(v);
+    CHECK(cons_both[v].kind == cons[v].kind);
+  }
+
   gp::LocalSmoothOptions o;
   o.target = 0.99;
   std::vector<Index> all(start.hexes.size());
