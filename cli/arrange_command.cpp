@@ -112,7 +112,7 @@ void add_arrange_command(CLI::App& app) {
               "with --smooth: tet- and hex-side nodes slide within their faces");
   c->add_flag("--fixup", args->fixup,
               "pillow away the obstructions to a positive-Jacobian placement (pinched corners,\n"
-              "as `geode template geode4tri` does; docs/templates.md) before placing the nodes:\n"
+              "as `geode template geode4tri` does; docs/results.md) before placing the nodes:\n"
               "the boundary's quads are kept, the dual is no longer the arrangement's alone");
   c->add_flag("--quality", args->quality,
               "append the quality report (the paper's Table 1 metrics)");
