@@ -16,6 +16,7 @@
 #include <geode/io/nemesis_set.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/input_check.hpp>
+#include <geode/primal/node_set_pieces.hpp>
 
 namespace geode::io {
 
@@ -149,6 +150,7 @@ Model read_model(const std::filesystem::path& path, const ReadOptions& options, 
   if (const auto set = find_nemesis_set(path)) {
     try {
       Model model = read_nemesis_set(*set, options, partition);
+      primal::infer_boundary_node_set_pieces(model);
       if (options.check_geometry && check_covering)
         require_single_covering(model, set->name(), covering);
       return model;
@@ -169,6 +171,8 @@ Model read_model(const std::filesystem::path& path, const ReadOptions& options, 
                   : format->read == read_exodus && covering.shares > 1
                       ? read_exodus_shared(path, options, covering)
                       : format->read(path, options);
+    // Node sets given as nodes only (Exodus) on the boundary: dicing keeps them there.
+    primal::infer_boundary_node_set_pieces(model);
     if (options.check_geometry && check_covering)
       require_single_covering(model, path.string(), covering);
     return model;
