@@ -240,8 +240,7 @@ void Conformer::keep_sets() {
     }
     kept_.surfaces.push_back(std::move(quads));
   }
-  for (const primal::NodeSet& s : node_sets_)
-    kept_.nodes.insert(kept_.nodes.end(), s.nodes.begin(), s.nodes.end());
+  for (const primal::NodeSet& s : node_sets_) kept_.node_sets.push_back(s.nodes);
 }
 
 }  // namespace geode::conform::detail

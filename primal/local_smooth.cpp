@@ -699,7 +699,7 @@ LocalSmoothResult smooth_hexes_local(HexMesh& mesh, std::span<const NodeConstrai
 namespace {
 
 // boundary_slide_constraints over `surfaces` and kept.surfaces, then each kept surface's rim
-// (its quads' edges used once) and kept.nodes (KeptFeatures); nodes checked by the caller.
+// (its quads' edges used once) and kept.node_sets (KeptFeatures); nodes checked by the caller.
 std::vector<NodeConstraint> slide_constraints(const HexMesh& mesh,
                                               std::vector<BoundaryQuad> surfaces,
                                               const KeptFeatures& kept) {
@@ -743,9 +743,57 @@ std::vector<NodeConstraint> slide_constraints(const HexMesh& mesh,
       c = NodeConstraint::fixed();
     }
   }
-  for (Index v : kept.nodes)
-    if (out[index_cast<std::size_t>(v)].kind == NodeConstraint::Kind::kFree)
-      out[index_cast<std::size_t>(v)] = NodeConstraint::fixed();
+  // A node set's node slides only within its set, so that the set keeps its place: in its
+  // plane where every surface quad through it there is the set's (a surface the set covers: a
+  // boundary condition's face), along its line where its neighbours on the line both are (a
+  // curve the set runs along); a point load, a curve's end, a surface's rim, or a node inside
+  // the model stays.
+  if (kept.node_sets.empty()) return out;
+  using Kind = NodeConstraint::Kind;
+  // Per set node on a line: its neighbours along the line, with their side (one scan of the
+  // hexes for every set).
+  std::vector<char> in_any(p.size(), 0);
+  for (const auto& nodes : kept.node_sets)
+    for (Index v : nodes) in_any[index_cast<std::size_t>(v)] = 1;
+  std::unordered_map<Index, std::vector<std::pair<Index, int>>> on_line;
+  for (const auto& h : mesh.hexes)
+    for (const auto& e : topology::kHexEdgeCorners)
+      for (const auto& [x, y] : {std::pair{h[e[0]], h[e[1]]}, std::pair{h[e[1]], h[e[0]]}}) {
+        const NodeConstraint& c = out[index_cast<std::size_t>(x)];
+        if (!in_any[index_cast<std::size_t>(x)] || c.kind != Kind::kLine) continue;
+        const Point d = (p[y] - p[x]).normalized(), u = c.direction.normalized();
+        if (d.cross(u).norm() <= kParallel) on_line[x].emplace_back(y, d.dot(u) > 0 ? 0 : 1);
+      }
+  std::vector<char> in_set(p.size(), 0), leaves(p.size(), 0);
+  std::vector<Index> fix;  // decided against the constraints as boundary and surfaces made them
+  for (const auto& nodes : kept.node_sets) {
+    for (Index v : nodes) in_set[index_cast<std::size_t>(v)] = 1;
+    const auto set = [&](Index v) { return in_set[index_cast<std::size_t>(v)] != 0; };
+    for (const BoundaryQuad& q : surfaces) {
+      if (std::none_of(q.nodes.begin(), q.nodes.end(), set) ||
+          std::all_of(q.nodes.begin(), q.nodes.end(), set))
+        continue;
+      const Point n = (p[q.nodes[2]] - p[q.nodes[0]]).cross(p[q.nodes[3]] - p[q.nodes[1]]);
+      for (Index v : q.nodes) {
+        const NodeConstraint& c = out[index_cast<std::size_t>(v)];
+        if (set(v) && c.kind == Kind::kPlane && n.norm() > 0.0 &&
+            n.normalized().cross(c.direction.normalized()).norm() <= kParallel)
+          leaves[index_cast<std::size_t>(v)] = 1;
+      }
+    }
+    for (Index v : nodes) {
+      const auto i = index_cast<std::size_t>(v);
+      std::array<bool, 2> along{false, false};
+      if (const auto it = on_line.find(v); it != on_line.end())
+        for (const auto& [y, side] : it->second) along[index_cast<std::size_t>(side)] |= set(y);
+      if (out[i].kind == Kind::kFree || (out[i].kind == Kind::kPlane && leaves[i]) ||
+          (out[i].kind == Kind::kLine && !(along[0] && along[1])))
+        fix.push_back(v);
+    }
+    for (Index v : nodes)
+      in_set[index_cast<std::size_t>(v)] = leaves[index_cast<std::size_t>(v)] = 0;
+  }
+  for (Index v : fix) out[index_cast<std::size_t>(v)] = NodeConstraint::fixed();
   return out;
 }
 
@@ -819,8 +867,12 @@ LocalSmoothResult smooth_hexes_around(HexMesh& mesh, std::span<const Index> seed
       }
       if (!near.empty()) kept.surfaces.push_back(std::move(near));
     }
-    for (Index v : options.kept->nodes)
-      if (const Index l = sub_node(v); moving(l)) kept.nodes.push_back(l);
+    for (const auto& nodes : options.kept->node_sets) {
+      std::vector<Index> near;
+      for (Index v : nodes)
+        if (const Index l = sub_node(v); l != kInvalidIndex) near.push_back(l);
+      if (std::any_of(near.begin(), near.end(), moving)) kept.node_sets.push_back(std::move(near));
+    }
   }
   auto constraints = slide_constraints(sub, surface_quads_at(sub, sub_region, moves), kept);
   std::vector<Index> local_seeds;
@@ -925,7 +977,8 @@ std::vector<NodeConstraint> kept_slide_constraints(const HexMesh& mesh, const Ke
   for (const auto& surface : kept.surfaces)
     for (const auto& q : surface)
       for (Index v : q) check(v);
-  for (Index v : kept.nodes) check(v);
+  for (const auto& nodes : kept.node_sets)
+    for (Index v : nodes) check(v);
   return slide_constraints(mesh, material_surface_quads(mesh), kept);
 }
 

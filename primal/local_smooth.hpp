@@ -55,9 +55,12 @@ struct KeptFeatures {
   // of one of its quads only) slides along the rim where it is straight, so that the surface
   // keeps its extent; otherwise the node is fixed.
   std::vector<std::vector<std::array<Index, 4>>> surfaces;
-  // Fixed, unless a surface through them (the boundary, a face between blocks, a kept surface)
-  // lets them slide in it: a set's node on the model's boundary stays on it.
-  std::vector<Index> nodes;
+  // Node sets, each on its own: a node slides only within every set holding it, in the plane
+  // of the surfaces through it (the boundary, a face between blocks, a kept surface) where every
+  // quad of theirs there is in the set, along its line where its neighbours on the line both
+  // are; otherwise it is fixed (a point, a curve's end, a surface's rim, a node inside the
+  // model).
+  std::vector<std::vector<Index>> node_sets;
 };
 
 struct LocalSmoothOptions {

@@ -256,4 +256,61 @@ TEST_CASE("sets inside a block and on part of a face keep their place and extent
   }
 }
 
+// A node set's node slides only within its own set: a physical point on the interface where
+// two physical curves and an inner physical surface meet (tests/conform/point_sets_model.py)
+// stays where it is under every smoothing; the curves' nodes stay on their lines, which keep
+// their ends. Global smoothing moved the point along one curve (y 1 -> 1.0057): the nodes of
+// all sets were judged as one.
+TEST_CASE("a point set stays where curves and surfaces through it would let it slide") {
+  test::TempDir dir;
+  const std::string model = (dir.path / "points.msh").string();
+  const std::string cmd = "/usr/bin/python3 '" + std::string(GEODE_SOURCE_DIR) +
+                          "/tests/conform/point_sets_model.py' '" + model + "'";
+  REQUIRE_MESSAGE(std::system(cmd.c_str()) == 0, cmd);
+  const primal::Model in = io::read_model(model);
+  struct Line {
+    int id;
+    Point from, to;
+  };
+  for (const auto smooth : {conform::ConformSmooth::kNone, conform::ConformSmooth::kLocal,
+                            conform::ConformSmooth::kGlobal}) {
+    CAPTURE(static_cast<int>(smooth));
+    conform::ConformOptions o;
+    o.smooth = smooth;
+    const conform::ConformResult r = conform::conform(in, o);
+    REQUIRE(r.validity.ok());
+    const primal::Model& out = r.model;
+    const auto nodes_of = [&](int id) {
+      const auto it = std::find_if(out.node_sets.begin(), out.node_sets.end(),
+                                   [&](const primal::NodeSet& s) { return s.id == id; });
+      REQUIRE(it != out.node_sets.end());
+      std::vector<Point> x;
+      for (Index v : it->nodes) x.push_back(out.points[primal::index_cast<std::size_t>(v)]);
+      return x;
+    };
+    for (const auto& [id, at] : {std::pair{6, Point(1, 1, 1)}, std::pair{8, Point(2, 1, 1)}}) {
+      CAPTURE(id);
+      const std::vector<Point> x = nodes_of(id);
+      REQUIRE(x.size() == 1);
+      CHECK((x[0] - at).norm() == 0.0);
+    }
+    for (const Line& l : {Line{7, {1, 1, 0}, {1, 1, 2}}, Line{9, {2, 0, 1}, {2, 2, 1}},
+                          Line{10, {0, 1, 1}, {2, 1, 1}}}) {
+      CAPTURE(l.id);
+      const Point u = (l.to - l.from).normalized();
+      bool from = false, to = false;
+      for (const Point& x : nodes_of(l.id)) {
+        CHECK((x - l.from).cross(u).norm() < 1e-12);  // on the line
+        const double t = (x - l.from).dot(u);
+        CHECK(t > -1e-12);
+        CHECK(t < (l.to - l.from).norm() + 1e-12);
+        from = from || (x - l.from).norm() == 0.0;
+        to = to || (x - l.to).norm() == 0.0;
+      }
+      CHECK(from);
+      CHECK(to);
+    }
+  }
+}
+
 }  // namespace geode

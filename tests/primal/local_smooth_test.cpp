@@ -411,7 +411,8 @@ TEST_CASE(
 // node set's): the surface's nodes slide in its plane, its rim's along the rim where it is
 // straight, its corners and the kept interior node stay, a kept node on the boundary slides on
 // it; the same through smooth_hexes_local with kept_slide_constraints and smooth_hexes_around
-// with LocalSmoothOptions::kept.
+// with LocalSmoothOptions::kept. A node set's node slides only within the set (a face it
+// covers, a line it runs along); alone, or inside the model, it stays.
 TEST_CASE("kept surfaces keep their plane and extent, kept nodes stay") {
   constexpr int n = 4;
   // The kept patch: the 2 x 2 quads of the plane z = 2 over [1, 3]^2; its centre (2, 2, 2) is
@@ -437,7 +438,15 @@ TEST_CASE("kept surfaces keep their plane and extent, kept nodes stay") {
     for (int i = 1; i < 3; ++i)
       kept.surfaces[0].push_back(
           {id(i, j, 2), id(i + 1, j, 2), id(i + 1, j + 1, 2), id(i, j + 1, 2)});
-  kept.nodes = {id(2, 2, 1), id(0, 2, 2)};  // interior; on the boundary face x = 0
+  // A node set: the whole face x = 0 (a boundary condition's), one node inside and one alone on
+  // the face y = 0 (points).
+  kept.node_sets.emplace_back();
+  for (int k = 0; k <= n; ++k)
+    for (int j = 0; j <= n; ++j) kept.node_sets[0].push_back(id(0, j, k));
+  kept.node_sets[0].push_back(id(2, 2, 1));
+  kept.node_sets[0].push_back(id(2, 0, 2));
+  // A point set at (0, 2, 2) too, inside the face set: the point stays.
+  kept.node_sets.push_back({id(0, 1, 2)});
 
   // The constraints, node by node.
   const auto cons = gp::kept_slide_constraints(start, kept);
@@ -453,7 +462,11 @@ TEST_CASE("kept surfaces keep their plane and extent, kept nodes stay") {
                             Expected{id(1, 1, 2), Kind::kFixed, {0, 0, 0}},
                             Expected{id(3, 3, 2), Kind::kFixed, {0, 0, 0}},
                             Expected{id(2, 2, 1), Kind::kFixed, {0, 0, 0}},
+                            Expected{id(2, 0, 2), Kind::kFixed, {0, 0, 0}},
                             Expected{id(0, 2, 2), Kind::kPlane, {1, 0, 0}},
+                            Expected{id(0, 1, 2), Kind::kFixed, {0, 0, 0}},
+                            Expected{id(0, 0, 2), Kind::kLine, {0, 0, 1}},
+                            Expected{id(0, 0, 0), Kind::kFixed, {0, 0, 0}},
                             Expected{id(2, 1, 1), Kind::kFree, {0, 0, 0}}}) {
     CAPTURE(e.node);
     const NodeConstraint& c = cons[gp::index_cast<std::size_t>(e.node)];
@@ -494,6 +507,7 @@ TEST_CASE("kept surfaces keep their plane and extent, kept nodes stay") {
     CHECK(m->points[id(2, 2, 1)] == start.points[id(2, 2, 1)]);
     CHECK(m->points[id(1, 1, 2)] == start.points[id(1, 1, 2)]);
     CHECK(m->points[id(0, 2, 2)].x() == 0.0);
+    CHECK(m->points[id(2, 0, 2)] == start.points[id(2, 0, 2)]);
     // The centre and the rims moved (the test would pass on fixed nodes otherwise).
     CHECK((m->points[id(2, 2, 2)] - start.points[id(2, 2, 2)]).norm() > 1e-3);
     CHECK((m->points[id(1, 2, 2)] - start.points[id(1, 2, 2)]).norm() > 1e-6);
