@@ -125,10 +125,10 @@ void Conformer::add_smoothing(const primal::LocalSmoothResult& r) {
 
 // The worst-first smoother (primal/local_smooth.hpp); nodes on the model boundary, between
 // blocks and on the user's side sets slide only where that keeps every block's volume and the
-// sets' surfaces, the other nodes of node sets stay (keep_sets). Local: patches seeded near the
-// geode hexes, on the submesh around the seeds, so the cost follows the interface (or, with the
-// automatic target, its defects); global: every hex, then the automatic passes wherever a hex is
-// still below the yardstick.
+// sets' surfaces, and a node set's nodes only within their set (keep_sets). Local: patches
+// seeded near the geode hexes, on the submesh around the seeds, so the cost follows the
+// interface (or, with the automatic target, its defects); global: every hex, then the automatic
+// passes wherever a hex is still below the yardstick.
 void Conformer::smooth() {
   t0_ = Clock::now();
   res_.smoothing.initial_min_scaled_jacobian = res_.min_scaled_jacobian_before_smoothing;
