@@ -177,26 +177,22 @@ TEST_CASE("sets on the interface stay on it; sets across it take the buffer laye
   }
 }
 
-// Sets inside a block and on part of a face stay where the user put them, whatever the
-// smoothing: a Gmsh model (tests/conform/embedded_sets_model.py) with a physical surface
-// embedded in the tets beside the interface, one on a patch of the tet box's top face, a
-// physical point and a physical curve embedded there too. Global smoothing moved the embedded
-// surface off its plane (z 0.487-0.506) and its rim and the patch's in their planes (the
-// sheet's x from 1.04 to 1.039), and the curve's and the point's nodes with the tets.
-TEST_CASE("sets inside a block and on part of a face keep their place and extent") {
-  test::TempDir dir;
-  const std::string model = (dir.path / "embedded.msh").string();
+namespace {
+
+// tests/conform/sets_models.py's model `name` (made by Gmsh at test time, written as .msh and
+// read back as a user's file is).
+primal::Model gmsh_model(const std::string& name, const test::TempDir& dir) {
+  const std::string model = (dir.path / (name + ".msh")).string();
   const std::string cmd = "/usr/bin/python3 '" + std::string(GEODE_SOURCE_DIR) +
-                          "/tests/conform/embedded_sets_model.py' '" + model + "'";
+                          "/tests/conform/sets_models.py' " + name + " '" + model + "'";
   // python3-gmsh is a required package (scripts/common.sh): a missing one fails the test.
   REQUIRE_MESSAGE(std::system(cmd.c_str()) == 0, cmd);
-  const primal::Model in = io::read_model(model);
-  struct Rectangle {
-    int id;
-    Point low, high;  // the corners of an axis-aligned rectangle
-  };
-  const Rectangle sheet{3, {1.04, 0.15, 0.5}, {1.64, 0.75, 0.5}},
-      patch{4, {1.1, 0.2, 1.0}, {1.6, 0.7, 1.0}};
+  return io::read_model(model);
+}
+
+// conform of `in` with every smoothing mode (none, local, global), each valid output to `check`.
+void in_every_smoothing(const primal::Model& in,
+                        const std::function<void(const primal::Model&)>& check) {
   for (const auto smooth : {conform::ConformSmooth::kNone, conform::ConformSmooth::kLocal,
                             conform::ConformSmooth::kGlobal}) {
     CAPTURE(static_cast<int>(smooth));
@@ -204,7 +200,28 @@ TEST_CASE("sets inside a block and on part of a face keep their place and extent
     o.smooth = smooth;
     const conform::ConformResult r = conform::conform(in, o);
     REQUIRE(r.validity.ok());
-    const primal::Model& out = r.model;
+    check(r.model);
+  }
+}
+
+}  // namespace
+
+// Sets inside a block and on part of a face stay where the user put them, whatever the
+// smoothing: a Gmsh model (tests/conform/sets_models.py embedded) with a physical surface
+// embedded in the tets beside the interface, one on a patch of the tet box's top face, a
+// physical point and a physical curve embedded there too. Global smoothing moved the embedded
+// surface off its plane (z 0.487-0.506) and its rim and the patch's in their planes (the
+// sheet's x from 1.04 to 1.039), and the curve's and the point's nodes with the tets.
+TEST_CASE("sets inside a block and on part of a face keep their place and extent") {
+  test::TempDir dir;
+  const primal::Model in = gmsh_model("embedded", dir);
+  struct Rectangle {
+    int id;
+    Point low, high;  // the corners of an axis-aligned rectangle
+  };
+  const Rectangle sheet{3, {1.04, 0.15, 0.5}, {1.64, 0.75, 0.5}},
+      patch{4, {1.1, 0.2, 1.0}, {1.6, 0.7, 1.0}};
+  in_every_smoothing(in, [&](const primal::Model& out) {
     const auto side_set = [&](int id) -> const primal::SideSet& {
       const auto it = std::find_if(out.side_sets.begin(), out.side_sets.end(),
                                    [&](const primal::SideSet& s) { return s.id == id; });
@@ -253,33 +270,22 @@ TEST_CASE("sets inside a block and on part of a face keep their place and extent
     }
     CHECK(low == doctest::Approx(0.1));
     CHECK(high == doctest::Approx(0.9));
-  }
+  });
 }
 
 // A node set's node slides only within its own set: a physical point on the interface where
-// two physical curves and an inner physical surface meet (tests/conform/point_sets_model.py)
+// two physical curves and an inner physical surface meet (tests/conform/sets_models.py points)
 // stays where it is under every smoothing; the curves' nodes stay on their lines, which keep
 // their ends. Global smoothing moved the point along one curve (y 1 -> 1.0057): the nodes of
 // all sets were judged as one.
 TEST_CASE("a point set stays where curves and surfaces through it would let it slide") {
   test::TempDir dir;
-  const std::string model = (dir.path / "points.msh").string();
-  const std::string cmd = "/usr/bin/python3 '" + std::string(GEODE_SOURCE_DIR) +
-                          "/tests/conform/point_sets_model.py' '" + model + "'";
-  REQUIRE_MESSAGE(std::system(cmd.c_str()) == 0, cmd);
-  const primal::Model in = io::read_model(model);
+  const primal::Model in = gmsh_model("points", dir);
   struct Line {
     int id;
     Point from, to;
   };
-  for (const auto smooth : {conform::ConformSmooth::kNone, conform::ConformSmooth::kLocal,
-                            conform::ConformSmooth::kGlobal}) {
-    CAPTURE(static_cast<int>(smooth));
-    conform::ConformOptions o;
-    o.smooth = smooth;
-    const conform::ConformResult r = conform::conform(in, o);
-    REQUIRE(r.validity.ok());
-    const primal::Model& out = r.model;
+  in_every_smoothing(in, [&](const primal::Model& out) {
     const auto nodes_of = [&](int id) {
       const auto it = std::find_if(out.node_sets.begin(), out.node_sets.end(),
                                    [&](const primal::NodeSet& s) { return s.id == id; });
@@ -310,7 +316,7 @@ TEST_CASE("a point set stays where curves and surfaces through it would let it s
       CHECK(from);
       CHECK(to);
     }
-  }
+  });
 }
 
 }  // namespace geode
