@@ -1,9 +1,10 @@
 #include <geode/primal/node_set_pieces.hpp>
 
 #include <algorithm>
-#include <unordered_map>
+#include <array>
 
 #include <geode/primal/boundary.hpp>
+#include <geode/primal/key_map.hpp>
 
 namespace geode::primal {
 
@@ -14,41 +15,52 @@ void infer_boundary_node_set_pieces(Model& model) {
       continue;
     std::vector<char> in(model.points.size(), 0);
     for (Index v : ns.nodes) in[index_cast<std::size_t>(v)] = 1;
-    // The faces with a node in the set, each with its uses and its nodes (first use's order).
+    const auto set = [&](Index v) { return in[index_cast<std::size_t>(v)] != 0; };
+    // The faces with a node in the set, each once with its uses and its nodes (first use's
+    // order), read off the topology table: the whole input's faces pass here, so no face is
+    // copied or hashed unless it touches the set.
     struct Face {
       int uses = 0;
-      std::vector<Index> nodes;
+      int size = 0;
+      std::array<Index, 4> nodes{};
     };
-    std::unordered_map<FaceKey, Face, IndexArrayHash> faces;
+    std::vector<Face> faces;
+    KeyMap<4> index;
     for (ElementKind kind : kElementKinds) {
-      const int n = cell_topology(kind).faces;
-      for (std::size_t e = 0; e < element_count(model, kind); ++e)
-        for (int f = 0; f < n; ++f) {
-          std::vector<Index> nodes = element_face(model, {{kind, index_cast(e)}, f});
-          if (std::none_of(nodes.begin(), nodes.end(),
-                           [&](Index v) { return in[index_cast<std::size_t>(v)]; }))
-            continue;
-          Face& face = faces[face_key(nodes)];
-          if (face.uses++ == 0) face.nodes = std::move(nodes);
+      const auto& topo = cell_topology(kind);
+      for (std::size_t e = 0; e < element_count(model, kind); ++e) {
+        const auto corners = element_corners(model, {kind, index_cast(e)});
+        for (int f = 0; f < topo.faces; ++f) {
+          const topology::CellFace& cf = topo.face[index_cast<std::size_t>(f)];
+          std::array<Index, 4> nodes{};
+          bool touches = false;
+          for (int k = 0; k < cf.size; ++k) {
+            nodes[index_cast<std::size_t>(k)] =
+                corners[index_cast<std::size_t>(cf.corners[index_cast<std::size_t>(k)])];
+            touches = touches || set(nodes[index_cast<std::size_t>(k)]);
+          }
+          if (!touches) continue;
+          const std::span<const Index> face(nodes.data(), index_cast<std::size_t>(cf.size));
+          const auto [slot, added] = index.try_emplace(face_key(face), index_cast(faces.size()));
+          if (added) faces.push_back({0, cf.size, nodes});
+          ++faces[index_cast<std::size_t>(*slot)].uses;
         }
+      }
     }
     std::vector<char> on_boundary(model.points.size(), 0), covered(model.points.size(), 0);
     std::vector<std::vector<Index>> pieces;
-    for (const auto& [key, face] : faces) {
+    for (const Face& face : faces) {  // in order of first use: deterministic
       if (face.uses != 1) continue;
-      for (Index v : face.nodes) on_boundary[index_cast<std::size_t>(v)] = 1;
-      if (std::all_of(face.nodes.begin(), face.nodes.end(),
-                      [&](Index v) { return in[index_cast<std::size_t>(v)]; })) {
-        pieces.push_back(face.nodes);
-        for (Index v : face.nodes) covered[index_cast<std::size_t>(v)] = 1;
+      const std::span<const Index> nodes(face.nodes.data(), index_cast<std::size_t>(face.size));
+      for (Index v : nodes) on_boundary[index_cast<std::size_t>(v)] = 1;
+      if (std::all_of(nodes.begin(), nodes.end(), set)) {
+        pieces.emplace_back(nodes.begin(), nodes.end());
+        for (Index v : nodes) covered[index_cast<std::size_t>(v)] = 1;
       }
     }
     if (std::any_of(ns.nodes.begin(), ns.nodes.end(),
                     [&](Index v) { return !on_boundary[index_cast<std::size_t>(v)]; }))
       continue;
-    // In a fixed order (the map's is not): by their sorted nodes.
-    std::sort(pieces.begin(), pieces.end(),
-              [](const auto& a, const auto& b) { return face_key(a) < face_key(b); });
     for (Index v : ns.nodes)
       if (!covered[index_cast<std::size_t>(v)]) pieces.push_back({v});
     ns.pieces = std::move(pieces);
