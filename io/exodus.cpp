@@ -159,6 +159,18 @@ void write_exodus(const Model& model, const std::filesystem::path& path,
     if (!blocks.empty())
       check(ex_put_names(exo, EX_ELEM_BLOCK, block_names.pointers.data()), target,
             "writing block names");
+    // A split block's parts say whose they are (kBlockProperty), so that reading the file
+    // gives the model's block back: one material, whose inner faces smoothing may move.
+    if (std::any_of(exodus_id.begin(), exodus_id.end(),
+                    [](const auto& e) { return e.first.first != e.second; })) {
+      std::string property = kBlockProperty;
+      char* properties[] = {property.data()};
+      check(ex_put_prop_names(exo, EX_ELEM_BLOCK, 1, properties), target,
+            "writing block properties");
+      for (const auto& [key, id] : exodus_id)
+        check(ex_put_prop(exo, EX_ELEM_BLOCK, id, kBlockProperty, key.first), target,
+              "writing block " + std::to_string(id) + "'s properties");
+    }
     // Node and side sets alike: each set's size, then their names.
     auto define_sets = [&](ex_entity_type type, const auto& sets, const std::string& what,
                            auto size) {

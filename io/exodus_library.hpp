@@ -18,6 +18,12 @@ namespace geode::io::exodus_library {
 // Longer names than Exodus's default 32 characters.
 constexpr int kNameLength = 80;
 
+// An element block property: the id of the model block an Exodus block belongs to. An Exodus
+// block holds one element type, so the writer splits a model block of several kinds (Gmsh's
+// tets and pyramids in one volume) and gives each part this property; the reader joins the
+// parts again.
+constexpr const char* kBlockProperty = "GEODE_BLOCK";
+
 // Owns an open Exodus file id.
 class ExodusFile {
  public:

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -71,6 +72,7 @@ struct BlockData {
   std::string name, type;
   int per_elem = 0;
   std::int64_t count = 0;  // the block's elements in the file
+  int model_block = 0;     // kBlockProperty: the model block it is a part of (0: none given)
   std::vector<int> conn;   // its run of them (all of them but in a shared read) x per_elem
 };
 struct SetData {
@@ -195,6 +197,19 @@ Contents read_contents(const std::string& source, ExodusBounds bound, Slice slic
               where, "reading connectivity");
       c.blocks.push_back(std::move(block));
     }
+    // Properties are named per file; ours (kBlockProperty) only where the writer split a block.
+    const int64_t properties = ex_inquire_int(exo, EX_INQ_EB_PROP);
+    bound.check(properties, 4, "element block properties");
+    if (properties > 1) {
+      NameBuffers property_names(index_cast<std::size_t>(properties));
+      check(ex_get_prop_names(exo, EX_ELEM_BLOCK, property_names.pointers.data()), source,
+            "reading element block property names");
+      for (std::size_t p = 0; p < property_names.storage.size(); ++p)
+        if (property_names.get(p) == kBlockProperty)
+          for (BlockData& block : c.blocks)
+            check(ex_get_prop(exo, EX_ELEM_BLOCK, block.id, kBlockProperty, &block.model_block),
+                  source + ": element block " + std::to_string(block.id), "reading its properties");
+    }
   }
 
   const auto read_sets = [&](ex_entity_type type, int n, const char* what, std::size_t each,
@@ -314,6 +329,7 @@ std::string pack(const Contents& c) {
     p.text(b.type);
     p.i64(b.per_elem);
     p.i64(b.count);
+    p.i64(b.model_block);
     p.array(b.conn);
   }
   for (const auto* sets : {&c.node_sets, &c.side_sets}) {
@@ -364,6 +380,7 @@ void unpack_onto(Contents& c, std::string_view bytes, const std::string& source,
     block.name = std::move(name), block.type = std::move(type);
     header(block.per_elem);
     header(block.count);
+    header(block.model_block);
     u.array_onto(block.conn);
   }
   for (auto* sets : {&c.node_sets, &c.side_sets})
@@ -437,10 +454,19 @@ Model build_model(const Contents& c, const std::string& source) {
   std::vector<ElementRef> global;  // global element number (1-based) - 1 -> element
   global.reserve(index_cast<std::size_t>(std::max(c.num_elem, 0)));
   const bool renumber_blocks = renumbered(c.blocks);
+  // Parts of a block our writer split by element type (kBlockProperty) join it again: a block
+  // whose property names another block, one that names itself.
+  std::set<int> joinable;
+  for (const BlockData& block : c.blocks)
+    if (block.model_block == block.id) joinable.insert(block.id);
   for (std::size_t b = 0; b < c.blocks.size(); ++b) {
     const BlockData& block = c.blocks[b];
-    const int block_id = renumber_blocks ? static_cast<int>(b) + 1 : block.id;
-    if (!block.name.empty()) model.block_names[block_id] = block.name;
+    const bool part =
+        !renumber_blocks && block.model_block != block.id && joinable.count(block.model_block) > 0;
+    const int block_id = renumber_blocks ? static_cast<int>(b) + 1
+                         : part          ? block.model_block
+                                         : block.id;
+    if (!block.name.empty() && !part) model.block_names[block_id] = block.name;
     const std::string where = source + ": element block " + std::to_string(block.id);
     const std::size_t k = cell_of(block);
     const ExodusCell* cell = k < kExodusCells.size() ? &kExodusCells[k] : nullptr;

@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 #include <string>
@@ -215,21 +216,62 @@ TEST_CASE("write_exodus numbers a block's elements in runs: sides name the file'
   CHECK(back.tet_block == std::vector<int>{2, 2, 2, 2, 2, 2, 3, 3, 3, 3, 3, 3});
 }
 
-TEST_CASE("write_exodus writes a block of two kinds as one block per kind") {
+TEST_CASE("a block of two kinds: one Exodus block per kind, joined again on reading") {
   const fs::path file = scratch_dir() / "mixed.exo";
   Model mixed = sample_model();
   mixed.tet_block.assign(mixed.tets.size(), 1);  // block 1 now holds both
   mixed.block_names[1] = "steel";
   write_exodus(mixed, file);
+  {  // as the file holds it: hexes keep the id, the tets get the next one and say whose they are
+    const int exo = open_raw(file);
+    std::vector<int> ids(2);
+    REQUIRE(ex_inquire_int(exo, EX_INQ_ELEM_BLK) == 2);
+    REQUIRE(ex_get_ids(exo, EX_ELEM_BLOCK, ids.data()) >= 0);
+    CHECK(ids == std::vector<int>{1, 2});
+    char name[MAX_STR_LENGTH + 1] = {};
+    REQUIRE(ex_get_name(exo, EX_ELEM_BLOCK, 2, name) >= 0);
+    CHECK(std::string(name) == "steel tets");
+    for (int id : ids) {
+      int whose = 0;
+      REQUIRE(ex_get_prop(exo, EX_ELEM_BLOCK, id, "GEODE_BLOCK", &whose) >= 0);
+      CHECK(whose == 1);
+    }
+    ex_close(exo);
+  }
   const Model back = read_exodus(file);
-  CHECK(back.hexes.size() == mixed.hexes.size());
-  CHECK(back.tets.size() == mixed.tets.size());
-  REQUIRE(!back.tets.empty());
-  int top = 0;
-  for (std::size_t h = 0; h < mixed.hexes.size(); ++h) top = std::max(top, mixed.hex_block[h]);
-  CHECK(back.hex_block.front() == 1);  // hexes first: they keep the id
-  CHECK(back.tet_block.front() == top + 1);
-  CHECK(back.block_names.at(top + 1) == "steel tets");
+  CHECK(back.hexes == mixed.hexes);
+  CHECK(back.tets == mixed.tets);
+  CHECK(back.hex_block == mixed.hex_block);
+  CHECK(back.tet_block == mixed.tet_block);
+  CHECK(back.block_names == mixed.block_names);
+}
+
+TEST_CASE("read_exodus joins only blocks whose GEODE_BLOCK names a block that names itself") {
+  // Four one-tet blocks: 3 names 4 (which names itself: joined), 5 names 9 (absent) and 6
+  // names 3 (a part itself): kept as the file has them, names and all.
+  const fs::path file = scratch_dir() / "parts.exo";
+  int cpu = 8, io = 8;
+  const int exo = ex_create(file.string().c_str(), EX_CLOBBER, &cpu, &io);
+  REQUIRE(exo >= 0);
+  const std::vector<int> ids{3, 4, 5, 6}, whose{4, 4, 9, 3};
+  REQUIRE(ex_put_init(exo, "parts", 3, 4, 4, 4, 0, 0) >= 0);
+  const std::vector<double> x{0, 1, 0, 0}, y{0, 0, 1, 0}, z{0, 0, 0, 1};
+  REQUIRE(ex_put_coord(exo, x.data(), y.data(), z.data()) >= 0);
+  char property[] = "GEODE_BLOCK";
+  char* properties[] = {property};
+  REQUIRE(ex_put_prop_names(exo, EX_ELEM_BLOCK, 1, properties) >= 0);
+  const std::vector<int> conn{1, 2, 3, 4};
+  std::vector<std::string> names{"a", "b", "c", "d"};
+  for (std::size_t b = 0; b < ids.size(); ++b) {
+    REQUIRE(ex_put_block(exo, EX_ELEM_BLOCK, ids[b], "TETRA4", 1, 4, 0, 0, 0) >= 0);
+    REQUIRE(ex_put_conn(exo, EX_ELEM_BLOCK, ids[b], conn.data(), nullptr, nullptr) >= 0);
+    REQUIRE(ex_put_prop(exo, EX_ELEM_BLOCK, ids[b], "GEODE_BLOCK", whose[b]) >= 0);
+    REQUIRE(ex_put_name(exo, EX_ELEM_BLOCK, ids[b], names[b].data()) >= 0);
+  }
+  REQUIRE(ex_close(exo) >= 0);
+  const Model back = read_exodus(file);
+  CHECK(back.tet_block == std::vector<int>{4, 4, 5, 6});
+  CHECK(back.block_names == std::map<int, std::string>{{4, "b"}, {5, "c"}, {6, "d"}});
 }
 
 TEST_CASE("write_exodus is atomic") {

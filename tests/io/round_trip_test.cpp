@@ -38,10 +38,12 @@ Point centroid(const Model& m, std::span<const Index> corners) {
   return c / static_cast<double>(corners.size());
 }
 
-// Hexes (block 1 "steel") beside Kuhn tets (block 2 "rubber"); a node set, a side set on a hex
-// and one on a tet, each named.
+// Hexes (block 1 "steel") beside Kuhn tets (block 2 "rubber"), one of which is steel too (a
+// block of two kinds, which Exodus writes as two blocks); a node set, a side set on a hex and
+// one on a tet, each named.
 Model sample_model() {
   Model m = grid_model({2, 2, 1}, 0.5, [](int i, int, int) { return i >= 1; });
+  m.tet_block[0] = 1;
   m.block_names[1] = "steel";
   m.block_names[2] = "rubber: soft";
   m.node_sets.push_back({11, "bottom", {0, 2, 4, 8}});
