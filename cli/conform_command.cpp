@@ -51,6 +51,7 @@ struct ConformArgs {
   std::string relax = "interface";
   double smooth_target = 0.0;
   std::string template_box;
+  std::vector<std::string> join_blocks;  // --join-blocks lists
   int n = 4;
   bool quiet = false;
   bool write_invalid = false;
@@ -369,6 +370,7 @@ void add_conform_commands(CLI::App& app) {
       "fails verification.");
   c->add_option("INPUT", args->input, "input model (" + input_extensions_help() + ")")->required();
   add_run_options(c, *args);
+  add_join_blocks_option(c, args->join_blocks);
   c->callback([args] {
     const std::string format = check_outputs(*args);  // before the long run, not after it
     // The templates depend on the options alone: built while the file is read, on a thread of
@@ -380,8 +382,9 @@ void add_conform_commands(CLI::App& app) {
       templates = conform::build_reference_templates_ahead(
           args->template_box.empty() ? conform::ConformOptions{}.template_box
                                      : template_box(args->template_box));
-    run(io::read_model(args->input, {}, args->merge_tolerance < 0), *args, format, false,
-        args->input);
+    primal::Model model = io::read_model(args->input, {}, args->merge_tolerance < 0);
+    join_block_lists(model, args->join_blocks, args->input);
+    run(std::move(model), *args, format, false, args->input);
   });
 
   auto dargs = std::make_shared<ConformArgs>();

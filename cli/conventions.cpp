@@ -218,6 +218,48 @@ void check_not_input(const std::string& output, const std::string& input) {
   refuse_input_as_output(output, input, "");
 }
 
+namespace {
+// "5,6,7" as block ids; empty when it is not two or more positive integers.
+std::vector<int> block_ids(const std::string& text) {
+  std::vector<int> ids;
+  for (std::size_t at = 0; at <= text.size();) {
+    const std::size_t end = std::min(text.find(',', at), text.size());
+    int id = 0;
+    const auto [ptr, ec] = std::from_chars(text.data() + at, text.data() + end, id);
+    if (ec != std::errc() || ptr != text.data() + end || id < 1) return {};
+    ids.push_back(id);
+    at = end + 1;
+  }
+  return ids.size() >= 2 ? ids : std::vector<int>{};
+}
+}  // namespace
+
+CLI::Option* add_join_blocks_option(CLI::App* app, std::vector<std::string>& lists) {
+  return app
+      ->add_option(
+          "--join-blocks", lists,
+          "A,B[,...]: input blocks that are one material, joined into block A (which keeps its\n"
+          "name) before conforming, so that smoothing moves the faces between them; for files\n"
+          "that keep a volume's element types apart, such as Cubit's Exodus blocks of tets and\n"
+          "of pyramids (repeat the option for several materials; geode's own Exodus files are\n"
+          "joined by themselves)")
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            return block_ids(text).empty()
+                       ? "'" + text + "' is not two or more block ids separated by commas"
+                       : std::string();
+          },
+          "A,B[,...]"))
+      ->allow_extra_args(
+          false)  // one list per occurrence: `--join-blocks 5,6 in.exo` leaves in.exo
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+}
+
+void join_block_lists(primal::Model& model, const std::vector<std::string>& lists,
+                      const std::string& source) {
+  for (const std::string& list : lists) primal::join_blocks(model, block_ids(list), source);
+}
+
 CLI::Option* add_force_flag(CLI::App* app, bool& flag) {
   return app->add_flag("--force", flag, "allow an output to overwrite the input file");
 }

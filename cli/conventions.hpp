@@ -56,6 +56,13 @@ void check_buffer_thickness(double thickness, const std::string& side);
 // InvalidInput naming `option` otherwise. A 2D box gets depth = width.
 std::array<double, 3> parse_box(const std::string& option, const std::string& text, int dim);
 
+// --join-blocks A,B[,...] (conform, geode_mpi; repeatable): input blocks that are one material
+// (primal::join_blocks). The option checks each value's form; join_block_lists applies them to
+// the model read from `source`, whose messages name it.
+CLI::Option* add_join_blocks_option(CLI::App* app, std::vector<std::string>& lists);
+void join_block_lists(primal::Model& model, const std::vector<std::string>& lists,
+                      const std::string& source);
+
 // ---- Outputs ----------------------------------------------------------------------------------
 
 // The format of output `path`: the format its extension names among `allowed` (a given

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <set>
 #include <string>
 #include <type_traits>
 #include <unordered_map>
@@ -189,6 +190,33 @@ int block_of(const Model& model, ElementRef element) {
   const auto& blocks = element_blocks(model, element.kind);
   return blocks.empty() ? default_block(element.kind)
                         : blocks[index_cast<std::size_t>(element.index)];
+}
+
+void join_blocks(Model& model, std::span<const int> ids, std::string_view source) {
+  const auto list = [&] {
+    std::string text;
+    for (int id : ids) text += (text.empty() ? "" : ",") + std::to_string(id);
+    return text;
+  };
+  const auto refuse = [&](const std::string& why) {
+    throw InvalidInput(std::string(source) + ": joining blocks " + list() + ": " + why);
+  };
+  if (ids.size() < 2) refuse("give two blocks or more");
+  std::set<int> used, listed;
+  for (ElementKind kind : kElementKinds)
+    for (std::size_t e = 0; e < element_count(model, kind); ++e)
+      used.insert(block_of(model, {kind, index_cast(e)}));
+  for (int id : ids) {
+    if (!listed.insert(id).second) refuse("block " + std::to_string(id) + " is listed twice");
+    if (!used.count(id)) refuse("no element is in block " + std::to_string(id));
+  }
+  for (ElementKind kind : kElementKinds) {
+    std::vector<int>& blocks = element_blocks(model, kind);
+    if (blocks.empty()) blocks.assign(element_count(model, kind), default_block(kind));
+    for (int& b : blocks)
+      if (listed.count(b)) b = ids.front();
+  }
+  for (int id : ids.subspan(1)) model.block_names.erase(id);
 }
 
 // A number outside the model's (kInvalidIndex in a message) is named as its 1-based self.

@@ -169,6 +169,13 @@ std::string point_text(const Point& p);
 // Block id of an element, applying the empty-vector defaults above.
 int block_of(const Model& model, ElementRef element);
 
+// Puts every element of blocks `ids` (two or more) into the first, which keeps its name; the
+// others' names go. For blocks a file had to keep apart that are one material: an Exodus block
+// holds one element type, so Cubit writes a volume's tets and its pyramids as two blocks, and
+// apart they are two materials whose shared faces smoothing must keep. Throws InvalidInput
+// naming `source` for an id no element has or one listed twice.
+void join_blocks(Model& model, std::span<const int> ids, std::string_view source);
+
 // Throws InvalidInput naming `source` and the offending element / set entry when a node index
 // is out of range, a block or file-id vector has the wrong size, an id is not positive, or a
 // side's face number is out of range. Readers call it before returning; writers before writing.

@@ -15,6 +15,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <mpi.h>
 #include <tbb/global_control.h>
@@ -184,6 +185,8 @@ int run(int argc, char** argv, int rank, int size) {
           "the ranks on its machine were given; they wait for the zone without spinning once their "
           "own dicing is done); the result is the same for any count")
       ->check(CLI::Range(0, 4096));
+  std::vector<std::string> join_blocks;
+  cli::add_join_blocks_option(conform, join_blocks);
   conform->add_flag("-q,--quiet", quiet, "no progress or summary");
   try {
     app.parse(argc, argv);
@@ -217,10 +220,15 @@ int run(int argc, char** argv, int rank, int size) {
       options.zone_threads = zone_threads;
       // Each rank frees the input once it has its piece, and reads it again only if the zone
       // grows after that (the read-time check passed already).
-      options.reload = [&input] { return io::read_model(input, {}, false); };
+      options.reload = [&] {
+        primal::Model again = io::read_model(input, {}, false);
+        cli::join_block_lists(again, join_blocks, input);
+        return again;
+      };
       io::FilePartition file_partition;
       primal::Model model = io::read_model(input, {}, true, &file_partition,
                                            parallel::shared_input_check(MPI_COMM_WORLD));
+      cli::join_block_lists(model, join_blocks, input);
       fail_for_test(rank, "read");
       // The input's own partition (a partitioned .msh, a Nemesis set) unless it has fewer parts
       // than there are ranks: then METIS (parallel/partition.hpp).

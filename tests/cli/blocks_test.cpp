@@ -17,6 +17,7 @@
 
 #include <geode/io/exodus.hpp>
 #include <geode/io/gmsh.hpp>
+#include <geode/io/read_model.hpp>
 #include <geode/io/vtk.hpp>
 #include <geode/primal/grid_model.hpp>
 #include <geode/primal/topology.hpp>
@@ -205,4 +206,54 @@ TEST_CASE("conform: parts meshed separately get a hint, and --merge-tolerance jo
   INFO(merged.out);
   CHECK(merged.code == 0);
   CHECK(io::read_exodus(out).hexes.size() == 360);
+}
+
+TEST_CASE("conform --join-blocks: tets and pyramids kept apart in the file are one material") {
+  // Gmsh's layer-side model (a wedge layer whose side quads meet tets; Gmsh puts pyramids there,
+  // in the tet volume's block 5), written as Cubit writes such a volume: its pyramids in a block
+  // of their own (99). Apart, the two are materials whose shared faces smoothing must keep;
+  // joined, the run is the .msh's, block for block.
+  test::TempDir dir;
+  const fs::path msh = dir.path / "ls.msh", exo = dir.path / "cubit.exo";
+  const test::CliRun made = test::geode_cli(
+      "demo --model layer-side -n 3 --save-input " + msh.string() + " --quiet", true);
+  INFO(made.out);
+  REQUIRE(made.code == 0);
+  primal::Model m = io::read_model(msh);
+  REQUIRE(!m.pyramids.empty());
+  REQUIRE(block_counts(m.pyramid_block) == std::map<int, std::size_t>{{5, m.pyramids.size()}});
+  m.pyramid_block.assign(m.pyramids.size(), 99);
+  m.block_names[99] = "tet slab pyramids";
+  io::write_exodus(m, exo);
+  const auto blocks = [&](const std::string& input, const std::string& options) {
+    const fs::path report = dir.path / "r.json";
+    const test::CliRun r = test::geode_cli(
+        "conform " + input + " " + options + " --report " + report.string() + " --quiet", true);
+    INFO(r.out);
+    REQUIRE(r.code == 0);
+    std::ifstream is(report);
+    const nlohmann::json j = nlohmann::json::parse(is);
+    std::map<int, std::pair<std::string, double>> out;  // id -> name, minimum
+    for (const auto& b : j.at("blocks"))
+      out[b.at("id")] = {b.at("name"), b.at("quality").at("metrics")[0].at("min")};
+    return out;
+  };
+  const auto from_msh = blocks(msh.string(), "");
+  const auto apart = blocks(exo.string(), ""), joined = blocks(exo.string(), "--join-blocks 5,99");
+  CHECK(from_msh.size() == 3);  // tet, boundary layer, tet slab
+  CHECK(apart.count(99) == 1);
+  CHECK(joined == from_msh);
+  CHECK(joined.count(99) == 0);
+  CHECK(joined.at(5).second >= apart.at(99).second);
+  // A block no element has, or a list of one, is refused naming the file; nothing written.
+  const fs::path out = dir.path / "never.exo";
+  for (const char* list : {"5,98", "5"}) {
+    CAPTURE(list);
+    const test::CliRun r = test::geode_cli(
+        "conform " + exo.string() + " --join-blocks " + std::string(list) + " -o " + out.string(),
+        true);
+    CHECK(r.code == 2);
+    CHECK(r.out.find("--join-blocks") + r.out.find("joining blocks") != 2 * std::string::npos);
+    CHECK(!fs::exists(out));
+  }
 }

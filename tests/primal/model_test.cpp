@@ -7,7 +7,9 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <map>
 #include <string>
+#include <vector>
 
 #include <geode/primal/errors.hpp>
 #include <geode/primal/topology.hpp>
@@ -202,4 +204,28 @@ TEST_CASE("model: a node set's node that no element uses is refused by its file 
                        doctest::Contains("in.msh: node set 8 'lost': node 15 (5, 0, 0) belongs to "
                                          "no element"),
                        geode::InvalidInput);
+}
+
+TEST_CASE("model: join_blocks puts the listed blocks' elements into the first") {
+  // Two wedges (one in the default block 4) and a hex in block 7 "steel", a tet in 9 "tets".
+  Model m = one_cell(ElementKind::kWedge, reference_corners(ElementKind::kWedge));
+  m.wedges.push_back(m.wedges.front());
+  m.hexes.push_back({0, 1, 2, 3, 4, 5, 0, 1});  // structure only: join_blocks reads blocks
+  m.hex_block = {7};
+  m.tets.push_back({0, 1, 2, 3});
+  m.tet_block = {9};
+  m.block_names = {{7, "steel"}, {9, "tets"}, {4, "layer"}};
+  const std::vector<int> steel{7, 9, 4};
+  join_blocks(m, steel, "m.exo");
+  CHECK(m.hex_block == std::vector<int>{7});
+  CHECK(m.tet_block == std::vector<int>{7});
+  CHECK(m.wedge_block == std::vector<int>{7, 7});  // the default block, written out
+  CHECK(m.block_names == std::map<int, std::string>{{7, "steel"}});
+  const std::vector<int> missing{7, 9}, twice{7, 7}, one{7};
+  CHECK_THROWS_WITH_AS(join_blocks(m, missing, "m.exo"),
+                       "m.exo: joining blocks 7,9: no element is in block 9", geode::InvalidInput);
+  CHECK_THROWS_WITH_AS(join_blocks(m, twice, "m.exo"),
+                       "m.exo: joining blocks 7,7: block 7 is listed twice", geode::InvalidInput);
+  CHECK_THROWS_WITH_AS(join_blocks(m, one, "m.exo"),
+                       "m.exo: joining blocks 7: give two blocks or more", geode::InvalidInput);
 }
