@@ -10,7 +10,8 @@
 #   conform dices) by `geode conform` and by geode_mpi: the same as the joined file conformed;
 # - the refusals: a piece missing, pieces of two sets mixed (global counts differ), a shared
 #   node moved in one piece, an element given in two pieces (tests/parallel/corrupt_piece.py),
-#   two sets beside a missing base name, one file of Gmsh's Mesh.PartitionSplitMeshFiles=1 set.
+#   two sets beside a missing base name, one file of Gmsh's Mesh.PartitionSplitMeshFiles=1 set;
+# - --join-blocks on 2 ranks as in the serial run, and a block it names missing refused.
 # usage: mpi_input_test.sh GEODE GEODE_MPI PARALLEL_CHECK MPIEXEC MODEL SIZE WORKDIR
 set -euo pipefail
 geode=$1 geode_mpi=$2 check=$3 mpiexec=$4 model=$5 size=$6 dir=$7
@@ -95,6 +96,13 @@ refused 2 "two/out3.exo: missing, and pieces of 2 Nemesis sets" -- \
   "$geode" conform two/out3.exo -o x.exo
 /usr/bin/python3 "$here/partition_model.py" in.msh split.msh 3 --split
 refused 2 "split_1.msh: holds partition 1 of 3 only" -- "$geode" conform split_1.msh -o x.exo
+# --join-blocks as the serial run takes it (both models' blocks 1 and 2 made one material).
+"$geode" conform whole.msh --join-blocks 2,1 -o serial-join.exo --quiet
+"$mpiexec" --oversubscribe -np 2 "$geode_mpi" conform whole.msh --join-blocks 2,1 -o join2.exo \
+  --join -q
+"$check" same serial-join.exo join2.exo
+refused 2 "whole.msh: joining blocks 2,9: no element is in block 9" -- \
+  "$mpiexec" --oversubscribe -np 2 "$geode_mpi" conform whole.msh --join-blocks 2,9 -o x.exo
 # Nothing written by any refused run: neither the serial file nor a rank's piece.
 [ ! -e x.exo ]
 if compgen -G "x.exo.*" >/dev/null; then echo "a refused run wrote $(compgen -G "x.exo.*")" >&2; exit 1; fi
