@@ -42,7 +42,7 @@ std::filesystem::path rank_file(const std::filesystem::path& output, int ranks, 
   return output.string() + "." + n + "." + r;
 }
 
-void write_nemesis(const RankMesh& mesh, const std::filesystem::path& path, int ranks, int rank) {
+void write_nemesis(const RankMesh& mesh, const std::filesystem::path& file, int ranks, int rank) {
   // Load balance: internal / border nodes and elements (1-based local numbers).
   std::vector<char> border(mesh.model.points.size(), 0);
   for (const auto& [q, shared] : mesh.shared_nodes)
@@ -61,60 +61,60 @@ void write_nemesis(const RankMesh& mesh, const std::filesystem::path& path, int 
   // are held beside the model and the writer's buffers.
   const auto define = [&](int exo) {
     char type[] = "p";
-    check(ex_put_init_info(exo, ranks, 1, type), path, "Nemesis init info");
+    check(ex_put_init_info(exo, ranks, 1, type), file, "Nemesis init info");
     check(ex_put_init_global(exo, mesh.global_nodes, mesh.global_hexes,
                              primal::index_cast<int64_t>(mesh.global_block_hexes.size()),
                              primal::index_cast<int64_t>(mesh.model.node_sets.size()),
                              primal::index_cast<int64_t>(mesh.model.side_sets.size())),
-          path, "Nemesis global counts");
+          file, "Nemesis global counts");
     std::vector<int> ids, counts;
     for (const auto& [id, n] : mesh.global_block_hexes)
       ids.push_back(id), counts.push_back(static_cast<int>(n));
     if (!ids.empty())
-      check(ex_put_eb_info_global(exo, ids.data(), counts.data()), path, "global blocks");
+      check(ex_put_eb_info_global(exo, ids.data(), counts.data()), file, "global blocks");
     ids.clear(), counts.clear();
     for (std::size_t s = 0; s < mesh.model.node_sets.size(); ++s)
       ids.push_back(mesh.model.node_sets[s].id),
           counts.push_back(static_cast<int>(mesh.global_node_set_nodes[s]));
     std::vector<int> zeros(std::max(ids.size(), mesh.model.side_sets.size()), 0);
     if (!ids.empty())
-      check(ex_put_ns_param_global(exo, ids.data(), counts.data(), zeros.data()), path,
+      check(ex_put_ns_param_global(exo, ids.data(), counts.data(), zeros.data()), file,
             "global node sets");
     ids.clear(), counts.clear();
     for (std::size_t s = 0; s < mesh.model.side_sets.size(); ++s)
       ids.push_back(mesh.model.side_sets[s].id),
           counts.push_back(static_cast<int>(mesh.global_side_set_sides[s]));
     if (!ids.empty())
-      check(ex_put_ss_param_global(exo, ids.data(), counts.data(), zeros.data()), path,
+      check(ex_put_ss_param_global(exo, ids.data(), counts.data(), zeros.data()), file,
             "global side sets");
     check(ex_put_loadbal_param(exo, primal::index_cast<int64_t>(internal_nodes),
                                primal::index_cast<int64_t>(border_nodes), 0,
                                primal::index_cast<int64_t>(internal_hexes),
                                primal::index_cast<int64_t>(border_hexes),
                                primal::index_cast<int64_t>(mesh.shared_nodes.size()), 0, rank),
-          path, "Nemesis load balance");
+          file, "Nemesis load balance");
     if (!mesh.shared_nodes.empty()) {
       std::vector<int> map_ids, map_counts;
       for (const auto& [q, shared] : mesh.shared_nodes)
         map_ids.push_back(q), map_counts.push_back(primal::index_cast<int>(shared.size()));
       check(ex_put_cmap_params(exo, map_ids.data(), map_counts.data(), nullptr, nullptr, rank),
-            path, "Nemesis communication map sizes");
+            file, "Nemesis communication map sizes");
     }
   };
   const auto write_maps = [&](int exo) {
     // The number maps (defined by their first write), then the data of what is defined.
     if (!mesh.node_gid.empty())
-      check(ex_put_id_map(exo, EX_NODE_MAP, one_based(mesh.node_gid, path).data()), path,
+      check(ex_put_id_map(exo, EX_NODE_MAP, one_based(mesh.node_gid, file).data()), file,
             "node map");
     if (!mesh.hex_gid.empty())
-      check(ex_put_id_map(exo, EX_ELEM_MAP, one_based(mesh.hex_gid, path).data()), path,
+      check(ex_put_id_map(exo, EX_ELEM_MAP, one_based(mesh.hex_gid, file).data()), file,
             "element map");
     {
       std::vector<int> internal, bordering;
       internal.reserve(internal_nodes), bordering.reserve(border_nodes);
       for (std::size_t v = 0; v < border.size(); ++v)
         (border[v] ? bordering : internal).push_back(primal::index_cast<int>(v + 1));
-      check(ex_put_processor_node_maps(exo, internal.data(), bordering.data(), nullptr, rank), path,
+      check(ex_put_processor_node_maps(exo, internal.data(), bordering.data(), nullptr, rank), file,
             "Nemesis node maps");
     }
     {
@@ -125,17 +125,17 @@ void write_nemesis(const RankMesh& mesh, const std::filesystem::path& path, int 
         for (Index v : mesh.model.hexes[h]) on = on || border[primal::index_cast<std::size_t>(v)];
         (on ? bordering : internal).push_back(primal::index_cast<int>(h + 1));
       }
-      check(ex_put_processor_elem_maps(exo, internal.data(), bordering.data(), rank), path,
+      check(ex_put_processor_elem_maps(exo, internal.data(), bordering.data(), rank), file,
             "Nemesis element maps");
     }
     for (const auto& [q, shared] : mesh.shared_nodes) {
       std::vector<int> local, procs(shared.size(), q);
       for (Index v : shared) local.push_back(v + 1);
-      check(ex_put_node_cmap(exo, q, local.data(), procs.data(), rank), path,
+      check(ex_put_node_cmap(exo, q, local.data(), procs.data(), rank), file,
             "Nemesis node communication map to rank " + std::to_string(q));
     }
   };
-  io::write_exodus(mesh.model, path, define, write_maps);
+  io::write_exodus(mesh.model, file, define, write_maps);
 }
 
 Model canonical(const Model& model) {
