@@ -250,8 +250,8 @@ CLI::Option* add_join_blocks_option(CLI::App* app, std::vector<std::string>& lis
                        : std::string();
           },
           "A,B[,...]"))
-      ->allow_extra_args(
-          false)  // one list per occurrence: `--join-blocks 5,6 in.exo` leaves in.exo
+      // One list per occurrence, so that `--join-blocks 5,6 in.exo` leaves in.exo the input.
+      ->allow_extra_args(false)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
 }
 
