@@ -663,6 +663,39 @@ class MshReader {
   }
   std::map<int, std::size_t> group_sizes_;  // physical volume -> entities in it
 
+  // Blocks of elements in no physical volume (an entity's tag, or the default block for
+  // meshio's 0), beside physical volumes in one file (Gmsh writes such elements with
+  // Mesh.SaveAll=1): their tags are entity tags, which may be a physical volume's too, so they
+  // are numbered above every physical volume (named or holding elements) instead, unnamed, each
+  // with a warning. A file without physical volumes keeps its entity tags as block ids.
+  template <class Volumes>
+  void number_entity_blocks(Volumes& volumes, const std::set<int>& volume_groups) const {
+    if (volume_groups.empty()) return;
+    std::int64_t top = *volume_groups.rbegin();
+    for (const auto& [key, name] : physical_names_)
+      if (key.first == 3) top = std::max<std::int64_t>(top, key.second);
+    std::map<int, std::pair<std::int64_t, std::size_t>> moved;  // tag -> first element, count
+    for (auto& v : volumes) {
+      if (!v.entity) continue;
+      const std::int64_t block = top + v.block;
+      if (block > INT32_MAX)
+        throw InvalidInput(source_ + ": element " + std::to_string(elements_[v.element].tag) +
+                           " is in no physical volume, and its entity's tag " +
+                           std::to_string(v.block) + " above the highest physical volume's (" +
+                           std::to_string(top) + ") is out of range for a block id");
+      auto [it, added] = moved.try_emplace(v.block, elements_[v.element].tag, 0);
+      ++it->second.second;
+      v.block = static_cast<int>(block);
+    }
+    for (const auto& [tag, first] : moved)
+      read_warning(source_ + ": " + std::to_string(first.second) + " volume elements (element " +
+                   std::to_string(first.first) +
+                   " the first) are in no physical volume, beside others that are (saved with "
+                   "Mesh.SaveAll=1?): they are block " +
+                   std::to_string(top + tag) + ", unnamed (their entity's tag " +
+                   std::to_string(tag) + " numbered above the physical volumes)");
+  }
+
   Model build() {
     Model model;
     // Nodes by ascending tag; a tag listed twice must name one point.
@@ -703,12 +736,14 @@ class MshReader {
     struct Volume {
       int block;
       std::size_t element;
+      bool entity;  // its block is its entity's (no physical volume holds it), not a group's
     };
     std::vector<Volume> volumes;
     std::set<int> volume_groups;   // every physical volume holding elements
     std::vector<int> volume_part;  // per element of elements_ that is a volume: 0-based
     std::size_t last_volume = 0;   // the volume element before this one
     int run_block = 0;             // its block before the default (model_entity, block_among)
+    bool run_entity = false;       // run_block is an entity's
     for (std::size_t i = 0; i < elements_.size(); ++i) {
       const RawElement& e = elements_[i];
       const GmshType& type = *gmsh_type(e.type);
@@ -722,7 +757,8 @@ class MshReader {
       // The elements of an entity come together: its block found once per run of them.
       if (volumes.empty() || !same_groups(e, elements_[last_volume])) {
         const std::vector<int> physicals = physicals_of(e, 3);
-        run_block = physicals.empty() ? model_entity(e, 3) : block_among(physicals);
+        run_entity = physicals.empty();
+        run_block = run_entity ? model_entity(e, 3) : block_among(physicals);
         volume_groups.insert(physicals.begin(), physicals.end());
       }
       last_volume = i;
@@ -733,9 +769,10 @@ class MshReader {
         throw InvalidInput(source_ + ": element " + std::to_string(e.tag) +
                            ": block (physical or entity tag) " + std::to_string(block) +
                            " is not positive");
-      volumes.push_back({block, i});
+      volumes.push_back({block, i, run_entity});
       if (partitioned_) volume_part.push_back(part_of(e));
     }
+    number_entity_blocks(volumes, volume_groups);
     // The partition is usable when every volume element has one part.
     const bool parts_known =
         partitioned_ && std::in_range<int>(partitions_) &&
@@ -770,8 +807,8 @@ class MshReader {
     for (std::size_t o : volume_order) {
       const Volume& v = volumes[o];
       const RawElement& e = elements_[v.element];
-      if (o == volume_order.front() || v.block != volumes[block_run].block)  // a block's first
-        if (auto it = physical_names_.find({3, v.block});
+      if (!v.entity && (o == volume_order.front() || v.block != volumes[block_run].block))
+        if (auto it = physical_names_.find({3, v.block});  // a physical block's first element
             it != physical_names_.end() && !it->second.empty())
           model.block_names[v.block] = it->second;
       block_run = o;
@@ -844,6 +881,19 @@ class MshReader {
         set.nodes.erase(std::unique(set.nodes.begin(), set.nodes.end()), set.nodes.end());
         model.node_sets.push_back(std::move(set));
       }
+    }
+    // Gmsh 2.2 gives each element its groups' tags; saved with Mesh.SaveAll=1 it gives every
+    // element 0, and $PhysicalNames alone still lists the groups: say they are lost.
+    if (version_ == 2) {
+      std::set<std::pair<int, int>> carried;
+      for (const RawElement& e : elements_)
+        if (e.physical != 0) carried.insert({gmsh_type(e.type)->dim, e.physical});
+      for (const auto& [key, name] : physical_names_)
+        if (!carried.count(key))
+          read_warning(source_ + ": physical group '" + sanitize_name(name) + "' (dimension " +
+                       std::to_string(key.first) + ", tag " + std::to_string(key.second) +
+                       ") in $PhysicalNames holds no element (Gmsh 2.2 saved with "
+                       "Mesh.SaveAll=1 writes none): it is not read");
     }
     sanitize_names(model);
     validate(model, source_);

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -246,6 +247,71 @@ TEST_CASE(
     const Point& p = diced.points[index_cast<std::size_t>(v)];
     CHECK(p.z() == 0.0);
     CHECK((p.y() == 0.0 || p.y() == 1.0));  // on edge 1-2 or 4-3, never the face centre (0.5, 0.5)
+  }
+}
+
+TEST_CASE(
+    "Mesh.SaveAll=1: elements in no physical volume never take a physical volume's id or name") {
+  // Gmsh: a hex box (entity 1) in physical volume 2 "steel" beside a tet box (entity 2, whose
+  // tag is steel's) in no group, saved with Mesh.SaveAll=1, which writes the tets too. The old
+  // reader made the tets block 2 by their entity: one block "steel" of both parts in 4.1; in
+  // 2.2, where SaveAll gives every element the physical tag 0, it named the tets "steel".
+  const test::TempDir dir;
+  {
+    demo::GmshSession session;
+    gmsh::model::add("saveall");
+    const int a = gmsh::model::occ::addBox(0, 0, 0, 1, 1, 1);
+    const int b = gmsh::model::occ::addBox(1, 0, 0, 1, 1, 1);
+    gmsh::vectorpair out;
+    std::vector<gmsh::vectorpair> map;
+    gmsh::model::occ::fragment({{3, a}}, {{3, b}}, out, map);
+    gmsh::model::occ::synchronize();
+    gmsh::vectorpair faces;
+    gmsh::model::getBoundary({{3, a}}, faces, false, false, false);
+    for (const auto& [dim, tag] : faces) {
+      gmsh::vectorpair curves;
+      gmsh::model::getBoundary({{2, std::abs(tag)}}, curves, false, false, false);
+      for (const auto& [cd, c] : curves) gmsh::model::mesh::setTransfiniteCurve(std::abs(c), 3);
+      gmsh::model::mesh::setTransfiniteSurface(std::abs(tag));
+      gmsh::model::mesh::setRecombine(2, std::abs(tag));
+    }
+    gmsh::model::mesh::setTransfiniteVolume(a);
+    gmsh::option::setNumber("Mesh.MeshSizeMax", 0.5);
+    REQUIRE(b == 2);
+    gmsh::model::addPhysicalGroup(3, {a}, 2);
+    gmsh::model::setPhysicalName(3, 2, "steel");
+    gmsh::model::mesh::generate(3);
+    gmsh::option::setNumber("Mesh.SaveAll", 1);
+    for (const char* version : {"4.1", "2.2"}) {
+      gmsh::option::setNumber("Mesh.MshFileVersion", std::stod(version));
+      gmsh::write((dir.path / (std::string("saveall-") + version + ".msh")).string());
+    }
+    gmsh::option::setNumber("Mesh.SaveAll", 0);
+  }
+  for (const char* version : {"4.1", "2.2"}) {
+    CAPTURE(version);
+    const fs::path file = dir.path / (std::string("saveall-") + version + ".msh");
+    ReadWarnings warnings;
+    const Model m = read_gmsh(file);
+    REQUIRE(!m.hexes.empty());
+    REQUIRE(!m.tets.empty());
+    const std::set<int> hex_blocks(m.hex_block.begin(), m.hex_block.end()),
+        tet_blocks(m.tet_block.begin(), m.tet_block.end());
+    REQUIRE(hex_blocks.size() == 1);
+    REQUIRE(tet_blocks.size() == 1);
+    CHECK(*hex_blocks.begin() != *tet_blocks.begin());  // two materials, as the model has
+    CHECK(m.block_names.count(*tet_blocks.begin()) == 0);
+    REQUIRE(warnings.messages().size() == 1);
+    if (std::string(version) == "4.1") {
+      CHECK(*hex_blocks.begin() == 2);
+      CHECK(m.block_names.at(2) == "steel");
+      CHECK(*tet_blocks.begin() == 2 + 2);  // above every physical volume: 2 + its entity tag
+      CHECK(warnings.messages()[0].find("are in no physical volume") != std::string::npos);
+    } else {  // Gmsh wrote no group: nothing is named, and the warning says steel is lost
+      CHECK(m.block_names.empty());
+      CHECK(warnings.messages()[0].find("physical group 'steel' (dimension 3, tag 2)") !=
+            std::string::npos);
+    }
   }
 }
 
