@@ -34,7 +34,11 @@ bool looks_like_exodus(std::string_view head) {
   return false;
 }
 
-bool looks_like_gmsh(std::string_view head) { return starts_with(skip_space(head), "$MeshFormat"); }
+// Gmsh itself reads $Comments sections anywhere, also before $MeshFormat.
+bool looks_like_gmsh(std::string_view head) {
+  const std::string_view text = skip_space(head);
+  return starts_with(text, "$MeshFormat") || starts_with(text, "$Comments");
+}
 
 bool looks_like_vtk(std::string_view head) {
   return starts_with(skip_space(head), "# vtk DataFile Version");

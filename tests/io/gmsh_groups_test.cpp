@@ -17,6 +17,7 @@
 
 #include <geode/demo/gmsh_session.hpp>
 #include <geode/io/gmsh.hpp>
+#include <geode/io/read_model.hpp>
 #include <geode/io/read_warnings.hpp>
 #include <geode/primal/dice_model.hpp>
 #include <geode/primal/errors.hpp>
@@ -313,6 +314,20 @@ TEST_CASE(
             std::string::npos);
     }
   }
+}
+
+TEST_CASE("a .msh may open with $Comments, as Gmsh and meshio read it") {
+  const std::string text =
+      "$Comments\nwritten by a script\n$EndComments\n"
+      "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
+      "$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n$EndNodes\n"
+      "$Elements\n1\n1 4 2 3 3 1 2 3 4\n$EndElements\n";
+  const test::TempDir dir;
+  const fs::path file = dir.path / "commented.msh";
+  write_text(file, text);
+  const Model m = read_model(file);
+  CHECK(m.tets.size() == 1);
+  CHECK(m.tet_block == std::vector<int>{3});
 }
 
 TEST_CASE("names read from a file are made safe: no bad UTF-8 reaches a JSON report") {
