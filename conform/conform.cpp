@@ -1,6 +1,7 @@
 #include <geode/conform/conform.hpp>
 
 #include <algorithm>
+#include <limits>
 #include <map>
 #include <span>
 #include <sstream>
@@ -36,6 +37,9 @@ OutputBlocks output_blocks(const primal::Model& input, const std::string& geode_
   for (primal::ElementKind kind : primal::kElementKinds)
     for (std::size_t e = 0; e < primal::element_count(input, kind); ++e)
       top = std::max(top, primal::block_of(input, {kind, primal::index_cast(e)}));
+  if (top == std::numeric_limits<int>::max())
+    throw InvalidInput("--geode-block: the input's block ids reach " + std::to_string(top) +
+                       ": no id above them is left for the geode hexes' block");
   o.geode_id = top + 1;
   o.names[o.geode_id] = geode_block;
   return o;

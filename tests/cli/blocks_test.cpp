@@ -174,6 +174,17 @@ TEST_CASE("conform carries blocks and sets: steel and rubber keep their ids and 
     CHECK(o.block_names.at(10) == "transition");
     CHECK(o.block_names.at(7) == "steel");
   }
+  SUBCASE("--geode-block with the input's block ids at the top of the range: refused") {
+    primal::Model top = model;
+    top.tet_block.assign(top.tets.size(), 2147483647);
+    const fs::path high = dir.path / "high.msh", out = dir.path / "never.exo";
+    io::write_gmsh(top, high);
+    const test::CliRun r = test::geode_cli(
+        "conform " + high.string() + " --geode-block transition -o " + out.string(), true);
+    CHECK(r.code == 2);
+    CHECK(r.out.find("block ids reach 2147483647: no id above them is left") != std::string::npos);
+    CHECK(!fs::exists(out));
+  }
   SUBCASE("--buffer-side tet: the geode hexes fill the rubber's space and join it") {
     const fs::path out = dir.path / "out.exo";
     REQUIRE(test::geode_cli("conform " + in.string() + " --buffer-side tet -o " + out.string() +
