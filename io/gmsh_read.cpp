@@ -141,6 +141,13 @@ class MshReader {
       if (pos_ >= s_.size()) break;
       const std::size_t start = pos_;
       const std::string name = section_name();
+      // $Comments may stand before $MeshFormat; no section that needs the version may.
+      if (version_ == 0 && name != "MeshFormat" && name != "Comments")
+        fail_at(start, "$" + name + " before $MeshFormat");
+      if (name == "ParametricNodes")  // Gmsh 2.2's Mesh.SaveParametric=1 writes it for $Nodes
+        fail_at(start,
+                "$ParametricNodes (Gmsh 2.2 saved with Mesh.SaveParametric=1) is not read; save "
+                "without it, or as 4.1");
       if (name == "MeshFormat") {
         mesh_format();
       } else if (name == "PhysicalNames") {

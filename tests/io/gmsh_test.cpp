@@ -193,6 +193,19 @@ TEST_CASE("read_gmsh rejects bad input naming the file, element and reason") {
     write_text(file, full.substr(0, full.find("1 1 0\n0 1 0")));  // cut inside $Nodes
     CHECK_THROWS_WITH_AS(read_gmsh(file), doctest::Contains(file.string().c_str()), InvalidInput);
   }
+  SUBCASE("$ParametricNodes (Gmsh 2.2, Mesh.SaveParametric=1) and $Nodes before $MeshFormat") {
+    const fs::path file = dir / "parametric.msh";
+    write_text(file,
+               "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$ParametricNodes\n1\n1 0 0 0 0 1\n"
+               "$EndParametricNodes\n");
+    CHECK_THROWS_WITH_AS(read_gmsh(file),
+                         doctest::Contains("line 4: $ParametricNodes (Gmsh 2.2 saved with "
+                                           "Mesh.SaveParametric=1) is not read"),
+                         InvalidInput);
+    write_text(file, "$Comments\n$EndComments\n$Nodes\n1\n1 0 0 0\n$EndNodes\n");
+    CHECK_THROWS_WITH_AS(read_gmsh(file), doctest::Contains("$Nodes before $MeshFormat"),
+                         InvalidInput);
+  }
   SUBCASE("unsupported element type: a 10-node tetrahedron (Gmsh type 11)") {
     const fs::path file = dir / "tet10.msh";
     write_text(file, hand_written_msh("3 1 11 1\n3 1 2 3 4 5 6 7 8 9 10\n3 1 4 1\n4 1 9 4 5\n"));
