@@ -92,7 +92,7 @@ class BufferBuilder {
   void sides();
   void interface_geometry();
   template <class Cells, class Edges, class Faces>
-  void moving_part(const Cells& cells, const Edges& edges, const Faces& faces,
+  void moving_part(ElementKind kind, const Cells& cells, const Edges& edges, const Faces& faces,
                    const std::vector<std::pair<Index, int>>& interface_faces);
   void measure_before();
   void directions();
@@ -111,7 +111,8 @@ class BufferBuilder {
   BufferLayer out_;
   // Per moved node: unit corner normals of its interface quads pointing into the moving part,
   // the shortest interface-quad or moving-part edge at it, area-weighted outward normals of
-  // the moving part's outer-boundary faces at it, its step direction and height.
+  // the moving part's outer-boundary faces and of the faces between its blocks (from the lower
+  // block) at it, its step direction and height.
   std::vector<std::vector<Point>> corner_normals_, outer_normals_;
   std::vector<double> shortest_, step_, safe_;
   std::vector<Point> direction_;
@@ -180,10 +181,11 @@ void BufferBuilder::interface_geometry() {
 
 // The moving part's cells at moved nodes (with a four-triangle centre on the tet side), their
 // edges at moved nodes, and the part's outer boundary (faces used once that are not interface
-// faces, given as (cell, local face)), whose normals constrain the direction of a moved node on
-// it.
+// faces, given as (cell, local face)) with the faces between two of its blocks, whose normals
+// constrain the direction of a moved node on them.
 template <class Cells, class Edges, class Faces>
-void BufferBuilder::moving_part(const Cells& cells, const Edges& edges, const Faces& faces,
+void BufferBuilder::moving_part(ElementKind kind, const Cells& cells, const Edges& edges,
+                                const Faces& faces,
                                 const std::vector<std::pair<Index, int>>& interface_faces) {
   constexpr std::size_t kFaceSize = std::tuple_size_v<typename Faces::value_type>;
   const std::size_t nf = faces.size();
@@ -204,25 +206,46 @@ void BufferBuilder::moving_part(const Cells& cells, const Edges& edges, const Fa
     if (touches) touched.push_back(ci);
   }
   // Their faces' uses over the whole part, counted in a table of those faces only (a table of
-  // every face of the part, filled and searched, was most of this stage); interface faces -1.
-  // Only a cell with a node of a touched cell can share a face with one: the others are passed
-  // over without a look-up (on the n = 36 bench, 280,000 of them on one thread).
-  KeyMap<4> uses(touched.size() * nf);
+  // every face of the part, filled and searched, was most of this stage); interface faces -1;
+  // with the lowest and highest block among the cells using them. Only a cell with a node of a
+  // touched cell can share a face with one: the others are passed over without a look-up (on
+  // the n = 36 bench, 280,000 of them on one thread).
+  struct FaceUse {
+    Index uses = 0;
+    int low = std::numeric_limits<int>::max(), high = std::numeric_limits<int>::min();
+  };
+  KeyMap<4> face_of(touched.size() * nf);
+  std::vector<FaceUse> face_uses;
   std::vector<char> near(n_points_, 0);
   for (Index c : touched) {
     const auto& cell = cells[index_cast<std::size_t>(c)];
     for (Index v : cell) near[index_cast<std::size_t>(v)] = 1;
-    for (std::size_t f = 0; f < nf; ++f) uses.try_emplace(face_key(face_nodes(cell, faces[f])), 0);
+    for (std::size_t f = 0; f < nf; ++f)
+      if (face_of.try_emplace(face_key(face_nodes(cell, faces[f])), index_cast(face_uses.size()))
+              .second)
+        face_uses.emplace_back();
   }
-  for (const auto& cell : cells)
+  const auto use_of = [&](const auto& f) -> FaceUse* {
+    const Index* i = face_of.find(face_key(f));
+    return i ? &face_uses[index_cast<std::size_t>(*i)] : nullptr;
+  };
+  for (std::size_t c = 0; c < cells.size(); ++c) {
+    const auto& cell = cells[c];
     if (std::any_of(cell.begin(), cell.end(),
-                    [&](Index v) { return near[index_cast<std::size_t>(v)] != 0; }))
+                    [&](Index v) { return near[index_cast<std::size_t>(v)] != 0; })) {
+      const int block = block_of(input_, {kind, index_cast(c)});
       for (std::size_t f = 0; f < nf; ++f)
-        if (Index* n = uses.find(face_key(face_nodes(cell, faces[f])))) ++*n;
+        if (FaceUse* u = use_of(face_nodes(cell, faces[f]))) {
+          ++u->uses;
+          u->low = std::min(u->low, block);
+          u->high = std::max(u->high, block);
+        }
+    }
+  }
   for (const auto& [cell, f] : interface_faces)
-    if (Index* n = uses.find(face_key(
-            face_nodes(cells[index_cast<std::size_t>(cell)], faces[index_cast<std::size_t>(f)]))))
-      *n = -1;
+    if (FaceUse* u = use_of(
+            face_nodes(cells[index_cast<std::size_t>(cell)], faces[index_cast<std::size_t>(f)])))
+      u->uses = -1;
   outer_normals_.assign(n_moved_, {});
   for (Index ci : touched) {
     const auto& cell = cells[index_cast<std::size_t>(ci)];
@@ -235,7 +258,12 @@ void BufferBuilder::moving_part(const Cells& cells, const Edges& edges, const Fa
     }
     for (std::size_t k = 0; k < nf; ++k) {
       const auto f = face_nodes(cell, faces[k]);
-      if (*uses.find(face_key(f)) != 1) continue;  // inner or interface face
+      // The part's boundary, and the faces between two of its blocks (materials, which the
+      // copy must not move across either), each of these once: from its lower block's cell.
+      const FaceUse& u = *use_of(f);
+      const bool between_blocks = opt_.keep_block_faces && u.uses == 2 && u.low != u.high &&
+                                  block_of(input_, {kind, ci}) == u.low;
+      if (u.uses != 1 && !between_blocks) continue;  // inner or interface face
       // Twice the outward area vector (triangle or quad: the cross product of the diagonals).
       const Point area = kFaceSize == 3
                              ? Point((pt(f[1]) - pt(f[0])).cross(pt(f[2]) - pt(f[0])))
@@ -291,7 +319,8 @@ void BufferBuilder::directions() {
     for (Point& f : features) f.normalize();
     if (features.size() >= 3)
       throw TopologyError("insert_buffer_layer: " + describe_node(input_, v) +
-                          " is a corner of the " + part + " part's outer boundary (" +
+                          " is a corner of the " + part +
+                          " part's outer boundary or of its blocks' boundaries (" +
                           std::to_string(features.size()) + " feature faces meet there): its " +
                           part + "-side copy cannot move off the interface");
     auto project = [&](Point d) -> Point {
@@ -556,10 +585,11 @@ BufferLayer BufferBuilder::run() {
         interface_faces.emplace_back(q.tets[i], q.tet_faces[i]);
   }
   if (hex_side_)
-    moving_part(input_.hexes, topology::kHexEdgeCorners, topology::kHexFaceCorners,
-                interface_faces);
+    moving_part(ElementKind::kHex, input_.hexes, topology::kHexEdgeCorners,
+                topology::kHexFaceCorners, interface_faces);
   else
-    moving_part(input_.tets, topology::kTetEdgeCorners, topology::kTetFaceCorners, interface_faces);
+    moving_part(ElementKind::kTet, input_.tets, topology::kTetEdgeCorners,
+                topology::kTetFaceCorners, interface_faces);
   measure_before();
   directions();
   heights();

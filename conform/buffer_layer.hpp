@@ -95,6 +95,10 @@ struct BufferLayerOptions {
   // feature: a moved node slides in the boundary's tangent plane, along a feature edge, or
   // (at a feature corner) cannot move.
   double feature_angle = primal::kFeatureAngle;
+  // The faces between two blocks of the moving part count as its boundary: a moved copy slides
+  // in them, so every block keeps its volume (materials never move). Off, a copy may move
+  // across them (conform's last resort, with a warning, where no layer keeps them).
+  bool keep_block_faces = true;
 };
 
 struct BufferHex {

@@ -117,9 +117,10 @@ primal::Model Conformer::node_set_model() const {
 //   were carved from (no --geode-block): the block's face is now the geode hexes' faces on the
 //   side that stayed, which replace those sides;
 // - a buffer hex side face whose edge on the moving side is shared with a face of a set lying
-//   on the same surface (a boundary or block face running across the interface; the buffer
-//   hex's own element's face where two buffer hexes share the side face): its geode hexes'
-//   faces there join the set.
+//   on the same surface (a boundary or block face running across the interface): its geode
+//   hexes' faces there join the set; where two buffer hexes share the side face, those of the
+//   one carved from the set face's block if the two were carved from two blocks, else of the
+//   one carved from the set face's own element.
 void Conformer::carry_side_sets() {
   primal::Model& lm = layer_.model;
   side_sets_.clear();
@@ -141,7 +142,7 @@ void Conformer::carry_side_sets() {
   // Each buffer hex's faces on the moving side, and the side faces two buffer hexes share.
   std::unordered_map<FaceKey, std::size_t, primal::IndexArrayHash> moving_face;
   std::vector<std::size_t> moving_faces(nb, 0);
-  std::unordered_map<FaceKey, int, primal::IndexArrayHash> side_uses;
+  std::unordered_map<FaceKey, std::vector<std::size_t>, primal::IndexArrayHash> side_owners;
   for (std::size_t b = 0; b < nb; ++b) {
     const BufferHex& bh = layer_.hexes[b];
     std::vector<std::vector<Index>> faces;
@@ -165,7 +166,7 @@ void Conformer::carry_side_sets() {
       std::vector<Index> f;
       for (int c : topo::kHexFaceCorners[k])
         f.push_back(bh.corners[primal::index_cast<std::size_t>(c)]);
-      ++side_uses[primal::face_key(f)];
+      side_owners[primal::face_key(f)].push_back(b);
     }
   }
   std::vector<std::vector<primal::Side>> added(lm.side_sets.size());
@@ -199,11 +200,19 @@ void Conformer::carry_side_sets() {
         }
         const auto it = by_edge.find(primal::edge_key(edge[0], edge[1]));
         if (it == by_edge.end()) continue;
-        const bool shared = side_uses[primal::face_key(f)] > 1;
+        // A side face two buffer hexes share is taken from one of them: the one carved from
+        // the set face's block where the two were carved from two blocks (a surface between
+        // blocks crossing the layer), else the one carved from the set face's own element.
+        const std::vector<std::size_t>& owners = side_owners[primal::face_key(f)];
+        const std::size_t other = owners.size() > 1 ? owners[owners[0] == b ? 1 : 0] : b;
+        const int mine = primal::block_of(lm, carved_from_[b]),
+                  theirs = primal::block_of(lm, carved_from_[other]);
         const Point n = face_normal(lm.points, f);
         for (std::size_t i : it->second) {
           const Point m = face_normal(lm.points, face[i]);
-          if (shared && !(sides[i].element == carved_from_[b])) continue;
+          if (other != b && (mine != theirs ? primal::block_of(lm, sides[i].element) != mine
+                                            : !(sides[i].element == carved_from_[b])))
+            continue;
           if (std::abs(n.dot(m)) < 0.5 * n.norm() * m.norm()) continue;  // not the same surface
           geode_faces(b, k, added[s]);
           break;

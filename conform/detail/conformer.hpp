@@ -119,6 +119,7 @@ class Conformer {
   void measure_near_interface();
   std::vector<double> local_minima(const std::vector<double>& tet) const;
   void insert_buffer();
+  void carved();  // after insert_buffer placed the layer
   void thicker_from_tets();
   void measure_changed();
   void trim_input();
