@@ -634,13 +634,55 @@ class MshReader {
                          "as one file");
   }
   // Two elements whose physical groups and entity are the same (physicals_of, model_entity).
-  static bool same_groups(const RawElement& a, const RawElement& b) {
-    return a.entity == b.entity && a.physical == b.physical;
+  bool same_groups(const RawElement& a, const RawElement& b) const {
+    return a.entity == b.entity && a.physical == b.physical && more_physicals_.empty();
   }
+
+  // Gmsh 2.2 writes a volume element once per physical volume it is in (an entity in "steel"
+  // and in "all"), each copy with a tag of its own: the copies (same type, entity and nodes)
+  // are one element in all those groups, the first copy's tag its id. Looked for only where an
+  // entity's volume elements carry two physical tags or more.
+  void merge_group_copies() {
+    if (version_ != 2) return;
+    std::map<int, int> tag_of;  // entity -> its volume elements' first physical tag
+    bool several = false;
+    for (const RawElement& e : elements_)
+      if (gmsh_type(e.type)->dim == 3 && e.physical != 0) {
+        const auto [it, added] = tag_of.try_emplace(e.entity, e.physical);
+        several = several || (!added && it->second != e.physical);
+      }
+    if (!several) return;
+    copy_.assign(elements_.size(), 0);
+    std::map<std::vector<std::int64_t>, std::size_t> first;  // type, entity, nodes -> element
+    for (std::size_t i = 0; i < elements_.size(); ++i) {
+      const RawElement& e = elements_[i];
+      const GmshType& type = *gmsh_type(e.type);
+      if (type.dim != 3 || e.physical == 0) continue;
+      std::vector<std::int64_t> key{e.type, e.entity};
+      key.insert(key.end(), element_nodes_.begin() + static_cast<std::ptrdiff_t>(e.first),
+                 element_nodes_.begin() + static_cast<std::ptrdiff_t>(e.first + type.nodes));
+      const auto [it, added] = first.try_emplace(std::move(key), i);
+      if (added) continue;
+      copy_[i] = 1;
+      std::vector<int>& more = more_physicals_[it->second];
+      if (elements_[it->second].physical != e.physical &&
+          std::find(more.begin(), more.end(), e.physical) == more.end())
+        more.push_back(e.physical);
+    }
+  }
+  std::vector<char> copy_;  // per element: a copy merge_group_copies dropped
+  std::map<std::size_t, std::vector<int>> more_physicals_;  // element -> its copies' physical tags
   // Physical groups of an element: its entity's (4.1; a partitioned entity's own, else its
   // parent's) or its own tag (2.2).
   std::vector<int> physicals_of(const RawElement& e, int dim) const {
-    if (version_ == 2) return e.physical != 0 ? std::vector<int>{e.physical} : std::vector<int>{};
+    if (version_ == 2) {
+      if (e.physical == 0) return {};
+      std::vector<int> tags{e.physical};
+      if (const auto it = more_physicals_.find(index_cast<std::size_t>(&e - elements_.data()));
+          it != more_physicals_.end())
+        tags.insert(tags.end(), it->second.begin(), it->second.end());
+      return tags;
+    }
     if (partitioned_) {
       const auto it = partitioned_entities_.find({dim, e.entity});
       if (it == partitioned_entities_.end()) return {};
@@ -659,6 +701,13 @@ class MshReader {
   // without elements that way is reported in a warning (build()).
   int block_among(const std::vector<int>& physicals) {
     if (physicals.size() == 1) return physicals.front();
+    if (group_sizes_.empty() && version_ == 2) {  // each element's groups: count entities
+      std::map<int, std::set<int>> entities;
+      for (const RawElement& e : elements_)
+        if (gmsh_type(e.type)->dim == 3)
+          for (int p : physicals_of(e, 3)) entities[p].insert(e.entity);
+      for (const auto& [p, in] : entities) group_sizes_[p] = in.size();
+    }
     if (group_sizes_.empty())
       for (const auto& [key, tags] : entity_physicals_)
         if (key.first == 3)
@@ -751,10 +800,11 @@ class MshReader {
     std::size_t last_volume = 0;   // the volume element before this one
     int run_block = 0;             // its block before the default (model_entity, block_among)
     bool run_entity = false;       // run_block is an entity's
+    merge_group_copies();
     for (std::size_t i = 0; i < elements_.size(); ++i) {
       const RawElement& e = elements_[i];
       const GmshType& type = *gmsh_type(e.type);
-      if (type.dim != 3) continue;
+      if (type.dim != 3 || (!copy_.empty() && copy_[i])) continue;
       const ElementKind* kind = gmsh_cell_kind(e.type);
       if (!kind)
         throw InvalidInput(source_ + ": element " + std::to_string(e.tag) + ": " + type.name +

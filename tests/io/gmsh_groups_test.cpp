@@ -316,6 +316,56 @@ TEST_CASE(
   }
 }
 
+TEST_CASE("Gmsh 2.2 writes an element once per physical volume: the copies are one element") {
+  // Gmsh: a tet box in "steel" (1), another in "potting" (2), both in "all" (3). In 2.2 Gmsh
+  // writes each element once per group, each copy with a tag of its own; the old reader refused
+  // the file ("tet 865 ... and tet 866 ... are one element twice"). Read as the 4.1 file is.
+  const test::TempDir dir;
+  {
+    demo::GmshSession session;
+    gmsh::model::add("twice");
+    const int a = gmsh::model::occ::addBox(0, 0, 0, 1, 1, 1);
+    const int b = gmsh::model::occ::addBox(1, 0, 0, 1, 1, 1);
+    gmsh::vectorpair out;
+    std::vector<gmsh::vectorpair> map;
+    gmsh::model::occ::fragment({{3, a}}, {{3, b}}, out, map);
+    gmsh::model::occ::synchronize();
+    gmsh::option::setNumber("Mesh.MeshSizeMax", 0.5);
+    gmsh::model::addPhysicalGroup(3, {a}, 1);
+    gmsh::model::setPhysicalName(3, 1, "steel");
+    gmsh::model::addPhysicalGroup(3, {b}, 2);
+    gmsh::model::setPhysicalName(3, 2, "potting");
+    gmsh::model::addPhysicalGroup(3, {a, b}, 3);
+    gmsh::model::setPhysicalName(3, 3, "all");
+    gmsh::model::mesh::generate(3);
+    for (const char* version : {"4.1", "2.2"})
+      for (int binary : {0, 1}) {
+        gmsh::option::setNumber("Mesh.MshFileVersion", std::stod(version));
+        gmsh::option::setNumber("Mesh.Binary", binary);
+        gmsh::write(
+            (dir.path / (std::string("twice-") + version + "-" + std::to_string(binary) + ".msh"))
+                .string());
+      }
+    gmsh::option::setNumber("Mesh.Binary", 0);
+  }
+  ReadWarnings first_warnings;
+  const Model reference = read_gmsh(dir.path / "twice-4.1-0.msh");
+  REQUIRE(first_warnings.messages().size() == 1);  // "all" is no block of its own
+  CHECK(std::set<int>(reference.tet_block.begin(), reference.tet_block.end()) ==
+        std::set<int>{1, 2});
+  for (const char* name : {"twice-4.1-1.msh", "twice-2.2-0.msh", "twice-2.2-1.msh"}) {
+    CAPTURE(name);
+    ReadWarnings warnings;
+    const Model m = read_gmsh(dir.path / name);
+    CHECK(m.tets == reference.tets);
+    CHECK(m.tet_block == reference.tet_block);
+    CHECK(m.block_names == reference.block_names);
+    REQUIRE(warnings.messages().size() == 1);
+    CHECK(warnings.messages()[0].find("physical volume 3 'all' is not a block of its own") !=
+          std::string::npos);
+  }
+}
+
 TEST_CASE("a .msh may open with $Comments, as Gmsh and meshio read it") {
   const std::string text =
       "$Comments\nwritten by a script\n$EndComments\n"
