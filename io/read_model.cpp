@@ -97,6 +97,16 @@ Model model_from_vtk(const VtkGrid& grid, const ReadOptions& options) {
       block_array = name;
       break;
     }
+  // meshio's gmsh:physical is 0 for a cell in no physical group: numbered as the .msh reader
+  // numbers such elements, by its entity (gmsh:geometrical; else the kind's default block),
+  // above every physical tag of a volume cell where some cell has one.
+  const bool physical = block_array == "gmsh:physical";
+  const std::vector<int>* entities =
+      physical ? grid.cell_data.find_int("gmsh:geometrical") : nullptr;
+  std::int64_t top = 0;
+  for (std::size_t c = 0; physical && c < grid.cells.size(); ++c)
+    if (grid.cell_types[c] != kVtkTriangle && grid.cell_types[c] != kVtkQuad)
+      top = std::max<std::int64_t>(top, (*blocks)[c]);
   std::vector<std::optional<ElementRef>> cells(grid.cells.size());
   for (std::size_t c = 0; c < grid.cells.size(); ++c) {
     const int type = grid.cell_types[c];
@@ -108,7 +118,16 @@ Model model_from_vtk(const VtkGrid& grid, const ReadOptions& options) {
                          " is not supported; only hexahedra (12), tetrahedra (10), wedges (13) and "
                          "pyramids (14) are");
     const ElementKind kind = kElementKinds[index_cast<std::size_t>(it - kVtkCellTypes.begin())];
-    const int block = blocks ? (*blocks)[c] : default_block(kind);
+    int block = blocks ? (*blocks)[c] : default_block(kind);
+    if (physical && block == 0) {
+      const int entity = entities && (*entities)[c] > 0 ? (*entities)[c] : default_block(kind);
+      if (top + entity > INT32_MAX)
+        throw InvalidInput(grid.source + ": cell " + std::to_string(c) +
+                           ": in no physical group, and its entity " + std::to_string(entity) +
+                           " above the highest physical tag " + std::to_string(top) +
+                           " is out of range for a block id");
+      block = static_cast<int>(top + entity);
+    }
     if (block <= 0)
       throw InvalidInput(grid.source + ": cell " + std::to_string(c) + ": block id " +
                          std::to_string(block) + " (cell array '" + block_array +

@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include <geode/io/atomic_file.hpp>
+#include <geode/io/read_model.hpp>
 #include <geode/primal/dice.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/quality.hpp>
@@ -417,4 +418,30 @@ TEST_CASE("io_vtk: VTK's own readers (ParaView's) open what we write") {
   check(dir.path / "quad.vtu", 2);
   check(dir.path / "quad.vtk", 2);
   check(dir.path / "quad-binary.vtk", 2);
+}
+
+TEST_CASE("io_vtk: meshio's gmsh:physical 0 (no group) numbered above the physical tags") {
+  // A hex in physical volume 2 (entity 1) and a tet in none (entity 2), as meshio converts a
+  // Gmsh file: the tet's 0 was refused as a block id; it is block 2 + its entity 2, as the .msh
+  // reader numbers it, not the hex's block 2.
+  const std::string vtu =
+      "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\">\n<UnstructuredGrid>\n"
+      "<Piece NumberOfPoints=\"12\" NumberOfCells=\"2\">\n"
+      "<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n"
+      "0 0 0 1 0 0 1 1 0 0 1 0 0 0 1 1 0 1 1 1 1 0 1 1 3 0 0 4 0 0 3 1 0 3 0 1\n"
+      "</DataArray></Points>\n<Cells>\n"
+      "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">0 1 2 3 4 5 6 7 8 9 10 "
+      "11</DataArray>\n"
+      "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">8 12</DataArray>\n"
+      "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">12 10</DataArray>\n</Cells>\n"
+      "<CellData>\n"
+      "<DataArray type=\"Int32\" Name=\"gmsh:physical\" format=\"ascii\">2 0</DataArray>\n"
+      "<DataArray type=\"Int32\" Name=\"gmsh:geometrical\" format=\"ascii\">1 2</DataArray>\n"
+      "</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
+  const TempDir dir;
+  const fs::path file = dir.path / "meshio.vtu";
+  spit(file, vtu);
+  const Model m = read_model(file);
+  CHECK(m.hex_block == std::vector<int>{2});
+  CHECK(m.tet_block == std::vector<int>{4});
 }
