@@ -271,6 +271,10 @@ PlainMesh read_plain_mesh(const fs::path& path, const MeshFormat** format) {
       throw InvalidInput(path.string() + ": holds " + std::to_string(n) + " " +
                          primal::element_kind_name(kind) +
                          "s; expected an all-hex mesh (use `geode conform` first)");
+  if (model.hexes.empty())  // surfaces only (a 2D Gmsh mesh), or nothing: no mesh to judge
+    throw InvalidInput(path.string() +
+                       ": holds no hexes (no volume element at all); expected an "
+                       "all-hex mesh");
   PlainMesh m;
   m.hex = primal::hex_part(model);
   return m;

@@ -97,6 +97,13 @@ TEST_CASE(
        2,
        {"text.exo", "not in Exodus II format", "no netCDF or HDF5 signature"}},
       {"an empty .vtk", "dual {in}", "empty.vtk", "", 2, {"empty.vtk", "the file is empty"}},
+      {"surfaces only (a 2D Gmsh mesh) given to check",
+       "check {in}",
+       "surface.msh",
+       "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n"
+       "$EndNodes\n$Elements\n1\n1 2 2 0 1 1 2 3\n$EndElements\n",
+       2,
+       {"surface.msh", "holds no hexes (no volume element at all)"}},
       {"VTK content named .msh",
        "conform {in} -o {out}.exo",
        "vtk.msh",
