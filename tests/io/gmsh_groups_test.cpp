@@ -11,6 +11,7 @@
 #include <map>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -106,6 +107,20 @@ std::map<std::int64_t, int> partitioned_file(const fs::path& file, bool binary, 
       for (std::size_t e : of_type) part_of[static_cast<std::int64_t>(e)] = partitions[0] - 1;
   }
   return part_of;
+}
+
+// Two unit boxes side by side (x in [0, 1] and [1, 2]) in a new model of the Gmsh session the
+// caller holds, fragmented so that they share the face x = 1 (Gmsh then puts pyramids there
+// where one side is hexes): their volume tags.
+std::pair<int, int> boxes_side_by_side(const std::string& name) {
+  gmsh::model::add(name);
+  const int a = gmsh::model::occ::addBox(0, 0, 0, 1, 1, 1);
+  const int b = gmsh::model::occ::addBox(1, 0, 0, 1, 1, 1);
+  gmsh::vectorpair out;
+  std::vector<gmsh::vectorpair> map;
+  gmsh::model::occ::fragment({{3, a}}, {{3, b}}, out, map);
+  gmsh::model::occ::synchronize();
+  return {a, b};
 }
 
 }  // namespace
@@ -260,13 +275,7 @@ TEST_CASE(
   const test::TempDir dir;
   {
     demo::GmshSession session;
-    gmsh::model::add("saveall");
-    const int a = gmsh::model::occ::addBox(0, 0, 0, 1, 1, 1);
-    const int b = gmsh::model::occ::addBox(1, 0, 0, 1, 1, 1);
-    gmsh::vectorpair out;
-    std::vector<gmsh::vectorpair> map;
-    gmsh::model::occ::fragment({{3, a}}, {{3, b}}, out, map);
-    gmsh::model::occ::synchronize();
+    const auto [a, b] = boxes_side_by_side("saveall");
     gmsh::vectorpair faces;
     gmsh::model::getBoundary({{3, a}}, faces, false, false, false);
     for (const auto& [dim, tag] : faces) {
@@ -323,13 +332,7 @@ TEST_CASE("Gmsh 2.2 writes an element once per physical volume: the copies are o
   const test::TempDir dir;
   {
     demo::GmshSession session;
-    gmsh::model::add("twice");
-    const int a = gmsh::model::occ::addBox(0, 0, 0, 1, 1, 1);
-    const int b = gmsh::model::occ::addBox(1, 0, 0, 1, 1, 1);
-    gmsh::vectorpair out;
-    std::vector<gmsh::vectorpair> map;
-    gmsh::model::occ::fragment({{3, a}}, {{3, b}}, out, map);
-    gmsh::model::occ::synchronize();
+    const auto [a, b] = boxes_side_by_side("twice");
     gmsh::option::setNumber("Mesh.MeshSizeMax", 0.5);
     gmsh::model::addPhysicalGroup(3, {a}, 1);
     gmsh::model::setPhysicalName(3, 1, "steel");
