@@ -12,7 +12,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
-#include <set>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -454,19 +454,10 @@ Model build_model(const Contents& c, const std::string& source) {
   std::vector<ElementRef> global;  // global element number (1-based) - 1 -> element
   global.reserve(index_cast<std::size_t>(std::max(c.num_elem, 0)));
   const bool renumber_blocks = renumbered(c.blocks);
-  // Parts of a block our writer split by element type (kBlockProperty) join it again: a block
-  // whose property names another block, one that names itself.
-  std::set<int> joinable;
-  for (const BlockData& block : c.blocks)
-    if (block.model_block == block.id) joinable.insert(block.id);
   for (std::size_t b = 0; b < c.blocks.size(); ++b) {
     const BlockData& block = c.blocks[b];
-    const bool part =
-        !renumber_blocks && block.model_block != block.id && joinable.count(block.model_block) > 0;
-    const int block_id = renumber_blocks ? static_cast<int>(b) + 1
-                         : part          ? block.model_block
-                                         : block.id;
-    if (!block.name.empty() && !part) model.block_names[block_id] = block.name;
+    const int block_id = renumber_blocks ? static_cast<int>(b) + 1 : block.id;
+    if (!block.name.empty()) model.block_names[block_id] = block.name;
     const std::string where = source + ": element block " + std::to_string(block.id);
     const std::size_t k = cell_of(block);
     const ExodusCell* cell = k < kExodusCells.size() ? &kExodusCells[k] : nullptr;
@@ -493,6 +484,21 @@ Model build_model(const Contents& c, const std::string& source) {
       global.push_back({kind, static_cast<Index>(element_count(model, kind))});
       add_element(model, kind, corners, block_id, element_file_id(global.size() - 1));
     }
+  }
+
+  // Parts of a block our writer split by element type (kBlockProperty) join it again
+  // (primal::join_blocks): a block whose property names another block, one that names itself;
+  // blocks with elements only.
+  if (!renumber_blocks) {
+    std::map<int, std::vector<int>> parts;  // block -> itself, then its parts
+    for (const BlockData& block : c.blocks)
+      if (block.model_block == block.id && block.count > 0) parts[block.id].push_back(block.id);
+    for (const BlockData& block : c.blocks)
+      if (block.model_block != block.id && block.count > 0)
+        if (const auto it = parts.find(block.model_block); it != parts.end())
+          it->second.push_back(block.id);
+    for (const auto& [id, ids] : parts)
+      if (ids.size() > 1) join_blocks(model, ids, source);
   }
 
   const bool renumber_node_sets = renumbered(c.node_sets);
