@@ -17,6 +17,8 @@
 #include <type_traits>
 #include <unordered_map>
 
+#include <Eigen/Geometry>
+
 #include <geode/primal/boundary.hpp>
 #include <geode/primal/detail/byte_packet.hpp>
 #include <geode/primal/detail/edge_thirds.hpp>
@@ -886,6 +888,29 @@ std::string count_text(long n) {
   return n >= 0 && n <= 12 ? words[n] : std::to_string(n);
 }
 
+// Where one of `elements`' corners lies at the same place as another node (within 1e-9 of the
+// model's size, as conform's hint and --merge-tolerance's scale): "; hint: ..." naming both,
+// else nothing. Elements that meet the rest of the model only along an edge or at a node are
+// most often a part whose interface nodes were duplicated (meshed separately, or a node
+// copied): the manifold refusal alone does not say so. A scan of the nodes per corner: this
+// runs once, on a refusal.
+std::string twin_node_hint(const Model& model, std::span<const ElementRef> elements) {
+  if (model.points.empty()) return {};
+  Eigen::AlignedBox3d box;
+  for (const Point& p : model.points) box.extend(p);
+  const double tolerance = 1e-9 * box.diagonal().norm();
+  for (const ElementRef& e : elements)
+    for (Index v : element_corners(model, e)) {
+      const Point& p = model.points[index_cast<std::size_t>(v)];
+      for (std::size_t w = 0; w < model.points.size(); ++w)
+        if (index_cast(w) != v && (model.points[w] - p).norm() <= tolerance)
+          return "; hint: " + describe_node(model, v) + " lies at the same place as node " +
+                 std::to_string(node_id(model, index_cast(w))) +
+                 " (duplicated nodes: parts meshed separately?), which --merge-tolerance merges";
+    }
+  return {};
+}
+
 }  // namespace
 
 std::string InputFinding::text(const Model& model) const {
@@ -920,14 +945,16 @@ std::string InputFinding::text(const Model& model) const {
              " boundary faces meet there, " + count_text(faces / 2) + " surface sheets (through " +
              through +
              "; the model touches itself there: elements meeting the rest of it only "
-             "along this edge, or faces not matched node for node)";
+             "along this edge, or faces not matched node for node)" +
+             twin_node_hint(model, elements);
     }
     case InputFault::kNonManifoldNode:
       return "the boundary is not a manifold at " + describe_node(model, node) + ": " +
              count_text(static_cast<long>(measure)) + " surface sheets meet there (through " +
              named(0) + " and " + named(1) +
              "; the model touches itself there: elements meeting the rest of it only at this "
-             "node, or faces not matched node for node)";
+             "node, or faces not matched node for node)" +
+             twin_node_hint(model, elements);
     case InputFault::kFoldedNode:
       return "the elements around " + describe_node(model, node) + " (" + named(0) +
              " among them) cover its neighbourhood " + number(measure) +

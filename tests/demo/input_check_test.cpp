@@ -447,6 +447,44 @@ TEST_CASE("input check: overlapping parts, a gap at the interface, a part inside
     CHECK(run.code == 0);
   }
   {
+    // One tet using a copy of an interface node (a merge that missed one element): the tet
+    // meets the rest only along its edges there, refused as non-manifold, and the message
+    // names the node and its copy, which --merge-tolerance merges.
+    primal::Model m = base;
+    std::vector<char> in_hex(m.points.size(), 0);
+    for (const auto& h : m.hexes)
+      for (Index v : h) in_hex[primal::index_cast<std::size_t>(v)] = 1;
+    std::size_t tet = 0, corner = 0;
+    for (; tet < m.tets.size(); ++tet) {
+      for (corner = 0; corner < 4; ++corner)
+        if (in_hex[primal::index_cast<std::size_t>(m.tets[tet][corner])]) break;
+      if (corner < 4) break;
+    }
+    REQUIRE(tet < m.tets.size());
+    const Index shared = m.tets[tet][corner];
+    m.points.push_back(m.points[primal::index_cast<std::size_t>(shared)]);
+    if (!m.node_ids.empty())
+      m.node_ids.push_back(*std::max_element(m.node_ids.begin(), m.node_ids.end()) + 1);
+    m.tets[tet][corner] = primal::index_cast(m.points.size() - 1);
+    const primal::InputCheckResult r = primal::check_input(m);
+    REQUIRE(!r.ok());
+    require_same_when_shared(m);
+    CHECK(r.findings[0].topological());
+    const std::string copy = std::to_string(primal::node_id(m, m.tets[tet][corner]));
+    const std::string text = r.findings[0].text(m);
+    INFO(text);
+    CHECK(text.find("hint: node " + std::to_string(primal::node_id(m, shared))) !=
+          std::string::npos);
+    CHECK(text.find("at the same place as node " + copy) != std::string::npos);
+    refused_by_conform(m, "copied", {"--merge-tolerance"}, dir, 3);
+    const auto run = test::geode_cli("conform " + (dir.path / "copied.msh").string() +
+                                         " --merge-tolerance 1e-6 --quiet -o " +
+                                         (dir.path / "copied.exo").string(),
+                                     true);
+    INFO(run.out);
+    CHECK(run.code == 0);
+  }
+  {
     // A hex box [1.3, 1.7]^3 inside the tet box (no hole cut for it): covered twice.
     primal::Model m = base;
     m.hexes.resize(1);
