@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <map>
 #include <optional>
 #include <sstream>
 
@@ -257,7 +258,19 @@ CLI::Option* add_join_blocks_option(CLI::App* app, std::vector<std::string>& lis
 
 void join_block_lists(primal::Model& model, const std::vector<std::string>& lists,
                       const std::string& source) {
-  for (const std::string& list : lists) primal::join_blocks(model, block_ids(list), source);
+  // A block an earlier list joined away has no element left: named as joined, not as missing.
+  std::map<int, std::string> joined;  // block -> the list that joined it into another
+  for (const std::string& list : lists) {
+    const std::vector<int> ids = block_ids(list);
+    for (int id : ids)
+      if (const auto it = joined.find(id); it != joined.end())
+        throw InvalidInput(source + ": joining blocks " + list + ": block " + std::to_string(id) +
+                           " was joined into block " + it->second.substr(0, it->second.find(',')) +
+                           " by --join-blocks " + it->second +
+                           " before; give one list for one material");
+    primal::join_blocks(model, ids, source);
+    for (std::size_t i = 1; i < ids.size(); ++i) joined.emplace(ids[i], list);
+  }
 }
 
 CLI::Option* add_force_flag(CLI::App* app, bool& flag) {

@@ -267,4 +267,14 @@ TEST_CASE("conform --join-blocks: tets and pyramids kept apart in the file are o
     CHECK(r.out.find("--join-blocks") + r.out.find("joining blocks") != 2 * std::string::npos);
     CHECK(!fs::exists(out));
   }
+  // A block an earlier list joined away is named as joined (its material is the other block's
+  // now), not as a block with no element.
+  const test::CliRun twice = test::geode_cli(
+      "conform " + exo.string() + " --join-blocks 5,99 --join-blocks 99,4 -o " + out.string(),
+      true);
+  INFO(twice.out);
+  CHECK(twice.code == 2);
+  CHECK(twice.out.find(exo.string() + ": joining blocks 99,4: block 99 was joined into block 5 "
+                                      "by --join-blocks 5,99") != std::string::npos);
+  CHECK(!fs::exists(out));
 }
