@@ -8,10 +8,13 @@
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
+#include <ostream>
+#include <streambuf>
 #include <string>
+#include <string_view>
 #include <system_error>
 
+#include <geode/io/file_sink.hpp>
 #include <geode/primal/errors.hpp>
 
 namespace geode::io {
@@ -298,15 +301,53 @@ void write_path_atomically(const fs::path& path, const std::string& suffix,
   write_atomically(path, suffix, write, true);
 }
 
+namespace {
+
+// An ostream's bytes through a FileSink: its checked writes (a failure names the file and the
+// system's reason, "No space left on device") and its direct I/O, for the writers that format
+// through iostreams (.vtu, .vtk, reports, the viewer's page).
+class SinkBuffer : public std::streambuf {
+ public:
+  explicit SinkBuffer(FileSink& sink) : sink_(sink) { setp(put_, put_ + sizeof put_); }
+
+ protected:
+  int_type overflow(int_type c) override {
+    pass_on();
+    if (!traits_type::eq_int_type(c, traits_type::eof())) sink_.ch(traits_type::to_char_type(c));
+    return traits_type::not_eof(c);
+  }
+  std::streamsize xsputn(const char* s, std::streamsize n) override {
+    pass_on();
+    sink_.text(std::string_view(s, static_cast<std::size_t>(n)));
+    return n;
+  }
+  int sync() override {
+    pass_on();
+    return 0;
+  }
+
+ private:
+  void pass_on() {
+    sink_.text(std::string_view(pbase(), static_cast<std::size_t>(pptr() - pbase())));
+    setp(put_, put_ + sizeof put_);
+  }
+  FileSink& sink_;
+  char put_[1 << 12];  // numbers formatted by the stream land here first, a character at a time
+};
+
+}  // namespace
+
 void write_file_atomically(const fs::path& path, const std::function<void(std::ostream&)>& write) {
   write_atomically(
       path, "",
       [&](const fs::path& tmp) {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        if (!out) throw InvalidInput(path.string() + ": cannot open its temporary file");
+        FileSink sink(tmp, path.string());
+        SinkBuffer buffer(sink);
+        std::ostream out(&buffer);
+        out.exceptions(std::ios::badbit);  // the sink's InvalidInput, not a silent bad stream
         write(out);
         out.flush();
-        if (!out) throw InvalidInput(path.string() + ": write failed (disk full?)");
+        sink.close();
       },
       false);
 }

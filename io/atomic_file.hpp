@@ -20,7 +20,8 @@ namespace geode::io {
 
 // Calls `write` with a stream on a temporary file next to `path`, then renames it over `path`.
 // If `write` throws or the stream fails, the temporary file is removed, `path` is left as it
-// was, and the exception propagates (stream failures become geode::InvalidInput naming `path`).
+// was, and the exception propagates (a failed write becomes geode::InvalidInput naming `path`
+// and the system's reason; io/file_sink.hpp writes the bytes).
 void write_file_atomically(const std::filesystem::path& path,
                            const std::function<void(std::ostream&)>& write);
 
