@@ -96,7 +96,7 @@ int agree(int code, const std::string& failure, int rank, const std::function<vo
 }
 
 // What rank 0 prints of a run that got as far as every rank's hexes (valid or not): the run's
-// line, each rank's stages and peak, the warnings.
+// line, each rank's stages and peak; and the warnings (on stderr, see run()).
 struct Summary {
   std::string head, line;
   std::vector<std::string> warnings;
@@ -125,7 +125,6 @@ void print_summary(const Summary& summary, int rank, int size) {
               << all.substr(primal::index_cast<std::size_t>(displs[r]),
                             primal::index_cast<std::size_t>(counts[r]))
               << "\n";
-  for (const auto& w : summary.warnings) std::cout << "  warning: " << w << "\n";
 }
 
 int run(int argc, char** argv, int rank, int size) {
@@ -310,6 +309,10 @@ int run(int argc, char** argv, int rank, int size) {
   arena.execute([&] { code = conform_in_arena(); });
   const int worst = agree(code, failure, rank, [&] { files.discard(); });
   if (!quiet) print_summary(summary, rank, size);
+  // Warnings of a valid result go to stderr, -q or not, as the serial command's do (an invalid
+  // one's are in its error): those of the zone's conform (every rank has them) among them.
+  if (worst == 0 && rank == 0)
+    for (const auto& w : summary.warnings) std::cerr << "geode_mpi: warning: " << w << "\n";
   if (worst != 0) return worst;
   try {
     files.commit();  // every rank wrote its piece: all published
