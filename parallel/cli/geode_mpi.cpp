@@ -23,6 +23,7 @@
 
 #include <geode/conform/buffer_layer.hpp>
 #include <geode/io/read_model.hpp>
+#include <geode/io/read_warnings.hpp>
 #include <geode/parallel/distributed_conform.hpp>
 #include <geode/parallel/machine_cpus.hpp>
 #include <geode/parallel/nemesis.hpp>
@@ -127,6 +128,20 @@ void print_summary(const Summary& summary, int rank, int size) {
               << "\n";
 }
 
+// Every rank reads the input (a .msh whole): the reader's warnings, the same on every rank, were
+// printed once per rank. Collected instead, and printed by rank 0, also when the read then fails.
+struct RankZeroReadWarnings {
+  explicit RankZeroReadWarnings(int r) : rank(r) {}
+  RankZeroReadWarnings(const RankZeroReadWarnings&) = delete;
+  RankZeroReadWarnings& operator=(const RankZeroReadWarnings&) = delete;
+  int rank;
+  io::ReadWarnings collected;
+  ~RankZeroReadWarnings() {
+    if (rank == 0)
+      for (const auto& w : collected.messages()) std::cerr << "geode_mpi: warning: " << w << "\n";
+  }
+};
+
 int run(int argc, char** argv, int rank, int size) {
   CLI::App app{"geode conform under MPI: mpirun -np N geode_mpi conform INPUT -o OUT.exo"};
   app.require_subcommand(1);
@@ -220,13 +235,17 @@ int run(int argc, char** argv, int rank, int size) {
       // Each rank frees the input once it has its piece, and reads it again only if the zone
       // grows after that (the read-time check passed already).
       options.reload = [&] {
+        io::ReadWarnings said_at_the_first_read;
         primal::Model again = io::read_model(input, {}, false);
         cli::join_block_lists(again, join_blocks, input);
         return again;
       };
       io::FilePartition file_partition;
-      primal::Model model = io::read_model(input, {}, true, &file_partition,
-                                           parallel::shared_input_check(MPI_COMM_WORLD));
+      primal::Model model = [&] {
+        RankZeroReadWarnings warnings(rank);
+        return io::read_model(input, {}, true, &file_partition,
+                              parallel::shared_input_check(MPI_COMM_WORLD));
+      }();
       cli::join_block_lists(model, join_blocks, input);
       fail_for_test(rank, "read");
       // The input's own partition (a partitioned .msh, a Nemesis set) unless it has fewer parts
