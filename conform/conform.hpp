@@ -17,6 +17,7 @@
 // hex stays valid.
 #include <algorithm>
 #include <functional>
+#include <limits>
 #include <span>
 #include <string>
 #include <vector>
@@ -82,6 +83,11 @@ struct ConformOptions {
   // part of a hex face), carve it from the other part (at that side's default thickness) and say
   // so in ConformResult::warnings; false: refuse.
   bool buffer_fallback = true;
+  // The model's tets from this index on are pyramids (or wedges) the caller split, as geode_mpi's
+  // zone is cut from a model whose pyramids it split: on an interface quad that is not planar
+  // their triangles stand for the quad's bilinear face, which bounded the pyramid (the volume
+  // warning of conform.cpp's warped_interface). conform itself so counts the pyramids it splits.
+  primal::Index split_tets_from = std::numeric_limits<primal::Index>::max();
   double interface_tolerance = 1e-6;  // find_interface: relative to the local edge length
   // Box of the reference template (x, y, z as in templates/geode.hpp: y is the buffer hex's
   // thickness direction). It is smoothed once per diagonal, top and bottom fixed and its four

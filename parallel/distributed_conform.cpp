@@ -173,6 +173,16 @@ void Distributor::conform_zone() {
       // it covers its region once (its cut, unlike a model's boundary, may be non-manifold, which
       // piece_ok does not judge); verify() checks around the cut whole.
       conform::ConformOptions zone_options = options_.conform;
+      // The zone's tets split from the input's pyramids come after its own (the split model's
+      // order, which extract_submodel keeps): conform's volume warning counts them as pyramids.
+      const auto& zone_tets = zone.element[static_cast<std::size_t>(ElementKind::kTet)];
+      zone_options.split_tets_from = primal::index_cast(
+          std::find_if(zone_tets.begin(), zone_tets.end(),
+                       [&](Index t) {
+                         const auto i = primal::index_cast<std::size_t>(t);
+                         return i < tet_pyramid_.size() && tet_pyramid_[i] != kInvalidIndex;
+                       }) -
+          zone_tets.begin());
       conform::ConformResult r;
       run_on_cpus(zone_cpus_, options_.zone_threads,
                   [&] { r = conform::conform(std::move(zone.model), zone_options); });

@@ -19,8 +19,9 @@ void broadcast(void* data, std::size_t n, MPI_Datatype type, std::size_t size, i
 
 }  // namespace
 
-// From the zone rank to every rank: the zone's depth and outcome, its points (for matching the
-// diced nodes on the cut), block names and sets. A rank that diced a zone since grown dices again.
+// From the zone rank to every rank: the zone's depth, outcome and warnings, its points (for
+// matching the diced nodes on the cut), block names and sets. A rank that diced a zone since grown
+// dices again.
 void Distributor::share_zone() {
   const int root = zone_rank();
   primal::detail::BytePacket packet;
@@ -28,6 +29,8 @@ void Distributor::share_zone() {
     packet.put(zone_failure_kind_);
     packet.put(zone_failure_);
     packet.put(rings_);
+    packet.put(rep_.zone.warnings.size());
+    for (const std::string& w : rep_.zone.warnings) packet.put(w);
     packet.put(zone_out_.hexes.size());
     packet.put(zone_out_.points.size());
     packet.put(zone_out_.block_names.size());
@@ -56,6 +59,10 @@ void Distributor::share_zone() {
   if (kind == 2) throw TopologyError(failure);
   if (kind != 0) throw std::runtime_error(failure);
   const int rings = packet.get<int>();
+  // The zone's conform warnings (the buffer layer carved from the other part, across faces
+  // between blocks so that they do not keep their volumes; wedges split) are the run's, as the
+  // serial run's are: every rank's report holds them, so the rank that prints has them.
+  for (auto n = packet.get<std::size_t>(); n > 0; --n) rep_.warnings.push_back(packet.get_string());
   zone_hexes_ = packet.get<std::size_t>();
   const auto points = packet.get<std::size_t>();
   if (rank_ != root) {

@@ -8,9 +8,11 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <limits>
 #include <map>
 #include <span>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -75,6 +77,10 @@ class Conformer {
         given_copy_(given),
         disposable_(disposable) {}
 
+  // How many of the input's tets are the caller's own, in front of those conform made of its
+  // pyramids and wedges (split_pyramids, split_wedges): those follow a quad's bilinear face.
+  void tets_given(Index n) { tets_given_ = n; }
+
   // The wedges run() found joining the two sides of the interface, where it stopped.
   const std::vector<Index>& joining() const { return joining_; }
 
@@ -83,6 +89,7 @@ class Conformer {
     find_interface();
     if (!joining_.empty()) return {};  // conform() splits their wedge pieces and starts again
     insert_buffer();
+    warn_warped();
     trim_input();
     build_references();
     dice_and_merge();
@@ -116,6 +123,8 @@ class Conformer {
   }
 
   void find_interface();
+  void warped_interface();
+  void warn_warped();
   void measure_near_interface();
   std::vector<double> local_minima(const std::vector<double>& tet) const;
   void insert_buffer();
@@ -174,6 +183,12 @@ class Conformer {
   Clock::time_point t0_;
   primal::Interface interface_;
   std::vector<Index> joining_;  // wedges joining the two sides of the interface (none: go on)
+  // warped_interface: per (hex-side block, tet-side block, the tets split from a pyramid or
+  // wedge) the space between the interface quads' bilinear faces and the tets' triangles on
+  // them (the hex block's side of the triangles, signed), the quads' scale (their sizes cubed)
+  // and how many are not planar.
+  Index tets_given_ = std::numeric_limits<Index>::max();
+  std::map<std::tuple<int, int, bool>, std::tuple<double, double, std::size_t>> warped_;
   BufferLayer layer_;
   primal::DicedModel diced_;
   std::array<const RefTemplate*, 3> refs_{};  // diagonal {4, 6}, {5, 7}, four triangles

@@ -23,6 +23,7 @@
 
 #include <geode/conform/buffer_layer.hpp>
 #include <geode/io/read_model.hpp>
+#include <geode/io/read_warnings.hpp>
 #include <geode/parallel/distributed_conform.hpp>
 #include <geode/parallel/machine_cpus.hpp>
 #include <geode/parallel/nemesis.hpp>
@@ -96,7 +97,7 @@ int agree(int code, const std::string& failure, int rank, const std::function<vo
 }
 
 // What rank 0 prints of a run that got as far as every rank's hexes (valid or not): the run's
-// line, each rank's stages and peak, the warnings.
+// line, each rank's stages and peak; and the warnings (on stderr, see run()).
 struct Summary {
   std::string head, line;
   std::vector<std::string> warnings;
@@ -125,8 +126,21 @@ void print_summary(const Summary& summary, int rank, int size) {
               << all.substr(primal::index_cast<std::size_t>(displs[r]),
                             primal::index_cast<std::size_t>(counts[r]))
               << "\n";
-  for (const auto& w : summary.warnings) std::cout << "  warning: " << w << "\n";
 }
+
+// Every rank reads the input (a .msh whole): the reader's warnings, the same on every rank, were
+// printed once per rank. Collected instead, and printed by rank 0, also when the read then fails.
+struct RankZeroReadWarnings {
+  explicit RankZeroReadWarnings(int r) : rank(r) {}
+  RankZeroReadWarnings(const RankZeroReadWarnings&) = delete;
+  RankZeroReadWarnings& operator=(const RankZeroReadWarnings&) = delete;
+  int rank;
+  io::ReadWarnings collected;
+  ~RankZeroReadWarnings() {
+    if (rank == 0)
+      for (const auto& w : collected.messages()) std::cerr << "geode_mpi: warning: " << w << "\n";
+  }
+};
 
 int run(int argc, char** argv, int rank, int size) {
   CLI::App app{"geode conform under MPI: mpirun -np N geode_mpi conform INPUT -o OUT.exo"};
@@ -221,13 +235,17 @@ int run(int argc, char** argv, int rank, int size) {
       // Each rank frees the input once it has its piece, and reads it again only if the zone
       // grows after that (the read-time check passed already).
       options.reload = [&] {
+        io::ReadWarnings said_at_the_first_read;
         primal::Model again = io::read_model(input, {}, false);
         cli::join_block_lists(again, join_blocks, input);
         return again;
       };
       io::FilePartition file_partition;
-      primal::Model model = io::read_model(input, {}, true, &file_partition,
-                                           parallel::shared_input_check(MPI_COMM_WORLD));
+      primal::Model model = [&] {
+        RankZeroReadWarnings warnings(rank);
+        return io::read_model(input, {}, true, &file_partition,
+                              parallel::shared_input_check(MPI_COMM_WORLD));
+      }();
       cli::join_block_lists(model, join_blocks, input);
       fail_for_test(rank, "read");
       // The input's own partition (a partitioned .msh, a Nemesis set) unless it has fewer parts
@@ -310,6 +328,10 @@ int run(int argc, char** argv, int rank, int size) {
   arena.execute([&] { code = conform_in_arena(); });
   const int worst = agree(code, failure, rank, [&] { files.discard(); });
   if (!quiet) print_summary(summary, rank, size);
+  // Warnings of a valid result go to stderr, -q or not, as the serial command's do (an invalid
+  // one's are in its error): those of the zone's conform (every rank has them) among them.
+  if (worst == 0 && rank == 0)
+    for (const auto& w : summary.warnings) std::cerr << "geode_mpi: warning: " << w << "\n";
   if (worst != 0) return worst;
   try {
     files.commit();  // every rank wrote its piece: all published

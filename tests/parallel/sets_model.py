@@ -1,13 +1,16 @@
 #!/usr/bin/python3
 """A hex box beside a tet box, meshed together by Gmsh (pyramids on the shared quads), with the
 physical groups users give: two volumes (blocks), surfaces (side sets), a curve and a point
-(node sets). usage: sets_model.py OUT.msh [n]"""
+(node sets). usage: sets_model.py OUT.msh [n] [aggregate]
+aggregate: also a physical volume "all" over both volumes (a group over materials, as users add
+one), which the reader names in a warning (each element goes to its most specific group)."""
 import sys
 
 import gmsh
 
 out = sys.argv[1]
 n = int(sys.argv[2]) if len(sys.argv) > 2 else 8
+aggregate = len(sys.argv) > 3 and sys.argv[3] == "aggregate"
 gmsh.initialize()
 gmsh.option.setNumber("General.Terminal", 0)
 gmsh.model.add("sets")
@@ -46,6 +49,8 @@ def curves(test):
 
 group(3, [a], 1, "steel")
 group(3, [b], 2, "potting")
+if aggregate:
+    group(3, [a, b], 3, "all")
 group(2, surfaces(lambda x0, y0, z0, x1, y1, z1: x1 < 1e-5), 10, "fixed")
 group(2, surfaces(lambda x0, y0, z0, x1, y1, z1: x0 > 2 - 1e-5), 11, "load")
 group(2, surfaces(lambda x0, y0, z0, x1, y1, z1: z1 < 1e-5), 12, "floor")
