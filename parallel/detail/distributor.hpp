@@ -212,6 +212,7 @@ class Distributor {
 
   void yardstick();
   void select_zone(int rings);
+  void lowest_outside();
   void conform_zone();
   void partition();
   void dice();
@@ -272,8 +273,14 @@ class Distributor {
   std::vector<Mask> node_users_;    // per model node: the ranks whose elements outside Z use it
   const Model* model_ = nullptr;
   std::array<std::size_t, 5> offsets_{};
-  std::vector<int> part_;              // per flat element
-  std::vector<std::size_t> lowest_;    // elements setting the yardstick (one per kind)
+  std::vector<int> part_;  // per flat element
+  // Per kind the element diced alone lowest of those outside the zone's rings (the zone takes
+  // them: the serial run's yardstick, and its aims', are the lowest over the whole model).
+  std::vector<std::size_t> lowest_;
+  // This rank's run of each kind's elements (hex, tet, wedge), diced alone: its first element
+  // and figures, from yardstick() until the zone is selected.
+  std::array<std::size_t, 3> measured_first_{};
+  std::array<std::vector<double>, 3> measured_;
   std::vector<std::size_t> inverted_;  // elements diced with a scaled Jacobian <= 0
   std::vector<signed char> level_;     // per flat element: ring in the zone, -1 outside
   std::vector<char> in_zone_, band_;   // per flat element: in the zone, in its outer two rings

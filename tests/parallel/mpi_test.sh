@@ -18,6 +18,9 @@ rm -rf "$dir" && mkdir -p "$dir" && cd "$dir"
 if [ "$model" = sets ]; then
   input=in.msh
   /usr/bin/python3 "$here/sets_model.py" "$input" "$size" aggregate
+elif [ "$model" = ball ]; then  # the serial run's aims set by a tet outside the default zone
+  input=in.msh
+  /usr/bin/python3 "$here/../conform/ball_model.py" "$input" "$size"
 else
   input=in.exo
   "$geode" demo --model "$model" -n "$size" --save-input "$input"
