@@ -18,18 +18,31 @@ constexpr double kReferenceChildren = 900000.0;
 
 // The serial run's yardstick is the lowest element of each kind diced alone over the whole
 // model: each rank measures a run of the elements (a contiguous one: no partition is needed
-// yet, and neighbours share nodes in memory), kept until the zone is selected, whose conform
-// then measures the same minimum (select_zone). Inverted elements are smoothed by the serial
-// run wherever they are: they seed the zone.
+// yet, and neighbours share nodes in memory), and the lowest of each kind outside the rings
+// selected before (select_rings) join the zone. conform's aims measure against the lowest
+// element over its model, tets as relaxed near the transition: the zone's own (its rings hold
+// every tet the relaxation moves) and, outside it, as given. With the lowest overall instead,
+// the zone's aims were higher than the serial run's where the lowest tet as relaxed lay outside
+// the rings (Gmsh's 7-block ball in tet potting, n = 4, four rings: 0.1312 against 0.1212, one
+// node smoothed 3e-5 elsewhere). A zone grown later, or by inverted elements (which the serial
+// run smooths wherever they are: they seed the zone), holds them still, and what lies outside
+// it is no lower.
 //
 // The zone rank builds the reference templates its zone's conform will take from their cache
 // (conform/reference_template.hpp) here, beside its share, and measures that many children fewer
 // than the others: they are the one stage of its critical path that does not wait for the zone
 // (with 2 ranks, rank 0 then waits that much less for it).
 void Distributor::yardstick() {
+  struct {
+    double value;
+    int cell;
+  } low[3], all[3];
+  for (auto& l : low) l = {2.0, std::numeric_limits<int>::max()};
   std::vector<int> inverted;
-  const auto consider = [&](std::size_t c, double v) {
-    if (v <= 0.0) inverted.push_back(primal::index_cast<int>(c));
+  const auto consider = [&](int k, std::size_t c, double v) {
+    const int cell = primal::index_cast<int>(c);
+    if (level_[c] < 0 && v < low[k].value) low[k] = {v, cell};  // in order: ties to the first
+    if (v <= 0.0) inverted.push_back(cell);
   };
   const std::size_t nh = m().hexes.size(), nt = m().tets.size(), nw = m().wedges.size();
   // Ranks [0, r) measure this fraction of each kind's elements.
@@ -64,32 +77,31 @@ void Distributor::yardstick() {
   };
   {
     const std::size_t a = share(nh, rank_), b = share(nh, rank_ + 1);
-    measured_first_[0] = cell_of(ElementKind::kHex, a);
-    measured_[0] =
+    const auto h =
         primal::diced_scaled_jacobian_per_cell(m().points, std::span(m().hexes.data() + a, b - a));
+    for (std::size_t i = 0; i < h.size(); ++i) consider(0, cell_of(ElementKind::kHex, a + i), h[i]);
   }
   {
     const std::size_t a = share(nt, rank_), b = share(nt, rank_ + 1);
-    measured_first_[1] = cell_of(ElementKind::kTet, a);
-    measured_[1] =
+    const auto t =
         primal::diced_scaled_jacobian_per_cell(m().points, std::span(m().tets.data() + a, b - a));
+    for (std::size_t i = 0; i < t.size(); ++i) consider(1, cell_of(ElementKind::kTet, a + i), t[i]);
   }
-  measured_first_[2] = cell_of(ElementKind::kWedge, share(nw, rank_));
   for (std::size_t i = share(nw, rank_); i < share(nw, rank_ + 1); ++i)
-    measured_[2].push_back(
-        primal::diced_wedge_min_scaled_jacobian(m().points, std::span(&m().wedges[i], 1)));
-  for (std::size_t k = 0; k < 3; ++k)
-    for (std::size_t i = 0; i < measured_[k].size(); ++i)
-      consider(measured_first_[k] + i, measured_[k][i]);
+    consider(2, cell_of(ElementKind::kWedge, i),
+             primal::diced_wedge_min_scaled_jacobian(m().points, std::span(&m().wedges[i], 1)));
   if (references_built.joinable()) references_built.join();
+  MPI_Allreduce(low, all, 3, MPI_DOUBLE_INT, MPI_MINLOC, comm_);
+  for (const auto& a : all)
+    if (a.value <= 1.5) lowest_.push_back(primal::index_cast<std::size_t>(a.cell));
   const std::vector<int> every = gather_all(inverted, comm_);
   inverted_.assign(every.begin(), every.end());
   std::sort(inverted_.begin(), inverted_.end());
 }
 
-// The zone `rings` deep (in_zone_), its outer two rings (band_) and its nodes (zone_node_): the
-// same on every rank.
-void Distributor::select_zone(int rings) {
+// The elements within `rings` node rings of the seeds (level_): nodes used by a hex and a tet,
+// inverted elements' nodes (once the yardstick found them) and wedges'. The same on every rank.
+void Distributor::select_rings(int rings) {
   rings_ = rings;
   const std::size_t nv = m().points.size();
   std::vector<char> used_by_hex(nv, 0), used_by_tet(nv, 0), marked(nv, 0);
@@ -123,11 +135,15 @@ void Distributor::select_zone(int rings) {
         marked[primal::index_cast<std::size_t>(v)] = 1;
     }
   }
-  if (lowest_.empty()) lowest_outside();
+}
+
+// The zone: the rings and the lowest elements (in_zone_), its outer two rings (band_) and its
+// nodes (zone_node_). The same on every rank.
+void Distributor::finish_zone() {
+  const std::size_t nv = m().points.size();
   in_zone_.assign(cells(), 0);
   for (std::size_t c = 0; c < cells(); ++c) in_zone_[c] = level_[c] >= 0;
-  for (std::size_t c : lowest_)
-    if (c < cells()) in_zone_[c] = 1;
+  for (std::size_t c : lowest_) in_zone_[c] = 1;
   // The band: the zone's elements within two rings of the cut (the nodes it shares with the
   // elements outside); none when the zone is the whole model.
   std::vector<char> outside(nv, 0), near(nv, 0);
@@ -155,35 +171,7 @@ void Distributor::select_zone(int rings) {
         zone_node_[primal::index_cast<std::size_t>(v)] = 1;
   rep_.zone_cells =
       primal::index_cast<std::int64_t>(std::count(in_zone_.begin(), in_zone_.end(), 1));
-  rep_.rings = rings;
-}
-
-// Per kind the lowest element diced alone outside the rings just selected (on every rank, the
-// first selection only), which the zone then takes. conform's aims measure against the lowest
-// element over its model, tets as relaxed near the transition: the zone's own (its rings hold
-// every tet the relaxation moves) and, outside it, as given. Without the lowest outside, the
-// zone's aims were higher than the serial run's where that element lay outside the rings
-// (Gmsh's 7-block ball in tet potting, n = 4, four rings: 0.1312 against 0.1212, one node
-// smoothed 3e-5 elsewhere). A zone grown later holds it still, and what lies outside the grown
-// zone is no lower.
-void Distributor::lowest_outside() {
-  struct {
-    double value;
-    int cell;
-  } low[3], all[3];
-  for (std::size_t k = 0; k < 3; ++k) {
-    low[k] = {2.0, std::numeric_limits<int>::max()};
-    for (std::size_t i = 0; i < measured_[k].size(); ++i) {
-      const std::size_t c = measured_first_[k] + i;
-      const double v = measured_[k][i];
-      if (level_[c] < 0 && v < low[k].value) low[k] = {v, primal::index_cast<int>(c)};
-    }
-    measured_[k] = {};
-  }
-  MPI_Allreduce(low, all, 3, MPI_DOUBLE_INT, MPI_MINLOC, comm_);
-  for (const auto& a : all)
-    if (a.value <= 1.5) lowest_.push_back(primal::index_cast<std::size_t>(a.cell));
-  if (lowest_.empty()) lowest_.push_back(cells());  // none outside: marks the selection done
+  rep_.rings = rings_;
 }
 
 // On the zone rank: the zone conformed, grown (rings doubled) until its outer two rings come out
@@ -230,7 +218,8 @@ void Distributor::conform_zone() {
       if (rings_ * 2 > options_.max_rings)
         throw TopologyError("geode_mpi: the transition reaches past " + std::to_string(rings_) +
                             " rings of elements around the interface");
-      select_zone(rings_ * 2);
+      select_rings(rings_ * 2);
+      finish_zone();
     }
   } catch (const InvalidInput& e) {
     zone_failure_kind_ = 1, zone_failure_ = e.what();

@@ -99,7 +99,8 @@ void Distributor::share_zone() {
           throw std::runtime_error("it is not the model conformed");
         trimmed_ = false;
       }
-      select_zone(rings);
+      select_rings(rings);
+      finish_zone();
       diced_ = primal::DicedModel(), dicing_ = primal::DicingCheck(), own_ = {};
       primal::release(diced_positive_);
       dice();

@@ -163,8 +163,14 @@ class Distributor {
     if (!opt.geode_block.empty())
       throw InvalidInput("a named geode block is not available under MPI");
     offsets_ = primal::element_offsets(m());
+    // The rings before the yardstick, which takes the lowest elements outside them; again after
+    // it where it found inverted elements, which seed the zone too.
+    stage("zone selection", [&] { select_rings(options_.rings); });
     stage("yardstick", [&] { yardstick(); });
-    stage("zone selection", [&] { select_zone(options_.rings); });
+    stage("zone selection", [&] {
+      if (!inverted_.empty()) select_rings(options_.rings);
+      finish_zone();
+    });
     // The zone rank conforms the zone while rank 0 partitions and the others wait for it.
     if (rank_ == zone_rank()) stage("zone", [&] { conform_zone(); });
     stage("partition", [&] { partition(); });
@@ -211,8 +217,8 @@ class Distributor {
   int zone_rank() const { return size_ - 1; }
 
   void yardstick();
-  void select_zone(int rings);
-  void lowest_outside();
+  void select_rings(int rings);
+  void finish_zone();
   void conform_zone();
   void partition();
   void dice();
@@ -274,13 +280,9 @@ class Distributor {
   const Model* model_ = nullptr;
   std::array<std::size_t, 5> offsets_{};
   std::vector<int> part_;  // per flat element
-  // Per kind the element diced alone lowest of those outside the zone's rings (the zone takes
-  // them: the serial run's yardstick, and its aims', are the lowest over the whole model).
+  // Per kind the element diced alone lowest of those outside the zone's first rings (the zone
+  // takes them: the serial run's yardstick, and its aims', are the lowest over the whole model).
   std::vector<std::size_t> lowest_;
-  // This rank's run of each kind's elements (hex, tet, wedge), diced alone: its first element
-  // and figures, from yardstick() until the zone is selected.
-  std::array<std::size_t, 3> measured_first_{};
-  std::array<std::vector<double>, 3> measured_;
   std::vector<std::size_t> inverted_;  // elements diced with a scaled Jacobian <= 0
   std::vector<signed char> level_;     // per flat element: ring in the zone, -1 outside
   std::vector<char> in_zone_, band_;   // per flat element: in the zone, in its outer two rings
