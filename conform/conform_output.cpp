@@ -50,6 +50,13 @@ void Conformer::invert_for_test() {
 // where they are (mesh_, or the result's model once output() has moved them); the whole-mesh
 // check reads mesh_.
 void Conformer::check(std::span<const Point> points, std::span<const std::array<Index, 8>> hexes) {
+  // What makes the result invalid leads the warnings, so that the refusal's one line (exit 4)
+  // says it first, before what the run said on its way (wedges split, volumes moved).
+  std::size_t verdicts = 0;
+  const auto verdict = [&](std::string why) {
+    res_.warnings.insert(res_.warnings.begin() + static_cast<std::ptrdiff_t>(verdicts++),
+                         std::move(why));
+  };
   if (verify_locally()) {
     // Seeds: the geode hexes and whatever smoothing could move; the rest is diced, checked
     // against the dicing tables in check_dicing().
@@ -63,13 +70,13 @@ void Conformer::check(std::span<const Point> points, std::span<const std::array<
     primal::release(positive_);
     res_.verified = ConformVerify::kLocal;
     res_.verified_hexes = res_.validity.num_cells;
-    if (!res_.dicing.ok()) res_.warnings.push_back("invalid dicing: " + res_.dicing.summary());
+    if (!res_.dicing.ok()) verdict("invalid dicing: " + res_.dicing.summary());
   } else {
     res_.validity = primal::check_validity(mesh_);
     res_.verified = ConformVerify::kFull;
     res_.verified_hexes = primal::index_cast(mesh_.hexes.size());
   }
-  if (!res_.validity.ok()) res_.warnings.push_back("invalid mesh: " + res_.validity.summary());
+  if (!res_.validity.ok()) verdict("invalid mesh: " + res_.validity.summary());
   if (!inverted_.empty()) {
     std::ostringstream m;
     // 1-based in the result model's element order (writers keep it when blocks ascend).
@@ -77,7 +84,7 @@ void Conformer::check(std::span<const Point> points, std::span<const std::array<
     for (std::size_t i = 0; i < std::min<std::size_t>(inverted_.size(), 20); ++i)
       m << " " << inverted_[i] + 1;
     if (inverted_.size() > 20) m << " ...";
-    res_.warnings.push_back(m.str());
+    verdict(m.str());
   }
 }
 

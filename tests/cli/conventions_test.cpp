@@ -389,6 +389,32 @@ TEST_CASE(
     CHECK(fs::exists(out));
     CHECK(fs::exists(report));
   }
+  // With a warning of the run's own before verification (the interface's corner node on the
+  // model's edge moved along it, off the interface's plane: its quad is not planar, and the
+  // output's volume moves between the blocks), the one line says first what makes the result
+  // invalid.
+  TempDir dir;
+  primal::Model m = small_model();
+  for (primal::Point& p : m.points)
+    if (p == primal::Point(2.0, 0.0, 0.0)) p.x() += 0.1;
+  const fs::path in = dir.path / "bent.exo";
+  io::write_exodus(m, in);
+  const std::string args = "conform " + in.string() + " -o " + (dir.path / "out.vtu").string() +
+                           " --smooth none --quiet";
+  const test::CliRun warned = test::geode_cli(args, true);
+  INFO(warned.out);
+  REQUIRE(warned.code == 0);
+  REQUIRE(warned.out.find("of volume") != std::string::npos);
+  ScopedEnv hook("GEODE_TEST_INVERT_OUTPUT_HEX", "1");
+  const test::CliRun r = test::geode_cli(args, true);
+  INFO(r.out);
+  CHECK(r.code == 4);
+  CHECK(lines(r.out) == 1);
+  const std::size_t reason = r.out.find("invalid result: " + in.string() + ": ");
+  REQUIRE(reason != std::string::npos);
+  const std::string after = r.out.substr(reason + 18 + in.string().size());
+  CHECK((after.starts_with("invalid mesh") || after.starts_with("1 hexes with scaled Jacobian")));
+  CHECK(after.find("of volume") != std::string::npos);
 }
 
 TEST_CASE(
