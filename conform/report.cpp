@@ -34,9 +34,7 @@ std::string invalid_reason(const ConformResult& r) {
 
 std::string duplicate_node_hint(const primal::Model& model, const std::string& merge_option) {
   if (model.points.empty()) return {};
-  Eigen::AlignedBox3d box;
-  for (const auto& p : model.points) box.extend(p);
-  const double tolerance = 1e-9 * box.diagonal().norm();
+  const double tolerance = primal::coincident_tolerance(model);
   primal::Model copy = model;
   const primal::Index merged = primal::merge_coincident_nodes(copy, tolerance);
   if (merged == 0) return {};

@@ -17,8 +17,6 @@
 #include <type_traits>
 #include <unordered_map>
 
-#include <Eigen/Geometry>
-
 #include <geode/primal/boundary.hpp>
 #include <geode/primal/detail/byte_packet.hpp>
 #include <geode/primal/detail/edge_thirds.hpp>
@@ -888,17 +886,14 @@ std::string count_text(long n) {
   return n >= 0 && n <= 12 ? words[n] : std::to_string(n);
 }
 
-// Where one of `elements`' corners lies at the same place as another node (within 1e-9 of the
-// model's size, as conform's hint and --merge-tolerance's scale): "; hint: ..." naming both,
+// Where one of `elements`' corners lies at the same place as another node (coincident_tolerance,
+// as conform's hint and --merge-tolerance's scale): "; hint: ..." naming both,
 // else nothing. Elements that meet the rest of the model only along an edge or at a node are
 // most often a part whose interface nodes were duplicated (meshed separately, or a node
 // copied): the manifold refusal alone does not say so. A scan of the nodes per corner: this
 // runs once, on a refusal.
 std::string twin_node_hint(const Model& model, std::span<const ElementRef> elements) {
-  if (model.points.empty()) return {};
-  Eigen::AlignedBox3d box;
-  for (const Point& p : model.points) box.extend(p);
-  const double tolerance = 1e-9 * box.diagonal().norm();
+  const double tolerance = coincident_tolerance(model);
   for (const ElementRef& e : elements)
     for (Index v : element_corners(model, e)) {
       const Point& p = model.points[index_cast<std::size_t>(v)];

@@ -9,6 +9,8 @@
 #include <string>
 #include <type_traits>
 #include <unordered_map>
+
+#include <Eigen/Geometry>
 #include <unordered_set>
 
 #include <geode/primal/errors.hpp>
@@ -515,6 +517,13 @@ TetMesh tet_part(const Model& model) {
 
 double tet_volume(const Point& a, const Point& b, const Point& c, const Point& d) {
   return (b - a).cross(c - a).dot(d - a) / 6.0;
+}
+
+double coincident_tolerance(const Model& model) {
+  if (model.points.empty()) return 0.0;
+  Eigen::AlignedBox3d box;
+  for (const Point& p : model.points) box.extend(p);
+  return 1e-9 * box.diagonal().norm();
 }
 
 Index merge_coincident_nodes(Model& model, double tolerance) {

@@ -199,6 +199,11 @@ TetMesh tet_part(const Model& model);
 // Signed volume of tet (a, b, c, d): positive when a-b-c is counter-clockwise seen from d.
 double tet_volume(const Point& a, const Point& b, const Point& c, const Point& d);
 
+// The distance under which two of the model's nodes count as one place (duplicated nodes): 1e-9
+// of its bounding box's diagonal (0 for no points). The hints naming duplicated nodes use it,
+// and offer it to --merge-tolerance.
+double coincident_tolerance(const Model& model);
+
 // Merges points closer than `tolerance` (keeps the lowest index, renumbers everything, drops
 // the merged points). Returns how many points were removed. Spatial hashing, O(n).
 Index merge_coincident_nodes(Model& model, double tolerance);
