@@ -913,7 +913,8 @@ ConformResult conform_model(const primal::Model& input, primal::Model* spare,
     r.seconds += relaxation.seconds;
     r.input_pyramids = input_pyramids;
     r.wedges_split = wedges_split;
-    r.warnings.insert(r.warnings.begin(), warnings.begin(), warnings.end());
+    r.warnings.insert(r.warnings.begin() + static_cast<std::ptrdiff_t>(r.findings),
+                      warnings.begin(), warnings.end());
     r.input_wedges += wedges_split;
     r.input_tets -= 2 * r.input_pyramids + 3 * wedges_split;
     return r;

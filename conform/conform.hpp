@@ -262,6 +262,9 @@ struct ConformResult {
       quality;  // one per output block, ascending id ("block N" unnamed); ConformOptions::quality
   std::vector<std::string>
       warnings;  // e.g. "3 hexes with scaled Jacobian <= 0 (1-based output elements): 12 40 ..."
+  // How many of the warnings, first, are verification's findings (what makes the result invalid:
+  // invalid dicing, invalid mesh, inverted hexes); the run's own come after them.
+  std::size_t findings = 0;
   double seconds = 0.0;
 };
 

@@ -52,9 +52,8 @@ void Conformer::invert_for_test() {
 void Conformer::check(std::span<const Point> points, std::span<const std::array<Index, 8>> hexes) {
   // What makes the result invalid leads the warnings, so that the refusal's one line (exit 4)
   // says it first, before what the run said on its way (wedges split, volumes moved).
-  std::size_t verdicts = 0;
   const auto verdict = [&](std::string why) {
-    res_.warnings.insert(res_.warnings.begin() + static_cast<std::ptrdiff_t>(verdicts++),
+    res_.warnings.insert(res_.warnings.begin() + static_cast<std::ptrdiff_t>(res_.findings++),
                          std::move(why));
   };
   if (verify_locally()) {

@@ -415,6 +415,21 @@ TEST_CASE(
   const std::string after = r.out.substr(reason + 18 + in.string().size());
   CHECK((after.starts_with("invalid mesh") || after.starts_with("1 hexes with scaled Jacobian")));
   CHECK(after.find("of volume") != std::string::npos);
+  // And after a warning of conform's outer loop (Gmsh's layer-mixed: its wedges split into tets,
+  // said after the run that found them), which came first.
+  const fs::path mixed = dir.path / "mixed.msh";
+  REQUIRE(test::geode_cli(
+              "demo --model layer-mixed -n 2 --save-input " + mixed.string() + " --quiet", true)
+              .code == 0);
+  const test::CliRun split = test::geode_cli(
+      "conform " + mixed.string() + " -o " + (dir.path / "m.vtu").string() + " --quiet", true);
+  INFO(split.out);
+  CHECK(split.code == 4);
+  const std::size_t at = split.out.find("invalid result: " + mixed.string() + ": ");
+  REQUIRE(at != std::string::npos);
+  const std::string rest = split.out.substr(at + 18 + mixed.string().size());
+  CHECK((rest.starts_with("invalid mesh") || rest.starts_with("1 hexes with scaled Jacobian")));
+  CHECK(rest.find("wedges split") != std::string::npos);
 }
 
 TEST_CASE(
