@@ -238,6 +238,70 @@ void Distributor::conform_zone() {
 // 572 / 536, 595 / 556, 605 / 544 and 617 / 537 MiB (rank 0 / the zone rank).
 constexpr double kZoneLoad = 1.8;
 
+// Every rank's face pairs to rank 0, in rank order (each rank's are the faces whose lowest node
+// is in its run: every interior face once), as flat elements of the model the stages read: a
+// pyramid split in two tets stands as its first, the two joined. When every rank has them and
+// their count fits MPI's ints.
+void Distributor::gather_pairs() {
+  using Pair = std::array<Index, 2>;
+  std::vector<Pair> none, &mine = options_.element_pairs ? *options_.element_pairs : none;
+  if (!options_.partition.empty() || size_ == 1) return primal::release(mine);
+  const std::int64_t given[2] = {options_.element_pairs ? 1 : 0,
+                                 primal::index_cast<std::int64_t>(mine.size())};
+  std::vector<std::int64_t> all(2 * primal::index_cast<std::size_t>(size_));
+  MPI_Allgather(given, 2, MPI_INT64_T, all.data(), 2, MPI_INT64_T, comm_);
+  std::int64_t total = 0;
+  bool every = true;
+  for (int r = 0; r < size_; ++r) {
+    every = every && all[2 * primal::index_cast<std::size_t>(r)] == 1;
+    total += all[2 * primal::index_cast<std::size_t>(r) + 1];
+  }
+  if (every && total <= std::numeric_limits<int>::max()) {
+    MPI_Datatype pair;
+    MPI_Type_contiguous(static_cast<int>(sizeof(Pair)), MPI_BYTE, &pair);
+    MPI_Type_commit(&pair);
+    std::vector<int> counts(primal::index_cast<std::size_t>(size_)),
+        displs(primal::index_cast<std::size_t>(size_));
+    for (int r = 0, at = 0; r < size_; ++r) {
+      counts[primal::index_cast<std::size_t>(r)] =
+          static_cast<int>(all[2 * primal::index_cast<std::size_t>(r) + 1]);
+      displs[primal::index_cast<std::size_t>(r)] = at;
+      at += counts[primal::index_cast<std::size_t>(r)];
+    }
+    if (rank_ == 0) pairs_.resize(primal::index_cast<std::size_t>(total));
+    MPI_Gatherv(mine.data(), static_cast<int>(mine.size()), pair, pairs_.data(), counts.data(),
+                displs.data(), pair, 0, comm_);
+    MPI_Type_free(&pair);
+    have_pairs_ = rank_ == 0;
+  }
+  primal::release(mine);
+  if (!have_pairs_ || tet_pyramid_.empty()) return;
+  // The input's flat numbers (pyramids among them) as the split model's.
+  const auto in = primal::element_offsets(input_);
+  std::vector<Index> first_tet(input_.pyramids.size(), kInvalidIndex);
+  for (std::size_t t = 0; t < tet_pyramid_.size(); ++t)
+    if (const Index p = tet_pyramid_[t]; p != kInvalidIndex) {
+      Index& first = first_tet[primal::index_cast<std::size_t>(p)];
+      const Index cell =
+          primal::index_cast(offsets_[static_cast<std::size_t>(ElementKind::kTet)] + t);
+      if (first == kInvalidIndex)
+        first = cell;
+      else
+        pairs_.push_back({first, cell});
+    }
+  const auto split = [&](Index f) {
+    const auto i = primal::index_cast<std::size_t>(f);
+    for (ElementKind kind : {ElementKind::kHex, ElementKind::kTet, ElementKind::kWedge})
+      if (i >= in[static_cast<std::size_t>(kind)] && i < in[static_cast<std::size_t>(kind) + 1])
+        return primal::index_cast(offsets_[static_cast<std::size_t>(kind)] + i -
+                                  in[static_cast<std::size_t>(kind)]);
+    return first_tet[i - in[static_cast<std::size_t>(ElementKind::kPyramid)]];
+  };
+  const std::size_t given_pairs = primal::index_cast<std::size_t>(total);
+  for (std::size_t k = 0; k < given_pairs; ++k)
+    for (Index& e : pairs_[k]) e = split(e);
+}
+
 // Per flat element its rank: the input's own partition, or METIS's on rank 0 (the elements
 // weighted by the hexes they dice into, the zone's elements only 1: the zone rank's share made
 // smaller by the zone's load), sent to the others; the zone rank takes it after the zone.
@@ -293,7 +357,9 @@ void Distributor::partition() {
     try {
       if (std::getenv("GEODE_TEST_FAIL_PARTITION"))  // tests/parallel/mpi_verify_test.sh
         throw std::runtime_error("GEODE_TEST_FAIL_PARTITION is set");
-      part_ = partition_elements(m(), size_, po);
+      if (have_pairs_) po.graph = graph_of_pairs(cells(), pairs_);
+      primal::release(pairs_);
+      part_ = partition_elements(m(), size_, std::move(po));
     } catch (const std::exception& e) {
       partition_failure_ = e.what();
       part_.assign(cells(), -1);

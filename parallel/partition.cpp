@@ -40,8 +40,9 @@ struct Graph {
 
 // The elements, weighted by the hexes each dices into (8, 4, 6; a pyramid as its two tets, 8)
 // unless `weight` says otherwise, joined across their faces.
-Graph element_level(const primal::Model& model, const std::vector<idx_t>& weight) {
-  primal::ElementGraph eg = primal::element_graph(model);
+Graph element_level(const primal::Model& model, primal::ElementGraph eg,
+                    const std::vector<idx_t>& weight) {
+  if (eg.offset.empty()) eg = primal::element_graph(model);
   Graph g;
   g.xadj.reserve(eg.offset.size());
   for (std::size_t o : eg.offset) g.xadj.push_back(primal::index_cast<idx_t>(o));
@@ -218,7 +219,7 @@ void refine(const Graph& g, const std::vector<double>& share, std::vector<idx_t>
 }  // namespace
 
 std::vector<int> partition_elements(const primal::Model& model, int parts,
-                                    const PartitionOptions& options) {
+                                    PartitionOptions options) {
   const std::size_t n = primal::element_offsets(model).back();
   std::vector<int> result(n, 0);
   if (parts <= 1 || n == 0) return result;
@@ -231,7 +232,11 @@ std::vector<int> partition_elements(const primal::Model& model, int parts,
   std::vector<double> share = options.share;
   if (share.empty()) share.assign(at(parts), 1.0 / parts);
   std::vector<real_t> tpwgts(share.begin(), share.end());
-  Graph elements = element_level(model, options.weight);
+  if (!options.graph.offset.empty() && options.graph.offset.size() != n + 1)
+    throw std::invalid_argument("partition_elements: a graph of " +
+                                std::to_string(options.graph.offset.size() - 1) + " elements for " +
+                                std::to_string(n));
+  Graph elements = element_level(model, std::move(options.graph), options.weight);
   // Small models (under 64 clusters a part) are partitioned element by element: fast anyway,
   // and clusters would leave the balance coarse.
   const bool cluster = primal::index_cast<std::int64_t>(n) >= kClusterSize * 64 * parts;
@@ -259,6 +264,29 @@ std::vector<int> partition_elements(const primal::Model& model, int parts,
   }
   for (std::size_t e = 0; e < n; ++e) result[e] = part[e];
   return result;
+}
+
+primal::ElementGraph graph_of_pairs(std::size_t elements,
+                                    std::span<const std::array<primal::Index, 2>> pairs) {
+  primal::ElementGraph g;
+  g.offset.assign(elements + 1, 0);
+  for (const auto& [a, b] : pairs) {
+    if (a < 0 || b < 0 || primal::index_cast<std::size_t>(a) >= elements ||
+        primal::index_cast<std::size_t>(b) >= elements)
+      throw std::invalid_argument("graph_of_pairs: a pair (" + std::to_string(a) + ", " +
+                                  std::to_string(b) + ") beyond " + std::to_string(elements) +
+                                  " elements");
+    ++g.offset[primal::index_cast<std::size_t>(a) + 1];
+    ++g.offset[primal::index_cast<std::size_t>(b) + 1];
+  }
+  for (std::size_t e = 0; e < elements; ++e) g.offset[e + 1] += g.offset[e];
+  g.neighbour.resize(g.offset.back());
+  std::vector<std::size_t> fill(g.offset.begin(), g.offset.end() - 1);
+  for (const auto& [a, b] : pairs) {
+    g.neighbour[fill[primal::index_cast<std::size_t>(a)]++] = b;
+    g.neighbour[fill[primal::index_cast<std::size_t>(b)]++] = a;
+  }
+  return g;
 }
 
 std::vector<int> ranks_of_parts(const std::vector<int>& part, int parts, int ranks) {

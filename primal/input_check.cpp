@@ -25,6 +25,7 @@
 #include <geode/primal/disjoint_sets.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/release.hpp>
+#include <geode/primal/submodel.hpp>
 
 namespace geode::primal {
 
@@ -92,9 +93,11 @@ double dihedral(const Point& axis, const Point& a, const Point& inward, const Po
 
 // The stages of check_input over one model, each adding findings.
 class InputChecker {
+  using ElementPair = std::array<Index, 2>;
+
  public:
   InputChecker(const Model& model, const InputCheckOptions& options)
-      : model_(model), options_(options) {}
+      : model_(model), options_(options), offsets_(element_offsets(model)) {}
 
   InputCheckResult run() {
     node_runs();
@@ -307,25 +310,42 @@ class InputChecker {
   // Faces used more than once: pairs must be seen in opposite orders; the rest into `single`.
   void pair_uses(const std::vector<FaceUse>& uses, std::vector<FaceUse>& single) {
     std::vector<std::vector<FaceUse>> singles(kPieces);
+    std::vector<std::vector<ElementPair>> pairs(options_.element_pairs ? kPieces : 0);
     in_pieces(
         uses.size(), [&](std::size_t a, std::size_t b) { return uses[a].key == uses[b].key; },
         [&](std::size_t p, std::vector<InputFinding>& out, std::size_t from, std::size_t to) {
-          pair_piece(uses, from, to, out, singles[p]);
+          pair_piece(uses, from, to, out, singles[p], pairs.empty() ? nullptr : &pairs[p]);
         });
     for (const std::vector<FaceUse>& piece : singles)
       single.insert(single.end(), piece.begin(), piece.end());
+    if (options_.element_pairs) {
+      std::size_t n = 0;
+      for (const auto& piece : pairs) n += piece.size();
+      options_.element_pairs->clear();
+      options_.element_pairs->reserve(n);
+      for (auto& piece : pairs) {
+        options_.element_pairs->insert(options_.element_pairs->end(), piece.begin(), piece.end());
+        release(piece);
+      }
+    }
+  }
+  // An element's flat number (element_offsets).
+  Index flat(ElementRef e) const {
+    return index_cast(offsets_[static_cast<std::size_t>(e.kind)]) + e.index;
   }
 
   // pair_uses on the runs of uses [from, to): findings into `out`, faces used once into
   // `single`.
   void pair_piece(const std::vector<FaceUse>& uses, std::size_t from, std::size_t to,
-                  std::vector<InputFinding>& out, std::vector<FaceUse>& single) const {
+                  std::vector<InputFinding>& out, std::vector<FaceUse>& single,
+                  std::vector<ElementPair>* pairs) const {
     for (std::size_t i = from; i < to;) {
       std::size_t j = i + 1;
       while (j < to && uses[j].key == uses[i].key) ++j;
       // The common case first: a face two elements see in opposite orders. Those are not one
       // element twice: positive elements on the same nodes lie on the same side of each face.
       if (j - i == 2 && opposite(uses[i], uses[i + 1])) {
+        if (pairs) pairs->push_back({flat(uses[i].element), flat(uses[i + 1].element)});
         i = j;
         continue;
       }
@@ -379,6 +399,9 @@ class InputChecker {
     std::stable_sort(triangle.begin(), triangle.end(), by_key);
     third.sort();
     std::vector<bool> paired(uses.size(), false);
+    // Each quad covered adds two or four pairs, of the triangles used once.
+    if (options_.element_pairs && options_.share == 0)
+      options_.element_pairs->reserve(options_.element_pairs->size() + triangle.size());
     auto tri = [&](Index a, Index b, Index c) -> const std::size_t* {
       const Index n[3] = {a, b, c};
       const Triangle probe{face_key(n), 0};
@@ -420,6 +443,9 @@ class InputChecker {
       }
       paired[s] = true;
       for (std::size_t t : cover) paired[t] = true;
+      if (options_.element_pairs && options_.share == 0)
+        for (std::size_t t : cover)
+          options_.element_pairs->push_back({flat(uses[s].element), flat(uses[t].element)});
       // A four-triangle centre lies on the quad, inside its element's face: that element covers
       // the half space beyond it there (the quad's tangent plane).
       if (cover.size() == 4) centre_on_quad_.push_back(third_node(uses[cover[0]].key, q));
@@ -860,7 +886,8 @@ class InputChecker {
 
   const Model& model_;
   const InputCheckOptions& options_;
-  Index first_ = 0, last_ = 0;  // this share's run of the nodes (node_runs)
+  const std::array<std::size_t, 5> offsets_;  // element_offsets
+  Index first_ = 0, last_ = 0;                // this share's run of the nodes (node_runs)
   InputCheckResult result_;
   std::vector<BoundaryFace> boundary_;
   std::vector<Index> centre_on_quad_;  // four-triangle centres, one per such interface quad

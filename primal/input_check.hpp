@@ -27,6 +27,7 @@
 // - degree: an element of each boundary component (up to max_components) must be covered once by
 //   the winding number of the whole boundary (a part lying inside another one).
 // Elements are assumed to have passed check_geometry (positive corners).
+#include <array>
 #include <cstddef>
 #include <functional>
 #include <string>
@@ -47,6 +48,12 @@ struct InputCheckOptions : Shares {
   double gap_fraction = 0.05;       // a gap thinner than this x the faces' longest edge is refused
   std::size_t max_components = 32;  // boundary components whose degree is checked
   std::size_t max_findings = 8;     // the check stops after this many
+  // When set, filled with the pairs of elements sharing a face, by flat number (submodel.hpp's
+  // element_offsets), in the order the check pairs them: the faces this share pairs (every face
+  // with one share), then each interface quad with the triangles covering it (share 0 only: every
+  // share matches the same interface). What geode_mpi's partition graph is made of, so that the
+  // faces are paired once (parallel/partition.hpp). Complete only when the check finds nothing.
+  std::vector<std::array<Index, 2>>* element_pairs = nullptr;
 };
 
 enum class InputFault {

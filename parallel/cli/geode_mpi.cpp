@@ -6,6 +6,7 @@
 #include <sys/resource.h>
 
 #include <CLI/CLI.hpp>
+#include <array>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -241,10 +242,14 @@ int run(int argc, char** argv, int rank, int size) {
         return again;
       };
       io::FilePartition file_partition;
+      // The check's face pairs make rank 0's partition graph (DistributedOptions).
+      std::vector<std::array<primal::Index, 2>> element_pairs;
+      options.element_pairs = &element_pairs;
       primal::Model model = [&] {
         RankZeroReadWarnings warnings(rank);
-        return io::read_model(input, {}, true, &file_partition,
-                              parallel::shared_input_check(MPI_COMM_WORLD));
+        primal::InputCheckOptions check = parallel::shared_input_check(MPI_COMM_WORLD);
+        check.element_pairs = &element_pairs;
+        return io::read_model(input, {}, true, &file_partition, check);
       }();
       cli::join_block_lists(model, join_blocks, input);
       fail_for_test(rank, "read");

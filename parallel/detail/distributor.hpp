@@ -171,6 +171,8 @@ class Distributor {
       if (!inverted_.empty()) select_rings(options_.rings);
       finish_zone();
     });
+    // Here, before the zone rank leaves for the zone: rank 0 gathers the face pairs.
+    stage("partition", [&] { gather_pairs(); });
     // The zone rank conforms the zone while rank 0 partitions and the others wait for it.
     if (rank_ == zone_rank()) stage("zone", [&] { conform_zone(); });
     stage("partition", [&] { partition(); });
@@ -220,6 +222,7 @@ class Distributor {
   void select_rings(int rings);
   void finish_zone();
   void conform_zone();
+  void gather_pairs();
   void partition();
   void dice();
   void share_zone();
@@ -280,6 +283,10 @@ class Distributor {
   const Model* model_ = nullptr;
   std::array<std::size_t, 5> offsets_{};
   std::vector<int> part_;  // per flat element
+  // On rank 0, gathered by gather_pairs: every rank's face pairs (options_.element_pairs), by
+  // flat element of the model the stages read; none when a rank gave none.
+  std::vector<std::array<Index, 2>> pairs_;
+  bool have_pairs_ = false;
   // Per kind the element diced alone lowest of those outside the zone's first rings (the zone
   // takes them: the serial run's yardstick, and its aims', are the lowest over the whole model).
   std::vector<std::size_t> lowest_;

@@ -10,6 +10,7 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
+#include <array>
 #include <barrier>
 #include <chrono>
 #include <cstdlib>
@@ -25,8 +26,10 @@
 #include <geode/demo/demo_models.hpp>
 #include <geode/io/formats.hpp>
 #include <geode/io/read_model.hpp>
+#include <geode/primal/element_graph.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/input_check.hpp>
+#include <geode/primal/submodel.hpp>
 #include "support/cli_run.hpp"
 #include "support/demo_input.hpp"
 #include "support/temp_dir.hpp"
@@ -43,8 +46,18 @@ namespace {
 // The check shared among `shares` processes as geode_mpi shares it among ranks
 // (InputCheckOptions::share, exchange), here threads meeting at a barrier for the all-gather:
 // every share must find what one process finds, finding for finding.
+// On a model the check passes, the face pairs (InputCheckOptions::element_pairs, geode_mpi's
+// partition graph) too: the shares' together are one process's.
 void require_same_when_shared(const primal::Model& m) {
-  const primal::InputCheckResult one = primal::check_input(m);
+  using Pairs = std::vector<std::array<Index, 2>>;
+  const auto sorted = [](Pairs p) {
+    std::sort(p.begin(), p.end());
+    return p;
+  };
+  Pairs one_pairs;
+  primal::InputCheckOptions with_pairs;
+  with_pairs.element_pairs = &one_pairs;
+  const primal::InputCheckResult one = primal::check_input(m, with_pairs);
   primal::InputCheckOptions alone;  // shares without an exchange: refused, not half a check
   alone.shares = 2;
   CHECK_THROWS_AS(primal::check_input(m, alone), std::invalid_argument);
@@ -53,11 +66,13 @@ void require_same_when_shared(const primal::Model& m) {
     std::vector<std::vector<char>> deposit(static_cast<std::size_t>(shares));
     std::barrier meet(shares);
     std::vector<primal::InputCheckResult> results(deposit.size());
+    std::vector<Pairs> pairs(deposit.size());
     std::vector<std::thread> threads;
     for (int s = 0; s < shares; ++s)
       threads.emplace_back([&, s] {
         primal::InputCheckOptions o;
         o.share = s, o.shares = shares;
+        o.element_pairs = &pairs[static_cast<std::size_t>(s)];
         o.exchange = [&, s](const std::vector<char>& mine) {
           deposit[static_cast<std::size_t>(s)] = mine;
           meet.arrive_and_wait();
@@ -69,6 +84,11 @@ void require_same_when_shared(const primal::Model& m) {
         results[static_cast<std::size_t>(s)] = primal::check_input(m, o);
       });
     for (auto& t : threads) t.join();
+    if (one.ok()) {
+      Pairs joined;
+      for (const Pairs& p : pairs) joined.insert(joined.end(), p.begin(), p.end());
+      CHECK(sorted(joined) == sorted(one_pairs));
+    }
     for (const primal::InputCheckResult& r : results) {
       CHECK(r.boundary_faces == one.boundary_faces);
       CHECK(r.interface_quads == one.interface_quads);
@@ -278,6 +298,39 @@ std::vector<Point> tet_beside(const primal::Model& m, Index c, Index up, bool al
   return p;
 }
 
+// The face pairs of a model the check passes are primal::element_graph's edges, each face once,
+// but where a quad meets triangles: the graph joins a quad to a triangle on three of its nodes,
+// the check a quad to the two or four triangles covering it (four around a centre node share
+// two nodes each with the quad: no edge of the graph).
+void require_face_pairs_are_graph_edges(const primal::Model& m) {
+  std::vector<std::array<Index, 2>> pairs;
+  primal::InputCheckOptions o;
+  o.element_pairs = &pairs;
+  REQUIRE(primal::check_input(m, o).ok());
+  const primal::ElementGraph g = primal::element_graph(m);
+  std::set<std::array<Index, 2>> edges, seen;
+  for (std::size_t e = 0; e + 1 < g.offset.size(); ++e)
+    for (std::size_t k = g.offset[e]; k < g.offset[e + 1]; ++k)
+      edges.insert({primal::index_cast(e), g.neighbour[k]});
+  const auto offsets = primal::element_offsets(m);
+  const auto is_tet = [&](Index e) {
+    const auto i = primal::index_cast<std::size_t>(e);
+    return i >= offsets[1] && i < offsets[2];
+  };
+  for (const auto& [a, b] : pairs) {
+    if (!edges.count({a, b})) CHECK(is_tet(a) != is_tet(b));
+    CHECK(seen.insert({std::min(a, b), std::max(a, b)}).second);  // each face once
+  }
+  std::size_t unpaired = 0, quad_triangle = 0;
+  for (const auto& [a, b] : edges)
+    if (a < b && !seen.count({a, b})) {
+      ++unpaired;
+      quad_triangle += is_tet(a) != is_tet(b);
+    }
+  CHECK(unpaired == quad_triangle);
+  CHECK(!pairs.empty());
+}
+
 }  // namespace
 
 TEST_CASE("input check: every demo model, as saved, covers its domain once") {
@@ -289,6 +342,7 @@ TEST_CASE("input check: every demo model, as saved, covers its domain once") {
     INFO((r.ok() ? std::string() : r.findings[0].text(m)));
     CHECK(r.ok());
     require_same_when_shared(m);
+    require_face_pairs_are_graph_edges(m);
     CHECK(r.boundary_components == 1);
     CHECK(r.boundary_faces > 0);
     // Read again with the check: nothing refused.

@@ -1,15 +1,18 @@
 // parallel::partition_elements with its options, on demo models as users make them (the half
 // model: a hex box beside a tet box meshed together by Gmsh; hexdominant: all four kinds): each
 // part gets its share of the weight within METIS's balance bound, the weights are the caller's
-// when given, the result is the same twice, and options of the wrong size are refused.
+// when given, the result is the same twice, and options of the wrong size are refused; the graph
+// geode_mpi gives it (the read-time check's face pairs, graph_of_pairs) partitions as well.
 #include <doctest/doctest.h>
 
+#include <array>
 #include <cstdint>
 #include <numeric>
 #include <stdexcept>
 #include <vector>
 
 #include <geode/parallel/partition.hpp>
+#include <geode/primal/input_check.hpp>
 #include <geode/primal/submodel.hpp>
 #include "support/demo_input.hpp"
 
@@ -82,6 +85,20 @@ TEST_CASE("partition_elements: parts get their shares, of the dicing weights or 
     std::fill(o.weight.begin(), o.weight.begin() + static_cast<std::ptrdiff_t>(cells / 2), 1);
     o.share = {0.4, 0.6};
     require_shares(partition_elements(m, 2, o), o.weight, o.share);
+    // The graph of the check's face pairs, as geode_mpi's rank 0 has it: balanced as well, and
+    // a different graph (no quad-triangle joins where pairs cover a quad): its own partition.
+    std::vector<std::array<gp::Index, 2>> pairs;
+    gp::InputCheckOptions check;
+    check.element_pairs = &pairs;
+    REQUIRE(gp::check_input(m, check).ok());
+    PartitionOptions given;
+    given.graph = geode::parallel::graph_of_pairs(cells, pairs);
+    CHECK(given.graph.neighbour.size() == 2 * pairs.size());
+    require_shares(partition_elements(m, 2, given), dicing, {0.5, 0.5});
+    given.graph = geode::parallel::graph_of_pairs(cells - 1, {});
+    CHECK_THROWS_AS(partition_elements(m, 2, given), std::invalid_argument);
+    pairs.push_back({0, static_cast<gp::Index>(cells)});
+    CHECK_THROWS_AS(geode::parallel::graph_of_pairs(cells, pairs), std::invalid_argument);
     // Options of the wrong size.
     PartitionOptions bad;
     bad.weight.assign(cells - 1, 1);
