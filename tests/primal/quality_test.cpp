@@ -11,6 +11,7 @@
 #include <string>
 
 #include <geode/primal/errors.hpp>
+#include <geode/primal/detail/scaled_jacobian_paths.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/topology.hpp>
 
@@ -221,6 +222,7 @@ TEST_CASE("hex scaled jacobian: the same number as the nine values' minimum, bit
   // hex_scaled_jacobians' and the bounded form's (a hex above 0 has positive corners), so they
   // must be the same doubles, not just close. Skewed, flat, inverted and collapsed hexes, at
   // scales from 1e-4 to 1e4.
+  const auto paths = gp::detail::scaled_jacobian_paths();
   std::uint64_t state = 12345;
   auto uniform = [&state] {  // 53-bit LCG draws in [0, 1): the same on every platform
     state = state * 6364136223846793005ULL + 1442695040888963407ULL;
@@ -238,6 +240,9 @@ TEST_CASE("hex scaled jacobian: the same number as the nine values' minimum, bit
     const auto q = gp::hex_scaled_jacobians(p);
     const double lowest = *std::min_element(q.begin(), q.end());
     CHECK(gp::hex_scaled_jacobian(p) == lowest);
+    // Both implementations (AVX2 where the processor has it, and SSE2), whichever runs.
+    CHECK(paths.fastest(p) == lowest);
+    CHECK(paths.portable(p) == lowest);
     CHECK(gp::hex_scaled_jacobian_bounded(p, -std::numeric_limits<double>::infinity()) == lowest);
     // With a bound: exact above it, at or below it otherwise.
     const double bound = uniform() - 0.5;
