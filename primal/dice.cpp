@@ -369,23 +369,56 @@ std::vector<std::array<std::vector<int>, 8>> child_weights() {
   return children;
 }
 
+// The children's corners of a diced reference element as its distinct corner subsets (15 for a
+// tet: its corners, edges, faces and centre; 27 for a hex), each child corner naming one: a
+// cell's child corners are then placed once each, not once per child using them (a tet's 32
+// child corners, a hex's 64).
+struct ChildCorners {
+  std::vector<std::vector<int>> subset;  // distinct, as child_weights lists them
+  std::vector<std::array<int, 8>> child;
+};
+
+template <class Mesh, std::size_t N>
+ChildCorners child_corners() {
+  ChildCorners t;
+  for (const auto& w : child_weights<Mesh, N>()) {
+    std::array<int, 8> at{};
+    for (int c = 0; c < 8; ++c) {
+      std::vector<int> key = w[c];
+      std::sort(key.begin(), key.end());
+      auto it = std::find_if(t.subset.begin(), t.subset.end(), [&](const std::vector<int>& s) {
+        std::vector<int> k = s;
+        std::sort(k.begin(), k.end());
+        return k == key;
+      });
+      if (it == t.subset.end()) it = t.subset.insert(t.subset.end(), w[c]);
+      at[c] = static_cast<int>(it - t.subset.begin());
+    }
+    t.child.push_back(at);
+  }
+  return t;
+}
+
 // The lowest scaled Jacobian among one cell's children, each corner placed as dice() places
 // it: the centroid of its edge's or face's nodes in ascending order (origin_centroid's key),
 // of the cell's corners in their order. So the figure is, bit for bit, the minimum over the
 // children a dicing of the same points and numbers makes (conform reads it off them).
-template <std::size_t N, class Children>
+template <std::size_t N>
 double diced_cell_min(std::span<const Point> points, const std::array<Index, N>& cell,
-                      const Children& children) {
+                      const ChildCorners& table) {
+  std::array<Point, 27> place;
+  for (std::size_t s = 0; s < table.subset.size(); ++s) {
+    const std::vector<int>& w = table.subset[s];
+    std::array<Index, N> nodes{};
+    const std::size_t n = w.size();
+    for (std::size_t i = 0; i < n; ++i) nodes[i] = cell[index_cast<std::size_t>(w[i])];
+    if (n < N) std::sort(nodes.begin(), nodes.begin() + static_cast<std::ptrdiff_t>(n));
+    place[s] = corner_centroid(points, std::span<const Index>(nodes.data(), n));
+  }
   double lowest = 1.0;
-  for (const auto& w : children) {
+  for (const auto& at : table.child) {
     HexCorners p;
-    for (int c = 0; c < 8; ++c) {
-      std::array<Index, N> nodes{};
-      const std::size_t n = w[c].size();
-      for (std::size_t i = 0; i < n; ++i) nodes[i] = cell[index_cast<std::size_t>(w[c][i])];
-      if (n < N) std::sort(nodes.begin(), nodes.begin() + static_cast<std::ptrdiff_t>(n));
-      p[c] = corner_centroid(points, std::span<const Index>(nodes.data(), n));
-    }
+    for (int c = 0; c < 8; ++c) p[c] = place[index_cast<std::size_t>(at[c])];
     lowest = std::min(lowest, hex_scaled_jacobian(p));
   }
   return lowest;
@@ -394,7 +427,7 @@ double diced_cell_min(std::span<const Point> points, const std::array<Index, N>&
 // Cells in parallel (TBB): a minimum does not depend on the order it is taken in.
 template <class Mesh, std::size_t N>
 double diced_min(std::span<const Point> points, std::span<const std::array<Index, N>> cells) {
-  static const auto children = child_weights<Mesh, N>();
+  static const auto children = child_corners<Mesh, N>();
   return tbb::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, cells.size(), 4096), 1.0,
       [&](const tbb::blocked_range<std::size_t>& range, double lowest) {
@@ -409,7 +442,7 @@ double diced_min(std::span<const Point> points, std::span<const std::array<Index
 template <class Mesh, std::size_t N>
 std::vector<double> diced_each(std::span<const Point> points,
                                std::span<const std::array<Index, N>> cells) {
-  static const auto children = child_weights<Mesh, N>();
+  static const auto children = child_corners<Mesh, N>();
   std::vector<double> out(cells.size(), 1.0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 4096),
                     [&](const tbb::blocked_range<std::size_t>& range) {

@@ -288,3 +288,28 @@ TEST_CASE("diced_min_scaled_jacobian: the minimum over dice()'s hexes, without d
   CHECK(diced_min_scaled_jacobian(std::vector<Point>{}, std::vector<std::array<Index, 4>>{}) ==
         1.0);
 }
+
+TEST_CASE("diced_scaled_jacobian_per_cell: each cell's children's minimum, bit for bit") {
+  // conform and geode_mpi compare these figures with those read off the diced children: they
+  // must be the same doubles (the children's corners placed as dice() places them).
+  for (double amount : {0.0, 0.08, 0.2}) {
+    CAPTURE(amount);
+    TetMesh t = kuhn_grid(3);
+    jitter(t.points, amount);
+    HexMesh h = structured_hex_grid(3, 2, 2);
+    jitter(h.points, amount);
+    const auto each_tet = diced_scaled_jacobian_per_cell(t.points, t.tets);
+    const auto each_hex = diced_scaled_jacobian_per_cell(h.points, h.hexes);
+    const auto children_min = [](const HexMesh& diced, std::size_t cell, std::size_t per) {
+      double m = 1.0;
+      for (std::size_t k = cell * per; k < (cell + 1) * per; ++k)
+        m = std::min(m, hex_scaled_jacobian(hex_corners(diced, index_cast(k))));
+      return m;
+    };
+    const HexMesh dt = dice(t).mesh, dh = dice(h).mesh;
+    REQUIRE(dt.hexes.size() == 4 * t.tets.size());
+    REQUIRE(dh.hexes.size() == 8 * h.hexes.size());
+    for (std::size_t c = 0; c < t.tets.size(); ++c) CHECK(each_tet[c] == children_min(dt, c, 4));
+    for (std::size_t c = 0; c < h.hexes.size(); ++c) CHECK(each_hex[c] == children_min(dh, c, 8));
+  }
+}
