@@ -232,10 +232,11 @@ void Distributor::conform_zone() {
 
 // The zone rank's load per child of a zone element, against 1 per diced hex elsewhere: the
 // zone's output per child (1.2 on bench_mpi's half 68) with its conform, the check around the
-// cut and writing on one rank. Tuned on half 68, 2 ranks: rank 0 waits about 0.6-0.7 s for the
-// zone rank whether this is 1.8 or 2.6 (the zone's conform, 1.9 s, is what it waits for; the
-// same wall time), so it balances the ranks' peaks instead: 1.8, 2.0, 2.3 and 2.6 gave
-// 572 / 536, 595 / 556, 605 / 544 and 617 / 537 MiB (rank 0 / the zone rank).
+// cut and writing on one rank. Tuned on half 68, 2 ranks: rank 0 waits 0.19-0.29 s for the zone
+// rank with 1.8 and 0.07-0.17 s with 2.6, for the same wall time (the zone's conform, on both
+// cores while rank 0 partitions and dices, is what it waits for), so it balances the ranks'
+// peaks instead: 1.8, 2.2, 2.6 and 3.4 gave 562 / 515, 576 / 498, 587 / 483 and 617 / 457 MiB
+// (rank 0 / the zone rank; 0.6 x the serial peak is 590).
 constexpr double kZoneLoad = 1.8;
 
 // Every rank's face pairs to rank 0, in rank order (each rank's are the faces whose lowest node

@@ -6,7 +6,9 @@
 #include <Eigen/Dense>
 #if defined(__SSE2__)
 #include <emmintrin.h>
+#if defined(__x86_64__)
 #include <immintrin.h>
+#endif
 #endif
 #include <algorithm>
 #include <cmath>
