@@ -244,10 +244,14 @@ TEST_CASE("hex scaled jacobian: the same number as the nine values' minimum, bit
     CHECK(paths.fastest(p) == lowest);
     CHECK(paths.portable(p) == lowest);
     CHECK(gp::hex_scaled_jacobian_bounded(p, -std::numeric_limits<double>::infinity()) == lowest);
+    CHECK(paths.fastest_bounded(p, -std::numeric_limits<double>::infinity()) == lowest);
+    CHECK(paths.portable_bounded(p, -std::numeric_limits<double>::infinity()) == lowest);
     // With a bound: exact above it, at or below it otherwise.
     const double bound = uniform() - 0.5;
-    const double bounded = gp::hex_scaled_jacobian_bounded(p, bound);
-    CHECK((lowest > bound ? bounded == lowest : bounded <= bound));
+    for (const double bounded :
+         {gp::hex_scaled_jacobian_bounded(p, bound), paths.fastest_bounded(p, bound),
+          paths.portable_bounded(p, bound)})
+      CHECK((lowest > bound ? bounded == lowest : bounded <= bound));
   }
 }
 
