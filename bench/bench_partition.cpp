@@ -1,9 +1,12 @@
 // geode_mpi's partition stage (parallel::partition_elements) on a demo model: seconds, the parts'
 // weights (the hexes each part's elements dice into, the balance METIS is asked for) and the
-// edge cut (element faces between parts, primal::element_graph) for 2, 3 and 4 parts.
+// edge cut (element faces between parts, primal::element_graph) for 2, 3 and 4 parts; then as
+// geode_mpi's rank 0 partitions, on the graph of the read-time check's face pairs: what keeping
+// the pairs adds to the check, the graph made of them, and its 2-part partition.
 // Usage: bench_partition [model] [n] [workdir]   (default half 64 /tmp/geode_bench_partition;
 // the model is built with Gmsh once and kept there as MODEL-N.exo, read back as geode_mpi does)
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -17,6 +20,7 @@
 #include <geode/io/read_model.hpp>
 #include <geode/parallel/partition.hpp>
 #include <geode/primal/element_graph.hpp>
+#include <geode/primal/input_check.hpp>
 #include <geode/primal/submodel.hpp>
 
 namespace gp = geode::primal;
@@ -103,6 +107,33 @@ int main(int argc, char** argv) {
                 static_cast<double>(*std::max_element(sum.begin(), sum.end())) * parts /
                     static_cast<double>(total),
                 cut / 2, pieces(g, part));
+  }
+  // geode_mpi's way: the check keeps its face pairs, rank 0 makes the graph of them.
+  {
+    const Clock plain;
+    const bool ok = gp::check_input(m).ok();
+    const double check_s = plain.cpu_s();
+    std::vector<std::array<gp::Index, 2>> pairs;
+    gp::InputCheckOptions o;
+    o.element_pairs = &pairs;
+    const Clock kept;
+    const bool ok_kept = gp::check_input(m, o).ok();
+    const double kept_s = kept.cpu_s();
+    const Clock made;
+    geode::parallel::PartitionOptions po;
+    po.graph = geode::parallel::graph_of_pairs(gp::element_offsets(m).back(), pairs);
+    std::printf(
+        "check %.2f s CPU, keeping its face pairs %.2f s CPU (%s); their graph %.3f s "
+        "(%zu pairs)\n",
+        check_s, kept_s, ok && ok_kept ? "passed" : "FAILED", made.wall_s(), pairs.size());
+    const Clock t;
+    const auto part = geode::parallel::partition_elements(m, 2, std::move(po));
+    std::size_t cut = 0;
+    for (std::size_t e = 0; e < part.size(); ++e)
+      for (std::size_t k = g.offset[e]; k < g.offset[e + 1]; ++k)
+        cut += part[gp::index_cast<std::size_t>(g.neighbour[k])] != part[e];
+    std::printf("2 parts of that graph: %.2f s (%.2f s CPU), edge cut %zu faces\n", t.wall_s(),
+                t.cpu_s(), cut / 2);
   }
   return 0;
 }
