@@ -929,8 +929,9 @@ ConformResult conform_model(const primal::Model& input, primal::Model* spare,
         // they would leave holes whose walls are interface quads as high as the layer's cells
         // (buffer hexes there inverted or flat, or two layer hexes meeting along an edge only).
         // The layer's whole pieces of hexes and wedges become tets, diced with the tets around
-        // them: split again from the input as given, the pyramids last, on the diagonals the
-        // layer's tets give them (each hex split as best suits its tets and its pyramids').
+        // them: split again from the input as given, in the order above (pyramids, wedges, then
+        // the hexes on the diagonals those give them), as geode_mpi's zone, whose pyramids come
+        // split, does.
         const primal::CellPieces layer = primal::cell_pieces(*model, pieces);
         for (Index w : layer.wedges)
           wedges_split.push_back(wedge_origin[primal::index_cast<std::size_t>(w)]);
@@ -950,10 +951,10 @@ ConformResult conform_model(const primal::Model& input, primal::Model* spare,
           options.progress("layer: " + std::to_string(layer.hexes.size()) + " hexes and " +
                            std::to_string(layer.wedges.size()) +
                            " wedges split into tets (wedges through a thin layer between tets)");
-        const primal::Model wedges = primal::split_wedges(input, wedges_split);
-        const primal::Model hexes = primal::split_hexes(wedges, hexes_split);
-        hex_tets = primal::index_cast(hexes.tets.size() - wedges.tets.size());
-        own = primal::split_pyramids(hexes, true).model;
+        const primal::Model wedges = primal::split_wedges(
+            input.pyramids.empty() ? input : primal::split_pyramids(input).model, wedges_split);
+        own = primal::split_hexes(wedges, hexes_split);
+        hex_tets = primal::index_cast(own.tets.size() - wedges.tets.size());
         model = owned = &own;
         wedge_origin = remaining(input.wedges.size(), wedges_split);
         hex_origin = remaining(input.hexes.size(), hexes_split);

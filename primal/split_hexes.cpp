@@ -7,7 +7,6 @@
 #include <geode/primal/disjoint_sets.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/key_map.hpp>
-#include <geode/primal/split_pyramids.hpp>
 
 namespace geode::primal {
 
@@ -270,12 +269,6 @@ Model split_hexes(const Model& model, std::span<const Index> hexes) {
       if (!fresh) ++*count;
     }
   std::vector<Index> tet_count(model.hexes.size(), 0);
-  // The pyramids' bases -> the pyramid on it.
-  KeyMap<4> bases(model.pyramids.size());
-  for (std::size_t p = 0; p < model.pyramids.size(); ++p) {
-    const auto& b = model.pyramids[p];
-    bases.try_emplace(face_key(std::array<Index, 4>{b[0], b[1], b[2], b[3]}), index_cast(p));
-  }
   for (std::size_t h = 0; h < model.hexes.size(); ++h) {
     const ElementRef ref{ElementKind::kHex, index_cast(h)};
     if (!split[h]) {
@@ -286,15 +279,12 @@ Model split_hexes(const Model& model, std::span<const Index> hexes) {
     }
     const auto& c = model.hexes[h];
     // Each face's diagonal: the tets' on it, else through the lowest node where another split
-    // hex shares the face, else (a pyramid's base, the boundary) either.
+    // hex shares the face, else (on the boundary) either.
     std::array<int, 6> want{};
-    std::array<Index, 6> pyramid{};
     for (std::size_t f = 0; f < 6; ++f) {
       const auto& fc = topology::kHexFaceCorners[f];
       std::array<Index, 4> v{};
       for (std::size_t i = 0; i < 4; ++i) v[i] = c[index_cast<std::size_t>(fc[i])];
-      const Index* p = bases.find(face_key(v));
-      pyramid[f] = p ? *p : kInvalidIndex;
       if (has(v[0], v[1], v[2]) && has(v[0], v[2], v[3])) {
         want[f] = 0;
       } else if (has(v[0], v[1], v[3]) && has(v[1], v[2], v[3])) {
@@ -305,8 +295,7 @@ Model split_hexes(const Model& model, std::span<const Index> hexes) {
         want[f] = -1;
       }
     }
-    // The triangulation whose tets, and the tets of the pyramids on the hex split along its
-    // diagonals (split_pyramids follows them), dice best.
+    // The triangulation with those diagonals whose tets dice best.
     std::vector<std::array<Index, 4>> best;
     double best_quality = -2.0;
     for (const Triangulation& t : cube_triangulations()) {
@@ -317,20 +306,12 @@ Model split_hexes(const Model& model, std::span<const Index> hexes) {
       for (const auto& x : t.tets)
         tets.push_back({c[index_cast<std::size_t>(x[0])], c[index_cast<std::size_t>(x[1])],
                         c[index_cast<std::size_t>(x[2])], c[index_cast<std::size_t>(x[3])]});
-      double q = diced_min_scaled_jacobian(model.points, tets);
-      for (std::size_t f = 0; f < 6; ++f) {
-        if (pyramid[f] == kInvalidIndex) continue;
-        const auto& base = model.pyramids[index_cast<std::size_t>(pyramid[f])];
-        const Index a = c[index_cast<std::size_t>(
-            topology::kHexFaceCorners[f][index_cast<std::size_t>(t.diagonal[f])])];
-        const int d = a == base[0] || a == base[2] ? 0 : 1;
-        q = std::min(q, diced_min_scaled_jacobian(model.points, pyramid_tets(base, d)));
-      }
+      const double q = diced_min_scaled_jacobian(model.points, tets);
       if (best.empty() || q > best_quality) best = std::move(tets), best_quality = q;
     }
-    // None fits, or the best has a tet inverted (one of the hex's or of a pyramid on it: the
-    // 18 choices of six diagonals no triangulation has, forced by its neighbours): its centre
-    // as a node of its own, coned over its faces' triangles, fits any.
+    // None fits (the 18 choices of six diagonals no triangulation has, which the tets on its
+    // faces can force), or the best has a tet inverted: its centre as a node of its own, coned
+    // over its faces' triangles, fits any.
     if (best.empty() || best_quality <= 0.0) {
       const Point centre = [&] {
         Point p = Point::Zero();
@@ -338,24 +319,13 @@ Model split_hexes(const Model& model, std::span<const Index> hexes) {
         return p;
       }();
       const Index node = index_cast(m.points.size());
-      std::vector<Point> points = model.points;
+      std::vector<Point> points = m.points;  // with the centres added before
       points.push_back(centre);
       std::vector<std::array<Index, 4>> tets;
-      double q = 2.0;
       for (std::size_t f = 0; f < 6; ++f) {
         const auto& fc = topology::kHexFaceCorners[f];
         int d = want[f];
-        if (d < 0 && pyramid[f] != kInvalidIndex) {  // the pyramid's better diagonal
-          const auto& base = model.pyramids[index_cast<std::size_t>(pyramid[f])];
-          std::array<double, 2> pq{};
-          for (int k = 0; k < 2; ++k)
-            pq[index_cast<std::size_t>(k)] =
-                diced_min_scaled_jacobian(model.points, pyramid_tets(base, k));
-          const int better = pq[1] > pq[0] ? 1 : 0;
-          const Index a = c[index_cast<std::size_t>(fc[0])];
-          d = (a == base[0] || a == base[2]) == (better == 0) ? 0 : 1;
-          q = std::min(q, pq[index_cast<std::size_t>(better)]);
-        } else if (d < 0) {
+        if (d < 0) {
           std::array<Index, 4> v{};
           for (std::size_t i = 0; i < 4; ++i) v[i] = c[index_cast<std::size_t>(fc[i])];
           d = index_cast<int>(std::min_element(v.begin(), v.end()) - v.begin()) % 2;
@@ -369,7 +339,7 @@ Model split_hexes(const Model& model, std::span<const Index> hexes) {
                                 : std::array<Index, 4>{at(0), at(3), at(2), node});
         }
       }
-      q = std::min(q, diced_min_scaled_jacobian(points, tets));
+      const double q = diced_min_scaled_jacobian(points, tets);
       if (best.empty() || q > best_quality) {
         best = std::move(tets), best_quality = q;
         m.points.push_back(centre);

@@ -6,18 +6,16 @@
 // hexes inverted or flat, or two layer hexes meeting along an edge only between two holes);
 // as tets, the whole layer is diced with the tets around it and needs no buffer layer.
 //
-// A quad face takes the diagonal the tets already on it have (a split wedge's, the tet part's),
-// else, where two split hexes share it, the one through its lowest node, so the tets conform; a
-// pyramid's base or a boundary face either. Each hex then takes the triangulation of the cube
-// by its corners (74: two of 5 tets, the rest of 6) that has those diagonals and whose tets,
-// with those of the pyramids on it split along its diagonals (split_pyramids with
-// keep_tet_diagonals, after), dice best. By the lowest-node rule alone one always has them (the
-// cone from the hex's lowest corner: Dompierre, Labbe, Vallet, Camarero, "How to subdivide
-// pyramids, prisms and hexahedra into tetrahedra", IMR 1999); 18 of the 64 choices of six
-// diagonals have none, which its neighbours can force (a pyramid's base then taking its better
-// diagonal, and a pyramid with one diagonal only, inverted the other way, is Gmsh's on a curved
-// layer). A hex none fits, or whose best has an inverted tet, gets its centre as a node of its
-// own, coned over its faces' triangles: 12 tets.
+// A quad face takes the diagonal the tets already on it have (a split pyramid's or wedge's, the
+// tet part's), else, where two split hexes share it, the one through its lowest node, so the tets
+// conform; on the boundary either. Each hex then takes the triangulation of the cube by its
+// corners (74: two of 5 tets, the rest of 6) that has those diagonals and whose tets dice best.
+// By the lowest-node rule alone one always has them (the cone from the hex's lowest corner:
+// Dompierre, Labbe, Vallet, Camarero, "How to subdivide pyramids, prisms and hexahedra into
+// tetrahedra", IMR 1999); 18 of the 64 choices of six diagonals have none, which the tets on its
+// faces can force (Gmsh's pyramids on both sides of a layer, split first). A hex none fits, or
+// whose best has an inverted tet, gets its centre as a node of its own, coned over its faces'
+// triangles: 12 tets.
 
 #include <array>
 #include <span>

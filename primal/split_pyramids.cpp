@@ -3,9 +3,7 @@
 #include <algorithm>
 #include <map>
 
-#include <geode/primal/boundary.hpp>
 #include <geode/primal/dice.hpp>
-#include <geode/primal/key_map.hpp>
 
 namespace geode::primal {
 
@@ -14,7 +12,7 @@ std::array<std::array<Index, 4>, 2> pyramid_tets(const std::array<Index, 5>& p, 
   return {{{p[0], p[1], p[3], p[4]}, {p[1], p[2], p[3], p[4]}}};
 }
 
-PyramidSplit split_pyramids(const Model& model, bool keep_tet_diagonals) {
+PyramidSplit split_pyramids(const Model& model) {
   PyramidSplit out;
   out.model = model;
   Model& m = out.model;
@@ -44,34 +42,10 @@ PyramidSplit split_pyramids(const Model& model, bool keep_tet_diagonals) {
     const Index a = c[index_cast<std::size_t>(d)], b = c[index_cast<std::size_t>(d + 2)];
     return std::pair<Index, Index>{std::min(a, b), std::max(a, b)};
   };
-  // The bases' triangles the model's tets have (a diagonal's two triangles: that diagonal).
-  KeyMap<4> forced;
-  if (keep_tet_diagonals) {
-    KeyMap<4> wanted(8 * by_base.size());
-    for (std::size_t p = 0; p < np; ++p)
-      for (int d = 0; d < 2; ++d)
-        for (const auto& t : pyramid_tets(model.pyramids[p], d))
-          wanted.try_emplace(face_key(std::array<Index, 3>{t[0], t[1], t[2]}), 0);
-    for (const auto& t : model.tets)
-      for (const auto& f : topology::kTetFaceCorners) {
-        const auto key = face_key(std::array<Index, 3>{t[index_cast<std::size_t>(f[0])],
-                                                       t[index_cast<std::size_t>(f[1])],
-                                                       t[index_cast<std::size_t>(f[2])]});
-        if (wanted.find(key)) forced.try_emplace(key, 0);
-      }
-  }
-  auto tets_have = [&](std::size_t p, int d) {
-    for (const auto& t : pyramid_tets(model.pyramids[p], d))
-      if (!forced.find(face_key(std::array<Index, 3>{t[0], t[1], t[2]}))) return false;
-    return true;
-  };
   for (const auto& [key, members] : by_base) {
     double best = -2.0;
     std::pair<Index, Index> chosen{};
-    bool kept = false;
-    for (int d = 0; d < 2 && forced.size() > 0 && !kept; ++d)
-      if (tets_have(members.front(), d)) chosen = pair_of(members.front(), d), kept = true;
-    for (int d = 0; d < 2 && !kept; ++d) {
+    for (int d = 0; d < 2; ++d) {
       const auto diagonal = pair_of(members.front(), d);
       double worst = 2.0;
       for (std::size_t p : members)

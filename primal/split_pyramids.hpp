@@ -26,8 +26,6 @@ struct PyramidSplit {
 // positively oriented for a pyramid whose base is counter-clockwise seen from the apex.
 std::array<std::array<Index, 4>, 2> pyramid_tets(const std::array<Index, 5>& p, int diagonal);
 
-// keep_tet_diagonals: a base quad the model's tets already split into two triangles (a hex split
-// into tets under it, primal/split_hexes.hpp) takes their diagonal, so the tets conform.
-PyramidSplit split_pyramids(const Model& model, bool keep_tet_diagonals = false);
+PyramidSplit split_pyramids(const Model& model);
 
 }  // namespace geode::primal
