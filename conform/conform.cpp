@@ -849,11 +849,27 @@ constexpr primal::RelaxTetsOptions kRelax{
 
 namespace {
 
-// A layer through which wedges join tets on its two sides is split into tets where its cells are
-// lower than this of their width: flatter than 2.5 : 1, the hex cells whose buffer hexes
-// Conformer::thicker_from_tets finds too flat (kThinHexBuffer: half the cell's height below
-// 0.2 of its width), and at the holes there is no thicker side to carve from.
+// A layer through which wedges join tets on its two sides is split into tets where its wedge
+// columns' cells are lower than this of their width: flatter than 2.5 : 1, the hex cells whose
+// buffer hexes Conformer::thicker_from_tets finds too flat (kThinHexBuffer: half the cell's
+// height below 0.2 of its width), and at the holes there is no thicker side to carve from.
 constexpr double kThinLayerCells = 0.4;
+// ... and where every hex of it is flatter than this (hex_flatness): a layer's, not a thick
+// part's (cube-like, near 1). Gmsh's layers 0.1 thick reach 0.53 at their narrowest quads.
+constexpr double kLayerHex = 2.0 / 3.0;
+
+// How flat a hex is: the mean length of its edges along its flattest direction over that along
+// its longest.
+double hex_flatness(const primal::Model& m, const std::array<Index, 8>& h) {
+  std::array<double, 3> mean{};
+  for (std::size_t e = 0; e < primal::topology::kHexEdgeCorners.size(); ++e) {
+    const auto& c = primal::topology::kHexEdgeCorners[e];
+    mean[e / 4] += (m.points[primal::index_cast<std::size_t>(h[static_cast<std::size_t>(c[1])])] -
+                    m.points[primal::index_cast<std::size_t>(h[static_cast<std::size_t>(c[0])])])
+                       .norm();
+  }
+  return *std::min_element(mean.begin(), mean.end()) / *std::max_element(mean.begin(), mean.end());
+}
 
 // conform() on `input`; `spare`: the same model when the caller gives it up (the Model&&
 // overload), then relaxed in place instead of copied, and trimmed once the buffer layer holds
@@ -923,8 +939,18 @@ ConformResult conform_model(const primal::Model& input, primal::Model* spare,
       // again; a hex quad they covered may join another piece to the sides, hence the loop.
       if (!given.empty()) owned->points = std::move(given);
       const std::vector<Index> pieces = primal::wedge_pieces(*model, joining);
-      if (const primal::WedgeColumns columns = primal::wedge_columns(*model, pieces);
-          columns.through && columns.height_ratio < kThinLayerCells) {
+      const primal::WedgeColumns columns = primal::wedge_columns(*model, pieces);
+      primal::CellPieces layer;
+      if (columns.through && columns.height_ratio < kThinLayerCells)
+        layer = primal::cell_pieces(*model, pieces);
+      // Only a layer: one joined to a thick part would take it along; it keeps the holes (and
+      // their buffer hexes) instead.
+      const bool thin =
+          !layer.hexes.empty() && std::all_of(layer.hexes.begin(), layer.hexes.end(), [&](Index h) {
+            return hex_flatness(*model, model->hexes[primal::index_cast<std::size_t>(h)]) <
+                   kLayerHex;
+          });
+      if (thin) {
         // Wedges go through a thin layer from tets on one side to tets on the other: split,
         // they would leave holes whose walls are interface quads as high as the layer's cells
         // (buffer hexes there inverted or flat, or two layer hexes meeting along an edge only).
@@ -932,7 +958,6 @@ ConformResult conform_model(const primal::Model& input, primal::Model* spare,
         // them: split again from the input as given, in the order above (pyramids, wedges, then
         // the hexes on the diagonals those give them), as geode_mpi's zone, whose pyramids come
         // split, does.
-        const primal::CellPieces layer = primal::cell_pieces(*model, pieces);
         for (Index w : layer.wedges)
           wedges_split.push_back(wedge_origin[primal::index_cast<std::size_t>(w)]);
         for (Index h : layer.hexes)
