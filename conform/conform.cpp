@@ -978,7 +978,13 @@ ConformResult conform_model(const primal::Model& input, primal::Model* spare,
                            " wedges split into tets (wedges through a thin layer between tets)");
         const primal::Model wedges = primal::split_wedges(
             input.pyramids.empty() ? input : primal::split_pyramids(input).model, wedges_split);
-        own = primal::split_hexes(wedges, hexes_split);
+        try {
+          own = primal::split_hexes(wedges, hexes_split);
+        } catch (const TopologyError& e) {
+          throw TopologyError(std::string(e.what()) +
+                              " (a hex of the thin layer wedges go through between tets, "
+                              "split into tets since no buffer layer fits at their holes)");
+        }
         hex_tets = primal::index_cast(own.tets.size() - wedges.tets.size());
         model = owned = &own;
         wedge_origin = remaining(input.wedges.size(), wedges_split);

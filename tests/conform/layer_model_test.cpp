@@ -14,6 +14,7 @@
 #include <geode/conform/conform.hpp>
 #include <geode/io/read_model.hpp>
 #include <geode/primal/boundary.hpp>
+#include <geode/primal/errors.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/validity.hpp>
 
@@ -116,6 +117,19 @@ TEST_CASE("a thin hex layer with wedges through it between tets is split into te
       CHECK(std::abs(side_set_area(r.model, r.model.side_sets[1]) - area) <= 1e-2 * area);
     }
   }
+}
+
+TEST_CASE("a layer too thin for its faces' curvature is refused by name, not written invalid") {
+  // 0.02 thick in 2 cells on a radius of 0.4: a hex has no positive split on the diagonals its
+  // pyramids force (before: valid at 0.0012, 0.04 x the yardstick, or exit 4 from the tet side).
+  const test::TempDir dir;
+  const primal::Model input = layer_model(dir, "cylinder 5 out 0.02");
+  REQUIRE(!input.wedges.empty());
+  CHECK_THROWS_WITH_AS(conform::conform(input),
+                       doctest::Contains("leave no way to split it into positive tets, on its "
+                                         "corners or with its centre (a hex of the thin layer"),
+                       TopologyError);
+  CHECK_THROWS_WITH_AS(conform::conform(input), doctest::Contains("hex "), TopologyError);
 }
 
 TEST_CASE("the same layer recombined into quads only keeps its hexes and gets the geode") {
