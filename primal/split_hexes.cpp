@@ -318,9 +318,10 @@ Model split_hexes(const Model& model, std::span<const Index> hexes) {
         for (Index v : c) p += model.points[index_cast<std::size_t>(v)] / 8.0;
         return p;
       }();
-      const Index node = index_cast(m.points.size());
-      std::vector<Point> points = m.points;  // with the centres added before
-      points.push_back(centre);
+      // Measured on the hex's own 9 points (its corners, then the centre: local numbers).
+      std::vector<Point> local;
+      for (Index v : c) local.push_back(model.points[index_cast<std::size_t>(v)]);
+      local.push_back(centre);
       std::vector<std::array<Index, 4>> tets;
       for (std::size_t f = 0; f < 6; ++f) {
         const auto& fc = topology::kHexFaceCorners[f];
@@ -333,14 +334,17 @@ Model split_hexes(const Model& model, std::span<const Index> hexes) {
         // Its two triangles, outward, coned to the centre inside: (a, c, b, centre).
         for (int k : {1, 2}) {
           const auto at = [&](int i) {
-            return c[index_cast<std::size_t>(fc[index_cast<std::size_t>((d + i) % 4)])];
+            return index_cast(fc[index_cast<std::size_t>((d + i) % 4)]);
           };
-          tets.push_back(k == 1 ? std::array<Index, 4>{at(0), at(2), at(1), node}
-                                : std::array<Index, 4>{at(0), at(3), at(2), node});
+          tets.push_back(k == 1 ? std::array<Index, 4>{at(0), at(2), at(1), 8}
+                                : std::array<Index, 4>{at(0), at(3), at(2), 8});
         }
       }
-      const double q = diced_min_scaled_jacobian(points, tets);
+      const double q = diced_min_scaled_jacobian(local, tets);
       if (best.empty() || q > best_quality) {
+        const Index node = index_cast(m.points.size());
+        for (auto& t : tets)
+          for (Index& v : t) v = v == 8 ? node : c[index_cast<std::size_t>(v)];
         best = std::move(tets), best_quality = q;
         m.points.push_back(centre);
         if (!m.node_ids.empty())
