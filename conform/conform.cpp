@@ -18,7 +18,6 @@
 #include <geode/primal/dice.hpp>
 #include <geode/primal/dice_model.hpp>
 #include <geode/primal/errors.hpp>
-#include <geode/primal/input_check.hpp>
 #include <geode/primal/interface.hpp>
 #include <geode/primal/multilinear.hpp>
 #include <geode/primal/quality.hpp>
@@ -986,12 +985,6 @@ ConformResult conform_model(const primal::Model& input, primal::Model* spare,
                               " (a hex of the thin layer wedges go through between tets, "
                               "split into tets since no buffer layer fits at their holes)");
         }
-        // Checked as the input was: the split must cover the layer once, conforming (a hex face
-        // under four tet triangles, which no split of the hex follows, would not).
-        if (const primal::InputCheckResult c = primal::check_input(own); !c.ok())
-          throw TopologyError(c.findings.front().text(own) +
-                              " (after splitting the thin hex layer wedges go through between "
-                              "tets into tets)");
         hex_tets = primal::index_cast(own.tets.size() - wedges.tets.size());
         model = owned = &own;
         wedge_origin = remaining(input.wedges.size(), wedges_split);
