@@ -1,6 +1,8 @@
 #include <geode/primal/split_hexes.hpp>
 
 #include <algorithm>
+#include <map>
+#include <utility>
 
 #include <geode/primal/boundary.hpp>
 #include <geode/primal/dice.hpp>
@@ -269,6 +271,22 @@ Model split_hexes(const Model& model, std::span<const Index> hexes) {
       if (!fresh) ++*count;
     }
   std::vector<Index> tet_count(model.hexes.size(), 0);
+  // The edges of split hexes' faces -> the third nodes of the tet triangles on them: a face
+  // under four tet triangles around a node (a four-triangle interface) has that node on all
+  // four of its edges, and no split of the hex follows it.
+  std::map<std::pair<Index, Index>, std::vector<Index>> thirds;
+  auto edge = [](Index a, Index b) { return std::pair{std::min(a, b), std::max(a, b)}; };
+  for (Index h : hexes)
+    for (const auto& e : topology::kHexEdgeCorners)
+      thirds[edge(model.hexes[index_cast<std::size_t>(h)][index_cast<std::size_t>(e[0])],
+                  model.hexes[index_cast<std::size_t>(h)][index_cast<std::size_t>(e[1])])];
+  for (const auto& t : model.tets)
+    for (const auto& f : topology::kTetFaceCorners)
+      for (std::size_t i = 0; i < 3; ++i) {
+        const auto it = thirds.find(
+            edge(t[index_cast<std::size_t>(f[i])], t[index_cast<std::size_t>(f[(i + 1) % 3])]));
+        if (it != thirds.end()) it->second.push_back(t[index_cast<std::size_t>(f[(i + 2) % 3])]);
+      }
   for (std::size_t h = 0; h < model.hexes.size(); ++h) {
     const ElementRef ref{ElementKind::kHex, index_cast(h)};
     if (!split[h]) {
@@ -293,6 +311,25 @@ Model split_hexes(const Model& model, std::span<const Index> hexes) {
         want[f] = index_cast<int>(std::min_element(v.begin(), v.end()) - v.begin()) % 2;
       } else {
         want[f] = -1;
+        // The centre: of the nodes on all four edges (the tets' apexes over the fan are too),
+        // the nearest the face's middle.
+        Index centre = kInvalidIndex;
+        double nearest = 0.0;
+        Point middle = Point::Zero();
+        for (Index u : v) middle += model.points[index_cast<std::size_t>(u)] / 4.0;
+        for (Index x : thirds.at(edge(v[0], v[1]))) {
+          bool fan = std::find(c.begin(), c.end(), x) == c.end();
+          for (std::size_t i = 1; i < 4 && fan; ++i) {
+            const auto& o = thirds.at(edge(v[i], v[(i + 1) % 4]));
+            fan = std::find(o.begin(), o.end(), x) != o.end();
+          }
+          const double d = (model.points[index_cast<std::size_t>(x)] - middle).norm();
+          if (fan && (centre == kInvalidIndex || d < nearest)) centre = x, nearest = d;
+        }
+        if (centre != kInvalidIndex)
+          throw TopologyError(describe_element(model, ref) + ": its face of nodes " +
+                              node_list(model, v) + " lies under four tet triangles around " +
+                              describe_node(model, centre) + ", which no split of it follows");
       }
     }
     // The triangulation with those diagonals whose tets dice best.

@@ -47,7 +47,8 @@ WedgeColumns wedge_columns(const Model& model, std::span<const Index> wedges);
 // hex's in hex order, in the hex's block with its file id; its other hexes kept in order; a
 // centre node appended for each hex split around one (the next file id); side sets on a split
 // hex's faces moved to its tets' faces on them (two on a quad). Throws TopologyError naming a hex
-// no split of which into positive tets has the diagonals its neighbours give it.
+// no split of which into positive tets has the diagonals its neighbours give it, or one with a
+// face under four tet triangles around a node (which no split of it follows).
 Model split_hexes(const Model& model, std::span<const Index> hexes);
 
 }  // namespace geode::primal

@@ -1,7 +1,7 @@
 // Hexes as tets (primal/split_hexes.hpp): a grid split whole conforms and fills it, its sides
 // moved onto the tets; by the lowest-node rule alone every hex splits on its corners whatever its
 // numbering; diagonals no triangulation of the cube has (tets on its faces force them) get the
-// hex's centre as a node.
+// hex's centre as a node; a face under four tet triangles (no split follows it) is refused.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -120,4 +120,26 @@ TEST_CASE("split_hexes: diagonals no triangulation of the cube has give the hex 
   }
   CHECK(sum == doctest::Approx(1.0));
   CHECK(primal::check_input(s).ok());
+}
+
+TEST_CASE("split_hexes: a face under four tet triangles around a node is refused by name") {
+  // No split of the hex follows the fan of four triangles on its top face: without the refusal
+  // its tets would leave that face unmatched.
+  primal::Model m;
+  for (const auto& c : primal::topology::kHexCornerCoords)
+    m.points.push_back(Point(c[0], c[1], c[2]));
+  primal::add_element(m, ElementKind::kHex, std::array<Index, 8>{0, 1, 2, 3, 4, 5, 6, 7}, 1, 1);
+  m.points.push_back(Point(0.5, 0.5, 1.0));  // the fan's centre, on the top face
+  m.points.push_back(Point(0.5, 0.5, 1.5));  // an apex above it
+  const std::array<Index, 4> top{4, 5, 6, 7};
+  for (std::size_t i = 0; i < 4; ++i)
+    primal::add_element(m, ElementKind::kTet, std::array<Index, 4>{top[i], top[(i + 1) % 4], 8, 9},
+                        2, static_cast<std::int64_t>(i) + 1);
+  for (const auto& t : m.tets) REQUIRE(volume(m, t) > 0.0);
+  REQUIRE(primal::check_input(m).ok());
+  CHECK_THROWS_WITH_AS(
+      primal::split_hexes(m, std::vector<Index>{0}),
+      doctest::Contains("hex 1 (centre (0.5, 0.5, 0.5)): its face of nodes 5 6 7 8 "
+                        "lies under four tet triangles around node 9"),
+      TopologyError);
 }
