@@ -59,7 +59,9 @@ struct ConformArgs {
 };
 
 void print_summary(const conform::ConformResult& r, std::ostream& os, bool tables) {
-  os << "input: " << r.input_hexes << " hexes, " << r.input_tets << " tets, ";
+  os << "input: " << r.input_hexes << " hexes, ";
+  if (r.hexes_split) os << r.hexes_split << " of them split into tets, ";
+  os << r.input_tets << " tets, ";
   if (r.input_pyramids) os << r.input_pyramids << " pyramids (split), ";
   if (r.input_wedges) os << r.input_wedges << " wedges, ";
   if (r.wedges_split) os << r.wedges_split << " of them split into tets, ";
@@ -90,7 +92,8 @@ void print_summary(const conform::ConformResult& r, std::ostream& os, bool table
   os << "input diced alone: min scaled Jacobian " << r.input_diced_hex_min_scaled_jacobian
      << " (hexes), " << r.input_diced_tet_min_scaled_jacobian << " (tets"
      << (r.input_pyramids ? ", pyramids as their two tets" : "")
-     << (r.wedges_split ? ", split wedges as their three" : "") << ")";
+     << (r.wedges_split ? ", split wedges as their three" : "")
+     << (r.hexes_split ? ", split hexes as their tets" : "") << ")";
   if (r.input_wedges > r.wedges_split)
     os << ", " << r.input_diced_wedge_min_scaled_jacobian << " (wedges)";
   os << "; output " << output;

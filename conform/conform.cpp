@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <span>
 #include <sstream>
 #include <unordered_map>
@@ -22,6 +23,7 @@
 #include <geode/primal/quality.hpp>
 #include <geode/primal/relax_tets.hpp>
 #include <geode/primal/release.hpp>
+#include <geode/primal/split_hexes.hpp>
 #include <geode/primal/split_pyramids.hpp>
 #include <geode/primal/split_wedges.hpp>
 #include <geode/primal/topology.hpp>
@@ -847,6 +849,28 @@ constexpr primal::RelaxTetsOptions kRelax{
 
 namespace {
 
+// A layer through which wedges join tets on its two sides is split into tets where its wedge
+// columns' cells are lower than this of their width: flatter than 2.5 : 1, the hex cells whose
+// buffer hexes Conformer::thicker_from_tets finds too flat (kThinHexBuffer: half the cell's
+// height below 0.2 of its width), and at the holes there is no thicker side to carve from.
+constexpr double kThinLayerCells = 0.4;
+// ... and where every hex of it is flatter than this (hex_flatness): a layer's, not a thick
+// part's (cube-like, near 1). Gmsh's layers 0.1 thick reach 0.53 at their narrowest quads.
+constexpr double kLayerHex = 2.0 / 3.0;
+
+// How flat a hex is: the mean length of its edges along its flattest direction over that along
+// its longest.
+double hex_flatness(const primal::Model& m, const std::array<Index, 8>& h) {
+  std::array<double, 3> mean{};
+  for (std::size_t e = 0; e < primal::topology::kHexEdgeCorners.size(); ++e) {
+    const auto& c = primal::topology::kHexEdgeCorners[e];
+    mean[e / 4] += (m.points[primal::index_cast<std::size_t>(h[static_cast<std::size_t>(c[1])])] -
+                    m.points[primal::index_cast<std::size_t>(h[static_cast<std::size_t>(c[0])])])
+                       .norm();
+  }
+  return *std::min_element(mean.begin(), mean.end()) / *std::max_element(mean.begin(), mean.end());
+}
+
 // conform() on `input`; `spare`: the same model when the caller gives it up (the Model&&
 // overload), then relaxed in place instead of copied, and trimmed once the buffer layer holds
 // the model.
@@ -863,14 +887,33 @@ ConformResult conform_model(const primal::Model& input, primal::Model* spare,
     own = primal::split_pyramids(input).model;
     model = owned = &own;
   }
-  Index wedges_split = 0;
+  // What was split, by the input's own wedge and hex numbers, and where the current model's
+  // wedges and hexes come from in the input (splitting renumbers the rest).
+  std::vector<Index> wedges_split, hexes_split;
+  Index hex_tets = 0;  // the tets the split hexes became
+  std::vector<Index> wedge_origin(input.wedges.size()), hex_origin(input.hexes.size());
+  std::iota(wedge_origin.begin(), wedge_origin.end(), Index{0});
+  std::iota(hex_origin.begin(), hex_origin.end(), Index{0});
+  auto remaining = [](std::size_t n, const std::vector<Index>& split) {
+    std::vector<Index> out;
+    for (std::size_t i = 0; i < n; ++i)
+      if (!std::binary_search(split.begin(), split.end(), primal::index_cast(i)))
+        out.push_back(primal::index_cast(i));
+    return out;
+  };
   std::vector<std::string> warnings;
   for (;;) {
     primal::RelaxTetsResult relaxation;
     std::vector<primal::Point> given;  // the points before relaxation
     if (options.relax == ConformRelax::kInterface &&
-        (!model->hexes.empty() || !model->wedges.empty()) && !model->tets.empty()) {
-      const std::vector<Index> nodes = primal::tet_nodes_to_relax(*model, kRelaxRings);
+        (!model->hexes.empty() || !model->wedges.empty() || !hexes_split.empty()) &&
+        !model->tets.empty()) {
+      // Where a hex layer was split into tets, its cells' corners seed the rings too: the
+      // pyramids Gmsh put on its quads are tets beside it still.
+      std::vector<Index> seeds;
+      for (Index h : hexes_split)
+        for (Index v : input.hexes[primal::index_cast<std::size_t>(h)]) seeds.push_back(v);
+      const std::vector<Index> nodes = primal::tet_nodes_to_relax(*model, kRelaxRings, seeds);
       if (!nodes.empty()) {
         if (!owned) {
           own = input;
@@ -896,6 +939,58 @@ ConformResult conform_model(const primal::Model& input, primal::Model* spare,
       // again; a hex quad they covered may join another piece to the sides, hence the loop.
       if (!given.empty()) owned->points = std::move(given);
       const std::vector<Index> pieces = primal::wedge_pieces(*model, joining);
+      const primal::WedgeColumns columns = primal::wedge_columns(*model, pieces);
+      primal::CellPieces layer;
+      if (columns.through && columns.height_ratio < kThinLayerCells)
+        layer = primal::cell_pieces(*model, pieces);
+      // Only a layer: one joined to a thick part would take it along; it keeps the holes (and
+      // their buffer hexes) instead.
+      const bool thin =
+          !layer.hexes.empty() && std::all_of(layer.hexes.begin(), layer.hexes.end(), [&](Index h) {
+            return hex_flatness(*model, model->hexes[primal::index_cast<std::size_t>(h)]) <
+                   kLayerHex;
+          });
+      if (thin) {
+        // Wedges go through a thin layer from tets on one side to tets on the other: split,
+        // they would leave holes whose walls are interface quads as high as the layer's cells
+        // (buffer hexes there inverted or flat, or two layer hexes meeting along an edge only).
+        // The layer's whole pieces of hexes and wedges become tets, diced with the tets around
+        // them: split again from the input as given, in the order above (pyramids, wedges, then
+        // the hexes on the diagonals those give them), as geode_mpi's zone, whose pyramids come
+        // split, does.
+        for (Index w : layer.wedges)
+          wedges_split.push_back(wedge_origin[primal::index_cast<std::size_t>(w)]);
+        for (Index h : layer.hexes)
+          hexes_split.push_back(hex_origin[primal::index_cast<std::size_t>(h)]);
+        std::sort(wedges_split.begin(), wedges_split.end());
+        std::sort(hexes_split.begin(), hexes_split.end());
+        std::ostringstream m;
+        m << layer.hexes.size() << " hexes and " << layer.wedges.size()
+          << " wedges split into tets: wedges go through the layer of "
+          << primal::describe_element(*model, {primal::ElementKind::kWedge, pieces.front()})
+          << " from tets on one side to tets on the other, and its cells are "
+          << columns.height_ratio
+          << " of their width high, too thin for buffer hexes at the holes split wedges leave";
+        warnings.push_back(m.str());
+        if (options.progress)
+          options.progress("layer: " + std::to_string(layer.hexes.size()) + " hexes and " +
+                           std::to_string(layer.wedges.size()) +
+                           " wedges split into tets (wedges through a thin layer between tets)");
+        const primal::Model wedges = primal::split_wedges(
+            input.pyramids.empty() ? input : primal::split_pyramids(input).model, wedges_split);
+        try {
+          own = primal::split_hexes(wedges, hexes_split);
+        } catch (const TopologyError& e) {
+          throw TopologyError(std::string(e.what()) +
+                              " (a hex of the thin layer wedges go through between tets, "
+                              "split into tets since no buffer layer fits at their holes)");
+        }
+        hex_tets = primal::index_cast(own.tets.size() - wedges.tets.size());
+        model = owned = &own;
+        wedge_origin = remaining(input.wedges.size(), wedges_split);
+        hex_origin = remaining(input.hexes.size(), hexes_split);
+        continue;
+      }
       warnings.push_back(
           std::to_string(pieces.size()) + " wedges split into three tets each: the layer of " +
           primal::describe_element(*model, {primal::ElementKind::kWedge, joining.front()}) +
@@ -903,7 +998,14 @@ ConformResult conform_model(const primal::Model& input, primal::Model* spare,
           "by side in a layer against tets), where no buffer layer can end");
       own = primal::split_wedges(*model, pieces);
       model = owned = &own;
-      wedges_split += primal::index_cast(pieces.size());
+      for (Index w : pieces)
+        wedges_split.push_back(wedge_origin[primal::index_cast<std::size_t>(w)]);
+      std::sort(wedges_split.begin(), wedges_split.end());
+      std::vector<Index> origin;
+      for (std::size_t w = 0; w < wedge_origin.size(); ++w)
+        if (!std::binary_search(pieces.begin(), pieces.end(), primal::index_cast(w)))
+          origin.push_back(wedge_origin[w]);
+      wedge_origin = std::move(origin);
       if (options.progress)
         options.progress("wedges: " + std::to_string(pieces.size()) +
                          " split into tets (a wedge layer joined the two sides of the interface)");
@@ -912,11 +1014,13 @@ ConformResult conform_model(const primal::Model& input, primal::Model* spare,
     r.relaxation = relaxation;
     r.seconds += relaxation.seconds;
     r.input_pyramids = input_pyramids;
-    r.wedges_split = wedges_split;
+    r.wedges_split = primal::index_cast(wedges_split.size());
+    r.hexes_split = primal::index_cast(hexes_split.size());
     r.warnings.insert(r.warnings.begin() + static_cast<std::ptrdiff_t>(r.findings),
                       warnings.begin(), warnings.end());
-    r.input_wedges += wedges_split;
-    r.input_tets -= 2 * r.input_pyramids + 3 * wedges_split;
+    r.input_wedges += r.wedges_split;
+    r.input_hexes += r.hexes_split;
+    r.input_tets -= 2 * r.input_pyramids + 3 * r.wedges_split + hex_tets;
     return r;
   }
 }

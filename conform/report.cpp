@@ -47,9 +47,13 @@ std::string duplicate_node_hint(const primal::Model& model, const std::string& m
 
 nlohmann::json report_json(const ConformResult& r) {
   nlohmann::json j;
-  j["input"] = {{"hexes", r.input_hexes},         {"tets", r.input_tets},
-                {"pyramids", r.input_pyramids},   {"wedges", r.input_wedges},
-                {"wedges_split", r.wedges_split}, {"interface_quads", r.interface_quads}};
+  j["input"] = {{"hexes", r.input_hexes},
+                {"tets", r.input_tets},
+                {"pyramids", r.input_pyramids},
+                {"wedges", r.input_wedges},
+                {"wedges_split", r.wedges_split},
+                {"hexes_split", r.hexes_split},
+                {"interface_quads", r.interface_quads}};
   j["output"] = {
       {"hexes", r.model.hexes.size()},        {"nodes", r.model.points.size()},
       {"diced_hexes", r.diced_hexes},         {"geode_hexes", r.geode_hexes},

@@ -233,7 +233,7 @@ RelaxTetsResult relax_tet_nodes(std::vector<Point>& points,
   return r;
 }
 
-std::vector<Index> tet_nodes_to_relax(const Model& model, int rings) {
+std::vector<Index> tet_nodes_to_relax(const Model& model, int rings, std::span<const Index> seeds) {
   const std::size_t n = model.points.size();
   // Nodes any other kind uses, a node set names or a side set's face holds (a surface
   // embedded in the tets stays where the user put it): fixed.
@@ -285,6 +285,7 @@ std::vector<Index> tet_nodes_to_relax(const Model& model, int rings) {
       }
     }
   }
+  for (Index v : seeds) near[index_cast<std::size_t>(v)] = 1;
   for (int ring = 0; ring < rings; ++ring) {
     each_tet([&](std::size_t t) {
       for (Index v : model.tets[t])

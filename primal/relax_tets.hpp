@@ -43,6 +43,9 @@ RelaxTetsResult relax_tet_nodes(std::vector<Point>& points,
 // changing the model's shape or its materials: used by tets only, all of one block, on no
 // boundary face (a face of one element; a quad's two triangles count as faces too), in no
 // node set and on no face of a side set (a surface embedded in the tets). Sorted ascending.
-std::vector<Index> tet_nodes_to_relax(const Model& model, int rings);
+// `seeds`: nodes the rings also start from (the corners of cells conform split into tets,
+// primal/split_hexes.hpp, where a hex layer was).
+std::vector<Index> tet_nodes_to_relax(const Model& model, int rings,
+                                      std::span<const Index> seeds = {});
 
 }  // namespace geode::primal

@@ -21,6 +21,9 @@ if [ "$model" = sets ]; then
 elif [ "$model" = ball ]; then  # the serial run's aims set by a tet outside the default zone
   input=in.msh
   /usr/bin/python3 "$here/../conform/ball_model.py" "$input" "$size"
+elif [ "$model" = layer ]; then  # a thin hex layer with wedges through it, split into tets
+  input=in.msh
+  /usr/bin/python3 "$here/../conform/layer_model.py" "$input" sphere "$size"
 else
   input=in.exo
   "$geode" demo --model "$model" -n "$size" --save-input "$input"

@@ -1,0 +1,149 @@
+// A thin hex layer with a few wedges in it between tets on both sides, as Gmsh makes one
+// (tests/conform/layer_model.py: a curved surface recombined with a few triangles left, extruded
+// in 2 cells into tet potting, tets inside too, pyramids on the layer's quads). Split into tets
+// only, the wedges left holes through the layer: on the sphere two layer hexes met along an edge
+// only between two holes (exit 3 from either side), on the cylinder the buffer hexes at the holes'
+// walls were flat (0.004, 0.08 x the yardstick) or inverted from the tet side (exit 4). conform
+// now splits the layer into tets and dices it with the tets around it.
+#include <doctest/doctest.h>
+
+#include <cstdlib>
+#include <set>
+#include <string>
+
+#include <geode/conform/conform.hpp>
+#include <geode/io/read_model.hpp>
+#include <geode/primal/boundary.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/validity.hpp>
+
+#include "../support/conform_checks.hpp"
+#include "../support/temp_dir.hpp"
+
+namespace geode {
+
+using primal::Index;
+using primal::Point;
+
+namespace {
+
+primal::Model layer_model(const test::TempDir& dir, const std::string& args) {
+  const std::string file = (dir.path / "layer.msh").string();
+  const std::string cmd = "/usr/bin/python3 '" + std::string(GEODE_SOURCE_DIR) +
+                          "/tests/conform/layer_model.py' '" + file + "' " + args;
+  REQUIRE_MESSAGE(std::system(cmd.c_str()) == 0, cmd);
+  return io::read_model(file);
+}
+
+double side_set_area(const primal::Model& m, const primal::SideSet& s) {
+  double area = 0.0;
+  for (const primal::Side& side : s.sides) {
+    const auto f = primal::element_face(m, side);
+    const auto at = [&](std::size_t i) { return m.points[primal::index_cast<std::size_t>(f[i])]; };
+    for (std::size_t i = 1; i + 1 < f.size(); ++i)  // a fan: exact for triangles
+      area += 0.5 * (at(i) - at(0)).cross(at(i + 1) - at(0)).norm();
+  }
+  return area;
+}
+
+}  // namespace
+
+TEST_CASE("a thin hex layer with wedges through it between tets is split into tets, valid") {
+  const test::TempDir dir;
+  // sphere: exit 3 before (two layer hexes along an edge); cylinder 0.04 thick: 0.004 from the
+  // hex side, exit 4 from the tet side.
+  for (const std::string args : {"sphere 6 out 0.1", "cylinder 6 out 0.04"}) {
+    CAPTURE(args);
+    const primal::Model input = layer_model(dir, args);
+    REQUIRE(!input.wedges.empty());
+    REQUIRE(!input.pyramids.empty());
+    Point lo = input.points.front(), hi = lo;
+    for (const Point& p : input.points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    const double box = (hi - lo).prod();
+    // Either side, with and without smoothing: no buffer layer is left to carve.
+    for (const auto& [side, smooth] :
+         {std::pair{conform::BufferSide::kHex, conform::ConformSmooth::kLocal},
+          std::pair{conform::BufferSide::kTet, conform::ConformSmooth::kLocal},
+          std::pair{conform::BufferSide::kHex, conform::ConformSmooth::kNone}}) {
+      CAPTURE(static_cast<int>(side));
+      CAPTURE(static_cast<int>(smooth));
+      conform::ConformOptions o;
+      o.buffer.side = side;
+      o.smooth = smooth;
+      const conform::ConformResult r = conform::conform(input, o);
+      test::check_conform_result(r, 0, 1);
+      CHECK(r.warnings.front().find(std::to_string(input.hexes.size()) + " hexes and " +
+                                    std::to_string(input.wedges.size()) +
+                                    " wedges split into tets: wedges go through the layer of "
+                                    "wedge ") == 0);
+      CHECK(r.hexes_split == primal::index_cast(input.hexes.size()));
+      CHECK(r.wedges_split == primal::index_cast(input.wedges.size()));
+      CHECK(r.input_hexes == primal::index_cast(input.hexes.size()));
+      CHECK(r.input_tets == primal::index_cast(input.tets.size()));
+      CHECK(r.interface_quads == 0);
+      // At or above the yardstick (its cells as conform split them, diced alone).
+      const double lowest = primal::min_scaled_jacobian(primal::hex_part(r.model));
+      CHECK(lowest >= r.yardstick());
+      CHECK(lowest > 0.01);  // the buffer at the holes gave 0.004 on the cylinder
+      // The blocks keep their names and cells: the core's and the potting's tets 4 hexes
+      // each and their pyramids 8, the layer the rest; the sphere's box's volume to rounding.
+      for (const auto& [id, name] : input.block_names) CHECK(r.model.block_names.at(id) == name);
+      std::map<int, std::size_t> count, expected;
+      for (int b : r.model.hex_block) ++count[b];
+      for (int b : input.tet_block) expected[b] += 4;
+      for (int b : input.pyramid_block) expected[b] += 8;
+      REQUIRE(count.size() == 3);
+      CHECK(count.at(1) == expected.at(1));
+      CHECK(count.at(3) == expected.at(3));
+      CHECK(count.at(2) >= 4 * 5 * input.hexes.size() + 12 * input.wedges.size());
+      double sum = 0.0;
+      for (const auto& [block, volume] : test::hex_block_volumes(r.model)) sum += volume;
+      // (The cylinder's layer ends stick out of the box's bottom and top by up to 0.0018:
+      // Gmsh's normals at its rims are not quite level.)
+      if (args.starts_with("sphere")) CHECK(std::abs(sum - box) <= 1e-9 * box);
+      // The sets: the skin is every boundary quad of the output; the surface the layer was
+      // extruded from keeps its area (its quads' triangles, to their non-planarity).
+      const primal::HexValidityReport v = primal::check_validity(primal::hex_part(r.model));
+      REQUIRE(r.model.side_sets.size() == 2);
+      std::set<std::array<Index, 4>> boundary, skin;
+      for (const auto& q : v.boundary.faces) boundary.insert(primal::face_key(q.nodes));
+      for (const primal::Side& s : r.model.side_sets[0].sides)
+        skin.insert(primal::face_key(primal::element_face(r.model, s)));
+      CHECK(r.model.side_sets[0].name == "skin");
+      CHECK(skin == boundary);
+      CHECK(r.model.side_sets[1].name == "surface");
+      const double area = side_set_area(input, input.side_sets[1]);
+      CHECK(std::abs(side_set_area(r.model, r.model.side_sets[1]) - area) <= 1e-2 * area);
+    }
+  }
+}
+
+TEST_CASE("a layer too thin for its faces' curvature is refused by name, not written invalid") {
+  // 0.02 thick in 2 cells on a radius of 0.4: a hex has no positive split on the diagonals its
+  // pyramids force (before: valid at 0.0012, 0.04 x the yardstick, or exit 4 from the tet side).
+  const test::TempDir dir;
+  const primal::Model input = layer_model(dir, "cylinder 5 out 0.02");
+  REQUIRE(!input.wedges.empty());
+  CHECK_THROWS_WITH_AS(conform::conform(input),
+                       doctest::Contains("leave no way to split it into positive tets, on its "
+                                         "corners or with its centre (a hex of the thin layer"),
+                       TopologyError);
+  CHECK_THROWS_WITH_AS(conform::conform(input), doctest::Contains("hex "), TopologyError);
+}
+
+TEST_CASE("the same layer recombined into quads only keeps its hexes and gets the geode") {
+  const test::TempDir dir;
+  const primal::Model input = layer_model(dir, "cylinder 6 out 0.1 quads");
+  REQUIRE(input.wedges.empty());
+  conform::ConformOptions o;
+  o.smooth = conform::ConformSmooth::kNone;  // the smoothing is most of its time, and not this
+  const conform::ConformResult r = conform::conform(input, o);
+  test::check_conform_result(r, -1, 1);  // carved from the tets (the layer's cells are thin)
+  CHECK(r.warnings.front().find("buffer layer carved from the tet part") == 0);
+  CHECK(r.hexes_split == 0);
+  CHECK(r.interface_quads == primal::index_cast(input.pyramids.size()));
+  CHECK(r.diced_hexes == 8 * primal::index_cast(input.hexes.size()));
+}
+
+}  // namespace geode

@@ -1,0 +1,145 @@
+// Hexes as tets (primal/split_hexes.hpp): a grid split whole conforms and fills it, its sides
+// moved onto the tets; by the lowest-node rule alone every hex splits on its corners whatever its
+// numbering; diagonals no triangulation of the cube has (tets on its faces force them) get the
+// hex's centre as a node; a face under four tet triangles (no split follows it) is refused.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <numeric>
+#include <random>
+
+#include <geode/primal/errors.hpp>
+#include <geode/primal/grid_model.hpp>
+#include <geode/primal/input_check.hpp>
+#include <geode/primal/quality.hpp>
+#include <geode/primal/split_hexes.hpp>
+
+using namespace geode;
+using primal::ElementKind;
+using primal::Index;
+using primal::Point;
+
+namespace {
+
+double volume(const primal::Model& m, const std::array<Index, 4>& t) {
+  auto p = [&](std::size_t k) { return m.points[primal::index_cast<std::size_t>(t[k])]; };
+  return primal::tet_volume(p(0), p(1), p(2), p(3));
+}
+
+// The model's nodes renumbered by a random permutation (so the lowest-node rule picks other
+// diagonals), its points slightly moved so that no tet is degenerate by symmetry.
+primal::Model shuffled(primal::Model m, unsigned seed) {
+  std::vector<Index> to(m.points.size());
+  std::iota(to.begin(), to.end(), Index{0});
+  std::mt19937 rng(seed);
+  std::shuffle(to.begin(), to.end(), rng);
+  std::uniform_real_distribution<double> jitter(-0.05, 0.05);
+  std::vector<Point> points(m.points.size());
+  for (std::size_t v = 0; v < m.points.size(); ++v)
+    points[primal::index_cast<std::size_t>(to[v])] =
+        m.points[v] + Point(jitter(rng), jitter(rng), jitter(rng));
+  m.points = points;
+  for (auto& h : m.hexes)
+    for (Index& v : h) v = to[primal::index_cast<std::size_t>(v)];
+  return m;
+}
+
+}  // namespace
+
+TEST_CASE("split_hexes: a grid split whole conforms, fills it and keeps its sides, on corners") {
+  const primal::Model grid =
+      primal::grid_model({3, 2, 2}, 1.0, [](int, int, int) { return false; });
+  REQUIRE(grid.hexes.size() == 12);
+  for (unsigned seed = 1; seed <= 20; ++seed) {
+    CAPTURE(seed);
+    primal::Model m = shuffled(grid, seed);
+    double given = 0.0;
+    for (const auto& h : m.hexes) {
+      primal::HexCorners c;
+      for (std::size_t k = 0; k < 8; ++k) c[k] = m.points[primal::index_cast<std::size_t>(h[k])];
+      given += primal::hex_volume(c);
+    }
+    m.side_sets.push_back(
+        {3, "bottom", {{{ElementKind::kHex, 0}, 4}, {{ElementKind::kHex, 5}, 1}}});
+    std::vector<Index> all(m.hexes.size());
+    std::iota(all.begin(), all.end(), Index{0});
+    const primal::Model s = primal::split_hexes(m, all);
+    CHECK(s.hexes.empty());
+    CHECK(s.points.size() == m.points.size());  // no centre: the lowest corner always fits
+    CHECK(s.tets.size() >= 5 * m.hexes.size());
+    CHECK(s.tets.size() <= 6 * m.hexes.size());
+    double sum = 0.0;
+    for (const auto& t : s.tets) {
+      CHECK(volume(s, t) > 0.0);
+      sum += volume(s, t);
+    }
+    // The jittered hexes' faces are not planar: their tets fill what the triangles bound.
+    CHECK(sum == doctest::Approx(given).epsilon(0.02));
+    CHECK(primal::check_input(s).ok());  // conforming, covering its domain once
+    REQUIRE(s.side_sets.size() == 1);
+    CHECK(s.side_sets.front().sides.size() == 4);  // two quads, two triangles each
+    for (const primal::Side& side : s.side_sets.front().sides)
+      CHECK(side.element.kind == ElementKind::kTet);
+    CHECK(std::all_of(s.tet_block.begin(), s.tet_block.end(),
+                      [&](int b) { return b == grid.hex_block.front(); }));
+  }
+}
+
+TEST_CASE("split_hexes: diagonals no triangulation of the cube has give the hex its centre") {
+  // A unit cube with two tets on each face split along its corners 0-2 (kHexFaceCorners):
+  // every corner on one or two diagonals, none on three, and none of the cube's 74
+  // triangulations has those six.
+  primal::Model m;
+  for (const auto& c : primal::topology::kHexCornerCoords)
+    m.points.push_back(Point(c[0], c[1], c[2]));
+  primal::add_element(m, ElementKind::kHex, std::array<Index, 8>{0, 1, 2, 3, 4, 5, 6, 7}, 1, 1);
+  const Point centre(0.5, 0.5, 0.5);
+  std::int64_t id = 1;
+  for (const auto& fc : primal::topology::kHexFaceCorners) {
+    Point mid = Point::Zero();
+    for (int k : fc) mid += m.points[static_cast<std::size_t>(k)] / 4.0;
+    m.points.push_back(mid + (mid - centre));  // an apex outside the face
+    const Index apex = primal::index_cast(m.points.size() - 1);
+    const auto v = [&](int i) { return primal::index_cast(fc[static_cast<std::size_t>(i)]); };
+    primal::add_element(m, ElementKind::kTet, std::array<Index, 4>{v(0), v(1), v(2), apex}, 2,
+                        id++);
+    primal::add_element(m, ElementKind::kTet, std::array<Index, 4>{v(0), v(2), v(3), apex}, 2,
+                        id++);
+  }
+  for (const auto& t : m.tets) REQUIRE(volume(m, t) > 0.0);
+  REQUIRE(primal::check_input(m).ok());
+  const primal::Model s = primal::split_hexes(m, std::vector<Index>{0});
+  REQUIRE(s.points.size() == m.points.size() + 1);
+  CHECK(s.points.back() == centre);
+  REQUIRE(s.tets.size() == 12 + 12);
+  double sum = 0.0;
+  for (std::size_t t = 12; t < s.tets.size(); ++t) {
+    CHECK(s.tets[t][3] == primal::index_cast(m.points.size()));
+    CHECK(volume(s, s.tets[t]) > 0.0);
+    sum += volume(s, s.tets[t]);
+  }
+  CHECK(sum == doctest::Approx(1.0));
+  CHECK(primal::check_input(s).ok());
+}
+
+TEST_CASE("split_hexes: a face under four tet triangles around a node is refused by name") {
+  // No split of the hex follows the fan of four triangles on its top face: without the refusal
+  // its tets would leave that face unmatched.
+  primal::Model m;
+  for (const auto& c : primal::topology::kHexCornerCoords)
+    m.points.push_back(Point(c[0], c[1], c[2]));
+  primal::add_element(m, ElementKind::kHex, std::array<Index, 8>{0, 1, 2, 3, 4, 5, 6, 7}, 1, 1);
+  m.points.push_back(Point(0.5, 0.5, 1.0));  // the fan's centre, on the top face
+  m.points.push_back(Point(0.5, 0.5, 1.5));  // an apex above it
+  const std::array<Index, 4> top{4, 5, 6, 7};
+  for (std::size_t i = 0; i < 4; ++i)
+    primal::add_element(m, ElementKind::kTet, std::array<Index, 4>{top[i], top[(i + 1) % 4], 8, 9},
+                        2, static_cast<std::int64_t>(i) + 1);
+  for (const auto& t : m.tets) REQUIRE(volume(m, t) > 0.0);
+  REQUIRE(primal::check_input(m).ok());
+  CHECK_THROWS_WITH_AS(
+      primal::split_hexes(m, std::vector<Index>{0}),
+      doctest::Contains("hex 1 (centre (0.5, 0.5, 0.5)): its face of nodes 5 6 7 8 "
+                        "lies under four tet triangles around node 9"),
+      TopologyError);
+}
