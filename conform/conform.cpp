@@ -902,6 +902,7 @@ ConformResult conform_model(const primal::Model& input, primal::Model* spare,
     return out;
   };
   std::vector<std::string> warnings;
+  bool layer_kept = false;  // a thin layer that could not be split into tets
   for (;;) {
     primal::RelaxTetsResult relaxation;
     std::vector<primal::Point> given;  // the points before relaxation
@@ -950,7 +951,7 @@ ConformResult conform_model(const primal::Model& input, primal::Model* spare,
             return hex_flatness(*model, model->hexes[primal::index_cast<std::size_t>(h)]) <
                    kLayerHex;
           });
-      if (thin) {
+      if (thin && !layer_kept) {
         // Wedges go through a thin layer from tets on one side to tets on the other: split,
         // they would leave holes whose walls are interface quads as high as the layer's cells
         // (buffer hexes there inverted or flat, or two layer hexes meeting along an edge only).
@@ -958,38 +959,49 @@ ConformResult conform_model(const primal::Model& input, primal::Model* spare,
         // them: split again from the input as given, in the order above (pyramids, wedges, then
         // the hexes on the diagonals those give them), as geode_mpi's zone, whose pyramids come
         // split, does.
+        std::vector<Index> wedges_now = wedges_split, hexes_now = hexes_split;
         for (Index w : layer.wedges)
-          wedges_split.push_back(wedge_origin[primal::index_cast<std::size_t>(w)]);
+          wedges_now.push_back(wedge_origin[primal::index_cast<std::size_t>(w)]);
         for (Index h : layer.hexes)
-          hexes_split.push_back(hex_origin[primal::index_cast<std::size_t>(h)]);
-        std::sort(wedges_split.begin(), wedges_split.end());
-        std::sort(hexes_split.begin(), hexes_split.end());
-        std::ostringstream m;
-        m << layer.hexes.size() << " hexes and " << layer.wedges.size()
-          << " wedges split into tets: wedges go through the layer of "
-          << primal::describe_element(*model, {primal::ElementKind::kWedge, pieces.front()})
-          << " from tets on one side to tets on the other, and its cells are "
-          << columns.height_ratio
-          << " of their width high, too thin for buffer hexes at the holes split wedges leave";
-        warnings.push_back(m.str());
-        if (options.progress)
-          options.progress("layer: " + std::to_string(layer.hexes.size()) + " hexes and " +
-                           std::to_string(layer.wedges.size()) +
-                           " wedges split into tets (wedges through a thin layer between tets)");
+          hexes_now.push_back(hex_origin[primal::index_cast<std::size_t>(h)]);
+        std::sort(wedges_now.begin(), wedges_now.end());
+        std::sort(hexes_now.begin(), hexes_now.end());
+        const std::string where =
+            "wedges go through the layer of " +
+            primal::describe_element(*model, {primal::ElementKind::kWedge, pieces.front()}) +
+            " from tets on one side to tets on the other";
         const primal::Model wedges = primal::split_wedges(
-            input.pyramids.empty() ? input : primal::split_pyramids(input).model, wedges_split);
+            input.pyramids.empty() ? input : primal::split_pyramids(input).model, wedges_now);
         try {
-          own = primal::split_hexes(wedges, hexes_split);
+          primal::Model tets = primal::split_hexes(wedges, hexes_now);
+          own = std::move(tets);
         } catch (const TopologyError& e) {
-          throw TopologyError(std::string(e.what()) +
-                              " (a hex of the thin layer wedges go through between tets, "
-                              "split into tets since no buffer layer fits at their holes)");
+          // Too thin for its faces' curvature: a hex has no positive split on the diagonals its
+          // pyramids force. Its wedges alone are split below, as a thicker layer's are: a
+          // mesh of flat buffer hexes at the holes, valid where they are (a 0.02 layer on a
+          // radius of 0.4: 0.0012), rather than none.
+          layer_kept = true;
+          warnings.push_back(where + ", but its hexes stay hexes: " + e.what());
         }
-        hex_tets = primal::index_cast(own.tets.size() - wedges.tets.size());
-        model = owned = &own;
-        wedge_origin = remaining(input.wedges.size(), wedges_split);
-        hex_origin = remaining(input.hexes.size(), hexes_split);
-        continue;
+        if (!layer_kept) {
+          wedges_split = std::move(wedges_now);
+          hexes_split = std::move(hexes_now);
+          std::ostringstream m;
+          m << layer.hexes.size() << " hexes and " << layer.wedges.size()
+            << " wedges split into tets: " << where << ", and its cells are "
+            << columns.height_ratio
+            << " of their width high, too thin for buffer hexes at the holes split wedges leave";
+          warnings.push_back(m.str());
+          if (options.progress)
+            options.progress("layer: " + std::to_string(layer.hexes.size()) + " hexes and " +
+                             std::to_string(layer.wedges.size()) +
+                             " wedges split into tets (wedges through a thin layer between tets)");
+          hex_tets = primal::index_cast(own.tets.size() - wedges.tets.size());
+          model = owned = &own;
+          wedge_origin = remaining(input.wedges.size(), wedges_split);
+          hex_origin = remaining(input.hexes.size(), hexes_split);
+          continue;
+        }
       }
       warnings.push_back(
           std::to_string(pieces.size()) + " wedges split into three tets each: the layer of " +

@@ -4,9 +4,11 @@
 // only, the wedges left holes through the layer: on the sphere two layer hexes met along an edge
 // only between two holes (exit 3 from either side), on the cylinder the buffer hexes at the holes'
 // walls were flat (0.004, 0.08 x the yardstick) or inverted from the tet side (exit 4). conform
-// now splits the layer into tets and dices it with the tets around it.
+// now splits the layer into tets and dices it with the tets around it; a layer too thin to split
+// (no positive split on the diagonals its pyramids force) keeps its hexes as before.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <set>
 #include <string>
@@ -119,17 +121,26 @@ TEST_CASE("a thin hex layer with wedges through it between tets is split into te
   }
 }
 
-TEST_CASE("a layer too thin for its faces' curvature is refused by name, not written invalid") {
+TEST_CASE("a layer too thin to split into tets keeps its hexes, valid, and says which one") {
   // 0.02 thick in 2 cells on a radius of 0.4: a hex has no positive split on the diagonals its
-  // pyramids force (before: valid at 0.0012, 0.04 x the yardstick, or exit 4 from the tet side).
+  // pyramids force, so only the wedges are split, as before the layer was split whole: valid at
+  // 0.0012 (0.04 x the yardstick), the layer's hex named in a warning, rather than a refusal.
   const test::TempDir dir;
   const primal::Model input = layer_model(dir, "cylinder 5 out 0.02");
   REQUIRE(!input.wedges.empty());
-  CHECK_THROWS_WITH_AS(conform::conform(input),
-                       doctest::Contains("leave no way to split it into positive tets, on its "
-                                         "corners or with its centre (a hex of the thin layer"),
-                       TopologyError);
-  CHECK_THROWS_WITH_AS(conform::conform(input), doctest::Contains("hex "), TopologyError);
+  const conform::ConformResult r = conform::conform(input);
+  // Valid, with its geode (26 per interface quad) and three warnings: the layer kept, its
+  // wedges split, the buffer carved from the tets.
+  test::check_conform_result(r, -1, 3);
+  CHECK(r.interface_quads > 0);
+  CHECK(r.hexes_split == 0);
+  CHECK(r.wedges_split > 0);
+  CHECK(primal::min_scaled_jacobian(primal::hex_part(r.model)) > 0.0);
+  const auto said = std::find_if(r.warnings.begin(), r.warnings.end(), [](const std::string& w) {
+    return w.find("its hexes stay hexes: hex ") != std::string::npos &&
+           w.find("no way to split it into positive tets") != std::string::npos;
+  });
+  CHECK(said != r.warnings.end());
 }
 
 TEST_CASE("the same layer recombined into quads only keeps its hexes and gets the geode") {
