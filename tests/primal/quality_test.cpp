@@ -10,8 +10,8 @@
 #include <limits>
 #include <string>
 
-#include <geode/primal/errors.hpp>
 #include <geode/primal/detail/scaled_jacobian_paths.hpp>
+#include <geode/primal/errors.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/topology.hpp>
 
@@ -248,9 +248,8 @@ TEST_CASE("hex scaled jacobian: the same number as the nine values' minimum, bit
     CHECK(paths.portable_bounded(p, -std::numeric_limits<double>::infinity()) == lowest);
     // With a bound: exact above it, at or below it otherwise.
     const double bound = uniform() - 0.5;
-    for (const double bounded :
-         {gp::hex_scaled_jacobian_bounded(p, bound), paths.fastest_bounded(p, bound),
-          paths.portable_bounded(p, bound)})
+    for (const double bounded : {gp::hex_scaled_jacobian_bounded(p, bound),
+                                 paths.fastest_bounded(p, bound), paths.portable_bounded(p, bound)})
       CHECK((lowest > bound ? bounded == lowest : bounded <= bound));
   }
 }
