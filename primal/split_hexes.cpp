@@ -5,6 +5,7 @@
 #include <utility>
 
 #include <geode/primal/boundary.hpp>
+#include <geode/primal/detail/split_cells.hpp>
 #include <geode/primal/dice.hpp>
 #include <geode/primal/disjoint_sets.hpp>
 #include <geode/primal/errors.hpp>
@@ -13,19 +14,6 @@
 namespace geode::primal {
 
 namespace {
-
-// Every face of the tets of `model`, by its nodes.
-KeyMap<4> tet_triangles(const Model& model) {
-  KeyMap<4> triangles(4 * model.tets.size());
-  for (const auto& t : model.tets)
-    for (const auto& f : topology::kTetFaceCorners) {
-      const std::array<Index, 3> tri{t[index_cast<std::size_t>(f[0])],
-                                     t[index_cast<std::size_t>(f[1])],
-                                     t[index_cast<std::size_t>(f[2])]};
-      triangles.try_emplace(face_key(tri), 0);
-    }
-  return triangles;
-}
 
 // The nodes of local face `face` of a cell.
 template <std::size_t N>
@@ -199,7 +187,7 @@ WedgeColumns wedge_columns(const Model& model, std::span<const Index> wedges) {
         if (face_key(face_nodes(model.wedges[o], topo.face[3 + u])) == face_key(nodes))
           next[o][u] = index_cast(w);
     }
-  const KeyMap<4> triangles = tet_triangles(model);
+  const KeyMap<4> triangles = detail::tet_triangles(model);
   const auto at = [&](Index n) { return model.points[index_cast<std::size_t>(n)]; };
   WedgeColumns out;
   std::vector<char> seen(model.wedges.size(), 0);
@@ -246,17 +234,11 @@ WedgeColumns wedge_columns(const Model& model, std::span<const Index> wedges) {
 Model split_hexes(const Model& model, std::span<const Index> hexes) {
   Model m = model;
   if (hexes.empty()) return m;
-  const KeyMap<4> triangles = tet_triangles(model);
-  auto has = [&](Index a, Index b, Index c) {
-    return triangles.find(face_key(std::array<Index, 3>{a, b, c})) != nullptr;
-  };
+  const KeyMap<4> triangles = detail::tet_triangles(model);
   std::vector<char> split(model.hexes.size(), 0);
   for (Index h : hexes) split[index_cast<std::size_t>(h)] = 1;
 
-  if (m.tet_block.empty()) m.tet_block.assign(model.tets.size(), default_block(ElementKind::kTet));
-  if (m.tet_ids.empty())
-    for (std::size_t t = 0; t < model.tets.size(); ++t)
-      m.tet_ids.push_back(static_cast<std::int64_t>(t) + 1);
+  detail::tets_with_blocks_and_ids(m);
   m.hexes.clear(), m.hex_block.clear(), m.hex_ids.clear();
   std::vector<Index> first_tet(model.hexes.size(), kInvalidIndex),
       kept(model.hexes.size(), kInvalidIndex);
@@ -303,14 +285,10 @@ Model split_hexes(const Model& model, std::span<const Index> hexes) {
       const auto& fc = topology::kHexFaceCorners[f];
       std::array<Index, 4> v{};
       for (std::size_t i = 0; i < 4; ++i) v[i] = c[index_cast<std::size_t>(fc[i])];
-      if (has(v[0], v[1], v[2]) && has(v[0], v[2], v[3])) {
-        want[f] = 0;
-      } else if (has(v[0], v[1], v[3]) && has(v[1], v[2], v[3])) {
-        want[f] = 1;
-      } else if (*split_faces.find(face_key(v)) > 1) {
-        want[f] = index_cast<int>(std::min_element(v.begin(), v.end()) - v.begin()) % 2;
-      } else {
-        want[f] = -1;
+      want[f] = detail::tets_diagonal(triangles, v);
+      if (want[f] < 0 && *split_faces.find(face_key(v)) > 1)
+        want[f] = detail::lowest_node_diagonal(v);
+      if (want[f] < 0) {
         // The centre: of the nodes on all four edges (the tets' apexes over the fan are too),
         // the nearest the face's middle.
         Index centre = kInvalidIndex;
@@ -366,7 +344,7 @@ Model split_hexes(const Model& model, std::span<const Index> hexes) {
         if (d < 0) {
           std::array<Index, 4> v{};
           for (std::size_t i = 0; i < 4; ++i) v[i] = c[index_cast<std::size_t>(fc[i])];
-          d = index_cast<int>(std::min_element(v.begin(), v.end()) - v.begin()) % 2;
+          d = detail::lowest_node_diagonal(v);
         }
         // Its two triangles, outward, coned to the centre inside: (a, c, b, centre).
         for (int k : {1, 2}) {

@@ -4,6 +4,7 @@
 #include <optional>
 
 #include <geode/primal/boundary.hpp>
+#include <geode/primal/detail/split_cells.hpp>
 #include <geode/primal/disjoint_sets.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/key_map.hpp>
@@ -111,24 +112,11 @@ Model split_wedges(const Model& model, std::span<const Index> wedges) {
   if (wedges.empty()) return m;
   const auto& faces = cell_topology(ElementKind::kWedge).face;
   // The triangles of the tets already there: a quad face with two of them has their diagonal.
-  KeyMap<4> triangles(4 * model.tets.size());
-  for (const auto& t : model.tets)
-    for (const auto& f : topology::kTetFaceCorners) {
-      const std::array<Index, 3> tri{t[index_cast<std::size_t>(f[0])],
-                                     t[index_cast<std::size_t>(f[1])],
-                                     t[index_cast<std::size_t>(f[2])]};
-      triangles.try_emplace(face_key(tri), 0);
-    }
-  auto has = [&](Index a, Index b, Index c) {
-    return triangles.find(face_key(std::array<Index, 3>{a, b, c})) != nullptr;
-  };
+  const KeyMap<4> triangles = detail::tet_triangles(model);
   std::vector<char> split(model.wedges.size(), 0);
   for (Index w : wedges) split[index_cast<std::size_t>(w)] = 1;
 
-  if (m.tet_block.empty()) m.tet_block.assign(model.tets.size(), default_block(ElementKind::kTet));
-  if (m.tet_ids.empty())
-    for (std::size_t t = 0; t < model.tets.size(); ++t)
-      m.tet_ids.push_back(static_cast<std::int64_t>(t) + 1);
+  detail::tets_with_blocks_and_ids(m);
   m.wedges.clear(), m.wedge_block.clear(), m.wedge_ids.clear();
   std::vector<Index> first_tet(model.wedges.size(), kInvalidIndex),
       kept(model.wedges.size(), kInvalidIndex);
@@ -145,13 +133,8 @@ Model split_wedges(const Model& model, std::span<const Index> wedges) {
     for (std::size_t q = 0; q < 3; ++q) {
       std::array<Index, 4> v{};
       for (std::size_t i = 0; i < 4; ++i) v[i] = c[index_cast<std::size_t>(faces[q].corners[i])];
-      if (has(v[0], v[1], v[2]) && has(v[0], v[2], v[3])) {
-        diagonal[q] = 0;
-      } else if (has(v[0], v[1], v[3]) && has(v[1], v[2], v[3])) {
-        diagonal[q] = 1;
-      } else {  // through the lowest node: corners 0 and 2, or 1 and 3
-        diagonal[q] = index_cast<int>(std::min_element(v.begin(), v.end()) - v.begin()) % 2;
-      }
+      diagonal[q] = detail::tets_diagonal(triangles, v);
+      if (diagonal[q] < 0) diagonal[q] = detail::lowest_node_diagonal(v);
     }
     first_tet[w] = index_cast(m.tets.size());
     for (const auto& t : wedge_tets(model, index_cast(w), diagonal))
