@@ -13,8 +13,9 @@ namespace geode::parallel {
 namespace detail {
 
 // Diced children the yardstick measures in the time the zone's two reference templates take to
-// build (bench_mpi half 68: 0.26 s for them, 0.29 us a child).
-constexpr double kReferenceChildren = 900000.0;
+// build (bench_mpi half 68: 0.26 s for them, 0.104 us a child with the scaled Jacobian four
+// corners at a time; 900,000 at 0.29 us before, which left the zone rank waiting for rank 0).
+constexpr double kReferenceChildren = 2500000.0;
 
 // The serial run's yardstick is the lowest element of each kind diced alone over the whole
 // model: each rank measures a run of the elements (a contiguous one: no partition is needed
