@@ -201,8 +201,8 @@ struct ConformResult {
   // input_tets: the input's own; its pyramids are split into two tets each before the rest.
   // wedges_split: of input_wedges, those split into three tets each where a wedge layer joined
   // the two sides of the interface (primal/split_wedges.hpp), the whole pieces of wedges they
-  // belong to. hexes_split: of input_hexes, those split into six tets each where wedges went
-  // through a thin layer of hexes from tets on one side to tets on the other
+  // belong to. hexes_split: of input_hexes, those split into tets (5, 6 or 12 each) where
+  // wedges went through a thin layer of hexes from tets on one side to tets on the other
   // (primal/split_hexes.hpp): the layer's whole pieces of hexes and wedges.
   primal::Index input_hexes = 0, input_tets = 0, input_pyramids = 0, input_wedges = 0,
                 interface_quads = 0, wedges_split = 0, hexes_split = 0;
