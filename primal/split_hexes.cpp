@@ -1,6 +1,7 @@
 #include <geode/primal/split_hexes.hpp>
 
 #include <algorithm>
+#include <cstdint>
 #include <map>
 #include <utility>
 
@@ -253,6 +254,9 @@ Model split_hexes(const Model& model, std::span<const Index> hexes) {
       if (!fresh) ++*count;
     }
   std::vector<Index> tet_count(model.hexes.size(), 0);
+  // A centre node's file id: past the highest so far (found once, not per centre).
+  std::int64_t last_node_id =
+      m.node_ids.empty() ? 0 : *std::max_element(m.node_ids.begin(), m.node_ids.end());
   // The edges of split hexes' faces -> the third nodes of the tet triangles on them: a face
   // under four tet triangles around a node (a four-triangle interface) has that node on all
   // four of its edges, and no split of the hex follows it.
@@ -362,8 +366,7 @@ Model split_hexes(const Model& model, std::span<const Index> hexes) {
           for (Index& v : t) v = v == 8 ? node : c[index_cast<std::size_t>(v)];
         best = std::move(tets), best_quality = q;
         m.points.push_back(centre);
-        if (!m.node_ids.empty())
-          m.node_ids.push_back(*std::max_element(m.node_ids.begin(), m.node_ids.end()) + 1);
+        if (!m.node_ids.empty()) m.node_ids.push_back(++last_node_id);
       }
     }
     if (best_quality <= 0.0)
@@ -375,7 +378,7 @@ Model split_hexes(const Model& model, std::span<const Index> hexes) {
     for (const auto& t : best)
       add_element(m, ElementKind::kTet, t, block_of(model, ref), element_id(model, ref));
   }
-  // Sides of split hexes: the faces of its six tets whose nodes all lie on the hex's face.
+  // Sides of split hexes: the faces of its tets whose nodes all lie on the hex's face.
   rewrite_sides(m, [&](const Side& s, std::vector<Side>& sides) {
     const auto h = index_cast<std::size_t>(s.element.index);
     if (s.element.kind != ElementKind::kHex) {

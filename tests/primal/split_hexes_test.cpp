@@ -108,9 +108,14 @@ TEST_CASE("split_hexes: diagonals no triangulation of the cube has give the hex 
   }
   for (const auto& t : m.tets) REQUIRE(volume(m, t) > 0.0);
   REQUIRE(primal::check_input(m).ok());
+  // File ids 10, 20, ..., not in order: the centre takes the next past the highest.
+  for (std::size_t v = 0; v < m.points.size(); ++v)
+    m.node_ids.push_back(10 * static_cast<std::int64_t>(m.points.size() - v));
   const primal::Model s = primal::split_hexes(m, std::vector<Index>{0});
   REQUIRE(s.points.size() == m.points.size() + 1);
   CHECK(s.points.back() == centre);
+  REQUIRE(s.node_ids.size() == s.points.size());
+  CHECK(s.node_ids.back() == 10 * static_cast<std::int64_t>(m.points.size()) + 1);
   REQUIRE(s.tets.size() == 12 + 12);
   double sum = 0.0;
   for (std::size_t t = 12; t < s.tets.size(); ++t) {
