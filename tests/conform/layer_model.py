@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """A hex layer with a few wedges in it between tets on both sides, as a user makes one with Gmsh.
 
-usage: layer_model.py OUT.msh cylinder|sphere [n] [out|in] [thickness] [quads]
+usage: layer_model.py OUT.msh cylinder|sphere [n] [out|in] [thickness] [quads] [cells=N]
+       [ratio=R]
 
 A curved surface recombined by Gmsh's default recombination (Blossom), which leaves a few
 triangles among the quads, extruded along its normals in 2 cells (`Extrude {Surface{...};
@@ -18,6 +19,8 @@ into the potting (out, the default) or into the core (in); n cells per unit leng
 surface recombined into quads only, so the layer has no wedges (the cylinder's side meshed by
 Gmsh's default frontal algorithm, which Blossom recombines fully there; the sphere by Blossom
 full-quad, Mesh.RecombinationAlgorithm 3).
+cells=N: the layer in N cells (2); ratio=R: their heights growing by R from the surface
+(1: equal).
 Physical surface 1 "skin": the model's boundary; physical surface 2 "surface": the surface the
 layer was extruded from.
 """
@@ -30,7 +33,10 @@ shape = sys.argv[2]
 n = int(sys.argv[3]) if len(sys.argv) > 3 else 6
 inward = len(sys.argv) > 4 and sys.argv[4] == "in"
 thickness = float(sys.argv[5]) if len(sys.argv) > 5 else 0.1
-quads = len(sys.argv) > 6 and sys.argv[6] == "quads"
+options = sys.argv[6:]
+quads = "quads" in options
+cells = next((int(o[6:]) for o in options if o.startswith("cells=")), 2)
+ratio = next((float(o[6:]) for o in options if o.startswith("ratio=")), 1.0)
 assert shape in ("cylinder", "sphere")
 gmsh.initialize(["-nt", "1"])
 gmsh.option.setNumber("General.Terminal", 0)
@@ -90,7 +96,15 @@ if shape == "sphere" and quads:
     gmsh.option.setNumber("Mesh.RecombinationAlgorithm", 3)  # Blossom full-quad
 # The layer: 2 cells along the surface's normals (the surface given negatively: the other way).
 sign = -1 if inward else 1
-extruded = geo.extrudeBoundaryLayer([(2, sign * s) for s in surface], [2], [thickness], True)
+# Equal cells: one layer of `cells` elements; graded: one element per height, the heights
+# cumulative (extrudeBoundaryLayer's numElements and heights).
+if ratio == 1.0:
+    elements, heights = [cells], [thickness]
+else:
+    grow = [ratio**i for i in range(cells)]
+    elements = [1] * cells
+    heights = [thickness * sum(grow[:i + 1]) / sum(grow) for i in range(cells)]
+extruded = geo.extrudeBoundaryLayer([(2, sign * s) for s in surface], elements, heights, True)
 geo.synchronize()
 # Per surface: its top, its volume, then the sides (the extrusions of its curves; Gmsh 4.8
 # lists the surface itself first when it is given negatively).
