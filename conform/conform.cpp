@@ -1013,11 +1013,7 @@ ConformResult conform_model(const primal::Model& input, primal::Model* spare,
       for (Index w : pieces)
         wedges_split.push_back(wedge_origin[primal::index_cast<std::size_t>(w)]);
       std::sort(wedges_split.begin(), wedges_split.end());
-      std::vector<Index> origin;
-      for (std::size_t w = 0; w < wedge_origin.size(); ++w)
-        if (!std::binary_search(pieces.begin(), pieces.end(), primal::index_cast(w)))
-          origin.push_back(wedge_origin[w]);
-      wedge_origin = std::move(origin);
+      wedge_origin = remaining(input.wedges.size(), wedges_split);
       if (options.progress)
         options.progress("wedges: " + std::to_string(pieces.size()) +
                          " split into tets (a wedge layer joined the two sides of the interface)");
