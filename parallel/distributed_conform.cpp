@@ -274,10 +274,9 @@ void Distributor::gather_pairs() {
     MPI_Gatherv(mine.data(), static_cast<int>(mine.size()), pair, pairs_.data(), counts.data(),
                 displs.data(), pair, 0, comm_);
     MPI_Type_free(&pair);
-    have_pairs_ = rank_ == 0;
   }
   primal::release(mine);
-  if (!have_pairs_ || tet_pyramid_.empty()) return;
+  if (pairs_.empty() || tet_pyramid_.empty()) return;
   // The input's flat numbers (pyramids among them) as the split model's.
   const auto in = primal::element_offsets(input_);
   std::vector<Index> first_tet(input_.pyramids.size(), kInvalidIndex);
@@ -359,7 +358,7 @@ void Distributor::partition() {
     try {
       if (std::getenv("GEODE_TEST_FAIL_PARTITION"))  // tests/parallel/mpi_verify_test.sh
         throw std::runtime_error("GEODE_TEST_FAIL_PARTITION is set");
-      if (have_pairs_) po.graph = graph_of_pairs(cells(), pairs_);
+      if (!pairs_.empty()) po.graph = graph_of_pairs(cells(), pairs_);
       primal::release(pairs_);
       part_ = partition_elements(m(), size_, std::move(po));
     } catch (const std::exception& e) {

@@ -284,9 +284,9 @@ class Distributor {
   std::array<std::size_t, 5> offsets_{};
   std::vector<int> part_;  // per flat element
   // On rank 0, gathered by gather_pairs: every rank's face pairs (options_.element_pairs), by
-  // flat element of the model the stages read; none when a rank gave none.
+  // flat element of the model the stages read; none when a rank gave none (rank 0 then pairs
+  // the faces itself).
   std::vector<std::array<Index, 2>> pairs_;
-  bool have_pairs_ = false;
   // Per kind the element diced alone lowest of those outside the zone's first rings (the zone
   // takes them: the serial run's yardstick, and its aims', are the lowest over the whole model).
   std::vector<std::size_t> lowest_;
