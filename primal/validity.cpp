@@ -888,4 +888,78 @@ QuadValidityReport check_validity(const QuadMesh& mesh, const Point& normal_in) 
   return r;
 }
 
+namespace {
+
+// "3 hexes with a repeated node: 2 5 9": a count, what they are, and the first few.
+template <class T, class Show>
+void finding(std::vector<std::string>& out, const std::vector<T>& items, const std::string& what,
+             Show&& show) {
+  if (items.empty()) return;
+  std::string s = std::to_string(items.size()) + " " + what + ":";
+  for (std::size_t i = 0; i < items.size() && i < 5; ++i) s += " " + show(items[i]);
+  out.push_back(s + (items.size() > 5 ? " ..." : ""));
+}
+
+template <std::size_t N>
+std::string show_nodes(const std::array<Index, N>& k, Index base) {
+  std::string s;
+  for (auto n : k)
+    if (n != kInvalidIndex) s += (s.empty() ? "" : "-") + std::to_string(n + base);
+  return s;
+}
+
+std::string joined(const std::vector<std::string>& parts) {
+  std::string s;
+  for (const auto& p : parts) s += (s.empty() ? "" : "; ") + p;
+  return s;
+}
+
+}  // namespace
+
+std::string findings(const HexValidityReport& r, const CellNumber& cell_number, Index node_base) {
+  if (r.ok()) return {};
+  const auto cell = [&cell_number](Index i) { return std::to_string(cell_number(i)); };
+  const auto node = [node_base](Index i) { return std::to_string(i + node_base); };
+  const auto face = [node_base](const FaceKey& k) { return show_nodes(k, node_base); };
+  const auto edge = [node_base](const EdgeKey& k) { return show_nodes(k, node_base); };
+  std::vector<std::string> f;
+  finding(f, r.out_of_range_hexes, "hexes with a node out of range", cell);
+  finding(f, r.non_finite_nodes, "nodes with a non-finite coordinate", node);
+  finding(f, r.repeated_node_hexes, "hexes with a repeated node", cell);
+  finding(f, r.inverted_hexes,
+          "of " + std::to_string(r.num_hexes) + " hexes inverted (a corner Jacobian <= 0), hexes",
+          cell);
+  finding(f, r.overlapping_nodes, "nodes covered more than once (overlapping hexes), nodes",
+          [node_base](const NodeCoverage& c) { return std::to_string(c.node + node_base); });
+  finding(f, r.overshared_faces, "faces in more than two hexes, by their nodes", face);
+  finding(f, r.misoriented_faces, "faces seen in the same order by both hexes, by their nodes",
+          face);
+  finding(f, r.nonmanifold_edges, "non-manifold edges, by their nodes", edge);
+  finding(f, r.nonmanifold_vertices, "non-manifold nodes", node);
+  if (!r.boundary.closed) f.push_back("the boundary is not closed");
+  if (!r.boundary.manifold) f.push_back("the boundary is not manifold");
+  return joined(f);
+}
+
+std::string findings(const QuadValidityReport& r, const CellNumber& cell_number, Index node_base) {
+  if (r.ok()) return {};
+  const auto cell = [&cell_number](Index i) { return std::to_string(cell_number(i)); };
+  const auto node = [node_base](Index i) { return std::to_string(i + node_base); };
+  const auto edge = [node_base](const EdgeKey& k) { return show_nodes(k, node_base); };
+  std::vector<std::string> f;
+  finding(f, r.out_of_range_quads, "quads with a node out of range", cell);
+  finding(f, r.non_finite_nodes, "nodes with a non-finite coordinate", node);
+  finding(f, r.repeated_node_quads, "quads with a repeated node", cell);
+  finding(f, r.inverted_quads,
+          "of " + std::to_string(r.num_quads) + " quads inverted (a corner <= 0), quads", cell);
+  finding(f, r.overlapping_nodes, "nodes covered more than once (overlapping quads), nodes",
+          [node_base](const NodeCoverage& c) { return std::to_string(c.node + node_base); });
+  finding(f, r.overshared_edges, "edges in more than two quads, by their nodes", edge);
+  finding(f, r.misoriented_edges, "edges run the same way by both quads, by their nodes", edge);
+  finding(f, r.nonmanifold_vertices, "non-manifold nodes", node);
+  if (!r.planar) f.push_back("not planar");
+  if (f.empty()) f.push_back("not a valid quad mesh");
+  return joined(f);
+}
+
 }  // namespace geode::primal

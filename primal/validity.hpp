@@ -2,6 +2,8 @@
 // Validity of a hex mesh (and of a planar quad mesh): is it a conforming, manifold,
 // positively oriented complex? The checks return a report instead of throwing so that a
 // researcher can see everything that is wrong at once; report.ok() is the yes/no answer.
+#include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -103,5 +105,15 @@ struct QuadValidityReport {
 };
 
 QuadValidityReport check_validity(const QuadMesh& mesh, const Point& normal = Point::UnitZ());
+
+// What makes a report not ok(), in one line for a message ("2 of 26 hexes inverted (a corner
+// Jacobian <= 0), hexes: 2 7; ..."; "" when ok()): a count and the first five of each finding,
+// cells named by `cell_number` (index -> the number the output file gives it) and nodes numbered
+// from `node_base`, as the output numbers them (every writer numbers nodes in model order).
+using CellNumber = std::function<std::int64_t(Index)>;
+std::string findings(const HexValidityReport& report, const CellNumber& cell_number,
+                     Index node_base);
+std::string findings(const QuadValidityReport& report, const CellNumber& cell_number,
+                     Index node_base);
 
 }  // namespace geode::primal
