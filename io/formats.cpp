@@ -96,6 +96,7 @@ const std::vector<MeshFormat>& table() {
        .read_plain = read_vtk_plain,
        .writes_scaled_jacobians = true,
        .index_base = 0,
+       .element_order = primal::ElementOrder::kAsGiven,
        .carries = {Carried::kYes, Carried::kYes, Carried::kYes, Carried::kYes, Carried::kYes,
                    "hex, tet, pyramid, wedge; planar quad"},
        .read_variants = "ascii, binary (base64), appended (raw and base64), zlib-compressed, "
@@ -119,6 +120,7 @@ const std::vector<MeshFormat>& table() {
        .read_plain = read_vtk_plain,
        .writes_scaled_jacobians = true,
        .index_base = 0,
+       .element_order = primal::ElementOrder::kAsGiven,
        .carries = {Carried::kYes, Carried::kYes, Carried::kYes, Carried::kYes, Carried::kYes,
                    "hex, tet, pyramid, wedge; planar quad"},
        .read_variants = "ASCII and BINARY, classic and 5.1 cell layouts",
@@ -282,6 +284,10 @@ PlainMesh read_plain_mesh(const fs::path& path, const MeshFormat** format) {
 
 const MeshFormat& output_format(const fs::path& path, std::string_view format) {
   return resolve(path, format, FormatRole::kWrite);
+}
+
+primal::ElementNumbering element_numbering(const MeshFormat& format) {
+  return {format.element_order, format.index_base};
 }
 
 void write_model(const primal::Model& model, const fs::path& path, std::string_view format,

@@ -16,6 +16,7 @@
 
 #include <geode/io/gmsh.hpp>
 #include <geode/io/vtk.hpp>
+#include <geode/primal/element_numbers.hpp>
 #include <geode/primal/mesh.hpp>
 #include <geode/primal/model.hpp>
 
@@ -86,6 +87,8 @@ struct MeshFormat {
   // Writes each cell's scaled Jacobian (WriteOptions::scaled_jacobians).
   bool writes_scaled_jacobians = false;
   primal::Index index_base = 1;  // how the file numbers nodes and elements (messages)
+  // The order its writer numbers an all-hex model's elements in (element_numbers.hpp).
+  primal::ElementOrder element_order = primal::ElementOrder::kByBlock;
   FormatCarries carries;
   std::string_view read_variants;  // versions and encodings read
   std::string_view written_as;     // the version and encoding written
@@ -104,6 +107,9 @@ const MeshFormat* writer_for(const std::filesystem::path& path);
 // The entry write_model uses for `path`: `format` by name, else by the path's extension;
 // InvalidInput naming the path when neither gives a model writer.
 const MeshFormat& output_format(const std::filesystem::path& path, std::string_view format);
+
+// How the file `format` writes numbers an all-hex model's hexes (messages, reports).
+primal::ElementNumbering element_numbering(const MeshFormat& format);
 
 // Lists for messages and help texts: ".exo, .e, .msh, .vtu or .vtk" (each extension once, in
 // table order), of the formats that read (or read planar quad meshes, write, write planar quad

@@ -7,6 +7,8 @@
 #include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <numeric>
 #include <set>
 #include <sstream>
 #include <string>
@@ -14,6 +16,7 @@
 #include <geode/io/file_format.hpp>
 #include <geode/io/formats.hpp>
 #include <geode/io/read_model.hpp>
+#include <geode/primal/element_numbers.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/grid_model.hpp>
 #include "support/temp_dir.hpp"
@@ -169,4 +172,33 @@ TEST_CASE("read_forks says which reads fork a child (a caller's threads must res
 TEST_CASE("format table: docs/formats.md holds the table's matrix (geode formats prints it)") {
   const std::string doc = slurp(fs::path(GEODE_SOURCE_DIR) / "docs" / "formats.md");
   CHECK(doc.find(format_matrix_markdown()) != std::string::npos);
+}
+
+TEST_CASE("format table: element_numbering names each hex as the written file numbers it") {
+  // An all-hex model whose blocks are not in ascending runs, as a conform output's are not.
+  Model m = grid_model({4, 2, 1}, 0.5, [](int, int, int) { return false; });
+  m.hex_block = {3, 1, 2, 1, 3, 3, 2, 1};
+  std::vector<Index> all(m.hexes.size());
+  std::iota(all.begin(), all.end(), Index{0});
+  test::TempDir dir;
+  int formats = 0;
+  for (const MeshFormat& f : mesh_formats()) {
+    if (!f.write) continue;
+    INFO(f.name);
+    const fs::path file = dir.path / ("numbered" + std::string(f.extensions.front()));
+    write_model(m, file, f.name);
+    const Model back = read_model(file);
+    REQUIRE(back.hexes.size() == m.hexes.size());
+    std::map<std::int64_t, std::array<Index, 8>> by_id;  // the file's id -> its corners
+    for (std::size_t k = 0; k < back.hexes.size(); ++k)
+      by_id[element_id(back, {ElementKind::kHex, index_cast(k)})] = back.hexes[k];
+    const std::vector<std::int64_t> numbers = hex_numbers(m.hex_block, all, element_numbering(f));
+    for (std::size_t h = 0; h < m.hexes.size(); ++h) {
+      INFO("hex " << h << " numbered " << numbers[h]);
+      REQUIRE(by_id.contains(numbers[h]));
+      CHECK(by_id[numbers[h]] == m.hexes[h]);  // nodes keep their order in every format
+    }
+    ++formats;
+  }
+  CHECK(formats >= 4);
 }
