@@ -205,6 +205,7 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
     });
     // A format that writes each cell's scaled Jacobian takes conform's (the same values).
     opts.write_ahead_scaled_jacobians = io::output_format(a.output, format).writes_scaled_jacobians;
+    opts.output_numbering = io::element_numbering(io::output_format(a.output, format));
     opts.write_ahead = [&, mesh_file](const primal::Model& m, std::span<const double> sj) {
       written = &m;
       written_sj = sj;

@@ -675,11 +675,12 @@ void Conformer::match_sides() {
       took());
 }
 
-// The hexes by block in ascending id, unused nodes dropped, node and side sets carried over
-// (they depend only on the numbering). Memory: the output is built out of the dicing data,
-// not beside them: the tet children's array becomes the output's hex array, each dicing array
-// is released as soon as it is consumed, and the nodes are renumbered in place (no second copy
-// of the output mesh); the smoothing and verification that follow need room of their own.
+// The output hexes (diced hexes, geode hexes, diced tets, diced wedges, each in the block of
+// the element it comes from: not in block order), unused nodes dropped, node and side sets carried
+// over (they depend only on the numbering). Memory: the output is built out of the dicing data, not
+// beside them: the tet children's array becomes the output's hex array, each dicing array is
+// released as soon as it is consumed, and the nodes are renumbered in place (no second copy of the
+// output mesh); the smoothing and verification that follow need room of their own.
 void Conformer::assemble() {
   const std::size_t nb = layer_.hexes.size();
   // Each output hex is in the input block of the element it comes from; a geode hex in the

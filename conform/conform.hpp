@@ -24,6 +24,7 @@
 
 #include <geode/conform/buffer_layer.hpp>
 #include <geode/primal/dice_model.hpp>
+#include <geode/primal/element_numbers.hpp>
 #include <geode/primal/local_smooth.hpp>
 #include <geode/primal/model.hpp>
 #include <geode/primal/quality_report.hpp>
@@ -170,6 +171,10 @@ struct ConformOptions {
   // a hex, until it returns. Else it is empty.
   std::function<void(const primal::Model&, std::span<const double> scaled_jacobians)> write_ahead;
   bool write_ahead_scaled_jacobians = false;
+  // How the output's file numbers its hexes and nodes (io::element_numbering of its format): the
+  // report's min_hex / max_hex and verification's findings name them so. The output model's
+  // own order is not the blocks' (ConformResult::model).
+  primal::ElementNumbering output_numbering;
 };
 
 struct BlockQuality {
@@ -263,7 +268,7 @@ struct ConformResult {
   std::vector<BlockQuality>
       quality;  // one per output block, ascending id ("block N" unnamed); ConformOptions::quality
   std::vector<std::string>
-      warnings;  // e.g. "3 hexes with scaled Jacobian <= 0 (1-based output elements): 12 40 ..."
+      warnings;  // e.g. "3 hexes with scaled Jacobian <= 0: 12 40 ..." (output_numbering)
   // How many of the warnings, first, are verification's findings (what makes the result invalid:
   // invalid dicing, invalid mesh, inverted hexes); the run's own come after them.
   std::size_t findings = 0;

@@ -15,6 +15,7 @@
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
+#include <geode/primal/element_numbers.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/quality_report.hpp>
 #include <geode/primal/release.hpp>
@@ -49,7 +50,8 @@ void Conformer::invert_for_test() {
 // The output's validity (verify_locally(): around what was not diced) on the output's arrays,
 // where they are (mesh_, or the result's model once output() has moved them); the whole-mesh
 // check reads mesh_.
-void Conformer::check(std::span<const Point> points, std::span<const std::array<Index, 8>> hexes) {
+void Conformer::check(std::span<const Point> points, std::span<const std::array<Index, 8>> hexes,
+                      std::span<const int> block) {
   // What makes the result invalid leads the warnings, so that the refusal's one line (exit 4)
   // says it first, before what the run said on its way (wedges split, volumes moved).
   const auto verdict = [&](std::string why) {
@@ -75,14 +77,21 @@ void Conformer::check(std::span<const Point> points, std::span<const std::array<
     res_.verified = ConformVerify::kFull;
     res_.verified_hexes = primal::index_cast(mesh_.hexes.size());
   }
-  if (!res_.validity.ok()) verdict("invalid mesh: " + res_.validity.summary());
+  // Hexes and nodes as the output file numbers them (ConformOptions::output_numbering).
+  const primal::ElementNumbering numbering = options_.output_numbering;
+  if (!res_.validity.ok())
+    verdict("invalid mesh: " +
+            primal::findings(
+                res_.validity,
+                [&](Index h) { return primal::hex_numbers(block, {{h}}, numbering).front(); },
+                numbering.base));
   if (!inverted_.empty()) {
     std::ostringstream m;
-    // 1-based in the result model's element order (writers keep it when blocks ascend).
-    m << inverted_.size() << " hexes with scaled Jacobian <= 0 (1-based output elements):";
-    for (std::size_t i = 0; i < std::min<std::size_t>(inverted_.size(), 20); ++i)
-      m << " " << inverted_[i] + 1;
-    if (inverted_.size() > 20) m << " ...";
+    m << inverted_.size() << " hexes with scaled Jacobian <= 0:";
+    const std::size_t shown = std::min<std::size_t>(inverted_.size(), 20);
+    for (std::int64_t n : primal::hex_numbers(block, std::span(inverted_).first(shown), numbering))
+      m << " " << n;
+    if (inverted_.size() > shown) m << " ...";
     verdict(m.str());
   }
 }
@@ -201,6 +210,14 @@ void Conformer::report(const std::vector<int>& block) {
             std::min(q.input_diced_min_scaled_jacobian, wedge_diced_[w]);
     res_.quality.push_back(std::move(q));
   }
+  // Where each metric's extremes are, as the output file numbers its hexes.
+  std::vector<Index*> at;
+  for (BlockQuality& q : res_.quality)
+    for (primal::MetricSummary& m : q.report.metrics) at.insert(at.end(), {&m.min_hex, &m.max_hex});
+  std::vector<Index> hexes(at.size());
+  std::transform(at.begin(), at.end(), hexes.begin(), [](const Index* h) { return *h; });
+  const auto numbers = primal::hex_numbers(block, hexes, options_.output_numbering);
+  for (std::size_t i = 0; i < at.size(); ++i) *at[i] = primal::index_cast(numbers[i]);
   // The geode hexes against their local yardsticks, per block and over all.
   ceilings(block);
   for (std::size_t b = 0; b + 1 < geode_first_.size(); ++b) {
@@ -274,7 +291,7 @@ void Conformer::verify_and_output() {
   if (!ahead) {
     report(mesh_.block);
     if (!hand_on) primal::release(sj_);
-    check(mesh_.points, mesh_.hexes);
+    check(mesh_.points, mesh_.hexes, mesh_.block);
     announce(since(t0_));
     output();
     if (options_.write_ahead) write();
@@ -303,7 +320,7 @@ void Conformer::verify_and_output() {
     // Jacobians, unless the writer reads them) freed before the check allocates its own.
     report(res_.model.hex_block);
     if (!hand_on) primal::release(sj_);
-    check(res_.model.points, res_.model.hexes);
+    check(res_.model.points, res_.model.hexes, res_.model.hex_block);
     seconds = since(t0_);
     if (writer.joinable())
       writer.join();

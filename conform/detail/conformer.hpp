@@ -167,7 +167,8 @@ class Conformer {
   void check_dicing();
   bool verify_locally() const;
   void invert_for_test();
-  void check(std::span<const Point> points, std::span<const std::array<Index, 8>> hexes);
+  void check(std::span<const Point> points, std::span<const std::array<Index, 8>> hexes,
+             std::span<const int> block);
   void ceilings(const std::vector<int>& block);
   void report(const std::vector<int>& block);
   void announce(double seconds) const;

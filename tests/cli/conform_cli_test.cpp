@@ -7,13 +7,16 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 
 #include <geode/conform/conform.hpp>
 #include <geode/io/exodus.hpp>
 #include <geode/io/gmsh.hpp>
+#include <geode/io/read_model.hpp>
 #include <geode/primal/grid_model.hpp>
+#include <geode/primal/quality.hpp>
 #include <geode/primal/validity.hpp>
 #include "support/cli_run.hpp"
 #include "support/fixtures.hpp"
@@ -189,4 +192,86 @@ TEST_CASE("geode conform: a layer of hexes beside wedges on tets is split, warne
   CHECK(j.at("valid") == true);
   CHECK(j.at("output_min_scaled_jacobian").get<double>() >=
         j.at("input_diced_alone_min_scaled_jacobian").at("tets").get<double>());
+}
+
+TEST_CASE("geode conform: the report and exit 4 name hexes as the written file numbers them") {
+  // The hex part in block 9 and the tet part in block 7: the output holds the hex part's hexes
+  // first, and Exodus and .msh number block 7's first (VTK keeps the model's order, from 0).
+  TempDir dir;
+  primal::Model model = small_model();
+  model.hex_block.assign(model.hexes.size(), 9);
+  model.tet_block.assign(model.tets.size(), 7);
+  const fs::path in = dir.path / "in.exo";
+  io::write_exodus(model, in);
+  for (const char* ext : {".exo", ".msh", ".vtu"}) {
+    CAPTURE(ext);
+    const fs::path out = dir.path / (std::string("out") + ext);
+    const fs::path report = dir.path / (std::string("out") + ext + ".json");
+    const Run r = geode_cli("conform " + in.string() + " -o " + out.string() + " --report " +
+                            report.string() + " --quiet");
+    INFO(r.out);
+    REQUIRE(r.code == 0);
+    const primal::Model result = io::read_model(out);
+    const primal::HexMesh mesh = primal::hex_part(result);
+    // The file's id -> the hex.
+    std::map<std::int64_t, std::size_t> by_id;
+    for (std::size_t k = 0; k < result.hexes.size(); ++k)
+      by_id[primal::element_id(result, {primal::ElementKind::kHex, primal::index_cast(k)})] = k;
+    std::ifstream is(report);
+    const nlohmann::json j = nlohmann::json::parse(is);
+    REQUIRE(j.at("blocks").size() == 2);
+    for (const auto& b : j.at("blocks")) {
+      const int id = b.at("id");
+      CAPTURE(id);
+      for (const auto& m : b.at("quality").at("metrics")) {
+        if (m.at("key") != "scaled_jacobian") continue;
+        for (const char* at : {"min_hex", "max_hex"}) {
+          CAPTURE(at);
+          const auto hex = by_id.find(m.at(at).get<std::int64_t>());
+          REQUIRE(hex != by_id.end());
+          CHECK(result.hex_block[hex->second] == id);
+          const double sj = primal::hex_scaled_jacobian(
+              primal::hex_corners(mesh, primal::index_cast(hex->second)));
+          CHECK(sj ==
+                doctest::Approx(m.at(std::string(at) == "min_hex" ? "min" : "max").get<double>()));
+        }
+      }
+    }
+  }
+  // The first output hex (a diced hex of block 9) inverted by the test hook: the message names
+  // it as the written file does.
+  test::ScopedEnv hook("GEODE_TEST_INVERT_OUTPUT_HEX", "1");
+  for (const char* ext : {".exo", ".vtu"}) {
+    CAPTURE(ext);
+    const fs::path out = dir.path / (std::string("bad") + ext);
+    const Run r = geode_cli("conform " + in.string() + " -o " + out.string() +
+                            " --write-invalid --smooth none --quiet");
+    INFO(r.out);
+    REQUIRE(r.code == 4);
+    // As the file holds it (its geometry checked, the reader would refuse the inverted hex).
+    primal::ReadOptions plain;
+    plain.check_geometry = false;
+    const primal::Model result = io::read_model(out, plain);
+    const primal::HexMesh mesh = primal::hex_part(result);
+    // Verification's finding and the measured list both name it first.
+    for (const std::string words : {"hexes inverted (a corner Jacobian <= 0), hexes: ",
+                                    "hexes with scaled Jacobian <= 0: "}) {
+      CAPTURE(words);
+      const std::size_t at = r.out.find(words);
+      REQUIRE(at != std::string::npos);
+      const std::int64_t named = std::stoll(r.out.substr(at + words.size()));
+      // Not the hex's index in the output model: 192 diced tets come first in .exo.
+      CHECK(named == (std::string(ext) == ".vtu" ? 0 : 193));
+      bool found = false;
+      for (std::size_t k = 0; k < result.hexes.size(); ++k)
+        if (primal::element_id(result, {primal::ElementKind::kHex, primal::index_cast(k)}) ==
+            named) {
+          found = true;
+          CHECK(result.hex_block[k] == 9);
+          CHECK(primal::hex_scaled_jacobian(primal::hex_corners(mesh, primal::index_cast(k))) <=
+                0.0);
+        }
+      CHECK(found);
+    }
+  }
 }

@@ -27,6 +27,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
+using test::ScopedEnv;
 using test::TempDir;
 
 std::string slurp(const fs::path& p) {
@@ -343,17 +344,6 @@ TEST_CASE(
     }
   }
 }
-
-namespace {
-
-// An environment variable for one scope (the commands run as children inherit it).
-struct ScopedEnv {
-  const char* name;
-  ScopedEnv(const char* n, const std::string& value) : name(n) { ::setenv(n, value.c_str(), 1); }
-  ~ScopedEnv() { ::unsetenv(name); }
-};
-
-}  // namespace
 
 TEST_CASE(
     "cli conventions: an invalid result exits 4, says so even with --quiet, writes only with "

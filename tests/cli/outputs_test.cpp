@@ -18,6 +18,7 @@
 
 namespace fs = std::filesystem;
 using geode::test::geode_cli;
+using geode::test::ScopedEnv;
 using geode::test::TempDir;
 
 namespace {
@@ -33,13 +34,6 @@ std::vector<std::string> names_in(const fs::path& dir) {
   std::sort(names.begin(), names.end());
   return names;
 }
-
-// Sets an environment variable for the commands this test starts.
-struct ScopedEnv {
-  const char* name;
-  ScopedEnv(const char* n, const std::string& value) : name(n) { ::setenv(n, value.c_str(), 1); }
-  ~ScopedEnv() { ::unsetenv(name); }
-};
 
 }  // namespace
 
