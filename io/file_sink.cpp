@@ -4,11 +4,11 @@
 #include <unistd.h>
 
 #include <cerrno>
-#include <charconv>
 #include <cstdlib>
 #include <cstring>
 #include <new>
 
+#include <geode/io/text_chunks.hpp>
 #include <geode/primal/errors.hpp>
 
 namespace geode::io {
@@ -119,17 +119,15 @@ void FileSink::flush() {
 }
 
 void FileSink::integer(std::int64_t x) {
-  if (kBufferBytes - used_ < 24) flush();
+  if (kBufferBytes - used_ < kIntegerText) flush();
   char* at = active();
-  const auto r = std::to_chars(at + used_, at + kBufferBytes, x);
-  used_ = static_cast<std::size_t>(r.ptr - at);
+  used_ = static_cast<std::size_t>(put_number(at + used_, x) - at);
 }
 
 void FileSink::real(double x) {
-  if (kBufferBytes - used_ < 32) flush();
+  if (kBufferBytes - used_ < kRealText) flush();
   char* at = active();
-  const auto r = std::to_chars(at + used_, at + kBufferBytes, x);
-  used_ = static_cast<std::size_t>(r.ptr - at);
+  used_ = static_cast<std::size_t>(put_number(at + used_, x) - at);
 }
 
 void FileSink::close() {

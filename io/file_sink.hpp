@@ -3,8 +3,8 @@
 // checked, and a failure (ENOSPC on a full disk, EFBIG past a file size limit, EIO) throws
 // InvalidInput naming the file the user asked for (not the temporary one) and the system's
 // reason. The writers that format their own bytes (.msh) use it instead of iostreams, whose
-// errors carry no cause, and it formats numbers with std::to_chars (shortest text that reads
-// back to the same double).
+// errors carry no cause, and it formats numbers as text_chunks.hpp's put_number does
+// (the shortest text that reads back to the same double).
 //
 // The bytes go to the disk directly (O_DIRECT, where the file system takes it), a buffer at a
 // time from a thread of the sink's own while the writer fills the next one: a 150 MB ASCII .msh

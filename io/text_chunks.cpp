@@ -1,5 +1,7 @@
 #include <geode/io/text_chunks.hpp>
 
+#include <fmt/compile.h>
+#include <fmt/format.h>
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
@@ -12,6 +14,9 @@
 namespace geode::io {
 
 using primal::index_cast;
+
+char* put_number(char* at, std::int64_t x) { return fmt::format_to(at, FMT_COMPILE("{}"), x); }
+char* put_number(char* at, double x) { return fmt::format_to(at, FMT_COMPILE("{}"), x); }
 
 void write_in_chunks(
     std::size_t n, std::size_t chunk,

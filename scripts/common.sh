@@ -5,7 +5,7 @@ GEODE_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 GEODE_PACKAGES=(cmake g++ make libopenmesh-dev libeigen3-dev doctest-dev libcli11-dev
   nlohmann-json3-dev libexodusii-dev libgmsh-dev gmsh python3-vtk9 python3-matplotlib
   zlib1g-dev python3-meshio python3-netcdf4 clang libclang-rt-14-dev libjs-three chromium
-  libtbb-dev ccache python3-getfem pybind11-dev python3-numpy python3-pytest python3-nbclient python3-nbformat
+  libtbb-dev libfmt-dev ccache python3-getfem pybind11-dev python3-numpy python3-pytest python3-nbclient python3-nbformat
   python3-ipykernel python3-gmsh clang-format clang-tidy tetgen libopenmpi-dev openmpi-bin libmetis-dev)
 JOBS=${JOBS:-$(nproc)}
 # ccache keeps compiled objects between runs (and between clones: paths below the root are
