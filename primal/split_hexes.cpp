@@ -143,6 +143,445 @@ const std::vector<Triangulation>& cube_triangulations() {
   return table;
 }
 
+// A hex's quality under a choice of its six diagonals, for comparing choices: 1 + the diced
+// minimum of its best split on its corners when that is positive (a split on corners adds no
+// node, so any beats a centre), else the better of that and its centre's split (at most 1).
+double split_value(double corners, double centre) {
+  return corners > 0.0 ? 1.0 + corners : std::max(corners, centre);
+}
+
+// The stages of split_hexes. A face's diagonal is kept as a choice between the one through its
+// lowest node (0) and the other (1), so that the split hexes sharing it read it alike.
+class HexSplitter {
+ public:
+  HexSplitter(const Model& model, std::span<const Index> hexes)
+      : model_(model), hexes_(hexes.begin(), hexes.end()) {}
+
+  Model run() {
+    number_faces();
+    refuse_fans();
+    measure();
+    choose_along_chains();
+    return build();
+  }
+
+ private:
+  // A run of split hexes through opposite faces: hex i enters by local face in[i] and leaves by
+  // out[i]; faces[i] and faces[i + 1] are those; on a cycle the last face is the first.
+  struct Chain {
+    std::vector<std::size_t> hexes;
+    std::vector<int> in, out;
+    std::vector<Index> faces;
+  };
+
+  std::array<Index, 4> face_of(std::size_t k, std::size_t f) const {
+    std::array<Index, 4> v{};
+    for (std::size_t i = 0; i < 4; ++i)
+      v[i] = hex(k)[index_cast<std::size_t>(topology::kHexFaceCorners[f][i])];
+    return v;
+  }
+  const std::array<Index, 8>& hex(std::size_t k) const {
+    return model_.hexes[index_cast<std::size_t>(hexes_[k])];
+  }
+  // Hex k's local diagonals (bit f: face f's, 0 through its corners 0-2, 1 through 1-3) under
+  // the current choice.
+  int diagonals(std::size_t k) const {
+    int bits = 0;
+    for (std::size_t f = 0; f < 6; ++f)
+      bits |= (low_[k][f] ^ choice_[index_cast<std::size_t>(face_[k][f])]) << f;
+    return bits;
+  }
+
+  // Every face of the split hexes, the split hexes on it, and the diagonal the tets on it have
+  // (forced; only the tet part's side can hold tets, so a forced face has one split hex).
+  void number_faces() {
+    triangles_ = detail::tet_triangles(model_);
+    KeyMap<4> ids(6 * hexes_.size());
+    face_.resize(hexes_.size()), low_.resize(hexes_.size());
+    for (std::size_t k = 0; k < hexes_.size(); ++k)
+      for (std::size_t f = 0; f < 6; ++f) {
+        const auto v = face_of(k, f);
+        const auto [id, fresh] = ids.try_emplace(face_key(v), index_cast(on_.size()));
+        if (fresh) {
+          on_.push_back({index_cast(k), kInvalidIndex});
+          const int d = detail::tets_diagonal(triangles_, v);
+          forced_.push_back(d >= 0);
+          choice_.push_back(d >= 0 ? static_cast<char>(d ^ detail::lowest_node_diagonal(v)) : 0);
+        } else {
+          on_[index_cast<std::size_t>(*id)][1] = index_cast(k);
+        }
+        face_[k][f] = *id;
+        low_[k][f] = detail::lowest_node_diagonal(v);
+      }
+  }
+
+  // A face no tets force and no other split hex shares, under four tet triangles around a node
+  // (a four-triangle interface): that node lies on all four of its edges, and no split of the
+  // hex follows it.
+  void refuse_fans() const {
+    auto edge = [](Index a, Index b) { return std::pair{std::min(a, b), std::max(a, b)}; };
+    // The edges of split hexes' faces -> the third nodes of the tet triangles on them.
+    std::map<std::pair<Index, Index>, std::vector<Index>> thirds;
+    for (std::size_t k = 0; k < hexes_.size(); ++k)
+      for (const auto& e : topology::kHexEdgeCorners)
+        thirds[edge(hex(k)[index_cast<std::size_t>(e[0])], hex(k)[index_cast<std::size_t>(e[1])])];
+    for (const auto& t : model_.tets)
+      for (const auto& f : topology::kTetFaceCorners)
+        for (std::size_t i = 0; i < 3; ++i) {
+          const auto it = thirds.find(
+              edge(t[index_cast<std::size_t>(f[i])], t[index_cast<std::size_t>(f[(i + 1) % 3])]));
+          if (it != thirds.end()) it->second.push_back(t[index_cast<std::size_t>(f[(i + 2) % 3])]);
+        }
+    for (std::size_t k = 0; k < hexes_.size(); ++k)
+      for (std::size_t f = 0; f < 6; ++f) {
+        const auto face = index_cast<std::size_t>(face_[k][f]);
+        if (forced_[face] || on_[face][1] != kInvalidIndex) continue;
+        const auto v = face_of(k, f);
+        // The centre: of the nodes on all four edges (the tets' apexes over the fan are too),
+        // the nearest the face's middle.
+        Index centre = kInvalidIndex;
+        double nearest = 0.0;
+        Point middle = Point::Zero();
+        for (Index u : v) middle += model_.points[index_cast<std::size_t>(u)] / 4.0;
+        for (Index x : thirds.at(edge(v[0], v[1]))) {
+          bool fan = std::find(hex(k).begin(), hex(k).end(), x) == hex(k).end();
+          for (std::size_t i = 1; i < 4 && fan; ++i) {
+            const auto& o = thirds.at(edge(v[i], v[(i + 1) % 4]));
+            fan = std::find(o.begin(), o.end(), x) != o.end();
+          }
+          const double d = (model_.points[index_cast<std::size_t>(x)] - middle).norm();
+          if (fan && (centre == kInvalidIndex || d < nearest)) centre = x, nearest = d;
+        }
+        if (centre != kInvalidIndex)
+          throw TopologyError(describe_element(model_, {ElementKind::kHex, hexes_[k]}) +
+                              ": its face of nodes " + node_list(model_, v) +
+                              " lies under four tet triangles around " +
+                              describe_node(model_, centre) + ", which no split of it follows");
+      }
+  }
+
+  // Each hex's split_value under each of the 64 choices of its diagonals, from the diced
+  // minimum of each tet it could have (on its corners, or its centre coned over a face's
+  // triangle), each measured once.
+  void measure() {
+    value_.resize(hexes_.size());
+    for (std::size_t k = 0; k < hexes_.size(); ++k) {
+      std::array<Point, 9> p;  // its corners, then its centre
+      p[8] = Point::Zero();
+      for (std::size_t i = 0; i < 8; ++i) {
+        p[i] = model_.points[index_cast<std::size_t>(hex(k)[i])];
+        p[8] += p[i] / 8.0;
+      }
+      auto tet = [&](int a, int b, int c, int d) {
+        return diced_tet_min_scaled_jacobian(
+            {p[index_cast<std::size_t>(a)], p[index_cast<std::size_t>(b)],
+             p[index_cast<std::size_t>(c)], p[index_cast<std::size_t>(d)]});
+      };
+      // Per corner tet (by its corners' bits): its diced minimum, measured when first needed.
+      std::array<double, 256> corner_tet;
+      corner_tet.fill(2.0);
+      std::array<double, 64> corners;
+      corners.fill(-2.0);  // none
+      for (const Triangulation& t : cube_triangulations()) {
+        double q = 1.0;
+        for (const auto& x : t.tets) {
+          double& m = corner_tet[index_cast<std::size_t>((1 << x[0]) | (1 << x[1]) | (1 << x[2]) |
+                                                         (1 << x[3]))];
+          if (m > 1.0) m = tet(x[0], x[1], x[2], x[3]);
+          q = std::min(q, m);
+        }
+        int bits = 0;
+        for (std::size_t f = 0; f < 6; ++f) bits |= t.diagonal[f] << f;
+        corners[index_cast<std::size_t>(bits)] =
+            std::max(corners[index_cast<std::size_t>(bits)], q);
+      }
+      // Per face and diagonal: its two triangles coned to the centre, as build() makes them.
+      std::array<std::array<double, 2>, 6> cone{};
+      for (std::size_t f = 0; f < 6; ++f)
+        for (int d = 0; d < 2; ++d) {
+          const auto at = [&](int i) {
+            return topology::kHexFaceCorners[f][index_cast<std::size_t>((d + i) % 4)];
+          };
+          cone[f][index_cast<std::size_t>(d)] =
+              std::min(tet(at(0), at(2), at(1), 8), tet(at(0), at(3), at(2), 8));
+        }
+      for (std::size_t bits = 0; bits < 64; ++bits) {
+        double centre = 1.0;
+        for (std::size_t f = 0; f < 6; ++f) centre = std::min(centre, cone[f][(bits >> f) & 1]);
+        value_[k][bits] = split_value(corners[bits], centre);
+      }
+    }
+  }
+
+  // The runs of split hexes through opposite faces: a thin layer's columns, where the diagonals
+  // of the faces between its cells must agree with those the tets force at its two ends (a
+  // face's warp can be as high as the cell, so a cell whose top and bottom diagonals cross the
+  // wrong way has a flat or inverted tet), and the layer's rows along it.
+  std::vector<Chain> chains() const {
+    // Across hex k's local face f: the other split hex there and its local face, if any.
+    auto across = [&](std::size_t k, int f) -> std::pair<std::size_t, int> {
+      const auto face = index_cast<std::size_t>(face_[k][index_cast<std::size_t>(f)]);
+      const Index o = on_[face][0] == index_cast(k) ? on_[face][1] : on_[face][0];
+      if (o == kInvalidIndex) return {hexes_.size(), -1};
+      const auto ko = index_cast<std::size_t>(o);
+      for (int g = 0; g < 6; ++g)
+        if (face_[ko][index_cast<std::size_t>(g)] == index_cast(face)) return {ko, g};
+      return {hexes_.size(), -1};
+    };
+    auto opposite = [](int f) { return topology::kHexOppositeFace[index_cast<std::size_t>(f)]; };
+    auto axis = [](int f) { return f < 4 ? f % 2 : 2; };
+    std::vector<std::array<char, 3>> seen(hexes_.size(), {0, 0, 0});
+    std::vector<Chain> out;
+    for (std::size_t k0 = 0; k0 < hexes_.size(); ++k0)
+      for (int e0 : {0, 1, 4}) {
+        if (seen[k0][index_cast<std::size_t>(axis(e0))]) continue;
+        // Back to its first hex (or round a cycle to this one), then forward through it.
+        std::size_t k = k0;
+        int e = e0;
+        for (std::size_t step = 0; step <= 3 * hexes_.size(); ++step) {
+          const auto [kb, fb] = across(k, e);
+          if (fb < 0 || (kb == k0 && opposite(fb) == e0)) break;
+          k = kb, e = opposite(fb);
+        }
+        Chain c;
+        const std::size_t ks = k;
+        const int es = e;
+        c.faces.push_back(face_[k][index_cast<std::size_t>(e)]);
+        for (std::size_t step = 0; step <= 3 * hexes_.size(); ++step) {
+          seen[k][index_cast<std::size_t>(axis(e))] = 1;
+          c.hexes.push_back(k), c.in.push_back(e), c.out.push_back(opposite(e));
+          c.faces.push_back(face_[k][index_cast<std::size_t>(opposite(e))]);
+          const auto [kn, fn] = across(k, opposite(e));
+          if (fn < 0 || (kn == ks && fn == es)) break;
+          k = kn, e = fn;
+        }
+        out.push_back(std::move(c));
+      }
+    return out;
+  }
+
+  // The free faces' diagonals: from the lowest-node rule's (which splits every hex where no tets
+  // force any), each chain in turn takes the diagonals of its free faces that give its hexes the
+  // highest lowest split_value, then the highest sum (exactly, by dynamic programming along it,
+  // the hexes' other faces as they are), until no chain gains; a hex met twice in a chain is
+  // measured as it is after the change, which is kept only where it gains.
+  void choose_along_chains() {
+    const std::vector<Chain> all = chains();
+    constexpr int kSweeps = 8;  // in practice two or three
+    for (int sweep = 0; sweep < kSweeps; ++sweep) {
+      bool gained = false;
+      for (const Chain& c : all) gained |= improve(c);
+      if (!gained) break;
+    }
+  }
+
+  // The lowest and the sum of the split_values of the (distinct) hexes of chain c.
+  std::pair<double, double> score(const Chain& c) const {
+    std::vector<std::size_t> ks = c.hexes;
+    std::sort(ks.begin(), ks.end());
+    ks.erase(std::unique(ks.begin(), ks.end()), ks.end());
+    double lowest = 2.0, sum = 0.0;
+    for (std::size_t k : ks) {
+      const double v = value_[k][index_cast<std::size_t>(diagonals(k))];
+      lowest = std::min(lowest, v), sum += v;
+    }
+    return {lowest, sum};
+  }
+
+  bool improve(const Chain& c) {
+    const std::size_t n = c.hexes.size();
+    const bool cycle = c.faces.front() == c.faces.back() && n > 1;
+    auto free_face = [&](std::size_t j) { return !forced_[index_cast<std::size_t>(c.faces[j])]; };
+    // Hex i's split_value with its entering face's choice u and its leaving face's v.
+    auto value = [&](std::size_t i, int u, int v) {
+      const std::size_t k = c.hexes[i];
+      int bits = diagonals(k);
+      for (const auto& [f, x] : {std::pair{c.in[i], u}, std::pair{c.out[i], v}}) {
+        const auto fi = index_cast<std::size_t>(f);
+        bits = (bits & ~(1 << f)) | ((low_[k][fi] ^ x) << f);
+      }
+      return value_[k][index_cast<std::size_t>(bits)];
+    };
+    auto allowed = [&](std::size_t j, int x) {
+      return free_face(j) || choice_[index_cast<std::size_t>(c.faces[j])] == x;
+    };
+    constexpr double kUnreached = -1e300;
+    // Along the chain from face 0 fixed at `first` (-1: either): per face j and choice, the best
+    // lowest value (no floor), or the best sum with every value at least `*floor`; `from` the
+    // choice of the face before. Returns the best at the last face (fixed at `first` on a cycle)
+    // and fills `pick`.
+    std::vector<std::array<int, 2>> from(n + 1);
+    auto solve = [&](int first, const double* floor, std::vector<char>& pick) {
+      const bool lowest = floor == nullptr;
+      std::array<double, 2> best{kUnreached, kUnreached};
+      for (int x = 0; x < 2; ++x)
+        if (allowed(0, x) && (first < 0 || x == first))
+          best[index_cast<std::size_t>(x)] = lowest ? 2.0 : 0.0;
+      for (std::size_t i = 0; i < n; ++i) {
+        std::array<double, 2> next{kUnreached, kUnreached};
+        for (int v = 0; v < 2; ++v) {
+          if (!allowed(i + 1, v) || (cycle && i + 1 == n && first >= 0 && v != first)) continue;
+          for (int u = 0; u < 2; ++u) {
+            if (best[index_cast<std::size_t>(u)] <= kUnreached) continue;
+            const double q = value(i, u, v);
+            if (!lowest && q < *floor) continue;
+            const double s = lowest ? std::min(best[index_cast<std::size_t>(u)], q)
+                                    : best[index_cast<std::size_t>(u)] + q;
+            if (s > next[index_cast<std::size_t>(v)])
+              next[index_cast<std::size_t>(v)] = s, from[i + 1][index_cast<std::size_t>(v)] = u;
+          }
+        }
+        best = next;
+      }
+      const int last = best[1] > best[0] ? 1 : 0;
+      if (best[index_cast<std::size_t>(last)] <= kUnreached) return kUnreached;
+      pick.assign(n + 1, 0);
+      pick[n] = static_cast<char>(last);
+      for (std::size_t j = n; j > 0; --j)
+        pick[j - 1] = static_cast<char>(from[j][index_cast<std::size_t>(pick[j])]);
+      return best[index_cast<std::size_t>(last)];
+    };
+    // On a cycle face 0 is its last face too: each choice of it in turn.
+    const std::vector<int> firsts = cycle ? std::vector<int>{0, 1} : std::vector<int>{-1};
+    double floor = kUnreached;
+    std::vector<char> pick, chosen;
+    for (int first : firsts) floor = std::max(floor, solve(first, nullptr, pick));
+    if (floor <= kUnreached) return false;
+    double sum = kUnreached;
+    for (int first : firsts) {
+      const double s = solve(first, &floor, pick);
+      if (s > sum) sum = s, chosen = pick;
+    }
+    if (chosen.empty()) return false;
+    // Kept where the chain gains: a higher lowest value, or as high and a higher sum.
+    const auto before = score(c);
+    std::vector<char> old;
+    for (Index f : c.faces) old.push_back(choice_[index_cast<std::size_t>(f)]);
+    for (std::size_t j = 0; j <= n; ++j) choice_[index_cast<std::size_t>(c.faces[j])] = chosen[j];
+    const auto after = score(c);
+    constexpr double kGain = 1e-9;
+    if (after.first > before.first + kGain ||
+        (after.first >= before.first - kGain && after.second > before.second + kGain))
+      return true;
+    for (std::size_t j = 0; j <= n; ++j) choice_[index_cast<std::size_t>(c.faces[j])] = old[j];
+    return false;
+  }
+
+  Model build() const;
+
+  const Model& model_;
+  std::vector<Index> hexes_;  // the split hexes, ascending (k: a position in it)
+  KeyMap<4> triangles_;
+  std::vector<std::array<Index, 6>> face_;     // per split hex, its faces' numbers
+  std::vector<std::array<int, 6>> low_;        // per split hex, its faces' lowest-node diagonals
+  std::vector<std::array<Index, 2>> on_;       // per face, the split hexes on it
+  std::vector<char> forced_, choice_;          // per face: tets on it; 1: not the lowest-node one
+  std::vector<std::array<double, 64>> value_;  // per split hex, per choice of its diagonals
+};
+
+// `model` with the split hexes as tets on the chosen diagonals: each the triangulation of the
+// cube with them whose tets dice best, or, none fitting or the best with a tet inverted, its
+// centre coned over its faces' triangles.
+Model HexSplitter::build() const {
+  Model m = model_;
+  std::vector<char> split(model_.hexes.size(), 0);
+  std::vector<std::size_t> position(model_.hexes.size(), 0);
+  for (std::size_t k = 0; k < hexes_.size(); ++k) {
+    split[index_cast<std::size_t>(hexes_[k])] = 1;
+    position[index_cast<std::size_t>(hexes_[k])] = k;
+  }
+  detail::tets_with_blocks_and_ids(m);
+  m.hexes.clear(), m.hex_block.clear(), m.hex_ids.clear();
+  std::vector<Index> first_tet(model_.hexes.size(), kInvalidIndex),
+      kept(model_.hexes.size(), kInvalidIndex), tet_count(model_.hexes.size(), 0);
+  // A centre node's file id: past the highest so far (found once, not per centre).
+  std::int64_t last_node_id =
+      m.node_ids.empty() ? 0 : *std::max_element(m.node_ids.begin(), m.node_ids.end());
+  for (std::size_t h = 0; h < model_.hexes.size(); ++h) {
+    const ElementRef ref{ElementKind::kHex, index_cast(h)};
+    if (!split[h]) {
+      kept[h] = index_cast(m.hexes.size());
+      add_element(m, ElementKind::kHex, model_.hexes[h], block_of(model_, ref),
+                  element_id(model_, ref));
+      continue;
+    }
+    const auto& c = model_.hexes[h];
+    const int want = diagonals(position[h]);
+    auto diagonal = [&](std::size_t f) { return (want >> f) & 1; };
+    // The triangulation with those diagonals whose tets dice best.
+    std::vector<std::array<Index, 4>> best;
+    double best_quality = -2.0;
+    for (const Triangulation& t : cube_triangulations()) {
+      bool fits = true;
+      for (std::size_t f = 0; f < 6; ++f) fits &= diagonal(f) == t.diagonal[f];
+      if (!fits) continue;
+      std::vector<std::array<Index, 4>> tets;
+      for (const auto& x : t.tets)
+        tets.push_back({c[index_cast<std::size_t>(x[0])], c[index_cast<std::size_t>(x[1])],
+                        c[index_cast<std::size_t>(x[2])], c[index_cast<std::size_t>(x[3])]});
+      const double q = diced_min_scaled_jacobian(model_.points, tets);
+      if (best.empty() || q > best_quality) best = std::move(tets), best_quality = q;
+    }
+    // None fits (the 18 choices of six diagonals no triangulation has, which the tets on its
+    // faces can force), or the best has a tet inverted: its centre as a node of its own, coned
+    // over its faces' triangles, fits any.
+    if (best.empty() || best_quality <= 0.0) {
+      const Point centre = [&] {
+        Point p = Point::Zero();
+        for (Index v : c) p += model_.points[index_cast<std::size_t>(v)] / 8.0;
+        return p;
+      }();
+      // Measured on the hex's own 9 points (its corners, then the centre: local numbers).
+      std::vector<Point> local;
+      for (Index v : c) local.push_back(model_.points[index_cast<std::size_t>(v)]);
+      local.push_back(centre);
+      std::vector<std::array<Index, 4>> tets;
+      for (std::size_t f = 0; f < 6; ++f) {
+        const auto& fc = topology::kHexFaceCorners[f];
+        const int d = diagonal(f);
+        // Its two triangles, outward, coned to the centre inside: (a, c, b, centre).
+        for (int k : {1, 2}) {
+          const auto at = [&](int i) {
+            return index_cast(fc[index_cast<std::size_t>((d + i) % 4)]);
+          };
+          tets.push_back(k == 1 ? std::array<Index, 4>{at(0), at(2), at(1), 8}
+                                : std::array<Index, 4>{at(0), at(3), at(2), 8});
+        }
+      }
+      const double q = diced_min_scaled_jacobian(local, tets);
+      if (best.empty() || q > best_quality) {
+        const Index node = index_cast(m.points.size());
+        for (auto& t : tets)
+          for (Index& v : t) v = v == 8 ? node : c[index_cast<std::size_t>(v)];
+        best = std::move(tets), best_quality = q;
+        m.points.push_back(centre);
+        if (!m.node_ids.empty()) m.node_ids.push_back(++last_node_id);
+      }
+    }
+    if (best_quality <= 0.0)
+      throw TopologyError(describe_element(model_, ref) +
+                          ": the diagonals its neighbours give its faces leave no way to split "
+                          "it into positive tets, on its corners or with its centre");
+    tet_count[h] = index_cast(best.size());
+    first_tet[h] = index_cast(m.tets.size());
+    for (const auto& t : best)
+      add_element(m, ElementKind::kTet, t, block_of(model_, ref), element_id(model_, ref));
+  }
+  // Sides of split hexes: the faces of its tets whose nodes all lie on the hex's face.
+  rewrite_sides(m, [&](const Side& s, std::vector<Side>& sides) {
+    const auto h = index_cast<std::size_t>(s.element.index);
+    if (s.element.kind != ElementKind::kHex) {
+      sides.push_back(s);
+    } else if (!split[h]) {
+      sides.push_back({{ElementKind::kHex, kept[h]}, s.face});
+    } else {
+      const auto on = tet_sides_on(m, first_tet[h], tet_count[h], element_face(model_, s));
+      sides.insert(sides.end(), on.begin(), on.end());
+    }
+  });
+  return m;
+}
+
 }  // namespace
 
 CellPieces cell_pieces(const Model& model, std::span<const Index> wedges) {
@@ -233,164 +672,8 @@ WedgeColumns wedge_columns(const Model& model, std::span<const Index> wedges) {
 }
 
 Model split_hexes(const Model& model, std::span<const Index> hexes) {
-  Model m = model;
-  if (hexes.empty()) return m;
-  const KeyMap<4> triangles = detail::tet_triangles(model);
-  std::vector<char> split(model.hexes.size(), 0);
-  for (Index h : hexes) split[index_cast<std::size_t>(h)] = 1;
-
-  detail::tets_with_blocks_and_ids(m);
-  m.hexes.clear(), m.hex_block.clear(), m.hex_ids.clear();
-  std::vector<Index> first_tet(model.hexes.size(), kInvalidIndex),
-      kept(model.hexes.size(), kInvalidIndex);
-  // Each face of a split hex -> how many split hexes have it.
-  KeyMap<4> split_faces(6 * hexes.size());
-  for (Index h : hexes)
-    for (const auto& fc : topology::kHexFaceCorners) {
-      std::array<Index, 4> v{};
-      for (std::size_t i = 0; i < 4; ++i)
-        v[i] = model.hexes[index_cast<std::size_t>(h)][index_cast<std::size_t>(fc[i])];
-      const auto [count, fresh] = split_faces.try_emplace(face_key(v), 1);
-      if (!fresh) ++*count;
-    }
-  std::vector<Index> tet_count(model.hexes.size(), 0);
-  // A centre node's file id: past the highest so far (found once, not per centre).
-  std::int64_t last_node_id =
-      m.node_ids.empty() ? 0 : *std::max_element(m.node_ids.begin(), m.node_ids.end());
-  // The edges of split hexes' faces -> the third nodes of the tet triangles on them: a face
-  // under four tet triangles around a node (a four-triangle interface) has that node on all
-  // four of its edges, and no split of the hex follows it.
-  std::map<std::pair<Index, Index>, std::vector<Index>> thirds;
-  auto edge = [](Index a, Index b) { return std::pair{std::min(a, b), std::max(a, b)}; };
-  for (Index h : hexes)
-    for (const auto& e : topology::kHexEdgeCorners)
-      thirds[edge(model.hexes[index_cast<std::size_t>(h)][index_cast<std::size_t>(e[0])],
-                  model.hexes[index_cast<std::size_t>(h)][index_cast<std::size_t>(e[1])])];
-  for (const auto& t : model.tets)
-    for (const auto& f : topology::kTetFaceCorners)
-      for (std::size_t i = 0; i < 3; ++i) {
-        const auto it = thirds.find(
-            edge(t[index_cast<std::size_t>(f[i])], t[index_cast<std::size_t>(f[(i + 1) % 3])]));
-        if (it != thirds.end()) it->second.push_back(t[index_cast<std::size_t>(f[(i + 2) % 3])]);
-      }
-  for (std::size_t h = 0; h < model.hexes.size(); ++h) {
-    const ElementRef ref{ElementKind::kHex, index_cast(h)};
-    if (!split[h]) {
-      kept[h] = index_cast(m.hexes.size());
-      add_element(m, ElementKind::kHex, model.hexes[h], block_of(model, ref),
-                  element_id(model, ref));
-      continue;
-    }
-    const auto& c = model.hexes[h];
-    // Each face's diagonal: the tets' on it, else through the lowest node where another split
-    // hex shares the face, else (on the boundary) either.
-    std::array<int, 6> want{};
-    for (std::size_t f = 0; f < 6; ++f) {
-      const auto& fc = topology::kHexFaceCorners[f];
-      std::array<Index, 4> v{};
-      for (std::size_t i = 0; i < 4; ++i) v[i] = c[index_cast<std::size_t>(fc[i])];
-      want[f] = detail::tets_diagonal(triangles, v);
-      if (want[f] < 0 && *split_faces.find(face_key(v)) > 1)
-        want[f] = detail::lowest_node_diagonal(v);
-      if (want[f] < 0) {
-        // The centre: of the nodes on all four edges (the tets' apexes over the fan are too),
-        // the nearest the face's middle.
-        Index centre = kInvalidIndex;
-        double nearest = 0.0;
-        Point middle = Point::Zero();
-        for (Index u : v) middle += model.points[index_cast<std::size_t>(u)] / 4.0;
-        for (Index x : thirds.at(edge(v[0], v[1]))) {
-          bool fan = std::find(c.begin(), c.end(), x) == c.end();
-          for (std::size_t i = 1; i < 4 && fan; ++i) {
-            const auto& o = thirds.at(edge(v[i], v[(i + 1) % 4]));
-            fan = std::find(o.begin(), o.end(), x) != o.end();
-          }
-          const double d = (model.points[index_cast<std::size_t>(x)] - middle).norm();
-          if (fan && (centre == kInvalidIndex || d < nearest)) centre = x, nearest = d;
-        }
-        if (centre != kInvalidIndex)
-          throw TopologyError(describe_element(model, ref) + ": its face of nodes " +
-                              node_list(model, v) + " lies under four tet triangles around " +
-                              describe_node(model, centre) + ", which no split of it follows");
-      }
-    }
-    // The triangulation with those diagonals whose tets dice best.
-    std::vector<std::array<Index, 4>> best;
-    double best_quality = -2.0;
-    for (const Triangulation& t : cube_triangulations()) {
-      bool fits = true;
-      for (std::size_t f = 0; f < 6; ++f) fits &= want[f] < 0 || want[f] == t.diagonal[f];
-      if (!fits) continue;
-      std::vector<std::array<Index, 4>> tets;
-      for (const auto& x : t.tets)
-        tets.push_back({c[index_cast<std::size_t>(x[0])], c[index_cast<std::size_t>(x[1])],
-                        c[index_cast<std::size_t>(x[2])], c[index_cast<std::size_t>(x[3])]});
-      const double q = diced_min_scaled_jacobian(model.points, tets);
-      if (best.empty() || q > best_quality) best = std::move(tets), best_quality = q;
-    }
-    // None fits (the 18 choices of six diagonals no triangulation has, which the tets on its
-    // faces can force), or the best has a tet inverted: its centre as a node of its own, coned
-    // over its faces' triangles, fits any.
-    if (best.empty() || best_quality <= 0.0) {
-      const Point centre = [&] {
-        Point p = Point::Zero();
-        for (Index v : c) p += model.points[index_cast<std::size_t>(v)] / 8.0;
-        return p;
-      }();
-      // Measured on the hex's own 9 points (its corners, then the centre: local numbers).
-      std::vector<Point> local;
-      for (Index v : c) local.push_back(model.points[index_cast<std::size_t>(v)]);
-      local.push_back(centre);
-      std::vector<std::array<Index, 4>> tets;
-      for (std::size_t f = 0; f < 6; ++f) {
-        const auto& fc = topology::kHexFaceCorners[f];
-        int d = want[f];
-        if (d < 0) {
-          std::array<Index, 4> v{};
-          for (std::size_t i = 0; i < 4; ++i) v[i] = c[index_cast<std::size_t>(fc[i])];
-          d = detail::lowest_node_diagonal(v);
-        }
-        // Its two triangles, outward, coned to the centre inside: (a, c, b, centre).
-        for (int k : {1, 2}) {
-          const auto at = [&](int i) {
-            return index_cast(fc[index_cast<std::size_t>((d + i) % 4)]);
-          };
-          tets.push_back(k == 1 ? std::array<Index, 4>{at(0), at(2), at(1), 8}
-                                : std::array<Index, 4>{at(0), at(3), at(2), 8});
-        }
-      }
-      const double q = diced_min_scaled_jacobian(local, tets);
-      if (best.empty() || q > best_quality) {
-        const Index node = index_cast(m.points.size());
-        for (auto& t : tets)
-          for (Index& v : t) v = v == 8 ? node : c[index_cast<std::size_t>(v)];
-        best = std::move(tets), best_quality = q;
-        m.points.push_back(centre);
-        if (!m.node_ids.empty()) m.node_ids.push_back(++last_node_id);
-      }
-    }
-    if (best_quality <= 0.0)
-      throw TopologyError(describe_element(model, ref) +
-                          ": the diagonals its neighbours give its faces leave no way to split "
-                          "it into positive tets, on its corners or with its centre");
-    tet_count[h] = index_cast(best.size());
-    first_tet[h] = index_cast(m.tets.size());
-    for (const auto& t : best)
-      add_element(m, ElementKind::kTet, t, block_of(model, ref), element_id(model, ref));
-  }
-  // Sides of split hexes: the faces of its tets whose nodes all lie on the hex's face.
-  rewrite_sides(m, [&](const Side& s, std::vector<Side>& sides) {
-    const auto h = index_cast<std::size_t>(s.element.index);
-    if (s.element.kind != ElementKind::kHex) {
-      sides.push_back(s);
-    } else if (!split[h]) {
-      sides.push_back({{ElementKind::kHex, kept[h]}, s.face});
-    } else {
-      const auto on = tet_sides_on(m, first_tet[h], tet_count[h], element_face(model, s));
-      sides.insert(sides.end(), on.begin(), on.end());
-    }
-  });
-  return m;
+  if (hexes.empty()) return model;
+  return HexSplitter(model, hexes).run();
 }
 
 }  // namespace geode::primal

@@ -7,15 +7,19 @@
 // as tets, the whole layer is diced with the tets around it and needs no buffer layer.
 //
 // A quad face takes the diagonal the tets already on it have (a split pyramid's or wedge's, the
-// tet part's), else, where two split hexes share it, the one through its lowest node, so the tets
-// conform; on the boundary either. Each hex then takes the triangulation of the cube by its
-// corners (74: two of 5 tets, the rest of 6) that has those diagonals and whose tets dice best.
-// By the lowest-node rule alone one always has them (the cone from the hex's lowest corner:
-// Dompierre, Labbe, Vallet, Camarero, "How to subdivide pyramids, prisms and hexahedra into
-// tetrahedra", IMR 1999); 18 of the 64 choices of six diagonals have none, which the tets on its
-// faces can force (Gmsh's pyramids on both sides of a layer, split first). A hex none fits, or
-// whose best has an inverted tet, gets its centre as a node of its own, coned over its faces'
-// triangles: 12 tets.
+// tet part's); the others are chosen run by run of hexes through opposite faces (a layer's
+// columns and rows), for the best lowest then total quality of the run's hexes' splits, starting
+// from the diagonals through their lowest nodes, so the tets conform. Each hex then takes the
+// triangulation of the cube by its corners (74: two of 5 tets, the rest of 6) that has those
+// diagonals and whose tets dice best. By the lowest-node rule alone one always has them (the cone
+// from the hex's lowest corner: Dompierre, Labbe, Vallet, Camarero, "How to subdivide pyramids,
+// prisms and hexahedra into tetrahedra", IMR 1999), but the tets on its faces can force others:
+// 18 of the 64 choices of six diagonals have none (Gmsh's pyramids on both sides of a layer,
+// split first), and where a thin cell's faces are warped about as much as it is high (a curved
+// layer in 3 cells, the extruded surface's nodes numbered before the cells' inner ones), a top
+// diagonal crossing the bottom one the wrong way leaves a tet flat or inverted, so a column's
+// free faces must follow the diagonals its ends are given. A hex none fits, or whose best has an
+// inverted tet, gets its centre as a node of its own, coned over its faces' triangles: 12 tets.
 
 #include <array>
 #include <span>

@@ -121,6 +121,39 @@ TEST_CASE("a thin hex layer with wedges through it between tets is split into te
   }
 }
 
+TEST_CASE("a thin layer in 3 or 4 cells, equal or graded, is split into tets, valid") {
+  // The extruded surface's nodes are numbered before the cells' inner ones, so the outermost
+  // cell's lowest node is on its top face, whose pyramid's split gives it a diagonal; its faces
+  // are warped about as much as the cell is high, so the lowest-node diagonal below crossing it
+  // left a tet inverted: the layer kept its hexes (0.0036 to 0.0048 from the hex side, exit 4
+  // from the tet side) until the faces between the cells took their diagonals along the
+  // columns (primal/split_hexes.hpp).
+  const test::TempDir dir;
+  for (const std::string args :
+       {"cylinder 6 out 0.06 cells=3", "cylinder 6 out 0.06 cells=3 ratio=1.3",
+        "cylinder 6 out 0.08 cells=4"}) {
+    CAPTURE(args);
+    const primal::Model input = layer_model(dir, args);
+    REQUIRE(!input.wedges.empty());
+    for (const auto side : {conform::BufferSide::kHex, conform::BufferSide::kTet}) {
+      if (side == conform::BufferSide::kTet && !args.ends_with("cells=3")) continue;
+      CAPTURE(static_cast<int>(side));
+      conform::ConformOptions o;
+      o.buffer.side = side;
+      const conform::ConformResult r = conform::conform(input, o);
+      test::check_conform_result(r, 0, 1);
+      CHECK(r.warnings.front().find(std::to_string(input.hexes.size()) + " hexes and " +
+                                    std::to_string(input.wedges.size()) +
+                                    " wedges split into tets: ") == 0);
+      CHECK(r.hexes_split == primal::index_cast(input.hexes.size()));
+      CHECK(r.wedges_split == primal::index_cast(input.wedges.size()));
+      const double lowest = primal::min_scaled_jacobian(primal::hex_part(r.model));
+      CHECK(lowest >= r.yardstick());
+      CHECK(lowest > 0.03);  // 0.048 to 0.05
+    }
+  }
+}
+
 TEST_CASE("a layer too thin to split into tets keeps its hexes, valid, and says which one") {
   // 0.02 thick in 2 cells on a radius of 0.4: a hex has no positive split on the diagonals its
   // pyramids force, so only the wedges are split, as before the layer was split whole: valid at

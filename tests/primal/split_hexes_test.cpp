@@ -148,3 +148,43 @@ TEST_CASE("split_hexes: a face under four tet triangles around a node is refused
                         "lies under four tet triangles around node 9"),
       TopologyError);
 }
+
+TEST_CASE("split_hexes: a column's faces between its cells follow the diagonal forced on its end") {
+  // Two cells 0.1 high over a unit square whose corners 1 and 3 are 0.15 higher than 0 and 2 (a
+  // warped layer, as a curved one's cells are): tets from an apex above force the top face's
+  // low diagonal, 0-2. The face between the cells has its lowest node at corner 1, as where the
+  // extruded surface's nodes come first: its lowest-node diagonal, 1-3, lies above the top's,
+  // so no split of the upper cell, nor its centre's, had positive tets on those two.
+  const double height = 0.1, warp = 0.15;
+  primal::Model m;
+  // Nodes: the top level's corners 0-3, then the middle's 1, 2, 3, 0, then the bottom's 0-3.
+  const std::array<std::array<int, 4>, 3> order{{{0, 1, 2, 3}, {1, 2, 3, 0}, {0, 1, 2, 3}}};
+  std::array<std::array<Index, 4>, 3> node{};  // per level (bottom first), per corner
+  for (std::size_t level : {2, 1, 0})
+    for (int c : order[2 - level]) {
+      const auto& xy = primal::topology::kHexCornerCoords[static_cast<std::size_t>(c)];
+      node[level][static_cast<std::size_t>(c)] = primal::index_cast(m.points.size());
+      m.points.push_back(
+          Point(xy[0], xy[1], height * static_cast<double>(level) + (c % 2 ? warp : 0.0)));
+    }
+  for (std::size_t level = 0; level < 2; ++level) {
+    std::array<Index, 8> h{};
+    for (std::size_t c = 0; c < 4; ++c) h[c] = node[level][c], h[c + 4] = node[level + 1][c];
+    primal::add_element(m, ElementKind::kHex, h, 1, primal::index_cast(level) + 1);
+  }
+  m.points.push_back(Point(0.5, 0.5, 2 * height + 0.5));
+  const Index apex = primal::index_cast(m.points.size() - 1);
+  const auto& top = node[2];
+  primal::add_element(m, ElementKind::kTet, std::array<Index, 4>{top[0], top[1], top[2], apex}, 2,
+                      1);
+  primal::add_element(m, ElementKind::kTet, std::array<Index, 4>{top[0], top[2], top[3], apex}, 2,
+                      2);
+  for (const auto& t : m.tets) REQUIRE(volume(m, t) > 0.0);
+  REQUIRE(primal::check_input(m).ok());
+  REQUIRE(std::min({node[1][0], node[1][1], node[1][2], node[1][3]}) == node[1][1]);
+  const primal::Model s = primal::split_hexes(m, std::vector<Index>{0, 1});
+  CHECK(s.hexes.empty());
+  CHECK(s.points.size() == m.points.size());  // on their corners
+  for (const auto& t : s.tets) CHECK(volume(s, t) > 0.0);
+  CHECK(primal::check_input(s).ok());  // conforming: the top face's two triangles kept
+}
