@@ -977,10 +977,10 @@ ConformResult conform_model(const primal::Model& input, primal::Model* spare,
           primal::Model tets = primal::split_hexes(wedges, hexes_now);
           own = std::move(tets);
         } catch (const TopologyError& e) {
-          // Too thin for its faces' curvature: a hex has no positive split on the diagonals its
-          // pyramids force. Its wedges alone are split below, as a thicker layer's are: a
-          // mesh of flat buffer hexes at the holes, valid where they are (a 0.02 layer on a
-          // radius of 0.4: 0.0012), rather than none.
+          // A hex with no positive split on the diagonals the tets on its faces force, or a
+          // face under four tet triangles (which no split follows). Its wedges alone are split
+          // below, as a thicker layer's are: buffer hexes at the holes, valid where they are,
+          // rather than no mesh.
           layer_kept = true;
           warnings.push_back(where + ", but its hexes stay hexes: " + e.what());
         }

@@ -160,6 +160,7 @@ class HexSplitter {
   Model run() {
     number_faces();
     refuse_fans();
+    find_pyramids();
     measure();
     choose_along_chains();
     return build();
@@ -173,6 +174,50 @@ class HexSplitter {
     std::vector<int> in, out;
     std::vector<Index> faces;
   };
+
+  // A pyramid on a forced face (find_pyramids): its two tets, the face's nodes as its split hex
+  // has them and its apex; per choice of the face (as choice_), its tets' split_value.
+  struct Pyramid {
+    std::size_t face;
+    std::array<Index, 2> tets;
+    std::array<Index, 4> quad;
+    Index apex;
+    bool reversed;  // its tets are (quad's cyclic order, apex) mirrored
+    std::array<double, 2> value;
+    int low;    // the quad's lowest-node diagonal
+    int given;  // the choice its tets have
+  };
+
+  // The node of tet t not on quad q, or none if it has two.
+  Index fourth(Index t, const std::array<Index, 4>& q) const {
+    Index out = kInvalidIndex;
+    for (Index v : model_.tets[index_cast<std::size_t>(t)])
+      if (std::find(q.begin(), q.end(), v) == q.end()) {
+        if (out != kInvalidIndex) return kInvalidIndex;
+        out = v;
+      }
+    return out;
+  }
+  // Pyramid p's two tets along diagonal d of its quad (0: q[0]-q[2], 1: q[1]-q[3]).
+  std::array<std::array<Index, 4>, 2> tets_of(const Pyramid& p, int d) const {
+    const auto& q = p.quad;
+    const auto at = [&](int i) { return q[index_cast<std::size_t>((d + i) % 4)]; };
+    std::array<std::array<Index, 4>, 2> t{
+        {{at(0), at(1), at(2), p.apex}, {at(0), at(2), at(3), p.apex}}};
+    if (p.reversed)
+      for (auto& x : t) std::swap(x[0], x[1]);
+    return t;
+  }
+  double volume(const std::array<Index, 4>& t) const {
+    const auto at = [&](std::size_t i) { return model_.points[index_cast<std::size_t>(t[i])]; };
+    return (at(1) - at(0)).cross(at(2) - at(0)).dot(at(3) - at(0));
+  }
+  // Face `face`'s pyramid's value under choice x, or none (2: above every value) where it has no
+  // pyramid.
+  double pyramid_value(Index face, int x) const {
+    const int p = pyramid_[index_cast<std::size_t>(face)];
+    return p < 0 ? 2.0 : pyramids_[index_cast<std::size_t>(p)].value[index_cast<std::size_t>(x)];
+  }
 
   std::array<Index, 4> face_of(std::size_t k, std::size_t f) const {
     std::array<Index, 4> v{};
@@ -258,6 +303,49 @@ class HexSplitter {
                               " lies under four tet triangles around " +
                               describe_node(model_, centre) + ", which no split of it follows");
       }
+  }
+
+  // The forced faces whose two tets share their fourth node: a pyramid split along the face's
+  // diagonal (Gmsh's, on the tet side of a layer), which can as well be split along the other
+  // one, its four side triangles kept. Such a face's diagonal is chosen with the hexes' (a
+  // column's end need not cross its cells' faces the wrong way), each choice valued by its two
+  // tets as a hex by its split (split_value). A tet on two such faces leaves both as forced.
+  void find_pyramids() {
+    pyramid_.assign(on_.size(), -1);
+    std::vector<int> uses(model_.tets.size(), 0);
+    for (std::size_t k = 0; k < hexes_.size(); ++k)
+      for (std::size_t f = 0; f < 6; ++f) {
+        const auto face = index_cast<std::size_t>(face_[k][f]);
+        if (!forced_[face]) continue;
+        const auto q = face_of(k, f);
+        const int given = low_[k][f] ^ choice_[face];  // 0: q[0]-q[2], 1: q[1]-q[3]
+        const auto g = index_cast<std::size_t>(given);
+        const Index* a = triangles_.find(face_key(std::array<Index, 3>{q[g], q[g + 1], q[g + 2]}));
+        const Index* b =
+            triangles_.find(face_key(std::array<Index, 3>{q[g], q[g + 2], q[(g + 3) % 4]}));
+        if (a == nullptr || b == nullptr || *a == *b) continue;
+        const Index apex = fourth(*a, q), other = fourth(*b, q);
+        if (apex == kInvalidIndex || apex != other) continue;
+        Pyramid p{face, {*a, *b}, q, apex, false, {}, low_[k][f], choice_[face]};
+        // Its tets as the model has them are positive: the quad's cyclic order then the apex is
+        // their orientation, or its mirror.
+        p.reversed = volume(tets_of(p, given)[0]) < 0.0;
+        for (int x = 0; x < 2; ++x) {
+          double lowest = 1.0;
+          for (const auto& t : tets_of(p, low_[k][f] ^ x)) {
+            std::array<Point, 4> c;
+            for (std::size_t i = 0; i < 4; ++i) c[i] = model_.points[index_cast<std::size_t>(t[i])];
+            lowest = std::min(lowest, diced_tet_min_scaled_jacobian(c));
+          }
+          p.value[index_cast<std::size_t>(x)] = split_value(lowest, lowest);
+        }
+        ++uses[index_cast<std::size_t>(*a)], ++uses[index_cast<std::size_t>(*b)];
+        pyramid_[face] = index_cast<int>(pyramids_.size());
+        pyramids_.push_back(p);
+      }
+    for (std::size_t i = 0; i < pyramids_.size(); ++i)
+      for (Index t : pyramids_[i].tets)
+        if (uses[index_cast<std::size_t>(t)] > 1) pyramid_[pyramids_[i].face] = -1;
   }
 
   // Each hex's split_value under each of the 64 choices of its diagonals, from the diced
@@ -385,6 +473,12 @@ class HexSplitter {
       const double v = value_[k][index_cast<std::size_t>(diagonals(k))];
       lowest = std::min(lowest, v), sum += v;
     }
+    // Its ends' pyramids (a face with one: only at an end, the tets on its other side).
+    for (Index f : {c.faces.front(), c.faces.back()})
+      if (pyramid_[index_cast<std::size_t>(f)] >= 0) {
+        const double v = pyramid_value(f, choice_[index_cast<std::size_t>(f)]);
+        lowest = std::min(lowest, v), sum += v;
+      }
     return {lowest, sum};
   }
 
@@ -402,9 +496,15 @@ class HexSplitter {
       }
       return value_[k][index_cast<std::size_t>(bits)];
     };
-    auto allowed = [&](std::size_t j, int x) {
-      return free_face(j) || choice_[index_cast<std::size_t>(c.faces[j])] == x;
+    auto has_pyramid = [&](std::size_t j) {
+      return pyramid_[index_cast<std::size_t>(c.faces[j])] >= 0;
     };
+    auto allowed = [&](std::size_t j, int x) {
+      return free_face(j) || has_pyramid(j) || choice_[index_cast<std::size_t>(c.faces[j])] == x;
+    };
+    // Face j's own value under choice x (its pyramid's), and its part of the sum.
+    auto face_value = [&](std::size_t j, int x) { return pyramid_value(c.faces[j], x); };
+    auto face_sum = [&](std::size_t j, int x) { return has_pyramid(j) ? face_value(j, x) : 0.0; };
     constexpr double kUnreached = -1e300;
     // Along the chain from face 0 fixed at `first` (-1: either): per face j and choice, the best
     // lowest value (no floor), or the best sum with every value at least `*floor`; `from` the
@@ -415,18 +515,21 @@ class HexSplitter {
       const bool lowest = floor == nullptr;
       std::array<double, 2> best{kUnreached, kUnreached};
       for (int x = 0; x < 2; ++x)
-        if (allowed(0, x) && (first < 0 || x == first))
-          best[index_cast<std::size_t>(x)] = lowest ? 2.0 : 0.0;
+        if (allowed(0, x) && (first < 0 || x == first) && (lowest || face_value(0, x) >= *floor))
+          best[index_cast<std::size_t>(x)] = lowest ? face_value(0, x) : face_sum(0, x);
       for (std::size_t i = 0; i < n; ++i) {
         std::array<double, 2> next{kUnreached, kUnreached};
         for (int v = 0; v < 2; ++v) {
           if (!allowed(i + 1, v) || (cycle && i + 1 == n && first >= 0 && v != first)) continue;
           for (int u = 0; u < 2; ++u) {
             if (best[index_cast<std::size_t>(u)] <= kUnreached) continue;
-            const double q = value(i, u, v);
-            if (!lowest && q < *floor) continue;
-            const double s = lowest ? std::min(best[index_cast<std::size_t>(u)], q)
-                                    : best[index_cast<std::size_t>(u)] + q;
+            // The hex, and the face it leaves by unless that is face 0 again (a cycle).
+            const bool again = cycle && i + 1 == n;
+            const double q = value(i, u, v), w = again ? 2.0 : face_value(i + 1, v);
+            if (!lowest && (q < *floor || w < *floor)) continue;
+            const double s =
+                lowest ? std::min({best[index_cast<std::size_t>(u)], q, w})
+                       : best[index_cast<std::size_t>(u)] + q + (again ? 0.0 : face_sum(i + 1, v));
             if (s > next[index_cast<std::size_t>(v)])
               next[index_cast<std::size_t>(v)] = s, from[i + 1][index_cast<std::size_t>(v)] = u;
           }
@@ -477,6 +580,8 @@ class HexSplitter {
   std::vector<std::array<Index, 2>> on_;       // per face, the split hexes on it
   std::vector<char> forced_, choice_;          // per face: tets on it; 1: not the lowest-node one
   std::vector<std::array<double, 64>> value_;  // per split hex, per choice of its diagonals
+  std::vector<Pyramid> pyramids_;
+  std::vector<int> pyramid_;  // per face: its pyramid in pyramids_, or -1
 };
 
 // `model` with the split hexes as tets on the chosen diagonals: each the triangulation of the
@@ -567,10 +672,33 @@ Model HexSplitter::build() const {
     for (const auto& t : best)
       add_element(m, ElementKind::kTet, t, block_of(model_, ref), element_id(model_, ref));
   }
-  // Sides of split hexes: the faces of its tets whose nodes all lie on the hex's face.
+  // The pyramids whose face took the other diagonal: their two tets along it, in their places.
+  std::vector<char> flipped(model_.tets.size(), 0);
+  for (const Pyramid& p : pyramids_) {
+    if (pyramid_[p.face] < 0 || choice_[p.face] == p.given) continue;
+    const auto tets = tets_of(p, p.low ^ choice_[p.face]);
+    for (std::size_t i = 0; i < 2; ++i) {
+      m.tets[index_cast<std::size_t>(p.tets[i])] = tets[i];
+      flipped[index_cast<std::size_t>(p.tets[i])] = 1;
+    }
+  }
+  // Sides of split hexes: the faces of its tets whose nodes all lie on the hex's face; of a
+  // flipped pyramid's tets: the new one's on the same side triangle.
   rewrite_sides(m, [&](const Side& s, std::vector<Side>& sides) {
     const auto h = index_cast<std::size_t>(s.element.index);
-    if (s.element.kind != ElementKind::kHex) {
+    if (s.element.kind == ElementKind::kTet && flipped[h]) {
+      const int p = [&] {
+        for (std::size_t i = 0; i < pyramids_.size(); ++i)
+          if (std::find(pyramids_[i].tets.begin(), pyramids_[i].tets.end(), s.element.index) !=
+              pyramids_[i].tets.end())
+            return index_cast<int>(i);
+        return -1;
+      }();
+      for (Index t : pyramids_[index_cast<std::size_t>(p)].tets) {
+        const auto on = tet_sides_on(m, t, 1, element_face(model_, s));
+        sides.insert(sides.end(), on.begin(), on.end());
+      }
+    } else if (s.element.kind != ElementKind::kHex) {
       sides.push_back(s);
     } else if (!split[h]) {
       sides.push_back({{ElementKind::kHex, kept[h]}, s.face});

@@ -6,20 +6,23 @@
 // hexes inverted or flat, or two layer hexes meeting along an edge only between two holes);
 // as tets, the whole layer is diced with the tets around it and needs no buffer layer.
 //
-// A quad face takes the diagonal the tets already on it have (a split pyramid's or wedge's, the
-// tet part's); the others are chosen run by run of hexes through opposite faces (a layer's
-// columns and rows), for the best lowest then total quality of the run's hexes' splits, starting
-// from the diagonals through their lowest nodes, so the tets conform. Each hex then takes the
+// A quad face takes the diagonal the tets already on it have (a split wedge's, the tet part's),
+// unless they are a pyramid's two tets (sharing their fourth node: Gmsh's pyramids on a layer,
+// split first), which may as well be split along the other one; the others are chosen run by
+// run of hexes through opposite faces (a layer's columns and rows), for the best lowest then
+// total quality of the run's hexes' splits and its end pyramids' tets, starting from the
+// diagonals through their lowest nodes, so the tets conform. Each hex then takes the
 // triangulation of the cube by its corners (74: two of 5 tets, the rest of 6) that has those
 // diagonals and whose tets dice best. By the lowest-node rule alone one always has them (the cone
 // from the hex's lowest corner: Dompierre, Labbe, Vallet, Camarero, "How to subdivide pyramids,
 // prisms and hexahedra into tetrahedra", IMR 1999), but the tets on its faces can force others:
-// 18 of the 64 choices of six diagonals have none (Gmsh's pyramids on both sides of a layer,
-// split first), and where a thin cell's faces are warped about as much as it is high (a curved
-// layer in 3 cells, the extruded surface's nodes numbered before the cells' inner ones), a top
-// diagonal crossing the bottom one the wrong way leaves a tet flat or inverted, so a column's
-// free faces must follow the diagonals its ends are given. A hex none fits, or whose best has an
-// inverted tet, gets its centre as a node of its own, coned over its faces' triangles: 12 tets.
+// 18 of the 64 choices of six diagonals have none, and where a thin cell's faces are warped
+// about as much as it is high (a curved layer in 3 cells, the extruded surface's nodes numbered
+// before the cells' inner ones), a top diagonal crossing the bottom one the wrong way leaves a
+// tet flat or inverted, so a column's free faces must follow the diagonals its ends are given,
+// and where both ends are given (pyramids on both sides of a layer 0.01 high on a radius of
+// 0.4), one end's pyramid must follow the other. A hex none fits, or whose best has an inverted
+// tet, gets its centre as a node of its own, coned over its faces' triangles: 12 tets.
 
 #include <array>
 #include <span>
@@ -47,7 +50,8 @@ struct WedgeColumns {
 };
 WedgeColumns wedge_columns(const Model& model, std::span<const Index> wedges);
 
-// `model` with `hexes` (ascending) as 5, 6 or 12 tets each: its tets first, then each split
+// `model` with `hexes` (ascending) as 5, 6 or 12 tets each: its tets first (a re-split
+// pyramid's two in their places, the sides on them moved with their triangles), then each split
 // hex's in hex order, in the hex's block with its file id; its other hexes kept in order; a
 // centre node appended for each hex split around one (the next file id); side sets on a split
 // hex's faces moved to its tets' faces on them (two on a quad). Throws TopologyError naming a hex

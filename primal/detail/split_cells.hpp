@@ -12,15 +12,16 @@
 
 namespace geode::primal::detail {
 
-// Every face of the tets of `model`, by its nodes.
+// Every face of the tets of `model`, by its nodes, to the first tet that has it.
 inline KeyMap<4> tet_triangles(const Model& model) {
   KeyMap<4> triangles(4 * model.tets.size());
-  for (const auto& t : model.tets)
+  for (std::size_t i = 0; i < model.tets.size(); ++i)
     for (const auto& f : topology::kTetFaceCorners) {
+      const auto& t = model.tets[i];
       const std::array<Index, 3> tri{t[index_cast<std::size_t>(f[0])],
                                      t[index_cast<std::size_t>(f[1])],
                                      t[index_cast<std::size_t>(f[2])]};
-      triangles.try_emplace(face_key(tri), 0);
+      triangles.try_emplace(face_key(tri), index_cast(i));
     }
   return triangles;
 }

@@ -4,8 +4,9 @@
 // only, the wedges left holes through the layer: on the sphere two layer hexes met along an edge
 // only between two holes (exit 3 from either side), on the cylinder the buffer hexes at the holes'
 // walls were flat (0.004, 0.08 x the yardstick) or inverted from the tet side (exit 4). conform
-// now splits the layer into tets and dices it with the tets around it; a layer too thin to split
-// (no positive split on the diagonals its pyramids force) keeps its hexes as before.
+// now splits the layer into tets and dices it with the tets around it; a layer that cannot be
+// split (a quad under four tet triangles, which no split of its hex follows) keeps its hexes as
+// before.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -154,24 +155,86 @@ TEST_CASE("a thin layer in 3 or 4 cells, equal or graded, is split into tets, va
   }
 }
 
-TEST_CASE("a layer too thin to split into tets keeps its hexes, valid, and says which one") {
-  // 0.02 thick in 2 cells on a radius of 0.4: a hex has no positive split on the diagonals its
-  // pyramids force, so only the wedges are split, as before the layer was split whole: valid at
-  // 0.0012 (0.04 x the yardstick), the layer's hex named in a warning, rather than a refusal.
+TEST_CASE("a layer whose pyramids force crossing diagonals is split, their pyramids re-split") {
+  // Cells 0.01 high on a radius of 0.4 (0.02 in 2 cells, 0.03 in 3): a face's triangles dip
+  // about as much as the cell is high, and the pyramids on both sides force the column's two
+  // end diagonals so that some cell's must cross the wrong way. The layer kept its hexes (0.0012
+  // with the defaults, 0.0001 without smoothing, exit 4 from the tet side, and in 3 cells exit
+  // 4 without smoothing too) until a pyramid's face took the diagonal its column needs, its two
+  // tets split along it instead (its side triangles kept).
   const test::TempDir dir;
-  const primal::Model input = layer_model(dir, "cylinder 5 out 0.02");
-  REQUIRE(!input.wedges.empty());
+  for (const std::string args : {"cylinder 5 out 0.02", "cylinder 5 out 0.03 cells=3"}) {
+    CAPTURE(args);
+    const primal::Model input = layer_model(dir, args);
+    REQUIRE(!input.wedges.empty());
+    REQUIRE(!input.pyramids.empty());
+    for (const auto smooth : {conform::ConformSmooth::kLocal, conform::ConformSmooth::kNone})
+      for (const auto side : {conform::BufferSide::kHex, conform::BufferSide::kTet}) {
+        if (smooth == conform::ConformSmooth::kNone && side == conform::BufferSide::kTet) continue;
+        CAPTURE(static_cast<int>(smooth));
+        CAPTURE(static_cast<int>(side));
+        conform::ConformOptions o;
+        o.smooth = smooth;
+        o.buffer.side = side;
+        const conform::ConformResult r = conform::conform(input, o);
+        test::check_conform_result(r, 0, 1);
+        CHECK(r.hexes_split == primal::index_cast(input.hexes.size()));
+        const double lowest = primal::min_scaled_jacobian(primal::hex_part(r.model));
+        CHECK(lowest >= r.yardstick());
+        CHECK(lowest > 0.02);  // 0.028 to 0.029
+      }
+  }
+}
+
+TEST_CASE("a thin layer that cannot be split keeps its hexes, valid, and says which one") {
+  // The 0.1 cylinder's layer with one pyramid on it made four tets around its base's middle (a
+  // node a tet mesher may put there): no split of the hex under it follows those four
+  // triangles, so only the wedges are split, as for a thick layer, and the four-triangle quad
+  // gets its template: valid, the hex named in a warning, rather than a refusal.
+  const test::TempDir dir;
+  primal::Model input = layer_model(dir, "cylinder 6 out 0.1");
+  REQUIRE(!input.pyramids.empty());
+  const std::size_t p = 0, last = input.pyramids.size() - 1;
+  const auto pyramid = input.pyramids[p];
+  const int block = primal::block_of(input, {primal::ElementKind::kPyramid, primal::index_cast(p)});
+  Point middle = Point::Zero();
+  for (std::size_t i = 0; i < 4; ++i)
+    middle += input.points[primal::index_cast<std::size_t>(pyramid[i])] / 4.0;
+  input.points.push_back(middle);
+  if (!input.node_ids.empty()) input.node_ids.push_back(input.node_ids.back() + 1000000);
+  const Index centre = primal::index_cast(input.points.size() - 1);
+  std::int64_t id = 1;
+  for (std::int64_t t : input.tet_ids) id = std::max(id, t + 1);
+  for (std::size_t i = 0; i < 4; ++i)
+    primal::add_element(input, primal::ElementKind::kTet,
+                        std::array<Index, 4>{pyramid[i], pyramid[(i + 1) % 4], centre, pyramid[4]},
+                        block, id++);
+  // The pyramid gone: the last one in its place (no side names the pyramid, inside the model).
+  for (primal::SideSet& set : input.side_sets)
+    for (primal::Side& side : set.sides)
+      if (side.element.kind == primal::ElementKind::kPyramid) {
+        REQUIRE(side.element.index != primal::index_cast(p));
+        if (side.element.index == primal::index_cast(last))
+          side.element.index = primal::index_cast(p);
+      }
+  input.pyramids[p] = input.pyramids[last];
+  input.pyramids.pop_back();
+  for (auto* v : {&input.pyramid_block})
+    if (!v->empty()) (*v)[p] = v->back(), v->pop_back();
+  if (!input.pyramid_ids.empty())
+    input.pyramid_ids[p] = input.pyramid_ids.back(), input.pyramid_ids.pop_back();
   const conform::ConformResult r = conform::conform(input);
-  // Valid, with its geode (26 per interface quad) and three warnings: the layer kept, its
-  // wedges split, the buffer carved from the tets.
-  test::check_conform_result(r, -1, 3);
-  CHECK(r.interface_quads > 0);
+  // Three warnings: the layer kept (naming the hex), its wedges split, the buffer carved
+  // from the tets; one four-triangle quad, whose template is larger than the geode.
+  test::check_conform_result(r, r.geode_hexes, 3);
+  CHECK(r.geode_hexes > 26 * r.interface_quads);
   CHECK(r.hexes_split == 0);
   CHECK(r.wedges_split > 0);
+  CHECK(r.interface_quads > 0);
   CHECK(primal::min_scaled_jacobian(primal::hex_part(r.model)) > 0.0);
   const auto said = std::find_if(r.warnings.begin(), r.warnings.end(), [](const std::string& w) {
     return w.find("its hexes stay hexes: hex ") != std::string::npos &&
-           w.find("no way to split it into positive tets") != std::string::npos;
+           w.find("lies under four tet triangles") != std::string::npos;
   });
   CHECK(said != r.warnings.end());
 }

@@ -1,7 +1,8 @@
 // Hexes as tets (primal/split_hexes.hpp): a grid split whole conforms and fills it, its sides
 // moved onto the tets; by the lowest-node rule alone every hex splits on its corners whatever its
 // numbering; diagonals no triangulation of the cube has (tets on its faces force them) get the
-// hex's centre as a node; a face under four tet triangles (no split follows it) is refused.
+// hex's centre as a node, unless the tets are pyramids', which then take the other diagonal; a
+// face under four tet triangles (no split follows it) is refused.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -41,6 +42,40 @@ primal::Model shuffled(primal::Model m, unsigned seed) {
   m.points = points;
   for (auto& h : m.hexes)
     for (Index& v : h) v = to[primal::index_cast<std::size_t>(v)];
+  return m;
+}
+
+// A unit cube with two tets on each face split along its corners 0-2 (kHexFaceCorners):
+// every corner on one or two diagonals, none on three, and none of the cube's 74
+// triangulations has those six. `pyramids`: each face's two tets share an apex outside it (a
+// pyramid, which may as well be split along the other diagonal); else each has its own, above
+// its triangle, and the diagonal is the tets' for good.
+primal::Model cube_with_forced_faces(bool pyramids) {
+  primal::Model m;
+  for (const auto& c : primal::topology::kHexCornerCoords)
+    m.points.push_back(Point(c[0], c[1], c[2]));
+  primal::add_element(m, ElementKind::kHex, std::array<Index, 8>{0, 1, 2, 3, 4, 5, 6, 7}, 1, 1);
+  const Point centre(0.5, 0.5, 0.5);
+  std::int64_t id = 1;
+  for (const auto& fc : primal::topology::kHexFaceCorners) {
+    const auto v = [&](int i) { return primal::index_cast(fc[static_cast<std::size_t>(i)]); };
+    const auto at = [&](int i) {
+      return m.points[static_cast<std::size_t>(fc[static_cast<std::size_t>(i)])];
+    };
+    const Point mid = (at(0) + at(1) + at(2) + at(3)) / 4.0;
+    std::array<Index, 2> apex{};
+    for (std::size_t k = 0; k < 2; ++k) {
+      // Above the face's middle, or above each triangle's centroid.
+      const Point below =
+          pyramids ? mid : (k == 0 ? at(0) + at(1) + at(2) : at(0) + at(2) + at(3)) / 3.0;
+      if (k == 0 || !pyramids) m.points.push_back(below + (mid - centre));
+      apex[k] = primal::index_cast(m.points.size() - 1);
+    }
+    primal::add_element(m, ElementKind::kTet, std::array<Index, 4>{v(0), v(1), v(2), apex[0]}, 2,
+                        id++);
+    primal::add_element(m, ElementKind::kTet, std::array<Index, 4>{v(0), v(2), v(3), apex[1]}, 2,
+                        id++);
+  }
   return m;
 }
 
@@ -86,26 +121,8 @@ TEST_CASE("split_hexes: a grid split whole conforms, fills it and keeps its side
 }
 
 TEST_CASE("split_hexes: diagonals no triangulation of the cube has give the hex its centre") {
-  // A unit cube with two tets on each face split along its corners 0-2 (kHexFaceCorners):
-  // every corner on one or two diagonals, none on three, and none of the cube's 74
-  // triangulations has those six.
-  primal::Model m;
-  for (const auto& c : primal::topology::kHexCornerCoords)
-    m.points.push_back(Point(c[0], c[1], c[2]));
-  primal::add_element(m, ElementKind::kHex, std::array<Index, 8>{0, 1, 2, 3, 4, 5, 6, 7}, 1, 1);
+  primal::Model m = cube_with_forced_faces(false);
   const Point centre(0.5, 0.5, 0.5);
-  std::int64_t id = 1;
-  for (const auto& fc : primal::topology::kHexFaceCorners) {
-    Point mid = Point::Zero();
-    for (int k : fc) mid += m.points[static_cast<std::size_t>(k)] / 4.0;
-    m.points.push_back(mid + (mid - centre));  // an apex outside the face
-    const Index apex = primal::index_cast(m.points.size() - 1);
-    const auto v = [&](int i) { return primal::index_cast(fc[static_cast<std::size_t>(i)]); };
-    primal::add_element(m, ElementKind::kTet, std::array<Index, 4>{v(0), v(1), v(2), apex}, 2,
-                        id++);
-    primal::add_element(m, ElementKind::kTet, std::array<Index, 4>{v(0), v(2), v(3), apex}, 2,
-                        id++);
-  }
   for (const auto& t : m.tets) REQUIRE(volume(m, t) > 0.0);
   REQUIRE(primal::check_input(m).ok());
   // File ids 10, 20, ..., not in order: the centre takes the next past the highest.
@@ -125,6 +142,51 @@ TEST_CASE("split_hexes: diagonals no triangulation of the cube has give the hex 
   }
   CHECK(sum == doctest::Approx(1.0));
   CHECK(primal::check_input(s).ok());
+}
+
+TEST_CASE("split_hexes: a pyramid on a face is split along the diagonal its hex's split needs") {
+  // The same six diagonals, each given by a pyramid's two tets: some pyramids take the other
+  // diagonal (their side triangles kept), so the hex splits on its corners, no centre.
+  const primal::Model m = cube_with_forced_faces(true);
+  for (const auto& t : m.tets) REQUIRE(volume(m, t) > 0.0);
+  REQUIRE(primal::check_input(m).ok());
+  primal::Model sided = m;
+  // A side on a pyramid's side triangle (tet 1's face of nodes 1 2 apex) follows its new tet.
+  const std::vector<Index> side_nodes{
+      m.tets[0][1], m.tets[0][2], m.tets[0][3]};  // tet 0 = face 0's (v0 v1 v2 apex): v1 v2 apex
+  int local = -1;
+  for (int f = 0; f < 4; ++f) {
+    std::vector<Index> nodes = primal::element_face(m, {{ElementKind::kTet, 0}, f});
+    std::sort(nodes.begin(), nodes.end());
+    std::vector<Index> want = side_nodes;
+    std::sort(want.begin(), want.end());
+    if (nodes == want) local = f;
+  }
+  REQUIRE(local >= 0);
+  sided.side_sets.push_back({4, "cap", {{{ElementKind::kTet, 0}, local}}});
+  const primal::Model s = primal::split_hexes(sided, std::vector<Index>{0});
+  CHECK(s.points.size() == m.points.size());  // on its corners
+  CHECK(s.tets.size() >= 12 + 5);
+  CHECK(s.tets.size() <= 12 + 6);
+  int flipped = 0;
+  for (std::size_t t = 0; t < 12; ++t) flipped += s.tets[t] != m.tets[t];
+  CHECK(flipped >= 2);  // at least one pyramid, both its tets
+  CHECK(flipped % 2 == 0);
+  CHECK(s.tets[0] != m.tets[0]);  // face 0's among them: the side below moves
+  double sum = 0.0;
+  for (std::size_t t = 0; t < s.tets.size(); ++t) {
+    CHECK(volume(s, s.tets[t]) > 0.0);
+    if (t >= 12) sum += volume(s, s.tets[t]);
+  }
+  CHECK(sum == doctest::Approx(1.0));
+  CHECK(primal::check_input(s).ok());  // conforming: each pyramid's tets meet the hex's
+  REQUIRE(s.side_sets.size() == 1);
+  REQUIRE(s.side_sets.front().sides.size() == 1);
+  std::vector<Index> got = primal::element_face(s, s.side_sets.front().sides.front());
+  std::sort(got.begin(), got.end());
+  std::vector<Index> want = side_nodes;
+  std::sort(want.begin(), want.end());
+  CHECK(got == want);
 }
 
 TEST_CASE("split_hexes: a face under four tet triangles around a node is refused by name") {
@@ -151,8 +213,9 @@ TEST_CASE("split_hexes: a face under four tet triangles around a node is refused
 
 TEST_CASE("split_hexes: a column's faces between its cells follow the diagonal forced on its end") {
   // Two cells 0.1 high over a unit square whose corners 1 and 3 are 0.15 higher than 0 and 2 (a
-  // warped layer, as a curved one's cells are): tets from an apex above force the top face's
-  // low diagonal, 0-2. The face between the cells has its lowest node at corner 1, as where the
+  // warped layer, as a curved one's cells are): two tets, each from an apex above its
+  // triangle (not a pyramid, which could take the other diagonal), force the top face's low
+  // diagonal, 0-2. The face between the cells has its lowest node at corner 1, as where the
   // extruded surface's nodes come first: its lowest-node diagonal, 1-3, lies above the top's,
   // so no split of the upper cell, nor its centre's, had positive tets on those two.
   const double height = 0.1, warp = 0.15;
@@ -172,13 +235,19 @@ TEST_CASE("split_hexes: a column's faces between its cells follow the diagonal f
     for (std::size_t c = 0; c < 4; ++c) h[c] = node[level][c], h[c + 4] = node[level + 1][c];
     primal::add_element(m, ElementKind::kHex, h, 1, primal::index_cast(level) + 1);
   }
-  m.points.push_back(Point(0.5, 0.5, 2 * height + 0.5));
-  const Index apex = primal::index_cast(m.points.size() - 1);
   const auto& top = node[2];
-  primal::add_element(m, ElementKind::kTet, std::array<Index, 4>{top[0], top[1], top[2], apex}, 2,
-                      1);
-  primal::add_element(m, ElementKind::kTet, std::array<Index, 4>{top[0], top[2], top[3], apex}, 2,
-                      2);
+  const std::array<std::array<Index, 3>, 2> triangles{
+      {{top[0], top[1], top[2]}, {top[0], top[2], top[3]}}};
+  for (std::size_t k = 0; k < 2; ++k) {
+    const auto& t = triangles[k];
+    Point above = Point::Zero();
+    for (Index v : t) above += m.points[primal::index_cast<std::size_t>(v)] / 3.0;
+    m.points.push_back(above + Point(0.0, 0.0, 0.5));
+    primal::add_element(
+        m, ElementKind::kTet,
+        std::array<Index, 4>{t[0], t[1], t[2], primal::index_cast(m.points.size() - 1)}, 2,
+        primal::index_cast(k) + 1);
+  }
   for (const auto& t : m.tets) REQUIRE(volume(m, t) > 0.0);
   REQUIRE(primal::check_input(m).ok());
   REQUIRE(std::min({node[1][0], node[1][1], node[1][2], node[1][3]}) == node[1][1]);
