@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <map>
+#include <set>
 #include <utility>
 
 #include <geode/primal/boundary.hpp>
@@ -306,13 +307,30 @@ class HexSplitter {
   }
 
   // The forced faces whose two tets share their fourth node: a pyramid split along the face's
-  // diagonal (Gmsh's, on the tet side of a layer), which can as well be split along the other
-  // one, its four side triangles kept. Such a face's diagonal is chosen with the hexes' (a
-  // column's end need not cross its cells' faces the wrong way), each choice valued by its two
-  // tets as a hex by its split (split_value). A tet on two such faces leaves both as forced.
+  // diagonal (Gmsh's, on the tet side of a layer; or two of a split wedge's three tets), which
+  // can as well be split along the other one, its four side triangles kept. Such a face's
+  // diagonal is chosen with the hexes' (a column's end need not cross its cells' faces the wrong
+  // way), each choice valued by its two tets as a hex by its split (split_value). Left forced:
+  // a pyramid inverted along the other diagonal, one with a side on its base, and both where a
+  // tet is on two such faces.
   void find_pyramids() {
     pyramid_.assign(on_.size(), -1);
     std::vector<int> uses(model_.tets.size(), 0);
+    // Triangles a side set names on a tet: a pyramid with a side on its base keeps its split
+    // (half the quad has no counterpart along the other diagonal).
+    std::set<std::array<Index, 3>> sided;
+    for (const SideSet& set : model_.side_sets)
+      for (const Side& side : set.sides)
+        if (side.element.kind == ElementKind::kTet) {
+          const auto f = element_face(model_, side);
+          std::array<Index, 3> t{f[0], f[1], f[2]};
+          std::sort(t.begin(), t.end());
+          sided.insert(t);
+        }
+    const auto has_side = [&](std::array<Index, 3> t) {
+      std::sort(t.begin(), t.end());
+      return sided.contains(t);
+    };
     for (std::size_t k = 0; k < hexes_.size(); ++k)
       for (std::size_t f = 0; f < 6; ++f) {
         const auto face = index_cast<std::size_t>(face_[k][f]);
@@ -320,10 +338,12 @@ class HexSplitter {
         const auto q = face_of(k, f);
         const int given = low_[k][f] ^ choice_[face];  // 0: q[0]-q[2], 1: q[1]-q[3]
         const auto g = index_cast<std::size_t>(given);
-        const Index* a = triangles_.find(face_key(std::array<Index, 3>{q[g], q[g + 1], q[g + 2]}));
-        const Index* b =
-            triangles_.find(face_key(std::array<Index, 3>{q[g], q[g + 2], q[(g + 3) % 4]}));
-        if (a == nullptr || b == nullptr || *a == *b) continue;
+        const std::array<Index, 3> base_a{q[g], q[g + 1], q[g + 2]},
+            base_b{q[g], q[g + 2], q[(g + 3) % 4]};
+        const Index* a = triangles_.find(face_key(base_a));
+        const Index* b = triangles_.find(face_key(base_b));
+        if (a == nullptr || b == nullptr || *a == *b || has_side(base_a) || has_side(base_b))
+          continue;
         const Index apex = fourth(*a, q), other = fourth(*b, q);
         if (apex == kInvalidIndex || apex != other) continue;
         Pyramid p{face, {*a, *b}, q, apex, false, {}, low_[k][f], choice_[face]};
@@ -339,6 +359,8 @@ class HexSplitter {
           }
           p.value[index_cast<std::size_t>(x)] = split_value(lowest, lowest);
         }
+        // Along the other diagonal a tet would be inverted (a non-convex pyramid): not a choice.
+        if (p.value[index_cast<std::size_t>(1 - p.given)] <= 0.0) continue;
         ++uses[index_cast<std::size_t>(*a)], ++uses[index_cast<std::size_t>(*b)];
         pyramid_[face] = index_cast<int>(pyramids_.size());
         pyramids_.push_back(p);
@@ -673,28 +695,23 @@ Model HexSplitter::build() const {
       add_element(m, ElementKind::kTet, t, block_of(model_, ref), element_id(model_, ref));
   }
   // The pyramids whose face took the other diagonal: their two tets along it, in their places.
-  std::vector<char> flipped(model_.tets.size(), 0);
-  for (const Pyramid& p : pyramids_) {
+  std::vector<int> flipped(model_.tets.size(), -1);  // per tet: its re-split pyramid
+  for (std::size_t i = 0; i < pyramids_.size(); ++i) {
+    const Pyramid& p = pyramids_[i];
     if (pyramid_[p.face] < 0 || choice_[p.face] == p.given) continue;
     const auto tets = tets_of(p, p.low ^ choice_[p.face]);
-    for (std::size_t i = 0; i < 2; ++i) {
-      m.tets[index_cast<std::size_t>(p.tets[i])] = tets[i];
-      flipped[index_cast<std::size_t>(p.tets[i])] = 1;
+    for (std::size_t j = 0; j < 2; ++j) {
+      m.tets[index_cast<std::size_t>(p.tets[j])] = tets[j];
+      flipped[index_cast<std::size_t>(p.tets[j])] = index_cast<int>(i);
     }
   }
   // Sides of split hexes: the faces of its tets whose nodes all lie on the hex's face; of a
   // flipped pyramid's tets: the new one's on the same side triangle.
   rewrite_sides(m, [&](const Side& s, std::vector<Side>& sides) {
     const auto h = index_cast<std::size_t>(s.element.index);
-    if (s.element.kind == ElementKind::kTet && flipped[h]) {
-      const int p = [&] {
-        for (std::size_t i = 0; i < pyramids_.size(); ++i)
-          if (std::find(pyramids_[i].tets.begin(), pyramids_[i].tets.end(), s.element.index) !=
-              pyramids_[i].tets.end())
-            return index_cast<int>(i);
-        return -1;
-      }();
-      for (Index t : pyramids_[index_cast<std::size_t>(p)].tets) {
+    if (s.element.kind == ElementKind::kTet && flipped[h] >= 0) {
+      // On a side triangle (none is on the base: find_pyramids).
+      for (Index t : pyramids_[index_cast<std::size_t>(flipped[h])].tets) {
         const auto on = tet_sides_on(m, t, 1, element_face(model_, s));
         sides.insert(sides.end(), on.begin(), on.end());
       }

@@ -7,8 +7,9 @@
 // as tets, the whole layer is diced with the tets around it and needs no buffer layer.
 //
 // A quad face takes the diagonal the tets already on it have (a split wedge's, the tet part's),
-// unless they are a pyramid's two tets (sharing their fourth node: Gmsh's pyramids on a layer,
-// split first), which may as well be split along the other one; the others are chosen run by
+// unless they are two tets sharing their fourth node (a pyramid: Gmsh's on a layer, split first,
+// or two of a split wedge's), which may as well be split along the other one where neither is
+// then inverted and no side set names the face; the others are chosen run by
 // run of hexes through opposite faces (a layer's columns and rows), for the best lowest then
 // total quality of the run's hexes' splits and its end pyramids' tets, starting from the
 // diagonals through their lowest nodes, so the tets conform. Each hex then takes the
@@ -51,7 +52,7 @@ struct WedgeColumns {
 WedgeColumns wedge_columns(const Model& model, std::span<const Index> wedges);
 
 // `model` with `hexes` (ascending) as 5, 6 or 12 tets each: its tets first (a re-split
-// pyramid's two in their places, the sides on them moved with their triangles), then each split
+// pyramid's two in their places, the sides on its side triangles moved with them), then each split
 // hex's in hex order, in the hex's block with its file id; its other hexes kept in order; a
 // centre node appended for each hex split around one (the next file id); side sets on a split
 // hex's faces moved to its tets' faces on them (two on a quad). Throws TopologyError naming a hex

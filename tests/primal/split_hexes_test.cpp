@@ -6,8 +6,10 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <map>
 #include <numeric>
 #include <random>
+#include <set>
 
 #include <geode/primal/errors.hpp>
 #include <geode/primal/grid_model.hpp>
@@ -79,6 +81,38 @@ primal::Model cube_with_forced_faces(bool pyramids) {
   return m;
 }
 
+// The triangles of `m`'s tets' faces named by its side sets, each sorted.
+std::multiset<std::array<Index, 3>> sided_triangles(const primal::Model& m) {
+  std::multiset<std::array<Index, 3>> out;
+  for (const primal::SideSet& set : m.side_sets)
+    for (const primal::Side& side : set.sides) {
+      const auto f = primal::element_face(m, side);
+      std::array<Index, 3> t{f[0], f[1], f[2]};
+      std::sort(t.begin(), t.end());
+      out.insert(t);
+    }
+  return out;
+}
+
+// `m` with a side set on every face of its tets on the model's boundary (once among them, not
+// all the hex's nodes): the pyramids' side triangles.
+primal::Model with_side_triangles(primal::Model m) {
+  std::map<std::array<Index, 3>, std::vector<primal::Side>> faces;
+  for (std::size_t t = 0; t < m.tets.size(); ++t)
+    for (int f = 0; f < 4; ++f) {
+      const primal::Side side{{ElementKind::kTet, primal::index_cast(t)}, f};
+      const auto nodes = primal::element_face(m, side);
+      std::array<Index, 3> key{nodes[0], nodes[1], nodes[2]};
+      std::sort(key.begin(), key.end());
+      faces[key].push_back(side);
+    }
+  primal::SideSet set{4, "sides", {}};
+  for (const auto& [key, sides] : faces)
+    if (sides.size() == 1 && key[2] >= 8) set.sides.push_back(sides.front());
+  m.side_sets.push_back(set);
+  return m;
+}
+
 }  // namespace
 
 TEST_CASE("split_hexes: a grid split whole conforms, fills it and keeps its sides, on corners") {
@@ -146,25 +180,13 @@ TEST_CASE("split_hexes: diagonals no triangulation of the cube has give the hex 
 
 TEST_CASE("split_hexes: a pyramid on a face is split along the diagonal its hex's split needs") {
   // The same six diagonals, each given by a pyramid's two tets: some pyramids take the other
-  // diagonal (their side triangles kept), so the hex splits on its corners, no centre.
-  const primal::Model m = cube_with_forced_faces(true);
+  // diagonal (their side triangles kept, the sides on them moved), so the hex splits on its
+  // corners, no centre.
+  const primal::Model m = with_side_triangles(cube_with_forced_faces(true));
   for (const auto& t : m.tets) REQUIRE(volume(m, t) > 0.0);
   REQUIRE(primal::check_input(m).ok());
-  primal::Model sided = m;
-  // A side on a pyramid's side triangle (tet 1's face of nodes 1 2 apex) follows its new tet.
-  const std::vector<Index> side_nodes{
-      m.tets[0][1], m.tets[0][2], m.tets[0][3]};  // tet 0 = face 0's (v0 v1 v2 apex): v1 v2 apex
-  int local = -1;
-  for (int f = 0; f < 4; ++f) {
-    std::vector<Index> nodes = primal::element_face(m, {{ElementKind::kTet, 0}, f});
-    std::sort(nodes.begin(), nodes.end());
-    std::vector<Index> want = side_nodes;
-    std::sort(want.begin(), want.end());
-    if (nodes == want) local = f;
-  }
-  REQUIRE(local >= 0);
-  sided.side_sets.push_back({4, "cap", {{{ElementKind::kTet, 0}, local}}});
-  const primal::Model s = primal::split_hexes(sided, std::vector<Index>{0});
+  REQUIRE(m.side_sets.front().sides.size() == 6 * 4);
+  const primal::Model s = primal::split_hexes(m, std::vector<Index>{0});
   CHECK(s.points.size() == m.points.size());  // on its corners
   CHECK(s.tets.size() >= 12 + 5);
   CHECK(s.tets.size() <= 12 + 6);
@@ -172,7 +194,6 @@ TEST_CASE("split_hexes: a pyramid on a face is split along the diagonal its hex'
   for (std::size_t t = 0; t < 12; ++t) flipped += s.tets[t] != m.tets[t];
   CHECK(flipped >= 2);  // at least one pyramid, both its tets
   CHECK(flipped % 2 == 0);
-  CHECK(s.tets[0] != m.tets[0]);  // face 0's among them: the side below moves
   double sum = 0.0;
   for (std::size_t t = 0; t < s.tets.size(); ++t) {
     CHECK(volume(s, s.tets[t]) > 0.0);
@@ -180,13 +201,29 @@ TEST_CASE("split_hexes: a pyramid on a face is split along the diagonal its hex'
   }
   CHECK(sum == doctest::Approx(1.0));
   CHECK(primal::check_input(s).ok());  // conforming: each pyramid's tets meet the hex's
-  REQUIRE(s.side_sets.size() == 1);
-  REQUIRE(s.side_sets.front().sides.size() == 1);
-  std::vector<Index> got = primal::element_face(s, s.side_sets.front().sides.front());
-  std::sort(got.begin(), got.end());
-  std::vector<Index> want = side_nodes;
-  std::sort(want.begin(), want.end());
-  CHECK(got == want);
+  CHECK(sided_triangles(s) == sided_triangles(m));  // every side on its triangle, once
+}
+
+TEST_CASE("split_hexes: a pyramid with a side on its base keeps its split") {
+  // A side set on each pyramid's base triangles (the hex's faces, from the tets' side): half a
+  // quad has no counterpart along the other diagonal, so the pyramids keep theirs, and the
+  // hex, on six diagonals no triangulation has, gets its centre.
+  primal::Model m = cube_with_forced_faces(true);
+  primal::SideSet base{5, "base", {}};
+  for (std::size_t t = 0; t < m.tets.size(); ++t)
+    for (int f = 0; f < 4; ++f) {
+      const auto nodes = primal::element_face(m, {{ElementKind::kTet, primal::index_cast(t)}, f});
+      if (std::all_of(nodes.begin(), nodes.end(), [](Index v) { return v < 8; }))
+        base.sides.push_back({{ElementKind::kTet, primal::index_cast(t)}, f});
+    }
+  REQUIRE(base.sides.size() == 12);
+  m.side_sets.push_back(base);
+  const primal::Model s = primal::split_hexes(m, std::vector<Index>{0});
+  CHECK(s.points.size() == m.points.size() + 1);  // the centre
+  for (std::size_t t = 0; t < 12; ++t) CHECK(s.tets[t] == m.tets[t]);
+  for (const auto& t : s.tets) CHECK(volume(s, t) > 0.0);
+  CHECK(primal::check_input(s).ok());
+  CHECK(sided_triangles(s) == sided_triangles(m));
 }
 
 TEST_CASE("split_hexes: a face under four tet triangles around a node is refused by name") {
