@@ -23,8 +23,10 @@ void write_in_chunks(
 // kIntegerText or kRealText characters (an int64 is at most 20, a double's shortest text 24:
 // "-1.2345678901234567e-308"); returns one past its end. Chunks write into a string sized for
 // their worst case and cut it to what was written: appending number by number cost more than
-// formatting. {fmt} (libfmt-dev), not std::to_chars: the same text, but an integer in 5 ns
-// against libstdc++'s 18 (a .msh's connectivity is ten million of them); doubles alike.
+// formatting. {fmt} (libfmt-dev), not std::to_chars: an integer in 5 ns against libstdc++'s 18
+// (a .msh's connectivity is ten million of them), doubles alike; both the shortest text that
+// reads back, but {fmt} writes exponents -4 to 15 in fixed notation (1e+06 as 1000000; at most
+// 23 characters, "-0.00012345678901234567").
 inline constexpr std::size_t kIntegerText = 20, kRealText = 24;
 char* put_number(char* at, std::int64_t x);
 char* put_number(char* at, double x);
