@@ -332,13 +332,13 @@ io::WriteOptions write_options(const EncodingArgs& args) {
 }
 
 std::string invalid_mesh_reason(const primal::HexMesh& mesh, primal::Index base) {
-  return primal::findings(
-      primal::check_validity(mesh), [base](primal::Index i) { return i + base; }, base);
+  const auto number = [base](primal::Index i) { return std::int64_t{i} + base; };
+  return primal::findings(primal::check_validity(mesh), number, number);
 }
 
 std::string invalid_mesh_reason(const primal::QuadMesh& mesh, primal::Index base) {
-  return primal::findings(
-      primal::check_validity(mesh), [base](primal::Index i) { return i + base; }, base);
+  const auto number = [base](primal::Index i) { return std::int64_t{i} + base; };
+  return primal::findings(primal::check_validity(mesh), number, number);
 }
 
 primal::Index output_index_base(const std::string& format) {

@@ -272,6 +272,8 @@ struct ConformResult {
   // How many of the warnings, first, are verification's findings (what makes the result invalid:
   // invalid dicing, invalid mesh, inverted hexes); the run's own come after them.
   std::size_t findings = 0;
+  // How the report and the findings number hexes and nodes (ConformOptions::output_numbering).
+  primal::ElementNumbering numbering;
   double seconds = 0.0;
 };
 

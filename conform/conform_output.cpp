@@ -71,7 +71,14 @@ void Conformer::check(std::span<const Point> points, std::span<const std::array<
     primal::release(positive_);
     res_.verified = ConformVerify::kLocal;
     res_.verified_hexes = res_.validity.num_cells;
-    if (!res_.dicing.ok()) verdict("invalid dicing: " + res_.dicing.summary());
+    if (!res_.dicing.ok()) {
+      // A faulty stage, not the input: named in the dicing's own arrays (children, nodes), on
+      // one line.
+      std::string why = res_.dicing.summary();
+      for (std::size_t at; (at = why.find("\n  ")) != std::string::npos;) why.replace(at, 3, "; ");
+      while (!why.empty() && why.back() == '\n') why.pop_back();
+      verdict("invalid dicing, numbered in the dicing's own arrays: " + why);
+    }
   } else {
     res_.validity = primal::check_validity(mesh_);
     res_.verified = ConformVerify::kFull;
@@ -79,12 +86,22 @@ void Conformer::check(std::span<const Point> points, std::span<const std::array<
   }
   // Hexes and nodes as the output file numbers them (ConformOptions::output_numbering).
   const primal::ElementNumbering numbering = options_.output_numbering;
-  if (!res_.validity.ok())
-    verdict("invalid mesh: " +
-            primal::findings(
-                res_.validity,
-                [&](Index h) { return primal::hex_numbers(block, {{h}}, numbering).front(); },
-                numbering.base));
+  if (!res_.validity.ok()) {
+    // The hexes findings() names (the first five of each list), numbered in one pass.
+    std::vector<Index> named;
+    for (const auto* list : {&res_.validity.out_of_range_hexes, &res_.validity.repeated_node_hexes,
+                             &res_.validity.inverted_hexes})
+      named.insert(
+          named.end(), list->begin(),
+          list->begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(list->size(), 5)));
+    const std::vector<std::int64_t> numbers = primal::hex_numbers(block, named, numbering);
+    const auto hex = [&](Index h) {
+      return numbers[static_cast<std::size_t>(std::find(named.begin(), named.end(), h) -
+                                              named.begin())];
+    };
+    const auto node = [&](Index v) { return std::int64_t{v} + numbering.base; };
+    verdict("invalid mesh: " + primal::findings(res_.validity, hex, node));
+  }
   if (!inverted_.empty()) {
     std::ostringstream m;
     m << inverted_.size() << " hexes with scaled Jacobian <= 0:";

@@ -82,6 +82,12 @@ nlohmann::json report_json(const ConformResult& r) {
   j["output_min_scaled_jacobian"] = output_min_scaled_jacobian(r);
   j["seconds"] = r.seconds;
   j["warnings"] = r.warnings;
+  // How min_hex and max_hex number the hexes: as the written file does (with no file written,
+  // as Exodus would).
+  j["numbering"] = {
+      {"index_base", r.numbering.base},
+      {"element_order",
+       r.numbering.order == primal::ElementOrder::kByBlock ? "by block" : "as given"}};
   j["blocks"] = nlohmann::json::array();
   j["local_yardstick_ratio"] = r.local_yardstick_ratio;
   j["capped_local_ratio"] = r.capped_local_ratio;

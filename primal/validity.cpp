@@ -901,10 +901,10 @@ void finding(std::vector<std::string>& out, const std::vector<T>& items, const s
 }
 
 template <std::size_t N>
-std::string show_nodes(const std::array<Index, N>& k, Index base) {
+std::string show_nodes(const std::array<Index, N>& k, const Numbering& node) {
   std::string s;
   for (auto n : k)
-    if (n != kInvalidIndex) s += (s.empty() ? "" : "-") + std::to_string(n + base);
+    if (n != kInvalidIndex) s += (s.empty() ? "" : "-") + std::to_string(node(n));
   return s;
 }
 
@@ -916,12 +916,13 @@ std::string joined(const std::vector<std::string>& parts) {
 
 }  // namespace
 
-std::string findings(const HexValidityReport& r, const CellNumber& cell_number, Index node_base) {
+std::string findings(const HexValidityReport& r, const Numbering& cell_number,
+                     const Numbering& node_number) {
   if (r.ok()) return {};
   const auto cell = [&cell_number](Index i) { return std::to_string(cell_number(i)); };
-  const auto node = [node_base](Index i) { return std::to_string(i + node_base); };
-  const auto face = [node_base](const FaceKey& k) { return show_nodes(k, node_base); };
-  const auto edge = [node_base](const EdgeKey& k) { return show_nodes(k, node_base); };
+  const auto node = [&node_number](Index i) { return std::to_string(node_number(i)); };
+  const auto face = [&node_number](const FaceKey& k) { return show_nodes(k, node_number); };
+  const auto edge = [&node_number](const EdgeKey& k) { return show_nodes(k, node_number); };
   std::vector<std::string> f;
   finding(f, r.out_of_range_hexes, "hexes with a node out of range", cell);
   finding(f, r.non_finite_nodes, "nodes with a non-finite coordinate", node);
@@ -930,7 +931,7 @@ std::string findings(const HexValidityReport& r, const CellNumber& cell_number, 
           "of " + std::to_string(r.num_hexes) + " hexes inverted (a corner Jacobian <= 0), hexes",
           cell);
   finding(f, r.overlapping_nodes, "nodes covered more than once (overlapping hexes), nodes",
-          [node_base](const NodeCoverage& c) { return std::to_string(c.node + node_base); });
+          [&node](const NodeCoverage& c) { return node(c.node); });
   finding(f, r.overshared_faces, "faces in more than two hexes, by their nodes", face);
   finding(f, r.misoriented_faces, "faces seen in the same order by both hexes, by their nodes",
           face);
@@ -941,11 +942,12 @@ std::string findings(const HexValidityReport& r, const CellNumber& cell_number, 
   return joined(f);
 }
 
-std::string findings(const QuadValidityReport& r, const CellNumber& cell_number, Index node_base) {
+std::string findings(const QuadValidityReport& r, const Numbering& cell_number,
+                     const Numbering& node_number) {
   if (r.ok()) return {};
   const auto cell = [&cell_number](Index i) { return std::to_string(cell_number(i)); };
-  const auto node = [node_base](Index i) { return std::to_string(i + node_base); };
-  const auto edge = [node_base](const EdgeKey& k) { return show_nodes(k, node_base); };
+  const auto node = [&node_number](Index i) { return std::to_string(node_number(i)); };
+  const auto edge = [&node_number](const EdgeKey& k) { return show_nodes(k, node_number); };
   std::vector<std::string> f;
   finding(f, r.out_of_range_quads, "quads with a node out of range", cell);
   finding(f, r.non_finite_nodes, "nodes with a non-finite coordinate", node);
@@ -953,7 +955,7 @@ std::string findings(const QuadValidityReport& r, const CellNumber& cell_number,
   finding(f, r.inverted_quads,
           "of " + std::to_string(r.num_quads) + " quads inverted (a corner <= 0), quads", cell);
   finding(f, r.overlapping_nodes, "nodes covered more than once (overlapping quads), nodes",
-          [node_base](const NodeCoverage& c) { return std::to_string(c.node + node_base); });
+          [&node](const NodeCoverage& c) { return node(c.node); });
   finding(f, r.overshared_edges, "edges in more than two quads, by their nodes", edge);
   finding(f, r.misoriented_edges, "edges run the same way by both quads, by their nodes", edge);
   finding(f, r.nonmanifold_vertices, "non-manifold nodes", node);

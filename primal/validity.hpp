@@ -108,12 +108,12 @@ QuadValidityReport check_validity(const QuadMesh& mesh, const Point& normal = Po
 
 // What makes a report not ok(), in one line for a message ("2 of 26 hexes inverted (a corner
 // Jacobian <= 0), hexes: 2 7; ..."; "" when ok()): a count and the first five of each finding,
-// cells named by `cell_number` (index -> the number the output file gives it) and nodes numbered
-// from `node_base`, as the output numbers them (every writer numbers nodes in model order).
-using CellNumber = std::function<std::int64_t(Index)>;
-std::string findings(const HexValidityReport& report, const CellNumber& cell_number,
-                     Index node_base);
-std::string findings(const QuadValidityReport& report, const CellNumber& cell_number,
-                     Index node_base);
+// cells and nodes named by `cell_number` and `node_number` (index -> the number the output file
+// gives it).
+using Numbering = std::function<std::int64_t(Index)>;
+std::string findings(const HexValidityReport& report, const Numbering& cell_number,
+                     const Numbering& node_number);
+std::string findings(const QuadValidityReport& report, const Numbering& cell_number,
+                     const Numbering& node_number);
 
 }  // namespace geode::primal

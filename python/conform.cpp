@@ -151,6 +151,8 @@ py::dict conform_arrays(const py::handle& points, const py::dict& cells,
   primal::check_geometry(model, source);
 
   conform::ConformOptions opts;
+  // Hexes named as the returned mesh holds them: grouped by block in ascending id, from 0.
+  opts.output_numbering = {primal::ElementOrder::kByBlock, 0};
   opts.smooth = conform::parse_conform_smooth(smooth);
   opts.quality = conform::parse_conform_quality(quality);
   opts.geode_block = geode_block;

@@ -86,6 +86,7 @@ class Conformer {
 
   ConformResult run() {
     const auto t_start = Clock::now();
+    res_.numbering = options_.output_numbering;
     find_interface();
     if (!joining_.empty()) return {};  // conform() splits their wedge pieces and starts again
     insert_buffer();

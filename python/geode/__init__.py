@@ -231,7 +231,9 @@ def conform(mesh=None, *, points=None, cells=None, cell_blocks=None, name="mesh"
     The options are those of `geode conform`.
     Returns (meshio.Mesh, report): the output with one cell block and one cell set per block,
     block ids as gmsh:physical, node sets as point sets; the report as `--report` writes it,
-    with "side_sets" ([{id, name, sides: K x 2 (hex in the output's order, local face)}]).
+    with "side_sets" ([{id, name, sides: K x 2 (hex, local face)}]). Hexes (the sides', each
+    metric's min_hex and max_hex, those an invalid result's reason names) are numbered from 0
+    over the returned mesh's cells, block after block.
     A result that fails verification raises InvalidResultError, unless allow_invalid=True.
     """
     pts, arrays, names, node_sets = _model_arrays(mesh, points, cells, cell_blocks, name)

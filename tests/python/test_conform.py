@@ -73,6 +73,25 @@ def test_conform_arrays_and_sets(half):
     assert len(out.point_sets["x0"]) > len(ends)
 
 
+def test_conform_report_names_hexes_in_the_returned_mesh(half):
+    # The hex part in block 9, the tets in 7: conform's own order has the hex part's hexes first,
+    # the returned mesh block 7's; min_hex and max_hex index the latter.
+    hexes = np.concatenate([c.data for c in half.cells if c.type == "hexahedron"])
+    tets = np.concatenate([c.data for c in half.cells if c.type == "tetra"])
+    out, report = geode.conform(points=half.points, cells=[("hexahedron", hexes), ("tetra", tets)],
+                                cell_blocks=[9, 7])
+    all_hexes = hexes_of(out)
+    sj = geode.quality(out.points, all_hexes, per_hex=True)["per_hex"]["scaled_jacobian"]
+    physical = np.concatenate(out.cell_data["gmsh:physical"])
+    assert [b["id"] for b in report["blocks"]] == [7, 9]
+    assert report["numbering"] == {"index_base": 0, "element_order": "by block"}
+    for b in report["blocks"]:
+        m = b["quality"]["metrics"][0]
+        for at, key in (("min_hex", "min"), ("max_hex", "max")):
+            assert physical[m[at]] == b["id"]
+            assert sj[m[at]] == pytest.approx(m[key], abs=1e-12)
+
+
 def test_block_ids_beyond_32_bits_are_refused_by_element(half):
     # The files hold 32-bit block ids: a larger one is an input error naming the first element
     # of the block (its 1-based position), not a failed conversion; so is a block name's id.
