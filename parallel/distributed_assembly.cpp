@@ -3,7 +3,6 @@
 #include <geode/parallel/detail/distributor.hpp>
 
 namespace geode::parallel::detail {
-namespace {
 
 // What holds piece by piece of a hex mesh: nodes in range and finite, no repeated corner, no
 // face of three hexes, none seen twice in one order, no corner Jacobian <= 0, the covering at
@@ -17,8 +16,6 @@ bool piece_ok(const primal::HexValidityReport& v, const std::vector<char>& exemp
          v.repeated_node_hexes.empty() && v.overshared_faces.empty() &&
          v.misoriented_faces.empty() && v.inverted_hexes.empty() && overlapping == 0;
 }
-
-}  // namespace
 
 // This rank's hexes (its zone hexes and its diced ones) over its nodes, ascending global id.
 // Memory: the dicing data are released as the output takes them over (points and origins once
@@ -353,11 +350,21 @@ void Distributor::verify() {
   for (const auto& [q, nodes] : out_.shared_nodes)
     for (Index n : nodes) shared[primal::index_cast<std::size_t>(n)] = 1;
   const bool piece = piece_ok(v, shared);
-  if (!piece) rep_.warnings.push_back("rank " + std::to_string(rank_) + ": " + v.summary());
+  // Hexes and nodes by their global ids (+ 1: the element and node ids of the files written).
+  if (!piece)
+    rep_.warnings.push_back(
+        "rank " + std::to_string(rank_) + ": " +
+        primal::findings(
+            v, [&](Index h) { return out_.hex_gid[primal::index_cast<std::size_t>(h)] + 1; },
+            [&](Index n) { return node_gid(n) + 1; }));
   if (!dicing_.ok())
     rep_.warnings.push_back("rank " + std::to_string(rank_) + ": " + dicing_.summary());
   const bool zone_ok = piece_ok(rep_.zone.validity, {});
-  if (!zone_ok) rep_.warnings.push_back("the transition zone: " + rep_.zone.validity.summary());
+  if (!zone_ok) {
+    const auto own = [](Index i) { return std::int64_t{i} + 1; };
+    rep_.warnings.push_back("the transition zone (numbered in its own output): " +
+                            primal::findings(rep_.zone.validity, own, own));
+  }
   int mine = piece && dicing_.ok() && zone_ok ? 1 : 0, all = 0;
   MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_MIN, comm_);
   rep_.valid = all == 1;

@@ -8,6 +8,7 @@
 #include <thread>
 
 #include <geode/conform/reference_template.hpp>
+#include <geode/conform/report.hpp>
 
 namespace geode::parallel {
 namespace detail {
@@ -212,6 +213,16 @@ void Distributor::conform_zone() {
       if (missing == 0) {
         zone_out_ = std::move(r.model);
         zone_first_ = 0, zone_last_ = zone_out_.hexes.size();
+        // Its findings name the zone's own output, numbered as written; none where the zone
+        // holds as a piece (verify()): its cut alone is not closed or manifold (--verify full).
+        if (piece_ok(r.validity, {}) && r.dicing.ok() &&
+            conform::output_min_scaled_jacobian(r) > 0.0) {
+          r.warnings.erase(r.warnings.begin(),
+                           r.warnings.begin() + static_cast<std::ptrdiff_t>(r.findings));
+          r.findings = 0;
+        }
+        for (std::size_t i = 0; i < r.findings; ++i)
+          r.warnings[i] = "in the transition zone (numbered in its own output): " + r.warnings[i];
         rep_.zone = std::move(r);
         rep_.zone.model = {};
         return;

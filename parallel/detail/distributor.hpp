@@ -34,6 +34,10 @@
 
 namespace geode::parallel::detail {
 
+// What holds piece by piece of a hex mesh (distributed_assembly.cpp): all but the boundary,
+// the Euler characteristic and manifoldness, and the covering at the nodes `exempt`.
+bool piece_ok(const primal::HexValidityReport& v, const std::vector<char>& exempt);
+
 using primal::ElementKind;
 using primal::FaceKey;
 using primal::Index;
@@ -231,6 +235,14 @@ class Distributor {
   void assemble();
   void break_for_test();
   void verify();
+  // Local node n's global id, as list_node_ids lists it (before it does: verify()'s messages).
+  std::int64_t node_gid(Index n) const {
+    const auto i = primal::index_cast<std::size_t>(n), low = low_ids_.size();
+    const auto owned = primal::index_cast<std::size_t>(owned_);
+    if (i < low) return low_ids_[i];
+    if (i < low + owned) return owned_first_ + primal::index_cast<std::int64_t>(i - low);
+    return high_ids_[i - low - owned];
+  }
   // The local nodes' global ids, whole (assembly lists those outside the rank's run).
   void list_node_ids() {
     auto& ids = out_.node_gid;

@@ -25,7 +25,7 @@ for n in 1 2; do
       echo "verify $mode, $n ranks: a broken dicing exited $status, not 4"; cat err.txt; exit 1
     fi
     grep -q "invalid result, nothing written" err.txt
-    grep -q "hexes with a non-positive corner Jacobian" err.txt
+    grep -q "hexes inverted (a corner Jacobian <= 0), hexes: " err.txt
     if [ "$mode" = local ]; then grep -q "dicing: NOT as its tables make it" err.txt; fi
     if ls broken_* >/dev/null 2>&1; then echo "verify $mode, $n ranks: wrote a file"; exit 1; fi
   done
@@ -38,7 +38,7 @@ for n in 1 2 3; do
   if [ "$status" != 4 ]; then
     echo "an invalid zone, $n ranks: exited $status, not 4"; cat err.txt; exit 1
   fi
-  grep -q "the transition zone: hex mesh" err.txt
+  grep -q "the transition zone (numbered in its own output): [0-9]* of [0-9]* hexes inverted" err.txt
   grep -q "invalid result, nothing written" err.txt
   if ls zone"$n".exo* >/dev/null 2>&1; then echo "an invalid zone, $n ranks: wrote a file"; exit 1; fi
 done
