@@ -563,7 +563,7 @@ class HexSplitter {
       pick.assign(n + 1, 0);
       pick[n] = static_cast<char>(last);
       for (std::size_t j = n; j > 0; --j)
-        pick[j - 1] = static_cast<char>(from[j][index_cast<std::size_t>(pick[j])]);
+        pick[j - 1] = static_cast<char>(from[j][static_cast<std::size_t>(pick[j])]);
       return best[index_cast<std::size_t>(last)];
     };
     // On a cycle face 0 is its last face too: each choice of it in turn.
