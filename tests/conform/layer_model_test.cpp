@@ -201,7 +201,8 @@ TEST_CASE("a thin layer that cannot be split keeps its hexes, valid, and says wh
   for (std::size_t i = 0; i < 4; ++i)
     middle += input.points[primal::index_cast<std::size_t>(pyramid[i])] / 4.0;
   input.points.push_back(middle);
-  if (!input.node_ids.empty()) input.node_ids.push_back(input.node_ids.back() + 1000000);
+  if (!input.node_ids.empty())  // the next file id
+    input.node_ids.push_back(*std::max_element(input.node_ids.begin(), input.node_ids.end()) + 1);
   const Index centre = primal::index_cast(input.points.size() - 1);
   std::int64_t id = 1;
   for (std::int64_t t : input.tet_ids) id = std::max(id, t + 1);
@@ -219,8 +220,8 @@ TEST_CASE("a thin layer that cannot be split keeps its hexes, valid, and says wh
       }
   input.pyramids[p] = input.pyramids[last];
   input.pyramids.pop_back();
-  for (auto* v : {&input.pyramid_block})
-    if (!v->empty()) (*v)[p] = v->back(), v->pop_back();
+  if (!input.pyramid_block.empty())
+    input.pyramid_block[p] = input.pyramid_block.back(), input.pyramid_block.pop_back();
   if (!input.pyramid_ids.empty())
     input.pyramid_ids[p] = input.pyramid_ids.back(), input.pyramid_ids.pop_back();
   const conform::ConformResult r = conform::conform(input);
