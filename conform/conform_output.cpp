@@ -87,17 +87,17 @@ void Conformer::check(std::span<const Point> points, std::span<const std::array<
   // Hexes and nodes as the output file numbers them (ConformOptions::output_numbering).
   const primal::ElementNumbering numbering = options_.output_numbering;
   if (!res_.validity.ok()) {
-    // The hexes findings() names (the first five of each list), numbered in one pass.
-    std::vector<Index> named;
+    // The hexes its lists hold, numbered in one pass (findings() names a few of each).
+    std::vector<Index> listed;
     for (const auto* list : {&res_.validity.out_of_range_hexes, &res_.validity.repeated_node_hexes,
                              &res_.validity.inverted_hexes})
-      named.insert(
-          named.end(), list->begin(),
-          list->begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(list->size(), 5)));
-    const std::vector<std::int64_t> numbers = primal::hex_numbers(block, named, numbering);
+      listed.insert(listed.end(), list->begin(), list->end());
+    std::sort(listed.begin(), listed.end());
+    listed.erase(std::unique(listed.begin(), listed.end()), listed.end());
+    const std::vector<std::int64_t> numbers = primal::hex_numbers(block, listed, numbering);
     const auto hex = [&](Index h) {
-      return numbers[static_cast<std::size_t>(std::find(named.begin(), named.end(), h) -
-                                              named.begin())];
+      return numbers[static_cast<std::size_t>(std::lower_bound(listed.begin(), listed.end(), h) -
+                                              listed.begin())];
     };
     const auto node = [&](Index v) { return std::int64_t{v} + numbering.base; };
     verdict("invalid mesh: " + primal::findings(res_.validity, hex, node));

@@ -209,10 +209,6 @@ class HexSplitter {
       for (auto& x : t) std::swap(x[0], x[1]);
     return t;
   }
-  double volume(const std::array<Index, 4>& t) const {
-    const auto at = [&](std::size_t i) { return model_.points[index_cast<std::size_t>(t[i])]; };
-    return (at(1) - at(0)).cross(at(2) - at(0)).dot(at(3) - at(0));
-  }
   // Face `face`'s pyramid's value under choice x, or none (2: above every value) where it has no
   // pyramid.
   double pyramid_value(Index face, int x) const {
@@ -349,7 +345,9 @@ class HexSplitter {
         Pyramid p{face, {*a, *b}, q, apex, false, {}, low_[k][f], choice_[face]};
         // Its tets as the model has them are positive: the quad's cyclic order then the apex is
         // their orientation, or its mirror.
-        p.reversed = volume(tets_of(p, given)[0]) < 0.0;
+        const auto t = tets_of(p, given)[0];
+        const auto at = [&](std::size_t i) { return model_.points[index_cast<std::size_t>(t[i])]; };
+        p.reversed = tet_volume(at(0), at(1), at(2), at(3)) < 0.0;
         for (int x = 0; x < 2; ++x) {
           double lowest = 1.0;
           for (const auto& t : tets_of(p, low_[k][f] ^ x)) {
