@@ -974,8 +974,7 @@ ConformResult conform_model(const primal::Model& input, primal::Model* spare,
         const primal::Model wedges = primal::split_wedges(
             input.pyramids.empty() ? input : primal::split_pyramids(input).model, wedges_now);
         try {
-          primal::Model tets = primal::split_hexes(wedges, hexes_now);
-          own = std::move(tets);
+          own = primal::split_hexes(wedges, hexes_now);  // untouched when it throws
         } catch (const TopologyError& e) {
           // A hex with no positive split on the diagonals the tets on its faces force, or a
           // face under four tet triangles (which no split follows). Its wedges alone are split
