@@ -7,6 +7,7 @@
 #include <tuple>
 
 #include <geode/primal/boundary.hpp>
+#include <geode/primal/disjoint_sets.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/gradation.hpp>
 #include <geode/primal/key_map.hpp>
@@ -600,10 +601,10 @@ BufferLayer BufferBuilder::run() {
 
 }  // namespace
 
-double buffer_height_ratio(const BufferLayer& layer) {
-  if (layer.hexes.empty()) return 0.0;
+std::vector<double> buffer_height_ratios(const BufferLayer& layer) {
   const auto& p = layer.model.points;
-  double sum = 0.0;
+  std::vector<double> ratio;
+  ratio.reserve(layer.hexes.size());
   for (const BufferHex& b : layer.hexes) {
     double edge = 0.0, height = std::numeric_limits<double>::infinity();
     for (std::size_t i = 0; i < 4; ++i) {
@@ -613,9 +614,24 @@ double buffer_height_ratio(const BufferLayer& layer) {
       edge += (at((i + 1) % 4) - at(i)).norm() / 4.0;
       height = std::min(height, (at(i + 4) - at(i)).norm());
     }
-    sum += edge > 0.0 ? height / edge : 0.0;
+    ratio.push_back(edge > 0.0 ? height / edge : 0.0);
   }
-  return sum / static_cast<double>(layer.hexes.size());
+  return ratio;
+}
+
+std::vector<Index> interface_pieces(const BufferLayer& layer) {
+  primal::DisjointSets joined(layer.top_node.size());  // over the input's nodes
+  for (const BufferHex& b : layer.hexes)
+    for (std::size_t i = 1; i < 4; ++i) joined.unite(b.corners[0], b.corners[i]);
+  std::vector<Index> piece, number(layer.top_node.size(), kInvalidIndex);
+  piece.reserve(layer.hexes.size());
+  Index pieces = 0;
+  for (const BufferHex& b : layer.hexes) {
+    Index& n = number[index_cast<std::size_t>(joined.find(b.corners[0]))];
+    if (n == kInvalidIndex) n = pieces++;
+    piece.push_back(n);
+  }
+  return piece;
 }
 
 std::vector<Eigen::Vector3d> buffer_proportions(const BufferLayer& layer) {

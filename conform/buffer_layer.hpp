@@ -129,10 +129,16 @@ struct BufferLayer {
   BufferLayerReport report;
 };
 
-// The mean over the buffer hexes of their height (the shortest of their four edges from the
-// interface quad to the top) over their interface quad's mean edge: how flat the geode
-// templates will be squashed (the reference box is half as high as wide); 0 without hexes.
-double buffer_height_ratio(const BufferLayer& layer);
+// Per buffer hex, its height (the shortest of its four edges from the interface quad to the
+// top) over its interface quad's mean edge: how flat its geode template will be squashed (the
+// reference box is half as high as wide).
+std::vector<double> buffer_height_ratios(const BufferLayer& layer);
+
+// Per buffer hex, the piece of the interface it is on: buffer hexes sharing an interface node
+// are on one piece (a hex layer between tets has two, one on each side), numbered from 0 in the
+// order of their first buffer hex. The same for any layer of one interface (its hexes are in
+// Interface::quads order, on the same interface nodes).
+std::vector<Index> interface_pieces(const BufferLayer& layer);
 
 // Per buffer hex: its mean edge lengths along its three directions, in the template box's axes
 // (conform/reference_template.hpp): x along corners 0-3 (and 1-2, 4-7, 5-6), y its height (the

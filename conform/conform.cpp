@@ -452,13 +452,37 @@ void Conformer::carved() {
 // hex cells at the interface are a graded boundary layer's thin first cells (hexes beside wedges
 // in an extruded layer), the buffer hexes and the diced hexes behind them are squashed flat
 // (layer-mixed, n = 3 to 6: 0.43 to 0.79 x the yardstick, against 1.1 to 2.0 x carved from the
-// tets). So where the hex part's buffer hexes are on average lower than kThinHexBuffer of their
-// quads' edge (hex cells flatter than 2.5 : 1; every other demo's are 0.24 to 0.5), the tet
-// part's layer is taken instead if it is thicker.
+// tets). So where the hex part's buffer hexes on some piece of the interface are on average
+// lower than kThinHexBuffer of their quads' edge (hex cells flatter than 2.5 : 1; every other
+// demo's are 0.24 to 0.5), the tet part's layer is taken instead if it is thicker on that piece.
+// Per piece, as a hex layer between tets has two sides: a layer graded out from a thin first
+// cell (0.048 high where its last is 0.107) averaged 0.2 over both, and its thin side's geode
+// hexes were inverted.
 constexpr double kThinHexBuffer = 0.2;
 
+namespace {
+
+// Per piece of the interface (interface_pieces), the mean of its buffer hexes' values.
+std::vector<double> piece_means(const std::vector<double>& value, const std::vector<Index>& piece) {
+  std::vector<double> sum, count;
+  for (std::size_t h = 0; h < value.size(); ++h) {
+    const auto p = primal::index_cast<std::size_t>(piece[h]);
+    if (p >= sum.size()) sum.resize(p + 1, 0.0), count.resize(p + 1, 0.0);
+    sum[p] += value[h], count[p] += 1.0;
+  }
+  for (std::size_t p = 0; p < sum.size(); ++p) sum[p] /= count[p];
+  return sum;
+}
+
+}  // namespace
+
 void Conformer::thicker_from_tets() {
-  const double hex = buffer_height_ratio(layer_);
+  const std::vector<Index> piece = interface_pieces(layer_);
+  const std::vector<double> hex_means = piece_means(buffer_height_ratios(layer_), piece);
+  if (hex_means.empty()) return;
+  const auto thinnest = static_cast<std::size_t>(
+      std::min_element(hex_means.begin(), hex_means.end()) - hex_means.begin());
+  const double hex = hex_means[thinnest];
   if (hex >= kThinHexBuffer) return;
   BufferLayerOptions other = options_.buffer;
   other.side = BufferSide::kTet;
@@ -479,13 +503,18 @@ void Conformer::thicker_from_tets() {
     }
     crossed = e.what();
   }
-  const double tet = buffer_height_ratio(tets);
+  const double tet = piece_means(buffer_height_ratios(tets), piece)[thinnest];
   if (tet <= hex) return;
   layer_ = std::move(tets);
   res_.buffer_side = BufferSide::kTet;
   std::ostringstream m;
   m << "buffer layer carved from the tet part, not the hex part: its hexes are " << tet
-    << " of their interface quads' edge high on average, against " << hex
+    << " of their interface quads' edge high on average";
+  if (hex_means.size() > 1)
+    m << " on the interface's thinnest piece ("
+      << std::count(piece.begin(), piece.end(), primal::index_cast(thinnest)) << " of its "
+      << piece.size() << " quads)";
+  m << ", against " << hex
     << " from the hex part (thin hex cells at the interface, as a boundary layer's)";
   if (!crossed.empty())
     m << "; across faces between the tet part's blocks, so blocks there do not keep their "

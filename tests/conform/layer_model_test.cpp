@@ -13,12 +13,15 @@
 #include <cstdlib>
 #include <set>
 #include <string>
+#include <vector>
 
+#include <geode/conform/buffer_layer.hpp>
 #include <geode/conform/conform.hpp>
 #include <geode/io/read_model.hpp>
 #include <geode/primal/boundary.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/quality.hpp>
+#include <geode/primal/split_pyramids.hpp>
 #include <geode/primal/validity.hpp>
 
 #include "../support/conform_checks.hpp"
@@ -252,6 +255,40 @@ TEST_CASE("the same layer recombined into quads only keeps its hexes and gets th
   CHECK(r.hexes_split == 0);
   CHECK(r.interface_quads == primal::index_cast(input.pyramids.size()));
   CHECK(r.diced_hexes == 8 * primal::index_cast(input.hexes.size()));
+}
+
+TEST_CASE("a quads-only layer graded from a thin side is carved from the tets: per piece") {
+  // Graded out by 1.3 from a 0.048-high first cell to a 0.107-high last: carved from the hex
+  // part, the inner side's buffer hexes are 0.16 of their edge high, the outer's more, 0.2 on
+  // average over both; decided over the whole interface, the hex part's layer was kept and
+  // geode hexes on the thin side came out inverted (exit 4, found by a fault hunt).
+  const test::TempDir dir;
+  const primal::Model input = layer_model(dir, "cylinder 5 out 0.3 quads cells=4 ratio=1.3");
+  REQUIRE(input.wedges.empty());
+  const primal::Model tets = primal::split_pyramids(input).model;  // as conform does first
+  const conform::BufferLayer from_hexes =
+      conform::insert_buffer_layer(tets, primal::find_interface(tets));
+  const std::vector<Index> piece = conform::interface_pieces(from_hexes);
+  const std::vector<double> ratio = conform::buffer_height_ratios(from_hexes);
+  REQUIRE(ratio.size() == piece.size());
+  double sum = 0.0, mean[2] = {0.0, 0.0};
+  int count[2] = {0, 0};
+  for (std::size_t h = 0; h < piece.size(); ++h) {
+    REQUIRE(piece[h] >= 0);
+    REQUIRE(piece[h] < 2);  // the layer's inner and outer sides
+    sum += ratio[h];
+    mean[piece[h]] += ratio[h], ++count[piece[h]];
+  }
+  REQUIRE(count[0] > 0);
+  REQUIRE(count[1] > 0);
+  CHECK(sum / static_cast<double>(piece.size()) >= 0.2);          // the whole interface: not thin
+  CHECK(std::min(mean[0] / count[0], mean[1] / count[1]) < 0.2);  // one side is
+  conform::ConformOptions o;
+  o.smooth = conform::ConformSmooth::kNone;  // invalid with it too, and faster
+  const conform::ConformResult r = conform::conform(input, o);
+  test::check_conform_result(r, -1, 1);  // the warning below
+  CHECK(r.buffer_side == conform::BufferSide::kTet);
+  CHECK(r.warnings.front().find("on the interface's thinnest piece") != std::string::npos);
 }
 
 }  // namespace geode
