@@ -46,7 +46,7 @@ struct ConformArgs {
   double merge_tolerance = -1;  // < 0: no merging
   double buffer_thickness = 0;  // 0: the side's default
   double feature_thickness = conform::BufferLayerOptions{}.feature_thickness;
-  std::string buffer_side = "hex";
+  std::string buffer_side;  // empty: automatic (conform::set_buffer_side)
   std::string pyramids = "split";
   std::string relax = "interface";
   double smooth_target = 0.0;
@@ -182,7 +182,7 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
   opts.quality = conform::parse_conform_quality(a.quality);
   opts.verify = conform::parse_conform_verify(a.verify);
   opts.geode_block = a.geode_block;
-  opts.buffer.side = conform::parse_buffer_side(a.buffer_side);
+  conform::set_buffer_side(opts, a.buffer_side);
   opts.buffer.thickness = std::max(a.buffer_thickness, 0.0);  // 0: the side's default
   opts.buffer.feature_thickness = a.feature_thickness;
   opts.smooth_target = a.smooth_target;
@@ -325,11 +325,12 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
       ->capture_default_str();
   c->add_option(
        "--buffer-side", a.buffer_side,
-       "the part the buffer layer is carved from: hex (default; the tets stay as meshed, the\n"
-       "hexes at the interface are squashed) or tet (the hexes stay, the tets shrink off the "
-       "interface)")
-      ->check(CLI::IsMember({"hex", "tet"}))
-      ->capture_default_str();
+       "the part the buffer layer is carved from: hex (the tets stay as meshed, the hexes at\n"
+       "the interface are squashed) or tet (the hexes stay, the tets shrink off the interface);\n"
+       "not given: hex, or tet with a warning where the hex cells at some piece of the\n"
+       "interface are thin (flatter than 2.5 : 1, a boundary layer's) and the tets give a\n"
+       "thicker layer there")
+      ->check(CLI::IsMember({"hex", "tet"}));
   c->add_option(
        "--buffer-thickness", a.buffer_thickness,
        "how far that part shrinks off the interface (the buffer layer's thickness), as a fraction\n"

@@ -97,11 +97,12 @@ CLI::Validator number_check(double lo, double hi, bool integer) {
 }
 
 void check_buffer_thickness(double thickness, const std::string& side) {
-  if (const double most = conform::max_buffer_thickness(conform::parse_buffer_side(side));
+  if (const double most = conform::max_buffer_thickness(
+          side.empty() ? conform::BufferSide::kHex : conform::parse_buffer_side(side));
       thickness > most) {
     std::ostringstream m;
-    m << "--buffer-thickness " << thickness << " with --buffer-side " << side << ": at most "
-      << most;
+    m << "--buffer-thickness " << thickness << " with --buffer-side "
+      << (side.empty() ? "hex" : side) << ": at most " << most;
     throw InvalidInput(m.str());
   }
 }

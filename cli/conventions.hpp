@@ -48,7 +48,8 @@ CLI::Validator number_check(double lo = std::numeric_limits<double>::lowest(),
 
 // --buffer-thickness against --buffer-side's maximum (conform::max_buffer_thickness), before
 // any work: InvalidInput "--buffer-thickness 0.6 with --buffer-side tet: at most 0.45". `geode
-// conform` and `geode_mpi conform` (which compiles this file too) check it alike.
+// conform` and `geode_mpi conform` (which compiles this file too) check it alike; an empty side
+// (not given) is the hex side's.
 void check_buffer_thickness(double thickness, const std::string& side);
 
 // "24x14x24" (dim 3) or "24x14" (dim 2): exactly `dim` finite numbers, each in [1e-6, 1e6] and

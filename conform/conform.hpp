@@ -84,6 +84,11 @@ struct ConformOptions {
   // part of a hex face), carve it from the other part (at that side's default thickness) and say
   // so in ConformResult::warnings; false: refuse.
   bool buffer_fallback = true;
+  // False (automatic): where the hex part's buffer hexes on some piece of the interface are
+  // flat (a graded boundary layer's thin first cells), the tet part's layer is taken if it is
+  // thicker there, with a warning (conform.cpp, kThinHexBuffer). True: buffer.side as the
+  // caller chose it (buffer_fallback still applies where that part gives no layer at all).
+  bool buffer_side_chosen = false;
   // The model's tets from this index on are pyramids (or wedges) the caller split, as geode_mpi's
   // zone is cut from a model whose pyramids it split: on an interface quad that is not planar
   // their triangles stand for the quad's bilinear face, which bounded the pyramid (the volume
@@ -176,6 +181,11 @@ struct ConformOptions {
   // own order is not the blocks' (ConformResult::model).
   primal::ElementNumbering output_numbering;
 };
+
+// The buffer side as the command line and Python spell it: "" (automatic: the hex part, or the
+// tet part where the hex part's cells at the interface are thin), "hex" or "tet" (that part, as
+// chosen); sets buffer.side and buffer_side_chosen. InvalidInput naming any other word.
+void set_buffer_side(ConformOptions& options, const std::string& word);
 
 struct BlockQuality {
   int block = 0;

@@ -157,12 +157,13 @@ py::dict conform_arrays(const py::handle& points, const py::dict& cells,
   opts.quality = conform::parse_conform_quality(quality);
   opts.geode_block = geode_block;
   opts.relax = conform::parse_conform_relax(relax);
-  opts.buffer.side = conform::parse_buffer_side(buffer_side);
+  conform::set_buffer_side(opts, buffer_side);  // "": automatic
   if (!(buffer_thickness >= 0) ||
       buffer_thickness > conform::max_buffer_thickness(opts.buffer.side)) {
     std::ostringstream m;
-    m << "buffer_thickness " << buffer_thickness << " with buffer_side " << buffer_side
-      << ": at most " << conform::max_buffer_thickness(opts.buffer.side);
+    m << "buffer_thickness " << buffer_thickness << " with buffer_side "
+      << conform::buffer_side_name(opts.buffer.side) << ": at most "
+      << conform::max_buffer_thickness(opts.buffer.side);
     throw InvalidInput(m.str());
   }
   opts.buffer.thickness = buffer_thickness;

@@ -147,7 +147,7 @@ int run(int argc, char** argv, int rank, int size) {
   CLI::App app{"geode conform under MPI: mpirun -np N geode_mpi conform INPUT -o OUT.exo"};
   app.require_subcommand(1);
   CLI::App* conform = app.add_subcommand("conform", "conform a hex + tet model, partitioned");
-  std::string input, output, smooth = "local", side = "hex", verify = "local";
+  std::string input, output, smooth = "local", side, verify = "local";  // side: automatic
   bool join = false, quiet = false;
   int rings = 4, threads = 1, zone_threads = 0;
   double thickness = 0;
@@ -164,9 +164,11 @@ int run(int argc, char** argv, int rank, int size) {
   conform->add_option("--smooth", smooth, "local or none (global moves every node: not here)")
       ->check(CLI::IsMember({"local", "none"}))
       ->capture_default_str();
-  conform->add_option("--buffer-side", side, "the part the buffer layer is carved from: hex or tet")
-      ->check(CLI::IsMember({"hex", "tet"}))
-      ->capture_default_str();
+  conform
+      ->add_option("--buffer-side", side,
+                   "the part the buffer layer is carved from: hex or tet; not given, as for geode "
+                   "conform: hex, or tet where the hex cells at the interface are thin")
+      ->check(CLI::IsMember({"hex", "tet"}));
   // As geode conform's (cli/conform_command.cpp): [0.01, 0.9], and at most the side's maximum.
   const double thickest = conform::max_buffer_thickness(conform::BufferSide::kHex);
   conform
@@ -228,7 +230,7 @@ int run(int argc, char** argv, int rank, int size) {
       const double t0 = MPI_Wtime();
       parallel::DistributedOptions options;
       options.conform.smooth = conform::parse_conform_smooth(smooth);
-      options.conform.buffer.side = conform::parse_buffer_side(side);
+      conform::set_buffer_side(options.conform, side);
       options.conform.buffer.thickness = thickness;
       options.conform.verify = conform::parse_conform_verify(verify);
       options.rings = rings;

@@ -215,7 +215,7 @@ def _model_to_meshio(model, cell_data_extra=None):
 
 
 def conform(mesh=None, *, points=None, cells=None, cell_blocks=None, name="mesh", smooth="local", quality="sj",
-            geode_block="", buffer_side="hex", buffer_thickness=0.0, smooth_target=0.0, template_box=None,
+            geode_block="", buffer_side=None, buffer_thickness=0.0, smooth_target=0.0, template_box=None,
             merge_tolerance=None, relax="interface", allow_invalid=False):
     """Conform a model of hexes, tets, pyramids and wedges into one valid all-hex mesh, as
     `geode conform` does.
@@ -228,7 +228,8 @@ def conform(mesh=None, *, points=None, cells=None, cell_blocks=None, name="mesh"
     per cell block). The input gets the checks a file gets when read: a cell in another corner
     order (a wedge in VTK's mirrored order, a pyramid's base clockwise) is inverted and raises
     InputError naming it by its 1-based position among the cells (a .msh file's element tag).
-    The options are those of `geode conform`.
+    The options are those of `geode conform` (buffer_side=None: not given, hex or tet as
+    `geode conform` chooses without --buffer-side).
     Returns (meshio.Mesh, report): the output with one cell block and one cell set per block,
     block ids as gmsh:physical, node sets as point sets; the report as `--report` writes it,
     with "side_sets" ([{id, name, sides: K x 2 (hex, local face)}]). Hexes (the sides', each
@@ -237,7 +238,7 @@ def conform(mesh=None, *, points=None, cells=None, cell_blocks=None, name="mesh"
     A result that fails verification raises InvalidResultError, unless allow_invalid=True.
     """
     pts, arrays, names, node_sets = _model_arrays(mesh, points, cells, cell_blocks, name)
-    out = _geode._conform(pts, arrays, names, node_sets, name, smooth, quality, geode_block, buffer_side,
+    out = _geode._conform(pts, arrays, names, node_sets, name, smooth, quality, geode_block, buffer_side or "",
                           float(buffer_thickness), float(smooth_target), template_box, merge_tolerance, relax)
     if not out["valid"] and not allow_invalid:
         raise InvalidResultError(out["invalid_reason"] + " (nothing returned; allow_invalid=True returns it anyway)")

@@ -255,6 +255,15 @@ TEST_CASE("the same layer recombined into quads only keeps its hexes and gets th
   CHECK(r.hexes_split == 0);
   CHECK(r.interface_quads == primal::index_cast(input.pyramids.size()));
   CHECK(r.diced_hexes == 8 * primal::index_cast(input.hexes.size()));
+  // The hex side chosen (--buffer-side hex) is kept: no switch, no warning.
+  conform::set_buffer_side(o, "hex");
+  const conform::ConformResult chosen = conform::conform(input, o);
+  CHECK(chosen.buffer_side == conform::BufferSide::kHex);
+  for (const std::string& w : chosen.warnings)
+    CHECK(w.find("buffer layer carved from the tet part") == std::string::npos);
+  conform::set_buffer_side(o, "");
+  CHECK(!o.buffer_side_chosen);
+  CHECK(o.buffer.side == conform::BufferSide::kHex);
 }
 
 TEST_CASE("a quads-only layer graded from a thin side is carved from the tets: per piece") {
