@@ -127,6 +127,17 @@ def test_conform_errors_match_cli(half, tmp_path):
     assert one_line(str(e.value)) == cli_error(cli)
 
 
+def test_conform_buffer_side(half):
+    # Not given: as `geode conform` without --buffer-side (the hex part here); given: as asked.
+    _, report = geode.conform(half, smooth="none")
+    assert report["buffer_side"] == "hex"
+    _, report = geode.conform(half, smooth="none", buffer_side="tet")
+    assert report["buffer_side"] == "tet"
+    with pytest.raises(geode.InputError) as e:
+        geode.conform(half, buffer_side="both")
+    assert "buffer side 'both'" in str(e.value)
+
+
 def test_conform_refuses_bad_cells(half):
     quadratic = meshio.Mesh(half.points, [("tetra10", np.array([list(range(10))]))])
     with pytest.raises(geode.InputError, match="cell block 0 holds 'tetra10' cells"):
