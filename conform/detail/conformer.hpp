@@ -3,7 +3,8 @@
 // (conform.hpp) whose stages are the methods of Conformer, defined by topic in conform.cpp (the
 // interface, the buffer layer, dicing, template placement, assembly), conform_smoothing.cpp
 // (settling, untangling, smoothing) and conform_output.cpp (verification, the report, the
-// output).
+// output). conform_model.cpp runs it, after what changes the model first (the tet relaxation,
+// pyramids and layers split into tets).
 #include <Eigen/Core>
 #include <algorithm>
 #include <array>

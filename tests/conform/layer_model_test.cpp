@@ -17,6 +17,7 @@
 
 #include <geode/conform/buffer_layer.hpp>
 #include <geode/conform/conform.hpp>
+#include <geode/conform/report.hpp>
 #include <geode/io/read_model.hpp>
 #include <geode/primal/boundary.hpp>
 #include <geode/primal/errors.hpp>
@@ -241,6 +242,27 @@ TEST_CASE("a thin layer that cannot be split keeps its hexes, valid, and says wh
            w.find("lies under four tet triangles") != std::string::npos;
   });
   CHECK(said != r.warnings.end());
+}
+
+TEST_CASE("a thicker layer whose holes give a poor transition is split into tets after all") {
+  // 0.2 thick in 2 cells, 0.6 of their width high: too thick to be split at once, so its wedges
+  // alone were split and the buffer hexes at the holes' walls (60 degrees apart around a
+  // triangle) gave 0.015 with --smooth none and 0.025 with the defaults, below the input's own
+  // elements diced alone (0.037). Conformed again split into tets: 0.145.
+  const test::TempDir dir;
+  const primal::Model input = layer_model(dir, "cylinder 6 out 0.2");
+  REQUIRE(!input.wedges.empty());
+  conform::ConformOptions o;
+  o.smooth = conform::ConformSmooth::kNone;
+  const conform::ConformResult r = conform::conform(input, o);
+  test::check_conform_result(r, -1, r.warnings.size());            // the split's and the volumes'
+  CHECK(r.hexes_split == primal::index_cast(input.hexes.size()));  // the layer is every hex
+  CHECK(r.diced_hexes == 0);
+  CHECK(r.wedges_split == primal::index_cast(input.wedges.size()));
+  CHECK(conform::output_min_scaled_jacobian(r) >= r.yardstick());
+  REQUIRE(!r.warnings.empty());
+  CHECK(r.warnings.front().find("with its wedges alone split, the buffer hexes at the holes") !=
+        std::string::npos);
 }
 
 TEST_CASE("the same layer recombined into quads only keeps its hexes and gets the geode") {

@@ -1,0 +1,343 @@
+// conform() itself: the stages before and around Conformer (detail/conformer.hpp) that change
+// the model it is given: the tet relaxation, pyramids split, and the layers of hexes and wedges
+// that join the two sides of the interface, split into tets (all of a thin layer, or its wedges
+// alone, leaving holes), the run started again after each.
+#include <geode/conform/conform.hpp>
+
+#include <algorithm>
+#include <array>
+#include <iterator>
+#include <numeric>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <geode/conform/detail/conformer.hpp>
+#include <geode/conform/report.hpp>
+#include <geode/primal/errors.hpp>
+#include <geode/primal/relax_tets.hpp>
+#include <geode/primal/split_hexes.hpp>
+#include <geode/primal/split_pyramids.hpp>
+#include <geode/primal/split_wedges.hpp>
+#include <geode/primal/topology.hpp>
+
+namespace geode::conform {
+
+namespace {
+
+using primal::Index;
+
+// Rings of tets out from the covered quads that relax_tet_nodes moves: two take in a pyramid's
+// apex and the tets around it (on the hexdominant demo, n = 8, the lowest diced tet among them
+// 0.060 -> 0.184); on the nugget (n = 3) one, two or three rings give the same output.
+constexpr int kRelaxRings = 2;
+// Only nodes with a tet diced below 0.3 (the geode template's own minimum is 0.33: a tet diced
+// at that level does not limit the transition), each step halved at most 3 times, 2 sweeps:
+// on the hexdominant demo at n = 28 (2,918 free nodes; load 0.5) 0.97 s instead of 1.85 s for
+// every node and 5 halvings, and the lowest diced tet there 0.175 instead of 0.167.
+constexpr primal::RelaxTetsOptions kRelax{
+    .sweeps = 2, .halvings = 3, .initial_step = 0.25, .good = 0.3};
+
+// A layer through which wedges join tets on its two sides is split into tets where its wedge
+// columns' cells are lower than this of their width: flatter than 2.5 : 1, the hex cells whose
+// buffer hexes Conformer::thicker_from_tets finds too flat (kThinHexBuffer: half the cell's
+// height below 0.2 of its width), and at the holes there is no thicker side to carve from.
+constexpr double kThinLayerCells = 0.4;
+// ... and where every hex of it is flatter than this (hex_flatness): a layer's, not a thick
+// part's (cube-like, near 1). Gmsh's layers 0.1 thick reach 0.53 at their narrowest quads.
+constexpr double kLayerHex = 2.0 / 3.0;
+// A thicker layer keeps its hexes, its wedges alone split: holes through it whose walls get
+// buffer hexes. Where the output is then below this x the yardstick (worse than the input's own
+// elements diced alone), the layer is split into tets as a thin one is and conformed again, and
+// the better output kept. The walls of triangular holes meet at 60 degrees: cylinder layers in 2
+// cells 0.2 and 0.3 thick (cells 0.6 and 0.9 of their width high) gave 0.025 and 0.0066 with the
+// holes (0.57 x and 0.15 x), 0.145 and 0.118 split.
+constexpr double kPoorHoles = 1.0;
+
+// How flat a hex is: the mean length of its edges along its flattest direction over that along
+// its longest.
+double hex_flatness(const primal::Model& m, const std::array<Index, 8>& h) {
+  std::array<double, 3> mean{};
+  for (std::size_t e = 0; e < primal::topology::kHexEdgeCorners.size(); ++e) {
+    const auto& c = primal::topology::kHexEdgeCorners[e];
+    mean[e / 4] += (m.points[primal::index_cast<std::size_t>(h[static_cast<std::size_t>(c[1])])] -
+                    m.points[primal::index_cast<std::size_t>(h[static_cast<std::size_t>(c[0])])])
+                       .norm();
+  }
+  return *std::min_element(mean.begin(), mean.end()) / *std::max_element(mean.begin(), mean.end());
+}
+
+// The indices in [0, n) not in `split` (ascending): where the current model's cells come from.
+std::vector<Index> remaining(std::size_t n, const std::vector<Index>& split) {
+  std::vector<Index> out;
+  for (std::size_t i = 0; i < n; ++i)
+    if (!std::binary_search(split.begin(), split.end(), primal::index_cast(i)))
+      out.push_back(primal::index_cast(i));
+  return out;
+}
+
+// `a` and `b` (ascending) merged, ascending, without repeats.
+std::vector<Index> merged(const std::vector<Index>& a, const std::vector<Index>& b) {
+  std::vector<Index> out;
+  std::set_union(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(out));
+  return out;
+}
+
+// conform() on `input`; `spare`: the same model when the caller gives it up (the Model&&
+// overload), then relaxed in place instead of copied, and trimmed once the buffer layer holds
+// the model. Each pass of run() conforms the current model; a pass that finds a layer of wedges
+// joining the two sides of the interface changes the model and starts again.
+class ModelConformer {
+ public:
+  ModelConformer(const primal::Model& input, primal::Model* spare, const ConformOptions& options)
+      : input_(input),
+        options_(options),
+        owned_(spare),
+        model_(&input),
+        wedge_origin_(input.wedges.size()),
+        hex_origin_(input.hexes.size()) {
+    std::iota(wedge_origin_.begin(), wedge_origin_.end(), Index{0});
+    std::iota(hex_origin_.begin(), hex_origin_.end(), Index{0});
+  }
+
+  ConformResult run();
+
+ private:
+  // The input's split pyramids (kSplit, the only pyramid treatment so far: each pyramid as its
+  // better two tets; a pyramid template, a ConformPyramids value of its own, would fill them in
+  // place), or the input.
+  primal::Model without_pyramids() const {
+    return input_.pyramids.empty() ? input_ : primal::split_pyramids(input_).model;
+  }
+  // One pass: the tets near the hex part relaxed (given_: their points before), then Conformer.
+  ConformResult pass(std::vector<Index>& joining);
+  // A thin layer joining the two sides: its whole pieces become tets; false where a hex of it has
+  // no split (it keeps its hexes, as a thick layer does).
+  bool split_layer(const primal::CellPieces& layer, const std::string& where,
+                   const std::string& why);
+  // Only the wedges of the pieces: holes through the layer.
+  void split_wedges_alone(const std::vector<Index>& pieces, Index first);
+  // The result's counts of what was split, the warnings in front of its own after its findings.
+  void finish(ConformResult& r) const;
+
+  const primal::Model& input_;
+  const ConformOptions& options_;
+  primal::Model own_;                   // the input as conform changes it, when it copies it
+  primal::Model* owned_;                // the model conform may change: the caller's, or own_
+  const primal::Model* model_;          // what the next pass conforms
+  std::vector<primal::Point> given_;    // the points before this pass's relaxation
+  primal::RelaxTetsResult relaxation_;  // this pass's
+  // What was split, by the input's own wedge and hex numbers, and where the current model's
+  // wedges and hexes come from in the input (splitting renumbers the rest).
+  std::vector<Index> wedges_split_, hexes_split_;
+  Index hex_tets_ = 0;  // the tets the split hexes became
+  std::vector<Index> wedge_origin_, hex_origin_;
+  std::vector<std::string> warnings_;
+  bool layer_kept_ = false;  // a thin layer that could not be split into tets
+  // The layers whose wedges alone were split (kPoorHoles), by the input's numbers, and where the
+  // warnings stood before the first of them.
+  primal::CellPieces holes_;
+  std::size_t warnings_before_holes_ = 0;
+  std::string holes_where_;  // the first of them, named
+};
+
+ConformResult ModelConformer::pass(std::vector<Index>& joining) {
+  relaxation_ = {};
+  given_.clear();
+  if (options_.relax == ConformRelax::kInterface &&
+      (!model_->hexes.empty() || !model_->wedges.empty() || !hexes_split_.empty()) &&
+      !model_->tets.empty()) {
+    // Where a hex layer was split into tets, its cells' corners seed the rings too: the
+    // pyramids Gmsh put on its quads are tets beside it still.
+    std::vector<Index> seeds;
+    for (Index h : hexes_split_)
+      for (Index v : input_.hexes[primal::index_cast<std::size_t>(h)]) seeds.push_back(v);
+    const std::vector<Index> nodes = primal::tet_nodes_to_relax(*model_, kRelaxRings, seeds);
+    if (!nodes.empty()) {
+      if (!owned_) {
+        own_ = input_;
+        model_ = owned_ = &own_;
+      }
+      given_ = owned_->points;
+      relaxation_ = primal::relax_tet_nodes(owned_->points, owned_->tets, nodes, kRelax);
+      if (options_.progress)
+        options_.progress("tet relaxation: " + std::to_string(relaxation_.nodes_moved) + " of " +
+                          std::to_string(nodes.size()) + " free tet nodes moved, their tets' " +
+                          "diced minimum " + std::to_string(relaxation_.min_before) + " -> " +
+                          std::to_string(relaxation_.min_after) + " (" +
+                          std::to_string(relaxation_.seconds) + " s)");
+    }
+  }
+  detail::Conformer conformer(*model_, options_, relaxation_.nodes_moved ? &given_ : nullptr,
+                              model_ == owned_ ? owned_ : nullptr);
+  conformer.tets_given(std::min(options_.split_tets_from, primal::index_cast(input_.tets.size())));
+  ConformResult r = conformer.run();
+  joining = conformer.joining();
+  return r;
+}
+
+bool ModelConformer::split_layer(const primal::CellPieces& layer, const std::string& where,
+                                 const std::string& why) {
+  // Split again from the input as given, in the order above (pyramids, wedges, then the hexes
+  // on the diagonals those give them), as geode_mpi's zone, whose pyramids come split, does.
+  std::vector<Index> wedges_now = wedges_split_, hexes_now = hexes_split_;
+  for (Index w : layer.wedges) wedges_now.push_back(w);
+  for (Index h : layer.hexes) hexes_now.push_back(h);
+  std::sort(wedges_now.begin(), wedges_now.end());
+  std::sort(hexes_now.begin(), hexes_now.end());
+  wedges_now.erase(std::unique(wedges_now.begin(), wedges_now.end()), wedges_now.end());
+  hexes_now.erase(std::unique(hexes_now.begin(), hexes_now.end()), hexes_now.end());
+  const primal::Model wedges = primal::split_wedges(without_pyramids(), wedges_now);
+  try {
+    own_ = primal::split_hexes(wedges, hexes_now);  // untouched when it throws
+  } catch (const TopologyError& e) {
+    // A hex with no positive split on the diagonals the tets on its faces force, or a face
+    // under four tet triangles (which no split follows). Its wedges alone are split, as a
+    // thicker layer's are: buffer hexes at the holes, valid where they are, rather than no mesh.
+    layer_kept_ = true;
+    warnings_.push_back(where + ", but its hexes stay hexes: " + e.what());
+    return false;
+  }
+  wedges_split_ = std::move(wedges_now);
+  hexes_split_ = std::move(hexes_now);
+  std::ostringstream m;
+  m << layer.hexes.size() << " hexes and " << layer.wedges.size()
+    << " wedges split into tets: " << where << ", and " << why;
+  warnings_.push_back(m.str());
+  if (options_.progress)
+    options_.progress("layer: " + std::to_string(layer.hexes.size()) + " hexes and " +
+                      std::to_string(layer.wedges.size()) +
+                      " wedges split into tets (wedges through a layer between tets)");
+  hex_tets_ = primal::index_cast(own_.tets.size() - wedges.tets.size());
+  model_ = owned_ = &own_;
+  wedge_origin_ = remaining(input_.wedges.size(), wedges_split_);
+  hex_origin_ = remaining(input_.hexes.size(), hexes_split_);
+  return true;
+}
+
+void ModelConformer::split_wedges_alone(const std::vector<Index>& pieces, Index first) {
+  warnings_.push_back(std::to_string(pieces.size()) +
+                      " wedges split into three tets each: the layer of " +
+                      primal::describe_element(*model_, {primal::ElementKind::kWedge, first}) +
+                      " joins the two sides of the hex/tet interface (hexes and wedges side "
+                      "by side in a layer against tets), where no buffer layer can end");
+  own_ = primal::split_wedges(*model_, pieces);
+  model_ = owned_ = &own_;
+  for (Index w : pieces) wedges_split_.push_back(wedge_origin_[primal::index_cast<std::size_t>(w)]);
+  std::sort(wedges_split_.begin(), wedges_split_.end());
+  wedge_origin_ = remaining(input_.wedges.size(), wedges_split_);
+  if (options_.progress)
+    options_.progress("wedges: " + std::to_string(pieces.size()) +
+                      " split into tets (a wedge layer joined the two sides of the interface)");
+}
+
+void ModelConformer::finish(ConformResult& r) const {
+  r.relaxation = relaxation_;
+  r.seconds += relaxation_.seconds;
+  r.input_pyramids = primal::index_cast(input_.pyramids.size());
+  r.wedges_split = primal::index_cast(wedges_split_.size());
+  r.hexes_split = primal::index_cast(hexes_split_.size());
+  r.warnings.insert(r.warnings.begin() + static_cast<std::ptrdiff_t>(r.findings), warnings_.begin(),
+                    warnings_.end());
+  r.input_wedges += r.wedges_split;
+  r.input_hexes += r.hexes_split;
+  r.input_tets -= 2 * r.input_pyramids + 3 * r.wedges_split + hex_tets_;
+}
+
+ConformResult ModelConformer::run() {
+  if (!input_.pyramids.empty()) {
+    own_ = without_pyramids();
+    model_ = owned_ = &own_;
+  }
+  std::optional<ConformResult> with_holes;  // kPoorHoles: the holes' result, while split is tried
+  for (;;) {
+    std::vector<Index> joining;
+    ConformResult r;
+    try {
+      r = pass(joining);
+    } catch (const TopologyError&) {
+      if (!with_holes) throw;
+      return std::move(*with_holes);  // the layers split could not be conformed: the holes
+    }
+    if (!joining.empty()) {
+      // A wedge layer joins the two sides of the interface: its pieces become tets (from the
+      // points as given: the relaxation runs again on the split model), and the run starts
+      // again; a hex quad they covered may join another piece to the sides, hence the loop.
+      if (!given_.empty()) owned_->points = std::move(given_);
+      const std::vector<Index> pieces = primal::wedge_pieces(*model_, joining);
+      const primal::WedgeColumns columns = primal::wedge_columns(*model_, pieces);
+      const primal::CellPieces layer =
+          columns.through ? primal::cell_pieces(*model_, pieces) : primal::CellPieces{};
+      primal::CellPieces as_input;  // the layer by the input's numbers
+      for (Index w : layer.wedges)
+        as_input.wedges.push_back(wedge_origin_[primal::index_cast<std::size_t>(w)]);
+      for (Index h : layer.hexes)
+        as_input.hexes.push_back(hex_origin_[primal::index_cast<std::size_t>(h)]);
+      const std::string where =
+          "wedges go through the layer of " +
+          primal::describe_element(*model_, {primal::ElementKind::kWedge, pieces.front()}) +
+          " from tets on one side to tets on the other";
+      // Only a layer: one joined to a thick part would take it along; it keeps the holes (and
+      // their buffer hexes) instead, unless they turn out poor (kPoorHoles).
+      const bool thin =
+          columns.height_ratio < kThinLayerCells && !layer.hexes.empty() &&
+          std::all_of(layer.hexes.begin(), layer.hexes.end(), [&](Index h) {
+            return hex_flatness(*model_, model_->hexes[primal::index_cast<std::size_t>(h)]) <
+                   kLayerHex;
+          });
+      if (thin && !layer_kept_) {
+        // Wedges go through a thin layer from tets on one side to tets on the other: split,
+        // they would leave holes whose walls are interface quads as high as the layer's cells
+        // (buffer hexes there inverted or flat, or two layer hexes meeting along an edge only).
+        // The layer's whole pieces of hexes and wedges become tets, diced with the tets around
+        // them.
+        std::ostringstream why;
+        why << "its cells are " << columns.height_ratio
+            << " of their width high, too thin for buffer hexes at the holes split wedges leave";
+        if (split_layer(as_input, where, why.str())) continue;
+      } else if (!layer.hexes.empty()) {
+        if (holes_.hexes.empty()) warnings_before_holes_ = warnings_.size(), holes_where_ = where;
+        std::sort(as_input.wedges.begin(), as_input.wedges.end());
+        std::sort(as_input.hexes.begin(), as_input.hexes.end());
+        holes_.wedges = merged(holes_.wedges, as_input.wedges);
+        holes_.hexes = merged(holes_.hexes, as_input.hexes);
+      }
+      split_wedges_alone(pieces, joining.front());
+      continue;
+    }
+    finish(r);
+    if (with_holes) {  // the layers split: the better of the two
+      if (result_valid(r) &&
+          output_min_scaled_jacobian(r) > output_min_scaled_jacobian(*with_holes))
+        return r;
+      return std::move(*with_holes);
+    }
+    const double holes_min = output_min_scaled_jacobian(r);
+    if (holes_.hexes.empty() || layer_kept_ || holes_min >= kPoorHoles * r.yardstick()) return r;
+    // The holes gave a poor transition: the layers split into tets instead, conformed again.
+    std::ostringstream why;
+    why << "with its wedges alone split, the buffer hexes at the holes they leave gave "
+        << holes_min << " (" << holes_min / r.yardstick() << " x the input's elements diced alone)";
+    const std::vector<std::string> kept = warnings_;
+    warnings_.resize(warnings_before_holes_);
+    with_holes = std::move(r);
+    const primal::CellPieces layers = holes_;
+    if (!split_layer(layers, holes_where_, why.str())) {
+      warnings_ = kept;
+      return std::move(*with_holes);
+    }
+  }
+}
+
+}  // namespace
+
+ConformResult conform(const primal::Model& input, const ConformOptions& options) {
+  return ModelConformer(input, nullptr, options).run();
+}
+
+ConformResult conform(primal::Model&& input, const ConformOptions& options) {
+  return ModelConformer(input, &input, options).run();
+}
+
+}  // namespace geode::conform
