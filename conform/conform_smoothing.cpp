@@ -91,25 +91,32 @@ void Conformer::settle_templates() {
 }
 
 // A hex is untangled by moving its neighbours too: the patches start on it and on the hexes
-// within this many rings of it.
+// within this many rings of it, and where some are still inverted after that, again within
+// kUntangleRings more, up to kUntangleTries times. With --smooth none, two templates inverted in
+// a quads-only layer's buffer hexes (cylinder layers 0.1 thick inwards and 0.15 outwards, warped
+// interface quads) were left at 4 and 2 inverted hexes by two rings, none by four.
 constexpr int kUntangleRings = 2;
+constexpr int kUntangleTries = 3;
 
 // A hex still inverted (one whose buffer hex leaves its template no valid placement, or one the
-// smoothing could not lift) is untangled with the hexes within kUntangleRings of it, at
+// smoothing could not lift) is untangled with the hexes within kUntangleRings of it (or more), at
 // local_smooth_options' own target, so that even --smooth none gives a usable mesh. Reads
 // inverted_ as the last measure() or scan() left it.
 void Conformer::untangle() {
   if (inverted_.empty()) return;
   const std::size_t before = inverted_.size();
-  std::vector<Index> seeds = inverted_;
-  for (int ring = 0; ring < kUntangleRings; ++ring) seeds = primal::hexes_around(mesh_, seeds);
   primal::LocalSmoothOptions o = options_.local_smooth_options;
   o.kept = &kept_;
-  const auto r = primal::smooth_hexes_around(mesh_, seeds, o);
-  add_smoothing(r);
-  measure(r.region);
-  res_.smoothing.final_min_scaled_jacobian = scan();
-  res_.smoothing.final_inverted = primal::index_cast(inverted_.size());
+  for (int attempt = 1; attempt <= kUntangleTries && !inverted_.empty(); ++attempt) {
+    std::vector<Index> seeds = inverted_;
+    for (int ring = 0; ring < attempt * kUntangleRings; ++ring)
+      seeds = primal::hexes_around(mesh_, seeds);
+    const auto r = primal::smooth_hexes_around(mesh_, seeds, o);
+    add_smoothing(r);
+    measure(r.region);
+    res_.smoothing.final_min_scaled_jacobian = scan();
+    res_.smoothing.final_inverted = primal::index_cast(inverted_.size());
+  }
   say("untangling: " + std::to_string(before) + " inverted hexes, " +
       std::to_string(inverted_.size()) + " left" + took());
 }

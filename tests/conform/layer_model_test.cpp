@@ -288,6 +288,20 @@ TEST_CASE("the same layer recombined into quads only keeps its hexes and gets th
   CHECK(o.buffer.side == conform::BufferSide::kHex);
 }
 
+TEST_CASE("templates a quads-only layer's buffer hexes invert are untangled, --smooth none") {
+  // Placement leaves 32 hexes inverted in 16 templates (warped interface quads); two rings of
+  // untangling left 4 (exit 4, found by a fault hunt), four rings none.
+  const test::TempDir dir;
+  const primal::Model input = layer_model(dir, "cylinder 6 in 0.1 quads");
+  conform::ConformOptions o;
+  o.smooth = conform::ConformSmooth::kNone;
+  const conform::ConformResult r = conform::conform(input, o);
+  CHECK(r.placement_inverted > 0);
+  test::check_conform_result(r, -1, r.warnings.size());  // the volumes' warnings only
+  CHECK(r.smoothing.final_inverted == 0);
+  CHECK(conform::result_valid(r));
+}
+
 TEST_CASE("a quads-only layer graded from a thin side is carved from the tets: per piece") {
   // Graded out by 1.3 from a 0.048-high first cell to a 0.107-high last: carved from the hex
   // part, the inner side's buffer hexes are 0.16 of their edge high, the outer's more, 0.2 on
