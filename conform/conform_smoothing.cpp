@@ -135,15 +135,20 @@ void Conformer::add_smoothing(const primal::LocalSmoothResult& r) {
 // sets' surfaces, and a node set's nodes only within their set (keep_sets). Local: patches
 // seeded near the geode hexes, on the submesh around the seeds, so the cost follows the
 // interface (or, with the automatic target, its defects); global: every hex, then the automatic
-// passes wherever a hex is still below the yardstick.
+// passes wherever a hex is still below the yardstick. Hexes the placement left inverted are
+// untangled first, as with --smooth none: the smoother's floors hold the worst hex of a patch
+// only where it is not inverted, and starting from the inverted hexes the passes (one visit a
+// seed) ended below --smooth none's result (quads-only cylinder layers with 32 and 50 hexes
+// inverted by placement: 0.029 and 0.011 against 0.033 and 0.018; untangled first, 0.069 and
+// 0.029). From a valid mesh they only raise its minimum.
 void Conformer::smooth() {
   t0_ = Clock::now();
   res_.smoothing.initial_min_scaled_jacobian = res_.min_scaled_jacobian_before_smoothing;
   res_.smoothing.final_min_scaled_jacobian = res_.min_scaled_jacobian_before_smoothing;
   res_.smoothing.initial_inverted = res_.smoothing.final_inverted = res_.placement_inverted;
   keep_sets();
+  untangle();
   if (options_.smooth == ConformSmooth::kNone) {
-    untangle();
     kept_ = {};
     return;
   }
