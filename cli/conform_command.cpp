@@ -329,7 +329,8 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
        "the interface are squashed) or tet (the hexes stay, the tets shrink off the interface);\n"
        "not given: hex, or tet with a warning where the hex cells at some piece of the\n"
        "interface are thin (flatter than 2.5 : 1, a boundary layer's) and the tets give a\n"
-       "thicker layer there")
+       "thicker layer there; where they are nearly so (flatter than 2 : 1) and the geode\n"
+       "hexes from the hex part are poor, both parts are tried and the better output kept")
       ->check(CLI::IsMember({"hex", "tet"}));
   c->add_option(
        "--buffer-thickness", a.buffer_thickness,

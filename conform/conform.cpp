@@ -461,6 +461,13 @@ constexpr double kThinHexBuffer = 0.2;
 // 0.180 -> 0.126 with the defaults, and the whole 0.033 -> 0.014 with --smooth none). Where it
 // was taken: 1.20 to 1.52 times thicker (layer-mixed, the graded quads-only cylinder).
 constexpr double kThickerBy = 1.1;
+// Hex cells at the interface flatter than 2 : 1 on some piece, but not taken for the tets'
+// layer above: which side gives the better transition is found by trying both (conform_model.cpp,
+// kPoorTransition). Every demo's are 0.31 to 0.5 at n = 3 and 5 but layer-mixed's (0.11, 0.15);
+// Gmsh's quads-only cylinder layers in 2 cells, 0.1 thick inward and 0.15 outward, 0.180 and
+// 0.228 (their tets' layers 0.195 and 0.195): 0.069 and 0.029 from the hexes, 0.149 and 0.073
+// from the tets.
+constexpr double kNearThinHexBuffer = 0.25;
 
 namespace {
 
@@ -485,7 +492,10 @@ void Conformer::thicker_from_tets() {
   const auto thinnest = static_cast<std::size_t>(
       std::min_element(hex_means.begin(), hex_means.end()) - hex_means.begin());
   const double hex = hex_means[thinnest];
-  if (hex >= kThinHexBuffer) return;
+  if (hex >= kThinHexBuffer) {
+    if (hex < kNearThinHexBuffer) near_thin_ = hex;
+    return;
+  }
   BufferLayerOptions other = options_.buffer;
   other.side = BufferSide::kTet;
   BufferLayer tets;
@@ -506,7 +516,10 @@ void Conformer::thicker_from_tets() {
     crossed = e.what();
   }
   const double tet = piece_means(buffer_height_ratios(tets), piece)[thinnest];
-  if (tet <= kThickerBy * hex) return;
+  if (tet <= kThickerBy * hex) {
+    near_thin_ = hex;
+    return;
+  }
   layer_ = std::move(tets);
   res_.buffer_side = BufferSide::kTet;
   std::ostringstream m;
@@ -532,6 +545,7 @@ void Conformer::thicker_from_tets() {
 void Conformer::trim_input() {
   measure_changed();
   blocks_ = output_blocks(input_, options_.geode_block);
+  if (near_thin_ > 0.0) return;  // kept for the tet part's layer (near_thin())
   if (given_copy_) primal::release(*given_copy_);
   if (!disposable_) return;
   primal::Model& m = *disposable_;

@@ -6,16 +6,24 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
+#include <functional>
 #include <iterator>
 #include <numeric>
 #include <optional>
+#include <span>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <geode/conform/detail/conformer.hpp>
 #include <geode/conform/report.hpp>
 #include <geode/primal/errors.hpp>
+#include <geode/primal/quality.hpp>
 #include <geode/primal/relax_tets.hpp>
 #include <geode/primal/split_hexes.hpp>
 #include <geode/primal/split_pyramids.hpp>
@@ -54,6 +62,15 @@ constexpr double kLayerHex = 2.0 / 3.0;
 // cells 0.2 and 0.3 thick (cells 0.6 and 0.9 of their width high) gave 0.025 and 0.0066 with the
 // holes (0.57 x and 0.15 x), 0.145 and 0.118 split.
 constexpr double kPoorHoles = 1.0;
+// Where the layer was carved from the hex part's near-thin cells (Conformer::near_thin), the
+// tet part's layer is tried too when the geode hexes fall below this x their local yardstick
+// capped by the template's ceiling (issue 22's aim for the transition; capped_local_ratio) or
+// the output is invalid, and the output with the higher minimum kept (the first on a tie). The
+// layer's cells' height alone does not tell which side is better: Gmsh's quads-only cylinder
+// layers 0.15 thick outward have a tets' layer thinner than the hexes' (0.195 against 0.228 of
+// the quads' edge) and give 0.073 from it against 0.029 from the hexes; a sphere's quads-only
+// layer 0.1 thick gives the same minimum (0.126) from both, and keeps the hexes'.
+constexpr double kPoorTransition = 0.9;
 
 // How flat a hex is: the mean length of its edges along its flattest direction over that along
 // its longest.
@@ -90,17 +107,32 @@ std::vector<Index> merged(const std::vector<Index>& a, const std::vector<Index>&
 // joining the two sides of the interface changes the model and starts again.
 class ModelConformer {
  public:
-  ModelConformer(const primal::Model& input, primal::Model* spare, const ConformOptions& options)
+  ModelConformer(const primal::Model& input, primal::Model* spare, ConformOptions options)
       : input_(input),
-        options_(options),
+        options_(std::move(options)),
         owned_(spare),
         model_(&input),
         wedge_origin_(input.wedges.size()),
-        hex_origin_(input.hexes.size()) {
+        hex_origin_(input.hexes.size()),
+        write_ahead_(std::move(options_.write_ahead)) {
     std::iota(wedge_origin_.begin(), wedge_origin_.end(), Index{0});
     std::iota(hex_origin_.begin(), hex_origin_.end(), Index{0});
+    // A pass whose result may yet be compared with another's does not write it: the caller's
+    // writer writes once, and the result returned is written after the comparison instead.
+    if (write_ahead_)
+      options_.write_ahead = [this](const primal::Model& m, std::span<const double> sj) {
+        if (compared_ || (!holes_.hexes.empty() && !layer_kept_) ||
+            (conformer_ && conformer_->near_thin() > 0.0)) {
+          deferred_ = true;
+          return;
+        }
+        write_ahead_(m, sj);
+      };
   }
+  ModelConformer(const ModelConformer&) = delete;  // options_.write_ahead holds `this`
+  ModelConformer& operator=(const ModelConformer&) = delete;
 
+  // The passes, then the result's output written where its pass deferred it.
   ConformResult run();
 
  private:
@@ -120,9 +152,12 @@ class ModelConformer {
   void split_wedges_alone(const std::vector<Index>& pieces, Index first);
   // The result's counts of what was split, the warnings in front of its own after its findings.
   void finish(ConformResult& r) const;
+  ConformResult passes();
+  // `r`, or the tet part's layer's result where that is better (kPoorTransition).
+  ConformResult from_tets(ConformResult r);
 
   const primal::Model& input_;
-  const ConformOptions& options_;
+  ConformOptions options_;              // the caller's; the buffer side changed by from_tets
   primal::Model own_;                   // the input as conform changes it, when it copies it
   primal::Model* owned_;                // the model conform may change: the caller's, or own_
   const primal::Model* model_;          // what the next pass conforms
@@ -135,6 +170,13 @@ class ModelConformer {
   std::vector<Index> wedge_origin_, hex_origin_;
   std::vector<std::string> warnings_;
   bool layer_kept_ = false;  // a thin layer that could not be split into tets
+  double near_thin_ = 0.0;   // the last pass's Conformer::near_thin()
+  // The caller's writer; the pass running (its near_thin() says whether from_tets may follow);
+  // whether the pass running will be compared with an earlier one; whether a pass deferred its
+  // writing.
+  std::function<void(const primal::Model&, std::span<const double>)> write_ahead_;
+  const detail::Conformer* conformer_ = nullptr;
+  bool compared_ = false, deferred_ = false;
   // The layers whose wedges alone were split (kPoorHoles), by the input's numbers, and where the
   // warnings stood before the first of them.
   primal::CellPieces holes_;
@@ -172,8 +214,11 @@ ConformResult ModelConformer::pass(std::vector<Index>& joining) {
   detail::Conformer conformer(*model_, options_, relaxation_.nodes_moved ? &given_ : nullptr,
                               model_ == owned_ ? owned_ : nullptr);
   conformer.tets_given(std::min(options_.split_tets_from, primal::index_cast(input_.tets.size())));
+  conformer_ = &conformer;
   ConformResult r = conformer.run();
+  conformer_ = nullptr;
   joining = conformer.joining();
+  near_thin_ = conformer.near_thin();
   return r;
 }
 
@@ -234,7 +279,6 @@ void ModelConformer::split_wedges_alone(const std::vector<Index>& pieces, Index 
 
 void ModelConformer::finish(ConformResult& r) const {
   r.relaxation = relaxation_;
-  r.seconds += relaxation_.seconds;
   r.input_pyramids = primal::index_cast(input_.pyramids.size());
   r.wedges_split = primal::index_cast(wedges_split_.size());
   r.hexes_split = primal::index_cast(hexes_split_.size());
@@ -246,6 +290,31 @@ void ModelConformer::finish(ConformResult& r) const {
 }
 
 ConformResult ModelConformer::run() {
+  const auto start = std::chrono::steady_clock::now();
+  ConformResult r = passes();
+  if (deferred_ && write_ahead_) {
+    std::vector<double> sj;
+    if (options_.write_ahead_scaled_jacobians) {
+      sj.resize(r.model.hexes.size());
+      tbb::parallel_for(
+          tbb::blocked_range<std::size_t>(0, sj.size(), 8192),
+          [&](const tbb::blocked_range<std::size_t>& range) {
+            primal::HexCorners p;
+            for (std::size_t h = range.begin(); h != range.end(); ++h) {
+              for (std::size_t c = 0; c < 8; ++c)
+                p[c] = r.model.points[primal::index_cast<std::size_t>(r.model.hexes[h][c])];
+              sj[h] = primal::hex_scaled_jacobian(p);
+            }
+          });
+    }
+    write_ahead_(r.model, sj);
+  }
+  // Every pass's, the results not kept too.
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+
+ConformResult ModelConformer::passes() {
   if (!input_.pyramids.empty()) {
     own_ = without_pyramids();
     model_ = owned_ = &own_;
@@ -314,7 +383,8 @@ ConformResult ModelConformer::run() {
       return std::move(*with_holes);
     }
     const double holes_min = output_min_scaled_jacobian(r);
-    if (holes_.hexes.empty() || layer_kept_ || holes_min >= kPoorHoles * r.yardstick()) return r;
+    if (holes_.hexes.empty() || layer_kept_ || holes_min >= kPoorHoles * r.yardstick())
+      return from_tets(std::move(r));
     // The holes gave a poor transition: the layers split into tets instead, conformed again.
     std::ostringstream why;
     why << "with its wedges alone split, the buffer hexes at the holes they leave gave "
@@ -322,12 +392,49 @@ ConformResult ModelConformer::run() {
     const std::vector<std::string> kept = warnings_;
     warnings_.resize(warnings_before_holes_);
     with_holes = std::move(r);
+    compared_ = true;
     const primal::CellPieces layers = holes_;
     if (!split_layer(layers, holes_where_, why.str())) {
       warnings_ = kept;
       return std::move(*with_holes);
     }
   }
+}
+
+ConformResult ModelConformer::from_tets(ConformResult r) {
+  if (near_thin_ <= 0.0 || (result_valid(r) && r.capped_local_ratio >= kPoorTransition)) return r;
+  const double hex_min = output_min_scaled_jacobian(r), height = near_thin_;
+  if (options_.progress)
+    options_.progress("buffer layer: from the hex part's thin cells the geode hexes reach " +
+                      std::to_string(r.capped_local_ratio) +
+                      " x their capped local yardstick; the tet part's layer tried too");
+  // The same pass from the tet part: the tets relaxed again from the points as given.
+  if (!given_.empty()) owned_->points = std::move(given_);
+  options_.buffer.side = BufferSide::kTet;
+  options_.buffer_side_chosen = true;
+  compared_ = true;
+  std::vector<Index> joining;
+  ConformResult t;
+  try {
+    t = pass(joining);
+  } catch (const TopologyError&) {
+    return r;
+  }
+  if (!joining.empty() || t.buffer_side != BufferSide::kTet || !result_valid(t) ||
+      (result_valid(r) && output_min_scaled_jacobian(t) <= hex_min)) {
+    if (options_.progress) options_.progress("buffer layer: the hex part's kept");
+    return r;
+  }
+  finish(t);
+  std::ostringstream m;
+  m << "buffer layer carved from the tet part, not the hex part: from the hex part's thin cells "
+       "at the interface (its buffer hexes "
+    << height << " of their interface quads' edge high on average on the thinnest piece) "
+    << (result_valid(r) ? "the output's minimum scaled Jacobian was " + std::to_string(hex_min)
+                        : std::string("the output was invalid"))
+    << ", from the tet part " << output_min_scaled_jacobian(t);
+  t.warnings.insert(t.warnings.begin() + static_cast<std::ptrdiff_t>(t.findings), m.str());
+  return t;
 }
 
 }  // namespace

@@ -85,6 +85,13 @@ class Conformer {
   // The wedges run() found joining the two sides of the interface, where it stopped.
   const std::vector<Index>& joining() const { return joining_; }
 
+  // Where the side was left to conform and the layer was carved from the hex part although its
+  // cells at some piece of the interface are flatter than 2 : 1 (kNearThinHexBuffer;
+  // thicker_from_tets did not take the tet part's layer): the thinnest piece's mean buffer
+  // height (buffer_height_ratios), else 0. The input is then kept, not trimmed, so that
+  // conform() can try the tet part's layer too.
+  double near_thin() const { return near_thin_; }
+
   ConformResult run() {
     const auto t_start = Clock::now();
     res_.numbering = options_.output_numbering;
@@ -186,6 +193,7 @@ class Conformer {
   Clock::time_point t0_;
   primal::Interface interface_;
   std::vector<Index> joining_;  // wedges joining the two sides of the interface (none: go on)
+  double near_thin_ = 0.0;      // near_thin()
   // warped_interface: per (hex-side block, tet-side block, the tets split from a pyramid or
   // wedge) the space between the interface quads' bilinear faces and the tets' triangles on
   // them (the hex block's side of the triangles, signed), the quads' scale (their sizes cubed)

@@ -167,7 +167,8 @@ int run(int argc, char** argv, int rank, int size) {
   conform
       ->add_option("--buffer-side", side,
                    "the part the buffer layer is carved from: hex or tet; not given, as for geode "
-                   "conform: hex, or tet where the hex cells at the interface are thin")
+                   "conform: hex, or tet where the hex cells at the interface are thin, or both "
+                   "tried where they are nearly so")
       ->check(CLI::IsMember({"hex", "tet"}));
   // As geode conform's (cli/conform_command.cpp): [0.01, 0.9], and at most the side's maximum.
   const double thickest = conform::max_buffer_thickness(conform::BufferSide::kHex);
