@@ -196,7 +196,7 @@ void run_shape(const ShapeArgs& a) {
 
 struct CornersArgs {
   int n = 3;
-  std::string output;
+  std::string output, buffer_side;
   bool quiet = false;
 };
 
@@ -204,9 +204,11 @@ void run_corners(const CornersArgs& a) {
   output_format(a.output, "", {"csv"}, "csv");
   check_output_path(a.output);
   const auto study = conform::corner_study(
-      demo_module().corner_study_models(a.n), a.n, [&](const conform::CornerStudyModelSummary& s) {
+      demo_module().corner_study_models(a.n), a.n,
+      [&](const conform::CornerStudyModelSummary& s) {
         if (!a.quiet) std::cerr << "study corners: " << s.name << " done\n";
-      });
+      },
+      a.buffer_side);
   if (a.output.empty()) {
     conform::write_corner_table(std::cout, study);
   } else {
@@ -294,6 +296,11 @@ void add_study_commands(CLI::App& app) {
   corners->add_option("-n", ca->n, "demo model size (default 3), in [2, 8]")
       ->check(CLI::Range(2, 8));
   corners->add_option("-o,--output", ca->output, "CSV output (default: a table on stdout)");
+  corners
+      ->add_option("--buffer-side", ca->buffer_side,
+                   "the part every model's buffer layer is carved from (as geode conform's "
+                   "--buffer-side; not given: as geode conform chooses)")
+      ->check(CLI::IsMember({"hex", "tet"}));
   corners->add_flag("--quiet", ca->quiet, "no progress lines or table on stderr");
   corners->callback([ca] { run_corners(*ca); });
 }

@@ -91,7 +91,8 @@ std::vector<double> geode_minima(const ConformResult& r) {
 }
 
 CornerStudy corner_study(const std::vector<CornerStudyModel>& models, int n,
-                         const std::function<void(const CornerStudyModelSummary&)>& done) {
+                         const std::function<void(const CornerStudyModelSummary&)>& done,
+                         const std::string& side) {
   CornerStudy study;
   study.n = n;
   for (const auto& [name, make] : models) {
@@ -106,9 +107,11 @@ CornerStudy corner_study(const std::vector<CornerStudyModel>& models, int n,
     }
     if (s.failure.empty()) try {
         ConformOptions none;
+        set_buffer_side(none, side);
         none.smooth = ConformSmooth::kNone;
         a = conform(input, none);
         ConformOptions defaults;  // every short buffer hex's ceiling: the classes' capped ratios
+        set_buffer_side(defaults, side);
         defaults.all_template_ceilings = true;
         b = conform(input, defaults);
       } catch (const std::exception& e) {

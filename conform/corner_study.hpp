@@ -69,9 +69,10 @@ struct CornerStudy {
 
 // Conforms each model twice (--smooth none and the defaults) and classes its buffer hexes.
 // `n` is only recorded (the models are built at their own size). `done` is called after each
-// model.
+// model. `side`: the buffer side both runs take (chosen, as --buffer-side is; "": automatic).
 CornerStudy corner_study(const std::vector<CornerStudyModel>& models, int n,
-                         const std::function<void(const CornerStudyModelSummary&)>& done = {});
+                         const std::function<void(const CornerStudyModelSummary&)>& done = {},
+                         const std::string& side = "");
 
 // model,n,kind,angle,buffer_hexes,min_sj_none,min_sj_default,min_local_ratio_default,
 // min_local_yardstick,min_capped_ratio_default

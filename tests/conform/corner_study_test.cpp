@@ -56,3 +56,20 @@ TEST_CASE("corner study: geode hexes at lshape's 90-degree convex edge reach 0.2
   }
   CHECK(edge);
 }
+
+TEST_CASE("corner study: the buffer side given is taken; from the tets a wedge's corners lift") {
+  // demo_wedge at 90 degrees, n = 3: its 90-degree convex corners 0.193 from the hex part,
+  // 0.270 from the tets (the defaults).
+  std::map<std::string, double> corner;
+  for (const std::string side : {"hex", "tet"}) {
+    const conform::CornerStudy s = conform::corner_study(
+        {{"wedge-90", [] { return demo::demo_wedge(3, 90.0); }}}, 3, {}, side);
+    REQUIRE(s.models.size() == 1);
+    CHECK(s.models[0].valid_default);
+    for (const auto& r : s.rows)
+      if (r.kind == "convex corner") corner[side] = r.min_default;
+  }
+  REQUIRE(corner.size() == 2);
+  CHECK(corner["hex"] < 0.25);
+  CHECK(corner["tet"] >= 0.25);
+}
