@@ -305,7 +305,9 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
       "--geode-block", a.geode_block,
       "put the geode hexes in a block of their own with this name (id one above every\n"
       "input block); by default each goes to the block of the element its buffer hex was carved\n"
-      "from (the hex under it; with --buffer-side tet, the tet above it)");
+      "from (the hex under it; with --buffer-side tet, the tet above it). A label only:\n"
+      "smoothing moves them as that block's, so the mesh is the one without the option\n"
+      "(but where a side set on the interface follows the geode block's face)");
   c->add_option("--merge-tolerance", a.merge_tolerance,
                 "first merge nodes closer than this distance (model units), for parts meshed\n"
                 "separately whose interface nodes are duplicated")
@@ -330,7 +332,8 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
        "not given: hex, or tet with a warning where the hex cells at some piece of the\n"
        "interface are thin (flatter than 2.5 : 1, a boundary layer's) and the tets give a\n"
        "thicker layer there; where they are nearly so (flatter than 2 : 1) and the geode\n"
-       "hexes from the hex part are poor, both parts are tried and the better output kept")
+       "hexes from the hex part are poor, both parts are tried and the better output kept.\n"
+       "hex given on such cells and the output invalid: the tet part's, with a warning")
       ->check(CLI::IsMember({"hex", "tet"}));
   c->add_option(
        "--buffer-thickness", a.buffer_thickness,

@@ -367,6 +367,16 @@ void Conformer::diced_alone_from_children(std::size_t tet_first) {
        tet_diced_.empty() ? 1.0 : *std::min_element(tet_diced_.begin(), tet_diced_.end())});
 }
 
+// Hex cells at the interface flatter than 2 : 1 on some piece (a buffer from the hex part lower
+// than this of its quads' edge on average there), but not taken for the tets' layer
+// (thicker_from_tets): which side gives the better transition is found by trying both
+// (conform_model.cpp, kPoorTransition); with --buffer-side hex given, the tet part's layer is
+// tried where the output is invalid. Every demo's are 0.31 to 0.5 at n = 3 and 5 but layer-mixed's
+// (0.11, 0.15); Gmsh's quads-only cylinder layers in 2 cells, 0.1 thick inward and 0.15 outward,
+// 0.180 and 0.228 (their tets' layers 0.195 and 0.195): 0.069 and 0.029 from the hexes, 0.149 and
+// 0.073 from the tets.
+constexpr double kNearThinHexBuffer = 0.25;
+
 void Conformer::insert_buffer() {
   t0_ = Clock::now();
   res_.buffer_side = options_.buffer.side;
@@ -377,9 +387,13 @@ void Conformer::insert_buffer() {
   }
   try {
     layer_ = insert_buffer_layer(input_, interface_, options_.buffer);
-    if (options_.buffer_fallback && !options_.buffer_side_chosen &&
-        options_.buffer.side == BufferSide::kHex && options_.buffer.thickness == 0.0)
-      thicker_from_tets();
+    if (options_.buffer_fallback && options_.buffer.side == BufferSide::kHex) {
+      if (!options_.buffer_side_chosen && options_.buffer.thickness == 0.0) {
+        thicker_from_tets();
+      } else if (const double hex = thinnest_piece_height(); hex < kNearThinHexBuffer) {
+        near_thin_ = hex;  // the tet part's layer is tried where this one's output is invalid
+      }
+    }
   } catch (const TopologyError& e) {
     if (!options_.buffer_fallback) throw;
     BufferLayerOptions other = options_.buffer;
@@ -461,13 +475,6 @@ constexpr double kThinHexBuffer = 0.2;
 // 0.180 -> 0.126 with the defaults, and the whole 0.033 -> 0.014 with --smooth none). Where it
 // was taken: 1.20 to 1.52 times thicker (layer-mixed, the graded quads-only cylinder).
 constexpr double kThickerBy = 1.1;
-// Hex cells at the interface flatter than 2 : 1 on some piece, but not taken for the tets'
-// layer above: which side gives the better transition is found by trying both (conform_model.cpp,
-// kPoorTransition). Every demo's are 0.31 to 0.5 at n = 3 and 5 but layer-mixed's (0.11, 0.15);
-// Gmsh's quads-only cylinder layers in 2 cells, 0.1 thick inward and 0.15 outward, 0.180 and
-// 0.228 (their tets' layers 0.195 and 0.195): 0.069 and 0.029 from the hexes, 0.149 and 0.073
-// from the tets.
-constexpr double kNearThinHexBuffer = 0.25;
 
 namespace {
 
@@ -484,6 +491,12 @@ std::vector<double> piece_means(const std::vector<double>& value, const std::vec
 }
 
 }  // namespace
+
+double Conformer::thinnest_piece_height() const {
+  const std::vector<double> means =
+      piece_means(buffer_height_ratios(layer_), interface_pieces(layer_));
+  return means.empty() ? 1.0 : *std::min_element(means.begin(), means.end());
+}
 
 void Conformer::thicker_from_tets() {
   const std::vector<Index> piece = interface_pieces(layer_);
@@ -799,7 +812,9 @@ void Conformer::assemble() {
   geode_first_.reserve(nb + 1);
   for (std::size_t b = 0; b < nb; ++b) {
     geode_first_.push_back(primal::index_cast(at));
-    const int id = blocks_.geode_id ? blocks_.geode_id : primal::block_of(lm, carved_from_[b]);
+    // Their carved-from block's, a named geode block's id given only by verify_and_output:
+    // smoothing would take that block's faces for the material interfaces they are not.
+    const int id = primal::block_of(lm, carved_from_[b]);
     for (const auto& h : ref(b).tpl.hex.hexes) {
       block[at] = id;
       hexes[at++] = renumbered(instance(b, h));

@@ -65,7 +65,9 @@ constexpr double kPoorHoles = 1.0;
 // Where the layer was carved from the hex part's near-thin cells (Conformer::near_thin), the
 // tet part's layer is tried too when the geode hexes fall below this x their local yardstick
 // capped by the template's ceiling (issue 22's aim for the transition; capped_local_ratio) or
-// the output is invalid, and the output with the higher minimum kept (the first on a tie). The
+// the output is invalid (only then where the hex side was given: a graded quads-only layer,
+// cylinder 6 out 0.1 quads cells=3 ratio=1.5, left 67 hexes inverted with --buffer-side hex),
+// and the output with the higher minimum kept (the first on a tie). The
 // layer's cells' height alone does not tell which side is better: Gmsh's quads-only cylinder
 // layers 0.15 thick outward have a tets' layer thinner than the hexes' (0.195 against 0.228 of
 // the quads' edge) and give 0.073 from it against 0.029 from the hexes; a sphere's quads-only
@@ -402,15 +404,24 @@ ConformResult ModelConformer::passes() {
 }
 
 ConformResult ModelConformer::from_tets(ConformResult r) {
-  if (near_thin_ <= 0.0 || (result_valid(r) && r.capped_local_ratio >= kPoorTransition)) return r;
+  // The side given (or a thickness for it): only an invalid output is not taken as it is.
+  const bool automatic = !options_.buffer_side_chosen && options_.buffer.thickness == 0.0;
+  const bool valid = result_valid(r);
+  if (near_thin_ <= 0.0 || (valid && (!automatic || r.capped_local_ratio >= kPoorTransition)))
+    return r;
   const double hex_min = output_min_scaled_jacobian(r), height = near_thin_;
   if (options_.progress)
-    options_.progress("buffer layer: from the hex part's thin cells the geode hexes reach " +
-                      std::to_string(r.capped_local_ratio) +
-                      " x their capped local yardstick; the tet part's layer tried too");
-  // The same pass from the tet part: the tets relaxed again from the points as given.
+    options_.progress(valid
+                          ? "buffer layer: from the hex part's thin cells the geode hexes reach " +
+                                std::to_string(r.capped_local_ratio) +
+                                " x their capped local yardstick; the tet part's layer tried too"
+                          : std::string("buffer layer: from the hex part's thin cells the "
+                                        "output is invalid; the tet part's layer tried"));
+  // The same pass from the tet part (at its default thickness): the tets relaxed again from the
+  // points as given.
   if (!given_.empty()) owned_->points = std::move(given_);
   options_.buffer.side = BufferSide::kTet;
+  options_.buffer.thickness = 0.0;
   options_.buffer_side_chosen = true;
   compared_ = true;
   std::vector<Index> joining;
@@ -421,17 +432,18 @@ ConformResult ModelConformer::from_tets(ConformResult r) {
     return r;
   }
   if (!joining.empty() || t.buffer_side != BufferSide::kTet || !result_valid(t) ||
-      (result_valid(r) && output_min_scaled_jacobian(t) <= hex_min)) {
+      (valid && output_min_scaled_jacobian(t) <= hex_min)) {
     if (options_.progress) options_.progress("buffer layer: the hex part's kept");
     return r;
   }
   finish(t);
   std::ostringstream m;
-  m << "buffer layer carved from the tet part, not the hex part: from the hex part's thin cells "
-       "at the interface (its buffer hexes "
-    << height << " of their interface quads' edge high on average on the thinnest piece) "
-    << (result_valid(r) ? "the output's minimum scaled Jacobian was " + std::to_string(hex_min)
-                        : std::string("the output was invalid"))
+  m << "buffer layer carved from the tet part, not the hex part"
+    << (automatic ? "" : " given (--buffer-side hex, or a thickness for it)")
+    << ": from the hex part's thin cells at the interface (its buffer hexes " << height
+    << " of their interface quads' edge high on average on the thinnest piece) "
+    << (valid ? "the output's minimum scaled Jacobian was " + std::to_string(hex_min)
+              : "the output was invalid (" + invalid_reason(r) + ")")
     << ", from the tet part " << output_min_scaled_jacobian(t);
   t.warnings.insert(t.warnings.begin() + static_cast<std::ptrdiff_t>(t.findings), m.str());
   return t;

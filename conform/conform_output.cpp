@@ -286,6 +286,13 @@ void Conformer::output() {
 // (check_validity, the full quality report) read mesh_: those run before the writer.
 void Conformer::verify_and_output() {
   t0_ = Clock::now();
+  // A named geode block (--geode-block) labels hexes of the material they were carved from:
+  // smoothing moved them as that block's, so the mesh is the one without the option (with it,
+  // their faces were block faces the smoothing kept, and quads-only layers came out with
+  // inverted hexes, exit 4, where the run without it was valid).
+  if (blocks_.geode_id != 0 && geode_first_.size() > 1)
+    std::fill(mesh_.block.begin() + geode_first_.front(), mesh_.block.begin() + geode_first_.back(),
+              blocks_.geode_id);
   if (verify_locally()) {  // what the local check reads of the scaled Jacobians
     positive_.resize(sj_.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sj_.size(), 8192),

@@ -85,8 +85,8 @@ class Conformer {
   // The wedges run() found joining the two sides of the interface, where it stopped.
   const std::vector<Index>& joining() const { return joining_; }
 
-  // Where the side was left to conform and the layer was carved from the hex part although its
-  // cells at some piece of the interface are flatter than 2 : 1 (kNearThinHexBuffer;
+  // Where the layer was carved from the hex part (left to conform, or given) although its cells
+  // at some piece of the interface are flatter than 2 : 1 (kNearThinHexBuffer;
   // thicker_from_tets did not take the tet part's layer): the thinnest piece's mean buffer
   // height (buffer_height_ratios), else 0. The input is then kept, not trimmed, so that
   // conform() can try the tet part's layer too.
@@ -139,6 +139,8 @@ class Conformer {
   void insert_buffer();
   void carved();  // after insert_buffer placed the layer
   void thicker_from_tets();
+  // The lowest mean of buffer_height_ratios over a piece of the interface (interface_pieces).
+  double thinnest_piece_height() const;
   void measure_changed();
   void trim_input();
   void build_references();

@@ -293,9 +293,13 @@ TEST_CASE("the same layer recombined into quads only keeps its hexes and gets th
   CHECK(r.hexes_split == 0);
   CHECK(r.interface_quads == primal::index_cast(input.pyramids.size()));
   CHECK(r.diced_hexes == 8 * primal::index_cast(input.hexes.size()));
-  // The hex side chosen (--buffer-side hex) is kept: no switch, no warning.
+  // The hex side chosen (--buffer-side hex) is kept where its output is valid: no switch, no
+  // warning (with --smooth none 4 hexes stay inverted: the tet part's is taken then, as the
+  // test below checks on a thinner layer).
   conform::set_buffer_side(o, "hex");
+  o.smooth = conform::ConformSmooth::kLocal;
   const conform::ConformResult chosen = conform::conform(input, o);
+  CHECK(conform::result_valid(chosen));
   CHECK(chosen.buffer_side == conform::BufferSide::kHex);
   for (const std::string& w : chosen.warnings)
     CHECK(w.find("buffer layer carved from the tet part") == std::string::npos);
@@ -346,6 +350,22 @@ TEST_CASE("a quads-only layer nearly thin: the tets' layer is tried too, the bet
   const conform::ConformResult hex = conform::conform(input, o);
   CHECK(conform::result_valid(hex));
   CHECK(conform::output_min_scaled_jacobian(r) > 1.2 * conform::output_min_scaled_jacobian(hex));
+}
+
+TEST_CASE("--buffer-side hex on a thin graded layer gives an invalid output: the tets' is taken") {
+  // Graded by 1.5 in 3 cells, the hex part's buffer is 0.072 of the quads' edge high: 67
+  // hexes stayed inverted with the defaults, exit 4 (found by a fault hunt); the automatic side
+  // takes the tets' at once.
+  const test::TempDir dir;
+  const primal::Model input = layer_model(dir, "cylinder 6 out 0.1 quads cells=3 ratio=1.5");
+  conform::ConformOptions o;
+  o.smooth = conform::ConformSmooth::kNone;  // invalid too, and faster
+  conform::set_buffer_side(o, "hex");
+  const conform::ConformResult r = conform::conform(input, o);
+  test::check_conform_result(r, -1, r.warnings.size());  // this warning and the volumes'
+  CHECK(r.buffer_side == conform::BufferSide::kTet);
+  CHECK(r.warnings.front().find("not the hex part given") != std::string::npos);
+  CHECK(r.warnings.front().find("the output was invalid") != std::string::npos);
 }
 
 TEST_CASE("a quads-only layer graded from a thin side is carved from the tets: per piece") {
