@@ -266,7 +266,12 @@ PlainMesh read_plain_mesh(const fs::path& path, const MeshFormat** format) {
     } catch (const std::bad_alloc&) {
       throw out_of_memory_reading(path);
     }
-  const primal::Model model = read_model(path);
+  // The cells as the file gives them, as read_plain does: judging them (inverted, folded,
+  // overshared) is the caller's (geode check reports an invalid mesh; it refused an .exo or
+  // .msh one at the read, exit 2, where it reported a .vtu one).
+  primal::ReadOptions plain;
+  plain.check_geometry = false;
+  const primal::Model model = read_model(path, plain, /*check_covering=*/false);
   for (primal::ElementKind kind :
        {primal::ElementKind::kTet, primal::ElementKind::kPyramid, primal::ElementKind::kWedge})
     if (const std::size_t n = primal::element_count(model, kind))

@@ -125,7 +125,9 @@ std::vector<std::string> format_names(FormatRole role);
 void check_signature(const std::filesystem::path& path, const MeshFormat& format);
 
 // Reads `path` with the hex or quad cells as the file gives them (PlainMesh) where the entry
-// can, else through read_model (geometry checked); InvalidInput naming the file otherwise.
+// can, else through read_model with its points checked but not its cells (their geometry and
+// covering are for the caller to judge, as with the entries that read plain meshes);
+// InvalidInput naming the file otherwise.
 PlainMesh read_plain_mesh(const std::filesystem::path& path, const MeshFormat** format = nullptr);
 
 // Writes a model in the format `format` names, or, when empty, the one the extension names

@@ -235,3 +235,27 @@ TEST_CASE("geode check: -o picks the report's format by its extension, the input
     CHECK(c.out.find("(--force overwrites it)") != std::string::npos);
   }
 }
+
+TEST_CASE("geode check: an invalid mesh is reported INVALID in every format, not refused") {
+  // The plain four-triangle dual (inverted hexes) written to each format: .exo and .msh were
+  // refused at the read (exit 2, the read-time check's "is inverted"), .vtu and .vtk reported
+  // (found by a fault hunt).
+  test::TempDir dir;
+  for (const std::string ext : {"vtu", "vtk", "exo", "msh"}) {
+    CAPTURE(ext);
+    const auto file = dir.path / ("plain4." + ext);
+    REQUIRE(geode_cli("template geode4tri --no-fixup --no-smooth --write-invalid --format " + ext +
+                      " -o " + file.string())
+                .code == 4);
+    const auto j = check_json(file);  // exit 0: checked
+    CHECK(j["valid"] == false);
+    CHECK(j["quality"]["num_hexes"] == 36);
+    bool scaled = false;
+    for (const auto& metric : j["quality"]["metrics"])
+      if (metric["key"] == "scaled_jacobian") {
+        scaled = true;
+        CHECK(metric["min"].get<double>() <= 0.0);
+      }
+    CHECK(scaled);
+  }
+}
