@@ -387,13 +387,8 @@ void Conformer::insert_buffer() {
   }
   try {
     layer_ = insert_buffer_layer(input_, interface_, options_.buffer);
-    if (options_.buffer_fallback && options_.buffer.side == BufferSide::kHex) {
-      if (!options_.buffer_side_chosen && options_.buffer.thickness == 0.0) {
-        thicker_from_tets();
-      } else if (const double hex = thinnest_piece_height(); hex < kNearThinHexBuffer) {
-        near_thin_ = hex;  // the tet part's layer is tried where this one's output is invalid
-      }
-    }
+    if (options_.buffer_fallback && options_.buffer.side == BufferSide::kHex)
+      thicker_from_tets(!options_.buffer_side_chosen && options_.buffer.thickness == 0.0);
   } catch (const TopologyError& e) {
     if (!options_.buffer_fallback) throw;
     BufferLayerOptions other = options_.buffer;
@@ -492,20 +487,14 @@ std::vector<double> piece_means(const std::vector<double>& value, const std::vec
 
 }  // namespace
 
-double Conformer::thinnest_piece_height() const {
-  const std::vector<double> means =
-      piece_means(buffer_height_ratios(layer_), interface_pieces(layer_));
-  return means.empty() ? 1.0 : *std::min_element(means.begin(), means.end());
-}
-
-void Conformer::thicker_from_tets() {
+void Conformer::thicker_from_tets(bool may_switch) {
   const std::vector<Index> piece = interface_pieces(layer_);
   const std::vector<double> hex_means = piece_means(buffer_height_ratios(layer_), piece);
   if (hex_means.empty()) return;
   const auto thinnest = static_cast<std::size_t>(
       std::min_element(hex_means.begin(), hex_means.end()) - hex_means.begin());
   const double hex = hex_means[thinnest];
-  if (hex >= kThinHexBuffer) {
+  if (hex >= kThinHexBuffer || !may_switch) {
     if (hex < kNearThinHexBuffer) near_thin_ = hex;
     return;
   }

@@ -17,9 +17,6 @@
 #include <utility>
 #include <vector>
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <geode/conform/detail/conformer.hpp>
 #include <geode/conform/report.hpp>
 #include <geode/primal/errors.hpp>
@@ -146,6 +143,10 @@ class ModelConformer {
   }
   // One pass: the tets near the hex part relaxed (given_: their points before), then Conformer.
   ConformResult pass(std::vector<Index>& joining);
+  // The points as given back in place of the last pass's relaxed ones, for another pass.
+  void restore_given() {
+    if (!given_.empty()) owned_->points = std::move(given_);
+  }
   // A thin layer joining the two sides: its whole pieces become tets; false where a hex of it has
   // no split (it keeps its hexes, as a thick layer does).
   bool split_layer(const primal::CellPieces& layer, const std::string& where,
@@ -297,17 +298,11 @@ ConformResult ModelConformer::run() {
   if (deferred_ && write_ahead_) {
     std::vector<double> sj;
     if (options_.write_ahead_scaled_jacobians) {
-      sj.resize(r.model.hexes.size());
-      tbb::parallel_for(
-          tbb::blocked_range<std::size_t>(0, sj.size(), 8192),
-          [&](const tbb::blocked_range<std::size_t>& range) {
-            primal::HexCorners p;
-            for (std::size_t h = range.begin(); h != range.end(); ++h) {
-              for (std::size_t c = 0; c < 8; ++c)
-                p[c] = r.model.points[primal::index_cast<std::size_t>(r.model.hexes[h][c])];
-              sj[h] = primal::hex_scaled_jacobian(p);
-            }
-          });
+      // primal's per-hex pass over the output's arrays, lent to a HexMesh and given back.
+      primal::HexMesh mesh{std::move(r.model.points), std::move(r.model.hexes), {}};
+      sj = primal::scaled_jacobian_per_hex(mesh);
+      r.model.points = std::move(mesh.points);
+      r.model.hexes = std::move(mesh.hexes);
     }
     write_ahead_(r.model, sj);
   }
@@ -335,7 +330,7 @@ ConformResult ModelConformer::passes() {
       // A wedge layer joins the two sides of the interface: its pieces become tets (from the
       // points as given: the relaxation runs again on the split model), and the run starts
       // again; a hex quad they covered may join another piece to the sides, hence the loop.
-      if (!given_.empty()) owned_->points = std::move(given_);
+      restore_given();
       const std::vector<Index> pieces = primal::wedge_pieces(*model_, joining);
       const primal::WedgeColumns columns = primal::wedge_columns(*model_, pieces);
       const primal::CellPieces layer =
@@ -419,7 +414,7 @@ ConformResult ModelConformer::from_tets(ConformResult r) {
                                         "output is invalid; the tet part's layer tried"));
   // The same pass from the tet part (at its default thickness): the tets relaxed again from the
   // points as given.
-  if (!given_.empty()) owned_->points = std::move(given_);
+  restore_given();
   options_.buffer.side = BufferSide::kTet;
   options_.buffer.thickness = 0.0;
   options_.buffer_side_chosen = true;

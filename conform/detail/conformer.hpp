@@ -138,9 +138,10 @@ class Conformer {
   std::vector<double> local_minima(const std::vector<double>& tet) const;
   void insert_buffer();
   void carved();  // after insert_buffer placed the layer
-  void thicker_from_tets();
-  // The lowest mean of buffer_height_ratios over a piece of the interface (interface_pieces).
-  double thinnest_piece_height() const;
+  // The hex part's layer on its thinnest piece: near_thin_ set where it is nearly thin; where
+  // it is thin and `may_switch` (the side left to conform), the tet part's layer taken if
+  // clearly thicker there.
+  void thicker_from_tets(bool may_switch);
   void measure_changed();
   void trim_input();
   void build_references();
