@@ -333,9 +333,12 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
        "the interface are squashed) or tet (the hexes stay, the tets shrink off the interface);\n"
        "not given: hex, or tet with a warning where the hex cells at some piece of the\n"
        "interface are thin (flatter than 2.5 : 1, a boundary layer's) and the tets give a\n"
-       "thicker layer there; where they are nearly so (flatter than 2 : 1) and the geode\n"
-       "hexes from the hex part are poor, both parts are tried and the better output kept.\n"
-       "hex given on such cells and the output invalid: the tet part's, with a warning")
+       "thicker layer there; where they are nearly so (flatter than 2 : 1), or the hex part\n"
+       "is convex at some interface corner (its buffer hexes taper there), and the geode\n"
+       "hexes from the hex part fall short of 0.9 x their capped local yardstick, both parts\n"
+       "are tried and the better kept (the higher minimum; on a tie, the better transition),\n"
+       "with a warning. hex given on nearly thin cells and the output invalid: the tet\n"
+       "part's, with a warning")
       ->check(CLI::IsMember({"hex", "tet"}));
   c->add_option(
        "--buffer-thickness", a.buffer_thickness,

@@ -299,7 +299,8 @@ void add_study_commands(CLI::App& app) {
   corners
       ->add_option("--buffer-side", ca->buffer_side,
                    "the part every model's buffer layer is carved from (as geode conform's "
-                   "--buffer-side; not given: as geode conform chooses)")
+                   "--buffer-side; not given: as geode conform chooses); the run with "
+                   "--smooth none is given the part the defaults' run took")
       ->check(CLI::IsMember({"hex", "tet"}));
   corners->add_flag("--quiet", ca->quiet, "no progress lines or table on stderr");
   corners->callback([ca] { run_corners(*ca); });

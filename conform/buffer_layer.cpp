@@ -355,7 +355,10 @@ void BufferBuilder::directions() {
             return f.normalized().dot(n.normalized()) >= feature_cos;
           }))
         directions_at.push_back(n);
-    if (directions_at.size() >= 3 && d.dot(lean[k]) > 0.0) feature_[k] = opt_.feature_thickness;
+    if (directions_at.size() >= 3 && d.dot(lean[k]) > 0.0) {
+      feature_[k] = opt_.feature_thickness;
+      ++out_.report.convex_corners;
+    }
   }
 }
 

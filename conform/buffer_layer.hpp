@@ -113,6 +113,9 @@ struct BufferLayerReport {
   double min_scaled_jacobian = 1.0;       // over the buffer hexes
   double min_step = 0.0, max_step = 0.0;  // distances the moving copies moved
   int halvings = 0;                       // rounds of step halving needed
+  // Interface nodes at a corner where the moving part is convex (feature_thickness applies):
+  // its buffer hexes taper there.
+  Index convex_corners = 0;
 };
 
 struct BufferLayer {

@@ -387,8 +387,12 @@ void Conformer::insert_buffer() {
   }
   try {
     layer_ = insert_buffer_layer(input_, interface_, options_.buffer);
-    if (options_.buffer_fallback && options_.buffer.side == BufferSide::kHex)
-      thicker_from_tets(!options_.buffer_side_chosen && options_.buffer.thickness == 0.0);
+    const bool automatic = !options_.buffer_side_chosen && options_.buffer.thickness == 0.0;
+    if (options_.buffer_fallback && options_.buffer.side == BufferSide::kHex) {
+      thicker_from_tets(automatic);
+      convex_hex_part_ = automatic && res_.buffer_side == BufferSide::kHex && near_thin_ == 0.0 &&
+                         layer_.report.convex_corners > 0;
+    }
   } catch (const TopologyError& e) {
     if (!options_.buffer_fallback) throw;
     BufferLayerOptions other = options_.buffer;
@@ -547,7 +551,8 @@ void Conformer::thicker_from_tets(bool may_switch) {
 void Conformer::trim_input() {
   measure_changed();
   blocks_ = output_blocks(input_, options_.geode_block);
-  if (near_thin_ > 0.0) return;  // kept for the tet part's layer (near_thin())
+  // Kept for the tet part's layer (near_thin(), convex_hex_part()).
+  if (near_thin_ > 0.0 || convex_hex_part_) return;
   if (given_copy_) primal::release(*given_copy_);
   if (!disposable_) return;
   primal::Model& m = *disposable_;

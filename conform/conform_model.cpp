@@ -69,6 +69,13 @@ constexpr double kPoorHoles = 1.0;
 // layers 0.15 thick outward have a tets' layer thinner than the hexes' (0.195 against 0.228 of
 // the quads' edge) and give 0.073 from it against 0.029 from the hexes; a sphere's quads-only
 // layer 0.1 thick gives the same minimum (0.126) from both, and keeps the hexes'.
+// So too where conform carved the layer from a hex part convex at some interface corner
+// (Conformer::convex_hex_part): its buffer hexes taper there by their height in two directions,
+// while from the tets they widen. On demo_wedge (n = 3) the tets' layer took the geode hexes
+// from 0.60-0.86 x to above 1 x at 60 to 270 degrees, its output's minimum as high or higher;
+// at 300 degrees it gave 0.1623 against 0.1631, and the hex part's is kept. On a tie of the
+// minimum (the same element lowest in both, away from the transition) the higher capped ratio
+// is kept.
 constexpr double kPoorTransition = 0.9;
 
 // How flat a hex is: the mean length of its edges along its flattest direction over that along
@@ -121,7 +128,9 @@ class ModelConformer {
     if (write_ahead_)
       options_.write_ahead = [this](const primal::Model& m, std::span<const double> sj) {
         if (compared_ || (!holes_.hexes.empty() && !layer_kept_) ||
-            (conformer_ && conformer_->near_thin() > 0.0)) {
+            (conformer_ &&
+             (conformer_->near_thin() > 0.0 ||
+              (conformer_->convex_hex_part() && conformer_->local_ratio() < kPoorTransition)))) {
           deferred_ = true;
           return;
         }
@@ -172,8 +181,9 @@ class ModelConformer {
   Index hex_tets_ = 0;  // the tets the split hexes became
   std::vector<Index> wedge_origin_, hex_origin_;
   std::vector<std::string> warnings_;
-  bool layer_kept_ = false;  // a thin layer that could not be split into tets
-  double near_thin_ = 0.0;   // the last pass's Conformer::near_thin()
+  bool layer_kept_ = false;       // a thin layer that could not be split into tets
+  double near_thin_ = 0.0;        // the last pass's Conformer::near_thin()
+  bool convex_hex_part_ = false;  // ... and its Conformer::convex_hex_part()
   // The caller's writer; the pass running (its near_thin() says whether from_tets may follow);
   // whether the pass running will be compared with an earlier one; whether a pass deferred its
   // writing.
@@ -222,6 +232,7 @@ ConformResult ModelConformer::pass(std::vector<Index>& joining) {
   conformer_ = nullptr;
   joining = conformer.joining();
   near_thin_ = conformer.near_thin();
+  convex_hex_part_ = conformer.convex_hex_part();
   return r;
 }
 
@@ -402,16 +413,21 @@ ConformResult ModelConformer::from_tets(ConformResult r) {
   // The side given (or a thickness for it): only an invalid output is not taken as it is.
   const bool automatic = !options_.buffer_side_chosen && options_.buffer.thickness == 0.0;
   const bool valid = result_valid(r);
-  if (near_thin_ <= 0.0 || (valid && (!automatic || r.capped_local_ratio >= kPoorTransition)))
-    return r;
+  const bool short_of_aim = r.capped_local_ratio < kPoorTransition;
+  // Nearly thin hex cells at the interface, or (chosen by conform) a hex part convex at some
+  // interface corner, where its buffer hexes taper.
+  const bool thin = near_thin_ > 0.0 && (!valid || (automatic && short_of_aim));
+  const bool convex = convex_hex_part_ && valid && short_of_aim;
+  if (!thin && !convex) return r;
   const double hex_min = output_min_scaled_jacobian(r), height = near_thin_;
   if (options_.progress)
-    options_.progress(valid
-                          ? "buffer layer: from the hex part's thin cells the geode hexes reach " +
-                                std::to_string(r.capped_local_ratio) +
-                                " x their capped local yardstick; the tet part's layer tried too"
-                          : std::string("buffer layer: from the hex part's thin cells the "
-                                        "output is invalid; the tet part's layer tried"));
+    options_.progress(
+        !valid ? std::string("buffer layer: from the hex part's thin cells the output is "
+                             "invalid; the tet part's layer tried")
+               : std::string("buffer layer: from the hex part's ") +
+                     (thin ? "thin cells" : "convex corners") + " the geode hexes reach " +
+                     std::to_string(r.capped_local_ratio) +
+                     " x their capped local yardstick; the tet part's layer tried too");
   // The same pass from the tet part (at its default thickness): the tets relaxed again from the
   // points as given.
   restore_given();
@@ -426,20 +442,30 @@ ConformResult ModelConformer::from_tets(ConformResult r) {
   } catch (const TopologyError&) {
     return r;
   }
-  if (!joining.empty() || t.buffer_side != BufferSide::kTet || !result_valid(t) ||
-      (valid && output_min_scaled_jacobian(t) <= hex_min)) {
+  // The higher minimum; on a tie (the same element lowest in both, away from the interface)
+  // the transition nearer its aim. The first on a tie of both.
+  const double tet_min = output_min_scaled_jacobian(t);
+  const bool better = !valid || tet_min > hex_min ||
+                      (tet_min == hex_min && t.capped_local_ratio > r.capped_local_ratio);
+  if (!joining.empty() || t.buffer_side != BufferSide::kTet || !result_valid(t) || !better) {
     if (options_.progress) options_.progress("buffer layer: the hex part's kept");
     return r;
   }
   finish(t);
   std::ostringstream m;
   m << "buffer layer carved from the tet part, not the hex part"
-    << (automatic ? "" : " given (--buffer-side hex, or a thickness for it)")
-    << ": from the hex part's thin cells at the interface (its buffer hexes " << height
-    << " of their interface quads' edge high on average on the thinnest piece) "
-    << (valid ? "the output's minimum scaled Jacobian was " + std::to_string(hex_min)
-              : "the output was invalid (" + invalid_reason(r) + ")")
-    << ", from the tet part " << output_min_scaled_jacobian(t);
+    << (automatic ? "" : " given (--buffer-side hex, or a thickness for it)") << ": ";
+  if (thin)
+    m << "from the hex part's thin cells at the interface (its buffer hexes " << height
+      << " of their interface quads' edge high on average on the thinnest piece) ";
+  else
+    m << "at the hex part's convex corners its buffer hexes taper, and from it ";
+  if (valid)
+    m << "the output's minimum scaled Jacobian was " << hex_min << ", its geode hexes "
+      << r.capped_local_ratio << " x their capped local yardstick; from the tet part " << tet_min
+      << " and " << t.capped_local_ratio << " x";
+  else
+    m << "the output was invalid (" << invalid_reason(r) << "); from the tet part " << tet_min;
   t.warnings.insert(t.warnings.begin() + static_cast<std::ptrdiff_t>(t.findings), m.str());
   return t;
 }

@@ -286,6 +286,14 @@ void Conformer::output() {
 // (check_validity, the full quality report) read mesh_: those run before the writer.
 void Conformer::verify_and_output() {
   t0_ = Clock::now();
+  // Before the writer may start: conform() defers it where the transition falls short and
+  // another layer may be tried (convex_hex_part()).
+  for (std::size_t b = 0; b + 1 < geode_first_.size(); ++b) {
+    const double local =
+        res_.local_yardstick[primal::index_cast<std::size_t>(layer_.hexes[b].quad)];
+    for (Index h = geode_first_[b]; h < geode_first_[b + 1]; ++h)
+      local_ratio_ = std::min(local_ratio_, sj_[primal::index_cast<std::size_t>(h)] / local);
+  }
   // A named geode block (--geode-block) labels hexes of the material they were carved from:
   // smoothing moved them as that block's, so the mesh is the one without the option (with it,
   // their faces were block faces the smoothing kept, and quads-only layers came out with

@@ -106,14 +106,16 @@ CornerStudy corner_study(const std::vector<CornerStudyModel>& models, int n,
       s.failure = std::string("not built: ") + e.what();
     }
     if (s.failure.empty()) try {
-        ConformOptions none;
-        set_buffer_side(none, side);
-        none.smooth = ConformSmooth::kNone;
-        a = conform(input, none);
         ConformOptions defaults;  // every short buffer hex's ceiling: the classes' capped ratios
         set_buffer_side(defaults, side);
         defaults.all_template_ceilings = true;
         b = conform(input, defaults);
+        // Before smoothing: the same part carved (conform may take either where none is given,
+        // and the choice of a run without smoothing need not be the defaults').
+        ConformOptions none;
+        set_buffer_side(none, buffer_side_name(b.buffer_side));
+        none.smooth = ConformSmooth::kNone;
+        a = conform(input, none);
       } catch (const std::exception& e) {
         s.failure = std::string("refused: ") + e.what();
       }
@@ -136,6 +138,7 @@ CornerStudy corner_study(const std::vector<CornerStudyModel>& models, int n,
         std::tie(r.kind, r.angle) = key;
         study.rows.push_back(r);
       }
+      s.buffer_side = b.buffer_side;
       s.valid_none = a.validity.ok();
       s.valid_default = b.validity.ok();
       s.seconds_none = a.seconds;
@@ -174,9 +177,10 @@ void write_corner_table(std::ostream& out, const CornerStudy& study) {
       continue;
     }
     std::snprintf(line, sizeof line,
-                  "%-10s valid %s / %s, %.2f s / %.2f s (none / default), smoothing %d patches\n",
-                  s.name.c_str(), s.valid_none ? "yes" : "NO", s.valid_default ? "yes" : "NO",
-                  s.seconds_none, s.seconds_default, s.patches);
+                  "%-10s carved from the %s part, valid %s / %s, %.2f s / %.2f s (none / "
+                  "default), smoothing %d patches\n",
+                  s.name.c_str(), buffer_side_name(s.buffer_side), s.valid_none ? "yes" : "NO",
+                  s.valid_default ? "yes" : "NO", s.seconds_none, s.seconds_default, s.patches);
     out << line;
   }
 }

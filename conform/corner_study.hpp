@@ -55,7 +55,8 @@ struct CornerStudyRow {
 
 struct CornerStudyModelSummary {
   std::string name;
-  std::string failure;  // not built or refused: why (no rows then)
+  std::string failure;                        // not built or refused: why (no rows then)
+  BufferSide buffer_side = BufferSide::kHex;  // the defaults' (the run without smoothing: the same)
   bool valid_none = false, valid_default = false;
   double seconds_none = 0.0, seconds_default = 0.0;
   int patches = 0;  // smoothing patches with the defaults
@@ -69,7 +70,8 @@ struct CornerStudy {
 
 // Conforms each model twice (--smooth none and the defaults) and classes its buffer hexes.
 // `n` is only recorded (the models are built at their own size). `done` is called after each
-// model. `side`: the buffer side both runs take (chosen, as --buffer-side is; "": automatic).
+// model. `side`: the buffer side the defaults' run takes (chosen, as --buffer-side is; "":
+// automatic); the run without smoothing is given the side that one took.
 CornerStudy corner_study(const std::vector<CornerStudyModel>& models, int n,
                          const std::function<void(const CornerStudyModelSummary&)>& done = {},
                          const std::string& side = "");

@@ -91,6 +91,14 @@ class Conformer {
   // height (buffer_height_ratios), else 0. The input is then kept, not trimmed, so that
   // conform() can try the tet part's layer too.
   double near_thin() const { return near_thin_; }
+  // Where the layer was carved, automatically, from a hex part convex at some interface corner
+  // (BufferLayerReport::convex_corners), not nearly thin: its buffer hexes taper there, and
+  // conform() tries the tet part's layer too where the geode hexes fall short. The input is then
+  // kept, as for near_thin().
+  bool convex_hex_part() const { return convex_hex_part_; }
+  // The geode hexes' lowest ratio to their local yardstick (uncapped: never above the capped
+  // ratio), known once smoothing is done, before the output is written.
+  double local_ratio() const { return local_ratio_; }
 
   ConformResult run() {
     const auto t_start = Clock::now();
@@ -197,6 +205,8 @@ class Conformer {
   primal::Interface interface_;
   std::vector<Index> joining_;  // wedges joining the two sides of the interface (none: go on)
   double near_thin_ = 0.0;      // near_thin()
+  bool convex_hex_part_ = false;
+  double local_ratio_ = 1.0;
   // warped_interface: per (hex-side block, tet-side block, the tets split from a pyramid or
   // wedge) the space between the interface quads' bilinear faces and the tets' triangles on
   // them (the hex block's side of the triangles, signed), the quads' scale (their sizes cubed)

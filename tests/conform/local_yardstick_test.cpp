@@ -10,8 +10,11 @@
 #include <map>
 #include <span>
 #include <string>
+#include <tuple>
+#include <vector>
 
 #include <geode/conform/conform.hpp>
+#include <geode/conform/report.hpp>
 #include <geode/demo/demo_models.hpp>
 #include <geode/primal/dice.hpp>
 #include <geode/primal/interface.hpp>
@@ -23,12 +26,16 @@ using primal::Index;
 
 TEST_CASE(
     "the local yardstick: the input cells around each buffer hex, diced alone; per block figures") {
-  for (const auto& [name, n] : {std::pair{"potting", 2}, std::pair{"lshape", 3}}) {
+  // The potting at n = 2 is carved from the tets (its boxes' corners gave 0.70 x from the
+  // hexes), with a warning; lshape from the hexes.
+  for (const auto& [name, n, from_tets] :
+       {std::tuple{"potting", 2, true}, std::tuple{"lshape", 3, false}}) {
     const std::string model_name = name;
     CAPTURE(model_name);
     const primal::Model input = demo::demo_model(name, n);
     const conform::ConformResult r = conform::conform(input);
-    test::check_conform_result(r);
+    test::check_conform_result(r, -1, from_tets ? 1 : 0);
+    CHECK((r.buffer_side == conform::BufferSide::kTet) == from_tets);
     const primal::Interface itf = primal::find_interface(input);
     REQUIRE(r.local_yardstick.size() == itf.quads.size());
     REQUIRE(r.template_ceiling.size() == itf.quads.size());
@@ -202,4 +209,34 @@ TEST_CASE("template ceilings measured only where they can set a block's capped r
     MESSAGE(model_name << ": ceilings measured " << lowered(a) << " of " << lowered(b)
                        << ", capped ratio " << a.capped_local_ratio);
   }
+}
+
+TEST_CASE("a hex part convex at its corners, its geode hexes short: the tets' layer tried too") {
+  // demo_wedge at 90 degrees, n = 3: from the hex part its buffer hexes taper at the prism's
+  // corners and its geode hexes reached 0.86 x their capped local yardstick (the output 0.1763),
+  // from the tets 1.27 x (0.1876): the tet part's kept, written once. At 300 degrees the tets'
+  // output is lower (0.1623 against 0.1631): the hex part's kept.
+  conform::ConformOptions o;
+  std::vector<primal::Model> written;
+  o.write_ahead = [&](const primal::Model& m, std::span<const double>) { written.push_back(m); };
+  const primal::Model input = demo::demo_wedge(3, 90.0);
+  const conform::ConformResult r = conform::conform(input, o);
+  test::check_conform_result(r, -1, r.warnings.size());
+  CHECK(r.buffer_side == conform::BufferSide::kTet);
+  REQUIRE(!r.warnings.empty());
+  CHECK(r.warnings.front().find("at the hex part's convex corners") != std::string::npos);
+  CHECK(r.capped_local_ratio >= 0.9);
+  REQUIRE(written.size() == 1);  // the one returned, not the hex part's first
+  CHECK(written.front().points == r.model.points);
+  conform::ConformOptions hex;
+  conform::set_buffer_side(hex, "hex");
+  const conform::ConformResult h = conform::conform(input, hex);
+  CHECK(conform::result_valid(h));
+  CHECK(h.capped_local_ratio < 0.9);
+  CHECK(conform::output_min_scaled_jacobian(r) > conform::output_min_scaled_jacobian(h));
+
+  const conform::ConformResult wide = conform::conform(demo::demo_wedge(3, 300.0));
+  test::check_conform_result(wide, -1, wide.warnings.size());
+  CHECK(wide.buffer_side == conform::BufferSide::kHex);
+  CHECK(wide.capped_local_ratio < 0.9);  // the tets' was no better
 }
