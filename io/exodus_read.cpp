@@ -84,7 +84,7 @@ struct Contents {
   int num_dim = 0, num_nodes = 0, num_elem = 0;
   NemesisInfo nemesis;
   std::vector<double> x, y, z;
-  std::vector<int> node_map, element_map;
+  std::vector<std::int64_t> node_map, element_map;  // 64-bit: Cubit's ids pass 2^31
   std::vector<BlockData> blocks;
   std::vector<SetData> node_sets, side_sets;
 };
@@ -115,6 +115,9 @@ Contents read_contents(const std::string& source, ExodusBounds bound, Slice slic
   if (file.id() < 0)
     throw InvalidInput(source + ": not a readable Exodus II file (truncated or corrupt?)");
   const int exo = file.id();
+  // The number maps through the 64-bit API whatever the file stores: ids of 2^31 and more
+  // (64-bit files) do not fit the 32-bit one, which refuses them.
+  ex_set_int64_status(exo, EX_MAPS_INT64_API);
   const int64_t used_name_length = ex_inquire_int(exo, EX_INQ_DB_MAX_USED_NAME_LENGTH);
   ex_set_max_name_length(exo,
                          static_cast<int>(std::clamp<int64_t>(used_name_length, 32, kNameLength)));
@@ -432,6 +435,10 @@ Model build_model(const Contents& c, const std::string& source) {
     return global_index < c.element_map.size() ? c.element_map[global_index]
                                                : static_cast<int64_t>(global_index) + 1;
   };
+  // An element named by the file's id (its number map), at its place in the global order.
+  const auto element_named = [&](std::size_t global_index) {
+    return "element " + std::to_string(element_file_id(global_index));
+  };
 
   // A block's cell, its index in kExodusCells by its type and node count; the table's size for
   // another.
@@ -457,23 +464,24 @@ Model build_model(const Contents& c, const std::string& source) {
   for (std::size_t b = 0; b < c.blocks.size(); ++b) {
     const BlockData& block = c.blocks[b];
     const int block_id = renumber_blocks ? static_cast<int>(b) + 1 : block.id;
+    // An empty block (libexodus writes one as type NULL, no connectivity): nothing to read.
+    if (block.count == 0) continue;
     if (!block.name.empty()) model.block_names[block_id] = block.name;
     const std::string where = source + ": element block " + std::to_string(block.id);
     const std::size_t k = cell_of(block);
     const ExodusCell* cell = k < kExodusCells.size() ? &kExodusCells[k] : nullptr;
     const ElementKind kind = cell ? kElementKinds[k] : ElementKind::kHex;
     if (!cell)
-      throw InvalidInput(where + ": element " + std::to_string(global.size() + 1) +
-                         ": element type '" + block.type + "' with " +
-                         std::to_string(block.per_elem) +
+      throw InvalidInput(where + ": " + element_named(global.size()) + ": element type '" +
+                         block.type + "' with " + std::to_string(block.per_elem) +
                          " nodes is not supported; only HEX8, TETRA4, PYRAMID5 and WEDGE6 are");
     const auto per_elem = index_cast<std::size_t>(block.per_elem);
     for (std::size_t base = 0; base + per_elem <= block.conn.size(); base += per_elem) {
       auto node = [&](int corner) {
         const int n = block.conn[base + index_cast<std::size_t>(corner)];
         if (n < 1 || n > c.num_nodes)
-          throw InvalidInput(where + ": element " + std::to_string(global.size() + 1) +
-                             ": corner " + std::to_string(corner + 1) + " refers to node " +
+          throw InvalidInput(where + ": " + element_named(global.size()) + ": corner " +
+                             std::to_string(corner + 1) + " refers to node number " +
                              std::to_string(n) + ", out of range [1, " +
                              std::to_string(c.num_nodes) + "]");
         return index_cast(n - 1);
@@ -524,14 +532,14 @@ Model build_model(const Contents& c, const std::string& source) {
       const std::string entry = where + ": entry " + std::to_string(i + 1);
       const int element_number = in.entries[i], side = in.sides[i];
       if (element_number < 1 || index_cast<std::size_t>(element_number) > global.size())
-        throw InvalidInput(entry + " refers to element " + std::to_string(element_number) +
-                           ", out of range");
+        throw InvalidInput(entry + " refers to element number " + std::to_string(element_number) +
+                           ", out of range [1, " + std::to_string(global.size()) + "]");
       const ElementRef element = global[index_cast<std::size_t>(element_number - 1)];
       const int faces = cell_topology(element.kind).faces;
       if (side < 1 || side > faces)
-        throw InvalidInput(entry + ": element " + std::to_string(element_number) + ": side " +
-                           std::to_string(side) + " out of range [1, " + std::to_string(faces) +
-                           "]");
+        throw InvalidInput(
+            entry + ": " + element_named(index_cast<std::size_t>(element_number - 1)) + ": side " +
+            std::to_string(side) + " out of range [1, " + std::to_string(faces) + "]");
       set.sides.push_back({element, side - 1});
     }
     model.side_sets.push_back(std::move(set));

@@ -4,8 +4,10 @@
 #include <exodusII.h>
 #include <unistd.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <set>
 #include <sstream>
@@ -78,6 +80,58 @@ std::string message_of(const fs::path& file) {
     return e.what();
   }
   return "no exception";
+}
+
+// The sample model written as a 64-bit file (netCDF-4, every integer 64 bits) with number maps
+// from `first_node` and `first_element` on, an empty NULL block (as libexodus writes a block
+// of no elements) after the others, and side set 7: `more` writes it, else it is empty.
+fs::path write_int64(const std::string& name, std::int64_t first_node, std::int64_t first_element,
+                     const std::function<void(int exo)>& more = {}) {
+  const Model m = sample_model();
+  const fs::path file = scratch_dir() / name;
+  write_exodus(m, file);
+  // Read back raw, written again through the 64-bit API.
+  const int in = open_raw(file);
+  ex_init_params p{};
+  REQUIRE(ex_get_init_ext(in, &p) >= 0);
+  std::vector<double> x(static_cast<std::size_t>(p.num_nodes)), y(x.size()), z(x.size());
+  REQUIRE(ex_get_coord(in, x.data(), y.data(), z.data()) >= 0);
+  std::vector<int> ids(static_cast<std::size_t>(p.num_elem_blk));
+  REQUIRE(ex_get_ids(in, EX_ELEM_BLOCK, ids.data()) >= 0);
+  int cpu = 8, io = 8;
+  const fs::path out = scratch_dir() / ("64-" + name);
+  const int exo =
+      ex_create(out.string().c_str(), EX_CLOBBER | EX_NETCDF4 | EX_ALL_INT64_DB, &cpu, &io);
+  REQUIRE(exo >= 0);
+  ex_set_int64_status(exo, EX_ALL_INT64_API);
+  REQUIRE(ex_put_init(exo, "int64", 3, p.num_nodes, p.num_elem, p.num_elem_blk + 1, 0, 1) >= 0);
+  REQUIRE(ex_put_coord(exo, x.data(), y.data(), z.data()) >= 0);
+  for (int id : ids) {
+    char type[MAX_STR_LENGTH + 1] = {};
+    int count = 0, per = 0, edges = 0, faces = 0, attributes = 0;
+    REQUIRE(ex_get_block(in, EX_ELEM_BLOCK, id, type, &count, &per, &edges, &faces, &attributes) >=
+            0);
+    std::vector<int> conn(static_cast<std::size_t>(count * per));
+    REQUIRE(ex_get_conn(in, EX_ELEM_BLOCK, id, conn.data(), nullptr, nullptr) >= 0);
+    REQUIRE(ex_put_block(exo, EX_ELEM_BLOCK, id, type, count, per, 0, 0, 0) >= 0);
+    const std::vector<std::int64_t> wide(conn.begin(), conn.end());
+    REQUIRE(ex_put_conn(exo, EX_ELEM_BLOCK, id, wide.data(), nullptr, nullptr) >= 0);
+  }
+  REQUIRE(ex_put_block(exo, EX_ELEM_BLOCK, 42, "NULL", 0, 0, 0, 0, 0) >= 0);
+  std::vector<std::int64_t> node_map(x.size()), element_map(static_cast<std::size_t>(p.num_elem));
+  for (std::size_t i = 0; i < node_map.size(); ++i)
+    node_map[i] = first_node + static_cast<std::int64_t>(i);
+  for (std::size_t i = 0; i < element_map.size(); ++i)
+    element_map[i] = first_element + static_cast<std::int64_t>(i);
+  REQUIRE(ex_put_id_map(exo, EX_NODE_MAP, node_map.data()) >= 0);
+  REQUIRE(ex_put_id_map(exo, EX_ELEM_MAP, element_map.data()) >= 0);
+  if (more)
+    more(exo);
+  else
+    REQUIRE(ex_put_set_param(exo, EX_SIDE_SET, 7, 0, 0) >= 0);  // empty
+  REQUIRE(ex_close(exo) >= 0);
+  REQUIRE(ex_close(in) >= 0);
+  return out;
 }
 
 }  // namespace
@@ -179,7 +233,7 @@ TEST_CASE("read_exodus rejects bad input naming the file, element and reason") {
     write_raw(file, "TETRA4", {1, 2, 99, 4}, 4);
     const std::string what = message_of(file);
     CHECK(what.find(file.string()) != std::string::npos);
-    CHECK(what.find("element 1: corner 3 refers to node 99") != std::string::npos);
+    CHECK(what.find("element 1: corner 3 refers to node number 99") != std::string::npos);
   }
 }
 
@@ -285,4 +339,31 @@ TEST_CASE("write_exodus is atomic") {
   std::stringstream text;
   text << in.rdbuf();
   CHECK(text.str() == "previous content");
+}
+
+TEST_CASE(
+    "64-bit files: ids of 2^31 and more, an empty NULL block, sides named by the file's ids") {
+  // A Cubit / SEACAS file with 64-bit integers and ids past 2^31 (refused before: the 32-bit
+  // API cannot hold them) and the NULL block libexodus writes for a block of no elements
+  // (refused before as an element of type 'NULL').
+  const std::int64_t first_node = std::int64_t{5} << 30, first_element = std::int64_t{9} << 31;
+  const Model read = read_exodus(write_int64("big.exo", first_node, first_element));
+  const Model m = sample_model();
+  CHECK(read.points.size() == m.points.size());
+  CHECK(read.hexes.size() == m.hexes.size());
+  CHECK(read.tets.size() == m.tets.size());
+  REQUIRE(!read.node_ids.empty());
+  CHECK(read.node_ids.front() == first_node);
+  CHECK(read.node_ids.back() == first_node + static_cast<std::int64_t>(m.points.size()) - 1);
+  REQUIRE(!read.hex_ids.empty());
+  CHECK(read.hex_ids.front() == first_element);  // block 1's hexes are written first
+  CHECK(read.block_names.count(42) == 0);
+  // A side set entry whose side is out of range is named by the element's id, not its place.
+  const fs::path bad = write_int64("bad-side.exo", 1000, 5000, [](int exo) {
+    REQUIRE(ex_put_set_param(exo, EX_SIDE_SET, 7, 1, 0) >= 0);
+    const std::int64_t element = 2, side = 9;
+    REQUIRE(ex_put_set(exo, EX_SIDE_SET, 7, &element, &side) >= 0);
+  });
+  const std::string what = message_of(bad);
+  CHECK(what.find("side set 7: entry 1: element 5001: side 9 out of range") != std::string::npos);
 }
