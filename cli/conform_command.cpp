@@ -76,9 +76,11 @@ void print_summary(const conform::ConformResult& r, std::ostream& os, bool table
   os << "), " << r.model.points.size() << " nodes, "
      << (conform::result_valid(r) ? "valid" : "INVALID") << ", " << r.seconds << " s\n";
   for (const auto& b : r.quality) {
-    os << "block " << b.block << " \"" << b.name << "\": " << b.report.num_hexes
-       << " hexes, min scaled Jacobian " << conform::block_min_scaled_jacobian(b.report)
-       << " (diced alone " << b.input_diced_min_scaled_jacobian << ")";
+    os << "block " << b.block;
+    if (!b.name.empty()) os << " \"" << b.name << "\"";
+    os << ": " << b.report.num_hexes << " hexes, min scaled Jacobian "
+       << conform::block_min_scaled_jacobian(b.report) << " (diced alone "
+       << b.input_diced_min_scaled_jacobian << ")";
     // Its geode hexes against the input cells around their buffer hexes (the local yardstick).
     if (b.geode_hexes > 0)
       os << "; " << b.geode_hexes << " geode hexes, min " << b.geode_min_scaled_jacobian

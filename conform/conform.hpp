@@ -189,7 +189,7 @@ void set_buffer_side(ConformOptions& options, const std::string& word);
 
 struct BlockQuality {
   int block = 0;
-  std::string name;
+  std::string name;  // the block's name; empty where it has none (as in the output file)
   primal::QualityReport report;
   // The block's input elements each diced alone (1 when it has none): what the part gives
   // without any transition.

@@ -210,7 +210,8 @@ void Conformer::report(const std::vector<int>& block) {
       report.metrics.push_back(
           primal::summarize_metric(primal::HexMetric::kScaledJacobian, values, sel));
     }
-    BlockQuality q{id, name != blocks_.names.end() ? name->second : "block " + std::to_string(id),
+    // An unnamed block stays so: the report says what the output file says.
+    BlockQuality q{id, name != blocks_.names.end() ? name->second : std::string(),
                    std::move(report)};
     // The input's elements by their diced-alone figures (trim_input kept their blocks only).
     for (std::size_t h = 0; h < hex_diced_.size(); ++h)

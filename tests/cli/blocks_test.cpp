@@ -195,6 +195,28 @@ TEST_CASE("conform carries blocks and sets: steel and rubber keep their ids and 
   }
 }
 
+TEST_CASE("conform: an unnamed block stays unnamed in the report, as in the file") {
+  // The report named it "block 9" where the written file had no name (found by a fault hunt).
+  test::TempDir dir;
+  primal::Model model = steel_rubber();
+  model.block_names.erase(9);
+  const fs::path in = dir.path / "in.msh", out = dir.path / "out.exo", report = dir.path / "r.json";
+  io::write_gmsh(model, in);
+  const test::CliRun r = test::geode_cli(
+      "conform " + in.string() + " -o " + out.string() + " --report " + report.string(), true);
+  INFO(r.out);
+  REQUIRE(r.code == 0);
+  CHECK(io::read_exodus(out).block_names.count(9) == 0);
+  std::ifstream is(report);
+  const nlohmann::json j = nlohmann::json::parse(is);
+  REQUIRE(j.at("blocks").size() == 2);
+  CHECK(j.at("blocks")[0].at("name") == "steel");
+  CHECK(j.at("blocks")[1].at("id") == 9);
+  CHECK(j.at("blocks")[1].at("name") == "");
+  CHECK(r.out.find("block 7 \"steel\": ") != std::string::npos);
+  CHECK(r.out.find("block 9: ") != std::string::npos);
+}
+
 TEST_CASE("conform: parts meshed separately get a hint, and --merge-tolerance joins them") {
   test::TempDir dir;
   // The tet part on nodes of its own: every interface node duplicated at the same place.
