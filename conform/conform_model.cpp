@@ -183,6 +183,7 @@ class ModelConformer {
   std::vector<std::string> warnings_;
   bool layer_kept_ = false;       // a thin layer that could not be split into tets
   double near_thin_ = 0.0;        // the last pass's Conformer::near_thin()
+  bool tets_cross_ = false;       // ... its Conformer::tets_cross()
   bool convex_hex_part_ = false;  // ... and its Conformer::convex_hex_part()
   // The caller's writer; the pass running (its near_thin() says whether from_tets may follow);
   // whether the pass running will be compared with an earlier one; whether a pass deferred its
@@ -232,6 +233,7 @@ ConformResult ModelConformer::pass(std::vector<Index>& joining) {
   conformer_ = nullptr;
   joining = conformer.joining();
   near_thin_ = conformer.near_thin();
+  tets_cross_ = conformer.tets_cross();
   convex_hex_part_ = conformer.convex_hex_part();
   return r;
 }
@@ -416,7 +418,12 @@ ConformResult ModelConformer::from_tets(ConformResult r) {
   const bool short_of_aim = r.capped_local_ratio < kPoorTransition;
   // Nearly thin hex cells at the interface, or (chosen by conform) a hex part convex at some
   // interface corner, where its buffer hexes taper.
-  const bool thin = near_thin_ > 0.0 && (!valid || (automatic && short_of_aim));
+  // Where the tets' layer would cross faces between their blocks (tets_cross_), only an output
+  // worse than the input's own elements diced alone justifies that.
+  const bool thin =
+      near_thin_ > 0.0 &&
+      (!valid ||
+       (automatic && (tets_cross_ ? output_min_scaled_jacobian(r) < r.yardstick() : short_of_aim)));
   const bool convex = convex_hex_part_ && valid && short_of_aim;
   if (!thin && !convex) return r;
   const double hex_min = output_min_scaled_jacobian(r), height = near_thin_;
@@ -434,6 +441,8 @@ ConformResult ModelConformer::from_tets(ConformResult r) {
   options_.buffer.side = BufferSide::kTet;
   options_.buffer.thickness = 0.0;
   options_.buffer_side_chosen = true;
+  const bool crossing = tets_cross_;
+  if (crossing) options_.buffer.keep_block_faces = false;
   compared_ = true;
   std::vector<Index> joining;
   ConformResult t;
@@ -466,6 +475,9 @@ ConformResult ModelConformer::from_tets(ConformResult r) {
       << " and " << t.capped_local_ratio << " x";
   else
     m << "the output was invalid (" << invalid_reason(r) << "); from the tet part " << tet_min;
+  if (crossing)
+    m << "; across faces between the tet part's blocks, so blocks there do not keep their "
+         "volumes: no layer from the tet part keeps them";
   t.warnings.insert(t.warnings.begin() + static_cast<std::ptrdiff_t>(t.findings), m.str());
   return t;
 }

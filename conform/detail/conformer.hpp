@@ -91,6 +91,10 @@ class Conformer {
   // height (buffer_height_ratios), else 0. The input is then kept, not trimmed, so that
   // conform() can try the tet part's layer too.
   double near_thin() const { return near_thin_; }
+  // Nearly thin (near_thin()) where the tet part's layer is thicker but crosses faces between
+  // its blocks (no layer from it keeps them): conform() tries it only where the hex part's output
+  // is below the yardstick or invalid, its blocks then not keeping their volumes.
+  bool tets_cross() const { return tets_cross_; }
   // Where the layer was carved, automatically, from a hex part convex at some interface corner
   // (BufferLayerReport::convex_corners), not nearly thin: its buffer hexes taper there, and
   // conform() tries the tet part's layer too where the geode hexes fall short. The input is then
@@ -206,6 +210,7 @@ class Conformer {
   std::vector<Index> joining_;  // wedges joining the two sides of the interface (none: go on)
   double near_thin_ = 0.0;      // near_thin()
   bool convex_hex_part_ = false;
+  bool tets_cross_ = false;
   double local_ratio_ = 1.0;
   // warped_interface: per (hex-side block, tet-side block, the tets split from a pyramid or
   // wedge) the space between the interface quads' bilinear faces and the tets' triangles on
