@@ -194,11 +194,13 @@ TEST_CASE("hex parts in a TetGen potting: valid, at or above the yardstick, volu
     CAPTURE(name);
     const primal::Model input = tetgen_potting(shape, 3, shear, dir);
     REQUIRE(input.tets.size() > 1000);
-    // The defaults, and the part given (--buffer-side hex). From the part, its corners' geode
-    // hexes reached 0.69 to 0.73 x their capped local yardstick (0.150 to 0.200, the part's
-    // block as low); from the potting 0.78 to 0.90 x (0.197 to 0.215), the output's minimum
+    // The defaults, and the part given (--buffer-side hex) on the boxes. From the part, its
+    // corners' geode hexes reached 0.69 to 0.73 x their capped local yardstick (0.150 to 0.200, the
+    // part's block as low); from the potting 0.78 to 0.90 x (0.197 to 0.215), the output's minimum
     // the same, the part's block 0.78 to 0.90: the defaults keep the potting's layer on all four.
     for (const std::string side : {"", "hex"}) {
+      // The part given: on the box and the sheared box (its non-planar quads' volume said).
+      if (side == "hex" && std::string(shape) != "box") continue;
       CAPTURE(side);
       conform::ConformOptions o;
       conform::set_buffer_side(o, side);
