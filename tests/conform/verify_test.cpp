@@ -37,6 +37,12 @@ TEST_CASE("local verification gives the full check's verdict on every demo model
     conform::ConformOptions local, full;
     local.verify = conform::ConformVerify::kLocal;
     full.verify = conform::ConformVerify::kFull;
+    // The potting at n = 2 as conform leaves it, carved from the tets, without the run from the
+    // hex part that finds it (test time; the local yardstick test checks that choice).
+    if (name == "potting") {
+      conform::set_buffer_side(local, "tet");
+      conform::set_buffer_side(full, "tet");
+    }
     const auto a = conform::conform(m, local);
     const auto b = conform::conform(m, full);
     CHECK(a.verified == conform::ConformVerify::kLocal);

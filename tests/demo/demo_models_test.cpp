@@ -18,6 +18,7 @@
 #include <geode/primal/interface.hpp>
 #include <geode/primal/quality.hpp>
 #include "support/conform_checks.hpp"
+#include "support/sanitized.hpp"
 
 using namespace geode;
 using primal::Index;
@@ -185,13 +186,8 @@ TEST_CASE("mixed two- and four-triangle interface: valid and untangled") {
 // sides in a Delaunay tet box), where, as for the two-triangle cylinder, smoothing is needed.
 // Skipped in the sanitized Debug build, where smoothing its 126 buffer hexes takes most of a
 // minute; that build runs the same code on the planar mixed model above.
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
 TEST_CASE("mixed interface on a curved cylinder, default options: valid and untangled" *
-          doctest::skip(kSanitized)) {
+          doctest::skip(test::kSanitized)) {
   const primal::Model m = demo::demo_model("fourtri-cylinder", 2);
   test::check_conform_result(conform::conform(m), mixed_geode_hexes(m));
 }
