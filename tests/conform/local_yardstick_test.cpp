@@ -189,6 +189,8 @@ TEST_CASE("template ceilings measured only where they can set a block's capped r
     const primal::Model input = demo::demo_model(name, n);
     conform::ConformOptions some;
     some.smooth = conform::ConformSmooth::kNone;
+    // From the hex part, without the tets' run conform adds on these two (test time).
+    conform::set_buffer_side(some, "hex");
     conform::ConformOptions all = some;
     all.all_template_ceilings = true;
     const conform::ConformResult a = conform::conform(input, some),
