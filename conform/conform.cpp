@@ -387,7 +387,7 @@ void Conformer::insert_buffer() {
   }
   try {
     layer_ = insert_buffer_layer(input_, interface_, options_.buffer);
-    const bool automatic = !options_.buffer_side_chosen && options_.buffer.thickness == 0.0;
+    const bool automatic = buffer_side_automatic(options_);
     if (options_.buffer_fallback && options_.buffer.side == BufferSide::kHex) {
       thicker_from_tets(automatic);
       convex_hex_part_ = automatic && res_.buffer_side == BufferSide::kHex && near_thin_ == 0.0 &&

@@ -84,10 +84,12 @@ struct ConformOptions {
   // part of a hex face), carve it from the other part (at that side's default thickness) and say
   // so in ConformResult::warnings; false: refuse.
   bool buffer_fallback = true;
-  // False (automatic): where the hex part's buffer hexes on some piece of the interface are
-  // flat (a graded boundary layer's thin first cells), the tet part's layer is taken if it is
-  // thicker there, with a warning (conform.cpp, kThinHexBuffer). True: buffer.side as the
-  // caller chose it (buffer_fallback still applies where that part gives no layer at all).
+  // False (automatic, with no thickness given: buffer_side_automatic): where the hex part's
+  // buffer hexes on some piece of the interface are flat (a graded boundary layer's thin first
+  // cells), the tet part's layer is taken if it is thicker there, with a warning (conform.cpp,
+  // kThinHexBuffer), and where they are nearly so or taper at convex corners the tet part's is
+  // tried too (conform_model.cpp, kPoorTransition). True: buffer.side as the caller chose it
+  // (buffer_fallback still applies where that part gives no layer at all).
   bool buffer_side_chosen = false;
   // The model's tets from this index on are pyramids (or wedges) the caller split, as geode_mpi's
   // zone is cut from a model whose pyramids it split: on an interface quad that is not planar
@@ -186,6 +188,10 @@ struct ConformOptions {
 // tet part where the hex part's cells at the interface are thin), "hex" or "tet" (that part, as
 // chosen); sets buffer.side and buffer_side_chosen. InvalidInput naming any other word.
 void set_buffer_side(ConformOptions& options, const std::string& word);
+// Whether the buffer side is conform's to choose: neither a side nor a thickness given.
+inline bool buffer_side_automatic(const ConformOptions& options) {
+  return !options.buffer_side_chosen && options.buffer.thickness == 0.0;
+}
 
 struct BlockQuality {
   int block = 0;

@@ -413,20 +413,19 @@ ConformResult ModelConformer::passes() {
 
 ConformResult ModelConformer::from_tets(ConformResult r) {
   // The side given (or a thickness for it): only an invalid output is not taken as it is.
-  const bool automatic = !options_.buffer_side_chosen && options_.buffer.thickness == 0.0;
+  const bool automatic = buffer_side_automatic(options_);
   const bool valid = result_valid(r);
   const bool short_of_aim = r.capped_local_ratio < kPoorTransition;
+  const double hex_min = output_min_scaled_jacobian(r), height = near_thin_;
   // Nearly thin hex cells at the interface, or (chosen by conform) a hex part convex at some
   // interface corner, where its buffer hexes taper.
   // Where the tets' layer would cross faces between their blocks (tets_cross_), only an output
   // worse than the input's own elements diced alone justifies that.
   const bool thin =
       near_thin_ > 0.0 &&
-      (!valid ||
-       (automatic && (tets_cross_ ? output_min_scaled_jacobian(r) < r.yardstick() : short_of_aim)));
+      (!valid || (automatic && (tets_cross_ ? hex_min < r.yardstick() : short_of_aim)));
   const bool convex = convex_hex_part_ && valid && short_of_aim;
   if (!thin && !convex) return r;
-  const double hex_min = output_min_scaled_jacobian(r), height = near_thin_;
   if (options_.progress)
     options_.progress(
         !valid ? std::string("buffer layer: from the hex part's thin cells the output is "

@@ -102,7 +102,7 @@ class Conformer {
   bool convex_hex_part() const { return convex_hex_part_; }
   // The geode hexes' lowest ratio to their local yardstick (uncapped: never above the capped
   // ratio), known once smoothing is done, before the output is written.
-  double local_ratio() const { return local_ratio_; }
+  double local_ratio() const { return res_.local_yardstick_ratio; }
 
   ConformResult run() {
     const auto t_start = Clock::now();
@@ -211,7 +211,6 @@ class Conformer {
   double near_thin_ = 0.0;      // near_thin()
   bool convex_hex_part_ = false;
   bool tets_cross_ = false;
-  double local_ratio_ = 1.0;
   // warped_interface: per (hex-side block, tet-side block, the tets split from a pyramid or
   // wedge) the space between the interface quads' bilinear faces and the tets' triangles on
   // them (the hex block's side of the triangles, signed), the quads' scale (their sizes cubed)
