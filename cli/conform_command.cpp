@@ -143,34 +143,10 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
   const std::string prefix = source.empty() ? "" : source + ": ";
   Progress progress = Progress::for_stderr(a.quiet);
   if (a.merge_tolerance >= 0) {
-    // A tolerance as long as an element's edge merges that element's own nodes: refuse it
-    // rather than report the collapsed elements it would leave.
-    double shortest = std::numeric_limits<double>::infinity();
-    primal::Index where = 0;
-    bool in_hex = true;
-    const auto scan = [&](const auto& cells, const auto& edges, bool hex) {
-      for (std::size_t e = 0; e < cells.size(); ++e)
-        for (const auto& ed : edges) {
-          const double l = (model.points[primal::index_cast<std::size_t>(
-                                cells[e][primal::index_cast<std::size_t>(ed[0])])] -
-                            model.points[primal::index_cast<std::size_t>(
-                                cells[e][primal::index_cast<std::size_t>(ed[1])])])
-                               .norm();
-          if (l < shortest) shortest = l, where = primal::index_cast(e), in_hex = hex;
-        }
-    };
-    scan(model.hexes, primal::topology::kHexEdgeCorners, true);
-    scan(model.tets, primal::topology::kTetEdgeCorners, false);
-    if (a.merge_tolerance >= shortest) {
-      std::ostringstream m;
-      m << prefix << "--merge-tolerance " << a.merge_tolerance
-        << " is not below the shortest element edge, " << shortest << " ("
-        << primal::describe_element(
-               model, {in_hex ? primal::ElementKind::kHex : primal::ElementKind::kTet, where})
-        << "): it would merge an element's own nodes; give a distance below that edge (and above "
-           "the gap between "
-        << "duplicated interface nodes)";
-      throw InvalidInput(m.str());
+    try {
+      primal::check_merge_tolerance(model, a.merge_tolerance, "--merge-tolerance");
+    } catch (const InvalidInput& e) {
+      throw InvalidInput(prefix + e.what());
     }
     const primal::Index merged = primal::merge_coincident_nodes(model, a.merge_tolerance);
     progress.stage("merged " + std::to_string(merged) + " coincident nodes");

@@ -425,7 +425,8 @@ void Conformer::insert_buffer() {
       res_.warnings.push_back(std::string("buffer layer carved from the ") +
                               buffer_side_name(crossing.side) +
                               " part across faces between blocks, so blocks there do not keep "
-                              "their volumes: no layer from either part keeps them (" +
+                              "their volumes, nor side sets on those faces their place: no layer "
+                              "from either part keeps them (" +
                               neither + ")");
       return carved();
     }

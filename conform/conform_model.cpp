@@ -476,7 +476,8 @@ ConformResult ModelConformer::from_tets(ConformResult r) {
     m << "the output was invalid (" << invalid_reason(r) << "); from the tet part " << tet_min;
   if (crossing)
     m << "; across faces between the tet part's blocks, so blocks there do not keep their "
-         "volumes: no layer from the tet part keeps them";
+         "volumes, nor side sets on those faces their place: no layer from the tet part keeps "
+         "them";
   t.warnings.insert(t.warnings.begin() + static_cast<std::ptrdiff_t>(t.findings), m.str());
   return t;
 }

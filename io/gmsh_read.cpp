@@ -30,7 +30,7 @@ using namespace primal;
 
 namespace {
 
-constexpr int kTri3 = 2, kQuad4 = 3;
+constexpr int kTri3 = 2, kQuad4 = 3, kLine2 = 1, kPoint1 = 15;
 
 struct GmshType {
   int type;
@@ -926,8 +926,14 @@ class MshReader {
         // The set's points and lines are kept as its pieces, so that dicing adds the nodes
         // on these lines only (not on a face between two of them: primal/model.hpp).
         NodeSet set{tag, name, {}, {}};
+        const std::string where = source_ + ": node set " + std::to_string(tag) + " '" + name + "'";
         for (std::size_t i : members) {
           const RawElement& e = elements_[i];
+          // A higher-order line's middle nodes belong to no linear element.
+          if (e.type != kPoint1 && e.type != kLine2)
+            throw InvalidInput(where + ": element " + std::to_string(e.tag) + ": " +
+                               gmsh_type(e.type)->name + " (Gmsh type " + std::to_string(e.type) +
+                               ") is not supported; only points and 2-node lines are");
           std::vector<Index> piece;
           for (int k = 0; k < gmsh_type(e.type)->nodes; ++k)
             piece.push_back(node(e, index_cast<std::size_t>(k)));

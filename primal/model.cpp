@@ -5,7 +5,9 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <set>
+#include <sstream>
 #include <string>
 #include <type_traits>
 #include <unordered_map>
@@ -620,6 +622,31 @@ Index merge_coincident_nodes(Model& model, double tolerance) {
   const auto removed = index_cast(n - points.size());
   model.points = std::move(points);
   return removed;
+}
+
+void check_merge_tolerance(const Model& model, double tolerance, const std::string& option) {
+  double shortest = std::numeric_limits<double>::infinity();
+  ElementRef where;
+  for (ElementKind kind : kElementKinds) {
+    const topology::CellKindTopology& t = cell_topology(kind);
+    with_cells(model, kind, [&](const auto& cells) {
+      for (std::size_t e = 0; e < cells.size(); ++e)
+        for (int k = 0; k < t.edges; ++k) {
+          const double l = (model.points[index_cast<std::size_t>(cells[e][t.edge[k][0]])] -
+                            model.points[index_cast<std::size_t>(cells[e][t.edge[k][1]])])
+                               .norm();
+          if (l < shortest) shortest = l, where = {kind, index_cast(e)};
+        }
+    });
+  }
+  if (tolerance < shortest) return;
+  std::ostringstream m;
+  m << option << (option.ends_with('=') ? "" : " ") << tolerance
+    << " is not below the shortest element edge, " << shortest << " ("
+    << describe_element(model, where)
+    << "): it would merge an element's own nodes; give a distance below that edge (and above the "
+       "gap between duplicated interface nodes)";
+  throw InvalidInput(m.str());
 }
 
 }  // namespace geode::primal

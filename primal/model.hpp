@@ -208,4 +208,10 @@ double coincident_tolerance(const Model& model);
 // the merged points). Returns how many points were removed. Spatial hashing, O(n).
 Index merge_coincident_nodes(Model& model, double tolerance);
 
+// A tolerance as long as an element's edge merges that element's own nodes: throws
+// InvalidInput naming the shortest edge's element (every kind) unless `tolerance` is below it,
+// so that the caller refuses it instead of reporting the collapsed elements it would leave.
+// `option` is how the caller's user gave it ("--merge-tolerance", "merge_tolerance=").
+void check_merge_tolerance(const Model& model, double tolerance, const std::string& option);
+
 }  // namespace geode::primal

@@ -596,6 +596,8 @@ std::vector<NodeConstraint> box_constraints(std::span<const Point> points, const
 
 SmoothResult smooth_hex_mesh(HexMesh& mesh, std::span<const NodeConstraint> constraints,
                              const SmoothOptions& options) {
+  // Its minimum, and so what the smoother maximises, is not defined on no hexes.
+  if (mesh.hexes.empty()) throw InvalidInput("smooth: the mesh has no hexes");
   for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
     for (Index n : mesh.hexes[h]) check_nodes(mesh.points.size(), n, "hex " + std::to_string(h));
   }
@@ -609,6 +611,7 @@ SmoothResult smooth_quad_mesh(QuadMesh& mesh, const Point& normal,
   if (!(normal.norm() > 0.0) || !normal.allFinite()) {
     throw InvalidInput("smooth_quad_mesh: the plane normal is zero or not finite");
   }
+  if (mesh.quads.empty()) throw InvalidInput("smooth_quad_mesh: the mesh has no quads");
   for (std::size_t q = 0; q < mesh.quads.size(); ++q) {
     for (Index n : mesh.quads[q]) check_nodes(mesh.points.size(), n, "quad " + std::to_string(q));
   }

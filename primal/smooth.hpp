@@ -103,13 +103,13 @@ struct SmoothResult {
 
 // Moves the nodes of `mesh` in place. `constraints` has one entry per node (empty: all free).
 // Nodes with a plane or line constraint are first projected onto it. Throws
-// geode::InvalidInput on a size mismatch, a zero direction, a bad node number or a non-finite
-// coordinate.
+// geode::InvalidInput on a mesh of no hexes, a size mismatch, a zero direction, a bad node
+// number or a non-finite coordinate.
 SmoothResult smooth_hex_mesh(HexMesh& mesh, std::span<const NodeConstraint> constraints = {},
                              const SmoothOptions& options = {});
 
 // The same for a quad mesh lying in a plane with normal `normal` (quads counter-clockwise seen
-// from it). Every node also stays in its plane: a free node moves in the plane, a plane
+// from it; InvalidInput on no quads). Every node also stays in its plane: a free node moves in the plane, a plane
 // constraint becomes the line where the two planes meet, a line must lie in the plane.
 SmoothResult smooth_quad_mesh(QuadMesh& mesh, const Point& normal,
                               std::span<const NodeConstraint> constraints = {},

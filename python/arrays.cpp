@@ -17,15 +17,22 @@ py::array owned(std::vector<T>&& v, std::vector<py::ssize_t> shape, py::dtype dt
 
 }  // namespace
 
-std::vector<Point> to_points(const py::handle& object, const std::string& what) {
+std::vector<Point> to_points(const py::handle& object, const std::string& what, bool finite) {
   const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(object);
   if (!a || a.ndim() != 2 || (a.shape(1) != 3 && a.shape(1) != 2))
     throw InvalidInput(what + ": expected an N x 3 (or N x 2) array of coordinates");
   const auto r = a.unchecked<2>();
   const bool planar = a.shape(1) == 2;
   std::vector<Point> points(primal::index_cast<std::size_t>(a.shape(0)));
-  for (py::ssize_t i = 0; i < a.shape(0); ++i)
-    points[primal::index_cast<std::size_t>(i)] = Point(r(i, 0), r(i, 1), planar ? 0.0 : r(i, 2));
+  for (py::ssize_t i = 0; i < a.shape(0); ++i) {
+    const Point p(r(i, 0), r(i, 1), planar ? 0.0 : r(i, 2));
+    // Every measure of a cell at such a point is NaN or infinite: quality would report it.
+    if (finite && !p.allFinite())
+      throw InvalidInput(what + ": point " + std::to_string(i) + " (" + std::to_string(p.x()) +
+                         ", " + std::to_string(p.y()) + ", " + std::to_string(p.z()) +
+                         ") is not finite");
+    points[primal::index_cast<std::size_t>(i)] = p;
+  }
   return points;
 }
 

@@ -19,8 +19,10 @@ namespace py = pybind11;
 using primal::Index;
 using primal::Point;
 
-// N x 3 (or N x 2, z = 0) numbers as points; InvalidInput naming `what` for another shape.
-std::vector<Point> to_points(const py::handle& array, const std::string& what);
+// N x 3 (or N x 2, z = 0) numbers as points; InvalidInput naming `what` for another shape, and
+// with `finite` the point (0-based) for a coordinate not finite (conform's model check names it
+// by its 1-based id instead, as the command does).
+std::vector<Point> to_points(const py::handle& array, const std::string& what, bool finite = true);
 // M x K node numbers (any integer dtype) as cells, K = 4, 5, 6 or 8 (tets or quads, pyramids,
 // wedges, hexes); InvalidInput naming `what` for another shape or a number outside the 32-bit
 // index range. Node ranges are checked by the library functions.

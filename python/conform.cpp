@@ -129,7 +129,7 @@ py::dict conform_arrays(const py::handle& points, const py::dict& cells,
                         const py::object& template_box, const py::object& merge_tolerance,
                         const std::string& relax) {
   primal::Model model;
-  model.points = to_points(points, source + ": points");
+  model.points = to_points(points, source + ": points", false);
   for (const KindKeys& keys : kKindKeys) add_cells(model, keys, cells, source);
   for (const auto& [id, name] : block_names) {
     check_block_id(id, source + ": block name '" + name + "'");
@@ -186,7 +186,14 @@ py::dict conform_arrays(const py::handle& points, const py::dict& cells,
   Index merged = 0;
   {
     py::gil_scoped_release free;
-    if (merge) merged = primal::merge_coincident_nodes(model, *merge);
+    if (merge) {
+      try {
+        primal::check_merge_tolerance(model, *merge, "merge_tolerance=");
+      } catch (const InvalidInput& e) {
+        throw InvalidInput(source + ": " + e.what());
+      }
+      merged = primal::merge_coincident_nodes(model, *merge);
+    }
     // The read-time check of a file (after merging: duplicated nodes look like a gap), which
     // local verification, the default, takes as given; its messages name the source.
     primal::require_single_covering(model, source);

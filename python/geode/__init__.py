@@ -153,6 +153,9 @@ def _model_arrays(mesh=None, points=None, cells=None, cell_blocks=None, name="me
             raise InputError("conform: give a meshio.Mesh, or points and cells")
         cells = list(cells.items()) if isinstance(cells, dict) else list(cells)
         physical, names, point_sets = None, {}, {}
+        if cell_blocks is not None and len(cell_blocks) != len(cells):
+            raise InputError("{}: {} cell_blocks for {} cell blocks: give one block id per cell block"
+                             .format(name, len(cell_blocks), len(cells)))
     points = _np.asarray(points, dtype=float)
     parts = {kind[1]: [] for kind in _KINDS}
     blocks = {kind[1]: [] for kind in _KINDS}

@@ -219,6 +219,22 @@ TEST_CASE("read_gmsh rejects bad input naming the file, element and reason") {
       CHECK(what.find("not supported") != std::string::npos);
     }
   }
+  SUBCASE("a physical curve of 3-node lines (Gmsh type 8) beside linear volumes") {
+    // As Gmsh saves a curve meshed at order 2 in a group: its middle node belongs to no
+    // volume element, and the line's type is the reason to give, by the element's tag.
+    const fs::path file = dir / "line3.msh";
+    write_text(file,
+               "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
+               "$PhysicalNames\n2\n1 20 \"edge\"\n3 1 \"solid\"\n$EndPhysicalNames\n"
+               "$Nodes\n9\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n5 0 0 1\n6 1 0 1\n7 1 1 1\n"
+               "8 0 1 1\n9 0.5 0 0\n$EndNodes\n"
+               "$Elements\n2\n7 8 2 20 1 1 2 9\n8 5 2 1 1 1 2 3 4 5 6 7 8\n$EndElements\n");
+    CHECK_THROWS_WITH_AS(
+        read_gmsh(file),
+        doctest::Contains("node set 20 'edge': element 7: 3-node line (Gmsh type 8) is not "
+                          "supported"),
+        InvalidInput);
+  }
   SUBCASE("side-set quad that is no element face") {
     const fs::path file = dir / "badside.msh";
     std::string text = hand_written_msh(kHexAndTet);

@@ -175,6 +175,24 @@ TEST_CASE("model: a corner out of range found in any cell, named by the first of
   }
 }
 
+TEST_CASE("model: a merge tolerance as long as some element's edge is refused, naming it") {
+  // Each kind in turn: its reference cell scaled by 0.01 (every kind's shortest edge is 1).
+  for (const ElementKind kind : kElementKinds) {
+    auto p = reference_corners(kind);
+    for (Point& x : p) x *= 0.01;
+    const Model m = one_cell(kind, p);
+    CAPTURE(element_kind_name(kind));
+    CHECK_NOTHROW(check_merge_tolerance(m, 0.009, "--merge-tolerance"));
+    const std::string named = std::string(element_kind_name(kind)) + " " +
+                              std::to_string(element_id(m, {kind, 0})) + " (centre";
+    CHECK_THROWS_WITH_AS(check_merge_tolerance(m, 0.01, "--merge-tolerance"),
+                         doctest::Contains(named.c_str()), geode::InvalidInput);
+    CHECK_THROWS_WITH_AS(check_merge_tolerance(m, 0.5, "merge_tolerance="),
+                         doctest::Contains("merge_tolerance=0.5 is not below the shortest"),
+                         geode::InvalidInput);
+  }
+}
+
 TEST_CASE("model: inverted wedges and pyramids refused by their file ids") {
   auto w = reference_corners(ElementKind::kWedge);
   std::swap(w[1], w[2]), std::swap(w[4], w[5]);  // VTK's order read as ours: mirrored

@@ -249,6 +249,17 @@ TEST_CASE("smoothing rejects malformed constraints") {
   CHECK_THROWS_AS(gp::smooth_quad_mesh(q, Point(0, 0, 0)), geode::InvalidInput);
 }
 
+TEST_CASE("smoothing no cells is refused by name, with or without points") {
+  HexMesh none;
+  CHECK_THROWS_WITH(gp::smooth_hex_mesh(none), doctest::Contains("no hexes"));
+  HexMesh points_only = appendix_a();
+  points_only.hexes.clear();
+  CHECK_THROWS_WITH(gp::smooth_hex_mesh(points_only), doctest::Contains("no hexes"));
+  gp::QuadMesh q = geode::test::structured_quad_grid(1, 1);
+  q.quads.clear();
+  CHECK_THROWS_WITH(gp::smooth_quad_mesh(q, Point(0, 0, 1)), doctest::Contains("no quads"));
+}
+
 TEST_CASE("linked nodes move as their leader's mirror image: a symmetric mesh stays symmetric") {
   // A 2 x 2 x 2 grid on [-1, 1]^3, perturbed symmetrically about x = 0.
   HexMesh m;

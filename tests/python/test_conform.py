@@ -153,6 +153,23 @@ def test_conform_refuses_bad_cells(half):
         geode.conform(half, smooth="everywhere")
 
 
+def test_conform_refuses_a_cell_blocks_list_of_another_length(half):
+    cells = [(c.type, c.data) for c in half.cells]
+    with pytest.raises(geode.InputError, match="1 cell_blocks for {} cell blocks".format(len(cells))):
+        geode.conform(points=half.points, cells=cells, cell_blocks=[1])
+
+
+def test_merge_tolerance_as_long_as_an_edge_is_refused_as_the_command_does(half, tmp_path):
+    path = tmp_path / "half.msh"
+    meshio.write(path, half, file_format="gmsh22", binary=False)
+    with pytest.raises(geode.InputError) as e:
+        geode.conform(meshio.read(path), name=path.name, merge_tolerance=10.0)
+    assert "merge_tolerance=10 is not below the shortest element edge" in str(e.value)
+    cli = run_cli("conform", path.name, "-o", "out.exo", "--merge-tolerance", "10", check=False, cwd=tmp_path)
+    assert cli.returncode == 2 and not (tmp_path / "out.exo").exists()
+    assert cli_error(cli) == one_line(str(e.value)).replace("merge_tolerance=", "--merge-tolerance ")
+
+
 def test_invalid_result_error_kind():
     assert geode.InvalidResultError.exit_code == 4 and issubclass(geode.InvalidResultError, geode.Error)
     assert geode.TopologyError.exit_code == 3 and geode.TopologyError.kind == "topology"

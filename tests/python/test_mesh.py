@@ -109,6 +109,24 @@ def test_smooth_keeps_the_boundary_and_untangles():
     assert np.array_equal(f["points"], pts)
 
 
+def test_smooth_refuses_no_cells():
+    pts, _ = grid(1, 1, 1)
+    for points in (np.zeros((0, 3)), pts):
+        for boundary in ("fixed", "free", "box"):
+            with pytest.raises(geode.InputError, match="no hexes"):
+                geode.smooth(points, np.zeros((0, 8), dtype=np.int32), boundary=boundary)
+    with pytest.raises(geode.InputError, match="no quads"):
+        geode.smooth(np.zeros((0, 2)), np.zeros((0, 4), dtype=np.int32))
+
+
+def test_points_not_finite_are_refused_by_number():
+    pts, hexes = grid(1, 1, 1)
+    pts[5] = [np.nan, 0, 0]
+    for f in (geode.quality, geode.check, geode.smooth):
+        with pytest.raises(geode.InputError, match="point 5 .* is not finite"):
+            f(pts, hexes)
+
+
 def test_isomorphism_of_renumbered_grid():
     _, hexes = grid(2, 2, 1)
     rng = np.random.default_rng(1)
