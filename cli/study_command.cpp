@@ -291,16 +291,17 @@ void add_study_commands(CLI::App& app) {
       "corners",
       "The transition at hex-part edges and corners: per demo model (nugget, lshape, potting,\n"
       "cylinder, wedges of 60 to 300 degrees), dihedral angle and corner kind, the geode hexes'\n"
-      "min scaled Jacobian with --smooth none and the defaults, and its ratio to the local\n"
-      "yardstick (a table; with -o the CSV notebooks-data/plot.py draws)");
+      "min scaled Jacobian with --smooth none, the defaults and --smooth global, and its ratio\n"
+      "to the local yardstick with the defaults (a table; with -o the CSV notebooks-data/plot.py\n"
+      "draws)");
   corners->add_option("-n", ca->n, "demo model size (default 3), in [2, 8]")
       ->check(CLI::Range(2, 8));
   corners->add_option("-o,--output", ca->output, "CSV output (default: a table on stdout)");
   corners
       ->add_option("--buffer-side", ca->buffer_side,
                    "the part every model's buffer layer is carved from (as geode conform's "
-                   "--buffer-side; not given: as geode conform chooses); the run with "
-                   "--smooth none is given the part the defaults' run took")
+                   "--buffer-side; not given: as geode conform chooses); the runs with "
+                   "--smooth none and global are given the part the defaults' run took")
       ->check(CLI::IsMember({"hex", "tet"}));
   corners->add_flag("--quiet", ca->quiet, "no progress lines or table on stderr");
   corners->callback([ca] { run_corners(*ca); });

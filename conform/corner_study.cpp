@@ -99,7 +99,7 @@ CornerStudy corner_study(const std::vector<CornerStudyModel>& models, int n,
     CornerStudyModelSummary s;
     s.name = name;
     primal::Model input;
-    ConformResult a, b;
+    ConformResult a, b, g;
     try {
       input = make();
     } catch (const std::exception& e) {
@@ -116,18 +116,22 @@ CornerStudy corner_study(const std::vector<CornerStudyModel>& models, int n,
         set_buffer_side(none, buffer_side_name(b.buffer_side));
         none.smooth = ConformSmooth::kNone;
         a = conform(input, none);
+        ConformOptions global = none;
+        global.smooth = ConformSmooth::kGlobal;
+        g = conform(input, global);
       } catch (const std::exception& e) {
         s.failure = std::string("refused: ") + e.what();
       }
     if (s.failure.empty()) {
       const auto classes = classify_interface_quads(input, primal::find_interface(input));
-      const auto before = geode_minima(a), after = geode_minima(b);
+      const auto before = geode_minima(a), after = geode_minima(b), global = geode_minima(g);
       std::map<std::tuple<std::string, double>, CornerStudyRow> rows;
       for (std::size_t q = 0; q < classes.size() && q < after.size(); ++q) {
         CornerStudyRow& r = rows[{classes[q].kind, classes[q].angle}];
         ++r.buffer_hexes;
         r.min_none = std::min(r.min_none, before[q]);
         r.min_default = std::min(r.min_default, after[q]);
+        r.min_global = std::min(r.min_global, global[q]);
         r.min_local_yardstick = std::min(r.min_local_yardstick, b.local_yardstick[q]);
         r.min_local_ratio = std::min(r.min_local_ratio, after[q] / b.local_yardstick[q]);
         r.min_capped_ratio = std::min(
@@ -141,8 +145,10 @@ CornerStudy corner_study(const std::vector<CornerStudyModel>& models, int n,
       s.buffer_side = b.buffer_side;
       s.valid_none = a.validity.ok();
       s.valid_default = b.validity.ok();
+      s.valid_global = g.validity.ok();
       s.seconds_none = a.seconds;
       s.seconds_default = b.seconds;
+      s.seconds_global = g.seconds;
       s.patches = static_cast<int>(b.smoothing.patches);
     }
     study.models.push_back(s);
@@ -153,22 +159,23 @@ CornerStudy corner_study(const std::vector<CornerStudyModel>& models, int n,
 
 void write_corner_csv(std::ostream& out, const CornerStudy& study) {
   out << "model,n,kind,angle,buffer_hexes,min_sj_none,min_sj_default,min_local_ratio_default,"
-         "min_local_yardstick,min_capped_ratio_default\n";
+         "min_local_yardstick,min_capped_ratio_default,min_sj_global\n";
   for (const auto& r : study.rows)
     out << r.model << "," << study.n << "," << r.kind << "," << r.angle << "," << r.buffer_hexes
         << "," << r.min_none << "," << r.min_default << "," << r.min_local_ratio << ","
-        << r.min_local_yardstick << "," << r.min_capped_ratio << "\n";
+        << r.min_local_yardstick << "," << r.min_capped_ratio << "," << r.min_global << "\n";
 }
 
 void write_corner_table(std::ostream& out, const CornerStudy& study) {
   char line[256];
-  std::snprintf(line, sizeof line, "%-10s %-15s %6s %6s %9s %9s %9s %9s %9s\n", "model", "kind",
-                "angle", "count", "none", "default", "x local", "local", "x capped");
+  std::snprintf(line, sizeof line, "%-10s %-15s %6s %6s %9s %9s %9s %9s %9s %9s\n", "model", "kind",
+                "angle", "count", "none", "default", "x local", "local", "x capped", "global");
   out << line;
   for (const auto& r : study.rows) {
-    std::snprintf(line, sizeof line, "%-10s %-15s %6.0f %6d %9.3f %9.3f %9.2f %9.3f %9.2f\n",
+    std::snprintf(line, sizeof line, "%-10s %-15s %6.0f %6d %9.3f %9.3f %9.2f %9.3f %9.2f %9.3f\n",
                   r.model.c_str(), r.kind.c_str(), r.angle, r.buffer_hexes, r.min_none,
-                  r.min_default, r.min_local_ratio, r.min_local_yardstick, r.min_capped_ratio);
+                  r.min_default, r.min_local_ratio, r.min_local_yardstick, r.min_capped_ratio,
+                  r.min_global);
     out << line;
   }
   for (const auto& s : study.models) {
@@ -177,10 +184,11 @@ void write_corner_table(std::ostream& out, const CornerStudy& study) {
       continue;
     }
     std::snprintf(line, sizeof line,
-                  "%-10s carved from the %s part, valid %s / %s, %.2f s / %.2f s (none / "
-                  "default), smoothing %d patches\n",
+                  "%-10s carved from the %s part, valid %s / %s / %s, %.2f s / %.2f s / %.2f s "
+                  "(none / default / global), smoothing %d patches (default)\n",
                   s.name.c_str(), buffer_side_name(s.buffer_side), s.valid_none ? "yes" : "NO",
-                  s.valid_default ? "yes" : "NO", s.seconds_none, s.seconds_default, s.patches);
+                  s.valid_default ? "yes" : "NO", s.valid_global ? "yes" : "NO", s.seconds_none,
+                  s.seconds_default, s.seconds_global, s.patches);
     out << line;
   }
 }

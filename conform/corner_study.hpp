@@ -1,9 +1,9 @@
 #pragma once
 // The transition at hex-part edges and corners (issue 22): per dihedral angle and corner kind,
 // the lowest scaled Jacobian of the geode hexes before smoothing (--smooth none) and after it
-// (the defaults), their lowest ratio to the local yardstick (ConformResult::local_yardstick)
-// and the lowest local yardstick there. `geode study corners` and bench_transition_study print
-// it; notebooks-data/plot.py draws its CSV.
+// (the defaults, and --smooth global), their lowest ratio to the local yardstick
+// (ConformResult::local_yardstick) and the lowest local yardstick there. `geode study corners` and
+// bench_transition_study print it; notebooks-data/plot.py draws its CSV.
 //
 // Classes. Every interface edge shared by two interface quads has a dihedral angle measured
 // inside the hex part (180: flat; below: convex; above: concave). A node where three or more
@@ -46,6 +46,7 @@ struct CornerStudyRow {
   double angle = 180.0;
   int buffer_hexes = 0;
   double min_none = 1.0, min_default = 1.0;  // geode hexes' minimum, --smooth none / defaults
+  double min_global = 1.0;                   // the same with --smooth global
   double min_local_ratio = 1e9;              // defaults: min of geode minimum / local yardstick
   double min_local_yardstick = 1.0;
   // Defaults: min of geode minimum / min(local yardstick, ConformResult::template_ceiling): at
@@ -57,8 +58,8 @@ struct CornerStudyModelSummary {
   std::string name;
   std::string failure;                        // not built or refused: why (no rows then)
   BufferSide buffer_side = BufferSide::kHex;  // the defaults' (the run without smoothing: the same)
-  bool valid_none = false, valid_default = false;
-  double seconds_none = 0.0, seconds_default = 0.0;
+  bool valid_none = false, valid_default = false, valid_global = false;
+  double seconds_none = 0.0, seconds_default = 0.0, seconds_global = 0.0;
   int patches = 0;  // smoothing patches with the defaults
 };
 
@@ -68,16 +69,16 @@ struct CornerStudy {
   std::vector<CornerStudyModelSummary> models;
 };
 
-// Conforms each model twice (--smooth none and the defaults) and classes its buffer hexes.
-// `n` is only recorded (the models are built at their own size). `done` is called after each
-// model. `side`: the buffer side the defaults' run takes (chosen, as --buffer-side is; "":
-// automatic); the run without smoothing is given the side that one took.
+// Conforms each model three times (the defaults, --smooth none and --smooth global) and classes
+// its buffer hexes. `n` is only recorded (the models are built at their own size). `done` is
+// called after each model. `side`: the buffer side the defaults' run takes (chosen, as
+// --buffer-side is; "": automatic); the other two runs are given the side that one took.
 CornerStudy corner_study(const std::vector<CornerStudyModel>& models, int n,
                          const std::function<void(const CornerStudyModelSummary&)>& done = {},
                          const std::string& side = "");
 
 // model,n,kind,angle,buffer_hexes,min_sj_none,min_sj_default,min_local_ratio_default,
-// min_local_yardstick,min_capped_ratio_default
+// min_local_yardstick,min_capped_ratio_default,min_sj_global
 void write_corner_csv(std::ostream& out, const CornerStudy& study);
 // The same as a table, with one summary line per model.
 void write_corner_table(std::ostream& out, const CornerStudy& study);

@@ -212,12 +212,14 @@ def corners():
         x = [float(r["angle"]) for r in sel]
         ax.scatter(x, [float(r["min_sj_none"]) for r in sel], facecolors="none", edgecolors=colours[kind], s=28)
         ax.scatter(x, [float(r["min_sj_default"]) for r in sel], color=colours[kind], s=18, label=kind)
+        ax.scatter(x, [float(r["min_sj_global"]) for r in sel], color=colours[kind], marker="+", s=30)
     ax.axhline(0.25, color="k", lw=0.6, ls="--")
     ax.text(62, 0.255, "target 0.25", fontsize=7)
     ax.set_xlabel("dihedral angle inside the hex part (degrees; 180 flat)")
     ax.set_ylabel("min scaled Jacobian of the geode hexes")
-    ax.set_title("Transition at hex-part edges and corners (open: --smooth none, filled: defaults;\n"
-                 "nugget, lshape, potting, cylinder, demo_wedge at n = 3; geode study corners)", fontsize=9)
+    ax.set_title("Transition at hex-part edges and corners (open: --smooth none, filled: defaults,\n"
+                 "+: --smooth global; nugget, lshape, potting, cylinder, demo_wedge at n = 3; geode study corners)",
+                 fontsize=9)
     ax.legend(fontsize=7, loc="lower right")
     ax.set_ylim(0, 0.5)
     save(fig, "transition-corners.png")

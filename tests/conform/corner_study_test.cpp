@@ -44,11 +44,13 @@ TEST_CASE("corner study: geode hexes at lshape's 90-degree convex edge reach 0.2
   CHECK(s.models[0].failure.empty());
   CHECK(s.models[0].valid_none);
   CHECK(s.models[0].valid_default);
+  CHECK(s.models[0].valid_global);
   bool edge = false;
   for (const auto& r : s.rows) {
     CAPTURE(r.kind);
     CHECK(r.min_none > 0.0);
     CHECK(r.min_default >= 0.25);  // measured 0.270 at the edge, 0.319 flat
+    CHECK(r.min_global >= 0.25);   // measured 0.282 at the edge
     // The capped ratio divides by a cap at most the local yardstick: never below the ratio.
     CHECK(r.min_capped_ratio >= r.min_local_ratio);
     CHECK(r.min_capped_ratio < 1e9);
