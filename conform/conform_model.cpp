@@ -77,6 +77,41 @@ constexpr double kPoorHoles = 1.0;
 // minimum (the same element lowest in both, away from the transition) the higher capped ratio
 // is kept.
 constexpr double kPoorTransition = 0.9;
+// A block below this x its own elements diced alone has been spoilt by the transition it
+// received (issue 22's target for each part's block). Carved from a hex part, the geode hexes
+// join the part's block and reach the template's own minimum at best (0.33), so a part diced
+// near 1 falls short wherever it is convex at some interface corner; there the tet part's layer
+// is tried too, and kept where it spoils no block while its output's minimum is at least
+// kPartTrade x the hex part's. The potting demo: n = 3, parts 0.197-0.36 x -> 0.79-0.92 x, the
+// output's minimum 0.0392 -> 0.0688 (higher anyway); n = 5, 0.19-0.40 x -> 0.80-0.96 x for
+// 0.0718 -> 0.0688 (0.96 x); demo_wedge at 300 degrees, its part 0.18 x -> 0.84 x for 0.1631 ->
+// 0.1623.
+constexpr double kPartKept = 0.5;
+constexpr double kPartTrade = 0.9;
+
+// The block of `r` lowest against its own elements diced alone, and that ratio (none: 1).
+std::pair<const BlockQuality*, double> lowest_block(const ConformResult& r) {
+  std::pair<const BlockQuality*, double> low{nullptr, 1.0};
+  for (const BlockQuality& q : r.quality)
+    if (q.report.num_hexes > 0 && q.input_diced_min_scaled_jacobian > 0.0) {
+      const double ratio = block_min_scaled_jacobian(q.report) / q.input_diced_min_scaled_jacobian;
+      if (ratio < low.second) low = {&q, ratio};
+    }
+  return low;
+}
+
+// Whether some block of `r` lies below kPartKept x its own elements diced alone.
+bool spoils_a_block(const ConformResult& r) { return lowest_block(r).second < kPartKept; }
+
+// "block 3 'pin_x' at 0.2 x its own elements diced alone"
+std::string lowest_block_text(const ConformResult& r) {
+  const auto [q, ratio] = lowest_block(r);
+  if (!q) return "every block at 1 x its own elements diced alone";
+  std::ostringstream m;
+  m << "block " << q->block << (q->name.empty() ? "" : " '" + q->name + "'") << " at " << ratio
+    << " x its own elements diced alone";
+  return m.str();
+}
 
 // How flat a hex is: the mean length of its edges along its flattest direction over that along
 // its longest.
@@ -128,9 +163,7 @@ class ModelConformer {
     if (write_ahead_)
       options_.write_ahead = [this](const primal::Model& m, std::span<const double> sj) {
         if (compared_ || (!holes_.hexes.empty() && !layer_kept_) ||
-            (conformer_ &&
-             (conformer_->near_thin() > 0.0 ||
-              (conformer_->convex_hex_part() && conformer_->local_ratio() < kPoorTransition)))) {
+            (conformer_ && (conformer_->near_thin() > 0.0 || conformer_->convex_hex_part()))) {
           deferred_ = true;
           return;
         }
@@ -424,7 +457,8 @@ ConformResult ModelConformer::from_tets(ConformResult r) {
   const bool thin =
       near_thin_ > 0.0 &&
       (!valid || (automatic && (tets_cross_ ? hex_min < r.yardstick() : short_of_aim)));
-  const bool convex = convex_hex_part_ && valid && short_of_aim;
+  const bool spoilt = valid && spoils_a_block(r);
+  const bool convex = convex_hex_part_ && valid && (short_of_aim || spoilt);
   if (!thin && !convex) return r;
   if (options_.progress)
     options_.progress(
@@ -432,8 +466,9 @@ ConformResult ModelConformer::from_tets(ConformResult r) {
                              "invalid; the tet part's layer tried")
                : std::string("buffer layer: from the hex part's ") +
                      (thin ? "thin cells" : "convex corners") + " the geode hexes reach " +
-                     std::to_string(r.capped_local_ratio) +
-                     " x their capped local yardstick; the tet part's layer tried too");
+                     std::to_string(r.capped_local_ratio) + " x their capped local yardstick" +
+                     (spoilt ? ", " + lowest_block_text(r) : std::string()) +
+                     "; the tet part's layer tried too");
   // The same pass from the tet part (at its default thickness): the tets relaxed again from the
   // points as given.
   restore_given();
@@ -451,9 +486,12 @@ ConformResult ModelConformer::from_tets(ConformResult r) {
     return r;
   }
   // The higher minimum; on a tie (the same element lowest in both, away from the interface)
-  // the transition nearer its aim. The first on a tie of both.
+  // the transition nearer its aim. The first on a tie of both. A block the hex part's spoils
+  // and the tet part's does not is worth kPartTrade of the minimum.
   const double tet_min = output_min_scaled_jacobian(t);
-  const bool better = !valid || tet_min > hex_min ||
+  const bool keeps_parts = convex && !crossing && spoilt && result_valid(t) && !spoils_a_block(t) &&
+                           tet_min >= kPartTrade * hex_min;
+  const bool better = !valid || tet_min > hex_min || keeps_parts ||
                       (tet_min == hex_min && t.capped_local_ratio > r.capped_local_ratio);
   if (!joining.empty() || t.buffer_side != BufferSide::kTet || !result_valid(t) || !better) {
     if (options_.progress) options_.progress("buffer layer: the hex part's kept");
@@ -470,8 +508,10 @@ ConformResult ModelConformer::from_tets(ConformResult r) {
     m << "at the hex part's convex corners its buffer hexes taper, and from it ";
   if (valid)
     m << "the output's minimum scaled Jacobian was " << hex_min << ", its geode hexes "
-      << r.capped_local_ratio << " x their capped local yardstick; from the tet part " << tet_min
-      << " and " << t.capped_local_ratio << " x";
+      << r.capped_local_ratio << " x their capped local yardstick"
+      << (spoilt ? ", " + lowest_block_text(r) : std::string()) << "; from the tet part " << tet_min
+      << " and " << t.capped_local_ratio << " x"
+      << (spoilt ? ", " + lowest_block_text(t) : std::string());
   else
     m << "the output was invalid (" << invalid_reason(r) << "); from the tet part " << tet_min;
   if (crossing)

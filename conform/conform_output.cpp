@@ -287,9 +287,7 @@ void Conformer::output() {
 // (check_validity, the full quality report) read mesh_: those run before the writer.
 void Conformer::verify_and_output() {
   t0_ = Clock::now();
-  // The geode hexes against their local yardstick, before the writer may start: conform()
-  // defers it where that falls short and another layer may be tried (convex_hex_part()); the
-  // report reads it too.
+  // The geode hexes against their local yardstick (the report's uncapped ratio).
   for (std::size_t b = 0; b + 1 < geode_first_.size(); ++b) {
     const double local =
         res_.local_yardstick[primal::index_cast<std::size_t>(layer_.hexes[b].quad)];

@@ -3,6 +3,7 @@
 #include <geode/parallel/detail/distributor.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <thread>
@@ -20,8 +21,8 @@ constexpr double kReferenceChildren = 2500000.0;
 
 // The serial run's yardstick is the lowest element of each kind diced alone over the whole
 // model: each rank measures a run of the elements (a contiguous one: no partition is needed
-// yet, and neighbours share nodes in memory), and the lowest of each kind outside the rings
-// selected before (select_rings) join the zone. conform's aims measure against the lowest
+// yet, and neighbours share nodes in memory), and the lowest of each kind and block outside the
+// rings selected before (select_rings) join the zone. conform's aims measure against the lowest
 // element over its model, tets as relaxed near the transition: the zone's own (its rings hold
 // every tet the relaxation moves) and, outside it, as given. With the lowest overall instead,
 // the zone's aims were higher than the serial run's where the lowest tet as relaxed lay outside
@@ -35,15 +36,35 @@ constexpr double kReferenceChildren = 2500000.0;
 // than the others: they are the one stage of its critical path that does not wait for the zone
 // (with 2 ranks, rank 0 then waits that much less for it).
 void Distributor::yardstick() {
-  struct {
+  // Per kind and block: conform compares each block's minimum with its own elements diced alone
+  // (where a hex part's transition spoils a block, the tets' layer is tried), so the zone holds
+  // the lowest of each block too. The blocks, ascending, are the same on every rank.
+  struct Low {
     double value;
     int cell;
-  } low[3], all[3];
-  for (auto& l : low) l = {2.0, std::numeric_limits<int>::max()};
+  };
+  std::array<std::vector<int>, 3> blocks;
+  const std::array<ElementKind, 3> kinds{ElementKind::kHex, ElementKind::kTet, ElementKind::kWedge};
+  for (std::size_t k = 0; k < 3; ++k) {
+    const auto kind = kinds[k];
+    for (std::size_t i = 0; i < primal::element_count(m(), kind); ++i)
+      blocks[k].push_back(primal::block_of(m(), {kind, primal::index_cast(i)}));
+    std::sort(blocks[k].begin(), blocks[k].end());
+    blocks[k].erase(std::unique(blocks[k].begin(), blocks[k].end()), blocks[k].end());
+  }
+  std::array<std::size_t, 4> first{};  // kind k's slots: [first[k], first[k + 1])
+  for (std::size_t k = 0; k < 3; ++k) first[k + 1] = first[k] + blocks[k].size();
+  std::vector<Low> low(first[3], Low{2.0, std::numeric_limits<int>::max()}), all(first[3]);
   std::vector<int> inverted;
-  const auto consider = [&](int k, std::size_t c, double v) {
+  const auto consider = [&](std::size_t k, std::size_t c, double v) {
     const int cell = primal::index_cast<int>(c);
-    if (level_[c] < 0 && v < low[k].value) low[k] = {v, cell};  // in order: ties to the first
+    if (level_[c] < 0) {
+      const int block = primal::block_of(m(), ref(c));
+      Low& l = low[first[k] + static_cast<std::size_t>(
+                                  std::lower_bound(blocks[k].begin(), blocks[k].end(), block) -
+                                  blocks[k].begin())];
+      if (v < l.value) l = {v, cell};  // in order: ties to the first
+    }
     if (v <= 0.0) inverted.push_back(cell);
   };
   const std::size_t nh = m().hexes.size(), nt = m().tets.size(), nw = m().wedges.size();
@@ -93,7 +114,8 @@ void Distributor::yardstick() {
     consider(2, cell_of(ElementKind::kWedge, i),
              primal::diced_wedge_min_scaled_jacobian(m().points, std::span(&m().wedges[i], 1)));
   if (references_built.joinable()) references_built.join();
-  MPI_Allreduce(low, all, 3, MPI_DOUBLE_INT, MPI_MINLOC, comm_);
+  MPI_Allreduce(low.data(), all.data(), primal::index_cast<int>(low.size()), MPI_DOUBLE_INT,
+                MPI_MINLOC, comm_);
   for (const auto& a : all)
     if (a.value <= 1.5) lowest_.push_back(primal::index_cast<std::size_t>(a.cell));
   const std::vector<int> every = gather_all(inverted, comm_);

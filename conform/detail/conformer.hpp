@@ -97,12 +97,9 @@ class Conformer {
   bool tets_cross() const { return tets_cross_; }
   // Where the layer was carved, automatically, from a hex part convex at some interface corner
   // (BufferLayerReport::convex_corners), not nearly thin: its buffer hexes taper there, and
-  // conform() tries the tet part's layer too where the geode hexes fall short. The input is then
-  // kept, as for near_thin().
+  // conform() tries the tet part's layer too where the geode hexes fall short or spoil a block.
+  // The input is then kept, as for near_thin().
   bool convex_hex_part() const { return convex_hex_part_; }
-  // The geode hexes' lowest ratio to their local yardstick (uncapped: never above the capped
-  // ratio), known once smoothing is done, before the output is written.
-  double local_ratio() const { return res_.local_yardstick_ratio; }
 
   ConformResult run() {
     const auto t_start = Clock::now();

@@ -299,8 +299,9 @@ class Distributor {
   // flat element of the model the stages read; none when a rank gave none (rank 0 then pairs
   // the faces itself).
   std::vector<std::array<Index, 2>> pairs_;
-  // Per kind the element diced alone lowest of those outside the zone's first rings (the zone
-  // takes them: the serial run's yardstick, and its aims', are the lowest over the whole model).
+  // Per kind and block the element diced alone lowest of those outside the zone's first rings
+  // (the zone takes them: the serial run's yardstick, its aims and each block's own figure are
+  // the lowest over the whole model).
   std::vector<std::size_t> lowest_;
   std::vector<std::size_t> inverted_;  // elements diced with a scaled Jacobian <= 0
   std::vector<signed char> level_;     // per flat element: ring in the zone, -1 outside
