@@ -47,8 +47,11 @@ void Distributor::yardstick() {
   const std::array<ElementKind, 3> kinds{ElementKind::kHex, ElementKind::kTet, ElementKind::kWedge};
   for (std::size_t k = 0; k < 3; ++k) {
     const auto kind = kinds[k];
-    for (std::size_t i = 0; i < primal::element_count(m(), kind); ++i)
-      blocks[k].push_back(primal::block_of(m(), {kind, primal::index_cast(i)}));
+    const std::vector<int>& ids = primal::element_blocks(m(), kind);  // empty: the default
+    if (ids.empty() && primal::element_count(m(), kind) > 0)
+      blocks[k].push_back(primal::default_block(kind));
+    for (int id : ids)  // a block's elements come in runs: few to sort
+      if (blocks[k].empty() || blocks[k].back() != id) blocks[k].push_back(id);
     std::sort(blocks[k].begin(), blocks[k].end());
     blocks[k].erase(std::unique(blocks[k].begin(), blocks[k].end()), blocks[k].end());
   }
