@@ -109,8 +109,9 @@ SmoothResult smooth_hex_mesh(HexMesh& mesh, std::span<const NodeConstraint> cons
                              const SmoothOptions& options = {});
 
 // The same for a quad mesh lying in a plane with normal `normal` (quads counter-clockwise seen
-// from it; InvalidInput on no quads). Every node also stays in its plane: a free node moves in the plane, a plane
-// constraint becomes the line where the two planes meet, a line must lie in the plane.
+// from it; InvalidInput on no quads). Every node also stays in its plane: a free node moves in the
+// plane, a plane constraint becomes the line where the two planes meet, a line must lie in the
+// plane.
 SmoothResult smooth_quad_mesh(QuadMesh& mesh, const Point& normal,
                               std::span<const NodeConstraint> constraints = {},
                               const SmoothOptions& options = {});
