@@ -26,6 +26,13 @@ namespace fs = std::filesystem;
 
 std::string version_text() { return std::string("geode ") + GEODE_VERSION; }
 
+std::string one_line(std::string s) {
+  for (char& c : s)
+    if (c == '\n' || c == '\r') c = ' ';
+  while (!s.empty() && s.back() == ' ') s.pop_back();
+  return s;
+}
+
 namespace {
 
 // Shortest text of a limit for messages ("64", "1e+06").

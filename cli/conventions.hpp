@@ -37,6 +37,8 @@ struct InvalidResult : std::runtime_error {
 
 // "geode 0.1.0" (CMake's project version).
 std::string version_text();
+// `s` on one line (CLI11's messages may span several): line breaks as spaces, no trailing ones.
+std::string one_line(std::string s);
 
 // ---- Numbers ----------------------------------------------------------------------------------
 

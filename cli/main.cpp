@@ -17,13 +17,7 @@
 
 namespace {
 
-// One line: CLI11's messages may span several.
-std::string one_line(std::string s) {
-  for (char& c : s)
-    if (c == '\n' || c == '\r') c = ' ';
-  while (!s.empty() && s.back() == ' ') s.pop_back();
-  return s;
-}
+using geode::cli::one_line;
 
 // A worker thread that could not be started: TBB reports pthread_create's failure as a
 // std::runtime_error ("pthread_create has failed: Resource temporarily unavailable"), std::thread

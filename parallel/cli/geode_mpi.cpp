@@ -23,6 +23,8 @@
 #include <tbb/task_arena.h>
 
 #include <geode/conform/buffer_layer.hpp>
+#include <geode/io/atomic_file.hpp>
+#include <geode/io/nemesis_set.hpp>
 #include <geode/io/read_model.hpp>
 #include <geode/io/read_warnings.hpp>
 #include <geode/parallel/distributed_conform.hpp>
@@ -143,9 +145,27 @@ struct RankZeroReadWarnings {
   }
 };
 
+// The outputs, before any work: Exodus pieces OUT.exo.N.r (and OUT.exo with --join) in a
+// writable directory, none of them the input or a piece of the input's Nemesis set (geode_mpi
+// has no --force: it would overwrite what it reads).
+void check_outputs(const std::string& output, const std::string& input, int size, bool join) {
+  if (output.empty() || output == "-")
+    throw InvalidInput("-o '" + output + "': the pieces are Exodus files: give -o OUT.exo");
+  cli::check_output_path(output);
+  cli::output_format(output, "", {"exo"}, "");
+  std::vector<std::string> inputs{input};
+  if (const auto set = io::find_nemesis_set(input))
+    for (const auto& f : set->files) inputs.push_back(f.string());
+  for (const std::string& in : inputs) {
+    if (join) cli::check_not_input(output, in);
+    for (int r = 0; r < size; ++r) cli::check_not_input(parallel::rank_file(output, size, r), in);
+  }
+}
+
 int run(int argc, char** argv, int rank, int size) {
   CLI::App app{"geode conform under MPI: mpirun -np N geode_mpi conform INPUT -o OUT.exo"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", cli::version_text(), "print the version and exit");
   CLI::App* conform = app.add_subcommand("conform", "conform a hex + tet model, partitioned");
   std::string input, output, smooth = "local", side, verify = "local";  // side: automatic
   bool join = false, quiet = false;
@@ -195,7 +215,8 @@ int run(int argc, char** argv, int rank, int size) {
                        std::to_string(max_rings) + ")")
       ->check(CLI::Range(1, max_rings))
       ->capture_default_str();
-  conform->add_option("--threads", threads, "TBB threads per rank (default 1: one core each)");
+  conform->add_option("--threads", threads, "TBB threads per rank (default 1: one core each)")
+      ->check(CLI::Range(1, 4096));
   conform
       ->add_option(
           "--zone-threads", zone_threads,
@@ -209,8 +230,16 @@ int run(int argc, char** argv, int rank, int size) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    if (rank == 0) app.exit(e);
-    return e.get_exit_code() == 0 ? 0 : 2;
+    if (e.get_exit_code() == 0) {  // --help, --version
+      if (rank == 0) app.exit(e);
+      return 0;
+    }
+    // One line, as geode's (cli/main.cpp), from the first rank only.
+    const std::string cmd = app.get_subcommands().empty() ? "geode_mpi" : "geode_mpi conform";
+    if (rank == 0)
+      std::cerr << cmd << ": usage error: " << cli::one_line(e.what()) << " (see " << cmd
+                << " --help)\n";
+    return 2;
   }
   // The rank's own work runs in an arena of `threads`; the zone's conform in one of its own,
   // which may take every CPU of the machine (DistributedOptions::zone_threads): the process's
@@ -228,6 +257,7 @@ int run(int argc, char** argv, int rank, int size) {
   const auto conform_in_arena = [&]() -> int {
     try {
       cli::check_buffer_thickness(thickness, side);
+      check_outputs(output, input, size, join);
       const double t0 = MPI_Wtime();
       parallel::DistributedOptions options;
       options.conform.smooth = conform::parse_conform_smooth(smooth);
@@ -361,6 +391,9 @@ int main(int argc, char** argv) {
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   MPI_Comm_dup(MPI_COMM_WORLD, &agreement);
+  // An interrupted rank removes its hidden temporaries (io/atomic_file.hpp), as geode does:
+  // mpirun passes SIGINT and SIGTERM on to the ranks as SIGTERM.
+  io::install_signal_cleanup();
   const int code = run(argc, argv, rank, size);  // every rank's worst (agree())
   MPI_Comm_free(&agreement);
   MPI_Finalize();

@@ -108,4 +108,27 @@ for args in "--smooth global" "--buffer-side wedge" "--rings 0" "--rings 65" \
   if ls refused.exo* >/dev/null 2>&1; then echo "conform $args: wrote a file"; exit 1; fi
 done
 grep -q "with --buffer-side tet: at most 0.45" err.txt
-echo "mpi_verify_test: both modes pass the result and find the broken dicing on 1 and 2 ranks, an invalid zone on 1 to 3, a refused share of the read on 2 and 3, a rank failing alone on 2 and 3, options out of range refused"
+for threads in 0 4097; do  # a usage error on one line (CLI11's two, unprefixed, before)
+  status=0
+  timeout 120 "$mpiexec" -np 1 "$geode_mpi" conform in.exo -o refused.exo --threads "$threads" \
+    2>err.txt >/dev/null || status=$?
+  [ "$status" = 2 ] || { echo "--threads $threads: exited $status, not 2"; cat err.txt; exit 1; }
+  [ "$(wc -l <err.txt)" = 1 ] && grep -q "^geode_mpi conform: usage error: --threads" err.txt
+done
+# Outputs checked before any work (a fault hunt's: -o IN --join overwrote the input, exit 0; -o
+# m.msh, -o - and -o '' wrote Exodus pieces named m.msh.2.0, -.2.0, .2.0): refused, the input
+# untouched, nothing written; so is an output whose pieces are the input set's.
+cp in.exo keep.exo
+"$mpiexec" --oversubscribe -np 2 "$geode_mpi" conform in.exo -o set.exo -q
+for args in "-o in.exo --join" "-o m.msh" "-o -" "-o ''" "-o ." "-o set.exo"; do
+  status=0
+  input=in.exo
+  [ "$args" = "-o set.exo" ] && input=set.exo.2.0
+  # shellcheck disable=SC2086
+  eval timeout 120 "$mpiexec" --oversubscribe -np 2 "$geode_mpi" conform "$input" $args -q \
+    2>err.txt >/dev/null || status=$?
+  [ "$status" = 2 ] || { echo "conform $args: exited $status, not 2"; cat err.txt; exit 1; }
+  if ls m.msh* ./-* .2.* >/dev/null 2>&1; then echo "conform $args: wrote a file"; exit 1; fi
+done
+cmp in.exo keep.exo
+echo "mpi_verify_test: both modes pass the result and find the broken dicing on 1 and 2 ranks, an invalid zone on 1 to 3, a refused share of the read on 2 and 3, a rank failing alone on 2 and 3, options out of range and outputs that are not Exodus files or are the input refused"
