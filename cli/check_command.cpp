@@ -150,7 +150,7 @@ void add_check_command(CLI::App& app) {
                 "boundary quads whose normals differ by less than this many degrees (and that lie "
                 "in one plane)\n"
                 "form one planar boundary face")
-      ->check(CLI::Range(0.0, 90.0))
+      ->check(number_check(0.0, 90.0))
       ->capture_default_str();
   c->callback([a] { run_check(*a); });
 }

@@ -430,6 +430,8 @@ void add_conform_commands(CLI::App& app) {
       check_output_path(dargs->save_input);
       save_format = output_format(dargs->save_input, "", mesh_format_names(), "");
     }
+    check_distinct_outputs(
+        {{"-o", dargs->output}, {"--report", dargs->report}, {"--save-input", dargs->save_input}});
     primal::Model model = demo_module().model(dargs->model, dargs->n);
     // The read-time check, as on a file: --verify local (the default) takes the diced parts of a
     // checked input as valid by construction.

@@ -9,6 +9,7 @@
 #include <map>
 #include <optional>
 #include <sstream>
+#include <string_view>
 
 #include <geode/conform/buffer_layer.hpp>
 #include <geode/io/atomic_file.hpp>
@@ -55,6 +56,7 @@ struct FormatInfo {
   std::string name;
   std::vector<std::string> extensions;
   bool mesh;
+  bool file_only = false;  // not written to standard output (a mesh's is binary or too large)
 };
 
 // The mesh formats that write (io/formats.hpp), then the text formats of the commands.
@@ -63,13 +65,13 @@ const std::vector<FormatInfo>& formats() {
     std::vector<FormatInfo> t;
     for (const io::MeshFormat& f : io::mesh_formats())
       if (f.write)
-        t.push_back({std::string(f.name), {f.extensions.begin(), f.extensions.end()}, true});
+        t.push_back({std::string(f.name), {f.extensions.begin(), f.extensions.end()}, true, true});
     for (FormatInfo text : std::vector<FormatInfo>{{"json", {".json"}, false},
                                                    {"spec", {".json"}, false},
                                                    {"csv", {".csv"}, false},
                                                    {"appendix", {".txt"}, false},
                                                    {"text", {".txt"}, false},
-                                                   {"html", {".html", ".htm"}, false}})
+                                                   {"html", {".html", ".htm"}, false, true}})
       t.push_back(std::move(text));
     return t;
   }();
@@ -162,6 +164,10 @@ std::string output_format(const std::string& path, const std::string& format,
     throw InvalidInput("--format " + format + ": expected one of " + join(allowed));
   if (path.empty() || path == "-") {
     const std::string f = format.empty() ? fallback : format;
+    const FormatInfo* info = find_format(f);
+    if (path == "-" && (!info || info->file_only))  // no fallback: a mesh
+      throw InvalidInput("'-': " + (f.empty() ? std::string("a mesh") : "--format " + f) +
+                         " is written to a file, not to standard output");
     if (is_mesh_format(f)) throw InvalidInput("--format " + f + " needs -o FILE");
     return f;
   }
@@ -279,6 +285,33 @@ void join_block_lists(primal::Model& model, const std::vector<std::string>& list
     primal::join_blocks(model, ids, source);
     for (std::size_t i = 1; i < ids.size(); ++i) joined.emplace(ids[i], list);
   }
+}
+
+// An empty argument (-o "", --report=) was taken as the option not given: a path or name
+// computed by a script that came out empty wrote nothing, or the default, with exit 0. Refused
+// before parsing, as CLI11's usage errors are.
+void refuse_empty_arguments(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view arg = argv[i];
+    if (!arg.empty() && !(arg.starts_with("--") && arg.ends_with("=") && arg.size() > 3)) continue;
+    const std::string option = !arg.empty() ? std::string(arg.substr(0, arg.size() - 1))
+                               : i > 1 && argv[i - 1][0] == '-'
+                                   ? std::string(argv[i - 1])
+                                   : std::string("argument ") + std::to_string(i);
+    throw CLI::ValidationError(option + ": an empty value (leave the option out instead)");
+  }
+}
+
+void check_distinct_outputs(const std::vector<std::pair<std::string, std::string>>& outputs) {
+  for (std::size_t i = 0; i < outputs.size(); ++i)
+    for (std::size_t j = i + 1; j < outputs.size(); ++j) {
+      const auto& [a, p] = outputs[i];
+      const auto& [b, q] = outputs[j];
+      if (p.empty() || q.empty() || p == "-" || q == "-") continue;
+      if (std::filesystem::weakly_canonical(p) == std::filesystem::weakly_canonical(q))
+        throw InvalidInput(q + ": given to both " + a + " and " + b +
+                           ": one would overwrite the other");
+    }
 }
 
 CLI::Option* add_force_flag(CLI::App* app, bool& flag) {

@@ -20,6 +20,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <geode/io/atomic_file.hpp>
@@ -39,6 +40,9 @@ struct InvalidResult : std::runtime_error {
 std::string version_text();
 // `s` on one line (CLI11's messages may span several): line breaks as spaces, no trailing ones.
 std::string one_line(std::string s);
+// An empty argument (-o "", --report=) is refused (CLI::ValidationError naming the option):
+// CLI11 takes it as the option not given. Call before parsing.
+void refuse_empty_arguments(int argc, char** argv);
 
 // ---- Numbers ----------------------------------------------------------------------------------
 
@@ -89,6 +93,9 @@ void check_not_input(const std::string& output, const std::string& input, bool f
 // the --force hint.
 void check_not_input(const std::string& output, const std::string& input);
 CLI::Option* add_force_flag(CLI::App* app, bool& flag);
+// Outputs given as (option, path): two that are the same file (also through links) would
+// overwrite one another: InvalidInput naming both options. Empty paths and "-" pass.
+void check_distinct_outputs(const std::vector<std::pair<std::string, std::string>>& outputs);
 
 // The mesh formats every command that writes a mesh offers (io/formats.hpp), in table order:
 // exo, msh, msh22, vtu, vtk. quads: those that write planar quad meshes.

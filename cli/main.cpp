@@ -5,6 +5,7 @@
 #include <iostream>
 #include <memory>
 #include <new>
+#include <string>
 #include <string_view>
 #include <system_error>
 
@@ -96,6 +97,7 @@ int main(int argc, char** argv) {
     geode::cli::add_arrange_command(app);
     geode::cli::add_view_command(app);
     geode::cli::add_formats_command(app);
+    geode::cli::refuse_empty_arguments(argc, argv);
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version

@@ -86,6 +86,7 @@ void run_interleave(const InterleaveArgs& a) {
     output_format(*path, "", {"csv"}, "csv");
     check_output_path(*path);
   }
+  check_distinct_outputs({{"-o", a.output}, {"--summary", a.summary}});
   templates::InterleaveStudy study;
   if (!a.spec.empty()) {
     study = spec_study(a);
@@ -168,6 +169,10 @@ void run_shape(const ShapeArgs& a) {
     output_format(*path, "", {"csv"}, "csv");
     check_output_path(*path);
   }
+  check_distinct_outputs({{"-o", a.height_csv},
+                          {"--distorted-csv", a.distorted_csv},
+                          {"--quality-csv", a.quality_csv},
+                          {"--sj-csv", a.sj_csv}});
   const bool any = !a.height_csv.empty() || !a.distorted_csv.empty() || !a.quality_csv.empty() ||
                    !a.sj_csv.empty();
   if (!a.height_csv.empty() || !any) {

@@ -228,6 +228,7 @@ int run(int argc, char** argv, int rank, int size) {
   cli::add_join_blocks_option(conform, join_blocks);
   conform->add_flag("-q,--quiet", quiet, "no progress or summary");
   try {
+    cli::refuse_empty_arguments(argc, argv);
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) {  // --help, --version

@@ -110,6 +110,18 @@ TEST_CASE(
       {"dual " + in.string() + " --rebuild " + d + "r.stl", "unknown output format '.stl'"},
       {"dual " + in.string() + " -o " + d + "r.json --format text", "contradicts"},
       {"study shape -o " + d + "h.txt", "unknown output format '.txt'"},
+      // A fault hunt's: these wrote a file named "-", a mesh to a garbled temporary's name, one
+      // output over the other, or took an empty value as none, all with exit 0 or after the work.
+      {"template geode3d -o - --format html", "--format html is written to a file"},
+      {"dual " + in.string() + " --rebuild -", "a mesh is written to a file"},
+      {"demo -n 2 --save-input " + d + "h.msh -o " + d + "h.msh",
+       "given to both -o and --save-input"},
+      {"study interleave -o " + d + "x.csv --summary " + d + "x.csv",
+       "given to both -o and --summary"},
+      {"study shape -o " + d + "a.csv --distorted-csv " + d + "a.csv",
+       "given to both -o and --distorted-csv"},
+      {"conform " + in.string() + " -o " + d + "out.exo --report=", "--report: an empty value"},
+      {"check " + in.string() + " --planar-angle nan", "'nan' is not a finite number"},
   };
   for (const Case& c : cases) {
     CAPTURE(c.args);
