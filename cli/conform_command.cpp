@@ -138,8 +138,10 @@ std::string check_outputs(const ConformArgs& a) {
 
 // `source` names the input file in the model's own errors (no tet part, no interface, a face
 // that does not conform: they name elements and nodes, not the file); empty for demos.
+// `together`: outputs written already (demo's --save-input), published with the mesh and
+// report, or removed with them.
 void run(primal::Model model, const ConformArgs& a, const std::string& format, bool tables,
-         const std::string& source = {}) {
+         const std::string& source = {}, OutputFiles* together = nullptr) {
   const std::string prefix = source.empty() ? "" : source + ": ";
   Progress progress = Progress::for_stderr(a.quiet);
   if (a.merge_tolerance >= 0) {
@@ -171,7 +173,8 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
   };
   // The mesh is written to its temporary while conform verifies it (ConformOptions::write_ahead),
   // and published (with the report) only if it is valid or --write-invalid asks for it.
-  OutputFiles files;
+  OutputFiles own;
+  OutputFiles& files = together ? *together : own;
   const primal::Model* written = nullptr;
   std::span<const double> written_sj;  // the hexes' scaled Jacobians, while conform keeps them
   std::exception_ptr write_failed;
@@ -436,19 +439,23 @@ void add_conform_commands(CLI::App& app) {
     // The read-time check, as on a file: --verify local (the default) takes the diced parts of a
     // checked input as valid by construction.
     primal::require_single_covering(model, "demo model " + dargs->model);
+    // The input saved to its temporary now (conform consumes the model), published with the
+    // mesh and report: a run that fails writes none of them.
+    OutputFiles files;
+    std::ostringstream saved;
     if (!dargs->save_input.empty()) {
-      OutputFiles files;
-      files.add(dargs->save_input, [&](const fs::path& temp) {
+      files.write(files.add(dargs->save_input, [&](const fs::path& temp) {
         io::write_model(model, temp, save_format, write_options(dargs->encoding));
-      });
-      files.commit();
-      if (!dargs->quiet)
-        std::cout << "wrote " << dargs->save_input << " (" << model.hexes.size() << " hexes, "
-                  << model.tets.size() << " tets, " << model.pyramids.size() << " pyramids, "
-                  << model.wedges.size() << " wedges)\n";
-      if (dargs->output.empty() && dargs->report.empty()) return;
+      }));
+      saved << "wrote " << dargs->save_input << " (" << model.hexes.size() << " hexes, "
+            << model.tets.size() << " tets, " << model.pyramids.size() << " pyramids, "
+            << model.wedges.size() << " wedges)\n";
     }
-    run(std::move(model), *dargs, format, true);
+    if (dargs->output.empty() && dargs->report.empty())
+      files.commit();
+    else
+      run(std::move(model), *dargs, format, true, {}, &files);
+    if (!dargs->quiet) std::cout << saved.str();
   });
 }
 
