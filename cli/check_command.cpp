@@ -37,26 +37,29 @@ struct Checked {
   std::vector<primal::Obstruction> obstructions;
 };
 
-Checked check_hexes(const primal::HexMesh& mesh, const primal::RealizabilityOptions& options) {
+Checked check_hexes(const primal::HexMesh& mesh, const primal::RealizabilityOptions& options,
+                    Index base) {
   Checked c;
   const auto v = primal::check_validity(mesh);
   c.valid = v.ok();
-  c.validity = v.summary();
+  c.validity = v.summary(base);
   c.analysable =
       v.out_of_range_hexes.empty() && v.repeated_node_hexes.empty() && !mesh.hexes.empty();
   if (!c.analysable) return c;
-  const auto q = primal::hex_quality_report(mesh);
+  auto q = primal::hex_quality_report(mesh);
+  for (auto& metric : q.metrics) metric.min_hex += base, metric.max_hex += base;
   c.quality = primal::quality_report_json(q);
   c.quality_text = primal::format_quality_table(q);
   c.obstructions = primal::find_obstructions(mesh, options);
   return c;
 }
 
-Checked check_quads(const primal::QuadMesh& mesh, const primal::RealizabilityOptions& options) {
+Checked check_quads(const primal::QuadMesh& mesh, const primal::RealizabilityOptions& options,
+                    Index base) {
   Checked c;
   const auto v = primal::check_validity(mesh);
   c.valid = v.ok();
-  c.validity = v.summary();
+  c.validity = v.summary(base);
   c.analysable =
       v.out_of_range_quads.empty() && v.repeated_node_quads.empty() && !mesh.quads.empty();
   if (!c.analysable) return c;
@@ -69,9 +72,9 @@ Checked check_quads(const primal::QuadMesh& mesh, const primal::RealizabilityOpt
     hi = std::max(hi, s);
   }
   c.quality = {{"num_quads", mesh.quads.size()},
-               {"scaled_jacobian", {{"min", lo}, {"max", hi}, {"min_quad", at}}}};
+               {"scaled_jacobian", {{"min", lo}, {"max", hi}, {"min_quad", at + base}}}};
   std::ostringstream s;
-  s << "Quad scaled Jacobian: min " << lo << " (quad " << at << "), max " << hi << "\n";
+  s << "Quad scaled Jacobian: min " << lo << " (quad " << at + base << "), max " << hi << "\n";
   c.quality_text = s.str();
   c.obstructions = primal::find_obstructions(mesh, options);
   return c;
@@ -84,14 +87,8 @@ void run_check(const CheckArgs& a) {
   const MeshFile m = read_mesh_file(a.input);
   primal::RealizabilityOptions options;
   options.planar_angle_degrees = a.planar_angle;
-  Checked c = m.dim == 3 ? check_hexes(m.hex, options) : check_quads(m.quad, options);
   const Index base = m.index_base;
-  if (c.quality.contains("num_quads"))
-    c.quality["scaled_jacobian"]["min_quad"] =
-        c.quality["scaled_jacobian"]["min_quad"].get<Index>() + base;
-  if (c.quality.contains("metrics"))
-    for (auto& metric : c.quality["metrics"])
-      for (const char* k : {"min_hex", "max_hex"}) metric[k] = metric[k].get<Index>() + base;
+  Checked c = m.dim == 3 ? check_hexes(m.hex, options, base) : check_quads(m.quad, options, base);
   std::string text;
   if (format == "json") {
     nlohmann::json j;

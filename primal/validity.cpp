@@ -120,22 +120,29 @@ void list(std::ostringstream& os, const char* what, const std::vector<T>& items,
   os << ")\n";
 }
 
-std::string show_index(Index i) { return std::to_string(i); }
-template <std::size_t N>
-std::string show_key(const std::array<Index, N>& k) {
-  std::string s = "{";
-  for (std::size_t i = 0; i < N; ++i) {
-    if (k[i] == kInvalidIndex) break;
-    s += (i ? " " : "") + std::to_string(k[i]);
-  }
-  return s + "}";
+// Each shows numbers from `base` (0, or 1 as a file numbers them).
+auto show_index(Index base) {
+  return [base](Index i) { return std::to_string(i + base); };
 }
-std::string show_coverage(const NodeCoverage& c) {
-  std::ostringstream os;
-  os.precision(3);
-  os << c.node << ": " << c.angle / std::numbers::pi << " pi, not " << c.expected / std::numbers::pi
-     << " pi";
-  return os.str();
+template <std::size_t N>
+auto show_key(Index base) {
+  return [base](const std::array<Index, N>& k) {
+    std::string s = "{";
+    for (std::size_t i = 0; i < N; ++i) {
+      if (k[i] == kInvalidIndex) break;
+      s += (i ? " " : "") + std::to_string(k[i] + base);
+    }
+    return s + "}";
+  };
+}
+auto show_coverage(Index base) {
+  return [base](const NodeCoverage& c) {
+    std::ostringstream os;
+    os.precision(3);
+    os << c.node + base << ": " << c.angle / std::numbers::pi << " pi, not "
+       << c.expected / std::numbers::pi << " pi";
+    return os.str();
+  };
 }
 
 // ---- Local covering ------------------------------------------------------------------------
@@ -349,7 +356,7 @@ bool HexValidityReport::ok() const {
          boundary.closed && boundary.manifold;
 }
 
-std::string HexValidityReport::summary() const {
+std::string HexValidityReport::summary(Index base) const {
   std::ostringstream os;
   os << "hex mesh: " << num_hexes << " hexes, " << num_nodes
      << " nodes: " << (ok() ? "valid" : "INVALID") << "\n";
@@ -360,18 +367,18 @@ std::string HexValidityReport::summary() const {
      << (boundary.manifold ? "manifold" : "NOT manifold") << ", V - E + F = " << boundary.euler
      << "\n";
   if (unused_nodes > 0) os << "  unused nodes: " << unused_nodes << "\n";
-  list(os, "hexes with out-of-range nodes", out_of_range_hexes, show_index);
-  list(os, "nodes with non-finite coordinates", non_finite_nodes, show_index);
-  list(os, "hexes with a repeated node", repeated_node_hexes, show_index);
-  list(os, "faces shared by more than two hexes", overshared_faces, show_key<4>);
-  list(os, "faces seen in the same order by both hexes", misoriented_faces, show_key<4>);
-  list(os, "non-manifold edges", nonmanifold_edges, show_key<2>);
-  list(os, "non-manifold vertices", nonmanifold_vertices, show_index);
+  list(os, "hexes with out-of-range nodes", out_of_range_hexes, show_index(base));
+  list(os, "nodes with non-finite coordinates", non_finite_nodes, show_index(base));
+  list(os, "hexes with a repeated node", repeated_node_hexes, show_index(base));
+  list(os, "faces shared by more than two hexes", overshared_faces, show_key<4>(base));
+  list(os, "faces seen in the same order by both hexes", misoriented_faces, show_key<4>(base));
+  list(os, "non-manifold edges", nonmanifold_edges, show_key<2>(base));
+  list(os, "non-manifold vertices", nonmanifold_vertices, show_index(base));
   list(os, "boundary quads OpenMesh rejected (hex)", boundary.rejected,
-       [](const BoundaryQuad& q) { return std::to_string(q.hex); });
-  list(os, "hexes with a non-positive corner Jacobian", inverted_hexes, show_index);
+       [base](const BoundaryQuad& q) { return std::to_string(q.hex + base); });
+  list(os, "hexes with a non-positive corner Jacobian", inverted_hexes, show_index(base));
   list(os, "nodes the hexes cover more than once (corner solid angles)", overlapping_nodes,
-       show_coverage);
+       show_coverage(base));
   return os.str();
 }
 
@@ -720,7 +727,7 @@ bool QuadValidityReport::ok() const {
          nonmanifold_vertices.empty() && inverted_quads.empty() && overlapping_nodes.empty();
 }
 
-std::string QuadValidityReport::summary() const {
+std::string QuadValidityReport::summary(Index base) const {
   std::ostringstream os;
   os << "quad mesh: " << num_quads << " quads, " << num_nodes
      << " nodes: " << (ok() ? "valid" : "INVALID") << "\n";
@@ -731,15 +738,15 @@ std::string QuadValidityReport::summary() const {
   os << " edges\n";
   if (!planar) os << "  not planar\n";
   if (unused_nodes > 0) os << "  unused nodes: " << unused_nodes << "\n";
-  list(os, "quads with out-of-range nodes", out_of_range_quads, show_index);
-  list(os, "nodes with non-finite coordinates", non_finite_nodes, show_index);
-  list(os, "quads with a repeated node", repeated_node_quads, show_index);
-  list(os, "edges shared by more than two quads", overshared_edges, show_key<2>);
-  list(os, "edges run in the same direction by both quads", misoriented_edges, show_key<2>);
-  list(os, "non-manifold vertices", nonmanifold_vertices, show_index);
-  list(os, "quads with a non-positive corner", inverted_quads, show_index);
+  list(os, "quads with out-of-range nodes", out_of_range_quads, show_index(base));
+  list(os, "nodes with non-finite coordinates", non_finite_nodes, show_index(base));
+  list(os, "quads with a repeated node", repeated_node_quads, show_index(base));
+  list(os, "edges shared by more than two quads", overshared_edges, show_key<2>(base));
+  list(os, "edges run in the same direction by both quads", misoriented_edges, show_key<2>(base));
+  list(os, "non-manifold vertices", nonmanifold_vertices, show_index(base));
+  list(os, "quads with a non-positive corner", inverted_quads, show_index(base));
   list(os, "nodes the quads cover more than once (corner angles)", overlapping_nodes,
-       show_coverage);
+       show_coverage(base));
   return os.str();
 }
 

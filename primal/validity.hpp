@@ -65,7 +65,9 @@ struct HexValidityReport {
   std::vector<NodeCoverage> overlapping_nodes;
 
   bool ok() const;
-  std::string summary() const;  // one line per finding, listing the first few offenders
+  // One line per finding, listing the first few offenders, numbered from `base` (0, or 1 as a
+  // file numbers its elements and nodes).
+  std::string summary(Index base = 0) const;
 };
 
 // Throws InvalidInput for a mesh of 2^28 hexes or more (the incidence is kept in 32 bits).
@@ -101,7 +103,7 @@ struct QuadValidityReport {
   std::vector<NodeCoverage> overlapping_nodes;
 
   bool ok() const;
-  std::string summary() const;
+  std::string summary(Index base = 0) const;  // as HexValidityReport's
 };
 
 QuadValidityReport check_validity(const QuadMesh& mesh, const Point& normal = Point::UnitZ());

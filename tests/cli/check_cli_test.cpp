@@ -176,6 +176,18 @@ TEST_CASE("geode check: text report, quad meshes, the file's own numbering") {
     CHECK(j["valid"] == true);
     CHECK(j["obstructions"].empty());
     CHECK(j["quality"]["metrics"][0]["min_hex"].get<int>() >= 1);
+    // The second hex mirrored (x -> 2 - x, its corners as they were): inverted. The validity
+    // lines number it and its face's nodes as the file does (they were 0-based under the header
+    // "numbered from 1": hex 1, nodes {1 4 7 10}; found by a fault hunt).
+    for (primal::Point& p : model.points)
+      if (p.x() > 1.5) p.x() = 0.5;
+    io::write_gmsh(model, in);
+    const auto t = geode_cli("check " + in.string());
+    REQUIRE(t.code == 0);
+    CHECK(t.out.find("numbered from 1") != std::string::npos);
+    CHECK(t.out.find("hexes with a non-positive corner Jacobian: 1 (2)") != std::string::npos);
+    const auto k = check_json(in);
+    CHECK(k["validity"].get<std::string>().find("Jacobian: 1 (2)") != std::string::npos);
   }
   SUBCASE("refusals") {
     CHECK(geode_cli("check " + (dir.path / "missing.vtu").string()).code == 2);
