@@ -102,7 +102,21 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     const std::string cmd = command_path(app);
-    std::cerr << cmd << ": usage error: " << one_line(e.what()) << " (see " << cmd << " --help)\n";
+    // An unknown command word: CLI11 says a subcommand is required, as if none were given.
+    std::string word;
+    for (int i = 1; i < argc && word.empty(); ++i) {
+      const std::string_view arg = argv[i];
+      if (arg == "--threads")
+        ++i;  // the global option's value
+      else if (!arg.empty() && arg[0] != '-')
+        word = arg;
+    }
+    if (cmd == "geode" && !word.empty() &&
+        app.get_subcommands([&](CLI::App* s) { return s->check_name(word); }).empty())
+      std::cerr << "geode: usage error: '" << word << "' is not a command (see geode --help)\n";
+    else
+      std::cerr << cmd << ": usage error: " << one_line(e.what()) << " (see " << cmd
+                << " --help)\n";
     code = 2;
   } catch (const geode::InvalidInput& e) {
     std::cerr << "geode: error: " << one_line(e.what()) << "\n";

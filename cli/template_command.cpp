@@ -1,5 +1,6 @@
 // geode template NAME: derive a transition template from its sheet arrangement and print or
 // write it.
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -194,6 +195,13 @@ void run_template(const TemplateArgs& a) {
   o.diagonal = a.diagonal == "anti" ? templates::Diagonal::kAnti : templates::Diagonal::kMain;
   o.higher = a.higher == "z" ? templates::Higher::kZ : templates::Higher::kX;
   o.push = a.push;
+  // Named by the option that sets it (the library names its field: "geode: tunnel roofs ...").
+  if (std::string key; !templates::push_error(a.push, &key).empty()) {
+    std::string option = "--" + key.substr(0, key.find('['));
+    std::replace(option.begin(), option.end(), '_', '-');
+    if (key == "low_roof") option = "--low-roof / --high-roof";
+    throw InvalidInput(option + ": " + templates::push_error(a.push));
+  }
   const bool refine = entry->family == templates::TemplateFamily::kRefine;
   templates::RefineOptions ro = a.refine;
   ro.box = o.box;

@@ -122,6 +122,10 @@ TEST_CASE(
        "given to both -o and --distorted-csv"},
       {"conform " + in.string() + " -o " + d + "out.exo --report=", "--report: an empty value"},
       {"check " + in.string() + " --planar-angle nan", "'nan' is not a finite number"},
+      {"quality " + in.string(), "'quality' is not a command"},
+      {"template geode3d --high-roof 2", "--low-roof / --high-roof: tunnel roofs"},
+      {"template geode4tri --dome-depth 1", "--dome-depth: dome depth"},
+      {"arrange " + d, "not a regular file"},
   };
   for (const Case& c : cases) {
     CAPTURE(c.args);
