@@ -204,7 +204,15 @@ void check_output_path(const std::string& path) {
   const fs::path p(path);
   std::error_code ec;
   if (fs::is_directory(p, ec)) throw InvalidInput(path + ": is a directory, not an output file");
-  const fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
+  // A symbolic link is written through (its temporary beside the file it names): that file's
+  // directory is the one to check (a dangling link into a missing one failed after the work).
+  fs::path real = p;
+  for (int hops = 0; hops < 40 && fs::is_symlink(real, ec); ++hops) {  // 40: Linux's own bound
+    const fs::path target = fs::read_symlink(real, ec);
+    if (ec) break;
+    real = target.is_absolute() ? target : real.parent_path() / target;
+  }
+  const fs::path dir = real.parent_path().empty() ? fs::path(".") : real.parent_path();
   if (!fs::is_directory(dir, ec))
     throw InvalidInput(path + ": directory " + dir.string() + " does not exist");
   if (::access(dir.c_str(), W_OK | X_OK) != 0)

@@ -127,6 +127,14 @@ TEST_CASE(
       {"template geode4tri --dome-depth 1", "--dome-depth: dome depth"},
       {"arrange " + d, "not a regular file"},
   };
+  // An output link into a missing directory: refused by the check before any work (it failed
+  // after the whole run, "cannot create a temporary file in ...": a fault hunt's).
+  fs::create_symlink(dir.path / "missing" / "x.exo", dir.path / "dangling.exo");
+  const test::CliRun dangling =
+      test::geode_cli("conform " + in.string() + " -o " + d + "dangling.exo", true);
+  CHECK(dangling.code == 2);
+  CHECK(dangling.out.find("directory " + d + "missing does not exist") != std::string::npos);
+  fs::remove(dir.path / "dangling.exo");
   for (const Case& c : cases) {
     CAPTURE(c.args);
     const test::CliRun r = test::geode_cli(c.args, true);  // stdout is empty: all of it is stderr
