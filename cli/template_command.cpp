@@ -307,7 +307,11 @@ void write_template(templates::Template& T, const TemplateOutput& a) {
     if (!r.untangled && !obstructions.empty() && !a.obstruction_hint.empty())
       std::cerr << "geode: " << a.obstruction_hint << "\n";
     else if (!obstructions.empty())
-      std::cerr << "geode: warning: every corner Jacobian is positive, but the cells overlap: "
+      // The smoother's corners may all be positive while the cells overlap (a pinched corner),
+      // or the validity check below may still find a corner at or below 0: the obstruction
+      // is what holds either way.
+      std::cerr << "geode: warning: the connectivity admits no valid placement (the cells "
+                   "overlap or fold somewhere): "
                 << primal::format_obstructions(obstructions, T.dim, 1);
   }
   const int dim = T.dim;

@@ -115,8 +115,9 @@ void smooth(TemplateResult& r, bool slide) {
              ? std::string("no combinatorial obstruction found")
              : "no placement can: " + primal::format_obstructions(obstructions, r.t.dim, 0)));
   else if (!obstructions.empty())
-    r.warnings.push_back("every corner Jacobian is positive, but the cells overlap: " +
-                         primal::format_obstructions(obstructions, r.t.dim, 0));
+    r.warnings.push_back(
+        "the connectivity admits no valid placement (the cells overlap or fold somewhere): " +
+        primal::format_obstructions(obstructions, r.t.dim, 0));
 }
 
 void note_conditions(TemplateResult& r) {
