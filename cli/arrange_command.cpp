@@ -108,8 +108,10 @@ void add_arrange_command(CLI::App& app) {
       "--smooth", args->smooth,
       "place the nodes by optimization (untangle, then maximise the minimum scaled Jacobian);\n"
       "without it, nodes sit at the dual's first guess (diced positions on a completion's faces)");
+  auto* smooth_flag = c->get_option("--smooth");
   c->add_flag("--slide", args->slide,
-              "with --smooth: tet- and hex-side nodes slide within their faces");
+              "with --smooth: tet- and hex-side nodes slide within their faces")
+      ->needs(smooth_flag);
   c->add_flag("--fixup", args->fixup,
               "pillow away the obstructions to a positive-Jacobian placement (pinched corners,\n"
               "as `geode template geode4tri` does; docs/results.md) before placing the nodes:\n"
