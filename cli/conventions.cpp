@@ -316,7 +316,8 @@ void check_distinct_outputs(const std::vector<std::pair<std::string, std::string
       const auto& [a, p] = outputs[i];
       const auto& [b, q] = outputs[j];
       if (p.empty() || q.empty() || p == "-" || q == "-") continue;
-      if (std::filesystem::weakly_canonical(p) == std::filesystem::weakly_canonical(q))
+      std::error_code ec, ed;  // a path that cannot be resolved is left to the writer
+      if (fs::weakly_canonical(p, ec) == fs::weakly_canonical(q, ed) && !ec && !ed)
         throw InvalidInput(q + ": given to both " + a + " and " + b +
                            ": one would overwrite the other");
     }
