@@ -100,12 +100,9 @@ std::pair<const BlockQuality*, double> lowest_block(const ConformResult& r) {
   return low;
 }
 
-// Whether some block of `r` lies below kPartKept x its own elements diced alone.
-bool spoils_a_block(const ConformResult& r) { return lowest_block(r).second < kPartKept; }
-
-// "block 3 'pin_x' at 0.2 x its own elements diced alone"
-std::string lowest_block_text(const ConformResult& r) {
-  const auto [q, ratio] = lowest_block(r);
+// "block 3 'pin_x' at 0.2 x its own elements diced alone", of lowest_block's result.
+std::string lowest_block_text(const std::pair<const BlockQuality*, double>& low) {
+  const auto [q, ratio] = low;
   if (!q) return "every block at 1 x its own elements diced alone";
   std::ostringstream m;
   m << "block " << q->block << (q->name.empty() ? "" : " '" + q->name + "'") << " at " << ratio
@@ -457,7 +454,8 @@ ConformResult ModelConformer::from_tets(ConformResult r) {
   const bool thin =
       near_thin_ > 0.0 &&
       (!valid || (automatic && (tets_cross_ ? hex_min < r.yardstick() : short_of_aim)));
-  const bool spoilt = valid && spoils_a_block(r);
+  const auto hex_low = lowest_block(r);
+  const bool spoilt = valid && hex_low.second < kPartKept;  // some block below it
   const bool convex = convex_hex_part_ && valid && (short_of_aim || spoilt);
   if (!thin && !convex) return r;
   if (options_.progress)
@@ -467,7 +465,7 @@ ConformResult ModelConformer::from_tets(ConformResult r) {
                : std::string("buffer layer: from the hex part's ") +
                      (thin ? "thin cells" : "convex corners") + " the geode hexes reach " +
                      std::to_string(r.capped_local_ratio) + " x their capped local yardstick" +
-                     (spoilt ? ", " + lowest_block_text(r) : std::string()) +
+                     (spoilt ? ", " + lowest_block_text(hex_low) : std::string()) +
                      "; the tet part's layer tried too");
   // The same pass from the tet part (at its default thickness): the tets relaxed again from the
   // points as given.
@@ -489,8 +487,9 @@ ConformResult ModelConformer::from_tets(ConformResult r) {
   // the transition nearer its aim. The first on a tie of both. A block the hex part's spoils
   // and the tet part's does not is worth kPartTrade of the minimum.
   const double tet_min = output_min_scaled_jacobian(t);
-  const bool keeps_parts = convex && !crossing && spoilt && result_valid(t) && !spoils_a_block(t) &&
-                           tet_min >= kPartTrade * hex_min;
+  const auto tet_low = lowest_block(t);
+  const bool keeps_parts = convex && !crossing && spoilt && result_valid(t) &&
+                           tet_low.second >= kPartKept && tet_min >= kPartTrade * hex_min;
   const bool better = !valid || tet_min > hex_min || keeps_parts ||
                       (tet_min == hex_min && t.capped_local_ratio > r.capped_local_ratio);
   if (!joining.empty() || t.buffer_side != BufferSide::kTet || !result_valid(t) || !better) {
@@ -509,9 +508,9 @@ ConformResult ModelConformer::from_tets(ConformResult r) {
   if (valid)
     m << "the output's minimum scaled Jacobian was " << hex_min << ", its geode hexes "
       << r.capped_local_ratio << " x their capped local yardstick"
-      << (spoilt ? ", " + lowest_block_text(r) : std::string()) << "; from the tet part " << tet_min
-      << " and " << t.capped_local_ratio << " x"
-      << (spoilt ? ", " + lowest_block_text(t) : std::string());
+      << (spoilt ? ", " + lowest_block_text(hex_low) : std::string()) << "; from the tet part "
+      << tet_min << " and " << t.capped_local_ratio << " x"
+      << (spoilt ? ", " + lowest_block_text(tet_low) : std::string());
   else
     m << "the output was invalid (" << invalid_reason(r) << "); from the tet part " << tet_min;
   if (crossing)

@@ -236,8 +236,7 @@ void Conformer::report(const std::vector<int>& block) {
   std::transform(at.begin(), at.end(), hexes.begin(), [](const Index* h) { return *h; });
   const auto numbers = primal::hex_numbers(block, hexes, options_.output_numbering);
   for (std::size_t i = 0; i < at.size(); ++i) *at[i] = primal::index_cast(numbers[i]);
-  // The geode hexes against their local yardsticks, per block, and capped over all (uncapped:
-  // verify_and_output).
+  // The geode hexes against their local yardsticks, per block and over all.
   ceilings(block);
   for (std::size_t b = 0; b + 1 < geode_first_.size(); ++b) {
     const auto quad = primal::index_cast<std::size_t>(layer_.hexes[b].quad);
@@ -253,6 +252,7 @@ void Conformer::report(const std::vector<int>& block) {
       it->local_yardstick = std::min(it->local_yardstick, local);
       it->local_ratio = std::min(it->local_ratio, sj / local);
       it->capped_local_ratio = std::min(it->capped_local_ratio, sj / capped);
+      res_.local_yardstick_ratio = std::min(res_.local_yardstick_ratio, sj / local);
       res_.capped_local_ratio = std::min(res_.capped_local_ratio, sj / capped);
     }
   }
@@ -287,14 +287,6 @@ void Conformer::output() {
 // (check_validity, the full quality report) read mesh_: those run before the writer.
 void Conformer::verify_and_output() {
   t0_ = Clock::now();
-  // The geode hexes against their local yardstick (the report's uncapped ratio).
-  for (std::size_t b = 0; b + 1 < geode_first_.size(); ++b) {
-    const double local =
-        res_.local_yardstick[primal::index_cast<std::size_t>(layer_.hexes[b].quad)];
-    for (Index h = geode_first_[b]; h < geode_first_[b + 1]; ++h)
-      res_.local_yardstick_ratio =
-          std::min(res_.local_yardstick_ratio, sj_[primal::index_cast<std::size_t>(h)] / local);
-  }
   // A named geode block (--geode-block) labels hexes of the material they were carved from:
   // smoothing moved them as that block's, so the mesh is the one without the option (with it,
   // their faces were block faces the smoothing kept, and quads-only layers came out with

@@ -45,12 +45,13 @@ void Distributor::yardstick() {
   };
   std::array<std::vector<int>, 3> blocks;
   const std::array<ElementKind, 3> kinds{ElementKind::kHex, ElementKind::kTet, ElementKind::kWedge};
+  std::array<const std::vector<int>*, 3> ids{};  // per kind, each element's block (empty: default)
   for (std::size_t k = 0; k < 3; ++k) {
     const auto kind = kinds[k];
-    const std::vector<int>& ids = primal::element_blocks(m(), kind);  // empty: the default
-    if (ids.empty() && primal::element_count(m(), kind) > 0)
+    ids[k] = &primal::element_blocks(m(), kind);
+    if (ids[k]->empty() && primal::element_count(m(), kind) > 0)
       blocks[k].push_back(primal::default_block(kind));
-    for (int id : ids)  // a block's elements come in runs: few to sort
+    for (int id : *ids[k])  // a block's elements come in runs: few to sort
       if (blocks[k].empty() || blocks[k].back() != id) blocks[k].push_back(id);
     std::sort(blocks[k].begin(), blocks[k].end());
     blocks[k].erase(std::unique(blocks[k].begin(), blocks[k].end()), blocks[k].end());
@@ -59,10 +60,12 @@ void Distributor::yardstick() {
   for (std::size_t k = 0; k < 3; ++k) first[k + 1] = first[k] + blocks[k].size();
   std::vector<Low> low(first[3], Low{2.0, std::numeric_limits<int>::max()}), all(first[3]);
   std::vector<int> inverted;
-  const auto consider = [&](std::size_t k, std::size_t c, double v) {
+  // Element i of kind k, diced alone: v.
+  const auto consider = [&](std::size_t k, std::size_t i, double v) {
+    const std::size_t c = offsets_[static_cast<std::size_t>(kinds[k])] + i;
     const int cell = primal::index_cast<int>(c);
     if (level_[c] < 0) {
-      const int block = primal::block_of(m(), ref(c));
+      const int block = ids[k]->empty() ? blocks[k].front() : (*ids[k])[i];
       Low& l = low[first[k] + static_cast<std::size_t>(
                                   std::lower_bound(blocks[k].begin(), blocks[k].end(), block) -
                                   blocks[k].begin())];
@@ -98,23 +101,20 @@ void Distributor::yardstick() {
                : std::min(n, static_cast<std::size_t>(static_cast<double>(n) *
                                                       before[primal::index_cast<std::size_t>(r)]));
   };
-  const auto cell_of = [&](ElementKind kind, std::size_t i) {
-    return offsets_[static_cast<std::size_t>(kind)] + i;
-  };
   {
     const std::size_t a = share(nh, rank_), b = share(nh, rank_ + 1);
     const auto h =
         primal::diced_scaled_jacobian_per_cell(m().points, std::span(m().hexes.data() + a, b - a));
-    for (std::size_t i = 0; i < h.size(); ++i) consider(0, cell_of(ElementKind::kHex, a + i), h[i]);
+    for (std::size_t i = 0; i < h.size(); ++i) consider(0, a + i, h[i]);
   }
   {
     const std::size_t a = share(nt, rank_), b = share(nt, rank_ + 1);
     const auto t =
         primal::diced_scaled_jacobian_per_cell(m().points, std::span(m().tets.data() + a, b - a));
-    for (std::size_t i = 0; i < t.size(); ++i) consider(1, cell_of(ElementKind::kTet, a + i), t[i]);
+    for (std::size_t i = 0; i < t.size(); ++i) consider(1, a + i, t[i]);
   }
   for (std::size_t i = share(nw, rank_); i < share(nw, rank_ + 1); ++i)
-    consider(2, cell_of(ElementKind::kWedge, i),
+    consider(2, i,
              primal::diced_wedge_min_scaled_jacobian(m().points, std::span(&m().wedges[i], 1)));
   if (references_built.joinable()) references_built.join();
   MPI_Allreduce(low.data(), all.data(), primal::index_cast<int>(low.size()), MPI_DOUBLE_INT,
