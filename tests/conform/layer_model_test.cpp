@@ -324,6 +324,9 @@ TEST_CASE("templates a quads-only layer's buffer hexes invert are untangled, the
   test::check_conform_result(r, -1, r.warnings.size());  // the volumes' warnings only
   CHECK(r.smoothing.final_inverted == 0);
   CHECK(conform::result_valid(r));
+  // Not in the sanitized build (85 s there): the run above untangles under the sanitizers, and
+  // the smoothing below runs there in the materials and local-yardstick tests.
+  if (test::kSanitized) return;
   // The default smoothing untangles them first, then only raises the minimum: before, its
   // passes started from the inverted hexes and ended at 0.029, below --smooth none's 0.033.
   const conform::ConformResult smoothed = conform::conform(input);
