@@ -39,7 +39,7 @@ struct Checked {
   std::vector<primal::Obstruction> obstructions;
 };
 
-// "valid", or "invalid" and the first of what fails (the report has it all).
+// "valid" or "invalid" (the report says what fails).
 std::string validity_line(bool valid) {
   return std::string("validity: ") + (valid ? "valid" : "invalid");
 }
