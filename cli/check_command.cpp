@@ -14,6 +14,7 @@
 #include <geode/primal/validity.hpp>
 #include "cli/commands.hpp"
 #include "cli/conventions.hpp"
+#include "cli/progress.hpp"
 
 namespace geode::cli {
 namespace {
@@ -25,6 +26,7 @@ struct CheckArgs {
   std::string format;  // empty: by the extension of -o, else text
   std::string output;
   double planar_angle = primal::RealizabilityOptions{}.planar_angle_degrees;
+  bool quiet = false;
 };
 
 struct Checked {
@@ -37,12 +39,22 @@ struct Checked {
   std::vector<primal::Obstruction> obstructions;
 };
 
+// "valid" or "invalid" (the report says what fails).
+std::string validity_line(bool valid) {
+  return std::string("validity: ") + (valid ? "valid" : "invalid");
+}
+
+std::string obstructions_line(const std::vector<primal::Obstruction>& o) {
+  return "realizability: " + std::to_string(o.size()) + " obstructions";
+}
+
 Checked check_hexes(const primal::HexMesh& mesh, const primal::RealizabilityOptions& options,
-                    Index base) {
+                    Index base, Progress& progress) {
   Checked c;
   const auto v = primal::check_validity(mesh);
   c.valid = v.ok();
   c.validity = v.summary(base);
+  progress.stage_done(validity_line(c.valid));
   c.analysable =
       v.out_of_range_hexes.empty() && v.repeated_node_hexes.empty() && !mesh.hexes.empty();
   if (!c.analysable) return c;
@@ -50,16 +62,19 @@ Checked check_hexes(const primal::HexMesh& mesh, const primal::RealizabilityOpti
   for (auto& metric : q.metrics) metric.min_hex += base, metric.max_hex += base;
   c.quality = primal::quality_report_json(q);
   c.quality_text = primal::format_quality_table(q);
+  progress.stage_done("quality: " + std::to_string(q.metrics.size()) + " metrics");
   c.obstructions = primal::find_obstructions(mesh, options);
+  progress.stage_done(obstructions_line(c.obstructions));
   return c;
 }
 
 Checked check_quads(const primal::QuadMesh& mesh, const primal::RealizabilityOptions& options,
-                    Index base) {
+                    Index base, Progress& progress) {
   Checked c;
   const auto v = primal::check_validity(mesh);
   c.valid = v.ok();
   c.validity = v.summary(base);
+  progress.stage_done(validity_line(c.valid));
   c.analysable =
       v.out_of_range_quads.empty() && v.repeated_node_quads.empty() && !mesh.quads.empty();
   if (!c.analysable) return c;
@@ -76,7 +91,9 @@ Checked check_quads(const primal::QuadMesh& mesh, const primal::RealizabilityOpt
   std::ostringstream s;
   s << "Quad scaled Jacobian: min " << lo << " (quad " << at + base << "), max " << hi << "\n";
   c.quality_text = s.str();
+  progress.stage_done("quality: scaled Jacobian");
   c.obstructions = primal::find_obstructions(mesh, options);
+  progress.stage_done(obstructions_line(c.obstructions));
   return c;
 }
 
@@ -84,11 +101,14 @@ void run_check(const CheckArgs& a) {
   check_output_path(a.output);
   const std::string format = output_format(a.output, a.format, {"text", "json"}, "text");
   check_not_input(a.output, a.input);  // a report never replaces the mesh it is about
+  Progress progress = Progress::for_stderr(a.quiet);
   const MeshFile m = read_mesh_file(a.input);
+  progress.stage_done(read_line(a.input, m));
   primal::RealizabilityOptions options;
   options.planar_angle_degrees = a.planar_angle;
   const Index base = m.index_base;
-  Checked c = m.dim == 3 ? check_hexes(m.hex, options, base) : check_quads(m.quad, options, base);
+  Checked c = m.dim == 3 ? check_hexes(m.hex, options, base, progress)
+                         : check_quads(m.quad, options, base, progress);
   std::string text;
   if (format == "json") {
     nlohmann::json j;
@@ -149,6 +169,7 @@ void add_check_command(CLI::App& app) {
                 "form one planar boundary face")
       ->check(number_check(0.0, 90.0))
       ->capture_default_str();
+  add_quiet_flag(c, a->quiet);
   c->callback([a] { run_check(*a); });
 }
 

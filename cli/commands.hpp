@@ -49,6 +49,11 @@ struct MeshFile {
   primal::Index index_base = 0;
 };
 MeshFile read_mesh_file(const std::filesystem::path& path);
+// The progress line of a mesh read: "read PATH: N hexes, M nodes" (quads in 2D).
+std::string read_line(const std::string& path, const MeshFile& m);
+// What the progress of stc::mesh_dual counts (MeshDualOptions::progress): "hex visits of the
+// dual" (quad in 2D), each cell visited stc::kMeshDualPasses times.
+std::string dual_step(int dim);
 
 // The sheets of a computed arrangement for the HTML viewer (cli/view_command.cpp): each sheet
 // contoured from its field inside the domain (stc/sheet_surfaces.hpp), its points mapped by

@@ -406,6 +406,11 @@ void invalid_written(const std::string& what, const std::string& reason) {
   throw InvalidResult(what + " is invalid: " + reason + " (written anyway: --write-invalid)");
 }
 
+CLI::Option* add_quiet_flag(CLI::App* app, bool& flag) {
+  return app->add_flag("--quiet", flag,
+                       "no progress on stderr (the output, errors and warnings still print)");
+}
+
 CLI::Option* add_write_invalid_flag(CLI::App* app, bool& flag) {
   return app->add_flag(
       "--write-invalid", flag,

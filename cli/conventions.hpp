@@ -138,6 +138,9 @@ void invalid_written(const std::string& what, const std::string& reason);
 
 // The same --write-invalid flag on every command that writes a mesh.
 CLI::Option* add_write_invalid_flag(CLI::App* app, bool& flag);
+// --quiet of a command whose output is its report (check, dual, view): no progress lines on
+// stderr; the report, errors and warnings still print.
+CLI::Option* add_quiet_flag(CLI::App* app, bool& flag);
 
 // Several outputs written as one: each goes to a temporary file next to its target (same
 // extension, so writers that go by it still work; registered for removal on signals), and only

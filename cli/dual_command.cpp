@@ -33,6 +33,7 @@ struct DualArgs {
   EncodingArgs encoding;  // --vtk-encoding, --msh-encoding
   bool write_invalid = false;
   bool force = false;
+  bool quiet = false;
 };
 
 template <class Dual>
@@ -104,19 +105,29 @@ void run_dual(const DualArgs& a) {
   check_not_input(a.output, a.input, a.force);
   check_not_input(a.rebuild, a.input, a.force);
   const fs::path in(a.input);
+  Progress progress = Progress::for_stderr(a.quiet);
   const MeshFile m = read_mesh_file(in);
+  progress.stage_done(read_line(a.input, m));
   if (m.dim == 2 && !rebuild_format.empty() && !io::find_mesh_format(rebuild_format)->write_quads)
     throw InvalidInput(a.rebuild + ": " + a.input + " is a quad mesh; rebuild it as " +
                        quad_output_extensions());
   nlohmann::json j;
   std::vector<Index> counts;
+  // A mesh of millions of cells takes tens of seconds here: say how far it is.
+  stc::MeshDualOptions dual_options;
+  dual_options.progress = [&progress, what = dual_step(m.dim)](std::size_t done,
+                                                               std::size_t total) {
+    progress.step(what, done, total);
+  };
   if (m.dim == 3) {
-    const auto dual = stc::mesh_dual(m.hex);
+    const auto dual = stc::mesh_dual(m.hex, dual_options);
+    progress.stage_done("dual: " + std::to_string(dual.sheets.size()) + " sheets");
     j = dual_json(dual, primal::index_cast(m.hex.points.size()),
                   primal::index_cast(m.hex.hexes.size()));
     counts = tuple_counts(dual);
   } else {
-    const auto dual = stc::mesh_dual(m.quad);
+    const auto dual = stc::mesh_dual(m.quad, dual_options);
+    progress.stage_done("dual: " + std::to_string(dual.sheets.size()) + " chords");
     j = dual_json(dual, primal::index_cast(m.quad.points.size()),
                   primal::index_cast(m.quad.quads.size()));
     counts = tuple_counts(dual);
@@ -130,8 +141,8 @@ void run_dual(const DualArgs& a) {
     try {
       const stc::MeshArrangementInput fields =
           m.dim == 3 ? stc::sheet_fields(m.hex) : stc::sheet_fields(m.quad);
+      progress.stage_done("sheet fields");
       // A large mesh has many sheets and the engine meets every pair: say how far it is.
-      Progress progress = Progress::for_stderr(false);
       stc::ArrangementOptions options;
       options.progress =
           [&progress, what = std::string(m.dim == 3 ? "sheet pairs traced" : "chords traced")](
@@ -150,6 +161,8 @@ void run_dual(const DualArgs& a) {
         m.dim == 3 ? tuple_counts(stc::mesh_dual(D.hex)) : tuple_counts(stc::mesh_dual(D.quad));
     r["same_counts"] = rebuilt == counts && r["nodes"] == j["nodes"] && r["cells"] == j["cells"];
     j["rebuild"] = r;
+    progress.stage_done("rebuilt: " + std::to_string(r["cells"].get<std::size_t>()) +
+                        (m.dim == 3 ? " hexes" : " quads"));
   }
 
   std::string text;
@@ -166,6 +179,8 @@ void run_dual(const DualArgs& a) {
               (r["same_counts"].get<bool>() ? "yes" : "NO") + "\n";
     }
   }
+  progress.stage_done("report: " + std::to_string(j["intersections"].size()) +
+                      (m.dim == 3 ? " sheet triples" : " chord crossings"));
   // The rebuilt mesh passes the one validity check before anything is written (its ids as the
   // rebuilt file numbers them); the report and the mesh are written as one (both or neither).
   std::string invalid;
@@ -173,6 +188,8 @@ void run_dual(const DualArgs& a) {
   if (!a.rebuild.empty()) {
     const primal::Index base = output_index_base(rebuild_format);
     invalid = m.dim == 3 ? invalid_mesh_reason(D.hex, base) : invalid_mesh_reason(D.quad, base);
+    progress.stage_done(std::string("validity of the rebuilt mesh: ") +
+                        (invalid.empty() ? "valid" : "invalid"));
     refuse_invalid(what, invalid, a.write_invalid);
   }
   OutputFiles files;
@@ -227,6 +244,7 @@ void add_dual_command(CLI::App& app) {
   add_write_invalid_flag(d, a->write_invalid);
   add_force_flag(d, a->force);
   add_encoding_options(d, a->encoding);
+  add_quiet_flag(d, a->quiet);
   d->callback([a] { run_dual(*a); });
 }
 

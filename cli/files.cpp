@@ -8,6 +8,7 @@
 #include <geode/io/formats.hpp>
 #include <geode/io/read_model.hpp>
 #include <geode/primal/errors.hpp>
+#include <geode/stc/mesh_dual.hpp>
 #include "cli/commands.hpp"
 
 namespace geode::cli {
@@ -36,6 +37,18 @@ MeshFile read_mesh_file(const fs::path& path) {
         throw InvalidInput(path.string() + ": node " + std::to_string(n) +
                            " has z != 0: a quad mesh must lie in the plane z = 0");
   return m;
+}
+
+std::string read_line(const std::string& path, const MeshFile& m) {
+  const bool hexes = m.dim == 3;
+  return "read " + path + ": " + std::to_string(hexes ? m.hex.hexes.size() : m.quad.quads.size()) +
+         (hexes ? " hexes, " : " quads, ") +
+         std::to_string(hexes ? m.hex.points.size() : m.quad.points.size()) + " nodes";
+}
+
+std::string dual_step(int dim) {
+  return std::string(dim == 3 ? "hex" : "quad") + " visits of the dual (" +
+         std::to_string(stc::kMeshDualPasses) + " per " + (dim == 3 ? "hex" : "quad") + ")";
 }
 
 void write_or_print(const std::string& path, const std::function<void(std::ostream&)>& write) {

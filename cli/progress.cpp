@@ -4,7 +4,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <iomanip>
 #include <iostream>
+#include <sstream>
 
 namespace geode::cli {
 
@@ -21,6 +23,15 @@ void Progress::stage(const std::string& line) {
   if (quiet_) return;
   end_bar();
   std::cerr << "geode: " << line << std::endl;
+}
+
+void Progress::stage_done(const std::string& line) {
+  const auto now = Clock::now();
+  const double seconds = std::chrono::duration<double>(now - stage_started_).count();
+  stage_started_ = now;
+  std::ostringstream s;
+  s << line << " (" << std::fixed << std::setprecision(1) << seconds << " s)";
+  stage(s.str());
 }
 
 void Progress::step(const std::string& what, std::size_t done, std::size_t total) {

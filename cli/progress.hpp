@@ -18,6 +18,9 @@ class Progress {
   static Progress for_stderr(bool quiet);
 
   void stage(const std::string& line);
+  // A stage that has ended: "LINE (S s)", S the seconds since the previous stage_done (or since
+  // this Progress was made), for commands whose stages say nothing while they run.
+  void stage_done(const std::string& line);
   // `done` of `total` units of `what` (e.g. "buffer hexes"); a new `what` starts a new step.
   void step(const std::string& what, std::size_t done, std::size_t total);
 
@@ -28,7 +31,7 @@ class Progress {
   void end_bar();
   bool quiet_, terminal_;
   std::string what_;
-  Clock::time_point started_{}, last_{};
+  Clock::time_point started_{}, last_{}, stage_started_ = Clock::now();
   bool bar_drawn_ = false;
 };
 

@@ -12,6 +12,7 @@
 #include <geode/stc/sheet_surfaces.hpp>
 #include "cli/commands.hpp"
 #include "cli/conventions.hpp"
+#include "cli/progress.hpp"
 
 namespace geode::cli {
 
@@ -51,14 +52,29 @@ struct ViewArgs {
   std::string input;
   std::string output;
   std::string title;
+  bool quiet = false;
 };
 
 // Sheets named as `geode dual` numbers them (0-based, first appearance), so the two agree.
 template <class Mesh, class Surfaces>
-std::vector<viewer::ViewSheet> mesh_view_sheets(const Mesh& mesh, const Surfaces& make_surfaces) {
-  const auto dual = stc::mesh_dual(mesh);
-  auto shapes = make_surfaces(mesh, dual);
+std::vector<viewer::ViewSheet> mesh_view_sheets(const Mesh& mesh, const Surfaces& make_surfaces,
+                                                Progress& progress) {
+  const bool hexes = std::is_same_v<Mesh, primal::HexMesh>;
+  stc::MeshDualOptions dual_options;
+  dual_options.progress = [&progress, what = dual_step(hexes ? 3 : 2)](std::size_t done,
+                                                                       std::size_t total) {
+    progress.step(what, done, total);
+  };
+  const auto dual = stc::mesh_dual(mesh, dual_options);
+  progress.stage_done("dual: " + std::to_string(dual.sheets.size()) +
+                      (hexes ? " sheets" : " chords"));
+  stc::DualSurfaceOptions surface_options;
+  surface_options.progress =
+      [&progress, what = std::string(hexes ? "hexes' sheet quads" : "quads' chord segments")](
+          std::size_t done, std::size_t total) { progress.step(what, done, total); };
+  auto shapes = make_surfaces(mesh, dual, surface_options);
   const auto layers = stc::sheet_layers(dual);
+  progress.stage_done(hexes ? "sheet surfaces" : "chord curves");
   std::vector<viewer::ViewSheet> out(dual.sheets.size());
   for (std::size_t s = 0; s < out.size(); ++s) {
     out[s].name = "sheet " + std::to_string(s);
@@ -78,7 +94,9 @@ void run_view(const ViewArgs& a) {
   if (file_extension(out) != ".html")
     throw InvalidInput(a.output + ": unknown output format '" + file_extension(out) +
                        "' (expected .html)");
+  Progress progress = Progress::for_stderr(a.quiet);
   const MeshFile m = read_mesh_file(a.input);
+  progress.stage_done(read_line(a.input, m));
   viewer::ViewScene scene;
   scene.title = a.title.empty() ? std::filesystem::path(a.input).filename().string() : a.title;
   const char* cells = m.dim == 3 ? "hexes" : "quads";
@@ -92,13 +110,14 @@ void run_view(const ViewArgs& a) {
       " (stc::mesh_dual, sheet numbers as in `geode dual`).";
   // A mesh whose dual cannot be read (a face on three hexes, ...) is still worth looking at.
   try {
-    scene.sheets = m.dim == 3 ? mesh_view_sheets(m.hex,
-                                                 [](const auto& mesh, const auto& d) {
-                                                   return stc::dual_surfaces(mesh, d);
-                                                 })
-                              : mesh_view_sheets(m.quad, [](const auto& mesh, const auto& d) {
-                                  return stc::dual_curves(mesh, d);
-                                });
+    const auto surfaces = [](const auto& mesh, const auto& d, const auto& o) {
+      return stc::dual_surfaces(mesh, d, o);
+    };
+    const auto curves = [](const auto& mesh, const auto& d, const auto& o) {
+      return stc::dual_curves(mesh, d, o);
+    };
+    scene.sheets = m.dim == 3 ? mesh_view_sheets(m.hex, surfaces, progress)
+                              : mesh_view_sheets(m.quad, curves, progress);
   } catch (const TopologyError& e) {
     std::cerr << "geode: warning: " << a.input << ": no sheets shown: " << e.what() << "\n";
   }
@@ -106,6 +125,7 @@ void run_view(const ViewArgs& a) {
     viewer::write_html(out, m.hex, scene);
   else
     viewer::write_html(out, m.quad, scene);
+  progress.stage_done("wrote " + a.output);
 }
 
 }  // namespace
@@ -126,6 +146,7 @@ void add_view_command(CLI::App& app) {
   v->add_option("mesh", a->input, hex_or_quad_input_help())->required();
   v->add_option("-o,--output", a->output, "The HTML file to write (atomically)")->required();
   v->add_option("--title", a->title, "Title shown in the page (default: the input's file name)");
+  add_quiet_flag(v, a->quiet);
   v->callback([a] { run_view(*a); });
 }
 

@@ -69,6 +69,10 @@ struct DistributedOptions {
   // 1.05 s partition). Used when every rank gives them; the partition stage takes them (the
   // vectors are left empty). Only the load balance depends on them, not the result.
   std::vector<std::array<primal::Index, 2>>* element_pairs = nullptr;
+  // Called on this rank with one line per stage as it ends ("dicing (3.2 s)"), for the command
+  // line's progress output (geode_mpi gives it on rank 0 only); may be empty. The stages are
+  // DistributedReport::seconds's (a stage that runs twice is told twice).
+  std::function<void(const std::string&)> progress;
 };
 
 // One rank's share of the output.

@@ -10,6 +10,7 @@
 #include <unordered_map>
 
 #include <geode/primal/errors.hpp>
+#include <geode/primal/release.hpp>
 #include <geode/primal/topology.hpp>
 
 namespace geode::stc {
@@ -103,17 +104,41 @@ void build_traces(const std::vector<std::array<Index, 4>>&, MeshDual<2>& dual) {
   }
 }
 
+// MeshDualOptions::progress over build()'s kMeshDualPasses passes over the cells: at(c) in
+// each pass (told every kEvery cells), next() between passes, end() once all is done.
+class PassProgress {
+ public:
+  PassProgress(const MeshDualOptions& options, std::size_t cells)
+      : f_(options.progress), cells_(cells) {}
+  void at(Index c) const {
+    const auto i = primal::index_cast<std::size_t>(c);
+    if (f_ && i % kEvery == 0) f_(pass_ * cells_ + i, kMeshDualPasses * cells_);
+  }
+  void next() { ++pass_; }
+  void end() const {
+    if (f_) f_(kMeshDualPasses * cells_, kMeshDualPasses * cells_);
+  }
+
+ private:
+  static constexpr std::size_t kEvery = 1 << 14;
+  const std::function<void(std::size_t, std::size_t)>& f_;
+  std::size_t cells_, pass_ = 0;
+};
+
 template <int Dim>
 MeshDual<Dim> build(std::size_t n_nodes,
-                    const std::vector<std::array<Index, Ref<Dim>::kCorners>>& cells) {
+                    const std::vector<std::array<Index, Ref<Dim>::kCorners>>& cells,
+                    const MeshDualOptions& options) {
   using R = Ref<Dim>;
   MeshDual<Dim> dual;
   const Index n_cells = primal::index_cast(cells.size());
+  PassProgress progress(options, cells.size());
 
   // Validate and number the edges.
   std::unordered_map<std::uint64_t, Index> edge_id;
   dual.cell_edges.resize(n_cells);
   for (Index c = 0; c < n_cells; ++c) {
+    progress.at(c);
     const auto& cell = cells[c];
     const std::string name = std::string(R::kCellName) + " " + std::to_string(c);
     for (int k = 0; k < R::kCorners; ++k) {
@@ -134,15 +159,23 @@ MeshDual<Dim> build(std::size_t n_nodes,
     }
   }
 
+  primal::release(edge_id);  // before the progress says done: a large map takes a while to free
+
   // Sheets: within a cell the edges of one class are equivalent.
+  progress.next();
   primal::DisjointSets uf(dual.edges.size());
-  for (const auto& ce : dual.cell_edges)
+  for (Index c = 0; c < n_cells; ++c) {
+    progress.at(c);
+    const auto& ce = dual.cell_edges[c];
     for (int e = 0; e < MeshDual<Dim>::kCellEdges; ++e)
       for (int f = e + 1; f < MeshDual<Dim>::kCellEdges; ++f)
         if (R::edge_class(e) == R::edge_class(f)) uf.unite(ce[e], ce[f]);
+  }
+  progress.next();
   std::vector<Index> sheet_of_root(dual.edges.size(), -1);
   dual.cell_sheets.resize(n_cells);
   for (Index c = 0; c < n_cells; ++c) {
+    progress.at(c);
     for (int e = 0; e < MeshDual<Dim>::kCellEdges; ++e) {
       Index& s = sheet_of_root[uf.find(dual.cell_edges[c][e])];
       if (s < 0) {
@@ -157,7 +190,9 @@ MeshDual<Dim> build(std::size_t n_nodes,
     dual.edge_sheet[e] = sheet_of_root[uf.find(primal::index_cast(e))];
     dual.sheets[dual.edge_sheet[e]].edges.push_back(primal::index_cast(e));
   }
+  progress.next();
   for (Index c = 0; c < n_cells; ++c) {
+    progress.at(c);
     auto tuple = dual.cell_sheets[c];
     for (Index s : tuple) dual.sheets[s].cells.push_back(c);
     std::sort(tuple.begin(), tuple.end());
@@ -167,15 +202,20 @@ MeshDual<Dim> build(std::size_t n_nodes,
   }
 
   // Boundary facets: used by one cell only.
+  progress.next();
   std::unordered_map<std::uint64_t, std::vector<CellFacet>> by_key;  // keyed by 2 min nodes
-  for (Index c = 0; c < n_cells; ++c)
+  for (Index c = 0; c < n_cells; ++c) {
+    progress.at(c);
     for (int f = 0; f < R::kFacets; ++f) {
       std::array<Index, R::kFacetSize> key{};
       for (int k = 0; k < R::kFacetSize; ++k) key[k] = cells[c][R::kFacetTable[f][k]];
       std::sort(key.begin(), key.end());
       by_key[pair_key(key[0], key[1])].push_back({c, f});
     }
-  for (Index c = 0; c < n_cells; ++c)
+  }
+  progress.next();
+  for (Index c = 0; c < n_cells; ++c) {
+    progress.at(c);
     for (int f = 0; f < R::kFacets; ++f) {
       std::array<Index, R::kFacetSize> key{};
       for (int k = 0; k < R::kFacetSize; ++k) key[k] = cells[c][R::kFacetTable[f][k]];
@@ -194,8 +234,12 @@ MeshDual<Dim> build(std::size_t n_nodes,
                             " cells");
       if (users.size() == 1) dual.boundary.push_back({c, f});
     }
+  }
+
+  primal::release(by_key);
 
   build_traces(cells, dual);
+  progress.end();
   return dual;
 }
 
@@ -265,10 +309,12 @@ FacetClassifier box_classifier(const std::vector<primal::Point>& points,
 
 }  // namespace
 
-HexDual mesh_dual(const primal::HexMesh& mesh) { return build<3>(mesh.points.size(), mesh.hexes); }
+HexDual mesh_dual(const primal::HexMesh& mesh, const MeshDualOptions& options) {
+  return build<3>(mesh.points.size(), mesh.hexes, options);
+}
 
-QuadDual mesh_dual(const primal::QuadMesh& mesh) {
-  return build<2>(mesh.points.size(), mesh.quads);
+QuadDual mesh_dual(const primal::QuadMesh& mesh, const MeshDualOptions& options) {
+  return build<2>(mesh.points.size(), mesh.quads, options);
 }
 
 std::vector<std::vector<TraceCurve>> trace_by_region(const HexDual& dual, Index sheet,

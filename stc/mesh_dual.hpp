@@ -13,6 +13,7 @@
 // QuadMesh. Nothing here knows about geodes; naming sheets is left to callers through
 // trace_by_region (e.g. per box face).
 #include <array>
+#include <cstddef>
 #include <functional>
 #include <map>
 #include <vector>
@@ -74,11 +75,20 @@ struct MeshDual {
 using HexDual = MeshDual<3>;
 using QuadDual = MeshDual<2>;
 
+struct MeshDualOptions {
+  // Told how many of the cell visits are done (the dual reads every cell kMeshDualPasses
+  // times: done of cells x kMeshDualPasses), every few thousand cells and once at the end, for a
+  // progress display (a mesh of millions of hexes takes tens of seconds); empty: silent. Called
+  // from the calling thread. Does not change the result.
+  std::function<void(std::size_t done, std::size_t total)> progress;
+};
+inline constexpr std::size_t kMeshDualPasses = 6;
+
 // Throws geode::InvalidInput for a corner out of range or repeated within a cell, and
 // geode::TopologyError for a facet shared by more than two cells or (3D) a boundary edge not
 // on exactly two boundary quads; messages name the cell (edge) and the reason.
-HexDual mesh_dual(const primal::HexMesh& mesh);
-QuadDual mesh_dual(const primal::QuadMesh& mesh);
+HexDual mesh_dual(const primal::HexMesh& mesh, const MeshDualOptions& options = {});
+QuadDual mesh_dual(const primal::QuadMesh& mesh, const MeshDualOptions& options = {});
 
 // Region of a boundary facet, e.g. which box face it lies on; a region in [0, regions), or
 // -1 for "none".

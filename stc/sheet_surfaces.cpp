@@ -225,11 +225,24 @@ std::vector<primal::SegmentMesh> contour_curves(const std::vector<Sheet>& sheets
   return out;
 }
 
-std::vector<primal::TriMesh> dual_surfaces(const primal::HexMesh& mesh, const HexDual& dual) {
+namespace {
+
+// DualSurfaceOptions::progress, every kEvery cells of `cells` and at the end.
+void tell(const DualSurfaceOptions& options, std::size_t done, std::size_t cells) {
+  constexpr std::size_t kEvery = 1 << 14;
+  if (options.progress && (done % kEvery == 0 || done == cells)) options.progress(done, cells);
+}
+
+}  // namespace
+
+std::vector<primal::TriMesh> dual_surfaces(const primal::HexMesh& mesh, const HexDual& dual,
+                                           const DualSurfaceOptions& options) {
   static const auto order = quad_order();
   std::vector<primal::TriMesh> out(dual.sheets.size());
   std::vector<std::unordered_map<Index, Index>> ids(dual.sheets.size());
-  for (std::size_t c = 0; c < dual.cell_sheets.size(); ++c)
+  const std::size_t cells = dual.cell_sheets.size();
+  for (std::size_t c = 0; c < cells; ++c) {
+    tell(options, c, cells);
     for (std::size_t k = 0; k < 3; ++k) {
       const auto s = primal::index_cast<std::size_t>(dual.cell_sheets[c][k]);
       std::array<Index, 4> q{};
@@ -241,13 +254,18 @@ std::vector<primal::TriMesh> dual_surfaces(const primal::HexMesh& mesh, const He
       out[s].tris.push_back({q[0], q[1], q[2]});
       out[s].tris.push_back({q[0], q[2], q[3]});
     }
+  }
+  tell(options, cells, cells);
   return out;
 }
 
-std::vector<primal::SegmentMesh> dual_curves(const primal::QuadMesh& mesh, const QuadDual& dual) {
+std::vector<primal::SegmentMesh> dual_curves(const primal::QuadMesh& mesh, const QuadDual& dual,
+                                             const DualSurfaceOptions& options) {
   std::vector<primal::SegmentMesh> out(dual.sheets.size());
   std::vector<std::unordered_map<Index, Index>> ids(dual.sheets.size());
-  for (std::size_t c = 0; c < dual.cell_sheets.size(); ++c)
+  const std::size_t cells = dual.cell_sheets.size();
+  for (std::size_t c = 0; c < cells; ++c) {
+    tell(options, c, cells);
     for (std::size_t k = 0; k < 2; ++k) {
       const auto s = primal::index_cast<std::size_t>(dual.cell_sheets[c][k]);
       const Index a = dual.cell_edges[c][k], b = dual.cell_edges[c][k + 2];  // opposite edges
@@ -257,6 +275,8 @@ std::vector<primal::SegmentMesh> dual_curves(const primal::QuadMesh& mesh, const
            midpoint_vertex(mesh.points, dual.edges[primal::index_cast<std::size_t>(b)], b, ids[s],
                            out[s])});
     }
+  }
+  tell(options, cells, cells);
   return out;
 }
 

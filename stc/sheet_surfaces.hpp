@@ -6,6 +6,8 @@
 //    every cell the sheet crosses contributes the quad through the midpoints of its 4 edges of
 //    that parallel class (in 2D the segment through the midpoints of the 2 opposite edges).
 // Both are for display; neither feeds back into the arrangement engine.
+#include <cstddef>
+#include <functional>
 #include <vector>
 
 #include <geode/primal/mesh.hpp>
@@ -33,11 +35,19 @@ std::vector<primal::SegmentMesh> contour_curves(const std::vector<Sheet>& sheets
                                                 const Domain& domain,
                                                 const ContourOptions& options = {});
 
+struct DualSurfaceOptions {
+  // Told how many of the cells are done, every few thousand cells and once at the end, for a
+  // progress display; empty: silent. Called from the calling thread. Does not change the result.
+  std::function<void(std::size_t done, std::size_t total)> progress;
+};
+
 // The dual surface of every sheet of `dual` (computed from `mesh`), in dual's sheet order, as
 // triangles (each quad split in two); midpoints are shared between the cells of a sheet.
-std::vector<primal::TriMesh> dual_surfaces(const primal::HexMesh& mesh, const HexDual& dual);
+std::vector<primal::TriMesh> dual_surfaces(const primal::HexMesh& mesh, const HexDual& dual,
+                                           const DualSurfaceOptions& options = {});
 // The dual curve of every chord of a quad mesh.
-std::vector<primal::SegmentMesh> dual_curves(const primal::QuadMesh& mesh, const QuadDual& dual);
+std::vector<primal::SegmentMesh> dual_curves(const primal::QuadMesh& mesh, const QuadDual& dual,
+                                             const DualSurfaceOptions& options = {});
 
 // The layer of each sheet: the cells it crosses, ascending, each once (a sheet that crosses
 // itself lists the cell once).

@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <functional>
+#include <iomanip>
 #include <iostream>
 #include <new>
 #include <sstream>
@@ -254,12 +255,25 @@ int run(int argc, char** argv, int rank, int size) {
   cli::OutputFiles files;
   std::string failure;
   Summary summary;  // filled once the rank has its hexes, printed by rank 0 (print_summary)
+  // Progress: rank 0 says each stage as it ends, with its seconds (the other ranks' stages are
+  // in the summary).
+  const bool say_progress = rank == 0 && !quiet;
+  double said_at = 0;
+  const auto say = [&](const std::string& line, bool timed) {
+    if (!say_progress) return;
+    std::ostringstream s;
+    s << "geode_mpi: " << line;
+    if (timed) s << " (" << std::fixed << std::setprecision(1) << MPI_Wtime() - said_at << " s)";
+    std::cerr << s.str() << std::endl;
+    said_at = MPI_Wtime();
+  };
   // Everything after the options, in the rank's arena.
   const auto conform_in_arena = [&]() -> int {
     try {
       cli::check_buffer_thickness(thickness, side);
       check_outputs(output, input, size, join);
       const double t0 = MPI_Wtime();
+      said_at = t0;
       parallel::DistributedOptions options;
       options.conform.smooth = conform::parse_conform_smooth(smooth);
       conform::set_buffer_side(options.conform, side);
@@ -267,6 +281,8 @@ int run(int argc, char** argv, int rank, int size) {
       options.conform.verify = conform::parse_conform_verify(verify);
       options.rings = rings;
       options.zone_threads = zone_threads;
+      // Rank 0's stages; it waits in "zone shared" while the last rank conforms the zone.
+      if (say_progress) options.progress = [&](const std::string& line) { say(line, false); };
       // Each rank frees the input once it has its piece, and reads it again only if the zone
       // grows after that (the read-time check passed already).
       options.reload = [&] {
@@ -286,6 +302,8 @@ int run(int argc, char** argv, int rank, int size) {
         return io::read_model(input, {}, true, &file_partition, check);
       }();
       cli::join_block_lists(model, join_blocks, input);
+      say("read " + input + ": " + std::to_string(primal::element_count(model)) + " elements",
+          true);
       fail_for_test(rank, "read");
       // The input's own partition (a partitioned .msh, a Nemesis set) unless it has fewer parts
       // than there are ranks: then METIS (parallel/partition.hpp).
@@ -323,6 +341,7 @@ int run(int argc, char** argv, int rank, int size) {
                                             });
         fail_for_test(rank, "write");
         files.write(piece);
+        say(join ? "wrote the joined file and rank 0's piece" : "wrote rank 0's piece", true);
       }
       const double t_all = MPI_Wtime() - t0;
       // Per rank: time per stage and peak memory, gathered to rank 0 after the agreement.

@@ -8,8 +8,10 @@
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
+#include <iomanip>
 #include <limits>
 #include <map>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -198,7 +200,13 @@ class Distributor {
   void stage(const std::string& name, F&& f) {
     const auto t0 = Clock::now();
     f();
-    rep_.seconds[name] += std::chrono::duration<double>(Clock::now() - t0).count();
+    const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    rep_.seconds[name] += seconds;
+    if (options_.progress) {
+      std::ostringstream line;
+      line << name << " (" << std::fixed << std::setprecision(1) << seconds << " s)";
+      options_.progress(line.str());
+    }
   }
   const Model& m() const { return *model_; }
   // The model the stages read: `input` itself, or its pyramids split as conform's own first

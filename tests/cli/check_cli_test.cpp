@@ -271,3 +271,42 @@ TEST_CASE("geode check: an invalid mesh is reported INVALID in every format, not
     CHECK(scaled);
   }
 }
+
+TEST_CASE("geode check: its stages on stderr as they end, none with --quiet, the report the same") {
+  test::TempDir dir;
+  const auto hex = dir.path / "grid.vtu", quad = dir.path / "grid2d.vtk";
+  io::write_vtu(hex, test::structured_hex_grid(3, 2, 2));
+  io::write_vtk(quad, test::structured_quad_grid(3, 2));
+  const auto contents = [](const std::filesystem::path& p) {
+    std::ifstream f(p);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+  };
+  for (const auto& in : {hex, quad}) {
+    CAPTURE(in);
+    const std::string cells = in == hex ? "12 hexes" : "6 quads";
+    // The report to a file: what the command prints is its standard error alone.
+    const auto report = dir.path / "r.txt";
+    const auto r = geode_cli("check " + in.string() + " -o " + report.string(), true);
+    REQUIRE(r.code == 0);
+    test::check_stage_lines(r.out, {"read " + in.string() + ": " + cells + ", ", "validity: valid",
+                                    "quality: ", "realizability: 0 obstructions"});
+    const std::string text = contents(report);
+    const auto quiet =
+        geode_cli("check " + in.string() + " -o " + report.string() + " --quiet", true);
+    REQUIRE(quiet.code == 0);
+    CHECK(quiet.out.empty());
+    CHECK(contents(report) == text);
+    // Standard output holds the report alone, as before.
+    const auto out = geode_cli("check " + in.string());
+    REQUIRE(out.code == 0);
+    CHECK(out.out == text);
+  }
+  // A refused input is still one line: nothing is said before the read.
+  const auto mixed = dir.path / "mixed.msh";
+  io::write_gmsh(primal::grid_model({2, 1, 1}, 1.0, [](int i, int, int) { return i == 1; }), mixed);
+  const auto bad = geode_cli("check " + mixed.string(), true);
+  CHECK(bad.code == 2);
+  CHECK(std::count(bad.out.begin(), bad.out.end(), '\n') == 1);
+}

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -90,4 +91,32 @@ TEST_CASE("geode dual: refusals name the file and write nothing") {
     CHECK(nlohmann::json::parse(ok.out)["sheets"].size() == 6);
     std::filesystem::remove(in);
   }
+}
+
+TEST_CASE("geode dual: its stages on stderr as they end, none with --quiet, the report the same") {
+  test::TempDir dir;
+  const auto in = dir.path / "grid.vtu", report = dir.path / "r.json";
+  io::write_vtu(in, moved_grid());
+  const auto r = geode_cli("dual " + in.string() + " -o " + report.string(), true);
+  REQUIRE(r.code == 0);
+  test::check_stage_lines(r.out, {"read " + in.string() + ": 12 hexes, 36 nodes", "dual: 7 sheets",
+                                  "report: 12 sheet triples"});
+  const auto j = nlohmann::json::parse(std::ifstream(report));
+  const auto quiet = geode_cli("dual " + in.string() + " -o " + report.string() + " --quiet", true);
+  REQUIRE(quiet.code == 0);
+  CHECK(quiet.out.empty());
+  CHECK(nlohmann::json::parse(std::ifstream(report)) == j);
+  // With --rebuild: the sheet fields, the rebuilt mesh and its validity too.
+  const auto grid = dir.path / "plain.vtu", rebuilt = dir.path / "rebuilt.vtu";
+  io::write_vtu(grid, test::structured_hex_grid(3, 2, 2));
+  const auto b = geode_cli(
+      "dual " + grid.string() + " -o " + report.string() + " --rebuild " + rebuilt.string(), true);
+  REQUIRE(b.code == 0);
+  test::check_stage_lines(b.out, {"read ", "dual: 7 sheets", "sheet fields", "rebuilt: 12 hexes",
+                                  "report: ", "validity of the rebuilt mesh: valid"});
+  const auto q = geode_cli("dual " + grid.string() + " -o " + report.string() + " --rebuild " +
+                               rebuilt.string() + " --quiet",
+                           true);
+  REQUIRE(q.code == 0);
+  CHECK(q.out.empty());
 }

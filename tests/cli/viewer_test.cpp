@@ -169,6 +169,18 @@ TEST_CASE("viewer: geode view shows any hex or quad mesh with its dual sheets") 
                     qs = page_status(dir, "file://" + q.string());
   CHECK_MESSAGE(hs.rfind("viewer-ok hexes=12 sheets=7 shown=7", 0) == 0, hs);
   CHECK_MESSAGE(qs.rfind("viewer-ok quads=6 sheets=5", 0) == 0, qs);
+  // Its stages on stderr as they end (the page is the output: all it prints); none with --quiet.
+  const auto said = geode_cli("view " + hex.string() + " -o " + h.string(), true);
+  REQUIRE(said.code == 0);
+  test::check_stage_lines(said.out, {"read " + hex.string() + ": 12 hexes, 36 nodes",
+                                     "dual: 7 sheets", "sheet surfaces", "wrote " + h.string()});
+  const auto quads = geode_cli("view " + quad.string() + " -o " + q.string(), true);
+  REQUIRE(quads.code == 0);
+  test::check_stage_lines(quads.out, {"read " + quad.string() + ": 6 quads, 12 nodes",
+                                      "dual: 5 chords", "chord curves", "wrote " + q.string()});
+  const auto quiet = geode_cli("view " + hex.string() + " -o " + h.string() + " --quiet", true);
+  REQUIRE(quiet.code == 0);
+  CHECK(quiet.out.empty());
   // Refusals: an output that is not .html, a missing input.
   CHECK(geode_cli("view " + hex.string() + " -o " + (dir.path / "x.vtu").string()).code == 2);
   CHECK(geode_cli("view " + (dir.path / "missing.vtu").string() + " -o " + h.string()).code == 2);

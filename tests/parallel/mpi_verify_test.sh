@@ -7,7 +7,7 @@
 # GEODE_TEST_INVERT_OUTPUT_HEX in its conform) fails every rank count alike; so does a partition
 # failing on rank 0 (GEODE_TEST_FAIL_PARTITION), and one rank's share of the read refused
 # (GEODE_TEST_FAIL_READ_SHARE), without a rank left waiting; so does one rank failing alone
-# (GEODE_TEST_FAIL_RANK). Options out of range exit 2.
+# (GEODE_TEST_FAIL_RANK). Options out of range exit 2. Rank 0 alone prints progress, -q none.
 # usage: mpi_verify_test.sh GEODE GEODE_MPI MPIEXEC WORKDIR
 set -euo pipefail
 geode=$1 geode_mpi=$2 mpiexec=$3 dir=$4
@@ -115,6 +115,18 @@ for threads in 0 4097; do  # a usage error on one line (CLI11's two, unprefixed,
   [ "$status" = 2 ] || { echo "--threads $threads: exited $status, not 2"; cat err.txt; exit 1; }
   [ "$(wc -l <err.txt)" = 1 ] && grep -q "^geode_mpi conform: usage error: --threads" err.txt
 done
+# Progress: rank 0 alone says each stage as it ends, with its seconds (every rank reads, dices
+# and verifies: a stage said twice was said by two ranks); -q says nothing.
+"$mpiexec" --oversubscribe -np 2 "$geode_mpi" conform in.exo -o said.exo 2>said.txt >/dev/null
+for stage in "read in.exo: " "yardstick (" "dicing (" "zone shared (" "verification (" \
+  "wrote rank 0's piece ("; do
+  [ "$(grep -c "^geode_mpi: $stage" said.txt)" = 1 ] || {
+    echo "progress: '$stage' not said once"; cat said.txt; exit 1
+  }
+done
+if grep -v '^geode_mpi: .* ([0-9]*\.[0-9] s)$' said.txt; then echo "progress: not a stage's line"; exit 1; fi
+"$mpiexec" --oversubscribe -np 2 "$geode_mpi" conform in.exo -o quiet.exo -q 2>quiet.txt >/dev/null
+[ ! -s quiet.txt ] || { echo "progress: -q printed"; cat quiet.txt; exit 1; }
 # Outputs checked before any work (a fault hunt's: -o IN --join overwrote the input, exit 0; -o
 # m.msh, -o - and -o '' wrote Exodus pieces named m.msh.2.0, -.2.0, .2.0): refused, the input
 # untouched, nothing written; so is an output whose pieces are the input set's.
@@ -131,4 +143,4 @@ for args in "-o in.exo --join" "-o m.msh" "-o -" "-o ''" "-o ." "-o set.exo"; do
   if ls m.msh* ./-* .2.* >/dev/null 2>&1; then echo "conform $args: wrote a file"; exit 1; fi
 done
 cmp in.exo keep.exo
-echo "mpi_verify_test: both modes pass the result and find the broken dicing on 1 and 2 ranks, an invalid zone on 1 to 3, a refused share of the read on 2 and 3, a rank failing alone on 2 and 3, options out of range and outputs that are not Exodus files or are the input refused"
+echo "mpi_verify_test: both modes pass the result and find the broken dicing on 1 and 2 ranks, an invalid zone on 1 to 3, a refused share of the read on 2 and 3, a rank failing alone on 2 and 3, options out of range and outputs that are not Exodus files or are the input refused, progress from rank 0 alone"

@@ -8,9 +8,12 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <set>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <unistd.h>
 
@@ -508,4 +511,55 @@ TEST_CASE("the fixture reader names the file and the line of a bad row") {
   CHECK_THROWS_WITH_AS(gt::read_hex_csv(gap, good), doctest::Contains("gap.csv:3"),
                        geode::InvalidInput);
   fs::remove_all(dir);
+}
+
+namespace {
+
+// Every call of a progress callback, in order.
+struct Told {
+  std::vector<std::pair<std::size_t, std::size_t>> calls;
+  std::function<void(std::size_t, std::size_t)> callback() {
+    return [this](std::size_t done, std::size_t total) { calls.emplace_back(done, total); };
+  }
+};
+
+// Told from 0 to `total` and never back, the total fixed, with calls between the ends (the
+// mesh has more cells than the callback's interval): what a progress bar needs.
+void check_told(const Told& told, std::size_t total) {
+  REQUIRE(told.calls.size() >= 3);
+  CHECK(told.calls.front().first == 0);
+  CHECK(told.calls.back().first == total);
+  for (std::size_t i = 0; i < told.calls.size(); ++i) {
+    CHECK(told.calls[i].second == total);
+    if (i > 0) CHECK(told.calls[i].first >= told.calls[i - 1].first);
+  }
+  CHECK(std::any_of(told.calls.begin(), told.calls.end(),
+                    [&](const auto& c) { return c.first > 0 && c.first < total; }));
+}
+
+}  // namespace
+
+TEST_CASE("mesh_dual tells its progress through every pass, and the dual is the same") {
+  SUBCASE("hexes") {
+    const HexMesh g = gt::structured_hex_grid(30, 30, 20);  // 18000 hexes: past 2^14
+    Told told;
+    stc::MeshDualOptions options;
+    options.progress = told.callback();
+    const auto dual = stc::mesh_dual(g, options);
+    check_told(told, stc::kMeshDualPasses * g.hexes.size());
+    const auto plain = stc::mesh_dual(g);
+    CHECK(dual.edge_sheet == plain.edge_sheet);
+    CHECK(dual.cell_sheets == plain.cell_sheets);
+    CHECK(dual.intersections == plain.intersections);
+    CHECK(dual.sheets.size() == 80);
+  }
+  SUBCASE("quads") {
+    const QuadMesh g = gt::structured_quad_grid(200, 100);  // 20000 quads
+    Told told;
+    stc::MeshDualOptions options;
+    options.progress = told.callback();
+    const auto dual = stc::mesh_dual(g, options);
+    check_told(told, stc::kMeshDualPasses * g.quads.size());
+    CHECK(dual.sheets.size() == 300);
+  }
 }

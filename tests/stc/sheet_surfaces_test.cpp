@@ -6,6 +6,8 @@
 #include <cmath>
 #include <map>
 #include <set>
+#include <utility>
+#include <vector>
 
 #include <geode/stc/mesh_dual.hpp>
 #include <geode/stc/sheet_surfaces.hpp>
@@ -152,4 +154,33 @@ TEST_CASE("dual_surfaces and dual_curves of the derived geodes: every cell in th
   std::size_t segments = 0;
   for (const auto& c : curves) segments += c.segments.size();
   CHECK(segments == 2 * T2.quad.quads.size());
+}
+
+TEST_CASE("dual_surfaces and dual_curves tell their progress, cell by cell up to the last") {
+  // Told every 2^14 cells and at the end, ascending, the total the cells; the result the same.
+  const auto check_told = [](const std::vector<std::pair<std::size_t, std::size_t>>& calls,
+                             std::size_t cells) {
+    REQUIRE(calls.size() >= 3);  // 0, 2^14, the end
+    CHECK(calls.front().first == 0);
+    CHECK(calls.back().first == cells);
+    for (std::size_t i = 0; i < calls.size(); ++i) {
+      CHECK(calls[i].second == cells);
+      if (i > 0) CHECK(calls[i].first > calls[i - 1].first);
+    }
+  };
+  std::vector<std::pair<std::size_t, std::size_t>> calls;
+  stc::DualSurfaceOptions options;
+  options.progress = [&](std::size_t done, std::size_t total) { calls.emplace_back(done, total); };
+  const primal::HexMesh g = test::structured_hex_grid(30, 30, 20);  // 18000 hexes
+  const auto dual = stc::mesh_dual(g);
+  const auto surfaces = stc::dual_surfaces(g, dual, options);
+  check_told(calls, g.hexes.size());
+  const auto plain = stc::dual_surfaces(g, dual);
+  REQUIRE(surfaces.size() == plain.size());
+  for (std::size_t s = 0; s < plain.size(); ++s) CHECK(surfaces[s].tris == plain[s].tris);
+  calls.clear();
+  const primal::QuadMesh q = test::structured_quad_grid(200, 100);  // 20000 quads
+  const auto curves = stc::dual_curves(q, stc::mesh_dual(q), options);
+  check_told(calls, q.quads.size());
+  CHECK(curves.size() == 300);
 }

@@ -9,7 +9,10 @@
 #include <stdlib.h>
 
 #include <cstdio>
+#include <regex>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "support/temp_dir.hpp"
 
@@ -34,6 +37,23 @@ inline CliRun geode_cli(const std::string& args, bool with_stderr = false) {
   const int status = ::pclose(p);
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
+}
+
+// The progress a command printed on stderr (`err`: its standard error alone, e.g. its report
+// sent to a file with -o) is its stage lines (cli/progress.hpp Progress::stage_done), one per
+// stage as it ends, in order: "geode: " + a line starting with starts[i] + " (S.S s)". A run
+// this short shows no progress step (steps wait 2 s before they show).
+inline void check_stage_lines(const std::string& err, const std::vector<std::string>& starts) {
+  INFO(err);
+  std::vector<std::string> lines;
+  std::istringstream in(err);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  REQUIRE(lines.size() == starts.size());
+  const std::regex timed(R"(geode: .* \([0-9]+\.[0-9] s\))");
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    CHECK(lines[i].rfind("geode: " + starts[i], 0) == 0);
+    CHECK(std::regex_match(lines[i], timed));
+  }
 }
 
 // An environment variable for one scope (the commands run as children inherit it).
