@@ -6,8 +6,9 @@
 #include <cassert>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <string>
-#include <unordered_map>
+#include <tuple>
 
 #include <geode/primal/errors.hpp>
 #include <geode/primal/release.hpp>
@@ -134,32 +135,46 @@ MeshDual<Dim> build(std::size_t n_nodes,
   const Index n_cells = primal::index_cast(cells.size());
   PassProgress progress(options, cells.size());
 
-  // Validate and number the edges.
-  std::unordered_map<std::uint64_t, Index> edge_id;
-  dual.cell_edges.resize(n_cells);
+  // Validate the cells and number the edges in the order they first appear: every edge
+  // occurrence (nodes, then cell and local edge) sorted, so that an edge's are one run (a hash
+  // map of the edges took a third of a large mesh's dual).
+  constexpr std::size_t kEdges = MeshDual<Dim>::kCellEdges;
+  std::vector<std::pair<std::uint64_t, std::size_t>> seen;  // (pair_key, c * kEdges + e)
+  seen.reserve(cells.size() * kEdges);
   for (Index c = 0; c < n_cells; ++c) {
     progress.at(c);
     const auto& cell = cells[c];
-    const std::string name = std::string(R::kCellName) + " " + std::to_string(c);
+    // Made for an error only, not for each of millions of cells.
+    const auto name = [c] { return std::string(R::kCellName) + " " + std::to_string(c); };
     for (int k = 0; k < R::kCorners; ++k) {
       if (cell[k] < 0 || primal::index_cast<std::size_t>(cell[k]) >= n_nodes)
-        throw InvalidInput(name + ": corner " + std::to_string(k) + " = " +
+        throw InvalidInput(name() + ": corner " + std::to_string(k) + " = " +
                            std::to_string(cell[k]) + " is not a node (mesh has " +
                            std::to_string(n_nodes) + ")");
       for (int j = 0; j < k; ++j)
         if (cell[j] == cell[k])
-          throw InvalidInput(name + ": node " + std::to_string(cell[k]) + " is corner " +
+          throw InvalidInput(name() + ": node " + std::to_string(cell[k]) + " is corner " +
                              std::to_string(j) + " and " + std::to_string(k));
     }
-    for (int e = 0; e < MeshDual<Dim>::kCellEdges; ++e) {
-      const Index a = cell[R::kEdgeTable[e][0]], b = cell[R::kEdgeTable[e][1]];
-      auto [it, fresh] = edge_id.emplace(pair_key(a, b), primal::index_cast(dual.edges.size()));
-      if (fresh) dual.edges.push_back({std::min(a, b), std::max(a, b)});
-      dual.cell_edges[c][e] = it->second;
-    }
+    for (std::size_t e = 0; e < kEdges; ++e)
+      seen.emplace_back(pair_key(cell[R::kEdgeTable[e][0]], cell[R::kEdgeTable[e][1]]),
+                        primal::index_cast<std::size_t>(c) * kEdges + e);
   }
-
-  primal::release(edge_id);  // before the progress says done: a large map takes a while to free
+  std::sort(seen.begin(), seen.end());
+  std::vector<std::pair<std::size_t, std::size_t>> runs;  // (first occurrence, start in seen)
+  for (std::size_t i = 0; i < seen.size(); ++i)
+    if (i == 0 || seen[i].first != seen[i - 1].first) runs.emplace_back(seen[i].second, i);
+  std::sort(runs.begin(), runs.end());
+  dual.cell_edges.resize(n_cells);
+  dual.edges.resize(runs.size());
+  for (std::size_t id = 0; id < runs.size(); ++id) {
+    const std::size_t i = runs[id].second;
+    const std::uint64_t key = seen[i].first;  // pair_key: the lower node in the high half
+    dual.edges[id] = {static_cast<Index>(key >> 32), static_cast<Index>(key & 0xffffffffu)};
+    for (std::size_t k = i; k < seen.size() && seen[k].first == key; ++k)
+      dual.cell_edges[seen[k].second / kEdges][seen[k].second % kEdges] = primal::index_cast(id);
+  }
+  primal::release(seen, runs);  // before the progress says done: freeing takes a while
 
   // Sheets: within a cell the edges of one class are equivalent.
   progress.next();
@@ -201,42 +216,49 @@ MeshDual<Dim> build(std::size_t n_nodes,
     ++dual.intersections[tuple];
   }
 
-  // Boundary facets: used by one cell only.
+  // Boundary facets: used by one cell only. Every facet with its sorted nodes, sorted: a facet's
+  // users are one run (a hash map of facet lists was half of a large mesh's dual).
   progress.next();
-  std::unordered_map<std::uint64_t, std::vector<CellFacet>> by_key;  // keyed by 2 min nodes
+  struct Facet {
+    std::array<Index, R::kFacetSize> key;
+    CellFacet at;
+  };
+  std::vector<Facet> facets;
+  facets.reserve(cells.size() * R::kFacets);
   for (Index c = 0; c < n_cells; ++c) {
     progress.at(c);
     for (int f = 0; f < R::kFacets; ++f) {
-      std::array<Index, R::kFacetSize> key{};
-      for (int k = 0; k < R::kFacetSize; ++k) key[k] = cells[c][R::kFacetTable[f][k]];
-      std::sort(key.begin(), key.end());
-      by_key[pair_key(key[0], key[1])].push_back({c, f});
+      Facet& x = facets.emplace_back();
+      for (int k = 0; k < R::kFacetSize; ++k) x.key[k] = cells[c][R::kFacetTable[f][k]];
+      std::sort(x.key.begin(), x.key.end());
+      x.at = {c, f};
     }
   }
+  std::sort(facets.begin(), facets.end(), [](const Facet& a, const Facet& b) {
+    return std::tie(a.key, a.at.cell, a.at.local) < std::tie(b.key, b.at.cell, b.at.local);
+  });
   progress.next();
-  for (Index c = 0; c < n_cells; ++c) {
-    progress.at(c);
-    for (int f = 0; f < R::kFacets; ++f) {
-      std::array<Index, R::kFacetSize> key{};
-      for (int k = 0; k < R::kFacetSize; ++k) key[k] = cells[c][R::kFacetTable[f][k]];
-      std::sort(key.begin(), key.end());
-      std::vector<Index> users;
-      for (const CellFacet& g : by_key[pair_key(key[0], key[1])]) {
-        std::array<Index, R::kFacetSize> other{};
-        for (int k = 0; k < R::kFacetSize; ++k)
-          other[k] = cells[g.cell][R::kFacetTable[g.local][k]];
-        std::sort(other.begin(), other.end());
-        if (other == key) users.push_back(g.cell);
-      }
-      if (users.size() > 2)
-        throw TopologyError(std::string(R::kCellName) + " " + std::to_string(c) + ": facet " +
-                            std::to_string(f) + " is shared by " + std::to_string(users.size()) +
-                            " cells");
-      if (users.size() == 1) dual.boundary.push_back({c, f});
-    }
+  // A facet on more than two cells: the first in cell order is named, as a scan of the cells
+  // would meet it.
+  std::optional<CellFacet> crowded;
+  std::size_t crowd = 0;
+  for (std::size_t i = 0, j = 0; i < facets.size(); i = j) {
+    for (j = i + 1; j < facets.size() && facets[j].key == facets[i].key; ++j) {}
+    progress.at(primal::index_cast(i / R::kFacets));
+    const CellFacet& first = facets[i].at;  // the run's lowest cell, then facet
+    if (j - i == 1) dual.boundary.push_back(first);
+    if (j - i > 2 &&
+        (!crowded || std::tie(first.cell, first.local) < std::tie(crowded->cell, crowded->local)))
+      crowded = first, crowd = j - i;
   }
-
-  primal::release(by_key);
+  if (crowded)
+    throw TopologyError(std::string(R::kCellName) + " " + std::to_string(crowded->cell) +
+                        ": facet " + std::to_string(crowded->local) + " is shared by " +
+                        std::to_string(crowd) + " cells");
+  primal::release(facets);
+  std::sort(dual.boundary.begin(), dual.boundary.end(), [](const CellFacet& a, const CellFacet& b) {
+    return std::tie(a.cell, a.local) < std::tie(b.cell, b.local);
+  });
 
   build_traces(cells, dual);
   progress.end();
