@@ -171,14 +171,19 @@ class Distributor {
     offsets_ = primal::element_offsets(m());
     // The rings before the yardstick, which takes the lowest elements outside them; again after
     // it where it found inverted elements, which seed the zone too.
-    stage("zone selection", [&] { select_rings(options_.rings); });
+    stage(
+        "zone selection", [&] { select_rings(options_.rings); }, "zone selection: rings");
     stage("yardstick", [&] { yardstick(); });
-    stage("zone selection", [&] {
-      if (!inverted_.empty()) select_rings(options_.rings);
-      finish_zone();
-    });
+    stage(
+        "zone selection",
+        [&] {
+          if (!inverted_.empty()) select_rings(options_.rings);
+          finish_zone();
+        },
+        "zone selection: closed");
     // Here, before the zone rank leaves for the zone: rank 0 gathers the face pairs.
-    stage("partition", [&] { gather_pairs(); });
+    stage(
+        "partition", [&] { gather_pairs(); }, "partition: face pairs gathered");
     // The zone rank conforms the zone while rank 0 partitions and the others wait for it.
     if (rank_ == zone_rank()) stage("zone", [&] { conform_zone(); });
     stage("partition", [&] { partition(); });
@@ -196,15 +201,18 @@ class Distributor {
   }
 
  private:
+  // `name`: the report's stage (its seconds summed over the calls); `label`: the progress line's,
+  // told apart where one stage is run in two steps.
   template <typename F>
-  void stage(const std::string& name, F&& f) {
+  void stage(const std::string& name, F&& f, const std::string& label = {}) {
     const auto t0 = Clock::now();
     f();
     const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
     rep_.seconds[name] += seconds;
     if (options_.progress) {
       std::ostringstream line;
-      line << name << " (" << std::fixed << std::setprecision(1) << seconds << " s)";
+      line << (label.empty() ? name : label) << " (" << std::fixed << std::setprecision(1)
+           << seconds << " s)";
       options_.progress(line.str());
     }
   }

@@ -118,7 +118,9 @@ done
 # Progress: rank 0 alone says each stage as it ends, with its seconds (every rank reads, dices
 # and verifies: a stage said twice was said by two ranks); -q says nothing.
 "$mpiexec" --oversubscribe -np 2 "$geode_mpi" conform in.exo -o said.exo 2>said.txt >/dev/null
-for stage in "read in.exo: " "yardstick (" "dicing (" "zone shared (" "verification (" \
+# The two steps of the zone selection and of the partition each under a name of its own.
+for stage in "read in.exo: " "zone selection: rings (" "yardstick (" "zone selection: closed (" \
+  "partition: face pairs gathered (" "partition (" "dicing (" "zone shared (" "verification (" \
   "wrote rank 0's piece ("; do
   [ "$(grep -c "^geode_mpi: $stage" said.txt)" = 1 ] || {
     echo "progress: '$stage' not said once"; cat said.txt; exit 1
