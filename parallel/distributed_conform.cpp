@@ -212,6 +212,7 @@ void Distributor::conform_zone() {
       // it covers its region once (its cut, unlike a model's boundary, may be non-manifold, which
       // piece_ok does not judge); verify() checks around the cut whole.
       conform::ConformOptions zone_options = options_.conform;
+      if (options_.zone_progress) zone_options.progress = options_.zone_progress;
       // The zone's tets split from the input's pyramids come after its own (the split model's
       // order, which extract_submodel keeps): conform's volume warning counts them as pyramids.
       const auto& zone_tets = zone.element[static_cast<std::size_t>(ElementKind::kTet)];

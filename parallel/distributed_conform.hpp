@@ -71,8 +71,11 @@ struct DistributedOptions {
   std::vector<std::array<primal::Index, 2>>* element_pairs = nullptr;
   // Called on this rank with one line per stage as it ends ("dicing (3.2 s)"), for the command
   // line's progress output (geode_mpi gives it on rank 0 only); may be empty. The stages are
-  // DistributedReport::seconds's (a stage that runs twice is told twice).
+  // DistributedReport::seconds's (a stage that runs twice is told twice, by a label of its own).
   std::function<void(const std::string&)> progress;
+  // Called on the rank that conforms the transition zone with the zone's conform stage lines
+  // (ConformOptions::progress), the longest stage, while rank 0 waits for it; may be empty.
+  std::function<void(const std::string&)> zone_progress;
 };
 
 // One rank's share of the output.

@@ -283,6 +283,11 @@ int run(int argc, char** argv, int rank, int size) {
       options.zone_threads = zone_threads;
       // Rank 0's stages; it waits in "zone shared" while the last rank conforms the zone.
       if (say_progress) options.progress = [&](const std::string& line) { say(line, false); };
+      // The zone's conform says its own stages on the rank that runs it (the last).
+      if (!quiet)
+        options.zone_progress = [](const std::string& line) {
+          std::cerr << "geode_mpi: zone: " << line << std::endl;
+        };
       // Each rank frees the input once it has its piece, and reads it again only if the zone
       // grows after that (the read-time check passed already).
       options.reload = [&] {
