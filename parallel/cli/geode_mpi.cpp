@@ -4,6 +4,7 @@
 // neither MPI nor its runtime (an MPI program started without mpirun still initializes MPI).
 #include <malloc.h>
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <array>
@@ -39,6 +40,14 @@
 namespace {
 
 using namespace geode;
+
+// A progress line on stderr in one write: lines of two ranks (rank 0's stages, the zone rank's
+// conform) reach mpirun's stderr whole; written piece by piece they interleaved mid-line.
+void say_line(const std::string& line) {
+  const std::string s = line + "\n";
+  std::cerr.flush();
+  [[maybe_unused]] const auto written = ::write(STDERR_FILENO, s.data(), s.size());
+}
 
 double peak_mib() {
   rusage u{};
@@ -264,7 +273,7 @@ int run(int argc, char** argv, int rank, int size) {
     std::ostringstream s;
     s << "geode_mpi: " << line;
     if (timed) s << " (" << std::fixed << std::setprecision(1) << MPI_Wtime() - said_at << " s)";
-    std::cerr << s.str() << std::endl;
+    say_line(s.str());
     said_at = MPI_Wtime();
   };
   // Everything after the options, in the rank's arena.
@@ -286,7 +295,7 @@ int run(int argc, char** argv, int rank, int size) {
       // The zone's conform says its own stages on the rank that runs it (the last).
       if (!quiet)
         options.zone_progress = [](const std::string& line) {
-          std::cerr << "geode_mpi: zone: " << line << std::endl;
+          say_line("geode_mpi: zone: " + line);
         };
       // Each rank frees the input once it has its piece, and reads it again only if the zone
       // grows after that (the read-time check passed already).
