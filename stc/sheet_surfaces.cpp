@@ -189,15 +189,19 @@ std::array<std::array<int, 4>, 3> quad_order() {
   return order;
 }
 
-// The midpoint of global edge e as a vertex of sheet s's mesh, shared between cells.
+// The midpoint of global edge e as a vertex of its sheet's mesh `out`, shared between cells.
+// An edge lies in one sheet only, so one id per edge (`ids`, -1 until made) serves every sheet:
+// a hash map per sheet took most of a million-hex mesh's surfaces.
 template <class Out>
 Index midpoint_vertex(const std::vector<Point>& nodes, const std::array<Index, 2>& edge, Index e,
-                      std::unordered_map<Index, Index>& ids, Out& out) {
-  const auto [it, added] = ids.emplace(e, primal::index_cast(out.points.size()));
-  if (added)
+                      std::vector<Index>& ids, Out& out) {
+  Index& id = ids[primal::index_cast<std::size_t>(e)];
+  if (id < 0) {
+    id = primal::index_cast(out.points.size());
     out.points.push_back(0.5 * (nodes[primal::index_cast<std::size_t>(edge[0])] +
                                 nodes[primal::index_cast<std::size_t>(edge[1])]));
-  return it->second;
+  }
+  return id;
 }
 
 }  // namespace
@@ -239,7 +243,7 @@ std::vector<primal::TriMesh> dual_surfaces(const primal::HexMesh& mesh, const He
                                            const DualSurfaceOptions& options) {
   static const auto order = quad_order();
   std::vector<primal::TriMesh> out(dual.sheets.size());
-  std::vector<std::unordered_map<Index, Index>> ids(dual.sheets.size());
+  std::vector<Index> ids(dual.edges.size(), -1);
   const std::size_t cells = dual.cell_sheets.size();
   for (std::size_t c = 0; c < cells; ++c) {
     tell(options, c, cells);
@@ -248,8 +252,8 @@ std::vector<primal::TriMesh> dual_surfaces(const primal::HexMesh& mesh, const He
       std::array<Index, 4> q{};
       for (std::size_t i = 0; i < 4; ++i) {
         const Index e = dual.cell_edges[c][primal::index_cast<std::size_t>(order[k][i])];
-        q[i] = midpoint_vertex(mesh.points, dual.edges[primal::index_cast<std::size_t>(e)], e,
-                               ids[s], out[s]);
+        q[i] = midpoint_vertex(mesh.points, dual.edges[primal::index_cast<std::size_t>(e)], e, ids,
+                               out[s]);
       }
       out[s].tris.push_back({q[0], q[1], q[2]});
       out[s].tris.push_back({q[0], q[2], q[3]});
@@ -262,7 +266,7 @@ std::vector<primal::TriMesh> dual_surfaces(const primal::HexMesh& mesh, const He
 std::vector<primal::SegmentMesh> dual_curves(const primal::QuadMesh& mesh, const QuadDual& dual,
                                              const DualSurfaceOptions& options) {
   std::vector<primal::SegmentMesh> out(dual.sheets.size());
-  std::vector<std::unordered_map<Index, Index>> ids(dual.sheets.size());
+  std::vector<Index> ids(dual.edges.size(), -1);
   const std::size_t cells = dual.cell_sheets.size();
   for (std::size_t c = 0; c < cells; ++c) {
     tell(options, c, cells);
@@ -270,9 +274,9 @@ std::vector<primal::SegmentMesh> dual_curves(const primal::QuadMesh& mesh, const
       const auto s = primal::index_cast<std::size_t>(dual.cell_sheets[c][k]);
       const Index a = dual.cell_edges[c][k], b = dual.cell_edges[c][k + 2];  // opposite edges
       out[s].segments.push_back(
-          {midpoint_vertex(mesh.points, dual.edges[primal::index_cast<std::size_t>(a)], a, ids[s],
+          {midpoint_vertex(mesh.points, dual.edges[primal::index_cast<std::size_t>(a)], a, ids,
                            out[s]),
-           midpoint_vertex(mesh.points, dual.edges[primal::index_cast<std::size_t>(b)], b, ids[s],
+           midpoint_vertex(mesh.points, dual.edges[primal::index_cast<std::size_t>(b)], b, ids,
                            out[s])});
     }
   }
