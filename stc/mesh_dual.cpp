@@ -24,12 +24,6 @@ namespace topo = primal::topology;
 template <int Dim>
 using Ref = topo::CellTopology<Dim>;
 
-std::uint64_t pair_key(Index a, Index b) {
-  if (a > b) std::swap(a, b);
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) |
-         static_cast<std::uint32_t>(b);
-}
-
 // Local hex edge joining two corners, from the edge table; -1 when they are not joined.
 int local_hex_edge(int a, int b) {
   for (int e = 0; e < topo::kHexEdges; ++e) {
@@ -135,12 +129,18 @@ MeshDual<Dim> build(std::size_t n_nodes,
   const Index n_cells = primal::index_cast(cells.size());
   PassProgress progress(options, cells.size());
 
-  // Validate the cells and number the edges in the order they first appear: every edge
-  // occurrence (nodes, then cell and local edge) sorted, so that an edge's are one run (a hash
-  // map of the edges took a third of a large mesh's dual).
+  // Validate the cells and number the edges in the order they first appear. The occurrences
+  // (slots c * kEdges + e) are bucketed by their lower node (a counting sort) and each node's
+  // few sorted by the upper one, so that an edge's occurrences are one run: a hash map of the
+  // edges took a third of a large mesh's dual, and a sort of all the occurrences half of that.
   constexpr std::size_t kEdges = MeshDual<Dim>::kCellEdges;
-  std::vector<std::pair<std::uint64_t, std::size_t>> seen;  // (pair_key, c * kEdges + e)
-  seen.reserve(cells.size() * kEdges);
+  const auto ends = [&cells](std::size_t slot) {
+    const auto& cell = cells[slot / kEdges];
+    const auto& corners = R::kEdgeTable[slot % kEdges];
+    const Index a = cell[corners[0]], b = cell[corners[1]];
+    return a < b ? std::array<Index, 2>{a, b} : std::array<Index, 2>{b, a};
+  };
+  std::vector<std::size_t> start(n_nodes + 1, 0);  // the buckets' bounds in by_lower
   for (Index c = 0; c < n_cells; ++c) {
     progress.at(c);
     const auto& cell = cells[c];
@@ -157,24 +157,48 @@ MeshDual<Dim> build(std::size_t n_nodes,
                              std::to_string(j) + " and " + std::to_string(k));
     }
     for (std::size_t e = 0; e < kEdges; ++e)
-      seen.emplace_back(pair_key(cell[R::kEdgeTable[e][0]], cell[R::kEdgeTable[e][1]]),
-                        primal::index_cast<std::size_t>(c) * kEdges + e);
+      ++start[primal::index_cast<std::size_t>(
+                  ends(primal::index_cast<std::size_t>(c) * kEdges + e)[0]) +
+              1];
   }
-  std::sort(seen.begin(), seen.end());
-  std::vector<std::pair<std::size_t, std::size_t>> runs;  // (first occurrence, start in seen)
-  for (std::size_t i = 0; i < seen.size(); ++i)
-    if (i == 0 || seen[i].first != seen[i - 1].first) runs.emplace_back(seen[i].second, i);
-  std::sort(runs.begin(), runs.end());
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  const std::size_t n_slots = cells.size() * kEdges;
+  std::vector<std::size_t> by_lower(n_slots);
+  {
+    std::vector<std::size_t> next(start.begin(), start.end() - 1);
+    for (std::size_t slot = 0; slot < n_slots; ++slot)
+      by_lower[next[primal::index_cast<std::size_t>(ends(slot)[0])]++] = slot;
+  }
+  // Each run an edge, numbered for now in bucket order (run_of: per slot), then renumbered in
+  // the order of first appearance.
+  std::vector<Index> run_of(n_slots);
+  std::vector<std::array<Index, 2>> run_edge;
+  for (std::size_t v = 0; v < n_nodes; ++v) {
+    const auto first = by_lower.begin() + static_cast<std::ptrdiff_t>(start[v]),
+               last = by_lower.begin() + static_cast<std::ptrdiff_t>(start[v + 1]);
+    std::sort(first, last, [&ends](std::size_t x, std::size_t y) {
+      return std::pair(ends(x)[1], x) < std::pair(ends(y)[1], y);
+    });
+    for (auto it = first; it != last; ++it) {
+      const auto edge = ends(*it);
+      if (it == first || ends(*(it - 1))[1] != edge[1]) run_edge.push_back(edge);
+      run_of[*it] = primal::index_cast(run_edge.size() - 1);
+    }
+  }
+  primal::release(by_lower, start);
   dual.cell_edges.resize(n_cells);
-  dual.edges.resize(runs.size());
-  for (std::size_t id = 0; id < runs.size(); ++id) {
-    const std::size_t i = runs[id].second;
-    const std::uint64_t key = seen[i].first;  // pair_key: the lower node in the high half
-    dual.edges[id] = {static_cast<Index>(key >> 32), static_cast<Index>(key & 0xffffffffu)};
-    for (std::size_t k = i; k < seen.size() && seen[k].first == key; ++k)
-      dual.cell_edges[seen[k].second / kEdges][seen[k].second % kEdges] = primal::index_cast(id);
+  dual.edges.reserve(run_edge.size());
+  std::vector<Index> id_of_run(run_edge.size(), -1);
+  for (std::size_t slot = 0; slot < n_slots; ++slot) {
+    Index& id = id_of_run[primal::index_cast<std::size_t>(run_of[slot])];
+    if (id < 0) {
+      id = primal::index_cast(dual.edges.size());
+      dual.edges.push_back(run_edge[primal::index_cast<std::size_t>(run_of[slot])]);
+    }
+    dual.cell_edges[slot / kEdges][slot % kEdges] = id;
   }
-  primal::release(seen, runs);  // before the progress says done: freeing takes a while
+  primal::release(run_of, run_edge,
+                  id_of_run);  // before the progress says done: freeing takes a while
 
   // Sheets: within a cell the edges of one class are equivalent.
   progress.next();
