@@ -1,11 +1,12 @@
 #include <geode/viewer/html.hpp>
 
+#include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 #include <geode/io/atomic_file.hpp>
 #include <geode/primal/boundary.hpp>
@@ -25,7 +26,9 @@ extern const char kThreeJs[];
 namespace {
 
 // JSON written by hand for the bulk arrays: coordinates to 7 significant digits keep the file
-// small; strings go through nlohmann::json for escaping.
+// small; strings go through nlohmann::json for escaping. Numbers through std::to_chars (its
+// general format at precision 7 is printf's "%.7g"; snprintf took a third of a million-hex
+// page's writing).
 class JsonOut {
  public:
   void key(const char* k) {
@@ -35,11 +38,20 @@ class JsonOut {
     s_ += "\":";
     first_ = true;
   }
-  void raw(const std::string& v) {
+  void raw(std::string_view v) {
     comma();
     s_ += v;
   }
-  void str(const std::string& v) { raw(nlohmann::json(v).dump()); }
+  // '<' only occurs inside strings here; escaping it keeps "</script>" out of the page.
+  void str(const std::string& v) {
+    comma();
+    for (char c : nlohmann::json(v).dump()) {
+      if (c == '<')
+        s_ += "\\u003c";
+      else
+        s_ += c;
+    }
+  }
   void open(char c) {
     comma();
     s_ += c;
@@ -51,10 +63,14 @@ class JsonOut {
   }
   void number(double v) {
     char b[32];
-    std::snprintf(b, sizeof b, "%.7g", std::isfinite(v) ? v : 0.0);
-    raw(b);
+    raw({b,
+         std::to_chars(b, b + sizeof b, std::isfinite(v) ? v : 0.0, std::chars_format::general, 7)
+             .ptr});
   }
-  void index(Index v) { raw(std::to_string(v)); }
+  void index(Index v) {
+    char b[16];
+    raw({b, std::to_chars(b, b + sizeof b, v).ptr});
+  }
   void points(const std::vector<Point>& pts) {
     open('[');
     for (const auto& p : pts) number(p.x()), number(p.y()), number(p.z());
@@ -67,12 +83,7 @@ class JsonOut {
       for (auto v : r) index(index_cast(v));
     close(']');
   }
-  // '<' only occurs inside strings here; escaping it keeps "</script>" out of the page.
-  std::string text() const {
-    std::string out;
-    for (char c : s_) out += c == '<' ? std::string("\\u003c") : std::string(1, c);
-    return out;
-  }
+  const std::string& text() const { return s_; }
 
  private:
   void comma() {
@@ -110,27 +121,29 @@ std::string html_escape(const std::string& t) {
   return out;
 }
 
-// Replaces each @NAME@ of the page by its value; inserted text is not scanned again.
-std::string fill(const std::string& page, const std::map<std::string, std::string>& values) {
-  std::string out;
+// Passes the page to `out` in pieces, each @NAME@ replaced by its value; inserted text is not
+// scanned again. The pieces go to the file as they are: a million-hex page is hundreds of MB,
+// and copying it whole (once filled, once escaped) doubled the memory and cost seconds.
+template <class Out>
+void fill(std::string_view page, const std::map<std::string_view, std::string_view>& values,
+          Out&& out) {
   std::size_t at = 0;
   while (true) {
     const std::size_t a = page.find('@', at);
-    const std::size_t b = a == std::string::npos ? a : page.find('@', a + 1);
+    const std::size_t b = a == std::string_view::npos ? a : page.find('@', a + 1);
     const auto it =
-        b == std::string::npos ? values.end() : values.find(page.substr(a + 1, b - a - 1));
+        b == std::string_view::npos ? values.end() : values.find(page.substr(a + 1, b - a - 1));
     if (it == values.end()) {
-      if (a == std::string::npos) break;
-      out.append(page, at, a + 1 - at);
+      if (a == std::string_view::npos) break;
+      out(page.substr(at, a + 1 - at));
       at = a + 1;
       continue;
     }
-    out.append(page, at, a - at);
-    out += it->second;
+    out(page.substr(at, a - at));
+    out(it->second);
     at = b + 1;
   }
-  out.append(page, at, std::string::npos);
-  return out;
+  out(page.substr(at));
 }
 
 template <std::size_t K, std::size_t C, class Facets>
@@ -148,10 +161,10 @@ void write_topology(JsonOut& j, int dim, const std::array<std::array<int, K>, C>
   j.close(']');
 }
 
+// The scene's data (the page's JSON) into j.
 template <class Cells>
-std::string page(const std::vector<Point>& points, const Cells& cells,
-                 const std::vector<int>* block, const std::vector<double>& quality,
-                 const ViewScene& scene, int dim, JsonOut& j) {
+void page_data(const std::vector<Point>& points, const Cells& cells, const std::vector<int>* block,
+               const std::vector<double>& quality, const ViewScene& scene, int dim, JsonOut& j) {
   const std::size_t n = points.size();
   check_ids(cells, n, dim == 3 ? "hex" : "quad");
   j.key("title"), j.str(scene.title);
@@ -205,10 +218,32 @@ std::string page(const std::vector<Point>& points, const Cells& cells,
   }
   j.close(']');
   j.close('}');
-  return fill(kViewerHtml, {{"GEODE_TITLE", html_escape(scene.title)},
-                            {"GEODE_THREE", kThreeJs},
-                            {"GEODE_DATA", j.text()},
-                            {"GEODE_VIEWER_JS", kViewerJs}});
+}
+
+// The page of `data` (page_data's) passed to `out` in pieces.
+template <class Out>
+void emit_page(const ViewScene& scene, const JsonOut& data, Out&& out) {
+  const std::string title = html_escape(scene.title);
+  fill(kViewerHtml,
+       {{"GEODE_TITLE", title},
+        {"GEODE_THREE", kThreeJs},
+        {"GEODE_DATA", data.text()},
+        {"GEODE_VIEWER_JS", kViewerJs}},
+       out);
+}
+
+std::string page_text(const ViewScene& scene, const JsonOut& data) {
+  std::string out;
+  emit_page(scene, data, [&out](std::string_view piece) { out += piece; });
+  return out;
+}
+
+void write_page(const std::filesystem::path& path, const ViewScene& scene, const JsonOut& data) {
+  io::write_file_atomically(path, [&](std::ostream& os) {
+    emit_page(scene, data, [&os](std::string_view piece) {
+      os.write(piece.data(), static_cast<std::streamsize>(piece.size()));
+    });
+  });
 }
 
 }  // namespace
@@ -227,7 +262,9 @@ ViewFaceGroup boundary_face_group(std::string name, const primal::HexMesh& mesh,
   return group;
 }
 
-std::string html_view(const HexMesh& mesh, const ViewScene& scene) {
+namespace {
+
+JsonOut scene_data(const HexMesh& mesh, const ViewScene& scene) {
   check_ids(mesh.hexes, mesh.points.size(), "hex");
   std::vector<double> q;
   for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
@@ -237,10 +274,11 @@ std::string html_view(const HexMesh& mesh, const ViewScene& scene) {
   std::vector<std::array<int, 2>> edges(topology::kHexEdgeCorners.begin(),
                                         topology::kHexEdgeCorners.end());
   write_topology(j, 3, topology::kHexFaceCorners, topology::kHexFaceCorners, edges);
-  return page(mesh.points, mesh.hexes, &mesh.block, q, scene, 3, j);
+  page_data(mesh.points, mesh.hexes, &mesh.block, q, scene, 3, j);
+  return j;
 }
 
-std::string html_view(const QuadMesh& mesh, const ViewScene& scene) {
+JsonOut scene_data(const QuadMesh& mesh, const ViewScene& scene) {
   check_ids(mesh.quads, mesh.points.size(), "quad");
   // A planar mesh in z = 0 (a 2D template) is measured against +z, so that a flipped quad shows
   // as inverted; a quad surface in space by its own corners.
@@ -257,17 +295,26 @@ std::string html_view(const QuadMesh& mesh, const ViewScene& scene) {
                                         topology::kQuadEdgeCorners.end());
   write_topology(j, 2, std::array<std::array<int, 4>, 1>{{{0, 1, 2, 3}}},
                  topology::kQuadEdgeCorners, edges);
-  return page(mesh.points, mesh.quads, nullptr, q, scene, 2, j);
+  page_data(mesh.points, mesh.quads, nullptr, q, scene, 2, j);
+  return j;
+}
+
+}  // namespace
+
+std::string html_view(const HexMesh& mesh, const ViewScene& scene) {
+  return page_text(scene, scene_data(mesh, scene));
+}
+
+std::string html_view(const QuadMesh& mesh, const ViewScene& scene) {
+  return page_text(scene, scene_data(mesh, scene));
 }
 
 void write_html(const std::filesystem::path& path, const HexMesh& mesh, const ViewScene& scene) {
-  const std::string text = html_view(mesh, scene);
-  io::write_file_atomically(path, [&](std::ostream& os) { os << text; });
+  write_page(path, scene, scene_data(mesh, scene));
 }
 
 void write_html(const std::filesystem::path& path, const QuadMesh& mesh, const ViewScene& scene) {
-  const std::string text = html_view(mesh, scene);
-  io::write_file_atomically(path, [&](std::ostream& os) { os << text; });
+  write_page(path, scene, scene_data(mesh, scene));
 }
 
 }  // namespace geode::viewer

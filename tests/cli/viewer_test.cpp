@@ -4,13 +4,16 @@
 // when a sheet is hidden through the URL hash.
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <regex>
 #include <sstream>
 #include <string>
 
 #include <geode/io/vtk.hpp>
+#include <geode/viewer/html.hpp>
 #include "support/cli_run.hpp"
 #include "support/fixtures.hpp"
 #include "support/png.hpp"
@@ -184,4 +187,52 @@ TEST_CASE("viewer: geode view shows any hex or quad mesh with its dual sheets") 
   // Refusals: an output that is not .html, a missing input.
   CHECK(geode_cli("view " + hex.string() + " -o " + (dir.path / "x.vtu").string()).code == 2);
   CHECK(geode_cli("view " + (dir.path / "missing.vtu").string() + " -o " + h.string()).code == 2);
+}
+
+TEST_CASE("viewer: the page's data: coordinates as printf's %.7g, strings escaped, file = text") {
+  // One hex with a corner per awkward value: rounding up a digit, exponents both ways, the
+  // smallest subnormal, the largest double, a negative zero; NaN is written as 0.
+  primal::HexMesh m = test::structured_hex_grid(1, 1, 1);
+  const std::vector<double> values = {0.1,
+                                      -0.0,
+                                      1e-5,
+                                      123456789.0,
+                                      1234567.,
+                                      0.00012345678,
+                                      9.9999995,
+                                      0.000099999995,
+                                      1e300,
+                                      5e-324,
+                                      1.0 / 3,
+                                      -2.5e-5,
+                                      1.7976931348623157e308,
+                                      0.5,
+                                      1e16,
+                                      std::numeric_limits<double>::quiet_NaN()};
+  std::size_t k = 0;
+  for (auto& p : m.points)
+    for (int i = 0; i < 3; ++i) p[i] = values[k++ % values.size()];
+  viewer::ViewScene scene;
+  scene.title = "a </script> & \"b\"";
+  const std::string page = viewer::html_view(m, scene);
+  const std::size_t from = page.find("\"nodes\":[");
+  REQUIRE(from != std::string::npos);
+  const std::size_t begin = from + 9, end = page.find(']', begin);
+  std::string expected;
+  k = 0;
+  for (std::size_t n = 0; n < 3 * m.points.size(); ++n) {
+    const double v = values[k++ % values.size()];
+    char b[40];
+    std::snprintf(b, sizeof b, "%.7g", std::isfinite(v) ? v : 0.0);
+    expected += (n ? "," : "") + std::string(b);
+  }
+  CHECK(page.substr(begin, end - begin) == expected);
+  // The title: in the data as a JSON string with '<' escaped (no "</script>" ends the script
+  // early), in <title> HTML-escaped.
+  CHECK(page.find("a \\u003c/script> & \\\"b\\\"") != std::string::npos);
+  CHECK(page.find("a &lt;/script&gt; &amp; &quot;b&quot;") != std::string::npos);
+  CHECK(page.find("a </script>") == std::string::npos);
+  test::TempDir dir;
+  viewer::write_html(dir.path / "one.html", m, scene);
+  CHECK(slurp(dir.path / "one.html") == page);
 }
