@@ -230,37 +230,63 @@ MeshDual<Dim> build(std::size_t n_nodes,
     dual.sheets[dual.edge_sheet[e]].edges.push_back(primal::index_cast(e));
   }
   progress.next();
+  // The intersections counted in a sorted list and put in the map in order (a map lookup per
+  // cell was a fifth of a large mesh's dual).
+  std::vector<std::array<Index, Dim>> tuples(cells.size());
   for (Index c = 0; c < n_cells; ++c) {
     progress.at(c);
-    auto tuple = dual.cell_sheets[c];
+    auto& tuple = tuples[primal::index_cast<std::size_t>(c)] = dual.cell_sheets[c];
     for (Index s : tuple) dual.sheets[s].cells.push_back(c);
     std::sort(tuple.begin(), tuple.end());
     for (int k = 1; k < Dim; ++k)
       if (tuple[k] == tuple[k - 1]) dual.sheets[tuple[k]].self_intersecting = true;
-    ++dual.intersections[tuple];
   }
+  std::sort(tuples.begin(), tuples.end());
+  for (std::size_t i = 0, j = 0; i < tuples.size(); i = j) {
+    for (j = i + 1; j < tuples.size() && tuples[j] == tuples[i]; ++j) {}
+    dual.intersections.emplace_hint(dual.intersections.end(), tuples[i], primal::index_cast(j - i));
+  }
+  primal::release(tuples);
 
-  // Boundary facets: used by one cell only. Every facet with its sorted nodes, sorted: a facet's
-  // users are one run (a hash map of facet lists was half of a large mesh's dual).
+  // Boundary facets: used by one cell only. Every facet with its sorted nodes, bucketed by its
+  // lowest node (a counting sort) and each bucket sorted: a facet's users are one run (a hash
+  // map of facet lists was half of a large mesh's dual, a sort of all the facets a sixth).
   progress.next();
   struct Facet {
     std::array<Index, R::kFacetSize> key;
     CellFacet at;
   };
-  std::vector<Facet> facets;
-  facets.reserve(cells.size() * R::kFacets);
-  for (Index c = 0; c < n_cells; ++c) {
-    progress.at(c);
-    for (int f = 0; f < R::kFacets; ++f) {
-      Facet& x = facets.emplace_back();
-      for (int k = 0; k < R::kFacetSize; ++k) x.key[k] = cells[c][R::kFacetTable[f][k]];
-      std::sort(x.key.begin(), x.key.end());
-      x.at = {c, f};
+  const auto facet = [&cells](Index c, int f) {
+    Facet x;
+    for (int k = 0; k < R::kFacetSize; ++k) x.key[k] = cells[c][R::kFacetTable[f][k]];
+    std::sort(x.key.begin(), x.key.end());
+    x.at = {c, f};
+    return x;
+  };
+  std::vector<std::size_t> first_of(n_nodes + 1, 0);
+  for (Index c = 0; c < n_cells; ++c)
+    for (int f = 0; f < R::kFacets; ++f)
+      ++first_of[primal::index_cast<std::size_t>(facet(c, f).key[0]) + 1];
+  std::partial_sum(first_of.begin(), first_of.end(), first_of.begin());
+  std::vector<Facet> facets(cells.size() * R::kFacets);
+  {
+    std::vector<std::size_t> next(first_of.begin(), first_of.end() - 1);
+    for (Index c = 0; c < n_cells; ++c) {
+      progress.at(c);
+      for (int f = 0; f < R::kFacets; ++f) {
+        const Facet x = facet(c, f);
+        facets[next[primal::index_cast<std::size_t>(x.key[0])]++] = x;
+      }
     }
   }
-  std::sort(facets.begin(), facets.end(), [](const Facet& a, const Facet& b) {
-    return std::tie(a.key, a.at.cell, a.at.local) < std::tie(b.key, b.at.cell, b.at.local);
-  });
+  for (std::size_t v = 0; v < n_nodes; ++v)
+    std::sort(facets.begin() + static_cast<std::ptrdiff_t>(first_of[v]),
+              facets.begin() + static_cast<std::ptrdiff_t>(first_of[v + 1]),
+              [](const Facet& a, const Facet& b) {
+                return std::tie(a.key, a.at.cell, a.at.local) <
+                       std::tie(b.key, b.at.cell, b.at.local);
+              });
+  primal::release(first_of);
   progress.next();
   // A facet on more than two cells: the first in cell order is named, as a scan of the cells
   // would meet it.
