@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -409,6 +410,12 @@ void invalid_written(const std::string& what, const std::string& reason) {
 CLI::Option* add_quiet_flag(CLI::App* app, bool& flag) {
   return app->add_flag("--quiet", flag,
                        "no progress on stderr (the output, errors and warnings still print)");
+}
+
+std::string stage_line(const std::string& line, double seconds) {
+  char tenths[32];
+  std::snprintf(tenths, sizeof tenths, "%.1f", seconds);
+  return line + " (" + tenths + " s)";
 }
 
 CLI::Option* add_write_invalid_flag(CLI::App* app, bool& flag) {

@@ -141,6 +141,8 @@ CLI::Option* add_write_invalid_flag(CLI::App* app, bool& flag);
 // --quiet of a command whose output is its report (check, dual, view): no progress lines on
 // stderr; the report, errors and warnings still print.
 CLI::Option* add_quiet_flag(CLI::App* app, bool& flag);
+// A stage's progress line as every command says it when the stage ends: "LINE (S.S s)".
+std::string stage_line(const std::string& line, double seconds);
 
 // Several outputs written as one: each goes to a temporary file next to its target (same
 // extension, so writers that go by it still work; registered for removal on signals), and only

@@ -4,9 +4,9 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <iomanip>
 #include <iostream>
-#include <sstream>
+
+#include "cli/conventions.hpp"
 
 namespace geode::cli {
 
@@ -29,9 +29,7 @@ void Progress::stage_done(const std::string& line) {
   const auto now = Clock::now();
   const double seconds = std::chrono::duration<double>(now - stage_started_).count();
   stage_started_ = now;
-  std::ostringstream s;
-  s << line << " (" << std::fixed << std::setprecision(1) << seconds << " s)";
-  stage(s.str());
+  stage(stage_line(line, seconds));
 }
 
 void Progress::step(const std::string& what, std::size_t done, std::size_t total) {

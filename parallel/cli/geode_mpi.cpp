@@ -12,7 +12,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <functional>
-#include <iomanip>
 #include <iostream>
 #include <new>
 #include <sstream>
@@ -270,10 +269,7 @@ int run(int argc, char** argv, int rank, int size) {
   double said_at = 0;
   const auto say = [&](const std::string& line, bool timed) {
     if (!say_progress) return;
-    std::ostringstream s;
-    s << "geode_mpi: " << line;
-    if (timed) s << " (" << std::fixed << std::setprecision(1) << MPI_Wtime() - said_at << " s)";
-    say_line(s.str());
+    say_line("geode_mpi: " + (timed ? cli::stage_line(line, MPI_Wtime() - said_at) : line));
     said_at = MPI_Wtime();
   };
   // Everything after the options, in the rank's arena.
