@@ -1,5 +1,6 @@
 // Sheets and chords read off meshes (stc/mesh_dual.hpp): structured grids with hand-counted
-// answers, a hand-built self-intersecting chord, and the paper's Appendix A geode.
+// answers, a hand-built self-intersecting chord, the paper's Appendix A geode, and conformed
+// Gmsh models against the definitions read the plain way.
 #include <doctest/doctest.h>
 
 #include <Eigen/Geometry>
@@ -17,9 +18,11 @@
 
 #include <unistd.h>
 
+#include <geode/primal/disjoint_sets.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/topology.hpp>
 #include <geode/stc/mesh_dual.hpp>
+#include "support/demo_input.hpp"
 #include "support/fixtures.hpp"
 #include "support/isomorphism.hpp"
 
@@ -561,5 +564,81 @@ TEST_CASE("mesh_dual tells its progress through every pass, and the dual is the 
     const auto dual = stc::mesh_dual(g, options);
     check_told(told, stc::kMeshDualPasses * g.quads.size());
     CHECK(dual.sheets.size() == 300);
+  }
+}
+
+// The dual as its definitions read, written the plain way (maps, one pass each): edges numbered
+// in order of first appearance, sheets the classes of edges joined by parallel edges within a
+// cell, boundary facets those of one cell. mesh_dual reaches the same by sorting and bucketing.
+TEST_CASE("mesh_dual of conformed Gmsh models equals its definitions read the plain way") {
+  geode::test::TempDir dir;
+  for (const char* model : {"hexdominant", "potting", "fulcher"}) {
+    CAPTURE(model);
+    const auto out = dir.path / (std::string(model) + ".vtu");
+    const auto run = geode::test::geode_cli(
+        std::string("demo --model ") + model + " -n 2 --quiet -o " + out.string(), true);
+    INFO(run.out);
+    REQUIRE(run.code == 0);
+    const auto m = geode::io::read_model(out);
+    const HexMesh mesh{m.points, m.hexes, {}};
+    REQUIRE(mesh.hexes.size() > 1000);
+    const auto dual = stc::mesh_dual(mesh);
+
+    std::map<std::pair<Index, Index>, Index> edge_id;
+    std::vector<std::array<Index, 2>> edges;
+    std::vector<std::array<Index, 12>> cell_edges(mesh.hexes.size());
+    for (std::size_t c = 0; c < mesh.hexes.size(); ++c)
+      for (int e = 0; e < 12; ++e) {
+        Index a = mesh.hexes[c][topo::kHexEdgeCorners[e][0]],
+              b = mesh.hexes[c][topo::kHexEdgeCorners[e][1]];
+        if (a > b) std::swap(a, b);
+        const auto [it, added] = edge_id.emplace(std::pair(a, b), Index(edges.size()));
+        if (added) edges.push_back({a, b});
+        cell_edges[c][e] = it->second;
+      }
+    CHECK(dual.edges == edges);
+    CHECK(dual.cell_edges == cell_edges);
+
+    // Sheets: parallel edges of a cell (kHexEdgeCorners lists the 4 edges of each direction
+    // together) in one class; numbered in order of first appearance, cell by cell.
+    geode::primal::DisjointSets classes(edges.size());
+    for (const auto& ce : cell_edges)
+      for (int e = 0; e < 12; ++e) classes.unite(ce[e], ce[4 * (e / 4)]);
+    std::map<Index, Index> sheet_of_class;
+    std::vector<std::array<Index, 3>> cell_sheets(mesh.hexes.size());
+    std::map<std::array<Index, 3>, Index> intersections;
+    for (std::size_t c = 0; c < mesh.hexes.size(); ++c) {
+      for (int e = 0; e < 12; ++e) {
+        const auto [it, added] =
+            sheet_of_class.emplace(classes.find(cell_edges[c][e]), Index(sheet_of_class.size()));
+        cell_sheets[c][e / 4] = it->second;
+      }
+      auto sorted = cell_sheets[c];
+      std::sort(sorted.begin(), sorted.end());
+      ++intersections[sorted];
+    }
+    CHECK(dual.sheets.size() == sheet_of_class.size());
+    CHECK(dual.cell_sheets == cell_sheets);
+    CHECK(dual.intersections == intersections);
+
+    std::map<std::array<Index, 4>, std::vector<stc::CellFacet>> users;
+    for (std::size_t c = 0; c < mesh.hexes.size(); ++c)
+      for (int f = 0; f < 6; ++f) {
+        std::array<Index, 4> key;
+        for (int k = 0; k < 4; ++k) key[k] = mesh.hexes[c][topo::kHexFaceCorners[f][k]];
+        std::sort(key.begin(), key.end());
+        users[key].push_back({Index(c), f});
+      }
+    std::vector<stc::CellFacet> boundary;
+    std::size_t crowded = 0;  // facets of three cells or more: none in a valid output
+    for (const auto& [key, list] : users) {
+      crowded += list.size() > 2;
+      if (list.size() == 1) boundary.push_back(list[0]);
+    }
+    CHECK(crowded == 0);
+    std::sort(boundary.begin(), boundary.end(), [](const auto& a, const auto& b) {
+      return std::pair(a.cell, a.local) < std::pair(b.cell, b.local);
+    });
+    CHECK(dual.boundary == boundary);
   }
 }
