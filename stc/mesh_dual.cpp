@@ -156,10 +156,10 @@ MeshDual<Dim> build(std::size_t n_nodes,
           throw InvalidInput(name() + ": node " + std::to_string(cell[k]) + " is corner " +
                              std::to_string(j) + " and " + std::to_string(k));
     }
-    for (std::size_t e = 0; e < kEdges; ++e)
-      ++start[primal::index_cast<std::size_t>(
-                  ends(primal::index_cast<std::size_t>(c) * kEdges + e)[0]) +
-              1];
+    for (std::size_t e = 0; e < kEdges; ++e) {
+      const Index lower = ends(primal::index_cast<std::size_t>(c) * kEdges + e)[0];
+      ++start[primal::index_cast<std::size_t>(lower) + 1];
+    }
   }
   std::partial_sum(start.begin(), start.end(), start.begin());
   const std::size_t n_slots = cells.size() * kEdges;
@@ -197,8 +197,8 @@ MeshDual<Dim> build(std::size_t n_nodes,
     }
     dual.cell_edges[slot / kEdges][slot % kEdges] = id;
   }
-  primal::release(run_of, run_edge,
-                  id_of_run);  // before the progress says done: freeing takes a while
+  // Freed before the progress says done: freeing takes a while.
+  primal::release(run_of, run_edge, id_of_run);
 
   // Sheets: within a cell the edges of one class are equivalent.
   progress.next();
