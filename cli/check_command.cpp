@@ -120,7 +120,7 @@ void run_check(const CheckArgs& a) {
     j["quality"] = c.analysable ? c.quality : nlohmann::json();
     j["obstructions"] =
         c.analysable ? primal::obstructions_json(c.obstructions, base) : nlohmann::json();
-    text = j.dump(1) + "\n";
+    text = json_text(j, 1);
   } else {
     std::ostringstream s;
     s << a.input << " (" << (m.dim == 3 ? "elements" : "quads") << " and nodes numbered from "

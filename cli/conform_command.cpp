@@ -213,7 +213,7 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
   if (valid || a.write_invalid) {
     if (write_failed) std::rethrow_exception(write_failed);
     if (!a.report.empty()) {
-      files.add(a.report, [text = conform::report_json(r).dump(2) + "\n"](const fs::path& temp) {
+      files.add(a.report, [text = json_text(conform::report_json(r), 2)](const fs::path& temp) {
         write_or_print(temp.string(), [&](std::ostream& os) { os << text; });
       });
     }

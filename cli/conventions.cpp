@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 #include <string_view>
@@ -410,6 +411,10 @@ void invalid_written(const std::string& what, const std::string& reason) {
 CLI::Option* add_quiet_flag(CLI::App* app, bool& flag) {
   return app->add_flag("--quiet", flag,
                        "no progress on stderr (the output, errors and warnings still print)");
+}
+
+std::string json_text(const nlohmann::json& j, int indent) {
+  return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 std::string stage_line(const std::string& line, double seconds) {

@@ -18,6 +18,7 @@
 #include <filesystem>
 #include <functional>
 #include <limits>
+#include <nlohmann/json_fwd.hpp>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -141,6 +142,10 @@ CLI::Option* add_write_invalid_flag(CLI::App* app, bool& flag);
 // --quiet of a command whose output is its report (check, dual, view): no progress lines on
 // stderr; the report, errors and warnings still print.
 CLI::Option* add_quiet_flag(CLI::App* app, bool& flag);
+// JSON as every command writes it (reports, tables): a file name that is not UTF-8 (Linux names
+// are bytes) is written with U+FFFD in its place, as JSON text must be UTF-8, instead of the
+// library's exception failing the whole run.
+std::string json_text(const nlohmann::json& j, int indent);
 // A stage's progress line as every command says it when the stage ends: "LINE (S.S s)".
 std::string stage_line(const std::string& line, double seconds);
 

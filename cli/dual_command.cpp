@@ -167,7 +167,7 @@ void run_dual(const DualArgs& a) {
 
   std::string text;
   if (format == "json") {
-    text = j.dump(2) + "\n";
+    text = json_text(j, 2);
   } else {
     text = dual_text(j, m.dim);
     if (j.contains("rebuild")) {

@@ -333,7 +333,7 @@ void write_template(templates::Template& T, const TemplateOutput& a) {
   } else if (a.format == "csv") {
     text = dim == 3 ? csv_tables(pts, T.hex.hexes, 3) : csv_tables(pts, T.quad.quads, 2);
   } else if (a.format == "json") {
-    text = to_json(T, a.name).dump(1) + "\n";
+    text = json_text(to_json(T, a.name), 1);
   }
   if (a.quality && dim == 3)
     text +=

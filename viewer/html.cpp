@@ -42,10 +42,12 @@ class JsonOut {
     comma();
     s_ += v;
   }
-  // '<' only occurs inside strings here; escaping it keeps "</script>" out of the page.
+  // '<' only occurs inside strings here; escaping it keeps "</script>" out of the page. A caption
+  // naming a file whose name is not UTF-8 gets U+FFFD in its place (JSON text is UTF-8).
   void str(const std::string& v) {
     comma();
-    for (char c : nlohmann::json(v).dump()) {
+    for (char c :
+         nlohmann::json(v).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)) {
       if (c == '<')
         s_ += "\\u003c";
       else

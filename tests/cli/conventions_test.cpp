@@ -12,6 +12,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -471,4 +473,28 @@ TEST_CASE(
       CHECK(binary_doubles(slurp(out), "Name=\"scaled_jacobian\"").size() == 8);
     }
   }
+}
+
+TEST_CASE("cli conventions: a file name that is not UTF-8 is written into JSON with U+FFFD") {
+  // Linux file names are bytes; JSON text is UTF-8. The reports and the page name the input:
+  // nlohmann::json's strict dump threw (exit 1, no output) on such a name.
+  TempDir dir;
+  const std::string name = "mesh-\xff\xfe";  // Latin-1 bytes, not UTF-8
+  const fs::path mesh = dir.path / (name + ".exo");
+  io::write_exodus(primal::grid_model({2, 2, 2}, 1.0, [](int, int, int) { return false; }), mesh);
+  const std::string quoted = "'" + mesh.string() + "'";
+  const std::string replaced = "mesh-\xef\xbf\xbd\xef\xbf\xbd.exo";  // two U+FFFD
+  for (const std::string& command : {"check " + quoted + " --format json --quiet",
+                                     "dual " + quoted + " --format json --quiet"}) {
+    CAPTURE(command);
+    const auto run = test::geode_cli(command);
+    REQUIRE(run.code == 0);
+    const auto j = nlohmann::json::parse(run.out);  // throws on text that is not UTF-8
+    CHECK(j.dump().find(replaced) != std::string::npos);
+  }
+  const fs::path page = dir.path / "page.html";
+  REQUIRE(test::geode_cli("view " + quoted + " -o " + page.string() + " --quiet").code == 0);
+  std::ifstream in(page, std::ios::binary);
+  const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  CHECK(html.find(replaced) != std::string::npos);
 }
