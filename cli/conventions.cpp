@@ -1,6 +1,7 @@
 // Conventions shared by every command (cli/conventions.hpp).
 #include "cli/conventions.hpp"
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -415,6 +416,14 @@ CLI::Option* add_quiet_flag(CLI::App* app, bool& flag) {
 
 std::string json_text(const nlohmann::json& j, int indent) {
   return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+}
+
+std::string out_of_memory_reason() {
+  rlimit limit{};
+  if (::getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
+    return "the input needs more memory than this process may use (ulimit -v: " +
+           std::to_string(limit.rlim_cur >> 20) + " MiB)";
+  return "the input needs more memory than this machine gives";
 }
 
 std::string stage_line(const std::string& line, double seconds) {

@@ -146,6 +146,9 @@ CLI::Option* add_quiet_flag(CLI::App* app, bool& flag);
 // are bytes) is written with U+FFFD in its place, as JSON text must be UTF-8, instead of the
 // library's exception failing the whole run.
 std::string json_text(const nlohmann::json& j, int indent);
+// Why a std::bad_alloc ended a run: "the input needs more memory than this machine gives", or,
+// under an address-space limit (ulimit -v), "... than this process may use (ulimit -v: N MiB)".
+std::string out_of_memory_reason();
 // A stage's progress line as every command says it when the stage ends: "LINE (S.S s)".
 std::string stage_line(const std::string& line, double seconds);
 

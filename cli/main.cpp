@@ -130,8 +130,8 @@ int main(int argc, char** argv) {
   } catch (const std::bad_alloc&) {
     // An input whose model does not fit: still one line and exit 2, not a crash.
     std::cerr << command_path(app)
-              << ": error: out of memory: the input needs more memory than this machine "
-              << "gives (nothing written)\n";
+              << ": error: out of memory: " << geode::cli::out_of_memory_reason()
+              << " (nothing written)\n";
     code = 2;
   } catch (const std::length_error& e) {
     std::cerr << command_path(app)

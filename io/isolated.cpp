@@ -60,8 +60,23 @@ void write_all(int fd, const char* p, std::size_t n) {
   }
 }
 
+// The child's address space: what it inherits and limits.memory_bytes more, unless this process
+// may use less (ulimit -v): then that, which a child of root could otherwise exceed.
+struct AddressLimit {
+  std::uint64_t bytes = 0;
+  bool own = false;  // this process's own limit, lower than the reader's allowance
+};
+AddressLimit address_limit(const IsolationLimits& limits, std::uint64_t inherited) {
+  const std::uint64_t wanted = inherited + limits.memory_bytes;
+  rlimit current{};
+  if (::getrlimit(RLIMIT_AS, &current) == 0 && current.rlim_cur != RLIM_INFINITY &&
+      current.rlim_cur < wanted)
+    return {current.rlim_cur, true};
+  return {wanted, false};
+}
+
 [[noreturn]] void run_child(int fd, const std::function<std::string()>& work,
-                            const IsolationLimits& limits, std::uint64_t inherited) {
+                            const IsolationLimits& limits, AddressLimit address) {
   // Default actions: a crash ends the child (not a fuzzer's or sanitizer's handler reporting
   // it as ours), and the parent's signal cleanup (atomic_file.hpp) is the parent's alone.
   for (int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT, SIGTRAP, SIGSYS, SIGINT, SIGTERM,
@@ -86,7 +101,7 @@ void write_all(int fd, const char* p, std::size_t n) {
   const rlimit cpu{limits.cpu_seconds, limits.cpu_seconds + 5};
   ::setrlimit(RLIMIT_CPU, &cpu);
   if (!kSanitized) {
-    const rlimit as{inherited + limits.memory_bytes, inherited + limits.memory_bytes};
+    const rlimit as{address.bytes, address.bytes};
     ::setrlimit(RLIMIT_AS, &as);
   }
   char status = kResult;
@@ -151,7 +166,7 @@ std::string run_isolated(const std::function<std::string()>& work, const std::st
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0)
     throw InvalidInput(source + ": " + what + ": cannot create a pipe: " + std::strerror(errno));
-  const std::uint64_t inherited = address_space();
+  const AddressLimit address = address_limit(limits, address_space());
   const pid_t pid = ::fork();
   if (pid < 0) {
     const int e = errno;
@@ -162,7 +177,7 @@ std::string run_isolated(const std::function<std::string()>& work, const std::st
   }
   if (pid == 0) {
     ::close(fds[0]);
-    run_child(fds[1], work, limits, inherited);
+    run_child(fds[1], work, limits, address);
   }
   ::close(fds[1]);
   // A larger pipe (the most an unprivileged process may ask for, 1 MiB by default) than its
@@ -251,6 +266,10 @@ std::string run_isolated(const std::function<std::string()>& work, const std::st
     case kInvalid:
       throw InvalidInput(answer);
     case kOutOfMemory:
+      if (address.own)  // the user's limit, not the file, ran out
+        throw InvalidInput(failed + "out of memory: this process may use " +
+                           std::to_string(address.bytes >> 20) +
+                           " MiB of address space (ulimit -v), too little to read it");
       throw InvalidInput(failed + "it needs more than " +
                          std::to_string(limits.memory_bytes >> 20) +
                          " MiB of memory (corrupt file?)");

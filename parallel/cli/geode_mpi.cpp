@@ -383,8 +383,7 @@ int run(int argc, char** argv, int rank, int size) {
     } catch (const std::bad_alloc&) {
       // As the serial command (cli/main.cpp): one line and exit 2.
       failure = "geode_mpi conform (rank " + std::to_string(rank) +
-                "): error: out of memory: the input needs more memory than this machine gives "
-                "(nothing written)";
+                "): error: out of memory: " + cli::out_of_memory_reason() + " (nothing written)";
       return 2;
     } catch (const std::exception& e) {
       failure = "geode_mpi (rank " + std::to_string(rank) + "): " + e.what();

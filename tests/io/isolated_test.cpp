@@ -3,11 +3,14 @@
 // child's answer, and no child is left behind.
 #include <doctest/doctest.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
+#include <cstdint>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -87,5 +90,41 @@ TEST_CASE("run_isolated: the child's address space is capped") {
                            "f.exo", "reading", small),
                        doctest::Contains("needs more than 256 MiB"), InvalidInput);
   CHECK(no_children());
+}
+
+TEST_CASE("run_isolated: under the caller's own lower cap (ulimit -v) the child keeps it") {
+  // In a process of its own: the cap would hold the test binary too. Its child, allowed 2 GiB
+  // by default, must neither exceed the caller's limit (root could raise it) nor blame the
+  // file for running out under it.
+  const pid_t pid = ::fork();
+  REQUIRE(pid >= 0);
+  if (pid == 0) {
+    std::ifstream statm("/proc/self/statm");
+    std::uint64_t pages = 0;
+    statm >> pages;
+    const std::uint64_t cap =
+        pages * static_cast<std::uint64_t>(::sysconf(_SC_PAGESIZE)) + (std::uint64_t{256} << 20);
+    const rlimit limit{cap, cap};
+    if (::setrlimit(RLIMIT_AS, &limit) != 0) ::_exit(3);
+    try {
+      run_isolated(
+          []() -> std::string {
+            std::vector<char> v(std::size_t{1} << 30, 'x');  // within 2 GiB, beyond the cap
+            return std::string(1, v[12345]);
+          },
+          "f.exo", "reading");
+    } catch (const InvalidInput& e) {
+      const std::string what = e.what();
+      ::_exit(what.find("f.exo: reading failed: out of memory: this process may use") == 0 &&
+                      what.find("(ulimit -v)") != std::string::npos
+                  ? 0
+                  : 1);
+    }
+    ::_exit(2);  // the child's read succeeded: it was not capped
+  }
+  int status = 0;
+  REQUIRE(::waitpid(pid, &status, 0) == pid);
+  REQUIRE(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 0);  // 1: another message; 2: not capped; 3: setrlimit failed
 }
 #endif
