@@ -2,6 +2,9 @@
 #include <execinfo.h>
 #include <malloc.h>
 
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <iostream>
 #include <memory>
 #include <new>
@@ -42,6 +45,20 @@ std::string command_path(const CLI::App& app) {
     path += " " + a->get_name();
   }
   return path;
+}
+
+// What a command printed on standard output went out whole, or the run fails (exit 2 unless it
+// failed already): a full disk or a closed descriptor behind `geode check m.exo > report.txt`
+// lost the report while the command exited 0.
+int check_standard_output(int code, const std::string& command) {
+  errno = 0;
+  std::cout.flush();
+  const bool failed = !std::cout || std::fflush(stdout) != 0 || std::ferror(stdout);
+  if (!failed) return code;
+  const int e = errno;
+  std::cerr << command << ": error: writing standard output failed"
+            << (e != 0 ? std::string(": ") + std::strerror(e) : std::string()) << "\n";
+  return code != 0 ? code : 2;
 }
 
 }  // namespace
@@ -100,7 +117,8 @@ int main(int argc, char** argv) {
     geode::cli::refuse_empty_arguments(argc, argv);
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    if (e.get_exit_code() == 0)  // --help, --version
+      return check_standard_output(app.exit(e), command_path(app));
     const std::string cmd = command_path(app);
     // An unknown command word: CLI11 says a subcommand is required, as if none were given.
     std::string word;
@@ -150,5 +168,5 @@ int main(int argc, char** argv) {
       code = 1;
     }
   }
-  return code;
+  return check_standard_output(code, command_path(app));
 }

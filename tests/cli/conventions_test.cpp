@@ -6,6 +6,7 @@
 #include <doctest/doctest.h>
 
 #include <stdlib.h>
+#include <sys/wait.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -497,4 +498,31 @@ TEST_CASE("cli conventions: a file name that is not UTF-8 is written into JSON w
   std::ifstream in(page, std::ios::binary);
   const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   CHECK(html.find(replaced) != std::string::npos);
+}
+
+TEST_CASE("cli conventions: output that cannot be written to standard output fails the run") {
+  // `geode check m.exo > report.txt` on a full disk (/dev/full) or with standard output closed
+  // lost the report and exited 0.
+  TempDir dir;
+  const fs::path mesh = dir.path / "m.exo", err = dir.path / "err.txt";
+  io::write_exodus(primal::grid_model({2, 2, 2}, 1.0, [](int, int, int) { return false; }), mesh);
+  const auto run = [&](const std::string& args, const std::string& redirect) {
+    const int status = std::system(
+        (std::string(GEODE_CLI_PATH) + " " + args + " " + redirect + " 2>'" + err.string() + "'")
+            .c_str());
+    std::ifstream in(err);
+    std::string line;
+    std::getline(in, line);
+    return std::pair(WIFEXITED(status) ? WEXITSTATUS(status) : -1, line);
+  };
+  for (const std::string& args :
+       {std::string("template geode3d"), "check " + mesh.string() + " --quiet",
+        "dual " + mesh.string() + " --quiet", std::string("formats"), std::string("--help")}) {
+    CAPTURE(args);
+    CHECK(run(args, ">/dev/null").first == 0);
+    const auto [code, line] = run(args, ">/dev/full");
+    CHECK(code == 2);
+    CHECK(line.find("error: writing standard output failed") != std::string::npos);
+    CHECK(run(args, ">&-").first == 2);
+  }
 }
