@@ -215,6 +215,8 @@ void check_output_path(const std::string& path) {
     if (ec) break;
     real = target.is_absolute() ? target : real.parent_path() / target;
   }
+  if (fs::is_symlink(real, ec))  // a loop: refused now, not after the work
+    throw InvalidInput(path + ": too many levels of symbolic links");
   const fs::path dir = real.parent_path().empty() ? fs::path(".") : real.parent_path();
   if (!fs::is_directory(dir, ec))
     throw InvalidInput(path + ": directory " + dir.string() + " does not exist");

@@ -3,6 +3,7 @@
 #include <malloc.h>
 
 #include <cerrno>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <iostream>
@@ -81,6 +82,12 @@ int main(int argc, char** argv) {
       "the\n"
       "geode algorithm that conforms a diced hex mesh to a diced tet mesh with them.\n"
       "Exit codes: 0 done, 2 usage or input error, 3 topology refusal, 4 invalid result."};
+  // A write to a closed pipe or FIFO (SIGPIPE) or past a file size limit (ulimit -f: SIGXFSZ)
+  // fails as an error the command reports in one line (exit 2), its outputs rolled back, instead
+  // of killing it mid-publish: a FIFO output whose reader left ended the run by SIGPIPE with the
+  // report already replaced and the mesh not.
+  ::signal(SIGPIPE, SIG_IGN);
+  ::signal(SIGXFSZ, SIG_IGN);
   // An interrupted run removes its hidden temporary files (io/atomic_file.hpp).
   geode::io::install_signal_cleanup();
   // Building the commands allocates too: inside the try, so that running out of memory there

@@ -89,6 +89,7 @@ std::vector<viewer::ViewSheet> mesh_view_sheets(const Mesh& mesh, const Surfaces
 }
 
 void run_view(const ViewArgs& a) {
+  check_output_path(a.output);         // before the work, as every command does
   check_not_input(a.output, a.input);  // the page never replaces the mesh it shows
   const std::filesystem::path out(a.output);
   if (file_extension(out) != ".html")

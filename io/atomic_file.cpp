@@ -158,7 +158,12 @@ void install_signal_cleanup() {
   sa.sa_handler = unlink_temporaries_and_reraise;
   sigemptyset(&sa.sa_mask);
   sa.sa_flags = 0;
-  for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) {
+  // Every signal whose default action ends the process and that a user or the system sends a
+  // running command: a CPU limit (ulimit -t: SIGXCPU), a timer, a script's SIGUSR1 left the
+  // temporaries behind. SIGPIPE is the caller's to ignore (geode does: a write to a closed
+  // pipe is then an error it reports).
+  for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGXCPU, SIGXFSZ, SIGALRM, SIGVTALRM, SIGPROF,
+                  SIGUSR1, SIGUSR2, SIGPIPE}) {
     struct sigaction old {};
     // A signal ignored by whoever started us (nohup) stays ignored.
     if (::sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
@@ -194,11 +199,15 @@ fs::path create_temporary(const OutputTarget& target, const std::string& suffix)
   // O_CREAT|O_EXCL with a per-process counter gives a name no concurrent writer of the same
   // target uses; the kernel applies the umask to mode 0666 like for any new file.
   static std::atomic<unsigned> counter{0};
+  // The target's name cut to leave room for the rest within a name's 255 bytes (a temporary of
+  // a temporary included): a legal long output name was refused after the work.
+  std::string name = target.file.filename().string();
+  if (name.size() > 160) name.resize(160);
   fs::path tmp;
   int fd = -1;
   for (int attempt = 0; attempt < 100 && fd < 0; ++attempt) {
-    tmp = dir / ("." + target.file.filename().string() + ".tmp-" + std::to_string(::getpid()) +
-                 "-" + std::to_string(counter++) + suffix);
+    tmp = dir / ("." + name + ".tmp-" + std::to_string(::getpid()) + "-" +
+                 std::to_string(counter++) + suffix);
     // Registered before it exists: a signal between open and registration cannot leave it.
     register_temporary(tmp);
     fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0666);

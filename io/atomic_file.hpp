@@ -4,8 +4,9 @@
 // POSIX), which replaces the target only once it has been written, flushed and synced.
 //
 // Every temporary is registered while it exists, and install_signal_cleanup() (called once by
-// the `geode` command) makes SIGINT, SIGTERM, SIGHUP and SIGQUIT unlink the registered ones
-// before the signal takes its default action: an interrupted run leaves no hidden file behind.
+// the `geode` command) makes the signals that end a process (SIGINT, SIGTERM, SIGHUP, SIGQUIT,
+// a CPU limit's SIGXCPU, ...) unlink the registered ones before the signal takes its default
+// action: an interrupted run leaves no hidden file behind.
 //
 // The target is followed through symbolic links: a link is written through to the file it
 // names (and stays a link). A target that is not a regular file (a device such as /dev/full, a
@@ -75,8 +76,10 @@ void remove_temporary(const std::filesystem::path& temp);
 void register_temporary(const std::filesystem::path& temp);
 void unregister_temporary(const std::filesystem::path& temp);
 
-// Installs the handlers for SIGINT, SIGTERM, SIGHUP and SIGQUIT: unlink every registered
-// temporary (async-signal-safe: a fixed table, unlink), then re-raise with the default action.
+// Installs the handlers for SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGXCPU, SIGXFSZ, SIGALRM,
+// SIGVTALRM, SIGPROF, SIGUSR1, SIGUSR2 and SIGPIPE (unless ignored when the process started):
+// unlink every registered temporary (async-signal-safe: a fixed table, unlink), then re-raise
+// with the default action.
 void install_signal_cleanup();
 
 }  // namespace geode::io

@@ -86,6 +86,10 @@ AddressLimit address_limit(const IsolationLimits& limits, std::uint64_t inherite
   // who gets one line from the caller. In sanitizer builds too: the child runs only the
   // library, so a sanitizer's report there is the library's fault on a corrupt file (libhdf5's
   // overlapping memcpy), and it ends the child, which the caller reports in its one line.
+  // The answer's pipe off the standard descriptors first: a caller started with 1 or 2 closed
+  // got the pipe there, and /dev/null put over it swallowed the answer ("the library reading it
+  // ended its process ... a corrupt or truncated file?").
+  if (fd <= STDERR_FILENO) fd = ::fcntl(fd, F_DUPFD_CLOEXEC, STDERR_FILENO + 1);
   if (const int null = ::open("/dev/null", O_WRONLY); null >= 0) {
     ::dup2(null, STDERR_FILENO);
     ::dup2(null, STDOUT_FILENO);

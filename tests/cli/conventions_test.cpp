@@ -526,3 +526,34 @@ TEST_CASE("cli conventions: output that cannot be written to standard output fai
     CHECK(run(args, ">&-").first == 2);
   }
 }
+
+TEST_CASE("cli conventions: closed standard descriptors, symlink loops, long names (a hunt's)") {
+  TempDir dir;
+  const fs::path mesh = dir.path / "m.exo";
+  io::write_exodus(primal::grid_model({2, 2, 2}, 1.0, [](int, int, int) { return false; }), mesh);
+  const auto sh = [](const std::string& line) {
+    const int status = std::system((std::string(GEODE_CLI_PATH) + " " + line).c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  };
+  // Started with 0 and 1 closed, the Exodus reader's pipe got a standard descriptor, which its
+  // child covered with /dev/null: the file was blamed ("a corrupt or truncated file?").
+  const fs::path report = dir.path / "c.json";
+  CHECK(sh("check " + mesh.string() + " -o " + report.string() + " --quiet <&- >&-") == 0);
+  CHECK(fs::file_size(report) > 100);
+  // A symbolic link loop as the output is refused before the work, as a missing directory is.
+  fs::create_symlink("l2.json", dir.path / "l1.json");
+  fs::create_symlink("l1.json", dir.path / "l2.json");
+  const auto loop = test::geode_cli(
+      "check " + mesh.string() + " -o " + (dir.path / "l1.json").string() + " --quiet", true);
+  CHECK(loop.code == 2);
+  CHECK(loop.out.find("too many levels of symbolic links") != std::string::npos);
+  const auto missing =
+      test::geode_cli("view " + mesh.string() + " -o /nonexistent-dir/v.html", true);
+  CHECK(missing.code == 2);
+  CHECK(missing.out.find("does not exist") != std::string::npos);
+  CHECK(missing.out.find("read") == std::string::npos);  // no stage ran: refused first
+  // A name of 244 bytes is legal (255 at most): its hidden temporary's must be too.
+  const fs::path long_name = dir.path / (std::string(240, 'x') + ".vtu");
+  CHECK(sh("template geode3d -o " + long_name.string()) == 0);
+  CHECK(fs::exists(long_name));
+}
