@@ -3,10 +3,12 @@
 // (conform/corner_study.hpp).
 #include <algorithm>
 #include <filesystem>
+#include <functional>
 #include <iomanip>
 #include <iostream>
 #include <memory>
 #include <sstream>
+#include <vector>
 
 #include <geode/conform/corner_study.hpp>
 #include <geode/primal/errors.hpp>
@@ -175,12 +177,24 @@ void run_shape(const ShapeArgs& a) {
                           {"--sj-csv", a.sj_csv}});
   const bool any = !a.height_csv.empty() || !a.distorted_csv.empty() || !a.quality_csv.empty() ||
                    !a.sj_csv.empty();
+  // The CSVs are written as one (all or none: a fourth that failed left the first three
+  // replaced); `-`, or no output named, prints to standard output once they are.
+  OutputFiles files;
+  std::vector<std::function<void()>> printed;
+  const auto output = [&](const std::string& path, std::function<void(std::ostream&)> write) {
+    if (path.empty() || path == "-") {
+      printed.push_back([write] { write(std::cout); });
+      return;
+    }
+    files.add(path,
+              [write](const std::filesystem::path& temp) { write_or_print(temp.string(), write); });
+  };
   if (!a.height_csv.empty() || !any) {
     std::vector<double> h = a.heights;
     if (h.empty())
       for (int x = 6; x <= 30; x += 2) h.push_back(x);
     const auto rows = templates::height_study(h);
-    write_or_print(a.height_csv, [&](std::ostream& s) { templates::write_shape_csv(s, rows); });
+    output(a.height_csv, [rows](std::ostream& s) { templates::write_shape_csv(s, rows); });
   }
   if (!a.distorted_csv.empty()) {
     const std::vector<double> shears =
@@ -188,15 +202,17 @@ void run_shape(const ShapeArgs& a) {
     const std::vector<double> tapers =
         a.tapers.empty() ? std::vector<double>{0.4, 0.6, 0.8, 1.0, 1.25, 1.5} : a.tapers;
     const auto rows = templates::distorted_study(shears, tapers);
-    write_or_print(a.distorted_csv, [&](std::ostream& s) { templates::write_shape_csv(s, rows); });
+    output(a.distorted_csv, [rows](std::ostream& s) { templates::write_shape_csv(s, rows); });
   }
   if (!a.quality_csv.empty() || !a.sj_csv.empty()) {
     std::ostringstream report, per_hex;
     templates::write_geode_quality(report, &per_hex);
     if (!a.quality_csv.empty())
-      write_or_print(a.quality_csv, [&](std::ostream& s) { s << report.str(); });
-    if (!a.sj_csv.empty()) write_or_print(a.sj_csv, [&](std::ostream& s) { s << per_hex.str(); });
+      output(a.quality_csv, [text = report.str()](std::ostream& s) { s << text; });
+    if (!a.sj_csv.empty()) output(a.sj_csv, [text = per_hex.str()](std::ostream& s) { s << text; });
   }
+  files.commit();
+  for (const auto& print : printed) print();
 }
 
 struct CornersArgs {

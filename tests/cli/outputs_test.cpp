@@ -144,3 +144,25 @@ TEST_CASE("an output FIFO whose reader leaves: exit 2 in one line, the report no
   CHECK(bytes_of(report) == "former report\n");
   CHECK(names_in(dir.path) == std::vector<std::string>{"f.msh", "hexes.msh", "r.json"});
 }
+
+TEST_CASE(
+    "study shape's CSVs are written as one: a fourth that fails leaves the three as they were") {
+  TempDir dir;
+  for (const char* name : {"sh.csv", "sd.csv", "sq.csv"}) std::ofstream(dir.path / name) << "OLD\n";
+  fs::create_symlink("/dev/full", dir.path / "sj.csv");
+  const auto at = [&](const char* name) { return (dir.path / name).string(); };
+  const std::string command = "study shape --heights 10 --shears 0 --tapers 1 -o " + at("sh.csv") +
+                              " --distorted-csv " + at("sd.csv") + " --quality-csv " +
+                              at("sq.csv") + " --sj-csv " + at("sj.csv");
+  const auto run = geode_cli(command, true);
+  INFO(run.out);
+  CHECK(run.code == 2);
+  CHECK(run.out.find("nothing written") != std::string::npos);
+  for (const char* name : {"sh.csv", "sd.csv", "sq.csv"})
+    CHECK(bytes_of(dir.path / name) == "OLD\n");
+  CHECK(names_in(dir.path) == std::vector<std::string>{"sd.csv", "sh.csv", "sj.csv", "sq.csv"});
+  fs::remove(dir.path / "sj.csv");
+  CHECK(geode_cli(command).code == 0);
+  for (const char* name : {"sh.csv", "sd.csv", "sq.csv", "sj.csv"})
+    CHECK(bytes_of(dir.path / name).rfind("OLD", 0) != 0);
+}
