@@ -83,6 +83,30 @@ templates::InterleaveStudy spec_study(const InterleaveArgs& a) {
   return study;
 }
 
+// A study's outputs written as one (OutputFiles: all or none); an output named `-`, or one
+// left unnamed that goes to standard output, is printed once the files are published.
+class StudyOutputs {
+ public:
+  using Write = std::function<void(std::ostream&)>;
+  void add(const std::string& path, Write write) {
+    if (path.empty() || path == "-") {
+      printed_.push_back(std::move(write));
+      return;
+    }
+    files_.add(path, [write = std::move(write)](const std::filesystem::path& temp) {
+      write_or_print(temp.string(), write);
+    });
+  }
+  void commit() {
+    files_.commit();
+    for (const Write& write : printed_) write(std::cout);
+  }
+
+ private:
+  OutputFiles files_;
+  std::vector<Write> printed_;
+};
+
 void run_interleave(const InterleaveArgs& a) {
   for (const std::string* path : {&a.output, &a.summary}) {
     output_format(*path, "", {"csv"}, "csv");
@@ -120,22 +144,11 @@ void run_interleave(const InterleaveArgs& a) {
       throw InvalidInput("study interleave: no grid point has 0 < low < high < 1");
   }
   // The runs and the summary are written as one (both or neither); the runs to stdout otherwise.
-  OutputFiles files;
-  const bool runs_to_file = !a.output.empty() && a.output != "-";
-  if (runs_to_file)
-    files.add(a.output, [&](const std::filesystem::path& temp) {
-      write_or_print(temp.string(),
-                     [&](std::ostream& s) { templates::write_interleave_csv(s, study); });
-    });
-  const bool summary_to_file = !a.summary.empty() && a.summary != "-";
-  if (summary_to_file)
-    files.add(a.summary, [&](const std::filesystem::path& temp) {
-      write_or_print(temp.string(),
-                     [&](std::ostream& s) { templates::write_interleave_summary(s, study); });
-    });
-  files.commit();
-  if (!runs_to_file) templates::write_interleave_csv(std::cout, study);
-  if (a.summary == "-") templates::write_interleave_summary(std::cout, study);
+  StudyOutputs outputs;
+  outputs.add(a.output, [&](std::ostream& s) { templates::write_interleave_csv(s, study); });
+  if (!a.summary.empty())
+    outputs.add(a.summary, [&](std::ostream& s) { templates::write_interleave_summary(s, study); });
+  outputs.commit();
   double total = 0;
   for (const auto& r : study.runs) total += r.seconds;
   std::ostream& log = a.output.empty() ? std::cerr : std::cout;
@@ -178,23 +191,14 @@ void run_shape(const ShapeArgs& a) {
   const bool any = !a.height_csv.empty() || !a.distorted_csv.empty() || !a.quality_csv.empty() ||
                    !a.sj_csv.empty();
   // The CSVs are written as one (all or none: a fourth that failed left the first three
-  // replaced); `-`, or no output named, prints to standard output once they are.
-  OutputFiles files;
-  std::vector<std::function<void()>> printed;
-  const auto output = [&](const std::string& path, std::function<void(std::ostream&)> write) {
-    if (path.empty() || path == "-") {
-      printed.push_back([write] { write(std::cout); });
-      return;
-    }
-    files.add(path,
-              [write](const std::filesystem::path& temp) { write_or_print(temp.string(), write); });
-  };
+  // replaced); `-`, or no output named, prints the table.
+  StudyOutputs outputs;
   if (!a.height_csv.empty() || !any) {
     std::vector<double> h = a.heights;
     if (h.empty())
       for (int x = 6; x <= 30; x += 2) h.push_back(x);
     const auto rows = templates::height_study(h);
-    output(a.height_csv, [rows](std::ostream& s) { templates::write_shape_csv(s, rows); });
+    outputs.add(a.height_csv, [rows](std::ostream& s) { templates::write_shape_csv(s, rows); });
   }
   if (!a.distorted_csv.empty()) {
     const std::vector<double> shears =
@@ -202,17 +206,17 @@ void run_shape(const ShapeArgs& a) {
     const std::vector<double> tapers =
         a.tapers.empty() ? std::vector<double>{0.4, 0.6, 0.8, 1.0, 1.25, 1.5} : a.tapers;
     const auto rows = templates::distorted_study(shears, tapers);
-    output(a.distorted_csv, [rows](std::ostream& s) { templates::write_shape_csv(s, rows); });
+    outputs.add(a.distorted_csv, [rows](std::ostream& s) { templates::write_shape_csv(s, rows); });
   }
   if (!a.quality_csv.empty() || !a.sj_csv.empty()) {
     std::ostringstream report, per_hex;
     templates::write_geode_quality(report, &per_hex);
     if (!a.quality_csv.empty())
-      output(a.quality_csv, [text = report.str()](std::ostream& s) { s << text; });
-    if (!a.sj_csv.empty()) output(a.sj_csv, [text = per_hex.str()](std::ostream& s) { s << text; });
+      outputs.add(a.quality_csv, [text = report.str()](std::ostream& s) { s << text; });
+    if (!a.sj_csv.empty())
+      outputs.add(a.sj_csv, [text = per_hex.str()](std::ostream& s) { s << text; });
   }
-  files.commit();
-  for (const auto& print : printed) print();
+  outputs.commit();
 }
 
 struct CornersArgs {

@@ -36,6 +36,14 @@ std::vector<std::string> names_in(const fs::path& dir) {
   return names;
 }
 
+// dir/hexes.msh: an n^3 grid of unit hexes, conform's input here; returns its path.
+fs::path hex_grid_msh(const TempDir& dir, int n) {
+  const fs::path path = dir.path / "hexes.msh";
+  geode::io::write_gmsh(
+      geode::primal::grid_model({n, n, n}, 1.0, [](int, int, int) { return false; }), path);
+  return path;
+}
+
 }  // namespace
 
 TEST_CASE("conform -o and --report: a signal between the two renames leaves both or neither") {
@@ -51,17 +59,15 @@ TEST_CASE("conform -o and --report: a signal between the two renames leaves both
     CAPTURE(row.signal);
     CAPTURE(row.former_outputs);
     TempDir dir;
-    geode::io::write_gmsh(
-        geode::primal::grid_model({2, 2, 2}, 1.0, [](int, int, int) { return false; }),
-        dir.path / "hexes.msh");
+    const fs::path input = hex_grid_msh(dir, 2);
     const fs::path out = dir.path / "out.exo", report = dir.path / "r.json";
     if (row.former_outputs) {
       std::ofstream(out) << "former mesh\n";
       std::ofstream(report) << "former report\n";
     }
     const std::vector<std::string> before = names_in(dir.path);
-    const std::string command = "conform " + (dir.path / "hexes.msh").string() + " -o " +
-                                out.string() + " --report " + report.string() + " --quiet";
+    const std::string command = "conform " + input.string() + " -o " + out.string() + " --report " +
+                                report.string() + " --quiet";
     {
       ScopedEnv hook("GEODE_TEST_SIGNAL_BETWEEN_RENAMES", std::to_string(row.signal));
       const auto run = geode_cli(command, true);
@@ -86,15 +92,13 @@ TEST_CASE("conform -o and --report: a signal between the two renames leaves both
 
 TEST_CASE("conform -o and --report: a report that cannot be written puts the former mesh back") {
   TempDir dir;
-  geode::io::write_gmsh(
-      geode::primal::grid_model({2, 2, 2}, 1.0, [](int, int, int) { return false; }),
-      dir.path / "hexes.msh");
+  const fs::path input = hex_grid_msh(dir, 2);
   const fs::path out = dir.path / "out.exo", report = dir.path / "r.json";
   std::ofstream(out) << "former mesh\n";
   // The report goes to a full device (copied into last, after the mesh's rename).
   fs::create_symlink("/dev/full", report);
-  const auto run = geode_cli("conform " + (dir.path / "hexes.msh").string() + " -o " +
-                                 out.string() + " --report " + report.string() + " --quiet",
+  const auto run = geode_cli("conform " + input.string() + " -o " + out.string() + " --report " +
+                                 report.string() + " --quiet",
                              true);
   INFO(run.out);
   CHECK(run.code == 2);
@@ -127,16 +131,14 @@ TEST_CASE("an output FIFO whose reader leaves: exit 2 in one line, the report no
   // A hunt's: the write into the FIFO raised SIGPIPE, which ended the run with the new report
   // published and the mesh lost. geode ignores SIGPIPE: the write fails as an error instead.
   TempDir dir;
-  geode::io::write_gmsh(
-      geode::primal::grid_model({12, 12, 12}, 1.0, [](int, int, int) { return false; }),
-      dir.path / "hexes.msh");
+  const fs::path input = hex_grid_msh(dir, 12);
   const fs::path fifo = dir.path / "f.msh", report = dir.path / "r.json";
   REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
   std::ofstream(report) << "former report\n";
   // The reader takes one byte and leaves: the mesh (about 1 MB) does not fit the pipe.
   REQUIRE(std::system(("(head -c 1 '" + fifo.string() + "' >/dev/null &)").c_str()) == 0);
-  const auto run = geode_cli("conform " + (dir.path / "hexes.msh").string() + " -o " +
-                                 fifo.string() + " --report " + report.string() + " --quiet",
+  const auto run = geode_cli("conform " + input.string() + " -o " + fifo.string() + " --report " +
+                                 report.string() + " --quiet",
                              true);
   INFO(run.out);
   CHECK(run.code == 2);
