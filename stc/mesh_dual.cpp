@@ -265,8 +265,12 @@ MeshDual<Dim> build(std::size_t n_nodes,
   };
   std::vector<std::size_t> first_of(n_nodes + 1, 0);
   for (Index c = 0; c < n_cells; ++c)
-    for (int f = 0; f < R::kFacets; ++f)
-      ++first_of[primal::index_cast<std::size_t>(facet(c, f).key[0]) + 1];
+    for (int f = 0; f < R::kFacets; ++f) {
+      Index lowest = cells[c][R::kFacetTable[f][0]];  // the bucket: no need of the sorted key
+      for (int k = 1; k < R::kFacetSize; ++k)
+        lowest = std::min(lowest, cells[c][R::kFacetTable[f][k]]);
+      ++first_of[primal::index_cast<std::size_t>(lowest) + 1];
+    }
   std::partial_sum(first_of.begin(), first_of.end(), first_of.begin());
   std::vector<Facet> facets(cells.size() * R::kFacets);
   {
