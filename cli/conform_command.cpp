@@ -210,20 +210,22 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
   }
   const bool valid = conform::result_valid(r);
   written = &r.model;
-  if (valid || a.write_invalid) {
+  const bool publish = valid || a.write_invalid;
+  if (publish) {
     if (write_failed) std::rethrow_exception(write_failed);
     if (!a.report.empty()) {
       files.add(a.report, [text = json_text(conform::report_json(r), 2)](const fs::path& temp) {
         write_or_print(temp.string(), [&](std::ostream& os) { os << text; });
       });
     }
-    files.commit();
   }
+  // The summary before the files: commit() publishes nothing if it was lost.
   if (!a.quiet) print_summary(r, std::cout, tables);
+  if (publish) files.commit();
   // Warnings of a valid result go to stderr, --quiet or not (an invalid one's are in its error).
   if (valid)
     for (const auto& w : r.warnings) std::cerr << "geode: warning: " << w << "\n";
-  if (!a.quiet && (valid || a.write_invalid)) {
+  if (!a.quiet && publish) {
     if (!a.output.empty()) std::cout << "wrote " << a.output << "\n";
     if (!a.report.empty()) std::cout << "wrote " << a.report << "\n";
   }

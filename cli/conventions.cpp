@@ -1,13 +1,17 @@
 // Conventions shared by every command (cli/conventions.hpp).
 #include "cli/conventions.hpp"
 
+#include <stdio_ext.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -442,6 +446,24 @@ CLI::Option* add_write_invalid_flag(CLI::App* app, bool& flag) {
       "is not written");
 }
 
+std::string standard_output_failure() {
+  errno = 0;
+  std::cout.flush();
+  const bool failed = !std::cout || std::fflush(stdout) != 0 || std::ferror(stdout);
+  if (!failed) return {};
+  const int e = errno;
+  std::cout.clear();
+  __fpurge(stdout);  // glibc <stdio_ext.h>: the text that could not go out, dropped
+  std::clearerr(stdout);
+  return std::string("writing standard output failed") +
+         (e != 0 ? std::string(": ") + std::strerror(e) : std::string());
+}
+
+void require_standard_output() {
+  if (std::string failure = standard_output_failure(); !failure.empty())
+    throw InvalidInput(failure + " (nothing written)");
+}
+
 std::size_t OutputFiles::add(const fs::path& target, Writer write) {
   entries_.push_back({target, io::resolve_output(target), {}, std::move(write)});
   return entries_.size() - 1;
@@ -470,6 +492,7 @@ void OutputFiles::write(std::size_t i) {
 
 void OutputFiles::commit() {
   for (std::size_t i = 0; i < entries_.size(); ++i) write(i);
+  require_standard_output();
   // All renamed as one (io/atomic_file.hpp): a failure or a signal between two renames puts
   // back what the targets held, so a mesh never stands without its report.
   std::vector<io::Publication> items;

@@ -152,13 +152,24 @@ std::string out_of_memory_reason();
 // A stage's progress line as every command says it when the stage ends: "LINE (S.S s)".
 std::string stage_line(const std::string& line, double seconds);
 
+// Standard output flushed: "" when everything printed so far went out, else why not ("writing
+// standard output failed: No space left on device"). The failed text is dropped, so that the
+// exit path (main.cpp) does not report it a second time.
+std::string standard_output_failure();
+// InvalidInput (exit 2) with standard_output_failure() when it is not empty. OutputFiles::commit
+// calls it before publishing, and a command prints its summary before it publishes: a summary
+// lost (stdout closed, a full disk behind `> log`) fails the run with nothing published, instead
+// of files left in place by a run that exits 2.
+void require_standard_output();
+
 // Several outputs written as one: each goes to a temporary file next to its target (same
 // extension, so writers that go by it still work; registered for removal on signals), and only
 // when all are written are they renamed over their targets (through symbolic links; copied into
 // a target that is not a regular file, e.g. a device). If any write fails, every temporary is
 // removed and nothing is written; if a rename fails or a signal comes between two renames, the
 // targets already replaced get their former content back (io::publish_together: never half a
-// result).
+// result). commit() publishes nothing when what the command printed before it on standard output
+// was lost (require_standard_output).
 class OutputFiles {
  public:
   using Writer = std::function<void(const std::filesystem::path& temp)>;

@@ -210,8 +210,8 @@ void run_dual(const DualArgs& a) {
     files.add(a.output, [&](const fs::path& temp) {
       write_or_print(temp.string(), [&](std::ostream& os) { os << text; });
     });
+  if (!to_file) std::cout << text;  // first: commit() publishes nothing if it was lost
   files.commit();
-  if (!to_file) std::cout << text;
   invalid_written(what, invalid);
 }
 

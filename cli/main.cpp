@@ -2,10 +2,7 @@
 #include <execinfo.h>
 #include <malloc.h>
 
-#include <cerrno>
 #include <csignal>
-#include <cstdio>
-#include <cstring>
 #include <iostream>
 #include <memory>
 #include <new>
@@ -52,13 +49,9 @@ std::string command_path(const CLI::App& app) {
 // failed already): a full disk or a closed descriptor behind `geode check m.exo > report.txt`
 // lost the report while the command exited 0.
 int check_standard_output(int code, const std::string& command) {
-  errno = 0;
-  std::cout.flush();
-  const bool failed = !std::cout || std::fflush(stdout) != 0 || std::ferror(stdout);
-  if (!failed) return code;
-  const int e = errno;
-  std::cerr << command << ": error: writing standard output failed"
-            << (e != 0 ? std::string(": ") + std::strerror(e) : std::string()) << "\n";
+  const std::string failure = geode::cli::standard_output_failure();
+  if (failure.empty()) return code;
+  std::cerr << command << ": error: " << failure << "\n";
   return code != 0 ? code : 2;
 }
 

@@ -84,7 +84,8 @@ templates::InterleaveStudy spec_study(const InterleaveArgs& a) {
 }
 
 // A study's outputs written as one (OutputFiles: all or none); an output named `-`, or one
-// left unnamed that goes to standard output, is printed once the files are published.
+// left unnamed that goes to standard output, is printed first: the files are published only
+// if it went out (OutputFiles::commit).
 class StudyOutputs {
  public:
   using Write = std::function<void(std::ostream&)>;
@@ -98,8 +99,8 @@ class StudyOutputs {
     });
   }
   void commit() {
-    files_.commit();
     for (const Write& write : printed_) write(std::cout);
+    files_.commit();
   }
 
  private:

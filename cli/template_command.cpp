@@ -353,8 +353,9 @@ void write_template(templates::Template& T, const TemplateOutput& a) {
   }
   if (a.format == "html") {
     if (a.output.empty()) throw InvalidInput("--format html needs -o FILE.html");
+    if (!text.empty()) std::cout << text;  // first: nothing is written if it was lost
+    require_standard_output();
     write_template_html(a, T, smooth_note);
-    if (!text.empty()) std::cout << text;
     invalid_written(what, invalid);
     return;
   }
@@ -363,6 +364,8 @@ void write_template(templates::Template& T, const TemplateOutput& a) {
     // tables, if asked for, to standard output.
     if (a.output.empty()) throw InvalidInput("--format " + a.format + " needs -o FILE");
     const io::WriteOptions options = write_options(a.encoding);
+    if (!text.empty()) std::cout << text;  // first: nothing is written if it was lost
+    require_standard_output();
     if (dim == 2) {
       io::write_quad_mesh(T.quad, a.output, a.format, options);  // refuses formats without quads
     } else {
@@ -371,7 +374,6 @@ void write_template(templates::Template& T, const TemplateOutput& a) {
       m.hexes = T.hex.hexes;
       io::write_model(m, a.output, a.format, options);
     }
-    if (!text.empty()) std::cout << text;
     invalid_written(what, invalid);
     return;
   }

@@ -400,6 +400,16 @@ int run(int argc, char** argv, int rank, int size) {
   if (worst == 0 && rank == 0)
     for (const auto& w : summary.warnings) std::cerr << "geode_mpi: warning: " << w << "\n";
   if (worst != 0) return worst;
+  // Rank 0's summary lost (its standard output closed, a full disk behind `> log`): no rank
+  // publishes, where OutputFiles::commit refusing on rank 0 alone would leave a set with its
+  // piece missing. Every rank is past agree(): a blocking broadcast.
+  std::string lost = rank == 0 ? cli::standard_output_failure() : std::string();
+  int lost_flag = lost.empty() ? 0 : 1;
+  MPI_Bcast(&lost_flag, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  if (lost_flag) {
+    if (rank == 0) std::cerr << "geode_mpi conform: error: " << lost << " (nothing written)\n";
+    return 2;  // the temporaries go with `files`
+  }
   try {
     files.commit();  // every rank wrote its piece: all published
   } catch (const std::exception& e) {

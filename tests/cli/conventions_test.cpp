@@ -527,6 +527,48 @@ TEST_CASE("cli conventions: output that cannot be written to standard output fai
   }
 }
 
+TEST_CASE("cli conventions: a summary lost on standard output publishes no file") {
+  // With standard output lost, conform published its mesh and report and then exited 2 (the
+  // summary was printed after them): a run that fails must leave no outputs.
+  TempDir dir;
+  const fs::path mesh = dir.path / "m.exo", err = dir.path / "err.txt";
+  io::write_exodus(primal::grid_model({2, 2, 2}, 1.0, [](int, int, int) { return false; }), mesh);
+  const fs::path out = dir.path / "out.exo", page = dir.path / "out.html",
+                 report = dir.path / "out.json";
+  const auto run = [&](const std::string& args, const std::string& redirect) {
+    const int status = std::system(
+        (std::string(GEODE_CLI_PATH) + " " + args + " " + redirect + " 2>'" + err.string() + "'")
+            .c_str());
+    std::ifstream in(err);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    return std::pair(WIFEXITED(status) ? WEXITSTATUS(status) : -1, text);
+  };
+  const std::string o = " -o " + out.string();
+  for (const std::string& args : {"demo --model nugget -n 2" + o + " --report " + report.string(),
+                                  "template geode3d --format exo --quality" + o,
+                                  "template geode3d --format html --quality -o " + page.string(),
+                                  "dual " + mesh.string() + " --rebuild " + out.string()}) {
+    CAPTURE(args);
+    for (const std::string redirect : {">/dev/full", ">&-"}) {
+      CAPTURE(redirect);
+      const auto [code, text] = run(args, redirect);
+      CHECK(code == 2);
+      CHECK(!fs::exists(out));
+      CHECK(!fs::exists(page));
+      CHECK(!fs::exists(report));
+      // One line says it, not a second one from the exit path's check.
+      const auto at = text.find("writing standard output failed");
+      CHECK(text.find("error: writing standard output failed") != std::string::npos);
+      CHECK(text.find("writing standard output failed", at + 1) == std::string::npos);
+      CHECK(text.find("(nothing written)", at) != std::string::npos);
+    }
+    const auto [code, text] = run(args, ">/dev/null");
+    CHECK(code == 0);
+    CHECK((fs::exists(out) || fs::exists(page)));
+    for (const auto& f : {out, page, report}) fs::remove(f);
+  }
+}
+
 TEST_CASE("cli conventions: closed standard descriptors, symlink loops, long names (a hunt's)") {
   TempDir dir;
   const fs::path mesh = dir.path / "m.exo";

@@ -7,7 +7,8 @@
 # GEODE_TEST_INVERT_OUTPUT_HEX in its conform) fails every rank count alike; so does a partition
 # failing on rank 0 (GEODE_TEST_FAIL_PARTITION), and one rank's share of the read refused
 # (GEODE_TEST_FAIL_READ_SHARE), without a rank left waiting; so does one rank failing alone
-# (GEODE_TEST_FAIL_RANK). Options out of range exit 2. Rank 0 alone prints progress, -q none.
+# (GEODE_TEST_FAIL_RANK). Options out of range exit 2; a summary rank 0 cannot print publishes
+# nothing. Rank 0 alone prints progress, -q none.
 # usage: mpi_verify_test.sh GEODE GEODE_MPI MPIEXEC WORKDIR
 set -euo pipefail
 geode=$1 geode_mpi=$2 mpiexec=$3 dir=$4
@@ -149,4 +150,11 @@ for args in "-o in.exo --join" "-o m.msh" "-o -" "-o ''" "-o ." "-o set.exo"; do
   if ls m.msh* ./-* .2.* >/dev/null 2>&1; then echo "conform $args: wrote a file"; exit 1; fi
 done
 cmp in.exo keep.exo
-echo "mpi_verify_test: both modes pass the result and find the broken dicing on 1 and 2 ranks, an invalid zone on 1 to 3, a refused share of the read on 2 and 3, a rank failing alone on 2 and 3, options out of range and outputs that are not Exodus files or are the input refused, progress from rank 0 alone"
+# Rank 0's summary lost (started alone, its standard output its own; under mpirun the launcher
+# holds it): the run fails, no piece published.
+status=0
+"$geode_mpi" conform in.exo -o lost.exo >/dev/full 2>err.txt || status=$?
+[ "$status" = 2 ] || { echo "summary to /dev/full: exited $status, not 2"; cat err.txt; exit 1; }
+grep -q "writing standard output failed: .* (nothing written)" err.txt
+if ls lost.exo* >/dev/null 2>&1; then echo "summary to /dev/full: wrote a file"; exit 1; fi
+echo "mpi_verify_test: both modes pass the result and find the broken dicing on 1 and 2 ranks, an invalid zone on 1 to 3, a refused share of the read on 2 and 3, a rank failing alone on 2 and 3, options out of range and outputs that are not Exodus files or are the input refused, a lost summary publishing nothing, progress from rank 0 alone"
