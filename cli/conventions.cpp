@@ -223,7 +223,15 @@ void check_output_path(const std::string& path) {
     throw InvalidInput(path + ": too many levels of symbolic links");
   const fs::path dir = real.parent_path().empty() ? fs::path(".") : real.parent_path();
   if (!fs::is_directory(dir, ec))
-    throw InvalidInput(path + ": directory " + dir.string() + " does not exist");
+    throw InvalidInput(path + ": directory " + dir.string() +
+                       (ec && ec != std::errc::no_such_file_or_directory ? ": " + ec.message()
+                                                                         : " does not exist"));
+  // A name longer than the file system takes failed only when the temporary was renamed.
+  const long name_max = ::pathconf(dir.c_str(), _PC_NAME_MAX);
+  if (const auto n = real.filename().native().size();
+      name_max > 0 && n > static_cast<std::size_t>(name_max))
+    throw InvalidInput(path + ": file name too long (" + std::to_string(n) + " bytes, at most " +
+                       std::to_string(name_max) + " here)");
   if (::access(dir.c_str(), W_OK | X_OK) != 0)
     throw InvalidInput(path + ": directory " + dir.string() + " is not writable");
   if (fs::exists(p, ec) && ::access(p.c_str(), W_OK) != 0)

@@ -87,7 +87,10 @@ const char* mesh_format_name(MeshFileFormat format) {
 
 std::string read_file_head(const std::filesystem::path& path, std::size_t max_bytes) {
   std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw InvalidInput(path.string() + ": no such file");
+  // exists() fails for a reason of its own (a name longer than the system takes, a directory
+  // that may not be searched): that reason, not "no such file".
+  if (!std::filesystem::exists(path, ec))
+    throw InvalidInput(path.string() + ": " + (ec ? ec.message() : std::string("no such file")));
   if (!std::filesystem::is_regular_file(path, ec))
     throw InvalidInput(path.string() + ": not a regular file");
   std::ifstream in(path, std::ios::binary);

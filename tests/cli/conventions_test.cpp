@@ -598,4 +598,20 @@ TEST_CASE("cli conventions: closed standard descriptors, symlink loops, long nam
   const fs::path long_name = dir.path / (std::string(240, 'x') + ".vtu");
   CHECK(sh("template geode3d -o " + long_name.string()) == 0);
   CHECK(fs::exists(long_name));
+  // Names longer than the system takes: said so (an input was "no such file", an output failed
+  // only when its temporary was renamed, a directory "does not exist"), before any work.
+  const std::string too_long = (dir.path / (std::string(300, 'y') + ".exo")).string();
+  std::string deep = dir.path.string();
+  while (deep.size() < 5000) deep += "/" + std::string(200, 'z');
+  deep += "/m.exo";
+  for (const std::string& args :
+       {"check " + too_long, "check " + deep, "template geode3d --format exo -o " + too_long,
+        "template geode3d --format exo -o " + deep, "view " + mesh.string() + " -o " + deep}) {
+    CAPTURE(args);
+    const auto run = test::geode_cli(args, true);
+    CHECK(run.code == 2);
+    CHECK((run.out.find("File name too long") != std::string::npos ||
+           run.out.find("file name too long") != std::string::npos));
+    CHECK(run.out.find("read") == std::string::npos);  // refused first
+  }
 }
