@@ -268,4 +268,6 @@ void write_exodus(const Model& model, const std::filesystem::path& path,
   });
 }
 
+std::string exodus_error_cause() { return exodus_library::exodus_cause(); }
+
 }  // namespace geode::io

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <string>
 
 #include <geode/primal/model.hpp>
 #include <geode/primal/shares.hpp>
@@ -86,5 +87,9 @@ primal::Model read_exodus_piece(const std::filesystem::path& path,
 void write_exodus(const primal::Model& model, const std::filesystem::path& path,
                   const std::function<void(int exo)>& define = {},
                   const std::function<void(int exo)>& write_more = {});
+
+// Why the last libexodusII call failed, in words ("No space left on device (the disk is full)",
+// a netCDF error), for callers of its API beside write_exodus (the Nemesis maps' writer).
+std::string exodus_error_cause();
 
 }  // namespace geode::io

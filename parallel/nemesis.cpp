@@ -17,8 +17,7 @@ using primal::Point;
 
 void check(int status, const std::filesystem::path& path, const std::string& what) {
   if (status < 0)
-    throw InvalidInput(path.string() + ": " + what + " failed (libexodusII status " +
-                       std::to_string(status) + ")");
+    throw InvalidInput(path.string() + ": " + what + " failed: " + io::exodus_error_cause());
 }
 
 // Ids as libexodusII's int API takes them: 1-based, within int (checked).
