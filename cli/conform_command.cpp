@@ -139,9 +139,10 @@ std::string check_outputs(const ConformArgs& a) {
 // `source` names the input file in the model's own errors (no tet part, no interface, a face
 // that does not conform: they name elements and nodes, not the file); empty for demos.
 // `together`: outputs written already (demo's --save-input), published with the mesh and
-// report, or removed with them.
+// report, or removed with them; `together_lines` what to print for them.
 void run(primal::Model model, const ConformArgs& a, const std::string& format, bool tables,
-         const std::string& source = {}, OutputFiles* together = nullptr) {
+         const std::string& source = {}, OutputFiles* together = nullptr,
+         const std::string& together_lines = {}) {
   const std::string prefix = source.empty() ? "" : source + ": ";
   Progress progress = Progress::for_stderr(a.quiet);
   if (a.merge_tolerance >= 0) {
@@ -219,16 +220,18 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
       });
     }
   }
-  // The summary before the files: commit() publishes nothing if it was lost.
+  // Everything for stdout before the files: commit() publishes nothing if it was lost (and
+  // says so if the publishing fails after these lines).
   if (!a.quiet) print_summary(r, std::cout, tables);
+  if (!a.quiet && publish) {
+    if (!a.output.empty()) std::cout << "wrote " << a.output << "\n";
+    if (!a.report.empty()) std::cout << "wrote " << a.report << "\n";
+    std::cout << together_lines;
+  }
   if (publish) files.commit();
   // Warnings of a valid result go to stderr, --quiet or not (an invalid one's are in its error).
   if (valid)
     for (const auto& w : r.warnings) std::cerr << "geode: warning: " << w << "\n";
-  if (!a.quiet && publish) {
-    if (!a.output.empty()) std::cout << "wrote " << a.output << "\n";
-    if (!a.report.empty()) std::cout << "wrote " << a.report << "\n";
-  }
   if (!valid) {
     throw InvalidResult(prefix + conform::invalid_reason(r) +
                         (a.write_invalid ? " (written anyway: --write-invalid)"
@@ -453,11 +456,14 @@ void add_conform_commands(CLI::App& app) {
             << model.tets.size() << " tets, " << model.pyramids.size() << " pyramids, "
             << model.wedges.size() << " wedges)\n";
     }
-    if (dargs->output.empty() && dargs->report.empty())
+    // The line before the files: commit() publishes nothing if it was lost.
+    const std::string lines = dargs->quiet ? std::string() : saved.str();
+    if (dargs->output.empty() && dargs->report.empty()) {
+      std::cout << lines;
       files.commit();
-    else
-      run(std::move(model), *dargs, format, true, {}, &files);
-    if (!dargs->quiet) std::cout << saved.str();
+    } else {
+      run(std::move(model), *dargs, format, true, {}, &files, lines);
+    }
   });
 }
 

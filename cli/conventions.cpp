@@ -236,6 +236,9 @@ void check_output_path(const std::string& path) {
     throw InvalidInput(path + ": directory " + dir.string() + " is not writable");
   if (fs::exists(p, ec) && ::access(p.c_str(), W_OK) != 0)
     throw InvalidInput(path + ": exists and is not writable");
+  // The rest the write needs (the temporary's path within PATH_MAX too, a file system that takes
+  // new files): a temporary made and removed now, not found after the work.
+  io::remove_temporary(io::create_temporary(io::resolve_output(p), p.extension().string()));
 }
 
 namespace {

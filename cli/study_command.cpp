@@ -149,10 +149,9 @@ void run_interleave(const InterleaveArgs& a) {
   outputs.add(a.output, [&](std::ostream& s) { templates::write_interleave_csv(s, study); });
   if (!a.summary.empty())
     outputs.add(a.summary, [&](std::ostream& s) { templates::write_interleave_summary(s, study); });
-  outputs.commit();
   double total = 0;
   for (const auto& r : study.runs) total += r.seconds;
-  std::ostream& log = a.output.empty() ? std::cerr : std::cout;
+  std::ostringstream log;
   log << study.template_name << ": " << study.runs.size() << " runs, " << std::setprecision(3)
       << total << " s, " << study.classes.size() << " outcome classes";
   if (study.skipped) log << ", " << study.skipped << " sweep points skipped as invalid input";
@@ -173,6 +172,12 @@ void run_interleave(const InterleaveArgs& a) {
       log << (i ? ", " : "; ") << study.parameter_names[i] << " " << c.example_parameters[i];
     log << "\n      " << c.key << "\n";
   }
+  // The classes on stdout when the runs go to a file, printed before the files are published
+  // (commit() publishes nothing if they were lost); else on stderr, after the runs' CSV.
+  const bool runs_on_stdout = a.output.empty() || a.output == "-";
+  if (!runs_on_stdout) std::cout << log.str();
+  outputs.commit();
+  if (runs_on_stdout) std::cerr << log.str();
 }
 
 struct ShapeArgs {

@@ -598,8 +598,11 @@ json read_spec_json(const std::filesystem::path& path) {
   namespace fs = std::filesystem;
   const std::string name = path.string();
   std::error_code ec;
-  if (!fs::is_regular_file(path, ec))
-    throw InvalidInput(name + (fs::exists(path, ec) ? ": not a regular file" : ": no such file"));
+  if (!fs::is_regular_file(path, ec)) {
+    const bool exists = fs::exists(path, ec);  // ec: why not, when not simply missing
+    throw InvalidInput(name + (exists ? ": not a regular file"
+                                      : ": " + (ec ? ec.message() : std::string("no such file"))));
+  }
   // A spec is a few kilobytes; anything much larger is not one.
   if (fs::file_size(path, ec) > (16u << 20))
     throw InvalidInput(name + ": larger than 16 MiB, not a spec");

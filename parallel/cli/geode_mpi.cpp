@@ -161,6 +161,7 @@ void check_outputs(const std::string& output, const std::string& input, int size
   if (output.empty() || output == "-")
     throw InvalidInput("-o '" + output + "': the pieces are Exodus files: give -o OUT.exo");
   cli::check_output_path(output);
+  cli::check_output_path(parallel::rank_file(output, size, size - 1));  // pieces: names alike
   cli::output_format(output, "", {"exo"}, "");
   std::vector<std::string> inputs{input};
   if (const auto set = io::find_nemesis_set(input))

@@ -534,7 +534,8 @@ TEST_CASE("cli conventions: a summary lost on standard output publishes no file"
   const fs::path mesh = dir.path / "m.exo", err = dir.path / "err.txt";
   io::write_exodus(primal::grid_model({2, 2, 2}, 1.0, [](int, int, int) { return false; }), mesh);
   const fs::path out = dir.path / "out.exo", page = dir.path / "out.html",
-                 report = dir.path / "out.json";
+                 report = dir.path / "out.json", runs = dir.path / "runs.csv",
+                 summary = dir.path / "summary.csv";
   const auto run = [&](const std::string& args, const std::string& redirect) {
     const int status = std::system(
         (std::string(GEODE_CLI_PATH) + " " + args + " " + redirect + " 2>'" + err.string() + "'")
@@ -544,18 +545,20 @@ TEST_CASE("cli conventions: a summary lost on standard output publishes no file"
     return std::pair(WIFEXITED(status) ? WEXITSTATUS(status) : -1, text);
   };
   const std::string o = " -o " + out.string();
-  for (const std::string& args : {"demo --model nugget -n 2" + o + " --report " + report.string(),
-                                  "template geode3d --format exo --quality" + o,
-                                  "template geode3d --format html --quality -o " + page.string(),
-                                  "dual " + mesh.string() + " --rebuild " + out.string()}) {
+  for (const std::string& args :
+       {"demo --model nugget -n 2" + o + " --report " + report.string(),
+        "demo --model nugget -n 2 --save-input " + out.string(),
+        "template geode3d --format exo --quality" + o,
+        "template geode3d --format html --quality -o " + page.string(),
+        "dual " + mesh.string() + " --rebuild " + out.string(),
+        "study interleave --high 0.8 --low 0.4 --depth 0.5 --radius 0.5 -o " + runs.string() +
+            " --summary " + summary.string()}) {
     CAPTURE(args);
     for (const std::string redirect : {">/dev/full", ">&-"}) {
       CAPTURE(redirect);
       const auto [code, text] = run(args, redirect);
       CHECK(code == 2);
-      CHECK(!fs::exists(out));
-      CHECK(!fs::exists(page));
-      CHECK(!fs::exists(report));
+      for (const auto& f : {out, page, report, runs, summary}) CHECK(!fs::exists(f));
       // One line says it, not a second one from the exit path's check.
       const auto at = text.find("writing standard output failed");
       CHECK(text.find("error: writing standard output failed") != std::string::npos);
@@ -564,8 +567,8 @@ TEST_CASE("cli conventions: a summary lost on standard output publishes no file"
     }
     const auto [code, text] = run(args, ">/dev/null");
     CHECK(code == 0);
-    CHECK((fs::exists(out) || fs::exists(page)));
-    for (const auto& f : {out, page, report}) fs::remove(f);
+    CHECK((fs::exists(out) || fs::exists(page) || fs::exists(runs)));
+    for (const auto& f : {out, page, report, runs, summary}) fs::remove(f);
   }
 }
 
@@ -604,14 +607,21 @@ TEST_CASE("cli conventions: closed standard descriptors, symlink loops, long nam
   std::string deep = dir.path.string();
   while (deep.size() < 5000) deep += "/" + std::string(200, 'z');
   deep += "/m.exo";
+  // A directory of 4,000 bytes (legal) with a name of 240 (legal): the temporary's path passes
+  // PATH_MAX (4,096).
+  std::string near = dir.path.string();
+  while (near.size() < 4000)
+    near += "/" + std::string(std::min<std::size_t>(200, 4000 - near.size()), 'w');
+  fs::create_directories(near);
+  const std::string past = near + "/" + std::string(240, 'v') + ".html";
   for (const std::string& args :
-       {"check " + too_long, "check " + deep, "template geode3d --format exo -o " + too_long,
-        "template geode3d --format exo -o " + deep, "view " + mesh.string() + " -o " + deep}) {
+       {"check " + too_long, "check " + deep, "view " + mesh.string() + " -o " + too_long + ".html",
+        "view " + mesh.string() + " -o " + deep, "view " + mesh.string() + " -o " + past}) {
     CAPTURE(args);
     const auto run = test::geode_cli(args, true);
     CHECK(run.code == 2);
     CHECK((run.out.find("File name too long") != std::string::npos ||
            run.out.find("file name too long") != std::string::npos));
-    CHECK(run.out.find("read") == std::string::npos);  // refused first
+    CHECK(run.out.find(": read ") == std::string::npos);  // refused before reading
   }
 }

@@ -157,4 +157,12 @@ status=0
 [ "$status" = 2 ] || { echo "summary to /dev/full: exited $status, not 2"; cat err.txt; exit 1; }
 grep -q "writing standard output failed: .* (nothing written)" err.txt
 if ls lost.exo* >/dev/null 2>&1; then echo "summary to /dev/full: wrote a file"; exit 1; fi
+# Two ranks, rank 0's standard output a full disk of its own: neither publishes its piece.
+status=0
+# shellcheck disable=SC2016
+"$mpiexec" --oversubscribe -np 2 sh -c 'if [ "$OMPI_COMM_WORLD_RANK" = 0 ]; then exec "$0" "$@" >/dev/full; else exec "$0" "$@"; fi' \
+  "$geode_mpi" conform in.exo -o lost2.exo 2>err.txt || status=$?
+[ "$status" = 2 ] || { echo "2 ranks, rank 0's summary to /dev/full: exited $status, not 2"; cat err.txt; exit 1; }
+grep -q "writing standard output failed: .* (nothing written)" err.txt
+if ls lost2.exo* >/dev/null 2>&1; then echo "2 ranks, rank 0's summary lost: wrote a piece"; exit 1; fi
 echo "mpi_verify_test: both modes pass the result and find the broken dicing on 1 and 2 ranks, an invalid zone on 1 to 3, a refused share of the read on 2 and 3, a rank failing alone on 2 and 3, options out of range and outputs that are not Exodus files or are the input refused, a lost summary publishing nothing, progress from rank 0 alone"
