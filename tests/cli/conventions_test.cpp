@@ -616,7 +616,8 @@ TEST_CASE("cli conventions: closed standard descriptors, symlink loops, long nam
   const std::string past = near + "/" + std::string(240, 'v') + ".html";
   for (const std::string& args :
        {"check " + too_long, "check " + deep, "view " + mesh.string() + " -o " + too_long + ".html",
-        "view " + mesh.string() + " -o " + deep, "view " + mesh.string() + " -o " + past}) {
+        "view " + mesh.string() + " -o " + deep, "view " + mesh.string() + " -o " + past,
+        "arrange " + too_long + ".json"}) {
     CAPTURE(args);
     const auto run = test::geode_cli(args, true);
     CHECK(run.code == 2);
