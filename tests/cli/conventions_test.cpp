@@ -554,7 +554,11 @@ TEST_CASE("cli conventions: a summary lost on standard output publishes no file"
         "study interleave --high 0.8 --low 0.4 --depth 0.5 --radius 0.5 -o " + runs.string() +
             " --summary " + summary.string()}) {
     CAPTURE(args);
+    // A closed descriptor fails as a full disk does (the other commands show it): the demos,
+    // the slow ones under the sanitizers, once.
+    const bool demo = args.starts_with("demo");
     for (const std::string redirect : {">/dev/full", ">&-"}) {
+      if (demo && redirect == ">&-") continue;
       CAPTURE(redirect);
       const auto [code, text] = run(args, redirect);
       CHECK(code == 2);
