@@ -500,6 +500,22 @@ TEST_CASE("cli conventions: a file name that is not UTF-8 is written into JSON w
   CHECK(html.find(replaced) != std::string::npos);
 }
 
+namespace {
+
+// `geode ARGS` with standard output redirected as the shell does (`>/dev/full`, `>&-`) and its
+// stderr into `err`: the exit code and everything it said there.
+std::pair<int, std::string> run_redirected(const std::string& args, const std::string& redirect,
+                                           const fs::path& err) {
+  const int status = std::system(
+      (std::string(GEODE_CLI_PATH) + " " + args + " " + redirect + " 2>'" + err.string() + "'")
+          .c_str());
+  std::ifstream in(err);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, std::move(text)};
+}
+
+}  // namespace
+
 TEST_CASE("cli conventions: output that cannot be written to standard output fails the run") {
   // `geode check m.exo > report.txt` on a full disk (/dev/full) or with standard output closed
   // lost the report and exited 0.
@@ -507,13 +523,7 @@ TEST_CASE("cli conventions: output that cannot be written to standard output fai
   const fs::path mesh = dir.path / "m.exo", err = dir.path / "err.txt";
   io::write_exodus(primal::grid_model({2, 2, 2}, 1.0, [](int, int, int) { return false; }), mesh);
   const auto run = [&](const std::string& args, const std::string& redirect) {
-    const int status = std::system(
-        (std::string(GEODE_CLI_PATH) + " " + args + " " + redirect + " 2>'" + err.string() + "'")
-            .c_str());
-    std::ifstream in(err);
-    std::string line;
-    std::getline(in, line);
-    return std::pair(WIFEXITED(status) ? WEXITSTATUS(status) : -1, line);
+    return run_redirected(args, redirect, err);
   };
   for (const std::string& args :
        {std::string("template geode3d"), "check " + mesh.string() + " --quiet",
@@ -537,12 +547,7 @@ TEST_CASE("cli conventions: a summary lost on standard output publishes no file"
                  report = dir.path / "out.json", runs = dir.path / "runs.csv",
                  summary = dir.path / "summary.csv";
   const auto run = [&](const std::string& args, const std::string& redirect) {
-    const int status = std::system(
-        (std::string(GEODE_CLI_PATH) + " " + args + " " + redirect + " 2>'" + err.string() + "'")
-            .c_str());
-    std::ifstream in(err);
-    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    return std::pair(WIFEXITED(status) ? WEXITSTATUS(status) : -1, text);
+    return run_redirected(args, redirect, err);
   };
   const std::string o = " -o " + out.string();
   for (const std::string& args :
