@@ -100,9 +100,13 @@ void Conformer::find_interface() {
   if ((!input_.hexes.empty() || !input_.wedges.empty()) && !input_.tets.empty())
     interface_ = primal::find_interface(input_, options_.interface_tolerance, &joining_);
   if (!joining_.empty()) return;
-  // Both parts but no shared quad: the parts were meshed apart (unmerged nodes, a gap).
+  // Both parts but no shared quad: separate bodies (a bolt beside a bracket), each diced alone,
+  // as a model with another interface dices a body apart from it. Parts that touch without
+  // sharing their nodes were refused when read (the covering check: "lie against each other").
   if (!input_.hexes.empty() && !input_.tets.empty() && interface_.quads.empty())
-    throw InvalidInput("conform: the hex part and the tet part share no interface quad");
+    res_.warnings.push_back(
+        "the hex part and the tet part share no interface quad: each is diced alone, with no "
+        "transition between them");
   measure_near_interface();
   wedge_diced_.reserve(input_.wedges.size());
   for (std::size_t w = 0; w < input_.wedges.size(); ++w)

@@ -127,22 +127,38 @@ TEST_CASE("geode conform: bad input exits non-zero, names the file and writes no
   };
 
   SUBCASE("a file that does not exist") { check_refused(dir.path / "missing.msh", "no such file"); }
-  SUBCASE("a hex part and a tet part that do not touch") {
-    // Two hex cells, a gap cell and two tet cells: no interface quad.
-    const primal::Model apart = [] {
-      primal::Model m = primal::grid_model({5, 1, 1}, 1.0, [](int i, int, int) { return i >= 3; });
-      m.hexes.erase(m.hexes.begin() + 2);
-      m.hex_block.erase(m.hex_block.begin() + 2);
-      return m;
-    }();
-    io::write_exodus(apart, dir.path / "apart.exo");
-    check_refused(dir.path / "apart.exo", "no interface quad");
-  }
   // Nothing half-written left behind either.
   for (const auto& e : fs::directory_iterator(dir.path)) {
     const std::string name = e.path().filename().string();
     CHECK(name == "apart.exo");
   }
+}
+
+TEST_CASE("geode conform: a hex part and a tet part that do not touch are each diced, warned") {
+  // Separate bodies (a bolt beside a bracket) in one file: two hex cells, a gap cell and two
+  // tet cells. There is no transition to make; each part is diced alone, as a body apart from
+  // the interface is in a model that has one, and a warning says so (it was refused).
+  TempDir dir;
+  primal::Model apart = primal::grid_model({5, 1, 1}, 1.0, [](int i, int, int) { return i >= 3; });
+  apart.hexes.erase(apart.hexes.begin() + 2);
+  apart.hex_block.erase(apart.hex_block.begin() + 2);
+  io::write_exodus(apart, dir.path / "apart.exo");
+  const fs::path report = dir.path / "r.json";
+  const Run r =
+      geode_cli("conform " + (dir.path / "apart.exo").string() + " -o " +
+                (dir.path / "out.exo").string() + " --report " + report.string() + " --quiet");
+  INFO(r.out);
+  REQUIRE(r.code == 0);
+  CHECK(r.out ==
+        "geode: warning: the hex part and the tet part share no interface quad: each is diced "
+        "alone, with no transition between them\n");
+  const nlohmann::json j = nlohmann::json::parse(std::ifstream(report));
+  CHECK(j.at("valid").get<bool>());
+  CHECK(j.at("output").at("hexes").get<std::size_t>() == 2 * 8 + 2 * 6 * 4);
+  CHECK(j.at("output").at("geode_hexes").get<std::size_t>() == 0);
+  const primal::Model out = io::read_exodus(dir.path / "out.exo");
+  CHECK(out.hexes.size() == 2 * 8 + 2 * 6 * 4);
+  CHECK(primal::check_validity(primal::hex_part(out)).ok());
 }
 
 TEST_CASE("geode conform: a warning reaches stderr with --quiet, and the report names the side") {

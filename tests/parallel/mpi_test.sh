@@ -24,6 +24,9 @@ elif [ "$model" = ball ]; then  # the serial run's aims set by a tet outside the
 elif [ "$model" = layer ]; then  # a thin hex layer with wedges through it, split into tets
   input=in.msh
   /usr/bin/python3 "$here/../conform/layer_model.py" "$input" sphere "$size"
+elif [ "$model" = apart ]; then  # two bodies that share no face: each diced alone, warned
+  input=in.msh
+  /usr/bin/python3 "$here/../conform/apart_model.py" "$input" "$size"
 elif [ "$model" = layer-quads ]; then  # a nearly thin quads-only layer: both sides tried
   input=in.msh
   /usr/bin/python3 "$here/../conform/layer_model.py" "$input" cylinder "$size" out 0.15 quads
