@@ -127,17 +127,27 @@ TEST_CASE("geode conform: bad input exits non-zero, names the file and writes no
   };
 
   SUBCASE("a file that does not exist") { check_refused(dir.path / "missing.msh", "no such file"); }
-  // Nothing half-written left behind either.
-  for (const auto& e : fs::directory_iterator(dir.path)) {
-    const std::string name = e.path().filename().string();
-    CHECK(name == "apart.exo");
+  SUBCASE("a hex part and a tet part against each other without shared nodes") {
+    // Two hex cells beside two tet cells, the tets on copies of every node: parts meshed
+    // separately and not merged.
+    primal::Model m = primal::grid_model({4, 1, 1}, 1.0, [](int i, int, int) { return i >= 2; });
+    const auto first_copy = primal::index_cast<primal::Index>(m.points.size());
+    m.points.insert(m.points.end(), m.points.begin(), m.points.end());
+    for (auto& t : m.tets)
+      for (auto& v : t) v += first_copy;
+    io::write_exodus(m, dir.path / "unmerged.exo");
+    check_refused(dir.path / "unmerged.exo", "lie against each other");
   }
+  // Nothing half-written left behind either.
+  for (const auto& e : fs::directory_iterator(dir.path))
+    if (e.path().filename() != "unmerged.exo")
+      FAIL_CHECK("left behind: " << e.path().filename().string());
 }
 
 TEST_CASE("geode conform: a hex part and a tet part that do not touch are each diced, warned") {
   // Separate bodies (a bolt beside a bracket) in one file: two hex cells, a gap cell and two
   // tet cells. There is no transition to make; each part is diced alone, as a body apart from
-  // the interface is in a model that has one, and a warning says so (it was refused).
+  // the interface is in a model that has one, and a warning says so.
   TempDir dir;
   primal::Model apart = primal::grid_model({5, 1, 1}, 1.0, [](int i, int, int) { return i >= 3; });
   apart.hexes.erase(apart.hexes.begin() + 2);
