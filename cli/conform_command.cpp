@@ -10,7 +10,10 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <string>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include <geode/conform/conform.hpp>
 #include <geode/conform/reference_template.hpp>
@@ -91,18 +94,32 @@ void print_summary(const conform::ConformResult& r, std::ostream& os, bool table
   // The transition against the input's own elements diced alone (the yardstick).
   const double yardstick = r.yardstick();
   const double output = conform::output_min_scaled_jacobian(r);
-  os << "input diced alone: min scaled Jacobian " << r.input_diced_hex_min_scaled_jacobian
-     << " (hexes), " << r.input_diced_tet_min_scaled_jacobian << " (tets"
-     << (r.input_pyramids ? ", pyramids as their two tets" : "")
-     << (r.wedges_split ? ", split wedges as their three" : "")
-     << (r.hexes_split ? ", split hexes as their tets" : "") << ")";
-  if (r.input_wedges > r.wedges_split)
-    os << ", " << r.input_diced_wedge_min_scaled_jacobian << " (wedges)";
+  // Only the kinds the input holds, and the geode hexes where there are some: a kind without
+  // elements has no minimum (the result's 1 is a placeholder).
+  std::vector<std::string> kinds;
+  auto add = [&](double value, const std::string& what) {
+    std::ostringstream k;
+    k << value << " (" << what << ")";
+    kinds.push_back(k.str());
+  };
+  if (r.input_hexes > r.hexes_split) add(r.input_diced_hex_min_scaled_jacobian, "hexes");
+  std::string tets;  // what the tets' minimum is over
+  for (const auto& [count, what] :
+       {std::pair{r.input_tets, "tets"}, std::pair{r.input_pyramids, "pyramids as their two tets"},
+        std::pair{r.wedges_split, "split wedges as their three"},
+        std::pair{r.hexes_split, "split hexes as their tets"}})
+    if (count > 0) tets += (tets.empty() ? "" : ", ") + std::string(what);
+  if (!tets.empty()) add(r.input_diced_tet_min_scaled_jacobian, tets);
+  if (r.input_wedges > r.wedges_split) add(r.input_diced_wedge_min_scaled_jacobian, "wedges");
+  os << "input diced alone: min scaled Jacobian ";
+  for (std::size_t i = 0; i < kinds.size(); ++i) os << (i ? ", " : "") << kinds[i];
   os << "; output " << output;
   if (yardstick > 0) os << " = " << output / yardstick << " x the lower";
-  os << "; geode hexes >= " << r.local_yardstick_ratio << " x their local yardstick ("
-     << r.capped_local_ratio
-     << " x it capped by the template's own minimum at its buffer hex's proportions)\n";
+  if (r.geode_hexes > 0)
+    os << "; geode hexes >= " << r.local_yardstick_ratio << " x their local yardstick ("
+       << r.capped_local_ratio
+       << " x it capped by the template's own minimum at its buffer hex's proportions)";
+  os << "\n";
 }
 
 // --template-box: three sizes, checked as template --box checks its box.

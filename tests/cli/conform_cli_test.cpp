@@ -169,6 +169,22 @@ TEST_CASE("geode conform: a hex part and a tet part that do not touch are each d
   const primal::Model out = io::read_exodus(dir.path / "out.exo");
   CHECK(out.hexes.size() == 2 * 8 + 2 * 6 * 4);
   CHECK(primal::check_validity(primal::hex_part(out)).ok());
+  // The summary names the kinds the input holds, and no geode hexes where there are none.
+  const Run summary = geode_cli("conform " + (dir.path / "apart.exo").string() + " -o " +
+                                (dir.path / "again.exo").string());
+  INFO(summary.out);
+  CHECK(summary.out.find("input diced alone: min scaled Jacobian 1 (hexes), ") !=
+        std::string::npos);
+  CHECK(summary.out.find("geode hexes") == std::string::npos);
+  primal::Model tets = apart;
+  tets.hexes.clear(), tets.hex_block.clear();
+  io::write_exodus(tets, dir.path / "tets.exo");
+  const Run only_tets = geode_cli("conform " + (dir.path / "tets.exo").string() + " -o " +
+                                  (dir.path / "tets_out.exo").string());
+  INFO(only_tets.out);
+  CHECK(only_tets.code == 0);
+  CHECK(only_tets.out.find("input diced alone: min scaled Jacobian 0.") != std::string::npos);
+  CHECK(only_tets.out.find("(hexes)") == std::string::npos);
 }
 
 TEST_CASE("geode conform: a warning reaches stderr with --quiet, and the report names the side") {
