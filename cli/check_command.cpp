@@ -1,6 +1,7 @@
 // geode check MESH: is a hex (or planar quad) mesh a valid complex, how good are its elements,
 // and which combinatorial obstructions keep any placement of its nodes from positive
-// Jacobians (primal/validity.hpp, primal/quality_report.hpp, primal/realizability.hpp).
+// Jacobians (primal/validity.hpp, primal/quality_report.hpp, primal/realizability.hpp); for a
+// hybrid mesh, conform's input checks (primal/input_check.hpp).
 #include <algorithm>
 #include <iostream>
 #include <memory>
@@ -8,6 +9,8 @@
 #include <sstream>
 
 #include <geode/primal/errors.hpp>
+#include <geode/primal/input_check.hpp>
+#include <geode/primal/model.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/quality_report.hpp>
 #include <geode/primal/realizability.hpp>
@@ -97,24 +100,58 @@ Checked check_quads(const primal::QuadMesh& mesh, const primal::RealizabilityOpt
   return c;
 }
 
+// A hybrid mesh (tets, pyramids or wedges, with hexes or not): the checks conform makes when it
+// reads one (primal::check_geometry, then the covering check of primal/input_check.hpp), with
+// every covering finding listed where conform refuses at the first. Quality and realizability
+// are an all-hex mesh's: conform's output.
+Checked check_model(const primal::Model& model, const std::string& source, Progress& progress) {
+  Checked c;
+  std::ostringstream s;
+  s << "hybrid mesh: " << model.hexes.size() << " hexes, " << model.tets.size() << " tets, "
+    << model.pyramids.size() << " pyramids, " << model.wedges.size() << " wedges, "
+    << model.points.size() << " nodes\n";
+  try {
+    primal::check_geometry(model, source);
+    const primal::InputCheckResult r = primal::check_input(model);
+    c.valid = r.ok();
+    s << "conform's input checks: "
+      << (r.ok() ? "passed" : std::to_string(r.findings.size()) + " findings") << " ("
+      << r.boundary_faces << " boundary faces)\n";
+    for (const primal::InputFinding& f : r.findings) s << "  " << f.text(model) << "\n";
+  } catch (const InvalidInput& e) {  // the first element check_geometry refuses
+    s << "conform's input checks: " << e.what() << "\n";
+  }
+  c.validity = s.str();
+  progress.stage_done(validity_line(c.valid));
+  return c;
+}
+
 void run_check(const CheckArgs& a) {
   check_output_path(a.output);
   const std::string format = output_format(a.output, a.format, {"text", "json"}, "text");
   check_not_input(a.output, a.input);  // a report never replaces the mesh it is about
   Progress progress = Progress::for_stderr(a.quiet);
-  const MeshFile m = read_mesh_file(a.input);
-  progress.stage_done(read_line(a.input, m));
+  const MeshFile m = read_mesh_file(a.input, /*other_cells=*/true);
+  progress.stage_done(m.model ? "read " + a.input + ": " +
+                                    std::to_string(primal::element_count(*m.model)) + " elements"
+                              : read_line(a.input, m));
   primal::RealizabilityOptions options;
   options.planar_angle_degrees = a.planar_angle;
   const Index base = m.index_base;
-  Checked c = m.dim == 3 ? check_hexes(m.hex, options, base, progress)
-                         : check_quads(m.quad, options, base, progress);
+  Checked c = m.model      ? check_model(*m.model, a.input, progress)
+              : m.dim == 3 ? check_hexes(m.hex, options, base, progress)
+                           : check_quads(m.quad, options, base, progress);
   std::string text;
   if (format == "json") {
     nlohmann::json j;
     j["file"] = a.input;
     j["dimension"] = m.dim;
     j["index_base"] = base;
+    if (m.model)
+      j["elements"] = {{"hexes", m.model->hexes.size()},
+                       {"tets", m.model->tets.size()},
+                       {"pyramids", m.model->pyramids.size()},
+                       {"wedges", m.model->wedges.size()}};
     j["valid"] = c.valid;
     j["validity"] = c.validity;
     j["quality"] = c.analysable ? c.quality : nlohmann::json();
@@ -126,7 +163,10 @@ void run_check(const CheckArgs& a) {
     s << a.input << " (" << (m.dim == 3 ? "elements" : "quads") << " and nodes numbered from "
       << base << ")\n"
       << c.validity;
-    if (c.analysable) {
+    if (m.model) {
+      s << "quality and realizability not checked: they are an all-hex mesh's (geode conform "
+           "makes one)\n";
+    } else if (c.analysable) {
       s << "\n"
         << c.quality_text << "\nrealizability: "
         << primal::format_obstructions(c.obstructions, m.dim, base, static_cast<std::size_t>(-1));
@@ -154,13 +194,20 @@ void add_check_command(CLI::App& app) {
       "two\n"
       "faces on one planar boundary face, flat corners, two-quad boundary nodes "
       "(primal/realizability.hpp\n"
-      "says why each blocks). Exit 0 whenever the file could be checked.");
-  c->add_option("mesh", a->input, hex_or_quad_input_help())->required();
+      "says why each blocks). A hybrid mesh (tets, pyramids, wedges) gets the checks conform makes "
+      "when\n"
+      "it reads one (positive elements, one covering of one domain: folds, overlaps, gaps), every "
+      "finding\n"
+      "listed. Exit 0 whenever the file could be checked.");
+  c->add_option("mesh", a->input,
+                hex_or_quad_input_help() + ", or a hybrid mesh (tets, pyramids, wedges, hexes)")
+      ->required();
   c->add_option("--format", a->format,
                 "text (default), or json: {\"valid\", \"validity\", \"quality\", "
                 "\"obstructions\": [{\"kind\", \"hexes\", \"nodes\"}]}\n"
-                "with ids as the file numbers them (\"index_base\"); without it the extension of "
-                "-o decides\n(.txt, .json); one that contradicts the extension is refused")
+                "with ids as the file numbers them (\"index_base\"); a hybrid mesh: \"elements\" "
+                "per kind,\nquality and obstructions null. Without it the extension of -o decides "
+                "(.txt, .json);\none that contradicts the extension is refused")
       ->check(CLI::IsMember({"text", "json"}));
   c->add_option("-o,--output", a->output, "Write the report here instead of standard output");
   c->add_option("--planar-angle", a->planar_angle,

@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -47,8 +48,9 @@ struct MeshFile {
   primal::HexMesh hex;
   primal::QuadMesh quad;
   primal::Index index_base = 0;
+  std::optional<primal::Model> model;  // with other_cells: a hybrid mesh (io::PlainMesh::model)
 };
-MeshFile read_mesh_file(const std::filesystem::path& path);
+MeshFile read_mesh_file(const std::filesystem::path& path, bool other_cells = false);
 // The progress line of a mesh read: "read PATH: N hexes, M nodes" (quads in 2D).
 std::string read_line(const std::string& path, const MeshFile& m);
 // What the progress of stc::mesh_dual counts (MeshDualOptions::progress): "hex visits of the

@@ -23,13 +23,14 @@ std::string file_extension(const fs::path& p) {
 
 primal::Model read_model(const fs::path& path) { return io::read_model(path); }
 
-MeshFile read_mesh_file(const fs::path& path) {
+MeshFile read_mesh_file(const fs::path& path, bool other_cells) {
   const io::MeshFormat* format = nullptr;
-  io::PlainMesh plain = io::read_plain_mesh(path, &format);
+  io::PlainMesh plain = io::read_plain_mesh(path, &format, other_cells);
   MeshFile m;
   m.dim = plain.dim;
   m.hex = std::move(plain.hex);
   m.quad = std::move(plain.quad);
+  m.model = std::move(plain.model);
   m.index_base = format->index_base;
   if (m.dim == 2)
     for (std::size_t n = 0; n < m.quad.points.size(); ++n)

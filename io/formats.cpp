@@ -252,7 +252,7 @@ void check_signature(const fs::path& path, const MeshFormat& format) {
   throw InvalidInput(what);
 }
 
-PlainMesh read_plain_mesh(const fs::path& path, const MeshFormat** format) {
+PlainMesh read_plain_mesh(const fs::path& path, const MeshFormat** format, bool other_cells) {
   const MeshFormat* f = reader_for(path);
   if (!f) {
     (void)read_file_head(path);  // a missing file is named as such first
@@ -271,7 +271,13 @@ PlainMesh read_plain_mesh(const fs::path& path, const MeshFormat** format) {
   // .msh one at the read, exit 2, where it reported a .vtu one).
   primal::ReadOptions plain;
   plain.check_geometry = false;
-  const primal::Model model = read_model(path, plain, /*check_covering=*/false);
+  primal::Model model = read_model(path, plain, /*check_covering=*/false);
+  const bool hybrid = model.tets.size() + model.pyramids.size() + model.wedges.size() > 0;
+  if (hybrid && other_cells) {
+    PlainMesh m;
+    m.model = std::move(model);
+    return m;
+  }
   for (primal::ElementKind kind :
        {primal::ElementKind::kTet, primal::ElementKind::kPyramid, primal::ElementKind::kWedge})
     if (const std::size_t n = primal::element_count(model, kind))

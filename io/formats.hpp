@@ -57,6 +57,9 @@ struct PlainMesh {
   int dim = 3;  // 3: hex, 2: quad
   primal::HexMesh hex;
   primal::QuadMesh quad;
+  // With read_plain_mesh's `other_cells`: a file holding tets, pyramids or wedges (a hybrid
+  // mesh) as read_model reads it, its cells unchecked (dim 3, hex empty).
+  std::optional<primal::Model> model;
 };
 
 using ModelReader = primal::Model (*)(const std::filesystem::path& path,
@@ -127,8 +130,10 @@ void check_signature(const std::filesystem::path& path, const MeshFormat& format
 // Reads `path` with the hex or quad cells as the file gives them (PlainMesh) where the entry
 // can, else through read_model with its points checked but not its cells (their geometry and
 // covering are for the caller to judge, as with the entries that read plain meshes);
-// InvalidInput naming the file otherwise.
-PlainMesh read_plain_mesh(const std::filesystem::path& path, const MeshFormat** format = nullptr);
+// InvalidInput naming the file otherwise, and for a file with other cells than hexes unless
+// `other_cells` (PlainMesh::model).
+PlainMesh read_plain_mesh(const std::filesystem::path& path, const MeshFormat** format = nullptr,
+                          bool other_cells = false);
 
 // Writes a model in the format `format` names, or, when empty, the one the extension names
 // (.msh: Gmsh 4.1). InvalidInput naming the file for an unknown format or extension, and

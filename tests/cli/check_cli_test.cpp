@@ -17,6 +17,7 @@
 #include <geode/primal/grid_model.hpp>
 #include <geode/primal/topology.hpp>
 #include "support/cli_run.hpp"
+#include "support/demo_input.hpp"
 #include "support/fixtures.hpp"
 
 using namespace geode;
@@ -191,11 +192,13 @@ TEST_CASE("geode check: text report, quad meshes, the file's own numbering") {
   }
   SUBCASE("refusals") {
     CHECK(geode_cli("check " + (dir.path / "missing.vtu").string()).code == 2);
-    const auto in = dir.path / "mixed.msh";
-    io::write_gmsh(primal::grid_model({2, 1, 1}, 1.0, [](int i, int, int) { return i == 1; }), in);
+    // A Gmsh file named .vtu: refused before any parser, naming what it holds.
+    const auto in = dir.path / "gmsh.vtu";
+    io::write_gmsh(primal::grid_model({2, 1, 1}, 1.0, [](int, int, int) { return false; }), in);
     const auto r = geode_cli("check " + in.string(), true);
     CHECK(r.code == 2);
-    CHECK(r.out.find(in.string() + ": holds") != std::string::npos);
+    CHECK(r.out.find(in.string() + ": ") != std::string::npos);
+    CHECK(r.out.find("Gmsh") != std::string::npos);
     CHECK(geode_cli("check " + in.string() + " --format yaml").code != 0);
   }
 }
@@ -304,9 +307,50 @@ TEST_CASE("geode check: its stages on stderr as they end, none with --quiet, the
     CHECK(out.out == text);
   }
   // A refused input is still one line: nothing is said before the read.
-  const auto mixed = dir.path / "mixed.msh";
-  io::write_gmsh(primal::grid_model({2, 1, 1}, 1.0, [](int i, int, int) { return i == 1; }), mixed);
-  const auto bad = geode_cli("check " + mixed.string(), true);
+  const auto misnamed = dir.path / "gmsh.vtu";  // Gmsh's content under another extension
+  io::write_gmsh(primal::grid_model({2, 1, 1}, 1.0, [](int, int, int) { return false; }), misnamed);
+  const auto bad = geode_cli("check " + misnamed.string(), true);
   CHECK(bad.code == 2);
   CHECK(std::count(bad.out.begin(), bad.out.end(), '\n') == 1);
+}
+
+TEST_CASE("geode check: a hybrid mesh gets conform's input checks, every finding listed") {
+  test::TempDir dir;
+  // Gmsh's hexdominant demo as a user saves it (hexes, tets, Gmsh's pyramids, wedges): passes.
+  (void)test::demo_input("hexdominant", 4, dir, ".msh");
+  const auto ok = check_json(dir.path / "hexdominant.msh");
+  CHECK(ok["valid"] == true);
+  CHECK(ok["elements"]["pyramids"].get<int>() > 0);
+  CHECK(ok["elements"]["wedges"].get<int>() > 0);
+  CHECK(ok["quality"].is_null());
+  // Two hex cells beside two tet cells on copies of every node (parts meshed apart, not
+  // merged): each tet face against a hex face is a finding, all of them listed (conform
+  // refuses at the first), ids as the file numbers them.
+  primal::Model m = primal::grid_model({4, 1, 1}, 1.0, [](int i, int, int) { return i >= 2; });
+  const auto first_copy = primal::index_cast<Index>(m.points.size());
+  m.points.insert(m.points.end(), m.points.begin(), m.points.end());
+  for (auto& t : m.tets)
+    for (auto& v : t) v += first_copy;
+  io::write_gmsh(m, dir.path / "unmerged.msh");
+  const auto r = geode_cli("check " + (dir.path / "unmerged.msh").string());
+  INFO(r.out);
+  CHECK(r.code == 0);
+  std::size_t against = 0;
+  for (std::size_t at = r.out.find("lie against each other"); at != std::string::npos;
+       at = r.out.find("lie against each other", at + 1))
+    ++against;
+  CHECK(against >= 2);
+  CHECK(r.out.find("conform's input checks: " + std::to_string(against) + " findings") !=
+        std::string::npos);
+  CHECK(check_json(dir.path / "unmerged.msh")["valid"] == false);
+  // An inverted tet: the element the geometry check refuses, by its file id.
+  primal::Model inverted =
+      primal::grid_model({2, 1, 1}, 1.0, [](int i, int, int) { return i >= 1; });
+  std::swap(inverted.tets[0][0], inverted.tets[0][1]);
+  io::write_gmsh(inverted, dir.path / "inverted.msh");
+  const auto bad = geode_cli("check " + (dir.path / "inverted.msh").string());
+  INFO(bad.out);
+  CHECK(bad.code == 0);
+  CHECK(bad.out.find("is inverted") != std::string::npos);
+  CHECK(check_json(dir.path / "inverted.msh")["valid"] == false);
 }
