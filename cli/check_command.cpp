@@ -104,6 +104,7 @@ Checked check_quads(const primal::QuadMesh& mesh, const primal::RealizabilityOpt
 // reads one (primal::check_geometry, then the covering check of primal/input_check.hpp), with
 // every covering finding listed where conform refuses at the first. Quality and realizability
 // are an all-hex mesh's: conform's output.
+constexpr std::size_t kFindingsListed = 1000;  // a mesh broken everywhere: a readable report
 Checked check_model(const primal::Model& model, const std::string& source, Progress& progress) {
   Checked c;
   std::ostringstream s;
@@ -117,7 +118,10 @@ Checked check_model(const primal::Model& model, const std::string& source, Progr
     s << "conform's input checks: "
       << (r.ok() ? "passed" : std::to_string(r.findings.size()) + " findings") << " ("
       << r.boundary_faces << " boundary faces)\n";
-    for (const primal::InputFinding& f : r.findings) s << "  " << f.text(model) << "\n";
+    for (std::size_t i = 0; i < std::min(r.findings.size(), kFindingsListed); ++i)
+      s << "  " << r.findings[i].text(model) << "\n";
+    if (r.findings.size() > kFindingsListed)
+      s << "  ... and " << r.findings.size() - kFindingsListed << " more\n";
   } catch (const InvalidInput& e) {  // the first element check_geometry refuses
     s << "conform's input checks: " << e.what() << "\n";
   }
