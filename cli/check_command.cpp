@@ -4,6 +4,7 @@
 // hybrid mesh, conform's input checks (primal/input_check.hpp).
 #include <algorithm>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -100,11 +101,12 @@ Checked check_quads(const primal::QuadMesh& mesh, const primal::RealizabilityOpt
   return c;
 }
 
+constexpr std::size_t kFindingsListed = 1000;  // a mesh broken everywhere: a readable report
+
 // A hybrid mesh (tets, pyramids or wedges, with hexes or not): the checks conform makes when it
 // reads one (primal::check_geometry, then the covering check of primal/input_check.hpp), with
 // every covering finding listed where conform refuses at the first. Quality and realizability
 // are an all-hex mesh's: conform's output.
-constexpr std::size_t kFindingsListed = 1000;  // a mesh broken everywhere: a readable report
 Checked check_model(const primal::Model& model, const std::string& source, Progress& progress) {
   Checked c;
   std::ostringstream s;
@@ -113,7 +115,9 @@ Checked check_model(const primal::Model& model, const std::string& source, Progr
     << model.points.size() << " nodes\n";
   try {
     primal::check_geometry(model, source);
-    const primal::InputCheckResult r = primal::check_input(model);
+    primal::InputCheckOptions every;  // conform's read stops at its first few
+    every.max_findings = std::numeric_limits<std::size_t>::max();
+    const primal::InputCheckResult r = primal::check_input(model, every);
     c.valid = r.ok();
     s << "conform's input checks: "
       << (r.ok() ? "passed" : std::to_string(r.findings.size()) + " findings") << " ("

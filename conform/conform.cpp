@@ -100,9 +100,10 @@ void Conformer::find_interface() {
   if ((!input_.hexes.empty() || !input_.wedges.empty()) && !input_.tets.empty())
     interface_ = primal::find_interface(input_, options_.interface_tolerance, &joining_);
   if (!joining_.empty()) return;
-  // Both parts but no shared quad: separate bodies (a bolt beside a bracket), each diced alone,
-  // as a model with another interface dices a body apart from it. Parts that touch without
-  // sharing their nodes were refused when read (the covering check: "lie against each other").
+  // Both parts but no shared quad: separate bodies (a bolt beside a bracket), or hexes that meet
+  // the tets only through wedges' triangles; each diced alone, as a model with another interface
+  // dices a body apart from it. Parts that touch without sharing their nodes were refused when
+  // read (the covering check: "lie against each other").
   if (!input_.hexes.empty() && !input_.tets.empty() && interface_.quads.empty())
     res_.warnings.push_back(
         "the hex part and the tet part share no interface quad: each is diced alone, with no "

@@ -300,8 +300,9 @@ struct ConformResult {
 // Throws TopologyError from find_interface / insert_buffer_layer (named by them: e.g. a wedge
 // joining the two sides around an interface node), when a side face is shared by more than two
 // buffer hexes or when the side faces of two buffer hexes do not match; InvalidInput when the
-// model is empty or has both parts but no interface quad. A result whose validity is not ok()
-// is still returned (with warnings) so that it can be inspected.
+// model is empty. A model with both parts but no interface quad is diced, with a warning. A
+// result whose validity is not ok() is still returned (with warnings) so that it can be
+// inspected.
 ConformResult conform(const primal::Model& input, const ConformOptions& options = {});
 // The same on a model the caller gives up, changed in place rather than copied: its tets
 // relaxed, and once the buffer layer holds the model (a copy of it) its arrays freed but the

@@ -19,9 +19,13 @@ namespace fs = std::filesystem;
 namespace {
 
 // A VTK file's cells as given: all quads (a planar quad mesh), or hexes (with triangles and
-// quads, boundary annotations, left out by to_hex_mesh naming the first other cell).
+// quads, boundary annotations, left out by to_hex_mesh naming the first other cell); nothing for
+// a file with tets, pyramids or wedges, which read_plain_mesh reads as a model.
 std::optional<PlainMesh> read_vtk_plain(const fs::path& path) {
   const VtkGrid g = read_vtk_file(path);
+  if (std::any_of(g.cell_types.begin(), g.cell_types.end(),
+                  [](int t) { return t == kVtkTetra || t == kVtkPyramid || t == kVtkWedge; }))
+    return std::nullopt;
   PlainMesh m;
   const bool quads = !g.cell_types.empty() && std::all_of(g.cell_types.begin(), g.cell_types.end(),
                                                           [](int t) { return t == kVtkQuad; });

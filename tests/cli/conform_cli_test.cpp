@@ -177,7 +177,8 @@ TEST_CASE("geode conform: a hex part and a tet part that do not touch are each d
         std::string::npos);
   CHECK(summary.out.find("geode hexes") == std::string::npos);
   primal::Model tets = apart;
-  tets.hexes.clear(), tets.hex_block.clear();
+  tets.hexes.clear();
+  tets.hex_block.clear();
   io::write_exodus(tets, dir.path / "tets.exo");
   const Run only_tets = geode_cli("conform " + (dir.path / "tets.exo").string() + " -o " +
                                   (dir.path / "tets_out.exo").string());
