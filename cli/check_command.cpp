@@ -101,6 +101,12 @@ Checked check_quads(const primal::QuadMesh& mesh, const primal::RealizabilityOpt
   return c;
 }
 
+// "hexes", "tets", "pyramids", "wedges".
+std::string kind_plural(primal::ElementKind kind) {
+  return kind == primal::ElementKind::kHex ? "hexes"
+                                           : std::string(primal::element_kind_name(kind)) + "s";
+}
+
 constexpr std::size_t kFindingsListed = 1000;  // a mesh broken everywhere: a readable report
 
 // A hybrid mesh (tets, pyramids or wedges, with hexes or not): the checks conform makes when it
@@ -110,9 +116,10 @@ constexpr std::size_t kFindingsListed = 1000;  // a mesh broken everywhere: a re
 Checked check_model(const primal::Model& model, const std::string& source, Progress& progress) {
   Checked c;
   std::ostringstream s;
-  s << "hybrid mesh: " << model.hexes.size() << " hexes, " << model.tets.size() << " tets, "
-    << model.pyramids.size() << " pyramids, " << model.wedges.size() << " wedges, "
-    << model.points.size() << " nodes\n";
+  s << "hybrid mesh: ";
+  for (primal::ElementKind kind : primal::kElementKinds)
+    s << primal::element_count(model, kind) << " " << kind_plural(kind) << ", ";
+  s << model.points.size() << " nodes\n";
   try {
     primal::check_geometry(model, source);
     primal::InputCheckOptions every;  // conform's read stops at its first few
@@ -156,10 +163,8 @@ void run_check(const CheckArgs& a) {
     j["dimension"] = m.dim;
     j["index_base"] = base;
     if (m.model)
-      j["elements"] = {{"hexes", m.model->hexes.size()},
-                       {"tets", m.model->tets.size()},
-                       {"pyramids", m.model->pyramids.size()},
-                       {"wedges", m.model->wedges.size()}};
+      for (primal::ElementKind kind : primal::kElementKinds)
+        j["elements"][kind_plural(kind)] = primal::element_count(*m.model, kind);
     j["valid"] = c.valid;
     j["validity"] = c.validity;
     j["quality"] = c.analysable ? c.quality : nlohmann::json();

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cctype>
 #include <new>
+#include <stdexcept>
 
 #include <geode/io/exodus.hpp>
 #include <geode/io/file_format.hpp>
@@ -19,14 +20,19 @@ namespace fs = std::filesystem;
 namespace {
 
 // A VTK file's cells as given: all quads (a planar quad mesh), or hexes (with triangles and
-// quads, boundary annotations, left out by to_hex_mesh naming the first other cell); nothing for
-// a file with tets, pyramids or wedges, which read_plain_mesh reads as a model.
+// quads, boundary annotations, left out by to_hex_mesh naming the first other cell); a file
+// with tets, pyramids or wedges as a model from the same parse, its cells unchecked
+// (PlainMesh::model: read_plain_mesh says whether the caller takes one).
 std::optional<PlainMesh> read_vtk_plain(const fs::path& path) {
   const VtkGrid g = read_vtk_file(path);
-  if (std::any_of(g.cell_types.begin(), g.cell_types.end(),
-                  [](int t) { return t == kVtkTetra || t == kVtkPyramid || t == kVtkWedge; }))
-    return std::nullopt;
   PlainMesh m;
+  if (std::any_of(g.cell_types.begin(), g.cell_types.end(),
+                  [](int t) { return t == kVtkTetra || t == kVtkPyramid || t == kVtkWedge; })) {
+    primal::ReadOptions plain;
+    plain.check_geometry = false;
+    m.model = model_from_vtk(g, plain);
+    return m;
+  }
   const bool quads = !g.cell_types.empty() && std::all_of(g.cell_types.begin(), g.cell_types.end(),
                                                           [](int t) { return t == kVtkQuad; });
   if (quads) {
@@ -265,8 +271,25 @@ PlainMesh read_plain_mesh(const fs::path& path, const MeshFormat** format, bool 
   }
   if (format) *format = f;
   check_signature(path, *f);
+  // A model with other cells than hexes goes to a caller that takes one, whichever reader made
+  // it; to the others it is refused naming what it holds.
+  auto other = [&](primal::Model model) {
+    if (other_cells) {
+      PlainMesh m;
+      m.model = std::move(model);
+      return m;
+    }
+    for (primal::ElementKind kind :
+         {primal::ElementKind::kTet, primal::ElementKind::kPyramid, primal::ElementKind::kWedge})
+      if (const std::size_t n = primal::element_count(model, kind))
+        throw InvalidInput(path.string() + ": holds " + std::to_string(n) + " " +
+                           primal::element_kind_name(kind) +
+                           "s; expected an all-hex mesh (use `geode conform` first)");
+    throw std::logic_error("read_plain_mesh: a model without other cells");
+  };
   if (f->read_plain) try {
-      if (auto m = f->read_plain(path)) return std::move(*m);
+      if (auto m = f->read_plain(path))
+        return m->model ? other(std::move(*m->model)) : std::move(*m);
     } catch (const std::bad_alloc&) {
       throw out_of_memory_reading(path);
     }
@@ -276,18 +299,7 @@ PlainMesh read_plain_mesh(const fs::path& path, const MeshFormat** format, bool 
   primal::ReadOptions plain;
   plain.check_geometry = false;
   primal::Model model = read_model(path, plain, /*check_covering=*/false);
-  const bool hybrid = model.tets.size() + model.pyramids.size() + model.wedges.size() > 0;
-  if (hybrid && other_cells) {
-    PlainMesh m;
-    m.model = std::move(model);
-    return m;
-  }
-  for (primal::ElementKind kind :
-       {primal::ElementKind::kTet, primal::ElementKind::kPyramid, primal::ElementKind::kWedge})
-    if (const std::size_t n = primal::element_count(model, kind))
-      throw InvalidInput(path.string() + ": holds " + std::to_string(n) + " " +
-                         primal::element_kind_name(kind) +
-                         "s; expected an all-hex mesh (use `geode conform` first)");
+  if (primal::element_count(model) > model.hexes.size()) return other(std::move(model));
   if (model.hexes.empty())  // surfaces only (a 2D Gmsh mesh), or nothing: no mesh to judge
     throw InvalidInput(path.string() +
                        ": holds no hexes (no volume element at all); expected an "

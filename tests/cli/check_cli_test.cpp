@@ -324,6 +324,8 @@ TEST_CASE("geode check: a hybrid mesh gets conform's input checks, every finding
     CAPTURE(ext);
     const auto ok = check_json(dir.path / ("hexdominant" + ext));
     CHECK(ok["valid"] == true);
+    CHECK(ok["elements"]["hexes"].get<int>() > 0);
+    CHECK(ok["elements"]["tets"].get<int>() > 0);
     CHECK(ok["elements"]["pyramids"].get<int>() > 0);
     CHECK(ok["elements"]["wedges"].get<int>() > 0);
     CHECK(ok["quality"].is_null());
@@ -331,12 +333,7 @@ TEST_CASE("geode check: a hybrid mesh gets conform's input checks, every finding
   // Two hex cells beside two tet cells on copies of every node (parts meshed apart, not
   // merged): each tet face against a hex face is a finding, all of them listed (conform
   // refuses at the first), ids as the file numbers them.
-  primal::Model m = primal::grid_model({4, 3, 3}, 1.0, [](int i, int, int) { return i >= 2; });
-  const auto first_copy = primal::index_cast<Index>(m.points.size());
-  m.points.insert(m.points.end(), m.points.begin(), m.points.end());
-  for (auto& t : m.tets)
-    for (auto& v : t) v += first_copy;
-  io::write_gmsh(m, dir.path / "unmerged.msh");
+  io::write_gmsh(test::unmerged_parts({4, 3, 3}), dir.path / "unmerged.msh");
   const auto r = geode_cli("check " + (dir.path / "unmerged.msh").string());
   INFO(r.out);
   CHECK(r.code == 0);

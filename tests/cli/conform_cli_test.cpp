@@ -130,12 +130,7 @@ TEST_CASE("geode conform: bad input exits non-zero, names the file and writes no
   SUBCASE("a hex part and a tet part against each other without shared nodes") {
     // Two hex cells beside two tet cells, the tets on copies of every node: parts meshed
     // separately and not merged.
-    primal::Model m = primal::grid_model({4, 1, 1}, 1.0, [](int i, int, int) { return i >= 2; });
-    const auto first_copy = primal::index_cast<primal::Index>(m.points.size());
-    m.points.insert(m.points.end(), m.points.begin(), m.points.end());
-    for (auto& t : m.tets)
-      for (auto& v : t) v += first_copy;
-    io::write_exodus(m, dir.path / "unmerged.exo");
+    io::write_exodus(test::unmerged_parts({4, 1, 1}), dir.path / "unmerged.exo");
     check_refused(dir.path / "unmerged.exo", "lie against each other");
   }
   // Nothing half-written left behind either.

@@ -168,4 +168,14 @@ primal::Model tet_cell_on_hex_top() {
   return m;
 }
 
+primal::Model unmerged_parts(std::array<int, 3> cells) {
+  const int half = cells[0] / 2;
+  primal::Model m = primal::grid_model(cells, 1.0, [&](int i, int, int) { return i >= half; });
+  const auto first_copy = primal::index_cast<primal::Index>(m.points.size());
+  m.points.insert(m.points.end(), m.points.begin(), m.points.end());
+  for (auto& t : m.tets)
+    for (auto& v : t) v += first_copy;
+  return m;
+}
+
 }  // namespace geode::test

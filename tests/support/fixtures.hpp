@@ -49,4 +49,9 @@ primal::Model four_tet_fan(const primal::Point& centre, const primal::Point& ape
 // layer can be carved from the hex part there.
 primal::Model tet_cell_on_hex_top();
 
+// primal::grid_model(cells) with hexes (block 1) in the first half of x and tets (block 2) in the
+// second, the tets on copies of every node: parts meshed apart and not merged, each tet face at
+// the interface against a hex face without sharing its nodes.
+primal::Model unmerged_parts(std::array<int, 3> cells);
+
 }  // namespace geode::test
