@@ -102,15 +102,16 @@ void print_summary(const conform::ConformResult& r, std::ostream& os, bool table
     k << value << " (" << what << ")";
     kinds.push_back(k.str());
   };
-  if (r.input_hexes > r.hexes_split) add(r.input_diced_hex_min_scaled_jacobian, "hexes");
+  const conform::DicedAloneKinds has = conform::diced_alone_kinds(r);
+  if (has.hexes) add(r.input_diced_hex_min_scaled_jacobian, "hexes");
   std::string tets;  // what the tets' minimum is over
   for (const auto& [count, what] :
        {std::pair{r.input_tets, "tets"}, std::pair{r.input_pyramids, "pyramids as their two tets"},
         std::pair{r.wedges_split, "split wedges as their three"},
         std::pair{r.hexes_split, "split hexes as their tets"}})
     if (count > 0) tets += (tets.empty() ? "" : ", ") + std::string(what);
-  if (!tets.empty()) add(r.input_diced_tet_min_scaled_jacobian, tets);
-  if (r.input_wedges > r.wedges_split) add(r.input_diced_wedge_min_scaled_jacobian, "wedges");
+  if (has.tets) add(r.input_diced_tet_min_scaled_jacobian, tets);
+  if (has.wedges) add(r.input_diced_wedge_min_scaled_jacobian, "wedges");
   os << "input diced alone: min scaled Jacobian ";
   for (std::size_t i = 0; i < kinds.size(); ++i) os << (i ? ", " : "") << kinds[i];
   os << "; output " << output;

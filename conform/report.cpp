@@ -45,7 +45,17 @@ std::string duplicate_node_hint(const primal::Model& model, const std::string& m
   return s.str();
 }
 
+DicedAloneKinds diced_alone_kinds(const ConformResult& r) {
+  return {r.input_hexes > r.hexes_split,
+          r.input_tets + r.input_pyramids + r.wedges_split + r.hexes_split > 0,
+          r.input_wedges > r.wedges_split};
+}
+
 nlohmann::json report_json(const ConformResult& r) {
+  // null where the minimum is over nothing (the result holds 1 or 0 there).
+  const auto over = [](bool any, double value) { return any ? nlohmann::json(value) : nullptr; };
+  const DicedAloneKinds kinds = diced_alone_kinds(r);
+  const bool geode = r.geode_hexes > 0;
   nlohmann::json j;
   j["input"] = {{"hexes", r.input_hexes},
                 {"tets", r.input_tets},
@@ -61,7 +71,7 @@ nlohmann::json report_json(const ConformResult& r) {
   j["valid"] = r.validity.ok() && r.dicing.ok();
   j["verification"] = {{"scope", r.verified == ConformVerify::kLocal ? "local" : "full"},
                        {"hexes_checked_whole", r.verified_hexes}};
-  j["template_min_scaled_jacobian"] = r.template_min_scaled_jacobian;
+  j["template_min_scaled_jacobian"] = over(geode, r.template_min_scaled_jacobian);
   j["min_scaled_jacobian_before_smoothing"] = r.min_scaled_jacobian_before_smoothing;
   j["min_scaled_jacobian_after_smoothing"] = r.smoothing.final_min_scaled_jacobian;
   j["hexes_inverted_by_placement"] = r.placement_inverted;
@@ -73,12 +83,12 @@ nlohmann::json report_json(const ConformResult& r) {
                          {"min_before", r.relaxation.min_before},
                          {"min_after", r.relaxation.min_after},
                          {"seconds", r.relaxation.seconds}};
-  j["buffer_layer_min_scaled_jacobian"] = r.buffer.min_scaled_jacobian;
+  j["buffer_layer_min_scaled_jacobian"] = over(geode, r.buffer.min_scaled_jacobian);
   j["buffer_side"] = buffer_side_name(r.buffer_side);
   j["input_diced_alone_min_scaled_jacobian"] = {
-      {"hexes", r.input_diced_hex_min_scaled_jacobian},
-      {"tets", r.input_diced_tet_min_scaled_jacobian},
-      {"wedges", r.input_diced_wedge_min_scaled_jacobian}};
+      {"hexes", over(kinds.hexes, r.input_diced_hex_min_scaled_jacobian)},
+      {"tets", over(kinds.tets, r.input_diced_tet_min_scaled_jacobian)},
+      {"wedges", over(kinds.wedges, r.input_diced_wedge_min_scaled_jacobian)}};
   j["output_min_scaled_jacobian"] = output_min_scaled_jacobian(r);
   j["seconds"] = r.seconds;
   j["warnings"] = r.warnings;
@@ -89,8 +99,8 @@ nlohmann::json report_json(const ConformResult& r) {
       {"element_order",
        r.numbering.order == primal::ElementOrder::kByBlock ? "by block" : "as given"}};
   j["blocks"] = nlohmann::json::array();
-  j["local_yardstick_ratio"] = r.local_yardstick_ratio;
-  j["capped_local_ratio"] = r.capped_local_ratio;
+  j["local_yardstick_ratio"] = over(geode, r.local_yardstick_ratio);
+  j["capped_local_ratio"] = over(geode, r.capped_local_ratio);
   for (const auto& b : r.quality) {
     nlohmann::json block = {
         {"id", b.block},

@@ -24,9 +24,20 @@ std::string invalid_reason(const ConformResult& result);
 // merge tolerance: "--merge-tolerance", "merge_tolerance="), empty when there are none.
 std::string duplicate_node_hint(const primal::Model& model, const std::string& merge_option);
 
+// The kinds the input holds as conform dices them alone (ConformResult::yardstick): its hexes not
+// split into tets; tets, with the pyramids, split wedges and split hexes as their tets; wedges
+// not split. A kind without elements has no minimum (the result's 1 is a placeholder), so the
+// summary line leaves it out and the JSON report says null.
+struct DicedAloneKinds {
+  bool hexes = false, tets = false, wedges = false;
+};
+DicedAloneKinds diced_alone_kinds(const ConformResult& result);
+
 // {"input": {...}, "output": {...}, "valid", minima before and after smoothing, "smoothing",
 // the yardstick "input_diced_alone_min_scaled_jacobian", "seconds", "warnings",
-// "blocks": [{"id", "name", "quality"}]}: the report `geode conform --report` writes.
+// "blocks": [{"id", "name", "quality"}]}: the report `geode conform --report` writes. A minimum
+// over nothing is null: a kind the input lacks (diced_alone_kinds), and without geode hexes
+// the template's, the buffer layer's and the local yardstick ratios.
 nlohmann::json report_json(const ConformResult& result);
 
 }  // namespace geode::conform

@@ -108,6 +108,14 @@ TEST_CASE("geode conform: a hex-only model has no transition to make and is simp
   CHECK(j.at("valid").get<bool>());
   CHECK(j.at("output").at("hexes").get<std::size_t>() == 64);
   CHECK(j.at("output").at("geode_hexes").get<std::size_t>() == 0);
+  // A minimum over nothing is null: no tets, no wedges, no template, no geode hexes.
+  const nlohmann::json& alone = j.at("input_diced_alone_min_scaled_jacobian");
+  CHECK(alone.at("hexes").get<double>() == 1.0);
+  CHECK(alone.at("tets").is_null());
+  CHECK(alone.at("wedges").is_null());
+  for (const char* key : {"template_min_scaled_jacobian", "buffer_layer_min_scaled_jacobian",
+                          "local_yardstick_ratio", "capped_local_ratio"})
+    CHECK_MESSAGE(j.at(key).is_null(), key);
 }
 
 TEST_CASE("geode conform: bad input exits non-zero, names the file and writes nothing") {
@@ -175,12 +183,22 @@ TEST_CASE("geode conform: a hex part and a tet part that do not touch are each d
   tets.hexes.clear();
   tets.hex_block.clear();
   io::write_exodus(tets, dir.path / "tets.exo");
-  const Run only_tets = geode_cli("conform " + (dir.path / "tets.exo").string() + " -o " +
-                                  (dir.path / "tets_out.exo").string());
+  const fs::path tets_report = dir.path / "tets.json";
+  const Run only_tets =
+      geode_cli("conform " + (dir.path / "tets.exo").string() + " -o " +
+                (dir.path / "tets_out.exo").string() + " --report " + tets_report.string());
   INFO(only_tets.out);
   CHECK(only_tets.code == 0);
   CHECK(only_tets.out.find("input diced alone: min scaled Jacobian 0.") != std::string::npos);
   CHECK(only_tets.out.find("(hexes)") == std::string::npos);
+  // The JSON report too: the tets' minimum, null for the kinds the input lacks.
+  const nlohmann::json t = nlohmann::json::parse(std::ifstream(tets_report));
+  const nlohmann::json& alone = t.at("input_diced_alone_min_scaled_jacobian");
+  CHECK(alone.at("hexes").is_null());
+  CHECK(alone.at("wedges").is_null());
+  CHECK(alone.at("tets").get<double>() > 0.0);
+  CHECK(alone.at("tets").get<double>() < 1.0);
+  CHECK(t.at("local_yardstick_ratio").is_null());
 }
 
 TEST_CASE("geode conform: a warning reaches stderr with --quiet, and the report names the side") {
