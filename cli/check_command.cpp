@@ -120,8 +120,30 @@ Checked check_model(const primal::Model& model, const std::string& source, Progr
   for (primal::ElementKind kind : primal::kElementKinds)
     s << primal::element_count(model, kind) << " " << kind_plural(kind) << ", ";
   s << model.points.size() << " nodes\n";
+  const auto list = [&s](const std::vector<std::string>& findings) {
+    for (std::size_t i = 0; i < std::min(findings.size(), kFindingsListed); ++i)
+      s << "  " << findings[i] << "\n";
+    if (findings.size() > kFindingsListed)
+      s << "  ... and " << findings.size() - kFindingsListed << " more\n";
+  };
   try {
-    primal::check_geometry(model, source);
+    primal::check_points(model, source);
+  } catch (const InvalidInput& e) {  // a non-finite coordinate: nothing else can be measured
+    s << "conform's input checks: " << e.what() << "\n";
+    c.validity = s.str();
+    progress.stage_done(validity_line(c.valid));
+    return c;
+  }
+  // Every element conform's read would refuse (it stops at the first), then the covering
+  // check, which measures the elements' corners and so needs them all positive.
+  const std::vector<std::string> geometry =
+      primal::geometry_findings(model, std::numeric_limits<std::size_t>::max());
+  if (!geometry.empty()) {
+    s << "conform's input checks: " << geometry.size()
+      << " elements or nodes refused (the covering check needs every element positive: not "
+         "run)\n";
+    list(geometry);
+  } else {
     primal::InputCheckOptions every;  // conform's read stops at its first few
     every.max_findings = std::numeric_limits<std::size_t>::max();
     const primal::InputCheckResult r = primal::check_input(model, every);
@@ -129,12 +151,12 @@ Checked check_model(const primal::Model& model, const std::string& source, Progr
     s << "conform's input checks: "
       << (r.ok() ? "passed" : std::to_string(r.findings.size()) + " findings") << " ("
       << r.boundary_faces << " boundary faces)\n";
+    std::vector<std::string> texts;
     for (std::size_t i = 0; i < std::min(r.findings.size(), kFindingsListed); ++i)
-      s << "  " << r.findings[i].text(model) << "\n";
+      texts.push_back(r.findings[i].text(model));
+    list(texts);
     if (r.findings.size() > kFindingsListed)
       s << "  ... and " << r.findings.size() - kFindingsListed << " more\n";
-  } catch (const InvalidInput& e) {  // the first element check_geometry refuses
-    s << "conform's input checks: " << e.what() << "\n";
   }
   c.validity = s.str();
   progress.stage_done(validity_line(c.valid));

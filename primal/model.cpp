@@ -414,18 +414,23 @@ void check_points(const Model& model, std::string_view source) {
                          " has a non-finite coordinate");
 }
 
-void check_geometry(const Model& model, std::string_view source) {
-  const std::string where(source);
-  check_points(model, source);
+std::vector<std::string> geometry_findings(const Model& model, std::size_t max_findings) {
+  std::vector<std::string> found;
+  // Adds a finding; true once there are max_findings.
+  const auto add = [&](std::string text) {
+    found.push_back(std::move(text));
+    return found.size() >= max_findings;
+  };
+  if (max_findings == 0) return found;
   auto pt = [&](Index v) -> const Point& { return model.points[index_cast<std::size_t>(v)]; };
   for (std::size_t t = 0; t < model.tets.size(); ++t) {
     const auto& c = model.tets[t];
     const double volume = tet_volume(pt(c[0]), pt(c[1]), pt(c[2]), pt(c[3]));
     if (!(volume > 0.0)) {
       const ElementRef e{ElementKind::kTet, index_cast(t)};
-      throw InvalidInput(where + ": " + describe_element(model, e) + " is " +
-                         (volume < 0.0 ? "inverted" : "flat") + " (signed volume " +
-                         number_text(volume) + "; nodes " + node_list(model, c) + ")");
+      if (add(describe_element(model, e) + " is " + (volume < 0.0 ? "inverted" : "flat") +
+              " (signed volume " + number_text(volume) + "; nodes " + node_list(model, c) + ")"))
+        return found;
     }
   }
   for (std::size_t h = 0; h < model.hexes.size(); ++h) {
@@ -435,11 +440,11 @@ void check_geometry(const Model& model, std::string_view source) {
     for (std::size_t c = 0; c < 8; ++c)
       if (!(jacobians[c] > 0.0)) {
         const ElementRef e{ElementKind::kHex, index_cast(h)};
-        throw InvalidInput(where + ": " + describe_element(model, e) + " is " +
-                           (jacobians[c] < 0.0 ? "inverted" : "flat") + " at its corner " +
-                           describe_node(model, model.hexes[h][c]) + " (corner Jacobian " +
-                           number_text(jacobians[c]) + "; nodes " +
-                           node_list(model, model.hexes[h]) + ")");
+        if (add(describe_element(model, e) + " is " + (jacobians[c] < 0.0 ? "inverted" : "flat") +
+                " at its corner " + describe_node(model, model.hexes[h][c]) + " (corner Jacobian " +
+                number_text(jacobians[c]) + "; nodes " + node_list(model, model.hexes[h]) + ")"))
+          return found;
+        break;  // one finding per element
       }
   }
   // A wedge's corner Jacobian: the determinant of its three edges there (topology.hpp's
@@ -454,10 +459,11 @@ void check_geometry(const Model& model, std::string_view source) {
           6.0;
       if (!(j > 0.0)) {
         const ElementRef e{ElementKind::kWedge, index_cast(w)};
-        throw InvalidInput(where + ": " + describe_element(model, e) + " is " +
-                           (j < 0.0 ? "inverted" : "flat") + " at its corner " +
-                           describe_node(model, c[k]) + " (corner Jacobian " + number_text(j) +
-                           "; nodes " + node_list(model, c) + ")");
+        if (add(describe_element(model, e) + " is " + (j < 0.0 ? "inverted" : "flat") +
+                " at its corner " + describe_node(model, c[k]) + " (corner Jacobian " +
+                number_text(j) + "; nodes " + node_list(model, c) + ")"))
+          return found;
+        break;  // one finding per element
       }
     }
   }
@@ -473,18 +479,18 @@ void check_geometry(const Model& model, std::string_view source) {
       const auto worst =
           index_cast<std::size_t>(std::min_element(corner.begin(), corner.end()) - corner.begin());
       const ElementRef e{ElementKind::kPyramid, index_cast(p)};
-      throw InvalidInput(where + ": " + describe_element(model, e) + " is " +
-                         (corner[worst] < 0.0 ? "inverted" : "flat") + " at its base corner " +
-                         describe_node(model, c[worst]) + " (signed volume " +
-                         number_text(corner[worst]) +
-                         " of the tet there, and neither base diagonal gives two " +
-                         "positive tets; nodes " + node_list(model, c) + ")");
+      if (add(describe_element(model, e) + " is " + (corner[worst] < 0.0 ? "inverted" : "flat") +
+              " at its base corner " + describe_node(model, c[worst]) + " (signed volume " +
+              number_text(corner[worst]) +
+              " of the tet there, and neither base diagonal gives two " + "positive tets; nodes " +
+              node_list(model, c) + ")"))
+        return found;
     }
   }
   // A node set's node no element uses has no node in any output made from the elements: the
   // set would lose it without a word (a Gmsh file saved without the elements of a volume in no
   // physical group keeps that volume's points and curves).
-  if (model.node_sets.empty()) return;
+  if (model.node_sets.empty()) return found;
   std::vector<char> used(model.points.size(), 0);
   for (ElementKind kind : kElementKinds)
     for (std::size_t e = 0; e < element_count(model, kind); ++e)
@@ -493,8 +499,16 @@ void check_geometry(const Model& model, std::string_view source) {
   for (const NodeSet& set : model.node_sets)
     for (Index v : set.nodes)
       if (!used[index_cast<std::size_t>(v)])
-        throw InvalidInput(where + ": node set " + std::to_string(set.id) + " '" + set.name +
-                           "': " + describe_node(model, v) + " belongs to no element");
+        if (add("node set " + std::to_string(set.id) + " '" + set.name +
+                "': " + describe_node(model, v) + " belongs to no element"))
+          return found;
+  return found;
+}
+
+void check_geometry(const Model& model, std::string_view source) {
+  check_points(model, source);
+  const std::vector<std::string> found = geometry_findings(model, 1);
+  if (!found.empty()) throw InvalidInput(std::string(source) + ": " + found.front());
 }
 
 HexMesh hex_part(const Model& model) {

@@ -190,6 +190,10 @@ void check_points(const Model& model, std::string_view source);
 // node set's node that no element uses. Throws InvalidInput naming `source` and the node or
 // element by its file id, with coordinates.
 void check_geometry(const Model& model, std::string_view source);
+// What check_geometry refuses (but check_points), every element and node at most once, up to
+// max_findings of them, in its order: each text names the element or node by its file id,
+// without the source. `geode check` lists them all where a reader stops at the first.
+std::vector<std::string> geometry_findings(const Model& model, std::size_t max_findings);
 
 // The two parts over the model's whole point array (unused points included), so that node
 // numbers agree between the parts and the model. Every element carries its block (block_of).

@@ -345,14 +345,24 @@ TEST_CASE("geode check: a hybrid mesh gets conform's input checks, every finding
   CHECK(r.out.find("conform's input checks: " + std::to_string(against) + " findings") !=
         std::string::npos);
   CHECK(check_json(dir.path / "unmerged.msh")["valid"] == false);
-  // An inverted tet: the element the geometry check refuses, by its file id.
+  // Two inverted tets and an inverted hex: every element the geometry check refuses (conform's
+  // read names the first), each once, by its file id.
   primal::Model inverted =
       primal::grid_model({2, 1, 1}, 1.0, [](int i, int, int) { return i >= 1; });
   std::swap(inverted.tets[0][0], inverted.tets[0][1]);
+  std::swap(inverted.tets[3][0], inverted.tets[3][1]);
+  auto& hex = inverted.hexes[0];  // top and bottom faces swapped: inverted at every corner
+  std::rotate(hex.begin(), hex.begin() + 4, hex.end());
   io::write_gmsh(inverted, dir.path / "inverted.msh");
   const auto bad = geode_cli("check " + (dir.path / "inverted.msh").string());
   INFO(bad.out);
   CHECK(bad.code == 0);
-  CHECK(bad.out.find("is inverted") != std::string::npos);
+  std::size_t listed = 0;
+  for (std::size_t at = bad.out.find(" is inverted"); at != std::string::npos;
+       at = bad.out.find(" is inverted", at + 1))
+    ++listed;
+  CHECK(listed == 3);
+  CHECK(bad.out.find("conform's input checks: 3 elements or nodes refused") != std::string::npos);
+  CHECK(bad.out.find("\n  hex ") != std::string::npos);
   CHECK(check_json(dir.path / "inverted.msh")["valid"] == false);
 }
