@@ -19,12 +19,30 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A VTK file's cells as given: all quads (a planar quad mesh), or hexes (with triangles and
-// quads, boundary annotations, left out by to_hex_mesh naming the first other cell); a file
-// with tets, pyramids or wedges as a model from the same parse, its cells unchecked
+// The grid's volume cells and their cell arrays, the points as they are.
+VtkGrid without_boundary_cells(VtkGrid g) {
+  std::vector<std::size_t> keep;
+  for (std::size_t c = 0; c < g.cells.size(); ++c)
+    if (!vtk_boundary_cell(g.cell_types[c])) keep.push_back(c);
+  const auto kept = [&keep](auto values) {
+    decltype(values) out;
+    out.reserve(keep.size());
+    for (std::size_t c : keep) out.push_back(std::move(values[c]));
+    return out;
+  };
+  g.cells = kept(std::move(g.cells));
+  g.cell_types = kept(std::move(g.cell_types));
+  for (auto& [name, values] : g.cell_data.doubles) values = kept(std::move(values));
+  for (auto& [name, values] : g.cell_data.ints) values = kept(std::move(values));
+  return g;
+}
+
+// A VTK file's cells as given: all quads (a planar quad mesh), or hexes (vertices, lines,
+// triangles and quads beside them annotate the volume, vtk_boundary_cell, and are left out); a
+// file with tets, pyramids or wedges as a model from the same parse, its cells unchecked
 // (PlainMesh::model: read_plain_mesh says whether the caller takes one).
 std::optional<PlainMesh> read_vtk_plain(const fs::path& path) {
-  const VtkGrid g = read_vtk_file(path);
+  VtkGrid g = read_vtk_file(path);
   PlainMesh m;
   if (std::any_of(g.cell_types.begin(), g.cell_types.end(),
                   [](int t) { return t == kVtkTetra || t == kVtkPyramid || t == kVtkWedge; })) {
@@ -38,9 +56,14 @@ std::optional<PlainMesh> read_vtk_plain(const fs::path& path) {
   if (quads) {
     m.dim = 2;
     m.quad = to_quad_mesh(g);
-  } else {
-    m.hex = to_hex_mesh(g);  // names the first cell that is not a hex
+    return m;
   }
+  if (std::any_of(g.cell_types.begin(), g.cell_types.end(), vtk_boundary_cell) &&
+      std::any_of(g.cell_types.begin(), g.cell_types.end(),
+                  [](int t) { return t == kVtkHexahedron; }))
+    g = without_boundary_cells(std::move(g));
+  m.hex = to_hex_mesh(g);  // names the first cell that is not a hex
+  return m;
   return m;
 }
 

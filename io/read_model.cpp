@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <climits>
+#include <map>
 #include <new>
 #include <optional>
 #include <string>
@@ -14,6 +15,7 @@
 #include <geode/io/gmsh.hpp>
 #include <geode/io/names.hpp>
 #include <geode/io/nemesis_set.hpp>
+#include <geode/io/read_warnings.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/input_check.hpp>
 #include <geode/primal/node_set_pieces.hpp>
@@ -83,6 +85,64 @@ void read_field_data(const VtkGrid& grid, const std::vector<std::optional<Elemen
   }
 }
 
+// Points, lines and faces listed as cells (vtk_boundary_cell). Gmsh's legacy .vtk tags each
+// with its physical group (CellEntityIds; Gmsh saves only the elements of physical groups unless
+// Mesh.SaveAll is set), meshio's files too (gmsh:physical, 0 for none): they become sets as the
+// .msh reader makes them from the same groups, vertices and lines node sets (each cell a piece)
+// and triangles and quads side sets of the volume cells they are faces of, by tag in ascending
+// (dimension, tag). Such cells in other files (geode's writers keep sets in field data and write
+// none) are left out, with one warning.
+void read_tagged_boundary_cells(const VtkGrid& grid, const std::string& block_array,
+                                const std::vector<int>* tags, Model& model) {
+  const bool tagged = tags && (block_array == "CellEntityIds" || block_array == "gmsh:physical");
+  std::map<std::pair<int, int>, std::vector<std::size_t>> groups;  // (dim, tag) -> cells
+  std::size_t untagged = 0;
+  for (std::size_t c = 0; c < grid.cells.size(); ++c) {
+    const int type = grid.cell_types[c];
+    if (!vtk_boundary_cell(type)) continue;
+    if (!tagged || (*tags)[c] <= 0) {
+      ++untagged;
+      continue;
+    }
+    const int dim = type == kVtkVertex ? 0 : type == kVtkLine ? 1 : 2;
+    groups[{dim, (*tags)[c]}].push_back(c);
+  }
+  if (untagged > 0)
+    read_warning(grid.source + ": " + std::to_string(untagged) +
+                 " vertex, line, triangle or quad cells carry no set tag (a CellEntityIds or "
+                 "gmsh:physical cell array): they are not read");
+  if (groups.empty()) return;
+  FaceOwners owners;
+  if (std::any_of(groups.begin(), groups.end(), [](const auto& g) { return g.first.first == 2; }))
+    owners = FaceOwners(model);
+  for (const auto& [key, members] : groups) {
+    const auto [dim, tag] = key;
+    if (dim == 2) {
+      SideSet set{tag, {}, {}};
+      for (std::size_t c : members) {
+        const Side* owner = owners.find(grid.cells[c]);
+        if (!owner)
+          throw InvalidInput(grid.source + ": side set " + std::to_string(tag) + ": cell " +
+                             std::to_string(c) + " (" + block_array + " " + std::to_string(tag) +
+                             ") is not a face of any volume cell");
+        set.sides.push_back(*owner);
+      }
+      std::sort(set.sides.begin(), set.sides.end());
+      set.sides.erase(std::unique(set.sides.begin(), set.sides.end()), set.sides.end());
+      model.side_sets.push_back(std::move(set));
+    } else {
+      NodeSet set{tag, {}, {}, {}};
+      for (std::size_t c : members) {
+        set.nodes.insert(set.nodes.end(), grid.cells[c].begin(), grid.cells[c].end());
+        set.pieces.emplace_back(grid.cells[c].begin(), grid.cells[c].end());
+      }
+      std::sort(set.nodes.begin(), set.nodes.end());
+      set.nodes.erase(std::unique(set.nodes.begin(), set.nodes.end()), set.nodes.end());
+      model.node_sets.push_back(std::move(set));
+    }
+  }
+}
+
 }  // namespace
 
 Model model_from_vtk(const VtkGrid& grid, const ReadOptions& options) {
@@ -105,12 +165,11 @@ Model model_from_vtk(const VtkGrid& grid, const ReadOptions& options) {
       physical ? grid.cell_data.find_int("gmsh:geometrical") : nullptr;
   std::int64_t top = 0;
   for (std::size_t c = 0; physical && c < grid.cells.size(); ++c)
-    if (grid.cell_types[c] != kVtkTriangle && grid.cell_types[c] != kVtkQuad)
-      top = std::max<std::int64_t>(top, (*blocks)[c]);
+    if (!vtk_boundary_cell(grid.cell_types[c])) top = std::max<std::int64_t>(top, (*blocks)[c]);
   std::vector<std::optional<ElementRef>> cells(grid.cells.size());
   for (std::size_t c = 0; c < grid.cells.size(); ++c) {
     const int type = grid.cell_types[c];
-    if (type == kVtkTriangle || type == kVtkQuad) continue;
+    if (vtk_boundary_cell(type)) continue;  // sets, below
     const auto it = std::find(kVtkCellTypes.begin(), kVtkCellTypes.end(), type);
     if (it == kVtkCellTypes.end())
       throw InvalidInput(grid.source + ": cell " + std::to_string(c) + ": VTK cell type " +
@@ -142,6 +201,7 @@ Model model_from_vtk(const VtkGrid& grid, const ReadOptions& options) {
     add_element(model, kind, corners, block, static_cast<std::int64_t>(c));
   }
   read_field_data(grid, cells, model);
+  read_tagged_boundary_cells(grid, block_array, blocks, model);
   sanitize_names(model);
   validate(model, grid.source);
   options.check_geometry ? check_geometry(model, grid.source) : check_points(model, grid.source);

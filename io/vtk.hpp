@@ -20,6 +20,8 @@
 namespace geode::io {
 
 // VTK cell type numbers (vtkCellType.h).
+inline constexpr int kVtkVertex = 1;
+inline constexpr int kVtkLine = 3;
 inline constexpr int kVtkTriangle = 5;
 inline constexpr int kVtkQuad = 9;
 inline constexpr int kVtkTetra = 10;
@@ -29,6 +31,13 @@ inline constexpr int kVtkPyramid = 14;
 // The VTK type per primal::ElementKind (hex, tet, pyramid, wedge).
 inline constexpr std::array<int, 4> kVtkCellTypes{kVtkHexahedron, kVtkTetra, kVtkPyramid,
                                                   kVtkWedge};
+
+// Cells below the volume: points, lines and faces that annotate a volume mesh (Gmsh's legacy
+// .vtk lists its physical points, curves and surfaces so). Readers take them as sets where the
+// file tags them (model_from_vtk), and leave them out of a hex mesh.
+inline constexpr bool vtk_boundary_cell(int type) {
+  return type == kVtkVertex || type == kVtkLine || type == kVtkTriangle || type == kVtkQuad;
+}
 
 // Named per-cell arrays, written in this order. Names: non-empty, no white space (the legacy
 // format separates tokens by white space).
@@ -95,11 +104,11 @@ struct VtkGrid {
 
 // Readers of ASCII files: .vtu with format="ascii" DataArrays (one Piece), legacy .vtk in
 // ASCII with the classic CELLS layout or the 5.1 OFFSETS/CONNECTIVITY layout. Cells must be
-// triangles, quads, tets or hexes. Point data is skipped. Throw geode::InvalidInput naming the
-// file, the line (and point or cell) and the reason: truncated file, unknown cell type, wrong
-// node count for a cell type, node number out of range, NaN or infinite coordinate, too few or
-// too many values, unsupported encoding.
-// The file's content is checked (file_format.hpp) before it is parsed.
+// vertices, lines, triangles, quads, tets, pyramids, wedges or hexes. Point data is skipped. Throw
+// geode::InvalidInput naming the file, the line (and point or cell) and the reason: truncated file,
+// unknown cell type, wrong node count for a cell type, node number out of range, NaN or infinite
+// coordinate, too few or too many values, unsupported encoding. The file's content is checked
+// (file_format.hpp) before it is parsed.
 VtkGrid read_vtu(const std::filesystem::path& path);
 VtkGrid read_vtk(const std::filesystem::path& path);
 // The same on a file's content; `source` names it in messages.

@@ -15,7 +15,9 @@ struct CellType {
   int size;  // nodes
 };
 
-inline constexpr std::array<CellType, 6> kCellTypes{{{kVtkTriangle, "triangle", 3},
+inline constexpr std::array<CellType, 8> kCellTypes{{{kVtkVertex, "vertex", 1},
+                                                     {kVtkLine, "line", 2},
+                                                     {kVtkTriangle, "triangle", 3},
                                                      {kVtkQuad, "quad", 4},
                                                      {kVtkTetra, "tetra", 4},
                                                      {kVtkHexahedron, "hexahedron", 8},

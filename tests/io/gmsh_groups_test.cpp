@@ -399,3 +399,109 @@ TEST_CASE("names read from a file are made safe: no bad UTF-8 reaches a JSON rep
   CHECK(m.block_names.at(4) == "st\xEF\xBF\xBD");
   CHECK_NOTHROW((void)nlohmann::json(m.block_names.at(4)).dump());
 }
+
+namespace {
+
+// Each node set's nodes and each side set's faces by their coordinates, so that files that
+// number nodes differently compare.
+std::map<int, std::set<std::array<double, 3>>> node_sets_at(const Model& m) {
+  std::map<int, std::set<std::array<double, 3>>> out;
+  for (const NodeSet& s : m.node_sets)
+    for (Index v : s.nodes) {
+      const Point& p = m.points[static_cast<std::size_t>(v)];
+      out[s.id].insert({p.x(), p.y(), p.z()});
+    }
+  return out;
+}
+
+std::map<int, std::set<std::set<std::array<double, 3>>>> side_sets_at(const Model& m) {
+  std::map<int, std::set<std::set<std::array<double, 3>>>> out;
+  for (const SideSet& s : m.side_sets)
+    for (const Side& side : s.sides) {
+      std::set<std::array<double, 3>> face;
+      for (Index v : element_face(m, side)) {
+        const Point& p = m.points[static_cast<std::size_t>(v)];
+        face.insert({p.x(), p.y(), p.z()});
+      }
+      out[s.id].insert(face);
+    }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("Gmsh's legacy .vtk: its physical points, curves and surfaces are the .msh's sets") {
+  // Gmsh writes the elements of physical points and curves as VTK vertex and line cells and
+  // those of physical surfaces as triangles and quads, each with its physical tag in
+  // CellEntityIds. The reader refused the vertex and line cells (unknown cell type 1) and
+  // dropped the faces without a word.
+  const test::TempDir dir;
+  {
+    demo::GmshSession session;
+    const auto [a, b] = boxes_side_by_side("annotated");
+    gmsh::vectorpair faces;
+    gmsh::model::getBoundary({{3, a}}, faces, false, false, false);
+    for (const auto& [dim, tag] : faces) {
+      gmsh::vectorpair curves;
+      gmsh::model::getBoundary({{2, std::abs(tag)}}, curves, false, false, false);
+      for (const auto& [cd, c] : curves) gmsh::model::mesh::setTransfiniteCurve(std::abs(c), 3);
+      gmsh::model::mesh::setTransfiniteSurface(std::abs(tag));
+      gmsh::model::mesh::setRecombine(2, std::abs(tag));
+    }
+    gmsh::model::mesh::setTransfiniteVolume(a);
+    gmsh::option::setNumber("Mesh.MeshSizeMax", 0.4);
+    gmsh::model::addPhysicalGroup(3, {a}, 1);
+    gmsh::model::addPhysicalGroup(3, {b}, 2);
+    // The far faces of both boxes (a quad of the hexes, triangles of the tets), an edge of the
+    // tet box and a corner of the hex box.
+    const auto where = [](int dim, auto test) {
+      std::vector<int> tags;
+      gmsh::vectorpair entities;
+      gmsh::model::getEntities(entities, dim);
+      for (const auto& [d, tag] : entities) {
+        double x0, y0, z0, x1, y1, z1;
+        gmsh::model::getBoundingBox(d, tag, x0, y0, z0, x1, y1, z1);
+        if (test(x0, y0, z0, x1, y1, z1)) tags.push_back(tag);
+      }
+      return tags;
+    };
+    constexpr double e = 1e-6;
+    gmsh::model::addPhysicalGroup(2,
+                                  where(2, [](double x0, double, double, double x1, double,
+                                              double) { return x1 < e || x0 > 2 - e; }),
+                                  10);
+    gmsh::model::addPhysicalGroup(1,
+                                  where(1, [](double x0, double y0, double, double, double y1,
+                                              double) { return x0 > 2 - e && y0 < e && y1 < e; }),
+                                  20);
+    gmsh::model::addPhysicalGroup(0,
+                                  where(0, [](double x0, double y0, double z0, double, double,
+                                              double) { return x0 < e && y0 < e && z0 < e; }),
+                                  30);
+    gmsh::model::mesh::generate(3);
+    gmsh::write((dir.path / "annotated.msh").string());
+    gmsh::write((dir.path / "annotated.vtk").string());
+  }
+  const Model msh = read_model(dir.path / "annotated.msh");
+  const std::string text = [&] {
+    std::ifstream in(dir.path / "annotated.vtk", std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  }();
+  REQUIRE(text.find("CellEntityIds") != std::string::npos);
+  ReadWarnings warnings;
+  const Model vtk = read_model(dir.path / "annotated.vtk");
+  CHECK(warnings.messages().empty());
+  CHECK(vtk.hexes.size() == msh.hexes.size());
+  CHECK(vtk.tets.size() == msh.tets.size());
+  CHECK(vtk.pyramids.size() == msh.pyramids.size());
+  CHECK(!vtk.pyramids.empty());
+  const auto nodes = node_sets_at(vtk);
+  REQUIRE(nodes.size() == 2);
+  CHECK(nodes.at(30).size() == 1);
+  CHECK(nodes.at(20).size() > 2);
+  CHECK(nodes == node_sets_at(msh));
+  const auto sides = side_sets_at(vtk);
+  REQUIRE(sides.size() == 1);
+  CHECK(sides.at(10).size() > 8);  // 4 quads and the triangles of the far tet face
+  CHECK(sides == side_sets_at(msh));
+}

@@ -298,8 +298,8 @@ TEST_CASE("io_vtk: bad input names the file, the line and the reason") {
       "point 0: non-finite coordinate");
   add("vtk unknown cell type",
       edit_line(vtk, after("CELL_TYPES"), [](const std::string&) { return std::string("42"); }),
-      "cell 0: unknown or unsupported cell type 42 (supported: 5 triangle, 9 quad, 10 tetra, 12 "
-      "hexahedron, 13 wedge, 14 pyramid)");
+      "cell 0: unknown or unsupported cell type 42 (supported: 1 vertex, 3 line, 5 triangle, 9 "
+      "quad, 10 tetra, 12 hexahedron, 13 wedge, 14 pyramid)");
   add("vtk node out of range",
       edit_line(vtk, after("CELLS"),
                 [](const std::string&) { return std::string("8 0 1 4 3 9 10 13 -1"); }),
