@@ -752,6 +752,35 @@ class MshReader {
                    std::to_string(tag) + " numbered above the physical volumes)");
   }
 
+  // Volume entities in no physical group and without elements, in a file where other volumes
+  // are in one: Gmsh saves only the elements of physical groups unless Mesh.SaveAll=1, so
+  // their space is left empty in every output (a ball in potting came out a hole, a whole part
+  // missing, without a word). Not partitioned files: there elements live on partitioned
+  // entities, not on the entities they came from.
+  std::vector<int> unsaved_volumes() const {
+    std::vector<int> unsaved;
+    if (version_ != 4 || partitioned_) return unsaved;
+    const bool physical =
+        std::any_of(entity_physicals_.begin(), entity_physicals_.end(),
+                    [](const auto& e) { return e.first.first == 3 && !e.second.empty(); });
+    if (!physical) return unsaved;
+    std::set<int> with_elements;
+    for (const RawElement& e : elements_)
+      if (gmsh_type(e.type)->dim == 3) with_elements.insert(e.entity);
+    for (const auto& [key, physicals] : entity_physicals_)
+      if (key.first == 3 && physicals.empty() && !with_elements.count(key.second))
+        unsaved.push_back(key.second);
+    return unsaved;
+  }
+  std::string unsaved_text(const std::vector<int>& unsaved) const {
+    std::string tags;
+    for (int t : unsaved) tags += (tags.empty() ? "" : ", ") + std::to_string(t);
+    return std::string(unsaved.size() == 1 ? "volume entity " : "volume entities ") + tags +
+           (unsaved.size() == 1 ? " is" : " are") +
+           " in no physical group and without elements (Gmsh saves only the elements of "
+           "physical groups unless Mesh.SaveAll=1)";
+  }
+
   Model build() {
     Model model;
     // Nodes by ascending tag; a tag listed twice must name one point.
@@ -914,9 +943,12 @@ class MshReader {
           std::vector<Index> face;
           for (std::size_t k = 0; k < (e.type == kTri3 ? 3u : 4u); ++k) face.push_back(node(e, k));
           const Side* owner = face_owner.find(face);
-          if (!owner)
+          if (!owner) {
+            const std::vector<int> unsaved = unsaved_volumes();
             throw InvalidInput(where + ": element " + std::to_string(e.tag) +
-                               " is not a face of any volume element");
+                               " is not a face of any volume element" +
+                               (unsaved.empty() ? "" : "; " + unsaved_text(unsaved)));
+          }
           set.sides.push_back(*owner);
         }
         std::sort(set.sides.begin(), set.sides.end());
@@ -958,6 +990,9 @@ class MshReader {
                        ") in $PhysicalNames holds no element (Gmsh 2.2 saved with "
                        "Mesh.SaveAll=1 writes none): it is not read");
     }
+    if (const std::vector<int> unsaved = unsaved_volumes(); !unsaved.empty())
+      read_warning(source_ + ": " + unsaved_text(unsaved) + ": the space " +
+                   (unsaved.size() == 1 ? "it fills" : "they fill") + " is left empty");
     sanitize_names(model);
     validate(model, source_);
     return model;

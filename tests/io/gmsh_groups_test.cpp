@@ -505,3 +505,64 @@ TEST_CASE("Gmsh's legacy .vtk: its physical points, curves and surfaces are the 
   CHECK(sides.at(10).size() > 8);  // 4 quads and the triangles of the far tet face
   CHECK(sides == side_sets_at(msh));
 }
+
+TEST_CASE("a volume in no physical group, which Gmsh saves without elements, is warned about") {
+  // Gmsh saves only the elements of physical groups unless Mesh.SaveAll=1, but lists every
+  // entity in $Entities: the second box of a file whose first alone is in a physical volume was
+  // read as nothing, and conform's output had a hole (or lacked a part) without a word.
+  const test::TempDir dir;
+  {
+    demo::GmshSession session;
+    const auto [a, b] = boxes_side_by_side("unsaved");
+    gmsh::option::setNumber("Mesh.MeshSizeMax", 0.5);
+    gmsh::model::addPhysicalGroup(3, {a}, 1);
+    gmsh::model::mesh::generate(3);
+    gmsh::write((dir.path / "unsaved.msh").string());
+    // A physical surface on the unsaved box's far face: its faces belong to no volume element.
+    gmsh::vectorpair faces;
+    gmsh::model::getBoundary({{3, b}}, faces, false, false, false);
+    std::vector<int> far;
+    for (const auto& [dim, tag] : faces) {
+      double x0, y0, z0, x1, y1, z1;
+      gmsh::model::getBoundingBox(2, std::abs(tag), x0, y0, z0, x1, y1, z1);
+      if (x0 > 2 - 1e-6) far.push_back(std::abs(tag));
+    }
+    REQUIRE(far.size() == 1);
+    gmsh::model::addPhysicalGroup(2, far, 12);
+    gmsh::write((dir.path / "unsaved-side.msh").string());
+    gmsh::option::setNumber("Mesh.SaveAll", 1);
+    gmsh::write((dir.path / "saved.msh").string());
+    gmsh::option::setNumber("Mesh.SaveAll", 0);
+  }
+  std::size_t saved_tets = 0;
+  {
+    ReadWarnings warnings;  // SaveAll's own (an entity's block numbered above the groups')
+    saved_tets = read_model(dir.path / "saved.msh").tets.size();
+  }
+  {
+    ReadWarnings warnings;
+    const Model m = read_model(dir.path / "unsaved.msh");
+    CHECK(m.tets.size() < saved_tets);
+    REQUIRE(warnings.messages().size() == 1);
+    CHECK(warnings.messages()[0] ==
+          (dir.path / "unsaved.msh").string() +
+              ": volume entity 2 is in no physical group and without elements (Gmsh saves only "
+              "the elements of physical groups unless Mesh.SaveAll=1): the space it fills is left "
+              "empty");
+  }
+  {
+    ReadWarnings warnings;
+    (void)read_model(dir.path / "saved.msh");
+    for (const std::string& w : warnings.messages())
+      CHECK(w.find("without elements") == std::string::npos);
+  }
+  try {
+    ReadWarnings warnings;
+    (void)read_model(dir.path / "unsaved-side.msh");
+    FAIL("read");
+  } catch (const InvalidInput& e) {
+    const std::string what = e.what();
+    CHECK(what.find("is not a face of any volume element; volume entity 2 is in no physical "
+                    "group and without elements") != std::string::npos);
+  }
+}
