@@ -339,10 +339,12 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
        "interface are thin (flatter than 2.5 : 1, a boundary layer's) and the tets give a\n"
        "thicker layer there; where they are nearly so (flatter than 2 : 1), or the hex part\n"
        "is convex at some interface corner (its buffer hexes taper there), and the geode\n"
-       "hexes from the hex part fall short of 0.9 x their capped local yardstick, both parts\n"
-       "are tried and the better kept (the higher minimum; on a tie, the better transition),\n"
-       "with a warning. hex given on nearly thin cells and the output invalid: the tet\n"
-       "part's, with a warning")
+       "hexes from the hex part fall short of 0.9 x their capped local yardstick or leave a\n"
+       "block below 0.5 x its own elements diced alone, both parts are tried and the better\n"
+       "kept (the higher minimum; on a tie, the better transition; the tet part's where only\n"
+       "the hex part's leaves a block so spoilt and its minimum is at least 0.9 x the hex\n"
+       "part's), with a warning. hex given on nearly thin cells and the output invalid: the\n"
+       "tet part's, with a warning")
       ->check(CLI::IsMember({"hex", "tet"}));
   c->add_option(
        "--buffer-thickness", a.buffer_thickness,

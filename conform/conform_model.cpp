@@ -89,10 +89,10 @@ constexpr double kPoorTransition = 0.9;
 constexpr double kPartKept = 0.5;
 constexpr double kPartTrade = 0.9;
 
-// The block of `r` lowest against its own elements diced alone, and that ratio (none: 1).
-std::pair<const BlockQuality*, double> lowest_block(const ConformResult& r) {
+// The block lowest against its own elements diced alone, and that ratio (none: 1).
+std::pair<const BlockQuality*, double> lowest_block(const std::vector<BlockQuality>& quality) {
   std::pair<const BlockQuality*, double> low{nullptr, 1.0};
-  for (const BlockQuality& q : r.quality)
+  for (const BlockQuality& q : quality)
     if (q.report.num_hexes > 0 && q.input_diced_min_scaled_jacobian > 0.0) {
       const double ratio = block_min_scaled_jacobian(q.report) / q.input_diced_min_scaled_jacobian;
       if (ratio < low.second) low = {&q, ratio};
@@ -211,10 +211,11 @@ class ModelConformer {
   Index hex_tets_ = 0;  // the tets the split hexes became
   std::vector<Index> wedge_origin_, hex_origin_;
   std::vector<std::string> warnings_;
-  bool layer_kept_ = false;       // a thin layer that could not be split into tets
-  double near_thin_ = 0.0;        // the last pass's Conformer::near_thin()
-  bool tets_cross_ = false;       // ... its Conformer::tets_cross()
-  bool convex_hex_part_ = false;  // ... and its Conformer::convex_hex_part()
+  bool layer_kept_ = false;                    // a thin layer that could not be split into tets
+  double near_thin_ = 0.0;                     // the last pass's Conformer::near_thin()
+  bool tets_cross_ = false;                    // ... its Conformer::tets_cross()
+  bool convex_hex_part_ = false;               // ... and its Conformer::convex_hex_part()
+  std::optional<detail::AsCarved> as_carved_;  // ... and its Conformer::as_carved()
   // The caller's writer; the pass running (its near_thin() says whether from_tets may follow);
   // whether the pass running will be compared with an earlier one; whether a pass deferred its
   // writing.
@@ -265,6 +266,7 @@ ConformResult ModelConformer::pass(std::vector<Index>& joining) {
   near_thin_ = conformer.near_thin();
   tets_cross_ = conformer.tets_cross();
   convex_hex_part_ = conformer.convex_hex_part();
+  as_carved_ = conformer.as_carved();
   return r;
 }
 
@@ -445,7 +447,11 @@ ConformResult ModelConformer::from_tets(ConformResult r) {
   // The side given (or a thickness for it): only an invalid output is not taken as it is.
   const bool automatic = buffer_side_automatic(options_);
   const bool valid = result_valid(r);
-  const bool short_of_aim = r.capped_local_ratio < kPoorTransition;
+  // The blocks and the capped ratio as without a named geode block, a label only (AsCarved).
+  const std::optional<detail::AsCarved> hex_carved = as_carved_;
+  const auto& hex_quality = hex_carved ? hex_carved->quality : r.quality;
+  const double hex_capped = hex_carved ? hex_carved->capped_local_ratio : r.capped_local_ratio;
+  const bool short_of_aim = hex_capped < kPoorTransition;
   const double hex_min = output_min_scaled_jacobian(r), height = near_thin_;
   // Nearly thin hex cells at the interface, or (chosen by conform) a hex part convex at some
   // interface corner, where its buffer hexes taper.
@@ -454,7 +460,7 @@ ConformResult ModelConformer::from_tets(ConformResult r) {
   const bool thin =
       near_thin_ > 0.0 &&
       (!valid || (automatic && (tets_cross_ ? hex_min < r.yardstick() : short_of_aim)));
-  const auto hex_low = lowest_block(r);
+  const auto hex_low = lowest_block(hex_quality);
   const bool spoilt = valid && hex_low.second < kPartKept;  // some block below it
   const bool convex = convex_hex_part_ && valid && (short_of_aim || spoilt);
   if (!thin && !convex) return r;
@@ -464,7 +470,7 @@ ConformResult ModelConformer::from_tets(ConformResult r) {
                              "invalid; the tet part's layer tried")
                : std::string("buffer layer: from the hex part's ") +
                      (thin ? "thin cells" : "convex corners") + " the geode hexes reach " +
-                     std::to_string(r.capped_local_ratio) + " x their capped local yardstick" +
+                     std::to_string(hex_capped) + " x their capped local yardstick" +
                      (spoilt ? ", " + lowest_block_text(hex_low) : std::string()) +
                      "; the tet part's layer tried too");
   // The same pass from the tet part (at its default thickness): the tets relaxed again from the
@@ -487,11 +493,13 @@ ConformResult ModelConformer::from_tets(ConformResult r) {
   // the transition nearer its aim. The first on a tie of both. A block the hex part's spoils
   // and the tet part's does not is worth kPartTrade of the minimum.
   const double tet_min = output_min_scaled_jacobian(t);
-  const auto tet_low = lowest_block(t);
+  const auto& tet_quality = as_carved_ ? as_carved_->quality : t.quality;
+  const double tet_capped = as_carved_ ? as_carved_->capped_local_ratio : t.capped_local_ratio;
+  const auto tet_low = lowest_block(tet_quality);
   const bool keeps_parts = convex && !crossing && spoilt && result_valid(t) &&
                            tet_low.second >= kPartKept && tet_min >= kPartTrade * hex_min;
-  const bool better = !valid || tet_min > hex_min || keeps_parts ||
-                      (tet_min == hex_min && t.capped_local_ratio > r.capped_local_ratio);
+  const bool better =
+      !valid || tet_min > hex_min || keeps_parts || (tet_min == hex_min && tet_capped > hex_capped);
   if (!joining.empty() || t.buffer_side != BufferSide::kTet || !result_valid(t) || !better) {
     if (options_.progress) options_.progress("buffer layer: the hex part's kept");
     return r;
@@ -507,9 +515,9 @@ ConformResult ModelConformer::from_tets(ConformResult r) {
     m << "at the hex part's convex corners its buffer hexes taper, and from it ";
   if (valid)
     m << "the output's minimum scaled Jacobian was " << hex_min << ", its geode hexes "
-      << r.capped_local_ratio << " x their capped local yardstick"
+      << hex_capped << " x their capped local yardstick"
       << (spoilt ? ", " + lowest_block_text(hex_low) : std::string()) << "; from the tet part "
-      << tet_min << " and " << t.capped_local_ratio << " x"
+      << tet_min << " and " << tet_capped << " x"
       << (spoilt ? ", " + lowest_block_text(tet_low) : std::string());
   else
     m << "the output was invalid (" << invalid_reason(r) << "); from the tet part " << tet_min;

@@ -258,6 +258,24 @@ void Conformer::report(const std::vector<int>& block) {
   }
 }
 
+// The report again with the geode hexes in the blocks they were carved from (AsCarved), the
+// result's own report (the output's blocks) left as it was.
+void Conformer::report_as_carved() {
+  if (carved_blocks_.empty()) return;
+  std::vector<BlockQuality> labelled = std::move(res_.quality);
+  std::vector<double> ceilings = res_.template_ceiling;
+  const double local = res_.local_yardstick_ratio, capped = res_.capped_local_ratio;
+  res_.quality.clear();
+  res_.local_yardstick_ratio = res_.capped_local_ratio = 1.0;
+  report(carved_blocks_);
+  as_carved_ = AsCarved{std::move(res_.quality), res_.capped_local_ratio};
+  res_.quality = std::move(labelled);
+  res_.template_ceiling = std::move(ceilings);
+  res_.local_yardstick_ratio = local;
+  res_.capped_local_ratio = capped;
+  primal::release(carved_blocks_);
+}
+
 // Verification's verdict, as a progress line; `seconds`: the report and the check (not the
 // writing beside them).
 void Conformer::announce(double seconds) const {
@@ -291,9 +309,11 @@ void Conformer::verify_and_output() {
   // smoothing moved them as that block's, so the mesh is the one without the option (with it,
   // their faces were block faces the smoothing kept, and quads-only layers came out with
   // inverted hexes, exit 4, where the run without it was valid).
-  if (blocks_.geode_id != 0 && geode_first_.size() > 1)
+  if (blocks_.geode_id != 0 && geode_first_.size() > 1) {
+    carved_blocks_ = mesh_.block;
     std::fill(mesh_.block.begin() + geode_first_.front(), mesh_.block.begin() + geode_first_.back(),
               blocks_.geode_id);
+  }
   if (verify_locally()) {  // what the local check reads of the scaled Jacobians
     positive_.resize(sj_.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sj_.size(), 8192),
@@ -315,6 +335,7 @@ void Conformer::verify_and_output() {
       tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism) > 1;
   if (!ahead) {
     report(mesh_.block);
+    report_as_carved();
     if (!hand_on) primal::release(sj_);
     check(mesh_.points, mesh_.hexes, mesh_.block);
     announce(since(t0_));
@@ -344,6 +365,7 @@ void Conformer::verify_and_output() {
     // The report first (on this thread, beside the writer), its lists (and the scaled
     // Jacobians, unless the writer reads them) freed before the check allocates its own.
     report(res_.model.hex_block);
+    report_as_carved();
     if (!hand_on) primal::release(sj_);
     check(res_.model.points, res_.model.hexes, res_.model.hex_block);
     seconds = since(t0_);

@@ -11,6 +11,7 @@
 #include <chrono>
 #include <limits>
 #include <map>
+#include <optional>
 #include <span>
 #include <string>
 #include <tuple>
@@ -61,6 +62,14 @@ struct OutputBlocks {
 Point buffer_map(const std::array<Point, 8>& P, const std::array<int, 2>& diagonal,
                  const Point& rst, const Point* centre = nullptr);
 
+// With a named geode block (ConformOptions::geode_block): the per-block quality and the capped
+// ratio as without it, every geode hex in the block it was carved from. conform()'s choice of
+// the buffer side reads these, so that the option stays a label and the mesh the one without it.
+struct AsCarved {
+  std::vector<BlockQuality> quality;
+  double capped_local_ratio = 1.0;
+};
+
 // conform()'s stages, in the order run() calls them; each reads what the previous ones left.
 class Conformer {
  public:
@@ -100,6 +109,8 @@ class Conformer {
   // conform() tries the tet part's layer too where the geode hexes fall short or spoil a block.
   // The input is then kept, as for near_thin().
   bool convex_hex_part() const { return convex_hex_part_; }
+  // With a named geode block, the report as without it (AsCarved); else nothing.
+  const std::optional<AsCarved>& as_carved() const { return as_carved_; }
 
   ConformResult run() {
     const auto t_start = Clock::now();
@@ -192,6 +203,7 @@ class Conformer {
              std::span<const int> block);
   void ceilings(const std::vector<int>& block);
   void report(const std::vector<int>& block);
+  void report_as_carved();
   void announce(double seconds) const;
   void output();
   void verify_and_output();
@@ -236,6 +248,10 @@ class Conformer {
   // by BufferLayerOptions::side), whose block its geode hexes join by default: they fill space
   // that part had.
   std::vector<primal::ElementRef> carved_from_;
+  // With a named geode block: mesh_.block before the geode hexes join it (until
+  // report_as_carved), and that report.
+  std::vector<int> carved_blocks_;
+  std::optional<AsCarved> as_carved_;
   std::vector<double> hex_diced_, tet_diced_, wedge_diced_;  // per input cell: diced alone
   std::vector<double> tet_given_;  // per input tet: diced alone where the caller gave it
   // Per input hex and tet: 0, its figures are measured; kLater, read off its children; a tet

@@ -259,6 +259,17 @@ TEST_CASE("a hex part convex at its corners, its geode hexes short: the tets' la
             conform::block_min_scaled_jacobian(q.report) / q.input_diced_min_scaled_jacobian;
         CHECK((res == &wide ? ratio >= 0.5 : ratio < 0.5));
       }
+  // A named geode block is a label: the side chosen and the mesh are the ones without it. The
+  // block rule read the geode block (no input elements, so "diced alone 1") as a part the
+  // transition spoilt from either side, and kept the hex part's layer.
+  conform::ConformOptions labelled;
+  labelled.geode_block = "geode";
+  const conform::ConformResult wide_labelled = conform::conform(wide_input, labelled);
+  CHECK(wide_labelled.buffer_side == conform::BufferSide::kTet);
+  CHECK(wide_labelled.model.points == wide.model.points);
+  CHECK(wide_labelled.model.hexes == wide.model.hexes);
+  REQUIRE(!wide_labelled.warnings.empty());
+  CHECK(wide_labelled.warnings.front() == wide.warnings.front());
 }
 
 TEST_CASE("a hex part convex at its corners whose block the transition spoils: the tets' tried" *
