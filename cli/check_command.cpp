@@ -41,6 +41,10 @@ struct Checked {
   nlohmann::json quality;
   std::string quality_text;
   std::vector<primal::Obstruction> obstructions;
+  // A hybrid mesh: each finding of conform's input checks (the first kFindingsListed), as the
+  // text lists it, and how many there were.
+  std::vector<std::string> findings;
+  std::size_t finding_count = 0;
 };
 
 // "valid" or "invalid" (the report says what fails).
@@ -120,9 +124,11 @@ Checked check_model(const primal::Model& model, const std::string& source, Progr
   for (primal::ElementKind kind : primal::kElementKinds)
     s << primal::element_count(model, kind) << " " << kind_plural(kind) << ", ";
   s << model.points.size() << " nodes\n";
-  const auto list = [&s](const std::vector<std::string>& findings) {
-    for (std::size_t i = 0; i < std::min(findings.size(), kFindingsListed); ++i)
+  const auto list = [&](const std::vector<std::string>& findings) {
+    for (std::size_t i = 0; i < std::min(findings.size(), kFindingsListed); ++i) {
       s << "  " << findings[i] << "\n";
+      c.findings.push_back(findings[i]);
+    }
     if (findings.size() > kFindingsListed)
       s << "  ... and " << findings.size() - kFindingsListed << " more\n";
   };
@@ -130,6 +136,8 @@ Checked check_model(const primal::Model& model, const std::string& source, Progr
     primal::check_points(model, source);
   } catch (const InvalidInput& e) {  // a non-finite coordinate: nothing else can be measured
     s << "conform's input checks: " << e.what() << "\n";
+    c.findings.push_back(e.what());
+    c.finding_count = 1;
     c.validity = s.str();
     progress.stage_done(validity_line(c.valid));
     return c;
@@ -143,6 +151,7 @@ Checked check_model(const primal::Model& model, const std::string& source, Progr
       << " elements or nodes refused (the covering check needs every element positive: not "
          "run)\n";
     list(geometry);
+    c.finding_count = geometry.size();
   } else {
     primal::InputCheckOptions every;  // conform's read stops at its first few
     every.max_findings = std::numeric_limits<std::size_t>::max();
@@ -155,6 +164,7 @@ Checked check_model(const primal::Model& model, const std::string& source, Progr
     for (std::size_t i = 0; i < std::min(r.findings.size(), kFindingsListed); ++i)
       texts.push_back(r.findings[i].text(model));
     list(texts);
+    c.finding_count = r.findings.size();
     if (r.findings.size() > kFindingsListed)
       s << "  ... and " << r.findings.size() - kFindingsListed << " more\n";
   }
@@ -189,6 +199,10 @@ void run_check(const CheckArgs& a) {
         j["elements"][kind_plural(kind)] = primal::element_count(*m.model, kind);
     j["valid"] = c.valid;
     j["validity"] = c.validity;
+    if (m.model) {  // conform's input checks: the findings listed, and how many there were
+      j["findings"] = c.findings;
+      j["finding_count"] = c.finding_count;
+    }
     j["quality"] = c.analysable ? c.quality : nlohmann::json();
     j["obstructions"] =
         c.analysable ? primal::obstructions_json(c.obstructions, base) : nlohmann::json();

@@ -329,6 +329,8 @@ TEST_CASE("geode check: a hybrid mesh gets conform's input checks, every finding
     CHECK(ok["elements"]["pyramids"].get<int>() > 0);
     CHECK(ok["elements"]["wedges"].get<int>() > 0);
     CHECK(ok["quality"].is_null());
+    CHECK(ok["finding_count"] == 0);
+    CHECK(ok["findings"].empty());
   }
   // Two hex cells beside two tet cells on copies of every node (parts meshed apart, not
   // merged): each tet face against a hex face is a finding, all of them listed (conform
@@ -344,7 +346,12 @@ TEST_CASE("geode check: a hybrid mesh gets conform's input checks, every finding
   CHECK(against > 8);  // past conform's first few
   CHECK(r.out.find("conform's input checks: " + std::to_string(against) + " findings") !=
         std::string::npos);
-  CHECK(check_json(dir.path / "unmerged.msh")["valid"] == false);
+  const nlohmann::json unmerged = check_json(dir.path / "unmerged.msh");
+  CHECK(unmerged["valid"] == false);
+  CHECK(unmerged["finding_count"] == against);
+  REQUIRE(unmerged["findings"].size() == against);
+  CHECK(unmerged["findings"][0].get<std::string>().find("lie against each other") !=
+        std::string::npos);
   // Two inverted tets and an inverted hex: every element the geometry check refuses (conform's
   // read names the first), each once, by its file id.
   primal::Model inverted =
@@ -364,5 +371,10 @@ TEST_CASE("geode check: a hybrid mesh gets conform's input checks, every finding
   CHECK(listed == 3);
   CHECK(bad.out.find("conform's input checks: 3 elements or nodes refused") != std::string::npos);
   CHECK(bad.out.find("\n  hex ") != std::string::npos);
-  CHECK(check_json(dir.path / "inverted.msh")["valid"] == false);
+  const nlohmann::json j = check_json(dir.path / "inverted.msh");
+  CHECK(j["valid"] == false);
+  CHECK(j["finding_count"] == 3);
+  REQUIRE(j["findings"].size() == 3);
+  for (const auto& f : j["findings"])
+    CHECK(f.get<std::string>().find(" is inverted") != std::string::npos);
 }
