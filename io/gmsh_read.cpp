@@ -480,9 +480,12 @@ class MshReader {
         add_node(tags[i], p);
       }
     }
+    // Gmsh itself reads the blocks whatever the total says, and writes a total other than
+    // theirs after some API edits (nodes added to a cleared mesh): the blocks are read.
     if (node_tags_.size() != total)
-      fail("$Nodes announces " + std::to_string(total) + " nodes, its blocks hold " +
-           std::to_string(node_tags_.size()));
+      read_warning(source_ + ": $Nodes announces " + std::to_string(total) +
+                   " nodes, its blocks hold " + std::to_string(node_tags_.size()) +
+                   ": read as its blocks hold them");
   }
 
   // A count written as text even in binary files (version 2.2), then its line end.
@@ -539,9 +542,10 @@ class MshReader {
         elements_.push_back(el);
       }
     }
-    if (elements_.size() != total)
-      fail("$Elements announces " + std::to_string(total) + " elements, its blocks hold " +
-           std::to_string(elements_.size()));
+    if (elements_.size() != total)  // as for $Nodes
+      read_warning(source_ + ": $Elements announces " + std::to_string(total) +
+                   " elements, its blocks hold " + std::to_string(elements_.size()) +
+                   ": read as its blocks hold them");
   }
 
   void elements22() {

@@ -566,3 +566,39 @@ TEST_CASE("a volume in no physical group, which Gmsh saves without elements, is 
                     "group and without elements") != std::string::npos);
   }
 }
+
+TEST_CASE("a .msh 4.1 whose $Nodes or $Elements total is not its blocks' is read, warned") {
+  // Gmsh writes such totals after some API edits (nodes added to a cleared mesh) and reads the
+  // blocks whatever the total says; the reader refused the file.
+  const test::TempDir dir;
+  {
+    demo::GmshSession session;
+    (void)boxes_side_by_side("totals");
+    gmsh::option::setNumber("Mesh.MeshSizeMax", 0.5);
+    gmsh::model::mesh::generate(3);
+    gmsh::write((dir.path / "totals.msh").string());
+  }
+  const Model given = read_model(dir.path / "totals.msh");
+  const std::string text = [&] {
+    std::ifstream in(dir.path / "totals.msh", std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  }();
+  for (const std::string section : {"$Nodes\n", "$Elements\n"}) {
+    CAPTURE(section);
+    // The header's second number, the total, 36 more.
+    const std::size_t at = text.find(section) + section.size();
+    const std::size_t first = text.find(' ', at) + 1, end = text.find(' ', first);
+    const long total = std::stol(text.substr(first, end - first));
+    std::string edited = text;
+    edited.replace(first, end - first, std::to_string(total + 36));
+    const fs::path file = dir.path / "edited.msh";
+    std::ofstream(file, std::ios::binary) << edited;
+    ReadWarnings warnings;
+    const Model m = read_model(file);
+    CHECK(m.points == given.points);
+    CHECK(m.tets == given.tets);
+    REQUIRE(warnings.messages().size() == 1);
+    CHECK(warnings.messages()[0].find(section.substr(0, section.size() - 1) + " announces " +
+                                      std::to_string(total + 36)) != std::string::npos);
+  }
+}
