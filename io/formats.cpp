@@ -64,7 +64,6 @@ std::optional<PlainMesh> read_vtk_plain(const fs::path& path) {
     g = without_boundary_cells(std::move(g));
   m.hex = to_hex_mesh(g);  // names the first cell that is not a hex
   return m;
-  return m;
 }
 
 constexpr FormatCarries kExodusCarries{Carried::kYes, Carried::kYes, Carried::kYes,
