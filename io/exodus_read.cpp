@@ -5,6 +5,7 @@
 // ones, and nothing short of a process contains that; a classic file's header is screened whole
 // by our own parser first (netcdf_screen.hpp), an HDF5 superblock checked.
 #include <geode/io/exodus.hpp>
+#include <geode/io/read_warnings.hpp>
 
 #include <algorithm>
 #include <array>
@@ -418,6 +419,17 @@ std::string upper(std::string s) {
   return s;
 }
 
+// Element types of points, lines and faces (Exodus's SPHERE, BAR, BEAM, TRUSS, TRI, SHELL, QUAD
+// and their numbered forms): what meshio writes of a Gmsh mesh's physical points, curves and
+// surfaces, and shell or beam blocks beside a solid model. No volume cell: such a block is left
+// out (one warning names them all), its elements keeping their numbers.
+bool lower_dimensional_type(const std::string& upper_type) {
+  for (const char* prefix :
+       {"SPHERE", "CIRCLE", "BAR", "BEAM", "TRUSS", "ROD", "EDGE", "TRI", "SHELL", "QUAD", "POINT"})
+    if (upper_type.rfind(prefix, 0) == 0) return true;
+  return false;
+}
+
 // meshio numbers blocks and sets from 0: a file with any id <= 0 gets them numbered by
 // position (1, 2, ...), which keeps every id positive and distinct.
 template <typename T>
@@ -461,6 +473,7 @@ Model build_model(const Contents& c, const std::string& source) {
   std::vector<ElementRef> global;  // global element number (1-based) - 1 -> element
   global.reserve(index_cast<std::size_t>(std::max(c.num_elem, 0)));
   const bool renumber_blocks = renumbered(c.blocks);
+  std::string left_out;  // blocks of points, lines or faces: "3 (QUAD4, 96), ..."
   for (std::size_t b = 0; b < c.blocks.size(); ++b) {
     const BlockData& block = c.blocks[b];
     const int block_id = renumber_blocks ? static_cast<int>(b) + 1 : block.id;
@@ -469,6 +482,13 @@ Model build_model(const Contents& c, const std::string& source) {
     if (!block.name.empty()) model.block_names[block_id] = block.name;
     const std::string where = source + ": element block " + std::to_string(block.id);
     const std::size_t k = cell_of(block);
+    if (k == kExodusCells.size() && lower_dimensional_type(upper(block.type))) {
+      left_out += (left_out.empty() ? "" : ", ") + std::to_string(block.id) + " (" + block.type +
+                  ", " + std::to_string(block.count) + ")";
+      global.insert(global.end(), index_cast<std::size_t>(block.count),
+                    ElementRef{ElementKind::kHex, kInvalidIndex});
+      continue;
+    }
     const ExodusCell* cell = k < kExodusCells.size() ? &kExodusCells[k] : nullptr;
     const ElementKind kind = cell ? kElementKinds[k] : ElementKind::kHex;
     if (!cell)
@@ -493,6 +513,12 @@ Model build_model(const Contents& c, const std::string& source) {
       add_element(model, kind, corners, block_id, element_file_id(global.size() - 1));
     }
   }
+
+  if (!left_out.empty())
+    read_warning(source +
+                 ": element blocks of points, lines or faces, not volume cells, are not "
+                 "read (block id, type, elements): " +
+                 left_out);
 
   // Parts of a block our writer split by element type (kBlockProperty) join it again
   // (primal::join_blocks): a block whose property names another block, one that names itself;
@@ -535,6 +561,10 @@ Model build_model(const Contents& c, const std::string& source) {
         throw InvalidInput(entry + " refers to element number " + std::to_string(element_number) +
                            ", out of range [1, " + std::to_string(global.size()) + "]");
       const ElementRef element = global[index_cast<std::size_t>(element_number - 1)];
+      if (element.index == kInvalidIndex)
+        throw InvalidInput(entry + ": " +
+                           element_named(index_cast<std::size_t>(element_number - 1)) +
+                           " is in a block of points, lines or faces, not a volume cell");
       const int faces = cell_topology(element.kind).faces;
       if (side < 1 || side > faces)
         throw InvalidInput(

@@ -14,6 +14,7 @@
 #include <geode/demo/gmsh_session.hpp>
 #include <geode/io/gmsh.hpp>
 #include <geode/io/read_model.hpp>
+#include <geode/io/read_warnings.hpp>
 #include <geode/io/vtk.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/grid_model.hpp>
@@ -130,6 +131,23 @@ TEST_CASE("meshio's .exo with node sets numbered from 0: the sets numbered by po
   CHECK(model.node_sets[0].nodes.size() == bottom);
   for (Index v : model.node_sets[0].nodes)
     CHECK(model.points[index_cast<std::size_t>(v)].z() < low + 1e-9);
+}
+
+TEST_CASE("meshio's .exo of a Gmsh mesh: its blocks of vertices and faces left out, warned") {
+  // meshio writes the physical points and surfaces of a mesh it read from Gmsh as SPHERE, QUAD4
+  // and TRI3 blocks; the reader refused the file at the first ("element type 'SPHERE' with 1
+  // nodes is not supported").
+  test::TempDir dir;
+  const HexMesh m = write_variants("meshio", dir.path);
+  ReadWarnings warnings;
+  const Model model = read_model(dir.path / "meshio-surfaces.exo");
+  CHECK(model.hexes == m.hexes);
+  REQUIRE(warnings.messages().size() == 1);
+  CHECK(warnings.messages()[0].find("element blocks of points, lines or faces, not volume cells, "
+                                    "are not read (block id, type, elements): 0 (SPHERE, 1), 1 "
+                                    "(QUAD4, ") != std::string::npos);
+  // The hexes keep their file numbers after the blocks left out: 1 vertex and the quads first.
+  CHECK(element_id(model, {ElementKind::kHex, 0}) > 1);
 }
 
 TEST_CASE("Gmsh's own writer: .msh 2.2 and 4.1, ASCII and binary, read back the same model") {

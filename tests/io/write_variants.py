@@ -81,6 +81,12 @@ def meshio_variants(source, outdir):
     top = np.nonzero(mesh.points[:, 2] > mesh.points[:, 2].max() - 1e-9)[0]
     meshio.Mesh(mesh.points, mesh.cells, point_sets={"ns_bottom": bottom, "ns_top": top}).write(
         os.path.join(outdir, "meshio-sets.exo"))
+    # As meshio writes a Gmsh mesh read with meshio.read: its physical points and surfaces as
+    # blocks of vertices and quads (here the bottom's quads and one node) before the volume's.
+    quads = [h[:4] for h in mesh.cells[0].data if all(mesh.points[h[:4], 2] < mesh.points[:, 2].min() + 1e-9)]
+    meshio.Mesh(mesh.points, [("vertex", np.array([[bottom[0]]])), ("quad", np.array(quads))] +
+                [(c.type, c.data) for c in mesh.cells]).write(
+        os.path.join(outdir, "meshio-surfaces.exo"))
     # Materials as SfePy and meshio users give them: the source's blocks as the cell array mat_id.
     blocks = meshio.read(source).cell_data["block"]
     for name in ("meshio-matid.vtu", "meshio-matid.vtk"):
