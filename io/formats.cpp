@@ -9,6 +9,7 @@
 #include <geode/io/exodus.hpp>
 #include <geode/io/file_format.hpp>
 #include <geode/io/gmsh.hpp>
+#include <geode/io/nemesis_set.hpp>
 #include <geode/io/read_model.hpp>
 #include <geode/io/vtk.hpp>
 #include <geode/primal/errors.hpp>
@@ -285,14 +286,17 @@ void check_signature(const fs::path& path, const MeshFormat& format) {
 }
 
 PlainMesh read_plain_mesh(const fs::path& path, const MeshFormat** format, bool other_cells) {
-  const MeshFormat* f = reader_for(path);
+  // A Nemesis set (geode_mpi's pieces without --join, named by a piece or by the joined name):
+  // an Exodus model, which read_model joins.
+  const std::optional<NemesisSet> set = find_nemesis_set(path);
+  const MeshFormat* f = reader_for(set ? set->base : path);
   if (!f) {
     (void)read_file_head(path);  // a missing file is named as such first
     throw InvalidInput(path.string() + ": unknown input format '" + lower_extension(path) +
                        "' (expected " + extension_list(FormatRole::kRead) + ")");
   }
   if (format) *format = f;
-  check_signature(path, *f);
+  if (!set) check_signature(path, *f);  // each piece's is read_model's
   // A model with other cells than hexes goes to a caller that takes one, whichever reader made
   // it; to the others it is refused naming what it holds.
   auto other = [&](primal::Model model) {
@@ -309,7 +313,7 @@ PlainMesh read_plain_mesh(const fs::path& path, const MeshFormat** format, bool 
                            "s; expected an all-hex mesh (use `geode conform` first)");
     throw std::logic_error("read_plain_mesh: a model without other cells");
   };
-  if (f->read_plain) try {
+  if (f->read_plain && !set) try {
       if (auto m = f->read_plain(path))
         return m->model ? other(std::move(*m->model)) : std::move(*m);
     } catch (const std::bad_alloc&) {

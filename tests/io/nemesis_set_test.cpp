@@ -12,6 +12,7 @@
 #include <vector>
 
 #include <geode/io/exodus.hpp>
+#include <geode/io/formats.hpp>
 #include <geode/io/nemesis_set.hpp>
 #include <geode/io/read_model.hpp>
 #include <geode/primal/errors.hpp>
@@ -100,6 +101,16 @@ TEST_CASE("a Nemesis set of a conform output reads as the whole model, refused w
   // read_model finds the set from its base name (no such file) and from a piece.
   CHECK(read_model(base).hexes == whole.hexes);
   CHECK(read_model(base.string() + ".2.1").hexes == whole.hexes);
+  // So does the hex-mesh read of check, dual and view, which refused both names ("no such file",
+  // "unknown input format '.1'"), as an Exodus file.
+  for (const fs::path& name : {base, fs::path(base.string() + ".2.1")}) {
+    CAPTURE(name);
+    const MeshFormat* format = nullptr;
+    const PlainMesh plain = read_plain_mesh(name, &format);
+    CHECK(plain.hex.hexes == whole.hexes);
+    REQUIRE(format);
+    CHECK(format->index_base == 1);
+  }
 
   const std::string piece1 = base.string() + ".2.1";
   const auto refused = [&](const PieceOptions& o, const std::string& message) {
