@@ -23,6 +23,7 @@ struct ArrangeArgs {
   EncodingArgs encoding;  // --vtk-encoding, --msh-encoding
   bool smooth = false;
   bool fixup = false;
+  int seed_resolution = stc::ArrangementOptions{}.seed_resolution;
   bool slide = false;
   bool quality = false;
   bool write_invalid = false;
@@ -35,6 +36,8 @@ void run_arrange(const ArrangeArgs& a) {
       a.output, a.format, with_mesh_formats({"appendix", "csv", "json"}, {"html"}), "appendix");
   check_not_input(a.output, a.spec, a.force);
   const templates::ArrangementSpec spec = templates::read_spec(a.spec);
+  if (a.fixup && spec.dim != 3)
+    throw InvalidInput(a.spec + ": --fixup: only 3D templates are fixed up (this spec is 2D)");
   // The smoother's constraints keep nodes on axis-aligned box faces.
   if (a.smooth && spec.domain.corners)
     throw InvalidInput(a.spec + ": --smooth needs a box domain (this spec's domain is a " +
@@ -45,6 +48,7 @@ void run_arrange(const ArrangeArgs& a) {
   // diagnoses name sheets and places; the file is named here.
   Progress progress = Progress::for_stderr(false);
   stc::ArrangementOptions options;
+  options.seed_resolution = a.seed_resolution;
   options.progress = [&progress,
                       what = std::string(spec.dim == 3 ? "sheet pairs traced" : "sheets traced")](
                          std::size_t done, std::size_t total) { progress.step(what, done, total); };
@@ -112,10 +116,19 @@ void add_arrange_command(CLI::App& app) {
   c->add_flag("--slide", args->slide,
               "with --smooth: tet- and hex-side nodes slide within their faces")
       ->needs(smooth_flag);
-  c->add_flag("--fixup", args->fixup,
-              "pillow away the obstructions to a positive-Jacobian placement (pinched corners,\n"
-              "as `geode template geode4tri` does; docs/results.md) before placing the nodes:\n"
-              "the boundary's quads are kept, the dual is no longer the arrangement's alone");
+  c->add_flag(
+      "--fixup", args->fixup,
+      "3D specs: pillow away the obstructions to a positive-Jacobian placement (pinched\n"
+      "corners, as `geode template geode4tri` does; docs/results.md) before placing the\n"
+      "nodes: the boundary's quads are kept, the dual is no longer the arrangement's alone");
+  c->add_option(
+       "--seed-resolution", args->seed_resolution,
+       "cells of the grid that seeds the tracing of the sheets' intersections, along the\n"
+       "domain's longest axis: raise it where a diagnosis says a piece smaller than the\n"
+       "grid was missed (every value that finds every piece gives the same mesh, its node\n"
+       "positions to rounding)")
+      ->check(CLI::Range(4, 400))
+      ->capture_default_str();
   c->add_flag("--quality", args->quality,
               "append the quality report (the paper's Table 1 metrics)");
   add_encoding_options(c, args->encoding);

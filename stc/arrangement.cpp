@@ -221,9 +221,10 @@ Arrangement Engine::run() {
     if (v.found != dim_)
       throw TopologyError(
           "arrangement: the vertex of sheets " + names(v.sheets) + " at " + fmt_point(v.x, dim_) +
-          " was found on " + std::to_string(v.found) + " of its " + std::to_string(dim_) +
-          " curves: part of a curve was missed (raise the seed resolution) or the sheets are not "
-          "in general position");
+          " was found " + std::to_string(v.found) + " times on its " + std::to_string(dim_) +
+          " curves (once on each): part of a curve was missed or traced twice (raise the seed "
+          "resolution: geode arrange --seed-resolution) or the sheets are not in general "
+          "position");
 
   // 3. Deterministic vertex order: by sheets, then by position.
   std::vector<int> order(vertices_.size());

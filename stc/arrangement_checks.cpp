@@ -158,7 +158,8 @@ void Engine::check_touching(const std::vector<Curve>& curves) const {
           throw TopologyError(
               "arrangement: sheets " + names(S) + " meet at " + fmt_point(x, dim_) + " but no " +
               (dim_ == 3 ? "curve traced for them passes there" : "vertex was found there") +
-              ": a piece smaller than the seeding grid was missed (raise the seed resolution)");
+              ": a piece smaller than the seeding grid was missed (raise the seed resolution: "
+              "geode arrange --seed-resolution)");
       }
     }
 

@@ -375,11 +375,11 @@ int run(int argc, char** argv, int rank, int size) {
         return 4;
       }
       return 0;
-    } catch (const InvalidInput& e) {
-      failure = "geode_mpi: " + std::string(e.what());
+    } catch (const InvalidInput& e) {  // the kinds geode's own lines name (cli/main.cpp)
+      failure = "geode_mpi: error: " + std::string(e.what());
       return 2;
     } catch (const TopologyError& e) {
-      failure = "geode_mpi: " + std::string(e.what());
+      failure = "geode_mpi: topology error: " + std::string(e.what());
       return 3;
     } catch (const std::bad_alloc&) {
       // As the serial command (cli/main.cpp): one line and exit 2.

@@ -128,6 +128,29 @@ TEST_CASE("geode arrange --fixup: the four-triangle specs become valid templates
   }
 }
 
+TEST_CASE("geode arrange: --fixup of a 2D spec refused by name; --seed-resolution, same mesh") {
+  const std::filesystem::path specs =
+      std::filesystem::path(GEODE_SOURCE_DIR) / "notebooks-data/specs";
+  const std::string flat = (specs / "geode2d.json").string();
+  const auto refused = geode_cli("arrange " + flat + " --fixup", true);
+  CHECK(refused.code == 2);
+  CHECK(refused.out ==
+        "geode: error: " + flat + ": --fixup: only 3D templates are fixed up (this spec is 2D)\n");
+  // A finer seeding grid finds the same arrangement: the same mesh, its nodes to rounding.
+  const std::string spec = (specs / "geode3d.json").string();
+  const auto coarse = geode_cli("arrange " + spec + " --smooth --format json");
+  const auto fine = geode_cli("arrange " + spec + " --smooth --format json --seed-resolution 48");
+  REQUIRE(coarse.code == 0);
+  REQUIRE(fine.code == 0);
+  const JsonMesh a = mesh_of(nlohmann::json::parse(coarse.out)),
+                 b = mesh_of(nlohmann::json::parse(fine.out));
+  CHECK(a.hex.hexes == b.hex.hexes);
+  REQUIRE(a.hex.points.size() == b.hex.points.size());
+  for (std::size_t i = 0; i < a.hex.points.size(); ++i)
+    CHECK((a.hex.points[i] - b.hex.points[i]).norm() < 1e-9);
+  CHECK(geode_cli("arrange " + spec + " --seed-resolution 3", true).code == 2);
+}
+
 TEST_CASE("geode arrange: the README's examples, the pillowed hex and the pillowed quad") {
   const auto specs = std::filesystem::path(GEODE_SOURCE_DIR) / "notebooks-data/specs";
   const auto out = temp_path("pillow-out.json");
