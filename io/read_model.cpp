@@ -111,36 +111,16 @@ void read_tagged_boundary_cells(const VtkGrid& grid, const std::string& block_ar
     read_warning(grid.source + ": " + std::to_string(untagged) +
                  " vertex, line, triangle or quad cells carry no set tag (a CellEntityIds or "
                  "gmsh:physical cell array): they are not read");
-  if (groups.empty()) return;
-  FaceOwners owners;
-  if (std::any_of(groups.begin(), groups.end(), [](const auto& g) { return g.first.first == 2; }))
-    owners = FaceOwners(model);
+  std::vector<TaggedCells> sets;
   for (const auto& [key, members] : groups) {
-    const auto [dim, tag] = key;
-    if (dim == 2) {
-      SideSet set{tag, {}, {}};
-      for (std::size_t c : members) {
-        const Side* owner = owners.find(grid.cells[c]);
-        if (!owner)
-          throw InvalidInput(grid.source + ": side set " + std::to_string(tag) + ": cell " +
-                             std::to_string(c) + " (" + block_array + " " + std::to_string(tag) +
-                             ") is not a face of any volume cell");
-        set.sides.push_back(*owner);
-      }
-      std::sort(set.sides.begin(), set.sides.end());
-      set.sides.erase(std::unique(set.sides.begin(), set.sides.end()), set.sides.end());
-      model.side_sets.push_back(std::move(set));
-    } else {
-      NodeSet set{tag, {}, {}, {}};
-      for (std::size_t c : members) {
-        set.nodes.insert(set.nodes.end(), grid.cells[c].begin(), grid.cells[c].end());
-        set.pieces.emplace_back(grid.cells[c].begin(), grid.cells[c].end());
-      }
-      std::sort(set.nodes.begin(), set.nodes.end());
-      set.nodes.erase(std::unique(set.nodes.begin(), set.nodes.end()), set.nodes.end());
-      model.node_sets.push_back(std::move(set));
+    TaggedCells t{key.first, key.second, {}, {}, {}};
+    for (std::size_t c : members) {
+      t.cells.push_back(grid.cells[c]);
+      t.cell_ids.push_back(static_cast<std::int64_t>(c));
     }
+    sets.push_back(std::move(t));
   }
+  add_tagged_sets(model, sets, grid.source, "cell");
 }
 
 }  // namespace

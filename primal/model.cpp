@@ -190,6 +190,40 @@ const Side* FaceOwners::find(std::span<const Index> nodes) const {
   return it == owner_.end() ? nullptr : &it->second;
 }
 
+void add_tagged_sets(Model& model, std::span<const TaggedCells> groups, const std::string& source,
+                     const std::string& cell_word) {
+  FaceOwners owners;
+  if (std::any_of(groups.begin(), groups.end(), [](const TaggedCells& g) { return g.dim == 2; }))
+    owners = FaceOwners(model);
+  for (const TaggedCells& g : groups) {
+    if (g.dim == 2) {
+      SideSet set{g.id, g.name, {}};
+      for (std::size_t c = 0; c < g.cells.size(); ++c) {
+        const Side* owner =
+            g.cells[c].size() == 3 || g.cells[c].size() == 4 ? owners.find(g.cells[c]) : nullptr;
+        if (!owner)
+          throw InvalidInput(source + ": side set " + std::to_string(g.id) +
+                             (g.name.empty() ? "" : " '" + g.name + "'") + ": " + cell_word + " " +
+                             std::to_string(g.cell_ids[c]) +
+                             " is not a face of any volume element");
+        set.sides.push_back(*owner);
+      }
+      std::sort(set.sides.begin(), set.sides.end());
+      set.sides.erase(std::unique(set.sides.begin(), set.sides.end()), set.sides.end());
+      model.side_sets.push_back(std::move(set));
+    } else {
+      NodeSet set{g.id, g.name, {}, {}};
+      for (const auto& cell : g.cells) {
+        set.nodes.insert(set.nodes.end(), cell.begin(), cell.end());
+        set.pieces.push_back(cell);
+      }
+      std::sort(set.nodes.begin(), set.nodes.end());
+      set.nodes.erase(std::unique(set.nodes.begin(), set.nodes.end()), set.nodes.end());
+      model.node_sets.push_back(std::move(set));
+    }
+  }
+}
+
 int block_of(const Model& model, ElementRef element) {
   const auto& blocks = element_blocks(model, element.kind);
   return blocks.empty() ? default_block(element.kind)

@@ -147,6 +147,23 @@ class FaceOwners {
   std::unordered_map<std::array<Index, 4>, Side, Hash> owner_;
 };
 
+// The points, lines or faces of one group a file tags (a Gmsh physical point, curve or surface
+// as Gmsh's .vtk and meshio give them, cells with a tag): each cell's nodes, and its id in the
+// file for messages.
+struct TaggedCells {
+  int dim = 0;  // 0 points, 1 lines, 2 faces
+  int id = 0;   // the group's tag, the set's id
+  std::string name;
+  std::vector<std::vector<Index>> cells;
+  std::vector<std::int64_t> cell_ids;
+};
+// The sets the .msh reader makes of such groups, added to the model: points and lines a node
+// set (each cell a piece), faces a side set of the elements they are faces of. InvalidInput
+// naming `source`, the set and the cell by its file id (`cell_word`: how the file names one,
+// "cell", "element") for a face of no element.
+void add_tagged_sets(Model& model, std::span<const TaggedCells> groups, const std::string& source,
+                     const std::string& cell_word);
+
 // What readers check beyond the file's structure.
 struct ReadOptions {
   // check_geometry below (else check_points only): off for tools that read connectivity

@@ -122,12 +122,12 @@ py::dict model_dict(primal::Model&& model) {
 // The model as arrays; conform's options by name, as `geode conform` spells them (with _).
 py::dict conform_arrays(const py::handle& points, const py::dict& cells,
                         const std::map<std::int64_t, std::string>& block_names,
-                        const py::list& node_sets, const std::string& source,
-                        const std::string& smooth, const std::string& quality,
-                        const std::string& geode_block, const std::string& buffer_side,
-                        double buffer_thickness, double smooth_target,
-                        const py::object& template_box, const py::object& merge_tolerance,
-                        const std::string& relax) {
+                        const py::list& node_sets, const py::list& tagged,
+                        const std::string& source, const std::string& smooth,
+                        const std::string& quality, const std::string& geode_block,
+                        const std::string& buffer_side, double buffer_thickness,
+                        double smooth_target, const py::object& template_box,
+                        const py::object& merge_tolerance, const std::string& relax) {
   primal::Model model;
   model.points = to_points(points, source + ": points", false);
   for (const KindKeys& keys : kKindKeys) add_cells(model, keys, cells, source);
@@ -143,6 +143,26 @@ py::dict conform_arrays(const py::handle& points, const py::dict& cells,
     set.nodes = d["nodes"].cast<std::vector<Index>>();
     model.node_sets.push_back(std::move(set));
   }
+  // Gmsh's physical points, curves and surfaces as meshio gives them (cells with their tag):
+  // the sets a file's reader makes of them.
+  std::vector<primal::TaggedCells> groups;
+  for (const auto& t : tagged) {
+    const auto d = t.cast<py::dict>();
+    primal::TaggedCells g;
+    g.dim = d["dim"].cast<int>();
+    g.id = d["id"].cast<int>();
+    g.name = d["name"].cast<std::string>();
+    g.cells = d["cells"].cast<std::vector<std::vector<Index>>>();
+    g.cell_ids = d["ids"].cast<std::vector<std::int64_t>>();
+    for (std::size_t c = 0; c < g.cells.size(); ++c)
+      for (Index v : g.cells[c])
+        if (v < 0 || primal::index_cast<std::size_t>(v) >= model.points.size())
+          throw InvalidInput(source + ": cell " + std::to_string(g.cell_ids[c]) +
+                             " refers to node " + std::to_string(v) + ", out of range [0, " +
+                             std::to_string(model.points.size()) + ")");
+    groups.push_back(std::move(g));
+  }
+  primal::add_tagged_sets(model, groups, source, "cell");
   // What the readers check of a file, here of the arrays: a wedge or pyramid in another corner
   // order is inverted, and refused as a file's is (the element ids are the package's: each
   // cell's 1-based position among the mesh's cells, a .msh file's element tag when meshio or
@@ -221,10 +241,10 @@ py::dict conform_arrays(const py::handle& points, const py::dict& cells,
 
 void bind_conform(py::module_& m) {
   m.def("_conform", &conform_arrays, py::arg("points"), py::arg("cells"), py::arg("block_names"),
-        py::arg("node_sets"), py::arg("source"), py::arg("smooth"), py::arg("quality"),
-        py::arg("geode_block"), py::arg("buffer_side"), py::arg("buffer_thickness"),
-        py::arg("smooth_target"), py::arg("template_box"), py::arg("merge_tolerance"),
-        py::arg("relax"));
+        py::arg("node_sets"), py::arg("tagged"), py::arg("source"), py::arg("smooth"),
+        py::arg("quality"), py::arg("geode_block"), py::arg("buffer_side"),
+        py::arg("buffer_thickness"), py::arg("smooth_target"), py::arg("template_box"),
+        py::arg("merge_tolerance"), py::arg("relax"));
   m.def(
       "_demo_model",
       [](const std::string& name, int n) {

@@ -135,7 +135,8 @@ _KINDS = (("hexahedron", "hexes", "hex_block", "hex_ids", 8), ("tetra", "tets", 
           ("pyramid", "pyramids", "pyramid_block", "pyramid_ids", 5),
           ("wedge", "wedges", "wedge_block", "wedge_ids", 6))
 _VOLUME = {kind[0]: kind for kind in _KINDS}
-_SURFACE = {"vertex", "line", "triangle", "quad"}  # boundary entities of a Gmsh file: not elements
+# Boundary entities of a Gmsh file, not elements, by their dimension.
+_SURFACE = {"vertex": 0, "line": 1, "triangle": 2, "quad": 2}
 
 
 def _model_arrays(mesh=None, points=None, cells=None, cell_blocks=None, name="mesh"):
@@ -147,12 +148,14 @@ def _model_arrays(mesh=None, points=None, cells=None, cell_blocks=None, name="me
         cells = [(c.type, c.data) for c in mesh.cells]
         physical = mesh.cell_data.get("gmsh:physical")
         names = {int(v[0]): k for k, v in (mesh.field_data or {}).items() if len(v) > 1 and int(v[1]) == 3}
+        # Physical points, curves and surfaces by (dimension, tag), as Gmsh's physical names.
+        set_names = {(int(v[1]), int(v[0])): k for k, v in (mesh.field_data or {}).items() if len(v) > 1}
         point_sets = dict(mesh.point_sets or {})
     else:
         if points is None or cells is None:
             raise InputError("conform: give a meshio.Mesh, or points and cells")
         cells = list(cells.items()) if isinstance(cells, dict) else list(cells)
-        physical, names, point_sets = None, {}, {}
+        physical, names, point_sets, set_names = None, {}, {}, {}
         if cell_blocks is not None and len(cell_blocks) != len(cells):
             raise InputError("{}: {} cell_blocks for {} cell blocks: give one block id per cell block"
                              .format(name, len(cell_blocks), len(cells)))
@@ -162,10 +165,23 @@ def _model_arrays(mesh=None, points=None, cells=None, cell_blocks=None, name="me
     ids = {kind[1]: [] for kind in _KINDS}
     volume_index = 0
     position = 0  # cells before this block
+    tagged, untagged = {}, 0  # (dim, tag) -> cells and their ids; surface cells without a tag
     for i, (kind, data) in enumerate(cells):
         data = _np.asarray(data)
         first, position = position + 1, position + len(data)
         if kind in _SURFACE:
+            # Gmsh's physical points, curves and surfaces (meshio gives their tags in
+            # gmsh:physical): the sets `geode conform` makes of the same file.
+            tags = _np.asarray(physical[i]) if physical is not None and len(physical[i]) == len(data) else None
+            dim = _SURFACE[kind]
+            for k in range(len(data)):
+                tag = int(tags[k]) if tags is not None else 0
+                if tag <= 0:
+                    untagged += 1
+                    continue
+                group = tagged.setdefault((dim, tag), ([], []))
+                group[0].append([int(x) for x in _np.asarray(data[k]).ravel()])
+                group[1].append(first + k)
             continue
         if kind not in _VOLUME:
             raise InputError("{}: cell block {} holds '{}' cells; geode.conform takes linear hexahedron, tetra, "
@@ -186,9 +202,16 @@ def _model_arrays(mesh=None, points=None, cells=None, cell_blocks=None, name="me
         arrays[key] = _np.concatenate(parts[key]) if parts[key] else _np.zeros((0, width), dtype=_np.int64)
         arrays[block_key] = _np.concatenate(blocks[key]) if blocks[key] else _np.zeros(0, dtype=int)
         arrays[ids_key] = _np.concatenate(ids[key]) if ids[key] else _np.zeros(0, dtype=_np.int64)
-    node_sets = [{"id": k + 1, "name": n, "nodes": [int(x) for x in _np.asarray(v).ravel()]}
+    if untagged:
+        _warnings.warn("{}: {} vertex, line, triangle or quad cells carry no gmsh:physical tag: they are not read"
+                       .format(name, untagged), GeodeWarning, stacklevel=3)
+    sets = [{"dim": dim, "id": tag, "name": set_names.get((dim, tag), ""), "cells": group[0], "ids": group[1]}
+            for (dim, tag), group in sorted(tagged.items())]
+    # Point sets numbered after the node sets of tagged cells, whose ids are their tags.
+    first_id = max([t["id"] for t in sets if t["dim"] < 2], default=0) + 1
+    node_sets = [{"id": first_id + k, "name": n, "nodes": [int(x) for x in _np.asarray(v).ravel()]}
                  for k, (n, v) in enumerate(point_sets.items())]
-    return points, arrays, names, node_sets
+    return points, arrays, names, node_sets, sets
 
 
 def _model_to_meshio(model, cell_data_extra=None):
@@ -225,9 +248,10 @@ def conform(mesh=None, *, points=None, cells=None, cell_blocks=None, name="mesh"
 
     mesh: a meshio.Mesh (hexahedron, tetra, pyramid and wedge cells in meshio's corner orders, a
     wedge's 0-1-2 counter-clockwise seen from 3-4-5 as Gmsh's prism; Gmsh's surface and point
-    entities are skipped; blocks from gmsh:physical, else one per cell block; block names from
-    field_data; point sets become node sets; side sets are not read: meshio has no form for
-    them), or points and cells ([(type, array)] or {type: array}) with cell_blocks (one block id
+    entities with a gmsh:physical tag become sets as `geode conform` makes them of the .msh file
+    (physical points and curves node sets, surfaces side sets; untagged ones are skipped with a
+    GeodeWarning); blocks from gmsh:physical, else one per cell block; block and set names from
+    field_data; point sets become node sets too), or points and cells ([(type, array)] or {type: array}) with cell_blocks (one block id
     per cell block). The input gets the checks a file gets when read: a cell in another corner
     order (a wedge in VTK's mirrored order, a pyramid's base clockwise) is inverted and raises
     InputError naming it by its 1-based position among the cells (a .msh file's element tag).
@@ -240,8 +264,8 @@ def conform(mesh=None, *, points=None, cells=None, cell_blocks=None, name="mesh"
     over the returned mesh's cells, block after block.
     A result that fails verification raises InvalidResultError, unless allow_invalid=True.
     """
-    pts, arrays, names, node_sets = _model_arrays(mesh, points, cells, cell_blocks, name)
-    out = _geode._conform(pts, arrays, names, node_sets, name, smooth, quality, geode_block, buffer_side or "",
+    pts, arrays, names, node_sets, tagged = _model_arrays(mesh, points, cells, cell_blocks, name)
+    out = _geode._conform(pts, arrays, names, node_sets, tagged, name, smooth, quality, geode_block, buffer_side or "",
                           float(buffer_thickness), float(smooth_target), template_box, merge_tolerance, relax)
     if not out["valid"] and not allow_invalid:
         raise InvalidResultError(out["invalid_reason"] + " (nothing returned; allow_invalid=True returns it anyway)")

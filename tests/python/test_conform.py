@@ -202,3 +202,26 @@ def test_conform_relax_option_matches_cli(tmp_path):
     assert kept["output_min_scaled_jacobian"] == pytest.approx(cli["output_min_scaled_jacobian"], abs=1e-9)
     with pytest.raises(geode.InputError, match="tet relaxation"):
         geode.conform(mesh, relax="all")
+
+
+def test_gmsh_physical_points_curves_and_surfaces_are_the_commands_sets(tmp_path):
+    # meshio gives a Gmsh file's physical points, curves and surfaces as vertex, line, triangle
+    # and quad cells tagged in gmsh:physical; the module dropped them without a word, where
+    # `geode conform` of the same file keeps them as node and side sets.
+    import subprocess
+    import sys
+
+    from conftest import SOURCE
+
+    path = tmp_path / "sets.msh"
+    subprocess.run([sys.executable, str(SOURCE / "tests" / "conform" / "sets_models.py"), "embedded", str(path)],
+                   check=True)
+    run_cli("conform", path, "-o", tmp_path / "cli.vtu", "--quiet")
+    cli = meshio.read(tmp_path / "cli.vtu")
+    cli_nodes = {k.split(":", 2)[2]: len(v) for k, v in cli.field_data.items() if k.startswith("node_set:")}
+    cli_sides = {k.split(":", 2)[2]: len(np.asarray(v).reshape(-1, 2)) for k, v in cli.field_data.items()
+                 if k.startswith("side_set:")}
+    assert set(cli_nodes) == {"load_point", "probe_line"} and set(cli_sides) == {"sheet", "patch"}
+    out, report = geode.conform(meshio.read(path))
+    assert {name: len(nodes) for name, nodes in out.point_sets.items()} == cli_nodes
+    assert {s["name"]: len(s["sides"]) for s in report["side_sets"]} == cli_sides
