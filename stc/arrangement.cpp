@@ -154,6 +154,21 @@ Arrangement Engine::run() {
     for (auto& c : found) A.curves.push_back(std::move(c));
   }
   if (options_.progress) options_.progress(subsets.size(), subsets.size());
+  // A sheet in the domain on which no curve was traced (3D) meets no other sheet there: its
+  // pieces hold no vertex, so no dual element, and the dual would silently lack the sheet.
+  // (In 2D the curve is the sheet itself, refused below when no other sheet crosses it.)
+  for (int s = 0; s < m; ++s) {
+    bool traced = false;
+    for (const Curve& c : A.curves)
+      traced = traced || std::find(c.sheets.begin(), c.sheets.end(), s) != c.sheets.end();
+    if (traced) continue;
+    const std::vector<Point> on = seeds({s});
+    if (!on.empty())
+      throw TopologyError("arrangement: sheet " + name(s) + " passes through " +
+                          fmt_point(on.front(), dim_) +
+                          " but meets no other sheet inside the domain: a sheet with no "
+                          "vertex has no dual element");
+  }
 
   // 2. Events along each curve, vertices, and 1-cells.
   struct RawEdge {
@@ -288,9 +303,15 @@ Arrangement Engine::run() {
   A.region.assign(primal::index_cast<std::size_t>(nv), {-1, -1, -1, -1, -1, -1, -1, -1});
   for (int v = 0; v < nv; ++v) {
     const Vertex& V = A.vertices[primal::index_cast<std::size_t>(v)];
-    const Eigen::MatrixXd Jinv =
-        jacobians_[primal::index_cast<std::size_t>(order[primal::index_cast<std::size_t>(v)])]
-            .inverse();
+    // Step into each octant along the direction that moves every sheet of the vertex by the
+    // same distance: the gradients normalized first, since fields are scaled arbitrarily (a
+    // plane's gradient is 1, a tunnel's 1 / its size). Unnormalized, the step runs nearly along
+    // the sheet with the steeper field, whose curvature can then put the sample on its other
+    // side (on boxes a few 1e-4 across: refine3).
+    Eigen::MatrixXd J =
+        jacobians_[primal::index_cast<std::size_t>(order[primal::index_cast<std::size_t>(v)])];
+    for (int i = 0; i < dim_; ++i) J.row(i).normalize();
+    const Eigen::MatrixXd Jinv = J.inverse();
     for (int b = 0; b < octants; ++b) {
       const int root = uf.find(v * octants + b);
       int& l = label[primal::index_cast<std::size_t>(root)];

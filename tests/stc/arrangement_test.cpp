@@ -164,3 +164,51 @@ TEST_CASE("arrangement: sheets composed with the field algebra") {
                                             [](const Point& x) { return x[0] - 0.7; });
   CHECK(stc::dualize(stc::compute_arrangement(sheets, box)).hex.hexes.size() == 12);
 }
+
+// The octant samples at a vertex stepped along the raw gradients, nearly along the steeper
+// sheet: on boxes 1e-4 across refine3's arch put them on its other side ("one region joins
+// octants of different sign vectors").
+TEST_CASE("arrangement: the result does not depend on the domain's scale or the fields' scaling") {
+  // refine3-2d's sheets: a unit-gradient plane and line meet an arch whose gradient grows as
+  // 1 / size. Same regions at every size in the supported range.
+  for (double s : {1e6, 1.0, 1e-3, 1e-4, 1e-6}) {
+    CAPTURE(s);
+    const double a = s / 3, h = 0.75 * s, foot = -0.5 * s, layer = foot + 0.35 * s;
+    std::vector<stc::Sheet> sh{{"tunnel",
+                                [=](const Point& x) {
+                                  const double u = x.x() / a, v = (x.y() - foot) / h;
+                                  return u * u + v * v - 1.0;
+                                },
+                                "tunnel"},
+                               plane(0, 0.0, "middle"),
+                               plane(1, layer, "layer")};
+    const auto A = stc::compute_arrangement(
+        sh, stc::Domain(Point(-s / 2, -s / 2, 0), Point(s / 2, s / 2, 0), 2));
+    CHECK(A.vertices.size() == 4);
+    CHECK(A.region_count == 8);
+    CHECK(stc::dualize(A).quad.quads.size() == 4);
+  }
+}
+
+// A sheet on which no curve is traced (inside one octant, or across the box's corners only)
+// vanished from the dual without a word: exit 0, one sheet fewer.
+TEST_CASE("arrangement: a sheet that meets no other sheet is refused by name") {
+  const stc::Domain box{Point(0, 0, 0), Point(1, 1, 1), 3};
+  auto sphere = [](Point c, double r) {
+    return stc::Sheet{"s", [c, r](const Point& x) { return (x - c).squaredNorm() / (r * r) - 1; },
+                      "sphere"};
+  };
+  std::vector<stc::Sheet> planes{plane(0, 0.5, "x"), plane(1, 0.5, "y"), plane(2, 0.5, "z")};
+  for (const auto& s : {sphere(Point(0.25, 0.25, 0.25), 0.1),  // inside one octant
+                        sphere(Point(0.5, 0.5, 0.5), 0.8)}) {  // cuts only the box's corners
+    auto all = planes;
+    all.push_back(s);
+    const std::string d = diagnosis(all, box);
+    CHECK(d.find("sheet 's'") != std::string::npos);
+    CHECK(d.find("meets no other sheet") != std::string::npos);
+  }
+  // A sheet wholly outside the domain still changes nothing.
+  auto all = planes;
+  all.push_back(sphere(Point(3, 3, 3), 0.5));
+  CHECK(stc::dualize(stc::compute_arrangement(all, box)).hex.hexes.size() == 1);
+}

@@ -201,3 +201,17 @@ TEST_CASE(
     }
   }
 }
+
+// The --box range `geode template --help` states, 1e-6 to 1e6: refine3 failed below 2e-4.
+TEST_CASE("refine3: boxes down to the documented 1e-6 build the same templates") {
+  for (double s : {1e-3, 1e-4, 1e-6}) {
+    CAPTURE(s);
+    templates::RefineOptions o;
+    o.box = Eigen::Vector3d(s, s, s);
+    const auto T2 = templates::build_refine3_2d(o);
+    CHECK(T2.quad.quads.size() == 4);
+    const auto T3 = templates::build_refine3(o);
+    CHECK(T3.hex.hexes.size() == 13);
+    CHECK(primal::check_validity(T3.hex).euler == 1);
+  }
+}
