@@ -22,6 +22,7 @@
 #include <geode/io/atomic_file.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/validity.hpp>
+#include <geode/templates/template_table.hpp>
 #include "cli/commands.hpp"
 
 #ifndef GEODE_VERSION
@@ -147,16 +148,13 @@ std::array<double, 3> parse_box(const std::string& option, const std::string& te
     if (!x)
       throw InvalidInput(option + " '" + text + "': '" + parts[primal::index_cast<std::size_t>(a)] +
                          "' is not a finite number; expected " + expected);
-    if (!(*x >= 1e-6 && *x <= 1e6))
-      throw InvalidInput(option + " '" + text + "': every dimension must lie in [1e-6, 1e6]");
     box[primal::index_cast<std::size_t>(a)] = *x;
   }
+  if (const std::string why =
+          templates::box_problem(std::span(box.data(), primal::index_cast<std::size_t>(dim)));
+      !why.empty())
+    throw InvalidInput(option + " '" + text + "': " + why);
   if (dim == 2) box[2] = box[0];
-  const auto [lo, hi] = std::minmax_element(box.begin(), box.begin() + dim);
-  if (*hi > 1e4 * *lo)
-    throw InvalidInput(
-        option + " '" + text +
-        "': degenerate box (the largest dimension is more than 1e4 times the smallest)");
   return box;
 }
 

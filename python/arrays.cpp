@@ -44,7 +44,8 @@ int cell_width(const py::handle& object, const std::string& what) {
 }
 
 template <int K>
-std::vector<std::array<Index, K>> to_cells(const py::handle& object, const std::string& what) {
+std::vector<std::array<Index, K>> to_cells(const py::handle& object, const std::string& what,
+                                           const std::function<std::string(std::size_t)>& cell) {
   const py::array any = py::array::ensure(object);
   if (any && any.size() > 0 && any.dtype().kind() != 'i' && any.dtype().kind() != 'u')
     throw InvalidInput(what + ": node numbers must be integers");
@@ -53,22 +54,36 @@ std::vector<std::array<Index, K>> to_cells(const py::handle& object, const std::
   if (!a || a.ndim() != 2 || a.shape(1) != K)
     throw InvalidInput(what + ": expected an M x " + std::to_string(K) + " array of node numbers");
   const auto r = a.unchecked<2>();
+  // Unsigned 64-bit numbers past int64's range wrapped when cast: read as they were given.
+  const bool wide_unsigned = any && any.dtype().kind() == 'u' && any.dtype().itemsize() == 8;
+  const auto u =
+      wide_unsigned
+          ? py::array_t<std::uint64_t, py::array::c_style | py::array::forcecast>::ensure(object)
+          : py::array_t<std::uint64_t, py::array::c_style | py::array::forcecast>();
   std::vector<std::array<Index, K>> cells(primal::index_cast<std::size_t>(a.shape(0)));
   for (py::ssize_t i = 0; i < a.shape(0); ++i)
     for (int c = 0; c < K; ++c) {
       const std::int64_t v = r(i, c);
-      if (v < std::numeric_limits<Index>::min() || v > std::numeric_limits<Index>::max())
-        throw InvalidInput(what + ": cell " + std::to_string(i) + " has node " + std::to_string(v) +
+      if (v < std::numeric_limits<Index>::min() || v > std::numeric_limits<Index>::max()) {
+        const std::string given = wide_unsigned ? std::to_string(u.at(i, c)) : std::to_string(v);
+        const auto at = primal::index_cast<std::size_t>(i);
+        throw InvalidInput((cell ? cell(at) : what + ": cell " + std::to_string(at)) + ": corner " +
+                           std::to_string(c + 1) + " refers to node index " + given +
                            ", outside the 32-bit index range");
+      }
       cells[primal::index_cast<std::size_t>(i)][primal::index_cast<std::size_t>(c)] =
           primal::index_cast(v);
     }
   return cells;
 }
-template std::vector<std::array<Index, 4>> to_cells<4>(const py::handle&, const std::string&);
-template std::vector<std::array<Index, 5>> to_cells<5>(const py::handle&, const std::string&);
-template std::vector<std::array<Index, 6>> to_cells<6>(const py::handle&, const std::string&);
-template std::vector<std::array<Index, 8>> to_cells<8>(const py::handle&, const std::string&);
+template std::vector<std::array<Index, 4>> to_cells<4>(
+    const py::handle&, const std::string&, const std::function<std::string(std::size_t)>&);
+template std::vector<std::array<Index, 5>> to_cells<5>(
+    const py::handle&, const std::string&, const std::function<std::string(std::size_t)>&);
+template std::vector<std::array<Index, 6>> to_cells<6>(
+    const py::handle&, const std::string&, const std::function<std::string(std::size_t)>&);
+template std::vector<std::array<Index, 8>> to_cells<8>(
+    const py::handle&, const std::string&, const std::function<std::string(std::size_t)>&);
 
 py::array points_array(std::vector<Point>&& points) {
   const auto n = static_cast<py::ssize_t>(points.size());

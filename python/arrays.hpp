@@ -6,6 +6,7 @@
 #include <pybind11/stl.h>
 
 #include <array>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -25,9 +26,12 @@ using primal::Point;
 std::vector<Point> to_points(const py::handle& array, const std::string& what, bool finite = true);
 // M x K node numbers (any integer dtype) as cells, K = 4, 5, 6 or 8 (tets or quads, pyramids,
 // wedges, hexes); InvalidInput naming `what` for another shape or a number outside the 32-bit
-// index range. Node ranges are checked by the library functions.
+// index range (that cell as `cell(i)` names it, where given; else "what: cell i"). Node ranges
+// are checked by the library functions.
 template <int K>
-std::vector<std::array<Index, K>> to_cells(const py::handle& array, const std::string& what);
+std::vector<std::array<Index, K>> to_cells(
+    const py::handle& array, const std::string& what,
+    const std::function<std::string(std::size_t)>& cell = {});
 // The number of columns of a 2D cell array (4 or 8 picks quads or hexes); InvalidInput otherwise.
 int cell_width(const py::handle& array, const std::string& what);
 

@@ -65,18 +65,23 @@ void add_cells(primal::Model& model, const KindKeys& keys, const py::dict& array
     }
   };
   const py::object cells = arrays[keys.cells];
+  // A cell by its id, as the checks after name it ("mesh: tet 30").
+  const auto cell = [&](std::size_t i) {
+    return source + ": " + primal::element_kind_name(keys.kind) + " " +
+           (i < ids.size() ? std::to_string(ids[i]) : std::to_string(i + 1));
+  };
   switch (primal::cell_topology(keys.kind).corners) {
     case 4:
-      add(to_cells<4>(cells, what));
+      add(to_cells<4>(cells, what, cell));
       break;
     case 5:
-      add(to_cells<5>(cells, what));
+      add(to_cells<5>(cells, what, cell));
       break;
     case 6:
-      add(to_cells<6>(cells, what));
+      add(to_cells<6>(cells, what, cell));
       break;
     default:
-      add(to_cells<8>(cells, what));
+      add(to_cells<8>(cells, what, cell));
   }
 }
 

@@ -64,6 +64,8 @@ py::list coverage(const std::vector<primal::NodeCoverage>& nodes) {
 // {"valid", "validity" (the report's text), "report": {what each check found}, "quality",
 // "obstructions"}: `geode check --format json` with 0-based ids.
 py::dict check(const py::handle& points, const py::handle& cells, double planar_angle) {
+  if (!(planar_angle >= 0.0 && planar_angle <= 90.0))  // as `geode check --planar-angle`
+    throw InvalidInput("check: planar_angle must lie in [0, 90] degrees");
   primal::RealizabilityOptions options;
   options.planar_angle_degrees = planar_angle;
   py::dict d;
@@ -330,7 +332,12 @@ py::dict smooth(const py::handle& points, const py::handle& cells, const std::st
 py::object isomorphism(const py::handle& a, const py::handle& b, const py::object& labels) {
   primal::NodeLabels l;
   if (!labels.is_none()) {
-    const auto pair = labels.cast<std::pair<std::vector<int>, std::vector<int>>>();
+    std::pair<std::vector<int>, std::vector<int>> pair;
+    try {
+      pair = labels.cast<std::pair<std::vector<int>, std::vector<int>>>();
+    } catch (const py::cast_error&) {
+      throw InvalidInput("isomorphism: labels must be two sequences of integers, one per node");
+    }
     l.first = pair.first, l.second = pair.second;
   }
   const int k = cell_width(a, "a");

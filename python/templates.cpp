@@ -18,6 +18,7 @@
 #include <geode/templates/refine.hpp>
 #include <geode/templates/spec.hpp>
 #include <geode/templates/study.hpp>
+#include <geode/templates/template_table.hpp>
 #include <geode/viewer/html.hpp>
 #include "python/arrays.hpp"
 
@@ -196,9 +197,8 @@ Eigen::Vector3d parse_box(const py::handle& box, int dim) {
   if (b.size() != primal::index_cast<std::size_t>(dim))
     throw InvalidInput("template: box has " + std::to_string(b.size()) + " numbers for a " +
                        std::to_string(dim) + "D template");
-  for (double x : b)
-    if (!std::isfinite(x) || x <= 0)
-      throw InvalidInput("template: every box dimension must be positive and finite");
+  if (const std::string why = templates::box_problem(b); !why.empty())
+    throw InvalidInput("template: box: " + why);  // as `geode template --box` refuses it
   return {b[0], b[1], dim == 3 ? b[2] : b[0]};
 }
 

@@ -1,6 +1,7 @@
 // The template table (templates/template_table.hpp).
 #include <geode/templates/template_table.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -151,6 +152,15 @@ TemplateOptions template_options(const TemplateEntry& entry, const GeodeOptions&
   o.geode.split = split;
   o.refine = refine;
   return o;
+}
+
+std::string box_problem(std::span<const double> box) {
+  for (double x : box)
+    if (!(x >= 1e-6 && x <= 1e6)) return "every dimension must lie in [1e-6, 1e6]";
+  const auto [lo, hi] = std::minmax_element(box.begin(), box.end());
+  if (!box.empty() && *hi > 1e4 * *lo)
+    return "degenerate box (the largest dimension is more than 1e4 times the smallest)";
+  return {};
 }
 
 }  // namespace geode::templates

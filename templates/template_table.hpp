@@ -17,6 +17,11 @@
 
 namespace geode::templates {
 
+// The boxes a template may be built in (`geode template --box`, the module's box=): each
+// dimension in [1e-6, 1e6], the largest at most 1e4 times the smallest. Empty when `box` is one,
+// else why not.
+std::string box_problem(std::span<const double> box);
+
 // Which options a template reads: the geode family's (GeodeOptions: box, diagonal, higher, push)
 // or the refinement family's (RefineOptions: box, roofs, layer).
 enum class TemplateFamily { kGeode, kRefine };

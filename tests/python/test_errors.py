@@ -1,6 +1,7 @@
 """Errors: the command's messages and exit-code kinds, as Python exceptions."""
 import json
 
+import numpy as np
 import pytest
 
 import geode
@@ -50,3 +51,34 @@ def test_input_errors_name_the_place(tmp_path):
         geode.check([[0, 0, 0]], [[0.5] * 8])
     with pytest.raises(ValueError):  # InputError is a ValueError too
         geode.quality([[0, 0, 0]], [[0, 1, 2, 3, 4, 5, 6, 7]])
+
+
+def test_arguments_the_command_refuses_the_module_refuses(tmp_path):
+    # The module took planar_angle outside [0, 90] and boxes outside the command's range (a
+    # TopologyError from the engine), and let pybind11's cast errors through for bad labels.
+    t = geode.template("geode3d")
+    template = tmp_path / "g.vtu"
+    run_cli("template", "geode3d", "-o", template)
+    for angle in (float("nan"), -1.0, 1000.0):
+        with pytest.raises(geode.InputError, match=r"planar_angle must lie in \[0, 90\]"):
+            geode.check(t.points, t.hexes, planar_angle=angle)
+        assert run_cli("check", template, "--planar-angle", str(angle), check=False).returncode == 2
+    for box, text in (((1e-7, 1, 1), "1e-7x1x1"), ((1, 1, 10001), "1x1x10001")):
+        cli = run_cli("template", "geode3d", "--box", text, check=False)
+        assert cli.returncode == 2
+        with pytest.raises(geode.InputError) as e:
+            geode.template("geode3d", box=box)
+        # The same reason as the command's, after its own prefix.
+        assert cli_error(cli).split("': ", 1)[1] == str(e.value).split("box: ", 1)[1]
+    for labels in ((np.zeros(48), np.zeros(48)), [1, 1, 1]):
+        with pytest.raises(geode.InputError, match="labels must be two sequences of integers"):
+            geode.isomorphism(t.hexes, t.hexes, labels=labels)
+
+
+def test_a_node_number_past_32_bits_names_the_cell_as_the_other_checks_do():
+    t = geode.template("geode3d")
+    tets = np.array([[0, 1, 2, 4], [0, 1, 2, 3]], dtype=np.uint64)
+    tets[1, 2] = 2**63
+    with pytest.raises(geode.InputError, match=r"^mesh: tet 28: corner 3 refers to node index "
+                                               r"9223372036854775808, outside the 32-bit index range$"):
+        geode.conform(points=t.points, cells=[("hexahedron", t.hexes.astype(np.int64)), ("tetra", tets)])
