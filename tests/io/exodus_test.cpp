@@ -15,6 +15,7 @@
 #include <vector>
 
 #include <geode/io/exodus.hpp>
+#include <geode/io/read_warnings.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/grid_model.hpp>
 #include "support/temp_dir.hpp"
@@ -216,12 +217,22 @@ TEST_CASE("read_exodus rejects bad input naming the file, element and reason") {
     CHECK(what.find(cut.string()) != std::string::npos);
   }
   SUBCASE("unknown element type") {
-    const fs::path file = dir / "shell.exo";
-    write_raw(file, "SHELL4", {1, 2, 3, 4}, 4);
+    const fs::path file = dir / "tet10.exo";
+    write_raw(file, "TETRA10", {1, 2, 3, 4, 5, 6, 7, 8, 9, 10}, 10);
     const std::string what = message_of(file);
     CHECK(what.find(file.string()) != std::string::npos);
     CHECK(what.find("element block 3: element 1") != std::string::npos);
-    CHECK(what.find("'SHELL4'") != std::string::npos);
+    CHECK(what.find("'TETRA10' with 10 nodes is not supported") != std::string::npos);
+  }
+  SUBCASE("a block of faces is left out, warned") {
+    const fs::path file = dir / "shell.exo";
+    write_raw(file, "SHELL4", {1, 2, 3, 4}, 4);
+    ReadWarnings warnings;
+    const Model m = read_exodus(file);
+    CHECK(element_count(m) == 0);
+    REQUIRE(warnings.messages().size() == 1);
+    CHECK(warnings.messages()[0].find("not read (block id, type, elements): 3 (SHELL4, 1)") !=
+          std::string::npos);
   }
   SUBCASE("a wedge with the wrong node count") {
     const fs::path file = dir / "wedge5.exo";
