@@ -769,8 +769,9 @@ class MshReader {
                     [](const auto& e) { return e.first.first == 3 && !e.second.empty(); });
     if (!physical) return unsaved;
     std::set<int> with_elements;
+    int last = 0;  // an entity's elements come in a run: one insert per run
     for (const RawElement& e : elements_)
-      if (gmsh_type(e.type)->dim == 3) with_elements.insert(e.entity);
+      if (e.entity != last && gmsh_type(e.type)->dim == 3) with_elements.insert(last = e.entity);
     for (const auto& [key, physicals] : entity_physicals_)
       if (key.first == 3 && physicals.empty() && !with_elements.count(key.second))
         unsaved.push_back(key.second);
