@@ -119,7 +119,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0)  // --help, --version
       return check_standard_output(app.exit(e), command_path(app));
-    const std::string cmd = command_path(app);
+    std::string cmd = command_path(app);
     // An unknown command word: CLI11 says a subcommand is required, as if none were given.
     std::string word;
     for (int i = 1; i < argc && word.empty(); ++i) {
@@ -129,8 +129,10 @@ int main(int argc, char** argv) {
       else if (!arg.empty() && arg[0] != '-')
         word = arg;
     }
-    if (cmd == "geode" && !word.empty() &&
-        app.get_subcommands([&](CLI::App* s) { return s->check_name(word); }).empty())
+    const auto named = app.get_subcommands([&](CLI::App* s) { return s->check_name(word); });
+    // Refused before parsing (refuse_empty_arguments): the command word still names the help.
+    if (cmd == "geode" && named.size() == 1) cmd += " " + named.front()->get_name();
+    if (cmd == "geode" && !word.empty() && named.empty())
       std::cerr << "geode: usage error: '" << word << "' is not a command (see geode --help)\n";
     else
       std::cerr << cmd << ": usage error: " << one_line(e.what()) << " (see " << cmd

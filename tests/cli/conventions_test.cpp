@@ -124,6 +124,10 @@ TEST_CASE(
       {"study shape -o " + d + "a.csv --distorted-csv " + d + "a.csv",
        "given to both -o and --distorted-csv"},
       {"conform " + in.string() + " -o " + d + "out.exo --report=", "--report: an empty value"},
+      // Refused before parsing, named as the command's own usage errors are.
+      {"conform " + in.string() + " -o ''",
+       "geode conform: usage error: -o: an empty value (leave the option out instead) (see geode "
+       "conform --help)"},
       {"check " + in.string() + " --planar-angle nan", "'nan' is not a finite number"},
       {"quality " + in.string(), "'quality' is not a command"},
       {"template geode3d --high-roof 2", "--low-roof / --high-roof: tunnel roofs"},
