@@ -443,10 +443,11 @@ void add_conform_commands(CLI::App& app) {
           },
           "NAME"))
       ->capture_default_str();
-  d->add_option("-n,--size", dargs->n,
-                "cells per unit length (1 to 64; default 4; nugget, fulcher round up to even;\n"
-                "boundary-layer, layer-side and layer-mixed cap Gmsh's own sizes, about 5 cells per\n"
-                "unit, so that n below 4 or 5 gives the same mesh as there)")
+  d->add_option(
+       "-n,--size", dargs->n,
+       "cells per unit length (1 to 64; default 4; nugget, fulcher round up to even;\n"
+       "boundary-layer, layer-side and layer-mixed cap Gmsh's own sizes, about 5 cells per\n"
+       "unit, so that n below 4 or 5 gives the same mesh as there)")
       ->check(number_check(1, 64, true));
   d->add_option("--save-input", dargs->save_input,
                 "write the demo's input model (" +

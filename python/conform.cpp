@@ -155,10 +155,17 @@ py::dict conform_arrays(const py::handle& points, const py::dict& cells,
     const auto d = t.cast<py::dict>();
     primal::TaggedCells g;
     g.dim = d["dim"].cast<int>();
-    g.id = d["id"].cast<int>();
-    g.name = d["name"].cast<std::string>();
-    g.cells = d["cells"].cast<std::vector<std::vector<Index>>>();
     g.cell_ids = d["ids"].cast<std::vector<std::int64_t>>();
+    try {  // a tag or a node number past 32 bits: the file's own refusal, not a cast error
+      g.id = d["id"].cast<int>();
+      g.name = d["name"].cast<std::string>();
+      g.cells = d["cells"].cast<std::vector<std::vector<Index>>>();
+    } catch (const py::cast_error&) {
+      throw InvalidInput(source + ": the points, lines or faces of one tag, cell " +
+                         (g.cell_ids.empty() ? std::string("?") : std::to_string(g.cell_ids[0])) +
+                         " the first: their gmsh:physical tag or a node number lies outside the "
+                         "32-bit range");
+    }
     for (std::size_t c = 0; c < g.cells.size(); ++c)
       for (Index v : g.cells[c])
         if (v < 0 || primal::index_cast<std::size_t>(v) >= model.points.size())

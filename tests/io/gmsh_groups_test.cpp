@@ -123,6 +123,20 @@ std::pair<int, int> boxes_side_by_side(const std::string& name) {
   return {a, b};
 }
 
+// Volume `a` of the session's model meshed as 2 x 2 x 2 hexes (transfinite, recombined).
+void transfinite_hexes(int a) {
+  gmsh::vectorpair faces;
+  gmsh::model::getBoundary({{3, a}}, faces, false, false, false);
+  for (const auto& [dim, tag] : faces) {
+    gmsh::vectorpair curves;
+    gmsh::model::getBoundary({{2, std::abs(tag)}}, curves, false, false, false);
+    for (const auto& [cd, c] : curves) gmsh::model::mesh::setTransfiniteCurve(std::abs(c), 3);
+    gmsh::model::mesh::setTransfiniteSurface(std::abs(tag));
+    gmsh::model::mesh::setRecombine(2, std::abs(tag));
+  }
+  gmsh::model::mesh::setTransfiniteVolume(a);
+}
+
 }  // namespace
 
 TEST_CASE("a partitioned .msh 4.1 (ASCII and binary) gives the blocks of its physical volumes") {
@@ -276,16 +290,7 @@ TEST_CASE(
   {
     demo::GmshSession session;
     const auto [a, b] = boxes_side_by_side("saveall");
-    gmsh::vectorpair faces;
-    gmsh::model::getBoundary({{3, a}}, faces, false, false, false);
-    for (const auto& [dim, tag] : faces) {
-      gmsh::vectorpair curves;
-      gmsh::model::getBoundary({{2, std::abs(tag)}}, curves, false, false, false);
-      for (const auto& [cd, c] : curves) gmsh::model::mesh::setTransfiniteCurve(std::abs(c), 3);
-      gmsh::model::mesh::setTransfiniteSurface(std::abs(tag));
-      gmsh::model::mesh::setRecombine(2, std::abs(tag));
-    }
-    gmsh::model::mesh::setTransfiniteVolume(a);
+    transfinite_hexes(a);
     gmsh::option::setNumber("Mesh.MeshSizeMax", 0.5);
     REQUIRE(b == 2);
     gmsh::model::addPhysicalGroup(3, {a}, 2);
@@ -439,16 +444,7 @@ TEST_CASE("Gmsh's legacy .vtk: its physical points, curves and surfaces are the 
   {
     demo::GmshSession session;
     const auto [a, b] = boxes_side_by_side("annotated");
-    gmsh::vectorpair faces;
-    gmsh::model::getBoundary({{3, a}}, faces, false, false, false);
-    for (const auto& [dim, tag] : faces) {
-      gmsh::vectorpair curves;
-      gmsh::model::getBoundary({{2, std::abs(tag)}}, curves, false, false, false);
-      for (const auto& [cd, c] : curves) gmsh::model::mesh::setTransfiniteCurve(std::abs(c), 3);
-      gmsh::model::mesh::setTransfiniteSurface(std::abs(tag));
-      gmsh::model::mesh::setRecombine(2, std::abs(tag));
-    }
-    gmsh::model::mesh::setTransfiniteVolume(a);
+    transfinite_hexes(a);
     gmsh::option::setNumber("Mesh.MeshSizeMax", 0.4);
     gmsh::model::addPhysicalGroup(3, {a}, 1);
     gmsh::model::addPhysicalGroup(3, {b}, 2);
