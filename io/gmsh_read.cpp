@@ -929,58 +929,38 @@ class MshReader {
       if (dim < 3 && !on_partition_boundary(elements_[i], dim))
         for (int p : physicals_of(elements_[i], dim)) groups[{dim, p}].push_back(i);
     }
-    FaceOwners face_owner;
-    if (std::any_of(groups.begin(), groups.end(), [](const auto& g) { return g.first.first == 2; }))
-      face_owner = FaceOwners(model);
+    // The sets as primal::add_tagged_sets makes them of any file's tagged cells (a node set's
+    // points and lines kept as its pieces, so that dicing adds the nodes on these lines only);
+    // linear cells only: a higher-order line's middle nodes belong to no linear element.
+    std::vector<TaggedCells> tagged;
     for (const auto& [key, members] : groups) {
       const auto [dim, tag] = key;
-      std::string name;
-      if (auto it = physical_names_.find(key); it != physical_names_.end()) name = it->second;
-      if (dim == 2) {
-        SideSet set{tag, name, {}};
-        const std::string where = source_ + ": side set " + std::to_string(tag) + " '" + name + "'";
-        for (std::size_t i : members) {
-          const RawElement& e = elements_[i];
-          if (e.type != kTri3 && e.type != kQuad4)
-            throw InvalidInput(where + ": element " + std::to_string(e.tag) + ": " +
-                               gmsh_type(e.type)->name + " (Gmsh type " + std::to_string(e.type) +
-                               ") is not supported; only 3-node triangles and 4-node quads are");
-          std::vector<Index> face;
-          for (std::size_t k = 0; k < (e.type == kTri3 ? 3u : 4u); ++k) face.push_back(node(e, k));
-          const Side* owner = face_owner.find(face);
-          if (!owner) {
-            const std::vector<int> unsaved = unsaved_volumes();
-            throw InvalidInput(where + ": element " + std::to_string(e.tag) +
-                               " is not a face of any volume element" +
-                               (unsaved.empty() ? "" : "; " + unsaved_text(unsaved)));
-          }
-          set.sides.push_back(*owner);
-        }
-        std::sort(set.sides.begin(), set.sides.end());
-        set.sides.erase(std::unique(set.sides.begin(), set.sides.end()), set.sides.end());
-        model.side_sets.push_back(std::move(set));
-      } else {
-        // The set's points and lines are kept as its pieces, so that dicing adds the nodes
-        // on these lines only (not on a face between two of them: primal/model.hpp).
-        NodeSet set{tag, name, {}, {}};
-        const std::string where = source_ + ": node set " + std::to_string(tag) + " '" + name + "'";
-        for (std::size_t i : members) {
-          const RawElement& e = elements_[i];
-          // A higher-order line's middle nodes belong to no linear element.
-          if (e.type != kPoint1 && e.type != kLine2)
-            throw InvalidInput(where + ": element " + std::to_string(e.tag) + ": " +
-                               gmsh_type(e.type)->name + " (Gmsh type " + std::to_string(e.type) +
-                               ") is not supported; only points and 2-node lines are");
-          std::vector<Index> piece;
-          for (int k = 0; k < gmsh_type(e.type)->nodes; ++k)
-            piece.push_back(node(e, index_cast<std::size_t>(k)));
-          set.nodes.insert(set.nodes.end(), piece.begin(), piece.end());
-          set.pieces.push_back(std::move(piece));
-        }
-        std::sort(set.nodes.begin(), set.nodes.end());
-        set.nodes.erase(std::unique(set.nodes.begin(), set.nodes.end()), set.nodes.end());
-        model.node_sets.push_back(std::move(set));
+      TaggedCells t{dim, tag, {}, {}, {}};
+      if (auto it = physical_names_.find(key); it != physical_names_.end()) t.name = it->second;
+      for (std::size_t i : members) {
+        const RawElement& e = elements_[i];
+        const bool linear =
+            dim == 2 ? e.type == kTri3 || e.type == kQuad4 : e.type == kPoint1 || e.type == kLine2;
+        if (!linear)
+          throw InvalidInput(
+              source_ + (dim == 2 ? ": side set " : ": node set ") + std::to_string(tag) + " '" +
+              t.name + "': element " + std::to_string(e.tag) + ": " + gmsh_type(e.type)->name +
+              " (Gmsh type " + std::to_string(e.type) + ") is not supported; only " +
+              (dim == 2 ? "3-node triangles and 4-node quads are" : "points and 2-node lines are"));
+        std::vector<Index> cell;
+        for (int k = 0; k < gmsh_type(e.type)->nodes; ++k)
+          cell.push_back(node(e, index_cast<std::size_t>(k)));
+        t.cells.push_back(std::move(cell));
+        t.cell_ids.push_back(e.tag);
       }
+      tagged.push_back(std::move(t));
+    }
+    try {
+      add_tagged_sets(model, tagged, source_, "element");
+    } catch (const InvalidInput& e) {  // a face of no element: say why, where Gmsh left one out
+      const std::vector<int> unsaved = unsaved_volumes();
+      if (unsaved.empty()) throw;
+      throw InvalidInput(std::string(e.what()) + "; " + unsaved_text(unsaved));
     }
     // Gmsh 2.2 gives each element its groups' tags; saved with Mesh.SaveAll=1 it gives every
     // element 0, and $PhysicalNames alone still lists the groups: say they are lost.
