@@ -19,6 +19,8 @@ using geode::test::TempDir;
 
 namespace {
 
+using geode::test::slurp;
+
 // A .msh 4.1 file: the unit hex on tags 1..8 (Gmsh corner order, the same as VTK's) and one tet
 // on its x = 1 face with tag 9 at (2, 0, 0); `nodes` and `elements` replace the defaults.
 const std::string kNodes = "0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n2 0 0\n";
@@ -28,11 +30,6 @@ std::string msh41(const std::string& coordinates = kNodes, const std::string& el
   return "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n"
          "$Nodes\n1 9 1 9\n3 1 0 9\n1\n2\n3\n4\n5\n6\n7\n8\n9\n" +
          coordinates + "$EndNodes\n$Elements\n2 2 1 2\n" + elements + end;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
 std::string replaced(std::string s, const std::string& from, const std::string& to) {

@@ -28,6 +28,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
+using test::slurp;
+
 // 4 x 2 x 2 unit cells, i >= 2 split into tets: 8 steel hexes, 48 rubber tets, 4 interface
 // quads. Node set 3 "clamp": the nodes at x = 0; side set 5 "load": the tet faces at x = 4.
 primal::Model steel_rubber() {
@@ -58,13 +60,6 @@ std::map<int, std::size_t> block_counts(const std::vector<int>& block) {
   std::map<int, std::size_t> n;
   for (int b : block) ++n[b];
   return n;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 // 8 hexes * 8 diced + 4 buffer hexes * 26 geode; 48 tets * 4 diced.

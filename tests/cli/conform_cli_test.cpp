@@ -30,19 +30,13 @@ using test::TempDir;
 using Run = test::CliRun;
 
 // Standard output and standard error together: the messages are checked.
-Run geode_cli(const std::string& args) { return test::geode_cli(args, true); }
-
-// 4 x 2 x 2 unit cells; cells with i >= 2 split into 6 tets. Hand count: 8 hexes, 8 * 6 = 48
-// tets, the interface x = 2 is 2 x 2 = 4 quads.
-primal::Model small_model() {
-  return primal::grid_model({4, 2, 2}, 1.0, [](int i, int, int) { return i >= 2; });
-}
+Run run_geode(const std::string& args) { return test::geode_cli(args, true); }
 
 }  // namespace
 
 TEST_CASE("geode conform: .msh and .exo input -> valid all-hex Exodus matching the report") {
   TempDir dir;
-  const primal::Model model = small_model();
+  const primal::Model model = test::small_hybrid_model();
   REQUIRE(model.hexes.size() == 8);
   REQUIRE(model.tets.size() == 48);
   io::write_gmsh(model, dir.path / "in.msh");
@@ -52,7 +46,7 @@ TEST_CASE("geode conform: .msh and .exo input -> valid all-hex Exodus matching t
     CAPTURE(input);
     const fs::path out = dir.path / (std::string(input) + ".out.exo");
     const fs::path report = dir.path / (std::string(input) + ".json");
-    const Run r = geode_cli("conform " + (dir.path / input).string() + " -o " + out.string() +
+    const Run r = run_geode("conform " + (dir.path / input).string() + " -o " + out.string() +
                             " --report " + report.string() + " --quiet");
     INFO(r.out);
     REQUIRE(r.code == 0);
@@ -100,7 +94,7 @@ TEST_CASE("geode conform: a hex-only model has no transition to make and is simp
   io::write_gmsh(hexes, dir.path / "hexes.msh");
   const fs::path report = dir.path / "r.json";
   const Run r =
-      geode_cli("conform " + (dir.path / "hexes.msh").string() + " -o " +
+      run_geode("conform " + (dir.path / "hexes.msh").string() + " -o " +
                 (dir.path / "out.exo").string() + " --report " + report.string() + " --quiet");
   INFO(r.out);
   REQUIRE(r.code == 0);
@@ -124,7 +118,7 @@ TEST_CASE("geode conform: bad input exits non-zero, names the file and writes no
   const fs::path report = dir.path / "r.json";
   auto check_refused = [&](const fs::path& input, const std::string& why) {
     CAPTURE(input);
-    const Run r = geode_cli("conform " + input.string() + " -o " + out.string() + " --report " +
+    const Run r = run_geode("conform " + input.string() + " -o " + out.string() + " --report " +
                             report.string() + " --quiet");
     INFO(r.out);
     CHECK(r.code != 0);
@@ -158,7 +152,7 @@ TEST_CASE("geode conform: a hex part and a tet part that do not touch are each d
   io::write_exodus(apart, dir.path / "apart.exo");
   const fs::path report = dir.path / "r.json";
   const Run r =
-      geode_cli("conform " + (dir.path / "apart.exo").string() + " -o " +
+      run_geode("conform " + (dir.path / "apart.exo").string() + " -o " +
                 (dir.path / "out.exo").string() + " --report " + report.string() + " --quiet");
   INFO(r.out);
   REQUIRE(r.code == 0);
@@ -173,7 +167,7 @@ TEST_CASE("geode conform: a hex part and a tet part that do not touch are each d
   CHECK(out.hexes.size() == 2 * 8 + 2 * 6 * 4);
   CHECK(primal::check_validity(primal::hex_part(out)).ok());
   // The summary names the kinds the input holds, and no geode hexes where there are none.
-  const Run summary = geode_cli("conform " + (dir.path / "apart.exo").string() + " -o " +
+  const Run summary = run_geode("conform " + (dir.path / "apart.exo").string() + " -o " +
                                 (dir.path / "again.exo").string());
   INFO(summary.out);
   CHECK(summary.out.find("input diced alone: min scaled Jacobian 1 (hexes), ") !=
@@ -185,7 +179,7 @@ TEST_CASE("geode conform: a hex part and a tet part that do not touch are each d
   io::write_exodus(tets, dir.path / "tets.exo");
   const fs::path tets_report = dir.path / "tets.json";
   const Run only_tets =
-      geode_cli("conform " + (dir.path / "tets.exo").string() + " -o " +
+      run_geode("conform " + (dir.path / "tets.exo").string() + " -o " +
                 (dir.path / "tets_out.exo").string() + " --report " + tets_report.string());
   INFO(only_tets.out);
   CHECK(only_tets.code == 0);
@@ -209,7 +203,7 @@ TEST_CASE("geode conform: a warning reaches stderr with --quiet, and the report 
   io::write_gmsh(test::tet_cell_on_hex_top(), dir.path / "in.msh");
   const fs::path report = dir.path / "r.json";
   const Run r =
-      geode_cli("conform " + (dir.path / "in.msh").string() + " -o " +
+      run_geode("conform " + (dir.path / "in.msh").string() + " -o " +
                 (dir.path / "out.exo").string() + " --report " + report.string() + " --quiet");
   CHECK(r.code == 0);
   // Nothing but the warning, on one line.
@@ -230,8 +224,8 @@ TEST_CASE("geode conform: a layer of hexes beside wedges on tets is split, warne
   // and the report counts the split wedges among the input's.
   TempDir dir;
   const fs::path in = dir.path / "mixed.msh", report = dir.path / "r.json";
-  REQUIRE(geode_cli("demo --model layer-mixed -n 3 --quiet --save-input " + in.string()).code == 0);
-  const Run r = geode_cli("conform " + in.string() + " -o " + (dir.path / "out.exo").string() +
+  REQUIRE(run_geode("demo --model layer-mixed -n 3 --quiet --save-input " + in.string()).code == 0);
+  const Run r = run_geode("conform " + in.string() + " -o " + (dir.path / "out.exo").string() +
                           " --report " + report.string() + " --quiet");
   INFO(r.out);
   CHECK(r.code == 0);
@@ -254,7 +248,7 @@ TEST_CASE("geode conform: the report and exit 4 name hexes as the written file n
   // The hex part in block 9 and the tet part in block 7: the output holds the hex part's hexes
   // first, and Exodus and .msh number block 7's first (VTK keeps the model's order, from 0).
   TempDir dir;
-  primal::Model model = small_model();
+  primal::Model model = test::small_hybrid_model();
   model.hex_block.assign(model.hexes.size(), 9);
   model.tet_block.assign(model.tets.size(), 7);
   const fs::path in = dir.path / "in.exo";
@@ -263,7 +257,7 @@ TEST_CASE("geode conform: the report and exit 4 name hexes as the written file n
     CAPTURE(ext);
     const fs::path out = dir.path / (std::string("out") + ext);
     const fs::path report = dir.path / (std::string("out") + ext + ".json");
-    const Run r = geode_cli("conform " + in.string() + " -o " + out.string() + " --report " +
+    const Run r = run_geode("conform " + in.string() + " -o " + out.string() + " --report " +
                             report.string() + " --quiet");
     INFO(r.out);
     REQUIRE(r.code == 0);
@@ -303,7 +297,7 @@ TEST_CASE("geode conform: the report and exit 4 name hexes as the written file n
   for (const char* ext : {".exo", ".vtu"}) {
     CAPTURE(ext);
     const fs::path out = dir.path / (std::string("bad") + ext);
-    const Run r = geode_cli("conform " + in.string() + " -o " + out.string() +
+    const Run r = run_geode("conform " + in.string() + " -o " + out.string() +
                             " --write-invalid --smooth none --quiet");
     INFO(r.out);
     REQUIRE(r.code == 4);

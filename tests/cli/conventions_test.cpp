@@ -24,29 +24,20 @@
 #include <geode/io/vtk.hpp>
 #include <geode/primal/grid_model.hpp>
 #include "support/cli_run.hpp"
+#include "support/fixtures.hpp"
 
 using namespace geode;
 namespace fs = std::filesystem;
 
 namespace {
 
+using test::slurp;
+
 using test::ScopedEnv;
 using test::TempDir;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 std::size_t lines(const std::string& s) {
   return primal::index_cast<std::size_t>(std::count(s.begin(), s.end(), '\n'));
-}
-
-// 4 x 2 x 2 unit cells, cells with i >= 2 split into 6 tets: 8 hexes, 48 tets, 4 interface quads.
-primal::Model small_model() {
-  return primal::grid_model({4, 2, 2}, 1.0, [](int i, int, int) { return i >= 2; });
 }
 
 }  // namespace
@@ -57,7 +48,7 @@ TEST_CASE(
   TempDir dir;
   const std::string d = dir.path.string() + "/";
   const fs::path in = dir.path / "in.msh";
-  io::write_gmsh(small_model(), in);
+  io::write_gmsh(test::small_hybrid_model(), in);
   struct Case {
     std::string args;
     std::string words;  // expected in the message
@@ -286,7 +277,7 @@ TEST_CASE(
     "neither") {
   TempDir dir;
   const fs::path in = dir.path / "in.msh", out = dir.path / "out.exo", report = dir.path / "r.json";
-  io::write_gmsh(small_model(), in);
+  io::write_gmsh(test::small_hybrid_model(), in);
   SUBCASE("a report in a missing directory: no mesh, exit 2, named") {
     const test::CliRun r =
         test::geode_cli("conform " + in.string() + " -o " + out.string() + " --report " +
@@ -334,7 +325,7 @@ TEST_CASE(
                         Row{"node", -1.0, "not a manifold at node"}}) {
     CAPTURE(row.name);
     TempDir dir;
-    primal::Model m = small_model();
+    primal::Model m = test::small_hybrid_model();
     auto node_at = [&](const primal::Point& p) {
       for (std::size_t i = 0; i < m.points.size(); ++i)
         if ((m.points[i] - p).norm() < 1e-12) return primal::index_cast(i);
@@ -389,7 +380,7 @@ TEST_CASE(
     TempDir dir;
     const fs::path in = dir.path / "in.exo", out = dir.path / "out.vtu",
                    report = dir.path / "r.json";
-    io::write_exodus(small_model(), in);
+    io::write_exodus(test::small_hybrid_model(), in);
     const std::string args = "conform " + in.string() + " -o " + out.string() + " --report " +
                              report.string() + " --verify " + verify + " --smooth none --quiet";
     const test::CliRun valid = test::geode_cli(args, true);  // without the hook: valid
@@ -415,7 +406,7 @@ TEST_CASE(
   // output's volume moves between the blocks), the one line says first what makes the result
   // invalid.
   TempDir dir;
-  primal::Model m = small_model();
+  primal::Model m = test::small_hybrid_model();
   for (primal::Point& p : m.points)
     if (p == primal::Point(2.0, 0.0, 0.0)) p.x() += 0.1;
   const fs::path in = dir.path / "bent.exo";

@@ -23,12 +23,7 @@ using test::geode_cli;
 
 namespace {
 
-std::string slurp(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::slurp;
 
 // Runs headless Chromium on `url` with `mode` (--dump-dom, or --screenshot=FILE); returns its
 // standard output. The network is off: a dead proxy and no host names resolve.

@@ -35,7 +35,7 @@ const fs::path& scratch_dir() {
 
 // 2 x 2 x 1 cells of size 0.5: x < 0.5 hexes (block 1 "steel"), x >= 0.5 Kuhn tets (block 2),
 // a node set and a side set listed out of order (Exodus keeps the order).
-Model sample_model() {
+Model exodus_model() {
   Model m = grid_model({2, 2, 1}, 0.5, [](int i, int, int) { return i >= 1; });
   m.points[4] += Point(0.01, -0.02, 0.03);
   m.block_names[1] = "steel";
@@ -88,7 +88,7 @@ std::string message_of(const fs::path& file) {
 // of no elements) after the others, and side set 7: `more` writes it, else it is empty.
 fs::path write_int64(const std::string& name, std::int64_t first_node, std::int64_t first_element,
                      const std::function<void(int exo)>& more = {}) {
-  const Model m = sample_model();
+  const Model m = exodus_model();
   const fs::path file = scratch_dir() / name;
   write_exodus(m, file);
   // Read back raw, written again through the 64-bit API.
@@ -138,7 +138,7 @@ fs::path write_int64(const std::string& name, std::int64_t first_node, std::int6
 }  // namespace
 
 TEST_CASE("write_exodus then read_exodus gives the same model") {
-  const Model m = sample_model();
+  const Model m = exodus_model();
   const fs::path file = scratch_dir() / "rt.exo";
   write_exodus(m, file);
   const Model r = read_exodus(file);
@@ -165,7 +165,7 @@ TEST_CASE("the written file follows Exodus's own HEX8 / TETRA4 / side convention
   // Read back with the raw C API, not with read_exodus: Exodus II manual, HEX8 nodes 1-4 are
   // one face counter-clockwise seen from nodes 5-8 (node 5 above node 1); TETRA4 nodes 1-2-3
   // counter-clockwise seen from node 4; hex side 5 is the face 1-4-3-2.
-  const Model m = sample_model();
+  const Model m = exodus_model();
   const fs::path file = scratch_dir() / "raw.exo";
   write_exodus(m, file);
   const int exo = open_raw(file);
@@ -207,7 +207,7 @@ TEST_CASE("read_exodus rejects bad input naming the file, element and reason") {
   }
   SUBCASE("truncated file") {
     const fs::path whole = dir / "whole.exo", cut = dir / "cut.exo";
-    write_exodus(sample_model(), whole);
+    write_exodus(exodus_model(), whole);
     std::ifstream in(whole, std::ios::binary);
     std::stringstream bytes;
     bytes << in.rdbuf();
@@ -252,7 +252,7 @@ TEST_CASE("write_exodus numbers a block's elements in runs: sides name the file'
   // Tets two by two between blocks 2 and 3: each block is three runs of two tets. The file
   // numbers its elements block by block (ascending id), each block in model order: hexes 1-2
   // (block 1), tets 0, 1, 4, 5, 8, 9 as 3-8 (block 2), tets 2, 3, 6, 7, 10, 11 as 9-14 (block 3).
-  Model m = sample_model();
+  Model m = exodus_model();
   for (std::size_t t = 0; t < m.tets.size(); ++t) m.tet_block[t] = t / 2 % 2 ? 3 : 2;
   m.side_sets[0].sides = {{{ElementKind::kTet, 5}, 3},
                           {{ElementKind::kTet, 4}, 0},
@@ -283,7 +283,7 @@ TEST_CASE("write_exodus numbers a block's elements in runs: sides name the file'
 
 TEST_CASE("a block of two kinds: one Exodus block per kind, joined again on reading") {
   const fs::path file = scratch_dir() / "mixed.exo";
-  Model mixed = sample_model();
+  Model mixed = exodus_model();
   mixed.tet_block.assign(mixed.tets.size(), 1);  // block 1 now holds both
   mixed.block_names[1] = "steel";
   write_exodus(mixed, file);
@@ -342,7 +342,7 @@ TEST_CASE("read_exodus joins only blocks whose GEODE_BLOCK names a block that na
 TEST_CASE("write_exodus is atomic") {
   const fs::path file = scratch_dir() / "atomic.exo";
   std::ofstream(file) << "previous content";
-  Model bad = sample_model();
+  Model bad = exodus_model();
   bad.side_sets[0].sides[0].face = 4;  // tets have faces 0..3
   CHECK_THROWS_WITH_AS(write_exodus(bad, file), doctest::Contains("face 5 out of range"),
                        InvalidInput);
@@ -359,7 +359,7 @@ TEST_CASE(
   // (refused before as an element of type 'NULL').
   const std::int64_t first_node = std::int64_t{5} << 30, first_element = std::int64_t{9} << 31;
   const Model read = read_exodus(write_int64("big.exo", first_node, first_element));
-  const Model m = sample_model();
+  const Model m = exodus_model();
   CHECK(read.points.size() == m.points.size());
   CHECK(read.hexes.size() == m.hexes.size());
   CHECK(read.tets.size() == m.tets.size());

@@ -29,7 +29,7 @@ using namespace geode::io;
 namespace {
 
 // Hexes (block 1 "steel") beside Kuhn tets (block 2), a node set and a side set with names.
-Model sample_model() {
+Model formats_model() {
   Model m = grid_model({2, 2, 1}, 0.5, [](int i, int, int) { return i >= 1; });
   m.block_names[1] = "steel";
   m.node_sets.push_back({11, "bottom", {0, 2, 4, 8}});
@@ -77,7 +77,7 @@ TEST_CASE(
     "format table: each writer's output has its signature and no other's, and reads back with what "
     "it carries") {
   const geode::test::TempDir dir;
-  const Model m = sample_model();
+  const Model m = formats_model();
   for (const MeshFormat& f : mesh_formats()) {
     if (!f.write) continue;
     CAPTURE(f.name);
@@ -123,7 +123,7 @@ TEST_CASE(
     "format table: dispatch refuses unknown formats and content of another format, naming the "
     "file") {
   const geode::test::TempDir dir;
-  const Model m = sample_model();
+  const Model m = formats_model();
   CHECK_THROWS_WITH_AS(write_model(m, dir.path / "out.stl"),
                        doctest::Contains("unknown output format '.stl'"), InvalidInput);
   CHECK_THROWS_WITH_AS(write_model(m, dir.path / "out.vtu", "obj"),
@@ -159,7 +159,7 @@ TEST_CASE("read_forks says which reads fork a child (a caller's threads must res
     if (!f.read || !f.write) continue;
     CAPTURE(f.name);
     const fs::path file = dir.path / ("model" + std::string(f.extensions.front()));
-    write_model(sample_model(), file, f.name);
+    write_model(formats_model(), file, f.name);
     const int before = forks;
     (void)read_model(file);
     CHECK((forks > before) == read_forks(file));

@@ -82,7 +82,7 @@ void check_same(const Model& a, const Model& b) {
 // 2 x 2 x 1 cells: x < 1 hexes (block 1 "steel"), x >= 1 Kuhn tets (block 2); a node set on
 // the z = 0 face and a side set with hex and tet faces on the outside, both sorted as the
 // Gmsh reader returns them.
-Model sample_model() {
+Model gmsh_model() {
   Model m = grid_model({2, 2, 1}, 0.5, [](int i, int, int) { return i >= 1; });
   m.points[4] += Point(0.01, -0.02, 0.03);  // coordinates that are not all round numbers
   m.block_names[1] = "steel";
@@ -163,7 +163,7 @@ TEST_CASE("read_gmsh: sparse node tags, and one entity's elements in two runs") 
 }
 
 TEST_CASE("write_gmsh then read_gmsh gives the same model (ASCII and binary)") {
-  const Model m = sample_model();
+  const Model m = gmsh_model();
   REQUIRE(m.hexes.size() == 2);
   REQUIRE(m.tets.size() == 12);
   for (GmshFormat format : {GmshFormat::kAscii, GmshFormat::kBinary}) {
@@ -248,7 +248,7 @@ TEST_CASE("read_gmsh rejects bad input naming the file, element and reason") {
 TEST_CASE("write_gmsh is atomic and validates indices") {
   const fs::path file = scratch_dir() / "atomic.msh";
   write_text(file, "previous content");
-  Model bad = sample_model();
+  Model bad = gmsh_model();
   bad.hexes[1][6] = 999;  // out of range
   CHECK_THROWS_WITH_AS(write_gmsh(bad, file),
                        doctest::Contains("hex 2: corner 7 refers to node index 999"), InvalidInput);

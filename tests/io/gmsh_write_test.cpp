@@ -32,7 +32,7 @@ namespace {
 
 // 2 x 2 x 1 cells: hexes (block 1 "steel") and Kuhn tets (block 2 "rubber"), a node set, a
 // side set with hex and tet faces.
-Model sample_model() {
+Model written_model() {
   Model m = grid_model({2, 2, 1}, 0.5, [](int i, int, int) { return i >= 1; });
   m.points[4] += Point(0.01, -0.02, 0.03);
   m.block_names[1] = "steel";
@@ -96,7 +96,7 @@ std::map<std::pair<int, int>, std::pair<std::string, std::size_t>> gmsh_groups(
 
 TEST_CASE("write_gmsh: every version and encoding reads back the same model") {
   const test::TempDir dir;
-  const Model m = sample_model();
+  const Model m = written_model();
   for (const Variant& v : kVariants) {
     CAPTURE(v.name);
     const fs::path file = dir.path / (std::string(v.name) + ".msh");
@@ -127,7 +127,7 @@ TEST_CASE("write_gmsh: Gmsh itself lists every physical group with its name and 
   // The old writer (libgmsh with Mesh.SaveAll) wrote physical tag 0 on every element of a
   // .msh 2.2 file: Gmsh then listed no physical group at all.
   const test::TempDir dir;
-  const Model m = sample_model();
+  const Model m = written_model();
   for (const Variant& v : kVariants) {
     CAPTURE(v.name);
     const fs::path file = dir.path / (std::string(v.name) + ".msh");
@@ -145,7 +145,7 @@ TEST_CASE("write_gmsh: block, side set and node set physical tags are distinct")
   // Legal in .msh (tags are per dimension), but GetFEM keeps one region per tag and renumbers
   // a tag used twice: a set whose id is a block's moves by 10^k above every id.
   const test::TempDir dir;
-  Model m = sample_model();
+  Model m = written_model();
   m.node_sets[0].id = 1;
   m.side_sets[0].id = 1;
   const fs::path file = dir.path / "shared.msh";
@@ -159,7 +159,7 @@ TEST_CASE("write_gmsh: block, side set and node set physical tags are distinct")
 
 TEST_CASE("names with quotes, newlines, control characters and bad UTF-8 never break an output") {
   const test::TempDir dir;
-  Model m = sample_model();
+  Model m = written_model();
   m.block_names[1] = "st\"e\nel\x01 \xff";
   m.side_sets[0].name = "out\rside\t\"x\"";
   const std::string block = "st'e el  \xEF\xBF\xBD", side = "out side 'x'";

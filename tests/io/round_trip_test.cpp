@@ -41,7 +41,7 @@ Point centroid(const Model& m, std::span<const Index> corners) {
 // Hexes (block 1 "steel") beside Kuhn tets (block 2 "rubber"), one of which is steel too (a
 // block of two kinds, which Exodus writes as two blocks); a node set, a side set on a hex and
 // one on a tet, each named.
-Model sample_model() {
+Model round_trip_model() {
   Model m = grid_model({2, 2, 1}, 0.5, [](int i, int, int) { return i >= 1; });
   m.tet_block[0] = 1;
   m.block_names[1] = "steel";
@@ -104,7 +104,7 @@ Carried both(Carried a, Carried b) {
 
 TEST_CASE("round trips: blocks, block names, node sets and side sets through every format pair") {
   const geode::test::TempDir dir;
-  const Model original = sample_model();
+  const Model original = round_trip_model();
   int pairs = 0;
   for (const MeshFormat& a : mesh_formats()) {
     if (!a.write) continue;

@@ -16,6 +16,7 @@
 #include <geode/primal/input_check.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/split_hexes.hpp>
+#include "support/model_checks.hpp"
 
 using namespace geode;
 using primal::ElementKind;
@@ -23,11 +24,6 @@ using primal::Index;
 using primal::Point;
 
 namespace {
-
-double volume(const primal::Model& m, const std::array<Index, 4>& t) {
-  auto p = [&](std::size_t k) { return m.points[primal::index_cast<std::size_t>(t[k])]; };
-  return primal::tet_volume(p(0), p(1), p(2), p(3));
-}
 
 // The model's nodes renumbered by a random permutation (so the lowest-node rule picks other
 // diagonals), its points slightly moved so that no tet is degenerate by symmetry.
@@ -139,8 +135,8 @@ TEST_CASE("split_hexes: a grid split whole conforms, fills it and keeps its side
     CHECK(s.tets.size() <= 6 * m.hexes.size());
     double sum = 0.0;
     for (const auto& t : s.tets) {
-      CHECK(volume(s, t) > 0.0);
-      sum += volume(s, t);
+      CHECK(test::tet_volume(s, t) > 0.0);
+      sum += test::tet_volume(s, t);
     }
     // The jittered hexes' faces are not planar: their tets fill what the triangles bound.
     CHECK(sum == doctest::Approx(given).epsilon(0.02));
@@ -157,7 +153,7 @@ TEST_CASE("split_hexes: a grid split whole conforms, fills it and keeps its side
 TEST_CASE("split_hexes: diagonals no triangulation of the cube has give the hex its centre") {
   primal::Model m = cube_with_forced_faces(false);
   const Point centre(0.5, 0.5, 0.5);
-  for (const auto& t : m.tets) REQUIRE(volume(m, t) > 0.0);
+  for (const auto& t : m.tets) REQUIRE(test::tet_volume(m, t) > 0.0);
   REQUIRE(primal::check_input(m).ok());
   // File ids 10, 20, ..., not in order: the centre takes the next past the highest.
   for (std::size_t v = 0; v < m.points.size(); ++v)
@@ -171,8 +167,8 @@ TEST_CASE("split_hexes: diagonals no triangulation of the cube has give the hex 
   double sum = 0.0;
   for (std::size_t t = 12; t < s.tets.size(); ++t) {
     CHECK(s.tets[t][3] == primal::index_cast(m.points.size()));
-    CHECK(volume(s, s.tets[t]) > 0.0);
-    sum += volume(s, s.tets[t]);
+    CHECK(test::tet_volume(s, s.tets[t]) > 0.0);
+    sum += test::tet_volume(s, s.tets[t]);
   }
   CHECK(sum == doctest::Approx(1.0));
   CHECK(primal::check_input(s).ok());
@@ -183,7 +179,7 @@ TEST_CASE("split_hexes: a pyramid on a face is split along the diagonal its hex'
   // diagonal (their side triangles kept, the sides on them moved), so the hex splits on its
   // corners, no centre.
   const primal::Model m = with_side_triangles(cube_with_forced_faces(true));
-  for (const auto& t : m.tets) REQUIRE(volume(m, t) > 0.0);
+  for (const auto& t : m.tets) REQUIRE(test::tet_volume(m, t) > 0.0);
   REQUIRE(primal::check_input(m).ok());
   REQUIRE(m.side_sets.front().sides.size() == 6 * 4);
   const primal::Model s = primal::split_hexes(m, std::vector<Index>{0});
@@ -196,8 +192,8 @@ TEST_CASE("split_hexes: a pyramid on a face is split along the diagonal its hex'
   CHECK(flipped % 2 == 0);
   double sum = 0.0;
   for (std::size_t t = 0; t < s.tets.size(); ++t) {
-    CHECK(volume(s, s.tets[t]) > 0.0);
-    if (t >= 12) sum += volume(s, s.tets[t]);
+    CHECK(test::tet_volume(s, s.tets[t]) > 0.0);
+    if (t >= 12) sum += test::tet_volume(s, s.tets[t]);
   }
   CHECK(sum == doctest::Approx(1.0));
   CHECK(primal::check_input(s).ok());  // conforming: each pyramid's tets meet the hex's
@@ -221,7 +217,7 @@ TEST_CASE("split_hexes: a pyramid with a side on its base keeps its split") {
   const primal::Model s = primal::split_hexes(m, std::vector<Index>{0});
   CHECK(s.points.size() == m.points.size() + 1);  // the centre
   for (std::size_t t = 0; t < 12; ++t) CHECK(s.tets[t] == m.tets[t]);
-  for (const auto& t : s.tets) CHECK(volume(s, t) > 0.0);
+  for (const auto& t : s.tets) CHECK(test::tet_volume(s, t) > 0.0);
   CHECK(primal::check_input(s).ok());
   CHECK(sided_triangles(s) == sided_triangles(m));
 }
@@ -239,7 +235,7 @@ TEST_CASE("split_hexes: a face under four tet triangles around a node is refused
   for (std::size_t i = 0; i < 4; ++i)
     primal::add_element(m, ElementKind::kTet, std::array<Index, 4>{top[i], top[(i + 1) % 4], 8, 9},
                         2, static_cast<std::int64_t>(i) + 1);
-  for (const auto& t : m.tets) REQUIRE(volume(m, t) > 0.0);
+  for (const auto& t : m.tets) REQUIRE(test::tet_volume(m, t) > 0.0);
   REQUIRE(primal::check_input(m).ok());
   CHECK_THROWS_WITH_AS(
       primal::split_hexes(m, std::vector<Index>{0}),
@@ -285,12 +281,12 @@ TEST_CASE("split_hexes: a column's faces between its cells follow the diagonal f
         std::array<Index, 4>{t[0], t[1], t[2], primal::index_cast(m.points.size() - 1)}, 2,
         primal::index_cast(k) + 1);
   }
-  for (const auto& t : m.tets) REQUIRE(volume(m, t) > 0.0);
+  for (const auto& t : m.tets) REQUIRE(test::tet_volume(m, t) > 0.0);
   REQUIRE(primal::check_input(m).ok());
   REQUIRE(std::min({node[1][0], node[1][1], node[1][2], node[1][3]}) == node[1][1]);
   const primal::Model s = primal::split_hexes(m, std::vector<Index>{0, 1});
   CHECK(s.hexes.empty());
   CHECK(s.points.size() == m.points.size());  // on their corners
-  for (const auto& t : s.tets) CHECK(volume(s, t) > 0.0);
+  for (const auto& t : s.tets) CHECK(test::tet_volume(s, t) > 0.0);
   CHECK(primal::check_input(s).ok());  // conforming: the top face's two triangles kept
 }

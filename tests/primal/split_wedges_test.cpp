@@ -15,6 +15,7 @@
 #include <geode/primal/split_pyramids.hpp>
 #include <geode/primal/split_wedges.hpp>
 #include "support/demo_input.hpp"
+#include "support/model_checks.hpp"
 #include "support/temp_dir.hpp"
 
 using namespace geode;
@@ -40,13 +41,6 @@ bool has_edge(const std::array<std::array<Index, 4>, 3>& tets, Index a, Index b)
   return std::any_of(tets.begin(), tets.end(), [&](const auto& t) {
     return std::count(t.begin(), t.end(), a) && std::count(t.begin(), t.end(), b);
   });
-}
-
-double volume(const primal::Model& m, const std::array<Index, 4>& t) {
-  auto p = [&](int k) {
-    return m.points[primal::index_cast<std::size_t>(t[static_cast<std::size_t>(k)])];
-  };
-  return primal::tet_volume(p(0), p(1), p(2), p(3));
 }
 
 // The triangles of the tets on the nodes of `quad`.
@@ -81,8 +75,8 @@ TEST_CASE(
       ++valid;
       double sum = 0.0;
       for (const auto& t : tets) {
-        CHECK(volume(m, t) > 0.0);
-        sum += volume(m, t);
+        CHECK(test::tet_volume(m, t) > 0.0);
+        sum += test::tet_volume(m, t);
       }
       CHECK(sum == doctest::Approx(expected));
       for (std::size_t q = 0; q < 3; ++q) {
@@ -116,7 +110,7 @@ TEST_CASE("split_wedges: shared quads split alike, kept wedges renumbered, sides
     CHECK(s.wedge_ids == std::vector<std::int64_t>{12});
     CHECK(s.tet_ids == std::vector<std::int64_t>{11, 11, 11});
     CHECK(s.tet_block == std::vector<int>{4, 4, 4});
-    for (const auto& t : s.tets) CHECK(volume(s, t) > 0.0);
+    for (const auto& t : s.tets) CHECK(test::tet_volume(s, t) > 0.0);
     // The quad both wedges share, split through its lowest node (1): triangles (1,2,5), (1,5,4).
     CHECK(triangles_on(s, {1, 2, 5, 4}) ==
           std::set<std::array<Index, 4>>{primal::face_key(std::array<Index, 3>{1, 2, 5}),
@@ -194,7 +188,7 @@ TEST_CASE("split_wedges: Gmsh's layer of hexes beside wedges on tets, refused wh
   const primal::Model s = primal::split_wedges(m, pieces);
   CHECK(s.wedges.empty());
   CHECK(s.tets.size() == m.tets.size() + 3 * m.wedges.size());
-  for (const auto& t : s.tets) CHECK(volume(s, t) > 0.0);
+  for (const auto& t : s.tets) CHECK(test::tet_volume(s, t) > 0.0);
   CHECK(primal::check_input(s).ok());
   // The hexes' quads the wedges covered are now interface quads too.
   const primal::Interface itf = primal::find_interface(s);

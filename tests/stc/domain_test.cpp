@@ -15,11 +15,14 @@
 #include <geode/templates/geode.hpp>
 #include "support/fixtures.hpp"
 #include "support/isomorphism.hpp"
+#include "support/sheets.hpp"
 
 using namespace geode;
 using stc::Point;
 
 namespace {
+
+using test::plane;
 
 using Corners = std::array<Point, 8>;
 
@@ -54,10 +57,6 @@ Point local_of(const stc::Domain& d, const Point& x) {
 }
 
 // A plane through p with normal n.
-stc::Sheet plane(const Point& p, const Point& n, const std::string& name) {
-  return {name, [p, n](const Point& x) { return (x - p).dot(n); }, "plane"};
-}
-
 // k planes across each local axis, through the points at local coordinate i / (k + 1) on
 // the line through the cell's centre, each roughly parallel to a pair of opposite faces
 // (normal along the line joining their centres, tilted a little so none is special). In 2D

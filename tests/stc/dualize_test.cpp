@@ -11,15 +11,14 @@
 #include <geode/primal/errors.hpp>
 #include <geode/stc/arrangement.hpp>
 #include <geode/stc/dualize.hpp>
+#include "support/sheets.hpp"
 
 using namespace geode;
 using stc::Point;
 
 namespace {
 
-stc::Sheet sphere(const Point& c, double r, const std::string& name) {
-  return {name, [c, r](const Point& x) { return (x - c).norm() - r; }, "sphere"};
-}
+using test::sphere;
 
 std::string diagnosis(const std::vector<stc::Sheet>& s) {
   const stc::Domain box{Point(0, 0, 0), Point(1, 1, 1), 3};

@@ -10,11 +10,14 @@
 #include <geode/primal/validity.hpp>
 #include <geode/stc/arrangement.hpp>
 #include <geode/stc/dualize.hpp>
+#include "support/sheets.hpp"
 
 using namespace geode;
 using stc::Point;
 
 namespace {
+
+using test::plane;
 
 // The equilateral pyramid: base [-1, 1]^2 at y = 0, counter-clockwise seen from the apex, every
 // edge 2 long.
@@ -23,11 +26,7 @@ std::array<Point, 5> equilateral() {
           Point(0, std::sqrt(2.0), 0)};
 }
 
-stc::Sheet plane(const Point& p, const Point& n, const std::string& name) {
-  return {name, [p, n](const Point& x) { return (x - p).dot(n); }, "plane"};
-}
-
-stc::Sheet sphere(const Point& c, double r, const std::string& name) {
+stc::Sheet squared_sphere(const Point& c, double r, const std::string& name) {
   return {name, [c, r](const Point& x) { return (x - c).squaredNorm() / (r * r) - 1.0; }, "sphere"};
 }
 
@@ -66,7 +65,7 @@ TEST_CASE("pyramid domain: three planes and a sphere around their crossing give 
   const Point c(0.05, 0.5, -0.04);
   const auto A =
       stc::compute_arrangement({plane(c, Point::UnitX(), "x"), plane(c, Point::UnitY(), "y"),
-                                plane(c, Point::UnitZ(), "z"), sphere(c, 0.3, "s")},
+                                plane(c, Point::UnitZ(), "z"), squared_sphere(c, 0.3, "s")},
                                stc::Domain::pyramid(P));
   const auto D = stc::dualize(A);
   CHECK(D.hex.hexes.size() == 7);

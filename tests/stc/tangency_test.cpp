@@ -10,18 +10,15 @@
 #include <geode/primal/validity.hpp>
 #include <geode/stc/arrangement.hpp>
 #include <geode/stc/dualize.hpp>
+#include "support/sheets.hpp"
 
 using namespace geode;
 using stc::Point;
 
 namespace {
 
-stc::Sheet plane(const Point& p, const Point& n, const std::string& name) {
-  return {name, [p, n](const Point& x) { return (x - p).dot(n); }, "plane"};
-}
-stc::Sheet sphere(const Point& c, double r, const std::string& name) {
-  return {name, [c, r](const Point& x) { return (x - c).norm() - r; }, "sphere"};
-}
+using test::plane;
+using test::sphere;
 
 // The TopologyError's message, or "" when the arrangement dualizes into a valid mesh (with
 // its element count in `elements`).

@@ -178,4 +178,8 @@ primal::Model unmerged_parts(std::array<int, 3> cells) {
   return m;
 }
 
+primal::Model small_hybrid_model() {
+  return primal::grid_model({4, 2, 2}, 1.0, [](int i, int, int) { return i >= 2; });
+}
+
 }  // namespace geode::test

@@ -39,6 +39,9 @@ primal::QuadMesh structured_quad_grid(int nx, int ny);
 primal::QuadMesh boundary_quads(const primal::HexMesh& mesh,
                                 const std::function<bool(const primal::Point&)>& keep);
 
+// 4 x 2 x 2 unit cells, cells with i >= 2 split into 6 tets: 8 hexes, 48 tets, 4 interface quads.
+primal::Model small_hybrid_model();
+
 // One unit hex (primal::grid_model, block 1) whose top face, nodes 4 5 7 6 counter-clockwise
 // seen from above, is split into four triangles around node 8 at `centre`, each under a tet
 // (block 2) with apex node 9 at `apex`: the smallest four-triangle interface.

@@ -1,7 +1,10 @@
 #pragma once
-// Two models with the same cells: points, every kind's connectivity and blocks, and the block
-// names, field by field (so that a failure names the field).
+// Checks on models shared by the tests: two models with the same cells (points, every kind's
+// connectivity and blocks, and the block names, field by field, so that a failure names the
+// field), and a tet's signed volume.
 #include <doctest/doctest.h>
+
+#include <array>
 
 #include <geode/primal/model.hpp>
 
@@ -18,6 +21,12 @@ inline void check_same_cells(const primal::Model& a, const primal::Model& b) {
   CHECK(a.pyramid_block == b.pyramid_block);
   CHECK(a.wedge_block == b.wedge_block);
   CHECK(a.block_names == b.block_names);
+}
+
+// The signed volume of tet `t` (node numbers) of `m`.
+inline double tet_volume(const primal::Model& m, const std::array<primal::Index, 4>& t) {
+  auto p = [&](std::size_t k) { return m.points[primal::index_cast<std::size_t>(t[k])]; };
+  return primal::tet_volume(p(0), p(1), p(2), p(3));
 }
 
 }  // namespace geode::test
