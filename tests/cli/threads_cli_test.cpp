@@ -29,8 +29,8 @@ std::string bytes(const fs::path& p) {
 }  // namespace
 
 // Skipped in the sanitized build (54 s there for the hex-dominant model alone): what it proves,
-// one output for any thread count, is not the sanitizers' to check, and the conform and
-// verification it runs, they check in the conform suite.
+// one output for any thread count, is not the sanitizers' to check, and the conform suite runs
+// the same conform and verification under them.
 TEST_CASE("geode demo: the same bytes on one thread and two, verified whole or locally" *
           doctest::skip(test::kSanitized)) {
   const test::TempDir dir;

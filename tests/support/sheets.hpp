@@ -1,5 +1,5 @@
 #pragma once
-// Sheets the stc tests build arrangements of: planes and spheres as signed distances.
+// Sheets the stc tests build arrangements of: planes and spheres, each the zero set of its field.
 #include <string>
 
 #include <geode/stc/arrangement.hpp>
