@@ -19,12 +19,7 @@ using test::temp_path;
 
 namespace {
 
-std::string read_text(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using geode::test::slurp;
 
 void write_text(const std::filesystem::path& p, const std::string& text) {
   std::ofstream(p) << text;
@@ -78,7 +73,7 @@ TEST_CASE("geode arrange: the shipped specs are the built-in templates") {
         std::filesystem::path(GEODE_SOURCE_DIR) / "notebooks-data/specs" / (name + ".json");
     const auto spec = geode_cli("template " + name + " --format spec");
     REQUIRE(spec.code == 0);
-    CHECK(spec.out == read_text(shipped));  // regenerate with the command when this fails
+    CHECK(spec.out == slurp(shipped));  // regenerate with the command when this fails
 
     // The plain dual: the arrangement has no fix-up. Unsmoothed it may be invalid (exit 4, both
     // alike: one validity check), so both are written on request.
@@ -161,7 +156,7 @@ TEST_CASE("geode arrange: the README's examples, the pillowed hex and the pillow
   const auto r = geode_cli("arrange " + (specs / "pillow.json").string() +
                            " --smooth --format json -o " + out.string());
   REQUIRE(r.code == 0);
-  const auto j = nlohmann::json::parse(read_text(out));
+  const auto j = nlohmann::json::parse(slurp(out));
   CHECK(j["hexes"].size() == 7);  // three planes and a sphere around their crossing
   CHECK(j["nodes"].size() == 16);
   CHECK(j["sheets"].size() == 4);
@@ -184,7 +179,7 @@ TEST_CASE("geode arrange: the README's examples, the pillowed hex and the pillow
   REQUIRE(geode_cli("study interleave --quiet --spec " + (specs / "pillow2d.json").string() +
                     " --summary " + summary.string())
               .code == 0);
-  const std::string table = read_text(summary);
+  const std::string table = slurp(summary);
   CHECK(table.find(",usable,\"example_sheets[2].circle.radius\"\n") != std::string::npos);
   CHECK(table.find(",1,0.6\n") != std::string::npos);  // V2, usable, first seen at radius 0.6
   std::filesystem::remove(summary);

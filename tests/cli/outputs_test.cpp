@@ -24,10 +24,7 @@ using geode::test::TempDir;
 
 namespace {
 
-std::string bytes_of(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
+using geode::test::slurp;
 
 std::vector<std::string> names_in(const fs::path& dir) {
   std::vector<std::string> names;
@@ -77,15 +74,15 @@ TEST_CASE("conform -o and --report: a signal between the two renames leaves both
     }
     CHECK(names_in(dir.path) == before);  // no temporary, no backup, no lone output
     if (row.former_outputs) {
-      CHECK(bytes_of(out) == "former mesh\n");
-      CHECK(bytes_of(report) == "former report\n");
+      CHECK(slurp(out) == "former mesh\n");
+      CHECK(slurp(report) == "former report\n");
     }
     // The control: without the signal the same run writes both.
     const auto run = geode_cli(command, true);
     INFO(run.out);
     CHECK(run.code == 0);
     CHECK(fs::file_size(out) > 1000);
-    CHECK(bytes_of(report).find("\"valid\"") != std::string::npos);
+    CHECK(slurp(report).find("\"valid\"") != std::string::npos);
     CHECK(names_in(dir.path).size() == 3);
   }
 }
@@ -103,7 +100,7 @@ TEST_CASE("conform -o and --report: a report that cannot be written puts the for
   INFO(run.out);
   CHECK(run.code == 2);
   CHECK(run.out.find("nothing written") != std::string::npos);
-  CHECK(bytes_of(out) == "former mesh\n");
+  CHECK(slurp(out) == "former mesh\n");
   CHECK(names_in(dir.path) == std::vector<std::string>{"hexes.msh", "out.exo", "r.json"});
 }
 
@@ -143,7 +140,7 @@ TEST_CASE("an output FIFO whose reader leaves: exit 2 in one line, the report no
   INFO(run.out);
   CHECK(run.code == 2);
   CHECK(run.out.find("f.msh: write failed: Broken pipe") != std::string::npos);
-  CHECK(bytes_of(report) == "former report\n");
+  CHECK(slurp(report) == "former report\n");
   CHECK(names_in(dir.path) == std::vector<std::string>{"f.msh", "hexes.msh", "r.json"});
 }
 
@@ -160,11 +157,10 @@ TEST_CASE(
   INFO(run.out);
   CHECK(run.code == 2);
   CHECK(run.out.find("nothing written") != std::string::npos);
-  for (const char* name : {"sh.csv", "sd.csv", "sq.csv"})
-    CHECK(bytes_of(dir.path / name) == "OLD\n");
+  for (const char* name : {"sh.csv", "sd.csv", "sq.csv"}) CHECK(slurp(dir.path / name) == "OLD\n");
   CHECK(names_in(dir.path) == std::vector<std::string>{"sd.csv", "sh.csv", "sj.csv", "sq.csv"});
   fs::remove(dir.path / "sj.csv");
   CHECK(geode_cli(command).code == 0);
   for (const char* name : {"sh.csv", "sd.csv", "sq.csv", "sj.csv"})
-    CHECK(bytes_of(dir.path / name).rfind("OLD", 0) != 0);
+    CHECK(slurp(dir.path / name).rfind("OLD", 0) != 0);
 }

@@ -21,10 +21,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string bytes(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using geode::test::slurp;
 
 }  // namespace
 
@@ -47,11 +44,11 @@ TEST_CASE("geode demo: the same bytes on one thread and two, verified whole or l
                           true);
       INFO(run.out);
       REQUIRE(run.code == 0);
-      const auto j = nlohmann::json::parse(bytes(report));
+      const auto j = nlohmann::json::parse(slurp(report));
       CHECK(j["valid"] == true);
       CHECK(j["verification"]["scope"] ==
             (std::string(extra).find("full") != std::string::npos ? "full" : "local"));
-      const std::string written = bytes(out);
+      const std::string written = slurp(out);
       CHECK(!written.empty());
       if (reference.empty())
         reference = written;

@@ -28,6 +28,8 @@ using namespace geode::io;
 
 namespace {
 
+using geode::test::slurp;
+
 // Hexes (block 1 "steel") beside Kuhn tets (block 2), a node set and a side set with names.
 Model formats_model() {
   Model m = grid_model({2, 2, 1}, 0.5, [](int i, int, int) { return i >= 1; });
@@ -37,13 +39,6 @@ Model formats_model() {
   outside.sides.push_back({{ElementKind::kHex, 0}, 0});
   m.side_sets.push_back(outside);
   return m;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 }  // namespace

@@ -30,6 +30,8 @@ using namespace geode::io;
 
 namespace {
 
+using geode::test::slurp;
+
 // 2 x 2 x 1 cells: hexes (block 1 "steel") and Kuhn tets (block 2 "rubber"), a node set, a
 // side set with hex and tet faces.
 Model written_model() {
@@ -59,13 +61,6 @@ constexpr Variant kVariants[] = {
     {GmshFormat::kAscii, GmshVersion::k22, "22-ascii"},
     {GmshFormat::kBinary, GmshVersion::k22, "22-binary"},
 };
-
-std::string text_of(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // What Gmsh sees in a file: per physical group (dim, tag), its name and element count.
 std::map<std::pair<int, int>, std::pair<std::string, std::size_t>> gmsh_groups(
@@ -101,7 +96,7 @@ TEST_CASE("write_gmsh: every version and encoding reads back the same model") {
     CAPTURE(v.name);
     const fs::path file = dir.path / (std::string(v.name) + ".msh");
     write_gmsh(m, file, v.format, v.version);
-    const std::string text = text_of(file);
+    const std::string text = slurp(file);
     const std::string header = text.substr(text.find('\n') + 1, 5);
     CHECK(header == std::string(v.version == GmshVersion::k41 ? "4.1 " : "2.2 ") +
                         (v.format == GmshFormat::kBinary ? "1" : "0"));
@@ -180,7 +175,7 @@ TEST_CASE("names with quotes, newlines, control characters and bad UTF-8 never b
   CHECK(read_exodus(exo).block_names.at(1) == block);
   const fs::path vtu = dir.path / "names.vtu";
   write_vtu(vtu, m);
-  const std::string xml = text_of(vtu);
+  const std::string xml = slurp(vtu);
   CHECK(xml.find('\x01') == std::string::npos);
   CHECK(xml.find("block:st&quot;") == std::string::npos);
   CHECK_NOTHROW((void)read_vtu(vtu));

@@ -28,14 +28,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-using geode::test::TempDir;  // a fresh directory per test case, removed afterwards
+using geode::test::slurp;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using geode::test::TempDir;  // a fresh directory per test case, removed afterwards
 
 void spit(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
 
