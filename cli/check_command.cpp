@@ -59,7 +59,9 @@ std::string obstructions_line(const std::vector<primal::Obstruction>& o) {
 Checked check_hexes(const primal::HexMesh& mesh, const primal::RealizabilityOptions& options,
                     Index base, Progress& progress) {
   Checked c;
-  const auto v = primal::check_validity(mesh);
+  const auto v = primal::check_validity(mesh, [&progress](std::size_t done, std::size_t total) {
+    progress.share("of the mesh checked", done, total);
+  });
   c.valid = v.ok();
   c.validity = v.summary(base);
   progress.stage_done(validity_line(c.valid));

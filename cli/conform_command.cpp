@@ -190,6 +190,9 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
   opts.smoothing_progress = [&progress](std::size_t done, std::size_t total) {
     progress.step("seed hexes settled", done, total);
   };
+  opts.verification_progress = [&progress](std::size_t done, std::size_t total) {
+    progress.share("of the output verified", done, total);
+  };
   // The mesh is written to its temporary while conform verifies it (ConformOptions::write_ahead),
   // and published (with the report) only if it is valid or --write-invalid asks for it.
   OutputFiles own;

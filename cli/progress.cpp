@@ -34,6 +34,17 @@ void Progress::stage_done(const std::string& line) {
 
 void Progress::step(const std::string& what, std::size_t done, std::size_t total) {
   if (quiet_) return;
+  show(what, done, total, std::to_string(done) + " / " + std::to_string(total) + " " + what);
+}
+
+void Progress::share(const std::string& what, std::size_t done, std::size_t total) {
+  if (quiet_) return;
+  const std::size_t percent = total ? 100 * std::min(done, total) / total : 100;
+  show(what, done, total, std::to_string(percent) + " % " + what);
+}
+
+void Progress::show(const std::string& what, std::size_t done, std::size_t total,
+                    const std::string& count) {
   const auto now = Clock::now();
   if (what != what_ || done == 0) {
     end_bar();
@@ -43,7 +54,6 @@ void Progress::step(const std::string& what, std::size_t done, std::size_t total
   }
   const bool finished = done >= total;
   if (now - started_ < kDelay) return;  // short steps stay silent
-  const auto count = std::to_string(done) + " / " + std::to_string(total) + " " + what;
   const auto seconds = std::chrono::duration_cast<std::chrono::seconds>(now - started_).count();
   if (terminal_) {
     if (!finished && bar_drawn_ && now - last_ < kRedraw) return;

@@ -23,12 +23,17 @@ class Progress {
   void stage_done(const std::string& line);
   // `done` of `total` units of `what` (e.g. "buffer hexes"); a new `what` starts a new step.
   void step(const std::string& what, std::size_t done, std::size_t total);
+  // The same for work counted in units that mean nothing to a user (primal::ValidityProgress):
+  // shown as a percentage, "40 % of the output verified".
+  void share(const std::string& what, std::size_t done, std::size_t total);
 
   // How long to wait before showing a step, and between log lines.
   static constexpr std::chrono::milliseconds kDelay{2000}, kLogEvery{5000}, kRedraw{100};
 
  private:
   void end_bar();
+  // step() and share(): `count` is how the step reads ("3 / 8 buffer hexes").
+  void show(const std::string& what, std::size_t done, std::size_t total, const std::string& count);
   bool quiet_, terminal_;
   std::string what_;
   Clock::time_point started_{}, last_{}, stage_started_ = Clock::now();

@@ -167,6 +167,9 @@ struct ConformOptions {
   // Called after each round of smoothing with (seed hexes settled, seed hexes), for a progress
   // bar; when empty, `progress` gets a line every few seconds instead.
   std::function<void(std::size_t done, std::size_t total)> smoothing_progress;
+  // Called during the whole-output check (ConformVerify::kFull, and `--smooth global`) with its
+  // (work done, all the work), as primal::ValidityProgress says; may be empty.
+  primal::ValidityProgress verification_progress;
   // Called once with the output model (ConformResult::model, before it is returned) when it is
   // final: on a thread of its own while the default verification (ConformVerify::kLocal, the
   // scaled Jacobian report) runs, else after verification, so that a caller writing it (to a

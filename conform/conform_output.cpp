@@ -80,7 +80,7 @@ void Conformer::check(std::span<const Point> points, std::span<const std::array<
       verdict("invalid dicing, numbered in the dicing's own arrays: " + why);
     }
   } else {
-    res_.validity = primal::check_validity(mesh_);
+    res_.validity = primal::check_validity(mesh_, options_.verification_progress);
     res_.verified = ConformVerify::kFull;
     res_.verified_hexes = primal::index_cast(mesh_.hexes.size());
   }

@@ -10,9 +10,11 @@
 #include <geode/primal/errors.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <cassert>
 #include <cmath>
 #include <cstdint>
+#include <mutex>
 #include <numbers>
 #include <numeric>
 #include <optional>
@@ -144,6 +146,32 @@ auto show_coverage(Index base) {
     return os.str();
   };
 }
+
+// Work done on any thread, handed to a ValidityProgress one call at a time: a thread that finds
+// a call under way goes on with its work instead of waiting. Each call reads the count after the
+// previous one did, so what it is told never decreases.
+class ProgressTicker {
+ public:
+  ProgressTicker(const ValidityProgress& report, std::size_t total)
+      : report_(report), total_(total) {}
+  void add(std::size_t work) {
+    if (!report_) return;
+    done_.fetch_add(work, std::memory_order_relaxed);
+    std::unique_lock lock(calling_, std::try_to_lock);
+    if (lock.owns_lock()) report_(std::min(done_.load(std::memory_order_relaxed), total_), total_);
+  }
+  void finish() {
+    if (!report_) return;
+    std::lock_guard lock(calling_);
+    report_(total_, total_);
+  }
+
+ private:
+  const ValidityProgress& report_;
+  const std::size_t total_;
+  std::atomic<std::size_t> done_{0};
+  std::mutex calling_;
+};
 
 // ---- Local covering ------------------------------------------------------------------------
 // The corners around a node tile its neighbourhood once when the mesh is embedded there. The
@@ -382,11 +410,14 @@ std::string HexValidityReport::summary(Index base) const {
   return os.str();
 }
 
-HexValidityReport check_validity(const HexMesh& mesh) { return detail::check_validity(mesh, {}); }
+HexValidityReport check_validity(const HexMesh& mesh, const ValidityProgress& progress) {
+  return detail::check_validity(mesh, {}, progress);
+}
 
 namespace detail {
 
-HexValidityReport check_validity(const HexMesh& mesh, std::span<const char> focus) {
+HexValidityReport check_validity(const HexMesh& mesh, std::span<const char> focus,
+                                 const ValidityProgress& progress) {
   // Everything is read off the node -> hex incidence (CSR) instead of hashing every face and
   // edge of the mesh: all hexes using a face (an edge) contain its smallest node, so the uses of
   // a face or edge are found among the few hexes around one node. A face or edge is numbered by
@@ -395,6 +426,11 @@ HexValidityReport check_validity(const HexMesh& mesh, std::span<const char> focu
   r.num_nodes = index_cast(mesh.points.size());
   r.num_hexes = index_cast(mesh.hexes.size());
   r.non_finite_nodes = non_finite(mesh.points);
+  // The work in units of about equal cost (measured on a million hexes): a hex's geometry, its
+  // place in the incidence, and per node twice that for its faces and four times for its link;
+  // one more for the boundary surface, so that only the end says all is done.
+  const std::size_t nh_all = mesh.hexes.size(), nv_all = mesh.points.size();
+  ProgressTicker ticker(progress, 2 * nh_all + 6 * nv_all + 1);
 
   // The proper hexes, on which the topology is analysed; use p refers to mesh.hexes[original[p]].
   std::vector<Index> original;  // proper hex -> input hex
@@ -443,6 +479,7 @@ HexValidityReport check_validity(const HexMesh& mesh, std::span<const char> focu
                           found[h] = kMeasured | (positive ? 0u : kInverted) |
                                      ProbeCount::classify(p, j, corners);
                         }
+                        ticker.add(range.size());
                       });
     for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
       if (!(found[h] & kMeasured)) continue;
@@ -487,6 +524,7 @@ HexValidityReport check_validity(const HexMesh& mesh, std::span<const char> focu
             index_cast(8 * p + index_cast<std::size_t>(c));
     }
   }
+  ticker.add(nh_all);
   // An incidence entry: the hex and the node's corner in it.
   auto use_at = [&](Index k) {
     const Index a = around[index_cast<std::size_t>(k)];
@@ -538,6 +576,7 @@ HexValidityReport check_validity(const HexMesh& mesh, std::span<const char> focu
             i = j;
           }
         }
+        ticker.add(2 * range.size());
       });
   std::vector<BoundaryQuad> boundary;
   for (std::size_t u = 0; u < 6 * nh; ++u) {
@@ -695,6 +734,7 @@ HexValidityReport check_validity(const HexMesh& mesh, std::span<const char> focu
       nv, 4096, [&](std::size_t, std::size_t begin, std::size_t end, Found& out) {
         Scratch scratch;
         for (std::size_t v = begin; v < end; ++v) visit(v, scratch, out);
+        ticker.add(4 * (end - begin));
       });
   std::vector<std::pair<Index, EdgeKey>> bad_edges;
   for (Found& f : found) {
@@ -714,6 +754,7 @@ HexValidityReport check_validity(const HexMesh& mesh, std::span<const char> focu
   r.euler = r.num_vertices - r.num_edges + r.num_faces - r.num_cells;
 
   r.boundary = extract_boundary(mesh.points, std::move(boundary));
+  ticker.finish();
   return r;
 }
 

@@ -2,6 +2,7 @@
 // Validity of a hex mesh (and of a planar quad mesh): is it a conforming, manifold,
 // positively oriented complex? The checks return a report instead of throwing so that a
 // researcher can see everything that is wrong at once; report.ok() is the yes/no answer.
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -70,8 +71,14 @@ struct HexValidityReport {
   std::string summary(Index base = 0) const;
 };
 
+// Called now and then while check_validity runs with (work done, all the work), in the check's
+// own units, one call at a time (from whichever thread did the work), `done` never decreasing
+// and equal to `total` at the last call: for a progress bar, the check taking seconds on
+// millions of hexes.
+using ValidityProgress = std::function<void(std::size_t done, std::size_t total)>;
+
 // Throws InvalidInput for a mesh of 2^28 hexes or more (the incidence is kept in 32 bits).
-HexValidityReport check_validity(const HexMesh& mesh);
+HexValidityReport check_validity(const HexMesh& mesh, const ValidityProgress& progress = {});
 
 // A quad mesh lying in the plane through its first node with normal `normal`.
 struct QuadValidityReport {

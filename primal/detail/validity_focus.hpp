@@ -15,6 +15,7 @@ namespace geode::primal::detail {
 // Jacobians and the probe are taken at flagged corners only (inverted_hexes: a non-positive
 // one there), and the boundary surface is made of the boundary quads with a flagged node. The
 // counts (V, E, F, C and the Euler characteristic) are the whole mesh's either way.
-HexValidityReport check_validity(const HexMesh& mesh, std::span<const char> focus);
+HexValidityReport check_validity(const HexMesh& mesh, std::span<const char> focus,
+                                 const ValidityProgress& progress = {});
 
 }  // namespace geode::primal::detail

@@ -83,6 +83,30 @@ TEST_CASE("validity: 3x3x3 block is a valid ball") {
   CHECK(r.summary().find("valid") != std::string::npos);
 }
 
+TEST_CASE("validity: progress rises to the whole work, and the report is the one without it") {
+  // 40^3 hexes: many of the check's parallel chunks (4096 hexes or nodes), so calls come from
+  // several threads and the count must still never go down.
+  HexMesh m = structured_hex_grid(40, 40, 40);
+  std::swap(m.hexes[100][0], m.hexes[100][1]);  // a finding, so that the reports say something
+  std::vector<std::pair<std::size_t, std::size_t>> calls;
+  const auto r = check_validity(
+      m, [&calls](std::size_t done, std::size_t total) { calls.emplace_back(done, total); });
+  const auto plain = check_validity(m);
+  CHECK(r.summary() == plain.summary());
+  CHECK(r.inverted_hexes == plain.inverted_hexes);
+  REQUIRE(calls.size() >= 3);
+  const std::size_t total = calls.front().second;
+  CHECK(total > 0);
+  for (std::size_t i = 0; i < calls.size(); ++i) {
+    CAPTURE(i);
+    CHECK(calls[i].second == total);
+    CHECK(calls[i].first <= total);
+    if (i > 0) CHECK(calls[i].first >= calls[i - 1].first);
+  }
+  CHECK(calls.back().first == total);
+  CHECK(calls[calls.size() / 2].first < total);  // not only told at the end
+}
+
 TEST_CASE("boundary_quads: outward, one per boundary face, with hex and local face") {
   const HexMesh m = structured_hex_grid(3, 3, 3);
   const auto quads = boundary_quads(m);
