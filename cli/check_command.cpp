@@ -68,12 +68,19 @@ Checked check_hexes(const primal::HexMesh& mesh, const primal::RealizabilityOpti
   c.analysable =
       v.out_of_range_hexes.empty() && v.repeated_node_hexes.empty() && !mesh.hexes.empty();
   if (!c.analysable) return c;
-  auto q = primal::hex_quality_report(mesh);
+  auto q = primal::hex_quality_report(mesh, {}, {}, primal::StdDevKind::kSample,
+                                      [&progress](std::size_t done, std::size_t total) {
+                                        progress.step("quality metrics", done, total);
+                                      });
   for (auto& metric : q.metrics) metric.min_hex += base, metric.max_hex += base;
   c.quality = primal::quality_report_json(q);
   c.quality_text = primal::format_quality_table(q);
   progress.stage_done("quality: " + std::to_string(q.metrics.size()) + " metrics");
-  c.obstructions = primal::find_obstructions(mesh, options);
+  primal::RealizabilityOptions shown = options;
+  shown.progress = [&progress](std::size_t done, std::size_t total) {
+    progress.share("of the realizability search done", done, total);
+  };
+  c.obstructions = primal::find_obstructions(mesh, shown);
   progress.stage_done(obstructions_line(c.obstructions));
   return c;
 }

@@ -51,8 +51,11 @@ void Progress::show(const std::string& what, std::size_t done, std::size_t total
     what_ = what;
     started_ = now;
     last_ = now;
+    finished_ = false;
   }
   const bool finished = done >= total;
+  if (finished && finished_) return;  // its end said (or passed) once
+  finished_ = finished;
   if (now - started_ < kDelay) return;  // short steps stay silent
   const auto seconds = std::chrono::duration_cast<std::chrono::seconds>(now - started_).count();
   if (terminal_) {

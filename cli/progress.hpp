@@ -38,6 +38,7 @@ class Progress {
   std::string what_;
   Clock::time_point started_{}, last_{}, stage_started_ = Clock::now();
   bool bar_drawn_ = false;
+  bool finished_ = false;  // the step has been told it is done
 };
 
 }  // namespace geode::cli

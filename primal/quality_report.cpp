@@ -55,7 +55,8 @@ MetricSummary summarize_metric(HexMetric metric, std::span<const double> q,
 }
 
 QualityReport hex_quality_report(const HexMesh& mesh, std::span<const Index> hexes,
-                                 std::span<const HexMetric> metrics, StdDevKind kind) {
+                                 std::span<const HexMetric> metrics, StdDevKind kind,
+                                 const MetricProgress& progress) {
   std::vector<Index> all;
   if (hexes.empty()) {
     all.resize(mesh.hexes.size());
@@ -79,6 +80,7 @@ QualityReport hex_quality_report(const HexMesh& mesh, std::span<const Index> hex
   report.num_hexes = index_cast(hexes.size());
   report.std_dev_kind = kind;
   std::vector<double> q(hexes.size());
+  if (progress) progress(0, chosen.size());
   for (HexMetric id : chosen) {
     const HexMetricInfo& info = hex_metric_info(id);
     // Hexes are independent: evaluated in parallel (TBB), each value in its own slot, so the
@@ -94,6 +96,7 @@ QualityReport hex_quality_report(const HexMesh& mesh, std::span<const Index> hex
                         }
                       });
     report.metrics.push_back(summarize_metric(id, q, hexes, kind));
+    if (progress) progress(report.metrics.size(), chosen.size());
   }
   return report;
 }

@@ -1,6 +1,8 @@
 #pragma once
 // Quality summaries of a hex mesh: per metric the average, standard deviation, minimum and
 // maximum over a set of hexes, printed like the CUBIT report of the paper's Table 1 or as JSON.
+#include <cstddef>
+#include <functional>
 #include <nlohmann/json_fwd.hpp>
 #include <span>
 #include <string>
@@ -30,12 +32,17 @@ struct QualityReport {
   std::vector<MetricSummary> metrics;  // in the order asked for
 };
 
+// Called with (metrics done, metrics) before the first metric and after each: for a progress
+// bar (about 0.6 s a metric on 5 million hexes).
+using MetricProgress = std::function<void(std::size_t done, std::size_t total)>;
+
 // Summary of `metrics` (default: every registered hex metric, registry order) over the hexes
 // numbered in `hexes` (default: all). Throws geode::InvalidInput on an empty selection or a
 // bad hex or node number.
 QualityReport hex_quality_report(const HexMesh& mesh, std::span<const Index> hexes = {},
                                  std::span<const HexMetric> metrics = {},
-                                 StdDevKind kind = StdDevKind::kSample);
+                                 StdDevKind kind = StdDevKind::kSample,
+                                 const MetricProgress& progress = {});
 
 // The summary of one metric from values already computed: values[i] belongs to hexes[i]
 // (hex numbers for min_hex / max_hex). Throws geode::InvalidInput when empty or the sizes differ.

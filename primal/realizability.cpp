@@ -210,13 +210,20 @@ class HexFinder {
       : mesh_(mesh), options_(options) {}
 
   std::vector<Obstruction> run() {
-    collect_faces();
-    find_patches();
-    find_doublets();
-    find_pinched_corners();
-    find_two_faces();
-    find_flat_corners();
-    find_two_quad_nodes();
+    // Each stage's share of the work, in percent as measured on 5.2 million hexes.
+    const auto stage = [this](auto&& run, std::size_t share) {
+      run();
+      done_ += share;
+      if (options_.progress) options_.progress(done_, 100);
+    };
+    if (options_.progress) options_.progress(0, 100);  // the start, from which a bar counts
+    stage([this] { collect_faces(); }, 37);
+    stage([this] { find_patches(); }, 6);
+    stage([this] { find_doublets(); }, 26);
+    stage([this] { find_pinched_corners(); }, 25);
+    stage([this] { find_two_faces(); }, 0);
+    stage([this] { find_flat_corners(); }, 6);
+    stage([this] { find_two_quad_nodes(); }, 0);
     std::vector<Obstruction> out;
     for (auto* list : {&doublets_, &pinched_, &two_faces_, &flat_, &two_quad_})
       out.insert(out.end(), list->begin(), list->end());
@@ -224,6 +231,7 @@ class HexFinder {
   }
 
  private:
+  std::size_t done_ = 0;                  // the stages' shares reported
   using FaceUse = std::pair<Index, int>;  // (hex, local face)
   struct Face {
     std::array<Index, 4> nodes{};  // as the first hex using it sees it

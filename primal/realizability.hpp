@@ -41,6 +41,8 @@
 // of its quads. For a template, pass `node_faces` instead: the faces of its box each node lies
 // on, as bits (templates::Template::node_faces), so the answer does not depend on where the
 // nodes currently are.
+#include <cstddef>
+#include <functional>
 #include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <string_view>
@@ -76,6 +78,10 @@ struct RealizabilityOptions {
   // replaces the geometric grouping when not empty. A boundary quad lies on face f when its
   // corners all do.
   std::vector<unsigned> node_faces;
+  // Called after each of the hex search's stages with (work done, all the work), in units of
+  // its own, `done` equal to `total` at the last call: for a progress bar (about 15 s on 5
+  // million hexes). May be empty; quad meshes do not call it.
+  std::function<void(std::size_t done, std::size_t total)> progress;
 };
 
 // The obstructions of the hexes as given, by kind (in enum order), then by first appearance.

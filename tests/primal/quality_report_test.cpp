@@ -6,6 +6,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <geode/primal/errors.hpp>
 #include <geode/primal/quality_report.hpp>
@@ -86,6 +88,23 @@ TEST_CASE("report statistics: average, sample and population std dev, min, max")
   // One hex: the sample std dev has no degrees of freedom and is reported as 0.
   const gp::Index one[] = {1};
   CHECK(find(gp::hex_quality_report(mesh, one), HexMetric::kSkew).std_dev == 0.0);
+}
+
+TEST_CASE("report progress: before the first metric and after each, the report the same") {
+  const gp::HexMesh m = three_hexes();
+  std::vector<std::pair<std::size_t, std::size_t>> told;
+  const auto r = gp::hex_quality_report(
+      m, {}, {}, gp::StdDevKind::kSample,
+      [&told](std::size_t done, std::size_t total) { told.emplace_back(done, total); });
+  const auto plain = gp::hex_quality_report(m);
+  REQUIRE(r.metrics.size() == plain.metrics.size());
+  for (std::size_t i = 0; i < r.metrics.size(); ++i)
+    CHECK(r.metrics[i].minimum == plain.metrics[i].minimum);
+  REQUIRE(told.size() == plain.metrics.size() + 1);
+  for (std::size_t i = 0; i < told.size(); ++i) {
+    CHECK(told[i].first == i);
+    CHECK(told[i].second == plain.metrics.size());
+  }
 }
 
 TEST_CASE("report table looks like the paper's Table 1") {

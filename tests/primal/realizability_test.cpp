@@ -146,6 +146,23 @@ TEST_CASE(
   CHECK(all.size() == 5);
 }
 
+TEST_CASE("realizability: progress from 0 to the whole search, the findings the same") {
+  std::vector<std::size_t> told;
+  RealizabilityOptions o;
+  o.progress = [&told](std::size_t done, std::size_t total) {
+    CHECK(total == 100);
+    told.push_back(done);
+  };
+  const HexMesh m = doublet_column().mesh;
+  const auto found = find_obstructions(m, o);
+  CHECK(found.size() == find_obstructions(m).size());
+  CHECK(!found.empty());
+  REQUIRE(told.size() >= 3);
+  CHECK(told.front() == 0);
+  CHECK(told.back() == 100);
+  CHECK(std::is_sorted(told.begin(), told.end()));
+}
+
 TEST_CASE("realizability: a face cut open at a tet split's centre pinches the centre") {
   // The face between the hexes at vertices 0 and 1 loses its contact: hex 1 gets its own copy
   // of the edge midpoint 01, at the same place. Both copies of the face are tangent to the same
