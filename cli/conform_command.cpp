@@ -142,7 +142,7 @@ std::string check_outputs(const ConformArgs& a) {
   } else if (!a.format.empty()) {
     throw InvalidInput("--format " + a.format + " needs -o FILE");
   }
-  if (!a.report.empty()) {
+  if (!a.report.empty() && a.report != "-") {  // "-": standard output, after the mesh
     if (file_extension(a.report) != ".json")
       throw InvalidInput(a.report + ": the report is JSON; name it *.json");
     check_output_path(a.report);
@@ -233,9 +233,13 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
   const bool valid = conform::result_valid(r);
   written = &r.model;
   const bool publish = valid || a.write_invalid;
+  // --report -: standard output carries the JSON report alone (for a pipe into jq), once the
+  // files are published; the summary goes to stderr.
+  const bool report_out = a.report == "-";
+  std::ostream& said = report_out ? std::cerr : std::cout;
   if (publish) {
     if (write_failed) std::rethrow_exception(write_failed);
-    if (!a.report.empty()) {
+    if (!a.report.empty() && !report_out) {
       files.add(a.report, [text = json_text(conform::report_json(r), 2)](const fs::path& temp) {
         write_or_print(temp.string(), [&](std::ostream& os) { os << text; });
       });
@@ -243,13 +247,14 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
   }
   // Everything for stdout before the files: commit() publishes nothing if it was lost (and
   // says so if the publishing fails after these lines).
-  if (!a.quiet) print_summary(r, std::cout, tables);
+  if (!a.quiet) print_summary(r, said, tables);
   if (!a.quiet && publish) {
-    if (!a.output.empty()) std::cout << "wrote " << a.output << "\n";
-    if (!a.report.empty()) std::cout << "wrote " << a.report << "\n";
-    std::cout << together_lines;
+    if (!a.output.empty()) said << "wrote " << a.output << "\n";
+    if (!a.report.empty() && !report_out) said << "wrote " << a.report << "\n";
+    said << together_lines;
   }
   if (publish) files.commit();
+  if (publish && report_out) std::cout << json_text(conform::report_json(r), 2) << std::flush;
   // Warnings of a valid result go to stderr, --quiet or not (an invalid one's are in its error).
   if (valid)
     for (const auto& w : r.warnings) std::cerr << "geode: warning: " << w << "\n";
@@ -273,7 +278,9 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
       ->check(CLI::IsMember(mesh_format_names()));
   add_encoding_options(c, a.encoding);
   c->add_option("--report", a.report,
-                "write a JSON report (counts, validity, quality per output block) to FILE.json");
+                "write a JSON report (counts, validity, quality per output block) to FILE.json;\n"
+                "- prints it on standard output once the mesh is written (the summary then goes\n"
+                "to stderr)");
   c->add_option(
        "--smooth", a.smooth,
        "worst-first smoothing; materials never move: nodes on the model boundary and between\n"

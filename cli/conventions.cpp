@@ -209,6 +209,13 @@ void check_output_path(const std::string& path) {
   const fs::path p(path);
   std::error_code ec;
   if (fs::is_directory(p, ec)) throw InvalidInput(path + ": is a directory, not an output file");
+  // A device or FIFO (/dev/null; /dev/stdout, a link to "pipe:[N]" when it is a pipe) gets the
+  // finished file copied into it (io/atomic_file.hpp): its own permission is what counts, and
+  // the temporary's directory, probed below.
+  const fs::file_status st = fs::status(p, ec);
+  const bool device = !ec && fs::exists(st) && !fs::is_regular_file(st);
+  if (device && ::access(p.c_str(), W_OK) != 0)
+    throw InvalidInput(path + ": exists and is not writable");
   // A symbolic link is written through (its temporary beside the file it names): that file's
   // directory is the one to check (a dangling link into a missing one failed after the work).
   fs::path real = p;
@@ -219,6 +226,10 @@ void check_output_path(const std::string& path) {
   }
   if (fs::is_symlink(real, ec))  // a loop: refused now, not after the work
     throw InvalidInput(path + ": too many levels of symbolic links");
+  if (device) {
+    io::remove_temporary(io::create_temporary(io::resolve_output(p), p.extension().string()));
+    return;
+  }
   const fs::path dir = real.parent_path().empty() ? fs::path(".") : real.parent_path();
   if (!fs::is_directory(dir, ec))
     throw InvalidInput(path + ": directory " + dir.string() +

@@ -172,8 +172,13 @@ void install_signal_cleanup() {
 }
 
 OutputTarget resolve_output(const fs::path& path) {
-  fs::path p = path;
   std::error_code ec;
+  // A device or FIFO is written where the path leads, however it gets there: /dev/stdout on a
+  // pipe is a link to "pipe:[N]", which names nothing in the file system.
+  if (const fs::file_status st = fs::status(path, ec);
+      !ec && fs::exists(st) && !fs::is_regular_file(st) && !fs::is_directory(st))
+    return OutputTarget{path, false};
+  fs::path p = path;
   int hops = 0;
   while (fs::is_symlink(p, ec)) {
     if (++hops > 40) throw InvalidInput(path.string() + ": too many levels of symbolic links");

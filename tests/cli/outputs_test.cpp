@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include <geode/io/gmsh.hpp>
 #include <geode/primal/grid_model.hpp>
 #include "support/cli_run.hpp"
@@ -163,4 +165,34 @@ TEST_CASE(
   CHECK(geode_cli(command).code == 0);
   for (const char* name : {"sh.csv", "sd.csv", "sq.csv", "sj.csv"})
     CHECK(slurp(dir.path / name).rfind("OLD", 0) != 0);
+}
+
+TEST_CASE("conform --report -: the JSON alone on standard output, after the mesh is written") {
+  TempDir dir;
+  const fs::path input = dir.path / "m.msh", mesh = dir.path / "out.vtk";
+  geode::io::write_gmsh(
+      geode::primal::grid_model({2, 2, 2}, 1.0, [](int i, int, int) { return i == 1; }), input);
+  const auto run = geode_cli("conform " + input.string() + " -o " + mesh.string() + " --report -");
+  CHECK(run.code == 0);
+  const auto j = nlohmann::json::parse(run.out);  // nothing but the report: the summary on stderr
+  CHECK(j.at("valid") == true);
+  CHECK(j.at("blocks").size() == 2);
+  CHECK(fs::file_size(mesh) > 0);
+  const auto both = geode_cli("conform " + input.string() + " --report - --quiet", true);
+  CHECK(both.code == 0);
+  CHECK(both.out.rfind("{", 0) == 0);  // --quiet, stderr kept: no summary, the report printed
+}
+
+TEST_CASE("an output linked to /dev/stdout, stdout a pipe: the mesh comes through the pipe") {
+  // A hunt's: the link's target, "pipe:[N]", was taken for a path (/proc/self/fd/pipe:[N]), and
+  // the run refused naming it. The pipe is a FIFO: the finished file is copied into it.
+  TempDir dir;
+  const fs::path input = dir.path / "m.msh", link = dir.path / "out.vtk";
+  geode::io::write_gmsh(
+      geode::primal::grid_model({2, 2, 2}, 1.0, [](int i, int, int) { return i == 1; }), input);
+  fs::create_symlink("/dev/stdout", link);
+  const auto run = geode_cli("conform " + input.string() + " -o " + link.string() + " --quiet");
+  CHECK(run.code == 0);
+  CHECK(run.out.rfind("# vtk DataFile Version", 0) == 0);
+  CHECK(fs::is_symlink(link));  // still the link
 }
