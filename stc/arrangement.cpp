@@ -154,21 +154,7 @@ Arrangement Engine::run() {
     for (auto& c : found) A.curves.push_back(std::move(c));
   }
   if (options_.progress) options_.progress(subsets.size(), subsets.size());
-  // A sheet in the domain on which no curve was traced (3D) meets no other sheet there: its
-  // pieces hold no vertex, so no dual element, and the dual would silently lack the sheet.
-  // (In 2D the curve is the sheet itself, refused below when no other sheet crosses it.)
-  for (int s = 0; s < m; ++s) {
-    bool traced = false;
-    for (const Curve& c : A.curves)
-      traced = traced || std::find(c.sheets.begin(), c.sheets.end(), s) != c.sheets.end();
-    if (traced) continue;
-    const std::vector<Point> on = seeds({s});
-    if (!on.empty())
-      throw TopologyError("arrangement: sheet " + name(s) + " passes through " +
-                          fmt_point(on.front(), dim_) +
-                          " but meets no other sheet inside the domain: a sheet with no "
-                          "vertex has no dual element");
-  }
+  check_lone_pieces(A.curves);
 
   // 2. Events along each curve, vertices, and 1-cells.
   struct RawEdge {

@@ -42,6 +42,92 @@ bool Engine::common_zero(const Equation& a, const Equation& b, Point& x) const {
   return false;
 }
 
+// A piece of a sheet on which no curve was traced (3D) meets no other sheet: it holds no vertex,
+// so no dual element, and the dual would silently lack it (a whole sheet, or a second piece of
+// one whose first piece crosses the others). The pieces are the sheet's cells of the seeding
+// grid (its field changing sign over the cell's corners) joined through faces, edges and
+// corners; a piece is met when a curve of the sheet passes within one cell of it. Like the
+// seeds, this takes the grid to resolve the sheet: a fold thinner than a cell could cut a piece
+// in two there (see the resolution limits in arrangement.hpp). (In 2D the curve is the sheet
+// itself, refused later when no other sheet crosses it.)
+void Engine::check_lone_pieces(const std::vector<Curve>& curves) const {
+  if (dim_ != 3) return;
+  const int ncell = cell_count();
+  const int m = primal::index_cast<int>(sheets_.size());
+  auto corner_id = [&](int i, int j, int k, int c) {
+    return grid_id(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1));
+  };
+  std::vector<int> piece(primal::index_cast<std::size_t>(ncell));
+  std::vector<char> met;
+  std::vector<int> stack;
+  for (int s = 0; s < m; ++s) {
+    const auto& val = grid_[primal::index_cast<std::size_t>(s)];
+    // -1: the sheet does not cross the cell; else its piece.
+    std::fill(piece.begin(), piece.end(), -2);
+    for (int k = 0; k < n_[2]; ++k)
+      for (int j = 0; j < n_[1]; ++j)
+        for (int i = 0; i < n_[0]; ++i) {
+          double lo = 1e300, hi = -1e300;
+          for (int c = 0; c < 8; ++c) {
+            const double v = val[corner_id(i, j, k, c)];
+            lo = std::min(lo, v), hi = std::max(hi, v);
+          }
+          piece[primal::index_cast<std::size_t>(cell_id(i, j, k))] =
+              lo <= 0.0 && hi >= 0.0 ? -2 : -1;  // -2: crossed, not yet in a piece
+        }
+    int pieces = 0;
+    for (int start = 0; start < ncell; ++start) {
+      if (piece[primal::index_cast<std::size_t>(start)] != -2) continue;
+      piece[primal::index_cast<std::size_t>(start)] = pieces;
+      stack.assign(1, start);
+      while (!stack.empty()) {
+        const int id = stack.back();
+        stack.pop_back();
+        const int i = id % n_[0], j = (id / n_[0]) % n_[1], k = id / (n_[0] * n_[1]);
+        for (int c = std::max(0, k - 1); c <= std::min(n_[2] - 1, k + 1); ++c)
+          for (int b = std::max(0, j - 1); b <= std::min(n_[1] - 1, j + 1); ++b)
+            for (int a = std::max(0, i - 1); a <= std::min(n_[0] - 1, i + 1); ++a) {
+              int& p = piece[primal::index_cast<std::size_t>(cell_id(a, b, c))];
+              if (p != -2) continue;
+              p = pieces;
+              stack.push_back(cell_id(a, b, c));
+            }
+      }
+      ++pieces;
+    }
+    // The pieces a curve of the sheet passes within one cell of.
+    met.assign(primal::index_cast<std::size_t>(pieces), 0);
+    for (const Curve& curve : curves) {
+      if (std::find(curve.sheets.begin(), curve.sheets.end(), s) == curve.sheets.end()) continue;
+      for (const Point& x : curve.polyline) {
+        const auto cell = cell_of(x);
+        for (int c = std::max(0, cell[2] - 1); c <= std::min(n_[2] - 1, cell[2] + 1); ++c)
+          for (int b = std::max(0, cell[1] - 1); b <= std::min(n_[1] - 1, cell[1] + 1); ++b)
+            for (int a = std::max(0, cell[0] - 1); a <= std::min(n_[0] - 1, cell[0] + 1); ++a)
+              if (const int p = piece[primal::index_cast<std::size_t>(cell_id(a, b, c))]; p >= 0)
+                met[primal::index_cast<std::size_t>(p)] = 1;
+      }
+    }
+    // An unmet piece inside the domain: a point of it, as seeds() finds one (a cell's centre
+    // projected onto the sheet).
+    for (int id = 0; id < ncell; ++id) {
+      const int p = piece[primal::index_cast<std::size_t>(id)];
+      if (p < 0 || met[primal::index_cast<std::size_t>(p)]) continue;
+      const int i = id % n_[0], j = (id / n_[0]) % n_[1], k = id / (n_[0] * n_[1]);
+      Point x = 0.5 * (grid_node(i, j, k) + grid_node(i + 1, j + 1, k + 1));
+      if (!project({s}, x) || !inside(x)) continue;
+      const bool any = std::any_of(curves.begin(), curves.end(), [s](const Curve& c) {
+        return std::find(c.sheets.begin(), c.sheets.end(), s) != c.sheets.end();
+      });
+      throw TopologyError("arrangement: sheet " + name(s) + " passes through " +
+                          fmt_point(x, dim_) + " but " +
+                          (any ? "that piece of it meets" : "meets") +
+                          " no other sheet inside the domain: a sheet piece with no vertex has "
+                          "no dual element");
+    }
+  }
+}
+
 // Sheets that touch without crossing leave no curve (3D) or no vertex (2D) behind, and a sheet
 // that touches the domain boundary no trace on it: nothing else notices them. Look where the
 // seeding grid says two zero sets come within about a cell of each other with nearly parallel

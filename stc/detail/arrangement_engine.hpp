@@ -227,6 +227,7 @@ class Engine {
   Curve trace(const std::vector<int>& S, const Point& x0) const;
   std::vector<Event> events(const Curve& c) const;
   void check_touching(const std::vector<Curve>& curves) const;
+  void check_lone_pieces(const std::vector<Curve>& curves) const;
   int register_vertex(std::vector<int> sheets, const Point& x);
   void check_vertex(const Vertex& v, const Eigen::MatrixXd& J) const;
 

@@ -212,3 +212,26 @@ TEST_CASE("arrangement: a sheet that meets no other sheet is refused by name") {
   all.push_back(sphere(Point(3, 3, 3), 0.5));
   CHECK(stc::dualize(stc::compute_arrangement(all, box)).hex.hexes.size() == 1);
 }
+
+// One sheet of two pieces: a sphere around the centre, crossed by the three planes, and a small
+// one inside an octant (the field the product of theirs). The second piece vanished from the dual
+// without a word where the first was crossed.
+TEST_CASE("arrangement: a second piece of a sheet that meets no other sheet is refused by name") {
+  const stc::Domain box{Point(0, 0, 0), Point(1, 1, 1), 3};
+  const std::vector<stc::Sheet> planes{plane(0, 0.5, "x"), plane(1, 0.5, "y"), plane(2, 0.5, "z")};
+  const auto ball = [](const Point& x, const Point& c, double r) { return (x - c).norm() - r; };
+  auto with = [&](stc::Sheet s) {
+    auto all = planes;
+    all.push_back(std::move(s));
+    return all;
+  };
+  const Point centre(0.5, 0.5, 0.5), off(0.2, 0.2, 0.2);
+  // The control: the crossed piece alone is a valid arrangement.
+  const auto one = with({"s", [&](const Point& x) { return ball(x, centre, 0.3); }, "sphere"});
+  CHECK(stc::dualize(stc::compute_arrangement(one, box)).hex.hexes.size() > 0);
+  const auto two = with(
+      {"s", [&](const Point& x) { return ball(x, centre, 0.3) * ball(x, off, 0.08); }, "spheres"});
+  const std::string d = diagnosis(two, box);
+  CHECK(d.find("sheet 's'") != std::string::npos);
+  CHECK(d.find("that piece of it meets no other sheet") != std::string::npos);
+}
