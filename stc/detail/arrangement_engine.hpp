@@ -69,8 +69,15 @@ class Engine {
     if (primal::index_cast<int>(sheets.size()) < dim_)
       throw InvalidInput("arrangement: needs at least as many sheets as dimensions");
     diag_ = (domain_.hi - domain_.lo).head(dim_).norm();
-    h_ = options_.step * diag_;
-    grad_h_ = 1e-6 * diag_;
+    // The tracing step and the gradient's difference step follow the diagonal, but at most
+    // 32 times the shortest side: in a slab or a needle (refine3 in a --box of aspect 80 and
+    // more) a step of the diagonal's 0.004 was a third of the short side, and curves there
+    // were missed. Boxes of aspect up to about 23 (all of conform's) are traced as before.
+    double shortest = diag_;
+    for (int a = 0; a < dim_; ++a) shortest = std::min(shortest, domain_.hi[a] - domain_.lo[a]);
+    const double scale = std::min(diag_, 32.0 * shortest);
+    h_ = options_.step * scale;
+    grad_h_ = 1e-6 * scale;
     tol_ = options_.tolerance * diag_;
   }
 

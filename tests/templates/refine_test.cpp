@@ -215,3 +215,18 @@ TEST_CASE("refine3: boxes down to the documented 1e-6 build the same templates")
     CHECK(primal::check_validity(T3.hex).euler == 1);
   }
 }
+
+// Slabs and needles: with the tracing step a fraction of the diagonal, curves in the short
+// directions were stepped over (exit 3 at aspect 80 and more); the step is now at most 32 times
+// the shortest side's fraction.
+TEST_CASE("refine3: slabs and needles up to aspect 200 build the template, valid") {
+  for (const Eigen::Vector3d& box : {Eigen::Vector3d(1, 200, 1), Eigen::Vector3d(200, 1, 200),
+                                     Eigen::Vector3d(0.14, 24, 0.14), Eigen::Vector3d(1, 100, 1)}) {
+    CAPTURE(box.transpose());
+    templates::RefineOptions o;
+    o.box = box;
+    const auto T3 = templates::build_refine3(o);
+    CHECK(T3.hex.hexes.size() == 13);
+    CHECK(primal::check_validity(T3.hex).ok());
+  }
+}
