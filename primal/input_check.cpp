@@ -933,6 +933,76 @@ std::string twin_node_hint(const Model& model, std::span<const ElementRef> eleme
   return {};
 }
 
+// Where two of the elements at a non-manifold edge or node have faces through it (`at`: the
+// edge's two nodes, or the node) lying against each other with other nodes (planes within a tenth
+// of the faces' size, outward normals opposed): "; hint: ..." saying the interface between them
+// does not conform, else nothing. Parts meshed separately and then merged (--merge-tolerance)
+// share their boundary nodes but not their faces: the tets' triangles do not split the hexes'
+// quads, and the check can only call that a non-manifold boundary.
+std::string nonconforming_hint(const Model& model, std::span<const ElementRef> elements,
+                               std::span<const Index> at) {
+  if (elements.size() < 2) return {};
+  struct Face {
+    std::vector<Index> nodes;
+    Point normal, centre;
+    double size = 0.0;
+  };
+  const auto faces_through = [&](ElementRef e) {
+    std::vector<Face> out;
+    const auto& topo = cell_topology(e.kind);
+    const auto cs = element_corners(model, e);
+    for (int f = 0; f < topo.faces; ++f) {
+      const auto& cf = topo.face[index_cast<std::size_t>(f)];
+      Face face;
+      for (int i = 0; i < cf.size; ++i)
+        face.nodes.push_back(cs[index_cast<std::size_t>(cf.corners[index_cast<std::size_t>(i)])]);
+      if (!std::all_of(at.begin(), at.end(), [&](Index v) {
+            return std::find(face.nodes.begin(), face.nodes.end(), v) != face.nodes.end();
+          }))
+        continue;
+      // Newell's normal (outward: the faces' corners run outward), the centre, the size.
+      face.normal = Point::Zero();
+      face.centre = Point::Zero();
+      for (std::size_t i = 0; i < face.nodes.size(); ++i) {
+        const Point& p = model.points[index_cast<std::size_t>(face.nodes[i])];
+        const Point& q =
+            model.points[index_cast<std::size_t>(face.nodes[(i + 1) % face.nodes.size()])];
+        face.normal += p.cross(q);
+        face.centre += p;
+        face.size = std::max(face.size, (q - p).norm());
+      }
+      face.centre /= static_cast<double>(face.nodes.size());
+      if (!(face.normal.norm() > 0.0)) continue;
+      face.normal.normalize();
+      out.push_back(std::move(face));
+    }
+    return out;
+  };
+  for (std::size_t i = 0; i < elements.size(); ++i)
+    for (std::size_t j = i + 1; j < elements.size(); ++j)
+      for (const Face& a : faces_through(elements[i]))
+        for (const Face& b : faces_through(elements[j])) {
+          auto sa = a.nodes, sb = b.nodes;
+          std::sort(sa.begin(), sa.end());
+          std::sort(sb.begin(), sb.end());
+          const double reach = 0.1 * std::min(a.size, b.size);
+          if (sa == sb || a.normal.dot(b.normal) > -0.95 ||
+              std::abs(a.normal.dot(b.centre - a.centre)) > reach ||
+              std::abs(b.normal.dot(a.centre - b.centre)) > reach)
+            continue;
+          const auto named = [&](ElementRef e, const Face& f) {
+            return std::string(cell_topology(e.kind).name) + " " +
+                   std::to_string(element_id(model, e)) + "'s " +
+                   (f.nodes.size() == 4 ? "quad" : "triangle");
+          };
+          return "; hint: " + named(elements[i], a) + " and " + named(elements[j], b) +
+                 " lie against each other here on other nodes: the interface does not conform, "
+                 "as when parts are meshed separately (in Gmsh, fragment the volumes before "
+                 "meshing, gmsh.model.occ.fragment, so that they share the interface's mesh)";
+        }
+  return {};
+}
+
 }  // namespace
 
 std::string InputFinding::text(const Model& model) const {
@@ -968,7 +1038,12 @@ std::string InputFinding::text(const Model& model) const {
              through +
              "; the model touches itself there: elements meeting the rest of it only "
              "along this edge, or faces not matched node for node)" +
-             twin_node_hint(model, elements);
+             [&] {
+               std::string hint = twin_node_hint(model, elements);
+               return hint.empty() ? nonconforming_hint(model, elements,
+                                                        std::array<Index, 2>{node, edge_end})
+                                   : hint;
+             }();
     }
     case InputFault::kNonManifoldNode:
       return "the boundary is not a manifold at " + describe_node(model, node) + ": " +
@@ -976,7 +1051,11 @@ std::string InputFinding::text(const Model& model) const {
              named(0) + " and " + named(1) +
              "; the model touches itself there: elements meeting the rest of it only at this "
              "node, or faces not matched node for node)" +
-             twin_node_hint(model, elements);
+             [&] {
+               std::string hint = twin_node_hint(model, elements);
+               return hint.empty() ? nonconforming_hint(model, elements, std::array<Index, 1>{node})
+                                   : hint;
+             }();
     case InputFault::kFoldedNode:
       return "the elements around " + describe_node(model, node) + " (" + named(0) +
              " among them) cover its neighbourhood " + number(measure) +

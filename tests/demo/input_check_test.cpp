@@ -23,7 +23,10 @@
 #include <thread>
 #include <vector>
 
+#include <gmsh.h>
+
 #include <geode/demo/demo_models.hpp>
+#include <geode/demo/gmsh_session.hpp>
 #include <geode/io/formats.hpp>
 #include <geode/io/read_model.hpp>
 #include <geode/primal/element_graph.hpp>
@@ -651,4 +654,45 @@ TEST_CASE(
   CHECK(m.points[primal::index_cast<std::size_t>(r.findings[0].node)].x() ==
         1.0);  // on the interface
   refused_by_conform(m, "hanging", {"not a manifold", "not matched node for node"}, dir, 3);
+}
+
+TEST_CASE("input check: parts meshed separately, their nodes merged: the interface named as such") {
+  // A hex box and a tet box meshed by Gmsh without fragmenting the geometry (a user's usual slip):
+  // once --merge-tolerance merges their interface nodes, the tets' triangles still do not split
+  // the hexes' quads (Gmsh triangulates the tet box's face on its own), which the check sees as a
+  // non-manifold boundary; the message says the interface does not conform and how to mesh it.
+  primal::Model m;
+  {
+    demo::GmshSession session;
+    const int a = gmsh::model::occ::addBox(0, 0, 0, 1, 1, 1);
+    const int b = gmsh::model::occ::addBox(1, 0, 0, 1, 1, 1);
+    gmsh::model::occ::synchronize();
+    gmsh::vectorpair curves;
+    gmsh::model::getEntities(curves, 1);
+    for (const auto& [dim, tag] : curves) gmsh::model::mesh::setTransfiniteCurve(tag, 4);
+    gmsh::vectorpair faces;
+    gmsh::model::getBoundary({{3, a}}, faces, false, false);
+    for (const auto& [dim, tag] : faces) {
+      gmsh::model::mesh::setTransfiniteSurface(tag);
+      gmsh::model::mesh::setRecombine(2, tag);
+    }
+    gmsh::model::mesh::setTransfiniteVolume(a);
+    gmsh::model::addPhysicalGroup(3, {a}, 1);
+    gmsh::model::addPhysicalGroup(3, {b}, 2);
+    gmsh::option::setNumber("Mesh.MeshSizeMax", 0.3);
+    gmsh::model::mesh::generate(3);
+    m = demo::model_from_gmsh("separate");
+  }
+  REQUIRE(!m.hexes.empty());
+  REQUIRE(!m.tets.empty());
+  CHECK(primal::merge_coincident_nodes(m, 1e-9) > 0);
+  const primal::InputCheckResult r = primal::check_input(m);
+  REQUIRE(!r.ok());
+  CHECK(r.findings[0].topological());
+  const std::string text = r.findings[0].text(m);
+  INFO(text);
+  CHECK(text.find("the interface does not conform") != std::string::npos);
+  CHECK(text.find("gmsh.model.occ.fragment") != std::string::npos);
+  // The hint names a hex's quad and a tet's triangle.
+  CHECK(text.find("'s quad and tet ") != std::string::npos);
 }
