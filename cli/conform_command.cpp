@@ -24,6 +24,7 @@
 #include <geode/primal/quality.hpp>
 #include <geode/primal/quality_report.hpp>
 #include <geode/primal/topology.hpp>
+#include <geode/primal/unfold.hpp>
 #include "cli/commands.hpp"
 #include "cli/conventions.hpp"
 #include "cli/demo_module.hpp"
@@ -47,6 +48,7 @@ struct ConformArgs {
   std::string model = "half";
   std::string save_input;
   double merge_tolerance = -1;  // < 0: no merging
+  bool unfold = false;          // --unfold: tets a mesher folded turned back
   double buffer_thickness = 0;  // 0: the side's default
   double feature_thickness = conform::BufferLayerOptions{}.feature_thickness;
   std::string buffer_side;  // empty: automatic (conform::set_buffer_side)
@@ -129,6 +131,15 @@ Eigen::Vector3d template_box(const std::string& text) {
   return {b[0], b[1], b[2]};
 }
 
+// The covering check's options: a fold's refusal points at --unfold unless it was given.
+primal::InputCheckOptions fold_hint(const ConformArgs& a) {
+  primal::InputCheckOptions o;
+  if (!a.unfold)
+    o.fold_hint =
+        " (a mesher's fold: --unfold turns such tets back, or mesh again at another size)";
+  return o;
+}
+
 // The output paths and format, checked before any work: names, directories, format agreement.
 std::string check_outputs(const ConformArgs& a) {
   if (!a.template_box.empty()) template_box(a.template_box);  // a usage error, before the work
@@ -171,9 +182,26 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
     }
     const primal::Index merged = primal::merge_coincident_nodes(model, a.merge_tolerance);
     progress.stage("merged " + std::to_string(merged) + " coincident nodes");
-    // Read without the covering check (duplicated interface nodes look like a gap): run here.
-    if (!source.empty()) primal::require_single_covering(model, source);
   }
+  if (a.unfold) {
+    const primal::UnfoldResult u = primal::unfold_tets(model);
+    if (u.unfolded()) {
+      // The analyst's mesh changed: said whatever --quiet says.
+      std::string ids;
+      for (std::size_t i = 0; i < u.moved.size() && i < 10; ++i)
+        ids += (i ? " " : "") + std::to_string(primal::node_id(model, u.moved[i]));
+      const bool one = u.moved.size() == 1;
+      std::cerr << "geode: warning: " << prefix << "--unfold: " << u.turned.size()
+                << (one ? " tet" : " tets") << " folded over " << (one ? "its" : "their")
+                << " neighbours turned back, node" << (one ? " " : "s ") << ids
+                << (u.moved.size() > 10 ? " ..." : "") << " moved into " << (one ? "its" : "their")
+                << " tets (by at most " << primal::number_text(u.farthest) << ")\n";
+    }
+  }
+  // Read without the covering check where nodes are merged (duplicated interface nodes look
+  // like a gap) or folds mended: run here.
+  if (!source.empty() && (a.merge_tolerance >= 0 || a.unfold))
+    primal::require_single_covering(model, source, fold_hint(a));
   conform::ConformOptions opts;
   opts.smooth = conform::parse_conform_smooth(a.smooth);
   opts.pyramids = conform::parse_conform_pyramids(a.pyramids);
@@ -328,6 +356,11 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
                 "first merge nodes closer than this distance (model units), for parts meshed\n"
                 "separately whose interface nodes are duplicated")
       ->check(number_check(0, 1e300));
+  c->add_flag("--unfold", a.unfold,
+              "turn back tets a mesher folded over their neighbours (Gmsh 4.8 near its\n"
+              "pyramids: a tet written positive lying on the same side of its faces as every\n"
+              "neighbour) and move one free node of each into its tets; only where that mends\n"
+              "every fold; warns naming the nodes moved");
   c->add_option(
        "--pyramids", a.pyramids,
        "what pyramids of a hybrid mesh become: split (default): two tets along the base diagonal\n"
@@ -412,7 +445,8 @@ void add_conform_commands(CLI::App& app) {
       templates = conform::build_reference_templates_ahead(
           args->template_box.empty() ? conform::ConformOptions{}.template_box
                                      : template_box(args->template_box));
-    primal::Model model = io::read_model(args->input, {}, args->merge_tolerance < 0);
+    primal::Model model = io::read_model(
+        args->input, {}, args->merge_tolerance < 0 && !args->unfold, nullptr, fold_hint(*args));
     join_block_lists(model, args->join_blocks, args->input);
     run(std::move(model), *args, format, false, args->input);
   });

@@ -1094,7 +1094,11 @@ void require_single_covering(const Model& model, std::string_view source,
   one.max_findings = 1;
   const InputCheckResult r = check_input(model, one);
   if (r.ok()) return;
-  const std::string what = std::string(source) + ": " + r.findings[0].text(model);
+  const InputFault fault = r.findings[0].fault;
+  const std::string what =
+      std::string(source) + ": " + r.findings[0].text(model) +
+      (fault == InputFault::kSameSideFace || fault == InputFault::kFoldedNode ? options.fold_hint
+                                                                              : "");
   if (r.findings[0].topological()) throw TopologyError(what);
   throw InvalidInput(what);
 }

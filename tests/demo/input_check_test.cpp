@@ -13,6 +13,7 @@
 #include <array>
 #include <barrier>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <map>
@@ -33,6 +34,7 @@
 #include <geode/primal/errors.hpp>
 #include <geode/primal/input_check.hpp>
 #include <geode/primal/submodel.hpp>
+#include <geode/primal/unfold.hpp>
 #include "support/cli_run.hpp"
 #include "support/demo_input.hpp"
 #include "support/temp_dir.hpp"
@@ -695,4 +697,130 @@ TEST_CASE("input check: parts meshed separately, their nodes merged: the interfa
   CHECK(text.find("gmsh.model.occ.fragment") != std::string::npos);
   // The hint names a hex's quad and a tet's triangle.
   CHECK(text.find("'s quad and tet ") != std::string::npos);
+}
+
+namespace {
+
+// A hex ring (an annulus of radii 0.5 and 1, recombined and swept 0.5 in n layers) in a tet box
+// [-2, 2]^2 x [-1, 1], meshed by Gmsh in one generate(3) with the built-in kernel, as a user
+// scripts it (the box's boundary the outer shell of the tet volume, the ring's its hole): Gmsh
+// puts pyramids on the ring's quads, and Debian's 4.8 folds tets near them (at n = 3 one tet;
+// most sizes tried fold somewhere).
+primal::Model gmsh_ring(int n) {
+  demo::GmshSession session;
+  namespace geo = gmsh::model::geo;
+  const double ring_size = 1.0 / n, box_size = 1.5 / n;
+  const auto circle = [&](double r) {
+    const int c = geo::addPoint(0, 0, -0.25, ring_size);
+    std::vector<int> p, arcs;
+    for (int i = 0; i < 4; ++i)
+      p.push_back(
+          geo::addPoint(r * std::cos(i * M_PI / 2), r * std::sin(i * M_PI / 2), -0.25, ring_size));
+    for (int i = 0; i < 4; ++i) {
+      arcs.push_back(geo::addCircleArc(p[static_cast<std::size_t>(i)], c,
+                                       p[static_cast<std::size_t>((i + 1) % 4)]));
+      geo::mesh::setTransfiniteCurve(arcs.back(), 2 * n + 1);
+    }
+    return geo::addCurveLoop(arcs);
+  };
+  const int outer = circle(1.0), inner = circle(0.5);
+  const int annulus = geo::addPlaneSurface({outer, inner});
+  geo::mesh::setRecombine(2, annulus);
+  gmsh::vectorpair swept;
+  geo::extrude({{2, annulus}}, 0, 0, 0.5, swept, {n}, {}, true);
+  int ring = 0;
+  std::vector<int> ring_faces{annulus};
+  for (const auto& [dim, tag] : swept) {
+    if (dim == 3) ring = tag;
+    if (dim == 2) ring_faces.push_back(tag);
+  }
+  // The box: corners (x, y, z) in {-2, 2}^2 x {-1, 1}, corner c at bits (x, y, z) = (c & 1,
+  // c & 2, c & 4), its six faces by their corners in cycle.
+  std::vector<int> corner;
+  for (int c = 0; c < 8; ++c)
+    corner.push_back(geo::addPoint(c & 1 ? 2 : -2, c & 2 ? 2 : -2, c & 4 ? 1 : -1, box_size));
+  std::map<std::pair<int, int>, int> lines;
+  const auto line = [&](int a, int b) {
+    if (const auto it = lines.find({b, a}); it != lines.end()) return -it->second;
+    if (const auto it = lines.find({a, b}); it != lines.end()) return it->second;
+    return lines[{a, b}] = geo::addLine(corner[static_cast<std::size_t>(a)],
+                                        corner[static_cast<std::size_t>(b)]);
+  };
+  std::vector<int> box_faces;
+  for (const std::array<int, 4> f : {std::array<int, 4>{0, 1, 3, 2},
+                                     {4, 5, 7, 6},
+                                     {0, 1, 5, 4},
+                                     {1, 3, 7, 5},
+                                     {3, 2, 6, 7},
+                                     {2, 0, 4, 6}}) {
+    std::vector<int> loop;
+    for (int i = 0; i < 4; ++i)
+      loop.push_back(
+          line(f[static_cast<std::size_t>(i)], f[static_cast<std::size_t>((i + 1) % 4)]));
+    box_faces.push_back(geo::addPlaneSurface({geo::addCurveLoop(loop)}));
+  }
+  const int potting =
+      geo::addVolume({geo::addSurfaceLoop(box_faces), geo::addSurfaceLoop(ring_faces)});
+  geo::synchronize();
+  gmsh::model::addPhysicalGroup(3, {ring}, 1);
+  gmsh::model::addPhysicalGroup(3, {potting}, 2);
+  gmsh::model::mesh::generate(3);
+  return demo::model_from_gmsh("ring");
+}
+
+}  // namespace
+
+TEST_CASE("--unfold: the tets Gmsh folds near its pyramids turned back, the ring conformed") {
+  test::TempDir dir;
+  const primal::Model folded = gmsh_ring(3);
+  REQUIRE(!folded.pyramids.empty());
+  const primal::InputCheckResult before = primal::check_input(folded);
+  REQUIRE(!before.ok());
+  CHECK(before.findings[0].fault == InputFault::kSameSideFace);
+
+  primal::Model m = folded;
+  const primal::UnfoldResult u = primal::unfold_tets(m);
+  REQUIRE(u.unfolded());
+  CHECK(u.turned.size() == u.moved.size());
+  CHECK(primal::check_input(m).ok());
+  REQUIRE_NOTHROW(primal::check_geometry(m, "unfolded"));  // every element positive
+  // Only the moved nodes moved, by less than the box's mesh size; the turned tets' node order
+  // is the only change to the elements.
+  std::size_t moved = 0;
+  for (std::size_t v = 0; v < m.points.size(); ++v)
+    if (m.points[v] != folded.points[v]) {
+      ++moved;
+      CHECK(std::find(u.moved.begin(), u.moved.end(), primal::index_cast(v)) != u.moved.end());
+      CHECK((m.points[v] - folded.points[v]).norm() < 0.5);
+    }
+  CHECK(moved == u.moved.size());
+  CHECK(m.hexes == folded.hexes);
+  CHECK(m.pyramids == folded.pyramids);
+  std::size_t changed = 0;
+  for (std::size_t t = 0; t < m.tets.size(); ++t) changed += m.tets[t] != folded.tets[t];
+  CHECK(changed == u.turned.size());
+
+  // The command: refused with the hint, conformed with --unfold (a warning naming the nodes).
+  const auto in = dir.path / "ring.msh", out = dir.path / "ring.exo";
+  io::write_model(folded, in);
+  const auto refused = test::geode_cli("conform " + in.string() + " -o " + out.string(), true);
+  CHECK(refused.code == 2);
+  CHECK(refused.out.find("--unfold turns such tets back") != std::string::npos);
+  const auto run =
+      test::geode_cli("conform " + in.string() + " -o " + out.string() + " --unfold --quiet", true);
+  INFO(run.out);
+  CHECK(run.code == 0);
+  CHECK(run.out.find("--unfold: " + std::to_string(u.turned.size())) != std::string::npos);
+  CHECK(std::filesystem::exists(out));
+
+  // A fault --unfold does not mend (one tet twice) leaves the model as it was.
+  primal::Model twice = folded;
+  twice.tets.push_back(twice.tets.front());
+  if (!twice.tet_block.empty()) twice.tet_block.push_back(twice.tet_block.front());
+  if (!twice.tet_ids.empty())
+    twice.tet_ids.push_back(*std::max_element(twice.tet_ids.begin(), twice.tet_ids.end()) + 1);
+  const primal::Model kept = twice;
+  CHECK(!primal::unfold_tets(twice).unfolded());
+  CHECK(twice.points == kept.points);
+  CHECK(twice.tets == kept.tets);
 }
