@@ -7,12 +7,14 @@
 #include <cmath>
 #include <exception>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <geode/demo/detail/model_building.hpp>
 #include <geode/primal/errors.hpp>
 #include <geode/primal/input_check.hpp>
+#include <geode/primal/unfold.hpp>
 
 namespace geode::demo {
 
@@ -63,6 +65,7 @@ Model hybrid_gmsh(const std::string& name, F&& build) {
     gmsh::model::add(name);
     build();
     std::string refused;
+    std::optional<Model> first;  // the first mesh refused, kept for unfold_tets
     for (const double factor : kRemeshFactors) {
       gmsh::option::setNumber("Mesh.MeshSizeFactor", factor);
       gmsh::model::mesh::clear();
@@ -88,8 +91,11 @@ Model hybrid_gmsh(const std::string& name, F&& build) {
         return m;
       } catch (const InvalidInput& e) {
         refused = e.what();
+        if (!first) first = std::move(m);
       }
     }
+    // Folded at every size: the first mesh's folds turned back, as conform --unfold does.
+    if (first && unfold_tets(*first).unfolded()) return std::move(*first);
     throw InvalidInput(refused + " (with the tet sizes 0.98 to 1.02 times the model's too)");
   });
 }
