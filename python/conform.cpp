@@ -15,6 +15,7 @@
 #include <geode/demo/demo_models.hpp>
 #include <geode/primal/input_check.hpp>
 #include <geode/primal/model.hpp>
+#include <geode/primal/unfold.hpp>
 #include "python/arrays.hpp"
 
 namespace geode::python {
@@ -132,7 +133,7 @@ py::dict conform_arrays(const py::handle& points, const py::dict& cells,
                         const std::string& quality, const std::string& geode_block,
                         const std::string& buffer_side, double buffer_thickness,
                         double smooth_target, const py::object& template_box,
-                        const py::object& merge_tolerance, const std::string& relax) {
+                        const py::object& merge_tolerance, const std::string& relax, bool unfold) {
   primal::Model model;
   model.points = to_points(points, source + ": points", false);
   for (const KindKeys& keys : kKindKeys) add_cells(model, keys, cells, source);
@@ -216,6 +217,7 @@ py::dict conform_arrays(const py::handle& points, const py::dict& cells,
   }
   conform::ConformResult r;
   Index merged = 0;
+  std::vector<Index> moved;  // by unfold
   {
     py::gil_scoped_release free;
     if (merge) {
@@ -226,9 +228,16 @@ py::dict conform_arrays(const py::handle& points, const py::dict& cells,
       }
       merged = primal::merge_coincident_nodes(model, *merge);
     }
+    primal::UnfoldResult unfolded;
+    if (unfold) unfolded = primal::unfold_tets(model);  // as --unfold
     // The read-time check of a file (after merging: duplicated nodes look like a gap), which
     // local verification, the default, takes as given; its messages name the source.
-    primal::require_single_covering(model, source);
+    primal::InputCheckOptions checked;
+    if (!unfold)
+      checked.fold_hint =
+          " (a mesher's fold: unfold=True turns such tets back, or mesh again at another size)";
+    primal::require_single_covering(model, source, checked);
+    moved = std::move(unfolded.moved);
     try {
       r = conform::conform(std::move(model), opts);  // the hints below read what is left
     } catch (const InvalidInput& e) {
@@ -245,6 +254,7 @@ py::dict conform_arrays(const py::handle& points, const py::dict& cells,
       d["valid"].cast<bool>() ? std::string() : source + ": " + conform::invalid_reason(r);
   d["report"] = to_python(conform::report_json(r));
   d["merged_nodes"] = merged;
+  d["unfolded_nodes"] = moved;
   d["model"] = model_dict(std::move(r.model));
   return d;
 }
@@ -256,7 +266,7 @@ void bind_conform(py::module_& m) {
         py::arg("node_sets"), py::arg("tagged"), py::arg("source"), py::arg("smooth"),
         py::arg("quality"), py::arg("geode_block"), py::arg("buffer_side"),
         py::arg("buffer_thickness"), py::arg("smooth_target"), py::arg("template_box"),
-        py::arg("merge_tolerance"), py::arg("relax"));
+        py::arg("merge_tolerance"), py::arg("relax"), py::arg("unfold"));
   m.def(
       "_demo_model",
       [](const std::string& name, int n) {

@@ -242,7 +242,7 @@ def _model_to_meshio(model, cell_data_extra=None):
 
 def conform(mesh=None, *, points=None, cells=None, cell_blocks=None, name="mesh", smooth="local", quality="sj",
             geode_block="", buffer_side=None, buffer_thickness=0.0, smooth_target=0.0, template_box=None,
-            merge_tolerance=None, relax="interface", allow_invalid=False):
+            merge_tolerance=None, relax="interface", unfold=False, allow_invalid=False):
     """Conform a model of hexes, tets, pyramids and wedges into one valid all-hex mesh, as
     `geode conform` does.
 
@@ -256,7 +256,8 @@ def conform(mesh=None, *, points=None, cells=None, cell_blocks=None, name="mesh"
     order (a wedge in VTK's mirrored order, a pyramid's base clockwise) is inverted and raises
     InputError naming it by its 1-based position among the cells (a .msh file's element tag).
     The options are those of `geode conform` (buffer_side=None: not given, hex or tet as
-    `geode conform` chooses without --buffer-side).
+    `geode conform` chooses without --buffer-side; unfold=True as --unfold, the report's
+    "unfolded_nodes" then the 0-based nodes moved).
     Returns (meshio.Mesh, report): the output with one cell block and one cell set per block,
     block ids as gmsh:physical, node sets as point sets; the report as `--report` writes it,
     with "side_sets" ([{id, name, sides: K x 2 (hex, local face)}]). Hexes (the sides', each
@@ -266,7 +267,8 @@ def conform(mesh=None, *, points=None, cells=None, cell_blocks=None, name="mesh"
     """
     pts, arrays, names, node_sets, tagged = _model_arrays(mesh, points, cells, cell_blocks, name)
     out = _geode._conform(pts, arrays, names, node_sets, tagged, name, smooth, quality, geode_block, buffer_side or "",
-                          float(buffer_thickness), float(smooth_target), template_box, merge_tolerance, relax)
+                          float(buffer_thickness), float(smooth_target), template_box, merge_tolerance, relax,
+                          bool(unfold))
     if not out["valid"] and not allow_invalid:
         raise InvalidResultError(out["invalid_reason"] + " (nothing returned; allow_invalid=True returns it anyway)")
     model = out["model"]
@@ -279,6 +281,7 @@ def conform(mesh=None, *, points=None, cells=None, cell_blocks=None, name="mesh"
                             "sides": _np.column_stack([new_index[s["sides"][:, 0]], s["sides"][:, 1]])
                             if len(s["sides"]) else s["sides"]} for s in model["side_sets"]]
     report["merged_nodes"] = out["merged_nodes"]
+    report["unfolded_nodes"] = list(out["unfolded_nodes"])
     return _model_to_meshio(model), report
 
 

@@ -1,5 +1,8 @@
 """geode.conform on meshio meshes and arrays, against `geode demo` / `geode conform`."""
 import json
+import pathlib
+import subprocess
+import sys
 
 import meshio
 import numpy as np
@@ -225,3 +228,22 @@ def test_gmsh_physical_points_curves_and_surfaces_are_the_commands_sets(tmp_path
     out, report = geode.conform(meshio.read(path))
     assert {name: len(nodes) for name, nodes in out.point_sets.items()} == cli_nodes
     assert {s["name"]: len(s["sides"]) for s in report["side_sets"]} == cli_sides
+
+
+
+def test_unfold_turns_back_the_tets_gmsh_folds_as_the_command_does(tmp_path):
+    # Made by the script a user would run, in a process of its own (libgmsh is not finalized in
+    # this one: the demo models use it).
+    path = tmp_path / "ring.msh"
+    script = pathlib.Path(__file__).resolve().parent.parent / "conform" / "ring_model.py"
+    subprocess.run([sys.executable, str(script), str(path), "3"], check=True)
+    mesh = meshio.read(path)
+    with pytest.raises(geode.InputError) as e:
+        geode.conform(mesh, name=path.name)
+    assert "the mesh folds over itself there" in str(e.value) and "unfold=True" in str(e.value)
+    out, report = geode.conform(mesh, name=path.name, unfold=True)
+    assert report["valid"] and report["unfolded_nodes"]
+    assert geode.check(out.points, hexes_of(out))["valid"]
+    cli = run_cli("conform", path.name, "-o", "out.exo", "--unfold", "--report", "r.json", cwd=tmp_path)
+    assert "--unfold: " in cli.stderr
+    assert json.loads((tmp_path / "r.json").read_text())["output"] == report["output"]
