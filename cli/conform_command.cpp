@@ -3,6 +3,7 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
+#include <chrono>
 #include <exception>
 #include <filesystem>
 #include <iostream>
@@ -184,7 +185,11 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
     progress.stage("merged " + std::to_string(merged) + " coincident nodes");
   }
   if (a.unfold) {
+    const auto started = std::chrono::steady_clock::now();
     const primal::UnfoldResult u = primal::unfold_tets(model);
+    progress.stage(stage_line(
+        "unfold: " + std::to_string(u.turned.size()) + " folded tets turned back",
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count()));
     if (u.unfolded()) {
       // The analyst's mesh changed: said whatever --quiet says.
       std::string ids;

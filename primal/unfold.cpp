@@ -106,10 +106,28 @@ UnfoldResult unfold_tets(Model& model) {
         if (e.kind == ElementKind::kTet) work.push_back(e.index);
   if (work.empty()) return none;
 
-  // Every element's triangles (a quad face is no tet's) with the elements using them, each in the
-  // cyclic order that element gives it; per node: on a boundary face, elements other than tets,
-  // blocks.
+  // Near the folds (their tets' nodes and three rings of elements around them, so that each
+  // node moved has its whole star and each tet turned its neighbours'): every element's
+  // triangles (a quad face is no tet's) with the elements using them, each in the cyclic order
+  // that element gives it; per node: on a boundary face, elements other than tets, blocks.
   const std::size_t nv = model.points.size();
+  std::vector<char> near(nv, 0);
+  for (Index t : work)
+    for (Index v : model.tets[index_cast<std::size_t>(t)]) near[index_cast<std::size_t>(v)] = 1;
+  const auto touches = [&](std::span<const Index> cs) {
+    return std::any_of(cs.begin(), cs.end(),
+                       [&](Index v) { return near[index_cast<std::size_t>(v)] == 1; });
+  };
+  for (int ring = 0; ring < 3; ++ring) {
+    for (ElementKind kind : kElementKinds)
+      for (std::size_t i = 0; i < element_count(model, kind); ++i) {
+        const auto cs = element_corners(model, {kind, index_cast(i)});
+        if (touches(cs))
+          for (Index v : cs)
+            if (!near[index_cast<std::size_t>(v)]) near[index_cast<std::size_t>(v)] = 2;
+      }
+    for (char& c : near) c = c ? 1 : 0;
+  }
   struct Use {
     ElementRef element;
     Triangle cycle;  // as the element orders it (outward)
@@ -127,6 +145,7 @@ UnfoldResult unfold_tets(Model& model) {
     for (std::size_t i = 0; i < element_count(model, kind); ++i) {
       const ElementRef e{kind, index_cast(i)};
       const auto cs = element_corners(model, e);
+      if (!touches(cs)) continue;
       const auto& topo = cell_topology(kind);
       for (int f = 0; f < topo.faces; ++f) {
         const auto& cf = topo.face[static_cast<std::size_t>(f)];
