@@ -243,8 +243,18 @@ UnfoldResult unfold_tets(Model& model) {
       for (Index t : group) turned[index_cast<std::size_t>(t)] = 0;
   }
 
-  const Model before = model;  // restored unless every fold is mended
   UnfoldResult result;
+  std::vector<Point> from;  // where the moved nodes were
+  // Unless every fold is mended, the model goes back as it was.
+  const auto undo = [&] {
+    for (const ElementRef& e : result.turned) {
+      auto& tet = model.tets[index_cast<std::size_t>(e.index)];
+      std::swap(tet[0], tet[1]);
+    }
+    for (std::size_t i = 0; i < result.moved.size(); ++i)
+      model.points[index_cast<std::size_t>(result.moved[i])] = from[i];
+    return none;
+  };
   for (std::size_t t = 0; t < model.tets.size(); ++t)
     if (turned[t]) {
       std::swap(model.tets[t][0], model.tets[t][1]);  // as the geometry has it: inverted
@@ -254,9 +264,9 @@ UnfoldResult unfold_tets(Model& model) {
     const auto& tet = model.tets[index_cast<std::size_t>(e.index)];
     if (volume_with(model, tet, tet[0], model.points[index_cast<std::size_t>(tet[0])]) > 0.0)
       continue;  // put right by a node moved for a neighbour
-    // The free node whose star has the deepest centre moves there.
+    // Of its free nodes, the one whose tets come out the largest at its new place moves.
     Index node = kInvalidIndex;
-    Point to;
+    Point to = Point::Zero();
     double depth = 0.0;
     for (Index v : tet) {
       if (fixed[index_cast<std::size_t>(v)]) continue;
@@ -267,19 +277,14 @@ UnfoldResult unfold_tets(Model& model) {
         d = std::min(d, volume_with(model, model.tets[index_cast<std::size_t>(s)], v, x));
       if (d > depth) depth = d, node = v, to = x;
     }
-    if (node == kInvalidIndex) {
-      model = before;
-      return none;
-    }
-    result.farthest =
-        std::max(result.farthest, (to - model.points[index_cast<std::size_t>(node)]).norm());
-    model.points[index_cast<std::size_t>(node)] = to;
+    if (node == kInvalidIndex) return undo();
+    Point& at = model.points[index_cast<std::size_t>(node)];
+    result.farthest = std::max(result.farthest, (to - at).norm());
+    from.push_back(at);
     result.moved.push_back(node);
+    at = to;
   }
-  if (result.moved.empty() || !check_input(model).ok()) {
-    model = before;
-    return none;
-  }
+  if (result.moved.empty() || !check_input(model).ok()) return undo();
   return result;
 }
 
