@@ -2,6 +2,9 @@
 // a demo model built with Gmsh (demo/demo_models).
 #include <tbb/global_control.h>
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <exception>
@@ -154,6 +157,14 @@ std::string check_outputs(const ConformArgs& a) {
   } else if (!a.format.empty()) {
     throw InvalidInput("--format " + a.format + " needs -o FILE");
   }
+  if (a.report == "-" && !a.output.empty()) {
+    // stat, not fs::equivalent: libstdc++'s refuses a pipe ("operation not supported").
+    struct stat out {
+    }, std_out{};
+    if (::stat(a.output.c_str(), &out) == 0 && ::fstat(STDOUT_FILENO, &std_out) == 0 &&
+        out.st_dev == std_out.st_dev && out.st_ino == std_out.st_ino)
+      throw InvalidInput(a.output + ": is standard output, where --report - prints the report");
+  }
   if (!a.report.empty() && a.report != "-") {  // "-": standard output, after the mesh
     if (file_extension(a.report) != ".json")
       throw InvalidInput(a.report + ": the report is JSON; name it *.json");
@@ -195,12 +206,13 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
       std::string ids;
       for (std::size_t i = 0; i < u.moved.size() && i < 10; ++i)
         ids += (i ? " " : "") + std::to_string(primal::node_id(model, u.moved[i]));
-      const bool one = u.moved.size() == 1;
+      const bool one_tet = u.turned.size() == 1, one_node = u.moved.size() == 1;
       std::cerr << "geode: warning: " << prefix << "--unfold: " << u.turned.size()
-                << (one ? " tet" : " tets") << " folded over " << (one ? "its" : "their")
-                << " neighbours turned back, node" << (one ? " " : "s ") << ids
-                << (u.moved.size() > 10 ? " ..." : "") << " moved into " << (one ? "its" : "their")
-                << " tets (by at most " << primal::number_text(u.farthest) << ")\n";
+                << (one_tet ? " tet" : " tets") << " folded over " << (one_tet ? "its" : "their")
+                << " neighbours turned back, node" << (one_node ? " " : "s ") << ids
+                << (u.moved.size() > 10 ? " ..." : "") << " moved into "
+                << (one_node ? "its" : "their") << " tets (by at most "
+                << primal::number_text(u.farthest) << ")\n";
     }
   }
   // Read without the covering check where nodes are merged (duplicated interface nodes look

@@ -211,8 +211,8 @@ class HexFinder {
 
   std::vector<Obstruction> run() {
     // Each stage's share of the work, in percent as measured on 5.2 million hexes.
-    const auto stage = [this](auto&& run, std::size_t share) {
-      run();
+    const auto stage = [this](auto&& search, std::size_t share) {
+      search();
       done_ += share;
       if (options_.progress) options_.progress(done_, 100);
     };

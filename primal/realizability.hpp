@@ -78,9 +78,9 @@ struct RealizabilityOptions {
   // replaces the geometric grouping when not empty. A boundary quad lies on face f when its
   // corners all do.
   std::vector<unsigned> node_faces;
-  // Called after each of the hex search's stages with (work done, all the work), in units of
-  // its own, `done` equal to `total` at the last call: for a progress bar (about 15 s on 5
-  // million hexes). May be empty; quad meshes do not call it.
+  // Called at the start and after each of the hex search's stages with (work done, all the
+  // work), in units of its own, `done` equal to `total` at the last call: for a progress bar (about
+  // 15 s on 5 million hexes). May be empty; quad meshes do not call it.
   std::function<void(std::size_t done, std::size_t total)> progress;
 };
 

@@ -171,6 +171,13 @@ UnfoldResult unfold_tets(Model& model) {
       for (Index v : t) fixed[index_cast<std::size_t>(v)] = 1;
   for (const NodeSet& s : model.node_sets)
     for (Index v : s.nodes) fixed[index_cast<std::size_t>(v)] = 1;
+  for (const SideSet& s : model.side_sets)  // a surface embedded in the tets stays too
+    for (const Side& side : s.sides) {
+      const auto cs = element_corners(model, side.element);
+      const auto& cf = cell_topology(side.element.kind).face[static_cast<std::size_t>(side.face)];
+      for (int i = 0; i < cf.size; ++i)
+        fixed[index_cast<std::size_t>(cs[static_cast<std::size_t>(cf.corners[i])])] = 1;
+    }
   for (std::size_t v = 0; v < nv; ++v)
     if (block[v] < 0) fixed[v] = 1;
 
@@ -191,8 +198,9 @@ UnfoldResult unfold_tets(Model& model) {
     for (int f = 0; f < 4; ++f) {
       const Triangle mine =
           triangle(cs, cell_topology(ElementKind::kTet).face[static_cast<std::size_t>(f)]);
-      const auto& list = uses[sorted(mine)];
-      if (list.size() != 2) continue;
+      const auto found = uses.find(sorted(mine));
+      if (found == uses.end() || found->second.size() != 2) continue;
+      const auto& list = found->second;
       ++n.first;
       const Use& other = list[0].element == ElementRef{ElementKind::kTet, t} ? list[1] : list[0];
       // Each side's cycle as it is now (a turned tet's reversed), the same: one side.
@@ -203,6 +211,11 @@ UnfoldResult unfold_tets(Model& model) {
   };
   std::map<Index, int> folds;  // the tets found, with their faces on one side
   for (Index t : work) folds[t] = sides(t).second;
+  // The tets on one side of the most faces first: a neighbour of a fold, on one side of its one
+  // face with the fold, is not turned in its place (its nodes fixed, the whole mend given up).
+  std::sort(work.begin(), work.end());
+  work.erase(std::unique(work.begin(), work.end()), work.end());
+  std::stable_sort(work.begin(), work.end(), [&](Index a, Index b) { return folds[a] > folds[b]; });
   for (std::size_t round = 0; !work.empty() && round < 100; ++round) {
     std::vector<Index> next;
     for (Index t : work) {
@@ -251,7 +264,7 @@ UnfoldResult unfold_tets(Model& model) {
       auto& tet = model.tets[index_cast<std::size_t>(e.index)];
       std::swap(tet[0], tet[1]);
     }
-    for (std::size_t i = 0; i < result.moved.size(); ++i)
+    for (std::size_t i = result.moved.size(); i-- > 0;)  // the first place last
       model.points[index_cast<std::size_t>(result.moved[i])] = from[i];
     return none;
   };

@@ -25,7 +25,7 @@ struct UnfoldResult {
 // check_input then finds nothing: else the model is left as it was (and the result empty), so
 // that the refusal names the first fault as before. A node is moved only if its elements are
 // tets of one block and it lies on no boundary face (the model's boundary and its materials do
-// not move) and on no node set.
+// not move), no node set and no side set's face.
 UnfoldResult unfold_tets(Model& model);
 
 }  // namespace geode::primal

@@ -153,7 +153,9 @@ auto show_coverage(Index base) {
 class ProgressTicker {
  public:
   ProgressTicker(const ValidityProgress& report, std::size_t total)
-      : report_(report), total_(total) {}
+      : report_(report), total_(total) {
+    if (report_) report_(0, total_);  // the start, from which a bar counts
+  }
   void add(std::size_t work) {
     if (!report_) return;
     done_.fetch_add(work, std::memory_order_relaxed);

@@ -62,7 +62,8 @@ void Engine::check_lone_pieces(const std::vector<Curve>& curves) const {
   std::vector<int> stack;
   for (int s = 0; s < m; ++s) {
     const auto& val = grid_[primal::index_cast<std::size_t>(s)];
-    // -1: the sheet does not cross the cell; else its piece.
+    // -1: the sheet does not cross the cell; -2: it does, the piece not known yet; else its
+    // piece.
     std::fill(piece.begin(), piece.end(), -2);
     for (int k = 0; k < n_[2]; ++k)
       for (int j = 0; j < n_[1]; ++j)
@@ -73,7 +74,7 @@ void Engine::check_lone_pieces(const std::vector<Curve>& curves) const {
             lo = std::min(lo, v), hi = std::max(hi, v);
           }
           piece[primal::index_cast<std::size_t>(cell_id(i, j, k))] =
-              lo <= 0.0 && hi >= 0.0 ? -2 : -1;  // -2: crossed, not yet in a piece
+              lo <= 0.0 && hi >= 0.0 ? -2 : -1;
         }
     int pieces = 0;
     for (int start = 0; start < ncell; ++start) {

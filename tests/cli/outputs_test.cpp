@@ -195,4 +195,10 @@ TEST_CASE("an output linked to /dev/stdout, stdout a pipe: the mesh comes throug
   CHECK(run.code == 0);
   CHECK(run.out.rfind("# vtk DataFile Version", 0) == 0);
   CHECK(fs::is_symlink(link));  // still the link
+  // With --report - the report would go there too: refused before the work.
+  const auto both =
+      geode_cli("conform " + input.string() + " -o " + link.string() + " --report - --quiet", true);
+  CHECK(both.code == 2);
+  CHECK(both.out.find("is standard output, where --report - prints the report") !=
+        std::string::npos);
 }

@@ -17,6 +17,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <map>
+#include <numbers>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -714,8 +715,8 @@ primal::Model gmsh_ring(int n) {
     const int c = geo::addPoint(0, 0, -0.25, ring_size);
     std::vector<int> p, arcs;
     for (int i = 0; i < 4; ++i)
-      p.push_back(
-          geo::addPoint(r * std::cos(i * M_PI / 2), r * std::sin(i * M_PI / 2), -0.25, ring_size));
+      p.push_back(geo::addPoint(r * std::cos(i * std::numbers::pi / 2),
+                                r * std::sin(i * std::numbers::pi / 2), -0.25, ring_size));
     for (int i = 0; i < 4; ++i) {
       arcs.push_back(geo::addCircleArc(p[static_cast<std::size_t>(i)], c,
                                        p[static_cast<std::size_t>((i + 1) % 4)]));
