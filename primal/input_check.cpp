@@ -1094,11 +1094,14 @@ void require_single_covering(const Model& model, std::string_view source,
   one.max_findings = 1;
   const InputCheckResult r = check_input(model, one);
   if (r.ok()) return;
-  const InputFault fault = r.findings[0].fault;
+  // The hint where a tet folds (what unfold_tets mends), not a pyramid over a hex.
+  const InputFinding& f = r.findings[0];
+  const bool tet_fold =
+      (f.fault == InputFault::kSameSideFace || f.fault == InputFault::kFoldedNode) &&
+      std::any_of(f.elements.begin(), f.elements.end(),
+                  [](const ElementRef& e) { return e.kind == ElementKind::kTet; });
   const std::string what =
-      std::string(source) + ": " + r.findings[0].text(model) +
-      (fault == InputFault::kSameSideFace || fault == InputFault::kFoldedNode ? options.fold_hint
-                                                                              : "");
+      std::string(source) + ": " + f.text(model) + (tet_fold ? options.fold_hint : "");
   if (r.findings[0].topological()) throw TopologyError(what);
   throw InvalidInput(what);
 }
