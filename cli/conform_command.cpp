@@ -195,11 +195,13 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
     const primal::Index merged = primal::merge_coincident_nodes(model, a.merge_tolerance);
     progress.stage("merged " + std::to_string(merged) + " coincident nodes");
   }
+  bool covered_once = false;  // checked already, by unfold_tets
   if (a.unfold) {
     const auto started = std::chrono::steady_clock::now();
     const primal::UnfoldResult u = primal::unfold_tets(model);
+    covered_once = u.covered_once;
     progress.stage(stage_line(
-        "unfold: " + std::to_string(u.turned.size()) + " folded tets turned back",
+        "unfold: folded tets turned back: " + std::to_string(u.turned.size()),
         std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count()));
     if (u.unfolded()) {
       // The analyst's mesh changed: said whatever --quiet says.
@@ -217,7 +219,7 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
   }
   // Read without the covering check where nodes are merged (duplicated interface nodes look
   // like a gap) or folds mended: run here.
-  if (!source.empty() && (a.merge_tolerance >= 0 || a.unfold))
+  if (!source.empty() && (a.merge_tolerance >= 0 || a.unfold) && !covered_once)
     primal::require_single_covering(model, source, fold_hint(a));
   conform::ConformOptions opts;
   opts.smooth = conform::parse_conform_smooth(a.smooth);

@@ -8,6 +8,7 @@
 #include <map>
 #include <span>
 
+#include <geode/primal/boundary.hpp>
 #include <geode/primal/input_check.hpp>
 
 namespace geode::primal {
@@ -16,18 +17,12 @@ namespace {
 
 using Triangle = std::array<Index, 3>;
 
-Triangle sorted(Triangle t) {
-  std::sort(t.begin(), t.end());
-  return t;
-}
-
-// Six times the signed volume of tet t with node `at` (one of its corners) placed at x.
+// The signed volume of tet t (tet_volume) with node `at` (one of its corners) placed at x.
 double volume_with(const Model& m, const std::array<Index, 4>& t, Index at, const Point& x) {
-  std::array<Point, 4> p;
-  for (int i = 0; i < 4; ++i)
-    p[static_cast<std::size_t>(i)] =
-        t[static_cast<std::size_t>(i)] == at ? x : m.points[index_cast<std::size_t>(t[i])];
-  return (p[1] - p[0]).cross(p[2] - p[0]).dot(p[3] - p[0]);
+  const auto p = [&](std::size_t i) -> const Point& {
+    return t[i] == at ? x : m.points[index_cast<std::size_t>(t[i])];
+  };
+  return tet_volume(p(0), p(1), p(2), p(3));
 }
 
 // Where node v goes: the star of v (its tets, oriented) has a point farthest inside the planes
@@ -97,7 +92,10 @@ UnfoldResult unfold_tets(Model& model) {
   o.max_findings = 1000;
   const InputCheckResult check = check_input(model, o);
   UnfoldResult none;
-  if (check.ok()) return none;
+  if (check.ok()) {
+    none.covered_once = true;
+    return none;
+  }
   // The tets check_input found on the same side of a shared face as another element.
   std::vector<Index> work;
   for (const InputFinding& f : check.findings)
@@ -132,7 +130,7 @@ UnfoldResult unfold_tets(Model& model) {
     ElementRef element;
     Triangle cycle;  // as the element orders it (outward)
   };
-  std::map<Triangle, std::vector<Use>> uses;
+  std::map<FaceKey, std::vector<Use>> uses;
   std::vector<char> fixed(nv, 0);
   std::vector<int> block(nv, 0);  // the one block of the node's tets, -1 when more than one
   std::vector<std::vector<Index>> tets_at(nv);
@@ -151,7 +149,7 @@ UnfoldResult unfold_tets(Model& model) {
         const auto& cf = topo.face[static_cast<std::size_t>(f)];
         if (cf.size != 3) continue;
         const Triangle t = triangle(cs, cf);
-        uses[sorted(t)].push_back({e, t});
+        uses[face_key(t)].push_back({e, t});
       }
       for (Index v : cs) {
         const auto u = index_cast<std::size_t>(v);
@@ -168,7 +166,8 @@ UnfoldResult unfold_tets(Model& model) {
   // interface counts as boundary too, and stays), in a node set, or between blocks stay.
   for (const auto& [t, list] : uses)
     if (list.size() == 1)
-      for (Index v : t) fixed[index_cast<std::size_t>(v)] = 1;
+      for (Index v : t)
+        if (v != kInvalidIndex) fixed[index_cast<std::size_t>(v)] = 1;  // a triangle's pad
   for (const NodeSet& s : model.node_sets)
     for (Index v : s.nodes) fixed[index_cast<std::size_t>(v)] = 1;
   for (const SideSet& s : model.side_sets)  // a surface embedded in the tets stays too
@@ -198,7 +197,7 @@ UnfoldResult unfold_tets(Model& model) {
     for (int f = 0; f < 4; ++f) {
       const Triangle mine =
           triangle(cs, cell_topology(ElementKind::kTet).face[static_cast<std::size_t>(f)]);
-      const auto found = uses.find(sorted(mine));
+      const auto found = uses.find(face_key(mine));
       if (found == uses.end() || found->second.size() != 2) continue;
       const auto& list = found->second;
       ++n.first;
@@ -298,6 +297,7 @@ UnfoldResult unfold_tets(Model& model) {
     at = to;
   }
   if (result.moved.empty() || !check_input(model).ok()) return undo();
+  result.covered_once = true;
   return result;
 }
 

@@ -18,6 +18,9 @@ struct UnfoldResult {
   std::vector<ElementRef> turned;  // tets whose node order was turned back
   std::vector<Index> moved;        // the nodes moved (at most one per turned tet)
   double farthest = 0.0;           // the longest distance a node moved
+  // check_input found nothing (before, or after the mend): no need to run it again. When false
+  // the model is as it was given, and require_single_covering names its first fault.
+  bool covered_once = false;
   bool unfolded() const { return !moved.empty(); }
 };
 

@@ -236,7 +236,7 @@ py::dict conform_arrays(const py::handle& points, const py::dict& cells,
     if (!unfold)
       checked.fold_hint =
           " (a mesher's fold: unfold=True turns such tets back, or mesh again at another size)";
-    primal::require_single_covering(model, source, checked);
+    if (!unfolded.covered_once) primal::require_single_covering(model, source, checked);
     moved = std::move(unfolded.moved);
     try {
       r = conform::conform(std::move(model), opts);  // the hints below read what is left

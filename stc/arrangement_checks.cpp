@@ -54,25 +54,16 @@ void Engine::check_lone_pieces(const std::vector<Curve>& curves) const {
   if (dim_ != 3) return;
   const int ncell = cell_count();
   const int m = primal::index_cast<int>(sheets_.size());
-  auto corner_id = [&](int i, int j, int k, int c) {
-    return grid_id(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1));
-  };
   std::vector<int> piece(primal::index_cast<std::size_t>(ncell));
   std::vector<char> met;
   std::vector<int> stack;
   for (int s = 0; s < m; ++s) {
-    const auto& val = grid_[primal::index_cast<std::size_t>(s)];
     // -1: the sheet does not cross the cell; -2: it does, the piece not known yet; else its
     // piece.
-    std::fill(piece.begin(), piece.end(), -2);
     for (int k = 0; k < n_[2]; ++k)
       for (int j = 0; j < n_[1]; ++j)
         for (int i = 0; i < n_[0]; ++i) {
-          double lo = 1e300, hi = -1e300;
-          for (int c = 0; c < 8; ++c) {
-            const double v = val[corner_id(i, j, k, c)];
-            lo = std::min(lo, v), hi = std::max(hi, v);
-          }
+          const auto [lo, hi] = cell_span(s, i, j, k);
           piece[primal::index_cast<std::size_t>(cell_id(i, j, k))] =
               lo <= 0.0 && hi >= 0.0 ? -2 : -1;
         }

@@ -45,20 +45,12 @@ std::vector<Point> Engine::seeds(const std::vector<int>& S) const {
   // comes close to one): project its centre onto the curve.
   std::vector<Point> out;
   const int kcells = dim_ == 3 ? n_[2] : 1;
-  const int corners = dim_ == 3 ? 8 : 4;
   for (int k = 0; k < kcells; ++k)
     for (int j = 0; j < n_[1]; ++j)
       for (int i = 0; i < n_[0]; ++i) {
         bool all = true;
         for (std::size_t s = 0; s < S.size() && all; ++s) {
-          const auto& val = grid_[primal::index_cast<std::size_t>(S[s])];
-          double lo = 1e300, hi = -1e300;
-          for (int c = 0; c < corners; ++c) {
-            const double v =
-                val[grid_id(i + (c & 1), j + ((c >> 1) & 1), dim_ == 3 ? k + ((c >> 2) & 1) : 0)];
-            lo = std::min(lo, v);
-            hi = std::max(hi, v);
-          }
+          const auto [lo, hi] = cell_span(S[s], i, j, k);
           all = lo <= 0.0 && hi >= 0.0;
         }
         if (!all) continue;

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <string>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include <geode/primal/errors.hpp>
@@ -271,6 +272,18 @@ class Engine {
     return c;
   }
   int cell_id(int i, int j, int k) const { return (k * n_[1] + j) * n_[0] + i; }
+  // The least and greatest of sheet s's field over the corners of cell (i, j, k) (k = 0 in 2D):
+  // the sheet may cross the cell when the first is <= 0 <= the second.
+  std::pair<double, double> cell_span(int s, int i, int j, int k) const {
+    const auto& val = grid_[primal::index_cast<std::size_t>(s)];
+    double lo = 1e300, hi = -1e300;
+    for (int c = 0; c < (dim_ == 3 ? 8 : 4); ++c) {
+      const double v =
+          val[grid_id(i + (c & 1), j + ((c >> 1) & 1), dim_ == 3 ? k + ((c >> 2) & 1) : 0)];
+      lo = std::min(lo, v), hi = std::max(hi, v);
+    }
+    return {lo, hi};
+  }
   Point grid_node(int i, int j, int k) const;
   std::size_t grid_id(int i, int j, int k) const {
     return primal::index_cast<std::size_t>((k * (n_[1] + 1) + j) * (n_[0] + 1) + i);
