@@ -52,7 +52,7 @@ struct ConformArgs {
   std::string model = "half";
   std::string save_input;
   double merge_tolerance = -1;  // < 0: no merging
-  bool unfold = false;          // --unfold: tets a mesher folded turned back
+  bool unfold = false;          // --unfold: tets and pyramids a mesher folded turned back
   double buffer_thickness = 0;  // 0: the side's default
   double feature_thickness = conform::BufferLayerOptions{}.feature_thickness;
   std::string buffer_side;  // empty: automatic (conform::set_buffer_side)
@@ -140,7 +140,7 @@ primal::InputCheckOptions fold_hint(const ConformArgs& a) {
   primal::InputCheckOptions o;
   if (!a.unfold)
     o.fold_hint =
-        " (a mesher's fold: --unfold turns such tets back, or mesh again at another size)";
+        " (a mesher's fold: --unfold turns such cells back, or mesh again at another size)";
   return o;
 }
 
@@ -195,25 +195,36 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
     const primal::Index merged = primal::merge_coincident_nodes(model, a.merge_tolerance);
     progress.stage("merged " + std::to_string(merged) + " coincident nodes");
   }
-  bool covered_once = false;  // checked already, by unfold_tets
+  bool covered_once = false;  // checked already, by unfold
   if (a.unfold) {
     const auto started = std::chrono::steady_clock::now();
-    const primal::UnfoldResult u = primal::unfold_tets(model);
+    const primal::UnfoldResult u = primal::unfold(model);
     covered_once = u.covered_once;
+    // "2 tets and 1 pyramid", "1 tet"
+    std::size_t pyramids = 0;
+    for (const primal::ElementRef& e : u.turned)
+      pyramids += e.kind == primal::ElementKind::kPyramid;
+    const std::size_t tets = u.turned.size() - pyramids;
+    const auto counted = [](std::size_t n, const char* what) {
+      return std::to_string(n) + " " + what + (n == 1 ? "" : "s");
+    };
+    const std::string turned = pyramids == 0 ? counted(tets, "tet")
+                               : tets == 0
+                                   ? counted(pyramids, "pyramid")
+                                   : counted(tets, "tet") + " and " + counted(pyramids, "pyramid");
     progress.stage(stage_line(
-        "unfold: folded tets turned back: " + std::to_string(u.turned.size()),
+        "unfold: folded cells turned back: " + turned,
         std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count()));
     if (u.unfolded()) {
       // The analyst's mesh changed: said whatever --quiet says.
       std::string ids;
       for (std::size_t i = 0; i < u.moved.size() && i < 10; ++i)
         ids += (i ? " " : "") + std::to_string(primal::node_id(model, u.moved[i]));
-      const bool one_tet = u.turned.size() == 1, one_node = u.moved.size() == 1;
-      std::cerr << "geode: warning: " << prefix << "--unfold: " << u.turned.size()
-                << (one_tet ? " tet" : " tets") << " folded over " << (one_tet ? "its" : "their")
-                << " neighbours turned back, node" << (one_node ? " " : "s ") << ids
-                << (u.moved.size() > 10 ? " ..." : "") << " moved into "
-                << (one_node ? "its" : "their") << " tets (by at most "
+      const bool one = u.turned.size() == 1, one_node = u.moved.size() == 1;
+      std::cerr << "geode: warning: " << prefix << "--unfold: " << turned << " folded over "
+                << (one ? "its" : "their") << " neighbours turned back, node"
+                << (one_node ? " " : "s ") << ids << (u.moved.size() > 10 ? " ..." : "")
+                << " moved into " << (one_node ? "its" : "their") << " cells (by at most "
                 << primal::number_text(u.farthest) << ")\n";
     }
   }
@@ -376,10 +387,10 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
                 "separately whose interface nodes are duplicated")
       ->check(number_check(0, 1e300));
   c->add_flag("--unfold", a.unfold,
-              "turn back tets a mesher folded over their neighbours (Gmsh 4.8 near its\n"
-              "pyramids: a tet written positive lying on the same side of its faces as every\n"
-              "neighbour) and move one free node of each into its tets; only where that mends\n"
-              "every fold; warns naming the nodes moved");
+              "turn back tets and pyramids a mesher folded over their neighbours (Gmsh 4.8\n"
+              "near its pyramids: a cell written positive lying on the same side of its faces\n"
+              "as every neighbour) and move one free node of each (a pyramid's apex) into its\n"
+              "cells; only where that mends every fold; warns naming the nodes moved");
   c->add_option(
        "--pyramids", a.pyramids,
        "what pyramids of a hybrid mesh become: split (default): two tets along the base diagonal\n"

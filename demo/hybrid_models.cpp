@@ -65,7 +65,7 @@ Model hybrid_gmsh(const std::string& name, F&& build) {
     gmsh::model::add(name);
     build();
     std::string refused;
-    std::optional<Model> first;  // the first mesh refused, kept for unfold_tets
+    std::optional<Model> first;  // the first mesh refused, kept for unfold
     for (const double factor : kRemeshFactors) {
       gmsh::option::setNumber("Mesh.MeshSizeFactor", factor);
       gmsh::model::mesh::clear();
@@ -95,7 +95,7 @@ Model hybrid_gmsh(const std::string& name, F&& build) {
       }
     }
     // Folded at every size: the first mesh's folds turned back, as conform --unfold does.
-    if (first && unfold_tets(*first).unfolded()) return std::move(*first);
+    if (first && unfold(*first).unfolded()) return std::move(*first);
     throw InvalidInput(refused + " (with the tet sizes 0.98 to 1.02 times the model's too)");
   });
 }

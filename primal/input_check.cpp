@@ -1094,12 +1094,13 @@ void require_single_covering(const Model& model, std::string_view source,
   one.max_findings = 1;
   const InputCheckResult r = check_input(model, one);
   if (r.ok()) return;
-  // The hint where a tet folds (what unfold_tets mends), not a pyramid over a hex.
+  // The hint where a tet or pyramid folds (what unfold mends), not a hex or wedge alone.
   const InputFinding& f = r.findings[0];
   const bool tet_fold =
       (f.fault == InputFault::kSameSideFace || f.fault == InputFault::kFoldedNode) &&
-      std::any_of(f.elements.begin(), f.elements.end(),
-                  [](const ElementRef& e) { return e.kind == ElementKind::kTet; });
+      std::any_of(f.elements.begin(), f.elements.end(), [](const ElementRef& e) {
+        return e.kind == ElementKind::kTet || e.kind == ElementKind::kPyramid;
+      });
   const std::string what =
       std::string(source) + ": " + f.text(model) + (tet_fold ? options.fold_hint : "");
   if (r.findings[0].topological()) throw TopologyError(what);

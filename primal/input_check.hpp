@@ -54,8 +54,8 @@ struct InputCheckOptions : Shares {
   // share matches the same interface). What geode_mpi's partition graph is made of, so that the
   // faces are paired once (parallel/partition.hpp). Complete only when the check finds nothing.
   std::vector<std::array<Index, 2>>* element_pairs = nullptr;
-  // require_single_covering: appended to the message of a fold with a tet in it (kSameSideFace,
-  // kFoldedNode), e.g. what the command offers for one.
+  // require_single_covering: appended to the message of a fold with a tet or pyramid in it
+  // (kSameSideFace, kFoldedNode), e.g. what the command offers for one.
   std::string fold_hint;
 };
 

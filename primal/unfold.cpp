@@ -1,4 +1,4 @@
-// Folded tets put back (primal/unfold.hpp).
+// Folded tets and pyramids put back (primal/unfold.hpp).
 #include <geode/primal/unfold.hpp>
 
 #include <Eigen/Dense>
@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <map>
+#include <set>
 #include <span>
 
 #include <geode/primal/boundary.hpp>
@@ -15,32 +16,55 @@ namespace geode::primal {
 
 namespace {
 
-using Triangle = std::array<Index, 3>;
+using Tet = std::array<Index, 4>;
+using Cycle = std::array<Index, 4>;  // a face's corners as an element orders it; a triangle's
+                                     // fourth kInvalidIndex
+
+// The tets whose signed volumes say that an element is positive: a tet itself; a pyramid's four
+// corner tets (two per base diagonal: positive along both diagonals, which check_geometry's one
+// diagonal and conform's choice of either follow from, and linear in the apex).
+std::vector<Tet> pieces(const Model& m, ElementRef e) {
+  const auto c = element_corners(m, e);
+  if (e.kind == ElementKind::kTet) return {Tet{c[0], c[1], c[2], c[3]}};
+  std::vector<Tet> out;
+  for (std::size_t k = 0; k < 4; ++k)
+    out.push_back({c[(k + 3) % 4], c[k], c[(k + 1) % 4], c[topology::kPyramidApex]});
+  return out;
+}
+
+// Turns an element's node order (its faces' cycles reversed): a tet's first two corners, a
+// pyramid's base corners 1 and 3. Its own inverse.
+void turn(Model& m, ElementRef e) {
+  const auto i = index_cast<std::size_t>(e.index);
+  if (e.kind == ElementKind::kTet)
+    std::swap(m.tets[i][0], m.tets[i][1]);
+  else
+    std::swap(m.pyramids[i][1], m.pyramids[i][3]);
+}
 
 // The signed volume of tet t (tet_volume) with node `at` (one of its corners) placed at x.
-double volume_with(const Model& m, const std::array<Index, 4>& t, Index at, const Point& x) {
+double volume_with(const Model& m, const Tet& t, Index at, const Point& x) {
   const auto p = [&](std::size_t i) -> const Point& {
     return t[i] == at ? x : m.points[index_cast<std::size_t>(t[i])];
   };
   return tet_volume(p(0), p(1), p(2), p(3));
 }
 
-// Where node v goes: the star of v (its tets, oriented) has a point farthest inside the planes
-// of their faces opposite v, max t such that the distance from x to each of those planes, on the
-// tet's side, is at least t (the Chebyshev centre; each such distance is linear in x, so the
-// optimum is where four of them are equal: the LP's vertices, enumerated, a star having a few
-// dozen tets). v moves from where the mesher put it toward that centre only until every distance
-// is half that depth: its tets positive and well clear of flat, the mesh changed no more than
-// that needs. False when no point leaves every tet positive.
-bool unfolded_position(const Model& m, Index v, const std::vector<Index>& star, Point& best) {
+// Where node v goes: the star of v (its elements' pieces, oriented) has a point farthest inside
+// the planes of their faces opposite v, max t such that the distance from x to each of those
+// planes, on the tet's side, is at least t (the Chebyshev centre; each such distance is linear in
+// x, so the optimum is where four of them are equal: the LP's vertices, enumerated, a star having a
+// few dozen tets). v moves from where the mesher put it toward that centre only until every
+// distance is half that depth: its tets positive and well clear of flat, the mesh changed no more
+// than that needs. False when no point leaves every tet positive.
+bool unfolded_position(const Model& m, Index v, const std::vector<Tet>& star, Point& best) {
   struct Plane {
     Point n;  // unit, into the tet
     double d;
   };
   std::vector<Plane> planes;
   const Point here = m.points[index_cast<std::size_t>(v)];
-  for (Index t : star) {
-    const auto& tet = m.tets[index_cast<std::size_t>(t)];
+  for (const Tet& tet : star) {
     // The volume is linear in x: its gradient from three unit steps (exact up to rounding).
     const double at0 = volume_with(m, tet, v, here);
     Point g;
@@ -87,7 +111,7 @@ bool unfolded_position(const Model& m, Index v, const std::vector<Index>& star, 
 
 }  // namespace
 
-UnfoldResult unfold_tets(Model& model) {
+UnfoldResult unfold(Model& model) {
   InputCheckOptions o;
   o.max_findings = 1000;
   const InputCheckResult check = check_input(model, o);
@@ -96,22 +120,25 @@ UnfoldResult unfold_tets(Model& model) {
     none.covered_once = true;
     return none;
   }
-  // The tets check_input found on the same side of a shared face as another element.
-  std::vector<Index> work;
+  // The tets and pyramids check_input found on the same side of a shared face as another element.
+  const auto mendable = [](ElementKind k) {
+    return k == ElementKind::kTet || k == ElementKind::kPyramid;
+  };
+  std::vector<ElementRef> work;
   for (const InputFinding& f : check.findings)
     if (f.fault == InputFault::kSameSideFace)
       for (const ElementRef& e : f.elements)
-        if (e.kind == ElementKind::kTet) work.push_back(e.index);
+        if (mendable(e.kind)) work.push_back(e);
   if (work.empty()) return none;
 
-  // Near the folds (their tets' nodes and three rings of elements around them, so that each
-  // node moved has its whole star and each tet turned its neighbours'): every element's
-  // triangles (a quad face is no tet's) with the elements using them, each in the cyclic order
-  // that element gives it; per node: on a boundary face, elements other than tets, blocks.
+  // Near the folds (their elements' nodes and three rings of elements around them, so that each
+  // node moved has its whole star and each element turned its neighbours'): every element's
+  // faces with the elements using them, each in the cyclic order that element gives it; per
+  // node: on a boundary face, elements it cannot move in, blocks.
   const std::size_t nv = model.points.size();
   std::vector<char> near(nv, 0);
-  for (Index t : work)
-    for (Index v : model.tets[index_cast<std::size_t>(t)]) near[index_cast<std::size_t>(v)] = 1;
+  for (const ElementRef& e : work)
+    for (Index v : element_corners(model, e)) near[index_cast<std::size_t>(v)] = 1;
   const auto touches = [&](std::span<const Index> cs) {
     return std::any_of(cs.begin(), cs.end(),
                        [&](Index v) { return near[index_cast<std::size_t>(v)] == 1; });
@@ -128,16 +155,20 @@ UnfoldResult unfold_tets(Model& model) {
   }
   struct Use {
     ElementRef element;
-    Triangle cycle;  // as the element orders it (outward)
+    Cycle cycle;  // as the element orders it (outward)
   };
   std::map<FaceKey, std::vector<Use>> uses;
   std::vector<char> fixed(nv, 0);
-  std::vector<int> block(nv, 0);  // the one block of the node's tets, -1 when more than one
-  std::vector<std::vector<Index>> tets_at(nv);
-  const auto triangle = [&](std::span<const Index> cs, const topology::CellFace& cf) {
-    return Triangle{cs[static_cast<std::size_t>(cf.corners[0])],
-                    cs[static_cast<std::size_t>(cf.corners[1])],
-                    cs[static_cast<std::size_t>(cf.corners[2])]};
+  std::vector<int> block(nv, 0);  // the one block of the node's elements, -1 when more than one
+  std::vector<std::vector<ElementRef>> star(nv);  // the elements the node may move in
+  const auto cycle = [](std::span<const Index> cs, const topology::CellFace& cf) {
+    Cycle c{kInvalidIndex, kInvalidIndex, kInvalidIndex, kInvalidIndex};
+    for (int i = 0; i < cf.size; ++i)
+      c[static_cast<std::size_t>(i)] = cs[static_cast<std::size_t>(cf.corners[i])];
+    return c;
+  };
+  const auto key = [](const Cycle& c) {
+    return face_key(std::span<const Index>(c.data(), c[3] == kInvalidIndex ? 3 : 4));
   };
   for (ElementKind kind : kElementKinds)
     for (std::size_t i = 0; i < element_count(model, kind); ++i) {
@@ -146,27 +177,29 @@ UnfoldResult unfold_tets(Model& model) {
       if (!touches(cs)) continue;
       const auto& topo = cell_topology(kind);
       for (int f = 0; f < topo.faces; ++f) {
-        const auto& cf = topo.face[static_cast<std::size_t>(f)];
-        if (cf.size != 3) continue;
-        const Triangle t = triangle(cs, cf);
-        uses[face_key(t)].push_back({e, t});
+        const Cycle c = cycle(cs, topo.face[static_cast<std::size_t>(f)]);
+        uses[key(c)].push_back({e, c});
       }
-      for (Index v : cs) {
-        const auto u = index_cast<std::size_t>(v);
-        if (kind != ElementKind::kTet) {
+      for (std::size_t k = 0; k < cs.size(); ++k) {
+        const auto u = index_cast<std::size_t>(cs[k]);
+        // A tet's corners and a pyramid's apex may move; a pyramid's base (on a quad of a hex
+        // or wedge, or of another pyramid), hexes and wedges stay.
+        if (!(kind == ElementKind::kTet ||
+              (kind == ElementKind::kPyramid && k == topology::kPyramidApex))) {
           fixed[u] = 1;
           continue;
         }
-        tets_at[u].push_back(e.index);
+        star[u].push_back(e);
         const int b = block_of(model, e);
         block[u] = block[u] == 0 || block[u] == b ? b : -1;
       }
     }
-  // Nodes on a face used once (the boundary; quads are not counted, so a tet corner on a quad
-  // interface counts as boundary too, and stays), in a node set, or between blocks stay.
-  for (const auto& [t, list] : uses)
+  // Nodes on a face used once (the boundary; a quad covered by two triangles, as at a hex part's
+  // interface with tets, is used once as well: its nodes stay), in a node set, or between blocks
+  // stay.
+  for (const auto& [k, list] : uses)
     if (list.size() == 1)
-      for (Index v : t)
+      for (Index v : k)
         if (v != kInvalidIndex) fixed[index_cast<std::size_t>(v)] = 1;  // a triangle's pad
   for (const NodeSet& s : model.node_sets)
     for (Index v : s.nodes) fixed[index_cast<std::size_t>(v)] = 1;
@@ -180,113 +213,131 @@ UnfoldResult unfold_tets(Model& model) {
   for (std::size_t v = 0; v < nv; ++v)
     if (block[v] < 0) fixed[v] = 1;
 
-  // Tets turned over: each on the same side as every element it shares a face with, counting
-  // the tets turned so far as turned (two neighbours turned together agree on their face until
-  // one of them is turned back). Turned until none is left.
-  std::vector<char> turned(model.tets.size(), 0);
-  const auto same_cycle = [](const Triangle& a, const Triangle& b) {
-    return a == b || a == Triangle{b[1], b[2], b[0]} || a == Triangle{b[2], b[0], b[1]};
+  // Elements turned over: each on the same side as every element it shares a face with,
+  // counting the elements turned so far as turned (two neighbours turned together agree on their
+  // face until one of them is turned back). Turned until none is left.
+  std::array<std::vector<char>, kElementKinds.size()> turned_by_kind;
+  for (ElementKind kind : kElementKinds)
+    turned_by_kind[static_cast<std::size_t>(kind)].assign(element_count(model, kind), 0);
+  const auto turned = [&](const ElementRef& e) -> char& {
+    return turned_by_kind[static_cast<std::size_t>(e.kind)][index_cast<std::size_t>(e.index)];
   };
-  const auto flipped = [&](const Use& u) {
-    return u.element.kind == ElementKind::kTet && turned[index_cast<std::size_t>(u.element.index)];
+  const auto same_cycle = [](const Cycle& a, const Cycle& b) {
+    const std::size_t n = a[3] == kInvalidIndex ? 3 : 4;
+    for (std::size_t r = 0; r < n; ++r) {
+      bool same = true;
+      for (std::size_t i = 0; i < n && same; ++i) same = a[i] == b[(i + r) % n];
+      if (same) return true;
+    }
+    return false;
   };
-  // (faces t shares with another element, of them those on one side) as the tets stand now.
-  const auto sides = [&](Index t) {
-    const auto cs = element_corners(model, {ElementKind::kTet, t});
+  // (faces e shares with another element, of them those on one side) as the elements stand now.
+  const auto sides = [&](const ElementRef& e) {
+    const auto cs = element_corners(model, e);
+    const auto& topo = cell_topology(e.kind);
     std::pair<int, int> n{0, 0};
-    for (int f = 0; f < 4; ++f) {
-      const Triangle mine =
-          triangle(cs, cell_topology(ElementKind::kTet).face[static_cast<std::size_t>(f)]);
-      const auto found = uses.find(face_key(mine));
+    for (int f = 0; f < topo.faces; ++f) {
+      const Cycle mine = cycle(cs, topo.face[static_cast<std::size_t>(f)]);
+      const auto found = uses.find(key(mine));
       if (found == uses.end() || found->second.size() != 2) continue;
       const auto& list = found->second;
       ++n.first;
-      const Use& other = list[0].element == ElementRef{ElementKind::kTet, t} ? list[1] : list[0];
-      // Each side's cycle as it is now (a turned tet's reversed), the same: one side.
-      n.second +=
-          same_cycle(mine, other.cycle) != (flipped(other) != turned[index_cast<std::size_t>(t)]);
+      const Use& other = list[0].element == e ? list[1] : list[0];
+      // Each side's cycle as it is now (a turned element's reversed), the same: one side.
+      const bool other_turned = mendable(other.element.kind) && turned(other.element);
+      n.second += same_cycle(mine, other.cycle) != (other_turned != (turned(e) != 0));
     }
     return n;
   };
-  std::map<Index, int> folds;  // the tets found, with their faces on one side
-  for (Index t : work) folds[t] = sides(t).second;
-  // The tets on one side of the most faces first: a neighbour of a fold, on one side of its one
-  // face with the fold, is not turned in its place (its nodes fixed, the whole mend given up).
+  std::map<ElementRef, int> folds;  // the elements found, with their faces on one side
+  for (const ElementRef& e : work) folds[e] = sides(e).second;
+  // The elements on one side of the most faces first: a neighbour of a fold, on one side of its
+  // one face with the fold, is not turned in its place (its nodes fixed, the whole mend given up).
   std::sort(work.begin(), work.end());
   work.erase(std::unique(work.begin(), work.end()), work.end());
-  std::stable_sort(work.begin(), work.end(), [&](Index a, Index b) { return folds[a] > folds[b]; });
+  std::stable_sort(work.begin(), work.end(),
+                   [&](const ElementRef& a, const ElementRef& b) { return folds[a] > folds[b]; });
   for (std::size_t round = 0; !work.empty() && round < 100; ++round) {
-    std::vector<Index> next;
-    for (Index t : work) {
-      if (turned[index_cast<std::size_t>(t)]) continue;
-      const auto [shared, same] = sides(t);
+    std::vector<ElementRef> next;
+    for (const ElementRef& e : work) {
+      if (turned(e)) continue;
+      const auto [shared, same] = sides(e);
       if (shared == 0 || same < shared) continue;
-      turned[index_cast<std::size_t>(t)] = 1;
+      turned(e) = 1;
       // Its neighbours may now be on its same side: looked at again.
-      for (Index v : model.tets[index_cast<std::size_t>(t)])
-        for (Index s : tets_at[index_cast<std::size_t>(v)]) next.push_back(s);
+      for (Index v : element_corners(model, e))
+        for (const ElementRef& s : star[index_cast<std::size_t>(v)]) next.push_back(s);
     }
     std::sort(next.begin(), next.end());
     next.erase(std::unique(next.begin(), next.end()), next.end());
     work = std::move(next);
   }
-  // Neighbours turned together (each on one side with all its faces but theirs): the tets left
-  // with two or more such faces, joined through shared faces, turned as one where that leaves
-  // none of them on one side of any face.
-  std::vector<Index> left;
-  for (const auto& [t, same] : folds)
-    if (same >= 2 && !turned[index_cast<std::size_t>(t)] && sides(t).second >= 2) left.push_back(t);
-  std::vector<char> seen(model.tets.size(), 0);
-  for (Index start : left) {
-    if (seen[index_cast<std::size_t>(start)]) continue;
-    std::vector<Index> group{start};
-    seen[index_cast<std::size_t>(start)] = 1;
+  // Neighbours turned together (each on one side with all its faces but theirs): the elements
+  // left with two or more such faces, joined through shared faces (three common corners), turned
+  // as one where that leaves none of them on one side of any face.
+  std::vector<ElementRef> left;
+  for (const auto& [e, same] : folds)
+    if (same >= 2 && !turned(e) && sides(e).second >= 2) left.push_back(e);
+  std::set<ElementRef> seen;
+  const auto common = [&](const ElementRef& a, const ElementRef& b) {
+    const auto ca = element_corners(model, a), cb = element_corners(model, b);
+    return std::count_if(ca.begin(), ca.end(),
+                         [&](Index v) { return std::find(cb.begin(), cb.end(), v) != cb.end(); });
+  };
+  for (const ElementRef& start : left) {
+    if (!seen.insert(start).second) continue;
+    std::vector<ElementRef> group{start};
     for (std::size_t i = 0; i < group.size(); ++i)
-      for (Index t : left)
-        if (!seen[index_cast<std::size_t>(t)]) {
-          int common = 0;
-          for (Index v : model.tets[index_cast<std::size_t>(t)])
-            common += std::count(model.tets[index_cast<std::size_t>(group[i])].begin(),
-                                 model.tets[index_cast<std::size_t>(group[i])].end(), v) > 0;
-          if (common == 3) group.push_back(t), seen[index_cast<std::size_t>(t)] = 1;
-        }
-    for (Index t : group) turned[index_cast<std::size_t>(t)] = 1;
-    if (!std::all_of(group.begin(), group.end(), [&](Index t) { return sides(t).second == 0; }))
-      for (Index t : group) turned[index_cast<std::size_t>(t)] = 0;
+      for (const ElementRef& e : left)
+        if (!seen.count(e) && common(e, group[i]) >= 3) group.push_back(e), seen.insert(e);
+    for (const ElementRef& e : group) turned(e) = 1;
+    if (!std::all_of(group.begin(), group.end(),
+                     [&](const ElementRef& e) { return sides(e).second == 0; }))
+      for (const ElementRef& e : group) turned(e) = 0;
   }
 
   UnfoldResult result;
   std::vector<Point> from;  // where the moved nodes were
   // Unless every fold is mended, the model goes back as it was.
   const auto undo = [&] {
-    for (const ElementRef& e : result.turned) {
-      auto& tet = model.tets[index_cast<std::size_t>(e.index)];
-      std::swap(tet[0], tet[1]);
-    }
+    for (const ElementRef& e : result.turned) turn(model, e);
     for (std::size_t i = result.moved.size(); i-- > 0;)  // the first place last
       model.points[index_cast<std::size_t>(result.moved[i])] = from[i];
     return none;
   };
-  for (std::size_t t = 0; t < model.tets.size(); ++t)
-    if (turned[t]) {
-      std::swap(model.tets[t][0], model.tets[t][1]);  // as the geometry has it: inverted
-      result.turned.push_back({ElementKind::kTet, index_cast(t)});
+  for (ElementKind kind : {ElementKind::kTet, ElementKind::kPyramid})
+    for (std::size_t i = 0; i < element_count(model, kind); ++i) {
+      const ElementRef e{kind, index_cast(i)};
+      if (!turned(e)) continue;
+      turn(model, e);  // as the geometry has it: inverted
+      result.turned.push_back(e);
     }
+  // The pieces of v's elements, each with v a corner (so volume_with can move it).
+  const auto pieces_at = [&](Index v) {
+    std::vector<Tet> all;
+    for (const ElementRef& e : star[index_cast<std::size_t>(v)])
+      for (const Tet& t : pieces(model, e)) all.push_back(t);
+    return all;
+  };
+  const auto least = [&](const std::vector<Tet>& ts, Index v, const Point& x) {
+    double d = 1e300;
+    for (const Tet& t : ts) d = std::min(d, volume_with(model, t, v, x));
+    return d;
+  };
   for (const ElementRef& e : result.turned) {
-    const auto& tet = model.tets[index_cast<std::size_t>(e.index)];
-    if (volume_with(model, tet, tet[0], model.points[index_cast<std::size_t>(tet[0])]) > 0.0)
+    const auto cs = element_corners(model, e);
+    if (least(pieces(model, e), cs[0], model.points[index_cast<std::size_t>(cs[0])]) > 0.0)
       continue;  // put right by a node moved for a neighbour
-    // Of its free nodes, the one whose tets come out the largest at its new place moves.
+    // Of its free nodes, the one whose elements come out the largest at its new place moves.
     Index node = kInvalidIndex;
     Point to = Point::Zero();
     double depth = 0.0;
-    for (Index v : tet) {
+    for (Index v : cs) {
       if (fixed[index_cast<std::size_t>(v)]) continue;
+      const std::vector<Tet> around = pieces_at(v);
       Point x;
-      if (!unfolded_position(model, v, tets_at[index_cast<std::size_t>(v)], x)) continue;
-      double d = 1e300;
-      for (Index s : tets_at[index_cast<std::size_t>(v)])
-        d = std::min(d, volume_with(model, model.tets[index_cast<std::size_t>(s)], v, x));
+      if (!unfolded_position(model, v, around, x)) continue;
+      const double d = least(around, v, x);
       if (d > depth) depth = d, node = v, to = x;
     }
     if (node == kInvalidIndex) return undo();

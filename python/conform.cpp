@@ -229,13 +229,13 @@ py::dict conform_arrays(const py::handle& points, const py::dict& cells,
       merged = primal::merge_coincident_nodes(model, *merge);
     }
     primal::UnfoldResult unfolded;
-    if (unfold) unfolded = primal::unfold_tets(model);  // as --unfold
+    if (unfold) unfolded = primal::unfold(model);  // as --unfold
     // The read-time check of a file (after merging: duplicated nodes look like a gap), which
     // local verification, the default, takes as given; its messages name the source.
     primal::InputCheckOptions checked;
     if (!unfold)
       checked.fold_hint =
-          " (a mesher's fold: unfold=True turns such tets back, or mesh again at another size)";
+          " (a mesher's fold: unfold=True turns such cells back, or mesh again at another size)";
     if (!unfolded.covered_once) primal::require_single_covering(model, source, checked);
     moved = std::move(unfolded.moved);
     try {

@@ -284,7 +284,7 @@ def conform(mesh=None, *, points=None, cells=None, cell_blocks=None, name="mesh"
     report["merged_nodes"] = out["merged_nodes"]
     report["unfolded_nodes"] = list(out["unfolded_nodes"])
     if report["unfolded_nodes"]:  # the model changed, as the command warns
-        _warnings.warn("{}: unfold: {} nodes moved into the tets folded over them"
+        _warnings.warn("{}: unfold: {} nodes moved into the cells folded over them"
                        .format(name, len(report["unfolded_nodes"])), GeodeWarning, stacklevel=2)
     return _model_to_meshio(model), report
 

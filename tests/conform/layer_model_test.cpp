@@ -22,8 +22,10 @@
 #include <geode/io/read_model.hpp>
 #include <geode/primal/boundary.hpp>
 #include <geode/primal/errors.hpp>
+#include <geode/primal/input_check.hpp>
 #include <geode/primal/quality.hpp>
 #include <geode/primal/split_pyramids.hpp>
+#include <geode/primal/unfold.hpp>
 #include <geode/primal/validity.hpp>
 
 #include "../support/conform_checks.hpp"
@@ -37,12 +39,13 @@ using primal::Point;
 
 namespace {
 
-primal::Model layer_model(const test::TempDir& dir, const std::string& args) {
+// `covering`: read_model's covering check (off: a folded mesh read as it is).
+primal::Model layer_model(const test::TempDir& dir, const std::string& args, bool covering = true) {
   const std::string file = (dir.path / "layer.msh").string();
   const std::string cmd = "/usr/bin/python3 '" + std::string(GEODE_SOURCE_DIR) +
                           "/tests/conform/layer_model.py' '" + file + "' " + args;
   REQUIRE_MESSAGE(std::system(cmd.c_str()) == 0, cmd);
-  return io::read_model(file);
+  return io::read_model(file, {}, covering);
 }
 
 double side_set_area(const primal::Model& m, const primal::SideSet& s) {
@@ -310,6 +313,63 @@ TEST_CASE("the same layer recombined into quads only keeps its hexes and gets th
   conform::set_buffer_side(o, "");
   CHECK(!o.buffer_side_chosen);
   CHECK(o.buffer.side == conform::BufferSide::kHex);
+}
+
+TEST_CASE("a pyramid Gmsh folds over a quads-only layer's hex is turned back by unfold") {
+  // At n = 4 and 8 Gmsh puts a pyramid's apex on the hex's side of its twisted base quad, positive
+  // along one diagonal and ordered to read so: it lies on the same side as the hex and its four
+  // tets (refused, exit 2). unfold turns it back and moves its apex out into its tets.
+  const test::TempDir dir;
+  const primal::Model folded = layer_model(dir, "cylinder 4 out 0.15 quads", false);
+  primal::InputCheckOptions every;
+  every.max_findings = 100;
+  const primal::InputCheckResult before = primal::check_input(folded, every);
+  REQUIRE(before.findings.size() == 5);  // the pyramid against the hex and its four tets
+  for (const primal::InputFinding& f : before.findings) {
+    CHECK(f.fault == primal::InputFault::kSameSideFace);
+    REQUIRE(f.elements.size() == 2);
+    CHECK(f.elements[1] == before.findings[0].elements[1]);
+    CHECK(f.elements[1].kind == primal::ElementKind::kPyramid);
+  }
+  const primal::ElementRef pyramid = before.findings[0].elements[1];
+  CHECK(before.findings[0].elements[0].kind == primal::ElementKind::kHex);
+
+  primal::Model m = folded;
+  const primal::UnfoldResult u = primal::unfold(m);
+  REQUIRE(u.unfolded());
+  REQUIRE(u.turned.size() == 1);
+  CHECK(u.turned[0] == pyramid);
+  const auto p = primal::index_cast<std::size_t>(pyramid.index);
+  REQUIRE(u.moved.size() == 1);
+  CHECK(u.moved[0] == folded.pyramids[p][4]);  // its apex
+  CHECK(u.covered_once);
+  CHECK(primal::check_input(m).ok());
+  REQUIRE_NOTHROW(primal::check_geometry(m, "unfolded"));
+  // The pyramid's base reversed, nothing else: the apex alone moved, by less than the layer is
+  // thick.
+  CHECK(m.pyramids[p] == std::array<Index, 5>{folded.pyramids[p][0], folded.pyramids[p][3],
+                                              folded.pyramids[p][2], folded.pyramids[p][1],
+                                              folded.pyramids[p][4]});
+  for (std::size_t i = 0; i < m.pyramids.size(); ++i)
+    if (i != p) CHECK(m.pyramids[i] == folded.pyramids[i]);
+  CHECK(m.tets == folded.tets);
+  CHECK(m.hexes == folded.hexes);
+  std::size_t moved = 0;
+  for (std::size_t v = 0; v < m.points.size(); ++v) moved += m.points[v] != folded.points[v];
+  CHECK(moved == 1);
+  CHECK(u.farthest < 0.15);
+  // Now along both diagonals positive, the apex beyond the base as the hex's face has it.
+  const auto& c = m.pyramids[p];
+  const auto at = [&](std::size_t i) { return m.points[primal::index_cast<std::size_t>(c[i])]; };
+  for (std::size_t k = 0; k < 4; ++k)
+    CHECK(primal::tet_volume(at((k + 3) % 4), at(k), at((k + 1) % 4), at(4)) > 0.0);
+  // Not in the sanitized build (the thin layer's conform: tens of seconds there; the unfold
+  // above runs there).
+  if (test::kSanitized) return;
+  const conform::ConformResult r = conform::conform(m);
+  CHECK(conform::result_valid(r));
+  test::check_conform_result(r, -1, r.warnings.size());
+  CHECK(conform::output_min_scaled_jacobian(r) >= r.yardstick());
 }
 
 TEST_CASE("templates a quads-only layer's buffer hexes invert are untangled, then smoothed") {

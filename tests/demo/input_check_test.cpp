@@ -780,7 +780,7 @@ TEST_CASE("--unfold: the tets Gmsh folds near its pyramids turned back, the ring
   CHECK(before.findings[0].fault == InputFault::kSameSideFace);
 
   primal::Model m = folded;
-  const primal::UnfoldResult u = primal::unfold_tets(m);
+  const primal::UnfoldResult u = primal::unfold(m);
   REQUIRE(u.unfolded());
   CHECK(u.turned.size() == u.moved.size());
   CHECK(primal::check_input(m).ok());
@@ -806,7 +806,7 @@ TEST_CASE("--unfold: the tets Gmsh folds near its pyramids turned back, the ring
   io::write_model(folded, in);
   const auto refused = test::geode_cli("conform " + in.string() + " -o " + out.string(), true);
   CHECK(refused.code == 2);
-  CHECK(refused.out.find("--unfold turns such tets back") != std::string::npos);
+  CHECK(refused.out.find("--unfold turns such cells back") != std::string::npos);
   const auto run =
       test::geode_cli("conform " + in.string() + " -o " + out.string() + " --unfold --quiet", true);
   INFO(run.out);
@@ -821,7 +821,7 @@ TEST_CASE("--unfold: the tets Gmsh folds near its pyramids turned back, the ring
   if (!twice.tet_ids.empty())
     twice.tet_ids.push_back(*std::max_element(twice.tet_ids.begin(), twice.tet_ids.end()) + 1);
   const primal::Model kept = twice;
-  CHECK(!primal::unfold_tets(twice).unfolded());
+  CHECK(!primal::unfold(twice).unfolded());
   CHECK(twice.points == kept.points);
   CHECK(twice.tets == kept.tets);
 }
