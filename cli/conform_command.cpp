@@ -135,6 +135,19 @@ Eigen::Vector3d template_box(const std::string& text) {
   return {b[0], b[1], b[2]};
 }
 
+// "2 tets and 1 pyramid", "1 tet", "0 tets": cells counted by kind (tets and pyramids).
+std::string counted_cells(const std::vector<primal::ElementRef>& cells) {
+  std::size_t tets = 0, pyramids = 0;
+  for (const primal::ElementRef& e : cells)
+    ++(e.kind == primal::ElementKind::kPyramid ? pyramids : tets);
+  const auto counted = [](std::size_t n, const char* what) {
+    return std::to_string(n) + " " + what + (n == 1 ? "" : "s");
+  };
+  if (pyramids == 0) return counted(tets, "tet");
+  return tets == 0 ? counted(pyramids, "pyramid")
+                   : counted(tets, "tet") + " and " + counted(pyramids, "pyramid");
+}
+
 // The covering check's options: a fold's refusal points at --unfold unless it was given.
 primal::InputCheckOptions fold_hint(const ConformArgs& a) {
   primal::InputCheckOptions o;
@@ -200,33 +213,29 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
     const auto started = std::chrono::steady_clock::now();
     const primal::UnfoldResult u = primal::unfold(model);
     covered_once = u.covered_once;
-    // "2 tets and 1 pyramid", "1 tet"
-    std::size_t pyramids = 0;
-    for (const primal::ElementRef& e : u.turned)
-      pyramids += e.kind == primal::ElementKind::kPyramid;
-    const std::size_t tets = u.turned.size() - pyramids;
-    const auto counted = [](std::size_t n, const char* what) {
-      return std::to_string(n) + " " + what + (n == 1 ? "" : "s");
-    };
-    const std::string turned = pyramids == 0 ? counted(tets, "tet")
-                               : tets == 0
-                                   ? counted(pyramids, "pyramid")
-                                   : counted(tets, "tet") + " and " + counted(pyramids, "pyramid");
     progress.stage(stage_line(
-        "unfold: folded cells turned back: " + turned,
+        "unfold: " + counted_cells(u.turned) + " turned back, " + counted_cells(u.inverted) +
+            " inverted",
         std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count()));
     if (u.unfolded()) {
       // The analyst's mesh changed: said whatever --quiet says.
-      std::string ids;
+      std::string ids, what;
       for (std::size_t i = 0; i < u.moved.size() && i < 10; ++i)
         ids += (i ? " " : "") + std::to_string(primal::node_id(model, u.moved[i]));
-      const bool one = u.turned.size() == 1, one_node = u.moved.size() == 1;
-      std::cerr << "geode: warning: " << prefix << "--unfold: " << turned << " folded over "
-                << (one ? "its" : "their") << " neighbours turned back, node"
+      if (!u.turned.empty())
+        what = counted_cells(u.turned) + " folded over " +
+               (u.turned.size() == 1 ? "its" : "their") + " neighbours turned back";
+      if (!u.inverted.empty())
+        what += (what.empty() ? "" : ", ") + counted_cells(u.inverted) + " inverted";
+      const bool one_node = u.moved.size() == 1;
+      std::cerr << "geode: warning: " << prefix << "--unfold: " << what << ", node"
                 << (one_node ? " " : "s ") << ids << (u.moved.size() > 10 ? " ..." : "")
                 << " moved into " << (one_node ? "its" : "their") << " cells (by at most "
                 << primal::number_text(u.farthest) << ")\n";
     }
+    // Read without the geometry check (inverted tets and pyramids are unfold's to mend): run
+    // here, naming what is left.
+    if (!source.empty()) primal::check_geometry(model, source);
   }
   // Read without the covering check where nodes are merged (duplicated interface nodes look
   // like a gap) or folds mended: run here.
@@ -475,8 +484,11 @@ void add_conform_commands(CLI::App& app) {
       templates = conform::build_reference_templates_ahead(
           args->template_box.empty() ? conform::ConformOptions{}.template_box
                                      : template_box(args->template_box));
+    // With --unfold neither the geometry nor the covering check at read: run after unfold.
+    primal::ReadOptions read;
+    read.check_geometry = !args->unfold;
     primal::Model model = io::read_model(
-        args->input, {}, args->merge_tolerance < 0 && !args->unfold, nullptr, fold_hint(*args));
+        args->input, read, args->merge_tolerance < 0 && !args->unfold, nullptr, fold_hint(*args));
     join_block_lists(model, args->join_blocks, args->input);
     run(std::move(model), *args, format, false, args->input);
   });

@@ -116,7 +116,26 @@ UnfoldResult unfold(Model& model) {
   o.max_findings = 1000;
   const InputCheckResult check = check_input(model, o);
   UnfoldResult none;
-  if (check.ok()) {
+  // Tets and pyramids the readers refuse as inverted (check_geometry), read without that check:
+  // a node pushed through a face and left there, the node orders agreeing with the neighbours'.
+  std::vector<ElementRef> inverted;
+  for (ElementKind kind : {ElementKind::kTet, ElementKind::kPyramid})
+    for (std::size_t i = 0; i < element_count(model, kind); ++i) {
+      const ElementRef e{kind, index_cast(i)};
+      std::array<double, 4> v{};
+      std::size_t n = 0;
+      for (const Tet& t : pieces(model, e))
+        v[n++] = tet_volume(model.points[index_cast<std::size_t>(t[0])],
+                            model.points[index_cast<std::size_t>(t[1])],
+                            model.points[index_cast<std::size_t>(t[2])],
+                            model.points[index_cast<std::size_t>(t[3])]);
+      // A pyramid along a diagonal: its two corner tets off it (pieces' order: corners 0 to 3).
+      const bool positive = kind == ElementKind::kTet
+                                ? v[0] > 0.0
+                                : (v[1] > 0.0 && v[3] > 0.0) || (v[0] > 0.0 && v[2] > 0.0);
+      if (!positive) inverted.push_back(e);
+    }
+  if (check.ok() && inverted.empty()) {
     none.covered_once = true;
     return none;
   }
@@ -129,7 +148,7 @@ UnfoldResult unfold(Model& model) {
     if (f.fault == InputFault::kSameSideFace)
       for (const ElementRef& e : f.elements)
         if (mendable(e.kind)) work.push_back(e);
-  if (work.empty()) return none;
+  if (work.empty() && inverted.empty()) return none;
 
   // Near the folds (their elements' nodes and three rings of elements around them, so that each
   // node moved has its whole star and each element turned its neighbours'): every element's
@@ -137,8 +156,9 @@ UnfoldResult unfold(Model& model) {
   // node: on a boundary face, elements it cannot move in, blocks.
   const std::size_t nv = model.points.size();
   std::vector<char> near(nv, 0);
-  for (const ElementRef& e : work)
-    for (Index v : element_corners(model, e)) near[index_cast<std::size_t>(v)] = 1;
+  for (const auto* list : {&work, &inverted})
+    for (const ElementRef& e : *list)
+      for (Index v : element_corners(model, e)) near[index_cast<std::size_t>(v)] = 1;
   const auto touches = [&](std::span<const Index> cs) {
     return std::any_of(cs.begin(), cs.end(),
                        [&](Index v) { return near[index_cast<std::size_t>(v)] == 1; });
@@ -312,6 +332,8 @@ UnfoldResult unfold(Model& model) {
       turn(model, e);  // as the geometry has it: inverted
       result.turned.push_back(e);
     }
+  for (const ElementRef& e : inverted)
+    if (!turned(e)) result.inverted.push_back(e);
   // The pieces of v's elements, each with v a corner (so volume_with can move it).
   const auto pieces_at = [&](Index v) {
     std::vector<Tet> all;
@@ -324,7 +346,9 @@ UnfoldResult unfold(Model& model) {
     for (const Tet& t : ts) d = std::min(d, volume_with(model, t, v, x));
     return d;
   };
-  for (const ElementRef& e : result.turned) {
+  std::vector<ElementRef> mend = result.turned;
+  mend.insert(mend.end(), result.inverted.begin(), result.inverted.end());
+  for (const ElementRef& e : mend) {
     const auto cs = element_corners(model, e);
     if (least(pieces(model, e), cs[0], model.points[index_cast<std::size_t>(cs[0])]) > 0.0)
       continue;  // put right by a node moved for a neighbour

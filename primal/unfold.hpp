@@ -9,7 +9,9 @@
 // turned back), turns it back (now inverted, as the geometry has it), and moves one of its free
 // nodes (a pyramid's: its apex) toward the point of its element star farthest from the planes of
 // the star's outer faces (the star's Chebyshev centre), until every element around it is
-// positive again and well clear of flat (a pyramid along both base diagonals).
+// positive again and well clear of flat (a pyramid along both base diagonals). A tet or pyramid
+// inverted in a model read without check_geometry (a pyramid positive along neither diagonal:
+// Gmsh's apex below a twisted base) has a node moved the same way, without the turn.
 #include <vector>
 
 #include <geode/primal/model.hpp>
@@ -17,21 +19,22 @@
 namespace geode::primal {
 
 struct UnfoldResult {
-  std::vector<ElementRef> turned;  // tets and pyramids whose node order was turned back
-  std::vector<Index> moved;        // the nodes moved (at most one per turned element)
-  double farthest = 0.0;           // the longest distance a node moved
+  std::vector<ElementRef> turned;    // tets and pyramids whose node order was turned back
+  std::vector<ElementRef> inverted;  // tets and pyramids read inverted, not turned
+  std::vector<Index> moved;          // the nodes moved (at most one per turned or inverted element)
+  double farthest = 0.0;             // the longest distance a node moved
   // check_input found nothing (before, or after the mend): no need to run it again. When false
   // the model is as it was given, and require_single_covering names its first fault.
   bool covered_once = false;
   bool unfolded() const { return !moved.empty(); }
 };
 
-// Mends the folds check_input finds as above, and only where every fold it found is mended and
-// check_input then finds nothing: else the model is left as it was (and the result empty), so
-// that the refusal names the first fault as before. A node is moved only if it lies on no
-// boundary face (the model's boundary and its materials do
-// not move), no node set and no side set's face, and its elements are tets and pyramids (whose
-// apex it is) of one block.
+// Mends the folds check_input finds and the inverted tets and pyramids as above, and only where
+// every one is mended and check_input then finds nothing: else the model is left as it was (and
+// the result empty), so that the refusal names the first fault as before. A node is moved only
+// if it lies on no boundary face (the model's boundary and its materials do not move), no node
+// set and no side set's face, and its elements are tets and pyramids (whose apex it is) of one
+// block. Other elements check_geometry refuses stay: the caller runs it after.
 UnfoldResult unfold(Model& model);
 
 }  // namespace geode::primal

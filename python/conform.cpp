@@ -181,7 +181,7 @@ py::dict conform_arrays(const py::handle& points, const py::dict& cells,
   // cell's 1-based position among the mesh's cells, a .msh file's element tag when meshio or
   // geode wrote it; messages name the source).
   primal::validate(model, source);
-  primal::check_geometry(model, source);
+  if (!unfold) primal::check_geometry(model, source);  // with unfold: after it (its inverted cells)
 
   conform::ConformOptions opts;
   // Hexes named as the returned mesh holds them: grouped by block in ascending id, from 0.
@@ -229,7 +229,10 @@ py::dict conform_arrays(const py::handle& points, const py::dict& cells,
       merged = primal::merge_coincident_nodes(model, *merge);
     }
     primal::UnfoldResult unfolded;
-    if (unfold) unfolded = primal::unfold(model);  // as --unfold
+    if (unfold) {  // as --unfold
+      unfolded = primal::unfold(model);
+      primal::check_geometry(model, source);
+    }
     // The read-time check of a file (after merging: duplicated nodes look like a gap), which
     // local verification, the default, takes as given; its messages name the source.
     primal::InputCheckOptions checked;

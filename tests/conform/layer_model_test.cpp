@@ -19,6 +19,7 @@
 #include <geode/conform/buffer_layer.hpp>
 #include <geode/conform/conform.hpp>
 #include <geode/conform/report.hpp>
+#include <geode/io/formats.hpp>
 #include <geode/io/read_model.hpp>
 #include <geode/primal/boundary.hpp>
 #include <geode/primal/errors.hpp>
@@ -28,6 +29,7 @@
 #include <geode/primal/unfold.hpp>
 #include <geode/primal/validity.hpp>
 
+#include "../support/cli_run.hpp"
 #include "../support/conform_checks.hpp"
 #include "../support/sanitized.hpp"
 #include "../support/temp_dir.hpp"
@@ -363,6 +365,33 @@ TEST_CASE("a pyramid Gmsh folds over a quads-only layer's hex is turned back by 
   const auto at = [&](std::size_t i) { return m.points[primal::index_cast<std::size_t>(c[i])]; };
   for (std::size_t k = 0; k < 4; ++k)
     CHECK(primal::tet_volume(at((k + 3) % 4), at(k), at((k + 1) % 4), at(4)) > 0.0);
+
+  // Another pyramid's apex pushed just through its base, its node order kept: inverted along
+  // both diagonals as read (Gmsh writes such pyramids, beside tets it writes twice), refused by
+  // the readers' geometry check, which --unfold runs after it instead. Its apex moves back out.
+  primal::Model pushed = m;
+  const std::size_t q = (p + 1) % m.pyramids.size();
+  const auto qc = pushed.pyramids[q];
+  Point centre = Point::Zero();
+  for (std::size_t i = 0; i < 4; ++i)
+    centre += pushed.points[primal::index_cast<std::size_t>(qc[i])] / 4.0;
+  Point& apex = pushed.points[primal::index_cast<std::size_t>(qc[4])];
+  apex = centre - 0.2 * (apex - centre);
+  CHECK_THROWS_WITH_AS(primal::check_geometry(pushed, "pushed"), doctest::Contains("inverted"),
+                       InvalidInput);
+  const primal::Model before_mend = pushed;
+  const primal::UnfoldResult mended = primal::unfold(pushed);
+  REQUIRE(mended.unfolded());
+  CHECK(mended.turned.empty());
+  CHECK(std::find(mended.inverted.begin(), mended.inverted.end(),
+                  primal::ElementRef{primal::ElementKind::kPyramid, primal::index_cast(q)}) !=
+        mended.inverted.end());
+  CHECK(mended.moved == std::vector<Index>{qc[4]});
+  CHECK(primal::check_input(pushed).ok());
+  CHECK_NOTHROW(primal::check_geometry(pushed, "mended"));
+  CHECK(pushed.pyramids == before_mend.pyramids);
+  CHECK(pushed.tets == before_mend.tets);
+
   // Not in the sanitized build (the thin layer's conform: tens of seconds there; the unfold
   // above runs there).
   if (test::kSanitized) return;
@@ -370,6 +399,24 @@ TEST_CASE("a pyramid Gmsh folds over a quads-only layer's hex is turned back by 
   CHECK(conform::result_valid(r));
   test::check_conform_result(r, -1, r.warnings.size());
   CHECK(conform::output_min_scaled_jacobian(r) >= r.yardstick());
+  // The command: the file with the folded pyramid and the inverted one, refused naming the
+  // inverted one (the geometry check comes first), conformed with --unfold.
+  const auto file = dir.path / "pushed.msh", out = dir.path / "pushed.exo";
+  primal::Model both = before_mend;
+  both.pyramids[p] = folded.pyramids[p];
+  both.points[primal::index_cast<std::size_t>(folded.pyramids[p][4])] =
+      folded.points[primal::index_cast<std::size_t>(folded.pyramids[p][4])];
+  io::write_model(both, file);
+  const auto refused = test::geode_cli("conform " + file.string() + " -o " + out.string(), true);
+  CHECK(refused.code == 2);
+  CHECK(refused.out.find("is inverted at its base corner") != std::string::npos);
+  const auto run = test::geode_cli(
+      "conform " + file.string() + " -o " + out.string() + " --unfold --quiet", true);
+  INFO(run.out);
+  CHECK(run.code == 0);
+  CHECK(run.out.find("--unfold: 1 pyramid folded over its neighbours turned back, 1 pyramid "
+                     "inverted, nodes ") != std::string::npos);
+  CHECK(std::filesystem::exists(out));
 }
 
 TEST_CASE("templates a quads-only layer's buffer hexes invert are untangled, then smoothed") {
