@@ -317,6 +317,27 @@ TEST_CASE("the same layer recombined into quads only keeps its hexes and gets th
   CHECK(o.buffer.side == conform::BufferSide::kHex);
 }
 
+TEST_CASE("a layer whose holes take no buffer layer is split into tets after all") {
+  // The sphere's layer 0.15 thick at n = 6 (Gmsh folds a tet of it too: unfolded first) is too
+  // thick to be split at once; with its wedges alone split, no direction at a node where a
+  // hole's wall meets the layer's face lies above all its interface faces, from either side:
+  // refused (exit 3) until the layer was split into tets on that refusal as on a poor result.
+  const test::TempDir dir;
+  primal::Model input = layer_model(dir, "sphere 6 out 0.15", false);
+  REQUIRE(!input.wedges.empty());
+  REQUIRE(primal::unfold(input).unfolded());
+  const conform::ConformResult r = conform::conform(input);
+  test::check_conform_result(r, 0, r.warnings.size());
+  CHECK(r.hexes_split == primal::index_cast(input.hexes.size()));
+  CHECK(r.wedges_split == primal::index_cast(input.wedges.size()));
+  CHECK(conform::output_min_scaled_jacobian(r) >= r.yardstick());
+  const auto said = std::find_if(r.warnings.begin(), r.warnings.end(), [](const std::string& w) {
+    return w.find("split into tets: ") != std::string::npos &&
+           w.find("the holes they leave take no buffer layer") != std::string::npos;
+  });
+  CHECK(said != r.warnings.end());
+}
+
 TEST_CASE("a pyramid Gmsh folds over a quads-only layer's hex is turned back by unfold") {
   // At n = 4 and 8 Gmsh puts a pyramid's apex on the hex's side of its twisted base quad, positive
   // along one diagonal and ordered to read so: it lies on the same side as the hex and its four
