@@ -256,9 +256,9 @@ def conform(mesh=None, *, points=None, cells=None, cell_blocks=None, name="mesh"
     order (a wedge in VTK's mirrored order, a pyramid's base clockwise) is inverted and raises
     InputError naming it by its 1-based position among the cells (a .msh file's element tag).
     The options are those of `geode conform` (buffer_side=None: not given, hex or tet as
-    `geode conform` chooses without --buffer-side; unfold=True as --unfold, with a GeodeWarning
-    where it moved nodes, the report's "unfolded_nodes" naming them, 0-based, after
-    merge_tolerance's merging if any).
+    `geode conform` chooses without --buffer-side; unfold=True as --unfold: tets and pyramids a
+    mesher folded or wrote inverted mended, with a GeodeWarning where it moved nodes, the
+    report's "unfolded_nodes" naming them, 0-based, after merge_tolerance's merging if any).
     Returns (meshio.Mesh, report): the output with one cell block and one cell set per block,
     block ids as gmsh:physical, node sets as point sets; the report as `--report` writes it,
     with "side_sets" ([{id, name, sides: K x 2 (hex, local face)}]). Hexes (the sides', each
