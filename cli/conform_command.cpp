@@ -135,19 +135,6 @@ Eigen::Vector3d template_box(const std::string& text) {
   return {b[0], b[1], b[2]};
 }
 
-// "2 tets and 1 pyramid", "1 tet", "0 tets": cells counted by kind (tets and pyramids).
-std::string counted_cells(const std::vector<primal::ElementRef>& cells) {
-  std::size_t tets = 0, pyramids = 0;
-  for (const primal::ElementRef& e : cells)
-    ++(e.kind == primal::ElementKind::kPyramid ? pyramids : tets);
-  const auto counted = [](std::size_t n, const char* what) {
-    return std::to_string(n) + " " + what + (n == 1 ? "" : "s");
-  };
-  if (pyramids == 0) return counted(tets, "tet");
-  return tets == 0 ? counted(pyramids, "pyramid")
-                   : counted(tets, "tet") + " and " + counted(pyramids, "pyramid");
-}
-
 // The covering check's options: a fold's refusal points at --unfold unless it was given.
 primal::InputCheckOptions fold_hint(const ConformArgs& a) {
   primal::InputCheckOptions o;
@@ -214,25 +201,10 @@ void run(primal::Model model, const ConformArgs& a, const std::string& format, b
     const primal::UnfoldResult u = primal::unfold(model);
     covered_once = u.covered_once;
     progress.stage(stage_line(
-        "unfold: " + counted_cells(u.turned) + " turned back, " + counted_cells(u.inverted) +
-            " inverted",
+        unfold_stage(u),
         std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count()));
-    if (u.unfolded()) {
-      // The analyst's mesh changed: said whatever --quiet says.
-      std::string ids, what;
-      for (std::size_t i = 0; i < u.moved.size() && i < 10; ++i)
-        ids += (i ? " " : "") + std::to_string(primal::node_id(model, u.moved[i]));
-      if (!u.turned.empty())
-        what = counted_cells(u.turned) + " folded over " +
-               (u.turned.size() == 1 ? "its" : "their") + " neighbours turned back";
-      if (!u.inverted.empty())
-        what += (what.empty() ? "" : ", ") + counted_cells(u.inverted) + " inverted";
-      const bool one_node = u.moved.size() == 1;
-      std::cerr << "geode: warning: " << prefix << "--unfold: " << what << ", node"
-                << (one_node ? " " : "s ") << ids << (u.moved.size() > 10 ? " ..." : "")
-                << " moved into " << (one_node ? "its" : "their") << " cells (by at most "
-                << primal::number_text(u.farthest) << ")\n";
-    }
+    // The analyst's mesh changed: said whatever --quiet says.
+    if (u.unfolded()) std::cerr << "geode: warning: " << prefix << unfold_warning(model, u) << "\n";
     // Read without the geometry check (inverted tets and pyramids are unfold's to mend): run
     // here, naming what is left.
     if (!source.empty()) primal::check_geometry(model, source);
@@ -395,11 +367,7 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
                 "first merge nodes closer than this distance (model units), for parts meshed\n"
                 "separately whose interface nodes are duplicated")
       ->check(number_check(0, 1e300));
-  c->add_flag("--unfold", a.unfold,
-              "turn back tets and pyramids a mesher folded over their neighbours (Gmsh 4.8\n"
-              "near its pyramids: a cell written positive lying on the same side of its faces\n"
-              "as every neighbour) and move one free node of each (a pyramid's apex) into its\n"
-              "cells; only where that mends every fold; warns naming the nodes moved");
+  add_unfold_option(c, a.unfold);
   c->add_option(
        "--pyramids", a.pyramids,
        "what pyramids of a hybrid mesh become: split (default): two tets along the base diagonal\n"

@@ -286,6 +286,54 @@ std::vector<int> block_ids(const std::string& text) {
 }
 }  // namespace
 
+namespace {
+
+// "2 tets and 1 pyramid", "1 tet", "0 tets": cells counted by kind (tets and pyramids).
+std::string counted_cells(const std::vector<primal::ElementRef>& cells) {
+  std::size_t tets = 0, pyramids = 0;
+  for (const primal::ElementRef& e : cells)
+    ++(e.kind == primal::ElementKind::kPyramid ? pyramids : tets);
+  const auto counted = [](std::size_t n, const char* what) {
+    return std::to_string(n) + " " + what + (n == 1 ? "" : "s");
+  };
+  if (pyramids == 0) return counted(tets, "tet");
+  return tets == 0 ? counted(pyramids, "pyramid")
+                   : counted(tets, "tet") + " and " + counted(pyramids, "pyramid");
+}
+
+}  // namespace
+
+CLI::Option* add_unfold_option(CLI::App* app, bool& unfold) {
+  return app->add_flag(
+      "--unfold", unfold,
+      "turn back tets and pyramids a mesher folded over their neighbours (Gmsh 4.8 near its\n"
+      "pyramids: a cell written positive lying on the same side of its faces as every\n"
+      "neighbour) and move one free node of each (a pyramid's apex) into its cells; tets and\n"
+      "pyramids written inverted get a node moved the same way (the geometry check runs\n"
+      "after); only where that mends every one; warns naming the nodes moved");
+}
+
+std::string unfold_stage(const primal::UnfoldResult& result) {
+  return "unfold: " + counted_cells(result.turned) + " turned back, " +
+         counted_cells(result.inverted) + " inverted";
+}
+
+std::string unfold_warning(const primal::Model& model, const primal::UnfoldResult& result) {
+  std::string what;
+  if (!result.turned.empty())
+    what = counted_cells(result.turned) + " folded over " +
+           (result.turned.size() == 1 ? "its" : "their") + " neighbours turned back";
+  if (!result.inverted.empty())
+    what += (what.empty() ? "" : ", ") + counted_cells(result.inverted) + " inverted";
+  std::string ids;
+  for (std::size_t i = 0; i < result.moved.size() && i < 10; ++i)
+    ids += (i ? " " : "") + std::to_string(primal::node_id(model, result.moved[i]));
+  const bool one = result.moved.size() == 1;
+  return "--unfold: " + what + ", node" + (one ? " " : "s ") + ids +
+         (result.moved.size() > 10 ? " ..." : "") + " moved into " + (one ? "its" : "their") +
+         " cells (by at most " + primal::number_text(result.farthest) + ")";
+}
+
 CLI::Option* add_join_blocks_option(CLI::App* app, std::vector<std::string>& lists) {
   return app
       ->add_option(

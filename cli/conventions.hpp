@@ -28,6 +28,7 @@
 #include <geode/io/formats.hpp>
 #include <geode/primal/mesh.hpp>
 #include <geode/primal/model.hpp>
+#include <geode/primal/unfold.hpp>
 
 namespace geode::cli {
 
@@ -70,6 +71,13 @@ std::array<double, 3> parse_box(const std::string& option, const std::string& te
 CLI::Option* add_join_blocks_option(CLI::App* app, std::vector<std::string>& lists);
 void join_block_lists(primal::Model& model, const std::vector<std::string>& lists,
                       const std::string& source);
+
+// --unfold (conform, geode_mpi): tets and pyramids a mesher folded or wrote inverted, mended by
+// primal::unfold before the covering check. The stage line ("unfold: 1 pyramid turned back, 0
+// tets inverted") and the warning naming the nodes moved (without "warning: ").
+CLI::Option* add_unfold_option(CLI::App* app, bool& unfold);
+std::string unfold_stage(const primal::UnfoldResult& result);
+std::string unfold_warning(const primal::Model& model, const primal::UnfoldResult& result);
 
 // ---- Outputs ----------------------------------------------------------------------------------
 

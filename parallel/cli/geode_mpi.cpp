@@ -178,7 +178,7 @@ int run(int argc, char** argv, int rank, int size) {
   app.set_version_flag("--version", cli::version_text(), "print the version and exit");
   CLI::App* conform = app.add_subcommand("conform", "conform a hex + tet model, partitioned");
   std::string input, output, smooth = "local", side, verify = "local";  // side: automatic
-  bool join = false, quiet = false;
+  bool join = false, quiet = false, unfold = false;
   int rings = 4, threads = 1, zone_threads = 0;
   double thickness = 0;
   conform
@@ -236,6 +236,7 @@ int run(int argc, char** argv, int rank, int size) {
       ->check(CLI::Range(0, 4096));
   std::vector<std::string> join_blocks;
   cli::add_join_blocks_option(conform, join_blocks);
+  cli::add_unfold_option(conform, unfold);
   conform->add_flag("-q,--quiet", quiet, "no progress or summary");
   try {
     cli::refuse_empty_arguments(argc, argv);
@@ -296,9 +297,14 @@ int run(int argc, char** argv, int rank, int size) {
         };
       // Each rank frees the input once it has its piece, and reads it again only if the zone
       // grows after that (the read-time check passed already).
+      // With --unfold (as geode conform's): read without the geometry check, then every rank
+      // mends the same folds in its whole copy (unfold is deterministic).
+      primal::ReadOptions read;
+      read.check_geometry = !unfold;
       options.reload = [&] {
         io::ReadWarnings said_at_the_first_read;
-        primal::Model again = io::read_model(input, {}, false);
+        primal::Model again = io::read_model(input, read, false);
+        if (unfold) primal::unfold(again);
         cli::join_block_lists(again, join_blocks, input);
         return again;
       };
@@ -310,11 +316,25 @@ int run(int argc, char** argv, int rank, int size) {
         RankZeroReadWarnings warnings(rank);
         primal::InputCheckOptions check = parallel::shared_input_check(MPI_COMM_WORLD);
         check.element_pairs = &element_pairs;
-        return io::read_model(input, {}, true, &file_partition, check);
+        check.fold_hint =
+            " (a mesher's fold: --unfold turns such cells back, or mesh again at another size)";
+        return io::read_model(input, read, !unfold, &file_partition, check);
       }();
-      cli::join_block_lists(model, join_blocks, input);
       say("read " + input + ": " + std::to_string(primal::element_count(model)) + " elements",
           true);
+      if (unfold) {
+        const primal::UnfoldResult u = primal::unfold(model);
+        say(cli::unfold_stage(u), true);
+        if (rank == 0 && u.unfolded())  // the analyst's mesh changed: said whatever -q says
+          std::cerr << "geode_mpi: warning: " << input << ": " << cli::unfold_warning(model, u)
+                    << "\n";
+        primal::check_geometry(model, input);
+        // The shared check even where unfold ran its own: its face pairs are the partition's.
+        primal::InputCheckOptions check = parallel::shared_input_check(MPI_COMM_WORLD);
+        check.element_pairs = &element_pairs;
+        primal::require_single_covering(model, input, check);
+      }
+      cli::join_block_lists(model, join_blocks, input);
       fail_for_test(rank, "read");
       // The input's own partition (a partitioned .msh, a Nemesis set) unless it has fewer parts
       // than there are ranks: then METIS (parallel/partition.hpp).

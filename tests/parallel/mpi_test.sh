@@ -8,6 +8,7 @@
 # usage: mpi_test.sh GEODE GEODE_MPI PARALLEL_CHECK MPIEXEC MODEL SIZE WORKDIR
 set -euo pipefail
 geode=$1 geode_mpi=$2 check=$3 mpiexec=$4 model=$5 size=$6 dir=$7
+flags=  # options of both the serial and the MPI runs
 # OpenMPI refuses root unless told (containers and CI run tests as root).
 if [ "$(id -u)" = 0 ]; then export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1; fi
 here=$(cd "$(dirname "$0")" && pwd)
@@ -30,15 +31,26 @@ elif [ "$model" = apart ]; then  # two bodies that share no face: each diced alo
 elif [ "$model" = layer-quads ]; then  # a nearly thin quads-only layer: both sides tried
   input=in.msh
   /usr/bin/python3 "$here/../conform/layer_model.py" "$input" cylinder "$size" out 0.15 quads
+elif [ "$model" = layer-folded ]; then  # the same at a size where Gmsh folds a pyramid: --unfold
+  input=in.msh
+  /usr/bin/python3 "$here/../conform/layer_model.py" "$input" cylinder "$size" out 0.15 quads
+  flags=--unfold
+  # Refused without it, the option named (every rank reads the file: one line).
+  status=0
+  timeout 300 "$mpiexec" --oversubscribe -np 2 "$geode_mpi" conform "$input" -o refused.exo -q \
+    2>refused.txt || status=$?
+  [ "$status" = 2 ] && [ "$(grep -c 'lie on the same side' refused.txt)" = 1 ] &&
+    grep -q -- '--unfold turns such cells back' refused.txt ||
+    { echo "layer-folded: exit $status without --unfold"; cat refused.txt; exit 1; }
 else
   input=in.exo
   "$geode" demo --model "$model" -n "$size" --save-input "$input"
 fi
-"$geode" conform "$input" -o serial.exo --quiet 2>serial_warnings.txt
+"$geode" conform "$input" -o serial.exo --quiet $flags 2>serial_warnings.txt
 sed -i 's/^geode: warning: //' serial_warnings.txt
 for n in 1 2 3 4; do
   timeout 300 "$mpiexec" --oversubscribe -np "$n" "$geode_mpi" conform "$input" -o "out$n.exo" \
-    --join --rings 1 -q 2>"warnings$n.txt"
+    --join --rings 1 -q $flags 2>"warnings$n.txt"
   "$check" same serial.exo "out$n.exo"
   # The serial run's warnings, once, on stderr under -q (layer-mixed: its wedges split, the
   # buffer layer carved from the tets across their block's faces, so blocks do not keep their
@@ -60,7 +72,7 @@ for n in 2 3 4; do cmp out1.exo "out$n.exo"; done
 # nothing left to dice beside it (timeout: a rank left waiting would hang the suite).
 for n in 2 3; do
   timeout 300 "$mpiexec" --oversubscribe -np "$n" "$geode_mpi" conform "$input" -o "default$n.exo" \
-    --join -q
+    --join -q $flags
   "$check" same serial.exo "default$n.exo"
 done
 # The sets model's input is a .msh; its serial output, an Exodus file with blocks, node and side
