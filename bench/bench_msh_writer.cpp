@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
         });
         if (r.seconds < best) best = r.seconds, mem = r.peak_mib;
       }
-      const Model back = io::read_gmsh(file, {false});
+      const Model back = io::read_gmsh(file, {false, {}});
       std::printf(
           "%-10s %-7s %8.3f s %8.1f MiB peak %8.1f MiB file, read back %zu hexes %zu tets\n",
           c.name, who ? "libgmsh" : "geode", best, mem,

@@ -455,6 +455,10 @@ void add_conform_commands(CLI::App& app) {
     // With --unfold neither the geometry nor the covering check at read: run after unfold.
     primal::ReadOptions read;
     read.check_geometry = !args->unfold;
+    if (!args->unfold)  // with it, the geometry is checked after unfold
+      read.inverted_hint =
+          " (a mesher's fault: --unfold moves a node of such cells, or mesh again at another "
+          "size)";
     primal::Model model = io::read_model(
         args->input, read, args->merge_tolerance < 0 && !args->unfold, nullptr, fold_hint(*args));
     join_block_lists(model, args->join_blocks, args->input);

@@ -609,7 +609,8 @@ Model model_of(const Contents& contents, const std::string& source, const ReadOp
   Model model = build_model(contents, source);
   sanitize_names(model);
   validate(model, source);
-  options.check_geometry ? check_geometry(model, source) : check_points(model, source);
+  options.check_geometry ? check_geometry(model, source, options.inverted_hint)
+                         : check_points(model, source);
   return model;
 }
 

@@ -990,7 +990,8 @@ Model parse_gmsh(std::string_view content, const std::string& source, const Read
                  FilePartition* partition) {
   if (partition) *partition = {};
   Model model = MshReader(content, source, partition).read();
-  options.check_geometry ? check_geometry(model, source) : check_points(model, source);
+  options.check_geometry ? check_geometry(model, source, options.inverted_hint)
+                         : check_points(model, source);
   return model;
 }
 

@@ -82,7 +82,8 @@ class SetReader {
     std::int64_t local_nodes = 0, local_elements = 0;
     for (std::size_t p = 0; p < set_.files.size(); ++p) {
       // Geometry is checked once, on the joined model.
-      pieces_[p] = read_exodus_piece(set_.files[p], {.check_geometry = false}, &info[p]);
+      pieces_[p] = read_exodus_piece(set_.files[p], {.check_geometry = false, .inverted_hint = {}},
+                                     &info[p]);
       const std::string file = set_.files[p].string();
       if (info[p].processors == 0)
         throw InvalidInput(file + ": no Nemesis I counts (not a piece of a partitioned set)");
@@ -295,7 +296,8 @@ std::optional<NemesisSet> find_nemesis_set(const fs::path& path) {
 Model read_nemesis_set(const NemesisSet& set, const ReadOptions& options,
                        FilePartition* partition) {
   Model model = SetReader(set, partition).read();
-  options.check_geometry ? check_geometry(model, set.name()) : check_points(model, set.name());
+  options.check_geometry ? check_geometry(model, set.name(), options.inverted_hint)
+                         : check_points(model, set.name());
   return model;
 }
 

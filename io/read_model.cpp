@@ -184,7 +184,8 @@ Model model_from_vtk(const VtkGrid& grid, const ReadOptions& options) {
   read_tagged_boundary_cells(grid, block_array, blocks, model);
   sanitize_names(model);
   validate(model, grid.source);
-  options.check_geometry ? check_geometry(model, grid.source) : check_points(model, grid.source);
+  options.check_geometry ? check_geometry(model, grid.source, options.inverted_hint)
+                         : check_points(model, grid.source);
   return model;
 }
 

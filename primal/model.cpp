@@ -448,7 +448,8 @@ void check_points(const Model& model, std::string_view source) {
                          " has a non-finite coordinate");
 }
 
-std::vector<std::string> geometry_findings(const Model& model, std::size_t max_findings) {
+std::vector<std::string> geometry_findings(const Model& model, std::size_t max_findings,
+                                           std::string_view inverted_hint) {
   std::vector<std::string> found;
   // Adds a finding; true once there are max_findings.
   const auto add = [&](std::string text) {
@@ -463,7 +464,8 @@ std::vector<std::string> geometry_findings(const Model& model, std::size_t max_f
     if (!(volume > 0.0)) {
       const ElementRef e{ElementKind::kTet, index_cast(t)};
       if (add(describe_element(model, e) + " is " + (volume < 0.0 ? "inverted" : "flat") +
-              " (signed volume " + number_text(volume) + "; nodes " + node_list(model, c) + ")"))
+              " (signed volume " + number_text(volume) + "; nodes " + node_list(model, c) + ")" +
+              std::string(inverted_hint)))
         return found;
     }
   }
@@ -517,7 +519,7 @@ std::vector<std::string> geometry_findings(const Model& model, std::size_t max_f
               " at its base corner " + describe_node(model, c[worst]) + " (signed volume " +
               number_text(corner[worst]) +
               " of the tet there, and neither base diagonal gives two " + "positive tets; nodes " +
-              node_list(model, c) + ")"))
+              node_list(model, c) + ")" + std::string(inverted_hint)))
         return found;
     }
   }
@@ -539,9 +541,9 @@ std::vector<std::string> geometry_findings(const Model& model, std::size_t max_f
   return found;
 }
 
-void check_geometry(const Model& model, std::string_view source) {
+void check_geometry(const Model& model, std::string_view source, std::string_view inverted_hint) {
   check_points(model, source);
-  const std::vector<std::string> found = geometry_findings(model, 1);
+  const std::vector<std::string> found = geometry_findings(model, 1, inverted_hint);
   if (!found.empty()) throw InvalidInput(std::string(source) + ": " + found.front());
 }
 

@@ -169,6 +169,9 @@ struct ReadOptions {
   // check_geometry below (else check_points only): off for tools that read connectivity
   // alone (a mesh's dual).
   bool check_geometry = true;
+  // Appended to check_geometry's refusal of an inverted or flat tet or pyramid: what the command
+  // offers for one (conform's --unfold).
+  std::string inverted_hint;
 };
 
 // The file id of a node or element (see Model::node_ids).
@@ -205,12 +208,15 @@ void check_points(const Model& model, std::string_view source);
 // <= 0, a hex or wedge with a corner Jacobian <= 0 (topology.hpp's corner frames: inverted,
 // flat or folded), a pyramid that splits along neither base diagonal into two positive tets, a
 // node set's node that no element uses. Throws InvalidInput naming `source` and the node or
-// element by its file id, with coordinates.
-void check_geometry(const Model& model, std::string_view source);
+// element by its file id, with coordinates; `inverted_hint` appended where a tet or pyramid is
+// at fault (ReadOptions::inverted_hint).
+void check_geometry(const Model& model, std::string_view source,
+                    std::string_view inverted_hint = {});
 // What check_geometry refuses (but check_points), every element and node at most once, up to
 // max_findings of them, in its order: each text names the element or node by its file id,
 // without the source. `geode check` lists them all where a reader stops at the first.
-std::vector<std::string> geometry_findings(const Model& model, std::size_t max_findings);
+std::vector<std::string> geometry_findings(const Model& model, std::size_t max_findings,
+                                           std::string_view inverted_hint = {});
 
 // The two parts over the model's whole point array (unused points included), so that node
 // numbers agree between the parts and the model. Every element carries its block (block_of).

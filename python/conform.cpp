@@ -181,7 +181,11 @@ py::dict conform_arrays(const py::handle& points, const py::dict& cells,
   // cell's 1-based position among the mesh's cells, a .msh file's element tag when meshio or
   // geode wrote it; messages name the source).
   primal::validate(model, source);
-  if (!unfold) primal::check_geometry(model, source);  // with unfold: after it (its inverted cells)
+  if (!unfold)  // with unfold: after it (its inverted cells)
+    primal::check_geometry(
+        model, source,
+        " (a mesher's fault: unfold=True moves a node of such cells, or mesh again at another "
+        "size)");
 
   conform::ConformOptions opts;
   // Hexes named as the returned mesh holds them: grouped by block in ascending id, from 0.

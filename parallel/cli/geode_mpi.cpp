@@ -301,6 +301,8 @@ int run(int argc, char** argv, int rank, int size) {
       // mends the same folds in its whole copy (unfold is deterministic).
       primal::ReadOptions read;
       read.check_geometry = !unfold;
+      read.inverted_hint =
+          " (a mesher's fault: --unfold moves a node of such cells, or mesh again at another size)";
       options.reload = [&] {
         io::ReadWarnings said_at_the_first_read;
         primal::Model again = io::read_model(input, read, false);

@@ -132,7 +132,9 @@ def test_a_cell_in_a_mirrored_order_is_refused_as_the_command_refuses_it(saved, 
     assert "{} {} ".format(kind, tag) in str(e.value) and "inverted" in str(e.value)
     cli = run_cli("conform", path.name, "-o", "out.vtu", check=False, cwd=tmp_path)
     assert cli.returncode == 2 and not (tmp_path / "out.vtu").exists()
-    assert one_line(str(e.value)) == cli_error(cli)
+    # (A tet's or pyramid's hint names the module's option where the command names its own.)
+    assert ("unfold=True moves a node of such cells" in str(e.value)) == (kind in ("tet", "pyramid"))
+    assert one_line(str(e.value)).replace("unfold=True", "--unfold") == cli_error(cli)
     # The same element given as arrays is refused by the same id.
     with pytest.raises(geode.InputError, match="{} {} ".format(kind, tag)):
         geode.conform(points=mesh.points, cells=[(c.type, c.data) for c in mesh.cells])
