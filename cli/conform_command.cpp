@@ -138,9 +138,7 @@ Eigen::Vector3d template_box(const std::string& text) {
 // The covering check's options: a fold's refusal points at --unfold unless it was given.
 primal::InputCheckOptions fold_hint(const ConformArgs& a) {
   primal::InputCheckOptions o;
-  if (!a.unfold)
-    o.fold_hint =
-        " (a mesher's fold: --unfold turns such cells back, or mesh again at another size)";
+  if (!a.unfold) o.fold_hint = primal::fold_hint("--unfold");
   return o;
 }
 
@@ -456,9 +454,7 @@ void add_conform_commands(CLI::App& app) {
     primal::ReadOptions read;
     read.check_geometry = !args->unfold;
     if (!args->unfold)  // with it, the geometry is checked after unfold
-      read.inverted_hint =
-          " (a mesher's fault: --unfold moves a node of such cells, or mesh again at another "
-          "size)";
+      read.inverted_hint = primal::inverted_hint("--unfold");
     primal::Model model = io::read_model(
         args->input, read, args->merge_tolerance < 0 && !args->unfold, nullptr, fold_hint(*args));
     join_block_lists(model, args->join_blocks, args->input);

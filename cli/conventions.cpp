@@ -284,9 +284,6 @@ std::vector<int> block_ids(const std::string& text) {
   }
   return ids.size() >= 2 ? ids : std::vector<int>{};
 }
-}  // namespace
-
-namespace {
 
 // "2 tets and 1 pyramid", "1 tet", "0 tets": cells counted by kind (tets and pyramids).
 std::string counted_cells(const std::vector<primal::ElementRef>& cells) {
@@ -314,8 +311,11 @@ CLI::Option* add_unfold_option(CLI::App* app, bool& unfold) {
 }
 
 std::string unfold_stage(const primal::UnfoldResult& result) {
+  if (!result.unfolded())
+    return result.covered_once ? "unfold: nothing to mend"
+                               : "unfold: not every fault can be mended: the model left as read";
   return "unfold: " + counted_cells(result.turned) + " turned back, " +
-         counted_cells(result.inverted) + " inverted";
+         counted_cells(result.inverted) + " read inverted mended";
 }
 
 std::string unfold_warning(const primal::Model& model, const primal::UnfoldResult& result) {
@@ -324,7 +324,8 @@ std::string unfold_warning(const primal::Model& model, const primal::UnfoldResul
     what = counted_cells(result.turned) + " folded over " +
            (result.turned.size() == 1 ? "its" : "their") + " neighbours turned back";
   if (!result.inverted.empty())
-    what += (what.empty() ? "" : ", ") + counted_cells(result.inverted) + " inverted";
+    what += (what.empty() ? "" : ", ") + counted_cells(result.inverted) + " read inverted";
+  if (result.moved.empty()) return "--unfold: " + what;  // node orders only
   std::string ids;
   for (std::size_t i = 0; i < result.moved.size() && i < 10; ++i)
     ids += (i ? " " : "") + std::to_string(primal::node_id(model, result.moved[i]));

@@ -192,6 +192,9 @@ class ModelConformer {
                    const std::string& why);
   // Only the wedges of the pieces: holes through the layer.
   void split_wedges_alone(const std::vector<Index>& pieces, Index first);
+  // The layers whose wedges alone were split (holes_), split into tets for another pass, `why`
+  // said in the warning; the holes' warnings dropped but where the split fails.
+  bool split_holes(const std::string& why);
   // The result's counts of what was split, the warnings in front of its own after its findings.
   void finish(ConformResult& r) const;
   ConformResult passes();
@@ -225,6 +228,7 @@ class ModelConformer {
   // The layers whose wedges alone were split (kPoorHoles), by the input's numbers, and where the
   // warnings stood before the first of them.
   primal::CellPieces holes_;
+  bool holes_split_ = false;  // ... and split into tets since (split_holes): not again
   std::size_t warnings_before_holes_ = 0;
   std::string holes_where_;  // the first of them, named
 };
@@ -260,8 +264,12 @@ ConformResult ModelConformer::pass(std::vector<Index>& joining) {
                               model_ == owned_ ? owned_ : nullptr);
   conformer.tets_given(std::min(options_.split_tets_from, primal::index_cast(input_.tets.size())));
   conformer_ = &conformer;
+  // Not left pointing at the conformer when its run throws.
+  struct Unset {
+    const detail::Conformer*& conformer;
+    ~Unset() { conformer = nullptr; }
+  } unset{conformer_};
   ConformResult r = conformer.run();
-  conformer_ = nullptr;
   joining = conformer.joining();
   near_thin_ = conformer.near_thin();
   tets_cross_ = conformer.tets_cross();
@@ -362,30 +370,20 @@ ConformResult ModelConformer::passes() {
     model_ = owned_ = &own_;
   }
   std::optional<ConformResult> with_holes;  // kPoorHoles: the holes' result, while split is tried
-  bool holes_refused = false;  // the holes' walls took no buffer layer: the layers split instead
   for (;;) {
     std::vector<Index> joining;
     ConformResult r;
     try {
       r = pass(joining);
     } catch (const TopologyError& e) {
-      conformer_ = nullptr;
       if (with_holes) return std::move(*with_holes);  // the layers split failed: the holes
       // No buffer layer at a hole's wall (where the wall meets the layer's face, the interface
       // faces at a node can all turn away from every direction: the sphere's layer 0.15 to 0.2
-      // thick in tests/conform/layer_model.py at n = 6): the layers split into tets, once.
-      if (holes_.hexes.empty() || layer_kept_ || holes_refused) throw;
-      holes_refused = true;
-      std::ostringstream why;
-      why << "with its wedges alone split, the holes they leave take no buffer layer (" << e.what()
-          << ")";
-      const std::vector<std::string> kept = warnings_;
-      warnings_.resize(warnings_before_holes_);
-      const primal::CellPieces layers = holes_;
-      if (!split_layer(layers, holes_where_, why.str())) {
-        warnings_ = kept;
+      // thick in tests/conform/layer_model.py at n = 6): the layers split into tets instead.
+      if (holes_.hexes.empty() || layer_kept_ || holes_split_) throw;
+      if (!split_holes("with its wedges alone split, the holes they leave take no buffer layer (" +
+                       std::string(e.what()) + ")"))
         throw;
-      }
       continue;
     }
     if (!joining.empty()) {
@@ -442,22 +440,26 @@ ConformResult ModelConformer::passes() {
       return std::move(*with_holes);
     }
     const double holes_min = output_min_scaled_jacobian(r);
-    if (holes_.hexes.empty() || layer_kept_ || holes_min >= kPoorHoles * r.yardstick())
+    if (holes_.hexes.empty() || layer_kept_ || holes_split_ ||
+        holes_min >= kPoorHoles * r.yardstick())
       return from_tets(std::move(r));
     // The holes gave a poor transition: the layers split into tets instead, conformed again.
     std::ostringstream why;
     why << "with its wedges alone split, the buffer hexes at the holes they leave gave "
         << holes_min << " (" << holes_min / r.yardstick() << " x the input's elements diced alone)";
-    const std::vector<std::string> kept = warnings_;
-    warnings_.resize(warnings_before_holes_);
     with_holes = std::move(r);
     compared_ = true;
-    const primal::CellPieces layers = holes_;
-    if (!split_layer(layers, holes_where_, why.str())) {
-      warnings_ = kept;
-      return std::move(*with_holes);
-    }
+    if (!split_holes(why.str())) return std::move(*with_holes);
   }
+}
+
+bool ModelConformer::split_holes(const std::string& why) {
+  const std::vector<std::string> kept = warnings_;
+  warnings_.resize(warnings_before_holes_);
+  const primal::CellPieces layers = holes_;
+  holes_split_ = split_layer(layers, holes_where_, why);
+  if (!holes_split_) warnings_ = kept;
+  return holes_split_;
 }
 
 ConformResult ModelConformer::from_tets(ConformResult r) {

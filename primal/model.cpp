@@ -448,6 +448,26 @@ void check_points(const Model& model, std::string_view source) {
                          " has a non-finite coordinate");
 }
 
+std::array<std::array<Index, 4>, 4> pyramid_corner_tets(const std::array<Index, 5>& c) {
+  std::array<std::array<Index, 4>, 4> out{};
+  for (std::size_t k = 0; k < 4; ++k)
+    out[k] = {c[(k + 3) % 4], c[k], c[(k + 1) % 4], c[topology::kPyramidApex]};
+  return out;
+}
+
+std::array<double, 4> pyramid_corner_volumes(const Model& model, const std::array<Index, 5>& c) {
+  const auto pt = [&](Index v) -> const Point& { return model.points[index_cast<std::size_t>(v)]; };
+  std::array<double, 4> v{};
+  const auto tets = pyramid_corner_tets(c);
+  for (std::size_t k = 0; k < 4; ++k)
+    v[k] = tet_volume(pt(tets[k][0]), pt(tets[k][1]), pt(tets[k][2]), pt(tets[k][3]));
+  return v;
+}
+
+bool splits_positive(const std::array<double, 4>& v) {
+  return (v[1] > 0.0 && v[3] > 0.0) || (v[0] > 0.0 && v[2] > 0.0);
+}
+
 std::vector<std::string> geometry_findings(const Model& model, std::size_t max_findings,
                                            std::string_view inverted_hint) {
   std::vector<std::string> found;
@@ -503,15 +523,12 @@ std::vector<std::string> geometry_findings(const Model& model, std::size_t max_f
       }
     }
   }
-  // A pyramid must split into two positive tets along one of its base diagonals (the tets at
-  // base corners 1 and 3 for the diagonal 0-2, at 0 and 2 for 1-3): what conform makes of it.
+  // A pyramid must split into two positive tets along one of its base diagonals: what conform
+  // makes of it.
   for (std::size_t p = 0; p < model.pyramids.size(); ++p) {
     const auto& c = model.pyramids[p];
-    std::array<double, 4> corner{};
-    for (std::size_t k = 0; k < 4; ++k)
-      corner[k] = tet_volume(pt(c[(k + 3) % 4]), pt(c[k]), pt(c[(k + 1) % 4]), pt(c[4]));
-    const bool d02 = corner[1] > 0.0 && corner[3] > 0.0, d13 = corner[0] > 0.0 && corner[2] > 0.0;
-    if (!d02 && !d13) {
+    const std::array<double, 4> corner = pyramid_corner_volumes(model, c);
+    if (!splits_positive(corner)) {
       const auto worst =
           index_cast<std::size_t>(std::min_element(corner.begin(), corner.end()) - corner.begin());
       const ElementRef e{ElementKind::kPyramid, index_cast(p)};

@@ -21,15 +21,24 @@ using Cycle = std::array<Index, 4>;  // a face's corners as an element orders it
                                      // fourth kInvalidIndex
 
 // The tets whose signed volumes say that an element is positive: a tet itself; a pyramid's four
-// corner tets (two per base diagonal: positive along both diagonals, which check_geometry's one
-// diagonal and conform's choice of either follow from, and linear in the apex).
+// corner tets (pyramid_corner_tets; all four positive: along both diagonals, which
+// check_geometry's one diagonal and conform's choice of either follow from, and linear in the
+// apex).
 std::vector<Tet> pieces(const Model& m, ElementRef e) {
-  const auto c = element_corners(m, e);
-  if (e.kind == ElementKind::kTet) return {Tet{c[0], c[1], c[2], c[3]}};
-  std::vector<Tet> out;
-  for (std::size_t k = 0; k < 4; ++k)
-    out.push_back({c[(k + 3) % 4], c[k], c[(k + 1) % 4], c[topology::kPyramidApex]});
-  return out;
+  if (e.kind == ElementKind::kTet) return {m.tets[index_cast<std::size_t>(e.index)]};
+  const auto corner = pyramid_corner_tets(m.pyramids[index_cast<std::size_t>(e.index)]);
+  return {corner.begin(), corner.end()};
+}
+
+// The least signed volume of the tets.
+double min_volume(const Model& m, const std::vector<Tet>& tets) {
+  double least = 1e300;
+  for (const Tet& t : tets)
+    least = std::min(least, tet_volume(m.points[index_cast<std::size_t>(t[0])],
+                                       m.points[index_cast<std::size_t>(t[1])],
+                                       m.points[index_cast<std::size_t>(t[2])],
+                                       m.points[index_cast<std::size_t>(t[3])]));
+  return least;
 }
 
 // Turns an element's node order (its faces' cycles reversed): a tet's first two corners, a
@@ -119,22 +128,12 @@ UnfoldResult unfold(Model& model) {
   // Tets and pyramids the readers refuse as inverted (check_geometry), read without that check:
   // a node pushed through a face and left there, the node orders agreeing with the neighbours'.
   std::vector<ElementRef> inverted;
-  for (ElementKind kind : {ElementKind::kTet, ElementKind::kPyramid})
-    for (std::size_t i = 0; i < element_count(model, kind); ++i) {
-      const ElementRef e{kind, index_cast(i)};
-      std::array<double, 4> v{};
-      std::size_t n = 0;
-      for (const Tet& t : pieces(model, e))
-        v[n++] = tet_volume(model.points[index_cast<std::size_t>(t[0])],
-                            model.points[index_cast<std::size_t>(t[1])],
-                            model.points[index_cast<std::size_t>(t[2])],
-                            model.points[index_cast<std::size_t>(t[3])]);
-      // A pyramid along a diagonal: its two corner tets off it (pieces' order: corners 0 to 3).
-      const bool positive = kind == ElementKind::kTet
-                                ? v[0] > 0.0
-                                : (v[1] > 0.0 && v[3] > 0.0) || (v[0] > 0.0 && v[2] > 0.0);
-      if (!positive) inverted.push_back(e);
-    }
+  for (std::size_t t = 0; t < model.tets.size(); ++t)
+    if (!(min_volume(model, {model.tets[t]}) > 0.0))
+      inverted.push_back({ElementKind::kTet, index_cast(t)});
+  for (std::size_t p = 0; p < model.pyramids.size(); ++p)
+    if (!splits_positive(pyramid_corner_volumes(model, model.pyramids[p])))
+      inverted.push_back({ElementKind::kPyramid, index_cast(p)});
   if (check.ok() && inverted.empty()) {
     none.covered_once = true;
     return none;
@@ -151,7 +150,8 @@ UnfoldResult unfold(Model& model) {
   if (work.empty() && inverted.empty()) return none;
 
   // Near the folds (their elements' nodes and three rings of elements around them, so that each
-  // node moved has its whole star and each element turned its neighbours'): every element's
+  // node moved has its whole star and each element turned its neighbours', unless the turning
+  // below spreads further: the checks at the end stand behind it): every element's
   // faces with the elements using them, each in the cyclic order that element gives it; per
   // node: on a boundary face, elements it cannot move in, blocks.
   const std::size_t nv = model.points.size();
@@ -264,7 +264,7 @@ UnfoldResult unfold(Model& model) {
       ++n.first;
       const Use& other = list[0].element == e ? list[1] : list[0];
       // Each side's cycle as it is now (a turned element's reversed), the same: one side.
-      const bool other_turned = mendable(other.element.kind) && turned(other.element);
+      const bool other_turned = turned(other.element);
       n.second += same_cycle(mine, other.cycle) != (other_turned != (turned(e) != 0));
     }
     return n;
@@ -350,8 +350,7 @@ UnfoldResult unfold(Model& model) {
   mend.insert(mend.end(), result.inverted.begin(), result.inverted.end());
   for (const ElementRef& e : mend) {
     const auto cs = element_corners(model, e);
-    if (least(pieces(model, e), cs[0], model.points[index_cast<std::size_t>(cs[0])]) > 0.0)
-      continue;  // put right by a node moved for a neighbour
+    if (min_volume(model, pieces(model, e)) > 0.0) continue;  // put right by a turn or a move
     // Of its free nodes, the one whose elements come out the largest at its new place moves.
     Index node = kInvalidIndex;
     Point to = Point::Zero();
@@ -371,9 +370,19 @@ UnfoldResult unfold(Model& model) {
     result.moved.push_back(node);
     at = to;
   }
-  if (result.moved.empty() || !check_input(model).ok()) return undo();
+  if (!result.unfolded() || !check_input(model).ok()) return undo();
   result.covered_once = true;
   return result;
+}
+
+std::string fold_hint(std::string_view option) {
+  return " (a mesher's fold: " + std::string(option) +
+         " turns such cells back, or mesh again at another size)";
+}
+
+std::string inverted_hint(std::string_view option) {
+  return " (a mesher's fault: " + std::string(option) +
+         " mends such cells where it can, or mesh again at another size)";
 }
 
 }  // namespace geode::primal

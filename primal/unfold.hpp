@@ -12,6 +12,8 @@
 // positive again and well clear of flat (a pyramid along both base diagonals). A tet or pyramid
 // inverted in a model read without check_geometry (a pyramid positive along neither diagonal:
 // Gmsh's apex below a twisted base) has a node moved the same way, without the turn.
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include <geode/primal/model.hpp>
@@ -26,7 +28,9 @@ struct UnfoldResult {
   // check_input found nothing (before, or after the mend): no need to run it again. When false
   // the model is as it was given, and require_single_covering names its first fault.
   bool covered_once = false;
-  bool unfolded() const { return !moved.empty(); }
+  // The model changed: a node moved, or only node orders turned back (a cell written in mirrored
+  // order: inverted, and on the same side as every neighbour, positive once turned).
+  bool unfolded() const { return !turned.empty() || !moved.empty(); }
 };
 
 // Mends the folds check_input finds and the inverted tets and pyramids as above, and only where
@@ -36,5 +40,11 @@ struct UnfoldResult {
 // set and no side set's face, and its elements are tets and pyramids (whose apex it is) of one
 // block. Other elements check_geometry refuses stay: the caller runs it after.
 UnfoldResult unfold(Model& model);
+
+// What a refusal offers where unfold may mend it, naming the caller's option ("--unfold",
+// "unfold=True"): for a fold (InputCheckOptions::fold_hint) and for a tet or pyramid read
+// inverted (ReadOptions::inverted_hint).
+std::string fold_hint(std::string_view option);
+std::string inverted_hint(std::string_view option);
 
 }  // namespace geode::primal

@@ -182,10 +182,7 @@ py::dict conform_arrays(const py::handle& points, const py::dict& cells,
   // geode wrote it; messages name the source).
   primal::validate(model, source);
   if (!unfold)  // with unfold: after it (its inverted cells)
-    primal::check_geometry(
-        model, source,
-        " (a mesher's fault: unfold=True moves a node of such cells, or mesh again at another "
-        "size)");
+    primal::check_geometry(model, source, primal::inverted_hint("unfold=True"));
 
   conform::ConformOptions opts;
   // Hexes named as the returned mesh holds them: grouped by block in ascending id, from 0.
@@ -222,6 +219,7 @@ py::dict conform_arrays(const py::handle& points, const py::dict& cells,
   conform::ConformResult r;
   Index merged = 0;
   std::vector<Index> moved;  // by unfold
+  Index unfolded_cells = 0;  // turned back or read inverted, mended
   {
     py::gil_scoped_release free;
     if (merge) {
@@ -240,11 +238,10 @@ py::dict conform_arrays(const py::handle& points, const py::dict& cells,
     // The read-time check of a file (after merging: duplicated nodes look like a gap), which
     // local verification, the default, takes as given; its messages name the source.
     primal::InputCheckOptions checked;
-    if (!unfold)
-      checked.fold_hint =
-          " (a mesher's fold: unfold=True turns such cells back, or mesh again at another size)";
+    if (!unfold) checked.fold_hint = primal::fold_hint("unfold=True");
     if (!unfolded.covered_once) primal::require_single_covering(model, source, checked);
     moved = std::move(unfolded.moved);
+    unfolded_cells = primal::index_cast(unfolded.turned.size() + unfolded.inverted.size());
     try {
       r = conform::conform(std::move(model), opts);  // the hints below read what is left
     } catch (const InvalidInput& e) {
@@ -262,6 +259,7 @@ py::dict conform_arrays(const py::handle& points, const py::dict& cells,
   d["report"] = to_python(conform::report_json(r));
   d["merged_nodes"] = merged;
   d["unfolded_nodes"] = moved;
+  d["unfolded_cells"] = unfolded_cells;
   d["model"] = model_dict(std::move(r.model));
   return d;
 }

@@ -34,6 +34,7 @@
 
 #include <geode/parallel/partition.hpp>
 #include <geode/primal/errors.hpp>
+#include <geode/primal/unfold.hpp>
 #include "cli/conventions.hpp"
 
 namespace {
@@ -301,13 +302,12 @@ int run(int argc, char** argv, int rank, int size) {
       // mends the same folds in its whole copy (unfold is deterministic).
       primal::ReadOptions read;
       read.check_geometry = !unfold;
-      read.inverted_hint =
-          " (a mesher's fault: --unfold moves a node of such cells, or mesh again at another size)";
+      if (!unfold) read.inverted_hint = primal::inverted_hint("--unfold");
       options.reload = [&] {
         io::ReadWarnings said_at_the_first_read;
         primal::Model again = io::read_model(input, read, false);
-        if (unfold) primal::unfold(again);
         cli::join_block_lists(again, join_blocks, input);
+        if (unfold) primal::unfold(again);
         return again;
       };
       io::FilePartition file_partition;
@@ -318,10 +318,11 @@ int run(int argc, char** argv, int rank, int size) {
         RankZeroReadWarnings warnings(rank);
         primal::InputCheckOptions check = parallel::shared_input_check(MPI_COMM_WORLD);
         check.element_pairs = &element_pairs;
-        check.fold_hint =
-            " (a mesher's fold: --unfold turns such cells back, or mesh again at another size)";
+        if (!unfold) check.fold_hint = primal::fold_hint("--unfold");
         return io::read_model(input, read, !unfold, &file_partition, check);
       }();
+      // Joined before unfold, as geode conform does: a node between the blocks joined may move.
+      cli::join_block_lists(model, join_blocks, input);
       say("read " + input + ": " + std::to_string(primal::element_count(model)) + " elements",
           true);
       if (unfold) {
@@ -336,7 +337,6 @@ int run(int argc, char** argv, int rank, int size) {
         check.element_pairs = &element_pairs;
         primal::require_single_covering(model, input, check);
       }
-      cli::join_block_lists(model, join_blocks, input);
       fail_for_test(rank, "read");
       // The input's own partition (a partitioned .msh, a Nemesis set) unless it has fewer parts
       // than there are ranks: then METIS (parallel/partition.hpp).

@@ -257,8 +257,9 @@ def conform(mesh=None, *, points=None, cells=None, cell_blocks=None, name="mesh"
     InputError naming it by its 1-based position among the cells (a .msh file's element tag).
     The options are those of `geode conform` (buffer_side=None: not given, hex or tet as
     `geode conform` chooses without --buffer-side; unfold=True as --unfold: tets and pyramids a
-    mesher folded or wrote inverted mended, with a GeodeWarning where it moved nodes, the
-    report's "unfolded_nodes" naming them, 0-based, after merge_tolerance's merging if any).
+    mesher folded or wrote inverted mended, with a GeodeWarning where it changed the model, the
+    report's "unfolded_cells" counting them and "unfolded_nodes" naming the nodes moved, 0-based,
+    after merge_tolerance's merging if any).
     Returns (meshio.Mesh, report): the output with one cell block and one cell set per block,
     block ids as gmsh:physical, node sets as point sets; the report as `--report` writes it,
     with "side_sets" ([{id, name, sides: K x 2 (hex, local face)}]). Hexes (the sides', each
@@ -283,9 +284,12 @@ def conform(mesh=None, *, points=None, cells=None, cell_blocks=None, name="mesh"
                             if len(s["sides"]) else s["sides"]} for s in model["side_sets"]]
     report["merged_nodes"] = out["merged_nodes"]
     report["unfolded_nodes"] = list(out["unfolded_nodes"])
-    if report["unfolded_nodes"]:  # the model changed, as the command warns
-        _warnings.warn("{}: unfold: {} nodes moved into the cells folded over them"
-                       .format(name, len(report["unfolded_nodes"])), GeodeWarning, stacklevel=2)
+    report["unfolded_cells"] = out["unfolded_cells"]
+    if report["unfolded_cells"]:  # the model changed, as the command warns
+        nodes = len(report["unfolded_nodes"])
+        _warnings.warn("{}: unfold: {} cell{} a mesher folded or wrote inverted mended, {} node{} moved"
+                       .format(name, report["unfolded_cells"], "" if report["unfolded_cells"] == 1 else "s",
+                               nodes, "" if nodes == 1 else "s"), GeodeWarning, stacklevel=2)
     return _model_to_meshio(model), report
 
 

@@ -433,7 +433,7 @@ TEST_CASE("a pyramid Gmsh folds over a quads-only layer's hex is turned back by 
   const auto refused = test::geode_cli("conform " + file.string() + " -o " + out.string(), true);
   CHECK(refused.code == 2);
   CHECK(refused.out.find("is inverted at its base corner") != std::string::npos);
-  CHECK(refused.out.find("--unfold moves a node of such cells") != std::string::npos);
+  CHECK(refused.out.find("--unfold mends such cells") != std::string::npos);
   const auto run = test::geode_cli(
       "conform " + file.string() + " -o " + out.string() + " --unfold --quiet", true);
   INFO(run.out);

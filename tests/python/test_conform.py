@@ -128,8 +128,14 @@ def test_conform_errors_match_cli(half, tmp_path):
     cli = run_cli("conform", path.name, "-o", "out.vtu", check=False, cwd=tmp_path)
     assert cli.returncode == 2 and not (tmp_path / "out.vtu").exists()
     # (The hint names the module's option where the command names its own.)
-    assert "unfold=True moves a node of such cells" in str(e.value)
+    assert "unfold=True mends such cells" in str(e.value)
     assert one_line(str(e.value)).replace("unfold=True", "--unfold") == cli_error(cli)
+    # That tet lies on the same side as each of its neighbours: unfold turns it back, no node moved.
+    with pytest.warns(geode.GeodeWarning, match="1 cell a mesher folded or wrote inverted mended, 0 nodes"):
+        out, report = geode.conform(meshio.read(path), name=path.name, unfold=True)
+    assert report["valid"] and report["unfolded_cells"] == 1 and report["unfolded_nodes"] == []
+    cli = run_cli("conform", path.name, "-o", "out.vtu", "--unfold", check=False, cwd=tmp_path)
+    assert cli.returncode == 0 and "--unfold: 1 tet folded over its neighbours turned back\n" in cli.stderr
 
 
 def test_conform_buffer_side(half):
