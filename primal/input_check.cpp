@@ -1096,13 +1096,13 @@ void require_single_covering(const Model& model, std::string_view source,
   if (r.ok()) return;
   // The hint where a tet or pyramid folds (what unfold mends), not a hex or wedge alone.
   const InputFinding& f = r.findings[0];
-  const bool tet_fold =
+  const bool mendable_fold =
       (f.fault == InputFault::kSameSideFace || f.fault == InputFault::kFoldedNode) &&
       std::any_of(f.elements.begin(), f.elements.end(), [](const ElementRef& e) {
         return e.kind == ElementKind::kTet || e.kind == ElementKind::kPyramid;
       });
   const std::string what =
-      std::string(source) + ": " + f.text(model) + (tet_fold ? options.fold_hint : "");
+      std::string(source) + ": " + f.text(model) + (mendable_fold ? options.fold_hint : "");
   if (r.findings[0].topological()) throw TopologyError(what);
   throw InvalidInput(what);
 }
