@@ -128,9 +128,12 @@ UnfoldResult unfold(Model& model) {
   // Tets and pyramids the readers refuse as inverted (check_geometry), read without that check:
   // a node pushed through a face and left there, the node orders agreeing with the neighbours'.
   std::vector<ElementRef> inverted;
-  for (std::size_t t = 0; t < model.tets.size(); ++t)
-    if (!(min_volume(model, {model.tets[t]}) > 0.0))
+  const auto pt = [&](Index v) -> const Point& { return model.points[index_cast<std::size_t>(v)]; };
+  for (std::size_t t = 0; t < model.tets.size(); ++t) {
+    const auto& c = model.tets[t];
+    if (!(tet_volume(pt(c[0]), pt(c[1]), pt(c[2]), pt(c[3])) > 0.0))
       inverted.push_back({ElementKind::kTet, index_cast(t)});
+  }
   for (std::size_t p = 0; p < model.pyramids.size(); ++p)
     if (!splits_positive(pyramid_corner_volumes(model, model.pyramids[p])))
       inverted.push_back({ElementKind::kPyramid, index_cast(p)});
