@@ -74,7 +74,8 @@ void join_block_lists(primal::Model& model, const std::vector<std::string>& list
 
 // --unfold (conform, geode_mpi): tets and pyramids a mesher folded or wrote inverted, mended by
 // primal::unfold before the covering check. The stage line ("unfold: 1 pyramid turned back, 0
-// tets inverted") and the warning naming the nodes moved (without "warning: ").
+// tets read inverted mended", or that nothing was) and the warning naming the cells and the
+// nodes moved (without "warning: ").
 CLI::Option* add_unfold_option(CLI::App* app, bool& unfold);
 std::string unfold_stage(const primal::UnfoldResult& result);
 std::string unfold_warning(const primal::Model& model, const primal::UnfoldResult& result);
