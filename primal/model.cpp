@@ -448,19 +448,12 @@ void check_points(const Model& model, std::string_view source) {
                          " has a non-finite coordinate");
 }
 
-std::array<std::array<Index, 4>, 4> pyramid_corner_tets(const std::array<Index, 5>& c) {
-  std::array<std::array<Index, 4>, 4> out{};
-  for (std::size_t k = 0; k < 4; ++k)
-    out[k] = {c[(k + 3) % 4], c[k], c[(k + 1) % 4], c[topology::kPyramidApex]};
-  return out;
-}
-
 std::array<double, 4> pyramid_corner_volumes(const Model& model, const std::array<Index, 5>& c) {
   const auto pt = [&](Index v) -> const Point& { return model.points[index_cast<std::size_t>(v)]; };
   std::array<double, 4> v{};
-  const auto tets = pyramid_corner_tets(c);
   for (std::size_t k = 0; k < 4; ++k)
-    v[k] = tet_volume(pt(tets[k][0]), pt(tets[k][1]), pt(tets[k][2]), pt(tets[k][3]));
+    v[k] =
+        tet_volume(pt(c[(k + 3) % 4]), pt(c[k]), pt(c[(k + 1) % 4]), pt(c[topology::kPyramidApex]));
   return v;
 }
 

@@ -226,11 +226,10 @@ TetMesh tet_part(const Model& model);
 // Signed volume of tet (a, b, c, d): positive when a-b-c is counter-clockwise seen from d.
 double tet_volume(const Point& a, const Point& b, const Point& c, const Point& d);
 
-// A pyramid's corner tets: at base corner k, (k - 1, k, k + 1, apex); their signed volumes, in
-// base corner order. The pyramid splits into two positive tets along its diagonal 0-2 when those
-// at corners 1 and 3 are positive, along 1-3 when those at 0 and 2 are (what conform makes of
-// it, and what check_geometry asks of one of the two).
-std::array<std::array<Index, 4>, 4> pyramid_corner_tets(const std::array<Index, 5>& pyramid);
+// The signed volumes of a pyramid's corner tets, in base corner order: at corner k, (k - 1, k,
+// k + 1, apex). The pyramid splits into two positive tets (split_pyramids.hpp pyramid_tets)
+// along its diagonal 0-2 when those at corners 1 and 3 are positive, along 1-3 when those at 0
+// and 2 are (what conform makes of it, and what check_geometry asks of one of the two).
 std::array<double, 4> pyramid_corner_volumes(const Model& model,
                                              const std::array<Index, 5>& pyramid);
 bool splits_positive(const std::array<double, 4>& corner_volumes);

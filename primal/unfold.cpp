@@ -11,6 +11,7 @@
 
 #include <geode/primal/boundary.hpp>
 #include <geode/primal/input_check.hpp>
+#include <geode/primal/split_pyramids.hpp>
 
 namespace geode::primal {
 
@@ -20,14 +21,15 @@ using Tet = std::array<Index, 4>;
 using Cycle = std::array<Index, 4>;  // a face's corners as an element orders it; a triangle's
                                      // fourth kInvalidIndex
 
-// The tets whose signed volumes say that an element is positive: a tet itself; a pyramid's four
-// corner tets (pyramid_corner_tets; all four positive: along both diagonals, which
-// check_geometry's one diagonal and conform's choice of either follow from, and linear in the
-// apex).
+// The tets whose signed volumes say that an element is positive: a tet itself; a pyramid's two
+// tets along each base diagonal (pyramid_tets; all four positive: positive along both
+// diagonals, which check_geometry's one and conform's choice of either follow from, and linear
+// in the apex).
 std::vector<Tet> pieces(const Model& m, ElementRef e) {
   if (e.kind == ElementKind::kTet) return {m.tets[index_cast<std::size_t>(e.index)]};
-  const auto corner = pyramid_corner_tets(m.pyramids[index_cast<std::size_t>(e.index)]);
-  return {corner.begin(), corner.end()};
+  const auto& p = m.pyramids[index_cast<std::size_t>(e.index)];
+  const auto d02 = pyramid_tets(p, 0), d13 = pyramid_tets(p, 1);
+  return {d02[0], d02[1], d13[0], d13[1]};
 }
 
 // The least signed volume of the tets.
