@@ -356,13 +356,21 @@ class InputChecker {
       if (j - i == 1) {
         single.push_back(uses[i]);
       } else if (twin != j) {
-        std::size_t other = twin + 1;
-        while (!same_nodes(uses[twin].element, uses[other].element)) ++other;
-        keep(out, {InputFault::kDuplicateElement,
-                   {uses[twin].element, uses[other].element},
-                   kInvalidIndex,
-                   centre(uses[twin].element),
-                   0.0});
+        // An element twice is seen on every face the two share (a face of two such pairs holds
+        // both): each pair said once, at the face 0 of its first element.
+        for (std::size_t a = i; a < j; ++a) {
+          if (uses[a].face != 0) continue;
+          for (std::size_t b = i; b < j; ++b)
+            if (b != a && same_nodes(uses[a].element, uses[b].element)) {
+              if (uses[a].element < uses[b].element)
+                keep(out, {InputFault::kDuplicateElement,
+                           {uses[a].element, uses[b].element},
+                           kInvalidIndex,
+                           centre(uses[a].element),
+                           0.0});
+              break;
+            }
+        }
       } else if (j - i > 2) {
         InputFinding f{InputFault::kOversharedFace, {}, kInvalidIndex, face_centre(uses[i]), 0.0};
         for (std::size_t k = i; k < j && k < i + 3; ++k) f.elements.push_back(uses[k].element);

@@ -256,8 +256,9 @@ UnfoldResult unfold(Model& model) {
     }
     return false;
   };
-  // (faces e shares with another element, of them those on one side) as the elements stand now.
-  const auto sides = [&](const ElementRef& e) {
+  // (faces e shares with another element, of them those on one side) as the elements stand now;
+  // the elements on one side with e added to `with` if given.
+  const auto sides = [&](const ElementRef& e, std::vector<ElementRef>* with = nullptr) {
     const auto cs = element_corners(model, e);
     const auto& topo = cell_topology(e.kind);
     std::pair<int, int> n{0, 0};
@@ -270,10 +271,24 @@ UnfoldResult unfold(Model& model) {
       const Use& other = list[0].element == e ? list[1] : list[0];
       // Each side's cycle as it is now (a turned element's reversed), the same: one side.
       const bool other_turned = turned(other.element);
-      n.second += same_cycle(mine, other.cycle) != (other_turned != (turned(e) != 0));
+      const bool one_side = same_cycle(mine, other.cycle) != (other_turned != (turned(e) != 0));
+      n.second += one_side;
+      if (one_side && with) with->push_back(other.element);
     }
     return n;
   };
+  // An element with a face more than two use (an element written twice, overlapping ones) is no
+  // fold: never turned (a duplicate's faces with its twin alone looked like a fold).
+  const auto tangled = [&](const ElementRef& e) {
+    const auto cs = element_corners(model, e);
+    const auto& topo = cell_topology(e.kind);
+    for (int f = 0; f < topo.faces; ++f) {
+      const auto found = uses.find(key(cycle(cs, topo.face[static_cast<std::size_t>(f)])));
+      if (found != uses.end() && found->second.size() > 2) return true;
+    }
+    return false;
+  };
+  std::erase_if(work, tangled);
   std::map<ElementRef, int> folds;  // the elements found, with their faces on one side
   for (const ElementRef& e : work) folds[e] = sides(e).second;
   // The elements on one side of the most faces first: a neighbour of a fold, on one side of its
@@ -285,7 +300,7 @@ UnfoldResult unfold(Model& model) {
   for (std::size_t round = 0; !work.empty() && round < 100; ++round) {
     std::vector<ElementRef> next;
     for (const ElementRef& e : work) {
-      if (turned(e)) continue;
+      if (turned(e) || tangled(e)) continue;
       const auto [shared, same] = sides(e);
       if (shared == 0 || same < shared) continue;
       turned(e) = 1;
@@ -315,9 +330,26 @@ UnfoldResult unfold(Model& model) {
     for (std::size_t i = 0; i < group.size(); ++i)
       for (const ElementRef& e : left)
         if (!seen.count(e) && common(e, group[i]) >= 3) group.push_back(e), seen.insert(e);
+    // Members on one side of a face with an element outside the turned group once it is turned
+    // (a pyramid whose base, on a hex, turned with it) are turned back, all such at once, until
+    // none is left; the group is kept where that leaves none of its members on one side.
     for (const ElementRef& e : group) turned(e) = 1;
+    const auto in_group = [&](const ElementRef& o) {
+      return turned(o) && std::find(group.begin(), group.end(), o) != group.end();
+    };
+    for (;;) {
+      std::vector<ElementRef> back;
+      for (const ElementRef& e : group) {
+        std::vector<ElementRef> with;
+        if (turned(e) && sides(e, &with).second != 0 &&
+            !std::all_of(with.begin(), with.end(), in_group))
+          back.push_back(e);
+      }
+      if (back.empty()) break;
+      for (const ElementRef& e : back) turned(e) = 0;
+    }
     if (!std::all_of(group.begin(), group.end(),
-                     [&](const ElementRef& e) { return sides(e).second == 0; }))
+                     [&](const ElementRef& e) { return !turned(e) || sides(e).second == 0; }))
       for (const ElementRef& e : group) turned(e) = 0;
   }
 
@@ -375,8 +407,21 @@ UnfoldResult unfold(Model& model) {
     result.moved.push_back(node);
     at = to;
   }
-  if (!result.unfolded() || !check_input(model).ok()) return undo();
-  result.covered_once = true;
+  if (!result.unfolded()) return undo();
+  const InputCheckResult after = check_input(model, o);
+  if (after.ok()) {
+    result.covered_once = true;
+    return result;
+  }
+  // Only faults unfold does not mend left, each found before it (an element written twice):
+  // the mends stay, so that the caller's check names what is left rather than a fold mended.
+  const auto found_before = [&](const InputFinding& f) {
+    return f.fault != InputFault::kSameSideFace &&
+           std::any_of(check.findings.begin(), check.findings.end(), [&](const InputFinding& g) {
+             return g.fault == f.fault && g.elements == f.elements;
+           });
+  };
+  if (!std::all_of(after.findings.begin(), after.findings.end(), found_before)) return undo();
   return result;
 }
 

@@ -34,8 +34,10 @@ struct UnfoldResult {
 };
 
 // Mends the folds check_input finds and the inverted tets and pyramids as above, and only where
-// every one is mended and check_input then finds nothing: else the model is left as it was (and
-// the result empty), so that the refusal names the first fault as before. A node is moved only
+// every one is mended and check_input then finds nothing new: else the model is left as it was
+// (and the result empty), so that the refusal names the first fault as before. Where only faults
+// it does not mend are left (an element written twice), the mends stay and covered_once is
+// false: the caller's check names what is left. A node is moved only
 // if it lies on no boundary face (the model's boundary and its materials do not move), no node
 // set and no side set's face, and its elements are tets and pyramids (whose apex it is) of one
 // block. Other elements check_geometry refuses stay: the caller runs it after.

@@ -440,14 +440,18 @@ TEST_CASE("input check: many tets written twice, named in one order for any thre
   }
   REQUIRE(two.findings.size() >= copies);
   CHECK(elements(one) == elements(two));
-  // Every copy named as one, at one of its faces (a finding per face the copy hides; the later
-  // stages find more).
+  // Every copy named as one, once (at one of its faces, not at each: copies side by side share
+  // a face; the later stages find more).
   std::set<Index> named;
+  std::size_t said = 0;
   for (const primal::InputFinding& f : two.findings)
-    if (f.fault == InputFault::kDuplicateElement)
+    if (f.fault == InputFault::kDuplicateElement) {
+      ++said;
       for (const primal::ElementRef& e : f.elements)
         if (e.index >= primal::index_cast(tets)) named.insert(e.index);
+    }
   CHECK(named.size() == copies);
+  CHECK(said == copies);
   CHECK(two.findings.front().fault == InputFault::kDuplicateElement);
   const primal::InputCheckResult few = primal::check_input(m);  // the first 8
   REQUIRE(few.findings.size() == 8);
@@ -769,6 +773,49 @@ primal::Model gmsh_ring(int n) {
   return demo::model_from_gmsh("ring");
 }
 
+// A hex part with a dihedral angle not 90 degrees, as a user builds one with OCC: a cylinder
+// sector of `degrees` about a vertical edge (radius 1.2, 1 high, its base transfinite and
+// recombined, swept in layers), fragmented with a tet box of [0,3]x[0,3]x[0,2] and meshed
+// together (Gmsh's pyramids on the sector's quads).
+primal::Model gmsh_sector(int n, double degrees) {
+  demo::GmshSession session;
+  namespace occ = gmsh::model::occ;
+  const int box = occ::addBox(0, 0, 0, 3, 3, 2);
+  const double cx = 1.5, cy = 1.0, z = 0.5, r = 1.2;
+  const double a0 = (90 - degrees / 2) * std::numbers::pi / 180,
+               a1 = (90 + degrees / 2) * std::numbers::pi / 180, am = (a0 + a1) / 2;
+  const auto at = [&](double a) {
+    return occ::addPoint(cx + r * std::cos(a), cy + r * std::sin(a), z);
+  };
+  const int o = occ::addPoint(cx, cy, z), a = at(a0), m = at(am), b = at(a1),
+            c = occ::addPoint(cx, cy, z);  // the arcs' centre
+  const std::vector<int> curves{occ::addLine(o, a), occ::addCircleArc(a, c, m),
+                                occ::addCircleArc(m, c, b), occ::addLine(b, o)};
+  const int base = occ::addPlaneSurface({occ::addCurveLoop(curves)});
+  occ::remove({{0, c}});
+  occ::synchronize();
+  for (const int curve : curves)
+    gmsh::model::mesh::setTransfiniteCurve(curve, static_cast<int>(std::lround(r * n)) + 1);
+  gmsh::model::mesh::setTransfiniteSurface(base);
+  gmsh::model::mesh::setRecombine(2, base);
+  gmsh::vectorpair swept, parts;
+  occ::extrude({{2, base}}, 0, 0, 1, swept, {n}, {}, true);
+  std::vector<int> sector;
+  for (const auto& [dim, tag] : swept)
+    if (dim == 3) sector.push_back(tag);
+  std::vector<gmsh::vectorpair> children;
+  occ::fragment({{3, box}}, {{3, sector.front()}}, parts, children);
+  occ::synchronize();
+  std::vector<int> potting;
+  for (const auto& [dim, tag] : children.front())
+    if (dim == 3 && tag != sector.front()) potting.push_back(tag);
+  gmsh::model::addPhysicalGroup(3, sector, 1);
+  gmsh::model::addPhysicalGroup(3, potting, 2);
+  gmsh::option::setNumber("Mesh.MeshSizeMax", 1.0 / n);
+  gmsh::model::mesh::generate(3);
+  return demo::model_from_gmsh("sector");
+}
+
 }  // namespace
 
 TEST_CASE("--unfold: the tets Gmsh folds near its pyramids turned back, the ring conformed") {
@@ -814,14 +861,43 @@ TEST_CASE("--unfold: the tets Gmsh folds near its pyramids turned back, the ring
   CHECK(run.out.find("--unfold: " + std::to_string(u.turned.size())) != std::string::npos);
   CHECK(std::filesystem::exists(out));
 
-  // A fault --unfold does not mend (one tet twice) leaves the model as it was.
+  // A fault --unfold does not mend (one tet twice, as Gmsh writes some): the folds are mended
+  // and the tet twice is what the check names (it named the first fold, which unfold had mended).
   primal::Model twice = folded;
   twice.tets.push_back(twice.tets.front());
   if (!twice.tet_block.empty()) twice.tet_block.push_back(twice.tet_block.front());
   if (!twice.tet_ids.empty())
     twice.tet_ids.push_back(*std::max_element(twice.tet_ids.begin(), twice.tet_ids.end()) + 1);
-  const primal::Model kept = twice;
-  CHECK(!primal::unfold(twice).unfolded());
-  CHECK(twice.points == kept.points);
-  CHECK(twice.tets == kept.tets);
+  const primal::UnfoldResult partly = primal::unfold(twice);
+  CHECK(partly.turned.size() == u.turned.size());
+  CHECK(!partly.covered_once);
+  const primal::InputCheckResult left = primal::check_input(twice);
+  REQUIRE(!left.ok());
+  CHECK(left.findings.size() == 1);  // said once, not on each of its four faces
+  CHECK(left.findings[0].fault == InputFault::kDuplicateElement);
+  // Folds unfold cannot mend (every node in a node set, which stays) leave the model as it was.
+  primal::Model stuck = folded;
+  primal::NodeSet all{1, "all", {}};
+  for (std::size_t v = 0; v < stuck.points.size(); ++v) all.nodes.push_back(primal::index_cast(v));
+  stuck.node_sets.push_back(all);
+  const primal::Model kept = stuck;
+  CHECK(!primal::unfold(stuck).unfolded());
+  CHECK(stuck.points == kept.points);
+  CHECK(stuck.tets == kept.tets);
+}
+
+TEST_CASE("--unfold: folds around a pyramid at a 45-degree sector's edge, turned back together") {
+  // Gmsh folds two tets over the pyramid on a sector's quad and over their other neighbours:
+  // each is on the pyramid's side, which turned with them would put its base on the hex's side.
+  // The tets alone are turned (the model was refused with --unfold, found by a fault hunt).
+  const primal::Model folded = gmsh_sector(6, 45);
+  REQUIRE(!primal::check_input(folded).ok());
+  primal::Model m = folded;
+  const primal::UnfoldResult u = primal::unfold(m);
+  REQUIRE(u.unfolded());
+  CHECK(u.covered_once);
+  CHECK(primal::check_input(m).ok());
+  REQUIRE_NOTHROW(primal::check_geometry(m, "unfolded"));
+  CHECK(m.pyramids == folded.pyramids);  // no pyramid turned
+  CHECK(m.hexes == folded.hexes);
 }
