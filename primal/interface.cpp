@@ -621,8 +621,10 @@ Interface find_interface(const Model& model, double tol, std::vector<Index>* joi
   std::sort(out.nodes.begin(), out.nodes.end());
   out.nodes.erase(std::unique(out.nodes.begin(), out.nodes.end()), out.nodes.end());
 
-  // Nodes shared by both parts must be interface nodes.
-  for (std::size_t v = 0; v < P.size(); ++v)
+  // Nodes shared by both parts must be interface nodes, the buffer layer's start; without an
+  // interface quad (the parts joined through wedges, say) each part is diced alone, and dicing
+  // conforms along the edges and at the points they share.
+  for (std::size_t v = 0; v < P.size() && !out.quads.empty(); ++v)
     if (in_hex(index_cast(v)) && in_tet[v] &&
         !std::binary_search(out.nodes.begin(), out.nodes.end(), index_cast(v)))
       throw TopologyError("find_interface: " + describe_node(model, index_cast(v)) +

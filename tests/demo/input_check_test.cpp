@@ -36,6 +36,7 @@
 #include <geode/primal/input_check.hpp>
 #include <geode/primal/submodel.hpp>
 #include <geode/primal/unfold.hpp>
+#include <geode/primal/validity.hpp>
 #include "support/cli_run.hpp"
 #include "support/demo_input.hpp"
 #include "support/temp_dir.hpp"
@@ -335,6 +336,60 @@ void require_face_pairs_are_graph_edges(const primal::Model& m) {
     }
   CHECK(unpaired == quad_triangle);
   CHECK(!pairs.empty());
+}
+
+// A hex box beside a wedge layer between two tet boxes, as a user builds it with OCC: the lower
+// box's top face swept th high in k recombined layers (wedges), the layer's top swept again
+// (tets), a transfinite hex box of k cells through th fragmented against the layer's side. The
+// hexes meet the wedges through quads and the tets above and below along edges only.
+primal::Model gmsh_hexes_beside_wedges(int n, int k) {
+  demo::GmshSession session;
+  namespace occ = gmsh::model::occ;
+  const double th = 0.2;
+  const int bottom = occ::addBox(0, 0, 0, 2, 2, 0.8);
+  occ::synchronize();
+  int top = 0;
+  gmsh::vectorpair faces;
+  gmsh::model::getBoundary({{3, bottom}}, faces, false, false);
+  for (const auto& [dim, tag] : faces) {
+    double x0, y0, z0, x1, y1, z1;
+    gmsh::model::getBoundingBox(2, std::abs(tag), x0, y0, z0, x1, y1, z1);
+    if (z0 > 0.79) top = std::abs(tag);
+  }
+  gmsh::vectorpair layer, upper, parts;
+  occ::extrude({{2, top}}, 0, 0, th, layer, {k}, {}, true);
+  occ::extrude({layer[0]}, 0, 0, 0.8, upper);
+  const auto volume = [](const gmsh::vectorpair& v) {
+    for (const auto& [dim, tag] : v)
+      if (dim == 3) return tag;
+    return 0;
+  };
+  const int hexes = occ::addBox(2, 0, 0.8, 0.6, 2, th);
+  std::vector<gmsh::vectorpair> children;
+  occ::fragment({{3, bottom}, {3, volume(layer)}, {3, volume(upper)}}, {{3, hexes}}, parts,
+                children);
+  occ::synchronize();
+  gmsh::model::getBoundary({{3, volume(children[3])}}, faces, false, false);
+  for (const auto& [dim, face] : faces) {
+    gmsh::vectorpair curves;
+    gmsh::model::getBoundary({{2, std::abs(face)}}, curves, false, false);
+    for (const auto& [d, curve] : curves) {
+      double x0, y0, z0, x1, y1, z1;
+      gmsh::model::getBoundingBox(1, std::abs(curve), x0, y0, z0, x1, y1, z1);
+      const double length = std::max({x1 - x0, y1 - y0, z1 - z0});
+      gmsh::model::mesh::setTransfiniteCurve(
+          std::abs(curve), z1 - z0 > 1e-6 ? k + 1 : static_cast<int>(std::lround(length * n)) + 1);
+    }
+    gmsh::model::mesh::setTransfiniteSurface(std::abs(face));
+    gmsh::model::mesh::setRecombine(2, std::abs(face));
+  }
+  gmsh::model::mesh::setTransfiniteVolume(volume(children[3]));
+  gmsh::model::mesh::setRecombine(3, volume(children[3]));
+  for (int b = 0; b < 4; ++b)
+    gmsh::model::addPhysicalGroup(3, {volume(children[static_cast<std::size_t>(b)])}, b + 1);
+  gmsh::option::setNumber("Mesh.MeshSizeMax", 1.0 / n);
+  gmsh::model::mesh::generate(3);
+  return demo::model_from_gmsh("beside");
 }
 
 }  // namespace
@@ -900,4 +955,34 @@ TEST_CASE("--unfold: folds around a pyramid at a 45-degree sector's edge, turned
   REQUIRE_NOTHROW(primal::check_geometry(m, "unfolded"));
   CHECK(m.pyramids == folded.pyramids);  // no pyramid turned
   CHECK(m.hexes == folded.hexes);
+}
+
+TEST_CASE("conform: hexes beside a wedge layer, touching the tets along edges only, are diced") {
+  // No hex quad meets a tet triangle: no transition to make, each part diced alone and the
+  // dicing conforms along the shared edges. find_interface refused the model (a node of both
+  // parts on no interface quad), found by a fault hunt.
+  test::TempDir dir;
+  const primal::Model m = gmsh_hexes_beside_wedges(4, 2);
+  REQUIRE(!m.hexes.empty());
+  REQUIRE(!m.wedges.empty());
+  REQUIRE(!m.tets.empty());
+  REQUIRE(m.pyramids.empty());
+  std::vector<char> in_hex(m.points.size(), 0);
+  for (const auto& h : m.hexes)
+    for (Index v : h) in_hex[static_cast<std::size_t>(v)] = 1;
+  std::size_t shared = 0;  // nodes of both parts: the edges where they touch
+  std::set<Index> tet_nodes;
+  for (const auto& t : m.tets)
+    for (Index v : t) tet_nodes.insert(v);
+  for (Index v : tet_nodes) shared += in_hex[static_cast<std::size_t>(v)];
+  REQUIRE(shared > 0);
+  const auto in = dir.path / "beside.msh", out = dir.path / "beside.exo";
+  io::write_model(m, in);
+  const auto run = test::geode_cli("conform " + in.string() + " -o " + out.string() + " -q", true);
+  INFO(run.out);
+  REQUIRE(run.code == 0);
+  CHECK(run.out.find("share no interface quad: each is diced alone") != std::string::npos);
+  const primal::Model diced = io::read_model(out);
+  CHECK(diced.hexes.size() == 8 * m.hexes.size() + 6 * m.wedges.size() + 4 * m.tets.size());
+  CHECK(primal::check_validity(primal::hex_part(diced)).ok());
 }
