@@ -417,7 +417,7 @@ void add_run_options(CLI::App* c, ConformArgs& a) {
   c->add_flag("--write-invalid", a.write_invalid,
               "write the mesh and report even when verification fails (the exit code is still 4)");
   add_force_flag(c, a.force);
-  c->add_flag("--quiet", a.quiet,
+  c->add_flag("-q,--quiet", a.quiet,
               "no progress and no summary (errors and the invalid-result message still print)");
 }
 

@@ -485,7 +485,7 @@ void invalid_written(const std::string& what, const std::string& reason) {
 }
 
 CLI::Option* add_quiet_flag(CLI::App* app, bool& flag) {
-  return app->add_flag("--quiet", flag,
+  return app->add_flag("-q,--quiet", flag,
                        "no progress on stderr (the output, errors and warnings still print)");
 }
 

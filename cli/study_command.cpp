@@ -288,7 +288,7 @@ void add_study_commands(CLI::App& app) {
       "--sweep", ia->sweep,
       "with --spec: PATH=FROM:TO:COUNT or PATH=V1,V2,... for a number in the spec, e.g.\n"
       "push.high_roof=0.55:0.95:5 or sheets[3].sphere.radius=0.2,0.3 (repeat for a grid)");
-  inter->add_flag("--quiet", ia->quiet,
+  inter->add_flag("-q,--quiet", ia->quiet,
                   "no progress lines (a bar on a terminal, a line every few seconds in a log)");
   inter->callback([ia] { run_interleave(*ia); });
 
@@ -334,7 +334,7 @@ void add_study_commands(CLI::App& app) {
                    "--buffer-side; not given: as geode conform chooses); the runs with "
                    "--smooth none and global are given the part the defaults' run took")
       ->check(CLI::IsMember({"hex", "tet"}));
-  corners->add_flag("--quiet", ca->quiet, "no progress lines or table on stderr");
+  corners->add_flag("-q,--quiet", ca->quiet, "no progress lines or table on stderr");
   corners->callback([ca] { run_corners(*ca); });
 }
 
