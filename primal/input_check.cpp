@@ -943,7 +943,8 @@ std::string twin_node_hint(const Model& model, std::span<const ElementRef> eleme
 
 // Where two of the elements at a non-manifold edge or node have faces through it (`at`: the
 // edge's two nodes, or the node) lying against each other with other nodes (planes within a tenth
-// of the faces' size, outward normals opposed): "; hint: ..." saying the interface between them
+// of the faces' size, outward normals opposed, one's centre inside the other): "; hint: ..."
+// saying the interface between them
 // does not conform, else nothing. Parts meshed separately and then merged (--merge-tolerance)
 // share their boundary nodes but not their faces: the tets' triangles do not split the hexes'
 // quads, and the check can only call that a non-manifold boundary.
@@ -986,6 +987,16 @@ std::string nonconforming_hint(const Model& model, std::span<const ElementRef> e
     }
     return out;
   };
+  // Whether x, in the face's plane, lies inside it (its corners run counter-clockwise about
+  // Newell's normal; the faces are convex enough for this).
+  const auto inside = [&](const Face& f, const Point& x) {
+    for (std::size_t i = 0; i < f.nodes.size(); ++i) {
+      const Point& p = model.points[index_cast<std::size_t>(f.nodes[i])];
+      const Point& q = model.points[index_cast<std::size_t>(f.nodes[(i + 1) % f.nodes.size()])];
+      if ((q - p).cross(x - p).dot(f.normal) < 0.0) return false;
+    }
+    return true;
+  };
   for (std::size_t i = 0; i < elements.size(); ++i)
     for (std::size_t j = i + 1; j < elements.size(); ++j)
       for (const Face& a : faces_through(elements[i]))
@@ -998,6 +1009,9 @@ std::string nonconforming_hint(const Model& model, std::span<const ElementRef> e
               std::abs(a.normal.dot(b.centre - a.centre)) > reach ||
               std::abs(b.normal.dot(a.centre - b.centre)) > reach)
             continue;
+          // Faces on either side of an edge or node where the parts only touch (fragmented in
+          // one plane) do not overlap: no hint.
+          if (!inside(a, b.centre) && !inside(b, a.centre)) continue;
           const auto named = [&](ElementRef e, const Face& f) {
             return std::string(cell_topology(e.kind).name) + " " +
                    std::to_string(element_id(model, e)) + "'s " +

@@ -759,6 +759,46 @@ TEST_CASE("input check: parts meshed separately, their nodes merged: the interfa
   CHECK(text.find("'s quad and tet ") != std::string::npos);
 }
 
+TEST_CASE("input check: a hex box and a tet box fragmented, touching along an edge: no hint") {
+  // The boxes meet only along the edge x = y = 1: the hex's quad at x = 1 and the tet's triangle
+  // at x = 1 lie in one plane, opposed, on either side of that edge, touching, not against each
+  // other. The refusal names the edge; the hint that the parts were meshed separately (sent a
+  // user who had fragmented them to fragment them) is not given (found by a fault hunt).
+  primal::Model m;
+  {
+    demo::GmshSession session;
+    const int a = gmsh::model::occ::addBox(0, 0, 0, 1, 1, 1);
+    const int b = gmsh::model::occ::addBox(1, 1, 0, 1, 1, 1);
+    gmsh::vectorpair parts;
+    std::vector<gmsh::vectorpair> children;
+    gmsh::model::occ::fragment({{3, a}}, {{3, b}}, parts, children);
+    gmsh::model::occ::synchronize();
+    gmsh::vectorpair faces, curves;
+    gmsh::model::getBoundary({{3, a}}, faces, false, false);
+    for (const auto& [dim, face] : faces) {
+      gmsh::model::getBoundary({{2, std::abs(face)}}, curves, false, false);
+      for (const auto& [d, curve] : curves)
+        gmsh::model::mesh::setTransfiniteCurve(std::abs(curve), 5);
+      gmsh::model::mesh::setTransfiniteSurface(std::abs(face));
+      gmsh::model::mesh::setRecombine(2, std::abs(face));
+    }
+    gmsh::model::mesh::setTransfiniteVolume(a);
+    gmsh::model::addPhysicalGroup(3, {a}, 1);
+    gmsh::model::addPhysicalGroup(3, {b}, 2);
+    gmsh::option::setNumber("Mesh.MeshSizeMax", 0.3);
+    gmsh::model::mesh::generate(3);
+    m = demo::model_from_gmsh("edge");
+  }
+  REQUIRE(!m.hexes.empty());
+  REQUIRE(!m.tets.empty());
+  const primal::InputCheckResult r = primal::check_input(m);
+  REQUIRE(!r.ok());
+  CHECK(r.findings[0].fault == InputFault::kNonManifoldEdge);
+  const std::string text = r.findings[0].text(m);
+  INFO(text);
+  CHECK(text.find("hint") == std::string::npos);
+}
+
 namespace {
 
 // A hex ring (an annulus of radii 0.5 and 1, recombined and swept 0.5 in n layers) in a tet box
