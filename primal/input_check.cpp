@@ -944,10 +944,10 @@ std::string twin_node_hint(const Model& model, std::span<const ElementRef> eleme
 // Where two of the elements at a non-manifold edge or node have faces through it (`at`: the
 // edge's two nodes, or the node) lying against each other with other nodes (planes within a tenth
 // of the faces' size, outward normals opposed, one's centre inside the other): "; hint: ..."
-// saying the interface between them
-// does not conform, else nothing. Parts meshed separately and then merged (--merge-tolerance)
-// share their boundary nodes but not their faces: the tets' triangles do not split the hexes'
-// quads, and the check can only call that a non-manifold boundary.
+// saying the interface between them does not conform, else nothing. Parts meshed separately and
+// then merged (--merge-tolerance) share their boundary nodes but not their faces: the tets'
+// triangles do not split the hexes' quads, and the check can only call that a non-manifold
+// boundary.
 std::string nonconforming_hint(const Model& model, std::span<const ElementRef> elements,
                                std::span<const Index> at) {
   if (elements.size() < 2) return {};
