@@ -337,7 +337,10 @@ void BufferBuilder::directions() {
       throw TopologyError(
           "insert_buffer_layer: " + describe_node(input_, v) + ": no direction into the " + part +
           " side lies above all " + std::to_string(corner_normals_[k].size()) +
-          " interface faces at it (best min cos " + std::to_string(m) +
+          " interface faces at it (" +
+          // -inf: the part's boundary features there leave no direction to look along.
+          (std::isfinite(m) ? "best min cos " + std::to_string(m)
+                            : "none along its boundary's features there") +
           "), so no valid buffer layer can be placed there (the paper's Figure 9 right)");
     // The mitred offset: a step of height / (d . n) along d puts the node at distance height
     // from every interface face whose corner normal fixes the cap's rim, so at convex and
