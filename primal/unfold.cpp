@@ -277,7 +277,7 @@ UnfoldResult unfold(Model& model) {
     }
     return n;
   };
-  // An element with a face more than two use (an element written twice, overlapping ones) is no
+  // An element with a face more than two elements use (one written twice, overlapping ones) is no
   // fold: never turned (a duplicate's faces with its twin alone looked like a fold).
   const auto tangled = [&](const ElementRef& e) {
     const auto cs = element_corners(model, e);
