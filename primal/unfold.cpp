@@ -277,18 +277,27 @@ UnfoldResult unfold(Model& model) {
     }
     return n;
   };
-  // An element with a face more than two elements use (one written twice, overlapping ones) is no
-  // fold: never turned (a duplicate's faces with its twin alone looked like a fold).
-  const auto tangled = [&](const ElementRef& e) {
+  // An element written twice (another on the same nodes) is no fold: never turned (its faces
+  // with its twin alone looked like one).
+  const auto written_twice = [&](const ElementRef& e) {
     const auto cs = element_corners(model, e);
+    std::vector<Index> mine(cs.begin(), cs.end());
+    std::sort(mine.begin(), mine.end());
     const auto& topo = cell_topology(e.kind);
     for (int f = 0; f < topo.faces; ++f) {
       const auto found = uses.find(key(cycle(cs, topo.face[static_cast<std::size_t>(f)])));
-      if (found != uses.end() && found->second.size() > 2) return true;
+      if (found == uses.end()) continue;
+      for (const Use& u : found->second) {
+        if (u.element == e || u.element.kind != e.kind) continue;
+        const auto os = element_corners(model, u.element);
+        std::vector<Index> other(os.begin(), os.end());
+        std::sort(other.begin(), other.end());
+        if (other == mine) return true;
+      }
     }
     return false;
   };
-  std::erase_if(work, tangled);
+  std::erase_if(work, written_twice);
   std::map<ElementRef, int> folds;  // the elements found, with their faces on one side
   for (const ElementRef& e : work) folds[e] = sides(e).second;
   // The elements on one side of the most faces first: a neighbour of a fold, on one side of its
@@ -300,7 +309,7 @@ UnfoldResult unfold(Model& model) {
   for (std::size_t round = 0; !work.empty() && round < 100; ++round) {
     std::vector<ElementRef> next;
     for (const ElementRef& e : work) {
-      if (turned(e) || tangled(e)) continue;
+      if (turned(e) || written_twice(e)) continue;
       const auto [shared, same] = sides(e);
       if (shared == 0 || same < shared) continue;
       turned(e) = 1;
@@ -418,7 +427,10 @@ UnfoldResult unfold(Model& model) {
   const auto found_before = [&](const InputFinding& f) {
     return f.fault != InputFault::kSameSideFace &&
            std::any_of(check.findings.begin(), check.findings.end(), [&](const InputFinding& g) {
-             return g.fault == f.fault && g.elements == f.elements;
+             // A node's finding by its node (the element named among those around it may
+             // change), the others by their elements.
+             return g.fault == f.fault &&
+                    (f.node != kInvalidIndex ? g.node == f.node : g.elements == f.elements);
            });
   };
   if (!std::all_of(after.findings.begin(), after.findings.end(), found_before)) return undo();
