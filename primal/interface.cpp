@@ -629,7 +629,8 @@ Interface find_interface(const Model& model, double tol, std::vector<Index>* joi
         !std::binary_search(out.nodes.begin(), out.nodes.end(), index_cast(v)))
       throw TopologyError("find_interface: " + describe_node(model, index_cast(v)) +
                           " is used by both the hex and the tet part but lies on no interface quad "
-                          "(the parts touch along an edge or at a point only)");
+                          "(the parts touch there along an edge or at a point: the buffer layer "
+                          "starts from the interface quads' nodes)");
   out.uses = node_uses(model, out, joining);
   if (joining) {
     std::sort(joining->begin(), joining->end());
