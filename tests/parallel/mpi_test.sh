@@ -7,8 +7,8 @@
 # until the smoothing and the buffer layer stop short of its cut (the check is what is tested),
 # the rest diced on every rank; on 1 and 4 ranks with the default depth, as users run it (on the
 # smaller models the zone is then the whole model). Each growth conforms the zone again (three
-# times on the layer models), the same work on any rank count: run on two counts, not four, it
-# kept this suite's MPI tests within CI's time.
+# times on the layer models), the same work on any rank count: it runs on two counts, not four,
+# to keep the suite within CI's time.
 # usage: mpi_test.sh GEODE GEODE_MPI PARALLEL_CHECK MPIEXEC MODEL SIZE WORKDIR
 set -euo pipefail
 geode=$1 geode_mpi=$2 check=$3 mpiexec=$4 model=$5 size=$6 dir=$7
