@@ -957,7 +957,7 @@ TEST_CASE("--unfold: the tets Gmsh folds near its pyramids turned back, the ring
   CHECK(std::filesystem::exists(out));
 
   // A fault --unfold does not mend (one tet twice, as Gmsh writes some): the folds are mended
-  // and the tet twice is what the check names (it named the first fold, which unfold had mended).
+  // and the tet twice is what the check names, not a fold unfold mended.
   primal::Model twice = folded;
   twice.tets.push_back(twice.tets.front());
   if (!twice.tet_block.empty()) twice.tet_block.push_back(twice.tet_block.front());
