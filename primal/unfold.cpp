@@ -277,26 +277,13 @@ UnfoldResult unfold(Model& model) {
     }
     return n;
   };
-  // An element written twice (another on the same nodes) is no fold: never turned (its faces
-  // with its twin alone looked like one).
-  const auto written_twice = [&](const ElementRef& e) {
-    const auto cs = element_corners(model, e);
-    std::vector<Index> mine(cs.begin(), cs.end());
-    std::sort(mine.begin(), mine.end());
-    const auto& topo = cell_topology(e.kind);
-    for (int f = 0; f < topo.faces; ++f) {
-      const auto found = uses.find(key(cycle(cs, topo.face[static_cast<std::size_t>(f)])));
-      if (found == uses.end()) continue;
-      for (const Use& u : found->second) {
-        if (u.element == e || u.element.kind != e.kind) continue;
-        const auto os = element_corners(model, u.element);
-        std::vector<Index> other(os.begin(), os.end());
-        std::sort(other.begin(), other.end());
-        if (other == mine) return true;
-      }
-    }
-    return false;
-  };
+  // An element written twice (check_input found it on the same nodes as another) is no fold:
+  // never turned (its faces with its twin alone looked like one).
+  std::set<ElementRef> twice;
+  for (const InputFinding& f : check.findings)
+    if (f.fault == InputFault::kDuplicateElement)
+      twice.insert(f.elements.begin(), f.elements.end());
+  const auto written_twice = [&](const ElementRef& e) { return twice.count(e) > 0; };
   std::erase_if(work, written_twice);
   std::map<ElementRef, int> folds;  // the elements found, with their faces on one side
   for (const ElementRef& e : work) folds[e] = sides(e).second;
