@@ -410,14 +410,21 @@ class InputChecker {
     // Each quad covered adds two or four pairs, of the triangles used once.
     if (options_.element_pairs && options_.share == 0)
       options_.element_pairs->reserve(options_.element_pairs->size() + triangle.size());
+    // A triangle of the quad's own element never covers it: a lone pyramid's four sides meet
+    // at its apex around its base as four triangles of a neighbour would.
+    ElementRef quad_element{};
     auto tri = [&](Index a, Index b, Index c) -> const std::size_t* {
       const Index n[3] = {a, b, c};
       const Triangle probe{face_key(n), 0};
       const auto it = std::lower_bound(triangle.begin(), triangle.end(), probe, by_key);
-      return it == triangle.end() || it->key != probe.key || paired[it->use] ? nullptr : &it->use;
+      return it == triangle.end() || it->key != probe.key || paired[it->use] ||
+                     uses[it->use].element == quad_element
+                 ? nullptr
+                 : &it->use;
     };
     for (std::size_t s = 0; s < uses.size(); ++s) {
       if (uses[s].key[3] == kInvalidIndex) continue;
+      quad_element = uses[s].element;
       const auto q = face_nodes(uses[s].element, uses[s].face);
       std::vector<std::size_t> cover;
       for (int d = 0; d < 2 && cover.empty(); ++d) {  // diagonal q[d] - q[d + 2]
