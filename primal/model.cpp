@@ -470,12 +470,29 @@ std::vector<std::string> geometry_findings(const Model& model, std::size_t max_f
     return found.size() >= max_findings;
   };
   if (max_findings == 0) return found;
+  // An element listing a node twice is flat or folded, but a writer's fault, not a fold: said
+  // as such, without the hint (--unfold moves nodes and cannot mend it). True if it did.
+  const auto repeats = [&](ElementRef ref) {
+    const auto c = element_corners(model, ref);
+    for (std::size_t i = 0; i < c.size(); ++i)
+      if (std::find(c.begin() + static_cast<std::ptrdiff_t>(i) + 1, c.end(), c[i]) != c.end()) {
+        add(describe_element(model, ref) + " lists " + describe_node(model, c[i]) +
+            " twice (nodes " + node_list(model, c) + ")");
+        return true;
+      }
+    return false;
+  };
+  const auto full = [&] { return found.size() >= max_findings; };
   auto pt = [&](Index v) -> const Point& { return model.points[index_cast<std::size_t>(v)]; };
   for (std::size_t t = 0; t < model.tets.size(); ++t) {
     const auto& c = model.tets[t];
     const double volume = tet_volume(pt(c[0]), pt(c[1]), pt(c[2]), pt(c[3]));
     if (!(volume > 0.0)) {
       const ElementRef e{ElementKind::kTet, index_cast(t)};
+      if (repeats(e)) {
+        if (full()) return found;
+        continue;
+      }
       if (add(describe_element(model, e) + " is " + (volume < 0.0 ? "inverted" : "flat") +
               " (signed volume " + number_text(volume) + "; nodes " + node_list(model, c) + ")" +
               std::string(inverted_hint)))
@@ -489,6 +506,10 @@ std::vector<std::string> geometry_findings(const Model& model, std::size_t max_f
     for (std::size_t c = 0; c < 8; ++c)
       if (!(jacobians[c] > 0.0)) {
         const ElementRef e{ElementKind::kHex, index_cast(h)};
+        if (repeats(e)) {
+          if (full()) return found;
+          break;
+        }
         if (add(describe_element(model, e) + " is " + (jacobians[c] < 0.0 ? "inverted" : "flat") +
                 " at its corner " + describe_node(model, model.hexes[h][c]) + " (corner Jacobian " +
                 number_text(jacobians[c]) + "; nodes " + node_list(model, model.hexes[h]) + ")"))
@@ -508,6 +529,10 @@ std::vector<std::string> geometry_findings(const Model& model, std::size_t max_f
           6.0;
       if (!(j > 0.0)) {
         const ElementRef e{ElementKind::kWedge, index_cast(w)};
+        if (repeats(e)) {
+          if (full()) return found;
+          break;
+        }
         if (add(describe_element(model, e) + " is " + (j < 0.0 ? "inverted" : "flat") +
                 " at its corner " + describe_node(model, c[k]) + " (corner Jacobian " +
                 number_text(j) + "; nodes " + node_list(model, c) + ")"))
@@ -522,6 +547,10 @@ std::vector<std::string> geometry_findings(const Model& model, std::size_t max_f
     const auto& c = model.pyramids[p];
     const std::array<double, 4> corner = pyramid_corner_volumes(model, c);
     if (!splits_positive(corner)) {
+      if (repeats({ElementKind::kPyramid, index_cast(p)})) {
+        if (full()) return found;
+        continue;
+      }
       const auto worst =
           index_cast<std::size_t>(std::min_element(corner.begin(), corner.end()) - corner.begin());
       const ElementRef e{ElementKind::kPyramid, index_cast(p)};

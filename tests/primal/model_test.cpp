@@ -209,6 +209,25 @@ TEST_CASE("model: inverted wedges and pyramids refused by their file ids") {
   CHECK_NOTHROW(check_geometry(one_cell(ElementKind::kPyramid, p), "in.msh"));
 }
 
+TEST_CASE("model: an element listing a node twice is said so, with no hint to unfold it") {
+  // A flat cell's refusal suggests --unfold, which moves nodes and cannot mend a repeated one
+  // (found by a fault hunt: "tet 138 is flat ... --unfold mends such cells").
+  for (const ElementKind kind : kElementKinds) {
+    CAPTURE(static_cast<int>(kind));
+    Model m = one_cell(kind, reference_corners(kind));
+    with_cells(m, kind, [](auto& cells) { cells[0][1] = cells[0][0]; });
+    const std::string hint = " (--unfold mends such cells)";
+    try {
+      check_geometry(m, "in.msh", hint);
+      FAIL("not refused");
+    } catch (const geode::InvalidInput& e) {
+      const std::string text = e.what();
+      CHECK(text.find(" lists node 1 (0, 0, 0) twice (nodes 1 1 ") != std::string::npos);
+      CHECK(text.find(hint) == std::string::npos);
+    }
+  }
+}
+
 TEST_CASE("model: a node set's node that no element uses is refused by its file id") {
   // As a Gmsh file saved without the elements of a volume in no physical group: the volume's
   // physical point stays, its elements do not.
