@@ -955,6 +955,8 @@ class MshReader {
       }
       tagged.push_back(std::move(t));
     }
+    const auto moved = separate_node_set_ids(tagged, source_);
+    warn_moved_node_sets(tagged, moved, source_, "physical curve", "physical point");
     try {
       add_tagged_sets(model, tagged, source_, "element");
     } catch (const InvalidInput& e) {  // a face of no element: say why, where Gmsh left one out

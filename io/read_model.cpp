@@ -120,6 +120,8 @@ void read_tagged_boundary_cells(const VtkGrid& grid, const std::string& block_ar
     }
     sets.push_back(std::move(t));
   }
+  const auto moved = separate_node_set_ids(sets, grid.source);
+  warn_moved_node_sets(sets, moved, grid.source, "line cells tagged", "vertex cells tagged");
   add_tagged_sets(model, sets, grid.source, "cell");
 }
 

@@ -190,6 +190,30 @@ const Side* FaceOwners::find(std::span<const Index> nodes) const {
   return it == owner_.end() ? nullptr : &it->second;
 }
 
+std::vector<MovedGroup> separate_node_set_ids(std::span<TaggedCells> groups,
+                                              const std::string& source) {
+  std::set<int> point_tags;
+  int highest = 0;
+  for (const TaggedCells& g : groups)
+    if (g.dim < 2) {
+      if (g.dim == 0) point_tags.insert(g.id);
+      highest = std::max(highest, g.id);
+    }
+  int shift = 1;
+  while (shift <= highest && shift <= std::numeric_limits<int>::max() / 10) shift *= 10;
+  std::vector<MovedGroup> moved;
+  for (std::size_t k = 0; k < groups.size(); ++k) {
+    TaggedCells& g = groups[k];
+    if (g.dim != 1 || !point_tags.count(g.id)) continue;
+    if (shift <= highest || g.id > std::numeric_limits<int>::max() - shift)
+      throw InvalidInput(source + ": the points and lines tagged " + std::to_string(g.id) +
+                         " would be two node sets of one id, and no other id is free");
+    moved.push_back({k, g.id});
+    g.id += shift;
+  }
+  return moved;
+}
+
 void add_tagged_sets(Model& model, std::span<const TaggedCells> groups, const std::string& source,
                      const std::string& cell_word) {
   FaceOwners owners;

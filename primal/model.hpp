@@ -163,6 +163,17 @@ struct TaggedCells {
 // "cell", "element") for a face of no element.
 void add_tagged_sets(Model& model, std::span<const TaggedCells> groups, const std::string& source,
                      const std::string& cell_word);
+// Gmsh's tags are per dimension while node sets share one range of ids: a physical curve may
+// have a physical point's tag. Such a group of lines takes tag + 10^k, 10^k the smallest power
+// of ten above every point and line tag (as the .msh writer moves a set's id off a taken one);
+// returns, per group moved, its index and the tag it had. InvalidInput naming `source` where no
+// such id fits in an int.
+struct MovedGroup {
+  std::size_t group = 0;
+  int was = 0;
+};
+std::vector<MovedGroup> separate_node_set_ids(std::span<TaggedCells> groups,
+                                              const std::string& source);
 
 // What readers check beyond the file's structure.
 struct ReadOptions {

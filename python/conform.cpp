@@ -13,6 +13,7 @@
 #include <geode/conform/conform.hpp>
 #include <geode/conform/report.hpp>
 #include <geode/demo/demo_models.hpp>
+#include <geode/io/read_warnings.hpp>
 #include <geode/primal/input_check.hpp>
 #include <geode/primal/model.hpp>
 #include <geode/primal/unfold.hpp>
@@ -175,6 +176,14 @@ py::dict conform_arrays(const py::handle& points, const py::dict& cells,
                              std::to_string(model.points.size()) + ")");
     groups.push_back(std::move(g));
   }
+  std::vector<std::string> read_warnings;  // as a file's reader says them
+  {
+    const io::ReadWarnings collected;
+    const auto moved_sets = primal::separate_node_set_ids(groups, source);
+    io::warn_moved_node_sets(groups, moved_sets, source, "line cells tagged",
+                             "vertex cells tagged");
+    read_warnings = collected.messages();
+  }
   primal::add_tagged_sets(model, groups, source, "cell");
   // What the readers check of a file, here of the arrays: a wedge or pyramid in another corner
   // order is inverted, and refused as a file's is (the element ids are the package's: each
@@ -260,6 +269,7 @@ py::dict conform_arrays(const py::handle& points, const py::dict& cells,
   d["merged_nodes"] = merged;
   d["unfolded_nodes"] = moved;
   d["unfolded_cells"] = unfolded_cells;
+  d["read_warnings"] = read_warnings;
   d["model"] = model_dict(std::move(r.model));
   return d;
 }

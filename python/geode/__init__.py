@@ -271,6 +271,8 @@ def conform(mesh=None, *, points=None, cells=None, cell_blocks=None, name="mesh"
     out = _geode._conform(pts, arrays, names, node_sets, tagged, name, smooth, quality, geode_block, buffer_side or "",
                           float(buffer_thickness), float(smooth_target), template_box, merge_tolerance, relax,
                           bool(unfold))
+    for w in out["read_warnings"]:  # what a file's reader says of the same cells
+        _warnings.warn(w, GeodeWarning, stacklevel=2)
     if not out["valid"] and not allow_invalid:
         raise InvalidResultError(out["invalid_reason"] + " (nothing returned; allow_invalid=True returns it anyway)")
     model = out["model"]

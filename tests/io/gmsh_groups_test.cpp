@@ -502,6 +502,52 @@ TEST_CASE("Gmsh's legacy .vtk: its physical points, curves and surfaces are the 
   CHECK(sides == side_sets_at(msh));
 }
 
+TEST_CASE("a physical curve with a physical point's tag: two node sets, the curve's moved") {
+  // Gmsh's tags are per dimension, so Physical Point(5) and Physical Curve(5) are common; both
+  // were node set 5 and the file was refused ("node set id 5 is used twice"; found by a fault
+  // hunt), through the .msh and Gmsh's .vtk alike.
+  const test::TempDir dir;
+  {
+    demo::GmshSession session;
+    const auto [a, b] = boxes_side_by_side("same tags");
+    transfinite_hexes(a);
+    gmsh::option::setNumber("Mesh.MeshSizeMax", 0.4);
+    gmsh::model::addPhysicalGroup(3, {a}, 1);
+    gmsh::model::addPhysicalGroup(3, {b}, 2);
+    gmsh::vectorpair points, curves;
+    gmsh::model::getEntities(points, 0);
+    gmsh::model::getEntities(curves, 1);
+    gmsh::model::addPhysicalGroup(0, {points.front().second}, 5);
+    gmsh::model::setPhysicalName(0, 5, "corner");
+    gmsh::model::addPhysicalGroup(1, {curves.back().second}, 5);
+    gmsh::model::setPhysicalName(1, 5, "edge");
+    gmsh::model::mesh::generate(3);
+    gmsh::write((dir.path / "same.msh").string());
+    gmsh::write((dir.path / "same.vtk").string());
+  }
+  std::map<int, std::set<std::array<double, 3>>> from_msh;
+  for (const std::string name : {"same.msh", "same.vtk"}) {
+    CAPTURE(name);
+    ReadWarnings warnings;
+    const Model m = read_model(dir.path / name);
+    REQUIRE(m.node_sets.size() == 2);
+    const auto sets = node_sets_at(m);
+    REQUIRE(sets.count(5));
+    REQUIRE(sets.count(15));
+    CHECK(sets.at(5).size() == 1);  // the point
+    CHECK(sets.at(15).size() > 2);  // the curve's nodes
+    REQUIRE(warnings.messages().size() == 1);
+    const std::string said = warnings.messages().front();
+    CHECK(said.find(name == "same.msh"
+                        ? "physical curve 5 'edge' and physical point 5 'corner' would both be "
+                          "node set 5: the lines are node set 15"
+                        : "line cells tagged 5 and vertex cells tagged 5 would both be node set "
+                          "5: the lines are node set 15") != std::string::npos);
+    if (name == "same.msh") from_msh = sets;
+    CHECK(sets == from_msh);
+  }
+}
+
 TEST_CASE("a volume in no physical group, which Gmsh saves without elements, is warned about") {
   // Gmsh saves only the elements of physical groups unless Mesh.SaveAll=1, but lists every
   // entity in $Entities: the second box of a file whose first alone is in a physical volume was

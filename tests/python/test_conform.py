@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import geode
-from conftest import cli_error, one_line, run_cli
+from conftest import SOURCE, cli_error, one_line, run_cli
 
 
 @pytest.fixture(scope="module")
@@ -219,11 +219,6 @@ def test_gmsh_physical_points_curves_and_surfaces_are_the_commands_sets(tmp_path
     # meshio gives a Gmsh file's physical points, curves and surfaces as vertex, line, triangle
     # and quad cells tagged in gmsh:physical; the module dropped them without a word, where
     # `geode conform` of the same file keeps them as node and side sets.
-    import subprocess
-    import sys
-
-    from conftest import SOURCE
-
     path = tmp_path / "sets.msh"
     subprocess.run([sys.executable, str(SOURCE / "tests" / "conform" / "sets_models.py"), "embedded", str(path)],
                    check=True)
@@ -236,6 +231,25 @@ def test_gmsh_physical_points_curves_and_surfaces_are_the_commands_sets(tmp_path
     out, report = geode.conform(meshio.read(path))
     assert {name: len(nodes) for name, nodes in out.point_sets.items()} == cli_nodes
     assert {s["name"]: len(s["sides"]) for s in report["side_sets"]} == cli_sides
+
+
+def test_a_physical_curve_with_a_physical_points_tag_is_a_node_set_of_its_own(tmp_path):
+    # Gmsh's tags are per dimension: both groups were node set 5 and the mesh was refused ("node
+    # set id 5 is used twice"), as the command refused the file.
+    path = tmp_path / "sets.msh"
+    subprocess.run([sys.executable, str(SOURCE / "tests" / "conform" / "sets_models.py"), "embedded", str(path)],
+                   check=True)
+    mesh = meshio.read(path)
+    for block, tags in zip(mesh.cells, mesh.cell_data["gmsh:physical"]):
+        if block.type == "line":
+            tags[:] = 5  # the curve "probe_line" (6) given the tag of the point "load_point" (5)
+    mesh.field_data["probe_line"][0] = 5
+    with pytest.warns(geode.GeodeWarning, match="line cells tagged 5 'probe_line' and vertex cells tagged 5 "
+                                                "'load_point' would both be node set 5: the lines are node set 15"):
+        out, report = geode.conform(mesh)
+    assert report["valid"]
+    assert set(out.point_sets) == {"load_point", "probe_line"}
+    assert len(out.point_sets["load_point"]) == 1 and len(out.point_sets["probe_line"]) > 2
 
 
 def test_unfold_turns_back_the_tets_gmsh_folds_as_the_command_does(tmp_path):
