@@ -431,10 +431,21 @@ bool lower_dimensional_type(const std::string& upper_type) {
 }
 
 // meshio numbers blocks and sets from 0: a file with any id <= 0 gets them numbered by
-// position (1, 2, ...), which keeps every id positive and distinct.
+// position (1, 2, ...), which keeps every id positive and distinct, and the reader says so:
+// the output, and options naming blocks (--join-blocks), use the new ids.
 template <typename T>
-bool renumbered(const std::vector<T>& items) {
-  return std::any_of(items.begin(), items.end(), [](const T& i) { return i.id <= 0; });
+bool renumbered(const std::vector<T>& items, const std::string& source, const char* what) {
+  if (std::none_of(items.begin(), items.end(), [](const T& i) { return i.id <= 0; })) return false;
+  std::string from, to;  // the first few, on one line
+  constexpr std::size_t kListed = 6;
+  for (std::size_t k = 0; k < std::min(items.size(), kListed); ++k) {
+    from += (k ? ", " : "") + std::to_string(items[k].id);
+    to += (k ? ", " : "") + std::to_string(k + 1);
+  }
+  if (items.size() > kListed) from += ", ...", to += ", ...";
+  read_warning(source + ": " + what + " ids " + from + " are not all positive: read as " + to +
+               ", in the file's order (the output and options naming them use these)");
+  return true;
 }
 
 // Stage two: the model, every entry checked (the file's ids in messages).
@@ -472,7 +483,7 @@ Model build_model(const Contents& c, const std::string& source) {
   }
   std::vector<ElementRef> global;  // global element number (1-based) - 1 -> element
   global.reserve(index_cast<std::size_t>(std::max(c.num_elem, 0)));
-  const bool renumber_blocks = renumbered(c.blocks);
+  const bool renumber_blocks = renumbered(c.blocks, source, "element block");
   std::string left_out;  // blocks of points, lines or faces: "3 (QUAD4, 96), ..."
   for (std::size_t b = 0; b < c.blocks.size(); ++b) {
     const BlockData& block = c.blocks[b];
@@ -535,7 +546,7 @@ Model build_model(const Contents& c, const std::string& source) {
       if (ids.size() > 1) join_blocks(model, ids, source);
   }
 
-  const bool renumber_node_sets = renumbered(c.node_sets);
+  const bool renumber_node_sets = renumbered(c.node_sets, source, "node set");
   for (std::size_t s = 0; s < c.node_sets.size(); ++s) {
     const SetData& in = c.node_sets[s];
     NodeSet set{renumber_node_sets ? static_cast<int>(s) + 1 : in.id, in.name, {}};
@@ -549,7 +560,7 @@ Model build_model(const Contents& c, const std::string& source) {
     model.node_sets.push_back(std::move(set));
   }
 
-  const bool renumber_side_sets = renumbered(c.side_sets);
+  const bool renumber_side_sets = renumbered(c.side_sets, source, "side set");
   for (std::size_t s = 0; s < c.side_sets.size(); ++s) {
     const SetData& in = c.side_sets[s];
     SideSet set{renumber_side_sets ? static_cast<int>(s) + 1 : in.id, in.name, {}};

@@ -167,6 +167,13 @@ class MshReader {
         version_ == 4 ? elements41() : elements22();
         have_elements = true;
       } else {
+        // Periodic meshes (representative volumes): nothing carries the pairing, and nodes on
+        // those faces may move within them (buffer layer, smoothing) on one side only.
+        if (name == "Periodic")
+          read_warning(source_ +
+                       ": $Periodic is not read: the output has no periodic node pairs, and its "
+                       "periodic faces match node for node only where the transition and "
+                       "smoothing moved no node on them");
         skip_section(name, start);
         continue;
       }

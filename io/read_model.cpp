@@ -1,6 +1,7 @@
 #include <geode/io/read_model.hpp>
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <climits>
 #include <map>
@@ -134,11 +135,27 @@ Model model_from_vtk(const VtkGrid& grid, const ReadOptions& options) {
     model.node_ids.push_back(static_cast<std::int64_t>(n));
   const std::vector<int>* blocks = nullptr;
   std::string block_array;
-  for (const char* name : {"block", "gmsh:physical", "CellEntityIds", "mat_id"})
+  constexpr std::array<const char*, 4> kBlockArrays{"block", "gmsh:physical", "CellEntityIds",
+                                                    "mat_id"};
+  for (const char* name : kBlockArrays)
     if ((blocks = grid.cell_data.find_int(name))) {
       block_array = name;
       break;
     }
+  // A material array under another name (meshio writes cell_data as named) would be lost
+  // without a word: the blocks then follow the cell kinds.
+  if (!blocks && !grid.cell_data.ints.empty()) {
+    std::string names;
+    for (const auto& [name, values] : grid.cell_data.ints)
+      if (name != "gmsh:geometrical")
+        names += (names.empty() ? "'" : ", '") + sanitize_name(name) + "'";
+    std::string known;
+    for (const char* name : kBlockArrays) known += (known.empty() ? "" : ", ") + std::string(name);
+    if (!names.empty())
+      read_warning(grid.source + ": integer cell array " + names +
+                   " not read as blocks (only one named " + known +
+                   " is): the blocks are the cell kinds'");
+  }
   // meshio's gmsh:physical is 0 for a cell in no physical group: numbered as the .msh reader
   // numbers such elements, by its entity (gmsh:geometrical; else the kind's default block),
   // above every physical tag of a volume cell where some cell has one.

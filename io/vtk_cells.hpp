@@ -40,6 +40,13 @@ inline int cell_type_size(int type) {
   return t ? t->size : 0;
 }
 
+// VTK's higher-order cells (vtkCellType.h: 21 VTK_QUADRATIC_EDGE to 37
+// VTK_TRIQUADRATIC_PYRAMID, 68 VTK_LAGRANGE_CURVE to 80 VTK_BEZIER_PYRAMID): named as such when
+// refused, since a mesher's second-order output is the usual reason for one.
+inline bool higher_order(int type) {
+  return (type >= 21 && type <= 37) || (type >= 68 && type <= 80);
+}
+
 // "5 triangle, 9 quad, ...": the types the readers take.
 inline std::string supported_cell_types() {
   std::string s;

@@ -34,8 +34,14 @@ void check_cells(const VtkGrid& g, LineOf&& line_of_cell) {
     const char* name = vtk_cells::cell_type_name(type);
     if (!name) {
       fail(g.source, line_of_cell(c, true),
-           "cell " + std::to_string(c) + ": unknown or unsupported cell type " +
-               std::to_string(type) + " (supported: " + vtk_cells::supported_cell_types() + ")");
+           "cell " + std::to_string(c) + ": " +
+               (vtk_cells::higher_order(type)
+                    ? "cell type " + std::to_string(type) +
+                          " is a higher-order cell (quadratic, "
+                          "cubic or Lagrange); only linear cells are "
+                          "read"
+                    : "unknown or unsupported cell type " + std::to_string(type)) +
+               " (supported: " + vtk_cells::supported_cell_types() + ")");
     }
     if (primal::index_cast<int>(g.cells[c].size()) != vtk_cells::cell_type_size(type)) {
       fail(g.source, line_of_cell(c, false),

@@ -548,6 +548,34 @@ TEST_CASE("a physical curve with a physical point's tag: two node sets, the curv
   }
 }
 
+TEST_CASE("a periodic mesh's $Periodic is said not to be carried") {
+  const test::TempDir dir;
+  {
+    demo::GmshSession session;
+    gmsh::model::add("periodic");
+    gmsh::model::occ::addBox(0, 0, 0, 1, 1, 1);
+    gmsh::model::occ::synchronize();
+    gmsh::option::setNumber("Mesh.MeshSizeMax", 0.5);
+    // The face y = 1 a copy of y = 0, moved by 1 along y.
+    const auto face_at = [](double y) {
+      gmsh::vectorpair faces;
+      gmsh::model::getEntitiesInBoundingBox(-0.1, y - 0.1, -0.1, 1.1, y + 0.1, 1.1, faces, 2);
+      REQUIRE(faces.size() == 1);
+      return faces.front().second;
+    };
+    gmsh::model::mesh::setPeriodic(2, {face_at(1)}, {face_at(0)},
+                                   {1, 0, 0, 0, 0, 1, 0, 1, 0, 0, 1, 0, 0, 0, 0, 1});
+    gmsh::model::mesh::generate(3);
+    gmsh::write((dir.path / "periodic.msh").string());
+  }
+  ReadWarnings warnings;
+  const Model m = read_model(dir.path / "periodic.msh");
+  CHECK(!m.tets.empty());
+  REQUIRE(warnings.messages().size() == 1);
+  CHECK(warnings.messages().front().find("periodic.msh: $Periodic is not read") !=
+        std::string::npos);
+}
+
 TEST_CASE("a volume in no physical group, which Gmsh saves without elements, is warned about") {
   // Gmsh saves only the elements of physical groups unless Mesh.SaveAll=1, but lists every
   // entity in $Entities: the second box of a file whose first alone is in a physical volume was

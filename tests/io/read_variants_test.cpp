@@ -112,12 +112,33 @@ TEST_CASE("meshio's .vtu and .vtk with materials as mat_id: the blocks") {
   }
 }
 
+TEST_CASE("meshio's .vtu with materials under another name: not read, said") {
+  // The blocks then follow the cell kinds; the array was left out without a word (found by a
+  // fault hunt).
+  test::TempDir dir;
+  write_variants("meshio", dir.path);
+  ReadWarnings warnings;
+  const Model model = read_model(dir.path / "meshio-material.vtu");
+  CHECK(!model.hexes.empty());
+  REQUIRE(warnings.messages().size() == 1);
+  CHECK(warnings.messages().front().find(
+            "meshio-material.vtu: integer cell array 'material' not read as blocks (only one "
+            "named block, gmsh:physical, CellEntityIds, mat_id is)") != std::string::npos);
+}
+
 TEST_CASE("meshio's .exo with node sets numbered from 0: the sets numbered by position") {
   // The old reader refused the file ("node set 0 'ns_bottom': id is not positive") although it
   // renumbers meshio's block ids from 0 the same way.
   test::TempDir dir;
   const HexMesh m = write_variants("meshio", dir.path);
+  ReadWarnings warnings;
   const Model model = read_model(dir.path / "meshio-sets.exo");
+  // Said, since options naming blocks (--join-blocks) and the output use the new ids.
+  CHECK(std::any_of(warnings.messages().begin(), warnings.messages().end(), [](const auto& w) {
+    return w.find(
+               "meshio-sets.exo: node set ids 0, 1 are not all positive: read as 1, 2, in the "
+               "file's order") != std::string::npos;
+  }));
   REQUIRE(model.node_sets.size() == 2);
   CHECK(model.node_sets[0].id == 1);
   CHECK(model.node_sets[0].name == "ns_bottom");
@@ -142,8 +163,9 @@ TEST_CASE("meshio's .exo of a Gmsh mesh: its blocks of vertices and faces left o
   ReadWarnings warnings;
   const Model model = read_model(dir.path / "meshio-surfaces.exo");
   CHECK(model.hexes == m.hexes);
-  REQUIRE(warnings.messages().size() == 1);
-  CHECK(warnings.messages()[0].find("element blocks of points, lines or faces, not volume cells, "
+  REQUIRE(warnings.messages().size() == 2);
+  CHECK(warnings.messages()[0].find("element block ids 0, 1, ") != std::string::npos);
+  CHECK(warnings.messages()[1].find("element blocks of points, lines or faces, not volume cells, "
                                     "are not read (block id, type, elements): 0 (SPHERE, 1), 1 "
                                     "(QUAD4, ") != std::string::npos);
   // The hexes keep their file numbers after the blocks left out: 1 vertex and the quads first.

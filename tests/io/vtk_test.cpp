@@ -295,6 +295,11 @@ TEST_CASE("io_vtk: bad input names the file, the line and the reason") {
       edit_line(vtk, after("CELL_TYPES"), [](const std::string&) { return std::string("42"); }),
       "cell 0: unknown or unsupported cell type 42 (supported: 1 vertex, 3 line, 5 triangle, 9 "
       "quad, 10 tetra, 12 hexahedron, 13 wedge, 14 pyramid)");
+  // A mesher's second-order output: named as such (meshio writes Gmsh's 27-node hexes as 29).
+  add("vtk higher-order cell type",
+      edit_line(vtk, after("CELL_TYPES"), [](const std::string&) { return std::string("29"); }),
+      "cell 0: cell type 29 is a higher-order cell (quadratic, cubic or Lagrange); only linear "
+      "cells are read (supported: 1 vertex");
   add("vtk node out of range",
       edit_line(vtk, after("CELLS"),
                 [](const std::string&) { return std::string("8 0 1 4 3 9 10 13 -1"); }),
