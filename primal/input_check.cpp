@@ -1027,7 +1027,8 @@ std::string nonconforming_hint(const Model& model, std::span<const ElementRef> e
           return "; hint: " + named(elements[i], a) + " and " + named(elements[j], b) +
                  " lie against each other here on other nodes: the interface does not conform, "
                  "as when parts are meshed separately (in Gmsh, fragment the volumes before "
-                 "meshing, gmsh.model.occ.fragment, so that they share the interface's mesh)";
+                 "meshing, gmsh.model.occ.fragment, so that they share the interface's mesh; "
+                 "in TetGen, -Y keeps the given boundary's faces as they are)";
         }
   return {};
 }
