@@ -467,9 +467,17 @@ void validate(const Model& model, std::string_view source) {
 
 void check_points(const Model& model, std::string_view source) {
   for (std::size_t n = 0; n < model.points.size(); ++n)
-    if (!model.points[n].allFinite())
+    if (!model.points[n].allFinite()) {
+      // A node no element uses is refused too (whatever reads every point, a bounding box, a
+      // merge of coincident nodes, would take it in): said, so that the user looks for a stray
+      // node rather than a broken element.
+      bool used = false;
+      for (ElementKind kind : kElementKinds)
+        for (std::size_t e = 0; e < element_count(model, kind) && !used; ++e)
+          for (Index v : element_corners(model, {kind, index_cast(e)})) used |= v == index_cast(n);
       throw InvalidInput(std::string(source) + ": " + describe_node(model, index_cast(n)) +
-                         " has a non-finite coordinate");
+                         " has a non-finite coordinate" + (used ? "" : " (no element uses it)"));
+    }
 }
 
 std::array<double, 4> pyramid_corner_volumes(const Model& model, const std::array<Index, 5>& c) {

@@ -7,6 +7,8 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -226,6 +228,20 @@ TEST_CASE("model: an element listing a node twice is said so, with no hint to un
       CHECK(text.find(hint) == std::string::npos);
     }
   }
+}
+
+TEST_CASE("model: a non-finite node is refused, and said to be unused where no element uses it") {
+  Model m = one_cell(ElementKind::kTet, reference_corners(ElementKind::kTet));
+  m.points.push_back(Point(std::nan(""), 0.0, 0.0));
+  m.node_ids = {11, 12, 13, 14, 15};
+  CHECK_THROWS_WITH_AS(
+      check_points(m, "in.msh"),
+      "in.msh: node 15 (nan, 0, 0) has a non-finite coordinate (no element uses it)",
+      geode::InvalidInput);
+  m.points[1].y() = std::numeric_limits<double>::infinity();
+  CHECK_THROWS_WITH_AS(check_points(m, "in.msh"),
+                       "in.msh: node 12 (1, inf, 0) has a non-finite coordinate",
+                       geode::InvalidInput);
 }
 
 TEST_CASE("model: a node set's node that no element uses is refused by its file id") {
