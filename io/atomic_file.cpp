@@ -2,10 +2,13 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
+#include <chrono>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <ostream>
@@ -13,6 +16,7 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <thread>
 
 #include <geode/io/file_sink.hpp>
 #include <geode/primal/errors.hpp>
@@ -169,6 +173,40 @@ void install_signal_cleanup() {
     if (::sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
     ::sigaction(sig, &sa, nullptr);
   }
+}
+
+namespace {
+
+std::atomic<std::int64_t> g_heartbeat_ns{0};  // CLOCK_MONOTONIC of the last tick
+static_assert(std::atomic<std::int64_t>::is_always_lock_free);
+
+std::int64_t monotonic_ns() {  // async-signal-safe (clock_gettime is)
+  timespec t{};
+  ::clock_gettime(CLOCK_MONOTONIC, &t);
+  return static_cast<std::int64_t>(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
+}
+
+extern "C" void abort_on_unstopped_continue(int) {
+  const auto since = monotonic_ns() - g_heartbeat_ns.load();
+  if (since < static_cast<std::int64_t>(kLauncherStopSeconds * 1e9))
+    unlink_temporaries_and_reraise(SIGTERM);
+}
+
+}  // namespace
+
+void install_launcher_abort_cleanup() {
+  g_heartbeat_ns.store(monotonic_ns());
+  std::thread([] {
+    while (true) {
+      g_heartbeat_ns.store(monotonic_ns());
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+  }).detach();
+  struct sigaction sa {};
+  sa.sa_handler = abort_on_unstopped_continue;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESTART;
+  ::sigaction(SIGCONT, &sa, nullptr);
 }
 
 OutputTarget resolve_output(const fs::path& path) {

@@ -82,4 +82,15 @@ void unregister_temporary(const std::filesystem::path& temp);
 // with the default action.
 void install_signal_cleanup();
 
+// For a process run by a parallel launcher: there an abort (the launcher's own SIGINT or
+// SIGTERM, or another rank's failure) reaches a rank as SIGCONT at once, SIGTERM only a second
+// later (OpenMPI's odls_base_sigkill_timeout; Slurm's scancel alike) and SIGKILL a few
+// milliseconds after that: a rank that waited for SIGTERM went on publishing its outputs in
+// that second, or was killed mid-cleanup. A SIGCONT that does not end a stop is therefore taken
+// as that SIGTERM. A stop is told by a heartbeat thread's last tick (every 50 ms): a process
+// resumed after a stop of kLauncherStopSeconds or more (Ctrl-Z then fg, a scheduler's suspend)
+// sees it stale and goes on.
+inline constexpr double kLauncherStopSeconds = 0.5;
+void install_launcher_abort_cleanup();
+
 }  // namespace geode::io

@@ -433,6 +433,10 @@ int run(int argc, char** argv, int rank, int size) {
     if (rank == 0) std::cerr << "geode_mpi conform: error: " << lost << " (nothing written)\n";
     return 2;  // the temporaries go with `files`
   }
+  // Test hook (tests/parallel/mpi_verify_test.sh, docs/cli.md): GEODE_TEST_PAUSE_BEFORE_COMMIT=S
+  // makes every rank wait S seconds with its pieces written, before publishing them.
+  if (const char* pause = std::getenv("GEODE_TEST_PAUSE_BEFORE_COMMIT"); pause && *pause)
+    std::this_thread::sleep_for(std::chrono::duration<double>(std::atof(pause)));
   try {
     files.commit();  // every rank wrote its piece: all published
   } catch (const std::exception& e) {
@@ -454,8 +458,10 @@ int main(int argc, char** argv) {
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   MPI_Comm_dup(MPI_COMM_WORLD, &agreement);
   // An interrupted rank removes its hidden temporaries (io/atomic_file.hpp), as geode does:
-  // mpirun passes SIGINT and SIGTERM on to the ranks as SIGTERM.
+  // mpirun passes SIGINT and SIGTERM on to the ranks as SIGTERM, after a SIGCONT a second
+  // earlier, which is taken as the abort.
   io::install_signal_cleanup();
+  io::install_launcher_abort_cleanup();
   const int code = run(argc, argv, rank, size);  // every rank's worst (agree())
   MPI_Comm_free(&agreement);
   MPI_Finalize();
