@@ -3,6 +3,7 @@
 #include <malloc.h>
 
 #include <csignal>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <new>
@@ -157,6 +158,11 @@ int main(int argc, char** argv) {
     std::cerr << command_path(app)
               << ": error: the input asks for a container larger than memory can hold ("
               << one_line(e.what()) << "; nothing written)\n";
+    code = 2;
+  } catch (const std::filesystem::filesystem_error& e) {
+    // A path the command could not resolve or reach: the user's, so exit 2 as any bad path
+    // (the message names it), not 1, which no documented case uses.
+    std::cerr << command_path(app) << ": error: " << one_line(e.what()) << " (nothing written)\n";
     code = 2;
   } catch (const std::exception& e) {
     if (thread_start_failed(e)) {

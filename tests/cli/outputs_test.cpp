@@ -201,4 +201,19 @@ TEST_CASE("an output linked to /dev/stdout, stdout a pipe: the mesh comes throug
   CHECK(both.code == 2);
   CHECK(both.out.find("is standard output, where --report - prints the report") !=
         std::string::npos);
+  // Beside a report (or as the report), the link was resolved to compare the two paths and
+  // the run ended with exit 1 and libstdc++'s "cannot make canonical path" (a hunt's).
+  const fs::path report_link = dir.path / "out.json";
+  fs::create_symlink("/dev/stdout", report_link);
+  const auto mesh_there = geode_cli("conform " + input.string() + " -o " + link.string() +
+                                    " --report " + (dir.path / "r.json").string() + " --quiet");
+  CHECK(mesh_there.code == 0);
+  CHECK(mesh_there.out.rfind("# vtk DataFile Version", 0) == 0);
+  CHECK(fs::exists(dir.path / "r.json"));
+  const auto report_there =
+      geode_cli("conform " + input.string() + " -o " + (dir.path / "m.exo").string() +
+                " --report " + report_link.string() + " --quiet");
+  CHECK(report_there.code == 0);
+  CHECK(report_there.out.rfind("{", 0) == 0);
+  CHECK(fs::exists(dir.path / "m.exo"));
 }
