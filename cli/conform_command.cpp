@@ -536,7 +536,9 @@ void add_conform_commands(CLI::App& app) {
     }
     // The line before the files: commit() publishes nothing if it was lost.
     const std::string lines = dargs->quiet ? std::string() : saved.str();
-    if (dargs->output.empty() && dargs->report.empty()) {
+    // --save-input alone: the input is what was asked for; nothing given at all: the demo is
+    // conformed and its report printed, as --help says (it did nothing, exit 0; a hunt's).
+    if (dargs->output.empty() && dargs->report.empty() && !dargs->save_input.empty()) {
       std::cout << lines;
       files.commit();
     } else {

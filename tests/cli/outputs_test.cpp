@@ -126,6 +126,22 @@ TEST_CASE("demo --save-input is published with -o: a mesh that cannot be written
   CHECK(names_in(dir.path) == std::vector<std::string>{"in.msh", "out.exo"});
 }
 
+TEST_CASE("demo without outputs conforms and prints its report; --save-input alone saves") {
+  // A hunt's: docs/whole-models.md's `geode demo --model delaunay -n 4 --smooth none` printed
+  // nothing and exited 0, the conform skipped as if --save-input had been given.
+  TempDir dir;
+  const auto printed = geode_cli("demo --model half -n 2 --smooth none");
+  CHECK(printed.code == 0);
+  CHECK(printed.out.find("block 1 ") != std::string::npos);
+  CHECK(printed.out.find("input diced alone: min scaled Jacobian") != std::string::npos);
+  const fs::path saved = dir.path / "in.msh";
+  const auto save = geode_cli("demo --model half -n 2 --save-input " + saved.string());
+  CHECK(save.code == 0);
+  CHECK(save.out.find("wrote " + saved.string()) != std::string::npos);
+  CHECK(save.out.find("block 1 ") == std::string::npos);
+  CHECK(names_in(dir.path) == std::vector<std::string>{"in.msh"});
+}
+
 TEST_CASE("an output FIFO whose reader leaves: exit 2 in one line, the report not replaced") {
   // A hunt's: the write into the FIFO raised SIGPIPE, which ended the run with the new report
   // published and the mesh lost. geode ignores SIGPIPE: the write fails as an error instead.
