@@ -194,6 +194,11 @@ std::string output_format(const std::string& path, const std::string& format,
       known_elsewhere |=
           std::find(f.extensions.begin(), f.extensions.end(), e) != f.extensions.end();
     if (!format.empty() && !is_mesh_format(format) && !known_elsewhere) return format;
+    if (e.empty())  // /dev/stdout, a name without extension: say how to get there
+      throw InvalidInput(path + ": no extension, which tells the output format (expected " +
+                         join(extensions) +
+                         "; to write to standard output, give a link to /dev/stdout such as "
+                         "out.vtk)");
     throw InvalidInput(path + ": unknown output format '" + e + "' (expected " + join(extensions) +
                        ")");
   }

@@ -232,4 +232,10 @@ TEST_CASE("an output linked to /dev/stdout, stdout a pipe: the mesh comes throug
   CHECK(report_there.code == 0);
   CHECK(report_there.out.rfind("{", 0) == 0);
   CHECK(fs::exists(dir.path / "m.exo"));
+  // /dev/stdout itself has no extension to tell the format by: the refusal says how to get
+  // there (it said "unknown output format ''").
+  const auto bare = geode_cli("conform " + input.string() + " -o /dev/stdout --quiet", true);
+  CHECK(bare.code == 2);
+  CHECK(bare.out.find("/dev/stdout: no extension, which tells the output format") !=
+        std::string::npos);
 }
