@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <cerrno>
+#include <cstring>
 #include <fstream>
 
 #include <geode/primal/errors.hpp>
@@ -20,6 +22,10 @@ std::string_view skip_space(std::string_view s) {
   while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
   return s;
 }
+
+// The system's reason a stream did not open (libstdc++ opens with open(2), which sets errno):
+// ": Permission denied", or nothing where none was left.
+std::string open_reason() { return errno ? std::string(": ") + std::strerror(errno) : ""; }
 
 }  // namespace
 
@@ -93,8 +99,9 @@ std::string read_file_head(const std::filesystem::path& path, std::size_t max_by
     throw InvalidInput(path.string() + ": " + (ec ? ec.message() : std::string("no such file")));
   if (!std::filesystem::is_regular_file(path, ec))
     throw InvalidInput(path.string() + ": not a regular file");
+  errno = 0;
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InvalidInput(path.string() + ": cannot open for reading");
+  if (!in) throw InvalidInput(path.string() + ": cannot open for reading" + open_reason());
   std::string head(max_bytes, '\0');
   in.read(head.data(), static_cast<std::streamsize>(max_bytes));
   head.resize(static_cast<std::size_t>(in.gcount()));
@@ -102,8 +109,9 @@ std::string read_file_head(const std::filesystem::path& path, std::size_t max_by
 }
 
 std::string read_file_bytes(const std::filesystem::path& path) {
+  errno = 0;
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InvalidInput(path.string() + ": cannot open for reading");
+  if (!in) throw InvalidInput(path.string() + ": cannot open for reading" + open_reason());
   std::string bytes;
   char buf[1 << 16];
   while (in.read(buf, sizeof buf) || in.gcount() > 0)
