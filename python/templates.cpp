@@ -27,39 +27,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// ---- The built-in templates: the one table of the module ---------------------------------------
+// ---- The built-in templates: the library's table (templates/template_table.hpp) ------------
 
-enum class Family { kGeode, kRefine };
-
-struct TemplateEntry {
-  const char* name;
-  int dim;
-  Family family;
-  templates::TopSplit split;
-  const char* what;
-};
-
-const std::vector<TemplateEntry>& template_table() {
-  using templates::TopSplit;
-  static const std::vector<TemplateEntry> table{
-      {"geode3d", 3, Family::kGeode, TopSplit::kTwoTriangles,
-       "the 26-hex geode (tet side in 2 triangles)"},
-      {"geode2d", 2, Family::kGeode, TopSplit::kTwoTriangles, "the 5-quad 2D geode"},
-      {"geode4tri", 3, Family::kGeode, TopSplit::kFourTriangles,
-       "the tet side in 4 triangles, fixed up"},
-      {"refine3", 3, Family::kRefine, TopSplit::kTwoTriangles,
-       "one coarse quad over 3 x 3 fine (13 hexes)"},
-      {"refine3-2d", 2, Family::kRefine, TopSplit::kTwoTriangles,
-       "one coarse edge over three fine (4 quads)"}};
-  return table;
-}
-
-const TemplateEntry& find_template(const std::string& name) {
+const templates::TemplateEntry& find_entry(const std::string& name) {
+  if (const templates::TemplateEntry* e = templates::find_template(name)) return *e;
   std::string names;
-  for (const auto& e : template_table()) {
-    if (name == e.name) return e;
-    names += (names.empty() ? "" : ", ") + std::string(e.name);
-  }
+  for (const auto& n : templates::template_names()) names += (names.empty() ? "" : ", ") + n;
   throw InvalidInput("template: unknown template '" + name + "' (expected " + names + ")");
 }
 
@@ -251,14 +224,15 @@ std::unique_ptr<TemplateResult> make_template(const std::string& name, const py:
                                               const std::string& diagonal,
                                               const std::string& higher, bool smooth_it, bool slide,
                                               bool fixup, const py::dict& kwargs) {
-  const TemplateEntry& entry = find_template(name);
+  const templates::TemplateEntry& entry = find_entry(name);
   if (diagonal != "main" && diagonal != "anti")
     throw InvalidInput("template: diagonal must be 'main' or 'anti'");
   if (higher != "x" && higher != "z") throw InvalidInput("template: higher must be 'x' or 'z'");
   const int dim = entry.dim;
   const Eigen::Vector3d box =
       box_arg.is_none() ? Eigen::Vector3d(24, 14, 24) : parse_box(box_arg, dim);
-  const PushArgs push = parse_push(kwargs, entry.family == Family::kRefine);
+  const bool refine = entry.family == templates::TemplateFamily::kRefine;
+  const PushArgs push = parse_push(kwargs, refine);
   auto r = std::make_unique<TemplateResult>();
   r->name = name;
   std::ostringstream caption;
@@ -268,35 +242,35 @@ std::unique_ptr<TemplateResult> make_template(const std::string& name, const py:
   r->caption = caption.str();
   {
     py::gil_scoped_release free;
-    if (entry.family == Family::kRefine) {
-      templates::RefineOptions ro;
-      ro.box = box;
-      if (push.high_roof) ro.high_roof = *push.high_roof;
-      if (push.low_roof) ro.low_roof = *push.low_roof;
-      if (push.layer) ro.layer = *push.layer;
-      const templates::ArrangementSpec spec = templates::refine_spec(ro, dim);
-      r->spec = templates::spec_json(spec);
+    templates::GeodeOptions o;
+    o.box = box;
+    o.diagonal = diagonal == "anti" ? templates::Diagonal::kAnti : templates::Diagonal::kMain;
+    o.higher = higher == "z" ? templates::Higher::kZ : templates::Higher::kX;
+    o.push = push.push;
+    templates::RefineOptions ro;
+    ro.box = box;
+    if (push.high_roof) ro.high_roof = *push.high_roof;
+    if (push.low_roof) ro.low_roof = *push.low_roof;
+    if (push.layer) ro.layer = *push.layer;
+    // As `geode template` builds it: the entry's own split, spec, build, smoothing, fix-up (and
+    // its refusal: Schneiders' pyramid raises TopologyError with its certificate).
+    const templates::TemplateOptions options = templates::template_options(entry, o, ro);
+    r->t = entry.build(options);
+    const templates::ArrangementSpec spec = entry.spec(options);
+    r->spec = templates::spec_json(spec);
+    if (refine) {  // its spec is in the box already
       r->sheets = templates::spec_sheets(spec), r->domain = spec.domain;
-      r->t = dim == 3 ? templates::build_refine3(ro) : templates::build_refine3_2d(ro);
-      r->smoother = [ro](templates::Template& t, bool s) {
-        return templates::smooth_refine3(t, ro, !s);
-      };
-    } else {
-      templates::GeodeOptions o;
-      o.box = box;
-      o.diagonal = diagonal == "anti" ? templates::Diagonal::kAnti : templates::Diagonal::kMain;
-      o.higher = higher == "z" ? templates::Higher::kZ : templates::Higher::kX;
-      o.split = entry.split;
-      o.push = push.push;
-      r->t = dim == 2 ? templates::build_geode2d(o) : templates::build_geode3d(o);
-      r->check_conditions = dim == 3;
-      r->spec = templates::spec_json(templates::geode_spec(o, dim));
-      const templates::GeodeArrangement G = templates::geode_arrangement(o, dim);
+    } else {  // the geode's arrangement is built in the reference cell, mapped to the box
+      const templates::GeodeArrangement G = templates::geode_arrangement(options.geode, dim);
       r->sheets = G.sheets, r->domain = G.domain;
       r->to_physical = [box, dim](const Point& p) { return templates::box_point(p, box, dim); };
-      if (entry.split == templates::TopSplit::kFourTriangles && fixup)
-        r->fixup = templates::fix_up(r->t);
     }
+    if (entry.smooth)
+      r->smoother = [&entry, options](templates::Template& t, bool s) {
+        return entry.smooth(t, options, s);
+      };
+    r->check_conditions = entry.interleave_conditions;
+    if (entry.fix_up && fixup) r->fixup = templates::fix_up(r->t);
   }
   note_conditions(*r);
   if (r->fixup && r->fixup->obstructions_after > 0)
@@ -360,12 +334,10 @@ py::tuple study_interleave(const py::handle& spec_arg, const py::object& sweep,
   nlohmann::json spec;
   if (py::isinstance<py::str>(spec_arg) && !fs::exists(spec_arg.cast<std::string>())) {
     // A built-in geode template by name: its spec, swept the same way.
-    const TemplateEntry& e = find_template(spec_arg.cast<std::string>());
-    if (e.family != Family::kGeode)
+    const templates::TemplateEntry& e = find_entry(spec_arg.cast<std::string>());
+    if (e.family != templates::TemplateFamily::kGeode)
       throw InvalidInput("study_interleave: " + std::string(e.name) + " has no push to sweep");
-    templates::GeodeOptions o;
-    o.split = e.split;
-    spec = templates::spec_json(templates::geode_spec(o, e.dim));
+    spec = templates::spec_json(e.spec(templates::template_options(e, {}, {})));
     source = stem = e.name;
   } else {
     spec = spec_argument(spec_arg, source, stem);
@@ -624,7 +596,7 @@ void bind_templates(py::module_& m) {
         py::arg("higher"), py::arg("smooth"), py::arg("slide"), py::arg("fixup"), py::arg("push"));
   m.def("_template_names", [] {
     py::dict d;
-    for (const auto& e : template_table()) d[e.name] = e.what;
+    for (const auto& e : templates::template_table()) d[py::str(e.name)] = py::str(e.summary);
     return d;
   });
   m.def(

@@ -63,7 +63,8 @@ def template_names():
 def template(name, box=None, *, diagonal="main", higher="x", smooth=True, slide=False, fixup=True, **push):
     """Derive a built-in template from its completed, pushed-together sheet arrangement.
 
-    name: geode3d, geode2d, geode4tri, refine3 or refine3-2d (template_names()). box: the buffer
+    name: geode3d, geode2d, geode4tri, refine3 or refine3-2d (template_names(); pyramid raises
+    TopologyError with the certificate that its dual needs a self-intersecting sheet). box: the buffer
     cell (width, height, depth), tet side on top; default (24, 14, 24), (24, 14) in 2D.
     diagonal: 'main' or 'anti'; higher: 'x' or 'z' (which tunnel's roof is higher). push: the
     push parameters of `geode template` (high_roof, low_roof, dome_depth, dome_radius,

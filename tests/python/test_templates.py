@@ -162,7 +162,16 @@ def test_meshio_and_viewer(geode3d):
 
 
 def test_template_names_and_2d():
-    assert set(geode.template_names()) == {"geode3d", "geode2d", "geode4tri", "refine3", "refine3-2d"}
+    # The library's table, as `geode template` lists it (the module kept a table of its own,
+    # without the pyramid).
+    assert set(geode.template_names()) == {"geode3d", "geode2d", "geode4tri", "refine3", "refine3-2d", "pyramid"}
     t = geode.template("geode2d")
     assert t.dim == 2 and t.quads.shape == (5, 4) and t.hexes is None
     assert "<iframe" in t._repr_html_()
+
+
+def test_the_pyramid_is_refused_with_its_certificate_as_the_command_refuses_it():
+    with pytest.raises(geode.TopologyError, match="crosses itself is the trace of a self-intersecting sheet"):
+        geode.template("pyramid")
+    cli = run_cli("template", "pyramid", check=False)
+    assert cli.returncode == 3 and "crosses itself is the trace of a self-intersecting sheet" in cli.stderr
