@@ -140,6 +140,25 @@ _VOLUME = {kind[0]: kind for kind in _KINDS}
 _SURFACE = {"vertex": 0, "line": 1, "triangle": 2, "quad": 2}
 
 
+def _integers(values, what, name):
+    """values (a number or an array) as integers, refused as the file readers refuse a bad tag: a
+    value that is not a whole finite number was truncated (gmsh:physical 1.5 read as block 1) or
+    raised Python's own ValueError."""
+    try:
+        a = _np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError("{}: {} holds a value that is not a number".format(name, what)) from None
+    bad = ~_np.isfinite(a) | (a != _np.round(a))
+    if bad.any():
+        raise InputError("{}: {} holds {}, not an integer id".format(name, what, a[bad].ravel()[0]))
+    return a.astype(_np.int64)
+
+
+def _groups(field_data, name):
+    """meshio's field_data {name: [tag, dimension]}, each checked."""
+    return {k: _integers(v, "field_data '{}'".format(k), name).ravel() for k, v in (field_data or {}).items()}
+
+
 def _model_arrays(mesh=None, points=None, cells=None, cell_blocks=None, name="mesh"):
     """A meshio.Mesh (or points + [(type, array)] cell blocks) as conform's arrays. Each element's
     id (messages name it) is its 1-based position among all the cells, surface cells counted:
@@ -148,9 +167,10 @@ def _model_arrays(mesh=None, points=None, cells=None, cell_blocks=None, name="me
         points = mesh.points
         cells = [(c.type, c.data) for c in mesh.cells]
         physical = mesh.cell_data.get("gmsh:physical")
-        names = {int(v[0]): k for k, v in (mesh.field_data or {}).items() if len(v) > 1 and int(v[1]) == 3}
+        groups = _groups(mesh.field_data, name)
+        names = {int(v[0]): k for k, v in groups.items() if len(v) > 1 and int(v[1]) == 3}
         # Physical points, curves and surfaces by (dimension, tag), as Gmsh's physical names.
-        set_names = {(int(v[1]), int(v[0])): k for k, v in (mesh.field_data or {}).items() if len(v) > 1}
+        set_names = {(int(v[1]), int(v[0])): k for k, v in groups.items() if len(v) > 1}
         point_sets = dict(mesh.point_sets or {})
     else:
         if points is None or cells is None:
@@ -173,7 +193,8 @@ def _model_arrays(mesh=None, points=None, cells=None, cell_blocks=None, name="me
         if kind in _SURFACE:
             # Gmsh's physical points, curves and surfaces (meshio gives their tags in
             # gmsh:physical): the sets `geode conform` makes of the same file.
-            tags = _np.asarray(physical[i]) if physical is not None and len(physical[i]) == len(data) else None
+            tags = (_integers(physical[i], "gmsh:physical of cell block {}".format(i), name)
+                    if physical is not None and len(physical[i]) == len(data) else None)
             dim = _SURFACE[kind]
             for k in range(len(data)):
                 tag = int(tags[k]) if tags is not None else 0
@@ -189,9 +210,9 @@ def _model_arrays(mesh=None, points=None, cells=None, cell_blocks=None, name="me
                              "pyramid and wedge cells".format(name, i, kind))
         key = _VOLUME[kind][1]
         if cell_blocks is not None:
-            block = _np.full(len(data), int(cell_blocks[i]))
+            block = _np.full(len(data), int(_integers(cell_blocks[i], "cell_blocks[{}]".format(i), name)))
         elif physical is not None and len(physical[i]) == len(data):
-            block = _np.asarray(physical[i], dtype=int)
+            block = _integers(physical[i], "gmsh:physical of cell block {}".format(i), name)
         else:
             block = _np.full(len(data), volume_index + 1)
         volume_index += 1

@@ -1,5 +1,6 @@
 """Errors: the command's messages and exit-code kinds, as Python exceptions."""
 import json
+import re
 
 import numpy as np
 import pytest
@@ -82,3 +83,23 @@ def test_a_node_number_past_32_bits_names_the_cell_as_the_other_checks_do():
     with pytest.raises(geode.InputError, match=r"^mesh: tet 28: corner 3 refers to node index "
                                                r"9223372036854775808, outside the 32-bit index range$"):
         geode.conform(points=t.points, cells=[("hexahedron", t.hexes.astype(np.int64)), ("tetra", tets)])
+
+
+@pytest.mark.parametrize("mesh_args, said", [
+    ({"cell_blocks": [float("nan")]}, "cell_blocks[0] holds nan, not an integer id"),
+    ({"cell_blocks": [1.5]}, "cell_blocks[0] holds 1.5, not an integer id"),
+    ({"cell_blocks": ["steel"]}, "cell_blocks[0] holds a value that is not a number"),
+    ({"cell_data": {"gmsh:physical": [np.array([1.5])]}}, "gmsh:physical of cell block 0 holds 1.5"),
+    ({"field_data": {"steel": "str"}}, "field_data 'steel' holds a value that is not a number"),
+])
+def test_block_ids_that_are_not_integers_are_input_errors(mesh_args, said):
+    # A hunt's: gmsh:physical 1.5 became block 1 without a word, and a NaN block id or a text in
+    # field_data raised Python's bare ValueError.
+    import meshio
+    points = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
+    cells = [("tetra", np.array([[0, 1, 2, 3]]))]
+    with pytest.raises(geode.InputError, match=r"^mesh: " + re.escape(said)):
+        if "cell_blocks" in mesh_args:
+            geode.conform(points=points, cells=cells, cell_blocks=mesh_args["cell_blocks"])
+        else:
+            geode.conform(meshio.Mesh(points, cells, **mesh_args))
