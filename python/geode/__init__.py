@@ -229,8 +229,13 @@ def _model_arrays(mesh=None, points=None, cells=None, cell_blocks=None, name="me
                        .format(name, untagged), GeodeWarning, stacklevel=3)
     sets = [{"dim": dim, "id": tag, "name": set_names.get((dim, tag), ""), "cells": group[0], "ids": group[1]}
             for (dim, tag), group in sorted(tagged.items())]
-    # Point sets numbered after the node sets of tagged cells, whose ids are their tags.
-    first_id = max([t["id"] for t in sets if t["dim"] < 2], default=0) + 1
+    # Point sets numbered after the node sets of tagged cells, whose ids are their tags, and
+    # after tag + 10^k, where the module moves a curve's set that has a point's tag
+    # (primal::separate_node_set_ids).
+    highest = max([t["id"] for t in sets if t["dim"] < 2], default=0)
+    first_id = highest + 1
+    if {t["id"] for t in sets if t["dim"] == 0} & {t["id"] for t in sets if t["dim"] == 1}:
+        first_id += 10 ** len(str(highest))
     node_sets = [{"id": first_id + k, "name": n, "nodes": [int(x) for x in _np.asarray(v).ravel()]}
                  for k, (n, v) in enumerate(point_sets.items())]
     return points, arrays, names, node_sets, sets
