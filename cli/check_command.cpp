@@ -64,6 +64,28 @@ Checked check_hexes(const primal::HexMesh& mesh, const primal::RealizabilityOpti
   });
   c.valid = v.ok();
   c.validity = v.summary(base);
+  if (c.valid && !mesh.hexes.empty()) {
+    // A valid complex of positive hexes may still overlap itself: parts that interpenetrate
+    // share no face. The covering check conform makes of its input finds them (a hunt's two
+    // interpenetrating hexes were "valid").
+    primal::Model model;
+    model.points = mesh.points;
+    model.hexes = mesh.hexes;
+    for (std::size_t n = 0; n < mesh.points.size(); ++n) model.node_ids.push_back(base + Index(n));
+    for (std::size_t h = 0; h < mesh.hexes.size(); ++h) model.hex_ids.push_back(base + Index(h));
+    const primal::InputCheckResult r = primal::check_input(model);
+    if (!r.ok()) {
+      c.valid = false;
+      // The summary's first line said "valid" of the complex.
+      if (const auto at = c.validity.find(": valid\n"); at != std::string::npos)
+        c.validity.replace(at, 8, ": invalid (it overlaps itself)\n");
+      c.validity +=
+          "covering: " + std::to_string(r.findings.size()) +
+          (r.findings.size() == primal::InputCheckOptions{}.max_findings ? " or more" : "") +
+          " findings, the mesh overlaps itself or folds\n";
+      for (const primal::InputFinding& f : r.findings) c.validity += "  " + f.text(model) + "\n";
+    }
+  }
   progress.stage_done(validity_line(c.valid));
   c.analysable =
       v.out_of_range_hexes.empty() && v.repeated_node_hexes.empty() && !mesh.hexes.empty();

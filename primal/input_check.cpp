@@ -807,12 +807,18 @@ class InputChecker {
       if (std::find(b.begin(), b.end(), x) != b.end()) return std::nullopt;
     const ElementRef ea = boundary_[index_cast<std::size_t>(triangles_[s].face)].element;
     const ElementRef eb = boundary_[index_cast<std::size_t>(triangles_[t].face)].element;
-    if (const auto x = crossing(a, b, length); x)
+    if (const auto x = crossing(s, t, length); x)
       return InputFinding{InputFault::kCrossingFaces, {ea, eb}, kInvalidIndex, *x, 0.0};
-    if (const auto x = crossing(b, a, length); x)
+    if (const auto x = crossing(t, s, length); x)
       return InputFinding{InputFault::kCrossingFaces, {ea, eb}, kInvalidIndex, *x, 0.0};
     const Point na = (pt(a[1]) - pt(a[0])).cross(pt(a[2]) - pt(a[0])).normalized();
     const Point nb = (pt(b[1]) - pt(b[0])).cross(pt(b[2]) - pt(b[0])).normalized();
+    // In one plane and facing the same way, their elements lie on the same side of it: where
+    // the triangles overlap, so do the elements (no edge crosses the other's interior there).
+    if (na.dot(nb) > 0.9 &&
+        std::abs(((pt(a[0]) + pt(a[1]) + pt(a[2])) / 3.0 - pt(b[0])).dot(nb)) <= 1e-9 * length)
+      if (const auto x = coplanar_overlap(a, b, nb, length); x)
+        return InputFinding{InputFault::kCrossingFaces, {ea, eb}, kInvalidIndex, *x, 0.0};
     if (!(na.dot(nb) < -0.9)) return std::nullopt;
     if (const auto g = facing(a, b, nb, length); g)
       return InputFinding{InputFault::kGap, {ea, eb}, kInvalidIndex, g->first, g->second};
@@ -846,9 +852,59 @@ class InputChecker {
     return true;
   }
 
-  // Where an edge of triangle a passes through triangle b's interior, if one does.
-  std::optional<Point> crossing(const std::array<Index, 3>& a, const std::array<Index, 3>& b,
-                                double length) const {
+  // Whether x, in the plane of boundary triangle t, lies inside its face: strictly inside the
+  // triangle, or, for a quad's triangle, on the diagonal it shares with the quad's other one,
+  // inside the quad's outer edges (an edge through a quad's centre: in neither triangle
+  // strictly; two hexes overlapping by exactly half a cell were found valid so).
+  bool inside_face(std::size_t t, const Point& x) const {
+    const auto& v = triangles_[t].v;
+    if (inside(v, x, 1e-9)) return true;
+    const BoundaryFace& f = boundary_[index_cast<std::size_t>(triangles_[t].face)];
+    if (f.size != 4) return false;
+    const Point n = (pt(v[1]) - pt(v[0])).cross(pt(v[2]) - pt(v[0]));
+    const double n2 = n.squaredNorm();
+    for (std::size_t k = 0; k < 4; ++k) {
+      const Point& p = pt(f.nodes[k]);
+      const Point& q = pt(f.nodes[(k + 1) % 4]);
+      if ((q - p).cross(x - p).dot(n) < 1e-9 * n2) return false;
+    }
+    return true;
+  }
+
+  // Coplanar triangles a and b (unit normal n) overlapping: an edge of one properly crossing an
+  // edge of the other, or the centroid of one strictly inside the other. Where, if so.
+  std::optional<Point> coplanar_overlap(const std::array<Index, 3>& a,
+                                        const std::array<Index, 3>& b, const Point& n,
+                                        double length) const {
+    const double eps = 1e-9 * length * length;  // twice a signed area
+    const auto side = [&](const Point& p, const Point& q, const Point& x) {
+      return (q - p).cross(x - p).dot(n);
+    };
+    const auto apart = [eps](double x, double y) {
+      return (x > eps && y < -eps) || (x < -eps && y > eps);
+    };
+    for (std::size_t i = 0; i < 3; ++i)
+      for (std::size_t j = 0; j < 3; ++j) {
+        const Point& p = pt(a[i]);
+        const Point& q = pt(a[(i + 1) % 3]);
+        const Point& r = pt(b[j]);
+        const Point& u = pt(b[(j + 1) % 3]);
+        const double d3 = side(r, u, p), d4 = side(r, u, q);
+        if (apart(side(p, q, r), side(p, q, u)) && apart(d3, d4))
+          return Point(p + (d3 / (d3 - d4)) * (q - p));
+      }
+    const Point ga = (pt(a[0]) + pt(a[1]) + pt(a[2])) / 3.0;
+    const Point gb = (pt(b[0]) + pt(b[1]) + pt(b[2])) / 3.0;
+    if (inside(b, ga, 1e-9)) return ga;
+    if (inside(a, gb, 1e-9)) return gb;
+    return std::nullopt;
+  }
+
+  // Where an edge of boundary triangle s passes through the face of boundary triangle t, if
+  // one does.
+  std::optional<Point> crossing(std::size_t s, std::size_t t, double length) const {
+    const auto& a = triangles_[s].v;
+    const auto& b = triangles_[t].v;
     const double eps = 1e-9 * length * length * length;
     for (int k = 0; k < 3; ++k) {
       const Point& u = pt(a[k]);
@@ -857,7 +913,7 @@ class InputChecker {
       const double sw = orient(pt(b[0]), pt(b[1]), pt(b[2]), w);
       if (!((su > eps && sw < -eps) || (su < -eps && sw > eps))) continue;
       const Point x = u + (su / (su - sw)) * (w - u);
-      if (inside(b, x, 1e-9)) return x;
+      if (inside_face(t, x)) return x;
     }
     return std::nullopt;
   }

@@ -1,9 +1,11 @@
 // check_input on cells whose faces could be mistaken for a neighbour's: the pairing of a quad
-// with four triangles around a centre must not take the quad's own element's triangles.
+// with four triangles around a centre must not take the quad's own element's triangles; and
+// hexes that overlap where every crossing falls on a quad's diagonal or in one plane.
 #include <doctest/doctest.h>
 
 #include <geode/primal/input_check.hpp>
 #include <geode/primal/model.hpp>
+#include <geode/primal/topology.hpp>
 
 using namespace geode;
 using namespace geode::primal;
@@ -40,4 +42,35 @@ TEST_CASE("check_input: a lone pyramid's sides are its boundary, not a cover of 
   const InputCheckResult r = check_input(m);
   CHECK(r.ok());
   CHECK(r.boundary_faces == 9);
+}
+
+TEST_CASE("check_input: hexes overlapping by exactly half a cell are found") {
+  // Every edge of one crosses the other's boundary through a quad's centre line (on both of its
+  // triangles' edges) or lies in its faces' planes: no crossing was found, and conform wrote the
+  // two overlapping (a fault hunt's). Touching face to face without shared nodes stays a gap,
+  // touching along an edge passes.
+  struct Case {
+    Point shift;
+    bool ok;
+    InputFault fault;
+  };
+  for (const Case& c :
+       {Case{{0.5, 0.5, 0.5}, false, InputFault::kCrossingFaces},
+        Case{{0.5, 0, 0}, false, InputFault::kCrossingFaces},
+        Case{{0.5, 0.5, 0}, false, InputFault::kCrossingFaces},
+        Case{{0, 0.25, 0.5}, false, InputFault::kCrossingFaces},
+        Case{{1, 0, 0}, false, InputFault::kGap}, Case{{1, 1, 0}, true, InputFault::kGap}}) {
+    CAPTURE(c.shift.transpose());
+    Model m;
+    for (const Point& offset : {Point(0, 0, 0), c.shift})
+      for (const auto& k : topology::kHexCornerCoords)
+        m.points.push_back(Point(k[0], k[1], k[2]) + offset);
+    m.hexes = {{0, 1, 2, 3, 4, 5, 6, 7}, {8, 9, 10, 11, 12, 13, 14, 15}};
+    const InputCheckResult r = check_input(m);
+    CHECK(r.ok() == c.ok);
+    if (!c.ok) {
+      REQUIRE(!r.findings.empty());
+      CHECK(r.findings.front().fault == c.fault);
+    }
+  }
 }
