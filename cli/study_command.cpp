@@ -33,23 +33,6 @@ struct InterleaveArgs {
   bool quiet = false;
 };
 
-// At most this many sweep points (the product of the axes' counts): 20,000 runs of the geode
-// take hours on two cores, and every run is kept in memory for the summary.
-constexpr double kMaxSweepPoints = 20000;
-
-void check_sweep_size(const std::vector<std::size_t>& counts, const std::string& where) {
-  double product = 1;
-  for (std::size_t c : counts) product *= static_cast<double>(c);
-  if (product > kMaxSweepPoints) {
-    std::string f;
-    for (std::size_t c : counts) f += (f.empty() ? "" : " x ") + std::to_string(c);
-    std::ostringstream m;
-    m << where << ": " << f << " = " << product << " sweep points; at most " << kMaxSweepPoints
-      << " (sweep fewer values, or split the study)";
-    throw InvalidInput(m.str());
-  }
-}
-
 // The spec's sweep block, then --sweep options (replacing an axis of the same path).
 templates::InterleaveStudy spec_study(const InterleaveArgs& a) {
   const nlohmann::json spec = templates::read_spec_json(a.spec);
@@ -70,9 +53,6 @@ templates::InterleaveStudy spec_study(const InterleaveArgs& a) {
   if (axes.empty())
     throw InvalidInput(source +
                        ": nothing to sweep (give --sweep PATH=FROM:TO:COUNT or a sweep block)");
-  std::vector<std::size_t> counts;
-  for (const auto& x : axes) counts.push_back(x.values.size());
-  check_sweep_size(counts, source);
   Progress progress = Progress::for_stderr(a.quiet);
   auto study =
       templates::interleave_study(spec, source, axes, std::filesystem::path(a.spec).stem().string(),
@@ -132,9 +112,9 @@ void run_interleave(const InterleaveArgs& a) {
     if (!a.low.empty()) grid.low_roof = a.low;
     if (!a.depth.empty()) grid.dome_depth = a.depth;
     if (!a.radius.empty()) grid.dome_radius = a.radius;
-    check_sweep_size({grid.high_roof.size(), grid.low_roof.size(), grid.dome_depth.size(),
-                      grid.dome_radius.size()},
-                     "study interleave");
+    templates::check_sweep_size({grid.high_roof.size(), grid.low_roof.size(),
+                                 grid.dome_depth.size(), grid.dome_radius.size()},
+                                "study interleave");
     const templates::GeodeOptions o = entry->defaults.geode;
     Progress progress = Progress::for_stderr(a.quiet);
     study = templates::interleave_study(

@@ -97,9 +97,16 @@ InterleaveStudy interleave_study(const std::vector<InterleaveCase>& cases,
                                  const std::vector<std::string>& parameter_names = {},
                                  const StudyProgress& progress = {});
 
+// At most this many sweep points (the product of the axes' counts): 20,000 runs of the geode
+// take hours on two cores, and every run is kept in memory for the summary.
+inline constexpr double kMaxSweepPoints = 20000;
+// InvalidInput naming `where` when the product of `counts` is above kMaxSweepPoints.
+void check_sweep_size(const std::vector<std::size_t>& counts, const std::string& where);
+
 // A spec (templates/spec.hpp) swept over every combination of the axes' values (the first
 // axis slowest); points whose spec is invalid input (e.g. low roof above high) are skipped
-// and counted. `source` names the spec in messages.
+// and counted. `source` names the spec in messages. InvalidInput past kMaxSweepPoints
+// points, before any run.
 InterleaveStudy interleave_study(const nlohmann::json& spec, const std::string& source,
                                  const std::vector<SweepAxis>& axes,
                                  const std::string& template_name,

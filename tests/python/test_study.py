@@ -55,3 +55,8 @@ def test_study_errors():
         geode.study_interleave("geode3d", {"push.nope": [1]})
     with pytest.raises(geode.InputError, match="no push to sweep"):
         geode.study_interleave("refine3", {"push.high_roof": [0.5]})
+    # The command's bound on the sweep's size holds here too (a hunt's 200 x 200 sweep ran on,
+    # past Ctrl-C, with the GIL released).
+    with pytest.raises(geode.InputError, match=r"200 x 200 = 40000 sweep points; at most 20000"):
+        geode.study_interleave("geode3d", {"push.high_roof": [0.61 + 0.0019 * k for k in range(200)],
+                                           "push.dome_radius": [0.1 + 0.004 * k for k in range(200)]})
