@@ -238,10 +238,14 @@ MeshArrangementInput build(const std::vector<Point>& points,
   for (std::size_t s = 0; s < dual.sheets.size(); ++s) {
     const MeshSheet& sheet = dual.sheets[s];
     const std::string who = "sheet_fields: sheet " + std::to_string(s);
-    if (sheet.self_intersecting)
+    if (sheet.self_intersecting) {
+      // A cell it crosses itself in is listed twice (cells ascend); the first cell it crosses
+      // was named, which need not be one (a hunt's: quad 0 for a crossing in quad 184).
+      const auto twice = std::adjacent_find(sheet.cells.begin(), sheet.cells.end());
       throw TopologyError(who + " crosses itself (in " + cell_word(Dim) + " " +
-                          std::to_string(sheet.cells.empty() ? -1 : sheet.cells.front()) +
-                          " or another): it has no two sides to give a field");
+                          std::to_string(twice == sheet.cells.end() ? -1 : *twice) +
+                          " and maybe others): it has no two sides to give a field");
+    }
     // Sides: the nodes joined by edges of other sheets.
     primal::DisjointSets sides(nn);
     for (std::size_t e = 0; e < dual.edges.size(); ++e)

@@ -210,7 +210,12 @@ TEST_CASE("round trip: meshes the fields cannot represent are refused with the r
     QuadMesh band;
     band.points.assign(6, Point::Zero());
     band.quads = {{0, 1, 2, 3}, {2, 1, 4, 5}, {5, 4, 0, 1}};
-    CHECK_THROWS_WITH_AS(stc::sheet_fields(band), doctest::Contains("sheet 0 crosses itself"),
+    CHECK_THROWS_WITH_AS(stc::sheet_fields(band),
+                         doctest::Contains("sheet 0 crosses itself (in quad 0 "), TopologyError);
+    // With the self-crossing quad last, it is the one named (the sheet's first cell was: a
+    // hunt's "quad 0" for a crossing in quad 184).
+    band.quads = {{2, 1, 4, 5}, {5, 4, 0, 1}, {0, 1, 2, 3}};
+    CHECK_THROWS_WITH_AS(stc::sheet_fields(band), doctest::Contains("crosses itself (in quad 2 "),
                          TopologyError);
   }
 }
