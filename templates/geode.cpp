@@ -79,13 +79,17 @@ void place_interface(const stc::DualMesh& D, const std::vector<stc::Sheet>& shee
     if (((D.node_faces[n] >> face) & 1u) && !matched.count(static_cast<int>(n)))
       throw TopologyError(std::string("geode: the template has a node on the ") + side_name +
                           " face that the diced interface does not have");
-  std::set<std::vector<int>> faces;
+  std::set<std::vector<int>> faces, on_face;  // on_face: the faces lying on the box face
   auto add_faces = [&](const auto& elements, const auto& table) {
     for (const auto& e : elements)
       for (const auto& fc : table) {
         std::vector<int> k;
         for (int c : fc) k.push_back(e[primal::index_cast<std::size_t>(c)]);
         std::sort(k.begin(), k.end());
+        if (std::all_of(k.begin(), k.end(), [&](int n) {
+              return (D.node_faces[primal::index_cast<std::size_t>(n)] >> face) & 1u;
+            }))
+          on_face.insert(k);
         faces.insert(k);
       }
   };
@@ -93,6 +97,7 @@ void place_interface(const stc::DualMesh& D, const std::vector<stc::Sheet>& shee
     add_faces(D.hex.hexes, primal::topology::kHexFaceCorners);
   else
     add_faces(D.quad.quads, primal::topology::kQuadEdgeCorners);
+  std::set<std::vector<int>> given;
   for (const auto& c : diced.cells) {
     std::vector<int> k;
     for (int i : c) k.push_back(node_of[primal::index_cast<std::size_t>(i)]);
@@ -101,7 +106,16 @@ void place_interface(const stc::DualMesh& D, const std::vector<stc::Sheet>& shee
       throw TopologyError(
           std::string("geode: a diced ") + side_name +
           " cell is not a face of the template: the boundary is not the prescribed one");
+    if (!given.insert(k).second)
+      throw TopologyError(std::string("geode: a ") + side_name +
+                          " cell is given twice: the boundary is not the prescribed one");
   }
+  // Exactly these cells: a part of them, its nodes all given, was taken (a hunt's refine3 spec
+  // with 1 of its 9 bottom quads).
+  if (given != on_face)
+    throw TopologyError(std::string("geode: ") + side_name + ": " + std::to_string(given.size()) +
+                        " cells given, the template has " + std::to_string(on_face.size()) +
+                        " there: the boundary is not the prescribed one");
   for (std::size_t i = 0; i < diced.nodes.size(); ++i)
     pts[primal::index_cast<std::size_t>(node_of[i])] = diced.nodes[i];
 }

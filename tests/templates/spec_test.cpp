@@ -9,6 +9,7 @@
 #include <geode/primal/errors.hpp>
 #include <geode/primal/validity.hpp>
 #include <geode/templates/geode.hpp>
+#include <geode/templates/refine.hpp>
 #include <geode/templates/spec.hpp>
 #include "support/isomorphism.hpp"
 
@@ -369,6 +370,20 @@ TEST_CASE(
   } catch (const TopologyError& e) {
     CHECK(std::string(e.what()).find("faces.bottom") != std::string::npos);
   }
+
+  // Part of the cells (each a face of the dual, every node given) or one given twice: not
+  // exactly the dual's cells there (a hunt's refine3 spec with 1 of its 9 bottom quads built).
+  const json refine = templates::spec_json(templates::refine_spec({}, 3));
+  REQUIRE(refine["faces"]["bottom"]["cells"].size() == 9);
+  json part = refine, twice = refine;
+  part["faces"]["bottom"]["cells"] = {refine["faces"]["bottom"]["cells"][0]};
+  twice["faces"]["bottom"]["cells"][1] = refine["faces"]["bottom"]["cells"][0];
+  CHECK_NOTHROW(build(refine));
+  CHECK_THROWS_WITH_AS(build(part),
+                       doctest::Contains("faces.bottom: 1 cells given, the template has 9 there"),
+                       TopologyError);
+  CHECK_THROWS_WITH_AS(build(twice), doctest::Contains("a faces.bottom cell is given twice"),
+                       TopologyError);
 
   json triangle = three_planes(), off_face = three_planes(),
        with_completion =
