@@ -119,18 +119,28 @@ void run_dual(const DualArgs& a) {
                                                                std::size_t total) {
     progress.step(what, done, total);
   };
-  if (m.dim == 3) {
-    const auto dual = stc::mesh_dual(m.hex, dual_options);
-    progress.stage_done("dual: " + std::to_string(dual.sheets.size()) + " sheets");
-    j = dual_json(dual, primal::index_cast(m.hex.points.size()),
-                  primal::index_cast(m.hex.hexes.size()));
-    counts = tuple_counts(dual);
-  } else {
-    const auto dual = stc::mesh_dual(m.quad, dual_options);
-    progress.stage_done("dual: " + std::to_string(dual.sheets.size()) + " chords");
-    j = dual_json(dual, primal::index_cast(m.quad.points.size()),
-                  primal::index_cast(m.quad.quads.size()));
-    counts = tuple_counts(dual);
+  // The library knows cells and nodes by position: the refusal names the file, and says so
+  // (it said "edge 1-5 lies on 4 boundary quads" with neither; a hunt's).
+  const std::string numbering = std::string(" (") + (m.dim == 3 ? "hexes" : "quads") +
+                                " and nodes numbered from 0 in the file's order)";
+  try {
+    if (m.dim == 3) {
+      const auto dual = stc::mesh_dual(m.hex, dual_options);
+      progress.stage_done("dual: " + std::to_string(dual.sheets.size()) + " sheets");
+      j = dual_json(dual, primal::index_cast(m.hex.points.size()),
+                    primal::index_cast(m.hex.hexes.size()));
+      counts = tuple_counts(dual);
+    } else {
+      const auto dual = stc::mesh_dual(m.quad, dual_options);
+      progress.stage_done("dual: " + std::to_string(dual.sheets.size()) + " chords");
+      j = dual_json(dual, primal::index_cast(m.quad.points.size()),
+                    primal::index_cast(m.quad.quads.size()));
+      counts = tuple_counts(dual);
+    }
+  } catch (const InvalidInput& x) {
+    throw InvalidInput(a.input + ": " + x.what() + numbering);
+  } catch (const TopologyError& x) {
+    throw TopologyError(a.input + ": " + x.what() + numbering);
   }
   j["input"] = a.input;
   j["dimension"] = m.dim;
@@ -149,9 +159,9 @@ void run_dual(const DualArgs& a) {
               std::size_t done, std::size_t total) { progress.step(what, done, total); };
       D = stc::dualize(stc::compute_arrangement(fields.sheets, fields.domain, options));
     } catch (const InvalidInput& x) {
-      throw InvalidInput(a.input + ": cannot rebuild: " + x.what());
+      throw InvalidInput(a.input + ": cannot rebuild: " + x.what() + numbering);
     } catch (const TopologyError& x) {
-      throw TopologyError(a.input + ": cannot rebuild: " + x.what());
+      throw TopologyError(a.input + ": cannot rebuild: " + x.what() + numbering);
     }
     nlohmann::json r;
     r["file"] = a.rebuild;

@@ -84,6 +84,18 @@ TEST_CASE("geode dual: refusals name the file and write nothing") {
       std::filesystem::remove(in);
     }
   }
+  SUBCASE("a mesh whose dual cannot be read: named by the file, its numbering said") {
+    // It said "geode: topology error: edge 2-6 lies on 4 boundary quads, not 2" (a hunt's).
+    const auto in = temp_path("pinched.vtu");
+    primal::HexMesh m = test::structured_hex_grid(2, 1, 1);
+    m.hexes[1][0] = m.hexes[1][1];  // a hex listing a node twice
+    io::write_vtu(in, m);
+    const auto r = geode_cli("dual " + in.string(), true);
+    CHECK(r.code == 2);
+    CHECK(r.out.find(in.string() + ": hex 1: node ") != std::string::npos);
+    CHECK(r.out.find("(hexes and nodes numbered from 0 in the file's order)") != std::string::npos);
+    std::filesystem::remove(in);
+  }
   SUBCASE("a rebuild the fields cannot represent (the printed Appendix A positions fold 8 hexes)") {
     const auto in = temp_path("appendix.vtu"), out = temp_path("appendix-rebuilt.vtu");
     io::write_vtu(in, test::appendix_a_geode());
@@ -91,6 +103,7 @@ TEST_CASE("geode dual: refusals name the file and write nothing") {
     CHECK(r.code == 2);
     CHECK(r.out.find(in.string() + ": cannot rebuild: sheet_fields: hex") != std::string::npos);
     CHECK(r.out.find("is inverted or flat") != std::string::npos);
+    CHECK(r.out.find("(hexes and nodes numbered from 0 in the file's order)") != std::string::npos);
     CHECK_FALSE(std::filesystem::exists(out));
     // Without --rebuild the same file is reported: the dual is read off the connectivity.
     const auto ok = geode_cli("dual " + in.string() + " --format json");
