@@ -30,13 +30,6 @@ class ReadWarnings {
 
  private:
   friend void read_warning(const std::string& message);
-
-  // Says of each group primal::separate_node_set_ids moved which node set it became: "`source`:
-  // `line_word` 5 'edge' has the tag of `point_word` 5 'corner': both would be node set 5; it is
-  // node set 15".
-  void warn_moved_node_sets(std::span<const primal::TaggedCells> groups,
-                            std::span<const primal::MovedGroup> moved, const std::string& source,
-                            const std::string& line_word, const std::string& point_word);
   std::vector<std::string> messages_;
   ReadWarnings* previous_ = nullptr;
 };
