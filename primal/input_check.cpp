@@ -853,9 +853,11 @@ class InputChecker {
   }
 
   // Whether x, in the plane of boundary triangle t, lies inside its face: strictly inside the
-  // triangle, or, for a quad's triangle, on the diagonal it shares with the quad's other one,
-  // inside the quad's outer edges (an edge through a quad's centre: in neither triangle
-  // strictly; two hexes overlapping by exactly half a cell were found valid so).
+  // triangle, or, for a quad's triangle, on the quad's diagonal (the edge it shares with the
+  // quad's other triangle) strictly between the quad's outer edges: an edge through a quad's
+  // centre is strictly in neither triangle (two hexes overlapping by exactly half a cell were
+  // found valid so). Only on the diagonal itself: elsewhere a warped quad's surface is the other
+  // triangle, not this one's plane.
   bool inside_face(std::size_t t, const Point& x) const {
     const auto& v = triangles_[t].v;
     if (inside(v, x, 1e-9)) return true;
@@ -863,10 +865,12 @@ class InputChecker {
     if (f.size != 4) return false;
     const Point n = (pt(v[1]) - pt(v[0])).cross(pt(v[2]) - pt(v[0]));
     const double n2 = n.squaredNorm();
-    for (std::size_t k = 0; k < 4; ++k) {
-      const Point& p = pt(f.nodes[k]);
-      const Point& q = pt(f.nodes[(k + 1) % 4]);
-      if ((q - p).cross(x - p).dot(n) < 1e-9 * n2) return false;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const Index p = v[k], q = v[(k + 1) % 3];
+      const double side = (pt(q) - pt(p)).cross(x - pt(p)).dot(n) / n2;
+      const bool diagonal =
+          (p == f.nodes[0] && q == f.nodes[2]) || (p == f.nodes[2] && q == f.nodes[0]);
+      if (diagonal ? std::abs(side) > 1e-9 : side < 1e-9) return false;
     }
     return true;
   }
