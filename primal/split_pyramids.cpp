@@ -42,11 +42,6 @@ PyramidSplit split_pyramids(const Model& model) {
     const Index a = c[index_cast<std::size_t>(d)], b = c[index_cast<std::size_t>(d + 2)];
     return std::pair<Index, Index>{std::min(a, b), std::max(a, b)};
   };
-  // Diagonals within kTie of each other are a tie, taken by the first (the base's first
-  // corner's): a symmetric pyramid's two are equal but for rounding, which changes with the
-  // model's scale and position, so an exact comparison gave another mesh for the same model
-  // in other units.
-  constexpr double kTie = 1e-9;
   for (const auto& [key, members] : by_base) {
     double best = -2.0;
     std::pair<Index, Index> chosen{};
@@ -55,7 +50,7 @@ PyramidSplit split_pyramids(const Model& model) {
       double worst = 2.0;
       for (std::size_t p : members)
         worst = std::min(worst, quality[p][pair_of(p, 0) == diagonal ? 0 : 1]);
-      if (worst > best + kTie) best = worst, chosen = diagonal;
+      if (worst > best) best = worst, chosen = diagonal;
     }
     for (std::size_t p : members) out.diagonal[p] = pair_of(p, 0) == chosen ? 0 : 1;
   }
